@@ -1,0 +1,1 @@
+"""Bundled data: scene files (`scenes/`) and the scene JSON Schema (`schema/`)."""

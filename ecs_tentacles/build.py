@@ -1,0 +1,116 @@
+"""Scene data -> entities: creatures, tentacles, links, suckers and goals.
+
+Takes a validated scene dict with defaults applied (`ecs_tentacles.scene.load`)
+and creates the entities with their components and store rows, posed by the
+construction rules (`ecs_tentacles.construction`). Physics is built afterwards,
+from these entities (`ecs_tentacles.physics.model`).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ecs_tentacles.components import Creature, Goal, Link, Motor, Sucker, Tentacle, Transform
+from ecs_tentacles.construction import tentacle_angles, tentacle_shape
+from ecs_tentacles.mathutil import quat_about_z, quat_rotate
+
+if TYPE_CHECKING:
+    from ecs_tentacles.world import World
+
+TENTACLE_FIELDS = ("links", "link_length", "link_radius", "end_scale", "strength", "damping")
+
+
+def tentacle_params(tentacles: dict[str, Any], index: int) -> dict[str, Any]:
+    """The creature-wide tentacle settings with tentacle `index`'s overrides applied."""
+    params = {key: tentacles[key] for key in tentacles if key != "overrides"}
+    for override in tentacles.get("overrides", []):
+        if override["index"] == index:
+            params.update({k: v for k, v in override.items() if k != "index"})
+    return params
+
+
+def resting_height(tentacles: dict[str, Any]) -> float:
+    """Base height that lets the thickest first link rest on the ground."""
+    radii = [tentacle_params(tentacles, k)["link_radius"] for k in range(tentacles["count"])]
+    return float(max(radii))
+
+
+def build_creature(world: World, spec: dict[str, Any]) -> int:
+    """Create one creature's entities from its scene entry; return the creature entity."""
+    mantle = spec["mantle"]
+    tentacles = spec["tentacles"]
+    position = list(spec["position"])
+    if len(position) == 2:
+        position.append(resting_height(tentacles))
+    origin = np.asarray(position, dtype=np.float64)
+    heading = np.radians(spec["heading_deg"])
+    turn = quat_about_z(heading)
+
+    creature = Creature(
+        name=spec["name"],
+        mantle_radius=mantle["radius"],
+        mantle_height=mantle["height"],
+        mantle_density=mantle["density"],
+    )
+    row = int(world.transforms.add(pos=origin + [0.0, 0.0, 0.5 * mantle["height"]], quat=turn)[0])
+    creature_entity = world.create_entity(creature, Transform(world.transforms, row))
+
+    for k, angle in enumerate(tentacle_angles(tentacles["count"])):
+        params = tentacle_params(tentacles, k)
+        tentacle = Tentacle(creature=creature_entity, index=k, base_angle=float(angle))
+        tentacle_entity = world.create_entity(tentacle)
+        creature.tentacles.append(tentacle_entity)
+        _build_links(world, tentacle, tentacle_entity, params, mantle["radius"], origin, heading)
+    for order, goal in enumerate(spec["goals"]):
+        point = list(goal["position"]) + ([0.0] if len(goal["position"]) == 2 else [])
+        world.create_entity(Goal(creature_entity, order, np.asarray(point, float), goal["radius"]))
+    return creature_entity
+
+
+def _build_links(
+    world: World,
+    tentacle: Tentacle,
+    tentacle_entity: int,
+    params: dict[str, Any],
+    mantle_radius: float,
+    origin: np.ndarray,
+    heading: float,
+) -> None:
+    shape = tentacle_shape(
+        mantle_radius, params["link_length"], params["link_radius"], params["links"], params["end_scale"]
+    )
+    angle = heading + tentacle.base_angle
+    quat = quat_about_z(angle)
+    axis = quat_rotate(quat, np.array([1.0, 0.0, 0.0]))
+    n = len(shape.scales)
+    rows = world.transforms.add(n, pos=origin + shape.centres[:, None] * axis, quat=quat)
+    motor_rows = world.motors.add(
+        n,
+        strength=params["strength"] * shape.scales,
+        damping=params["damping"] * shape.scales,
+        max_torque=params["max_torque"] * shape.scales,
+    )
+    limit = float(np.radians(params["joint_limit_deg"]))
+    for i in range(n):
+        link = Link(
+            tentacle=tentacle_entity,
+            index=i,
+            length=float(shape.lengths[i]),
+            radius=float(shape.radii[i]),
+            scale=float(shape.scales[i]),
+            density=params["density"],
+            joint_limit=limit,
+            twist=params["twist"],
+        )
+        entity = world.create_entity(
+            link, Transform(world.transforms, int(rows[i])), Motor(world.motors, int(motor_rows[i]))
+        )
+        tentacle.links.append(entity)
+    carriers = range(n) if params["suckers"] == "every_link" else [n - 1]
+    for i in carriers:
+        offset = (0.5 * shape.lengths[i], 0.0, -shape.radii[i])
+        sucker_row = int(world.suckers.add(link_row=rows[i], offset=offset)[0])
+        entity = world.create_entity(Sucker(world.suckers, sucker_row, tentacle.links[i]))
+        tentacle.suckers.append(entity)

@@ -1,0 +1,132 @@
+"""Components: plain dataclasses attached to esper entities.
+
+Numbers that systems touch every frame live in stores (`ecs_tentacles.store`); the
+components that expose them (`Transform`, `Motor`, `Sucker`) hold their store and
+row, and each field reads as a writable numpy view (vectors) or a float (scalars):
+
+    link.transform.pos[2] += 0.1        # writes into the TransformStore
+    motor.strength = 8.0                # reaches the servo on the next physics step
+
+Structural components (`Creature`, `Tentacle`, `Link`, `Goal`) are plain data fixed
+at construction. Components are never added or removed per frame.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ecs_tentacles.store import ArrayStore, MotorStore, SuckerStore, TransformStore
+
+
+class RowField:
+    """A component attribute that reads and writes one row of a store field."""
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        self.name = name
+
+    def __get__(self, component: Any, owner: type | None = None) -> Any:
+        if component is None:
+            return self
+        value = getattr(component.store, self.name)[component.row]
+        return value.item() if value.ndim == 0 else value
+
+    def __set__(self, component: Any, value: Any) -> None:
+        getattr(component.store, self.name)[component.row] = value
+
+
+@dataclass(eq=False)
+class _Row:
+    store: ArrayStore
+    row: int
+
+    def __repr__(self) -> str:
+        fields = ", ".join(
+            f"{f.name}={getattr(self, f.name)!r}" for f in type(self.store).fields()
+        )
+        return f"{type(self).__name__}(row={self.row}, {fields})"
+
+
+@dataclass(eq=False, repr=False)
+class Transform(_Row):
+    """World pose of a body: `pos` (3,) metres, `quat` (4,) unit quaternion (w, x, y, z)."""
+
+    store: TransformStore
+    pos = RowField()
+    quat = RowField()
+
+
+@dataclass(eq=False, repr=False)
+class Motor(_Row):
+    """A link's servo: `target` (curl, sweep, twist) radians, `strength` kp, `damping` kv."""
+
+    store: MotorStore
+    target = RowField()
+    strength = RowField()
+    damping = RowField()
+    max_torque = RowField()
+
+
+@dataclass(eq=False, repr=False)
+class Sucker(_Row):
+    """A sucker under a link: `offset` in the link frame, `attached`, world `anchor`."""
+
+    store: SuckerStore
+    link: int
+    link_row = RowField()
+    offset = RowField()
+    attached = RowField()
+    anchor = RowField()
+
+
+@dataclass(eq=False)
+class Creature:
+    """A creature: its mantle (a cylinder along +z) and its tentacles, counter-clockwise."""
+
+    name: str
+    mantle_radius: float
+    mantle_height: float
+    mantle_density: float
+    tentacles: list[int] = field(default_factory=list)
+
+
+@dataclass(eq=False)
+class Tentacle:
+    """Tentacle `index` of `creature`; its axis is +x rotated by `base_angle` about +z."""
+
+    creature: int
+    index: int
+    base_angle: float
+    links: list[int] = field(default_factory=list)
+    suckers: list[int] = field(default_factory=list)
+
+    @property
+    def axis(self) -> np.ndarray:
+        """Unit axis in the creature frame."""
+        return np.array([np.cos(self.base_angle), np.sin(self.base_angle), 0.0])
+
+
+@dataclass(eq=False)
+class Link:
+    """Link `index` of `tentacle`: a capsule along its local +x, `scale` of the first link."""
+
+    tentacle: int
+    index: int
+    length: float
+    radius: float
+    scale: float
+    density: float
+    joint_limit: float
+    twist: bool
+
+
+@dataclass(eq=False)
+class Goal:
+    """A place `owner` should reach: within `radius` of `position`; `order` in its path."""
+
+    owner: int
+    order: int
+    position: np.ndarray
+    radius: float

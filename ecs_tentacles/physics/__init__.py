@@ -1,0 +1,1 @@
+"""The MuJoCo backend: model building from entities, stepping and syncing."""

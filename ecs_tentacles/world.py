@@ -1,0 +1,216 @@
+"""The World: one esper context, the stores, the physics backend and the schedule.
+
+    world = World.from_scene("assets/scenes/octopus.json")
+    world.step(60)                       # one simulated second at 60 fps
+    octo = world.creature("octopus")
+    print(world.component(octo, Transform).pos)
+
+Each World owns its own esper context, so several worlds (tests, parallel bakes)
+live side by side; every World method switches to its context first.
+"""
+
+from __future__ import annotations
+
+import importlib
+import os
+import uuid
+from collections.abc import Iterator
+from dataclasses import dataclass
+from typing import Any, TypeVar
+
+import esper
+import numpy as np
+
+from ecs_tentacles.components import Creature
+from ecs_tentacles.events import Events
+from ecs_tentacles.physics.backend import PhysicsBackend
+from ecs_tentacles.schedule import Schedule
+from ecs_tentacles.store import MotorStore, SuckerStore, TransformStore
+from ecs_tentacles.system import System
+
+C = TypeVar("C")
+
+
+@dataclass(frozen=True)
+class Settings:
+    """The fixed-step clock and physics constants of a world."""
+
+    fps: float = 60.0
+    substeps: int = 8
+    gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)
+    ground_friction: float = 1.0
+    sucker_timeconst: float = 0.005
+
+    @property
+    def dt(self) -> float:
+        """Seconds per frame."""
+        return 1.0 / self.fps
+
+    @property
+    def substep_dt(self) -> float:
+        """Seconds per physics step (the MuJoCo timestep)."""
+        return 1.0 / (self.fps * self.substeps)
+
+
+class World:
+    """Entities, their stores, the physics and the systems that run each frame."""
+
+    def __init__(self, settings: Settings | None = None, *, seed: int = 0, name: str = "world"):
+        self.name = name
+        self.settings = settings or Settings()
+        self.seed = seed
+        self.rng = np.random.default_rng(seed)
+        self.context = f"ecs_tentacles:{name}:{uuid.uuid4().hex}"
+        esper.switch_world(self.context)
+        self.transforms = TransformStore()
+        self.motors = MotorStore()
+        self.suckers = SuckerStore()
+        self.schedule = Schedule()
+        self.events = Events()
+        self._physics: PhysicsBackend | None = None
+        self.frame = 0
+
+    # -- construction ------------------------------------------------------------------
+    @classmethod
+    def from_scene(
+        cls,
+        source: str | os.PathLike[str] | dict[str, Any],
+        *,
+        seed: int | None = None,
+        allow_systems: bool = False,
+    ) -> World:
+        """Build a world from a scene file or dict: validate, build entities, compile physics.
+
+        Raises `SceneError` (one line per problem) before anything is built. Systems the
+        scene names are imported only with `allow_systems=True`.
+        """
+        from ecs_tentacles.build import build_creature
+        from ecs_tentacles.scene.errors import SceneError
+        from ecs_tentacles.scene.load import load_scene
+        from ecs_tentacles.systems import builtin_systems
+
+        data = load_scene(source)
+        if data["systems"] and not allow_systems:  # checked before importing anything
+            raise SceneError(
+                [
+                    f"systems[{i}]: the scene asks to run {path!r}; allow it with --allow-systems"
+                    " (API: allow_systems=True)"
+                    for i, path in enumerate(data["systems"])
+                ]
+            )
+        extra = _import_systems(data["systems"])
+        physics = data["physics"]
+        settings = Settings(
+            fps=float(physics["fps"]),
+            substeps=int(physics["substeps"]),
+            gravity=tuple(float(g) for g in physics["gravity"]),  # type: ignore[arg-type]
+            ground_friction=float(physics["ground_friction"]),
+            sucker_timeconst=float(physics["sucker_timeconst"]),
+        )
+        world = cls(settings, seed=data["seed"] if seed is None else seed, name=data.get("name", "scene"))
+        world.scene = data
+        for creature in data["creatures"]:
+            build_creature(world, creature)
+        world.build_physics()
+        for system in builtin_systems() + [factory() for factory in extra]:
+            world.add_system(system)
+        return world
+
+    scene: dict[str, Any] | None = None
+
+    def build_physics(self) -> PhysicsBackend:
+        """Compile the MuJoCo model from the current entities and sync the Transform store."""
+        self.activate()
+        self._physics = PhysicsBackend(self)
+        self._physics.sync(self.transforms)
+        return self._physics
+
+    @property
+    def physics(self) -> PhysicsBackend:
+        if self._physics is None:
+            raise RuntimeError("this world has no physics yet: call world.build_physics()")
+        return self._physics
+
+    def add_system(self, system: System) -> System:
+        """Schedule `system` at the place it declares and call its `setup`."""
+        self.schedule.add(system)
+        system.setup(self)
+        return system
+
+    # -- running -----------------------------------------------------------------------
+    def step(self, frames: int = 1) -> None:
+        """Run `frames` fixed-duration frames: every system in schedule order."""
+        self.activate()
+        dt = self.settings.dt
+        for _ in range(frames):
+            for system in self.schedule:
+                system.process(self, dt)
+            self.frame += 1
+
+    @property
+    def time(self) -> float:
+        """Simulated seconds since the start."""
+        return self.frame * self.settings.dt
+
+    # -- entities ----------------------------------------------------------------------
+    def activate(self) -> None:
+        """Make this world's esper context the current one."""
+        if esper.current_world != self.context:
+            esper.switch_world(self.context)
+
+    def create_entity(self, *components: Any) -> int:
+        self.activate()
+        return esper.create_entity(*components)
+
+    def component(self, entity: int, kind: type[C]) -> C:
+        """The `kind` component of `entity` (KeyError if it has none)."""
+        self.activate()
+        return esper.component_for_entity(entity, kind)
+
+    def try_component(self, entity: int, kind: type[C]) -> C | None:
+        self.activate()
+        return esper.try_component(entity, kind)
+
+    def query(self, *kinds: type) -> Iterator[tuple[int, Any]]:
+        """(entity, component) or (entity, (components...)) for entities having all `kinds`."""
+        self.activate()
+        if len(kinds) == 1:
+            return iter(esper.get_component(kinds[0]))
+        return iter(esper.get_components(*kinds))
+
+    def creature(self, name: str) -> int:
+        """The entity of the creature called `name`."""
+        for entity, creature in self.query(Creature):
+            if creature.name == name:
+                return entity
+        names = ", ".join(c.name for _, c in self.query(Creature))
+        raise KeyError(f"no creature named {name!r}; this world has: {names}")
+
+    def close(self) -> None:
+        """Delete this world's esper context."""
+        if esper.current_world == self.context:
+            esper.switch_world("default")
+        if self.context in esper.list_worlds():
+            esper.delete_world(self.context)
+
+
+def _import_systems(paths: list[str]) -> list[type[System]]:
+    """Resolve 'package.module:Class' paths to System subclasses (only when allowed)."""
+    from ecs_tentacles.scene.errors import SceneError
+
+    found: list[type[System]] = []
+    problems: list[str] = []
+    for i, path in enumerate(paths):
+        module_name, _, attr = path.partition(":")
+        try:
+            factory = getattr(importlib.import_module(module_name), attr)
+        except (ImportError, AttributeError) as exc:
+            problems.append(f"systems[{i}]: cannot import {path!r}: {exc}")
+            continue
+        if not (isinstance(factory, type) and issubclass(factory, System)):
+            problems.append(f"systems[{i}]: {path!r} is not a System subclass")
+            continue
+        found.append(factory)
+    if problems:
+        raise SceneError(problems)
+    return found

@@ -1,0 +1,36 @@
+"""physics: steps MuJoCo one frame.
+
+Reads: Motor store (target, strength, damping, max_torque), Sucker store (attached,
+anchor). Writes: MjData (ctrl, eq_active), MjModel servo gains and sucker anchors,
+then advances `world.settings.substeps` steps. Systems that override
+`System.substep` run before every substep, in schedule order.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from ecs_tentacles.system import System
+
+if TYPE_CHECKING:
+    from ecs_tentacles.world import World
+
+
+class Physics(System):
+    name = "physics"
+
+    def process(self, world: World, dt: float) -> None:
+        backend = world.physics
+        backend.write_controls(world.motors)
+        backend.write_suckers(world.suckers)
+        hooks = world.schedule.substep_systems()
+        if not hooks:
+            backend.step(world.settings.substeps)
+            return
+        substep_dt = world.settings.substep_dt
+
+        def before_substep(index: int) -> None:
+            for system in hooks:
+                system.substep(world, index, substep_dt)
+
+        backend.step(world.settings.substeps, before_substep)

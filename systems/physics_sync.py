@@ -1,0 +1,22 @@
+"""physics_sync: copies body poses from MuJoCo into the Transform store.
+
+Reads: MjData.xpos, MjData.xquat. Writes: Transform store (pos, quat) of every
+mantle and link, in one gather per field.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from ecs_tentacles.system import System
+
+if TYPE_CHECKING:
+    from ecs_tentacles.world import World
+
+
+class PhysicsSync(System):
+    name = "physics_sync"
+    after = ("physics",)
+
+    def process(self, world: World, dt: float) -> None:
+        world.physics.sync(world.transforms)
