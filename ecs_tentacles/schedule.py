@@ -1,7 +1,7 @@
 """The frame's system order, resolved once from the names systems declare.
 
-`Schedule.names` is the one place the order can be read (and it is tested). Ties
-between systems with no constraint between them keep the order they were added in.
+`Schedule.names` is the one place the order can be read (and it is tested). Among the
+systems whose constraints are met, the one added earliest runs first.
 """
 
 from __future__ import annotations

@@ -21,7 +21,7 @@ from typing import Any, TypeVar
 import esper
 import numpy as np
 
-from ecs_tentacles.components import Creature
+from ecs_tentacles.components import Creature, Sucker
 from ecs_tentacles.events import Events
 from ecs_tentacles.physics.backend import PhysicsBackend
 from ecs_tentacles.schedule import Schedule
@@ -151,6 +151,28 @@ class World:
     def time(self) -> float:
         """Simulated seconds since the start."""
         return self.frame * self.settings.dt
+
+    # -- suckers ------------------------------------------------------------------------
+    def sucker_points(self) -> np.ndarray:
+        """World position (n, 3) of every sucker, by sucker row."""
+        return self.physics.sucker_points(self.suckers, self.transforms)
+
+    def attach(self, sucker_entity: int) -> None:
+        """Fix a sucker to the world where it is now; fires `sucker_attached`."""
+        sucker = self.component(sucker_entity, Sucker)
+        if sucker.attached:
+            return
+        sucker.anchor = self.sucker_points()[sucker.row]
+        sucker.attached = True
+        self.events.emit("sucker_attached", world=self, sucker=sucker_entity, anchor=sucker.anchor.copy())
+
+    def release(self, sucker_entity: int, reason: str = "command") -> None:
+        """Let a sucker go; fires `sucker_released` with the `reason`."""
+        sucker = self.component(sucker_entity, Sucker)
+        if not sucker.attached:
+            return
+        sucker.attached = False
+        self.events.emit("sucker_released", world=self, sucker=sucker_entity, reason=reason)
 
     # -- entities ----------------------------------------------------------------------
     def activate(self) -> None:

@@ -1,0 +1,243 @@
+"""Validate scene data against the bundled JSON Schema and a few semantic rules.
+
+Every problem is one line ``"<json path>: <message>"``; paths look like
+``creatures[1].tentacles.end_scale`` and the root itself is called ``scene``.
+"""
+
+from __future__ import annotations
+
+import copy
+import functools
+import importlib.resources
+import json
+import math
+import re
+from collections.abc import Iterable, Mapping, Sequence
+from typing import Any
+
+from jsonschema import Draft202012Validator, ValidationError
+
+JsonPath = tuple[str | int, ...]
+Problem = tuple[JsonPath, str]
+
+_IDENT = re.compile(r"^[A-Za-z_$][A-Za-z0-9_$]*$")
+_TYPE_NAMES = {
+    "number": "a number",
+    "integer": "an integer",
+    "string": "a string",
+    "boolean": "a boolean",
+    "object": "an object",
+    "array": "an array",
+    "null": "null",
+}
+_MAX_SHOWN = 60
+
+
+@functools.cache
+def load_schema() -> dict[str, Any]:
+    """Return the scene JSON Schema bundled with the package (parsed once, then cached)."""
+    resource = importlib.resources.files("ecs_tentacles.assets") / "schema" / "scene.schema.json"
+    schema: dict[str, Any] = json.loads(resource.read_text(encoding="utf-8"))
+    return schema
+
+
+@functools.cache
+def _validator() -> Draft202012Validator:
+    return Draft202012Validator(load_schema())
+
+
+def format_path(path: Iterable[str | int]) -> str:
+    """Format a path such as ``("creatures", 1, "name")`` as ``creatures[1].name``."""
+    out = ""
+    for part in path:
+        if isinstance(part, int):
+            out += f"[{part}]"
+        elif _IDENT.match(part):
+            out += f".{part}" if out else part
+        else:
+            out += f"[{json.dumps(part)}]"
+    return out or "scene"
+
+
+def _show(value: object) -> str:
+    """JSON text of a value, shortened so a problem stays one readable line."""
+    try:
+        text = json.dumps(value)
+    except (TypeError, ValueError):
+        text = repr(value)
+    return text if len(text) <= _MAX_SHOWN else text[: _MAX_SHOWN - 3] + "..."
+
+
+def _range(schema: Mapping[str, Any]) -> str:
+    """Describe every numeric bound of ``schema``: ``in (0, 1]``, ``>= 1`` or ``< 5``."""
+    low: tuple[str, Any] | None = None
+    high: tuple[str, Any] | None = None
+    if "exclusiveMinimum" in schema:
+        low = ("(", schema["exclusiveMinimum"])
+    elif "minimum" in schema:
+        low = ("[", schema["minimum"])
+    if "exclusiveMaximum" in schema:
+        high = (")", schema["exclusiveMaximum"])
+    elif "maximum" in schema:
+        high = ("]", schema["maximum"])
+    if low and high:
+        return f"in {low[0]}{_show(low[1])}, {_show(high[1])}{high[0]}"
+    if low:
+        return f"{'>' if low[0] == '(' else '>='} {_show(low[1])}"
+    assert high is not None
+    return f"{'<' if high[0] == ')' else '<='} {_show(high[1])}"
+
+
+def _count_bounds(schema: Mapping[str, Any], unit: str) -> str:
+    """Describe minItems/maxItems-style bounds: ``2 to 3 items``, ``at least 1 item``."""
+    low, high = schema.get(f"min{unit}"), schema.get(f"max{unit}")
+    noun = "items" if unit == "Items" else "characters"
+    if low is not None and high is not None:
+        return f"exactly {low} {noun}" if low == high else f"{low} to {high} {noun}"
+    return f"at least {low} {noun}" if low is not None else f"at most {high} {noun}"
+
+
+def _describe(error: ValidationError) -> list[Problem]:
+    """Turn one jsonschema error into human one-line problems (with their paths)."""
+    path: JsonPath = tuple(error.absolute_path)
+    schema: Mapping[str, Any] = error.schema if isinstance(error.schema, Mapping) else {}
+    value: Any = error.instance
+    expected: Any = error.validator_value
+    kind = error.validator
+    got = f"got {_show(value)}"
+    if kind == "type":
+        names = [expected] if isinstance(expected, str) else list(expected)
+        return [(path, f"must be {' or '.join(_TYPE_NAMES.get(t, t) for t in names)}, {got}")]
+    if kind in ("minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum"):
+        return [(path, f"must be {_range(schema)}, {got}")]
+    if kind == "additionalProperties" and isinstance(value, Mapping):
+        allowed = sorted(schema.get("properties", {}))
+        extra = [key for key in value if key not in allowed]
+        hint = f"unknown key (allowed: {', '.join(allowed)})"
+        return [((*path, key), hint) for key in extra]
+    if kind == "required" and isinstance(value, Mapping):
+        return [((*path, key), "is required") for key in expected if key not in value]
+    if kind == "enum":
+        options = ", ".join(_show(option) for option in expected)
+        return [(path, f"must be one of {options}, {got}")]
+    if kind == "const":
+        return [(path, f"must be {_show(expected)}, {got}")]
+    if kind in ("minItems", "maxItems") and isinstance(value, list):
+        return [(path, f"must have {_count_bounds(schema, 'Items')}, got {len(value)}")]
+    if kind in ("minLength", "maxLength") and isinstance(value, str):
+        return [(path, f"must have {_count_bounds(schema, 'Length')}, got {len(value)}")]
+    if kind == "pattern":
+        hint = schema.get("x-hint") or f"text matching {expected}"
+        return [(path, f"must be {hint}, {got}")]
+    return [(path, " ".join(error.message.split()))]
+
+
+def _path_key(problem: Problem) -> tuple[tuple[tuple[int, int | str], ...], str]:
+    """Sort key: paths compared part by part (indices numerically), then the message."""
+    parts = tuple((0, p) if isinstance(p, int) else (1, p) for p in problem[0])
+    return parts, problem[1]
+
+
+def _semantic_problems(scene: Mapping[str, Any]) -> list[Problem]:
+    """Rules the schema cannot express; ``scene`` is schema-valid with defaults applied."""
+    problems: list[Problem] = []
+    creatures: Sequence[Mapping[str, Any]] = scene["creatures"]
+    seen_names: dict[str, int] = {}
+    for i, creature in enumerate(creatures):
+        name = creature["name"]
+        if name in seen_names:
+            first = format_path(("creatures", seen_names[name]))
+            problems.append(
+                (("creatures", i, "name"), f"duplicate name {_show(name)} (also {first})")
+            )
+        else:
+            seen_names[name] = i
+        tentacles = creature["tentacles"]
+        count = tentacles["count"]
+        seen_indices: dict[int, int] = {}
+        for j, override in enumerate(tentacles["overrides"]):
+            where: JsonPath = ("creatures", i, "tentacles", "overrides", j, "index")
+            index = override["index"]
+            if index >= count:
+                problems.append((where, f"must be < count ({count}), got {index}"))
+            if index in seen_indices:
+                first = format_path(("creatures", i, "tentacles", "overrides", seen_indices[index]))
+                problems.append((where, f"duplicate index {index} (also {first})"))
+            else:
+                seen_indices[index] = j
+    for j, later in enumerate(creatures):
+        for i, earlier in enumerate(creatures[:j]):
+            (x1, y1), (x2, y2) = earlier["position"][:2], later["position"][:2]
+            reach = earlier["mantle"]["radius"] + later["mantle"]["radius"]
+            if math.hypot(x2 - x1, y2 - y1) < reach:
+                problems.append((("creatures", j, "position"), f"mantle overlaps creatures[{i}]'s"))
+    return problems
+
+
+def validate_scene(data: object) -> list[str]:
+    """Return every problem of ``data`` as a scene, sorted by JSON path; ``[]`` if it is valid.
+
+    Each problem is one line ``"<json path>: <message>"``. Semantic rules (override
+    indices, unique names, overlapping mantles) are checked only once the schema passes.
+    """
+    errors = list(_validator().iter_errors(data))
+    # A value of the wrong type (0.5 for an integer) may fail its range too: report the type.
+    mistyped = {tuple(e.absolute_path) for e in errors if e.validator == "type"}
+    problems = [
+        problem
+        for error in errors
+        if error.validator == "type" or tuple(error.absolute_path) not in mistyped
+        for problem in _describe(error)
+    ]
+    if not problems and isinstance(data, dict):
+        problems = _semantic_problems(with_defaults(data))
+    unique = sorted(set(problems), key=_path_key)
+    return [f"{format_path(path)}: {message}" for path, message in unique]
+
+
+def _resolve(schema: Mapping[str, Any], root: Mapping[str, Any]) -> Mapping[str, Any]:
+    """Follow local ``$ref``s; keywords beside a ``$ref`` (like ``default``) win."""
+    seen: set[str] = set()
+    while isinstance(schema.get("$ref"), str) and schema["$ref"] not in seen:
+        ref: str = schema["$ref"]
+        seen.add(ref)
+        target: Any = root
+        for part in ref.removeprefix("#").strip("/").split("/"):
+            if part:
+                target = target[part.replace("~1", "/").replace("~0", "~")]
+        schema = {**target, **{k: v for k, v in schema.items() if k != "$ref"}}
+    return schema
+
+
+def _fill(value: Any, schema: Mapping[str, Any], root: Mapping[str, Any]) -> None:
+    """Fill schema defaults into ``value`` in place, recursing into objects and arrays."""
+    schema = _resolve(schema, root)
+    if isinstance(value, dict):
+        for key, sub in schema.get("properties", {}).items():
+            sub = _resolve(sub, root)
+            if key not in value and "default" in sub:
+                value[key] = copy.deepcopy(sub["default"])
+            if key in value:
+                _fill(value[key], sub, root)
+    elif isinstance(value, list) and isinstance(schema.get("items"), Mapping):
+        for item in value:
+            _fill(item, schema["items"], root)
+
+
+def with_defaults(data: dict[str, Any]) -> dict[str, Any]:
+    """Return a deep copy of ``data`` with every schema ``default`` filled in.
+
+    Works recursively through nested objects (objects defaulting to ``{}`` get their own
+    defaults too), array items and ``$ref``s. Creatures without a name are called
+    ``creature_<index>``. Optional fields without a default stay absent; ``data`` is
+    not modified.
+    """
+    result = copy.deepcopy(data)
+    schema = load_schema()
+    _fill(result, schema, schema)
+    creatures = result.get("creatures")
+    if isinstance(creatures, list):
+        for i, creature in enumerate(creatures):
+            if isinstance(creature, dict):
+                creature.setdefault("name", f"creature_{i}")
+    return result

@@ -1,0 +1,33 @@
+"""Shared fixtures: fresh worlds from small scenes, closed after each test."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator
+from typing import Any
+
+import pytest
+
+from ecs_tentacles.world import World
+
+
+def creature_scene(**tentacles: Any) -> dict[str, Any]:
+    """A one-creature scene dict with the given tentacle settings."""
+    return {
+        "version": 1,
+        "creatures": [{"name": "octo", "position": [0, 0], "tentacles": tentacles}],
+    }
+
+
+@pytest.fixture
+def make_world() -> Iterator[Callable[..., World]]:
+    """Build worlds from scene dicts; every world is closed at the end of the test."""
+    worlds: list[World] = []
+
+    def make(scene: dict[str, Any], **kwargs: Any) -> World:
+        world = World.from_scene(scene, **kwargs)
+        worlds.append(world)
+        return world
+
+    yield make
+    for world in worlds:
+        world.close()

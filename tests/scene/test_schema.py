@@ -1,0 +1,139 @@
+"""The bundled scene schema, and with_defaults filling in the defaults it declares."""
+
+from __future__ import annotations
+
+import copy
+from collections.abc import Iterator
+from typing import Any
+
+from jsonschema import Draft202012Validator
+
+from ecs_tentacles.scene.validate import load_schema, validate_scene, with_defaults
+
+
+def subschemas(node: Any, where: str = "#") -> Iterator[tuple[str, dict[str, Any]]]:
+    """Every schema object under ``node`` (properties, items, $defs, ...), with a pointer."""
+    if not isinstance(node, dict):
+        return
+    yield where, node
+    for key in ("properties", "$defs"):
+        for name, sub in node.get(key, {}).items():
+            yield from subschemas(sub, f"{where}/{key}/{name}")
+    for key in ("items", "additionalProperties"):
+        yield from subschemas(node.get(key), f"{where}/{key}")
+
+
+def test_schema_is_a_valid_draft_2020_12_schema() -> None:
+    Draft202012Validator.check_schema(load_schema())
+
+
+def test_schema_is_loaded_once() -> None:
+    assert load_schema() is load_schema()
+
+
+def test_every_object_forbids_unknown_keys() -> None:
+    objects = [(where, s) for where, s in subschemas(load_schema()) if s.get("type") == "object"]
+    assert len(objects) >= 7
+    loose = [where for where, s in objects if s.get("additionalProperties") is not False]
+    assert loose == []
+
+
+def test_every_pattern_has_a_hint() -> None:
+    missing = [
+        where for where, s in subschemas(load_schema()) if "pattern" in s and "x-hint" not in s
+    ]
+    assert missing == []
+
+
+def test_every_default_is_valid_for_its_own_schema() -> None:
+    schema = load_schema()
+    checked = 0
+    for where, sub in subschemas(schema):
+        if "default" in sub:
+            resolved = {**sub, "$defs": schema["$defs"]}
+            errors = list(Draft202012Validator(resolved).iter_errors(sub["default"]))
+            assert errors == [], where
+            checked += 1
+    assert checked >= 20
+
+
+def test_with_defaults_fills_nested_defaults_exactly() -> None:
+    data = {
+        "version": 1,
+        "creatures": [
+            {"goals": [{"position": [1, 2]}], "tentacles": {"overrides": [{"index": 1}]}}
+        ],
+    }
+    original = copy.deepcopy(data)
+    full = with_defaults(data)
+    assert data == original
+    assert full == {
+        "version": 1,
+        "seed": 0,
+        "physics": {
+            "fps": 60,
+            "substeps": 8,
+            "gravity": [0, 0, -9.81],
+            "ground_friction": 1.0,
+            "sucker_timeconst": 0.005,
+        },
+        "systems": [],
+        "creatures": [
+            {
+                "name": "creature_0",
+                "position": [0, 0],
+                "heading_deg": 0,
+                "mantle": {"radius": 0.15, "height": 0.2, "density": 400},
+                "tentacles": {
+                    "count": 8,
+                    "links": 10,
+                    "link_length": 0.07,
+                    "link_radius": 0.025,
+                    "end_scale": 0.3,
+                    "density": 1000,
+                    "strength": 4.0,
+                    "damping": 0.1,
+                    "max_torque": 20.0,
+                    "joint_limit_deg": 60,
+                    "twist": False,
+                    "suckers": "tip",
+                    "overrides": [{"index": 1}],
+                },
+                "goals": [{"position": [1, 2], "radius": 0.3}],
+            }
+        ],
+    }
+
+
+def test_with_defaults_keeps_given_values_and_names() -> None:
+    data = {
+        "version": 1,
+        "creatures": [{"name": "octo"}, {"tentacles": {"end_scale": 0.5}}],
+        "physics": {"substeps": 2},
+    }
+    full = with_defaults(data)
+    assert [c["name"] for c in full["creatures"]] == ["octo", "creature_1"]
+    assert full["creatures"][1]["tentacles"]["end_scale"] == 0.5
+    assert full["creatures"][0]["tentacles"]["end_scale"] == 0.3
+    assert full["creatures"][0]["tentacles"]["overrides"] == []
+    assert full["physics"] == {
+        "fps": 60,
+        "substeps": 2,
+        "gravity": [0, 0, -9.81],
+        "ground_friction": 1.0,
+        "sucker_timeconst": 0.005,
+    }
+
+
+def test_with_defaults_copies_defaults() -> None:
+    first = with_defaults({"version": 1})
+    first["physics"]["gravity"].append(1)
+    first["creatures"].append({})
+    assert with_defaults({"version": 1})["physics"]["gravity"] == [0, 0, -9.81]
+    assert with_defaults({"version": 1})["creatures"] == []
+
+
+def test_with_defaults_result_is_valid() -> None:
+    full = with_defaults({"version": 1, "creatures": [{}, {"position": [1, 0]}]})
+    assert validate_scene(full) == []
+    assert with_defaults(full) == full

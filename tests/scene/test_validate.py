@@ -1,0 +1,284 @@
+"""Exact one-line messages of validate_scene (with_defaults is tested in test_schema.py)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import pytest
+
+from ecs_tentacles.scene.validate import format_path, validate_scene
+
+TENTACLE_KEYS = (
+    "count, damping, density, end_scale, joint_limit_deg, link_length, link_radius, links, "
+    "max_torque, overrides, strength, suckers, twist"
+)
+TOP_KEYS = "$schema, creatures, description, name, physics, seed, systems, version"
+CREATURE_KEYS = "goals, heading_deg, mantle, name, position, tentacles"
+
+
+def scene(*creatures: dict[str, Any], **top: Any) -> dict[str, Any]:
+    """A version-1 scene with the given creatures (spread far apart unless positioned)."""
+    placed = [{"position": [3 * i, 0], **c} for i, c in enumerate(creatures)]
+    return {"version": 1, **({"creatures": placed} if creatures else {}), **top}
+
+
+def tentacles(**fields: Any) -> dict[str, Any]:
+    """A creature whose tentacles have the given fields."""
+    return {"tentacles": fields}
+
+
+BAD_SCENES: list[tuple[str, object, str]] = [
+    ("version missing", {}, "version: is required"),
+    ("version 2", {"version": 2}, "version: must be 1, got 2"),
+    ("version as text", {"version": "1"}, 'version: must be 1, got "1"'),
+    (
+        "unknown top-level key",
+        scene(colour="red"),
+        f"colour: unknown key (allowed: {TOP_KEYS})",
+    ),
+    (
+        "unknown creature key",
+        scene({"legs": 8}),
+        f"creatures[0].legs: unknown key (allowed: {CREATURE_KEYS})",
+    ),
+    (
+        "unknown tentacles key",
+        scene(tentacles(lenght=2)),
+        f"creatures[0].tentacles.lenght: unknown key (allowed: {TENTACLE_KEYS})",
+    ),
+    (
+        "unknown override key",
+        scene(tentacles(overrides=[{"index": 0, "colour": "red"}])),
+        "creatures[0].tentacles.overrides[0].colour: unknown key (allowed: damping, end_scale, "
+        "index, link_length, link_radius, links, strength)",
+    ),
+    (
+        "end_scale 1.7",
+        scene({}, tentacles(end_scale=1.7)),
+        "creatures[1].tentacles.end_scale: must be in (0, 1], got 1.7",
+    ),
+    (
+        "end_scale 0",
+        scene(tentacles(end_scale=0)),
+        "creatures[0].tentacles.end_scale: must be in (0, 1], got 0",
+    ),
+    (
+        "links 0",
+        scene(tentacles(links=0)),
+        "creatures[0].tentacles.links: must be in [1, 64], got 0",
+    ),
+    (
+        "count 0",
+        scene(tentacles(count=0)),
+        "creatures[0].tentacles.count: must be in [1, 16], got 0",
+    ),
+    (
+        "negative link_length",
+        scene(tentacles(link_length=-0.05)),
+        "creatures[0].tentacles.link_length: must be in (0, 10], got -0.05",
+    ),
+    (
+        "link_radius as string",
+        scene(tentacles(link_radius="abc")),
+        'creatures[0].tentacles.link_radius: must be a number, got "abc"',
+    ),
+    (
+        "twist as string",
+        scene(tentacles(twist="yes")),
+        'creatures[0].tentacles.twist: must be a boolean, got "yes"',
+    ),
+    (
+        "position with 4 numbers",
+        scene({"position": [1, 2, 3, 4]}),
+        "creatures[0].position: must have 2 to 3 items, got 4",
+    ),
+    (
+        "gravity with 2 items",
+        scene(physics={"gravity": [0, -9.81]}),
+        "physics.gravity: must have exactly 3 items, got 2",
+    ),
+    ("fps 0", scene(physics={"fps": 0}), "physics.fps: must be in (0, 1000], got 0"),
+    ("fps true", scene(physics={"fps": True}), "physics.fps: must be a number, got true"),
+    (
+        "substeps 0.5",
+        scene(physics={"substeps": 0.5}),
+        "physics.substeps: must be an integer, got 0.5",
+    ),
+    ("physics a list", scene(physics=[1, 2]), "physics: must be an object, got [1, 2]"),
+    ("seed -1", scene(seed=-1), "seed: must be >= 0, got -1"),
+    (
+        "heading 400",
+        scene({"heading_deg": 400}),
+        "creatures[0].heading_deg: must be in [-360, 360], got 400",
+    ),
+    (
+        "override index out of range",
+        scene({}, tentacles(overrides=[{"index": 1}, {"index": 9}])),
+        "creatures[1].tentacles.overrides[1].index: must be < count (8), got 9",
+    ),
+    (
+        "override index equal to a lowered count",
+        scene(tentacles(count=4, overrides=[{"index": 4}])),
+        "creatures[0].tentacles.overrides[0].index: must be < count (4), got 4",
+    ),
+    (
+        "override index negative",
+        scene(tentacles(overrides=[{"index": -1}])),
+        "creatures[0].tentacles.overrides[0].index: must be >= 0, got -1",
+    ),
+    (
+        "override without index",
+        scene(tentacles(overrides=[{"links": 3}])),
+        "creatures[0].tentacles.overrides[0].index: is required",
+    ),
+    (
+        "duplicate override index",
+        scene(tentacles(overrides=[{"index": 2}, {"index": 3}, {"index": 2, "links": 4}])),
+        "creatures[0].tentacles.overrides[2].index: duplicate index 2 "
+        "(also creatures[0].tentacles.overrides[0])",
+    ),
+    (
+        "duplicate creature names",
+        scene({"name": "octo"}, {"name": "squid"}, {"name": "octo"}),
+        'creatures[2].name: duplicate name "octo" (also creatures[0])',
+    ),
+    (
+        "explicit name clashes with a default name",
+        scene({"name": "creature_1"}, {}),
+        'creatures[1].name: duplicate name "creature_1" (also creatures[0])',
+    ),
+    (
+        "overlapping creatures",
+        scene({"position": [0, 0]}, {"position": [0.2, 0.1]}),
+        "creatures[1].position: mantle overlaps creatures[0]'s",
+    ),
+    (
+        "overlap ignores z and uses each mantle radius",
+        scene({"position": [0, 0, 0]}, {"position": [1, 0, 5], "mantle": {"radius": 0.9}}),
+        "creatures[1].position: mantle overlaps creatures[0]'s",
+    ),
+    (
+        "goal radius 0",
+        scene({"goals": [{"position": [1, 1], "radius": 0}]}),
+        "creatures[0].goals[0].radius: must be in (0, 1000], got 0",
+    ),
+    (
+        "goal without position",
+        scene({"goals": [{"position": [1, 1]}, {"radius": 0.5}]}),
+        "creatures[0].goals[1].position: is required",
+    ),
+    (
+        'suckers "all"',
+        scene(tentacles(suckers="all")),
+        'creatures[0].tentacles.suckers: must be one of "tip", "every_link", got "all"',
+    ),
+    (
+        "bad systems import path",
+        scene(systems=["os.system('rm -rf /')"]),
+        "systems[0]: must be an import path 'package.module:ClassName', "
+        "got \"os.system('rm -rf /')\"",
+    ),
+    ("creatures not an array", scene(creatures={}), "creatures: must be an array, got {}"),
+    (
+        "name with a space",
+        scene({"name": "my octo"}),
+        "creatures[0].name: must be letters, digits and _, not starting with a digit, "
+        'got "my octo"',
+    ),
+    (
+        "name starting with a digit",
+        scene({"name": "8arms"}),
+        'creatures[0].name: must be letters, digits and _, not starting with a digit, got "8arms"',
+    ),
+    ("top level a list", [1, 2], "scene: must be an object, got [1, 2]"),
+    ("top level null", None, "scene: must be an object, got null"),
+]
+
+
+@pytest.mark.parametrize(
+    ("data", "expected"),
+    [pytest.param(data, expected, id=name) for name, data, expected in BAD_SCENES],
+)
+def test_bad_scene_gives_one_exact_problem(data: object, expected: str) -> None:
+    assert validate_scene(data) == [expected]
+
+
+def test_bad_scene_names_are_distinct() -> None:
+    assert len({name for name, _, _ in BAD_SCENES}) == len(BAD_SCENES) >= 18
+
+
+def test_minimal_scene_is_valid() -> None:
+    assert validate_scene({"version": 1}) == []
+
+
+def test_full_scene_is_valid() -> None:
+    data = scene(
+        {"name": "octo", "tentacles": {"count": 6, "overrides": [{"index": 5, "links": 3}]}},
+        {"goals": [{"position": [1, 2, 0.5], "radius": 1}], "mantle": {"radius": 0.2}},
+        systems=["my_pkg.systems:Wiggle"],
+        physics={"gravity": [0, 0, -1.6], "substeps": 4},
+        seed=7,
+    )
+    assert validate_scene(data) == []
+
+
+def test_touching_mantles_do_not_overlap() -> None:
+    assert validate_scene(scene({"position": [0, 0]}, {"position": [0.3, 0]})) == []
+
+
+def test_many_problems_are_all_reported_sorted_by_path() -> None:
+    creatures: list[dict[str, Any]] = [{} for _ in range(11)]
+    creatures[10] = tentacles(count=0)
+    creatures[2] = {"name": "my octo", "tentacles": {"end_scale": 1.7, "lenght": 1}}
+    data = scene(*creatures, physics={"fps": 0, "substeps": 0.5}, colour="red", seed=-1)
+    del data["version"]
+    assert validate_scene(data) == [
+        f"colour: unknown key (allowed: {TOP_KEYS})",
+        "creatures[2].name: must be letters, digits and _, not starting with a digit, "
+        'got "my octo"',
+        "creatures[2].tentacles.end_scale: must be in (0, 1], got 1.7",
+        f"creatures[2].tentacles.lenght: unknown key (allowed: {TENTACLE_KEYS})",
+        "creatures[10].tentacles.count: must be in [1, 16], got 0",
+        "physics.fps: must be in (0, 1000], got 0",
+        "physics.substeps: must be an integer, got 0.5",
+        "seed: must be >= 0, got -1",
+        "version: is required",
+    ]
+
+
+def test_many_semantic_problems_are_all_reported_sorted() -> None:
+    data = scene(
+        {"name": "a", "position": [0, 0], "tentacles": {"overrides": [{"index": 8}, {"index": 8}]}},
+        {"name": "a", "position": [0.1, 0]},
+        {"name": "b", "position": [0, 0.1]},
+    )
+    assert validate_scene(data) == [
+        "creatures[0].tentacles.overrides[0].index: must be < count (8), got 8",
+        "creatures[0].tentacles.overrides[1].index: duplicate index 8 "
+        "(also creatures[0].tentacles.overrides[0])",
+        "creatures[0].tentacles.overrides[1].index: must be < count (8), got 8",
+        'creatures[1].name: duplicate name "a" (also creatures[0])',
+        "creatures[1].position: mantle overlaps creatures[0]'s",
+        "creatures[2].position: mantle overlaps creatures[0]'s",
+        "creatures[2].position: mantle overlaps creatures[1]'s",
+    ]
+
+
+def test_semantic_checks_wait_for_the_schema() -> None:
+    data = scene({"name": "a"}, {"name": "a", "tentacles": {"end_scale": 2}})
+    assert validate_scene(data) == ["creatures[1].tentacles.end_scale: must be in (0, 1], got 2"]
+
+
+def test_long_values_are_shortened_to_one_line() -> None:
+    (problem,) = validate_scene(list(range(100)))
+    shown = "[0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16..."
+    assert problem == f"scene: must be an object, got {shown}"
+
+
+def test_format_path() -> None:
+    assert format_path([]) == "scene"
+    assert format_path(["creatures", 1, "tentacles", "end_scale"]) == (
+        "creatures[1].tentacles.end_scale"
+    )
+    assert format_path(["$schema"]) == "$schema"
+    assert format_path(["my key", 0]) == '["my key"][0]'

@@ -1,0 +1,58 @@
+"""Stores are contiguous arrays; components read and write them in place."""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.testing import assert_array_equal
+
+from ecs_tentacles.components import Motor, Transform
+from ecs_tentacles.store import MotorStore, TransformStore
+
+
+def test_rows_get_defaults_then_values() -> None:
+    store = TransformStore(capacity=2)
+    rows = store.add(3, pos=[1.0, 2.0, 3.0])
+    assert_array_equal(rows, [0, 1, 2])
+    assert_array_equal(store.pos, [[1, 2, 3]] * 3)
+    assert_array_equal(store.quat, [[1, 0, 0, 0]] * 3)
+    assert store.pos.flags["C_CONTIGUOUS"]
+
+
+def test_component_fields_are_views_into_the_store() -> None:
+    store = TransformStore()
+    store.add(2)
+    transform = Transform(store, 1)
+    transform.pos[2] += 0.5
+    transform.quat = [0.0, 1.0, 0.0, 0.0]
+    assert_array_equal(store.pos[1], [0, 0, 0.5])
+    assert_array_equal(store.quat[1], [0, 1, 0, 0])
+    store.pos[1, 0] = 7.0
+    assert transform.pos[0] == 7.0
+
+
+def test_scalar_fields_read_as_floats_and_write_through() -> None:
+    store = MotorStore()
+    store.add(2, strength=[3.0, 4.0])
+    motor = Motor(store, 1)
+    assert isinstance(motor.strength, float) and motor.strength == 4.0
+    motor.strength = 8.0
+    assert_array_equal(store.strength, [3.0, 8.0])
+
+
+def test_growth_keeps_rows_and_components_follow() -> None:
+    store = TransformStore(capacity=1)
+    store.add(1, pos=[1.0, 1.0, 1.0])
+    transform = Transform(store, 0)
+    store.add(100)
+    assert store.capacity >= 101 and len(store) == 101
+    transform.pos[0] = 5.0
+    assert store.pos[0, 0] == 5.0
+    assert_array_equal(store.pos[1:], np.zeros((100, 3)))
+
+
+def test_whole_array_math_on_live_rows() -> None:
+    store = MotorStore(capacity=64)
+    store.add(3, strength=2.0)
+    store.strength *= 1.5
+    assert_array_equal(store.strength, [3.0, 3.0, 3.0])
+    assert len(store.strength) == 3
