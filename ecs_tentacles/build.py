@@ -54,7 +54,8 @@ def build_creature(world: World, spec: dict[str, Any]) -> int:
         mantle_height=mantle["height"],
         mantle_density=mantle["density"],
     )
-    row = int(world.transforms.add(pos=origin + [0.0, 0.0, 0.5 * mantle["height"]], quat=turn)[0])
+    centre = origin + np.array([0.0, 0.0, 0.5 * mantle["height"]])
+    row = int(world.transforms.add(pos=centre, quat=turn)[0])
     creature_entity = world.create_entity(creature, Transform(world.transforms, row))
 
     for k, angle in enumerate(tentacle_angles(tentacles["count"])):
@@ -79,7 +80,11 @@ def _build_links(
     heading: float,
 ) -> None:
     shape = tentacle_shape(
-        mantle_radius, params["link_length"], params["link_radius"], params["links"], params["end_scale"]
+        mantle_radius,
+        params["link_length"],
+        params["link_radius"],
+        params["links"],
+        params["end_scale"],
     )
     angle = heading + tentacle.base_angle
     quat = quat_about_z(angle)

@@ -43,9 +43,7 @@ class _Row:
     row: int
 
     def __repr__(self) -> str:
-        fields = ", ".join(
-            f"{f.name}={getattr(self, f.name)!r}" for f in type(self.store).fields()
-        )
+        fields = ", ".join(f"{f.name}={getattr(self, f.name)!r}" for f in type(self.store).fields())
         return f"{type(self).__name__}(row={self.row}, {fields})"
 
 

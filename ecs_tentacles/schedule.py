@@ -71,11 +71,15 @@ def _resolve(systems: list[System]) -> list[System]:
     for s in systems:
         for other in s.after:
             if other not in by_name:
-                raise ScheduleError(f"system {s.name!r} runs after {other!r}, which is not scheduled")
+                raise ScheduleError(
+                    f"system {s.name!r} runs after {other!r}, which is not scheduled"
+                )
             preds[s.name].add(other)
         for other in s.before:
             if other not in by_name:
-                raise ScheduleError(f"system {s.name!r} runs before {other!r}, which is not scheduled")
+                raise ScheduleError(
+                    f"system {s.name!r} runs before {other!r}, which is not scheduled"
+                )
             preds[other].add(s.name)
     ordered: list[System] = []
     placed: set[str] = set()

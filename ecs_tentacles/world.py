@@ -107,7 +107,9 @@ class World:
             ground_friction=float(physics["ground_friction"]),
             sucker_timeconst=float(physics["sucker_timeconst"]),
         )
-        world = cls(settings, seed=data["seed"] if seed is None else seed, name=data.get("name", "scene"))
+        world = cls(
+            settings, seed=data["seed"] if seed is None else seed, name=data.get("name", "scene")
+        )
         world.scene = data
         for creature in data["creatures"]:
             build_creature(world, creature)
@@ -164,7 +166,9 @@ class World:
             return
         sucker.anchor = self.sucker_points()[sucker.row]
         sucker.attached = True
-        self.events.emit("sucker_attached", world=self, sucker=sucker_entity, anchor=sucker.anchor.copy())
+        self.events.emit(
+            "sucker_attached", world=self, sucker=sucker_entity, anchor=sucker.anchor.copy()
+        )
 
     def release(self, sucker_entity: int, reason: str = "command") -> None:
         """Let a sucker go; fires `sucker_released` with the `reason`."""

@@ -9,9 +9,10 @@ writes; `World.schedule.names` shows the resolved order, user systems included):
 
 from __future__ import annotations
 
-from ecs_tentacles.system import System
 from ecs_tentacles.systems.physics import Physics
 from ecs_tentacles.systems.physics_sync import PhysicsSync
+
+from ecs_tentacles.system import System
 
 __all__ = ["Physics", "PhysicsSync", "builtin_systems"]
 

@@ -25,7 +25,9 @@ SCENE = {
                 "link_radius": 0.02,
                 "end_scale": 0.1,
                 "strength": 5.0,
-                "overrides": [{"index": 2, "links": 3, "link_length": 0.2, "end_scale": 0.5, "strength": 9.0}],
+                "overrides": [
+                    {"index": 2, "links": 3, "link_length": 0.2, "end_scale": 0.5, "strength": 9.0}
+                ],
             },
         }
     ],
@@ -79,7 +81,10 @@ def test_every_link_has_a_motor_and_every_tip_a_sucker(make_world: Callable[...,
 
 
 def test_suckers_along_the_tentacle(make_world: Callable[..., World]) -> None:
-    scene = {"version": 1, "creatures": [{"tentacles": {"count": 3, "links": 4, "suckers": "every_link"}}]}
+    scene = {
+        "version": 1,
+        "creatures": [{"tentacles": {"count": 3, "links": 4, "suckers": "every_link"}}],
+    }
     world = make_world(scene)
     assert len(world.suckers) == 12
     assert world.physics.model.neq == 12
@@ -87,12 +92,17 @@ def test_suckers_along_the_tentacle(make_world: Callable[..., World]) -> None:
 
 
 def test_twist_adds_a_third_hinge(make_world: Callable[..., World]) -> None:
-    world = make_world({"version": 1, "creatures": [{"tentacles": {"count": 3, "links": 2, "twist": True}}]})
+    world = make_world(
+        {"version": 1, "creatures": [{"tentacles": {"count": 3, "links": 2, "twist": True}}]}
+    )
     assert world.physics.model.nu == 3 * 2 * 3
 
 
 def test_heading_rotates_the_whole_creature(make_world: Callable[..., World]) -> None:
-    scene = {"version": 1, "creatures": [{"name": "octo", "heading_deg": 90, "tentacles": {"count": 4}}]}
+    scene = {
+        "version": 1,
+        "creatures": [{"name": "octo", "heading_deg": 90, "tentacles": {"count": 4}}],
+    }
     world = make_world(scene)
     base = world.component(_tentacle(world, 0).links[0], Transform).pos
     assert_allclose(base[:2], [0.0, 0.15 + 0.035], atol=1e-12)  # tentacle 0 now along +y

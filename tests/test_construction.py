@@ -46,7 +46,19 @@ def test_end_scale_one_gives_uniform_links() -> None:
     [
         (3, [[1, 0, 0], [-0.5, H, 0], [-0.5, -H, 0]]),
         (6, [[1, 0, 0], [0.5, H, 0], [-0.5, H, 0], [-1, 0, 0], [-0.5, -H, 0], [0.5, -H, 0]]),
-        (8, [[1, 0, 0], [S, S, 0], [0, 1, 0], [-S, S, 0], [-1, 0, 0], [-S, -S, 0], [0, -1, 0], [S, -S, 0]]),
+        (
+            8,
+            [
+                [1, 0, 0],
+                [S, S, 0],
+                [0, 1, 0],
+                [-S, S, 0],
+                [-1, 0, 0],
+                [-S, -S, 0],
+                [0, -1, 0],
+                [S, -S, 0],
+            ],
+        ),
     ],
 )
 def test_tentacle_axes_counter_clockwise_about_z(count: int, expected: list[list[float]]) -> None:

@@ -88,7 +88,10 @@ def test_class_priority_attributes_are_ignored() -> None:
     [
         ([named("a", after=("nope",))], "system 'a' runs after 'nope', which is not scheduled"),
         ([named("a"), named("a")], "a system named 'a' is already scheduled"),
-        ([named("a"), named("b", after=("a",), before=("a",))], "systems a, b wait on each other (a cycle)"),
+        (
+            [named("a"), named("b", after=("a",), before=("a",))],
+            "systems a, b wait on each other (a cycle)",
+        ),
         ([named("")], "has no name"),
     ],
 )

@@ -42,7 +42,9 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         description="Simulate a scene headless (no window) for a number of frames.",
     )
     parser.add_argument("scene", metavar="SCENE", help="scene file or bundled scene name")
-    parser.add_argument("--frames", type=positive_int, default=600, help="frames to run (default 600)")
+    parser.add_argument(
+        "--frames", type=positive_int, default=600, help="frames to run (default 600)"
+    )
     parser.add_argument("--seed", type=seed_int, default=None, help="override the scene's seed")
     parser.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -63,9 +65,11 @@ def handle(args: argparse.Namespace) -> int:
         print(json.dumps(summary))
     else:
         print(
-            f"{path}: {summary['frames']} frames, {summary['sim_seconds']:.2f} s simulated in "
-            f"{summary['wall_seconds']:.2f} s wall, real-time factor {summary['real_time_factor']:.2f}x "
-            f"({summary['creatures']} creatures, {summary['bodies']} bodies, {summary['dofs']} dofs)"
+            f"{path}: {summary['frames']} frames, {summary['sim_seconds']:.2f} s simulated in"
+            f" {summary['wall_seconds']:.2f} s wall,"
+            f" real-time factor {summary['real_time_factor']:.2f}x"
+            f" ({summary['creatures']} creatures, {summary['bodies']} bodies,"
+            f" {summary['dofs']} dofs)"
         )
     return 0
 
@@ -73,10 +77,12 @@ def handle(args: argparse.Namespace) -> int:
 def simulate(world: World, frames: int, *, progress: bool = True) -> dict[str, Any]:
     """Step `world` for `frames` frames and return timing and size figures."""
     model = world.physics.model
-    chunk = max(1, int(round(world.settings.fps / 10)))
+    chunk = max(1, round(world.settings.fps / 10))
     start_time = world.time
     wall_start = time.perf_counter()
-    with tqdm(total=frames, unit="frame", disable=None if progress else True, file=sys.stderr, leave=False) as bar:
+    with tqdm(
+        total=frames, unit="frame", disable=None if progress else True, file=sys.stderr, leave=False
+    ) as bar:
         done = 0
         while done < frames:
             n = min(chunk, frames - done)

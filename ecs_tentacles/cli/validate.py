@@ -15,7 +15,9 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         help="check scene files against the schema (exit 0 if all are valid, 2 if not)",
         description="Check scene files; print one line per problem with its JSON path.",
     )
-    parser.add_argument("scenes", nargs="+", metavar="SCENE", help="scene file or bundled scene name")
+    parser.add_argument(
+        "scenes", nargs="+", metavar="SCENE", help="scene file or bundled scene name"
+    )
     parser.set_defaults(handler=handle)
 
 

@@ -45,7 +45,9 @@ class PhysicsBackend:
         self.actuator_dof = self.model.jnt_dofadr[self.model.actuator_trnid[:, 0]]
         # sucker row -> equality id
         self.equality_ids = _ids(self.model, obj.mjOBJ_EQUALITY, names.equalities)
-        self.mantle_qpos = self.model.jnt_qposadr[_ids(self.model, obj.mjOBJ_JOINT, names.mantle_joints)]
+        self.mantle_qpos = self.model.jnt_qposadr[
+            _ids(self.model, obj.mjOBJ_JOINT, names.mantle_joints)
+        ]
         self.resets = 0
         mujoco.mj_forward(self.model, self.data)
 

@@ -52,6 +52,7 @@ def build_spec(world: World) -> tuple[mujoco.MjSpec, ModelNames]:
     settings = world.settings
     spec = mujoco.MjSpec()
     spec.modelname = "ecs_tentacles"
+    spec.compiler.degree = False  # joint ranges are radians
     spec.option.timestep = settings.substep_dt
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
     spec.option.gravity = list(settings.gravity)
@@ -64,7 +65,7 @@ def build_spec(world: World) -> tuple[mujoco.MjSpec, ModelNames]:
         conaffinity=GROUND_CONAFFINITY,
     )
     names = ModelNames(bodies=[""] * len(world.transforms))
-    for entity, (creature, transform) in sorted(world.query(Creature, Transform)):
+    for _, (creature, transform) in sorted(world.query(Creature, Transform)):
         _add_creature(spec, world, creature, transform, names)
     if any(not name for name in names.bodies):
         raise RuntimeError("a Transform row has no body: build entities with ecs_tentacles.build")
@@ -74,7 +75,9 @@ def build_spec(world: World) -> tuple[mujoco.MjSpec, ModelNames]:
 def _add_creature(
     spec: mujoco.MjSpec, world: World, creature: Creature, transform: Transform, names: ModelNames
 ) -> None:
-    mantle = spec.worldbody.add_body(name=f"{creature.name}/mantle", pos=transform.pos, quat=transform.quat)
+    mantle = spec.worldbody.add_body(
+        name=f"{creature.name}/mantle", pos=transform.pos, quat=transform.quat
+    )
     mantle.add_freejoint(name=f"{creature.name}/root")
     mantle.add_geom(
         name=f"{creature.name}/mantle",
@@ -96,7 +99,11 @@ def _add_creature(
             if previous is None:  # base of the tentacle: edge of the mantle's base
                 angle = tentacle.base_angle
                 distance = creature.mantle_radius + 0.5 * link.length
-                pos = [distance * np.cos(angle), distance * np.sin(angle), -0.5 * creature.mantle_height]
+                pos = [
+                    distance * np.cos(angle),
+                    distance * np.sin(angle),
+                    -0.5 * creature.mantle_height,
+                ]
                 quat = quat_about_z(angle)
             else:
                 pos = [0.5 * (previous.length + link.length), 0.0, 0.0]
