@@ -79,16 +79,20 @@ class World:
         seed: int | None = None,
         allow_systems: bool = False,
     ) -> World:
-        """Build a world from a scene file or dict: validate, build entities, compile physics.
+        """Build a world from a scene file, bundled scene name or dict.
+
+        Validates, builds the entities, compiles the physics, schedules the systems.
 
         Raises `SceneError` (one line per problem) before anything is built. Systems the
         scene names are imported only with `allow_systems=True`.
         """
         from ecs_tentacles.build import build_creature
         from ecs_tentacles.scene.errors import SceneError
-        from ecs_tentacles.scene.load import load_scene
+        from ecs_tentacles.scene.load import load_scene, resolve_scene_path
         from ecs_tentacles.systems import builtin_systems
 
+        if not isinstance(source, dict):
+            source = resolve_scene_path(os.fspath(source))  # a path, or a bundled scene's name
         data = load_scene(source)
         if data["systems"] and not allow_systems:  # checked before importing anything
             raise SceneError(

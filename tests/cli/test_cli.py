@@ -1,0 +1,102 @@
+"""The command line: validate, run, exit codes, one-line errors, no tracebacks."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from ecs_tentacles.cli import main
+from ecs_tentacles.scene.load import bundled_scene, bundled_scene_names
+
+BUNDLED = {
+    "asymmetric": "1 creatures, 5 tentacles",
+    "octopus": "1 creatures, 8 tentacles",
+    "thesis_four_by_six": "4 creatures, 24 tentacles",
+    "three_goals": "1 creatures, 6 tentacles",
+}
+
+
+def test_the_issue_scenes_are_bundled() -> None:
+    assert set(BUNDLED) <= set(bundled_scene_names())
+
+
+@pytest.mark.parametrize("name", sorted(BUNDLED))
+def test_validate_accepts_every_bundled_scene(
+    name: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert main(["validate", name]) == 0
+    assert capsys.readouterr().out == f"{bundled_scene(name)}: ok ({BUNDLED[name]})\n"
+
+
+def test_validate_reports_each_problem_and_exits_2(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    scene = tmp_path / "bad.json"
+    scene.write_text(json.dumps({"version": 1, "creatures": [{"tentacles": {"end_scale": 1.7}}]}))
+    assert main(["validate", str(scene), str(bundled_scene("octopus"))]) == 2
+    captured = capsys.readouterr()
+    assert (
+        captured.err
+        == f"error: {scene}: creatures[0].tentacles.end_scale: must be in (0, 1], got 1.7\n"
+    )
+    assert "octopus.json: ok (1 creatures, 8 tentacles)" in captured.out
+
+
+def test_run_prints_one_json_summary(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["run", "octopus", "--frames", "12", "--json", "--quiet", "--seed", "7"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["frames"] == 12 and summary["seed"] == 7
+    assert summary["sim_seconds"] == pytest.approx(0.2)
+    assert summary["real_time_factor"] == pytest.approx(
+        summary["sim_seconds"] / summary["wall_seconds"], rel=0.01
+    )
+    assert (summary["creatures"], summary["bodies"], summary["physics_resets"]) == (1, 81, 0)
+
+
+def test_run_human_summary(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["run", "three_goals", "--frames", "6", "--quiet"]) == 0
+    out = capsys.readouterr().out
+    assert "6 frames, 0.10 s simulated in" in out and "real-time factor" in out
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["run", "octopus", "--frames", "0"], "argument --frames: must be >= 1, got 0"),
+        (
+            ["run", "octopus", "--frames", "ten"],
+            "argument --frames: must be a whole number, got 'ten'",
+        ),
+        (["run", "octopus", "--seed", "-1"], "argument --seed: must be >= 0, got -1"),
+    ],
+)
+def test_bad_arguments_exit_2(
+    argv: list[str], message: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    with pytest.raises(SystemExit) as caught:
+        main(argv)
+    assert caught.value.code == 2
+    assert message in capsys.readouterr().err
+
+
+def test_bad_scene_in_a_real_process_has_no_traceback(tmp_path: Path) -> None:
+    scene = tmp_path / "bad.json"
+    scene.write_text('{"version": 1, "creatures": [{"tentacles": {"links": 0}}], "colour": 1}')
+    result = subprocess.run(
+        [sys.executable, "-m", "ecs_tentacles.cli", "run", str(scene), "--frames", "5"],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert result.returncode == 2
+    assert result.stdout == ""
+    assert result.stderr.splitlines() == [
+        f"error: {scene}: colour: unknown key (allowed: $schema, creatures, description, name,"
+        " physics, seed, systems, version)",
+        f"error: {scene}: creatures[0].tentacles.links: must be in [1, 64], got 0",
+    ]
+    assert "Traceback" not in result.stderr

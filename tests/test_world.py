@@ -1,0 +1,117 @@
+"""World: scenes in, entities out; contexts apart; events; scene-named systems."""
+
+from __future__ import annotations
+
+import sys
+import textwrap
+from collections.abc import Callable
+from pathlib import Path
+
+import pytest
+
+from ecs_tentacles.components import Creature, Goal
+from ecs_tentacles.scene.errors import SceneError
+from ecs_tentacles.system import System
+from ecs_tentacles.world import World
+from tests.conftest import creature_scene
+
+
+def test_two_worlds_keep_their_entities_apart(make_world: Callable[..., World]) -> None:
+    small = make_world(creature_scene(count=3, links=2))
+    large = make_world(creature_scene(count=6, links=2))
+    assert len(small.component(small.creature("octo"), Creature).tentacles) == 3
+    assert len(large.component(large.creature("octo"), Creature).tentacles) == 6
+    small.step(1)
+    assert small.frame == 1 and large.frame == 0
+
+
+def test_step_advances_the_fixed_clock(make_world: Callable[..., World]) -> None:
+    scene = creature_scene(count=3, links=2)
+    scene["physics"] = {"fps": 50, "substeps": 4}
+    world = make_world(scene)
+    world.step(25)
+    assert world.time == 0.5
+    assert world.physics.time == pytest.approx(0.5, abs=1e-12)
+    assert world.physics.model.opt.timestep == 0.005
+
+
+def test_goals_become_entities_in_path_order(make_world: Callable[..., World]) -> None:
+    scene = creature_scene(count=3, links=2)
+    scene["creatures"][0]["goals"] = [
+        {"position": [1, 0]},
+        {"position": [2, 1, 0.5], "radius": 0.5},
+    ]
+    world = make_world(scene)
+    goals = sorted((g.order, g.position.tolist(), g.radius) for _, g in world.query(Goal))
+    assert goals == [(0, [1.0, 0.0, 0.0], 0.3), (1, [2.0, 1.0, 0.5], 0.5)]
+    assert {g.owner for _, g in world.query(Goal)} == {world.creature("octo")}
+
+
+def test_unknown_creature_name_lists_the_known_ones(make_world: Callable[..., World]) -> None:
+    world = make_world(creature_scene(count=3, links=2))
+    with pytest.raises(KeyError, match="no creature named 'squid'; this world has: octo"):
+        world.creature("squid")
+
+
+def test_bad_scene_builds_nothing() -> None:
+    with pytest.raises(SceneError) as caught:
+        World.from_scene({"version": 1, "creatures": [{"tentacles": {"end_scale": 1.7}}]})
+    assert caught.value.problems == ["creatures[0].tentacles.end_scale: must be in (0, 1], got 1.7"]
+
+
+@pytest.fixture
+def user_system_module(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> str:
+    """A module `my_systems` on sys.path that counts its imports and frames."""
+    (tmp_path / "my_systems.py").write_text(
+        textwrap.dedent(
+            """
+            from ecs_tentacles.system import System
+            IMPORTS = []
+            IMPORTS.append(1)
+
+            class Counter(System):
+                name = "counter"
+                after = ("physics_sync",)
+                frames = 0
+
+                def process(self, world, dt):
+                    type(self).frames += 1
+            """
+        )
+    )
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.delitem(sys.modules, "my_systems", raising=False)
+    return "my_systems"
+
+
+def test_scene_systems_are_not_imported_unless_allowed(
+    user_system_module: str, make_world: Callable[..., World]
+) -> None:
+    scene = creature_scene(count=3, links=2)
+    scene["systems"] = [f"{user_system_module}:Counter"]
+    with pytest.raises(
+        SceneError, match=r"systems\[0\]: the scene asks to run 'my_systems:Counter'"
+    ):
+        World.from_scene(scene)
+    assert user_system_module not in sys.modules
+    world = make_world(scene, allow_systems=True)
+    assert world.schedule.names == ["physics", "physics_sync", "counter"]
+    world.step(3)
+    assert type(world.schedule["counter"]).frames == 3  # type: ignore[attr-defined]
+
+
+def test_scene_system_that_is_not_a_system(user_system_module: str) -> None:
+    scene = creature_scene(count=3, links=2)
+    scene["systems"] = [f"{user_system_module}:IMPORTS", "no_such_module_xyz:Thing"]
+    with pytest.raises(SceneError) as caught:
+        World.from_scene(scene, allow_systems=True)
+    assert caught.value.problems[0] == "systems[0]: 'my_systems:IMPORTS' is not a System subclass"
+    assert caught.value.problems[1].startswith(
+        "systems[1]: cannot import 'no_such_module_xyz:Thing'"
+    )
+
+
+def test_user_system_base_class_is_the_builtin_one() -> None:
+    from ecs_tentacles.systems import Physics, PhysicsSync
+
+    assert issubclass(Physics, System) and issubclass(PhysicsSync, System)
