@@ -11,6 +11,7 @@ import pytest
 
 from ecs_tentacles.cli import main
 from ecs_tentacles.scene.load import bundled_scene, bundled_scene_names
+from tests.scene.test_validate import BAD_SCENES
 
 BUNDLED = {
     "asymmetric": "1 creatures, 5 tentacles",
@@ -100,3 +101,18 @@ def test_bad_scene_in_a_real_process_has_no_traceback(tmp_path: Path) -> None:
         f"error: {scene}: creatures[0].tentacles.links: must be in [1, 64], got 0",
     ]
     assert "Traceback" not in result.stderr
+
+
+@pytest.mark.parametrize(
+    ("data", "expected"),
+    [pytest.param(data, expected, id=name) for name, data, expected in BAD_SCENES],
+)
+def test_every_bad_scene_exits_2_with_its_json_path(
+    data: object, expected: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    scene = tmp_path / "bad.json"
+    scene.write_text(json.dumps(data))
+    assert main(["run", str(scene), "--frames", "1", "--quiet"]) == 2
+    captured = capsys.readouterr()
+    assert captured.err == f"error: {scene}: {expected}\n"
+    assert captured.out == ""
