@@ -68,6 +68,7 @@ class World:
         self.schedule = Schedule()
         self.events = Events()
         self._physics: PhysicsBackend | None = None
+        self.scene: dict[str, Any] | None = None  # the validated scene, defaults filled in
         self.frame = 0
 
     # -- construction ------------------------------------------------------------------
@@ -121,8 +122,6 @@ class World:
         for system in builtin_systems() + [factory() for factory in extra]:
             world.add_system(system)
         return world
-
-    scene: dict[str, Any] | None = None
 
     def build_physics(self) -> PhysicsBackend:
         """Compile the MuJoCo model from the current entities and sync the Transform store."""
