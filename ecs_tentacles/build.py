@@ -12,14 +12,15 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ecs_tentacles.components import Creature, Goal, Link, Motor, Sucker, Tentacle, Transform
+from ecs_tentacles.components import Creature, Link, Motor, Sucker, Tentacle, Transform
 from ecs_tentacles.construction import tentacle_angles, tentacle_shape
+from ecs_tentacles.locomotion.actions import ActionQueue
 from ecs_tentacles.mathutil import quat_about_z, quat_rotate
 
 if TYPE_CHECKING:
     from ecs_tentacles.world import World
 
-TENTACLE_FIELDS = ("links", "link_length", "link_radius", "end_scale", "strength", "damping")
+GAITS = {"cyclic": 0, "coordinated": 1}
 
 
 def tentacle_params(tentacles: dict[str, Any], index: int) -> dict[str, Any]:
@@ -56,18 +57,64 @@ def build_creature(world: World, spec: dict[str, Any]) -> int:
     )
     centre = origin + np.array([0.0, 0.0, 0.5 * mantle["height"]])
     row = int(world.transforms.add(pos=centre, quat=turn)[0])
+    locomotion = spec["locomotion"]
+    creature.row = int(
+        world.creatures.add(
+            mantle_row=row,
+            mantle_radius=mantle["radius"],
+            first_tentacle=len(world.tentacles),
+            tentacles=tentacles["count"],
+            gait=GAITS[locomotion["gait"]],
+            speed=locomotion["speed"],
+            drivers=min(locomotion["drivers"], tentacles["count"]),
+            release_stretch=locomotion["release_stretch"],
+            release_reach=locomotion["release_reach"],
+        )[0]
+    )
     creature_entity = world.create_entity(creature, Transform(world.transforms, row))
+    world.creatures.entity[creature.row] = creature_entity
 
     for k, angle in enumerate(tentacle_angles(tentacles["count"])):
         params = tentacle_params(tentacles, k)
         tentacle = Tentacle(creature=creature_entity, index=k, base_angle=float(angle))
-        tentacle_entity = world.create_entity(tentacle)
+        tentacle_entity = world.create_entity(tentacle, ActionQueue())
         creature.tentacles.append(tentacle_entity)
         _build_links(world, tentacle, tentacle_entity, params, mantle["radius"], origin, heading)
-    for order, goal in enumerate(spec["goals"]):
+        _add_tentacle_row(world, tentacle, creature.row, params)
+    for goal in spec["goals"]:
         point = list(goal["position"]) + ([0.0] if len(goal["position"]) == 2 else [])
-        world.create_entity(Goal(creature_entity, order, np.asarray(point, float), goal["radius"]))
+        world.goals.append(creature_entity, point, goal["radius"])
     return creature_entity
+
+
+def _add_tentacle_row(
+    world: World, tentacle: Tentacle, creature_row: int, params: dict[str, Any]
+) -> None:
+    links = [world.component(e, Link) for e in tentacle.links]
+    motors = [world.component(e, Motor) for e in tentacle.links]
+    sucker = world.component(tentacle.suckers[-1], Sucker)
+    tentacle.row = int(
+        world.tentacles.add(
+            creature_row=creature_row,
+            base_angle=tentacle.base_angle,
+            first_link=motors[0].row,
+            links=len(links),
+            base_row=world.component(tentacle.links[0], Transform).row,
+            tip_sucker=sucker.row,
+            length=sum(link.length for link in links),
+            joint_limit=links[0].joint_limit,
+            speed=params["speed"],
+            target_angle=np.radians(params["target_angle_deg"]),
+            wave_amplitude=np.radians(params["wave_amplitude_deg"]),
+            wave_frequency=params["wave_frequency"],
+            wavelength=params["wavelength"],
+            writhe=params["writhe"],
+            phase=world.rng.uniform(0.0, 2.0 * np.pi),
+        )[0]
+    )
+    world.motors.tentacle_row[[m.row for m in motors]] = tentacle.row
+    sucker_rows = [world.component(e, Sucker).row for e in tentacle.suckers]
+    world.suckers.tentacle_row[sucker_rows] = tentacle.row
 
 
 def _build_links(
@@ -96,6 +143,9 @@ def _build_links(
         strength=params["strength"] * shape.scales,
         damping=params["damping"] * shape.scales,
         max_torque=params["max_torque"] * shape.scales,
+        arc=(shape.centres - mantle_radius)
+        / (shape.centres[-1] + 0.5 * shape.lengths[-1] - mantle_radius),
+        scale=shape.scales,
     )
     limit = float(np.radians(params["joint_limit_deg"]))
     for i in range(n):
@@ -118,4 +168,5 @@ def _build_links(
         offset = (0.5 * shape.lengths[i], 0.0, -shape.radii[i])
         sucker_row = int(world.suckers.add(link_row=rows[i], offset=offset)[0])
         entity = world.create_entity(Sucker(world.suckers, sucker_row, tentacle.links[i]))
+        world.suckers.entity[sucker_row] = entity
         tentacle.suckers.append(entity)

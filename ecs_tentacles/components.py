@@ -87,6 +87,7 @@ class Creature:
     mantle_radius: float
     mantle_height: float
     mantle_density: float
+    row: int = -1  # CreatureStore row
     tentacles: list[int] = field(default_factory=list)
 
 
@@ -97,6 +98,7 @@ class Tentacle:
     creature: int
     index: int
     base_angle: float
+    row: int = -1  # TentacleStore row
     links: list[int] = field(default_factory=list)
     suckers: list[int] = field(default_factory=list)
 

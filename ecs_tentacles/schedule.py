@@ -22,14 +22,20 @@ class Schedule:
         self._added: list[System] = []
         self._ordered: list[System] = []
 
-    def add(self, system: System) -> None:
-        """Add a system and re-resolve the order; raises ScheduleError on a bad place."""
-        if not system.name:
-            raise ScheduleError(f"{type(system).__name__} has no name")
-        if any(s.name == system.name for s in self._added):
-            raise ScheduleError(f"a system named {system.name!r} is already scheduled")
-        self._ordered = _resolve([*self._added, system])
-        self._added.append(system)
+    def add(self, *systems: System) -> None:
+        """Add systems and re-resolve the order; raises ScheduleError on a bad place.
+
+        Systems added together may name each other in `after` / `before`.
+        """
+        names = [s.name for s in self._added]
+        for system in systems:
+            if not system.name:
+                raise ScheduleError(f"{type(system).__name__} has no name")
+            if system.name in names:
+                raise ScheduleError(f"a system named {system.name!r} is already scheduled")
+            names.append(system.name)
+        self._ordered = _resolve([*self._added, *systems])
+        self._added.extend(systems)
 
     def remove(self, name: str) -> System:
         """Remove a system by name (other systems may not depend on it)."""

@@ -96,18 +96,88 @@ class TransformStore(ArrayStore):
 
 
 class MotorStore(ArrayStore):
-    """Servo state per link: hinge targets (curl, sweep, twist) in radians and gains."""
+    """Servo state per link: hinge targets (curl, sweep, twist) in radians and gains.
+
+    The servo's kp is `strength * gain` and its kv `damping * gain`: `strength` and
+    `damping` are the link's own (scene or script), `gain` is what locomotion writes
+    each frame (action strength and writhing). `tentacle_row` and `arc` (where the
+    link's centre lies along its tentacle, 0 at the base, 1 at the tip) let systems
+    compute poses for every link at once.
+    """
 
     target = Field((3,))
     strength = Field()
     damping = Field()
     max_torque = Field()
+    gain = Field(default=1.0)
+    tentacle_row = Field(dtype=np.int64)
+    arc = Field()
+    scale = Field(default=1.0)  # the link's construction scale (tapers strength)
+
+
+class TentacleStore(ArrayStore):
+    """Per tentacle: layout, locomotion parameters and the current action, as arrays.
+
+    Links of a tentacle are the contiguous motor rows `first_link .. first_link + links`.
+    Parameters (`speed` ... `writhe`) are what scripts and the HUD change at run time.
+    The current action (`action`, `timer`, `duration`, `action_angle`,
+    `action_strength`) mirrors the head of the tentacle's `ActionQueue`.
+    """
+
+    creature_row = Field(dtype=np.int64)
+    base_angle = Field()
+    first_link = Field(dtype=np.int64)
+    links = Field(dtype=np.int64)
+    base_row = Field(dtype=np.int64)  # transform row of the first link
+    tip_sucker = Field(dtype=np.int64)  # sucker row on the tip link
+    length = Field()
+    joint_limit = Field()
+    # parameters
+    speed = Field(default=1.0)
+    target_angle = Field()
+    wave_amplitude = Field()
+    wave_frequency = Field()
+    wavelength = Field(default=1.0)
+    writhe = Field()
+    phase = Field()
+    # the current action
+    action = Field(dtype=np.int64)
+    timer = Field()
+    duration = Field(default=np.inf)
+    action_angle = Field()
+    action_strength = Field(default=1.0)
+    orient = Field()  # sweep (radians) toward the goal line, held through a stroke
+    mode = Field(dtype=np.int64)  # 0 idle, 1 push, 2 pull
+    driving = Field(dtype=np.bool_, default=False)
+    started = Field(default=-np.inf)  # time the current drive began
+
+
+class CreatureStore(ArrayStore):
+    """Per creature: mantle row, tentacle rows, gait and locomotion settings."""
+
+    entity = Field(dtype=np.int64)
+    mantle_row = Field(dtype=np.int64)
+    mantle_radius = Field()
+    first_tentacle = Field(dtype=np.int64)
+    tentacles = Field(dtype=np.int64)
+    gait = Field(dtype=np.int64)  # 0 cyclic, 1 coordinated
+    speed = Field(default=1.0)
+    drivers = Field(dtype=np.int64, default=1)
+    release_stretch = Field()
+    release_reach = Field()
+    next_driver = Field(dtype=np.int64)  # cyclic: whose turn is next
+    last_start = Field(default=-np.inf)  # coordinated: when the last drive began
+    has_goal = Field(dtype=np.bool_, default=False)
+    goal = Field((3,))  # the current goal's position (valid when has_goal)
+    goal_radius = Field()
 
 
 class SuckerStore(ArrayStore):
     """Suckers: the link body row they sit on, offset in the link frame, attachment state."""
 
     link_row = Field(dtype=np.int64)
+    tentacle_row = Field(dtype=np.int64)
+    entity = Field(dtype=np.int64)
     offset = Field((3,))
     attached = Field(dtype=np.bool_, default=False)
     anchor = Field((3,))

@@ -23,9 +23,17 @@ import numpy as np
 
 from ecs_tentacles.components import Creature, Sucker
 from ecs_tentacles.events import Events
+from ecs_tentacles.locomotion.goals import GoalBook
+from ecs_tentacles.locomotion.params import Locomotion
 from ecs_tentacles.physics.backend import PhysicsBackend
 from ecs_tentacles.schedule import Schedule
-from ecs_tentacles.store import MotorStore, SuckerStore, TransformStore
+from ecs_tentacles.store import (
+    CreatureStore,
+    MotorStore,
+    SuckerStore,
+    TentacleStore,
+    TransformStore,
+)
 from ecs_tentacles.system import System
 
 C = TypeVar("C")
@@ -65,6 +73,10 @@ class World:
         self.transforms = TransformStore()
         self.motors = MotorStore()
         self.suckers = SuckerStore()
+        self.creatures = CreatureStore()
+        self.tentacles = TentacleStore()
+        self.goals = GoalBook(self)
+        self.locomotion = Locomotion(self)
         self.schedule = Schedule()
         self.events = Events()
         self._physics: PhysicsBackend | None = None
@@ -79,13 +91,15 @@ class World:
         *,
         seed: int | None = None,
         allow_systems: bool = False,
+        locomotion: bool = True,
     ) -> World:
         """Build a world from a scene file, bundled scene name or dict.
 
         Validates, builds the entities, compiles the physics, schedules the systems.
 
         Raises `SceneError` (one line per problem) before anything is built. Systems the
-        scene names are imported only with `allow_systems=True`.
+        scene names are imported only with `allow_systems=True`. With `locomotion=False`
+        only the physics systems run, so scripts drive the motors themselves.
         """
         from ecs_tentacles.build import build_creature
         from ecs_tentacles.scene.errors import SceneError
@@ -119,8 +133,10 @@ class World:
         for creature in data["creatures"]:
             build_creature(world, creature)
         world.build_physics()
-        for system in builtin_systems() + [factory() for factory in extra]:
-            world.add_system(system)
+        systems = builtin_systems()
+        if not locomotion:
+            systems = [s for s in systems if s.name in ("physics", "physics_sync")]
+        world.add_systems(*systems, *(factory() for factory in extra))
         return world
 
     def build_physics(self) -> PhysicsBackend:
@@ -138,9 +154,14 @@ class World:
 
     def add_system(self, system: System) -> System:
         """Schedule `system` at the place it declares and call its `setup`."""
-        self.schedule.add(system)
-        system.setup(self)
+        self.add_systems(system)
         return system
+
+    def add_systems(self, *systems: System) -> None:
+        """Schedule several systems at once (they may name each other), then set them up."""
+        self.schedule.add(*systems)
+        for system in systems:
+            system.setup(self)
 
     # -- running -----------------------------------------------------------------------
     def step(self, frames: int = 1) -> None:

@@ -9,6 +9,8 @@ from typing import Any
 import numpy as np
 import pytest
 
+from ecs_tentacles.world import World
+
 README = Path(__file__).resolve().parents[1] / "README.md"
 
 
@@ -20,8 +22,15 @@ def test_readme_python_blocks_run() -> None:
     for block in blocks:
         exec(compile(block, str(README), "exec"), namespace)
     world: Any = namespace["world"]
-    assert world.schedule.names == ["wave", "physics", "physics_sync"]
-    before = world.time
-    world.step(1)
-    assert (world.motors.target[:, 1] == 0.3 * np.sin(2 * np.pi * before)).all()
+    names = world.schedule.names
+    assert names.index("motor_targets") < names.index("wave") < names.index("physics")
     world.close()
+    # the Wave system adds exactly its sweep on top of what motor_targets wrote
+    plain, waved = World.from_scene("octopus"), World.from_scene("octopus")
+    waved.add_system(namespace["Wave"]())  # type: ignore[operator]
+    plain.step(2)
+    waved.step(2)
+    added = waved.motors.target[:, 1] - plain.motors.target[:, 1]
+    np.testing.assert_allclose(added, 0.3 * np.sin(2 * np.pi / 60), rtol=1e-9)
+    plain.close()
+    waved.close()

@@ -45,13 +45,26 @@ class Late(Probe):
     after = ("physics_sync",)
 
 
+BUILTIN = [
+    "goals",
+    "tentacle_selection",
+    "action_queue",
+    "motor_targets",
+    "suckers",
+    "physics",
+    "physics_sync",
+]
+
+
 def test_builtin_order(make_world: Callable[..., World]) -> None:
     world = make_world(creature_scene(count=3, links=2))
-    assert world.schedule.names == ["physics", "physics_sync"]
+    assert world.schedule.names == BUILTIN
+    physics_only = make_world(creature_scene(count=3, links=2), locomotion=False)
+    assert physics_only.schedule.names == ["physics", "physics_sync"]
 
 
 def test_probe_records_frame_and_substep_order(make_world: Callable[..., World]) -> None:
-    world = make_world(creature_scene(count=3, links=2))
+    world = make_world(creature_scene(count=3, links=2), locomotion=False)
     Probe.log.clear()
     world.add_system(Late())
     world.add_system(SubstepProbe())

@@ -53,14 +53,15 @@ class PhysicsBackend:
 
     # -- per frame -------------------------------------------------------------------
     def write_controls(self, motors: MotorStore) -> None:
-        """Motor targets into `ctrl`, strength/damping/limits into the servo parameters."""
+        """Targets into `ctrl`; kp = strength x gain, kv = damping x gain; torque limits."""
         m, d = self.model, self.data
         np.take(motors.target.reshape(-1), self.actuator_target_index, out=d.ctrl, mode="clip")
         rows = self.actuator_motor_rows
-        kp = motors.strength[rows]
+        gain = motors.gain[rows]
+        kp = motors.strength[rows] * gain
         m.actuator_gainprm[:, 0] = kp
         m.actuator_biasprm[:, 1] = -kp
-        m.actuator_biasprm[:, 2] = -motors.damping[rows]
+        m.actuator_biasprm[:, 2] = -motors.damping[rows] * gain
         torque = motors.max_torque[rows]
         m.actuator_forcerange[:, 0] = -torque
         m.actuator_forcerange[:, 1] = torque

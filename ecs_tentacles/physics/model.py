@@ -33,6 +33,14 @@ AXIS_INDEX = {"curl": 0, "sweep": 1, "twist": 2}
 JOINT_ARMATURE = 0.002
 CREATURE_CONTYPE, CREATURE_CONAFFINITY = 2, 1
 GROUND_CONTYPE, GROUND_CONAFFINITY = 1, 2
+# MuJoCo takes the larger friction of two touching geoms: creature skin is zero so the
+# scene's ground_friction alone sets how creatures slide.
+SKIN_FRICTION = [0.0, 0.0, 0.0]
+# Stiffer contacts than MuJoCo's default (0.02 s), so thin tips do not sink into the
+# ground; still above twice the default timestep (1 / 480 s).
+CONTACT_SOLREF = [0.006, 1.0]
+# Suckers hold harder than contacts push (impedance close to 1): the tip stays put.
+SUCKER_SOLIMP = [0.97, 0.995, 0.001, 0.5, 2.0]
 
 
 @dataclass
@@ -63,6 +71,7 @@ def build_spec(world: World) -> tuple[mujoco.MjSpec, ModelNames]:
         friction=[settings.ground_friction, 0.005, 0.0001],
         contype=GROUND_CONTYPE,
         conaffinity=GROUND_CONAFFINITY,
+        solref=CONTACT_SOLREF,
     )
     names = ModelNames(bodies=[""] * len(world.transforms))
     for _, (creature, transform) in sorted(world.query(Creature, Transform)):
@@ -86,6 +95,8 @@ def _add_creature(
         density=creature.mantle_density,
         contype=CREATURE_CONTYPE,
         conaffinity=CREATURE_CONAFFINITY,
+        friction=SKIN_FRICTION,
+        solref=CONTACT_SOLREF,
     )
     names.bodies[transform.row] = mantle.name
     names.mantle_joints.append(f"{creature.name}/root")
@@ -117,6 +128,8 @@ def _add_creature(
                 density=link.density,
                 contype=CREATURE_CONTYPE,
                 conaffinity=CREATURE_CONAFFINITY,
+                friction=SKIN_FRICTION,
+                solref=CONTACT_SOLREF,
             )
             names.bodies[world.component(link_entity, Transform).row] = prefix
             motor = world.component(link_entity, Motor)
@@ -135,6 +148,7 @@ def _add_creature(
                 name2="world",
                 active=False,
                 solref=[world.settings.sucker_timeconst, 1.0],
+                solimp=SUCKER_SOLIMP,
             )
             data = np.array(equality.data)
             data[0:3] = sucker.offset  # anchor in the link frame; the world anchor is set at attach

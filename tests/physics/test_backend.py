@@ -28,7 +28,7 @@ def _joint(world: World, link_entity: int, hinge: str) -> int:
 
 
 def test_model_options(make_world: Callable[..., World]) -> None:
-    world = make_world(creature_scene(count=3, links=2))
+    world = make_world(creature_scene(count=3, links=2), locomotion=False)
     model = world.physics.model
     assert model.opt.integrator == mujoco.mjtIntegrator.mjINT_IMPLICITFAST
     assert model.opt.timestep == world.settings.substep_dt == 1 / 480
@@ -41,7 +41,7 @@ def test_model_options(make_world: Callable[..., World]) -> None:
 
 
 def test_creature_settles_on_the_ground(make_world: Callable[..., World]) -> None:
-    world = make_world(creature_scene())  # 8 tentacles of 10 links, radius 0.025
+    world = make_world(creature_scene(), locomotion=False)  # 8 tentacles x 10 links, r 0.025
     world.step(300)  # 5 simulated seconds
     data = world.physics.data
     assert np.isfinite(data.qpos).all() and np.isfinite(data.qvel).all()
@@ -70,7 +70,7 @@ def test_servo_reaches_its_target(
 ) -> None:
     scene = creature_scene(count=4, links=5)
     scene["physics"] = {"gravity": gravity}
-    world = make_world(scene)
+    world = make_world(scene, locomotion=False)
     link = _tentacle(world, 0).links[link_index]
     world.component(link, Motor).target = target
     world.step(120)
@@ -81,7 +81,7 @@ def test_servo_reaches_its_target(
 def test_strength_change_at_run_time_changes_the_servo_force(
     make_world: Callable[..., World],
 ) -> None:
-    world = make_world(creature_scene(count=4, links=5))
+    world = make_world(creature_scene(count=4, links=5), locomotion=False)
     link = _tentacle(world, 1).links[0]
     motor = world.component(link, Motor)
     motor.target = [0.0, 0.4, 0.0]
@@ -98,14 +98,16 @@ def test_strength_change_at_run_time_changes_the_servo_force(
         qd = data.qvel[model.jnt_dofadr[joint]]
         return float(kp * (0.4 - q) - kv * qd)
 
+    kp, kv = motor.strength, motor.damping
+    assert (kp, kv) == (25.0, 0.5)  # the scene defaults, on the base link (scale 1)
     world.step(1)
-    assert_allclose(servo_force(), expected(4.0, 0.1), rtol=1e-9)
-    motor.strength = 12.0
-    motor.damping = 0.5
+    assert_allclose(servo_force(), expected(kp, kv), rtol=1e-9)
+    motor.strength = 3 * kp
+    motor.damping = 2 * kv
     world.step(1)
-    assert model.actuator_gainprm[actuator, 0] == 12.0
-    assert_allclose(servo_force(), expected(12.0, 0.5), rtol=1e-9)
-    assert abs(servo_force() - expected(4.0, 0.1)) > 0.1
+    assert model.actuator_gainprm[actuator, 0] == 3 * kp
+    assert_allclose(servo_force(), expected(3 * kp, 2 * kv), rtol=1e-9)
+    assert abs(servo_force() - expected(kp, kv)) > 0.1
 
 
 def _wave_tentacle(world: World, tentacle: Tentacle, frames: int) -> np.ndarray:
@@ -125,7 +127,7 @@ def _wave_tentacle(world: World, tentacle: Tentacle, frames: int) -> np.ndarray:
 def test_attached_sucker_pins_the_tip_and_release_frees_it(
     make_world: Callable[..., World],
 ) -> None:
-    world = make_world(creature_scene(count=4, links=6))
+    world = make_world(creature_scene(count=4, links=6), locomotion=False)
     events: list[str] = []
     world.events.on("sucker_attached", lambda **kw: events.append("attached"))
     world.events.on("sucker_released", lambda **kw: events.append(kw["reason"]))
@@ -145,7 +147,7 @@ def test_attached_sucker_pins_the_tip_and_release_frees_it(
 
 
 def test_physics_sync_copies_poses_bit_for_bit(make_world: Callable[..., World]) -> None:
-    world = make_world(creature_scene(count=5, links=4))
+    world = make_world(creature_scene(count=5, links=4), locomotion=False)
     world.motors.target[:, 0] = 0.3
     world.step(20)
     data, ids = world.physics.data, world.physics.body_ids

@@ -10,10 +10,11 @@ from ecs_tentacles.scene.validate import format_path, validate_scene
 
 TENTACLE_KEYS = (
     "count, damping, density, end_scale, joint_limit_deg, link_length, link_radius, links, "
-    "max_torque, overrides, strength, suckers, twist"
+    "max_torque, overrides, speed, strength, suckers, target_angle_deg, twist, "
+    "wave_amplitude_deg, wave_frequency, wavelength, writhe"
 )
 TOP_KEYS = "$schema, creatures, description, name, physics, seed, systems, version"
-CREATURE_KEYS = "goals, heading_deg, mantle, name, position, tentacles"
+CREATURE_KEYS = "goals, heading_deg, locomotion, mantle, name, position, tentacles"
 
 
 def scene(*creatures: dict[str, Any], **top: Any) -> dict[str, Any]:
@@ -50,7 +51,8 @@ BAD_SCENES: list[tuple[str, object, str]] = [
         "unknown override key",
         scene(tentacles(overrides=[{"index": 0, "colour": "red"}])),
         "creatures[0].tentacles.overrides[0].colour: unknown key (allowed: damping, end_scale, "
-        "index, link_length, link_radius, links, strength)",
+        "index, link_length, link_radius, links, speed, strength, target_angle_deg, "
+        "wave_amplitude_deg, wave_frequency, wavelength, writhe)",
     ),
     (
         "end_scale 1.7",

@@ -1,0 +1,117 @@
+"""Actions a tentacle performs, and the push and pull sequences of the thesis (IV.B).
+
+Push = compress -> attach -> push (extend while attached) -> detach.
+Pull = extend -> attach -> pull (compress while attached) -> detach.
+The coordinated gait orients the tentacle toward the goal line first and settles
+after. Durations are base seconds divided by the creature's and tentacle's speed.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass, field
+from enum import IntEnum
+
+
+class Kind(IntEnum):
+    """What a tentacle is doing; the value is stored in `TentacleStore.action`."""
+
+    IDLE = 0  # writhe in place
+    COMPRESS = 1  # arch up, shortening the tentacle
+    EXTEND = 2  # straighten, tip lifted
+    ORIENT = 3  # sweep the base toward the goal line
+    ATTACH = 4  # press the tip down; the sucker grabs when it touches
+    DETACH = 5  # let go, lift the tip
+    PUSH = 6  # extend while attached
+    PULL = 7  # compress while attached
+    SETTLE = 8  # relax to the rest pose
+
+
+class Mode(IntEnum):
+    """Why a tentacle is driving."""
+
+    NONE = 0
+    PUSH = 1
+    PULL = 2
+
+
+BASE_SECONDS: dict[Kind, float] = {
+    Kind.COMPRESS: 0.35,
+    Kind.EXTEND: 0.25,
+    Kind.ORIENT: 0.2,
+    Kind.ATTACH: 0.15,
+    Kind.DETACH: 0.1,
+    Kind.PUSH: 0.55,
+    Kind.PULL: 0.55,
+    Kind.SETTLE: 0.15,
+}
+
+# Relative motor strength during each action: power strokes at full strength.
+STRENGTH: dict[Kind, float] = {
+    Kind.IDLE: 0.6,
+    Kind.COMPRESS: 0.8,
+    Kind.EXTEND: 0.8,
+    Kind.ORIENT: 0.8,
+    Kind.ATTACH: 1.0,
+    Kind.DETACH: 0.8,
+    Kind.PUSH: 1.0,
+    Kind.PULL: 1.0,
+    Kind.SETTLE: 0.6,
+}
+
+
+@dataclass(frozen=True)
+class Action:
+    """One queued action: `kind`, how long (`duration` s), `angle` (rad), `strength`."""
+
+    kind: Kind
+    duration: float
+    angle: float = 0.0
+    strength: float = 1.0
+
+
+def make_action(kind: Kind, speed: float, angle: float = 0.0) -> Action:
+    """An action of `kind` with its base duration divided by `speed`."""
+    if speed <= 0:
+        raise ValueError(f"speed must be > 0, got {speed}")
+    return Action(kind, BASE_SECONDS[kind] / speed, angle, STRENGTH[kind])
+
+
+def drive_sequence(
+    mode: Mode, angle: float, speed: float, orient: float | None = None
+) -> list[Action]:
+    """The actions of one push or pull stroke; with `orient`, aim first and settle after."""
+    if mode == Mode.PUSH:
+        kinds = [Kind.COMPRESS, Kind.ATTACH, Kind.PUSH, Kind.DETACH]
+    elif mode == Mode.PULL:
+        kinds = [Kind.EXTEND, Kind.ATTACH, Kind.PULL, Kind.DETACH]
+    else:
+        raise ValueError(f"a drive is a push or a pull, got {mode!r}")
+    actions = [make_action(kind, speed, angle) for kind in kinds]
+    if orient is not None:
+        actions = [
+            make_action(Kind.ORIENT, speed, orient),
+            *actions,
+            make_action(Kind.SETTLE, speed),
+        ]
+    return actions
+
+
+@dataclass(eq=False)
+class ActionQueue:
+    """A tentacle's pending actions (the current one lives in the TentacleStore row)."""
+
+    pending: deque[Action] = field(default_factory=deque)
+
+    def extend(self, actions: list[Action]) -> None:
+        self.pending.extend(actions)
+
+    def clear(self) -> None:
+        self.pending.clear()
+
+    def __len__(self) -> int:
+        return len(self.pending)
+
+    def kinds(self) -> list[str]:
+        """Names of the pending actions, for the HUD and tests."""
+        return [action.kind.name.lower() for action in self.pending]

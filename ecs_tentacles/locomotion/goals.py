@@ -1,0 +1,104 @@
+"""Goals and paths: the API the sandbox, scripts and the `goals` system use.
+
+A goal is an entity with a `Goal` component (position, radius, owner, order in its
+owner's path). A creature has no goal, one, or an ordered path; the first is
+current and is mirrored into the CreatureStore (`has_goal`, `goal`, `goal_radius`)
+for the vectorised systems. Changes happen on calls (clicks, scripts, a goal
+reached), never per frame.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+import esper
+import numpy as np
+
+from ecs_tentacles.components import Creature, Goal
+
+if TYPE_CHECKING:
+    from ecs_tentacles.world import World
+
+DEFAULT_RADIUS = 0.3
+
+
+class GoalBook:
+    """Each creature's ordered path of goal entities."""
+
+    def __init__(self, world: World):
+        self._world = world
+        self._paths: dict[int, list[int]] = {}
+
+    def path(self, creature: int) -> list[int]:
+        """The creature's goal entities in order (a copy)."""
+        return list(self._paths.get(creature, []))
+
+    def current(self, creature: int) -> int | None:
+        """The goal the creature is heading for, or None."""
+        path = self._paths.get(creature)
+        return path[0] if path else None
+
+    def positions(self, creature: int) -> np.ndarray:
+        """(n, 3) positions of the creature's path, in order."""
+        goals = [self._world.component(g, Goal).position for g in self._paths.get(creature, [])]
+        return np.array(goals).reshape(-1, 3)
+
+    def set(self, creature: int, position: Sequence[float], radius: float = DEFAULT_RADIUS) -> int:
+        """Replace the creature's path with one goal; return the goal entity."""
+        self.clear(creature)
+        return self.append(creature, position, radius)
+
+    def append(
+        self, creature: int, position: Sequence[float], radius: float = DEFAULT_RADIUS
+    ) -> int:
+        """Add a goal at the end of the creature's path; return the goal entity."""
+        point = np.zeros(3)
+        values = np.asarray(position, dtype=np.float64)
+        if values.shape not in ((2,), (3,)) or not np.isfinite(values).all():
+            raise ValueError(f"goal position must be 2 or 3 finite numbers, got {list(position)}")
+        if not radius > 0:
+            raise ValueError(f"goal radius must be > 0, got {radius}")
+        self._world.component(creature, Creature)  # raises KeyError for a non-creature
+        point[: len(values)] = values
+        path = self._paths.setdefault(creature, [])
+        goal = self._world.create_entity(Goal(creature, len(path), point, float(radius)))
+        path.append(goal)
+        self._sync(creature)
+        return goal
+
+    def remove(self, goal: int) -> None:
+        """Delete a goal wherever it is in its owner's path."""
+        owner = self._world.component(goal, Goal).owner
+        self._paths[owner].remove(goal)
+        self._world.activate()
+        esper.delete_entity(goal, immediate=True)
+        self._sync(owner)
+
+    def clear(self, creature: int) -> None:
+        """Delete all of the creature's goals."""
+        for goal in self.path(creature):
+            self.remove(goal)
+
+    def reach(self, creature: int) -> None:
+        """The current goal was reached: remove it, fire `goal_reached`, move to the next."""
+        goal = self.current(creature)
+        if goal is None:
+            return
+        position = self._world.component(goal, Goal).position.copy()
+        self.remove(goal)
+        self._world.events.emit(
+            "goal_reached", world=self._world, creature=creature, goal=goal, position=position
+        )
+
+    def _sync(self, creature: int) -> None:
+        path = self._paths.get(creature, [])
+        for order, goal in enumerate(path):
+            self._world.component(goal, Goal).order = order
+        row = self._world.component(creature, Creature).row
+        store = self._world.creatures
+        store.has_goal[row] = bool(path)
+        if path:
+            first = self._world.component(path[0], Goal)
+            store.goal[row] = first.position
+            store.goal_radius[row] = first.radius

@@ -1,0 +1,140 @@
+"""Locomotion parameters, read and changed at run time (the HUD and scripts use this).
+
+    world.locomotion.set(octo, speed=1.5)                    # the creature's speed
+    world.locomotion.set(octo, tentacle=2, strength=12.0)    # one tentacle's servo kp
+    world.locomotion.set(octo, wave_amplitude=0.2)           # every tentacle
+    world.locomotion.set(octo, gait="cyclic")
+    world.locomotion.actions(octo)                           # what each tentacle is doing
+
+Angles are radians here (scenes use degrees). Values are checked; a bad one raises
+ValueError naming the parameter. Changes reach the servos on the next physics step.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ecs_tentacles.components import Creature, Tentacle
+from ecs_tentacles.locomotion.actions import ActionQueue, Kind
+
+if TYPE_CHECKING:
+    from ecs_tentacles.world import World
+
+GAITS = ("cyclic", "coordinated")
+# name -> (lowest, highest, lowest is allowed)
+TENTACLE_RANGES: dict[str, tuple[float, float, bool]] = {
+    "speed": (0.0, 10.0, False),
+    "target_angle": (0.0, np.pi / 2, True),
+    "strength": (0.0, 1e5, True),
+    "damping": (0.0, 1e4, True),
+    "wave_amplitude": (0.0, np.radians(60), True),
+    "wave_frequency": (0.0, 20.0, True),
+    "wavelength": (0.0, 10.0, False),
+    "writhe": (0.0, 1.0, True),
+}
+CREATURE_ONLY = ("gait", "drivers")
+
+
+def _check(name: str, value: Any) -> float:
+    low, high, closed = TENTACLE_RANGES[name]
+    if isinstance(value, bool) or not isinstance(value, int | float) or not np.isfinite(value):
+        raise ValueError(f"{name}: must be a number, got {value!r}")
+    if not (low <= value if closed else low < value) or value > high:
+        bracket = "[" if closed else "("
+        raise ValueError(f"{name}: must be in {bracket}{low:g}, {high:g}], got {value!r}")
+    return float(value)
+
+
+class Locomotion:
+    """Per-creature and per-tentacle locomotion settings of a world."""
+
+    def __init__(self, world: World):
+        self._world = world
+
+    def _tentacles(self, creature: int, tentacle: int | None) -> list[Tentacle]:
+        entities = self._world.component(creature, Creature).tentacles
+        if tentacle is None:
+            return [self._world.component(e, Tentacle) for e in entities]
+        if not 0 <= tentacle < len(entities):
+            raise ValueError(f"tentacle: must be in [0, {len(entities) - 1}], got {tentacle}")
+        return [self._world.component(entities[tentacle], Tentacle)]
+
+    def set(self, creature: int, tentacle: int | None = None, **params: Any) -> None:
+        """Change parameters of a creature's tentacles (all, or the one at index `tentacle`).
+
+        `speed` without `tentacle` is the creature's speed; `gait` and `drivers` are
+        creature-wide. Everything is checked before anything changes.
+        """
+        world = self._world
+        row = world.component(creature, Creature).row
+        targets = self._tentacles(creature, tentacle)
+        unknown = set(params) - set(TENTACLE_RANGES) - set(CREATURE_ONLY)
+        if unknown:
+            allowed = ", ".join(sorted([*TENTACLE_RANGES, *CREATURE_ONLY]))
+            raise ValueError(f"{sorted(unknown)[0]}: unknown parameter (allowed: {allowed})")
+        if tentacle is not None and set(params) & set(CREATURE_ONLY):
+            raise ValueError(f"{sorted(set(params) & set(CREATURE_ONLY))[0]}: is set per creature")
+        checked = {k: _check(k, v) for k, v in params.items() if k in TENTACLE_RANGES}
+        if "gait" in params and params["gait"] not in GAITS:
+            raise ValueError(f"gait: must be one of {', '.join(GAITS)}, got {params['gait']!r}")
+        if "drivers" in params:
+            count = int(world.creatures.tentacles[row])
+            drivers = params["drivers"]
+            if (
+                isinstance(drivers, bool)
+                or not isinstance(drivers, int)
+                or not 1 <= drivers <= count
+            ):
+                raise ValueError(
+                    f"drivers: must be a whole number in [1, {count}], got {drivers!r}"
+                )
+            world.creatures.drivers[row] = drivers
+        if "gait" in params:
+            world.creatures.gait[row] = GAITS.index(params["gait"])
+        rows = np.array([t.row for t in targets])
+        for name, value in checked.items():
+            if name == "speed" and tentacle is None:
+                world.creatures.speed[row] = value
+            elif name in ("strength", "damping"):
+                links = self._link_rows(rows)
+                getattr(world.motors, name)[links] = value * world.motors.scale[links]
+            else:
+                getattr(world.tentacles, name)[rows] = value
+
+    def get(self, creature: int, tentacle: int = 0) -> dict[str, Any]:
+        """The parameters of one tentacle plus its creature's gait, speed and drivers."""
+        world = self._world
+        row = world.component(creature, Creature).row
+        t = self._tentacles(creature, tentacle)[0].row
+        first = int(world.tentacles.first_link[t])
+        values: dict[str, Any] = {
+            name: float(getattr(world.tentacles, name)[t])
+            for name in TENTACLE_RANGES
+            if name not in ("strength", "damping")
+        }
+        values["strength"] = float(world.motors.strength[first] / world.motors.scale[first])
+        values["damping"] = float(world.motors.damping[first] / world.motors.scale[first])
+        values["gait"] = GAITS[int(world.creatures.gait[row])]
+        values["creature_speed"] = float(world.creatures.speed[row])
+        values["drivers"] = int(world.creatures.drivers[row])
+        return values
+
+    def actions(self, creature: int) -> list[str]:
+        """The current action of each of the creature's tentacles, by index."""
+        kinds = self._world.tentacles.action[[t.row for t in self._tentacles(creature, None)]]
+        return [Kind(int(k)).name.lower() for k in kinds]
+
+    def queue(self, creature: int, tentacle: int) -> list[str]:
+        """The current action followed by the pending ones, for one tentacle."""
+        target = self._tentacles(creature, tentacle)[0]
+        entity = self._world.component(creature, Creature).tentacles[tentacle]
+        pending = self._world.component(entity, ActionQueue).kinds()
+        current = Kind(int(self._world.tentacles.action[target.row])).name.lower()
+        return [current, *pending]
+
+    def _link_rows(self, tentacle_rows: np.ndarray) -> np.ndarray:
+        first = self._world.tentacles.first_link[tentacle_rows]
+        count = self._world.tentacles.links[tentacle_rows]
+        return np.concatenate([np.arange(f, f + n) for f, n in zip(first, count, strict=True)])

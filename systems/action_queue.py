@@ -1,0 +1,68 @@
+"""action_queue: advances every tentacle's action timer and starts the next action.
+
+Reads: TentacleStore (timer, duration, action), Sucker store (attached: an attach
+action waits for its sucker, up to three times its duration), ActionQueues.
+Writes: TentacleStore (current action, timer, duration, angle, strength, orient;
+driving and mode go back to idle when a queue runs dry).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ecs_tentacles.components import Tentacle
+from ecs_tentacles.locomotion.actions import STRENGTH, ActionQueue, Kind, Mode
+from ecs_tentacles.system import System
+
+if TYPE_CHECKING:
+    from ecs_tentacles.world import World
+
+ATTACH_PATIENCE = 3.0
+
+
+class ActionQueueSystem(System):
+    name = "action_queue"
+    after = ("tentacle_selection",)
+
+    def setup(self, world: World) -> None:
+        self.queues = [ActionQueue()] * len(world.tentacles)
+        for entity, tentacle in world.query(Tentacle):
+            self.queues[tentacle.row] = world.component(entity, ActionQueue)
+
+    def process(self, world: World, dt: float) -> None:
+        t = world.tentacles
+        if not len(t):
+            return
+        t.timer += dt
+        done = t.timer >= t.duration
+        attaching = t.action == Kind.ATTACH
+        if attaching.any():
+            gripped = world.suckers.attached[t.tip_sucker]
+            done &= ~attaching | gripped | (t.timer >= ATTACH_PATIENCE * t.duration)
+        for row in np.flatnonzero(done):
+            self._advance(world, int(row))
+
+    def _advance(self, world: World, row: int) -> None:
+        t = world.tentacles
+        queue = self.queues[row].pending
+        t.timer[row] = 0.0
+        if not queue:
+            t.action[row] = Kind.IDLE
+            t.duration[row] = np.inf
+            t.action_angle[row] = 0.0
+            t.action_strength[row] = STRENGTH[Kind.IDLE]
+            t.orient[row] = 0.0
+            t.driving[row] = False
+            t.mode[row] = Mode.NONE
+            return
+        action = queue.popleft()
+        t.action[row] = action.kind
+        t.duration[row] = action.duration
+        t.action_angle[row] = action.angle
+        t.action_strength[row] = action.strength
+        if action.kind == Kind.ORIENT:
+            t.orient[row] = action.angle
+        elif action.kind == Kind.SETTLE:
+            t.orient[row] = 0.0

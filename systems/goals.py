@@ -1,0 +1,31 @@
+"""goals: a creature whose mantle enters its current goal's radius reaches it.
+
+Reads: CreatureStore (has_goal, goal, goal_radius, mantle_row), Transform store.
+Writes: through `world.goals.reach` (removes the goal entity, makes the next goal of
+the path current, fires `goal_reached`). Distances are measured in the ground plane.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ecs_tentacles.system import System
+
+if TYPE_CHECKING:
+    from ecs_tentacles.world import World
+
+
+class Goals(System):
+    name = "goals"
+
+    def process(self, world: World, dt: float) -> None:
+        creatures = world.creatures
+        if not creatures.has_goal.any():
+            return
+        mantle = world.transforms.pos[creatures.mantle_row, :2]
+        distance = np.linalg.norm(mantle - creatures.goal[:, :2], axis=1)
+        reached = creatures.has_goal & (distance <= creatures.goal_radius)
+        for row in np.flatnonzero(reached):
+            world.goals.reach(int(creatures.entity[row]))

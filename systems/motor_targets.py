@@ -1,0 +1,88 @@
+"""motor_targets: joint targets and servo gains of every link, from actions and waves.
+
+For every link at once: the pose of its tentacle's current action (a straight,
+slightly tilted tentacle, or an arch for compress/pull: link pitch
+-angle * sin(2 pi arc), flat at base and tip, which shortens the tentacle to about
+J0(angle) of its length), the orient sweep on the first two joints, plus travelling sine waves
+(amplitude, frequency, wavelength in tentacle lengths, per-tentacle phase) on curl
+and sweep; targets ease toward that (time constant SMOOTHING_SECONDS) so light
+tips never whip. Writhing (thesis IV.B): the servo gain is modulated by the same wave,
+scaled by the action's strength.
+
+Reads: TentacleStore (action, action_angle, action_strength, orient, mode, wave
+parameters), MotorStore (tentacle_row, arc). Writes: MotorStore (target, gain).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ecs_tentacles.locomotion.actions import Kind, Mode
+from ecs_tentacles.system import System
+
+if TYPE_CHECKING:
+    from ecs_tentacles.world import World
+
+# Constant pitch (radians, positive = tip down) of each action's pose.
+LIFT = np.zeros(len(Kind))
+LIFT[[Kind.COMPRESS, Kind.EXTEND, Kind.ORIENT, Kind.DETACH]] = [-0.08, -0.1, -0.08, -0.12]
+LIFT[Kind.ATTACH] = 0.04
+ORIENTED = np.zeros(len(Kind), dtype=bool)
+ORIENTED[
+    [Kind.ORIENT, Kind.EXTEND, Kind.COMPRESS, Kind.ATTACH, Kind.PUSH, Kind.PULL, Kind.DETACH]
+] = True
+GRIPPING = np.zeros(len(Kind), dtype=bool)
+GRIPPING[[Kind.ATTACH, Kind.PUSH, Kind.PULL]] = True
+GRIP_WAVE = 0.3  # waves are quieter while a sucker holds
+SMOOTHING_SECONDS = 0.06  # targets ease toward each new pose (slow-in) instead of jumping
+
+
+class MotorTargets(System):
+    name = "motor_targets"
+    after = ("action_queue",)
+
+    def setup(self, world: World) -> None:
+        motors, tentacles = world.motors, world.tentacles
+        rows = np.arange(len(motors))
+        self.previous = rows - 1
+        first = tentacles.first_link
+        self.previous[first] = -1
+        self.orient_share = np.zeros(len(motors))
+        self.orient_share[first] = 0.5
+        self.orient_share[np.minimum(first + 1, first + tentacles.links - 1)] += 0.5
+        # the eased targets live here, so systems that add to Motor.target after this one
+        # (user waves, the HUD) do not feed back into the easing
+        self.eased = motors.target[:, :2].copy()
+
+    def process(self, world: World, dt: float) -> None:
+        motors, t = world.motors, world.tentacles
+        if not len(motors):
+            return
+        row = motors.tentacle_row
+        kind = t.action[row]
+        mode = t.mode[row]
+        arc = motors.arc
+
+        arched = (
+            (kind == Kind.COMPRESS)
+            | (kind == Kind.PULL)
+            | ((kind == Kind.ATTACH) & (mode == Mode.PUSH))
+            | ((kind == Kind.DETACH) & (mode == Mode.PULL))
+        )
+        # the arch: rises from a flat base, peaks mid-way, comes down to a flat tip
+        pitch = np.where(arched, -t.action_angle[row] * np.sin(2 * np.pi * arc), 0.0) + LIFT[kind]
+        curl = pitch - np.where(self.previous >= 0, pitch[self.previous], 0.0)
+        sweep = np.where(ORIENTED[kind], t.orient[row] * self.orient_share, 0.0)
+
+        phase = (
+            2 * np.pi * (t.wave_frequency[row] * world.time - arc / t.wavelength[row])
+            + t.phase[row]
+        )
+        amplitude = t.wave_amplitude[row] * np.where(GRIPPING[kind], GRIP_WAVE, 1.0)
+        ease = 1.0 - np.exp(-dt / SMOOTHING_SECONDS)
+        self.eased[:, 0] += ease * (curl + amplitude * np.sin(phase) - self.eased[:, 0])
+        self.eased[:, 1] += ease * (sweep + amplitude * np.cos(phase) - self.eased[:, 1])
+        motors.target[:, :2] = self.eased
+        motors.gain = t.action_strength[row] * (1.0 + t.writhe[row] * np.sin(phase + np.pi / 3))

@@ -1,0 +1,60 @@
+"""suckers: grab and let go.
+
+* attach: a tentacle in its attach action grabs with its tip sucker once the sucker
+  touches the ground (within ATTACH_HEIGHT); the anchor is where the sucker is now.
+* release on command: when the tentacle's action no longer grips (detach, settle,
+  idle, ...).
+* release on stretch: the sucker is pulled farther than the creature's
+  `release_stretch` from its anchor (the elastic energy of the hold is too high).
+* release on reach: the tentacle's base is farther from the anchor than
+  `release_reach` tentacle lengths, so a creature never drags a sucker behind it.
+Each change fires `sucker_attached` / `sucker_released` (with the reason).
+
+Reads: TentacleStore (action, tip_sucker, length), CreatureStore (release
+thresholds), Sucker store, Transform store. Writes: Sucker store (attached, anchor).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ecs_tentacles.locomotion.actions import Kind
+from ecs_tentacles.system import System
+
+if TYPE_CHECKING:
+    from ecs_tentacles.world import World
+
+ATTACH_HEIGHT = 0.01  # metres above the ground a sucker may be and still grab
+HOLDING = np.zeros(len(Kind), dtype=bool)
+HOLDING[[Kind.ATTACH, Kind.PUSH, Kind.PULL]] = True
+
+
+class Suckers(System):
+    name = "suckers"
+    after = ("motor_targets",)
+    before = ("physics",)
+
+    def process(self, world: World, dt: float) -> None:
+        s, t, c = world.suckers, world.tentacles, world.creatures
+        if not len(s) or not len(t):
+            return
+        points = world.sucker_points()
+        tip = t.tip_sucker
+        grab = (t.action == Kind.ATTACH) & ~s.attached[tip] & (points[tip, 2] <= ATTACH_HEIGHT)
+        for row in tip[grab]:
+            world.attach(int(s.entity[row]))
+
+        if not s.attached.any():
+            return
+        tentacle = s.tentacle_row
+        creature = t.creature_row[tentacle]
+        holding = HOLDING[t.action[tentacle]] & (tip[tentacle] == np.arange(len(s)))
+        stretch = np.linalg.norm(points - s.anchor, axis=1) > c.release_stretch[creature]
+        base = world.transforms.pos[t.base_row[tentacle], :2]
+        reach = np.linalg.norm(base - s.anchor[:, :2], axis=1)
+        too_far = reach > c.release_reach[creature] * t.length[tentacle]
+        for reason, mask in (("command", ~holding), ("stretch", stretch), ("reach", too_far)):
+            for row in np.flatnonzero(s.attached & mask):
+                world.release(int(s.entity[row]), reason)

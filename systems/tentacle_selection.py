@@ -1,0 +1,146 @@
+"""tentacle_selection: which tentacles drive, and whether each pushes or pulls.
+
+Push or pull follows the thesis: compare the unit vectors mantle -> goal and
+mantle -> tentacle base (in the ground plane); an angle within +-pi/2 (dot >= 0)
+means the tentacle lies between mantle and goal: pull; otherwise push.
+
+* cyclic gait (the thesis): one driving tentacle at a time, in turn; a tentacle
+  classifies itself only when its stroke is queued.
+* coordinated gait (the thesis's future work): up to `drivers` tentacles at once,
+  started out of phase; the next driver is the idle tentacle nearest the goal line
+  (largest |cos|), pulls preferred; each first orients its base toward the goal
+  direction; drivers are re-classified every frame and abort when the goal has moved
+  to their other side.
+* no goal: drives stop (the sucker lets go) and every tentacle idles.
+
+Reads: CreatureStore (goal, gait, drivers, speed), TentacleStore (base, action,
+mode, driving), Transform store. Writes: TentacleStore (driving, mode, started,
+current action on abort), CreatureStore (next_driver, last_start), ActionQueues.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ecs_tentacles.components import Tentacle
+from ecs_tentacles.locomotion.actions import BASE_SECONDS, ActionQueue, Kind, Mode, drive_sequence
+from ecs_tentacles.locomotion.actions import make_action as action
+from ecs_tentacles.system import System
+
+if TYPE_CHECKING:
+    from ecs_tentacles.world import World
+
+CYCLIC, COORDINATED = 0, 1
+PULL_TOLERANCE = 1e-9  # dot products this close to 0 count as the +-pi/2 boundary: pull
+ABORT_MARGIN = 0.25  # coordinated drivers abort once cos is this far on the wrong side
+PUSH_PREFERENCE = 0.8  # pulls grip better than pushes
+MIN_SCORE = 0.2
+STROKE_SECONDS = sum(BASE_SECONDS[k] for k in (Kind.ORIENT, Kind.EXTEND, Kind.ATTACH, Kind.PULL))
+
+
+def classify(goal_dir: np.ndarray, base_dir: np.ndarray) -> np.ndarray:
+    """True where a tentacle should pull: angle between the unit vectors within +-pi/2."""
+    return np.einsum("ij,ij->i", goal_dir, base_dir) >= -PULL_TOLERANCE
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    norm = np.linalg.norm(v, axis=-1, keepdims=True)
+    return np.divide(v, norm, out=np.zeros_like(v), where=norm > 0)
+
+
+class TentacleSelection(System):
+    name = "tentacle_selection"
+    after = ("goals",)
+
+    def setup(self, world: World) -> None:
+        self.queues = [ActionQueue()] * len(world.tentacles)
+        for entity, tentacle in world.query(Tentacle):
+            self.queues[tentacle.row] = world.component(entity, ActionQueue)
+
+    def process(self, world: World, dt: float) -> None:
+        t, c = world.tentacles, world.creatures
+        if not len(t):
+            return
+        creature = t.creature_row
+        mantle = world.transforms.pos[c.mantle_row, :2]
+        goal_dir = _unit(c.goal[:, :2] - mantle)[creature]
+        base_dir = _unit(world.transforms.pos[t.base_row, :2] - mantle[creature])
+        cos = np.einsum("ij,ij->i", goal_dir, base_dir)
+        pull = cos >= -PULL_TOLERANCE
+        has_goal = c.has_goal[creature]
+
+        no_goal = t.driving & ~has_goal
+        wrong_side = (
+            t.driving
+            & has_goal
+            & (c.gait[creature] == COORDINATED)
+            & np.where(t.mode == Mode.PULL, cos < -ABORT_MARGIN, cos > ABORT_MARGIN)
+        )
+        for row in np.flatnonzero(no_goal | wrong_side):
+            self._abort(world, int(row))
+
+        driving = np.bincount(creature, weights=t.driving, minlength=len(c))
+        for row in np.flatnonzero(c.has_goal & (driving == 0) & (c.gait == CYCLIC)):
+            first = int(c.first_tentacle[row])
+            k = first + int(c.next_driver[row])
+            self._start(world, k, Mode.PULL if pull[k] else Mode.PUSH, orient=None)
+            c.next_driver[row] = (c.next_driver[row] + 1) % c.tentacles[row]
+
+        stagger = STROKE_SECONDS / (c.speed * np.maximum(c.drivers, 1))
+        ready = (
+            c.has_goal
+            & (c.gait == COORDINATED)
+            & (driving < c.drivers)
+            & (world.time - c.last_start >= stagger)
+        )
+        for row in np.flatnonzero(ready):
+            self._start_best(world, int(row), cos, pull, goal_dir, base_dir)
+
+    def _start_best(
+        self,
+        world: World,
+        creature_row: int,
+        cos: np.ndarray,
+        pull: np.ndarray,
+        goal_dir: np.ndarray,
+        base_dir: np.ndarray,
+    ) -> None:
+        t, c = world.tentacles, world.creatures
+        first = int(c.first_tentacle[creature_row])
+        rows = np.arange(first, first + int(c.tentacles[creature_row]))
+        free = ~t.driving[rows] & (t.action[rows] == Kind.IDLE)
+        score = np.abs(cos[rows]) * np.where(pull[rows], 1.0, PUSH_PREFERENCE)
+        score[~free] = -1.0
+        best = int(np.argmax(score))
+        if score[best] < MIN_SCORE:
+            return
+        k = int(rows[best])
+        mode = Mode.PULL if pull[k] else Mode.PUSH
+        wanted = goal_dir[k] if mode == Mode.PULL else -goal_dir[k]
+        turn = np.arctan2(
+            base_dir[k, 0] * wanted[1] - base_dir[k, 1] * wanted[0], base_dir[k] @ wanted
+        )
+        limit = 1.8 * t.joint_limit[k]  # the sweep is shared by the first two joints
+        self._start(world, k, mode, orient=float(np.clip(turn, -limit, limit)))
+        c.last_start[creature_row] = world.time
+
+    def _start(self, world: World, row: int, mode: Mode, orient: float | None) -> None:
+        t = world.tentacles
+        speed = float(t.speed[row] * world.creatures.speed[t.creature_row[row]])
+        self.queues[row].extend(drive_sequence(mode, float(t.target_angle[row]), speed, orient))
+        t.driving[row] = True
+        t.mode[row] = mode
+        t.started[row] = world.time
+        t.duration[row] = 0.0  # the action queue moves on to the new actions this frame
+
+    def _abort(self, world: World, row: int) -> None:
+        t = world.tentacles
+        speed = float(t.speed[row] * world.creatures.speed[t.creature_row[row]])
+        queue = self.queues[row]
+        queue.clear()
+        queue.extend([action(Kind.DETACH, speed), action(Kind.SETTLE, speed)])
+        t.driving[row] = False
+        t.mode[row] = Mode.NONE
+        t.duration[row] = 0.0
