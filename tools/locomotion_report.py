@@ -143,7 +143,8 @@ def summary(rows: list[dict[str, Any]]) -> list[str]:
     if all(by_gait.values()):
         med = {g: statistics.median(r["time_s"] for r in by_gait[g]) for g in GAITS}
         lines.append(
-            f"median time to goal: cyclic {med['cyclic']:.1f} s, coordinated {med['coordinated']:.1f} s"
+            f"median time to goal: cyclic {med['cyclic']:.1f} s,"
+            f" coordinated {med['coordinated']:.1f} s"
             f" -> coordinated is {med['cyclic'] / med['coordinated']:.2f}x as fast"
         )
     missed = [f"{r['case']}/{r['gait']}" for r in goal_rows if not r["reached"]]
@@ -172,12 +173,14 @@ def main() -> None:
     if args.json:
         print(json.dumps(rows, indent=1))
         return
-    header = f"{'case':<12} {'n':>2} {'gait':<11} {'reached':<7} {'time_s':>6} {'radii/s':>7} {'effic':>5} {'attach':>6} {'pen_mm':>6}"
-    print(header)
+    print(
+        f"{'case':<12} {'n':>2} {'gait':<11} {'reached':<7} {'time_s':>6} {'radii/s':>7}"
+        f" {'effic':>5} {'attach':>6} {'pen_mm':>6}"
+    )
     for r in rows:
         print(
-            f"{r['case']:<12} {r['tentacles']:>2} {r['gait']:<11} {r['reached']!s:<7} {r['time_s']:>6.1f}"
-            f" {r['speed_radii_per_s']:>7.3f} {r['path_efficiency'] or 0:>5.2f} {r['attaches']:>6}"
+            f"{r['case']:<12} {r['tentacles']:>2} {r['gait']:<11} {r['reached']!s:<7}"
+            f" {r['time_s']:>6.1f} {r['speed_radii_per_s']:>7.3f} {r['path_efficiency'] or 0:>5.2f} {r['attaches']:>6}"
             f" {1000 * r['max_penetration_m']:>6.1f}"
             + (
                 f"  drift {r['drift_radii']:.2f} radii, joint std {r['joint_std_rad']:.3f} rad"
