@@ -180,7 +180,8 @@ def main() -> None:
     for r in rows:
         print(
             f"{r['case']:<12} {r['tentacles']:>2} {r['gait']:<11} {r['reached']!s:<7}"
-            f" {r['time_s']:>6.1f} {r['speed_radii_per_s']:>7.3f} {r['path_efficiency'] or 0:>5.2f} {r['attaches']:>6}"
+            f" {r['time_s']:>6.1f} {r['speed_radii_per_s']:>7.3f}"
+            f" {r['path_efficiency'] or 0:>5.2f} {r['attaches']:>6}"
             f" {1000 * r['max_penetration_m']:>6.1f}"
             + (
                 f"  drift {r['drift_radii']:.2f} radii, joint std {r['joint_std_rad']:.3f} rad"
