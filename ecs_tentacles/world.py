@@ -25,6 +25,7 @@ from ecs_tentacles.components import Creature, Sucker
 from ecs_tentacles.events import Events
 from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.locomotion.params import Locomotion
+from ecs_tentacles.mathutil import quat_rotate
 from ecs_tentacles.physics.backend import PhysicsBackend
 from ecs_tentacles.schedule import Schedule
 from ecs_tentacles.store import (
@@ -179,16 +180,19 @@ class World:
         return self.frame * self.settings.dt
 
     # -- suckers ------------------------------------------------------------------------
-    def sucker_points(self) -> np.ndarray:
-        """World position (n, 3) of every sucker, by sucker row."""
-        return self.physics.sucker_points(self.suckers, self.transforms)
+    def sucker_points(self, rows: np.ndarray | None = None) -> np.ndarray:
+        """World position (n, 3) of every sucker (or of sucker `rows`), by sucker row."""
+        suckers = self.suckers
+        links = suckers.link_row if rows is None else suckers.link_row[rows]
+        offset = suckers.offset if rows is None else suckers.offset[rows]
+        return self.transforms.pos[links] + quat_rotate(self.transforms.quat[links], offset)
 
     def attach(self, sucker_entity: int) -> None:
         """Fix a sucker to the world where it is now; fires `sucker_attached`."""
         sucker = self.component(sucker_entity, Sucker)
         if sucker.attached:
             return
-        sucker.anchor = self.sucker_points()[sucker.row]
+        sucker.anchor = self.sucker_points(np.array([sucker.row]))[0]
         sucker.attached = True
         self.events.emit(
             "sucker_attached", world=self, sucker=sucker_entity, anchor=sucker.anchor.copy()

@@ -20,6 +20,7 @@ if TYPE_CHECKING:
     from ecs_tentacles.world import World
 
 ATTACH_PATIENCE = 3.0
+ATTACH = int(Kind.ATTACH)
 
 
 class ActionQueueSystem(System):
@@ -37,7 +38,7 @@ class ActionQueueSystem(System):
             return
         t.timer += dt
         done = t.timer >= t.duration
-        attaching = t.action == Kind.ATTACH
+        attaching = t.action == ATTACH
         if attaching.any():
             gripped = world.suckers.attached[t.tip_sucker]
             done &= ~attaching | gripped | (t.timer >= ATTACH_PATIENCE * t.duration)

@@ -24,8 +24,8 @@ class Goals(System):
         creatures = world.creatures
         if not creatures.has_goal.any():
             return
-        mantle = world.transforms.pos[creatures.mantle_row, :2]
-        distance = np.linalg.norm(mantle - creatures.goal[:, :2], axis=1)
-        reached = creatures.has_goal & (distance <= creatures.goal_radius)
+        offset = world.transforms.pos[creatures.mantle_row, :2] - creatures.goal[:, :2]
+        distance_sq = np.einsum("ij,ij->i", offset, offset)
+        reached = creatures.has_goal & (distance_sq <= creatures.goal_radius**2)
         for row in np.flatnonzero(reached):
             world.goals.reach(int(creatures.entity[row]))

@@ -35,6 +35,11 @@ ORIENTED[
 ] = True
 GRIPPING = np.zeros(len(Kind), dtype=bool)
 GRIPPING[[Kind.ATTACH, Kind.PUSH, Kind.PULL]] = True
+# Which (action, mode) pairs hold the arch pose.
+ARCHED = np.zeros((len(Kind), len(Mode)), dtype=bool)
+ARCHED[[Kind.COMPRESS, Kind.PULL], :] = True
+ARCHED[Kind.ATTACH, Mode.PUSH] = True
+ARCHED[Kind.DETACH, Mode.PULL] = True
 GRIP_WAVE = 0.3  # waves are quieter while a sucker holds
 SMOOTHING_SECONDS = 0.06  # targets ease toward each new pose (slow-in) instead of jumping
 
@@ -65,12 +70,7 @@ class MotorTargets(System):
         mode = t.mode[row]
         arc = motors.arc
 
-        arched = (
-            (kind == Kind.COMPRESS)
-            | (kind == Kind.PULL)
-            | ((kind == Kind.ATTACH) & (mode == Mode.PUSH))
-            | ((kind == Kind.DETACH) & (mode == Mode.PULL))
-        )
+        arched = ARCHED[kind, mode]
         # the arch: rises from a flat base, peaks mid-way, comes down to a flat tip
         pitch = np.where(arched, -t.action_angle[row] * np.sin(2 * np.pi * arc), 0.0) + LIFT[kind]
         curl = pitch - np.where(self.previous >= 0, pitch[self.previous], 0.0)

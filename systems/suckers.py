@@ -27,6 +27,7 @@ if TYPE_CHECKING:
     from ecs_tentacles.world import World
 
 ATTACH_HEIGHT = 0.01  # metres above the ground a sucker may be and still grab
+ATTACH = int(Kind.ATTACH)
 HOLDING = np.zeros(len(Kind), dtype=bool)
 HOLDING[[Kind.ATTACH, Kind.PUSH, Kind.PULL]] = True
 
@@ -40,21 +41,32 @@ class Suckers(System):
         s, t, c = world.suckers, world.tentacles, world.creatures
         if not len(s) or not len(t):
             return
-        points = world.sucker_points()
+        attached = s.attached
         tip = t.tip_sucker
-        grab = (t.action == Kind.ATTACH) & ~s.attached[tip] & (points[tip, 2] <= ATTACH_HEIGHT)
-        for row in tip[grab]:
-            world.attach(int(s.entity[row]))
+        reaching = np.flatnonzero(t.action == ATTACH)
+        if len(reaching):
+            rows = tip[reaching]
+            rows = rows[~attached[rows]]
+            low = world.sucker_points(rows)[:, 2] <= ATTACH_HEIGHT
+            for row in rows[low]:
+                world.attach(int(s.entity[row]))
 
-        if not s.attached.any():
+        held = np.flatnonzero(attached)
+        if not len(held):
             return
-        tentacle = s.tentacle_row
+        tentacle = s.tentacle_row[held]
         creature = t.creature_row[tentacle]
-        holding = HOLDING[t.action[tentacle]] & (tip[tentacle] == np.arange(len(s)))
-        stretch = np.linalg.norm(points - s.anchor, axis=1) > c.release_stretch[creature]
+        anchor = s.anchor[held]
+        holding = HOLDING[t.action[tentacle]] & (tip[tentacle] == held)
+        stretch = np.linalg.norm(world.sucker_points(held) - anchor, axis=1)
         base = world.transforms.pos[t.base_row[tentacle], :2]
-        reach = np.linalg.norm(base - s.anchor[:, :2], axis=1)
-        too_far = reach > c.release_reach[creature] * t.length[tentacle]
-        for reason, mask in (("command", ~holding), ("stretch", stretch), ("reach", too_far)):
-            for row in np.flatnonzero(s.attached & mask):
-                world.release(int(s.entity[row]), reason)
+        reach = np.linalg.norm(base - anchor[:, :2], axis=1)
+        reasons = (
+            ("command", ~holding),
+            ("stretch", stretch > c.release_stretch[creature]),
+            ("reach", reach > c.release_reach[creature] * t.length[tentacle]),
+        )
+        for reason, mask in reasons:
+            for row in held[mask]:
+                if attached[row]:  # a sucker is released once, for the first reason
+                    world.release(int(s.entity[row]), reason)

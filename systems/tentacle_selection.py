@@ -33,6 +33,7 @@ if TYPE_CHECKING:
     from ecs_tentacles.world import World
 
 CYCLIC, COORDINATED = 0, 1
+PULL = int(Mode.PULL)
 PULL_TOLERANCE = 1e-9  # dot products this close to 0 count as the +-pi/2 boundary: pull
 ABORT_MARGIN = 0.25  # coordinated drivers abort once cos is this far on the wrong side
 PUSH_PREFERENCE = 0.8  # pulls grip better than pushes
@@ -46,8 +47,8 @@ def classify(goal_dir: np.ndarray, base_dir: np.ndarray) -> np.ndarray:
 
 
 def _unit(v: np.ndarray) -> np.ndarray:
-    norm = np.linalg.norm(v, axis=-1, keepdims=True)
-    return np.divide(v, norm, out=np.zeros_like(v), where=norm > 0)
+    norm = np.sqrt(np.einsum("ij,ij->i", v, v))[:, None]
+    return v / np.where(norm > 0, norm, np.inf)
 
 
 class TentacleSelection(System):
@@ -61,7 +62,7 @@ class TentacleSelection(System):
 
     def process(self, world: World, dt: float) -> None:
         t, c = world.tentacles, world.creatures
-        if not len(t):
+        if not len(t) or not (c.has_goal.any() or t.driving.any()):
             return
         creature = t.creature_row
         mantle = world.transforms.pos[c.mantle_row, :2]
@@ -76,7 +77,7 @@ class TentacleSelection(System):
             t.driving
             & has_goal
             & (c.gait[creature] == COORDINATED)
-            & np.where(t.mode == Mode.PULL, cos < -ABORT_MARGIN, cos > ABORT_MARGIN)
+            & np.where(t.mode == PULL, cos < -ABORT_MARGIN, cos > ABORT_MARGIN)
         )
         for row in np.flatnonzero(no_goal | wrong_side):
             self._abort(world, int(row))

@@ -13,7 +13,6 @@ from typing import TYPE_CHECKING
 import mujoco
 import numpy as np
 
-from ecs_tentacles.mathutil import quat_rotate
 from ecs_tentacles.physics.model import build_spec
 
 if TYPE_CHECKING:
@@ -92,11 +91,6 @@ class PhysicsBackend:
         np.take(self.data.xquat, self.body_ids, axis=0, out=transforms.quat, mode="clip")
 
     # -- queries ---------------------------------------------------------------------
-    def sucker_points(self, suckers: SuckerStore, transforms: TransformStore) -> np.ndarray:
-        """World position (n, 3) of every sucker, from the Transform store."""
-        rows = suckers.link_row
-        return transforms.pos[rows] + quat_rotate(transforms.quat[rows], suckers.offset)
-
     @property
     def time(self) -> float:
         return float(self.data.time)
