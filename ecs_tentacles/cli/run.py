@@ -69,7 +69,8 @@ def handle(args: argparse.Namespace) -> int:
             f" {summary['wall_seconds']:.2f} s wall,"
             f" real-time factor {summary['real_time_factor']:.2f}x"
             f" ({summary['creatures']} creatures, {summary['bodies']} bodies,"
-            f" {summary['dofs']} dofs)"
+            f" {summary['dofs']} dofs); goals reached {summary['goals_reached']},"
+            f" left {summary['goals_left']}; sucker attaches {summary['sucker_attaches']}"
         )
     return 0
 
@@ -101,4 +102,7 @@ def simulate(world: World, frames: int, *, progress: bool = True) -> dict[str, A
         "bodies": int(model.nbody - 1),
         "dofs": int(model.nv),
         "physics_resets": int(world.physics.resets),
+        "goals_reached": int(world.events.counts["goal_reached"]),
+        "goals_left": int(sum(len(world.goals.path(e)) for e, _ in world.query(Creature))),
+        "sucker_attaches": int(world.events.counts["sucker_attached"]),
     }

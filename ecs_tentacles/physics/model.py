@@ -7,8 +7,10 @@
   sweep (about local +z; positive swings counter-clockwise) and optional twist
   (about local +x), each driven by a position servo (kp = strength, kv = damping);
 * sucker: an inactive `connect` equality between its link and the world;
-* ground: an infinite plane. Creatures touch the ground and static geoms, not each
-  other or themselves (contype/conaffinity bits), which keeps crowds cheap.
+* ground: an infinite plane. Creatures touch the ground and each other, never
+  themselves: creature k's geoms carry collision bit 1 + k % 30 and accept every
+  creature bit but their own (creatures 30 apart in a scene therefore pass through
+  each other).
 
 Every element gets a stable name (`octo/t3/l07/curl`); `ModelNames` lists them per
 store row so the backend can look ids up once after compiling.
@@ -31,8 +33,17 @@ if TYPE_CHECKING:
 AXES = {"curl": (0.0, 1.0, 0.0), "sweep": (0.0, 0.0, 1.0), "twist": (1.0, 0.0, 0.0)}
 AXIS_INDEX = {"curl": 0, "sweep": 1, "twist": 2}
 JOINT_ARMATURE = 0.002
-CREATURE_CONTYPE, CREATURE_CONAFFINITY = 2, 1
-GROUND_CONTYPE, GROUND_CONAFFINITY = 1, 2
+GROUND_BIT = 1
+CREATURE_BITS = 30
+ALL_CREATURES = ((1 << CREATURE_BITS) - 1) << 1
+
+
+def collision_bits(index: int) -> tuple[int, int]:
+    """(contype, conaffinity) of creature `index`: touches the ground and other creatures."""
+    own = 1 << (1 + index % CREATURE_BITS)
+    return own, GROUND_BIT | (ALL_CREATURES & ~own)
+
+
 # MuJoCo takes the larger friction of two touching geoms: creature skin is zero so the
 # scene's ground_friction alone sets how creatures slide.
 SKIN_FRICTION = [0.0, 0.0, 0.0]
@@ -69,20 +80,25 @@ def build_spec(world: World) -> tuple[mujoco.MjSpec, ModelNames]:
         type=mujoco.mjtGeom.mjGEOM_PLANE,
         size=[0.0, 0.0, 1.0],
         friction=[settings.ground_friction, 0.005, 0.0001],
-        contype=GROUND_CONTYPE,
-        conaffinity=GROUND_CONAFFINITY,
+        contype=GROUND_BIT,
+        conaffinity=ALL_CREATURES,
         solref=CONTACT_SOLREF,
     )
     names = ModelNames(bodies=[""] * len(world.transforms))
-    for _, (creature, transform) in sorted(world.query(Creature, Transform)):
-        _add_creature(spec, world, creature, transform, names)
+    for index, (_, (creature, transform)) in enumerate(sorted(world.query(Creature, Transform))):
+        _add_creature(spec, world, creature, transform, names, collision_bits(index))
     if any(not name for name in names.bodies):
         raise RuntimeError("a Transform row has no body: build entities with ecs_tentacles.build")
     return spec, names
 
 
 def _add_creature(
-    spec: mujoco.MjSpec, world: World, creature: Creature, transform: Transform, names: ModelNames
+    spec: mujoco.MjSpec,
+    world: World,
+    creature: Creature,
+    transform: Transform,
+    names: ModelNames,
+    bits: tuple[int, int],
 ) -> None:
     mantle = spec.worldbody.add_body(
         name=f"{creature.name}/mantle", pos=transform.pos, quat=transform.quat
@@ -93,8 +109,8 @@ def _add_creature(
         type=mujoco.mjtGeom.mjGEOM_CYLINDER,
         size=[creature.mantle_radius, 0.5 * creature.mantle_height, 0.0],
         density=creature.mantle_density,
-        contype=CREATURE_CONTYPE,
-        conaffinity=CREATURE_CONAFFINITY,
+        contype=bits[0],
+        conaffinity=bits[1],
         friction=SKIN_FRICTION,
         solref=CONTACT_SOLREF,
     )
@@ -126,8 +142,8 @@ def _add_creature(
                 fromto=[-0.5 * link.length, 0, 0, 0.5 * link.length, 0, 0],
                 size=[link.radius, 0.0, 0.0],
                 density=link.density,
-                contype=CREATURE_CONTYPE,
-                conaffinity=CREATURE_CONAFFINITY,
+                contype=bits[0],
+                conaffinity=bits[1],
                 friction=SKIN_FRICTION,
                 solref=CONTACT_SOLREF,
             )

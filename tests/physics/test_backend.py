@@ -156,3 +156,23 @@ def test_physics_sync_copies_poses_bit_for_bit(make_world: Callable[..., World])
     link = _tentacle(world, 3).links[2]
     body = world.physics.model.body("octo/t3/l02").id
     assert_array_equal(world.component(link, Transform).pos, data.xpos[body])
+
+
+def test_creatures_touch_each_other_but_never_themselves(make_world: Callable[..., World]) -> None:
+    # two creatures 0.9 m apart, tentacle 0 of each reaching 0.6 m toward the other
+    scene = {
+        "version": 1,
+        "creatures": [
+            {"name": "a", "position": [0.0, 0.0], "tentacles": {"count": 4}},
+            {"name": "b", "position": [0.9, 0.0], "heading_deg": 180, "tentacles": {"count": 4}},
+        ],
+    }
+    world = make_world(scene, locomotion=False)
+    model, data = world.physics.model, world.physics.data
+    mujoco.mj_forward(model, data)
+    owner = [
+        mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_GEOM, g).split("/")[0]
+        for g in range(model.ngeom)
+    ]
+    pairs = {tuple(sorted((owner[g1], owner[g2]))) for g1, g2 in data.contact.geom[: data.ncon]}
+    assert pairs == {("a", "b"), ("a", "ground"), ("b", "ground")}
