@@ -14,7 +14,7 @@ import numpy as np
 
 from ecs_tentacles.components import Creature, Link, Motor, Sucker, Tentacle, Transform
 from ecs_tentacles.construction import tentacle_angles, tentacle_shape
-from ecs_tentacles.locomotion.actions import ActionQueue
+from ecs_tentacles.locomotion.actions import STRENGTH, ActionQueue, Kind
 from ecs_tentacles.mathutil import quat_about_z, quat_rotate
 
 if TYPE_CHECKING:
@@ -93,6 +93,7 @@ def _add_tentacle_row(
     links = [world.component(e, Link) for e in tentacle.links]
     motors = [world.component(e, Motor) for e in tentacle.links]
     sucker = world.component(tentacle.suckers[-1], Sucker)
+    length = sum(link.length for link in links)
     tentacle.row = int(
         world.tentacles.add(
             creature_row=creature_row,
@@ -101,8 +102,9 @@ def _add_tentacle_row(
             links=len(links),
             base_row=world.component(tentacle.links[0], Transform).row,
             tip_sucker=sucker.row,
-            length=sum(link.length for link in links),
+            length=length,
             joint_limit=links[0].joint_limit,
+            rest_pitch=np.arcsin((links[0].radius - links[-1].radius) / length),
             speed=params["speed"],
             target_angle=np.radians(params["target_angle_deg"]),
             wave_amplitude=np.radians(params["wave_amplitude_deg"]),
@@ -110,6 +112,7 @@ def _add_tentacle_row(
             wavelength=params["wavelength"],
             writhe=params["writhe"],
             phase=world.rng.uniform(0.0, 2.0 * np.pi),
+            action_strength=STRENGTH[Kind.IDLE],
         )[0]
     )
     world.motors.tentacle_row[[m.row for m in motors]] = tentacle.row

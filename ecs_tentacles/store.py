@@ -132,6 +132,7 @@ class TentacleStore(ArrayStore):
     tip_sucker = Field(dtype=np.int64)  # sucker row on the tip link
     length = Field()
     joint_limit = Field()
+    rest_pitch = Field()  # tilt that lays a tapering tentacle's underside on the ground
     # parameters
     speed = Field(default=1.0)
     target_angle = Field()

@@ -20,6 +20,7 @@ if TYPE_CHECKING:
     from ecs_tentacles.world import World
 
 ATTACH_PATIENCE = 3.0
+TIME_EPSILON = 1e-9  # sums of frame durations fall a hair short of whole durations
 ATTACH = int(Kind.ATTACH)
 
 
@@ -37,11 +38,12 @@ class ActionQueueSystem(System):
         if not len(t):
             return
         t.timer += dt
-        done = t.timer >= t.duration
+        done = t.timer >= t.duration - TIME_EPSILON
         attaching = t.action == ATTACH
         if attaching.any():
             gripped = world.suckers.attached[t.tip_sucker]
-            done &= ~attaching | gripped | (t.timer >= ATTACH_PATIENCE * t.duration)
+            patience = ATTACH_PATIENCE * t.duration - TIME_EPSILON
+            done &= ~attaching | gripped | (t.timer >= patience)
         for row in np.flatnonzero(done):
             self._advance(world, int(row))
 

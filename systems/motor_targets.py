@@ -1,7 +1,8 @@
 """motor_targets: joint targets and servo gains of every link, from actions and waves.
 
 For every link at once: the pose of its tentacle's current action (a straight,
-slightly tilted tentacle, or an arch for compress/pull: link pitch
+slightly tilted tentacle, drooping toward its tip so a tapering tentacle's
+underside lies on the ground, or an arch for compress/pull: link pitch
 -angle * sin(2 pi arc), flat at base and tip, which shortens the tentacle to about
 J0(angle) of its length), the orient sweep on the first two joints, plus travelling sine waves
 (amplitude, frequency, wavelength in tentacle lengths, per-tentacle phase) on curl
@@ -18,6 +19,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 import numpy as np
+from ecs_tentacles.systems.action_queue import ATTACH_PATIENCE
 
 from ecs_tentacles.locomotion.actions import Kind, Mode
 from ecs_tentacles.system import System
@@ -28,7 +30,7 @@ if TYPE_CHECKING:
 # Constant pitch (radians, positive = tip down) of each action's pose.
 LIFT = np.zeros(len(Kind))
 LIFT[[Kind.COMPRESS, Kind.EXTEND, Kind.ORIENT, Kind.DETACH]] = [-0.08, -0.1, -0.08, -0.12]
-LIFT[Kind.ATTACH] = 0.04
+LIFT[Kind.ATTACH] = 0.0
 ORIENTED = np.zeros(len(Kind), dtype=bool)
 ORIENTED[
     [Kind.ORIENT, Kind.EXTEND, Kind.COMPRESS, Kind.ATTACH, Kind.PUSH, Kind.PULL, Kind.DETACH]
@@ -40,7 +42,11 @@ ARCHED = np.zeros((len(Kind), len(Mode)), dtype=bool)
 ARCHED[[Kind.COMPRESS, Kind.PULL], :] = True
 ARCHED[Kind.ATTACH, Mode.PUSH] = True
 ARCHED[Kind.DETACH, Mode.PULL] = True
-GRIP_WAVE = 0.3  # waves are quieter while a sucker holds
+ATTACH = int(Kind.ATTACH)
+ATTACH_PRESS = 0.15  # extra tip-down pitch (at the tip) per attach duration without a grip
+# While a tentacle grips, its vertical wave stops (the tip must stay on the ground)
+# and its sideways wave quietens.
+GRIP_CURL_WAVE, GRIP_SWEEP_WAVE = 0.0, 0.3
 SMOOTHING_SECONDS = 0.06  # targets ease toward each new pose (slow-in) instead of jumping
 
 
@@ -72,7 +78,13 @@ class MotorTargets(System):
 
         arched = ARCHED[kind, mode]
         # the arch: rises from a flat base, peaks mid-way, comes down to a flat tip
-        pitch = np.where(arched, -t.action_angle[row] * np.sin(2 * np.pi * arc), 0.0) + LIFT[kind]
+        pitch = np.where(arched, -t.action_angle[row] * np.sin(2 * np.pi * arc), 0.0)
+        # the base lies on the ground and cannot tilt down, so tip-down bends are ramps
+        # along the tentacle: the rest droop, and an attaching tip pressing down further
+        # the longer it takes to touch the ground
+        progress = np.minimum(t.timer / t.duration, ATTACH_PATIENCE)[row]
+        droop = 2.0 * t.rest_pitch[row] + np.where(kind == ATTACH, ATTACH_PRESS * progress, 0.0)
+        pitch += LIFT[kind] + droop * arc
         curl = pitch - np.where(self.previous >= 0, pitch[self.previous], 0.0)
         sweep = np.where(ORIENTED[kind], t.orient[row] * self.orient_share, 0.0)
 
@@ -80,9 +92,12 @@ class MotorTargets(System):
             2 * np.pi * (t.wave_frequency[row] * world.time - arc / t.wavelength[row])
             + t.phase[row]
         )
-        amplitude = t.wave_amplitude[row] * np.where(GRIPPING[kind], GRIP_WAVE, 1.0)
+        amplitude = t.wave_amplitude[row]
+        gripping = GRIPPING[kind]
+        curl_amplitude = amplitude * np.where(gripping, GRIP_CURL_WAVE, 1.0)
+        sweep_amplitude = amplitude * np.where(gripping, GRIP_SWEEP_WAVE, 1.0)
         ease = 1.0 - np.exp(-dt / SMOOTHING_SECONDS)
-        self.eased[:, 0] += ease * (curl + amplitude * np.sin(phase) - self.eased[:, 0])
-        self.eased[:, 1] += ease * (sweep + amplitude * np.cos(phase) - self.eased[:, 1])
+        self.eased[:, 0] += ease * (curl + curl_amplitude * np.sin(phase) - self.eased[:, 0])
+        self.eased[:, 1] += ease * (sweep + sweep_amplitude * np.cos(phase) - self.eased[:, 1])
         motors.target[:, :2] = self.eased
         motors.gain = t.action_strength[row] * (1.0 + t.writhe[row] * np.sin(phase + np.pi / 3))

@@ -26,7 +26,7 @@ from ecs_tentacles.system import System
 if TYPE_CHECKING:
     from ecs_tentacles.world import World
 
-ATTACH_HEIGHT = 0.01  # metres above the ground a sucker may be and still grab
+ATTACH_HEIGHT = 0.004  # metres above the ground a sucker may be and still grab
 ATTACH = int(Kind.ATTACH)
 HOLDING = np.zeros(len(Kind), dtype=bool)
 HOLDING[[Kind.ATTACH, Kind.PUSH, Kind.PULL]] = True

@@ -45,22 +45,32 @@ class GoalBook:
         return np.array(goals).reshape(-1, 3)
 
     def set(self, creature: int, position: Sequence[float], radius: float = DEFAULT_RADIUS) -> int:
-        """Replace the creature's path with one goal; return the goal entity."""
+        """Replace the creature's path with one goal; return the goal entity.
+
+        A bad position or radius raises ValueError and leaves the old path alone.
+        """
+        point = self._checked(creature, position, radius)
         self.clear(creature)
-        return self.append(creature, position, radius)
+        return self._append(creature, point, radius)
 
     def append(
         self, creature: int, position: Sequence[float], radius: float = DEFAULT_RADIUS
     ) -> int:
         """Add a goal at the end of the creature's path; return the goal entity."""
-        point = np.zeros(3)
+        return self._append(creature, self._checked(creature, position, radius), radius)
+
+    def _checked(self, creature: int, position: Sequence[float], radius: float) -> np.ndarray:
         values = np.asarray(position, dtype=np.float64)
         if values.shape not in ((2,), (3,)) or not np.isfinite(values).all():
             raise ValueError(f"goal position must be 2 or 3 finite numbers, got {list(position)}")
         if not radius > 0:
             raise ValueError(f"goal radius must be > 0, got {radius}")
         self._world.component(creature, Creature)  # raises KeyError for a non-creature
+        point = np.zeros(3)
         point[: len(values)] = values
+        return point
+
+    def _append(self, creature: int, point: np.ndarray, radius: float) -> int:
         path = self._paths.setdefault(creature, [])
         goal = self._world.create_entity(Goal(creature, len(path), point, float(radius)))
         path.append(goal)

@@ -12,6 +12,7 @@ ValueError naming the parameter. Changes reach the servos on the next physics st
 
 from __future__ import annotations
 
+import numbers
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -39,7 +40,10 @@ CREATURE_ONLY = ("gait", "drivers")
 
 def _check(name: str, value: Any) -> float:
     low, high, closed = TENTACLE_RANGES[name]
-    if isinstance(value, bool) or not isinstance(value, int | float) or not np.isfinite(value):
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise ValueError(f"{name}: must be a number, got {value!r}")
+    value = float(value)
+    if not np.isfinite(value):
         raise ValueError(f"{name}: must be a number, got {value!r}")
     if not (low <= value if closed else low < value) or value > high:
         bracket = "[" if closed else "("
@@ -82,15 +86,12 @@ class Locomotion:
         if "drivers" in params:
             count = int(world.creatures.tentacles[row])
             drivers = params["drivers"]
-            if (
-                isinstance(drivers, bool)
-                or not isinstance(drivers, int)
-                or not 1 <= drivers <= count
-            ):
+            whole = isinstance(drivers, numbers.Integral) and not isinstance(drivers, bool)
+            if not whole or not 1 <= drivers <= count:
                 raise ValueError(
                     f"drivers: must be a whole number in [1, {count}], got {drivers!r}"
                 )
-            world.creatures.drivers[row] = drivers
+            world.creatures.drivers[row] = int(drivers)
         if "gait" in params:
             world.creatures.gait[row] = GAITS.index(params["gait"])
         rows = np.array([t.row for t in targets])

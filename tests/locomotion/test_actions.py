@@ -1,0 +1,86 @@
+"""Actions and the push and pull sequences (thesis IV.B)."""
+
+from __future__ import annotations
+
+import pytest
+
+from ecs_tentacles.locomotion.actions import (
+    BASE_SECONDS,
+    STRENGTH,
+    Action,
+    ActionQueue,
+    Kind,
+    Mode,
+    drive_sequence,
+    make_action,
+)
+
+PUSH = [Kind.COMPRESS, Kind.ATTACH, Kind.PUSH, Kind.DETACH]
+PULL = [Kind.EXTEND, Kind.ATTACH, Kind.PULL, Kind.DETACH]
+
+
+@pytest.mark.parametrize("speed", [1.0, 2.0])
+@pytest.mark.parametrize(
+    ("mode", "kinds"), [(Mode.PUSH, PUSH), (Mode.PULL, PULL)], ids=["push", "pull"]
+)
+def test_drive_sequences(mode: Mode, kinds: list[Kind], speed: float) -> None:
+    actions = drive_sequence(mode, 0.7, speed)
+    assert [a.kind for a in actions] == kinds
+    assert [a.duration for a in actions] == [BASE_SECONDS[k] / speed for k in kinds]
+    assert [a.angle for a in actions] == [0.7] * 4
+    assert [a.strength for a in actions] == [STRENGTH[k] for k in kinds]
+
+
+def test_power_strokes_are_at_full_strength() -> None:
+    pull = drive_sequence(Mode.PULL, 0.7, 1.0)
+    assert [a.strength for a in pull] == [0.8, 1.0, 1.0, 0.8]
+
+
+@pytest.mark.parametrize(
+    ("mode", "kinds"), [(Mode.PUSH, PUSH), (Mode.PULL, PULL)], ids=["push", "pull"]
+)
+def test_oriented_sequence_aims_first_and_settles_after(mode: Mode, kinds: list[Kind]) -> None:
+    actions = drive_sequence(mode, 0.7, 2.0, orient=-0.4)
+    assert [a.kind for a in actions] == [Kind.ORIENT, *kinds, Kind.SETTLE]
+    assert actions[0] == Action(Kind.ORIENT, BASE_SECONDS[Kind.ORIENT] / 2.0, -0.4, 0.8)
+    assert actions[-1] == Action(Kind.SETTLE, BASE_SECONDS[Kind.SETTLE] / 2.0, 0.0, 0.6)
+    assert [a.angle for a in actions[1:-1]] == [0.7] * 4
+    assert [a.duration for a in actions] == [
+        BASE_SECONDS[k] / 2.0 for k in [Kind.ORIENT, *kinds, Kind.SETTLE]
+    ]
+
+
+def test_orient_of_zero_still_aims() -> None:
+    actions = drive_sequence(Mode.PULL, 0.7, 1.0, orient=0.0)
+    assert [a.kind for a in actions] == [Kind.ORIENT, *PULL, Kind.SETTLE]
+    assert actions[0].angle == 0.0
+
+
+def test_make_action() -> None:
+    assert make_action(Kind.PUSH, 4.0, 0.3) == Action(Kind.PUSH, 0.55 / 4.0, 0.3, 1.0)
+    assert make_action(Kind.SETTLE, 0.5) == Action(Kind.SETTLE, 0.3, 0.0, 0.6)
+
+
+@pytest.mark.parametrize("speed", [0.0, -1.0])
+def test_make_action_needs_a_positive_speed(speed: float) -> None:
+    with pytest.raises(ValueError, match=r"^speed must be > 0, got "):
+        make_action(Kind.EXTEND, speed)
+    with pytest.raises(ValueError, match=r"^speed must be > 0, got "):
+        drive_sequence(Mode.PULL, 0.5, speed)
+
+
+def test_a_drive_is_a_push_or_a_pull() -> None:
+    with pytest.raises(ValueError, match=r"^a drive is a push or a pull, got <Mode.NONE: 0>$"):
+        drive_sequence(Mode.NONE, 0.5, 1.0)
+    with pytest.raises(ValueError, match="a drive is a push or a pull"):
+        drive_sequence(Mode.NONE, 0.5, 1.0, orient=0.2)
+
+
+def test_action_queue_names_its_pending_actions() -> None:
+    queue = ActionQueue()
+    assert queue.kinds() == []
+    queue.extend(drive_sequence(Mode.PUSH, 0.5, 1.0, orient=0.1))
+    assert queue.kinds() == ["orient", "compress", "attach", "push", "detach", "settle"]
+    assert len(queue) == 6
+    queue.clear()
+    assert (len(queue), queue.kinds()) == (0, [])

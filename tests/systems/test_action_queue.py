@@ -1,0 +1,160 @@
+"""action_queue: timers, one action after another, attach waits for the sucker."""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Callable
+
+import numpy as np
+import pytest
+from ecs_tentacles.systems.action_queue import ATTACH_PATIENCE
+
+from ecs_tentacles.components import Creature
+from ecs_tentacles.locomotion.actions import (
+    BASE_SECONDS,
+    STRENGTH,
+    ActionQueue,
+    Kind,
+    Mode,
+    drive_sequence,
+    make_action,
+)
+from ecs_tentacles.world import World
+from tests.conftest import creature_scene
+
+
+def _queue(world: World, tentacle: int) -> ActionQueue:
+    creature = world.component(world.creature("octo"), Creature)
+    return world.component(creature.tentacles[tentacle], ActionQueue)
+
+
+def _frames(seconds: float, fps: float) -> int:
+    """Whole frames an action of `seconds` lasts: its duration rounded up."""
+    return math.ceil(round(seconds * fps, 9))
+
+
+def _runs(actions: list[int]) -> list[tuple[str, int]]:
+    return [(Kind(kind).name.lower(), len(list(run))) for kind, run in itertools.groupby(actions)]
+
+
+@pytest.mark.parametrize("speed", [1.0, 2.0])
+def test_pull_sequence_runs_each_action_for_its_duration(
+    make_world: Callable[..., World], speed: float
+) -> None:
+    # no goal: nothing but the queue we fill changes tentacle 0's action
+    world = make_world(creature_scene(count=2, links=10))
+    octo = world.creature("octo")
+    fps = world.settings.fps
+    t = world.tentacles
+    tip = int(t.tip_sucker[0])
+    world.step(5)
+    assert world.locomotion.queue(octo, 0) == ["idle"]
+    sequence = drive_sequence(Mode.PULL, float(t.target_angle[0]), speed)
+    _queue(world, 0).extend(sequence)
+    t.duration[0] = 0.0  # end the idle action: the queue moves on this frame
+    actions: list[int] = []
+    attached: list[bool] = []
+    for _ in range(100):
+        world.step(1)
+        actions.append(int(t.action[0]))
+        attached.append(bool(world.suckers.attached[tip]))
+    runs = _runs(actions)
+    assert [name for name, _ in runs] == ["extend", "attach", "pull", "detach", "idle"]
+    # the attach action ends on the frame after its sucker grips, but never early
+    start = runs[0][1]
+    gripped = attached.index(True) - start + 1
+    attach = sequence[1].duration
+    attach_frames = max(_frames(attach, fps), gripped)
+    assert attach_frames <= _frames(ATTACH_PATIENCE * attach, fps)
+    assert runs[:4] == [
+        ("extend", _frames(sequence[0].duration, fps)),
+        ("attach", attach_frames),
+        ("pull", _frames(sequence[2].duration, fps)),
+        ("detach", _frames(sequence[3].duration, fps)),
+    ]
+
+
+def test_every_action_lasts_its_duration_rounded_up_to_whole_frames(
+    make_world: Callable[..., World],
+) -> None:
+    # one tentacle per action kind (attach waits for its sucker: tested on its own)
+    kinds = [kind for kind in BASE_SECONDS if kind != Kind.ATTACH]
+    world = make_world(creature_scene(count=len(kinds), links=2))
+    t = world.tentacles
+    for row, kind in enumerate(kinds):
+        _queue(world, row).extend([make_action(kind, 1.0)])
+        t.duration[row] = 0.0
+    actions = []
+    for _ in range(40):
+        world.step(1)
+        actions.append(t.action.copy())
+    lasted = {
+        kind.name.lower(): _runs(list(np.array(actions)[:, row]))[0][1]
+        for row, kind in enumerate(kinds)
+    }
+    fps = world.settings.fps
+    assert lasted == {kind.name.lower(): _frames(BASE_SECONDS[kind], fps) for kind in kinds}
+
+
+def test_attach_gives_up_after_three_times_its_duration(make_world: Callable[..., World]) -> None:
+    # weightless and lifted: the tip never reaches the ground, the sucker never grips
+    scene = creature_scene(count=2, links=6)
+    scene["physics"] = {"gravity": [0, 0, 0]}
+    scene["creatures"][0]["position"] = [0, 0, 0.5]
+    world = make_world(scene)
+    t = world.tentacles
+    sequence = drive_sequence(Mode.PUSH, 0.5, 1.0)
+    _queue(world, 0).extend(sequence)
+    t.duration[0] = 0.0
+    actions = []
+    for _ in range(90):
+        world.step(1)
+        actions.append(int(t.action[0]))
+    assert world.events.counts["sucker_attached"] == 0
+    fps = world.settings.fps
+    assert _runs(actions)[:3] == [
+        ("compress", _frames(0.35, fps)),
+        ("attach", _frames(ATTACH_PATIENCE * 0.15, fps)),
+        ("push", _frames(0.55, fps)),
+    ]
+
+
+def test_empty_queue_idles_for_ever(make_world: Callable[..., World]) -> None:
+    world = make_world(creature_scene(count=2, links=3))
+    octo = world.creature("octo")
+    t = world.tentacles
+    _queue(world, 1).extend(drive_sequence(Mode.PUSH, 0.5, 5.0)[-1:])  # one detach, 0.02 s
+    t.duration[1] = 0.0
+    world.step(1)
+    assert world.locomotion.queue(octo, 1) == ["detach"]
+    assert t.duration[1] == 0.1 / 5.0
+    assert t.action_strength[1] == STRENGTH[Kind.DETACH]
+    world.step(2)
+    assert world.locomotion.queue(octo, 1) == ["idle"]
+    assert t.action[1] == Kind.IDLE
+    assert t.duration[1] == np.inf
+    assert t.action_strength[1] == STRENGTH[Kind.IDLE]
+    assert t.action_angle[1] == 0.0
+    assert t.orient[1] == 0.0
+    assert t.mode[1] == Mode.NONE
+    assert not t.driving[1]
+    world.step(60)
+    assert world.locomotion.actions(octo) == ["idle", "idle"]
+
+
+def test_orient_angle_is_held_until_settle(make_world: Callable[..., World]) -> None:
+    world = make_world(creature_scene(count=2, links=3))
+    t = world.tentacles
+    _queue(world, 0).extend(drive_sequence(Mode.PUSH, 0.5, 10.0, orient=0.3))
+    t.duration[0] = 0.0
+    orient = []
+    actions = []
+    for _ in range(40):
+        world.step(1)
+        orient.append(float(t.orient[0]))
+        actions.append(int(t.action[0]))
+    settle = actions.index(Kind.SETTLE)
+    assert actions[0] == Kind.ORIENT
+    assert orient[:settle] == [0.3] * settle
+    assert orient[settle:] == [0.0] * (40 - settle)

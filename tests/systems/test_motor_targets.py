@@ -1,0 +1,168 @@
+"""motor_targets: action poses, easing, travelling waves and writhing gains."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+import pytest
+from ecs_tentacles.systems.motor_targets import LIFT, SMOOTHING_SECONDS
+from numpy.testing import assert_allclose, assert_array_equal
+
+from ecs_tentacles.components import Creature
+from ecs_tentacles.locomotion.actions import STRENGTH, ActionQueue, Kind, make_action
+from ecs_tentacles.world import World
+from tests.conftest import creature_scene
+
+
+def _links(world: World, tentacle: int) -> np.ndarray:
+    first = int(world.tentacles.first_link[tentacle])
+    return np.arange(first, first + int(world.tentacles.links[tentacle]))
+
+
+def _rest_pitch(world: World, tentacle: int) -> np.ndarray:
+    """Link pitches at rest: a droop along the tentacle that lays its underside flat."""
+    return 2.0 * world.tentacles.rest_pitch[tentacle] * world.motors.arc[_links(world, tentacle)]
+
+
+def _rest_targets(world: World) -> np.ndarray:
+    """(curl, sweep) of every link at rest: curls turn each link by its pitch change."""
+    curl = np.concatenate(
+        [np.diff(_rest_pitch(world, k), prepend=0.0) for k in range(len(world.tentacles))]
+    )
+    return np.stack([curl, np.zeros_like(curl)], axis=1)
+
+
+def _eased(start: np.ndarray, goal: np.ndarray, frames: int, dt: float) -> np.ndarray:
+    """Where a target starting at `start` is after easing toward `goal` for `frames`."""
+    keep = np.exp(-dt / SMOOTHING_SECONDS) ** frames
+    return goal + (start - goal) * keep
+
+
+def test_idle_targets_ease_to_rest_without_waves(make_world: Callable[..., World]) -> None:
+    world = make_world(creature_scene(count=2, links=4))
+    octo = world.creature("octo")
+    world.step(20)  # waving: the targets are off zero
+    start = world.motors.target.copy()
+    assert np.abs(start[:, :2]).min() > 1e-4
+    assert_array_equal(start[:, 2], 0.0)
+    world.locomotion.set(octo, wave_amplitude=0.0, writhe=0.0)
+    # an exponential ease with the smoothing time constant, no jump
+    rest = _rest_targets(world)
+    assert (rest[:, 0] > 0).all() and (rest[:, 0] < 0.1).all()  # a gentle droop
+    dt = world.settings.dt
+    done = 0
+    for frames in (1, 5, 30):
+        world.step(frames - done)
+        done = frames
+        expected = _eased(start[:, :2], rest, frames, dt)
+        assert_allclose(world.motors.target[:, :2], expected, rtol=1e-12, atol=1e-15)
+    world.step(90)
+    assert_allclose(world.motors.target[:, :2], rest, atol=1e-8)
+    assert_array_equal(world.motors.target[:, 2], 0.0)
+    assert world.locomotion.actions(octo) == ["idle", "idle"]
+
+
+def test_idle_gain_is_the_same_before_and_after_a_drive(
+    make_world: Callable[..., World],
+) -> None:
+    # an idle tentacle writhes at STRENGTH[IDLE] whether or not it has driven yet
+    world = make_world(creature_scene(count=2, links=3))
+    octo = world.creature("octo")
+    world.locomotion.set(octo, writhe=0.0)
+    creature = world.component(octo, Creature)
+    world.component(creature.tentacles[1], ActionQueue).extend(
+        [make_action(Kind.DETACH, 10.0)]  # one short action, then idle again
+    )
+    world.tentacles.duration[1] = 0.0
+    world.step(3)
+    assert world.locomotion.actions(octo) == ["idle", "idle"]
+    assert_allclose(world.motors.gain, STRENGTH[Kind.IDLE], rtol=1e-15)
+
+
+def _arch(world: World, tentacle: int, angle: float) -> None:
+    """Hold `tentacle` in a compress of `angle` for ever, with nothing queued after it."""
+    creature = world.component(world.creature("octo"), Creature)
+    world.component(creature.tentacles[tentacle], ActionQueue).clear()
+    t = world.tentacles
+    t.action[tentacle] = Kind.COMPRESS
+    t.action_angle[tentacle] = angle
+    t.action_strength[tentacle] = STRENGTH[Kind.COMPRESS]
+    t.orient[tentacle] = 0.0
+    t.duration[tentacle] = np.inf
+
+
+@pytest.mark.parametrize("angle", [0.3, np.radians(50)])
+def test_compress_arches_the_tentacle(make_world: Callable[..., World], angle: float) -> None:
+    # no goal, so tentacle selection leaves the tentacle alone
+    world = make_world(creature_scene(count=2, links=6))
+    octo = world.creature("octo")
+    world.locomotion.set(octo, wave_amplitude=0.0, writhe=0.0)
+    world.step(3)
+    start = world.motors.target.copy()
+    _arch(world, 0, angle)
+    world.step(30)
+    links = _links(world, 0)
+    pitch = -angle * np.sin(2 * np.pi * world.motors.arc[links]) + LIFT[Kind.COMPRESS]
+    pitch += _rest_pitch(world, 0)
+    curl = np.diff(pitch, prepend=0.0)  # each joint turns by its link's pitch change
+    dt = world.settings.dt
+    assert_allclose(
+        world.motors.target[links, 0], _eased(start[links, 0], curl, 30, dt), atol=1e-15
+    )
+    assert_allclose(world.motors.target[links, 1:], 0.0, atol=1e-6)  # no sweep, no twist
+    world.step(30)
+    assert_allclose(world.motors.target[links, 0], curl, atol=1e-7)
+    # the link pitches: up from a flat base, highest mid-way, down to a flat tip
+    assert_allclose(np.cumsum(world.motors.target[links, 0]), pitch, atol=1e-7)
+    assert world.locomotion.actions(octo) == ["compress", "idle"]
+    # the other tentacle stays at rest
+    other = _links(world, 1)
+    assert_allclose(world.motors.target[other, :2], _rest_targets(world)[other], atol=1e-7)
+    assert_allclose(world.motors.gain[links], STRENGTH[Kind.COMPRESS], rtol=1e-15)
+
+
+def test_arched_tentacle_is_shorter(make_world: Callable[..., World]) -> None:
+    world = make_world(creature_scene(count=2, links=6))
+    octo = world.creature("octo")
+    world.locomotion.set(octo, wave_amplitude=0.0, writhe=0.0)
+    tip = int(world.tentacles.tip_sucker[0])
+    mantle = world.creatures.mantle_row[0]
+    world.step(30)
+    straight = np.linalg.norm(world.sucker_points()[tip, :2] - world.transforms.pos[mantle, :2])
+    _arch(world, 0, np.radians(50))
+    world.step(60)
+    arched = np.linalg.norm(world.sucker_points()[tip, :2] - world.transforms.pos[mantle, :2])
+    assert arched < straight - 0.02
+
+
+def test_gain_is_the_action_strength_without_writhing(make_world: Callable[..., World]) -> None:
+    world = make_world(creature_scene(count=2, links=4))
+    octo = world.creature("octo")
+    world.locomotion.set(octo, writhe=0.0)
+    _arch(world, 1, 0.5)
+    gains = []
+    for _ in range(20):
+        world.step(1)
+        gains.append(world.motors.gain[_links(world, 1)].copy())
+    assert_allclose(np.array(gains), STRENGTH[Kind.COMPRESS], rtol=1e-15)
+
+
+def test_writhing_modulates_the_gain_in_time(make_world: Callable[..., World]) -> None:
+    world = make_world(creature_scene(count=2, links=4))
+    octo = world.creature("octo")
+    world.locomotion.set(octo, writhe=0.5, wave_frequency=1.0)
+    _arch(world, 0, 0.5)
+    links = _links(world, 0)
+    samples = []
+    for _ in range(60):  # one period of the wave
+        world.step(1)
+        samples.append(world.motors.gain[links].copy())
+    gains = np.array(samples)
+    strength = STRENGTH[Kind.COMPRESS]
+    assert gains.min() >= strength * 0.5 - 1e-12
+    assert gains.max() <= strength * 1.5 + 1e-12
+    # every link swings through nearly the whole range within a period, around the strength
+    assert_allclose(gains.max(axis=0), strength * 1.5, rtol=2e-3)
+    assert_allclose(gains.min(axis=0), strength * 0.5, rtol=4e-3)
+    assert_allclose(gains.mean(axis=0), strength, rtol=1e-9)

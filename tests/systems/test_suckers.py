@@ -1,0 +1,192 @@
+"""suckers: grab at the ground during attach; let go on command, on stretch, on reach."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+import pytest
+from ecs_tentacles.systems.suckers import ATTACH_HEIGHT
+from numpy.testing import assert_allclose, assert_array_equal
+
+from ecs_tentacles.components import Creature, Sucker, Tentacle
+from ecs_tentacles.locomotion.actions import Kind
+from ecs_tentacles.world import World
+from tests.conftest import creature_scene
+
+
+class Recorder:
+    """Every sucker event, as (name, frame, payload)."""
+
+    def __init__(self, world: World):
+        self.world = world
+        self.events: list[tuple[str, int, dict[str, Any]]] = []
+        for name in ("sucker_attached", "sucker_released"):
+            world.events.on(name, self._handler(name))
+
+    def _handler(self, name: str) -> Callable[..., None]:
+        def record(**payload: Any) -> None:
+            self.events.append((name, self.world.frame, payload))
+
+        return record
+
+    def reasons(self) -> list[str]:
+        return [p["reason"] for name, _, p in self.events if name == "sucker_released"]
+
+
+def _world(make_world: Callable[..., World], **scene: Any) -> World:
+    # no goal: the tentacles idle and only what a test writes changes their actions
+    base = creature_scene(count=2)  # ten links: a straight tentacle's tip can touch down
+    for key, value in scene.items():
+        if key == "locomotion":
+            base["creatures"][0]["locomotion"] = value
+        else:
+            base[key] = value
+    return make_world(base)
+
+
+def _tip_sucker(world: World, tentacle: int) -> int:
+    creature = world.component(world.creature("octo"), Creature)
+    return world.component(creature.tentacles[tentacle], Tentacle).suckers[-1]
+
+
+def _hold(world: World, row: int, kind: Kind) -> None:
+    """Give tentacle `row` the action `kind` for ever."""
+    world.tentacles.action[row] = kind
+    world.tentacles.duration[row] = np.inf
+    world.tentacles.timer[row] = 0.0
+
+
+def _grab(world: World, row: int, frames: int = 40) -> np.ndarray:
+    """Press tentacle `row` down until its tip grips; return where the tip was then."""
+    _hold(world, row, Kind.ATTACH)
+    tip = int(world.tentacles.tip_sucker[row])
+    for _ in range(frames):
+        before = world.sucker_points()[tip].copy()
+        world.step(1)
+        if world.suckers.attached[tip]:
+            return before
+    raise AssertionError(f"tentacle {row} never gripped")
+
+
+def test_attach_only_near_the_ground(make_world: Callable[..., World]) -> None:
+    scene = creature_scene(count=2)
+    scene["physics"] = {"gravity": [0, 0, 0]}
+    scene["creatures"][0]["position"] = [0, 0, 0.5]  # weightless, in the air
+    world = make_world(scene)
+    events = Recorder(world)
+    _hold(world, 0, Kind.ATTACH)
+    lowest = np.inf
+    for _ in range(40):
+        world.step(1)
+        lowest = min(lowest, float(world.sucker_points()[:, 2].min()))
+    assert lowest > 0.4
+    assert world.suckers.attached.tolist() == [False, False]
+    assert events.events == []
+
+
+def test_tip_grabs_the_ground_where_it_touches(make_world: Callable[..., World]) -> None:
+    world = _world(make_world)
+    events = Recorder(world)
+    world.step(5)
+    tip = int(world.tentacles.tip_sucker[0])
+    assert world.sucker_points()[tip, 2] > ATTACH_HEIGHT  # a straight tentacle's tip hovers
+    world.step(20)
+    assert events.events == []  # idle tentacles never grab, even where they touch down
+    where = _grab(world, 0)
+    assert where[2] <= ATTACH_HEIGHT
+    sucker = world.component(_tip_sucker(world, 0), Sucker)
+    assert sucker.attached
+    assert_array_equal(sucker.anchor, where)
+    assert [(name, p["sucker"]) for name, _, p in events.events] == [
+        ("sucker_attached", _tip_sucker(world, 0))
+    ]
+    assert_array_equal(events.events[0][2]["anchor"], where)
+    assert world.suckers.attached.tolist() == [True, False]
+    world.step(10)  # the hold lasts while the tentacle grips; the tip stays put
+    assert world.suckers.attached.tolist() == [True, False]
+    assert np.linalg.norm(world.sucker_points()[tip] - where) < 0.01
+    assert world.events.counts["sucker_attached"] == 1
+
+
+@pytest.mark.parametrize("kind", [Kind.DETACH, Kind.SETTLE, Kind.IDLE, Kind.EXTEND])
+def test_release_on_command(make_world: Callable[..., World], kind: Kind) -> None:
+    world = _world(make_world)
+    events = Recorder(world)
+    _grab(world, 0)
+    for holding in (Kind.PUSH, Kind.PULL, Kind.ATTACH):
+        _hold(world, 0, holding)
+        world.step(1)
+        assert world.suckers.attached.tolist() == [True, False], holding
+    _hold(world, 0, kind)
+    frame = world.frame
+    world.step(1)
+    assert world.suckers.attached.tolist() == [False, False]
+    assert [(name, f) for name, f, _ in events.events] == [
+        ("sucker_attached", events.events[0][1]),
+        ("sucker_released", frame),
+    ]
+    assert events.reasons() == ["command"]
+    assert events.events[1][2]["sucker"] == _tip_sucker(world, 0)
+    assert world.events.counts["sucker_released"] == 1
+
+
+def test_release_on_stretch(make_world: Callable[..., World]) -> None:
+    world = _world(make_world)
+    events = Recorder(world)
+    _grab(world, 0)
+    row = int(world.tentacles.tip_sucker[0])
+    stretch = world.creatures.release_stretch[0]
+    assert stretch == 0.04  # the scene default
+    anchor = world.suckers.anchor[row].copy()
+    # just within the stretch: held (straight up, so the reach is unchanged)
+    world.suckers.anchor[row] = world.sucker_points()[row] + np.array([0.0, 0.0, 0.9 * stretch])
+    world.step(1)
+    assert world.suckers.attached[row]
+    world.suckers.anchor[row] = anchor + np.array([0.0, 0.0, 0.1])
+    world.step(1)
+    assert not world.suckers.attached[row]
+    assert events.reasons() == ["stretch"]
+    assert world.events.counts["sucker_released"] == 1
+
+
+def test_release_on_reach(make_world: Callable[..., World]) -> None:
+    # stretch cannot trip first: the anchor may be pulled up to 10 m away
+    world = _world(make_world, locomotion={"release_stretch": 10})
+    events = Recorder(world)
+    _grab(world, 0)
+    t = world.tentacles
+    row = int(t.tip_sucker[0])
+    reach = world.creatures.release_reach[0] * t.length[0]
+    assert_allclose(reach, 1.1 * 0.07 * np.linspace(1.0, 0.3, 10).sum(), rtol=1e-12)
+
+    def place(fraction: float) -> None:
+        base = world.transforms.pos[t.base_row[0]]
+        out = world.suckers.anchor[row, :2] - base[:2]
+        out /= np.linalg.norm(out)
+        world.suckers.anchor[row, :2] = base[:2] + fraction * reach * out
+
+    place(0.99)
+    world.step(1)
+    assert world.suckers.attached[row]
+    place(1.01)
+    world.step(1)
+    assert not world.suckers.attached[row]
+    assert events.reasons() == ["reach"]
+    assert world.events.counts["sucker_released"] == 1
+
+
+def test_each_release_is_counted(make_world: Callable[..., World]) -> None:
+    world = _world(make_world)
+    events = Recorder(world)
+    row = int(world.tentacles.tip_sucker[0])
+    _grab(world, 0)
+    world.suckers.anchor[row] += np.array([0.0, 0.0, 0.1])
+    world.step(1)  # stretch; the tentacle still attaches, so it grabs again
+    _grab(world, 0)
+    _hold(world, 0, Kind.DETACH)
+    world.step(1)
+    assert events.reasons() == ["stretch", "command"]
+    assert world.events.counts["sucker_attached"] == 2
+    assert world.events.counts["sucker_released"] == 2

@@ -1,0 +1,258 @@
+"""tentacle_selection: push or pull by the thesis's test, who drives, aborts, no goal."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+import pytest
+from ecs_tentacles.systems.tentacle_selection import STROKE_SECONDS, classify
+
+from ecs_tentacles.locomotion.actions import Kind, Mode, drive_sequence
+from ecs_tentacles.world import World
+from tests.conftest import creature_scene
+
+
+def _scene(
+    gait: str, goal: list[float] | None, count: int = 4, links: int = 4, **locomotion: Any
+) -> dict[str, Any]:
+    scene = creature_scene(count=count, links=links)
+    scene["creatures"][0]["locomotion"] = {"gait": gait, **locomotion}
+    if goal is not None:
+        scene["creatures"][0]["goals"] = [{"position": goal}]
+    return scene
+
+
+def _names(mode: Mode) -> list[str]:
+    return [action.kind.name.lower() for action in drive_sequence(mode, 0.5, 1.0)]
+
+
+def _unit(degrees: float) -> list[float]:
+    angle = np.radians(degrees)
+    return [np.cos(angle), np.sin(angle)]
+
+
+# -- classify ---------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("degrees", "pull"),
+    [
+        (0.0, True),
+        (45.0, True),
+        (-45.0, True),
+        (89.9, True),
+        (-89.9, True),
+        (90.1, False),
+        (-90.1, False),
+        (135.0, False),
+        (-135.0, False),
+        (180.0, False),
+    ],
+)
+@pytest.mark.parametrize("base_degrees", [0.0, 30.0, 200.0])
+def test_classify_pulls_within_a_right_angle(
+    degrees: float, pull: bool, base_degrees: float
+) -> None:
+    goal = np.array([_unit(base_degrees + degrees)])
+    base = np.array([_unit(base_degrees)])
+    assert classify(goal, base).tolist() == [pull]
+
+
+def test_classify_counts_the_right_angle_itself_as_pull() -> None:
+    # cos(pi/2) is 6e-17, not 0: both signs of that rounding must still pull
+    quarter = np.pi / 2
+    goal = np.array(
+        [
+            [np.cos(quarter), np.sin(quarter)],
+            [np.cos(-quarter), np.sin(-quarter)],
+            [0.0, 1.0],
+            [0.0, -1.0],
+            [1.0, 0.0],
+            [np.cos(3 * quarter), np.sin(3 * quarter)],  # -1.8e-16 . [1, 0]
+        ]
+    )
+    base = np.array([[1.0, 0.0], [1.0, 0.0], [1.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 0.0]])
+    assert classify(goal, base).tolist() == [True] * 6
+
+
+def test_classify_works_row_by_row() -> None:
+    goal = np.array([_unit(0.0), _unit(0.0), _unit(90.0), _unit(90.0)])
+    base = np.array([_unit(10.0), _unit(170.0), _unit(100.0), _unit(-100.0)])
+    assert classify(goal, base).tolist() == [True, False, True, False]
+
+
+# -- in a world -------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(("goal", "mode"), [([1.5, 0.0], Mode.PULL), ([-1.5, 0.0], Mode.PUSH)])
+def test_cyclic_first_stroke_pulls_toward_and_pushes_away(
+    make_world: Callable[..., World], goal: list[float], mode: Mode
+) -> None:
+    world = make_world(_scene("cyclic", goal))
+    octo = world.creature("octo")
+    world.step(1)
+    t = world.tentacles
+    assert t.driving.tolist() == [True, False, False, False]
+    assert t.mode.tolist() == [mode, Mode.NONE, Mode.NONE, Mode.NONE]
+    assert world.locomotion.queue(octo, 0) == _names(mode)
+    assert _names(Mode.PULL) == ["extend", "attach", "pull", "detach"]
+    assert _names(Mode.PUSH) == ["compress", "attach", "push", "detach"]
+    assert [world.locomotion.queue(octo, k) for k in (1, 2, 3)] == [["idle"]] * 3
+    assert t.started.tolist() == [0.0, -np.inf, -np.inf, -np.inf]
+
+
+def test_coordinated_first_stroke_orients_then_pulls(make_world: Callable[..., World]) -> None:
+    world = make_world(_scene("coordinated", [1.5, 0.0]))
+    octo = world.creature("octo")
+    world.step(1)
+    assert world.tentacles.driving.tolist() == [True, False, False, False]
+    assert world.tentacles.mode.tolist() == [Mode.PULL, Mode.NONE, Mode.NONE, Mode.NONE]
+    assert world.locomotion.queue(octo, 0) == ["orient", *_names(Mode.PULL), "settle"]
+
+
+def test_coordinated_goal_behind_pulls_with_the_far_tentacle(
+    make_world: Callable[..., World],
+) -> None:
+    world = make_world(_scene("coordinated", [-1.5, 0.0]))
+    octo = world.creature("octo")
+    world.step(1)
+    assert world.tentacles.driving.tolist() == [False, False, True, False]
+    assert world.tentacles.mode.tolist() == [Mode.NONE, Mode.NONE, Mode.PULL, Mode.NONE]
+    assert world.locomotion.queue(octo, 2) == ["orient", *_names(Mode.PULL), "settle"]
+
+
+def test_each_creature_drives_on_its_own(make_world: Callable[..., World]) -> None:
+    def creature(name: str, position: list[float], count: int, **more: Any) -> dict[str, Any]:
+        return {
+            "name": name,
+            "position": position,
+            "tentacles": {"count": count, "links": 3},
+            **more,
+        }
+
+    scene = {
+        "version": 1,
+        "creatures": [
+            creature("a", [0, 0], 3, locomotion={"gait": "cyclic"}, goals=[{"position": [-2, 0]}]),
+            creature("b", [3, 0], 4, goals=[{"position": [3, 2]}]),  # coordinated
+            creature("c", [-3, 3], 2),  # no goal
+        ],
+    }
+    world = make_world(scene)
+    world.step(1)
+    a, b, c = (world.creature(name) for name in "abc")
+    assert world.locomotion.actions(a) == ["compress", "idle", "idle"]  # +x pushes from -x
+    assert world.locomotion.actions(b) == ["idle", "orient", "idle", "idle"]  # +y pulls to +y
+    assert world.locomotion.actions(c) == ["idle", "idle"]
+    assert world.tentacles.mode.tolist() == [
+        Mode.PUSH, Mode.NONE, Mode.NONE,
+        Mode.NONE, Mode.PULL, Mode.NONE, Mode.NONE,
+        Mode.NONE, Mode.NONE,
+    ]  # fmt: skip
+
+
+def _new_drivers(world: World, frames: int) -> list[tuple[int, Mode]]:
+    """Step `frames` frames; (tentacle, mode) of each drive that starts, in order."""
+    started: list[tuple[int, Mode]] = []
+    for _ in range(frames):
+        before = world.tentacles.driving.copy()
+        world.step(1)
+        for row in np.flatnonzero(world.tentacles.driving & ~before):
+            started.append((int(row), Mode(int(world.tentacles.mode[row]))))
+    return started
+
+
+def test_cyclic_keeps_the_queued_stroke_when_the_goal_changes_sides(
+    make_world: Callable[..., World],
+) -> None:
+    world = make_world(_scene("cyclic", [1.5, 0.0]))
+    octo = world.creature("octo")
+    world.step(5)
+    assert world.locomotion.queue(octo, 0) == _names(Mode.PULL)
+    # behind and a little to the right: tentacle 1 (+y) now pushes, tentacle 2 (-x) pulls
+    world.goals.set(octo, [-1.5, -0.5])
+    world.step(1)
+    assert world.tentacles.driving.tolist() == [True, False, False, False]
+    assert world.tentacles.mode[0] == Mode.PULL
+    assert world.locomotion.queue(octo, 0) == _names(Mode.PULL)
+    assert _new_drivers(world, 180) == [(1, Mode.PUSH), (2, Mode.PULL)]
+
+
+def test_coordinated_driver_aborts_when_the_goal_changes_sides(
+    make_world: Callable[..., World],
+) -> None:
+    world = make_world(_scene("coordinated", [1.5, 0.0]))
+    octo = world.creature("octo")
+    world.step(10)
+    assert world.tentacles.driving.tolist() == [True, False, False, False]
+    assert world.tentacles.mode[0] == Mode.PULL
+    world.goals.set(octo, [-1.5, 0.0])
+    world.step(1)
+    assert world.locomotion.queue(octo, 0) == ["detach", "settle"]
+    assert world.tentacles.driving.tolist() == [False, False, False, False]
+    assert world.tentacles.mode.tolist() == [Mode.NONE] * 4
+    # the next drive starts one stagger after the first, with the tentacle now facing the goal
+    stagger_frames = int(np.ceil(STROKE_SECONDS / 2 * world.settings.fps))
+    frames = stagger_frames - world.frame
+    assert _new_drivers(world, frames) == []
+    mantle = world.transforms.pos[world.creatures.mantle_row[0], :2]
+    base = world.transforms.pos[world.tentacles.base_row[2], :2]
+    goal_dir = (np.array([-1.5, 0.0]) - mantle) / np.linalg.norm([-1.5, 0.0] - mantle)
+    base_dir = (base - mantle) / np.linalg.norm(base - mantle)
+    assert classify(goal_dir[None], base_dir[None]).tolist() == [True]
+    assert _new_drivers(world, 1) == [(2, Mode.PULL)]
+    assert world.locomotion.queue(octo, 2) == ["orient", *_names(Mode.PULL), "settle"]
+
+
+def test_no_goal_stops_the_drive_and_every_tentacle_idles(
+    make_world: Callable[..., World],
+) -> None:
+    world = make_world(_scene("coordinated", [1.5, 0.0], links=6))
+    octo = world.creature("octo")
+    released: list[str] = []
+    world.events.on("sucker_released", lambda **kw: released.append(kw["reason"]))
+    tip = world.tentacles.tip_sucker[0]
+    for _ in range(60):  # until tentacle 0 grips for its pull
+        world.step(1)
+        if world.tentacles.action[0] == Kind.PULL:
+            break
+    assert world.tentacles.action[0] == Kind.PULL
+    assert world.suckers.attached[tip]
+    assert world.tentacles.driving.tolist() == [True, False, True, False]  # 2 pushes too
+    world.goals.clear(octo)
+    world.step(1)
+    assert world.locomotion.queue(octo, 0) == ["detach", "settle"]
+    assert world.locomotion.queue(octo, 2) == ["detach", "settle"]
+    assert world.tentacles.driving.tolist() == [False] * 4
+    assert released == ["command"]
+    assert not world.suckers.attached[tip]
+    world.step(30)
+    assert world.locomotion.actions(octo) == ["idle"] * 4
+    assert world.tentacles.driving.tolist() == [False] * 4
+    assert world.tentacles.mode.tolist() == [Mode.NONE] * 4
+    assert [world.locomotion.queue(octo, k) for k in range(4)] == [["idle"]] * 4
+    assert world.suckers.attached.tolist() == [False] * 4
+    assert world.events.counts["sucker_released"] == 1
+
+
+@pytest.mark.parametrize("drivers", [1, 3])
+def test_coordinated_drivers_cap_and_stagger(
+    make_world: Callable[..., World], drivers: int
+) -> None:
+    world = make_world(_scene("coordinated", [1.5, 0.0], count=8, links=3, drivers=drivers))
+    t = world.tentacles
+    stagger = STROKE_SECONDS / drivers
+    most = 0
+    starts: set[float] = set()
+    for _ in range(180):
+        world.step(1)
+        driving = np.flatnonzero(t.driving)
+        assert len(driving) <= drivers
+        most = max(most, len(driving))
+        times = np.sort(t.started[driving])
+        assert (np.diff(times) >= stagger - 1e-9).all(), times  # out of phase
+        starts.update(times.tolist())
+    assert most == drivers
+    assert min(starts) == 0.0  # the first drive starts on the first frame
