@@ -35,6 +35,7 @@ ORIENTED = np.zeros(len(Kind), dtype=bool)
 ORIENTED[
     [Kind.ORIENT, Kind.EXTEND, Kind.COMPRESS, Kind.ATTACH, Kind.PUSH, Kind.PULL, Kind.DETACH]
 ] = True
+HALF_ROOT3 = np.sqrt(3.0) / 2.0
 GRIPPING = np.zeros(len(Kind), dtype=bool)
 GRIPPING[[Kind.ATTACH, Kind.PUSH, Kind.PULL]] = True
 # Which (action, mode) pairs hold the arch pose.
@@ -57,12 +58,15 @@ class MotorTargets(System):
     def setup(self, world: World) -> None:
         motors, tentacles = world.motors, world.tentacles
         rows = np.arange(len(motors))
-        self.previous = rows - 1
         first = tentacles.first_link
-        self.previous[first] = -1
+        inner = np.ones(len(motors), dtype=bool)
+        inner[first] = False
+        self.inner = rows[inner]  # links whose joint turns relative to a previous link
+        self.previous = self.inner - 1
         self.orient_share = np.zeros(len(motors))
         self.orient_share[first] = 0.5
         self.orient_share[np.minimum(first + 1, first + tentacles.links - 1)] += 0.5
+        self.arch_shape = np.sin(2 * np.pi * motors.arc)
         # the eased targets live here, so systems that add to Motor.target after this one
         # (user waves, the HUD) do not feed back into the easing
         self.eased = motors.target[:, :2].copy()
@@ -72,32 +76,34 @@ class MotorTargets(System):
         if not len(motors):
             return
         row = motors.tentacle_row
-        kind = t.action[row]
-        mode = t.mode[row]
         arc = motors.arc
-
-        arched = ARCHED[kind, mode]
-        # the arch: rises from a flat base, peaks mid-way, comes down to a flat tip
-        pitch = np.where(arched, -t.action_angle[row] * np.sin(2 * np.pi * arc), 0.0)
+        action = t.action
+        # per tentacle (few rows) where it saves work, then gathered to every link
+        progress = np.minimum(t.timer / np.maximum(t.duration, 1e-9), ATTACH_PATIENCE)
+        # the arch rises from a flat base, peaks mid-way and comes down to a flat tip;
         # the base lies on the ground and cannot tilt down, so tip-down bends are ramps
         # along the tentacle: the rest droop, and an attaching tip pressing down further
         # the longer it takes to touch the ground
-        progress = np.minimum(t.timer / t.duration, ATTACH_PATIENCE)[row]
-        droop = 2.0 * t.rest_pitch[row] + np.where(kind == ATTACH, ATTACH_PRESS * progress, 0.0)
-        pitch += LIFT[kind] + droop * arc
-        curl = pitch - np.where(self.previous >= 0, pitch[self.previous], 0.0)
-        sweep = np.where(ORIENTED[kind], t.orient[row] * self.orient_share, 0.0)
+        arch = np.where(ARCHED[action, t.mode], -t.action_angle, 0.0)[row]
+        droop = (2.0 * t.rest_pitch + np.where(action == ATTACH, ATTACH_PRESS * progress, 0.0))[row]
+        pitch = arch * self.arch_shape + LIFT[action][row] + droop * arc
+        curl = pitch.copy()
+        curl[self.inner] -= pitch[self.previous]
+        sweep = np.where(ORIENTED[action], t.orient, 0.0)[row] * self.orient_share
 
-        phase = (
-            2 * np.pi * (t.wave_frequency[row] * world.time - arc / t.wavelength[row])
-            + t.phase[row]
-        )
-        amplitude = t.wave_amplitude[row]
-        gripping = GRIPPING[kind]
-        curl_amplitude = amplitude * np.where(gripping, GRIP_CURL_WAVE, 1.0)
-        sweep_amplitude = amplitude * np.where(gripping, GRIP_SWEEP_WAVE, 1.0)
+        phase = (2 * np.pi * t.wave_frequency * world.time + t.phase)[row] - (
+            2 * np.pi / t.wavelength
+        )[row] * arc
+        sin, cos = np.sin(phase), np.cos(phase)
+        gripping = GRIPPING[action]
+        amplitude = t.wave_amplitude
+        curl_amp = (amplitude * np.where(gripping, GRIP_CURL_WAVE, 1.0))[row]
+        sweep_amp = (amplitude * np.where(gripping, GRIP_SWEEP_WAVE, 1.0))[row]
         ease = 1.0 - np.exp(-dt / SMOOTHING_SECONDS)
-        self.eased[:, 0] += ease * (curl + curl_amplitude * np.sin(phase) - self.eased[:, 0])
-        self.eased[:, 1] += ease * (sweep + sweep_amplitude * np.cos(phase) - self.eased[:, 1])
-        motors.target[:, :2] = self.eased
-        motors.gain = t.action_strength[row] * (1.0 + t.writhe[row] * np.sin(phase + np.pi / 3))
+        eased = self.eased
+        eased[:, 0] += ease * (curl + curl_amp * sin - eased[:, 0])
+        eased[:, 1] += ease * (sweep + sweep_amp * cos - eased[:, 1])
+        motors.target[:, :2] = eased
+        # writhing: sin(phase + pi/3), from the sine and cosine already at hand
+        strength = t.action_strength
+        motors.gain = strength[row] + (strength * t.writhe)[row] * (0.5 * sin + HALF_ROOT3 * cos)

@@ -46,11 +46,6 @@ def classify(goal_dir: np.ndarray, base_dir: np.ndarray) -> np.ndarray:
     return np.einsum("ij,ij->i", goal_dir, base_dir) >= -PULL_TOLERANCE
 
 
-def _unit(v: np.ndarray) -> np.ndarray:
-    norm = np.sqrt(np.einsum("ij,ij->i", v, v))[:, None]
-    return v / np.where(norm > 0, norm, np.inf)
-
-
 class TentacleSelection(System):
     name = "tentacle_selection"
     after = ("goals",)
@@ -65,39 +60,37 @@ class TentacleSelection(System):
         if not len(t) or not (c.has_goal.any() or t.driving.any()):
             return
         creature = t.creature_row
-        mantle = world.transforms.pos[c.mantle_row, :2]
-        goal_dir = _unit(c.goal[:, :2] - mantle)[creature]
-        base_dir = _unit(world.transforms.pos[t.base_row, :2] - mantle[creature])
-        cos = np.einsum("ij,ij->i", goal_dir, base_dir)
+        pos = world.transforms.pos
+        mantle = pos[c.mantle_row, :2]
+        to_goal = (c.goal[:, :2] - mantle)[creature]
+        to_base = pos[t.base_row, :2] - mantle[creature]
+        dot = to_goal[:, 0] * to_base[:, 0] + to_goal[:, 1] * to_base[:, 1]
+        lengths = np.hypot(to_goal[:, 0], to_goal[:, 1]) * np.hypot(to_base[:, 0], to_base[:, 1])
+        cos = dot / np.maximum(lengths, 1e-12)
         pull = cos >= -PULL_TOLERANCE
         has_goal = c.has_goal[creature]
+        driving_now = t.driving
 
-        no_goal = t.driving & ~has_goal
-        wrong_side = (
-            t.driving
-            & has_goal
-            & (c.gait[creature] == COORDINATED)
-            & np.where(t.mode == PULL, cos < -ABORT_MARGIN, cos > ABORT_MARGIN)
-        )
-        for row in np.flatnonzero(no_goal | wrong_side):
-            self._abort(world, int(row))
+        if driving_now.any():
+            wrong_side = (c.gait[creature] == COORDINATED) & np.where(
+                t.mode == PULL, cos < -ABORT_MARGIN, cos > ABORT_MARGIN
+            )
+            for row in np.flatnonzero(driving_now & (~has_goal | wrong_side)):
+                self._abort(world, int(row))
 
         driving = np.bincount(creature, weights=t.driving, minlength=len(c))
-        for row in np.flatnonzero(c.has_goal & (driving == 0) & (c.gait == CYCLIC)):
-            first = int(c.first_tentacle[row])
-            k = first + int(c.next_driver[row])
+        idle_goal = c.has_goal & (driving < c.drivers)
+        if not idle_goal.any():
+            return
+        cyclic = c.gait == CYCLIC
+        for row in np.flatnonzero(idle_goal & cyclic & (driving == 0)):
+            k = int(c.first_tentacle[row] + c.next_driver[row])
             self._start(world, k, Mode.PULL if pull[k] else Mode.PUSH, orient=None)
             c.next_driver[row] = (c.next_driver[row] + 1) % c.tentacles[row]
-
-        stagger = STROKE_SECONDS / (c.speed * np.maximum(c.drivers, 1))
-        ready = (
-            c.has_goal
-            & (c.gait == COORDINATED)
-            & (driving < c.drivers)
-            & (world.time - c.last_start >= stagger)
-        )
+        stagger = STROKE_SECONDS / (c.speed * c.drivers)
+        ready = idle_goal & ~cyclic & (world.time - c.last_start >= stagger)
         for row in np.flatnonzero(ready):
-            self._start_best(world, int(row), cos, pull, goal_dir, base_dir)
+            self._start_best(world, int(row), cos, pull, to_goal, to_base)
 
     def _start_best(
         self,
@@ -105,8 +98,8 @@ class TentacleSelection(System):
         creature_row: int,
         cos: np.ndarray,
         pull: np.ndarray,
-        goal_dir: np.ndarray,
-        base_dir: np.ndarray,
+        to_goal: np.ndarray,
+        to_base: np.ndarray,
     ) -> None:
         t, c = world.tentacles, world.creatures
         first = int(c.first_tentacle[creature_row])
@@ -119,10 +112,9 @@ class TentacleSelection(System):
             return
         k = int(rows[best])
         mode = Mode.PULL if pull[k] else Mode.PUSH
-        wanted = goal_dir[k] if mode == Mode.PULL else -goal_dir[k]
-        turn = np.arctan2(
-            base_dir[k, 0] * wanted[1] - base_dir[k, 1] * wanted[0], base_dir[k] @ wanted
-        )
+        wanted = to_goal[k] if mode == Mode.PULL else -to_goal[k]
+        base = to_base[k]
+        turn = np.arctan2(base[0] * wanted[1] - base[1] * wanted[0], base @ wanted)
         limit = 1.8 * t.joint_limit[k]  # the sweep is shared by the first two joints
         self._start(world, k, mode, orient=float(np.clip(turn, -limit, limit)))
         c.last_start[creature_row] = world.time
