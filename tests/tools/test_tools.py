@@ -1,0 +1,62 @@
+"""The measurement tools run and report the fields their docs promise (short runs)."""
+
+from __future__ import annotations
+
+import importlib.util
+import sys
+from pathlib import Path
+from types import ModuleType
+
+import pytest
+
+TOOLS = Path(__file__).resolve().parents[2] / "tools"
+
+pytestmark = pytest.mark.skipif(not TOOLS.is_dir(), reason="needs the source tree")
+
+
+def _load(name: str) -> ModuleType:
+    spec = importlib.util.spec_from_file_location(name, TOOLS / f"{name}.py")
+    assert spec and spec.loader
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_locomotion_report_row_has_the_issue_fields() -> None:
+    report = _load("locomotion_report")
+    from ecs_tentacles.world import World
+
+    world = World.from_scene(report.case_scene(4, "coordinated", 0.0))
+    row = report.run(world, "4_front", 2.0)
+    world.close()
+    assert {
+        "case",
+        "tentacles",
+        "gait",
+        "reached",
+        "time_s",
+        "speed_radii_per_s",
+        "path_efficiency",
+        "attaches",
+        "max_penetration_m",
+    } <= set(row)
+    assert (row["case"], row["tentacles"], row["gait"], row["reached"]) == (
+        "4_front",
+        4,
+        "coordinated",
+        False,
+    )
+    assert row["time_s"] == pytest.approx(2.0)
+    assert row["finite"] and not row["flipped"] and row["suckers_left_behind"] == 0
+    assert row["speed_radii_per_s"] > 0 and row["attaches"] >= 1
+    assert len(report.cases(None, None)) == 5 * 3 * 2 + 2 + 1
+
+
+def test_frame_benchmark_splits_the_frame() -> None:
+    bench = _load("bench_frame")
+    row = bench.bench_scene("three_goals", frames=3, repeats=1)
+    ms = row["ms_per_frame"]
+    names = {"goals", "tentacle_selection", "action_queue", "motor_targets", "suckers"}
+    assert names | {"physics", "physics_sync", "total", "mj_step"} == set(ms)
+    assert ms["total"] >= ms["mj_step"] > 0
