@@ -11,10 +11,10 @@ import sys
 from collections.abc import Sequence
 
 from ecs_tentacles import __version__
-from ecs_tentacles.cli import run, validate
+from ecs_tentacles.cli import play, run, validate
 from ecs_tentacles.scene.errors import SceneError
 
-COMMANDS = {"validate": validate, "run": run}
+COMMANDS = {"validate": validate, "run": run, "play": play}
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -1,0 +1,94 @@
+"""`ecs-tentacles play SCENE`: the interactive sandbox, or headless screenshots/video."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from collections.abc import Callable
+from pathlib import Path
+
+from ecs_tentacles.cli.run import positive_int, seed_int
+from ecs_tentacles.scene.load import resolve_scene_path
+
+
+def even_size(text: str) -> int:
+    value = positive_int(text)
+    if value % 2 or not 64 <= value <= 8192:
+        raise argparse.ArgumentTypeError(
+            f"must be an even number of pixels in [64, 8192], got {value}"
+        )
+    return value
+
+
+def output_file(suffix: str) -> Callable[[str], Path]:
+    def check(text: str) -> Path:
+        path = Path(text)
+        if path.suffix.lower() != suffix:
+            raise argparse.ArgumentTypeError(f"must end in {suffix}, got {text!r}")
+        if not path.parent.resolve().is_dir():
+            raise argparse.ArgumentTypeError(f"folder {str(path.parent)!r} does not exist")
+        return path
+
+    return check
+
+
+def add_parser(commands: argparse._SubParsersAction) -> None:
+    parser = commands.add_parser(
+        "play",
+        help="open the sandbox: watch, click goals, tune tentacles (or render headless)",
+        description=(
+            "Open a scene in the sandbox window. Mouse: left-drag orbit, right-drag pan, wheel "
+            "zoom, click a creature to select it, click the ground to set its goal, shift-click "
+            "to append, right-click a goal to remove it. Keys: space pause, . step, r reset, "
+            "h HUD, f follow, a frame all, tab next tentacle, F12 screenshot, v video."
+        ),
+    )
+    parser.add_argument("scene", metavar="SCENE", help="scene file or bundled scene name")
+    parser.add_argument("--headless", action="store_true", help="no window: render off-screen")
+    parser.add_argument("--frames", type=positive_int, default=300, help="headless: frames to run")
+    parser.add_argument("--screenshot", type=output_file(".png"), help="headless: final PNG")
+    parser.add_argument("--video", type=output_file(".mp4"), help="headless: record an MP4")
+    parser.add_argument("--width", type=even_size, default=1280)
+    parser.add_argument("--height", type=even_size, default=720)
+    parser.add_argument("--seed", type=seed_int, default=None, help="override the scene's seed")
+    parser.add_argument("--allow-systems", action="store_true", help="run systems the scene names")
+    parser.add_argument("--quiet", action="store_true", help="no progress bar")
+    parser.set_defaults(handler=handle)
+
+
+def handle(args: argparse.Namespace) -> int:
+    if not args.headless and (args.screenshot or args.video):
+        print(
+            "error: --screenshot and --video need --headless (in the window: F12, v)",
+            file=sys.stderr,
+        )
+        return 2
+    path = resolve_scene_path(args.scene)
+    from ecs_tentacles.render import configure
+
+    configure(headless=args.headless)
+    from ecs_tentacles.scene.load import load_scene
+
+    load_scene(path)  # a bad scene fails before a window opens
+    from ecs_tentacles.render.sandbox import Sandbox
+
+    sandbox = Sandbox(
+        path,
+        width=args.width,
+        height=args.height,
+        headless=args.headless,
+        seed=args.seed,
+        allow_systems=args.allow_systems,
+    )
+    try:
+        if args.headless:
+            result = sandbox.run_headless(
+                args.frames, screenshot=args.screenshot, video=args.video, progress=not args.quiet
+            )
+            print(json.dumps({"scene": str(path), **result}))
+        else:
+            sandbox.run()
+    finally:
+        sandbox.close()
+    return 0

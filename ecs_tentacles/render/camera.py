@@ -1,0 +1,133 @@
+"""An orbit camera (orbit, pan, zoom, frame all, follow) and mouse picking.
+
+Pure numpy: matrices are column-vector convention (p_clip = P @ V @ p_world) and are
+sent to OpenGL transposed (column-major).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+def perspective(fov_y: float, aspect: float, near: float, far: float) -> np.ndarray:
+    f = 1.0 / np.tan(fov_y / 2)
+    m = np.zeros((4, 4))
+    m[0, 0] = f / aspect
+    m[1, 1] = f
+    m[2, 2] = (far + near) / (near - far)
+    m[2, 3] = 2 * far * near / (near - far)
+    m[3, 2] = -1.0
+    return m
+
+
+def look_at(eye: np.ndarray, target: np.ndarray, up: np.ndarray) -> np.ndarray:
+    forward = target - eye
+    forward = forward / np.linalg.norm(forward)
+    right = np.cross(forward, up)
+    right = right / np.linalg.norm(right)
+    true_up = np.cross(right, forward)
+    m = np.eye(4)
+    m[0, :3], m[1, :3], m[2, :3] = right, true_up, -forward
+    m[:3, 3] = -m[:3, :3] @ eye
+    return m
+
+
+@dataclass
+class OrbitCamera:
+    """Looks at `target` from `distance`, turned by `yaw` about +z and tilted by `pitch`."""
+
+    width: int = 1280
+    height: int = 720
+    target: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    distance: float = 3.0
+    yaw: float = np.radians(-60.0)
+    pitch: float = np.radians(35.0)
+    fov_y: float = np.radians(45.0)
+    follow: int | None = None  # transform row to keep centred
+    shift_x: float = 0.0  # pixels to move the picture's centre right (to clear a side panel)
+
+    MIN_PITCH = np.radians(3.0)
+    MAX_PITCH = np.radians(89.0)
+
+    @property
+    def eye(self) -> np.ndarray:
+        cp = np.cos(self.pitch)
+        offset = np.array([cp * np.cos(self.yaw), cp * np.sin(self.yaw), np.sin(self.pitch)])
+        return self.target + self.distance * offset
+
+    def view(self) -> np.ndarray:
+        return look_at(self.eye, self.target, np.array([0.0, 0.0, 1.0]))
+
+    def projection(self) -> np.ndarray:
+        near = max(0.01, self.distance * 0.01)
+        matrix = perspective(self.fov_y, self.width / self.height, near, self.distance * 50 + 50)
+        matrix[0, 2] = -2.0 * self.shift_x / self.width  # lens shift: x_ndc += 2 shift / width
+        return matrix
+
+    def view_projection(self) -> np.ndarray:
+        return self.projection() @ self.view()
+
+    def orbit(self, dx: float, dy: float) -> None:
+        """Turn by mouse motion in pixels."""
+        self.yaw -= dx * 0.008
+        self.pitch = float(np.clip(self.pitch - dy * 0.008, self.MIN_PITCH, self.MAX_PITCH))
+
+    def pan(self, dx: float, dy: float) -> None:
+        """Slide the target in the view plane by mouse motion in pixels."""
+        view = self.view()
+        right, up = view[0, :3], view[1, :3]
+        scale = self.distance * np.tan(self.fov_y / 2) * 2 / self.height
+        self.target = self.target - (right * dx + up * dy) * scale
+        self.follow = None
+
+    def zoom(self, steps: float) -> None:
+        """Move closer (positive steps) or farther."""
+        self.distance = float(np.clip(self.distance * 0.9**steps, 0.2, 500.0))
+
+    def frame(self, points: np.ndarray, margin: float = 1.3) -> None:
+        """Centre on `points` (n, 3) and back off until they all fit."""
+        if not len(points):
+            return
+        low, high = points.min(axis=0), points.max(axis=0)
+        self.target = (low + high) / 2
+        self.target[2] = 0.0
+        radius = max(float(np.linalg.norm(high - low)) / 2, 0.3)
+        self.distance = margin * radius / np.sin(self.fov_y / 2)
+
+    def ray(self, x: float, y: float) -> tuple[np.ndarray, np.ndarray]:
+        """World ray (origin, unit direction) through pixel (x, y), origin bottom-left."""
+        ndc = np.array([2 * x / self.width - 1, 2 * y / self.height - 1])
+        inverse = np.linalg.inv(self.view_projection())
+        near = inverse @ np.array([ndc[0], ndc[1], -1.0, 1.0])
+        far = inverse @ np.array([ndc[0], ndc[1], 1.0, 1.0])
+        near, far = near[:3] / near[3], far[:3] / far[3]
+        direction = far - near
+        return near, direction / np.linalg.norm(direction)
+
+    def ground_point(self, x: float, y: float, height: float = 0.0) -> np.ndarray | None:
+        """Where the ray through pixel (x, y) meets the plane z = height (None if it doesn't)."""
+        origin, direction = self.ray(x, y)
+        if abs(direction[2]) < 1e-9:
+            return None
+        t = (height - origin[2]) / direction[2]
+        return origin + t * direction if t > 0 else None
+
+    def project(self, points: np.ndarray) -> np.ndarray:
+        """Pixel coordinates (n, 2), origin bottom-left, of world points (n, 3)."""
+        homogeneous = np.hstack([points, np.ones((len(points), 1))]) @ self.view_projection().T
+        ndc = homogeneous[:, :2] / homogeneous[:, 3:4]
+        return (ndc + 1) / 2 * [self.width, self.height]
+
+
+def ray_sphere(
+    origin: np.ndarray, direction: np.ndarray, centres: np.ndarray, radii: np.ndarray
+) -> np.ndarray:
+    """Distance along the ray to each sphere (inf where missed)."""
+    to_centre = centres - origin
+    along = to_centre @ direction
+    closest_sq = np.einsum("ij,ij->i", to_centre, to_centre) - along**2
+    inside = radii**2 - closest_sq
+    hit = (inside >= 0) & (along > 0)
+    return np.where(hit, along - np.sqrt(np.maximum(inside, 0)), np.inf)

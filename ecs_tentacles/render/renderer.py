@@ -1,0 +1,222 @@
+"""Draws a World: ground grid, mantles, links, attached suckers, goals and paths.
+
+Per frame: one numpy pass fills each mesh kind's instance array from the Transform
+store (interpolated between the last two physics frames), one upload per kind, one
+instanced draw per kind (links in two levels of detail). Draw calls do not grow with
+the number of creatures.
+"""
+
+from __future__ import annotations
+
+import colorsys
+
+import numpy as np
+from pyglet import gl
+
+from ecs_tentacles.components import Creature, Goal, Link, Tentacle, Transform
+from ecs_tentacles.render import shaders
+from ecs_tentacles.render.camera import OrbitCamera
+from ecs_tentacles.render.gpu import (
+    INSTANCE_FLOATS,
+    InstancedMesh,
+    Lines,
+    Quad,
+    Target,
+    program,
+    set_matrix,
+)
+from ecs_tentacles.render.meshes import CAPSULE_LODS, CYLINDER_LOD, SPHERE_LOD
+from ecs_tentacles.world import World
+
+SKY = (0.70, 0.76, 0.82)
+LIGHT = np.array([0.35, -0.45, 0.82]) / np.linalg.norm([0.35, -0.45, 0.82])
+LOD_DISTANCE = 6.0  # metres from the eye beyond which links use the lean mesh
+RING_SEGMENTS = 48
+
+
+def creature_colours(count: int) -> np.ndarray:
+    """Distinct warm colours (count, 3), octopus-like."""
+    hues = (0.02 + 0.61803 * np.arange(count)) % 1.0
+    return np.array([colorsys.hsv_to_rgb(h, 0.65, 0.85) for h in hues]).reshape(-1, 3)
+
+
+def _nlerp(a: np.ndarray, b: np.ndarray, t: float) -> np.ndarray:
+    b = np.where((np.einsum("ij,ij->i", a, b) < 0)[:, None], -b, b)
+    q = a + t * (b - a)
+    return q / np.linalg.norm(q, axis=1, keepdims=True)
+
+
+class Renderer:
+    """GPU objects and per-frame instance arrays for one world."""
+
+    def __init__(self, world: World, width: int, height: int):
+        self.world = world
+        self.target = Target(width, height)
+        self.camera = OrbitCamera(width, height)
+        self.lit = program(shaders.INSTANCED_VERTEX, shaders.LIT_FRAGMENT)
+        self.ground_program = program(shaders.GROUND_VERTEX, shaders.GROUND_FRAGMENT)
+        self.line_program = program(shaders.LINE_VERTEX, shaders.LINE_FRAGMENT)
+        self.ground = Quad(200.0)
+        self.mantles = InstancedMesh(CYLINDER_LOD)
+        self.links_near = InstancedMesh(CAPSULE_LODS[0])
+        self.links_far = InstancedMesh(CAPSULE_LODS[1])
+        self.suckers = InstancedMesh(SPHERE_LOD)
+        self.lines = Lines()
+        self.selected: int | None = None  # creature entity
+        self.draw_calls = 0
+        self.extra_lines: list = []  # callables world -> float32 (2n, 7) segments
+        self._build_static()
+        self.previous = (world.transforms.pos.copy(), world.transforms.quat.copy())
+        self.current = self.previous
+
+    # -- static per-instance data ------------------------------------------------------
+    def _build_static(self) -> None:
+        world = self.world
+        creatures = sorted(world.query(Creature, Transform))
+        colours = creature_colours(len(creatures))
+        self.creature_entities = [e for e, _ in creatures]
+        self.creature_colour = {e: colours[i] for i, e in enumerate(self.creature_entities)}
+        mantle = np.zeros((len(creatures), INSTANCE_FLOATS), np.float32)
+        self.mantle_rows = np.array([t.row for _, (_, t) in creatures], dtype=np.int64)
+        for i, (_, (creature, _)) in enumerate(creatures):
+            r, h = creature.mantle_radius, creature.mantle_height
+            mantle[i, 7:11] = (r, r, h / 2, 0.0)
+            mantle[i, 11:15] = (*colours[i], 1.0)
+        self.mantle_instances = mantle
+        link_rows, link_static = [], []
+        for i, entity in enumerate(self.creature_entities):
+            creature = world.component(entity, Creature)
+            for tentacle_entity in creature.tentacles:
+                tentacle = world.component(tentacle_entity, Tentacle)
+                n = len(tentacle.links)
+                for link_entity in tentacle.links:
+                    link = world.component(link_entity, Link)
+                    shade = 1.0 - 0.35 * link.index / max(n - 1, 1)
+                    link_rows.append(world.component(link_entity, Transform).row)
+                    colour = np.clip(colours[i] * shade + 0.08 * (1 - shade), 0, 1)
+                    link_static.append(
+                        (link.radius, link.radius, link.radius, link.length / 2, *colour, 1.0)
+                    )
+        self.link_rows = np.array(link_rows, dtype=np.int64)
+        self.link_instances = np.zeros((len(link_rows), INSTANCE_FLOATS), np.float32)
+        if link_rows:
+            self.link_instances[:, 7:] = np.array(link_static)
+
+    # -- per frame -----------------------------------------------------------------------
+    def sync(self) -> None:
+        """Remember the newest physics poses (the render system calls this each frame)."""
+        self.previous = self.current
+        self.current = (self.world.transforms.pos.copy(), self.world.transforms.quat.copy())
+
+    def poses(self, alpha: float) -> tuple[np.ndarray, np.ndarray]:
+        """Body poses interpolated between the last two physics frames (alpha in [0, 1])."""
+        (p0, q0), (p1, q1) = self.previous, self.current
+        if alpha >= 1.0 or p0 is p1:
+            return p1, q1
+        return p0 + alpha * (p1 - p0), _nlerp(q0, q1, alpha)
+
+    def upload(self, alpha: float = 1.0) -> None:
+        """Fill and upload every instance array and the line list."""
+        pos, quat = self.poses(alpha)
+        if self.camera.follow is not None:
+            self.camera.target = pos[self.camera.follow] * [1, 1, 0]
+        m = self.mantle_instances
+        m[:, 0:3], m[:, 3:7] = pos[self.mantle_rows], quat[self.mantle_rows]
+        self.mantles.update(m)
+        links = self.link_instances
+        links[:, 0:3], links[:, 3:7] = pos[self.link_rows], quat[self.link_rows]
+        near = np.linalg.norm(links[:, 0:3] - self.camera.eye, axis=1) < LOD_DISTANCE
+        self.links_near.update(links[near])
+        self.links_far.update(links[~near])
+        self.suckers.update(self._sucker_instances())
+        self.lines.update(self._line_vertices(pos))
+
+    def _sucker_instances(self) -> np.ndarray:
+        s = self.world.suckers
+        held = np.flatnonzero(s.attached)
+        out = np.zeros((len(held), INSTANCE_FLOATS), np.float32)
+        out[:, 0:3] = s.anchor[held] + [0.0, 0.0, 0.01]
+        out[:, 3] = 1.0
+        out[:, 7:11] = (0.024, 0.024, 0.024, 0.0)
+        out[:, 11:15] = (1.0, 0.92, 0.25, 1.0)
+        return out
+
+    def _line_vertices(self, pos: np.ndarray) -> np.ndarray:
+        segments: list[np.ndarray] = []
+        angles = np.linspace(0, 2 * np.pi, RING_SEGMENTS + 1)
+        circle = np.stack([np.cos(angles), np.sin(angles), np.zeros_like(angles)], axis=1)
+        for entity in self.creature_entities:
+            colour = np.append(self.creature_colour[entity] * 0.6 + 0.4, 1.0)
+            goals = self.world.goals.path(entity)
+            if not goals:
+                continue
+            points = self.world.goals.positions(entity) + [0, 0, 0.005]
+            mantle = pos[self.world.component(entity, Transform).row] * [1, 1, 0] + [0, 0, 0.005]
+            path = np.vstack([mantle, points])
+            segments.append(_segments(path, colour))
+            for goal, point in zip(goals, points, strict=True):
+                radius = self._goal_radius(goal)
+                ring = point + radius * circle
+                segments.append(_segments(ring, colour))
+                segments.append(_segments(np.array([point, point + [0, 0, 0.3]]), colour))
+        if self.selected is not None:
+            row = self.world.component(self.selected, Transform).row
+            creature = self.world.component(self.selected, Creature)
+            ring = pos[row] * [1, 1, 0] + [0, 0, 0.01] + creature.mantle_radius * 1.6 * circle
+            segments.append(_segments(ring, np.array([1.0, 1.0, 1.0, 1.0])))
+        for provider in self.extra_lines:
+            segments.append(provider(self.world))
+        if not segments:
+            return np.zeros((0, 7), np.float32)
+        return np.vstack(segments).astype(np.float32)
+
+    def _goal_radius(self, goal: int) -> float:
+        return self.world.component(goal, Goal).radius
+
+    def draw(self, alpha: float = 1.0) -> int:
+        """Render into the off-screen target; returns the number of draw calls."""
+        self.upload(alpha)
+        self.target.bind()
+        gl.glClearColor(*SKY, 1.0)
+        gl.glClear(gl.GL_COLOR_BUFFER_BIT | gl.GL_DEPTH_BUFFER_BIT)
+        gl.glEnable(gl.GL_DEPTH_TEST)
+        gl.glEnable(gl.GL_CULL_FACE)
+        view_projection = self.camera.view_projection()
+        eye = tuple(self.camera.eye.astype(np.float32))
+        calls = 0
+        self.ground_program.use()
+        set_matrix(self.ground_program, "u_view_projection", view_projection)
+        self.ground_program["u_eye"] = eye
+        gl.glDisable(gl.GL_CULL_FACE)
+        calls += self.ground.draw()
+        gl.glEnable(gl.GL_CULL_FACE)
+        self.lit.use()
+        set_matrix(self.lit, "u_view_projection", view_projection)
+        self.lit["u_light"] = tuple(LIGHT.astype(np.float32))
+        self.lit["u_eye"] = eye
+        for mesh in (self.mantles, self.links_near, self.links_far, self.suckers):
+            calls += mesh.draw()
+        self.line_program.use()
+        set_matrix(self.line_program, "u_view_projection", view_projection)
+        gl.glLineWidth(1.0)
+        calls += self.lines.draw()
+        gl.glBindVertexArray(0)
+        gl.glUseProgram(0)
+        self.draw_calls = calls
+        return calls
+
+    def frame_all(self) -> None:
+        """Point the camera so every creature and goal is in view."""
+        points = [self.world.transforms.pos]
+        for entity in self.creature_entities:
+            points.append(self.world.goals.positions(entity))
+        self.camera.follow = None
+        self.camera.frame(np.vstack(points), margin=1.0)
+
+
+def _segments(polyline: np.ndarray, colour: np.ndarray) -> np.ndarray:
+    """Line-list vertices (2(n-1), 7) for a polyline (n, 3) in one colour."""
+    starts, ends = polyline[:-1], polyline[1:]
+    pairs = np.empty((2 * len(starts), 3))
+    pairs[0::2], pairs[1::2] = starts, ends
+    return np.hstack([pairs, np.tile(colour, (len(pairs), 1))])

@@ -1,0 +1,289 @@
+"""The sandbox: a window (or an off-screen one) where players watch, click and tune.
+
+Physics runs at the scene's fixed frame rate with its own accumulator; drawing
+happens at display rate and interpolates between the last two physics frames.
+
+Mouse: left-drag orbits, right- or middle-drag pans, wheel zooms; click a creature
+to select it, click the ground to set its goal, shift-click to append to its path,
+right-click a goal to remove it. Keys: space pause, . single step, r reset,
+h HUD, f follow, a frame all, tab next tentacle, F12 screenshot, v video.
+
+Call `ecs_tentacles.render.configure(headless=...)` before importing this module.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pyglet
+from pyglet import gl
+from pyglet.window import key, mouse
+from tqdm import tqdm
+
+from ecs_tentacles.components import Creature, Goal, Transform
+from ecs_tentacles.render.camera import ray_sphere
+from ecs_tentacles.render.hud import PANEL_WIDTH, Hud
+from ecs_tentacles.render.output import VideoWriter, save_png
+from ecs_tentacles.render.renderer import Renderer
+from ecs_tentacles.systems.render import RenderSync
+from ecs_tentacles.world import World
+
+CLICK_PIXELS = 4  # a press and release closer than this is a click, not a drag
+MAX_CATCH_UP = 0.25  # seconds of physics to catch up at most per display frame
+
+
+class Sandbox:
+    """One scene in a window, with the renderer, HUD and input."""
+
+    def __init__(
+        self,
+        scene: str | os.PathLike[str] | dict[str, Any],
+        *,
+        width: int = 1280,
+        height: int = 720,
+        headless: bool = False,
+        seed: int | None = None,
+        allow_systems: bool = False,
+    ):
+        self.scene, self.seed, self.allow_systems = scene, seed, allow_systems
+        self.headless = headless
+        self.window = pyglet.window.Window(
+            width, height, caption="ecs_tentacles", visible=not headless, vsync=False
+        )
+        self.world = World.from_scene(scene, seed=seed, allow_systems=allow_systems)
+        self.hud = Hud(self.window, self.world)
+        self._attach_world()
+        self.window.push_handlers(self)
+        self.paused = False
+        self.accumulator = 0.0
+        self.video: VideoWriter | None = None
+        self.screenshots = 0
+        self._press: tuple[float, float] | None = None
+        self.stats = {"fps": 0.0, "physics_ms": 0.0, "sim_time": 0.0, "rtf": 0.0, "attached": 0}
+        self._wall_start = time.perf_counter()
+
+    def _attach_world(self) -> None:
+        self.renderer = Renderer(self.world, self.window.width, self.window.height)
+        self.renderer.camera.shift_x = PANEL_WIDTH / 2 if self.hud.visible else 0.0
+        self.world.add_system(RenderSync(self.renderer))
+        self.renderer.frame_all()
+        self.hud.world = self.world
+        first = self.renderer.creature_entities[0] if self.renderer.creature_entities else None
+        self.select(first)
+
+    # -- simulation --------------------------------------------------------------------
+    def step(self, frames: int = 1) -> None:
+        """Advance the world by whole physics frames."""
+        start = time.perf_counter()
+        self.world.step(frames)
+        self.stats["physics_ms"] = 1000 * (time.perf_counter() - start) / frames
+
+    def tick(self, dt: float) -> None:
+        """Display-rate callback: run the physics frames that are due."""
+        self.stats["fps"] = 0.9 * self.stats["fps"] + 0.1 / max(dt, 1e-6)
+        if self.paused:
+            return
+        frame = self.world.settings.dt
+        self.accumulator = min(self.accumulator + dt, MAX_CATCH_UP)
+        while self.accumulator >= frame:
+            self.step(1)
+            self.accumulator -= frame
+
+    def reset(self) -> None:
+        """Rebuild the scene from its file."""
+        self.world.close()
+        self.world = World.from_scene(self.scene, seed=self.seed, allow_systems=self.allow_systems)
+        self._attach_world()
+
+    # -- drawing -----------------------------------------------------------------------
+    def render(self) -> np.ndarray | None:
+        """Draw the world and the HUD off-screen; return the picture if recording."""
+        alpha = 1.0 if self.paused else self.accumulator / self.world.settings.dt
+        self.renderer.draw(alpha)
+        self._update_stats()
+        gl.glDisable(gl.GL_DEPTH_TEST)
+        gl.glDisable(gl.GL_CULL_FACE)
+        self.hud.draw()
+        pixels = None
+        if self.video is not None:
+            pixels = self.renderer.target.read()
+            self.video.add(pixels)
+        if not self.headless:
+            self.renderer.target.blit_to_window(*self.window.get_framebuffer_size())
+        return pixels
+
+    def on_draw(self) -> None:
+        self.window.clear()
+        self.render()
+
+    def _update_stats(self) -> None:
+        wall = time.perf_counter() - self._wall_start
+        self.stats["sim_time"] = self.world.time
+        self.stats["rtf"] = self.world.time / wall if wall > 0 else 0.0
+        self.stats["attached"] = int(self.world.suckers.attached.sum())
+        self.hud.update(self.stats)
+
+    def screenshot(self, path: str | os.PathLike[str] | None = None) -> Path:
+        """Save what the camera sees (with the HUD) as a PNG."""
+        self.render()
+        if path is None:
+            self.screenshots += 1
+            path = f"ecs_tentacles_{self.screenshots:03d}.png"
+        return save_png(self.renderer.target.read(), path)
+
+    def toggle_video(self, path: str | os.PathLike[str] | None = None) -> Path | None:
+        """Start recording, or stop and return the finished file."""
+        if self.video is None:
+            target = path or f"ecs_tentacles_{int(time.time())}.mp4"
+            self.video = VideoWriter(
+                target, self.window.width, self.window.height, self.world.settings.fps
+            )
+            return None
+        video, self.video = self.video, None
+        return video.close()
+
+    # -- selection and goals -------------------------------------------------------------
+    def select(self, creature: int | None) -> None:
+        self.renderer.selected = creature
+        self.hud.select(creature)
+
+    def pick_creature(self, x: float, y: float) -> int | None:
+        """The creature whose mantle is under pixel (x, y), nearest first."""
+        if not self.renderer.creature_entities:
+            return None
+        origin, direction = self.renderer.camera.ray(x, y)
+        creatures = [self.world.component(e, Creature) for e in self.renderer.creature_entities]
+        centres = self.world.transforms.pos[self.renderer.mantle_rows]
+        radii = np.array([max(c.mantle_radius, c.mantle_height / 2) * 1.25 for c in creatures])
+        hits = ray_sphere(origin, direction, centres, radii)
+        best = int(np.argmin(hits))
+        return self.renderer.creature_entities[best] if np.isfinite(hits[best]) else None
+
+    def click(self, x: float, y: float, button: int, modifiers: int) -> None:
+        """What a click at pixel (x, y) does in the world."""
+        if self.hud.contains(x, y):
+            return
+        if button == mouse.LEFT:
+            picked = self.pick_creature(x, y)
+            if picked is not None:
+                self.select(picked)
+                return
+            point = self.renderer.camera.ground_point(x, y)
+            creature = self.renderer.selected
+            if point is None or creature is None:
+                return
+            if modifiers & key.MOD_SHIFT:
+                self.world.goals.append(creature, point[:2].tolist())
+            else:
+                self.world.goals.set(creature, point[:2].tolist())
+        elif button == mouse.RIGHT:
+            point = self.renderer.camera.ground_point(x, y)
+            if point is not None:
+                self.remove_goal_at(point)
+
+    def remove_goal_at(self, point: np.ndarray) -> int | None:
+        """Remove the goal whose ring contains `point` (the nearest one)."""
+        best, best_distance = None, np.inf
+        for entity, goal in self.world.query(Goal):
+            distance = float(np.linalg.norm(goal.position[:2] - point[:2]))
+            if distance <= goal.radius and distance < best_distance:
+                best, best_distance = entity, distance
+        if best is not None:
+            self.world.goals.remove(best)
+        return best
+
+    # -- window events -------------------------------------------------------------------
+    def on_mouse_press(self, x: int, y: int, button: int, modifiers: int) -> None:
+        self._press = (x, y) if not self.hud.contains(x, y) else None
+
+    def on_mouse_release(self, x: int, y: int, button: int, modifiers: int) -> None:
+        if (
+            self._press is not None
+            and np.hypot(x - self._press[0], y - self._press[1]) < CLICK_PIXELS
+        ):
+            self.click(x, y, button, modifiers)
+        self._press = None
+
+    def on_mouse_drag(self, x: int, y: int, dx: int, dy: int, buttons: int, modifiers: int) -> None:
+        if self._press is None:
+            return
+        if buttons & mouse.LEFT:
+            self.renderer.camera.orbit(dx, dy)
+        elif buttons & (mouse.RIGHT | mouse.MIDDLE):
+            self.renderer.camera.pan(dx, dy)
+
+    def on_mouse_scroll(self, x: int, y: int, scroll_x: float, scroll_y: float) -> None:
+        if not self.hud.contains(x, y):
+            self.renderer.camera.zoom(scroll_y)
+
+    def on_key_press(self, symbol: int, modifiers: int) -> None:
+        camera = self.renderer.camera
+        if symbol == key.SPACE:
+            self.paused = not self.paused
+        elif symbol == key.PERIOD:
+            self.paused = True
+            self.step(1)
+        elif symbol == key.R:
+            self.reset()
+        elif symbol == key.H:
+            self.hud.visible = not self.hud.visible
+            self.renderer.camera.shift_x = PANEL_WIDTH / 2 if self.hud.visible else 0.0
+        elif symbol == key.F and self.renderer.selected is not None:
+            row = self.world.component(self.renderer.selected, Transform).row
+            camera.follow = None if camera.follow == row else row
+        elif symbol == key.A:
+            self.renderer.frame_all()
+        elif symbol == key.TAB:
+            self.hud._step_tentacle(-1 if modifiers & key.MOD_SHIFT else 1)
+        elif symbol == key.F12:
+            print(f"saved {self.screenshot()}")
+        elif symbol == key.V:
+            finished = self.toggle_video()
+            print(f"saved {finished}" if finished else "recording video (v to stop)")
+
+    # -- running -------------------------------------------------------------------------
+    def run(self) -> None:
+        """Open the window and run until it is closed."""
+        pyglet.clock.schedule(self.tick)
+        pyglet.app.run()
+        if self.video is not None:
+            self.video.close()
+
+    def run_headless(
+        self,
+        frames: int,
+        screenshot: str | os.PathLike[str] | None = None,
+        video: str | os.PathLike[str] | None = None,
+        progress: bool = True,
+    ) -> dict[str, Any]:
+        """Step `frames` frames off-screen, recording a video and/or a final screenshot."""
+        if video is not None:
+            self.toggle_video(video)
+        try:
+            for _ in tqdm(
+                range(frames), unit="frame", disable=None if progress else True, leave=False
+            ):
+                self.step(1)
+                if self.video is not None:
+                    self.render()
+        except BaseException:
+            if self.video is not None:
+                self.video.abort()
+                self.video = None
+            raise
+        result: dict[str, Any] = {"frames": frames, "sim_seconds": self.world.time}
+        if self.video is not None:
+            result["video"] = str(self.toggle_video())
+        if screenshot is not None:
+            result["screenshot"] = str(self.screenshot(screenshot))
+        return result
+
+    def close(self) -> None:
+        if self.video is not None:
+            self.video.abort()
+        self.world.close()
+        self.window.close()

@@ -1,0 +1,100 @@
+"""GLSL sources (OpenGL 3.3 core)."""
+
+INSTANCED_VERTEX = """
+#version 330 core
+layout(location = 0) in vec3 a_position;
+layout(location = 1) in vec3 a_normal;
+layout(location = 2) in float a_side;
+layout(location = 3) in vec3 i_position;
+layout(location = 4) in vec4 i_quat;      // w, x, y, z
+layout(location = 5) in vec4 i_scale;     // xyz scale, w: extend along x per side
+layout(location = 6) in vec4 i_colour;
+uniform mat4 u_view_projection;
+out vec3 v_normal;
+out vec4 v_colour;
+out vec3 v_world;
+
+vec3 rotate(vec4 q, vec3 v) {
+    vec3 t = 2.0 * cross(q.yzw, v);
+    return v + q.x * t + cross(q.yzw, t);
+}
+
+void main() {
+    vec3 local = a_position * i_scale.xyz + vec3(a_side * i_scale.w, 0.0, 0.0);
+    vec3 world = i_position + rotate(i_quat, local);
+    v_normal = rotate(i_quat, normalize(a_normal / i_scale.xyz));
+    v_colour = i_colour;
+    v_world = world;
+    gl_Position = u_view_projection * vec4(world, 1.0);
+}
+"""
+
+LIT_FRAGMENT = """
+#version 330 core
+in vec3 v_normal;
+in vec4 v_colour;
+in vec3 v_world;
+uniform vec3 u_light;
+uniform vec3 u_eye;
+out vec4 f_colour;
+void main() {
+    vec3 n = normalize(v_normal);
+    float diffuse = max(dot(n, u_light), 0.0);
+    float sky = 0.5 + 0.5 * n.z;                       // hemisphere ambient
+    vec3 view = normalize(u_eye - v_world);
+    float rim = pow(1.0 - max(dot(n, view), 0.0), 3.0) * 0.25;
+    vec3 half_vector = normalize(u_light + view);
+    float specular = pow(max(dot(n, half_vector), 0.0), 24.0) * 0.25;
+    vec3 colour = v_colour.rgb * (0.32 + 0.25 * sky + 0.6 * diffuse) + rim + specular;
+    f_colour = vec4(colour, v_colour.a);
+}
+"""
+
+GROUND_VERTEX = """
+#version 330 core
+layout(location = 0) in vec3 a_position;
+uniform mat4 u_view_projection;
+out vec3 v_world;
+void main() {
+    v_world = a_position;
+    gl_Position = u_view_projection * vec4(a_position, 1.0);
+}
+"""
+
+GROUND_FRAGMENT = """
+#version 330 core
+in vec3 v_world;
+uniform vec3 u_eye;
+out vec4 f_colour;
+float grid(vec2 p, float spacing, float width) {
+    vec2 g = abs(fract(p / spacing - 0.5) - 0.5) / fwidth(p / spacing);
+    return 1.0 - min(min(g.x, g.y) / width, 1.0);
+}
+void main() {
+    vec3 base = vec3(0.56, 0.60, 0.55);
+    float fine = grid(v_world.xy, 0.25, 1.0) * 0.10;
+    float coarse = grid(v_world.xy, 1.0, 1.5) * 0.25;
+    vec3 colour = mix(base, vec3(0.30, 0.33, 0.30), fine + coarse);
+    float fog = clamp(length(v_world - u_eye) / 60.0, 0.0, 1.0);
+    f_colour = vec4(mix(colour, vec3(0.70, 0.76, 0.82), fog * fog), 1.0);
+}
+"""
+
+LINE_VERTEX = """
+#version 330 core
+layout(location = 0) in vec3 a_position;
+layout(location = 1) in vec4 a_colour;
+uniform mat4 u_view_projection;
+out vec4 v_colour;
+void main() {
+    v_colour = a_colour;
+    gl_Position = u_view_projection * vec4(a_position, 1.0);
+}
+"""
+
+LINE_FRAGMENT = """
+#version 330 core
+in vec4 v_colour;
+out vec4 f_colour;
+void main() { f_colour = v_colour; }
+"""

@@ -1,0 +1,30 @@
+"""render: hands the newest body poses to the sandbox renderer.
+
+Reads: Transform store (pos, quat). Writes: the Renderer's last two pose snapshots,
+between which it interpolates when it draws at display rate. Added only by the
+sandbox (`ecs-tentacles play`), never to headless runs.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from ecs_tentacles.system import System
+
+if TYPE_CHECKING:
+    from ecs_tentacles.render.renderer import Renderer
+    from ecs_tentacles.world import World
+
+
+class RenderSync(System):
+    name = "render"
+    after = ("physics_sync",)
+
+    def __init__(self, renderer: Renderer):
+        self.renderer = renderer
+
+    def setup(self, world: World) -> None:
+        self.renderer.sync()
+
+    def process(self, world: World, dt: float) -> None:
+        self.renderer.sync()

@@ -1,0 +1,136 @@
+"""The sandbox drawn off-screen: pixels, clicks, HUD, draw calls, files."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+from PIL import Image
+from pyglet.event import EventDispatcher
+from pyglet.window import key, mouse
+
+from ecs_tentacles.components import Creature, Goal, Transform
+
+
+def _event(sandbox: Any, name: str, *args: Any) -> None:
+    """Deliver a window event now (a window queues events outside its own loop)."""
+    EventDispatcher.dispatch_event(sandbox.window, name, *args)
+
+
+def _click(sandbox: Any, x: float, y: float, button: int = mouse.LEFT, modifiers: int = 0) -> None:
+    _event(sandbox, "on_mouse_press", round(x), round(y), button, modifiers)
+    _event(sandbox, "on_mouse_release", round(x), round(y), button, modifiers)
+
+
+def test_octopus_is_drawn_where_the_camera_says(make_sandbox: Callable[..., Any]) -> None:
+    sandbox = make_sandbox("octopus")
+    sandbox.step(30)
+    sandbox.hud.visible = False
+    sandbox.render()
+    pixels = sandbox.renderer.target.read().astype(int)
+    assert pixels.shape == (360, 640, 3)
+    octo = sandbox.world.creature("octopus")
+    creature = sandbox.world.component(octo, Creature)
+    mantle = sandbox.world.component(octo, Transform).pos
+    top = mantle + [0.0, 0.0, creature.mantle_height / 2]
+    x, y = sandbox.renderer.camera.project(top[None])[0]
+    r, g, b = pixels[360 - round(y), round(x)]
+    assert r > g + 60 and r > b + 60  # the mantle's warm red, lit
+    corner = pixels[5, 630]  # far ground in the top-right corner: grey-green, not red
+    assert abs(corner[0] - corner[1]) < 25 and corner[1] > corner[2] - 25
+    assert not (pixels == pixels[0, 0]).all()  # not a blank frame
+    assert pixels.mean() > 60  # not a black frame
+
+
+def test_clicks_set_append_and_remove_goals(make_sandbox: Callable[..., Any]) -> None:
+    sandbox = make_sandbox("octopus")
+    octo = sandbox.world.creature("octopus")
+    camera = sandbox.renderer.camera
+    first, second = np.array([0.8, -0.6, 0.0]), np.array([1.2, 0.5, 0.0])
+    _click(sandbox, *camera.project(first[None])[0])
+    path = sandbox.world.goals.path(octo)
+    assert len(path) == 1
+    assert np.linalg.norm(sandbox.world.component(path[0], Goal).position - first) < 0.01
+    _click(sandbox, *camera.project(second[None])[0], modifiers=key.MOD_SHIFT)
+    positions = sandbox.world.goals.positions(octo)
+    assert positions.shape == (2, 3)
+    assert np.linalg.norm(positions - [first, second], axis=1).max() < 0.01
+    _click(sandbox, *camera.project(first[None])[0], button=mouse.RIGHT)
+    assert_allclose(sandbox.world.goals.positions(octo), [second], atol=0.01)
+
+
+def test_clicking_a_creature_selects_it(make_sandbox: Callable[..., Any]) -> None:
+    sandbox = make_sandbox("thesis_four_by_six")
+    world = sandbox.world
+    target = world.creature("creature_2")
+    centre = world.component(target, Transform).pos
+    _click(sandbox, *sandbox.renderer.camera.project(centre[None])[0])
+    assert sandbox.renderer.selected == target
+    assert sandbox.hud.title.text == "creature_2"
+
+
+def test_hud_slider_reaches_the_servo_gains(make_sandbox: Callable[..., Any]) -> None:
+    sandbox = make_sandbox("octopus")
+    world = sandbox.world
+    octo = world.creature("octopus")
+    slider, _, knob = sandbox.hud.sliders["strength"]
+    x = slider.x + slider._edge + 0.75 * (slider.width - 2 * slider._edge)
+    y = slider.y + slider.height / 2
+    _event(sandbox, "on_mouse_press", round(x), round(y), mouse.LEFT, 0)
+    _event(sandbox, "on_mouse_release", round(x), round(y), mouse.LEFT, 0)
+    kp = world.locomotion.get(octo, 0)["strength"]
+    assert 70 < slider.value < 85  # the knob jumped to where we clicked
+    assert kp == pytest.approx(knob.low + (knob.high - knob.low) * slider.value / 100, rel=1e-12)
+    assert [world.locomotion.get(octo, k)["strength"] for k in range(8)] == [kp] * 8  # "all"
+    sandbox.step(1)
+    model = world.physics.model
+    actuator = model.actuator("octopus/t3/l00/curl").id
+    row = int(world.tentacles.first_link[3])
+    assert model.actuator_gainprm[actuator, 0] == pytest.approx(
+        kp * world.motors.gain[row], rel=1e-12
+    )
+    assert sandbox.hud.sliders["strength"][1].text == f"{kp:.1f}"
+
+
+def _crowd(count: int) -> dict[str, Any]:
+    creatures = [
+        {
+            "name": f"c{i}",
+            "position": [1.5 * (i % 4), 1.5 * (i // 4)],
+            "tentacles": {"count": 5, "links": 6},
+            "goals": [{"position": [1.5 * (i % 4) + 1.0, 1.5 * (i // 4)]}],
+        }
+        for i in range(count)
+    ]
+    return {"version": 1, "creatures": creatures}
+
+
+def test_draw_calls_do_not_grow_with_creatures(make_sandbox: Callable[..., Any]) -> None:
+    calls = []
+    for count in (1, 16):
+        sandbox = make_sandbox(_crowd(count))
+        sandbox.step(40)
+        calls.append(sandbox.renderer.draw())
+        assert sandbox.renderer.links_near.count + sandbox.renderer.links_far.count == count * 30
+    assert calls[0] == calls[1] == 6  # ground, mantles, near and far links, suckers, lines
+
+
+def test_headless_run_writes_a_screenshot_and_a_video(
+    make_sandbox: Callable[..., Any], tmp_path: Path
+) -> None:
+    sandbox = make_sandbox("three_goals")
+    result = sandbox.run_headless(
+        12, screenshot=tmp_path / "shot.png", video=tmp_path / "clip.mp4", progress=False
+    )
+    assert result["frames"] == 12
+    with Image.open(tmp_path / "shot.png") as image:
+        assert image.size == (640, 360)
+    assert (tmp_path / "clip.mp4").stat().st_size > 1000
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        "clip.mp4",
+        "shot.png",
+    ]  # no partial files
