@@ -29,6 +29,7 @@ class GoalBook:
     def __init__(self, world: World):
         self._world = world
         self._paths: dict[int, list[int]] = {}
+        self.version = 0  # bumped on every change, so views can cache what they drew
 
     def path(self, creature: int) -> list[int]:
         """The creature's goal entities in order (a copy)."""
@@ -102,6 +103,7 @@ class GoalBook:
         )
 
     def _sync(self, creature: int) -> None:
+        self.version += 1
         path = self._paths.get(creature, [])
         for order, goal in enumerate(path):
             self._world.component(goal, Goal).order = order

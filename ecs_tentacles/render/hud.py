@@ -203,8 +203,9 @@ class Hud:
 
     def update(self, stats: dict[str, float]) -> None:
         """Refresh the live numbers."""
+        fps = f"fps {stats['fps']:.0f}   " if stats["fps"] > 0 else ""  # no display: no fps
         self.stats.text = (
-            f"fps {stats['fps']:.0f}   physics {stats['physics_ms']:.1f} ms\n"
+            f"{fps}physics {stats['physics_ms']:.1f} ms\n"
             f"sim {stats['sim_time']:.1f} s   real-time x{stats['rtf']:.2f}\n"
             f"suckers attached {stats['attached']}"
         )

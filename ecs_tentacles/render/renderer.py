@@ -9,6 +9,7 @@ the number of creatures.
 from __future__ import annotations
 
 import colorsys
+from collections.abc import Callable
 
 import numpy as np
 from pyglet import gl
@@ -32,6 +33,8 @@ SKY = (0.70, 0.76, 0.82)
 LIGHT = np.array([0.35, -0.45, 0.82]) / np.linalg.norm([0.35, -0.45, 0.82])
 LOD_DISTANCE = 6.0  # metres from the eye beyond which links use the lean mesh
 RING_SEGMENTS = 48
+_ANGLES = np.linspace(0, 2 * np.pi, RING_SEGMENTS + 1)
+CIRCLE = np.stack([np.cos(_ANGLES), np.sin(_ANGLES), np.zeros_like(_ANGLES)], axis=1)
 
 
 def creature_colours(count: int) -> np.ndarray:
@@ -64,7 +67,8 @@ class Renderer:
         self.lines = Lines()
         self.selected: int | None = None  # creature entity
         self.draw_calls = 0
-        self.extra_lines: list = []  # callables world -> float32 (2n, 7) segments
+        self.extra_lines: list[Callable[[World], np.ndarray]] = []  # -> (2n, 7) segments
+        self._goal_version = -1
         self._build_static()
         self.previous = (world.transforms.pos.copy(), world.transforms.quat.copy())
         self.current = self.previous
@@ -141,33 +145,45 @@ class Renderer:
         out[:, 11:15] = (1.0, 0.92, 0.25, 1.0)
         return out
 
-    def _line_vertices(self, pos: np.ndarray) -> np.ndarray:
-        segments: list[np.ndarray] = []
-        angles = np.linspace(0, 2 * np.pi, RING_SEGMENTS + 1)
-        circle = np.stack([np.cos(angles), np.sin(angles), np.zeros_like(angles)], axis=1)
+    def _goal_geometry(self) -> None:
+        """Rings, markers and path legs between goals: rebuilt only when goals change."""
+        fixed: list[np.ndarray] = []
+        leaders, firsts, colours = [], [], []
         for entity in self.creature_entities:
-            colour = np.append(self.creature_colour[entity] * 0.6 + 0.4, 1.0)
             goals = self.world.goals.path(entity)
             if not goals:
                 continue
+            colour = np.append(self.creature_colour[entity] * 0.6 + 0.4, 1.0)
             points = self.world.goals.positions(entity) + [0, 0, 0.005]
-            mantle = pos[self.world.component(entity, Transform).row] * [1, 1, 0] + [0, 0, 0.005]
-            path = np.vstack([mantle, points])
-            segments.append(_segments(path, colour))
+            fixed.append(_segments(points, colour))
             for goal, point in zip(goals, points, strict=True):
-                radius = self._goal_radius(goal)
-                ring = point + radius * circle
-                segments.append(_segments(ring, colour))
-                segments.append(_segments(np.array([point, point + [0, 0, 0.3]]), colour))
+                fixed.append(_segments(point + self._goal_radius(goal) * CIRCLE, colour))
+                fixed.append(_segments(np.array([point, point + [0, 0, 0.3]]), colour))
+            leaders.append(self.world.component(entity, Transform).row)
+            firsts.append(points[0])
+            colours.append(colour)
+        self._goal_lines = np.vstack(fixed) if fixed else np.zeros((0, 7))
+        self._leader_rows = np.array(leaders, dtype=np.int64)
+        self._leader_ends = np.array(firsts).reshape(-1, 3)
+        self._leader_colours = np.array(colours).reshape(-1, 4)
+        self._goal_version = self.world.goals.version
+
+    def _line_vertices(self, pos: np.ndarray) -> np.ndarray:
+        if self._goal_version != self.world.goals.version:
+            self._goal_geometry()
+        # each creature's leg to its current goal moves with it: one vectorised pass
+        leaders = np.empty((2 * len(self._leader_rows), 7))
+        leaders[0::2, :3] = pos[self._leader_rows] * [1, 1, 0] + [0, 0, 0.005]
+        leaders[1::2, :3] = self._leader_ends
+        leaders[:, 3:] = np.repeat(self._leader_colours, 2, axis=0)
+        segments = [self._goal_lines, leaders]
         if self.selected is not None:
             row = self.world.component(self.selected, Transform).row
             creature = self.world.component(self.selected, Creature)
-            ring = pos[row] * [1, 1, 0] + [0, 0, 0.01] + creature.mantle_radius * 1.6 * circle
+            ring = pos[row] * [1, 1, 0] + [0, 0, 0.01] + creature.mantle_radius * 1.6 * CIRCLE
             segments.append(_segments(ring, np.array([1.0, 1.0, 1.0, 1.0])))
         for provider in self.extra_lines:
             segments.append(provider(self.world))
-        if not segments:
-            return np.zeros((0, 7), np.float32)
         return np.vstack(segments).astype(np.float32)
 
     def _goal_radius(self, goal: int) -> float:
