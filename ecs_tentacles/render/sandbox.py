@@ -34,6 +34,7 @@ from ecs_tentacles.world import World
 
 CLICK_PIXELS = 4  # a press and release closer than this is a click, not a drag
 MAX_CATCH_UP = 0.25  # seconds of physics to catch up at most per display frame
+DISPLAY_HZ = 60
 
 
 class Sandbox:
@@ -65,6 +66,7 @@ class Sandbox:
         self._press: tuple[float, float] | None = None
         self.stats = {"fps": 0.0, "physics_ms": 0.0, "sim_time": 0.0, "rtf": 0.0, "attached": 0}
         self._wall_start = time.perf_counter()
+        self._last_draw: float | None = None
 
     def _attach_world(self) -> None:
         self.renderer = Renderer(self.world, self.window.width, self.window.height)
@@ -83,8 +85,7 @@ class Sandbox:
         self.stats["physics_ms"] = 1000 * (time.perf_counter() - start) / frames
 
     def tick(self, dt: float) -> None:
-        """Display-rate callback: run the physics frames that are due."""
-        self.stats["fps"] = 0.9 * self.stats["fps"] + 0.1 / max(dt, 1e-6)
+        """Clock callback: run the physics frames that are due."""
         if self.paused:
             return
         frame = self.world.settings.dt
@@ -117,6 +118,10 @@ class Sandbox:
         return pixels
 
     def on_draw(self) -> None:
+        now = time.perf_counter()
+        if self._last_draw is not None:
+            self.stats["fps"] = 0.9 * self.stats["fps"] + 0.1 / max(now - self._last_draw, 1e-6)
+        self._last_draw = now
         self.window.clear()
         self.render()
 
@@ -248,8 +253,8 @@ class Sandbox:
     # -- running -------------------------------------------------------------------------
     def run(self) -> None:
         """Open the window and run until it is closed."""
-        pyglet.clock.schedule(self.tick)
-        pyglet.app.run()
+        pyglet.clock.schedule_interval(self.tick, 1 / 240)  # late calls are fine: dt is real
+        pyglet.app.run(1 / DISPLAY_HZ)
         if self.video is not None:
             self.video.close()
 
