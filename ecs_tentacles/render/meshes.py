@@ -38,7 +38,8 @@ def _grid_indices(rows: int, columns: int) -> np.ndarray:
     b = a + 1
     d = a + columns + 1
     e = d + 1
-    return np.stack([a, d, b, b, d, e], axis=-1).reshape(-1).astype(np.uint32)
+    # counter-clockwise seen from outside (the front faces OpenGL keeps when culling)
+    return np.stack([a, b, d, b, e, d], axis=-1).reshape(-1).astype(np.uint32)
 
 
 def capsule(segments: int = 10, rings: int = 3) -> Mesh:

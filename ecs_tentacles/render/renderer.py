@@ -68,6 +68,12 @@ class Renderer:
         self.selected: int | None = None  # creature entity
         self.draw_calls = 0
         self.extra_lines: list[Callable[[World], np.ndarray]] = []  # -> (2n, 7) segments
+        self.set_world(world)
+
+    def set_world(self, world: World) -> None:
+        """Draw `world` from now on (same GPU objects, new instance tables)."""
+        self.world = world
+        self.selected = None
         self._goal_version = -1
         self._build_static()
         self.previous = (world.transforms.pos.copy(), world.transforms.quat.copy())
