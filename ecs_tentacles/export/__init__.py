@@ -1,0 +1,42 @@
+"""Exporters: takes (npz), USD and glTF, all written atomically.
+
+    take = bake(BakePlan.make("octopus", seconds=2))     # ecs_tentacles.export.bake
+    write(take, "octopus.usda")                          # or .npz, .usd, .usdc, .glb
+
+Modules: `take` (the file format), `recording` (World -> Take), `bake` (headless
+runs), `usd`, `gltf`, `atomic` (temporary file + rename).
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable
+
+from ecs_tentacles.export.bake import output_kind
+from ecs_tentacles.export.take import Take, TakeError
+
+__all__ = ["SUFFIXES", "Take", "TakeError", "output_kind", "write"]
+
+SUFFIXES = (".npz", ".usd", ".usda", ".usdc", ".glb")
+
+
+def write(
+    take: Take, path: str | os.PathLike[str], progress: Callable[[int], object] | None = None
+) -> None:
+    """Write `take` in the format its suffix names (see `SUFFIXES`), atomically.
+
+    `progress(n)` hears of bodies written, for the slow format (USD).
+    """
+    kind = output_kind(path)
+    if kind == "take":
+        take.save(path)
+    elif kind == "usd":
+        from ecs_tentacles.export.usd import write_usd
+
+        write_usd(take, path, progress)
+    elif kind == "gltf":
+        from ecs_tentacles.export.gltf import write_glb
+
+        write_glb(take, path)
+    else:
+        raise ValueError(f"{path}: unknown output format (use {', '.join(SUFFIXES)})")

@@ -1,0 +1,157 @@
+"""Baking: simulate a scene headless for some seconds and record every frame into a Take.
+
+    plan = BakePlan.make("octopus", seconds=2.0, fps=30)
+    take = bake(plan)                      # deterministic for a given scene and seed
+    take.save("octopus.npz")
+
+The take's frame rate may differ from the scene's: when it divides the scene's
+`physics.fps` the bake records every k-th frame; otherwise the simulation runs at the
+smallest multiple of the take's rate not below the scene's (24 fps from a 60 fps
+scene simulates at 72 fps, recording every third frame), so every take frame is a
+simulated frame, never an interpolation.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import sys
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from tqdm import tqdm
+
+from ecs_tentacles.export.recording import scene_sha256
+from ecs_tentacles.export.take import Take
+from ecs_tentacles.scene.load import load_scene, resolve_scene_path
+from ecs_tentacles.world import World
+
+
+@dataclass(frozen=True)
+class BakePlan:
+    """What a bake will do: the scene (validated, defaults in), timing and seed."""
+
+    scene: dict[str, Any]
+    source: str
+    seconds: float
+    fps: float  # of the take
+    sim_fps: float  # of the simulation
+    every: int  # simulated frames per take frame
+    seed: int
+
+    @classmethod
+    def make(
+        cls,
+        scene: str | os.PathLike[str] | dict[str, Any],
+        *,
+        seconds: float,
+        fps: float | None = None,
+        seed: int | None = None,
+    ) -> BakePlan:
+        """Load and validate `scene` (SceneError if bad) and work out the frame rates."""
+        if isinstance(scene, dict):
+            source, data = "<dict>", load_scene(scene)
+        else:
+            path = resolve_scene_path(os.fspath(scene))
+            source, data = str(path), load_scene(path)
+        if not (seconds > 0 and math.isfinite(seconds)):
+            raise ValueError(f"seconds must be a positive number, got {seconds}")
+        scene_fps = float(data["physics"]["fps"])
+        take_fps = scene_fps if fps is None else float(fps)
+        if not (take_fps > 0 and math.isfinite(take_fps)):
+            raise ValueError(f"fps must be a positive number, got {fps}")
+        every, sim_fps = simulation_rate(scene_fps, take_fps)
+        return cls(
+            scene=data,
+            source=source,
+            seconds=float(seconds),
+            fps=take_fps,
+            sim_fps=sim_fps,
+            every=every,
+            seed=int(data["seed"] if seed is None else seed),
+        )
+
+    @property
+    def intervals(self) -> int:
+        """Take frames after the first (frame 0 is the built pose)."""
+        return round(self.seconds * self.fps)
+
+    @property
+    def frames(self) -> int:
+        """Frames in the take, frame 0 included."""
+        return self.intervals + 1
+
+    @property
+    def steps(self) -> int:
+        """Simulated frames the bake runs."""
+        return self.intervals * self.every
+
+    @property
+    def scene_sha256(self) -> str:
+        """Hash of the scene as loaded (before a frame-rate change for the bake)."""
+        return scene_sha256(self.scene)
+
+    def world(self, *, allow_systems: bool = False) -> World:
+        """Build the world to bake, at the simulation frame rate."""
+        scene = dict(self.scene)
+        scene["physics"] = {**scene["physics"], "fps": self.sim_fps}
+        return World.from_scene(scene, seed=self.seed, allow_systems=allow_systems)
+
+
+def simulation_rate(scene_fps: float, take_fps: float) -> tuple[int, float]:
+    """(simulated frames per take frame, simulation fps) for a take at `take_fps`."""
+    ratio = scene_fps / take_fps
+    nearest = round(ratio)
+    if nearest >= 1 and math.isclose(ratio, nearest, rel_tol=1e-9):
+        return int(nearest), scene_fps
+    every = max(1, math.ceil(ratio))
+    return every, take_fps * every
+
+
+def bake(
+    plan: BakePlan,
+    *,
+    progress: bool = True,
+    allow_systems: bool = False,
+    on_world: Callable[[World], None] | None = None,
+) -> Take:
+    """Run the plan and return the take; a tqdm bar with ETA goes to stderr when `progress`.
+
+    `on_world(world)` is called once the world is built (tests use it to add systems).
+    """
+    from ecs_tentacles.systems.record import Record
+
+    world = plan.world(allow_systems=allow_systems)
+    try:
+        if on_world is not None:
+            on_world(world)
+        record = Record(plan.every, scene_sha256=plan.scene_sha256, capacity=plan.frames)
+        world.add_system(record)
+        chunk = max(1, round(plan.sim_fps / 10))
+        with tqdm(
+            total=plan.steps,
+            unit="frame",
+            desc="bake",
+            disable=None if progress else True,
+            file=sys.stderr,
+            leave=False,
+        ) as bar:
+            done = 0
+            while done < plan.steps:
+                n = min(chunk, plan.steps - done)
+                world.step(n)
+                done += n
+                bar.update(n)
+        return record.take()
+    finally:
+        world.close()
+
+
+def output_kind(path: str | os.PathLike[str]) -> str | None:
+    """'take', 'usd' or 'gltf' from a file name's suffix, None if unsupported."""
+    suffix = Path(path).suffix.lower()
+    return {".npz": "take", ".usd": "usd", ".usda": "usd", ".usdc": "usd", ".glb": "gltf"}.get(
+        suffix
+    )

@@ -1,0 +1,250 @@
+"""Recording a live World into a `Take`, one frame at a time.
+
+`TakeRecorder(world)` fixes the layout once (which store rows are which bodies,
+suckers, goals) and `capture()` copies the current frame with one gather per array;
+the `record` system (`ecs_tentacles.systems.record`) calls it after physics_sync.
+Goals are discovered as they appear (scripts may add some); fur guides are read
+through `fur_guides(world)` when the world has fur.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ecs_tentacles.components import Creature, Goal, Link, Tentacle, Transform
+from ecs_tentacles.export.take import FORMAT, VERSION, Take
+
+if TYPE_CHECKING:
+    from ecs_tentacles.world import World
+
+
+@dataclass(frozen=True)
+class GuideFrame:
+    """Fur guide curves at one frame: `points` (guides, points, 3) world metres,
+    `widths` (guides, points) metres, `creatures` (guides,) owning creature entities."""
+
+    points: np.ndarray
+    widths: np.ndarray
+    creatures: np.ndarray
+
+
+GuideSource = Callable[["World"], GuideFrame | None]
+
+
+def fur_guides(world: World) -> GuideFrame | None:
+    """The world's fur guide curves (`world.fur`, the rig's output), or None without fur.
+
+    Uses `world.fur.guide_frame()` when the fur package offers it; otherwise reads the
+    rig's buffers: `curves` (guides, points, 3), each guide's fur set (`guides.fur_row`)
+    for its creature entity and width (`sets.creature`, `sets.width`).
+    """
+    fur = getattr(world, "fur", None)
+    if fur is None:
+        return None
+    frame = getattr(fur, "guide_frame", None)
+    if callable(frame):
+        result: GuideFrame | None = frame()
+        return result
+    guides, curves = getattr(fur, "guides", None), getattr(fur, "curves", None)
+    if guides is None or curves is None or len(curves) == 0:
+        return None
+    sets = np.asarray(guides.fur_row)  # each guide's fur set row
+    width = np.asarray(fur.sets.width)[sets]
+    return GuideFrame(
+        points=np.asarray(curves),
+        widths=np.repeat(width[:, None], curves.shape[1], axis=1),
+        creatures=np.asarray(fur.sets.creature)[sets],
+    )
+
+
+def scene_sha256(scene: dict[str, Any] | None) -> str:
+    """SHA-256 of a scene's canonical JSON (sorted keys, no spaces); '' without a scene."""
+    if scene is None:
+        return ""
+    text = json.dumps(scene, sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+class TakeRecorder:
+    """Copies a world's frames into growing float32 arrays; `take()` returns the Take.
+
+    `fps` is the take's frame rate (the world's by default; a bake recording every
+    k-th frame passes world fps / k). `scene_sha256` defaults to the hash of
+    `world.scene`.
+    """
+
+    def __init__(
+        self,
+        world: World,
+        *,
+        fps: float | None = None,
+        scene_sha256: str | None = None,
+        capacity: int = 64,
+        guides: GuideSource = fur_guides,
+    ):
+        self.world = world
+        self.guides = guides
+        self._layout(world)
+        self.header: dict[str, Any] = {
+            "format": FORMAT,
+            "version": VERSION,
+            "scene": world.name,
+            "scene_sha256": _sha(world) if scene_sha256 is None else scene_sha256,
+            "seed": int(world.seed),
+            "fps": float(fps if fps is not None else world.settings.fps),
+            "sim_fps": float(world.settings.fps),
+            "substeps": int(world.settings.substeps),
+            "frames": 0,
+            "creatures": self._creatures,
+            "bodies": self._bodies,
+            "suckers": self._suckers,
+            "goals": [],
+            "guides": None,
+        }
+        bodies, suckers = len(self._rows), len(self._suckers)
+        capacity = max(1, capacity)
+        self._pos = np.empty((capacity, bodies, 3), np.float32)
+        self._quat = np.empty((capacity, bodies, 4), np.float32)
+        self._attached = np.empty((capacity, suckers), np.bool_)
+        self._anchor = np.empty((capacity, suckers, 3), np.float32)
+        self._goal_columns: dict[int, int] = {}  # goal entity -> column
+        self._goal_pos: list[np.ndarray] = []
+        self._goals_alive: list[list[int]] = []  # per frame, the live columns
+        self._points: list[np.ndarray] = []
+        self._widths: list[np.ndarray] = []
+        self.count = 0
+
+    def _layout(self, world: World) -> None:
+        """Body and sucker tables in take order: creature by creature, mantle then links."""
+        self._creatures: list[dict[str, Any]] = []
+        self._bodies: list[dict[str, Any]] = []
+        rows: list[int] = []
+        by_entity = sorted(world.query(Creature), key=lambda item: item[1].row)
+        self._creature_index = {entity: i for i, (entity, _) in enumerate(by_entity)}
+        for index, (entity, creature) in enumerate(by_entity):
+            name = creature.name
+            entry: dict[str, Any] = {"name": name, "mantle": len(rows), "tentacles": []}
+            rows.append(world.component(entity, Transform).row)
+            self._bodies.append(_body(f"{name}/mantle", index, "cylinder", "Z", creature))
+            for tentacle_entity in creature.tentacles:
+                tentacle = world.component(tentacle_entity, Tentacle)
+                chain = []
+                for link_entity in tentacle.links:
+                    link = world.component(link_entity, Link)
+                    chain.append(len(rows))
+                    rows.append(world.component(link_entity, Transform).row)
+                    body = f"{name}/tentacles/t{tentacle.index}/link{link.index}"
+                    self._bodies.append(_body(body, index, "capsule", "X", link))
+                entry["tentacles"].append(chain)
+            self._creatures.append(entry)
+        self._rows = np.asarray(rows, dtype=np.int64)
+        body_of_row = {row: i for i, row in enumerate(rows)}
+        self._suckers: list[dict[str, Any]] = []
+        seen: dict[int, int] = {}
+        suckers = world.suckers
+        for link_row, offset in zip(
+            suckers.link_row.tolist(), suckers.offset.tolist(), strict=True
+        ):
+            carrier = body_of_row[link_row]
+            n = seen[carrier] = seen.get(carrier, -1) + 1
+            name = f"{self._bodies[carrier]['name']}/sucker{n}"
+            self._suckers.append({"name": name, "body": carrier, "offset": offset})
+
+    def capture(self) -> None:
+        """Append the world's current frame."""
+        world, i = self.world, self.count
+        if i == len(self._pos):
+            self._grow()
+        transforms = world.transforms
+        self._pos[i] = transforms.pos[self._rows]
+        self._quat[i] = transforms.quat[self._rows]
+        self._attached[i] = world.suckers.attached
+        self._anchor[i] = world.suckers.anchor
+        alive = []
+        for entity, goal in world.query(Goal):
+            column = self._goal_columns.get(entity)
+            if column is None:
+                column = self._add_goal(entity, goal)
+            alive.append(column)
+        self._goals_alive.append(alive)
+        guides = self.guides(world)
+        if guides is not None:
+            self._add_guides(guides)
+        elif self._points:
+            raise ValueError("fur guides disappeared during the recording")
+        self.count += 1
+
+    def _add_goal(self, entity: int, goal: Goal) -> int:
+        column = self._goal_columns[entity] = len(self._goal_pos)
+        creature = self._creature_index[goal.owner]
+        number = sum(g["creature"] == creature for g in self.header["goals"])
+        name = f"{self._creatures[creature]['name']}/goals/goal{number}"
+        self.header["goals"].append({"name": name, "creature": creature, "radius": goal.radius})
+        self._goal_pos.append(np.asarray(goal.position, dtype=np.float64))
+        return column
+
+    def _add_guides(self, guides: GuideFrame) -> None:
+        points = np.asarray(guides.points, dtype=np.float32)
+        widths = np.broadcast_to(np.asarray(guides.widths, dtype=np.float32), points.shape[:2])
+        if points.ndim != 3 or points.shape[2] != 3:
+            raise ValueError(f"fur guide points must be (guides, points, 3), got {points.shape}")
+        if self._points and points.shape != self._points[0].shape:
+            raise ValueError(f"fur guides changed shape: {self._points[0].shape} -> {points.shape}")
+        if not self._points:
+            owners = [self._creature_index.get(int(e), -1) for e in guides.creatures]
+            self.header["guides"] = {"creatures": owners}
+        self._points.append(points)
+        self._widths.append(np.array(widths))
+
+    def _grow(self) -> None:
+        for name in ("_pos", "_quat", "_attached", "_anchor"):
+            old = getattr(self, name)
+            grown = np.empty((2 * len(old), *old.shape[1:]), old.dtype)
+            grown[: len(old)] = old
+            setattr(self, name, grown)
+
+    def take(self) -> Take:
+        """The frames captured so far as a Take (copies; recording may go on)."""
+        n = self.count
+        goals = len(self._goal_pos)
+        active = np.zeros((n, goals), np.bool_)
+        for frame, alive in enumerate(self._goals_alive):
+            active[frame, alive] = True
+        header = json.loads(json.dumps(self.header))  # a deep copy
+        header["frames"] = n
+        return Take(
+            header=header,
+            pos=self._pos[:n].copy(),
+            quat=self._quat[:n].copy(),
+            sucker_attached=self._attached[:n].copy(),
+            sucker_anchor=self._anchor[:n].copy(),
+            goal_pos=np.array(self._goal_pos, np.float32).reshape(goals, 3),
+            goal_active=active,
+            guide_points=np.stack(self._points) if self._points else None,
+            guide_widths=np.stack(self._widths) if self._widths else None,
+        )
+
+
+def _body(name: str, creature: int, shape: str, axis: str, part: Any) -> dict[str, Any]:
+    if isinstance(part, Creature):
+        radius, length = part.mantle_radius, part.mantle_height
+    else:
+        radius, length = part.radius, part.length
+    return {
+        "name": name,
+        "creature": creature,
+        "shape": shape,
+        "axis": axis,
+        "radius": float(radius),
+        "length": float(length),
+    }
+
+
+def _sha(world: World) -> str:
+    return scene_sha256(world.scene)

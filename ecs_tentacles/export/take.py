@@ -1,0 +1,212 @@
+"""Takes: every frame of a simulation in one compact, reproducible npz file.
+
+A take holds, per frame, the pose of every mantle and link, the state of every
+sucker, which goals are still to reach and, when the world has fur, the guide curves.
+The header (JSON) names everything and carries the geometry, so exporters (USD,
+glTF) need nothing but the take.
+
+The file is a zip of `.npy` arrays in this fixed order (`ARRAYS`); every entry is
+dated 1980-01-01, so the same scene and seed give byte-identical files:
+
+    header           uint8    UTF-8 JSON (see `Take.header`)
+    pos              float32  (frames, bodies, 3)  body centres, metres, z up
+    quat             float32  (frames, bodies, 4)  body orientations (w, x, y, z)
+    sucker_attached  bool     (frames, suckers)
+    sucker_anchor    float32  (frames, suckers, 3) world anchor (kept after release)
+    goal_pos         float32  (goals, 3)
+    goal_active      bool     (frames, goals)      still in its creature's path
+    guide_points     float32  (frames, guides, points, 3)   only with fur
+    guide_widths     float32  (frames, guides, points)      only with fur
+
+Frame i is simulated time i / fps; frame 0 is the pose the scene was built in.
+Bodies: a mantle is a cylinder along its local +z (`length` = height), a link a
+capsule along its local +x (`length` = the spine between the cap centres).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import zipfile
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ecs_tentacles.export.atomic import atomic_output
+
+FORMAT = "ecs_tentacles.take"
+VERSION = 1
+ARRAYS = (
+    "header",
+    "pos",
+    "quat",
+    "sucker_attached",
+    "sucker_anchor",
+    "goal_pos",
+    "goal_active",
+    "guide_points",
+    "guide_widths",
+)
+OPTIONAL = ("guide_points", "guide_widths")
+HEADER_KEYS: dict[str, type] = {
+    "fps": float,
+    "frames": int,
+    "creatures": list,
+    "bodies": list,
+    "suckers": list,
+    "goals": list,
+}
+_EPOCH = (1980, 1, 1, 0, 0, 0)  # the earliest zip date: no wall-clock time in the file
+
+
+class TakeError(ValueError):
+    """A take file cannot be read; the message is one line naming the file and the problem."""
+
+
+@dataclass
+class Take:
+    """A recorded simulation: `header` (names, geometry, timing) and per-frame arrays.
+
+    `header` keys: format, version, scene, scene_sha256, seed, fps, sim_fps, substeps,
+    frames, creatures [{name, mantle (body index), tentacles [[body index per link]]}],
+    bodies [{name, creature, shape cylinder|capsule, axis, radius, length}],
+    suckers [{name, body, offset (in the body's frame)}], goals [{name, creature,
+    radius}], guides (null, or {creatures: [creature index per guide]}).
+    """
+
+    header: dict[str, Any]
+    pos: np.ndarray
+    quat: np.ndarray
+    sucker_attached: np.ndarray
+    sucker_anchor: np.ndarray
+    goal_pos: np.ndarray
+    goal_active: np.ndarray
+    guide_points: np.ndarray | None = None
+    guide_widths: np.ndarray | None = None
+
+    # -- reading -----------------------------------------------------------------------
+    @property
+    def frames(self) -> int:
+        """Number of frames (the first is time 0)."""
+        return int(self.pos.shape[0])
+
+    @property
+    def fps(self) -> float:
+        """Frames per second of the take."""
+        return float(self.header["fps"])
+
+    @property
+    def times(self) -> np.ndarray:
+        """Seconds of each frame."""
+        return np.arange(self.frames) / self.fps
+
+    @property
+    def body_names(self) -> list[str]:
+        """Body names in array order: `<creature>/mantle`, `<creature>/tentacles/t<k>/link<i>`."""
+        return [body["name"] for body in self.header["bodies"]]
+
+    def body(self, name: str) -> int:
+        """Array index of the body called `name`."""
+        try:
+            return self.body_names.index(name)
+        except ValueError:
+            raise KeyError(f"no body named {name!r} in this take") from None
+
+    def arrays(self) -> dict[str, np.ndarray]:
+        """The arrays to store, in file order (the header encoded as UTF-8 JSON bytes)."""
+        text = json.dumps(self.header, sort_keys=True, separators=(",", ":"))
+        out = {"header": np.frombuffer(text.encode(), dtype=np.uint8)}
+        for name in ARRAYS[1:]:
+            value = getattr(self, name)
+            if value is not None:
+                out[name] = np.ascontiguousarray(value)
+        return out
+
+    # -- files -------------------------------------------------------------------------
+    def save(self, path: str | os.PathLike[str]) -> None:
+        """Write the take to `path` atomically (see `ecs_tentacles.export.atomic`)."""
+        with atomic_output(path) as temporary:
+            write_npz(temporary, self.arrays())
+
+    @classmethod
+    def load(cls, path: str | os.PathLike[str]) -> Take:
+        """Read a take; raises `TakeError` (one line) when the file is not a valid take."""
+        where = Path(path)
+        if where.is_file() and not zipfile.is_zipfile(where):
+            raise TakeError(f"{where}: not a take file (not an npz archive)")
+        try:
+            with np.load(where, allow_pickle=False) as npz:
+                data = {name: npz[name] for name in npz.files}
+        except FileNotFoundError:
+            raise TakeError(f"{where}: no such file") from None
+        except (OSError, ValueError, zipfile.BadZipFile, EOFError) as exc:
+            raise TakeError(f"{where}: not a take file ({type(exc).__name__}: {exc})") from None
+        if not isinstance(data, dict) or "header" not in data:
+            raise TakeError(f"{where}: not a take file (no header)")
+        try:
+            header = json.loads(data["header"].tobytes().decode())
+        except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+            raise TakeError(f"{where}: header: not JSON ({exc})") from None
+        take = cls(
+            header=header,
+            **{k: data.get(k) for k in ARRAYS[1:]},  # type: ignore[arg-type]
+        )
+        problem = take.problem()
+        if problem:
+            raise TakeError(f"{where}: {problem}")
+        return take
+
+    def problem(self) -> str | None:
+        """The first inconsistency between header and arrays, or None if the take is sound."""
+        header = self.header
+        if not isinstance(header, dict) or header.get("format") != FORMAT:
+            return f"header.format: expected {FORMAT!r}"
+        if header.get("version") != VERSION:
+            got = header.get("version")
+            return f"header.version: this reader knows version {VERSION}, got {got!r}"
+        for key, kind in HEADER_KEYS.items():
+            if not isinstance(header.get(key), kind):
+                return f"header.{key}: missing or not {kind.__name__}"
+        missing = [k for k in ARRAYS[1:] if k not in OPTIONAL and getattr(self, k) is None]
+        if missing:
+            return f"{missing[0]}: missing"
+        frames, bodies = header["frames"], len(header["bodies"])
+        shapes: dict[str, tuple[int, ...]] = {
+            "pos": (frames, bodies, 3),
+            "quat": (frames, bodies, 4),
+            "sucker_attached": (frames, len(header["suckers"])),
+            "sucker_anchor": (frames, len(header["suckers"]), 3),
+            "goal_pos": (len(header["goals"]), 3),
+            "goal_active": (frames, len(header["goals"])),
+        }
+        if (self.guide_points is None) != (header.get("guides") is None):
+            return "guide_points: present only when header.guides is"
+        if self.guide_points is not None:
+            guides = len(header["guides"]["creatures"])
+            points = self.guide_points.shape[2] if self.guide_points.ndim == 4 else -1
+            shapes["guide_points"] = (frames, guides, points, 3)
+            shapes["guide_widths"] = (frames, guides, points)
+        for name, shape in shapes.items():
+            value = getattr(self, name)
+            if value is None or value.shape != shape:
+                got = None if value is None else value.shape
+                return f"{name}: shape {got}, expected {shape} from the header"
+        return None
+
+
+def write_npz(path: str | os.PathLike[str], arrays: dict[str, np.ndarray]) -> None:
+    """Write `arrays` as an npz readable by `np.load`, byte-reproducibly.
+
+    `np.savez` stamps each zip entry with the current time; here every entry gets the
+    same fixed date and permissions, in the order of `arrays`.
+    """
+    with zipfile.ZipFile(path, "w", compression=zipfile.ZIP_DEFLATED, allowZip64=True) as zf:
+        for name, array in arrays.items():
+            info = zipfile.ZipInfo(f"{name}.npy", date_time=_EPOCH)
+            info.compress_type = zipfile.ZIP_DEFLATED
+            info.create_system = 3  # unix, whatever the writing platform
+            info.external_attr = 0o644 << 16
+            with zf.open(info, "w", force_zip64=True) as out:
+                np.lib.format.write_array(out, np.asanyarray(array), allow_pickle=False)

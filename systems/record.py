@@ -1,0 +1,52 @@
+"""record: appends the frame to a take (optional; `ecs-tentacles bake` adds it).
+
+Reads: Transform store (every mantle and link), Sucker store (attached, anchor),
+Goal components, fur guide curves when the world has fur. Writes: its
+`TakeRecorder`'s arrays, nothing in the world.
+
+Runs after physics_sync (and after rig, which is added before it). It records the
+pose it finds when it joins the world (take frame 0), then every `every`-th frame, so a take
+at 30 fps of a 60 fps world has `every=2`. Not one of the built-in systems.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+from ecs_tentacles.export.recording import TakeRecorder
+from ecs_tentacles.export.take import Take
+from ecs_tentacles.system import System
+
+if TYPE_CHECKING:
+    from ecs_tentacles.world import World
+
+
+class Record(System):
+    """Record the world into a take; `record.take()` returns it."""
+
+    name = "record"
+    after = ("physics_sync",)
+
+    def __init__(self, every: int = 1, **recorder: Any):
+        if every < 1:
+            raise ValueError(f"every must be >= 1, got {every}")
+        self.every = every
+        self._options = recorder  # TakeRecorder keywords: scene_sha256, capacity, guides
+        self.recorder: TakeRecorder | None = None
+        self._start = 0
+
+    def setup(self, world: World) -> None:
+        fps = world.settings.fps / self.every
+        self.recorder = TakeRecorder(world, fps=fps, **self._options)
+        self.recorder.capture()
+        self._start = world.frame
+
+    def process(self, world: World, dt: float) -> None:
+        if (world.frame + 1 - self._start) % self.every == 0 and self.recorder is not None:
+            self.recorder.capture()
+
+    def take(self) -> Take:
+        """The frames recorded so far."""
+        if self.recorder is None:
+            raise RuntimeError("the record system has not joined a world yet")
+        return self.recorder.take()

@@ -1,0 +1,61 @@
+"""Shared pieces of the export tests: a small scene, synthetic fur guides, a recorded take."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from typing import Any
+
+import numpy as np
+import pytest
+from ecs_tentacles.systems.record import Record
+
+from ecs_tentacles.components import Creature, Link, Tentacle, Transform
+from ecs_tentacles.export.recording import GuideFrame
+from ecs_tentacles.export.take import Take
+from ecs_tentacles.world import World
+
+# One creature, three tentacles of four links, tip suckers, a goal 1 m ahead.
+SMALL_SCENE: dict[str, Any] = {
+    "version": 1,
+    "name": "small",
+    "seed": 4,
+    "creatures": [
+        {
+            "name": "octo",
+            "position": [0, 0],
+            "tentacles": {"count": 3, "links": 4},
+            "goals": [{"position": [1.0, 0.0], "radius": 0.2}],
+        }
+    ],
+}
+
+
+def link_centres(world: World) -> GuideFrame:
+    """Synthetic fur: one guide per tentacle through its link centres (moves with it)."""
+    points, widths, owners = [], [], []
+    for entity, creature in world.query(Creature):
+        for tentacle_entity in creature.tentacles:
+            links = world.component(tentacle_entity, Tentacle).links
+            points.append([world.component(e, Transform).pos for e in links])
+            widths.append([2 * world.component(e, Link).radius for e in links])
+            owners.append(entity)
+    return GuideFrame(np.array(points), np.array(widths), np.array(owners))
+
+
+def record(
+    scene: dict[str, Any], frames: int, every: int = 1, **recorder: Any
+) -> tuple[World, Record]:
+    """A world of `scene` with a Record system, stepped `frames` frames (caller closes it)."""
+    world = World.from_scene(scene)
+    system = Record(every, **recorder)
+    world.add_system(system)
+    world.step(frames)
+    return world, system
+
+
+@pytest.fixture(scope="session")
+def guided_take() -> Iterator[Take]:
+    """0.2 s of the small scene at 30 fps (every 2nd frame of 60), with synthetic guides."""
+    world, system = record(SMALL_SCENE, 12, every=2, guides=link_centres)
+    yield system.take()
+    world.close()

@@ -1,0 +1,195 @@
+"""Takes: recording equals the live world, the file round-trips, bakes are reproducible."""
+
+from __future__ import annotations
+
+import json
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+from ecs_tentacles.systems.record import Record
+
+from ecs_tentacles.components import Creature, Sucker, Tentacle, Transform
+from ecs_tentacles.export.bake import BakePlan, bake, simulation_rate
+from ecs_tentacles.export.take import ARRAYS, Take, TakeError
+from ecs_tentacles.world import World
+from tests.export.conftest import SMALL_SCENE, link_centres
+
+
+def live_poses(world: World) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """Every body's pose by its take name, read through components (not the recorder)."""
+    poses = {}
+    for entity, creature in world.query(Creature):
+        mantle = world.component(entity, Transform)
+        poses[f"{creature.name}/mantle"] = (mantle.pos.copy(), mantle.quat.copy())
+        for tentacle_entity in creature.tentacles:
+            tentacle = world.component(tentacle_entity, Tentacle)
+            for i, link in enumerate(tentacle.links):
+                t = world.component(link, Transform)
+                name = f"{creature.name}/tentacles/t{tentacle.index}/link{i}"
+                poses[name] = (t.pos.copy(), t.quat.copy())
+    return poses
+
+
+def test_take_round_trip_equals_the_live_world_at_sampled_frames(tmp_path: Path) -> None:
+    world = World.from_scene(SMALL_SCENE)
+    system = Record(2, guides=link_centres)
+    world.add_system(system)
+    live = {0: live_poses(world)}
+    attached = {0: world.suckers.attached.copy()}
+    for frame in range(1, 7):  # take frames 1..6 are world frames 2, 4, ... 12
+        world.step(2)
+        live[frame] = live_poses(world)
+        attached[frame] = world.suckers.attached.copy()
+    guides_now = link_centres(world)
+    system.take().save(tmp_path / "take.npz")
+    take = Take.load(tmp_path / "take.npz")
+    assert (take.frames, take.fps, take.header["sim_fps"], take.header["seed"]) == (
+        7,
+        30.0,
+        60.0,
+        4,
+    )
+    assert len(take.body_names) == 1 + 3 * 4 and take.body_names[0] == "octo/mantle"
+    np.testing.assert_array_equal(take.times, np.arange(7) / 30.0)
+    for frame in (0, 3, 6):
+        for name, (pos, quat) in live[frame].items():
+            index = take.body(name)
+            np.testing.assert_array_equal(take.pos[frame, index], pos.astype(np.float32))
+            np.testing.assert_array_equal(take.quat[frame, index], quat.astype(np.float32))
+        np.testing.assert_array_equal(take.sucker_attached[frame], attached[frame])
+    np.testing.assert_array_equal(take.guide_points[6], guides_now.points.astype(np.float32))
+    assert take.header["guides"] == {"creatures": [0, 0, 0]}
+    tips = [world.component(e, Sucker) for e in world.suckers.entity]
+    assert [s["name"] for s in take.header["suckers"]] == [
+        f"octo/tentacles/t{k}/link3/sucker0" for k in range(3)
+    ]
+    assert [s["offset"] for s in take.header["suckers"]] == [t.offset.tolist() for t in tips]
+    world.close()
+
+
+def test_goals_added_and_removed_while_recording_are_tracked() -> None:
+    world = World.from_scene(SMALL_SCENE)
+    system = Record()
+    world.add_system(system)
+    octo = world.creature("octo")
+    world.step(1)
+    extra = world.goals.append(octo, [0.0, 2.0], 0.5)
+    world.step(1)
+    world.goals.remove(extra)
+    world.step(1)
+    take = system.take()
+    assert take.header["goals"] == [
+        {"name": "octo/goals/goal0", "creature": 0, "radius": 0.2},
+        {"name": "octo/goals/goal1", "creature": 0, "radius": 0.5},
+    ]
+    np.testing.assert_array_equal(take.goal_pos, [[1.0, 0.0, 0.0], [0.0, 2.0, 0.0]])
+    np.testing.assert_array_equal(take.goal_active, [[1, 0], [1, 0], [1, 1], [1, 0]])
+    world.close()
+
+
+def test_two_bakes_of_the_same_scene_and_seed_are_byte_identical(tmp_path: Path) -> None:
+    plan = BakePlan.make(SMALL_SCENE, seconds=0.25, fps=30)
+    bake(plan, progress=False).save(tmp_path / "a.npz")
+    bake(plan, progress=False).save(tmp_path / "b.npz")
+    other = BakePlan.make(SMALL_SCENE, seconds=0.25, fps=30, seed=5)
+    bake(other, progress=False).save(tmp_path / "c.npz")
+    a, b, c = ((tmp_path / f"{n}.npz").read_bytes() for n in "abc")
+    assert a == b
+    assert a != c  # the seed matters (per-tentacle wave phases)
+    with zipfile.ZipFile(tmp_path / "a.npz") as archive:
+        entries = archive.infolist()
+    assert [e.filename for e in entries] == [f"{n}.npy" for n in ARRAYS[:7]]
+    assert {e.date_time for e in entries} == {(1980, 1, 1, 0, 0, 0)}
+    header = json.loads(np.load(tmp_path / "a.npz")["header"].tobytes())
+    assert header["scene_sha256"] == plan.scene_sha256 and len(plan.scene_sha256) == 64
+    assert (header["frames"], header["fps"], header["seed"]) == (9, 30.0, 4)
+
+
+@pytest.mark.parametrize(
+    ("scene_fps", "take_fps", "expected"),
+    [
+        (60, 60, (1, 60)),
+        (60, 30, (2, 60)),
+        (60, 24, (3, 72)),
+        (60, 120, (1, 120)),
+        (50, 30, (2, 60)),
+    ],
+)
+def test_simulation_rate(scene_fps: float, take_fps: float, expected: tuple[int, float]) -> None:
+    assert simulation_rate(scene_fps, take_fps) == expected
+
+
+def test_a_24_fps_take_simulates_at_72_fps() -> None:
+    plan = BakePlan.make(SMALL_SCENE, seconds=0.25, fps=24)
+    assert (plan.every, plan.sim_fps, plan.frames, plan.steps) == (3, 72.0, 7, 18)
+    take = bake(plan, progress=False)
+    assert (take.frames, take.fps, take.header["sim_fps"]) == (7, 24.0, 72.0)
+
+
+def _take(tmp_path: Path, **changes: object) -> Path:
+    world = World.from_scene(SMALL_SCENE)
+    system = Record()
+    world.add_system(system)
+    take = system.take()
+    world.close()
+    arrays = take.arrays()
+    for key, value in changes.items():
+        if key == "header":
+            header = {**take.header, **value}  # type: ignore[dict-item]
+            arrays["header"] = np.frombuffer(json.dumps(header).encode(), np.uint8)
+        elif value is None:
+            del arrays[key]
+        else:
+            arrays[key] = value  # type: ignore[assignment]
+    path = tmp_path / "t.npz"
+    np.savez(path, **arrays)
+    return path
+
+
+def test_bad_take_files_give_one_line(tmp_path: Path) -> None:
+    junk = tmp_path / "junk.npz"
+    junk.write_text("hello")
+    cases = {
+        tmp_path / "missing.npz": "no such file",
+        junk: "not a take file (not an npz archive)",
+    }
+    for path, message in cases.items():
+        with pytest.raises(TakeError) as caught:
+            Take.load(path)
+        assert str(caught.value) == f"{path}: {message}"
+    for changes, message in [
+        ({"header": {"version": 9}}, "header.version: this reader knows version 1, got 9"),
+        ({"header": {"format": "x"}}, "header.format: expected 'ecs_tentacles.take'"),
+        ({"quat": None}, "quat: missing"),
+        (
+            {"pos": np.zeros((2, 13, 3), np.float32)},
+            "pos: shape (2, 13, 3), expected (1, 13, 3) from the header",
+        ),
+    ]:
+        path = _take(tmp_path, **changes)
+        with pytest.raises(TakeError) as caught:
+            Take.load(path)
+        assert str(caught.value) == f"{path}: {message}"
+
+
+def test_fur_guides_reads_the_rig_buffers_of_world_fur() -> None:
+    from types import SimpleNamespace
+
+    from ecs_tentacles.export.recording import fur_guides
+
+    curves = np.arange(2 * 3 * 3, dtype=np.float32).reshape(2, 3, 3)
+    world = SimpleNamespace(
+        fur=SimpleNamespace(
+            guides=SimpleNamespace(fur_row=np.array([1, 0])),
+            curves=curves,
+            sets=SimpleNamespace(width=np.array([0.001, 0.002]), creature=np.array([7, 9])),
+        )
+    )
+    assert fur_guides(SimpleNamespace()) is None  # type: ignore[arg-type]
+    frame = fur_guides(world)  # type: ignore[arg-type]
+    assert frame is not None
+    np.testing.assert_array_equal(frame.points, curves)
+    np.testing.assert_array_equal(frame.widths, [[0.002] * 3, [0.001] * 3])
+    np.testing.assert_array_equal(frame.creatures, [9, 7])
