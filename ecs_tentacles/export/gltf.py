@@ -1,0 +1,228 @@
+"""Take -> binary glTF 2.0 (.glb) for game engines: one animated node per body.
+
+Nodes mirror the USD layout: `World` / `<creature>` / `mantle` and
+`tentacles` / `t<k>` / `link<i>`. Parents carry no transform, so each body node's
+translation and rotation are its world pose; one animation (`take`) has a
+translation and a rotation channel per body (LINEAR, a key per take frame, time =
+frame / fps). Bodies carry lean meshes (capsules along +x, the mantle's cylinder)
+sharing one material.
+
+glTF is y-up, our world z-up: everything is turned by -90 degrees about x on the
+way out, (x, y, z) -> (x, z, -y) for points and for quaternion vector parts, so an
+engine shows the creature standing on its ground. Written with numpy and `struct`
+(the format is a JSON chunk and a binary chunk); `ecs-tentacles export` and the
+tests check files with the Khronos glTF validator.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import struct
+from typing import Any
+
+import numpy as np
+
+from ecs_tentacles import __version__
+from ecs_tentacles.export.atomic import atomic_output
+from ecs_tentacles.export.meshes import Mesh, body_mesh
+from ecs_tentacles.export.take import Take
+
+Z_UP_TO_Y_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
+_FLOAT, _USHORT = 5126, 5123
+_ARRAY_BUFFER, _ELEMENT_ARRAY_BUFFER = 34962, 34963
+_GLB_MAGIC, _JSON_CHUNK, _BIN_CHUNK = 0x46546C67, 0x4E4F534A, 0x004E4942
+
+
+def to_y_up_points(points: np.ndarray) -> np.ndarray:
+    """(..., 3) z-up points or vectors -> y-up."""
+    return np.asarray(points, dtype=np.float64) @ Z_UP_TO_Y_UP.T
+
+
+def to_y_up_rotations(quat_wxyz: np.ndarray) -> np.ndarray:
+    """(..., 4) z-up (w, x, y, z) quaternions -> y-up glTF (x, y, z, w), unit length."""
+    q = np.asarray(quat_wxyz, dtype=np.float64)
+    q = q / np.linalg.norm(q, axis=-1, keepdims=True)
+    vector = to_y_up_points(q[..., 1:])
+    return np.concatenate([vector, q[..., :1]], axis=-1)
+
+
+class _Buffer:
+    """Binary chunk under construction: one buffer view and accessor per array."""
+
+    def __init__(self) -> None:
+        self.data = bytearray()
+        self.views: list[dict[str, Any]] = []
+        self.accessors: list[dict[str, Any]] = []
+
+    def add(self, array: np.ndarray, kind: str, target: int | None = None) -> int:
+        """Append `array` (float32 or uint16), return its accessor index."""
+        raw = np.ascontiguousarray(array).tobytes()
+        view: dict[str, Any] = {"buffer": 0, "byteOffset": len(self.data), "byteLength": len(raw)}
+        if target is not None:
+            view["target"] = target
+        self.data += raw + b"\0" * (-len(raw) % 4)
+        self.views.append(view)
+        accessor: dict[str, Any] = {
+            "bufferView": len(self.views) - 1,
+            "componentType": _FLOAT if array.dtype == np.float32 else _USHORT,
+            "count": int(array.shape[0]),
+            "type": kind,
+        }
+        if kind in ("VEC3", "SCALAR") and array.dtype == np.float32:
+            flat = array.reshape(array.shape[0], -1)
+            accessor["min"] = flat.min(axis=0).tolist()
+            accessor["max"] = flat.max(axis=0).tolist()
+        self.accessors.append(accessor)
+        return len(self.accessors) - 1
+
+
+def build_gltf(take: Take) -> tuple[dict[str, Any], bytes]:
+    """The glTF JSON document and its binary buffer."""
+    header = take.header
+    buffer = _Buffer()
+    meshes: list[dict[str, Any]] = []
+    mesh_of: dict[tuple[str, str, float, float], int] = {}
+    nodes: list[dict[str, Any]] = [{"name": "World", "children": []}]
+    body_nodes: list[int] = []
+    translations = to_y_up_points(take.pos).astype(np.float32)
+    rotations = to_y_up_rotations(take.quat).astype(np.float32)
+
+    def node(name: str, parent: int, **fields: Any) -> int:
+        nodes.append({"name": name, **fields})
+        nodes[parent].setdefault("children", []).append(len(nodes) - 1)
+        return len(nodes) - 1
+
+    def body(index: int, parent: int) -> None:
+        info = header["bodies"][index]
+        key = (info["shape"], info["axis"], float(info["radius"]), float(info["length"]))
+        if key not in mesh_of:
+            mesh_of[key] = len(meshes)
+            meshes.append(_mesh(buffer, body_mesh(*key), info["shape"]))
+        body_nodes.append(
+            node(
+                info["name"].rsplit("/", 1)[1],
+                parent,
+                mesh=mesh_of[key],
+                translation=translations[0, index].tolist(),
+                rotation=rotations[0, index].tolist(),
+            )
+        )
+
+    for creature in header["creatures"]:
+        root = node(creature["name"], 0)
+        body(creature["mantle"], root)
+        tentacles = node("tentacles", root)
+        for k, chain in enumerate(creature["tentacles"]):
+            folder = node(f"t{k}", tentacles)
+            for index in chain:
+                body(index, folder)
+    document: dict[str, Any] = {
+        "asset": {
+            "version": "2.0",
+            "generator": f"ecs_tentacles {__version__}",
+            "extras": {k: header[k] for k in ("scene", "scene_sha256", "seed", "fps")},
+        },
+        "scene": 0,
+        "scenes": [{"name": str(header["scene"]), "nodes": [0]}],
+        "nodes": nodes,
+        "meshes": meshes,
+        "materials": [
+            {
+                "name": "skin",
+                "pbrMetallicRoughness": {
+                    "baseColorFactor": [0.85, 0.45, 0.5, 1.0],
+                    "metallicFactor": 0.0,
+                    "roughnessFactor": 0.6,
+                },
+            }
+        ],
+    }
+    document["animations"] = [_animation(buffer, take, body_nodes, translations, rotations)]
+    document["buffers"] = [{"byteLength": len(buffer.data)}]
+    document["bufferViews"] = buffer.views
+    document["accessors"] = buffer.accessors
+    return document, bytes(buffer.data)
+
+
+def _mesh(buffer: _Buffer, mesh: Mesh, name: str) -> dict[str, Any]:
+    positions = to_y_up_points(mesh.positions).astype(np.float32)
+    normals = to_y_up_points(mesh.normals).astype(np.float32)
+    attributes = {
+        "POSITION": buffer.add(positions, "VEC3", _ARRAY_BUFFER),
+        "NORMAL": buffer.add(normals, "VEC3", _ARRAY_BUFFER),
+    }
+    indices = buffer.add(mesh.indices, "SCALAR", _ELEMENT_ARRAY_BUFFER)
+    primitive = {"attributes": attributes, "indices": indices, "material": 0, "mode": 4}
+    return {"name": name, "primitives": [primitive]}
+
+
+def _animation(
+    buffer: _Buffer,
+    take: Take,
+    body_nodes: list[int],
+    translations: np.ndarray,
+    rotations: np.ndarray,
+) -> dict[str, Any]:
+    times = buffer.add(take.times.astype(np.float32), "SCALAR")
+    interpolation = "LINEAR" if take.frames > 1 else "STEP"
+    samplers: list[dict[str, Any]] = []
+    channels: list[dict[str, Any]] = []
+    for index, target in enumerate(body_nodes):
+        for path, values, kind in (
+            ("translation", translations[:, index], "VEC3"),
+            ("rotation", rotations[:, index], "VEC4"),
+        ):
+            output = buffer.add(np.ascontiguousarray(values), kind)
+            samplers.append({"input": times, "output": output, "interpolation": interpolation})
+            channels.append(
+                {"sampler": len(samplers) - 1, "target": {"node": target, "path": path}}
+            )
+    return {"name": "take", "samplers": samplers, "channels": channels}
+
+
+def glb_bytes(document: dict[str, Any], binary: bytes) -> bytes:
+    """A GLB container: 12-byte header, JSON chunk (space-padded), BIN chunk (zero-padded)."""
+    text = json.dumps(document, separators=(",", ":"), sort_keys=True).encode()
+    text += b" " * (-len(text) % 4)
+    binary += b"\0" * (-len(binary) % 4)
+    total = 12 + 8 + len(text) + 8 + len(binary)
+    return b"".join(
+        [
+            struct.pack("<III", _GLB_MAGIC, 2, total),
+            struct.pack("<II", len(text), _JSON_CHUNK),
+            text,
+            struct.pack("<II", len(binary), _BIN_CHUNK),
+            binary,
+        ]
+    )
+
+
+def read_glb(data: bytes) -> tuple[dict[str, Any], bytes]:
+    """Split a GLB into its JSON document and binary chunk (for tests and tools)."""
+    magic, version, total = struct.unpack_from("<III", data, 0)
+    if magic != _GLB_MAGIC or version != 2 or total != len(data):
+        raise ValueError("not a glTF 2.0 binary file")
+    json_length, _ = struct.unpack_from("<II", data, 12)
+    document = json.loads(data[20 : 20 + json_length])
+    bin_length, _ = struct.unpack_from("<II", data, 20 + json_length)
+    start = 28 + json_length
+    return document, data[start : start + bin_length]
+
+
+def accessor_array(document: dict[str, Any], binary: bytes, index: int) -> np.ndarray:
+    """Read accessor `index` of a document as a numpy array (float32 or uint16)."""
+    accessor = document["accessors"][index]
+    view = document["bufferViews"][accessor["bufferView"]]
+    dtype = np.float32 if accessor["componentType"] == _FLOAT else np.uint16
+    width = {"SCALAR": 1, "VEC3": 3, "VEC4": 4}[accessor["type"]]
+    start = view.get("byteOffset", 0) + accessor.get("byteOffset", 0)
+    flat = np.frombuffer(binary, dtype=dtype, count=accessor["count"] * width, offset=start)
+    return flat.reshape(accessor["count"], width) if width > 1 else flat
+
+
+def write_glb(take: Take, path: str | os.PathLike[str]) -> None:
+    """Write `take` as a .glb file, atomically."""
+    data = glb_bytes(*build_gltf(take))
+    with atomic_output(path) as temporary:
+        temporary.write_bytes(data)

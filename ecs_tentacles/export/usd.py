@@ -1,0 +1,178 @@
+"""Take -> USD stage (needs the `usd` extra: `pip install 'ecs-tentacles[usd]'`).
+
+    /World                                    Xform, the default prim
+      /<creature>                             Xform
+        /mantle                               Xform: time-sampled translate + orient
+          /geom                               Cylinder, axis Z, radius, height
+        /tentacles/t<k>/link<i>               Xform: time-sampled translate + orient
+          /geom                               Capsule, axis X, radius, height = spine
+          /sucker<n>                          Xform at the sucker, `ecs:attached` sampled
+        /goals/goal<j>                        Xform at the goal; visibility sampled
+                                              (invisible once reached), `ecs:radius`
+        /fur/guides                           BasisCurves (linear): points, widths sampled
+      /fur/guides                             guides not owned by a creature, if any
+
+Poses are world-space (every parent is an identity transform), so the time samples
+are the take's numbers: translate (double3) = pos, orient (quatf) = quat. Stage:
+upAxis Z, metersPerUnit 1, timeCodesPerSecond = framesPerSecond = the take's fps,
+time codes 0 .. frames - 1 (time code i is frame i, i / fps seconds).
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from ecs_tentacles.export.atomic import atomic_output
+from ecs_tentacles.export.take import Take
+
+
+class UsdUnavailable(RuntimeError):
+    """usd-core is not installed."""
+
+
+def _pxr() -> Any:
+    try:
+        import pxr.Gf
+        import pxr.Sdf
+        import pxr.Usd
+        import pxr.UsdGeom
+        import pxr.Vt
+    except ImportError:
+        raise UsdUnavailable(
+            "writing USD needs usd-core: pip install 'ecs-tentacles[usd]'"
+        ) from None
+    return pxr
+
+
+def write_usd(
+    take: Take, path: str | os.PathLike[str], progress: Callable[[int], object] | None = None
+) -> None:
+    """Write `take` as a USD file (.usda text, .usdc or .usd binary), atomically.
+
+    `progress(n)` is called as bodies are written (n bodies at a time).
+    """
+    stage = build_stage(take, progress)
+    with atomic_output(path) as temporary:
+        if not stage.GetRootLayer().Export(str(temporary)):
+            raise OSError(f"{path}: USD could not write the file")
+
+
+def build_stage(take: Take, progress: Callable[[int], object] | None = None) -> Any:
+    """An in-memory `Usd.Stage` holding the take; `progress(1)` after each body."""
+    pxr = _pxr()
+    Usd, UsdGeom = pxr.Usd, pxr.UsdGeom
+    stage = Usd.Stage.CreateInMemory()
+    UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.z)
+    UsdGeom.SetStageMetersPerUnit(stage, 1.0)
+    stage.SetTimeCodesPerSecond(take.fps)
+    stage.SetFramesPerSecond(take.fps)
+    stage.SetStartTimeCode(0)
+    stage.SetEndTimeCode(take.frames - 1)
+    root = UsdGeom.Xform.Define(stage, "/World")
+    stage.SetDefaultPrim(root.GetPrim())
+    header = take.header
+    for creature in header["creatures"]:
+        base = f"/World/{creature['name']}"
+        UsdGeom.Xform.Define(stage, base)
+        _body(pxr, stage, take, creature["mantle"])
+        if progress is not None:
+            progress(1)
+        UsdGeom.Xform.Define(stage, f"{base}/tentacles")
+        for k, chain in enumerate(creature["tentacles"]):
+            UsdGeom.Xform.Define(stage, f"{base}/tentacles/t{k}")
+            for index in chain:
+                _body(pxr, stage, take, index)
+                if progress is not None:
+                    progress(1)
+    for index, sucker in enumerate(header["suckers"]):
+        _sucker(pxr, stage, take, index, sucker)
+    for index, goal in enumerate(header["goals"]):
+        _goal(pxr, stage, take, index, goal)
+    if take.guide_points is not None:
+        _guides(pxr, stage, take)
+    return stage
+
+
+def _body(pxr: Any, stage: Any, take: Take, index: int) -> None:
+    Gf, UsdGeom = pxr.Gf, pxr.UsdGeom
+    body = take.header["bodies"][index]
+    xform = UsdGeom.Xform.Define(stage, f"/World/{body['name']}")
+    translate = xform.AddTranslateOp()  # double3
+    orient = xform.AddOrientOp()  # quatf
+    pos = take.pos[:, index].astype(np.float64).tolist()
+    quat = take.quat[:, index].tolist()
+    for frame in range(take.frames):
+        translate.Set(Gf.Vec3d(*pos[frame]), frame)
+        w, x, y, z = quat[frame]
+        orient.Set(Gf.Quatf(w, Gf.Vec3f(x, y, z)), frame)
+    radius, length = float(body["radius"]), float(body["length"])
+    path = f"/World/{body['name']}/geom"
+    kind = UsdGeom.Cylinder if body["shape"] == "cylinder" else UsdGeom.Capsule
+    geom = kind.Define(stage, path)
+    geom.CreateAxisAttr(body["axis"])
+    geom.CreateRadiusAttr(radius)
+    geom.CreateHeightAttr(length)
+    half = [radius, radius, radius]
+    half["XYZ".index(body["axis"])] = 0.5 * length + (radius if kind is UsdGeom.Capsule else 0.0)
+    geom.CreateExtentAttr([Gf.Vec3f(*(-h for h in half)), Gf.Vec3f(*half)])
+
+
+def _sucker(pxr: Any, stage: Any, take: Take, index: int, sucker: dict[str, Any]) -> None:
+    Gf, Sdf, UsdGeom = pxr.Gf, pxr.Sdf, pxr.UsdGeom
+    xform = UsdGeom.Xform.Define(stage, f"/World/{sucker['name']}")
+    xform.AddTranslateOp().Set(Gf.Vec3d(*sucker["offset"]))
+    attached = xform.GetPrim().CreateAttribute("ecs:attached", Sdf.ValueTypeNames.Bool)
+    values = take.sucker_attached[:, index].tolist()
+    for frame in _changes(values):
+        attached.Set(values[frame], frame)
+
+
+def _goal(pxr: Any, stage: Any, take: Take, index: int, goal: dict[str, Any]) -> None:
+    Gf, Sdf, UsdGeom = pxr.Gf, pxr.Sdf, pxr.UsdGeom
+    path = f"/World/{goal['name']}"
+    UsdGeom.Xform.Define(stage, path.rsplit("/", 1)[0])  # the creature's goals folder
+    xform = UsdGeom.Xform.Define(stage, path)
+    xform.AddTranslateOp().Set(Gf.Vec3d(*take.goal_pos[index].astype(np.float64).tolist()))
+    xform.GetPrim().CreateAttribute("ecs:radius", Sdf.ValueTypeNames.Double).Set(goal["radius"])
+    visibility = xform.CreateVisibilityAttr()
+    values = take.goal_active[:, index].tolist()
+    for frame in _changes(values):
+        token = UsdGeom.Tokens.inherited if values[frame] else UsdGeom.Tokens.invisible
+        visibility.Set(token, frame)
+
+
+def _guides(pxr: Any, stage: Any, take: Take) -> None:
+    Gf, Vt, UsdGeom = pxr.Gf, pxr.Vt, pxr.UsdGeom
+    assert take.guide_points is not None and take.guide_widths is not None
+    owners = np.asarray(take.header["guides"]["creatures"], dtype=np.int64)
+    names = [c["name"] for c in take.header["creatures"]]
+    points_per_guide = take.guide_points.shape[2]
+    for owner in sorted(set(owners.tolist())):
+        chosen = np.flatnonzero(owners == owner)
+        folder = f"/World/{names[owner]}" if 0 <= owner < len(names) else "/World"
+        UsdGeom.Xform.Define(stage, f"{folder}/fur")
+        curves = UsdGeom.BasisCurves.Define(stage, f"{folder}/fur/guides")
+        curves.CreateTypeAttr(UsdGeom.Tokens.linear)
+        curves.CreateWrapAttr(UsdGeom.Tokens.nonperiodic)
+        curves.CreateCurveVertexCountsAttr([points_per_guide] * len(chosen))
+        points_attr = curves.CreatePointsAttr()
+        widths_attr = curves.CreateWidthsAttr()
+        curves.SetWidthsInterpolation(UsdGeom.Tokens.vertex)
+        extent_attr = curves.CreateExtentAttr()
+        for frame in range(take.frames):
+            points = take.guide_points[frame, chosen].reshape(-1, 3)
+            widths = take.guide_widths[frame, chosen].reshape(-1)
+            points_attr.Set(Vt.Vec3fArray.FromNumpy(points), frame)
+            widths_attr.Set(Vt.FloatArray.FromNumpy(widths), frame)
+            pad = 0.5 * float(widths.max(initial=0.0))
+            low, high = points.min(axis=0) - pad, points.max(axis=0) + pad
+            extent_attr.Set([Gf.Vec3f(*low.tolist()), Gf.Vec3f(*high.tolist())], frame)
+
+
+def _changes(values: list[Any]) -> list[int]:
+    """Frames where a held (step) value changes, the first included."""
+    return [i for i, v in enumerate(values) if i == 0 or v != values[i - 1]]
