@@ -1,0 +1,153 @@
+"""`ecs-tentacles create ... --out scene.json`: the creature creator, for scripts.
+
+The same steps as the creator window (`ecs_tentacles.creator.CreatureDesign`):
+uniform settings ("Build creature"), then per-tentacle changes, then "Export":
+
+    ecs-tentacles create --tentacles 6 --links 10 --end-scale 0.4 \\
+        --tentacle 2:links=12,link_length=0.09 --out squid.json
+
+`--from SCENE` starts from a scene's creature instead of the defaults. Without
+`--out` the interactive window would open; it needs the renderer and is not built
+yet, so that is an error for now.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+from typing import Any
+
+from ecs_tentacles.cli.bake import positive_float
+from ecs_tentacles.cli.run import positive_int
+from ecs_tentacles.creator import SHAPE_KEYS, CreatureDesign, DesignError
+
+# design field -> the option that sets it
+OPTIONS = {
+    "name": "--name",
+    "creature": "--creature",
+    "mantle_radius": "--mantle-radius",
+    "mantle_height": "--mantle-height",
+    "count": "--tentacles",
+    "links": "--links",
+    "link_length": "--link-length",
+    "link_radius": "--link-radius",
+    "end_scale": "--end-scale",
+}
+
+
+def json_file(text: str) -> Path:
+    """A .json output path in an existing folder (argparse type)."""
+    path = Path(text)
+    if path.suffix.lower() != ".json":
+        raise argparse.ArgumentTypeError(f"must end in .json, got {text!r}")
+    if not path.parent.is_dir():
+        raise argparse.ArgumentTypeError(f"folder {str(path.parent)!r} does not exist")
+    return path
+
+
+def tentacle_edit(text: str) -> tuple[int, dict[str, float]]:
+    """`K:key=value[,key=value]` with keys links, link_length, link_radius, end_scale."""
+    index, colon, rest = text.partition(":")
+    if not colon or not index.strip().isdigit() or not rest:
+        raise argparse.ArgumentTypeError(f"must look like 2:links=12,end_scale=0.5, got {text!r}")
+    changes: dict[str, float] = {}
+    for item in rest.split(","):
+        key, equals, value = (part.strip() for part in item.partition("="))
+        if not equals or key not in SHAPE_KEYS:
+            raise argparse.ArgumentTypeError(
+                f"{item!r}: expected key=value with key one of {', '.join(SHAPE_KEYS)}"
+            )
+        try:
+            changes[key] = float(value)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{key}: must be a number, got {value!r}") from None
+    return int(index), changes
+
+
+def add_parser(commands: argparse._SubParsersAction) -> None:
+    parser = commands.add_parser(
+        "create",
+        help="design a creature and write it as a scene (--out; the window is not built yet)",
+        description="The creature creator: uniform settings, then per-tentacle changes, then"
+        " export. Unset options keep the defaults (or the --from scene's values).",
+    )
+    parser.add_argument("--out", type=json_file, metavar="FILE", help="scene file to write")
+    parser.add_argument("--from", dest="source", metavar="SCENE", help="start from this scene")
+    parser.add_argument("--creature", default="0", help="--from: creature name or index")
+    parser.add_argument("--name", help="creature name (letters, digits, _)")
+    for option, text in (
+        ("--mantle-radius", "mantle radius (m)"),
+        ("--mantle-height", "mantle height (m)"),
+        ("--link-length", "first link's length (m)"),
+        ("--link-radius", "first link's radius (m)"),
+    ):
+        parser.add_argument(option, type=positive_float, metavar="M", help=text)
+    parser.add_argument("--tentacles", type=positive_int, metavar="N", help="tentacle count")
+    parser.add_argument("--links", type=positive_int, metavar="N", help="links per tentacle")
+    parser.add_argument(
+        "--end-scale", type=positive_float, metavar="S", help="tip link size / first link size"
+    )
+    parser.add_argument(
+        "--tentacle",
+        type=tentacle_edit,
+        action="append",
+        default=[],
+        metavar="K:KEY=VALUE,...",
+        help="change tentacle K after the uniform build (keys: links, link_length,"
+        " link_radius, end_scale); repeatable",
+    )
+    parser.set_defaults(handler=handle)
+
+
+def handle(args: argparse.Namespace) -> int:
+    if args.out is None:
+        print(
+            "error: argument --out: required: the creator window needs the renderer and is not"
+            " built yet; give --out FILE to write the scene",
+            file=sys.stderr,
+        )
+        return 2
+    try:
+        design = make_design(args)
+        design.export(args.out)
+    except DesignError as error:
+        option = OPTIONS.get(error.field, "--tentacle")
+        print(f"error: argument {option}: {error.message}", file=sys.stderr)
+        return 2
+    links = sum(t.links for t in design.tentacles)
+    print(f"{args.out}: creature {design.name!r}: {len(design.tentacles)} tentacles, {links} links")
+    return 0
+
+
+def make_design(args: argparse.Namespace) -> CreatureDesign:
+    """Apply the options in the creator's order: start, uniform build, tentacle edits."""
+    if args.source:
+        creature: Any = int(args.creature) if args.creature.isdigit() else args.creature
+        design = CreatureDesign.from_scene(args.source, creature)
+    else:
+        design = CreatureDesign()
+    if args.name is not None:
+        design.name = args.name
+    uniform = {
+        "mantle_radius": args.mantle_radius,
+        "mantle_height": args.mantle_height,
+        "count": args.tentacles,
+        "links": args.links,
+        "link_length": args.link_length,
+        "link_radius": args.link_radius,
+        "end_scale": args.end_scale,
+    }
+    if args.source is None or any(v is not None for k, v in uniform.items() if "mantle" not in k):
+        design.build(**uniform)
+    else:
+        design.set_mantle(radius=args.mantle_radius, height=args.mantle_height)
+    for index, changes in args.tentacle:
+        if "links" in changes:
+            changes["links"] = _whole(changes["links"])
+        design.set_tentacle(index, **changes)
+    return design
+
+
+def _whole(value: float) -> int | float:
+    return int(value) if value == int(value) else value

@@ -1,0 +1,57 @@
+"""`ecs-tentacles export TAKE --out FILE`: convert a take (.npz) to USD or glTF.
+
+The suffix of FILE picks the format (`.usd`, `.usda`, `.usdc`, `.glb`); the file is
+written atomically. A file that is not a take gives one line naming it and exit 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from ecs_tentacles.cli.bake import output_file, save, summary, usd_missing
+from ecs_tentacles.export.take import Take, TakeError
+
+FORMATS = (".usd", ".usda", ".usdc", ".glb")
+
+
+def converted_file(text: str) -> Path:
+    """An output path for a conversion: USD or glTF (argparse type)."""
+    path = output_file(text)
+    if path.suffix.lower() not in FORMATS:
+        raise argparse.ArgumentTypeError(f"must end in one of {', '.join(FORMATS)}, got {text!r}")
+    return path
+
+
+def add_parser(commands: argparse._SubParsersAction) -> None:
+    parser = commands.add_parser(
+        "export",
+        help="convert a take (.npz from `bake`) to USD or glTF",
+        description="Convert a take to USD (.usd, .usda, .usdc) or binary glTF (.glb).",
+    )
+    parser.add_argument("take", metavar="TAKE", help="a take file written by `bake --out X.npz`")
+    parser.add_argument(
+        "--out",
+        type=converted_file,
+        required=True,
+        metavar="FILE",
+        help=f"output file; its suffix picks the format ({', '.join(FORMATS)})",
+    )
+    parser.add_argument("--quiet", action="store_true", help="no progress bar")
+    parser.set_defaults(handler=handle)
+
+
+def handle(args: argparse.Namespace) -> int:
+    problem = usd_missing(args.out)
+    if problem:
+        print(f"error: {problem}", file=sys.stderr)
+        return 2
+    try:
+        take = Take.load(args.take)
+    except TakeError as error:
+        print(f"error: {error}", file=sys.stderr)
+        return 2
+    save(take, args.out, progress=not args.quiet)
+    print(summary(take, args.out))
+    return 0

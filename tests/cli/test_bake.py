@@ -1,0 +1,171 @@
+"""`bake`, `export` and `create` on the command line: outputs, one-line errors, kills."""
+
+from __future__ import annotations
+
+import json
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from ecs_tentacles.cli import main
+from ecs_tentacles.export.take import Take
+from tests.export.conftest import SMALL_SCENE
+
+
+@pytest.fixture
+def scene(tmp_path: Path) -> Path:
+    path = tmp_path / "small.json"
+    path.write_text(json.dumps(SMALL_SCENE))
+    return path
+
+
+def test_bake_writes_a_take_and_reports_it(
+    scene: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "take.npz"
+    argv = ["bake", str(scene), "--seconds", "0.2", "--fps", "30", "--out", str(out), "--quiet"]
+    assert main(argv) == 0
+    captured = capsys.readouterr()
+    assert captured.err == (
+        f"bake: {scene} -> {out}: 7 frames at 30 fps (simulated at 60 fps), seed 4\n"
+    )
+    take = Take.load(out)
+    assert captured.out.startswith(
+        f"{out}: 7 frames at 30 fps, 1 creatures, 13 bodies, 3 suckers, 1 goals; sha256 "
+    )
+    assert (take.frames, take.fps, take.header["scene"]) == (7, 30.0, "small")
+    assert main([*argv, "--seed", "9"]) == 0  # overwrites atomically
+    assert Take.load(out).header["seed"] == 9
+
+
+def test_baking_to_usd_or_glb_equals_exporting_the_take(scene: Path, tmp_path: Path) -> None:
+    common = ["--seconds", "0.1", "--quiet"]
+    for name in ("take.npz", "direct.usda", "direct.glb"):
+        assert main(["bake", str(scene), *common, "--out", str(tmp_path / name)]) == 0
+    for name in ("exported.usda", "exported.glb"):
+        out = str(tmp_path / name)
+        assert main(["export", str(tmp_path / "take.npz"), "--out", out, "--quiet"]) == 0
+    for suffix in ("usda", "glb"):
+        direct = (tmp_path / f"direct.{suffix}").read_bytes()
+        assert direct == (tmp_path / f"exported.{suffix}").read_bytes()
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--seconds", "0"], "argument --seconds: must be a finite number > 0, got 0"),
+        (["--seconds", "nan"], "argument --seconds: must be a finite number > 0, got nan"),
+        (["--seconds", "two"], "argument --seconds: must be a number, got 'two'"),
+        (["--seconds", "1", "--fps", "0"], "argument --fps: must be a finite number > 0, got 0"),
+        (["--seconds", "1", "--fps", "5000"], "argument --fps: must be <= 1000, got 5000"),
+        (["--seconds", "1", "--seed", "-2"], "argument --seed: must be >= 0, got -2"),
+        (
+            ["--seconds", "1", "--out", "take.mp4"],
+            "argument --out: must end in one of .npz, .usd, .usda, .usdc, .glb, got 'take.mp4'",
+        ),
+        (
+            ["--seconds", "1", "--out", "no/such/folder/t.npz"],
+            "argument --out: folder 'no/such/folder' does not exist",
+        ),
+    ],
+)
+def test_bad_bake_arguments_exit_2_with_one_line(
+    args: list[str], message: str, scene: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    argv = ["bake", str(scene), "--out", "t.npz", *args]
+    with pytest.raises(SystemExit) as caught:
+        main(argv)
+    assert caught.value.code == 2
+    assert capsys.readouterr().err.splitlines()[-1] == f"ecs-tentacles bake: error: {message}"
+
+
+def test_bake_errors_found_after_parsing_exit_2(
+    scene: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = str(tmp_path / "t.npz")
+    assert main(["bake", str(scene), "--seconds", "0.001", "--out", out]) == 2
+    assert capsys.readouterr().err == (
+        "error: argument --seconds: 0.001 s is less than one frame at 60 fps\n"
+    )
+    assert main(["bake", str(tmp_path / "none.json"), "--seconds", "1", "--out", out]) == 2
+    assert capsys.readouterr().err == (
+        f"error: {tmp_path / 'none.json'}: cannot read scene: No such file or directory\n"
+    )
+    assert not (tmp_path / "t.npz").exists()
+
+
+def test_export_errors_exit_2_with_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    junk = tmp_path / "junk.npz"
+    junk.write_bytes(b"\x00" * 10)
+    assert main(["export", str(junk), "--out", str(tmp_path / "a.glb")]) == 2
+    assert capsys.readouterr().err == f"error: {junk}: not a take file (not an npz archive)\n"
+    with pytest.raises(SystemExit):
+        main(["export", str(junk), "--out", str(tmp_path / "a.npz")])
+    assert capsys.readouterr().err.splitlines()[-1] == (
+        "ecs-tentacles export: error: argument --out: must end in one of .usd, .usda, .usdc,"
+        " .glb, got '" + str(tmp_path / "a.npz") + "'"
+    )
+    import importlib.util
+
+    real = importlib.util.find_spec
+    monkeypatch.setattr(
+        importlib.util, "find_spec", lambda name, *a: None if name == "pxr" else real(name, *a)
+    )
+    assert main(["export", str(junk), "--out", str(tmp_path / "a.usd")]) == 2
+    assert capsys.readouterr().err == (
+        "error: argument --out: writing USD needs usd-core: pip install 'ecs-tentacles[usd]'\n"
+    )
+
+
+def _start_long_bake(out: Path) -> subprocess.Popen[str]:
+    """A bake of ten simulated minutes; returns once it has started simulating."""
+    process = subprocess.Popen(
+        [sys.executable, "-m", "ecs_tentacles.cli", "bake", "octopus", "--seconds", "600"]
+        + ["--out", str(out)],
+        stderr=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        text=True,
+    )
+    assert process.stderr is not None
+    assert process.stderr.readline().startswith("bake: ")  # the world is built, stepping now
+    return process
+
+
+def test_a_killed_bake_leaves_no_file_or_the_previous_one(tmp_path: Path) -> None:
+    fresh, previous = tmp_path / "fresh" / "take.npz", tmp_path / "old" / "take.npz"
+    fresh.parent.mkdir()
+    previous.parent.mkdir()
+    previous.write_bytes(b"yesterday's take")
+    bakes = [_start_long_bake(fresh), _start_long_bake(previous)]
+    time.sleep(0.5)  # well inside the simulation
+    for process in bakes:
+        process.send_signal(signal.SIGKILL)
+        assert process.wait(timeout=30) == -signal.SIGKILL
+    assert list(fresh.parent.iterdir()) == []
+    assert previous.read_bytes() == b"yesterday's take"
+    assert list(previous.parent.iterdir()) == [previous]
+
+
+def test_an_interrupted_bake_exits_130_and_leaves_nothing(tmp_path: Path) -> None:
+    out = tmp_path / "take.usda"
+    process = _start_long_bake(out)
+    time.sleep(0.3)
+    process.send_signal(signal.SIGINT)
+    _, err = process.communicate(timeout=30)
+    assert process.returncode == 130
+    assert err.strip().splitlines()[-1] == "interrupted" and "Traceback" not in err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_take_arrays_are_plain_numpy(scene: Path, tmp_path: Path) -> None:
+    out = tmp_path / "t.npz"
+    assert main(["bake", str(scene), "--seconds", "0.05", "--out", str(out), "--quiet"]) == 0
+    with np.load(out) as npz:  # no pickles: readable anywhere numpy is
+        assert npz["pos"].dtype == np.float32 and npz["pos"].shape == (4, 13, 3)
