@@ -14,6 +14,7 @@ import numpy as np
 
 from ecs_tentacles.components import Creature, Link, Motor, Sucker, Tentacle, Transform
 from ecs_tentacles.construction import tentacle_angles, tentacle_shape
+from ecs_tentacles.fur.build import build_creature_extras
 from ecs_tentacles.locomotion.actions import STRENGTH, ActionQueue, Kind
 from ecs_tentacles.mathutil import quat_about_z, quat_rotate
 
@@ -84,6 +85,8 @@ def build_creature(world: World, spec: dict[str, Any]) -> int:
     for goal in spec["goals"]:
         point = list(goal["position"]) + ([0.0] if len(goal["position"]) == 2 else [])
         world.goals.append(creature_entity, point, goal["radius"])
+    if "fur" in spec or "emotion" in spec or spec.get("threat"):
+        build_creature_extras(world, creature_entity, spec)
     return creature_entity
 
 

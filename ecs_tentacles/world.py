@@ -23,6 +23,7 @@ import numpy as np
 
 from ecs_tentacles.components import Creature, Sucker
 from ecs_tentacles.events import Events
+from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.locomotion.params import Locomotion
 from ecs_tentacles.mathutil import quat_rotate
@@ -38,6 +39,7 @@ from ecs_tentacles.store import (
 from ecs_tentacles.system import System
 
 C = TypeVar("C")
+FUR_SYSTEMS = ("emotion", "rig")  # kept with locomotion off: fur is not locomotion
 
 
 @dataclass(frozen=True)
@@ -77,6 +79,7 @@ class World:
         self.creatures = CreatureStore()
         self.tentacles = TentacleStore()
         self.goals = GoalBook(self)
+        self.fur = FurData()  # fur guides, controls, emotions, threats
         self.locomotion = Locomotion(self)
         self.schedule = Schedule()
         self.events = Events()
@@ -103,6 +106,7 @@ class World:
         only the physics systems run, so scripts drive the motors themselves.
         """
         from ecs_tentacles.build import build_creature
+        from ecs_tentacles.fur.build import build_threats
         from ecs_tentacles.scene.errors import SceneError
         from ecs_tentacles.scene.load import load_scene, resolve_scene_path
         from ecs_tentacles.systems import builtin_systems
@@ -133,10 +137,11 @@ class World:
         world.scene = data
         for creature in data["creatures"]:
             build_creature(world, creature)
+        build_threats(world, data["threats"])
         world.build_physics()
         systems = builtin_systems()
         if not locomotion:
-            systems = [s for s in systems if s.name in ("physics", "physics_sync")]
+            systems = [s for s in systems if s.name in ("physics", "physics_sync", *FUR_SYSTEMS)]
         world.add_systems(*systems, *(factory() for factory in extra))
         return world
 

@@ -10,15 +10,19 @@ writes; `World.schedule.names` shows the resolved order, user systems included):
 5. suckers             attach at the ground on command; release on command, stretch or reach
 6. physics             motor targets, gains and sucker switches -> MuJoCo; mj_step x substeps
 7. physics_sync        MuJoCo body poses -> Transform store
+8. emotion             threats near -> fear/aggression level -> fur controls' lift and random
+9. rig                 fur guides posed from mantle poses and controls (tracks, dynamic blend)
 """
 
 from __future__ import annotations
 
 from ecs_tentacles.systems.action_queue import ActionQueueSystem
+from ecs_tentacles.systems.emotion import EmotionSystem
 from ecs_tentacles.systems.goals import Goals
 from ecs_tentacles.systems.motor_targets import MotorTargets
 from ecs_tentacles.systems.physics import Physics
 from ecs_tentacles.systems.physics_sync import PhysicsSync
+from ecs_tentacles.systems.rig import Rig
 from ecs_tentacles.systems.suckers import Suckers
 from ecs_tentacles.systems.tentacle_selection import TentacleSelection
 
@@ -26,10 +30,12 @@ from ecs_tentacles.system import System
 
 __all__ = [
     "ActionQueueSystem",
+    "EmotionSystem",
     "Goals",
     "MotorTargets",
     "Physics",
     "PhysicsSync",
+    "Rig",
     "Suckers",
     "TentacleSelection",
     "builtin_systems",
@@ -46,4 +52,6 @@ def builtin_systems() -> list[System]:
         Suckers(),
         Physics(),
         PhysicsSync(),
+        EmotionSystem(),
+        Rig(),
     ]

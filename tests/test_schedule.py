@@ -53,6 +53,8 @@ BUILTIN = [
     "suckers",
     "physics",
     "physics_sync",
+    "emotion",
+    "rig",
 ]
 
 
@@ -60,7 +62,7 @@ def test_builtin_order(make_world: Callable[..., World]) -> None:
     world = make_world(creature_scene(count=3, links=2))
     assert world.schedule.names == BUILTIN
     physics_only = make_world(creature_scene(count=3, links=2), locomotion=False)
-    assert physics_only.schedule.names == ["physics", "physics_sync"]
+    assert physics_only.schedule.names == ["physics", "physics_sync", "emotion", "rig"]
 
 
 def test_probe_records_frame_and_substep_order(make_world: Callable[..., World]) -> None:
@@ -69,7 +71,15 @@ def test_probe_records_frame_and_substep_order(make_world: Callable[..., World])
     world.add_system(Late())
     world.add_system(SubstepProbe())
     world.add_system(Early())
-    assert world.schedule.names == ["substep_probe", "early", "physics", "physics_sync", "late"]
+    assert world.schedule.names == [
+        "substep_probe",
+        "early",
+        "physics",
+        "physics_sync",
+        "emotion",
+        "rig",
+        "late",
+    ]
     world.step(2)
     substeps = world.settings.substeps
     expected: list[tuple[object, ...]] = []

@@ -95,7 +95,7 @@ def test_scene_systems_are_not_imported_unless_allowed(
         World.from_scene(scene)
     assert user_system_module not in sys.modules
     world = make_world(scene, allow_systems=True)
-    assert world.schedule.names[-3:] == ["physics", "physics_sync", "counter"]
+    assert world.schedule.names[-5:] == ["physics", "physics_sync", "emotion", "rig", "counter"]
     world.step(3)
     assert type(world.schedule["counter"]).frames == 3  # type: ignore[attr-defined]
 

@@ -17,6 +17,8 @@ from typing import Any
 
 from jsonschema import Draft202012Validator, ValidationError
 
+from ecs_tentacles.fur.checks import fur_problems
+
 JsonPath = tuple[str | int, ...]
 Problem = tuple[JsonPath, str]
 
@@ -126,6 +128,8 @@ def _describe(error: ValidationError) -> list[Problem]:
         return [(path, f"must have {_count_bounds(schema, 'Items')}, got {len(value)}")]
     if kind in ("minLength", "maxLength") and isinstance(value, str):
         return [(path, f"must have {_count_bounds(schema, 'Length')}, got {len(value)}")]
+    if kind == "uniqueItems":
+        return [(path, f"must not repeat an item, got {_show(value)}")]
     if kind == "pattern":
         hint = schema.get("x-hint") or f"text matching {expected}"
         return [(path, f"must be {hint}, {got}")]
@@ -171,7 +175,7 @@ def _semantic_problems(scene: Mapping[str, Any]) -> list[Problem]:
             reach = earlier["mantle"]["radius"] + later["mantle"]["radius"]
             if math.hypot(x2 - x1, y2 - y1) < reach:
                 problems.append((("creatures", j, "position"), f"mantle overlaps creatures[{i}]'s"))
-    return problems
+    return problems + fur_problems(scene)
 
 
 def validate_scene(data: object) -> list[str]:
@@ -213,6 +217,9 @@ def _fill(value: Any, schema: Mapping[str, Any], root: Mapping[str, Any]) -> Non
     """Fill schema defaults into ``value`` in place, recursing into objects and arrays."""
     schema = _resolve(schema, root)
     if isinstance(value, dict):
+        presets = schema.get("x-presets", {})
+        if value.get("preset") in presets:  # a preset fills what the scene leaves out
+            _merge_under(value, presets[value["preset"]])
         for key, sub in schema.get("properties", {}).items():
             sub = _resolve(sub, root)
             if key not in value and "default" in sub:
@@ -224,13 +231,23 @@ def _fill(value: Any, schema: Mapping[str, Any], root: Mapping[str, Any]) -> Non
             _fill(item, schema["items"], root)
 
 
+def _merge_under(value: dict[str, Any], base: Mapping[str, Any]) -> None:
+    """Copy into ``value`` every key of ``base`` it lacks, merging nested objects."""
+    for key, item in base.items():
+        if key not in value:
+            value[key] = copy.deepcopy(item)
+        elif isinstance(value[key], dict) and isinstance(item, Mapping):
+            _merge_under(value[key], item)
+
+
 def with_defaults(data: dict[str, Any]) -> dict[str, Any]:
     """Return a deep copy of ``data`` with every schema ``default`` filled in.
 
     Works recursively through nested objects (objects defaulting to ``{}`` get their own
-    defaults too), array items and ``$ref``s. Creatures without a name are called
-    ``creature_<index>``. Optional fields without a default stay absent; ``data`` is
-    not modified.
+    defaults too), array items and ``$ref``s. An object whose schema has ``x-presets``
+    and whose ``preset`` names one first takes the preset's values it lacks. Creatures
+    without a name are called ``creature_<index>``. Optional fields without a default
+    stay absent; ``data`` is not modified.
     """
     result = copy.deepcopy(data)
     schema = load_schema()

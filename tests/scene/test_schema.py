@@ -78,6 +78,7 @@ def test_with_defaults_fills_nested_defaults_exactly() -> None:
             "sucker_timeconst": 0.005,
         },
         "systems": [],
+        "threats": [],
         "creatures": [
             {
                 "name": "creature_0",
@@ -113,6 +114,7 @@ def test_with_defaults_fills_nested_defaults_exactly() -> None:
                     "release_stretch": 0.04,
                     "release_reach": 1.1,
                 },
+                "threat": False,
             }
         ],
     }

@@ -13,8 +13,10 @@ TENTACLE_KEYS = (
     "max_torque, overrides, speed, strength, suckers, target_angle_deg, twist, "
     "wave_amplitude_deg, wave_frequency, wavelength, writhe"
 )
-TOP_KEYS = "$schema, creatures, description, name, physics, seed, systems, version"
-CREATURE_KEYS = "goals, heading_deg, locomotion, mantle, name, position, tentacles"
+TOP_KEYS = "$schema, creatures, description, name, physics, seed, systems, threats, version"
+CREATURE_KEYS = (
+    "emotion, fur, goals, heading_deg, locomotion, mantle, name, position, tentacles, threat"
+)
 
 
 def scene(*creatures: dict[str, Any], **top: Any) -> dict[str, Any]:
@@ -193,6 +195,196 @@ BAD_SCENES: list[tuple[str, object, str]] = [
         'creatures[0].name: must be letters, digits and _, not starting with a digit, got "8arms"',
     ),
     ("top level a list", [1, 2], "scene: must be an object, got [1, 2]"),
+    (
+        "unknown fur key",
+        scene({"fur": {"colour_by": 1}}),
+        "creatures[0].fur.colour_by: unknown key (allowed: behaviours, children, colour, controls, "
+        "direction_reach, dynamics, groom, guides, min_elevation_deg, piloerection, preset, "
+        "twist_max_deg, width)",
+    ),
+    (
+        "unknown fur preset",
+        scene({"fur": {"preset": "dog"}}),
+        'creatures[0].fur.preset: must be one of "none", "hedgehog", "cat", "bird", got "dog"',
+    ),
+    (
+        "groom with 1 point",
+        scene({"fur": {"groom": {"points": 1}}}),
+        "creatures[0].fur.groom.points: must be in [2, 64], got 1",
+    ),
+    (
+        "groom region belly",
+        scene({"fur": {"groom": {"region": "belly"}}}),
+        'creatures[0].fur.groom.region: must be one of "all", "top", "side", "back", "rear", '
+        '"front", got "belly"',
+    ),
+    (
+        "control lift 2",
+        scene({"fur": {"controls": [{"name": "a", "lift": 2}]}}),
+        "creatures[0].fur.controls[0].lift: must be in [0, 1], got 2",
+    ),
+    (
+        "control without name",
+        scene({"fur": {"controls": [{"lift": 1}]}}),
+        "creatures[0].fur.controls[0].name: is required",
+    ),
+    (
+        "no controls",
+        scene({"fur": {"controls": []}}),
+        "creatures[0].fur.controls: must have at least 1 items, got 0",
+    ),
+    (
+        "duplicate control name",
+        scene({"fur": {"controls": [{"name": "a"}, {"name": "a"}]}}),
+        'creatures[0].fur.controls[1].name: control name "a" is taken by '
+        "creatures[0].fur.controls[0]",
+    ),
+    (
+        "control name taken by a mirror twin",
+        scene({"fur": {"controls": [{"name": "L_a", "mirror": "x"}, {"name": "R_a"}]}}),
+        'creatures[0].fur.controls[1].name: control name "R_a" is taken by the twin of '
+        "creatures[0].fur.controls[0]",
+    ),
+    (
+        "guide names an unknown control",
+        scene({"fur": {"guides": [{"points": [[0, 0, 0.1], [0, 0, 0.2]], "control": "x"}]}}),
+        'creatures[0].fur.guides[0].control: no control named "x" (controls: main)',
+    ),
+    (
+        "guide control missing from the preset",
+        scene(
+            {
+                "fur": {
+                    "preset": "cat",
+                    "guides": [{"points": [[0, 0, 0], [0, 0, 1]], "control": "main"}],
+                }
+            }
+        ),
+        'creatures[0].fur.guides[0].control: no control named "main" '
+        "(controls: neck, back, tail, L_flank, R_flank)",
+    ),
+    (
+        "guide whose first points coincide",
+        scene({"fur": {"guides": [{"points": [[0, 0, 0.1], [0, 0, 0.1]]}]}}),
+        "creatures[0].fur.guides[0].points: the first two points must differ",
+    ),
+    (
+        "behaviour repeated",
+        scene({"fur": {"behaviours": ["lift", "lift"]}}),
+        'creatures[0].fur.behaviours: must not repeat an item, got ["lift", "lift"]',
+    ),
+    (
+        "track keys out of order",
+        scene(
+            {
+                "fur": {
+                    "controls": [
+                        {
+                            "name": "a",
+                            "tracks": [
+                                {
+                                    "attribute": "lift",
+                                    "keys": [{"time": 1, "value": 0}, {"time": 0.5, "value": 1}],
+                                }
+                            ],
+                        }
+                    ]
+                }
+            }
+        ),
+        "creatures[0].fur.controls[0].tracks[0].keys[1].time: must be > 1 (the previous key's), "
+        "got 0.5",
+    ),
+    (
+        "position track with a number",
+        scene(
+            {
+                "fur": {
+                    "controls": [
+                        {
+                            "name": "a",
+                            "tracks": [
+                                {"attribute": "position", "keys": [{"time": 0, "value": 0.5}]}
+                            ],
+                        }
+                    ]
+                }
+            }
+        ),
+        "creatures[0].fur.controls[0].tracks[0].keys[0].value: must be [x, y, z] for position, "
+        "got 0.5",
+    ),
+    (
+        "lift track with a vector",
+        scene(
+            {
+                "fur": {
+                    "controls": [
+                        {
+                            "name": "a",
+                            "tracks": [
+                                {"attribute": "lift", "keys": [{"time": 0, "value": [1, 2, 3]}]}
+                            ],
+                        }
+                    ]
+                }
+            }
+        ),
+        "creatures[0].fur.controls[0].tracks[0].keys[0].value: must be a number in [0, 1] for "
+        "lift, got [1, 2, 3]",
+    ),
+    (
+        "unknown easing",
+        scene(
+            {
+                "fur": {
+                    "controls": [
+                        {
+                            "name": "a",
+                            "tracks": [
+                                {
+                                    "attribute": "lift",
+                                    "keys": [{"time": 0, "value": 1, "easing": "bounce"}],
+                                }
+                            ],
+                        }
+                    ]
+                }
+            }
+        ),
+        'creatures[0].fur.controls[0].tracks[0].keys[0].easing: must be one of "linear", '
+        '"ease", "slow_out", "slow_in", "step", got "bounce"',
+    ),
+    (
+        "emotion radius 0",
+        scene({"emotion": {"radius": 0}}),
+        "creatures[0].emotion.radius: must be in (0, 1000], got 0",
+    ),
+    ("threat without path", scene(threats=[{"name": "roach"}]), "threats[0].path: is required"),
+    (
+        "threat path keys at one time",
+        scene(
+            threats=[
+                {"path": [{"time": 1, "position": [0, 0, 0]}, {"time": 1, "position": [1, 0, 0]}]}
+            ]
+        ),
+        "threats[0].path[1].time: must be > 1 (the previous key's), got 1",
+    ),
+    (
+        "duplicate threat names",
+        scene(threats=[{"name": "r", "path": [{"time": 0, "position": [0, 0, 0]}]}] * 2),
+        'threats[1].name: duplicate name "r" (also threats[0])',
+    ),
+    (
+        "threat position with 2 numbers",
+        scene(threats=[{"path": [{"time": 0, "position": [0, 0]}]}]),
+        "threats[0].path[0].position: must have exactly 3 items, got 2",
+    ),
+    (
+        "threat mark as text",
+        scene({"threat": "yes"}),
+        'creatures[0].threat: must be a boolean, got "yes"',
+    ),
     ("top level null", None, "scene: must be an object, got null"),
 ]
 

@@ -1,0 +1,38 @@
+"""Fur and feathers: guide curves on a creature, spatial controls, the rig, presets.
+
+- `groom`: guides generated on the mantle (or listed), roots in the body frame;
+- `controls`: mirrored twins, nearest-control assignment;
+- `rig`, `bind`, `dynamics`: the vectorised rig (lift, aim, direction, random
+  twist, dynamic blend) run by `ecs_tentacles.systems.rig`;
+- `tracks`: keyframes and easing; `presets`: hedgehog, cat, bird;
+- `hooks`: polylines and child hairs for the renderer and the exporter;
+- `build`: scene data -> entities; `stores`, `components`: the data.
+"""
+
+from __future__ import annotations
+
+from ecs_tentacles.fur.components import Emotion, Fur, FurControl, FurGuide, Threat
+from ecs_tentacles.fur.hooks import (
+    ControlMarker,
+    GuideCurves,
+    child_hairs,
+    control_markers,
+    guide_curves,
+    threat_positions,
+)
+from ecs_tentacles.fur.stores import FurData
+
+__all__ = [
+    "ControlMarker",
+    "Emotion",
+    "Fur",
+    "FurControl",
+    "FurData",
+    "FurGuide",
+    "GuideCurves",
+    "Threat",
+    "child_hairs",
+    "control_markers",
+    "guide_curves",
+    "threat_positions",
+]

@@ -1,0 +1,123 @@
+"""Binding: the fur stores packed into the rig's float32 arrays, once per change.
+
+`make_bind` builds the `rig.Bind` of every guide (rest directions lifted into each
+guide's cap, bodies indexed), `control_values` turns the control store into the
+effective per-control values the rig reads each frame, `make_strands` the dynamic
+state of guides whose fur has the dynamic behaviour, and `ControlTracks` writes
+keyframed tracks into the control store.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ecs_tentacles.fur.dynamics import Strands, blend_profile
+from ecs_tentacles.fur.rig import (
+    F32,
+    Bind,
+    ControlValues,
+    clamp_to_cap,
+    dot,
+    normalize,
+    rotate_minimal,
+)
+from ecs_tentacles.fur.stores import CONTROL_VALUES, ControlStore, FurData
+from ecs_tentacles.fur.tracks import TrackSet
+
+MAX_ELEVATION = np.radians(80.0)  # the cap never shrinks to nothing, even for bent guides
+LIFT, AIM, DIRECTION, RANDOM, DYNAMIC = range(5)
+
+
+def cone_angles(shape: np.ndarray) -> np.ndarray:
+    """Per guide, the widest angle between its axis and a chord from the root (radians)."""
+    chord = shape[:, 1:]
+    off_axis = np.sqrt(chord[..., 1] ** 2 + chord[..., 2] ** 2)
+    angles = np.arctan2(off_axis, np.maximum(chord[..., 0], 0.0) + (off_axis == 0))
+    return np.asarray(angles.max(axis=1) if chord.shape[1] else np.zeros(len(shape)))
+
+
+def make_bind(fur: FurData) -> tuple[Bind, np.ndarray]:
+    """The rig's bind pose of every guide, and the Transform rows of its bodies."""
+    g = fur.guides
+    bodies, body_index = np.unique(g.body_row, return_inverse=True)
+    floor = fur.sets.min_elevation[g.fur_row] + cone_angles(fur.shape)
+    tan_min = np.tan(np.minimum(floor, MAX_ELEVATION)).astype(F32)
+    normal = normalize(g.normal.T.astype(F32))
+    given = normalize(g.rest.T.astype(F32))
+    rest = clamp_to_cap(given, normal, tan_min)
+    side = rotate_minimal(given, rest, g.side.T.astype(F32))
+    side = normalize(side - dot(side, rest) * rest)
+    shape_h = np.ones((len(g), fur.points, 4), dtype=F32)
+    shape_h[..., :3] = fur.shape
+    bind = Bind(
+        root=np.ascontiguousarray(g.root.T, dtype=F32),
+        normal=normal,
+        rest=rest,
+        side=side,
+        tan_min=tan_min,
+        multiplier=g.multiplier.astype(F32),
+        control=g.control_row.copy(),
+        body=body_index.astype(np.int64),
+        shape_h=shape_h,
+    )
+    return bind, bodies
+
+
+def control_values(fur: FurData) -> tuple[ControlValues, np.ndarray]:
+    """Effective values of every control (behaviours a fur lacks are 0) and `dynamic`."""
+    c, sets = fur.controls, fur.sets
+    on = sets.enabled[c.fur_row]
+    lift = np.clip(c.lift + c.drive_lift, 0.0, 1.0) * on[:, LIFT]
+    random = np.clip(c.random + c.drive_random, 0.0, 1.0) * on[:, RANDOM]
+    offset = (c.position - c.rest_position) / sets.reach[c.fur_row][:, None]
+    values = ControlValues(
+        lift=lift.astype(F32),
+        aim=(np.clip(c.aim, 0.0, 1.0) * on[:, AIM]).astype(F32),
+        direction=(np.clip(c.direction, 0.0, 1.0) * on[:, DIRECTION]).astype(F32),
+        twist=(random * sets.twist_max[c.fur_row]).astype(F32),
+        position=np.ascontiguousarray(c.position.T, dtype=F32),
+        offset=np.ascontiguousarray(offset.T, dtype=F32),
+    )
+    return values, (np.clip(c.dynamic, 0.0, 1.0) * on[:, DYNAMIC]).astype(F32)
+
+
+def make_strands(fur: FurData, gravity: np.ndarray, dt: float) -> Strands | None:
+    """Strand state for the guides of furs with the dynamic behaviour (None if none)."""
+    g, sets = fur.guides, fur.sets
+    rows = np.flatnonzero(sets.enabled[g.fur_row, DYNAMIC] > 0)
+    if not len(rows):
+        return None
+    f = g.fur_row[rows]
+    steps = np.linalg.norm(np.diff(fur.shape[rows], axis=1), axis=2)
+    segment = np.concatenate([np.zeros((len(rows), 1)), steps], axis=1).T
+    return Strands(
+        guides=rows,
+        segment=segment.astype(F32),
+        pull=(1.0 - np.exp(-sets.stiffness[f] * dt)).astype(F32),
+        keep=np.exp(-sets.damping[f] * dt).astype(F32),
+        gravity=(np.outer(gravity, sets.gravity_scale[f]) * dt * dt).astype(F32),
+        profile=blend_profile(fur.points)[:, None, None],
+    )
+
+
+@dataclass
+class ControlTracks:
+    """Keyframed control attributes, written into the ControlStore at a time."""
+
+    tracks: TrackSet
+
+    def apply(self, controls: ControlStore, t: float) -> None:
+        """Write every track's value at time `t` into its control's attribute."""
+        if not len(self.tracks):
+            return
+        values = self.tracks.evaluate(t)
+        rows, columns = self.tracks.rows, self.tracks.columns
+        moved = columns < 3
+        if moved.any():
+            controls.position[rows[moved], columns[moved]] = values[moved]
+        for column, name in enumerate(CONTROL_VALUES, start=3):
+            mask = columns == column
+            if mask.any():
+                getattr(controls, name)[rows[mask]] = values[mask]

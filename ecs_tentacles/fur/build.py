@@ -1,0 +1,193 @@
+"""Scene data -> fur entities: guides, controls, the creature's Fur, Emotion and threats.
+
+Called by `ecs_tentacles.build.build_creature` for a creature with `fur`, `emotion` or
+`threat`, and by `World.from_scene` for the scene's `threats`. Guides attach to the
+mantle body (its Transform row); their roots live in the mantle's local frame.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import esper
+import numpy as np
+
+from ecs_tentacles.components import Creature, Transform
+from ecs_tentacles.fur import groom as grooming
+from ecs_tentacles.fur.components import Emotion, Fur, FurControl, FurGuide, Threat
+from ecs_tentacles.fur.controls import expand_mirrors, nearest_control
+from ecs_tentacles.fur.stores import BEHAVIOURS
+from ecs_tentacles.fur.tracks import channels_from_keys
+
+if TYPE_CHECKING:
+    from ecs_tentacles.world import World
+
+# Track columns of the ControlStore: position x, y, z, then the behaviour values.
+COLUMNS = {"position": (0, 1, 2), "lift": (3,), "aim": (4,), "direction": (5,)}
+COLUMNS |= {"random": (6,), "dynamic": (7,)}
+
+
+def build_creature_extras(world: World, creature: int, spec: dict[str, Any]) -> None:
+    """Fur, emotion and the threat mark of one creature (as its scene entry asks)."""
+    if "fur" in spec:
+        build_fur(world, creature, spec["fur"])
+    if "emotion" in spec:
+        build_emotion(world, creature, spec["emotion"])
+    if spec.get("threat"):
+        fur = world.fur
+        row = world.component(creature, Transform).row
+        fur.threat_bodies = np.append(fur.threat_bodies, row)
+        fur.threat_creatures = np.append(fur.threat_creatures, creature)
+
+
+def _points_per_guide(world: World, spec: dict[str, Any]) -> int:
+    """The world's shared point count: the largest any fur of the scene asks for."""
+    if world.fur.points:
+        return world.fur.points
+    asked = [spec["groom"]["points"]]
+    if world.scene is not None:
+        asked += [c["fur"]["groom"]["points"] for c in world.scene["creatures"] if "fur" in c]
+    return max(asked)
+
+
+def build_fur(world: World, creature: int, spec: dict[str, Any]) -> int:
+    """Controls and guides of `creature` from a defaults-filled `fur` spec; the Fur row."""
+    fur = world.fur
+    info = world.component(creature, Creature)
+    body = world.component(creature, Transform).row
+    fur.points = _points_per_guide(world, spec)
+    dynamics, erect = spec["dynamics"], spec["piloerection"]
+    row = int(
+        fur.sets.add(
+            creature=creature,
+            body_row=body,
+            enabled=[float(b in spec["behaviours"]) for b in BEHAVIOURS],
+            twist_max=np.radians(spec["twist_max_deg"]),
+            reach=spec["direction_reach"],
+            min_elevation=np.radians(spec["min_elevation_deg"]),
+            stiffness=dynamics["stiffness"],
+            damping=dynamics["damping"],
+            gravity_scale=dynamics["gravity_scale"],
+            erect_lift=erect["lift"],
+            erect_random=erect["random"],
+            colour=spec["colour"],
+            width=spec["width"],
+            children=spec["children"],
+        )[0]
+    )
+    controls = _build_controls(world, creature, row, spec["controls"])
+    guides = _build_guides(world, creature, row, body, info, spec, controls)
+    component = Fur(fur.sets, row, spec["preset"], guides, [e for e, _ in controls.values()])
+    world.activate()
+    esper.add_component(creature, component)
+    return row
+
+
+def _build_controls(
+    world: World, creature: int, fur_row: int, specs: list[dict[str, Any]]
+) -> dict[str, tuple[int, int]]:
+    """Control entities (mirrored twins included): name -> (entity, control row)."""
+    store = world.fur.controls
+    made: dict[str, tuple[int, int]] = {}
+    for spec in expand_mirrors(specs):
+        values = {k: spec[k] for k in ("lift", "aim", "direction", "random", "dynamic")}
+        row = int(
+            store.add(
+                fur_row=fur_row,
+                position=spec["position"],
+                rest_position=spec["position"],
+                emotion=spec["emotion"],
+                colour=spec["colour"],
+                size=spec["size"],
+                **values,
+            )[0]
+        )
+        control = FurControl(store, row, spec["name"], spec["shape"], creature)
+        entity = world.create_entity(control)
+        store.entity[row] = entity
+        made[spec["name"]] = (entity, row)
+        for track in spec["tracks"]:
+            columns = COLUMNS[track["attribute"]]
+            world.fur.tracks += channels_from_keys(row, columns, track["keys"])
+    return made
+
+
+def _build_guides(
+    world: World,
+    creature: int,
+    fur_row: int,
+    body: int,
+    info: Creature,
+    spec: dict[str, Any],
+    controls: dict[str, tuple[int, int]],
+) -> list[int]:
+    fur = world.fur
+    radius, height = info.mantle_radius, info.mantle_height
+    groom = dict(spec["groom"], points=fur.points)
+    parts = [grooming.generate(groom, radius, height)]
+    listed = spec["guides"]
+    if listed:
+        extra = grooming.explicit(listed, fur.points, radius, height)
+        rng = np.random.default_rng([groom["seed"], 1])
+        drawn = rng.uniform(-1.0, 1.0, len(listed))
+        extra.multiplier = np.array(
+            [g.get("multiplier", d) for g, d in zip(listed, drawn, strict=True)], dtype=np.float64
+        )
+        parts.append(extra)
+    fields = ("root", "normal", "rest", "side", "length", "multiplier", "shape")
+    data = {f: np.concatenate([getattr(p, f) for p in parts]) for f in fields}
+    names = list(controls)
+    rows = np.array([controls[n][1] for n in names])
+    rests = fur.controls.rest_position[rows]
+    assigned = rows[nearest_control(data["root"], rests)]
+    first_listed = len(data["root"]) - len(listed)
+    for i, guide in enumerate(listed):
+        if "control" in guide:
+            assigned[first_listed + i] = controls[guide["control"]][1]
+    shape = data.pop("shape")
+    new = fur.guides.add(
+        len(assigned), body_row=body, fur_row=fur_row, control_row=assigned, **data
+    )
+    fur.add_shapes(shape)
+    entities = []
+    for row in new:
+        entity = world.create_entity(FurGuide(fur.guides, int(row), fur, creature))
+        entities.append(entity)
+    fur.guides.entity[new] = entities
+    return entities
+
+
+def build_emotion(world: World, creature: int, spec: dict[str, Any]) -> int:
+    """The creature's Emotion (its controls get driven by it); returns the emotion row."""
+    store = world.fur.emotions
+    row = int(
+        store.add(
+            creature=creature,
+            body_row=world.component(creature, Transform).row,
+            radius=spec["radius"],
+            rise=spec["rise_s"],
+            decay=spec["decay_s"],
+            anticipation=spec["anticipation"],
+        )[0]
+    )
+    world.activate()
+    esper.add_component(creature, Emotion(store, row, spec["kind"]))
+    fur = world.try_component(creature, Fur)
+    if fur is not None:
+        rows = [world.component(e, FurControl).row for e in fur.controls]
+        world.fur.controls.emotion_row[rows] = row
+    return row
+
+
+def build_threats(world: World, threats: list[dict[str, Any]]) -> list[int]:
+    """Threat entities that follow keyframed paths; returns their entities."""
+    store = world.fur.threats
+    entities = []
+    for i, spec in enumerate(threats):
+        path = spec["path"]
+        row = int(store.add(pos=path[0]["position"])[0])
+        entity = world.create_entity(Threat(store, row, spec.get("name", f"threat_{i}")))
+        store.entity[row] = entity
+        world.fur.threat_paths += channels_from_keys(row, (0, 1, 2), path, "position")
+        entities.append(entity)
+    return entities

@@ -1,0 +1,138 @@
+"""Fur components: views into the fur stores, like `Transform` and `Motor`.
+
+    guide = world.component(entity, FurGuide)
+    guide.root                    # (3,) body-local root, a writable view
+    guide.points                  # (points, 3) world polyline after the rig ran
+    control = world.component(world.fur_control("hedgehog", "spine"), FurControl)
+    control.lift = 1.0            # quills up on the next frame
+
+Writing a guide's bind fields (root, normal, rest, side, length, multiplier,
+control_row) marks the rig's bind pose stale, so the next frame re-binds.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ecs_tentacles.components import RowField
+from ecs_tentacles.fur.stores import (
+    ControlStore,
+    EmotionStore,
+    FurData,
+    FurSetStore,
+    GuideStore,
+    ThreatStore,
+)
+
+
+class BindField(RowField):
+    """A RowField whose writes bump the fur's version (the rig re-binds)."""
+
+    def __set__(self, component: Any, value: Any) -> None:
+        super().__set__(component, value)
+        component.fur.touch()
+
+
+@dataclass(eq=False)
+class _Row:
+    store: Any
+    row: int
+
+    def __repr__(self) -> str:
+        names = [
+            n for k in type(self).__mro__ for n, v in vars(k).items() if isinstance(v, RowField)
+        ]
+        shown = ", ".join(f"{n}={getattr(self, n)!r}" for n in names)
+        return f"{type(self).__name__}(row={self.row}, {shown})"
+
+
+@dataclass(eq=False, repr=False)
+class FurGuide(_Row):
+    """A guide curve on a creature's mantle (all vectors in the mantle's local frame)."""
+
+    store: GuideStore
+    fur: FurData
+    creature: int
+    root = BindField()
+    normal = BindField()
+    rest = BindField()
+    side = BindField()
+    length = BindField()
+    multiplier = BindField()
+    control_row = BindField()
+
+    @property
+    def points(self) -> np.ndarray:
+        """World polyline (points, 3) from the last rig evaluation (float32 view)."""
+        return self.fur.curves[self.row]
+
+    @property
+    def direction(self) -> np.ndarray:
+        """World unit direction of the guide's root after the last rig evaluation."""
+        return self.fur.frames[self.row, 0]
+
+
+@dataclass(eq=False, repr=False)
+class FurControl(_Row):
+    """A spatial control: `position` in the creature frame and behaviour values 0..1."""
+
+    store: ControlStore
+    name: str
+    shape: str
+    creature: int
+    position = RowField()
+    rest_position = RowField()
+    lift = RowField()
+    aim = RowField()
+    direction = RowField()
+    random = RowField()
+    dynamic = RowField()
+    emotion = RowField()
+    colour = RowField()
+    size = RowField()
+
+
+@dataclass(eq=False, repr=False)
+class Fur(_Row):
+    """A creature's fur: rig constants (`twist_max` radians, `reach` m...) and its members."""
+
+    store: FurSetStore
+    preset: str
+    guides: list[int]
+    controls: list[int]
+    twist_max = RowField()
+    reach = RowField()
+    min_elevation = RowField()
+    stiffness = RowField()
+    damping = RowField()
+    gravity_scale = RowField()
+    erect_lift = RowField()
+    erect_random = RowField()
+    colour = RowField()
+    width = RowField()
+
+
+@dataclass(eq=False, repr=False)
+class Emotion(_Row):
+    """Fear or aggression of a creature: `level` (about 0..1) and its sensing and timing."""
+
+    store: EmotionStore
+    kind: str
+    radius = RowField()
+    rise = RowField()
+    decay = RowField()
+    anticipation = RowField()
+    level = RowField()
+    threatened = RowField()
+
+
+@dataclass(eq=False, repr=False)
+class Threat(_Row):
+    """A marked entity that frightens creatures: world `pos` (follows its keyframed path)."""
+
+    store: ThreatStore
+    name: str
+    pos = RowField()

@@ -1,0 +1,117 @@
+"""Rendering and export hooks: guide polylines, child hairs, controls, threats.
+
+The renderer and the exporter call these after a frame (the rig system has run):
+
+    curves = guide_curves(world)             # GuideCurves
+    curves.points                            # (n_guides, points, 3) float32, world space
+    curves.colour, curves.width              # (n_guides, 4) RGBA, (n_guides,) metres
+    dense = child_hairs(world)               # the furs' `children` per guide, same layout
+
+Everything returned is a fresh array (safe to keep); empty arrays for a world
+without fur.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ecs_tentacles.fur.components import FurControl, Threat
+from ecs_tentacles.mathutil import quat_rotate
+
+if TYPE_CHECKING:
+    from ecs_tentacles.world import World
+
+
+@dataclass
+class GuideCurves:
+    """Polylines to draw: points (n, points, 3), colour (n, 4) RGBA and root width (n,)."""
+
+    points: np.ndarray
+    colour: np.ndarray
+    width: np.ndarray
+    guide: np.ndarray  # (n,) guide row each polyline belongs to (children: their parent)
+
+
+def guide_curves(world: World, colour_by: str = "fur") -> GuideCurves:
+    """Every guide's world polyline; colour from its fur, or its control's (`"control"`)."""
+    fur = world.fur
+    n = len(fur.guides)
+    rows = np.arange(n)
+    if colour_by not in ("fur", "control"):
+        raise ValueError(f"colour_by must be 'fur' or 'control', got {colour_by!r}")
+    source = fur.sets.colour[fur.guides.fur_row]
+    if colour_by == "control":
+        source = fur.controls.colour[fur.guides.control_row]
+    colour = np.ones((n, 4), dtype=np.float32)
+    colour[:, :3] = source
+    width = fur.sets.width[fur.guides.fur_row].astype(np.float32)
+    return GuideCurves(fur.curves[:n].copy(), colour, width, rows)
+
+
+def child_hairs(
+    world: World, per_guide: int | None = None, radius: float | None = None, seed: int = 0
+) -> GuideCurves:
+    """Child hairs around each guide, for visual density (deterministic for `seed`).
+
+    Each child takes its guide's posed curve, moved to a root scattered in the skin's
+    tangent plane within `radius` (default: half the guide's length) and scaled in
+    length by 0.7-1.0, so it follows every rig behaviour and the dynamics of its
+    guide. `per_guide` defaults to each fur's `children`.
+    """
+    fur = world.fur
+    g = fur.guides
+    counts = fur.sets.children[g.fur_row] if per_guide is None else np.full(len(g), per_guide)
+    parent = np.repeat(np.arange(len(g)), counts)
+    rng = np.random.default_rng(seed)
+    m = len(parent)
+    curves = fur.curves[parent].astype(np.float64)
+    frames = fur.frames[parent].astype(np.float64)
+    spread = 0.5 * g.length[parent] if radius is None else np.full(m, radius)
+    angle = rng.uniform(0.0, 2.0 * np.pi, m)
+    reach = spread * np.sqrt(rng.random(m))
+    normal = quat_rotate(world.transforms.quat[g.body_row[parent]], g.normal[parent])
+    side = frames[:, 2]
+    along = np.cross(normal, side)
+    offset = reach[:, None] * (np.cos(angle)[:, None] * side + np.sin(angle)[:, None] * along)
+    scale = rng.uniform(0.7, 1.0, m)[:, None, None]
+    root = curves[:, :1]
+    points = (root + offset[:, None, :] + scale * (curves - root)).astype(np.float32)
+    base = guide_curves(world)
+    return GuideCurves(points, base.colour[parent], base.width[parent] * 0.5, parent)
+
+
+@dataclass
+class ControlMarker:
+    """A control as the sandbox draws it: world position, shape, colour and size."""
+
+    entity: int
+    name: str
+    shape: str
+    position: np.ndarray
+    colour: np.ndarray
+    size: float
+
+
+def control_markers(world: World) -> list[ControlMarker]:
+    """Every fur control, placed in world space by its creature's mantle pose."""
+    fur = world.fur
+    markers = []
+    for entity, control in world.query(FurControl):
+        body = fur.sets.body_row[control.store.fur_row[control.row]]
+        pos = world.transforms.pos[body] + quat_rotate(
+            world.transforms.quat[body], control.position
+        )
+        markers.append(
+            ControlMarker(
+                entity, control.name, control.shape, pos, control.colour.copy(), control.size
+            )
+        )
+    return markers
+
+
+def threat_positions(world: World) -> dict[str, np.ndarray]:
+    """World position of every marked threat, by name."""
+    return {threat.name: threat.pos.copy() for _, threat in world.query(Threat)}

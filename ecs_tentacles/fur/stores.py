@@ -1,0 +1,143 @@
+"""Struct-of-array stores of the fur rig: guides, controls, furs, emotions, threats.
+
+`FurData` (``world.fur``) holds them. Rows are never removed. Guides of all creatures
+share one point count (`FurData.points`): the first fur built sets it and guides of
+later furs with another count are resampled along their length.
+
+Anything that changes the bind pose (roots, normals, rest directions, shapes,
+multipliers, control assignment) must bump `FurData.version` so the rig re-binds;
+the `FurGuide` component does that on every write.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ecs_tentacles.fur.tracks import Channel
+from ecs_tentacles.store import ArrayStore, Field
+
+BEHAVIOURS = ("lift", "aim", "direction", "random", "dynamic")
+CONTROL_VALUES = ("lift", "aim", "direction", "random", "dynamic")
+
+
+class GuideStore(ArrayStore):
+    """Per guide, in the mantle body's local frame: root, normal, rest frame and links.
+
+    `rest` is the unit direction of the curve's first segment (the guide's axis runs
+    down the curve from its root); `side` is the rest frame's sideways unit vector
+    (normal x rest, normalised). Shapes are in `FurData.shape` (rest-frame coordinates).
+    """
+
+    entity = Field(dtype=np.int64)
+    body_row = Field(dtype=np.int64)  # Transform row of the mantle
+    fur_row = Field(dtype=np.int64)
+    control_row = Field(dtype=np.int64)
+    root = Field((3,))
+    normal = Field((3,), default=(0.0, 0.0, 1.0))
+    rest = Field((3,), default=(1.0, 0.0, 0.0))
+    side = Field((3,), default=(0.0, 1.0, 0.0))
+    length = Field()
+    multiplier = Field()  # random-twist multiplier in [-1, 1], fixed at generation
+
+
+class ControlStore(ArrayStore):
+    """Per control: position in the creature frame, rest position and behaviour values.
+
+    `lift` ... `dynamic` are the values the scene, tracks and scripts set (0..1);
+    `drive_lift` / `drive_random` are what the emotion system adds on top.
+    """
+
+    entity = Field(dtype=np.int64)
+    fur_row = Field(dtype=np.int64)
+    emotion_row = Field(dtype=np.int64, default=-1)
+    position = Field((3,))
+    rest_position = Field((3,))
+    lift = Field()
+    aim = Field()
+    direction = Field()
+    random = Field()
+    dynamic = Field()
+    emotion = Field(default=1.0)  # how much the creature's emotion drives this control
+    drive_lift = Field()
+    drive_random = Field()
+    colour = Field((3,), default=(1.0, 0.8, 0.0))
+    size = Field(default=0.03)
+
+
+class FurSetStore(ArrayStore):
+    """Per creature with fur: which behaviours it has and the rig's constants."""
+
+    creature = Field(dtype=np.int64)
+    body_row = Field(dtype=np.int64)
+    enabled = Field((len(BEHAVIOURS),), default=1.0)  # 1 on / 0 off, in BEHAVIOURS order
+    twist_max = Field()  # radians of twist at random = 1 for multiplier 1
+    reach = Field(default=0.1)  # metres: direction target distance along the guide
+    min_elevation = Field()  # radians above the skin every guide stays
+    stiffness = Field(default=8.0)  # 1/s: how fast a dynamic strand returns to the rig
+    damping = Field(default=2.0)  # 1/s: velocity lost by a dynamic strand
+    gravity_scale = Field(default=1.0)
+    erect_lift = Field(default=1.0)  # emotion level 1 adds this much lift
+    erect_random = Field()  # and this much random
+    colour = Field((3,))
+    width = Field(default=0.002)
+    children = Field(dtype=np.int64)
+
+
+class EmotionStore(ArrayStore):
+    """Per creature with an emotion: sensing, timing and the current level."""
+
+    creature = Field(dtype=np.int64)
+    body_row = Field(dtype=np.int64)
+    radius = Field(default=1.0)
+    rise = Field(default=0.4)  # seconds to 90 % of a rise
+    decay = Field(default=2.0)  # seconds to 90 % of a decay
+    anticipation = Field(default=0.3)
+    state = Field()  # the critically damped follower's position
+    speed = Field()  # and its velocity
+    level = Field()  # state - anticipation * speed / omega, in [-1, 1]
+    threatened = Field(dtype=np.bool_, default=False)
+
+
+class ThreatStore(ArrayStore):
+    """Marked entities that frighten creatures: world position (from a keyframed path)."""
+
+    entity = Field(dtype=np.int64)
+    pos = Field((3,))
+
+
+class FurData:
+    """The fur stores of one world (``world.fur``), plus the rig's output buffers.
+
+    After the rig runs: `points` (n_guides, points, 3) world polylines (float32) and
+    `frames` (n_guides, 4, 3): rows are the guide's axis, up and side unit vectors and
+    its root, in world space.
+    """
+
+    def __init__(self) -> None:
+        self.guides = GuideStore()
+        self.controls = ControlStore()
+        self.sets = FurSetStore()
+        self.emotions = EmotionStore()
+        self.threats = ThreatStore()
+        self.points = 0  # points per guide; set by the first fur built
+        self.shape = np.zeros((0, 0, 3))  # per guide: points in rest-frame (axis, up, side)
+        self.curves = np.zeros((0, 0, 3), dtype=np.float32)
+        self.frames = np.zeros((0, 4, 3), dtype=np.float32)
+        self.version = 0
+        self.tracks: list[Channel] = []  # control attributes (columns: see fur.build.COLUMNS)
+        self.threat_paths: list[Channel] = []  # threat positions (columns 0, 1, 2)
+        self.threat_bodies = np.zeros(0, dtype=np.int64)  # mantle rows of threat creatures
+        self.threat_creatures = np.zeros(0, dtype=np.int64)  # their creature entities
+
+    def add_shapes(self, shapes: np.ndarray) -> None:
+        """Append rest shapes (k, points, 3) for guides just added; grow the buffers."""
+        n = len(self.guides)
+        kept = self.shape[: n - len(shapes)].reshape(n - len(shapes), self.points, 3)
+        self.shape = np.concatenate([kept, shapes])
+        self.curves = np.zeros((n, self.points, 3), dtype=np.float32)
+        self.frames = np.zeros((n, 4, 3), dtype=np.float32)
+        self.version += 1
+
+    def touch(self) -> None:
+        """Mark the bind pose as changed (after writing guide arrays directly)."""
+        self.version += 1

@@ -1,0 +1,79 @@
+"""emotion: fear or aggression that rises near a threat and raises the fur (piloerection).
+
+Threats are the scene's marked entities (their keyframed paths are evaluated here at
+`world.time`) and creatures marked `threat`. A creature with an `Emotion` is roused
+while any threat other than itself is within its radius of its mantle. Its emotion
+follows a critically damped response toward 1 (roused) or 0 (calm), reaching 90 % in
+`rise` or `decay` seconds: it starts slowly and settles slowly (slow-in, slow-out).
+The level shown is ``state - anticipation * speed / omega_rise``: before it rises it
+first dips (the fur flattens a little, anticipation), before it falls it first swells.
+Each of the creature's controls gets ``level * control.emotion * fur.piloerection``
+added to its lift and random (clipped to 0..1 by the rig). No emotions: nothing done.
+
+Reads: ThreatStore paths, Transform store (mantles of emotional and threat creatures),
+EmotionStore settings and state. Writes: ThreatStore.pos, EmotionStore (state, speed,
+level, threatened), ControlStore (drive_lift, drive_random).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ecs_tentacles.fur.tracks import TrackSet
+from ecs_tentacles.system import System
+
+if TYPE_CHECKING:
+    from ecs_tentacles.world import World
+
+NINETY_PERCENT = 3.8897  # omega * t at which a critically damped step reaches 90 %
+
+
+class EmotionSystem(System):
+    name = "emotion"
+    after = ("physics_sync",)
+    before = ("rig",)
+
+    def __init__(self) -> None:
+        self.paths = TrackSet([])
+        self.path_count = -1
+
+    def process(self, world: World, dt: float) -> None:
+        fur = world.fur
+        threats = fur.threats
+        if len(fur.threat_paths) != self.path_count:
+            self.paths = TrackSet(fur.threat_paths)
+            self.path_count = len(fur.threat_paths)
+        if len(self.paths):
+            threats.pos[self.paths.rows, self.paths.columns] = self.paths.evaluate(world.time)
+        e = fur.emotions
+        if not len(e):
+            return
+        sources = np.concatenate([threats.pos, world.transforms.pos[fur.threat_bodies]])
+        owners = np.concatenate([np.full(len(threats), -1), fur.threat_creatures])
+        if len(sources):
+            here = world.transforms.pos[e.body_row]
+            distance = np.linalg.norm(here[:, None, :] - sources[None, :, :], axis=2)
+            distance[owners[None, :] == e.creature[:, None]] = np.inf  # not afraid of itself
+            near = (distance < e.radius[:, None]).any(axis=1)
+        else:
+            near = np.zeros(len(e), dtype=bool)
+        target = near.astype(np.float64)
+        rise = NINETY_PERCENT / e.rise
+        omega = np.where(target > e.state, rise, NINETY_PERCENT / e.decay)
+        # exact step of x'' = omega^2 (target - x) - 2 omega x' over dt
+        error, speed = e.state - target, e.speed
+        grow = speed + omega * error
+        fade = np.exp(-omega * dt)
+        e.state = target + (error + grow * dt) * fade
+        e.speed = (speed - omega * grow * dt) * fade
+        e.level = np.clip(e.state - e.anticipation * e.speed / rise, -1.0, 1.0)
+        e.threatened = near
+        c = fur.controls
+        if not len(c):
+            return
+        roused = np.where(c.emotion_row >= 0, e.level[np.maximum(c.emotion_row, 0)], 0.0)
+        roused = roused * c.emotion
+        c.drive_lift = roused * fur.sets.erect_lift[c.fur_row]
+        c.drive_random = roused * fur.sets.erect_random[c.fur_row]

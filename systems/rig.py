@@ -1,0 +1,86 @@
+"""rig: fur guides posed from creature poses and control values (the fur/feather thesis).
+
+Each frame: keyframed control tracks are written at `world.time`; every guide's
+frame is evaluated from its bind pose and its control's effective values (lift, aim,
+direction, random twist, the emotion system's drive added) as whole-array math; the
+guides' rest shapes are posed in world space by the mantle's Transform; guides of
+furs with the dynamic behaviour blend toward a light strand simulation from root to
+tip. A world without fur returns at once. See `ecs_tentacles.fur.rig` for the math.
+
+Reads: Transform store (mantle rows), fur ControlStore (position, rest position,
+behaviour values, drives), GuideStore and FurSetStore (bind pose, re-read when
+`world.fur.version` changes). Writes: ControlStore (tracked attributes),
+`world.fur.frames` (axis, up, side, root per guide) and `world.fur.curves` (polylines).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ecs_tentacles.fur.bind import ControlTracks, control_values, make_bind, make_strands
+from ecs_tentacles.fur.dynamics import Strands
+from ecs_tentacles.fur.rig import Bind, local_frames, pose, quat_matrices, world_frames
+from ecs_tentacles.fur.tracks import TrackSet
+from ecs_tentacles.system import System
+
+if TYPE_CHECKING:
+    from ecs_tentacles.world import World
+
+
+class Rig(System):
+    name = "rig"
+    after = ("physics_sync",)
+
+    def __init__(self) -> None:
+        self.version = -1
+        self.bind: Bind | None = None
+        self.bodies = np.zeros(0, dtype=np.int64)
+        self.tracks = ControlTracks(TrackSet([]))
+        self.strands: Strands | None = None
+
+    def rebind(self, world: World) -> None:
+        """Re-read the bind pose, tracks and dynamic strands from the fur stores."""
+        fur = world.fur
+        self.bind, self.bodies = make_bind(fur)
+        self.tracks = ControlTracks(TrackSet(fur.tracks))
+        gravity = np.asarray(world.settings.gravity, dtype=np.float64)
+        self.strands = make_strands(fur, gravity, world.settings.dt)
+        self.version = fur.version
+
+    def process(self, world: World, dt: float) -> None:
+        fur = world.fur
+        if not len(fur.guides):
+            return
+        if self.version != fur.version:
+            self.rebind(world)
+        bind = self.bind
+        assert bind is not None
+        self.tracks.apply(fur.controls, world.time)
+        values, dynamic = control_values(fur)
+        rotation = quat_matrices(world.transforms.quat[self.bodies])
+        position = world.transforms.pos[self.bodies]
+        local = local_frames(bind, values)
+        world_frames(bind, local, rotation, position, out=fur.frames)
+        pose(bind.shape_h, fur.frames, out=fur.curves)
+        if self.strands is not None:
+            self._dynamics(fur.frames, fur.curves, bind, rotation, dynamic)
+
+    def _dynamics(
+        self,
+        frames: np.ndarray,
+        curves: np.ndarray,
+        bind: Bind,
+        rotation: np.ndarray,
+        dynamic: np.ndarray,
+    ) -> None:
+        strands = self.strands
+        assert strands is not None
+        rows = strands.guides
+        rig = curves[rows].transpose(1, 2, 0)
+        root = frames[rows, 3].T
+        turn = rotation.astype(np.float32)[bind.body[rows]]  # (m, 3, 3)
+        normal = np.einsum("mij,jm->im", turn, bind.normal[:, rows])
+        blended = strands.step(np.ascontiguousarray(rig), root, normal, dynamic[bind.control[rows]])
+        curves[rows] = blended.transpose(2, 0, 1)
