@@ -2,18 +2,20 @@
 
 Reads: Transform store (every mantle and link), Sucker store (attached, anchor),
 Goal components, fur guide curves when the world has fur. Writes: its
-`TakeRecorder`'s arrays, nothing in the world.
+`TakeRecorder`'s arrays; before the first frame only, the fur rig's output buffers
+(`pose_fur_at_build`), which the rig rewrites every frame.
 
 Runs after physics_sync (and after rig, which is added before it). It records the
-pose it finds when it joins the world (take frame 0), then every `every`-th frame, so a take
-at 30 fps of a 60 fps world has `every=2`. Not one of the built-in systems.
+pose it finds when it joins the world (take frame 0; fur guides are posed for it
+if no frame has run yet), then every `every`-th frame, so a take at 30 fps of a
+60 fps world has `every=2`. Not one of the built-in systems.
 """
 
 from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from ecs_tentacles.export.recording import TakeRecorder
+from ecs_tentacles.export.recording import TakeRecorder, pose_fur_at_build
 from ecs_tentacles.export.take import Take
 from ecs_tentacles.system import System
 
@@ -38,6 +40,7 @@ class Record(System):
     def setup(self, world: World) -> None:
         fps = world.settings.fps / self.every
         self.recorder = TakeRecorder(world, fps=fps, **self._options)
+        pose_fur_at_build(world)
         self.recorder.capture()
         self._start = world.frame
 

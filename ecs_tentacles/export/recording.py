@@ -38,29 +38,36 @@ GuideSource = Callable[["World"], GuideFrame | None]
 
 
 def fur_guides(world: World) -> GuideFrame | None:
-    """The world's fur guide curves (`world.fur`, the rig's output), or None without fur.
+    """The world's fur guide curves as the rig posed them, or None without fur.
 
-    Uses `world.fur.guide_frame()` when the fur package offers it; otherwise reads the
-    rig's buffers: `curves` (guides, points, 3), each guide's fur set (`guides.fur_row`)
-    for its creature entity and width (`sets.creature`, `sets.width`).
+    Reads the fur package's export hook (`ecs_tentacles.fur.hooks.guide_curves`): world
+    polylines and root widths (kept along each guide); owners from the guides' fur sets.
     """
     fur = getattr(world, "fur", None)
     if fur is None:
         return None
-    frame = getattr(fur, "guide_frame", None)
-    if callable(frame):
-        result: GuideFrame | None = frame()
-        return result
-    guides, curves = getattr(fur, "guides", None), getattr(fur, "curves", None)
-    if guides is None or curves is None or len(curves) == 0:
+    try:
+        from ecs_tentacles.fur.hooks import guide_curves
+    except ImportError:  # a tree without the fur package
         return None
-    sets = np.asarray(guides.fur_row)  # each guide's fur set row
-    width = np.asarray(fur.sets.width)[sets]
-    return GuideFrame(
-        points=np.asarray(curves),
-        widths=np.repeat(width[:, None], curves.shape[1], axis=1),
-        creatures=np.asarray(fur.sets.creature)[sets],
-    )
+    curves = guide_curves(world)
+    if len(curves.points) == 0:
+        return None
+    owners = np.asarray(fur.sets.creature)[np.asarray(fur.guides.fur_row)]
+    widths = np.repeat(np.asarray(curves.width)[:, None], curves.points.shape[1], axis=1)
+    return GuideFrame(points=curves.points, widths=widths, creatures=owners)
+
+
+def pose_fur_at_build(world: World) -> None:
+    """Pose fur guides before the first frame, so a take's frame 0 has them.
+
+    The rig system poses guides during a frame; at the built pose nothing has run. A
+    fresh rig (its own dynamics state, thrown away) poses them once; it writes only
+    the rig's output buffers, which the real rig rewrites every frame.
+    """
+    fur = getattr(world, "fur", None)
+    if world.frame == 0 and fur is not None and len(fur.guides) and "rig" in world.schedule:
+        type(world.schedule["rig"])().process(world, 0.0)
 
 
 def scene_sha256(scene: dict[str, Any] | None) -> str:

@@ -172,24 +172,3 @@ def test_bad_take_files_give_one_line(tmp_path: Path) -> None:
         with pytest.raises(TakeError) as caught:
             Take.load(path)
         assert str(caught.value) == f"{path}: {message}"
-
-
-def test_fur_guides_reads_the_rig_buffers_of_world_fur() -> None:
-    from types import SimpleNamespace
-
-    from ecs_tentacles.export.recording import fur_guides
-
-    curves = np.arange(2 * 3 * 3, dtype=np.float32).reshape(2, 3, 3)
-    world = SimpleNamespace(
-        fur=SimpleNamespace(
-            guides=SimpleNamespace(fur_row=np.array([1, 0])),
-            curves=curves,
-            sets=SimpleNamespace(width=np.array([0.001, 0.002]), creature=np.array([7, 9])),
-        )
-    )
-    assert fur_guides(SimpleNamespace()) is None  # type: ignore[arg-type]
-    frame = fur_guides(world)  # type: ignore[arg-type]
-    assert frame is not None
-    np.testing.assert_array_equal(frame.points, curves)
-    np.testing.assert_array_equal(frame.widths, [[0.002] * 3, [0.001] * 3])
-    np.testing.assert_array_equal(frame.creatures, [9, 7])
