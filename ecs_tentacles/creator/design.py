@@ -25,13 +25,13 @@ from __future__ import annotations
 
 import copy
 import json
-import math
 import os
 import re
 from dataclasses import asdict, dataclass, replace
 from typing import TYPE_CHECKING, Any
 
 from ecs_tentacles.construction import TentacleShape, tentacle_shape
+from ecs_tentacles.creator.limits import DesignError, checked, default
 from ecs_tentacles.export.atomic import atomic_output
 from ecs_tentacles.scene.load import load_scene, resolve_scene_path
 from ecs_tentacles.scene.validate import load_schema
@@ -40,43 +40,6 @@ if TYPE_CHECKING:
     from ecs_tentacles.world import World
 
 SHAPE_KEYS = ("links", "link_length", "link_radius", "end_scale")
-
-
-class DesignError(ValueError):
-    """A value the design cannot take; `field` names it (`links`, `mantle_radius`...)."""
-
-    def __init__(self, field: str, message: str):
-        self.field = field
-        self.message = message
-        super().__init__(f"{field}: {message}")
-
-
-def _spec(section: str, key: str) -> dict[str, Any]:
-    """The schema of a creature's `mantle.<key>` or `tentacles.<key>`."""
-    creature = load_schema()["$defs"]["creature"]["properties"]
-    spec: dict[str, Any] = creature[section]["properties"][key]
-    return spec
-
-
-def _checked(field: str, section: str, key: str, value: Any) -> Any:
-    """`value` if the schema allows it for `section.key`, else DesignError naming `field`."""
-    spec = _spec(section, key)
-    integer = spec.get("type") == "integer"
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        raise DesignError(field, f"must be a number, got {value!r}")
-    if integer and value != int(value):
-        raise DesignError(field, f"must be a whole number, got {value!r}")
-    if not math.isfinite(value):
-        raise DesignError(field, f"must be a finite number, got {value!r}")
-    low = spec.get("exclusiveMinimum", spec.get("minimum"))
-    high = spec.get("exclusiveMaximum", spec.get("maximum"))
-    too_low = low is not None and (value <= low if "exclusiveMinimum" in spec else value < low)
-    too_high = high is not None and (value >= high if "exclusiveMaximum" in spec else value > high)
-    if too_low or too_high:
-        opening = "(" if "exclusiveMinimum" in spec else "["
-        closing = ")" if "exclusiveMaximum" in spec else "]"
-        raise DesignError(field, f"must be in {opening}{low}, {high}{closing}, got {value}")
-    return int(value) if integer else float(value)
 
 
 @dataclass(frozen=True)
@@ -90,12 +53,8 @@ class TentacleDesign:
 
     def checked(self, prefix: str = "") -> TentacleDesign:
         """A copy with every value checked against the scene schema."""
-        values = {k: _checked(prefix + k, "tentacles", k, getattr(self, k)) for k in SHAPE_KEYS}
+        values = {k: checked(prefix + k, "tentacles", k, getattr(self, k)) for k in SHAPE_KEYS}
         return TentacleDesign(**values)
-
-
-def _default(section: str, key: str) -> Any:
-    return _spec(section, key)["default"]
 
 
 class CreatureDesign:
@@ -114,9 +73,9 @@ class CreatureDesign:
         end_scale: float | None = None,
     ):
         self.name = name  # checked by the property
-        self.mantle_radius: float = _default("mantle", "radius")
-        self.mantle_height: float = _default("mantle", "height")
-        self.uniform = TentacleDesign(*(_default("tentacles", k) for k in SHAPE_KEYS))
+        self.mantle_radius: float = default("mantle", "radius")
+        self.mantle_height: float = default("mantle", "height")
+        self.uniform = TentacleDesign(*(default("tentacles", k) for k in SHAPE_KEYS))
         self.tentacles: list[TentacleDesign] = []
         self.selected: int | None = None
         # the rest of a loaded scene and creature entry (physics, locomotion, strength...)
@@ -168,8 +127,8 @@ class CreatureDesign:
         uniform = replace(self.uniform, **{k: v for k, v in changes.items() if v is not None})
         uniform = uniform.checked()
         if count is None:
-            count = len(self.tentacles) or _default("tentacles", "count")
-        number = _checked("count", "tentacles", "count", count)
+            count = len(self.tentacles) or default("tentacles", "count")
+        number = checked("count", "tentacles", "count", count)
         self.set_mantle(radius=mantle_radius, height=mantle_height)
         self.uniform = uniform
         self.tentacles = [uniform] * number
@@ -179,8 +138,8 @@ class CreatureDesign:
         """Resize the mantle (None keeps a value)."""
         new_radius = self.mantle_radius if radius is None else radius
         new_height = self.mantle_height if height is None else height
-        self.mantle_radius = _checked("mantle_radius", "mantle", "radius", new_radius)
-        self.mantle_height = _checked("mantle_height", "mantle", "height", new_height)
+        self.mantle_radius = checked("mantle_radius", "mantle", "radius", new_radius)
+        self.mantle_height = checked("mantle_height", "mantle", "height", new_height)
 
     # -- step 2: one tentacle at a time ------------------------------------------------
     def select(self, index: int | None) -> None:
