@@ -29,6 +29,9 @@ if TYPE_CHECKING:
     from ecs_tentacles.world import World
 
 
+BLOCK = 32768  # guides per block
+
+
 class Rig(System):
     name = "rig"
     after = ("physics_sync",)
@@ -39,11 +42,18 @@ class Rig(System):
         self.bodies = np.zeros(0, dtype=np.int64)
         self.tracks = ControlTracks(TrackSet([]))
         self.strands: Strands | None = None
+        # blocks of guides evaluated one after the other, so temporaries stay in cache
+        self.blocks: list[tuple[slice, Bind, np.ndarray]] = []
 
     def rebind(self, world: World) -> None:
         """Re-read the bind pose, tracks and dynamic strands from the fur stores."""
         fur = world.fur
         self.bind, self.bodies = make_bind(fur)
+        n = len(self.bind)
+        self.blocks = [
+            (rows, self.bind.part(rows), np.empty((4, 3, rows.stop - rows.start), np.float32))
+            for rows in (slice(s, min(s + BLOCK, n)) for s in range(0, n, BLOCK))
+        ]
         self.tracks = ControlTracks(TrackSet(fur.tracks))
         gravity = np.asarray(world.settings.gravity, dtype=np.float64)
         self.strands = make_strands(fur, gravity, world.settings.dt)
@@ -61,9 +71,10 @@ class Rig(System):
         values, dynamic = control_values(fur)
         rotation = quat_matrices(world.transforms.quat[self.bodies])
         position = world.transforms.pos[self.bodies]
-        local = local_frames(bind, values)
-        world_frames(bind, local, rotation, position, out=fur.frames)
-        pose(bind.shape_h, fur.frames, out=fur.curves)
+        for rows, part, local in self.blocks:
+            local_frames(part, values, out=local)
+            world_frames(part, local, rotation, position, out=fur.frames[rows])
+            pose(part.shape_h, fur.frames[rows], out=fur.curves[rows])
         if self.strands is not None:
             self._dynamics(fur.frames, fur.curves, bind, rotation, dynamic)
 

@@ -14,15 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ecs_tentacles.fur.dynamics import Strands, blend_profile
-from ecs_tentacles.fur.rig import (
-    F32,
-    Bind,
-    ControlValues,
-    clamp_to_cap,
-    dot,
-    normalize,
-    rotate_minimal,
-)
+from ecs_tentacles.fur.rig import F32, Bind, ControlValues, clamp_to_cap, cross, dot, normalize
 from ecs_tentacles.fur.stores import CONTROL_VALUES, ControlStore, FurData
 from ecs_tentacles.fur.tracks import TrackSet
 
@@ -45,17 +37,21 @@ def make_bind(fur: FurData) -> tuple[Bind, np.ndarray]:
     floor = fur.sets.min_elevation[g.fur_row] + cone_angles(fur.shape)
     tan_min = np.tan(np.minimum(floor, MAX_ELEVATION)).astype(F32)
     normal = normalize(g.normal.T.astype(F32))
-    given = normalize(g.rest.T.astype(F32))
-    rest = clamp_to_cap(given, normal, tan_min)
-    side = rotate_minimal(given, rest, g.side.T.astype(F32))
-    side = normalize(side - dot(side, rest) * rest)
+    rest = clamp_to_cap(normalize(g.rest.T.astype(F32)), normal, tan_min)
+    rest_sin = dot(rest, normal)
+    along = rest - rest_sin * normal
+    upright = dot(along, along) < 1e-12  # a guide standing on its normal: its side decides
+    along[:, upright] = cross(g.side.T.astype(F32)[:, upright], normal[:, upright])
+    along = normalize(along)
     shape_h = np.ones((len(g), fur.points, 4), dtype=F32)
     shape_h[..., :3] = fur.shape
     bind = Bind(
         root=np.ascontiguousarray(g.root.T, dtype=F32),
         normal=normal,
-        rest=rest,
-        side=side,
+        along=along,
+        side=cross(normal, along),
+        rest_cos=np.sqrt(np.maximum(1.0 - rest_sin * rest_sin, 0.0)),
+        rest_sin=rest_sin,
         tan_min=tan_min,
         multiplier=g.multiplier.astype(F32),
         control=g.control_row.copy(),

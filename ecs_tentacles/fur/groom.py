@@ -192,7 +192,7 @@ def explicit(guides: list[dict[str, Any]], points: int, radius: float, height: f
     local = stack - stack[:, :1]  # the curve moves with its root onto the skin
     rest = _unit(local[:, 1])
     side = side_vectors(normal, rest)
-    up = np.cross(side, rest)
+    up = np.cross(rest, side)
     frame = np.stack([rest, up, side], axis=1)  # (n, 3 axes, 3)
     shape = np.einsum("npk,nak->npa", local, frame)
     length = np.sum(np.linalg.norm(np.diff(stack, axis=1), axis=2), axis=1)

@@ -1,25 +1,26 @@
 """The rig's math: every guide's result frame from its bind pose and its control.
 
-Vectors are float32 arrays of shape (3, n) (one row per axis), so every step is a few
-whole-array operations. Per guide, in the mantle's local frame (thesis 3.2, 4.3):
+Per guide, in the guide's own skin basis (along = the rest direction's tangent part,
+side = normal x along, normal), where the rest direction is (cos e0, 0, sin e0)
+(thesis 3.2 and 4.3):
 
 1. direction and aim: the rest direction, the *direction* target (the rest direction
    reaching `reach` metres plus the control's offset from its rest position) and the
    *aim* target (root -> control) are blended with weights ``1 - aim - direction``
    (at least 0), `direction`, `aim`, as a normalised weighted sum on the unit sphere;
 2. lift: the result turns along the great circle toward the surface normal by the
-   fraction `lift` of the angle (lift 1 is the normal);
+   fraction `lift` of the angle (lift 1 is the normal, exactly);
 3. random twist: it turns about the normal (the follicle axis) by
    ``random * twist_max * multiplier`` (the multiplier fixed per guide at generation).
 
-No flipping: every target is clamped into the guide's outer cap (at least
-`min_elevation` above the skin; for a bent guide, more, so its whole curve stays out)
-by a continuous map, and a weighted sum of vectors in a cap stays in it, so a result
-can neither enter the surface nor jump when controls move or cross; the guide's frame
-is carried by the minimal rotation from its rest direction (never antipodal inside the
-cap), then twisted. Finally the frame goes to world space by the body's pose and each
-guide's rest shape (rest-frame coordinates, homogeneous) is posed by one batched
-matrix product.
+No flipping: every target is moved into the guide's outer cap (at least its lowest
+elevation above the skin; for a bent guide more, so the whole curve stays out) by a
+continuous map (`clamp`), and a weighted sum of vectors in a cap stays in it, so a
+result can neither enter the surface nor jump when controls move or cross. The frame's
+side is the (twisted) rest side made perpendicular to the result; it never degenerates
+because the result is never tangent. Frames go to world space with the body's pose and
+each guide's rest shape (homogeneous rest-frame coordinates) is posed by one batched
+matrix product. Arrays are float32; vectors are (3, n), one row per axis.
 """
 
 from __future__ import annotations
@@ -38,16 +39,30 @@ class Bind:
 
     root: np.ndarray
     normal: np.ndarray
-    rest: np.ndarray  # unit, inside the guide's cap
-    side: np.ndarray  # unit, normal x rest
+    along: np.ndarray  # unit tangent of the rest direction
+    side: np.ndarray  # unit, normal x along
+    rest_cos: np.ndarray  # (n,) cos and sin of the rest direction's elevation
+    rest_sin: np.ndarray
     tan_min: np.ndarray  # (n,) tan of the lowest elevation allowed
     multiplier: np.ndarray  # (n,)
     control: np.ndarray  # (n,) control row
-    body: np.ndarray  # (n,) index into the bodies passed to `frames`
+    body: np.ndarray  # (n,) index into the bodies passed to `world_frames`
     shape_h: np.ndarray  # (n, points, 4): rest-frame coordinates and a 1
 
     def __len__(self) -> int:
         return len(self.control)
+
+    def part(self, rows: slice) -> Bind:
+        """The guides `rows` (views, no copies)."""
+        vectors = {k: getattr(self, k)[:, rows] for k in ("root", "normal", "along", "side")}
+        scalars = ("rest_cos", "rest_sin", "tan_min", "multiplier", "control", "body", "shape_h")
+        return Bind(**vectors, **{k: getattr(self, k)[rows] for k in scalars})
+
+    @property
+    def rest(self) -> np.ndarray:
+        """Rest directions (3, n), body-local."""
+        result: np.ndarray = self.rest_cos * self.along + self.rest_sin * self.normal
+        return result
 
 
 @dataclass
@@ -84,43 +99,125 @@ def normalize(v: np.ndarray) -> np.ndarray:
 
 
 def clamp_to_cap(v: np.ndarray, normal: np.ndarray, tan_min: np.ndarray) -> np.ndarray:
-    """Unit vectors `v` moved continuously into the caps elevation >= atan(tan_min).
+    """Unit vectors `v` (3, n) moved continuously into the caps elevation >= atan(tan_min).
 
     The normal component is raised to at least `tan_min` and the result normalised:
     unchanged inside the cap (up to a sliver of width tan - sin of the bound), a vector
     below it keeps its azimuth, and -normal goes smoothly to +normal: no jumps anywhere.
     """
     h = dot(v, normal)
-    lifted = np.maximum(h, tan_min)
-    return normalize(v + (lifted - h) * normal)
+    return normalize(v + (np.maximum(h, tan_min) - h) * normal)
 
 
-def slerp_to_normal(d: np.ndarray, normal: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """Turn unit `d` toward `normal` by the fraction `t` of the angle between them."""
-    cos = np.clip(dot(d, normal), -1.0, 1.0)
-    angle = np.arccos(cos)
-    sin = np.sin(angle)
-    near = sin < 1e-6
-    safe = np.where(near, F32(1.0), sin)
-    a = np.where(near, 1.0 - t, np.sin((1.0 - t) * angle) / safe)
-    b = np.where(near, t, np.sin(t * angle) / safe)
-    result: np.ndarray = a * d + b * normal
-    return result
+Coords = tuple[np.ndarray, np.ndarray, np.ndarray]
 
 
-def rotate_minimal(a: np.ndarray, b: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """Rotate `x` by the smallest rotation taking unit `a` to unit `b` (a != -b)."""
-    c = dot(a, b)
-    k = cross(a, b)
-    result: np.ndarray = c * x + cross(k, x) + k * (dot(k, x) / np.maximum(1.0 + c, 1e-7))
-    return result
+def _unit(x: np.ndarray, y: np.ndarray, z: np.ndarray) -> Coords:
+    inv = 1.0 / np.maximum(np.sqrt(x * x + y * y + z * z), TINY)
+    return x * inv, y * inv, z * inv
 
 
-def rotate_about(axis: np.ndarray, angle: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """Rotate `x` about unit `axis` by `angle` radians (right hand)."""
-    cos, sin = np.cos(angle), np.sin(angle)
-    result: np.ndarray = cos * x + sin * cross(axis, x) + ((1.0 - cos) * dot(axis, x)) * axis
-    return result
+def _clamp(x: np.ndarray, y: np.ndarray, z: np.ndarray, tan_min: np.ndarray) -> Coords:
+    """`clamp_to_cap` in skin coordinates, for unit (x, y, z)."""
+    return _unit(x, y, np.maximum(z, tan_min))
+
+
+def _to_skin(bind: Bind, v: np.ndarray) -> Coords:
+    """Body-local vectors (3, n) in each guide's skin basis (along, side, normal)."""
+    return dot(v, bind.along), dot(v, bind.side), dot(v, bind.normal)
+
+
+def skin_directions(bind: Bind, values: ControlValues) -> tuple[Coords, Coords | None]:
+    """Result direction and side of every guide in skin coordinates (None: the rest side)."""
+    ctrl = bind.control
+    x, z = bind.rest_cos, bind.rest_sin
+    y: np.ndarray | float = 0.0
+    aiming, directing = values.aim.any(), values.direction.any()
+    if aiming or directing:
+        aim, turn = values.aim[ctrl], values.direction[ctrl]
+        keep = np.maximum(1.0 - aim - turn, 0.0)
+        x, y, z = keep * x, 0.0, keep * z
+        if directing:
+            ox, oy, oz = _to_skin(bind, values.offset[:, ctrl])
+            ox, oy, oz = _clamp(*_unit(ox + bind.rest_cos, oy, oz + bind.rest_sin), bind.tan_min)
+            x, y, z = x + turn * ox, turn * oy, z + turn * oz
+        if aiming:
+            toward = _to_skin(bind, values.position[:, ctrl] - bind.root)
+            ax, ay, az = _clamp(*_unit(*toward), bind.tan_min)
+            x, y, z = x + aim * ax, y + aim * ay, z + aim * az
+        x, y, z = _unit(x, y, z)  # type: ignore[arg-type]
+    if values.lift.any():
+        # turn toward the normal along the great circle: the polar angle shrinks by `lift`
+        flat = np.sqrt(x * x + y * y)
+        polar = (1.0 - values.lift[ctrl]) * np.arctan2(flat, z)
+        scale = np.sin(polar) / np.maximum(flat, TINY)
+        x, y, z = x * scale, y * scale, np.cos(polar)
+    if not values.twist.any():
+        if isinstance(y, float):
+            return (x, np.zeros_like(x), z), None  # still in the rest plane: rest side holds
+        side_x: np.ndarray | float = 0.0
+        side_y: np.ndarray | float = 1.0
+    else:
+        angle = values.twist[ctrl] * bind.multiplier
+        cos, sin = np.cos(angle), np.sin(angle)
+        x, y = x * cos - y * sin, x * sin + y * cos
+        side_x, side_y = -sin, cos
+    # the twisted rest side, made perpendicular to the result
+    k = side_x * x + side_y * y
+    side = _unit(side_x - k * x, side_y - k * y, -k * z)
+    return (x, np.asarray(y), z), side
+
+
+def _from_skin(bind: Bind, c: Coords, out: np.ndarray) -> None:
+    np.multiply(c[0], bind.along, out=out)
+    out += c[1] * bind.side
+    out += c[2] * bind.normal
+
+
+def local_frames(bind: Bind, values: ControlValues, out: np.ndarray | None = None) -> np.ndarray:
+    """Body-local frames (4, 3, n): result axis, up (axis x side), side, and the root."""
+    if out is None:
+        out = np.empty((4, 3, len(bind)), dtype=F32)
+    (x, y, z), side = skin_directions(bind, values)
+    if side is None:  # axis in the rest plane, side unchanged: up = (-z, 0, x)
+        np.multiply(x, bind.along, out=out[0])
+        out[0] += z * bind.normal
+        np.multiply(x, bind.normal, out=out[1])
+        out[1] -= z * bind.along
+        out[2] = bind.side
+    else:
+        sx, sy, sz = side
+        _from_skin(bind, (x, y, z), out[0])
+        _from_skin(bind, (y * sz - z * sy, z * sx - x * sz, x * sy - y * sx), out[1])
+        _from_skin(bind, side, out[2])
+    out[3] = bind.root
+    return out
+
+
+def world_frames(
+    bind: Bind, local: np.ndarray, rotation: np.ndarray, position: np.ndarray, out: np.ndarray
+) -> np.ndarray:
+    """Frames (4, 3, n) to world space, written into `out` (n, 4, 3) for `pose`.
+
+    `rotation` (n_bodies, 3, 3) and `position` (n_bodies, 3) are the bodies' poses;
+    `bind.body` picks each guide's.
+    """
+    n = local.shape[2]
+    if len(rotation) == 1:  # one body: four small matrix products for all
+        turned = np.matmul(rotation[0].astype(F32), local).reshape(12, n)
+        out.reshape(n, 12)[...] = turned.T  # numpy copies (12, n) -> (n, 12) fast
+        out[:, 3] += position[0].astype(F32)
+        return out
+    rows = np.ascontiguousarray(local.transpose(2, 0, 1))  # (n, 4, 3)
+    turn = rotation.astype(F32).transpose(0, 2, 1)[bind.body]  # (n, 3, 3), transposed
+    np.matmul(rows, turn, out=out)
+    out[:, 3] += position.astype(F32)[bind.body]
+    return out
+
+
+def pose(shape_h: np.ndarray, frames: np.ndarray, out: np.ndarray) -> np.ndarray:
+    """World points (n, points, 3) = rest-frame coordinates x world frame, batched."""
+    return np.matmul(shape_h, frames, out=out)
 
 
 def quat_matrices(quat: np.ndarray) -> np.ndarray:
@@ -133,65 +230,3 @@ def quat_matrices(quat: np.ndarray) -> np.ndarray:
             [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
         ]
     ).transpose(2, 0, 1)
-
-
-def local_frames(bind: Bind, values: ControlValues) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Result axis, up and side unit vectors (3, n), body-local, of every guide."""
-    ctrl = bind.control
-    rest, normal = bind.rest, bind.normal
-    direction = rest
-    aim_w = values.aim[ctrl]
-    dir_w = values.direction[ctrl]
-    if values.aim.any() or values.direction.any():
-        total = rest * np.maximum(1.0 - aim_w - dir_w, 0.0)
-        if values.direction.any():
-            target = normalize(rest + values.offset[:, ctrl])
-            total += dir_w * clamp_to_cap(target, normal, bind.tan_min)
-        if values.aim.any():
-            target = normalize(values.position[:, ctrl] - bind.root)
-            total += aim_w * clamp_to_cap(target, normal, bind.tan_min)
-        direction = normalize(total)
-    if values.lift.any():
-        direction = slerp_to_normal(direction, normal, values.lift[ctrl])
-    side = bind.side if direction is rest else rotate_minimal(rest, direction, bind.side)
-    if values.twist.any():
-        angle = values.twist[ctrl] * bind.multiplier
-        direction = rotate_about(normal, angle, direction)
-        side = rotate_about(normal, angle, side)
-    return direction, cross(side, direction), side
-
-
-def world_frames(
-    bind: Bind,
-    local: tuple[np.ndarray, np.ndarray, np.ndarray],
-    rotation: np.ndarray,
-    position: np.ndarray,
-    out: np.ndarray,
-) -> np.ndarray:
-    """Write the frames to world space into `out` (n, 4, 3): axis, up, side, root rows.
-
-    `rotation` (n_bodies, 3, 3) and `position` (n_bodies, 3) are the bodies' poses;
-    `bind.body` picks each guide's.
-    """
-    if len(rotation) == 1:  # one body: plain numbers, no per-guide gather
-        rot = [[F32(rotation[0, i, j]) for j in range(3)] for i in range(3)]
-        pos = [F32(position[0, i]) for i in range(3)]
-    else:
-        gathered = rotation.astype(F32).reshape(-1, 9).T[:, bind.body]
-        rot = [[gathered[3 * i + j] for j in range(3)] for i in range(3)]
-        moved = position.astype(F32).T[:, bind.body]
-        pos = [moved[i] for i in range(3)]
-    for slot, vec in enumerate((*local, bind.root)):
-        for i in range(3):
-            row = out[:, slot, i]
-            np.multiply(vec[0], rot[i][0], out=row)
-            row += vec[1] * rot[i][1]
-            row += vec[2] * rot[i][2]
-            if slot == 3:
-                row += pos[i]
-    return out
-
-
-def pose(shape_h: np.ndarray, frames: np.ndarray, out: np.ndarray) -> np.ndarray:
-    """World points (n, points, 3) = rest-frame coordinates x world frame, batched."""
-    return np.matmul(shape_h, frames, out=out)

@@ -1,0 +1,109 @@
+"""The rig system: guides follow their creature, tracks drive controls, re-binding, no fur."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+from numpy.testing import assert_allclose
+
+from ecs_tentacles.fur import FurControl, FurGuide
+from ecs_tentacles.mathutil import quat_rotate
+from ecs_tentacles.world import World
+
+
+def creature(name: str, x: float, fur: dict[str, Any], **extra: Any) -> dict[str, Any]:
+    return {
+        "name": name,
+        "position": [x, 0],
+        "tentacles": {"count": 4, "links": 3},
+        "fur": fur,
+    } | extra
+
+
+def roots_in_world(world: World) -> np.ndarray:
+    g = world.fur.guides
+    return world.transforms.pos[g.body_row] + quat_rotate(world.transforms.quat[g.body_row], g.root)
+
+
+def test_a_world_without_fur_does_no_rig_work(make_world: Callable[..., World]) -> None:
+    world = make_world({"version": 1, "creatures": [{"tentacles": {"count": 3, "links": 2}}]})
+    world.step(3)
+    rig = world.schedule["rig"]
+    assert rig.bind is None and rig.version == -1 and world.fur.curves.shape == (0, 0, 3)
+
+
+def test_guides_follow_a_moving_creature(make_world: Callable[..., World]) -> None:
+    fur = {"groom": {"count": 150, "bend_deg": 30, "rest_angle_deg": 20}}
+    fur["controls"] = [{"name": "m", "lift": 0.3, "random": 0.5, "aim": 0.2}]
+    scene = {
+        "version": 1,
+        "creatures": [
+            creature("a", 0.0, fur, goals=[{"position": [1.0, 0.5]}]),
+            creature("b", 2.0, {"groom": {"count": 60}}, heading_deg=90),
+        ],
+    }
+    world = make_world(scene)
+    start = world.transforms.pos[world.fur.sets.body_row].copy()
+    world.step(90)
+    moved = np.linalg.norm(world.transforms.pos[world.fur.sets.body_row] - start, axis=1)
+    assert moved[0] > 0.02  # it crawled
+    frames, curves = world.fur.frames, world.fur.curves
+    assert_allclose(frames[:, 3], roots_in_world(world), atol=2e-6)
+    assert_allclose(curves[:, 0], roots_in_world(world), atol=2e-6)
+    guide = world.component(int(world.fur.guides.entity[7]), FurGuide)
+    assert_allclose(guide.points, curves[7]) and guide.creature == world.creature("a")
+
+
+def test_tracks_drive_control_attributes(make_world: Callable[..., World]) -> None:
+    tracks = [
+        {
+            "attribute": "lift",
+            "keys": [{"time": 0, "value": 0}, {"time": 1, "value": 1, "easing": "linear"}],
+        },
+        {
+            "attribute": "position",
+            "keys": [{"time": 0, "value": [0, 0, 0.3]}, {"time": 2, "value": [0.2, 0, 0.3]}],
+        },
+    ]
+    tracks[0]["keys"][0]["easing"] = "linear"
+    fur = {"groom": {"count": 30}, "controls": [{"name": "m", "tracks": tracks}]}
+    world = make_world({"version": 1, "creatures": [creature("a", 0, fur)]}, locomotion=False)
+    control = world.component(world.fur.controls.entity[0], FurControl)
+    world.step(31)  # the last frame ran at t = 0.5
+    assert control.lift == 0.5
+    assert_allclose(control.position, [0.2 * 0.15625, 0, 0.3])  # ease at u = 1/4
+    world.step(60)
+    assert control.lift == 1.0
+    g = world.fur.guides
+    normals = quat_rotate(world.transforms.quat[g.body_row], g.normal)
+    assert_allclose(world.fur.frames[:, 0], normals, atol=1e-6)
+
+
+def test_a_scripted_control_move_turns_its_guides(make_world: Callable[..., World]) -> None:
+    fur = {"groom": {"count": 80, "region": "top"}, "controls": [{"name": "m", "direction": 1.0}]}
+    world = make_world({"version": 1, "creatures": [creature("a", 0, fur)]}, locomotion=False)
+    world.step(1)
+    before = world.fur.frames[:, 0].copy()
+    control = world.component(world.fur.controls.entity[0], FurControl)
+    control.position = control.rest_position + (0.0, 0.1, 0.0)  # one reach toward +y
+    world.step(1)
+    turned = world.fur.frames[:, 0] - before
+    y_world = quat_rotate(world.transforms.quat[world.fur.sets.body_row[0]], np.array([0, 1.0, 0]))
+    assert np.all(turned @ y_world > 0.05)
+
+
+def test_writing_a_guide_rebinds(make_world: Callable[..., World]) -> None:
+    fur = {"groom": {"count": 10}}
+    world = make_world({"version": 1, "creatures": [creature("a", 0, fur)]}, locomotion=False)
+    world.step(1)
+    version = world.fur.version
+    guide = world.component(int(world.fur.guides.entity[3]), FurGuide)
+    guide.root = (0.0, 0.0, 0.1)
+    guide.normal = (0.0, 0.0, 1.0)
+    assert world.fur.version == version + 2
+    world.step(1)
+    assert world.schedule["rig"].version == world.fur.version
+    assert_allclose(world.fur.frames[3, 3], roots_in_world(world)[3], atol=1e-6)
+    assert "FurGuide(row=3, root=" in repr(guide)

@@ -1,0 +1,132 @@
+"""Benchmark: fur rig evaluation time for 1k, 10k and 100k guides of 8 points.
+
+    python tools/bench_rig.py                   # median ms, synthetic arrays and the system
+    python tools/bench_rig.py --sizes 10000 --repeats 50 --json
+
+"math": the rig functions on synthetic arrays (every behaviour on: lift, aim,
+direction, random twist), posing included; "math+dynamic": the same plus the strand
+simulation on every guide; "system": `Rig.process` in a world whose creature has a
+fur of n guides (all behaviours on, controls moved, emotion off), with and without
+the dynamic behaviour. Targets on the 2-core machine: 10k <= 2 ms, 100k <= 16 ms.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import time
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from ecs_tentacles.fur.dynamics import Strands, blend_profile
+from ecs_tentacles.fur.rig import local_frames, pose, world_frames
+from ecs_tentacles.fur.synthetic import synthetic_rig
+from ecs_tentacles.world import World
+
+POINTS = 8
+
+
+def median_ms(func: Callable[[], Any], repeats: int) -> float:
+    """Median wall time of `func` in milliseconds (after one warm-up call)."""
+    func()
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        func()
+        times.append(time.perf_counter() - start)
+    return 1000 * statistics.median(times)
+
+
+def bench_math(n: int, repeats: int, dynamic: bool) -> float:
+    """Rig math on synthetic arrays (one body), optionally with strands on every guide."""
+    bind, values = synthetic_rig(n, POINTS)
+    rotation = np.eye(3)[None]
+    position = np.zeros((1, 3))
+    frames = np.zeros((n, 4, 3), dtype=np.float32)
+    curves = np.zeros((n, POINTS, 3), dtype=np.float32)
+    strands = Strands(
+        guides=np.arange(n),
+        segment=np.full((POINTS, n), 0.05 / (POINTS - 1), dtype=np.float32),
+        pull=np.full(n, 0.1, dtype=np.float32),
+        keep=np.full(n, 0.95, dtype=np.float32),
+        gravity=np.tile(np.array([[0.0], [0.0], [-9.81 / 3600]], dtype=np.float32), (1, n)),
+        profile=blend_profile(POINTS)[:, None, None],
+    )
+    weight = np.full(n, 0.6, dtype=np.float32)
+    buffer = np.empty((4, 3, n), dtype=np.float32)
+
+    def run() -> None:
+        local = local_frames(bind, values, out=buffer)
+        world_frames(bind, local, rotation, position, out=frames)
+        pose(bind.shape_h, frames, out=curves)
+        if dynamic:
+            rig = np.ascontiguousarray(curves.transpose(1, 2, 0))
+            out = strands.step(rig, frames[:, 3].T, bind.normal, weight)
+            curves[...] = out.transpose(2, 0, 1)
+
+    return median_ms(run, repeats)
+
+
+def bench_system(n: int, repeats: int, dynamic: bool) -> float:
+    """`Rig.process` in a world with one creature carrying n guides."""
+    behaviours = ["lift", "aim", "direction", "random"] + (["dynamic"] if dynamic else [])
+    control = {"name": "main", "lift": 0.3, "aim": 0.3, "direction": 0.3, "random": 0.5}
+    control["dynamic"] = 0.6
+    scene = {
+        "version": 1,
+        "creatures": [
+            {
+                "name": "furry",
+                "tentacles": {"count": 3, "links": 2},
+                "fur": {
+                    "behaviours": behaviours,
+                    "groom": {"count": n, "points": POINTS},
+                    "controls": [control],
+                },
+            }
+        ],
+    }
+    world = World.from_scene(scene, locomotion=False)
+    world.step(1)
+    world.fur.controls.position[0] += (0.02, 0.0, 0.01)  # a moved control: direction works
+    rig = world.schedule["rig"]
+    result = median_ms(lambda: rig.process(world, world.settings.dt), repeats)
+    world.close()
+    return result
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
+    parser.add_argument("--sizes", type=int, nargs="*", default=[1_000, 10_000, 100_000])
+    parser.add_argument("--repeats", type=int, default=30)
+    parser.add_argument("--json", action="store_true")
+    args = parser.parse_args()
+    rows = []
+    for n in args.sizes:
+        repeats = max(5, args.repeats * 10_000 // max(n, 10_000))
+        rows.append(
+            {
+                "guides": n,
+                "points": POINTS,
+                "math_ms": round(bench_math(n, repeats, False), 3),
+                "math_dynamic_ms": round(bench_math(n, repeats, True), 3),
+                "system_ms": round(bench_system(n, repeats, False), 3),
+                "system_dynamic_ms": round(bench_system(n, repeats, True), 3),
+            }
+        )
+    if args.json:
+        print(json.dumps(rows, indent=2))
+        return
+    print(f"{'guides':>8} {'math':>9} {'+dynamic':>9} {'system':>9} {'+dynamic':>9}   (median ms)")
+    for row in rows:
+        print(
+            f"{row['guides']:>8} {row['math_ms']:>9.3f} {row['math_dynamic_ms']:>9.3f}"
+            f" {row['system_ms']:>9.3f} {row['system_dynamic_ms']:>9.3f}"
+        )
+
+
+if __name__ == "__main__":
+    main()
