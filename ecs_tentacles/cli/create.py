@@ -7,8 +7,8 @@ uniform settings ("Build creature"), then per-tentacle changes, then "Export":
         --tentacle 2:links=12,link_length=0.09 --out squid.json
 
 `--from SCENE` starts from a scene's creature instead of the defaults. Without
-`--out` the interactive window would open; it needs the renderer and is not built
-yet, so that is an error for now.
+`--out` (or with `--window`) the creator window opens with the same settings
+applied; its Export button writes `--out`, or `<name>.json`.
 """
 
 from __future__ import annotations
@@ -68,11 +68,14 @@ def tentacle_edit(text: str) -> tuple[int, dict[str, float]]:
 def add_parser(commands: argparse._SubParsersAction) -> None:
     parser = commands.add_parser(
         "create",
-        help="design a creature and write it as a scene (--out; the window is not built yet)",
+        help="the creature creator: a window, or --out FILE for scripts",
         description="The creature creator: uniform settings, then per-tentacle changes, then"
         " export. Unset options keep the defaults (or the --from scene's values).",
     )
     parser.add_argument("--out", type=json_file, metavar="FILE", help="scene file to write")
+    parser.add_argument(
+        "--window", action="store_true", help="open the creator window even with --out"
+    )
     parser.add_argument("--from", dest="source", metavar="SCENE", help="start from this scene")
     parser.add_argument("--creature", default="0", help="--from: creature name or index")
     parser.add_argument("--name", help="creature name (letters, digits, _)")
@@ -101,15 +104,10 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 
 def handle(args: argparse.Namespace) -> int:
-    if args.out is None:
-        print(
-            "error: argument --out: required: the creator window needs the renderer and is not"
-            " built yet; give --out FILE to write the scene",
-            file=sys.stderr,
-        )
-        return 2
     try:
         design = make_design(args)
+        if args.out is None or args.window:
+            return open_window(design, args.out or Path(f"{design.name}.json"))
         design.export(args.out)
     except DesignError as error:
         option = OPTIONS.get(error.field, "--tentacle")
@@ -117,6 +115,21 @@ def handle(args: argparse.Namespace) -> int:
         return 2
     links = sum(t.links for t in design.tentacles)
     print(f"{args.out}: creature {design.name!r}: {len(design.tentacles)} tentacles, {links} links")
+    return 0
+
+
+def open_window(design: CreatureDesign, out: Path) -> int:
+    """The interactive creator on `design`; Export writes `out`."""
+    from ecs_tentacles.render import configure
+
+    configure(headless=False)
+    from ecs_tentacles.render.creator import Creator
+
+    creator = Creator(design, out)
+    try:
+        creator.run()
+    finally:
+        creator.close()
     return 0
 
 

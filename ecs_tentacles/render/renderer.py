@@ -15,6 +15,7 @@ import numpy as np
 from pyglet import gl
 
 from ecs_tentacles.components import Creature, Goal, Link, Tentacle, Transform
+from ecs_tentacles.fur.hooks import child_hairs, guide_curves
 from ecs_tentacles.render import shaders
 from ecs_tentacles.render.camera import OrbitCamera
 from ecs_tentacles.render.gpu import (
@@ -188,6 +189,8 @@ class Renderer:
             creature = self.world.component(self.selected, Creature)
             ring = pos[row] * [1, 1, 0] + [0, 0, 0.01] + creature.mantle_radius * 1.6 * CIRCLE
             segments.append(_segments(ring, np.array([1.0, 1.0, 1.0, 1.0])))
+        if len(self.world.fur.guides):
+            segments.append(fur_lines(self.world))
         for provider in self.extra_lines:
             segments.append(provider(self.world))
         return np.vstack(segments).astype(np.float32)
@@ -234,6 +237,21 @@ class Renderer:
             points.append(self.world.goals.positions(entity))
         self.camera.follow = None
         self.camera.frame(np.vstack(points), margin=1.0)
+
+
+def fur_lines(world: World) -> np.ndarray:
+    """Line-list vertices of every fur guide and its child hairs (one pass each)."""
+    parts = []
+    for curves in (guide_curves(world), child_hairs(world)):
+        points, colour = curves.points, curves.colour
+        if not len(points):
+            continue
+        n, p = points.shape[:2]
+        out = np.empty((n, p - 1, 2, 7), np.float32)
+        out[:, :, 0, :3], out[:, :, 1, :3] = points[:, :-1], points[:, 1:]
+        out[:, :, :, 3:] = colour[:, None, None, :]
+        parts.append(out.reshape(-1, 7))
+    return np.vstack(parts) if parts else np.zeros((0, 7), np.float32)
 
 
 def _segments(polyline: np.ndarray, colour: np.ndarray) -> np.ndarray:
