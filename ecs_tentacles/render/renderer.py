@@ -15,7 +15,7 @@ import numpy as np
 from pyglet import gl
 
 from ecs_tentacles.components import Creature, Goal, Link, Tentacle, Transform
-from ecs_tentacles.fur.hooks import child_hairs, guide_curves
+from ecs_tentacles.fur.hooks import child_hairs, guide_curves, threat_positions
 from ecs_tentacles.render import shaders
 from ecs_tentacles.render.camera import OrbitCamera
 from ecs_tentacles.render.gpu import (
@@ -143,13 +143,19 @@ class Renderer:
         self.lines.update(self._line_vertices(pos))
 
     def _sucker_instances(self) -> np.ndarray:
+        """Attached suckers (yellow) and marked threats (dark red): one sphere batch."""
         s = self.world.suckers
         held = np.flatnonzero(s.attached)
-        out = np.zeros((len(held), INSTANCE_FLOATS), np.float32)
-        out[:, 0:3] = s.anchor[held] + [0.0, 0.0, 0.01]
+        threats = list(threat_positions(self.world).values()) if len(self.world.fur.threats) else []
+        out = np.zeros((len(held) + len(threats), INSTANCE_FLOATS), np.float32)
         out[:, 3] = 1.0
-        out[:, 7:11] = (0.024, 0.024, 0.024, 0.0)
-        out[:, 11:15] = (1.0, 0.92, 0.25, 1.0)
+        out[: len(held), 0:3] = s.anchor[held] + [0.0, 0.0, 0.01]
+        out[: len(held), 7:11] = (0.024, 0.024, 0.024, 0.0)
+        out[: len(held), 11:15] = (1.0, 0.92, 0.25, 1.0)
+        if threats:
+            out[len(held) :, 0:3] = np.array(threats) + [0.0, 0.0, 0.04]
+            out[len(held) :, 7:11] = (0.07, 0.045, 0.04, 0.0)
+            out[len(held) :, 11:15] = (0.35, 0.12, 0.08, 1.0)
         return out
 
     def _goal_geometry(self) -> None:

@@ -134,3 +134,20 @@ def test_headless_run_writes_a_screenshot_and_a_video(
         "clip.mp4",
         "shot.png",
     ]  # no partial files
+
+
+def test_fur_and_threats_are_drawn(make_sandbox: Callable[..., Any]) -> None:
+    from ecs_tentacles.fur.hooks import child_hairs, guide_curves
+
+    sandbox = make_sandbox("hedgehog_octopus")
+    sandbox.step(3)
+    sandbox.render()
+    world = sandbox.world
+    guides, children = guide_curves(world).points, child_hairs(world).points
+    segments = 2 * (
+        guides.shape[0] * (guides.shape[1] - 1) + children.shape[0] * (children.shape[1] - 1)
+    )
+    assert guides.shape[0] == 500
+    assert sandbox.renderer.lines.count >= segments  # + the selection ring
+    attached = int(world.suckers.attached.sum())
+    assert sandbox.renderer.suckers.count == attached + 1  # the roach

@@ -1,0 +1,51 @@
+"""Headless pictures of the fur scenes: the presets side by side, and the hedgehog
+octopus before and after the roach arrives (quills lowered, then raised).
+
+    python tools/fur_screenshots.py --out-dir shots/
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+import numpy as np
+
+from ecs_tentacles.render import configure
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
+    parser.add_argument("--out-dir", type=Path, default=Path("."))
+    parser.add_argument("--width", type=int, default=1280)
+    parser.add_argument("--height", type=int, default=720)
+    args = parser.parse_args()
+    args.out_dir.mkdir(parents=True, exist_ok=True)
+    configure(headless=True)
+    from ecs_tentacles.components import Transform
+    from ecs_tentacles.render.sandbox import Sandbox
+
+    presets = Sandbox("fur_presets", width=args.width, height=args.height, headless=True)
+    presets.hud.visible = False
+    presets.renderer.camera.shift_x = 0.0
+    presets.step(90)
+    presets.renderer.frame_all()
+    presets.renderer.camera.distance *= 0.7
+    presets.renderer.camera.pitch = np.radians(30)
+    print(presets.screenshot(args.out_dir / "fur_presets.png"))
+    presets.close()
+
+    hedgehog = Sandbox("hedgehog_octopus", width=args.width, height=args.height, headless=True)
+    hedgehog.hud.visible = False
+    camera = hedgehog.renderer.camera
+    camera.shift_x, camera.distance, camera.pitch = 0.0, 1.6, np.radians(28)
+    octo = hedgehog.world.creature("hedgehog")
+    for name, seconds in (("before", 1.5), ("after", 4.2)):
+        hedgehog.step(round(seconds * hedgehog.world.settings.fps) - hedgehog.world.frame)
+        camera.target = hedgehog.world.component(octo, Transform).pos * [1, 1, 0] + [0.15, 0, 0]
+        print(hedgehog.screenshot(args.out_dir / f"hedgehog_octopus_{name}.png"))
+    hedgehog.close()
+
+
+if __name__ == "__main__":
+    main()
