@@ -29,7 +29,8 @@ if TYPE_CHECKING:
     from ecs_tentacles.world import World
 
 
-BLOCK = 32768  # guides per block
+BLOCK = 16384  # guides per block
+STRAND_BLOCK = 4096  # dynamic guides per block (their arrays are 8x larger)
 
 
 class Rig(System):
@@ -88,10 +89,20 @@ class Rig(System):
     ) -> None:
         strands = self.strands
         assert strands is not None
-        rows = strands.guides
-        rig = curves[rows].transpose(1, 2, 0)
-        root = frames[rows, 3].T
-        turn = rotation.astype(np.float32)[bind.body[rows]]  # (m, 3, 3)
-        normal = np.einsum("mij,jm->im", turn, bind.normal[:, rows])
-        blended = strands.step(np.ascontiguousarray(rig), root, normal, dynamic[bind.control[rows]])
-        curves[rows] = blended.transpose(2, 0, 1)
+        turn = rotation.astype(np.float32)
+        guides = strands.guides
+        first = int(guides[0])
+        contiguous = bool(guides[-1] - first == len(guides) - 1)
+        for start in range(0, len(guides), STRAND_BLOCK):  # block by block, in cache
+            cols = slice(start, min(start + STRAND_BLOCK, len(guides)))
+            rows = slice(first + start, first + cols.stop) if contiguous else guides[cols]
+            rig = np.ascontiguousarray(curves[rows].transpose(1, 2, 0))
+            root = frames[rows, 3].T
+            local_normal = bind.normal[:, rows]
+            if len(turn) == 1:
+                normal = turn[0] @ local_normal
+            else:
+                normal = np.einsum("mij,jm->im", turn[bind.body[rows]], local_normal)
+            weight = dynamic[bind.control[rows]]
+            blended = strands.step(rig, root, normal, weight, cols)
+            curves[rows] = blended.transpose(2, 0, 1)

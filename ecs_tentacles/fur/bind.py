@@ -47,9 +47,7 @@ def make_bind(fur: FurData) -> tuple[Bind, np.ndarray]:
     shape_h[..., :3] = fur.shape
     bind = Bind(
         root=np.ascontiguousarray(g.root.T, dtype=F32),
-        normal=normal,
-        along=along,
-        side=cross(normal, along),
+        basis=np.stack([along, cross(normal, along), normal]),
         rest_cos=np.sqrt(np.maximum(1.0 - rest_sin * rest_sin, 0.0)),
         rest_sin=rest_sin,
         tan_min=tan_min,

@@ -144,6 +144,9 @@ def _build_guides(
     for i, guide in enumerate(listed):
         if "control" in guide:
             assigned[first_listed + i] = controls[guide["control"]][1]
+    order = np.argsort(assigned, kind="stable")  # grouped by control: the rig's runs
+    assigned = assigned[order]
+    data = {k: v[order] for k, v in data.items()}
     shape = data.pop("shape")
     new = fur.guides.add(
         len(assigned), body_row=body, fur_row=fur_row, control_row=assigned, **data

@@ -39,32 +39,55 @@ class Strands:
     profile: np.ndarray  # (points, 1, 1)
     pos: np.ndarray | None = None
     prev: np.ndarray | None = None
+    fresh: np.ndarray | None = None  # strands not stepped yet
 
     def step(
-        self, rig: np.ndarray, root: np.ndarray, normal: np.ndarray, weight: np.ndarray
+        self,
+        rig: np.ndarray,
+        root: np.ndarray,
+        normal: np.ndarray,
+        weight: np.ndarray,
+        cols: slice | None = None,
     ) -> np.ndarray:
         """Advance one frame toward `rig` (points, 3, m); return the blended curves.
 
         `root` and `normal` (3, m) are world space; `weight` (m,) is each guide's
-        dynamic blend (0 shows the rig exactly).
+        dynamic blend (0 shows the rig exactly). With `cols`, only those strands step
+        (the arrays given are theirs): callers go block by block to stay in cache.
         """
-        if self.pos is None or self.prev is None or self.pos.shape != rig.shape:
-            self.pos = rig.copy()
-            self.prev = rig.copy()
-        pos, prev = self.pos, self.prev
-        velocity = (pos - prev) * self.keep
+        cols = slice(None) if cols is None else cols
+        if self.pos is None or self.prev is None:
+            points = len(self.segment)
+            self.pos = np.zeros((points, 3, len(self.guides)), dtype=F32)
+            self.prev = np.zeros_like(self.pos)
+            self.fresh = np.ones(len(self.guides), dtype=bool)
+        pos, prev = self.pos[..., cols], self.prev[..., cols]
+        fresh = self.fresh[cols]
+        if fresh.any():  # first frame of these strands: start at rest on the rig
+            pos[..., fresh] = rig[..., fresh]
+            prev[..., fresh] = rig[..., fresh]
+            fresh[...] = False
+        velocity = pos - prev
+        velocity *= self.keep[cols]
         prev[...] = pos
         pos += velocity
-        pos += self.gravity
-        pos += (rig - pos) * self.pull
+        pos += self.gravity[:, cols]
+        pull = rig - pos
+        pull *= self.pull[cols]
+        pos += pull
         pos[0] = rig[0]
+        segment = self.segment[:, cols]
         for k in range(1, len(pos)):  # follow the leader, a few points per guide
             link = pos[k] - pos[k - 1]
             length = np.sqrt(link[0] * link[0] + link[1] * link[1] + link[2] * link[2])
-            pos[k] = pos[k - 1] + link * (self.segment[k] / np.maximum(length, 1e-12))
+            link *= segment[k] / np.maximum(length, 1e-12)
+            np.add(pos[k - 1], link, out=pos[k])
             below = (pos[k, 0] - root[0]) * normal[0]
             below += (pos[k, 1] - root[1]) * normal[1]
             below += (pos[k, 2] - root[2]) * normal[2]
-            pos[k] -= np.minimum(below, 0.0) * normal
-        result: np.ndarray = rig + (self.profile * weight) * (pos - rig)
+            np.minimum(below, 0.0, out=below)
+            pos[k] -= below * normal
+        result = pos - rig
+        result *= self.profile * weight
+        result += rig
         return result

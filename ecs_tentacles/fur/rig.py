@@ -35,12 +35,14 @@ TINY = 1e-12
 
 @dataclass
 class Bind:
-    """The rig's bind pose of n guides (float32, body-local, vectors as (3, n))."""
+    """The rig's bind pose of n guides (float32, body-local, vectors as (3, n)).
+
+    Guides are best ordered by control (the builder does it): per-control values then
+    reach the guides through a few runs (`np.repeat`) instead of a gather per guide.
+    """
 
     root: np.ndarray
-    normal: np.ndarray
-    along: np.ndarray  # unit tangent of the rest direction
-    side: np.ndarray  # unit, normal x along
+    basis: np.ndarray  # (3, 3, n): along (rest direction's unit tangent), side, normal
     rest_cos: np.ndarray  # (n,) cos and sin of the rest direction's elevation
     rest_sin: np.ndarray
     tan_min: np.ndarray  # (n,) tan of the lowest elevation allowed
@@ -49,14 +51,36 @@ class Bind:
     body: np.ndarray  # (n,) index into the bodies passed to `world_frames`
     shape_h: np.ndarray  # (n, points, 4): rest-frame coordinates and a 1
 
+    def __post_init__(self) -> None:
+        starts = np.flatnonzero(np.diff(self.control)) + 1
+        starts = np.concatenate([[0], starts]) if len(self.control) else starts
+        self.run_control = self.control[starts]
+        self.run_length = np.diff(np.append(starts, len(self.control)))
+
     def __len__(self) -> int:
         return len(self.control)
 
     def part(self, rows: slice) -> Bind:
         """The guides `rows` (views, no copies)."""
-        vectors = {k: getattr(self, k)[:, rows] for k in ("root", "normal", "along", "side")}
         scalars = ("rest_cos", "rest_sin", "tan_min", "multiplier", "control", "body", "shape_h")
-        return Bind(**vectors, **{k: getattr(self, k)[rows] for k in scalars})
+        parts = {k: getattr(self, k)[rows] for k in scalars}
+        return Bind(root=self.root[:, rows], basis=self.basis[:, :, rows], **parts)
+
+    def spread(self, table: np.ndarray) -> np.ndarray:
+        """Per-control rows (k, n_controls) -> per-guide rows (k, n), run by run."""
+        return np.repeat(table[:, self.run_control], self.run_length, axis=1)
+
+    @property
+    def along(self) -> np.ndarray:
+        return self.basis[0]  # type: ignore[no-any-return]
+
+    @property
+    def side(self) -> np.ndarray:
+        return self.basis[1]  # type: ignore[no-any-return]
+
+    @property
+    def normal(self) -> np.ndarray:
+        return self.basis[2]  # type: ignore[no-any-return]
 
     @property
     def rest(self) -> np.ndarray:
@@ -75,6 +99,11 @@ class ControlValues:
     twist: np.ndarray  # radians for a multiplier of 1
     position: np.ndarray  # creature frame
     offset: np.ndarray  # (position - rest position) / reach
+
+    def table(self) -> np.ndarray:
+        """All values as rows (10, n_controls): lift, aim, direction, twist, position, offset."""
+        rows = [self.lift, self.aim, self.direction, self.twist, *self.position, *self.offset]
+        return np.array(rows, dtype=F32).reshape(10, -1)
 
 
 def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -122,34 +151,33 @@ def _clamp(x: np.ndarray, y: np.ndarray, z: np.ndarray, tan_min: np.ndarray) -> 
     return _unit(x, y, np.maximum(z, tan_min))
 
 
-def _to_skin(bind: Bind, v: np.ndarray) -> Coords:
-    """Body-local vectors (3, n) in each guide's skin basis (along, side, normal)."""
-    return dot(v, bind.along), dot(v, bind.side), dot(v, bind.normal)
+def _to_skin(bind: Bind, v: np.ndarray) -> np.ndarray:
+    """Body-local vectors (3, n) in each guide's skin basis: rows along, side, normal."""
+    return np.einsum("in,jin->jn", v, bind.basis)
 
 
 def skin_directions(bind: Bind, values: ControlValues) -> tuple[Coords, Coords | None]:
     """Result direction and side of every guide in skin coordinates (None: the rest side)."""
-    ctrl = bind.control
+    per_guide = bind.spread(values.table())
+    lift, aim, turn, twist = per_guide[0], per_guide[1], per_guide[2], per_guide[3]
     x, z = bind.rest_cos, bind.rest_sin
     y: np.ndarray | float = 0.0
     aiming, directing = values.aim.any(), values.direction.any()
     if aiming or directing:
-        aim, turn = values.aim[ctrl], values.direction[ctrl]
         keep = np.maximum(1.0 - aim - turn, 0.0)
         x, y, z = keep * x, 0.0, keep * z
         if directing:
-            ox, oy, oz = _to_skin(bind, values.offset[:, ctrl])
+            ox, oy, oz = _to_skin(bind, per_guide[7:10])
             ox, oy, oz = _clamp(*_unit(ox + bind.rest_cos, oy, oz + bind.rest_sin), bind.tan_min)
             x, y, z = x + turn * ox, turn * oy, z + turn * oz
         if aiming:
-            toward = _to_skin(bind, values.position[:, ctrl] - bind.root)
-            ax, ay, az = _clamp(*_unit(*toward), bind.tan_min)
+            ax, ay, az = _clamp(*_unit(*_to_skin(bind, per_guide[4:7] - bind.root)), bind.tan_min)
             x, y, z = x + aim * ax, y + aim * ay, z + aim * az
         x, y, z = _unit(x, y, z)  # type: ignore[arg-type]
     if values.lift.any():
         # turn toward the normal along the great circle: the polar angle shrinks by `lift`
         flat = np.sqrt(x * x + y * y)
-        polar = (1.0 - values.lift[ctrl]) * np.arctan2(flat, z)
+        polar = (1.0 - lift) * np.arctan2(flat, z)
         scale = np.sin(polar) / np.maximum(flat, TINY)
         x, y, z = x * scale, y * scale, np.cos(polar)
     if not values.twist.any():
@@ -158,7 +186,7 @@ def skin_directions(bind: Bind, values: ControlValues) -> tuple[Coords, Coords |
         side_x: np.ndarray | float = 0.0
         side_y: np.ndarray | float = 1.0
     else:
-        angle = values.twist[ctrl] * bind.multiplier
+        angle = twist * bind.multiplier
         cos, sin = np.cos(angle), np.sin(angle)
         x, y = x * cos - y * sin, x * sin + y * cos
         side_x, side_y = -sin, cos
@@ -168,28 +196,22 @@ def skin_directions(bind: Bind, values: ControlValues) -> tuple[Coords, Coords |
     return (x, np.asarray(y), z), side
 
 
-def _from_skin(bind: Bind, c: Coords, out: np.ndarray) -> None:
-    np.multiply(c[0], bind.along, out=out)
-    out += c[1] * bind.side
-    out += c[2] * bind.normal
-
-
 def local_frames(bind: Bind, values: ControlValues, out: np.ndarray | None = None) -> np.ndarray:
     """Body-local frames (4, 3, n): result axis, up (axis x side), side, and the root."""
     if out is None:
         out = np.empty((4, 3, len(bind)), dtype=F32)
     (x, y, z), side = skin_directions(bind, values)
+    along, normal = bind.along, bind.normal
     if side is None:  # axis in the rest plane, side unchanged: up = (-z, 0, x)
-        np.multiply(x, bind.along, out=out[0])
-        out[0] += z * bind.normal
-        np.multiply(x, bind.normal, out=out[1])
-        out[1] -= z * bind.along
+        np.multiply(x, along, out=out[0])
+        out[0] += z * normal
+        np.multiply(x, normal, out=out[1])
+        out[1] -= z * along
         out[2] = bind.side
     else:
         sx, sy, sz = side
-        _from_skin(bind, (x, y, z), out[0])
-        _from_skin(bind, (y * sz - z * sy, z * sx - x * sz, x * sy - y * sx), out[1])
-        _from_skin(bind, side, out[2])
+        skin = np.array([[x, y, z], [y * sz - z * sy, z * sx - x * sz, x * sy - y * sx], side])
+        np.einsum("kjn,jin->kin", skin, bind.basis, out=out[:3])
     out[3] = bind.root
     return out
 
@@ -204,9 +226,9 @@ def world_frames(
     """
     n = local.shape[2]
     if len(rotation) == 1:  # one body: four small matrix products for all
-        turned = np.matmul(rotation[0].astype(F32), local).reshape(12, n)
-        out.reshape(n, 12)[...] = turned.T  # numpy copies (12, n) -> (n, 12) fast
-        out[:, 3] += position[0].astype(F32)
+        turned = np.matmul(rotation[0].astype(F32), local)
+        turned[3] += position[0].astype(F32)[:, None]
+        out.reshape(n, 12)[...] = turned.reshape(12, n).T  # numpy copies this fast
         return out
     rows = np.ascontiguousarray(local.transpose(2, 0, 1))  # (n, 4, 3)
     turn = rotation.astype(F32).transpose(0, 2, 1)[bind.body]  # (n, 3, 3), transposed

@@ -42,14 +42,12 @@ def synthetic_rig(
     shape_h[..., :3] = shape
     bind = Bind(
         root=(radius * normal).astype(F32),
-        normal=normal,
-        along=tangent,
-        side=cross(normal, tangent),
+        basis=np.stack([tangent, cross(normal, tangent), normal]),
         rest_cos=np.sqrt(1.0 - rest_sin * rest_sin),
         rest_sin=rest_sin,
         tan_min=floor,
         multiplier=rng.uniform(-1.0, 1.0, guides).astype(F32),
-        control=rng.integers(0, controls, guides),
+        control=np.sort(rng.integers(0, controls, guides)),  # grouped, as the builder does
         body=np.zeros(guides, dtype=np.int64),
         shape_h=shape_h,
     )

@@ -6,6 +6,8 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
+import pytest
+from ecs_tentacles.systems import rig as rig_module
 from numpy.testing import assert_allclose
 
 from ecs_tentacles.fur import FurControl, FurGuide
@@ -107,3 +109,26 @@ def test_writing_a_guide_rebinds(make_world: Callable[..., World]) -> None:
     assert world.schedule["rig"].version == world.fur.version
     assert_allclose(world.fur.frames[3, 3], roots_in_world(world)[3], atol=1e-6)
     assert "FurGuide(row=3, root=" in repr(guide)
+
+
+def test_blocks_give_the_same_result_as_one_pass(
+    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    scene = {
+        "version": 1,
+        "creatures": [
+            creature("bird", 0.0, {"preset": "bird", "groom": {"count": 50}}),
+            creature("cat", 2.0, {"preset": "cat", "groom": {"count": 70}}),
+        ],
+    }
+    results = []
+    for block, strands in [(10_000, 10_000), (16, 7)]:
+        monkeypatch.setattr(rig_module, "BLOCK", block)
+        monkeypatch.setattr(rig_module, "STRAND_BLOCK", strands)
+        world = make_world(scene, locomotion=False)
+        world.fur.controls.lift[:] = 0.4
+        world.fur.controls.random[:] = 0.6
+        world.step(20)
+        results.append((world.fur.frames.copy(), world.fur.curves.copy()))
+    np.testing.assert_array_equal(results[0][0], results[1][0])
+    np.testing.assert_array_equal(results[0][1], results[1][1])
