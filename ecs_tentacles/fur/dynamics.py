@@ -56,7 +56,7 @@ class Strands:
         (the arrays given are theirs): callers go block by block to stay in cache.
         """
         cols = slice(None) if cols is None else cols
-        if self.pos is None or self.prev is None:
+        if self.pos is None or self.prev is None or self.fresh is None:
             points = len(self.segment)
             self.pos = np.zeros((points, 3, len(self.guides)), dtype=F32)
             self.prev = np.zeros_like(self.pos)

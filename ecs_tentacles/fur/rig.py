@@ -72,15 +72,21 @@ class Bind:
 
     @property
     def along(self) -> np.ndarray:
-        return self.basis[0]  # type: ignore[no-any-return]
+        """Unit tangents (3, n) of the rest directions."""
+        result: np.ndarray = self.basis[0]
+        return result
 
     @property
     def side(self) -> np.ndarray:
-        return self.basis[1]  # type: ignore[no-any-return]
+        """Unit side vectors (3, n): normal x along."""
+        result: np.ndarray = self.basis[1]
+        return result
 
     @property
     def normal(self) -> np.ndarray:
-        return self.basis[2]  # type: ignore[no-any-return]
+        """Unit surface normals (3, n) at the roots."""
+        result: np.ndarray = self.basis[2]
+        return result
 
     @property
     def rest(self) -> np.ndarray:
