@@ -55,13 +55,15 @@ def _parts(region: str, radius: float, half: float) -> list[tuple[str, float, fl
     return table[region]
 
 
+def _part_area(part: tuple[str, float, float, int], radius: float) -> float:
+    kind, low, high, sign = part
+    full = np.pi * radius**2 if kind == "top" else 2 * np.pi * radius * (high - low)
+    return float(full * (0.5 if sign else 1.0))
+
+
 def region_area(region: str, radius: float, height: float) -> float:
     """Skin area (m^2) of `region` on a mantle of `radius` and `height`."""
-    area = 0.0
-    for part, low, high, sign in _parts(region, radius, 0.5 * height):
-        full = np.pi * radius**2 if part == "top" else 2 * np.pi * radius * (high - low)
-        area += full * (0.5 if sign else 1.0)
-    return float(area)
+    return sum(_part_area(p, radius) for p in _parts(region, radius, 0.5 * height))
 
 
 def sample_surface(
@@ -70,7 +72,7 @@ def sample_surface(
     """`count` area-uniform points on `region` and their outward normals, (count, 3) each."""
     half = 0.5 * height
     parts = _parts(region, radius, half)
-    areas = np.array([region_area_part(p, radius) for p in parts])
+    areas = np.array([_part_area(p, radius) for p in parts])
     which = rng.choice(len(parts), size=count, p=areas / areas.sum())
     u, v = rng.random(count), rng.random(count)
     points = np.zeros((count, 3))
@@ -92,13 +94,6 @@ def sample_surface(
             points[mask] = radius * ring + z[:, None] * np.array([0.0, 0.0, 1.0])
             normals[mask] = ring
     return points, normals
-
-
-def region_area_part(part: tuple[str, float, float, int], radius: float) -> float:
-    """Area of one piece returned by `_parts`."""
-    kind, low, high, sign = part
-    full = np.pi * radius**2 if kind == "top" else 2 * np.pi * radius * (high - low)
-    return float(full * (0.5 if sign else 1.0))
 
 
 def tangent_flow(points: np.ndarray, normals: np.ndarray, flow: str, radius: float) -> np.ndarray:

@@ -179,9 +179,11 @@ def skin_directions(bind: Bind, values: ControlValues) -> tuple[Coords, Coords |
         if aiming:
             ax, ay, az = _clamp(*_unit(*_to_skin(bind, per_guide[4:7] - bind.root)), bind.tan_min)
             x, y, z = x + aim * ax, y + aim * ay, z + aim * az
-        x, y, z = _unit(x, y, z)  # type: ignore[arg-type]
+        if not values.lift.any():
+            x, y, z = _unit(x, y, z)  # type: ignore[arg-type]
     if values.lift.any():
         # turn toward the normal along the great circle: the polar angle shrinks by `lift`
+        # (this also normalises a blend: the angle and the azimuth do not need unit input)
         flat = np.sqrt(x * x + y * y)
         polar = (1.0 - lift) * np.arctan2(flat, z)
         scale = np.sin(polar) / np.maximum(flat, TINY)
@@ -196,9 +198,11 @@ def skin_directions(bind: Bind, values: ControlValues) -> tuple[Coords, Coords |
         cos, sin = np.cos(angle), np.sin(angle)
         x, y = x * cos - y * sin, x * sin + y * cos
         side_x, side_y = -sin, cos
-    # the twisted rest side, made perpendicular to the result
+    # the twisted rest side, made perpendicular to the result; both are unit vectors, so
+    # its length is sqrt(1 - k^2) >= sin(lowest elevation) > 0
     k = side_x * x + side_y * y
-    side = _unit(side_x - k * x, side_y - k * y, -k * z)
+    inv = 1.0 / np.sqrt(np.maximum(1.0 - k * k, TINY))
+    side = ((side_x - k * x) * inv, (side_y - k * y) * inv, -k * z * inv)
     return (x, np.asarray(y), z), side
 
 
