@@ -153,7 +153,7 @@ def controls(draw: st.DrawFn, count: int = 4) -> ControlValues:
 BENT, _ = synthetic_rig(300, controls=4, bend_deg=40.0, seed=3)
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=100, deadline=None)
 @given(controls())
 def test_every_guide_and_every_point_stays_outside_the_skin(values: ControlValues) -> None:
     local = local_frames(BENT, values)
@@ -169,7 +169,7 @@ def _angles(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.asarray(np.arccos(np.clip(dot(a.astype(float), b.astype(float)), -1.0, 1.0)))
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=100, deadline=None)
 @given(controls(), st.integers(0, 2**31 - 1))
 def test_a_small_control_change_gives_a_small_direction_change(
     values: ControlValues, seed: int
