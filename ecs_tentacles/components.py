@@ -38,17 +38,22 @@ class RowField:
 
 
 @dataclass(eq=False)
-class _Row:
+class RowComponent:
+    """Base of components whose numeric fields (`RowField`s) live in one store row."""
+
     store: ArrayStore
     row: int
 
     def __repr__(self) -> str:
-        fields = ", ".join(f"{f.name}={getattr(self, f.name)!r}" for f in type(self.store).fields())
-        return f"{type(self).__name__}(row={self.row}, {fields})"
+        names = [
+            n for k in type(self).__mro__ for n, v in vars(k).items() if isinstance(v, RowField)
+        ]
+        shown = ", ".join(f"{n}={getattr(self, n)!r}" for n in names)
+        return f"{type(self).__name__}(row={self.row}, {shown})"
 
 
 @dataclass(eq=False, repr=False)
-class Transform(_Row):
+class Transform(RowComponent):
     """World pose of a body: `pos` (3,) metres, `quat` (4,) unit quaternion (w, x, y, z)."""
 
     store: TransformStore
@@ -57,7 +62,7 @@ class Transform(_Row):
 
 
 @dataclass(eq=False, repr=False)
-class Motor(_Row):
+class Motor(RowComponent):
     """A link's servo: `target` (curl, sweep, twist) radians, `strength` kp, `damping` kv."""
 
     store: MotorStore
@@ -68,7 +73,7 @@ class Motor(_Row):
 
 
 @dataclass(eq=False, repr=False)
-class Sucker(_Row):
+class Sucker(RowComponent):
     """A sucker under a link: `offset` in the link frame, `attached`, world `anchor`."""
 
     store: SuckerStore

@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from ecs_tentacles.components import RowField
+from ecs_tentacles.components import RowComponent, RowField
 from ecs_tentacles.fur.stores import (
     ControlStore,
     EmotionStore,
@@ -36,21 +36,8 @@ class BindField(RowField):
         component.fur.touch()
 
 
-@dataclass(eq=False)
-class _Row:
-    store: Any
-    row: int
-
-    def __repr__(self) -> str:
-        names = [
-            n for k in type(self).__mro__ for n, v in vars(k).items() if isinstance(v, RowField)
-        ]
-        shown = ", ".join(f"{n}={getattr(self, n)!r}" for n in names)
-        return f"{type(self).__name__}(row={self.row}, {shown})"
-
-
 @dataclass(eq=False, repr=False)
-class FurGuide(_Row):
+class FurGuide(RowComponent):
     """A guide curve on a creature's mantle (all vectors in the mantle's local frame)."""
 
     store: GuideStore
@@ -76,7 +63,7 @@ class FurGuide(_Row):
 
 
 @dataclass(eq=False, repr=False)
-class FurControl(_Row):
+class FurControl(RowComponent):
     """A spatial control: `position` in the creature frame and behaviour values 0..1."""
 
     store: ControlStore
@@ -96,7 +83,7 @@ class FurControl(_Row):
 
 
 @dataclass(eq=False, repr=False)
-class Fur(_Row):
+class Fur(RowComponent):
     """A creature's fur: rig constants (`twist_max` radians, `reach` m...) and its members."""
 
     store: FurSetStore
@@ -116,7 +103,7 @@ class Fur(_Row):
 
 
 @dataclass(eq=False, repr=False)
-class Emotion(_Row):
+class Emotion(RowComponent):
     """Fear or aggression of a creature: `level` (about 0..1) and its sensing and timing."""
 
     store: EmotionStore
@@ -130,7 +117,7 @@ class Emotion(_Row):
 
 
 @dataclass(eq=False, repr=False)
-class Threat(_Row):
+class Threat(RowComponent):
     """A marked entity that frightens creatures: world `pos` (follows its keyframed path)."""
 
     store: ThreatStore

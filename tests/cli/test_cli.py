@@ -11,7 +11,7 @@ import pytest
 
 from ecs_tentacles.cli import main
 from ecs_tentacles.scene.load import bundled_scene, bundled_scene_names
-from tests.scene.test_validate import BAD_SCENES
+from tests.scene.bad_scenes import BAD_SCENES
 
 BUNDLED = {
     "asymmetric": "1 creatures, 5 tentacles",
