@@ -1,0 +1,45 @@
+"""`ecs-tentacles play`: headless output and argument errors."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from PIL import Image
+
+from ecs_tentacles.cli import main
+
+
+def test_headless_play_writes_the_screenshot(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    shot = tmp_path / "shot.png"
+    argv = ["play", "three_goals", "--headless", "--frames", "3", "--quiet"]
+    assert main([*argv, "--screenshot", str(shot), "--width", "320", "--height", "180"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert (result["frames"], result["screenshot"]) == (3, str(shot))
+    with Image.open(shot) as image:
+        assert image.size == (320, 180)
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--screenshot", "x.png"], "error: --screenshot and --video need --headless"),
+        (["--headless", "--width", "333"], "argument --width: must be an even number of pixels"),
+        (
+            ["--headless", "--video", "clip.avi"],
+            "argument --video: must end in .mp4, got 'clip.avi'",
+        ),
+    ],
+)
+def test_bad_play_arguments_exit_2(
+    argv: list[str], message: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    try:
+        code = main(["play", "octopus", *argv])
+    except SystemExit as exit_:
+        code = int(exit_.code or 0)
+    assert code == 2
+    assert message in capsys.readouterr().err
