@@ -5,7 +5,9 @@ frame is evaluated from its bind pose and its control's effective values (lift, 
 direction, random twist, the emotion system's drive added) as whole-array math; the
 guides' rest shapes are posed in world space by the mantle's Transform; guides of
 furs with the dynamic behaviour blend toward a light strand simulation from root to
-tip. A world without fur returns at once. See `ecs_tentacles.fur.rig` for the math.
+tip. A world without fur returns at once. See `ecs_tentacles.fur.rig` for the math:
+the guides go through `rig.evaluate` in blocks that share one scratch (no allocation
+per frame), by numba kernels when numba is installed, else whole-array numpy.
 
 Reads: Transform store (mantle rows), fur ControlStore (position, rest position,
 behaviour values, drives), GuideStore and FurSetStore (bind pose, re-read when
@@ -21,7 +23,7 @@ import numpy as np
 
 from ecs_tentacles.fur.bind import ControlTracks, control_values, make_bind, make_strands
 from ecs_tentacles.fur.dynamics import Strands
-from ecs_tentacles.fur.rig import Bind, local_frames, pose, quat_matrices, world_frames
+from ecs_tentacles.fur.rig import Bind, Scratch, control_table, evaluate, quat_matrices
 from ecs_tentacles.fur.tracks import TrackSet
 from ecs_tentacles.system import System
 
@@ -44,7 +46,8 @@ class Rig(System):
         self.tracks = ControlTracks(TrackSet([]))
         self.strands: Strands | None = None
         # blocks of guides evaluated one after the other, so temporaries stay in cache
-        self.blocks: list[tuple[slice, Bind, np.ndarray]] = []
+        self.blocks: list[tuple[slice, Bind]] = []
+        self.scratch = Scratch()  # work buffers, shared by the blocks and kept
 
     def rebind(self, world: World) -> None:
         """Re-read the bind pose, tracks and dynamic strands from the fur stores."""
@@ -52,7 +55,7 @@ class Rig(System):
         self.bind, self.bodies = make_bind(fur)
         n = len(self.bind)
         self.blocks = [
-            (rows, self.bind.part(rows), np.empty((4, 3, rows.stop - rows.start), np.float32))
+            (rows, self.bind.part(rows))
             for rows in (slice(s, min(s + BLOCK, n)) for s in range(0, n, BLOCK))
         ]
         self.tracks = ControlTracks(TrackSet(fur.tracks))
@@ -70,12 +73,13 @@ class Rig(System):
         assert bind is not None
         self.tracks.apply(fur.controls, world.time)
         values, dynamic = control_values(fur)
+        plan = control_table(values)  # per-control values and skips, once a frame
         rotation = quat_matrices(world.transforms.quat[self.bodies])
         position = world.transforms.pos[self.bodies]
-        for rows, part, local in self.blocks:
-            local_frames(part, values, out=local)
-            world_frames(part, local, rotation, position, out=fur.frames[rows])
-            pose(part.shape_h, fur.frames[rows], out=fur.curves[rows])
+        for rows, part in self.blocks:
+            evaluate(
+                part, plan, rotation, position, fur.frames[rows], fur.curves[rows], self.scratch
+            )
         if self.strands is not None:
             self._dynamics(fur.frames, fur.curves, bind, rotation, dynamic)
 

@@ -2,12 +2,15 @@
 
     python tools/bench_rig.py                   # median ms, synthetic arrays and the system
     python tools/bench_rig.py --sizes 10000 --repeats 50 --json
+    python tools/bench_rig.py --backend numpy   # without the numba kernels
 
-"math": the rig functions on synthetic arrays (every behaviour on: lift, aim,
-direction, random twist), posing included; "math+dynamic": the same plus the strand
-simulation on every guide; "system": `Rig.process` in a world whose creature has a
-fur of n guides (all behaviours on, controls moved, emotion off), with and without
-the dynamic behaviour. Targets on the 2-core machine: 10k <= 2 ms, 100k <= 16 ms.
+"math": `rig.evaluate` on synthetic arrays (every behaviour on: lift, aim, direction,
+random twist), in the system's blocks, world frames and posed curves included;
+"math+dynamic": the same plus the strand simulation on every guide; "system":
+`Rig.process` in a world whose creature has a fur of n guides (all behaviours on,
+controls moved, emotion off), with and without the dynamic behaviour. The backend is
+numba's kernels when numba imports (the dev extra), else numpy (see `fur.rig`).
+Targets on the 2-core machine: 10k <= 2 ms, 100k <= 16 ms.
 """
 
 from __future__ import annotations
@@ -20,9 +23,10 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
+from ecs_tentacles.systems.rig import BLOCK
 
+from ecs_tentacles.fur import rig as rig_math
 from ecs_tentacles.fur.dynamics import Strands, blend_profile
-from ecs_tentacles.fur.rig import local_frames, pose, world_frames
 from ecs_tentacles.fur.synthetic import synthetic_rig
 from ecs_tentacles.world import World
 
@@ -56,12 +60,13 @@ def bench_math(n: int, repeats: int, dynamic: bool) -> float:
         profile=blend_profile(POINTS)[:, None, None],
     )
     weight = np.full(n, 0.6, dtype=np.float32)
-    buffer = np.empty((4, 3, n), dtype=np.float32)
+    scratch = rig_math.Scratch()
+    blocks = [(rows, bind.part(rows)) for rows in (slice(s, s + BLOCK) for s in range(0, n, BLOCK))]
 
     def run() -> None:
-        local = local_frames(bind, values, out=buffer)
-        world_frames(bind, local, rotation, position, out=frames)
-        pose(bind.shape_h, frames, out=curves)
+        plan = rig_math.control_table(values)  # as `Rig.process` does: once a frame
+        for rows, part in blocks:
+            rig_math.evaluate(part, plan, rotation, position, frames[rows], curves[rows], scratch)
         if dynamic:
             rig = np.ascontiguousarray(curves.transpose(1, 2, 0))
             out = strands.step(rig, frames[:, 3].T, bind.normal, weight)
@@ -103,7 +108,10 @@ def main() -> None:
     parser.add_argument("--sizes", type=int, nargs="*", default=[1_000, 10_000, 100_000])
     parser.add_argument("--repeats", type=int, default=30)
     parser.add_argument("--json", action="store_true")
+    parser.add_argument("--backend", choices=["auto", "numpy"], default=rig_math.BACKEND)
     args = parser.parse_args()
+    rig_math.BACKEND = args.backend
+    backend = "numba" if rig_math.kernels() is not None else "numpy"
     rows = []
     for n in args.sizes:
         repeats = max(5, args.repeats * 10_000 // max(n, 10_000))
@@ -111,6 +119,7 @@ def main() -> None:
             {
                 "guides": n,
                 "points": POINTS,
+                "backend": backend,
                 "math_ms": round(bench_math(n, repeats, False), 3),
                 "math_dynamic_ms": round(bench_math(n, repeats, True), 3),
                 "system_ms": round(bench_system(n, repeats, False), 3),
@@ -120,6 +129,7 @@ def main() -> None:
     if args.json:
         print(json.dumps(rows, indent=2))
         return
+    print(f"backend: {backend}")
     print(f"{'guides':>8} {'math':>9} {'+dynamic':>9} {'system':>9} {'+dynamic':>9}   (median ms)")
     for row in rows:
         print(

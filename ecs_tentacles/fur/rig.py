@@ -19,13 +19,26 @@ continuous map (`clamp`), and a weighted sum of vectors in a cap stays in it, so
 result can neither enter the surface nor jump when controls move or cross. The frame's
 side is the (twisted) rest side made perpendicular to the result; it never degenerates
 because the result is never tangent. Frames go to world space with the body's pose and
-each guide's rest shape (homogeneous rest-frame coordinates) is posed by one batched
-matrix product. Arrays are float32; vectors are (3, n), one row per axis.
+each guide's rest shape (homogeneous rest-frame coordinates) is posed by them.
+Arrays are float32; vectors are (3, n), one row per axis.
+
+Speed (tools/bench_rig.py): `evaluate` is the per-frame entry point, called block by
+block with one `control_table` (per-control values and the behaviours in use, once a
+frame) and one `Scratch` (work buffers kept between frames). With numba installed
+(the ``dev`` extra) the kernels of `ecs_tentacles.fur.kernels` do the work, guide by
+guide on all cores; without it, the whole-array numpy code here (`local_frames`,
+`world_frames`, `pose`). ``ECS_TENTACLES_RIG=numpy`` (or `BACKEND = "numpy"`) forces
+numpy. Both give the same results within float32 rounding; a behaviour that no
+control uses is skipped by both.
 """
 
 from __future__ import annotations
 
+import importlib
+import os
+import threading
 from dataclasses import dataclass
+from types import ModuleType
 
 import numpy as np
 
@@ -39,6 +52,7 @@ class Bind:
 
     Guides are best ordered by control (the builder does it): per-control values then
     reach the guides through a few runs (`np.repeat`) instead of a gather per guide.
+    Arrays are made contiguous float32 (int64 indices) on construction.
     """
 
     root: np.ndarray
@@ -52,19 +66,33 @@ class Bind:
     shape_h: np.ndarray  # (n, points, 4): rest-frame coordinates and a 1
 
     def __post_init__(self) -> None:
+        for name in ("root", "basis", "rest_cos", "rest_sin", "tan_min", "multiplier", "shape_h"):
+            setattr(self, name, np.ascontiguousarray(getattr(self, name), dtype=F32))
+        self.control = np.ascontiguousarray(self.control, dtype=np.int64)
+        self.body = np.ascontiguousarray(self.body, dtype=np.int64)
         starts = np.flatnonzero(np.diff(self.control)) + 1
         starts = np.concatenate([[0], starts]) if len(self.control) else starts
         self.run_control = self.control[starts]
         self.run_length = np.diff(np.append(starts, len(self.control)))
+        # the kernels index without checks: `evaluate` compares these with its tables
+        self.controls_needed = int(self.control.max()) + 1 if len(self.control) else 0
+        self.bodies_needed = int(self.body.max()) + 1 if len(self.body) else 0
+        bodies = np.unique(self.body)
+        self.one_body: int | None = int(bodies[0]) if len(bodies) == 1 else None
 
     def __len__(self) -> int:
         return len(self.control)
 
     def part(self, rows: slice) -> Bind:
-        """The guides `rows` (views, no copies)."""
-        scalars = ("rest_cos", "rest_sin", "tan_min", "multiplier", "control", "body", "shape_h")
-        parts = {k: getattr(self, k)[rows] for k in scalars}
-        return Bind(root=self.root[:, rows], basis=self.basis[:, :, rows], **parts)
+        """The guides `rows`, as contiguous copies (blocks that stay in cache)."""
+        scalars = ("rest_cos", "rest_sin", "tan_min", "multiplier", "control", "body")
+        parts = {k: np.ascontiguousarray(getattr(self, k)[rows]) for k in scalars}
+        return Bind(
+            root=np.ascontiguousarray(self.root[:, rows]),
+            basis=np.ascontiguousarray(self.basis[:, :, rows]),
+            shape_h=self.shape_h[rows],
+            **parts,
+        )
 
     def spread(self, table: np.ndarray) -> np.ndarray:
         """Per-control rows (k, n_controls) -> per-guide rows (k, n), run by run."""
@@ -144,6 +172,81 @@ def clamp_to_cap(v: np.ndarray, normal: np.ndarray, tan_min: np.ndarray) -> np.n
     return normalize(v + (np.maximum(h, tan_min) - h) * normal)
 
 
+class Scratch:
+    """Float32 work buffers, made on first use and kept: no allocation per frame.
+
+    One scratch serves blocks of guides one after the other (`use(n)` before each), so
+    its buffers stay in cache between them; each buffer is a contiguous (*shape, n).
+    """
+
+    def __init__(self, n: int = 0) -> None:
+        self.n = n
+        self._memory: dict[tuple[str, tuple[int, ...]], np.ndarray] = {}
+        self._views: dict[tuple[str, tuple[int, ...], int], np.ndarray] = {}
+
+    def use(self, n: int) -> Scratch:
+        """Hand out buffers for n guides from now on."""
+        self.n = n
+        return self
+
+    def __call__(self, name: str, *shape: int) -> np.ndarray:
+        """The buffer `name` of shape (*shape, n) (contents left from its last use)."""
+        view = self._views.get((name, shape, self.n))
+        if view is None:
+            size = int(np.prod(shape, dtype=np.int64)) * self.n
+            memory = self._memory.get((name, shape))
+            if memory is None or len(memory) < size:
+                memory = self._memory[(name, shape)] = np.empty(size, dtype=F32)
+                self._views = {k: v for k, v in self._views.items() if k[:2] != (name, shape)}
+            view = self._views[(name, shape, self.n)] = memory[:size].reshape(*shape, self.n)
+        return view
+
+
+# rows of the per-control table (`control_table`)
+UNLIFT, KEEP, TWIST, TARGETS, WEIGHTS = 0, 1, 2, slice(3, 9), slice(9, 11)
+TABLE_ROWS = 11
+
+
+@dataclass
+class Plan:
+    """What one frame's controls ask of the rig: their table and which behaviours act."""
+
+    values: ControlValues
+    table: np.ndarray  # (TABLE_ROWS, n_controls) float32, the kernels' input
+    lifting: bool
+    aiming: bool
+    directing: bool
+    twisting: bool
+
+
+def control_table(values: ControlValues) -> Plan:
+    """Per-control rows, computed once a frame, that the kernels read for each guide.
+
+    Rows: 1 - lift, the rest direction's weight ``max(1 - aim - direction, 0)``, the
+    twist angle, the aim and direction targets interleaved (x_aim, x_dir, y_aim,
+    y_dir, z_aim, z_dir: position and offset) and their weights (aim, direction).
+    A behaviour whose values are all zero is skipped (the numpy path leaves out its
+    work, the kernels its trigonometry; their terms then add exact zeros), so the
+    cost follows what the controls use.
+    """
+    table = np.empty((TABLE_ROWS, len(values.lift)), dtype=F32)
+    table[UNLIFT] = F32(1.0) - values.lift
+    np.maximum(F32(1.0) - values.aim - values.direction, F32(0.0), out=table[KEEP])
+    table[TWIST] = values.twist
+    targets = table[TARGETS].reshape(3, 2, -1)
+    targets[:, 0] = values.position
+    targets[:, 1] = values.offset
+    table[WEIGHTS] = values.aim, values.direction
+    return Plan(
+        values,
+        table,
+        lifting=bool(values.lift.any()),
+        aiming=bool(values.aim.any()),
+        directing=bool(values.direction.any()),
+        twisting=bool(values.twist.any()),
+    )
+
+
 Coords = tuple[np.ndarray, np.ndarray, np.ndarray]
 
 
@@ -206,11 +309,138 @@ def skin_directions(bind: Bind, values: ControlValues) -> tuple[Coords, Coords |
     return (x, np.asarray(y), z), side
 
 
-def local_frames(bind: Bind, values: ControlValues, out: np.ndarray | None = None) -> np.ndarray:
-    """Body-local frames (4, 3, n): result axis, up (axis x side), side, and the root."""
-    if out is None:
-        out = np.empty((4, 3, len(bind)), dtype=F32)
-    (x, y, z), side = skin_directions(bind, values)
+# "auto": the numba kernels when numba imports, else numpy; "numpy": numpy always.
+BACKEND = os.environ.get("ECS_TENTACLES_RIG", "auto")
+_kernels: ModuleType | bool | None = False  # False: not looked for yet
+
+
+def kernels() -> ModuleType | None:
+    """The numba kernels (`ecs_tentacles.fur.kernels`), or None: numpy does the work."""
+    global _kernels
+    if BACKEND == "numpy":
+        return None
+    if _kernels is False:
+        module: ModuleType | None
+        try:
+            module = importlib.import_module("ecs_tentacles.fur.kernels")
+        except ImportError:  # numba is optional (the dev extra installs it)
+            module = None
+        _kernels = module
+    return _kernels if isinstance(_kernels, ModuleType) else None
+
+
+# numba's default threading layer (workqueue, without TBB) promises no thread safety:
+# worlds stepped on several threads take turns in the (parallel) kernels
+_KERNEL_LOCK = threading.Lock()
+NO_LOCAL = np.empty((4, 3, 0), dtype=F32)
+NO_WORLD = np.empty((0, 4, 3), dtype=F32)
+NO_CURVES = np.empty((0, 1, 3), dtype=F32)
+
+
+def _kernel_frames(
+    k: ModuleType,
+    bind: Bind,
+    plan: Plan,
+    s: Scratch,
+    rotation: np.ndarray,
+    position: np.ndarray,
+    local: np.ndarray,
+    world: np.ndarray,
+    curves: np.ndarray,
+) -> None:
+    """The numba passes (blend, whole-array trigonometry, frames): see `kernels`."""
+    with _KERNEL_LOCK:
+        _kernel_passes(k, bind, plan, s, rotation, position, local, world, curves)
+
+
+def _kernel_passes(
+    k: ModuleType,
+    bind: Bind,
+    plan: Plan,
+    s: Scratch,
+    rotation: np.ndarray,
+    position: np.ndarray,
+    local: np.ndarray,
+    world: np.ndarray,
+    curves: np.ndarray,
+) -> None:
+    s.use(len(bind))
+    axis, flat, unlift, angle = s("k_axis", 3), s("k_flat"), s("k_unlift"), s("k_angle")
+    normalise = (plan.aiming or plan.directing) and not plan.lifting
+    k.blend(
+        bind.control, plan.table, bind.rest_cos, bind.rest_sin, bind.tan_min, bind.multiplier,
+        bind.basis, bind.root, normalise, axis, flat, unlift, angle,
+    )  # fmt: skip
+    polar_sin, polar_cos = s("k_polar_sin"), s("k_polar_cos")
+    twist_cos, twist_sin = s("k_twist_cos"), s("k_twist_sin")
+    if plan.lifting:
+        polar = s("k_polar")
+        np.arctan2(flat, axis[2], out=polar)
+        polar *= unlift
+        np.sin(polar, out=polar_sin)
+        np.cos(polar, out=polar_cos)
+    if plan.twisting:
+        np.cos(angle, out=twist_cos)
+        np.sin(angle, out=twist_sin)
+    k.frames(
+        axis, flat, polar_sin, polar_cos, twist_cos, twist_sin, plan.lifting, plan.twisting,
+        bind.basis, bind.root, bind.body, rotation, position, local, world, bind.shape_h, curves,
+    )  # fmt: skip
+
+
+def evaluate(
+    bind: Bind,
+    values: ControlValues | Plan,
+    rotation: np.ndarray,
+    position: np.ndarray,
+    frames: np.ndarray,
+    curves: np.ndarray,
+    scratch: Scratch | None = None,
+) -> None:
+    """World frames (n, 4, 3) and posed curves (n, points, 3) of every guide, in place.
+
+    `local_frames`, `world_frames` and `pose` in one call, by the numba kernels when
+    they are there. `rotation` (n_bodies, 3, 3) and `position` (n_bodies, 3) are the
+    bodies' poses.
+    """
+    s = Scratch() if scratch is None else scratch
+    plan = values if isinstance(values, Plan) else control_table(values)
+    if bind.controls_needed > plan.table.shape[1] or bind.bodies_needed > len(rotation):
+        raise IndexError("a guide names a control or a body that the values do not have")
+    k = kernels()
+    if k is None:
+        local = local_frames(bind, plan, out=s.use(len(bind))("local", 4, 3), scratch=s)
+        world_frames(bind, local, rotation, position, out=frames, scratch=s)
+        np.matmul(bind.shape_h, frames, out=curves)
+        return
+    turn = np.ascontiguousarray(rotation, dtype=F32)
+    move = np.ascontiguousarray(position, dtype=F32)
+    _kernel_frames(k, bind, plan, s, turn, move, NO_LOCAL, frames, curves)
+
+
+def local_frames(
+    bind: Bind,
+    values: ControlValues | Plan,
+    out: np.ndarray | None = None,
+    scratch: Scratch | None = None,
+) -> np.ndarray:
+    """Body-local frames (4, 3, n): result axis, up (axis x side), side, and the root.
+
+    Give a `Plan` (`control_table(values)`) to share it between blocks of guides and a
+    `Scratch` kept between frames for the kernels' work buffers.
+    """
+    n = len(bind)
+    out = np.empty((4, 3, n), dtype=F32) if out is None else out
+    s = Scratch() if scratch is None else scratch
+    plan = values if isinstance(values, Plan) else control_table(values)
+    k = kernels()
+    if k is not None:
+        if bind.controls_needed > plan.table.shape[1]:
+            raise IndexError("a guide names a control that the values do not have")
+        one = np.eye(3, dtype=F32)[None]
+        _kernel_frames(k, bind, plan, s, one, np.zeros((1, 3), F32), out, NO_WORLD, NO_CURVES)
+        return out
+    (x, y, z), side = skin_directions(bind, plan.values)
     along, normal = bind.along, bind.normal
     if side is None:  # axis in the rest plane, side unchanged: up = (-z, 0, x)
         np.multiply(x, along, out=out[0])
@@ -227,7 +457,12 @@ def local_frames(bind: Bind, values: ControlValues, out: np.ndarray | None = Non
 
 
 def world_frames(
-    bind: Bind, local: np.ndarray, rotation: np.ndarray, position: np.ndarray, out: np.ndarray
+    bind: Bind,
+    local: np.ndarray,
+    rotation: np.ndarray,
+    position: np.ndarray,
+    out: np.ndarray,
+    scratch: Scratch | None = None,
 ) -> np.ndarray:
     """Frames (4, 3, n) to world space, written into `out` (n, 4, 3) for `pose`.
 
@@ -235,9 +470,11 @@ def world_frames(
     `bind.body` picks each guide's.
     """
     n = local.shape[2]
-    if len(rotation) == 1:  # one body: four small matrix products for all
-        turned = np.matmul(rotation[0].astype(F32), local)
-        turned[3] += position[0].astype(F32)[:, None]
+    body = bind.one_body if len(rotation) > 1 else 0
+    if body is not None:  # one body: four small matrix products for all, then one copy
+        turned = np.empty_like(local) if scratch is None else scratch.use(n)("world", 4, 3)
+        np.matmul(rotation[body].astype(F32), local, out=turned)
+        turned[3] += position[body].astype(F32)[:, None]
         out.reshape(n, 12)[...] = turned.reshape(12, n).T  # numpy copies this fast
         return out
     rows = np.ascontiguousarray(local.transpose(2, 0, 1))  # (n, 4, 3)
@@ -249,7 +486,12 @@ def world_frames(
 
 def pose(shape_h: np.ndarray, frames: np.ndarray, out: np.ndarray) -> np.ndarray:
     """World points (n, points, 3) = rest-frame coordinates x world frame, batched."""
-    return np.matmul(shape_h, frames, out=out)
+    k = kernels()
+    if k is None:
+        return np.matmul(shape_h, frames, out=out)
+    with _KERNEL_LOCK:
+        k.pose(shape_h, frames, out)
+    return out
 
 
 def quat_matrices(quat: np.ndarray) -> np.ndarray:
