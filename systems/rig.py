@@ -23,8 +23,9 @@ import numpy as np
 
 from ecs_tentacles.fur.bind import ControlTracks, control_values, make_bind, make_strands
 from ecs_tentacles.fur.dynamics import Strands
-from ecs_tentacles.fur.rig import Bind, Scratch, control_table, evaluate, quat_matrices
+from ecs_tentacles.fur.rig import Bind, Scratch, control_table, evaluate
 from ecs_tentacles.fur.tracks import TrackSet
+from ecs_tentacles.fur.vectors import quat_matrices
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:

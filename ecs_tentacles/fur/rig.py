@@ -42,8 +42,10 @@ from types import ModuleType
 
 import numpy as np
 
+from ecs_tentacles.fur.scratch import Scratch
+from ecs_tentacles.fur.vectors import TINY
+
 F32 = np.float32
-TINY = 1e-12
 
 
 @dataclass
@@ -138,68 +140,6 @@ class ControlValues:
         """All values as rows (10, n_controls): lift, aim, direction, twist, position, offset."""
         rows = [self.lift, self.aim, self.direction, self.twist, *self.position, *self.offset]
         return np.array(rows, dtype=F32).reshape(10, -1)
-
-
-def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Row-wise dot product of (3, n) arrays."""
-    result: np.ndarray = a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-    return result
-
-
-def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Row-wise cross product of (3, n) arrays."""
-    out = np.empty(np.broadcast_shapes(a.shape, b.shape), dtype=np.result_type(a, b))
-    np.subtract(a[1] * b[2], a[2] * b[1], out=out[0])
-    np.subtract(a[2] * b[0], a[0] * b[2], out=out[1])
-    np.subtract(a[0] * b[1], a[1] * b[0], out=out[2])
-    return out
-
-
-def normalize(v: np.ndarray) -> np.ndarray:
-    """Unit vectors of (3, n) `v` (zero vectors stay zero)."""
-    result: np.ndarray = v / np.maximum(np.sqrt(dot(v, v)), TINY)
-    return result
-
-
-def clamp_to_cap(v: np.ndarray, normal: np.ndarray, tan_min: np.ndarray) -> np.ndarray:
-    """Unit vectors `v` (3, n) moved continuously into the caps elevation >= atan(tan_min).
-
-    The normal component is raised to at least `tan_min` and the result normalised:
-    unchanged inside the cap (up to a sliver of width tan - sin of the bound), a vector
-    below it keeps its azimuth, and -normal goes smoothly to +normal: no jumps anywhere.
-    """
-    h = dot(v, normal)
-    return normalize(v + (np.maximum(h, tan_min) - h) * normal)
-
-
-class Scratch:
-    """Float32 work buffers, made on first use and kept: no allocation per frame.
-
-    One scratch serves blocks of guides one after the other (`use(n)` before each), so
-    its buffers stay in cache between them; each buffer is a contiguous (*shape, n).
-    """
-
-    def __init__(self, n: int = 0) -> None:
-        self.n = n
-        self._memory: dict[tuple[str, tuple[int, ...]], np.ndarray] = {}
-        self._views: dict[tuple[str, tuple[int, ...], int], np.ndarray] = {}
-
-    def use(self, n: int) -> Scratch:
-        """Hand out buffers for n guides from now on."""
-        self.n = n
-        return self
-
-    def __call__(self, name: str, *shape: int) -> np.ndarray:
-        """The buffer `name` of shape (*shape, n) (contents left from its last use)."""
-        view = self._views.get((name, shape, self.n))
-        if view is None:
-            size = int(np.prod(shape, dtype=np.int64)) * self.n
-            memory = self._memory.get((name, shape))
-            if memory is None or len(memory) < size:
-                memory = self._memory[(name, shape)] = np.empty(size, dtype=F32)
-                self._views = {k: v for k, v in self._views.items() if k[:2] != (name, shape)}
-            view = self._views[(name, shape, self.n)] = memory[:size].reshape(*shape, self.n)
-        return view
 
 
 # rows of the per-control table (`control_table`)
@@ -492,15 +432,3 @@ def pose(shape_h: np.ndarray, frames: np.ndarray, out: np.ndarray) -> np.ndarray
     with _KERNEL_LOCK:
         k.pose(shape_h, frames, out)
     return out
-
-
-def quat_matrices(quat: np.ndarray) -> np.ndarray:
-    """Rotation matrices (n, 3, 3) of unit quaternions (n, 4) (w, x, y, z)."""
-    w, x, y, z = quat.T
-    return np.stack(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
-        ]
-    ).transpose(2, 0, 1)

@@ -9,7 +9,8 @@ from __future__ import annotations
 import numpy as np
 
 from ecs_tentacles.fur.groom import arc_shapes
-from ecs_tentacles.fur.rig import F32, Bind, ControlValues, clamp_to_cap, cross, dot, normalize
+from ecs_tentacles.fur.rig import F32, Bind, ControlValues
+from ecs_tentacles.fur.vectors import clamp_to_cap, cross, dot, normalize
 
 
 def synthetic_rig(

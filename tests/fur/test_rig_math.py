@@ -11,14 +11,12 @@ from ecs_tentacles.fur.rig import (
     F32,
     Bind,
     ControlValues,
-    clamp_to_cap,
-    dot,
     local_frames,
-    normalize,
     pose,
     world_frames,
 )
 from ecs_tentacles.fur.synthetic import synthetic_rig
+from ecs_tentacles.fur.vectors import clamp_to_cap, dot, normalize
 
 N = 500
 
