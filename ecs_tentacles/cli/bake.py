@@ -17,6 +17,7 @@ from pathlib import Path
 
 from tqdm import tqdm
 
+from ecs_tentacles.cli.arguments import output_path
 from ecs_tentacles.cli.run import seed_int
 from ecs_tentacles.export import SUFFIXES, write
 from ecs_tentacles.export.bake import BakePlan, bake, output_kind
@@ -42,17 +43,7 @@ def fps_float(text: str) -> float:
     return value
 
 
-def output_file(text: str) -> Path:
-    """An output path with a known suffix, in an existing folder (argparse type)."""
-    path = Path(text)
-    if output_kind(path) is None:
-        raise argparse.ArgumentTypeError(f"must end in one of {', '.join(SUFFIXES)}, got {text!r}")
-    if path.is_dir():
-        raise argparse.ArgumentTypeError(f"{text} is a folder")
-    folder = path.parent
-    if not folder.is_dir():
-        raise argparse.ArgumentTypeError(f"folder {str(folder)!r} does not exist")
-    return path
+output_file = output_path(*SUFFIXES)  # an output path with a known suffix
 
 
 def usd_missing(path: Path) -> str | None:

@@ -18,6 +18,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from ecs_tentacles.cli.arguments import output_path
 from ecs_tentacles.cli.bake import positive_float
 from ecs_tentacles.cli.run import positive_int
 from ecs_tentacles.creator import SHAPE_KEYS, CreatureDesign, DesignError
@@ -36,14 +37,7 @@ OPTIONS = {
 }
 
 
-def json_file(text: str) -> Path:
-    """A .json output path in an existing folder (argparse type)."""
-    path = Path(text)
-    if path.suffix.lower() != ".json":
-        raise argparse.ArgumentTypeError(f"must end in .json, got {text!r}")
-    if not path.parent.is_dir():
-        raise argparse.ArgumentTypeError(f"folder {str(path.parent)!r} does not exist")
-    return path
+json_file = output_path(".json")  # a .json output path in an existing folder
 
 
 def tentacle_edit(text: str) -> tuple[int, dict[str, float]]:

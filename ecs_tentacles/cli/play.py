@@ -5,9 +5,8 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from collections.abc import Callable
-from pathlib import Path
 
+from ecs_tentacles.cli.arguments import output_path
 from ecs_tentacles.cli.run import positive_int, seed_int
 from ecs_tentacles.scene.load import resolve_scene_path
 
@@ -19,18 +18,6 @@ def even_size(text: str) -> int:
             f"must be an even number of pixels in [64, 8192], got {value}"
         )
     return value
-
-
-def output_file(suffix: str) -> Callable[[str], Path]:
-    def check(text: str) -> Path:
-        path = Path(text)
-        if path.suffix.lower() != suffix:
-            raise argparse.ArgumentTypeError(f"must end in {suffix}, got {text!r}")
-        if not path.parent.resolve().is_dir():
-            raise argparse.ArgumentTypeError(f"folder {str(path.parent)!r} does not exist")
-        return path
-
-    return check
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
@@ -47,8 +34,8 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.add_argument("scene", metavar="SCENE", help="scene file or bundled scene name")
     parser.add_argument("--headless", action="store_true", help="no window: render off-screen")
     parser.add_argument("--frames", type=positive_int, default=300, help="headless: frames to run")
-    parser.add_argument("--screenshot", type=output_file(".png"), help="headless: final PNG")
-    parser.add_argument("--video", type=output_file(".mp4"), help="headless: record an MP4")
+    parser.add_argument("--screenshot", type=output_path(".png"), help="headless: final PNG")
+    parser.add_argument("--video", type=output_path(".mp4"), help="headless: record an MP4")
     parser.add_argument("--width", type=even_size, default=1280)
     parser.add_argument("--height", type=even_size, default=720)
     parser.add_argument("--seed", type=seed_int, default=None, help="override the scene's seed")

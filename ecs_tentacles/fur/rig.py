@@ -289,43 +289,30 @@ def _kernel_frames(
     curves: np.ndarray,
 ) -> None:
     """The numba passes (blend, whole-array trigonometry, frames): see `kernels`."""
-    with _KERNEL_LOCK:
-        _kernel_passes(k, bind, plan, s, rotation, position, local, world, curves)
-
-
-def _kernel_passes(
-    k: ModuleType,
-    bind: Bind,
-    plan: Plan,
-    s: Scratch,
-    rotation: np.ndarray,
-    position: np.ndarray,
-    local: np.ndarray,
-    world: np.ndarray,
-    curves: np.ndarray,
-) -> None:
-    s.use(len(bind))
-    axis, flat, unlift, angle = s("k_axis", 3), s("k_flat"), s("k_unlift"), s("k_angle")
-    normalise = (plan.aiming or plan.directing) and not plan.lifting
-    k.blend(
-        bind.control, plan.table, bind.rest_cos, bind.rest_sin, bind.tan_min, bind.multiplier,
-        bind.basis, bind.root, normalise, axis, flat, unlift, angle,
-    )  # fmt: skip
-    polar_sin, polar_cos = s("k_polar_sin"), s("k_polar_cos")
-    twist_cos, twist_sin = s("k_twist_cos"), s("k_twist_sin")
-    if plan.lifting:
-        polar = s("k_polar")
-        np.arctan2(flat, axis[2], out=polar)
-        polar *= unlift
-        np.sin(polar, out=polar_sin)
-        np.cos(polar, out=polar_cos)
-    if plan.twisting:
-        np.cos(angle, out=twist_cos)
-        np.sin(angle, out=twist_sin)
-    k.frames(
-        axis, flat, polar_sin, polar_cos, twist_cos, twist_sin, plan.lifting, plan.twisting,
-        bind.basis, bind.root, bind.body, rotation, position, local, world, bind.shape_h, curves,
-    )  # fmt: skip
+    with _KERNEL_LOCK:  # numba's thread pool is not documented as safe to share
+        s.use(len(bind))
+        axis, flat, unlift, angle = s("k_axis", 3), s("k_flat"), s("k_unlift"), s("k_angle")
+        normalise = (plan.aiming or plan.directing) and not plan.lifting
+        k.blend(
+            bind.control, plan.table, bind.rest_cos, bind.rest_sin, bind.tan_min, bind.multiplier,
+            bind.basis, bind.root, normalise, axis, flat, unlift, angle,
+        )  # fmt: skip
+        polar_sin, polar_cos = s("k_polar_sin"), s("k_polar_cos")
+        twist_cos, twist_sin = s("k_twist_cos"), s("k_twist_sin")
+        if plan.lifting:
+            polar = s("k_polar")
+            np.arctan2(flat, axis[2], out=polar)
+            polar *= unlift
+            np.sin(polar, out=polar_sin)
+            np.cos(polar, out=polar_cos)
+        if plan.twisting:
+            np.cos(angle, out=twist_cos)
+            np.sin(angle, out=twist_sin)
+        k.frames(
+            axis, flat, polar_sin, polar_cos, twist_cos, twist_sin, plan.lifting,
+            plan.twisting, bind.basis, bind.root, bind.body, rotation, position, local, world,
+            bind.shape_h, curves,
+        )  # fmt: skip
 
 
 def evaluate(
