@@ -40,6 +40,7 @@ from ecs_tentacles.system import System
 
 C = TypeVar("C")
 FUR_SYSTEMS = ("emotion", "rig")  # kept with locomotion off: fur is not locomotion
+PHYSICS_SYSTEMS = ("physics", "physics_health", "physics_sync")
 
 
 @dataclass(frozen=True)
@@ -51,6 +52,8 @@ class Settings:
     gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)
     ground_friction: float = 1.0
     sucker_timeconst: float = 0.005
+    max_speed: float = 30.0  # m/s: a body faster than this has blown up (physics/health.py)
+    max_penetration: float = 0.05  # m: a contact deeper than this has blown up
 
     @property
     def dt(self) -> float:
@@ -96,6 +99,7 @@ class World:
         seed: int | None = None,
         allow_systems: bool = False,
         locomotion: bool = True,
+        threads: int | None = None,
     ) -> World:
         """Build a world from a scene file, bundled scene name or dict.
 
@@ -103,7 +107,9 @@ class World:
 
         Raises `SceneError` (one line per problem) before anything is built. Systems the
         scene names are imported only with `allow_systems=True`. With `locomotion=False`
-        only the physics systems run, so scripts drive the motors themselves.
+        only the physics systems run, so scripts drive the motors themselves. `threads`
+        steps the physics groups on that many threads (default: one per core); results
+        do not depend on it.
         """
         from ecs_tentacles.build import build_creature
         from ecs_tentacles.fur.build import build_threats
@@ -130,6 +136,8 @@ class World:
             gravity=tuple(float(g) for g in physics["gravity"]),  # type: ignore[arg-type]
             ground_friction=float(physics["ground_friction"]),
             sucker_timeconst=float(physics["sucker_timeconst"]),
+            max_speed=float(physics.get("max_speed", Settings.max_speed)),
+            max_penetration=float(physics.get("max_penetration", Settings.max_penetration)),
         )
         world = cls(
             settings, seed=data["seed"] if seed is None else seed, name=data.get("name", "scene")
@@ -138,17 +146,22 @@ class World:
         for creature in data["creatures"]:
             build_creature(world, creature)
         build_threats(world, data["threats"])
-        world.build_physics()
+        world.build_physics(threads)
         systems = builtin_systems()
         if not locomotion:
-            systems = [s for s in systems if s.name in ("physics", "physics_sync", *FUR_SYSTEMS)]
+            systems = [s for s in systems if s.name in (*PHYSICS_SYSTEMS, *FUR_SYSTEMS)]
         world.add_systems(*systems, *(factory() for factory in extra))
         return world
 
-    def build_physics(self) -> PhysicsBackend:
-        """Compile the MuJoCo model from the current entities and sync the Transform store."""
+    def build_physics(self, threads: int | None = None) -> PhysicsBackend:
+        """Compile the physics groups from the current entities and sync the Transform store.
+
+        `threads` steps the groups on that many threads (default: one per core).
+        """
         self.activate()
-        self._physics = PhysicsBackend(self)
+        if self._physics is not None:
+            self._physics.close()
+        self._physics = PhysicsBackend(self, threads)
         self._physics.sync(self.transforms)
         return self._physics
 
@@ -237,6 +250,10 @@ class World:
             return iter(esper.get_component(kinds[0]))
         return iter(esper.get_components(*kinds))
 
+    def creature_name(self, entity: int) -> str:
+        """The name of creature `entity`."""
+        return self.component(entity, Creature).name
+
     def creature(self, name: str) -> int:
         """The entity of the creature called `name`."""
         for entity, creature in self.query(Creature):
@@ -246,11 +263,20 @@ class World:
         raise KeyError(f"no creature named {name!r}; this world has: {names}")
 
     def close(self) -> None:
-        """Delete this world's esper context."""
+        """Stop the physics threads and delete this world's esper context."""
+        if self._physics is not None:
+            self._physics.close()
         if esper.current_world == self.context:
             esper.switch_world("default")
         if self.context in esper.list_worlds():
             esper.delete_world(self.context)
+
+
+    def __enter__(self) -> World:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
 
 
 def _import_systems(paths: list[str]) -> list[type[System]]:

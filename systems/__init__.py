@@ -8,10 +8,12 @@ writes; `World.schedule.names` shows the resolved order, user systems included):
 3. action_queue        action timers advance; finished actions give way to the next
 4. motor_targets       action poses + travelling waves -> joint targets; writhing -> gains
 5. suckers             attach at the ground on command; release on command, stretch or reach
-6. physics             motor targets, gains and sucker switches -> MuJoCo; mj_step x substeps
-7. physics_sync        MuJoCo body poses -> Transform store
-8. emotion             threats near -> fear/aggression level -> fur controls' lift and random
-9. rig                 fur guides posed from mantle poses and controls (tracks, dynamic blend)
+6. physics             motor targets, gains, sucker switches, contact proxies -> every physics
+                       group; mj_step x substeps on the thread pool
+7. physics_health      blow-ups found per creature; that creature restored to its last good state
+8. physics_sync        MuJoCo body poses -> Transform store
+9. emotion             threats near -> fear/aggression level -> fur controls' lift and random
+10. rig                fur guides posed from mantle poses and controls (tracks, dynamic blend)
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ from ecs_tentacles.systems.emotion import EmotionSystem
 from ecs_tentacles.systems.goals import Goals
 from ecs_tentacles.systems.motor_targets import MotorTargets
 from ecs_tentacles.systems.physics import Physics
+from ecs_tentacles.systems.physics_health import PhysicsHealth
 from ecs_tentacles.systems.physics_sync import PhysicsSync
 from ecs_tentacles.systems.rig import Rig
 from ecs_tentacles.systems.suckers import Suckers
@@ -34,6 +37,7 @@ __all__ = [
     "Goals",
     "MotorTargets",
     "Physics",
+    "PhysicsHealth",
     "PhysicsSync",
     "Rig",
     "Suckers",
@@ -51,6 +55,7 @@ def builtin_systems() -> list[System]:
         MotorTargets(),
         Suckers(),
         Physics(),
+        PhysicsHealth(),
         PhysicsSync(),
         EmotionSystem(),
         Rig(),

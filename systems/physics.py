@@ -1,8 +1,10 @@
 """physics: steps MuJoCo one frame.
 
 Reads: Motor store (target, strength, damping, max_torque), Sucker store (attached,
-anchor). Writes: MjData (ctrl, eq_active), MjModel servo gains and sucker anchors,
-then advances `world.settings.substeps` steps. Systems that override
+anchor), Transform store (where other creatures are). Writes, in every physics group:
+MjData (ctrl, eq_active, contact proxies' mocap poses), MjModel servo gains, sucker
+anchors and proxy sizes; then advances `world.settings.substeps` steps, the groups in
+parallel. Systems that override
 `System.substep` run before every substep, in schedule order.
 """
 
@@ -23,6 +25,7 @@ class Physics(System):
         backend = world.physics
         backend.write_controls(world.motors)
         backend.write_suckers(world.suckers)
+        backend.proxies.update(world.transforms)
         hooks = world.schedule.substep_systems()
         if not hooks:
             backend.step(world.settings.substeps)

@@ -48,7 +48,9 @@ def test_installed_package_beside_a_user_systems_package(tmp_path: Path) -> None
     where = str(Path(ecs_tentacles.__file__).parents[1])
     result = _run(USER_CHECK.format(where=where), _user_project(tmp_path))
     assert result.returncode == 0, result.stderr
-    assert result.stdout.strip().endswith("'physics', 'physics_sync', 'emotion', 'rig']")
+    assert result.stdout.strip().endswith(
+        "'physics', 'physics_health', 'physics_sync', 'emotion', 'rig']"
+    )
 
 
 @pytest.mark.skipif(not (ROOT / "pyproject.toml").exists(), reason="needs the source tree")

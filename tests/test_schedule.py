@@ -52,6 +52,7 @@ BUILTIN = [
     "motor_targets",
     "suckers",
     "physics",
+    "physics_health",
     "physics_sync",
     "emotion",
     "rig",
@@ -62,7 +63,13 @@ def test_builtin_order(make_world: Callable[..., World]) -> None:
     world = make_world(creature_scene(count=3, links=2))
     assert world.schedule.names == BUILTIN
     physics_only = make_world(creature_scene(count=3, links=2), locomotion=False)
-    assert physics_only.schedule.names == ["physics", "physics_sync", "emotion", "rig"]
+    assert physics_only.schedule.names == [
+        "physics",
+        "physics_health",
+        "physics_sync",
+        "emotion",
+        "rig",
+    ]
 
 
 def test_probe_records_frame_and_substep_order(make_world: Callable[..., World]) -> None:
@@ -75,6 +82,7 @@ def test_probe_records_frame_and_substep_order(make_world: Callable[..., World])
         "substep_probe",
         "early",
         "physics",
+        "physics_health",
         "physics_sync",
         "emotion",
         "rig",

@@ -32,7 +32,7 @@ def test_step_advances_the_fixed_clock(make_world: Callable[..., World]) -> None
     world.step(25)
     assert world.time == 0.5
     assert world.physics.time == pytest.approx(0.5, abs=1e-12)
-    assert world.physics.model.opt.timestep == 0.005
+    assert world.physics.groups[0].model.opt.timestep == 0.005
 
 
 def test_goals_become_entities_in_path_order(make_world: Callable[..., World]) -> None:
@@ -95,7 +95,14 @@ def test_scene_systems_are_not_imported_unless_allowed(
         World.from_scene(scene)
     assert user_system_module not in sys.modules
     world = make_world(scene, allow_systems=True)
-    assert world.schedule.names[-5:] == ["physics", "physics_sync", "emotion", "rig", "counter"]
+    assert world.schedule.names[-6:] == [
+        "physics",
+        "physics_health",
+        "physics_sync",
+        "emotion",
+        "rig",
+        "counter",
+    ]
     world.step(3)
     assert type(world.schedule["counter"]).frames == 3  # type: ignore[attr-defined]
 

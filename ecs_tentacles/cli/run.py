@@ -51,13 +51,42 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--allow-systems", action="store_true", help="import and run the systems the scene names"
     )
+    add_physics_arguments(parser)
     parser.set_defaults(handler=handle)
+
+
+def add_physics_arguments(parser: argparse.ArgumentParser) -> None:
+    """`--threads` and `--strict`, shared by the commands that simulate."""
+    parser.add_argument(
+        "--threads",
+        type=positive_int,
+        default=None,
+        help="threads that step the physics groups (default: one per core); results are the same",
+    )
+    parser.add_argument(
+        "--strict",
+        action="store_true",
+        help="exit 1 if any creature's physics had to be recovered or frozen",
+    )
+
+
+def health_line(summary: dict[str, Any]) -> str:
+    """One sentence about recoveries, for the human-readable reports ('' when none)."""
+    if not summary["recoveries"]:
+        return ""
+    causes = ", ".join(f"{k} {v}" for k, v in sorted(summary["recovery_causes"].items()))
+    return (
+        f"physics recovered {summary['recoveries']} times ({causes}),"
+        f" {summary['frozen']} creatures frozen"
+    )
 
 
 def handle(args: argparse.Namespace) -> int:
     path = resolve_scene_path(args.scene)
     build_start = time.perf_counter()
-    world = World.from_scene(path, seed=args.seed, allow_systems=args.allow_systems)
+    world = World.from_scene(
+        path, seed=args.seed, allow_systems=args.allow_systems, threads=args.threads
+    )
     build_seconds = time.perf_counter() - build_start
     summary = simulate(world, args.frames, progress=not args.quiet)
     summary = {"scene": str(path), **summary, "build_seconds": round(build_seconds, 4)}
@@ -72,12 +101,15 @@ def handle(args: argparse.Namespace) -> int:
             f" {summary['dofs']} dofs); goals reached {summary['goals_reached']},"
             f" left {summary['goals_left']}; sucker attaches {summary['sucker_attaches']}"
         )
-    return 0
+        if health_line(summary):
+            print(f"warning: {health_line(summary)}", file=sys.stderr)
+    world.close()
+    return 1 if args.strict and summary["recoveries"] else 0
 
 
 def simulate(world: World, frames: int, *, progress: bool = True) -> dict[str, Any]:
     """Step `world` for `frames` frames and return timing and size figures."""
-    model = world.physics.model
+    physics = world.physics
     chunk = max(1, round(world.settings.fps / 10))
     start_time = world.time
     wall_start = time.perf_counter()
@@ -99,9 +131,13 @@ def simulate(world: World, frames: int, *, progress: bool = True) -> dict[str, A
         "wall_seconds": round(wall, 4),
         "real_time_factor": round(sim / wall, 3) if wall > 0 else None,
         "creatures": len(list(world.query(Creature))),
-        "bodies": int(model.nbody - 1),
-        "dofs": int(model.nv),
-        "physics_resets": int(world.physics.resets),
+        "bodies": physics.bodies,
+        "dofs": physics.dofs,
+        "groups": len(physics.groups),
+        "threads": physics.threads,
+        "recoveries": physics.health.recoveries,
+        "recovery_causes": dict(physics.health.causes),
+        "frozen": physics.health.frozen,
         "goals_reached": int(world.events.counts["goal_reached"]),
         "goals_left": int(sum(len(world.goals.path(e)) for e, _ in world.query(Creature))),
         "sucker_attaches": int(world.events.counts["sucker_attached"]),

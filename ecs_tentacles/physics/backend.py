@@ -1,96 +1,188 @@
-"""The compiled MuJoCo model and data, with index arrays from store rows to ids.
+"""The physics groups of a world, stepped in parallel, with store-row index maps.
 
-Built once per scene (`PhysicsBackend(world)`); per frame only array copies run:
-`write_controls` (motor targets and gains), `write_suckers` (equality switches and
-anchors), `step` (`mj_step` x substeps) and `sync` (body poses -> Transform store).
+Built once per scene (`PhysicsBackend(world)`): every creature becomes a physics
+group (`ecs_tentacles.physics.group`); creatures of one morphology share one compiled
+model (`compiles` counts the compilations). Per frame only array copies run:
+`write_controls` (motor targets and gains scattered to every group), `write_suckers`
+(equality switches and anchors), `step` (`mj_step` x substeps for every active group,
+on a thread pool: MuJoCo releases the GIL) and `sync` (body poses gathered back into
+the Transform store). Systems stay whole-array and never see the groups.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import logging
+import os
+from collections.abc import Callable, Sequence
+from concurrent.futures import ThreadPoolExecutor
 from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
 
-from ecs_tentacles.physics.model import build_spec
+from ecs_tentacles.components import Creature, Transform
+from ecs_tentacles.physics.group import PhysicsGroup
+from ecs_tentacles.physics.health import PhysicsHealth
+from ecs_tentacles.physics.model import build_spec, creature_layout
+from ecs_tentacles.physics.proxies import ContactProxies
 
 if TYPE_CHECKING:
     from ecs_tentacles.store import MotorStore, SuckerStore, TransformStore
     from ecs_tentacles.world import World
 
+log = logging.getLogger("ecs_tentacles.mujoco")
 
-def _ids(model: mujoco.MjModel, kind: mujoco.mjtObj, names: list[str]) -> np.ndarray:
-    return np.array([mujoco.mj_name2id(model, kind, n) for n in names], dtype=np.int64)
+
+def _log_mujoco_warning(message: str) -> None:
+    log.warning("%s", message.strip())
+
+
+def route_mujoco_messages() -> None:
+    """Send MuJoCo's warnings to `logging`, never to MUJOCO_LOG.TXT in the working folder."""
+    mujoco.set_mju_user_warning(_log_mujoco_warning)
 
 
 class PhysicsBackend:
-    """MuJoCo model + data for a world, with entity-row -> MuJoCo-id maps."""
+    """Every creature's physics group, the thread pool that steps them, and index maps."""
 
-    def __init__(self, world: World):
-        self.spec, names = build_spec(world)
-        self.model = self.spec.compile()
-        self.data = mujoco.MjData(self.model)
-        obj = mujoco.mjtObj
-        # transform row -> body id
-        self.body_ids = _ids(self.model, obj.mjOBJ_BODY, names.bodies)
-        # actuator i drives motor row actuator_motor_rows[i], hinge actuator_axes[i]
-        actuator_ids = _ids(self.model, obj.mjOBJ_ACTUATOR, names.actuators)
-        order = np.argsort(actuator_ids)
-        self.actuator_motor_rows = np.asarray(names.actuator_motor_rows, dtype=np.int64)[order]
-        self.actuator_target_index = (
-            self.actuator_motor_rows * 3 + np.asarray(names.actuator_axes, dtype=np.int64)[order]
-        )
-        self.actuator_dof = self.model.jnt_dofadr[self.model.actuator_trnid[:, 0]]
-        # sucker row -> equality id
-        self.equality_ids = _ids(self.model, obj.mjOBJ_EQUALITY, names.equalities)
-        self.mantle_qpos = self.model.jnt_qposadr[
-            _ids(self.model, obj.mjOBJ_JOINT, names.mantle_joints)
-        ]
-        self.resets = 0
-        mujoco.mj_forward(self.model, self.data)
+    def __init__(self, world: World, threads: int | None = None):
+        route_mujoco_messages()
+        self.threads = max(1, threads if threads is not None else os.cpu_count() or 1)
+        self.compiles = 0
+        self.time = 0.0
+        templates: dict[tuple, mujoco.MjModel] = {}
+        self.groups: list[PhysicsGroup] = []
+        for entity, (creature, transform) in sorted(world.query(Creature, Transform)):
+            layout = creature_layout(world, creature, transform)
+            template = templates.get(layout.key)
+            if template is None:
+                template = templates[layout.key] = build_spec(world, creature).compile()
+                self.compiles += 1
+            pose = (np.array(transform.pos), np.array(transform.quat))
+            group = PhysicsGroup(
+                len(self.groups), entity, creature.row, layout, template, pose
+            )
+            self.groups.append(group)
+        self.group_of_creature_row = np.full(len(world.creatures), -1, dtype=np.int64)
+        for group in self.groups:
+            self.group_of_creature_row[group.creature_row] = group.index
+        self.proxies = ContactProxies(self.groups)
+        self.health = PhysicsHealth(world, self.groups)
+        self._pool = ThreadPoolExecutor(self.threads) if self.threads > 1 else None
 
     # -- per frame -------------------------------------------------------------------
     def write_controls(self, motors: MotorStore) -> None:
         """Targets into `ctrl`; kp = strength x gain, kv = damping x gain; torque limits."""
-        m, d = self.model, self.data
-        np.take(motors.target.reshape(-1), self.actuator_target_index, out=d.ctrl, mode="clip")
-        rows = self.actuator_motor_rows
-        gain = motors.gain[rows]
-        kp = motors.strength[rows] * gain
-        m.actuator_gainprm[:, 0] = kp
-        m.actuator_biasprm[:, 1] = -kp
-        m.actuator_biasprm[:, 2] = -motors.damping[rows] * gain
-        torque = motors.max_torque[rows]
-        m.actuator_forcerange[:, 0] = -torque
-        m.actuator_forcerange[:, 1] = torque
+        target = motors.target.reshape(-1)
+        kp_all = motors.strength * motors.gain
+        kv_all = motors.damping * motors.gain
+        torque_all = motors.max_torque
+        for group in self.groups:
+            if not group.active:
+                continue
+            m, rows = group.model, group.actuator_motor_rows
+            np.take(target, group.actuator_target_index, out=group.data.ctrl, mode="clip")
+            kp = kp_all[rows] * group.soften if group.soften != 1.0 else kp_all[rows]
+            m.actuator_gainprm[:, 0] = kp
+            m.actuator_biasprm[:, 1] = -kp
+            m.actuator_biasprm[:, 2] = -kv_all[rows]
+            torque = torque_all[rows]
+            m.actuator_forcerange[:, 0] = -torque
+            m.actuator_forcerange[:, 1] = torque
 
     def write_suckers(self, suckers: SuckerStore) -> None:
         """Switch sucker equalities on/off and place their world anchors."""
-        if not len(self.equality_ids):
-            return
-        self.model.eq_data[self.equality_ids, 3:6] = suckers.anchor
-        self.data.eq_active[self.equality_ids] = suckers.attached
+        anchor, attached = suckers.anchor, suckers.attached
+        for group in self.groups:
+            if not len(group.equality_ids) or not group.active:
+                continue
+            rows = group.sucker_rows
+            group.model.eq_data[group.equality_ids, 3:6] = anchor[rows]
+            group.data.eq_active[group.equality_ids] = attached[rows]
 
     def step(self, substeps: int, before_substep: Callable[[int], None] | None = None) -> None:
-        """Advance `substeps` physics steps, calling `before_substep(i)` first if given."""
-        m, d = self.model, self.data
-        bad = mujoco.mjtWarning.mjWARN_BADQACC
-        warnings_before = d.warning[bad].number
+        """Advance every active group `substeps` steps; `before_substep(i)` runs first if given.
+
+        Groups never read each other's data, so the result does not depend on the
+        number of threads. Asleep or frozen groups keep their state; the clock moves on.
+        """
+        active = [g for g in self.groups if g.active]
         if before_substep is None:
-            mujoco.mj_step(m, d, nstep=substeps)
+            self._run(active, substeps)
         else:
             for i in range(substeps):
                 before_substep(i)
-                mujoco.mj_step(m, d)
-        self.resets += d.warning[bad].number - warnings_before
+                self._run(active, 1)
+        self.time += substeps * self.substep_dt
+
+    def step_bare(self, datas: Sequence[mujoco.MjData], substeps: int) -> None:
+        """Step `datas` (one per group, in group order) on this pool, with nothing else.
+
+        For benchmarks: the framework's cost is a frame minus this.
+        """
+        pairs = [(g.model, d) for g, d in zip(self.groups, datas, strict=True)]
+        self._map(pairs, substeps)
+
+    def _run(self, groups: list[PhysicsGroup], substeps: int) -> None:
+        self._map([(g.model, g.data) for g in groups], substeps)
+
+    def _map(self, pairs: list[tuple[mujoco.MjModel, mujoco.MjData]], substeps: int) -> None:
+        if self._pool is None or len(pairs) < 2:
+            for m, d in pairs:
+                mujoco.mj_step(m, d, nstep=substeps)
+            return
+        chunks = _balanced_chunks(pairs, self.threads)
+        for future in [self._pool.submit(_step_chunk, c, substeps) for c in chunks]:
+            future.result()
 
     def sync(self, transforms: TransformStore) -> None:
-        """Copy every body's world pose into the Transform store (one gather per field)."""
-        np.take(self.data.xpos, self.body_ids, axis=0, out=transforms.pos, mode="clip")
-        np.take(self.data.xquat, self.body_ids, axis=0, out=transforms.quat, mode="clip")
+        """Copy every body's world pose into the Transform store (one gather per group)."""
+        pos, quat = transforms.pos, transforms.quat
+        for group in self.groups:
+            pos[group.body_rows] = group.data.xpos[group.body_ids]
+            quat[group.body_rows] = group.data.xquat[group.body_ids]
 
     # -- queries ---------------------------------------------------------------------
     @property
-    def time(self) -> float:
-        return float(self.data.time)
+    def substep_dt(self) -> float:
+        return float(self.groups[0].model.opt.timestep) if self.groups else 0.0
+
+    def group_of(self, creature: Creature) -> PhysicsGroup:
+        """The group that simulates `creature`."""
+        return self.groups[int(self.group_of_creature_row[creature.row])]
+
+    @property
+    def bodies(self) -> int:
+        """Creature bodies in all groups (proxies not counted)."""
+        return int(sum(len(g.body_ids) for g in self.groups))
+
+    @property
+    def dofs(self) -> int:
+        return int(sum(g.model.nv for g in self.groups))
+
+    def close(self) -> None:
+        """Stop the thread pool."""
+        if self._pool is not None:
+            self._pool.shutdown(wait=True)
+            self._pool = None
+
+    def __repr__(self) -> str:
+        return (
+            f"<physics: {len(self.groups)} groups, {self.compiles} compiled models,"
+            f" {self.threads} threads>"
+        )
+
+
+def _step_chunk(pairs: list[tuple[mujoco.MjModel, mujoco.MjData]], substeps: int) -> None:
+    for m, d in pairs:
+        mujoco.mj_step(m, d, nstep=substeps)
+
+
+def _balanced_chunks(
+    pairs: list[tuple[mujoco.MjModel, mujoco.MjData]], threads: int
+) -> list[list[tuple[mujoco.MjModel, mujoco.MjData]]]:
+    """Split `pairs` into at most `threads` contiguous runs of about equal dofs."""
+    cost = np.cumsum([m.nv + 1 for m, _ in pairs], dtype=np.float64)
+    cuts = np.searchsorted(cost, cost[-1] * np.arange(1, threads) / threads)
+    bounds = [0, *cuts.tolist(), len(pairs)]
+    return [pairs[a:b] for a, b in zip(bounds[:-1], bounds[1:], strict=True) if b > a]

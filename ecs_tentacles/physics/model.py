@@ -1,4 +1,9 @@
-"""Entities -> a MuJoCo model built in code with `mujoco.MjSpec`.
+"""One creature's entities -> a MuJoCo model built in code with `mujoco.MjSpec`.
+
+Every creature is its own physics group (`ecs_tentacles.physics.group`): a model
+holding that creature alone, built at the origin and placed by its free joint, so
+creatures of one morphology share one compiled model (`morphology_key` says which
+ones match; the backend compiles each key once and copies the compiled model).
 
 * mantle: a body with a free joint and a cylinder geom (height along +z);
 * link: a body with a capsule geom along its local +x; its joint to the parent (the
@@ -7,19 +12,20 @@
   sweep (about local +z; positive swings counter-clockwise) and optional twist
   (about local +x), each driven by a position servo (kp = strength, kv = damping);
 * sucker: an inactive `connect` equality between its link and the world;
-* ground: an infinite plane. Creatures touch the ground and each other, never
-  themselves: creature k's geoms carry collision bit 1 + k % 30 and accept every
-  creature bit but their own (creatures 30 apart in a scene therefore pass through
-  each other).
+* ground: an infinite plane;
+* contact proxies: a pool of kinematic (mocap) capsules and cylinders that the
+  backend places where other creatures' bodies are, so creatures in different
+  models push each other (`ecs_tentacles.physics.proxies`). A creature touches the
+  ground and the proxies, never itself; proxies touch only the creature.
 
-Every element gets a stable name (`octo/t3/l07/curl`); `ModelNames` lists them per
-store row so the backend can look ids up once after compiling.
+Element names are the same in every creature's model (`t3/l07/curl`); `Layout`
+lists, in model order, which store rows they belong to.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import mujoco
 import numpy as np
@@ -28,21 +34,17 @@ from ecs_tentacles.components import Creature, Link, Motor, Sucker, Tentacle, Tr
 from ecs_tentacles.mathutil import quat_about_z
 
 if TYPE_CHECKING:
-    from ecs_tentacles.world import World
+    from ecs_tentacles.world import Settings, World
 
 AXES = {"curl": (0.0, 1.0, 0.0), "sweep": (0.0, 0.0, 1.0), "twist": (1.0, 0.0, 0.0)}
 AXIS_INDEX = {"curl": 0, "sweep": 1, "twist": 2}
 JOINT_ARMATURE = 0.002
-GROUND_BIT = 1
-CREATURE_BITS = 30
-ALL_CREATURES = ((1 << CREATURE_BITS) - 1) << 1
-
-
-def collision_bits(index: int) -> tuple[int, int]:
-    """(contype, conaffinity) of creature `index`: touches the ground and other creatures."""
-    own = 1 << (1 + index % CREATURE_BITS)
-    return own, GROUND_BIT | (ALL_CREATURES & ~own)
-
+GROUND_BIT, CREATURE_BIT, PROXY_BIT = 1, 2, 4
+# Proxy pool per model: enough capsules for the nearest links of the creatures around
+# (the nearest are chosen when more are near), a few cylinders for their mantles.
+PROXY_CAPSULES = 64
+PROXY_CYLINDERS = 4
+PROXY_PARK = np.array([1.0e4, 0.0, -1.0e4])  # unused proxies wait here, 10 m apart
 
 # MuJoCo takes the larger friction of two touching geoms: creature skin is zero so the
 # scene's ground_friction alone sets how creatures slide.
@@ -55,74 +57,114 @@ SUCKER_SOLIMP = [0.97, 0.995, 0.001, 0.5, 2.0]
 
 
 @dataclass
-class ModelNames:
-    """Names of the MuJoCo elements, in store-row order."""
+class Layout:
+    """Which store rows a creature model's elements belong to, in model-building order."""
 
-    bodies: list[str] = field(default_factory=list)  # per transform row
+    key: tuple[Any, ...]  # the morphology: equal keys compile to equal models
+    body_rows: list[int] = field(default_factory=list)  # transform row per body name
+    bodies: list[str] = field(default_factory=list)
     actuators: list[str] = field(default_factory=list)  # one per hinge
     actuator_motor_rows: list[int] = field(default_factory=list)
     actuator_axes: list[int] = field(default_factory=list)
-    equalities: list[str] = field(default_factory=list)  # per sucker row
-    mantle_joints: list[str] = field(default_factory=list)
+    equalities: list[str] = field(default_factory=list)  # one per sucker
+    sucker_rows: list[int] = field(default_factory=list)
 
 
-def build_spec(world: World) -> tuple[mujoco.MjSpec, ModelNames]:
-    """An MjSpec of the whole scene and the names of its elements by store row."""
+def creature_layout(world: World, creature: Creature, transform: Transform) -> Layout:
+    """The creature's morphology key and its rows, without building anything."""
+    key: list[Any] = [
+        _settings_key(world.settings),
+        (creature.mantle_radius, creature.mantle_height, creature.mantle_density),
+    ]
+    layout = Layout(key=())
+    layout.bodies.append("mantle")
+    layout.body_rows.append(transform.row)
+    for tentacle_entity in creature.tentacles:
+        tentacle = world.component(tentacle_entity, Tentacle)
+        links: list[tuple[Any, ...]] = []
+        for link_entity in tentacle.links:
+            link = world.component(link_entity, Link)
+            prefix = f"t{tentacle.index}/l{link.index:02d}"
+            layout.bodies.append(prefix)
+            layout.body_rows.append(world.component(link_entity, Transform).row)
+            motor = world.component(link_entity, Motor)
+            for hinge in _hinges(link):
+                layout.actuators.append(f"{prefix}/{hinge}")
+                layout.actuator_motor_rows.append(motor.row)
+                layout.actuator_axes.append(AXIS_INDEX[hinge])
+            links.append(
+                (link.length, link.radius, link.density, link.joint_limit, link.twist, link.scale)
+            )
+        suckers: list[tuple[Any, ...]] = []
+        for sucker_entity in tentacle.suckers:
+            sucker = world.component(sucker_entity, Sucker)
+            index = tentacle.links.index(sucker.link)
+            layout.equalities.append(f"t{tentacle.index}/sucker{len(layout.equalities)}")
+            layout.sucker_rows.append(sucker.row)
+            suckers.append((index, *np.asarray(sucker.offset).tolist()))
+        key.append((tentacle.base_angle, tuple(links), tuple(suckers)))
+    layout.key = tuple(key)
+    return layout
+
+
+def _settings_key(settings: Settings) -> tuple[Any, ...]:
+    return (settings.substep_dt, tuple(settings.gravity), settings.ground_friction,
+            settings.sucker_timeconst)  # fmt: skip
+
+
+def _hinges(link: Link) -> tuple[str, ...]:
+    return ("curl", "sweep", "twist") if link.twist else ("curl", "sweep")
+
+
+def build_spec(world: World, creature: Creature) -> mujoco.MjSpec:
+    """An MjSpec of `creature` alone, its mantle at the origin, with the proxy pool."""
     settings = world.settings
     spec = mujoco.MjSpec()
-    spec.modelname = "ecs_tentacles"
+    spec.modelname = "ecs_tentacles_creature"
     spec.compiler.degree = False  # joint ranges are radians
     spec.option.timestep = settings.substep_dt
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
     spec.option.gravity = list(settings.gravity)
+    # The framework, not MuJoCo, decides what happens after a blow-up (physics/health.py).
+    spec.option.disableflags |= mujoco.mjtDisableBit.mjDSBL_AUTORESET
     spec.worldbody.add_geom(
         name="ground",
         type=mujoco.mjtGeom.mjGEOM_PLANE,
         size=[0.0, 0.0, 1.0],
         friction=[settings.ground_friction, 0.005, 0.0001],
         contype=GROUND_BIT,
-        conaffinity=ALL_CREATURES,
+        conaffinity=CREATURE_BIT,
         solref=CONTACT_SOLREF,
     )
-    names = ModelNames(bodies=[""] * len(world.transforms))
-    for index, (_, (creature, transform)) in enumerate(sorted(world.query(Creature, Transform))):
-        _add_creature(spec, world, creature, transform, names, collision_bits(index))
-    if any(not name for name in names.bodies):
-        raise RuntimeError("a Transform row has no body: build entities with ecs_tentacles.build")
-    return spec, names
+    _add_creature(spec, world, creature)
+    _add_proxies(spec)
+    return spec
 
 
-def _add_creature(
-    spec: mujoco.MjSpec,
-    world: World,
-    creature: Creature,
-    transform: Transform,
-    names: ModelNames,
-    bits: tuple[int, int],
-) -> None:
-    mantle = spec.worldbody.add_body(
-        name=f"{creature.name}/mantle", pos=transform.pos, quat=transform.quat
-    )
-    mantle.add_freejoint(name=f"{creature.name}/root")
+def _add_creature(spec: mujoco.MjSpec, world: World, creature: Creature) -> None:
+    skin = {
+        "contype": CREATURE_BIT,
+        "conaffinity": GROUND_BIT | PROXY_BIT,
+        "friction": SKIN_FRICTION,
+        "solref": CONTACT_SOLREF,
+    }
+    mantle = spec.worldbody.add_body(name="mantle")
+    mantle.add_freejoint(name="root")
     mantle.add_geom(
-        name=f"{creature.name}/mantle",
+        name="mantle",
         type=mujoco.mjtGeom.mjGEOM_CYLINDER,
         size=[creature.mantle_radius, 0.5 * creature.mantle_height, 0.0],
         density=creature.mantle_density,
-        contype=bits[0],
-        conaffinity=bits[1],
-        friction=SKIN_FRICTION,
-        solref=CONTACT_SOLREF,
+        **skin,
     )
-    names.bodies[transform.row] = mantle.name
-    names.mantle_joints.append(f"{creature.name}/root")
+    equalities = 0
     for tentacle_entity in creature.tentacles:
         tentacle = world.component(tentacle_entity, Tentacle)
         parent = mantle
         previous: Link | None = None
         for link_entity in tentacle.links:
             link = world.component(link_entity, Link)
-            prefix = f"{creature.name}/t{tentacle.index}/l{link.index:02d}"
+            prefix = f"t{tentacle.index}/l{link.index:02d}"
             if previous is None:  # base of the tentacle: edge of the mantle's base
                 angle = tentacle.base_angle
                 distance = creature.mantle_radius + 0.5 * link.length
@@ -134,7 +176,7 @@ def _add_creature(
                 quat = quat_about_z(angle)
             else:
                 pos = [0.5 * (previous.length + link.length), 0.0, 0.0]
-                quat = np.array([1.0, 0.0, 0.0, 0.0])
+                quat = [1.0, 0.0, 0.0, 0.0]
             body = parent.add_body(name=prefix, pos=pos, quat=quat)
             body.add_geom(
                 name=prefix,
@@ -142,25 +184,20 @@ def _add_creature(
                 fromto=[-0.5 * link.length, 0, 0, 0.5 * link.length, 0, 0],
                 size=[link.radius, 0.0, 0.0],
                 density=link.density,
-                contype=bits[0],
-                conaffinity=bits[1],
-                friction=SKIN_FRICTION,
-                solref=CONTACT_SOLREF,
+                **skin,
             )
-            names.bodies[world.component(link_entity, Transform).row] = prefix
             motor = world.component(link_entity, Motor)
-            hinges = ("curl", "sweep", "twist") if link.twist else ("curl", "sweep")
-            for hinge in hinges:
-                _add_servo(spec, body, f"{prefix}/{hinge}", hinge, link, motor, names)
+            for hinge in _hinges(link):
+                _add_servo(spec, body, f"{prefix}/{hinge}", hinge, link, motor)
             parent, previous = body, link
         for sucker_entity in tentacle.suckers:
             sucker = world.component(sucker_entity, Sucker)
-            name = f"{creature.name}/t{tentacle.index}/sucker{len(names.equalities)}"
+            link_index = tentacle.links.index(sucker.link)
             equality = spec.add_equality(
-                name=name,
+                name=f"t{tentacle.index}/sucker{equalities}",
                 type=mujoco.mjtEq.mjEQ_CONNECT,
                 objtype=mujoco.mjtObj.mjOBJ_BODY,
-                name1=names.bodies[sucker.link_row],
+                name1=f"t{tentacle.index}/l{link_index:02d}",
                 name2="world",
                 active=False,
                 solref=[world.settings.sucker_timeconst, 1.0],
@@ -169,17 +206,37 @@ def _add_creature(
             data = np.array(equality.data)
             data[0:3] = sucker.offset  # anchor in the link frame; the world anchor is set at attach
             equality.data = data
-            names.equalities.append(name)
+            equalities += 1
+
+
+def _add_proxies(spec: mujoco.MjSpec) -> None:
+    """Kinematic stand-ins for other creatures' bodies; sized and placed per frame."""
+    kinds = (
+        ("capsule", PROXY_CAPSULES, mujoco.mjtGeom.mjGEOM_CAPSULE, [0.7071068, 0.0, 0.7071068, 0.0]),
+        ("cylinder", PROXY_CYLINDERS, mujoco.mjtGeom.mjGEOM_CYLINDER, [1.0, 0.0, 0.0, 0.0]),
+    )
+    slot = 0
+    for kind, count, geom_type, quat in kinds:
+        for i in range(count):
+            body = spec.worldbody.add_body(
+                name=f"proxy/{kind}{i}", mocap=True, pos=PROXY_PARK + [10.0 * slot, 0.0, 0.0]
+            )
+            # capsules lie along the body's +x like the links they stand for
+            body.add_geom(
+                name=f"proxy/{kind}{i}",
+                type=geom_type,
+                size=[0.01, 0.01, 0.0],
+                quat=quat,
+                contype=PROXY_BIT,
+                conaffinity=CREATURE_BIT,
+                friction=SKIN_FRICTION,
+                solref=CONTACT_SOLREF,
+            )
+            slot += 1
 
 
 def _add_servo(
-    spec: mujoco.MjSpec,
-    body: mujoco.MjsBody,
-    name: str,
-    hinge: str,
-    link: Link,
-    motor: Motor,
-    names: ModelNames,
+    spec: mujoco.MjSpec, body: mujoco.MjsBody, name: str, hinge: str, link: Link, motor: Motor
 ) -> None:
     body.add_joint(
         name=name,
@@ -194,6 +251,3 @@ def _add_servo(
     actuator.set_to_position(kp=motor.strength, kv=motor.damping)
     actuator.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
     actuator.forcerange = [-motor.max_torque, motor.max_torque]
-    names.actuators.append(name)
-    names.actuator_motor_rows.append(motor.row)
-    names.actuator_axes.append(AXIS_INDEX[hinge])

@@ -55,7 +55,7 @@ def test_run_prints_one_json_summary(capsys: pytest.CaptureFixture[str]) -> None
     assert summary["real_time_factor"] == pytest.approx(
         summary["sim_seconds"] / summary["wall_seconds"], rel=0.01
     )
-    assert (summary["creatures"], summary["bodies"], summary["physics_resets"]) == (1, 81, 0)
+    assert (summary["creatures"], summary["bodies"], summary["recoveries"]) == (1, 81, 0)
     assert (summary["goals_reached"], summary["goals_left"]) == (0, 1)  # 0.2 s is not enough
 
 

@@ -28,13 +28,13 @@ def _links(world: World, tentacle: int) -> np.ndarray:
 
 
 def _actuators(world: World, motor_rows: np.ndarray) -> np.ndarray:
-    return np.flatnonzero(np.isin(world.physics.actuator_motor_rows, motor_rows))
+    return np.flatnonzero(np.isin(world.physics.groups[0].actuator_motor_rows, motor_rows))
 
 
 def test_strength_of_one_tentacle_reaches_its_servos(make_world: Callable[..., World]) -> None:
     world = _world(make_world)
     octo = world.creature("octo")
-    model = world.physics.model
+    model = world.physics.groups[0].model
     world.step(1)
     before = model.actuator_gainprm[:, 0].copy()
     world.locomotion.set(octo, tentacle=1, strength=40.0, damping=2.0)
@@ -46,7 +46,7 @@ def test_strength_of_one_tentacle_reaches_its_servos(make_world: Callable[..., W
     assert_allclose(model.actuator_gainprm[base, 0], 40.0 * motors.gain[links[0]], rtol=1e-12)
     assert_allclose(model.actuator_biasprm[base, 2], -2.0 * motors.gain[links[0]], rtol=1e-12)
     # every link of the tentacle, tapered by its scale
-    rows = world.physics.actuator_motor_rows
+    rows = world.physics.groups[0].actuator_motor_rows
     mine = _actuators(world, links)
     assert_allclose(
         model.actuator_gainprm[mine, 0],

@@ -23,29 +23,29 @@ def _tentacle(world: World, k: int) -> Tentacle:
 def _joint(world: World, link_entity: int, hinge: str) -> int:
     link = world.component(link_entity, Link)
     tentacle = world.component(link.tentacle, Tentacle)
-    name = f"octo/t{tentacle.index}/l{link.index:02d}/{hinge}"
-    return int(world.physics.model.joint(name).id)
+    name = f"t{tentacle.index}/l{link.index:02d}/{hinge}"
+    return int(world.physics.groups[0].model.joint(name).id)
 
 
 def test_model_options(make_world: Callable[..., World]) -> None:
     world = make_world(creature_scene(count=3, links=2), locomotion=False)
-    model = world.physics.model
+    model = world.physics.groups[0].model
     assert model.opt.integrator == mujoco.mjtIntegrator.mjINT_IMPLICITFAST
     assert model.opt.timestep == world.settings.substep_dt == 1 / 480
     assert model.geom("ground").type == mujoco.mjtGeom.mjGEOM_PLANE
-    assert model.geom("octo/mantle").type == mujoco.mjtGeom.mjGEOM_CYLINDER
-    assert model.geom("octo/t2/l01").type == mujoco.mjtGeom.mjGEOM_CAPSULE
+    assert model.geom("mantle").type == mujoco.mjtGeom.mjGEOM_CYLINDER
+    assert model.geom("t2/l01").type == mujoco.mjtGeom.mjGEOM_CAPSULE
     assert not model.eq_active0.any()
     limit = np.radians(60.0)  # the default joint_limit_deg, compiled as radians
-    assert_allclose(model.jnt_range[model.joint("octo/t0/l01/curl").id], [-limit, limit])
+    assert_allclose(model.jnt_range[model.joint("t0/l01/curl").id], [-limit, limit])
 
 
 def test_creature_settles_on_the_ground(make_world: Callable[..., World]) -> None:
     world = make_world(creature_scene(), locomotion=False)  # 8 tentacles x 10 links, r 0.025
     world.step(300)  # 5 simulated seconds
-    data = world.physics.data
+    data = world.physics.groups[0].data
     assert np.isfinite(data.qpos).all() and np.isfinite(data.qvel).all()
-    assert world.physics.resets == 0
+    assert world.physics.health.recoveries == 0
     mantle = world.component(world.creature("octo"), Transform)
     # base link radius + half the mantle height: resting on its tentacles
     assert abs(mantle.pos[2] - (0.025 + 0.1)) < 0.005
@@ -74,7 +74,7 @@ def test_servo_reaches_its_target(
     link = _tentacle(world, 0).links[link_index]
     world.component(link, Motor).target = target
     world.step(120)
-    angle = world.physics.data.qpos[world.physics.model.jnt_qposadr[_joint(world, link, hinge)]]
+    angle = world.physics.groups[0].data.qpos[world.physics.groups[0].model.jnt_qposadr[_joint(world, link, hinge)]]
     assert abs(angle - sum(target)) < 0.01
 
 
@@ -85,8 +85,8 @@ def test_strength_change_at_run_time_changes_the_servo_force(
     link = _tentacle(world, 1).links[0]
     motor = world.component(link, Motor)
     motor.target = [0.0, 0.4, 0.0]
-    model, data = world.physics.model, world.physics.data
-    actuator = int(model.actuator("octo/t1/l00/sweep").id)
+    model, data = world.physics.groups[0].model, world.physics.groups[0].data
+    actuator = int(model.actuator("t1/l00/sweep").id)
     joint = _joint(world, link, "sweep")
 
     def servo_force() -> float:
@@ -150,29 +150,9 @@ def test_physics_sync_copies_poses_bit_for_bit(make_world: Callable[..., World])
     world = make_world(creature_scene(count=5, links=4), locomotion=False)
     world.motors.target[:, 0] = 0.3
     world.step(20)
-    data, ids = world.physics.data, world.physics.body_ids
+    data, ids = world.physics.groups[0].data, world.physics.groups[0].body_ids
     assert_array_equal(world.transforms.pos, data.xpos[ids])
     assert_array_equal(world.transforms.quat, data.xquat[ids])
     link = _tentacle(world, 3).links[2]
-    body = world.physics.model.body("octo/t3/l02").id
+    body = world.physics.groups[0].model.body("t3/l02").id
     assert_array_equal(world.component(link, Transform).pos, data.xpos[body])
-
-
-def test_creatures_touch_each_other_but_never_themselves(make_world: Callable[..., World]) -> None:
-    # two creatures 0.9 m apart, tentacle 0 of each reaching 0.6 m toward the other
-    scene = {
-        "version": 1,
-        "creatures": [
-            {"name": "a", "position": [0.0, 0.0], "tentacles": {"count": 4}},
-            {"name": "b", "position": [0.9, 0.0], "heading_deg": 180, "tentacles": {"count": 4}},
-        ],
-    }
-    world = make_world(scene, locomotion=False)
-    model, data = world.physics.model, world.physics.data
-    mujoco.mj_forward(model, data)
-    owner = [
-        mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_GEOM, g).split("/")[0]
-        for g in range(model.ngeom)
-    ]
-    pairs = {tuple(sorted((owner[g1], owner[g2]))) for g1, g2 in data.contact.geom[: data.ncon]}
-    assert pairs == {("a", "b"), ("a", "ground"), ("b", "ground")}

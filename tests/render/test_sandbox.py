@@ -87,8 +87,8 @@ def test_hud_slider_reaches_the_servo_gains(make_sandbox: Callable[..., Any]) ->
     assert kp == pytest.approx(knob.low + (knob.high - knob.low) * slider.value / 100, rel=1e-12)
     assert [world.locomotion.get(octo, k)["strength"] for k in range(8)] == [kp] * 8  # "all"
     sandbox.step(1)
-    model = world.physics.model
-    actuator = model.actuator("octopus/t3/l00/curl").id
+    model = world.physics.groups[0].model
+    actuator = model.actuator("t3/l00/curl").id
     row = int(world.tentacles.first_link[3])
     assert model.actuator_gainprm[actuator, 0] == pytest.approx(
         kp * world.motors.gain[row], rel=1e-12

@@ -59,5 +59,5 @@ def test_frame_benchmark_splits_the_frame() -> None:
     ms = row["ms_per_frame"]
     names = {"goals", "tentacle_selection", "action_queue", "motor_targets", "suckers"}
     names |= {"emotion", "rig"}
-    assert names | {"physics", "physics_sync", "total", "mj_step"} == set(ms)
+    assert names | {"physics", "physics_health", "physics_sync", "total", "mj_step"} == set(ms)
     assert ms["total"] >= ms["mj_step"] > 0
