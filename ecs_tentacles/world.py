@@ -271,7 +271,6 @@ class World:
         if self.context in esper.list_worlds():
             esper.delete_world(self.context)
 
-
     def __enter__(self) -> World:
         return self
 

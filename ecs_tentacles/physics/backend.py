@@ -11,6 +11,7 @@ the Transform store). Systems stay whole-array and never see the groups.
 
 from __future__ import annotations
 
+import itertools
 import logging
 import os
 from collections.abc import Callable, Sequence
@@ -59,9 +60,7 @@ class PhysicsBackend:
                 template = templates[layout.key] = build_spec(world, creature).compile()
                 self.compiles += 1
             pose = (np.array(transform.pos), np.array(transform.quat))
-            group = PhysicsGroup(
-                len(self.groups), entity, creature.row, layout, template, pose
-            )
+            group = PhysicsGroup(len(self.groups), entity, creature.row, layout, template, pose)
             self.groups.append(group)
         self.group_of_creature_row = np.full(len(world.creatures), -1, dtype=np.int64)
         for group in self.groups:
@@ -185,4 +184,4 @@ def _balanced_chunks(
     cost = np.cumsum([m.nv + 1 for m, _ in pairs], dtype=np.float64)
     cuts = np.searchsorted(cost, cost[-1] * np.arange(1, threads) / threads)
     bounds = [0, *cuts.tolist(), len(pairs)]
-    return [pairs[a:b] for a, b in zip(bounds[:-1], bounds[1:], strict=True) if b > a]
+    return [pairs[a:b] for a, b in itertools.pairwise(bounds) if b > a]

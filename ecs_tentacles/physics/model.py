@@ -176,7 +176,7 @@ def _add_creature(spec: mujoco.MjSpec, world: World, creature: Creature) -> None
                 quat = quat_about_z(angle)
             else:
                 pos = [0.5 * (previous.length + link.length), 0.0, 0.0]
-                quat = [1.0, 0.0, 0.0, 0.0]
+                quat = np.array([1.0, 0.0, 0.0, 0.0])
             body = parent.add_body(name=prefix, pos=pos, quat=quat)
             body.add_geom(
                 name=prefix,
@@ -211,8 +211,9 @@ def _add_creature(spec: mujoco.MjSpec, world: World, creature: Creature) -> None
 
 def _add_proxies(spec: mujoco.MjSpec) -> None:
     """Kinematic stand-ins for other creatures' bodies; sized and placed per frame."""
+    z_to_x = [np.sqrt(0.5), 0.0, np.sqrt(0.5), 0.0]  # capsules lie along +x like links
     kinds = (
-        ("capsule", PROXY_CAPSULES, mujoco.mjtGeom.mjGEOM_CAPSULE, [0.7071068, 0.0, 0.7071068, 0.0]),
+        ("capsule", PROXY_CAPSULES, mujoco.mjtGeom.mjGEOM_CAPSULE, z_to_x),
         ("cylinder", PROXY_CYLINDERS, mujoco.mjtGeom.mjGEOM_CYLINDER, [1.0, 0.0, 0.0, 0.0]),
     )
     slot = 0
@@ -221,7 +222,6 @@ def _add_proxies(spec: mujoco.MjSpec) -> None:
             body = spec.worldbody.add_body(
                 name=f"proxy/{kind}{i}", mocap=True, pos=PROXY_PARK + [10.0 * slot, 0.0, 0.0]
             )
-            # capsules lie along the body's +x like the links they stand for
             body.add_geom(
                 name=f"proxy/{kind}{i}",
                 type=geom_type,

@@ -14,6 +14,7 @@ and the nearest ones kept when more are near than the pool holds.
 
 from __future__ import annotations
 
+import itertools
 from typing import TYPE_CHECKING
 
 import mujoco
@@ -88,7 +89,7 @@ class ContactProxies:
             who, body, slot = who[fits], body[fits], slot[fits]
             slot = slot + np.where(self.kind[body] == CYLINDER, PROXY_CAPSULES, 0)
             bounds = np.flatnonzero(np.r_[True, who[1:] != who[:-1], True])
-            for s, e in zip(bounds[:-1], bounds[1:], strict=True):
+            for s, e in itertools.pairwise(bounds):
                 placed[int(who[s])] = (body[s:e], slot[s:e])
         quat = transforms.quat[self.rows]
         for group in self.groups:

@@ -74,7 +74,8 @@ def test_servo_reaches_its_target(
     link = _tentacle(world, 0).links[link_index]
     world.component(link, Motor).target = target
     world.step(120)
-    angle = world.physics.groups[0].data.qpos[world.physics.groups[0].model.jnt_qposadr[_joint(world, link, hinge)]]
+    group = world.physics.groups[0]
+    angle = group.data.qpos[group.model.jnt_qposadr[_joint(world, link, hinge)]]
     assert abs(angle - sum(target)) < 0.01
 
 
