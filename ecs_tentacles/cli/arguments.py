@@ -1,10 +1,11 @@
-"""argparse types shared by the commands: output files with known suffixes."""
+"""argparse helpers shared by the commands: output files with known suffixes, one-line errors."""
 
 from __future__ import annotations
 
 import argparse
 from collections.abc import Callable
 from pathlib import Path
+from typing import NoReturn
 
 
 def output_path(*suffixes: str) -> Callable[[str], Path]:
@@ -22,3 +23,13 @@ def output_path(*suffixes: str) -> Callable[[str], Path]:
         return path
 
     return check
+
+
+def one_line_errors(parser: argparse.ArgumentParser) -> argparse.ArgumentParser:
+    """Make `parser` report a bad argument as one line (no usage block) and exit 2."""
+
+    def error(message: str) -> NoReturn:
+        parser.exit(2, f"{parser.prog}: error: {message}\n")
+
+    parser.error = error  # type: ignore[method-assign]
+    return parser

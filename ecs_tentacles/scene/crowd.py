@@ -19,8 +19,9 @@ gives the same JSON, byte for byte):
 * Placement: a square grid centred on the origin, `spacing` apart, each position
   jittered. A creature's reach is its mantle radius + its longest tentacle + its
   thickest link radius. The default spacing is twice the largest reach in the crowd
-  plus `CLEARANCE`; jitter is at most a quarter of the spare room (spacing - 2 x
-  largest reach) per axis, so no two creatures' reach circles overlap at build.
+  plus `CLEARANCE`; jitter per axis is at most a quarter of the spare room
+  (spacing - 2 x largest reach) and at most `JITTER` x spacing, so no two
+  creatures' reach circles overlap at build.
 * Goals: each creature crawls to its position mirrored through the crowd's centre
   (plus a little jitter), so mirrored pairs meet head-on and the whole crowd
   crosses in the middle. A creature too close to the centre for that gets a goal
@@ -44,6 +45,7 @@ from ecs_tentacles.scene.load import load_scene
 
 DEFAULT_SPECIES = 8
 CLEARANCE = 0.4  # metres between the reach circles of two neighbours, before jitter
+JITTER = 0.1  # largest jitter per axis, as a share of the spacing
 FUR_SHARE = 0.25
 FUR_PRESETS = ("hedgehog", "cat", "bird")
 GROOM_COUNT = (16, 48)  # guides per furry creature: a look, not a hero groom
@@ -196,7 +198,7 @@ def crowd_scene(
         raise ValueError(
             f"spacing: must be >= {least:.3f} m (twice the largest creature reach), got {spacing}"
         )
-    jitter = 0.25 * (spacing - least)
+    jitter = min(0.25 * (spacing - least), JITTER * spacing)
     columns, rows = grid_shape(n)
     cells = np.arange(n)
     grid = np.stack([cells % columns - 0.5 * (columns - 1), cells // columns - 0.5 * (rows - 1)])

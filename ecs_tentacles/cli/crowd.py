@@ -1,0 +1,89 @@
+"""`ecs-tentacles crowd N --out scene.json`: write a scene of N varied creatures.
+
+    ecs-tentacles crowd 256 --out crowd.json --seed 4 --idle 0.2
+
+The creatures, their placement and their goals are described in
+`ecs_tentacles.scene.crowd`; the same seed writes the same file.
+"""
+
+from __future__ import annotations
+
+import argparse
+from typing import Any
+
+from ecs_tentacles.cli.arguments import one_line_errors, output_path
+from ecs_tentacles.cli.bake import positive_float
+from ecs_tentacles.cli.run import positive_int, seed_int
+from ecs_tentacles.scene.crowd import DEFAULT_SPECIES, crowd_scene, write_crowd_scene
+from ecs_tentacles.scene.errors import SceneError
+
+
+def fraction(text: str) -> float:
+    """argparse type: a number in [0, 1]."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a number, got {text!r}") from None
+    if not 0.0 <= value <= 1.0:
+        raise argparse.ArgumentTypeError(f"must be in [0, 1], got {text}")
+    return value
+
+
+def add_crowd_options(parser: argparse.ArgumentParser) -> None:
+    """--seed, --spacing, --idle and --species: shared by `crowd` and `bench --crowd`."""
+    parser.add_argument("--seed", type=seed_int, default=0, help="random seed (default 0)")
+    parser.add_argument(
+        "--spacing",
+        type=positive_float,
+        default=None,
+        help="grid spacing in metres (default: twice the largest creature reach + 0.4 m)",
+    )
+    parser.add_argument(
+        "--idle",
+        type=fraction,
+        default=0.0,
+        help="fraction of creatures with no goal (default 0)",
+    )
+    parser.add_argument(
+        "--species",
+        type=positive_int,
+        default=DEFAULT_SPECIES,
+        help=f"number of distinct body plans (default {DEFAULT_SPECIES})",
+    )
+
+
+def crowd_from_args(n: int, args: argparse.Namespace) -> dict[str, Any]:
+    """The crowd scene of `n` creatures the options ask for; SceneError names a bad option."""
+    try:
+        return crowd_scene(n, args.seed, args.spacing, idle=args.idle, species=args.species)
+    except ValueError as error:  # only --spacing can be wrong once argparse has checked
+        raise SceneError([f"--{error}"]) from None
+
+
+def add_parser(commands: argparse._SubParsersAction) -> None:
+    parser = one_line_errors(
+        commands.add_parser(
+            "crowd",
+            help="write a scene of N varied creatures whose paths cross",
+            description=(
+                "Write a scene of N varied creatures (3-8 tentacles, varied sizes, some with fur)"
+                " on a jittered grid, each crawling to the far side of the crowd's centre."
+            ),
+        )
+    )
+    parser.add_argument("n", type=positive_int, metavar="N", help="number of creatures (>= 1)")
+    parser.add_argument(
+        "--out", type=output_path(".json"), required=True, help="scene file to write (.json)"
+    )
+    add_crowd_options(parser)
+    parser.set_defaults(handler=handle)
+
+
+def handle(args: argparse.Namespace) -> int:
+    scene = crowd_from_args(args.n, args)
+    write_crowd_scene(scene, args.out)
+    creatures = scene["creatures"]
+    furry = sum("fur" in c for c in creatures)
+    idle = sum("goals" not in c for c in creatures)
+    print(f"{args.out}: {len(creatures)} creatures ({furry} with fur, {idle} idle)")
+    return 0
