@@ -15,32 +15,20 @@ import json
 import statistics
 import time
 from collections import defaultdict
-from collections.abc import Callable
 from typing import Any
 
+from ecs_tentacles.bench import time_systems, timed
 from ecs_tentacles.scene.load import bundled_scene_names
 from ecs_tentacles.world import World
-
-
-def _timed(func: Callable[..., Any], bucket: list[float]) -> Callable[..., Any]:
-    def wrapper(*args: Any, **kwargs: Any) -> Any:
-        start = time.perf_counter()
-        result = func(*args, **kwargs)
-        bucket[0] += time.perf_counter() - start
-        return result
-
-    return wrapper
 
 
 def bench_scene(scene: str, frames: int, repeats: int) -> dict[str, Any]:
     """Median ms per frame: total, mj_step, each system without its MuJoCo time."""
     world = World.from_scene(scene)
     world.step(frames)  # warm up: goals chosen, suckers in use
-    buckets: dict[str, list[float]] = {s.name: [0.0] for s in world.schedule}
-    for system in world.schedule:
-        system.process = _timed(system.process, buckets[system.name])  # type: ignore[method-assign]
+    buckets = time_systems(world)
     mujoco_time = [0.0]
-    world.physics.step = _timed(world.physics.step, mujoco_time)  # type: ignore[method-assign]
+    world.physics.step = timed(world.physics.step, mujoco_time)  # type: ignore[method-assign]
     per_frame: dict[str, list[float]] = defaultdict(list)
     for _ in range(repeats):
         for bucket in [*buckets.values(), mujoco_time]:

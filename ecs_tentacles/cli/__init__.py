@@ -11,12 +11,12 @@ import sys
 from collections.abc import Sequence
 
 from ecs_tentacles import __version__
-from ecs_tentacles.cli import bake, create, crowd, export, play, run, validate
+from ecs_tentacles.cli import bake, bench, create, crowd, export, play, run, validate
 from ecs_tentacles.scene.errors import SceneError
 
 COMMANDS = {"validate": validate, "run": run, "play": play}
 COMMANDS |= {"bake": bake, "export": export, "create": create}
-COMMANDS |= {"crowd": crowd}
+COMMANDS |= {"crowd": crowd, "bench": bench}
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -1,0 +1,151 @@
+"""Headless benchmark of a world: build time, frame time, and MuJoCo stepped bare.
+
+    from ecs_tentacles.bench import bench
+    from ecs_tentacles.scene.crowd import crowd_scene
+    result = bench(crowd_scene(16), frames=120, threads=2)
+    print(result["frame_ms"], result["raw_mujoco_ms"], result["overhead_ratio"])
+
+How `bench` measures (every figure is milliseconds per frame, the median over blocks):
+
+* `build_s`: `World.from_scene` (validate, build entities, compile, schedule).
+* After `warmup` untimed frames, the run alternates blocks of `block` framework
+  frames (`world.step`) with blocks of as many bare frames: copies of every
+  group's MjData (taken outside the timing, so the world's own state is never
+  touched) stepped by `world.physics.step_bare` with the world's substeps, on the
+  world's thread pool, and nothing else. Alternating in the same run means both
+  see the same machine load; which comes first alternates block by block.
+* `frame_ms`: a whole framework frame. `raw_mujoco_ms`: a bare frame.
+  `overhead_ratio` = frame_ms / raw_mujoco_ms (the design's target is <= 1.10).
+* `systems`: each system's `process`, wrapped with `timed`; `physics_ms` is the
+  physics layer's share: the `physics` system (controls and sucker switches in,
+  stepping) plus `physics_sync` (poses out).
+* `realtime_factor`: simulated seconds per wall second of framework frames.
+* `rss_mb`: the process's resident memory at the end (psutil).
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import os
+import statistics
+import time
+from collections import defaultdict
+from collections.abc import Callable
+from typing import Any
+
+import psutil
+
+from ecs_tentacles.world import World
+
+BLOCK = 10  # frames per interleaved block
+WARMUP = 30  # untimed frames first: goals chosen, suckers in use, kernels loaded
+PHYSICS_SYSTEMS = ("physics", "physics_sync")
+
+
+def timed(func: Callable[..., Any], bucket: list[float]) -> Callable[..., Any]:
+    """`func` wrapped so every call adds its wall seconds to `bucket[0]`."""
+
+    def wrapper(*args: Any, **kwargs: Any) -> Any:
+        start = time.perf_counter()
+        result = func(*args, **kwargs)
+        bucket[0] += time.perf_counter() - start
+        return result
+
+    return wrapper
+
+
+def time_systems(world: World) -> dict[str, list[float]]:
+    """Wrap every scheduled system's `process` with `timed`; return the buckets by name."""
+    buckets: dict[str, list[float]] = {s.name: [0.0] for s in world.schedule}
+    for system in world.schedule:
+        system.process = timed(system.process, buckets[system.name])  # type: ignore[method-assign]
+    return buckets
+
+
+def _bare_block(world: World, frames: int) -> float:
+    """Seconds to step copies of every group's data `frames` frames with nothing else."""
+    physics = world.physics
+    datas = [copy.copy(group.data) for group in physics.groups]
+    substeps = world.settings.substeps
+    start = time.perf_counter()
+    for _ in range(frames):
+        physics.step_bare(datas, substeps)
+    return time.perf_counter() - start
+
+
+def _framework_block(world: World, frames: int, buckets: dict[str, list[float]]) -> float:
+    """Seconds to run `frames` framework frames; `buckets` hold each system's seconds."""
+    for bucket in buckets.values():
+        bucket[0] = 0.0
+    start = time.perf_counter()
+    world.step(frames)
+    return time.perf_counter() - start
+
+
+def measure(
+    world: World, frames: int, *, block: int = BLOCK, warmup: int = WARMUP
+) -> dict[str, Any]:
+    """Median ms per frame of `frames` framework frames and as many bare ones, interleaved."""
+    if frames < 1 or block < 1 or warmup < 0:
+        raise ValueError(f"frames and block must be >= 1, warmup >= 0; got {frames, block, warmup}")
+    world.step(warmup)
+    _bare_block(world, 1)  # the bare path's first call pays for its own warm-up
+    buckets = time_systems(world)
+    per_frame: dict[str, list[float]] = defaultdict(list)
+    for index, first in enumerate(range(0, frames, block)):
+        k = min(block, frames - first)
+        bare_first = index % 2 == 1
+        bare = _bare_block(world, k) if bare_first else 0.0
+        per_frame["frame"].append(_framework_block(world, k, buckets) * 1000 / k)
+        for name, bucket in buckets.items():
+            per_frame[name].append(bucket[0] * 1000 / k)
+        if not bare_first:
+            bare = _bare_block(world, k)
+        per_frame["raw"].append(bare * 1000 / k)
+    physics = zip(*(per_frame[name] for name in PHYSICS_SYSTEMS), strict=True)
+    physics_ms = statistics.median(map(sum, physics))
+    medians = {name: statistics.median(values) for name, values in per_frame.items()}
+    frame_ms, raw_ms = medians.pop("frame"), medians.pop("raw")
+    return {
+        "frames": frames,
+        "frame_ms": frame_ms,
+        "physics_ms": physics_ms,
+        "raw_mujoco_ms": raw_ms,
+        "overhead_ratio": frame_ms / raw_ms if raw_ms > 0 else math.inf,
+        "realtime_factor": 1000 * world.settings.dt / frame_ms,
+        "systems": medians,
+    }
+
+
+def bench(
+    source: str | os.PathLike[str] | dict[str, Any],
+    *,
+    frames: int = 120,
+    threads: int | None = None,
+    block: int = BLOCK,
+    warmup: int = WARMUP,
+    allow_systems: bool = False,
+) -> dict[str, Any]:
+    """Build `source` (scene path, bundled name or dict), run `measure`, report sizes.
+
+    The keys, in order: creatures, bodies, groups, threads, build_s, frames, frame_ms,
+    physics_ms, raw_mujoco_ms, overhead_ratio, realtime_factor, systems, rss_mb.
+    """
+    start = time.perf_counter()
+    world = World.from_scene(source, threads=threads, allow_systems=allow_systems)
+    build_s = time.perf_counter() - start
+    try:
+        groups = world.physics.groups
+        sizes = {
+            "creatures": sum(len(group.creatures) for group in groups),
+            "bodies": world.physics.bodies,  # creature bodies, contact proxies not counted
+            "groups": len(groups),
+            "threads": int(world.physics.threads),
+            "build_s": build_s,
+        }
+        timings = measure(world, frames, block=block, warmup=warmup)
+    finally:
+        world.close()
+    rss_mb = psutil.Process().memory_info().rss / 2**20
+    return {**sizes, **timings, "rss_mb": rss_mb}

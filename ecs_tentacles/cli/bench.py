@@ -1,0 +1,99 @@
+"""`ecs-tentacles bench [SCENE | --crowd N]`: headless build and frame timings.
+
+    ecs-tentacles bench --crowd 64 --frames 120 --threads 2 --json
+    ecs-tentacles bench octopus
+
+What is measured, and how the bare MuJoCo figure is taken in the same run, is
+described in `ecs_tentacles.bench`.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from typing import Any
+
+from ecs_tentacles.bench import BLOCK, WARMUP, bench
+from ecs_tentacles.cli.arguments import one_line_errors
+from ecs_tentacles.cli.crowd import add_crowd_options, crowd_from_args
+from ecs_tentacles.cli.run import positive_int, seed_int
+from ecs_tentacles.scene.load import resolve_scene_path
+
+
+def add_parser(commands: argparse._SubParsersAction) -> None:
+    parser = one_line_errors(
+        commands.add_parser(
+            "bench",
+            help="time building and running a scene or a generated crowd, headless",
+            description=(
+                "Build a scene (or a generated crowd), run it headless and report build seconds,"
+                " ms per frame, per system, and MuJoCo stepping the same models bare."
+            ),
+        )
+    )
+    source = parser.add_mutually_exclusive_group(required=True)
+    source.add_argument("scene", nargs="?", metavar="SCENE", help="scene file or bundled name")
+    source.add_argument(
+        "--crowd",
+        type=positive_int,
+        metavar="N",
+        help="bench a crowd of N creatures (as `ecs-tentacles crowd N` writes)",
+    )
+    parser.add_argument(
+        "--frames", type=positive_int, default=120, help="timed frames (default 120)"
+    )
+    parser.add_argument(
+        "--threads", type=positive_int, default=None, help="physics threads (default: all cores)"
+    )
+    parser.add_argument(
+        "--block",
+        type=positive_int,
+        default=BLOCK,
+        help=f"frames per interleaved framework / bare block (default {BLOCK})",
+    )
+    parser.add_argument(
+        "--warmup",
+        type=seed_int,
+        default=WARMUP,
+        help=f"untimed frames before timing (default {WARMUP})",
+    )
+    parser.add_argument("--json", action="store_true", help="print the result as one JSON object")
+    parser.add_argument(
+        "--allow-systems", action="store_true", help="import and run the systems the scene names"
+    )
+    add_crowd_options(parser)
+    parser.set_defaults(handler=handle)
+
+
+def handle(args: argparse.Namespace) -> int:
+    if args.crowd is not None:
+        source: Any = crowd_from_args(args.crowd, args)
+        label = f"crowd of {args.crowd} (seed {args.seed}, {args.idle:.0%} idle)"
+    else:
+        source = resolve_scene_path(args.scene)
+        label = str(source)
+    result = bench(
+        source,
+        frames=args.frames,
+        threads=args.threads,
+        block=args.block,
+        warmup=args.warmup,
+        allow_systems=args.allow_systems,
+    )
+    if args.json:
+        print(json.dumps(result))
+        return 0
+    print(
+        f"{label}: {result['creatures']} creatures, {result['bodies']} bodies,"
+        f" {result['groups']} physics groups, {result['threads']} threads;"
+        f" built in {result['build_s']:.2f} s"
+    )
+    print(
+        f"  {result['frames']} frames: {result['frame_ms']:.2f} ms/frame"
+        f" ({result['realtime_factor']:.2f}x real time), physics {result['physics_ms']:.2f} ms,"
+        f" bare MuJoCo {result['raw_mujoco_ms']:.2f} ms, overhead"
+        f" {result['overhead_ratio']:.3f}x; {result['rss_mb']:.0f} MB resident"
+    )
+    systems = sorted(result["systems"].items(), key=lambda item: -item[1])
+    print("  systems (ms/frame): " + ", ".join(f"{name} {ms:.3f}" for name, ms in systems))
+    return 0

@@ -1,0 +1,67 @@
+"""`ecs-tentacles bench`: one JSON object with every key, a human summary, one-line errors."""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+from pathlib import Path
+
+import pytest
+
+from ecs_tentacles.cli import main
+from tests.test_bench import KEYS
+
+
+def test_json_has_every_key_finite(capsys: pytest.CaptureFixture[str]) -> None:
+    argv = ["bench", "--crowd", "2", "--frames", "4", "--block", "2", "--warmup", "2"]
+    assert main([*argv, "--threads", "2", "--idle", "0.5", "--json"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert list(result) == KEYS
+    assert all(math.isfinite(v) for k, v in result.items() if k != "systems")
+    assert all(math.isfinite(v) for v in result["systems"].values())
+    assert (result["creatures"], result["threads"], result["frames"]) == (2, 2, 4)
+
+
+def test_human_summary_of_a_scene_file(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["bench", "three_goals", "--frames", "2", "--warmup", "1", "--threads", "1"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert len(lines) == 3
+    assert re.fullmatch(
+        r".*three_goals\.json: 1 creatures, 61 bodies, 1 physics groups, 1 threads;"
+        r" built in \d+\.\d\d s",
+        lines[0],
+    )
+    assert "2 frames: " in lines[1] and "bare MuJoCo" in lines[1] and "overhead" in lines[1]
+    assert lines[2].startswith("  systems (ms/frame): ")
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--crowd", "2", "--threads", "0"], "argument --threads: must be >= 1, got 0"),
+        (["--crowd", "0"], "argument --crowd: must be >= 1, got 0"),
+        (["octopus", "--crowd", "2"], "argument --crowd: not allowed with argument SCENE"),
+        ([], "one of the arguments SCENE --crowd is required"),
+    ],
+)
+def test_bad_arguments_are_one_line_exit_2(
+    argv: list[str], message: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    with pytest.raises(SystemExit) as caught:
+        main(["bench", *argv])
+    assert caught.value.code == 2
+    assert capsys.readouterr().err == f"ecs-tentacles bench: error: {message}\n"
+
+
+def test_bad_scene_is_one_line_exit_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    scene = tmp_path / "bad.json"
+    scene.write_text('{"version": 1, "creatures": [{"tentacles": {"count": 0}}]}')
+    assert main(["bench", str(scene), "--frames", "2"]) == 2
+    captured = capsys.readouterr()
+    assert (
+        captured.err == f"error: {scene}: creatures[0].tentacles.count: must be in [1, 16], got 0\n"
+    )
+    assert captured.out == ""
+    assert main(["bench", "--crowd", "3", "--spacing", "0.2"]) == 2
+    assert capsys.readouterr().err.count("\n") == 1

@@ -1,0 +1,68 @@
+"""The bench: every figure present and finite, and the world's run left undisturbed."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+import numpy as np
+import pytest
+
+from ecs_tentacles.bench import bench, measure, timed
+from ecs_tentacles.scene.crowd import crowd_scene
+from ecs_tentacles.world import World
+
+KEYS = [
+    "creatures",
+    "bodies",
+    "groups",
+    "threads",
+    "build_s",
+    "frames",
+    "frame_ms",
+    "physics_ms",
+    "raw_mujoco_ms",
+    "overhead_ratio",
+    "realtime_factor",
+    "systems",
+    "rss_mb",
+]
+
+
+def test_bench_reports_every_key_finite() -> None:
+    result = bench(crowd_scene(2, seed=4), frames=4, threads=1, block=2, warmup=2)
+    assert list(result) == KEYS
+    numbers = [v for k, v in result.items() if k != "systems"] + list(result["systems"].values())
+    assert all(math.isfinite(v) and v >= 0 for v in numbers)
+    assert (result["creatures"], result["threads"], result["frames"]) == (2, 1, 4)
+    assert result["groups"] >= 1 and result["bodies"] >= 2 * (1 + 3 * 5)  # >= 3 x 5 links each
+    assert {"goals", "physics", "physics_sync", "rig"} <= set(result["systems"])
+    assert result["overhead_ratio"] == pytest.approx(result["frame_ms"] / result["raw_mujoco_ms"])
+    assert result["realtime_factor"] == pytest.approx(1000 / 60 / result["frame_ms"])
+    assert 0 < result["physics_ms"] <= result["frame_ms"]
+    assert result["rss_mb"] > 50  # numpy + MuJoCo alone are more
+
+
+def test_bare_stepping_leaves_the_world_as_plain_stepping_would(
+    make_world: Callable[..., World],
+) -> None:
+    scene = crowd_scene(2, seed=1)
+    measured, plain = make_world(scene), make_world(scene)
+    timings = measure(measured, 6, block=2, warmup=3)
+    plain.step(9)
+    assert measured.frame == plain.frame == 9
+    assert timings["raw_mujoco_ms"] > 0
+    np.testing.assert_array_equal(measured.transforms.pos, plain.transforms.pos)
+    np.testing.assert_array_equal(measured.transforms.quat, plain.transforms.quat)
+
+
+def test_measure_refuses_no_frames(make_world: Callable[..., World]) -> None:
+    with pytest.raises(ValueError, match="frames and block must be >= 1"):
+        measure(make_world(crowd_scene(1)), 0)
+
+
+def test_timed_adds_each_call_to_its_bucket() -> None:
+    bucket = [0.0]
+    doubled = timed(lambda x: 2 * x, bucket)
+    assert doubled(21) == 42 and doubled(1) == 2
+    assert 0 < bucket[0] < 1
