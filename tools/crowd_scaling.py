@@ -50,11 +50,17 @@ COLUMNS = (
 
 
 def bench_once(
-    creatures: int, threads: int, frames: int, seed: int, timeout: float
+    creatures: int,
+    threads: int,
+    frames: int,
+    seed: int,
+    timeout: float,
+    extra: tuple[str, ...] = (),
 ) -> dict[str, Any]:
-    """One CSV row: `ecs-tentacles bench --crowd` run in a fresh process."""
+    """One CSV row: `ecs-tentacles bench --crowd` (+ `extra` options) in a fresh process."""
     command = [sys.executable, "-m", "ecs_tentacles.cli", "bench", "--crowd", str(creatures)]
     command += ["--threads", str(threads), "--frames", str(frames), "--seed", str(seed), "--json"]
+    command += extra
     row: dict[str, Any] = {"creatures": creatures, "threads": threads, "error": ""}
     try:
         done = subprocess.run(command, capture_output=True, text=True, timeout=timeout, check=False)
@@ -125,6 +131,10 @@ def main(argv: list[str] | None = None) -> int:
     )
     parser.add_argument("--frames", type=int, default=120, help="timed frames per run")
     parser.add_argument("--seed", type=int, default=0, help="crowd seed")
+    parser.add_argument(
+        "--uniform", action="store_true", help="crowds of 8 x 10 octopuses (one morphology)"
+    )
+    parser.add_argument("--idle", type=float, default=0.0, help="fraction of idle creatures")
     parser.add_argument("--timeout", type=float, default=3600.0, help="seconds allowed per run")
     parser.add_argument(
         "--out", type=Path, default=Path("crowd_scaling"), help="writes OUT.csv and OUT.png"
@@ -134,7 +144,8 @@ def main(argv: list[str] | None = None) -> int:
     rows = []
     for i, (creatures, threads) in enumerate(runs, 1):
         print(f"[{i}/{len(runs)}] {creatures} creatures, {threads} threads ...", file=sys.stderr)
-        row = bench_once(creatures, threads, args.frames, args.seed, args.timeout)
+        extra = ("--idle", str(args.idle)) + (("--uniform",) if args.uniform else ())
+        row = bench_once(creatures, threads, args.frames, args.seed, args.timeout, extra)
         rows.append(row)
         if row["error"]:
             print(f"    failed: {row['error']}", file=sys.stderr)

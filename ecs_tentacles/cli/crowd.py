@@ -30,7 +30,7 @@ def fraction(text: str) -> float:
 
 
 def add_crowd_options(parser: argparse.ArgumentParser) -> None:
-    """--seed, --spacing, --idle and --species: shared by `crowd` and `bench --crowd`."""
+    """--seed, --spacing, --idle, --species, --uniform: shared by `crowd` and `bench --crowd`."""
     parser.add_argument("--seed", type=seed_int, default=0, help="random seed (default 0)")
     parser.add_argument(
         "--spacing",
@@ -50,12 +50,19 @@ def add_crowd_options(parser: argparse.ArgumentParser) -> None:
         default=DEFAULT_SPECIES,
         help=f"number of distinct body plans (default {DEFAULT_SPECIES})",
     )
+    parser.add_argument(
+        "--uniform",
+        action="store_true",
+        help="every creature the default 8 x 10 octopus (one morphology; behaviour still varies)",
+    )
 
 
 def crowd_from_args(n: int, args: argparse.Namespace) -> dict[str, Any]:
     """The crowd scene of `n` creatures the options ask for; SceneError names a bad option."""
     try:
-        return crowd_scene(n, args.seed, args.spacing, idle=args.idle, species=args.species)
+        return crowd_scene(
+            n, args.seed, args.spacing, idle=args.idle, species=args.species, uniform=args.uniform
+        )
     except ValueError as error:  # only --spacing can be wrong once argparse has checked
         raise SceneError([f"--{error}"]) from None
 

@@ -7,12 +7,14 @@ How a crowd is made, all from one `numpy.random.default_rng(seed)` (the same see
 gives the same JSON, byte for byte):
 
 * Body plans ("species", default 8): 3 to 8 tentacles (the first six plans take
-  3, 4, 5, 6, 7 and 8 in turn, so every count occurs), mantle radius and height,
+  8, 7, 6, 5, 4 and 3 in turn, so every count occurs), mantle radius and height,
   links per tentacle, first-link length and radius, end scale, and one or two
   tentacles per plan with their own shape (the schema's `tentacles.overrides`).
   Creatures share a few body plans, as a real crowd of a few species does, so a
   physics layer that compiles each morphology once compiles a handful of models.
   Servo strength and torque limit scale with the tentacle's weight x length.
+  `uniform=True` makes every creature the default octopus (8 x 10 links, the
+  schema's sizes) instead: one morphology, still with varied behaviour and fur.
 * Per creature: heading, gait, crawl speed, travelling-wave settings, per-tentacle
   speed and wave changes (overrides that leave the shape alone), and for about a
   quarter of them fur (a preset with a small groom, so a 1,024 crowd stays cheap).
@@ -40,6 +42,7 @@ import numpy as np
 
 from ecs_tentacles.build import tentacle_params
 from ecs_tentacles.construction import tentacle_shape
+from ecs_tentacles.creator.limits import default
 from ecs_tentacles.export.atomic import atomic_output
 from ecs_tentacles.scene.load import load_scene
 
@@ -118,8 +121,16 @@ def _body_plan(rng: np.random.Generator, count: int) -> dict[str, Any]:
     }
 
 
+def _octopus() -> dict[str, Any]:
+    """The schema's default creature (8 x 10 links) as a body plan."""
+    mantle = {key: default("mantle", key) for key in ("radius", "height", "density")}
+    keys = ("count", "links", "link_length", "link_radius", "end_scale", "strength", "max_torque")
+    tentacles = {key: default("tentacles", key) for key in keys}
+    return {"mantle": mantle, "tentacles": tentacles, "shape_overrides": {}}
+
+
 def _species(rng: np.random.Generator, species: int) -> list[dict[str, Any]]:
-    counts = [3 + k if k < 6 else int(rng.integers(3, 9)) for k in range(species)]
+    counts = [8 - k if k < 6 else int(rng.integers(3, 9)) for k in range(species)]
     return [_body_plan(rng, count) for count in counts]
 
 
@@ -173,6 +184,7 @@ def crowd_scene(
     *,
     idle: float = 0.0,
     species: int = DEFAULT_SPECIES,
+    uniform: bool = False,
 ) -> dict[str, Any]:
     """A scene dict of `n` varied creatures crossing the crowd (see the module docstring).
 
@@ -186,7 +198,8 @@ def crowd_scene(
     if species < 1:
         raise ValueError(f"species: must be >= 1, got {species}")
     rng = np.random.default_rng(seed)
-    plans = _species(rng, species)
+    plans = [_octopus()] if uniform else _species(rng, species)
+    species = len(plans)
     plan_of = rng.permutation(np.arange(n) % species)
     width = len(str(n - 1))
     creatures = [_creature(rng, f"c{i:0{width}d}", plans[p]) for i, p in enumerate(plan_of)]
@@ -216,9 +229,9 @@ def crowd_scene(
         "version": 1,
         "name": f"crowd_{n}",
         "description": (
-            f"{n} generated creatures of {min(species, n)} body plans, {spacing:.2f} m apart on a"
+            f"{n} generated creatures of {min(species, n)} body plan(s), {spacing:.2f} m apart on a"
             f" {columns} x {rows} grid, crawling across the crowd's centre"
-            f" ({len(idle_ones)} idle); ecs-tentacles crowd {n} --seed {seed}."
+            f" ({len(idle_ones)} idle; seed {seed})."
         ),
         "seed": seed,
         "creatures": creatures,

@@ -60,6 +60,23 @@ def test_creatures_vary() -> None:
     assert len({c["heading_deg"] for c in creatures}) == 256
 
 
+def test_uniform_crowds_are_one_morphology_with_varied_behaviour() -> None:
+    creatures = load_scene(crowd_scene(40, seed=2, uniform=True))["creatures"]
+    default = load_scene({"version": 1, "creatures": [{}]})["creatures"][0]
+    shape = ("count", "links", "link_length", "link_radius", "end_scale")
+    for creature in creatures:
+        assert creature["mantle"] == default["mantle"]
+        assert {k: creature["tentacles"][k] for k in shape} == {
+            k: default["tentacles"][k] for k in shape
+        }
+        assert all(
+            set(o) <= {"index", "speed", "wave_frequency"}
+            for o in creature["tentacles"]["overrides"]
+        )
+    assert len({c["tentacles"]["wave_frequency"] for c in creatures}) == 40
+    assert any("fur" in c for c in creatures)
+
+
 @pytest.mark.parametrize(("n", "spacing"), [(17, None), (256, None), (30, 4.0)])
 def test_reach_circles_never_overlap(n: int, spacing: float | None) -> None:
     scene = crowd_scene(n, seed=n, spacing=spacing)
