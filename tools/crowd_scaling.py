@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import Any
 
 from matplotlib.figure import Figure
+from matplotlib.ticker import FuncFormatter, NullFormatter
 
 from ecs_tentacles.export.atomic import atomic_output
 
@@ -95,13 +96,19 @@ def plot(rows: list[dict[str, Any]], path: Path) -> None:
         label = f"{threads} thread" + ("s" if threads > 1 else "")
         build.plot(sizes, [r["build_s"] for r in ok], marker="o", label=label)
         frame.plot(sizes, [r["frame_ms_per_creature"] for r in ok], marker="o", label=label)
+    plain = FuncFormatter(lambda value, _: f"{value:g}")
+    sizes = sorted({row["creatures"] for row in rows})
     for axes, title in ((build, "build (s)"), (frame, "frame ms per creature")):
         axes.set_xscale("log")
+        axes.set_xticks(sizes, [str(n) for n in sizes])
+        axes.xaxis.set_minor_formatter(NullFormatter())
         axes.set_xlabel("creatures")
         axes.set_title(title)
         axes.grid(True, which="both", alpha=0.3)
         axes.legend()
     build.set_yscale("log")
+    build.yaxis.set_major_formatter(plain)
+    build.yaxis.set_minor_formatter(plain)
     figure.suptitle("ecs-tentacles bench --crowd N")
     with atomic_output(path) as temporary:
         figure.savefig(temporary, dpi=110)
