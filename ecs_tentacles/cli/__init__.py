@@ -7,11 +7,15 @@ exits with code 2, without a traceback.
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
+from types import FrameType
 
 from ecs_tentacles import __version__
 from ecs_tentacles.cli import bake, create, export, play, run, validate
+from ecs_tentacles.export.atomic import OutputError
 from ecs_tentacles.scene.errors import SceneError
 
 COMMANDS = {"validate": validate, "run": run, "play": play}
@@ -30,11 +34,45 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+class Terminated(BaseException):
+    """SIGTERM or SIGHUP arrived: unwinds like Ctrl-C so partial outputs are removed."""
+
+
+def _terminate(signum: int, frame: FrameType | None) -> None:
+    raise Terminated(signal.Signals(signum).name)
+
+
+@contextmanager
+def terminate_by_exception() -> Iterator[None]:
+    """While inside, SIGTERM and SIGHUP raise `Terminated` (main thread only)."""
+    wanted = (signal.SIGTERM, signal.SIGHUP)
+    try:
+        previous = {s: signal.signal(s, _terminate) for s in wanted}
+    except ValueError:  # not the main thread: leave signals alone
+        previous = {}
+    try:
+        yield
+    finally:
+        for number, handler in previous.items():
+            signal.signal(number, handler)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the `ecs-tentacles` console script; returns the exit code."""
     args = build_parser().parse_args(argv)
+    with terminate_by_exception():
+        return _run(args)
+
+
+def _run(args: argparse.Namespace) -> int:
     try:
         return int(args.handler(args))
+    except OutputError as error:
+        print(f"error: {error}", file=sys.stderr)
+        return 1
+    except Terminated as stop:
+        print(f"error: stopped by {stop}; partial outputs removed", file=sys.stderr)
+        return 143
     except SceneError as error:
         for problem in error.problems:
             print(f"error: {problem}", file=sys.stderr)

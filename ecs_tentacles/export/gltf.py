@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 
 from ecs_tentacles import __version__
-from ecs_tentacles.export.atomic import atomic_output
+from ecs_tentacles.export.atomic import atomic_file
 from ecs_tentacles.export.meshes import Mesh, body_mesh
 from ecs_tentacles.export.take import Take
 
@@ -224,5 +224,5 @@ def accessor_array(document: dict[str, Any], binary: bytes, index: int) -> np.nd
 def write_glb(take: Take, path: str | os.PathLike[str]) -> None:
     """Write `take` as a .glb file, atomically."""
     data = glb_bytes(*build_gltf(take))
-    with atomic_output(path) as temporary:
-        temporary.write_bytes(data)
+    with atomic_file(path) as handle:
+        handle.write(data)
