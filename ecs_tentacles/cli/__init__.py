@@ -16,6 +16,7 @@ from types import FrameType
 from ecs_tentacles import __version__
 from ecs_tentacles.cli import bake, create, export, play, run, validate
 from ecs_tentacles.export.atomic import OutputError
+from ecs_tentacles.scene import load
 from ecs_tentacles.scene.errors import SceneError
 
 COMMANDS = {"validate": validate, "run": run, "play": play}
@@ -28,6 +29,13 @@ def build_parser() -> argparse.ArgumentParser:
         description="Tentacled creatures from JSON scenes, simulated with MuJoCo.",
     )
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    parser.add_argument(
+        "--max-scene-mb",
+        type=scene_megabytes,
+        default=None,
+        metavar="MB",
+        help=f"largest scene file read (default {load.MAX_SCENE_BYTES >> 20})",
+    )
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for module in COMMANDS.values():
         module.add_parser(commands)
@@ -57,11 +65,28 @@ def terminate_by_exception() -> Iterator[None]:
             signal.signal(number, handler)
 
 
+def scene_megabytes(text: str) -> float:
+    """argparse type: a size in MB, > 0."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a number, got {text!r}") from None
+    if not 0 < value < 1e6:
+        raise argparse.ArgumentTypeError(f"must be in (0, 1000000), got {text}")
+    return value
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the `ecs-tentacles` console script; returns the exit code."""
     args = build_parser().parse_args(argv)
-    with terminate_by_exception():
-        return _run(args)
+    limit = load.MAX_SCENE_BYTES
+    if args.max_scene_mb is not None:
+        load.MAX_SCENE_BYTES = int(args.max_scene_mb * 1024**2)
+    try:
+        with terminate_by_exception():
+            return _run(args)
+    finally:
+        load.MAX_SCENE_BYTES = limit
 
 
 def _run(args: argparse.Namespace) -> int:

@@ -117,3 +117,37 @@ def test_every_bad_scene_exits_2_with_its_json_path(
     captured = capsys.readouterr()
     assert captured.err == f"error: {scene}: {expected}\n"
     assert captured.out == ""
+
+
+def test_validate_names_the_systems_a_scene_asks_for(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    scene = tmp_path / "systems.json"
+    scene.write_text(
+        json.dumps({"version": 1, "systems": ["mine.wiggle:Wiggle"], "creatures": [{}]})
+    )
+    assert main(["validate", str(scene)]) == 0
+    assert capsys.readouterr().out == (
+        f"{scene}: ok (1 creatures, 8 tentacles); asks to run systems mine.wiggle:Wiggle"
+        " (run, bake and play need --allow-systems)\n"
+    )
+    assert main(["validate", "--json", str(scene)]) == 0
+    assert json.loads(capsys.readouterr().out) == {
+        "scene": str(scene),
+        "creatures": 1,
+        "tentacles": 8,
+        "systems": ["mine.wiggle:Wiggle"],
+    }
+
+
+def test_the_scene_size_cap_has_an_override(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    scene = tmp_path / "padded.json"
+    scene.write_text(json.dumps({"version": 1, "creatures": [{}]}) + " " * (9 << 20))
+    assert main(["validate", str(scene)]) == 2
+    assert capsys.readouterr().err == (
+        f"error: {scene}: cannot read scene: larger than 8 MB (raise the limit with"
+        " --max-scene-mb)\n"
+    )
+    assert main(["--max-scene-mb", "10", "validate", str(scene)]) == 0
