@@ -1,7 +1,11 @@
-"""The `ecs-tentacles` command line: `validate` and `run` (headless).
+"""The `ecs-tentacles` command line: validate, run, play, bake, export, create.
 
-Bad input (a scene file, an argument) prints one line per problem to stderr and
-exits with code 2, without a traceback.
+It speaks one way: every error is one line `error: <where>: <what>` on stderr (one per
+problem for a scene), exit 2 for bad input (arguments, scenes, takes, no display),
+1 for a failure at run time (a write that lost a race, a crash), 130 for Ctrl-C and
+143 for SIGTERM; never a traceback unless `--debug` is given. Commands that report
+print a sentence by default and one JSON object with `--json`. SIGTERM and SIGHUP
+unwind like Ctrl-C, so no partial output is left behind.
 """
 
 from __future__ import annotations
@@ -15,7 +19,9 @@ from types import FrameType
 
 from ecs_tentacles import __version__
 from ecs_tentacles.cli import bake, create, export, play, run, validate
+from ecs_tentacles.cli.arguments import NoDisplay, OneLineParser
 from ecs_tentacles.export.atomic import OutputError
+from ecs_tentacles.export.take import TakeError
 from ecs_tentacles.scene import load
 from ecs_tentacles.scene.errors import SceneError
 
@@ -24,7 +30,7 @@ COMMANDS |= {"bake": bake, "export": export, "create": create}
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = OneLineParser(
         prog="ecs-tentacles",
         description="Tentacled creatures from JSON scenes, simulated with MuJoCo.",
     )
@@ -36,6 +42,7 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="MB",
         help=f"largest scene file read (default {load.MAX_SCENE_BYTES >> 20})",
     )
+    parser.add_argument("--debug", action="store_true", help="show tracebacks of failures")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for module in COMMANDS.values():
         module.add_parser(commands)
@@ -92,16 +99,31 @@ def main(argv: Sequence[str] | None = None) -> int:
 def _run(args: argparse.Namespace) -> int:
     try:
         return int(args.handler(args))
-    except OutputError as error:
-        print(f"error: {error}", file=sys.stderr)
-        return 1
-    except Terminated as stop:
-        print(f"error: stopped by {stop}; partial outputs removed", file=sys.stderr)
-        return 143
     except SceneError as error:
         for problem in error.problems:
             print(f"error: {problem}", file=sys.stderr)
         return 2
+    except (TakeError, NoDisplay) as error:
+        print(f"error: {error}", file=sys.stderr)
+        return 2
+    except OutputError as error:
+        print(f"error: {error}", file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
-        print("interrupted", file=sys.stderr)
+        print("error: interrupted (Ctrl-C); partial outputs removed", file=sys.stderr)
         return 130
+    except Terminated as stop:
+        print(f"error: stopped by {stop}; partial outputs removed", file=sys.stderr)
+        return 143
+    except Exception as error:
+        if args.debug:
+            raise
+        if type(error).__name__ == "NoSuchDisplayException":  # pyglet's, from any platform
+            print(f"error: {args.command}: {NoDisplay.advice(args.command)}", file=sys.stderr)
+            return 2
+        text = " ".join(str(error).split()) or "no details"
+        print(
+            f"error: {args.command}: {type(error).__name__}: {text} (--debug shows where)",
+            file=sys.stderr,
+        )
+        return 1
