@@ -62,20 +62,28 @@ class VideoWriter:
         self.path = Path(path)
         self.frames = 0
         self._output = AtomicOutput(self.path)
-        os.close(self._output.open())
+        descriptor = self._output.open()
         assert self._output.temporary is not None
         self.partial = self._output.temporary
+        linux = sys.platform.startswith("linux")
+        # On Linux ffmpeg opens /dev/fd/N: exactly the file we created, whatever
+        # happens to its name meanwhile; elsewhere it opens the name.
+        target = Path(f"/dev/fd/{descriptor}") if linux else self.partial
         try:
             self._process = subprocess.Popen(
-                ffmpeg_command(self.partial, width, height, fps),
+                ffmpeg_command(target, width, height, fps),
                 stdin=subprocess.PIPE,
                 stdout=subprocess.DEVNULL,
                 start_new_session=True,  # Ctrl-C reaches us, and we stop ffmpeg
-                preexec_fn=_die_with_parent if sys.platform.startswith("linux") else None,
+                preexec_fn=_die_with_parent if linux else None,
+                pass_fds=(descriptor,) if linux else (),
             )
         except BaseException:
             self._output.discard()
             raise
+        finally:
+            os.close(descriptor)
+        self._same_file = linux
 
     def add(self, pixels: np.ndarray) -> None:
         """Append one (height, width, 3) uint8 frame."""
@@ -99,7 +107,7 @@ class VideoWriter:
         if code != 0:
             self._output.discard()
             raise OutputError(f"{self.path}: ffmpeg failed (exit {code}); nothing written")
-        return self._output.commit()
+        return self._output.commit(same_file=self._same_file)
 
     def abort(self) -> None:
         """Stop ffmpeg now and leave nothing behind."""

@@ -194,3 +194,21 @@ def test_symlinks_planted_at_every_temporary_name_are_never_followed(
     assert (out / name).is_file() and not (out / name).is_symlink()
     assert sorted(p.name for p in out.iterdir()) == sorted([*planted, name])
     assert all((out / link).is_symlink() for link in planted)
+
+
+def test_a_temporary_file_swapped_for_a_symlink_mid_video_is_not_followed(
+    tmp_path: Path,
+) -> None:
+    from ecs_tentacles.export.atomic import OutputError
+
+    victim = tmp_path / "victim.txt"
+    victim.write_text("precious")
+    video = VideoWriter(tmp_path / "clip.mp4", 64, 64, 30.0)
+    video.partial.unlink()
+    video.partial.symlink_to(victim)  # someone who can write the folder, mid-recording
+    for _ in range(3):
+        video.add(np.zeros((64, 64, 3), np.uint8))
+    with pytest.raises(OutputError, match="was removed or replaced while writing"):
+        video.close()
+    assert victim.read_text() == "precious"
+    assert not (tmp_path / "clip.mp4").exists()
