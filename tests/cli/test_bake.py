@@ -154,15 +154,23 @@ def test_a_killed_bake_leaves_no_file_or_the_previous_one(tmp_path: Path) -> Non
     assert list(previous.parent.iterdir()) == [previous]
 
 
-def test_an_interrupted_bake_exits_130_and_leaves_nothing(tmp_path: Path) -> None:
+@pytest.mark.parametrize(
+    ("stop", "code", "line"),
+    [
+        (signal.SIGINT, 130, "error: interrupted (Ctrl-C); partial outputs removed"),
+        (signal.SIGTERM, 143, "error: stopped by SIGTERM; partial outputs removed"),
+    ],
+)
+def test_an_interrupted_bake_exits_with_one_line_and_leaves_nothing(
+    tmp_path: Path, stop: signal.Signals, code: int, line: str
+) -> None:
     out = tmp_path / "take.usda"
     process = _start_long_bake(out)
     time.sleep(0.3)
-    process.send_signal(signal.SIGINT)
+    process.send_signal(stop)
     _, err = process.communicate(timeout=30)
-    assert process.returncode == 130
-    assert err.strip().splitlines()[-1] == "error: interrupted (Ctrl-C); partial outputs removed"
-    assert "Traceback" not in err
+    assert process.returncode == code
+    assert err.strip().splitlines()[-1] == line and "Traceback" not in err
     assert list(tmp_path.iterdir()) == []
 
 
