@@ -151,3 +151,22 @@ def test_the_scene_size_cap_has_an_override(
         " --max-scene-mb)\n"
     )
     assert main(["--max-scene-mb", "10", "validate", str(scene)]) == 0
+
+
+def test_every_reporting_command_has_json(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    take, glb, scene = tmp_path / "t.npz", tmp_path / "t.glb", tmp_path / "c.json"
+    base = ["three_goals", "--seconds", "0.05", "--out", str(take), "--quiet"]
+    assert main(["bake", *base, "--json"]) == 0
+    baked = json.loads(capsys.readouterr().out)
+    assert (baked["out"], baked["frames"], baked["creatures"]) == (str(take), 4, 1)
+    assert main(["export", str(take), "--out", str(glb), "--quiet", "--json"]) == 0
+    exported = json.loads(capsys.readouterr().out)
+    assert exported["out"] == str(glb) and exported["frames"] == 4
+    assert len(exported["sha256"]) == 64
+    assert main(["create", "--tentacles", "3", "--out", str(scene), "--json"]) == 0
+    created = json.loads(capsys.readouterr().out)
+    assert (created["scene"], created["tentacles"]) == (str(scene), 3)
+    assert main(["run", str(scene), "--frames", "2", "--quiet", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["frames"] == 2
