@@ -215,8 +215,10 @@ def _read_entry(archive: zipfile.ZipFile, name: str, shape: tuple[int, ...] | No
             raise TakeError(f"{name}: dtype {dtype}, expected {DTYPES[name]}")
         if math.prod(stored) * dtype.itemsize > entry.file_size:
             raise TakeError(f"{name}: shape {tuple(stored)} holds more than the stored data")
-        if shape is None and len(stored) != 4:
-            raise TakeError(f"{name}: shape {stored}, expected (frames, guides, points, 3)")
+        if shape is None and (len(stored) != 4 or stored[2] < 2 or stored[3] != 3):
+            raise TakeError(
+                f"{name}: shape {tuple(stored)}, expected (frames, guides, points >= 2, 3)"
+            )
         if shape is not None and tuple(stored) != shape:
             raise TakeError(f"{name}: shape {tuple(stored)}, expected {shape} from the header")
         array = np.empty(stored[::-1], dtype).T if fortran else np.empty(stored, dtype)

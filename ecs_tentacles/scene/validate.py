@@ -196,13 +196,13 @@ def validate_scene(data: object) -> list[str]:
     Each problem is one line ``"<json path>: <message>"``. Semantic rules (override
     indices, unique names, overlapping mantles) are checked only once the schema passes.
     """
-    deep = _too_deep(data)
-    if deep is not None:
-        return [f"{format_path(deep)}: nested deeper than {MAX_DEPTH} levels"]
     schema = load_schema()
-    too_long = _limit_problems(data, schema, schema)
+    too_long = _limit_problems(data, schema, schema)  # iterative, stops at long arrays
     if too_long:  # checked first: validating a million goals would take minutes
         return [f"{format_path(path)}: {message}" for path, message in too_long]
+    deep = _too_deep(data)
+    if deep is not None:  # before anything recursive (jsonschema, deepcopy, json.dumps)
+        return [f"{format_path(deep)}: nested deeper than {MAX_DEPTH} levels"]
     errors = list(_validator().iter_errors(data))
     # A value of the wrong type (0.5 for an integer) may fail its range too: report the type.
     mistyped = {tuple(e.absolute_path) for e in errors if e.validator == "type"}

@@ -140,6 +140,12 @@ BROKEN_TAKES: dict[str, Callable[[Path, Path], None]] = {
     "goal_of_no_creature": edit(lambda h, a: h["goals"][0].update(creature=7)),
     "guide_owner_out_of_range": edit(lambda h, a: h["guides"].update(creatures=[5, 0, 0])),
     "bodies_not_a_list": edit(lambda h, a: h.update(bodies={"0": 1})),
+    "guides_of_one_point": edit(
+        lambda h, a: a.update(
+            guide_points=a["guide_points"][:, :, :1].copy(),
+            guide_widths=a["guide_widths"][:, :, :1].copy(),
+        )
+    ),
     "zip_bomb_directory": raw(_claim_huge),
     "corrupt_compressed_data": raw(_flip_middle),
     "truncated_file": raw(lambda data: data[: len(data) // 2]),
