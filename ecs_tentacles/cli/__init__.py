@@ -1,17 +1,28 @@
-"""The `ecs-tentacles` command line: `validate` and `run` (headless).
+"""The `ecs-tentacles` command line: validate, run, play, bake, export, create.
 
-Bad input (a scene file, an argument) prints one line per problem to stderr and
-exits with code 2, without a traceback.
+It speaks one way: every error is one line `error: <where>: <what>` on stderr (one per
+problem for a scene), exit 2 for bad input (arguments, scenes, takes, no display),
+1 for a failure at run time (a write that lost a race, a crash), 130 for Ctrl-C and
+143 for SIGTERM; never a traceback unless `--debug` is given. Commands that report
+print a sentence by default and one JSON object with `--json`. SIGTERM and SIGHUP
+unwind like Ctrl-C, so no partial output is left behind.
 """
 
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
+from types import FrameType
 
 from ecs_tentacles import __version__
 from ecs_tentacles.cli import bake, bench, create, crowd, export, play, run, validate
+from ecs_tentacles.cli.arguments import NoDisplay, OneLineParser
+from ecs_tentacles.export.atomic import OutputError
+from ecs_tentacles.export.take import TakeError
+from ecs_tentacles.scene import load
 from ecs_tentacles.scene.errors import SceneError
 
 COMMANDS = {"validate": validate, "run": run, "play": play}
@@ -20,26 +31,100 @@ COMMANDS |= {"crowd": crowd, "bench": bench}
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = OneLineParser(
         prog="ecs-tentacles",
         description="Tentacled creatures from JSON scenes, simulated with MuJoCo.",
     )
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    parser.add_argument(
+        "--max-scene-mb",
+        type=scene_megabytes,
+        default=None,
+        metavar="MB",
+        help=f"largest scene file read (default {load.MAX_SCENE_BYTES >> 20})",
+    )
+    parser.add_argument("--debug", action="store_true", help="show tracebacks of failures")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for module in COMMANDS.values():
         module.add_parser(commands)
     return parser
 
 
+class Terminated(BaseException):
+    """SIGTERM or SIGHUP arrived: unwinds like Ctrl-C so partial outputs are removed."""
+
+
+def _terminate(signum: int, frame: FrameType | None) -> None:
+    raise Terminated(signal.Signals(signum).name)
+
+
+@contextmanager
+def terminate_by_exception() -> Iterator[None]:
+    """While inside, SIGTERM and SIGHUP raise `Terminated` (main thread only)."""
+    wanted = (signal.SIGTERM, signal.SIGHUP)
+    try:
+        previous = {s: signal.signal(s, _terminate) for s in wanted}
+    except ValueError:  # not the main thread: leave signals alone
+        previous = {}
+    try:
+        yield
+    finally:
+        for number, handler in previous.items():
+            signal.signal(number, handler)
+
+
+def scene_megabytes(text: str) -> float:
+    """argparse type: a size in MB, > 0."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a number, got {text!r}") from None
+    if not 0 < value < 1e6:
+        raise argparse.ArgumentTypeError(f"must be in (0, 1000000), got {text}")
+    return value
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the `ecs-tentacles` console script; returns the exit code."""
     args = build_parser().parse_args(argv)
+    limit = load.MAX_SCENE_BYTES
+    if args.max_scene_mb is not None:
+        load.MAX_SCENE_BYTES = int(args.max_scene_mb * 1024**2)
+    try:
+        with terminate_by_exception():
+            return _run(args)
+    finally:
+        load.MAX_SCENE_BYTES = limit
+
+
+def _run(args: argparse.Namespace) -> int:
     try:
         return int(args.handler(args))
     except SceneError as error:
         for problem in error.problems:
             print(f"error: {problem}", file=sys.stderr)
         return 2
+    except (TakeError, NoDisplay) as error:
+        print(f"error: {error}", file=sys.stderr)
+        return 2
+    except OutputError as error:
+        print(f"error: {error}", file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
-        print("interrupted", file=sys.stderr)
+        print("error: interrupted (Ctrl-C); partial outputs removed", file=sys.stderr)
         return 130
+    except Terminated as stop:
+        print(f"error: stopped by {stop}; partial outputs removed", file=sys.stderr)
+        return 143
+    except Exception as error:
+        if args.debug:
+            raise
+        if type(error).__name__ == "NoSuchDisplayException":  # pyglet's, from any platform
+            print(f"error: {args.command}: {NoDisplay.advice(args.command)}", file=sys.stderr)
+            return 2
+        text = " ".join(str(error).split()) or "no details"
+        print(
+            f"error: {args.command}: {type(error).__name__}: {text} (--debug shows where)",
+            file=sys.stderr,
+        )
+        return 1

@@ -1,11 +1,47 @@
-"""argparse helpers shared by the commands: output files with known suffixes, one-line errors."""
+"""Shared command-line pieces: the one-line parser, output-file types, the display check."""
 
 from __future__ import annotations
 
 import argparse
+import os
+import sys
 from collections.abc import Callable
 from pathlib import Path
 from typing import NoReturn
+
+
+class OneLineParser(argparse.ArgumentParser):
+    """argparse, but a bad argument is one line `error: <where>: <what>` (exit 2).
+
+    `<where>` is the argument argparse names, or the command; `--help` shows usage.
+    """
+
+    def error(self, message: str) -> NoReturn:
+        text = " ".join(message.split())
+        where = "" if text.startswith("argument ") else f"{self.prog}: "
+        self.exit(2, f"error: {where}{text} (see {self.prog} --help)\n")
+
+
+class NoDisplay(Exception):
+    """A window was asked for on a machine without a display."""
+
+    ADVICE = {
+        "play": "no display to open a window on; use --headless (with --screenshot or --video)",
+        "create": "no display to open the creator window on; use --out FILE to write the"
+        " scene without a window",
+    }
+
+    @classmethod
+    def advice(cls, command: str) -> str:
+        return cls.ADVICE.get(command, "no display to open a window on")
+
+
+def require_display(command: str) -> None:
+    """Raise `NoDisplay` (one line) before pyglet tries to open a window with no display."""
+    if sys.platform.startswith("linux") and not (
+        os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
+    ):
+        raise NoDisplay(f"{command}: {NoDisplay.advice(command)}")
 
 
 def output_path(*suffixes: str) -> Callable[[str], Path]:
@@ -23,13 +59,3 @@ def output_path(*suffixes: str) -> Callable[[str], Path]:
         return path
 
     return check
-
-
-def one_line_errors(parser: argparse.ArgumentParser) -> argparse.ArgumentParser:
-    """Make `parser` report a bad argument as one line (no usage block) and exit 2."""
-
-    def error(message: str) -> NoReturn:
-        parser.exit(2, f"{parser.prog}: error: {message}\n")
-
-    parser.error = error  # type: ignore[method-assign]
-    return parser

@@ -11,9 +11,11 @@ from __future__ import annotations
 import argparse
 import hashlib
 import importlib.util
+import json
 import math
 import sys
 from pathlib import Path
+from typing import Any
 
 from tqdm import tqdm
 
@@ -79,6 +81,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         help="frames per second of the take (default: the scene's physics fps)",
     )
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
+    parser.add_argument("--json", action="store_true", help="print the summary as JSON")
     parser.add_argument(
         "--allow-systems", action="store_true", help="import and run the systems the scene names"
     )
@@ -106,7 +109,7 @@ def handle(args: argparse.Namespace) -> int:
     )
     take = bake(plan, progress=not args.quiet, allow_systems=args.allow_systems)
     save(take, args.out, progress=not args.quiet)
-    print(summary(take, args.out))
+    print(summary(take, args.out, args.json))
     return 0
 
 
@@ -121,12 +124,24 @@ def save(take: Take, path: Path, *, progress: bool) -> None:
         write(take, path, bar.update)
 
 
-def summary(take: Take, path: Path) -> str:
-    """One line: what was written and the file's SHA-256 (equal for equal bakes)."""
-    digest = hashlib.sha256(path.read_bytes()).hexdigest()
+def report(take: Take, path: Path) -> dict[str, Any]:
+    """What was written and the file's SHA-256 (equal for equal bakes)."""
     header = take.header
+    return {
+        "out": str(path),
+        "frames": take.frames,
+        "fps": take.fps,
+        **{key: len(header[key]) for key in ("creatures", "bodies", "suckers", "goals")},
+        "sha256": hashlib.sha256(path.read_bytes()).hexdigest(),
+    }
+
+
+def summary(take: Take, path: Path, as_json: bool = False) -> str:
+    """One line: the report as a sentence, or as JSON."""
+    r = report(take, path)
+    if as_json:
+        return json.dumps(r)
     return (
-        f"{path}: {take.frames} frames at {take.fps:g} fps, {len(header['creatures'])} creatures,"
-        f" {len(header['bodies'])} bodies, {len(header['suckers'])} suckers,"
-        f" {len(header['goals'])} goals; sha256 {digest}"
+        f"{path}: {r['frames']} frames at {r['fps']:g} fps, {r['creatures']} creatures,"
+        f" {r['bodies']} bodies, {r['suckers']} suckers, {r['goals']} goals; sha256 {r['sha256']}"
     )

@@ -14,22 +14,19 @@ import json
 from typing import Any
 
 from ecs_tentacles.bench import BLOCK, WARMUP, bench
-from ecs_tentacles.cli.arguments import one_line_errors
 from ecs_tentacles.cli.crowd import add_crowd_options, crowd_from_args
 from ecs_tentacles.cli.run import positive_int, seed_int
 from ecs_tentacles.scene.load import resolve_scene_path
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
-    parser = one_line_errors(
-        commands.add_parser(
-            "bench",
-            help="time building and running a scene or a generated crowd, headless",
-            description=(
-                "Build a scene (or a generated crowd), run it headless and report build seconds,"
-                " ms per frame, per system, and MuJoCo stepping the same models bare."
-            ),
-        )
+    parser = commands.add_parser(
+        "bench",
+        help="time building and running a scene or a generated crowd, headless",
+        description=(
+            "Build a scene (or a generated crowd), run it headless and report build seconds,"
+            " ms per frame, per system, and MuJoCo stepping the same models bare."
+        ),
     )
     source = parser.add_mutually_exclusive_group(required=True)
     source.add_argument("scene", nargs="?", metavar="SCENE", help="scene file or bundled name")

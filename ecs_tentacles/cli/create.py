@@ -14,11 +14,12 @@ applied; its Export button writes `--out`, or `<name>.json`.
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 from pathlib import Path
 from typing import Any
 
-from ecs_tentacles.cli.arguments import output_path
+from ecs_tentacles.cli.arguments import output_path, require_display
 from ecs_tentacles.cli.bake import positive_float
 from ecs_tentacles.cli.run import positive_int
 from ecs_tentacles.creator import SHAPE_KEYS, CreatureDesign, DesignError
@@ -70,6 +71,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--window", action="store_true", help="open the creator window even with --out"
     )
+    parser.add_argument("--json", action="store_true", help="print the summary as JSON")
     parser.add_argument("--from", dest="source", metavar="SCENE", help="start from this scene")
     parser.add_argument("--creature", default="0", help="--from: creature name or index")
     parser.add_argument("--name", help="creature name (letters, digits, _)")
@@ -107,13 +109,18 @@ def handle(args: argparse.Namespace) -> int:
         option = OPTIONS.get(error.field, "--tentacle")
         print(f"error: argument {option}: {error.message}", file=sys.stderr)
         return 2
-    links = sum(t.links for t in design.tentacles)
-    print(f"{args.out}: creature {design.name!r}: {len(design.tentacles)} tentacles, {links} links")
+    count, links = len(design.tentacles), sum(t.links for t in design.tentacles)
+    if args.json:
+        report = {"scene": str(args.out), "creature": design.name}
+        print(json.dumps({**report, "tentacles": count, "links": links}))
+    else:
+        print(f"{args.out}: creature {design.name!r}: {count} tentacles, {links} links")
     return 0
 
 
 def open_window(design: CreatureDesign, out: Path) -> int:
     """The interactive creator on `design`; Export writes `out`."""
+    require_display("create")
     from ecs_tentacles.render import configure
 
     configure(headless=False)

@@ -11,7 +11,7 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from ecs_tentacles.cli.arguments import one_line_errors, output_path
+from ecs_tentacles.cli.arguments import output_path
 from ecs_tentacles.cli.bake import positive_float
 from ecs_tentacles.cli.run import positive_int, seed_int
 from ecs_tentacles.scene.crowd import DEFAULT_SPECIES, crowd_scene, write_crowd_scene
@@ -68,15 +68,13 @@ def crowd_from_args(n: int, args: argparse.Namespace) -> dict[str, Any]:
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
-    parser = one_line_errors(
-        commands.add_parser(
-            "crowd",
-            help="write a scene of N varied creatures whose paths cross",
-            description=(
-                "Write a scene of N varied creatures (3-8 tentacles, varied sizes, some with fur)"
-                " on a jittered grid, each crawling to the far side of the crowd's centre."
-            ),
-        )
+    parser = commands.add_parser(
+        "crowd",
+        help="write a scene of N varied creatures whose paths cross",
+        description=(
+            "Write a scene of N varied creatures (3-8 tentacles, varied sizes, some with fur)"
+            " on a jittered grid, each crawling to the far side of the crowd's centre."
+        ),
     )
     parser.add_argument("n", type=positive_int, metavar="N", help="number of creatures (>= 1)")
     parser.add_argument(

@@ -8,20 +8,15 @@ from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
 
-from ecs_tentacles.cli.bake import output_file, save, summary, usd_missing
-from ecs_tentacles.export.take import Take, TakeError
+from ecs_tentacles.cli.arguments import output_path
+from ecs_tentacles.cli.bake import save, summary, usd_missing
+from ecs_tentacles.export.take import Take
 
 FORMATS = (".usd", ".usda", ".usdc", ".glb")
 
 
-def converted_file(text: str) -> Path:
-    """An output path for a conversion: USD or glTF (argparse type)."""
-    path = output_file(text)
-    if path.suffix.lower() not in FORMATS:
-        raise argparse.ArgumentTypeError(f"must end in one of {', '.join(FORMATS)}, got {text!r}")
-    return path
+converted_file = output_path(*FORMATS)  # an output path for a conversion: USD or glTF
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
@@ -39,6 +34,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         help=f"output file; its suffix picks the format ({', '.join(FORMATS)})",
     )
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
+    parser.add_argument("--json", action="store_true", help="print the summary as JSON")
     parser.set_defaults(handler=handle)
 
 
@@ -47,11 +43,7 @@ def handle(args: argparse.Namespace) -> int:
     if problem:
         print(f"error: {problem}", file=sys.stderr)
         return 2
-    try:
-        take = Take.load(args.take)
-    except TakeError as error:
-        print(f"error: {error}", file=sys.stderr)
-        return 2
+    take = Take.load(args.take)  # TakeError: one line, exit 2
     save(take, args.out, progress=not args.quiet)
-    print(summary(take, args.out))
+    print(summary(take, args.out, args.json))
     return 0

@@ -5,18 +5,23 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from typing import Any
 
-from ecs_tentacles.cli.arguments import output_path
+from ecs_tentacles.cli.arguments import output_path, require_display
 from ecs_tentacles.cli.run import positive_int, seed_int
 from ecs_tentacles.scene.load import resolve_scene_path
 
+SIZE_RULE = "an even number of pixels in [64, 8192]"
+
 
 def even_size(text: str) -> int:
-    value = positive_int(text)
+    """argparse type: a window or image side, an even number of pixels in [64, 8192]."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = -1
     if value % 2 or not 64 <= value <= 8192:
-        raise argparse.ArgumentTypeError(
-            f"must be an even number of pixels in [64, 8192], got {value}"
-        )
+        raise argparse.ArgumentTypeError(f"must be {SIZE_RULE}, got {text!r}")
     return value
 
 
@@ -36,22 +41,25 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.add_argument("--frames", type=positive_int, default=300, help="headless: frames to run")
     parser.add_argument("--screenshot", type=output_path(".png"), help="headless: final PNG")
     parser.add_argument("--video", type=output_path(".mp4"), help="headless: record an MP4")
-    parser.add_argument("--width", type=even_size, default=1280)
-    parser.add_argument("--height", type=even_size, default=720)
+    parser.add_argument("--width", type=even_size, default=1280, help=f"{SIZE_RULE} (default 1280)")
+    parser.add_argument("--height", type=even_size, default=720, help=f"{SIZE_RULE} (default 720)")
     parser.add_argument("--seed", type=seed_int, default=None, help="override the scene's seed")
     parser.add_argument("--allow-systems", action="store_true", help="run systems the scene names")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
+    parser.add_argument("--json", action="store_true", help="headless: the summary as JSON")
     parser.set_defaults(handler=handle)
 
 
 def handle(args: argparse.Namespace) -> int:
     if not args.headless and (args.screenshot or args.video):
         print(
-            "error: --screenshot and --video need --headless (in the window: F12, v)",
+            "error: argument --screenshot/--video: needs --headless (in the window: F12, v)",
             file=sys.stderr,
         )
         return 2
     path = resolve_scene_path(args.scene)
+    if not args.headless:
+        require_display("play")
     from ecs_tentacles.render import configure
 
     configure(headless=args.headless)
@@ -73,9 +81,17 @@ def handle(args: argparse.Namespace) -> int:
             result = sandbox.run_headless(
                 args.frames, screenshot=args.screenshot, video=args.video, progress=not args.quiet
             )
-            print(json.dumps({"scene": str(path), **result}))
+            report = {"scene": str(path), **result}
+            print(json.dumps(report) if args.json else sentence(report))
         else:
             sandbox.run()
     finally:
         sandbox.close()
     return 0
+
+
+def sentence(report: dict[str, Any]) -> str:
+    """`octopus.json: 300 frames (5.00 s simulated); wrote shot.png, clip.mp4`."""
+    written = [str(report[k]) for k in ("screenshot", "video") if k in report]
+    text = f"{report['scene']}: {report['frames']} frames ({report['sim_seconds']:.2f} s simulated)"
+    return text + (f"; wrote {', '.join(written)}" if written else "")

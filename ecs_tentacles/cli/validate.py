@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import argparse
+import json
 import sys
+from typing import Any
 
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.load import load_scene, resolve_scene_path
@@ -13,26 +15,52 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser = commands.add_parser(
         "validate",
         help="check scene files against the schema (exit 0 if all are valid, 2 if not)",
-        description="Check scene files; print one line per problem with its JSON path.",
+        description="Check scene files; print one line per problem with its JSON path, and"
+        " the systems a scene asks for (run, bake and play import them only with"
+        " --allow-systems).",
     )
     parser.add_argument(
         "scenes", nargs="+", metavar="SCENE", help="scene file or bundled scene name"
     )
+    parser.add_argument("--json", action="store_true", help="one JSON object per valid scene")
     parser.set_defaults(handler=handle)
+
+
+def summary(path: str, data: dict[str, Any]) -> dict[str, Any]:
+    """What a valid scene holds, for the sentence and for --json."""
+    creatures = data["creatures"]
+    return {
+        "scene": path,
+        "creatures": len(creatures),
+        "tentacles": sum(c["tentacles"]["count"] for c in creatures),
+        "systems": list(data.get("systems", [])),
+    }
+
+
+def sentence(report: dict[str, Any]) -> str:
+    """`octopus.json: ok (1 creatures, 8 tentacles)`, plus the systems it asks for."""
+    text = (
+        f"{report['scene']}: ok ({report['creatures']} creatures, {report['tentacles']} tentacles)"
+    )
+    if report["systems"]:
+        text += (
+            f"; asks to run systems {', '.join(report['systems'])}"
+            " (run, bake and play need --allow-systems)"
+        )
+    return text
 
 
 def handle(args: argparse.Namespace) -> int:
     failed = False
     for scene in args.scenes:
-        path = resolve_scene_path(scene)
         try:
+            path = resolve_scene_path(scene)
             data = load_scene(path)
         except SceneError as error:
             failed = True
             for problem in error.problems:
                 print(f"error: {problem}", file=sys.stderr)
             continue
-        creatures = data["creatures"]
-        tentacles = sum(c["tentacles"]["count"] for c in creatures)
-        print(f"{path}: ok ({len(creatures)} creatures, {tentacles} tentacles)")
+        report = summary(str(path), data)
+        print(json.dumps(report) if args.json else sentence(report))
     return 2 if failed else 0

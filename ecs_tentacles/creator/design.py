@@ -32,7 +32,7 @@ from typing import TYPE_CHECKING, Any
 
 from ecs_tentacles.construction import TentacleShape, tentacle_shape
 from ecs_tentacles.creator.limits import DesignError, checked, default
-from ecs_tentacles.export.atomic import atomic_output
+from ecs_tentacles.export.atomic import atomic_file
 from ecs_tentacles.scene.load import load_scene, resolve_scene_path
 from ecs_tentacles.scene.validate import load_schema
 
@@ -231,8 +231,8 @@ class CreatureDesign:
         """Validate the scene and write it as JSON to `path`, atomically."""
         scene = self.scene()
         load_scene(scene)  # raises SceneError if the schema disagrees with the design
-        with atomic_output(path) as temporary:
-            temporary.write_text(json.dumps(scene, indent=2) + "\n", encoding="utf-8")
+        with atomic_file(path) as handle:
+            handle.write((json.dumps(scene, indent=2) + "\n").encode())
 
     def preview_world(self) -> World:
         """The World of this design as exported (physics compiled, nothing stepped)."""

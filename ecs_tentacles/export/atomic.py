@@ -1,43 +1,130 @@
-"""Atomic file output: write beside the target, then rename over it in one step.
+"""The one output writer: every file the project writes appears whole or not at all.
 
-    with atomic_output("take.npz") as temporary:
-        write_everything(temporary)       # any path-taking writer (numpy, USD, json)
+    with atomic_output("take.npz") as temporary:    # for writers that take a path
+        write_everything(temporary)                 # (numpy, USD, ffmpeg)
+    with atomic_file("shot.png") as handle:         # for writers that take a file
+        handle.write(data)
 
 The temporary file sits in the target's folder (so the rename never crosses file
-systems), is flushed to disk, then `os.replace`d onto the target. If anything fails
-or the user presses Ctrl-C, the temporary file is removed and the target is left as
-it was: a reader never sees half a file where the output should be. A process killed
-outright (SIGKILL, power loss) can leave the hidden temporary file behind, never a
-partial target.
+systems) under a random name, `.take.3f9a1c2e.partial.npz`, created exclusively
+(`O_CREAT | O_EXCL | O_NOFOLLOW`): a file or symlink planted at that name is never
+opened or followed, another name is drawn. When the writer is done the file is
+fsynced and renamed onto the target, then the folder is fsynced.
+
+- Any exception (KeyboardInterrupt included, and SIGTERM once the CLI's handler turns
+  it into an exception) removes the temporary file and leaves the target as it was.
+- Two runs writing one target at the same time: exactly one wins. Each remembers what
+  the target was when it started; at the end, under a lock on the folder, a run whose
+  target changed meanwhile discards its own output and raises `OutputConflict`
+  instead of overwriting the other run's file.
+- A process killed outright (SIGKILL, power loss) can leave its hidden temporary file
+  behind (USD's own `.take.3f9a1c2e.partial.XXXXXX` too), never a partial target. The
+  next write to the same target removes such leftovers older than a day
+  (`STALE_SECONDS`) and says so on stderr.
 """
 
 from __future__ import annotations
 
 import contextlib
+import fcntl
 import os
+import re
 import secrets
+import stat
+import sys
+import time
 from collections.abc import Iterator
 from pathlib import Path
+from typing import BinaryIO
+
+STALE_SECONDS = 24 * 3600  # a partial file older than this is a dead run's leftover
+_CREATE = os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW | os.O_CLOEXEC
+
+Identity = tuple[int, int, int, int, int] | None
+
+
+class OutputError(OSError):
+    """An output could not be written; the message is one line naming the file."""
+
+
+class OutputConflict(OutputError):
+    """Another program replaced the target while this run was writing it."""
+
+
+def temporary_name(path: Path, token: str) -> Path:
+    """`take.usda` + token -> `.take.<token>.partial.usda` (the suffix picks writers' formats)."""
+    return path.with_name(f".{path.stem}.{token}.partial{path.suffix}")
+
+
+def _create_exclusive(path: Path) -> tuple[Path, int]:
+    """A new, empty temporary file beside `path` and its open descriptor (never a symlink)."""
+    while True:
+        candidate = temporary_name(path, secrets.token_hex(4))
+        try:
+            return candidate, os.open(candidate, _CREATE, 0o666)  # the umask applies
+        except FileExistsError:  # a leftover or a planted file or symlink: draw again
+            continue
+        except OSError as error:
+            raise OutputError(f"{path}: cannot write: {error.strerror or error}") from None
 
 
 def temporary_sibling(path: Path) -> Path:
-    """A new, empty, hidden file beside `path` that keeps its suffix (writers pick formats by it).
+    """Create an exclusive temporary file beside `path` (closed) and return its path."""
+    candidate, descriptor = _create_exclusive(path)
+    os.close(descriptor)
+    return candidate
 
-    `take.usda` -> `.take.3f9a1c2e.partial.usda`. Created with the user's umask, like
-    the target would be.
+
+def partial_pattern(path: Path) -> re.Pattern[str]:
+    """Names of this tool's temporary files for `path`: ours, USD's and the old fixed one."""
+    stem, suffix = re.escape(path.stem), re.escape(path.suffix)
+    return re.compile(
+        rf"^\.{stem}(?:\.[0-9a-f]{{8}}\.partial(?:{suffix}|\.[A-Za-z0-9]{{6}})|\.partial{suffix})$"
+    )
+
+
+def remove_stale_partials(path: Path, now: float | None = None) -> list[Path]:
+    """Delete this tool's temporary files for `path` older than a day; report each on stderr.
+
+    Only regular files owned by this user are touched (never a symlink's target).
     """
-    while True:
-        candidate = path.with_name(f".{path.stem}.{secrets.token_hex(4)}.partial{path.suffix}")
-        try:
-            with open(candidate, "xb"):
-                return candidate
-        except FileExistsError:  # pragma: no cover - 32 random bits collided
+    pattern = partial_pattern(path)
+    now = time.time() if now is None else now
+    removed: list[Path] = []
+    try:
+        names = os.listdir(path.parent)
+    except OSError:
+        return removed
+    for name in names:
+        if not pattern.match(name):
             continue
+        candidate = path.parent / name
+        try:
+            info = candidate.lstat()
+            if not stat.S_ISREG(info.st_mode) or info.st_uid != os.getuid():
+                continue
+            if now - info.st_mtime < STALE_SECONDS:
+                continue  # perhaps a run still writing
+            candidate.unlink()
+        except OSError:
+            continue
+        hours = (now - info.st_mtime) / 3600
+        print(
+            f"note: {path}: removed {name}, a partial file left by an interrupted run"
+            f" {hours:.0f} h ago",
+            file=sys.stderr,
+        )
+        removed.append(candidate)
+    return removed
 
 
-def _fsync_file(path: Path) -> None:
-    with open(path, "rb+") as handle:
-        os.fsync(handle.fileno())
+def _identity(path: Path) -> Identity:
+    """What the target is now (None: absent); any replacement changes it."""
+    try:
+        info = path.lstat()
+    except FileNotFoundError:
+        return None
+    return (info.st_dev, info.st_ino, info.st_size, info.st_mtime_ns, info.st_ctime_ns)
 
 
 def _fsync_folder(folder: Path) -> None:
@@ -55,20 +142,129 @@ def _fsync_folder(folder: Path) -> None:
 
 
 @contextlib.contextmanager
+def _folder_lock(folder: Path) -> Iterator[None]:
+    """Hold an exclusive flock on `folder` (brief: only around check + rename)."""
+    try:
+        descriptor = os.open(folder, os.O_RDONLY | os.O_DIRECTORY | os.O_CLOEXEC)
+    except OSError:  # pragma: no cover - a folder that cannot be opened: no lock
+        yield
+        return
+    try:
+        with contextlib.suppress(OSError):  # file systems without flock: no lock
+            fcntl.flock(descriptor, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(descriptor)  # releases the lock
+
+
+class AtomicOutput:
+    """One output in progress: `open()` the temporary file, then `commit()` or `discard()`.
+
+    `atomic_output` wraps this for `with` blocks; long-lived writers (a video recorded
+    over many frames) hold one directly.
+    """
+
+    def __init__(self, target: str | os.PathLike[str]):
+        self.target = Path(target)
+        self.temporary: Path | None = None
+        self._before: Identity = None
+        self._created: tuple[int, int] | None = None
+
+    def open(self) -> int:
+        """Clean stale leftovers, create the temporary file; returns its open descriptor."""
+        remove_stale_partials(self.target)
+        self._before = _identity(self.target)
+        self.temporary, descriptor = _create_exclusive(self.target)
+        info = os.fstat(descriptor)
+        self._created = (info.st_dev, info.st_ino)
+        return descriptor
+
+    def commit(self, *, same_file: bool = False) -> Path:
+        """Fsync the finished temporary file and rename it onto the target.
+
+        `same_file`: the writer wrote through our descriptor, so the file must still be
+        the one we created (path-based writers such as USD may replace it by rename).
+        Raises `OutputConflict` (and discards) if the target changed since `open()`.
+        """
+        assert self.temporary is not None, "open() first"
+        temporary = self.temporary
+        try:
+            descriptor = os.open(temporary, os.O_RDONLY | os.O_NOFOLLOW | os.O_CLOEXEC)
+        except OSError as error:
+            self.discard()
+            raise OutputError(
+                f"{self.target}: the temporary file {temporary.name} was"
+                f" removed or replaced while writing ({error.strerror})"
+            ) from None
+        try:
+            info = os.fstat(descriptor)
+            if not stat.S_ISREG(info.st_mode) or (
+                same_file and (info.st_dev, info.st_ino) != self._created
+            ):
+                raise OutputError(
+                    f"{self.target}: the temporary file {temporary.name} was replaced while"
+                    " writing; nothing written"
+                )
+            os.fsync(descriptor)
+        except BaseException:
+            self.discard()
+            raise
+        finally:
+            os.close(descriptor)
+        with _folder_lock(self.target.parent):
+            if _identity(self.target) != self._before:
+                self.discard()
+                raise OutputConflict(
+                    f"{self.target}: another program wrote this file while this run was"
+                    " writing it; kept theirs, discarded ours"
+                )
+            try:
+                os.replace(temporary, self.target)
+            except BaseException:
+                self.discard()
+                raise
+        self.temporary = None
+        _fsync_folder(self.target.parent)
+        return self.target
+
+    def discard(self) -> None:
+        """Remove the temporary file (if any); the target stays as it was."""
+        if self.temporary is not None:
+            with contextlib.suppress(FileNotFoundError):
+                self.temporary.unlink()
+            self.temporary = None
+
+
+@contextlib.contextmanager
 def atomic_output(target: str | os.PathLike[str]) -> Iterator[Path]:
     """Yield a temporary path to write; on success move it onto `target` atomically.
 
     On any exception (KeyboardInterrupt included) the temporary file is deleted, the
     target is untouched and the exception propagates.
     """
-    path = Path(target)
-    temporary = temporary_sibling(path)
+    output = AtomicOutput(target)
+    os.close(output.open())
+    assert output.temporary is not None
     try:
-        yield temporary
-        _fsync_file(temporary)
-        os.replace(temporary, path)
+        yield output.temporary
     except BaseException:
-        with contextlib.suppress(FileNotFoundError):
-            temporary.unlink()
+        output.discard()
         raise
-    _fsync_folder(path.parent)
+    output.commit()
+
+
+@contextlib.contextmanager
+def atomic_file(target: str | os.PathLike[str]) -> Iterator[BinaryIO]:
+    """Yield the exclusive temporary file, open for binary writing; then as `atomic_output`.
+
+    The writer never opens a path itself, so nothing planted in the folder is followed.
+    """
+    output = AtomicOutput(target)
+    descriptor = output.open()
+    try:
+        with os.fdopen(descriptor, "wb") as handle:
+            yield handle
+    except BaseException:
+        output.discard()
+        raise
+    output.commit(same_file=True)

@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 
 from ecs_tentacles import __version__
-from ecs_tentacles.export.atomic import atomic_output
+from ecs_tentacles.export.atomic import atomic_file
 from ecs_tentacles.export.meshes import Mesh, body_mesh
 from ecs_tentacles.export.take import Take
 
@@ -183,7 +183,7 @@ def _animation(
 
 def glb_bytes(document: dict[str, Any], binary: bytes) -> bytes:
     """A GLB container: 12-byte header, JSON chunk (space-padded), BIN chunk (zero-padded)."""
-    text = json.dumps(document, separators=(",", ":"), sort_keys=True).encode()
+    text = json.dumps(document, separators=(",", ":"), sort_keys=True, allow_nan=False).encode()
     text += b" " * (-len(text) % 4)
     binary += b"\0" * (-len(binary) % 4)
     total = 12 + 8 + len(text) + 8 + len(binary)
@@ -222,7 +222,8 @@ def accessor_array(document: dict[str, Any], binary: bytes, index: int) -> np.nd
 
 
 def write_glb(take: Take, path: str | os.PathLike[str]) -> None:
-    """Write `take` as a .glb file, atomically."""
+    """Write `take` as a .glb file, atomically; `TakeError` for a take glTF cannot hold."""
+    take.check_exportable(path)
     data = glb_bytes(*build_gltf(take))
-    with atomic_output(path) as temporary:
-        temporary.write_bytes(data)
+    with atomic_file(path) as handle:
+        handle.write(data)

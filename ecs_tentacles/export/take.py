@@ -30,14 +30,23 @@ import os
 import zipfile
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, BinaryIO
 
 import numpy as np
 
-from ecs_tentacles.export.atomic import atomic_output
+from ecs_tentacles.export.atomic import atomic_file
+from ecs_tentacles.export.take_read import (
+    FORMAT,
+    MAX_TAKE_BYTES,
+    OPTIONAL,
+    VERSION,
+    TakeError,
+    data_problem,
+    expected_shapes,
+    header_problem,
+    read_take,
+)
 
-FORMAT = "ecs_tentacles.take"
-VERSION = 1
 ARRAYS = (
     "header",
     "pos",
@@ -49,20 +58,8 @@ ARRAYS = (
     "guide_points",
     "guide_widths",
 )
-OPTIONAL = ("guide_points", "guide_widths")
-HEADER_KEYS: dict[str, type] = {
-    "fps": float,
-    "frames": int,
-    "creatures": list,
-    "bodies": list,
-    "suckers": list,
-    "goals": list,
-}
+__all__ = ["ARRAYS", "FORMAT", "VERSION", "Take", "TakeError", "write_npz"]
 _EPOCH = (1980, 1, 1, 0, 0, 0)  # the earliest zip date: no wall-clock time in the file
-
-
-class TakeError(ValueError):
-    """A take file cannot be read; the message is one line naming the file and the problem."""
 
 
 @dataclass
@@ -127,76 +124,47 @@ class Take:
     # -- files -------------------------------------------------------------------------
     def save(self, path: str | os.PathLike[str]) -> None:
         """Write the take to `path` atomically (see `ecs_tentacles.export.atomic`)."""
-        with atomic_output(path) as temporary:
-            write_npz(temporary, self.arrays())
+        with atomic_file(path) as handle:
+            write_npz(handle, self.arrays())
 
     @classmethod
-    def load(cls, path: str | os.PathLike[str]) -> Take:
-        """Read a take; raises `TakeError` (one line) when the file is not a valid take."""
-        where = Path(path)
-        if where.is_file() and not zipfile.is_zipfile(where):
-            raise TakeError(f"{where}: not a take file (not an npz archive)")
-        try:
-            with np.load(where, allow_pickle=False) as npz:
-                data = {name: npz[name] for name in npz.files}
-        except FileNotFoundError:
-            raise TakeError(f"{where}: no such file") from None
-        except (OSError, ValueError, zipfile.BadZipFile, EOFError) as exc:
-            raise TakeError(f"{where}: not a take file ({type(exc).__name__}: {exc})") from None
-        if not isinstance(data, dict) or "header" not in data:
-            raise TakeError(f"{where}: not a take file (no header)")
-        try:
-            header = json.loads(data["header"].tobytes().decode())
-        except (UnicodeDecodeError, json.JSONDecodeError) as exc:
-            raise TakeError(f"{where}: header: not JSON ({exc})") from None
-        take = cls(
-            header=header,
-            **{k: data.get(k) for k in ARRAYS[1:]},  # type: ignore[arg-type]
-        )
-        problem = take.problem()
-        if problem:
-            raise TakeError(f"{where}: {problem}")
-        return take
+    def load(cls, path: str | os.PathLike[str], max_bytes: int = MAX_TAKE_BYTES) -> Take:
+        """Read a take; raises `TakeError` (one line) when the file is not a sound take.
+
+        Takes are untrusted input: see `ecs_tentacles.export.take_read` for every check
+        (zip-bomb cap `max_bytes` on the uncompressed size, header, dtypes, shapes,
+        finite values) made before the exporters see the data.
+        """
+        header, arrays = read_take(Path(path), max_bytes)
+        return cls(header=header, **arrays)
 
     def problem(self) -> str | None:
-        """The first inconsistency between header and arrays, or None if the take is sound."""
-        header = self.header
-        if not isinstance(header, dict) or header.get("format") != FORMAT:
-            return f"header.format: expected {FORMAT!r}"
-        if header.get("version") != VERSION:
-            got = header.get("version")
-            return f"header.version: this reader knows version {VERSION}, got {got!r}"
-        for key, kind in HEADER_KEYS.items():
-            if not isinstance(header.get(key), kind):
-                return f"header.{key}: missing or not {kind.__name__}"
+        """The first problem of this (in-memory) take, as `Take.load` would report it."""
+        problem = header_problem(self.header)
+        if problem:
+            return problem
         missing = [k for k in ARRAYS[1:] if k not in OPTIONAL and getattr(self, k) is None]
         if missing:
             return f"{missing[0]}: missing"
-        frames, bodies = header["frames"], len(header["bodies"])
-        shapes: dict[str, tuple[int, ...]] = {
-            "pos": (frames, bodies, 3),
-            "quat": (frames, bodies, 4),
-            "sucker_attached": (frames, len(header["suckers"])),
-            "sucker_anchor": (frames, len(header["suckers"]), 3),
-            "goal_pos": (len(header["goals"]), 3),
-            "goal_active": (frames, len(header["goals"])),
-        }
-        if (self.guide_points is None) != (header.get("guides") is None):
+        if (self.guide_points is None) != (self.header.get("guides") is None):
             return "guide_points: present only when header.guides is"
-        if self.guide_points is not None:
-            guides = len(header["guides"]["creatures"])
-            points = self.guide_points.shape[2] if self.guide_points.ndim == 4 else -1
-            shapes["guide_points"] = (frames, guides, points, 3)
-            shapes["guide_widths"] = (frames, guides, points)
+        points = None if self.guide_points is None else self.guide_points.shape[2:3]
+        shapes = expected_shapes(self.header, points[0] if points else -1)
         for name, shape in shapes.items():
             value = getattr(self, name)
             if value is None or value.shape != shape:
                 got = None if value is None else value.shape
                 return f"{name}: shape {got}, expected {shape} from the header"
-        return None
+        return data_problem({k: v for k, v in self.arrays().items() if k != "header"})
+
+    def check_exportable(self, path: str | os.PathLike[str]) -> None:
+        """Raise `TakeError` (one line) unless exporters can write this take to `path`."""
+        problem = self.problem()
+        if problem:
+            raise TakeError(f"{path}: cannot export this take: {problem}")
 
 
-def write_npz(path: str | os.PathLike[str], arrays: dict[str, np.ndarray]) -> None:
+def write_npz(path: str | os.PathLike[str] | BinaryIO, arrays: dict[str, np.ndarray]) -> None:
     """Write `arrays` as an npz readable by `np.load`, byte-reproducibly.
 
     `np.savez` stamps each zip entry with the current time; here every entry gets the

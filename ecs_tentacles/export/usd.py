@@ -53,8 +53,10 @@ def write_usd(
 ) -> None:
     """Write `take` as a USD file (.usda text, .usdc or .usd binary), atomically.
 
-    `progress(n)` is called as bodies are written (n bodies at a time).
+    `progress(n)` is called as bodies are written (n bodies at a time). Raises
+    `TakeError` (one line) for a take USD cannot hold (non-finite numbers, bad names).
     """
+    take.check_exportable(path)
     stage = build_stage(take, progress)
     with atomic_output(path) as temporary:
         if not stage.GetRootLayer().Export(str(temporary)):

@@ -2,20 +2,28 @@
 
 Scenes are data only: they are parsed with :mod:`json` and nothing in them is executed
 or imported here (``systems`` import paths are only strings at this stage).
+
+Scene files are untrusted input: only regular files are read (a FIFO or a device is
+refused without blocking), at most ``MAX_SCENE_BYTES`` of them (the CLI's
+``--max-scene-mb`` changes it), and data nested deeper than ``validate.MAX_DEPTH`` or
+with arrays over the schema's ``maxItems`` is refused before it is walked further.
 """
 
 from __future__ import annotations
 
+import difflib
 import importlib.resources
 import json
 import os
 import pathlib
 import re
+import stat
 from typing import Any
 
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.validate import validate_scene, with_defaults
 
+MAX_SCENE_BYTES = 8 * 1024**2  # bundled scenes are a few kB; 1024 goals x 64 creatures fit
 _SCENE_NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.-]*$")
 
 
@@ -32,12 +40,44 @@ def _refuse_constant(name: str) -> Any:
     raise ValueError(f"{name} is not valid JSON")
 
 
+def _read_text(path: pathlib.Path) -> str:
+    """The file's text: a regular file of at most `MAX_SCENE_BYTES`, opened without blocking."""
+    descriptor = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_CLOEXEC)
+    mode = os.fstat(descriptor).st_mode
+    if not stat.S_ISREG(mode):
+        os.close(descriptor)
+        kind = (
+            "a folder"
+            if stat.S_ISDIR(mode)
+            else "a FIFO"
+            if stat.S_ISFIFO(mode)
+            else "a device or socket"
+        )
+        raise SceneError([f"{path}: cannot read scene: {kind}, not a regular file"])
+    with os.fdopen(descriptor, "rb") as handle:
+        data = handle.read(MAX_SCENE_BYTES + 1)
+    if len(data) > MAX_SCENE_BYTES:
+        raise SceneError(
+            [
+                f"{path}: cannot read scene: larger than {MAX_SCENE_BYTES / 1024**2:g} MB"
+                " (raise the limit with --max-scene-mb)"
+            ]
+        )
+    return data.decode("utf-8-sig")
+
+
 def _read_json(path: pathlib.Path) -> object:
     """Read and parse ``path``, raising SceneError with a one-line, located problem."""
     try:
-        text = path.read_text(encoding="utf-8-sig")
+        text = _read_text(path)
     except UnicodeDecodeError as exc:
         raise SceneError([f"{path}: cannot read scene: not UTF-8 text ({exc.reason})"]) from None
+    except FileNotFoundError as exc:
+        if len(path.parts) == 1:  # a bare name: perhaps a misspelt bundled scene
+            raise SceneError(
+                [f"{path}: no such file or bundled scene{_suggestion(path)}"]
+            ) from None
+        raise SceneError([f"{path}: cannot read scene: {exc.strerror}"]) from None
     except OSError as exc:
         raise SceneError([f"{path}: cannot read scene: {exc.strerror or exc}"]) from None
     try:
@@ -93,8 +133,17 @@ def bundled_scene(name: str) -> pathlib.Path:
     path = _scenes_dir() / f"{stem}.json"
     if not _SCENE_NAME.match(stem) or not path.is_file():
         available = ", ".join(bundled_scene_names()) or "none"
-        raise SceneError([f"{name}: no such bundled scene (available: {available})"])
+        hint = _suggestion(pathlib.Path(name)) or f" (available: {available})"
+        raise SceneError([f"{name}: no such bundled scene{hint}"])
     return path
+
+
+def _suggestion(path: pathlib.Path) -> str:
+    """`; did you mean 'octopus'?` for a bare name close to a bundled scene's, else ''."""
+    if len(path.parts) != 1:
+        return ""
+    close = difflib.get_close_matches(path.name.removesuffix(".json"), bundled_scene_names(), 1)
+    return f"; did you mean {close[0]!r}?" if close else ""
 
 
 def resolve_scene_path(arg: str) -> pathlib.Path:

@@ -15,7 +15,7 @@ import re
 from collections.abc import Iterable, Mapping, Sequence
 from typing import Any
 
-from jsonschema import Draft202012Validator, ValidationError
+from jsonschema import Draft202012Validator, ValidationError, validators
 
 from ecs_tentacles.fur.checks import fur_problems
 
@@ -33,6 +33,18 @@ _TYPE_NAMES = {
     "null": "null",
 }
 _MAX_SHOWN = 60
+MAX_DEPTH = 32  # a scene is about 8 levels deep; deeper data is refused before recursing
+
+
+def _is_integer(checker: object, value: object) -> bool:
+    """JSON Schema calls 8.0 an integer; a scene's counts and seeds must be written 8."""
+    return isinstance(value, int) and not isinstance(value, bool)
+
+
+_StrictValidator = validators.extend(
+    Draft202012Validator,
+    type_checker=Draft202012Validator.TYPE_CHECKER.redefine("integer", _is_integer),
+)
 
 
 @functools.cache
@@ -44,8 +56,8 @@ def load_schema() -> dict[str, Any]:
 
 
 @functools.cache
-def _validator() -> Draft202012Validator:
-    return Draft202012Validator(load_schema())
+def _validator() -> Any:
+    return _StrictValidator(load_schema())
 
 
 def format_path(path: Iterable[str | int]) -> str:
@@ -184,6 +196,13 @@ def validate_scene(data: object) -> list[str]:
     Each problem is one line ``"<json path>: <message>"``. Semantic rules (override
     indices, unique names, overlapping mantles) are checked only once the schema passes.
     """
+    schema = load_schema()
+    too_long = _limit_problems(data, schema, schema)  # iterative, stops at long arrays
+    if too_long:  # checked first: validating a million goals would take minutes
+        return [f"{format_path(path)}: {message}" for path, message in too_long]
+    deep = _too_deep(data)
+    if deep is not None:  # before anything recursive (jsonschema, deepcopy, json.dumps)
+        return [f"{format_path(deep)}: nested deeper than {MAX_DEPTH} levels"]
     errors = list(_validator().iter_errors(data))
     # A value of the wrong type (0.5 for an integer) may fail its range too: report the type.
     mistyped = {tuple(e.absolute_path) for e in errors if e.validator == "type"}
@@ -197,6 +216,44 @@ def validate_scene(data: object) -> list[str]:
         problems = _semantic_problems(with_defaults(data))
     unique = sorted(set(problems), key=_path_key)
     return [f"{format_path(path)}: {message}" for path, message in unique]
+
+
+def _too_deep(data: object) -> JsonPath | None:
+    """The path of the first value nested deeper than `MAX_DEPTH`, or None (no recursion)."""
+    stack: list[tuple[JsonPath, object]] = [((), data)]
+    while stack:
+        path, value = stack.pop()
+        if len(path) > MAX_DEPTH:
+            return path
+        if isinstance(value, dict):
+            stack.extend(((*path, str(k)), v) for k, v in value.items())
+        elif isinstance(value, list):
+            stack.extend(((*path, i), v) for i, v in enumerate(value))
+    return None
+
+
+def _limit_problems(
+    data: object, schema: Mapping[str, Any], root: Mapping[str, Any]
+) -> list[Problem]:
+    """Arrays longer than their schema's `maxItems`, found without descending into them."""
+    problems: list[Problem] = []
+    stack: list[tuple[JsonPath, object, Mapping[str, Any]]] = [((), data, schema)]
+    while stack:
+        path, value, node = stack.pop()
+        node = _resolve(node, root)
+        if isinstance(value, list):
+            if len(value) > node.get("maxItems", len(value)):
+                problems.append(
+                    (path, f"must have {_count_bounds(node, 'Items')}, got {len(value)}")
+                )
+            elif isinstance(node.get("items"), Mapping):
+                stack.extend(((*path, i), item, node["items"]) for i, item in enumerate(value))
+        elif isinstance(value, dict):
+            properties = node.get("properties", {})
+            stack.extend(
+                ((*path, k), v, properties[k]) for k, v in value.items() if k in properties
+            )
+    return sorted(problems, key=_path_key)
 
 
 def _resolve(schema: Mapping[str, Any], root: Mapping[str, Any]) -> Mapping[str, Any]:

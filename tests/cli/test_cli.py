@@ -117,3 +117,56 @@ def test_every_bad_scene_exits_2_with_its_json_path(
     captured = capsys.readouterr()
     assert captured.err == f"error: {scene}: {expected}\n"
     assert captured.out == ""
+
+
+def test_validate_names_the_systems_a_scene_asks_for(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    scene = tmp_path / "systems.json"
+    scene.write_text(
+        json.dumps({"version": 1, "systems": ["mine.wiggle:Wiggle"], "creatures": [{}]})
+    )
+    assert main(["validate", str(scene)]) == 0
+    assert capsys.readouterr().out == (
+        f"{scene}: ok (1 creatures, 8 tentacles); asks to run systems mine.wiggle:Wiggle"
+        " (run, bake and play need --allow-systems)\n"
+    )
+    assert main(["validate", "--json", str(scene)]) == 0
+    assert json.loads(capsys.readouterr().out) == {
+        "scene": str(scene),
+        "creatures": 1,
+        "tentacles": 8,
+        "systems": ["mine.wiggle:Wiggle"],
+    }
+
+
+def test_the_scene_size_cap_has_an_override(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    scene = tmp_path / "padded.json"
+    scene.write_text(json.dumps({"version": 1, "creatures": [{}]}) + " " * (9 << 20))
+    assert main(["validate", str(scene)]) == 2
+    assert capsys.readouterr().err == (
+        f"error: {scene}: cannot read scene: larger than 8 MB (raise the limit with"
+        " --max-scene-mb)\n"
+    )
+    assert main(["--max-scene-mb", "10", "validate", str(scene)]) == 0
+
+
+def test_every_reporting_command_has_json(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    take, glb, scene = tmp_path / "t.npz", tmp_path / "t.glb", tmp_path / "c.json"
+    base = ["three_goals", "--seconds", "0.05", "--out", str(take), "--quiet"]
+    assert main(["bake", *base, "--json"]) == 0
+    baked = json.loads(capsys.readouterr().out)
+    assert (baked["out"], baked["frames"], baked["creatures"]) == (str(take), 4, 1)
+    assert main(["export", str(take), "--out", str(glb), "--quiet", "--json"]) == 0
+    exported = json.loads(capsys.readouterr().out)
+    assert exported["out"] == str(glb) and exported["frames"] == 4
+    assert len(exported["sha256"]) == 64
+    assert main(["create", "--tentacles", "3", "--out", str(scene), "--json"]) == 0
+    created = json.loads(capsys.readouterr().out)
+    assert (created["scene"], created["tentacles"]) == (str(scene), 3)
+    assert main(["run", str(scene), "--frames", "2", "--quiet", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["frames"] == 2

@@ -2,14 +2,16 @@
 
 from __future__ import annotations
 
+import os
 import signal
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
 
-from ecs_tentacles.export.atomic import atomic_output
+from ecs_tentacles.export.atomic import STALE_SECONDS, OutputConflict, atomic_file, atomic_output
 
 
 def test_success_replaces_the_target_and_leaves_nothing_else(tmp_path: Path) -> None:
@@ -67,3 +69,58 @@ def test_a_writer_killed_mid_write_never_leaves_a_partial_target(
         assert target.read_bytes() == previous
     # what a kill can leave is the hidden temporary file, never the target
     assert next(p.name for p in tmp_path.iterdir() if p != target).startswith(".out.")
+
+
+# -- one writer for every output: exclusive names, races, signals, stale leftovers ----------
+
+
+def test_a_later_run_removes_stale_leftovers_of_this_tool_and_says_so(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    target = tmp_path / "take.usda"
+    day_old = time.time() - STALE_SECONDS - 60
+    stale = [
+        ".take.0123abcd.partial.usda",  # ours
+        ".take.0123abcd.partial.X6bhx5",  # USD's own temporary file, next to ours
+        ".take.partial.usda",  # the old fixed name
+    ]
+    kept = [".take.89abcdef.partial.usda", ".other.0123abcd.partial.usda", "take.0123.usda"]
+    for name in stale + kept:
+        (tmp_path / name).write_text("x")
+        os.utime(tmp_path / name, (day_old, day_old))
+    os.utime(tmp_path / kept[0])  # fresh: perhaps a run still writing
+    with atomic_output(target) as temporary:
+        temporary.write_text("#usda 1.0\n")
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([*kept, "take.usda"])
+    lines = capsys.readouterr().err.splitlines()
+    assert len(lines) == 3 and all("partial file left by an interrupted run" in x for x in lines)
+    assert {line.split("removed ")[1].split(",")[0] for line in lines} == set(stale)
+
+
+def test_a_planted_symlink_at_a_temporary_name_is_never_followed(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    victim = tmp_path / "victim.txt"
+    victim.write_text("precious")
+    tokens = iter(["deadbeef", "deadbeef", "0badf00d"])
+    monkeypatch.setattr("ecs_tentacles.export.atomic.secrets.token_hex", lambda n: next(tokens))
+    for name in (".out.deadbeef.partial.png", ".out.partial.png"):
+        (tmp_path / name).symlink_to(victim)
+    with atomic_file(tmp_path / "out.png") as handle:
+        handle.write(b"picture")
+    assert victim.read_text() == "precious"
+    assert (tmp_path / "out.png").read_bytes() == b"picture"
+    assert not (tmp_path / "out.png").is_symlink()
+    assert all((tmp_path / n).is_symlink() for n in (".out.deadbeef.partial.png",))
+
+
+def test_two_writers_to_one_path_exactly_one_wins(tmp_path: Path) -> None:
+    target = tmp_path / "take.npz"
+    with pytest.raises(OutputConflict) as caught:
+        with atomic_output(target) as first:
+            with atomic_output(target) as second:
+                second.write_bytes(b"second")
+            first.write_bytes(b"first")
+    assert target.read_bytes() == b"second"  # the one that finished first
+    assert str(caught.value).startswith(f"{target}: another program wrote this file")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["take.npz"]

@@ -9,6 +9,7 @@ import pytest
 from PIL import Image
 
 from ecs_tentacles.cli import main
+from ecs_tentacles.scene.load import bundled_scene
 
 
 def test_headless_play_writes_the_screenshot(
@@ -16,18 +17,23 @@ def test_headless_play_writes_the_screenshot(
 ) -> None:
     shot = tmp_path / "shot.png"
     argv = ["play", "three_goals", "--headless", "--frames", "3", "--quiet"]
-    assert main([*argv, "--screenshot", str(shot), "--width", "320", "--height", "180"]) == 0
-    result = json.loads(capsys.readouterr().out)
-    assert (result["frames"], result["screenshot"]) == (3, str(shot))
+    size = ["--width", "320", "--height", "180"]
+    assert main([*argv, "--screenshot", str(shot), *size]) == 0
+    scene = bundled_scene("three_goals")
+    assert capsys.readouterr().out == f"{scene}: 3 frames (0.05 s simulated); wrote {shot}\n"
     with Image.open(shot) as image:
         assert image.size == (320, 180)
+    assert main([*argv, "--screenshot", str(shot), *size, "--json"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert (result["frames"], result["screenshot"]) == (3, str(shot))
 
 
 @pytest.mark.parametrize(
     ("argv", "message"),
     [
-        (["--screenshot", "x.png"], "error: --screenshot and --video need --headless"),
+        (["--screenshot", "x.png"], "error: argument --screenshot/--video: needs --headless"),
         (["--headless", "--width", "333"], "argument --width: must be an even number of pixels"),
+        (["--headless", "--width", "0"], "argument --width: must be an even number of pixels"),
         (
             ["--headless", "--video", "clip.avi"],
             "argument --video: must end in .mp4, got 'clip.avi'",

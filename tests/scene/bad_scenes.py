@@ -227,7 +227,7 @@ BAD_SCENES: list[tuple[str, object, str]] = [
     (
         "no controls",
         scene({"fur": {"controls": []}}),
-        "creatures[0].fur.controls: must have at least 1 items, got 0",
+        "creatures[0].fur.controls: must have 1 to 64 items, got 0",
     ),
     (
         "duplicate control name",

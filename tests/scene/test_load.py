@@ -75,7 +75,7 @@ def test_missing_file(tmp_path: pathlib.Path) -> None:
 
 
 def test_directory_is_not_a_scene(tmp_path: pathlib.Path) -> None:
-    assert problems_of(tmp_path) == [f"{tmp_path}: cannot read scene: Is a directory"]
+    assert problems_of(tmp_path) == [f"{tmp_path}: cannot read scene: a folder, not a regular file"]
 
 
 def test_not_utf8(tmp_path: pathlib.Path) -> None:
@@ -148,7 +148,10 @@ def test_resolve_scene_path(
     assert resolve_scene_path("octopus") == scenes_dir / "octopus.json"
     assert resolve_scene_path("nowhere.json") == pathlib.Path("nowhere.json")
     assert problems_of(resolve_scene_path("nowhere.json")) == [
-        "nowhere.json: cannot read scene: No such file or directory"
+        "nowhere.json: no such file or bundled scene"
+    ]
+    assert problems_of(resolve_scene_path("octopuss")) == [
+        "octopuss: no such file or bundled scene; did you mean 'octopus'?"
     ]
 
 

@@ -1,0 +1,158 @@
+"""The CLI speaks one way: every bad invocation of every command is one stderr line.
+
+`error: <where>: <what>`, exit 2 for bad input and 1 for a failure at run time, no
+traceback, no usage block. In-process for speed; a few cases also as real processes
+(`python -m ecs_tentacles`, no display).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from ecs_tentacles.cli import main
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    folder = tmp_path_factory.mktemp("cli")
+    take = folder / "take.npz"
+    assert main(["bake", "three_goals", "--seconds", "0.05", "--out", str(take), "--quiet"]) == 0
+    junk = folder / "junk.npz"
+    junk.write_bytes(b"PK\x03\x04 not really")
+    fifo = folder / "fifo.json"
+    os.mkfifo(fifo)
+    deep = folder / "deep.json"
+    deep.write_text('{"version": 1, "x": ' + "[" * 500 + "]" * 500 + "}")
+    floats = folder / "floats.json"
+    floats.write_text(json.dumps({"version": 1, "creatures": [{"tentacles": {"count": 8.0}}]}))
+    return {"take": take, "junk": junk, "fifo": fifo, "deep": deep, "floats": floats}
+
+
+def _cases(f: dict[str, Path], out: Path) -> list[tuple[list[str], int]]:
+    take, fifo = str(f["take"]), str(f["fifo"])
+    npz, glb, js = str(out / "t.npz"), str(out / "t.glb"), str(out / "c.json")
+    return [
+        ([], 2),
+        (["frob"], 2),
+        (["--max-scene-mb", "0", "validate", "octopus"], 2),
+        (["validate"], 2),
+        (["validate", "octopuss"], 2),
+        (["validate", fifo], 2),
+        (["validate", "/dev/zero"], 2),
+        (["validate", str(f["deep"])], 2),
+        (["validate", str(f["floats"])], 2),
+        (["run"], 2),
+        (["run", "octopus", "--frames", "0"], 2),
+        (["run", "octopus", "--frames", "ten"], 2),
+        (["run", "octopus", "--seed", "-1"], 2),
+        (["run", "octopuss"], 2),
+        (["run", "/dev/zero"], 2),
+        (["run", "octopus", "--bogus"], 2),
+        (["play", "octopus", "--width", "0"], 2),
+        (["play", "octopus", "--height", "721"], 2),
+        (["play", "octopus", "--screenshot", str(out / "s.png")], 2),
+        (["play", "octopus", "--headless", "--video", "c.avi"], 2),
+        (["play", "octopus"], 2),  # no display
+        (["play", "octopuss", "--headless"], 2),
+        (["play", fifo, "--headless"], 2),
+        (["bake", "octopus"], 2),
+        (["bake", "octopus", "--seconds", "0", "--out", npz], 2),
+        (["bake", "octopus", "--seconds", "1e400", "--out", npz], 2),
+        (["bake", "octopus", "--seconds", "1", "--out", "x.fbx"], 2),
+        (["bake", "octopus", "--seconds", "1", "--out", "no/such/t.npz"], 2),
+        (["bake", "octopus", "--seconds", "1", "--out", npz, "--fps", "0"], 2),
+        (["bake", "octopus", "--seconds", "0.001", "--out", npz], 2),
+        (["bake", str(f["floats"]), "--seconds", "1", "--out", npz], 2),
+        (["export"], 2),
+        (["export", str(out / "none.npz"), "--out", glb], 2),
+        (["export", str(f["junk"]), "--out", glb], 2),
+        (["export", take, "--out", "x.fbx"], 2),
+        (["export", take, "--out", npz], 2),
+        (["export", take, "--out", "/proc/t.glb"], 1),  # cannot write there: run time
+        (["create", "--tentacles", "0", "--out", js], 2),
+        (["create", "--tentacles", "17", "--out", js], 2),
+        (["create", "--links", "8.5", "--out", js], 2),
+        (["create", "--tentacle", "two:links=3", "--out", js], 2),
+        (["create", "--out", "x.txt"], 2),
+        (["create", "--from", "octopuss", "--out", js], 2),
+        (["create"], 2),  # no display
+    ]
+
+
+def test_every_command_with_bad_arguments_gives_one_line(
+    files: dict[str, Path],
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    commands = set()
+    for argv, expected in _cases(files, tmp_path):
+        try:
+            code = main(argv)
+        except SystemExit as stop:
+            code = int(stop.code or 0)
+        captured = capsys.readouterr()
+        lines = captured.err.splitlines()
+        assert code == expected, (argv, captured.err)
+        assert len(lines) == 1 and lines[0].startswith("error: "), (argv, captured.err)
+        assert "Traceback" not in captured.err and captured.out == ""
+        commands.add(next((a for a in argv if not a.startswith("-")), ""))
+    assert {"validate", "run", "play", "bake", "export", "create"} <= commands
+    assert list(tmp_path.iterdir()) == []
+
+
+NO_DISPLAY = {
+    ("play", "octopus"): "error: play: no display to open a window on; use --headless",
+    ("create",): "error: create: no display to open the creator window on; use --out FILE",
+}
+
+
+@pytest.mark.parametrize("argv", sorted(NO_DISPLAY))
+def test_without_a_display_play_and_create_say_so_in_one_line(argv: tuple[str, ...]) -> None:
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+    process = subprocess.run(
+        [sys.executable, "-m", "ecs_tentacles", *argv],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=60,
+    )
+    assert process.returncode == 2
+    assert process.stderr.startswith(NO_DISPLAY[argv]) and process.stderr.count("\n") == 1
+
+
+def test_python_dash_m_and_did_you_mean() -> None:
+    process = subprocess.run(
+        [sys.executable, "-m", "ecs_tentacles", "validate", "octopuss"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert process.returncode == 2
+    assert process.stderr == (
+        "error: octopuss: no such file or bundled scene; did you mean 'octopus'?\n"
+    )
+
+
+def test_unexpected_failures_are_one_line_unless_debug(
+    files: dict[str, Path], capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    def broken(*args: object, **kwargs: object) -> None:
+        raise RuntimeError("the disk\nis on fire")
+
+    monkeypatch.setattr("ecs_tentacles.cli.export.save", broken)
+    argv = ["export", str(files["take"]), "--out", "/tmp/never.glb"]
+    assert main(argv) == 1
+    assert capsys.readouterr().err == (
+        "error: export: RuntimeError: the disk is on fire (--debug shows where)\n"
+    )
+    with pytest.raises(RuntimeError):
+        main(["--debug", *argv])

@@ -1,0 +1,78 @@
+"""Takes are untrusted input: every hand-broken take is refused with one line, exit 2."""
+
+from __future__ import annotations
+
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from ecs_tentacles.cli import main
+from ecs_tentacles.export.take import Take, TakeError
+from ecs_tentacles.export.take_read import read_take
+from tests.export.broken_takes import BROKEN_TAKES
+
+
+@pytest.fixture(scope="module")
+def good_take(tmp_path_factory: pytest.TempPathFactory, guided_take: Take) -> Path:
+    path = tmp_path_factory.mktemp("good") / "good.npz"
+    guided_take.save(path)
+    return path
+
+
+def test_the_corpus_is_large_and_starts_from_a_sound_take(good_take: Path) -> None:
+    assert len(BROKEN_TAKES) >= 30
+    header, arrays = read_take(good_take)
+    assert header["guides"] is not None and set(arrays) >= {"pos", "guide_points"}
+
+
+@pytest.mark.parametrize("case", sorted(BROKEN_TAKES))
+def test_export_refuses_every_broken_take_with_one_line(
+    case: str, good_take: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    bad = tmp_path / f"{case}.npz"
+    BROKEN_TAKES[case](good_take, bad)
+    out = tmp_path / "out"
+    out.mkdir()
+    suffix = ".glb" if sorted(BROKEN_TAKES).index(case) % 2 else ".usda"
+    assert main(["export", str(bad), "--out", str(out / f"x{suffix}"), "--quiet"]) == 2
+    captured = capsys.readouterr()
+    lines = captured.err.splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"error: {bad}: "), captured.err
+    assert captured.out == "" and list(out.iterdir()) == []
+
+
+def test_a_real_zip_bomb_is_refused_before_it_is_inflated(tmp_path: Path) -> None:
+    bomb = tmp_path / "bomb.npz"
+    with zipfile.ZipFile(bomb, "w", compression=zipfile.ZIP_DEFLATED) as archive:
+        with archive.open("pos.npy", "w", force_zip64=True) as entry:
+            np.lib.format.write_array_header_2_0(
+                entry, {"descr": "<f4", "fortran_order": False, "shape": (64, 1024, 1024)}
+            )
+            block = bytes(1 << 20)
+            for _ in range(256):
+                entry.write(block)
+    assert bomb.stat().st_size < 1 << 20  # 256 MiB of zeros in well under 1 MiB
+    with pytest.raises(TakeError, match="would expand to 268435"):
+        Take.load(bomb, max_bytes=64 << 20)
+
+
+@pytest.mark.parametrize("suffix", [".glb", ".usda", ".usdc"])
+def test_exporters_refuse_a_recorded_take_with_non_finite_numbers(
+    suffix: str, guided_take: Take, tmp_path: Path
+) -> None:
+    from dataclasses import replace
+
+    from ecs_tentacles.export import write
+
+    pos = guided_take.pos.copy()
+    pos[2, 3, 1] = np.nan
+    broken = replace(guided_take, pos=pos)
+    target = tmp_path / f"take{suffix}"
+    with pytest.raises(TakeError) as caught:
+        write(broken, target)
+    assert str(caught.value) == (
+        f"{target}: cannot export this take: pos: non-finite value nan at (2, 3, 1)"
+    )
+    assert list(tmp_path.iterdir()) == []
