@@ -19,7 +19,9 @@ from tqdm import tqdm
 
 from ecs_tentacles.cli.arguments import output_path
 from ecs_tentacles.cli.run import seed_int
-from ecs_tentacles.export import SUFFIXES, write
+from ecs_tentacles.cli.skin_options import add_arguments as add_skin_arguments
+from ecs_tentacles.cli.skin_options import skin_options
+from ecs_tentacles.export import SUFFIXES, Skin, write
 from ecs_tentacles.export.bake import BakePlan, bake, output_kind
 from ecs_tentacles.export.take import Take
 
@@ -79,6 +81,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         help="frames per second of the take (default: the scene's physics fps)",
     )
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_skin_arguments(parser)
     parser.add_argument(
         "--allow-systems", action="store_true", help="import and run the systems the scene names"
     )
@@ -104,21 +107,30 @@ def handle(args: argparse.Namespace) -> int:
         file=sys.stderr,
         flush=True,
     )
+    try:
+        skin = skin_options(args)
+    except ValueError as error:
+        print(f"error: {error}", file=sys.stderr)
+        return 2
     take = bake(plan, progress=not args.quiet, allow_systems=args.allow_systems)
-    save(take, args.out, progress=not args.quiet)
-    print(summary(take, args.out))
+    print(save(take, args.out, progress=not args.quiet, skin=skin))
     return 0
 
 
-def save(take: Take, path: Path, *, progress: bool) -> None:
-    """Write `take` to `path` in the format its suffix names; a bar for slow (USD) output."""
+def save(take: Take, path: Path, *, progress: bool, skin: Skin | None = None) -> str:
+    """Write `take` to `path` in the format its suffix names (a bar for slow, rigid USD
+    output); returns the summary line, with the key report when skinned."""
     slow = output_kind(path) == "usd"
     bodies = len(take.header["bodies"])
     disable = None if progress and slow else True
     with tqdm(
         total=bodies, unit="body", desc="usd", disable=disable, file=sys.stderr, leave=False
     ) as bar:
-        write(take, path, bar.update)
+        report = write(take, path, bar.update, skin)
+    line = summary(take, path)
+    if report is None:
+        return line
+    return f"{line}\n{path}: skinned, {path.stat().st_size} bytes, {report.line()}"
 
 
 def summary(take: Take, path: Path) -> str:

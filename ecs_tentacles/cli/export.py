@@ -1,7 +1,8 @@
 """`ecs-tentacles export TAKE --out FILE`: convert a take (.npz) to USD or glTF.
 
 The suffix of FILE picks the format (`.usd`, `.usda`, `.usdc`, `.glb`); the file is
-written atomically. A file that is not a take gives one line naming it and exit 2.
+written atomically. Creatures are skinned (a mesh on a joint skeleton with rotation
+keys) unless `--rigid`. A file that is not a take gives one line naming it and exit 2.
 """
 
 from __future__ import annotations
@@ -10,7 +11,9 @@ import argparse
 import sys
 from pathlib import Path
 
-from ecs_tentacles.cli.bake import output_file, save, summary, usd_missing
+from ecs_tentacles.cli.bake import output_file, save, usd_missing
+from ecs_tentacles.cli.skin_options import add_arguments as add_skin_arguments
+from ecs_tentacles.cli.skin_options import skin_options
 from ecs_tentacles.export.take import Take, TakeError
 
 FORMATS = (".usd", ".usda", ".usdc", ".glb")
@@ -39,6 +42,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         help=f"output file; its suffix picks the format ({', '.join(FORMATS)})",
     )
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_skin_arguments(parser)
     parser.set_defaults(handler=handle)
 
 
@@ -48,10 +52,10 @@ def handle(args: argparse.Namespace) -> int:
         print(f"error: {problem}", file=sys.stderr)
         return 2
     try:
+        skin = skin_options(args)
         take = Take.load(args.take)
-    except TakeError as error:
+    except (TakeError, ValueError) as error:
         print(f"error: {error}", file=sys.stderr)
         return 2
-    save(take, args.out, progress=not args.quiet)
-    print(summary(take, args.out))
+    print(save(take, args.out, progress=not args.quiet, skin=skin))
     return 0

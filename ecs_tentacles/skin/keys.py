@@ -20,17 +20,21 @@ ROOT_TOLERANCE_M = 0.0005  # the root translation channel's tolerance with reduc
 
 @dataclass(frozen=True)
 class KeyReport:
-    """Keys in all joint channels before and after, and the largest error left (deg, m)."""
+    """Keys in all joint channels before and after, the largest error left (deg, m), and
+    how many frames hold any key (a USD SkelAnimation samples all joints at those)."""
 
     before: int
     after: int
     max_rotation_error_deg: float
     max_translation_error_m: float
+    sample_frames: int  # frames where any channel keeps a key (USD's time samples)
+    frames: int
 
     def line(self) -> str:
         """One line for the CLI."""
         return (
-            f"keys {self.before} -> {self.after}; max error {self.max_rotation_error_deg:.3f} deg,"
+            f"keys {self.before} -> {self.after} (frames with a key: {self.sample_frames} of"
+            f" {self.frames}); max error {self.max_rotation_error_deg:.3f} deg,"
             f" {1000 * self.max_translation_error_m:.3f} mm"
         )
 

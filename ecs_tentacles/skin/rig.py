@@ -75,7 +75,7 @@ def skinned_creatures(
     """Every creature of `take` rigged, and the key counts and errors over all of them."""
     keys = keys or Keys()
     creatures: list[SkinnedCreature] = []
-    before = after = 0
+    before = after = samples = 0
     rotation_error = translation_error = 0.0
     for index in range(len(take.header["creatures"])):
         skeleton = creature_skeleton(take, index)
@@ -95,6 +95,7 @@ def skinned_creatures(
             translation_keys=translation_keys,
         )
         creatures.append(creature)
+        samples = max(samples, len(creature.sample_frames))
         before += frames * (joints + 1)
         after += int(rotation_keys.sum() + translation_keys.sum())
         every = np.arange(frames)
@@ -102,4 +103,5 @@ def skinned_creatures(
         rotation_error = max(rotation_error, float(error.max(initial=0.0)))
         moved = creature.translations_at(every)[:, 0] - animation.translation[:, 0]
         translation_error = max(translation_error, float(np.linalg.norm(moved, axis=1).max()))
-    return creatures, KeyReport(before, after, rotation_error, translation_error)
+    report = KeyReport(before, after, rotation_error, translation_error, samples, take.frames)
+    return creatures, report
