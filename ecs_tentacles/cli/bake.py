@@ -21,8 +21,9 @@ from ecs_tentacles.cli.arguments import output_path
 from ecs_tentacles.cli.run import seed_int
 from ecs_tentacles.cli.skin_options import add_arguments as add_skin_arguments
 from ecs_tentacles.cli.skin_options import skin_options
-from ecs_tentacles.export import SUFFIXES, Skin, write
+from ecs_tentacles.export import SUFFIXES, write
 from ecs_tentacles.export.bake import BakePlan, bake, output_kind
+from ecs_tentacles.export.skinned import Skin
 from ecs_tentacles.export.take import Take
 
 

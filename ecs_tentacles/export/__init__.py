@@ -12,13 +12,16 @@ from __future__ import annotations
 
 import os
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 from ecs_tentacles.export.bake import output_kind
-from ecs_tentacles.export.skinned import Skin, write_skinned
 from ecs_tentacles.export.take import Take, TakeError
-from ecs_tentacles.skin.keys import KeyReport
 
-__all__ = ["SUFFIXES", "Skin", "Take", "TakeError", "output_kind", "write"]
+if TYPE_CHECKING:
+    from ecs_tentacles.export.skinned import Skin
+    from ecs_tentacles.skin.keys import KeyReport
+
+__all__ = ["SUFFIXES", "Take", "TakeError", "output_kind", "write"]
 
 SUFFIXES = (".npz", ".usd", ".usda", ".usdc", ".glb")
 
@@ -37,6 +40,8 @@ def write(
     """
     kind = output_kind(path)
     if skin is not None and kind in ("usd", "gltf"):
+        from ecs_tentacles.export.skinned import write_skinned
+
         return write_skinned(take, path, skin)
     if kind == "take":
         take.save(path)

@@ -107,27 +107,62 @@ class Animation:
 
 
 def creature_skeleton(take: Take, creature: int) -> Skeleton:
-    """The skeleton of creature number `creature` of `take`, bound at the construction pose."""
+    """The skeleton of creature number `creature` of `take`, bound at the construction pose
+    placed at the mantle's frame-0 pose."""
     entry = take.header["creatures"][creature]
     bodies = take.header["bodies"]
     mantle = bodies[entry["mantle"]]
-    radius, height = float(mantle["radius"]), float(mantle["length"])
     chains = entry["tentacles"]
-    names, parents, indices = ["mantle"], [-1], [entry["mantle"]]
-    offset = [0.0]
+    tentacles = [
+        (
+            float(angle),
+            [float(bodies[i]["length"]) for i in chain],
+            [float(bodies[i]["radius"]) for i in chain],
+        )
+        for chain, angle in zip(chains, tentacle_angles(len(chains)), strict=True)
+    ]
+    layout = creature_layout(entry["name"], mantle["radius"], mantle["length"], tentacles)
+    body_index = [entry["mantle"], *(i for chain in chains for i in chain)]
+    pose = (take.quat[0, entry["mantle"]], take.pos[0, entry["mantle"]])
+    return build_skeleton(layout, np.array(body_index), *pose)
+
+
+def creature_layout(
+    name: str,
+    mantle_radius: float,
+    mantle_height: float,
+    tentacles: list[tuple[float, list[float], list[float]]],
+) -> CreatureLayout:
+    """A layout from (azimuth, link lengths, link radii) per tentacle; joints numbered
+    mantle first, then tentacle by tentacle, base to tip."""
+    made, first = [], 1
+    for angle, lengths, radii in tentacles:
+        joints = np.arange(first, first + len(lengths))
+        made.append(TentacleLayout(angle, np.array(lengths), np.array(radii), joints))
+        first += len(lengths)
+    return CreatureLayout(name, float(mantle_radius), float(mantle_height), made)
+
+
+def build_skeleton(
+    layout: CreatureLayout,
+    bodies: np.ndarray,
+    root_rotation: np.ndarray | None = None,
+    root_translation: np.ndarray | None = None,
+) -> Skeleton:
+    """The skeleton of `layout` bound at its construction pose, the mantle at the given
+    pose (the origin by default). `bodies` names the body (take index or store row) of
+    each joint."""
+    radius, height = layout.mantle_radius, layout.mantle_height
+    names, parents, offset = ["mantle"], [-1], [0.0]
     rest_rotation = [np.array([1.0, 0.0, 0.0, 0.0])]
     rest_translation = [np.zeros(3)]
-    tentacles = []
-    for k, (chain, angle) in enumerate(zip(chains, tentacle_angles(len(chains)), strict=True)):
-        lengths = np.array([bodies[i]["length"] for i in chain], dtype=np.float64)
-        radii = np.array([bodies[i]["radius"] for i in chain], dtype=np.float64)
-        joints = np.arange(len(names), len(names) + len(chain))
+    for k, tentacle in enumerate(layout.tentacles):
         path, parent = "mantle", 0
-        for i, body in enumerate(chain):
+        lengths, angle = tentacle.lengths, tentacle.angle
+        for i in range(len(lengths)):
             path = f"{path}/t{k}_link{i}"
             names.append(path)
             parents.append(parent)
-            indices.append(body)
             offset.append(-0.5 * lengths[i])
             if i == 0:
                 base = [radius * np.cos(angle), radius * np.sin(angle), -0.5 * height]
@@ -137,18 +172,18 @@ def creature_skeleton(take: Take, creature: int) -> Skeleton:
                 rest_rotation.append(np.array([1.0, 0.0, 0.0, 0.0]))
                 rest_translation.append(np.array([lengths[i - 1], 0.0, 0.0]))
             parent = len(names) - 1
-        tentacles.append(TentacleLayout(float(angle), lengths, radii, joints))
-    layout = CreatureLayout(entry["name"], radius, height, tentacles)
     rotation, translation = np.array(rest_rotation), np.array(rest_translation)
-    rotation[0] = take.quat[0, entry["mantle"]]
-    translation[0] = take.pos[0, entry["mantle"]]
+    if root_rotation is not None:
+        rotation[0] = root_rotation
+    if root_translation is not None:
+        translation[0] = root_translation
     parent_array = np.array(parents)
     world_rotation, world_translation = forward(parent_array, rotation, translation)
     return Skeleton(
         layout=layout,
         names=names,
         parents=parent_array,
-        bodies=np.array(indices),
+        bodies=np.asarray(bodies),
         offset=np.array(offset),
         rest_rotation=rotation,
         rest_translation=translation,
