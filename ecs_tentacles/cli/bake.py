@@ -25,6 +25,7 @@ from ecs_tentacles.export import SUFFIXES, write
 from ecs_tentacles.export.bake import BakePlan, bake, output_kind
 from ecs_tentacles.export.skinned import Skin
 from ecs_tentacles.export.take import Take
+from ecs_tentacles.skin.mesh import MeshError
 
 
 def positive_float(text: str) -> float:
@@ -114,7 +115,11 @@ def handle(args: argparse.Namespace) -> int:
         print(f"error: {error}", file=sys.stderr)
         return 2
     take = bake(plan, progress=not args.quiet, allow_systems=args.allow_systems)
-    print(save(take, args.out, progress=not args.quiet, skin=skin))
+    try:
+        print(save(take, args.out, progress=not args.quiet, skin=skin))
+    except MeshError as error:  # e.g. tentacle bases that overlap on the mantle
+        print(f"error: {error}", file=sys.stderr)
+        return 2
     return 0
 
 

@@ -15,6 +15,7 @@ from ecs_tentacles.cli.bake import output_file, save, usd_missing
 from ecs_tentacles.cli.skin_options import add_arguments as add_skin_arguments
 from ecs_tentacles.cli.skin_options import skin_options
 from ecs_tentacles.export.take import Take, TakeError
+from ecs_tentacles.skin.mesh import MeshError
 
 FORMATS = (".usd", ".usda", ".usdc", ".glb")
 
@@ -57,5 +58,9 @@ def handle(args: argparse.Namespace) -> int:
     except (TakeError, ValueError) as error:
         print(f"error: {error}", file=sys.stderr)
         return 2
-    print(save(take, args.out, progress=not args.quiet, skin=skin))
+    try:
+        print(save(take, args.out, progress=not args.quiet, skin=skin))
+    except MeshError as error:  # e.g. tentacle bases that overlap on the mantle
+        print(f"error: {error}", file=sys.stderr)
+        return 2
     return 0

@@ -19,7 +19,7 @@ from pyglet import gl
 
 from ecs_tentacles.components import Creature, Link, Tentacle, Transform
 from ecs_tentacles.render.gpu import FLOAT, _attribute, _buffer, _upload, _vertex_array
-from ecs_tentacles.skin.mesh import Detail, SkinMesh, creature_mesh
+from ecs_tentacles.skin.mesh import Detail, MeshError, SkinMesh, creature_mesh
 from ecs_tentacles.skin.skeleton import Skeleton, build_skeleton, creature_layout, quat_matrix
 
 if TYPE_CHECKING:
@@ -111,7 +111,7 @@ class SkinnedCreatures:
             if key not in cache:
                 try:
                     cache[key] = creature_mesh(skeleton, SANDBOX_DETAIL)
-                except ValueError:
+                except MeshError:
                     continue  # tentacle bases overlap: this one keeps its capsules
             mesh = cache[key]
             data = np.empty((len(mesh.positions), VERTEX_FLOATS), np.float32)

@@ -30,6 +30,10 @@ import numpy as np
 from ecs_tentacles.skin.skeleton import Skeleton, TentacleLayout
 
 
+class MeshError(ValueError):
+    """A creature cannot be meshed (one line naming the creature and the problem)."""
+
+
 @dataclass(frozen=True)
 class Detail:
     """Level of detail: rings per link, sides (a multiple of 4), tip cap rings, suckers."""
@@ -232,7 +236,7 @@ def _columns(
         end = angles[nxt] + (2 * np.pi if nxt <= t else 0.0) - half[nxt]
         gap = end - (angles[t] + half[t])
         if gap <= 1e-6:
-            raise ValueError(
+            raise MeshError(
                 f"creature {name}: tentacles t{t} and t{nxt} overlap at the mantle;"
                 " the skinned mesh needs room between tentacle bases"
             )

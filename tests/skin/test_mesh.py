@@ -111,3 +111,15 @@ def test_levels_of_detail_change_the_vertex_count(octopus_take: Take) -> None:
 def test_bad_detail_is_one_line(field: str, value: int, message: str) -> None:
     with pytest.raises(ValueError, match=f"^{message}$"):
         Detail(**{field: value})
+
+
+def test_tentacles_too_thick_for_the_mantle_are_one_line(octopus_take: Take) -> None:
+    from dataclasses import replace
+
+    from ecs_tentacles.skin.mesh import MeshError
+
+    skeleton = creature_skeleton(octopus_take, 0)
+    fat = [replace(t, radii=t.radii * 3) for t in skeleton.layout.tentacles]
+    crowded = replace(skeleton, layout=replace(skeleton.layout, tentacles=fat))
+    with pytest.raises(MeshError, match=r"^creature octopus: tentacles t0 and t1 overlap at the"):
+        creature_mesh(crowded)
