@@ -31,3 +31,11 @@ def make_world() -> Iterator[Callable[..., World]]:
     yield make
     for world in worlds:
         world.close()
+
+
+@pytest.fixture(scope="session")
+def octopus_take() -> Any:
+    """4 s of the bundled octopus scene at 30 fps (121 frames), baked once per session."""
+    from ecs_tentacles.export.bake import BakePlan, bake
+
+    return bake(BakePlan.make("octopus", seconds=4.0, fps=30.0), progress=False)

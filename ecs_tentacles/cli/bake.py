@@ -21,9 +21,14 @@ from tqdm import tqdm
 
 from ecs_tentacles.cli.arguments import output_path
 from ecs_tentacles.cli.run import seed_int
+from ecs_tentacles.cli.skin_options import add_arguments as add_skin_arguments
+from ecs_tentacles.cli.skin_options import skin_options
 from ecs_tentacles.export import SUFFIXES, write
 from ecs_tentacles.export.bake import BakePlan, bake, output_kind
+from ecs_tentacles.export.skinned import Skin
 from ecs_tentacles.export.take import Take
+from ecs_tentacles.skin.keys import KeyReport
+from ecs_tentacles.skin.mesh import MeshError
 
 
 def positive_float(text: str) -> float:
@@ -82,6 +87,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
     parser.add_argument("--json", action="store_true", help="print the summary as JSON")
+    add_skin_arguments(parser)
     parser.add_argument(
         "--allow-systems", action="store_true", help="import and run the systems the scene names"
     )
@@ -107,21 +113,31 @@ def handle(args: argparse.Namespace) -> int:
         file=sys.stderr,
         flush=True,
     )
+    try:
+        skin = skin_options(args)
+    except ValueError as error:
+        print(f"error: {error}", file=sys.stderr)
+        return 2
     take = bake(plan, progress=not args.quiet, allow_systems=args.allow_systems)
-    save(take, args.out, progress=not args.quiet)
-    print(summary(take, args.out, args.json))
+    try:
+        skinned = save(take, args.out, progress=not args.quiet, skin=skin)
+    except MeshError as error:  # e.g. tentacle bases that overlap on the mantle
+        print(f"error: {error}", file=sys.stderr)
+        return 2
+    print(summary(take, args.out, args.json, skinned))
     return 0
 
 
-def save(take: Take, path: Path, *, progress: bool) -> None:
-    """Write `take` to `path` in the format its suffix names; a bar for slow (USD) output."""
+def save(take: Take, path: Path, *, progress: bool, skin: Skin | None = None) -> KeyReport | None:
+    """Write `take` to `path` in the format its suffix names (a bar for slow, rigid USD
+    output); returns the key report when skinned."""
     slow = output_kind(path) == "usd"
     bodies = len(take.header["bodies"])
     disable = None if progress and slow else True
     with tqdm(
         total=bodies, unit="body", desc="usd", disable=disable, file=sys.stderr, leave=False
     ) as bar:
-        write(take, path, bar.update)
+        return write(take, path, bar.update, skin)
 
 
 def report(take: Take, path: Path) -> dict[str, Any]:
@@ -136,12 +152,17 @@ def report(take: Take, path: Path) -> dict[str, Any]:
     }
 
 
-def summary(take: Take, path: Path, as_json: bool = False) -> str:
-    """One line: the report as a sentence, or as JSON."""
+def summary(take: Take, path: Path, as_json: bool = False, skinned: KeyReport | None = None) -> str:
+    """The report as a sentence (a second line for skinned creatures), or as JSON."""
     r = report(take, path)
+    if skinned is not None:
+        r["skinned"] = skinned.line()
     if as_json:
         return json.dumps(r)
-    return (
+    line = (
         f"{path}: {r['frames']} frames at {r['fps']:g} fps, {r['creatures']} creatures,"
         f" {r['bodies']} bodies, {r['suckers']} suckers, {r['goals']} goals; sha256 {r['sha256']}"
     )
+    if skinned is None:
+        return line
+    return f"{line}\n{path}: skinned, {path.stat().st_size} bytes, {r['skinned']}"

@@ -1,7 +1,8 @@
 """`ecs-tentacles export TAKE --out FILE`: convert a take (.npz) to USD or glTF.
 
 The suffix of FILE picks the format (`.usd`, `.usda`, `.usdc`, `.glb`); the file is
-written atomically. A file that is not a take gives one line naming it and exit 2.
+written atomically. Creatures are skinned (a mesh on a joint skeleton with rotation
+keys) unless `--rigid`. A file that is not a take gives one line naming it and exit 2.
 """
 
 from __future__ import annotations
@@ -11,7 +12,10 @@ import sys
 
 from ecs_tentacles.cli.arguments import output_path
 from ecs_tentacles.cli.bake import save, summary, usd_missing
+from ecs_tentacles.cli.skin_options import add_arguments as add_skin_arguments
+from ecs_tentacles.cli.skin_options import skin_options
 from ecs_tentacles.export.take import Take
+from ecs_tentacles.skin.mesh import MeshError
 
 FORMATS = (".usd", ".usda", ".usdc", ".glb")
 
@@ -35,6 +39,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
     parser.add_argument("--json", action="store_true", help="print the summary as JSON")
+    add_skin_arguments(parser)
     parser.set_defaults(handler=handle)
 
 
@@ -43,7 +48,16 @@ def handle(args: argparse.Namespace) -> int:
     if problem:
         print(f"error: {problem}", file=sys.stderr)
         return 2
+    try:
+        skin = skin_options(args)
+    except ValueError as error:
+        print(f"error: {error}", file=sys.stderr)
+        return 2
     take = Take.load(args.take)  # TakeError: one line, exit 2
-    save(take, args.out, progress=not args.quiet)
-    print(summary(take, args.out, args.json))
+    try:
+        skinned = save(take, args.out, progress=not args.quiet, skin=skin)
+    except MeshError as error:  # e.g. tentacle bases that overlap on the mantle
+        print(f"error: {error}", file=sys.stderr)
+        return 2
+    print(summary(take, args.out, args.json, skinned))
     return 0

@@ -4,16 +4,22 @@
     write(take, "octopus.usda")                          # or .npz, .usd, .usdc, .glb
 
 Modules: `take` (the file format), `recording` (World -> Take), `bake` (headless
-runs), `usd`, `gltf`, `atomic` (temporary file + rename).
+runs), `usd`, `gltf` (rigid bodies), `skinned`, `skinned_usd`, `skinned_gltf` (skinned
+creatures, `ecs_tentacles.skin`), `atomic` (temporary file + rename).
 """
 
 from __future__ import annotations
 
 import os
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 from ecs_tentacles.export.bake import output_kind
 from ecs_tentacles.export.take import Take, TakeError
+
+if TYPE_CHECKING:
+    from ecs_tentacles.export.skinned import Skin
+    from ecs_tentacles.skin.keys import KeyReport
 
 __all__ = ["SUFFIXES", "Take", "TakeError", "output_kind", "write"]
 
@@ -21,13 +27,22 @@ SUFFIXES = (".npz", ".usd", ".usda", ".usdc", ".glb")
 
 
 def write(
-    take: Take, path: str | os.PathLike[str], progress: Callable[[int], object] | None = None
-) -> None:
+    take: Take,
+    path: str | os.PathLike[str],
+    progress: Callable[[int], object] | None = None,
+    skin: Skin | None = None,
+) -> KeyReport | None:
     """Write `take` in the format its suffix names (see `SUFFIXES`), atomically.
 
-    `progress(n)` hears of bodies written, for the slow format (USD).
+    `progress(n)` hears of bodies written, for the slow format (USD). With `skin`, USD
+    and glTF get skinned creatures (`ecs_tentacles.export.skinned`) and the key report
+    is returned; without, rigid bodies.
     """
     kind = output_kind(path)
+    if skin is not None and kind in ("usd", "gltf"):
+        from ecs_tentacles.export.skinned import write_skinned
+
+        return write_skinned(take, path, skin)
     if kind == "take":
         take.save(path)
     elif kind == "usd":
@@ -40,3 +55,4 @@ def write(
         write_glb(take, path)
     else:
         raise ValueError(f"{path}: unknown output format (use {', '.join(SUFFIXES)})")
+    return None

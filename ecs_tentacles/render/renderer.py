@@ -1,9 +1,12 @@
-"""Draws a World: ground grid, mantles, links, attached suckers, goals and paths.
+"""Draws a World: ground grid, creatures, attached suckers, goals and paths.
 
-Per frame: one numpy pass fills each mesh kind's instance array from the Transform
-store (interpolated between the last two physics frames), one upload per kind, one
-instanced draw per kind (links in two levels of detail). Draw calls do not grow with
-the number of creatures.
+Creatures are drawn skinned by default (`view = "skinned"`: one continuous mesh per
+creature, skinned on the GPU, all creatures in one draw; `ecs_tentacles.render.skinned`)
+or as the physics sees them (`view = "capsules"`: a cylinder per mantle, a capsule per
+link). Per frame: one numpy pass fills each mesh kind's instance array from the
+Transform store (interpolated between the last two physics frames), one upload per
+kind, one draw per kind (capsule links in two levels of detail). Draw calls do not
+grow with the number of creatures.
 """
 
 from __future__ import annotations
@@ -28,11 +31,13 @@ from ecs_tentacles.render.gpu import (
     set_matrix,
 )
 from ecs_tentacles.render.meshes import CAPSULE_LODS, CYLINDER_LOD, SPHERE_LOD
+from ecs_tentacles.render.skinned import SkinnedCreatures
 from ecs_tentacles.world import World
 
 SKY = (0.70, 0.76, 0.82)
 LIGHT = np.array([0.35, -0.45, 0.82]) / np.linalg.norm([0.35, -0.45, 0.82])
 LOD_DISTANCE = 6.0  # metres from the eye beyond which links use the lean mesh
+VIEWS = ("skinned", "capsules")
 RING_SEGMENTS = 48
 _ANGLES = np.linspace(0, 2 * np.pi, RING_SEGMENTS + 1)
 CIRCLE = np.stack([np.cos(_ANGLES), np.sin(_ANGLES), np.zeros_like(_ANGLES)], axis=1)
@@ -60,6 +65,9 @@ class Renderer:
         self.lit = program(shaders.INSTANCED_VERTEX, shaders.LIT_FRAGMENT)
         self.ground_program = program(shaders.GROUND_VERTEX, shaders.GROUND_FRAGMENT)
         self.line_program = program(shaders.LINE_VERTEX, shaders.LINE_FRAGMENT)
+        self.skinned_program = program(shaders.SKINNED_VERTEX, shaders.LIT_FRAGMENT)
+        self.skinned = SkinnedCreatures()
+        self.view = "skinned"
         self.ground = Quad(200.0)
         self.mantles = InstancedMesh(CYLINDER_LOD)
         self.links_near = InstancedMesh(CAPSULE_LODS[0])
@@ -94,7 +102,7 @@ class Renderer:
             mantle[i, 7:11] = (r, r, h / 2, 0.0)
             mantle[i, 11:15] = (*colours[i], 1.0)
         self.mantle_instances = mantle
-        link_rows, link_static = [], []
+        link_rows, link_static, link_creature = [], [], []
         for i, entity in enumerate(self.creature_entities):
             creature = world.component(entity, Creature)
             for tentacle_entity in creature.tentacles:
@@ -104,6 +112,7 @@ class Renderer:
                     link = world.component(link_entity, Link)
                     shade = 1.0 - 0.35 * link.index / max(n - 1, 1)
                     link_rows.append(world.component(link_entity, Transform).row)
+                    link_creature.append(i)
                     colour = np.clip(colours[i] * shade + 0.08 * (1 - shade), 0, 1)
                     link_static.append(
                         (link.radius, link.radius, link.radius, link.length / 2, *colour, 1.0)
@@ -112,6 +121,15 @@ class Renderer:
         self.link_instances = np.zeros((len(link_rows), INSTANCE_FLOATS), np.float32)
         if link_rows:
             self.link_instances[:, 7:] = np.array(link_static)
+        self.skinned.build(world, self.creature_entities, self.creature_colour)
+        meshed = set(self.skinned.creatures)
+        self.mantle_skinned = np.array([e in meshed for e in self.creature_entities], bool)
+        self.link_skinned = self.mantle_skinned[np.array(link_creature, dtype=np.int64)]
+
+    def toggle_view(self) -> str:
+        """Switch between the skinned and the capsule view; returns the new view."""
+        self.view = VIEWS[(VIEWS.index(self.view) + 1) % len(VIEWS)]
+        return self.view
 
     # -- per frame -----------------------------------------------------------------------
     def sync(self) -> None:
@@ -131,14 +149,18 @@ class Renderer:
         pos, quat = self.poses(alpha)
         if self.camera.follow is not None:
             self.camera.target = pos[self.camera.follow] * [1, 1, 0]
+        skinned = self.view == "skinned"
         m = self.mantle_instances
         m[:, 0:3], m[:, 3:7] = pos[self.mantle_rows], quat[self.mantle_rows]
-        self.mantles.update(m)
+        self.mantles.update(m[~self.mantle_skinned] if skinned else m)
         links = self.link_instances
         links[:, 0:3], links[:, 3:7] = pos[self.link_rows], quat[self.link_rows]
         near = np.linalg.norm(links[:, 0:3] - self.camera.eye, axis=1) < LOD_DISTANCE
-        self.links_near.update(links[near])
-        self.links_far.update(links[~near])
+        capsules = ~self.link_skinned if skinned else np.ones(len(links), bool)
+        self.links_near.update(links[near & capsules])
+        self.links_far.update(links[~near & capsules])
+        if skinned:
+            self.skinned.update(pos, quat)
         self.suckers.update(self._sucker_instances())
         self.lines.update(self._line_vertices(pos))
 
@@ -227,6 +249,13 @@ class Renderer:
         self.lit["u_eye"] = eye
         for mesh in (self.mantles, self.links_near, self.links_far, self.suckers):
             calls += mesh.draw()
+        if self.view == "skinned":
+            self.skinned_program.use()
+            set_matrix(self.skinned_program, "u_view_projection", view_projection)
+            self.skinned_program["u_light"] = tuple(LIGHT.astype(np.float32))
+            self.skinned_program["u_eye"] = eye
+            self.skinned_program["u_palette"] = 0
+            calls += self.skinned.draw()
         self.line_program.use()
         set_matrix(self.line_program, "u_view_projection", view_projection)
         gl.glLineWidth(1.0)

@@ -242,6 +242,8 @@ class Sandbox:
             camera.follow = None if camera.follow == row else row
         elif symbol == key.A:
             self.renderer.frame_all()
+        elif symbol == key.C:
+            print(f"view: {self.renderer.toggle_view()}")
         elif symbol == key.TAB:
             self.hud._step_tentacle(-1 if modifiers & key.MOD_SHIFT else 1)
         elif symbol == key.F12:

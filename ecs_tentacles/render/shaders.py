@@ -98,3 +98,33 @@ in vec4 v_colour;
 out vec4 f_colour;
 void main() { f_colour = v_colour; }
 """
+
+SKINNED_VERTEX = """
+#version 330 core
+layout(location = 0) in vec3 a_position;   // bind pose, the creature's mantle frame
+layout(location = 1) in vec3 a_normal;
+layout(location = 2) in vec3 a_colour;
+layout(location = 3) in vec2 a_joints;     // two palette indices
+layout(location = 4) in float a_weight;    // of the second joint
+uniform mat4 u_view_projection;
+uniform sampler2D u_palette;  // 3 texels (rows of world * bind^-1) per joint, 512 joints a row
+out vec3 v_normal;
+out vec4 v_colour;
+out vec3 v_world;
+
+mat4 joint(float index) {
+    int j = int(index + 0.5);
+    ivec2 at = ivec2(3 * (j % 512), j / 512);
+    return transpose(mat4(texelFetch(u_palette, at, 0), texelFetch(u_palette, at + ivec2(1, 0), 0),
+                          texelFetch(u_palette, at + ivec2(2, 0), 0), vec4(0.0, 0.0, 0.0, 1.0)));
+}
+
+void main() {
+    mat4 m = (1.0 - a_weight) * joint(a_joints.x) + a_weight * joint(a_joints.y);
+    vec4 world = m * vec4(a_position, 1.0);
+    v_normal = mat3(m) * a_normal;
+    v_colour = vec4(a_colour, 1.0);
+    v_world = world.xyz;
+    gl_Position = u_view_projection * world;
+}
+"""

@@ -2,7 +2,11 @@
 
 from __future__ import annotations
 
+import os
+import shutil
+import sys
 from collections.abc import Iterator
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -59,3 +63,21 @@ def guided_take() -> Iterator[Take]:
     world, system = record(SMALL_SCENE, 12, every=2, guides=link_centres)
     yield system.take()
     world.close()
+
+
+@pytest.fixture(scope="session")
+def gltf_validator() -> tuple[str, Path]:
+    """(node, the npm package gltf-validator): $ECS_TENTACLES_GLTF_VALIDATOR, else where
+    .ci/run installs it (<venv>/node/node_modules/gltf-validator); skips with the reason."""
+    node = shutil.which("node")
+    if node is None:
+        pytest.skip("node is not on PATH, so the Khronos glTF validator (npm) cannot run")
+    default = Path(sys.prefix) / "node" / "node_modules" / "gltf-validator"
+    package = Path(os.environ.get("ECS_TENTACLES_GLTF_VALIDATOR", default))
+    if not (package / "package.json").is_file():
+        pytest.skip(
+            f"the npm package gltf-validator is not at {package}: `npm install --prefix"
+            f" {Path(sys.prefix) / 'node'} gltf-validator` (.ci/run does) or set"
+            " ECS_TENTACLES_GLTF_VALIDATOR"
+        )
+    return node, package

@@ -110,13 +110,20 @@ def _crowd(count: int) -> dict[str, Any]:
 
 
 def test_draw_calls_do_not_grow_with_creatures(make_sandbox: Callable[..., Any]) -> None:
-    calls = []
+    calls: dict[str, list[int]] = {"skinned": [], "capsules": []}
     for count in (1, 16):
         sandbox = make_sandbox(_crowd(count))
         sandbox.step(40)
-        calls.append(sandbox.renderer.draw())
-        assert sandbox.renderer.links_near.count + sandbox.renderer.links_far.count == count * 30
-    assert calls[0] == calls[1] == 6  # ground, mantles, near and far links, suckers, lines
+        renderer = sandbox.renderer
+        assert renderer.view == "skinned"  # the default
+        calls["skinned"].append(renderer.draw())
+        assert renderer.links_near.count + renderer.links_far.count == 0
+        assert len(renderer.skinned.creatures) == count
+        assert renderer.toggle_view() == "capsules"
+        calls["capsules"].append(renderer.draw())
+        assert renderer.links_near.count + renderer.links_far.count == count * 30
+    # ground, mantles, near and far links, suckers, lines (+ all skinned creatures)
+    assert calls == {"skinned": [7, 7], "capsules": [6, 6]}
 
 
 def test_headless_run_writes_a_screenshot_and_a_video(

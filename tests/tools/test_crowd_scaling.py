@@ -68,5 +68,6 @@ def test_a_failed_run_keeps_its_error_line() -> None:
     assert row == {
         "creatures": 1,
         "threads": 1,
-        "error": "ecs-tentacles bench: error: argument --frames: must be >= 1, got 0",
+        "error": "error: argument --frames: must be >= 1, got 0"
+        " (see ecs-tentacles bench --help)",
     }

@@ -1,0 +1,40 @@
+"""Skinned export options and the writer that picks USD or glTF from the suffix.
+
+Skinned is what `ecs-tentacles export` and `bake` write by default: one mesh per
+creature bound to a joint skeleton with rotation keys, which an animator can grab and
+adjust in Blender, Maya, Houdini or a game engine. `--rigid` keeps the capsule form
+(one transform per body, exact world poses: for checking the physics).
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+
+from ecs_tentacles.export.bake import output_kind
+from ecs_tentacles.export.take import Take
+from ecs_tentacles.skin.keys import KeyReport
+from ecs_tentacles.skin.mesh import Detail
+from ecs_tentacles.skin.rig import Keys
+
+
+@dataclass(frozen=True)
+class Skin:
+    """How to write skinned creatures: the mesh's level of detail and which keys to keep."""
+
+    detail: Detail = field(default_factory=Detail)
+    keys: Keys = field(default_factory=Keys)
+
+
+def write_skinned(take: Take, path: str | os.PathLike[str], skin: Skin) -> KeyReport:
+    """Write `take` with skinned creatures as USD or glTF (by suffix), atomically."""
+    kind = output_kind(path)
+    if kind == "usd":
+        from ecs_tentacles.export.skinned_usd import write_skinned_usd
+
+        return write_skinned_usd(take, path, skin.detail, skin.keys)
+    if kind == "gltf":
+        from ecs_tentacles.export.skinned_gltf import write_skinned_glb
+
+        return write_skinned_glb(take, path, skin.detail, skin.keys)
+    raise ValueError(f"{path}: skinned creatures are written as USD or glTF, not {kind}")

@@ -1,0 +1,228 @@
+"""Take -> binary glTF (.glb) with skinned creatures: a skin per creature, its joints
+animated by rotation keys (and the root by translation keys).
+
+    scene nodes: World -> <creature> -> mantle -> t0_link0 -> t0_link1 ...   (joints)
+                 <creature>/skin   {mesh, skin}   (a root node: glTF ignores the
+                                                   transform of a skinned mesh's node)
+Joint nodes carry their rest (bind) transforms; the one animation has a rotation
+channel per joint and a translation channel on each mantle, each with its own key
+times when keys are reduced. The mesh: POSITION, NORMAL, TEXCOORD_0 (a vertex is split
+where its UVs differ), JOINTS_0/WEIGHTS_0 (two influences used of four). Everything is
+turned to glTF's y-up like the rigid form (`ecs_tentacles.export.gltf`).
+"""
+
+from __future__ import annotations
+
+import io
+import os
+from typing import Any
+
+import numpy as np
+
+from ecs_tentacles import __version__
+from ecs_tentacles.export.atomic import atomic_output
+from ecs_tentacles.export.gltf import (
+    _ARRAY_BUFFER,
+    _ELEMENT_ARRAY_BUFFER,
+    Z_UP_TO_Y_UP,
+    _Buffer,
+    glb_bytes,
+    to_y_up_points,
+    to_y_up_rotations,
+)
+from ecs_tentacles.export.take import Take
+from ecs_tentacles.skin.keys import KeyReport
+from ecs_tentacles.skin.mesh import Detail, SkinMesh
+from ecs_tentacles.skin.rig import Keys, SkinnedCreature, skinned_creatures
+
+_TURN = np.eye(4)
+_TURN[:3, :3] = Z_UP_TO_Y_UP
+
+
+def write_skinned_glb(
+    take: Take,
+    path: str | os.PathLike[str],
+    detail: Detail | None = None,
+    keys: Keys | None = None,
+) -> KeyReport:
+    """Write `take` as a skinned .glb atomically; returns the key counts and errors."""
+    document, binary, report = build_skinned_gltf(take, detail, keys)
+    data = glb_bytes(document, binary)
+    with atomic_output(path) as temporary:
+        temporary.write_bytes(data)
+    return report
+
+
+def build_skinned_gltf(
+    take: Take, detail: Detail | None = None, keys: Keys | None = None
+) -> tuple[dict[str, Any], bytes, KeyReport]:
+    """The glTF JSON document, its binary buffer and the key report."""
+    header = take.header
+    creatures, report = skinned_creatures(take, detail, keys)
+    buffer = _Buffer()
+    nodes: list[dict[str, Any]] = [{"name": "World", "children": []}]
+    roots = [0]
+    meshes, skins = [], []
+    samplers: list[dict[str, Any]] = []
+    channels: list[dict[str, Any]] = []
+    times: dict[bytes, int] = {}
+    for creature in creatures:
+        skeleton = creature.skeleton
+        holder = len(nodes)
+        nodes.append({"name": skeleton.layout.name, "children": []})
+        nodes[0]["children"].append(holder)
+        first = len(nodes)
+        rotation = to_y_up_rotations(skeleton.rest_rotation).astype(np.float32)
+        translation = to_y_up_points(skeleton.rest_translation).astype(np.float32)
+        for j, name in enumerate(skeleton.leaf_names):
+            nodes.append(
+                {
+                    "name": name,
+                    "rotation": rotation[j].tolist(),
+                    "translation": translation[j].tolist(),
+                }
+            )
+            parent = skeleton.parents[j]
+            owner = nodes[holder if parent < 0 else first + parent]
+            owner.setdefault("children", []).append(first + j)
+        bind = _TURN @ skeleton.bind @ _TURN.T
+        inverse = np.linalg.inv(bind).transpose(0, 2, 1).reshape(-1, 16)  # column-major
+        skins.append(
+            {
+                "name": skeleton.layout.name,
+                "joints": list(range(first, first + len(skeleton.names))),
+                "skeleton": first,
+                "inverseBindMatrices": buffer.add(inverse.astype(np.float32), "MAT4"),
+            }
+        )
+        meshes.append(_mesh(buffer, creature.mesh, skeleton.layout.name))
+        roots.append(len(nodes))
+        nodes.append(
+            {
+                "name": f"{skeleton.layout.name}/skin",
+                "mesh": len(meshes) - 1,
+                "skin": len(skins) - 1,
+            }
+        )
+        _channels(buffer, take, creature, first, samplers, channels, times)
+    document: dict[str, Any] = {
+        "asset": {
+            "version": "2.0",
+            "generator": f"ecs_tentacles {__version__}",
+            "extras": {k: header[k] for k in ("scene", "scene_sha256", "seed", "fps")},
+        },
+        "scene": 0,
+        "scenes": [{"name": str(header["scene"]), "nodes": roots}],
+        "nodes": nodes,
+        "meshes": meshes,
+        "skins": skins,
+        "materials": [
+            {
+                "name": "skin",
+                "pbrMetallicRoughness": {
+                    "baseColorTexture": {"index": 0},
+                    "metallicFactor": 0.0,
+                    "roughnessFactor": 0.6,
+                },
+            }
+        ],
+        "textures": [{"sampler": 0, "source": 0}],
+        "samplers": [{"magFilter": 9729, "minFilter": 9729}],
+        "images": [{"bufferView": _image(buffer, skin_texture()), "mimeType": "image/png"}],
+        "animations": [{"name": "take", "samplers": samplers, "channels": channels}],
+        "buffers": [{"byteLength": len(buffer.data)}],
+        "bufferViews": buffer.views,
+        "accessors": buffer.accessors,
+    }
+    return document, bytes(buffer.data), report
+
+
+def skin_texture(size: int = 64) -> bytes:
+    """A PNG laid out on the tentacle UVs: rose skin, rings along v, a pale underside
+    (u from 0.75 to 1 is the strip facing down in the bind pose)."""
+    from PIL import Image
+
+    # image rows run top to bottom, glTF's v; the mesh's v (USD's) runs bottom to top
+    u = (np.arange(size) + 0.5) / size
+    v = (np.arange(size) + 0.5) / size
+    rings = 0.9 + 0.1 * np.cos(2 * np.pi * 12 * v)[:, None]
+    underside = np.clip(1 - np.abs(u - 0.875) / 0.125, 0.0, 1.0)[None, :] ** 0.5
+    rose, pale = np.array([0.85, 0.45, 0.5]), np.array([0.95, 0.85, 0.8])
+    colour = rose + underside[..., None] * (pale - rose)
+    pixels = np.clip(255 * rings[..., None] * colour, 0, 255).astype(np.uint8)
+    out = io.BytesIO()
+    Image.fromarray(pixels[::-1], "RGB").save(out, format="PNG", optimize=False)
+    return out.getvalue()
+
+
+def _image(buffer: _Buffer, png: bytes) -> int:
+    """A buffer view holding `png` (images are views, not accessors)."""
+    buffer.views.append({"buffer": 0, "byteOffset": len(buffer.data), "byteLength": len(png)})
+    buffer.data += png + b"\0" * (-len(png) % 4)
+    return len(buffer.views) - 1
+
+
+def split_by_uv(mesh: SkinMesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """glTF vertices carry one UV each: (source vertex, uv) per new vertex, and triangles."""
+    corners = mesh.faces.reshape(-1)
+    uv = mesh.uv.reshape(-1, 2).astype(np.float32)
+    keys = np.concatenate([corners[:, None].astype(np.float64), uv.astype(np.float64)], axis=1)
+    unique, inverse = np.unique(keys, axis=0, return_inverse=True)
+    return unique[:, 0].astype(np.int64), unique[:, 1:].astype(np.float32), inverse.reshape(-1, 3)
+
+
+def _mesh(buffer: _Buffer, mesh: SkinMesh, name: str) -> dict[str, Any]:
+    source, uv, triangles = split_by_uv(mesh)
+    if len(source) > 65535:
+        raise ValueError(
+            f"creature {name}: {len(source)} skinned vertices, over glTF's 16-bit indices here;"
+            " use fewer rings per link or sides"
+        )
+    joints = np.zeros((len(source), 4), np.uint16)
+    joints[:, :2] = mesh.joints[source]
+    weights = np.zeros((len(source), 4), np.float32)
+    weights[:, 0] = mesh.weights[source, 0].astype(np.float32)
+    weights[:, 1] = np.float32(1.0) - weights[:, 0]  # exact float32 sums
+    attributes = {
+        "POSITION": buffer.add(
+            to_y_up_points(mesh.positions[source]).astype(np.float32), "VEC3", _ARRAY_BUFFER
+        ),
+        "NORMAL": buffer.add(
+            to_y_up_points(mesh.normals[source]).astype(np.float32), "VEC3", _ARRAY_BUFFER
+        ),
+        "TEXCOORD_0": buffer.add((uv * [1, -1] + [0, 1]).astype(np.float32), "VEC2", _ARRAY_BUFFER),
+        "JOINTS_0": buffer.add(joints, "VEC4", _ARRAY_BUFFER),
+        "WEIGHTS_0": buffer.add(weights, "VEC4", _ARRAY_BUFFER),
+    }
+    indices = buffer.add(triangles.reshape(-1).astype(np.uint16), "SCALAR", _ELEMENT_ARRAY_BUFFER)
+    primitive = {"attributes": attributes, "indices": indices, "material": 0, "mode": 4}
+    return {"name": f"{name}/skin", "primitives": [primitive]}
+
+
+def _channels(
+    buffer: _Buffer,
+    take: Take,
+    creature: SkinnedCreature,
+    first: int,
+    samplers: list[dict[str, Any]],
+    channels: list[dict[str, Any]],
+    times: dict[bytes, int],
+) -> None:
+    """A rotation channel per joint and the root's translation channel, with their keys."""
+    seconds = take.times.astype(np.float32)
+    interpolation = "LINEAR" if take.frames > 1 else "STEP"
+    animation = creature.animation
+    rotation = to_y_up_rotations(animation.rotation).astype(np.float32)
+    root = to_y_up_points(creature.translations_at(np.arange(take.frames))[:, 0])
+
+    def sampler(keep: np.ndarray, values: np.ndarray, kind: str, node: int, path: str) -> None:
+        mask = keep.tobytes()
+        if mask not in times:
+            times[mask] = buffer.add(seconds[keep], "SCALAR")
+        output = buffer.add(np.ascontiguousarray(values[keep]), kind)
+        samplers.append({"input": times[mask], "output": output, "interpolation": interpolation})
+        channels.append({"sampler": len(samplers) - 1, "target": {"node": node, "path": path}})
+
+    for j in range(len(creature.skeleton.names)):
+        sampler(creature.rotation_keys[:, j], rotation[:, j], "VEC4", first + j, "rotation")
+    sampler(creature.translation_keys, root.astype(np.float32), "VEC3", first, "translation")

@@ -1,0 +1,123 @@
+"""Editable keys: keep, per joint channel, only the keys a curve needs.
+
+`reduce_rotations` is Ramer-Douglas-Peucker on rotation angle: between two kept keys
+the curve is the slerp of the keys (what glTF's LINEAR rotation and USD's quaternion
+interpolation do); the sample furthest from it (as an angle) is kept when it is more
+than the tolerance away, until no sample is. Every round splits all joints' segments
+at once (array math over frames x joints), so the rounds number the recursion depth.
+`reduce_points` is the same on distance, for the root's translation.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+ROOT_TOLERANCE_M = 0.0005  # the root translation channel's tolerance with reduced keys
+
+
+@dataclass(frozen=True)
+class KeyReport:
+    """Keys in all joint channels before and after, the largest error left (deg, m), and
+    how many frames hold any key (a USD SkelAnimation samples all joints at those)."""
+
+    before: int
+    after: int
+    max_rotation_error_deg: float
+    max_translation_error_m: float
+    sample_frames: int  # frames where any channel keeps a key (USD's time samples)
+    frames: int
+
+    def line(self) -> str:
+        """One line for the CLI."""
+        return (
+            f"keys {self.before} -> {self.after} (frames with a key: {self.sample_frames} of"
+            f" {self.frames}); max error {self.max_rotation_error_deg:.3f} deg,"
+            f" {1000 * self.max_translation_error_m:.3f} mm"
+        )
+
+
+def slerp(a: np.ndarray, b: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Spherical interpolation of unit quaternions (..., 4) by t (...) (short way round)."""
+    dot = np.einsum("...c,...c->...", a, b)
+    b = np.where(dot[..., None] < 0, -b, b)
+    dot = np.abs(dot)
+    angle = np.arccos(np.clip(dot, -1.0, 1.0))
+    small = angle < 1e-6
+    sin = np.where(small, 1.0, np.sin(angle))
+    wa = np.where(small, 1.0 - t, np.sin((1.0 - t) * angle) / sin)
+    wb = np.where(small, t, np.sin(t * angle) / sin)
+    out = wa[..., None] * a + wb[..., None] * b
+    return out / np.linalg.norm(out, axis=-1, keepdims=True)
+
+
+def angle_between(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Rotation angle (degrees) between unit quaternions (..., 4)."""
+    dot = np.abs(np.einsum("...c,...c->...", a, b))
+    return np.degrees(2.0 * np.arccos(np.clip(dot, -1.0, 1.0)))
+
+
+def _brackets(keep: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For every (frame, channel): the last kept frame at or before it, the first at or after."""
+    frames = np.arange(len(keep))[:, None]
+    before = np.maximum.accumulate(np.where(keep, frames, 0), axis=0)
+    after = np.minimum.accumulate(np.where(keep, frames, len(keep) - 1)[::-1], axis=0)[::-1]
+    return before, after
+
+
+def interpolate_rotations(q: np.ndarray, keep: np.ndarray) -> np.ndarray:
+    """The curve (F, J, 4) that slerps between the kept keys of `q` (F, J, 4)."""
+    before, after = _brackets(keep)
+    frames = np.arange(len(q))[:, None]
+    span = np.maximum(after - before, 1)
+    t = np.clip((frames - before) / span, 0.0, 1.0)
+    joints = np.arange(q.shape[1])[None, :]
+    return slerp(q[before, joints], q[after, joints], t)
+
+
+def interpolate_points(p: np.ndarray, keep: np.ndarray) -> np.ndarray:
+    """The polyline (F, 3) through the kept samples of `p` (F, 3)."""
+    frames = np.flatnonzero(keep)
+    times = np.arange(len(p))
+    return np.stack([np.interp(times, frames, p[frames, i]) for i in range(p.shape[1])], axis=1)
+
+
+def _rdp(
+    error_of: Callable[[np.ndarray], np.ndarray], shape: tuple[int, int], tolerance: float
+) -> np.ndarray:
+    """Keep mask (F, C): endpoints, then each segment's worst sample while above tolerance."""
+    keep = np.zeros(shape, bool)
+    keep[0] = keep[-1] = True
+    while True:
+        error = error_of(keep)
+        error[keep] = 0.0
+        if error.max(initial=0.0) <= tolerance:
+            return keep
+        # segments are runs of frames after each kept key, per channel (columns)
+        segment = np.cumsum(keep, axis=0) + np.arange(shape[1])[None, :] * (shape[0] + 1)
+        flat_segment, flat_error = segment.T.reshape(-1), error.T.reshape(-1)
+        order = np.lexsort((-flat_error, flat_segment))
+        first = order[np.r_[True, flat_segment[order][1:] != flat_segment[order][:-1]]]
+        worst = first[flat_error[first] > tolerance]
+        channel, frame = np.divmod(worst, shape[0])
+        keep[frame, channel] = True
+
+
+def reduce_rotations(q: np.ndarray, tolerance_deg: float) -> np.ndarray:
+    """Keep mask (F, J): the keys each joint's rotation curve needs to stay within tolerance."""
+    q = np.asarray(q, dtype=np.float64)
+    return _rdp(
+        lambda keep: angle_between(interpolate_rotations(q, keep), q), q.shape[:2], tolerance_deg
+    )
+
+
+def reduce_points(p: np.ndarray, tolerance: float) -> np.ndarray:
+    """Keep mask (F,): the samples a translation curve needs to stay within `tolerance` metres."""
+    p = np.asarray(p, dtype=np.float64)
+
+    def error(keep: np.ndarray) -> np.ndarray:
+        return np.linalg.norm(interpolate_points(p, keep[:, 0]) - p, axis=1)[:, None]
+
+    return _rdp(error, (len(p), 1), tolerance)[:, 0]

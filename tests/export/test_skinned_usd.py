@@ -1,0 +1,125 @@
+"""Skinned USD: a SkelRoot per creature that passes Pixar's checks and that USD's own
+skinning turns back into the simulated tentacles."""
+
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from ecs_tentacles.export.skinned_usd import build_skinned_stage, write_skinned_usd
+from ecs_tentacles.export.take import Take
+from ecs_tentacles.mathutil import quat_rotate
+from ecs_tentacles.skin.keys import angle_between
+from ecs_tentacles.skin.mesh import Detail, creature_mesh
+from ecs_tentacles.skin.rig import Keys
+from ecs_tentacles.skin.skeleton import creature_animation, creature_skeleton, joint_world_poses
+from ecs_tentacles.skin.skinning import skin_points, skinning_matrices
+
+pxr = pytest.importorskip("pxr", reason="USD export needs usd-core (the usd / dev extras)")
+from pxr import Usd, UsdGeom, UsdSkel, UsdUtils, Vt  # noqa: E402
+
+
+def compliance(path: Path) -> dict[str, list[str]]:
+    """Errors, failed checks and warnings of UsdUtils.ComplianceChecker on `path`."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DeprecationWarning)
+        checker = UsdUtils.ComplianceChecker()
+        checker.CheckCompliance(str(path))
+    return {
+        "errors": checker.GetErrors(),
+        "failed": checker.GetFailedChecks(),
+        "warnings": checker.GetWarnings(),
+    }
+
+
+@pytest.mark.parametrize(("suffix", "keys"), [(".usda", "all"), (".usdc", "reduced")])
+def test_the_skinned_stage_passes_the_compliance_checker(
+    guided_take: Take, tmp_path: Path, suffix: str, keys: str
+) -> None:
+    path = tmp_path / f"take{suffix}"
+    write_skinned_usd(guided_take, path, keys=Keys(keys, 0.5))
+    assert compliance(path) == {"errors": [], "failed": [], "warnings": []}
+    stage = Usd.Stage.Open(str(path))
+    root = stage.GetPrimAtPath("/World/octo")
+    assert root.GetTypeName() == "SkelRoot"
+    assert [p.GetName() for p in root.GetChildren()] == [
+        "skeleton",
+        "skin",
+        "suckers",
+        "goals",
+        "fur",
+    ]
+    skeleton = UsdSkel.Skeleton(stage.GetPrimAtPath("/World/octo/skeleton"))
+    assert len(skeleton.GetJointsAttr().Get()) == 1 + 3 * 4
+    assert len(skeleton.GetRestTransformsAttr().Get()) == 13
+    curves = UsdGeom.BasisCurves(stage.GetPrimAtPath("/World/octo/fur/guides"))
+    np.testing.assert_array_equal(
+        np.array(curves.GetPointsAttr().Get(3)), guided_take.guide_points[3].reshape(-1, 3)
+    )
+    sucker = stage.GetPrimAtPath("/World/octo/suckers/t0/link3/sucker0")
+    assert sucker.GetAttribute("ecs:attached").Get(0) is False
+
+
+def _skinned(stage: Any, creature: str, frame: int) -> np.ndarray:
+    """The mesh points as USD's own UsdSkel skinning poses them at `frame`."""
+    cache = UsdSkel.Cache()
+    root = UsdSkel.Root(stage.GetPrimAtPath(f"/World/{creature}"))
+    cache.Populate(root, Usd.TraverseInstanceProxies())
+    skel = cache.GetSkelQuery(UsdSkel.Skeleton(stage.GetPrimAtPath(f"/World/{creature}/skeleton")))
+    skinning = cache.GetSkinningQuery(stage.GetPrimAtPath(f"/World/{creature}/skin"))
+    xforms = skel.ComputeSkinningTransforms(frame)
+    points = Vt.Vec3fArray(UsdGeom.Mesh(skinning.GetPrim()).GetPointsAttr().Get())
+    assert skinning.ComputeSkinnedPoints(xforms, points, frame)
+    return np.array(points, dtype=np.float64)
+
+
+def test_usd_skinning_puts_the_tubes_on_the_simulated_links(octopus_take: Take) -> None:
+    take = octopus_take
+    stage, _ = build_skinned_stage(take)
+    skeleton = creature_skeleton(take, 0)
+    mesh = creature_mesh(skeleton, Detail())
+    rotation, origin = joint_world_poses(skeleton, take)
+    rigid = mesh.weights[mesh.rings[:, 0], 1] == 0  # rings on one link only
+    rigid &= mesh.joints[mesh.rings[:, 0], 0] > 0
+    for frame in (0, 37, 120):
+        points = _skinned(stage, "octopus", frame)
+        centres = points[mesh.rings].mean(axis=1)
+        # the same blend of the simulated link poses, straight from the take
+        expected = skin_points(mesh, skinning_matrices(skeleton, rotation[frame], origin[frame]))
+        np.testing.assert_allclose(centres, expected[mesh.rings].mean(axis=1), atol=1e-3)
+        assert np.abs(points - expected).max() < 1e-3
+        # rings bound to one link lie on that link's capsule axis in the simulation
+        joint = mesh.joints[mesh.rings[rigid, 0], 0]
+        body = skeleton.bodies[joint]
+        axis_point = take.pos[frame, body]
+        quat = take.quat[frame, body].astype(np.float64)
+        direction = quat_rotate(quat, np.array([1.0, 0.0, 0.0]))
+        offset = centres[rigid] - axis_point
+        along = np.einsum("ij,ij->i", offset, direction)
+        off_axis = np.linalg.norm(offset - along[:, None] * direction, axis=1)
+        assert off_axis.max() < 1e-3
+        lengths = np.array([take.header["bodies"][b]["length"] for b in body])
+        radii = np.array([take.header["bodies"][b]["radius"] for b in body])
+        assert (np.abs(along) <= 0.5 * lengths + radii + 1e-3).all()
+    assert np.abs(origin[120] - origin[0]).max() > 0.05  # the creature did move
+
+
+def test_reduced_keys_stay_within_the_tolerance_through_usd_interpolation(
+    octopus_take: Take,
+) -> None:
+    stage, report = build_skinned_stage(octopus_take, keys=Keys("reduced", 0.5))
+    animation = UsdSkel.Animation(stage.GetPrimAtPath("/World/octopus/skeleton/animation"))
+    samples = animation.GetRotationsAttr().GetTimeSamples()
+    assert 3 <= len(samples) <= octopus_take.frames
+    expected = creature_animation(creature_skeleton(octopus_take, 0), octopus_take).rotation
+    for frame in range(octopus_take.frames):  # between samples USD interpolates (slerp)
+        got = np.array(
+            [[q.GetReal(), *q.GetImaginary()] for q in animation.GetRotationsAttr().Get(frame)]
+        )
+        assert angle_between(got, expected[frame]).max() <= 0.5 + 1e-3
+    assert report.after < report.before // 2
+    assert report.max_rotation_error_deg <= 0.5

@@ -1,0 +1,64 @@
+"""Skinned creatures in the sandbox: the GPU palette matches the CPU skinning, and the
+picture shows one smooth creature where the capsules were."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from ecs_tentacles.components import Creature, Transform
+from ecs_tentacles.mathutil import quat_rotate
+from ecs_tentacles.render.skinned import SANDBOX_DETAIL, world_skeleton
+from ecs_tentacles.skin.mesh import creature_mesh
+from ecs_tentacles.skin.skinning import skin_points
+
+
+def test_the_palette_puts_the_tubes_on_the_simulated_links(
+    make_sandbox: Callable[..., Any],
+) -> None:
+    sandbox = make_sandbox("octopus")
+    sandbox.step(60)
+    world, skinned = sandbox.world, sandbox.renderer.skinned
+    pos, quat = world.transforms.pos.astype(np.float64), world.transforms.quat.astype(np.float64)
+    skeleton = world_skeleton(world, world.creature("octopus"))
+    np.testing.assert_array_equal(skinned.rows, skeleton.bodies)
+    mesh = creature_mesh(skeleton, SANDBOX_DETAIL)
+    palette = np.zeros((len(skinned.rows), 4, 4))
+    palette[:, :3] = skinned.palette(pos, quat)
+    palette[:, 3, 3] = 1.0
+    points = skin_points(mesh, palette)  # what the vertex shader computes
+    centres = points[mesh.rings].mean(axis=1)
+    rigid = (mesh.weights[mesh.rings[:, 0], 1] == 0) & (mesh.joints[mesh.rings[:, 0], 0] > 0)
+    rows = skeleton.bodies[mesh.joints[mesh.rings[rigid, 0], 0]]
+    direction = quat_rotate(quat[rows], np.array([1.0, 0.0, 0.0]))
+    offset = centres[rigid] - pos[rows]
+    along = np.einsum("ij,ij->i", offset, direction)
+    off_axis = np.linalg.norm(offset - along[:, None] * direction, axis=1)
+    assert rigid.sum() > 100 and off_axis.max() < 1e-3  # on the capsule's axis
+    tips = quat_rotate(quat[skeleton.bodies[10::10]], np.array([1.0, 0.0, 0.0]))
+    bases = quat_rotate(quat[skeleton.bodies[1::10]], np.array([1.0, 0.0, 0.0]))
+    bend = np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", tips, bases), -1, 1)))
+    assert bend.max() > 10  # the tentacles are bent, not in the bind pose
+
+
+def test_skinned_view_draws_one_smooth_creature(make_sandbox: Callable[..., Any]) -> None:
+    sandbox = make_sandbox("octopus")
+    sandbox.step(30)
+    sandbox.hud.visible = False
+    sandbox.render()
+    skinned = sandbox.renderer.target.read().astype(int)
+    sandbox.renderer.toggle_view()
+    sandbox.render()
+    capsules = sandbox.renderer.target.read().astype(int)
+    octo = sandbox.world.creature("octopus")
+    creature = sandbox.world.component(octo, Creature)
+    top = sandbox.world.component(octo, Transform).pos + [0.0, 0.0, creature.mantle_height / 2]
+    x, y = sandbox.renderer.camera.project(top[None])[0]
+    for pixels in (skinned, capsules):
+        r, g, b = pixels[360 - round(y) + 3, round(x)]
+        assert r > g + 60 and r > b + 60  # the warm red creature is there in both views
+    warm = lambda p: ((p[..., 0] > p[..., 1] + 60) & (p[..., 0] > p[..., 2] + 60)).sum()  # noqa: E731
+    assert 0.5 < warm(skinned) / warm(capsules) < 2.0  # the same creature, not a blob
+    assert (np.abs(skinned - capsules).sum(axis=2) > 30).sum() > 200  # but drawn differently
