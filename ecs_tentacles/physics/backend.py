@@ -16,7 +16,8 @@ import logging
 import os
 from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
-from typing import TYPE_CHECKING
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Protocol
 
 import mujoco
 import numpy as np
@@ -119,20 +120,21 @@ class PhysicsBackend:
 
         For benchmarks: the framework's cost is a frame minus this.
         """
-        pairs = [(g.model, d) for g, d in zip(self.groups, datas, strict=True)]
-        self._map(pairs, substeps)
+        self._map([Bare(g.model, d) for g, d in zip(self.groups, datas, strict=True)], substeps)
 
     def _run(self, groups: list[PhysicsGroup], substeps: int) -> None:
-        self._map([(g.model, g.data) for g in groups], substeps)
+        for group, error in zip(groups, self._map(groups, substeps), strict=True):
+            if error is not None:
+                group.error = error
 
-    def _map(self, pairs: list[tuple[mujoco.MjModel, mujoco.MjData]], substeps: int) -> None:
-        if self._pool is None or len(pairs) < 2:
-            for m, d in pairs:
-                mujoco.mj_step(m, d, nstep=substeps)
-            return
-        chunks = _balanced_chunks(pairs, self.threads)
-        for future in [self._pool.submit(_step_chunk, c, substeps) for c in chunks]:
-            future.result()
+    def _map(self, groups: Sequence[Steppable], substeps: int) -> list[str | None]:
+        """Step each of `groups` (anything with `model` and `data`); MuJoCo's fatal errors
+        (a blown-up state overflowing its arena) come back per group instead of raising."""
+        if self._pool is None or len(groups) < 2:
+            return _step_chunk(groups, substeps)
+        chunks = _balanced_chunks(groups, self.threads)
+        futures = [self._pool.submit(_step_chunk, chunk, substeps) for chunk in chunks]
+        return [error for future in futures for error in future.result()]
 
     def sync(self, transforms: TransformStore) -> None:
         """Copy every body's world pose into the Transform store (one gather per group)."""
@@ -172,16 +174,33 @@ class PhysicsBackend:
         )
 
 
-def _step_chunk(pairs: list[tuple[mujoco.MjModel, mujoco.MjData]], substeps: int) -> None:
-    for m, d in pairs:
-        mujoco.mj_step(m, d, nstep=substeps)
+class Steppable(Protocol):
+    model: mujoco.MjModel
+    data: mujoco.MjData
 
 
-def _balanced_chunks(
-    pairs: list[tuple[mujoco.MjModel, mujoco.MjData]], threads: int
-) -> list[list[tuple[mujoco.MjModel, mujoco.MjData]]]:
-    """Split `pairs` into at most `threads` contiguous runs of about equal dofs."""
-    cost = np.cumsum([m.nv + 1 for m, _ in pairs], dtype=np.float64)
+@dataclass
+class Bare:
+    """A model with a data of its own, stepped without the framework (benchmarks)."""
+
+    model: mujoco.MjModel
+    data: mujoco.MjData
+
+
+def _step_chunk(groups: Sequence[Steppable], substeps: int) -> list[str | None]:
+    errors: list[str | None] = []
+    for group in groups:
+        try:
+            mujoco.mj_step(group.model, group.data, nstep=substeps)
+            errors.append(None)
+        except mujoco.FatalError as exc:
+            errors.append(str(exc).splitlines()[0])
+    return errors
+
+
+def _balanced_chunks(groups: Sequence[Steppable], threads: int) -> list[Sequence[Steppable]]:
+    """Split `groups` into at most `threads` contiguous runs of about equal dofs."""
+    cost = np.cumsum([g.model.nv + 1 for g in groups], dtype=np.float64)
     cuts = np.searchsorted(cost, cost[-1] * np.arange(1, threads) / threads)
-    bounds = [0, *cuts.tolist(), len(pairs)]
-    return [pairs[a:b] for a, b in itertools.pairwise(bounds) if b > a]
+    bounds = [0, *cuts.tolist(), len(groups)]
+    return [groups[a:b] for a, b in itertools.pairwise(bounds) if b > a]

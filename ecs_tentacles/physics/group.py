@@ -60,6 +60,7 @@ class PhysicsGroup:
         # run-time state the backend and the health check keep
         self.frozen = False
         self.sleeping = False
+        self.error: str | None = None  # MuJoCo's fatal error in the last step, if any
         self.soften = 1.0  # servo gain multiplier while recovering (1 = normal)
         self.warnings = np.zeros(len(self.data.warning.number), dtype=np.int64)
         self.place(*pose)

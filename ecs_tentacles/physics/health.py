@@ -3,6 +3,7 @@
 Each frame, after the step and before poses reach the Transform store, every active
 group is checked:
 
+* a fatal MuJoCo error in the step (a blown-up state overflowing the arena);
 * any MuJoCo warning counted since the last frame (bad qacc, qpos, qvel or ctrl,
   bad inertia, a full contact or constraint buffer); MuJoCo's own auto-reset is off
   (`physics.model`), so nothing clears the counters behind our back;
@@ -89,6 +90,9 @@ class PhysicsHealth:
 
     def _cause(self, group: PhysicsGroup, pos: np.ndarray, limit: float) -> str | None:
         d = group.data
+        if group.error is not None:
+            cause, group.error = f"fatal {group.error}", None
+            return cause
         counts = d.warning.number
         if (counts > group.warnings).any():
             first = int(np.flatnonzero(counts > group.warnings)[0])

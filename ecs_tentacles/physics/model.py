@@ -52,6 +52,10 @@ SKIN_FRICTION = [0.0, 0.0, 0.0]
 # Stiffer contacts than MuJoCo's default (0.02 s), so thin tips do not sink into the
 # ground; still above twice the default timestep (1 / 480 s).
 CONTACT_SOLREF = [0.006, 1.0]
+# Contacts with proxies are softer: a proxy moves by a whole frame at once and cannot
+# give way, so a stiff contact would throw a light link out of a deep overlap.
+PROXY_SOLREF = [0.004, 1.0]
+PROXY_MARGIN = 0.004
 # Suckers hold harder than contacts push (impedance close to 1): the tip stays put.
 SUCKER_SOLIMP = [0.97, 0.995, 0.001, 0.5, 2.0]
 
@@ -229,8 +233,10 @@ def _add_proxies(spec: mujoco.MjSpec) -> None:
                 quat=quat,
                 contype=PROXY_BIT,
                 conaffinity=CREATURE_BIT,
-                friction=SKIN_FRICTION,
-                solref=CONTACT_SOLREF,
+                condim=1,  # frictionless: a zero-friction pyramid is degenerate and blows up
+                margin=PROXY_MARGIN,
+                priority=1,  # its contact parameters win over the creature's
+                solref=PROXY_SOLREF,
             )
             slot += 1
 

@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING
 import mujoco
 import numpy as np
 
-from ecs_tentacles.physics.model import PROXY_CAPSULES, PROXY_CYLINDERS
+from ecs_tentacles.physics.model import PROXY_CAPSULES, PROXY_CYLINDERS, PROXY_MARGIN
 
 if TYPE_CHECKING:
     from ecs_tentacles.physics.group import PhysicsGroup
@@ -59,55 +59,81 @@ class ContactProxies:
         self.count = counts.astype(np.int64)
         self.mantle = self.start  # a group's first body is its mantle
         self.pairs = 0  # creature pairs near each other last frame
+        self.previous = np.zeros((0, 3))  # body positions at the last update
+        self.skin = np.zeros(0)  # per body: contact margin of its proxies
 
     def update(self, transforms: TransformStore) -> None:
         """Give every creature proxies of the other creatures' bodies near it."""
         if len(self.groups) < 2:
             return
         pos = transforms.pos[self.rows]
+        # a proxy stands still for a frame while its body moves on: its contact starts
+        # early by as far as the body moved last frame (plus a fixed skin)
+        if len(self.previous) == len(pos):
+            self.skin = PROXY_MARGIN + np.linalg.norm(pos - self.previous, axis=1)
+        else:
+            self.skin = np.full(len(pos), PROXY_MARGIN)
+        self.previous = pos
         centre = pos[self.mantle]
         reach = np.linalg.norm(pos - centre[self.owner], axis=1) + self.rbound
         radius = np.maximum.reduceat(reach, self.start)
         a, b = _near_pairs(centre, radius)
         self.pairs = len(a) // 2
-        placed: dict[int, tuple[np.ndarray, np.ndarray]] = {}
-        if len(a):
-            # candidate bodies: every body of b, kept if inside a's sphere (plus margin)
-            per = self.count[b]
-            pair = np.repeat(np.arange(len(a)), per)
-            body = np.arange(per.sum()) - np.repeat(np.cumsum(per) - per, per) + self.start[b][pair]
-            who = a[pair]
-            gap = np.linalg.norm(pos[body] - centre[who], axis=1) - self.rbound[body] - radius[who]
-            keep = gap < MARGIN
-            who, body, gap = who[keep], body[keep], gap[keep]
-            order = np.lexsort((gap, self.kind[body], who))
-            who, body = who[order], body[order]
-            group_kind = who * 2 + self.kind[body]
-            first = np.searchsorted(group_kind, group_kind, side="left")
-            slot = np.arange(len(body)) - first
-            fits = slot < POOL[self.kind[body]]
-            who, body, slot = who[fits], body[fits], slot[fits]
-            slot = slot + np.where(self.kind[body] == CYLINDER, PROXY_CAPSULES, 0)
-            bounds = np.flatnonzero(np.r_[True, who[1:] != who[:-1], True])
-            for s, e in itertools.pairwise(bounds):
-                placed[int(who[s])] = (body[s:e], slot[s:e])
+        placed = self._assign(a, b, pos, centre, radius) if len(a) else {}
         quat = transforms.quat[self.rows]
         for group in self.groups:
             found = placed.get(group.index)
+            if group.proxies_used:
+                _park(group)
             if found is None:
-                if group.proxies_used:
-                    _park(group)
                 continue
             body, slot = found
-            _park(group)
             m, d = group.model, group.data
-            geoms = group.proxy_geoms[slot]
-            d.mocap_pos[group.proxy_mocap[slot]] = pos[body]
-            d.mocap_quat[group.proxy_mocap[slot]] = quat[body]
+            geoms, mocap = group.proxy_geoms[slot], group.proxy_mocap[slot]
+            d.mocap_pos[mocap] = pos[body]
+            d.mocap_quat[mocap] = quat[body]
             m.geom_size[geoms, :2] = self.size[body]
             m.geom_rbound[geoms] = self.rbound[body]
             m.geom_aabb[geoms] = self.aabb[body]
+            m.geom_margin[geoms] = self.skin[body]
             group.proxies_used = len(slot)
+
+    def _assign(
+        self, a: np.ndarray, b: np.ndarray, pos: np.ndarray, centre: np.ndarray, radius: np.ndarray
+    ) -> dict[int, tuple[np.ndarray, np.ndarray]]:
+        """Group index -> (source bodies, proxy slots): b's bodies inside a's sphere, nearest
+        first, as many as the pool of each kind holds."""
+        per = self.count[b]
+        pair = np.repeat(np.arange(len(a)), per)
+        body = np.arange(per.sum()) - np.repeat(np.cumsum(per) - per, per) + self.start[b][pair]
+        who = a[pair]
+        gap = np.linalg.norm(pos[body] - centre[who], axis=1) - self.rbound[body] - radius[who]
+        keep = gap < MARGIN
+        who, body, gap = who[keep], body[keep], gap[keep]
+        if not len(who):
+            return {}
+        crowded = np.bincount(who, minlength=len(self.groups)) > POOL.min()
+        if crowded[who].any():  # more candidates than proxies: rank by the nearest own body
+            some = np.flatnonzero(crowded[who])
+            gap[some] = self._body_gaps(who[some], body[some], pos)
+        order = np.lexsort((gap, self.kind[body], who))
+        who, body = who[order], body[order]
+        group_kind = who * 2 + self.kind[body]
+        slot = np.arange(len(body)) - np.searchsorted(group_kind, group_kind, side="left")
+        fits = slot < POOL[self.kind[body]]
+        who, body, slot = who[fits], body[fits], slot[fits]
+        slot = slot + np.where(self.kind[body] == CYLINDER, PROXY_CAPSULES, 0)
+        bounds = np.flatnonzero(np.r_[True, who[1:] != who[:-1], True])
+        return {int(who[s]): (body[s:e], slot[s:e]) for s, e in itertools.pairwise(bounds)}
+
+    def _body_gaps(self, who: np.ndarray, body: np.ndarray, pos: np.ndarray) -> np.ndarray:
+        """Gap between each candidate body and the nearest body of creature `who`."""
+        per = self.count[who]
+        pair = np.repeat(np.arange(len(who)), per)
+        own = np.arange(per.sum()) - np.repeat(np.cumsum(per) - per, per) + self.start[who][pair]
+        gap = np.linalg.norm(pos[own] - pos[body[pair]], axis=1) - self.rbound[own]
+        nearest = np.minimum.reduceat(gap, np.cumsum(per) - per)
+        return nearest - self.rbound[body]
 
 
 def _park(group: PhysicsGroup) -> None:

@@ -68,6 +68,5 @@ def test_a_failed_run_keeps_its_error_line() -> None:
     assert row == {
         "creatures": 1,
         "threads": 1,
-        "error": "error: argument --frames: must be >= 1, got 0"
-        " (see ecs-tentacles bench --help)",
+        "error": "error: argument --frames: must be >= 1, got 0 (see ecs-tentacles bench --help)",
     }
