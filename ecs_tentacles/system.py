@@ -29,6 +29,8 @@ class System:
     name: ClassVar[str] = ""
     after: ClassVar[tuple[str, ...]] = ()
     before: ClassVar[tuple[str, ...]] = ()
+    # attributes that carry simulation state from frame to frame (copied by snapshots)
+    state_attributes: ClassVar[tuple[str, ...]] = ()
 
     def setup(self, world: World) -> None:
         """Called once when the system joins a world (after physics is built)."""

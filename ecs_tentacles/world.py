@@ -16,7 +16,7 @@ import os
 import uuid
 from collections.abc import Iterator
 from dataclasses import dataclass
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import esper
 import numpy as np
@@ -38,6 +38,9 @@ from ecs_tentacles.store import (
 )
 from ecs_tentacles.system import System
 
+if TYPE_CHECKING:
+    from ecs_tentacles.snapshot import Snapshot
+
 C = TypeVar("C")
 FUR_SYSTEMS = ("emotion", "rig")  # kept with locomotion off: fur is not locomotion
 PHYSICS_SYSTEMS = ("physics", "physics_health", "physics_sync")
@@ -52,8 +55,9 @@ class Settings:
     gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)
     ground_friction: float = 1.0
     sucker_timeconst: float = 0.005
-    max_speed: float = 30.0  # m/s: a body faster than this has blown up (physics/health.py)
+    max_speed: float = 12.0  # m/s: a body faster than this has blown up (physics/health.py)
     max_penetration: float = 0.05  # m: a contact deeper than this has blown up
+    sleep: bool = True  # still, idle creatures are not stepped (physics/sleep.py)
 
     @property
     def dt(self) -> float:
@@ -136,8 +140,9 @@ class World:
             gravity=tuple(float(g) for g in physics["gravity"]),  # type: ignore[arg-type]
             ground_friction=float(physics["ground_friction"]),
             sucker_timeconst=float(physics["sucker_timeconst"]),
-            max_speed=float(physics.get("max_speed", Settings.max_speed)),
-            max_penetration=float(physics.get("max_penetration", Settings.max_penetration)),
+            max_speed=float(physics["max_speed"]),
+            max_penetration=float(physics["max_penetration"]),
+            sleep=bool(physics["sleep"]),
         )
         world = cls(
             settings, seed=data["seed"] if seed is None else seed, name=data.get("name", "scene")
@@ -191,6 +196,20 @@ class World:
             for system in self.schedule:
                 system.process(self, dt)
             self.frame += 1
+
+    def snapshot(self) -> Snapshot:
+        """The whole simulation state, to `restore` later (`ecs_tentacles.snapshot`)."""
+        from ecs_tentacles import snapshot
+
+        self.activate()
+        return snapshot.take(self)
+
+    def restore(self, state: Snapshot) -> None:
+        """Go back to a `snapshot()` of this world; stepping on repeats exactly."""
+        from ecs_tentacles import snapshot
+
+        self.activate()
+        snapshot.restore(self, state)
 
     @property
     def time(self) -> float:

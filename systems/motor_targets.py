@@ -54,6 +54,7 @@ SMOOTHING_SECONDS = 0.06  # targets ease toward each new pose (slow-in) instead 
 class MotorTargets(System):
     name = "motor_targets"
     after = ("action_queue",)
+    state_attributes = ("eased",)
 
     def setup(self, world: World) -> None:
         motors, tentacles = world.motors, world.tentacles

@@ -3,7 +3,8 @@
 Reads: Motor store (target, strength, damping, max_torque), Sucker store (attached,
 anchor), Transform store (where other creatures are). Writes, in every physics group:
 MjData (ctrl, eq_active, contact proxies' mocap poses), MjModel servo gains, sucker
-anchors and proxy sizes; then advances `world.settings.substeps` steps, the groups in
+anchors and proxy sizes; puts still, idle creatures to sleep (`physics.sleep`) and
+wakes the others; then advances `world.settings.substeps` steps, the awake groups in
 parallel. Systems that override
 `System.substep` run before every substep, in schedule order.
 """
@@ -26,6 +27,7 @@ class Physics(System):
         backend.write_controls(world.motors)
         backend.write_suckers(world.suckers)
         backend.proxies.update(world.transforms)
+        backend.sleep.update(world)
         hooks = world.schedule.substep_systems()
         if not hooks:
             backend.step(world.settings.substeps)

@@ -39,6 +39,7 @@ STRAND_BLOCK = 4096  # dynamic guides per block (their arrays are 8x larger)
 class Rig(System):
     name = "rig"
     after = ("physics_sync",)
+    state_attributes = ("strands",)  # the dynamic blend's strand positions and velocities
 
     def __init__(self) -> None:
         self.version = -1

@@ -91,6 +91,11 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--allow-systems", action="store_true", help="import and run the systems the scene names"
     )
+    parser.add_argument(
+        "--strict",
+        action="store_true",
+        help="write nothing and exit 1 if any creature's physics had to be recovered",
+    )
     parser.set_defaults(handler=handle)
 
 
@@ -119,6 +124,18 @@ def handle(args: argparse.Namespace) -> int:
         print(f"error: {error}", file=sys.stderr)
         return 2
     take = bake(plan, progress=not args.quiet, allow_systems=args.allow_systems)
+    health = take.header["health"]
+    if health["recoveries"]:
+        frames = sorted({e["frame"] for e in health["events"]})
+        shown = ", ".join(map(str, frames[:8])) + (", ..." if len(frames) > 8 else "")
+        print(
+            f"{'error' if args.strict else 'warning'}: physics recovered {health['recoveries']}"
+            f" times, {health['frozen']} creatures frozen (take frames {shown};"
+            " marked in the take header)",
+            file=sys.stderr,
+        )
+        if args.strict:
+            return 1
     try:
         skinned = save(take, args.out, progress=not args.quiet, skin=skin)
     except MeshError as error:  # e.g. tentacle bases that overlap on the mantle
@@ -149,6 +166,7 @@ def report(take: Take, path: Path) -> dict[str, Any]:
         "fps": take.fps,
         **{key: len(header[key]) for key in ("creatures", "bodies", "suckers", "goals")},
         "sha256": hashlib.sha256(path.read_bytes()).hexdigest(),
+        "recoveries": header.get("health", {}).get("recoveries", 0),
     }
 
 

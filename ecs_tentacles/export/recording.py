@@ -126,6 +126,18 @@ class TakeRecorder:
         self._points: list[np.ndarray] = []
         self._widths: list[np.ndarray] = []
         self.count = 0
+        # physics recoveries, marked on the take frame that follows them
+        self._health: list[dict[str, Any]] = []
+        world.events.on("creature_recovered", self._on_health("recovered"))
+        world.events.on("creature_frozen", self._on_health("frozen"))
+
+    def _on_health(self, what: str) -> Any:
+        def handler(*, creature: int, cause: str, **_: Any) -> None:
+            index = self._creature_index[creature]
+            entry = {"frame": self.count, "creature": index, "event": what, "cause": cause}
+            self._health.append(entry)
+
+        return handler
 
     def _layout(self, world: World) -> None:
         """Body and sucker tables in take order: creature by creature, mantle then links."""
@@ -225,6 +237,12 @@ class TakeRecorder:
             active[frame, alive] = True
         header = json.loads(json.dumps(self.header))  # a deep copy
         header["frames"] = n
+        events = [e for e in self._health if e["frame"] < n]
+        header["health"] = {
+            "recoveries": sum(e["event"] == "recovered" for e in events),
+            "frozen": sum(e["event"] == "frozen" for e in events),
+            "events": events,
+        }
         return Take(
             header=header,
             pos=self._pos[:n].copy(),

@@ -27,6 +27,7 @@ from ecs_tentacles.physics.group import PhysicsGroup
 from ecs_tentacles.physics.health import PhysicsHealth
 from ecs_tentacles.physics.model import build_spec, creature_layout
 from ecs_tentacles.physics.proxies import ContactProxies
+from ecs_tentacles.physics.sleep import Sleep
 
 if TYPE_CHECKING:
     from ecs_tentacles.store import MotorStore, SuckerStore, TransformStore
@@ -68,6 +69,8 @@ class PhysicsBackend:
             self.group_of_creature_row[group.creature_row] = group.index
         self.proxies = ContactProxies(self.groups)
         self.health = PhysicsHealth(world, self.groups)
+        self.sleep = Sleep(self.groups)
+        self.sleep.enabled = world.settings.sleep
         self._pool = ThreadPoolExecutor(self.threads) if self.threads > 1 else None
 
     # -- per frame -------------------------------------------------------------------
@@ -78,7 +81,7 @@ class PhysicsBackend:
         kv_all = motors.damping * motors.gain
         torque_all = motors.max_torque
         for group in self.groups:
-            if not group.active:
+            if group.frozen:
                 continue
             m, rows = group.model, group.actuator_motor_rows
             np.take(target, group.actuator_target_index, out=group.data.ctrl, mode="clip")
@@ -94,7 +97,7 @@ class PhysicsBackend:
         """Switch sucker equalities on/off and place their world anchors."""
         anchor, attached = suckers.anchor, suckers.attached
         for group in self.groups:
-            if not len(group.equality_ids) or not group.active:
+            if not len(group.equality_ids) or group.frozen:
                 continue
             rows = group.sucker_rows
             group.model.eq_data[group.equality_ids, 3:6] = anchor[rows]

@@ -99,4 +99,5 @@ class PhysicsGroup:
     def __repr__(self) -> str:
         m = self.model
         state = "frozen" if self.frozen else "asleep" if self.sleeping else "active"
-        return f"<physics group {self.index}: {m.nbody - 1} bodies, {m.nv} dofs, {state}>"
+        bodies = len(self.body_ids)
+        return f"<physics group {self.index}: {bodies} bodies, {m.nv} dofs, {state}>"

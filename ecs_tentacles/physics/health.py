@@ -95,9 +95,10 @@ class PhysicsHealth:
             return cause
         counts = d.warning.number
         if (counts > group.warnings).any():
-            first = int(np.flatnonzero(counts > group.warnings)[0])
+            raised = np.flatnonzero(counts > group.warnings)
             group.warnings[:] = counts
-            return WARNINGS.get(first, f"warning {first}")
+            names = sorted(WARNINGS.get(int(i), f"warning{i}") for i in raised)
+            return f"mujoco {', '.join(names)}"
         if not (np.isfinite(d.qpos).all() and np.isfinite(d.qvel).all()):
             return "non-finite state"
         moved = d.xpos[group.body_ids] - pos[group.body_rows]

@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING
 import mujoco
 import numpy as np
 
-from ecs_tentacles.physics.model import PROXY_CAPSULES, PROXY_CYLINDERS, PROXY_MARGIN
+from ecs_tentacles.physics.model import PROXY_CAPSULES, PROXY_CYLINDERS
 
 if TYPE_CHECKING:
     from ecs_tentacles.physics.group import PhysicsGroup
@@ -59,21 +59,12 @@ class ContactProxies:
         self.count = counts.astype(np.int64)
         self.mantle = self.start  # a group's first body is its mantle
         self.pairs = 0  # creature pairs near each other last frame
-        self.previous = np.zeros((0, 3))  # body positions at the last update
-        self.skin = np.zeros(0)  # per body: contact margin of its proxies
 
     def update(self, transforms: TransformStore) -> None:
         """Give every creature proxies of the other creatures' bodies near it."""
         if len(self.groups) < 2:
             return
         pos = transforms.pos[self.rows]
-        # a proxy stands still for a frame while its body moves on: its contact starts
-        # early by as far as the body moved last frame (plus a fixed skin)
-        if len(self.previous) == len(pos):
-            self.skin = PROXY_MARGIN + np.linalg.norm(pos - self.previous, axis=1)
-        else:
-            self.skin = np.full(len(pos), PROXY_MARGIN)
-        self.previous = pos
         centre = pos[self.mantle]
         reach = np.linalg.norm(pos - centre[self.owner], axis=1) + self.rbound
         radius = np.maximum.reduceat(reach, self.start)
@@ -95,7 +86,6 @@ class ContactProxies:
             m.geom_size[geoms, :2] = self.size[body]
             m.geom_rbound[geoms] = self.rbound[body]
             m.geom_aabb[geoms] = self.aabb[body]
-            m.geom_margin[geoms] = self.skin[body]
             group.proxies_used = len(slot)
 
     def _assign(

@@ -6,7 +6,8 @@ happens at display rate and interpolates between the last two physics frames.
 Mouse: left-drag orbits, right- or middle-drag pans, wheel zooms; click a creature
 to select it, click the ground to set its goal, shift-click to append to its path,
 right-click a goal to remove it. Keys: space pause, . single step, r reset,
-h HUD, f follow, a frame all, tab next tentacle, F12 screenshot, v video.
+h HUD, f follow, a frame all, tab next tentacle, F12 screenshot, v video,
+F5 save the state, F9 go back to it.
 
 Call `ecs_tentacles.render.configure(headless=...)` before importing this module.
 """
@@ -16,7 +17,7 @@ from __future__ import annotations
 import os
 import time
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pyglet
@@ -31,6 +32,9 @@ from ecs_tentacles.render.output import VideoWriter, save_png
 from ecs_tentacles.render.renderer import Renderer
 from ecs_tentacles.systems.render import RenderSync
 from ecs_tentacles.world import World
+
+if TYPE_CHECKING:
+    from ecs_tentacles.snapshot import Snapshot
 
 CLICK_PIXELS = 4  # a press and release closer than this is a click, not a drag
 MAX_CATCH_UP = 0.25  # seconds of physics to catch up at most per display frame
@@ -67,6 +71,7 @@ class Sandbox:
         self.stats = {"fps": 0.0, "physics_ms": 0.0, "sim_time": 0.0, "rtf": 0.0, "attached": 0}
         self._wall_start = time.perf_counter()
         self._last_draw: float | None = None
+        self.saved_state: Snapshot | None = None
 
     def _attach_world(self) -> None:
         self.renderer = Renderer(self.world, self.window.width, self.window.height)
@@ -94,8 +99,22 @@ class Sandbox:
             self.step(1)
             self.accumulator -= frame
 
+    def save_state(self) -> None:
+        """Remember the whole simulation state (F5)."""
+        self.saved_state = self.world.snapshot()
+
+    def load_state(self) -> bool:
+        """Go back to the state saved with F5 (F9); False if none was saved."""
+        if self.saved_state is None:
+            return False
+        self.world.restore(self.saved_state)
+        self.world.schedule["render"].process(self.world, 0.0)  # show it now
+        self.accumulator = 0.0
+        return True
+
     def reset(self) -> None:
         """Rebuild the scene from its file."""
+        self.saved_state = None
         self.world.close()
         self.world = World.from_scene(self.scene, seed=self.seed, allow_systems=self.allow_systems)
         self._attach_world()
@@ -246,6 +265,12 @@ class Sandbox:
             print(f"view: {self.renderer.toggle_view()}")
         elif symbol == key.TAB:
             self.hud._step_tentacle(-1 if modifiers & key.MOD_SHIFT else 1)
+        elif symbol == key.F5:
+            self.save_state()
+            print(f"state saved at {self.world.time:.2f} s (F9 to go back)")
+        elif symbol == key.F9:
+            print(f"state restored to {self.world.time:.2f} s" if self.load_state() else
+                  "no saved state: F5 saves one")  # fmt: skip
         elif symbol == key.F12:
             print(f"saved {self.screenshot()}")
         elif symbol == key.V:

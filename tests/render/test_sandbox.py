@@ -158,3 +158,19 @@ def test_fur_and_threats_are_drawn(make_sandbox: Callable[..., Any]) -> None:
     assert sandbox.renderer.lines.count >= segments  # + the selection ring
     attached = int(world.suckers.attached.sum())
     assert sandbox.renderer.suckers.count == attached + 1  # the roach
+
+
+def test_f5_saves_the_state_and_f9_goes_back(make_sandbox: Callable[..., Any]) -> None:
+    sandbox = make_sandbox("octopus")
+    _event(sandbox, "on_key_press", key.F9, 0)  # nothing saved yet: nothing happens
+    sandbox.step(20)
+    _event(sandbox, "on_key_press", key.F5, 0)
+    saved = sandbox.world.transforms.pos.copy()
+    sandbox.step(40)
+    later = sandbox.world.transforms.pos.copy()
+    assert not np.array_equal(saved, later)
+    _event(sandbox, "on_key_press", key.F9, 0)
+    assert sandbox.world.frame == 20
+    assert np.array_equal(sandbox.world.transforms.pos, saved)
+    sandbox.step(40)
+    assert np.array_equal(sandbox.world.transforms.pos, later)  # the same 40 frames again

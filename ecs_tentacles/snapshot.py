@@ -1,0 +1,148 @@
+"""World snapshots: the whole simulation state, restored to continue bit-identically.
+
+    snap = world.snapshot()       # cheap copies, no pickling of MuJoCo objects
+    world.step(300)
+    world.restore(snap)           # back to where it was; stepping again repeats exactly
+
+A snapshot holds every store's live rows, each physics group's integration state
+(`mj_getState`: positions, velocities, warm start, controls, sucker switches, proxy
+poses) and run-time flags, the health check's saved states, every creature's goal
+path, every tentacle's pending actions, the state systems declare
+(`System.state_attributes`), the frame counter and the random generator. It lives in
+memory and belongs to the world it came from (same entities, same groups).
+"""
+
+from __future__ import annotations
+
+import copy
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ecs_tentacles.components import Creature, Goal
+from ecs_tentacles.locomotion.actions import ActionQueue
+
+if TYPE_CHECKING:
+    from ecs_tentacles.store import ArrayStore
+    from ecs_tentacles.world import World
+
+
+@dataclass
+class Snapshot:
+    """Everything `World.restore` needs; opaque to callers."""
+
+    frame: int
+    physics_time: float
+    rng: dict[str, Any]
+    stores: dict[str, tuple[int, dict[str, np.ndarray]]]
+    fur_outputs: tuple[np.ndarray, np.ndarray]
+    groups: list[dict[str, Any]]
+    health: dict[str, Any]
+    sleep: tuple[np.ndarray, list[np.ndarray]]
+    goals: dict[int, list[tuple[np.ndarray, float]]]
+    queues: dict[int, Any]
+    systems: dict[str, dict[str, Any]] = field(default_factory=dict)
+
+
+def _stores(world: World) -> dict[str, ArrayStore]:
+    fur = world.fur
+    return {
+        "transforms": world.transforms,
+        "motors": world.motors,
+        "suckers": world.suckers,
+        "creatures": world.creatures,
+        "tentacles": world.tentacles,
+        "fur.guides": fur.guides,
+        "fur.controls": fur.controls,
+        "fur.sets": fur.sets,
+        "fur.emotions": fur.emotions,
+        "fur.threats": fur.threats,
+    }
+
+
+def take(world: World) -> Snapshot:
+    """Copy the world's state (see the module docstring)."""
+    physics = world.physics
+    health = physics.health
+    return Snapshot(
+        frame=world.frame,
+        physics_time=physics.time,
+        rng=dict(copy.deepcopy(world.rng.bit_generator.state)),
+        stores={
+            name: (store.count, {f: a[: store.count].copy() for f, a in store._arrays.items()})
+            for name, store in _stores(world).items()
+        },
+        fur_outputs=(world.fur.curves.copy(), world.fur.frames.copy()),
+        groups=[
+            {
+                "state": group.get_state(),
+                "frozen": group.frozen,
+                "sleeping": group.sleeping,
+                "soften": group.soften,
+            }
+            for group in physics.groups
+        ],
+        health=copy.deepcopy(
+            {
+                "state": health.state,
+                "recoveries": health.recoveries,
+                "frozen": health.frozen,
+                "causes": health.causes,
+                "recovered_frames": health.recovered_frames,
+            }
+        ),
+        sleep=(physics.sleep.still.copy(), [c.copy() for c in physics.sleep.commands]),
+        goals={
+            entity: [
+                (world.component(g, Goal).position.copy(), world.component(g, Goal).radius)
+                for g in world.goals.path(entity)
+            ]
+            for entity, _ in world.query(Creature)
+        },
+        queues={entity: copy.deepcopy(queue.pending) for entity, queue in world.query(ActionQueue)},
+        systems={
+            system.name: {a: copy.deepcopy(getattr(system, a)) for a in system.state_attributes}
+            for system in world.schedule
+            if system.state_attributes
+        },
+    )
+
+
+def restore(world: World, snapshot: Snapshot) -> None:
+    """Put the world back in `snapshot`'s state."""
+    world.frame = snapshot.frame
+    world.rng.bit_generator.state = copy.deepcopy(snapshot.rng)
+    for name, store in _stores(world).items():
+        count, arrays = snapshot.stores[name]
+        store.count = count
+        for f, values in arrays.items():
+            store._arrays[f][:count] = values
+    world.fur.curves[...] = snapshot.fur_outputs[0]
+    world.fur.frames[...] = snapshot.fur_outputs[1]
+    physics = world.physics
+    physics.time = snapshot.physics_time
+    for group, saved in zip(physics.groups, snapshot.groups, strict=True):
+        group.set_state(saved["state"], forward=False)
+        group.frozen, group.sleeping, group.soften = (
+            saved["frozen"], saved["sleeping"], saved["soften"]
+        )  # fmt: skip
+        group.warnings[:] = group.data.warning.number  # counters are not state
+        group.error = None
+    health = copy.deepcopy(snapshot.health)
+    physics.health.state = health["state"]
+    physics.health.recoveries = health["recoveries"]
+    physics.health.frozen = health["frozen"]
+    physics.health.causes = health["causes"]
+    physics.health.recovered_frames = health["recovered_frames"]
+    physics.sleep.still[:] = snapshot.sleep[0]
+    physics.sleep.commands = [c.copy() for c in snapshot.sleep[1]]
+    for entity, path in snapshot.goals.items():
+        world.goals.clear(entity)
+        for position, radius in path:
+            world.goals.append(entity, position.tolist(), radius)
+    for entity, queue in world.query(ActionQueue):
+        queue.pending = copy.deepcopy(snapshot.queues[entity])
+    for system in world.schedule:
+        for attribute, value in snapshot.systems.get(system.name, {}).items():
+            setattr(system, attribute, copy.deepcopy(value))

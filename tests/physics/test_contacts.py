@@ -1,0 +1,121 @@
+"""Creatures in different physics groups push each other and never pass through."""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+from numpy.testing import assert_allclose
+
+from ecs_tentacles.physics.clearance import clearance
+from ecs_tentacles.scene.crowd import creature_reach
+from ecs_tentacles.scene.load import load_scene
+from ecs_tentacles.world import World
+
+TOLERANCE = 0.005  # metres of interpenetration allowed, measured on the geoms
+
+
+def _worst_clearance(world: World, frames: int, every: int = 3) -> float:
+    """Step `frames`; the smallest gap between any two nearby creatures, checked often."""
+    entities = [int(e) for e in world.creatures.entity]
+    mantles = world.creatures.mantle_row
+    worst = np.inf
+    for frame in range(frames):
+        world.step(1)
+        if frame % every:
+            continue
+        pos = world.transforms.pos[mantles, :2]
+        near = np.linalg.norm(pos[:, None] - pos[None], axis=2) < 2.5
+        for i, j in itertools.combinations(range(len(entities)), 2):
+            if near[i, j]:
+                worst = min(worst, clearance(world, entities[i], entities[j]))
+    return worst
+
+
+def test_proxies_stand_where_the_other_creatures_bodies_are(
+    make_world: Callable[..., World],
+) -> None:
+    scene = {
+        "version": 1,
+        "creatures": [
+            {"name": "a", "position": [0.0, 0.0], "tentacles": {"count": 3, "links": 4}},
+            {
+                "name": "b",
+                "position": [0.7, 0.0],
+                "heading_deg": 180,  # tentacle tips 3 cm apart
+                "tentacles": {"count": 3, "links": 4},
+            },
+            {"name": "far", "position": [9.0, 0.0], "tentacles": {"count": 3, "links": 4}},
+        ],
+    }
+    world = make_world(scene, locomotion=False)
+    before = world.transforms.pos.copy()  # proxies are placed from the poses a frame starts with
+    world.step(1)
+    a, b, far = world.physics.groups
+    assert far.proxies_used == 0 and a.proxies_used > 0 and b.proxies_used > 0
+    # every proxy of a stands exactly on one of b's bodies, with its size
+    used = a.proxy_mocap[: a.proxies_used]  # capsules first; no mantle is near
+    placed = a.data.mocap_pos[used]
+    bodies = before[b.body_rows]
+    nearest = np.linalg.norm(placed[:, None] - bodies[None], axis=2).min(axis=1)
+    assert_allclose(nearest, 0.0, atol=1e-12)
+    parked = np.setdiff1d(a.proxy_mocap, used)
+    assert (a.data.mocap_pos[parked, 2] < -1000).all()  # the rest wait out of reach
+
+
+def test_two_creatures_driven_head_on_never_interpenetrate(
+    make_world: Callable[..., World],
+) -> None:
+    scene = {
+        "version": 1,
+        "creatures": [
+            {"name": "a", "position": [-1.2, 0.0], "goals": [{"position": [2.4, 0.0]}]},
+            {
+                "name": "b",
+                "position": [1.2, 0.0],
+                "heading_deg": 180,
+                "goals": [{"position": [-2.4, 0.0]}],
+            },
+        ],
+    }
+    world = make_world(scene)
+    worst = _worst_clearance(world, 12 * 60)
+    assert worst > -TOLERANCE
+    assert world.physics.health.recoveries == 0  # the physics never became unstable
+    mantles = world.transforms.pos[world.creatures.mantle_row]
+    assert mantles[0, 0] < mantles[1, 0]  # neither passed through the other
+
+
+def _crossing_crowd(side: int) -> dict[str, Any]:
+    """side x side small creatures on a grid, each heading for its mirror image."""
+    tentacles = {"count": 3, "links": 5}
+    creature: dict[str, Any] = {"name": "x", "position": [0, 0], "tentacles": tentacles}
+    spacing = 2.0 * creature_reach(load_scene({"version": 1, "creatures": [creature]})[
+        "creatures"][0]) + 0.2  # fmt: skip
+    creatures = []
+    for k, (i, j) in enumerate(itertools.product(range(side), repeat=2)):
+        x, y = (i - (side - 1) / 2) * spacing, (j - (side - 1) / 2) * spacing
+        creatures.append(
+            {
+                "name": f"c{k}",
+                "position": [x, y],
+                "heading_deg": float(np.degrees(np.arctan2(-y, -x))),
+                "tentacles": tentacles,
+                "goals": [{"position": [-x, -y]}],
+            }
+        )
+    return {"version": 1, "creatures": creatures}
+
+
+def test_sixteen_creatures_with_crossing_goals_stay_apart_for_20_seconds(
+    make_world: Callable[..., World],
+) -> None:
+    world = make_world(_crossing_crowd(4))
+    start = world.transforms.pos[world.creatures.mantle_row].copy()
+    worst = _worst_clearance(world, 20 * 60, every=6)
+    assert worst > -TOLERANCE
+    assert world.physics.health.recoveries == 0
+    end = world.transforms.pos[world.creatures.mantle_row]
+    assert np.median(np.linalg.norm(end[:, :2] - start[:, :2], axis=1)) > 0.3  # they crawled

@@ -1,0 +1,74 @@
+"""Physics groups: one compiled model per morphology, threads, a creature alone."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+from numpy.testing import assert_array_equal
+
+from ecs_tentacles.components import Creature
+from ecs_tentacles.world import World
+
+
+def _far_apart(tentacles: list[dict[str, Any]], goals: bool = True) -> dict[str, Any]:
+    """Creatures 4 m apart in a row, each with its own tentacle settings and a goal."""
+    creatures = [
+        {
+            "name": f"c{i}",
+            "position": [4.0 * i, 0.0],
+            "tentacles": spec,
+            "goals": [{"position": [4.0 * i, 1.0]}] if goals else [],
+        }
+        for i, spec in enumerate(tentacles)
+    ]
+    return {"version": 1, "creatures": creatures}
+
+
+def test_one_compile_per_morphology(make_world: Callable[..., World]) -> None:
+    same = {"count": 4, "links": 5}
+    world = make_world(_far_apart([same, same, {"count": 5, "links": 5}, same]))
+    physics = world.physics
+    assert (len(physics.groups), physics.compiles) == (4, 2)
+    assert [g.creatures for g in physics.groups] == [[world.creature(f"c{i}")] for i in range(4)]
+    # creatures that share a compiled model still own their data and servo gains
+    first, second = physics.groups[0], physics.groups[1]
+    assert first.model is not second.model and first.data is not second.data
+    assert first.key == second.key != physics.groups[2].key
+
+
+def test_trajectories_do_not_depend_on_the_thread_count(make_world: Callable[..., World]) -> None:
+    scene = _far_apart([{"count": 4, "links": 5}] * 3 + [{"count": 3, "links": 6}])
+    runs = []
+    for threads in (1, 2):
+        world = make_world(scene, threads=threads)
+        assert world.physics.threads == threads
+        poses = []
+        for _ in range(6):
+            world.step(10)
+            poses.append(world.transforms.pos.copy())
+        runs.append(np.array(poses))
+    assert_array_equal(runs[0], runs[1])
+    assert np.ptp(runs[0][:, :, :2], axis=0).max() > 0.01  # they did move
+
+
+def test_a_creature_alone_moves_as_in_a_world_of_its_own(make_world: Callable[..., World]) -> None:
+    # the first creature draws the same random tentacle phases in both worlds
+    crowd = make_world(_far_apart([{"count": 4, "links": 5}, {"count": 6}, {"count": 3}]))
+    alone = make_world(_far_apart([{"count": 4, "links": 5}]))
+    rows = crowd.physics.groups[0].body_rows
+    assert_array_equal(rows, alone.physics.groups[0].body_rows)
+    for _ in range(5):
+        crowd.step(24)
+        alone.step(24)
+        assert_array_equal(crowd.transforms.pos[rows], alone.transforms.pos)
+        assert_array_equal(crowd.transforms.quat[rows], alone.transforms.quat)
+
+
+def test_groups_are_visible(make_world: Callable[..., World]) -> None:
+    world = make_world(_far_apart([{"count": 3, "links": 4}] * 2), threads=2)
+    octo = world.component(world.creature("c1"), Creature)
+    assert world.physics.group_of(octo) is world.physics.groups[1]
+    assert repr(world.physics) == "<physics: 2 groups, 1 compiled models, 2 threads>"
+    assert world.physics.bodies == 2 * (1 + 3 * 4)

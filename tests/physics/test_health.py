@@ -1,0 +1,196 @@
+"""Physics health: injected blow-ups recover only the creature hit, and are reported."""
+
+from __future__ import annotations
+
+import json
+import logging
+import textwrap
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from numpy.testing import assert_array_equal
+
+from ecs_tentacles.cli import main
+from ecs_tentacles.world import World
+
+SCENE: dict[str, Any] = {
+    "version": 1,
+    "creatures": [
+        {
+            "name": f"c{i}",
+            "position": [4.0 * i, 0.0],
+            "tentacles": {"count": 3, "links": 5},
+            "goals": [{"position": [4.0 * i, 1.5]}],
+        }
+        for i in range(3)
+    ],
+}
+
+
+def _hit_strength(world: World) -> None:
+    rows = world.physics.groups[1].actuator_motor_rows
+    world.motors.strength[rows[:10]] = 1e5  # one tentacle's servos, far past sane
+
+
+def _hit_force(world: World) -> None:
+    group = world.physics.groups[1]
+    group.data.xfrc_applied[group.body_ids[0], 2] = 1e7  # on the mantle, for one frame
+
+
+def _hit_nan(world: World) -> None:
+    world.physics.groups[1].data.qvel[7] = np.nan
+
+
+FAULTS = {"strength": _hit_strength, "force": _hit_force, "nan": _hit_nan}
+
+
+@pytest.mark.parametrize("fault", sorted(FAULTS))
+def test_a_blow_up_recovers_only_the_creature_hit(
+    fault: str, make_world: Callable[..., World]
+) -> None:
+    clean, hurt = make_world(SCENE), make_world(SCENE)
+    events: list[dict[str, Any]] = []
+    hurt.events.on("creature_recovered", lambda **e: events.append(e))
+    for world in (clean, hurt):
+        world.step(30)
+    FAULTS[fault](hurt)
+    hurt.step(1)
+    if fault == "force":
+        hurt.physics.groups[1].data.xfrc_applied[:] = 0.0
+    clean.step(1)
+    clean.step(120)
+    hurt.step(120)
+    assert {e["creature"] for e in events} == {hurt.creature("c1")}
+    # servos left at 1e5 keep shaking their creature (until it is frozen); one-off hits heal
+    expected = len(events) if fault == "strength" else 1
+    assert hurt.physics.health.recoveries == expected >= 1
+    assert hurt.events.counts["creature_recovered"] == expected
+    for k in (0, 2):  # the others never noticed
+        rows = hurt.physics.groups[k].body_rows
+        assert_array_equal(hurt.transforms.pos[rows], clean.transforms.pos[rows])
+    assert np.isfinite(hurt.transforms.pos).all()
+    speed = np.linalg.norm(hurt.transforms.pos - clean.transforms.pos, axis=1)
+    assert speed.max() < 0.5  # restored, not thrown across the scene
+
+
+def test_a_teleport_never_reaches_a_goal(make_world: Callable[..., World]) -> None:
+    world = make_world(SCENE)
+    world.step(10)
+    group = world.physics.groups[0]
+    goal = world.creatures.goal[0]
+    group.data.qpos[0:2] = goal[:2]  # jump into the goal between two frames
+    world.step(5)
+    assert world.events.counts["goal_reached"] == 0
+    assert world.physics.health.causes == {"speed": 1}
+    assert len(world.goals.path(world.creature("c0"))) == 1
+
+
+def test_a_creature_that_keeps_failing_is_frozen(
+    make_world: Callable[..., World], caplog: pytest.LogCaptureFixture
+) -> None:
+    world = make_world(SCENE)
+    frozen: list[dict[str, Any]] = []
+    world.events.on("creature_frozen", lambda **e: frozen.append(e))
+    world.step(10)
+    with caplog.at_level(logging.WARNING, logger="ecs_tentacles.physics"):
+        for _ in range(3):
+            _hit_nan(world)
+            world.step(5)
+    group = world.physics.groups[1]
+    assert group.frozen and world.physics.health.frozen == 1 and len(frozen) == 1
+    [line] = [r.message for r in caplog.records if r.name == "ecs_tentacles.physics"]
+    assert line.startswith("creature 'c1' frozen: 3 physics failures in 2.0 s (last: ")
+    still = world.transforms.pos[group.body_rows].copy()
+    world.step(30)
+    assert_array_equal(world.transforms.pos[group.body_rows], still)
+    assert world.physics.health.recoveries == 3  # frozen, not looping
+
+
+FAULTY = """
+import numpy as np
+from ecs_tentacles.system import System
+
+class BreakOne(System):
+    '''Writes NaN into creature 0's velocities on frame 20.'''
+    name = "break_one"
+    after = ("physics",)
+    before = ("physics_health",)
+
+    def process(self, world, dt):
+        if world.frame == 20:
+            world.physics.groups[0].data.qvel[0] = np.nan
+"""
+
+
+@pytest.fixture
+def faulty_scene(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    (tmp_path / "faulty_system.py").write_text(textwrap.dedent(FAULTY))
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.chdir(tmp_path)
+    scene = {**SCENE, "systems": ["faulty_system:BreakOne"]}
+    path = tmp_path / "faulty.json"
+    path.write_text(json.dumps(scene))
+    return path
+
+
+def test_run_reports_recoveries_and_strict_exits_1(
+    faulty_scene: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    args = ["run", str(faulty_scene), "--frames", "40", "--allow-systems", "--quiet"]
+    assert main([*args, "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert (summary["recoveries"], summary["recovery_causes"], summary["frozen"]) == (
+        1,
+        {"non-finite": 1},
+        0,
+    )
+    assert main(args) == 0
+    err = capsys.readouterr().err
+    assert "warning: physics recovered 1 times (non-finite 1), 0 creatures frozen" in err
+    assert main([*args, "--strict"]) == 1
+    assert not (faulty_scene.parent / "MUJOCO_LOG.TXT").exists()
+
+
+def test_mujoco_messages_go_to_logging_not_a_file(
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    make_world: Callable[..., World],
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    monkeypatch.chdir(tmp_path)
+    world = make_world(SCENE)
+    causes: list[str] = []
+    world.events.on("creature_recovered", lambda **e: causes.append(e["cause"]))
+    with caplog.at_level(logging.WARNING, logger="ecs_tentacles.mujoco"):
+        world.physics.groups[2].data.qvel[0] = 1e12  # MuJoCo warns: bad qvel (> 1e10)
+        world.step(2)
+    assert any("QVEL" in r.message for r in caplog.records)
+    assert world.physics.health.causes == {"mujoco": 1}
+    assert len(causes) == 1 and "badqvel" in causes[0].split(" ", 1)[1].split(", ")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_bake_marks_recoveries_in_the_take_and_strict_writes_nothing(
+    faulty_scene: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from ecs_tentacles.export.take import Take
+
+    out = faulty_scene.parent / "take.npz"
+    args = ["bake", str(faulty_scene), "--seconds", "1", "--allow-systems", "--quiet"]
+    assert main([*args, "--out", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert "warning: physics recovered 1 times, 0 creatures frozen (take frames 21;" in err
+    health = Take.load(out).header["health"]
+    assert health == {
+        "recoveries": 1,
+        "frozen": 0,
+        "events": [{"frame": 21, "creature": 0, "event": "recovered", "cause": "non-finite state"}],
+    }
+    strict = faulty_scene.parent / "strict.npz"
+    assert main([*args, "--out", str(strict), "--strict"]) == 1
+    assert not strict.exists()
+    left = {p.name for p in faulty_scene.parent.iterdir()} - {"__pycache__"}
+    assert left == {"faulty.json", "faulty_system.py", "take.npz"}  # no partial, no log

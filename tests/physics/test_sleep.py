@@ -1,0 +1,58 @@
+"""Still, idle creatures sleep (are not stepped) and wake when something changes."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+from numpy.testing import assert_array_equal
+
+from ecs_tentacles.physics.sleep import SETTLE_FRAMES
+from ecs_tentacles.world import World
+
+RESTING = {"count": 3, "links": 5, "wave_amplitude_deg": 0, "writhe": 0}
+
+
+def _scene(tentacles: dict[str, Any], **physics: Any) -> dict[str, Any]:
+    creatures = [
+        {"name": "rest", "position": [0.0, 0.0], "tentacles": tentacles},
+        {"name": "busy", "position": [4.0, 0.0], "tentacles": {"count": 3, "links": 5}},
+    ]
+    return {"version": 1, "physics": physics, "creatures": creatures}
+
+
+def test_a_still_idle_creature_sleeps_and_a_goal_wakes_it(
+    make_world: Callable[..., World],
+) -> None:
+    world = make_world(_scene(RESTING))
+    rest, busy = world.physics.groups
+    world.step(240)  # settles on the ground, then lies still
+    assert rest.sleeping and not busy.sleeping  # the writhing one never sleeps
+    assert world.physics.sleep.asleep == 1
+    state = rest.get_state()
+    world.step(30)
+    assert_array_equal(rest.get_state(), state)  # not stepped at all
+    start = world.transforms.pos[rest.body_rows[0]].copy()
+    world.goals.set(world.creature("rest"), [1.0, 0.0])
+    world.step(1)
+    assert not rest.sleeping
+    world.step(120)
+    assert np.linalg.norm(world.transforms.pos[rest.body_rows[0]] - start) > 0.01
+
+
+def test_a_script_moving_a_servo_wakes_it(make_world: Callable[..., World]) -> None:
+    world = make_world(_scene(RESTING), locomotion=False)  # the script drives the servos
+    rest = world.physics.groups[0]
+    world.step(240)
+    assert rest.sleeping
+    world.motors.target[rest.actuator_motor_rows[0], 0] = -0.5
+    world.step(1)
+    assert not rest.sleeping
+    assert np.abs(rest.data.qvel).max() > 1e-3
+
+
+def test_sleep_can_be_switched_off(make_world: Callable[..., World]) -> None:
+    world = make_world(_scene(RESTING, sleep=False))
+    world.step(SETTLE_FRAMES + 240)
+    assert world.physics.sleep.asleep == 0

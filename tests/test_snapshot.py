@@ -1,0 +1,45 @@
+"""World snapshots: restore continues bit-identically; worlds close themselves."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import esper
+import numpy as np
+from numpy.testing import assert_array_equal
+
+from ecs_tentacles.world import World
+
+
+def _state(world: World) -> list[np.ndarray]:
+    physics = [a for g in world.physics.groups for a in (g.data.qpos, g.data.qvel, g.get_state())]
+    stores = [world.transforms.pos, world.motors.target, world.suckers.anchor, world.fur.curves]
+    return [np.array(a, copy=True) for a in (*physics, *stores, world.tentacles.timer)]
+
+
+def test_restore_continues_bit_identically_with_suckers_attached(
+    make_world: Callable[..., World],
+) -> None:
+    world = make_world("hedgehog_octopus")  # crawls with suckers; fur with dynamics
+    while not world.suckers.attached.any():
+        world.step(1)
+    snap = world.snapshot()
+    octo = int(world.creatures.entity[0])
+    actions = world.locomotion.actions(octo)
+    world.step(300)
+    first = _state(world)
+    reached = world.events.counts["goal_reached"]
+    world.restore(snap)
+    assert world.suckers.attached.any() and world.frame == snap.frame
+    assert world.locomotion.actions(octo) == actions
+    world.step(300)
+    for a, b in zip(first, _state(world), strict=True):
+        assert_array_equal(a, b)
+    assert world.events.counts["goal_reached"] == 2 * reached  # the same goals again
+
+
+def test_world_is_a_context_manager() -> None:
+    with World.from_scene("octopus") as world:
+        context = world.context
+        world.step(2)
+    assert context not in esper.list_worlds()
