@@ -19,10 +19,13 @@ from typing import Any
 
 from tqdm import tqdm
 
+from ecs_tentacles.cli import bake_ray
 from ecs_tentacles.cli.arguments import output_path
 from ecs_tentacles.cli.run import seed_int
 from ecs_tentacles.cli.skin_options import add_arguments as add_skin_arguments
 from ecs_tentacles.cli.skin_options import skin_options
+from ecs_tentacles.distributed.driver import ShardFailed
+from ecs_tentacles.distributed.wedge import WedgeError
 from ecs_tentacles.export import SUFFIXES, write
 from ecs_tentacles.export.bake import BakePlan, bake, output_kind
 from ecs_tentacles.export.skinned import Skin
@@ -88,6 +91,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
     parser.add_argument("--json", action="store_true", help="print the summary as JSON")
     add_skin_arguments(parser)
+    bake_ray.add_arguments(parser)
     parser.add_argument(
         "--allow-systems", action="store_true", help="import and run the systems the scene names"
     )
@@ -96,6 +100,8 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 def handle(args: argparse.Namespace) -> int:
     problem = usd_missing(args.out)
+    if args.ray is not None and not problem:
+        problem = bake_ray.ray_missing()
     if problem:
         print(f"error: {problem}", file=sys.stderr)
         return 2
@@ -107,6 +113,12 @@ def handle(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return 2
+    if args.wedge:
+        try:
+            return bake_ray.run_wedge(args, plan, save)
+        except WedgeError as error:
+            print(f"error: {error}", file=sys.stderr)
+            return 2
     print(
         f"bake: {plan.source} -> {args.out}: {plan.frames} frames at {plan.fps:g} fps"
         f" (simulated at {plan.sim_fps:g} fps), seed {plan.seed}",
@@ -118,12 +130,20 @@ def handle(args: argparse.Namespace) -> int:
     except ValueError as error:
         print(f"error: {error}", file=sys.stderr)
         return 2
-    take = bake(plan, progress=not args.quiet, allow_systems=args.allow_systems)
+    if args.ray is not None:
+        try:
+            take = bake_ray.bake_on_ray(args, plan)
+        except ShardFailed as error:
+            print(f"error: {error}", file=sys.stderr)
+            return 1
+    else:
+        take = bake(plan, progress=not args.quiet, allow_systems=args.allow_systems)
     try:
         skinned = save(take, args.out, progress=not args.quiet, skin=skin)
     except MeshError as error:  # e.g. tentacle bases that overlap on the mantle
         print(f"error: {error}", file=sys.stderr)
         return 2
+    getattr(args, "after_write", lambda: None)()
     print(summary(take, args.out, args.json, skinned))
     return 0
 

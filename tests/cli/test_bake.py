@@ -179,3 +179,15 @@ def test_take_arrays_are_plain_numpy(scene: Path, tmp_path: Path) -> None:
     assert main(["bake", str(scene), "--seconds", "0.05", "--out", str(out), "--quiet"]) == 0
     with np.load(out) as npz:  # no pickles: readable anywhere numpy is
         assert npz["pos"].dtype == np.float32 and npz["pos"].shape == (4, 13, 3)
+
+
+def test_a_local_bake_never_imports_ray(scene: Path, tmp_path: Path) -> None:
+    code = (
+        "import sys; from ecs_tentacles.cli import main;"
+        f" assert main(['bake', {str(scene)!r}, '--seconds', '0.1', '--quiet',"
+        f" '--out', {str(tmp_path / 't.npz')!r}]) == 0;"
+        " print(sorted(m for m in sys.modules if m == 'ray' or m.startswith('ray.')))"
+    )
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.splitlines()[-1] == "[]"

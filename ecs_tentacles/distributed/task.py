@@ -1,0 +1,78 @@
+"""One shard's bake, as a Ray worker (or this process) runs it.
+
+`bake_shard(plan, members)` builds the sub-scene of creatures `members` (scene
+indices) and bakes it exactly as a local bake would (same seed, rates and scene hash
+in the header; each creature draws its own random values, see
+`ecs_tentacles.build.creature_rng`), recording each creature's contact sphere every
+frame (`ecs_tentacles.distributed.spheres`). Physics steps on one thread: a worker
+is one CPU.
+
+Test hook: when `ECS_TENTACLES_CRASH_DIR` names a folder holding a file named after
+the shard's key, the worker claims that file (a rename, so only one worker does) and
+dies at once with `os._exit`, as a killed worker would; tests use it to show that
+Ray's retry bakes the shard again and the merged take is unchanged.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from ecs_tentacles.distributed.shards import sub_scene
+from ecs_tentacles.distributed.spheres import ContactSpheres
+from ecs_tentacles.export.bake import BakePlan, bake
+from ecs_tentacles.export.take import Take
+
+CRASH_DIR = "ECS_TENTACLES_CRASH_DIR"
+
+
+@dataclass
+class ShardResult:
+    """A shard's take, its creatures' contact spheres and how long the bake took."""
+
+    members: list[int]
+    take: Take
+    spheres: np.ndarray  # (steps + 1, creatures, 4)
+    seconds: float = 0.0
+
+
+def bake_shard(
+    plan: BakePlan,
+    members: list[int],
+    key: str = "",
+    *,
+    allow_systems: bool = False,
+    on_steps: Callable[[int], None] | None = None,
+) -> ShardResult:
+    """Bake creatures `members` of `plan`'s scene; `key` names the shard (test hook)."""
+    _crash_if_asked(key)
+    started = time.perf_counter()
+    sub = dataclasses.replace(plan, scene=sub_scene(plan.scene, members))
+    spheres = ContactSpheres(plan.steps)
+    take = bake(
+        sub,
+        progress=False,
+        allow_systems=allow_systems,
+        on_world=lambda world: world.add_systems(spheres),
+        threads=1,
+        scene_sha256=plan.scene_sha256,
+        on_steps=on_steps,
+    )
+    return ShardResult(list(members), take, spheres.spheres, time.perf_counter() - started)
+
+
+def _crash_if_asked(key: str) -> None:
+    folder = os.environ.get(CRASH_DIR)
+    if not folder or not key:
+        return
+    request = os.path.join(folder, key)
+    try:
+        os.rename(request, f"{request}.claimed.{os.getpid()}")
+    except OSError:
+        return  # no request for this shard (or another worker claimed it)
+    os._exit(70)
