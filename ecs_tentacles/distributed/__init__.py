@@ -2,7 +2,7 @@
 
 - `shards`: which creatures a bake may simulate apart (declared in the scene, or
   worked out from where each creature can travel during the bake), packed into tasks.
-- `task`: one shard's bake, as a Ray worker runs it (a sub-scene of its creatures).
+- `task`: one shard's bake, as a Ray worker runs it (only its creatures built).
 - `spheres`: the contact-range check that proves shards never met (else they re-bake
   together), so a sharded bake always equals the local one.
 - `merge`: shard takes -> the one take a local bake writes, byte for byte.

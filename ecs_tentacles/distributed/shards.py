@@ -163,13 +163,6 @@ def _links(creature: dict[str, Any]) -> list[int]:
     return [overrides.get(k) or tentacles["links"] for k in range(tentacles["count"])]
 
 
-def sub_scene(scene: dict[str, Any], members: list[int]) -> dict[str, Any]:
-    """The scene with only creatures `members` (everything else as it was, no `shards`)."""
-    out = {key: value for key, value in scene.items() if key != "shards"}
-    out["creatures"] = [scene["creatures"][i] for i in members]
-    return out
-
-
 def default_tasks(cpus: float) -> int:
     """Shards to aim for on `cpus` workers: a few per worker, so a slow one evens out."""
     return max(1, 4 * math.floor(cpus))

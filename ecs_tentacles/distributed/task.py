@@ -1,8 +1,9 @@
 """One shard's bake, as a Ray worker (or this process) runs it.
 
-`bake_shard(plan, members)` builds the sub-scene of creatures `members` (scene
-indices) and bakes it exactly as a local bake would (same seed, rates and scene hash
-in the header; each creature draws its own random values, see
+`bake_shard(plan, members)` builds only the creatures `members` (scene indices) of
+the plan's scene and bakes them exactly as a local bake would (same seed, rates and
+scene in the header and for everything scene-wide, such as the fur's shared point
+count and the threats; each creature draws its own random values, see
 `ecs_tentacles.build.creature_rng`), recording each creature's contact sphere every
 frame (`ecs_tentacles.distributed.spheres`). Physics steps on one thread: a worker
 is one CPU.
@@ -15,7 +16,6 @@ Ray's retry bakes the shard again and the merged take is unchanged.
 
 from __future__ import annotations
 
-import dataclasses
 import os
 import time
 from collections.abc import Callable
@@ -23,7 +23,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ecs_tentacles.distributed.shards import sub_scene
 from ecs_tentacles.distributed.spheres import ContactSpheres
 from ecs_tentacles.export.bake import BakePlan, bake
 from ecs_tentacles.export.take import Take
@@ -52,15 +51,14 @@ def bake_shard(
     """Bake creatures `members` of `plan`'s scene; `key` names the shard (test hook)."""
     _crash_if_asked(key)
     started = time.perf_counter()
-    sub = dataclasses.replace(plan, scene=sub_scene(plan.scene, members))
     spheres = ContactSpheres(plan.steps)
     take = bake(
-        sub,
+        plan,
         progress=False,
         allow_systems=allow_systems,
         on_world=lambda world: world.add_systems(spheres),
         threads=1,
-        scene_sha256=plan.scene_sha256,
+        only=set(members),
         on_steps=on_steps,
     )
     return ShardResult(list(members), take, spheres.spheres, time.perf_counter() - started)

@@ -7,7 +7,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from ecs_tentacles.distributed.shards import pack, plan_shards, segment_distance, sub_scene
+from ecs_tentacles.distributed.shards import pack, plan_shards, segment_distance
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.load import load_scene
 
@@ -53,18 +53,12 @@ def test_islands_are_packed_into_at_most_tasks_shards_balanced() -> None:
     assert pack(islands, data["creatures"], 1) == [[0, 1, 2, 3, 4]]
 
 
-def test_declared_shards_are_used_and_sub_scenes_keep_everything_else() -> None:
+def test_declared_shards_are_used_as_they_are() -> None:
     raw = scene((0, 0), (1, 0), (2, 0))
     raw["shards"] = [["c2", "c0"], ["c1"]]
     data = load_scene(raw)
     plan = plan_shards(data, seconds=1.0, tasks=8)
     assert plan.shards == [[0, 2], [1]] and plan.declared
-    sub = sub_scene(data, [0, 2])
-    assert [c["name"] for c in sub["creatures"]] == ["c0", "c2"] and "shards" not in sub
-    assert {k: v for k, v in sub.items() if k != "creatures"} == {
-        k: v for k, v in data.items() if k not in ("creatures", "shards")
-    }
-    load_scene(sub)  # still a valid scene
 
 
 @pytest.mark.parametrize(
