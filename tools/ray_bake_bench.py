@@ -27,7 +27,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from ecs_tentacles.distributed.driver import ray_bake
+from ecs_tentacles.distributed.driver import ray_bake, start_ray
 from ecs_tentacles.export.bake import BakePlan, bake
 from ecs_tentacles.export.take import Take, write_npz
 from ecs_tentacles.scene.crowd import crowd_scene
@@ -61,7 +61,7 @@ def run(creatures: int, seconds: float, stripes: int, workers: int) -> dict[str,
         rows[f"local_{threads}_s"] = time.perf_counter() - start
     print(f"ray, {workers} workers...", file=sys.stderr, flush=True)
     start = time.perf_counter()
-    ray.init(num_cpus=workers, include_dashboard=False, log_to_driver=False, logging_level="ERROR")
+    start_ray(None, workers)
     rows["ray_start_s"] = time.perf_counter() - start
     try:
         with tempfile.TemporaryDirectory() as folder:

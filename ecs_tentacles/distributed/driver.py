@@ -19,6 +19,7 @@ every running task (`ray.cancel`) and keeps the finished shards there too.
 
 from __future__ import annotations
 
+import logging
 import sys
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -61,7 +62,7 @@ def start_ray(address: str | None, cpus: int | None) -> bool:
     if ray.is_initialized():
         return False
     options: dict[str, Any] = {"include_dashboard": False, "log_to_driver": False}
-    options["logging_level"] = "ERROR"
+    options["logging_level"] = logging.ERROR
     if address:
         ray.init(address=address, **options)
     else:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import logging
 import os
 import signal
 import subprocess
@@ -36,7 +37,7 @@ def cluster(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Path]:
     """A local Ray with 2 CPUs; yields the folder its workers read crash requests from."""
     crashes = tmp_path_factory.mktemp("crashes")
     os.environ[CRASH_DIR] = str(crashes)  # inherited by the workers Ray starts
-    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False, logging_level="ERROR")
+    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False, logging_level=logging.ERROR)
     yield crashes
     ray.shutdown()
     del os.environ[CRASH_DIR]
