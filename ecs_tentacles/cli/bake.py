@@ -4,6 +4,8 @@ FILE's suffix picks the format: `.npz` a take (the compact, reproducible record)
 `.usd`/`.usda`/`.usdc` a USD stage (needs the `usd` extra), `.glb` binary glTF. The
 output is written to a temporary file beside FILE and renamed at the end, so an
 interrupted bake never leaves a partial FILE (an existing FILE stays as it was).
+`--ray [ADDRESS]` bakes in shards on Ray and `--wedge PATH=VALUES` bakes variants
+(`ecs_tentacles.cli.bake_ray`, `ecs_tentacles.distributed`).
 """
 
 from __future__ import annotations
