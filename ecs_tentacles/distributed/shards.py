@@ -8,7 +8,8 @@ creature can crawl in the bake (`CRAWL_SPEED` x its locomotion speed x seconds),
 with the creature's reach plus `SLACK` as radius (a disc when it has no goal or its
 path turns within that length). Creatures whose capsules come within `MARGIN` are
 joined (union-find); each connected set is one island, and islands are packed into
-at most `tasks` shards of balanced size.
+at most `tasks` shards of balanced size. Creatures marked `threat` and the creatures
+with an `emotion` they may rouse always share a shard (declared shards too).
 
 The plan is an estimate; the bake proves it (`ecs_tentacles.distributed.spheres`):
 shards whose creatures did come within contact range are baked again together.
@@ -50,12 +51,37 @@ class ShardPlan:
 def plan_shards(scene: dict[str, Any], seconds: float, tasks: int) -> ShardPlan:
     """The shards of `scene` (validated, defaults in) for a bake of `seconds`."""
     creatures = scene["creatures"]
+    if not creatures:
+        return ShardPlan([[]], 1, declared=False)
     if "shards" in scene:
         index = {c["name"]: i for i, c in enumerate(creatures)}
         shards = [sorted(index[name] for name in shard) for shard in scene["shards"]]
+        shards = _joined(shards, roused(creatures))
         return ShardPlan(sorted(shards), len(shards), declared=True)
-    islands = islands_of(creatures, seconds)
+    islands = _joined(islands_of(creatures, seconds), roused(creatures))
     return ShardPlan(pack(islands, creatures, tasks), len(islands), declared=False)
+
+
+def roused(creatures: list[dict[str, Any]]) -> list[int]:
+    """Creatures that must share a shard because one rouses another's emotion.
+
+    A creature marked `threat` rouses any creature with an `emotion` near it (the
+    emotion system), wherever their shards are: all of them bake together.
+    """
+    threats = {i for i, c in enumerate(creatures) if c.get("threat")}
+    emotional = {i for i, c in enumerate(creatures) if "emotion" in c}
+    if not threats or not (emotional - threats or (len(threats) > 1 and emotional)):
+        return []
+    return sorted(threats | emotional)
+
+
+def _joined(sets: list[list[int]], together: list[int]) -> list[list[int]]:
+    """`sets` with every set holding one of `together` merged into one."""
+    if not together:
+        return sets
+    wanted = set(together)
+    merged = sorted({i for s in sets if wanted & set(s) for i in s})
+    return sorted([merged, *(s for s in sets if not wanted & set(s))])
 
 
 def travel_capsules(creatures: list[dict[str, Any]], seconds: float) -> np.ndarray:

@@ -84,3 +84,17 @@ def test_segment_distance() -> None:
     p0, p1 = np.array([[0.0, 0.0], [0.0, 0.0]]), np.array([[2.0, 0.0], [2.0, 0.0]])
     q0, q1 = np.array([[1.0, 1.0], [3.0, 3.0]]), np.array([[1.0, -1.0], [3.0, 4.0]])
     np.testing.assert_allclose(segment_distance(p0, p1, q0, q1), [0.0, np.hypot(1, 3)])
+
+
+def test_a_threat_creature_shares_a_shard_with_the_creatures_it_may_rouse() -> None:
+    raw = scene((0, 0), (50, 0), (100, 0), (150, 0))
+    raw["creatures"][0]["threat"] = True
+    raw["creatures"][2]["emotion"] = {}
+    assert plan_shards(load_scene(raw), seconds=1.0, tasks=8).shards == [[0, 2], [1], [3]]
+    raw["shards"] = [["c0", "c1"], ["c2"], ["c3"]]
+    declared = plan_shards(load_scene(raw), seconds=1.0, tasks=8)
+    assert declared.shards == [[0, 1, 2], [3]]
+
+
+def test_a_scene_without_creatures_is_one_empty_shard() -> None:
+    assert plan_shards(load_scene({"version": 1}), seconds=1.0, tasks=8).shards == [[]]
