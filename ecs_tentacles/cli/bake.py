@@ -102,8 +102,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 def handle(args: argparse.Namespace) -> int:
     problem = usd_missing(args.out)
-    if args.ray is not None and not problem:
-        problem = bake_ray.ray_missing()
+    problem = problem or bake_ray.ray_problem(args)
     if problem:
         print(f"error: {problem}", file=sys.stderr)
         return 2

@@ -14,6 +14,21 @@ from ecs_tentacles.export.bake import BakePlan, bake
 from ecs_tentacles.export.take import Take
 
 
+def count(low: int) -> Any:
+    """argparse type: an integer >= `low`."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"must be an integer, got {text!r}") from None
+        if value < low:
+            raise argparse.ArgumentTypeError(f"must be >= {low}, got {value}")
+        return value
+
+    return parse
+
+
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """The distributed options of `bake`."""
     parser.add_argument(
@@ -26,10 +41,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         " or start a local one",
     )
     parser.add_argument(
-        "--cpus", type=int, default=None, help="CPUs of a local Ray (default: all of them)"
+        "--cpus", type=count(1), default=None, help="CPUs of a local Ray (default: all of them)"
     )
     parser.add_argument(
-        "--retries", type=int, default=3, help="runs of a failed Ray task after the first"
+        "--retries", type=count(0), default=3, help="runs of a failed Ray task after the first"
     )
     parser.add_argument(
         "--resume",
@@ -46,11 +61,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def ray_missing() -> str | None:
-    """The one-line problem when Ray is not installed, else None."""
+def ray_problem(args: argparse.Namespace) -> str | None:
+    """The one-line problem with the distributed options (Ray missing...), else None."""
     import importlib.util
 
-    if importlib.util.find_spec("ray") is None:
+    if args.resume and (args.ray is None or args.wedge):
+        return "argument --resume: only for a --ray bake without --wedge"
+    if args.ray is not None and importlib.util.find_spec("ray") is None:
         return "argument --ray: needs Ray: pip install 'ecs-tentacles[ray]'"
     return None
 
