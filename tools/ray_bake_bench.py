@@ -12,6 +12,8 @@ that met, and the table says how many). Ray runs a local cluster of `--workers` 
 Reports wall seconds and speed-up against 1 thread, Ray's start-up, its overhead
 per task ((wall x workers - seconds inside the tasks) / tasks), the bytes that came
 back from the workers, and whether the Ray take equals the local one byte for byte.
+CPU seconds (this process for local bakes, the workers inside their tasks for Ray)
+and the load average show how much of a wall time was other programs' doing.
 Not a test: run it by hand on a quiet machine (numbers move with the load).
 """
 
@@ -21,6 +23,7 @@ import argparse
 import hashlib
 import io
 import json
+import os
 import sys
 import tempfile
 import time
@@ -53,12 +56,14 @@ def run(creatures: int, seconds: float, stripes: int, workers: int) -> dict[str,
 
     plan = BakePlan.make(striped(creatures, stripes), seconds=seconds, fps=30)
     rows: dict[str, Any] = {"creatures": creatures, "seconds": seconds, "frames": plan.frames}
+    rows["load_before"] = os.getloadavg()[0]
     takes = {}
     for threads in (1, 2):
         print(f"local, {threads} thread(s)...", file=sys.stderr, flush=True)
-        start = time.perf_counter()
+        start, cpu = time.perf_counter(), time.process_time()
         takes[threads] = bake(plan, progress=False, threads=threads)
         rows[f"local_{threads}_s"] = time.perf_counter() - start
+        rows[f"local_{threads}_cpu_s"] = time.process_time() - cpu
     print(f"ray, {workers} workers...", file=sys.stderr, flush=True)
     start = time.perf_counter()
     start_ray(None, workers)
@@ -76,6 +81,8 @@ def run(creatures: int, seconds: float, stripes: int, workers: int) -> dict[str,
         tasks=tasks,
         rebaked=stats.rebaked,
         inside_tasks_s=sum(stats.task_seconds),
+        tasks_cpu_s=sum(stats.task_cpu_seconds),
+        load_after=os.getloadavg()[0],
         overhead_per_task_s=(rows["ray_s"] * workers - sum(stats.task_seconds)) / max(1, tasks),
         bytes_back=stats.result_bytes,
         identical=sha(take) == sha(takes[1]) == sha(takes[2]),
@@ -87,13 +94,16 @@ def table(r: dict[str, Any], workers: int) -> str:
     base = r["local_1_s"]
     lines = [
         f"{r['creatures']} creatures, {r['seconds']:g} s ({r['frames']} frames at 30 fps)",
-        "| run | wall s | speed-up |",
-        "| --- | ---: | ---: |",
-        f"| local, 1 thread | {base:.1f} | 1.00 |",
-        f"| local, 2 threads | {r['local_2_s']:.1f} | {base / r['local_2_s']:.2f} |",
+        "| run | wall s | speed-up | CPU s |",
+        "| --- | ---: | ---: | ---: |",
+        f"| local, 1 thread | {base:.1f} | 1.00 | {r['local_1_cpu_s']:.1f} |",
+        f"| local, 2 threads | {r['local_2_s']:.1f} | {base / r['local_2_s']:.2f} |"
+        f" {r['local_2_cpu_s']:.1f} |",
         f"| Ray, {workers} workers ({r['shards']} shards) | {r['ray_s']:.1f} |"
-        f" {base / r['ray_s']:.2f} |",
+        f" {base / r['ray_s']:.2f} | {r['tasks_cpu_s']:.1f} (in tasks) |",
         "",
+        f"load average {r['load_before']:.1f} before, {r['load_after']:.1f} after"
+        f" on {os.cpu_count()} CPUs (shared machine: wall times move with it)",
         f"Ray start-up {r['ray_start_s']:.1f} s (not in the Ray wall time); {r['tasks']} tasks"
         f" ({r['rebaked']} re-baked together), {r['inside_tasks_s']:.1f} s inside them;"
         f" overhead per task {r['overhead_per_task_s']:.2f} s; {r['bytes_back'] / 1e6:.1f} MB"

@@ -51,6 +51,7 @@ class RayStats:
     resumed: int = 0  # shards loaded from the work folder
     rebaked: int = 0  # shards joined and baked again because their creatures met
     task_seconds: list[float] = field(default_factory=list)  # time inside each task
+    task_cpu_seconds: list[float] = field(default_factory=list)  # CPU time of each task
     result_bytes: int = 0  # array bytes that came back from the workers
     workers: float = 0.0  # CPUs of the cluster
 
@@ -191,6 +192,7 @@ def _run_all(
                     results[key] = result
                     stats.baked += 1
                     stats.task_seconds.append(result.seconds)
+                    stats.task_cpu_seconds.append(result.cpu_seconds)
                     stats.result_bytes += _nbytes(result)
                     done += 1
                     bar.set_postfix_str(f"shards {done}/{done + len(pending)}")

@@ -38,6 +38,7 @@ class ShardResult:
     take: Take
     spheres: np.ndarray  # (steps + 1, creatures, 4)
     seconds: float = 0.0
+    cpu_seconds: float = 0.0  # of the worker process during the task
 
 
 def bake_shard(
@@ -50,7 +51,7 @@ def bake_shard(
 ) -> ShardResult:
     """Bake creatures `members` of `plan`'s scene; `key` names the shard (test hook)."""
     _crash_if_asked(key)
-    started = time.perf_counter()
+    started, cpu = time.perf_counter(), time.process_time()
     spheres = ContactSpheres(plan.steps)
     take = bake(
         plan,
@@ -61,7 +62,8 @@ def bake_shard(
         only=set(members),
         on_steps=on_steps,
     )
-    return ShardResult(list(members), take, spheres.spheres, time.perf_counter() - started)
+    wall, cpu = time.perf_counter() - started, time.process_time() - cpu
+    return ShardResult(list(members), take, spheres.spheres, wall, cpu)
 
 
 def _crash_if_asked(key: str) -> None:
