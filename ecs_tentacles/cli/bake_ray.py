@@ -10,23 +10,9 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from ecs_tentacles.cli.run import positive_int, seed_int
 from ecs_tentacles.export.bake import BakePlan, bake
 from ecs_tentacles.export.take import Take
-
-
-def count(low: int) -> Any:
-    """argparse type: an integer >= `low`."""
-
-    def parse(text: str) -> int:
-        try:
-            value = int(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"must be an integer, got {text!r}") from None
-        if value < low:
-            raise argparse.ArgumentTypeError(f"must be >= {low}, got {value}")
-        return value
-
-    return parse
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -41,10 +27,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         " or start a local one",
     )
     parser.add_argument(
-        "--cpus", type=count(1), default=None, help="CPUs of a local Ray (default: all of them)"
+        "--cpus", type=positive_int, default=None, help="CPUs of a local Ray (default: all of them)"
     )
     parser.add_argument(
-        "--retries", type=count(0), default=3, help="runs of a failed Ray task after the first"
+        "--retries",
+        type=seed_int,  # a whole number >= 0
+        default=3,
+        help="runs of a failed Ray task after the first",
     )
     parser.add_argument(
         "--resume",
