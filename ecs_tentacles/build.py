@@ -8,6 +8,7 @@ from these entities (`ecs_tentacles.physics.model`).
 
 from __future__ import annotations
 
+import hashlib
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -37,6 +38,17 @@ def resting_height(tentacles: dict[str, Any]) -> float:
     """Base height that lets the thickest first link rest on the ground."""
     radii = [tentacle_params(tentacles, k)["link_radius"] for k in range(tentacles["count"])]
     return float(max(radii))
+
+
+def creature_rng(seed: int, name: str) -> np.random.Generator:
+    """The random stream of one creature: from the world's seed and the creature's name.
+
+    Never from a stream shared by all creatures, so a creature draws the same values
+    whichever creatures are built before it (a shard of a distributed bake builds only
+    some of them), and adding or removing a creature leaves the others' draws alone.
+    """
+    key = int.from_bytes(hashlib.sha256(name.encode()).digest()[:8], "little")
+    return np.random.default_rng([int(seed), key])
 
 
 def build_creature(world: World, spec: dict[str, Any]) -> int:
@@ -75,13 +87,14 @@ def build_creature(world: World, spec: dict[str, Any]) -> int:
     creature_entity = world.create_entity(creature, Transform(world.transforms, row))
     world.creatures.entity[creature.row] = creature_entity
 
+    rng = creature_rng(world.seed, spec["name"])
     for k, angle in enumerate(tentacle_angles(tentacles["count"])):
         params = tentacle_params(tentacles, k)
         tentacle = Tentacle(creature=creature_entity, index=k, base_angle=float(angle))
         tentacle_entity = world.create_entity(tentacle, ActionQueue())
         creature.tentacles.append(tentacle_entity)
         _build_links(world, tentacle, tentacle_entity, params, mantle["radius"], origin, heading)
-        _add_tentacle_row(world, tentacle, creature.row, params)
+        _add_tentacle_row(world, tentacle, creature.row, params, rng)
     for goal in spec["goals"]:
         point = list(goal["position"]) + ([0.0] if len(goal["position"]) == 2 else [])
         world.goals.append(creature_entity, point, goal["radius"])
@@ -91,7 +104,11 @@ def build_creature(world: World, spec: dict[str, Any]) -> int:
 
 
 def _add_tentacle_row(
-    world: World, tentacle: Tentacle, creature_row: int, params: dict[str, Any]
+    world: World,
+    tentacle: Tentacle,
+    creature_row: int,
+    params: dict[str, Any],
+    rng: np.random.Generator,
 ) -> None:
     links = [world.component(e, Link) for e in tentacle.links]
     motors = [world.component(e, Motor) for e in tentacle.links]
@@ -114,7 +131,7 @@ def _add_tentacle_row(
             wave_frequency=params["wave_frequency"],
             wavelength=params["wavelength"],
             writhe=params["writhe"],
-            phase=world.rng.uniform(0.0, 2.0 * np.pi),
+            phase=rng.uniform(0.0, 2.0 * np.pi),
             action_strength=STRENGTH[Kind.IDLE],
         )[0]
     )

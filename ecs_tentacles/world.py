@@ -14,7 +14,7 @@ from __future__ import annotations
 import importlib
 import os
 import uuid
-from collections.abc import Iterator
+from collections.abc import Collection, Iterator
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, TypeVar
 
@@ -104,6 +104,7 @@ class World:
         allow_systems: bool = False,
         locomotion: bool = True,
         threads: int | None = None,
+        only: Collection[int] | None = None,
     ) -> World:
         """Build a world from a scene file, bundled scene name or dict.
 
@@ -113,7 +114,8 @@ class World:
         scene names are imported only with `allow_systems=True`. With `locomotion=False`
         only the physics systems run, so scripts drive the motors themselves. `threads`
         steps the physics groups on that many threads (default: one per core); results
-        do not depend on it.
+        do not depend on it. `only` builds just the creatures at those scene indices (a
+        shard of a distributed bake); `world.scene` is still the whole scene.
         """
         from ecs_tentacles.build import build_creature
         from ecs_tentacles.fur.build import build_threats
@@ -148,8 +150,9 @@ class World:
             settings, seed=data["seed"] if seed is None else seed, name=data.get("name", "scene")
         )
         world.scene = data
-        for creature in data["creatures"]:
-            build_creature(world, creature)
+        for index, creature in enumerate(data["creatures"]):
+            if only is None or index in only:
+                build_creature(world, creature)
         build_threats(world, data["threats"])
         world.build_physics(threads)
         systems = builtin_systems()

@@ -19,6 +19,9 @@ if TYPE_CHECKING:
     from ecs_tentacles.world import World
 
 
+PROXY_ROUNDS = 4  # parts a frame is stepped in while creatures touch (proxies catch up)
+
+
 class Physics(System):
     name = "physics"
 
@@ -30,7 +33,17 @@ class Physics(System):
         backend.sleep.update(world)
         hooks = world.schedule.substep_systems()
         if not hooks:
-            backend.step(world.settings.substeps)
+            proxies = backend.proxies
+            if not proxies.in_use:
+                backend.step(world.settings.substeps)
+                return
+            # creatures near each other: step the frame in parts, their proxies following
+            transforms = world.transforms
+            backend.step(
+                world.settings.substeps,
+                rounds=PROXY_ROUNDS,
+                between=lambda: proxies.refresh(transforms),
+            )
             return
         substep_dt = world.settings.substep_dt
 

@@ -106,3 +106,19 @@ def test_heading_rotates_the_whole_creature(make_world: Callable[..., World]) ->
     world = make_world(scene)
     base = world.component(_tentacle(world, 0).links[0], Transform).pos
     assert_allclose(base[:2], [0.0, 0.15 + 0.035], atol=1e-12)  # tentacle 0 now along +y
+
+
+def test_a_creatures_random_draws_do_not_depend_on_the_other_creatures() -> None:
+    creature = {"name": "b", "position": [3, 0], "tentacles": {"count": 5, "links": 3}}
+    other = {"name": "a", "position": [0, 0], "tentacles": {"count": 7, "links": 3}}
+    phases = []
+    for creatures in ([creature], [other, creature]):
+        scene = {"version": 1, "seed": 11, "creatures": creatures}
+        with World.from_scene(scene) as world:
+            row = world.component(world.creature("b"), Creature).row
+            first = world.creatures.first_tentacle[row]
+            phases.append(world.tentacles.phase[first : first + 5].copy())
+    np.testing.assert_array_equal(phases[0], phases[1])
+    assert len(set(phases[0].tolist())) == 5
+    with World.from_scene({"version": 1, "seed": 12, "creatures": [creature]}) as world:
+        assert not np.array_equal(world.tentacles.phase[:5], phases[0])  # the seed matters

@@ -4,6 +4,8 @@ FILE's suffix picks the format: `.npz` a take (the compact, reproducible record)
 `.usd`/`.usda`/`.usdc` a USD stage (needs the `usd` extra), `.glb` binary glTF. The
 output is written to a temporary file beside FILE and renamed at the end, so an
 interrupted bake never leaves a partial FILE (an existing FILE stays as it was).
+`--ray [ADDRESS]` bakes in shards on Ray and `--wedge PATH=VALUES` bakes variants
+(`ecs_tentacles.cli.bake_ray`, `ecs_tentacles.distributed`).
 """
 
 from __future__ import annotations
@@ -19,10 +21,13 @@ from typing import Any
 
 from tqdm import tqdm
 
+from ecs_tentacles.cli import bake_ray
 from ecs_tentacles.cli.arguments import output_path
 from ecs_tentacles.cli.run import seed_int
 from ecs_tentacles.cli.skin_options import add_arguments as add_skin_arguments
 from ecs_tentacles.cli.skin_options import skin_options
+from ecs_tentacles.distributed.driver import ShardFailed
+from ecs_tentacles.distributed.wedge import WedgeError
 from ecs_tentacles.export import SUFFIXES, write
 from ecs_tentacles.export.bake import BakePlan, bake, output_kind
 from ecs_tentacles.export.skinned import Skin
@@ -88,6 +93,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
     parser.add_argument("--json", action="store_true", help="print the summary as JSON")
     add_skin_arguments(parser)
+    bake_ray.add_arguments(parser)
     parser.add_argument(
         "--allow-systems", action="store_true", help="import and run the systems the scene names"
     )
@@ -101,6 +107,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 def handle(args: argparse.Namespace) -> int:
     problem = usd_missing(args.out)
+    problem = problem or bake_ray.ray_problem(args)
     if problem:
         print(f"error: {problem}", file=sys.stderr)
         return 2
@@ -112,6 +119,12 @@ def handle(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return 2
+    if args.wedge:
+        try:
+            return bake_ray.run_wedge(args, plan, save)
+        except WedgeError as error:
+            print(f"error: {error}", file=sys.stderr)
+            return 2
     print(
         f"bake: {plan.source} -> {args.out}: {plan.frames} frames at {plan.fps:g} fps"
         f" (simulated at {plan.sim_fps:g} fps), seed {plan.seed}",
@@ -123,7 +136,14 @@ def handle(args: argparse.Namespace) -> int:
     except ValueError as error:
         print(f"error: {error}", file=sys.stderr)
         return 2
-    take = bake(plan, progress=not args.quiet, allow_systems=args.allow_systems)
+    if args.ray is not None:
+        try:
+            take = bake_ray.bake_on_ray(args, plan)
+        except ShardFailed as error:
+            print(f"error: {error}", file=sys.stderr)
+            return 1
+    else:
+        take = bake(plan, progress=not args.quiet, allow_systems=args.allow_systems)
     health = take.header["health"]
     if health["recoveries"]:
         frames = sorted({e["frame"] for e in health["events"]})
@@ -141,6 +161,7 @@ def handle(args: argparse.Namespace) -> int:
     except MeshError as error:  # e.g. tentacle bases that overlap on the mantle
         print(f"error: {error}", file=sys.stderr)
         return 2
+    getattr(args, "after_write", lambda: None)()
     print(summary(take, args.out, args.json, skinned))
     return 0
 

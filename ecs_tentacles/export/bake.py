@@ -16,7 +16,7 @@ from __future__ import annotations
 import math
 import os
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Collection
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -93,11 +93,19 @@ class BakePlan:
         """Hash of the scene as loaded (before a frame-rate change for the bake)."""
         return scene_sha256(self.scene)
 
-    def world(self, *, allow_systems: bool = False) -> World:
-        """Build the world to bake, at the simulation frame rate."""
+    def world(
+        self,
+        *,
+        allow_systems: bool = False,
+        threads: int | None = None,
+        only: Collection[int] | None = None,
+    ) -> World:
+        """Build the world to bake, at the simulation frame rate (`only`: see `World`)."""
         scene = dict(self.scene)
         scene["physics"] = {**scene["physics"], "fps": self.sim_fps}
-        return World.from_scene(scene, seed=self.seed, allow_systems=allow_systems)
+        return World.from_scene(
+            scene, seed=self.seed, allow_systems=allow_systems, threads=threads, only=only
+        )
 
 
 def simulation_rate(scene_fps: float, take_fps: float) -> tuple[int, float]:
@@ -116,14 +124,20 @@ def bake(
     progress: bool = True,
     allow_systems: bool = False,
     on_world: Callable[[World], None] | None = None,
+    threads: int | None = None,
+    only: Collection[int] | None = None,
+    on_steps: Callable[[int], None] | None = None,
 ) -> Take:
     """Run the plan and return the take; a tqdm bar with ETA goes to stderr when `progress`.
 
     `on_world(world)` is called once the world is built (tests use it to add systems).
+    `threads` steps the physics groups on that many threads; `only` bakes just the
+    creatures at those scene indices (a shard); `on_steps(n)` is told of every `n`
+    frames simulated.
     """
     from ecs_tentacles.systems.record import Record
 
-    world = plan.world(allow_systems=allow_systems)
+    world = plan.world(allow_systems=allow_systems, threads=threads, only=only)
     try:
         if on_world is not None:
             on_world(world)
@@ -144,6 +158,8 @@ def bake(
                 world.step(n)
                 done += n
                 bar.update(n)
+                if on_steps is not None:
+                    on_steps(n)
         return record.take()
     finally:
         world.close()

@@ -185,12 +185,15 @@ class TakeRecorder:
         self._quat[i] = transforms.quat[self._rows]
         self._attached[i] = world.suckers.attached
         self._anchor[i] = world.suckers.anchor
-        alive = []
-        for entity, goal in world.query(Goal):
-            column = self._goal_columns.get(entity)
-            if column is None:
-                column = self._add_goal(entity, goal)
-            alive.append(column)
+        goals = list(world.query(Goal))
+        new = [(e, g) for e, g in goals if e not in self._goal_columns]
+        # new goals in creature, then path order: never in entity-id order, which
+        # depends on which other creatures the world holds (a shard of a bake)
+        for entity, goal in sorted(
+            new, key=lambda eg: (self._creature_index[eg[1].owner], eg[1].order)
+        ):
+            self._add_goal(entity, goal)
+        alive = sorted(self._goal_columns[entity] for entity, _ in goals)
         self._goals_alive.append(alive)
         guides = self.guides(world)
         if guides is not None:

@@ -103,19 +103,31 @@ class PhysicsBackend:
             group.model.eq_data[group.equality_ids, 3:6] = anchor[rows]
             group.data.eq_active[group.equality_ids] = attached[rows]
 
-    def step(self, substeps: int, before_substep: Callable[[int], None] | None = None) -> None:
+    def step(
+        self,
+        substeps: int,
+        before_substep: Callable[[int], None] | None = None,
+        rounds: int = 1,
+        between: Callable[[], None] | None = None,
+    ) -> None:
         """Advance every active group `substeps` steps; `before_substep(i)` runs first if given.
 
-        Groups never read each other's data, so the result does not depend on the
-        number of threads. Asleep or frozen groups keep their state; the clock moves on.
+        Without hooks the steps are taken in `rounds` batches with `between()` called
+        between them (the contact proxies catch up within the frame). Groups never read
+        each other's data while they step, so the result does not depend on the number
+        of threads. Asleep or frozen groups keep their state; the clock moves on.
         """
         active = [g for g in self.groups if g.active]
-        if before_substep is None:
-            self._run(active, substeps)
-        else:
+        if before_substep is not None:
             for i in range(substeps):
                 before_substep(i)
                 self._run(active, 1)
+        else:
+            batches = [int(n) for n in np.diff(np.linspace(0, substeps, rounds + 1).round())]
+            for k, n in enumerate(b for b in batches if b):
+                if k and between is not None:
+                    between()
+                self._run(active, n)
         self.time += substeps * self.substep_dt
 
     def step_bare(self, datas: Sequence[mujoco.MjData], substeps: int) -> None:

@@ -64,14 +64,35 @@ class ContactProxies:
         """Give every creature proxies of the other creatures' bodies near it."""
         if len(self.groups) < 2:
             return
-        pos = transforms.pos[self.rows]
+        self._place(transforms.pos[self.rows], transforms.quat[self.rows])
+
+    @property
+    def in_use(self) -> bool:
+        """Some creature is near another (its proxies are placed)."""
+        return any(group.proxies_used for group in self.groups)
+
+    def refresh(self, transforms: TransformStore) -> None:
+        """Move the proxies to where the bodies are now, within the frame.
+
+        Bodies of creatures near someone are read from their MuJoCo data (as of their
+        last substep); every other body is as the frame started."""
+        pos, quat = transforms.pos[self.rows], transforms.quat[self.rows]
+        for group in self.groups:
+            if group.proxies_used:
+                rows = slice(
+                    self.start[group.index], self.start[group.index] + self.count[group.index]
+                )
+                pos[rows] = group.data.xpos[group.body_ids]
+                quat[rows] = group.data.xquat[group.body_ids]
+        self._place(pos, quat)
+
+    def _place(self, pos: np.ndarray, quat: np.ndarray) -> None:
         centre = pos[self.mantle]
         reach = np.linalg.norm(pos - centre[self.owner], axis=1) + self.rbound
         radius = np.maximum.reduceat(reach, self.start)
         a, b = _near_pairs(centre, radius)
         self.pairs = len(a) // 2
         placed = self._assign(a, b, pos, centre, radius) if len(a) else {}
-        quat = transforms.quat[self.rows]
         for group in self.groups:
             found = placed.get(group.index)
             if group.proxies_used:

@@ -18,6 +18,7 @@ from typing import Any
 from jsonschema import Draft202012Validator, ValidationError, validators
 
 from ecs_tentacles.fur.checks import fur_problems
+from ecs_tentacles.scene.shards import shard_problems
 
 JsonPath = tuple[str | int, ...]
 Problem = tuple[JsonPath, str]
@@ -187,7 +188,7 @@ def _semantic_problems(scene: Mapping[str, Any]) -> list[Problem]:
             reach = earlier["mantle"]["radius"] + later["mantle"]["radius"]
             if math.hypot(x2 - x1, y2 - y1) < reach:
                 problems.append((("creatures", j, "position"), f"mantle overlaps creatures[{i}]'s"))
-    return problems + fur_problems(scene)
+    return problems + fur_problems(scene) + shard_problems(scene)
 
 
 def validate_scene(data: object) -> list[str]:

@@ -69,6 +69,11 @@ def test_baking_to_usd_or_glb_equals_exporting_the_take(scene: Path, tmp_path: P
             "argument --out: must end in one of .npz, .usd, .usda, .usdc, .glb, got 'take.mp4'",
         ),
         (
+            ["--seconds", "1", "--ray", "--retries", "-1"],
+            "argument --retries: must be >= 0, got -1",
+        ),
+        (["--seconds", "1", "--ray", "--cpus", "0"], "argument --cpus: must be >= 1, got 0"),
+        (
             ["--seconds", "1", "--out", "no/such/folder/t.npz"],
             "argument --out: folder 'no/such/folder' does not exist",
         ),
@@ -179,3 +184,26 @@ def test_take_arrays_are_plain_numpy(scene: Path, tmp_path: Path) -> None:
     assert main(["bake", str(scene), "--seconds", "0.05", "--out", str(out), "--quiet"]) == 0
     with np.load(out) as npz:  # no pickles: readable anywhere numpy is
         assert npz["pos"].dtype == np.float32 and npz["pos"].shape == (4, 13, 3)
+
+
+def test_a_local_bake_never_imports_ray(scene: Path, tmp_path: Path) -> None:
+    code = (
+        "import sys; from ecs_tentacles.cli import main;"
+        f" assert main(['bake', {str(scene)!r}, '--seconds', '0.1', '--quiet',"
+        f" '--out', {str(tmp_path / 't.npz')!r}]) == 0;"
+        " print(sorted(m for m in sys.modules if m == 'ray' or m.startswith('ray.')))"
+    )
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.splitlines()[-1] == "[]"
+
+
+def test_resume_without_ray_is_refused(
+    scene: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "t.npz"
+    assert main(["bake", str(scene), "--seconds", "0.1", "--out", str(out), "--resume"]) == 2
+    assert capsys.readouterr().err == (
+        "error: argument --resume: only for a --ray bake without --wedge\n"
+    )
+    assert not out.exists()

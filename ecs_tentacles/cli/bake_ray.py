@@ -1,0 +1,173 @@
+"""`bake --ray [ADDRESS]` and `bake --wedge PATH=VALUES`: the distributed side of `bake`.
+
+Ray is imported only here, and only when one of these options is given.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+from typing import Any
+
+from ecs_tentacles.cli.run import positive_int, seed_int
+from ecs_tentacles.export.bake import BakePlan, bake
+from ecs_tentacles.export.take import Take
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """The distributed options of `bake`."""
+    parser.add_argument(
+        "--ray",
+        nargs="?",
+        const="",
+        default=None,
+        metavar="ADDRESS",
+        help="bake on Ray (pip install 'ecs-tentacles[ray]'): join the cluster at ADDRESS,"
+        " or start a local one",
+    )
+    parser.add_argument(
+        "--cpus", type=positive_int, default=None, help="CPUs of a local Ray (default: all of them)"
+    )
+    parser.add_argument(
+        "--retries",
+        type=seed_int,  # a whole number >= 0
+        default=3,
+        help="runs of a failed Ray task after the first",
+    )
+    parser.add_argument(
+        "--resume",
+        action="store_true",
+        help="reuse the shards an interrupted --ray bake finished (kept in .OUT.work/)",
+    )
+    parser.add_argument(
+        "--wedge",
+        action="append",
+        default=[],
+        metavar="PATH=VALUES",
+        help="bake every combination: PATH a scene JSON path, VALUES A..B or a,b,c;"
+        " --out names each output with {name}",
+    )
+
+
+def ray_problem(args: argparse.Namespace) -> str | None:
+    """The one-line problem with the distributed options (Ray missing...), else None."""
+    import importlib.util
+
+    if args.resume and (args.ray is None or args.wedge):
+        return "argument --resume: only for a --ray bake without --wedge"
+    if args.ray is not None and importlib.util.find_spec("ray") is None:
+        return "argument --ray: needs Ray: pip install 'ecs-tentacles[ray]'"
+    return None
+
+
+def bake_on_ray(args: argparse.Namespace, plan: BakePlan) -> Take:
+    """Bake `plan` in shards on Ray, keeping finished shards beside `args.out`."""
+    from ecs_tentacles.distributed.driver import ray_bake
+    from ecs_tentacles.distributed.work import remove_work, work_folder
+
+    folder = work_folder(args.out)
+    try:
+        take, stats = ray_bake(
+            plan,
+            folder,
+            address=args.ray or None,
+            cpus=args.cpus,
+            resume=args.resume,
+            retries=args.retries,
+            progress=not args.quiet,
+            allow_systems=args.allow_systems,
+        )
+    except BaseException:
+        kept = len(list(folder.glob("*.npz"))) if folder.is_dir() else 0
+        if kept:
+            print(f"note: {kept} finished shard(s) kept in {folder} for --resume", file=sys.stderr)
+        else:
+            remove_work(folder)
+        raise
+    args.after_write = lambda: remove_work(folder)
+    print(
+        f"ray: {stats.baked} shard(s) baked, {stats.resumed} resumed, {stats.rebaked} re-baked"
+        f" together on {stats.workers:g} CPU(s)",
+        file=sys.stderr,
+    )
+    return take
+
+
+def _bake_variant(plan: BakePlan, allow: bool) -> Take:
+    return bake(plan, progress=False, allow_systems=allow, threads=1)
+
+
+def run_wedge(args: argparse.Namespace, plan: BakePlan, save: Any) -> int:
+    """Bake every variant (on Ray with --ray, else here), write each output and wedge.json."""
+    from ecs_tentacles.distributed.wedge import (
+        output_for,
+        parse_parameter,
+        variants,
+        write_index,
+    )
+
+    parameters = [parse_parameter(text) for text in args.wedge]
+    every = variants(plan.scene, parameters, plan.source)
+    pattern: Path = args.out
+    if len(every) > 1 and "{name}" not in pattern.name:
+        print("error: argument --out: a wedge needs {name} in the file name", file=sys.stderr)
+        return 2
+    plans = [
+        BakePlan.make(v.scene, seconds=plan.seconds, fps=plan.fps, seed=args.seed) for v in every
+    ]
+    print(f"wedge: {len(every)} variants -> {pattern.parent}", file=sys.stderr, flush=True)
+    takes = _wedge_takes(args, plans)
+    rows = []
+    for variant, take in zip(every, takes, strict=True):
+        out = output_for(pattern, variant.name)
+        save(take, out, progress=not args.quiet)
+        rows.append({"name": variant.name, "file": str(out), "parameters": variant.values})
+    base = {
+        "scene": plan.source,
+        "seconds": plan.seconds,
+        "fps": plan.fps,
+        "parameters": [p.text for p in parameters],
+    }
+    index = write_index(pattern, base, rows)
+    print(f"{index}: {len(rows)} outputs")
+    return 0
+
+
+def _wedge_takes(args: argparse.Namespace, plans: list[BakePlan]) -> list[Take]:
+    from tqdm import tqdm
+
+    bar = tqdm(
+        total=len(plans), unit="bake", desc="wedge", disable=None if not args.quiet else True
+    )
+    with bar:
+        if args.ray is None:
+            out = []
+            for p in plans:
+                out.append(bake(p, progress=False, allow_systems=args.allow_systems))
+                bar.update(1)
+            return out
+        import ray
+
+        from ecs_tentacles.distributed.driver import start_ray
+
+        started = start_ray(args.ray or None, args.cpus)
+        try:
+            task = ray.remote(num_cpus=1, max_retries=args.retries, retry_exceptions=True)(
+                _bake_variant
+            )
+            refs = [task.remote(p, args.allow_systems) for p in plans]
+            pending = set(refs)
+            try:
+                while pending:
+                    ready, _ = ray.wait(list(pending), num_returns=1, timeout=0.5)
+                    pending -= set(ready)
+                    bar.update(len(ready))
+                return [ray.get(ref) for ref in refs]
+            except BaseException:
+                for ref in pending:
+                    ray.cancel(ref, force=True)
+                raise
+        finally:
+            if started:
+                ray.shutdown()

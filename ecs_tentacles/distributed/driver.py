@@ -1,0 +1,250 @@
+"""Run a bake's shards on Ray and merge them: `ray_bake(plan, out, ...)`.
+
+With no address a local Ray starts (quiet: no dashboard, workers' logs kept out of
+the terminal); with one, the bake joins that cluster; if this process already runs
+Ray (a test, a notebook) it is used as is. Each shard is one task (`num_cpus=1`,
+`max_retries`: a task whose worker dies, or that raises, is run again). Results
+stream back with `ray.wait`; one progress bar counts simulated frames over every
+shard (workers report to a small counter actor) and shards done. Each finished shard
+is saved to the work folder (`ecs_tentacles.distributed.work`) at once.
+
+When every shard is in, their contact spheres are checked (`spheres.meetings`):
+shards whose creatures came within contact range are joined and baked again, until
+none meet. Then the takes are merged into the local bake's take.
+
+A shard that still fails after its retries fails the bake with one line naming it;
+the other shards finish and stay in the work folder for `--resume`. Ctrl-C cancels
+every running task (`ray.cancel`) and keeps the finished shards there too.
+"""
+
+from __future__ import annotations
+
+import logging
+import sys
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from tqdm import tqdm
+
+from ecs_tentacles.distributed.merge import merge_takes
+from ecs_tentacles.distributed.shards import ShardPlan, default_tasks, plan_shards
+from ecs_tentacles.distributed.spheres import meetings
+from ecs_tentacles.distributed.task import ShardResult, bake_shard
+from ecs_tentacles.distributed.work import load_shard, remove_work, save_shard, shard_key
+from ecs_tentacles.export.bake import BakePlan
+from ecs_tentacles.export.take import Take
+
+
+class ShardFailed(RuntimeError):
+    """A shard failed after its retries; the message is one line naming it."""
+
+
+@dataclass
+class RayStats:
+    """What a distributed bake did."""
+
+    plan: ShardPlan | None = None
+    baked: int = 0  # shard tasks run to completion
+    resumed: int = 0  # shards loaded from the work folder
+    rebaked: int = 0  # shards joined and baked again because their creatures met
+    task_seconds: list[float] = field(default_factory=list)  # time inside each task
+    task_cpu_seconds: list[float] = field(default_factory=list)  # CPU time of each task
+    result_bytes: int = 0  # array bytes that came back from the workers
+    workers: float = 0.0  # CPUs of the cluster
+
+
+def start_ray(address: str | None, cpus: int | None) -> bool:
+    """Join `address` or start a local Ray; False when this process already had Ray."""
+    import ray
+
+    if ray.is_initialized():
+        return False
+    options: dict[str, Any] = {"include_dashboard": False, "log_to_driver": False}
+    options["logging_level"] = logging.ERROR
+    if address:
+        ray.init(address=address, **options)
+    else:
+        ray.init(num_cpus=cpus, **options)
+    return True
+
+
+def _run_shard(plan: BakePlan, members: list[int], key: str, counter: Any, allow: bool) -> Any:
+    """The Ray task: bake one shard, telling `counter` of progress."""
+    return bake_shard(
+        plan, members, key, allow_systems=allow, on_steps=lambda n: counter.add.remote(n)
+    )
+
+
+class _Counter:
+    def __init__(self) -> None:
+        self.steps = 0
+
+    def add(self, n: int) -> None:
+        self.steps += n
+
+    def value(self) -> int:
+        return self.steps
+
+
+def ray_bake(
+    plan: BakePlan,
+    folder: Path,
+    *,
+    address: str | None = None,
+    cpus: int | None = None,
+    resume: bool = False,
+    retries: int = 3,
+    progress: bool = True,
+    allow_systems: bool = False,
+    note: Callable[[str], None] = lambda line: print(line, file=sys.stderr),
+) -> tuple[Take, RayStats]:
+    """Bake `plan` on Ray; finished shards go to `folder` (see the module docstring)."""
+    import ray
+
+    started = start_ray(address, cpus)
+    try:
+        stats = RayStats(workers=float(ray.cluster_resources().get("CPU", 1)))
+        stats.plan = plan_shards(plan.scene, plan.seconds, default_tasks(stats.workers))
+        note(f"ray: {stats.plan.describe()}")
+        if not resume:
+            remove_work(folder)
+        shards = stats.plan.shards
+        results = _run_all(plan, shards, folder, resume, retries, progress, allow_systems, stats)
+        while True:
+            met = _meetings(plan, results)
+            if not met:
+                break
+            shards = _join(shards, met)
+            for i, j, frame in met[:3]:
+                names = [plan.scene["creatures"][k]["name"] for k in (i, j)]
+                note(
+                    f"ray: {names[0]} and {names[1]} came within contact range at"
+                    f" {frame / plan.sim_fps:.2f} s: baking their shards again as one"
+                )
+            todo = [s for s in shards if tuple(s) not in results]
+            stats.rebaked += len(todo)
+            results.update(
+                _run_all(plan, todo, folder, resume, retries, progress, allow_systems, stats)
+            )
+            results = {tuple(s): results[tuple(s)] for s in shards}
+        take = merge_takes([(r.members, r.take) for r in results.values()])
+        return take, stats
+    finally:
+        if started:
+            ray.shutdown()
+
+
+def _run_all(
+    plan: BakePlan,
+    shards: list[list[int]],
+    folder: Path,
+    resume: bool,
+    retries: int,
+    progress: bool,
+    allow: bool,
+    stats: RayStats,
+) -> dict[tuple[int, ...], ShardResult]:
+    import ray
+
+    results: dict[tuple[int, ...], ShardResult] = {}
+    keys = {tuple(s): shard_key(plan, s, allow) for s in shards}
+    number = {tuple(s): i for i, s in enumerate(shards)}
+    for shard in shards:
+        found = load_shard(folder, keys[tuple(shard)]) if resume else None
+        if found is not None:
+            results[tuple(shard)] = found
+            stats.resumed += 1
+    counter = ray.remote(num_cpus=0)(_Counter).remote()
+    task = ray.remote(num_cpus=1, max_retries=retries, retry_exceptions=True)(_run_shard)
+    plan_ref = ray.put(plan)
+    pending = {
+        task.remote(plan_ref, s, keys[tuple(s)], counter, allow): tuple(s)
+        for s in shards
+        if tuple(s) not in results
+    }
+    failures: list[str] = []
+    total = plan.steps * len(pending)
+    with tqdm(
+        total=total,
+        unit="frame",
+        desc="ray bake",
+        disable=None if progress else True,
+        file=sys.stderr,
+        leave=False,
+    ) as bar:
+        bar.set_postfix_str(f"shards 0/{len(pending)}")
+        done = 0
+        try:
+            while pending:
+                ready, _ = ray.wait(list(pending), num_returns=1, timeout=0.5)
+                for ref in ready:
+                    key = pending.pop(ref)
+                    label = _label(plan, number[key], list(key))
+                    try:
+                        result: ShardResult = ray.get(ref)
+                    except Exception as error:  # the task's error after its retries
+                        failures.append(f"{label} failed: {_one_line(error)}")
+                        continue
+                    save_shard(folder, keys[key], result)
+                    results[key] = result
+                    stats.baked += 1
+                    stats.task_seconds.append(result.seconds)
+                    stats.task_cpu_seconds.append(result.cpu_seconds)
+                    stats.result_bytes += _nbytes(result)
+                    done += 1
+                    bar.set_postfix_str(f"shards {done}/{done + len(pending)}")
+                if bar.disable is not True:
+                    steps = ray.get(counter.value.remote())  # type: ignore[attr-defined]
+                    bar.update(min(total, steps) - bar.n)
+        except BaseException:  # Ctrl-C, SIGTERM: stop every running task
+            for ref in pending:
+                ray.cancel(ref, force=True)
+            raise
+    if failures:
+        more = f" (and {len(failures) - 1} more)" if len(failures) > 1 else ""
+        raise ShardFailed(f"{failures[0]}{more}; finished shards kept for --resume")
+    return results
+
+
+def _meetings(plan: BakePlan, results: dict[tuple[int, ...], ShardResult]) -> list:
+    n = len(plan.scene["creatures"])
+    first = next(iter(results.values())).spheres
+    spheres = np.zeros((len(first), n, 4))
+    shard_of = np.zeros(n, dtype=np.int64)
+    for k, result in enumerate(results.values()):
+        spheres[:, result.members] = result.spheres
+        shard_of[result.members] = k
+    return meetings(spheres, shard_of)
+
+
+def _join(shards: list[list[int]], met: list[tuple[int, int, int]]) -> list[list[int]]:
+    """Shards with every met pair's shards joined into one."""
+    groups = [set(s) for s in shards]
+    for i, j, _ in met:
+        a = next(g for g in groups if i in g)
+        b = next(g for g in groups if j in g)
+        if a is not b:
+            a |= b
+            groups.remove(b)
+    return sorted(sorted(g) for g in groups)
+
+
+def _label(plan: BakePlan, number: int, members: list[int]) -> str:
+    names = [plan.scene["creatures"][i]["name"] for i in members[:3]]
+    more = f", +{len(members) - 3}" if len(members) > 3 else ""
+    return f"shard {number} ({', '.join(names)}{more})"
+
+
+def _one_line(error: BaseException) -> str:
+    cause = getattr(error, "cause", None) or error
+    text = f"{type(cause).__name__}: {cause}".strip()
+    lines = [line for line in text.splitlines() if line.strip()]
+    return lines[0][:300].rstrip(".") if lines else type(cause).__name__
+
+
+def _nbytes(result: ShardResult) -> int:
+    arrays = result.take.arrays()
+    return int(sum(a.nbytes for a in arrays.values()) + result.spheres.nbytes)

@@ -1,0 +1,135 @@
+"""Shard takes -> the take a local bake of the whole scene writes, byte for byte.
+
+A take lists creatures in scene order, then bodies, suckers, goals and fur guides
+creature by creature (`ecs_tentacles.export.recording`). A shard's take does the
+same for its own creatures, so merging is a stable sort of every table by the
+creature's index in the whole scene, with the header's indices renumbered.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from ecs_tentacles.export.take import Take
+
+
+def merge_takes(parts: Sequence[tuple[Sequence[int], Take]]) -> Take:
+    """One take from (scene indices of its creatures, take) per shard."""
+    first = parts[0][1]
+    header: dict[str, Any] = {
+        k: v for k, v in first.header.items() if k not in ("creatures", "bodies", "suckers")
+    }
+    for key in ("frames", "fps", "seed", "scene_sha256"):
+        values = {repr(take.header[key]) for _, take in parts}
+        if len(values) > 1:
+            raise ValueError(f"shard takes differ in {key}: {sorted(values)}")
+    tables: dict[str, list[tuple[int, Any]]] = {
+        k: [] for k in ("creatures", "bodies", "suckers", "goals", "guides")
+    }
+    arrays: dict[str, list[tuple[np.ndarray, np.ndarray]]] = {}
+    for members, take in parts:
+        h = take.header
+        glob = np.asarray(members, dtype=np.int64)  # shard creature index -> scene index
+        body_owner = glob[[b["creature"] for b in h["bodies"]]].reshape(-1)
+        sucker_owner = body_owner[[s["body"] for s in h["suckers"]]].reshape(-1)
+        goal_owner = glob[[g["creature"] for g in h["goals"]]].reshape(-1)
+        body_base = len(tables["bodies"])  # placeholder ids, renumbered below
+        for c, entry in enumerate(h["creatures"]):
+            tables["creatures"].append((int(glob[c]), (body_base, entry)))
+        for b in h["bodies"]:
+            tables["bodies"].append((int(glob[b["creature"]]), b))
+        for s in h["suckers"]:
+            tables["suckers"].append((int(body_owner[s["body"]]), (body_base, s)))
+        for g in h["goals"]:
+            tables["goals"].append((int(glob[g["creature"]]), g))
+        owners = {
+            "pos": body_owner,
+            "quat": body_owner,
+            "sucker_attached": sucker_owner,
+            "sucker_anchor": sucker_owner,
+            "goal_pos": goal_owner,
+            "goal_active": goal_owner,
+        }
+        if h["guides"] is not None:
+            guide_owner = glob[h["guides"]["creatures"]].reshape(-1)
+            owners["guide_points"] = owners["guide_widths"] = guide_owner
+            tables["guides"] += [(int(o), None) for o in guide_owner]
+        for name, owner in owners.items():
+            axis = 0 if name == "goal_pos" else 1
+            arrays.setdefault(name, []).append((owner, np.moveaxis(getattr(take, name), axis, 0)))
+    body_map = _order([o for o, _ in tables["bodies"]])
+    header["creatures"] = _creatures(tables["creatures"], body_map)
+    header["bodies"] = _pick(tables["bodies"], body_map)
+    header["suckers"] = [
+        {**s, "body": int(body_map.new[base + s["body"]])}
+        for base, s in _pick(tables["suckers"], _order([o for o, _ in tables["suckers"]]))
+    ]
+    for i, body in enumerate(header["bodies"]):
+        body["creature"] = tables["bodies"][body_map.old[i]][0]
+    goals = _order([o for o, _ in tables["goals"]])
+    header["goals"] = [
+        {**g, "creature": tables["goals"][goals.old[i]][0]}
+        for i, g in enumerate(_pick(tables["goals"], goals))
+    ]
+    if tables["guides"]:
+        guides = _order([o for o, _ in tables["guides"]])
+        header["guides"] = {"creatures": [tables["guides"][k][0] for k in guides.old.tolist()]}
+    header["health"] = _health(parts)
+    merged = {}
+    for name, pieces in arrays.items():
+        owner = np.concatenate([o for o, _ in pieces])
+        stacked = np.concatenate([a for _, a in pieces], axis=0)
+        axis = 0 if name == "goal_pos" else 1
+        merged[name] = np.ascontiguousarray(
+            np.moveaxis(stacked[np.argsort(owner, kind="stable")], 0, axis)
+        )
+    return Take(header=header, **merged)
+
+
+class _Order:
+    """A stable sort by owner: `old[new index]` and `new[old index]`."""
+
+    def __init__(self, owners: Sequence[int]):
+        self.old = np.argsort(np.asarray(owners, dtype=np.int64), kind="stable")
+        self.new = np.empty_like(self.old)
+        self.new[self.old] = np.arange(len(self.old))
+
+
+def _order(owners: Sequence[int]) -> _Order:
+    return _Order(owners)
+
+
+def _pick(table: list[tuple[int, Any]], order: _Order) -> list[Any]:
+    return [dict(table[k][1]) if isinstance(table[k][1], dict) else table[k][1] for k in order.old]
+
+
+def _creatures(table: list[tuple[int, Any]], body_map: _Order) -> list[dict[str, Any]]:
+    out = []
+    for _, (base, entry) in sorted(table, key=lambda item: item[0]):
+        new = body_map.new
+        out.append(
+            {
+                **entry,
+                "mantle": int(new[base + entry["mantle"]]),
+                "tentacles": [[int(new[base + b]) for b in chain] for chain in entry["tentacles"]],
+            }
+        )
+    return out
+
+
+def _health(parts: Sequence[tuple[Sequence[int], Take]]) -> dict[str, Any]:
+    """Every shard's physics recoveries, renumbered and in the order a local bake logs them
+    (by frame, then creature)."""
+    events = []
+    for members, take in parts:
+        for event in take.header.get("health", {}).get("events", []):
+            events.append({**event, "creature": int(members[event["creature"]])})
+    events.sort(key=lambda e: (e["frame"], e["creature"]))  # stable: recovered before frozen
+    return {
+        "recoveries": sum(e["event"] == "recovered" for e in events),
+        "frozen": sum(e["event"] == "frozen" for e in events),
+        "events": events,
+    }

@@ -1,0 +1,194 @@
+"""Shards: sets of creatures a bake may simulate apart because they can never meet.
+
+Creatures meet through contact proxies (`ecs_tentacles.physics.proxies`): when their
+bounding spheres come within `MARGIN`. A shard plan is either the scene's own
+`shards` field, or worked out here from where each creature can get to during the
+bake: a capsule on the ground around the path toward its first goal, as long as the
+creature can crawl in the bake (`CRAWL_SPEED` x its locomotion speed x seconds),
+with the creature's reach plus `SLACK` as radius (a disc when it has no goal or its
+path turns within that length). Creatures whose capsules come within `MARGIN` are
+joined (union-find); each connected set is one island, and islands are packed into
+at most `tasks` shards of balanced size. Creatures marked `threat` and the creatures
+with an `emotion` they may rouse always share a shard (declared shards too).
+
+The plan is an estimate; the bake proves it (`ecs_tentacles.distributed.spheres`):
+shards whose creatures did come within contact range are baked again together.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ecs_tentacles.physics.proxies import MARGIN
+from ecs_tentacles.scene.crowd import creature_reach
+
+CRAWL_SPEED = 0.25  # m/s per unit of `locomotion.speed`: twice the fastest crawl measured
+SLACK = 0.15  # metres: settling at the start, sideways drift, tentacles lifting
+
+
+@dataclass(frozen=True)
+class ShardPlan:
+    """Creature indices (scene order) per shard, and how the plan was made."""
+
+    shards: list[list[int]]
+    islands: int  # sets of creatures that may meet (before packing into shards)
+    declared: bool
+
+    def describe(self) -> str:
+        """One line for the user."""
+        n = len(self.shards)
+        if self.declared:
+            return f"{n} shard{'s' * (n != 1)} as the scene declares"
+        if self.islands == 1:
+            return "1 shard: every creature may meet another during the bake"
+        return f"{n} shard{'s' * (n != 1)} from {self.islands} sets of creatures that never meet"
+
+
+def plan_shards(scene: dict[str, Any], seconds: float, tasks: int) -> ShardPlan:
+    """The shards of `scene` (validated, defaults in) for a bake of `seconds`."""
+    creatures = scene["creatures"]
+    if not creatures:
+        return ShardPlan([[]], 1, declared=False)
+    if "shards" in scene:
+        index = {c["name"]: i for i, c in enumerate(creatures)}
+        shards = [sorted(index[name] for name in shard) for shard in scene["shards"]]
+        shards = _joined(shards, roused(creatures))
+        return ShardPlan(sorted(shards), len(shards), declared=True)
+    islands = _joined(islands_of(creatures, seconds), roused(creatures))
+    return ShardPlan(pack(islands, creatures, tasks), len(islands), declared=False)
+
+
+def roused(creatures: list[dict[str, Any]]) -> list[int]:
+    """Creatures that must share a shard because one rouses another's emotion.
+
+    A creature marked `threat` rouses any creature with an `emotion` near it (the
+    emotion system), wherever their shards are: all of them bake together.
+    """
+    threats = {i for i, c in enumerate(creatures) if c.get("threat")}
+    emotional = {i for i, c in enumerate(creatures) if "emotion" in c}
+    if not threats or not (emotional - threats or (len(threats) > 1 and emotional)):
+        return []
+    return sorted(threats | emotional)
+
+
+def _joined(sets: list[list[int]], together: list[int]) -> list[list[int]]:
+    """`sets` with every set holding one of `together` merged into one."""
+    if not together:
+        return sets
+    wanted = set(together)
+    merged = sorted({i for s in sets if wanted & set(s) for i in s})
+    return sorted([merged, *(s for s in sets if not wanted & set(s))])
+
+
+def travel_capsules(creatures: list[dict[str, Any]], seconds: float) -> np.ndarray:
+    """(n, 5): start x, y, end x, y and radius of where each creature can get to."""
+    out = np.zeros((len(creatures), 5))
+    for i, creature in enumerate(creatures):
+        start = np.asarray(creature["position"][:2], dtype=np.float64)
+        reach = creature_reach(creature) + 0.5 * creature["mantle"]["height"] + SLACK
+        travel = CRAWL_SPEED * creature["locomotion"]["speed"] * seconds
+        end, radius = start, reach + travel
+        goals = creature["goals"]
+        if goals:
+            towards = np.asarray(goals[0]["position"][:2], dtype=np.float64) - start
+            length = float(np.linalg.norm(towards))
+            if length >= travel:  # it heads straight for the goal all the bake
+                end, radius = start + towards * (travel / length), reach
+        out[i] = (*start, *end, radius)
+    return out
+
+
+def islands_of(creatures: list[dict[str, Any]], seconds: float) -> list[list[int]]:
+    """Sets of creature indices that may meet during the bake (union-find), sorted."""
+    capsules = travel_capsules(creatures, seconds)
+    parent = list(range(len(creatures)))
+
+    def find(i: int) -> int:
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    for i, j in _near_pairs(capsules):
+        a, b = find(i), find(j)
+        if a != b:
+            parent[max(a, b)] = min(a, b)
+    groups: dict[int, list[int]] = {}
+    for i in range(len(creatures)):
+        groups.setdefault(find(i), []).append(i)
+    return sorted(groups.values())
+
+
+def _near_pairs(capsules: np.ndarray) -> list[tuple[int, int]]:
+    """Pairs i < j of capsules closer than MARGIN (bounding circles first, in blocks)."""
+    a, b, radius = capsules[:, :2], capsules[:, 2:4], capsules[:, 4]
+    mid = 0.5 * (a + b)
+    bound = 0.5 * np.linalg.norm(b - a, axis=1) + radius
+    pairs: list[tuple[int, int]] = []
+    n = len(capsules)
+    block = max(1, 2_000_000 // max(n, 1))
+    for lo in range(0, n, block):
+        hi = min(n, lo + block)
+        gap = np.linalg.norm(mid[lo:hi, None] - mid[None], axis=2) - bound[lo:hi, None] - bound
+        i, j = np.nonzero(gap < MARGIN)
+        i += lo
+        keep = i < j
+        i, j = i[keep], j[keep]
+        if len(i) == 0:
+            continue
+        distance = segment_distance(a[i], b[i], a[j], b[j])
+        near = distance - radius[i] - radius[j] < MARGIN
+        pairs += list(zip(i[near].tolist(), j[near].tolist(), strict=True))
+    return pairs
+
+
+def segment_distance(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray, q1: np.ndarray) -> np.ndarray:
+    """Distance between 2D segments p0-p1 and q0-q1, row by row (0 where they cross)."""
+
+    def to_segment(x: np.ndarray, s0: np.ndarray, s1: np.ndarray) -> np.ndarray:
+        d = s1 - s0
+        length2 = np.einsum("ij,ij->i", d, d)
+        t = np.clip(np.einsum("ij,ij->i", x - s0, d) / np.where(length2 > 0, length2, 1), 0, 1)
+        return np.linalg.norm(x - (s0 + t[:, None] * d), axis=1)
+
+    def side(o: np.ndarray, s: np.ndarray, x: np.ndarray) -> np.ndarray:
+        u, v = s - o, x - o
+        return np.sign(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0])
+
+    ends = np.minimum.reduce(
+        [
+            to_segment(p0, q0, q1),
+            to_segment(p1, q0, q1),
+            to_segment(q0, p0, p1),
+            to_segment(q1, p0, p1),
+        ]
+    )
+    cross = (side(p0, p1, q0) * side(p0, p1, q1) < 0) & (side(q0, q1, p0) * side(q0, q1, p1) < 0)
+    return np.where(cross, 0.0, ends)
+
+
+def pack(islands: list[list[int]], creatures: list[dict[str, Any]], tasks: int) -> list[list[int]]:
+    """Islands packed into at most `tasks` shards, balanced by bodies (largest first)."""
+    weight = [1 + sum(_links(c)) for c in creatures]
+    bins: list[list[int]] = [[] for _ in range(max(1, min(tasks, len(islands))))]
+    load = [0] * len(bins)
+    for island in sorted(islands, key=lambda s: (-sum(weight[i] for i in s), s)):
+        k = min(range(len(bins)), key=lambda b: (load[b], b))
+        bins[k] += island
+        load[k] += sum(weight[i] for i in island)
+    return sorted(sorted(b) for b in bins if b)
+
+
+def _links(creature: dict[str, Any]) -> list[int]:
+    tentacles = creature["tentacles"]
+    overrides = {o["index"]: o.get("links") for o in tentacles.get("overrides", [])}
+    return [overrides.get(k) or tentacles["links"] for k in range(tentacles["count"])]
+
+
+def default_tasks(cpus: float) -> int:
+    """Shards to aim for on `cpus` workers: a few per worker, so a slow one evens out."""
+    return max(1, 4 * math.floor(cpus))

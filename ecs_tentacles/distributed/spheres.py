@@ -1,0 +1,97 @@
+"""contact_spheres: each creature's bounding sphere every simulated frame, as the
+contact proxies see it, and the check that creatures of different shards never met.
+
+A shard's bake adds `ContactSpheres` (a system, not one of the built-ins). Reads:
+the Transform store (every mantle and link), the bodies' radius and length. Writes:
+its own array `spheres` (frames + 1, creatures, 4): centre x, y, z and radius, in the
+world's creature order, frame 0 the built pose. Runs after physics_sync.
+
+`meetings` then finds creatures of different shards whose spheres came within the
+proxies' `MARGIN` in the same frame: exactly when a local bake would have given
+them proxies of each other, so a bake with no meetings equals the local bake.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ecs_tentacles.components import Creature, Link, Tentacle, Transform
+from ecs_tentacles.physics.proxies import MARGIN
+from ecs_tentacles.system import System
+
+if TYPE_CHECKING:
+    from ecs_tentacles.world import World
+
+
+class ContactSpheres(System):
+    """Record every creature's contact sphere each frame into `self.spheres`."""
+
+    name = "contact_spheres"
+    after = ("physics_sync",)
+
+    def __init__(self, steps: int):
+        self.steps = steps
+        self.spheres = np.zeros((0, 0, 4))
+        self._frame = 0
+
+    def setup(self, world: World) -> None:
+        rows, owner, bound = [], [], []
+        creatures = sorted(world.query(Creature), key=lambda item: item[1].row)
+        for index, (entity, creature) in enumerate(creatures):
+            rows.append(world.component(entity, Transform).row)
+            owner.append(index)
+            bound.append(float(np.hypot(creature.mantle_radius, 0.5 * creature.mantle_height)))
+            for tentacle_entity in creature.tentacles:
+                for link_entity in world.component(tentacle_entity, Tentacle).links:
+                    link = world.component(link_entity, Link)
+                    rows.append(world.component(link_entity, Transform).row)
+                    owner.append(index)
+                    bound.append(link.radius + 0.5 * link.length)
+        self.rows = np.asarray(rows, dtype=np.int64)
+        self.owner = np.asarray(owner, dtype=np.int64)
+        self.bound = np.asarray(bound)
+        self.start = np.flatnonzero(np.r_[True, self.owner[1:] != self.owner[:-1]])
+        self.spheres = np.zeros((self.steps + 1, len(creatures), 4))
+        self._frame = 0
+        self._capture(world)
+
+    def _capture(self, world: World) -> None:
+        if self._frame >= len(self.spheres) or not len(self.rows):
+            return
+        pos = world.transforms.pos[self.rows]
+        centre = pos[self.start]
+        reach = np.linalg.norm(pos - centre[self.owner], axis=1) + self.bound
+        self.spheres[self._frame, :, :3] = centre
+        self.spheres[self._frame, :, 3] = np.maximum.reduceat(reach, self.start)
+        self._frame += 1
+
+    def process(self, world: World, dt: float) -> None:
+        self._capture(world)
+
+
+def meetings(spheres: np.ndarray, shard_of: np.ndarray) -> list[tuple[int, int, int]]:
+    """(creature i, creature j, first frame) for creatures of different shards that met.
+
+    `spheres` (frames, creatures, 4) in scene order; `shard_of` the shard of each creature.
+    """
+    centre, radius = spheres[..., :3], spheres[..., 3]
+    start = centre[0]
+    extent = (np.linalg.norm(centre - start, axis=2) + radius).max(axis=0)
+    found: list[tuple[int, int, int]] = []
+    n = len(start)
+    block = max(1, 2_000_000 // max(n, 1))
+    for lo in range(0, n, block):
+        hi = min(n, lo + block)
+        gap = np.linalg.norm(start[lo:hi, None] - start[None], axis=2)
+        gap -= extent[lo:hi, None] + extent[None]
+        i, j = np.nonzero(gap < MARGIN)
+        i += lo
+        keep = (i < j) & (shard_of[i] != shard_of[j])
+        for a, b in zip(i[keep].tolist(), j[keep].tolist(), strict=True):
+            distance = np.linalg.norm(centre[:, a] - centre[:, b], axis=1)
+            close = np.flatnonzero(distance - radius[:, a] - radius[:, b] < MARGIN)
+            if len(close):
+                found.append((a, b, int(close[0])))
+    return found

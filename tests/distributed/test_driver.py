@@ -1,0 +1,199 @@
+"""Bakes on a local Ray (2 CPUs, started once): equal to local bakes, wedges, retries,
+--resume and Ctrl-C. Skipped without the `ray` extra."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import logging
+import os
+import signal
+import subprocess
+import sys
+import time
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from ecs_tentacles.cli import main
+from ecs_tentacles.distributed.merge import merge_takes
+from ecs_tentacles.distributed.shards import default_tasks, plan_shards
+from ecs_tentacles.distributed.task import CRASH_DIR, bake_shard
+from ecs_tentacles.distributed.work import shard_key, work_folder
+from ecs_tentacles.export.bake import BakePlan
+from ecs_tentacles.export.take import Take
+from ecs_tentacles.scene.crowd import crowd_scene
+
+ray = pytest.importorskip("ray", reason="the `ray` extra is not installed")
+
+SECONDS = "0.3"
+
+
+@pytest.fixture(scope="module")
+def cluster(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Path]:
+    """A local Ray with 2 CPUs; yields the folder its workers read crash requests from."""
+    crashes = tmp_path_factory.mktemp("crashes")
+    os.environ[CRASH_DIR] = str(crashes)  # inherited by the workers Ray starts
+    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False, logging_level=logging.ERROR)
+    yield crashes
+    ray.shutdown()
+    del os.environ[CRASH_DIR]
+
+
+@pytest.fixture
+def crowd(tmp_path: Path) -> Path:
+    """Six creatures that the planner splits into 2 shards for a 0.3 s bake."""
+    path = tmp_path / "crowd.json"
+    path.write_text(json.dumps(crowd_scene(6, seed=3)))
+    return path
+
+
+def bake(scene: Path, out: Path, *extra: str) -> int:
+    argv = ["bake", str(scene), "--seconds", SECONDS, "--fps", "30", "--out", str(out)]
+    return main([*argv, "--quiet", *extra])
+
+
+def shards_of(scene: Path) -> tuple[BakePlan, list[list[int]]]:
+    plan = BakePlan.make(scene, seconds=float(SECONDS), fps=30)
+    return plan, plan_shards(plan.scene, plan.seconds, default_tasks(2)).shards
+
+
+def test_sharded_bake_equals_local_bake_byte_for_byte(
+    cluster: Path, crowd: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    _, shards = shards_of(crowd)
+    assert len(shards) >= 2
+    assert bake(crowd, tmp_path / "local.npz") == 0
+    assert bake(crowd, tmp_path / "ray.npz", "--ray") == 0
+    assert (tmp_path / "ray.npz").read_bytes() == (tmp_path / "local.npz").read_bytes()
+    err = capsys.readouterr().err
+    assert f"ray: {len(shards)} shards from" in err
+    assert f"ray: {len(shards)} shard(s) baked, 0 resumed, 0 re-baked" in err
+    assert not work_folder(tmp_path / "ray.npz").exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["crowd.json", "local.npz", "ray.npz"]
+
+
+def test_creatures_of_declared_shards_that_meet_are_baked_again_together(
+    cluster: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    tentacles = {"count": 4, "links": 5}
+    scene: dict[str, Any] = {
+        "version": 1,
+        "name": "meet",
+        "creatures": [
+            {
+                "name": "a",
+                "position": [0, 0],
+                "tentacles": tentacles,
+                "goals": [{"position": [2, 0]}],
+            },
+            {
+                "name": "b",
+                "position": [0.7, 0],
+                "tentacles": tentacles,
+                "goals": [{"position": [-1, 0]}],
+            },
+            {"name": "c", "position": [6, 6], "tentacles": tentacles},
+        ],
+        "shards": [["a", "c"], ["b"]],
+    }
+    path = tmp_path / "meet.json"
+    path.write_text(json.dumps(scene))
+    assert bake(path, tmp_path / "local.npz") == 0
+    assert bake(path, tmp_path / "ray.npz", "--ray") == 0
+    assert (tmp_path / "ray.npz").read_bytes() == (tmp_path / "local.npz").read_bytes()
+    err = capsys.readouterr().err
+    assert "ray: a and b came within contact range at" in err
+    assert "3 shard(s) baked, 0 resumed, 1 re-baked together" in err
+    # the check matters: baked apart, a and b would not have pushed each other
+    plan = BakePlan.make(path, seconds=float(SECONDS), fps=30)
+    apart = merge_takes([(m, bake_shard(plan, m).take) for m in ([0, 2], [1])])
+    assert not np.array_equal(apart.pos, Take.load(tmp_path / "local.npz").pos)
+
+
+def test_a_2x2_wedge_writes_4_outputs_and_their_index(
+    cluster: Path, crowd: Path, tmp_path: Path
+) -> None:
+    out = tmp_path / "wedge"
+    out.mkdir()
+    wedges = ["--wedge", "seed=1..2", "--wedge", "creatures[0].tentacles.strength=20,30.5"]
+    assert bake(crowd, out / "{name}.npz", *wedges, "--ray") == 0
+    index = json.loads((out / "wedge.json").read_text())
+    names = [f"seed-{s}_creatures0.tentacles.strength-{v}" for s in (1, 2) for v in ("20", "30.5")]
+    assert [row["name"] for row in index["outputs"]] == names
+    assert sorted(p.name for p in out.iterdir()) == sorted(
+        [*(f"{n}.npz" for n in names), "wedge.json"]
+    )
+    for row in index["outputs"]:
+        data = (out / row["file"]).read_bytes()
+        assert row["sha256"] == hashlib.sha256(data).hexdigest()
+    assert index["outputs"][3]["parameters"] == {"seed": 2, "creatures[0].tentacles.strength": 30.5}
+    # each output is the bake of its variant
+    variant = json.loads(crowd.read_text())
+    variant["seed"] = 2
+    variant["creatures"][0]["tentacles"]["strength"] = 30.5
+    (tmp_path / "variant.json").write_text(json.dumps(variant))
+    assert bake(tmp_path / "variant.json", tmp_path / "variant.npz") == 0
+    assert (tmp_path / "variant.npz").read_bytes() == (out / f"{names[3]}.npz").read_bytes()
+
+
+def test_a_killed_workers_shard_is_retried_and_the_take_is_unchanged(
+    cluster: Path, crowd: Path, tmp_path: Path
+) -> None:
+    plan, shards = shards_of(crowd)
+    (cluster / shard_key(plan, shards[0], False)).write_text("crash once")
+    assert bake(crowd, tmp_path / "local.npz") == 0
+    assert bake(crowd, tmp_path / "ray.npz", "--ray") == 0
+    assert list(cluster.glob("*.claimed.*")), "the worker never crashed"
+    assert (tmp_path / "ray.npz").read_bytes() == (tmp_path / "local.npz").read_bytes()
+
+
+def test_a_failed_shard_is_named_and_resume_bakes_only_the_others(
+    cluster: Path, crowd: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    plan, shards = shards_of(crowd)
+    (cluster / shard_key(plan, shards[-1], False)).write_text("crash")
+    out = tmp_path / "ray.npz"
+    assert bake(crowd, out, "--ray", "--retries", "0") == 1
+    err = capsys.readouterr().err
+    names = ", ".join(plan.scene["creatures"][i]["name"] for i in shards[-1][:3])
+    assert f"error: shard {len(shards) - 1} ({names}" in err
+    assert "failed: WorkerCrashedError: The worker died unexpectedly" in err
+    assert not out.exists()
+    kept = list(work_folder(out).glob("*.npz"))
+    assert len(kept) == len(shards) - 1
+    assert bake(crowd, out, "--ray", "--resume") == 0
+    err = capsys.readouterr().err
+    assert f"ray: 1 shard(s) baked, {len(shards) - 1} resumed" in err
+    assert bake(crowd, tmp_path / "local.npz") == 0
+    assert out.read_bytes() == (tmp_path / "local.npz").read_bytes()
+    assert not work_folder(out).exists()
+
+
+def test_ctrl_c_cancels_the_bake_and_leaves_no_output(
+    cluster: Path, crowd: Path, tmp_path: Path
+) -> None:
+    out = tmp_path / "ray.npz"
+    address = ray.get_runtime_context().gcs_address
+    argv = [sys.executable, "-m", "ecs_tentacles", "bake", str(crowd), "--seconds", "20"]
+    process = subprocess.Popen(
+        [*argv, "--out", str(out), "--ray", address, "--quiet"],
+        stderr=subprocess.PIPE,
+        text=True,
+        cwd=tmp_path,
+    )
+    assert process.stderr is not None
+    line = process.stderr.readline()
+    while line and not line.startswith("ray:"):
+        line = process.stderr.readline()
+    time.sleep(1.0)  # the tasks are running
+    process.send_signal(signal.SIGINT)
+    _, err = process.communicate(timeout=60)
+    assert process.returncode == 130, err
+    assert "interrupted" in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["crowd.json"]
+    time.sleep(0.5)
+    assert ray.available_resources().get("CPU") == 2  # the cancelled tasks freed their CPUs
