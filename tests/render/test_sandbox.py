@@ -84,7 +84,7 @@ def test_hud_slider_reaches_the_servo_gains(make_sandbox: Callable[..., Any]) ->
     _event(sandbox, "on_mouse_release", round(x), round(y), mouse.LEFT, 0)
     kp = world.locomotion.get(octo, 0)["strength"]
     assert 70 < slider.value < 85  # the knob jumped to where we clicked
-    assert kp == pytest.approx(knob.low + (knob.high - knob.low) * slider.value / 100, rel=1e-12)
+    assert kp == pytest.approx(knob.value(slider.value), rel=1e-12)
     assert [world.locomotion.get(octo, k)["strength"] for k in range(8)] == [kp] * 8  # "all"
     sandbox.step(1)
     model = world.physics.model
