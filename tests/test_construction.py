@@ -2,11 +2,25 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
+import mujoco
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from ecs_tentacles.construction import link_scales, tentacle_angles, tentacle_axes, tentacle_shape
+from ecs_tentacles.components import Creature, Link, Tentacle, Transform
+from ecs_tentacles.construction import (
+    capsule_mass_inertia,
+    creature_layout,
+    cylinder_mass_inertia,
+    link_scales,
+    tentacle_angles,
+    tentacle_axes,
+    tentacle_shape,
+)
+from ecs_tentacles.world import World
+from tests.conftest import creature_scene
 
 S = np.sqrt(0.5)
 H = np.sqrt(3) / 2
@@ -70,3 +84,64 @@ def test_tentacle_axes_counter_clockwise_about_z(count: int, expected: list[list
 def test_impossible_tentacles_are_refused(links: int, end_scale: float) -> None:
     with pytest.raises(ValueError):
         link_scales(links, end_scale)
+
+
+def test_rest_pitch_lays_the_underside_on_the_ground() -> None:
+    shape = tentacle_shape(0.2, 0.1, 0.02, 2, 0.5)  # drop 0.01 over 0.15
+    assert shape.length == pytest.approx(0.15)
+    assert shape.rest_pitch == pytest.approx(np.arcsin(0.01 / 0.15))
+    assert tentacle_shape(0.2, 0.1, 0.02, 1, 0.5).rest_pitch == 0.0
+
+
+@pytest.mark.parametrize(
+    ("link_length", "link_radius"), [(0.01, 0.025), (0.07, 10.0)], ids=["short", "fat"]
+)
+def test_rest_pitch_of_a_stub_whose_tip_cannot_reach_the_ground_is_straight_down(
+    link_length: float, link_radius: float
+) -> None:
+    shape = tentacle_shape(0.15, link_length, link_radius, 2, 0.3)
+    assert (shape.radii[0] - shape.radii[-1]) > shape.length  # arcsin of > 1 before
+    assert shape.rest_pitch == np.pi / 2
+
+
+def test_the_layout_is_where_the_build_puts_every_body(make_world: Callable[..., World]) -> None:
+    spec = {
+        "name": "octo",
+        "position": [1.0, -2.0],
+        "heading_deg": 30,
+        "tentacles": {"count": 5, "links": 4, "overrides": [{"index": 3, "link_radius": 0.04}]},
+    }
+    world = make_world({"version": 1, "creatures": [spec]})
+    layout = creature_layout(world.scene["creatures"][0])  # type: ignore[index]
+    assert_allclose(layout.origin, [1.0, -2.0, 0.04])  # the thickest first link rests
+    creature = world.component(world.creature("octo"), Creature)
+    starts, ends, radii = layout.capsules()
+    row = 1
+    for k, entity in enumerate(creature.tentacles):
+        links = world.component(entity, Tentacle).links
+        built = np.array([world.component(e, Transform).pos for e in links])
+        assert_allclose(layout.link_centres(k), built, atol=1e-12)
+        assert_allclose(0.5 * (starts + ends)[row : row + len(links)], built, atol=1e-12)
+        assert_allclose(
+            radii[row : row + len(links)], [world.component(e, Link).radius for e in links]
+        )
+        row += len(links)
+    mantle = world.component(world.creature("octo"), Transform).pos
+    assert_allclose(0.5 * (starts[0] + ends[0]), mantle, atol=1e-12)
+
+
+def test_masses_and_inertias_are_mujocos(make_world: Callable[..., World]) -> None:
+    scene = creature_scene(count=2, links=3, link_radius=0.03, end_scale=0.4, density=900)
+    scene["creatures"][0]["mantle"] = {"radius": 0.2, "height": 0.05, "density": 300}
+    world = make_world(scene)
+    model = world.physics.model
+    mantle = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "octo/mantle")
+    mass, smallest = cylinder_mass_inertia(0.2, 0.05, 300)
+    assert model.body_mass[mantle] == pytest.approx(mass, rel=1e-9)
+    assert model.body_inertia[mantle].min() == pytest.approx(smallest, rel=1e-9)
+    shape = tentacle_shape(0.2, 0.07, 0.03, 3, 0.4)
+    expected = capsule_mass_inertia(shape.lengths, shape.radii, 900)
+    for i in range(3):
+        body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, f"octo/t1/l{i:02d}")
+        assert model.body_mass[body] == pytest.approx(expected[i, 0], rel=1e-9)
+        assert model.body_inertia[body].min() == pytest.approx(expected[i, 1], rel=1e-9)

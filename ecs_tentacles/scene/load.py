@@ -14,6 +14,7 @@ import re
 from typing import Any
 
 from ecs_tentacles.scene.errors import SceneError
+from ecs_tentacles.scene.physical import physically_checked
 from ecs_tentacles.scene.validate import validate_scene, with_defaults
 
 _SCENE_NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.-]*$")
@@ -69,7 +70,7 @@ def load_scene(source: str | os.PathLike[str] | dict[str, Any]) -> dict[str, Any
     if problems:
         raise SceneError([prefix + problem for problem in problems])
     assert isinstance(data, dict)  # the schema requires an object
-    return with_defaults(data)
+    return physically_checked(with_defaults(data), prefix)
 
 
 def _scenes_dir() -> pathlib.Path:

@@ -159,16 +159,19 @@ def test_physics_sync_copies_poses_bit_for_bit(make_world: Callable[..., World])
 
 
 def test_creatures_touch_each_other_but_never_themselves(make_world: Callable[..., World]) -> None:
-    # two creatures 0.9 m apart, tentacle 0 of each reaching 0.6 m toward the other
+    # two creatures 1.3 m apart, tentacle 0 of each reaching 0.6 m toward the other; the
+    # scene may not overlap them at build, so b is slid to 0.9 m before the contacts run
     scene = {
         "version": 1,
         "creatures": [
             {"name": "a", "position": [0.0, 0.0], "tentacles": {"count": 4}},
-            {"name": "b", "position": [0.9, 0.0], "heading_deg": 180, "tentacles": {"count": 4}},
+            {"name": "b", "position": [1.3, 0.0], "heading_deg": 180, "tentacles": {"count": 4}},
         ],
     }
     world = make_world(scene, locomotion=False)
     model, data = world.physics.model, world.physics.data
+    root = model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "b/root")]
+    data.qpos[root] -= 0.4
     mujoco.mj_forward(model, data)
     owner = [
         mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_GEOM, g).split("/")[0]
