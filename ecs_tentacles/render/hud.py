@@ -185,6 +185,8 @@ class Hud:
         """Apply a parameter to the selection through the locomotion API."""
         if self.creature is None:
             return
+        if name == "strength":  # no stiffer than the damping holds at this physics step
+            value = min(value, self.world.locomotion.strength_limit(self.creature, self.tentacle))
         self.world.locomotion.set(self.creature, tentacle=self.tentacle, **{name: float(value)})
         self.refresh()
 

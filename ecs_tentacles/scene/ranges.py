@@ -82,3 +82,15 @@ def physics_range(key: str) -> Range:
     """The range of the scene's `physics.<key>` (for gravity: of each component)."""
     spec: dict[str, Any] = load_schema()["properties"]["physics"]["properties"][key]
     return _range_of(spec.get("items", spec))
+
+
+def damping_floor(strength: float, step: float) -> float:
+    """The least servo damping (N m s / rad) that keeps a servo of `strength` stable.
+
+    MuJoCo integrates the damping implicitly and the stiffness explicitly: one physics
+    step of `step` seconds stays stable, whatever the link's inertia, while
+    `strength * step**2 < 2 * damping * step` (+ 4 x inertia). Asking for
+    `damping >= strength * step` keeps a factor of two; undamped stiff servos (damping 0,
+    strength 100) shook their links apart at 60 fps.
+    """
+    return float(strength) * float(step)
