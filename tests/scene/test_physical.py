@@ -56,7 +56,7 @@ REFUSED: list[tuple[str, dict[str, Any], str]] = [
     (
         "a mantle 1 nm high: MuJoCo's inertia triangle fails on rounding",
         scene({"mantle": {"height": 1e-9}}),
-        "creatures[0].mantle: is too flat to simulate (height 1e-09 m under 1e-06 of its"
+        "creatures[0].mantle: is too flat to simulate (height 1e-09 m, under 0.01 x its"
         " radius 0.15 m); raise height",
     ),
     (
@@ -64,6 +64,50 @@ REFUSED: list[tuple[str, dict[str, Any], str]] = [
         scene({}, fps=60, substeps=1),
         "physics.substeps: a physics step of 1 / (fps * substeps) = 16.7 ms is longer than"
         " 2.5 ms, beyond which servos and contacts shake apart; at fps 60 use substeps >= 7",
+    ),
+    (
+        "an undamped stiff servo",
+        scene({"tentacles": {"strength": 100, "damping": 0}}),
+        "creatures[0].tentacles.damping: 0 is below strength x physics step (100 x 2.08 ms ="
+        " 0.208): a servo this stiff and this little damped shakes its links apart; raise"
+        " damping to >= 0.208, lower strength or add substeps",
+    ),
+    (
+        "an override's strength against the creature's damping",
+        scene({"tentacles": {"overrides": [{"index": 0, "strength": 1000}]}}),
+        "creatures[0].tentacles.overrides[0].damping: 0.5 is below strength x physics step"
+        " (1000 x 2.08 ms = 2.08): a servo this stiff and this little damped shakes its links"
+        " apart; raise damping to >= 2.08, lower strength or add substeps",
+    ),
+    (
+        "gravity pulling sideways harder than friction holds",
+        scene({}, gravity=[0, -30, -30]),
+        "physics.gravity: pulls sideways (30 m/s^2) harder than ground_friction 0.4 holds"
+        " against z = -30 (12 m/s^2): creatures would slide ever faster; tilt it less or raise"
+        " ground_friction",
+    ),
+    (
+        "gravity pointing up",
+        scene({}, gravity=[0, 0, 5]),
+        "physics.gravity: points up (z = 5): creatures would fall away from the ground; use z <= 0",
+    ),
+    (
+        "needle links",
+        scene({"tentacles": {"link_length": 10, "link_radius": 0.025}}),
+        "creatures[0].tentacles: links 400 times longer than their radius (at most 100) are"
+        " needles, not tentacle links; shorten link_length or thicken link_radius",
+    ),
+    (
+        "a feather-light mantle on heavy tentacles",
+        scene({"mantle": {"density": 0.01}}),
+        "creatures[0].mantle: weighs 0.000141 kg against 6.04 kg of tentacles; keep the ratio"
+        " within 10000 either way (change the mantle's or the tentacles' size or density)",
+    ),
+    (
+        "link radius 10 m on a 15 cm mantle (issue 10's arcsin case)",
+        scene({"tentacles": {"link_radius": 10}}),
+        "creatures[0].mantle: weighs 5.65 kg against 1.25e+08 kg of tentacles; keep the ratio"
+        " within 10000 either way (change the mantle's or the tentacles' size or density)",
     ),
     (
         "a creature started inside the ground",
@@ -128,7 +172,7 @@ def mujoco_warnings() -> Iterator[list[str]]:
     "tentacles",
     [
         pytest.param({"links": 2, "link_length": 0.01}, id="2 links of 1 cm"),
-        pytest.param({"link_radius": 10.0}, id="link radius 10 m"),
+        pytest.param({"links": 2, "link_length": 0.01, "link_radius": 0.2}, id="fat 20 cm links"),
     ],
 )
 def test_a_stub_tentacle_hangs_straight_down_and_freezes_nobody(
