@@ -77,7 +77,7 @@ class Bodies:
         return Bodies(self.starts + offset, self.ends + offset, self.radii)
 
 
-def _candidates(bodies: list[Bodies]) -> list[tuple[int, int]]:
+def candidate_pairs(bodies: list[Bodies]) -> list[tuple[int, int]]:
     """Pairs (i < j) whose bounding boxes touch: a sweep along x, boxes checked on y, z."""
     if len(bodies) < 2:
         return []
@@ -110,7 +110,7 @@ def _depth(a: Bodies, b: Bodies) -> tuple[float, str]:
 def find_overlaps(bodies: list[Bodies]) -> list[Overlap]:
     """Every pair of creatures whose capsules interpenetrate, in index order."""
     found = []
-    for i, j in _candidates(bodies):
+    for i, j in candidate_pairs(bodies):
         depth, what = _depth(bodies[i], bodies[j])
         if depth > 1e-9:
             found.append(Overlap(i, j, depth, what))

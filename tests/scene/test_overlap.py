@@ -11,7 +11,7 @@ from numpy.testing import assert_allclose
 from ecs_tentacles.scene.overlap import (
     CLEARANCE,
     Bodies,
-    _candidates,
+    candidate_pairs,
     find_overlaps,
     segment_distances,
 )
@@ -68,7 +68,7 @@ def test_candidate_pairs_are_the_pairs_whose_boxes_touch() -> None:
         for i, j in itertools.combinations(range(len(bodies)), 2)
         if np.all(boxes[i][0] <= boxes[j][1]) and np.all(boxes[j][0] <= boxes[i][1])
     ]
-    assert _candidates(bodies) == touching
+    assert candidate_pairs(bodies) == touching
     assert len(touching) > 10
 
 
