@@ -20,7 +20,6 @@ from ecs_tentacles.construction import (
     tentacle_shape,
 )
 from ecs_tentacles.world import World
-from tests.conftest import creature_scene
 
 S = np.sqrt(0.5)
 H = np.sqrt(3) / 2
@@ -130,18 +129,27 @@ def test_the_layout_is_where_the_build_puts_every_body(make_world: Callable[...,
     assert_allclose(0.5 * (starts[0] + ends[0]), mantle, atol=1e-12)
 
 
-def test_masses_and_inertias_are_mujocos(make_world: Callable[..., World]) -> None:
-    scene = creature_scene(count=2, links=3, link_radius=0.03, end_scale=0.4, density=900)
-    scene["creatures"][0]["mantle"] = {"radius": 0.2, "height": 0.05, "density": 300}
-    world = make_world(scene)
-    model = world.physics.model
-    mantle = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "octo/mantle")
-    mass, smallest = cylinder_mass_inertia(0.2, 0.05, 300)
-    assert model.body_mass[mantle] == pytest.approx(mass, rel=1e-9)
-    assert model.body_inertia[mantle].min() == pytest.approx(smallest, rel=1e-9)
-    shape = tentacle_shape(0.2, 0.07, 0.03, 3, 0.4)
-    expected = capsule_mass_inertia(shape.lengths, shape.radii, 900)
-    for i in range(3):
-        body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, f"octo/t1/l{i:02d}")
-        assert model.body_mass[body] == pytest.approx(expected[i, 0], rel=1e-9)
-        assert model.body_inertia[body].min() == pytest.approx(expected[i, 1], rel=1e-9)
+def _compiled_body(geom: dict[str, object]) -> tuple[float, float]:
+    """(mass, smallest principal inertia) MuJoCo compiles for a free body of one geom."""
+    spec = mujoco.MjSpec()
+    body = spec.worldbody.add_body()
+    body.add_freejoint()
+    body.add_geom(**geom)
+    model = spec.compile()
+    return float(model.body_mass[1]), float(model.body_inertia[1].min())
+
+
+@pytest.mark.parametrize(("length", "radius", "density"), [(0.07, 0.025, 1000), (0.01, 0.03, 20)])
+def test_capsule_mass_and_inertia_are_mujocos(length: float, radius: float, density: float) -> None:
+    capsule = mujoco.mjtGeom.mjGEOM_CAPSULE
+    fromto = [-0.5 * length, 0, 0, 0.5 * length, 0, 0]
+    geom = {"type": capsule, "fromto": fromto, "size": [radius, 0, 0], "density": density}
+    expected = capsule_mass_inertia(np.array([length]), np.array([radius]), density)[0]
+    assert_allclose(_compiled_body(geom), expected, rtol=1e-9)
+
+
+@pytest.mark.parametrize(("radius", "height"), [(0.15, 0.2), (0.2, 0.01), (0.05, 1.0)])
+def test_cylinder_mass_and_inertia_are_mujocos(radius: float, height: float) -> None:
+    cylinder = mujoco.mjtGeom.mjGEOM_CYLINDER
+    geom = {"type": cylinder, "size": [radius, 0.5 * height, 0], "density": 400.0}
+    assert_allclose(_compiled_body(geom), cylinder_mass_inertia(radius, height, 400.0), rtol=1e-9)
