@@ -152,9 +152,9 @@ def test_numpy_numbers_are_numbers(make_world: Callable[..., World]) -> None:
 @pytest.mark.parametrize(
     ("params", "message"),
     [
-        ({"speed": -1}, r"speed: must be in (0, 10], got -1"),
-        ({"speed": 0}, r"speed: must be in (0, 10], got 0"),
-        ({"speed": 10.5}, r"speed: must be in (0, 10], got 10.5"),
+        ({"speed": -1}, r"speed: must be in [0.01, 10], got -1"),
+        ({"speed": 0}, r"speed: must be in [0.01, 10], got 0"),
+        ({"speed": 10.5}, r"speed: must be in [0.01, 10], got 10.5"),
         ({"speed": float("nan")}, r"speed: must be a finite number, got nan"),
         ({"speed": "fast"}, r"speed: must be a number, got 'fast'"),
         ({"writhe": True}, r"writhe: must be a number, got True"),
@@ -162,7 +162,7 @@ def test_numpy_numbers_are_numbers(make_world: Callable[..., World]) -> None:
         ({"strength": -0.1}, r"strength: must be in [0, 1000], got -0.1"),
         ({"damping": float("inf")}, r"damping: must be a finite number, got inf"),
         ({"wave_amplitude": 2.0}, r"wave_amplitude: must be in [0, 1.0472], got 2.0"),
-        ({"wavelength": 0.0}, r"wavelength: must be in (0, 10], got 0.0"),
+        ({"wavelength": 0.0}, r"wavelength: must be in [0.01, 10], got 0.0"),
         ({"target_angle": -0.5}, r"target_angle: must be in [0, 1.5708], got -0.5"),
         ({"wave_frequency": 21}, r"wave_frequency: must be in [0, 20], got 21"),
         ({"gait": "gallop"}, r"gait: must be one of cyclic, coordinated, got 'gallop'"),

@@ -15,7 +15,8 @@ from ecs_tentacles.scene.validate import load_schema
 
 def test_ranges_are_the_schemas() -> None:
     assert field_range("tentacles", "strength") == Range(0, 1000)
-    assert field_range("tentacles", "speed") == Range(0, 10, low_open=True)
+    assert field_range("tentacles", "speed") == Range(0.01, 10)
+    assert field_range("tentacles", "end_scale") == Range(0, 1, low_open=True)
     assert field_range("tentacles", "links") == Range(1, 64, integer=True)
     assert field_range("mantle", "radius") == Range(5e-5, 10)
     assert physics_range("gravity") == Range(-30, 30)
