@@ -7,8 +7,8 @@ small, and the few cross-field rules the validator adds (override indices, fur c
 names, increasing key times) are kept so that most examples reach the build. Each
 scene goes through `ecs-tentacles validate` and `run` in-process
 (`ecs_tentacles.cli.main`): a refused scene exits 2 with one `error:` line per
-problem and no traceback; an accepted one builds a world whose bodies and fur curves
-stay finite for 60 frames without a single MuJoCo warning (instability, NaN, bad
+problem and no traceback; an accepted one builds a world whose bodies, joint targets
+and fur curves stay finite for 60 frames without a single MuJoCo warning (instability, NaN, bad
 controls).
 """
 
@@ -168,4 +168,5 @@ def test_a_schema_scene_builds_a_finite_world_or_is_refused(
             assert np.isfinite(world.transforms.pos).all(), f"frame {world.frame}"
             assert np.isfinite(world.transforms.quat).all(), f"frame {world.frame}"
             assert np.isfinite(world.fur.curves).all(), f"frame {world.frame}"
+            assert np.isfinite(world.motors.target).all(), f"frame {world.frame}"
     assert warnings == []
