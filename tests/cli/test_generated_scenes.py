@@ -8,8 +8,8 @@ names, increasing key times) are kept so that most examples reach the build. Eac
 scene goes through `ecs-tentacles validate` and `run` in-process
 (`ecs_tentacles.cli.main`): a refused scene exits 2 with one `error:` line per
 problem and no traceback; an accepted one builds a world whose bodies, joint targets
-and fur curves stay finite for 60 frames without a single MuJoCo warning (instability, NaN, bad
-controls).
+and fur curves stay finite for 60 frames without a single MuJoCo warning (instability,
+NaN, bad controls) or recovery.
 """
 
 from __future__ import annotations
@@ -18,6 +18,7 @@ import contextlib
 import copy
 import io
 import json
+import logging
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -126,14 +127,31 @@ def scene_file(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return tmp_path_factory.mktemp("generated") / "scene.json"
 
 
+class _Collect(logging.Handler):
+    def __init__(self, seen: list[str]) -> None:
+        super().__init__(logging.WARNING)
+        self.seen = seen
+
+    def emit(self, record: logging.LogRecord) -> None:
+        self.seen.append(record.getMessage())
+
+
 @contextlib.contextmanager
 def mujoco_warnings() -> Iterator[list[str]]:
-    """Collect MuJoCo's warnings (instead of MUJOCO_LOG.TXT) while the block runs."""
+    """Collect MuJoCo's warnings while the block runs, however the physics routes them.
+
+    Our own handler gets them unless the physics layer installs its own, which sends
+    them to the `ecs_tentacles.mujoco` logger: that logger is listened to as well.
+    """
     seen: list[str] = []
+    logger = logging.getLogger("ecs_tentacles.mujoco")
+    collect = _Collect(seen)
+    logger.addHandler(collect)
     mujoco.set_mju_user_warning(seen.append)
     try:
         yield seen
     finally:
+        logger.removeHandler(collect)
         mujoco.set_mju_user_warning(None)
 
 
@@ -170,3 +188,6 @@ def test_a_schema_scene_builds_a_finite_world_or_is_refused(
             assert np.isfinite(world.fur.curves).all(), f"frame {world.frame}"
             assert np.isfinite(world.motors.target).all(), f"frame {world.frame}"
     assert warnings == []
+    # a physics layer that recovers creatures itself must not have had to
+    assert world.events.counts["creature_recovered"] == 0
+    assert world.events.counts["creature_frozen"] == 0
