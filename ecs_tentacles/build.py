@@ -14,30 +14,15 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ecs_tentacles.components import Creature, Link, Motor, Sucker, Tentacle, Transform
-from ecs_tentacles.construction import tentacle_angles, tentacle_shape
+from ecs_tentacles.construction import CreatureLayout, creature_layout
 from ecs_tentacles.fur.build import build_creature_extras
 from ecs_tentacles.locomotion.actions import STRENGTH, ActionQueue, Kind
-from ecs_tentacles.mathutil import quat_about_z, quat_rotate
+from ecs_tentacles.mathutil import quat_about_z
 
 if TYPE_CHECKING:
     from ecs_tentacles.world import World
 
 GAITS = {"cyclic": 0, "coordinated": 1}
-
-
-def tentacle_params(tentacles: dict[str, Any], index: int) -> dict[str, Any]:
-    """The creature-wide tentacle settings with tentacle `index`'s overrides applied."""
-    params = {key: tentacles[key] for key in tentacles if key != "overrides"}
-    for override in tentacles.get("overrides", []):
-        if override["index"] == index:
-            params.update({k: v for k, v in override.items() if k != "index"})
-    return params
-
-
-def resting_height(tentacles: dict[str, Any]) -> float:
-    """Base height that lets the thickest first link rest on the ground."""
-    radii = [tentacle_params(tentacles, k)["link_radius"] for k in range(tentacles["count"])]
-    return float(max(radii))
 
 
 def creature_rng(seed: int, name: str) -> np.random.Generator:
@@ -55,12 +40,8 @@ def build_creature(world: World, spec: dict[str, Any]) -> int:
     """Create one creature's entities from its scene entry; return the creature entity."""
     mantle = spec["mantle"]
     tentacles = spec["tentacles"]
-    position = list(spec["position"])
-    if len(position) == 2:
-        position.append(resting_height(tentacles))
-    origin = np.asarray(position, dtype=np.float64)
-    heading = np.radians(spec["heading_deg"])
-    turn = quat_about_z(heading)
+    layout = creature_layout(spec)
+    turn = quat_about_z(layout.heading)
 
     creature = Creature(
         name=spec["name"],
@@ -68,7 +49,7 @@ def build_creature(world: World, spec: dict[str, Any]) -> int:
         mantle_height=mantle["height"],
         mantle_density=mantle["density"],
     )
-    centre = origin + np.array([0.0, 0.0, 0.5 * mantle["height"]])
+    centre = layout.origin + np.array([0.0, 0.0, 0.5 * mantle["height"]])
     row = int(world.transforms.add(pos=centre, quat=turn)[0])
     locomotion = spec["locomotion"]
     creature.row = int(
@@ -88,13 +69,12 @@ def build_creature(world: World, spec: dict[str, Any]) -> int:
     world.creatures.entity[creature.row] = creature_entity
 
     rng = creature_rng(world.seed, spec["name"])
-    for k, angle in enumerate(tentacle_angles(tentacles["count"])):
-        params = tentacle_params(tentacles, k)
+    for k, angle in enumerate(layout.angles):
         tentacle = Tentacle(creature=creature_entity, index=k, base_angle=float(angle))
         tentacle_entity = world.create_entity(tentacle, ActionQueue())
         creature.tentacles.append(tentacle_entity)
-        _build_links(world, tentacle, tentacle_entity, params, mantle["radius"], origin, heading)
-        _add_tentacle_row(world, tentacle, creature.row, params, rng)
+        _build_links(world, tentacle, tentacle_entity, layout, k)
+        _add_tentacle_row(world, tentacle, creature.row, layout, k, rng)
     for goal in spec["goals"]:
         point = list(goal["position"]) + ([0.0] if len(goal["position"]) == 2 else [])
         world.goals.append(creature_entity, point, goal["radius"])
@@ -107,13 +87,14 @@ def _add_tentacle_row(
     world: World,
     tentacle: Tentacle,
     creature_row: int,
-    params: dict[str, Any],
+    layout: CreatureLayout,
+    k: int,
     rng: np.random.Generator,
 ) -> None:
+    params, shape = layout.params[k], layout.shapes[k]
     links = [world.component(e, Link) for e in tentacle.links]
     motors = [world.component(e, Motor) for e in tentacle.links]
     sucker = world.component(tentacle.suckers[-1], Sucker)
-    length = sum(link.length for link in links)
     tentacle.row = int(
         world.tentacles.add(
             creature_row=creature_row,
@@ -122,9 +103,9 @@ def _add_tentacle_row(
             links=len(links),
             base_row=world.component(tentacle.links[0], Transform).row,
             tip_sucker=sucker.row,
-            length=length,
+            length=shape.length,
             joint_limit=links[0].joint_limit,
-            rest_pitch=np.arcsin((links[0].radius - links[-1].radius) / length),
+            rest_pitch=shape.rest_pitch,
             speed=params["speed"],
             target_angle=np.radians(params["target_angle_deg"]),
             wave_amplitude=np.radians(params["wave_amplitude_deg"]),
@@ -144,23 +125,14 @@ def _build_links(
     world: World,
     tentacle: Tentacle,
     tentacle_entity: int,
-    params: dict[str, Any],
-    mantle_radius: float,
-    origin: np.ndarray,
-    heading: float,
+    layout: CreatureLayout,
+    k: int,
 ) -> None:
-    shape = tentacle_shape(
-        mantle_radius,
-        params["link_length"],
-        params["link_radius"],
-        params["links"],
-        params["end_scale"],
-    )
-    angle = heading + tentacle.base_angle
-    quat = quat_about_z(angle)
-    axis = quat_rotate(quat, np.array([1.0, 0.0, 0.0]))
+    params, shape = layout.params[k], layout.shapes[k]
+    mantle_radius = layout.mantle_radius
+    quat = quat_about_z(layout.heading + tentacle.base_angle)
     n = len(shape.scales)
-    rows = world.transforms.add(n, pos=origin + shape.centres[:, None] * axis, quat=quat)
+    rows = world.transforms.add(n, pos=layout.link_centres(k), quat=quat)
     motor_rows = world.motors.add(
         n,
         strength=params["strength"] * shape.scales,

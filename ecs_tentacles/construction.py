@@ -8,13 +8,18 @@
   its scale.
 * The first link's centre lies mantle radius + 1/2 link length along the axis; each
   child's centre lies 1/2 (parent length + child length) beyond its parent's.
+* A creature's scene entry places the centre of the mantle's base at `position`; a 2-d
+  position rests the thickest first link on the ground. Tentacles are straight at build.
 
-These functions are pure: numbers in, numpy arrays out.
+These functions are pure: numbers (or a creature's scene entry) in, numpy arrays out. The
+build (`ecs_tentacles.build`) and the load-time physical checks
+(`ecs_tentacles.scene.physical`) both place creatures with them.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -53,6 +58,22 @@ class TentacleShape:
     radii: np.ndarray
     centres: np.ndarray
 
+    @property
+    def length(self) -> float:
+        """Length of the whole tentacle along its axis."""
+        return float(self.lengths.sum())
+
+    @property
+    def rest_pitch(self) -> float:
+        """Tilt (radians) that lays the underside of the tapering tentacle on the ground.
+
+        The axis drops by the base radius minus the tip radius over the tentacle's
+        length. A tip so much thinner than the base that it cannot reach the ground
+        even hanging straight down (a stub of fat, short links) gets pi / 2.
+        """
+        drop = float(self.radii[0] - self.radii[-1])
+        return float(np.arcsin(min(1.0, drop / self.length)))
+
 
 def tentacle_shape(
     mantle_radius: float, link_length: float, link_radius: float, links: int, end_scale: float
@@ -65,3 +86,99 @@ def tentacle_shape(
     centres[0] = mantle_radius + 0.5 * lengths[0]
     centres[1:] = centres[0] + np.cumsum(0.5 * (lengths[:-1] + lengths[1:]))
     return TentacleShape(scales=scales, lengths=lengths, radii=radii, centres=centres)
+
+
+def tentacle_params(tentacles: dict[str, Any], index: int) -> dict[str, Any]:
+    """The creature-wide tentacle settings with tentacle `index`'s overrides applied."""
+    params = {key: tentacles[key] for key in tentacles if key != "overrides"}
+    for override in tentacles.get("overrides", []):
+        if override["index"] == index:
+            params.update({k: v for k, v in override.items() if k != "index"})
+    return params
+
+
+def resting_height(tentacles: dict[str, Any]) -> float:
+    """Base height that lets the thickest first link rest on the ground."""
+    radii = [tentacle_params(tentacles, k)["link_radius"] for k in range(tentacles["count"])]
+    return float(max(radii))
+
+
+@dataclass(frozen=True)
+class CreatureLayout:
+    """Where a creature's bodies are at build, from its scene entry (defaults filled in)."""
+
+    origin: np.ndarray  # centre of the mantle's base, world frame
+    heading: float  # radians about +z
+    mantle_radius: float
+    mantle_height: float
+    angles: np.ndarray  # base angle of each tentacle in the creature frame
+    params: list[dict[str, Any]]  # each tentacle's settings, overrides applied
+    shapes: list[TentacleShape]
+
+    def axis(self, k: int) -> np.ndarray:
+        """World-frame unit axis of tentacle `k`."""
+        angle = self.heading + self.angles[k]
+        return np.array([np.cos(angle), np.sin(angle), 0.0])
+
+    def link_centres(self, k: int) -> np.ndarray:
+        """World positions (links, 3) of tentacle `k`'s link centres."""
+        return self.origin + self.shapes[k].centres[:, None] * self.axis(k)
+
+    def capsules(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Every body as a capsule: segment starts (n, 3), ends (n, 3) and radii (n,).
+
+        Row 0 is the mantle (its axis from base to top: exact sideways, rounded at the
+        rims); the links follow, tentacle by tentacle, base to tip.
+        """
+        top = self.origin + np.array([0.0, 0.0, self.mantle_height])
+        starts, ends, radii = [self.origin[None]], [top[None]], [np.array([self.mantle_radius])]
+        for k, shape in enumerate(self.shapes):
+            centres = self.link_centres(k)
+            half = 0.5 * shape.lengths[:, None] * self.axis(k)
+            starts.append(centres - half)
+            ends.append(centres + half)
+            radii.append(shape.radii)
+        return np.concatenate(starts), np.concatenate(ends), np.concatenate(radii)
+
+
+def creature_layout(spec: dict[str, Any]) -> CreatureLayout:
+    """The build-time layout of a creature from its scene entry (defaults filled in)."""
+    mantle, tentacles = spec["mantle"], spec["tentacles"]
+    position = [float(v) for v in spec["position"]]
+    if len(position) == 2:
+        position.append(resting_height(tentacles))
+    params = [tentacle_params(tentacles, k) for k in range(tentacles["count"])]
+    shapes = [
+        tentacle_shape(
+            mantle["radius"], p["link_length"], p["link_radius"], p["links"], p["end_scale"]
+        )
+        for p in params
+    ]
+    return CreatureLayout(
+        origin=np.asarray(position, dtype=np.float64),
+        heading=float(np.radians(spec["heading_deg"])),
+        mantle_radius=float(mantle["radius"]),
+        mantle_height=float(mantle["height"]),
+        angles=tentacle_angles(tentacles["count"]),
+        params=params,
+        shapes=shapes,
+    )
+
+
+def capsule_mass_inertia(length: np.ndarray, radius: np.ndarray, density: float) -> np.ndarray:
+    """(mass, smallest principal inertia) of capsules, the way MuJoCo computes them; (n, 2).
+
+    The smallest principal inertia of a capsule is the one about its own axis.
+    """
+    cylinder = density * np.pi * radius**2 * length
+    spheres = density * 4.0 / 3.0 * np.pi * radius**3
+    axial = cylinder * radius**2 / 2.0 + spheres * 2.0 * radius**2 / 5.0
+    return np.stack([cylinder + spheres, axial], axis=-1)
+
+
+def cylinder_mass_inertia(radius: float, height: float, density: float) -> tuple[float, float]:
+    """(mass, smallest principal inertia) of a solid cylinder such as the mantle."""
+    mass = density * np.pi * radius**2 * height
+    axial = mass * radius**2 / 2.0
+    across = mass * (3.0 * radius**2 + height**2) / 12.0
+    return float(mass), float(min(axial, across))

@@ -2,11 +2,24 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
+import mujoco
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from ecs_tentacles.construction import link_scales, tentacle_angles, tentacle_axes, tentacle_shape
+from ecs_tentacles.components import Creature, Link, Tentacle, Transform
+from ecs_tentacles.construction import (
+    capsule_mass_inertia,
+    creature_layout,
+    cylinder_mass_inertia,
+    link_scales,
+    tentacle_angles,
+    tentacle_axes,
+    tentacle_shape,
+)
+from ecs_tentacles.world import World
 
 S = np.sqrt(0.5)
 H = np.sqrt(3) / 2
@@ -70,3 +83,73 @@ def test_tentacle_axes_counter_clockwise_about_z(count: int, expected: list[list
 def test_impossible_tentacles_are_refused(links: int, end_scale: float) -> None:
     with pytest.raises(ValueError):
         link_scales(links, end_scale)
+
+
+def test_rest_pitch_lays_the_underside_on_the_ground() -> None:
+    shape = tentacle_shape(0.2, 0.1, 0.02, 2, 0.5)  # drop 0.01 over 0.15
+    assert shape.length == pytest.approx(0.15)
+    assert shape.rest_pitch == pytest.approx(np.arcsin(0.01 / 0.15))
+    assert tentacle_shape(0.2, 0.1, 0.02, 1, 0.5).rest_pitch == 0.0
+
+
+@pytest.mark.parametrize(
+    ("link_length", "link_radius"), [(0.01, 0.025), (0.07, 10.0)], ids=["short", "fat"]
+)
+def test_rest_pitch_of_a_stub_whose_tip_cannot_reach_the_ground_is_straight_down(
+    link_length: float, link_radius: float
+) -> None:
+    shape = tentacle_shape(0.15, link_length, link_radius, 2, 0.3)
+    assert (shape.radii[0] - shape.radii[-1]) > shape.length  # arcsin of > 1 before
+    assert shape.rest_pitch == np.pi / 2
+
+
+def test_the_layout_is_where_the_build_puts_every_body(make_world: Callable[..., World]) -> None:
+    spec = {
+        "name": "octo",
+        "position": [1.0, -2.0],
+        "heading_deg": 30,
+        "tentacles": {"count": 5, "links": 4, "overrides": [{"index": 3, "link_radius": 0.04}]},
+    }
+    world = make_world({"version": 1, "creatures": [spec]})
+    layout = creature_layout(world.scene["creatures"][0])  # type: ignore[index]
+    assert_allclose(layout.origin, [1.0, -2.0, 0.04])  # the thickest first link rests
+    creature = world.component(world.creature("octo"), Creature)
+    starts, ends, radii = layout.capsules()
+    row = 1
+    for k, entity in enumerate(creature.tentacles):
+        links = world.component(entity, Tentacle).links
+        built = np.array([world.component(e, Transform).pos for e in links])
+        assert_allclose(layout.link_centres(k), built, atol=1e-12)
+        assert_allclose(0.5 * (starts + ends)[row : row + len(links)], built, atol=1e-12)
+        assert_allclose(
+            radii[row : row + len(links)], [world.component(e, Link).radius for e in links]
+        )
+        row += len(links)
+    mantle = world.component(world.creature("octo"), Transform).pos
+    assert_allclose(0.5 * (starts[0] + ends[0]), mantle, atol=1e-12)
+
+
+def _compiled_body(geom: dict[str, object]) -> tuple[float, float]:
+    """(mass, smallest principal inertia) MuJoCo compiles for a free body of one geom."""
+    spec = mujoco.MjSpec()
+    body = spec.worldbody.add_body()
+    body.add_freejoint()
+    body.add_geom(**geom)
+    model = spec.compile()
+    return float(model.body_mass[1]), float(model.body_inertia[1].min())
+
+
+@pytest.mark.parametrize(("length", "radius", "density"), [(0.07, 0.025, 1000), (0.01, 0.03, 20)])
+def test_capsule_mass_and_inertia_are_mujocos(length: float, radius: float, density: float) -> None:
+    capsule = mujoco.mjtGeom.mjGEOM_CAPSULE
+    fromto = [-0.5 * length, 0, 0, 0.5 * length, 0, 0]
+    geom = {"type": capsule, "fromto": fromto, "size": [radius, 0, 0], "density": density}
+    expected = capsule_mass_inertia(np.array([length]), np.array([radius]), density)[0]
+    assert_allclose(_compiled_body(geom), expected, rtol=1e-9)
+
+
+@pytest.mark.parametrize(("radius", "height"), [(0.15, 0.2), (0.2, 0.01), (0.05, 1.0)])
+def test_cylinder_mass_and_inertia_are_mujocos(radius: float, height: float) -> None:
+    cylinder = mujoco.mjtGeom.mjGEOM_CYLINDER
+    geom = {"type": cylinder, "size": [radius, 0.5 * height, 0], "density": 400.0}
+    assert_allclose(_compiled_body(geom), cylinder_mass_inertia(radius, height, 400.0), rtol=1e-9)

@@ -27,12 +27,12 @@ def test_two_worlds_keep_their_entities_apart(make_world: Callable[..., World]) 
 
 def test_step_advances_the_fixed_clock(make_world: Callable[..., World]) -> None:
     scene = creature_scene(count=3, links=2)
-    scene["physics"] = {"fps": 50, "substeps": 4}
+    scene["physics"] = {"fps": 50, "substeps": 8}
     world = make_world(scene)
     world.step(25)
     assert world.time == 0.5
     assert world.physics.time == pytest.approx(0.5, abs=1e-12)
-    assert world.physics.groups[0].model.opt.timestep == 0.005
+    assert world.physics.groups[0].model.opt.timestep == 0.0025
 
 
 def test_goals_become_entities_in_path_order(make_world: Callable[..., World]) -> None:

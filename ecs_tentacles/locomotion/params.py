@@ -6,8 +6,10 @@
     world.locomotion.set(octo, gait="cyclic")
     world.locomotion.actions(octo)                           # what each tentacle is doing
 
-Angles are radians here (scenes use degrees). Values are checked; a bad one raises
-ValueError naming the parameter. Changes reach the servos on the next physics step.
+Angles are radians here (scenes use degrees). Values are checked against the scene
+schema's ranges (`ecs_tentacles.scene.ranges`), and a strength against its damping
+(`damping >= strength x physics step`, as in scenes); a bad one raises ValueError
+naming the parameter. Changes reach the servos on the next physics step.
 """
 
 from __future__ import annotations
@@ -19,36 +21,25 @@ import numpy as np
 
 from ecs_tentacles.components import Creature, Tentacle
 from ecs_tentacles.locomotion.actions import ActionQueue, Kind
+from ecs_tentacles.scene.ranges import Range, damping_floor, field_range
 
 if TYPE_CHECKING:
     from ecs_tentacles.world import World
 
 GAITS = ("cyclic", "coordinated")
-# name -> (lowest, highest, lowest is allowed)
-TENTACLE_RANGES: dict[str, tuple[float, float, bool]] = {
-    "speed": (0.0, 10.0, False),
-    "target_angle": (0.0, np.pi / 2, True),
-    "strength": (0.0, 1e5, True),
-    "damping": (0.0, 1e4, True),
-    "wave_amplitude": (0.0, np.radians(60), True),
-    "wave_frequency": (0.0, 20.0, True),
-    "wavelength": (0.0, 10.0, False),
-    "writhe": (0.0, 1.0, True),
+DEGREE = float(np.radians(1.0))
+# API name -> its range: the scene schema's, in radians where the scene says degrees
+TENTACLE_RANGES: dict[str, Range] = {
+    "speed": field_range("tentacles", "speed"),
+    "target_angle": field_range("tentacles", "target_angle_deg").scaled(DEGREE),
+    "strength": field_range("tentacles", "strength"),
+    "damping": field_range("tentacles", "damping"),
+    "wave_amplitude": field_range("tentacles", "wave_amplitude_deg").scaled(DEGREE),
+    "wave_frequency": field_range("tentacles", "wave_frequency"),
+    "wavelength": field_range("tentacles", "wavelength"),
+    "writhe": field_range("tentacles", "writhe"),
 }
 CREATURE_ONLY = ("gait", "drivers")
-
-
-def _check(name: str, value: Any) -> float:
-    low, high, closed = TENTACLE_RANGES[name]
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise ValueError(f"{name}: must be a number, got {value!r}")
-    value = float(value)
-    if not np.isfinite(value):
-        raise ValueError(f"{name}: must be a number, got {value!r}")
-    if not (low <= value if closed else low < value) or value > high:
-        bracket = "[" if closed else "("
-        raise ValueError(f"{name}: must be in {bracket}{low:g}, {high:g}], got {value!r}")
-    return float(value)
 
 
 class Locomotion:
@@ -80,7 +71,11 @@ class Locomotion:
             raise ValueError(f"{sorted(unknown)[0]}: unknown parameter (allowed: {allowed})")
         if tentacle is not None and set(params) & set(CREATURE_ONLY):
             raise ValueError(f"{sorted(set(params) & set(CREATURE_ONLY))[0]}: is set per creature")
-        checked = {k: _check(k, v) for k, v in params.items() if k in TENTACLE_RANGES}
+        checked = {
+            k: TENTACLE_RANGES[k].check(k, v) for k, v in params.items() if k in TENTACLE_RANGES
+        }
+        if "strength" in checked or "damping" in checked:
+            self._check_servos(targets, checked)
         if "gait" in params and params["gait"] not in GAITS:
             raise ValueError(f"gait: must be one of {', '.join(GAITS)}, got {params['gait']!r}")
         if "drivers" in params:
@@ -104,19 +99,45 @@ class Locomotion:
             else:
                 getattr(world.tentacles, name)[rows] = value
 
+    def _servo(self, tentacle: Tentacle) -> tuple[float, float]:
+        """(strength, damping) of a tentacle's base link, before its links' taper."""
+        motors = self._world.motors
+        first = int(self._world.tentacles.first_link[tentacle.row])
+        scale = motors.scale[first]
+        return float(motors.strength[first] / scale), float(motors.damping[first] / scale)
+
+    def _check_servos(self, targets: list[Tentacle], checked: dict[str, float]) -> None:
+        """Refuse a strength its damping cannot keep stable at this world's physics step."""
+        step = self._world.settings.substep_dt
+        for tentacle in targets:
+            strength, damping = self._servo(tentacle)
+            strength, damping = checked.get("strength", strength), checked.get("damping", damping)
+            least = damping_floor(strength, step)
+            if damping < least:
+                name = "strength" if "strength" in checked else "damping"
+                raise ValueError(
+                    f"{name}: strength {strength:g} needs damping >= {least:.3g} at this world's"
+                    f" physics step ({1e3 * step:.3g} ms), got damping {damping:g}"
+                )
+
+    def strength_limit(self, creature: int, tentacle: int | None = None) -> float:
+        """The highest strength `set` accepts now: the schema's, or what the damping holds."""
+        step = self._world.settings.substep_dt
+        dampings = [self._servo(t)[1] for t in self._tentacles(creature, tentacle)]
+        return min(TENTACLE_RANGES["strength"].high, min(dampings) / step)
+
     def get(self, creature: int, tentacle: int = 0) -> dict[str, Any]:
         """The parameters of one tentacle plus its creature's gait, speed and drivers."""
         world = self._world
         row = world.component(creature, Creature).row
-        t = self._tentacles(creature, tentacle)[0].row
-        first = int(world.tentacles.first_link[t])
+        target = self._tentacles(creature, tentacle)[0]
+        t = target.row
         values: dict[str, Any] = {
             name: float(getattr(world.tentacles, name)[t])
             for name in TENTACLE_RANGES
             if name not in ("strength", "damping")
         }
-        values["strength"] = float(world.motors.strength[first] / world.motors.scale[first])
-        values["damping"] = float(world.motors.damping[first] / world.motors.scale[first])
+        values["strength"], values["damping"] = self._servo(target)
         values["gait"] = GAITS[int(world.creatures.gait[row])]
         values["creature_speed"] = float(world.creatures.speed[row])
         values["drivers"] = int(world.creatures.drivers[row])

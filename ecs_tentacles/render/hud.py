@@ -1,10 +1,11 @@
 """The heads-up display: tune the selected creature's tentacles, see live stats.
 
 Sliders (pyglet.gui) for speed, target angle, strength, wave amplitude and
-frequency, a gait toggle, and a tentacle selector ("all" or one tentacle). Every
-change goes through `world.locomotion.set`, the same API scripts use, so it reaches
-the servos on the next physics step. Labels show fps, physics ms, simulated time,
-real-time factor, attached suckers and each tentacle's current action.
+frequency, over the scene schema's ranges (the API's too), a gait toggle, and a
+tentacle selector ("all" or one tentacle). Every change goes through
+`world.locomotion.set`, the same API scripts use, so it reaches the servos on the next
+physics step. Labels show fps, physics ms, simulated time, real-time factor, attached
+suckers and each tentacle's current action.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ import pyglet
 from pyglet.gui import Frame, PushButton, Slider, ToggleButton
 
 from ecs_tentacles.components import Creature
+from ecs_tentacles.locomotion.params import TENTACLE_RANGES
 
 PANEL_WIDTH = 300
 ROW = 34
@@ -26,27 +28,44 @@ TEXT = (20, 24, 28, 255)
 
 @dataclass(frozen=True)
 class Knob:
-    """A slider's parameter, its range, and how it is shown."""
+    """A slider's parameter and how it is shown; its range is the scene schema's.
+
+    The slider's 0..100 maps onto the parameter's range (`TENTACLE_RANGES`, read from
+    the schema) as `low + span * (s / 100) ** curve`: a curve above 1 gives the low
+    end, where the defaults sit, more of the slider. An open lower bound (speed > 0)
+    starts a thousandth of the span above it.
+    """
 
     name: str
     label: str
-    low: float
-    high: float
     shown: Callable[[float], str]
+    curve: float = 1.0
+
+    @property
+    def low(self) -> float:
+        allowed = TENTACLE_RANGES[self.name]
+        return allowed.low + (1e-3 * (allowed.high - allowed.low) if allowed.low_open else 0.0)
+
+    @property
+    def high(self) -> float:
+        return TENTACLE_RANGES[self.name].high
+
+    def value(self, slider: float) -> float:
+        """The parameter value at slider position `slider` (0..100)."""
+        return self.low + (self.high - self.low) * (slider / 100.0) ** self.curve
+
+    def slider(self, value: float) -> float:
+        """The slider position (0..100) showing `value`."""
+        fraction = np.clip((value - self.low) / (self.high - self.low), 0.0, 1.0)
+        return float(100.0 * fraction ** (1.0 / self.curve))
 
 
 KNOBS = (
-    Knob("speed", "speed", 0.2, 3.0, lambda v: f"{v:.2f}x"),
-    Knob("target_angle", "target angle", 0.0, np.radians(80), lambda v: f"{np.degrees(v):.0f} deg"),
-    Knob("strength", "strength (kp)", 0.0, 100.0, lambda v: f"{v:.1f}"),
-    Knob(
-        "wave_amplitude",
-        "wave amplitude",
-        0.0,
-        np.radians(30),
-        lambda v: f"{np.degrees(v):.1f} deg",
-    ),
-    Knob("wave_frequency", "wave frequency", 0.0, 3.0, lambda v: f"{v:.2f} Hz"),
+    Knob("speed", "speed", lambda v: f"{v:.2f}x", curve=2.0),
+    Knob("target_angle", "target angle", lambda v: f"{np.degrees(v):.0f} deg"),
+    Knob("strength", "strength (kp)", lambda v: f"{v:.1f}", curve=3.0),
+    Knob("wave_amplitude", "wave amplitude", lambda v: f"{np.degrees(v):.1f} deg"),
+    Knob("wave_frequency", "wave frequency", lambda v: f"{v:.2f} Hz", curve=2.0),
 )
 
 
@@ -158,7 +177,7 @@ class Hud:
     def _changer(self, knob: Knob) -> Callable[[Slider, float], None]:
         def changed(widget: Slider, value: float) -> None:
             if not self._refreshing:
-                self.set_parameter(knob.name, knob.low + (knob.high - knob.low) * value / 100.0)
+                self.set_parameter(knob.name, knob.value(value))
 
         return changed
 
@@ -166,6 +185,8 @@ class Hud:
         """Apply a parameter to the selection through the locomotion API."""
         if self.creature is None:
             return
+        if name == "strength":  # no stiffer than the damping holds at this physics step
+            value = min(value, self.world.locomotion.strength_limit(self.creature, self.tentacle))
         self.world.locomotion.set(self.creature, tentacle=self.tentacle, **{name: float(value)})
         self.refresh()
 
@@ -192,9 +213,7 @@ class Hud:
         try:
             for slider, label, knob in self.sliders.values():
                 value = values[knob.name]
-                slider.value = float(
-                    np.clip(100 * (value - knob.low) / (knob.high - knob.low), 0, 100)
-                )
+                slider.value = knob.slider(value)
                 label.text = knob.shown(value)
             self.gait.value = values["gait"] == "coordinated"
         finally:

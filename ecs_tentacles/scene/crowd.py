@@ -40,8 +40,7 @@ from typing import Any
 
 import numpy as np
 
-from ecs_tentacles.build import tentacle_params
-from ecs_tentacles.construction import tentacle_shape
+from ecs_tentacles.construction import tentacle_params, tentacle_shape
 from ecs_tentacles.creator.limits import default
 from ecs_tentacles.export.atomic import atomic_output
 from ecs_tentacles.scene.load import load_scene

@@ -21,6 +21,7 @@ import stat
 from typing import Any
 
 from ecs_tentacles.scene.errors import SceneError
+from ecs_tentacles.scene.physical import physically_checked
 from ecs_tentacles.scene.validate import validate_scene, with_defaults
 
 MAX_SCENE_BYTES = 8 * 1024**2  # bundled scenes are a few kB; 1024 goals x 64 creatures fit
@@ -109,7 +110,7 @@ def load_scene(source: str | os.PathLike[str] | dict[str, Any]) -> dict[str, Any
     if problems:
         raise SceneError([prefix + problem for problem in problems])
     assert isinstance(data, dict)  # the schema requires an object
-    return with_defaults(data)
+    return physically_checked(with_defaults(data), prefix)
 
 
 def _scenes_dir() -> pathlib.Path:

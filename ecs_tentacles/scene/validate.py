@@ -10,7 +10,6 @@ import copy
 import functools
 import importlib.resources
 import json
-import math
 import re
 from collections.abc import Iterable, Mapping, Sequence
 from typing import Any
@@ -182,12 +181,6 @@ def _semantic_problems(scene: Mapping[str, Any]) -> list[Problem]:
                 problems.append((where, f"duplicate index {index} (also {first})"))
             else:
                 seen_indices[index] = j
-    for j, later in enumerate(creatures):
-        for i, earlier in enumerate(creatures[:j]):
-            (x1, y1), (x2, y2) = earlier["position"][:2], later["position"][:2]
-            reach = earlier["mantle"]["radius"] + later["mantle"]["radius"]
-            if math.hypot(x2 - x1, y2 - y1) < reach:
-                problems.append((("creatures", j, "position"), f"mantle overlaps creatures[{i}]'s"))
     return problems + fur_problems(scene) + shard_problems(scene)
 
 
@@ -195,7 +188,8 @@ def validate_scene(data: object) -> list[str]:
     """Return every problem of ``data`` as a scene, sorted by JSON path; ``[]`` if it is valid.
 
     Each problem is one line ``"<json path>: <message>"``. Semantic rules (override
-    indices, unique names, overlapping mantles) are checked only once the schema passes.
+    indices, unique names) are checked only once the schema passes; overlapping bodies
+    are a physical problem (`ecs_tentacles.scene.physical`), checked when loading.
     """
     schema = load_schema()
     too_long = _limit_problems(data, schema, schema)  # iterative, stops at long arrays

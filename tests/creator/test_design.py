@@ -123,7 +123,10 @@ def test_bad_values_name_the_field_and_change_nothing() -> None:
     cases = [
         (lambda: design.set_tentacle(2, links=65), "links: must be in [1, 64], got 65"),
         (lambda: design.set_tentacle(2, end_scale=0.0), "end_scale: must be in (0, 1], got 0.0"),
-        (lambda: design.set_tentacle(2, link_length=-1), "link_length: must be in (0, 10], got -1"),
+        (
+            lambda: design.set_tentacle(2, link_length=-1),
+            "link_length: must be in [1e-06, 10], got -1",
+        ),
         (lambda: design.set_tentacle(2, links=2.5), "links: must be a whole number, got 2.5"),
         (lambda: design.select(6), "tentacle: must be in [0, 5], got 6"),
         (lambda: design.build(count=0), "count: must be in [1, 16], got 0"),

@@ -152,17 +152,17 @@ def test_numpy_numbers_are_numbers(make_world: Callable[..., World]) -> None:
 @pytest.mark.parametrize(
     ("params", "message"),
     [
-        ({"speed": -1}, r"speed: must be in (0, 10], got -1"),
-        ({"speed": 0}, r"speed: must be in (0, 10], got 0"),
-        ({"speed": 10.5}, r"speed: must be in (0, 10], got 10.5"),
-        ({"speed": float("nan")}, r"speed: must be a number, got nan"),
+        ({"speed": -1}, r"speed: must be in [0.01, 10], got -1"),
+        ({"speed": 0}, r"speed: must be in [0.01, 10], got 0"),
+        ({"speed": 10.5}, r"speed: must be in [0.01, 10], got 10.5"),
+        ({"speed": float("nan")}, r"speed: must be a finite number, got nan"),
         ({"speed": "fast"}, r"speed: must be a number, got 'fast'"),
         ({"writhe": True}, r"writhe: must be a number, got True"),
         ({"writhe": 1.5}, r"writhe: must be in [0, 1], got 1.5"),
-        ({"strength": -0.1}, r"strength: must be in [0, 100000], got -0.1"),
-        ({"damping": float("inf")}, r"damping: must be a number, got inf"),
+        ({"strength": -0.1}, r"strength: must be in [0, 1000], got -0.1"),
+        ({"damping": float("inf")}, r"damping: must be a finite number, got inf"),
         ({"wave_amplitude": 2.0}, r"wave_amplitude: must be in [0, 1.0472], got 2.0"),
-        ({"wavelength": 0.0}, r"wavelength: must be in (0, 10], got 0.0"),
+        ({"wavelength": 0.0}, r"wavelength: must be in [0.01, 10], got 0.0"),
         ({"target_angle": -0.5}, r"target_angle: must be in [0, 1.5708], got -0.5"),
         ({"wave_frequency": 21}, r"wave_frequency: must be in [0, 20], got 21"),
         ({"gait": "gallop"}, r"gait: must be one of cyclic, coordinated, got 'gallop'"),
@@ -171,6 +171,17 @@ def test_numpy_numbers_are_numbers(make_world: Callable[..., World]) -> None:
         ({"drivers": 2.0}, r"drivers: must be a whole number in [1, 4], got 2.0"),
         ({"drivers": True}, r"drivers: must be a whole number in [1, 4], got True"),
         ({"colour": 1}, r"colour: unknown parameter (allowed: damping, drivers, gait, "),
+        ({"strength": 1e5}, r"strength: must be in [0, 1000], got 100000.0"),
+        (
+            {"strength": 500},
+            r"strength: strength 500 needs damping >= 1.04 at this world's physics step"
+            r" (2.08 ms), got damping 0.5",
+        ),
+        (
+            {"damping": 0.0},
+            r"damping: strength 25 needs damping >= 0.0521 at this world's physics step"
+            r" (2.08 ms), got damping 0",
+        ),
     ],
 )
 def test_bad_values_name_the_parameter(
@@ -232,3 +243,13 @@ def test_actions_lists_each_tentacle(make_world: Callable[..., World]) -> None:
     assert world.locomotion.actions(octo) == ["idle"] * 4
     world.step(1)
     assert world.locomotion.actions(octo) == ["idle", "idle", "orient", "idle"]
+
+
+def test_a_stiffer_servo_needs_more_damping(make_world: Callable[..., World]) -> None:
+    world = _world(make_world)  # 60 fps x 8 substeps: a physics step of 1/480 s
+    octo = world.creature("octo")
+    assert world.locomotion.strength_limit(octo) == pytest.approx(0.5 * 480)
+    world.locomotion.set(octo, tentacle=2, strength=1000.0, damping=1000.0 / 480)
+    assert world.locomotion.get(octo, 2)["strength"] == 1000.0
+    assert world.locomotion.strength_limit(octo, 2) == 1000.0  # the schema's ceiling
+    assert world.locomotion.strength_limit(octo) == pytest.approx(240.0)  # the others'

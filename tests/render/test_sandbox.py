@@ -73,18 +73,24 @@ def test_clicking_a_creature_selects_it(make_sandbox: Callable[..., Any]) -> Non
     assert sandbox.hud.title.text == "creature_2"
 
 
+def _click_slider(sandbox: Any, name: str, fraction: float) -> None:
+    """Click the HUD slider `name` at `fraction` of its track."""
+    slider = sandbox.hud.sliders[name][0]
+    x = slider.x + slider._edge + fraction * (slider.width - 2 * slider._edge)
+    y = slider.y + slider.height / 2
+    _event(sandbox, "on_mouse_press", round(x), round(y), mouse.LEFT, 0)
+    _event(sandbox, "on_mouse_release", round(x), round(y), mouse.LEFT, 0)
+
+
 def test_hud_slider_reaches_the_servo_gains(make_sandbox: Callable[..., Any]) -> None:
     sandbox = make_sandbox("octopus")
     world = sandbox.world
     octo = world.creature("octopus")
     slider, _, knob = sandbox.hud.sliders["strength"]
-    x = slider.x + slider._edge + 0.75 * (slider.width - 2 * slider._edge)
-    y = slider.y + slider.height / 2
-    _event(sandbox, "on_mouse_press", round(x), round(y), mouse.LEFT, 0)
-    _event(sandbox, "on_mouse_release", round(x), round(y), mouse.LEFT, 0)
+    _click_slider(sandbox, "strength", 0.5)
     kp = world.locomotion.get(octo, 0)["strength"]
-    assert 70 < slider.value < 85  # the knob jumped to where we clicked
-    assert kp == pytest.approx(knob.low + (knob.high - knob.low) * slider.value / 100, rel=1e-12)
+    assert 40 < slider.value < 60  # the knob jumped to where we clicked
+    assert kp == pytest.approx(knob.value(slider.value), rel=1e-12)
     assert [world.locomotion.get(octo, k)["strength"] for k in range(8)] == [kp] * 8  # "all"
     sandbox.step(1)
     model = world.physics.groups[0].model
@@ -94,6 +100,18 @@ def test_hud_slider_reaches_the_servo_gains(make_sandbox: Callable[..., Any]) ->
         kp * world.motors.gain[row], rel=1e-12
     )
     assert sandbox.hud.sliders["strength"][1].text == f"{kp:.1f}"
+
+
+def test_the_strength_slider_stops_where_the_damping_holds(
+    make_sandbox: Callable[..., Any],
+) -> None:
+    sandbox = make_sandbox("octopus")
+    world = sandbox.world
+    octo = world.creature("octopus")
+    _click_slider(sandbox, "strength", 0.95)
+    # damping 0.5 at 1/480 s holds at most kp 240 (damping >= strength x step)
+    assert world.locomotion.strength_limit(octo) == pytest.approx(240.0)
+    assert world.locomotion.get(octo, 5)["strength"] == pytest.approx(240.0)
 
 
 def _crowd(count: int) -> dict[str, Any]:

@@ -59,7 +59,7 @@ def test_dict_problems_have_no_prefix() -> None:
 def test_file_problems_are_prefixed_with_the_path(tmp_path: pathlib.Path) -> None:
     path = write(tmp_path / "bad.json", json.dumps({"physics": {"fps": 0}}))
     assert problems_of(path) == [
-        f"{path}: physics.fps: must be in (0, 1000], got 0",
+        f"{path}: physics.fps: must be in [4, 1000], got 0",
         f"{path}: version: is required",
     ]
 

@@ -76,6 +76,7 @@ def test_with_defaults_fills_nested_defaults_exactly() -> None:
             "gravity": [0, 0, -9.81],
             "ground_friction": 0.4,
             "sucker_timeconst": 0.005,
+            "separate_overlaps": False,
         },
         "systems": [],
         "threats": [],
@@ -137,6 +138,7 @@ def test_with_defaults_keeps_given_values_and_names() -> None:
         "gravity": [0, 0, -9.81],
         "ground_friction": 0.4,
         "sucker_timeconst": 0.005,
+        "separate_overlaps": False,
     }
 
 

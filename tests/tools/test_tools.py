@@ -61,3 +61,13 @@ def test_frame_benchmark_splits_the_frame() -> None:
     names |= {"emotion", "rig"}
     assert names | {"physics", "physics_health", "physics_sync", "total", "mj_step"} == set(ms)
     assert ms["total"] >= ms["mj_step"] > 0
+
+
+def test_scene_corners_builds_or_refuses_every_corner_scene() -> None:
+    corners = _load("scene_corners")
+    result = corners.search(scenes=60, seed=1, frames=10)
+    counts = result["counts"]
+    assert sum(counts.values()) == 60
+    assert counts.get("ok", 0) >= 3  # some corners are accepted and stepped
+    assert result["unstable"] == [] and "unstable" not in counts
+    assert all(key == "ok" or key.startswith("refused ") for key in counts)

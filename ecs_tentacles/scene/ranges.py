@@ -1,0 +1,96 @@
+"""Numeric ranges of scene fields, read from the scene schema: the one place they live.
+
+The loader validates scenes against the schema; the run-time setters
+(`world.locomotion.set`), the HUD sliders and the creature creator check values with
+the same ranges through this module, so nothing can be set at run time that a scene
+could not say.
+
+    field_range("tentacles", "strength")          # Range(low=0, high=1000, ...)
+    field_range("tentacles", "strength").check("strength", 5e4)   # ValueError
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+from dataclasses import dataclass, replace
+from typing import Any
+
+from ecs_tentacles.scene.validate import load_schema
+
+
+@dataclass(frozen=True)
+class Range:
+    """An interval of allowed numbers; `integer` ranges take whole numbers only."""
+
+    low: float
+    high: float
+    low_open: bool = False
+    high_open: bool = False
+    integer: bool = False
+
+    def __str__(self) -> str:
+        """`[0, 1000]`, `(0, 10]`: numbers shortened with `g`."""
+        opening, closing = "(" if self.low_open else "[", ")" if self.high_open else "]"
+        return f"{opening}{self.low:g}, {self.high:g}{closing}"
+
+    def __contains__(self, value: object) -> bool:
+        if not isinstance(value, int | float):
+            return False
+        above = value > self.low if self.low_open else value >= self.low
+        below = value < self.high if self.high_open else value <= self.high
+        return above and below
+
+    def scaled(self, factor: float) -> Range:
+        """The same range in other units (degrees in the scene, radians in the API)."""
+        return replace(self, low=self.low * factor, high=self.high * factor)
+
+    def check(self, name: str, value: Any) -> Any:
+        """`value` (a float, or an int for integer ranges) if allowed, else a ValueError."""
+        if isinstance(value, bool) or not isinstance(value, numbers.Real):
+            raise ValueError(f"{name}: must be a number, got {value!r}")
+        value = float(value) if not isinstance(value, int) else value
+        if not math.isfinite(value):
+            raise ValueError(f"{name}: must be a finite number, got {value!r}")
+        if self.integer and value != int(value):
+            raise ValueError(f"{name}: must be a whole number, got {value!r}")
+        if value not in self:
+            raise ValueError(f"{name}: must be in {self}, got {value!r}")
+        return int(value) if self.integer else float(value)
+
+
+def _range_of(spec: dict[str, Any]) -> Range:
+    low_open, high_open = "exclusiveMinimum" in spec, "exclusiveMaximum" in spec
+    low = spec.get("exclusiveMinimum", spec.get("minimum", -math.inf))
+    high = spec.get("exclusiveMaximum", spec.get("maximum", math.inf))
+    return Range(low, high, low_open, high_open, spec.get("type") == "integer")
+
+
+def field_schema(section: str, key: str) -> dict[str, Any]:
+    """The schema of a creature's `<section>.<key>` (section: mantle, tentacles, locomotion)."""
+    creature = load_schema()["$defs"]["creature"]["properties"]
+    found: dict[str, Any] = creature[section]["properties"][key]
+    return found
+
+
+def field_range(section: str, key: str) -> Range:
+    """The range of a creature's `<section>.<key>`, e.g. `("tentacles", "strength")`."""
+    return _range_of(field_schema(section, key))
+
+
+def physics_range(key: str) -> Range:
+    """The range of the scene's `physics.<key>` (for gravity: of each component)."""
+    spec: dict[str, Any] = load_schema()["properties"]["physics"]["properties"][key]
+    return _range_of(spec.get("items", spec))
+
+
+def damping_floor(strength: float, step: float) -> float:
+    """The least servo damping (N m s / rad) that keeps a servo of `strength` stable.
+
+    MuJoCo integrates the damping implicitly and the stiffness explicitly: one physics
+    step of `step` seconds stays stable, whatever the link's inertia, while
+    `strength * step**2 < 2 * damping * step` (+ 4 x inertia). Asking for
+    `damping >= strength * step` keeps a factor of two; undamped stiff servos (damping 0,
+    strength 100) shook their links apart at 60 fps.
+    """
+    return float(strength) * float(step)
