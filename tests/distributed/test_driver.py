@@ -92,7 +92,7 @@ def test_creatures_of_declared_shards_that_meet_are_baked_again_together(
             },
             {
                 "name": "b",
-                "position": [0.7, 0],
+                "position": [0.35, 0, 0.45],  # falls onto a
                 "tentacles": tentacles,
                 "goals": [{"position": [-1, 0]}],
             },

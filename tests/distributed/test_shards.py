@@ -54,7 +54,7 @@ def test_islands_are_packed_into_at_most_tasks_shards_balanced() -> None:
 
 
 def test_declared_shards_are_used_as_they_are() -> None:
-    raw = scene((0, 0), (1, 0), (2, 0))
+    raw = scene((0, 0), (1.5, 0), (3, 0))
     raw["shards"] = [["c2", "c0"], ["c1"]]
     data = load_scene(raw)
     plan = plan_shards(data, seconds=1.0, tasks=8)
