@@ -40,7 +40,7 @@ from ecs_tentacles.world import World
 
 BLOCK = 10  # frames per interleaved block
 WARMUP = 30  # untimed frames first: goals chosen, suckers in use, kernels loaded
-PHYSICS_SYSTEMS = ("physics", "physics_sync")
+PHYSICS_SYSTEMS = ("physics", "physics_health", "physics_sync")
 
 
 def timed(func: Callable[..., Any], bucket: list[float]) -> Callable[..., Any]:
@@ -126,12 +126,17 @@ def bench(
     block: int = BLOCK,
     warmup: int = WARMUP,
     allow_systems: bool = False,
+    sleep: bool = True,
 ) -> dict[str, Any]:
     """Build `source` (scene path, bundled name or dict), run `measure`, report sizes.
 
     The keys, in order: creatures, bodies, groups, threads, build_s, frames, frame_ms,
-    physics_ms, raw_mujoco_ms, overhead_ratio, realtime_factor, systems, rss_mb.
+    physics_ms, raw_mujoco_ms, overhead_ratio, realtime_factor, systems, rss_mb, then
+    asleep (groups asleep at the end), compiles (models compiled) and recoveries.
+    With `sleep=False` idle creatures are stepped like the rest (to show what sleep saves).
     """
+    if not sleep:
+        source = _without_sleep(source)
     start = time.perf_counter()
     world = World.from_scene(source, threads=threads, allow_systems=allow_systems)
     build_s = time.perf_counter() - start
@@ -145,7 +150,20 @@ def bench(
             "build_s": build_s,
         }
         timings = measure(world, frames, block=block, warmup=warmup)
+        after = {
+            "asleep": world.physics.sleep.asleep,
+            "compiles": world.physics.compiles,
+            "recoveries": world.physics.health.recoveries,
+        }
     finally:
         world.close()
     rss_mb = psutil.Process().memory_info().rss / 2**20
-    return {**sizes, **timings, "rss_mb": rss_mb}
+    return {**sizes, **timings, "rss_mb": rss_mb, **after}
+
+
+def _without_sleep(source: Any) -> dict[str, Any]:
+    from ecs_tentacles.scene.load import load_scene
+
+    scene = copy.deepcopy(load_scene(source))
+    scene["physics"]["sleep"] = False
+    return scene

@@ -56,6 +56,9 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("--json", action="store_true", help="print the result as one JSON object")
     parser.add_argument(
+        "--no-sleep", action="store_true", help="step idle creatures too (to see what sleep saves)"
+    )
+    parser.add_argument(
         "--allow-systems", action="store_true", help="import and run the systems the scene names"
     )
     add_crowd_options(parser)
@@ -76,13 +79,15 @@ def handle(args: argparse.Namespace) -> int:
         block=args.block,
         warmup=args.warmup,
         allow_systems=args.allow_systems,
+        sleep=not args.no_sleep,
     )
     if args.json:
         print(json.dumps(result))
         return 0
     print(
         f"{label}: {result['creatures']} creatures, {result['bodies']} bodies,"
-        f" {result['groups']} physics groups, {result['threads']} threads;"
+        f" {result['groups']} physics groups ({result['compiles']} compiled,"
+        f" {result['asleep']} asleep at the end), {result['threads']} threads;"
         f" built in {result['build_s']:.2f} s"
     )
     print(

@@ -28,7 +28,8 @@ gives the same JSON, byte for byte):
   (plus a little jitter), so mirrored pairs meet head-on and the whole crowd
   crosses in the middle. A creature too close to the centre for that gets a goal
   one spacing away in a random direction. `idle` is the fraction of creatures (chosen
-  at random) with no goal at all.
+  at random) with no goal at all; they rest (no waves, no writhing), so they fall
+  asleep (`ecs_tentacles.physics.sleep`) until another creature comes near.
 """
 
 from __future__ import annotations
@@ -224,6 +225,8 @@ def crowd_scene(
         creature["position"] = [_r(v) for v in positions[i]]
         if i not in idle_ones:
             creature["goals"] = [{"position": [_r(v) for v in goals[i]]}]
+        else:
+            _rest(creature)
     return {
         "version": 1,
         "name": f"crowd_{n}",
@@ -242,3 +245,12 @@ def write_crowd_scene(scene: dict[str, Any], path: str | os.PathLike[str]) -> No
     load_scene(scene)
     with atomic_output(path) as temporary:
         temporary.write_text(json.dumps(scene, indent=1) + "\n", encoding="utf-8")
+
+
+def _rest(creature: dict[str, Any]) -> None:
+    """No goal, and tentacles that lie still: no travelling waves, no writhing."""
+    tentacles = creature.setdefault("tentacles", {})
+    for part in (tentacles, *tentacles.get("overrides", [])):
+        for key in ("wave_amplitude_deg", "writhe"):
+            if key in part or part is tentacles:
+                part[key] = 0

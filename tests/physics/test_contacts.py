@@ -51,14 +51,13 @@ def test_proxies_stand_where_the_other_creatures_bodies_are(
         ],
     }
     world = make_world(scene, locomotion=False)
-    before = world.transforms.pos.copy()  # proxies are placed from the poses a frame starts with
-    world.step(1)
+    world.physics.proxies.update(world.transforms)  # as each frame starts
     a, b, far = world.physics.groups
     assert far.proxies_used == 0 and a.proxies_used > 0 and b.proxies_used > 0
     # every proxy of a stands exactly on one of b's bodies, with its size
     used = a.proxy_mocap[: a.proxies_used]  # capsules first; no mantle is near
     placed = a.data.mocap_pos[used]
-    bodies = before[b.body_rows]
+    bodies = world.transforms.pos[b.body_rows]
     nearest = np.linalg.norm(placed[:, None] - bodies[None], axis=2).min(axis=1)
     assert_allclose(nearest, 0.0, atol=1e-12)
     parked = np.setdiff1d(a.proxy_mocap, used)

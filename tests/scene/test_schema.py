@@ -76,6 +76,9 @@ def test_with_defaults_fills_nested_defaults_exactly() -> None:
             "gravity": [0, 0, -9.81],
             "ground_friction": 0.4,
             "sucker_timeconst": 0.005,
+            "max_speed": 12,
+            "max_penetration": 0.05,
+            "sleep": True,
             "separate_overlaps": False,
         },
         "systems": [],
@@ -138,6 +141,9 @@ def test_with_defaults_keeps_given_values_and_names() -> None:
         "gravity": [0, 0, -9.81],
         "ground_friction": 0.4,
         "sucker_timeconst": 0.005,
+        "max_speed": 12,
+        "max_penetration": 0.05,
+        "sleep": True,
         "separate_overlaps": False,
     }
 
