@@ -1,7 +1,8 @@
 """How far apart two creatures' bodies are (negative: how deep they interpenetrate).
 
 Measured on the geometry the physics uses, from the Transform store: link capsules
-(segment along the link's +x, radius) exactly, segment to segment; the mantle
+(segment along the link's +x, radius) exactly, segment to segment
+(`ecs_tentacles.scene.overlap.segment_distances`, shared with the build check); the mantle
 cylinder against link capsules by sampling each link's segment at a few points
 (exact point-to-cylinder distances). Used by tests, the bench and the crowd checks;
 not per frame in the engine.
@@ -15,6 +16,7 @@ import numpy as np
 
 from ecs_tentacles.components import Creature, Link, Tentacle, Transform
 from ecs_tentacles.mathutil import quat_rotate
+from ecs_tentacles.scene.overlap import segment_distances
 
 if TYPE_CHECKING:
     from ecs_tentacles.world import World
@@ -49,7 +51,8 @@ def clearance(world: World, a: int, b: int) -> float:
     """Smallest gap (metres) between creatures `a` and `b`; negative when they overlap."""
     sa, sb = creature_shapes(world, a), creature_shapes(world, b)
     gaps = [
-        (segment_distances(sa["start"], sa["end"], sb["start"], sb["end"])
+        (segment_distances(sa["start"][:, None], sa["end"][:, None], sb["start"][None],
+                           sb["end"][None])
          - sa["radius"][:, None] - sb["radius"][None, :]).min(initial=np.inf),
         _capsules_to_mantle(sa, sb),
         _capsules_to_mantle(sb, sa),
@@ -71,25 +74,3 @@ def _capsules_to_mantle(capsules: dict[str, np.ndarray], other: dict[str, np.nda
     inside = np.minimum(np.maximum(out_r, out_h), 0.0)
     gap = outside + inside - capsules["radius"][:, None]
     return float(gap.min())
-
-
-def segment_distances(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray, q1: np.ndarray) -> np.ndarray:
-    """(n, m) closest distances between segments p0-p1 (n) and q0-q1 (m)."""
-    d1 = (p1 - p0)[:, None, :]
-    d2 = (q1 - q0)[None, :, :]
-    r = p0[:, None, :] - q0[None, :, :]
-    a = np.einsum("ijk,ijk->ij", d1, d1) + np.zeros(r.shape[:2])
-    e = np.einsum("ijk,ijk->ij", d2, d2) + np.zeros(r.shape[:2])
-    b = np.einsum("ijk,ijk->ij", d1, d2)
-    c = np.einsum("ijk,ijk->ij", d1, r)
-    f = np.einsum("ijk,ijk->ij", d2, r)
-    tiny = 1e-12
-    denom = a * e - b * b
-    s = np.where(denom > tiny, np.clip((b * f - c * e) / np.maximum(denom, tiny), 0.0, 1.0), 0.0)
-    t = (b * s + f) / np.maximum(e, tiny)
-    # t outside [0, 1]: clamp it and recompute s for that end of the second segment
-    s = np.where(t < 0.0, np.clip(-c / np.maximum(a, tiny), 0.0, 1.0), s)
-    s = np.where(t > 1.0, np.clip((b - c) / np.maximum(a, tiny), 0.0, 1.0), s)
-    t = np.clip(t, 0.0, 1.0)
-    closest = r + s[..., None] * d1 - t[..., None] * d2
-    return np.linalg.norm(closest, axis=-1)
