@@ -1,136 +1,72 @@
 """The heads-up display: tune the selected creature's tentacles, see live stats.
 
-Sliders (pyglet.gui) for speed, target angle, strength, wave amplitude and
-frequency, a gait toggle, and a tentacle selector ("all" or one tentacle). Every
-change goes through `world.locomotion.set`, the same API scripts use, so it reaches
-the servos on the next physics step. Labels show fps, physics ms, simulated time,
-real-time factor, attached suckers and each tentacle's current action.
+Drawn with Dear ImGui (`render.gui`): a panel on the left, as wide as the window
+allows, in collapsible sections. "Locomotion" has sliders for speed, target angle,
+strength, wave amplitude and frequency, the gait, and a tentacle selector ("all"
+or one tentacle). Every change goes through `world.locomotion.set`, the same API
+scripts use, so it reaches the servos on the next physics step. "Stats" shows fps,
+physics ms, simulated time, real-time factor and attached suckers; "Physics" the
+groups, threads, recoveries and frozen creatures; "Actions" each tentacle's action.
+Extra panels (the fur tool) add sections through `sections`.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, Literal
+from typing import Any
 
 import numpy as np
-import pyglet
-from pyglet.gui import Frame, PushButton, Slider, ToggleButton
+from imgui_bundle import imgui
 
 from ecs_tentacles.components import Creature
+from ecs_tentacles.render.gui import Gui, gui_scale
 
-PANEL_WIDTH = 300
-ROW = 34
+PANEL_WIDTH = 300  # the panel's width at scale 1 (the creator still uses it as is)
+PANEL_SHARE = 0.4  # the panel never covers more than this share of the window's width
 TEXT = (20, 24, 28, 255)
+
+
+def panel_width(width: int, height: int) -> int:
+    """The HUD panel's width in pixels for a window of this size."""
+    return int(min(PANEL_WIDTH * gui_scale(height), PANEL_SHARE * width))
 
 
 @dataclass(frozen=True)
 class Knob:
-    """A slider's parameter, its range, and how it is shown."""
+    """A slider's parameter, its range (in shown units), and how it is converted."""
 
     name: str
     label: str
     low: float
     high: float
-    shown: Callable[[float], str]
+    unit: str
+    to_shown: float = 1.0  # shown value = stored value * to_shown
 
 
 KNOBS = (
-    Knob("speed", "speed", 0.2, 3.0, lambda v: f"{v:.2f}x"),
-    Knob("target_angle", "target angle", 0.0, np.radians(80), lambda v: f"{np.degrees(v):.0f} deg"),
-    Knob("strength", "strength (kp)", 0.0, 100.0, lambda v: f"{v:.1f}"),
-    Knob(
-        "wave_amplitude",
-        "wave amplitude",
-        0.0,
-        np.radians(30),
-        lambda v: f"{np.degrees(v):.1f} deg",
-    ),
-    Knob("wave_frequency", "wave frequency", 0.0, 3.0, lambda v: f"{v:.2f} Hz"),
+    Knob("speed", "speed", 0.2, 3.0, "%.2fx"),
+    Knob("target_angle", "target angle", 0.0, 80.0, "%.0f deg", float(np.degrees(1.0))),
+    Knob("strength", "strength (kp)", 0.0, 100.0, "%.1f"),
+    Knob("wave_amplitude", "wave amplitude", 0.0, 30.0, "%.1f deg", float(np.degrees(1.0))),
+    Knob("wave_frequency", "wave frequency", 0.0, 3.0, "%.2f Hz"),
 )
-
-
-def _image(width: int, height: int, colour: tuple[int, int, int, int]) -> Any:
-    return pyglet.image.SolidColorImagePattern(colour).create_image(width, height)
+GAITS = ("cyclic", "coordinated")
 
 
 class Hud:
-    """Widgets and labels bound to a world's locomotion parameters."""
+    """The sandbox's panel, bound to a world's locomotion parameters."""
 
-    def __init__(self, window: pyglet.window.Window, world: Any):
+    def __init__(self, window: Any, world: Any, *, visible: bool = True):
         self.window = window
         self.world = world
-        self.visible = True
-        self.batch = pyglet.graphics.Batch()
-        self._keep: list[Any] = []  # labels pyglet would otherwise drop from the batch
-        self.frame = Frame(window, cell_size=32)
+        self.visible = visible
+        self.gui = Gui(window)
         self.creature: int | None = None
-        self._refreshing = False  # widgets being set from the world, not by the user
         self.tentacle: int | None = None  # None: all tentacles
-        top = window.height - 16
-        self.title = self._label(16, top, "", weight="bold")
-        self.selector = self._label(50, top - ROW, "")
-        self.previous = self._button(16, top - ROW - 6, "<", self._previous_tentacle)
-        self.next = self._button(PANEL_WIDTH - 40, top - ROW - 6, ">", self._next_tentacle)
-        self.sliders: dict[str, tuple[Slider, Any, Knob]] = {}
-        for i, knob in enumerate(KNOBS):
-            y = top - (i + 2) * ROW - 12
-            slider = Slider(
-                112,
-                y,
-                _image(120, 6, (90, 96, 104, 255)),
-                _image(10, 18, (60, 110, 200, 255)),
-                edge=5,
-                batch=self.batch,
-            )
-            slider.set_handler("on_change", self._changer(knob))
-            self.frame.add_widget(slider)
-            self._label(16, y + 2, knob.label)
-            value = self._label(PANEL_WIDTH - 4, y + 2, "", anchor_x="right")
-            self.sliders[knob.name] = (slider, value, knob)
-        y = top - (len(KNOBS) + 2) * ROW - 12
-        self.gait = ToggleButton(
-            120,
-            y,
-            _image(60, 20, (70, 140, 90, 255)),
-            _image(60, 20, (150, 110, 70, 255)),
-            batch=self.batch,
-        )
-        self.gait.set_handler("on_toggle", self._toggle_gait)
-        self.frame.add_widget(self.gait)
-        self._label(16, y + 4, "gait")
-        self.gait_value = self._label(190, y + 4, "")
-        self.stats = self._label(16, y - ROW, "", multiline=True, width=PANEL_WIDTH - 20)
-        self.actions = self._label(16, y - 4 * ROW, "", multiline=True, width=PANEL_WIDTH - 20)
-        self.background = pyglet.shapes.Rectangle(
-            0,
-            0,
-            PANEL_WIDTH,
-            window.height,
-            color=(245, 247, 250, 215),
-            batch=self.batch,
-            group=pyglet.graphics.Group(order=-1),
-        )
-
-    # -- building --------------------------------------------------------------------
-    def _label(self, x: int, y: int, text: str, **kwargs: Any) -> pyglet.text.Label:
-        anchor_y: Literal["top", "baseline"] = "top" if kwargs.get("multiline") else "baseline"
-        label = pyglet.text.Label(
-            text, x=x, y=y, font_size=10, color=TEXT, batch=self.batch, anchor_y=anchor_y, **kwargs
-        )
-        self._keep.append(label)
-        return label
-
-    def _button(self, x: int, y: int, text: str, action: Callable[[], None]) -> PushButton:
-        pressed, unpressed = (
-            _image(24, 20, (150, 160, 175, 255)),
-            _image(24, 20, (190, 198, 210, 255)),
-        )
-        button = PushButton(x, y, pressed, unpressed, batch=self.batch)
-        button.set_handler("on_release", lambda widget: action())
-        self.frame.add_widget(button)
-        self._label(x + 8, y + 5, text)
-        return button
+        self.stats: dict[str, float] = {}
+        self.values: dict[str, Any] = {}
+        self.sections: list[tuple[str, Callable[[Gui], None]]] = []  # (title, draw)
 
     # -- selection -------------------------------------------------------------------
     def select(self, creature: int | None, tentacle: int | None = None) -> None:
@@ -138,16 +74,17 @@ class Hud:
         self.creature, self.tentacle = creature, tentacle
         self.refresh()
 
+    @property
+    def title(self) -> str:
+        if self.creature is None:
+            return "click a creature to select it"
+        return str(self.world.component(self.creature, Creature).name)
+
     def _count(self) -> int:
         return len(self.world.component(self.creature, Creature).tentacles) if self.creature else 0
 
-    def _previous_tentacle(self) -> None:
-        self._step_tentacle(-1)
-
-    def _next_tentacle(self) -> None:
-        self._step_tentacle(1)
-
-    def _step_tentacle(self, step: int) -> None:
+    def step_tentacle(self, step: int) -> None:
+        """Select the next (+1) or previous (-1) tentacle, through "all"."""
         if self.creature is None:
             return
         choices: list[int | None] = [None, *range(self._count())]
@@ -155,70 +92,132 @@ class Hud:
         self.refresh()
 
     # -- editing ---------------------------------------------------------------------
-    def _changer(self, knob: Knob) -> Callable[[Slider, float], None]:
-        def changed(widget: Slider, value: float) -> None:
-            if not self._refreshing:
-                self.set_parameter(knob.name, knob.low + (knob.high - knob.low) * value / 100.0)
-
-        return changed
-
-    def set_parameter(self, name: str, value: float) -> None:
+    def set_parameter(self, name: str, value: float | str) -> None:
         """Apply a parameter to the selection through the locomotion API."""
         if self.creature is None:
             return
-        self.world.locomotion.set(self.creature, tentacle=self.tentacle, **{name: float(value)})
+        if name == "gait":
+            self.world.locomotion.set(self.creature, gait=str(value))
+        else:
+            self.world.locomotion.set(self.creature, tentacle=self.tentacle, **{name: float(value)})
         self.refresh()
 
-    def _toggle_gait(self, widget: ToggleButton, pressed: bool) -> None:
-        if self.creature is not None and not self._refreshing:
-            self.world.locomotion.set(self.creature, gait="coordinated" if pressed else "cyclic")
-            self.refresh()
-
     def refresh(self) -> None:
-        """Show the selection's current values."""
+        """Read the selection's current values from the world."""
         if self.creature is None:
-            self.title.text = "click a creature to select it"
-            self.selector.text = ""
+            self.values = {}
             return
-        creature = self.world.component(self.creature, Creature)
-        self.title.text = f"{creature.name}"
-        self.selector.text = (
-            "all tentacles" if self.tentacle is None else f"tentacle {self.tentacle}"
-        )
         values = self.world.locomotion.get(self.creature, self.tentacle or 0)
         if self.tentacle is None:
             values["speed"] = values["creature_speed"]
-        self._refreshing = True
-        try:
-            for slider, label, knob in self.sliders.values():
-                value = values[knob.name]
-                slider.value = float(
-                    np.clip(100 * (value - knob.low) / (knob.high - knob.low), 0, 100)
-                )
-                label.text = knob.shown(value)
-            self.gait.value = values["gait"] == "coordinated"
-        finally:
-            self._refreshing = False
-        self.gait_value.text = values["gait"]
+        self.values = values
 
     def update(self, stats: dict[str, float]) -> None:
-        """Refresh the live numbers."""
-        fps = f"fps {stats['fps']:.0f}   " if stats["fps"] > 0 else ""  # no display: no fps
-        self.stats.text = (
-            f"{fps}physics {stats['physics_ms']:.1f} ms\n"
-            f"sim {stats['sim_time']:.1f} s   real-time x{stats['rtf']:.2f}\n"
-            f"suckers attached {stats['attached']}"
-        )
-        if self.creature is not None:
-            actions = self.world.locomotion.actions(self.creature)
-            self.actions.text = "\n".join(f"t{k}: {a}" for k, a in enumerate(actions))
-        else:
-            self.actions.text = ""
+        """Keep the live numbers for the next draw."""
+        self.stats = dict(stats)
 
+    # -- drawing ---------------------------------------------------------------------
     def contains(self, x: float, y: float) -> bool:
-        """True when (x, y) is over the panel (clicks there are not for the world)."""
-        return self.visible and x < PANEL_WIDTH
+        """True when pyglet pixel (x, y) is over the panel (clicks there are not for the world)."""
+        return self.visible and x < self.width
 
-    def draw(self) -> None:
-        if self.visible:
-            self.batch.draw()
+    @property
+    def width(self) -> int:
+        """Pixels the panel covers on the left (0 when hidden)."""
+        return panel_width(self.window.width, self.window.height) if self.visible else 0
+
+    def draw(self) -> int:
+        """Build and draw the panel; return the GL draw calls it issued."""
+        if not self.visible:
+            self.gui.skip_frame()
+            return 0
+        gui = self.gui
+        gui.begin_frame()
+        imgui.set_next_window_pos((0.0, 0.0))
+        imgui.set_next_window_size((float(self.width), float(self.window.height)))
+        flags = imgui.WindowFlags_.no_move | imgui.WindowFlags_.no_resize
+        imgui.begin("ecs_tentacles", None, flags | imgui.WindowFlags_.no_collapse)
+        gui.window_rect("panel")
+        imgui.text(self.title)
+        gui.item("title")
+        own: list[tuple[str, Callable[[Gui], None]]] = [
+            ("Locomotion", self._locomotion),
+            ("Stats", self._stats),
+            ("Physics", self._physics),
+        ]
+        for name, build in [*own, *self.sections, ("Actions", self._actions)]:
+            opened = imgui.collapsing_header(
+                name, imgui.TreeNodeFlags_.default_open if name != "Actions" else 0
+            )
+            gui.item(name)
+            if opened:
+                build(gui)
+        imgui.end()
+        return gui.end_frame()
+
+    def _locomotion(self, gui: Gui) -> None:
+        if self.creature is None:
+            return
+        if imgui.arrow_button("##previous", imgui.Dir.left):
+            self.step_tentacle(-1)
+        gui.item("previous")
+        imgui.same_line()
+        if imgui.arrow_button("##next", imgui.Dir.right):
+            self.step_tentacle(1)
+        gui.item("next")
+        imgui.same_line()
+        imgui.text("all tentacles" if self.tentacle is None else f"tentacle {self.tentacle}")
+        gui.item("tentacle")
+        for knob in KNOBS:
+            imgui.text(knob.label)
+            gui.item(f"{knob.name} label")
+            imgui.set_next_item_width(-1.0)
+            shown = float(self.values[knob.name]) * knob.to_shown
+            changed, shown = imgui.slider_float(
+                f"##{knob.name}", shown, knob.low, knob.high, knob.unit
+            )
+            gui.item(knob.name)
+            if changed:
+                self.set_parameter(knob.name, shown / knob.to_shown)
+        imgui.text("gait")
+        gui.item("gait label")
+        for i, gait in enumerate(GAITS):
+            if i:
+                imgui.same_line()
+            if imgui.radio_button(gait, self.values["gait"] == gait):
+                self.set_parameter("gait", gait)
+            gui.item(f"gait {gait}")
+
+    def _stats(self, gui: Gui) -> None:
+        stats = self.stats
+        if stats.get("fps", 0.0) > 0:  # no display: no fps
+            imgui.text(f"fps {stats['fps']:.0f}")
+            gui.item("fps")
+        for name, text in (
+            ("physics ms", f"physics {stats.get('physics_ms', 0.0):.1f} ms"),
+            ("sim", f"sim {stats.get('sim_time', 0.0):.1f} s"),
+            ("rtf", f"real-time x{stats.get('rtf', 0.0):.2f}"),
+            ("attached", f"suckers attached {int(stats.get('attached', 0))}"),
+        ):
+            imgui.text(text)
+            gui.item(name)
+
+    def _physics(self, gui: Gui) -> None:
+        physics = self.world.physics
+        health = physics.health
+        for name, text in (
+            ("groups", f"groups {len(physics.groups)} on {physics.threads} threads"),
+            ("recoveries", f"recoveries {health.recoveries}   frozen {health.frozen}"),
+        ):
+            imgui.text(text)
+            gui.item(name)
+
+    def _actions(self, gui: Gui) -> None:
+        if self.creature is None:
+            return
+        for k, action in enumerate(self.world.locomotion.actions(self.creature)):
+            imgui.text(f"t{k}: {action}")
+            gui.item(f"action {k}")
+
+    def close(self) -> None:
+        self.gui.close()

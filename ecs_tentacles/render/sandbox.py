@@ -26,7 +26,7 @@ from tqdm import tqdm
 
 from ecs_tentacles.components import Creature, Goal, Transform
 from ecs_tentacles.render.camera import ray_sphere
-from ecs_tentacles.render.hud import PANEL_WIDTH, Hud
+from ecs_tentacles.render.hud import Hud
 from ecs_tentacles.render.output import VideoWriter, save_png
 from ecs_tentacles.render.renderer import Renderer
 from ecs_tentacles.systems.render import RenderSync
@@ -49,6 +49,7 @@ class Sandbox:
         headless: bool = False,
         seed: int | None = None,
         allow_systems: bool = False,
+        hud: bool = True,
     ):
         self.scene, self.seed, self.allow_systems = scene, seed, allow_systems
         self.headless = headless
@@ -56,9 +57,10 @@ class Sandbox:
             width, height, caption="ecs_tentacles", visible=not headless, vsync=False
         )
         self.world = World.from_scene(scene, seed=seed, allow_systems=allow_systems)
-        self.hud = Hud(self.window, self.world)
+        self.hud = Hud(self.window, self.world, visible=hud)
         self._attach_world()
         self.window.push_handlers(self)
+        self.window.push_handlers(self.hud.gui)  # the GUI sees every event first
         self.paused = False
         self.accumulator = 0.0
         self.video: VideoWriter | None = None
@@ -70,7 +72,7 @@ class Sandbox:
 
     def _attach_world(self) -> None:
         self.renderer = Renderer(self.world, self.window.width, self.window.height)
-        self.renderer.camera.shift_x = PANEL_WIDTH / 2 if self.hud.visible else 0.0
+        self.renderer.camera.shift_x = self.hud.width / 2
         self.world.add_system(RenderSync(self.renderer))
         self.renderer.frame_all()
         self.hud.world = self.world
@@ -227,6 +229,8 @@ class Sandbox:
 
     def on_key_press(self, symbol: int, modifiers: int) -> None:
         camera = self.renderer.camera
+        if self.hud.visible and self.hud.gui.wants_keyboard:
+            return  # typing into a text field
         if symbol == key.SPACE:
             self.paused = not self.paused
         elif symbol == key.PERIOD:
@@ -236,7 +240,7 @@ class Sandbox:
             self.reset()
         elif symbol == key.H:
             self.hud.visible = not self.hud.visible
-            self.renderer.camera.shift_x = PANEL_WIDTH / 2 if self.hud.visible else 0.0
+            self.renderer.camera.shift_x = self.hud.width / 2
         elif symbol == key.F and self.renderer.selected is not None:
             row = self.world.component(self.renderer.selected, Transform).row
             camera.follow = None if camera.follow == row else row
@@ -245,7 +249,7 @@ class Sandbox:
         elif symbol == key.C:
             print(f"view: {self.renderer.toggle_view()}")
         elif symbol == key.TAB:
-            self.hud._step_tentacle(-1 if modifiers & key.MOD_SHIFT else 1)
+            self.hud.step_tentacle(-1 if modifiers & key.MOD_SHIFT else 1)
         elif symbol == key.F12:
             print(f"saved {self.screenshot()}")
         elif symbol == key.V:
@@ -293,4 +297,6 @@ class Sandbox:
         if self.video is not None:
             self.video.abort()
         self.world.close()
+        self.window.switch_to()
+        self.hud.close()
         self.window.close()

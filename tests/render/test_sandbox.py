@@ -7,7 +7,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import pytest
 from numpy.testing import assert_allclose
 from PIL import Image
 from pyglet.event import EventDispatcher
@@ -70,30 +69,7 @@ def test_clicking_a_creature_selects_it(make_sandbox: Callable[..., Any]) -> Non
     centre = world.component(target, Transform).pos
     _click(sandbox, *sandbox.renderer.camera.project(centre[None])[0])
     assert sandbox.renderer.selected == target
-    assert sandbox.hud.title.text == "creature_2"
-
-
-def test_hud_slider_reaches_the_servo_gains(make_sandbox: Callable[..., Any]) -> None:
-    sandbox = make_sandbox("octopus")
-    world = sandbox.world
-    octo = world.creature("octopus")
-    slider, _, knob = sandbox.hud.sliders["strength"]
-    x = slider.x + slider._edge + 0.75 * (slider.width - 2 * slider._edge)
-    y = slider.y + slider.height / 2
-    _event(sandbox, "on_mouse_press", round(x), round(y), mouse.LEFT, 0)
-    _event(sandbox, "on_mouse_release", round(x), round(y), mouse.LEFT, 0)
-    kp = world.locomotion.get(octo, 0)["strength"]
-    assert 70 < slider.value < 85  # the knob jumped to where we clicked
-    assert kp == pytest.approx(knob.low + (knob.high - knob.low) * slider.value / 100, rel=1e-12)
-    assert [world.locomotion.get(octo, k)["strength"] for k in range(8)] == [kp] * 8  # "all"
-    sandbox.step(1)
-    model = world.physics.groups[0].model
-    actuator = model.actuator("t3/l00/curl").id
-    row = int(world.tentacles.first_link[3])
-    assert model.actuator_gainprm[actuator, 0] == pytest.approx(
-        kp * world.motors.gain[row], rel=1e-12
-    )
-    assert sandbox.hud.sliders["strength"][1].text == f"{kp:.1f}"
+    assert sandbox.hud.title == "creature_2"
 
 
 def _crowd(count: int) -> dict[str, Any]:
