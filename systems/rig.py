@@ -23,7 +23,7 @@ import numpy as np
 
 from ecs_tentacles.fur.bind import ControlTracks, control_values, make_bind, make_strands
 from ecs_tentacles.fur.dynamics import Strands
-from ecs_tentacles.fur.rig import Bind, Scratch, control_table, evaluate
+from ecs_tentacles.fur.rig import Bind, Scratch, control_table, evaluate, use_parallel
 from ecs_tentacles.fur.tracks import TrackSet
 from ecs_tentacles.fur.vectors import quat_matrices
 from ecs_tentacles.system import System
@@ -49,6 +49,10 @@ class Rig(System):
         # blocks of guides evaluated one after the other, so temporaries stay in cache
         self.blocks: list[tuple[slice, Bind]] = []
         self.scratch = Scratch()  # work buffers, shared by the blocks and kept
+        self.parallel = False  # numba's kernels on all cores (large furs only)
+        self.strand_normal = np.zeros((3, 0), dtype=np.float32)  # skin normals (3, m)
+        self.strand_control = np.zeros(0, dtype=np.int64)  # the strands' controls
+        self.strand_body = np.zeros(0, dtype=np.int64)  # the strands' bodies
 
     def rebind(self, world: World) -> None:
         """Re-read the bind pose, tracks and dynamic strands from the fur stores."""
@@ -62,6 +66,12 @@ class Rig(System):
         self.tracks = ControlTracks(TrackSet(fur.tracks))
         gravity = np.asarray(world.settings.gravity, dtype=np.float64)
         self.strands = make_strands(fur, gravity, world.settings.dt)
+        if self.strands is not None:  # the strands' skin normals and controls, gathered once
+            guides = self.strands.guides
+            self.strand_normal = np.ascontiguousarray(self.bind.normal[:, guides], np.float32)
+            self.strand_control = self.bind.control[guides]
+            self.strand_body = self.bind.body[guides]
+        self.parallel = use_parallel(n)
         self.version = fur.version
 
     def process(self, world: World, dt: float) -> None:
@@ -79,7 +89,14 @@ class Rig(System):
         position = world.transforms.pos[self.bodies]
         for rows, part in self.blocks:
             evaluate(
-                part, plan, rotation, position, fur.frames[rows], fur.curves[rows], self.scratch
+                part,
+                plan,
+                rotation,
+                position,
+                fur.frames[rows],
+                fur.curves[rows],
+                self.scratch,
+                self.parallel,
             )
         if self.strands is not None:
             self._dynamics(fur.frames, fur.curves, bind, rotation, dynamic)
@@ -96,6 +113,12 @@ class Rig(System):
         assert strands is not None
         turn = rotation.astype(np.float32)
         guides = strands.guides
+        if len(turn) == 1:
+            normal = turn[0] @ self.strand_normal
+        else:
+            normal = np.einsum("mij,jm->im", turn[self.strand_body], self.strand_normal)
+        if strands.step_kernel(curves, frames, normal, dynamic[self.strand_control], self.parallel):
+            return
         first = int(guides[0])
         contiguous = bool(guides[-1] - first == len(guides) - 1)
         for start in range(0, len(guides), STRAND_BLOCK):  # block by block, in cache
@@ -103,11 +126,6 @@ class Rig(System):
             rows = slice(first + start, first + cols.stop) if contiguous else guides[cols]
             rig = np.ascontiguousarray(curves[rows].transpose(1, 2, 0))
             root = frames[rows, 3].T
-            local_normal = bind.normal[:, rows]
-            if len(turn) == 1:
-                normal = turn[0] @ local_normal
-            else:
-                normal = np.einsum("mij,jm->im", turn[bind.body[rows]], local_normal)
-            weight = dynamic[bind.control[rows]]
-            blended = strands.step(rig, root, normal, weight, cols)
+            weight = dynamic[self.strand_control[cols]]
+            blended = strands.step(rig, root, normal[:, cols], weight, cols)
             curves[rows] = blended.transpose(2, 0, 1)
