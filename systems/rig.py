@@ -1,6 +1,7 @@
 """rig: fur guides posed from creature poses and control values (the fur/feather thesis).
 
-Each frame: keyframed control tracks are written at `world.time`; every guide's
+Each frame: keyframed control tracks are written at `world.time` (or at `track_time`,
+which the sandbox's timeline sets while it scrubs; not while `play_tracks` is off); every guide's
 frame is evaluated from its bind pose and its control's effective values (lift, aim,
 direction, random twist, the emotion system's drive added) as whole-array math; the
 guides' rest shapes are posed in world space by the mantle's Transform; guides of
@@ -50,6 +51,8 @@ class Rig(System):
         self.blocks: list[tuple[slice, Bind]] = []
         self.scratch = Scratch()  # work buffers, shared by the blocks and kept
         self.parallel = False  # numba's kernels on all cores (large furs only)
+        self.track_time: float | None = None  # tracks played at this time, not the world's
+        self.play_tracks = True  # False: the tool holds an edit until time moves again
         self.strand_normal = np.zeros((3, 0), dtype=np.float32)  # skin normals (3, m)
         self.strand_control = np.zeros(0, dtype=np.int64)  # the strands' controls
         self.strand_body = np.zeros(0, dtype=np.int64)  # the strands' bodies
@@ -82,7 +85,9 @@ class Rig(System):
             self.rebind(world)
         bind = self.bind
         assert bind is not None
-        self.tracks.apply(fur.controls, world.time)
+        if self.play_tracks:
+            time = world.time if self.track_time is None else self.track_time
+            self.tracks.apply(fur.controls, time)
         values, dynamic = control_values(fur)
         plan = control_table(values)  # per-control values and skips, once a frame
         rotation = quat_matrices(world.transforms.quat[self.bodies])

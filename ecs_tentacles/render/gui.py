@@ -52,6 +52,18 @@ def gui_scale(height: int) -> float:
     return min(1.5, max(0.7, height / BASE_HEIGHT))
 
 
+def same_line_if_fits(width: float) -> None:
+    """Continue the row when an item `width` pixels wide still fits, else start a new one."""
+    imgui.same_line()
+    if imgui.get_content_region_avail().x < width:
+        imgui.new_line()
+
+
+def text_width(label: str) -> float:
+    """Pixels a button or radio button labelled `label` needs (frame padding included)."""
+    return float(imgui.calc_text_size(label).x + 2 * imgui.get_frame_height())
+
+
 class Gui:
     """One ImGui context bound to a pyglet window; draws into the current framebuffer."""
 
@@ -73,6 +85,7 @@ class Gui:
         self._last = time.perf_counter()
         self._in_frame = False
         self.draw_commands = 0
+        self.frames = 0  # frames built so far
 
     # -- events: pyglet -> ImGui -------------------------------------------------------
     def _use(self) -> Any:
@@ -152,9 +165,13 @@ class Gui:
         pos, size = imgui.get_window_pos(), imgui.get_window_size()
         self.windows[name] = (pos.x, pos.y, pos.x + size.x, pos.y + size.y)
 
-    def end_frame(self) -> int:
+    def end_frame(self, draw: bool = True) -> int:
         """Draw the frame into the bound framebuffer; return the GL draw calls issued."""
         imgui.render()
+        self.frames += 1
+        if not draw:
+            self._in_frame = False
+            return 0
         data = imgui.get_draw_data()
         self.draw_commands = sum(
             data.cmd_lists[i].cmd_buffer.size() for i in range(data.cmd_lists_count)

@@ -20,7 +20,7 @@ import numpy as np
 from imgui_bundle import imgui
 
 from ecs_tentacles.components import Creature
-from ecs_tentacles.render.gui import Gui, gui_scale
+from ecs_tentacles.render.gui import Gui, gui_scale, same_line_if_fits, text_width
 
 PANEL_WIDTH = 300  # the panel's width at scale 1 (the creator still uses it as is)
 PANEL_SHARE = 0.4  # the panel never covers more than this share of the window's width
@@ -67,6 +67,7 @@ class Hud:
         self.stats: dict[str, float] = {}
         self.values: dict[str, Any] = {}
         self.sections: list[tuple[str, Callable[[Gui], None]]] = []  # (title, draw)
+        self.windows: list[Callable[[Gui], None]] = []  # more ImGui windows (the timeline)
 
     # -- selection -------------------------------------------------------------------
     def select(self, creature: int | None, tentacle: int | None = None) -> None:
@@ -119,7 +120,7 @@ class Hud:
     # -- drawing ---------------------------------------------------------------------
     def contains(self, x: float, y: float) -> bool:
         """True when pyglet pixel (x, y) is over the panel (clicks there are not for the world)."""
-        return self.visible and x < self.width
+        return self.visible and (x < self.width or self.gui.contains(x, y))
 
     @property
     def width(self) -> int:
@@ -131,6 +132,13 @@ class Hud:
         if not self.visible:
             self.gui.skip_frame()
             return 0
+        if not self.gui.frames:  # windows that fit their content know their size from frame 2
+            self._build()
+            self.gui.end_frame(draw=False)
+        self._build()
+        return self.gui.end_frame()
+
+    def _build(self) -> None:
         gui = self.gui
         gui.begin_frame()
         imgui.set_next_window_pos((0.0, 0.0))
@@ -153,7 +161,8 @@ class Hud:
             if opened:
                 build(gui)
         imgui.end()
-        return gui.end_frame()
+        for window in self.windows:
+            window(gui)
 
     def _locomotion(self, gui: Gui) -> None:
         if self.creature is None:
@@ -183,7 +192,7 @@ class Hud:
         gui.item("gait label")
         for i, gait in enumerate(GAITS):
             if i:
-                imgui.same_line()
+                same_line_if_fits(text_width(gait))
             if imgui.radio_button(gait, self.values["gait"] == gait):
                 self.set_parameter("gait", gait)
             gui.item(f"gait {gait}")

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import colorsys
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 from pyglet import gl
@@ -30,6 +31,7 @@ from ecs_tentacles.render.gpu import (
     program,
     set_matrix,
 )
+from ecs_tentacles.render.markers import marker_lines
 from ecs_tentacles.render.meshes import CAPSULE_LODS, CYLINDER_LOD, SPHERE_LOD
 from ecs_tentacles.render.skinned import SkinnedCreatures
 from ecs_tentacles.world import World
@@ -77,6 +79,7 @@ class Renderer:
         self.selected: int | None = None  # creature entity
         self.draw_calls = 0
         self.extra_lines: list[Callable[[World], np.ndarray]] = []  # -> (2n, 7) segments
+        self.fur_display = FurDisplay()
         self.set_world(world)
 
     def set_world(self, world: World) -> None:
@@ -218,7 +221,9 @@ class Renderer:
             ring = pos[row] * [1, 1, 0] + [0, 0, 0.01] + creature.mantle_radius * 1.6 * CIRCLE
             segments.append(_segments(ring, np.array([1.0, 1.0, 1.0, 1.0])))
         if len(self.world.fur.guides):
-            segments.append(fur_lines(self.world))
+            segments.append(fur_lines(self.world, self.fur_display))
+            if self.fur_display.markers:
+                segments.append(marker_lines(self.world, self.fur_display.selected_control))
         for provider in self.extra_lines:
             segments.append(provider(self.world))
         return np.vstack(segments).astype(np.float32)
@@ -274,10 +279,31 @@ class Renderer:
         self.camera.frame(np.vstack(points), margin=1.0)
 
 
-def fur_lines(world: World) -> np.ndarray:
-    """Line-list vertices of every fur guide and its child hairs (one pass each)."""
+@dataclass
+class FurDisplay:
+    """How fur is drawn: colour by fur or by control, guides and/or child hairs."""
+
+    colour_by: str = "fur"
+    guides: bool = True
+    children: bool = True
+    per_guide: int | None = None  # child hairs per guide; None: each fur's `children`
+    markers: bool = False  # the controls' shapes (the fur tool shows them)
+    selected_control: int | None = None  # a control entity, drawn highlighted
+
+
+def fur_lines(world: World, display: FurDisplay | None = None) -> np.ndarray:
+    """Line-list vertices of the fur guides and their child hairs (one pass each)."""
+    display = FurDisplay() if display is None else display
+    kinds = []
+    if display.guides:
+        kinds.append(guide_curves(world, display.colour_by))
+    if display.children:
+        dense = child_hairs(world, display.per_guide)
+        if display.colour_by == "control":
+            dense.colour = guide_curves(world, "control").colour[dense.guide]
+        kinds.append(dense)
     parts = []
-    for curves in (guide_curves(world), child_hairs(world)):
+    for curves in kinds:
         points, colour = curves.points, curves.colour
         if not len(points):
             continue

@@ -26,6 +26,7 @@ from tqdm import tqdm
 
 from ecs_tentacles.components import Creature, Goal, Transform
 from ecs_tentacles.render.camera import ray_sphere
+from ecs_tentacles.render.furpanel import FurPanel
 from ecs_tentacles.render.hud import Hud
 from ecs_tentacles.render.output import VideoWriter, save_png
 from ecs_tentacles.render.renderer import Renderer
@@ -58,10 +59,13 @@ class Sandbox:
         )
         self.world = World.from_scene(scene, seed=seed, allow_systems=allow_systems)
         self.hud = Hud(self.window, self.world, visible=hud)
+        self.paused = False
+        self.fur: FurPanel | None = None
         self._attach_world()
+        if self.world.scene is not None and any("fur" in c for c in self.world.scene["creatures"]):
+            self.open_fur_tool()
         self.window.push_handlers(self)
         self.window.push_handlers(self.hud.gui)  # the GUI sees every event first
-        self.paused = False
         self.accumulator = 0.0
         self.video: VideoWriter | None = None
         self.screenshots = 0
@@ -78,6 +82,32 @@ class Sandbox:
         self.hud.world = self.world
         first = self.renderer.creature_entities[0] if self.renderer.creature_entities else None
         self.select(first)
+
+    def open_fur_tool(self) -> FurPanel:
+        """The fur panel (a HUD section) and the timeline (a window at the bottom)."""
+        from ecs_tentacles.render.timeline import Timeline
+
+        self.fur = FurPanel(self)
+        self.timeline = Timeline(self, self.fur)
+        self.hud.sections.append(("Fur", self.fur.draw))
+        self.hud.windows.append(lambda gui: self.timeline.draw(gui, self.hud.width))
+        self.fur.select_creature(self.renderer.selected)
+        return self.fur
+
+    def rebuild(self, scene: dict[str, Any]) -> World:
+        """Rebuild the world from an edited scene; the camera and the selection stay."""
+        selected = self.renderer.selected
+        name = None if selected is None else self.world.component(selected, Creature).name
+        self.world.close()
+        self.scene = scene
+        self.world = World.from_scene(scene, seed=self.seed, allow_systems=self.allow_systems)
+        self.renderer.set_world(self.world)
+        self.world.add_system(RenderSync(self.renderer))
+        self.hud.world = self.world
+        if self.fur is not None:
+            self.fur.editor.attach(self.world)
+        self.select(self.world.creature(name) if name is not None else None)
+        return self.world
 
     # -- simulation --------------------------------------------------------------------
     def step(self, frames: int = 1) -> None:
@@ -97,10 +127,13 @@ class Sandbox:
             self.accumulator -= frame
 
     def reset(self) -> None:
-        """Rebuild the scene from its file."""
+        """Rebuild the scene from its file (or the fur tool's edited scene)."""
         self.world.close()
         self.world = World.from_scene(self.scene, seed=self.seed, allow_systems=self.allow_systems)
         self._attach_world()
+        if self.fur is not None:
+            self.fur.editor.attach(self.world)
+            self.fur.sync_view()
 
     # -- drawing -----------------------------------------------------------------------
     def render(self) -> np.ndarray | None:
@@ -157,6 +190,8 @@ class Sandbox:
     def select(self, creature: int | None) -> None:
         self.renderer.selected = creature
         self.hud.select(creature)
+        if self.fur is not None:
+            self.fur.select_creature(creature)
 
     def pick_creature(self, x: float, y: float) -> int | None:
         """The creature whose mantle is under pixel (x, y), nearest first."""
@@ -206,8 +241,13 @@ class Sandbox:
     # -- window events -------------------------------------------------------------------
     def on_mouse_press(self, x: int, y: int, button: int, modifiers: int) -> None:
         self._press = (x, y) if not self.hud.contains(x, y) else None
+        if self._press is not None and button == mouse.LEFT and self.fur is not None:
+            if self.fur.press(x, y):  # a control's marker: drag it over the body
+                self._press = None
 
     def on_mouse_release(self, x: int, y: int, button: int, modifiers: int) -> None:
+        if self.fur is not None:
+            self.fur.release()
         if (
             self._press is not None
             and np.hypot(x - self._press[0], y - self._press[1]) < CLICK_PIXELS
@@ -216,6 +256,9 @@ class Sandbox:
         self._press = None
 
     def on_mouse_drag(self, x: int, y: int, dx: int, dy: int, buttons: int, modifiers: int) -> None:
+        if self.fur is not None and self.fur.dragging:
+            self.fur.drag(x, y)
+            return
         if self._press is None:
             return
         if buttons & mouse.LEFT:

@@ -10,28 +10,11 @@ from typing import Any
 import numpy as np
 import pytest
 from PIL import Image
-from pyglet.event import EventDispatcher
-from pyglet.window import key, mouse
+from pyglet.window import key
 
 from ecs_tentacles.cli import main
 from ecs_tentacles.render.hud import PANEL_SHARE, panel_width
-
-
-def event(sandbox: Any, name: str, *args: Any) -> None:
-    """Deliver a window event now (a window queues events outside its own loop)."""
-    EventDispatcher.dispatch_event(sandbox.window, name, *args)
-
-
-def click_gui(sandbox: Any, x: float, top: float) -> None:
-    """Press and release at (x, top) in GUI pixels (from the top left), drawing between."""
-    y = round(sandbox.window.height - top)
-    event(sandbox, "on_mouse_motion", round(x), y, 0, 0)
-    sandbox.render()
-    event(sandbox, "on_mouse_press", round(x), y, mouse.LEFT, 0)
-    sandbox.render()
-    event(sandbox, "on_mouse_release", round(x), y, mouse.LEFT, 0)
-    sandbox.render()
-    sandbox.render()
+from tests.render.conftest import click_gui, event
 
 
 def overlaps(rects: dict[str, tuple[float, float, float, float]]) -> list[tuple[str, str]]:
@@ -57,7 +40,14 @@ def test_widgets_never_overlap_and_fit_the_panel(
     x0, y0, x1, y1 = sandbox.hud.gui.windows["panel"]
     assert (x0, y0, x1, y1) == (0, 0, panel_width(*size), size[1])
     assert x1 <= PANEL_SHARE * size[0]
-    assert all(r[2] <= x1 for r in rects.values())  # nothing spills out sideways
+    windows = sandbox.hud.gui.windows
+    assert set(windows) == {"panel", "timeline"}  # hedgehog_octopus has fur: the fur tool
+    assert overlaps(windows) == []
+
+    def inside(r: tuple[float, ...], w: tuple[float, ...]) -> bool:
+        return w[0] <= r[0] and r[2] <= w[2] and w[1] <= r[1]
+
+    assert [n for n, r in rects.items() if not any(inside(r, w) for w in windows.values())] == []
 
 
 def test_panel_and_text_scale_with_the_window(make_sandbox: Callable[..., Any]) -> None:
