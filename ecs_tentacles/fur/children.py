@@ -125,13 +125,27 @@ def _nearest(
     return out_rows, out_weights
 
 
-def interpolated_children(world: World, children: ChildLayout) -> np.ndarray:
-    """The children's world polylines (m, points, 3) float32, for this frame's guides."""
+def point_indices(points: int, keep: int | None) -> np.ndarray:
+    """`keep` of a curve's `points` indices, evenly spread, root and tip kept (all: None)."""
+    if keep is None or keep >= points:
+        return np.arange(points)
+    return np.unique(np.round(np.linspace(0, points - 1, max(keep, 2))).astype(np.int64))
+
+
+def interpolated_children(
+    world: World, children: ChildLayout, keep: int | None = None
+) -> np.ndarray:
+    """The children's world polylines (m, points, 3) float32, for this frame's guides.
+
+    `keep`: that many points per child (evenly picked along the guides; fewer points
+    draw faster, the sandbox's level of detail), else all of them.
+    """
     fur = world.fur
+    picked = point_indices(fur.points, keep)
     if not len(children.parent):
-        return np.zeros((0, fur.points, 3), np.float32)
-    curves, roots = fur.curves, fur.frames[:, 3]
-    offsets = np.zeros((len(children.parent), fur.points, 3), np.float32)
+        return np.zeros((0, len(picked), 3), np.float32)
+    curves, roots = fur.curves[:, picked], fur.frames[:, 3]
+    offsets = np.zeros((len(children.parent), len(picked), 3), np.float32)
     for i in range(NEIGHBOURS):
         rows = children.neighbours[:, i]
         weight = (children.weights[:, i] * children.scale).astype(np.float32)

@@ -58,6 +58,7 @@ def child_hairs(
     radius: float | None = None,
     seed: int = 0,
     follow: str = "neighbours",
+    points: int | None = None,
 ) -> GuideCurves:
     """Child hairs around each guide, for visual density (deterministic for `seed`).
 
@@ -66,15 +67,16 @@ def child_hairs(
     `follow="own"`: each child takes its guide's posed curve, moved to a root scattered
     in the skin's tangent plane within `radius` (default: half the guide's length) and
     scaled in length by 0.7-1.0. Either way children follow every rig behaviour and
-    the dynamics. `per_guide` defaults to each fur's `children`.
+    the dynamics. `per_guide` defaults to each fur's `children`; `points`: that many
+    points per child, picked evenly along the curve (default: all).
     """
     if follow == "neighbours":
         made = children.layout(world, per_guide, seed)
         base = guide_curves(world)
         colour = base.colour[made.parent].copy()
         colour[:, :3] *= made.jitter[:, None].astype(np.float32)
-        points = children.interpolated_children(world, made)
-        return GuideCurves(points, colour, base.width[made.parent] * 0.5, made.parent)
+        curves = children.interpolated_children(world, made, points)
+        return GuideCurves(curves, colour, base.width[made.parent] * 0.5, made.parent)
     if follow != "own":
         raise ValueError(f"follow must be 'neighbours' or 'own', got {follow!r}")
     fur = world.fur
@@ -94,9 +96,10 @@ def child_hairs(
     offset = reach[:, None] * (np.cos(angle)[:, None] * side + np.sin(angle)[:, None] * along)
     scale = rng.uniform(0.7, 1.0, m)[:, None, None]
     root = curves[:, :1]
-    points = (root + offset[:, None, :] + scale * (curves - root)).astype(np.float32)
+    dense = (root + offset[:, None, :] + scale * (curves - root)).astype(np.float32)
+    dense = dense[:, children.point_indices(fur.points, points)]
     base = guide_curves(world)
-    return GuideCurves(points, base.colour[parent], base.width[parent] * 0.5, parent)
+    return GuideCurves(dense, base.colour[parent], base.width[parent] * 0.5, parent)
 
 
 @dataclass

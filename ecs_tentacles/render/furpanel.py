@@ -273,6 +273,10 @@ class FurPanel:
         gui.item("guides")
         display.children = imgui.checkbox("child hairs", display.children)[1]
         gui.item("child hairs")
+        changed, alone = imgui.checkbox("own guide only", display.follow == "own")
+        gui.item("follow own")
+        if changed:
+            display.follow = "own" if alone else "neighbours"
         world = self.sandbox.world
         own = int(world.fur.sets.children.max()) if len(world.fur.sets) else 0
         per_guide = own if display.per_guide is None else display.per_guide

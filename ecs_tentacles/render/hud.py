@@ -68,6 +68,9 @@ class Hud:
         self.values: dict[str, Any] = {}
         self.sections: list[tuple[str, Callable[[Gui], None]]] = []  # (title, draw)
         self.windows: list[Callable[[Gui], None]] = []  # more ImGui windows (the timeline)
+        self._fold: set[str] = set()  # sections to close on the next frame
+        self.name_labels = False  # creatures' names over them (even with the panel hidden)
+        self.label_at: Callable[[], list[tuple[str, float, float]]] = list  # (text, x, y)
 
     # -- selection -------------------------------------------------------------------
     def select(self, creature: int | None, tentacle: int | None = None) -> None:
@@ -118,6 +121,10 @@ class Hud:
         self.stats = dict(stats)
 
     # -- drawing ---------------------------------------------------------------------
+    def fold(self, *sections: str) -> None:
+        """Close these sections (as a click on their headers would)."""
+        self._fold.update(sections)
+
     def contains(self, x: float, y: float) -> bool:
         """True when pyglet pixel (x, y) is over the panel (clicks there are not for the world)."""
         return self.visible and (x < self.width or self.gui.contains(x, y))
@@ -129,7 +136,7 @@ class Hud:
 
     def draw(self) -> int:
         """Build and draw the panel; return the GL draw calls it issued."""
-        if not self.visible:
+        if not self.visible and not self.name_labels:
             self.gui.skip_frame()
             return 0
         if not self.gui.frames:  # windows that fit their content know their size from frame 2
@@ -141,6 +148,10 @@ class Hud:
     def _build(self) -> None:
         gui = self.gui
         gui.begin_frame()
+        if self.name_labels:
+            self._name_labels()
+        if not self.visible:
+            return
         imgui.set_next_window_pos((0.0, 0.0))
         imgui.set_next_window_size((float(self.width), float(self.window.height)))
         flags = imgui.WindowFlags_.no_move | imgui.WindowFlags_.no_resize
@@ -154,6 +165,9 @@ class Hud:
             ("Physics", self._physics),
         ]
         for name, build in [*own, *self.sections, ("Actions", self._actions)]:
+            if name in self._fold:
+                imgui.set_next_item_open(False)
+                self._fold.discard(name)
             opened = imgui.collapsing_header(
                 name, imgui.TreeNodeFlags_.default_open if name != "Actions" else 0
             )
@@ -163,6 +177,19 @@ class Hud:
         imgui.end()
         for window in self.windows:
             window(gui)
+
+    def _name_labels(self) -> None:
+        """Each `label_at` text centred at its pixel (pyglet's y), on a dark plate."""
+        draw = imgui.get_foreground_draw_list()
+        pad = 4.0 * self.gui.scale
+        for text, x, y in self.label_at():
+            size = imgui.calc_text_size(text)
+            left, top = x - size.x / 2, self.window.height - y - size.y / 2
+            plate = imgui.get_color_u32((0.1, 0.1, 0.12, 0.75))
+            draw.add_rect_filled(
+                (left - pad, top - pad), (left + size.x + pad, top + size.y + pad), plate, pad
+            )
+            draw.add_text((left, top), imgui.get_color_u32((1.0, 1.0, 1.0, 1.0)), text)
 
     def _locomotion(self, gui: Gui) -> None:
         if self.creature is None:

@@ -59,6 +59,7 @@ class Sandbox:
         )
         self.world = World.from_scene(scene, seed=seed, allow_systems=allow_systems)
         self.hud = Hud(self.window, self.world, visible=hud)
+        self.hud.label_at = self.creature_labels
         self.paused = False
         self.fur: FurPanel | None = None
         self._attach_world()
@@ -139,6 +140,7 @@ class Sandbox:
     def render(self) -> np.ndarray | None:
         """Draw the world and the HUD off-screen; return the picture if recording."""
         alpha = 1.0 if self.paused else self.accumulator / self.world.settings.dt
+        self.renderer.fur_display.markers = self.fur is not None and self.hud.visible
         self.renderer.draw(alpha)
         self._update_stats()
         gl.glDisable(gl.GL_DEPTH_TEST)
@@ -166,6 +168,17 @@ class Sandbox:
         self.stats["rtf"] = self.world.time / wall if wall > 0 else 0.0
         self.stats["attached"] = int(self.world.suckers.attached.sum())
         self.hud.update(self.stats)
+
+    def creature_labels(self) -> list[tuple[str, float, float]]:
+        """Each creature's name at the pixel above its mantle (for `hud.name_labels`)."""
+        rows = self.renderer.mantle_rows
+        if not len(rows):
+            return []
+        tops = self.world.transforms.pos[rows].copy()
+        names = [self.world.component(e, Creature) for e in self.renderer.creature_entities]
+        tops[:, 2] += [c.mantle_height * 1.8 + 0.05 for c in names]
+        pixels = self.renderer.camera.project(tops)
+        return [(c.name, float(x), float(y)) for c, (x, y) in zip(names, pixels, strict=True)]
 
     def screenshot(self, path: str | os.PathLike[str] | None = None) -> Path:
         """Save what the camera sees (with the HUD) as a PNG."""
