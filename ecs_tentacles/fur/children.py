@@ -63,11 +63,17 @@ def layout(world: World, per_guide: int | None = None, seed: int = 0) -> ChildLa
     return made
 
 
+def parents(fur: FurData, per_guide: int | None) -> np.ndarray:
+    """The guide row of every child: `per_guide` each, default each fur's `children`."""
+    g = fur.guides
+    counts = fur.sets.children[g.fur_row] if per_guide is None else np.full(len(g), per_guide)
+    return np.repeat(np.arange(len(g)), counts)
+
+
 def _make_layout(world: World, per_guide: int | None, seed: int) -> ChildLayout:
     fur = world.fur
     g = fur.guides
-    counts = fur.sets.children[g.fur_row] if per_guide is None else np.full(len(g), per_guide)
-    parent = np.repeat(np.arange(len(g)), counts)
+    parent = parents(fur, per_guide)
     rng = np.random.default_rng(seed)
     m = len(parent)
     angle = rng.uniform(0.0, 2.0 * np.pi, m)

@@ -71,8 +71,9 @@ class Strands:
         if k is None:
             return False
         pos, prev, fresh = self._state()
-        with rig_math.kernel_lock(parallel):
-            rig_math.kernel(k, "strands", parallel)(
+        step, lock = rig_math.kernel(k, "strands", parallel)
+        with lock:
+            step(
                 pos, prev, fresh, curves, frames, self.guides, normal, weight,
                 self.keep, self.pull, self.gravity, self.segment, self.profile.reshape(-1),
             )  # fmt: skip

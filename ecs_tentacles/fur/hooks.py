@@ -81,8 +81,7 @@ def child_hairs(
         raise ValueError(f"follow must be 'neighbours' or 'own', got {follow!r}")
     fur = world.fur
     g = fur.guides
-    counts = fur.sets.children[g.fur_row] if per_guide is None else np.full(len(g), per_guide)
-    parent = np.repeat(np.arange(len(g)), counts)
+    parent = children.parents(fur, per_guide)
     rng = np.random.default_rng(seed)
     m = len(parent)
     curves = fur.curves[parent].astype(np.float64)

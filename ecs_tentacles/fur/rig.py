@@ -40,6 +40,7 @@ import contextlib
 import importlib
 import os
 import threading
+from contextlib import AbstractContextManager
 from dataclasses import dataclass
 from types import ModuleType
 from typing import Any
@@ -273,9 +274,7 @@ def kernels() -> ModuleType | None:
     return _kernels if isinstance(_kernels, ModuleType) else None
 
 
-# Guides from which the parallel kernels pay (tools/bench_rig.py on 2 cores: below it
-# the serial kernels were as fast, and the pool's spinning threads slow the physics).
-PARALLEL_GUIDES = 20_000
+PARALLEL_GUIDES = 20_000  # below, serial kernels were as fast (tools/bench_rig.py, 2 cores)
 
 
 def use_parallel(guides: int) -> bool:
@@ -283,19 +282,13 @@ def use_parallel(guides: int) -> bool:
     return guides >= PARALLEL_GUIDES
 
 
-# numba's threading layers do not all promise thread safety: worlds stepped on
-# several threads take turns in the parallel kernels (the serial ones need no lock)
-_KERNEL_LOCK = threading.Lock()
+_KERNEL_LOCK = threading.Lock()  # numba's pool is not documented as safe to share
 
 
-def kernel_lock(parallel: bool) -> threading.Lock | contextlib.nullcontext[None]:
-    """The lock a kernel call takes: numba's pool for parallel kernels, none for serial."""
-    return _KERNEL_LOCK if parallel else contextlib.nullcontext()
-
-
-def kernel(k: ModuleType, name: str, parallel: bool) -> Any:
-    """Kernel `name` of module `k`, compiled for all cores or serial."""
-    return getattr(k, name if parallel else f"{name}_serial")
+def kernel(k: ModuleType, name: str, parallel: bool) -> tuple[Any, AbstractContextManager[Any]]:
+    """Kernel `name` of `k` for all cores or serial, and the lock a call takes (parallel)."""
+    lock = _KERNEL_LOCK if parallel else contextlib.nullcontext()
+    return getattr(k, name if parallel else f"{name}_serial"), lock
 
 
 NO_LOCAL = np.empty((4, 3, 0), dtype=F32)
@@ -316,11 +309,12 @@ def _kernel_frames(
     parallel: bool,
 ) -> None:
     """The numba passes (blend, whole-array trigonometry, frames): see `kernels`."""
-    with kernel_lock(parallel):
+    blend, lock = kernel(k, "blend", parallel)
+    with lock:
         s.use(len(bind))
         axis, flat, unlift, angle = s("k_axis", 3), s("k_flat"), s("k_unlift"), s("k_angle")
         normalise = (plan.aiming or plan.directing) and not plan.lifting
-        kernel(k, "blend", parallel)(
+        blend(
             bind.control, plan.table, bind.rest_cos, bind.rest_sin, bind.tan_min, bind.multiplier,
             bind.basis, bind.root, normalise, axis, flat, unlift, angle,
         )  # fmt: skip
@@ -335,7 +329,7 @@ def _kernel_frames(
         if plan.twisting:
             np.cos(angle, out=twist_cos)
             np.sin(angle, out=twist_sin)
-        kernel(k, "frames", parallel)(
+        kernel(k, "frames", parallel)[0](
             axis, flat, polar_sin, polar_cos, twist_cos, twist_sin, plan.lifting,
             plan.twisting, bind.basis, bind.root, bind.body, rotation, position, local, world,
             bind.shape_h, curves,
@@ -448,7 +442,7 @@ def pose(shape_h: np.ndarray, frames: np.ndarray, out: np.ndarray) -> np.ndarray
     k = kernels()
     if k is None:
         return np.matmul(shape_h, frames, out=out)
-    many = use_parallel(len(shape_h))
-    with kernel_lock(many):
-        kernel(k, "pose", many)(shape_h, frames, out)
+    run, lock = kernel(k, "pose", use_parallel(len(shape_h)))
+    with lock:
+        run(shape_h, frames, out)
     return out
