@@ -5,7 +5,8 @@
     python tools/bench_render.py --only fur_1k     # 1,000 guides x 10 children as ribbons
 
 `draw` ends with glFinish, so it includes the rasterising (llvmpipe on a machine
-without a GPU). Medians over the measured frames, after a warm-up.
+without a GPU); `strands` is the fur's part of it (guides and child hairs as lit
+ribbons, drawn again alone). Medians over the measured frames, after a warm-up.
 """
 
 from __future__ import annotations
@@ -51,7 +52,7 @@ def bench(scene: Any, name: str, frames: int, width: int, height: int) -> dict[s
     renderer = sandbox.renderer
     renderer.camera.shift_x = 0.0
     sandbox.step(30)
-    timings: dict[str, list[float]] = {"simulate": [], "upload": [], "draw": []}
+    timings: dict[str, list[float]] = {"simulate": [], "upload": [], "draw": [], "strands": []}
     for _ in range(frames):
         start = time.perf_counter()
         sandbox.step(1)
@@ -64,6 +65,11 @@ def bench(scene: Any, name: str, frames: int, width: int, height: int) -> dict[s
         timings["simulate"].append(simulated - start)
         timings["upload"].append(uploaded - simulated)
         timings["draw"].append(drawn - uploaded - (uploaded - simulated))
+        renderer.target.bind()
+        start = time.perf_counter()
+        renderer.draw_strands()
+        gl.glFinish()
+        timings["strands"].append(time.perf_counter() - start)
     stats = {k: round(1000 * statistics.median(v), 3) for k, v in timings.items()}
     result = {
         "scene": name,
@@ -105,7 +111,7 @@ def main() -> None:
             f" {row['strands']} strands, {row['width']}x{row['height']},"
             f" {row['draw_calls']} draw calls):"
             f" simulate {ms['simulate']:.2f} ms, upload {ms['upload']:.2f} ms,"
-            f" draw {ms['draw']:.2f} ms"
+            f" draw {ms['draw']:.2f} ms (strands {ms['strands']:.2f} ms)"
         )
 
 

@@ -271,19 +271,19 @@ class Renderer:
         gl.glLineWidth(1.0)
         calls += self.lines.draw()
         if self.guide_ribbons.count or self.child_ribbons.count:
-            calls += self._draw_ribbons(view_projection, eye)
+            calls += self.draw_strands()
         gl.glBindVertexArray(0)
         gl.glUseProgram(0)
         self.draw_calls = calls
         return calls
 
-    def _draw_ribbons(self, view_projection: np.ndarray, eye: tuple[float, ...]) -> int:
-        """Guides and child hairs: one draw each, both faces (a ribbon has no back)."""
+    def draw_strands(self) -> int:
+        """Guides and child hairs as uploaded: one draw each, both faces (ribbons)."""
         prog = self.ribbon_program
         prog.use()
-        set_matrix(prog, "u_view_projection", view_projection)
+        set_matrix(prog, "u_view_projection", self.camera.view_projection())
         prog["u_light"] = tuple(LIGHT.astype(np.float32))
-        prog["u_eye"] = eye
+        prog["u_eye"] = tuple(self.camera.eye.astype(np.float32))
         pixel = 2.0 * np.tan(self.camera.fov_y / 2) * self.camera.distance / self.target.height
         prog["u_min_width"] = float(0.8 * pixel)  # about a pixel at the target's distance
         gl.glDisable(gl.GL_CULL_FACE)
@@ -309,7 +309,7 @@ class FurDisplay:
     children: bool = True
     per_guide: int | None = None  # child hairs per guide; None: each fur's `children`
     follow: str = "neighbours"  # child hairs blend their 3 nearest guides, or "own"
-    child_points: int | None = 4  # points per child hair drawn (level of detail); None: all
+    child_points: int | None = 3  # points per child hair drawn (level of detail); None: all
     markers: bool = False  # the controls' shapes (the fur tool shows them)
     selected_control: int | None = None  # a control entity, drawn highlighted
 

@@ -55,9 +55,7 @@ def test_ribbons_face_the_camera_and_taper(make_sandbox: Callable[..., Any]) -> 
         renderer.guide_ribbons.update(strand)
         renderer.target.bind()
         gl.glEnable(gl.GL_DEPTH_TEST)
-        calls = renderer._draw_ribbons(
-            camera.view_projection(), tuple(camera.eye.astype(np.float32))
-        )
+        calls = renderer.draw_strands()
         assert calls == 1
         changed = _width_rows(renderer.target.read(), background.astype(int))
         rows = np.flatnonzero(changed)
