@@ -11,7 +11,6 @@ The timeline (`render.timeline`) keys the picked control.
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -72,7 +71,7 @@ class FurPanel:
         self.editor = FurEditor(sandbox.world, sandbox.rebuild)
         self.new_name, self.new_count, self.new_shape = "control", 1, 0
         self.new_colour, self.new_mirror = [0.2, 0.7, 1.0], 0
-        self.save_path = str(Path.cwd() / f"{sandbox.world.scene.get('name', 'scene')}_fur.json")
+        self.save_path = f"{sandbox.world.scene.get('name', 'scene')}_fur.json"  # in the cwd
         self.message = ""
         self.dragging = False
         sandbox.renderer.fur_display.markers = True
