@@ -118,8 +118,9 @@ class Rig(System):
         assert strands is not None
         turn = rotation.astype(np.float32)
         guides = strands.guides
-        if len(turn) == 1:
-            normal = turn[0] @ self.strand_normal
+        if len(turn) == 1:  # three row sums: a BLAS call here woke its spinning threads
+            r, local = turn[0], self.strand_normal
+            normal = r[:, 0:1] * local[0] + r[:, 1:2] * local[1] + r[:, 2:3] * local[2]
         else:
             normal = np.einsum("mij,jm->im", turn[self.strand_body], self.strand_normal)
         if strands.step_kernel(curves, frames, normal, dynamic[self.strand_control], self.parallel):
