@@ -1,6 +1,7 @@
 """rig: fur guides posed from creature poses and control values (the fur/feather thesis).
 
-Each frame: keyframed control tracks are written at `world.time`; every guide's
+Each frame: keyframed control tracks are written at `world.time` (or at `track_time`,
+which the sandbox's timeline sets while it scrubs; not while `play_tracks` is off); every guide's
 frame is evaluated from its bind pose and its control's effective values (lift, aim,
 direction, random twist, the emotion system's drive added) as whole-array math; the
 guides' rest shapes are posed in world space by the mantle's Transform; guides of
@@ -23,7 +24,7 @@ import numpy as np
 
 from ecs_tentacles.fur.bind import ControlTracks, control_values, make_bind, make_strands
 from ecs_tentacles.fur.dynamics import Strands
-from ecs_tentacles.fur.rig import Bind, Scratch, control_table, evaluate
+from ecs_tentacles.fur.rig import Bind, Scratch, control_table, evaluate, use_parallel
 from ecs_tentacles.fur.tracks import TrackSet
 from ecs_tentacles.fur.vectors import quat_matrices
 from ecs_tentacles.system import System
@@ -50,6 +51,12 @@ class Rig(System):
         # blocks of guides evaluated one after the other, so temporaries stay in cache
         self.blocks: list[tuple[slice, Bind]] = []
         self.scratch = Scratch()  # work buffers, shared by the blocks and kept
+        self.parallel = False  # numba's kernels on all cores (large furs only)
+        self.track_time: float | None = None  # tracks played at this time, not the world's
+        self.play_tracks = True  # False: the tool holds an edit until time moves again
+        self.strand_normal = np.zeros((3, 0), dtype=np.float32)  # skin normals (3, m)
+        self.strand_control = np.zeros(0, dtype=np.int64)  # the strands' controls
+        self.strand_body = np.zeros(0, dtype=np.int64)  # the strands' bodies
 
     def rebind(self, world: World) -> None:
         """Re-read the bind pose, tracks and dynamic strands from the fur stores."""
@@ -63,6 +70,12 @@ class Rig(System):
         self.tracks = ControlTracks(TrackSet(fur.tracks))
         gravity = np.asarray(world.settings.gravity, dtype=np.float64)
         self.strands = make_strands(fur, gravity, world.settings.dt)
+        if self.strands is not None:  # the strands' skin normals and controls, gathered once
+            guides = self.strands.guides
+            self.strand_normal = np.ascontiguousarray(self.bind.normal[:, guides], np.float32)
+            self.strand_control = self.bind.control[guides]
+            self.strand_body = self.bind.body[guides]
+        self.parallel = use_parallel(n)
         self.version = fur.version
 
     def process(self, world: World, dt: float) -> None:
@@ -73,14 +86,23 @@ class Rig(System):
             self.rebind(world)
         bind = self.bind
         assert bind is not None
-        self.tracks.apply(fur.controls, world.time)
+        if self.play_tracks:
+            time = world.time if self.track_time is None else self.track_time
+            self.tracks.apply(fur.controls, time)
         values, dynamic = control_values(fur)
         plan = control_table(values)  # per-control values and skips, once a frame
         rotation = quat_matrices(world.transforms.quat[self.bodies])
         position = world.transforms.pos[self.bodies]
         for rows, part in self.blocks:
             evaluate(
-                part, plan, rotation, position, fur.frames[rows], fur.curves[rows], self.scratch
+                part,
+                plan,
+                rotation,
+                position,
+                fur.frames[rows],
+                fur.curves[rows],
+                self.scratch,
+                self.parallel,
             )
         if self.strands is not None:
             self._dynamics(fur.frames, fur.curves, bind, rotation, dynamic)
@@ -97,6 +119,13 @@ class Rig(System):
         assert strands is not None
         turn = rotation.astype(np.float32)
         guides = strands.guides
+        if len(turn) == 1:  # three row sums: a BLAS call here woke its spinning threads
+            r, local = turn[0], self.strand_normal
+            normal = r[:, 0:1] * local[0] + r[:, 1:2] * local[1] + r[:, 2:3] * local[2]
+        else:
+            normal = np.einsum("mij,jm->im", turn[self.strand_body], self.strand_normal)
+        if strands.step_kernel(curves, frames, normal, dynamic[self.strand_control], self.parallel):
+            return
         first = int(guides[0])
         contiguous = bool(guides[-1] - first == len(guides) - 1)
         for start in range(0, len(guides), STRAND_BLOCK):  # block by block, in cache
@@ -104,11 +133,6 @@ class Rig(System):
             rows = slice(first + start, first + cols.stop) if contiguous else guides[cols]
             rig = np.ascontiguousarray(curves[rows].transpose(1, 2, 0))
             root = frames[rows, 3].T
-            local_normal = bind.normal[:, rows]
-            if len(turn) == 1:
-                normal = turn[0] @ local_normal
-            else:
-                normal = np.einsum("mij,jm->im", turn[bind.body[rows]], local_normal)
-            weight = dynamic[bind.control[rows]]
-            blended = strands.step(rig, root, normal, weight, cols)
+            weight = dynamic[self.strand_control[cols]]
+            blended = strands.step(rig, root, normal[:, cols], weight, cols)
             curves[rows] = blended.transpose(2, 0, 1)

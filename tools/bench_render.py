@@ -2,9 +2,11 @@
 
     python tools/bench_render.py                 # thesis_four_by_six and a 64-creature crowd
     python tools/bench_render.py --frames 60 --width 1280 --height 720 --json
+    python tools/bench_render.py --only fur_1k     # 1,000 guides x 10 children as ribbons
 
 `draw` ends with glFinish, so it includes the rasterising (llvmpipe on a machine
-without a GPU). Medians over the measured frames, after a warm-up.
+without a GPU); `strands` is the fur's part of it (guides and child hairs as lit
+ribbons, drawn again alone). Medians over the measured frames, after a warm-up.
 """
 
 from __future__ import annotations
@@ -33,15 +35,24 @@ def crowd(count: int) -> dict[str, Any]:
     return {"version": 1, "name": f"crowd_{count}", "creatures": creatures}
 
 
+def furry(guides: int, children: int) -> dict[str, Any]:
+    """One cat-furred creature with `guides` guides of 8 points and `children` each."""
+    fur = {"preset": "cat", "groom": {"count": guides, "points": 8}, "children": children}
+    creature = {"name": "cat", "tentacles": {"count": 6}, "fur": fur}
+    return {"version": 1, "name": f"fur_{guides}", "creatures": [creature]}
+
+
 def bench(scene: Any, name: str, frames: int, width: int, height: int) -> dict[str, Any]:
     from pyglet import gl
 
     from ecs_tentacles.render.sandbox import Sandbox
 
     sandbox = Sandbox(scene, width=width, height=height, headless=True)
+    sandbox.hud.visible = False
     renderer = sandbox.renderer
+    renderer.camera.shift_x = 0.0
     sandbox.step(30)
-    timings: dict[str, list[float]] = {"simulate": [], "upload": [], "draw": []}
+    timings: dict[str, list[float]] = {"simulate": [], "upload": [], "draw": [], "strands": []}
     for _ in range(frames):
         start = time.perf_counter()
         sandbox.step(1)
@@ -54,6 +65,11 @@ def bench(scene: Any, name: str, frames: int, width: int, height: int) -> dict[s
         timings["simulate"].append(simulated - start)
         timings["upload"].append(uploaded - simulated)
         timings["draw"].append(drawn - uploaded - (uploaded - simulated))
+        renderer.target.bind()
+        start = time.perf_counter()
+        renderer.draw_strands()
+        gl.glFinish()
+        timings["strands"].append(time.perf_counter() - start)
     stats = {k: round(1000 * statistics.median(v), 3) for k, v in timings.items()}
     result = {
         "scene": name,
@@ -64,6 +80,7 @@ def bench(scene: Any, name: str, frames: int, width: int, height: int) -> dict[s
         "frames": frames,
         "ms": stats,
         "draw_calls": renderer.draw_calls,
+        "strands": renderer.guide_ribbons.shape[0] + renderer.child_ribbons.shape[0],
     }
     sandbox.close()
     return result
@@ -75,12 +92,15 @@ def main() -> None:
     parser.add_argument("--width", type=int, default=1280)
     parser.add_argument("--height", type=int, default=720)
     parser.add_argument("--json", action="store_true")
+    scenes = {
+        "thesis_four_by_six": lambda: "thesis_four_by_six",
+        "crowd_64": lambda: crowd(64),
+        "fur_1k": lambda: furry(1000, 10),
+    }
+    parser.add_argument("--only", choices=sorted(scenes), nargs="*", default=sorted(scenes))
     args = parser.parse_args()
     configure(headless=True)
-    rows = [
-        bench("thesis_four_by_six", "thesis_four_by_six", args.frames, args.width, args.height),
-        bench(crowd(64), "crowd_64", args.frames, args.width, args.height),
-    ]
+    rows = [bench(scenes[name](), name, args.frames, args.width, args.height) for name in args.only]
     if args.json:
         print(json.dumps(rows, indent=2))
         return
@@ -88,9 +108,10 @@ def main() -> None:
         ms = row["ms"]
         print(
             f"{row['scene']} ({row['creatures']} creatures, {row['links']} links,"
-            f" {row['width']}x{row['height']}, {row['draw_calls']} draw calls):"
+            f" {row['strands']} strands, {row['width']}x{row['height']},"
+            f" {row['draw_calls']} draw calls):"
             f" simulate {ms['simulate']:.2f} ms, upload {ms['upload']:.2f} ms,"
-            f" draw {ms['draw']:.2f} ms"
+            f" draw {ms['draw']:.2f} ms (strands {ms['strands']:.2f} ms)"
         )
 
 

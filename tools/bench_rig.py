@@ -3,13 +3,16 @@
     python tools/bench_rig.py                   # median ms, synthetic arrays and the system
     python tools/bench_rig.py --sizes 10000 --repeats 50 --json
     python tools/bench_rig.py --backend numpy   # without the numba kernels
+    python tools/bench_rig.py --parallel off    # numba's serial kernels at every size
+    python tools/bench_rig.py --clock cpu       # CPU time of all threads (a busy machine)
 
 "math": `rig.evaluate` on synthetic arrays (every behaviour on: lift, aim, direction,
 random twist), in the system's blocks, world frames and posed curves included;
 "math+dynamic": the same plus the strand simulation on every guide; "system":
 `Rig.process` in a world whose creature has a fur of n guides (all behaviours on,
 controls moved, emotion off), with and without the dynamic behaviour. The backend is
-numba's kernels when numba imports (the dev extra), else numpy (see `fur.rig`).
+numba's kernels when numba imports (the dev extra), else numpy (see `fur.rig`); the
+numba kernels run on all cores from `rig.PARALLEL_GUIDES` guides ("auto"), or as told.
 Targets on the 2-core machine: 10k <= 2 ms, 100k <= 16 ms.
 """
 
@@ -33,14 +36,17 @@ from ecs_tentacles.world import World
 POINTS = 8
 
 
+CLOCK = time.perf_counter  # --clock cpu: time.process_time (all threads' CPU time)
+
+
 def median_ms(func: Callable[[], Any], repeats: int) -> float:
-    """Median wall time of `func` in milliseconds (after one warm-up call)."""
+    """Median time of `func` in milliseconds on `CLOCK` (after one warm-up call)."""
     func()
     times = []
     for _ in range(repeats):
-        start = time.perf_counter()
+        start = CLOCK()
         func()
-        times.append(time.perf_counter() - start)
+        times.append(CLOCK() - start)
     return 1000 * statistics.median(times)
 
 
@@ -63,11 +69,15 @@ def bench_math(n: int, repeats: int, dynamic: bool) -> float:
     scratch = rig_math.Scratch()
     blocks = [(rows, bind.part(rows)) for rows in (slice(s, s + BLOCK) for s in range(0, n, BLOCK))]
 
+    many = rig_math.use_parallel(n)
+
     def run() -> None:
         plan = rig_math.control_table(values)  # as `Rig.process` does: once a frame
         for rows, part in blocks:
-            rig_math.evaluate(part, plan, rotation, position, frames[rows], curves[rows], scratch)
-        if dynamic:
+            rig_math.evaluate(
+                part, plan, rotation, position, frames[rows], curves[rows], scratch, many
+            )
+        if dynamic and not strands.step_kernel(curves, frames, bind.normal, weight, many):
             rig = np.ascontiguousarray(curves.transpose(1, 2, 0))
             out = strands.step(rig, frames[:, 3].T, bind.normal, weight)
             curves[...] = out.transpose(2, 0, 1)
@@ -109,8 +119,15 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=30)
     parser.add_argument("--json", action="store_true")
     parser.add_argument("--backend", choices=["auto", "numpy"], default=rig_math.BACKEND)
+    parser.add_argument("--parallel", choices=["auto", "on", "off"], default="auto")
+    parser.add_argument("--clock", choices=["wall", "cpu"], default="wall")
     args = parser.parse_args()
+    global CLOCK
+    CLOCK = time.process_time if args.clock == "cpu" else time.perf_counter
     rig_math.BACKEND = args.backend
+    rig_math.PARALLEL_GUIDES = {"auto": rig_math.PARALLEL_GUIDES, "on": 0, "off": 1 << 62}[
+        args.parallel
+    ]
     backend = "numba" if rig_math.kernels() is not None else "numpy"
     rows = []
     for n in args.sizes:
@@ -129,7 +146,7 @@ def main() -> None:
     if args.json:
         print(json.dumps(rows, indent=2))
         return
-    print(f"backend: {backend}")
+    print(f"backend: {backend}, parallel from {rig_math.PARALLEL_GUIDES} guides, {args.clock} ms")
     print(f"{'guides':>8} {'math':>9} {'+dynamic':>9} {'system':>9} {'+dynamic':>9}   (median ms)")
     for row in rows:
         print(

@@ -1,5 +1,6 @@
-"""Headless pictures of the fur scenes: the presets side by side, and the hedgehog
-octopus before and after the roach arrives (quills lowered, then raised).
+"""Headless pictures of the fur scenes: the presets side by side (labelled), the hedgehog
+octopus before and after the roach arrives (quills lowered, then raised), close-ups of
+cat hair and bird feathers as lit strands, and the fur tool editing the hedgehog.
 
     python tools/fur_screenshots.py --out-dir shots/
 """
@@ -27,16 +28,42 @@ def main() -> None:
 
     presets = Sandbox("fur_presets", width=args.width, height=args.height, headless=True)
     presets.hud.visible = False
+    presets.hud.name_labels = True
     presets.renderer.camera.shift_x = 0.0
     presets.step(90)
     presets.renderer.frame_all()
     presets.renderer.camera.distance *= 0.7
     presets.renderer.camera.pitch = np.radians(30)
     print(presets.screenshot(args.out_dir / "fur_presets.png"))
+    camera = presets.renderer.camera
+    for name in ("cat", "bird"):  # close-ups: the strands' shading and taper
+        entity = presets.world.creature(name)
+        camera.target = presets.world.component(entity, Transform).pos * [1, 1, 0] + [0, 0, 0.2]
+        camera.distance, camera.pitch, camera.yaw = 1.0, np.radians(22), np.radians(-60)
+        print(presets.screenshot(args.out_dir / f"fur_{name}_strands.png"))
     presets.close()
+
+    tool = Sandbox("hedgehog_octopus", width=args.width, height=args.height, headless=True)
+    tool.step(60)
+    tool.paused = True
+    assert tool.fur is not None
+    tool.hud.fold("Locomotion", "Stats", "Physics")  # the fur panel in view
+    tool.fur.editor.create("L_cheek", shape="cube", colour=(0.2, 0.7, 1.0), mirror="y")
+    tool.fur.editor.set_value("L_cheek", "lift", 0.8)
+    tool.fur.editor.set_key("crown", "lift", 1.0, "slow_in")
+    tool.fur.sync_view()
+    tool.renderer.fur_display.colour_by = "control"
+    tool.fur.refresh_rig(edit=True)
+    camera = tool.renderer.camera
+    octo = tool.world.creature("hedgehog")
+    camera.target = tool.world.component(octo, Transform).pos * [1, 1, 0] + [0, 0, 0.1]
+    camera.distance, camera.pitch = 1.4, np.radians(30)
+    print(tool.screenshot(args.out_dir / "fur_tool.png"))
+    tool.close()
 
     hedgehog = Sandbox("hedgehog_octopus", width=args.width, height=args.height, headless=True)
     hedgehog.hud.visible = False
+    hedgehog.renderer.camera.shift_x = 0.0
     camera = hedgehog.renderer.camera
     camera.shift_x, camera.distance, camera.pitch = 0.0, 1.6, np.radians(28)
     octo = hedgehog.world.creature("hedgehog")

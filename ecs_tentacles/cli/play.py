@@ -45,6 +45,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.add_argument("--height", type=even_size, default=720, help=f"{SIZE_RULE} (default 720)")
     parser.add_argument("--seed", type=seed_int, default=None, help="override the scene's seed")
     parser.add_argument("--allow-systems", action="store_true", help="run systems the scene names")
+    parser.add_argument("--no-hud", action="store_true", help="start with the HUD hidden (h)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
     parser.add_argument("--json", action="store_true", help="headless: the summary as JSON")
     parser.set_defaults(handler=handle)
@@ -75,6 +76,7 @@ def handle(args: argparse.Namespace) -> int:
         headless=args.headless,
         seed=args.seed,
         allow_systems=args.allow_systems,
+        hud=not args.no_hud,
     )
     try:
         if args.headless:

@@ -94,7 +94,7 @@ def make_strands(fur: FurData, gravity: np.ndarray, dt: float) -> Strands | None
     segment = np.concatenate([np.zeros((len(rows), 1)), steps], axis=1).T
     return Strands(
         guides=rows,
-        segment=segment.astype(F32),
+        segment=np.ascontiguousarray(segment, dtype=F32),  # the kernel reads rows
         pull=(1.0 - np.exp(-sets.stiffness[f] * dt)).astype(F32),
         keep=np.exp(-sets.damping[f] * dt).astype(F32),
         gravity=(np.outer(gravity, sets.gravity_scale[f]) * dt * dt).astype(F32),

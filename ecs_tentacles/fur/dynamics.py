@@ -10,6 +10,8 @@ tip the strand. The body's own motion drives the strand, since the rig pose move
 with the body and the simulated points lag behind it.
 
 Arrays are float32 and laid out (points, 3, n) so each step is a contiguous operation.
+With numba (the rig's kernels) a strand kernel does the same float32 operations in
+the same order guide by guide; numpy is the fallback and gives the same result.
 """
 
 from __future__ import annotations
@@ -17,6 +19,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+
+from ecs_tentacles.fur import rig as rig_math
 
 F32 = np.float32
 
@@ -41,6 +45,40 @@ class Strands:
     prev: np.ndarray | None = None
     fresh: np.ndarray | None = None  # strands not stepped yet
 
+    def _state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        if self.pos is None or self.prev is None or self.fresh is None:
+            points = len(self.segment)
+            self.pos = np.zeros((points, 3, len(self.guides)), dtype=F32)
+            self.prev = np.zeros_like(self.pos)
+            self.fresh = np.ones(len(self.guides), dtype=bool)
+        return self.pos, self.prev, self.fresh
+
+    def step_kernel(
+        self,
+        curves: np.ndarray,
+        frames: np.ndarray,
+        normal: np.ndarray,
+        weight: np.ndarray,
+        parallel: bool = False,
+    ) -> bool:
+        """`step` for every strand by numba's kernel, in place in `curves` (n, points, 3).
+
+        `frames` (n, 4, 3) give the roots, `normal` and `weight` are the strands' (3, m)
+        and (m,). `parallel`: on all cores (large furs, `rig.use_parallel`). Returns
+        False, doing nothing, when the kernels are not there (then call `step`).
+        """
+        k = rig_math.kernels()
+        if k is None:
+            return False
+        pos, prev, fresh = self._state()
+        step, lock = rig_math.kernel(k, "strands", parallel)
+        with lock:
+            step(
+                pos, prev, fresh, curves, frames, self.guides, normal, weight,
+                self.keep, self.pull, self.gravity, self.segment, self.profile.reshape(-1),
+            )  # fmt: skip
+        return True
+
     def step(
         self,
         rig: np.ndarray,
@@ -56,13 +94,9 @@ class Strands:
         (the arrays given are theirs): callers go block by block to stay in cache.
         """
         cols = slice(None) if cols is None else cols
-        if self.pos is None or self.prev is None or self.fresh is None:
-            points = len(self.segment)
-            self.pos = np.zeros((points, 3, len(self.guides)), dtype=F32)
-            self.prev = np.zeros_like(self.pos)
-            self.fresh = np.ones(len(self.guides), dtype=bool)
-        pos, prev = self.pos[..., cols], self.prev[..., cols]
-        fresh = self.fresh[cols]
+        pos, prev, fresh = self._state()
+        pos, prev = pos[..., cols], prev[..., cols]
+        fresh = fresh[cols]
         if fresh.any():  # first frame of these strands: start at rest on the rig
             pos[..., fresh] = rig[..., fresh]
             prev[..., fresh] = rig[..., fresh]

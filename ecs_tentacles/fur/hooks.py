@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ecs_tentacles.fur import children
 from ecs_tentacles.fur.components import FurControl, Threat
 from ecs_tentacles.mathutil import quat_rotate
 
@@ -52,19 +53,35 @@ def guide_curves(world: World, colour_by: str = "fur") -> GuideCurves:
 
 
 def child_hairs(
-    world: World, per_guide: int | None = None, radius: float | None = None, seed: int = 0
+    world: World,
+    per_guide: int | None = None,
+    radius: float | None = None,
+    seed: int = 0,
+    follow: str = "neighbours",
+    points: int | None = None,
 ) -> GuideCurves:
     """Child hairs around each guide, for visual density (deterministic for `seed`).
 
-    Each child takes its guide's posed curve, moved to a root scattered in the skin's
-    tangent plane within `radius` (default: half the guide's length) and scaled in
-    length by 0.7-1.0, so it follows every rig behaviour and the dynamics of its
-    guide. `per_guide` defaults to each fur's `children`.
+    `follow="neighbours"` (the default): each child grows from the skin near its guide
+    and blends its 3 nearest guides (`fur.children`); its colour is jittered per strand.
+    `follow="own"`: each child takes its guide's posed curve, moved to a root scattered
+    in the skin's tangent plane within `radius` (default: half the guide's length) and
+    scaled in length by 0.7-1.0. Either way children follow every rig behaviour and
+    the dynamics. `per_guide` defaults to each fur's `children`; `points`: that many
+    points per child, picked evenly along the curve (default: all).
     """
+    if follow == "neighbours":
+        made = children.layout(world, per_guide, seed)
+        base = guide_curves(world)
+        colour = base.colour[made.parent].copy()
+        colour[:, :3] *= made.jitter[:, None].astype(np.float32)
+        curves = children.interpolated_children(world, made, points)
+        return GuideCurves(curves, colour, base.width[made.parent] * 0.5, made.parent)
+    if follow != "own":
+        raise ValueError(f"follow must be 'neighbours' or 'own', got {follow!r}")
     fur = world.fur
     g = fur.guides
-    counts = fur.sets.children[g.fur_row] if per_guide is None else np.full(len(g), per_guide)
-    parent = np.repeat(np.arange(len(g)), counts)
+    parent = children.parents(fur, per_guide)
     rng = np.random.default_rng(seed)
     m = len(parent)
     curves = fur.curves[parent].astype(np.float64)
@@ -78,9 +95,10 @@ def child_hairs(
     offset = reach[:, None] * (np.cos(angle)[:, None] * side + np.sin(angle)[:, None] * along)
     scale = rng.uniform(0.7, 1.0, m)[:, None, None]
     root = curves[:, :1]
-    points = (root + offset[:, None, :] + scale * (curves - root)).astype(np.float32)
+    dense = (root + offset[:, None, :] + scale * (curves - root)).astype(np.float32)
+    dense = dense[:, children.point_indices(fur.points, points)]
     base = guide_curves(world)
-    return GuideCurves(points, base.colour[parent], base.width[parent] * 0.5, parent)
+    return GuideCurves(dense, base.colour[parent], base.width[parent] * 0.5, parent)
 
 
 @dataclass

@@ -14,18 +14,35 @@ functions one value at a time. So a block of guides goes through three passes:
 3. `frames` (numba): lift, twist, side and up, the skin -> body -> world turn, the
    frames written in (n, 4, 3) rows and the curves posed from them (as `pose` does).
 
-Kernels compute in float32 (as the numpy path does), guide by guide on all cores
-(``prange``), and branch only on what is the same for every guide: a behaviour no
-control uses contributes exact zeros. They are compiled on first use and cached on
-disk (``cache=True``), so only the first run after an install or an edit pays the
-compile time (about 10 s on the 2-core machine).
+Kernels compute in float32 (as the numpy path does), guide by guide, and branch
+only on what is the same for every guide: a behaviour no control uses contributes
+exact zeros. Each kernel is compiled twice: on all cores (``prange``, numba's
+OpenMP pool) and serially (`<name>_serial`). The parallel ones pay only for large
+furs: below `rig.PARALLEL_GUIDES` guides the pool's start-up and its spinning
+threads cost more than they save, and they take cores from the physics threads.
+They are compiled on first use and cached on disk (``cache=True``), so only the
+first run after an install or an edit pays the compile time (about 20 s on the
+2-core machine).
+
+`strands` is the dynamic blend's strand step (`dynamics.Strands.step`), the same
+float32 operations in the same order, one guide at a time.
 """
 
 from __future__ import annotations
 
 import math
+import os
+import types
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
+
+# OpenMP's worker threads (numba's "omp" layer) spin after each parallel kernel by
+# default, taking the cores from the physics threads; passive ones sleep. Read when
+# numba first starts its pool, so set before any parallel kernel runs.
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+
 from numba import njit, prange
 
 ONE = np.float32(1.0)
@@ -33,6 +50,20 @@ ZERO = np.float32(0.0)
 TINY = np.float32(1e-12)
 UNLIFT, KEEP, TWIST = 0, 1, 2  # rows of `rig.control_table`
 AIM_X, DIRECTION_X, AIM_WEIGHT, DIRECTION_WEIGHT = 3, 4, 9, 10
+TINY_LINK = np.float32(1e-12)
+STRAND_CHUNK = 512  # strands a parallel task takes (a few cache lines per row each)
+
+
+def _compiled(func: Callable[..., Any]) -> tuple[Any, Any]:
+    """`func` compiled for all cores and serially; distinct names keep their caches apart."""
+    serial = types.FunctionType(
+        func.__code__, func.__globals__, f"{func.__name__}_serial", func.__defaults__
+    )
+    serial.__qualname__ = f"{func.__qualname__}_serial"
+    return (
+        njit(cache=True, nogil=True, parallel=True)(func),
+        njit(cache=True, nogil=True)(serial),
+    )
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -47,8 +78,7 @@ def _capped(vx, vy, vz, tan_min, weight):
     return vx * scale, vy * scale, vz * scale
 
 
-@njit(cache=True, nogil=True, parallel=True)
-def blend(
+def _blend(
     control,
     table,
     rest_cos,
@@ -116,8 +146,7 @@ def _pose_guide(shape_h, frames, out, g):
             )
 
 
-@njit(cache=True, nogil=True, parallel=True)
-def frames(
+def _frames(
     axis,
     flat,
     polar_sin,
@@ -194,8 +223,94 @@ def frames(
                 _pose_guide(shape_h, world, curves, g)
 
 
-@njit(cache=True, nogil=True, parallel=True)
-def pose(shape_h, frames, out):
+def _pose(shape_h, frames, out):
     """World points (n, points, 3): rest-frame coordinates x world frame, guide by guide."""
     for g in prange(shape_h.shape[0]):
         _pose_guide(shape_h, frames, out, g)
+
+
+def _strands(
+    pos, prev, fresh, curves, frames, rows, normal, weight, keep, pull, gravity, segment, profile
+):
+    """One Verlet step of the strands toward the rig's curves, blended in place.
+
+    `pos`, `prev` (points, 3, m) and `fresh` (m,) are `Strands`' state; strand g is
+    guide `rows[g]` of `curves` (n, points, 3) and `frames` (n, 4, 3), whose rig
+    curve it reads and whose blended curve it writes back; `normal` (3, m) is world
+    space, `profile` (points,). Chunks of `STRAND_CHUNK` strands go in parallel;
+    inside a chunk the strands are the innermost loop, so the state is read in
+    order. The float32 operations are `Strands.step`'s, in the same order.
+    """
+    points, m = pos.shape[0], pos.shape[2]
+    for chunk in prange((m + STRAND_CHUNK - 1) // STRAND_CHUNK):
+        # loops over 0..count on slices of the chunk (not lo..hi): numba then knows
+        # the indices are not negative, and the compiler vectorises the loops
+        lo = chunk * STRAND_CHUNK
+        hi = min(lo + STRAND_CHUNK, m)
+        count = hi - lo
+        rig = np.empty((points, 3, count), dtype=np.float32)
+        root = np.empty((3, count), dtype=np.float32)
+        kept, pulled, blend, new = keep[lo:hi], pull[lo:hi], weight[lo:hi], fresh[lo:hi]
+        chunk_rows = rows[lo:hi]
+        for j in range(count):
+            r = chunk_rows[j]
+            for i in range(3):
+                root[i, j] = frames[r, 3, i]
+            for p in range(points):
+                for i in range(3):
+                    rig[p, i, j] = curves[r, p, i]
+            if new[j]:  # first frame of this strand: start at rest on the rig
+                for p in range(points):
+                    for i in range(3):
+                        pos[p, i, lo + j] = rig[p, i, j]
+                        prev[p, i, lo + j] = rig[p, i, j]
+                new[j] = False
+        for p in range(points):
+            for i in range(3):
+                x, before, fall = pos[p, i, lo:hi], prev[p, i, lo:hi], gravity[i, lo:hi]
+                target = rig[p, i]
+                for j in range(count):
+                    velocity = (x[j] - before[j]) * kept[j]
+                    before[j] = x[j]
+                    x[j] = x[j] + velocity + fall[j]
+                for j in range(count):
+                    x[j] = x[j] + (target[j] - x[j]) * pulled[j]
+        for i in range(3):
+            start = pos[0, i, lo:hi]
+            for j in range(count):
+                start[j] = rig[0, i, j]
+        nx, ny, nz = normal[0, lo:hi], normal[1, lo:hi], normal[2, lo:hi]
+        ox, oy, oz = root[0], root[1], root[2]
+        for k in range(1, points):  # follow the leader; never below the root's plane
+            x0, y0, z0 = pos[k - 1, 0, lo:hi], pos[k - 1, 1, lo:hi], pos[k - 1, 2, lo:hi]
+            x1, y1, z1 = pos[k, 0, lo:hi], pos[k, 1, lo:hi], pos[k, 2, lo:hi]
+            length_k = segment[k, lo:hi]
+            for j in range(count):
+                lx = x1[j] - x0[j]
+                ly = y1[j] - y0[j]
+                lz = z1[j] - z0[j]
+                length = math.sqrt(lx * lx + ly * ly + lz * lz)
+                scale = length_k[j] / (length if length > TINY_LINK else TINY_LINK)
+                px = x0[j] + lx * scale
+                py = y0[j] + ly * scale
+                pz = z0[j] + lz * scale
+                below = (px - ox[j]) * nx[j]
+                below += (py - oy[j]) * ny[j]
+                below += (pz - oz[j]) * nz[j]
+                below = below if below < ZERO else ZERO
+                x1[j] = px - below * nx[j]
+                y1[j] = py - below * ny[j]
+                z1[j] = pz - below * nz[j]
+        for j in range(count):
+            r = chunk_rows[j]
+            for p in range(points):
+                share = profile[p] * blend[j]
+                for i in range(3):
+                    x = rig[p, i, j]
+                    curves[r, p, i] = (pos[p, i, lo + j] - x) * share + x
+
+
+blend, blend_serial = _compiled(_blend)
+frames, frames_serial = _compiled(_frames)
+pose, pose_serial = _compiled(_pose)
+strands, strands_serial = _compiled(_strands)

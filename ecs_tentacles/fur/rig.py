@@ -26,7 +26,9 @@ Speed (tools/bench_rig.py): `evaluate` is the per-frame entry point, called bloc
 block with one `control_table` (per-control values and the behaviours in use, once a
 frame) and one `Scratch` (work buffers kept between frames). With numba installed
 (the ``dev`` extra) the kernels of `ecs_tentacles.fur.kernels` do the work, guide by
-guide on all cores; without it, the whole-array numpy code here (`local_frames`,
+guide, on all cores for furs of `PARALLEL_GUIDES` guides or more and serially below
+(numba's thread pool costs small furs more than it saves and competes with the
+physics threads); without it, the whole-array numpy code here (`local_frames`,
 `world_frames`, `pose`). ``ECS_TENTACLES_RIG=numpy`` (or `BACKEND = "numpy"`) forces
 numpy. Both give the same results within float32 rounding; a behaviour that no
 control uses is skipped by both.
@@ -34,11 +36,14 @@ control uses is skipped by both.
 
 from __future__ import annotations
 
+import contextlib
 import importlib
 import os
 import threading
+from contextlib import AbstractContextManager
 from dataclasses import dataclass
 from types import ModuleType
+from typing import Any
 
 import numpy as np
 
@@ -269,9 +274,23 @@ def kernels() -> ModuleType | None:
     return _kernels if isinstance(_kernels, ModuleType) else None
 
 
-# numba's default threading layer (workqueue, without TBB) promises no thread safety:
-# worlds stepped on several threads take turns in the (parallel) kernels
-_KERNEL_LOCK = threading.Lock()
+PARALLEL_GUIDES = 20_000  # below, serial kernels were as fast (tools/bench_rig.py, 2 cores)
+
+
+def use_parallel(guides: int) -> bool:
+    """Whether a fur of `guides` guides runs the parallel kernels."""
+    return guides >= PARALLEL_GUIDES
+
+
+_KERNEL_LOCK = threading.Lock()  # numba's pool is not documented as safe to share
+
+
+def kernel(k: ModuleType, name: str, parallel: bool) -> tuple[Any, AbstractContextManager[Any]]:
+    """Kernel `name` of `k` for all cores or serial, and the lock a call takes (parallel)."""
+    lock = _KERNEL_LOCK if parallel else contextlib.nullcontext()
+    return getattr(k, name if parallel else f"{name}_serial"), lock
+
+
 NO_LOCAL = np.empty((4, 3, 0), dtype=F32)
 NO_WORLD = np.empty((0, 4, 3), dtype=F32)
 NO_CURVES = np.empty((0, 1, 3), dtype=F32)
@@ -287,13 +306,15 @@ def _kernel_frames(
     local: np.ndarray,
     world: np.ndarray,
     curves: np.ndarray,
+    parallel: bool,
 ) -> None:
     """The numba passes (blend, whole-array trigonometry, frames): see `kernels`."""
-    with _KERNEL_LOCK:  # numba's thread pool is not documented as safe to share
+    blend, lock = kernel(k, "blend", parallel)
+    with lock:
         s.use(len(bind))
         axis, flat, unlift, angle = s("k_axis", 3), s("k_flat"), s("k_unlift"), s("k_angle")
         normalise = (plan.aiming or plan.directing) and not plan.lifting
-        k.blend(
+        blend(
             bind.control, plan.table, bind.rest_cos, bind.rest_sin, bind.tan_min, bind.multiplier,
             bind.basis, bind.root, normalise, axis, flat, unlift, angle,
         )  # fmt: skip
@@ -308,7 +329,7 @@ def _kernel_frames(
         if plan.twisting:
             np.cos(angle, out=twist_cos)
             np.sin(angle, out=twist_sin)
-        k.frames(
+        kernel(k, "frames", parallel)[0](
             axis, flat, polar_sin, polar_cos, twist_cos, twist_sin, plan.lifting,
             plan.twisting, bind.basis, bind.root, bind.body, rotation, position, local, world,
             bind.shape_h, curves,
@@ -323,12 +344,14 @@ def evaluate(
     frames: np.ndarray,
     curves: np.ndarray,
     scratch: Scratch | None = None,
+    parallel: bool | None = None,
 ) -> None:
     """World frames (n, 4, 3) and posed curves (n, points, 3) of every guide, in place.
 
     `local_frames`, `world_frames` and `pose` in one call, by the numba kernels when
     they are there. `rotation` (n_bodies, 3, 3) and `position` (n_bodies, 3) are the
-    bodies' poses.
+    bodies' poses. `parallel`: the kernels for all cores (default: for a block of
+    `PARALLEL_GUIDES` or more; callers going block by block pass the whole fur's).
     """
     s = Scratch() if scratch is None else scratch
     plan = values if isinstance(values, Plan) else control_table(values)
@@ -342,7 +365,8 @@ def evaluate(
         return
     turn = np.ascontiguousarray(rotation, dtype=F32)
     move = np.ascontiguousarray(position, dtype=F32)
-    _kernel_frames(k, bind, plan, s, turn, move, NO_LOCAL, frames, curves)
+    many = use_parallel(len(bind)) if parallel is None else parallel
+    _kernel_frames(k, bind, plan, s, turn, move, NO_LOCAL, frames, curves, many)
 
 
 def local_frames(
@@ -365,7 +389,9 @@ def local_frames(
         if bind.controls_needed > plan.table.shape[1]:
             raise IndexError("a guide names a control that the values do not have")
         one = np.eye(3, dtype=F32)[None]
-        _kernel_frames(k, bind, plan, s, one, np.zeros((1, 3), F32), out, NO_WORLD, NO_CURVES)
+        origin = np.zeros((1, 3), F32)
+        many = use_parallel(n)
+        _kernel_frames(k, bind, plan, s, one, origin, out, NO_WORLD, NO_CURVES, many)
         return out
     (x, y, z), side = skin_directions(bind, plan.values)
     along, normal = bind.along, bind.normal
@@ -416,6 +442,7 @@ def pose(shape_h: np.ndarray, frames: np.ndarray, out: np.ndarray) -> np.ndarray
     k = kernels()
     if k is None:
         return np.matmul(shape_h, frames, out=out)
-    with _KERNEL_LOCK:
-        k.pose(shape_h, frames, out)
+    run, lock = kernel(k, "pose", use_parallel(len(shape_h)))
+    with lock:
+        run(shape_h, frames, out)
     return out

@@ -1,155 +1,92 @@
 """The heads-up display: tune the selected creature's tentacles, see live stats.
 
-Sliders (pyglet.gui) for speed, target angle, strength, wave amplitude and
-frequency, over the scene schema's ranges (the API's too), a gait toggle, and a
-tentacle selector ("all" or one tentacle). Every change goes through
-`world.locomotion.set`, the same API scripts use, so it reaches the servos on the next
-physics step. Labels show fps, physics ms, simulated time, real-time factor, attached
-suckers and each tentacle's current action.
+Drawn with Dear ImGui (`render.gui`): a panel on the left, as wide as the window
+allows, in collapsible sections. "Locomotion" has sliders for speed, target angle,
+strength, wave amplitude and frequency (over the scene schema's ranges, the API's too;
+strength stops where the servos' damping can hold it), the gait, and a tentacle selector ("all"
+or one tentacle). Every change goes through `world.locomotion.set`, the same API
+scripts use, so it reaches the servos on the next physics step. "Stats" shows fps,
+physics ms, simulated time, real-time factor and attached suckers; "Physics" the
+groups, threads, recoveries and frozen creatures; "Actions" each tentacle's action.
+Extra panels (the fur tool) add sections through `sections`.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, Literal
+from typing import Any
 
 import numpy as np
-import pyglet
-from pyglet.gui import Frame, PushButton, Slider, ToggleButton
+from imgui_bundle import imgui
 
 from ecs_tentacles.components import Creature
 from ecs_tentacles.locomotion.params import TENTACLE_RANGES
+from ecs_tentacles.render.gui import Gui, gui_scale, same_line_if_fits, text_width
 
-PANEL_WIDTH = 300
-ROW = 34
+PANEL_WIDTH = 300  # the panel's width at scale 1 (the creator still uses it as is)
+PANEL_SHARE = 0.4  # the panel never covers more than this share of the window's width
 TEXT = (20, 24, 28, 255)
+
+
+def panel_width(width: int, height: int) -> int:
+    """The HUD panel's width in pixels for a window of this size."""
+    return int(min(PANEL_WIDTH * gui_scale(height), PANEL_SHARE * width))
 
 
 @dataclass(frozen=True)
 class Knob:
     """A slider's parameter and how it is shown; its range is the scene schema's.
 
-    The slider's 0..100 maps onto the parameter's range (`TENTACLE_RANGES`, read from
-    the schema) as `low + span * (s / 100) ** curve`: a curve above 1 gives the low
-    end, where the defaults sit, more of the slider. An open lower bound (speed > 0)
-    starts a thousandth of the span above it.
+    `TENTACLE_RANGES` (read from the schema, the API's ranges too) bounds the slider,
+    in shown units; `log` sliders give the low end, where the defaults sit, more room.
+    An open lower bound (speed > 0) starts a thousandth of the span above it.
     """
 
     name: str
     label: str
-    shown: Callable[[float], str]
-    curve: float = 1.0
+    unit: str
+    to_shown: float = 1.0  # shown value = stored value * to_shown
+    log: bool = False
 
     @property
     def low(self) -> float:
         allowed = TENTACLE_RANGES[self.name]
-        return allowed.low + (1e-3 * (allowed.high - allowed.low) if allowed.low_open else 0.0)
+        low = allowed.low + (1e-3 * (allowed.high - allowed.low) if allowed.low_open else 0.0)
+        return low * self.to_shown
 
     @property
     def high(self) -> float:
-        return TENTACLE_RANGES[self.name].high
-
-    def value(self, slider: float) -> float:
-        """The parameter value at slider position `slider` (0..100)."""
-        return self.low + (self.high - self.low) * (slider / 100.0) ** self.curve
-
-    def slider(self, value: float) -> float:
-        """The slider position (0..100) showing `value`."""
-        fraction = np.clip((value - self.low) / (self.high - self.low), 0.0, 1.0)
-        return float(100.0 * fraction ** (1.0 / self.curve))
+        return TENTACLE_RANGES[self.name].high * self.to_shown
 
 
 KNOBS = (
-    Knob("speed", "speed", lambda v: f"{v:.2f}x", curve=2.0),
-    Knob("target_angle", "target angle", lambda v: f"{np.degrees(v):.0f} deg"),
-    Knob("strength", "strength (kp)", lambda v: f"{v:.1f}", curve=3.0),
-    Knob("wave_amplitude", "wave amplitude", lambda v: f"{np.degrees(v):.1f} deg"),
-    Knob("wave_frequency", "wave frequency", lambda v: f"{v:.2f} Hz", curve=2.0),
+    Knob("speed", "speed", "%.2fx", log=True),
+    Knob("target_angle", "target angle", "%.0f deg", float(np.degrees(1.0))),
+    Knob("strength", "strength (kp)", "%.1f", log=True),
+    Knob("wave_amplitude", "wave amplitude", "%.1f deg", float(np.degrees(1.0))),
+    Knob("wave_frequency", "wave frequency", "%.2f Hz", log=True),
 )
-
-
-def _image(width: int, height: int, colour: tuple[int, int, int, int]) -> Any:
-    return pyglet.image.SolidColorImagePattern(colour).create_image(width, height)
+GAITS = ("cyclic", "coordinated")
 
 
 class Hud:
-    """Widgets and labels bound to a world's locomotion parameters."""
+    """The sandbox's panel, bound to a world's locomotion parameters."""
 
-    def __init__(self, window: pyglet.window.Window, world: Any):
+    def __init__(self, window: Any, world: Any, *, visible: bool = True):
         self.window = window
         self.world = world
-        self.visible = True
-        self.batch = pyglet.graphics.Batch()
-        self._keep: list[Any] = []  # labels pyglet would otherwise drop from the batch
-        self.frame = Frame(window, cell_size=32)
+        self.visible = visible
+        self.gui = Gui(window)
         self.creature: int | None = None
-        self._refreshing = False  # widgets being set from the world, not by the user
         self.tentacle: int | None = None  # None: all tentacles
-        top = window.height - 16
-        self.title = self._label(16, top, "", weight="bold")
-        self.selector = self._label(50, top - ROW, "")
-        self.previous = self._button(16, top - ROW - 6, "<", self._previous_tentacle)
-        self.next = self._button(PANEL_WIDTH - 40, top - ROW - 6, ">", self._next_tentacle)
-        self.sliders: dict[str, tuple[Slider, Any, Knob]] = {}
-        for i, knob in enumerate(KNOBS):
-            y = top - (i + 2) * ROW - 12
-            slider = Slider(
-                112,
-                y,
-                _image(120, 6, (90, 96, 104, 255)),
-                _image(10, 18, (60, 110, 200, 255)),
-                edge=5,
-                batch=self.batch,
-            )
-            slider.set_handler("on_change", self._changer(knob))
-            self.frame.add_widget(slider)
-            self._label(16, y + 2, knob.label)
-            value = self._label(PANEL_WIDTH - 4, y + 2, "", anchor_x="right")
-            self.sliders[knob.name] = (slider, value, knob)
-        y = top - (len(KNOBS) + 2) * ROW - 12
-        self.gait = ToggleButton(
-            120,
-            y,
-            _image(60, 20, (70, 140, 90, 255)),
-            _image(60, 20, (150, 110, 70, 255)),
-            batch=self.batch,
-        )
-        self.gait.set_handler("on_toggle", self._toggle_gait)
-        self.frame.add_widget(self.gait)
-        self._label(16, y + 4, "gait")
-        self.gait_value = self._label(190, y + 4, "")
-        self.stats = self._label(16, y - ROW, "", multiline=True, width=PANEL_WIDTH - 20)
-        self.actions = self._label(16, y - 4 * ROW, "", multiline=True, width=PANEL_WIDTH - 20)
-        self.background = pyglet.shapes.Rectangle(
-            0,
-            0,
-            PANEL_WIDTH,
-            window.height,
-            color=(245, 247, 250, 215),
-            batch=self.batch,
-            group=pyglet.graphics.Group(order=-1),
-        )
-
-    # -- building --------------------------------------------------------------------
-    def _label(self, x: int, y: int, text: str, **kwargs: Any) -> pyglet.text.Label:
-        anchor_y: Literal["top", "baseline"] = "top" if kwargs.get("multiline") else "baseline"
-        label = pyglet.text.Label(
-            text, x=x, y=y, font_size=10, color=TEXT, batch=self.batch, anchor_y=anchor_y, **kwargs
-        )
-        self._keep.append(label)
-        return label
-
-    def _button(self, x: int, y: int, text: str, action: Callable[[], None]) -> PushButton:
-        pressed, unpressed = (
-            _image(24, 20, (150, 160, 175, 255)),
-            _image(24, 20, (190, 198, 210, 255)),
-        )
-        button = PushButton(x, y, pressed, unpressed, batch=self.batch)
-        button.set_handler("on_release", lambda widget: action())
-        self.frame.add_widget(button)
-        self._label(x + 8, y + 5, text)
-        return button
+        self.stats: dict[str, float] = {}
+        self.values: dict[str, Any] = {}
+        self.sections: list[tuple[str, Callable[[Gui], None]]] = []  # (title, draw)
+        self.windows: list[Callable[[Gui], None]] = []  # more ImGui windows (the timeline)
+        self._fold: set[str] = set()  # sections to close on the next frame
+        self.name_labels = False  # creatures' names over them (even with the panel hidden)
+        self.label_at: Callable[[], list[tuple[str, float, float]]] = list  # (text, x, y)
 
     # -- selection -------------------------------------------------------------------
     def select(self, creature: int | None, tentacle: int | None = None) -> None:
@@ -157,16 +94,17 @@ class Hud:
         self.creature, self.tentacle = creature, tentacle
         self.refresh()
 
+    @property
+    def title(self) -> str:
+        if self.creature is None:
+            return "click a creature to select it"
+        return str(self.world.component(self.creature, Creature).name)
+
     def _count(self) -> int:
         return len(self.world.component(self.creature, Creature).tentacles) if self.creature else 0
 
-    def _previous_tentacle(self) -> None:
-        self._step_tentacle(-1)
-
-    def _next_tentacle(self) -> None:
-        self._step_tentacle(1)
-
-    def _step_tentacle(self, step: int) -> None:
+    def step_tentacle(self, step: int) -> None:
+        """Select the next (+1) or previous (-1) tentacle, through "all"."""
         if self.creature is None:
             return
         choices: list[int | None] = [None, *range(self._count())]
@@ -174,70 +112,168 @@ class Hud:
         self.refresh()
 
     # -- editing ---------------------------------------------------------------------
-    def _changer(self, knob: Knob) -> Callable[[Slider, float], None]:
-        def changed(widget: Slider, value: float) -> None:
-            if not self._refreshing:
-                self.set_parameter(knob.name, knob.value(value))
-
-        return changed
-
-    def set_parameter(self, name: str, value: float) -> None:
+    def set_parameter(self, name: str, value: float | str) -> None:
         """Apply a parameter to the selection through the locomotion API."""
         if self.creature is None:
             return
-        if name == "strength":  # no stiffer than the damping holds at this physics step
-            value = min(value, self.world.locomotion.strength_limit(self.creature, self.tentacle))
-        self.world.locomotion.set(self.creature, tentacle=self.tentacle, **{name: float(value)})
+        if name == "gait":
+            self.world.locomotion.set(self.creature, gait=str(value))
+        else:
+            self.world.locomotion.set(self.creature, tentacle=self.tentacle, **{name: float(value)})
         self.refresh()
 
-    def _toggle_gait(self, widget: ToggleButton, pressed: bool) -> None:
-        if self.creature is not None and not self._refreshing:
-            self.world.locomotion.set(self.creature, gait="coordinated" if pressed else "cyclic")
-            self.refresh()
-
     def refresh(self) -> None:
-        """Show the selection's current values."""
+        """Read the selection's current values from the world."""
         if self.creature is None:
-            self.title.text = "click a creature to select it"
-            self.selector.text = ""
+            self.values = {}
             return
-        creature = self.world.component(self.creature, Creature)
-        self.title.text = f"{creature.name}"
-        self.selector.text = (
-            "all tentacles" if self.tentacle is None else f"tentacle {self.tentacle}"
-        )
         values = self.world.locomotion.get(self.creature, self.tentacle or 0)
         if self.tentacle is None:
             values["speed"] = values["creature_speed"]
-        self._refreshing = True
-        try:
-            for slider, label, knob in self.sliders.values():
-                value = values[knob.name]
-                slider.value = knob.slider(value)
-                label.text = knob.shown(value)
-            self.gait.value = values["gait"] == "coordinated"
-        finally:
-            self._refreshing = False
-        self.gait_value.text = values["gait"]
+        self.values = values
 
     def update(self, stats: dict[str, float]) -> None:
-        """Refresh the live numbers."""
-        fps = f"fps {stats['fps']:.0f}   " if stats["fps"] > 0 else ""  # no display: no fps
-        self.stats.text = (
-            f"{fps}physics {stats['physics_ms']:.1f} ms\n"
-            f"sim {stats['sim_time']:.1f} s   real-time x{stats['rtf']:.2f}\n"
-            f"suckers attached {stats['attached']}"
-        )
-        if self.creature is not None:
-            actions = self.world.locomotion.actions(self.creature)
-            self.actions.text = "\n".join(f"t{k}: {a}" for k, a in enumerate(actions))
-        else:
-            self.actions.text = ""
+        """Keep the live numbers for the next draw."""
+        self.stats = dict(stats)
+
+    # -- drawing ---------------------------------------------------------------------
+    def fold(self, *sections: str) -> None:
+        """Close these sections (as a click on their headers would)."""
+        self._fold.update(sections)
 
     def contains(self, x: float, y: float) -> bool:
-        """True when (x, y) is over the panel (clicks there are not for the world)."""
-        return self.visible and x < PANEL_WIDTH
+        """True when pyglet pixel (x, y) is over the panel (clicks there are not for the world)."""
+        return self.visible and (x < self.width or self.gui.contains(x, y))
 
-    def draw(self) -> None:
-        if self.visible:
-            self.batch.draw()
+    @property
+    def width(self) -> int:
+        """Pixels the panel covers on the left (0 when hidden)."""
+        return panel_width(self.window.width, self.window.height) if self.visible else 0
+
+    def draw(self) -> int:
+        """Build and draw the panel; return the GL draw calls it issued."""
+        if not self.visible and not self.name_labels:
+            self.gui.skip_frame()
+            return 0
+        if not self.gui.frames:  # windows that fit their content know their size from frame 2
+            self._build()
+            self.gui.end_frame(draw=False)
+        self._build()
+        return self.gui.end_frame()
+
+    def _build(self) -> None:
+        gui = self.gui
+        gui.begin_frame()
+        if self.name_labels:
+            self._name_labels()
+        if not self.visible:
+            return
+        imgui.set_next_window_pos((0.0, 0.0))
+        imgui.set_next_window_size((float(self.width), float(self.window.height)))
+        flags = imgui.WindowFlags_.no_move | imgui.WindowFlags_.no_resize
+        imgui.begin("ecs_tentacles", None, flags | imgui.WindowFlags_.no_collapse)
+        gui.window_rect("panel")
+        imgui.text(self.title)
+        gui.item("title")
+        own: list[tuple[str, Callable[[Gui], None]]] = [
+            ("Locomotion", self._locomotion),
+            ("Stats", self._stats),
+            ("Physics", self._physics),
+        ]
+        for name, build in [*own, *self.sections, ("Actions", self._actions)]:
+            if name in self._fold:
+                imgui.set_next_item_open(False)
+                self._fold.discard(name)
+            opened = imgui.collapsing_header(
+                name, imgui.TreeNodeFlags_.default_open if name != "Actions" else 0
+            )
+            gui.item(name)
+            if opened:
+                build(gui)
+        imgui.end()
+        for window in self.windows:
+            window(gui)
+
+    def _name_labels(self) -> None:
+        """Each `label_at` text centred at its pixel (pyglet's y), on a dark plate."""
+        draw = imgui.get_foreground_draw_list()
+        pad = 4.0 * self.gui.scale
+        for text, x, y in self.label_at():
+            size = imgui.calc_text_size(text)
+            left, top = x - size.x / 2, self.window.height - y - size.y / 2
+            plate = imgui.get_color_u32((0.1, 0.1, 0.12, 0.75))
+            draw.add_rect_filled(
+                (left - pad, top - pad), (left + size.x + pad, top + size.y + pad), plate, pad
+            )
+            draw.add_text((left, top), imgui.get_color_u32((1.0, 1.0, 1.0, 1.0)), text)
+
+    def _locomotion(self, gui: Gui) -> None:
+        if self.creature is None:
+            return
+        if imgui.arrow_button("##previous", imgui.Dir.left):
+            self.step_tentacle(-1)
+        gui.item("previous")
+        imgui.same_line()
+        if imgui.arrow_button("##next", imgui.Dir.right):
+            self.step_tentacle(1)
+        gui.item("next")
+        imgui.same_line()
+        imgui.text("all tentacles" if self.tentacle is None else f"tentacle {self.tentacle}")
+        gui.item("tentacle")
+        for knob in KNOBS:
+            imgui.text(knob.label)
+            gui.item(f"{knob.name} label")
+            imgui.set_next_item_width(-1.0)
+            shown = float(self.values[knob.name]) * knob.to_shown
+            high = knob.high
+            if knob.name == "strength":  # no stronger than the servos' damping holds
+                high = self.world.locomotion.strength_limit(self.creature, self.tentacle)
+            flags = imgui.SliderFlags_.logarithmic.value if knob.log else 0
+            changed, shown = imgui.slider_float(
+                f"##{knob.name}", shown, knob.low, high, knob.unit, flags
+            )
+            gui.item(knob.name)
+            if changed:
+                self.set_parameter(knob.name, min(shown, high) / knob.to_shown)
+        imgui.text("gait")
+        gui.item("gait label")
+        for i, gait in enumerate(GAITS):
+            if i:
+                same_line_if_fits(text_width(gait))
+            if imgui.radio_button(gait, self.values["gait"] == gait):
+                self.set_parameter("gait", gait)
+            gui.item(f"gait {gait}")
+
+    def _stats(self, gui: Gui) -> None:
+        stats = self.stats
+        if stats.get("fps", 0.0) > 0:  # no display: no fps
+            imgui.text(f"fps {stats['fps']:.0f}")
+            gui.item("fps")
+        for name, text in (
+            ("physics ms", f"physics {stats.get('physics_ms', 0.0):.1f} ms"),
+            ("sim", f"sim {stats.get('sim_time', 0.0):.1f} s"),
+            ("rtf", f"real-time x{stats.get('rtf', 0.0):.2f}"),
+            ("attached", f"suckers attached {int(stats.get('attached', 0))}"),
+        ):
+            imgui.text(text)
+            gui.item(name)
+
+    def _physics(self, gui: Gui) -> None:
+        physics = self.world.physics
+        health = physics.health
+        for name, text in (
+            ("groups", f"groups {len(physics.groups)} on {physics.threads} threads"),
+            ("recoveries", f"recoveries {health.recoveries}   frozen {health.frozen}"),
+        ):
+            imgui.text(text)
+            gui.item(name)
+
+    def _actions(self, gui: Gui) -> None:
+        if self.creature is None:
+            return
+        for k, action in enumerate(self.world.locomotion.actions(self.creature)):
+            imgui.text(f"t{k}: {action}")
+            gui.item(f"action {k}")
+
+    def close(self) -> None:
+        self.gui.close()

@@ -13,12 +13,13 @@ from __future__ import annotations
 
 import colorsys
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 from pyglet import gl
 
 from ecs_tentacles.components import Creature, Goal, Link, Tentacle, Transform
-from ecs_tentacles.fur.hooks import child_hairs, guide_curves, threat_positions
+from ecs_tentacles.fur.hooks import GuideCurves, child_hairs, guide_curves, threat_positions
 from ecs_tentacles.render import shaders
 from ecs_tentacles.render.camera import OrbitCamera
 from ecs_tentacles.render.gpu import (
@@ -30,7 +31,9 @@ from ecs_tentacles.render.gpu import (
     program,
     set_matrix,
 )
+from ecs_tentacles.render.markers import marker_lines
 from ecs_tentacles.render.meshes import CAPSULE_LODS, CYLINDER_LOD, SPHERE_LOD
+from ecs_tentacles.render.ribbons import Ribbons
 from ecs_tentacles.render.skinned import SkinnedCreatures
 from ecs_tentacles.world import World
 
@@ -74,9 +77,13 @@ class Renderer:
         self.links_far = InstancedMesh(CAPSULE_LODS[1])
         self.suckers = InstancedMesh(SPHERE_LOD)
         self.lines = Lines()
+        self.ribbon_program = program(shaders.RIBBON_VERTEX, shaders.RIBBON_FRAGMENT)
+        self.guide_ribbons = Ribbons()
+        self.child_ribbons = Ribbons()
         self.selected: int | None = None  # creature entity
         self.draw_calls = 0
         self.extra_lines: list[Callable[[World], np.ndarray]] = []  # -> (2n, 7) segments
+        self.fur_display = FurDisplay()
         self.set_world(world)
 
     def set_world(self, world: World) -> None:
@@ -163,6 +170,9 @@ class Renderer:
             self.skinned.update(pos, quat)
         self.suckers.update(self._sucker_instances())
         self.lines.update(self._line_vertices(pos))
+        guides, children = fur_strands(self.world, self.fur_display)
+        self.guide_ribbons.update(guides)
+        self.child_ribbons.update(children)
 
     def _sucker_instances(self) -> np.ndarray:
         """Attached suckers (yellow) and marked threats (dark red): one sphere batch."""
@@ -217,8 +227,8 @@ class Renderer:
             creature = self.world.component(self.selected, Creature)
             ring = pos[row] * [1, 1, 0] + [0, 0, 0.01] + creature.mantle_radius * 1.6 * CIRCLE
             segments.append(_segments(ring, np.array([1.0, 1.0, 1.0, 1.0])))
-        if len(self.world.fur.guides):
-            segments.append(fur_lines(self.world))
+        if len(self.world.fur.guides) and self.fur_display.markers:
+            segments.append(marker_lines(self.world, self.fur_display.selected_control))
         for provider in self.extra_lines:
             segments.append(provider(self.world))
         return np.vstack(segments).astype(np.float32)
@@ -260,9 +270,25 @@ class Renderer:
         set_matrix(self.line_program, "u_view_projection", view_projection)
         gl.glLineWidth(1.0)
         calls += self.lines.draw()
+        if self.guide_ribbons.count or self.child_ribbons.count:
+            calls += self.draw_strands()
         gl.glBindVertexArray(0)
         gl.glUseProgram(0)
         self.draw_calls = calls
+        return calls
+
+    def draw_strands(self) -> int:
+        """Guides and child hairs as uploaded: one draw each, both faces (ribbons)."""
+        prog = self.ribbon_program
+        prog.use()
+        set_matrix(prog, "u_view_projection", self.camera.view_projection())
+        prog["u_light"] = tuple(LIGHT.astype(np.float32))
+        prog["u_eye"] = tuple(self.camera.eye.astype(np.float32))
+        pixel = 2.0 * np.tan(self.camera.fov_y / 2) * self.camera.distance / self.target.height
+        prog["u_min_width"] = float(0.8 * pixel)  # about a pixel at the target's distance
+        gl.glDisable(gl.GL_CULL_FACE)
+        calls = self.guide_ribbons.draw() + self.child_ribbons.draw()
+        gl.glEnable(gl.GL_CULL_FACE)
         return calls
 
     def frame_all(self) -> None:
@@ -274,19 +300,42 @@ class Renderer:
         self.camera.frame(np.vstack(points), margin=1.0)
 
 
-def fur_lines(world: World) -> np.ndarray:
-    """Line-list vertices of every fur guide and its child hairs (one pass each)."""
-    parts = []
-    for curves in (guide_curves(world), child_hairs(world)):
-        points, colour = curves.points, curves.colour
-        if not len(points):
-            continue
-        n, p = points.shape[:2]
-        out = np.empty((n, p - 1, 2, 7), np.float32)
-        out[:, :, 0, :3], out[:, :, 1, :3] = points[:, :-1], points[:, 1:]
-        out[:, :, :, 3:] = colour[:, None, None, :]
-        parts.append(out.reshape(-1, 7))
-    return np.vstack(parts) if parts else np.zeros((0, 7), np.float32)
+@dataclass
+class FurDisplay:
+    """How fur is drawn: colour by fur or by control, guides and/or child hairs."""
+
+    colour_by: str = "fur"
+    guides: bool = True
+    children: bool = True
+    per_guide: int | None = None  # child hairs per guide; None: each fur's `children`
+    follow: str = "neighbours"  # child hairs blend their 3 nearest guides, or "own"
+    child_points: int | None = 3  # points per child hair drawn (level of detail); None: all
+    markers: bool = False  # the controls' shapes (the fur tool shows them)
+    selected_control: int | None = None  # a control entity, drawn highlighted
+
+
+def fur_strands(world: World, display: FurDisplay) -> tuple[GuideCurves, GuideCurves]:
+    """This frame's guides and child hairs as `display` asks (empty when hidden)."""
+    points = max(world.fur.points, 1)
+    empty = GuideCurves(
+        np.zeros((0, points, 3), np.float32),
+        np.zeros((0, 4), np.float32),
+        np.zeros(0, np.float32),
+        np.zeros(0, np.int64),
+    )
+    if not len(world.fur.guides):
+        return empty, empty
+    guides = guide_curves(world, display.colour_by) if display.guides else empty
+    if not display.children:
+        return guides, empty
+    dense = child_hairs(
+        world, display.per_guide, follow=display.follow, points=display.child_points
+    )
+    if display.colour_by == "control":
+        jitter = dense.colour[:, :3] / np.maximum(guide_curves(world).colour[dense.guide, :3], 1e-6)
+        dense.colour = guide_curves(world, "control").colour[dense.guide]
+        dense.colour[:, :3] *= jitter
+    return guides, dense
 
 
 def _segments(polyline: np.ndarray, colour: np.ndarray) -> np.ndarray:

@@ -27,7 +27,8 @@ from tqdm import tqdm
 
 from ecs_tentacles.components import Creature, Goal, Transform
 from ecs_tentacles.render.camera import ray_sphere
-from ecs_tentacles.render.hud import PANEL_WIDTH, Hud
+from ecs_tentacles.render.furpanel import FurPanel
+from ecs_tentacles.render.hud import Hud
 from ecs_tentacles.render.output import VideoWriter, save_png
 from ecs_tentacles.render.renderer import Renderer
 from ecs_tentacles.systems.render import RenderSync
@@ -53,6 +54,7 @@ class Sandbox:
         headless: bool = False,
         seed: int | None = None,
         allow_systems: bool = False,
+        hud: bool = True,
     ):
         self.scene, self.seed, self.allow_systems = scene, seed, allow_systems
         self.headless = headless
@@ -60,10 +62,15 @@ class Sandbox:
             width, height, caption="ecs_tentacles", visible=not headless, vsync=False
         )
         self.world = World.from_scene(scene, seed=seed, allow_systems=allow_systems)
-        self.hud = Hud(self.window, self.world)
-        self._attach_world()
-        self.window.push_handlers(self)
+        self.hud = Hud(self.window, self.world, visible=hud)
+        self.hud.label_at = self.creature_labels
         self.paused = False
+        self.fur: FurPanel | None = None
+        self._attach_world()
+        if self.world.scene is not None and any("fur" in c for c in self.world.scene["creatures"]):
+            self.open_fur_tool()
+        self.window.push_handlers(self)
+        self.window.push_handlers(self.hud.gui)  # the GUI sees every event first
         self.accumulator = 0.0
         self.video: VideoWriter | None = None
         self.screenshots = 0
@@ -75,12 +82,39 @@ class Sandbox:
 
     def _attach_world(self) -> None:
         self.renderer = Renderer(self.world, self.window.width, self.window.height)
-        self.renderer.camera.shift_x = PANEL_WIDTH / 2 if self.hud.visible else 0.0
+        self.renderer.camera.shift_x = self.hud.width / 2
         self.world.add_system(RenderSync(self.renderer))
         self.renderer.frame_all()
         self.hud.world = self.world
         first = self.renderer.creature_entities[0] if self.renderer.creature_entities else None
         self.select(first)
+
+    def open_fur_tool(self) -> FurPanel:
+        """The fur panel (a HUD section) and the timeline (a window at the bottom)."""
+        from ecs_tentacles.render.timeline import Timeline
+
+        self.fur = FurPanel(self)
+        self.timeline = Timeline(self, self.fur)
+        self.hud.sections.append(("Fur", self.fur.draw))
+        self.hud.windows.append(lambda gui: self.timeline.draw(gui, self.hud.width))
+        self.fur.select_creature(self.renderer.selected)
+        return self.fur
+
+    def rebuild(self, scene: dict[str, Any]) -> World:
+        """Rebuild the world from an edited scene; the camera and the selection stay."""
+        selected = self.renderer.selected
+        name = None if selected is None else self.world.component(selected, Creature).name
+        self.world.close()
+        self.saved_state = None  # a snapshot belongs to the world it came from
+        self.scene = scene
+        self.world = World.from_scene(scene, seed=self.seed, allow_systems=self.allow_systems)
+        self.renderer.set_world(self.world)
+        self.world.add_system(RenderSync(self.renderer))
+        self.hud.world = self.world
+        if self.fur is not None:
+            self.fur.editor.attach(self.world)
+        self.select(self.world.creature(name) if name is not None else None)
+        return self.world
 
     # -- simulation --------------------------------------------------------------------
     def step(self, frames: int = 1) -> None:
@@ -113,16 +147,20 @@ class Sandbox:
         return True
 
     def reset(self) -> None:
-        """Rebuild the scene from its file."""
+        """Rebuild the scene from its file (or the fur tool's edited scene)."""
         self.saved_state = None
         self.world.close()
         self.world = World.from_scene(self.scene, seed=self.seed, allow_systems=self.allow_systems)
         self._attach_world()
+        if self.fur is not None:
+            self.fur.editor.attach(self.world)
+            self.fur.sync_view()
 
     # -- drawing -----------------------------------------------------------------------
     def render(self) -> np.ndarray | None:
         """Draw the world and the HUD off-screen; return the picture if recording."""
         alpha = 1.0 if self.paused else self.accumulator / self.world.settings.dt
+        self.renderer.fur_display.markers = self.fur is not None and self.hud.visible
         self.renderer.draw(alpha)
         self._update_stats()
         gl.glDisable(gl.GL_DEPTH_TEST)
@@ -151,6 +189,17 @@ class Sandbox:
         self.stats["attached"] = int(self.world.suckers.attached.sum())
         self.hud.update(self.stats)
 
+    def creature_labels(self) -> list[tuple[str, float, float]]:
+        """Each creature's name at the pixel above its mantle (for `hud.name_labels`)."""
+        rows = self.renderer.mantle_rows
+        if not len(rows):
+            return []
+        tops = self.world.transforms.pos[rows].copy()
+        names = [self.world.component(e, Creature) for e in self.renderer.creature_entities]
+        tops[:, 2] += [c.mantle_height * 1.8 + 0.05 for c in names]
+        pixels = self.renderer.camera.project(tops)
+        return [(c.name, float(x), float(y)) for c, (x, y) in zip(names, pixels, strict=True)]
+
     def screenshot(self, path: str | os.PathLike[str] | None = None) -> Path:
         """Save what the camera sees (with the HUD) as a PNG."""
         self.render()
@@ -174,6 +223,8 @@ class Sandbox:
     def select(self, creature: int | None) -> None:
         self.renderer.selected = creature
         self.hud.select(creature)
+        if self.fur is not None:
+            self.fur.select_creature(creature)
 
     def pick_creature(self, x: float, y: float) -> int | None:
         """The creature whose mantle is under pixel (x, y), nearest first."""
@@ -223,8 +274,13 @@ class Sandbox:
     # -- window events -------------------------------------------------------------------
     def on_mouse_press(self, x: int, y: int, button: int, modifiers: int) -> None:
         self._press = (x, y) if not self.hud.contains(x, y) else None
+        if self._press is not None and button == mouse.LEFT and self.fur is not None:
+            if self.fur.press(x, y):  # a control's marker: drag it over the body
+                self._press = None
 
     def on_mouse_release(self, x: int, y: int, button: int, modifiers: int) -> None:
+        if self.fur is not None:
+            self.fur.release()
         if (
             self._press is not None
             and np.hypot(x - self._press[0], y - self._press[1]) < CLICK_PIXELS
@@ -233,6 +289,9 @@ class Sandbox:
         self._press = None
 
     def on_mouse_drag(self, x: int, y: int, dx: int, dy: int, buttons: int, modifiers: int) -> None:
+        if self.fur is not None and self.fur.dragging:
+            self.fur.drag(x, y)
+            return
         if self._press is None:
             return
         if buttons & mouse.LEFT:
@@ -246,6 +305,8 @@ class Sandbox:
 
     def on_key_press(self, symbol: int, modifiers: int) -> None:
         camera = self.renderer.camera
+        if self.hud.visible and self.hud.gui.wants_keyboard:
+            return  # typing into a text field
         if symbol == key.SPACE:
             self.paused = not self.paused
         elif symbol == key.PERIOD:
@@ -255,7 +316,7 @@ class Sandbox:
             self.reset()
         elif symbol == key.H:
             self.hud.visible = not self.hud.visible
-            self.renderer.camera.shift_x = PANEL_WIDTH / 2 if self.hud.visible else 0.0
+            self.renderer.camera.shift_x = self.hud.width / 2
         elif symbol == key.F and self.renderer.selected is not None:
             row = self.world.component(self.renderer.selected, Transform).row
             camera.follow = None if camera.follow == row else row
@@ -264,7 +325,7 @@ class Sandbox:
         elif symbol == key.C:
             print(f"view: {self.renderer.toggle_view()}")
         elif symbol == key.TAB:
-            self.hud._step_tentacle(-1 if modifiers & key.MOD_SHIFT else 1)
+            self.hud.step_tentacle(-1 if modifiers & key.MOD_SHIFT else 1)
         elif symbol == key.F5:
             self.save_state()
             print(f"state saved at {self.world.time:.2f} s (F9 to go back)")
@@ -318,4 +379,6 @@ class Sandbox:
         if self.video is not None:
             self.video.abort()
         self.world.close()
+        self.window.switch_to()
+        self.hud.close()
         self.window.close()

@@ -49,7 +49,7 @@ def test_guide_curves(make_world: Callable[..., World]) -> None:
 def test_child_hairs_follow_their_guide(make_world: Callable[..., World]) -> None:
     world = make_world(SCENE, locomotion=False)
     world.step(1)
-    kids = child_hairs(world, radius=0.01, seed=2)
+    kids = child_hairs(world, radius=0.01, seed=2, follow="own")
     assert kids.points.shape == (120, 6, 3)
     assert_array_equal(kids.guide, np.repeat(np.arange(40), 3))
     parent = world.fur.curves[kids.guide]
@@ -63,8 +63,9 @@ def test_child_hairs_follow_their_guide(make_world: Callable[..., World]) -> Non
     scale = np.linalg.norm(shape[:, -1], axis=1) / np.linalg.norm(parent_shape[:, -1], axis=1)
     assert np.all((scale > 0.7 - 1e-5) & (scale < 1.0 + 1e-5))
     assert_allclose(shape, scale[:, None, None] * parent_shape, atol=1e-6)
-    assert child_hairs(world, per_guide=0).points.shape == (0, 6, 3)
-    assert_array_equal(child_hairs(world, seed=2).points, child_hairs(world, seed=2).points)
+    assert child_hairs(world, per_guide=0, follow="own").points.shape == (0, 6, 3)
+    again = child_hairs(world, seed=2, follow="own").points
+    assert_array_equal(child_hairs(world, seed=2, follow="own").points, again)
 
 
 def test_controls_and_threats(make_world: Callable[..., World]) -> None:

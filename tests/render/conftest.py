@@ -11,6 +11,9 @@ from ecs_tentacles.render import configure
 
 configure(headless=True)
 
+from pyglet.event import EventDispatcher  # noqa: E402  (after configure: pyglet reads it)
+from pyglet.window import mouse  # noqa: E402
+
 
 @pytest.fixture
 def make_sandbox() -> Iterator[Callable[..., Any]]:
@@ -29,3 +32,26 @@ def make_sandbox() -> Iterator[Callable[..., Any]]:
     yield make
     for sandbox in made:
         sandbox.close()
+
+
+def event(sandbox: Any, name: str, *args: Any) -> None:
+    """Deliver a window event now (a window queues events outside its own loop)."""
+    EventDispatcher.dispatch_event(sandbox.window, name, *args)
+
+
+def click_gui(sandbox: Any, x: float, top: float) -> None:
+    """Press and release at (x, top) in GUI pixels (from the top left), drawing between."""
+    y = round(sandbox.window.height - top)
+    event(sandbox, "on_mouse_motion", round(x), y, 0, 0)
+    sandbox.render()
+    event(sandbox, "on_mouse_press", round(x), y, mouse.LEFT, 0)
+    sandbox.render()
+    event(sandbox, "on_mouse_release", round(x), y, mouse.LEFT, 0)
+    sandbox.render()
+    sandbox.render()
+
+
+def click_item(sandbox: Any, name: str, fraction: float = 0.5) -> None:
+    """Click the GUI widget recorded as `name`, at `fraction` of its width."""
+    x0, y0, x1, y1 = sandbox.hud.gui.rects[name]
+    click_gui(sandbox, x0 + fraction * (x1 - x0), (y0 + y1) / 2)

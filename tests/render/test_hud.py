@@ -1,23 +1,156 @@
-"""HUD knobs: their sliders span exactly the API's (the schema's) ranges."""
+"""The ImGui HUD: layout without overlaps, scaling, hiding, sections, and its sliders."""
 
 from __future__ import annotations
 
+import itertools
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
 import pytest
+from PIL import Image
+from pyglet.window import key
 
-from ecs_tentacles.locomotion.params import TENTACLE_RANGES
-from ecs_tentacles.render.hud import KNOBS, Knob
-
-
-@pytest.mark.parametrize("knob", KNOBS, ids=[k.name for k in KNOBS])
-def test_each_slider_spans_the_range_and_round_trips(knob: Knob) -> None:
-    allowed = TENTACLE_RANGES[knob.name]
-    assert knob.value(100) == allowed.high
-    assert knob.value(0) in allowed  # an open lower bound (speed > 0) is never reached
-    assert knob.value(0) - allowed.low <= 1e-3 * (allowed.high - allowed.low)
-    for position in (0.0, 12.5, 50.0, 99.0, 100.0):
-        assert knob.slider(knob.value(position)) == pytest.approx(position, abs=1e-9)
+from ecs_tentacles.cli import main
+from ecs_tentacles.render.hud import PANEL_SHARE, panel_width
+from tests.render.conftest import click_gui, event
 
 
-def test_the_strength_slider_gives_the_default_room() -> None:
-    (strength,) = [k for k in KNOBS if k.name == "strength"]
-    assert 25 < strength.slider(25.0) < 35  # kp 25 (the default) sits a quarter of the way
+def overlaps(rects: dict[str, tuple[float, float, float, float]]) -> list[tuple[str, str]]:
+    return [
+        (a, b)
+        for (a, (ax0, ay0, ax1, ay1)), (b, (bx0, by0, bx1, by1)) in itertools.combinations(
+            rects.items(), 2
+        )
+        if ax0 < bx1 and bx0 < ax1 and ay0 < by1 and by0 < ay1
+    ]
+
+
+@pytest.mark.parametrize("size", [(1280, 720), (640, 360), (320, 240)])
+def test_widgets_never_overlap_and_fit_the_panel(
+    make_sandbox: Callable[..., Any], size: tuple[int, int]
+) -> None:
+    sandbox = make_sandbox("hedgehog_octopus", width=size[0], height=size[1])
+    sandbox.hud.sections.append(("Extra", lambda gui: None))
+    sandbox.render()
+    rects = sandbox.hud.gui.rects
+    assert {"speed label", "speed", "wave_amplitude label", "gait label", "groups"} <= set(rects)
+    assert overlaps(rects) == []
+    x0, y0, x1, y1 = sandbox.hud.gui.windows["panel"]
+    assert (x0, y0, x1, y1) == (0, 0, panel_width(*size), size[1])
+    assert x1 <= PANEL_SHARE * size[0]
+    windows = sandbox.hud.gui.windows
+    assert set(windows) == {"panel", "timeline"}  # hedgehog_octopus has fur: the fur tool
+    assert overlaps(windows) == []
+
+    def inside(r: tuple[float, ...], w: tuple[float, ...]) -> bool:
+        return w[0] <= r[0] and r[2] <= w[2] and w[1] <= r[1]
+
+    assert [n for n, r in rects.items() if not any(inside(r, w) for w in windows.values())] == []
+
+
+def test_panel_and_text_scale_with_the_window(make_sandbox: Callable[..., Any]) -> None:
+    heights = {}
+    for size in ((1280, 720), (640, 360)):
+        sandbox = make_sandbox("octopus", width=size[0], height=size[1])
+        sandbox.render()
+        rect = sandbox.hud.gui.rects["speed label"]
+        heights[size] = rect[3] - rect[1]
+    assert heights[(640, 360)] < 0.8 * heights[(1280, 720)]
+
+
+def _panel_pixels(pixels: np.ndarray, colour: np.ndarray) -> int:
+    return int((pixels == colour).all(axis=2).sum())
+
+
+def test_no_hud_flag_and_h_key_hide_the_panel(
+    make_sandbox: Callable[..., Any], tmp_path: Path
+) -> None:
+    sandbox = make_sandbox("octopus")
+    sandbox.render()
+    shown = sandbox.renderer.target.read()
+    background = shown[350, 5]  # the panel's own colour, bottom left
+    assert _panel_pixels(shown[:, : sandbox.hud.width], background) > 0.5 * 360 * sandbox.hud.width
+    event(sandbox, "on_key_press", key.H, 0)
+    assert sandbox.renderer.camera.shift_x == 0.0
+    sandbox.render()
+    assert _panel_pixels(sandbox.renderer.target.read(), background) == 0
+    event(sandbox, "on_key_press", key.H, 0)
+    sandbox.render()
+    assert (sandbox.renderer.target.read()[350, 5] == background).all()
+    shot = tmp_path / "bare.png"
+    argv = ["play", "octopus", "--headless", "--frames", "2", "--quiet", "--no-hud"]
+    assert main([*argv, "--width", "640", "--height", "360", "--screenshot", str(shot)]) == 0
+    with Image.open(shot) as image:
+        assert _panel_pixels(np.asarray(image), background) == 0
+
+
+def test_sections_collapse(make_sandbox: Callable[..., Any]) -> None:
+    sandbox = make_sandbox("octopus")
+    sandbox.render()
+    assert "speed" in sandbox.hud.gui.rects and "action 0" not in sandbox.hud.gui.rects
+    x0, y0, x1, y1 = sandbox.hud.gui.rects["Locomotion"]
+    click_gui(sandbox, (x0 + x1) / 2, (y0 + y1) / 2)
+    assert "speed" not in sandbox.hud.gui.rects and "Stats" in sandbox.hud.gui.rects
+    x0, y0, x1, y1 = sandbox.hud.gui.rects["Actions"]
+    click_gui(sandbox, (x0 + x1) / 2, (y0 + y1) / 2)
+    assert "action 7" in sandbox.hud.gui.rects
+
+
+def test_slider_click_reaches_the_servo_gains(make_sandbox: Callable[..., Any]) -> None:
+    sandbox = make_sandbox("octopus")
+    world = sandbox.world
+    octo = world.creature("octopus")
+    sandbox.render()
+    x0, y0, x1, y1 = sandbox.hud.gui.rects["strength"]
+    click_gui(sandbox, x0 + 0.75 * (x1 - x0), (y0 + y1) / 2)
+    kp = world.locomotion.get(octo, 0)["strength"]
+    # the knob jumped to where we clicked, on a logarithmic scale up to what damping holds
+    assert 10 < kp < world.locomotion.strength_limit(octo)
+    assert [world.locomotion.get(octo, k)["strength"] for k in range(8)] == [kp] * 8  # "all"
+    sandbox.step(1)
+    model = world.physics.groups[0].model
+    actuator = model.actuator("t3/l00/curl").id
+    row = int(world.tentacles.first_link[3])
+    assert model.actuator_gainprm[actuator, 0] == pytest.approx(
+        kp * world.motors.gain[row], rel=1e-12
+    )
+    x0, y0, x1, y1 = sandbox.hud.gui.rects["gait cyclic"]
+    click_gui(sandbox, (x0 + x1) / 2, (y0 + y1) / 2)
+    assert world.locomotion.get(octo, 0)["gait"] == "cyclic"
+
+
+def test_gui_draw_calls_do_not_grow_with_creatures(make_sandbox: Callable[..., Any]) -> None:
+    calls = []
+    for scene in ("octopus", "thesis_four_by_six"):
+        sandbox = make_sandbox(scene)
+        sandbox.render()
+        calls.append(sandbox.hud.gui.draw_commands)
+    assert calls[0] == calls[1] <= 8
+
+
+@pytest.mark.parametrize("name", ["speed", "target_angle", "strength", "wave_amplitude"])
+def test_each_slider_spans_the_schema_range(name: str) -> None:
+    from ecs_tentacles.locomotion.params import TENTACLE_RANGES
+    from ecs_tentacles.render.hud import KNOBS
+
+    (knob,) = [k for k in KNOBS if k.name == name]
+    allowed = TENTACLE_RANGES[name]
+    assert knob.high == pytest.approx(allowed.high * knob.to_shown)
+    assert knob.low / knob.to_shown in allowed  # an open lower bound (speed > 0) is never shown
+    assert knob.low / knob.to_shown - allowed.low <= 1e-3 * (allowed.high - allowed.low)
+
+
+def test_the_strength_slider_stops_where_the_damping_holds(
+    make_sandbox: Callable[..., Any],
+) -> None:
+    sandbox = make_sandbox("octopus")
+    world = sandbox.world
+    octo = world.creature("octopus")
+    sandbox.render()
+    _, y0, x1, y1 = sandbox.hud.gui.rects["strength"]
+    click_gui(sandbox, x1 - 1, (y0 + y1) / 2)
+    # damping 0.5 at 1/480 s holds at most kp 240 (damping >= strength x step)
+    assert world.locomotion.strength_limit(octo) == pytest.approx(240.0)
+    assert world.locomotion.get(octo, 5)["strength"] == pytest.approx(240.0, rel=1e-3)

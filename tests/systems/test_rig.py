@@ -132,3 +132,36 @@ def test_blocks_give_the_same_result_as_one_pass(
         results.append((world.fur.frames.copy(), world.fur.curves.copy()))
     np.testing.assert_array_equal(results[0][0], results[1][0])
     np.testing.assert_array_equal(results[0][1], results[1][1])
+
+
+def test_kernels_serial_or_parallel_and_numpy_give_the_same_fur(
+    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    pytest.importorskip("numba")
+    from ecs_tentacles.fur import rig as rig_math
+
+    scene = {
+        "version": 1,
+        "creatures": [
+            creature("cat", 0.0, {"preset": "cat", "groom": {"count": 700}}),
+            creature("bird", 2.0, {"preset": "bird", "groom": {"count": 90}}),
+        ],
+    }
+    scene["creatures"][0]["goals"] = [{"position": [1.0, 0.5]}]
+    results = {}
+    for backend, parallel_from in [("numpy", 0), ("auto", 1 << 40), ("auto", 0)]:
+        monkeypatch.setattr(rig_math, "BACKEND", backend)
+        monkeypatch.setattr(rig_math, "PARALLEL_GUIDES", parallel_from)
+        world = make_world(scene)
+        world.fur.controls.lift[:] = 0.4
+        world.fur.controls.random[:] = 0.6
+        world.step(40)
+        rig = world.schedule["rig"]
+        assert rig.strands is not None and len(rig.strands.guides) == 700  # the cat's
+        assert rig.parallel == (parallel_from == 0)
+        results[backend, parallel_from] = world.fur.curves.copy()
+    serial, parallel = results["auto", 1 << 40], results["auto", 0]
+    np.testing.assert_array_equal(serial, parallel)  # the same float32 operations
+    # the rig's own float32 rounding (see tests/fur/test_rig_kernels.py), carried by the strands
+    assert_allclose(serial, results["numpy", 0], atol=1e-5)
+    assert not rig_math.use_parallel(rig_math.PARALLEL_GUIDES - 1)

@@ -1,0 +1,200 @@
+"""Dear ImGui (imgui-bundle) drawn into pyglet's own GL context, windowed or headless.
+
+ImGui's C++ OpenGL 3 backend renders into whatever context is current, so it shares
+pyglet's EGL context off-screen (checked on Mesa llvmpipe) and draws into the
+sandbox's framebuffer after the 3D scene. Each `Gui` owns one ImGui context and
+feeds it pyglet's window events (y flipped: ImGui's origin is the top left).
+
+Panels are built every frame (immediate mode): a panel function calls ImGui
+between `begin_frame` and `end_frame`. `item(name)` records the last widget's
+rectangle, in pixels from the top left, so tests can check layout, and `contains`
+says whether a pixel belongs to the GUI (clicks there are not for the world).
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+from imgui_bundle import imgui
+from pyglet.window import key, mouse
+
+BASE_HEIGHT = 720  # the window height at which the GUI is drawn at scale 1
+
+_KEYS = {
+    key.TAB: imgui.Key.tab,
+    key.LEFT: imgui.Key.left_arrow,
+    key.RIGHT: imgui.Key.right_arrow,
+    key.UP: imgui.Key.up_arrow,
+    key.DOWN: imgui.Key.down_arrow,
+    key.HOME: imgui.Key.home,
+    key.END: imgui.Key.end,
+    key.DELETE: imgui.Key.delete,
+    key.BACKSPACE: imgui.Key.backspace,
+    key.RETURN: imgui.Key.enter,
+    key.ENTER: imgui.Key.keypad_enter,
+    key.ESCAPE: imgui.Key.escape,
+    key.LCTRL: imgui.Key.left_ctrl,
+    key.RCTRL: imgui.Key.right_ctrl,
+    key.LSHIFT: imgui.Key.left_shift,
+    key.RSHIFT: imgui.Key.right_shift,
+    key.A: imgui.Key.a,
+    key.C: imgui.Key.c,
+    key.V: imgui.Key.v,
+    key.X: imgui.Key.x,
+    key.Z: imgui.Key.z,
+}
+_BUTTONS = {mouse.LEFT: 0, mouse.RIGHT: 1, mouse.MIDDLE: 2}
+
+
+def gui_scale(height: int) -> float:
+    """Text and spacing scale for a window `height` pixels tall (0.7 to 1.5)."""
+    return min(1.5, max(0.7, height / BASE_HEIGHT))
+
+
+def same_line_if_fits(width: float) -> None:
+    """Continue the row when an item `width` pixels wide still fits, else start a new one."""
+    imgui.same_line()
+    if imgui.get_content_region_avail().x < width:
+        imgui.new_line()
+
+
+def text_width(label: str) -> float:
+    """Pixels a button or radio button labelled `label` needs (frame padding included)."""
+    return float(imgui.calc_text_size(label).x + 2 * imgui.get_frame_height())
+
+
+class Gui:
+    """One ImGui context bound to a pyglet window; draws into the current framebuffer."""
+
+    def __init__(self, window: Any):
+        self.window = window
+        self.context: Any = imgui.create_context()
+        imgui.set_current_context(self.context)
+        io = imgui.get_io()
+        io.set_ini_filename("")  # no imgui.ini written into the user's directory
+        io.config_input_trickle_event_queue = True  # a press and release are two frames
+        imgui.style_colors_light()
+        style = imgui.get_style()
+        style.window_rounding = 0.0
+        self.scale = 1.0
+        if not imgui.backends.opengl3_init("#version 330"):
+            raise RuntimeError("Dear ImGui could not initialise its OpenGL 3 renderer")
+        self.rects: dict[str, tuple[float, float, float, float]] = {}
+        self.windows: dict[str, tuple[float, float, float, float]] = {}
+        self._last = time.perf_counter()
+        self._in_frame = False
+        self.draw_commands = 0
+        self.frames = 0  # frames built so far
+
+    # -- events: pyglet -> ImGui -------------------------------------------------------
+    def _use(self) -> Any:
+        imgui.set_current_context(self.context)
+        return imgui.get_io()
+
+    def _mouse(self, x: float, y: float) -> Any:
+        io = self._use()
+        io.add_mouse_pos_event(float(x), float(self.window.height - y))
+        return io
+
+    def on_mouse_motion(self, x: int, y: int, dx: int, dy: int) -> None:
+        self._mouse(x, y)
+
+    def on_mouse_press(self, x: int, y: int, button: int, modifiers: int) -> None:
+        self._mouse(x, y).add_mouse_button_event(_BUTTONS.get(button, 0), True)
+
+    def on_mouse_release(self, x: int, y: int, button: int, modifiers: int) -> None:
+        self._mouse(x, y).add_mouse_button_event(_BUTTONS.get(button, 0), False)
+
+    def on_mouse_drag(self, x: int, y: int, dx: int, dy: int, buttons: int, modifiers: int) -> None:
+        self._mouse(x, y)
+
+    def on_mouse_scroll(self, x: int, y: int, scroll_x: float, scroll_y: float) -> None:
+        self._mouse(x, y).add_mouse_wheel_event(float(scroll_x), float(scroll_y))
+
+    def on_key_press(self, symbol: int, modifiers: int) -> None:
+        self._key(symbol, modifiers, True)
+
+    def on_key_release(self, symbol: int, modifiers: int) -> None:
+        self._key(symbol, modifiers, False)
+
+    def _key(self, symbol: int, modifiers: int, down: bool) -> None:
+        io = self._use()
+        io.add_key_event(imgui.Key.mod_ctrl, bool(modifiers & key.MOD_CTRL))
+        io.add_key_event(imgui.Key.mod_shift, bool(modifiers & key.MOD_SHIFT))
+        if symbol in _KEYS:
+            io.add_key_event(_KEYS[symbol], down)
+
+    def on_text(self, text: str) -> None:
+        io = self._use()
+        for character in text:
+            io.add_input_character(ord(character))
+
+    @property
+    def wants_keyboard(self) -> bool:
+        """True while a text field has the focus (keys are typed, not shortcuts)."""
+        return bool(self._use().want_text_input)
+
+    # -- frames ----------------------------------------------------------------------
+    def begin_frame(self) -> None:
+        """Start a GUI frame sized and scaled for the window."""
+        io = self._use()
+        io.display_size = (float(self.window.width), float(self.window.height))
+        now = time.perf_counter()
+        io.delta_time = max(now - self._last, 1e-4)
+        self._last = now
+        scale = gui_scale(self.window.height)
+        if scale != self.scale:  # only when the window is resized
+            style = imgui.get_style()
+            style.scale_all_sizes(scale / self.scale)
+            style.font_scale_main = scale
+            self.scale = scale
+        imgui.backends.opengl3_new_frame()
+        imgui.new_frame()
+        self.rects.clear()
+        self.windows.clear()
+        self._in_frame = True
+
+    def item(self, name: str) -> None:
+        """Record the last widget's rectangle (x0, y0, x1, y1 from the top left)."""
+        low, high = imgui.get_item_rect_min(), imgui.get_item_rect_max()
+        self.rects[name] = (low.x, low.y, high.x, high.y)
+
+    def window_rect(self, name: str) -> None:
+        """Record the current ImGui window's rectangle (call between begin and end)."""
+        pos, size = imgui.get_window_pos(), imgui.get_window_size()
+        self.windows[name] = (pos.x, pos.y, pos.x + size.x, pos.y + size.y)
+
+    def end_frame(self, draw: bool = True) -> int:
+        """Draw the frame into the bound framebuffer; return the GL draw calls issued."""
+        imgui.render()
+        self.frames += 1
+        if not draw:
+            self._in_frame = False
+            return 0
+        data = imgui.get_draw_data()
+        self.draw_commands = sum(
+            data.cmd_lists[i].cmd_buffer.size() for i in range(data.cmd_lists_count)
+        )
+        imgui.backends.opengl3_render_draw_data(data)
+        self._in_frame = False
+        return self.draw_commands
+
+    def skip_frame(self) -> None:
+        """No GUI this frame (hidden): forget last frame's rectangles."""
+        self.rects.clear()
+        self.windows.clear()
+
+    def contains(self, x: float, y: float) -> bool:
+        """True when pyglet pixel (x, y) is over one of last frame's GUI windows."""
+        top = self.window.height - y
+        return any(x0 <= x < x1 and y0 <= top < y1 for x0, y0, x1, y1 in self.windows.values())
+
+    def close(self) -> None:
+        """Free the GL objects and the ImGui context (the GL context must be current)."""
+        if self.context is None:
+            return
+        imgui.set_current_context(self.context)
+        imgui.backends.opengl3_shutdown()
+        imgui.destroy_context(self.context)
+        self.context = None
