@@ -135,6 +135,7 @@ def restore(world: World, snapshot: Snapshot) -> None:
     physics.health.frozen = health["frozen"]
     physics.health.causes = health["causes"]
     physics.health.recovered_frames = health["recovered_frames"]
+    physics.health.previous = world.transforms.pos.copy()  # no jump: speeds start here
     physics.sleep.still[:] = snapshot.sleep[0]
     physics.sleep.commands = [c.copy() for c in snapshot.sleep[1]]
     for entity, path in snapshot.goals.items():

@@ -43,7 +43,7 @@ if TYPE_CHECKING:
 
 C = TypeVar("C")
 FUR_SYSTEMS = ("emotion", "rig")  # kept with locomotion off: fur is not locomotion
-PHYSICS_SYSTEMS = ("physics", "physics_health", "physics_sync")
+PHYSICS_SYSTEMS = ("physics", "physics_sync", "physics_health")
 
 
 @dataclass(frozen=True)
@@ -171,6 +171,7 @@ class World:
             self._physics.close()
         self._physics = PhysicsBackend(self, threads)
         self._physics.sync(self.transforms)
+        self._physics.health.previous = self.transforms.pos.copy()
         return self._physics
 
     @property

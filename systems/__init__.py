@@ -10,8 +10,8 @@ writes; `World.schedule.names` shows the resolved order, user systems included):
 5. suckers             attach at the ground on command; release on command, stretch or reach
 6. physics             motor targets, gains, sucker switches, contact proxies -> every physics
                        group; mj_step x substeps on the thread pool
-7. physics_health      blow-ups found per creature; that creature restored to its last good state
-8. physics_sync        MuJoCo body poses -> Transform store
+7. physics_sync        MuJoCo body poses -> Transform store
+8. physics_health      blow-ups found per creature; that creature restored to its last good state
 9. emotion             threats near -> fear/aggression level -> fur controls' lift and random
 10. rig                fur guides posed from mantle poses and controls (tracks, dynamic blend)
 """
@@ -55,8 +55,8 @@ def builtin_systems() -> list[System]:
         MotorTargets(),
         Suckers(),
         Physics(),
-        PhysicsHealth(),
         PhysicsSync(),
+        PhysicsHealth(),
         EmotionSystem(),
         Rig(),
     ]

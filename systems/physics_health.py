@@ -1,10 +1,11 @@
 """physics_health: every creature's physics checked after the step; failures recovered.
 
-Reads: each physics group's MjData (warnings, qpos, qvel, poses, contacts), the
-Transform store (last frame's poses, for speeds). Writes: the failing group's MjData
-(restored to its last good state), Sucker store (its suckers released), events
-`creature_recovered` / `creature_frozen`. Runs before `physics_sync`, so a blown-up
-pose never reaches the store (`ecs_tentacles.physics.health`).
+Reads: each physics group's MjData (warnings, velocities, contacts), the Transform
+store (this frame's poses against last frame's, for speeds and non-finite poses).
+Writes: the failing group's MjData (restored to its last good state) and its
+Transform rows, Sucker store (its suckers released), events `creature_recovered` /
+`creature_frozen`. Runs right after `physics_sync`, before any system that reads
+poses, so no system sees a blown-up pose (`ecs_tentacles.physics.health`).
 """
 
 from __future__ import annotations
@@ -19,8 +20,7 @@ if TYPE_CHECKING:
 
 class PhysicsHealth(System):
     name = "physics_health"
-    after = ("physics",)
-    before = ("physics_sync",)
+    after = ("physics_sync",)
 
     def process(self, world: World, dt: float) -> None:
         world.physics.health.check(world)

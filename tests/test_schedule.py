@@ -52,8 +52,8 @@ BUILTIN = [
     "motor_targets",
     "suckers",
     "physics",
-    "physics_health",
     "physics_sync",
+    "physics_health",
     "emotion",
     "rig",
 ]
@@ -65,8 +65,8 @@ def test_builtin_order(make_world: Callable[..., World]) -> None:
     physics_only = make_world(creature_scene(count=3, links=2), locomotion=False)
     assert physics_only.schedule.names == [
         "physics",
-        "physics_health",
         "physics_sync",
+        "physics_health",
         "emotion",
         "rig",
     ]
@@ -82,8 +82,8 @@ def test_probe_records_frame_and_substep_order(make_world: Callable[..., World])
         "substep_probe",
         "early",
         "physics",
-        "physics_health",
         "physics_sync",
+        "physics_health",
         "emotion",
         "rig",
         "late",

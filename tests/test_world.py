@@ -97,8 +97,8 @@ def test_scene_systems_are_not_imported_unless_allowed(
     world = make_world(scene, allow_systems=True)
     assert world.schedule.names[-6:] == [
         "physics",
-        "physics_health",
         "physics_sync",
+        "physics_health",
         "emotion",
         "rig",
         "counter",

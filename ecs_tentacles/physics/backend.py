@@ -153,10 +153,8 @@ class PhysicsBackend:
 
     def sync(self, transforms: TransformStore) -> None:
         """Copy every body's world pose into the Transform store (one gather per group)."""
-        pos, quat = transforms.pos, transforms.quat
         for group in self.groups:
-            pos[group.body_rows] = group.data.xpos[group.body_ids]
-            quat[group.body_rows] = group.data.xquat[group.body_ids]
+            group.sync(transforms)
 
     # -- queries ---------------------------------------------------------------------
     @property

@@ -9,11 +9,15 @@ rows; the backend scatters controls through them and gathers poses back.
 from __future__ import annotations
 
 import copy
+from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
 
 from ecs_tentacles.physics.model import PROXY_CAPSULES, PROXY_CYLINDERS, PROXY_PARK, Layout
+
+if TYPE_CHECKING:
+    from ecs_tentacles.store import TransformStore
 
 STATE = mujoco.mjtState.mjSTATE_INTEGRATION  # everything mj_step reads, warm start included
 
@@ -63,6 +67,7 @@ class PhysicsGroup:
         self.error: str | None = None  # MuJoCo's fatal error in the last step, if any
         self.soften = 1.0  # servo gain multiplier while recovering (1 = normal)
         self.warnings = np.zeros(len(self.data.warning.number), dtype=np.int64)
+        self.warning_total = 0
         self.place(*pose)
 
     def place(self, pos: np.ndarray, quat: np.ndarray) -> None:
@@ -90,6 +95,11 @@ class PhysicsGroup:
         mujoco.mj_setState(self.model, self.data, state, STATE)
         if forward:
             mujoco.mj_forward(self.model, self.data)
+
+    def sync(self, transforms: TransformStore) -> None:
+        """Copy this group's body poses into the Transform store."""
+        transforms.pos[self.body_rows] = self.data.xpos[self.body_ids]
+        transforms.quat[self.body_rows] = self.data.xquat[self.body_ids]
 
     @property
     def active(self) -> bool:

@@ -13,10 +13,12 @@ group is checked:
 
 A failing creature is restored to a state saved at least `SAVE_EVERY` frames earlier
 (two are kept), its suckers are released and its servos softened for a moment, and
-`creature_recovered` is emitted with the cause. A creature that fails `FREEZE_AFTER`
+`creature_recovered` is emitted with the cause. The check runs right after
+`physics_sync` and puts a failing creature's rows back before any other system runs.
+A creature that fails `FREEZE_AFTER`
 times within `FREEZE_WINDOW` seconds is frozen where it last was good
 (`creature_frozen`, and one logged warning). Other creatures are never touched: each
-is its own group. Bad poses never reach the store, so a teleport never reaches a goal.
+is its own group. No system ever sees a bad pose, so a teleport never reaches a goal.
 """
 
 from __future__ import annotations
@@ -69,17 +71,33 @@ class PhysicsHealth:
         self.frozen = 0
         self.causes: dict[str, int] = {}
         self.recovered_frames: list[int] = []  # world frames on which a recovery happened
+        # every group's store rows, group by group, for whole-array speed checks
+        empty = np.zeros(0, dtype=np.int64)
+        self.rows = np.concatenate([g.body_rows for g in groups]) if groups else empty
+        counts = [len(g.body_rows) for g in groups]
+        self.start = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
+        self.previous = np.zeros((0, 3))  # last frame's poses (set on the first check)
 
     def check(self, world: World) -> None:
-        """Check every active group stepped this frame; recover the ones that failed."""
+        """Check every active group stepped this frame; recover the ones that failed.
+
+        Runs right after `physics_sync`: speeds and non-finite poses are read from the
+        Transform store as whole arrays; a failing group's rows are put back before any
+        other system reads them.
+        """
         limit = self.max_speed * world.settings.dt
         save = world.frame % SAVE_EVERY == 0
         ramp = world.settings.dt / SOFT_SECONDS
         pos = world.transforms.pos
+        if len(self.previous) != len(pos):
+            self.previous = pos.copy()
+        moved = pos[self.rows] - self.previous[self.rows]
+        step = np.einsum("ij,ij->i", moved, moved)  # nan where a pose is not finite
+        fastest = np.sqrt(np.maximum.reduceat(step, self.start)) if len(step) else step
         for group, health in zip(self.groups, self.state, strict=True):
             if not group.active:
                 continue
-            cause = self._cause(group, pos, limit)
+            cause = self._cause(group, float(fastest[group.index]), limit)
             if cause is not None:
                 self._recover(world, group, health, cause)
                 continue
@@ -87,24 +105,26 @@ class PhysicsHealth:
                 group.soften = min(1.0, group.soften + ramp * (1.0 - SOFT_GAIN))
             if save:
                 health.saved = [health.saved[1], group.get_state()]
+        self.previous[:] = pos
 
-    def _cause(self, group: PhysicsGroup, pos: np.ndarray, limit: float) -> str | None:
+    def _cause(self, group: PhysicsGroup, fastest: float, limit: float) -> str | None:
         d = group.data
         if group.error is not None:
             cause, group.error = f"fatal {group.error}", None
             return cause
         counts = d.warning.number
-        if (counts > group.warnings).any():
+        if int(counts.sum()) != group.warning_total:
             raised = np.flatnonzero(counts > group.warnings)
             group.warnings[:] = counts
+            group.warning_total = int(counts.sum())
             names = sorted(WARNINGS.get(int(i), f"warning{i}") for i in raised)
             return f"mujoco {', '.join(names)}"
-        if not (np.isfinite(d.qpos).all() and np.isfinite(d.qvel).all()):
+        if not fastest <= limit:  # also nan: a pose that is not finite
+            if not np.isfinite(fastest):
+                return "non-finite state"
+            return f"speed {fastest / limit * self.max_speed:.3g} m/s"
+        if not np.isfinite(d.qvel.sum()):
             return "non-finite state"
-        moved = d.xpos[group.body_ids] - pos[group.body_rows]
-        speed = float(np.sqrt(np.einsum("ij,ij->i", moved, moved).max()))
-        if not speed <= limit:
-            return f"speed {speed / limit * self.max_speed:.3g} m/s"
         if d.ncon and d.contact.dist.min() < -self.max_penetration:
             return f"penetration {-1000 * d.contact.dist.min():.1f} mm"
         return None
@@ -117,6 +137,8 @@ class PhysicsHealth:
         group.set_state(health.saved[0])
         group.data.time = world.physics.time
         group.warnings[:] = group.data.warning.number
+        group.warning_total = int(group.warnings.sum())
+        group.sync(world.transforms)  # its rows, before any other system reads them
         group.soften = SOFT_GAIN
         if len(group.equality_ids):
             group.data.eq_active[group.equality_ids] = 0

@@ -46,6 +46,8 @@ PROXY_CAPSULES = 64
 PROXY_CYLINDERS = 4
 PROXY_PARK = np.array([1.0e4, 0.0, -1.0e4])  # unused proxies wait here, 10 m apart
 
+ARENA_BYTES = 4 << 20
+
 # MuJoCo takes the larger friction of two touching geoms: creature skin is zero so the
 # scene's ground_friction alone sets how creatures slide.
 SKIN_FRICTION = [0.0, 0.0, 0.0]
@@ -135,6 +137,10 @@ def build_spec(world: World, creature: Creature) -> mujoco.MjSpec:
     spec.option.gravity = list(settings.gravity)
     # The framework, not MuJoCo, decides what happens after a blow-up (physics/health.py).
     spec.option.disableflags |= mujoco.mjtDisableBit.mjDSBL_AUTORESET
+    # MuJoCo's default arena (24 MB for an octopus) is 80x what a crawling creature uses
+    # (0.3 MB): at 1,024 creatures that was 4-5 GB resident. A blow-up that overflows
+    # this one is caught as a fatal error and recovered (physics/health.py).
+    spec.memory = ARENA_BYTES
     spec.worldbody.add_geom(
         name="ground",
         type=mujoco.mjtGeom.mjGEOM_PLANE,

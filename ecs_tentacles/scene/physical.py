@@ -7,7 +7,8 @@ each problem is one line naming its JSON path, like the validator's:
 
 * the physics step `1 / (fps * substeps)` longer than `MAX_SUBSTEP` (servos at the
   schema's highest strength and contacts are stable up to it);
-* gravity pointing up, or pulling sideways harder than the ground's friction holds: the
+* gravity pointing up, tilted more than 45 degrees (creatures tumble over and fall away
+  ever faster), or pulling sideways harder than the ground's friction holds: the
   creatures would fall or slide away ever faster (sliding at 100 m/s blew contacts up);
 * a body too light for MuJoCo (it refuses masses and inertias under mjMINVAL = 1e-15;
   we keep `MIN_MASS` and `MIN_INERTIA` a thousand times above that), or a link shorter
@@ -115,6 +116,11 @@ def _gravity_problems(physics: dict[str, Any]) -> list[tuple[Path, str]]:
     sideways, friction = math.hypot(x, y), physics["ground_friction"]
     if z > 0:
         message = f"points up (z = {z:g}): creatures would fall away from the ground; use z <= 0"
+    elif sideways > -z:
+        message = (
+            f"tilts more than 45 degrees (sideways {sideways:.3g} m/s^2 against z = {z:g}):"
+            " creatures would tumble over and fall ever faster; keep |sideways| <= |z|"
+        )
     elif sideways > friction * -z:
         message = (
             f"pulls sideways ({sideways:.3g} m/s^2) harder than ground_friction {friction:g}"

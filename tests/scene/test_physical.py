@@ -87,6 +87,12 @@ REFUSED: list[tuple[str, dict[str, Any], str]] = [
         " ground_friction",
     ),
     (
+        "gravity tilted past 45 degrees",
+        scene({}, gravity=[0, -20, -10]),
+        "physics.gravity: tilts more than 45 degrees (sideways 20 m/s^2 against z = -10):"
+        " creatures would tumble over and fall ever faster; keep |sideways| <= |z|",
+    ),
+    (
         "gravity pointing up",
         scene({}, gravity=[0, 0, 5]),
         "physics.gravity: points up (z = 5): creatures would fall away from the ground; use z <= 0",
