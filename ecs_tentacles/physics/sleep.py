@@ -35,7 +35,7 @@ class Sleep:
     @property
     def asleep(self) -> int:
         """Groups asleep now."""
-        return sum(g.sleeping for g in self.groups)
+        return int(sum(g.sleeping for g in self.groups))
 
     def update(self, world: World) -> None:
         """Put still groups to sleep and wake the ones whose situation changed."""
@@ -64,4 +64,4 @@ class Sleep:
                 continue
             moving = float(np.abs(d.qvel).max(initial=0.0)) >= STILL_SPEED
             self.still[group.index] = 0 if moving else self.still[group.index] + 1
-            group.sleeping = self.still[group.index] >= SETTLE_FRAMES
+            group.sleeping = bool(self.still[group.index] >= SETTLE_FRAMES)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 from collections.abc import Callable
 from typing import Any
 
@@ -30,6 +31,7 @@ def test_a_still_idle_creature_sleeps_and_a_goal_wakes_it(
     world.step(240)  # settles on the ground, then lies still
     assert rest.sleeping and not busy.sleeping  # the writhing one never sleeps
     assert world.physics.sleep.asleep == 1
+    assert json.dumps({"asleep": world.physics.sleep.asleep}) == '{"asleep": 1}'  # bench JSON
     state = rest.get_state()
     world.step(30)
     assert_array_equal(rest.get_state(), state)  # not stepped at all
