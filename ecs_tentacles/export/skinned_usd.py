@@ -29,7 +29,7 @@ import numpy as np
 
 from ecs_tentacles.export.atomic import atomic_output
 from ecs_tentacles.export.take import Take
-from ecs_tentacles.export.usd import _goal, _guides, _pxr
+from ecs_tentacles.export.usd import _goal, _guides, _pxr, new_stage
 from ecs_tentacles.mathutil import quat_rotate
 from ecs_tentacles.skin.keys import KeyReport
 from ecs_tentacles.skin.mesh import Detail
@@ -58,14 +58,8 @@ def build_skinned_stage(
     pxr = _pxr()
     importlib.import_module("pxr.UsdSkel")  # the skel schemas, into the `pxr` namespace
 
-    Usd, UsdGeom = pxr.Usd, pxr.UsdGeom
-    stage = Usd.Stage.CreateInMemory()
-    UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.z)
-    UsdGeom.SetStageMetersPerUnit(stage, 1.0)
-    stage.SetTimeCodesPerSecond(take.fps)
-    stage.SetFramesPerSecond(take.fps)
-    stage.SetStartTimeCode(0)
-    stage.SetEndTimeCode(take.frames - 1)
+    UsdGeom = pxr.UsdGeom
+    stage = new_stage(take)
     stage.SetDefaultPrim(UsdGeom.Xform.Define(stage, "/World").GetPrim())
     creatures, report = skinned_creatures(take, detail, keys)
     for creature in creatures:

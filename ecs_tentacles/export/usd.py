@@ -63,17 +63,24 @@ def write_usd(
             raise OSError(f"{path}: USD could not write the file")
 
 
-def build_stage(take: Take, progress: Callable[[int], object] | None = None) -> Any:
-    """An in-memory `Usd.Stage` holding the take; `progress(1)` after each body."""
-    pxr = _pxr()
-    Usd, UsdGeom = pxr.Usd, pxr.UsdGeom
-    stage = Usd.Stage.CreateInMemory()
+def new_stage(take: Take) -> Any:
+    """An empty in-memory stage: z up, metres, the take's frame rate and frame range."""
+    UsdGeom = _pxr().UsdGeom
+    stage = _pxr().Usd.Stage.CreateInMemory()
     UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.z)
     UsdGeom.SetStageMetersPerUnit(stage, 1.0)
     stage.SetTimeCodesPerSecond(take.fps)
     stage.SetFramesPerSecond(take.fps)
     stage.SetStartTimeCode(0)
     stage.SetEndTimeCode(take.frames - 1)
+    return stage
+
+
+def build_stage(take: Take, progress: Callable[[int], object] | None = None) -> Any:
+    """An in-memory `Usd.Stage` holding the take; `progress(1)` after each body."""
+    pxr = _pxr()
+    UsdGeom = pxr.UsdGeom
+    stage = new_stage(take)
     root = UsdGeom.Xform.Define(stage, "/World")
     stage.SetDefaultPrim(root.GetPrim())
     header = take.header
