@@ -3,10 +3,7 @@
 from __future__ import annotations
 
 import json
-import os
-import shutil
 import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -23,13 +20,6 @@ from ecs_tentacles.export.meshes import body_mesh
 from ecs_tentacles.export.take import Take
 
 ROOT = Path(__file__).resolve().parents[2]
-
-
-def validator_package() -> Path:
-    """Where the npm package `gltf-validator` is: $ECS_TENTACLES_GLTF_VALIDATOR, else the
-    folder .ci/run installs it in (<venv>/node/node_modules/gltf-validator)."""
-    default = Path(sys.prefix) / "node" / "node_modules" / "gltf-validator"
-    return Path(os.environ.get("ECS_TENTACLES_GLTF_VALIDATOR", default))
 
 
 def test_nodes_and_animation_hold_the_take_turned_y_up(guided_take: Take, tmp_path: Path) -> None:
@@ -96,17 +86,10 @@ def test_meshes_are_closed_outward_and_have_no_degenerate_triangles(shape: str, 
     np.testing.assert_allclose(extent, expected, rtol=1e-6)
 
 
-def test_the_khronos_validator_finds_nothing(guided_take: Take, tmp_path: Path) -> None:
-    node = shutil.which("node")
-    if node is None:
-        pytest.skip("node is not on PATH, so the Khronos glTF validator (npm) cannot run")
-    package = validator_package()
-    if not (package / "package.json").is_file():
-        pytest.skip(
-            f"the npm package gltf-validator is not at {package}: `npm install --prefix"
-            f" {Path(sys.prefix) / 'node'} gltf-validator` (.ci/run does) or set"
-            " ECS_TENTACLES_GLTF_VALIDATOR"
-        )
+def test_the_khronos_validator_finds_nothing(
+    guided_take: Take, tmp_path: Path, gltf_validator: tuple[str, Path]
+) -> None:
+    node, package = gltf_validator
     write_glb(guided_take, tmp_path / "take.glb")
     result = subprocess.run(
         [node, str(ROOT / "tools" / "validate_gltf.cjs"), str(tmp_path / "take.glb"), str(package)],
