@@ -89,7 +89,6 @@ def take(world: World) -> Snapshot:
                 "recoveries": health.recoveries,
                 "frozen": health.frozen,
                 "causes": health.causes,
-                "recovered_frames": health.recovered_frames,
             }
         ),
         sleep=(physics.sleep.still.copy(), [c.copy() for c in physics.sleep.commands]),
@@ -134,7 +133,6 @@ def restore(world: World, snapshot: Snapshot) -> None:
     physics.health.recoveries = health["recoveries"]
     physics.health.frozen = health["frozen"]
     physics.health.causes = health["causes"]
-    physics.health.recovered_frames = health["recovered_frames"]
     physics.health.previous = world.transforms.pos.copy()  # no jump: speeds start here
     physics.sleep.still[:] = snapshot.sleep[0]
     physics.sleep.commands = [c.copy() for c in snapshot.sleep[1]]

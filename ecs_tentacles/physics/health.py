@@ -70,7 +70,6 @@ class PhysicsHealth:
         self.recoveries = 0
         self.frozen = 0
         self.causes: dict[str, int] = {}
-        self.recovered_frames: list[int] = []  # world frames on which a recovery happened
         # every group's store rows, group by group, for whole-array speed checks
         empty = np.zeros(0, dtype=np.int64)
         self.rows = np.concatenate([g.body_rows for g in groups]) if groups else empty
@@ -147,8 +146,6 @@ class PhysicsHealth:
             world.release(int(suckers.entity[row]), "recovery")
         creature = group.creatures[0]
         self.recoveries += 1
-        if not self.recovered_frames or self.recovered_frames[-1] != world.frame:
-            self.recovered_frames.append(world.frame)
         world.events.emit("creature_recovered", world=world, creature=creature, cause=cause)
         if len(health.failures) >= FREEZE_AFTER:
             group.data.qvel[:] = 0.0

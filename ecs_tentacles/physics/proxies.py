@@ -58,7 +58,6 @@ class ContactProxies:
         self.start = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
         self.count = counts.astype(np.int64)
         self.mantle = self.start  # a group's first body is its mantle
-        self.pairs = 0  # creature pairs near each other last frame
 
     def update(self, transforms: TransformStore) -> None:
         """Give every creature proxies of the other creatures' bodies near it."""
@@ -91,7 +90,6 @@ class ContactProxies:
         reach = np.linalg.norm(pos - centre[self.owner], axis=1) + self.rbound
         radius = np.maximum.reduceat(reach, self.start)
         a, b = _near_pairs(centre, radius)
-        self.pairs = len(a) // 2
         placed = self._assign(a, b, pos, centre, radius) if len(a) else {}
         for group in self.groups:
             found = placed.get(group.index)

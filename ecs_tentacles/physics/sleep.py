@@ -39,6 +39,8 @@ class Sleep:
 
     def update(self, world: World) -> None:
         """Put still groups to sleep and wake the ones whose situation changed."""
+        if not self.enabled:  # nothing ever sleeps: no per-group work
+            return
         has_goal = world.creatures.has_goal
         attached = world.suckers.attached
         for group in self.groups:
@@ -48,8 +50,7 @@ class Sleep:
             commands = np.concatenate((d.ctrl, m.actuator_gainprm[:, 0]))
             previous = self.commands[group.index]
             calm = (
-                self.enabled
-                and not has_goal[group.creature_row]
+                not has_goal[group.creature_row]
                 and not group.proxies_used
                 and not attached[group.sucker_rows].any()
                 and len(previous) == len(commands)
