@@ -1,9 +1,10 @@
-"""Scene data -> entities: creatures, tentacles, links, suckers and goals.
+"""Scene data -> a creature's body: the creature, its tentacles, links and suckers.
 
 Takes a validated scene dict with defaults applied (`ecs_tentacles.scene.load`)
 and creates the entities with their components and store rows, posed by the
-construction rules (`ecs_tentacles.construction`). Physics is built afterwards,
-from these entities (`ecs_tentacles.physics.model`).
+construction rules (`ecs_tentacles.construction`). Plugins then add what they own to
+each creature (goals, action queues, fur: their `build_creature` hooks). Physics is
+built afterwards, from these entities (`ecs_tentacles.physics.model`).
 """
 
 from __future__ import annotations
@@ -15,14 +16,10 @@ import numpy as np
 
 from ecs_tentacles.components import Creature, Link, Motor, Sucker, Tentacle, Transform
 from ecs_tentacles.construction import CreatureLayout, creature_layout
-from ecs_tentacles.fur.build import build_creature_extras
-from ecs_tentacles.locomotion.actions import STRENGTH, ActionQueue, Kind
 from ecs_tentacles.mathutil import quat_about_z
 
 if TYPE_CHECKING:
     from ecs_tentacles.world import World
-
-GAITS = {"cyclic": 0, "coordinated": 1}
 
 
 def creature_rng(seed: int, name: str) -> np.random.Generator:
@@ -51,18 +48,12 @@ def build_creature(world: World, spec: dict[str, Any]) -> int:
     )
     centre = layout.origin + np.array([0.0, 0.0, 0.5 * mantle["height"]])
     row = int(world.transforms.add(pos=centre, quat=turn)[0])
-    locomotion = spec["locomotion"]
     creature.row = int(
         world.creatures.add(
             mantle_row=row,
             mantle_radius=mantle["radius"],
             first_tentacle=len(world.tentacles),
             tentacles=tentacles["count"],
-            gait=GAITS[locomotion["gait"]],
-            speed=locomotion["speed"],
-            drivers=min(locomotion["drivers"], tentacles["count"]),
-            release_stretch=locomotion["release_stretch"],
-            release_reach=locomotion["release_reach"],
         )[0]
     )
     creature_entity = world.create_entity(creature, Transform(world.transforms, row))
@@ -71,15 +62,10 @@ def build_creature(world: World, spec: dict[str, Any]) -> int:
     rng = creature_rng(world.seed, spec["name"])
     for k, angle in enumerate(layout.angles):
         tentacle = Tentacle(creature=creature_entity, index=k, base_angle=float(angle))
-        tentacle_entity = world.create_entity(tentacle, ActionQueue())
+        tentacle_entity = world.create_entity(tentacle)
         creature.tentacles.append(tentacle_entity)
         _build_links(world, tentacle, tentacle_entity, layout, k)
         _add_tentacle_row(world, tentacle, creature.row, layout, k, rng)
-    for goal in spec["goals"]:
-        point = list(goal["position"]) + ([0.0] if len(goal["position"]) == 2 else [])
-        world.goals.append(creature_entity, point, goal["radius"])
-    if "fur" in spec or "emotion" in spec or spec.get("threat"):
-        build_creature_extras(world, creature_entity, spec)
     return creature_entity
 
 
@@ -113,7 +99,6 @@ def _add_tentacle_row(
             wavelength=params["wavelength"],
             writhe=params["writhe"],
             phase=rng.uniform(0.0, 2.0 * np.pi),
-            action_strength=STRENGTH[Kind.IDLE],
         )[0]
     )
     world.motors.tentacle_row[[m.row for m in motors]] = tentacle.row

@@ -6,9 +6,10 @@
 
 A snapshot holds every store's live rows, each physics group's integration state
 (`mj_getState`: positions, velocities, warm start, controls, sucker switches, proxy
-poses) and run-time flags, the health check's saved states, every creature's goal
-path, every tentacle's pending actions, the state systems declare
-(`System.state_attributes`), the frame counter and the random generator. It lives in
+poses) and run-time flags, the health check's saved states, what each plugin saves
+(`Plugin.snapshot`: goal paths and action queues, fur stores, threats), the state
+systems declare (`System.state_attributes`), the frame counter and the random
+generator. It lives in
 memory and belongs to the world it came from (same entities, same groups).
 """
 
@@ -19,9 +20,6 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-
-from ecs_tentacles.components import Creature, Goal
-from ecs_tentacles.locomotion.actions import ActionQueue
 
 if TYPE_CHECKING:
     from ecs_tentacles.store import ArrayStore
@@ -36,28 +34,20 @@ class Snapshot:
     physics_time: float
     rng: dict[str, Any]
     stores: dict[str, tuple[int, dict[str, np.ndarray]]]
-    fur_outputs: tuple[np.ndarray, np.ndarray]
     groups: list[dict[str, Any]]
     health: dict[str, Any]
     sleep: tuple[np.ndarray, list[np.ndarray]]
-    goals: dict[int, list[tuple[np.ndarray, float]]]
-    queues: dict[int, Any]
+    plugins: dict[str, Any]
     systems: dict[str, dict[str, Any]] = field(default_factory=dict)
 
 
 def _stores(world: World) -> dict[str, ArrayStore]:
-    fur = world.fur
     return {
         "transforms": world.transforms,
         "motors": world.motors,
         "suckers": world.suckers,
         "creatures": world.creatures,
         "tentacles": world.tentacles,
-        "fur.guides": fur.guides,
-        "fur.controls": fur.controls,
-        "fur.sets": fur.sets,
-        "fur.emotions": fur.emotions,
-        "fur.threats": fur.threats,
     }
 
 
@@ -73,7 +63,6 @@ def take(world: World) -> Snapshot:
             name: (store.count, {f: a[: store.count].copy() for f, a in store._arrays.items()})
             for name, store in _stores(world).items()
         },
-        fur_outputs=(world.fur.curves.copy(), world.fur.frames.copy()),
         groups=[
             {
                 "state": group.get_state(),
@@ -92,14 +81,7 @@ def take(world: World) -> Snapshot:
             }
         ),
         sleep=(physics.sleep.still.copy(), [c.copy() for c in physics.sleep.commands]),
-        goals={
-            entity: [
-                (world.component(g, Goal).position.copy(), world.component(g, Goal).radius)
-                for g in world.goals.path(entity)
-            ]
-            for entity, _ in world.query(Creature)
-        },
-        queues={entity: copy.deepcopy(queue.pending) for entity, queue in world.query(ActionQueue)},
+        plugins={plugin.key: plugin.snapshot(world) for plugin in world.plugins},
         systems={
             system.name: {a: copy.deepcopy(getattr(system, a)) for a in system.state_attributes}
             for system in world.schedule
@@ -117,8 +99,6 @@ def restore(world: World, snapshot: Snapshot) -> None:
         store.count = count
         for f, values in arrays.items():
             store._arrays[f][:count] = values
-    world.fur.curves[...] = snapshot.fur_outputs[0]
-    world.fur.frames[...] = snapshot.fur_outputs[1]
     physics = world.physics
     physics.time = snapshot.physics_time
     for group, saved in zip(physics.groups, snapshot.groups, strict=True):
@@ -136,12 +116,8 @@ def restore(world: World, snapshot: Snapshot) -> None:
     physics.health.previous = world.transforms.pos.copy()  # no jump: speeds start here
     physics.sleep.still[:] = snapshot.sleep[0]
     physics.sleep.commands = [c.copy() for c in snapshot.sleep[1]]
-    for entity, path in snapshot.goals.items():
-        world.goals.clear(entity)
-        for position, radius in path:
-            world.goals.append(entity, position.tolist(), radius)
-    for entity, queue in world.query(ActionQueue):
-        queue.pending = copy.deepcopy(snapshot.queues[entity])
+    for plugin in world.plugins:
+        plugin.restore(world, snapshot.plugins[plugin.key])
     for system in world.schedule:
         for attribute, value in snapshot.systems.get(system.name, {}).items():
             setattr(system, attribute, copy.deepcopy(value))

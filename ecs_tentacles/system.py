@@ -1,18 +1,26 @@
 """The `System` base class, shared by built-in and user systems.
 
-A system has a unique `name` and declares its place in the frame by name:
-`after = ("physics",)`, `before = ("render",)`. The `Schedule` turns those into
-one explicit order (see `World.schedule.names`); esper's processor priorities are
-not used, because `esper.add_processor` silently overwrites a priority attribute.
+A system has a unique `name`, runs in one of the frame's public stages and may order
+itself inside its stage by name. It declares the store fields it reads and writes, so
+the schedule can print the frame's data flow and warn about two unordered writers:
 
     class Wobble(System):
         '''Reads Motor.target; writes Motor.target (adds a wobble).'''
         name = "wobble"
-        after = ("motor_targets",)
-        before = ("physics",)
+        stage = "act"
+        after = ("motor_targets",)      # a no-op when motor_targets is not scheduled
+        reads = ("motors.target",)
+        writes = ("motors.target",)
 
         def process(self, world, dt):
             world.motors.target[:, 0] += 0.1 * np.sin(world.time)
+
+Stages, in frame order (`STAGES`): `decide` (goals, who drives), `act` (actions, motor
+targets, suckers), `physics` (stepping), `sync` (poses back, health), `animate` (fur,
+emotion) and `output` (record, render). A system without a `stage` joins the stage of
+the last system it runs `after`, else of the first it runs `before`, else `act`.
+esper's processor priorities are not used: `esper.add_processor` silently overwrites
+a priority attribute.
 """
 
 from __future__ import annotations
@@ -22,15 +30,22 @@ from typing import TYPE_CHECKING, ClassVar
 if TYPE_CHECKING:
     from ecs_tentacles.world import World
 
+STAGES = ("decide", "act", "physics", "sync", "animate", "output")
+DEFAULT_STAGE = "act"
+
 
 class System:
     """One job per frame. Override `process`; optionally `substep` and `setup`."""
 
     name: ClassVar[str] = ""
+    stage: ClassVar[str | None] = None  # one of STAGES; None: inferred from after/before
     after: ClassVar[tuple[str, ...]] = ()
     before: ClassVar[tuple[str, ...]] = ()
+    reads: ClassVar[tuple[str, ...]] = ()  # "store.field" names, e.g. "motors.target"
+    writes: ClassVar[tuple[str, ...]] = ()
     # attributes that carry simulation state from frame to frame (copied by snapshots)
     state_attributes: ClassVar[tuple[str, ...]] = ()
+    plugin: str = ""  # the plugin that added this system ("" when added directly)
 
     def setup(self, world: World) -> None:
         """Called once when the system joins a world (after physics is built)."""
@@ -47,3 +62,19 @@ class System:
 
     def __repr__(self) -> str:
         return f"<system {self.name}>"
+
+
+class SystemFailure(RuntimeError):
+    """A system raised while processing a frame; the original exception is `__cause__`."""
+
+    def __init__(self, system: System, label: str, frame: int, error: BaseException):
+        self.system = system
+        self.label = label  # the name it is scheduled under
+        self.frame = frame
+        self.error = error
+        owner = f" (plugin {system.plugin!r})" if system.plugin else ""
+        first = str(error).splitlines()[0] if str(error) else ""
+        super().__init__(
+            f"system {label!r}{owner} failed at frame {frame}: {type(error).__name__}"
+            + (f": {first}" if first else "")
+        )

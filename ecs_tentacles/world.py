@@ -13,8 +13,9 @@ from __future__ import annotations
 
 import importlib
 import os
+import pathlib
 import uuid
-from collections.abc import Collection, Iterator
+from collections.abc import Collection, Iterator, Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, TypeVar
 
@@ -23,11 +24,9 @@ import numpy as np
 
 from ecs_tentacles.components import Creature, Sucker
 from ecs_tentacles.events import Events
-from ecs_tentacles.fur.stores import FurData
-from ecs_tentacles.locomotion.goals import GoalBook
-from ecs_tentacles.locomotion.params import Locomotion
 from ecs_tentacles.mathutil import quat_rotate
 from ecs_tentacles.physics.backend import PhysicsBackend
+from ecs_tentacles.plugin import Plugin, SystemsPlugin, scene_first
 from ecs_tentacles.schedule import Schedule
 from ecs_tentacles.store import (
     CreatureStore,
@@ -36,14 +35,13 @@ from ecs_tentacles.store import (
     TentacleStore,
     TransformStore,
 )
-from ecs_tentacles.system import System
+from ecs_tentacles.system import System, SystemFailure
 
 if TYPE_CHECKING:
     from ecs_tentacles.snapshot import Snapshot
 
 C = TypeVar("C")
-FUR_SYSTEMS = ("emotion", "rig")  # kept with locomotion off: fur is not locomotion
-PHYSICS_SYSTEMS = ("physics", "physics_sync", "physics_health")
+LOCOMOTION_PLUGINS = ("locomotion", "suckers")  # their systems stay out with locomotion=False
 
 
 @dataclass(frozen=True)
@@ -85,9 +83,8 @@ class World:
         self.suckers = SuckerStore()
         self.creatures = CreatureStore()
         self.tentacles = TentacleStore()
-        self.goals = GoalBook(self)
-        self.fur = FurData()  # fur guides, controls, emotions, threats
-        self.locomotion = Locomotion(self)
+        self.plugins: list[Plugin] = []
+        self.resources: dict[str, Any] = {}  # plugins' stores and APIs, also world.<name>
         self.schedule = Schedule()
         self.events = Events()
         self._physics: PhysicsBackend | None = None
@@ -105,27 +102,37 @@ class World:
         locomotion: bool = True,
         threads: int | None = None,
         only: Collection[int] | None = None,
+        plugins: Mapping[str, Any] | None = None,
+        scene_dir: str | os.PathLike[str] | None = None,
     ) -> World:
         """Build a world from a scene file, bundled scene name or dict.
 
-        Validates, builds the entities, compiles the physics, schedules the systems.
+        Validates, builds the entities (the creature bodies, then each plugin's build
+        hooks), compiles the physics, schedules the systems of every plugin on.
 
-        Raises `SceneError` (one line per problem) before anything is built. Systems the
-        scene names are imported only with `allow_systems=True`. With `locomotion=False`
-        only the physics systems run, so scripts drive the motors themselves. `threads`
+        Raises `SceneError` (one line per problem) before anything is built. Plugins
+        from a file or module, and systems the scene names, are imported only with
+        `allow_systems=True`; files are looked up in the scene's folder (`scene_dir` for
+        a dict). `plugins` turns plugins on, off or configures them over what the scene
+        says. With `locomotion=False` the locomotion and suckers plugins build their data
+        but their systems do not run, so scripts drive the motors themselves. `threads`
         steps the physics groups on that many threads (default: one per core); results
         do not depend on it. `only` builds just the creatures at those scene indices (a
         shard of a distributed bake); `world.scene` is still the whole scene.
         """
         from ecs_tentacles.build import build_creature
-        from ecs_tentacles.fur.build import build_threats
         from ecs_tentacles.scene.errors import SceneError
-        from ecs_tentacles.scene.load import load_scene, resolve_scene_path
-        from ecs_tentacles.systems import builtin_systems
+        from ecs_tentacles.scene.load import load_scene_plugins, resolve_scene_path
+        from ecs_tentacles.systems import core_systems
 
+        folder = pathlib.Path(scene_dir) if scene_dir is not None else None
         if not isinstance(source, dict):
             source = resolve_scene_path(os.fspath(source))  # a path, or a bundled scene's name
-        data = load_scene(source)
+            folder = source.resolve().parent
+        if plugins:  # the caller's choices over the scene's
+            raw = source if isinstance(source, dict) else _read_scene(source)
+            source = {**raw, "plugins": {**(raw.get("plugins") or {}), **plugins}}
+        data, chosen = load_scene_plugins(source, allow_systems=allow_systems, scene_dir=folder)
         if data["systems"] and not allow_systems:  # checked before importing anything
             raise SceneError(
                 [
@@ -134,7 +141,10 @@ class World:
                     for i, path in enumerate(data["systems"])
                 ]
             )
-        extra = _import_systems(data["systems"])
+        if data["systems"]:
+            legacy = SystemsPlugin(_import_systems(data["systems"], folder))
+            legacy.key, legacy.source = "systems", "the scene's systems list"
+            chosen.append(legacy)
         physics = data["physics"]
         settings = Settings(
             fps=float(physics["fps"]),
@@ -150,15 +160,21 @@ class World:
             settings, seed=data["seed"] if seed is None else seed, name=data.get("name", "scene")
         )
         world.scene = data
+        for plugin in chosen:
+            world._adopt(plugin)
         for index, creature in enumerate(data["creatures"]):
             if only is None or index in only:
-                build_creature(world, creature)
-        build_threats(world, data["threats"])
+                entity = build_creature(world, creature)
+                for plugin in chosen:
+                    plugin.build_creature(world, entity, creature)
+        for plugin in chosen:
+            plugin.build_scene(world, data)
         world.build_physics(threads)
-        systems = builtin_systems()
-        if not locomotion:
-            systems = [s for s in systems if s.name in (*PHYSICS_SYSTEMS, *FUR_SYSTEMS)]
-        world.add_systems(*systems, *(factory() for factory in extra))
+        systems = core_systems()
+        for plugin in chosen:
+            if locomotion or plugin.key not in LOCOMOTION_PLUGINS:
+                systems += _owned(plugin)
+        world.add_systems(*systems)
         return world
 
     def build_physics(self, threads: int | None = None) -> PhysicsBackend:
@@ -180,6 +196,44 @@ class World:
             raise RuntimeError("this world has no physics yet: call world.build_physics()")
         return self._physics
 
+    def add_plugin(self, plugin: Plugin) -> Plugin:
+        """Turn a plugin on in a built world: its resources, then its systems (set up).
+
+        Build hooks are not run (the creatures exist already): plugins that build data
+        per creature are turned on in the scene (`plugins`) instead.
+        """
+        self._adopt(plugin)
+        self.add_systems(*_owned(plugin))
+        return plugin
+
+    def _adopt(self, plugin: Plugin) -> None:
+        if any(p.key == plugin.key for p in self.plugins):
+            raise ValueError(f"plugin {plugin.key!r} is already on in this world")
+        made = plugin.resources(self)
+        for name in made:
+            if name in self.resources or name in vars(self) or hasattr(type(self), name):
+                raise ValueError(f"plugin {plugin.key!r}: world.{name} exists already")
+        self.plugins.append(plugin)
+        self.resources.update(made)
+        vars(self).update(made)  # world.<name>, as fast as any attribute
+
+    def plugin(self, key: str) -> Plugin:
+        """The plugin on as `key`."""
+        for plugin in self.plugins:
+            if plugin.key == key:
+                return plugin
+        on = ", ".join(p.key for p in self.plugins) or "none"
+        raise KeyError(f"no plugin {key!r} is on in this world (on: {on})")
+
+    def __getattr__(self, name: str) -> Any:
+        """Only for names nothing defines: a plugin's resource that is not there."""
+        if name.startswith("_"):
+            raise AttributeError(name)
+        on = ", ".join(p.key for p in self.__dict__.get("plugins", [])) or "none"
+        raise AttributeError(
+            f"this world has no {name!r}: no plugin that is on provides it (plugins on: {on})"
+        )
+
     def add_system(self, system: System) -> System:
         """Schedule `system` at the place it declares and call its `setup`."""
         self.add_systems(system)
@@ -193,12 +247,22 @@ class World:
 
     # -- running -----------------------------------------------------------------------
     def step(self, frames: int = 1) -> None:
-        """Run `frames` fixed-duration frames: every system in schedule order."""
+        """Run `frames` fixed-duration frames: every system in schedule order.
+
+        An exception inside a system is raised as `SystemFailure` (naming the system,
+        its plugin and the frame; the original is its `__cause__`). The frame counter
+        stays at the failed frame.
+        """
         self.activate()
         dt = self.settings.dt
         for _ in range(frames):
             for system in self.schedule:
-                system.process(self, dt)
+                try:
+                    system.process(self, dt)
+                except Exception as error:  # name the system and the frame; cause kept
+                    raise SystemFailure(
+                        system, self.schedule.label(system), self.frame, error
+                    ) from error
             self.frame += 1
 
     def snapshot(self) -> Snapshot:
@@ -257,6 +321,11 @@ class World:
         self.activate()
         return esper.create_entity(*components)
 
+    def add_component(self, entity: int, component: Any) -> None:
+        """Give `entity` a component (at build time: it invalidates esper's query cache)."""
+        self.activate()
+        esper.add_component(entity, component)
+
     def component(self, entity: int, kind: type[C]) -> C:
         """The `kind` component of `entity` (KeyError if it has none)."""
         self.activate()
@@ -301,8 +370,29 @@ class World:
         self.close()
 
 
-def _import_systems(paths: list[str]) -> list[type[System]]:
-    """Resolve 'package.module:Class' paths to System subclasses (only when allowed)."""
+def _owned(plugin: Plugin) -> list[System]:
+    """The plugin's systems, each tagged with the plugin's key."""
+    systems = plugin.systems()
+    for system in systems:
+        system.plugin = plugin.key
+    return systems
+
+
+def _read_scene(path: pathlib.Path) -> dict[str, Any]:
+    from ecs_tentacles.scene.errors import SceneError
+    from ecs_tentacles.scene.load import read_scene_json
+
+    data = read_scene_json(path)
+    if not isinstance(data, dict):
+        raise SceneError([f"{path}: scene: must be an object"])
+    return data
+
+
+def _import_systems(paths: list[str], folder: pathlib.Path | None) -> list[type[System]]:
+    """Resolve 'package.module:Class' paths to System subclasses (only when allowed).
+
+    The scene's folder is searched first, so a module beside the scene is found.
+    """
     from ecs_tentacles.scene.errors import SceneError
 
     found: list[type[System]] = []
@@ -310,7 +400,8 @@ def _import_systems(paths: list[str]) -> list[type[System]]:
     for i, path in enumerate(paths):
         module_name, _, attr = path.partition(":")
         try:
-            factory = getattr(importlib.import_module(module_name), attr)
+            with scene_first(folder):
+                factory = getattr(importlib.import_module(module_name), attr)
         except (ImportError, AttributeError) as exc:
             problems.append(f"systems[{i}]: cannot import {path!r}: {exc}")
             continue

@@ -1,62 +1,39 @@
 """Built-in systems, one per file; installed as `ecs_tentacles.systems`.
 
-The frame runs them in this order (each file's docstring says what it reads and
-writes; `World.schedule.names` shows the resolved order, user systems included):
+Each system belongs to a plugin (`ecs_tentacles.plugins`) and runs in a public stage
+(`ecs_tentacles.system.STAGES`); `world.schedule.table()` (or `ecs-tentacles systems
+SCENE`) shows the resolved frame with what each system reads and writes:
 
-1. goals               mantle inside its current goal's radius -> goal removed, next one current
-2. tentacle_selection  who drives, push or pull (cyclic or coordinated gait); idle without a goal
-3. action_queue        action timers advance; finished actions give way to the next
-4. motor_targets       action poses + travelling waves -> joint targets; writhing -> gains
-5. suckers             attach at the ground on command; release on command, stretch or reach
-6. physics             motor targets, gains, sucker switches, contact proxies -> every physics
-                       group; mj_step x substeps on the thread pool
-7. physics_sync        MuJoCo body poses -> Transform store
-8. physics_health      blow-ups found per creature; that creature restored to its last good state
-9. emotion             threats near -> fear/aggression level -> fur controls' lift and random
-10. rig                fur guides posed from mantle poses and controls (tracks, dynamic blend)
+decide   goals               mantle inside its current goal's radius -> next goal (locomotion)
+         tentacle_selection  who drives, push or pull (cyclic or coordinated gait) (locomotion)
+act      action_queue        action timers advance; finished actions give way (locomotion)
+         motor_targets       action poses + travelling waves -> joint targets (locomotion)
+         suckers             attach on command; release on command, stretch or reach (suckers)
+physics  physics             targets, gains, suckers, contact proxies -> mj_step (core)
+sync     physics_sync        MuJoCo body poses -> Transform store (core)
+         physics_health      blow-ups found per creature and recovered (core)
+animate  threats             path threats follow their keyframes (threats)
+         emotion             threats near -> fear -> fur lift and random (fur)
+         rig                 fur guides posed from mantle poses and controls (fur)
+output   record              the frame into a take (record; `bake`)
+         render              poses to the sandbox renderer (render; `play`)
+
+`examples/` holds example plugins that are not on by default (wander, flee,
+follow_leader, flock); a scene turns them on by name under `plugins`.
 """
 
 from __future__ import annotations
 
-from ecs_tentacles.systems.action_queue import ActionQueueSystem
-from ecs_tentacles.systems.emotion import EmotionSystem
-from ecs_tentacles.systems.goals import Goals
-from ecs_tentacles.systems.motor_targets import MotorTargets
-from ecs_tentacles.systems.physics import Physics
-from ecs_tentacles.systems.physics_health import PhysicsHealth
-from ecs_tentacles.systems.physics_sync import PhysicsSync
-from ecs_tentacles.systems.rig import Rig
-from ecs_tentacles.systems.suckers import Suckers
-from ecs_tentacles.systems.tentacle_selection import TentacleSelection
-
 from ecs_tentacles.system import System
 
-__all__ = [
-    "ActionQueueSystem",
-    "EmotionSystem",
-    "Goals",
-    "MotorTargets",
-    "Physics",
-    "PhysicsHealth",
-    "PhysicsSync",
-    "Rig",
-    "Suckers",
-    "TentacleSelection",
-    "builtin_systems",
-]
 
+def core_systems() -> list[System]:
+    """Fresh instances of the core systems (physics, sync, health), in frame order."""
+    from ecs_tentacles.systems.physics import Physics
+    from ecs_tentacles.systems.physics_health import PhysicsHealth
+    from ecs_tentacles.systems.physics_sync import PhysicsSync
 
-def builtin_systems() -> list[System]:
-    """Fresh instances of the built-in systems, in frame order."""
-    return [
-        Goals(),
-        TentacleSelection(),
-        ActionQueueSystem(),
-        MotorTargets(),
-        Suckers(),
-        Physics(),
-        PhysicsSync(),
-        PhysicsHealth(),
-        EmotionSystem(),
-        Rig(),
-    ]
+    systems: list[System] = [Physics(), PhysicsSync(), PhysicsHealth()]
+    for system in systems:
+        system.plugin = "core"
+    return systems

@@ -26,7 +26,9 @@ ATTACH = int(Kind.ATTACH)
 
 class ActionQueueSystem(System):
     name = "action_queue"
-    after = ("tentacle_selection",)
+    stage = "act"
+    reads = ("action_queues", "suckers.attached")
+    writes = ("tentacles.action", "tentacles.timer", "tentacles.orient")
 
     def setup(self, world: World) -> None:
         self.queues = [ActionQueue()] * len(world.tentacles)

@@ -1,18 +1,19 @@
 """emotion: fear or aggression that rises near a threat and raises the fur (piloerection).
 
-Threats are the scene's marked entities (their keyframed paths are evaluated here at
-`world.time`) and creatures marked `threat`. A creature with an `Emotion` is roused
-while any threat other than itself is within its radius of its mantle. Its emotion
-follows a critically damped response toward 1 (roused) or 0 (calm), reaching 90 % in
+Threats come from the threats plugin (`world.threats`: path threats, moved by the
+`threats` system, and creatures marked `threat`); without it nothing frightens. A
+creature with an `Emotion` is roused while any threat other than itself is within its
+radius of its mantle. Its emotion follows a critically damped response toward 1
+(roused) or 0 (calm), reaching 90 % in
 `rise` or `decay` seconds: it starts slowly and settles slowly (slow-in, slow-out).
 The level shown is ``state - anticipation * speed / omega_rise``: before it rises it
 first dips (the fur flattens a little, anticipation), before it falls it first swells.
 Each of the creature's controls gets ``level * control.emotion * fur.piloerection``
 added to its lift and random (clipped to 0..1 by the rig). No emotions: nothing done.
 
-Reads: ThreatStore paths, Transform store (mantles of emotional and threat creatures),
-EmotionStore settings and state. Writes: ThreatStore.pos, EmotionStore (state, speed,
-level, threatened), ControlStore (drive_lift, drive_random).
+Reads: `world.threats` (positions), Transform store (mantles of emotional and threat
+creatures), EmotionStore settings and state. Writes: EmotionStore (state, speed, level,
+threatened), ControlStore (drive_lift, drive_random).
 """
 
 from __future__ import annotations
@@ -21,7 +22,6 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ecs_tentacles.fur.tracks import TrackSet
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
@@ -32,26 +32,22 @@ NINETY_PERCENT = 3.8897  # omega * t at which a critically damped step reaches 9
 
 class EmotionSystem(System):
     name = "emotion"
-    after = ("physics_sync",)
+    stage = "animate"
+    after = ("threats",)
     before = ("rig",)
-
-    def __init__(self) -> None:
-        self.paths = TrackSet([])
-        self.path_count = -1
+    reads = ("threats", "transforms.pos", "fur.emotions", "fur.sets")
+    writes = ("fur.emotions", "fur.controls.drive_lift", "fur.controls.drive_random")
 
     def process(self, world: World, dt: float) -> None:
         fur = world.fur
-        threats = fur.threats
-        if len(fur.threat_paths) != self.path_count:
-            self.paths = TrackSet(fur.threat_paths)
-            self.path_count = len(fur.threat_paths)
-        if len(self.paths):
-            threats.pos[self.paths.rows, self.paths.columns] = self.paths.evaluate(world.time)
         e = fur.emotions
         if not len(e):
             return
-        sources = np.concatenate([threats.pos, world.transforms.pos[fur.threat_bodies]])
-        owners = np.concatenate([np.full(len(threats), -1), fur.threat_creatures])
+        threats = world.resources.get("threats")
+        if threats is not None:
+            sources, owners = threats.sources(world)
+        else:  # the threats plugin is off: nothing frightens anyone
+            sources, owners = np.zeros((0, 3)), np.zeros(0, dtype=np.int64)
         if len(sources):
             here = world.transforms.pos[e.body_row]
             distance = np.linalg.norm(here[:, None, :] - sources[None, :, :], axis=2)

@@ -19,6 +19,9 @@ if TYPE_CHECKING:
 
 class Goals(System):
     name = "goals"
+    stage = "decide"
+    reads = ("transforms.pos", "goals")
+    writes = ("goals", "creatures.goal", "creatures.has_goal")
 
     def process(self, world: World, dt: float) -> None:
         creatures = world.creatures

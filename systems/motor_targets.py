@@ -53,7 +53,10 @@ SMOOTHING_SECONDS = 0.06  # targets ease toward each new pose (slow-in) instead 
 
 class MotorTargets(System):
     name = "motor_targets"
+    stage = "act"
     after = ("action_queue",)
+    reads = ("tentacles.action", "tentacles.orient", "motors.arc")
+    writes = ("motors.target", "motors.gain")
     state_attributes = ("eased",)
 
     def setup(self, world: World) -> None:

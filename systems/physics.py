@@ -24,6 +24,9 @@ PROXY_ROUNDS = 4  # parts a frame is stepped in while creatures touch (proxies c
 
 class Physics(System):
     name = "physics"
+    stage = "physics"
+    reads = ("motors.target", "motors.gain", "suckers.attached", "suckers.anchor")
+    writes = ("physics",)
 
     def process(self, world: World, dt: float) -> None:
         backend = world.physics

@@ -20,7 +20,10 @@ if TYPE_CHECKING:
 
 class PhysicsHealth(System):
     name = "physics_health"
+    stage = "sync"
     after = ("physics_sync",)
+    reads = ("physics", "transforms.pos")
+    writes = ("physics", "transforms.pos", "transforms.quat", "suckers.attached")
 
     def process(self, world: World, dt: float) -> None:
         world.physics.health.check(world)

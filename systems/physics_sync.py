@@ -16,7 +16,9 @@ if TYPE_CHECKING:
 
 class PhysicsSync(System):
     name = "physics_sync"
-    after = ("physics",)
+    stage = "sync"
+    reads = ("physics",)
+    writes = ("transforms.pos", "transforms.quat")
 
     def process(self, world: World, dt: float) -> None:
         world.physics.sync(world.transforms)

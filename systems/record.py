@@ -5,10 +5,10 @@ Goal components, fur guide curves when the world has fur. Writes: its
 `TakeRecorder`'s arrays; before the first frame only, the fur rig's output buffers
 (`pose_fur_at_build`), which the rig rewrites every frame.
 
-Runs after physics_sync (and after rig, which is added before it). It records the
+Runs in stage output, after everything else of the frame. It records the
 pose it finds when it joins the world (take frame 0; fur guides are posed for it
 if no frame has run yet), then every `every`-th frame, so a take at 30 fps of a
-60 fps world has `every=2`. Not one of the built-in systems.
+60 fps world has `every=2`. The record plugin (`ecs_tentacles.plugins.record`) adds it.
 """
 
 from __future__ import annotations
@@ -27,7 +27,8 @@ class Record(System):
     """Record the world into a take; `record.take()` returns it."""
 
     name = "record"
-    after = ("physics_sync",)
+    stage = "output"
+    reads = ("transforms.pos", "transforms.quat", "suckers.attached", "goals", "fur.curves")
 
     def __init__(self, every: int = 1, **recorder: Any):
         if every < 1:

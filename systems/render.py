@@ -1,8 +1,8 @@
 """render: hands the newest body poses to the sandbox renderer.
 
 Reads: Transform store (pos, quat). Writes: the Renderer's last two pose snapshots,
-between which it interpolates when it draws at display rate. Added only by the
-sandbox (`ecs-tentacles play`), never to headless runs.
+between which it interpolates when it draws at display rate. The render plugin
+(`ecs_tentacles.plugins.render`) adds it, in the sandbox (`ecs-tentacles play`) only.
 """
 
 from __future__ import annotations
@@ -18,7 +18,8 @@ if TYPE_CHECKING:
 
 class RenderSync(System):
     name = "render"
-    after = ("physics_sync",)
+    stage = "output"
+    reads = ("transforms.pos", "transforms.quat")
 
     def __init__(self, renderer: Renderer):
         self.renderer = renderer

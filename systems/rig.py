@@ -39,7 +39,9 @@ STRAND_BLOCK = 4096  # dynamic guides per block (their arrays are 8x larger)
 
 class Rig(System):
     name = "rig"
-    after = ("physics_sync",)
+    stage = "animate"
+    reads = ("transforms.pos", "transforms.quat", "fur.controls", "fur.guides")
+    writes = ("fur.curves", "fur.frames", "fur.controls")
     state_attributes = ("strands",)  # the dynamic blend's strand positions and velocities
 
     def __init__(self) -> None:

@@ -34,8 +34,10 @@ HOLDING[[Kind.ATTACH, Kind.PUSH, Kind.PULL]] = True
 
 class Suckers(System):
     name = "suckers"
+    stage = "act"
     after = ("motor_targets",)
-    before = ("physics",)
+    reads = ("tentacles.action", "transforms.pos", "creatures.release_stretch")
+    writes = ("suckers.attached", "suckers.anchor")
 
     def process(self, world: World, dt: float) -> None:
         s, t, c = world.suckers, world.tentacles, world.creatures

@@ -48,7 +48,10 @@ def classify(goal_dir: np.ndarray, base_dir: np.ndarray) -> np.ndarray:
 
 class TentacleSelection(System):
     name = "tentacle_selection"
+    stage = "decide"
     after = ("goals",)
+    reads = ("creatures.goal", "transforms.pos", "tentacles.action")
+    writes = ("tentacles.driving", "tentacles.mode", "action_queues")
 
     def setup(self, world: World) -> None:
         self.queues = [ActionQueue()] * len(world.tentacles)

@@ -54,6 +54,7 @@ BUILTIN = [
     "physics",
     "physics_sync",
     "physics_health",
+    "threats",
     "emotion",
     "rig",
 ]
@@ -67,9 +68,14 @@ def test_builtin_order(make_world: Callable[..., World]) -> None:
         "physics",
         "physics_sync",
         "physics_health",
+        "threats",
         "emotion",
         "rig",
     ]
+    assert [world.schedule.stage_of(n) for n in BUILTIN] == [
+        "decide", "decide", "act", "act", "act", "physics", "sync", "sync",
+        "animate", "animate", "animate",
+    ]  # fmt: skip
 
 
 def test_probe_records_frame_and_substep_order(make_world: Callable[..., World]) -> None:
@@ -84,9 +90,10 @@ def test_probe_records_frame_and_substep_order(make_world: Callable[..., World])
         "physics",
         "physics_sync",
         "physics_health",
+        "late",  # after physics_sync: joins the sync stage, before fur animates
+        "threats",
         "emotion",
         "rig",
-        "late",
     ]
     world.step(2)
     substeps = world.settings.substeps
@@ -117,7 +124,6 @@ def test_class_priority_attributes_are_ignored() -> None:
 @pytest.mark.parametrize(
     ("systems", "message"),
     [
-        ([named("a", after=("nope",))], "system 'a' runs after 'nope', which is not scheduled"),
         ([named("a"), named("a")], "a system named 'a' is already scheduled"),
         (
             [named("a"), named("b", after=("a",), before=("a",))],
@@ -137,5 +143,5 @@ def test_refused_system_leaves_the_schedule_unchanged() -> None:
     schedule = Schedule()
     schedule.add(named("a"))
     with pytest.raises(ScheduleError):
-        schedule.add(named("b", after=("missing",)))
+        schedule.add(named("b", after=("a",), before=("a",)))
     assert schedule.names == ["a"] and "b" not in schedule

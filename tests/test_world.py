@@ -95,13 +95,14 @@ def test_scene_systems_are_not_imported_unless_allowed(
         World.from_scene(scene)
     assert user_system_module not in sys.modules
     world = make_world(scene, allow_systems=True)
-    assert world.schedule.names[-6:] == [
+    assert world.schedule.names[-7:] == [
         "physics",
         "physics_sync",
         "physics_health",
+        "counter",  # after physics_sync: the sync stage
+        "threats",
         "emotion",
         "rig",
-        "counter",
     ]
     world.step(3)
     assert type(world.schedule["counter"]).frames == 3  # type: ignore[attr-defined]
@@ -119,6 +120,7 @@ def test_scene_system_that_is_not_a_system(user_system_module: str) -> None:
 
 
 def test_user_system_base_class_is_the_builtin_one() -> None:
-    from ecs_tentacles.systems import Physics, PhysicsSync
+    from ecs_tentacles.systems.physics import Physics
+    from ecs_tentacles.systems.physics_sync import PhysicsSync
 
     assert issubclass(Physics, System) and issubclass(PhysicsSync, System)

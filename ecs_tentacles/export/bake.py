@@ -135,14 +135,17 @@ def bake(
     creatures at those scene indices (a shard); `on_steps(n)` is told of every `n`
     frames simulated.
     """
-    from ecs_tentacles.systems.record import Record
+    from ecs_tentacles.plugins.record import RecordPlugin
 
     world = plan.world(allow_systems=allow_systems, threads=threads, only=only)
     try:
         if on_world is not None:
             on_world(world)
-        record = Record(plan.every, scene_sha256=plan.scene_sha256, capacity=plan.frames)
-        world.add_system(record)
+        recording = RecordPlugin(
+            every=plan.every, scene_sha256=plan.scene_sha256, capacity=plan.frames
+        )
+        world.add_plugin(recording)
+        record = recording.system
         chunk = max(1, round(plan.sim_fps / 10))
         with tqdm(
             total=plan.steps,

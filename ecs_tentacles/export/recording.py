@@ -4,7 +4,7 @@
 suckers, goals) and `capture()` copies the current frame with one gather per array;
 the `record` system (`ecs_tentacles.systems.record`) calls it after physics_sync.
 Goals are discovered as they appear (scripts may add some); fur guides are read
-through `fur_guides(world)` when the world has fur.
+through the plugins' export hook (`plugin_curves`: the fur plugin's guides).
 """
 
 from __future__ import annotations
@@ -37,25 +37,13 @@ class GuideFrame:
 GuideSource = Callable[["World"], GuideFrame | None]
 
 
-def fur_guides(world: World) -> GuideFrame | None:
-    """The world's fur guide curves as the rig posed them, or None without fur.
-
-    Reads the fur package's export hook (`ecs_tentacles.fur.hooks.guide_curves`): world
-    polylines and root widths (kept along each guide); owners from the guides' fur sets.
-    """
-    fur = getattr(world, "fur", None)
-    if fur is None:
-        return None
-    try:
-        from ecs_tentacles.fur.hooks import guide_curves
-    except ImportError:  # a tree without the fur package
-        return None
-    curves = guide_curves(world)
-    if len(curves.points) == 0:
-        return None
-    owners = np.asarray(fur.sets.creature)[np.asarray(fur.guides.fur_row)]
-    widths = np.repeat(np.asarray(curves.width)[:, None], curves.points.shape[1], axis=1)
-    return GuideFrame(points=curves.points, widths=widths, creatures=owners)
+def plugin_curves(world: World) -> GuideFrame | None:
+    """The curves the world's plugins export (`Plugin.export_curves`: the fur guides)."""
+    for plugin in world.plugins:
+        found = plugin.export_curves(world)
+        if found is not None:
+            return found
+    return None
 
 
 def pose_fur_at_build(world: World) -> None:
@@ -65,7 +53,7 @@ def pose_fur_at_build(world: World) -> None:
     fresh rig (its own dynamics state, thrown away) poses them once; it writes only
     the rig's output buffers, which the real rig rewrites every frame.
     """
-    fur = getattr(world, "fur", None)
+    fur = world.resources.get("fur")
     if world.frame == 0 and fur is not None and len(fur.guides) and "rig" in world.schedule:
         type(world.schedule["rig"])().process(world, 0.0)
 
@@ -93,7 +81,7 @@ class TakeRecorder:
         fps: float | None = None,
         scene_sha256: str | None = None,
         capacity: int = 64,
-        guides: GuideSource = fur_guides,
+        guides: GuideSource = plugin_curves,
     ):
         self.world = world
         self.guides = guides

@@ -12,14 +12,13 @@
 
 from __future__ import annotations
 
-from ecs_tentacles.fur.components import Emotion, Fur, FurControl, FurGuide, Threat
+from ecs_tentacles.fur.components import Emotion, Fur, FurControl, FurGuide
 from ecs_tentacles.fur.hooks import (
     ControlMarker,
     GuideCurves,
     child_hairs,
     control_markers,
     guide_curves,
-    threat_positions,
 )
 from ecs_tentacles.fur.stores import FurData
 
@@ -31,9 +30,7 @@ __all__ = [
     "FurData",
     "FurGuide",
     "GuideCurves",
-    "Threat",
     "child_hairs",
     "control_markers",
     "guide_curves",
-    "threat_positions",
 ]

@@ -1,8 +1,8 @@
-"""Scene data -> fur entities: guides, controls, the creature's Fur, Emotion and threats.
+"""Scene data -> fur entities: guides, controls, the creature's Fur and Emotion.
 
-Called by `ecs_tentacles.build.build_creature` for a creature with `fur`, `emotion` or
-`threat`, and by `World.from_scene` for the scene's `threats`. Guides attach to the
-mantle body (its Transform row); their roots live in the mantle's local frame.
+Called by the fur plugin's build hook (`ecs_tentacles.plugins.fur`) for a creature with
+`fur` or `emotion`. Guides attach to the mantle body (its Transform row); their roots
+live in the mantle's local frame.
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ import numpy as np
 
 from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.fur import groom as grooming
-from ecs_tentacles.fur.components import Emotion, Fur, FurControl, FurGuide, Threat
+from ecs_tentacles.fur.components import Emotion, Fur, FurControl, FurGuide
 from ecs_tentacles.fur.controls import expand_mirrors, nearest_control
 from ecs_tentacles.fur.stores import BEHAVIOURS
 from ecs_tentacles.fur.tracks import channels_from_keys
@@ -25,19 +25,6 @@ if TYPE_CHECKING:
 # Track columns of the ControlStore: position x, y, z, then the behaviour values.
 COLUMNS = {"position": (0, 1, 2), "lift": (3,), "aim": (4,), "direction": (5,)}
 COLUMNS |= {"random": (6,), "dynamic": (7,)}
-
-
-def build_creature_extras(world: World, creature: int, spec: dict[str, Any]) -> None:
-    """Fur, emotion and the threat mark of one creature (as its scene entry asks)."""
-    if "fur" in spec:
-        build_fur(world, creature, spec["fur"])
-    if "emotion" in spec:
-        build_emotion(world, creature, spec["emotion"])
-    if spec.get("threat"):
-        fur = world.fur
-        row = world.component(creature, Transform).row
-        fur.threat_bodies = np.append(fur.threat_bodies, row)
-        fur.threat_creatures = np.append(fur.threat_creatures, creature)
 
 
 def _points_per_guide(world: World, spec: dict[str, Any]) -> int:
@@ -180,17 +167,3 @@ def build_emotion(world: World, creature: int, spec: dict[str, Any]) -> int:
         rows = [world.component(e, FurControl).row for e in fur.controls]
         world.fur.controls.emotion_row[rows] = row
     return row
-
-
-def build_threats(world: World, threats: list[dict[str, Any]]) -> list[int]:
-    """Threat entities that follow keyframed paths; returns their entities."""
-    store = world.fur.threats
-    entities = []
-    for i, spec in enumerate(threats):
-        path = spec["path"]
-        row = int(store.add(pos=path[0]["position"])[0])
-        entity = world.create_entity(Threat(store, row, spec.get("name", f"threat_{i}")))
-        store.entity[row] = entity
-        world.fur.threat_paths += channels_from_keys(row, (0, 1, 2), path, "position")
-        entities.append(entity)
-    return entities

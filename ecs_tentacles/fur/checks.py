@@ -1,4 +1,4 @@
-"""Scene rules for fur, emotion and threats that the JSON Schema cannot express.
+"""Scene rules for fur and emotion that the JSON Schema cannot express.
 
 Called by `ecs_tentacles.scene.validate` on a schema-valid scene with defaults (and
 presets) filled in; each problem is (JSON path, message).
@@ -84,26 +84,9 @@ def _fur_problems(fur: Mapping[str, Any], path: Path) -> list[Problem]:
 
 
 def fur_problems(scene: Mapping[str, Any]) -> list[Problem]:
-    """Every fur, emotion and threat problem of a defaults-filled scene."""
+    """Every fur and emotion problem of a defaults-filled scene."""
     problems: list[Problem] = []
     for i, creature in enumerate(scene["creatures"]):
         if "fur" in creature:
             problems += _fur_problems(creature["fur"], ("creatures", i, "fur"))
-    seen: dict[str, int] = {}
-    for i, threat in enumerate(scene["threats"]):
-        name = threat.get("name", f"threat_{i}")
-        if name in seen:
-            problems.append(
-                (("threats", i, "name"), f'duplicate name "{name}" (also threats[{seen[name]}])')
-            )
-        seen.setdefault(name, i)
-        for k, key in enumerate(threat["path"]):
-            if k and key["time"] <= threat["path"][k - 1]["time"]:
-                previous = threat["path"][k - 1]["time"]
-                problems.append(
-                    (
-                        ("threats", i, "path", k, "time"),
-                        f"must be > {previous} (the previous key's), got {key['time']}",
-                    )
-                )
     return problems

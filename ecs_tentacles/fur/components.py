@@ -24,7 +24,6 @@ from ecs_tentacles.fur.stores import (
     FurData,
     FurSetStore,
     GuideStore,
-    ThreatStore,
 )
 
 
@@ -114,12 +113,3 @@ class Emotion(RowComponent):
     anticipation = RowField()
     level = RowField()
     threatened = RowField()
-
-
-@dataclass(eq=False, repr=False)
-class Threat(RowComponent):
-    """A marked entity that frightens creatures: world `pos` (follows its keyframed path)."""
-
-    store: ThreatStore
-    name: str
-    pos = RowField()

@@ -1,4 +1,4 @@
-"""Rendering and export hooks: guide polylines, child hairs, controls, threats.
+"""Rendering and export hooks: guide polylines, child hairs, controls.
 
 The renderer and the exporter call these after a frame (the rig system has run):
 
@@ -19,10 +19,11 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ecs_tentacles.fur import children
-from ecs_tentacles.fur.components import FurControl, Threat
+from ecs_tentacles.fur.components import FurControl
 from ecs_tentacles.mathutil import quat_rotate
 
 if TYPE_CHECKING:
+    from ecs_tentacles.export.recording import GuideFrame
     from ecs_tentacles.world import World
 
 
@@ -130,6 +131,20 @@ def control_markers(world: World) -> list[ControlMarker]:
     return markers
 
 
-def threat_positions(world: World) -> dict[str, np.ndarray]:
-    """World position of every marked threat, by name."""
-    return {threat.name: threat.pos.copy() for _, threat in world.query(Threat)}
+def take_guides(world: World) -> GuideFrame | None:
+    """The world's fur guide curves as the rig posed them, or None without fur.
+
+    The fur plugin's export hook: world polylines and root widths (kept along each
+    guide, `ecs_tentacles.fur.hooks.guide_curves`); owners from the guides' fur sets.
+    """
+    fur = world.resources.get("fur")
+    if fur is None:
+        return None
+    curves = guide_curves(world)
+    if len(curves.points) == 0:
+        return None
+    owners = np.asarray(fur.sets.creature)[np.asarray(fur.guides.fur_row)]
+    from ecs_tentacles.export.recording import GuideFrame
+
+    widths = np.repeat(np.asarray(curves.width)[:, None], curves.points.shape[1], axis=1)
+    return GuideFrame(points=curves.points, widths=widths, creatures=owners)

@@ -98,13 +98,6 @@ class EmotionStore(ArrayStore):
     threatened = Field(dtype=np.bool_, default=False)
 
 
-class ThreatStore(ArrayStore):
-    """Marked entities that frighten creatures: world position (from a keyframed path)."""
-
-    entity = Field(dtype=np.int64)
-    pos = Field((3,))
-
-
 class FurData:
     """The fur stores of one world (``world.fur``), plus the rig's output buffers.
 
@@ -118,16 +111,12 @@ class FurData:
         self.controls = ControlStore()
         self.sets = FurSetStore()
         self.emotions = EmotionStore()
-        self.threats = ThreatStore()
         self.points = 0  # points per guide; set by the first fur built
         self.shape = np.zeros((0, 0, 3))  # per guide: points in rest-frame (axis, up, side)
         self.curves = np.zeros((0, 0, 3), dtype=np.float32)
         self.frames = np.zeros((0, 4, 3), dtype=np.float32)
         self.version = 0
         self.tracks: list[Channel] = []  # control attributes (columns: see fur.build.COLUMNS)
-        self.threat_paths: list[Channel] = []  # threat positions (columns 0, 1, 2)
-        self.threat_bodies = np.zeros(0, dtype=np.int64)  # mantle rows of threat creatures
-        self.threat_creatures = np.zeros(0, dtype=np.int64)  # their creature entities
 
     def add_shapes(self, shapes: np.ndarray) -> None:
         """Append rest shapes (k, points, 3) for guides just added; grow the buffers."""

@@ -19,7 +19,7 @@ import numpy as np
 from pyglet import gl
 
 from ecs_tentacles.components import Creature, Goal, Link, Tentacle, Transform
-from ecs_tentacles.fur.hooks import GuideCurves, child_hairs, guide_curves, threat_positions
+from ecs_tentacles.fur.hooks import GuideCurves, child_hairs, guide_curves
 from ecs_tentacles.render import shaders
 from ecs_tentacles.render.camera import OrbitCamera
 from ecs_tentacles.render.gpu import (
@@ -175,31 +175,36 @@ class Renderer:
         self.child_ribbons.update(children)
 
     def _sucker_instances(self) -> np.ndarray:
-        """Attached suckers (yellow) and marked threats (dark red): one sphere batch."""
+        """Attached suckers (yellow) and the plugins' markers (threats): one sphere batch."""
         s = self.world.suckers
         held = np.flatnonzero(s.attached)
-        threats = list(threat_positions(self.world).values()) if len(self.world.fur.threats) else []
-        out = np.zeros((len(held) + len(threats), INSTANCE_FLOATS), np.float32)
+        markers = [m for plugin in self.world.plugins for m in plugin.render_spheres(self.world)]
+        count = len(held) + sum(len(m.positions) for m in markers)
+        out = np.zeros((count, INSTANCE_FLOATS), np.float32)
         out[:, 3] = 1.0
         out[: len(held), 0:3] = s.anchor[held] + [0.0, 0.0, 0.01]
         out[: len(held), 7:11] = (0.024, 0.024, 0.024, 0.0)
         out[: len(held), 11:15] = (1.0, 0.92, 0.25, 1.0)
-        if threats:
-            out[len(held) :, 0:3] = np.array(threats) + [0.0, 0.0, 0.04]
-            out[len(held) :, 7:11] = (0.07, 0.045, 0.04, 0.0)
-            out[len(held) :, 11:15] = (0.35, 0.12, 0.08, 1.0)
+        start = len(held)
+        for marker in markers:
+            end = start + len(marker.positions)
+            out[start:end, 0:3] = marker.positions
+            out[start:end, 7:11] = (*marker.size, 0.0)
+            out[start:end, 11:15] = marker.rgba
+            start = end
         return out
 
     def _goal_geometry(self) -> None:
         """Rings, markers and path legs between goals: rebuilt only when goals change."""
         fixed: list[np.ndarray] = []
         leaders, firsts, colours = [], [], []
+        book = self.world.resources.get("goals")  # None with the locomotion plugin off
         for entity in self.creature_entities:
-            goals = self.world.goals.path(entity)
-            if not goals:
+            goals = book.path(entity) if book is not None else []
+            if book is None or not goals:
                 continue
             colour = np.append(self.creature_colour[entity] * 0.6 + 0.4, 1.0)
-            points = self.world.goals.positions(entity) + [0, 0, 0.005]
+            points = book.positions(entity) + [0, 0, 0.005]
             fixed.append(_segments(points, colour))
             for goal, point in zip(goals, points, strict=True):
                 fixed.append(_segments(point + self._goal_radius(goal) * CIRCLE, colour))
@@ -211,10 +216,10 @@ class Renderer:
         self._leader_rows = np.array(leaders, dtype=np.int64)
         self._leader_ends = np.array(firsts).reshape(-1, 3)
         self._leader_colours = np.array(colours).reshape(-1, 4)
-        self._goal_version = self.world.goals.version
+        self._goal_version = _goal_version(self.world)
 
     def _line_vertices(self, pos: np.ndarray) -> np.ndarray:
-        if self._goal_version != self.world.goals.version:
+        if self._goal_version != _goal_version(self.world):
             self._goal_geometry()
         # each creature's leg to its current goal moves with it: one vectorised pass
         leaders = np.empty((2 * len(self._leader_rows), 7))
@@ -227,7 +232,8 @@ class Renderer:
             creature = self.world.component(self.selected, Creature)
             ring = pos[row] * [1, 1, 0] + [0, 0, 0.01] + creature.mantle_radius * 1.6 * CIRCLE
             segments.append(_segments(ring, np.array([1.0, 1.0, 1.0, 1.0])))
-        if len(self.world.fur.guides) and self.fur_display.markers:
+        fur = self.world.resources.get("fur")
+        if fur is not None and len(fur.guides) and self.fur_display.markers:
             segments.append(marker_lines(self.world, self.fur_display.selected_control))
         for provider in self.extra_lines:
             segments.append(provider(self.world))
@@ -294,8 +300,9 @@ class Renderer:
     def frame_all(self) -> None:
         """Point the camera so every creature and goal is in view."""
         points = [self.world.transforms.pos]
-        for entity in self.creature_entities:
-            points.append(self.world.goals.positions(entity))
+        book = self.world.resources.get("goals")
+        if book is not None:
+            points += [book.positions(entity) for entity in self.creature_entities]
         self.camera.follow = None
         self.camera.frame(np.vstack(points), margin=1.0)
 
@@ -316,14 +323,15 @@ class FurDisplay:
 
 def fur_strands(world: World, display: FurDisplay) -> tuple[GuideCurves, GuideCurves]:
     """This frame's guides and child hairs as `display` asks (empty when hidden)."""
-    points = max(world.fur.points, 1)
+    fur = world.resources.get("fur")  # None with the fur plugin off
+    points = max(fur.points, 1) if fur is not None else 1
     empty = GuideCurves(
         np.zeros((0, points, 3), np.float32),
         np.zeros((0, 4), np.float32),
         np.zeros(0, np.float32),
         np.zeros(0, np.int64),
     )
-    if not len(world.fur.guides):
+    if fur is None or not len(fur.guides):
         return empty, empty
     guides = guide_curves(world, display.colour_by) if display.guides else empty
     if not display.children:
@@ -336,6 +344,12 @@ def fur_strands(world: World, display: FurDisplay) -> tuple[GuideCurves, GuideCu
         dense.colour = guide_curves(world, "control").colour[dense.guide]
         dense.colour[:, :3] *= jitter
     return guides, dense
+
+
+def _goal_version(world: World) -> int:
+    """Changes whenever any goal does (-1 without the locomotion plugin)."""
+    book = world.resources.get("goals")
+    return -1 if book is None else int(book.version)
 
 
 def _segments(polyline: np.ndarray, colour: np.ndarray) -> np.ndarray:

@@ -26,12 +26,12 @@ from pyglet.window import key, mouse
 from tqdm import tqdm
 
 from ecs_tentacles.components import Creature, Goal, Transform
+from ecs_tentacles.plugins.render import RenderPlugin
 from ecs_tentacles.render.camera import ray_sphere
 from ecs_tentacles.render.furpanel import FurPanel
 from ecs_tentacles.render.hud import Hud
 from ecs_tentacles.render.output import VideoWriter, save_png
 from ecs_tentacles.render.renderer import Renderer
-from ecs_tentacles.systems.render import RenderSync
 from ecs_tentacles.world import World
 
 if TYPE_CHECKING:
@@ -83,7 +83,7 @@ class Sandbox:
     def _attach_world(self) -> None:
         self.renderer = Renderer(self.world, self.window.width, self.window.height)
         self.renderer.camera.shift_x = self.hud.width / 2
-        self.world.add_system(RenderSync(self.renderer))
+        self.world.add_plugin(RenderPlugin(renderer=self.renderer))
         self.renderer.frame_all()
         self.hud.world = self.world
         first = self.renderer.creature_entities[0] if self.renderer.creature_entities else None
@@ -109,7 +109,7 @@ class Sandbox:
         self.scene = scene
         self.world = World.from_scene(scene, seed=self.seed, allow_systems=self.allow_systems)
         self.renderer.set_world(self.world)
-        self.world.add_system(RenderSync(self.renderer))
+        self.world.add_plugin(RenderPlugin(renderer=self.renderer))
         self.hud.world = self.world
         if self.fur is not None:
             self.fur.editor.attach(self.world)

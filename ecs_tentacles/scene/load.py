@@ -1,7 +1,9 @@
 """Load a scene from a JSON file (or an already-parsed dict), validate it, fill defaults.
 
-Scenes are data only: they are parsed with :mod:`json` and nothing in them is executed
-or imported here (``systems`` import paths are only strings at this stage).
+Scenes are data only: they are parsed with :mod:`json`, and the only code imported is
+the plugins the scene turns on: built-in and bundled ones by name, others (a file
+beside the scene, a module, an installed entry point) only with ``allow_systems``.
+``systems`` import paths are only strings at this stage.
 
 Scene files are untrusted input: only regular files are read (a FIFO or a device is
 refused without blocking), at most ``MAX_SCENE_BYTES`` of them (the CLI's
@@ -18,11 +20,15 @@ import os
 import pathlib
 import re
 import stat
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
+from ecs_tentacles.plugin import PluginError, resolve
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.physical import physically_checked
-from ecs_tentacles.scene.validate import validate_scene, with_defaults
+from ecs_tentacles.scene.validate import plugin_config, validate_scene, with_defaults
+
+if TYPE_CHECKING:
+    from ecs_tentacles.plugin import Plugin
 
 MAX_SCENE_BYTES = 8 * 1024**2  # bundled scenes are a few kB; 1024 goals x 64 creatures fit
 _SCENE_NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.-]*$")
@@ -67,7 +73,7 @@ def _read_text(path: pathlib.Path) -> str:
     return data.decode("utf-8-sig")
 
 
-def _read_json(path: pathlib.Path) -> object:
+def read_scene_json(path: pathlib.Path) -> object:
     """Read and parse ``path``, raising SceneError with a one-line, located problem."""
     try:
         text = _read_text(path)
@@ -91,26 +97,63 @@ def _read_json(path: pathlib.Path) -> object:
         raise SceneError([f"{path}: invalid JSON: nested too deeply"]) from None
 
 
-def load_scene(source: str | os.PathLike[str] | dict[str, Any]) -> dict[str, Any]:
+def load_scene(
+    source: str | os.PathLike[str] | dict[str, Any], *, allow_systems: bool = False
+) -> dict[str, Any]:
     """Load, validate and complete a scene.
 
     ``source`` is a path to a JSON file or an already-parsed dict (which is not
     modified). Returns a new dict with every schema default filled in (see
-    :func:`with_defaults`). Raises :class:`SceneError` listing every problem, one line
-    each; problems found in a file are prefixed with ``"<path>: "``.
+    :func:`with_defaults`), `plugins` listing every plugin on with its full config.
+    Raises :class:`SceneError` listing every problem, one line each; problems found in
+    a file are prefixed with ``"<path>: "``.
+    """
+    return load_scene_plugins(source, allow_systems=allow_systems)[0]
+
+
+def load_scene_plugins(
+    source: str | os.PathLike[str] | dict[str, Any],
+    *,
+    allow_systems: bool = False,
+    scene_dir: pathlib.Path | None = None,
+) -> tuple[dict[str, Any], list[Plugin]]:
+    """`load_scene`, and the plugins the scene turns on, configured (in build order).
+
+    Plugins from a file are looked up in the scene's folder (`scene_dir` for a dict;
+    default: the current folder).
     """
     if isinstance(source, dict):
         data: object = source
         prefix = ""
     else:
         path = pathlib.Path(source)
-        data = _read_json(path)
+        data = read_scene_json(path)
         prefix = f"{path}: "
-    problems = validate_scene(data)
+        scene_dir = path.resolve().parent
+    chosen = data.get("plugins") if isinstance(data, dict) else None
+    try:
+        plugins = resolve(
+            chosen if _plugin_choices(chosen) else None, scene_dir, allow=allow_systems
+        )
+    except PluginError as exc:
+        raise SceneError([prefix + line for line in str(exc).splitlines()]) from None
+    problems = validate_scene(data, plugins)
     if problems:
         raise SceneError([prefix + problem for problem in problems])
     assert isinstance(data, dict)  # the schema requires an object
-    return physically_checked(with_defaults(data), prefix)
+    full = physically_checked(with_defaults(data, plugins), prefix)
+    for plugin in plugins:
+        config = plugin_config(plugin, (data.get("plugins") or {}).get(plugin.key))
+        plugin.config = {k: v for k, v in config.items() if k != "from"}
+    return full, plugins
+
+
+def _plugin_choices(chosen: object) -> bool:
+    """True when `plugins` has the shape the schema asks (else the schema reports it)."""
+    return isinstance(chosen, dict) and all(
+        isinstance(k, str) and (isinstance(v, bool) or isinstance(v, dict))
+        for k, v in chosen.items()
+    )
 
 
 def _scenes_dir() -> pathlib.Path:

@@ -16,7 +16,7 @@ import numbers
 from dataclasses import dataclass, replace
 from typing import Any
 
-from ecs_tentacles.scene.validate import load_schema
+from ecs_tentacles.scene.validate import core_schema, fragment
 
 
 @dataclass(frozen=True)
@@ -68,7 +68,9 @@ def _range_of(spec: dict[str, Any]) -> Range:
 
 def field_schema(section: str, key: str) -> dict[str, Any]:
     """The schema of a creature's `<section>.<key>` (section: mantle, tentacles, locomotion)."""
-    creature = load_schema()["$defs"]["creature"]["properties"]
+    creature = core_schema()["$defs"]["creature"]["properties"]
+    if section not in creature:  # a plugin's section (locomotion): from its fragment
+        creature = fragment(section)["creature"]
     found: dict[str, Any] = creature[section]["properties"][key]
     return found
 
@@ -80,7 +82,7 @@ def field_range(section: str, key: str) -> Range:
 
 def physics_range(key: str) -> Range:
     """The range of the scene's `physics.<key>` (for gravity: of each component)."""
-    spec: dict[str, Any] = load_schema()["properties"]["physics"]["properties"][key]
+    spec: dict[str, Any] = core_schema()["properties"]["physics"]["properties"][key]
     return _range_of(spec.get("items", spec))
 
 

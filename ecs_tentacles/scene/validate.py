@@ -1,7 +1,13 @@
-"""Validate scene data against the bundled JSON Schema and a few semantic rules.
+"""Validate scene data against the scene JSON Schema and a few semantic rules.
 
 Every problem is one line ``"<json path>: <message>"``; paths look like
 ``creatures[1].tentacles.end_scale`` and the root itself is called ``scene``.
+
+The schema a scene is checked against is assembled: the core schema
+(`assets/schema/scene.schema.json`: physics, creatures' bodies) plus the fragment of
+each plugin the scene turns on (creature keys, scene keys, `$defs`), and each plugin's
+`plugins.<name>` config against the plugin's own `config_schema`. `load_schema()` is the
+schema of a scene that says nothing about plugins (the default plugins on).
 """
 
 from __future__ import annotations
@@ -12,12 +18,14 @@ import importlib.resources
 import json
 import re
 from collections.abc import Iterable, Mapping, Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from jsonschema import Draft202012Validator, ValidationError, validators
 
-from ecs_tentacles.fur.checks import fur_problems
 from ecs_tentacles.scene.shards import shard_problems
+
+if TYPE_CHECKING:
+    from ecs_tentacles.plugin import Plugin
 
 JsonPath = tuple[str | int, ...]
 Problem = tuple[JsonPath, str]
@@ -48,16 +56,75 @@ _StrictValidator = validators.extend(
 
 
 @functools.cache
-def load_schema() -> dict[str, Any]:
-    """Return the scene JSON Schema bundled with the package (parsed once, then cached)."""
+def core_schema() -> dict[str, Any]:
+    """The core scene schema bundled with the package, without any plugin's keys."""
     resource = importlib.resources.files("ecs_tentacles.assets") / "schema" / "scene.schema.json"
     schema: dict[str, Any] = json.loads(resource.read_text(encoding="utf-8"))
     return schema
 
 
 @functools.cache
-def _validator() -> Any:
+def fragment(name: str) -> dict[str, Any]:
+    """A built-in plugin's schema fragment (`assets/schema/plugins/<name>.json`)."""
+    resource = importlib.resources.files("ecs_tentacles.assets") / "schema" / "plugins"
+    found: dict[str, Any] = json.loads((resource / f"{name}.json").read_text(encoding="utf-8"))
+    return found
+
+
+def schema_for(plugins: Sequence[Plugin]) -> dict[str, Any]:
+    """The core schema with each plugin's creature keys, scene keys and `$defs` added."""
+    key = tuple((p.key, type(p)) for p in plugins)
+    if all(p.source is None for p in plugins):  # built-in plugins' fragments never change
+        return _cached_schema(key, tuple(plugins))
+    return _assemble(plugins)
+
+
+@functools.lru_cache(maxsize=32)
+def _cached_schema(key: tuple[Any, ...], plugins: tuple[Plugin, ...]) -> dict[str, Any]:
+    return _assemble(plugins)
+
+
+def _assemble(plugins: Sequence[Plugin]) -> dict[str, Any]:
+    schema = copy.deepcopy(core_schema())
+    owner: dict[tuple[str, str], str] = {}
+    places = {
+        "$defs": schema["$defs"],
+        "creature": schema["$defs"]["creature"]["properties"],
+        "scene": schema["properties"],
+    }
+    for plugin in plugins:
+        parts = {
+            "$defs": plugin.defs,
+            "creature": plugin.creature_schema,
+            "scene": plugin.scene_schema,
+        }
+        for place, entries in parts.items():
+            for name, entry in entries.items():
+                if name in places[place] or (place, name) in owner:
+                    first = owner.get((place, name), "core")
+                    raise ValueError(
+                        f"plugins.{plugin.key}: its {place} key {name!r} is already {first}'s"
+                    )
+                owner[(place, name)] = plugin.key
+                places[place][name] = copy.deepcopy(entry)
+    return schema
+
+
+@functools.cache
+def load_schema() -> dict[str, Any]:
+    """The schema of a scene that turns no plugin on or off (the default plugins' keys)."""
+    from ecs_tentacles.plugin import resolve
+
+    return schema_for(resolve(None))
+
+
+@functools.cache
+def _default_validator() -> Any:
     return _StrictValidator(load_schema())
+
+
+def _validator(schema: dict[str, Any]) -> Any:
+    return _default_validator() if schema is load_schema() else _StrictValidator(schema)
 
 
 def format_path(path: Iterable[str | int]) -> str:
@@ -181,34 +248,62 @@ def _semantic_problems(scene: Mapping[str, Any]) -> list[Problem]:
                 problems.append((where, f"duplicate index {index} (also {first})"))
             else:
                 seen_indices[index] = j
-    return problems + fur_problems(scene) + shard_problems(scene)
+    return problems + shard_problems(scene)
 
 
-def validate_scene(data: object) -> list[str]:
+def _schema_problems(data: object, validator: Any, prefix: JsonPath = ()) -> list[Problem]:
+    errors = list(validator.iter_errors(data))
+    # A value of the wrong type (0.5 for an integer) may fail its range too: report the type.
+    mistyped = {tuple(e.absolute_path) for e in errors if e.validator == "type"}
+    return [
+        ((*prefix, *path), message)
+        for error in errors
+        if error.validator == "type" or tuple(error.absolute_path) not in mistyped
+        for path, message in _describe(error)
+    ]
+
+
+def _plugin_configs(data: Mapping[str, Any], plugins: Sequence[Plugin]) -> list[Problem]:
+    """Each plugin's `plugins.<name>` config against the plugin's own `config_schema`."""
+    chosen = data.get("plugins", {})
+    problems: list[Problem] = []
+    for plugin in plugins:
+        config = chosen.get(plugin.key, {}) if isinstance(chosen, Mapping) else {}
+        if isinstance(config, Mapping):
+            config = {k: v for k, v in config.items() if k != "from"}
+            validator = _StrictValidator(plugin.config_schema)
+            problems += _schema_problems(config, validator, ("plugins", plugin.key))
+    return problems
+
+
+def validate_scene(data: object, plugins: Sequence[Plugin] | None = None) -> list[str]:
     """Return every problem of ``data`` as a scene, sorted by JSON path; ``[]`` if it is valid.
 
-    Each problem is one line ``"<json path>: <message>"``. Semantic rules (override
+    Each problem is one line ``"<json path>: <message>"``. ``plugins`` are the plugins
+    the scene turns on (`ecs_tentacles.plugin.resolve`; default: the default ones): their
+    keys are part of the schema, and their own rules run. Semantic rules (override
     indices, unique names) are checked only once the schema passes; overlapping bodies
     are a physical problem (`ecs_tentacles.scene.physical`), checked when loading.
     """
-    schema = load_schema()
+    if plugins is None:
+        from ecs_tentacles.plugin import resolve
+
+        plugins = resolve(None)
+    schema = schema_for(plugins)
     too_long = _limit_problems(data, schema, schema)  # iterative, stops at long arrays
     if too_long:  # checked first: validating a million goals would take minutes
         return [f"{format_path(path)}: {message}" for path, message in too_long]
     deep = _too_deep(data)
     if deep is not None:  # before anything recursive (jsonschema, deepcopy, json.dumps)
         return [f"{format_path(deep)}: nested deeper than {MAX_DEPTH} levels"]
-    errors = list(_validator().iter_errors(data))
-    # A value of the wrong type (0.5 for an integer) may fail its range too: report the type.
-    mistyped = {tuple(e.absolute_path) for e in errors if e.validator == "type"}
-    problems = [
-        problem
-        for error in errors
-        if error.validator == "type" or tuple(error.absolute_path) not in mistyped
-        for problem in _describe(error)
-    ]
+    problems = _schema_problems(data, _validator(schema))
+    if isinstance(data, dict):
+        problems += _plugin_configs(data, plugins)
     if not problems and isinstance(data, dict):
-        problems = _semantic_problems(with_defaults(data))
+        full = with_defaults(data, plugins)
+        problems = _semantic_problems(full)
+        for plugin in plugins:
+            problems += plugin.problems(full)
     unique = sorted(set(problems), key=_path_key)
     return [f"{format_path(path)}: {message}" for path, message in unique]
 
@@ -292,18 +387,34 @@ def _merge_under(value: dict[str, Any], base: Mapping[str, Any]) -> None:
             _merge_under(value[key], item)
 
 
-def with_defaults(data: dict[str, Any]) -> dict[str, Any]:
+def plugin_config(plugin: Plugin, given: object) -> dict[str, Any]:
+    """A plugin's config as a scene gives it (`true`, absent or an object), defaults filled."""
+    config = copy.deepcopy(dict(given)) if isinstance(given, Mapping) else {}
+    _fill(config, plugin.config_schema, plugin.config_schema)
+    return config
+
+
+def with_defaults(data: dict[str, Any], plugins: Sequence[Plugin] | None = None) -> dict[str, Any]:
     """Return a deep copy of ``data`` with every schema ``default`` filled in.
 
     Works recursively through nested objects (objects defaulting to ``{}`` get their own
     defaults too), array items and ``$ref``s. An object whose schema has ``x-presets``
     and whose ``preset`` names one first takes the preset's values it lacks. Creatures
     without a name are called ``creature_<index>``. Optional fields without a default
-    stay absent; ``data`` is not modified.
+    stay absent; ``data`` is not modified. ``plugins`` (default: the default ones) add
+    their keys' defaults, and each plugin's config gets its defaults under `plugins`.
     """
     result = copy.deepcopy(data)
-    schema = load_schema()
+    if plugins is None:
+        from ecs_tentacles.plugin import resolve
+
+        plugins = resolve(None)
+    schema = schema_for(plugins)
     _fill(result, schema, schema)
+    chosen = result.get("plugins")
+    if isinstance(chosen, dict):  # absent (most scenes): the defaults are the plugins' own
+        for plugin in plugins:
+            chosen[plugin.key] = plugin_config(plugin, chosen.get(plugin.key))
     creatures = result.get("creatures")
     if isinstance(creatures, list):
         for i, creature in enumerate(creatures):

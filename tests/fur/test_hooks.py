@@ -1,4 +1,4 @@
-"""Rendering hooks: guide polylines with colour and width, child hairs, controls, threats."""
+"""Rendering hooks: guide polylines with colour and width, child hairs, controls (and threats)."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
-from ecs_tentacles.fur import child_hairs, control_markers, guide_curves, threat_positions
+from ecs_tentacles.fur import child_hairs, control_markers, guide_curves
 from ecs_tentacles.mathutil import quat_rotate
 from ecs_tentacles.world import World
 
@@ -76,7 +76,7 @@ def test_controls_and_threats(make_world: Callable[..., World]) -> None:
     quat = world.transforms.quat[world.fur.sets.body_row[0]]
     assert (marker.name, marker.shape) == ("a", "cube")
     assert_allclose(marker.position, mantle + quat_rotate(quat, np.array([0, 0, 0.3])))
-    threats = threat_positions(world)
+    threats = world.threats.positions(world)
     assert list(threats) == ["roach"]
     assert_allclose(threats["roach"], [1.0, 2.0, 3.0])
 
@@ -86,4 +86,4 @@ def test_a_world_without_fur_gives_empty_arrays(make_world: Callable[..., World]
     world.step(1)
     assert guide_curves(world).points.shape[0] == 0
     assert child_hairs(world).points.shape[0] == 0
-    assert control_markers(world) == [] and threat_positions(world) == {}
+    assert control_markers(world) == [] and world.threats.positions(world) == {}

@@ -9,7 +9,10 @@ TENTACLE_KEYS = (
     "max_torque, overrides, speed, strength, suckers, target_angle_deg, twist, "
     "wave_amplitude_deg, wave_frequency, wavelength, writhe"
 )
-TOP_KEYS = "$schema, creatures, description, name, physics, seed, shards, systems, threats, version"
+TOP_KEYS = (
+    "$schema, creatures, description, name, physics, plugins, seed, shards, systems, threats,"
+    " version"
+)
 CREATURE_KEYS = (
     "emotion, fur, goals, heading_deg, locomotion, mantle, name, position, tentacles, threat"
 )

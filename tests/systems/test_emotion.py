@@ -115,5 +115,5 @@ def test_threats_follow_their_paths_without_any_emotion(make_world: Callable[...
     del data["creatures"][0]["emotion"]
     world = make_world(data, locomotion=False)
     world.step(61)
-    assert_allclose(world.fur.threats.pos[0], NEAR)
+    assert_allclose(world.threats.store.pos[0], NEAR)
     assert len(world.fur.emotions) == 0

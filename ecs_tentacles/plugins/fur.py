@@ -1,0 +1,76 @@
+"""The fur plugin: fur and feathers on the mantle, and the emotion that raises them.
+
+Scene keys: a creature's `fur` and `emotion` (`assets/schema/plugins/fur.json`).
+Resources: `world.fur` (`ecs_tentacles.fur.stores.FurData`). Systems: emotion, rig
+(stage animate). Export hook: the posed guide curves a take records.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import TYPE_CHECKING, Any
+
+from ecs_tentacles.fur.build import build_emotion, build_fur
+from ecs_tentacles.fur.checks import fur_problems
+from ecs_tentacles.fur.stores import FurData
+from ecs_tentacles.plugin import Plugin
+from ecs_tentacles.scene.validate import fragment
+from ecs_tentacles.system import System
+
+if TYPE_CHECKING:
+    from ecs_tentacles.world import World
+
+_FRAGMENT = fragment("fur")
+STORES = ("guides", "controls", "sets", "emotions")
+
+
+class FurPlugin(Plugin):
+    name = "fur"
+    description = "fur and feathers (lift, aim, direction, random, dynamic blend) and emotion"
+    creature_schema = _FRAGMENT["creature"]
+    defs = _FRAGMENT["$defs"]
+
+    def problems(self, scene: Mapping[str, Any]) -> list[tuple[tuple[str | int, ...], str]]:
+        return fur_problems(scene)
+
+    def resources(self, world: World) -> dict[str, Any]:
+        return {"fur": FurData()}
+
+    def build_creature(self, world: World, creature: int, spec: Mapping[str, Any]) -> None:
+        if "fur" in spec:
+            build_fur(world, creature, dict(spec["fur"]))
+        if "emotion" in spec:
+            build_emotion(world, creature, dict(spec["emotion"]))
+
+    def systems(self) -> list[System]:
+        from ecs_tentacles.systems.emotion import EmotionSystem
+        from ecs_tentacles.systems.rig import Rig
+
+        return [EmotionSystem(), Rig()]
+
+    def snapshot(self, world: World) -> Any:
+        fur = world.fur
+        stores = {}
+        for name in STORES:
+            store = getattr(fur, name)
+            stores[name] = (
+                store.count,
+                {f: a[: store.count].copy() for f, a in store._arrays.items()},
+            )
+        return stores, fur.curves.copy(), fur.frames.copy()
+
+    def restore(self, world: World, state: Any) -> None:
+        stores, curves, frames = state
+        fur = world.fur
+        for name, (count, arrays) in stores.items():
+            store = getattr(fur, name)
+            store.count = count
+            for f, values in arrays.items():
+                store._arrays[f][:count] = values
+        fur.curves[...] = curves
+        fur.frames[...] = frames
+
+    def export_curves(self, world: World) -> Any:
+        from ecs_tentacles.fur.hooks import take_guides
+
+        return take_guides(world)

@@ -1,0 +1,30 @@
+"""The record plugin: the run recorded into a take (`ecs-tentacles bake` adds it).
+
+    record = RecordPlugin(every=2)        # a 30 fps take of a 60 fps world
+    world.add_plugin(record)
+    world.step(120)
+    take = record.system.take()
+
+Systems: record (stage output), which captures the frame after everything else ran.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from ecs_tentacles.plugin import Plugin
+from ecs_tentacles.system import System
+
+
+class RecordPlugin(Plugin):
+    name = "record"
+    description = "records every frame's poses, suckers, goals and fur guides into a take"
+
+    def __init__(self, config: dict[str, Any] | None = None, *, every: int = 1, **recorder: Any):
+        super().__init__(config)
+        from ecs_tentacles.systems.record import Record
+
+        self.system = Record(every, **recorder)
+
+    def systems(self) -> list[System]:
+        return [self.system]

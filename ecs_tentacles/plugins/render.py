@@ -1,0 +1,31 @@
+"""The render plugin: the sandbox's renderer gets each frame's poses (`play` adds it).
+
+Systems: render (stage output). Other plugins draw through their render hooks
+(`Plugin.render_spheres`), which the renderer calls.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+from ecs_tentacles.plugin import Plugin
+from ecs_tentacles.system import System
+
+if TYPE_CHECKING:
+    from ecs_tentacles.render.renderer import Renderer
+
+
+class RenderPlugin(Plugin):
+    name = "render"
+    description = "hands the newest body poses to the sandbox renderer"
+
+    def __init__(self, config: dict[str, Any] | None = None, *, renderer: Renderer | None = None):
+        super().__init__(config)
+        if renderer is None:
+            raise ValueError("the render plugin needs the sandbox's renderer (renderer=...)")
+        self.renderer = renderer
+
+    def systems(self) -> list[System]:
+        from ecs_tentacles.systems.render import RenderSync
+
+        return [RenderSync(self.renderer)]

@@ -1,0 +1,108 @@
+"""Threats: marked things that frighten creatures (the `threats` plugin's data).
+
+A threat is either a scene `threats` entry, a point that follows a keyframed path, or a
+creature marked `"threat": true`, whose mantle is the threat. `world.threats` holds
+them; the `threats` system moves path threats, and the fur plugin's `emotion` system
+reads `world.threats.sources()` to rouse creatures nearby.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ecs_tentacles.components import RowComponent, RowField, Transform
+from ecs_tentacles.fur.tracks import Channel, channels_from_keys
+from ecs_tentacles.store import ArrayStore, Field
+
+if TYPE_CHECKING:
+    from ecs_tentacles.world import World
+
+Problem = tuple[tuple[str | int, ...], str]
+
+
+class ThreatStore(ArrayStore):
+    """Path threats: their entity and world position (from a keyframed path)."""
+
+    entity = Field(dtype=np.int64)
+    pos = Field((3,))
+
+
+@dataclass(eq=False, repr=False)
+class Threat(RowComponent):
+    """A marked entity that frightens creatures: world `pos` (follows its keyframed path)."""
+
+    store: ThreatStore
+    name: str
+    pos = RowField()
+
+
+class ThreatData:
+    """`world.threats`: path threats (a store and their paths) and threat creatures."""
+
+    def __init__(self) -> None:
+        self.store = ThreatStore()
+        self.paths: list[Channel] = []  # positions (columns 0, 1, 2) by store row
+        self.bodies = np.zeros(0, dtype=np.int64)  # mantle transform rows of threat creatures
+        self.creatures = np.zeros(0, dtype=np.int64)  # their creature entities
+
+    def __len__(self) -> int:
+        return len(self.store) + len(self.bodies)
+
+    def sources(self, world: World) -> tuple[np.ndarray, np.ndarray]:
+        """Every threat's world position (n, 3) and owner creature entity (-1: none)."""
+        pos = np.concatenate([self.store.pos, world.transforms.pos[self.bodies]])
+        owners = np.concatenate([np.full(len(self.store), -1), self.creatures])
+        return pos, owners
+
+    def positions(self, world: World) -> dict[str, np.ndarray]:
+        """World position of every path threat, by name."""
+        return {threat.name: threat.pos.copy() for _, threat in world.query(Threat)}
+
+
+def mark_creature(world: World, creature: int) -> None:
+    """Make a creature's mantle a threat to the others."""
+    threats: ThreatData = world.threats
+    row = world.component(creature, Transform).row
+    threats.bodies = np.append(threats.bodies, row)
+    threats.creatures = np.append(threats.creatures, creature)
+
+
+def build_threats(world: World, specs: Sequence[Mapping[str, Any]]) -> list[int]:
+    """Threat entities that follow keyframed paths; returns their entities."""
+    threats: ThreatData = world.threats
+    entities = []
+    for i, spec in enumerate(specs):
+        path = spec["path"]
+        row = int(threats.store.add(pos=path[0]["position"])[0])
+        entity = world.create_entity(Threat(threats.store, row, spec.get("name", f"threat_{i}")))
+        threats.store.entity[row] = entity
+        threats.paths += channels_from_keys(row, (0, 1, 2), path, "position")
+        entities.append(entity)
+    return entities
+
+
+def threat_problems(scene: Mapping[str, Any]) -> list[Problem]:
+    """Threat names are unique and path keys come in time order."""
+    problems: list[Problem] = []
+    seen: dict[str, int] = {}
+    for i, threat in enumerate(scene.get("threats", [])):
+        name = threat.get("name", f"threat_{i}")
+        if name in seen:
+            problems.append(
+                (("threats", i, "name"), f'duplicate name "{name}" (also threats[{seen[name]}])')
+            )
+        seen.setdefault(name, i)
+        for k, key in enumerate(threat["path"]):
+            if k and key["time"] <= threat["path"][k - 1]["time"]:
+                previous = threat["path"][k - 1]["time"]
+                problems.append(
+                    (
+                        ("threats", i, "path", k, "time"),
+                        f"must be > {previous} (the previous key's), got {key['time']}",
+                    )
+                )
+    return problems

@@ -1,0 +1,1 @@
+"""Example plugins (not on by default): wander, flee, follow_leader, flock."""

@@ -1,0 +1,35 @@
+"""threats: path threats follow their keyframed paths (the threats plugin).
+
+Reads: `world.threats.paths` (keyframed positions) and `world.time`. Writes: the
+ThreatStore's `pos` of every path threat. Creatures marked `threat` need nothing here:
+their mantle is the threat.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from ecs_tentacles.fur.tracks import TrackSet
+from ecs_tentacles.system import System
+
+if TYPE_CHECKING:
+    from ecs_tentacles.world import World
+
+
+class ThreatPaths(System):
+    name = "threats"
+    stage = "animate"
+    reads = ("threats.paths",)
+    writes = ("threats.pos",)
+
+    def __init__(self) -> None:
+        self.paths = TrackSet([])
+        self.path_count = -1
+
+    def process(self, world: World, dt: float) -> None:
+        threats = world.threats
+        if len(threats.paths) != self.path_count:
+            self.paths = TrackSet(threats.paths)
+            self.path_count = len(threats.paths)
+        if len(self.paths):
+            threats.store.pos[self.paths.rows, self.paths.columns] = self.paths.evaluate(world.time)
