@@ -121,7 +121,8 @@ class TentacleStore(ArrayStore):
     Links of a tentacle are the contiguous motor rows `first_link .. first_link + links`.
     Parameters (`speed` ... `writhe`) are what scripts and the HUD change at run time.
     The current action (`action`, `timer`, `duration`, `action_angle`,
-    `action_strength`) mirrors the head of the tentacle's `ActionQueue`.
+    `action_strength`) mirrors the head of the tentacle's `ActionQueue`; `interrupted`
+    ends it early (`ecs_tentacles.locomotion.actions.ActionQueues`).
     """
 
     creature_row = Field(dtype=np.int64)
@@ -148,6 +149,7 @@ class TentacleStore(ArrayStore):
     action_angle = Field()
     action_strength = Field(default=1.0)
     orient = Field()  # sweep (radians) toward the goal line, held through a stroke
+    interrupted = Field(dtype=np.bool_, default=False)  # ends this frame (ActionQueues.interrupt)
     mode = Field(dtype=np.int64)  # 0 idle, 1 push, 2 pull
     driving = Field(dtype=np.bool_, default=False)
     started = Field(default=-np.inf)  # time the current drive began

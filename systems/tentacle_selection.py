@@ -14,8 +14,9 @@ means the tentacle lies between mantle and goal: pull; otherwise push.
 * no goal: drives stop (the sucker lets go) and every tentacle idles.
 
 Reads: CreatureStore (goal, gait, drivers, speed), TentacleStore (base, action,
-mode, driving), Transform store. Writes: TentacleStore (driving, mode, started,
-current action on abort), CreatureStore (next_driver, last_start), ActionQueues.
+mode, driving), Transform store. Writes: TentacleStore (driving, mode, started),
+CreatureStore (next_driver, last_start), ActionQueues (a started drive is queued and
+the current action interrupted; an abort replaces the queue with detach, settle).
 """
 
 from __future__ import annotations
@@ -24,8 +25,13 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ecs_tentacles.components import Tentacle
-from ecs_tentacles.locomotion.actions import BASE_SECONDS, ActionQueue, Kind, Mode, drive_sequence
+from ecs_tentacles.locomotion.actions import (
+    BASE_SECONDS,
+    ActionQueues,
+    Kind,
+    Mode,
+    drive_sequence,
+)
 from ecs_tentacles.locomotion.actions import make_action as action
 from ecs_tentacles.system import System
 
@@ -51,9 +57,7 @@ class TentacleSelection(System):
     after = ("goals",)
 
     def setup(self, world: World) -> None:
-        self.queues = [ActionQueue()] * len(world.tentacles)
-        for entity, tentacle in world.query(Tentacle):
-            self.queues[tentacle.row] = world.component(entity, ActionQueue)
+        self.queues = ActionQueues(world)
 
     def process(self, world: World, dt: float) -> None:
         t, c = world.tentacles, world.creatures
@@ -122,18 +126,16 @@ class TentacleSelection(System):
     def _start(self, world: World, row: int, mode: Mode, orient: float | None) -> None:
         t = world.tentacles
         speed = float(t.speed[row] * world.creatures.speed[t.creature_row[row]])
+        # queued after whatever is pending; the current action ends now
         self.queues[row].extend(drive_sequence(mode, float(t.target_angle[row]), speed, orient))
+        self.queues.interrupt(row)
         t.driving[row] = True
         t.mode[row] = mode
         t.started[row] = world.time
-        t.duration[row] = 0.0  # the action queue moves on to the new actions this frame
 
     def _abort(self, world: World, row: int) -> None:
         t = world.tentacles
         speed = float(t.speed[row] * world.creatures.speed[t.creature_row[row]])
-        queue = self.queues[row]
-        queue.clear()
-        queue.extend([action(Kind.DETACH, speed), action(Kind.SETTLE, speed)])
+        self.queues.replace(row, [action(Kind.DETACH, speed), action(Kind.SETTLE, speed)])
         t.driving[row] = False
         t.mode[row] = Mode.NONE
-        t.duration[row] = 0.0
