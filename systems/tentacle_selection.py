@@ -21,7 +21,7 @@ the current action interrupted; an abort replaces the queue with detach, settle)
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
@@ -47,9 +47,20 @@ MIN_SCORE = 0.2
 STROKE_SECONDS = sum(BASE_SECONDS[k] for k in (Kind.ORIENT, Kind.EXTEND, Kind.ATTACH, Kind.PULL))
 
 
-def classify(goal_dir: np.ndarray, base_dir: np.ndarray) -> np.ndarray:
-    """True where a tentacle should pull: angle between the unit vectors within +-pi/2."""
-    return np.einsum("ij,ij->i", goal_dir, base_dir) >= -PULL_TOLERANCE
+class Classified(NamedTuple):
+    """Per tentacle: `pull` (else push) and `cos` of the angle goal -> base it came from."""
+
+    pull: np.ndarray
+    cos: np.ndarray
+
+
+def classify(to_goal: np.ndarray, to_base: np.ndarray) -> Classified:
+    """The thesis's test, row by row, on (n, 2) ground-plane vectors mantle -> goal and
+    mantle -> tentacle base (any lengths): pull where the angle is within +-pi/2."""
+    dot = to_goal[:, 0] * to_base[:, 0] + to_goal[:, 1] * to_base[:, 1]
+    lengths = np.hypot(to_goal[:, 0], to_goal[:, 1]) * np.hypot(to_base[:, 0], to_base[:, 1])
+    cos = dot / np.maximum(lengths, 1e-12)
+    return Classified(cos >= -PULL_TOLERANCE, cos)
 
 
 class TentacleSelection(System):
@@ -68,10 +79,7 @@ class TentacleSelection(System):
         mantle = pos[c.mantle_row, :2]
         to_goal = (c.goal[:, :2] - mantle)[creature]
         to_base = pos[t.base_row, :2] - mantle[creature]
-        dot = to_goal[:, 0] * to_base[:, 0] + to_goal[:, 1] * to_base[:, 1]
-        lengths = np.hypot(to_goal[:, 0], to_goal[:, 1]) * np.hypot(to_base[:, 0], to_base[:, 1])
-        cos = dot / np.maximum(lengths, 1e-12)
-        pull = cos >= -PULL_TOLERANCE
+        pull, cos = classify(to_goal, to_base)
         has_goal = c.has_goal[creature]
         driving_now = t.driving
 
