@@ -21,7 +21,7 @@ the current action interrupted; an abort replaces the queue with detach, settle)
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, NamedTuple
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -47,20 +47,13 @@ MIN_SCORE = 0.2
 STROKE_SECONDS = sum(BASE_SECONDS[k] for k in (Kind.ORIENT, Kind.EXTEND, Kind.ATTACH, Kind.PULL))
 
 
-class Classified(NamedTuple):
-    """Per tentacle: `pull` (else push) and `cos` of the angle goal -> base it came from."""
-
-    pull: np.ndarray
-    cos: np.ndarray
-
-
-def classify(to_goal: np.ndarray, to_base: np.ndarray) -> Classified:
-    """The thesis's test, row by row, on (n, 2) ground-plane vectors mantle -> goal and
-    mantle -> tentacle base (any lengths): pull where the angle is within +-pi/2."""
+def classify(to_goal: np.ndarray, to_base: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(pull, cos) per row: the thesis's test on (n, 2) ground-plane vectors mantle -> goal
+    and mantle -> tentacle base (any lengths); pull where their angle is within +-pi/2."""
     dot = to_goal[:, 0] * to_base[:, 0] + to_goal[:, 1] * to_base[:, 1]
     lengths = np.hypot(to_goal[:, 0], to_goal[:, 1]) * np.hypot(to_base[:, 0], to_base[:, 1])
     cos = dot / np.maximum(lengths, 1e-12)
-    return Classified(cos >= -PULL_TOLERANCE, cos)
+    return cos >= -PULL_TOLERANCE, cos
 
 
 class TentacleSelection(System):

@@ -57,7 +57,7 @@ def test_classify_pulls_within_a_right_angle(
 ) -> None:
     goal = np.array([_unit(base_degrees + degrees)])
     base = np.array([_unit(base_degrees)])
-    assert classify(goal, base).pull.tolist() == [pull]
+    assert classify(goal, base)[0].tolist() == [pull]
 
 
 def test_classify_counts_the_right_angle_itself_as_pull() -> None:
@@ -74,13 +74,13 @@ def test_classify_counts_the_right_angle_itself_as_pull() -> None:
         ]
     )
     base = np.array([[1.0, 0.0], [1.0, 0.0], [1.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 0.0]])
-    assert classify(goal, base).pull.tolist() == [True] * 6
+    assert classify(goal, base)[0].tolist() == [True] * 6
 
 
 def test_classify_works_row_by_row() -> None:
     goal = np.array([_unit(0.0), _unit(0.0), _unit(90.0), _unit(90.0)])
     base = np.array([_unit(10.0), _unit(170.0), _unit(100.0), _unit(-100.0)])
-    assert classify(goal, base).pull.tolist() == [True, False, True, False]
+    assert classify(goal, base)[0].tolist() == [True, False, True, False]
 
 
 def test_classify_ignores_lengths_and_gives_the_cosine() -> None:
@@ -210,7 +210,7 @@ def test_coordinated_driver_aborts_when_the_goal_changes_sides(
     base = world.transforms.pos[world.tentacles.base_row[2], :2]
     goal_dir = (np.array([-1.5, 0.0]) - mantle) / np.linalg.norm([-1.5, 0.0] - mantle)
     base_dir = (base - mantle) / np.linalg.norm(base - mantle)
-    assert classify(goal_dir[None], base_dir[None]).pull.tolist() == [True]
+    assert classify(goal_dir[None], base_dir[None])[0].tolist() == [True]
     assert _new_drivers(world, 1) == [(2, Mode.PULL)]
     assert world.locomotion.queue(octo, 2) == ["orient", *_names(Mode.PULL), "settle"]
 
