@@ -16,8 +16,11 @@ import numpy as np
 from ecs_tentacles.fur.tracks import Channel
 from ecs_tentacles.store import ArrayStore, Field
 
+# The rig's behaviours, in order: a fur switches each on or off (`FurSetStore.enabled`),
+# and a control drives each through its ControlStore field of the same name.
 BEHAVIOURS = ("lift", "aim", "direction", "random", "dynamic")
-CONTROL_VALUES = ("lift", "aim", "direction", "random", "dynamic")
+# Track columns of the ControlStore: position x, y, z, then the behaviour values.
+COLUMNS = {"position": (0, 1, 2)} | {name: (3 + i,) for i, name in enumerate(BEHAVIOURS)}
 
 
 class GuideStore(ArrayStore):
@@ -124,7 +127,7 @@ class FurData:
         self.curves = np.zeros((0, 0, 3), dtype=np.float32)
         self.frames = np.zeros((0, 4, 3), dtype=np.float32)
         self.version = 0
-        self.tracks: list[Channel] = []  # control attributes (columns: see fur.build.COLUMNS)
+        self.tracks: list[Channel] = []  # control attributes (columns: COLUMNS)
         self.threat_paths: list[Channel] = []  # threat positions (columns 0, 1, 2)
         self.threat_bodies = np.zeros(0, dtype=np.int64)  # mantle rows of threat creatures
         self.threat_creatures = np.zeros(0, dtype=np.int64)  # their creature entities
