@@ -107,11 +107,6 @@ class Tentacle:
     links: list[int] = field(default_factory=list)
     suckers: list[int] = field(default_factory=list)
 
-    @property
-    def axis(self) -> np.ndarray:
-        """Unit axis in the creature frame."""
-        return np.array([np.cos(self.base_angle), np.sin(self.base_angle), 0.0])
-
 
 @dataclass(eq=False)
 class Link:
