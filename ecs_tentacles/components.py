@@ -4,8 +4,8 @@ Numbers that systems touch every frame live in stores (`ecs_tentacles.store`); t
 components that expose them (`Transform`, `Motor`, `Sucker`) hold their store and
 row, and each field reads as a writable numpy view (vectors) or a float (scalars):
 
-    link.transform.pos[2] += 0.1        # writes into the TransformStore
-    motor.strength = 8.0                # reaches the servo on the next physics step
+    world.component(link, Transform).pos     # (3,) writable view into the TransformStore
+    world.component(link, Motor).strength = 8.0  # reaches the servo on the next step
 
 Structural components (`Creature`, `Tentacle`, `Link`, `Goal`) are plain data fixed
 at construction. Components are never added or removed per frame.
@@ -106,11 +106,6 @@ class Tentacle:
     row: int = -1  # TentacleStore row
     links: list[int] = field(default_factory=list)
     suckers: list[int] = field(default_factory=list)
-
-    @property
-    def axis(self) -> np.ndarray:
-        """Unit axis in the creature frame."""
-        return np.array([np.cos(self.base_angle), np.sin(self.base_angle), 0.0])
 
 
 @dataclass(eq=False)

@@ -43,12 +43,6 @@ def tentacle_angles(count: int) -> np.ndarray:
     return 2.0 * np.pi * np.arange(count) / count
 
 
-def tentacle_axes(count: int) -> np.ndarray:
-    """Unit axis (count, 3) of each tentacle in the creature frame."""
-    angles = tentacle_angles(count)
-    return np.stack([np.cos(angles), np.sin(angles), np.zeros(count)], axis=1)
-
-
 @dataclass(frozen=True)
 class TentacleShape:
     """Per-link numbers of one tentacle; `centres` are distances along its axis."""

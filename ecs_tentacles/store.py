@@ -3,9 +3,10 @@
 Each store owns one contiguous numpy array per field, with a row per entity of its
 kind. Built-in systems do whole-array math on `store.<field>` (a view of the live
 rows); components (`ecs_tentacles.components`) hold a store and a row and expose
-the same fields as writable views, so scripts can write `link.transform.pos`.
-Rows are never removed; stores grow by doubling, which is why components look their
-field up on every access instead of keeping an old view.
+the same fields as writable views, so scripts can write
+`world.component(link, Motor).target`. Rows are never removed; stores grow by
+doubling, which is why components look their field up on every access instead of
+keeping an old view.
 """
 
 from __future__ import annotations
@@ -121,7 +122,8 @@ class TentacleStore(ArrayStore):
     Links of a tentacle are the contiguous motor rows `first_link .. first_link + links`.
     Parameters (`speed` ... `writhe`) are what scripts and the HUD change at run time.
     The current action (`action`, `timer`, `duration`, `action_angle`,
-    `action_strength`) mirrors the head of the tentacle's `ActionQueue`.
+    `action_strength`) is the one last taken from the tentacle's `ActionQueue`;
+    `interrupted` ends it early (`ecs_tentacles.locomotion.actions.ActionQueues`).
     """
 
     creature_row = Field(dtype=np.int64)
@@ -148,6 +150,7 @@ class TentacleStore(ArrayStore):
     action_angle = Field()
     action_strength = Field(default=1.0)
     orient = Field()  # sweep (radians) toward the goal line, held through a stroke
+    interrupted = Field(dtype=np.bool_, default=False)  # ends this frame (ActionQueues.interrupt)
     mode = Field(dtype=np.int64)  # 0 idle, 1 push, 2 pull
     driving = Field(dtype=np.bool_, default=False)
     started = Field(default=-np.inf)  # time the current drive began

@@ -1,9 +1,13 @@
 """action_queue: advances every tentacle's action timer and starts the next action.
 
-Reads: TentacleStore (timer, duration, action), Sucker store (attached: an attach
-action waits for its sucker, up to three times its duration), ActionQueues.
-Writes: TentacleStore (current action, timer, duration, angle, strength, orient;
-driving and mode go back to idle when a queue runs dry).
+An interrupted tentacle (`ActionQueues.interrupt`: tentacle_selection starting or
+aborting a drive, or a script) moves on at once, whatever its timer.
+
+Reads: TentacleStore (timer, duration, action, interrupted), Sucker store (attached:
+an attach action waits for its sucker, up to ATTACH_PATIENCE times its duration),
+ActionQueues. Writes: TentacleStore (current action, timer, duration, angle,
+strength, orient, interrupted cleared; driving and mode go back to idle when a queue
+runs dry).
 """
 
 from __future__ import annotations
@@ -12,14 +16,12 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ecs_tentacles.components import Tentacle
-from ecs_tentacles.locomotion.actions import STRENGTH, ActionQueue, Kind, Mode
+from ecs_tentacles.locomotion.actions import ATTACH_PATIENCE, STRENGTH, ActionQueues, Kind, Mode
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
     from ecs_tentacles.world import World
 
-ATTACH_PATIENCE = 3.0
 TIME_EPSILON = 1e-9  # sums of frame durations fall a hair short of whole durations
 ATTACH = int(Kind.ATTACH)
 
@@ -31,9 +33,7 @@ class ActionQueueSystem(System):
     writes = ("tentacles.action", "tentacles.timer", "tentacles.orient")
 
     def setup(self, world: World) -> None:
-        self.queues = [ActionQueue()] * len(world.tentacles)
-        for entity, tentacle in world.query(Tentacle):
-            self.queues[tentacle.row] = world.component(entity, ActionQueue)
+        self.queues = ActionQueues(world)
 
     def process(self, world: World, dt: float) -> None:
         t = world.tentacles
@@ -46,6 +46,10 @@ class ActionQueueSystem(System):
             gripped = world.suckers.attached[t.tip_sucker]
             patience = ATTACH_PATIENCE * t.duration - TIME_EPSILON
             done &= ~attaching | gripped | (t.timer >= patience)
+        interrupted = t.interrupted
+        if interrupted.any():
+            done |= interrupted
+            interrupted[:] = False
         for row in np.flatnonzero(done):
             self._advance(world, int(row))
 

@@ -19,9 +19,8 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 import numpy as np
-from ecs_tentacles.systems.action_queue import ATTACH_PATIENCE
 
-from ecs_tentacles.locomotion.actions import Kind, Mode
+from ecs_tentacles.locomotion.actions import ATTACH_PATIENCE, GRIPPING, Kind, Mode
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
@@ -36,8 +35,6 @@ ORIENTED[
     [Kind.ORIENT, Kind.EXTEND, Kind.COMPRESS, Kind.ATTACH, Kind.PUSH, Kind.PULL, Kind.DETACH]
 ] = True
 HALF_ROOT3 = np.sqrt(3.0) / 2.0
-GRIPPING = np.zeros(len(Kind), dtype=bool)
-GRIPPING[[Kind.ATTACH, Kind.PUSH, Kind.PULL]] = True
 # Which (action, mode) pairs hold the arch pose.
 ARCHED = np.zeros((len(Kind), len(Mode)), dtype=bool)
 ARCHED[[Kind.COMPRESS, Kind.PULL], :] = True

@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ecs_tentacles.locomotion.actions import Kind
+from ecs_tentacles.locomotion.actions import GRIPPING, Kind
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
@@ -28,8 +28,6 @@ if TYPE_CHECKING:
 
 ATTACH_HEIGHT = 0.004  # metres above the ground a sucker may be and still grab
 ATTACH = int(Kind.ATTACH)
-HOLDING = np.zeros(len(Kind), dtype=bool)
-HOLDING[[Kind.ATTACH, Kind.PUSH, Kind.PULL]] = True
 
 
 class Suckers(System):
@@ -59,7 +57,7 @@ class Suckers(System):
         tentacle = s.tentacle_row[held]
         creature = t.creature_row[tentacle]
         anchor = s.anchor[held]
-        holding = HOLDING[t.action[tentacle]] & (tip[tentacle] == held)
+        holding = GRIPPING[t.action[tentacle]] & (tip[tentacle] == held)
         stretch = np.linalg.norm(world.sucker_points(held) - anchor, axis=1)
         base = world.transforms.pos[t.base_row[tentacle], :2]
         reach = np.linalg.norm(base - anchor[:, :2], axis=1)

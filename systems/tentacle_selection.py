@@ -14,8 +14,9 @@ means the tentacle lies between mantle and goal: pull; otherwise push.
 * no goal: drives stop (the sucker lets go) and every tentacle idles.
 
 Reads: CreatureStore (goal, gait, drivers, speed), TentacleStore (base, action,
-mode, driving), Transform store. Writes: TentacleStore (driving, mode, started,
-current action on abort), CreatureStore (next_driver, last_start), ActionQueues.
+mode, driving), Transform store. Writes: TentacleStore (driving, mode, started),
+CreatureStore (next_driver, last_start), ActionQueues (a started drive is queued and
+the current action interrupted; an abort replaces the queue with detach, settle).
 """
 
 from __future__ import annotations
@@ -24,8 +25,13 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ecs_tentacles.components import Tentacle
-from ecs_tentacles.locomotion.actions import BASE_SECONDS, ActionQueue, Kind, Mode, drive_sequence
+from ecs_tentacles.locomotion.actions import (
+    BASE_SECONDS,
+    ActionQueues,
+    Kind,
+    Mode,
+    drive_sequence,
+)
 from ecs_tentacles.locomotion.actions import make_action as action
 from ecs_tentacles.system import System
 
@@ -41,9 +47,13 @@ MIN_SCORE = 0.2
 STROKE_SECONDS = sum(BASE_SECONDS[k] for k in (Kind.ORIENT, Kind.EXTEND, Kind.ATTACH, Kind.PULL))
 
 
-def classify(goal_dir: np.ndarray, base_dir: np.ndarray) -> np.ndarray:
-    """True where a tentacle should pull: angle between the unit vectors within +-pi/2."""
-    return np.einsum("ij,ij->i", goal_dir, base_dir) >= -PULL_TOLERANCE
+def classify(to_goal: np.ndarray, to_base: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(pull, cos) per row: the thesis's test on (n, 2) ground-plane vectors mantle -> goal
+    and mantle -> tentacle base (any lengths); pull where their angle is within +-pi/2."""
+    dot = to_goal[:, 0] * to_base[:, 0] + to_goal[:, 1] * to_base[:, 1]
+    lengths = np.hypot(to_goal[:, 0], to_goal[:, 1]) * np.hypot(to_base[:, 0], to_base[:, 1])
+    cos = dot / np.maximum(lengths, 1e-12)
+    return cos >= -PULL_TOLERANCE, cos
 
 
 class TentacleSelection(System):
@@ -54,9 +64,7 @@ class TentacleSelection(System):
     writes = ("tentacles.driving", "tentacles.mode", "action_queues")
 
     def setup(self, world: World) -> None:
-        self.queues = [ActionQueue()] * len(world.tentacles)
-        for entity, tentacle in world.query(Tentacle):
-            self.queues[tentacle.row] = world.component(entity, ActionQueue)
+        self.queues = ActionQueues(world)
 
     def process(self, world: World, dt: float) -> None:
         t, c = world.tentacles, world.creatures
@@ -67,10 +75,7 @@ class TentacleSelection(System):
         mantle = pos[c.mantle_row, :2]
         to_goal = (c.goal[:, :2] - mantle)[creature]
         to_base = pos[t.base_row, :2] - mantle[creature]
-        dot = to_goal[:, 0] * to_base[:, 0] + to_goal[:, 1] * to_base[:, 1]
-        lengths = np.hypot(to_goal[:, 0], to_goal[:, 1]) * np.hypot(to_base[:, 0], to_base[:, 1])
-        cos = dot / np.maximum(lengths, 1e-12)
-        pull = cos >= -PULL_TOLERANCE
+        pull, cos = classify(to_goal, to_base)
         has_goal = c.has_goal[creature]
         driving_now = t.driving
 
@@ -125,18 +130,16 @@ class TentacleSelection(System):
     def _start(self, world: World, row: int, mode: Mode, orient: float | None) -> None:
         t = world.tentacles
         speed = float(t.speed[row] * world.creatures.speed[t.creature_row[row]])
+        # queued after whatever is pending; the current action ends now
         self.queues[row].extend(drive_sequence(mode, float(t.target_angle[row]), speed, orient))
+        self.queues.interrupt(row)
         t.driving[row] = True
         t.mode[row] = mode
         t.started[row] = world.time
-        t.duration[row] = 0.0  # the action queue moves on to the new actions this frame
 
     def _abort(self, world: World, row: int) -> None:
         t = world.tentacles
         speed = float(t.speed[row] * world.creatures.speed[t.creature_row[row]])
-        queue = self.queues[row]
-        queue.clear()
-        queue.extend([action(Kind.DETACH, speed), action(Kind.SETTLE, speed)])
+        self.queues.replace(row, [action(Kind.DETACH, speed), action(Kind.SETTLE, speed)])
         t.driving[row] = False
         t.mode[row] = Mode.NONE
-        t.duration[row] = 0.0

@@ -16,9 +16,9 @@ from ecs_tentacles.construction import (
     cylinder_mass_inertia,
     link_scales,
     tentacle_angles,
-    tentacle_axes,
     tentacle_shape,
 )
+from ecs_tentacles.scene.validate import with_defaults
 from ecs_tentacles.world import World
 
 S = np.sqrt(0.5)
@@ -75,7 +75,9 @@ def test_end_scale_one_gives_uniform_links() -> None:
     ],
 )
 def test_tentacle_axes_counter_clockwise_about_z(count: int, expected: list[list[float]]) -> None:
-    assert_allclose(tentacle_axes(count), expected, atol=1e-15)
+    scene = with_defaults({"version": 1, "creatures": [{"tentacles": {"count": count}}]})
+    layout = creature_layout(scene["creatures"][0])  # heading 0: creature frame = world
+    assert_allclose([layout.axis(k) for k in range(count)], expected, atol=1e-15)
     assert_allclose(tentacle_angles(count), np.radians(360.0 * np.arange(count) / count))
 
 

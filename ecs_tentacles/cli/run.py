@@ -8,9 +8,8 @@ import sys
 import time
 from typing import Any
 
-from tqdm import tqdm
-
 from ecs_tentacles.components import Creature
+from ecs_tentacles.progress import step_frames
 from ecs_tentacles.scene.load import resolve_scene_path
 from ecs_tentacles.world import World
 
@@ -110,18 +109,9 @@ def handle(args: argparse.Namespace) -> int:
 def simulate(world: World, frames: int, *, progress: bool = True) -> dict[str, Any]:
     """Step `world` for `frames` frames and return timing and size figures."""
     physics = world.physics
-    chunk = max(1, round(world.settings.fps / 10))
     start_time = world.time
     wall_start = time.perf_counter()
-    with tqdm(
-        total=frames, unit="frame", disable=None if progress else True, file=sys.stderr, leave=False
-    ) as bar:
-        done = 0
-        while done < frames:
-            n = min(chunk, frames - done)
-            world.step(n)
-            done += n
-            bar.update(n)
+    step_frames(world, frames, progress=progress)
     wall = time.perf_counter() - wall_start
     sim = world.time - start_time
     return {

@@ -68,13 +68,6 @@ def _create_exclusive(path: Path) -> tuple[Path, int]:
             raise OutputError(f"{path}: cannot write: {error.strerror or error}") from None
 
 
-def temporary_sibling(path: Path) -> Path:
-    """Create an exclusive temporary file beside `path` (closed) and return its path."""
-    candidate, descriptor = _create_exclusive(path)
-    os.close(descriptor)
-    return candidate
-
-
 def partial_pattern(path: Path) -> re.Pattern[str]:
     """Names of this tool's temporary files for `path`: ours, USD's and the old fixed one."""
     stem, suffix = re.escape(path.stem), re.escape(path.suffix)

@@ -15,16 +15,14 @@ from __future__ import annotations
 
 import math
 import os
-import sys
 from collections.abc import Callable, Collection
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from tqdm import tqdm
-
 from ecs_tentacles.export.recording import scene_sha256
 from ecs_tentacles.export.take import Take
+from ecs_tentacles.progress import step_frames
 from ecs_tentacles.scene.load import load_scene, resolve_scene_path
 from ecs_tentacles.world import World
 
@@ -146,23 +144,7 @@ def bake(
         )
         world.add_plugin(recording)
         record = recording.system
-        chunk = max(1, round(plan.sim_fps / 10))
-        with tqdm(
-            total=plan.steps,
-            unit="frame",
-            desc="bake",
-            disable=None if progress else True,
-            file=sys.stderr,
-            leave=False,
-        ) as bar:
-            done = 0
-            while done < plan.steps:
-                n = min(chunk, plan.steps - done)
-                world.step(n)
-                done += n
-                bar.update(n)
-                if on_steps is not None:
-                    on_steps(n)
+        step_frames(world, plan.steps, progress=progress, desc="bake", on_steps=on_steps)
         return record.take()
     finally:
         world.close()

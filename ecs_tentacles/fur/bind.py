@@ -15,7 +15,7 @@ import numpy as np
 
 from ecs_tentacles.fur.dynamics import Strands, blend_profile
 from ecs_tentacles.fur.rig import F32, Bind, ControlValues
-from ecs_tentacles.fur.stores import CONTROL_VALUES, ControlStore, FurData
+from ecs_tentacles.fur.stores import BEHAVIOURS, COLUMNS, ControlStore, FurData
 from ecs_tentacles.fur.tracks import TrackSet
 from ecs_tentacles.fur.vectors import clamp_to_cap, cross, dot, normalize
 
@@ -117,7 +117,7 @@ class ControlTracks:
         moved = columns < 3
         if moved.any():
             controls.position[rows[moved], columns[moved]] = values[moved]
-        for column, name in enumerate(CONTROL_VALUES, start=3):
-            mask = columns == column
+        for name in BEHAVIOURS:
+            mask = columns == COLUMNS[name][0]
             if mask.any():
                 getattr(controls, name)[rows[mask]] = values[mask]

@@ -16,15 +16,11 @@ from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.fur import groom as grooming
 from ecs_tentacles.fur.components import Emotion, Fur, FurControl, FurGuide
 from ecs_tentacles.fur.controls import expand_mirrors, nearest_control
-from ecs_tentacles.fur.stores import BEHAVIOURS
+from ecs_tentacles.fur.stores import BEHAVIOURS, COLUMNS
 from ecs_tentacles.fur.tracks import channels_from_keys
 
 if TYPE_CHECKING:
     from ecs_tentacles.world import World
-
-# Track columns of the ControlStore: position x, y, z, then the behaviour values.
-COLUMNS = {"position": (0, 1, 2), "lift": (3,), "aim": (4,), "direction": (5,)}
-COLUMNS |= {"random": (6,), "dynamic": (7,)}
 
 
 def _points_per_guide(world: World, spec: dict[str, Any]) -> int:
@@ -77,7 +73,7 @@ def _build_controls(
     store = world.fur.controls
     made: dict[str, tuple[int, int]] = {}
     for spec in expand_mirrors(specs):
-        values = {k: spec[k] for k in ("lift", "aim", "direction", "random", "dynamic")}
+        values = {k: spec[k] for k in BEHAVIOURS}
         row = int(
             store.add(
                 fur_row=fur_row,

@@ -3,7 +3,8 @@
     guide = world.component(entity, FurGuide)
     guide.root                    # (3,) body-local root, a writable view
     guide.points                  # (points, 3) world polyline after the rig ran
-    control = world.component(world.fur_control("hedgehog", "spine"), FurControl)
+    hog = world.creature("hedgehog")
+    control = next(c for _, c in world.query(FurControl) if (c.creature, c.name) == (hog, "spine"))
     control.lift = 1.0            # quills up on the next frame
 
 Writing a guide's bind fields (root, normal, rest, side, length, multiplier,

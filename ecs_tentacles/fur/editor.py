@@ -20,9 +20,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ecs_tentacles.components import Creature
-from ecs_tentacles.fur.build import COLUMNS
 from ecs_tentacles.fur.components import Fur, FurControl
 from ecs_tentacles.fur.controls import expand_mirrors, mirror_name, mirror_point, nearest_control
+from ecs_tentacles.fur.stores import BEHAVIOURS, COLUMNS
 from ecs_tentacles.fur.tracks import EASINGS, TrackSet, channels_from_keys
 from ecs_tentacles.scene.save import save_scene
 
@@ -31,8 +31,8 @@ if TYPE_CHECKING:
 
     from ecs_tentacles.world import World
 
-VALUES = ("lift", "aim", "direction", "random", "dynamic", "emotion")
-ATTRIBUTES = ("position", "lift", "aim", "direction", "random", "dynamic")  # keyable
+VALUES = (*BEHAVIOURS, "emotion")
+ATTRIBUTES = tuple(COLUMNS)  # keyable
 SHAPES = ("sphere", "cube", "circle", "diamond", "arrow")
 MIRRORS = ("none", "x", "y", "z")
 KEY_TOLERANCE = 1e-6  # seconds: a key set at the time of another replaces it

@@ -17,7 +17,6 @@ from typing import Any
 
 import numpy as np
 
-REGIONS = ("all", "top", "side", "back", "rear", "front")
 FLOWS = {"rear": (-1.0, 0.0, -0.3), "down": (-0.05, 0.0, -1.0)}
 DOWN_OUTWARD = 0.8  # how strongly "down" flows outward from the crown on the top cap
 

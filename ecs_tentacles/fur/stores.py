@@ -1,4 +1,4 @@
-"""Struct-of-array stores of the fur rig: guides, controls, furs, emotions, threats.
+"""Struct-of-array stores of the fur rig: guides, controls, furs, emotions.
 
 `FurData` (``world.fur``) holds them. Rows are never removed. Guides of all creatures
 share one point count (`FurData.points`): the first fur built sets it and guides of
@@ -16,8 +16,11 @@ import numpy as np
 from ecs_tentacles.fur.tracks import Channel
 from ecs_tentacles.store import ArrayStore, Field
 
+# The rig's behaviours, in order: a fur switches each on or off (`FurSetStore.enabled`),
+# and a control drives each through its ControlStore field of the same name.
 BEHAVIOURS = ("lift", "aim", "direction", "random", "dynamic")
-CONTROL_VALUES = ("lift", "aim", "direction", "random", "dynamic")
+# Track columns of the ControlStore: position x, y, z, then the behaviour values.
+COLUMNS = {"position": (0, 1, 2)} | {name: (3 + i,) for i, name in enumerate(BEHAVIOURS)}
 
 
 class GuideStore(ArrayStore):
@@ -116,7 +119,7 @@ class FurData:
         self.curves = np.zeros((0, 0, 3), dtype=np.float32)
         self.frames = np.zeros((0, 4, 3), dtype=np.float32)
         self.version = 0
-        self.tracks: list[Channel] = []  # control attributes (columns: see fur.build.COLUMNS)
+        self.tracks: list[Channel] = []  # control attributes (columns: COLUMNS)
 
     def add_shapes(self, shapes: np.ndarray) -> None:
         """Append rest shapes (k, points, 3) for guides just added; grow the buffers."""

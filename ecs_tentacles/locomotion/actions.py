@@ -4,13 +4,26 @@ Push = compress -> attach -> push (extend while attached) -> detach.
 Pull = extend -> attach -> pull (compress while attached) -> detach.
 The coordinated gait orients the tentacle toward the goal line first and settles
 after. Durations are base seconds divided by the creature's and tentacle's speed.
+
+Each tentacle's pending actions are its `ActionQueue` component; the current action
+lives in its `TentacleStore` row. `ActionQueues` reaches every queue by row and is how
+a system or script cuts the current action short (`interrupt`, `replace`).
 """
 
 from __future__ import annotations
 
 from collections import deque
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from enum import IntEnum
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ecs_tentacles.components import Tentacle
+
+if TYPE_CHECKING:
+    from ecs_tentacles.world import World
 
 
 class Kind(IntEnum):
@@ -59,6 +72,14 @@ STRENGTH: dict[Kind, float] = {
     Kind.SETTLE: 0.6,
 }
 
+# An attach action waits for its sucker to grip, up to this many times its duration.
+ATTACH_PATIENCE = 3.0
+
+# Actions during which the tip sucker holds the ground (attach: reaches for it); any
+# other action lets go. Indexed by Kind.
+GRIPPING = np.zeros(len(Kind), dtype=bool)
+GRIPPING[[Kind.ATTACH, Kind.PUSH, Kind.PULL]] = True
+
 
 @dataclass(frozen=True)
 class Action:
@@ -103,7 +124,7 @@ class ActionQueue:
 
     pending: deque[Action] = field(default_factory=deque)
 
-    def extend(self, actions: list[Action]) -> None:
+    def extend(self, actions: Iterable[Action]) -> None:
         self.pending.extend(actions)
 
     def clear(self) -> None:
@@ -115,3 +136,41 @@ class ActionQueue:
     def kinds(self) -> list[str]:
         """Names of the pending actions, for the HUD and tests."""
         return [action.kind.name.lower() for action in self.pending]
+
+
+class ActionQueues:
+    """Every tentacle's `ActionQueue` by TentacleStore row, and how to cut one short.
+
+        queues = ActionQueues(world)
+        queues.replace(row, [make_action(Kind.DETACH, 1.0)])  # drop all, detach now
+
+    `interrupt(row)` ends tentacle `row`'s current action: the action_queue system starts
+    its next pending action (or idles it) this frame, or next frame if it already ran.
+    The mark is the store's `interrupted` column, so every `ActionQueues` of a world
+    shares it. Built from the tentacles the world has now.
+    """
+
+    def __init__(self, world: World):
+        self._tentacles = world.tentacles
+        by_row = {t.row: world.component(e, ActionQueue) for e, t in world.query(Tentacle)}
+        # a row without a tentacle entity (stores filled by hand) gets a queue of its own
+        self._queues = [
+            by_row[row] if row in by_row else ActionQueue() for row in range(len(world.tentacles))
+        ]
+
+    def __getitem__(self, row: int) -> ActionQueue:
+        return self._queues[row]
+
+    def __len__(self) -> int:
+        return len(self._queues)
+
+    def interrupt(self, row: int) -> None:
+        """End tentacle `row`'s current action now; its pending actions stay queued."""
+        self._tentacles.interrupted[row] = True
+
+    def replace(self, row: int, actions: Iterable[Action]) -> None:
+        """Drop tentacle `row`'s current and pending actions; `actions` start now."""
+        queue = self._queues[row]
+        queue.clear()
+        queue.extend(actions)
+        self.interrupt(row)

@@ -42,7 +42,8 @@ class ContactProxies:
             geoms = m.body_geomadr[group.body_ids]
             rows.append(group.body_rows)
             owner.append(np.full(len(geoms), group.index))
-            kind.append(np.where(m.geom_type[geoms] == mujoco.mjtGeom.mjGEOM_CYLINDER, 1, 0))
+            cylinder = m.geom_type[geoms] == mujoco.mjtGeom.mjGEOM_CYLINDER
+            kind.append(np.where(cylinder, CYLINDER, CAPSULE))
             size.append(m.geom_size[geoms, :2])
         empty = np.zeros(0, dtype=np.int64)
         self.rows = np.concatenate(rows) if rows else empty

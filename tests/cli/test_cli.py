@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 import json
 import subprocess
 import sys
@@ -170,3 +171,13 @@ def test_every_reporting_command_has_json(
     assert (created["scene"], created["tentacles"]) == (str(scene), 3)
     assert main(["run", str(scene), "--frames", "2", "--quiet", "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["frames"] == 2
+
+
+def test_the_module_docstring_names_every_command() -> None:
+    import ecs_tentacles.cli as cli
+
+    parser = cli.build_parser()
+    (commands,) = [a for a in parser._actions if isinstance(a, argparse._SubParsersAction)]
+    first_line = (cli.__doc__ or "").splitlines()[0]
+    named = first_line.split(":", 1)[1].strip(" .").split(", ")
+    assert named == list(commands.choices)

@@ -2,18 +2,25 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import pytest
 
+from ecs_tentacles.components import Creature, Tentacle
 from ecs_tentacles.locomotion.actions import (
     BASE_SECONDS,
+    GRIPPING,
     STRENGTH,
     Action,
     ActionQueue,
+    ActionQueues,
     Kind,
     Mode,
     drive_sequence,
     make_action,
 )
+from ecs_tentacles.world import World
+from tests.conftest import creature_scene
 
 PUSH = [Kind.COMPRESS, Kind.ATTACH, Kind.PUSH, Kind.DETACH]
 PULL = [Kind.EXTEND, Kind.ATTACH, Kind.PULL, Kind.DETACH]
@@ -84,3 +91,34 @@ def test_action_queue_names_its_pending_actions() -> None:
     assert len(queue) == 6
     queue.clear()
     assert (len(queue), queue.kinds()) == (0, [])
+
+
+def test_gripping_actions_are_attach_push_and_pull() -> None:
+    assert [k for k in Kind if GRIPPING[k]] == [Kind.ATTACH, Kind.PUSH, Kind.PULL]
+
+
+def test_action_queues_reach_every_tentacle_queue_by_row(make_world: Callable[..., World]) -> None:
+    scene = creature_scene(count=3, links=2)
+    scene["creatures"].append({**scene["creatures"][0], "name": "other", "position": [2, 0]})
+    world = make_world(scene)
+    queues = ActionQueues(world)
+    assert len(queues) == 6
+    for name in ("octo", "other"):
+        for entity in world.component(world.creature(name), Creature).tentacles:
+            row = world.component(entity, Tentacle).row
+            assert queues[row] is world.component(entity, ActionQueue)
+
+
+def test_replace_empties_the_queue_and_marks_the_tentacle(
+    make_world: Callable[..., World],
+) -> None:
+    world = make_world(creature_scene(count=3, links=2))
+    queues = ActionQueues(world)
+    queues[1].extend(drive_sequence(Mode.PUSH, 0.5, 1.0))
+    queues.replace(1, [make_action(Kind.DETACH, 1.0)])
+    assert queues[1].kinds() == ["detach"]
+    assert world.tentacles.interrupted.tolist() == [False, True, False]
+    queues[2].extend([make_action(Kind.SETTLE, 1.0)])
+    queues.interrupt(2)  # keeps what is pending
+    assert queues[2].kinds() == ["settle"]
+    assert world.tentacles.interrupted.tolist() == [False, True, True]

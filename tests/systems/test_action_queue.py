@@ -8,13 +8,12 @@ from collections.abc import Callable
 
 import numpy as np
 import pytest
-from ecs_tentacles.systems.action_queue import ATTACH_PATIENCE
 
-from ecs_tentacles.components import Creature
 from ecs_tentacles.locomotion.actions import (
+    ATTACH_PATIENCE,
     BASE_SECONDS,
     STRENGTH,
-    ActionQueue,
+    ActionQueues,
     Kind,
     Mode,
     drive_sequence,
@@ -22,11 +21,6 @@ from ecs_tentacles.locomotion.actions import (
 )
 from ecs_tentacles.world import World
 from tests.conftest import creature_scene
-
-
-def _queue(world: World, tentacle: int) -> ActionQueue:
-    creature = world.component(world.creature("octo"), Creature)
-    return world.component(creature.tentacles[tentacle], ActionQueue)
 
 
 def _frames(seconds: float, fps: float) -> int:
@@ -51,8 +45,7 @@ def test_pull_sequence_runs_each_action_for_its_duration(
     world.step(5)
     assert world.locomotion.queue(octo, 0) == ["idle"]
     sequence = drive_sequence(Mode.PULL, float(t.target_angle[0]), speed)
-    _queue(world, 0).extend(sequence)
-    t.duration[0] = 0.0  # end the idle action: the queue moves on this frame
+    ActionQueues(world).replace(0, sequence)  # the idle action ends: extend starts this frame
     actions: list[int] = []
     attached: list[bool] = []
     for _ in range(100):
@@ -82,9 +75,9 @@ def test_every_action_lasts_its_duration_rounded_up_to_whole_frames(
     kinds = [kind for kind in BASE_SECONDS if kind != Kind.ATTACH]
     world = make_world(creature_scene(count=len(kinds), links=2))
     t = world.tentacles
+    queues = ActionQueues(world)
     for row, kind in enumerate(kinds):
-        _queue(world, row).extend([make_action(kind, 1.0)])
-        t.duration[row] = 0.0
+        queues.replace(row, [make_action(kind, 1.0)])
     actions = []
     for _ in range(40):
         world.step(1)
@@ -104,9 +97,7 @@ def test_attach_gives_up_after_three_times_its_duration(make_world: Callable[...
     scene["creatures"][0]["position"] = [0, 0, 0.5]
     world = make_world(scene)
     t = world.tentacles
-    sequence = drive_sequence(Mode.PUSH, 0.5, 1.0)
-    _queue(world, 0).extend(sequence)
-    t.duration[0] = 0.0
+    ActionQueues(world).replace(0, drive_sequence(Mode.PUSH, 0.5, 1.0))
     actions = []
     for _ in range(90):
         world.step(1)
@@ -124,8 +115,7 @@ def test_empty_queue_idles_for_ever(make_world: Callable[..., World]) -> None:
     world = make_world(creature_scene(count=2, links=3))
     octo = world.creature("octo")
     t = world.tentacles
-    _queue(world, 1).extend(drive_sequence(Mode.PUSH, 0.5, 5.0)[-1:])  # one detach, 0.02 s
-    t.duration[1] = 0.0
+    ActionQueues(world).replace(1, drive_sequence(Mode.PUSH, 0.5, 5.0)[-1:])  # one detach, 0.02 s
     world.step(1)
     assert world.locomotion.queue(octo, 1) == ["detach"]
     assert t.duration[1] == 0.1 / 5.0
@@ -146,8 +136,7 @@ def test_empty_queue_idles_for_ever(make_world: Callable[..., World]) -> None:
 def test_orient_angle_is_held_until_settle(make_world: Callable[..., World]) -> None:
     world = make_world(creature_scene(count=2, links=3))
     t = world.tentacles
-    _queue(world, 0).extend(drive_sequence(Mode.PUSH, 0.5, 10.0, orient=0.3))
-    t.duration[0] = 0.0
+    ActionQueues(world).replace(0, drive_sequence(Mode.PUSH, 0.5, 10.0, orient=0.3))
     orient = []
     actions = []
     for _ in range(40):
@@ -158,3 +147,86 @@ def test_orient_angle_is_held_until_settle(make_world: Callable[..., World]) -> 
     assert actions[0] == Kind.ORIENT
     assert orient[:settle] == [0.3] * settle
     assert orient[settle:] == [0.0] * (40 - settle)
+
+
+# -- interrupting (ActionQueues) --------------------------------------------------------
+
+TEN_SECONDS = 0.35 / 10.0  # the speed that makes a compress last 10 s
+
+
+def _busy(make_world: Callable[..., World]) -> World:
+    """A two-tentacle world whose tentacle 0 is 5 frames into a 10 s compress."""
+    world = make_world(creature_scene(count=2, links=3))
+    ActionQueues(world).replace(0, [make_action(Kind.COMPRESS, TEN_SECONDS)])
+    world.step(5)
+    assert world.locomotion.queue(world.creature("octo"), 0) == ["compress"]
+    return world
+
+
+def test_replace_starts_the_new_actions_the_same_frame(make_world: Callable[..., World]) -> None:
+    world = _busy(make_world)
+    octo = world.creature("octo")
+    t = world.tentacles
+    idle_timer = float(t.timer[1])
+    sequence = drive_sequence(Mode.PULL, 0.5, 1.0)
+    ActionQueues(world).replace(0, sequence)
+    world.step(1)
+    assert world.locomotion.queue(octo, 0) == ["extend", "attach", "pull", "detach"]
+    assert (t.timer[0], t.duration[0]) == (0.0, sequence[0].duration)
+    assert not t.interrupted.any()
+    # the other tentacle goes on as before
+    assert world.locomotion.queue(octo, 1) == ["idle"]
+    assert t.timer[1] == idle_timer + world.settings.dt
+    # the new action is not cut short in turn: it lasts its whole duration
+    actions = []
+    for _ in range(30):
+        world.step(1)
+        actions.append(int(t.action[0]))
+    extend = 1 + actions.index(Kind.ATTACH)
+    assert extend == _frames(sequence[0].duration, world.settings.fps)
+
+
+def test_interrupt_ends_the_current_action_and_keeps_the_pending_ones(
+    make_world: Callable[..., World],
+) -> None:
+    world = _busy(make_world)
+    octo = world.creature("octo")
+    queues = ActionQueues(world)
+    queues[0].extend([make_action(Kind.DETACH, 1.0), make_action(Kind.SETTLE, 1.0)])
+    world.step(1)
+    assert world.locomotion.queue(octo, 0) == ["compress", "detach", "settle"]
+    queues.interrupt(0)
+    world.step(1)
+    assert world.locomotion.queue(octo, 0) == ["detach", "settle"]
+    queues.interrupt(0)
+    queues.interrupt(0)  # twice in a frame is once
+    world.step(1)
+    assert world.locomotion.queue(octo, 0) == ["settle"]
+
+
+def test_interrupt_with_nothing_pending_idles_at_once(make_world: Callable[..., World]) -> None:
+    world = _busy(make_world)
+    t = world.tentacles
+    ActionQueues(world).interrupt(0)
+    world.step(1)
+    assert world.locomotion.queue(world.creature("octo"), 0) == ["idle"]
+    assert (t.duration[0], t.action_strength[0]) == (np.inf, STRENGTH[Kind.IDLE])
+
+
+def test_interrupt_ends_an_attach_that_waits_for_its_sucker(
+    make_world: Callable[..., World],
+) -> None:
+    # weightless and lifted: the sucker never grips, so the attach would wait 3x its 1.5 s
+    scene = creature_scene(count=2, links=6)
+    scene["physics"] = {"gravity": [0, 0, 0]}
+    scene["creatures"][0]["position"] = [0, 0, 0.5]
+    world = make_world(scene)
+    octo = world.creature("octo")
+    queues = ActionQueues(world)
+    queues.replace(0, [make_action(Kind.ATTACH, 0.1), make_action(Kind.PUSH, 1.0)])
+    world.step(20)
+    assert world.locomotion.queue(octo, 0) == ["attach", "push"]
+    queues.interrupt(0)
+    world.step(1)
+    assert world.locomotion.queue(octo, 0) == ["push"]
+    assert world.events.counts["sucker_attached"] == 0

@@ -10,7 +10,13 @@ from ecs_tentacles.systems.motor_targets import LIFT, SMOOTHING_SECONDS
 from numpy.testing import assert_allclose, assert_array_equal
 
 from ecs_tentacles.components import Creature
-from ecs_tentacles.locomotion.actions import STRENGTH, ActionQueue, Kind, make_action
+from ecs_tentacles.locomotion.actions import (
+    STRENGTH,
+    ActionQueue,
+    ActionQueues,
+    Kind,
+    make_action,
+)
 from ecs_tentacles.world import World
 from tests.conftest import creature_scene
 
@@ -70,11 +76,7 @@ def test_idle_gain_is_the_same_before_and_after_a_drive(
     world = make_world(creature_scene(count=2, links=3))
     octo = world.creature("octo")
     world.locomotion.set(octo, writhe=0.0)
-    creature = world.component(octo, Creature)
-    world.component(creature.tentacles[1], ActionQueue).extend(
-        [make_action(Kind.DETACH, 10.0)]  # one short action, then idle again
-    )
-    world.tentacles.duration[1] = 0.0
+    ActionQueues(world).replace(1, [make_action(Kind.DETACH, 10.0)])  # short, then idle again
     world.step(3)
     assert world.locomotion.actions(octo) == ["idle", "idle"]
     assert_allclose(world.motors.gain, STRENGTH[Kind.IDLE], rtol=1e-15)

@@ -57,7 +57,7 @@ def test_classify_pulls_within_a_right_angle(
 ) -> None:
     goal = np.array([_unit(base_degrees + degrees)])
     base = np.array([_unit(base_degrees)])
-    assert classify(goal, base).tolist() == [pull]
+    assert classify(goal, base)[0].tolist() == [pull]
 
 
 def test_classify_counts_the_right_angle_itself_as_pull() -> None:
@@ -74,13 +74,22 @@ def test_classify_counts_the_right_angle_itself_as_pull() -> None:
         ]
     )
     base = np.array([[1.0, 0.0], [1.0, 0.0], [1.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 0.0]])
-    assert classify(goal, base).tolist() == [True] * 6
+    assert classify(goal, base)[0].tolist() == [True] * 6
 
 
 def test_classify_works_row_by_row() -> None:
     goal = np.array([_unit(0.0), _unit(0.0), _unit(90.0), _unit(90.0)])
     base = np.array([_unit(10.0), _unit(170.0), _unit(100.0), _unit(-100.0)])
-    assert classify(goal, base).tolist() == [True, False, True, False]
+    assert classify(goal, base)[0].tolist() == [True, False, True, False]
+
+
+def test_classify_ignores_lengths_and_gives_the_cosine() -> None:
+    # process passes raw mantle -> goal and mantle -> base vectors, metres long or short
+    goal = np.array([[3.0, 0.0], [0.02, 0.0], [-5.0, 5.0]])
+    base = np.array([[0.1, 0.1], [0.0, -0.3], [0.4, 0.0]])
+    pull, cos = classify(goal, base)
+    assert pull.tolist() == [True, True, False]
+    np.testing.assert_allclose(cos, [np.sqrt(0.5), 0.0, -np.sqrt(0.5)], rtol=1e-15, atol=1e-15)
 
 
 # -- in a world -------------------------------------------------------------------------
@@ -201,7 +210,7 @@ def test_coordinated_driver_aborts_when_the_goal_changes_sides(
     base = world.transforms.pos[world.tentacles.base_row[2], :2]
     goal_dir = (np.array([-1.5, 0.0]) - mantle) / np.linalg.norm([-1.5, 0.0] - mantle)
     base_dir = (base - mantle) / np.linalg.norm(base - mantle)
-    assert classify(goal_dir[None], base_dir[None]).tolist() == [True]
+    assert classify(goal_dir[None], base_dir[None])[0].tolist() == [True]
     assert _new_drivers(world, 1) == [(2, Mode.PULL)]
     assert world.locomotion.queue(octo, 2) == ["orient", *_names(Mode.PULL), "settle"]
 

@@ -1,0 +1,44 @@
+"""step_frames: every frame run, in tenth-of-a-second chunks, a bar only when asked."""
+
+from __future__ import annotations
+
+import io
+import sys
+from collections.abc import Callable
+
+import pytest
+
+from ecs_tentacles.progress import step_frames
+from ecs_tentacles.world import World
+from tests.conftest import creature_scene
+
+
+class Terminal(io.StringIO):
+    """A captured stderr that says it is a terminal, as tqdm wants before it draws."""
+
+    def isatty(self) -> bool:
+        return True
+
+
+@pytest.mark.parametrize(("fps", "frames", "chunks"), [(60, 14, [6, 6, 2]), (20, 5, [2, 2, 1])])
+def test_steps_every_frame_in_chunks(
+    make_world: Callable[..., World], fps: int, frames: int, chunks: list[int]
+) -> None:
+    scene = creature_scene(count=2, links=2) | {"physics": {"fps": fps, "substeps": 24}}
+    world = make_world(scene)
+    told: list[int] = []
+    step_frames(world, frames, progress=False, on_steps=told.append)
+    assert (world.frame, told) == (frames, chunks)
+
+
+@pytest.mark.parametrize("progress", [True, False])
+def test_the_bar_is_drawn_only_with_progress(
+    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch, progress: bool
+) -> None:
+    world = make_world(creature_scene(count=2, links=2))
+    terminal = Terminal()
+    monkeypatch.setattr(sys, "stderr", terminal)
+    step_frames(world, 12, progress=progress, desc="bake")
+    drawn = terminal.getvalue()
+    assert ("bake:" in drawn and "/12 [" in drawn) == progress
+    assert drawn == "" or progress
