@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 import numbers
+from collections.abc import Mapping
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -59,7 +60,8 @@ class Range:
         return int(value) if self.integer else float(value)
 
 
-def _range_of(spec: dict[str, Any]) -> Range:
+def schema_range(spec: Mapping[str, Any]) -> Range:
+    """The range a number property of the schema allows (`minimum`, `exclusiveMaximum`...)."""
     low_open, high_open = "exclusiveMinimum" in spec, "exclusiveMaximum" in spec
     low = spec.get("exclusiveMinimum", spec.get("minimum", -math.inf))
     high = spec.get("exclusiveMaximum", spec.get("maximum", math.inf))
@@ -75,13 +77,13 @@ def field_schema(section: str, key: str) -> dict[str, Any]:
 
 def field_range(section: str, key: str) -> Range:
     """The range of a creature's `<section>.<key>`, e.g. `("tentacles", "strength")`."""
-    return _range_of(field_schema(section, key))
+    return schema_range(field_schema(section, key))
 
 
 def physics_range(key: str) -> Range:
     """The range of the scene's `physics.<key>` (for gravity: of each component)."""
     spec: dict[str, Any] = load_schema()["properties"]["physics"]["properties"][key]
-    return _range_of(spec.get("items", spec))
+    return schema_range(spec.get("items", spec))
 
 
 def damping_floor(strength: float, step: float) -> float:
