@@ -27,12 +27,12 @@ import numpy as np
 from ecs_tentacles.components import Tentacle
 from ecs_tentacles.locomotion.actions import BASE_SECONDS, ActionQueue, Kind, Mode, drive_sequence
 from ecs_tentacles.locomotion.actions import make_action as action
+from ecs_tentacles.scene.parameters import parameter
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
     from ecs_tentacles.world import World
 
-CYCLIC, COORDINATED = 0, 1
 PULL = int(Mode.PULL)
 PULL_TOLERANCE = 1e-9  # dot products this close to 0 count as the +-pi/2 boundary: pull
 ABORT_MARGIN = 0.25  # coordinated drivers abort once cos is this far on the wrong side
@@ -51,6 +51,8 @@ class TentacleSelection(System):
     after = ("goals",)
 
     def setup(self, world: World) -> None:
+        gait = parameter("locomotion", "gait")  # stored codes: the schema's choices' indices
+        self.cyclic, self.coordinated = gait.code("cyclic"), gait.code("coordinated")
         self.queues = [ActionQueue()] * len(world.tentacles)
         for entity, tentacle in world.query(Tentacle):
             self.queues[tentacle.row] = world.component(entity, ActionQueue)
@@ -72,7 +74,7 @@ class TentacleSelection(System):
         driving_now = t.driving
 
         if driving_now.any():
-            wrong_side = (c.gait[creature] == COORDINATED) & np.where(
+            wrong_side = (c.gait[creature] == self.coordinated) & np.where(
                 t.mode == PULL, cos < -ABORT_MARGIN, cos > ABORT_MARGIN
             )
             for row in np.flatnonzero(driving_now & (~has_goal | wrong_side)):
@@ -82,7 +84,7 @@ class TentacleSelection(System):
         idle_goal = c.has_goal & (driving < c.drivers)
         if not idle_goal.any():
             return
-        cyclic = c.gait == CYCLIC
+        cyclic = c.gait == self.cyclic
         for row in np.flatnonzero(idle_goal & cyclic & (driving == 0)):
             k = int(c.first_tentacle[row] + c.next_driver[row])
             self._start(world, k, Mode.PULL if pull[k] else Mode.PUSH, orient=None)

@@ -125,7 +125,10 @@ class Parameter:
         getattr(store, self.field)[rows] = stored
 
 
-def _walk(node: Any, section: str, path: tuple[str | int, ...]) -> Iterator[tuple[str, str, Any, str]]:
+Found = tuple[str, str, Mapping[str, Any], str]  # section, key, property schema, JSON path
+
+
+def _walk(node: Any, section: str, path: tuple[str | int, ...]) -> Iterator[Found]:
     """(section, key, property schema, JSON path) of every annotated property under `node`."""
     if not isinstance(node, Mapping):
         return

@@ -132,14 +132,15 @@ def test_gui_draw_calls_do_not_grow_with_creatures(make_sandbox: Callable[..., A
 
 @pytest.mark.parametrize("name", ["speed", "target_angle", "strength", "wave_amplitude"])
 def test_each_slider_spans_the_schema_range(name: str) -> None:
-    from ecs_tentacles.locomotion.params import TENTACLE_RANGES
     from ecs_tentacles.render.hud import KNOBS
+    from ecs_tentacles.scene.ranges import field_range
 
     (knob,) = [k for k in KNOBS if k.name == name]
-    allowed = TENTACLE_RANGES[name]
-    assert knob.high == pytest.approx(allowed.high * knob.to_shown)
-    assert knob.low / knob.to_shown in allowed  # an open lower bound (speed > 0) is never shown
-    assert knob.low / knob.to_shown - allowed.low <= 1e-3 * (allowed.high - allowed.low)
+    key = {"target_angle": "target_angle_deg", "wave_amplitude": "wave_amplitude_deg"}
+    allowed = field_range("tentacles", key.get(name, name))  # scene units, as the HUD shows
+    assert knob.high == pytest.approx(allowed.high)
+    assert knob.low in allowed  # an open lower bound (speed > 0) is never shown
+    assert knob.low - allowed.low <= 1e-3 * (allowed.high - allowed.low)
 
 
 def test_the_strength_slider_stops_where_the_damping_holds(

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from ecs_tentacles.creator.limits import DesignError, checked
-from ecs_tentacles.locomotion.params import TENTACLE_RANGES
+from ecs_tentacles.locomotion.params import settable
 from ecs_tentacles.scene.ranges import Range, field_range, physics_range
 from ecs_tentacles.scene.validate import load_schema
 
@@ -56,6 +56,17 @@ def test_check_keeps_whole_numbers_whole() -> None:
 
 
 def test_the_locomotion_api_uses_the_schema_ranges_in_radians() -> None:
+    TENTACLE_RANGES = {name: p.range for name, p in settable()[0].items()}  # noqa: N806
+    assert set(TENTACLE_RANGES) == {
+        "speed",
+        "target_angle",
+        "strength",
+        "damping",
+        "wave_amplitude",
+        "wave_frequency",
+        "wavelength",
+        "writhe",
+    }
     assert TENTACLE_RANGES["strength"] == field_range("tentacles", "strength")
     assert TENTACLE_RANGES["wave_amplitude"] == Range(0, math.radians(60))
     assert TENTACLE_RANGES["target_angle"].high == pytest.approx(math.pi / 2)
