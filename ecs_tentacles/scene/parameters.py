@@ -37,17 +37,13 @@ from typing import Any
 
 import numpy as np
 
-from ecs_tentacles.scene.ranges import Range, schema_range
+from ecs_tentacles.scene.ranges import Range, schema_objects, schema_range
 from ecs_tentacles.scene.validate import format_path, load_schema
 
 ANNOTATION = "x-parameter"
 DEGREE = math.radians(1.0)  # one scene degree in code's radians
 _KEYS = {"column", "units", "label", "taper", "at_most", "runtime", "slider"}
 _SLIDER_KEYS = {"order", "digits", "log"}
-# schema keywords that hold subschemas (the walk follows only these)
-_BY_NAME = ("properties", "$defs", "patternProperties", "dependentSchemas")
-_NESTED = ("items", "additionalProperties", "not", "if", "then", "else", "contains")
-_LISTS = ("allOf", "anyOf", "oneOf", "prefixItems")
 
 
 @dataclass(frozen=True)
@@ -125,26 +121,12 @@ class Parameter:
         getattr(store, self.field)[rows] = stored
 
 
-Found = tuple[str, str, Mapping[str, Any], str]  # section, key, property schema, JSON path
-
-
-def _walk(node: Any, section: str, path: tuple[str | int, ...]) -> Iterator[Found]:
-    """(section, key, property schema, JSON path) of every annotated property under `node`."""
-    if not isinstance(node, Mapping):
-        return
-    properties = node.get("properties")
-    if isinstance(properties, Mapping):
-        for key, spec in properties.items():
+def _annotated(schema: Mapping[str, Any]) -> Iterator[tuple[str, str, Mapping[str, Any], str]]:
+    """(section, key, property schema, JSON path) of every annotated property of `schema`."""
+    for section, node, path in schema_objects(schema):
+        for key, spec in node["properties"].items():
             if isinstance(spec, Mapping) and ANNOTATION in spec:
                 yield section, key, spec, format_path([*path, "properties", key])
-    for keyword in _BY_NAME:
-        for name, child in (node.get(keyword) or {}).items():
-            yield from _walk(child, name, (*path, keyword, name))
-    for keyword in _NESTED:
-        yield from _walk(node.get(keyword), section, (*path, keyword))
-    for keyword in _LISTS:
-        for i, child in enumerate(node.get(keyword) or []):
-            yield from _walk(child, section, (*path, keyword, i))
 
 
 def _parameter(section: str, key: str, spec: Mapping[str, Any], where: str) -> Parameter:
@@ -186,7 +168,7 @@ def read_parameters(schema: Mapping[str, Any]) -> tuple[Parameter, ...]:
     """Every annotated parameter of `schema`, in document order; each column at most once."""
     table: list[Parameter] = []
     seen: dict[tuple[str, str], str] = {}
-    for section, key, spec, where in _walk(schema, "", ()):
+    for section, key, spec, where in _annotated(schema):
         parameter = _parameter(section, key, spec, where)
         for kind, name in (("column", parameter.column), ("scene key", f"{section}.{key}")):
             if (kind, name) in seen:

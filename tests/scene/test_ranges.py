@@ -56,8 +56,8 @@ def test_check_keeps_whole_numbers_whole() -> None:
 
 
 def test_the_locomotion_api_uses_the_schema_ranges_in_radians() -> None:
-    TENTACLE_RANGES = {name: p.range for name, p in settable()[0].items()}  # noqa: N806
-    assert set(TENTACLE_RANGES) == {
+    api_ranges = {name: p.range for name, p in settable()[0].items()}
+    assert set(api_ranges) == {
         "speed",
         "target_angle",
         "strength",
@@ -67,10 +67,10 @@ def test_the_locomotion_api_uses_the_schema_ranges_in_radians() -> None:
         "wavelength",
         "writhe",
     }
-    assert TENTACLE_RANGES["strength"] == field_range("tentacles", "strength")
-    assert TENTACLE_RANGES["wave_amplitude"] == Range(0, math.radians(60))
-    assert TENTACLE_RANGES["target_angle"].high == pytest.approx(math.pi / 2)
-    for name, allowed in TENTACLE_RANGES.items():
+    assert api_ranges["strength"] == field_range("tentacles", "strength")
+    assert api_ranges["wave_amplitude"] == Range(0, math.radians(60))
+    assert api_ranges["target_angle"].high == pytest.approx(math.pi / 2)
+    for name, allowed in api_ranges.items():
         key = {"target_angle": "target_angle_deg", "wave_amplitude": "wave_amplitude_deg"}
         scene_range = field_range("tentacles", key.get(name, name))
         factor = math.radians(1) if name in key else 1.0
@@ -83,3 +83,8 @@ def test_the_creator_refuses_what_the_schema_refuses() -> None:
     assert refused.value.field == "link_length"
     assert refused.value.message == "must be in [1e-06, 10], got 0.0"
     assert checked("count", "tentacles", "count", 3.0) == 3
+
+
+def test_an_unknown_field_is_named() -> None:
+    with pytest.raises(KeyError, match=r"tentacles\.colour: not a field of the scene schema"):
+        field_range("tentacles", "colour")
