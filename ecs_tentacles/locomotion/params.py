@@ -116,10 +116,8 @@ class Locomotion:
 
     def _servo(self, tentacle: Tentacle) -> tuple[float, float]:
         """(strength, damping) of a tentacle's base link, before its links' taper."""
-        per_tentacle = settable()[0]
-        return self._value(per_tentacle["strength"], tentacle.row), self._value(
-            per_tentacle["damping"], tentacle.row
-        )
+        strength, damping = (settable()[0][name] for name in ("strength", "damping"))
+        return self._value(strength, tentacle.row), self._value(damping, tentacle.row)
 
     def _check_servos(self, targets: list[Tentacle], checked: dict[str, float]) -> None:
         """Refuse a strength its damping cannot keep stable at this world's physics step."""
