@@ -17,6 +17,7 @@ import numpy as np
 from ecs_tentacles.components import Creature, Link, Motor, Sucker, Tentacle, Transform
 from ecs_tentacles.construction import CreatureLayout, creature_layout
 from ecs_tentacles.mathutil import quat_about_z
+from ecs_tentacles.scene.parameters import apply_parameters, parameter
 
 if TYPE_CHECKING:
     from ecs_tentacles.world import World
@@ -90,17 +91,11 @@ def _add_tentacle_row(
             base_row=world.component(tentacle.links[0], Transform).row,
             tip_sucker=sucker.row,
             length=shape.length,
-            joint_limit=links[0].joint_limit,
             rest_pitch=shape.rest_pitch,
-            speed=params["speed"],
-            target_angle=np.radians(params["target_angle_deg"]),
-            wave_amplitude=np.radians(params["wave_amplitude_deg"]),
-            wave_frequency=params["wave_frequency"],
-            wavelength=params["wavelength"],
-            writhe=params["writhe"],
             phase=rng.uniform(0.0, 2.0 * np.pi),
         )[0]
     )
+    apply_parameters(world, "tentacles", params, tentacles=tentacle.row)
     world.motors.tentacle_row[[m.row for m in motors]] = tentacle.row
     sucker_rows = [world.component(e, Sucker).row for e in tentacle.suckers]
     world.suckers.tentacle_row[sucker_rows] = tentacle.row
@@ -120,14 +115,12 @@ def _build_links(
     rows = world.transforms.add(n, pos=layout.link_centres(k), quat=quat)
     motor_rows = world.motors.add(
         n,
-        strength=params["strength"] * shape.scales,
-        damping=params["damping"] * shape.scales,
-        max_torque=params["max_torque"] * shape.scales,
         arc=(shape.centres - mantle_radius)
         / (shape.centres[-1] + 0.5 * shape.lengths[-1] - mantle_radius),
         scale=shape.scales,
     )
-    limit = float(np.radians(params["joint_limit_deg"]))
+    apply_parameters(world, "tentacles", params, motors=motor_rows)  # tapered by `scale`
+    limit = float(parameter("tentacles", "joint_limit_deg").from_scene(params["joint_limit_deg"]))
     for i in range(n):
         link = Link(
             tentacle=tentacle_entity,

@@ -164,7 +164,7 @@ class CreatureStore(ArrayStore):
     mantle_radius = Field()
     first_tentacle = Field(dtype=np.int64)
     tentacles = Field(dtype=np.int64)
-    gait = Field(dtype=np.int64)  # 0 cyclic, 1 coordinated
+    gait = Field(dtype=np.int64)  # index into the schema's gait choices (scene.parameters)
     speed = Field(default=1.0)
     drivers = Field(dtype=np.int64, default=1)
     release_stretch = Field()

@@ -33,12 +33,12 @@ from ecs_tentacles.locomotion.actions import (
     drive_sequence,
 )
 from ecs_tentacles.locomotion.actions import make_action as action
+from ecs_tentacles.scene.parameters import parameter
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
     from ecs_tentacles.world import World
 
-CYCLIC, COORDINATED = 0, 1
 PULL = int(Mode.PULL)
 PULL_TOLERANCE = 1e-9  # dot products this close to 0 count as the +-pi/2 boundary: pull
 ABORT_MARGIN = 0.25  # coordinated drivers abort once cos is this far on the wrong side
@@ -64,6 +64,8 @@ class TentacleSelection(System):
     writes = ("tentacles.driving", "tentacles.mode", "action_queues")
 
     def setup(self, world: World) -> None:
+        gait = parameter("locomotion", "gait")  # stored codes: the schema's choices' indices
+        self.cyclic, self.coordinated = gait.code("cyclic"), gait.code("coordinated")
         self.queues = ActionQueues(world)
 
     def process(self, world: World, dt: float) -> None:
@@ -80,7 +82,7 @@ class TentacleSelection(System):
         driving_now = t.driving
 
         if driving_now.any():
-            wrong_side = (c.gait[creature] == COORDINATED) & np.where(
+            wrong_side = (c.gait[creature] == self.coordinated) & np.where(
                 t.mode == PULL, cos < -ABORT_MARGIN, cos > ABORT_MARGIN
             )
             for row in np.flatnonzero(driving_now & (~has_goal | wrong_side)):
@@ -90,7 +92,7 @@ class TentacleSelection(System):
         idle_goal = c.has_goal & (driving < c.drivers)
         if not idle_goal.any():
             return
-        cyclic = c.gait == CYCLIC
+        cyclic = c.gait == self.cyclic
         for row in np.flatnonzero(idle_goal & cyclic & (driving == 0)):
             k = int(c.first_tentacle[row] + c.next_driver[row])
             self._start(world, k, Mode.PULL if pull[k] else Mode.PUSH, orient=None)

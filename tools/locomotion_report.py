@@ -24,11 +24,12 @@ import numpy as np
 from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.mathutil import quat_rotate
 from ecs_tentacles.scene.load import bundled_scene
+from ecs_tentacles.scene.parameters import parameter
 from ecs_tentacles.world import World
 
 TENTACLE_COUNTS = (3, 4, 5, 6, 8)
 DIRECTIONS = {"front": 0.0, "side": 90.0, "behind": 180.0}
-GAITS = ("cyclic", "coordinated")
+GAITS = parameter("locomotion", "gait").choices
 LIMIT_SECONDS = 60.0
 IDLE_SECONDS = 30.0
 MANTLE_RADIUS = 0.15

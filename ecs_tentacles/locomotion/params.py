@@ -6,10 +6,13 @@
     world.locomotion.set(octo, gait="cyclic")
     world.locomotion.actions(octo)                           # what each tentacle is doing
 
-Angles are radians here (scenes use degrees). Values are checked against the scene
-schema's ranges (`ecs_tentacles.scene.ranges`), and a strength against its damping
-(`damping >= strength x physics step`, as in scenes); a bad one raises ValueError
-naming the parameter. Changes reach the servos on the next physics step.
+Angles are radians here (scenes use degrees). Which names exist, their ranges, units,
+taper and which are creature-wide all come from the parameter table
+(`ecs_tentacles.scene.parameters`, read from the scene schema): a parameter stored per
+creature is set per creature; `speed` names both the creature's (without `tentacle`,
+reported by `get` as `creature_speed`) and each tentacle's. A strength is also checked
+against its damping (`damping >= strength x physics step`, as in scenes); a bad value
+raises ValueError naming the parameter. Changes reach the servos on the next physics step.
 """
 
 from __future__ import annotations
@@ -21,25 +24,20 @@ import numpy as np
 
 from ecs_tentacles.components import Creature, Tentacle
 from ecs_tentacles.locomotion.actions import ActionQueue, Kind
-from ecs_tentacles.scene.ranges import Range, damping_floor, field_range
+from ecs_tentacles.scene.parameters import Parameter, parameters
+from ecs_tentacles.scene.ranges import damping_floor
 
 if TYPE_CHECKING:
     from ecs_tentacles.world import World
 
-GAITS = ("cyclic", "coordinated")
-DEGREE = float(np.radians(1.0))
-# API name -> its range: the scene schema's, in radians where the scene says degrees
-TENTACLE_RANGES: dict[str, Range] = {
-    "speed": field_range("tentacles", "speed"),
-    "target_angle": field_range("tentacles", "target_angle_deg").scaled(DEGREE),
-    "strength": field_range("tentacles", "strength"),
-    "damping": field_range("tentacles", "damping"),
-    "wave_amplitude": field_range("tentacles", "wave_amplitude_deg").scaled(DEGREE),
-    "wave_frequency": field_range("tentacles", "wave_frequency"),
-    "wavelength": field_range("tentacles", "wavelength"),
-    "writhe": field_range("tentacles", "writhe"),
-}
-CREATURE_ONLY = ("gait", "drivers")
+STORES = ("creatures", "tentacles", "motors")  # the stores whose rows `set` knows
+
+
+def settable() -> tuple[dict[str, Parameter], dict[str, Parameter]]:
+    """The run-time parameters by API name: (per tentacle, per creature)."""
+    table = [p for p in parameters() if p.runtime and p.store in STORES]
+    per_tentacle = {p.api: p for p in table if p.store != "creatures"}
+    return per_tentacle, {p.api: p for p in table if p.store == "creatures"}
 
 
 class Locomotion:
@@ -65,46 +63,61 @@ class Locomotion:
         world = self._world
         row = world.component(creature, Creature).row
         targets = self._tentacles(creature, tentacle)
-        unknown = set(params) - set(TENTACLE_RANGES) - set(CREATURE_ONLY)
+        per_tentacle, per_creature = settable()
+        unknown = set(params) - set(per_tentacle) - set(per_creature)
         if unknown:
-            allowed = ", ".join(sorted([*TENTACLE_RANGES, *CREATURE_ONLY]))
+            allowed = ", ".join(sorted({*per_tentacle, *per_creature}))
             raise ValueError(f"{sorted(unknown)[0]}: unknown parameter (allowed: {allowed})")
-        if tentacle is not None and set(params) & set(CREATURE_ONLY):
-            raise ValueError(f"{sorted(set(params) & set(CREATURE_ONLY))[0]}: is set per creature")
-        checked = {
-            k: TENTACLE_RANGES[k].check(k, v) for k, v in params.items() if k in TENTACLE_RANGES
+        creature_only = set(params) - set(per_tentacle)
+        if tentacle is not None and creature_only:
+            raise ValueError(f"{sorted(creature_only)[0]}: is set per creature")
+        chosen = {
+            name: per_creature[name]
+            if tentacle is None and name in per_creature
+            else per_tentacle[name]
+            for name in params
         }
+        rows = np.array([t.row for t in targets])
+        at = {name: self._rows(p, row, rows) for name, p in chosen.items()}
+        checked = {name: self._check(p, params[name], at[name]) for name, p in chosen.items()}
         if "strength" in checked or "damping" in checked:
             self._check_servos(targets, checked)
-        if "gait" in params and params["gait"] not in GAITS:
-            raise ValueError(f"gait: must be one of {', '.join(GAITS)}, got {params['gait']!r}")
-        if "drivers" in params:
-            count = int(world.creatures.tentacles[row])
-            drivers = params["drivers"]
-            whole = isinstance(drivers, numbers.Integral) and not isinstance(drivers, bool)
-            if not whole or not 1 <= drivers <= count:
-                raise ValueError(
-                    f"drivers: must be a whole number in [1, {count}], got {drivers!r}"
-                )
-            world.creatures.drivers[row] = int(drivers)
-        if "gait" in params:
-            world.creatures.gait[row] = GAITS.index(params["gait"])
-        rows = np.array([t.row for t in targets])
-        for name, value in checked.items():
-            if name == "speed" and tentacle is None:
-                world.creatures.speed[row] = value
-            elif name in ("strength", "damping"):
-                links = self._link_rows(rows)
-                getattr(world.motors, name)[links] = value * world.motors.scale[links]
-            else:
-                getattr(world.tentacles, name)[rows] = value
+        for name, p in chosen.items():
+            p.write(world, at[name], checked[name])
+
+    def _rows(self, p: Parameter, creature_row: int, tentacle_rows: np.ndarray) -> Any:
+        """The rows of `p`'s store that a change of these tentacles (or creature) writes."""
+        if p.store == "creatures":
+            return creature_row
+        return self._link_rows(tentacle_rows) if p.store == "motors" else tentacle_rows
+
+    def _check(self, p: Parameter, value: Any, rows: Any) -> Any:
+        """`value` checked against `p`'s range, capped by its `at_most` column if it has one."""
+        if p.at_most is None or p.range is None:
+            return p.check(value)
+        high = min(p.range.high, np.min(getattr(getattr(self._world, p.store), p.at_most)[rows]))
+        whole = isinstance(value, numbers.Integral) and not isinstance(value, bool)
+        if not whole or not p.range.low <= value <= high:
+            raise ValueError(
+                f"{p.api}: must be a whole number in [{p.range.low:g}, {high:g}], got {value!r}"
+            )
+        return int(value)
+
+    def _value(self, p: Parameter, tentacle_row: int) -> Any:
+        """One tentacle's value of `p`: its base link's for link parameters, before the taper."""
+        store = getattr(self._world, p.store)
+        at = (
+            int(self._world.tentacles.first_link[tentacle_row])
+            if p.store == "motors"
+            else tentacle_row
+        )
+        value = getattr(store, p.field)[at]
+        return p.to_api(value / getattr(store, p.taper)[at] if p.taper else value)
 
     def _servo(self, tentacle: Tentacle) -> tuple[float, float]:
         """(strength, damping) of a tentacle's base link, before its links' taper."""
-        motors = self._world.motors
-        first = int(self._world.tentacles.first_link[tentacle.row])
-        scale = motors.scale[first]
-        return float(motors.strength[first] / scale), float(motors.damping[first] / scale)
+        strength, damping = (settable()[0][name] for name in ("strength", "damping"))
+        return self._value(strength, tentacle.row), self._value(damping, tentacle.row)
 
     def _check_servos(self, targets: list[Tentacle], checked: dict[str, float]) -> None:
         """Refuse a strength its damping cannot keep stable at this world's physics step."""
@@ -124,23 +137,20 @@ class Locomotion:
         """The highest strength `set` accepts now: the schema's, or what the damping holds."""
         step = self._world.settings.substep_dt
         dampings = [self._servo(t)[1] for t in self._tentacles(creature, tentacle)]
-        return min(TENTACLE_RANGES["strength"].high, min(dampings) / step)
+        allowed = settable()[0]["strength"].range
+        assert allowed is not None
+        return min(allowed.high, min(dampings) / step)
 
     def get(self, creature: int, tentacle: int = 0) -> dict[str, Any]:
-        """The parameters of one tentacle plus its creature's gait, speed and drivers."""
+        """One tentacle's parameters plus its creature's (`creature_speed`, gait, drivers)."""
         world = self._world
         row = world.component(creature, Creature).row
-        target = self._tentacles(creature, tentacle)[0]
-        t = target.row
-        values: dict[str, Any] = {
-            name: float(getattr(world.tentacles, name)[t])
-            for name in TENTACLE_RANGES
-            if name not in ("strength", "damping")
-        }
-        values["strength"], values["damping"] = self._servo(target)
-        values["gait"] = GAITS[int(world.creatures.gait[row])]
-        values["creature_speed"] = float(world.creatures.speed[row])
-        values["drivers"] = int(world.creatures.drivers[row])
+        t = self._tentacles(creature, tentacle)[0].row
+        per_tentacle, per_creature = settable()
+        values = {name: self._value(p, t) for name, p in per_tentacle.items()}
+        for name, p in per_creature.items():
+            shown = f"creature_{name}" if name in per_tentacle else name
+            values[shown] = p.to_api(getattr(getattr(world, p.store), p.field)[row])
         return values
 
     def actions(self, creature: int) -> list[str]:

@@ -14,8 +14,9 @@ from typing import TYPE_CHECKING, Any
 from ecs_tentacles.components import Creature, Goal, Tentacle
 from ecs_tentacles.locomotion.actions import STRENGTH, ActionQueue, Kind
 from ecs_tentacles.locomotion.goals import GoalBook
-from ecs_tentacles.locomotion.params import GAITS, Locomotion
+from ecs_tentacles.locomotion.params import Locomotion
 from ecs_tentacles.plugin import Plugin
+from ecs_tentacles.scene.parameters import apply_parameters
 from ecs_tentacles.scene.validate import fragment
 from ecs_tentacles.system import System
 
@@ -36,13 +37,7 @@ class LocomotionPlugin(Plugin):
 
     def build_creature(self, world: World, creature: int, spec: Mapping[str, Any]) -> None:
         row = world.component(creature, Creature).row
-        locomotion = spec["locomotion"]
-        c = world.creatures
-        c.gait[row] = GAITS.index(locomotion["gait"])
-        c.speed[row] = locomotion["speed"]
-        c.drivers[row] = min(locomotion["drivers"], int(c.tentacles[row]))
-        c.release_stretch[row] = locomotion["release_stretch"]
-        c.release_reach[row] = locomotion["release_reach"]
+        apply_parameters(world, "locomotion", spec["locomotion"], creatures=row)
         for entity in world.component(creature, Creature).tentacles:
             world.add_component(entity, ActionQueue())
             world.tentacles.action_strength[world.component(entity, Tentacle).row] = STRENGTH[

@@ -1,10 +1,11 @@
 """The heads-up display: tune the selected creature's tentacles, see live stats.
 
 Drawn with Dear ImGui (`render.gui`): a panel on the left, as wide as the window
-allows, in collapsible sections. "Locomotion" has sliders for speed, target angle,
-strength, wave amplitude and frequency (over the scene schema's ranges, the API's too;
-strength stops where the servos' damping can hold it), the gait, and a tentacle selector ("all"
-or one tentacle). Every change goes through `world.locomotion.set`, the same API
+allows, in collapsible sections. "Locomotion" has a slider for each parameter the
+scene schema marks with one (`ecs_tentacles.scene.parameters`: speed, target angle,
+strength, wave amplitude and frequency), over its range and with its label and units
+(strength stops where the servos' damping can hold it), the gait's choices, and a tentacle
+selector ("all" or one tentacle). Every change goes through `world.locomotion.set`, the same API
 scripts use, so it reaches the servos on the next physics step. "Stats" shows fps,
 physics ms, simulated time, real-time factor and attached suckers; "Physics" the
 groups, threads, recoveries and frozen creatures; "Actions" each tentacle's action.
@@ -17,12 +18,12 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
 from imgui_bundle import imgui
 
 from ecs_tentacles.components import Creature
-from ecs_tentacles.locomotion.params import TENTACLE_RANGES
+from ecs_tentacles.locomotion.params import settable
 from ecs_tentacles.render.gui import Gui, gui_scale, same_line_if_fits, text_width
+from ecs_tentacles.scene.parameters import Parameter, parameter
 
 PANEL_WIDTH = 300  # the panel's width at scale 1 (the creator still uses it as is)
 PANEL_SHARE = 0.4  # the panel never covers more than this share of the window's width
@@ -36,38 +37,59 @@ def panel_width(width: int, height: int) -> int:
 
 @dataclass(frozen=True)
 class Knob:
-    """A slider's parameter and how it is shown; its range is the scene schema's.
+    """A slider for one parameter of the table, shown in the scene's units.
 
-    `TENTACLE_RANGES` (read from the schema, the API's ranges too) bounds the slider,
-    in shown units; `log` sliders give the low end, where the defaults sit, more room.
-    An open lower bound (speed > 0) starts a thousandth of the span above it.
+    The parameter's range (the scene schema's, the API's too) bounds the slider; `log`
+    sliders give the low end, where the defaults sit, more room. An open lower bound
+    (speed > 0) starts a thousandth of the span above it.
     """
 
-    name: str
-    label: str
-    unit: str
-    to_shown: float = 1.0  # shown value = stored value * to_shown
-    log: bool = False
+    parameter: Parameter
+
+    @property
+    def name(self) -> str:
+        return self.parameter.api
+
+    @property
+    def label(self) -> str:
+        return self.parameter.label
+
+    @property
+    def unit(self) -> str:
+        """The slider's printf format: the slider's digits, then the scene's units."""
+        p = self.parameter
+        assert p.slider is not None
+        return f"%.{p.slider.digits}f" + (f" {p.units}" if p.units else "")
+
+    @property
+    def to_shown(self) -> float:
+        """Shown value = stored value x this (degrees for radians)."""
+        return 1.0 / self.parameter.factor
+
+    @property
+    def log(self) -> bool:
+        return bool(self.parameter.slider and self.parameter.slider.log)
 
     @property
     def low(self) -> float:
-        allowed = TENTACLE_RANGES[self.name]
+        allowed = self.parameter.range
+        assert allowed is not None
         low = allowed.low + (1e-3 * (allowed.high - allowed.low) if allowed.low_open else 0.0)
         return low * self.to_shown
 
     @property
     def high(self) -> float:
-        return TENTACLE_RANGES[self.name].high * self.to_shown
+        assert self.parameter.range is not None
+        return self.parameter.range.high * self.to_shown
 
 
-KNOBS = (
-    Knob("speed", "speed", "%.2fx", log=True),
-    Knob("target_angle", "target angle", "%.0f deg", float(np.degrees(1.0))),
-    Knob("strength", "strength (kp)", "%.1f", log=True),
-    Knob("wave_amplitude", "wave amplitude", "%.1f deg", float(np.degrees(1.0))),
-    Knob("wave_frequency", "wave frequency", "%.2f Hz", log=True),
-)
-GAITS = ("cyclic", "coordinated")
+def knobs() -> tuple[Knob, ...]:
+    """A slider per run-time tentacle parameter with a `slider` entry, in its order."""
+    marked = [p for p in settable()[0].values() if p.slider is not None]
+    return tuple(Knob(p) for p in sorted(marked, key=lambda p: p.slider.order if p.slider else 0))
+
+
+KNOBS = knobs()
 
 
 class Hud:
@@ -116,8 +138,8 @@ class Hud:
         """Apply a parameter to the selection through the locomotion API."""
         if self.creature is None:
             return
-        if name == "gait":
-            self.world.locomotion.set(self.creature, gait=str(value))
+        if name not in settable()[0]:  # creature-wide (the gait)
+            self.world.locomotion.set(self.creature, **{name: value})
         else:
             self.world.locomotion.set(self.creature, tentacle=self.tentacle, **{name: float(value)})
         self.refresh()
@@ -235,9 +257,10 @@ class Hud:
             gui.item(knob.name)
             if changed:
                 self.set_parameter(knob.name, min(shown, high) / knob.to_shown)
-        imgui.text("gait")
+        gaits = parameter("locomotion", "gait")
+        imgui.text(gaits.label)
         gui.item("gait label")
-        for i, gait in enumerate(GAITS):
+        for i, gait in enumerate(gaits.choices):
             if i:
                 same_line_if_fits(text_width(gait))
             if imgui.radio_button(gait, self.values["gait"] == gait):

@@ -13,10 +13,18 @@ from __future__ import annotations
 
 import math
 import numbers
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, replace
 from typing import Any
 
-from ecs_tentacles.scene.validate import core_schema, fragment
+from ecs_tentacles.scene.validate import core_schema, load_schema
+
+JsonPath = tuple[str | int, ...]
+SchemaObject = tuple[str, Mapping[str, Any], JsonPath]
+# schema keywords that hold subschemas, by name, one, or a list (the walk follows these)
+_BY_NAME = ("properties", "$defs", "patternProperties", "dependentSchemas")
+_NESTED = ("items", "additionalProperties", "not", "if", "then", "else", "contains")
+_LISTS = ("allOf", "anyOf", "oneOf", "prefixItems")
 
 
 @dataclass(frozen=True)
@@ -59,31 +67,53 @@ class Range:
         return int(value) if self.integer else float(value)
 
 
-def _range_of(spec: dict[str, Any]) -> Range:
+def schema_range(spec: Mapping[str, Any]) -> Range:
+    """The range a number property of the schema allows (`minimum`, `exclusiveMaximum`...)."""
     low_open, high_open = "exclusiveMinimum" in spec, "exclusiveMaximum" in spec
     low = spec.get("exclusiveMinimum", spec.get("minimum", -math.inf))
     high = spec.get("exclusiveMaximum", spec.get("maximum", math.inf))
     return Range(low, high, low_open, high_open, spec.get("type") == "integer")
 
 
+def schema_objects(node: Any, name: str = "", path: JsonPath = ()) -> Iterator[SchemaObject]:
+    """(name, object schema, JSON path) of every object schema with `properties` in `node`.
+
+    An object is named by the property or definition holding it (`tentacles`,
+    `locomotion`), so a field is found wherever a schema (the bundled one, or one
+    assembled from plugins' fragments) puts it; array items keep their holder's name.
+    """
+    if not isinstance(node, Mapping):
+        return
+    if isinstance(node.get("properties"), Mapping):
+        yield name, node, path
+    for keyword in _BY_NAME:
+        for child_name, child in (node.get(keyword) or {}).items():
+            yield from schema_objects(child, child_name, (*path, keyword, child_name))
+    for keyword in _NESTED:
+        yield from schema_objects(node.get(keyword), name, (*path, keyword))
+    for keyword in _LISTS:
+        for i, child in enumerate(node.get(keyword) or []):
+            yield from schema_objects(child, name, (*path, keyword, i))
+
+
 def field_schema(section: str, key: str) -> dict[str, Any]:
-    """The schema of a creature's `<section>.<key>` (section: mantle, tentacles, locomotion)."""
-    creature = core_schema()["$defs"]["creature"]["properties"]
-    if section not in creature:  # a plugin's section (locomotion): from its fragment
-        creature = fragment(section)["creature"]
-    found: dict[str, Any] = creature[section]["properties"][key]
-    return found
+    """The schema of `<section>.<key>` (section: mantle, tentacles, locomotion...)."""
+    for name, node, _ in schema_objects(load_schema()):  # the default plugins' fields too
+        if name == section and key in node["properties"]:
+            found: dict[str, Any] = node["properties"][key]
+            return found
+    raise KeyError(f"{section}.{key}: not a field of the scene schema")
 
 
 def field_range(section: str, key: str) -> Range:
     """The range of a creature's `<section>.<key>`, e.g. `("tentacles", "strength")`."""
-    return _range_of(field_schema(section, key))
+    return schema_range(field_schema(section, key))
 
 
 def physics_range(key: str) -> Range:
     """The range of the scene's `physics.<key>` (for gravity: of each component)."""
     spec: dict[str, Any] = core_schema()["properties"]["physics"]["properties"][key]
-    return _range_of(spec.get("items", spec))
+    return schema_range(spec.get("items", spec))
 
 
 def damping_floor(strength: float, step: float) -> float:

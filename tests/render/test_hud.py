@@ -132,14 +132,15 @@ def test_gui_draw_calls_do_not_grow_with_creatures(make_sandbox: Callable[..., A
 
 @pytest.mark.parametrize("name", ["speed", "target_angle", "strength", "wave_amplitude"])
 def test_each_slider_spans_the_schema_range(name: str) -> None:
-    from ecs_tentacles.locomotion.params import TENTACLE_RANGES
     from ecs_tentacles.render.hud import KNOBS
+    from ecs_tentacles.scene.ranges import field_range
 
     (knob,) = [k for k in KNOBS if k.name == name]
-    allowed = TENTACLE_RANGES[name]
-    assert knob.high == pytest.approx(allowed.high * knob.to_shown)
-    assert knob.low / knob.to_shown in allowed  # an open lower bound (speed > 0) is never shown
-    assert knob.low / knob.to_shown - allowed.low <= 1e-3 * (allowed.high - allowed.low)
+    key = {"target_angle": "target_angle_deg", "wave_amplitude": "wave_amplitude_deg"}
+    allowed = field_range("tentacles", key.get(name, name))  # scene units, as the HUD shows
+    assert knob.high == pytest.approx(allowed.high)
+    assert knob.low in allowed  # an open lower bound (speed > 0) is never shown
+    assert knob.low - allowed.low <= 1e-3 * (allowed.high - allowed.low)
 
 
 def test_the_strength_slider_stops_where_the_damping_holds(
@@ -154,3 +155,21 @@ def test_the_strength_slider_stops_where_the_damping_holds(
     # damping 0.5 at 1/480 s holds at most kp 240 (damping >= strength x step)
     assert world.locomotion.strength_limit(octo) == pytest.approx(240.0)
     assert world.locomotion.get(octo, 5)["strength"] == pytest.approx(240.0, rel=1e-3)
+
+
+def test_the_sliders_are_the_parameter_tables() -> None:
+    """Which sliders, their order, labels and units: the schema's `x-parameter` entries."""
+    from ecs_tentacles.render.hud import KNOBS
+    from ecs_tentacles.scene.validate import load_schema
+
+    tentacles = load_schema()["$defs"]["creature"]["properties"]["tentacles"]["properties"]
+    marked = {
+        k: v["x-parameter"] for k, v in tentacles.items() if "slider" in v.get("x-parameter", {})
+    }
+    by_order = sorted(marked, key=lambda k: marked[k]["slider"]["order"])
+    assert [k.name for k in KNOBS] == [k.removesuffix("_deg") for k in by_order]
+    assert [k.label for k in KNOBS] == [marked[k]["label"] for k in by_order]
+    strength = next(k for k in KNOBS if k.name == "strength")
+    assert (strength.label, strength.unit, strength.log) == ("strength (kp)", "%.1f N m/rad", True)
+    angle = next(k for k in KNOBS if k.name == "target_angle")
+    assert angle.unit == "%.0f deg" and angle.to_shown == pytest.approx(180 / np.pi, rel=1e-15)

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from ecs_tentacles.creator.limits import DesignError, checked
-from ecs_tentacles.locomotion.params import TENTACLE_RANGES
+from ecs_tentacles.locomotion.params import settable
 from ecs_tentacles.scene.ranges import Range, field_range, physics_range
 from ecs_tentacles.scene.validate import load_schema
 
@@ -56,10 +56,21 @@ def test_check_keeps_whole_numbers_whole() -> None:
 
 
 def test_the_locomotion_api_uses_the_schema_ranges_in_radians() -> None:
-    assert TENTACLE_RANGES["strength"] == field_range("tentacles", "strength")
-    assert TENTACLE_RANGES["wave_amplitude"] == Range(0, math.radians(60))
-    assert TENTACLE_RANGES["target_angle"].high == pytest.approx(math.pi / 2)
-    for name, allowed in TENTACLE_RANGES.items():
+    api_ranges = {name: p.range for name, p in settable()[0].items()}
+    assert set(api_ranges) == {
+        "speed",
+        "target_angle",
+        "strength",
+        "damping",
+        "wave_amplitude",
+        "wave_frequency",
+        "wavelength",
+        "writhe",
+    }
+    assert api_ranges["strength"] == field_range("tentacles", "strength")
+    assert api_ranges["wave_amplitude"] == Range(0, math.radians(60))
+    assert api_ranges["target_angle"].high == pytest.approx(math.pi / 2)
+    for name, allowed in api_ranges.items():
         key = {"target_angle": "target_angle_deg", "wave_amplitude": "wave_amplitude_deg"}
         scene_range = field_range("tentacles", key.get(name, name))
         factor = math.radians(1) if name in key else 1.0
@@ -72,3 +83,8 @@ def test_the_creator_refuses_what_the_schema_refuses() -> None:
     assert refused.value.field == "link_length"
     assert refused.value.message == "must be in [1e-06, 10], got 0.0"
     assert checked("count", "tentacles", "count", 3.0) == 3
+
+
+def test_an_unknown_field_is_named() -> None:
+    with pytest.raises(KeyError, match=r"tentacles\.colour: not a field of the scene schema"):
+        field_range("tentacles", "colour")

@@ -1,0 +1,213 @@
+"""The parameter table: each tentacle and creature parameter, defined once, in the schema.
+
+A parameter is a property of the scene schema annotated with `x-parameter`:
+
+    "strength": {"type": "number", "minimum": 0, "maximum": 1000, "default": 25.0,
+                 "x-parameter": {"column": "motors.strength", "taper": "scale",
+                                 "units": "N m/rad", "label": "strength (kp)",
+                                 "slider": {"order": 2, "digits": 1, "log": true}}}
+
+The property gives the scene key, default and range (`minimum`/`maximum`, or `enum`:
+the stored code of a choice is its index there). The annotation gives the rest:
+
+* `column`: the store column it fills, `<store>.<field>` (`world.motors.strength`);
+  a parameter stored per creature (`creatures.*`) is creature-wide at run time;
+* `units`: the scene's units. A key ending in `_deg` is degrees in the scene and
+  radians in code (stores, `world.locomotion`), whose name drops the `_deg`;
+* `taper`: a column of the same store the value is multiplied by, row by row
+  (`scale`: each link's construction scale);
+* `at_most`: a column of the same store that caps it (drivers: the tentacle count);
+* `runtime`: false when `world.locomotion.set` cannot change it (read at compile);
+* `label`, and `slider` (`order`, `digits`, `log`): how the HUD shows it.
+
+`parameters(schema)` walks whatever schema dict it is given (the bundled one by
+default, or one assembled from plugins' fragments) and finds annotated properties
+wherever they sit; a parameter's section is the name of the object holding it
+(`tentacles`, `locomotion`). Build code fills store columns with `apply_parameters`;
+`world.locomotion`, the HUD and the creator read the same records.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from collections.abc import Iterable, Iterator, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ecs_tentacles.scene.ranges import Range, schema_objects, schema_range
+from ecs_tentacles.scene.validate import format_path, load_schema
+
+ANNOTATION = "x-parameter"
+DEGREE = math.radians(1.0)  # one scene degree in code's radians
+_KEYS = {"column", "units", "label", "taper", "at_most", "runtime", "slider"}
+_SLIDER_KEYS = {"order", "digits", "log"}
+
+
+@dataclass(frozen=True)
+class Slider:
+    """How the HUD shows a parameter: its place among the sliders, digits, log scale."""
+
+    order: int
+    digits: int
+    log: bool = False
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """One scene parameter: where it is in the scene, where it is stored, how it is shown.
+
+    `range` is in code units (radians for `_deg` keys); `choices` replaces it for
+    enumerations, whose stored value is the choice's index.
+    """
+
+    section: str
+    key: str
+    store: str
+    field: str
+    units: str
+    label: str
+    range: Range | None
+    choices: tuple[str, ...] = ()
+    factor: float = 1.0  # code value = scene value x factor
+    taper: str | None = None
+    at_most: str | None = None
+    runtime: bool = True
+    slider: Slider | None = None
+
+    @property
+    def api(self) -> str:
+        """The name scripts use (`world.locomotion.set(..., target_angle=0.5)`)."""
+        return self.key.removesuffix("_deg")
+
+    @property
+    def column(self) -> str:
+        return f"{self.store}.{self.field}"
+
+    def code(self, choice: str) -> int:
+        """The stored code of one of `choices` (gait "coordinated" -> 1)."""
+        return self.choices.index(choice)
+
+    def from_scene(self, value: Any) -> Any:
+        """A scene value in code units (radians for `_deg` keys); a choice stays its name."""
+        return value if self.choices else value * self.factor
+
+    def to_api(self, stored: Any) -> Any:
+        """A stored value as `world.locomotion.get` reports it (before any taper)."""
+        if self.choices:
+            return self.choices[int(stored)]
+        return int(stored) if self.range and self.range.integer else float(stored)
+
+    def check(self, value: Any) -> Any:
+        """An API value (code units) if allowed, else a ValueError naming the parameter."""
+        if self.choices:
+            if value not in self.choices:
+                allowed = ", ".join(self.choices)
+                raise ValueError(f"{self.api}: must be one of {allowed}, got {value!r}")
+            return value
+        assert self.range is not None
+        return self.range.check(self.api, value)
+
+    def write(self, world: Any, rows: Any, value: Any) -> None:
+        """Store an API value at `rows` of its column: tapered and capped by its row's columns."""
+        store = getattr(world, self.store)
+        stored = self.code(value) if self.choices else value
+        if self.taper:
+            stored = stored * getattr(store, self.taper)[rows]
+        if self.at_most:
+            stored = np.minimum(stored, getattr(store, self.at_most)[rows])
+        getattr(store, self.field)[rows] = stored
+
+
+def _annotated(schema: Mapping[str, Any]) -> Iterator[tuple[str, str, Mapping[str, Any], str]]:
+    """(section, key, property schema, JSON path) of every annotated property of `schema`."""
+    for section, node, path in schema_objects(schema):
+        for key, spec in node["properties"].items():
+            if isinstance(spec, Mapping) and ANNOTATION in spec:
+                yield section, key, spec, format_path([*path, "properties", key])
+
+
+def _parameter(section: str, key: str, spec: Mapping[str, Any], where: str) -> Parameter:
+    meta = spec[ANNOTATION]
+    where = f"{where}.{ANNOTATION}"
+    unknown = set(meta) - _KEYS
+    if unknown or not {"column", "units", "label"} <= set(meta):
+        problem = f"unknown key {sorted(unknown)[0]!r}" if unknown else "needs column, units, label"
+        raise ValueError(f"{where}: {problem}")
+    store, _, field = str(meta["column"]).partition(".")
+    if not store or not field:
+        raise ValueError(f"{where}: column must be <store>.<field>, got {meta['column']!r}")
+    degrees = key.endswith("_deg")
+    if degrees != (meta["units"] == "deg"):
+        raise ValueError(f"{where}: units must be 'deg' exactly when the key ends in _deg")
+    slider = meta.get("slider")
+    if slider is not None and set(slider) - _SLIDER_KEYS:
+        raise ValueError(f"{where}.slider: unknown key {sorted(set(slider) - _SLIDER_KEYS)[0]!r}")
+    factor = DEGREE if degrees else 1.0
+    choices = tuple(spec.get("enum", ()))
+    return Parameter(
+        section=section,
+        key=key,
+        store=store,
+        field=field,
+        units=meta["units"],
+        label=meta["label"],
+        range=None if choices else schema_range(spec).scaled(factor),
+        choices=choices,
+        factor=factor,
+        taper=meta.get("taper"),
+        at_most=meta.get("at_most"),
+        runtime=meta.get("runtime", True),
+        slider=Slider(**slider) if slider is not None else None,
+    )
+
+
+def read_parameters(schema: Mapping[str, Any]) -> tuple[Parameter, ...]:
+    """Every annotated parameter of `schema`, in document order; each column at most once."""
+    table: list[Parameter] = []
+    seen: dict[tuple[str, str], str] = {}
+    for section, key, spec, where in _annotated(schema):
+        parameter = _parameter(section, key, spec, where)
+        for kind, name in (("column", parameter.column), ("scene key", f"{section}.{key}")):
+            if (kind, name) in seen:
+                raise ValueError(f"{where}: {kind} {name} is already defined at {seen[kind, name]}")
+            seen[kind, name] = where
+        table.append(parameter)
+    return tuple(table)
+
+
+@functools.cache
+def parameters() -> tuple[Parameter, ...]:
+    """The parameters of the bundled scene schema (read once)."""
+    return read_parameters(load_schema())
+
+
+def parameter(section: str, key: str, table: Iterable[Parameter] | None = None) -> Parameter:
+    """The parameter at scene key `<section>.<key>` (`"tentacles", "strength"`)."""
+    for found in parameters() if table is None else table:
+        if (found.section, found.key) == (section, key):
+            return found
+    raise KeyError(f"{section}.{key}: not a parameter of the scene schema")
+
+
+def apply_parameters(
+    world: Any,
+    section: str,
+    entry: Mapping[str, Any],
+    table: Sequence[Parameter] | None = None,
+    **rows: Any,
+) -> None:
+    """Fill store columns from a scene entry (defaults applied) of `section`, at `rows`.
+
+    `rows` maps store names to the rows to fill; parameters of other stores are left
+    for another call (a tentacle's links are built before its tentacle row):
+
+        apply_parameters(world, "tentacles", params, motors=link_rows)
+        apply_parameters(world, "locomotion", spec["locomotion"], creatures=row)
+    """
+    for found in parameters() if table is None else table:
+        if found.section == section and found.store in rows and found.key in entry:
+            value = entry[found.key]
+            found.write(world, rows[found.store], found.from_scene(value))
