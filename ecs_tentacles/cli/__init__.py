@@ -1,4 +1,5 @@
-"""The `ecs-tentacles` command line: validate, run, play, bake, export, create, crowd, bench.
+"""The `ecs-tentacles` command line: validate, run, play, bake, export, create, crowd, bench,
+systems, migrate.
 
 It speaks one way: every error is one line `error: <where>: <what>` on stderr (one per
 problem for a scene), exit 2 for bad input (arguments, scenes, takes, no display),
@@ -18,7 +19,18 @@ from contextlib import contextmanager
 from types import FrameType
 
 from ecs_tentacles import __version__
-from ecs_tentacles.cli import bake, bench, create, crowd, export, play, run, validate
+from ecs_tentacles.cli import (
+    bake,
+    bench,
+    create,
+    crowd,
+    export,
+    migrate,
+    play,
+    run,
+    systems,
+    validate,
+)
 from ecs_tentacles.cli.arguments import NoDisplay, OneLineParser
 from ecs_tentacles.export.atomic import OutputError
 from ecs_tentacles.export.take import TakeError
@@ -27,7 +39,7 @@ from ecs_tentacles.scene.errors import SceneError
 
 COMMANDS = {"validate": validate, "run": run, "play": play}
 COMMANDS |= {"bake": bake, "export": export, "create": create}
-COMMANDS |= {"crowd": crowd, "bench": bench}
+COMMANDS |= {"crowd": crowd, "bench": bench, "systems": systems, "migrate": migrate}
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -73,18 +73,21 @@ def fragment(name: str) -> dict[str, Any]:
 
 def schema_for(plugins: Sequence[Plugin]) -> dict[str, Any]:
     """The core schema with each plugin's creature keys, scene keys and `$defs` added."""
-    key = tuple((p.key, type(p)) for p in plugins)
-    if all(p.source is None for p in plugins):  # built-in plugins' fragments never change
-        return _cached_schema(key, tuple(plugins))
-    return _assemble(plugins)
+    parts = [(p.key, p.defs, p.creature_schema, p.scene_schema) for p in plugins]
+    if any(p.source is not None for p in plugins):  # users' plugins: assembled each time
+        return _assemble(parts)
+    key = tuple((p.key, type(p)) for p in plugins)  # built-in fragments never change
+    if key not in _SCHEMAS:
+        _SCHEMAS[key] = _assemble(parts)
+    return _SCHEMAS[key]
 
 
-@functools.lru_cache(maxsize=32)
-def _cached_schema(key: tuple[Any, ...], plugins: tuple[Plugin, ...]) -> dict[str, Any]:
-    return _assemble(plugins)
+_SCHEMAS: dict[tuple[tuple[str, type], ...], dict[str, Any]] = {}
+Part = tuple[str, Mapping[str, Any], Mapping[str, Any], Mapping[str, Any]]
 
 
-def _assemble(plugins: Sequence[Plugin]) -> dict[str, Any]:
+def _assemble(parts: Sequence[Part]) -> dict[str, Any]:
+    """Core schema + (plugin key, $defs, creature keys, scene keys) of each plugin."""
     schema = copy.deepcopy(core_schema())
     owner: dict[tuple[str, str], str] = {}
     places = {
@@ -92,39 +95,49 @@ def _assemble(plugins: Sequence[Plugin]) -> dict[str, Any]:
         "creature": schema["$defs"]["creature"]["properties"],
         "scene": schema["properties"],
     }
-    for plugin in plugins:
-        parts = {
-            "$defs": plugin.defs,
-            "creature": plugin.creature_schema,
-            "scene": plugin.scene_schema,
-        }
-        for place, entries in parts.items():
+    for key, defs, creature, scene in parts:
+        for place, entries in (("$defs", defs), ("creature", creature), ("scene", scene)):
             for name, entry in entries.items():
                 if name in places[place] or (place, name) in owner:
                     first = owner.get((place, name), "core")
                     raise ValueError(
-                        f"plugins.{plugin.key}: its {place} key {name!r} is already {first}'s"
+                        f"plugins.{key}: its {place} key {name!r} is already {first}'s"
                     )
-                owner[(place, name)] = plugin.key
+                owner[(place, name)] = key
                 places[place][name] = copy.deepcopy(entry)
     return schema
 
 
 @functools.cache
 def load_schema() -> dict[str, Any]:
-    """The schema of a scene that turns no plugin on or off (the default plugins' keys)."""
-    from ecs_tentacles.plugin import resolve
+    """The schema of a scene that turns no plugin on or off (the default plugins' keys).
 
-    return schema_for(resolve(None))
+    Assembled from the fragment files of the default plugins (their code is not imported).
+    """
+    from ecs_tentacles.plugin import DEFAULT_ON
+
+    folder = importlib.resources.files("ecs_tentacles.assets") / "schema" / "plugins"
+    parts = []
+    for name in DEFAULT_ON:
+        if (folder / f"{name}.json").is_file():
+            part = fragment(name)
+            parts.append(
+                (name, part.get("$defs", {}), part.get("creature", {}), part.get("scene", {}))
+            )
+    return _assemble(parts)
 
 
-@functools.cache
-def _default_validator() -> Any:
-    return _StrictValidator(load_schema())
+_VALIDATORS: dict[int, tuple[dict[str, Any], Any]] = {}  # id -> (schema kept alive, validator)
 
 
 def _validator(schema: dict[str, Any]) -> Any:
-    return _default_validator() if schema is load_schema() else _StrictValidator(schema)
+    """A validator per schema object (assembled schemas are cached, so this is too)."""
+    found = _VALIDATORS.get(id(schema))
+    if found is None or found[0] is not schema:
+        if len(_VALIDATORS) > 64:
+            _VALIDATORS.clear()
+        found = _VALIDATORS[id(schema)] = (schema, _StrictValidator(schema))
+    return found[1]
 
 
 def format_path(path: Iterable[str | int]) -> str:

@@ -178,6 +178,6 @@ def test_the_module_docstring_names_every_command() -> None:
 
     parser = cli.build_parser()
     (commands,) = [a for a in parser._actions if isinstance(a, argparse._SubParsersAction)]
-    first_line = (cli.__doc__ or "").splitlines()[0]
+    first_line = " ".join((cli.__doc__ or "").split("\n\n")[0].split())
     named = first_line.split(":", 1)[1].strip(" .").split(", ")
     assert named == list(commands.choices)

@@ -1,0 +1,83 @@
+"""`ecs-tentacles migrate SCENE`: write a scene in today's form (explicit `plugins`).
+
+Old scenes stay valid (the default plugins are on), so migrating is optional. It
+writes every plugin the scene runs under `plugins`, with its full config, and turns
+the older `systems` list of import paths into plugin entries (`{"from": "module:Class"}`)
+so they are configured like any plugin. The result is validated before it is written,
+atomically, to `--out` (default: beside the scene, `<name>.migrated.json`) or over the
+scene with `--in-place`.
+"""
+
+from __future__ import annotations
+
+import argparse
+import copy
+import json
+import pathlib
+from typing import Any
+
+from ecs_tentacles.export.atomic import atomic_output
+from ecs_tentacles.plugin import DEFAULT_ON, FROM
+from ecs_tentacles.scene.errors import SceneError
+from ecs_tentacles.scene.load import load_scene_plugins, read_scene_json, resolve_scene_path
+
+
+def add_parser(commands: argparse._SubParsersAction) -> None:
+    parser = commands.add_parser(
+        "migrate",
+        help="rewrite a scene with an explicit plugins block (systems list -> plugins)",
+        description="Write the scene with every plugin it runs listed under `plugins` (with"
+        " its config) and its `systems` list turned into plugin entries. The output is"
+        " validated, then written atomically.",
+    )
+    parser.add_argument("scene", metavar="SCENE", help="scene file")
+    where = parser.add_mutually_exclusive_group()
+    where.add_argument("--out", metavar="FILE", help="output file (default SCENE.migrated.json)")
+    where.add_argument("--in-place", action="store_true", help="replace the scene file")
+    parser.add_argument(
+        "--allow-systems",
+        action="store_true",
+        help="import the plugins the scene names to check them",
+    )
+    parser.add_argument("--json", action="store_true", help="print the summary as JSON")
+    parser.set_defaults(handler=handle)
+
+
+def migrate(raw: dict[str, Any]) -> tuple[dict[str, Any], list[str]]:
+    """The scene with `plugins` explicit and `systems` folded in; and what changed."""
+    scene = copy.deepcopy(raw)
+    changes: list[str] = []
+    plugins: dict[str, Any] = dict(scene.get("plugins") or {})
+    for name in DEFAULT_ON:
+        if name not in plugins:
+            plugins[name] = {}
+            changes.append(f"plugins.{name}: on (it was on by default)")
+    for i, target in enumerate(scene.pop("systems", []) or []):
+        key = target.rpartition(":")[2].lower() or f"system_{i}"
+        while key in plugins:
+            key += "_"
+        plugins[key] = {FROM: target}
+        changes.append(f"systems[{i}] -> plugins.{key} (from {target})")
+    scene["plugins"] = plugins
+    return scene, changes
+
+
+def handle(args: argparse.Namespace) -> int:
+    path = resolve_scene_path(args.scene)
+    raw = read_scene_json(path)
+    if not isinstance(raw, dict):
+        raise SceneError([f"{path}: scene: must be an object"])
+    load_scene_plugins(path, allow_systems=args.allow_systems)  # the old form is valid
+    scene, changes = migrate(raw)
+    folder = path.resolve().parent
+    load_scene_plugins(scene, allow_systems=args.allow_systems, scene_dir=folder)
+    target = path if args.in_place else pathlib.Path(args.out or path.with_suffix(".migrated.json"))
+    with atomic_output(target) as temporary:
+        temporary.write_text(json.dumps(scene, indent=2) + "\n", encoding="utf-8")
+    if args.json:
+        print(json.dumps({"scene": str(path), "out": str(target), "changes": changes}))
+    else:
+        print(f"migrate: {path} -> {target}: {len(changes)} changes")
+        for change in changes:
+            print(f"  {change}")
+    return 0

@@ -1,0 +1,80 @@
+"""`ecs-tentacles systems` (the frame's data flow) and `ecs-tentacles migrate`."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from ecs_tentacles.cli import main
+from ecs_tentacles.scene.load import bundled_scene
+
+
+def test_systems_prints_the_frame_with_stages_plugins_and_fields(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    assert main(["systems", "hedgehog_octopus"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert (
+        lines[0]
+        == "plugins: locomotion (built in), suckers (built in), threats (built in), fur (built in)"
+    )
+    assert lines[1].split() == ["stage", "system", "plugin", "reads", "writes"]
+    rows = [line.split()[:3] for line in lines[2:]]
+    assert rows[0] == ["decide", "goals", "locomotion"]
+    assert ["physics", "physics", "core"] in rows and rows[-1] == ["animate", "rig", "fur"]
+    assert main(["systems", "octopus", "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["warnings"] == [] and report["systems"][3]["system"] == "motor_targets"
+
+
+def test_systems_warns_about_unordered_writers(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    (tmp_path / "twin.py").write_text(
+        "from ecs_tentacles.system import System\n"
+        "class Twin(System):\n"
+        "    name = 'twin'\n"
+        "    stage = 'act'\n"
+        "    writes = ('motors.target',)\n"
+    )
+    scene = json.loads(bundled_scene("octopus").read_text())
+    scene["plugins"] = {"twin": {"from": "twin.py"}}
+    (tmp_path / "s.json").write_text(json.dumps(scene))
+    with pytest.warns(UserWarning, match="both write 'motors.target'"):
+        assert main(["systems", str(tmp_path / "s.json"), "--allow-systems"]) == 0
+    out = capsys.readouterr().out
+    assert "warning: motor_targets and twin both write motors.target in stage act" in out
+
+
+def test_migrate_makes_plugins_explicit_and_folds_the_systems_list(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    (tmp_path / "mywave.py").write_text(
+        "from ecs_tentacles.system import System\nclass Wave(System):\n    name = 'wave'\n"
+    )
+    scene = json.loads(bundled_scene("octopus").read_text())
+    scene["systems"] = ["mywave:Wave"]
+    path = tmp_path / "old.json"
+    path.write_text(json.dumps(scene))
+    assert main(["migrate", str(path), "--allow-systems"]) == 0
+    new = json.loads((tmp_path / "old.migrated.json").read_text())
+    assert "systems" not in new
+    assert new["plugins"] == {
+        "locomotion": {}, "suckers": {}, "threats": {}, "fur": {}, "wave": {"from": "mywave:Wave"}
+    }  # fmt: skip
+    assert "systems[0] -> plugins.wave (from mywave:Wave)" in capsys.readouterr().out
+    assert main(["systems", str(tmp_path / "old.migrated.json"), "--allow-systems"]) == 0
+    assert "wave" in capsys.readouterr().out
+    assert json.loads(path.read_text()) == scene  # the original is untouched
+
+
+def test_migrate_refuses_a_bad_scene_and_writes_nothing(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    path = tmp_path / "bad.json"
+    path.write_text(json.dumps({"version": 1, "creatures": [{"fur": {"groom": {"count": -1}}}]}))
+    assert main(["migrate", str(path)]) == 2
+    assert "creatures[0].fur.groom.count" in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.json"]
