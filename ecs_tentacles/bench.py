@@ -1,7 +1,7 @@
 """Headless benchmark of a world: build time, frame time, and MuJoCo stepped bare.
 
     from ecs_tentacles.bench import bench
-    from ecs_tentacles.scene.crowd import crowd_scene
+    from ecs_tentacles.creator.crowd import crowd_scene
     result = bench(crowd_scene(16), frames=120, threads=2)
     print(result["frame_ms"], result["raw_mujoco_ms"], result["overhead_ratio"])
 

@@ -63,6 +63,17 @@ FROM = "from"  # the config key naming where a plugin's code is
 
 
 @dataclass(frozen=True)
+class GuideFrame:
+    """Curves a plugin exports at one frame (`Plugin.export_curves`; the fur guides):
+    `points` (curves, points, 3) world metres, `widths` (curves, points) metres,
+    `creatures` (curves,) owning creature entities."""
+
+    points: Any
+    widths: Any
+    creatures: Any
+
+
+@dataclass(frozen=True)
 class Marker:
     """Spheres a plugin asks the renderer to draw: centres (n, 3), size (x, y, z), rgba."""
 
@@ -121,7 +132,7 @@ class Plugin:
         """Marker spheres the sandbox draws this frame."""
         return []
 
-    def export_curves(self, world: World) -> Any:
+    def export_curves(self, world: World) -> GuideFrame | None:
         """Curves a take records each frame (fur guides), or None."""
         return None
 

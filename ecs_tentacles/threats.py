@@ -15,8 +15,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ecs_tentacles.components import RowComponent, RowField, Transform
-from ecs_tentacles.fur.tracks import Channel, channels_from_keys
 from ecs_tentacles.store import ArrayStore, Field
+from ecs_tentacles.tracks import Channel, channels_from_keys
 
 if TYPE_CHECKING:
     from ecs_tentacles.world import World

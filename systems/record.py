@@ -16,8 +16,8 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 from ecs_tentacles.export.recording import TakeRecorder, pose_fur_at_build
-from ecs_tentacles.export.take import Take
 from ecs_tentacles.system import System
+from ecs_tentacles.take import Take
 
 if TYPE_CHECKING:
     from ecs_tentacles.world import World

@@ -25,9 +25,9 @@ import numpy as np
 from ecs_tentacles.fur.bind import ControlTracks, control_values, make_bind, make_strands
 from ecs_tentacles.fur.dynamics import Strands
 from ecs_tentacles.fur.rig import Bind, Scratch, control_table, evaluate, use_parallel
-from ecs_tentacles.fur.tracks import TrackSet
 from ecs_tentacles.fur.vectors import quat_matrices
 from ecs_tentacles.system import System
+from ecs_tentacles.tracks import TrackSet
 
 if TYPE_CHECKING:
     from ecs_tentacles.world import World

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from ecs_tentacles.fur.tracks import TrackSet
 from ecs_tentacles.system import System
+from ecs_tentacles.tracks import TrackSet
 
 if TYPE_CHECKING:
     from ecs_tentacles.world import World

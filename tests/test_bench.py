@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from ecs_tentacles.bench import bench, measure, timed
-from ecs_tentacles.scene.crowd import crowd_scene
+from ecs_tentacles.creator.crowd import crowd_scene
 from ecs_tentacles.world import World
 
 KEYS = [

@@ -24,7 +24,7 @@ from typing import Any
 from matplotlib.figure import Figure
 from matplotlib.ticker import FuncFormatter, NullFormatter
 
-from ecs_tentacles.export.atomic import atomic_output
+from ecs_tentacles.atomic import atomic_output
 
 SIZES = (1, 4, 16, 64, 256, 1024)
 BENCH_KEYS = (

@@ -30,10 +30,10 @@ import time
 from pathlib import Path
 from typing import Any
 
+from ecs_tentacles.creator.crowd import crowd_scene
 from ecs_tentacles.distributed.driver import ray_bake, start_ray
 from ecs_tentacles.export.bake import BakePlan, bake
-from ecs_tentacles.export.take import Take, write_npz
-from ecs_tentacles.scene.crowd import crowd_scene
+from ecs_tentacles.take import Take, write_npz
 
 
 def striped(creatures: int, stripes: int) -> dict[str, Any]:

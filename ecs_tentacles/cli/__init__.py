@@ -19,6 +19,7 @@ from contextlib import contextmanager
 from types import FrameType
 
 from ecs_tentacles import __version__
+from ecs_tentacles.atomic import OutputError
 from ecs_tentacles.cli import (
     bake,
     bench,
@@ -32,10 +33,9 @@ from ecs_tentacles.cli import (
     validate,
 )
 from ecs_tentacles.cli.arguments import NoDisplay, OneLineParser
-from ecs_tentacles.export.atomic import OutputError
-from ecs_tentacles.export.take import TakeError
 from ecs_tentacles.scene import load
 from ecs_tentacles.scene.errors import SceneError
+from ecs_tentacles.take import TakeError
 
 COMMANDS = {"validate": validate, "run": run, "play": play}
 COMMANDS |= {"bake": bake, "export": export, "create": create}

@@ -31,9 +31,9 @@ from ecs_tentacles.distributed.wedge import WedgeError
 from ecs_tentacles.export import SUFFIXES, write
 from ecs_tentacles.export.bake import BakePlan, bake, output_kind
 from ecs_tentacles.export.skinned import Skin
-from ecs_tentacles.export.take import Take
 from ecs_tentacles.skin.keys import KeyReport
 from ecs_tentacles.skin.mesh import MeshError
+from ecs_tentacles.take import Take
 
 
 def positive_float(text: str) -> float:

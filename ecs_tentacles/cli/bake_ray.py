@@ -12,7 +12,7 @@ from typing import Any
 
 from ecs_tentacles.cli.run import positive_int, seed_int
 from ecs_tentacles.export.bake import BakePlan, bake
-from ecs_tentacles.export.take import Take
+from ecs_tentacles.take import Take
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

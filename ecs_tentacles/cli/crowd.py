@@ -3,7 +3,7 @@
     ecs-tentacles crowd 256 --out crowd.json --seed 4 --idle 0.2
 
 The creatures, their placement and their goals are described in
-`ecs_tentacles.scene.crowd`; the same seed writes the same file.
+`ecs_tentacles.creator.crowd`; the same seed writes the same file.
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ from typing import Any
 from ecs_tentacles.cli.arguments import output_path
 from ecs_tentacles.cli.bake import positive_float
 from ecs_tentacles.cli.run import positive_int, seed_int
-from ecs_tentacles.scene.crowd import DEFAULT_SPECIES, crowd_scene, write_crowd_scene
+from ecs_tentacles.creator.crowd import DEFAULT_SPECIES, crowd_scene, write_crowd_scene
 from ecs_tentacles.scene.errors import SceneError
 
 

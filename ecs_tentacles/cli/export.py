@@ -14,8 +14,8 @@ from ecs_tentacles.cli.arguments import output_path
 from ecs_tentacles.cli.bake import save, summary, usd_missing
 from ecs_tentacles.cli.skin_options import add_arguments as add_skin_arguments
 from ecs_tentacles.cli.skin_options import skin_options
-from ecs_tentacles.export.take import Take
 from ecs_tentacles.skin.mesh import MeshError
+from ecs_tentacles.take import Take
 
 FORMATS = (".usd", ".usda", ".usdc", ".glb")
 

@@ -16,7 +16,7 @@ import json
 import pathlib
 from typing import Any
 
-from ecs_tentacles.export.atomic import atomic_output
+from ecs_tentacles.atomic import atomic_output
 from ecs_tentacles.plugin import DEFAULT_ON, FROM
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.load import load_scene_plugins, read_scene_json, resolve_scene_path

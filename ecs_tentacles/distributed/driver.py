@@ -35,7 +35,7 @@ from ecs_tentacles.distributed.spheres import meetings
 from ecs_tentacles.distributed.task import ShardResult, bake_shard
 from ecs_tentacles.distributed.work import load_shard, remove_work, save_shard, shard_key
 from ecs_tentacles.export.bake import BakePlan
-from ecs_tentacles.export.take import Take
+from ecs_tentacles.take import Take
 
 
 class ShardFailed(RuntimeError):

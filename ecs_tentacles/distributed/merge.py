@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from ecs_tentacles.export.take import Take
+from ecs_tentacles.take import Take
 
 
 def merge_takes(parts: Sequence[tuple[Sequence[int], Take]]) -> Take:

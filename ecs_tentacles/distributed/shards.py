@@ -23,8 +23,8 @@ from typing import Any
 
 import numpy as np
 
+from ecs_tentacles.creator.crowd import creature_reach
 from ecs_tentacles.physics.proxies import MARGIN
-from ecs_tentacles.scene.crowd import creature_reach
 
 CRAWL_SPEED = 0.25  # m/s per unit of `locomotion.speed`: twice the fastest crawl measured
 SLACK = 0.15  # metres: settling at the start, sideways drift, tentacles lifting

@@ -25,7 +25,7 @@ import numpy as np
 
 from ecs_tentacles.distributed.spheres import ContactSpheres
 from ecs_tentacles.export.bake import BakePlan, bake
-from ecs_tentacles.export.take import Take
+from ecs_tentacles.take import Take
 
 CRASH_DIR = "ECS_TENTACLES_CRASH_DIR"
 

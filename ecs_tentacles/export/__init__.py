@@ -15,7 +15,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 from ecs_tentacles.export.bake import output_kind
-from ecs_tentacles.export.take import Take, TakeError
+from ecs_tentacles.take import Take, TakeError
 
 if TYPE_CHECKING:
     from ecs_tentacles.export.skinned import Skin

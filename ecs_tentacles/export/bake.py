@@ -21,9 +21,9 @@ from pathlib import Path
 from typing import Any
 
 from ecs_tentacles.export.recording import scene_sha256
-from ecs_tentacles.export.take import Take
 from ecs_tentacles.progress import step_frames
 from ecs_tentacles.scene.load import load_scene, resolve_scene_path
+from ecs_tentacles.take import Take
 from ecs_tentacles.world import World
 
 

@@ -24,9 +24,9 @@ from typing import Any
 import numpy as np
 
 from ecs_tentacles import __version__
-from ecs_tentacles.export.atomic import atomic_file
+from ecs_tentacles.atomic import atomic_file
 from ecs_tentacles.export.meshes import Mesh, body_mesh
-from ecs_tentacles.export.take import Take
+from ecs_tentacles.take import Take
 
 Z_UP_TO_Y_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
 _FLOAT, _USHORT = 5126, 5123

@@ -12,26 +12,16 @@ from __future__ import annotations
 import hashlib
 import json
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ecs_tentacles.components import Creature, Goal, Link, Tentacle, Transform
-from ecs_tentacles.export.take import FORMAT, VERSION, Take
+from ecs_tentacles.plugin import GuideFrame
+from ecs_tentacles.take import FORMAT, VERSION, Take
 
 if TYPE_CHECKING:
     from ecs_tentacles.world import World
-
-
-@dataclass(frozen=True)
-class GuideFrame:
-    """Fur guide curves at one frame: `points` (guides, points, 3) world metres,
-    `widths` (guides, points) metres, `creatures` (guides,) owning creature entities."""
-
-    points: np.ndarray
-    widths: np.ndarray
-    creatures: np.ndarray
 
 
 GuideSource = Callable[["World"], GuideFrame | None]

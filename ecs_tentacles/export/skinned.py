@@ -12,10 +12,10 @@ import os
 from dataclasses import dataclass, field
 
 from ecs_tentacles.export.bake import output_kind
-from ecs_tentacles.export.take import Take
 from ecs_tentacles.skin.keys import KeyReport
 from ecs_tentacles.skin.mesh import Detail
 from ecs_tentacles.skin.rig import Keys
+from ecs_tentacles.take import Take
 
 
 @dataclass(frozen=True)

@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 
 from ecs_tentacles import __version__
-from ecs_tentacles.export.atomic import atomic_output
+from ecs_tentacles.atomic import atomic_output
 from ecs_tentacles.export.gltf import (
     _ARRAY_BUFFER,
     _ELEMENT_ARRAY_BUFFER,
@@ -30,10 +30,10 @@ from ecs_tentacles.export.gltf import (
     to_y_up_points,
     to_y_up_rotations,
 )
-from ecs_tentacles.export.take import Take
 from ecs_tentacles.skin.keys import KeyReport
 from ecs_tentacles.skin.mesh import Detail, SkinMesh
 from ecs_tentacles.skin.rig import Keys, SkinnedCreature, skinned_creatures
+from ecs_tentacles.take import Take
 
 _TURN = np.eye(4)
 _TURN[:3, :3] = Z_UP_TO_Y_UP

@@ -27,14 +27,14 @@ from typing import Any
 
 import numpy as np
 
-from ecs_tentacles.export.atomic import atomic_output
-from ecs_tentacles.export.take import Take
+from ecs_tentacles.atomic import atomic_output
 from ecs_tentacles.export.usd import _goal, _guides, _pxr, new_stage
 from ecs_tentacles.mathutil import quat_rotate
 from ecs_tentacles.skin.keys import KeyReport
 from ecs_tentacles.skin.mesh import Detail
 from ecs_tentacles.skin.rig import Keys, SkinnedCreature, skinned_creatures
 from ecs_tentacles.skin.skeleton import transforms
+from ecs_tentacles.take import Take
 
 
 def write_skinned_usd(

@@ -26,8 +26,8 @@ from typing import Any
 
 import numpy as np
 
-from ecs_tentacles.export.atomic import atomic_output
-from ecs_tentacles.export.take import Take
+from ecs_tentacles.atomic import atomic_output
+from ecs_tentacles.take import Take
 
 
 class UsdUnavailable(RuntimeError):

@@ -21,9 +21,9 @@ import numpy as np
 from ecs_tentacles.fur import children
 from ecs_tentacles.fur.components import FurControl
 from ecs_tentacles.mathutil import quat_rotate
+from ecs_tentacles.plugin import GuideFrame
 
 if TYPE_CHECKING:
-    from ecs_tentacles.export.recording import GuideFrame
     from ecs_tentacles.world import World
 
 
@@ -144,7 +144,5 @@ def take_guides(world: World) -> GuideFrame | None:
     if len(curves.points) == 0:
         return None
     owners = np.asarray(fur.sets.creature)[np.asarray(fur.guides.fur_row)]
-    from ecs_tentacles.export.recording import GuideFrame
-
     widths = np.repeat(np.asarray(curves.width)[:, None], curves.points.shape[1], axis=1)
     return GuideFrame(points=curves.points, widths=widths, creatures=owners)

@@ -13,8 +13,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ecs_tentacles.fur.tracks import Channel
 from ecs_tentacles.store import ArrayStore, Field
+from ecs_tentacles.tracks import Channel
 
 # The rig's behaviours, in order: a fur switches each on or off (`FurSetStore.enabled`),
 # and a control drives each through its ControlStore field of the same name.

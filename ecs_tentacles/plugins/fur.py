@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Any
 from ecs_tentacles.fur.build import build_emotion, build_fur
 from ecs_tentacles.fur.checks import fur_problems
 from ecs_tentacles.fur.stores import FurData
-from ecs_tentacles.plugin import Plugin
+from ecs_tentacles.plugin import GuideFrame, Plugin
 from ecs_tentacles.scene.validate import fragment
 from ecs_tentacles.system import System
 
@@ -70,7 +70,7 @@ class FurPlugin(Plugin):
         fur.curves[...] = curves
         fur.frames[...] = frames
 
-    def export_curves(self, world: World) -> Any:
+    def export_curves(self, world: World) -> GuideFrame | None:
         from ecs_tentacles.fur.hooks import take_guides
 
         return take_guides(world)

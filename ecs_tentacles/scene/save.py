@@ -7,7 +7,7 @@ import os
 from pathlib import Path
 from typing import Any
 
-from ecs_tentacles.export.atomic import atomic_output
+from ecs_tentacles.atomic import atomic_output
 from ecs_tentacles.scene.load import load_scene
 
 

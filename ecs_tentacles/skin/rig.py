@@ -10,7 +10,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ecs_tentacles.export.take import Take
 from ecs_tentacles.skin.keys import (
     ROOT_TOLERANCE_M,
     KeyReport,
@@ -22,6 +21,7 @@ from ecs_tentacles.skin.keys import (
 )
 from ecs_tentacles.skin.mesh import Detail, SkinMesh, creature_mesh
 from ecs_tentacles.skin.skeleton import Animation, Skeleton, creature_animation, creature_skeleton
+from ecs_tentacles.take import Take
 
 KEY_MODES = ("all", "reduced")
 

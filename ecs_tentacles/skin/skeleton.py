@@ -22,8 +22,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ecs_tentacles.construction import tentacle_angles
-from ecs_tentacles.export.take import Take
 from ecs_tentacles.mathutil import quat_about_z, quat_multiply, quat_rotate
+from ecs_tentacles.take import Take
 
 
 def quat_conjugate(q: np.ndarray) -> np.ndarray:

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from ecs_tentacles.cli import main
-from ecs_tentacles.export.take import Take
+from ecs_tentacles.take import Take
 from tests.export.conftest import SMALL_SCENE
 
 

@@ -9,7 +9,7 @@ import pytest
 
 from ecs_tentacles.cli import main
 from ecs_tentacles.export.gltf import read_glb
-from ecs_tentacles.export.take import Take
+from ecs_tentacles.take import Take
 
 
 @pytest.fixture

@@ -6,12 +6,12 @@ import io
 
 import numpy as np
 
+from ecs_tentacles.creator.crowd import crowd_scene
 from ecs_tentacles.distributed.merge import merge_takes
 from ecs_tentacles.distributed.spheres import meetings
 from ecs_tentacles.distributed.task import bake_shard
 from ecs_tentacles.export.bake import BakePlan, bake
-from ecs_tentacles.export.take import Take, write_npz
-from ecs_tentacles.scene.crowd import crowd_scene
+from ecs_tentacles.take import Take, write_npz
 
 
 def data(take: Take) -> bytes:

@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from ecs_tentacles.export.take import write_npz
+from ecs_tentacles.take import write_npz
 
 Entries = dict[str, Any]  # name -> ndarray, or bytes for a raw .npy entry
 

@@ -15,7 +15,7 @@ from ecs_tentacles.systems.record import Record
 
 from ecs_tentacles.components import Creature, Link, Tentacle, Transform
 from ecs_tentacles.export.recording import GuideFrame
-from ecs_tentacles.export.take import Take
+from ecs_tentacles.take import Take
 from ecs_tentacles.world import World
 
 # One creature, three tentacles of four links, tip suckers, a goal 1 m ahead.

@@ -17,11 +17,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from ecs_tentacles.atomic import STALE_SECONDS, OutputConflict
 from ecs_tentacles.creator import CreatureDesign
 from ecs_tentacles.export import write
-from ecs_tentacles.export.atomic import STALE_SECONDS, OutputConflict
-from ecs_tentacles.export.take import Take
 from ecs_tentacles.render.output import VideoWriter, save_png
+from ecs_tentacles.take import Take
 
 TARGETS = ("take.npz", "take.usda", "take.glb", "shot.png", "clip.mp4", "scene.json")
 
@@ -32,7 +32,7 @@ import numpy as np
 from ecs_tentacles.cli import Terminated, terminate_by_exception
 from ecs_tentacles.creator import CreatureDesign
 from ecs_tentacles.export import write
-from ecs_tentacles.export.take import Take
+from ecs_tentacles.take import Take
 from ecs_tentacles.render.output import VideoWriter, save_png
 
 take, out = Take.load(sys.argv[1]), Path(sys.argv[2])
@@ -188,7 +188,7 @@ def test_symlinks_planted_at_every_temporary_name_are_never_followed(
     for link in planted:
         (out / link).symlink_to(victim)
     tokens = iter(["deadbeef", "deadbeef", "0badf00d"])
-    monkeypatch.setattr("ecs_tentacles.export.atomic.secrets.token_hex", lambda n: next(tokens))
+    monkeypatch.setattr("ecs_tentacles.atomic.secrets.token_hex", lambda n: next(tokens))
     _write_one(name, guided_take, out)
     assert victim.read_text() == "precious"
     assert (out / name).is_file() and not (out / name).is_symlink()
@@ -199,7 +199,7 @@ def test_symlinks_planted_at_every_temporary_name_are_never_followed(
 def test_a_temporary_file_swapped_for_a_symlink_mid_video_is_not_followed(
     tmp_path: Path,
 ) -> None:
-    from ecs_tentacles.export.atomic import OutputError
+    from ecs_tentacles.atomic import OutputError
 
     victim = tmp_path / "victim.txt"
     victim.write_text("precious")

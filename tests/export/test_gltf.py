@@ -17,7 +17,7 @@ from ecs_tentacles.export.gltf import (
     write_glb,
 )
 from ecs_tentacles.export.meshes import body_mesh
-from ecs_tentacles.export.take import Take
+from ecs_tentacles.take import Take
 
 ROOT = Path(__file__).resolve().parents[2]
 

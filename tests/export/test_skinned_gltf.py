@@ -13,12 +13,12 @@ import pytest
 
 from ecs_tentacles.export.gltf import accessor_array, read_glb, to_y_up_points
 from ecs_tentacles.export.skinned_gltf import split_by_uv, write_skinned_glb
-from ecs_tentacles.export.take import Take
 from ecs_tentacles.skin.keys import slerp
 from ecs_tentacles.skin.mesh import creature_mesh
 from ecs_tentacles.skin.rig import Keys
 from ecs_tentacles.skin.skeleton import creature_skeleton, joint_world_poses
 from ecs_tentacles.skin.skinning import skin_points, skinning_matrices
+from ecs_tentacles.take import Take
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -11,13 +11,13 @@ import numpy as np
 import pytest
 
 from ecs_tentacles.export.skinned_usd import build_skinned_stage, write_skinned_usd
-from ecs_tentacles.export.take import Take
 from ecs_tentacles.mathutil import quat_rotate
 from ecs_tentacles.skin.keys import angle_between
 from ecs_tentacles.skin.mesh import Detail, creature_mesh
 from ecs_tentacles.skin.rig import Keys
 from ecs_tentacles.skin.skeleton import creature_animation, creature_skeleton, joint_world_poses
 from ecs_tentacles.skin.skinning import skin_points, skinning_matrices
+from ecs_tentacles.take import Take
 
 pxr = pytest.importorskip("pxr", reason="USD export needs usd-core (the usd / dev extras)")
 from pxr import Usd, UsdGeom, UsdSkel, UsdUtils, Vt  # noqa: E402

@@ -12,7 +12,7 @@ from ecs_tentacles.systems.record import Record
 
 from ecs_tentacles.components import Creature, Sucker, Tentacle, Transform
 from ecs_tentacles.export.bake import BakePlan, bake, simulation_rate
-from ecs_tentacles.export.take import ARRAYS, Take, TakeError
+from ecs_tentacles.take import ARRAYS, Take, TakeError
 from ecs_tentacles.world import World
 from tests.export.conftest import SMALL_SCENE, link_centres
 

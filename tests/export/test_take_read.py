@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from ecs_tentacles.cli import main
-from ecs_tentacles.export.take import Take, TakeError
-from ecs_tentacles.export.take_read import read_take
+from ecs_tentacles.take import Take, TakeError
+from ecs_tentacles.take_read import read_take
 from tests.export.broken_takes import BROKEN_TAKES
 
 

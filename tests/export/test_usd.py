@@ -9,8 +9,8 @@ from typing import Any
 import numpy as np
 import pytest
 
-from ecs_tentacles.export.take import Take
 from ecs_tentacles.export.usd import build_stage, write_usd
+from ecs_tentacles.take import Take
 
 pxr = pytest.importorskip("pxr", reason="USD export needs usd-core (the usd / dev extras)")
 from pxr import Gf, Usd, UsdGeom, UsdUtils  # noqa: E402

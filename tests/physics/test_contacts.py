@@ -9,8 +9,8 @@ from typing import Any
 import numpy as np
 from numpy.testing import assert_allclose
 
+from ecs_tentacles.creator.crowd import creature_reach
 from ecs_tentacles.physics.clearance import clearance
-from ecs_tentacles.scene.crowd import creature_reach
 from ecs_tentacles.scene.load import load_scene
 from ecs_tentacles.world import World
 

@@ -176,7 +176,7 @@ def test_mujoco_messages_go_to_logging_not_a_file(
 def test_bake_marks_recoveries_in_the_take_and_strict_writes_nothing(
     faulty_scene: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    from ecs_tentacles.export.take import Take
+    from ecs_tentacles.take import Take
 
     out = faulty_scene.parent / "take.npz"
     args = ["bake", str(faulty_scene), "--seconds", "1", "--allow-systems", "--quiet"]

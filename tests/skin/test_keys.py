@@ -5,7 +5,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ecs_tentacles.export.take import Take
 from ecs_tentacles.mathutil import quat_about_z
 from ecs_tentacles.skin.keys import (
     angle_between,
@@ -16,6 +15,7 @@ from ecs_tentacles.skin.keys import (
 )
 from ecs_tentacles.skin.rig import Keys, skinned_creatures
 from ecs_tentacles.skin.skeleton import creature_animation, creature_skeleton
+from ecs_tentacles.take import Take
 
 
 def test_a_steady_turn_needs_only_its_ends_and_a_kink_keeps_its_corner() -> None:

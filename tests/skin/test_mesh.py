@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ecs_tentacles.export.take import Take
 from ecs_tentacles.skin.mesh import Detail, creature_mesh
 from ecs_tentacles.skin.skeleton import creature_skeleton
+from ecs_tentacles.take import Take
 
 
 def edges(faces: np.ndarray) -> np.ndarray:

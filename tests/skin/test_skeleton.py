@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from ecs_tentacles.export.take import Take
 from ecs_tentacles.skin.mesh import creature_mesh
 from ecs_tentacles.skin.skeleton import (
     creature_animation,
@@ -14,6 +13,7 @@ from ecs_tentacles.skin.skeleton import (
     transforms,
 )
 from ecs_tentacles.skin.skinning import skin_points, skinning_matrices
+from ecs_tentacles.take import Take
 
 
 def test_one_joint_per_body_mantle_first_links_chained(octopus_take: Take) -> None:

@@ -34,8 +34,8 @@ from typing import Any, BinaryIO
 
 import numpy as np
 
-from ecs_tentacles.export.atomic import atomic_file
-from ecs_tentacles.export.take_read import (
+from ecs_tentacles.atomic import atomic_file
+from ecs_tentacles.take_read import (
     FORMAT,
     MAX_TAKE_BYTES,
     OPTIONAL,
@@ -123,7 +123,7 @@ class Take:
 
     # -- files -------------------------------------------------------------------------
     def save(self, path: str | os.PathLike[str]) -> None:
-        """Write the take to `path` atomically (see `ecs_tentacles.export.atomic`)."""
+        """Write the take to `path` atomically (see `ecs_tentacles.atomic`)."""
         with atomic_file(path) as handle:
             write_npz(handle, self.arrays())
 
@@ -131,7 +131,7 @@ class Take:
     def load(cls, path: str | os.PathLike[str], max_bytes: int = MAX_TAKE_BYTES) -> Take:
         """Read a take; raises `TakeError` (one line) when the file is not a sound take.
 
-        Takes are untrusted input: see `ecs_tentacles.export.take_read` for every check
+        Takes are untrusted input: see `ecs_tentacles.take_read` for every check
         (zip-bomb cap `max_bytes` on the uncompressed size, header, dtypes, shapes,
         finite values) made before the exporters see the data.
         """
