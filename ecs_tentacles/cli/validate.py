@@ -23,6 +23,11 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         "scenes", nargs="+", metavar="SCENE", help="scene file or bundled scene name"
     )
     parser.add_argument("--json", action="store_true", help="one JSON object per valid scene")
+    parser.add_argument(
+        "--allow-systems",
+        action="store_true",
+        help="import the plugins scenes name from files or modules, to check their configs",
+    )
     parser.set_defaults(handler=handle)
 
 
@@ -34,6 +39,7 @@ def summary(path: str, data: dict[str, Any]) -> dict[str, Any]:
         "creatures": len(creatures),
         "tentacles": sum(c["tentacles"]["count"] for c in creatures),
         "systems": list(data.get("systems", [])),
+        "plugins": sorted(data.get("plugins", {})),
     }
 
 
@@ -55,7 +61,7 @@ def handle(args: argparse.Namespace) -> int:
     for scene in args.scenes:
         try:
             path = resolve_scene_path(scene)
-            data = load_scene(path)
+            data = load_scene(path, allow_systems=args.allow_systems)
         except SceneError as error:
             failed = True
             for problem in error.problems:
