@@ -222,7 +222,10 @@ def _read_entry(archive: zipfile.ZipFile, name: str, shape: tuple[int, ...] | No
         if shape is not None and tuple(stored) != shape:
             raise TakeError(f"{name}: shape {tuple(stored)}, expected {shape} from the header")
         array = np.empty(stored[::-1], dtype).T if fortran else np.empty(stored, dtype)
-        view = memoryview(cast(Any, array.T if fortran else array)).cast("B")
+        empty = memoryview(b"")  # an empty array (a take without goals): nothing to read
+        view = (
+            memoryview(cast(Any, array.T if fortran else array)).cast("B") if array.size else empty
+        )
         filled = 0
         while filled < len(view):
             count = handle.readinto(view[filled:])  # type: ignore[attr-defined]

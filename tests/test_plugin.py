@@ -205,3 +205,20 @@ def test_a_failing_system_is_named_with_its_plugin_and_frame(
         "system 'glow' (plugin 'glow') failed at frame 3: TypeError"
     )
     assert isinstance(caught.value.__cause__, TypeError) and world.frame == 3
+
+
+def test_bake_finds_a_plugin_beside_the_scene_from_another_folder(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from ecs_tentacles.cli import main
+    from ecs_tentacles.take import Take
+
+    scenes = tmp_path / "scenes"
+    scenes.mkdir()
+    path = glow_scene(scenes)
+    monkeypatch.chdir(tmp_path)
+    out = tmp_path / "glow.npz"
+    args = ["bake", str(path), "--seconds", "0.1", "--out", str(out), "--quiet"]
+    assert main(args) == 2 and not out.exists()  # not allowed
+    assert main([*args, "--allow-systems"]) == 0
+    assert Take.load(out).frames == 7

@@ -111,7 +111,13 @@ def handle(args: argparse.Namespace) -> int:
     if problem:
         print(f"error: {problem}", file=sys.stderr)
         return 2
-    plan = BakePlan.make(args.scene, seconds=args.seconds, fps=args.fps, seed=args.seed)
+    plan = BakePlan.make(
+        args.scene,
+        seconds=args.seconds,
+        fps=args.fps,
+        seed=args.seed,
+        allow_systems=args.allow_systems,
+    )
     if plan.intervals < 1:
         print(
             f"error: argument --seconds: {args.seconds:g} s is less than one frame at"

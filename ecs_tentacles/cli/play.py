@@ -66,7 +66,7 @@ def handle(args: argparse.Namespace) -> int:
     configure(headless=args.headless)
     from ecs_tentacles.scene.load import load_scene
 
-    load_scene(path)  # a bad scene fails before a window opens
+    load_scene(path, allow_systems=args.allow_systems)  # a bad scene fails before a window opens
     from ecs_tentacles.render.sandbox import Sandbox
 
     sandbox = Sandbox(

@@ -38,6 +38,7 @@ class BakePlan:
     sim_fps: float  # of the simulation
     every: int  # simulated frames per take frame
     seed: int
+    folder: str | None = None  # the scene's folder: plugins from files are found there
 
     @classmethod
     def make(
@@ -47,13 +48,19 @@ class BakePlan:
         seconds: float,
         fps: float | None = None,
         seed: int | None = None,
+        allow_systems: bool = False,
     ) -> BakePlan:
-        """Load and validate `scene` (SceneError if bad) and work out the frame rates."""
+        """Load and validate `scene` (SceneError if bad) and work out the frame rates.
+
+        `allow_systems` lets the scene's plugins from files or modules be imported.
+        """
+        folder = None
         if isinstance(scene, dict):
-            source, data = "<dict>", load_scene(scene)
+            source, data = "<dict>", load_scene(scene, allow_systems=allow_systems)
         else:
             path = resolve_scene_path(os.fspath(scene))
-            source, data = str(path), load_scene(path)
+            source, data = str(path), load_scene(path, allow_systems=allow_systems)
+            folder = str(path.resolve().parent)
         if not (seconds > 0 and math.isfinite(seconds)):
             raise ValueError(f"seconds must be a positive number, got {seconds}")
         scene_fps = float(data["physics"]["fps"])
@@ -69,6 +76,7 @@ class BakePlan:
             sim_fps=sim_fps,
             every=every,
             seed=int(data["seed"] if seed is None else seed),
+            folder=folder,
         )
 
     @property
@@ -102,7 +110,12 @@ class BakePlan:
         scene = dict(self.scene)
         scene["physics"] = {**scene["physics"], "fps": self.sim_fps}
         return World.from_scene(
-            scene, seed=self.seed, allow_systems=allow_systems, threads=threads, only=only
+            scene,
+            seed=self.seed,
+            allow_systems=allow_systems,
+            threads=threads,
+            only=only,
+            scene_dir=self.folder,
         )
 
 

@@ -76,3 +76,11 @@ def test_exporters_refuse_a_recorded_take_with_non_finite_numbers(
         f"{target}: cannot export this take: pos: non-finite value nan at (2, 3, 1)"
     )
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_take_without_goals_loads(tmp_path: Path) -> None:
+    """Empty arrays (no goals, no suckers held) read back; they once failed to load."""
+    out = tmp_path / "hedgehog.npz"
+    assert main(["bake", "hedgehog_octopus", "--seconds", "0.1", "--out", str(out), "--quiet"]) == 0
+    take = Take.load(out)
+    assert take.goal_pos.shape == (0, 3) and take.goal_active.shape == (take.frames, 0)
