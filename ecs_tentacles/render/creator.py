@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import os
 from collections.abc import Callable
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -24,6 +23,7 @@ from pyglet.gui import Frame, PushButton, Slider
 
 from ecs_tentacles.components import Creature, Tentacle, Transform
 from ecs_tentacles.creator import CreatureDesign, DesignError
+from ecs_tentacles.creator.limits import Setting, editor_setting
 from ecs_tentacles.render.hud import PANEL_WIDTH, TEXT
 from ecs_tentacles.render.output import save_png
 from ecs_tentacles.render.renderer import Renderer
@@ -32,30 +32,19 @@ SELECTED = (1.0, 0.85, 0.2, 1.0)
 ROW = 30
 
 
-@dataclass(frozen=True)
-class Setting:
-    """A slider: which design value it edits, its range, whole numbers or not."""
-
-    name: str
-    label: str
-    low: float
-    high: float
-    whole: bool = False
-
-
+# the sliders: labels and ranges from the scene schema's `x-editor` marks
 UNIFORM = (
-    Setting("mantle_radius", "mantle radius", 0.05, 0.5),
-    Setting("mantle_height", "mantle height", 0.05, 0.5),
-    Setting("count", "tentacles", 1, 16, whole=True),
-    Setting("link_length", "link length", 0.02, 0.2),
-    Setting("link_radius", "link radius", 0.005, 0.06),
-    Setting("links", "links", 1, 30, whole=True),
-    Setting("end_scale", "end scale", 0.05, 1.0),
+    editor_setting("mantle_radius", "mantle", "radius"),
+    editor_setting("mantle_height", "mantle", "height"),
+    editor_setting("count", "tentacles", "count"),
+    editor_setting("link_length", "tentacles", "link_length"),
+    editor_setting("link_radius", "tentacles", "link_radius"),
+    editor_setting("links", "tentacles", "links"),
+    editor_setting("end_scale", "tentacles", "end_scale"),
 )
-PER_TENTACLE = (
-    Setting("link_length", "length", 0.02, 0.2),
-    Setting("link_radius", "radius", 0.005, 0.06),
-    Setting("end_scale", "end scale", 0.05, 1.0),
+PER_TENTACLE = tuple(
+    editor_setting(name, "tentacles", name, short=True)
+    for name in ("link_length", "link_radius", "end_scale")
 )
 
 

@@ -197,3 +197,16 @@ def test_create_from_a_scene_edits_one_creature(tmp_path: Path) -> None:
     assert {"index": 1, "links": 9} in overrides and len(overrides) == 4
     assert scene["seed"] == 5 and scene["name"] == "asymmetric"
     assert main(["create", "--from", source, "--creature", "nobody", "--out", str(out)]) == 2
+
+
+def test_creator_sliders_come_from_the_schema_within_its_ranges() -> None:
+    from ecs_tentacles.creator.limits import editor_setting
+    from ecs_tentacles.scene.ranges import field_range
+    from ecs_tentacles.scene.validate import core_schema
+
+    tentacles = core_schema()["$defs"]["creature"]["properties"]["tentacles"]["properties"]
+    assert tentacles["link_length"]["x-editor"]["label"] == "link length"  # in the schema file
+    setting = editor_setting("link_length", "tentacles", "link_length", short=True)
+    assert (setting.label, setting.low, setting.high) == ("length", 0.02, 0.2)
+    count = editor_setting("count", "tentacles", "count")
+    assert count.whole and count.high == field_range("tentacles", "count").high
