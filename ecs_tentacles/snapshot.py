@@ -117,7 +117,8 @@ def restore(world: World, snapshot: Snapshot) -> None:
     physics.sleep.still[:] = snapshot.sleep[0]
     physics.sleep.commands = [c.copy() for c in snapshot.sleep[1]]
     for plugin in world.plugins:
-        plugin.restore(world, snapshot.plugins[plugin.key])
+        if plugin.key in snapshot.plugins:  # a plugin added since has nothing to go back to
+            plugin.restore(world, snapshot.plugins[plugin.key])
     for system in world.schedule:
         for attribute, value in snapshot.systems.get(system.name, {}).items():
             setattr(system, attribute, copy.deepcopy(value))
