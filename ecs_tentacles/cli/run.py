@@ -129,6 +129,14 @@ def simulate(world: World, frames: int, *, progress: bool = True) -> dict[str, A
         "recovery_causes": dict(physics.health.causes),
         "frozen": physics.health.frozen,
         "goals_reached": int(world.events.counts["goal_reached"]),
-        "goals_left": int(sum(len(world.goals.path(e)) for e, _ in world.query(Creature))),
+        "goals_left": _goals_left(world),
         "sucker_attaches": int(world.events.counts["sucker_attached"]),
     }
+
+
+def _goals_left(world: World) -> int:
+    """Goals still in every creature's path (0 with the locomotion plugin off)."""
+    book = world.resources.get("goals")
+    if book is None:
+        return 0
+    return int(sum(len(book.path(e)) for e, _ in world.query(Creature)))
