@@ -405,6 +405,9 @@ def _import_systems(paths: list[str], folder: pathlib.Path | None) -> list[type[
         except (ImportError, AttributeError) as exc:
             problems.append(f"systems[{i}]: cannot import {path!r}: {exc}")
             continue
+        except Exception as exc:  # the user's module raised while importing: say which and why
+            problems.append(f"systems[{i}]: cannot import {path!r}: {type(exc).__name__}: {exc}")
+            continue
         if not (isinstance(factory, type) and issubclass(factory, System)):
             problems.append(f"systems[{i}]: {path!r} is not a System subclass")
             continue
