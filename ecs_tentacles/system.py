@@ -25,6 +25,7 @@ a priority attribute.
 
 from __future__ import annotations
 
+import traceback
 from typing import TYPE_CHECKING, ClassVar
 
 if TYPE_CHECKING:
@@ -78,3 +79,13 @@ class SystemFailure(RuntimeError):
             f"system {label!r}{owner} failed at frame {frame}: {type(error).__name__}"
             + (f": {first}" if first else "")
         )
+
+    def user_traceback(self) -> str:
+        """The original exception's traceback, from the system's own code down.
+
+        The frame that caught it (`World.step`, which called the system) is left out,
+        so the first frame shown is the system's `process` (or `substep`).
+        """
+        error = self.error
+        tb = error.__traceback__.tb_next if error.__traceback__ is not None else None
+        return "".join(traceback.format_exception(type(error), error, tb))

@@ -15,7 +15,7 @@ import importlib
 import os
 import pathlib
 import uuid
-from collections.abc import Collection, Iterator, Mapping
+from collections.abc import Callable, Collection, Iterator, Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, TypeVar
 
@@ -246,23 +246,33 @@ class World:
             system.setup(self)
 
     # -- running -----------------------------------------------------------------------
-    def step(self, frames: int = 1) -> None:
+    def step(
+        self, frames: int = 1, *, on_failure: Callable[[SystemFailure], None] | None = None
+    ) -> None:
         """Run `frames` fixed-duration frames: every system in schedule order.
 
         An exception inside a system is raised as `SystemFailure` (naming the system,
-        its plugin and the frame; the original is its `__cause__`). The frame counter
-        stays at the failed frame.
+        its plugin and the frame; the original is its `__cause__`); the frame counter
+        stays at the failed frame. With `on_failure`, it is called with the failure
+        instead and the frame goes on with the next system (the sandbox disables the
+        failed one there and keeps running).
         """
         self.activate()
         dt = self.settings.dt
         for _ in range(frames):
-            for system in self.schedule:
+            for system in self.schedule:  # a disable() now does not change this frame's list
                 try:
                     system.process(self, dt)
+                except SystemFailure as named:  # a substep hook, named by the physics system
+                    if on_failure is None:
+                        raise
+                    on_failure(named)
                 except Exception as error:  # name the system and the frame; cause kept
-                    raise SystemFailure(
-                        system, self.schedule.label(system), self.frame, error
-                    ) from error
+                    failure = SystemFailure(system, self.schedule.label(system), self.frame, error)
+                    if on_failure is None:
+                        raise failure from error
+                    failure.__cause__ = error
+                    on_failure(failure)
             self.frame += 1
 
     def snapshot(self) -> Snapshot:

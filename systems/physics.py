@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from ecs_tentacles.system import System
+from ecs_tentacles.system import System, SystemFailure
 
 if TYPE_CHECKING:
     from ecs_tentacles.world import World
@@ -52,6 +52,10 @@ class Physics(System):
 
         def before_substep(index: int) -> None:
             for system in hooks:
-                system.substep(world, index, substep_dt)
+                try:
+                    system.substep(world, index, substep_dt)
+                except Exception as error:  # name the hook's system, not physics
+                    label = world.schedule.label(system)
+                    raise SystemFailure(system, label, world.frame, error) from error
 
         backend.step(world.settings.substeps, before_substep)

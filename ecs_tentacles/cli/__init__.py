@@ -4,7 +4,9 @@ systems, migrate.
 It speaks one way: every error is one line `error: <where>: <what>` on stderr (one per
 problem for a scene), exit 2 for bad input (arguments, scenes, takes, no display),
 1 for a failure at run time (a write that lost a race, a crash), 130 for Ctrl-C and
-143 for SIGTERM; never a traceback unless `--debug` is given. Commands that report
+143 for SIGTERM; never a traceback unless `--debug` is given, except the user's own
+code's when one of their systems raises (exit 1: the line names the system, its
+plugin and the frame; nothing is written). Commands that report
 print a sentence by default and one JSON object with `--json`. SIGTERM and SIGHUP
 unwind like Ctrl-C, so no partial output is left behind.
 """
@@ -35,6 +37,7 @@ from ecs_tentacles.cli import (
 from ecs_tentacles.cli.arguments import NoDisplay, OneLineParser
 from ecs_tentacles.scene import load
 from ecs_tentacles.scene.errors import SceneError
+from ecs_tentacles.system import SystemFailure
 from ecs_tentacles.take import TakeError
 
 COMMANDS = {"validate": validate, "run": run, "play": play}
@@ -121,6 +124,12 @@ def _run(args: argparse.Namespace) -> int:
         return 2
     except OutputError as error:
         print(f"error: {error}", file=sys.stderr)
+        return 1
+    except SystemFailure as failure:  # a user system raised: show where in their code
+        if args.debug:
+            raise
+        print(f"error: {failure}", file=sys.stderr)
+        print(failure.user_traceback(), end="", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
         print("error: interrupted (Ctrl-C); partial outputs removed", file=sys.stderr)

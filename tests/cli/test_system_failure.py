@@ -1,0 +1,126 @@
+"""A user system that raises: headless runs exit 1 with one line and the user's traceback.
+
+The first line names the system, its plugin and the frame; then comes the traceback
+of the user's code only (starting in their `process` or `substep`), and nothing is
+written.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from ecs_tentacles.cli import main
+
+FAILING = '''
+from ecs_tentacles.system import System
+
+
+def half(x):
+    return x / 0
+
+
+class Wave(System):
+    """Reads the frame; fails at frame 3."""
+
+    name = "wave"
+    stage = "act"
+
+    def process(self, world, dt):
+        if world.frame == 3:
+            half(world.frame)
+
+
+class Shake(System):
+    """A substep hook that fails at frame 2."""
+
+    name = "shake"
+    stage = "physics"
+    before = ("physics",)
+
+    def substep(self, world, index, dt):
+        if world.frame == 2 and index == 5:
+            raise KeyError("tentacle 9")
+'''
+FIRST = (
+    "error: system 'wave' (plugin 'mine') failed at frame 3: ZeroDivisionError: division by zero"
+)
+
+
+@pytest.fixture
+def failing(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    (tmp_path / "failing.py").write_text(FAILING)
+    scene = {
+        "version": 1,
+        "plugins": {"mine": {"from": "failing.py:Wave"}},
+        "creatures": [{"name": "octo", "tentacles": {"count": 3, "links": 2}}],
+    }
+    path = tmp_path / "scene.json"
+    path.write_text(json.dumps(scene))
+    monkeypatch.chdir(tmp_path)
+    return path
+
+
+def _user_traceback(err: str) -> list[str]:
+    """The traceback's File lines and the last line, without Python's ~~^~~ markers."""
+    return [
+        line.strip()
+        for line in err.splitlines()[1:]
+        if line.lstrip().startswith(("File", "Traceback")) or not line.startswith(" ")
+    ]
+
+
+def test_run_exits_1_naming_the_system_then_the_user_traceback(
+    failing: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert main(["run", str(failing), "--frames", "10", "--allow-systems", "--quiet"]) == 1
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    assert captured.err.splitlines()[0] == FIRST
+    source = failing.parent / "failing.py"
+    assert _user_traceback(captured.err) == [
+        "Traceback (most recent call last):",
+        f'File "{source}", line 17, in process',
+        f'File "{source}", line 6, in half',
+        "ZeroDivisionError: division by zero",
+    ]
+    assert "world.py" not in captured.err  # the engine's frames are not the user's concern
+
+
+def test_bake_exits_1_and_writes_nothing(failing: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = failing.parent / "take.npz"
+    args = ["bake", str(failing), "--seconds", "1", "--out", str(out), "--allow-systems"]
+    assert main([*args, "--quiet"]) == 1
+    err = capsys.readouterr().err.splitlines()
+    assert err[0].startswith("bake: ") and err[1] == FIRST
+    assert err[-1] == "ZeroDivisionError: division by zero"
+    assert sorted(p.name for p in failing.parent.iterdir()) == ["failing.py", "scene.json"]
+
+
+def test_a_failing_substep_hook_is_named_not_physics(
+    failing: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    scene = json.loads(failing.read_text())
+    scene["plugins"] = {"shaker": {"from": "failing.py:Shake"}}
+    failing.write_text(json.dumps(scene))
+    assert main(["run", str(failing), "--frames", "10", "--allow-systems", "--quiet"]) == 1
+    err = capsys.readouterr().err
+    assert err.splitlines()[0] == (
+        "error: system 'shake' (plugin 'shaker') failed at frame 2: KeyError: 'tentacle 9'"
+    )
+    assert _user_traceback(err) == [
+        "Traceback (most recent call last):",
+        f'File "{failing.parent / "failing.py"}", line 29, in substep',
+        "KeyError: 'tentacle 9'",
+    ]
+
+
+def test_debug_shows_the_whole_chain(failing: Path) -> None:
+    from ecs_tentacles.system import SystemFailure
+
+    with pytest.raises(SystemFailure) as caught:
+        main(["--debug", "run", str(failing), "--frames", "10", "--allow-systems", "--quiet"])
+    assert isinstance(caught.value.__cause__, ZeroDivisionError)
+    assert (caught.value.label, caught.value.frame) == ("wave", 3)
