@@ -89,6 +89,7 @@ class World:
         self.events = Events()
         self._physics: PhysicsBackend | None = None
         self.scene: dict[str, Any] | None = None  # the validated scene, defaults filled in
+        self.scene_dir: pathlib.Path | None = None  # its folder: plugin files are found there
         self.frame = 0
 
     # -- construction ------------------------------------------------------------------
@@ -159,7 +160,7 @@ class World:
         world = cls(
             settings, seed=data["seed"] if seed is None else seed, name=data.get("name", "scene")
         )
-        world.scene = data
+        world.scene, world.scene_dir = data, folder
         for plugin in chosen:
             world._adopt(plugin)
         for index, creature in enumerate(data["creatures"]):

@@ -9,6 +9,11 @@ right-click a goal to remove it. Keys: space pause, . single step, r reset,
 h HUD, f follow, a frame all, tab next tentacle, F12 screenshot, v video,
 F5 save the state, F9 go back to it.
 
+User code: a system that raises is disabled and shown in red at the top right (with
+a button to run it again) while the sandbox keeps running; a plugin file that changes
+is re-imported and swapped in, the world staying as it is (`render.scripts`,
+`ecs_tentacles.reload`).
+
 Call `ecs_tentacles.render.configure(headless=...)` before importing this module.
 """
 
@@ -32,6 +37,7 @@ from ecs_tentacles.render.furpanel import FurPanel
 from ecs_tentacles.render.hud import Hud
 from ecs_tentacles.render.output import VideoWriter, save_png
 from ecs_tentacles.render.renderer import Renderer
+from ecs_tentacles.render.scripts import Scripts
 from ecs_tentacles.world import World
 
 if TYPE_CHECKING:
@@ -62,8 +68,11 @@ class Sandbox:
             width, height, caption="ecs_tentacles", visible=not headless, vsync=False
         )
         self.world = World.from_scene(scene, seed=seed, allow_systems=allow_systems)
+        self.scene_dir = self.world.scene_dir  # plugin files of an edited (dict) scene
         self.hud = Hud(self.window, self.world, visible=hud)
         self.hud.label_at = self.creature_labels
+        self.scripts = Scripts(self.window)
+        self.hud.windows.append(self.scripts.draw)
         self.paused = False
         self.fur: FurPanel | None = None
         self._attach_world()
@@ -86,6 +95,7 @@ class Sandbox:
         self.world.add_plugin(RenderPlugin(renderer=self.renderer))
         self.renderer.frame_all()
         self.hud.world = self.world
+        self.scripts.attach(self.world)
         first = self.renderer.creature_entities[0] if self.renderer.creature_entities else None
         self.select(first)
 
@@ -107,24 +117,31 @@ class Sandbox:
         self.world.close()
         self.saved_state = None  # a snapshot belongs to the world it came from
         self.scene = scene
-        self.world = World.from_scene(scene, seed=self.seed, allow_systems=self.allow_systems)
+        self.world = self._build(scene)
         self.renderer.set_world(self.world)
         self.world.add_plugin(RenderPlugin(renderer=self.renderer))
         self.hud.world = self.world
+        self.scripts.attach(self.world)
         if self.fur is not None:
             self.fur.editor.attach(self.world)
         self.select(self.world.creature(name) if name is not None else None)
         return self.world
 
+    def _build(self, scene: str | os.PathLike[str] | dict[str, Any]) -> World:
+        return World.from_scene(
+            scene, seed=self.seed, allow_systems=self.allow_systems, scene_dir=self.scene_dir
+        )
+
     # -- simulation --------------------------------------------------------------------
     def step(self, frames: int = 1) -> None:
-        """Advance the world by whole physics frames."""
+        """Advance the world by whole physics frames; a system that raises is disabled."""
         start = time.perf_counter()
-        self.world.step(frames)
+        self.world.step(frames, on_failure=self.scripts.failed)
         self.stats["physics_ms"] = 1000 * (time.perf_counter() - start) / frames
 
     def tick(self, dt: float) -> None:
-        """Clock callback: run the physics frames that are due."""
+        """Clock callback: reload changed plugin files, run the physics frames that are due."""
+        self.scripts.poll()
         if self.paused:
             return
         frame = self.world.settings.dt
@@ -150,7 +167,7 @@ class Sandbox:
         """Rebuild the scene from its file (or the fur tool's edited scene)."""
         self.saved_state = None
         self.world.close()
-        self.world = World.from_scene(self.scene, seed=self.seed, allow_systems=self.allow_systems)
+        self.world = self._build(self.scene)
         self._attach_world()
         if self.fur is not None:
             self.fur.editor.attach(self.world)
