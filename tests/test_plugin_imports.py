@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 
 from ecs_tentacles.cli import main
-from ecs_tentacles.export.take import Take
+from ecs_tentacles.take import Take
 
 # A system that says when it runs (on stderr: `--json` keeps stdout for the summary)
 WAVE = '''
