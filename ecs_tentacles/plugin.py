@@ -202,9 +202,7 @@ def load(key: str, target: str, scene_dir: pathlib.Path | None) -> type[Plugin] 
     except PluginError:
         raise
     except Exception as exc:  # the user's module failed to import: say which and why
-        raise PluginError(
-            f"{where}: cannot import {target!r}: {type(exc).__name__}: {exc}"
-        ) from exc
+        raise PluginError(f"{where}: cannot import {target!r}: {_one_line(exc)}") from exc
     return pick(module, attr, where, target)
 
 
@@ -304,7 +302,11 @@ def resolve(
         settings = (
             {k: v for k, v in config.items() if k != FROM} if isinstance(config, Mapping) else {}
         )
-        plugin = made if isinstance(made, Plugin) else made(settings)
+        try:
+            plugin = made if isinstance(made, Plugin) else made(settings)
+        except Exception as exc:  # the user's plugin class failed to construct
+            problems.append(f"plugins.{key}: cannot make {found.target!r}: {_one_line(exc)}")
+            continue
         plugin.config = settings
         plugin.key = key
         plugin.source = None if found.trusted else found.target
@@ -317,3 +319,9 @@ def resolve(
     if problems:
         raise PluginError("\n".join(problems))
     return plugins
+
+
+def _one_line(error: BaseException) -> str:
+    """`Type: message` on one line (a user's exception, for a PluginError)."""
+    text = " ".join(str(error).split())
+    return type(error).__name__ + (f": {text}" if text else "")

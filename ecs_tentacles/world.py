@@ -172,10 +172,20 @@ class World:
             plugin.build_scene(world, data)
         world.build_physics(threads)
         systems = core_systems()
-        for plugin in chosen:
-            if locomotion or plugin.key not in LOCOMOTION_PLUGINS:
-                systems += _owned(plugin)
-        world.add_systems(*systems)
+        try:
+            for plugin in chosen:
+                if locomotion or plugin.key not in LOCOMOTION_PLUGINS:
+                    try:
+                        systems += _owned(plugin)
+                    except Exception as exc:  # one line naming the plugin, as for an import
+                        text = f"{type(exc).__name__}: {' '.join(str(exc).split())}"
+                        raise SceneError(
+                            [f"plugins.{plugin.key}: systems() raised {text}"]
+                        ) from exc
+            world.add_systems(*systems)
+        except BaseException:  # a user's systems() or setup() raised
+            world.close()  # its physics threads and esper context
+            raise
         return world
 
     def build_physics(self, threads: int | None = None) -> PhysicsBackend:
@@ -241,10 +251,17 @@ class World:
         return system
 
     def add_systems(self, *systems: System) -> None:
-        """Schedule several systems at once (they may name each other), then set them up."""
+        """Schedule several systems at once (they may name each other), then set them up.
+
+        A `setup` that raises is a `SystemFailure` (at the current frame).
+        """
         self.schedule.add(*systems)
         for system in systems:
-            system.setup(self)
+            try:
+                system.setup(self)
+            except Exception as error:  # name the system, as a failing process() is
+                label = self.schedule.label(system)
+                raise SystemFailure(system, label, self.frame, error) from error
 
     # -- running -----------------------------------------------------------------------
     def step(

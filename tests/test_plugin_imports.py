@@ -158,3 +158,28 @@ def test_a_systems_module_that_raises_at_import_is_one_line(
         "error: systems[0]: cannot import 'broken_mod:Wave': RuntimeError: no config file\n"
     )
     assert "broken_mod" not in sys.modules
+
+
+@pytest.mark.parametrize(
+    ("source", "problem"),
+    [
+        (
+            "class P(Plugin):\n    def __init__(self, config=None):\n"
+            "        raise ValueError('gain')\n",
+            "plugins.x: cannot make 'made.py': ValueError: gain",
+        ),
+        (
+            "class P(Plugin):\n    def systems(self):\n        return [undefined]\n",
+            "plugins.x: systems() raised NameError: name 'undefined' is not defined",
+        ),
+    ],
+    ids=["constructor", "systems"],
+)
+def test_a_plugin_that_cannot_be_made_is_one_line(
+    elsewhere: Path, capsys: pytest.CaptureFixture[str], source: str, problem: str
+) -> None:
+    (elsewhere / "made.py").write_text("from ecs_tentacles.plugin import Plugin\n\n" + source)
+    scene = _scene(elsewhere, "scene.json", plugins={"x": {"from": "made.py"}})
+    assert main(["run", str(scene), "--frames", "1", "--allow-systems", "--quiet"]) == 2
+    [line] = capsys.readouterr().err.splitlines()
+    assert line.startswith("error: ") and line.endswith(problem)

@@ -33,6 +33,15 @@ class Wave(System):
             half(world.frame)
 
 
+class Ready(System):
+    """Fails to set up."""
+
+    name = "ready"
+
+    def setup(self, world):
+        world.waves
+
+
 class Shake(System):
     """A substep hook that fails at frame 2."""
 
@@ -44,6 +53,13 @@ class Shake(System):
         if world.frame == 2 and index == 5:
             raise KeyError("tentacle 9")
 '''
+
+
+def _line(code: str) -> int:
+    """The line number of `code` in FAILING."""
+    return next(i for i, line in enumerate(FAILING.splitlines(), 1) if code in line)
+
+
 FIRST = (
     "error: system 'wave' (plugin 'mine') failed at frame 3: ZeroDivisionError: division by zero"
 )
@@ -82,8 +98,8 @@ def test_run_exits_1_naming_the_system_then_the_user_traceback(
     source = failing.parent / "failing.py"
     assert _user_traceback(captured.err) == [
         "Traceback (most recent call last):",
-        f'File "{source}", line 17, in process',
-        f'File "{source}", line 6, in half',
+        f'File "{source}", line {_line("half(world.frame)")}, in process',
+        f'File "{source}", line {_line("return x / 0")}, in half',
         "ZeroDivisionError: division by zero",
     ]
     assert "world.py" not in captured.err  # the engine's frames are not the user's concern
@@ -112,7 +128,7 @@ def test_a_failing_substep_hook_is_named_not_physics(
     )
     assert _user_traceback(err) == [
         "Traceback (most recent call last):",
-        f'File "{failing.parent / "failing.py"}", line 29, in substep',
+        f'File "{failing.parent / "failing.py"}", line {_line("raise KeyError")}, in substep',
         "KeyError: 'tentacle 9'",
     ]
 
@@ -124,3 +140,21 @@ def test_debug_shows_the_whole_chain(failing: Path) -> None:
         main(["--debug", "run", str(failing), "--frames", "10", "--allow-systems", "--quiet"])
     assert isinstance(caught.value.__cause__, ZeroDivisionError)
     assert (caught.value.label, caught.value.frame) == ("wave", 3)
+
+
+def test_a_failing_setup_is_named_with_its_traceback(
+    failing: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    scene = json.loads(failing.read_text())
+    scene["plugins"] = {"mine": {"from": "failing.py:Ready"}}
+    failing.write_text(json.dumps(scene))
+    assert main(["run", str(failing), "--frames", "10", "--allow-systems", "--quiet"]) == 1
+    err = capsys.readouterr().err
+    assert err.splitlines()[0].startswith(
+        "error: system 'ready' (plugin 'mine') failed at frame 0: AttributeError: this world"
+        " has no 'waves'"
+    )
+    assert (
+        _user_traceback(err)[1]
+        == f'File "{failing.parent / "failing.py"}", line {_line("world.waves")}, in setup'
+    )
