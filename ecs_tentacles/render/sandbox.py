@@ -38,6 +38,8 @@ from ecs_tentacles.render.hud import Hud
 from ecs_tentacles.render.output import VideoWriter, save_png
 from ecs_tentacles.render.renderer import Renderer
 from ecs_tentacles.render.scripts import Scripts
+from ecs_tentacles.scene.errors import SceneError
+from ecs_tentacles.system import SystemFailure
 from ecs_tentacles.world import World
 
 if TYPE_CHECKING:
@@ -163,15 +165,25 @@ class Sandbox:
         self.accumulator = 0.0
         return True
 
-    def reset(self) -> None:
-        """Rebuild the scene from its file (or the fur tool's edited scene)."""
+    def reset(self) -> bool:
+        """Rebuild the scene from its file (or the fur tool's edited scene).
+
+        If the scene or a plugin's code cannot be built now, the world stays as it is
+        and the Scripts window says why (False).
+        """
+        try:
+            world = self._build(self.scene)
+        except (SceneError, SystemFailure) as error:
+            self.scripts.say(False, f"not reset: {' '.join(str(error).split())}")
+            return False
         self.saved_state = None
         self.world.close()
-        self.world = self._build(self.scene)
+        self.world = world
         self._attach_world()
         if self.fur is not None:
             self.fur.editor.attach(self.world)
             self.fur.sync_view()
+        return True
 
     # -- drawing -----------------------------------------------------------------------
     def render(self) -> np.ndarray | None:

@@ -94,11 +94,14 @@ class Scripts:
         return done
 
     def note(self, reload: Reload) -> None:
-        ok = reload.error is None
-        self.notes.append((ok, reload.message))
-        (log.info if ok else log.warning)("%s", reload.message)
+        self.say(reload.error is None, reload.message)
         fixed = set(reload.swapped) | set(reload.removed)
         self.failures = [f for f in self.failures if f.label not in fixed]
+
+    def say(self, ok: bool, line: str) -> None:
+        """Add a line to the window (green when `ok`, else red) and to the log."""
+        self.notes.append((ok, line))
+        (log.info if ok else log.warning)("%s", line)
 
     def enable(self, label: str) -> None:
         """Run a disabled system again (the "re-enable" button)."""

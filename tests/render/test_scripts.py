@@ -123,3 +123,24 @@ def test_a_fixed_file_is_reloaded_and_runs_again(
     x0, y0, x1, y1 = (round(v) for v in sandbox.hud.gui.rects["note 0"])
     box = pixels[y0:y1, x0:x1]
     assert ((box[..., 1] > box[..., 0] + 40) & (box[..., 1] > box[..., 2] + 20)).sum() > 30  # green
+
+
+def test_reset_with_broken_code_keeps_the_world_and_says_why(
+    scene: Path, make_sandbox: Callable[..., Any], tmp_path: Path
+) -> None:
+    sandbox = make_sandbox(scene, allow_systems=True)
+    sandbox.step(8)
+    world = sandbox.world
+    (tmp_path / "mywave.py").write_text("class Wave(:\n")
+    assert sandbox.reset() is False
+    assert sandbox.world is world and world.frame == 8  # still there, still running
+    sandbox.step(1)
+    ok, line = sandbox.scripts.notes[-1]
+    assert not ok and line.startswith(
+        f"not reset: {scene}: plugins.mywave: cannot import 'mywave.py': SyntaxError:"
+    )
+    (tmp_path / "mywave.py").write_text(FIXED)
+    assert sandbox.reset() is True
+    assert sandbox.world is not world and sandbox.world.frame == 0
+    assert sandbox.scripts.failures == [] and sandbox.scripts.reloader is not None
+    assert sandbox.scripts.reloader.world is sandbox.world
