@@ -8,7 +8,7 @@ import sys
 from typing import Any
 
 from ecs_tentacles.scene.errors import SceneError
-from ecs_tentacles.scene.load import load_scene, resolve_scene_path
+from ecs_tentacles.scene.load import load_scene_plugins, resolve_scene_path
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
@@ -31,7 +31,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.set_defaults(handler=handle)
 
 
-def summary(path: str, data: dict[str, Any]) -> dict[str, Any]:
+def summary(path: str, data: dict[str, Any], plugins: list[str]) -> dict[str, Any]:
     """What a valid scene holds, for the sentence and for --json."""
     creatures = data["creatures"]
     return {
@@ -39,7 +39,7 @@ def summary(path: str, data: dict[str, Any]) -> dict[str, Any]:
         "creatures": len(creatures),
         "tentacles": sum(c["tentacles"]["count"] for c in creatures),
         "systems": list(data.get("systems", [])),
-        "plugins": sorted(data.get("plugins", {})),
+        "plugins": plugins,  # the plugins it runs
     }
 
 
@@ -61,12 +61,12 @@ def handle(args: argparse.Namespace) -> int:
     for scene in args.scenes:
         try:
             path = resolve_scene_path(scene)
-            data = load_scene(path, allow_systems=args.allow_systems)
+            data, plugins = load_scene_plugins(path, allow_systems=args.allow_systems)
         except SceneError as error:
             failed = True
             for problem in error.problems:
                 print(f"error: {problem}", file=sys.stderr)
             continue
-        report = summary(str(path), data)
+        report = summary(str(path), data, [plugin.key for plugin in plugins])
         print(json.dumps(report) if args.json else sentence(report))
     return 2 if failed else 0
