@@ -40,7 +40,7 @@ class FollowLeader(System):
     stage = "decide"
     after = ("goals",)
     before = ("tentacle_selection",)
-    reads = ("transforms.pos",)
+    reads = ("transforms.pos", "creatures.has_goal")
     writes = ("goals", "creatures.goal", "creatures.has_goal")
 
     def __init__(self, gap: float, interval: float, goal_radius: float):
