@@ -19,6 +19,7 @@ from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from ecs_tentacles.systems.examples import Problem, farther_than_reach, number, replanning
 
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.scene.validate import plugin_config
@@ -77,43 +78,14 @@ class FleePlugin(Plugin):
         "type": "object",
         "additionalProperties": False,
         "properties": {
-            "distance": {
-                "type": "number",
-                "exclusiveMinimum": 0,
-                "maximum": 100,
-                "default": 1.5,
-                "description": "Metres: threats closer than this (in the ground plane) are fled.",
-            },
-            "run": {
-                "type": "number",
-                "minimum": 0.2,
-                "maximum": 100,
-                "default": 1.0,
-                "description": "Metres: how far ahead of the creature the flight goal lies.",
-            },
-            "interval": {
-                "type": "number",
-                "minimum": 0.05,
-                "maximum": 600,
-                "default": 1.0,
-                "description": "Seconds between re-plans (strokes finish in between).",
-            },
-            "goal_radius": {
-                "type": "number",
-                "exclusiveMinimum": 0,
-                "maximum": 5,
-                "default": 0.3,
-                "description": "Metres: a flight goal is reached within this distance.",
-            },
+            "distance": number(0.1, 100, 1.5, "Metres: threats closer than this are fled."),
+            "run": number(0.2, 100, 1.0, "Metres ahead of the creature its flight goal lies."),
+            **replanning(1.0),
         },
     }
 
-    def problems(self, scene: Mapping[str, Any]) -> list[tuple[tuple[str | int, ...], str]]:
-        config = plugin_config(self, scene.get("plugins", {}).get(self.key))
-        if config["run"] <= config["goal_radius"]:  # reached where the creature stands
-            message = f"must be > goal_radius ({config['goal_radius']:g}), got {config['run']:g}"
-            return [(("plugins", self.key, "run"), message)]
-        return []
+    def problems(self, scene: Mapping[str, Any]) -> list[Problem]:
+        return farther_than_reach(self, scene, "run")
 
     def systems(self) -> list[System]:
         return [Flee(**plugin_config(self, self.config))]

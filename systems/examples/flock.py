@@ -22,6 +22,7 @@ from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from ecs_tentacles.systems.examples import Problem, farther_than_reach, number, replanning
 
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.scene.validate import plugin_config
@@ -93,16 +94,6 @@ class Flock(System):
             world.goals.set(int(creatures.entity[row]), goal, self.config["goal_radius"])
 
 
-def _number(low: float, high: float, default: float, description: str) -> dict[str, Any]:
-    return {
-        "type": "number",
-        "minimum": low,
-        "maximum": high,
-        "default": default,
-        "description": description,
-    }
-
-
 class FlockPlugin(Plugin):
     name = "flock"
     description = "the crowd moves together: separation, alignment, cohesion through goals"
@@ -111,12 +102,12 @@ class FlockPlugin(Plugin):
         "type": "object",
         "additionalProperties": False,
         "properties": {
-            "radius": _number(0.5, 100, 3.0, "Metres: mantles closer than this are neighbours."),
-            "separation": _number(0.3, 50, 1.4, "Metres: neighbours closer than this push away."),
-            "separate": _number(0, 10, 1.5, "Weight of separation."),
-            "align": _number(0, 10, 0.5, "Weight of alignment (the neighbours' mean velocity)."),
-            "cohere": _number(0, 10, 1.0, "Weight of cohesion (toward the neighbours' centre)."),
-            "seek": _number(0, 10, 1.0, "Weight of seeking `toward`."),
+            "radius": number(0.5, 100, 3.0, "Metres: mantles closer than this are neighbours."),
+            "separation": number(0.3, 50, 1.4, "Metres: neighbours closer than this push away."),
+            "separate": number(0, 10, 1.5, "Weight of separation."),
+            "align": number(0, 10, 0.5, "Weight of alignment (the neighbours' mean velocity)."),
+            "cohere": number(0, 10, 1.0, "Weight of cohesion (toward the neighbours' centre)."),
+            "seek": number(0, 10, 1.0, "Weight of seeking `toward`."),
             "toward": {
                 "type": "array",
                 "minItems": 2,
@@ -124,18 +115,13 @@ class FlockPlugin(Plugin):
                 "items": {"type": "number", "minimum": -1e4, "maximum": 1e4},
                 "description": "Optional [x, y] in metres the flock travels to.",
             },
-            "step": _number(0.4, 20, 0.8, "Metres ahead of a creature its goal is set."),
-            "interval": _number(0.05, 600, 1.0, "Seconds between re-plans."),
-            "goal_radius": _number(0.05, 5, 0.3, "Metres: a flock goal is reached within this."),
+            "step": number(0.4, 20, 0.8, "Metres ahead of a creature its goal is set."),
+            **replanning(1.0),
         },
     }
 
-    def problems(self, scene: Mapping[str, Any]) -> list[tuple[tuple[str | int, ...], str]]:
-        config = plugin_config(self, scene.get("plugins", {}).get(self.key))
-        if config["step"] <= config["goal_radius"]:  # reached where the creature stands
-            message = f"must be > goal_radius ({config['goal_radius']:g}), got {config['step']:g}"
-            return [(("plugins", self.key, "step"), message)]
-        return []
+    def problems(self, scene: Mapping[str, Any]) -> list[Problem]:
+        return farther_than_reach(self, scene, "step")
 
     def systems(self) -> list[System]:
         return [Flock(plugin_config(self, self.config))]

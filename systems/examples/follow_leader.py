@@ -21,6 +21,7 @@ from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from ecs_tentacles.systems.examples import Problem, number, replanning
 
 from ecs_tentacles.components import Creature
 from ecs_tentacles.plugin import Plugin
@@ -92,34 +93,17 @@ class FollowLeaderPlugin(Plugin):
         "type": "object",
         "additionalProperties": False,
         "properties": {
-            "gap": {
-                "type": "number",
-                "minimum": 0.3,
-                "maximum": 50,
-                "default": 0.8,
-                "description": "Metres kept between a follower's and its leader's mantles.",
-            },
-            "interval": {
-                "type": "number",
-                "minimum": 0.05,
-                "maximum": 600,
-                "default": 1.0,
-                "description": "Seconds between re-plans (strokes finish in between).",
-            },
-            "goal_radius": {
-                "type": "number",
-                "exclusiveMinimum": 0,
-                "maximum": 5,
-                "default": 0.3,
-                "description": "Metres: a follower is where it should be within this distance.",
-            },
+            "gap": number(
+                0.3, 50, 0.8, "Metres kept between a follower's and its leader's mantles."
+            ),
+            **replanning(1.0),
         },
     }
 
-    def problems(self, scene: Mapping[str, Any]) -> list[tuple[tuple[str | int, ...], str]]:
+    def problems(self, scene: Mapping[str, Any]) -> list[Problem]:
         creatures = scene.get("creatures", [])
         names = {creature["name"] for creature in creatures}
-        problems: list[tuple[tuple[str | int, ...], str]] = []
+        problems: list[Problem] = []
         for i, creature in enumerate(creatures):
             leader = creature.get(KEY)
             if leader is None:

@@ -18,6 +18,7 @@ from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from ecs_tentacles.systems.examples import Problem, farther_than_reach, number, replanning
 
 from ecs_tentacles.build import creature_rng
 from ecs_tentacles.plugin import Plugin
@@ -79,41 +80,13 @@ class WanderPlugin(Plugin):
         "type": "object",
         "additionalProperties": False,
         "properties": {
-            "radius": {
-                "type": "number",
-                "minimum": 0.2,
-                "maximum": 50,
-                "default": 1.0,
-                "description": "Metres: new goals lie between radius / 2 and radius away.",
-            },
-            "interval": {
-                "type": "number",
-                "minimum": 0.05,
-                "maximum": 600,
-                "default": 0.5,
-                "description": "Seconds between looks for creatures without a goal.",
-            },
-            "goal_radius": {
-                "type": "number",
-                "exclusiveMinimum": 0,
-                "maximum": 5,
-                "default": 0.3,
-                "description": "Metres: a wander goal is reached within this distance.",
-            },
+            "radius": number(0.2, 50, 1.0, "Metres: new goals lie radius / 2 to radius away."),
+            **replanning(0.5),
         },
     }
 
-    def problems(self, scene: Mapping[str, Any]) -> list[tuple[tuple[str | int, ...], str]]:
-        config = plugin_config(self, scene.get("plugins", {}).get(self.key))
-        radius, reach = config["radius"], config["goal_radius"]
-        if radius / 2 <= reach:  # the goal would be reached where the creature stands
-            return [
-                (
-                    ("plugins", self.key, "radius"),
-                    f"must be > 2 x goal_radius ({2 * reach:g}), got {radius:g}",
-                )
-            ]
-        return []
+    def problems(self, scene: Mapping[str, Any]) -> list[Problem]:
+        return farther_than_reach(self, scene, "radius", times=2)
 
     def systems(self) -> list[System]:
         return [Wander(**plugin_config(self, self.config))]
