@@ -69,8 +69,9 @@ class Flock(System):
         near = gap < config["radius"]
         count = np.maximum(near.sum(axis=1), 1)[:, None]
         # 0 at `separation`, growing without bound as two mantles meet
-        push = np.where(gap < config["separation"], config["separation"] / gap - 1, 0.0)
-        separate = np.einsum("ij,ijk->ik", push / np.maximum(gap, 1e-9), offset)
+        apart = np.maximum(gap, 1e-9)  # two mantles at one point still push
+        push = np.where(gap < config["separation"], config["separation"] / apart - 1, 0.0)
+        separate = np.einsum("ij,ijk->ik", push / apart, offset)
         align = (near @ vel) / count / CRAWL_SPEED
         align /= np.maximum(np.linalg.norm(align, axis=1, keepdims=True), 1)  # at most 1
         cohere = np.where(near.any(axis=1)[:, None], (near @ pos) / count - pos, 0.0)
