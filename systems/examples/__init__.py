@@ -1,1 +1,52 @@
-"""Example plugins (not on by default): wander, flee, follow_leader, flock."""
+"""Example plugins (not on by default): wander, flee, follow_leader, flock.
+
+Each is one file: a `Plugin` and the stage-`decide` `System` it brings, which writes
+goals (`world.goals`) every `interval` seconds rather than every frame, so strokes can
+finish. What their config schemas share is here: a number setting, the two re-planning
+settings, and the check that a goal set some distance away is not reached at once.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+from ecs_tentacles.plugin import Plugin
+from ecs_tentacles.scene.validate import plugin_config
+
+Problem = tuple[tuple[str | int, ...], str]
+
+
+def number(low: float, high: float, default: float, description: str) -> dict[str, Any]:
+    """The schema of a number setting in [low, high]."""
+    return {
+        "type": "number",
+        "minimum": low,
+        "maximum": high,
+        "default": default,
+        "description": description,
+    }
+
+
+def replanning(interval: float) -> dict[str, dict[str, Any]]:
+    """`interval` (seconds between re-plans, default `interval`) and `goal_radius`."""
+    return {
+        "interval": number(0.05, 600, interval, "Seconds between re-plans."),
+        "goal_radius": number(0.05, 5, 0.3, "Metres: a goal it sets is reached within this."),
+    }
+
+
+def farther_than_reach(
+    plugin: Plugin, scene: Mapping[str, Any], key: str, times: float = 1.0
+) -> list[Problem]:
+    """A problem unless the config's `key` is more than `times` x its `goal_radius`.
+
+    Else the goals it sets would be reached where the creature stands.
+    """
+    config = plugin_config(plugin, scene.get("plugins", {}).get(plugin.key))
+    reach = times * config["goal_radius"]
+    if config[key] > reach:
+        return []
+    factor = "" if times == 1 else f"{times:g} x "
+    message = f"must be > {factor}goal_radius ({reach:g}), got {config[key]:g}"
+    return [(("plugins", plugin.key, key), message)]
