@@ -92,6 +92,9 @@ def knobs() -> tuple[Knob, ...]:
 KNOBS = knobs()
 
 
+CLOSED = ("Actions", "Plugins")  # sections that start folded
+
+
 class Hud:
     """The sandbox's panel, bound to a world's locomotion parameters."""
 
@@ -146,7 +149,7 @@ class Hud:
 
     def refresh(self) -> None:
         """Read the selection's current values from the world."""
-        if self.creature is None:
+        if self.creature is None or "locomotion" not in self.world.resources:
             self.values = {}
             return
         values = self.world.locomotion.get(self.creature, self.tentacle or 0)
@@ -197,17 +200,20 @@ class Hud:
         gui.window_rect("panel")
         imgui.text(self.title)
         gui.item("title")
+        moving = "locomotion" in self.world.resources  # the locomotion plugin is on
         own: list[tuple[str, Callable[[Gui], None]]] = [
-            ("Locomotion", self._locomotion),
+            *([("Locomotion", self._locomotion)] if moving else []),
             ("Stats", self._stats),
             ("Physics", self._physics),
+            ("Plugins", self._plugins),
         ]
-        for name, build in [*own, *self.sections, ("Actions", self._actions)]:
+        last = [("Actions", self._actions)] if moving else []
+        for name, build in [*own, *self.sections, *last]:
             if name in self._fold:
                 imgui.set_next_item_open(False)
                 self._fold.discard(name)
             opened = imgui.collapsing_header(
-                name, imgui.TreeNodeFlags_.default_open if name != "Actions" else 0
+                name, imgui.TreeNodeFlags_.default_open if name not in CLOSED else 0
             )
             gui.item(name)
             if opened:
@@ -290,6 +296,19 @@ class Hud:
         ):
             imgui.text(text)
             gui.item(name)
+
+    def _plugins(self, gui: Gui) -> None:
+        """The plugins on, and every system in frame order with a box to switch it off."""
+        imgui.text_wrapped("on: " + ", ".join(p.key for p in self.world.plugins))
+        gui.item("plugins on")
+        schedule = self.world.schedule
+        off = set(schedule.disabled())
+        for row in schedule.rows():
+            name = row["system"].removesuffix(" (disabled)")
+            changed, running = imgui.checkbox(f"{row['stage']:<8} {name}", name not in off)
+            gui.item(f"system {name}")
+            if changed:
+                (schedule.enable if running else schedule.disable)(name)
 
     def _actions(self, gui: Gui) -> None:
         if self.creature is None:

@@ -90,7 +90,7 @@ class Renderer:
         """Draw `world` from now on (same GPU objects, new instance tables)."""
         self.world = world
         self.selected = None
-        self._goal_version = -1
+        self._goal_version: int | None = None  # goal lines not built yet
         self._build_static()
         self.previous = (world.transforms.pos.copy(), world.transforms.quat.copy())
         self.current = self.previous

@@ -173,3 +173,28 @@ def test_the_sliders_are_the_parameter_tables() -> None:
     assert (strength.label, strength.unit, strength.log) == ("strength (kp)", "%.1f N m/rad", True)
     angle = next(k for k in KNOBS if k.name == "target_angle")
     assert angle.unit == "%.0f deg" and angle.to_shown == pytest.approx(180 / np.pi, rel=1e-15)
+
+
+def test_plugins_section_switches_systems_off_and_on(make_sandbox: Callable[..., Any]) -> None:
+    sandbox = make_sandbox("octopus", width=960, height=720)
+    sandbox.render()
+    x0, y0, x1, y1 = sandbox.hud.gui.rects["Locomotion"]
+    click_gui(sandbox, (x0 + x1) / 2, (y0 + y1) / 2)  # fold it: room for the systems
+    x0, y0, x1, y1 = sandbox.hud.gui.rects["Plugins"]
+    click_gui(sandbox, (x0 + x1) / 2, (y0 + y1) / 2)
+    assert "system rig" in sandbox.hud.gui.rects
+    x0, y0, x1, y1 = sandbox.hud.gui.rects["system motor_targets"]
+    click_gui(sandbox, x0 + 6, (y0 + y1) / 2)  # the box
+    assert sandbox.world.schedule.disabled() == ["motor_targets"]
+    click_gui(sandbox, x0 + 6, (y0 + y1) / 2)
+    assert sandbox.world.schedule.disabled() == []
+
+
+def test_a_world_without_locomotion_has_no_locomotion_sections(
+    make_sandbox: Callable[..., Any],
+) -> None:
+    off = {"locomotion": False, "suckers": False}
+    sandbox = make_sandbox({"version": 1, "plugins": off, "creatures": [{}]})
+    sandbox.render()
+    assert "Locomotion" not in sandbox.hud.gui.rects and "Actions" not in sandbox.hud.gui.rects
+    assert "Plugins" in sandbox.hud.gui.rects
