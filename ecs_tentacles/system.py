@@ -73,6 +73,7 @@ class SystemFailure(RuntimeError):
         self.label = label  # the name it is scheduled under
         self.frame = frame
         self.error = error
+        self.traceback_text: str | None = None
         owner = f" (plugin {system.plugin!r})" if system.plugin else ""
         first = str(error).splitlines()[0] if str(error) else ""
         super().__init__(
@@ -80,12 +81,28 @@ class SystemFailure(RuntimeError):
             + (f": {first}" if first else "")
         )
 
+    def __reduce__(self) -> tuple[object, tuple[str, str, int, str]]:
+        """Pickled (a Ray worker's failure reaching the driver) as its message and traceback."""
+        return _unpickled_failure, (str(self), self.label, self.frame, self.user_traceback())
+
     def user_traceback(self) -> str:
         """The original exception's traceback, from the system's own code down.
 
         The frame that caught it (`World.step`, which called the system) is left out,
         so the first frame shown is the system's `process` (or `substep`).
         """
+        if getattr(self, "traceback_text", None) is not None:  # came through pickle
+            return str(self.traceback_text)
         error = self.error
         tb = error.__traceback__.tb_next if error.__traceback__ is not None else None
         return "".join(traceback.format_exception(type(error), error, tb))
+
+
+def _unpickled_failure(message: str, label: str, frame: int, text: str) -> SystemFailure:
+    """A SystemFailure rebuilt from its message and traceback text (no system object)."""
+    failure = SystemFailure.__new__(SystemFailure)
+    RuntimeError.__init__(failure, message)
+    failure.system, failure.label, failure.frame = None, label, frame  # type: ignore[assignment]
+    failure.error = RuntimeError(message)
+    failure.traceback_text = text
+    return failure

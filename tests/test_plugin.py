@@ -222,3 +222,20 @@ def test_bake_finds_a_plugin_beside_the_scene_from_another_folder(
     assert main(args) == 2 and not out.exists()  # not allowed
     assert main([*args, "--allow-systems"]) == 0
     assert Take.load(out).frames == 7
+
+
+def test_a_system_failure_survives_pickling(
+    tmp_path: Path, make_world: Callable[..., World]
+) -> None:
+    """A Ray worker's failure reaches the driver with its message and the user's traceback."""
+    import pickle
+
+    from ecs_tentacles.system import SystemFailure
+
+    world = make_world(glow_scene(tmp_path), allow_systems=True)
+    world.schedule["glow"].rate = "fast"  # type: ignore[attr-defined]
+    with pytest.raises(SystemFailure) as caught:
+        world.step(1)
+    back = pickle.loads(pickle.dumps(caught.value))
+    assert str(back) == str(caught.value) and (back.label, back.frame) == ("glow", 0)
+    assert "in process" in back.user_traceback() and "TypeError" in back.user_traceback()
