@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import json
 
+from ecs_tentacles.plugin import BUNDLED, Plugin
 from ecs_tentacles.scene.load import resolve_scene_path
 from ecs_tentacles.world import World
 
@@ -37,7 +38,7 @@ def handle(args: argparse.Namespace) -> int:
     with World.from_scene(path, allow_systems=args.allow_systems, threads=1) as world:
         schedule = world.schedule
         plugins = [
-            {"name": p.key, "source": p.source or "built in", "description": p.description}
+            {"name": p.key, "source": _origin(p), "description": p.description}
             for p in world.plugins
         ]
         conflicts = [
@@ -54,3 +55,10 @@ def handle(args: argparse.Namespace) -> int:
         for line in conflicts:
             print(f"warning: {line}")
     return 0
+
+
+def _origin(plugin: Plugin) -> str:
+    """Where a plugin came from: built in, a bundled example, or its file or module."""
+    if plugin.source is not None:
+        return plugin.source
+    return "bundled example" if plugin.key in BUNDLED else "built in"
