@@ -88,6 +88,16 @@ class ArrayStore:
     def __len__(self) -> int:
         return self.count
 
+    def state(self) -> tuple[int, dict[str, np.ndarray]]:
+        """A copy of the live rows (for snapshots)."""
+        return self.count, {f: a[: self.count].copy() for f, a in self._arrays.items()}
+
+    def set_state(self, state: tuple[int, dict[str, np.ndarray]]) -> None:
+        """Put back what `state` copied (the store must still have room for the rows)."""
+        self.count, arrays = state
+        for f, values in arrays.items():
+            self._arrays[f][: self.count] = values
+
 
 class TransformStore(ArrayStore):
     """World poses of bodies (mantles and links): position and unit quaternion (w, x, y, z)."""

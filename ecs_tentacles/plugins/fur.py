@@ -50,23 +50,14 @@ class FurPlugin(Plugin):
 
     def snapshot(self, world: World) -> Any:
         fur = world.fur
-        stores = {}
-        for name in STORES:
-            store = getattr(fur, name)
-            stores[name] = (
-                store.count,
-                {f: a[: store.count].copy() for f, a in store._arrays.items()},
-            )
+        stores = {name: getattr(fur, name).state() for name in STORES}
         return stores, fur.curves.copy(), fur.frames.copy()
 
     def restore(self, world: World, state: Any) -> None:
         stores, curves, frames = state
         fur = world.fur
-        for name, (count, arrays) in stores.items():
-            store = getattr(fur, name)
-            store.count = count
-            for f, values in arrays.items():
-                store._arrays[f][:count] = values
+        for name, saved in stores.items():
+            getattr(fur, name).set_state(saved)
         fur.curves[...] = curves
         fur.frames[...] = frames
 

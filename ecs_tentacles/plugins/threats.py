@@ -7,7 +7,6 @@ Resources: `world.threats` (`ecs_tentacles.threats.ThreatData`). Systems: threat
 
 from __future__ import annotations
 
-import copy
 from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
@@ -52,14 +51,10 @@ class ThreatsPlugin(Plugin):
         return [ThreatPaths()]
 
     def snapshot(self, world: World) -> Any:
-        store = world.threats.store
-        return store.count, {f: a[: store.count].copy() for f, a in store._arrays.items()}
+        return world.threats.store.state()
 
     def restore(self, world: World, state: Any) -> None:
-        store = world.threats.store
-        store.count, arrays = state[0], copy.deepcopy(state[1])
-        for f, values in arrays.items():
-            store._arrays[f][: store.count] = values
+        world.threats.store.set_state(state)
 
     def render_spheres(self, world: World) -> list[Marker]:
         positions = list(world.threats.positions(world).values())
