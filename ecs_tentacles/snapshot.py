@@ -59,7 +59,7 @@ def take(world: World) -> Snapshot:
         frame=world.frame,
         physics_time=physics.time,
         rng=dict(copy.deepcopy(world.rng.bit_generator.state)),
-        stores={name: store.state() for name, store in _stores(world).items()},
+        stores={name: store.copy_rows() for name, store in _stores(world).items()},
         groups=[
             {
                 "state": group.get_state(),
@@ -92,7 +92,7 @@ def restore(world: World, snapshot: Snapshot) -> None:
     world.frame = snapshot.frame
     world.rng.bit_generator.state = copy.deepcopy(snapshot.rng)
     for name, store in _stores(world).items():
-        store.set_state(snapshot.stores[name])
+        store.put_rows(snapshot.stores[name])
     physics = world.physics
     physics.time = snapshot.physics_time
     for group, saved in zip(physics.groups, snapshot.groups, strict=True):

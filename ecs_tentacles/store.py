@@ -88,12 +88,12 @@ class ArrayStore:
     def __len__(self) -> int:
         return self.count
 
-    def state(self) -> tuple[int, dict[str, np.ndarray]]:
+    def copy_rows(self) -> tuple[int, dict[str, np.ndarray]]:
         """A copy of the live rows (for snapshots)."""
         return self.count, {f: a[: self.count].copy() for f, a in self._arrays.items()}
 
-    def set_state(self, state: tuple[int, dict[str, np.ndarray]]) -> None:
-        """Put back what `state` copied (the store must still have room for the rows)."""
+    def put_rows(self, state: tuple[int, dict[str, np.ndarray]]) -> None:
+        """Put back what `copy_rows` copied (the store must still have room for the rows)."""
         self.count, arrays = state
         for f, values in arrays.items():
             self._arrays[f][: self.count] = values

@@ -50,14 +50,14 @@ class FurPlugin(Plugin):
 
     def snapshot(self, world: World) -> Any:
         fur = world.fur
-        stores = {name: getattr(fur, name).state() for name in STORES}
+        stores = {name: getattr(fur, name).copy_rows() for name in STORES}
         return stores, fur.curves.copy(), fur.frames.copy()
 
     def restore(self, world: World, state: Any) -> None:
         stores, curves, frames = state
         fur = world.fur
         for name, saved in stores.items():
-            getattr(fur, name).set_state(saved)
+            getattr(fur, name).put_rows(saved)
         fur.curves[...] = curves
         fur.frames[...] = frames
 

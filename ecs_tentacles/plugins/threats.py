@@ -51,10 +51,10 @@ class ThreatsPlugin(Plugin):
         return [ThreatPaths()]
 
     def snapshot(self, world: World) -> Any:
-        return world.threats.store.state()
+        return world.threats.store.copy_rows()
 
     def restore(self, world: World, state: Any) -> None:
-        world.threats.store.set_state(state)
+        world.threats.store.put_rows(state)
 
     def render_spheres(self, world: World) -> list[Marker]:
         positions = list(world.threats.positions(world).values())
