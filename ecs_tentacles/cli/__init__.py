@@ -1,5 +1,5 @@
 """The `ecs-tentacles` command line: validate, run, play, bake, export, create, crowd, bench,
-systems, migrate.
+systems, migrate, schema.
 
 It speaks one way: every error is one line `error: <where>: <what>` on stderr (one per
 problem for a scene), exit 2 for bad input (arguments, scenes, takes, no display),
@@ -31,6 +31,7 @@ from ecs_tentacles.cli import (
     migrate,
     play,
     run,
+    schema,
     systems,
     validate,
 )
@@ -43,6 +44,7 @@ from ecs_tentacles.take import TakeError
 COMMANDS = {"validate": validate, "run": run, "play": play}
 COMMANDS |= {"bake": bake, "export": export, "create": create}
 COMMANDS |= {"crowd": crowd, "bench": bench, "systems": systems, "migrate": migrate}
+COMMANDS |= {"schema": schema}
 
 
 def build_parser() -> argparse.ArgumentParser:

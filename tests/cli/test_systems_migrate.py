@@ -78,3 +78,22 @@ def test_migrate_refuses_a_bad_scene_and_writes_nothing(
     assert main(["migrate", str(path)]) == 2
     assert "creatures[0].fur.groom.count" in capsys.readouterr().err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.json"]
+
+
+def test_schema_writes_the_assembled_schema_an_editor_can_use(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from jsonschema import Draft202012Validator
+
+    out = tmp_path / "scene.schema.json"
+    assert main(["schema", "--out", str(out)]) == 0
+    assert capsys.readouterr().out == f"schema: wrote {out}\n"
+    schema = json.loads(out.read_text())
+    Draft202012Validator.check_schema(schema)
+    creature = schema["$defs"]["creature"]["properties"]
+    assert {"fur", "goals", "locomotion", "threat"} <= set(creature)
+    hedgehog = json.loads(bundled_scene("hedgehog_octopus").read_text())
+    assert list(Draft202012Validator(schema).iter_errors(hedgehog)) == []
+    assert main(["schema", "follow_leader"]) == 0
+    with_example = json.loads(capsys.readouterr().out)
+    assert "follow" in with_example["$defs"]["creature"]["properties"]

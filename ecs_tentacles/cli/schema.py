@@ -1,0 +1,49 @@
+"""`ecs-tentacles schema [SCENE]`: the whole scene schema, for editors and tools.
+
+The bundled `assets/schema/scene.schema.json` is the core only; each plugin adds its
+keys (`assets/schema/plugins/*.json` for the built-in ones). This writes the schema a
+scene is checked against: the default plugins' keys, or those of the plugins SCENE
+turns on. Point an editor at the file with the scene's `"$schema"`.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import pathlib
+
+from ecs_tentacles.atomic import atomic_output
+from ecs_tentacles.scene.load import load_scene_plugins, resolve_scene_path
+from ecs_tentacles.scene.validate import load_schema, schema_for
+
+
+def add_parser(commands: argparse._SubParsersAction) -> None:
+    parser = commands.add_parser(
+        "schema",
+        help="write the scene JSON Schema with the plugins' keys (for editors)",
+        description="Print (or write with --out) the scene schema assembled from the core"
+        " schema and the plugins' fragments: the default plugins, or those SCENE turns on.",
+    )
+    parser.add_argument("scene", nargs="?", metavar="SCENE", help="scene whose plugins to add")
+    parser.add_argument("--out", metavar="FILE", help="write it here (atomically) instead")
+    parser.add_argument(
+        "--allow-systems", action="store_true", help="import the plugins SCENE names from files"
+    )
+    parser.set_defaults(handler=handle)
+
+
+def handle(args: argparse.Namespace) -> int:
+    if args.scene is None:
+        schema = load_schema()
+    else:
+        path = resolve_scene_path(args.scene)
+        _, plugins = load_scene_plugins(path, allow_systems=args.allow_systems)
+        schema = schema_for(plugins)
+    text = json.dumps(schema, indent=2) + "\n"
+    if args.out is None:
+        print(text, end="")
+        return 0
+    with atomic_output(pathlib.Path(args.out)) as temporary:
+        temporary.write_text(text, encoding="utf-8")
+    print(f"schema: wrote {args.out}")
+    return 0
