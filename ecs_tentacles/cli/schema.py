@@ -1,9 +1,11 @@
 """`ecs-tentacles schema [SCENE]`: the whole scene schema, for editors and tools.
 
-The bundled `assets/schema/scene.schema.json` is the core only; each plugin adds its
-keys (`assets/schema/plugins/*.json` for the built-in ones). This writes the schema a
-scene is checked against: the default plugins' keys, or those of the plugins SCENE
-turns on. Point an editor at the file with the scene's `"$schema"`.
+`assets/schema/core.schema.json` is the core only; each plugin adds its keys
+(`assets/schema/plugins/*.json` for the built-in ones). This writes the schema a scene
+is checked against: the default plugins' keys, or those of the plugins SCENE turns on.
+Point an editor at the file with the scene's `"$schema"`. The bundled
+`assets/schema/scene.schema.json` is this command's output for the default plugins
+(a test keeps it so), which the bundled scenes name.
 """
 
 from __future__ import annotations

@@ -4,7 +4,7 @@ Every problem is one line ``"<json path>: <message>"``; paths look like
 ``creatures[1].tentacles.end_scale`` and the root itself is called ``scene``.
 
 The schema a scene is checked against is assembled: the core schema
-(`assets/schema/scene.schema.json`: physics, creatures' bodies) plus the fragment of
+(`assets/schema/core.schema.json`: physics, creatures' bodies) plus the fragment of
 each plugin the scene turns on (creature keys, scene keys, `$defs`), and each plugin's
 `plugins.<name>` config against the plugin's own `config_schema`. `load_schema()` is the
 schema of a scene that says nothing about plugins (the default plugins on).
@@ -58,7 +58,7 @@ _StrictValidator = validators.extend(
 @functools.cache
 def core_schema() -> dict[str, Any]:
     """The core scene schema bundled with the package, without any plugin's keys."""
-    resource = importlib.resources.files("ecs_tentacles.assets") / "schema" / "scene.schema.json"
+    resource = importlib.resources.files("ecs_tentacles.assets") / "schema" / "core.schema.json"
     schema: dict[str, Any] = json.loads(resource.read_text(encoding="utf-8"))
     return schema
 
@@ -89,6 +89,7 @@ Part = tuple[str, Mapping[str, Any], Mapping[str, Any], Mapping[str, Any]]
 def _assemble(parts: Sequence[Part]) -> dict[str, Any]:
     """Core schema + (plugin key, $defs, creature keys, scene keys) of each plugin."""
     schema = copy.deepcopy(core_schema())
+    schema["$id"] = schema["$id"].replace("core.schema.json", "scene.schema.json")
     owner: dict[tuple[str, str], str] = {}
     places = {
         "$defs": schema["$defs"],

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import copy
+import json
 from collections.abc import Iterator
 from typing import Any
 
@@ -161,3 +162,15 @@ def test_with_defaults_result_is_valid() -> None:
     full = with_defaults({"version": 1, "creatures": [{}, {"position": [1, 0]}]})
     assert validate_scene(full) == []
     assert with_defaults(full) == full
+
+
+def test_the_bundled_scene_schema_is_the_assembled_default_one() -> None:
+    """`scene.schema.json` (what the bundled scenes' "$schema" names, for editors) is
+    `ecs-tentacles schema`'s output: the core plus the default plugins' fragments."""
+    import importlib.resources
+
+    folder = importlib.resources.files("ecs_tentacles.assets") / "schema"
+    written = json.loads((folder / "scene.schema.json").read_text(encoding="utf-8"))
+    assert written == load_schema(), (
+        "regenerate: ecs-tentacles schema --out assets/schema/scene.schema.json"
+    )
