@@ -269,6 +269,15 @@ def scene_first(folder: pathlib.Path | None) -> Iterator[None]:
             sys.path.remove(entry)
 
 
+def instantiate(
+    made: type[Plugin] | Plugin, key: str, config: Mapping[str, Any], source: str | None
+) -> Plugin:
+    """The plugin `load` found, made with `config` and known as `key` (from `source`)."""
+    plugin = made if isinstance(made, Plugin) else made(dict(config))
+    plugin.config, plugin.key, plugin.source = dict(config), key, source
+    return plugin
+
+
 def resolve(
     choices: Mapping[str, Any] | None,
     scene_dir: pathlib.Path | None = None,
@@ -303,14 +312,11 @@ def resolve(
             {k: v for k, v in config.items() if k != FROM} if isinstance(config, Mapping) else {}
         )
         try:
-            plugin = made if isinstance(made, Plugin) else made(settings)
+            plugins.append(
+                instantiate(made, key, settings, None if found.trusted else found.target)
+            )
         except Exception as exc:  # the user's plugin class failed to construct
             problems.append(f"plugins.{key}: cannot make {found.target!r}: {_one_line(exc)}")
-            continue
-        plugin.config = settings
-        plugin.key = key
-        plugin.source = None if found.trusted else found.target
-        plugins.append(plugin)
     on = {p.key for p in plugins}
     for plugin in plugins:
         for need in plugin.requires:

@@ -28,7 +28,7 @@ import time
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
-from ecs_tentacles.plugin import Plugin, import_file, pick
+from ecs_tentacles.plugin import Plugin, import_file, instantiate, pick
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
@@ -128,8 +128,7 @@ class Reloader:
             raise
         target = watched.path.name + (f":{watched.attr}" if watched.attr else "")
         made = pick(module, watched.attr, f"plugins.{watched.key}", target)
-        fresh = made if isinstance(made, Plugin) else made(dict(old.config))
-        fresh.config, fresh.key, fresh.source = dict(old.config), old.key, old.source
+        fresh = instantiate(made, old.key, old.config, old.source)
         systems = fresh.systems()
         running = self._labels(old.key)
         for system in systems:
