@@ -32,7 +32,7 @@ import importlib.metadata
 import importlib.util
 import pathlib
 import sys
-from collections.abc import Iterator, Mapping
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from types import ModuleType
 from typing import TYPE_CHECKING, Any, ClassVar
@@ -40,17 +40,18 @@ from typing import TYPE_CHECKING, Any, ClassVar
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
+    from ecs_tentacles.store import ArrayStore
     from ecs_tentacles.world import World
 
 ENTRY_POINTS = "ecs_tentacles.plugins"
 # name -> where it lives; imported only when a world uses it
 BUILTIN = {
-    "locomotion": "ecs_tentacles.plugins.locomotion:LocomotionPlugin",
-    "suckers": "ecs_tentacles.plugins.suckers:SuckersPlugin",
-    "fur": "ecs_tentacles.plugins.fur:FurPlugin",
-    "threats": "ecs_tentacles.plugins.threats:ThreatsPlugin",
-    "record": "ecs_tentacles.plugins.record:RecordPlugin",
-    "render": "ecs_tentacles.plugins.render:RenderPlugin",
+    "locomotion": "ecs_tentacles.locomotion.plugin:LocomotionPlugin",
+    "suckers": "ecs_tentacles.locomotion.suckers:SuckersPlugin",
+    "fur": "ecs_tentacles.fur.plugin:FurPlugin",
+    "threats": "ecs_tentacles.threats.plugin:ThreatsPlugin",
+    "record": "ecs_tentacles.record.plugin:RecordPlugin",
+    "render": "ecs_tentacles.render.plugin:RenderPlugin",
 }
 BUNDLED = {
     "wander": "ecs_tentacles.systems.examples.wander:WanderPlugin",
@@ -105,8 +106,18 @@ class Plugin:
         return []
 
     # -- building ------------------------------------------------------------------------
-    def resources(self, world: World) -> dict[str, Any]:
-        """Stores and APIs this plugin owns, reachable as `world.<name>`."""
+    def resources(self, world: World) -> Sequence[object] | Mapping[str, object]:
+        """Stores and APIs this plugin owns, reachable by type: `world.resource(MyStore)`.
+
+        One object per type; give its class `provided_by = "<plugin name>"` so a world
+        without this plugin says which plugin to turn on. (A mapping's values are taken.)
+        """
+        return ()
+
+    def stores(self, world: World) -> Mapping[str, ArrayStore]:
+        """This plugin's stores by name (`"fur.guides"`: starting with the plugin's name),
+        called after `resources`. Systems declare reads and writes as `<store>.<field>`
+        against these names; snapshots copy them."""
         return {}
 
     def build_creature(self, world: World, creature: int, spec: Mapping[str, Any]) -> None:

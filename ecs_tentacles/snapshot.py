@@ -42,13 +42,7 @@ class Snapshot:
 
 
 def _stores(world: World) -> dict[str, ArrayStore]:
-    return {
-        "transforms": world.transforms,
-        "motors": world.motors,
-        "suckers": world.suckers,
-        "creatures": world.creatures,
-        "tentacles": world.tentacles,
-    }
+    return world.stores  # the core's and every plugin's, by name
 
 
 def take(world: World) -> Snapshot:
@@ -92,7 +86,8 @@ def restore(world: World, snapshot: Snapshot) -> None:
     world.frame = snapshot.frame
     world.rng.bit_generator.state = copy.deepcopy(snapshot.rng)
     for name, store in _stores(world).items():
-        store.put_rows(snapshot.stores[name])
+        if name in snapshot.stores:  # a plugin added since has nothing to go back to
+            store.put_rows(snapshot.stores[name])
     physics = world.physics
     physics.time = snapshot.physics_time
     for group, saved in zip(physics.groups, snapshot.groups, strict=True):

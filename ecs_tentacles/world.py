@@ -29,6 +29,7 @@ from ecs_tentacles.physics.backend import PhysicsBackend
 from ecs_tentacles.plugin import Plugin, SystemsPlugin, scene_first
 from ecs_tentacles.schedule import Schedule
 from ecs_tentacles.store import (
+    ArrayStore,
     CreatureStore,
     MotorStore,
     SuckerStore,
@@ -41,6 +42,7 @@ if TYPE_CHECKING:
     from ecs_tentacles.snapshot import Snapshot
 
 C = TypeVar("C")
+R = TypeVar("R")
 LOCOMOTION_PLUGINS = ("locomotion", "suckers")  # their systems stay out with locomotion=False
 
 
@@ -83,8 +85,17 @@ class World:
         self.suckers = SuckerStore()
         self.creatures = CreatureStore()
         self.tentacles = TentacleStore()
+        # every store by name: the core's, then the plugins' ("fur.guides"); systems
+        # declare "<store>.<field>" against these names
+        self.stores: dict[str, ArrayStore] = {
+            "transforms": self.transforms,
+            "motors": self.motors,
+            "suckers": self.suckers,
+            "creatures": self.creatures,
+            "tentacles": self.tentacles,
+        }
         self.plugins: list[Plugin] = []
-        self.resources: dict[str, Any] = {}  # plugins' stores and APIs, also world.<name>
+        self._resources: dict[type, Any] = {}  # plugins' stores and APIs, by type
         self.schedule = Schedule()
         self.events = Events()
         self._physics: PhysicsBackend | None = None
@@ -221,12 +232,22 @@ class World:
         if any(p.key == plugin.key for p in self.plugins):
             raise ValueError(f"plugin {plugin.key!r} is already on in this world")
         made = plugin.resources(self)
-        for name in made:
-            if name in self.resources or name in vars(self) or hasattr(type(self), name):
-                raise ValueError(f"plugin {plugin.key!r}: world.{name} exists already")
+        objects = list(made.values() if isinstance(made, Mapping) else made)
+        for obj in objects:
+            if type(obj) in self._resources:
+                raise ValueError(
+                    f"plugin {plugin.key!r}: this world has a {type(obj).__name__} already"
+                )
         self.plugins.append(plugin)
-        self.resources.update(made)
-        vars(self).update(made)  # world.<name>, as fast as any attribute
+        for obj in objects:
+            self._resources[type(obj)] = obj
+        for name, store in plugin.stores(self).items():
+            if name in self.stores or name.partition(".")[0] != plugin.name:
+                raise ValueError(
+                    f"plugin {plugin.key!r}: store name {name!r} is taken or does not start"
+                    f" with {plugin.name!r}"
+                )
+            self.stores[name] = store
 
     def plugin(self, key: str) -> Plugin:
         """The plugin on as `key`."""
@@ -236,14 +257,39 @@ class World:
         on = ", ".join(p.key for p in self.plugins) or "none"
         raise KeyError(f"no plugin {key!r} is on in this world (on: {on})")
 
-    def __getattr__(self, name: str) -> Any:
-        """Only for names nothing defines: a plugin's resource that is not there."""
-        if name.startswith("_"):
-            raise AttributeError(name)
-        on = ", ".join(p.key for p in self.__dict__.get("plugins", [])) or "none"
-        raise AttributeError(
-            f"this world has no {name!r}: no plugin that is on provides it (plugins on: {on})"
-        )
+    # -- resources ----------------------------------------------------------------------
+    def resource(self, kind: type[R]) -> R:
+        """The plugins' resource of type `kind` (`world.resource(GoalBook)`), as Bevy's `Res<T>`.
+
+        Raises `MissingResource` naming the plugin that provides it when it is not on.
+        """
+        found = self.get_resource(kind)
+        if found is None:
+            raise MissingResource(kind, [p.key for p in self.plugins])
+        return found
+
+    def get_resource(self, kind: type[R]) -> R | None:
+        """The resource of type `kind`, or None when no plugin that is on provides one.
+
+        A class re-imported by hot reload (`ecs_tentacles.reload`) is a new type object:
+        it finds the resource made from its old self (same module and name).
+        """
+        found = self._resources.get(kind)
+        if found is None:
+            name = (kind.__module__, kind.__qualname__)
+            for made, obj in self._resources.items():
+                if (made.__module__, made.__qualname__) == name:
+                    return obj
+        return found
+
+    def has_resource(self, kind: type) -> bool:
+        """Whether a plugin that is on provides a resource of type `kind`."""
+        return kind in self._resources
+
+    @property
+    def resources(self) -> tuple[Any, ...]:
+        """Every plugin resource of this world."""
+        return tuple(self._resources.values())
 
     def add_system(self, system: System) -> System:
         """Schedule `system` at the place it declares and call its `setup`."""
@@ -396,6 +442,17 @@ class World:
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+
+class MissingResource(LookupError):
+    """`world.resource(T)` found no T: the plugin that provides it is off."""
+
+    def __init__(self, kind: type, on: list[str]):
+        provider = getattr(kind, "provided_by", "")
+        which = f"the {provider!r} plugin provides it" if provider else "no plugin on provides it"
+        super().__init__(
+            f"this world has no {kind.__name__}: {which} (plugins on: {', '.join(on) or 'none'})"
+        )
 
 
 def _owned(plugin: Plugin) -> list[System]:

@@ -29,9 +29,9 @@ from ecs_tentacles.system import System
 
 def core_systems() -> list[System]:
     """Fresh instances of the core systems (physics, sync, health), in frame order."""
-    from ecs_tentacles.systems.physics import Physics
-    from ecs_tentacles.systems.physics_health import PhysicsHealth
-    from ecs_tentacles.systems.physics_sync import PhysicsSync
+    from ecs_tentacles.systems.physics.physics import Physics
+    from ecs_tentacles.systems.physics.physics_health import PhysicsHealth
+    from ecs_tentacles.systems.physics.physics_sync import PhysicsSync
 
     systems: list[System] = [Physics(), PhysicsSync(), PhysicsHealth()]
     for system in systems:

@@ -12,9 +12,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.plugin import PluginError, resolve
 from ecs_tentacles.scene.errors import SceneError
-from ecs_tentacles.world import World
+from ecs_tentacles.world import MissingResource, World
 
 GLOW = '''
 import numpy as np
@@ -39,7 +40,7 @@ class Glow(System):
         self.rate = rate
 
     def process(self, world, dt):
-        world.glow.level += self.rate * dt
+        world.resource(GlowStore).level += self.rate * dt
 
 
 class GlowPlugin(Plugin):
@@ -52,13 +53,16 @@ class GlowPlugin(Plugin):
     scene_schema = {"ambient": {"type": "number", "default": 0.1}}
 
     def resources(self, world):
-        return {"glow": GlowStore()}
+        return [GlowStore()]
+
+    def stores(self, world):
+        return {"glow": world.resource(GlowStore)}
 
     def build_creature(self, world, creature, spec):
-        world.glow.add(level=spec["glow"])
+        world.resource(GlowStore).add(level=spec["glow"])
 
     def build_scene(self, world, scene):
-        world.glow.level += scene["ambient"]
+        world.resource(GlowStore).level += scene["ambient"]
 
     def systems(self):
         return [Glow(self.config["rate"])]
@@ -85,13 +89,15 @@ def test_a_plugin_from_a_folder_adds_keys_a_store_and_a_system_at_its_stage(
     tmp_path: Path, make_world: Callable[..., World]
 ) -> None:
     world = make_world(glow_scene(tmp_path, rate=3.0), allow_systems=True)
-    np.testing.assert_allclose(world.glow.level, [0.35, 0.75])  # creature keys + scene key
+    np.testing.assert_allclose(
+        world.stores["glow"].level, [0.35, 0.75]
+    )  # creature keys + scene key
     assert world.schedule.stage_of("glow") == "animate"
     assert world.schedule.names.index("glow") > world.schedule.names.index("physics")
     assert world.plugin("glow").source == "glow.py"
     assert world.schedule["glow"].plugin == "glow"
     world.step(6)
-    np.testing.assert_allclose(world.glow.level, [0.35 + 0.3, 0.75 + 0.3])
+    np.testing.assert_allclose(world.stores["glow"].level, [0.35 + 0.3, 0.75 + 0.3])
 
 
 def test_a_plugin_from_a_file_needs_permission(tmp_path: Path) -> None:
@@ -123,9 +129,10 @@ def test_plugins_turned_off_take_their_keys_and_systems_with_them(
 ) -> None:
     scene = {"version": 1, "creatures": [{"tentacles": {"count": 3, "links": 2}}]}
     world = make_world(scene, plugins={"fur": False})
-    assert "rig" not in world.schedule and "fur" not in world.resources
-    with pytest.raises(AttributeError, match="no plugin that is on provides it"):
-        world.fur  # noqa: B018
+    assert "rig" not in world.schedule and world.get_resource(FurData) is None
+    assert not any(name.startswith("fur.") for name in world.stores)
+    with pytest.raises(MissingResource, match="no FurData: the 'fur' plugin provides it"):
+        world.resource(FurData)
     with pytest.raises(SceneError, match=r"creatures\[0\]\.fur: unknown key"):
         World.from_scene("hedgehog_octopus", plugins={"fur": False, "threats": False})
 

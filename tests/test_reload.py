@@ -20,7 +20,7 @@ from ecs_tentacles.system import System
 
 
 class Mark(System):
-    """Reads the frame; writes world.marks (frame, value) and counts its calls."""
+    """Reads the frame; writes Marks (frame, value) and counts its calls."""
 
     name = "mark"
     stage = "output"
@@ -32,8 +32,12 @@ class Mark(System):
 
     def process(self, world, dt):
         self.calls += 1
-        world.marks.append((world.frame, self.value))
+        world.resource(Marks).append((world.frame, self.value))
 {extra}
+
+class Marks(list):
+    """(frame, value) of every mark, in order."""
+
 
 class MarkPlugin(Plugin):
     name = "mark"
@@ -44,7 +48,7 @@ class MarkPlugin(Plugin):
     }}
 
     def resources(self, world):
-        return {{"marks": []}}
+        return [Marks()]
 
     def systems(self):
         return [{systems}]
@@ -52,14 +56,19 @@ class MarkPlugin(Plugin):
 TICK = '''
 
 class Tick(System):
-    """Reads nothing; writes world.marks (frame, "tick")."""
+    """Reads nothing; writes Marks (frame, "tick")."""
 
     name = "tick"
     stage = "act"
 
     def process(self, world, dt):
-        world.marks.append((world.frame, "tick"))
+        world.resource(Marks).append((world.frame, "tick"))
 '''
+
+
+def _marks(world: World) -> list:
+    """The plugin's Marks resource (its class lives in the user's file)."""
+    return next(r for r in world.resources if type(r).__name__ == "Marks")
 
 
 def _write(path: Path, systems: str, extra: str = "", stamp: int = 0) -> None:
@@ -87,14 +96,14 @@ def world(tmp_path: Path, make_world: Callable[..., World]) -> World:
 
 
 def _values(world: World, frames: range) -> list[object]:
-    return [value for frame, value in world.marks if frame in frames]
+    return [value for frame, value in _marks(world) if frame in frames]
 
 
 def test_a_changed_file_swaps_behaviour_and_keeps_the_world(world: World, tmp_path: Path) -> None:
     reloader = Reloader(world)
     assert list(reloader.watched) == ["mark"]
     world.step(12)
-    octo, marks = world.creature("octo"), world.marks
+    octo, marks = world.creature("octo"), _marks(world)
     pos = world.transforms.pos.copy()
     assert reloader.check() == []  # nothing changed yet
     _write(tmp_path / "mark.py", 'Mark(2.0 * self.config["scale"])', stamp=1)
@@ -102,7 +111,7 @@ def test_a_changed_file_swaps_behaviour_and_keeps_the_world(world: World, tmp_pa
     assert (done.message, done.swapped) == ("reloaded mark.py (mark)", ["mark"])
     assert world.creature("octo") == octo  # the same entity
     assert_array_equal(world.transforms.pos, pos)  # not moved by the swap
-    assert world.frame == 12 and world.marks is marks  # the clock and the plugin's data go on
+    assert world.frame == 12 and _marks(world) is marks  # the clock and the plugin's data go on
     world.step(3)
     assert _values(world, range(0, 12)) == [10.0] * 12  # old code, config scale 10
     assert _values(world, range(12, 15)) == [20.0] * 3  # new code, same config
@@ -140,7 +149,7 @@ def test_a_fixed_file_runs_the_failed_system_again_and_adds_new_ones(
     assert done.message == "reloaded mark.py (mark, +tick)"
     assert world.schedule.disabled() == []
     world.step(1)
-    assert world.marks == [(1, "tick"), (1, 3.0)]  # tick acts, mark outputs
+    assert _marks(world) == [(1, "tick"), (1, 3.0)]  # tick acts, mark outputs
     _write(tmp_path / "mark.py", "Tick()", extra=TICK, stamp=4)
     assert reloader.check()[0].removed == ["mark"]
     assert "mark" not in world.schedule

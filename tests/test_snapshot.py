@@ -8,12 +8,20 @@ import esper
 import numpy as np
 from numpy.testing import assert_array_equal
 
+from ecs_tentacles.fur.stores import FurData
+from ecs_tentacles.locomotion.goals import GoalBook
+from ecs_tentacles.locomotion.params import Locomotion
 from ecs_tentacles.world import World
 
 
 def _state(world: World) -> list[np.ndarray]:
     physics = [a for g in world.physics.groups for a in (g.data.qpos, g.data.qvel, g.get_state())]
-    stores = [world.transforms.pos, world.motors.target, world.suckers.anchor, world.fur.curves]
+    stores = [
+        world.transforms.pos,
+        world.motors.target,
+        world.suckers.anchor,
+        world.resource(FurData).curves,
+    ]
     return [np.array(a, copy=True) for a in (*physics, *stores, world.tentacles.timer)]
 
 
@@ -22,20 +30,20 @@ def test_restore_continues_bit_identically_with_suckers_attached(
 ) -> None:
     world = make_world("hedgehog_octopus")  # fur with dynamics
     octo = int(world.creatures.entity[0])
-    world.goals.set(octo, [1.5, 0.0])  # crawl, with suckers
+    world.resource(GoalBook).set(octo, [1.5, 0.0])  # crawl, with suckers
     for _ in range(600):
         if world.suckers.attached.any():
             break
         world.step(1)
     assert world.suckers.attached.any()
     snap = world.snapshot()
-    actions = world.locomotion.actions(octo)
+    actions = world.resource(Locomotion).actions(octo)
     world.step(300)
     first = _state(world)
     reached = world.events.counts["goal_reached"]
     world.restore(snap)
     assert world.suckers.attached.any() and world.frame == snap.frame
-    assert world.locomotion.actions(octo) == actions
+    assert world.resource(Locomotion).actions(octo) == actions
     world.step(300)
     for a, b in zip(first, _state(world), strict=True):
         assert_array_equal(a, b)

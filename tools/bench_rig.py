@@ -26,10 +26,11 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
-from ecs_tentacles.systems.rig import BLOCK
+from ecs_tentacles.systems.fur.rig import BLOCK
 
 from ecs_tentacles.fur import rig as rig_math
 from ecs_tentacles.fur.dynamics import Strands, blend_profile
+from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.fur.synthetic import synthetic_rig
 from ecs_tentacles.world import World
 
@@ -106,7 +107,11 @@ def bench_system(n: int, repeats: int, dynamic: bool) -> float:
     }
     world = World.from_scene(scene, locomotion=False)
     world.step(1)
-    world.fur.controls.position[0] += (0.02, 0.0, 0.01)  # a moved control: direction works
+    world.resource(FurData).controls.position[0] += (
+        0.02,
+        0.0,
+        0.01,
+    )  # a moved control: direction works
     rig = world.schedule["rig"]
     result = median_ms(lambda: rig.process(world, world.settings.dt), repeats)
     world.close()

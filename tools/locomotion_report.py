@@ -22,6 +22,8 @@ from typing import Any
 import numpy as np
 
 from ecs_tentacles.components import Creature, Transform
+from ecs_tentacles.locomotion.goals import GoalBook
+from ecs_tentacles.locomotion.params import Locomotion
 from ecs_tentacles.mathutil import quat_rotate
 from ecs_tentacles.scene.load import bundled_scene
 from ecs_tentacles.scene.parameters import parameter
@@ -56,7 +58,7 @@ def run(world: World, case: str, seconds: float) -> dict[str, Any]:
     mantle = world.component(entity, Transform)
     reached: list[float] = []
     world.events.on("goal_reached", lambda **kw: reached.append(world.time))
-    goals_at_start = len(world.goals.path(entity))
+    goals_at_start = len(world.resource(GoalBook).path(entity))
     start = mantle.pos[:2].copy()
     previous = start.copy()
     travelled = 0.0
@@ -91,7 +93,7 @@ def run(world: World, case: str, seconds: float) -> dict[str, Any]:
     return {
         "case": case,
         "tentacles": len(creature.tentacles),
-        "gait": world.locomotion.get(entity)["gait"],
+        "gait": world.resource(Locomotion).get(entity)["gait"],
         "reached": bool(goals_at_start) and len(reached) == goals_at_start,
         "time_s": round(elapsed, 3),
         "speed_radii_per_s": round(displacement / MANTLE_RADIUS / elapsed, 4),
@@ -114,7 +116,7 @@ def run_case(spec: tuple[str, int, str, float | None]) -> dict[str, Any]:
     case, tentacles, gait, direction = spec
     if case == "three_goals":
         world = World.from_scene(bundled_scene("three_goals"))
-        world.locomotion.set(world.creature("crawler"), gait=gait)
+        world.resource(Locomotion).set(world.creature("crawler"), gait=gait)
         row = run(world, case, LIMIT_SECONDS)
     else:
         world = World.from_scene(case_scene(tentacles, gait, direction))

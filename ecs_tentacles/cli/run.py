@@ -9,6 +9,7 @@ import time
 from typing import Any
 
 from ecs_tentacles.components import Creature
+from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.progress import step_frames
 from ecs_tentacles.scene.load import resolve_scene_path
 from ecs_tentacles.world import World
@@ -136,7 +137,7 @@ def simulate(world: World, frames: int, *, progress: bool = True) -> dict[str, A
 
 def _goals_left(world: World) -> int:
     """Goals still in every creature's path (0 with the locomotion plugin off)."""
-    book = world.resources.get("goals")
+    book = world.get_resource(GoalBook)
     if book is None:
         return 0
     return int(sum(len(book.path(e)) for e, _ in world.query(Creature)))

@@ -146,7 +146,7 @@ def bake(
     creatures at those scene indices (a shard); `on_steps(n)` is told of every `n`
     frames simulated.
     """
-    from ecs_tentacles.plugins.record import RecordPlugin
+    from ecs_tentacles.record.plugin import RecordPlugin
 
     world = plan.world(allow_systems=allow_systems, threads=threads, only=only)
     try:

@@ -2,7 +2,7 @@
 
 `TakeRecorder(world)` fixes the layout once (which store rows are which bodies,
 suckers, goals) and `capture()` copies the current frame with one gather per array;
-the `record` system (`ecs_tentacles.systems.record`) calls it after physics_sync.
+the `record` system (`ecs_tentacles.systems.record.record`) calls it after physics_sync.
 Goals are discovered as they appear (scripts may add some); fur guides are read
 through the plugins' export hook (`plugin_curves`: the fur plugin's guides).
 """
@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ecs_tentacles.components import Creature, Goal, Link, Tentacle, Transform
+from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.plugin import GuideFrame
 from ecs_tentacles.take import FORMAT, VERSION, Take
 
@@ -43,7 +44,7 @@ def pose_fur_at_build(world: World) -> None:
     fresh rig (its own dynamics state, thrown away) poses them once; it writes only
     the rig's output buffers, which the real rig rewrites every frame.
     """
-    fur = world.resources.get("fur")
+    fur = world.get_resource(FurData)
     if world.frame == 0 and fur is not None and len(fur.guides) and "rig" in world.schedule:
         type(world.schedule["rig"])().process(world, 0.0)
 

@@ -1,6 +1,6 @@
 """Scene data -> fur entities: guides, controls, the creature's Fur and Emotion.
 
-Called by the fur plugin's build hook (`ecs_tentacles.plugins.fur`) for a creature with
+Called by the fur plugin's build hook (`ecs_tentacles.fur.plugin`) for a creature with
 `fur` or `emotion`. Guides attach to the mantle body (its Transform row); their roots
 live in the mantle's local frame.
 """
@@ -16,7 +16,7 @@ from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.fur import groom as grooming
 from ecs_tentacles.fur.components import Emotion, Fur, FurControl, FurGuide
 from ecs_tentacles.fur.controls import expand_mirrors, nearest_control
-from ecs_tentacles.fur.stores import BEHAVIOURS, COLUMNS
+from ecs_tentacles.fur.stores import BEHAVIOURS, COLUMNS, FurData
 from ecs_tentacles.tracks import channels_from_keys
 
 if TYPE_CHECKING:
@@ -25,8 +25,8 @@ if TYPE_CHECKING:
 
 def _points_per_guide(world: World, spec: dict[str, Any]) -> int:
     """The world's shared point count: the largest any fur of the scene asks for."""
-    if world.fur.points:
-        return world.fur.points
+    if world.resource(FurData).points:
+        return world.resource(FurData).points
     asked = [spec["groom"]["points"]]
     if world.scene is not None:
         asked += [c["fur"]["groom"]["points"] for c in world.scene["creatures"] if "fur" in c]
@@ -35,7 +35,7 @@ def _points_per_guide(world: World, spec: dict[str, Any]) -> int:
 
 def build_fur(world: World, creature: int, spec: dict[str, Any]) -> int:
     """Controls and guides of `creature` from a defaults-filled `fur` spec; the Fur row."""
-    fur = world.fur
+    fur = world.resource(FurData)
     info = world.component(creature, Creature)
     body = world.component(creature, Transform).row
     fur.points = _points_per_guide(world, spec)
@@ -70,7 +70,7 @@ def _build_controls(
     world: World, creature: int, fur_row: int, specs: list[dict[str, Any]]
 ) -> dict[str, tuple[int, int]]:
     """Control entities (mirrored twins included): name -> (entity, control row)."""
-    store = world.fur.controls
+    store = world.resource(FurData).controls
     made: dict[str, tuple[int, int]] = {}
     for spec in expand_mirrors(specs):
         values = {k: spec[k] for k in BEHAVIOURS}
@@ -91,7 +91,7 @@ def _build_controls(
         made[spec["name"]] = (entity, row)
         for track in spec["tracks"]:
             columns = COLUMNS[track["attribute"]]
-            world.fur.tracks += channels_from_keys(row, columns, track["keys"])
+            world.resource(FurData).tracks += channels_from_keys(row, columns, track["keys"])
     return made
 
 
@@ -104,7 +104,7 @@ def _build_guides(
     spec: dict[str, Any],
     controls: dict[str, tuple[int, int]],
 ) -> list[int]:
-    fur = world.fur
+    fur = world.resource(FurData)
     radius, height = info.mantle_radius, info.mantle_height
     groom = dict(spec["groom"], points=fur.points)
     parts = [grooming.generate(groom, radius, height)]
@@ -145,7 +145,7 @@ def _build_guides(
 
 def build_emotion(world: World, creature: int, spec: dict[str, Any]) -> int:
     """The creature's Emotion (its controls get driven by it); returns the emotion row."""
-    store = world.fur.emotions
+    store = world.resource(FurData).emotions
     row = int(
         store.add(
             creature=creature,
@@ -161,5 +161,5 @@ def build_emotion(world: World, creature: int, spec: dict[str, Any]) -> int:
     fur = world.try_component(creature, Fur)
     if fur is not None:
         rows = [world.component(e, FurControl).row for e in fur.controls]
-        world.fur.controls.emotion_row[rows] = row
+        world.resource(FurData).controls.emotion_row[rows] = row
     return row

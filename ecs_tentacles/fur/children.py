@@ -53,7 +53,7 @@ _CACHE: weakref.WeakKeyDictionary[FurData, tuple[tuple[int, ...], ChildLayout]] 
 
 def layout(world: World, per_guide: int | None = None, seed: int = 0) -> ChildLayout:
     """The children of every fur (`per_guide` each, default each fur's `children`)."""
-    fur = world.fur
+    fur = world.resource(FurData)
     key = (fur.version, len(fur.guides), -1 if per_guide is None else per_guide, seed)
     cached = _CACHE.get(fur)
     if cached is not None and cached[0] == key:
@@ -71,7 +71,7 @@ def parents(fur: FurData, per_guide: int | None) -> np.ndarray:
 
 
 def _make_layout(world: World, per_guide: int | None, seed: int) -> ChildLayout:
-    fur = world.fur
+    fur = world.resource(FurData)
     g = fur.guides
     parent = parents(fur, per_guide)
     rng = np.random.default_rng(seed)
@@ -146,7 +146,7 @@ def interpolated_children(
     `keep`: that many points per child (evenly picked along the guides; fewer points
     draw faster, the sandbox's level of detail), else all of them.
     """
-    fur = world.fur
+    fur = world.resource(FurData)
     picked = point_indices(fur.points, keep)
     if not len(children.parent):
         return np.zeros((0, len(picked), 3), np.float32)

@@ -22,7 +22,7 @@ import numpy as np
 from ecs_tentacles.components import Creature
 from ecs_tentacles.fur.components import Fur, FurControl
 from ecs_tentacles.fur.controls import expand_mirrors, mirror_name, mirror_point, nearest_control
-from ecs_tentacles.fur.stores import BEHAVIOURS, COLUMNS
+from ecs_tentacles.fur.stores import BEHAVIOURS, COLUMNS, FurData
 from ecs_tentacles.scene.save import save_scene
 from ecs_tentacles.tracks import EASINGS, TrackSet, channels_from_keys
 
@@ -128,7 +128,7 @@ class FurEditor:
         """The control name each of the selected creature's guides follows (guide order)."""
         fur = self.world.component(self.entity(), Fur)
         names = {row: name for name, row in self.rows().items()}
-        g = self.world.fur.guides
+        g = self.world.resource(FurData).guides
         mine = np.flatnonzero(g.fur_row == fur.row)
         return np.array([names[int(r)] for r in g.control_row[mine]])
 
@@ -179,7 +179,7 @@ class FurEditor:
     def value(self, name: str, attribute: str) -> Any:
         """The world's current value of a control's attribute (position: creature frame)."""
         row = self.rows()[name]
-        store = self.world.fur.controls
+        store = self.world.resource(FurData).controls
         if attribute == "position":
             return store.position[row].copy()
         return float(getattr(store, attribute)[row])
@@ -191,7 +191,7 @@ class FurEditor:
         value = float(np.clip(value, 0.0, 1.0))
         control, _ = self.source(name)
         control[attribute] = value
-        column = getattr(self.world.fur.controls, attribute)
+        column = getattr(self.world.resource(FurData).controls, attribute)
         for row, _axis in self._twin_rows(name):
             column[row] = value
 
@@ -200,7 +200,7 @@ class FurEditor:
         control, axis = self.source(name)
         point = [float(x) for x in position]
         control["position"] = mirror_point(point, axis) if axis else point
-        store = self.world.fur.controls
+        store = self.world.resource(FurData).controls
         for row, mirror in self._twin_rows(name):
             placed = mirror_point(control["position"], mirror) if mirror else control["position"]
             store.position[row] = placed
@@ -210,13 +210,13 @@ class FurEditor:
     def _reassign(self) -> None:
         fur = self.world.component(self.entity(), Fur)
         rows = np.array(list(self.rows().values()))
-        g = self.world.fur.guides
+        g = self.world.resource(FurData).guides
         mine = np.flatnonzero(g.fur_row == fur.row)
         if any("control" in guide for guide in self.fur_spec()["guides"]):
             return  # guides that name their control keep it (their rows are not tracked)
-        rests = self.world.fur.controls.rest_position[rows]
+        rests = self.world.resource(FurData).controls.rest_position[rows]
         g.control_row[mine] = rows[nearest_control(g.root[mine], rests)]
-        self.world.fur.touch()
+        self.world.resource(FurData).touch()
 
     # -- keys --------------------------------------------------------------------------
     def keys(self, name: str, attribute: str) -> list[dict[str, Any]]:
@@ -287,8 +287,8 @@ class FurEditor:
                 for track in control["tracks"]:
                     columns = COLUMNS[track["attribute"]]
                     channels += channels_from_keys(rows[control["name"]], columns, track["keys"])
-        self.world.fur.tracks = channels
-        self.world.fur.touch()
+        self.world.resource(FurData).tracks = channels
+        self.world.resource(FurData).touch()
 
     def track_value(self, name: str, attribute: str, time: float) -> np.ndarray:
         """What fur.tracks gives for a control's attribute at `time` (as the rig plays it)."""

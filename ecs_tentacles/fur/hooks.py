@@ -20,6 +20,7 @@ import numpy as np
 
 from ecs_tentacles.fur import children
 from ecs_tentacles.fur.components import FurControl
+from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.mathutil import quat_rotate
 from ecs_tentacles.plugin import GuideFrame
 
@@ -39,7 +40,7 @@ class GuideCurves:
 
 def guide_curves(world: World, colour_by: str = "fur") -> GuideCurves:
     """Every guide's world polyline; colour from its fur, or its control's (`"control"`)."""
-    fur = world.fur
+    fur = world.resource(FurData)
     n = len(fur.guides)
     rows = np.arange(n)
     if colour_by not in ("fur", "control"):
@@ -80,7 +81,7 @@ def child_hairs(
         return GuideCurves(curves, colour, base.width[made.parent] * 0.5, made.parent)
     if follow != "own":
         raise ValueError(f"follow must be 'neighbours' or 'own', got {follow!r}")
-    fur = world.fur
+    fur = world.resource(FurData)
     g = fur.guides
     parent = children.parents(fur, per_guide)
     rng = np.random.default_rng(seed)
@@ -116,7 +117,7 @@ class ControlMarker:
 
 def control_markers(world: World) -> list[ControlMarker]:
     """Every fur control, placed in world space by its creature's mantle pose."""
-    fur = world.fur
+    fur = world.resource(FurData)
     markers = []
     for entity, control in world.query(FurControl):
         body = fur.sets.body_row[control.store.fur_row[control.row]]
@@ -137,7 +138,7 @@ def take_guides(world: World) -> GuideFrame | None:
     The fur plugin's export hook: world polylines and root widths (kept along each
     guide, `ecs_tentacles.fur.hooks.guide_curves`); owners from the guides' fur sets.
     """
-    fur = world.resources.get("fur")
+    fur = world.get_resource(FurData)
     if fur is None:
         return None
     curves = guide_curves(world)

@@ -1,6 +1,6 @@
 """Struct-of-array stores of the fur rig: guides, controls, furs, emotions.
 
-`FurData` (``world.fur``) holds them. Rows are never removed. Guides of all creatures
+`FurData` (``world.resource(FurData)``) holds them. Rows are never removed. Guides of all creatures
 share one point count (`FurData.points`): the first fur built sets it and guides of
 later furs with another count are resampled along their length.
 
@@ -102,12 +102,14 @@ class EmotionStore(ArrayStore):
 
 
 class FurData:
-    """The fur stores of one world (``world.fur``), plus the rig's output buffers.
+    """The fur stores of one world (``world.resource(FurData)``), plus the rig's output buffers.
 
     After the rig runs: `points` (n_guides, points, 3) world polylines (float32) and
     `frames` (n_guides, 4, 3): rows are the guide's axis, up and side unit vectors and
     its root, in world space.
     """
+
+    provided_by = "fur"  # the plugin that makes it (named by `world.resource` errors)
 
     def __init__(self) -> None:
         self.guides = GuideStore()

@@ -26,6 +26,8 @@ DEFAULT_RADIUS = 0.3
 class GoalBook:
     """Each creature's ordered path of goal entities."""
 
+    provided_by = "locomotion"  # the plugin that makes it (named by `world.resource` errors)
+
     def __init__(self, world: World):
         self._world = world
         self._paths: dict[int, list[int]] = {}

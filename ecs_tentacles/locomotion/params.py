@@ -1,10 +1,10 @@
 """Locomotion parameters, read and changed at run time (the HUD and scripts use this).
 
-    world.locomotion.set(octo, speed=1.5)                    # the creature's speed
-    world.locomotion.set(octo, tentacle=2, strength=12.0)    # one tentacle's servo kp
-    world.locomotion.set(octo, wave_amplitude=0.2)           # every tentacle
-    world.locomotion.set(octo, gait="cyclic")
-    world.locomotion.actions(octo)                           # what each tentacle is doing
+    world.resource(Locomotion).set(octo, speed=1.5)                    # the creature's speed
+    world.resource(Locomotion).set(octo, tentacle=2, strength=12.0)    # one tentacle's servo kp
+    world.resource(Locomotion).set(octo, wave_amplitude=0.2)           # every tentacle
+    world.resource(Locomotion).set(octo, gait="cyclic")
+    world.resource(Locomotion).actions(octo)                           # what each tentacle is doing
 
 Angles are radians here (scenes use degrees). Which names exist, their ranges, units,
 taper and which are creature-wide all come from the parameter table
@@ -42,6 +42,8 @@ def settable() -> tuple[dict[str, Parameter], dict[str, Parameter]]:
 
 class Locomotion:
     """Per-creature and per-tentacle locomotion settings of a world."""
+
+    provided_by = "locomotion"  # the plugin that makes it (named by `world.resource` errors)
 
     def __init__(self, world: World):
         self._world = world

@@ -5,8 +5,9 @@ allows, in collapsible sections. "Locomotion" has a slider for each parameter th
 scene schema marks with one (`ecs_tentacles.scene.parameters`: speed, target angle,
 strength, wave amplitude and frequency), over its range and with its label and units
 (strength stops where the servos' damping can hold it), the gait's choices, and a tentacle
-selector ("all" or one tentacle). Every change goes through `world.locomotion.set`, the same API
-scripts use, so it reaches the servos on the next physics step. "Stats" shows fps,
+selector ("all" or one tentacle). Every change goes through
+`world.resource(Locomotion).set`, the same API scripts use, so it reaches the servos on
+the next physics step. "Stats" shows fps,
 physics ms, simulated time, real-time factor and attached suckers; "Physics" the
 groups, threads, recoveries and frozen creatures; "Actions" each tentacle's action.
 Extra panels (the fur tool) add sections through `sections`.
@@ -21,7 +22,7 @@ from typing import Any
 from imgui_bundle import imgui
 
 from ecs_tentacles.components import Creature
-from ecs_tentacles.locomotion.params import settable
+from ecs_tentacles.locomotion.params import Locomotion, settable
 from ecs_tentacles.render.gui import Gui, gui_scale, same_line_if_fits, text_width
 from ecs_tentacles.scene.parameters import Parameter, parameter
 
@@ -142,17 +143,19 @@ class Hud:
         if self.creature is None:
             return
         if name not in settable()[0]:  # creature-wide (the gait)
-            self.world.locomotion.set(self.creature, **{name: value})
+            self.world.resource(Locomotion).set(self.creature, **{name: value})
         else:
-            self.world.locomotion.set(self.creature, tentacle=self.tentacle, **{name: float(value)})
+            self.world.resource(Locomotion).set(
+                self.creature, tentacle=self.tentacle, **{name: float(value)}
+            )
         self.refresh()
 
     def refresh(self) -> None:
         """Read the selection's current values from the world."""
-        if self.creature is None or "locomotion" not in self.world.resources:
+        if self.creature is None or not self.world.has_resource(Locomotion):
             self.values = {}
             return
-        values = self.world.locomotion.get(self.creature, self.tentacle or 0)
+        values = self.world.resource(Locomotion).get(self.creature, self.tentacle or 0)
         if self.tentacle is None:
             values["speed"] = values["creature_speed"]
         self.values = values
@@ -200,7 +203,7 @@ class Hud:
         gui.window_rect("panel")
         imgui.text(self.title)
         gui.item("title")
-        moving = "locomotion" in self.world.resources  # the locomotion plugin is on
+        moving = self.world.has_resource(Locomotion)  # the locomotion plugin is on
         own: list[tuple[str, Callable[[Gui], None]]] = [
             *([("Locomotion", self._locomotion)] if moving else []),
             ("Stats", self._stats),
@@ -255,7 +258,7 @@ class Hud:
             shown = float(self.values[knob.name]) * knob.to_shown
             high = knob.high
             if knob.name == "strength":  # no stronger than the servos' damping holds
-                high = self.world.locomotion.strength_limit(self.creature, self.tentacle)
+                high = self.world.resource(Locomotion).strength_limit(self.creature, self.tentacle)
             flags = imgui.SliderFlags_.logarithmic.value if knob.log else 0
             changed, shown = imgui.slider_float(
                 f"##{knob.name}", shown, knob.low, high, knob.unit, flags
@@ -313,7 +316,7 @@ class Hud:
     def _actions(self, gui: Gui) -> None:
         if self.creature is None:
             return
-        for k, action in enumerate(self.world.locomotion.actions(self.creature)):
+        for k, action in enumerate(self.world.resource(Locomotion).actions(self.creature)):
             imgui.text(f"t{k}: {action}")
             gui.item(f"action {k}")
 

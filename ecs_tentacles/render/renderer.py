@@ -20,6 +20,10 @@ from pyglet import gl
 
 from ecs_tentacles.components import Creature, Goal, Link, Tentacle, Transform
 from ecs_tentacles.fur.hooks import GuideCurves, child_hairs, guide_curves
+from ecs_tentacles.fur.render.markers import marker_lines
+from ecs_tentacles.fur.render.ribbons import Ribbons
+from ecs_tentacles.fur.stores import FurData
+from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.render import shaders
 from ecs_tentacles.render.camera import OrbitCamera
 from ecs_tentacles.render.gpu import (
@@ -31,9 +35,7 @@ from ecs_tentacles.render.gpu import (
     program,
     set_matrix,
 )
-from ecs_tentacles.render.markers import marker_lines
 from ecs_tentacles.render.meshes import CAPSULE_LODS, CYLINDER_LOD, SPHERE_LOD
-from ecs_tentacles.render.ribbons import Ribbons
 from ecs_tentacles.render.skinned import SkinnedCreatures
 from ecs_tentacles.world import World
 
@@ -198,7 +200,7 @@ class Renderer:
         """Rings, markers and path legs between goals: rebuilt only when goals change."""
         fixed: list[np.ndarray] = []
         leaders, firsts, colours = [], [], []
-        book = self.world.resources.get("goals")  # None with the locomotion plugin off
+        book = self.world.get_resource(GoalBook)  # None with the locomotion plugin off
         for entity in self.creature_entities:
             goals = book.path(entity) if book is not None else []
             if book is None or not goals:
@@ -232,7 +234,7 @@ class Renderer:
             creature = self.world.component(self.selected, Creature)
             ring = pos[row] * [1, 1, 0] + [0, 0, 0.01] + creature.mantle_radius * 1.6 * CIRCLE
             segments.append(_segments(ring, np.array([1.0, 1.0, 1.0, 1.0])))
-        fur = self.world.resources.get("fur")
+        fur = self.world.get_resource(FurData)
         if fur is not None and len(fur.guides) and self.fur_display.markers:
             segments.append(marker_lines(self.world, self.fur_display.selected_control))
         for provider in self.extra_lines:
@@ -300,7 +302,7 @@ class Renderer:
     def frame_all(self) -> None:
         """Point the camera so every creature and goal is in view."""
         points = [self.world.transforms.pos]
-        book = self.world.resources.get("goals")
+        book = self.world.get_resource(GoalBook)
         if book is not None:
             points += [book.positions(entity) for entity in self.creature_entities]
         self.camera.follow = None
@@ -323,7 +325,7 @@ class FurDisplay:
 
 def fur_strands(world: World, display: FurDisplay) -> tuple[GuideCurves, GuideCurves]:
     """This frame's guides and child hairs as `display` asks (empty when hidden)."""
-    fur = world.resources.get("fur")  # None with the fur plugin off
+    fur = world.get_resource(FurData)  # None with the fur plugin off
     points = max(fur.points, 1) if fur is not None else 1
     empty = GuideCurves(
         np.zeros((0, points, 3), np.float32),
@@ -348,7 +350,7 @@ def fur_strands(world: World, display: FurDisplay) -> tuple[GuideCurves, GuideCu
 
 def _goal_version(world: World) -> int:
     """Changes whenever any goal does (-1 without the locomotion plugin)."""
-    book = world.resources.get("goals")
+    book = world.get_resource(GoalBook)
     return -1 if book is None else int(book.version)
 
 

@@ -31,11 +31,12 @@ from pyglet.window import key, mouse
 from tqdm import tqdm
 
 from ecs_tentacles.components import Creature, Goal, Transform
-from ecs_tentacles.plugins.render import RenderPlugin
+from ecs_tentacles.fur.render.furpanel import FurPanel
+from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.render.camera import ray_sphere
-from ecs_tentacles.render.furpanel import FurPanel
 from ecs_tentacles.render.hud import Hud
 from ecs_tentacles.render.output import VideoWriter, save_png
+from ecs_tentacles.render.plugin import RenderPlugin
 from ecs_tentacles.render.renderer import Renderer
 from ecs_tentacles.render.scripts import Scripts
 from ecs_tentacles.scene.errors import SceneError
@@ -103,7 +104,7 @@ class Sandbox:
 
     def open_fur_tool(self) -> FurPanel:
         """The fur panel (a HUD section) and the timeline (a window at the bottom)."""
-        from ecs_tentacles.render.timeline import Timeline
+        from ecs_tentacles.fur.render.timeline import Timeline
 
         self.fur = FurPanel(self)
         self.timeline = Timeline(self, self.fur)
@@ -281,9 +282,9 @@ class Sandbox:
             if point is None or creature is None:
                 return
             if modifiers & key.MOD_SHIFT:
-                self.world.goals.append(creature, point[:2].tolist())
+                self.world.resource(GoalBook).append(creature, point[:2].tolist())
             else:
-                self.world.goals.set(creature, point[:2].tolist())
+                self.world.resource(GoalBook).set(creature, point[:2].tolist())
         elif button == mouse.RIGHT:
             point = self.renderer.camera.ground_point(x, y)
             if point is not None:
@@ -297,7 +298,7 @@ class Sandbox:
             if distance <= goal.radius and distance < best_distance:
                 best, best_distance = entity, distance
         if best is not None:
-            self.world.goals.remove(best)
+            self.world.resource(GoalBook).remove(best)
         return best
 
     # -- window events -------------------------------------------------------------------

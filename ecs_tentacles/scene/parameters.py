@@ -13,18 +13,18 @@ the stored code of a choice is its index there). The annotation gives the rest:
 * `column`: the store column it fills, `<store>.<field>` (`world.motors.strength`);
   a parameter stored per creature (`creatures.*`) is creature-wide at run time;
 * `units`: the scene's units. A key ending in `_deg` is degrees in the scene and
-  radians in code (stores, `world.locomotion`), whose name drops the `_deg`;
+  radians in code (stores, `world.resource(Locomotion)`), whose name drops the `_deg`;
 * `taper`: a column of the same store the value is multiplied by, row by row
   (`scale`: each link's construction scale);
 * `at_most`: a column of the same store that caps it (drivers: the tentacle count);
-* `runtime`: false when `world.locomotion.set` cannot change it (read at compile);
+* `runtime`: false when `world.resource(Locomotion).set` cannot change it (read at compile);
 * `label`, and `slider` (`order`, `digits`, `log`): how the HUD shows it.
 
 `parameters(schema)` walks whatever schema dict it is given (the bundled one by
 default, or one assembled from plugins' fragments) and finds annotated properties
 wherever they sit; a parameter's section is the name of the object holding it
 (`tentacles`, `locomotion`). Build code fills store columns with `apply_parameters`;
-`world.locomotion`, the HUD and the creator read the same records.
+`world.resource(Locomotion)`, the HUD and the creator read the same records.
 """
 
 from __future__ import annotations
@@ -79,7 +79,7 @@ class Parameter:
 
     @property
     def api(self) -> str:
-        """The name scripts use (`world.locomotion.set(..., target_angle=0.5)`)."""
+        """The name scripts use (`world.resource(Locomotion).set(..., target_angle=0.5)`)."""
         return self.key.removesuffix("_deg")
 
     @property
@@ -95,7 +95,7 @@ class Parameter:
         return value if self.choices else value * self.factor
 
     def to_api(self, stored: Any) -> Any:
-        """A stored value as `world.locomotion.get` reports it (before any taper)."""
+        """A stored value as `world.resource(Locomotion).get` reports it (before any taper)."""
         if self.choices:
             return self.choices[int(stored)]
         return int(stored) if self.range and self.range.integer else float(stored)

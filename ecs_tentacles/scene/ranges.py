@@ -1,7 +1,7 @@
 """Numeric ranges of scene fields, read from the scene schema: the one place they live.
 
 The loader validates scenes against the schema; the run-time setters
-(`world.locomotion.set`), the HUD sliders and the creature creator check values with
+(`world.resource(Locomotion).set`), the HUD sliders and the creature creator check values with
 the same ranges through this module, so nothing can be set at run time that a scene
 could not say.
 

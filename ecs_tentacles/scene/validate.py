@@ -64,10 +64,9 @@ def core_schema() -> dict[str, Any]:
 
 
 @functools.cache
-def fragment(name: str) -> dict[str, Any]:
-    """A built-in plugin's schema fragment (`assets/schema/plugins/<name>.json`)."""
-    resource = importlib.resources.files("ecs_tentacles.assets") / "schema" / "plugins"
-    found: dict[str, Any] = json.loads((resource / f"{name}.json").read_text(encoding="utf-8"))
+def fragment(package: str, name: str) -> dict[str, Any]:
+    """A built-in plugin's schema fragment: `<name>.schema.json` in its feature package."""
+    found: dict[str, Any] = json.loads(_fragment_file(package, name).read_text(encoding="utf-8"))
     return found
 
 
@@ -80,6 +79,12 @@ def schema_for(plugins: Sequence[Plugin]) -> dict[str, Any]:
     if key not in _SCHEMAS:
         _SCHEMAS[key] = _assemble(parts)
     return _SCHEMAS[key]
+
+
+def _fragment_file(package: str, name: str) -> importlib.resources.abc.Traversable:
+    """`<name>.schema.json` in a feature package, found without importing the package."""
+    top, *rest = package.split(".")
+    return importlib.resources.files(top).joinpath(*rest, f"{name}.schema.json")
 
 
 _SCHEMAS: dict[tuple[tuple[str, type], ...], dict[str, Any]] = {}
@@ -115,13 +120,13 @@ def load_schema() -> dict[str, Any]:
 
     Assembled from the fragment files of the default plugins (their code is not imported).
     """
-    from ecs_tentacles.plugin import DEFAULT_ON
+    from ecs_tentacles.plugin import BUILTIN, DEFAULT_ON
 
-    folder = importlib.resources.files("ecs_tentacles.assets") / "schema" / "plugins"
     parts = []
     for name in DEFAULT_ON:
-        if (folder / f"{name}.json").is_file():
-            part = fragment(name)
+        package = BUILTIN[name].partition(":")[0].rpartition(".")[0]  # the feature package
+        if _fragment_file(package, name).is_file():
+            part = fragment(package, name)
             parts.append(
                 (name, part.get("$defs", {}), part.get("creature", {}), part.get("scene", {}))
             )

@@ -1,8 +1,8 @@
 """Example plugins (not on by default): wander, flee, follow_leader, flock.
 
 Each is one file: a `Plugin` and the stage-`decide` `System` it brings, which writes
-goals (`world.goals`) every `interval` seconds rather than every frame, so strokes can
-finish. What their config schemas share is here: a number setting, the two re-planning
+goals (`world.resource(GoalBook)`) every `interval` seconds rather than every frame, so
+strokes can finish. What their config schemas share is here: a number setting, the two re-planning
 settings, and the check that a goal set some distance away is not reached at once.
 """
 

@@ -3,14 +3,14 @@
     "plugins": {"flee": {"distance": 1.5, "run": 1.0}}
 
 Every `interval` seconds the `flee` system (stage decide) measures, for every creature
-at once, the ground distance to every threat (`world.threats.sources`: the scene's
+at once, the ground distance to every threat (`world.resource(ThreatData).sources`: the scene's
 keyframed threats and creatures marked `"threat": true`, never a creature's own
 mantle). A creature with threats closer than `distance` gets a goal `run` metres away
 in the direction that leads away from them, each threat weighted by how close it is.
 Creatures out of reach keep whatever goal they had.
 
-Reads: `world.threats` (positions and owners), CreatureStore (mantle_row, entity),
-Transform store (mantle positions). Writes: goals, through `world.goals.set`.
+Reads: `world.resource(ThreatData)` (positions and owners), CreatureStore (mantle_row, entity),
+Transform store (mantle positions). Writes: goals, through `world.resource(GoalBook).set`.
 """
 
 from __future__ import annotations
@@ -21,9 +21,11 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from ecs_tentacles.systems.examples import Problem, farther_than_reach, number, replanning
 
+from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.scene.validate import plugin_config
 from ecs_tentacles.system import System
+from ecs_tentacles.threats.data import ThreatData
 
 if TYPE_CHECKING:
     from ecs_tentacles.world import World
@@ -52,7 +54,7 @@ class Flee(System):
     def process(self, world: World, dt: float) -> None:
         if world.frame % self.every:
             return
-        threats, owners = world.threats.sources(world)
+        threats, owners = world.resource(ThreatData).sources(world)
         creatures = world.creatures
         if not len(threats) or not creatures.count:
             return
@@ -67,7 +69,7 @@ class Flee(System):
         fleeing = np.flatnonzero(length > 1e-9)
         goals = mantles[fleeing] + self.run * push[fleeing] / length[fleeing, None]
         for row, goal in zip(fleeing, goals, strict=True):
-            world.goals.set(int(creatures.entity[row]), goal, self.goal_radius)
+            world.resource(GoalBook).set(int(creatures.entity[row]), goal, self.goal_radius)
 
 
 class FleePlugin(Plugin):

@@ -13,7 +13,7 @@ The weighted sum is a direction; the creature's goal is set `step` metres along 
 A creature with nothing to steer by keeps its goal.
 
 Reads: CreatureStore (mantle_row, entity), Transform store (mantle positions).
-Writes: goals, through `world.goals.set`.
+Writes: goals, through `world.resource(GoalBook).set`.
 """
 
 from __future__ import annotations
@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from ecs_tentacles.systems.examples import Problem, farther_than_reach, number, replanning
 
+from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.scene.validate import plugin_config
 from ecs_tentacles.system import System
@@ -92,7 +93,9 @@ class Flock(System):
         steer = np.flatnonzero(np.linalg.norm(direction, axis=1) > 1e-6)
         goals = pos[steer] + self.config["step"] * _unit(direction[steer])
         for row, goal in zip(steer, goals, strict=True):
-            world.goals.set(int(creatures.entity[row]), goal, self.config["goal_radius"])
+            world.resource(GoalBook).set(
+                int(creatures.entity[row]), goal, self.config["goal_radius"]
+            )
 
 
 class FlockPlugin(Plugin):

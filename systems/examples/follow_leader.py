@@ -11,8 +11,8 @@ The scene check refuses a leader that is not a creature of the scene, or the cre
 itself.
 
 Reads: CreatureStore (mantle_row, entity), Transform store (mantle positions), the
-scene's `follow` keys (once, at setup). Writes: goals, through `world.goals.set` and
-`world.goals.clear`.
+scene's `follow` keys (once, at setup). Writes: goals, through `world.resource(GoalBook).set` and
+`world.resource(GoalBook).clear`.
 """
 
 from __future__ import annotations
@@ -24,6 +24,7 @@ import numpy as np
 from ecs_tentacles.systems.examples import Problem, number, replanning
 
 from ecs_tentacles.components import Creature
+from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.scene.validate import plugin_config
 from ecs_tentacles.system import System
@@ -74,9 +75,9 @@ class FollowLeader(System):
         for row, goal, far in zip(self.followers, goals, behind, strict=True):
             entity = int(creatures.entity[row])
             if far:
-                world.goals.set(entity, goal, self.goal_radius)
+                world.resource(GoalBook).set(entity, goal, self.goal_radius)
             elif creatures.has_goal[row]:
-                world.goals.clear(entity)
+                world.resource(GoalBook).clear(entity)
 
 
 class FollowLeaderPlugin(Plugin):

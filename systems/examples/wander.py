@@ -9,7 +9,7 @@ creature (`creature_rng` of the world's seed and the creature's name): a run rep
 exactly, and a creature draws the same goals whichever other creatures exist.
 
 Reads: CreatureStore (has_goal, mantle_row), Transform store (mantle positions).
-Writes: goals, through `world.goals.set` (only for creatures that have none).
+Writes: goals, through `world.resource(GoalBook).set` (only for creatures that have none).
 """
 
 from __future__ import annotations
@@ -21,6 +21,7 @@ import numpy as np
 from ecs_tentacles.systems.examples import Problem, farther_than_reach, number, replanning
 
 from ecs_tentacles.build import creature_rng
+from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.scene.validate import plugin_config
 from ecs_tentacles.system import System
@@ -69,7 +70,7 @@ class Wander(System):
         mantles = world.transforms.pos[creatures.mantle_row[idle], :2]
         goals = mantles + distance[:, None] * np.column_stack([np.cos(angle), np.sin(angle)])
         for row, goal in zip(idle, goals, strict=True):
-            world.goals.set(int(creatures.entity[row]), goal, self.goal_radius)
+            world.resource(GoalBook).set(int(creatures.entity[row]), goal, self.goal_radius)
 
 
 class WanderPlugin(Plugin):

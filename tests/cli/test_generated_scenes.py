@@ -31,6 +31,7 @@ from hypothesis import strategies as st
 from hypothesis_jsonschema import from_schema
 
 from ecs_tentacles.cli import main
+from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.scene.validate import load_schema
 from ecs_tentacles.world import World
 
@@ -185,7 +186,7 @@ def test_a_schema_scene_builds_a_finite_world_or_is_refused(
             world.step(10)
             assert np.isfinite(world.transforms.pos).all(), f"frame {world.frame}"
             assert np.isfinite(world.transforms.quat).all(), f"frame {world.frame}"
-            assert np.isfinite(world.fur.curves).all(), f"frame {world.frame}"
+            assert np.isfinite(world.resource(FurData).curves).all(), f"frame {world.frame}"
             assert np.isfinite(world.motors.target).all(), f"frame {world.frame}"
     assert warnings == []  # MuJoCo never blew up
     # steep, strong gravity can make a creature tumble faster than the health check's

@@ -151,8 +151,8 @@ def test_a_failing_setup_is_named_with_its_traceback(
     assert main(["run", str(failing), "--frames", "10", "--allow-systems", "--quiet"]) == 1
     err = capsys.readouterr().err
     assert err.splitlines()[0].startswith(
-        "error: system 'ready' (plugin 'mine') failed at frame 0: AttributeError: this world"
-        " has no 'waves'"
+        "error: system 'ready' (plugin 'mine') failed at frame 0: AttributeError: 'World'"
+        " object has no attribute 'waves'"
     )
     assert (
         _user_traceback(err)[1]

@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 import pytest
-from ecs_tentacles.systems.record import Record
+from ecs_tentacles.systems.record.record import Record
 
 from ecs_tentacles.components import Creature, Link, Tentacle, Transform
 from ecs_tentacles.export.recording import GuideFrame

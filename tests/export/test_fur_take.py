@@ -6,9 +6,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from ecs_tentacles.systems.record import Record
+from ecs_tentacles.systems.record.record import Record
 
 from ecs_tentacles.export.usd import write_usd
+from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.world import World
 
 hooks = pytest.importorskip("ecs_tentacles.fur.hooks", reason="the fur package is not here yet")
@@ -34,7 +35,9 @@ def test_recording_poses_guides_at_frame_0_and_follows_the_rig(tmp_path: Path) -
     assert take.guide_points is not None and np.abs(take.guide_points[0]).max() > 0.1
     recorded.step(4)
     plain.step(4)
-    np.testing.assert_array_equal(recorded.fur.curves, plain.fur.curves)  # no side effects
+    np.testing.assert_array_equal(
+        recorded.resource(FurData).curves, plain.resource(FurData).curves
+    )  # no side effects
     take = system.take()
     curves = hooks.guide_curves(plain)
     assert take.guide_points is not None and take.guide_widths is not None

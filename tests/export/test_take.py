@@ -8,10 +8,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from ecs_tentacles.systems.record import Record
+from ecs_tentacles.systems.record.record import Record
 
 from ecs_tentacles.components import Creature, Sucker, Tentacle, Transform
 from ecs_tentacles.export.bake import BakePlan, bake, simulation_rate
+from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.take import ARRAYS, Take, TakeError
 from ecs_tentacles.world import World
 from tests.export.conftest import SMALL_SCENE, link_centres
@@ -75,9 +76,9 @@ def test_goals_added_and_removed_while_recording_are_tracked() -> None:
     world.add_system(system)
     octo = world.creature("octo")
     world.step(1)
-    extra = world.goals.append(octo, [0.0, 2.0], 0.5)
+    extra = world.resource(GoalBook).append(octo, [0.0, 2.0], 0.5)
     world.step(1)
-    world.goals.remove(extra)
+    world.resource(GoalBook).remove(extra)
     world.step(1)
     take = system.take()
     assert take.header["goals"] == [

@@ -11,6 +11,7 @@ from ecs_tentacles.components import Creature
 from ecs_tentacles.fur import child_hairs
 from ecs_tentacles.fur.children import layout
 from ecs_tentacles.fur.groom import closest_surface_point
+from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.mathutil import quat_rotate
 from ecs_tentacles.world import World
 
@@ -37,11 +38,11 @@ def test_child_roots_lie_on_the_skin_and_children_stay_above_it(
     make_world: Callable[..., World],
 ) -> None:
     world = make_world(SCENE)
-    world.fur.controls.lift[:] = 0.0  # guides lying close to the skin: the hard case
+    world.resource(FurData).controls.lift[:] = 0.0  # guides lying close to the skin: the hard case
     world.step(40)  # crawling and turning: the mantle is not at the origin
     kids = child_hairs(world)
     made = layout(world)
-    g = world.fur.guides
+    g = world.resource(FurData).guides
     assert kids.points.shape == (150 * 5 + 80 * 3, 8, 3)
     for f, name in enumerate(("cat", "hog")):
         mine = np.flatnonzero(g.fur_row[made.parent] == f)
@@ -67,11 +68,11 @@ def test_child_roots_lie_on_the_skin_and_children_stay_above_it(
 
 def test_children_blend_their_guides_offsets(make_world: Callable[..., World]) -> None:
     world = make_world(SCENE, locomotion=False)
-    world.fur.controls.lift[:] = 0.8  # standing up: nothing to clamp
+    world.resource(FurData).controls.lift[:] = 0.8  # standing up: nothing to clamp
     world.step(3)
     made = layout(world)
     kids = child_hairs(world).points
-    curves, roots = world.fur.curves, world.fur.frames[:, 3]
+    curves, roots = world.resource(FurData).curves, world.resource(FurData).frames[:, 3]
     offsets = curves[made.neighbours] - roots[made.neighbours][:, :, None]
     blended = np.einsum("mk,mkpd->mpd", made.weights * made.scale[:, None], offsets)
     quat = world.transforms.quat[made.body]
@@ -80,10 +81,12 @@ def test_children_blend_their_guides_offsets(make_world: Callable[..., World]) -
     assert 0 < (below < 0).any(axis=1).sum() < 0.05 * len(kids)  # a few at the cap's rim
     assert_allclose(kids - kids[:, :1], blended - below[..., None] * normal[:, None], atol=2e-6)
     assert layout(world) is made  # cached until the bind pose changes
-    world.fur.touch()
+    world.resource(FurData).touch()
     assert layout(world) is not made
     colours = child_hairs(world).colour[:, :3]
-    base = world.fur.sets.colour[g_fur := world.fur.guides.fur_row[made.parent]]
+    base = world.resource(FurData).sets.colour[
+        g_fur := world.resource(FurData).guides.fur_row[made.parent]
+    ]
     ratio = colours / base.astype(np.float32)
     assert ratio.std() > 0.02 and (ratio > 0.79).all() and (ratio < 1.16).all()  # jitter
     assert len(set(g_fur.tolist())) == 2

@@ -9,6 +9,7 @@ from numpy.testing import assert_array_equal
 
 from ecs_tentacles.fur import FurControl, FurGuide
 from ecs_tentacles.fur.controls import expand_mirrors, mirror_name, nearest_control
+from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.world import World
 
 
@@ -55,8 +56,8 @@ def test_world_assigns_every_guide_to_its_nearest_control(make_world: Callable[.
     made = {c.name: c for _, c in world.query(FurControl)}
     assert set(made) == {"L_side", "R_side", "front"}
     np.testing.assert_allclose(made["R_side"].position, [0.0, -0.3, 0.0])
-    g = world.fur.guides
-    rests = world.fur.controls.rest_position
+    g = world.resource(FurData).guides
+    rests = world.resource(FurData).controls.rest_position
     d = np.linalg.norm(g.root[:, None, :] - rests[None, :, :], axis=2)
     assert_array_equal(g.control_row, np.argmin(d, axis=1))
     assert set(g.control_row) == {0, 1, 2}

@@ -10,6 +10,7 @@ import pytest
 from numpy.testing import assert_allclose
 
 from ecs_tentacles.fur.editor import FurEditor
+from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.world import World
 
@@ -34,7 +35,7 @@ def test_delete_keeps_one_control_and_removes_twins(editor: FurEditor) -> None:
     assert editor.control_names() == ["crown", "spine", "L_fin", "R_fin"]
     editor.delete("R_fin")  # a twin goes with its original
     assert editor.control_names() == ["crown", "spine"]
-    assert len(editor.world.fur.controls) == 2  # the world was rebuilt without them
+    assert len(editor.world.resource(FurData).controls) == 2  # the world was rebuilt without them
     editor.delete("spine")
     with pytest.raises(ValueError, match="at least one control"):
         editor.delete("crown")
@@ -59,8 +60,10 @@ def test_keys_on_a_twin_go_to_its_original_mirrored(editor: FurEditor) -> None:
     world = editor.world
     rows = editor.rows()
     world.step(1)
-    assert world.fur.controls.lift[rows["R_fin"]] == 0.7  # the twin plays the same track
-    assert_allclose(world.fur.controls.position[rows["R_fin"]], [0.02, -0.1, 0.25])
+    assert (
+        world.resource(FurData).controls.lift[rows["R_fin"]] == 0.7
+    )  # the twin plays the same track
+    assert_allclose(world.resource(FurData).controls.position[rows["R_fin"]], [0.02, -0.1, 0.25])
     assert not editor.delete_key("L_fin", "lift", 1.5, within=0.1)
     assert editor.delete_key("L_fin", "lift", 1.05, within=0.1)
     assert editor.keys("L_fin", "lift") == []

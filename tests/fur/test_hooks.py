@@ -9,7 +9,9 @@ import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
 from ecs_tentacles.fur import child_hairs, control_markers, guide_curves
+from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.mathutil import quat_rotate
+from ecs_tentacles.threats.data import ThreatData
 from ecs_tentacles.world import World
 
 SCENE = {
@@ -36,8 +38,8 @@ def test_guide_curves(make_world: Callable[..., World]) -> None:
     world.step(1)
     curves = guide_curves(world)
     assert curves.points.shape == (40, 6, 3) and curves.points.dtype == np.float32
-    assert_array_equal(curves.points, world.fur.curves)
-    assert curves.points is not world.fur.curves
+    assert_array_equal(curves.points, world.resource(FurData).curves)
+    assert curves.points is not world.resource(FurData).curves
     assert_allclose(curves.colour, np.tile([0.2, 0.4, 0.6, 1.0], (40, 1)), atol=1e-7)
     assert_allclose(curves.width, 0.004, atol=1e-9)
     by_control = guide_curves(world, colour_by="control")
@@ -52,10 +54,10 @@ def test_child_hairs_follow_their_guide(make_world: Callable[..., World]) -> Non
     kids = child_hairs(world, radius=0.01, seed=2, follow="own")
     assert kids.points.shape == (120, 6, 3)
     assert_array_equal(kids.guide, np.repeat(np.arange(40), 3))
-    parent = world.fur.curves[kids.guide]
+    parent = world.resource(FurData).curves[kids.guide]
     offset = kids.points[:, 0] - parent[:, 0]
     assert np.linalg.norm(offset, axis=1).max() <= 0.01 + 1e-6
-    g = world.fur.guides
+    g = world.resource(FurData).guides
     normal = quat_rotate(world.transforms.quat[g.body_row[kids.guide]], g.normal[kids.guide])
     assert_allclose(np.sum(offset * normal, axis=1), 0.0, atol=1e-6)  # in the tangent plane
     shape = kids.points - kids.points[:, :1]
@@ -72,11 +74,11 @@ def test_controls_and_threats(make_world: Callable[..., World]) -> None:
     world = make_world(SCENE, locomotion=False)
     world.step(1)
     (marker,) = control_markers(world)
-    mantle = world.transforms.pos[world.fur.sets.body_row[0]]
-    quat = world.transforms.quat[world.fur.sets.body_row[0]]
+    mantle = world.transforms.pos[world.resource(FurData).sets.body_row[0]]
+    quat = world.transforms.quat[world.resource(FurData).sets.body_row[0]]
     assert (marker.name, marker.shape) == ("a", "cube")
     assert_allclose(marker.position, mantle + quat_rotate(quat, np.array([0, 0, 0.3])))
-    threats = world.threats.positions(world)
+    threats = world.resource(ThreatData).positions(world)
     assert list(threats) == ["roach"]
     assert_allclose(threats["roach"], [1.0, 2.0, 3.0])
 
@@ -86,4 +88,4 @@ def test_a_world_without_fur_gives_empty_arrays(make_world: Callable[..., World]
     world.step(1)
     assert guide_curves(world).points.shape[0] == 0
     assert child_hairs(world).points.shape[0] == 0
-    assert control_markers(world) == [] and world.threats.positions(world) == {}
+    assert control_markers(world) == [] and world.resource(ThreatData).positions(world) == {}

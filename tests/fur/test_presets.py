@@ -11,6 +11,7 @@ from numpy.testing import assert_allclose, assert_array_equal
 
 from ecs_tentacles.fur.presets import preset, preset_names, resolve
 from ecs_tentacles.fur.rig import pose
+from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.mathutil import quat_rotate
 from ecs_tentacles.scene.validate import validate_scene
 from ecs_tentacles.world import World
@@ -26,7 +27,7 @@ def fur_world(make: Callable[..., World], fur: dict[str, Any]) -> World:
 def evaluate(world: World) -> tuple[np.ndarray, np.ndarray]:
     """Run the rig once more this frame; its curves and frames."""
     world.schedule["rig"].process(world, world.settings.dt)
-    return world.fur.curves.copy(), world.fur.frames.copy()
+    return world.resource(FurData).curves.copy(), world.resource(FurData).frames.copy()
 
 
 def test_the_three_presets_exist_and_are_valid() -> None:
@@ -58,7 +59,7 @@ def test_a_scene_overrides_any_preset_field() -> None:
 
 def test_bird_feathers_only_lift(make_world: Callable[..., World]) -> None:
     world = fur_world(make_world, {"preset": "bird", "groom": {"count": 120}})
-    c = world.fur.controls
+    c = world.resource(FurData).controls
     rest_curves, rest_frames = evaluate(world)
     c.lift[:] = 0.6
     lifted, lifted_frames = evaluate(world)
@@ -70,7 +71,7 @@ def test_bird_feathers_only_lift(make_world: Callable[..., World]) -> None:
     assert_array_equal(everything, lifted)  # nothing but lift has any effect
     c.lift[:] = 1.0
     _, frames = evaluate(world)
-    g, body = world.fur.guides, world.fur.guides.body_row
+    g, body = world.resource(FurData).guides, world.resource(FurData).guides.body_row
     normals = quat_rotate(world.transforms.quat[body], g.normal)
     assert_allclose(frames[:, 0], normals, atol=1e-6)
 
@@ -81,16 +82,23 @@ def test_hedgehog_quills_lift_and_interlock_without_dynamics(
     world = fur_world(make_world, {"preset": "hedgehog", "groom": {"count": 200}})
     rig = world.schedule["rig"]
     assert rig.strands is None  # no dynamics at all
-    c = world.fur.controls
+    c = world.resource(FurData).controls
     c.lift[:], c.random[:] = 0.5, 1.0
-    world.transforms.pos[world.fur.guides.body_row[0]] += (0.3, 0.0, 0.0)  # a sudden move
+    world.transforms.pos[world.resource(FurData).guides.body_row[0]] += (
+        0.3,
+        0.0,
+        0.0,
+    )  # a sudden move
     curves, frames = evaluate(world)
     assert_array_equal(curves, pose(rig.bind.shape_h, frames, out=np.empty_like(curves)))
-    m = world.fur.guides.multiplier
+    m = world.resource(FurData).guides.multiplier
     assert (m < -0.3).sum() > 40 and (m > 0.3).sum() > 40  # twisted both ways: interlocking
     c.random[:] = 0.0
     _, untwisted = evaluate(world)
-    n = quat_rotate(world.transforms.quat[world.fur.guides.body_row], world.fur.guides.normal)
+    n = quat_rotate(
+        world.transforms.quat[world.resource(FurData).guides.body_row],
+        world.resource(FurData).guides.normal,
+    )
     turned = np.arctan2(
         np.sum(np.cross(untwisted[:, 0], frames[:, 0]) * n, axis=1),
         np.sum(untwisted[:, 0] * frames[:, 0], axis=1)
@@ -103,7 +111,7 @@ def test_cat_hair_blends_to_a_strand_simulation(make_world: Callable[..., World]
     world = fur_world(make_world, {"preset": "cat", "groom": {"count": 150}})
     rig = world.schedule["rig"]
     assert rig.strands is not None and len(rig.strands.guides) == 150
-    body = world.fur.guides.body_row[0]
+    body = world.resource(FurData).guides.body_row[0]
     for _ in range(5):  # the body jerks sideways: tips lag behind, roots follow
         world.transforms.pos[body] += (0.0, 0.02, 0.0)
         curves, frames = evaluate(world)
@@ -111,7 +119,7 @@ def test_cat_hair_blends_to_a_strand_simulation(make_world: Callable[..., World]
     assert_allclose(curves[:, 0], rigid[:, 0], atol=1e-6)
     lag = curves[:, -1, 1] - rigid[:, -1, 1]
     assert lag.mean() < -1e-3  # tips trail the motion
-    world.fur.controls.dynamic[:] = 0.0
+    world.resource(FurData).controls.dynamic[:] = 0.0
     curves, frames = evaluate(world)
     assert_array_equal(curves, pose(rig.bind.shape_h, frames, out=np.empty_like(curves)))
 

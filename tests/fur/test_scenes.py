@@ -7,14 +7,15 @@ from collections.abc import Callable
 import numpy as np
 
 from ecs_tentacles.fur import Fur, guide_curves
+from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.mathutil import quat_rotate
 from ecs_tentacles.world import World
 
 
 def mean_elevation(world: World) -> float:
-    g = world.fur.guides
+    g = world.resource(FurData).guides
     normals = quat_rotate(world.transforms.quat[g.body_row], g.normal)
-    return float(np.mean(np.sum(world.fur.frames[:, 0] * normals, axis=1)))
+    return float(np.mean(np.sum(world.resource(FurData).frames[:, 0] * normals, axis=1)))
 
 
 def test_hedgehog_octopus_bristles_when_the_roach_comes_near(
@@ -25,9 +26,9 @@ def test_hedgehog_octopus_bristles_when_the_roach_comes_near(
     assert fur.preset == "hedgehog" and len(fur.guides) == 500
     world.step(60)
     calm = mean_elevation(world)
-    assert world.fur.emotions.level[0] == 0.0 and calm < 0.2
+    assert world.resource(FurData).emotions.level[0] == 0.0 and calm < 0.2
     world.step(4 * 60)  # the roach arrives at 3 s
-    assert world.fur.emotions.level[0] > 0.9
+    assert world.resource(FurData).emotions.level[0] > 0.9
     assert mean_elevation(world) > calm + 0.4
     assert np.isfinite(guide_curves(world).points).all()
 
@@ -37,5 +38,10 @@ def test_fur_presets_has_one_creature_per_preset(make_world: Callable[..., World
     world.step(2)
     presets = {world.component(e, Fur).preset for e, _ in world.query(Fur)}
     assert presets == {"hedgehog", "cat", "bird"}
-    assert world.fur.points == 8  # the most any fur asks for (the cat): all guides share it
-    assert np.isfinite(world.fur.curves).all() and len(world.fur.curves) == 400 + 600 + 160
+    assert (
+        world.resource(FurData).points == 8
+    )  # the most any fur asks for (the cat): all guides share it
+    assert (
+        np.isfinite(world.resource(FurData).curves).all()
+        and len(world.resource(FurData).curves) == 400 + 600 + 160
+    )

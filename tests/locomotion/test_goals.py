@@ -10,7 +10,7 @@ import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
 from ecs_tentacles.components import Goal, Transform
-from ecs_tentacles.locomotion.goals import DEFAULT_RADIUS
+from ecs_tentacles.locomotion.goals import DEFAULT_RADIUS, GoalBook
 from ecs_tentacles.world import World
 from tests.conftest import creature_scene
 
@@ -29,19 +29,20 @@ def test_set_append_remove_clear(make_world: Callable[..., World]) -> None:
     world = _world(make_world)
     octo = world.creature("octo")
     store, row = world.creatures, 0
-    assert world.goals.path(octo) == []
-    assert world.goals.current(octo) is None
-    assert world.goals.positions(octo).shape == (0, 3)
+    assert world.resource(GoalBook).path(octo) == []
+    assert world.resource(GoalBook).current(octo) is None
+    assert world.resource(GoalBook).positions(octo).shape == (0, 3)
     assert not store.has_goal[row]
 
-    a = world.goals.set(octo, [1.0, 2.0])
-    b = world.goals.append(octo, [3.0, 4.0, 0.5], radius=0.1)
-    c = world.goals.append(octo, (-1.0, 0.0))
-    assert world.goals.path(octo) == [a, b, c]
-    assert world.goals.current(octo) == a
+    a = world.resource(GoalBook).set(octo, [1.0, 2.0])
+    b = world.resource(GoalBook).append(octo, [3.0, 4.0, 0.5], radius=0.1)
+    c = world.resource(GoalBook).append(octo, (-1.0, 0.0))
+    assert world.resource(GoalBook).path(octo) == [a, b, c]
+    assert world.resource(GoalBook).current(octo) == a
     assert _orders(world, [a, b, c]) == [0, 1, 2]
     assert_array_equal(
-        world.goals.positions(octo), [[1.0, 2.0, 0.0], [3.0, 4.0, 0.5], [-1.0, 0.0, 0.0]]
+        world.resource(GoalBook).positions(octo),
+        [[1.0, 2.0, 0.0], [3.0, 4.0, 0.5], [-1.0, 0.0, 0.0]],
     )
     goal_b = world.component(b, Goal)
     assert (goal_b.owner, goal_b.radius) == (octo, 0.1)
@@ -50,41 +51,43 @@ def test_set_append_remove_clear(make_world: Callable[..., World]) -> None:
     assert_array_equal(store.goal[row], [1.0, 2.0, 0.0])
     assert store.goal_radius[row] == DEFAULT_RADIUS
 
-    world.goals.remove(b)  # from the middle: the rest close ranks
-    assert world.goals.path(octo) == [a, c]
+    world.resource(GoalBook).remove(b)  # from the middle: the rest close ranks
+    assert world.resource(GoalBook).path(octo) == [a, c]
     assert _orders(world, [a, c]) == [0, 1]
     assert world.try_component(b, Goal) is None
 
-    world.goals.remove(a)  # the current one: the next becomes current, mirrored in the store
-    assert world.goals.current(octo) == c
+    world.resource(GoalBook).remove(
+        a
+    )  # the current one: the next becomes current, mirrored in the store
+    assert world.resource(GoalBook).current(octo) == c
     assert _orders(world, [c]) == [0]
     assert_array_equal(store.goal[row], [-1.0, 0.0, 0.0])
 
-    d = world.goals.set(octo, [5.0, 5.0], radius=2.0)  # replaces the whole path
-    assert world.goals.path(octo) == [d]
+    d = world.resource(GoalBook).set(octo, [5.0, 5.0], radius=2.0)  # replaces the whole path
+    assert world.resource(GoalBook).path(octo) == [d]
     assert world.try_component(c, Goal) is None
     assert_array_equal(store.goal[row], [5.0, 5.0, 0.0])
     assert store.goal_radius[row] == 2.0
 
-    path = world.goals.path(octo)
+    path = world.resource(GoalBook).path(octo)
     path.append(12345)  # path() is a copy
-    assert world.goals.path(octo) == [d]
+    assert world.resource(GoalBook).path(octo) == [d]
 
-    world.goals.clear(octo)
-    assert world.goals.path(octo) == []
-    assert world.goals.current(octo) is None
+    world.resource(GoalBook).clear(octo)
+    assert world.resource(GoalBook).path(octo) == []
+    assert world.resource(GoalBook).current(octo) is None
     assert world.try_component(d, Goal) is None
     assert not store.has_goal[row]
-    world.goals.clear(octo)  # clearing nothing is fine
-    assert world.goals.path(octo) == []
+    world.resource(GoalBook).clear(octo)  # clearing nothing is fine
+    assert world.resource(GoalBook).path(octo) == []
 
 
 def test_scene_goals_form_the_path(make_world: Callable[..., World]) -> None:
     world = _world(make_world, goals=[{"position": [1, 0]}, {"position": [2, 1, 0.2], "radius": 1}])
     octo = world.creature("octo")
-    path = world.goals.path(octo)
+    path = world.resource(GoalBook).path(octo)
     assert _orders(world, path) == [0, 1]
-    assert_array_equal(world.goals.positions(octo), [[1, 0, 0], [2, 1, 0.2]])
+    assert_array_equal(world.resource(GoalBook).positions(octo), [[1, 0, 0], [2, 1, 0.2]])
     assert [world.component(g, Goal).radius for g in path] == [DEFAULT_RADIUS, 1.0]
 
 
@@ -106,10 +109,10 @@ def test_bad_goals_are_refused_and_change_nothing(
 ) -> None:
     world = _world(make_world)
     octo = world.creature("octo")
-    first = world.goals.set(octo, [1.0, 1.0])
+    first = world.resource(GoalBook).set(octo, [1.0, 1.0])
     with pytest.raises(ValueError, match="^" + message.replace("[", r"\[").replace("]", r"\]")):
-        world.goals.append(octo, position, radius)
-    assert world.goals.path(octo) == [first]
+        world.resource(GoalBook).append(octo, position, radius)
+    assert world.resource(GoalBook).path(octo) == [first]
     assert_array_equal(world.creatures.goal[0], [1.0, 1.0, 0.0])
 
 
@@ -117,21 +120,24 @@ def test_a_refused_set_keeps_the_old_path(make_world: Callable[..., World]) -> N
     # e.g. a click that misses the ground gives nan: the creature should keep its path
     world = _world(make_world)
     octo = world.creature("octo")
-    path = [world.goals.set(octo, [1.0, 1.0]), world.goals.append(octo, [2.0, 1.0])]
+    path = [
+        world.resource(GoalBook).set(octo, [1.0, 1.0]),
+        world.resource(GoalBook).append(octo, [2.0, 1.0]),
+    ]
     with pytest.raises(ValueError, match=r"^goal position must be 2 or 3 finite numbers"):
-        world.goals.set(octo, [np.nan, 0.0])
+        world.resource(GoalBook).set(octo, [np.nan, 0.0])
     with pytest.raises(ValueError, match=r"^goal radius must be > 0, got 0"):
-        world.goals.set(octo, [1.0, 0.0], radius=0)
-    assert world.goals.path(octo) == path
+        world.resource(GoalBook).set(octo, [1.0, 0.0], radius=0)
+    assert world.resource(GoalBook).path(octo) == path
     assert world.creatures.has_goal[0]
 
 
 def test_goals_belong_to_creatures(make_world: Callable[..., World]) -> None:
     world = _world(make_world)
     octo = world.creature("octo")
-    goal = world.goals.set(octo, [1.0, 1.0])
+    goal = world.resource(GoalBook).set(octo, [1.0, 1.0])
     with pytest.raises(KeyError):
-        world.goals.append(goal, [0.0, 0.0])
+        world.resource(GoalBook).append(goal, [0.0, 0.0])
 
 
 def test_goal_on_the_creature_is_reached_on_the_first_frame(
@@ -141,15 +147,15 @@ def test_goal_on_the_creature_is_reached_on_the_first_frame(
     octo = world.creature("octo")
     reached: list[dict[str, Any]] = []
     world.events.on("goal_reached", lambda **kw: reached.append(kw))
-    here = world.goals.set(octo, [0.05, -0.05])
-    there = world.goals.append(octo, [3.0, 0.0])
+    here = world.resource(GoalBook).set(octo, [0.05, -0.05])
+    there = world.resource(GoalBook).append(octo, [3.0, 0.0])
     world.step(1)
     assert len(reached) == 1
     event = reached[0]
     assert (event["world"], event["creature"], event["goal"]) == (world, octo, here)
     assert_array_equal(event["position"], [0.05, -0.05, 0.0])
-    assert world.goals.path(octo) == [there]
-    assert world.goals.current(octo) == there
+    assert world.resource(GoalBook).path(octo) == [there]
+    assert world.resource(GoalBook).current(octo) == there
     assert world.component(there, Goal).order == 0
     assert world.try_component(here, Goal) is None
     assert_array_equal(world.creatures.goal[0], [3.0, 0.0, 0.0])
@@ -166,19 +172,19 @@ def test_goals_are_reached_in_path_order(make_world: Callable[..., World]) -> No
     world.events.on("goal_reached", lambda **kw: reached.append(kw["position"][:2].tolist()))
     path = [[0.0, 0.0], [0.25, 0.0], [0.0, -0.2], [0.1, 0.05], [2.0, 0.0]]
     for position in path:
-        world.goals.append(octo, position)
+        world.resource(GoalBook).append(octo, position)
     world.step(8)
     assert reached == path[:4]
-    assert_allclose(world.goals.positions(octo), [[2.0, 0.0, 0.0]])
+    assert_allclose(world.resource(GoalBook).positions(octo), [[2.0, 0.0, 0.0]])
     assert world.events.counts["goal_reached"] == 4
 
 
 def test_reaching_is_measured_in_the_ground_plane(make_world: Callable[..., World]) -> None:
     world = _world(make_world)
     octo = world.creature("octo")
-    world.goals.set(octo, [0.0, 0.0, 5.0], radius=0.05)  # straight above the mantle
+    world.resource(GoalBook).set(octo, [0.0, 0.0, 5.0], radius=0.05)  # straight above the mantle
     world.step(1)
-    assert world.goals.path(octo) == []
+    assert world.resource(GoalBook).path(octo) == []
     assert world.events.counts["goal_reached"] == 1
 
 
@@ -186,9 +192,9 @@ def test_goal_just_outside_its_radius_is_not_reached(make_world: Callable[..., W
     world = _world(make_world)
     octo = world.creature("octo")
     mantle = world.component(octo, Transform).pos[:2].copy()
-    far = world.goals.set(octo, mantle + np.array([0.31, 0.0]), radius=0.3)
+    far = world.resource(GoalBook).set(octo, mantle + np.array([0.31, 0.0]), radius=0.3)
     world.step(1)
-    assert world.goals.path(octo) == [far]
-    world.goals.set(octo, mantle + np.array([0.29, 0.0]), radius=0.3)
+    assert world.resource(GoalBook).path(octo) == [far]
+    world.resource(GoalBook).set(octo, mantle + np.array([0.29, 0.0]), radius=0.3)
     world.step(1)
-    assert world.goals.path(octo) == []
+    assert world.resource(GoalBook).path(octo) == []

@@ -8,6 +8,8 @@ import mujoco
 import numpy as np
 
 from ecs_tentacles.components import Transform
+from ecs_tentacles.locomotion.goals import GoalBook
+from ecs_tentacles.locomotion.params import Locomotion
 from ecs_tentacles.world import World
 from tests.conftest import creature_scene
 
@@ -27,7 +29,7 @@ def test_coordinated_creature_crawls_toward_its_goal(make_world: Callable[..., W
     assert world.physics.health.recoveries == 0
     assert float(np.linalg.norm(goal - mantle.pos[:2])) < start - 0.15
     assert world.events.counts["sucker_attached"] >= 2  # it crawled with its suckers
-    assert world.goals.path(octo) != []  # 1.5 m is too far for 4 s
+    assert world.resource(GoalBook).path(octo) != []  # 1.5 m is too far for 4 s
 
 
 def test_idle_creature_writhes_in_place(make_world: Callable[..., World]) -> None:
@@ -44,5 +46,5 @@ def test_idle_creature_writhes_in_place(make_world: Callable[..., World]) -> Non
         angles.append(data.qpos[model.jnt_qposadr[hinges]].copy())
     assert float(np.linalg.norm(mantle.pos[:2] - start)) < 0.05
     assert np.array(angles).std(axis=0).min() > 0.01  # every joint moves
-    assert world.locomotion.actions(octo) == ["idle"] * 8
+    assert world.resource(Locomotion).actions(octo) == ["idle"] * 8
     assert world.events.counts["sucker_attached"] == 0

@@ -11,6 +11,7 @@ from numpy.testing import assert_allclose, assert_array_equal
 
 from ecs_tentacles.components import Creature
 from ecs_tentacles.locomotion.actions import BASE_SECONDS, ActionQueue, Kind
+from ecs_tentacles.locomotion.params import Locomotion
 from ecs_tentacles.world import World
 from tests.conftest import creature_scene
 
@@ -37,7 +38,7 @@ def test_strength_of_one_tentacle_reaches_its_servos(make_world: Callable[..., W
     model = world.physics.groups[0].model
     world.step(1)
     before = model.actuator_gainprm[:, 0].copy()
-    world.locomotion.set(octo, tentacle=1, strength=40.0, damping=2.0)
+    world.resource(Locomotion).set(octo, tentacle=1, strength=40.0, damping=2.0)
     world.step(1)
     motors = world.motors
     links = _links(world, 1)
@@ -61,9 +62,9 @@ def test_strength_of_one_tentacle_reaches_its_servos(make_world: Callable[..., W
         rtol=1e-12,
     )
     assert not np.allclose(model.actuator_gainprm[mine, 0], before[mine])
-    assert world.locomotion.get(octo, 1)["strength"] == 40.0
-    assert world.locomotion.get(octo, 1)["damping"] == 2.0
-    assert world.locomotion.get(octo, 2)["strength"] == 25.0
+    assert world.resource(Locomotion).get(octo, 1)["strength"] == 40.0
+    assert world.resource(Locomotion).get(octo, 1)["damping"] == 2.0
+    assert world.resource(Locomotion).get(octo, 2)["strength"] == 25.0
 
 
 def test_tentacle_parameters_land_in_the_tentacle_store(
@@ -72,8 +73,10 @@ def test_tentacle_parameters_land_in_the_tentacle_store(
     world = _world(make_world)
     octo = world.creature("octo")
     t = world.tentacles
-    world.locomotion.set(octo, tentacle=2, speed=1.5, wave_amplitude=0.2, wavelength=2.0)
-    world.locomotion.set(octo, writhe=0.9, wave_frequency=3.0, target_angle=1.0)  # all four
+    world.resource(Locomotion).set(octo, tentacle=2, speed=1.5, wave_amplitude=0.2, wavelength=2.0)
+    world.resource(Locomotion).set(
+        octo, writhe=0.9, wave_frequency=3.0, target_angle=1.0
+    )  # all four
     assert t.speed.tolist() == [1.0, 1.0, 1.5, 1.0]
     assert_allclose(t.wave_amplitude, [np.radians(6)] * 2 + [0.2] + [np.radians(6)], rtol=1e-12)
     assert t.wavelength.tolist() == [0.7, 0.7, 2.0, 0.7]
@@ -81,7 +84,7 @@ def test_tentacle_parameters_land_in_the_tentacle_store(
     assert t.wave_frequency.tolist() == [3.0] * 4
     assert t.target_angle.tolist() == [1.0] * 4
     assert world.creatures.speed[0] == 1.0  # a tentacle's speed is not the creature's
-    got = world.locomotion.get(octo, 2)
+    got = world.resource(Locomotion).get(octo, 2)
     assert got == {
         "speed": 1.5,
         "target_angle": 1.0,
@@ -100,10 +103,13 @@ def test_tentacle_parameters_land_in_the_tentacle_store(
 def test_gait_and_drivers_are_per_creature(make_world: Callable[..., World]) -> None:
     world = _world(make_world)
     octo = world.creature("octo")
-    world.locomotion.set(octo, gait="cyclic")
-    assert world.locomotion.get(octo)["gait"] == "cyclic"
-    world.locomotion.set(octo, gait="coordinated", drivers=4)
-    assert (world.locomotion.get(octo, 3)["gait"], world.locomotion.get(octo, 3)["drivers"]) == (
+    world.resource(Locomotion).set(octo, gait="cyclic")
+    assert world.resource(Locomotion).get(octo)["gait"] == "cyclic"
+    world.resource(Locomotion).set(octo, gait="coordinated", drivers=4)
+    assert (
+        world.resource(Locomotion).get(octo, 3)["gait"],
+        world.resource(Locomotion).get(octo, 3)["drivers"],
+    ) == (
         "coordinated",
         4,
     )
@@ -113,9 +119,9 @@ def test_gait_and_drivers_are_per_creature(make_world: Callable[..., World]) -> 
 def test_gait_switch_changes_who_drives(make_world: Callable[..., World]) -> None:
     world = _world(make_world, goals=[{"position": [1.5, 0.0]}])
     octo = world.creature("octo")
-    world.locomotion.set(octo, gait="cyclic")
+    world.resource(Locomotion).set(octo, gait="cyclic")
     world.step(1)
-    assert world.locomotion.queue(octo, 0) == ["extend", "attach", "pull", "detach"]
+    assert world.resource(Locomotion).queue(octo, 0) == ["extend", "attach", "pull", "detach"]
 
 
 def _durations(world: World, tentacle: int) -> list[float]:
@@ -127,14 +133,14 @@ def _durations(world: World, tentacle: int) -> list[float]:
 def test_speeds_divide_the_durations_of_new_actions(make_world: Callable[..., World]) -> None:
     world = _world(make_world, gait="cyclic", goals=[{"position": [1.5, 0.0]}])
     octo = world.creature("octo")
-    world.locomotion.set(octo, speed=2.0)
-    world.locomotion.set(octo, tentacle=0, speed=1.25)
+    world.resource(Locomotion).set(octo, speed=2.0)
+    world.resource(Locomotion).set(octo, tentacle=0, speed=1.25)
     world.step(1)
     kinds = [Kind.EXTEND, Kind.ATTACH, Kind.PULL, Kind.DETACH]
     assert _durations(world, 0) == [BASE_SECONDS[k] / 2.5 for k in kinds]
-    assert world.locomotion.get(octo)["creature_speed"] == 2.0
+    assert world.resource(Locomotion).get(octo)["creature_speed"] == 2.0
     # a stroke under way keeps the durations it was queued with
-    world.locomotion.set(octo, speed=4.0)
+    world.resource(Locomotion).set(octo, speed=4.0)
     world.step(1)
     assert _durations(world, 0) == [BASE_SECONDS[k] / 2.5 for k in kinds]
 
@@ -143,9 +149,9 @@ def test_numpy_numbers_are_numbers(make_world: Callable[..., World]) -> None:
     # values straight from numpy arrays (sliders, scripts) are accepted like Python numbers
     world = _world(make_world)
     octo = world.creature("octo")
-    world.locomotion.set(octo, tentacle=1, writhe=np.float32(0.5), speed=np.int64(2))
-    world.locomotion.set(octo, drivers=np.int64(3))
-    got = world.locomotion.get(octo, 1)
+    world.resource(Locomotion).set(octo, tentacle=1, writhe=np.float32(0.5), speed=np.int64(2))
+    world.resource(Locomotion).set(octo, drivers=np.int64(3))
+    got = world.resource(Locomotion).get(octo, 1)
     assert (got["writhe"], got["speed"], got["drivers"]) == (0.5, 2.0, 3)
 
 
@@ -190,14 +196,14 @@ def test_bad_values_name_the_parameter(
     world = _world(make_world)
     octo = world.creature("octo")
     with pytest.raises(ValueError) as raised:
-        world.locomotion.set(octo, **params)
+        world.resource(Locomotion).set(octo, **params)
     assert str(raised.value).startswith(message)
 
 
 def test_nothing_changes_when_one_value_is_bad(make_world: Callable[..., World]) -> None:
     world = _world(make_world)
     octo = world.creature("octo")
-    before = world.locomotion.get(octo, 1)
+    before = world.resource(Locomotion).get(octo, 1)
     for params in (
         {"speed": 2.0, "writhe": 5.0},
         {"gait": "cyclic", "drivers": 9},
@@ -206,8 +212,8 @@ def test_nothing_changes_when_one_value_is_bad(make_world: Callable[..., World])
         {"writhe": 0.5, "colour": 2},
     ):
         with pytest.raises(ValueError):
-            world.locomotion.set(octo, **params)
-        assert world.locomotion.get(octo, 1) == before, params
+            world.resource(Locomotion).set(octo, **params)
+        assert world.resource(Locomotion).get(octo, 1) == before, params
     assert_array_equal(world.motors.strength[_links(world, 1)], 25.0 * world.motors.scale[:4])
 
 
@@ -217,11 +223,11 @@ def test_tentacle_index_out_of_range(make_world: Callable[..., World], tentacle:
     octo = world.creature("octo")
     message = rf"^tentacle: must be in \[0, 3\], got {tentacle}$"
     with pytest.raises(ValueError, match=message):
-        world.locomotion.set(octo, tentacle=tentacle, writhe=0.5)
+        world.resource(Locomotion).set(octo, tentacle=tentacle, writhe=0.5)
     with pytest.raises(ValueError, match=message):
-        world.locomotion.get(octo, tentacle)
+        world.resource(Locomotion).get(octo, tentacle)
     with pytest.raises(ValueError, match=message):
-        world.locomotion.queue(octo, tentacle)
+        world.resource(Locomotion).queue(octo, tentacle)
 
 
 @pytest.mark.parametrize(("params"), [{"gait": "cyclic"}, {"drivers": 1}])
@@ -232,24 +238,24 @@ def test_creature_parameters_refuse_a_tentacle_index(
     octo = world.creature("octo")
     name = next(iter(params))
     with pytest.raises(ValueError, match=rf"^{name}: is set per creature$"):
-        world.locomotion.set(octo, tentacle=0, **params)
-    assert world.locomotion.get(octo)["gait"] == "coordinated"
-    assert world.locomotion.get(octo)["drivers"] == 2
+        world.resource(Locomotion).set(octo, tentacle=0, **params)
+    assert world.resource(Locomotion).get(octo)["gait"] == "coordinated"
+    assert world.resource(Locomotion).get(octo)["drivers"] == 2
 
 
 def test_actions_lists_each_tentacle(make_world: Callable[..., World]) -> None:
     world = _world(make_world, goals=[{"position": [-1.5, 0.0]}])
     octo = world.creature("octo")
-    assert world.locomotion.actions(octo) == ["idle"] * 4
+    assert world.resource(Locomotion).actions(octo) == ["idle"] * 4
     world.step(1)
-    assert world.locomotion.actions(octo) == ["idle", "idle", "orient", "idle"]
+    assert world.resource(Locomotion).actions(octo) == ["idle", "idle", "orient", "idle"]
 
 
 def test_a_stiffer_servo_needs_more_damping(make_world: Callable[..., World]) -> None:
     world = _world(make_world)  # 60 fps x 8 substeps: a physics step of 1/480 s
     octo = world.creature("octo")
-    assert world.locomotion.strength_limit(octo) == pytest.approx(0.5 * 480)
-    world.locomotion.set(octo, tentacle=2, strength=1000.0, damping=1000.0 / 480)
-    assert world.locomotion.get(octo, 2)["strength"] == 1000.0
-    assert world.locomotion.strength_limit(octo, 2) == 1000.0  # the schema's ceiling
-    assert world.locomotion.strength_limit(octo) == pytest.approx(240.0)  # the others'
+    assert world.resource(Locomotion).strength_limit(octo) == pytest.approx(0.5 * 480)
+    world.resource(Locomotion).set(octo, tentacle=2, strength=1000.0, damping=1000.0 / 480)
+    assert world.resource(Locomotion).get(octo, 2)["strength"] == 1000.0
+    assert world.resource(Locomotion).strength_limit(octo, 2) == 1000.0  # the schema's ceiling
+    assert world.resource(Locomotion).strength_limit(octo) == pytest.approx(240.0)  # the others'

@@ -14,6 +14,7 @@ import pytest
 from numpy.testing import assert_array_equal
 
 from ecs_tentacles.cli import main
+from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.world import World
 
 SCENE: dict[str, Any] = {
@@ -85,7 +86,7 @@ def test_a_teleport_never_reaches_a_goal(make_world: Callable[..., World]) -> No
     world.step(5)
     assert world.events.counts["goal_reached"] == 0
     assert world.physics.health.causes == {"speed": 1}
-    assert len(world.goals.path(world.creature("c0"))) == 1
+    assert len(world.resource(GoalBook).path(world.creature("c0"))) == 1
 
 
 def test_a_creature_that_keeps_failing_is_frozen(

@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 from numpy.testing import assert_array_equal
 
+from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.physics.sleep import SETTLE_FRAMES
 from ecs_tentacles.world import World
 
@@ -36,7 +37,7 @@ def test_a_still_idle_creature_sleeps_and_a_goal_wakes_it(
     world.step(30)
     assert_array_equal(rest.get_state(), state)  # not stepped at all
     start = world.transforms.pos[rest.body_rows[0]].copy()
-    world.goals.set(world.creature("rest"), [1.0, 0.0])
+    world.resource(GoalBook).set(world.creature("rest"), [1.0, 0.0])
     world.step(1)
     assert not rest.sleeping
     world.step(120)

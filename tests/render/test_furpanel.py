@@ -13,6 +13,7 @@ from pyglet.window import key, mouse
 from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.fur.components import FurControl
 from ecs_tentacles.fur.controls import nearest_control
+from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.mathutil import quat_rotate
 from ecs_tentacles.scene.load import load_scene
 from ecs_tentacles.world import World
@@ -61,9 +62,11 @@ def expected_assignment(world: World, editor: Any) -> np.ndarray:
     """Every hedgehog guide's nearest control, computed here from the stores."""
     rows = editor.rows()
     names, control_rows = list(rows), np.array(list(rows.values()))
-    g = world.fur.guides
+    g = world.resource(FurData).guides
     mine = g.fur_row == g.fur_row[0]
-    nearest = nearest_control(g.root[mine], world.fur.controls.rest_position[control_rows])
+    nearest = nearest_control(
+        g.root[mine], world.resource(FurData).controls.rest_position[control_rows]
+    )
     return np.array(names)[nearest]
 
 
@@ -104,12 +107,15 @@ def test_create_a_mirrored_control_and_drag_it(make_sandbox: Callable[..., Any])
     assert (after == expected_assignment(sandbox.world, editor)).all()
     assert (after != before).any()
     assert (after == "spine").sum() < (before == "spine").sum()  # the ears took rear guides
-    g = sandbox.world.fur.guides
+    g = sandbox.world.resource(FurData).guides
     roots = g.root[g.fur_row == g.fur_row[0]]
     for name, side in (("L_ear", 1), ("R_ear", -1)):  # at the rear of their own side
         assert roots[before == name, 0].mean() > 0.0 > roots[after == name, 0].mean()
         assert (side * roots[after == name, 1] > 0).all()
-    assert sandbox.world.fur.version > 0 and sandbox.world.schedule["rig"].bind is not None
+    assert (
+        sandbox.world.resource(FurData).version > 0
+        and sandbox.world.schedule["rig"].bind is not None
+    )
 
 
 def test_two_slow_in_keys_play_back_as_the_tracks_evaluate(
@@ -118,7 +124,7 @@ def test_two_slow_in_keys_play_back_as_the_tracks_evaluate(
     sandbox = tool(make_sandbox)
     editor, timeline = sandbox.fur.editor, sandbox.timeline
     row = editor.rows()["crown"]
-    lift = sandbox.world.fur.controls.lift
+    lift = sandbox.world.resource(FurData).controls.lift
     click_item(sandbox, "easing slow_in")
     assert timeline.easing == 3
     click_item(sandbox, "scrubber", 0.1)
@@ -172,7 +178,7 @@ def test_save_reloads_to_the_same_fur(make_sandbox: Callable[..., Any], tmp_path
             world.schedule["rig"].play_tracks = True
         by_root = {}
         for world in (edited, reloaded):
-            g = world.fur.guides
+            g = world.resource(FurData).guides
             names = {row: name for name, row in _rows(world).items()}
             order = np.lexsort(g.root.T)
             by_root[id(world)] = (g.root[order], [names[int(r)] for r in g.control_row[order]])
@@ -180,7 +186,10 @@ def test_save_reloads_to_the_same_fur(make_sandbox: Callable[..., Any], tmp_path
         assert_allclose(by_root[id(edited)][0], by_root[id(reloaded)][0])
         assert by_root[id(edited)][1] == by_root[id(reloaded)][1]
         for name in ("lift", "position", "rest_position", "random", "emotion"):
-            a, b = getattr(edited.fur.controls, name), getattr(reloaded.fur.controls, name)
+            a, b = (
+                getattr(edited.resource(FurData).controls, name),
+                getattr(reloaded.resource(FurData).controls, name),
+            )
             rows_a, rows_b = _rows(edited), _rows(reloaded)
             assert rows_a.keys() == rows_b.keys()
             assert_allclose(a[list(rows_a.values())], b[list(rows_b.values())], atol=1e-12)

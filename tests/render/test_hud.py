@@ -13,6 +13,7 @@ from PIL import Image
 from pyglet.window import key
 
 from ecs_tentacles.cli import main
+from ecs_tentacles.locomotion.params import Locomotion
 from ecs_tentacles.render.hud import PANEL_SHARE, panel_width
 from tests.render.conftest import click_gui, event
 
@@ -105,10 +106,12 @@ def test_slider_click_reaches_the_servo_gains(make_sandbox: Callable[..., Any]) 
     sandbox.render()
     x0, y0, x1, y1 = sandbox.hud.gui.rects["strength"]
     click_gui(sandbox, x0 + 0.75 * (x1 - x0), (y0 + y1) / 2)
-    kp = world.locomotion.get(octo, 0)["strength"]
+    kp = world.resource(Locomotion).get(octo, 0)["strength"]
     # the knob jumped to where we clicked, on a logarithmic scale up to what damping holds
-    assert 10 < kp < world.locomotion.strength_limit(octo)
-    assert [world.locomotion.get(octo, k)["strength"] for k in range(8)] == [kp] * 8  # "all"
+    assert 10 < kp < world.resource(Locomotion).strength_limit(octo)
+    assert [world.resource(Locomotion).get(octo, k)["strength"] for k in range(8)] == [
+        kp
+    ] * 8  # "all"
     sandbox.step(1)
     model = world.physics.groups[0].model
     actuator = model.actuator("t3/l00/curl").id
@@ -118,7 +121,7 @@ def test_slider_click_reaches_the_servo_gains(make_sandbox: Callable[..., Any]) 
     )
     x0, y0, x1, y1 = sandbox.hud.gui.rects["gait cyclic"]
     click_gui(sandbox, (x0 + x1) / 2, (y0 + y1) / 2)
-    assert world.locomotion.get(octo, 0)["gait"] == "cyclic"
+    assert world.resource(Locomotion).get(octo, 0)["gait"] == "cyclic"
 
 
 def test_gui_draw_calls_do_not_grow_with_creatures(make_sandbox: Callable[..., Any]) -> None:
@@ -153,8 +156,8 @@ def test_the_strength_slider_stops_where_the_damping_holds(
     _, y0, x1, y1 = sandbox.hud.gui.rects["strength"]
     click_gui(sandbox, x1 - 1, (y0 + y1) / 2)
     # damping 0.5 at 1/480 s holds at most kp 240 (damping >= strength x step)
-    assert world.locomotion.strength_limit(octo) == pytest.approx(240.0)
-    assert world.locomotion.get(octo, 5)["strength"] == pytest.approx(240.0, rel=1e-3)
+    assert world.resource(Locomotion).strength_limit(octo) == pytest.approx(240.0)
+    assert world.resource(Locomotion).get(octo, 5)["strength"] == pytest.approx(240.0, rel=1e-3)
 
 
 def test_the_sliders_are_the_parameter_tables() -> None:

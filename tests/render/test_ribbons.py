@@ -9,7 +9,7 @@ import numpy as np
 from numpy.testing import assert_array_equal
 
 from ecs_tentacles.fur.hooks import GuideCurves
-from ecs_tentacles.render.ribbons import ribbon_vertices, strip_indices
+from ecs_tentacles.fur.render.ribbons import ribbon_vertices, strip_indices
 
 
 def test_strip_indices_and_vertices() -> None:

@@ -13,6 +13,7 @@ from pyglet.event import EventDispatcher
 from pyglet.window import key, mouse
 
 from ecs_tentacles.components import Creature, Goal, Transform
+from ecs_tentacles.locomotion.goals import GoalBook
 
 
 def _event(sandbox: Any, name: str, *args: Any) -> None:
@@ -51,15 +52,15 @@ def test_clicks_set_append_and_remove_goals(make_sandbox: Callable[..., Any]) ->
     camera = sandbox.renderer.camera
     first, second = np.array([0.8, -0.6, 0.0]), np.array([1.2, 0.5, 0.0])
     _click(sandbox, *camera.project(first[None])[0])
-    path = sandbox.world.goals.path(octo)
+    path = sandbox.world.resource(GoalBook).path(octo)
     assert len(path) == 1
     assert np.linalg.norm(sandbox.world.component(path[0], Goal).position - first) < 0.01
     _click(sandbox, *camera.project(second[None])[0], modifiers=key.MOD_SHIFT)
-    positions = sandbox.world.goals.positions(octo)
+    positions = sandbox.world.resource(GoalBook).positions(octo)
     assert positions.shape == (2, 3)
     assert np.linalg.norm(positions - [first, second], axis=1).max() < 0.01
     _click(sandbox, *camera.project(first[None])[0], button=mouse.RIGHT)
-    assert_allclose(sandbox.world.goals.positions(octo), [second], atol=0.01)
+    assert_allclose(sandbox.world.resource(GoalBook).positions(octo), [second], atol=0.01)
 
 
 def test_clicking_a_creature_selects_it(make_sandbox: Callable[..., Any]) -> None:

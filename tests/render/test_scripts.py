@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 import pytest
 
+from ecs_tentacles.locomotion.goals import GoalBook
 from tests.render.conftest import click_item
 
 WAVE = '''
@@ -75,7 +76,7 @@ def test_a_failing_system_is_disabled_shown_and_can_run_again(
     world = sandbox.world
     assert world.frame == 20 and world.waved == [0, 1, 2, 3, 4, 5]
     assert world.schedule.disabled() == ["wave"]
-    assert world.creature("octo") == octo and world.goals.path(octo)  # still crawling
+    assert world.creature("octo") == octo and world.resource(GoalBook).path(octo)  # still crawling
     [record] = caplog.records
     assert record.getMessage().startswith(
         "system 'wave' (plugin 'mywave') failed at frame 5: KeyError: 'amplitude'; system disabled"

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
-from ecs_tentacles.locomotion.params import settable
+from ecs_tentacles.locomotion.params import Locomotion, settable
 from ecs_tentacles.scene.parameters import (
     Parameter,
     apply_parameters,
@@ -107,14 +107,14 @@ def test_the_api_takes_each_parameter_over_its_table_range(
     assert set(per_creature) == {"gait", "speed", "drivers"}
     for name, p in per_tentacle.items():
         assert p.range is not None
-        world.locomotion.set(octo, tentacle=1, **{name: p.range.high})
-        assert world.locomotion.get(octo, 1)[name] == pytest.approx(p.range.high)
+        world.resource(Locomotion).set(octo, tentacle=1, **{name: p.range.high})
+        assert world.resource(Locomotion).get(octo, 1)[name] == pytest.approx(p.range.high)
         with pytest.raises(ValueError, match=rf"^{name}: must be in \[.*, got"):
-            world.locomotion.set(octo, **{name: p.range.high * 1.01 + 1e-9})
-    world.locomotion.set(octo, tentacle=1, target_angle=math.radians(30))
+            world.resource(Locomotion).set(octo, **{name: p.range.high * 1.01 + 1e-9})
+    world.resource(Locomotion).set(octo, tentacle=1, target_angle=math.radians(30))
     assert world.tentacles.target_angle[1] == pytest.approx(math.radians(30))
     first = int(world.tentacles.first_link[1])
-    world.locomotion.set(octo, tentacle=1, strength=20.0)
+    world.resource(Locomotion).set(octo, tentacle=1, strength=20.0)
     assert_allclose(world.motors.strength[first : first + 3], 20.0 * world.motors.scale[:3])
 
 

@@ -7,8 +7,10 @@ import json
 import numpy as np
 import pytest
 
+from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.load import bundled_scene
+from ecs_tentacles.threats.data import ThreatData
 from ecs_tentacles.world import World
 
 SECONDS = 7
@@ -16,7 +18,7 @@ SECONDS = 7
 
 def _distances(world: World) -> np.ndarray:
     """Ground distance from each creature's mantle to the roach."""
-    threats, _ = world.threats.sources(world)
+    threats, _ = world.resource(ThreatData).sources(world)
     mantles = world.transforms.pos[world.creatures.mantle_row, :2]
     return np.linalg.norm(mantles - threats[0, :2], axis=1)
 
@@ -48,9 +50,9 @@ def test_the_goal_points_away_and_a_threat_creature_does_not_flee_itself() -> No
     with World.from_scene(scene) as world:
         world.step(1)
         west, east = world.creature("west"), world.creature("east")
-        goal = world.goals.positions(west)[0]
+        goal = world.resource(GoalBook).positions(west)[0]
         np.testing.assert_allclose(goal[:2], [-0.8 - 1.0, 0.0], atol=0.02)  # run = 1.0 m west
-        assert world.goals.current(east) is None
+        assert world.resource(GoalBook).current(east) is None
 
 
 def test_out_of_reach_nobody_flees() -> None:

@@ -7,9 +7,11 @@ from typing import Any
 
 import numpy as np
 import pytest
-from ecs_tentacles.systems.tentacle_selection import STROKE_SECONDS, classify
+from ecs_tentacles.systems.locomotion.tentacle_selection import STROKE_SECONDS, classify
 
 from ecs_tentacles.locomotion.actions import Kind, Mode, drive_sequence
+from ecs_tentacles.locomotion.goals import GoalBook
+from ecs_tentacles.locomotion.params import Locomotion
 from ecs_tentacles.world import World
 from tests.conftest import creature_scene
 
@@ -105,10 +107,10 @@ def test_cyclic_first_stroke_pulls_toward_and_pushes_away(
     t = world.tentacles
     assert t.driving.tolist() == [True, False, False, False]
     assert t.mode.tolist() == [mode, Mode.NONE, Mode.NONE, Mode.NONE]
-    assert world.locomotion.queue(octo, 0) == _names(mode)
+    assert world.resource(Locomotion).queue(octo, 0) == _names(mode)
     assert _names(Mode.PULL) == ["extend", "attach", "pull", "detach"]
     assert _names(Mode.PUSH) == ["compress", "attach", "push", "detach"]
-    assert [world.locomotion.queue(octo, k) for k in (1, 2, 3)] == [["idle"]] * 3
+    assert [world.resource(Locomotion).queue(octo, k) for k in (1, 2, 3)] == [["idle"]] * 3
     assert t.started.tolist() == [0.0, -np.inf, -np.inf, -np.inf]
 
 
@@ -118,7 +120,7 @@ def test_coordinated_first_stroke_orients_then_pulls(make_world: Callable[..., W
     world.step(1)
     assert world.tentacles.driving.tolist() == [True, False, False, False]
     assert world.tentacles.mode.tolist() == [Mode.PULL, Mode.NONE, Mode.NONE, Mode.NONE]
-    assert world.locomotion.queue(octo, 0) == ["orient", *_names(Mode.PULL), "settle"]
+    assert world.resource(Locomotion).queue(octo, 0) == ["orient", *_names(Mode.PULL), "settle"]
 
 
 def test_coordinated_goal_behind_pulls_with_the_far_tentacle(
@@ -129,7 +131,7 @@ def test_coordinated_goal_behind_pulls_with_the_far_tentacle(
     world.step(1)
     assert world.tentacles.driving.tolist() == [False, False, True, False]
     assert world.tentacles.mode.tolist() == [Mode.NONE, Mode.NONE, Mode.PULL, Mode.NONE]
-    assert world.locomotion.queue(octo, 2) == ["orient", *_names(Mode.PULL), "settle"]
+    assert world.resource(Locomotion).queue(octo, 2) == ["orient", *_names(Mode.PULL), "settle"]
 
 
 def test_each_creature_drives_on_its_own(make_world: Callable[..., World]) -> None:
@@ -152,9 +154,18 @@ def test_each_creature_drives_on_its_own(make_world: Callable[..., World]) -> No
     world = make_world(scene)
     world.step(1)
     a, b, c = (world.creature(name) for name in "abc")
-    assert world.locomotion.actions(a) == ["compress", "idle", "idle"]  # +x pushes from -x
-    assert world.locomotion.actions(b) == ["idle", "orient", "idle", "idle"]  # +y pulls to +y
-    assert world.locomotion.actions(c) == ["idle", "idle"]
+    assert world.resource(Locomotion).actions(a) == [
+        "compress",
+        "idle",
+        "idle",
+    ]  # +x pushes from -x
+    assert world.resource(Locomotion).actions(b) == [
+        "idle",
+        "orient",
+        "idle",
+        "idle",
+    ]  # +y pulls to +y
+    assert world.resource(Locomotion).actions(c) == ["idle", "idle"]
     assert world.tentacles.mode.tolist() == [
         Mode.PUSH, Mode.NONE, Mode.NONE,
         Mode.NONE, Mode.PULL, Mode.NONE, Mode.NONE,
@@ -179,13 +190,13 @@ def test_cyclic_keeps_the_queued_stroke_when_the_goal_changes_sides(
     world = make_world(_scene("cyclic", [1.5, 0.0]))
     octo = world.creature("octo")
     world.step(5)
-    assert world.locomotion.queue(octo, 0) == _names(Mode.PULL)
+    assert world.resource(Locomotion).queue(octo, 0) == _names(Mode.PULL)
     # behind and a little to the right: tentacle 1 (+y) now pushes, tentacle 2 (-x) pulls
-    world.goals.set(octo, [-1.5, -0.5])
+    world.resource(GoalBook).set(octo, [-1.5, -0.5])
     world.step(1)
     assert world.tentacles.driving.tolist() == [True, False, False, False]
     assert world.tentacles.mode[0] == Mode.PULL
-    assert world.locomotion.queue(octo, 0) == _names(Mode.PULL)
+    assert world.resource(Locomotion).queue(octo, 0) == _names(Mode.PULL)
     assert _new_drivers(world, 180) == [(1, Mode.PUSH), (2, Mode.PULL)]
 
 
@@ -197,9 +208,9 @@ def test_coordinated_driver_aborts_when_the_goal_changes_sides(
     world.step(10)
     assert world.tentacles.driving.tolist() == [True, False, False, False]
     assert world.tentacles.mode[0] == Mode.PULL
-    world.goals.set(octo, [-1.5, 0.0])
+    world.resource(GoalBook).set(octo, [-1.5, 0.0])
     world.step(1)
-    assert world.locomotion.queue(octo, 0) == ["detach", "settle"]
+    assert world.resource(Locomotion).queue(octo, 0) == ["detach", "settle"]
     assert world.tentacles.driving.tolist() == [False, False, False, False]
     assert world.tentacles.mode.tolist() == [Mode.NONE] * 4
     # the next drive starts one stagger after the first, with the tentacle now facing the goal
@@ -212,7 +223,7 @@ def test_coordinated_driver_aborts_when_the_goal_changes_sides(
     base_dir = (base - mantle) / np.linalg.norm(base - mantle)
     assert classify(goal_dir[None], base_dir[None])[0].tolist() == [True]
     assert _new_drivers(world, 1) == [(2, Mode.PULL)]
-    assert world.locomotion.queue(octo, 2) == ["orient", *_names(Mode.PULL), "settle"]
+    assert world.resource(Locomotion).queue(octo, 2) == ["orient", *_names(Mode.PULL), "settle"]
 
 
 def test_no_goal_stops_the_drive_and_every_tentacle_idles(
@@ -230,18 +241,18 @@ def test_no_goal_stops_the_drive_and_every_tentacle_idles(
     assert world.tentacles.action[0] == Kind.PULL
     assert world.suckers.attached[tip]
     assert world.tentacles.driving.tolist() == [True, False, True, False]  # 2 pushes too
-    world.goals.clear(octo)
+    world.resource(GoalBook).clear(octo)
     world.step(1)
-    assert world.locomotion.queue(octo, 0) == ["detach", "settle"]
-    assert world.locomotion.queue(octo, 2) == ["detach", "settle"]
+    assert world.resource(Locomotion).queue(octo, 0) == ["detach", "settle"]
+    assert world.resource(Locomotion).queue(octo, 2) == ["detach", "settle"]
     assert world.tentacles.driving.tolist() == [False] * 4
     assert released == ["command"]
     assert not world.suckers.attached[tip]
     world.step(30)
-    assert world.locomotion.actions(octo) == ["idle"] * 4
+    assert world.resource(Locomotion).actions(octo) == ["idle"] * 4
     assert world.tentacles.driving.tolist() == [False] * 4
     assert world.tentacles.mode.tolist() == [Mode.NONE] * 4
-    assert [world.locomotion.queue(octo, k) for k in range(4)] == [["idle"]] * 4
+    assert [world.resource(Locomotion).queue(octo, k) for k in range(4)] == [["idle"]] * 4
     assert world.suckers.attached.tolist() == [False] * 4
     assert world.events.counts["sucker_released"] == 1
 

@@ -1,7 +1,8 @@
 """The locomotion plugin: goal paths, gait and the action queues that crawl toward goals.
 
-Scene keys: a creature's `goals` and `locomotion` (`assets/schema/plugins/locomotion.json`).
-Resources: `world.goals` (GoalBook) and `world.locomotion` (parameters at run time).
+Scene keys: a creature's `goals` and `locomotion` (`locomotion.schema.json` beside this file).
+Resources: `GoalBook` (goal paths) and `Locomotion` (parameters at run time), by type:
+`world.resource(GoalBook)`.
 Systems: goals, tentacle_selection (stage decide), action_queue, motor_targets (act).
 """
 
@@ -23,7 +24,7 @@ from ecs_tentacles.system import System
 if TYPE_CHECKING:
     from ecs_tentacles.world import World
 
-_FRAGMENT = fragment("locomotion")
+_FRAGMENT = fragment("ecs_tentacles.locomotion", "locomotion")
 
 
 class LocomotionPlugin(Plugin):
@@ -32,8 +33,8 @@ class LocomotionPlugin(Plugin):
     creature_schema = _FRAGMENT["creature"]
     defs = _FRAGMENT["$defs"]
 
-    def resources(self, world: World) -> dict[str, Any]:
-        return {"goals": GoalBook(world), "locomotion": Locomotion(world)}
+    def resources(self, world: World) -> list[object]:
+        return [GoalBook(world), Locomotion(world)]
 
     def build_creature(self, world: World, creature: int, spec: Mapping[str, Any]) -> None:
         row = world.component(creature, Creature).row
@@ -45,13 +46,13 @@ class LocomotionPlugin(Plugin):
             ]
         for goal in spec["goals"]:
             point = list(goal["position"]) + ([0.0] if len(goal["position"]) == 2 else [])
-            world.goals.append(creature, point, goal["radius"])
+            world.resource(GoalBook).append(creature, point, goal["radius"])
 
     def systems(self) -> list[System]:
-        from ecs_tentacles.systems.action_queue import ActionQueueSystem
-        from ecs_tentacles.systems.goals import Goals
-        from ecs_tentacles.systems.motor_targets import MotorTargets
-        from ecs_tentacles.systems.tentacle_selection import TentacleSelection
+        from ecs_tentacles.systems.locomotion.action_queue import ActionQueueSystem
+        from ecs_tentacles.systems.locomotion.goals import Goals
+        from ecs_tentacles.systems.locomotion.motor_targets import MotorTargets
+        from ecs_tentacles.systems.locomotion.tentacle_selection import TentacleSelection
 
         return [Goals(), TentacleSelection(), ActionQueueSystem(), MotorTargets()]
 
@@ -59,7 +60,7 @@ class LocomotionPlugin(Plugin):
         goals = {
             entity: [
                 (world.component(g, Goal).position.copy(), world.component(g, Goal).radius)
-                for g in world.goals.path(entity)
+                for g in world.resource(GoalBook).path(entity)
             ]
             for entity, _ in world.query(Creature)
         }
@@ -69,8 +70,8 @@ class LocomotionPlugin(Plugin):
     def restore(self, world: World, state: Any) -> None:
         goals, queues = state
         for entity, path in goals.items():
-            world.goals.clear(entity)
+            world.resource(GoalBook).clear(entity)
             for position, radius in path:
-                world.goals.append(entity, position.tolist(), radius)
+                world.resource(GoalBook).append(entity, position.tolist(), radius)
         for entity, queue in world.query(ActionQueue):
             queue.pending = copy.deepcopy(queues[entity])

@@ -1,7 +1,7 @@
 """goals: a creature whose mantle enters its current goal's radius reaches it.
 
 Reads: CreatureStore (has_goal, goal, goal_radius, mantle_row), Transform store.
-Writes: through `world.goals.reach` (removes the goal entity, makes the next goal of
+Writes: through `world.resource(GoalBook).reach` (removes the goal entity, makes the next goal of
 the path current, fires `goal_reached`). Distances are measured in the ground plane.
 """
 
@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
@@ -31,4 +32,4 @@ class Goals(System):
         distance_sq = np.einsum("ij,ij->i", offset, offset)
         reached = creatures.has_goal & (distance_sq <= creatures.goal_radius**2)
         for row in np.flatnonzero(reached):
-            world.goals.reach(int(creatures.entity[row]))
+            world.resource(GoalBook).reach(int(creatures.entity[row]))

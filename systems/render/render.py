@@ -2,7 +2,7 @@
 
 Reads: Transform store (pos, quat). Writes: the Renderer's last two pose snapshots,
 between which it interpolates when it draws at display rate. The render plugin
-(`ecs_tentacles.plugins.render`) adds it, in the sandbox (`ecs-tentacles play`) only.
+(`ecs_tentacles.render.plugin`) adds it, in the sandbox (`ecs-tentacles play`) only.
 """
 
 from __future__ import annotations

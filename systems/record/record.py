@@ -8,7 +8,7 @@ Goal components, fur guide curves when the world has fur. Writes: its
 Runs in stage output, after everything else of the frame. It records the
 pose it finds when it joins the world (take frame 0; fur guides are posed for it
 if no frame has run yet), then every `every`-th frame, so a take at 30 fps of a
-60 fps world has `every=2`. The record plugin (`ecs_tentacles.plugins.record`) adds it.
+60 fps world has `every=2`. The record plugin (`ecs_tentacles.record.plugin`) adds it.
 """
 
 from __future__ import annotations

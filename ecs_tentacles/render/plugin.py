@@ -26,6 +26,6 @@ class RenderPlugin(Plugin):
         self.renderer = renderer
 
     def systems(self) -> list[System]:
-        from ecs_tentacles.systems.render import RenderSync
+        from ecs_tentacles.systems.render.render import RenderSync
 
         return [RenderSync(self.renderer)]

@@ -7,10 +7,11 @@ from typing import Any
 
 import numpy as np
 import pytest
-from ecs_tentacles.systems import rig as rig_module
+from ecs_tentacles.systems.fur import rig as rig_module
 from numpy.testing import assert_allclose
 
 from ecs_tentacles.fur import FurControl, FurGuide
+from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.mathutil import quat_rotate
 from ecs_tentacles.world import World
 
@@ -25,7 +26,7 @@ def creature(name: str, x: float, fur: dict[str, Any], **extra: Any) -> dict[str
 
 
 def roots_in_world(world: World) -> np.ndarray:
-    g = world.fur.guides
+    g = world.resource(FurData).guides
     return world.transforms.pos[g.body_row] + quat_rotate(world.transforms.quat[g.body_row], g.root)
 
 
@@ -33,7 +34,9 @@ def test_a_world_without_fur_does_no_rig_work(make_world: Callable[..., World]) 
     world = make_world({"version": 1, "creatures": [{"tentacles": {"count": 3, "links": 2}}]})
     world.step(3)
     rig = world.schedule["rig"]
-    assert rig.bind is None and rig.version == -1 and world.fur.curves.shape == (0, 0, 3)
+    assert (
+        rig.bind is None and rig.version == -1 and world.resource(FurData).curves.shape == (0, 0, 3)
+    )
 
 
 def test_guides_follow_a_moving_creature(make_world: Callable[..., World]) -> None:
@@ -47,14 +50,16 @@ def test_guides_follow_a_moving_creature(make_world: Callable[..., World]) -> No
         ],
     }
     world = make_world(scene)
-    start = world.transforms.pos[world.fur.sets.body_row].copy()
+    start = world.transforms.pos[world.resource(FurData).sets.body_row].copy()
     world.step(90)
-    moved = np.linalg.norm(world.transforms.pos[world.fur.sets.body_row] - start, axis=1)
+    moved = np.linalg.norm(
+        world.transforms.pos[world.resource(FurData).sets.body_row] - start, axis=1
+    )
     assert moved[0] > 0.02  # it crawled
-    frames, curves = world.fur.frames, world.fur.curves
+    frames, curves = world.resource(FurData).frames, world.resource(FurData).curves
     assert_allclose(frames[:, 3], roots_in_world(world), atol=2e-6)
     assert_allclose(curves[:, 0], roots_in_world(world), atol=2e-6)
-    guide = world.component(int(world.fur.guides.entity[7]), FurGuide)
+    guide = world.component(int(world.resource(FurData).guides.entity[7]), FurGuide)
     assert_allclose(guide.points, curves[7]) and guide.creature == world.creature("a")
 
 
@@ -72,27 +77,29 @@ def test_tracks_drive_control_attributes(make_world: Callable[..., World]) -> No
     tracks[0]["keys"][0]["easing"] = "linear"
     fur = {"groom": {"count": 30}, "controls": [{"name": "m", "tracks": tracks}]}
     world = make_world({"version": 1, "creatures": [creature("a", 0, fur)]}, locomotion=False)
-    control = world.component(world.fur.controls.entity[0], FurControl)
+    control = world.component(world.resource(FurData).controls.entity[0], FurControl)
     world.step(31)  # the last frame ran at t = 0.5
     assert control.lift == 0.5
     assert_allclose(control.position, [0.2 * 0.15625, 0, 0.3])  # ease at u = 1/4
     world.step(60)
     assert control.lift == 1.0
-    g = world.fur.guides
+    g = world.resource(FurData).guides
     normals = quat_rotate(world.transforms.quat[g.body_row], g.normal)
-    assert_allclose(world.fur.frames[:, 0], normals, atol=1e-6)
+    assert_allclose(world.resource(FurData).frames[:, 0], normals, atol=1e-6)
 
 
 def test_a_scripted_control_move_turns_its_guides(make_world: Callable[..., World]) -> None:
     fur = {"groom": {"count": 80, "region": "top"}, "controls": [{"name": "m", "direction": 1.0}]}
     world = make_world({"version": 1, "creatures": [creature("a", 0, fur)]}, locomotion=False)
     world.step(1)
-    before = world.fur.frames[:, 0].copy()
-    control = world.component(world.fur.controls.entity[0], FurControl)
+    before = world.resource(FurData).frames[:, 0].copy()
+    control = world.component(world.resource(FurData).controls.entity[0], FurControl)
     control.position = control.rest_position + (0.0, 0.1, 0.0)  # one reach toward +y
     world.step(1)
-    turned = world.fur.frames[:, 0] - before
-    y_world = quat_rotate(world.transforms.quat[world.fur.sets.body_row[0]], np.array([0, 1.0, 0]))
+    turned = world.resource(FurData).frames[:, 0] - before
+    y_world = quat_rotate(
+        world.transforms.quat[world.resource(FurData).sets.body_row[0]], np.array([0, 1.0, 0])
+    )
     assert np.all(turned @ y_world > 0.05)
 
 
@@ -100,14 +107,14 @@ def test_writing_a_guide_rebinds(make_world: Callable[..., World]) -> None:
     fur = {"groom": {"count": 10}}
     world = make_world({"version": 1, "creatures": [creature("a", 0, fur)]}, locomotion=False)
     world.step(1)
-    version = world.fur.version
-    guide = world.component(int(world.fur.guides.entity[3]), FurGuide)
+    version = world.resource(FurData).version
+    guide = world.component(int(world.resource(FurData).guides.entity[3]), FurGuide)
     guide.root = (0.0, 0.0, 0.1)
     guide.normal = (0.0, 0.0, 1.0)
-    assert world.fur.version == version + 2
+    assert world.resource(FurData).version == version + 2
     world.step(1)
-    assert world.schedule["rig"].version == world.fur.version
-    assert_allclose(world.fur.frames[3, 3], roots_in_world(world)[3], atol=1e-6)
+    assert world.schedule["rig"].version == world.resource(FurData).version
+    assert_allclose(world.resource(FurData).frames[3, 3], roots_in_world(world)[3], atol=1e-6)
     assert "FurGuide(row=3, root=" in repr(guide)
 
 
@@ -126,10 +133,12 @@ def test_blocks_give_the_same_result_as_one_pass(
         monkeypatch.setattr(rig_module, "BLOCK", block)
         monkeypatch.setattr(rig_module, "STRAND_BLOCK", strands)
         world = make_world(scene, locomotion=False)
-        world.fur.controls.lift[:] = 0.4
-        world.fur.controls.random[:] = 0.6
+        world.resource(FurData).controls.lift[:] = 0.4
+        world.resource(FurData).controls.random[:] = 0.6
         world.step(20)
-        results.append((world.fur.frames.copy(), world.fur.curves.copy()))
+        results.append(
+            (world.resource(FurData).frames.copy(), world.resource(FurData).curves.copy())
+        )
     np.testing.assert_array_equal(results[0][0], results[1][0])
     np.testing.assert_array_equal(results[0][1], results[1][1])
 
@@ -153,13 +162,13 @@ def test_kernels_serial_or_parallel_and_numpy_give_the_same_fur(
         monkeypatch.setattr(rig_math, "BACKEND", backend)
         monkeypatch.setattr(rig_math, "PARALLEL_GUIDES", parallel_from)
         world = make_world(scene)
-        world.fur.controls.lift[:] = 0.4
-        world.fur.controls.random[:] = 0.6
+        world.resource(FurData).controls.lift[:] = 0.4
+        world.resource(FurData).controls.random[:] = 0.6
         world.step(40)
         rig = world.schedule["rig"]
         assert rig.strands is not None and len(rig.strands.guides) == 700  # the cat's
         assert rig.parallel == (parallel_from == 0)
-        results[backend, parallel_from] = world.fur.curves.copy()
+        results[backend, parallel_from] = world.resource(FurData).curves.copy()
     serial, parallel = results["auto", 1 << 40], results["auto", 0]
     np.testing.assert_array_equal(serial, parallel)  # the same float32 operations
     # the rig's own float32 rounding (see tests/fur/test_rig_kernels.py), carried by the strands

@@ -1,6 +1,6 @@
 """emotion: fear or aggression that rises near a threat and raises the fur (piloerection).
 
-Threats come from the threats plugin (`world.threats`: path threats, moved by the
+Threats come from the threats plugin (`world.resource(ThreatData)`: path threats, moved by the
 `threats` system, and creatures marked `threat`); without it nothing frightens. A
 creature with an `Emotion` is roused while any threat other than itself is within its
 radius of its mantle. Its emotion follows a critically damped response toward 1
@@ -11,7 +11,7 @@ first dips (the fur flattens a little, anticipation), before it falls it first s
 Each of the creature's controls gets ``level * control.emotion * fur.piloerection``
 added to its lift and random (clipped to 0..1 by the rig). No emotions: nothing done.
 
-Reads: `world.threats` (positions), Transform store (mantles of emotional and threat
+Reads: `world.resource(ThreatData)` (positions), Transform store (mantles of emotional and threat
 creatures), EmotionStore settings and state. Writes: EmotionStore (state, speed, level,
 threatened), ControlStore (drive_lift, drive_random).
 """
@@ -22,7 +22,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.system import System
+from ecs_tentacles.threats.data import ThreatData
 
 if TYPE_CHECKING:
     from ecs_tentacles.world import World
@@ -39,11 +41,11 @@ class EmotionSystem(System):
     writes = ("fur.emotions", "fur.controls.drive_lift", "fur.controls.drive_random")
 
     def process(self, world: World, dt: float) -> None:
-        fur = world.fur
+        fur = world.resource(FurData)
         e = fur.emotions
         if not len(e):
             return
-        threats = world.resources.get("threats")
+        threats = world.get_resource(ThreatData)
         if threats is not None:
             sources, owners = threats.sources(world)
         else:  # the threats plugin is off: nothing frightens anyone

@@ -6,7 +6,7 @@ from collections.abc import Callable
 
 import numpy as np
 import pytest
-from ecs_tentacles.systems.motor_targets import LIFT, SMOOTHING_SECONDS
+from ecs_tentacles.systems.locomotion.motor_targets import LIFT, SMOOTHING_SECONDS
 from numpy.testing import assert_allclose, assert_array_equal
 
 from ecs_tentacles.components import Creature
@@ -17,6 +17,7 @@ from ecs_tentacles.locomotion.actions import (
     Kind,
     make_action,
 )
+from ecs_tentacles.locomotion.params import Locomotion
 from ecs_tentacles.world import World
 from tests.conftest import creature_scene
 
@@ -52,7 +53,7 @@ def test_idle_targets_ease_to_rest_without_waves(make_world: Callable[..., World
     start = world.motors.target.copy()
     assert np.abs(start[:, :2]).min() > 1e-4
     assert_array_equal(start[:, 2], 0.0)
-    world.locomotion.set(octo, wave_amplitude=0.0, writhe=0.0)
+    world.resource(Locomotion).set(octo, wave_amplitude=0.0, writhe=0.0)
     # an exponential ease with the smoothing time constant, no jump
     rest = _rest_targets(world)
     assert (rest[:, 0] > 0).all() and (rest[:, 0] < 0.1).all()  # a gentle droop
@@ -66,7 +67,7 @@ def test_idle_targets_ease_to_rest_without_waves(make_world: Callable[..., World
     world.step(90)
     assert_allclose(world.motors.target[:, :2], rest, atol=1e-8)
     assert_array_equal(world.motors.target[:, 2], 0.0)
-    assert world.locomotion.actions(octo) == ["idle", "idle"]
+    assert world.resource(Locomotion).actions(octo) == ["idle", "idle"]
 
 
 def test_idle_gain_is_the_same_before_and_after_a_drive(
@@ -75,10 +76,10 @@ def test_idle_gain_is_the_same_before_and_after_a_drive(
     # an idle tentacle writhes at STRENGTH[IDLE] whether or not it has driven yet
     world = make_world(creature_scene(count=2, links=3))
     octo = world.creature("octo")
-    world.locomotion.set(octo, writhe=0.0)
+    world.resource(Locomotion).set(octo, writhe=0.0)
     ActionQueues(world).replace(1, [make_action(Kind.DETACH, 10.0)])  # short, then idle again
     world.step(3)
-    assert world.locomotion.actions(octo) == ["idle", "idle"]
+    assert world.resource(Locomotion).actions(octo) == ["idle", "idle"]
     assert_allclose(world.motors.gain, STRENGTH[Kind.IDLE], rtol=1e-15)
 
 
@@ -99,7 +100,7 @@ def test_compress_arches_the_tentacle(make_world: Callable[..., World], angle: f
     # no goal, so tentacle selection leaves the tentacle alone
     world = make_world(creature_scene(count=2, links=6))
     octo = world.creature("octo")
-    world.locomotion.set(octo, wave_amplitude=0.0, writhe=0.0)
+    world.resource(Locomotion).set(octo, wave_amplitude=0.0, writhe=0.0)
     world.step(3)
     start = world.motors.target.copy()
     _arch(world, 0, angle)
@@ -117,7 +118,7 @@ def test_compress_arches_the_tentacle(make_world: Callable[..., World], angle: f
     assert_allclose(world.motors.target[links, 0], curl, atol=1e-7)
     # the link pitches: up from a flat base, highest mid-way, down to a flat tip
     assert_allclose(np.cumsum(world.motors.target[links, 0]), pitch, atol=1e-7)
-    assert world.locomotion.actions(octo) == ["compress", "idle"]
+    assert world.resource(Locomotion).actions(octo) == ["compress", "idle"]
     # the other tentacle stays at rest
     other = _links(world, 1)
     assert_allclose(world.motors.target[other, :2], _rest_targets(world)[other], atol=1e-7)
@@ -127,7 +128,7 @@ def test_compress_arches_the_tentacle(make_world: Callable[..., World], angle: f
 def test_arched_tentacle_is_shorter(make_world: Callable[..., World]) -> None:
     world = make_world(creature_scene(count=2, links=6))
     octo = world.creature("octo")
-    world.locomotion.set(octo, wave_amplitude=0.0, writhe=0.0)
+    world.resource(Locomotion).set(octo, wave_amplitude=0.0, writhe=0.0)
     tip = int(world.tentacles.tip_sucker[0])
     mantle = world.creatures.mantle_row[0]
     world.step(30)
@@ -141,7 +142,7 @@ def test_arched_tentacle_is_shorter(make_world: Callable[..., World]) -> None:
 def test_gain_is_the_action_strength_without_writhing(make_world: Callable[..., World]) -> None:
     world = make_world(creature_scene(count=2, links=4))
     octo = world.creature("octo")
-    world.locomotion.set(octo, writhe=0.0)
+    world.resource(Locomotion).set(octo, writhe=0.0)
     _arch(world, 1, 0.5)
     gains = []
     for _ in range(20):
@@ -153,7 +154,7 @@ def test_gain_is_the_action_strength_without_writhing(make_world: Callable[..., 
 def test_writhing_modulates_the_gain_in_time(make_world: Callable[..., World]) -> None:
     world = make_world(creature_scene(count=2, links=4))
     octo = world.creature("octo")
-    world.locomotion.set(octo, writhe=0.5, wave_frequency=1.0)
+    world.resource(Locomotion).set(octo, writhe=0.5, wave_frequency=1.0)
     _arch(world, 0, 0.5)
     links = _links(world, 0)
     samples = []

@@ -18,6 +18,6 @@ class SuckersPlugin(Plugin):
     requires = ("locomotion",)
 
     def systems(self) -> list[System]:
-        from ecs_tentacles.systems.suckers import Suckers
+        from ecs_tentacles.systems.locomotion.suckers import Suckers
 
         return [Suckers()]

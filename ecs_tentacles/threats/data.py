@@ -1,9 +1,9 @@
 """Threats: marked things that frighten creatures (the `threats` plugin's data).
 
 A threat is either a scene `threats` entry, a point that follows a keyframed path, or a
-creature marked `"threat": true`, whose mantle is the threat. `world.threats` holds
+creature marked `"threat": true`, whose mantle is the threat. `world.resource(ThreatData)` holds
 them; the `threats` system moves path threats, and the fur plugin's `emotion` system
-reads `world.threats.sources()` to rouse creatures nearby.
+reads `world.resource(ThreatData).sources()` to rouse creatures nearby.
 """
 
 from __future__ import annotations
@@ -41,7 +41,9 @@ class Threat(RowComponent):
 
 
 class ThreatData:
-    """`world.threats`: path threats (a store and their paths) and threat creatures."""
+    """`world.resource(ThreatData)`: path threats (a store and their paths) and threat creatures."""
+
+    provided_by = "threats"  # the plugin that makes it (named by `world.resource` errors)
 
     def __init__(self) -> None:
         self.store = ThreatStore()
@@ -65,7 +67,7 @@ class ThreatData:
 
 def mark_creature(world: World, creature: int) -> None:
     """Make a creature's mantle a threat to the others."""
-    threats: ThreatData = world.threats
+    threats: ThreatData = world.resource(ThreatData)
     row = world.component(creature, Transform).row
     threats.bodies = np.append(threats.bodies, row)
     threats.creatures = np.append(threats.creatures, creature)
@@ -73,7 +75,7 @@ def mark_creature(world: World, creature: int) -> None:
 
 def build_threats(world: World, specs: Sequence[Mapping[str, Any]]) -> list[int]:
     """Threat entities that follow keyframed paths; returns their entities."""
-    threats: ThreatData = world.threats
+    threats: ThreatData = world.resource(ThreatData)
     entities = []
     for i, spec in enumerate(specs):
         path = spec["path"]

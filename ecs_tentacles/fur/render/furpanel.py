@@ -19,6 +19,7 @@ from imgui_bundle import imgui
 from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.fur.editor import MIRRORS, SHAPES, VALUES, FurEditor
 from ecs_tentacles.fur.groom import closest_surface_point
+from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.mathutil import quat_rotate
 from ecs_tentacles.render.gui import Gui, same_line_if_fits, text_width
 
@@ -96,7 +97,7 @@ class FurPanel:
         display.selected_control = None
         if editor.creature is not None and editor.control is not None:
             world = self.sandbox.world
-            fur_controls = world.fur.controls
+            fur_controls = world.resource(FurData).controls
             display.selected_control = int(fur_controls.entity[editor.rows()[editor.control]])
         self.refresh_rig()
 
@@ -109,7 +110,7 @@ class FurPanel:
         world = self.sandbox.world
         rig = world.schedule["rig"]
         rig.play_tracks = not edit if self.sandbox.paused else True
-        if self.sandbox.paused and len(world.fur.guides):
+        if self.sandbox.paused and len(world.resource(FurData).guides):
             rig.process(world, world.settings.dt)
 
     # -- the 3D view -----------------------------------------------------------------
@@ -153,7 +154,11 @@ class FurPanel:
         radius, height = creature.mantle_radius, creature.mantle_height
         hit = ray_mantle(local_origin, local_direction, radius, height / 2)
         surface, normal = closest_surface_point(hit[None], radius, height)
-        size = float(self.sandbox.world.fur.controls.size[self.editor.rows()[self.editor.control]])
+        size = float(
+            self.sandbox.world.resource(FurData).controls.size[
+                self.editor.rows()[self.editor.control]
+            ]
+        )
         self.editor.set_position(self.editor.control, surface[0] + normal[0] * size)
         self.refresh_rig(edit=True)
 
@@ -277,7 +282,11 @@ class FurPanel:
         if changed:
             display.follow = "own" if alone else "neighbours"
         world = self.sandbox.world
-        own = int(world.fur.sets.children.max()) if len(world.fur.sets) else 0
+        own = (
+            int(world.resource(FurData).sets.children.max())
+            if len(world.resource(FurData).sets)
+            else 0
+        )
         per_guide = own if display.per_guide is None else display.per_guide
         imgui.text("children per guide")
         gui.item("children label")

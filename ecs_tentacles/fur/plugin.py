@@ -1,7 +1,7 @@
 """The fur plugin: fur and feathers on the mantle, and the emotion that raises them.
 
-Scene keys: a creature's `fur` and `emotion` (`assets/schema/plugins/fur.json`).
-Resources: `world.fur` (`ecs_tentacles.fur.stores.FurData`). Systems: emotion, rig
+Scene keys: a creature's `fur` and `emotion` (`ecs_tentacles/fur/fur.schema.json`).
+Resources: `world.resource(FurData)` (`ecs_tentacles.fur.stores.FurData`). Systems: emotion, rig
 (stage animate). Export hook: the posed guide curves a take records.
 """
 
@@ -18,9 +18,10 @@ from ecs_tentacles.scene.validate import fragment
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
+    from ecs_tentacles.store import ArrayStore
     from ecs_tentacles.world import World
 
-_FRAGMENT = fragment("fur")
+_FRAGMENT = fragment("ecs_tentacles.fur", "fur")
 STORES = ("guides", "controls", "sets", "emotions")
 
 
@@ -33,8 +34,8 @@ class FurPlugin(Plugin):
     def problems(self, scene: Mapping[str, Any]) -> list[tuple[tuple[str | int, ...], str]]:
         return fur_problems(scene)
 
-    def resources(self, world: World) -> dict[str, Any]:
-        return {"fur": FurData()}
+    def resources(self, world: World) -> list[object]:
+        return [FurData()]
 
     def build_creature(self, world: World, creature: int, spec: Mapping[str, Any]) -> None:
         if "fur" in spec:
@@ -43,21 +44,22 @@ class FurPlugin(Plugin):
             build_emotion(world, creature, dict(spec["emotion"]))
 
     def systems(self) -> list[System]:
-        from ecs_tentacles.systems.emotion import EmotionSystem
-        from ecs_tentacles.systems.rig import Rig
+        from ecs_tentacles.systems.fur.emotion import EmotionSystem
+        from ecs_tentacles.systems.fur.rig import Rig
 
         return [EmotionSystem(), Rig()]
 
+    def stores(self, world: World) -> dict[str, ArrayStore]:
+        fur = world.resource(FurData)
+        return {f"fur.{name}": getattr(fur, name) for name in STORES}
+
     def snapshot(self, world: World) -> Any:
-        fur = world.fur
-        stores = {name: getattr(fur, name).copy_rows() for name in STORES}
-        return stores, fur.curves.copy(), fur.frames.copy()
+        fur = world.resource(FurData)  # its stores are copied with every store
+        return fur.curves.copy(), fur.frames.copy()
 
     def restore(self, world: World, state: Any) -> None:
-        stores, curves, frames = state
-        fur = world.fur
-        for name, saved in stores.items():
-            getattr(fur, name).put_rows(saved)
+        curves, frames = state
+        fur = world.resource(FurData)
         fur.curves[...] = curves
         fur.frames[...] = frames
 

@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 import pytest
-from ecs_tentacles.systems.suckers import ATTACH_HEIGHT
+from ecs_tentacles.systems.locomotion.suckers import ATTACH_HEIGHT
 from numpy.testing import assert_allclose, assert_array_equal
 
 from ecs_tentacles.components import Creature, Sucker, Tentacle

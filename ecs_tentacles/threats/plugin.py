@@ -1,7 +1,7 @@
 """The threats plugin: scene `threats` (keyframed paths) and creatures marked `threat`.
 
-Scene keys: `threats` and a creature's `threat` (`assets/schema/plugins/threats.json`).
-Resources: `world.threats` (`ecs_tentacles.threats.ThreatData`). Systems: threats
+Scene keys: `threats` and a creature's `threat` (`ecs_tentacles/threats/threats.schema.json`).
+Resources: `world.resource(ThreatData)` (`ecs_tentacles.threats.ThreatData`). Systems: threats
 (stage animate). The fur plugin's emotion reads them; render hook: dark red markers.
 """
 
@@ -15,12 +15,13 @@ import numpy as np
 from ecs_tentacles.plugin import Marker, Plugin
 from ecs_tentacles.scene.validate import fragment
 from ecs_tentacles.system import System
-from ecs_tentacles.threats import ThreatData, build_threats, mark_creature, threat_problems
+from ecs_tentacles.threats.data import ThreatData, build_threats, mark_creature, threat_problems
 
 if TYPE_CHECKING:
+    from ecs_tentacles.store import ArrayStore
     from ecs_tentacles.world import World
 
-_FRAGMENT = fragment("threats")
+_FRAGMENT = fragment("ecs_tentacles.threats", "threats")
 THREAT_SIZE = (0.07, 0.045, 0.04)  # metres along x, y, z
 THREAT_RGBA = (0.35, 0.12, 0.08, 1.0)
 
@@ -35,8 +36,8 @@ class ThreatsPlugin(Plugin):
     def problems(self, scene: Mapping[str, Any]) -> list[tuple[tuple[str | int, ...], str]]:
         return threat_problems(scene)
 
-    def resources(self, world: World) -> dict[str, Any]:
-        return {"threats": ThreatData()}
+    def resources(self, world: World) -> list[object]:
+        return [ThreatData()]
 
     def build_creature(self, world: World, creature: int, spec: Mapping[str, Any]) -> None:
         if spec.get("threat"):
@@ -46,18 +47,15 @@ class ThreatsPlugin(Plugin):
         build_threats(world, scene["threats"])
 
     def systems(self) -> list[System]:
-        from ecs_tentacles.systems.threats import ThreatPaths
+        from ecs_tentacles.systems.threats.threats import ThreatPaths
 
         return [ThreatPaths()]
 
-    def snapshot(self, world: World) -> Any:
-        return world.threats.store.copy_rows()
-
-    def restore(self, world: World, state: Any) -> None:
-        world.threats.store.put_rows(state)
+    def stores(self, world: World) -> dict[str, ArrayStore]:
+        return {"threats": world.resource(ThreatData).store}  # copied by snapshots
 
     def render_spheres(self, world: World) -> list[Marker]:
-        positions = list(world.threats.positions(world).values())
+        positions = list(world.resource(ThreatData).positions(world).values())
         if not positions:
             return []
         return [Marker(np.array(positions) + [0.0, 0.0, 0.04], THREAT_SIZE, THREAT_RGBA)]

@@ -22,7 +22,7 @@ class RecordPlugin(Plugin):
 
     def __init__(self, config: dict[str, Any] | None = None, *, every: int = 1, **recorder: Any):
         super().__init__(config)
-        from ecs_tentacles.systems.record import Record
+        from ecs_tentacles.systems.record.record import Record
 
         self.system = Record(every, **recorder)
 

@@ -12,8 +12,8 @@ per frame), by numba kernels when numba is installed, else whole-array numpy.
 
 Reads: Transform store (mantle rows), fur ControlStore (position, rest position,
 behaviour values, drives), GuideStore and FurSetStore (bind pose, re-read when
-`world.fur.version` changes). Writes: ControlStore (tracked attributes),
-`world.fur.frames` (axis, up, side, root per guide) and `world.fur.curves` (polylines).
+`world.resource(FurData).version` changes). Writes: ControlStore (tracked attributes),
+FurData's `frames` (axis, up, side, root per guide) and `curves` (polylines).
 """
 
 from __future__ import annotations
@@ -25,6 +25,7 @@ import numpy as np
 from ecs_tentacles.fur.bind import ControlTracks, control_values, make_bind, make_strands
 from ecs_tentacles.fur.dynamics import Strands
 from ecs_tentacles.fur.rig import Bind, Scratch, control_table, evaluate, use_parallel
+from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.fur.vectors import quat_matrices
 from ecs_tentacles.system import System
 from ecs_tentacles.tracks import TrackSet
@@ -62,7 +63,7 @@ class Rig(System):
 
     def rebind(self, world: World) -> None:
         """Re-read the bind pose, tracks and dynamic strands from the fur stores."""
-        fur = world.fur
+        fur = world.resource(FurData)
         self.bind, self.bodies = make_bind(fur)
         n = len(self.bind)
         self.blocks = [
@@ -81,7 +82,7 @@ class Rig(System):
         self.version = fur.version
 
     def process(self, world: World, dt: float) -> None:
-        fur = world.fur
+        fur = world.resource(FurData)
         if not len(fur.guides):
             return
         if self.version != fur.version:

@@ -1,6 +1,6 @@
 """threats: path threats follow their keyframed paths (the threats plugin).
 
-Reads: `world.threats.paths` (keyframed positions) and `world.time`. Writes: the
+Reads: `world.resource(ThreatData).paths` (keyframed positions) and `world.time`. Writes: the
 ThreatStore's `pos` of every path threat. Creatures marked `threat` need nothing here:
 their mantle is the threat.
 """
@@ -10,6 +10,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from ecs_tentacles.system import System
+from ecs_tentacles.threats.data import ThreatData
 from ecs_tentacles.tracks import TrackSet
 
 if TYPE_CHECKING:
@@ -27,7 +28,7 @@ class ThreatPaths(System):
         self.path_count = -1
 
     def process(self, world: World, dt: float) -> None:
-        threats = world.threats
+        threats = world.resource(ThreatData)
         if len(threats.paths) != self.path_count:
             self.paths = TrackSet(threats.paths)
             self.path_count = len(threats.paths)

@@ -6,10 +6,12 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
-from ecs_tentacles.systems.emotion import NINETY_PERCENT
+from ecs_tentacles.systems.fur.emotion import NINETY_PERCENT
 from numpy.testing import assert_allclose
 
 from ecs_tentacles.fur import Emotion
+from ecs_tentacles.fur.stores import FurData
+from ecs_tentacles.threats.data import ThreatData
 from ecs_tentacles.world import World
 
 FAR, NEAR = [5.0, 0.0, 0.1], [0.5, 0.0, 0.1]
@@ -35,7 +37,7 @@ def levels(world: World, frames: int) -> np.ndarray:
     out = []
     for _ in range(frames):
         world.step(1)
-        out.append(world.fur.emotions.level[0])
+        out.append(world.resource(FurData).emotions.level[0])
     return np.array(out)
 
 
@@ -67,13 +69,15 @@ def test_anticipation_then_slow_out_and_decay(make_world: Callable[..., World]) 
 def test_emotion_drives_the_controls(make_world: Callable[..., World]) -> None:
     world = make_world(scene(0.3), locomotion=False)
     world.step(100)
-    level = world.fur.emotions.level[0]
-    c, sets = world.fur.controls, world.fur.sets
+    level = world.resource(FurData).emotions.level[0]
+    c, sets = world.resource(FurData).controls, world.resource(FurData).sets
     assert level > 0.5
     assert_allclose(c.drive_lift, level * sets.erect_lift[0] * c.emotion)
     assert_allclose(c.drive_random, level * sets.erect_random[0] * c.emotion)
-    g = world.fur.guides
-    up = np.sum(world.fur.frames[:, 0] * world.fur.frames[:, 1], axis=1)  # sanity: orthogonal
+    g = world.resource(FurData).guides
+    up = np.sum(
+        world.resource(FurData).frames[:, 0] * world.resource(FurData).frames[:, 1], axis=1
+    )  # sanity: orthogonal
     assert_allclose(up, 0.0, atol=1e-6)
     elevation = np.einsum("ij,ij->i", g.rest, g.normal)
     assert elevation.max() < 0.2  # quills rest flat ...
@@ -81,7 +85,7 @@ def test_emotion_drives_the_controls(make_world: Callable[..., World]) -> None:
     from ecs_tentacles.mathutil import quat_rotate
 
     normals = quat_rotate(world.transforms.quat[g.body_row], g.normal)
-    raised = np.sum(world.fur.frames[:, 0] * normals, axis=1)
+    raised = np.sum(world.resource(FurData).frames[:, 0] * normals, axis=1)
     assert raised.min() > 0.5
 
 
@@ -105,7 +109,7 @@ def test_a_creature_marked_threat_frightens_others_not_itself(
     }
     world = make_world(data, locomotion=False)
     world.step(30)
-    e = world.fur.emotions
+    e = world.resource(FurData).emotions
     assert list(e.threatened) == [True, False, False]
     assert e.level[0] > 0.5 and e.level[1] == 0.0 and e.level[2] == 0.0
 
@@ -115,5 +119,5 @@ def test_threats_follow_their_paths_without_any_emotion(make_world: Callable[...
     del data["creatures"][0]["emotion"]
     world = make_world(data, locomotion=False)
     world.step(61)
-    assert_allclose(world.threats.store.pos[0], NEAR)
-    assert len(world.fur.emotions) == 0
+    assert_allclose(world.resource(ThreatData).store.pos[0], NEAR)
+    assert len(world.resource(FurData).emotions) == 0

@@ -19,6 +19,7 @@ from ecs_tentacles.locomotion.actions import (
     drive_sequence,
     make_action,
 )
+from ecs_tentacles.locomotion.params import Locomotion
 from ecs_tentacles.world import World
 from tests.conftest import creature_scene
 
@@ -43,7 +44,7 @@ def test_pull_sequence_runs_each_action_for_its_duration(
     t = world.tentacles
     tip = int(t.tip_sucker[0])
     world.step(5)
-    assert world.locomotion.queue(octo, 0) == ["idle"]
+    assert world.resource(Locomotion).queue(octo, 0) == ["idle"]
     sequence = drive_sequence(Mode.PULL, float(t.target_angle[0]), speed)
     ActionQueues(world).replace(0, sequence)  # the idle action ends: extend starts this frame
     actions: list[int] = []
@@ -117,11 +118,11 @@ def test_empty_queue_idles_for_ever(make_world: Callable[..., World]) -> None:
     t = world.tentacles
     ActionQueues(world).replace(1, drive_sequence(Mode.PUSH, 0.5, 5.0)[-1:])  # one detach, 0.02 s
     world.step(1)
-    assert world.locomotion.queue(octo, 1) == ["detach"]
+    assert world.resource(Locomotion).queue(octo, 1) == ["detach"]
     assert t.duration[1] == 0.1 / 5.0
     assert t.action_strength[1] == STRENGTH[Kind.DETACH]
     world.step(2)
-    assert world.locomotion.queue(octo, 1) == ["idle"]
+    assert world.resource(Locomotion).queue(octo, 1) == ["idle"]
     assert t.action[1] == Kind.IDLE
     assert t.duration[1] == np.inf
     assert t.action_strength[1] == STRENGTH[Kind.IDLE]
@@ -130,7 +131,7 @@ def test_empty_queue_idles_for_ever(make_world: Callable[..., World]) -> None:
     assert t.mode[1] == Mode.NONE
     assert not t.driving[1]
     world.step(60)
-    assert world.locomotion.actions(octo) == ["idle", "idle"]
+    assert world.resource(Locomotion).actions(octo) == ["idle", "idle"]
 
 
 def test_orient_angle_is_held_until_settle(make_world: Callable[..., World]) -> None:
@@ -159,7 +160,7 @@ def _busy(make_world: Callable[..., World]) -> World:
     world = make_world(creature_scene(count=2, links=3))
     ActionQueues(world).replace(0, [make_action(Kind.COMPRESS, TEN_SECONDS)])
     world.step(5)
-    assert world.locomotion.queue(world.creature("octo"), 0) == ["compress"]
+    assert world.resource(Locomotion).queue(world.creature("octo"), 0) == ["compress"]
     return world
 
 
@@ -171,11 +172,11 @@ def test_replace_starts_the_new_actions_the_same_frame(make_world: Callable[...,
     sequence = drive_sequence(Mode.PULL, 0.5, 1.0)
     ActionQueues(world).replace(0, sequence)
     world.step(1)
-    assert world.locomotion.queue(octo, 0) == ["extend", "attach", "pull", "detach"]
+    assert world.resource(Locomotion).queue(octo, 0) == ["extend", "attach", "pull", "detach"]
     assert (t.timer[0], t.duration[0]) == (0.0, sequence[0].duration)
     assert not t.interrupted.any()
     # the other tentacle goes on as before
-    assert world.locomotion.queue(octo, 1) == ["idle"]
+    assert world.resource(Locomotion).queue(octo, 1) == ["idle"]
     assert t.timer[1] == idle_timer + world.settings.dt
     # the new action is not cut short in turn: it lasts its whole duration
     actions = []
@@ -194,14 +195,14 @@ def test_interrupt_ends_the_current_action_and_keeps_the_pending_ones(
     queues = ActionQueues(world)
     queues[0].extend([make_action(Kind.DETACH, 1.0), make_action(Kind.SETTLE, 1.0)])
     world.step(1)
-    assert world.locomotion.queue(octo, 0) == ["compress", "detach", "settle"]
+    assert world.resource(Locomotion).queue(octo, 0) == ["compress", "detach", "settle"]
     queues.interrupt(0)
     world.step(1)
-    assert world.locomotion.queue(octo, 0) == ["detach", "settle"]
+    assert world.resource(Locomotion).queue(octo, 0) == ["detach", "settle"]
     queues.interrupt(0)
     queues.interrupt(0)  # twice in a frame is once
     world.step(1)
-    assert world.locomotion.queue(octo, 0) == ["settle"]
+    assert world.resource(Locomotion).queue(octo, 0) == ["settle"]
 
 
 def test_interrupt_with_nothing_pending_idles_at_once(make_world: Callable[..., World]) -> None:
@@ -209,7 +210,7 @@ def test_interrupt_with_nothing_pending_idles_at_once(make_world: Callable[..., 
     t = world.tentacles
     ActionQueues(world).interrupt(0)
     world.step(1)
-    assert world.locomotion.queue(world.creature("octo"), 0) == ["idle"]
+    assert world.resource(Locomotion).queue(world.creature("octo"), 0) == ["idle"]
     assert (t.duration[0], t.action_strength[0]) == (np.inf, STRENGTH[Kind.IDLE])
 
 
@@ -225,8 +226,8 @@ def test_interrupt_ends_an_attach_that_waits_for_its_sucker(
     queues = ActionQueues(world)
     queues.replace(0, [make_action(Kind.ATTACH, 0.1), make_action(Kind.PUSH, 1.0)])
     world.step(20)
-    assert world.locomotion.queue(octo, 0) == ["attach", "push"]
+    assert world.resource(Locomotion).queue(octo, 0) == ["attach", "push"]
     queues.interrupt(0)
     world.step(1)
-    assert world.locomotion.queue(octo, 0) == ["push"]
+    assert world.resource(Locomotion).queue(octo, 0) == ["push"]
     assert world.events.counts["sucker_attached"] == 0

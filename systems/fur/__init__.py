@@ -1,0 +1,1 @@
+"""The fur feature's systems (`ecs_tentacles.fur`): emotion, rig (stage animate)."""

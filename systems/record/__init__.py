@@ -1,0 +1,1 @@
+"""The record feature's system (`ecs_tentacles.record`): record (stage output)."""

@@ -1,0 +1,1 @@
+"""The threats feature's system (`ecs_tentacles.threats`): threats (stage animate)."""
