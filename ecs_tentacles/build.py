@@ -60,13 +60,12 @@ def build_creature(world: World, spec: dict[str, Any]) -> int:
     creature_entity = world.create_entity(creature, Transform(world.transforms, row))
     world.creatures.entity[creature.row] = creature_entity
 
-    rng = creature_rng(world.seed, spec["name"])
     for k, angle in enumerate(layout.angles):
         tentacle = Tentacle(creature=creature_entity, index=k, base_angle=float(angle))
         tentacle_entity = world.create_entity(tentacle)
         creature.tentacles.append(tentacle_entity)
         _build_links(world, tentacle, tentacle_entity, layout, k)
-        _add_tentacle_row(world, tentacle, creature.row, layout, k, rng)
+        _add_tentacle_row(world, tentacle, creature.row, layout, k)
     return creature_entity
 
 
@@ -76,7 +75,6 @@ def _add_tentacle_row(
     creature_row: int,
     layout: CreatureLayout,
     k: int,
-    rng: np.random.Generator,
 ) -> None:
     params, shape = layout.params[k], layout.shapes[k]
     links = [world.component(e, Link) for e in tentacle.links]
@@ -92,10 +90,9 @@ def _add_tentacle_row(
             tip_sucker=sucker.row,
             length=shape.length,
             rest_pitch=shape.rest_pitch,
-            phase=rng.uniform(0.0, 2.0 * np.pi),
         )[0]
     )
-    apply_parameters(world, "tentacles", params, tentacles=tentacle.row)
+    apply_parameters(world, "tentacles", params, {"tentacles": tentacle.row})
     world.motors.tentacle_row[[m.row for m in motors]] = tentacle.row
     sucker_rows = [world.component(e, Sucker).row for e in tentacle.suckers]
     world.suckers.tentacle_row[sucker_rows] = tentacle.row
@@ -119,7 +116,7 @@ def _build_links(
         / (shape.centres[-1] + 0.5 * shape.lengths[-1] - mantle_radius),
         scale=shape.scales,
     )
-    apply_parameters(world, "tentacles", params, motors=motor_rows)  # tapered by `scale`
+    apply_parameters(world, "tentacles", params, {"motors": motor_rows})  # tapered by `scale`
     limit = float(parameter("tentacles", "joint_limit_deg").from_scene(params["joint_limit_deg"]))
     for i in range(n):
         link = Link(

@@ -7,16 +7,15 @@ row, and each field reads as a writable numpy view (vectors) or a float (scalars
     world.component(link, Transform).pos     # (3,) writable view into the TransformStore
     world.component(link, Motor).strength = 8.0  # reaches the servo on the next step
 
-Structural components (`Creature`, `Tentacle`, `Link`, `Goal`) are plain data fixed
-at construction. Components are never added or removed per frame.
+Structural components (`Creature`, `Tentacle`, `Link`) are plain data fixed at
+construction; features define their own (`ecs_tentacles.locomotion.components`).
+Components are never added or removed per frame.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 from typing import Any
-
-import numpy as np
 
 from ecs_tentacles.store import ArrayStore, MotorStore, SuckerStore, TransformStore
 
@@ -120,13 +119,3 @@ class Link:
     density: float
     joint_limit: float
     twist: bool
-
-
-@dataclass(eq=False)
-class Goal:
-    """A place `owner` should reach: within `radius` of `position`; `order` in its path."""
-
-    owner: int
-    order: int
-    position: np.ndarray
-    radius: float

@@ -93,6 +93,8 @@ class Plugin:
     config_schema: ClassVar[dict[str, Any]] = {"type": "object", "additionalProperties": False}
     creature_schema: ClassVar[dict[str, Any]] = {}  # creature key -> its schema
     scene_schema: ClassVar[dict[str, Any]] = {}  # scene key -> its schema
+    # keys of a creature's `tentacles` (and its `overrides`, without default) -> schema
+    tentacle_schema: ClassVar[dict[str, Any]] = {}
     defs: ClassVar[dict[str, Any]] = {}  # "$defs" the fragments refer to ("#/$defs/...")
 
     def __init__(self, config: Mapping[str, Any] | None = None):

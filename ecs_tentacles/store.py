@@ -127,13 +127,11 @@ class MotorStore(ArrayStore):
 
 
 class TentacleStore(ArrayStore):
-    """Per tentacle: layout, locomotion parameters and the current action, as arrays.
+    """Per tentacle: its body's layout, as arrays.
 
     Links of a tentacle are the contiguous motor rows `first_link .. first_link + links`.
-    Parameters (`speed` ... `writhe`) are what scripts and the HUD change at run time.
-    The current action (`action`, `timer`, `duration`, `action_angle`,
-    `action_strength`) is the one last taken from the tentacle's `ActionQueue`;
-    `interrupted` ends it early (`ecs_tentacles.locomotion.actions.ActionQueues`).
+    What a feature keeps per tentacle (locomotion's parameters and current action) lives
+    in that feature's stores, row for row (`ecs_tentacles.locomotion.stores`).
     """
 
     creature_row = Field(dtype=np.int64)
@@ -145,45 +143,16 @@ class TentacleStore(ArrayStore):
     length = Field()
     joint_limit = Field()
     rest_pitch = Field()  # tilt that lays a tapering tentacle's underside on the ground
-    # parameters
-    speed = Field(default=1.0)
-    target_angle = Field()
-    wave_amplitude = Field()
-    wave_frequency = Field()
-    wavelength = Field(default=1.0)
-    writhe = Field()
-    phase = Field()
-    # the current action
-    action = Field(dtype=np.int64)
-    timer = Field()
-    duration = Field(default=np.inf)
-    action_angle = Field()
-    action_strength = Field(default=1.0)
-    orient = Field()  # sweep (radians) toward the goal line, held through a stroke
-    interrupted = Field(dtype=np.bool_, default=False)  # ends this frame (ActionQueues.interrupt)
-    mode = Field(dtype=np.int64)  # 0 idle, 1 push, 2 pull
-    driving = Field(dtype=np.bool_, default=False)
-    started = Field(default=-np.inf)  # time the current drive began
 
 
 class CreatureStore(ArrayStore):
-    """Per creature: mantle row, tentacle rows, gait and locomotion settings."""
+    """Per creature: its mantle row and size and its tentacle rows (features keep the rest)."""
 
     entity = Field(dtype=np.int64)
     mantle_row = Field(dtype=np.int64)
     mantle_radius = Field()
     first_tentacle = Field(dtype=np.int64)
     tentacles = Field(dtype=np.int64)
-    gait = Field(dtype=np.int64)  # index into the schema's gait choices (scene.parameters)
-    speed = Field(default=1.0)
-    drivers = Field(dtype=np.int64, default=1)
-    release_stretch = Field()
-    release_reach = Field()
-    next_driver = Field(dtype=np.int64)  # cyclic: whose turn is next
-    last_start = Field(default=-np.inf)  # coordinated: when the last drive began
-    has_goal = Field(dtype=np.bool_, default=False)
-    goal = Field((3,))  # the current goal's position (valid when has_goal)
-    goal_radius = Field()
 
 
 class SuckerStore(ArrayStore):

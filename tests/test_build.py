@@ -117,8 +117,10 @@ def test_a_creatures_random_draws_do_not_depend_on_the_other_creatures() -> None
         with World.from_scene(scene) as world:
             row = world.component(world.creature("b"), Creature).row
             first = world.creatures.first_tentacle[row]
-            phases.append(world.tentacles.phase[first : first + 5].copy())
+            phases.append(world.stores["locomotion.tentacles"].phase[first : first + 5].copy())
     np.testing.assert_array_equal(phases[0], phases[1])
     assert len(set(phases[0].tolist())) == 5
     with World.from_scene({"version": 1, "seed": 12, "creatures": [creature]}) as world:
-        assert not np.array_equal(world.tentacles.phase[:5], phases[0])  # the seed matters
+        assert not np.array_equal(
+            world.stores["locomotion.tentacles"].phase[:5], phases[0]
+        )  # the seed matters

@@ -180,10 +180,13 @@ CORE_ALONE = textwrap.dedent(
         world.step(30)
         fell = float(start[:, 2].mean() - world.transforms.pos[:, 2].mean())
         print(world.schedule.names, round(fell, 3) >= 0)
-    loaded = sorted(m for m in sys.modules if m.startswith(("ecs_tentacles.plugins",
+        columns = {name: [f.name for f in store.fields()] for name, store in world.stores.items()}
+    loaded = sorted(m for m in sys.modules if m.startswith(("ecs_tentacles.record",
         "ecs_tentacles.locomotion", "ecs_tentacles.fur", "ecs_tentacles.threats",
-        "ecs_tentacles.render", "ecs_tentacles.export")))
+        "ecs_tentacles.render", "ecs_tentacles.export", "ecs_tentacles.systems.locomotion",
+        "ecs_tentacles.systems.fur", "ecs_tentacles.systems.threats")))
     print(loaded)
+    print(sorted(columns.items()))
     """
 )
 
@@ -193,9 +196,25 @@ def test_core_runs_without_any_plugin_imported() -> None:
         [sys.executable, "-c", CORE_ALONE], capture_output=True, text=True, check=False
     )
     assert result.returncode == 0, result.stderr
-    names, loaded = result.stdout.strip().splitlines()
+    names, loaded, columns = result.stdout.strip().splitlines()
     assert names == "['physics', 'physics_sync', 'physics_health'] True"
     assert loaded == "[]"
+    # core stores hold the body and its physics only: no locomotion, fur or threat column
+    assert columns == str(sorted(BODY_COLUMNS.items()))
+
+
+BODY_COLUMNS = {
+    "transforms": ["pos", "quat"],
+    "motors": [
+        "target", "strength", "damping", "max_torque", "gain", "tentacle_row", "arc", "scale"
+    ],
+    "suckers": ["link_row", "tentacle_row", "entity", "offset", "attached", "anchor"],
+    "creatures": ["entity", "mantle_row", "mantle_radius", "first_tentacle", "tentacles"],
+    "tentacles": [
+        "creature_row", "base_angle", "first_link", "links", "base_row", "tip_sucker",
+        "length", "joint_limit", "rest_pitch",
+    ],
+}  # fmt: skip
 
 
 def test_a_failing_system_is_named_with_its_plugin_and_frame(

@@ -64,7 +64,7 @@ def test_remove_replace_and_disable_a_builtin(make_world: Callable[..., World]) 
         name = "still_goals"
 
         def process(self, world: World, dt: float) -> None:
-            world.creatures.has_goal[:] = False
+            world.stores["locomotion.creatures"].has_goal[:] = False
 
     old = world.schedule.replace("goals", StillGoals())
     assert old.name == "goals"
@@ -74,7 +74,7 @@ def test_remove_replace_and_disable_a_builtin(make_world: Callable[..., World]) 
     assert "rig" not in world.schedule.names and world.schedule.disabled() == ["rig"]
     assert "rig (disabled)" in world.schedule.table()
     world.step(5)
-    assert not world.creatures.has_goal.any()
+    assert not world.stores["locomotion.creatures"].has_goal.any()
     world.schedule.enable("rig")
     assert world.schedule.names[-1] == "rig"
 

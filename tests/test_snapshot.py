@@ -22,7 +22,10 @@ def _state(world: World) -> list[np.ndarray]:
         world.suckers.anchor,
         world.resource(FurData).curves,
     ]
-    return [np.array(a, copy=True) for a in (*physics, *stores, world.tentacles.timer)]
+    return [
+        np.array(a, copy=True)
+        for a in (*physics, *stores, world.stores["locomotion.tentacles"].timer)
+    ]
 
 
 def test_restore_continues_bit_identically_with_suckers_attached(

@@ -9,7 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from ecs_tentacles.components import Creature, Goal
+from ecs_tentacles.components import Creature
+from ecs_tentacles.locomotion.components import Goal
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.system import System
 from ecs_tentacles.world import World

@@ -24,6 +24,7 @@ import numpy as np
 from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.locomotion.params import Locomotion
+from ecs_tentacles.locomotion.stores import LocomotionStores
 from ecs_tentacles.mathutil import quat_rotate
 from ecs_tentacles.scene.load import bundled_scene
 from ecs_tentacles.scene.parameters import parameter
@@ -87,7 +88,10 @@ def run(world: World, case: str, seconds: float) -> dict[str, Any]:
         tentacle = s.tentacle_row[row]
         base = world.transforms.pos[t.base_row[tentacle], :2]
         distance = np.linalg.norm(base - s.anchor[row, :2])
-        left_behind += int(distance > world.creatures.release_reach[0] * t.length[tentacle])
+        left_behind += int(
+            distance
+            > world.resource(LocomotionStores).creatures.release_reach[0] * t.length[tentacle]
+        )
     elapsed = world.time
     displacement = float(np.linalg.norm(mantle.pos[:2] - start))
     return {

@@ -16,8 +16,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ecs_tentacles.components import Creature, Goal, Link, Tentacle, Transform
+from ecs_tentacles.components import Creature, Link, Tentacle, Transform
 from ecs_tentacles.fur.stores import FurData
+from ecs_tentacles.locomotion.components import Goal
 from ecs_tentacles.plugin import GuideFrame
 from ecs_tentacles.take import FORMAT, VERSION, Take
 

@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ecs_tentacles.components import Tentacle
+from ecs_tentacles.locomotion.stores import LocomotionStores
 
 if TYPE_CHECKING:
     from ecs_tentacles.world import World
@@ -151,7 +152,7 @@ class ActionQueues:
     """
 
     def __init__(self, world: World):
-        self._tentacles = world.tentacles
+        self._tentacles = world.resource(LocomotionStores).tentacles
         by_row = {t.row: world.component(e, ActionQueue) for e, t in world.query(Tentacle)}
         # a row without a tentacle entity (stores filled by hand) gets a queue of its own
         self._queues = [

@@ -15,7 +15,9 @@ from typing import TYPE_CHECKING
 import esper
 import numpy as np
 
-from ecs_tentacles.components import Creature, Goal
+from ecs_tentacles.components import Creature
+from ecs_tentacles.locomotion.components import Goal
+from ecs_tentacles.locomotion.stores import LocomotionStores
 
 if TYPE_CHECKING:
     from ecs_tentacles.world import World
@@ -110,7 +112,7 @@ class GoalBook:
         for order, goal in enumerate(path):
             self._world.component(goal, Goal).order = order
         row = self._world.component(creature, Creature).row
-        store = self._world.creatures
+        store = self._world.resource(LocomotionStores).creatures
         store.has_goal[row] = bool(path)
         if path:
             first = self._world.component(path[0], Goal)

@@ -24,20 +24,28 @@ import numpy as np
 
 from ecs_tentacles.components import Creature, Tentacle
 from ecs_tentacles.locomotion.actions import ActionQueue, Kind
+from ecs_tentacles.locomotion.stores import LocomotionStores
 from ecs_tentacles.scene.parameters import Parameter, parameters
 from ecs_tentacles.scene.ranges import damping_floor
 
 if TYPE_CHECKING:
     from ecs_tentacles.world import World
 
-STORES = ("creatures", "tentacles", "motors")  # the stores whose rows `set` knows
+# the stores whose rows `set` knows, and what one row of each is
+ROWS = {
+    "locomotion.creatures": "creature",
+    "creatures": "creature",
+    "locomotion.tentacles": "tentacle",
+    "tentacles": "tentacle",
+    "motors": "link",
+}
 
 
 def settable() -> tuple[dict[str, Parameter], dict[str, Parameter]]:
     """The run-time parameters by API name: (per tentacle, per creature)."""
-    table = [p for p in parameters() if p.runtime and p.store in STORES]
-    per_tentacle = {p.api: p for p in table if p.store != "creatures"}
-    return per_tentacle, {p.api: p for p in table if p.store == "creatures"}
+    table = [p for p in parameters() if p.runtime and p.store in ROWS]
+    per_tentacle = {p.api: p for p in table if ROWS[p.store] != "creature"}
+    return per_tentacle, {p.api: p for p in table if ROWS[p.store] == "creature"}
 
 
 class Locomotion:
@@ -89,15 +97,15 @@ class Locomotion:
 
     def _rows(self, p: Parameter, creature_row: int, tentacle_rows: np.ndarray) -> Any:
         """The rows of `p`'s store that a change of these tentacles (or creature) writes."""
-        if p.store == "creatures":
+        if ROWS[p.store] == "creature":
             return creature_row
-        return self._link_rows(tentacle_rows) if p.store == "motors" else tentacle_rows
+        return self._link_rows(tentacle_rows) if ROWS[p.store] == "link" else tentacle_rows
 
     def _check(self, p: Parameter, value: Any, rows: Any) -> Any:
         """`value` checked against `p`'s range, capped by its `at_most` column if it has one."""
         if p.at_most is None or p.range is None:
             return p.check(value)
-        high = min(p.range.high, np.min(getattr(getattr(self._world, p.store), p.at_most)[rows]))
+        high = min(p.range.high, np.min(p.cap(self._world)[rows]))
         whole = isinstance(value, numbers.Integral) and not isinstance(value, bool)
         if not whole or not p.range.low <= value <= high:
             raise ValueError(
@@ -107,10 +115,10 @@ class Locomotion:
 
     def _value(self, p: Parameter, tentacle_row: int) -> Any:
         """One tentacle's value of `p`: its base link's for link parameters, before the taper."""
-        store = getattr(self._world, p.store)
+        store = self._world.stores[p.store]
         at = (
             int(self._world.tentacles.first_link[tentacle_row])
-            if p.store == "motors"
+            if ROWS[p.store] == "link"
             else tentacle_row
         )
         value = getattr(store, p.field)[at]
@@ -152,12 +160,13 @@ class Locomotion:
         values = {name: self._value(p, t) for name, p in per_tentacle.items()}
         for name, p in per_creature.items():
             shown = f"creature_{name}" if name in per_tentacle else name
-            values[shown] = p.to_api(getattr(getattr(world, p.store), p.field)[row])
+            values[shown] = p.to_api(getattr(world.stores[p.store], p.field)[row])
         return values
 
     def actions(self, creature: int) -> list[str]:
         """The current action of each of the creature's tentacles, by index."""
-        kinds = self._world.tentacles.action[[t.row for t in self._tentacles(creature, None)]]
+        action = self._world.resource(LocomotionStores).tentacles.action
+        kinds = action[[t.row for t in self._tentacles(creature, None)]]
         return [Kind(int(k)).name.lower() for k in kinds]
 
     def queue(self, creature: int, tentacle: int) -> list[str]:
@@ -165,7 +174,8 @@ class Locomotion:
         target = self._tentacles(creature, tentacle)[0]
         entity = self._world.component(creature, Creature).tentacles[tentacle]
         pending = self._world.component(entity, ActionQueue).kinds()
-        current = Kind(int(self._world.tentacles.action[target.row])).name.lower()
+        action = self._world.resource(LocomotionStores).tentacles.action
+        current = Kind(int(action[target.row])).name.lower()
         return [current, *pending]
 
     def _link_rows(self, tentacle_rows: np.ndarray) -> np.ndarray:

@@ -1,8 +1,11 @@
 """The locomotion plugin: goal paths, gait and the action queues that crawl toward goals.
 
 Scene keys: a creature's `goals` and `locomotion` (`locomotion.schema.json` beside this file).
-Resources: `GoalBook` (goal paths) and `Locomotion` (parameters at run time), by type:
-`world.resource(GoalBook)`.
+Resources: `LocomotionStores` (per-tentacle and per-creature columns, row for row with
+the body's stores; `world.stores` "locomotion.tentacles" / "locomotion.creatures"),
+`GoalBook` (goal paths) and `Locomotion` (parameters at run time), by type:
+`world.resource(GoalBook)`. Scene keys also include six tentacle parameters (speed,
+target angle, waves, writhe; `tentacles` and its `overrides`).
 Systems: goals, tentacle_selection (stage decide), action_queue, motor_targets (act).
 """
 
@@ -12,16 +15,23 @@ import copy
 from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
-from ecs_tentacles.components import Creature, Goal, Tentacle
+import numpy as np
+
+from ecs_tentacles.build import creature_rng
+from ecs_tentacles.components import Creature, Tentacle
+from ecs_tentacles.construction import tentacle_params
 from ecs_tentacles.locomotion.actions import STRENGTH, ActionQueue, Kind
+from ecs_tentacles.locomotion.components import Goal
 from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.locomotion.params import Locomotion
+from ecs_tentacles.locomotion.stores import LocomotionStores
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.scene.parameters import apply_parameters
 from ecs_tentacles.scene.validate import fragment
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
+    from ecs_tentacles.store import ArrayStore
     from ecs_tentacles.world import World
 
 _FRAGMENT = fragment("ecs_tentacles.locomotion", "locomotion")
@@ -31,19 +41,37 @@ class LocomotionPlugin(Plugin):
     name = "locomotion"
     description = "goal-directed crawling: goal paths, gait, action queues, motor targets"
     creature_schema = _FRAGMENT["creature"]
+    tentacle_schema = _FRAGMENT["tentacles"]
     defs = _FRAGMENT["$defs"]
 
     def resources(self, world: World) -> list[object]:
-        return [GoalBook(world), Locomotion(world)]
+        return [LocomotionStores(), GoalBook(world), Locomotion(world)]
+
+    def stores(self, world: World) -> dict[str, ArrayStore]:
+        loco = world.resource(LocomotionStores)
+        return {"locomotion.tentacles": loco.tentacles, "locomotion.creatures": loco.creatures}
 
     def build_creature(self, world: World, creature: int, spec: Mapping[str, Any]) -> None:
-        row = world.component(creature, Creature).row
-        apply_parameters(world, "locomotion", spec["locomotion"], creatures=row)
-        for entity in world.component(creature, Creature).tentacles:
+        loco = world.resource(LocomotionStores)
+        body = world.component(creature, Creature)
+        row = int(loco.creatures.add()[0])
+        if row != body.row:
+            raise RuntimeError("locomotion's creature rows must line up with the body's")
+        apply_parameters(world, "locomotion", spec["locomotion"], {"locomotion.creatures": row})
+        rng = creature_rng(world.seed, spec["name"])  # the creature's own stream
+        tentacles = spec["tentacles"]
+        for k, entity in enumerate(body.tentacles):
+            tentacle = world.component(entity, Tentacle)
+            added = int(
+                loco.tentacles.add(
+                    phase=rng.uniform(0.0, 2.0 * np.pi), action_strength=STRENGTH[Kind.IDLE]
+                )[0]
+            )
+            if added != tentacle.row:
+                raise RuntimeError("locomotion's tentacle rows must line up with the body's")
+            params = tentacle_params(tentacles, k)
+            apply_parameters(world, "tentacles", params, {"locomotion.tentacles": added})
             world.add_component(entity, ActionQueue())
-            world.tentacles.action_strength[world.component(entity, Tentacle).row] = STRENGTH[
-                Kind.IDLE
-            ]
         for goal in spec["goals"]:
             point = list(goal["position"]) + ([0.0] if len(goal["position"]) == 2 else [])
             world.resource(GoalBook).append(creature, point, goal["radius"])

@@ -10,7 +10,7 @@ those changes (a goal, a neighbour, a script moving a target), before the step.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -41,7 +41,8 @@ class Sleep:
         """Put still groups to sleep and wake the ones whose situation changed."""
         if not self.enabled:  # nothing ever sleeps: no per-group work
             return
-        has_goal = world.creatures.has_goal
+        gaits: Any = world.stores.get("locomotion.creatures")  # no goals without locomotion
+        has_goal = gaits.has_goal if gaits is not None else np.zeros(len(world.creatures), bool)
         attached = world.suckers.attached
         for group in self.groups:
             if group.frozen:

@@ -18,11 +18,12 @@ from dataclasses import dataclass
 import numpy as np
 from pyglet import gl
 
-from ecs_tentacles.components import Creature, Goal, Link, Tentacle, Transform
+from ecs_tentacles.components import Creature, Link, Tentacle, Transform
 from ecs_tentacles.fur.hooks import GuideCurves, child_hairs, guide_curves
 from ecs_tentacles.fur.render.markers import marker_lines
 from ecs_tentacles.fur.render.ribbons import Ribbons
 from ecs_tentacles.fur.stores import FurData
+from ecs_tentacles.locomotion.components import Goal
 from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.render import shaders
 from ecs_tentacles.render.camera import OrbitCamera

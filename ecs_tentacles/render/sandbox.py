@@ -30,8 +30,9 @@ from pyglet import gl
 from pyglet.window import key, mouse
 from tqdm import tqdm
 
-from ecs_tentacles.components import Creature, Goal, Transform
+from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.fur.render.furpanel import FurPanel
+from ecs_tentacles.locomotion.components import Goal
 from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.render.camera import ray_sphere
 from ecs_tentacles.render.hud import Hud

@@ -10,13 +10,17 @@ A parameter is a property of the scene schema annotated with `x-parameter`:
 The property gives the scene key, default and range (`minimum`/`maximum`, or `enum`:
 the stored code of a choice is its index there). The annotation gives the rest:
 
-* `column`: the store column it fills, `<store>.<field>` (`world.motors.strength`);
-  a parameter stored per creature (`creatures.*`) is creature-wide at run time;
+* `column`: the store column it fills, `<store>.<field>` against the world's stores
+  by name (`motors.strength`, `locomotion.tentacles.speed`: `world.stores`); a
+  parameter stored per creature (`creatures.*`, `locomotion.creatures.*`) is
+  creature-wide at run time;
 * `units`: the scene's units. A key ending in `_deg` is degrees in the scene and
   radians in code (stores, `world.resource(Locomotion)`), whose name drops the `_deg`;
 * `taper`: a column of the same store the value is multiplied by, row by row
   (`scale`: each link's construction scale);
-* `at_most`: a column of the same store that caps it (drivers: the tentacle count);
+* `at_most`: a column that caps it, row by row: a field of the same store, or
+  `<store>.<field>` of another store with the same rows (drivers: `creatures.tentacles`,
+  the tentacle count);
 * `runtime`: false when `world.resource(Locomotion).set` cannot change it (read at compile);
 * `label`, and `slider` (`order`, `digits`, `log`): how the HUD shows it.
 
@@ -110,14 +114,20 @@ class Parameter:
         assert self.range is not None
         return self.range.check(self.api, value)
 
+    def cap(self, world: Any) -> Any:
+        """The `at_most` column of `world` (its rows line up with this parameter's store)."""
+        assert self.at_most is not None
+        store, _, field = self.at_most.rpartition(".")
+        return getattr(world.stores[store or self.store], field)
+
     def write(self, world: Any, rows: Any, value: Any) -> None:
         """Store an API value at `rows` of its column: tapered and capped by its row's columns."""
-        store = getattr(world, self.store)
+        store = world.stores[self.store]
         stored = self.code(value) if self.choices else value
         if self.taper:
             stored = stored * getattr(store, self.taper)[rows]
         if self.at_most:
-            stored = np.minimum(stored, getattr(store, self.at_most)[rows])
+            stored = np.minimum(stored, self.cap(world)[rows])
         getattr(store, self.field)[rows] = stored
 
 
@@ -136,7 +146,7 @@ def _parameter(section: str, key: str, spec: Mapping[str, Any], where: str) -> P
     if unknown or not {"column", "units", "label"} <= set(meta):
         problem = f"unknown key {sorted(unknown)[0]!r}" if unknown else "needs column, units, label"
         raise ValueError(f"{where}: {problem}")
-    store, _, field = str(meta["column"]).partition(".")
+    store, _, field = str(meta["column"]).rpartition(".")
     if not store or not field:
         raise ValueError(f"{where}: column must be <store>.<field>, got {meta['column']!r}")
     degrees = key.endswith("_deg")
@@ -196,16 +206,17 @@ def apply_parameters(
     world: Any,
     section: str,
     entry: Mapping[str, Any],
+    rows: Mapping[str, Any],
     table: Sequence[Parameter] | None = None,
-    **rows: Any,
 ) -> None:
     """Fill store columns from a scene entry (defaults applied) of `section`, at `rows`.
 
-    `rows` maps store names to the rows to fill; parameters of other stores are left
-    for another call (a tentacle's links are built before its tentacle row):
+    `rows` maps store names (`world.stores`) to the rows to fill; parameters of other
+    stores are left for another call (a tentacle's links are built before its tentacle
+    row, and features fill their own stores):
 
-        apply_parameters(world, "tentacles", params, motors=link_rows)
-        apply_parameters(world, "locomotion", spec["locomotion"], creatures=row)
+        apply_parameters(world, "tentacles", params, {"motors": link_rows})
+        apply_parameters(world, "locomotion", spec["locomotion"], {"locomotion.creatures": row})
     """
     for found in parameters() if table is None else table:
         if found.section == section and found.store in rows and found.key in entry:

@@ -72,7 +72,7 @@ def fragment(package: str, name: str) -> dict[str, Any]:
 
 def schema_for(plugins: Sequence[Plugin]) -> dict[str, Any]:
     """The core schema with each plugin's creature keys, scene keys and `$defs` added."""
-    parts = [(p.key, p.defs, p.creature_schema, p.scene_schema) for p in plugins]
+    parts = [(p.key, p.defs, p.creature_schema, p.scene_schema, p.tentacle_schema) for p in plugins]
     if any(p.source is not None for p in plugins):  # users' plugins: assembled each time
         return _assemble(parts)
     key = tuple((p.key, type(p)) for p in plugins)  # built-in fragments never change
@@ -88,11 +88,14 @@ def _fragment_file(package: str, name: str) -> importlib.resources.abc.Traversab
 
 
 _SCHEMAS: dict[tuple[tuple[str, type], ...], dict[str, Any]] = {}
-Part = tuple[str, Mapping[str, Any], Mapping[str, Any], Mapping[str, Any]]
+Part = tuple[str, Mapping[str, Any], Mapping[str, Any], Mapping[str, Any], Mapping[str, Any]]
+NOT_IN_OVERRIDES = ("default", "x-parameter")  # an override's key only changes one tentacle
 
 
 def _assemble(parts: Sequence[Part]) -> dict[str, Any]:
-    """Core schema + (plugin key, $defs, creature keys, scene keys) of each plugin."""
+    """Core schema + (plugin key, $defs, creature keys, scene keys, tentacle keys) of each
+    plugin. Tentacle keys join the creature's `tentacles` and, without their default and
+    parameter annotation, each entry of its `overrides`."""
     schema = copy.deepcopy(core_schema())
     schema["$id"] = schema["$id"].replace("core.schema.json", "scene.schema.json")
     owner: dict[tuple[str, str], str] = {}
@@ -100,9 +103,16 @@ def _assemble(parts: Sequence[Part]) -> dict[str, Any]:
         "$defs": schema["$defs"],
         "creature": schema["$defs"]["creature"]["properties"],
         "scene": schema["properties"],
+        "tentacles": schema["$defs"]["creature"]["properties"]["tentacles"]["properties"],
     }
-    for key, defs, creature, scene in parts:
-        for place, entries in (("$defs", defs), ("creature", creature), ("scene", scene)):
+    overrides = schema["$defs"]["tentacle_override"]["properties"]
+    for key, defs, creature, scene, tentacles in parts:
+        for place, entries in (
+            ("$defs", defs),
+            ("creature", creature),
+            ("scene", scene),
+            ("tentacles", tentacles),
+        ):
             for name, entry in entries.items():
                 if name in places[place] or (place, name) in owner:
                     first = owner.get((place, name), "core")
@@ -111,6 +121,10 @@ def _assemble(parts: Sequence[Part]) -> dict[str, Any]:
                     )
                 owner[(place, name)] = key
                 places[place][name] = copy.deepcopy(entry)
+                if place == "tentacles":
+                    overrides[name] = {
+                        k: copy.deepcopy(v) for k, v in entry.items() if k not in NOT_IN_OVERRIDES
+                    }
     return schema
 
 
@@ -128,7 +142,13 @@ def load_schema() -> dict[str, Any]:
         if _fragment_file(package, name).is_file():
             part = fragment(package, name)
             parts.append(
-                (name, part.get("$defs", {}), part.get("creature", {}), part.get("scene", {}))
+                (
+                    name,
+                    part.get("$defs", {}),
+                    part.get("creature", {}),
+                    part.get("scene", {}),
+                    part.get("tentacles", {}),
+                )
             )
     return _assemble(parts)
 

@@ -38,8 +38,13 @@ class Flee(System):
     stage = "decide"
     after = ("goals",)
     before = ("tentacle_selection",)
-    reads = ("threats.pos", "transforms.pos")
-    writes = ("goals", "creatures.goal", "creatures.has_goal")
+    reads = ("threats.pos", "transforms.pos", "creatures.entity", "creatures.mantle_row")
+    writes = (
+        "goals",
+        "locomotion.creatures.goal",
+        "locomotion.creatures.has_goal",
+        "locomotion.creatures.goal_radius",
+    )
 
     def __init__(self, distance: float, run: float, interval: float, goal_radius: float):
         self.distance = distance

@@ -48,8 +48,13 @@ class Flock(System):
     stage = "decide"
     after = ("goals",)
     before = ("tentacle_selection",)
-    reads = ("transforms.pos",)
-    writes = ("goals", "creatures.goal", "creatures.has_goal")
+    reads = ("transforms.pos", "creatures.entity", "creatures.mantle_row")
+    writes = (
+        "goals",
+        "locomotion.creatures.goal",
+        "locomotion.creatures.has_goal",
+        "locomotion.creatures.goal_radius",
+    )
     state_attributes = ("last",)  # positions at the last plan: velocities after a restore
 
     def __init__(self, config: Mapping[str, Any]):

@@ -25,6 +25,7 @@ from ecs_tentacles.systems.examples import Problem, number, replanning
 
 from ecs_tentacles.components import Creature
 from ecs_tentacles.locomotion.goals import GoalBook
+from ecs_tentacles.locomotion.stores import LocomotionStores
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.scene.validate import plugin_config
 from ecs_tentacles.system import System
@@ -42,8 +43,18 @@ class FollowLeader(System):
     stage = "decide"
     after = ("goals",)
     before = ("tentacle_selection",)
-    reads = ("transforms.pos", "creatures.has_goal")
-    writes = ("goals", "creatures.goal", "creatures.has_goal")
+    reads = (
+        "transforms.pos",
+        "locomotion.creatures.has_goal",
+        "creatures.entity",
+        "creatures.mantle_row",
+    )
+    writes = (
+        "goals",
+        "locomotion.creatures.goal",
+        "locomotion.creatures.has_goal",
+        "locomotion.creatures.goal_radius",
+    )
 
     def __init__(self, gap: float, interval: float, goal_radius: float):
         self.gap = gap
@@ -76,7 +87,7 @@ class FollowLeader(System):
             entity = int(creatures.entity[row])
             if far:
                 world.resource(GoalBook).set(entity, goal, self.goal_radius)
-            elif creatures.has_goal[row]:
+            elif world.resource(LocomotionStores).creatures.has_goal[row]:
                 world.resource(GoalBook).clear(entity)
 
 

@@ -22,6 +22,7 @@ from ecs_tentacles.systems.examples import Problem, farther_than_reach, number, 
 
 from ecs_tentacles.build import creature_rng
 from ecs_tentacles.locomotion.goals import GoalBook
+from ecs_tentacles.locomotion.stores import LocomotionStores
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.scene.validate import plugin_config
 from ecs_tentacles.system import System
@@ -37,8 +38,18 @@ class Wander(System):
     stage = "decide"
     after = ("goals",)  # goals just reached are gone: those creatures are idle now
     before = ("tentacle_selection",)
-    reads = ("creatures.has_goal", "transforms.pos")
-    writes = ("goals", "creatures.goal", "creatures.has_goal")
+    reads = (
+        "locomotion.creatures.has_goal",
+        "transforms.pos",
+        "creatures.entity",
+        "creatures.mantle_row",
+    )
+    writes = (
+        "goals",
+        "locomotion.creatures.goal",
+        "locomotion.creatures.has_goal",
+        "locomotion.creatures.goal_radius",
+    )
     state_attributes = ("streams",)  # each creature's generator: snapshots repeat exactly
 
     def __init__(self, radius: float, interval: float, goal_radius: float):
@@ -60,7 +71,7 @@ class Wander(System):
         if world.frame % self.every:
             return
         creatures = world.creatures
-        idle = np.flatnonzero(~creatures.has_goal)
+        idle = np.flatnonzero(~world.resource(LocomotionStores).creatures.has_goal)
         if not len(idle):
             return
         # two uniform draws per idle creature, each from its own stream

@@ -37,7 +37,15 @@ class EmotionSystem(System):
     stage = "animate"
     after = ("threats",)
     before = ("rig",)
-    reads = ("threats", "transforms.pos", "fur.emotions", "fur.sets")
+    reads = (
+        "threats",
+        "transforms.pos",
+        "fur.emotions",
+        "fur.sets",
+        "fur.controls.emotion",
+        "fur.controls.emotion_row",
+        "fur.controls.fur_row",
+    )
     writes = ("fur.emotions", "fur.controls.drive_lift", "fur.controls.drive_random")
 
     def process(self, world: World, dt: float) -> None:

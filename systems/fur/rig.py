@@ -41,7 +41,7 @@ STRAND_BLOCK = 4096  # dynamic guides per block (their arrays are 8x larger)
 class Rig(System):
     name = "rig"
     stage = "animate"
-    reads = ("transforms.pos", "transforms.quat", "fur.controls", "fur.guides")
+    reads = ("transforms.pos", "transforms.quat", "fur.controls", "fur.guides", "fur.sets")
     writes = ("fur.curves", "fur.frames", "fur.controls")
     state_attributes = ("strands",)  # the dynamic blend's strand positions and velocities
 

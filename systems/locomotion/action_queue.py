@@ -3,11 +3,11 @@
 An interrupted tentacle (`ActionQueues.interrupt`: tentacle_selection starting or
 aborting a drive, or a script) moves on at once, whatever its timer.
 
-Reads: TentacleStore (timer, duration, action, interrupted), Sucker store (attached:
-an attach action waits for its sucker, up to ATTACH_PATIENCE times its duration),
-ActionQueues. Writes: TentacleStore (current action, timer, duration, angle,
-strength, orient, interrupted cleared; driving and mode go back to idle when a queue
-runs dry).
+Reads: locomotion's tentacle store (timer, duration, action, interrupted),
+TentacleStore (tip sucker), Sucker store (attached: an attach action waits for its
+sucker, up to ATTACH_PATIENCE times its duration), ActionQueues. Writes: locomotion's
+tentacle store (current action, timer, duration, angle, strength, orient,
+interrupted cleared; driving and mode go back to idle when a queue runs dry).
 """
 
 from __future__ import annotations
@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ecs_tentacles.locomotion.actions import ATTACH_PATIENCE, STRENGTH, ActionQueues, Kind, Mode
+from ecs_tentacles.locomotion.stores import LocomotionStores
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
@@ -29,21 +30,32 @@ ATTACH = int(Kind.ATTACH)
 class ActionQueueSystem(System):
     name = "action_queue"
     stage = "act"
-    reads = ("action_queues", "suckers.attached")
-    writes = ("tentacles.action", "tentacles.timer", "tentacles.orient")
+    reads = ("action_queues", "suckers.attached", "tentacles.tip_sucker")
+    writes = (
+        "locomotion.tentacles.action",
+        "locomotion.tentacles.timer",
+        "locomotion.tentacles.duration",
+        "locomotion.tentacles.action_angle",
+        "locomotion.tentacles.action_strength",
+        "locomotion.tentacles.orient",
+        "locomotion.tentacles.interrupted",
+        "locomotion.tentacles.driving",
+        "locomotion.tentacles.mode",
+    )
 
     def setup(self, world: World) -> None:
         self.queues = ActionQueues(world)
+        self.strokes = world.resource(LocomotionStores).tentacles
 
     def process(self, world: World, dt: float) -> None:
-        t = world.tentacles
+        t = self.strokes
         if not len(t):
             return
         t.timer += dt
         done = t.timer >= t.duration - TIME_EPSILON
         attaching = t.action == ATTACH
         if attaching.any():
-            gripped = world.suckers.attached[t.tip_sucker]
+            gripped = world.suckers.attached[world.tentacles.tip_sucker]
             patience = ATTACH_PATIENCE * t.duration - TIME_EPSILON
             done &= ~attaching | gripped | (t.timer >= patience)
         interrupted = t.interrupted
@@ -54,7 +66,7 @@ class ActionQueueSystem(System):
             self._advance(world, int(row))
 
     def _advance(self, world: World, row: int) -> None:
-        t = world.tentacles
+        t = self.strokes
         queue = self.queues[row].pending
         t.timer[row] = 0.0
         if not queue:

@@ -1,6 +1,7 @@
 """goals: a creature whose mantle enters its current goal's radius reaches it.
 
-Reads: CreatureStore (has_goal, goal, goal_radius, mantle_row), Transform store.
+Reads: locomotion's creature store (has_goal, goal, goal_radius), CreatureStore
+(mantle_row, entity), Transform store.
 Writes: through `world.resource(GoalBook).reach` (removes the goal entity, makes the next goal of
 the path current, fires `goal_reached`). Distances are measured in the ground plane.
 """
@@ -12,6 +13,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ecs_tentacles.locomotion.goals import GoalBook
+from ecs_tentacles.locomotion.stores import LocomotionStores
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
@@ -21,15 +23,29 @@ if TYPE_CHECKING:
 class Goals(System):
     name = "goals"
     stage = "decide"
-    reads = ("transforms.pos", "goals")
-    writes = ("goals", "creatures.goal", "creatures.has_goal")
+    reads = (
+        "transforms.pos",
+        "goals",
+        "creatures.mantle_row",
+        "creatures.entity",
+        "locomotion.creatures.has_goal",
+        "locomotion.creatures.goal",
+        "locomotion.creatures.goal_radius",
+    )
+    writes = (
+        "goals",
+        "locomotion.creatures.goal",
+        "locomotion.creatures.has_goal",
+        "locomotion.creatures.goal_radius",
+    )
 
     def process(self, world: World, dt: float) -> None:
-        creatures = world.creatures
-        if not creatures.has_goal.any():
+        gaits = world.resource(LocomotionStores).creatures
+        if not gaits.has_goal.any():
             return
-        offset = world.transforms.pos[creatures.mantle_row, :2] - creatures.goal[:, :2]
+        creatures = world.creatures
+        offset = world.transforms.pos[creatures.mantle_row, :2] - gaits.goal[:, :2]
         distance_sq = np.einsum("ij,ij->i", offset, offset)
-        reached = creatures.has_goal & (distance_sq <= creatures.goal_radius**2)
+        reached = gaits.has_goal & (distance_sq <= gaits.goal_radius**2)
         for row in np.flatnonzero(reached):
             world.resource(GoalBook).reach(int(creatures.entity[row]))

@@ -10,8 +10,9 @@ and sweep; targets ease toward that (time constant SMOOTHING_SECONDS) so light
 tips never whip. Writhing (thesis IV.B): the servo gain is modulated by the same wave,
 scaled by the action's strength.
 
-Reads: TentacleStore (action, action_angle, action_strength, orient, mode, wave
-parameters), MotorStore (tentacle_row, arc). Writes: MotorStore (target, gain).
+Reads: locomotion's tentacle store (action, action_angle, action_strength, orient,
+mode, wave parameters), TentacleStore (rest pitch, link rows), MotorStore
+(tentacle_row, arc). Writes: MotorStore (target, gain).
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ecs_tentacles.locomotion.actions import ATTACH_PATIENCE, GRIPPING, Kind, Mode
+from ecs_tentacles.locomotion.stores import LocomotionStores
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
@@ -52,7 +54,14 @@ class MotorTargets(System):
     name = "motor_targets"
     stage = "act"
     after = ("action_queue",)
-    reads = ("tentacles.action", "tentacles.orient", "motors.arc")
+    reads = (
+        "locomotion.tentacles",
+        "tentacles.rest_pitch",
+        "tentacles.first_link",
+        "tentacles.links",
+        "motors.arc",
+        "motors.tentacle_row",
+    )
     writes = ("motors.target", "motors.gain")
     state_attributes = ("eased",)
 
@@ -71,9 +80,10 @@ class MotorTargets(System):
         # the eased targets live here, so systems that add to Motor.target after this one
         # (user waves, the HUD) do not feed back into the easing
         self.eased = motors.target[:, :2].copy()
+        self.strokes = world.resource(LocomotionStores).tentacles
 
     def process(self, world: World, dt: float) -> None:
-        motors, t = world.motors, world.tentacles
+        motors, t, body = world.motors, self.strokes, world.tentacles
         if not len(motors):
             return
         row = motors.tentacle_row
@@ -86,7 +96,9 @@ class MotorTargets(System):
         # along the tentacle: the rest droop, and an attaching tip pressing down further
         # the longer it takes to touch the ground
         arch = np.where(ARCHED[action, t.mode], -t.action_angle, 0.0)[row]
-        droop = (2.0 * t.rest_pitch + np.where(action == ATTACH, ATTACH_PRESS * progress, 0.0))[row]
+        droop = (2.0 * body.rest_pitch + np.where(action == ATTACH, ATTACH_PRESS * progress, 0.0))[
+            row
+        ]
         pitch = arch * self.arch_shape + LIFT[action][row] + droop * arc
         curl = pitch.copy()
         curl[self.inner] -= pitch[self.previous]

@@ -10,8 +10,8 @@
   `release_reach` tentacle lengths, so a creature never drags a sucker behind it.
 Each change fires `sucker_attached` / `sucker_released` (with the reason).
 
-Reads: TentacleStore (action, tip_sucker, length), CreatureStore (release
-thresholds), Sucker store, Transform store. Writes: Sucker store (attached, anchor).
+Reads: locomotion's stores (action; release thresholds), TentacleStore (tip_sucker,
+length, base, creature), Sucker store, Transform store. Writes: Sucker store (attached, anchor).
 """
 
 from __future__ import annotations
@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ecs_tentacles.locomotion.actions import GRIPPING, Kind
+from ecs_tentacles.locomotion.stores import LocomotionStores
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
@@ -34,16 +35,25 @@ class Suckers(System):
     name = "suckers"
     stage = "act"
     after = ("motor_targets",)
-    reads = ("tentacles.action", "transforms.pos", "creatures.release_stretch")
+    reads = (
+        "locomotion.tentacles.action",
+        "locomotion.creatures.release_stretch",
+        "locomotion.creatures.release_reach",
+        "tentacles",
+        "transforms",
+        "suckers",
+    )
     writes = ("suckers.attached", "suckers.anchor")
 
     def process(self, world: World, dt: float) -> None:
-        s, t, c = world.suckers, world.tentacles, world.creatures
+        s, t = world.suckers, world.tentacles
+        loco = world.resource(LocomotionStores)
+        action, c = loco.tentacles.action, loco.creatures
         if not len(s) or not len(t):
             return
         attached = s.attached
         tip = t.tip_sucker
-        reaching = np.flatnonzero(t.action == ATTACH)
+        reaching = np.flatnonzero(action == ATTACH)
         if len(reaching):
             rows = tip[reaching]
             rows = rows[~attached[rows]]
@@ -57,7 +67,7 @@ class Suckers(System):
         tentacle = s.tentacle_row[held]
         creature = t.creature_row[tentacle]
         anchor = s.anchor[held]
-        holding = GRIPPING[t.action[tentacle]] & (tip[tentacle] == held)
+        holding = GRIPPING[action[tentacle]] & (tip[tentacle] == held)
         stretch = np.linalg.norm(world.sucker_points(held) - anchor, axis=1)
         base = world.transforms.pos[t.base_row[tentacle], :2]
         reach = np.linalg.norm(base - anchor[:, :2], axis=1)

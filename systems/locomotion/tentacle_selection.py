@@ -13,9 +13,10 @@ means the tentacle lies between mantle and goal: pull; otherwise push.
   to their other side.
 * no goal: drives stop (the sucker lets go) and every tentacle idles.
 
-Reads: CreatureStore (goal, gait, drivers, speed), TentacleStore (base, action,
-mode, driving), Transform store. Writes: TentacleStore (driving, mode, started),
-CreatureStore (next_driver, last_start), ActionQueues (a started drive is queued and
+Reads: locomotion's stores (goal, gait, drivers, speed; action, mode, driving),
+CreatureStore and TentacleStore (mantle, tentacle rows, bases), Transform store.
+Writes: locomotion's tentacle store (driving, mode, started) and creature store
+(next_driver, last_start), ActionQueues (a started drive is queued and
 the current action interrupted; an abort replaces the queue with detach, settle).
 """
 
@@ -33,6 +34,7 @@ from ecs_tentacles.locomotion.actions import (
     drive_sequence,
 )
 from ecs_tentacles.locomotion.actions import make_action as action
+from ecs_tentacles.locomotion.stores import LocomotionStores
 from ecs_tentacles.scene.parameters import parameter
 from ecs_tentacles.system import System
 
@@ -60,45 +62,66 @@ class TentacleSelection(System):
     name = "tentacle_selection"
     stage = "decide"
     after = ("goals",)
-    reads = ("creatures.goal", "transforms.pos", "tentacles.action")
-    writes = ("tentacles.driving", "tentacles.mode", "action_queues")
+    reads = (
+        "transforms.pos",
+        "tentacles.creature_row",
+        "tentacles.base_row",
+        "tentacles.joint_limit",
+        "creatures.mantle_row",
+        "creatures.first_tentacle",
+        "creatures.tentacles",
+        "locomotion.creatures",
+        "locomotion.tentacles.action",
+        "locomotion.tentacles.speed",
+        "locomotion.tentacles.target_angle",
+    )
+    writes = (
+        "locomotion.tentacles.driving",
+        "locomotion.tentacles.mode",
+        "locomotion.tentacles.started",
+        "locomotion.tentacles.interrupted",
+        "locomotion.creatures.next_driver",
+        "locomotion.creatures.last_start",
+        "action_queues",
+    )
 
     def setup(self, world: World) -> None:
         gait = parameter("locomotion", "gait")  # stored codes: the schema's choices' indices
         self.cyclic, self.coordinated = gait.code("cyclic"), gait.code("coordinated")
         self.queues = ActionQueues(world)
+        loco = world.resource(LocomotionStores)
+        self.strokes, self.gaits = loco.tentacles, loco.creatures
 
     def process(self, world: World, dt: float) -> None:
         t, c = world.tentacles, world.creatures
-        if not len(t) or not (c.has_goal.any() or t.driving.any()):
+        s, g = self.strokes, self.gaits
+        if not len(t) or not (g.has_goal.any() or s.driving.any()):
             return
         creature = t.creature_row
         pos = world.transforms.pos
         mantle = pos[c.mantle_row, :2]
-        to_goal = (c.goal[:, :2] - mantle)[creature]
+        to_goal = (g.goal[:, :2] - mantle)[creature]
         to_base = pos[t.base_row, :2] - mantle[creature]
         pull, cos = classify(to_goal, to_base)
-        has_goal = c.has_goal[creature]
-        driving_now = t.driving
-
+        has_goal = g.has_goal[creature]
+        driving_now = s.driving
         if driving_now.any():
-            wrong_side = (c.gait[creature] == self.coordinated) & np.where(
-                t.mode == PULL, cos < -ABORT_MARGIN, cos > ABORT_MARGIN
+            wrong_side = (g.gait[creature] == self.coordinated) & np.where(
+                s.mode == PULL, cos < -ABORT_MARGIN, cos > ABORT_MARGIN
             )
             for row in np.flatnonzero(driving_now & (~has_goal | wrong_side)):
                 self._abort(world, int(row))
-
-        driving = np.bincount(creature, weights=t.driving, minlength=len(c))
-        idle_goal = c.has_goal & (driving < c.drivers)
+        driving = np.bincount(creature, weights=s.driving, minlength=len(c))
+        idle_goal = g.has_goal & (driving < g.drivers)
         if not idle_goal.any():
             return
-        cyclic = c.gait == self.cyclic
+        cyclic = g.gait == self.cyclic
         for row in np.flatnonzero(idle_goal & cyclic & (driving == 0)):
-            k = int(c.first_tentacle[row] + c.next_driver[row])
+            k = int(c.first_tentacle[row] + g.next_driver[row])
             self._start(world, k, Mode.PULL if pull[k] else Mode.PUSH, orient=None)
-            c.next_driver[row] = (c.next_driver[row] + 1) % c.tentacles[row]
-        stagger = STROKE_SECONDS / (c.speed * c.drivers)
-        ready = idle_goal & ~cyclic & (world.time - c.last_start >= stagger)
+            g.next_driver[row] = (g.next_driver[row] + 1) % c.tentacles[row]
+        stagger = STROKE_SECONDS / (g.speed * g.drivers)
+        ready = idle_goal & ~cyclic & (world.time - g.last_start >= stagger)
         for row in np.flatnonzero(ready):
             self._start_best(world, int(row), cos, pull, to_goal, to_base)
 
@@ -111,10 +134,10 @@ class TentacleSelection(System):
         to_goal: np.ndarray,
         to_base: np.ndarray,
     ) -> None:
-        t, c = world.tentacles, world.creatures
+        t, c, s = world.tentacles, world.creatures, self.strokes
         first = int(c.first_tentacle[creature_row])
         rows = np.arange(first, first + int(c.tentacles[creature_row]))
-        free = ~t.driving[rows] & (t.action[rows] == Kind.IDLE)
+        free = ~s.driving[rows] & (s.action[rows] == Kind.IDLE)
         score = np.abs(cos[rows]) * np.where(pull[rows], 1.0, PUSH_PREFERENCE)
         score[~free] = -1.0
         best = int(np.argmax(score))
@@ -127,21 +150,26 @@ class TentacleSelection(System):
         turn = np.arctan2(base[0] * wanted[1] - base[1] * wanted[0], base @ wanted)
         limit = 1.8 * t.joint_limit[k]  # the sweep is shared by the first two joints
         self._start(world, k, mode, orient=float(np.clip(turn, -limit, limit)))
-        c.last_start[creature_row] = world.time
+        self.gaits.last_start[creature_row] = world.time
+
+    def _speed(self, world: World, row: int) -> float:
+        """Tentacle `row`'s pace: its own speed times its creature's."""
+        creature = world.tentacles.creature_row[row]
+        return float(self.strokes.speed[row] * self.gaits.speed[creature])
 
     def _start(self, world: World, row: int, mode: Mode, orient: float | None) -> None:
-        t = world.tentacles
-        speed = float(t.speed[row] * world.creatures.speed[t.creature_row[row]])
+        s = self.strokes
+        speed = self._speed(world, row)
         # queued after whatever is pending; the current action ends now
-        self.queues[row].extend(drive_sequence(mode, float(t.target_angle[row]), speed, orient))
+        self.queues[row].extend(drive_sequence(mode, float(s.target_angle[row]), speed, orient))
         self.queues.interrupt(row)
-        t.driving[row] = True
-        t.mode[row] = mode
-        t.started[row] = world.time
+        s.driving[row] = True
+        s.mode[row] = mode
+        s.started[row] = world.time
 
     def _abort(self, world: World, row: int) -> None:
-        t = world.tentacles
-        speed = float(t.speed[row] * world.creatures.speed[t.creature_row[row]])
+        s = self.strokes
+        speed = self._speed(world, row)
         self.queues.replace(row, [action(Kind.DETACH, speed), action(Kind.SETTLE, speed)])
-        t.driving[row] = False
-        t.mode[row] = Mode.NONE
+        s.driving[row] = False
+        s.mode[row] = Mode.NONE

@@ -25,7 +25,18 @@ PROXY_ROUNDS = 4  # parts a frame is stepped in while creatures touch (proxies c
 class Physics(System):
     name = "physics"
     stage = "physics"
-    reads = ("motors.target", "motors.gain", "suckers.attached", "suckers.anchor")
+    reads = (
+        "motors.target",
+        "motors.gain",
+        "motors.strength",
+        "motors.damping",
+        "motors.max_torque",
+        "suckers.attached",
+        "suckers.anchor",
+        "transforms.pos",
+        "transforms.quat",
+        "locomotion.creatures.has_goal",  # sleep: a creature with a goal stays awake
+    )
     writes = ("physics",)
 
     def process(self, world: World, dt: float) -> None:

@@ -28,7 +28,7 @@ class Record(System):
 
     name = "record"
     stage = "output"
-    reads = ("transforms.pos", "transforms.quat", "suckers.attached", "goals", "fur.curves")
+    reads = ("transforms", "suckers", "goals", "fur.curves", "fur.guides", "fur.sets")
 
     def __init__(self, every: int = 1, **recorder: Any):
         if every < 1:

@@ -20,7 +20,7 @@ if TYPE_CHECKING:
 class ThreatPaths(System):
     name = "threats"
     stage = "animate"
-    reads = ("threats.paths",)
+    reads = ("threats",)  # ThreatData: its paths and store
     writes = ("threats.pos",)
 
     def __init__(self) -> None:

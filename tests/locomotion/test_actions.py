@@ -117,8 +117,8 @@ def test_replace_empties_the_queue_and_marks_the_tentacle(
     queues[1].extend(drive_sequence(Mode.PUSH, 0.5, 1.0))
     queues.replace(1, [make_action(Kind.DETACH, 1.0)])
     assert queues[1].kinds() == ["detach"]
-    assert world.tentacles.interrupted.tolist() == [False, True, False]
+    assert world.stores["locomotion.tentacles"].interrupted.tolist() == [False, True, False]
     queues[2].extend([make_action(Kind.SETTLE, 1.0)])
     queues.interrupt(2)  # keeps what is pending
     assert queues[2].kinds() == ["settle"]
-    assert world.tentacles.interrupted.tolist() == [False, True, True]
+    assert world.stores["locomotion.tentacles"].interrupted.tolist() == [False, True, True]

@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
-from ecs_tentacles.components import Goal, Transform
+from ecs_tentacles.components import Transform
+from ecs_tentacles.locomotion.components import Goal
 from ecs_tentacles.locomotion.goals import DEFAULT_RADIUS, GoalBook
 from ecs_tentacles.world import World
 from tests.conftest import creature_scene
@@ -28,7 +29,7 @@ def _orders(world: World, goals: list[int]) -> list[int]:
 def test_set_append_remove_clear(make_world: Callable[..., World]) -> None:
     world = _world(make_world)
     octo = world.creature("octo")
-    store, row = world.creatures, 0
+    store, row = world.stores["locomotion.creatures"], 0
     assert world.resource(GoalBook).path(octo) == []
     assert world.resource(GoalBook).current(octo) is None
     assert world.resource(GoalBook).positions(octo).shape == (0, 3)
@@ -113,7 +114,7 @@ def test_bad_goals_are_refused_and_change_nothing(
     with pytest.raises(ValueError, match="^" + message.replace("[", r"\[").replace("]", r"\]")):
         world.resource(GoalBook).append(octo, position, radius)
     assert world.resource(GoalBook).path(octo) == [first]
-    assert_array_equal(world.creatures.goal[0], [1.0, 1.0, 0.0])
+    assert_array_equal(world.stores["locomotion.creatures"].goal[0], [1.0, 1.0, 0.0])
 
 
 def test_a_refused_set_keeps_the_old_path(make_world: Callable[..., World]) -> None:
@@ -129,7 +130,7 @@ def test_a_refused_set_keeps_the_old_path(make_world: Callable[..., World]) -> N
     with pytest.raises(ValueError, match=r"^goal radius must be > 0, got 0"):
         world.resource(GoalBook).set(octo, [1.0, 0.0], radius=0)
     assert world.resource(GoalBook).path(octo) == path
-    assert world.creatures.has_goal[0]
+    assert world.stores["locomotion.creatures"].has_goal[0]
 
 
 def test_goals_belong_to_creatures(make_world: Callable[..., World]) -> None:
@@ -158,7 +159,7 @@ def test_goal_on_the_creature_is_reached_on_the_first_frame(
     assert world.resource(GoalBook).current(octo) == there
     assert world.component(there, Goal).order == 0
     assert world.try_component(here, Goal) is None
-    assert_array_equal(world.creatures.goal[0], [3.0, 0.0, 0.0])
+    assert_array_equal(world.stores["locomotion.creatures"].goal[0], [3.0, 0.0, 0.0])
     assert world.events.counts["goal_reached"] == 1
     world.step(5)
     assert world.events.counts["goal_reached"] == 1  # far away: not reached

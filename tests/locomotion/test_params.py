@@ -72,7 +72,7 @@ def test_tentacle_parameters_land_in_the_tentacle_store(
 ) -> None:
     world = _world(make_world)
     octo = world.creature("octo")
-    t = world.tentacles
+    t = world.stores["locomotion.tentacles"]
     world.resource(Locomotion).set(octo, tentacle=2, speed=1.5, wave_amplitude=0.2, wavelength=2.0)
     world.resource(Locomotion).set(
         octo, writhe=0.9, wave_frequency=3.0, target_angle=1.0
@@ -83,7 +83,8 @@ def test_tentacle_parameters_land_in_the_tentacle_store(
     assert t.writhe.tolist() == [0.9] * 4
     assert t.wave_frequency.tolist() == [3.0] * 4
     assert t.target_angle.tolist() == [1.0] * 4
-    assert world.creatures.speed[0] == 1.0  # a tentacle's speed is not the creature's
+    gaits = world.stores["locomotion.creatures"]
+    assert gaits.speed[0] == 1.0  # a tentacle's speed is not the creature's
     got = world.resource(Locomotion).get(octo, 2)
     assert got == {
         "speed": 1.5,
@@ -113,7 +114,7 @@ def test_gait_and_drivers_are_per_creature(make_world: Callable[..., World]) -> 
         "coordinated",
         4,
     )
-    assert world.creatures.drivers[0] == 4
+    assert world.stores["locomotion.creatures"].drivers[0] == 4
 
 
 def test_gait_switch_changes_who_drives(make_world: Callable[..., World]) -> None:
@@ -127,7 +128,9 @@ def test_gait_switch_changes_who_drives(make_world: Callable[..., World]) -> Non
 def _durations(world: World, tentacle: int) -> list[float]:
     creature = world.component(world.creature("octo"), Creature)
     pending = world.component(creature.tentacles[tentacle], ActionQueue).pending
-    return [float(world.tentacles.duration[tentacle])] + [a.duration for a in pending]
+    return [float(world.stores["locomotion.tentacles"].duration[tentacle])] + [
+        a.duration for a in pending
+    ]
 
 
 def test_speeds_divide_the_durations_of_new_actions(make_world: Callable[..., World]) -> None:

@@ -81,7 +81,7 @@ def test_a_teleport_never_reaches_a_goal(make_world: Callable[..., World]) -> No
     world = make_world(SCENE)
     world.step(10)
     group = world.physics.groups[0]
-    goal = world.creatures.goal[0]
+    goal = world.stores["locomotion.creatures"].goal[0]
     group.data.qpos[0:2] = goal[:2]  # jump into the goal between two frames
     world.step(5)
     assert world.events.counts["goal_reached"] == 0

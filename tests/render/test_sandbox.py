@@ -12,7 +12,8 @@ from PIL import Image
 from pyglet.event import EventDispatcher
 from pyglet.window import key, mouse
 
-from ecs_tentacles.components import Creature, Goal, Transform
+from ecs_tentacles.components import Creature, Transform
+from ecs_tentacles.locomotion.components import Goal
 from ecs_tentacles.locomotion.goals import GoalBook
 
 

@@ -49,7 +49,7 @@ def test_degree_keys_are_radians_in_code() -> None:
     assert (angle.api, angle.units, angle.column) == (
         "target_angle",
         "deg",
-        "tentacles.target_angle",
+        "locomotion.tentacles.target_angle",
     )
     assert angle.range == Range(0, math.radians(90))
     assert angle.from_scene(45) == pytest.approx(math.radians(45), rel=1e-15)
@@ -58,15 +58,17 @@ def test_degree_keys_are_radians_in_code() -> None:
 def test_every_column_exists_on_a_world(make_world: Callable[..., World]) -> None:
     world = make_world(creature_scene(count=2, links=3))
     for p in parameters():
-        store = getattr(world, p.store)
-        for field in (p.field, p.taper, p.at_most):
+        store = world.stores[p.store]
+        for field in (p.field, p.taper):
             if field is not None:
                 assert len(getattr(store, field)) == len(store), (p.key, field)
+        if p.at_most is not None:  # a cap from another store lines up row for row
+            assert len(p.cap(world)) == len(store), (p.key, p.at_most)
 
 
 def test_gait_is_encoded_once_as_the_schemas_choice_index() -> None:
     gait = parameter("locomotion", "gait")
-    (spec,) = _annotated(load_schema(), "creatures.gait")
+    (spec,) = _annotated(load_schema(), "locomotion.creatures.gait")
     assert gait.choices == tuple(spec["enum"]) == ("cyclic", "coordinated")
     assert [gait.code(g) for g in gait.choices] == [0, 1]
     assert gait.to_api(1) == "coordinated"
@@ -90,12 +92,16 @@ def test_build_fills_columns_from_the_scene_tapered_and_in_radians(
     assert_array_equal(world.motors.strength[:4], 30.0 * scale[:4])
     assert_array_equal(world.motors.strength[4:8], 45.0 * scale[4:8])
     assert_array_equal(world.motors.max_torque[:12], 12.0 * scale[:12])
-    assert_array_equal(world.tentacles.target_angle, np.radians([40, 40, 40]))
-    assert_array_equal(world.tentacles.wave_amplitude, np.radians([6, 20, 6]))
+    assert_array_equal(world.stores["locomotion.tentacles"].target_angle, np.radians([40, 40, 40]))
+    assert_array_equal(world.stores["locomotion.tentacles"].wave_amplitude, np.radians([6, 20, 6]))
     assert world.tentacles.joint_limit[0] == pytest.approx(math.radians(60))
-    assert world.creatures.gait[0] == parameter("locomotion", "gait").code("cyclic")
-    assert world.creatures.drivers[0] == 3  # at most the tentacle count (`at_most`)
-    assert world.creatures.speed[0] == 1.5
+    assert world.stores["locomotion.creatures"].gait[0] == parameter("locomotion", "gait").code(
+        "cyclic"
+    )
+    assert (
+        world.stores["locomotion.creatures"].drivers[0] == 3
+    )  # at most the tentacle count (`at_most`)
+    assert world.stores["locomotion.creatures"].speed[0] == 1.5
 
 
 def test_the_api_takes_each_parameter_over_its_table_range(
@@ -112,7 +118,7 @@ def test_the_api_takes_each_parameter_over_its_table_range(
         with pytest.raises(ValueError, match=rf"^{name}: must be in \[.*, got"):
             world.resource(Locomotion).set(octo, **{name: p.range.high * 1.01 + 1e-9})
     world.resource(Locomotion).set(octo, tentacle=1, target_angle=math.radians(30))
-    assert world.tentacles.target_angle[1] == pytest.approx(math.radians(30))
+    assert world.stores["locomotion.tentacles"].target_angle[1] == pytest.approx(math.radians(30))
     first = int(world.tentacles.first_link[1])
     world.resource(Locomotion).set(octo, tentacle=1, strength=20.0)
     assert_allclose(world.motors.strength[first : first + 3], 20.0 * world.motors.scale[:3])
@@ -139,13 +145,14 @@ def test_apply_parameters_writes_only_its_section_and_stores(
     make_world: Callable[..., World],
 ) -> None:
     world = make_world(creature_scene(count=2, links=3))
-    before = world.tentacles.speed.copy()
-    apply_parameters(world, "locomotion", {"speed": 2.5, "drivers": 5}, creatures=0)
-    assert world.creatures.speed[0] == 2.5 and world.creatures.drivers[0] == 2
-    assert_array_equal(world.tentacles.speed, before)  # tentacles.speed: another section
-    apply_parameters(world, "tentacles", {"damping": 3.0, "speed": 0.5}, motors=[3, 4])
+    strokes, gaits = world.stores["locomotion.tentacles"], world.stores["locomotion.creatures"]
+    before = strokes.speed.copy()
+    apply_parameters(world, "locomotion", {"speed": 2.5, "drivers": 5}, {"locomotion.creatures": 0})
+    assert gaits.speed[0] == 2.5 and gaits.drivers[0] == 2
+    assert_array_equal(strokes.speed, before)  # tentacles.speed: another section
+    apply_parameters(world, "tentacles", {"damping": 3.0, "speed": 0.5}, {"motors": [3, 4]})
     assert_array_equal(world.motors.damping[3:5], 3.0 * world.motors.scale[3:5])
-    assert_array_equal(world.tentacles.speed, before)  # no `tentacles=` rows given
+    assert_array_equal(strokes.speed, before)  # no locomotion.tentacles rows given
 
 
 def _with(annotation: dict[str, Any], key: str = "colour") -> dict[str, Any]:

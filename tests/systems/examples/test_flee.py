@@ -60,7 +60,7 @@ def test_out_of_reach_nobody_flees() -> None:
     scene["plugins"]["flee"]["distance"] = 0.5  # the roach stops 0.94 m away
     with World.from_scene(scene) as world:
         world.step(3 * 60)
-        assert not world.creatures.has_goal.any()
+        assert not world.stores["locomotion.creatures"].has_goal.any()
 
 
 def test_a_run_inside_the_goal_radius_is_refused() -> None:

@@ -35,7 +35,7 @@ def test_followers_end_closer_to_the_leader_and_keep_the_gap() -> None:
         end = _to_leader(world)
         assert (end < start - 0.3).all(), (start, end)
         assert (end > GAP - 0.1).all() and (end < GAP + GOAL_RADIUS + 0.1).all(), end
-        assert not world.creatures.has_goal.any()  # arrived: everybody stopped
+        assert not world.stores["locomotion.creatures"].has_goal.any()  # arrived: everybody stopped
 
 
 def test_without_the_plugin_the_followers_stay() -> None:

@@ -19,7 +19,7 @@ def _run(seed: int | None = None, seconds: float = SECONDS) -> Run:
     with World.from_scene("wander", seed=seed) as world:
         start = world.transforms.pos[world.creatures.mantle_row].copy()
         given: dict[str, list[np.ndarray]] = {"left": [], "right": []}
-        assert not world.creatures.has_goal.any()  # the scene gives them none
+        assert not world.stores["locomotion.creatures"].has_goal.any()  # the scene gives them none
         before, path = start, np.zeros(len(start))
         for _ in range(round(seconds * 60)):
             world.step()
@@ -27,9 +27,9 @@ def _run(seed: int | None = None, seconds: float = SECONDS) -> Run:
             path += np.linalg.norm(now[:, :2] - before[:, :2], axis=1)
             before = now
             for row, entity in enumerate(world.creatures.entity):
-                goal = world.creatures.goal[row, :2].copy()
+                goal = world.stores["locomotion.creatures"].goal[row, :2].copy()
                 history = given[world.creature_name(int(entity))]
-                if world.creatures.has_goal[row] and not (
+                if world.stores["locomotion.creatures"].has_goal[row] and not (
                     history and np.array_equal(history[-1], goal)
                 ):
                     history.append(goal)
@@ -67,10 +67,10 @@ def test_a_snapshot_repeats_the_wandering() -> None:
         world.step(200)
         snap = world.snapshot()
         world.step(100)
-        goals, end = world.creatures.goal.copy(), world.transforms.pos.copy()
+        goals, end = world.stores["locomotion.creatures"].goal.copy(), world.transforms.pos.copy()
         world.restore(snap)
         world.step(100)
-        np.testing.assert_array_equal(world.creatures.goal, goals)
+        np.testing.assert_array_equal(world.stores["locomotion.creatures"].goal, goals)
         np.testing.assert_array_equal(world.transforms.pos, end)
 
 

@@ -41,8 +41,8 @@ def test_pull_sequence_runs_each_action_for_its_duration(
     world = make_world(creature_scene(count=2, links=10))
     octo = world.creature("octo")
     fps = world.settings.fps
-    t = world.tentacles
-    tip = int(t.tip_sucker[0])
+    t = world.stores["locomotion.tentacles"]
+    tip = int(world.tentacles.tip_sucker[0])
     world.step(5)
     assert world.resource(Locomotion).queue(octo, 0) == ["idle"]
     sequence = drive_sequence(Mode.PULL, float(t.target_angle[0]), speed)
@@ -75,7 +75,7 @@ def test_every_action_lasts_its_duration_rounded_up_to_whole_frames(
     # one tentacle per action kind (attach waits for its sucker: tested on its own)
     kinds = [kind for kind in BASE_SECONDS if kind != Kind.ATTACH]
     world = make_world(creature_scene(count=len(kinds), links=2))
-    t = world.tentacles
+    t = world.stores["locomotion.tentacles"]
     queues = ActionQueues(world)
     for row, kind in enumerate(kinds):
         queues.replace(row, [make_action(kind, 1.0)])
@@ -97,7 +97,7 @@ def test_attach_gives_up_after_three_times_its_duration(make_world: Callable[...
     scene["physics"] = {"gravity": [0, 0, 0]}
     scene["creatures"][0]["position"] = [0, 0, 0.5]
     world = make_world(scene)
-    t = world.tentacles
+    t = world.stores["locomotion.tentacles"]
     ActionQueues(world).replace(0, drive_sequence(Mode.PUSH, 0.5, 1.0))
     actions = []
     for _ in range(90):
@@ -115,7 +115,7 @@ def test_attach_gives_up_after_three_times_its_duration(make_world: Callable[...
 def test_empty_queue_idles_for_ever(make_world: Callable[..., World]) -> None:
     world = make_world(creature_scene(count=2, links=3))
     octo = world.creature("octo")
-    t = world.tentacles
+    t = world.stores["locomotion.tentacles"]
     ActionQueues(world).replace(1, drive_sequence(Mode.PUSH, 0.5, 5.0)[-1:])  # one detach, 0.02 s
     world.step(1)
     assert world.resource(Locomotion).queue(octo, 1) == ["detach"]
@@ -136,7 +136,7 @@ def test_empty_queue_idles_for_ever(make_world: Callable[..., World]) -> None:
 
 def test_orient_angle_is_held_until_settle(make_world: Callable[..., World]) -> None:
     world = make_world(creature_scene(count=2, links=3))
-    t = world.tentacles
+    t = world.stores["locomotion.tentacles"]
     ActionQueues(world).replace(0, drive_sequence(Mode.PUSH, 0.5, 10.0, orient=0.3))
     orient = []
     actions = []
@@ -167,7 +167,7 @@ def _busy(make_world: Callable[..., World]) -> World:
 def test_replace_starts_the_new_actions_the_same_frame(make_world: Callable[..., World]) -> None:
     world = _busy(make_world)
     octo = world.creature("octo")
-    t = world.tentacles
+    t = world.stores["locomotion.tentacles"]
     idle_timer = float(t.timer[1])
     sequence = drive_sequence(Mode.PULL, 0.5, 1.0)
     ActionQueues(world).replace(0, sequence)
@@ -207,7 +207,7 @@ def test_interrupt_ends_the_current_action_and_keeps_the_pending_ones(
 
 def test_interrupt_with_nothing_pending_idles_at_once(make_world: Callable[..., World]) -> None:
     world = _busy(make_world)
-    t = world.tentacles
+    t = world.stores["locomotion.tentacles"]
     ActionQueues(world).interrupt(0)
     world.step(1)
     assert world.resource(Locomotion).queue(world.creature("octo"), 0) == ["idle"]

@@ -87,7 +87,7 @@ def _arch(world: World, tentacle: int, angle: float) -> None:
     """Hold `tentacle` in a compress of `angle` for ever, with nothing queued after it."""
     creature = world.component(world.creature("octo"), Creature)
     world.component(creature.tentacles[tentacle], ActionQueue).clear()
-    t = world.tentacles
+    t = world.stores["locomotion.tentacles"]
     t.action[tentacle] = Kind.COMPRESS
     t.action_angle[tentacle] = angle
     t.action_strength[tentacle] = STRENGTH[Kind.COMPRESS]

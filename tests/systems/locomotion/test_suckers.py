@@ -53,9 +53,9 @@ def _tip_sucker(world: World, tentacle: int) -> int:
 
 def _hold(world: World, row: int, kind: Kind) -> None:
     """Give tentacle `row` the action `kind` for ever."""
-    world.tentacles.action[row] = kind
-    world.tentacles.duration[row] = np.inf
-    world.tentacles.timer[row] = 0.0
+    world.stores["locomotion.tentacles"].action[row] = kind
+    world.stores["locomotion.tentacles"].duration[row] = np.inf
+    world.stores["locomotion.tentacles"].timer[row] = 0.0
 
 
 def _grab(world: World, row: int, frames: int = 40) -> np.ndarray:
@@ -137,7 +137,7 @@ def test_release_on_stretch(make_world: Callable[..., World]) -> None:
     events = Recorder(world)
     _grab(world, 0)
     row = int(world.tentacles.tip_sucker[0])
-    stretch = world.creatures.release_stretch[0]
+    stretch = world.stores["locomotion.creatures"].release_stretch[0]
     assert stretch == 0.04  # the scene default
     anchor = world.suckers.anchor[row].copy()
     # just within the stretch: held (straight up, so the reach is unchanged)
@@ -158,7 +158,7 @@ def test_release_on_reach(make_world: Callable[..., World]) -> None:
     _grab(world, 0)
     t = world.tentacles
     row = int(t.tip_sucker[0])
-    reach = world.creatures.release_reach[0] * t.length[0]
+    reach = world.stores["locomotion.creatures"].release_reach[0] * t.length[0]
     assert_allclose(reach, 1.1 * 0.07 * np.linspace(1.0, 0.3, 10).sum(), rtol=1e-12)
 
     def place(fraction: float) -> None:

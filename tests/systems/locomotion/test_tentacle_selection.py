@@ -104,7 +104,7 @@ def test_cyclic_first_stroke_pulls_toward_and_pushes_away(
     world = make_world(_scene("cyclic", goal))
     octo = world.creature("octo")
     world.step(1)
-    t = world.tentacles
+    t = world.stores["locomotion.tentacles"]
     assert t.driving.tolist() == [True, False, False, False]
     assert t.mode.tolist() == [mode, Mode.NONE, Mode.NONE, Mode.NONE]
     assert world.resource(Locomotion).queue(octo, 0) == _names(mode)
@@ -118,8 +118,13 @@ def test_coordinated_first_stroke_orients_then_pulls(make_world: Callable[..., W
     world = make_world(_scene("coordinated", [1.5, 0.0]))
     octo = world.creature("octo")
     world.step(1)
-    assert world.tentacles.driving.tolist() == [True, False, False, False]
-    assert world.tentacles.mode.tolist() == [Mode.PULL, Mode.NONE, Mode.NONE, Mode.NONE]
+    assert world.stores["locomotion.tentacles"].driving.tolist() == [True, False, False, False]
+    assert world.stores["locomotion.tentacles"].mode.tolist() == [
+        Mode.PULL,
+        Mode.NONE,
+        Mode.NONE,
+        Mode.NONE,
+    ]
     assert world.resource(Locomotion).queue(octo, 0) == ["orient", *_names(Mode.PULL), "settle"]
 
 
@@ -129,8 +134,13 @@ def test_coordinated_goal_behind_pulls_with_the_far_tentacle(
     world = make_world(_scene("coordinated", [-1.5, 0.0]))
     octo = world.creature("octo")
     world.step(1)
-    assert world.tentacles.driving.tolist() == [False, False, True, False]
-    assert world.tentacles.mode.tolist() == [Mode.NONE, Mode.NONE, Mode.PULL, Mode.NONE]
+    assert world.stores["locomotion.tentacles"].driving.tolist() == [False, False, True, False]
+    assert world.stores["locomotion.tentacles"].mode.tolist() == [
+        Mode.NONE,
+        Mode.NONE,
+        Mode.PULL,
+        Mode.NONE,
+    ]
     assert world.resource(Locomotion).queue(octo, 2) == ["orient", *_names(Mode.PULL), "settle"]
 
 
@@ -166,7 +176,7 @@ def test_each_creature_drives_on_its_own(make_world: Callable[..., World]) -> No
         "idle",
     ]  # +y pulls to +y
     assert world.resource(Locomotion).actions(c) == ["idle", "idle"]
-    assert world.tentacles.mode.tolist() == [
+    assert world.stores["locomotion.tentacles"].mode.tolist() == [
         Mode.PUSH, Mode.NONE, Mode.NONE,
         Mode.NONE, Mode.PULL, Mode.NONE, Mode.NONE,
         Mode.NONE, Mode.NONE,
@@ -177,10 +187,10 @@ def _new_drivers(world: World, frames: int) -> list[tuple[int, Mode]]:
     """Step `frames` frames; (tentacle, mode) of each drive that starts, in order."""
     started: list[tuple[int, Mode]] = []
     for _ in range(frames):
-        before = world.tentacles.driving.copy()
+        before = world.stores["locomotion.tentacles"].driving.copy()
         world.step(1)
-        for row in np.flatnonzero(world.tentacles.driving & ~before):
-            started.append((int(row), Mode(int(world.tentacles.mode[row]))))
+        for row in np.flatnonzero(world.stores["locomotion.tentacles"].driving & ~before):
+            started.append((int(row), Mode(int(world.stores["locomotion.tentacles"].mode[row]))))
     return started
 
 
@@ -194,8 +204,8 @@ def test_cyclic_keeps_the_queued_stroke_when_the_goal_changes_sides(
     # behind and a little to the right: tentacle 1 (+y) now pushes, tentacle 2 (-x) pulls
     world.resource(GoalBook).set(octo, [-1.5, -0.5])
     world.step(1)
-    assert world.tentacles.driving.tolist() == [True, False, False, False]
-    assert world.tentacles.mode[0] == Mode.PULL
+    assert world.stores["locomotion.tentacles"].driving.tolist() == [True, False, False, False]
+    assert world.stores["locomotion.tentacles"].mode[0] == Mode.PULL
     assert world.resource(Locomotion).queue(octo, 0) == _names(Mode.PULL)
     assert _new_drivers(world, 180) == [(1, Mode.PUSH), (2, Mode.PULL)]
 
@@ -206,13 +216,13 @@ def test_coordinated_driver_aborts_when_the_goal_changes_sides(
     world = make_world(_scene("coordinated", [1.5, 0.0]))
     octo = world.creature("octo")
     world.step(10)
-    assert world.tentacles.driving.tolist() == [True, False, False, False]
-    assert world.tentacles.mode[0] == Mode.PULL
+    assert world.stores["locomotion.tentacles"].driving.tolist() == [True, False, False, False]
+    assert world.stores["locomotion.tentacles"].mode[0] == Mode.PULL
     world.resource(GoalBook).set(octo, [-1.5, 0.0])
     world.step(1)
     assert world.resource(Locomotion).queue(octo, 0) == ["detach", "settle"]
-    assert world.tentacles.driving.tolist() == [False, False, False, False]
-    assert world.tentacles.mode.tolist() == [Mode.NONE] * 4
+    assert world.stores["locomotion.tentacles"].driving.tolist() == [False, False, False, False]
+    assert world.stores["locomotion.tentacles"].mode.tolist() == [Mode.NONE] * 4
     # the next drive starts one stagger after the first, with the tentacle now facing the goal
     stagger_frames = int(np.ceil(STROKE_SECONDS / 2 * world.settings.fps))
     frames = stagger_frames - world.frame
@@ -236,22 +246,27 @@ def test_no_goal_stops_the_drive_and_every_tentacle_idles(
     tip = world.tentacles.tip_sucker[0]
     for _ in range(60):  # until tentacle 0 grips for its pull
         world.step(1)
-        if world.tentacles.action[0] == Kind.PULL:
+        if world.stores["locomotion.tentacles"].action[0] == Kind.PULL:
             break
-    assert world.tentacles.action[0] == Kind.PULL
+    assert world.stores["locomotion.tentacles"].action[0] == Kind.PULL
     assert world.suckers.attached[tip]
-    assert world.tentacles.driving.tolist() == [True, False, True, False]  # 2 pushes too
+    assert world.stores["locomotion.tentacles"].driving.tolist() == [
+        True,
+        False,
+        True,
+        False,
+    ]  # 2 pushes too
     world.resource(GoalBook).clear(octo)
     world.step(1)
     assert world.resource(Locomotion).queue(octo, 0) == ["detach", "settle"]
     assert world.resource(Locomotion).queue(octo, 2) == ["detach", "settle"]
-    assert world.tentacles.driving.tolist() == [False] * 4
+    assert world.stores["locomotion.tentacles"].driving.tolist() == [False] * 4
     assert released == ["command"]
     assert not world.suckers.attached[tip]
     world.step(30)
     assert world.resource(Locomotion).actions(octo) == ["idle"] * 4
-    assert world.tentacles.driving.tolist() == [False] * 4
-    assert world.tentacles.mode.tolist() == [Mode.NONE] * 4
+    assert world.stores["locomotion.tentacles"].driving.tolist() == [False] * 4
+    assert world.stores["locomotion.tentacles"].mode.tolist() == [Mode.NONE] * 4
     assert [world.resource(Locomotion).queue(octo, k) for k in range(4)] == [["idle"]] * 4
     assert world.suckers.attached.tolist() == [False] * 4
     assert world.events.counts["sucker_released"] == 1
@@ -262,7 +277,7 @@ def test_coordinated_drivers_cap_and_stagger(
     make_world: Callable[..., World], drivers: int
 ) -> None:
     world = make_world(_scene("coordinated", [1.5, 0.0], count=8, links=3, drivers=drivers))
-    t = world.tentacles
+    t = world.stores["locomotion.tentacles"]
     stagger = STROKE_SECONDS / drivers
     most = 0
     starts: set[float] = set()
