@@ -159,8 +159,8 @@ class Schedule:
                 "stage": slot.stage,
                 "system": slot.label + ("" if slot.enabled else " (disabled)"),
                 "plugin": slot.system.plugin or "-",
-                "reads": ", ".join(slot.system.reads) or "-",
-                "writes": ", ".join(slot.system.writes) or "-",
+                "reads": compact(slot.system.reads) or "-",
+                "writes": compact(slot.system.writes) or "-",
             }
             for slot in self._ordered
         ]
@@ -293,3 +293,20 @@ def _unordered_writers(
                 ):
                     found.append((field, first.label, second.label))
     return found
+
+
+def compact(names: tuple[str, ...]) -> str:
+    """Declared names, columns of one store grouped: `motors.{target, gain}, goals`."""
+    groups: dict[str, list[str]] = {}
+    for name in names:
+        store, dot, field = name.rpartition(".")
+        groups.setdefault(store if dot else name, []).append(field if dot else "")
+    parts = []
+    for store, fields in groups.items():
+        if fields == [""]:
+            parts.append(store)
+        elif len(fields) == 1:
+            parts.append(f"{store}.{fields[0]}")
+        else:
+            parts.append(f"{store}.{{{', '.join(fields)}}}")
+    return ", ".join(parts)
