@@ -111,5 +111,5 @@ def test_builtins_have_no_unordered_writers(make_world: Callable[..., World]) ->
     assert world.schedule.conflicts == []
     rows = {row["system"]: row for row in world.schedule.rows()}
     assert rows["motor_targets"]["plugin"] == "locomotion"
-    assert "motors.target" in rows["motor_targets"]["writes"]
+    assert rows["motor_targets"]["writes"] == "motors.{target, gain}"
     assert rows["physics"]["plugin"] == "core"
