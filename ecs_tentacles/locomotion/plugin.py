@@ -4,6 +4,8 @@ Scene keys: a creature's `goals` and `locomotion` (`locomotion.schema.json` besi
 Resources: `GoalBook` (goal paths) and `Locomotion` (parameters at run time), by type:
 `world.resource(GoalBook)`.
 Systems: goals, tentacle_selection (stage decide), action_queue, motor_targets (act).
+Sandbox hooks: goal rings and paths, goals set by clicks (`locomotion.render`), the
+Locomotion and Actions sections of the HUD (`locomotion.panel`).
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ from ecs_tentacles.scene.validate import fragment
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
+    from ecs_tentacles.drawing import Click, Panel, RenderView
     from ecs_tentacles.world import World
 
 _FRAGMENT = fragment("ecs_tentacles.locomotion", "locomotion")
@@ -75,3 +78,24 @@ class LocomotionPlugin(Plugin):
                 world.resource(GoalBook).append(entity, position.tolist(), radius)
         for entity, queue in world.query(ActionQueue):
             queue.pending = copy.deepcopy(queues[entity])
+
+    # -- sandbox hooks -----------------------------------------------------------------
+    def render_lines(self, world: World, view: RenderView) -> list[Any]:
+        from ecs_tentacles.locomotion.render import path_lines
+
+        return path_lines(world, view)
+
+    def render_points(self, world: World) -> Any:
+        from ecs_tentacles.locomotion.render import goal_points
+
+        return goal_points(world)
+
+    def sandbox_click(self, world: World, click: Click) -> bool:
+        from ecs_tentacles.locomotion.render import click_goal
+
+        return click_goal(world, click)
+
+    def sandbox_panels(self, sandbox: Any) -> list[Panel]:
+        from ecs_tentacles.locomotion.panel import locomotion_panels
+
+        return locomotion_panels(sandbox)
