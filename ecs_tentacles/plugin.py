@@ -5,7 +5,7 @@ suckers, fur, threats, recording, the sandbox's drawing, users' behaviours) is a
 `Plugin`: a schema fragment (creature-level and scene-level keys, and the schema of
 its own `plugins.<name>` config), a per-creature build hook, its stores (world
 resources), its systems at a named stage, its validation, and optional render and
-export hooks (the sandbox's: `ecs_tentacles.drawing`). A scene turns plugins on and configures them:
+export hooks. A scene turns plugins on and configures them:
 
     "plugins": {"wander": {"radius": 2.0}, "fur": false, "mine": {"from": "mine.py"}}
 
