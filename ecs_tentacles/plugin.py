@@ -40,6 +40,7 @@ from typing import TYPE_CHECKING, Any, ClassVar
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
+    from ecs_tentacles.drawing import Click, Panel, RenderView
     from ecs_tentacles.store import ArrayStore
     from ecs_tentacles.world import World
 
@@ -144,6 +145,31 @@ class Plugin:
     def render_spheres(self, world: World) -> list[Marker]:
         """Marker spheres the sandbox draws this frame."""
         return []
+
+    # -- sandbox hooks (the generic renderer, HUD and mouse call these) ------------------
+    def render_lines(self, world: World, view: RenderView) -> list[Any]:
+        """Line-list vertices (2n, 7: xyz rgba) the sandbox draws this frame, in its one
+        line batch (`drawing.line_segments` makes them from polylines)."""
+        return []
+
+    def render_draw(self, world: World, view: RenderView) -> int:
+        """Draw what spheres and lines cannot, with this plugin's own GL objects (made
+        lazily here, kept in `view.state`); runs after the renderer's own draws with the
+        depth test on. Returns the draw calls issued."""
+        return 0
+
+    def render_points(self, world: World) -> Any:
+        """Points (n, 3) the camera's "frame all" keeps in view besides the creatures, or None."""
+        return None
+
+    def sandbox_panels(self, sandbox: Any) -> list[Panel]:
+        """HUD sections this plugin adds to a sandbox (`ecs_tentacles.render.sandbox`);
+        asked once per sandbox: panels live across resets (`Panel.attach`)."""
+        return []
+
+    def sandbox_click(self, world: World, click: Click) -> bool:
+        """A click in the sandbox's 3D view; True: handled (later plugins do not see it)."""
+        return False
 
     def export_curves(self, world: World) -> GuideFrame | None:
         """Curves a take records each frame (fur guides), or None."""

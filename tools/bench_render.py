@@ -6,7 +6,8 @@
 
 `draw` ends with glFinish, so it includes the rasterising (llvmpipe on a machine
 without a GPU); `strands` is the fur's part of it (guides and child hairs as lit
-ribbons, drawn again alone). Medians over the measured frames, after a warm-up.
+ribbons, drawn again alone; the fur plugin uploads them in its draw hook, so `upload`
+is the renderer's own arrays). Medians over the measured frames, after a warm-up.
 """
 
 from __future__ import annotations
@@ -45,6 +46,7 @@ def furry(guides: int, children: int) -> dict[str, Any]:
 def bench(scene: Any, name: str, frames: int, width: int, height: int) -> dict[str, Any]:
     from pyglet import gl
 
+    from ecs_tentacles.fur.render.strands import STRANDS, FurStrands
     from ecs_tentacles.render.sandbox import Sandbox
 
     sandbox = Sandbox(scene, width=width, height=height, headless=True)
@@ -66,8 +68,10 @@ def bench(scene: Any, name: str, frames: int, width: int, height: int) -> dict[s
         timings["upload"].append(uploaded - simulated)
         timings["draw"].append(drawn - uploaded - (uploaded - simulated))
         renderer.target.bind()
+        strands = renderer.state.get(STRANDS)  # the fur plugin's GL objects, if it drew fur
         start = time.perf_counter()
-        renderer.draw_strands()
+        if isinstance(strands, FurStrands):
+            strands.draw(renderer.render_view)
         gl.glFinish()
         timings["strands"].append(time.perf_counter() - start)
     stats = {k: round(1000 * statistics.median(v), 3) for k, v in timings.items()}
@@ -80,7 +84,9 @@ def bench(scene: Any, name: str, frames: int, width: int, height: int) -> dict[s
         "frames": frames,
         "ms": stats,
         "draw_calls": renderer.draw_calls,
-        "strands": renderer.guide_ribbons.shape[0] + renderer.child_ribbons.shape[0],
+        "strands": strands.guides.shape[0] + strands.children.shape[0]
+        if isinstance(strands, FurStrands)
+        else 0,
     }
     sandbox.close()
     return result

@@ -24,6 +24,7 @@ def main() -> None:
     args.out_dir.mkdir(parents=True, exist_ok=True)
     configure(headless=True)
     from ecs_tentacles.components import Transform
+    from ecs_tentacles.fur.render.furpanel import FurPanel
     from ecs_tentacles.render.sandbox import Sandbox
 
     presets = Sandbox("fur_presets", width=args.width, height=args.height, headless=True)
@@ -46,14 +47,15 @@ def main() -> None:
     tool = Sandbox("hedgehog_octopus", width=args.width, height=args.height, headless=True)
     tool.step(60)
     tool.paused = True
-    assert tool.fur is not None
+    fur = tool.panel("Fur")
+    assert isinstance(fur, FurPanel)
     tool.hud.fold("Locomotion", "Stats", "Physics")  # the fur panel in view
-    tool.fur.editor.create("L_cheek", shape="cube", colour=(0.2, 0.7, 1.0), mirror="y")
-    tool.fur.editor.set_value("L_cheek", "lift", 0.8)
-    tool.fur.editor.set_key("crown", "lift", 1.0, "slow_in")
-    tool.fur.sync_view()
-    tool.renderer.fur_display.colour_by = "control"
-    tool.fur.refresh_rig(edit=True)
+    fur.editor.create("L_cheek", shape="cube", colour=(0.2, 0.7, 1.0), mirror="y")
+    fur.editor.set_value("L_cheek", "lift", 0.8)
+    fur.editor.set_key("crown", "lift", 1.0, "slow_in")
+    fur.sync_view()
+    fur.display.colour_by = "control"
+    fur.refresh_rig(edit=True)
     camera = tool.renderer.camera
     octo = tool.world.creature("hedgehog")
     camera.target = tool.world.component(octo, Transform).pos * [1, 1, 0] + [0, 0, 0.1]

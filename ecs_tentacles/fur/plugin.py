@@ -2,7 +2,8 @@
 
 Scene keys: a creature's `fur` and `emotion` (`ecs_tentacles/fur/fur.schema.json`).
 Resources: `world.resource(FurData)` (`ecs_tentacles.fur.stores.FurData`). Systems: emotion, rig
-(stage animate). Export hook: the posed guide curves a take records.
+(stage animate). Export hook: the posed guide curves a take records. Sandbox hooks
+(`ecs_tentacles.fur.render`): strands as ribbons, the controls' markers, the fur panel.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from ecs_tentacles.scene.validate import fragment
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
+    from ecs_tentacles.drawing import Panel, RenderView
     from ecs_tentacles.store import ArrayStore
     from ecs_tentacles.world import World
 
@@ -67,3 +69,19 @@ class FurPlugin(Plugin):
         from ecs_tentacles.fur.hooks import take_guides
 
         return take_guides(world)
+
+    # -- sandbox hooks: GL and ImGui are imported only when a sandbox calls these ------
+    def render_lines(self, world: World, view: RenderView) -> list[Any]:
+        from ecs_tentacles.fur.render.strands import fur_lines
+
+        return fur_lines(world, view)
+
+    def render_draw(self, world: World, view: RenderView) -> int:
+        from ecs_tentacles.fur.render.strands import draw_fur
+
+        return draw_fur(world, view)
+
+    def sandbox_panels(self, sandbox: Any) -> list[Panel]:
+        from ecs_tentacles.fur.render.furpanel import fur_panels
+
+        return fur_panels(sandbox)

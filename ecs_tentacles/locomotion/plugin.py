@@ -7,6 +7,8 @@ the body's stores; `world.stores` "locomotion.tentacles" / "locomotion.creatures
 `world.resource(GoalBook)`. Scene keys also include six tentacle parameters (speed,
 target angle, waves, writhe; `tentacles` and its `overrides`).
 Systems: goals, tentacle_selection (stage decide), action_queue, motor_targets (act).
+Sandbox hooks: goal rings and paths, goals set by clicks (`locomotion.render`), the
+Locomotion and Actions sections of the HUD (`locomotion.panel`).
 """
 
 from __future__ import annotations
@@ -31,6 +33,7 @@ from ecs_tentacles.scene.validate import fragment
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
+    from ecs_tentacles.drawing import Click, Panel, RenderView
     from ecs_tentacles.store import ArrayStore
     from ecs_tentacles.world import World
 
@@ -103,3 +106,24 @@ class LocomotionPlugin(Plugin):
                 world.resource(GoalBook).append(entity, position.tolist(), radius)
         for entity, queue in world.query(ActionQueue):
             queue.pending = copy.deepcopy(queues[entity])
+
+    # -- sandbox hooks -----------------------------------------------------------------
+    def render_lines(self, world: World, view: RenderView) -> list[Any]:
+        from ecs_tentacles.locomotion.render import path_lines
+
+        return path_lines(world, view)
+
+    def render_points(self, world: World) -> Any:
+        from ecs_tentacles.locomotion.render import goal_points
+
+        return goal_points(world)
+
+    def sandbox_click(self, world: World, click: Click) -> bool:
+        from ecs_tentacles.locomotion.render import click_goal
+
+        return click_goal(world, click)
+
+    def sandbox_panels(self, sandbox: Any) -> list[Panel]:
+        from ecs_tentacles.locomotion.panel import locomotion_panels
+
+        return locomotion_panels(sandbox)

@@ -3,13 +3,24 @@
 Needs locomotion (its actions command attach and detach; its `locomotion` settings
 carry the release thresholds). Systems: suckers (stage act). The sucker bodies and
 their MuJoCo constraints are core (every creature has them; without this plugin they
-stay released unless a script attaches them with `world.attach`).
+stay released unless a script attaches them with `world.attach`). Render hook: each
+attached sucker as a small yellow sphere at its anchor.
 """
 
 from __future__ import annotations
 
-from ecs_tentacles.plugin import Plugin
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ecs_tentacles.plugin import Marker, Plugin
 from ecs_tentacles.system import System
+
+if TYPE_CHECKING:
+    from ecs_tentacles.world import World
+
+SUCKER_SIZE = (0.024, 0.024, 0.024)  # metres
+SUCKER_RGBA = (1.0, 0.92, 0.25, 1.0)
 
 
 class SuckersPlugin(Plugin):
@@ -21,3 +32,10 @@ class SuckersPlugin(Plugin):
         from ecs_tentacles.systems.locomotion.suckers import Suckers
 
         return [Suckers()]
+
+    def render_spheres(self, world: World) -> list[Marker]:
+        suckers = world.suckers
+        held = np.flatnonzero(suckers.attached)
+        if not len(held):
+            return []
+        return [Marker(suckers.anchor[held] + [0.0, 0.0, 0.01], SUCKER_SIZE, SUCKER_RGBA)]

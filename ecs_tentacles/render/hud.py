@@ -1,34 +1,32 @@
-"""The heads-up display: tune the selected creature's tentacles, see live stats.
+"""The heads-up display: the selected creature, live stats, and the plugins' sections.
 
 Drawn with Dear ImGui (`render.gui`): a panel on the left, as wide as the window
-allows, in collapsible sections. "Locomotion" has a slider for each parameter the
-scene schema marks with one (`ecs_tentacles.scene.parameters`: speed, target angle,
-strength, wave amplitude and frequency), over its range and with its label and units
-(strength stops where the servos' damping can hold it), the gait's choices, and a tentacle
-selector ("all" or one tentacle). Every change goes through
-`world.resource(Locomotion).set`, the same API scripts use, so it reaches the servos on
-the next physics step. "Stats" shows fps,
-physics ms, simulated time, real-time factor and attached suckers; "Physics" the
-groups, threads, recoveries and frozen creatures; "Actions" each tentacle's action.
-Extra panels (the fur tool) add sections through `sections`.
+allows, in collapsible sections. The HUD's own: "Stats" shows fps, physics ms,
+simulated time, real-time factor and attached suckers; "Physics" the groups, threads,
+recoveries and frozen creatures; "Plugins" the plugins on and every system, with a box
+to switch it off. Plugins add sections through `panels` (`ecs_tentacles.drawing.Panel`,
+from their `sandbox_panels` hooks: locomotion's sliders and actions, the fur tool),
+placed by their `order`; `sections` takes bare (title, draw) pairs and `windows` more
+ImGui windows. The HUD keeps the selection (a creature, and one tentacle or all) and
+tells every panel when it changes.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import Any
 
 from imgui_bundle import imgui
 
 from ecs_tentacles.components import Creature
-from ecs_tentacles.locomotion.params import Locomotion, settable
-from ecs_tentacles.render.gui import Gui, gui_scale, same_line_if_fits, text_width
-from ecs_tentacles.scene.parameters import Parameter, parameter
+from ecs_tentacles.drawing import Panel
+from ecs_tentacles.render.gui import Gui, gui_scale
 
 PANEL_WIDTH = 300  # the panel's width at scale 1 (the creator still uses it as is)
 PANEL_SHARE = 0.4  # the panel never covers more than this share of the window's width
 TEXT = (20, 24, 28, 255)
+OWN_ORDER = 0  # the HUD's own sections' place among the panels' (`Panel.order`)
+SECTION_ORDER = 10  # where bare `sections` go
 
 
 def panel_width(width: int, height: int) -> int:
@@ -36,68 +34,11 @@ def panel_width(width: int, height: int) -> int:
     return int(min(PANEL_WIDTH * gui_scale(height), PANEL_SHARE * width))
 
 
-@dataclass(frozen=True)
-class Knob:
-    """A slider for one parameter of the table, shown in the scene's units.
-
-    The parameter's range (the scene schema's, the API's too) bounds the slider; `log`
-    sliders give the low end, where the defaults sit, more room. An open lower bound
-    (speed > 0) starts a thousandth of the span above it.
-    """
-
-    parameter: Parameter
-
-    @property
-    def name(self) -> str:
-        return self.parameter.api
-
-    @property
-    def label(self) -> str:
-        return self.parameter.label
-
-    @property
-    def unit(self) -> str:
-        """The slider's printf format: the slider's digits, then the scene's units."""
-        p = self.parameter
-        assert p.slider is not None
-        return f"%.{p.slider.digits}f" + (f" {p.units}" if p.units else "")
-
-    @property
-    def to_shown(self) -> float:
-        """Shown value = stored value x this (degrees for radians)."""
-        return 1.0 / self.parameter.factor
-
-    @property
-    def log(self) -> bool:
-        return bool(self.parameter.slider and self.parameter.slider.log)
-
-    @property
-    def low(self) -> float:
-        allowed = self.parameter.range
-        assert allowed is not None
-        low = allowed.low + (1e-3 * (allowed.high - allowed.low) if allowed.low_open else 0.0)
-        return low * self.to_shown
-
-    @property
-    def high(self) -> float:
-        assert self.parameter.range is not None
-        return self.parameter.range.high * self.to_shown
-
-
-def knobs() -> tuple[Knob, ...]:
-    """A slider per run-time tentacle parameter with a `slider` entry, in its order."""
-    marked = [p for p in settable()[0].values() if p.slider is not None]
-    return tuple(Knob(p) for p in sorted(marked, key=lambda p: p.slider.order if p.slider else 0))
-
-
-KNOBS = knobs()
-
-
-CLOSED = ("Actions", "Plugins")  # sections that start folded
+CLOSED = ("Plugins",)  # own sections that start folded
 
 
 class Hud:
-    """The sandbox's panel, bound to a world's locomotion parameters."""
+    """The sandbox's panel: the selection, the HUD's own sections and the plugins'."""
 
     def __init__(self, window: Any, world: Any, *, visible: bool = True):
         self.window = window
@@ -107,7 +48,7 @@ class Hud:
         self.creature: int | None = None
         self.tentacle: int | None = None  # None: all tentacles
         self.stats: dict[str, float] = {}
-        self.values: dict[str, Any] = {}
+        self.panels: list[Panel] = []  # the plugins' sections (the sandbox keeps this list)
         self.sections: list[tuple[str, Callable[[Gui], None]]] = []  # (title, draw)
         self.windows: list[Callable[[Gui], None]] = []  # more ImGui windows (the timeline)
         self._fold: set[str] = set()  # sections to close on the next frame
@@ -118,7 +59,8 @@ class Hud:
     def select(self, creature: int | None, tentacle: int | None = None) -> None:
         """Show and edit `creature` (all its tentacles, or tentacle index `tentacle`)."""
         self.creature, self.tentacle = creature, tentacle
-        self.refresh()
+        for panel in self.panels:
+            panel.select(creature, tentacle)
 
     @property
     def title(self) -> str:
@@ -134,37 +76,13 @@ class Hud:
         if self.creature is None:
             return
         choices: list[int | None] = [None, *range(self._count())]
-        self.tentacle = choices[(choices.index(self.tentacle) + step) % len(choices)]
-        self.refresh()
+        self.select(self.creature, choices[(choices.index(self.tentacle) + step) % len(choices)])
 
-    # -- editing ---------------------------------------------------------------------
-    def set_parameter(self, name: str, value: float | str) -> None:
-        """Apply a parameter to the selection through the locomotion API."""
-        if self.creature is None:
-            return
-        if name not in settable()[0]:  # creature-wide (the gait)
-            self.world.resource(Locomotion).set(self.creature, **{name: value})
-        else:
-            self.world.resource(Locomotion).set(
-                self.creature, tentacle=self.tentacle, **{name: float(value)}
-            )
-        self.refresh()
-
-    def refresh(self) -> None:
-        """Read the selection's current values from the world."""
-        if self.creature is None or not self.world.has_resource(Locomotion):
-            self.values = {}
-            return
-        values = self.world.resource(Locomotion).get(self.creature, self.tentacle or 0)
-        if self.tentacle is None:
-            values["speed"] = values["creature_speed"]
-        self.values = values
-
+    # -- drawing ---------------------------------------------------------------------
     def update(self, stats: dict[str, float]) -> None:
         """Keep the live numbers for the next draw."""
         self.stats = dict(stats)
 
-    # -- drawing ---------------------------------------------------------------------
     def fold(self, *sections: str) -> None:
         """Close these sections (as a click on their headers would)."""
         self._fold.update(sections)
@@ -203,20 +121,19 @@ class Hud:
         gui.window_rect("panel")
         imgui.text(self.title)
         gui.item("title")
-        moving = self.world.has_resource(Locomotion)  # the locomotion plugin is on
-        own: list[tuple[str, Callable[[Gui], None]]] = [
-            *([("Locomotion", self._locomotion)] if moving else []),
-            ("Stats", self._stats),
-            ("Physics", self._physics),
-            ("Plugins", self._plugins),
+        own = [
+            (OWN_ORDER, "Stats", self._stats, False),
+            (OWN_ORDER, "Physics", self._physics, False),
+            (OWN_ORDER, "Plugins", self._plugins, True),
         ]
-        last = [("Actions", self._actions)] if moving else []
-        for name, build in [*own, *self.sections, *last]:
+        plugged = [(p.order, p.title, p.draw, p.closed) for p in self.panels]
+        bare = [(SECTION_ORDER, name, build, name in CLOSED) for name, build in self.sections]
+        for _, name, build, closed in sorted([*own, *plugged, *bare], key=lambda s: s[0]):
             if name in self._fold:
                 imgui.set_next_item_open(False)
                 self._fold.discard(name)
             opened = imgui.collapsing_header(
-                name, imgui.TreeNodeFlags_.default_open if name not in CLOSED else 0
+                name, imgui.TreeNodeFlags_.default_open if not closed else 0
             )
             gui.item(name)
             if opened:
@@ -224,6 +141,8 @@ class Hud:
         imgui.end()
         for window in self.windows:
             window(gui)
+        for panel in self.panels:
+            panel.windows(gui)
 
     def _name_labels(self) -> None:
         """Each `label_at` text centred at its pixel (pyglet's y), on a dark plate."""
@@ -237,44 +156,6 @@ class Hud:
                 (left - pad, top - pad), (left + size.x + pad, top + size.y + pad), plate, pad
             )
             draw.add_text((left, top), imgui.get_color_u32((1.0, 1.0, 1.0, 1.0)), text)
-
-    def _locomotion(self, gui: Gui) -> None:
-        if self.creature is None:
-            return
-        if imgui.arrow_button("##previous", imgui.Dir.left):
-            self.step_tentacle(-1)
-        gui.item("previous")
-        imgui.same_line()
-        if imgui.arrow_button("##next", imgui.Dir.right):
-            self.step_tentacle(1)
-        gui.item("next")
-        imgui.same_line()
-        imgui.text("all tentacles" if self.tentacle is None else f"tentacle {self.tentacle}")
-        gui.item("tentacle")
-        for knob in KNOBS:
-            imgui.text(knob.label)
-            gui.item(f"{knob.name} label")
-            imgui.set_next_item_width(-1.0)
-            shown = float(self.values[knob.name]) * knob.to_shown
-            high = knob.high
-            if knob.name == "strength":  # no stronger than the servos' damping holds
-                high = self.world.resource(Locomotion).strength_limit(self.creature, self.tentacle)
-            flags = imgui.SliderFlags_.logarithmic.value if knob.log else 0
-            changed, shown = imgui.slider_float(
-                f"##{knob.name}", shown, knob.low, high, knob.unit, flags
-            )
-            gui.item(knob.name)
-            if changed:
-                self.set_parameter(knob.name, min(shown, high) / knob.to_shown)
-        gaits = parameter("locomotion", "gait")
-        imgui.text(gaits.label)
-        gui.item("gait label")
-        for i, gait in enumerate(gaits.choices):
-            if i:
-                same_line_if_fits(text_width(gait))
-            if imgui.radio_button(gait, self.values["gait"] == gait):
-                self.set_parameter("gait", gait)
-            gui.item(f"gait {gait}")
 
     def _stats(self, gui: Gui) -> None:
         stats = self.stats
@@ -312,13 +193,6 @@ class Hud:
             gui.item(f"system {name}")
             if changed:
                 (schedule.enable if running else schedule.disable)(name)
-
-    def _actions(self, gui: Gui) -> None:
-        if self.creature is None:
-            return
-        for k, action in enumerate(self.world.resource(Locomotion).actions(self.creature)):
-            imgui.text(f"t{k}: {action}")
-            gui.item(f"action {k}")
 
     def close(self) -> None:
         self.gui.close()

@@ -1,7 +1,9 @@
 """The render plugin: the sandbox's renderer gets each frame's poses (`play` adds it).
 
-Systems: render (stage output). Other plugins draw through their render hooks
-(`Plugin.render_spheres`), which the renderer calls.
+Systems: render (stage output). Other plugins draw, add HUD sections and take clicks
+through their sandbox hooks (`render_spheres`, `render_lines`, `render_draw`,
+`render_points`, `sandbox_panels`, `sandbox_click`: `ecs_tentacles.drawing`), which the
+renderer, HUD and sandbox call; none of them names a feature.
 """
 
 from __future__ import annotations

@@ -4,10 +4,16 @@ Physics runs at the scene's fixed frame rate with its own accumulator; drawing
 happens at display rate and interpolates between the last two physics frames.
 
 Mouse: left-drag orbits, right- or middle-drag pans, wheel zooms; click a creature
-to select it, click the ground to set its goal, shift-click to append to its path,
-right-click a goal to remove it. Keys: space pause, . single step, r reset,
+to select it. Every other click in the 3D view goes to the plugins' `sandbox_click`
+hooks (`ecs_tentacles.drawing.Click`): the locomotion plugin's sets the selected
+creature's goal on a click on the ground, appends to its path on shift-click and
+removes the goal under a right click. Keys: space pause, . single step, r reset,
 h HUD, f follow, a frame all, tab next tentacle, F12 screenshot, v video,
 F5 save the state, F9 go back to it.
+
+Plugins add HUD sections (`sandbox_panels`, asked once per plugin and kept across
+rebuilds and resets: the locomotion sliders, the fur tool) and draw through the
+renderer's hooks; this module names no feature.
 
 User code: a system that raises is disabled and shown in red at the top right (with
 a button to run it again) while the sandbox keeps running; a plugin file that changes
@@ -31,9 +37,7 @@ from pyglet.window import key, mouse
 from tqdm import tqdm
 
 from ecs_tentacles.components import Creature, Transform
-from ecs_tentacles.fur.render.furpanel import FurPanel
-from ecs_tentacles.locomotion.components import Goal
-from ecs_tentacles.locomotion.goals import GoalBook
+from ecs_tentacles.drawing import Click, Panel
 from ecs_tentacles.render.camera import ray_sphere
 from ecs_tentacles.render.hud import Hud
 from ecs_tentacles.render.output import VideoWriter, save_png
@@ -48,6 +52,7 @@ if TYPE_CHECKING:
     from ecs_tentacles.snapshot import Snapshot
 
 CLICK_PIXELS = 4  # a press and release closer than this is a click, not a drag
+BUTTONS = {mouse.LEFT: "left", mouse.RIGHT: "right", mouse.MIDDLE: "middle"}
 MAX_CATCH_UP = 0.25  # seconds of physics to catch up at most per display frame
 DISPLAY_HZ = 60
 
@@ -78,10 +83,9 @@ class Sandbox:
         self.scripts = Scripts(self.window)
         self.hud.windows.append(self.scripts.draw)
         self.paused = False
-        self.fur: FurPanel | None = None
+        self.panels: dict[str, list[Panel]] = {}  # each plugin's HUD sections, by plugin key
+        self._grab: Panel | None = None  # the panel holding the mouse (a dragged marker)
         self._attach_world()
-        if self.world.scene is not None and any("fur" in c for c in self.world.scene["creatures"]):
-            self.open_fur_tool()
         self.window.push_handlers(self)
         self.window.push_handlers(self.hud.gui)  # the GUI sees every event first
         self.accumulator = 0.0
@@ -100,19 +104,24 @@ class Sandbox:
         self.renderer.frame_all()
         self.hud.world = self.world
         self.scripts.attach(self.world)
+        self._attach_panels()
         first = self.renderer.creature_entities[0] if self.renderer.creature_entities else None
         self.select(first)
 
-    def open_fur_tool(self) -> FurPanel:
-        """The fur panel (a HUD section) and the timeline (a window at the bottom)."""
-        from ecs_tentacles.fur.render.timeline import Timeline
+    def _attach_panels(self) -> None:
+        """Tell the kept panels about the new world; ask plugins seen first for theirs."""
+        names = [plugin.key for plugin in self.world.plugins]
+        for name in names:
+            for panel in self.panels.get(name, []):
+                panel.attach(self.world)
+        for plugin in self.world.plugins:
+            if plugin.key not in self.panels:
+                self.panels[plugin.key] = list(plugin.sandbox_panels(self))
+        self.hud.panels = [panel for name in names for panel in self.panels[name]]
 
-        self.fur = FurPanel(self)
-        self.timeline = Timeline(self, self.fur)
-        self.hud.sections.append(("Fur", self.fur.draw))
-        self.hud.windows.append(lambda gui: self.timeline.draw(gui, self.hud.width))
-        self.fur.select_creature(self.renderer.selected)
-        return self.fur
+    def panel(self, title: str) -> Panel | None:
+        """The plugins' HUD section titled `title` ("Fur", "Locomotion"), if shown."""
+        return next((p for p in self.hud.panels if p.title == title), None)
 
     def rebuild(self, scene: dict[str, Any]) -> World:
         """Rebuild the world from an edited scene; the camera and the selection stay."""
@@ -126,8 +135,7 @@ class Sandbox:
         self.world.add_plugin(RenderPlugin(renderer=self.renderer))
         self.hud.world = self.world
         self.scripts.attach(self.world)
-        if self.fur is not None:
-            self.fur.editor.attach(self.world)
+        self._attach_panels()
         self.select(self.world.creature(name) if name is not None else None)
         return self.world
 
@@ -182,16 +190,13 @@ class Sandbox:
         self.world.close()
         self.world = world
         self._attach_world()
-        if self.fur is not None:
-            self.fur.editor.attach(self.world)
-            self.fur.sync_view()
         return True
 
     # -- drawing -----------------------------------------------------------------------
     def render(self) -> np.ndarray | None:
         """Draw the world and the HUD off-screen; return the picture if recording."""
         alpha = 1.0 if self.paused else self.accumulator / self.world.settings.dt
-        self.renderer.fur_display.markers = self.fur is not None and self.hud.visible
+        self.renderer.overlays = self.hud.visible  # editing aids (fur control markers)
         self.renderer.draw(alpha)
         self._update_stats()
         gl.glDisable(gl.GL_DEPTH_TEST)
@@ -250,12 +255,10 @@ class Sandbox:
         video, self.video = self.video, None
         return video.close()
 
-    # -- selection and goals -------------------------------------------------------------
+    # -- selection and clicks ------------------------------------------------------------
     def select(self, creature: int | None) -> None:
         self.renderer.selected = creature
-        self.hud.select(creature)
-        if self.fur is not None:
-            self.fur.select_creature(creature)
+        self.hud.select(creature)  # and every panel
 
     def pick_creature(self, x: float, y: float) -> int | None:
         """The creature whose mantle is under pixel (x, y), nearest first."""
@@ -270,48 +273,37 @@ class Sandbox:
         return self.renderer.creature_entities[best] if np.isfinite(hits[best]) else None
 
     def click(self, x: float, y: float, button: int, modifiers: int) -> None:
-        """What a click at pixel (x, y) does in the world."""
+        """What a click at pixel (x, y) does: a left click on a creature selects it; then
+        the plugins' `sandbox_click` hooks see it, in plugin order, until one takes it."""
         if self.hud.contains(x, y):
             return
-        if button == mouse.LEFT:
-            picked = self.pick_creature(x, y)
-            if picked is not None:
-                self.select(picked)
+        picked = self.pick_creature(x, y)
+        if button == mouse.LEFT and picked is not None:
+            self.select(picked)
+        click = Click(
+            button=BUTTONS.get(button, "other"),
+            shift=bool(modifiers & key.MOD_SHIFT),
+            ground=self.renderer.camera.ground_point(x, y),
+            creature=picked,
+            selected=self.renderer.selected,
+        )
+        for plugin in self.world.plugins:
+            if plugin.sandbox_click(self.world, click):
                 return
-            point = self.renderer.camera.ground_point(x, y)
-            creature = self.renderer.selected
-            if point is None or creature is None:
-                return
-            if modifiers & key.MOD_SHIFT:
-                self.world.resource(GoalBook).append(creature, point[:2].tolist())
-            else:
-                self.world.resource(GoalBook).set(creature, point[:2].tolist())
-        elif button == mouse.RIGHT:
-            point = self.renderer.camera.ground_point(x, y)
-            if point is not None:
-                self.remove_goal_at(point)
-
-    def remove_goal_at(self, point: np.ndarray) -> int | None:
-        """Remove the goal whose ring contains `point` (the nearest one)."""
-        best, best_distance = None, np.inf
-        for entity, goal in self.world.query(Goal):
-            distance = float(np.linalg.norm(goal.position[:2] - point[:2]))
-            if distance <= goal.radius and distance < best_distance:
-                best, best_distance = entity, distance
-        if best is not None:
-            self.world.resource(GoalBook).remove(best)
-        return best
 
     # -- window events -------------------------------------------------------------------
     def on_mouse_press(self, x: int, y: int, button: int, modifiers: int) -> None:
         self._press = (x, y) if not self.hud.contains(x, y) else None
-        if self._press is not None and button == mouse.LEFT and self.fur is not None:
-            if self.fur.press(x, y):  # a control's marker: drag it over the body
-                self._press = None
+        if self._press is not None and button == mouse.LEFT:
+            for panel in self.hud.panels:
+                if panel.press(x, y):  # a fur control's marker: drag it over the body
+                    self._press, self._grab = None, panel
+                    break
 
     def on_mouse_release(self, x: int, y: int, button: int, modifiers: int) -> None:
-        if self.fur is not None:
-            self.fur.release()
+        for panel in self.hud.panels:
+            panel.release()
+        self._grab = None
         if (
             self._press is not None
             and np.hypot(x - self._press[0], y - self._press[1]) < CLICK_PIXELS
@@ -320,8 +312,8 @@ class Sandbox:
         self._press = None
 
     def on_mouse_drag(self, x: int, y: int, dx: int, dy: int, buttons: int, modifiers: int) -> None:
-        if self.fur is not None and self.fur.dragging:
-            self.fur.drag(x, y)
+        if self._grab is not None:
+            self._grab.drag(x, y)
             return
         if self._press is None:
             return

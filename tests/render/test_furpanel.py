@@ -13,6 +13,7 @@ from pyglet.window import key, mouse
 from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.fur.components import FurControl
 from ecs_tentacles.fur.controls import nearest_control
+from ecs_tentacles.fur.render.furpanel import FurPanel
 from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.mathutil import quat_rotate
 from ecs_tentacles.scene.load import load_scene
@@ -30,6 +31,13 @@ def tool(make_sandbox: Callable[..., Any]) -> Any:
         click_item(sandbox, section)
     assert "speed" not in sandbox.hud.gui.rects
     return sandbox
+
+
+def fur_panel(sandbox: Any) -> FurPanel:
+    """The fur plugin's HUD section (its `sandbox_panels` hook made it)."""
+    panel = sandbox.panel("Fur")
+    assert isinstance(panel, FurPanel)
+    return panel
 
 
 def type_text(sandbox: Any, field: str, text: str) -> None:
@@ -72,7 +80,7 @@ def expected_assignment(world: World, editor: Any) -> np.ndarray:
 
 def test_create_a_mirrored_control_and_drag_it(make_sandbox: Callable[..., Any]) -> None:
     sandbox = tool(make_sandbox)
-    editor = sandbox.fur.editor
+    editor = fur_panel(sandbox).editor
     assert editor.creature == "hedgehog" and editor.control_names() == ["crown", "spine"]
     click_item(sandbox, "create section")
     type_text(sandbox, "new name", "L_ear")
@@ -93,12 +101,12 @@ def test_create_a_mirrored_control_and_drag_it(make_sandbox: Callable[..., Any])
     target_local = np.array([-0.12, 0.1, 0.3])
     end = local_to_pixels(sandbox, target_local)
     event(sandbox, "on_mouse_press", round(start[0]), round(start[1]), mouse.LEFT, 0)
-    assert sandbox.fur.dragging
+    assert fur_panel(sandbox).dragging
     for f in np.linspace(0.2, 1.0, 5):
         x, y = start + f * (end - start)
         event(sandbox, "on_mouse_drag", round(x), round(y), 1, 1, mouse.LEFT, 0)
     event(sandbox, "on_mouse_release", round(end[0]), round(end[1]), mouse.LEFT, 0)
-    assert not sandbox.fur.dragging
+    assert not fur_panel(sandbox).dragging
     moved = editor.value("L_ear", "position")
     assert moved[0] < -0.05 and moved[1] > 0.0  # now at the rear, still on the left
     assert_allclose(editor.value("R_ear", "position"), moved * [1, -1, 1])
@@ -122,7 +130,7 @@ def test_two_slow_in_keys_play_back_as_the_tracks_evaluate(
     make_sandbox: Callable[..., Any],
 ) -> None:
     sandbox = tool(make_sandbox)
-    editor, timeline = sandbox.fur.editor, sandbox.timeline
+    editor, timeline = fur_panel(sandbox).editor, fur_panel(sandbox).timeline
     row = editor.rows()["crown"]
     lift = sandbox.world.resource(FurData).controls.lift
     click_item(sandbox, "easing slow_in")
@@ -160,7 +168,8 @@ def test_two_slow_in_keys_play_back_as_the_tracks_evaluate(
 
 def test_save_reloads_to_the_same_fur(make_sandbox: Callable[..., Any], tmp_path: Path) -> None:
     sandbox = tool(make_sandbox)
-    panel, editor = sandbox.fur, sandbox.fur.editor
+    panel = fur_panel(sandbox)
+    editor = panel.editor
     editor.create("tuft", count=2, shape="arrow", mirror="x")
     editor.set_value("tuft_0", "lift", 0.6)
     editor.set_position("tuft_1_mirror", [-0.05, 0.02, 0.25])

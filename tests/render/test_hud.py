@@ -135,7 +135,7 @@ def test_gui_draw_calls_do_not_grow_with_creatures(make_sandbox: Callable[..., A
 
 @pytest.mark.parametrize("name", ["speed", "target_angle", "strength", "wave_amplitude"])
 def test_each_slider_spans_the_schema_range(name: str) -> None:
-    from ecs_tentacles.render.hud import KNOBS
+    from ecs_tentacles.locomotion.panel import KNOBS
     from ecs_tentacles.scene.ranges import field_range
 
     (knob,) = [k for k in KNOBS if k.name == name]
@@ -162,7 +162,7 @@ def test_the_strength_slider_stops_where_the_damping_holds(
 
 def test_the_sliders_are_the_parameter_tables() -> None:
     """Which sliders, their order, labels and units: the schema's `x-parameter` entries."""
-    from ecs_tentacles.render.hud import KNOBS
+    from ecs_tentacles.locomotion.panel import KNOBS
     from ecs_tentacles.scene.validate import load_schema
 
     tentacles = load_schema()["$defs"]["creature"]["properties"]["tentacles"]["properties"]

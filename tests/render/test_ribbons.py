@@ -10,6 +10,7 @@ from numpy.testing import assert_array_equal
 
 from ecs_tentacles.fur.hooks import GuideCurves
 from ecs_tentacles.fur.render.ribbons import ribbon_vertices, strip_indices
+from ecs_tentacles.fur.render.strands import strands_of
 
 
 def test_strip_indices_and_vertices() -> None:
@@ -52,10 +53,11 @@ def test_ribbons_face_the_camera_and_taper(make_sandbox: Callable[..., Any]) -> 
         camera.yaw = yaw
         renderer.draw()
         background = renderer.target.read()
-        renderer.guide_ribbons.update(strand)
+        strands = strands_of(renderer.state)  # made here: this world has no fur
+        strands.guides.update(strand)
         renderer.target.bind()
         gl.glEnable(gl.GL_DEPTH_TEST)
-        calls = renderer.draw_strands()
+        calls = strands.draw(renderer.render_view)
         assert calls == 1
         changed = _width_rows(renderer.target.read(), background.astype(int))
         rows = np.flatnonzero(changed)

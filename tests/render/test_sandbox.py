@@ -100,7 +100,7 @@ def test_draw_calls_do_not_grow_with_creatures(make_sandbox: Callable[..., Any])
         assert renderer.toggle_view() == "capsules"
         calls["capsules"].append(renderer.draw())
         assert renderer.links_near.count + renderer.links_far.count == count * 30
-    # ground, mantles, near and far links, suckers, lines (+ all skinned creatures)
+    # ground, mantles, near and far links, spheres, lines (+ all skinned creatures)
     assert calls == {"skinned": [7, 7], "capsules": [6, 6]}
 
 
@@ -123,6 +123,7 @@ def test_headless_run_writes_a_screenshot_and_a_video(
 
 def test_fur_and_threats_are_drawn(make_sandbox: Callable[..., Any]) -> None:
     from ecs_tentacles.fur.hooks import child_hairs, guide_curves
+    from ecs_tentacles.fur.render.strands import strands_of
 
     sandbox = make_sandbox("hedgehog_octopus")
     sandbox.step(3)
@@ -131,11 +132,12 @@ def test_fur_and_threats_are_drawn(make_sandbox: Callable[..., Any]) -> None:
     guides, children = guide_curves(world).points, child_hairs(world).points
     assert guides.shape[0] == 500
     renderer = sandbox.renderer
-    assert renderer.guide_ribbons.count == 6 * guides.shape[0] * (guides.shape[1] - 1)
-    assert renderer.child_ribbons.count == 6 * children.shape[0] * (children.shape[1] - 1)
+    strands = strands_of(renderer.state)  # the fur plugin's GL objects, made by its hook
+    assert strands.guides.count == 6 * guides.shape[0] * (guides.shape[1] - 1)
+    assert strands.children.count == 6 * children.shape[0] * (children.shape[1] - 1)
     assert renderer.draw_calls == 8  # ground, 4 meshes, skinned, lines, guides (no children)
     attached = int(world.suckers.attached.sum())
-    assert sandbox.renderer.suckers.count == attached + 1  # the roach
+    assert sandbox.renderer.spheres.count == attached + 1  # the roach
 
 
 def test_f5_saves_the_state_and_f9_goes_back(make_sandbox: Callable[..., Any]) -> None:

@@ -1,4 +1,5 @@
-"""Fur's drawing in the sandbox: ribbons, control markers, the fur panel and timeline.
+"""Fur in the sandbox: strands as ribbons and control markers (`strands`, `ribbons`,
+`markers`), the fur panel and its timeline (`furpanel`, `timeline`).
 
-Imported only by the fur plugin's render hooks (they need pyglet and a GL context).
+Imported only by the fur plugin's sandbox hooks (they need pyglet and a GL context).
 """

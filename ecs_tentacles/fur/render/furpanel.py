@@ -6,7 +6,9 @@ mirror axis) and deleting, the picked control's position (numeric fields, or dra
 marker over the body) and sliders for lift, aim, direction, random, dynamic and the
 emotion weight; display options (colour by control, guides, child hairs, children per
 guide); and `Save scene`, which writes the edited scene through the atomic writer.
-The timeline (`render.timeline`) keys the picked control.
+The timeline (`fur.render.timeline`, a window of this panel) keys the picked control.
+The fur plugin's `sandbox_panels` hook makes it (`fur_panels`) when the scene has fur;
+the display options live in the renderer's state (`fur.render.strands.fur_display`).
 """
 
 from __future__ import annotations
@@ -17,8 +19,11 @@ import numpy as np
 from imgui_bundle import imgui
 
 from ecs_tentacles.components import Creature, Transform
+from ecs_tentacles.drawing import Panel
 from ecs_tentacles.fur.editor import MIRRORS, SHAPES, VALUES, FurEditor
 from ecs_tentacles.fur.groom import closest_surface_point
+from ecs_tentacles.fur.render.strands import FurDisplay, fur_display
+from ecs_tentacles.fur.render.timeline import Timeline
 from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.mathutil import quat_rotate
 from ecs_tentacles.render.gui import Gui, same_line_if_fits, text_width
@@ -64,8 +69,18 @@ def choice(gui: Gui, name: str, options: tuple[str, ...], current: int) -> tuple
     return changed, chosen
 
 
-class FurPanel:
-    """The "Fur" section and the 3D picking and dragging of controls, for a sandbox."""
+def fur_panels(sandbox: Any) -> list[Panel]:
+    """The fur tool for a sandbox whose scene has fur (none otherwise)."""
+    scene = sandbox.world.scene
+    if scene is None or not any("fur" in c for c in scene["creatures"]):
+        return []
+    return [FurPanel(sandbox)]
+
+
+class FurPanel(Panel):
+    """The "Fur" section, its timeline and the 3D picking and dragging of controls."""
+
+    title = "Fur"
 
     def __init__(self, sandbox: Any):
         self.sandbox = sandbox
@@ -75,8 +90,24 @@ class FurPanel:
         self.save_path = f"{sandbox.world.scene.get('name', 'scene')}_fur.json"  # in the cwd
         self.message = ""
         self.dragging = False
-        sandbox.renderer.fur_display.markers = True
+        self.timeline = Timeline(sandbox, self)
         self.sync_view()
+
+    @property
+    def display(self) -> FurDisplay:
+        """How the sandbox's renderer draws fur (the display options edit it)."""
+        return fur_display(self.sandbox.renderer.state)
+
+    # -- the panel's hooks -----------------------------------------------------------
+    def attach(self, world: Any) -> None:
+        self.editor.attach(world)
+        self.sync_view()
+
+    def select(self, creature: int | None, tentacle: int | None) -> None:
+        self.select_creature(creature)
+
+    def windows(self, gui: Gui) -> None:
+        self.timeline.draw(gui, self.sandbox.hud.width)
 
     # -- selection -------------------------------------------------------------------
     def select_creature(self, entity: int | None) -> None:
@@ -92,7 +123,7 @@ class FurPanel:
 
     def sync_view(self) -> None:
         """Highlight the picked control's marker; refresh the fur when paused."""
-        display = self.sandbox.renderer.fur_display
+        display = self.display
         editor = self.editor
         display.selected_control = None
         if editor.creature is not None and editor.control is not None:
@@ -266,7 +297,7 @@ class FurPanel:
                 self.refresh_rig(edit=True)
 
     def _display(self, gui: Gui) -> None:
-        display = self.sandbox.renderer.fur_display
+        display = self.display
         imgui.separator_text("display")
         gui.item("display title")
         changed, by_control = imgui.checkbox("colour by control", display.colour_by == "control")

@@ -4,7 +4,7 @@ A kind (guides, or child hairs) is n polylines of p points. Each point becomes t
 vertices (left, right) carrying its position, the strand's tangent there, the root
 width, the position along the strand (for the taper and the root shading) and the
 strand's colour; the vertex shader turns them across the view, the fragment shader
-lights them (Kajiya-Kay, `shaders.RIBBON_FRAGMENT`). The triangle indices depend only
+lights them (Kajiya-Kay, `RIBBON_FRAGMENT`). The triangle indices depend only
 on (n, p) and are rebuilt when those change; vertices are one numpy pass a frame.
 """
 
@@ -17,6 +17,63 @@ from ecs_tentacles.fur.hooks import GuideCurves
 from ecs_tentacles.render.gpu import FLOAT, _attribute, _buffer, _upload, _vertex_array
 
 VERTEX_FLOATS = 3 + 3 + 3 + 3  # position, tangent, (side, width, along), colour
+
+# Hair strands as camera-facing ribbons: each polyline point comes twice (side -1, +1)
+# and is pushed sideways, across the strand and the view, by half its tapered width.
+RIBBON_VERTEX = """
+#version 330 core
+layout(location = 0) in vec3 a_position;
+layout(location = 1) in vec3 a_tangent;
+layout(location = 2) in vec3 a_strand;    // side (-1, 1), width at the root (m), along (0..1)
+layout(location = 3) in vec3 a_colour;
+uniform mat4 u_view_projection;
+uniform vec3 u_eye;
+uniform float u_min_width;                // metres: never thinner than about a pixel
+out vec3 v_tangent;
+out vec3 v_world;
+out vec3 v_colour;
+out float v_along;
+void main() {
+    vec3 t = normalize(a_tangent);
+    vec3 view = normalize(u_eye - a_position);
+    vec3 across = cross(t, view);
+    float len = length(across);
+    across = len > 1e-6 ? across / len : vec3(0.0, 0.0, 1.0);
+    float width = max(a_strand.y * (1.0 - 0.85 * a_strand.z), u_min_width);
+    vec3 world = a_position + across * (0.5 * width * a_strand.x);
+    v_tangent = t;
+    v_world = world;
+    v_colour = a_colour;
+    v_along = a_strand.z;
+    gl_Position = u_view_projection * vec4(world, 1.0);
+}
+"""
+
+# Kajiya-Kay: diffuse from the sine of the angle between strand and light, a specular
+# lobe from the strand and the half vector, shifted toward the tip; roots darker.
+RIBBON_FRAGMENT = """
+#version 330 core
+in vec3 v_tangent;
+in vec3 v_world;
+in vec3 v_colour;
+in float v_along;
+uniform vec3 u_light;
+uniform vec3 u_eye;
+out vec4 f_colour;
+void main() {
+    vec3 t = normalize(v_tangent);
+    vec3 view = normalize(u_eye - v_world);
+    vec3 h = normalize(u_light + view);
+    float tl = dot(t, u_light);
+    float th = dot(t, h);
+    float diffuse = sqrt(max(1.0 - tl * tl, 0.0));
+    float specular = pow(sqrt(max(1.0 - th * th, 0.0)), 48.0);
+    float occlusion = 0.6 + 0.4 * v_along;      // the undercoat is in shadow
+    vec3 colour = v_colour * (0.35 + 0.75 * diffuse) * occlusion
+        + vec3(0.30, 0.28, 0.25) * specular * (0.3 + 0.7 * v_along);
+    f_colour = vec4(colour, 1.0);
+}
+"""
 
 
 def strip_indices(strands: int, points: int) -> np.ndarray:

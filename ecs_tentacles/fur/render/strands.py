@@ -1,0 +1,139 @@
+"""Fur in the sandbox's 3D view: guides and child hairs as ribbons, controls as markers.
+
+The fur plugin's render hooks call `fur_lines` (the controls' marker shapes, joined
+into the renderer's line batch while the HUD shows) and `draw_fur` (the strands: one
+draw for the guides, one for the child hairs). The GL objects (`FurStrands`: the
+ribbon program and two ribbon buffers) are made on the first frame with fur and kept
+in the renderer's `view.state`; how fur is drawn (`FurDisplay`, set by the fur panel)
+is kept there too. Reads: `FurData` (guides, controls, sets) through `fur.hooks`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ecs_tentacles.fur.hooks import GuideCurves, child_hairs, guide_curves
+from ecs_tentacles.fur.stores import FurData
+
+if TYPE_CHECKING:
+    from ecs_tentacles.drawing import RenderView
+    from ecs_tentacles.world import World
+
+DISPLAY = "fur.display"  # keys in the renderer's `view.state`
+STRANDS = "fur.strands"
+
+
+@dataclass
+class FurDisplay:
+    """How fur is drawn: colour by fur or by control, guides and/or child hairs."""
+
+    colour_by: str = "fur"
+    guides: bool = True
+    children: bool = True
+    per_guide: int | None = None  # child hairs per guide; None: each fur's `children`
+    follow: str = "neighbours"  # child hairs blend their 3 nearest guides, or "own"
+    child_points: int | None = 3  # points per child hair drawn (level of detail); None: all
+    markers: bool = True  # the controls' shapes, while the sandbox shows its overlays (HUD)
+    selected_control: int | None = None  # a control entity, drawn highlighted
+
+
+def fur_display(state: dict[str, Any]) -> FurDisplay:
+    """The renderer's fur display settings (`renderer.state` / `view.state`)."""
+    display = state.get(DISPLAY)
+    if display is None:
+        display = state[DISPLAY] = FurDisplay()
+    return display
+
+
+def fur_strands(world: World, display: FurDisplay) -> tuple[GuideCurves, GuideCurves]:
+    """This frame's guides and child hairs as `display` asks (empty when hidden)."""
+    fur = world.get_resource(FurData)  # None with the fur plugin off
+    points = max(fur.points, 1) if fur is not None else 1
+    empty = GuideCurves(
+        np.zeros((0, points, 3), np.float32),
+        np.zeros((0, 4), np.float32),
+        np.zeros(0, np.float32),
+        np.zeros(0, np.int64),
+    )
+    if fur is None or not len(fur.guides):
+        return empty, empty
+    guides = guide_curves(world, display.colour_by) if display.guides else empty
+    if not display.children:
+        return guides, empty
+    dense = child_hairs(
+        world, display.per_guide, follow=display.follow, points=display.child_points
+    )
+    if display.colour_by == "control":
+        jitter = dense.colour[:, :3] / np.maximum(guide_curves(world).colour[dense.guide, :3], 1e-6)
+        dense.colour = guide_curves(world, "control").colour[dense.guide]
+        dense.colour[:, :3] *= jitter
+    return guides, dense
+
+
+def fur_lines(world: World, view: RenderView) -> list[np.ndarray]:
+    """The controls' marker shapes (line-list vertices) while the sandbox shows overlays."""
+    from ecs_tentacles.fur.render.markers import marker_lines
+
+    fur = world.get_resource(FurData)
+    display = fur_display(view.state)
+    if fur is None or not len(fur.guides) or not (display.markers and view.overlays):
+        return []
+    return [marker_lines(world, display.selected_control)]
+
+
+class FurStrands:
+    """The GL side of the strands: the ribbon program, guides and child hairs."""
+
+    def __init__(self) -> None:
+        from ecs_tentacles.fur.render.ribbons import RIBBON_FRAGMENT, RIBBON_VERTEX, Ribbons
+        from ecs_tentacles.render.gpu import program
+
+        self.program = program(RIBBON_VERTEX, RIBBON_FRAGMENT)
+        self.guides = Ribbons()
+        self.children = Ribbons()
+
+    def update(self, world: World, display: FurDisplay) -> None:
+        """Upload this frame's strands as `display` asks."""
+        guides, children = fur_strands(world, display)
+        self.guides.update(guides)
+        self.children.update(children)
+
+    def draw(self, view: RenderView) -> int:
+        """Guides and child hairs as uploaded: one draw each, both faces (ribbons)."""
+        if not (self.guides.count or self.children.count):
+            return 0
+        from pyglet import gl
+
+        from ecs_tentacles.render.gpu import set_matrix
+
+        prog = self.program
+        prog.use()
+        set_matrix(prog, "u_view_projection", view.view_projection)
+        prog["u_light"] = tuple(np.asarray(view.light, np.float32))
+        prog["u_eye"] = tuple(np.asarray(view.eye, np.float32))
+        prog["u_min_width"] = float(0.8 * view.pixel)  # about a pixel at the target's distance
+        gl.glDisable(gl.GL_CULL_FACE)
+        calls = self.guides.draw() + self.children.draw()
+        gl.glEnable(gl.GL_CULL_FACE)
+        return calls
+
+
+def strands_of(state: dict[str, Any]) -> FurStrands:
+    """The renderer's `FurStrands`, made on first use (needs the renderer's GL context)."""
+    strands = state.get(STRANDS)
+    if strands is None:
+        strands = state[STRANDS] = FurStrands()
+    return strands
+
+
+def draw_fur(world: World, view: RenderView) -> int:
+    """Upload and draw this frame's strands; the draw calls (none without fur)."""
+    fur = world.get_resource(FurData)
+    if (fur is None or not len(fur.guides)) and STRANDS not in view.state:
+        return 0  # no fur, and no GL objects made for it
+    strands = strands_of(view.state)
+    strands.update(world, fur_display(view.state))
+    return strands.draw(view)

@@ -1,0 +1,190 @@
+"""Locomotion's HUD sections: tune the selected creature's tentacles, see their actions.
+
+"Locomotion" (first in the panel) has a slider for each parameter the scene schema
+marks with one (`ecs_tentacles.scene.parameters`: speed, target angle, strength, wave
+amplitude and frequency), over its range and with its label and units (strength stops
+where the servos' damping can hold it), the gait's choices, and a tentacle selector
+("all" or one tentacle; tab steps it too). Every change goes through
+`world.resource(Locomotion).set`, the same API scripts use, so it reaches the servos
+on the next physics step. "Actions" (last, folded) lists each tentacle's action.
+The locomotion plugin's `sandbox_panels` hook makes both. Reads and writes the
+parameters through `Locomotion`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from imgui_bundle import imgui
+
+from ecs_tentacles.drawing import Panel
+from ecs_tentacles.locomotion.params import Locomotion, settable
+from ecs_tentacles.render.gui import Gui, same_line_if_fits, text_width
+from ecs_tentacles.scene.parameters import Parameter, parameter
+
+
+@dataclass(frozen=True)
+class Knob:
+    """A slider for one parameter of the table, shown in the scene's units.
+
+    The parameter's range (the scene schema's, the API's too) bounds the slider; `log`
+    sliders give the low end, where the defaults sit, more room. An open lower bound
+    (speed > 0) starts a thousandth of the span above it.
+    """
+
+    parameter: Parameter
+
+    @property
+    def name(self) -> str:
+        return self.parameter.api
+
+    @property
+    def label(self) -> str:
+        return self.parameter.label
+
+    @property
+    def unit(self) -> str:
+        """The slider's printf format: the slider's digits, then the scene's units."""
+        p = self.parameter
+        assert p.slider is not None
+        return f"%.{p.slider.digits}f" + (f" {p.units}" if p.units else "")
+
+    @property
+    def to_shown(self) -> float:
+        """Shown value = stored value x this (degrees for radians)."""
+        return 1.0 / self.parameter.factor
+
+    @property
+    def log(self) -> bool:
+        return bool(self.parameter.slider and self.parameter.slider.log)
+
+    @property
+    def low(self) -> float:
+        allowed = self.parameter.range
+        assert allowed is not None
+        low = allowed.low + (1e-3 * (allowed.high - allowed.low) if allowed.low_open else 0.0)
+        return low * self.to_shown
+
+    @property
+    def high(self) -> float:
+        assert self.parameter.range is not None
+        return self.parameter.range.high * self.to_shown
+
+
+def knobs() -> tuple[Knob, ...]:
+    """A slider per run-time tentacle parameter with a `slider` entry, in its order."""
+    marked = [p for p in settable()[0].values() if p.slider is not None]
+    return tuple(Knob(p) for p in sorted(marked, key=lambda p: p.slider.order if p.slider else 0))
+
+
+KNOBS = knobs()
+
+
+def locomotion_panels(sandbox: Any) -> list[Panel]:
+    """The Locomotion and Actions sections for a sandbox."""
+    return [LocomotionPanel(sandbox), ActionsPanel(sandbox)]
+
+
+class LocomotionPanel(Panel):
+    """The selection's tentacle parameters as sliders, bound to `Locomotion`."""
+
+    title = "Locomotion"
+    order = -10  # before the sandbox's own sections
+
+    def __init__(self, sandbox: Any):
+        self.sandbox = sandbox  # its world and HUD (the tentacle selector steps the HUD's)
+        self.creature: int | None = None
+        self.tentacle: int | None = None  # None: all tentacles
+        self.values: dict[str, Any] = {}
+
+    @property
+    def world(self) -> Any:
+        return self.sandbox.world
+
+    def select(self, creature: int | None, tentacle: int | None) -> None:
+        self.creature, self.tentacle = creature, tentacle
+        self.refresh()
+
+    def set_parameter(self, name: str, value: float | str) -> None:
+        """Apply a parameter to the selection through the locomotion API."""
+        if self.creature is None:
+            return
+        if name not in settable()[0]:  # creature-wide (the gait)
+            self.world.resource(Locomotion).set(self.creature, **{name: value})
+        else:
+            self.world.resource(Locomotion).set(
+                self.creature, tentacle=self.tentacle, **{name: float(value)}
+            )
+        self.refresh()
+
+    def refresh(self) -> None:
+        """Read the selection's current values from the world."""
+        if self.creature is None or not self.world.has_resource(Locomotion):
+            self.values = {}
+            return
+        values = self.world.resource(Locomotion).get(self.creature, self.tentacle or 0)
+        if self.tentacle is None:
+            values["speed"] = values["creature_speed"]
+        self.values = values
+
+    def draw(self, gui: Gui) -> None:
+        if self.creature is None:
+            return
+        if imgui.arrow_button("##previous", imgui.Dir.left):
+            self.sandbox.hud.step_tentacle(-1)
+        gui.item("previous")
+        imgui.same_line()
+        if imgui.arrow_button("##next", imgui.Dir.right):
+            self.sandbox.hud.step_tentacle(1)
+        gui.item("next")
+        imgui.same_line()
+        imgui.text("all tentacles" if self.tentacle is None else f"tentacle {self.tentacle}")
+        gui.item("tentacle")
+        for knob in KNOBS:
+            imgui.text(knob.label)
+            gui.item(f"{knob.name} label")
+            imgui.set_next_item_width(-1.0)
+            shown = float(self.values[knob.name]) * knob.to_shown
+            high = knob.high
+            if knob.name == "strength":  # no stronger than the servos' damping holds
+                high = self.world.resource(Locomotion).strength_limit(self.creature, self.tentacle)
+            flags = imgui.SliderFlags_.logarithmic.value if knob.log else 0
+            changed, shown = imgui.slider_float(
+                f"##{knob.name}", shown, knob.low, high, knob.unit, flags
+            )
+            gui.item(knob.name)
+            if changed:
+                self.set_parameter(knob.name, min(shown, high) / knob.to_shown)
+        gaits = parameter("locomotion", "gait")
+        imgui.text(gaits.label)
+        gui.item("gait label")
+        for i, gait in enumerate(gaits.choices):
+            if i:
+                same_line_if_fits(text_width(gait))
+            if imgui.radio_button(gait, self.values["gait"] == gait):
+                self.set_parameter("gait", gait)
+            gui.item(f"gait {gait}")
+
+
+class ActionsPanel(Panel):
+    """Each tentacle's current action, for the selected creature."""
+
+    title = "Actions"
+    order = 90  # after every other section
+    closed = True
+
+    def __init__(self, sandbox: Any):
+        self.sandbox = sandbox
+        self.creature: int | None = None
+
+    def select(self, creature: int | None, tentacle: int | None) -> None:
+        self.creature = creature
+
+    def draw(self, gui: Gui) -> None:
+        if self.creature is None:
+            return
+        world = self.sandbox.world
+        for k, action in enumerate(world.resource(Locomotion).actions(self.creature)):
+            imgui.text(f"t{k}: {action}")
+            gui.item(f"action {k}")

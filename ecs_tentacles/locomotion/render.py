@@ -1,0 +1,118 @@
+"""Locomotion in the sandbox: goal rings and paths drawn, goals set and removed by clicks.
+
+The locomotion plugin's sandbox hooks call these. Each creature's path is a ring and
+a short post at every goal and the legs between them, in a light tint of the
+creature's colour, plus the leg from the creature to its current goal, which moves
+with it. The rings and legs between goals are rebuilt only when a goal changes
+(`GoalBook.version`); the moving legs are one vectorised pass a frame.
+
+Mouse (`sandbox_click`): a left click on the ground sets the selected creature's goal,
+shift-click appends one to its path, a right click inside a goal's ring removes it.
+Reads: `GoalBook` (paths, positions), `Goal` radii, the Transform store.
+Writes: goals, through `GoalBook`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ecs_tentacles.components import Creature, Transform
+from ecs_tentacles.drawing import CIRCLE, Click, RenderView, line_segments
+from ecs_tentacles.locomotion.components import Goal
+from ecs_tentacles.locomotion.goals import GoalBook
+
+if TYPE_CHECKING:
+    from ecs_tentacles.world import World
+
+GOALS = "locomotion.goals"  # the key of the cached geometry in the renderer's state
+LIFT = 0.005  # metres above the ground the lines are drawn
+
+
+@dataclass
+class GoalLines:
+    """Rings, posts and legs between goals of one world at one `GoalBook.version`."""
+
+    world: World
+    version: int
+    fixed: np.ndarray  # line-list vertices (2n, 7)
+    leader_rows: np.ndarray  # Transform rows of the creatures that have a goal
+    leader_ends: np.ndarray  # (n, 3) their current goals
+    leader_colours: np.ndarray  # (n, 4)
+
+
+def goal_lines(world: World, view: RenderView) -> GoalLines:
+    """Every path's fixed geometry, from the goal book as it is now."""
+    book = world.resource(GoalBook)
+    fixed: list[np.ndarray] = []
+    leaders, firsts, colours = [], [], []
+    for entity in view.creatures:
+        goals = book.path(entity)
+        if not goals:
+            continue
+        colour = np.append(view.colours[entity] * 0.6 + 0.4, 1.0)
+        points = book.positions(entity) + [0, 0, LIFT]
+        fixed.append(line_segments(points, colour))
+        for goal, point in zip(goals, points, strict=True):
+            radius = world.component(goal, Goal).radius
+            fixed.append(line_segments(point + radius * CIRCLE, colour))
+            fixed.append(line_segments(np.array([point, point + [0, 0, 0.3]]), colour))
+        leaders.append(world.component(entity, Transform).row)
+        firsts.append(points[0])
+        colours.append(colour)
+    return GoalLines(
+        world,
+        int(book.version),
+        np.vstack(fixed) if fixed else np.zeros((0, 7)),
+        np.array(leaders, dtype=np.int64),
+        np.array(firsts).reshape(-1, 3),
+        np.array(colours).reshape(-1, 4),
+    )
+
+
+def path_lines(world: World, view: RenderView) -> list[np.ndarray]:
+    """This frame's goal rings and paths (line-list vertices), the fixed part cached."""
+    cached = view.state.get(GOALS)
+    version = int(world.resource(GoalBook).version)
+    if not isinstance(cached, GoalLines) or cached.world is not world or cached.version != version:
+        cached = view.state[GOALS] = goal_lines(world, view)
+    # each creature's leg to its current goal moves with it: one vectorised pass
+    leaders = np.empty((2 * len(cached.leader_rows), 7))
+    leaders[0::2, :3] = view.pos[cached.leader_rows] * [1, 1, 0] + [0, 0, LIFT]
+    leaders[1::2, :3] = cached.leader_ends
+    leaders[:, 3:] = np.repeat(cached.leader_colours, 2, axis=0)
+    return [cached.fixed, leaders]
+
+
+def goal_points(world: World) -> np.ndarray:
+    """Every goal's position (n, 3), for the camera's "frame all"."""
+    book = world.resource(GoalBook)
+    paths = [book.positions(entity) for entity, _ in world.query(Creature)]
+    return np.vstack(paths) if paths else np.zeros((0, 3))
+
+
+def remove_goal_at(world: World, point: np.ndarray) -> int | None:
+    """Remove the goal whose ring contains `point` (the nearest one); its entity."""
+    best, best_distance = None, np.inf
+    for entity, goal in world.query(Goal):
+        distance = float(np.linalg.norm(goal.position[:2] - point[:2]))
+        if distance <= goal.radius and distance < best_distance:
+            best, best_distance = entity, distance
+    if best is not None:
+        world.resource(GoalBook).remove(best)
+    return best
+
+
+def click_goal(world: World, click: Click) -> bool:
+    """Set (left), append (shift-left) or remove (right) a goal; True if the click was one."""
+    if click.ground is None:
+        return False
+    if click.button == "left" and click.creature is None and click.selected is not None:
+        book = world.resource(GoalBook)
+        (book.append if click.shift else book.set)(click.selected, click.ground[:2].tolist())
+        return True
+    if click.button == "right":
+        return remove_goal_at(world, click.ground) is not None
+    return False

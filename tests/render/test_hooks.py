@@ -1,0 +1,149 @@
+"""The sandbox's plugin hooks: a user's plugin draws, adds a HUD section and takes clicks;
+the sandbox runs with the fur and locomotion plugins off."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from pyglet.window import mouse
+
+from tests.render.conftest import event
+
+BEACON = '''
+"""A user's plugin that draws through every sandbox hook."""
+import numpy as np
+from pyglet import gl
+
+from ecs_tentacles.drawing import Panel, line_segments
+from ecs_tentacles.plugin import Marker, Plugin
+
+SPHERE = (0.0, -1.0, 0.3)
+LINE = ((-1.5, 1.0, 0.02), (1.5, 1.0, 0.02))
+FAR = (4.0, 4.0, 0.0)
+
+
+class BeaconPanel(Panel):
+    title = "Beacon"
+
+    def draw(self, gui):
+        from imgui_bundle import imgui
+
+        imgui.text("beacon on")
+        gui.item("beacon text")
+
+
+class BeaconPlugin(Plugin):
+    name = "beacon"
+
+    def __init__(self, config=None):
+        super().__init__(config)
+        self.clicks = []
+
+    def render_spheres(self, world):
+        return [Marker(np.array([SPHERE]), (0.25, 0.25, 0.25), (1.0, 0.0, 1.0, 1.0))]
+
+    def render_lines(self, world, view):
+        return [line_segments(np.array(LINE), np.array([0.0, 1.0, 0.0, 1.0]))]
+
+    def render_draw(self, world, view):
+        view.state["beacon.frames"] = view.state.get("beacon.frames", 0) + 1
+        gl.glEnable(gl.GL_SCISSOR_TEST)  # a cyan square in the bottom-left corner
+        gl.glScissor(0, 0, 12, 12)
+        gl.glClearColor(0.0, 1.0, 1.0, 1.0)
+        gl.glClear(gl.GL_COLOR_BUFFER_BIT)
+        gl.glDisable(gl.GL_SCISSOR_TEST)
+        return 1
+
+    def render_points(self, world):
+        return np.array([FAR])
+
+    def sandbox_panels(self, sandbox):
+        return [BeaconPanel()]
+
+    def sandbox_click(self, world, click):
+        self.clicks.append(click)
+        return True
+'''
+
+
+def _beacon_scene(tmp_path: Path) -> Path:
+    (tmp_path / "beacon.py").write_text(BEACON)
+    scene = {
+        "version": 1,
+        "plugins": {"beacon": {"from": "beacon.py"}},
+        "creatures": [{"name": "octo", "tentacles": {"count": 6, "links": 6}}],
+    }
+    path = tmp_path / "beacon_scene.json"
+    path.write_text(json.dumps(scene))
+    return path
+
+
+def _near(pixels: np.ndarray, x: float, y: float, rgb: tuple[int, int, int], reach: int) -> bool:
+    """A pixel within `reach` of pyglet pixel (x, y) has about colour `rgb`."""
+    row, col = pixels.shape[0] - round(y), round(x)
+    patch = pixels[max(row - reach, 0) : row + reach + 1, max(col - reach, 0) : col + reach + 1]
+    return bool((np.abs(patch.astype(int) - rgb).max(axis=2) < 40).any())
+
+
+def test_a_user_plugin_draws_adds_a_panel_and_takes_clicks(
+    make_sandbox: Callable[..., Any], tmp_path: Path
+) -> None:
+    sandbox = make_sandbox(_beacon_scene(tmp_path), allow_systems=True)
+    beacon = next(p for p in sandbox.world.plugins if p.key == "beacon")
+    module = __import__(type(beacon).__module__, fromlist=["SPHERE"])
+    camera = sandbox.renderer.camera
+    x, y = camera.project(np.array([module.FAR]))[0]  # "frame all" kept it in view
+    assert sandbox.hud.width < x < 640 and 0 < y < 360
+
+    sandbox.step(2)
+    sandbox.render()
+    assert {"Beacon", "beacon text"} <= set(sandbox.hud.gui.rects)  # its HUD section
+    sandbox.hud.visible = False
+    calls = sandbox.renderer.draw()
+    assert calls == 7 + 1  # the renderer's own (skinned view) and the plugin's
+    pixels = sandbox.renderer.target.read()
+    assert tuple(pixels[-3, 3]) == (0, 255, 255)  # its own GL drawing, bottom left
+    sx, sy = camera.project(np.array([module.SPHERE]))[0]
+    r, g, b = pixels[360 - round(sy), round(sx)].astype(int)
+    assert r > g + 80 and b > g + 80  # the magenta sphere, lit
+    middle = np.mean(module.LINE, axis=0)
+    lx, ly = camera.project(middle[None])[0]
+    assert _near(pixels, lx, ly, (0, 255, 0), reach=2)  # the green line
+    assert sandbox.renderer.state["beacon.frames"] >= 2  # kept across frames
+
+    ground = np.array([-1.5, -1.5, 0.0])  # no goal there: locomotion leaves it alone
+    gx, gy = camera.project(ground[None])[0]
+    event(sandbox, "on_mouse_press", round(gx), round(gy), mouse.RIGHT, 0)
+    event(sandbox, "on_mouse_release", round(gx), round(gy), mouse.RIGHT, 0)
+    (click,) = beacon.clicks
+    assert click.button == "right" and click.creature is None
+    assert np.linalg.norm(click.ground - ground) < 0.02
+    assert click.selected == sandbox.world.creature("octo")
+
+
+def test_the_sandbox_runs_with_fur_and_locomotion_off(
+    make_sandbox: Callable[..., Any], tmp_path: Path
+) -> None:
+    off = {"locomotion": False, "suckers": False, "fur": False}
+    scene = {"version": 1, "plugins": off, "creatures": [{"name": "still"}]}
+    sandbox = make_sandbox(scene)
+    assert [p.key for p in sandbox.world.plugins] == ["threats", "render"]
+    x, y = sandbox.renderer.camera.project(np.array([[1.0, 0.5, 0.0]]))[0]
+    for button in (mouse.LEFT, mouse.RIGHT):  # clicks nobody takes do nothing
+        event(sandbox, "on_mouse_press", round(x), round(y), button, 0)
+        event(sandbox, "on_mouse_release", round(x), round(y), button, 0)
+    result = sandbox.run_headless(5, screenshot=tmp_path / "off.png", progress=False)
+    assert Path(result["screenshot"]).stat().st_size > 1000
+    rects = sandbox.hud.gui.rects
+    assert {"Stats", "Physics", "Plugins"} <= set(rects)
+    assert not {"Locomotion", "Actions", "Fur"} & set(rects)
+    assert sandbox.renderer.draw_calls == 7  # ground, 4 meshes, skinned, lines
+    pixels = sandbox.renderer.target.read().astype(int)
+    top = sandbox.world.transforms.pos[sandbox.renderer.mantle_rows[0]]
+    mx, my = sandbox.renderer.camera.project(top[None])[0]
+    r, g, b = pixels[360 - round(my), round(mx)]
+    assert r > g + 60 and r > b + 60  # the creature is drawn
