@@ -4,6 +4,7 @@ Scene keys: a creature's `goals` and `locomotion` (`locomotion.schema.json` besi
 Resources: `GoalBook` (goal paths) and `Locomotion` (parameters at run time), by type:
 `world.resource(GoalBook)`.
 Systems: goals, tentacle_selection (stage decide), action_queue, motor_targets (act).
+Hook: `wants_motion` (creatures with a goal stay awake).
 """
 
 from __future__ import annotations
@@ -22,6 +23,8 @@ from ecs_tentacles.scene.validate import fragment
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
+    import numpy as np
+
     from ecs_tentacles.world import World
 
 _FRAGMENT = fragment("ecs_tentacles.locomotion", "locomotion")
@@ -55,6 +58,10 @@ class LocomotionPlugin(Plugin):
         from ecs_tentacles.systems.locomotion.tentacle_selection import TentacleSelection
 
         return [Goals(), TentacleSelection(), ActionQueueSystem(), MotorTargets()]
+
+    def wants_motion(self, world: World) -> np.ndarray:
+        """Creatures with a goal crawl: they never fall asleep."""
+        return world.creatures.has_goal
 
     def snapshot(self, world: World) -> Any:
         goals = {

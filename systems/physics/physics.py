@@ -1,17 +1,20 @@
 """physics: steps MuJoCo one frame.
 
-Reads: Motor store (target, strength, damping, max_torque), Sucker store (attached,
-anchor), Transform store (where other creatures are). Writes, in every physics group:
-MjData (ctrl, eq_active, contact proxies' mocap poses), MjModel servo gains, sucker
-anchors and proxy sizes; puts still, idle creatures to sleep (`physics.sleep`) and
-wakes the others; then advances `world.settings.substeps` steps, the awake groups in
-parallel. Systems that override
-`System.substep` run before every substep, in schedule order.
+Reads: Motor store (target, strength, damping, max_torque, gain), Sucker store
+(attached, anchor), Transform store (pos, quat: where other creatures are), and which
+creatures the plugins want to move (`Plugin.wants_motion`). Writes, in every physics
+group: MjData (ctrl, eq_active, contact proxies' mocap poses), MjModel servo gains,
+sucker anchors and proxy sizes; puts still, idle creatures to sleep (`physics.sleep`)
+and wakes the others; then advances `world.settings.substeps` steps, the awake groups
+in parallel. Systems that override `System.substep` run before every substep, in
+schedule order.
 """
 
 from __future__ import annotations
 
 from typing import TYPE_CHECKING
+
+import numpy as np
 
 from ecs_tentacles.system import System, SystemFailure
 
@@ -25,7 +28,17 @@ PROXY_ROUNDS = 4  # parts a frame is stepped in while creatures touch (proxies c
 class Physics(System):
     name = "physics"
     stage = "physics"
-    reads = ("motors.target", "motors.gain", "suckers.attached", "suckers.anchor")
+    reads = (
+        "motors.target",
+        "motors.strength",
+        "motors.damping",
+        "motors.max_torque",
+        "motors.gain",
+        "suckers.attached",
+        "suckers.anchor",
+        "transforms.pos",
+        "transforms.quat",
+    )
     writes = ("physics",)
 
     def process(self, world: World, dt: float) -> None:
@@ -33,7 +46,7 @@ class Physics(System):
         backend.write_controls(world.motors)
         backend.write_suckers(world.suckers)
         backend.proxies.update(world.transforms)
-        backend.sleep.update(world)
+        backend.sleep.update(world, wanted_motion(world))
         hooks = world.schedule.substep_systems()
         if not hooks:
             proxies = backend.proxies
@@ -59,3 +72,17 @@ class Physics(System):
                     raise SystemFailure(system, label, world.frame, error) from error
 
         backend.step(world.settings.substeps, before_substep)
+
+
+def wanted_motion(world: World) -> np.ndarray | None:
+    """Creatures (bool per CreatureStore row) some plugin wants to move, or None for none.
+
+    The answers of every plugin's `wants_motion` hook, or-ed; one array operation per
+    plugin that answers.
+    """
+    wanted: np.ndarray | None = None
+    for plugin in world.plugins:
+        answer = plugin.wants_motion(world)
+        if answer is not None:
+            wanted = answer if wanted is None else wanted | answer
+    return wanted

@@ -33,9 +33,9 @@ def test_a_still_idle_creature_sleeps_and_a_goal_wakes_it(
     assert rest.sleeping and not busy.sleeping  # the writhing one never sleeps
     assert world.physics.sleep.asleep == 1
     assert json.dumps({"asleep": world.physics.sleep.asleep}) == '{"asleep": 1}'  # bench JSON
-    state = rest.get_state()
+    state = rest.integration_state()
     world.step(30)
-    assert_array_equal(rest.get_state(), state)  # not stepped at all
+    assert_array_equal(rest.integration_state(), state)  # not stepped at all
     start = world.transforms.pos[rest.body_rows[0]].copy()
     world.resource(GoalBook).set(world.creature("rest"), [1.0, 0.0])
     world.step(1)
