@@ -4,8 +4,8 @@ Core is the World, its Schedule and the physics. Everything else (locomotion,
 suckers, fur, threats, recording, the sandbox's drawing, users' behaviours) is a
 `Plugin`: a schema fragment (creature-level and scene-level keys, and the schema of
 its own `plugins.<name>` config), a per-creature build hook, its stores (world
-resources), its systems at a named stage, its validation, and optional render and
-export hooks. A scene turns plugins on and configures them:
+resources), its systems at a named stage, its validation, and optional render,
+export and motion hooks. A scene turns plugins on and configures them:
 
     "plugins": {"wander": {"radius": 2.0}, "fur": false, "mine": {"from": "mine.py"}}
 
@@ -40,6 +40,8 @@ from typing import TYPE_CHECKING, Any, ClassVar
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
+    import numpy as np
+
     from ecs_tentacles.drawing import Click, Panel, RenderView
     from ecs_tentacles.store import ArrayStore
     from ecs_tentacles.world import World
@@ -90,6 +92,9 @@ class Plugin:
     name: ClassVar[str] = ""
     description: ClassVar[str] = ""
     requires: ClassVar[tuple[str, ...]] = ()  # plugins that must be on too
+    # store columns this plugin's hooks read when a generic system calls them
+    # (`wants_motion`, take and render hooks): they count as that system's reads
+    hook_reads: ClassVar[tuple[str, ...]] = ()
     # JSON Schema of this plugin's `plugins.<name>` config (defaults are filled in)
     config_schema: ClassVar[dict[str, Any]] = {"type": "object", "additionalProperties": False}
     creature_schema: ClassVar[dict[str, Any]] = {}  # creature key -> its schema
@@ -173,6 +178,13 @@ class Plugin:
 
     def export_curves(self, world: World) -> GuideFrame | None:
         """Curves a take records each frame (fur guides), or None."""
+        return None
+
+    def wants_motion(self, world: World) -> np.ndarray | None:
+        """Which creatures this plugin wants to move now: bool per CreatureStore row, or
+        None for none. Asked every frame before the physics step; a creature some plugin
+        wants to move never falls asleep (`ecs_tentacles.physics.sleep`). Answer with
+        whole-array math (no per-creature loop); the array is only read."""
         return None
 
     def __repr__(self) -> str:

@@ -159,7 +159,9 @@ class Schedule:
                 "stage": slot.stage,
                 "system": slot.label + ("" if slot.enabled else " (disabled)"),
                 "plugin": slot.system.plugin or "-",
-                "reads": compact(slot.system.reads) or "-",
+                "reads": compact(slot.system.reads)
+                + (" + plugins' hook reads" if slot.system.calls_hooks else "")
+                or "-",
                 "writes": compact(slot.system.writes) or "-",
             }
             for slot in self._ordered

@@ -4,9 +4,9 @@
     world.step(300)
     world.restore(snap)           # back to where it was; stepping again repeats exactly
 
-A snapshot holds every store's live rows, each physics group's integration state
-(`mj_getState`: positions, velocities, warm start, controls, sucker switches, proxy
-poses) and run-time flags, the health check's saved states, what each plugin saves
+A snapshot holds every store's live rows, the physics' own state
+(`PhysicsBackend.state()`: each group's integration state and run-time flags, the
+health check's memory, the sleep counters, the physics clock), what each plugin saves
 (`Plugin.snapshot`: goal paths and action queues, fur stores, threats), the state
 systems declare (`System.state_attributes`), the frame counter and the random
 generator. It lives in
@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 if TYPE_CHECKING:
+    from ecs_tentacles.physics.backend import PhysicsState
     from ecs_tentacles.store import ArrayStore
     from ecs_tentacles.world import World
 
@@ -31,12 +32,9 @@ class Snapshot:
     """Everything `World.restore` needs; opaque to callers."""
 
     frame: int
-    physics_time: float
     rng: dict[str, Any]
     stores: dict[str, tuple[int, dict[str, np.ndarray]]]
-    groups: list[dict[str, Any]]
-    health: dict[str, Any]
-    sleep: tuple[np.ndarray, list[np.ndarray]]
+    physics: PhysicsState
     plugins: dict[str, Any]
     systems: dict[str, dict[str, Any]] = field(default_factory=dict)
 
@@ -47,31 +45,11 @@ def _stores(world: World) -> dict[str, ArrayStore]:
 
 def take(world: World) -> Snapshot:
     """Copy the world's state (see the module docstring)."""
-    physics = world.physics
-    health = physics.health
     return Snapshot(
         frame=world.frame,
-        physics_time=physics.time,
         rng=dict(copy.deepcopy(world.rng.bit_generator.state)),
         stores={name: store.copy_rows() for name, store in _stores(world).items()},
-        groups=[
-            {
-                "state": group.get_state(),
-                "frozen": group.frozen,
-                "sleeping": group.sleeping,
-                "soften": group.soften,
-            }
-            for group in physics.groups
-        ],
-        health=copy.deepcopy(
-            {
-                "state": health.state,
-                "recoveries": health.recoveries,
-                "frozen": health.frozen,
-                "causes": health.causes,
-            }
-        ),
-        sleep=(physics.sleep.still.copy(), [c.copy() for c in physics.sleep.commands]),
+        physics=world.physics.state(),
         plugins={plugin.key: plugin.snapshot(world) for plugin in world.plugins},
         systems={
             system.name: {a: copy.deepcopy(getattr(system, a)) for a in system.state_attributes}
@@ -88,23 +66,7 @@ def restore(world: World, snapshot: Snapshot) -> None:
     for name, store in _stores(world).items():
         if name in snapshot.stores:  # a plugin added since has nothing to go back to
             store.put_rows(snapshot.stores[name])
-    physics = world.physics
-    physics.time = snapshot.physics_time
-    for group, saved in zip(physics.groups, snapshot.groups, strict=True):
-        group.set_state(saved["state"], forward=False)
-        group.frozen, group.sleeping, group.soften = (
-            saved["frozen"], saved["sleeping"], saved["soften"]
-        )  # fmt: skip
-        group.warnings[:] = group.data.warning.number  # counters are not state
-        group.error = None
-    health = copy.deepcopy(snapshot.health)
-    physics.health.state = health["state"]
-    physics.health.recoveries = health["recoveries"]
-    physics.health.frozen = health["frozen"]
-    physics.health.causes = health["causes"]
-    physics.health.previous = world.transforms.pos.copy()  # no jump: speeds start here
-    physics.sleep.still[:] = snapshot.sleep[0]
-    physics.sleep.commands = [c.copy() for c in snapshot.sleep[1]]
+    world.physics.set_state(snapshot.physics)
     for plugin in world.plugins:
         if plugin.key in snapshot.plugins:  # a plugin added since has nothing to go back to
             plugin.restore(world, snapshot.plugins[plugin.key])

@@ -16,7 +16,6 @@ import os
 import pathlib
 import uuid
 from collections.abc import Callable, Collection, Iterator, Mapping
-from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, TypeVar
 
 import esper
@@ -28,6 +27,7 @@ from ecs_tentacles.mathutil import quat_rotate
 from ecs_tentacles.physics.backend import PhysicsBackend
 from ecs_tentacles.plugin import Plugin, SystemsPlugin, scene_first
 from ecs_tentacles.schedule import Schedule
+from ecs_tentacles.settings import Settings as Settings  # re-exported: old imports work
 from ecs_tentacles.store import (
     ArrayStore,
     CreatureStore,
@@ -44,30 +44,6 @@ if TYPE_CHECKING:
 C = TypeVar("C")
 R = TypeVar("R")
 LOCOMOTION_PLUGINS = ("locomotion", "suckers")  # their systems stay out with locomotion=False
-
-
-@dataclass(frozen=True)
-class Settings:
-    """The fixed-step clock and physics constants of a world."""
-
-    fps: float = 60.0
-    substeps: int = 8
-    gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)
-    ground_friction: float = 1.0
-    sucker_timeconst: float = 0.005
-    max_speed: float = 12.0  # m/s: a body faster than this has blown up (physics/health.py)
-    max_penetration: float = 0.05  # m: a contact deeper than this has blown up
-    sleep: bool = True  # still, idle creatures are not stepped (physics/sleep.py)
-
-    @property
-    def dt(self) -> float:
-        """Seconds per frame."""
-        return 1.0 / self.fps
-
-    @property
-    def substep_dt(self) -> float:
-        """Seconds per physics step (the MuJoCo timestep)."""
-        return 1.0 / (self.fps * self.substeps)
 
 
 class World:
@@ -133,9 +109,9 @@ class World:
         shard of a distributed bake); `world.scene` is still the whole scene.
         """
         from ecs_tentacles.build import build_creature
+        from ecs_tentacles.physics.systems import physics_systems
         from ecs_tentacles.scene.errors import SceneError
         from ecs_tentacles.scene.load import load_scene_plugins, resolve_scene_path
-        from ecs_tentacles.systems import core_systems
 
         folder = pathlib.Path(scene_dir) if scene_dir is not None else None
         if not isinstance(source, dict):
@@ -182,7 +158,7 @@ class World:
         for plugin in chosen:
             plugin.build_scene(world, data)
         world.build_physics(threads)
-        systems = core_systems()
+        systems = physics_systems()
         try:
             for plugin in chosen:
                 if locomotion or plugin.key not in LOCOMOTION_PLUGINS:

@@ -12,6 +12,9 @@ act      action_queue        action timers advance; finished actions give way (l
 physics  physics             targets, gains, suckers, contact proxies -> mj_step (core)
 sync     physics_sync        MuJoCo body poses -> Transform store (core)
          physics_health      blow-ups found per creature and recovered (core)
+
+The core systems (`physics/`) are declared by the physics package
+(`ecs_tentacles.physics.systems.physics_systems`) and run in every world.
 animate  threats             path threats follow their keyframes (threats)
          emotion             threats near -> fear -> fur lift and random (fur)
          rig                 fur guides posed from mantle poses and controls (fur)
@@ -21,19 +24,3 @@ output   record              the frame into a take (record; `bake`)
 `examples/` holds example plugins that are not on by default (wander, flee,
 follow_leader, flock); a scene turns them on by name under `plugins`.
 """
-
-from __future__ import annotations
-
-from ecs_tentacles.system import System
-
-
-def core_systems() -> list[System]:
-    """Fresh instances of the core systems (physics, sync, health), in frame order."""
-    from ecs_tentacles.systems.physics.physics import Physics
-    from ecs_tentacles.systems.physics.physics_health import PhysicsHealth
-    from ecs_tentacles.systems.physics.physics_sync import PhysicsSync
-
-    systems: list[System] = [Physics(), PhysicsSync(), PhysicsHealth()]
-    for system in systems:
-        system.plugin = "core"
-    return systems

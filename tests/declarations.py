@@ -61,6 +61,8 @@ def declared_only(world: World, system: System) -> Iterator[None]:
     """While inside, `system` can read what it declares and write what it declares writing."""
     writes, _ = columns(world, system.writes)
     reads, _ = columns(world, system.reads)
+    if system.calls_hooks:  # what the plugins' hooks read, it reads
+        reads |= columns(world, [r for p in world.plugins for r in p.hook_reads])[0]
     readable = reads | writes
     saved = {}
     for name, store in world.stores.items():

@@ -65,6 +65,8 @@ def test_every_declared_name_is_a_store_a_column_or_a_resource(
     for system in world.schedule:
         for names in (system.reads, system.writes):
             assert columns(world, names)[1] == [], system.name
+    for plugin in world.plugins:
+        assert columns(world, plugin.hook_reads)[1] == [], plugin.key
 
 
 def test_undeclared_reads_and_writes_are_caught(make_world: Callable[..., World]) -> None:

@@ -15,7 +15,8 @@ from ecs_tentacles.world import World
 
 
 def _state(world: World) -> list[np.ndarray]:
-    physics = [a for g in world.physics.groups for a in (g.data.qpos, g.data.qvel, g.get_state())]
+    groups = world.physics.groups
+    physics = [a for g in groups for a in (g.data.qpos, g.data.qvel, g.integration_state())]
     stores = [
         world.transforms.pos,
         world.motors.target,

@@ -32,6 +32,8 @@ class FurPlugin(Plugin):
     description = "fur and feathers (lift, aim, direction, random, dynamic blend) and emotion"
     creature_schema = _FRAGMENT["creature"]
     defs = _FRAGMENT["$defs"]
+    # the take's guide curves and the sandbox's strands and markers
+    hook_reads = ("fur.guides", "fur.sets", "fur.controls")
 
     def problems(self, scene: Mapping[str, Any]) -> list[tuple[tuple[str | int, ...], str]]:
         return fur_problems(scene)

@@ -8,7 +8,8 @@ the body's stores; `world.stores` "locomotion.tentacles" / "locomotion.creatures
 target angle, waves, writhe; `tentacles` and its `overrides`).
 Systems: goals, tentacle_selection (stage decide), action_queue, motor_targets (act).
 Sandbox hooks: goal rings and paths, goals set by clicks (`locomotion.render`), the
-Locomotion and Actions sections of the HUD (`locomotion.panel`).
+Locomotion and Actions sections of the HUD (`locomotion.panel`). Hook: `wants_motion`
+(creatures with a goal stay awake).
 """
 
 from __future__ import annotations
@@ -33,6 +34,8 @@ from ecs_tentacles.scene.validate import fragment
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
+    import numpy as np
+
     from ecs_tentacles.drawing import Click, Panel, RenderView
     from ecs_tentacles.store import ArrayStore
     from ecs_tentacles.world import World
@@ -45,6 +48,7 @@ class LocomotionPlugin(Plugin):
     description = "goal-directed crawling: goal paths, gait, action queues, motor targets"
     creature_schema = _FRAGMENT["creature"]
     tentacle_schema = _FRAGMENT["tentacles"]
+    hook_reads = ("locomotion.creatures.has_goal",)  # wants_motion
     defs = _FRAGMENT["$defs"]
 
     def resources(self, world: World) -> list[object]:
@@ -86,6 +90,10 @@ class LocomotionPlugin(Plugin):
         from ecs_tentacles.systems.locomotion.tentacle_selection import TentacleSelection
 
         return [Goals(), TentacleSelection(), ActionQueueSystem(), MotorTargets()]
+
+    def wants_motion(self, world: World) -> np.ndarray:
+        """Creatures with a goal crawl: they never fall asleep."""
+        return world.resource(LocomotionStores).creatures.has_goal
 
     def snapshot(self, world: World) -> Any:
         goals = {

@@ -7,6 +7,11 @@ model (`compiles` counts the compilations). Per frame only array copies run:
 (equality switches and anchors), `step` (`mj_step` x substeps for every active group,
 on a thread pool: MuJoCo releases the GIL) and `sync` (body poses gathered back into
 the Transform store). Systems stay whole-array and never see the groups.
+
+`state()` / `set_state()` copy everything that decides how the physics steps on
+(each group's integration state and flags, the health check's memory, the sleep
+counters, the clock): `ecs_tentacles.snapshot` saves and restores the physics
+through them alone. The backend sees a world as `PhysicsHost` (`physics.host`).
 """
 
 from __future__ import annotations
@@ -23,15 +28,15 @@ import mujoco
 import numpy as np
 
 from ecs_tentacles.components import Creature, Transform
-from ecs_tentacles.physics.group import PhysicsGroup
-from ecs_tentacles.physics.health import PhysicsHealth
-from ecs_tentacles.physics.model import build_spec, creature_layout
+from ecs_tentacles.physics.group import GroupState, PhysicsGroup
+from ecs_tentacles.physics.health import HealthCheck, HealthState
+from ecs_tentacles.physics.model import build_spec, model_layout
 from ecs_tentacles.physics.proxies import ContactProxies
-from ecs_tentacles.physics.sleep import Sleep
+from ecs_tentacles.physics.sleep import Sleep, SleepState
 
 if TYPE_CHECKING:
+    from ecs_tentacles.physics.host import PhysicsHost
     from ecs_tentacles.store import MotorStore, SuckerStore, TransformStore
-    from ecs_tentacles.world import World
 
 log = logging.getLogger("ecs_tentacles.mujoco")
 
@@ -45,10 +50,20 @@ def route_mujoco_messages() -> None:
     mujoco.set_mju_user_warning(_log_mujoco_warning)
 
 
+@dataclass(frozen=True)
+class PhysicsState:
+    """The whole physics between frames (`PhysicsBackend.state()`); opaque to callers."""
+
+    time: float
+    groups: list[GroupState]
+    health: HealthState
+    sleep: SleepState
+
+
 class PhysicsBackend:
     """Every creature's physics group, the thread pool that steps them, and index maps."""
 
-    def __init__(self, world: World, threads: int | None = None):
+    def __init__(self, world: PhysicsHost, threads: int | None = None):
         route_mujoco_messages()
         self.threads = max(1, threads if threads is not None else os.cpu_count() or 1)
         self.compiles = 0
@@ -56,7 +71,7 @@ class PhysicsBackend:
         templates: dict[tuple, mujoco.MjModel] = {}
         self.groups: list[PhysicsGroup] = []
         for entity, (creature, transform) in sorted(world.query(Creature, Transform)):
-            layout = creature_layout(world, creature, transform)
+            layout = model_layout(world, creature, transform)
             template = templates.get(layout.key)
             if template is None:
                 template = templates[layout.key] = build_spec(world, creature).compile()
@@ -68,10 +83,28 @@ class PhysicsBackend:
         for group in self.groups:
             self.group_of_creature_row[group.creature_row] = group.index
         self.proxies = ContactProxies(self.groups)
-        self.health = PhysicsHealth(world, self.groups)
+        self.health = HealthCheck(world, self.groups)
         self.sleep = Sleep(self.groups)
         self.sleep.enabled = world.settings.sleep
         self._pool = ThreadPoolExecutor(self.threads) if self.threads > 1 else None
+
+    # -- state -----------------------------------------------------------------------
+    def state(self) -> PhysicsState:
+        """A copy of the physics' state: restoring it steps on bit-identically."""
+        return PhysicsState(
+            time=self.time,
+            groups=[group.state() for group in self.groups],
+            health=self.health.state(),
+            sleep=self.sleep.state(),
+        )
+
+    def set_state(self, state: PhysicsState) -> None:
+        """Go back to `state()` of this backend (same groups); it stays reusable."""
+        self.time = state.time
+        for group, saved in zip(self.groups, state.groups, strict=True):
+            group.set_state(saved)
+        self.health.set_state(state.health)
+        self.sleep.set_state(state.sleep)
 
     # -- per frame -------------------------------------------------------------------
     def write_controls(self, motors: MotorStore) -> None:

@@ -19,12 +19,12 @@ from ecs_tentacles.mathutil import quat_rotate
 from ecs_tentacles.scene.overlap import segment_distances
 
 if TYPE_CHECKING:
-    from ecs_tentacles.world import World
+    from ecs_tentacles.physics.host import PhysicsHost
 
 SAMPLES = 9  # points along a link tested against a mantle
 
 
-def creature_shapes(world: World, creature_entity: int) -> dict[str, np.ndarray]:
+def creature_shapes(world: PhysicsHost, creature_entity: int) -> dict[str, np.ndarray]:
     """The creature's capsules (start, end, radius) and mantle (centre, axis, radius, half)."""
     creature = world.component(creature_entity, Creature)
     starts, ends, radii = [], [], []
@@ -47,7 +47,7 @@ def creature_shapes(world: World, creature_entity: int) -> dict[str, np.ndarray]
     }
 
 
-def clearance(world: World, a: int, b: int) -> float:
+def clearance(world: PhysicsHost, a: int, b: int) -> float:
     """Smallest gap (metres) between creatures `a` and `b`; negative when they overlap."""
     sa, sb = creature_shapes(world, a), creature_shapes(world, b)
     gaps = [

@@ -9,17 +9,28 @@ rows; the backend scatters controls through them and gathers poses back.
 from __future__ import annotations
 
 import copy
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
 
-from ecs_tentacles.physics.model import PROXY_CAPSULES, PROXY_CYLINDERS, PROXY_PARK, Layout
+from ecs_tentacles.physics.model import PROXY_CAPSULES, PROXY_CYLINDERS, PROXY_PARK, ModelLayout
 
 if TYPE_CHECKING:
     from ecs_tentacles.store import TransformStore
 
 STATE = mujoco.mjtState.mjSTATE_INTEGRATION  # everything mj_step reads, warm start included
+
+
+@dataclass(frozen=True)
+class GroupState:
+    """A group between frames: its MuJoCo integration state and its run-time flags."""
+
+    integration: np.ndarray  # `PhysicsGroup.integration_state()`
+    frozen: bool
+    sleeping: bool
+    soften: float
 
 
 def _ids(model: mujoco.MjModel, kind: mujoco.mjtObj, names: list[str]) -> np.ndarray:
@@ -34,7 +45,7 @@ class PhysicsGroup:
         index: int,
         creature: int,
         creature_row: int,
-        layout: Layout,
+        layout: ModelLayout,
         template: mujoco.MjModel,
         pose: tuple[np.ndarray, np.ndarray],
     ):
@@ -80,14 +91,14 @@ class PhysicsGroup:
         mujoco.mj_forward(self.model, d)
 
     # -- state ---------------------------------------------------------------------
-    def get_state(self) -> np.ndarray:
+    def integration_state(self) -> np.ndarray:
         """The data's integration state (qpos, qvel, warm start, ctrl, eq_active, ...)."""
         state = np.empty(mujoco.mj_stateSize(self.model, STATE))
         mujoco.mj_getState(self.model, self.data, state, STATE)
         return state
 
-    def set_state(self, state: np.ndarray, *, forward: bool = True) -> None:
-        """Restore `get_state()` output; `forward` recomputes poses from it.
+    def set_integration_state(self, state: np.ndarray, *, forward: bool = True) -> None:
+        """Restore `integration_state()` output; `forward` recomputes poses from it.
 
         Without `forward` the derived arrays (poses, contacts) keep what they held:
         the next `mj_step` recomputes them from the state alone.
@@ -95,6 +106,22 @@ class PhysicsGroup:
         mujoco.mj_setState(self.model, self.data, state, STATE)
         if forward:
             mujoco.mj_forward(self.model, self.data)
+
+    def state(self) -> GroupState:
+        """A copy of everything that decides how this group steps on (for snapshots)."""
+        return GroupState(self.integration_state(), self.frozen, self.sleeping, self.soften)
+
+    def set_state(self, state: GroupState) -> None:
+        """Go back to `state()`: bit-identical stepping from there.
+
+        Poses are not recomputed (the Transform store holds them; the next step
+        recomputes the data's). The warning counters restart from the data's and a
+        pending fatal error is dropped: neither is state.
+        """
+        self.set_integration_state(state.integration, forward=False)
+        self.frozen, self.sleeping, self.soften = state.frozen, state.sleeping, state.soften
+        self.warnings[:] = self.data.warning.number
+        self.error = None
 
     def sync(self, transforms: TransformStore) -> None:
         """Copy this group's body poses into the Transform store."""

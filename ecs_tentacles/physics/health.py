@@ -23,6 +23,7 @@ is its own group. No system ever sees a bad pose, so a teleport never reaches a 
 
 from __future__ import annotations
 
+import copy
 import logging
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
@@ -32,7 +33,7 @@ import numpy as np
 
 if TYPE_CHECKING:
     from ecs_tentacles.physics.group import PhysicsGroup
-    from ecs_tentacles.world import World
+    from ecs_tentacles.physics.host import PhysicsHost
 
 log = logging.getLogger("ecs_tentacles.physics")
 
@@ -56,16 +57,27 @@ class GroupHealth:
     failures: list[float] = field(default_factory=list)  # times of recent recoveries
 
 
-class PhysicsHealth:
+@dataclass(frozen=True)
+class HealthState:
+    """The health check between frames (`HealthCheck.state()`), for snapshots."""
+
+    groups: list[GroupHealth]
+    recoveries: int
+    frozen: int
+    causes: dict[str, int]
+    previous: np.ndarray  # last frame's poses
+
+
+class HealthCheck:
     """Checks every group after each step and recovers the ones that failed."""
 
-    def __init__(self, world: World, groups: list[PhysicsGroup]):
+    def __init__(self, world: PhysicsHost, groups: list[PhysicsGroup]):
         self.groups = groups
         self.max_speed = world.settings.max_speed
         self.max_penetration = world.settings.max_penetration
-        self.state = [GroupHealth() for _ in self.groups]
-        for group, health in zip(self.groups, self.state, strict=True):
-            start = group.get_state()
+        self.group_health = [GroupHealth() for _ in self.groups]
+        for group, health in zip(self.groups, self.group_health, strict=True):
+            start = group.integration_state()
             health.saved = [start, start]
         self.recoveries = 0
         self.frozen = 0
@@ -77,12 +89,32 @@ class PhysicsHealth:
         self.start = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
         self.previous = np.zeros((0, 3))  # last frame's poses (set on the first check)
 
-    def check(self, world: World) -> None:
+    # -- state ---------------------------------------------------------------------
+    def state(self) -> HealthState:
+        """A copy of what the check remembers: saved good states, failures, counts, poses."""
+        return HealthState(
+            copy.deepcopy(self.group_health),
+            self.recoveries,
+            self.frozen,
+            dict(self.causes),
+            self.previous.copy(),
+        )
+
+    def set_state(self, state: HealthState) -> None:
+        """Go back to `state()` (copied: one state can be restored many times)."""
+        self.group_health = copy.deepcopy(state.groups)
+        self.recoveries, self.frozen = state.recoveries, state.frozen
+        self.causes = dict(state.causes)
+        self.previous = state.previous.copy()
+
+    # -- per frame -------------------------------------------------------------------
+    def check(self, world: PhysicsHost, physics_time: float) -> None:
         """Check every active group stepped this frame; recover the ones that failed.
 
         Runs right after `physics_sync`: speeds and non-finite poses are read from the
         Transform store as whole arrays; a failing group's rows are put back before any
-        other system reads them.
+        other system reads them. `physics_time` is the physics clock: a recovered
+        group's data is set to it.
         """
         limit = self.max_speed * world.settings.dt
         save = world.frame % SAVE_EVERY == 0
@@ -93,17 +125,17 @@ class PhysicsHealth:
         moved = pos[self.rows] - self.previous[self.rows]
         step = np.einsum("ij,ij->i", moved, moved)  # nan where a pose is not finite
         fastest = np.sqrt(np.maximum.reduceat(step, self.start)) if len(step) else step
-        for group, health in zip(self.groups, self.state, strict=True):
+        for group, health in zip(self.groups, self.group_health, strict=True):
             if not group.active:
                 continue
             cause = self._cause(group, float(fastest[group.index]), limit)
             if cause is not None:
-                self._recover(world, group, health, cause)
+                self._recover(world, group, health, cause, physics_time)
                 continue
             if group.soften < 1.0:
                 group.soften = min(1.0, group.soften + ramp * (1.0 - SOFT_GAIN))
             if save:
-                health.saved = [health.saved[1], group.get_state()]
+                health.saved = [health.saved[1], group.integration_state()]
         self.previous[:] = pos
 
     def _cause(self, group: PhysicsGroup, fastest: float, limit: float) -> str | None:
@@ -128,13 +160,20 @@ class PhysicsHealth:
             return f"penetration {-1000 * d.contact.dist.min():.1f} mm"
         return None
 
-    def _recover(self, world: World, group: PhysicsGroup, health: GroupHealth, cause: str) -> None:
+    def _recover(
+        self,
+        world: PhysicsHost,
+        group: PhysicsGroup,
+        health: GroupHealth,
+        cause: str,
+        physics_time: float,
+    ) -> None:
         now = world.time
         health.failures = [t for t in health.failures if now - t < FREEZE_WINDOW] + [now]
         key = cause.split(" ")[0]
         self.causes[key] = self.causes.get(key, 0) + 1
-        group.set_state(health.saved[0])
-        group.data.time = world.physics.time
+        group.set_integration_state(health.saved[0])
+        group.data.time = physics_time
         group.warnings[:] = group.data.warning.number
         group.warning_total = int(group.warnings.sum())
         group.sync(world.transforms)  # its rows, before any other system reads them

@@ -2,7 +2,7 @@
 
 Every creature is its own physics group (`ecs_tentacles.physics.group`): a model
 holding that creature alone, built at the origin and placed by its free joint, so
-creatures of one morphology share one compiled model (`morphology_key` says which
+creatures of one morphology share one compiled model (`model_layout(...).key` says which
 ones match; the backend compiles each key once and copies the compiled model).
 
 * mantle: a body with a free joint and a cylinder geom (height along +z);
@@ -18,7 +18,7 @@ ones match; the backend compiles each key once and copies the compiled model).
   models push each other (`ecs_tentacles.physics.proxies`). A creature touches the
   ground and the proxies, never itself; proxies touch only the creature.
 
-Element names are the same in every creature's model (`t3/l07/curl`); `Layout`
+Element names are the same in every creature's model (`t3/l07/curl`); `ModelLayout`
 lists, in model order, which store rows they belong to.
 """
 
@@ -34,7 +34,8 @@ from ecs_tentacles.components import Creature, Link, Motor, Sucker, Tentacle, Tr
 from ecs_tentacles.mathutil import quat_about_z
 
 if TYPE_CHECKING:
-    from ecs_tentacles.world import Settings, World
+    from ecs_tentacles.physics.host import PhysicsHost
+    from ecs_tentacles.settings import Settings
 
 AXES = {"curl": (0.0, 1.0, 0.0), "sweep": (0.0, 0.0, 1.0), "twist": (1.0, 0.0, 0.0)}
 AXIS_INDEX = {"curl": 0, "sweep": 1, "twist": 2}
@@ -67,7 +68,7 @@ SUCKER_SOLIMP = [0.97, 0.995, 0.001, 0.5, 2.0]
 
 
 @dataclass
-class Layout:
+class ModelLayout:
     """Which store rows a creature model's elements belong to, in model-building order."""
 
     key: tuple[Any, ...]  # the morphology: equal keys compile to equal models
@@ -80,13 +81,13 @@ class Layout:
     sucker_rows: list[int] = field(default_factory=list)
 
 
-def creature_layout(world: World, creature: Creature, transform: Transform) -> Layout:
-    """The creature's morphology key and its rows, without building anything."""
+def model_layout(world: PhysicsHost, creature: Creature, transform: Transform) -> ModelLayout:
+    """The creature model's morphology key and its elements' store rows, building nothing."""
     key: list[Any] = [
         _settings_key(world.settings),
         (creature.mantle_radius, creature.mantle_height, creature.mantle_density),
     ]
-    layout = Layout(key=())
+    layout = ModelLayout(key=())
     layout.bodies.append("mantle")
     layout.body_rows.append(transform.row)
     for tentacle_entity in creature.tentacles:
@@ -126,7 +127,7 @@ def _hinges(link: Link) -> tuple[str, ...]:
     return ("curl", "sweep", "twist") if link.twist else ("curl", "sweep")
 
 
-def build_spec(world: World, creature: Creature) -> mujoco.MjSpec:
+def build_spec(world: PhysicsHost, creature: Creature) -> mujoco.MjSpec:
     """An MjSpec of `creature` alone, its mantle at the origin, with the proxy pool."""
     settings = world.settings
     spec = mujoco.MjSpec()
@@ -155,7 +156,7 @@ def build_spec(world: World, creature: Creature) -> mujoco.MjSpec:
     return spec
 
 
-def _add_creature(spec: mujoco.MjSpec, world: World, creature: Creature) -> None:
+def _add_creature(spec: mujoco.MjSpec, world: PhysicsHost, creature: Creature) -> None:
     skin = {
         "contype": CREATURE_BIT,
         "conaffinity": GROUND_BIT | PROXY_BIT,

@@ -1,6 +1,7 @@
 """Idle creatures sleep: their group is not stepped until something changes.
 
-A creature falls asleep after `SETTLE_FRAMES` frames in which it had no goal, no
+A creature falls asleep after `SETTLE_FRAMES` frames in which no plugin wanted it to
+move (`Plugin.wants_motion`: the locomotion plugin wants creatures with a goal), no
 other creature near it (no contact proxies in use), no sucker attached, servo
 commands that did not change (targets and gains: no writhing, no waves) and every
 velocity below `STILL_SPEED`. Its state then stays exactly as it was: asleep, it is
@@ -10,17 +11,26 @@ those changes (a goal, a neighbour, a script moving a target), before the step.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 if TYPE_CHECKING:
     from ecs_tentacles.physics.group import PhysicsGroup
-    from ecs_tentacles.world import World
+    from ecs_tentacles.physics.host import PhysicsHost
 
 SETTLE_FRAMES = 30  # frames of stillness before a creature sleeps
 STILL_SPEED = 1e-3  # m/s or rad/s: slower than this counts as still
 COMMAND_CHANGE = 1e-9  # servo targets or gains that moved less than this did not change
+
+
+@dataclass(frozen=True)
+class SleepState:
+    """The sleep counters between frames (`Sleep.state()`), for snapshots."""
+
+    still: np.ndarray  # frames each group has been still
+    commands: list[np.ndarray]  # each group's last servo commands
 
 
 class Sleep:
@@ -37,12 +47,23 @@ class Sleep:
         """Groups asleep now."""
         return int(sum(g.sleeping for g in self.groups))
 
-    def update(self, world: World) -> None:
-        """Put still groups to sleep and wake the ones whose situation changed."""
+    def state(self) -> SleepState:
+        """A copy of the counters and last commands."""
+        return SleepState(self.still.copy(), [c.copy() for c in self.commands])
+
+    def set_state(self, state: SleepState) -> None:
+        """Go back to `state()` (copied: one state can be restored many times)."""
+        self.still[:] = state.still
+        self.commands = [c.copy() for c in state.commands]
+
+    def update(self, world: PhysicsHost, wants_motion: np.ndarray | None) -> None:
+        """Put still groups to sleep and wake the ones whose situation changed.
+
+        `wants_motion` (bool per CreatureStore row, or None for nobody) says which
+        creatures some plugin wants to move (`Plugin.wants_motion`): those never sleep.
+        """
         if not self.enabled:  # nothing ever sleeps: no per-group work
             return
-        gaits: Any = world.stores.get("locomotion.creatures")  # no goals without locomotion
-        has_goal = gaits.has_goal if gaits is not None else np.zeros(len(world.creatures), bool)
         attached = world.suckers.attached
         for group in self.groups:
             if group.frozen:
@@ -51,7 +72,7 @@ class Sleep:
             commands = np.concatenate((d.ctrl, m.actuator_gainprm[:, 0]))
             previous = self.commands[group.index]
             calm = (
-                not has_goal[group.creature_row]
+                (wants_motion is None or not wants_motion[group.creature_row])
                 and not group.proxies_used
                 and not attached[group.sucker_rows].any()
                 and len(previous) == len(commands)

@@ -20,7 +20,7 @@ from pyglet import gl
 from ecs_tentacles.components import Creature, Link, Tentacle, Transform
 from ecs_tentacles.render.gpu import FLOAT, _attribute, _buffer, _upload, _vertex_array
 from ecs_tentacles.skin.mesh import Detail, MeshError, SkinMesh, creature_mesh
-from ecs_tentacles.skin.skeleton import Skeleton, build_skeleton, creature_layout, quat_matrix
+from ecs_tentacles.skin.skeleton import Skeleton, build_skeleton, quat_matrix, skin_layout
 
 if TYPE_CHECKING:
     from ecs_tentacles.world import World
@@ -43,9 +43,7 @@ def world_skeleton(world: World, entity: int) -> Skeleton:
             (tentacle.base_angle, [link.length for link in links], [link.radius for link in links])
         )
         rows.extend(world.component(e, Transform).row for e in tentacle.links)
-    layout = creature_layout(
-        creature.name, creature.mantle_radius, creature.mantle_height, tentacles
-    )
+    layout = skin_layout(creature.name, creature.mantle_radius, creature.mantle_height, tentacles)
     return build_skeleton(layout, np.array(rows))
 
 

@@ -62,8 +62,8 @@ class TentacleLayout:
 
 
 @dataclass(frozen=True)
-class CreatureLayout:
-    """What the mesh builder needs: mantle size and tentacles (mantle frame, metres)."""
+class SkinLayout:
+    """A creature as skinning needs it: mantle size and tentacles (mantle frame, metres)."""
 
     name: str
     mantle_radius: float
@@ -82,7 +82,7 @@ class Skeleton:
     `bind` the world bind matrices (J, 4, 4).
     """
 
-    layout: CreatureLayout
+    layout: SkinLayout
     names: list[str]
     parents: np.ndarray
     bodies: np.ndarray
@@ -121,18 +121,18 @@ def creature_skeleton(take: Take, creature: int) -> Skeleton:
         )
         for chain, angle in zip(chains, tentacle_angles(len(chains)), strict=True)
     ]
-    layout = creature_layout(entry["name"], mantle["radius"], mantle["length"], tentacles)
+    layout = skin_layout(entry["name"], mantle["radius"], mantle["length"], tentacles)
     body_index = [entry["mantle"], *(i for chain in chains for i in chain)]
     pose = (take.quat[0, entry["mantle"]], take.pos[0, entry["mantle"]])
     return build_skeleton(layout, np.array(body_index), *pose)
 
 
-def creature_layout(
+def skin_layout(
     name: str,
     mantle_radius: float,
     mantle_height: float,
     tentacles: list[tuple[float, list[float], list[float]]],
-) -> CreatureLayout:
+) -> SkinLayout:
     """A layout from (azimuth, link lengths, link radii) per tentacle; joints numbered
     mantle first, then tentacle by tentacle, base to tip."""
     made, first = [], 1
@@ -140,11 +140,11 @@ def creature_layout(
         joints = np.arange(first, first + len(lengths))
         made.append(TentacleLayout(angle, np.array(lengths), np.array(radii), joints))
         first += len(lengths)
-    return CreatureLayout(name, float(mantle_radius), float(mantle_height), made)
+    return SkinLayout(name, float(mantle_radius), float(mantle_height), made)
 
 
 def build_skeleton(
-    layout: CreatureLayout,
+    layout: SkinLayout,
     bodies: np.ndarray,
     root_rotation: np.ndarray | None = None,
     root_translation: np.ndarray | None = None,

@@ -1,2 +1,3 @@
-"""The physics systems, scheduled by the physics package (`ecs_tentacles.physics`):
-physics (stage physics), physics_sync, physics_health (stage sync)."""
+"""The physics systems, declared by the physics package
+(`ecs_tentacles.physics.systems.physics_systems`): physics (stage physics),
+physics_sync, physics_health (stage sync)."""

@@ -1,17 +1,20 @@
 """physics: steps MuJoCo one frame.
 
-Reads: Motor store (target, strength, damping, max_torque), Sucker store (attached,
-anchor), Transform store (where other creatures are). Writes, in every physics group:
-MjData (ctrl, eq_active, contact proxies' mocap poses), MjModel servo gains, sucker
-anchors and proxy sizes; puts still, idle creatures to sleep (`physics.sleep`) and
-wakes the others; then advances `world.settings.substeps` steps, the awake groups in
-parallel. Systems that override
-`System.substep` run before every substep, in schedule order.
+Reads: Motor store (target, strength, damping, max_torque, gain), Sucker store
+(attached, anchor), Transform store (pos, quat: where other creatures are), and which
+creatures the plugins want to move (`Plugin.wants_motion`). Writes, in every physics
+group: MjData (ctrl, eq_active, contact proxies' mocap poses), MjModel servo gains,
+sucker anchors and proxy sizes; puts still, idle creatures to sleep (`physics.sleep`)
+and wakes the others; then advances `world.settings.substeps` steps, the awake groups
+in parallel. Systems that override `System.substep` run before every substep, in
+schedule order.
 """
 
 from __future__ import annotations
 
 from typing import TYPE_CHECKING
+
+import numpy as np
 
 from ecs_tentacles.system import System, SystemFailure
 
@@ -27,24 +30,24 @@ class Physics(System):
     stage = "physics"
     reads = (
         "motors.target",
-        "motors.gain",
         "motors.strength",
         "motors.damping",
         "motors.max_torque",
+        "motors.gain",
         "suckers.attached",
         "suckers.anchor",
         "transforms.pos",
         "transforms.quat",
-        "locomotion.creatures.has_goal",  # sleep: a creature with a goal stays awake
     )
     writes = ("physics",)
+    calls_hooks = True  # wants_motion
 
     def process(self, world: World, dt: float) -> None:
         backend = world.physics
         backend.write_controls(world.motors)
         backend.write_suckers(world.suckers)
         backend.proxies.update(world.transforms)
-        backend.sleep.update(world)
+        backend.sleep.update(world, wanted_motion(world))
         hooks = world.schedule.substep_systems()
         if not hooks:
             proxies = backend.proxies
@@ -70,3 +73,17 @@ class Physics(System):
                     raise SystemFailure(system, label, world.frame, error) from error
 
         backend.step(world.settings.substeps, before_substep)
+
+
+def wanted_motion(world: World) -> np.ndarray | None:
+    """Creatures (bool per CreatureStore row) some plugin wants to move, or None for none.
+
+    The answers of every plugin's `wants_motion` hook, or-ed; one array operation per
+    plugin that answers.
+    """
+    wanted: np.ndarray | None = None
+    for plugin in world.plugins:
+        answer = plugin.wants_motion(world)
+        if answer is not None:
+            wanted = answer if wanted is None else wanted | answer
+    return wanted

@@ -1,11 +1,13 @@
 """physics_health: every creature's physics checked after the step; failures recovered.
 
 Reads: each physics group's MjData (warnings, velocities, contacts), the Transform
-store (this frame's poses against last frame's, for speeds and non-finite poses).
+store (this frame's poses against last frame's, for speeds and non-finite poses),
+the Sucker store (attached, entity: which suckers a failing creature holds).
 Writes: the failing group's MjData (restored to its last good state) and its
-Transform rows, Sucker store (its suckers released), events `creature_recovered` /
-`creature_frozen`. Runs right after `physics_sync`, before any system that reads
-poses, so no system sees a blown-up pose (`ecs_tentacles.physics.health`).
+Transform rows (pos, quat), Sucker store (attached: its suckers released), events
+`creature_recovered` / `creature_frozen` / `sucker_released`. Runs right after
+`physics_sync`, before any system that reads poses, so no system sees a blown-up
+pose (`ecs_tentacles.physics.health`).
 """
 
 from __future__ import annotations
@@ -22,8 +24,9 @@ class PhysicsHealth(System):
     name = "physics_health"
     stage = "sync"
     after = ("physics_sync",)
-    reads = ("physics", "transforms.pos")
+    reads = ("physics", "transforms.pos", "suckers.attached", "suckers.entity")
     writes = ("physics", "transforms.pos", "transforms.quat", "suckers.attached")
 
     def process(self, world: World, dt: float) -> None:
-        world.physics.health.check(world)
+        physics = world.physics
+        physics.health.check(world, physics.time)

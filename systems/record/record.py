@@ -27,8 +27,9 @@ class Record(System):
     """Record the world into a take; `record.take()` returns it."""
 
     name = "record"
+    calls_hooks = True  # the plugins' take hooks
     stage = "output"
-    reads = ("transforms", "suckers", "goals", "fur.curves", "fur.guides", "fur.sets")
+    reads = ("transforms", "suckers", "goals")
 
     def __init__(self, every: int = 1, **recorder: Any):
         if every < 1:

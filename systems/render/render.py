@@ -18,6 +18,7 @@ if TYPE_CHECKING:
 
 class RenderSync(System):
     name = "render"
+    calls_hooks = True  # the plugins' drawing hooks
     stage = "output"
     reads = ("transforms.pos", "transforms.quat")
 

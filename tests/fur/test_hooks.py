@@ -1,4 +1,4 @@
-"""Rendering hooks: guide polylines with colour and width, child hairs, controls (and threats)."""
+"""Rendering hooks: guide polylines with colour and width, child hairs, controls."""
 
 from __future__ import annotations
 
@@ -11,7 +11,6 @@ from numpy.testing import assert_allclose, assert_array_equal
 from ecs_tentacles.fur import child_hairs, control_markers, guide_curves
 from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.mathutil import quat_rotate
-from ecs_tentacles.threats.data import ThreatData
 from ecs_tentacles.world import World
 
 SCENE = {
@@ -70,7 +69,7 @@ def test_child_hairs_follow_their_guide(make_world: Callable[..., World]) -> Non
     assert_array_equal(child_hairs(world, seed=2, follow="own").points, again)
 
 
-def test_controls_and_threats(make_world: Callable[..., World]) -> None:
+def test_controls(make_world: Callable[..., World]) -> None:
     world = make_world(SCENE, locomotion=False)
     world.step(1)
     (marker,) = control_markers(world)
@@ -78,9 +77,6 @@ def test_controls_and_threats(make_world: Callable[..., World]) -> None:
     quat = world.transforms.quat[world.resource(FurData).sets.body_row[0]]
     assert (marker.name, marker.shape) == ("a", "cube")
     assert_allclose(marker.position, mantle + quat_rotate(quat, np.array([0, 0, 0.3])))
-    threats = world.resource(ThreatData).positions(world)
-    assert list(threats) == ["roach"]
-    assert_allclose(threats["roach"], [1.0, 2.0, 3.0])
 
 
 def test_a_world_without_fur_gives_empty_arrays(make_world: Callable[..., World]) -> None:
@@ -88,4 +84,4 @@ def test_a_world_without_fur_gives_empty_arrays(make_world: Callable[..., World]
     world.step(1)
     assert guide_curves(world).points.shape[0] == 0
     assert child_hairs(world).points.shape[0] == 0
-    assert control_markers(world) == [] and world.resource(ThreatData).positions(world) == {}
+    assert control_markers(world) == []

@@ -9,8 +9,10 @@ from typing import Any
 import numpy as np
 from numpy.testing import assert_array_equal
 
+from ecs_tentacles.components import Creature
 from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.physics.sleep import SETTLE_FRAMES
+from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.world import World
 
 RESTING = {"count": 3, "links": 5, "wave_amplitude_deg": 0, "writhe": 0}
@@ -33,9 +35,9 @@ def test_a_still_idle_creature_sleeps_and_a_goal_wakes_it(
     assert rest.sleeping and not busy.sleeping  # the writhing one never sleeps
     assert world.physics.sleep.asleep == 1
     assert json.dumps({"asleep": world.physics.sleep.asleep}) == '{"asleep": 1}'  # bench JSON
-    state = rest.get_state()
+    state = rest.integration_state()
     world.step(30)
-    assert_array_equal(rest.get_state(), state)  # not stepped at all
+    assert_array_equal(rest.integration_state(), state)  # not stepped at all
     start = world.transforms.pos[rest.body_rows[0]].copy()
     world.resource(GoalBook).set(world.creature("rest"), [1.0, 0.0])
     world.step(1)
@@ -59,3 +61,44 @@ def test_sleep_can_be_switched_off(make_world: Callable[..., World]) -> None:
     world = make_world(_scene(RESTING, sleep=False))
     world.step(SETTLE_FRAMES + 240)
     assert world.physics.sleep.asleep == 0
+
+
+class KeepAwake(Plugin):
+    """Wants the creature called `name` to move (a user plugin answering the hook)."""
+
+    name = "keep_awake"
+
+    def __init__(self, creature: str) -> None:
+        super().__init__()
+        self.creature = creature
+
+    def wants_motion(self, world: World) -> np.ndarray:
+        row = [c.row for _, c in world.query(Creature) if c.name == self.creature]
+        wanted = np.zeros(len(world.creatures), dtype=bool)
+        wanted[row] = True
+        return wanted
+
+
+class NoOpinion(Plugin):
+    name = "no_opinion"  # wants_motion: None, like every plugin by default
+
+
+def test_a_plugin_that_wants_a_creature_to_move_keeps_it_awake(
+    make_world: Callable[..., World],
+) -> None:
+    world = make_world(_scene(RESTING), locomotion=False)
+    world.add_plugin(KeepAwake("rest"))
+    world.add_plugin(NoOpinion())
+    rest, other = world.physics.groups  # no locomotion: nothing drives either one
+    world.step(240)  # as long as it took to fall asleep above
+    assert not rest.sleeping and other.sleeping
+    assert np.abs(rest.data.qvel).max() < 1e-3  # still, yet stepped: someone wants it
+
+
+def test_with_locomotion_off_no_goal_keeps_anyone_awake(
+    make_world: Callable[..., World],
+) -> None:
+    off = {"locomotion": False, "suckers": False}  # its waves and writhing are keys no more
+    world = make_world(_scene({"count": 3, "links": 5}), plugins=off)
+    world.step(240)
+    assert world.physics.groups[0].sleeping

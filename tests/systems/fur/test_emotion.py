@@ -11,7 +11,6 @@ from numpy.testing import assert_allclose
 
 from ecs_tentacles.fur import Emotion
 from ecs_tentacles.fur.stores import FurData
-from ecs_tentacles.threats.data import ThreatData
 from ecs_tentacles.world import World
 
 FAR, NEAR = [5.0, 0.0, 0.1], [0.5, 0.0, 0.1]
@@ -112,12 +111,3 @@ def test_a_creature_marked_threat_frightens_others_not_itself(
     e = world.resource(FurData).emotions
     assert list(e.threatened) == [True, False, False]
     assert e.level[0] > 0.5 and e.level[1] == 0.0 and e.level[2] == 0.0
-
-
-def test_threats_follow_their_paths_without_any_emotion(make_world: Callable[..., World]) -> None:
-    data = scene(0.0)
-    del data["creatures"][0]["emotion"]
-    world = make_world(data, locomotion=False)
-    world.step(61)
-    assert_allclose(world.resource(ThreatData).store.pos[0], NEAR)
-    assert len(world.resource(FurData).emotions) == 0

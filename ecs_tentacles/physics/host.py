@@ -1,0 +1,56 @@
+"""What the physics package needs of a world, and nothing more.
+
+The physics (model building, groups, health check, sleep) is written against this
+`typing.Protocol`, not against `ecs_tentacles.world.World`: the World satisfies it
+structurally, and the physics package never imports the module that builds on it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from typing import Any, Protocol, TypeVar
+
+from ecs_tentacles.events import Events
+from ecs_tentacles.settings import Settings
+from ecs_tentacles.store import CreatureStore, SuckerStore, TransformStore
+
+C = TypeVar("C")
+
+
+class PhysicsHost(Protocol):
+    """A world as the physics sees it: settings, clock, core stores, entities, events."""
+
+    @property
+    def settings(self) -> Settings: ...
+
+    @property
+    def frame(self) -> int:
+        """Frames stepped so far."""
+
+    @property
+    def time(self) -> float:
+        """Simulated seconds since the start."""
+
+    @property
+    def transforms(self) -> TransformStore: ...
+
+    @property
+    def suckers(self) -> SuckerStore: ...
+
+    @property
+    def creatures(self) -> CreatureStore: ...
+
+    @property
+    def events(self) -> Events: ...
+
+    def component(self, entity: int, kind: type[C]) -> C:
+        """The `kind` component of `entity`."""
+
+    def query(self, *kinds: type) -> Iterator[tuple[int, Any]]:
+        """(entity, component(s)) for the entities having all `kinds`."""
+
+    def creature_name(self, entity: int) -> str:
+        """The name of creature `entity`."""
+
+    def release(self, sucker_entity: int, reason: str = "command") -> None:
+        """Let a sucker go (fires `sucker_released`)."""
