@@ -4,6 +4,8 @@ Scene keys: a creature's `goals` and `locomotion` (`locomotion.schema.json` besi
 Resources: `GoalBook` (goal paths) and `Locomotion` (parameters at run time), by type:
 `world.resource(GoalBook)`.
 Systems: goals, tentacle_selection (stage decide), action_queue, motor_targets (act).
+Output hooks (`ecs_tentacles.locomotion.outputs`): the goals a take records, how far a
+creature may crawl during a distributed bake, goals reached for `ecs-tentacles run`.
 """
 
 from __future__ import annotations
@@ -16,7 +18,7 @@ from ecs_tentacles.components import Creature, Goal, Tentacle
 from ecs_tentacles.locomotion.actions import STRENGTH, ActionQueue, Kind
 from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.locomotion.params import Locomotion
-from ecs_tentacles.plugin import Plugin
+from ecs_tentacles.plugin import Plugin, Reach, RunSummary, TrackSource
 from ecs_tentacles.scene.parameters import apply_parameters
 from ecs_tentacles.scene.validate import fragment
 from ecs_tentacles.system import System
@@ -75,3 +77,19 @@ class LocomotionPlugin(Plugin):
                 world.resource(GoalBook).append(entity, position.tolist(), radius)
         for entity, queue in world.query(ActionQueue):
             queue.pending = copy.deepcopy(queues[entity])
+
+    # -- output hooks ----------------------------------------------------------------
+    def take_tracks(self, world: World) -> list[TrackSource]:
+        from ecs_tentacles.locomotion.outputs import GOAL_TRACK
+
+        return [GOAL_TRACK]
+
+    def shard_reach(self, creature: Mapping[str, Any], seconds: float) -> Reach | None:
+        from ecs_tentacles.locomotion.outputs import crawl_reach
+
+        return crawl_reach(creature, seconds)
+
+    def run_summary(self, world: World) -> RunSummary | None:
+        from ecs_tentacles.locomotion.outputs import goal_summary
+
+        return goal_summary(world)
