@@ -127,7 +127,7 @@ class TakeRecorder:
 
     def _on_health(self, what: str) -> Any:
         def handler(*, creature: int, cause: str, **_: Any) -> None:
-            index = self._creature_index[creature]
+            index = self.creature_index[creature]
             entry = {"frame": self.count, "creature": index, "event": what, "cause": cause}
             self._health.append(entry)
 
@@ -139,7 +139,8 @@ class TakeRecorder:
         self._bodies: list[dict[str, Any]] = []
         rows: list[int] = []
         by_entity = sorted(world.query(Creature), key=lambda item: item[1].row)
-        self._creature_index = {entity: i for i, (entity, _) in enumerate(by_entity)}
+        # creature entity -> its index in the take (tracks name their owners by it)
+        self.creature_index = {entity: i for i, (entity, _) in enumerate(by_entity)}
         for index, (entity, creature) in enumerate(by_entity):
             name = creature.name
             entry: dict[str, Any] = {"name": name, "mantle": len(rows), "tentacles": []}
@@ -230,7 +231,7 @@ class PointsTrack:
         if frame is None:
             self.alive.append([])
             return
-        index = self.recorder._creature_index
+        index = self.recorder.creature_index
         items = list(
             zip(frame.keys, frame.creatures, frame.order, range(len(frame.keys)), strict=True)
         )
@@ -243,7 +244,7 @@ class PointsTrack:
         entries = self.recorder.header[self.track.key]
         self.columns[key] = len(self.positions)
         number = sum(entry["creature"] == creature for entry in entries)
-        owner = self.recorder._creatures[creature]["name"]
+        owner = self.recorder.header["creatures"][creature]["name"]
         name = f"{owner}/{self.track.folder}/{self.track.item}{number}"
         entries.append({"name": name, "creature": creature, "radius": radius})
         self.positions.append(np.asarray(position, dtype=np.float64))
@@ -279,7 +280,7 @@ class CurvesTrack:
         if self.points and points.shape != self.points[0].shape:
             raise ValueError(f"{key} changed shape: {self.points[0].shape} -> {points.shape}")
         if not self.points:
-            owners = [self.recorder._creature_index.get(int(e), -1) for e in frame.creatures]
+            owners = [self.recorder.creature_index.get(int(e), -1) for e in frame.creatures]
             self.recorder.header[key] = {"creatures": owners}
         self.points.append(points)
         self.widths.append(np.array(widths))
