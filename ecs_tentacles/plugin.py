@@ -4,8 +4,11 @@ Core is the World, its Schedule and the physics. Everything else (locomotion,
 suckers, fur, threats, recording, the sandbox's drawing, users' behaviours) is a
 `Plugin`: a schema fragment (creature-level and scene-level keys, and the schema of
 its own `plugins.<name>` config), a per-creature build hook, its stores (world
-resources), its systems at a named stage, its validation, and optional render,
-export and motion hooks. A scene turns plugins on and configures them:
+resources), its systems at a named stage, its validation, and optional hooks the
+generic layers call (they never name a feature): render hooks for the sandbox;
+output hooks for takes (`take_tracks`, `before_recording`), for distributed bakes'
+shard plans (`shard_reach`, `shard_groups`) and for `run`'s report (`run_summary`).
+A scene turns plugins on and configures them:
 
     "plugins": {"wander": {"radius": 2.0}, "fur": false, "mine": {"from": "mine.py"}}
 
@@ -32,12 +35,13 @@ import importlib.metadata
 import importlib.util
 import pathlib
 import sys
-from collections.abc import Iterator, Mapping, Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from dataclasses import dataclass, field
 from types import ModuleType
 from typing import TYPE_CHECKING, Any, ClassVar
 
 from ecs_tentacles.system import System
+from ecs_tentacles.take_tracks import TakeTrack
 
 if TYPE_CHECKING:
     import numpy as np
@@ -67,14 +71,61 @@ FROM = "from"  # the config key naming where a plugin's code is
 
 
 @dataclass(frozen=True)
-class GuideFrame:
-    """Curves a plugin exports at one frame (`Plugin.export_curves`; the fur guides):
+class CurvesFrame:
+    """A curves track at one frame (`TrackSource.sample`; the fur guides):
     `points` (curves, points, 3) world metres, `widths` (curves, points) metres,
     `creatures` (curves,) owning creature entities."""
 
     points: Any
     widths: Any
     creatures: Any
+
+
+GuideFrame = CurvesFrame  # its older name
+
+
+@dataclass(frozen=True)
+class PointsFrame:
+    """A points track at one frame (`TrackSource.sample`; the goals): the live locators.
+
+    `keys` identify each across frames (an entity id); `creatures` are their owners'
+    entities; `order` sorts locators that appear in the same frame within a creature;
+    `positions` (n, 3) and `radii` (n,) are kept from the frame a locator first appears.
+    """
+
+    keys: Sequence[int]
+    creatures: Sequence[int]
+    order: Sequence[int]
+    positions: Any
+    radii: Sequence[float]
+
+
+@dataclass(frozen=True)
+class TrackSource:
+    """A track a plugin adds to takes: its declaration (`ecs_tentacles.take_tracks`) and
+    `sample(world)`, called at every recorded frame (a `PointsFrame` or `CurvesFrame`
+    as the kind says, or None: nothing this frame)."""
+
+    track: TakeTrack
+    sample: Callable[[World], PointsFrame | CurvesFrame | None]
+
+
+@dataclass(frozen=True)
+class Reach:
+    """How far a creature may get during a bake, beyond its body: a capsule from its
+    start along `towards` (x, y metres), widened by `radius` metres."""
+
+    towards: tuple[float, float] = (0.0, 0.0)
+    radius: float = 0.0
+
+
+@dataclass(frozen=True)
+class RunSummary:
+    """What a plugin adds to `ecs-tentacles run`'s report: counts for `--json` and a
+    phrase for the line (`"goals reached 2, left 0"`)."""
+
+    counts: dict[str, int] = field(default_factory=dict)
+    text: str = ""
 
 
 @dataclass(frozen=True)
@@ -176,8 +227,31 @@ class Plugin:
         """A click in the sandbox's 3D view; True: handled (later plugins do not see it)."""
         return False
 
-    def export_curves(self, world: World) -> GuideFrame | None:
-        """Curves a take records each frame (fur guides), or None."""
+    # -- output hooks (takes, shard plans, run reports) -------------------------------
+    def take_tracks(self, world: World) -> Sequence[TrackSource]:
+        """Tracks this plugin adds to every take recorded from `world` (the goals, the
+        fur guides; `ecs_tentacles.take_tracks` describes the kinds). A track with a
+        standard key (`goals`, `guides`) must be declared as the standard one; others
+        are declared in the take's header, so a take file describes itself."""
+        return ()
+
+    def before_recording(self, world: World) -> None:
+        """Called once when a recording starts, before its first frame is captured
+        (the fur plugin poses its guides at the built pose)."""
+
+    def shard_reach(self, creature: Mapping[str, Any], seconds: float) -> Reach | None:
+        """How far `creature` (its scene entry, defaults in) may move during a bake of
+        `seconds`, beyond its body (locomotion: its crawl). Distributed bakes keep
+        creatures whose reaches may meet in one shard."""
+        return None
+
+    def shard_groups(self, creatures: Sequence[Mapping[str, Any]]) -> list[list[int]]:
+        """Sets of creature indices (scene order) that must bake in one shard wherever
+        they are (fur: threats and the emotional creatures they rouse)."""
+        return []
+
+    def run_summary(self, world: World) -> RunSummary | None:
+        """Counts `ecs-tentacles run` reports after stepping `world` (goals reached)."""
         return None
 
     def wants_motion(self, world: World) -> np.ndarray | None:
@@ -327,6 +401,15 @@ def instantiate(
     plugin = made if isinstance(made, Plugin) else made(dict(config))
     plugin.config, plugin.key, plugin.source = dict(config), key, source
     return plugin
+
+
+def builtin(key: str, **options: Any) -> Plugin:
+    """The built-in plugin `key`, made with keyword `options` (a bake's record plugin:
+    `builtin("record", every=2)`), so generic code needs no feature's import."""
+    if key not in BUILTIN:
+        raise PluginError(f"plugins.{key}: not a built-in plugin (known: {', '.join(BUILTIN)})")
+    made = load(key, BUILTIN[key], None)
+    return instantiate(made(**options) if isinstance(made, type) else made, key, {}, None)
 
 
 def resolve(

@@ -1,22 +1,24 @@
 """Takes: every frame of a simulation in one compact, reproducible npz file.
 
 A take holds, per frame, the pose of every mantle and link, the state of every
-sucker, which goals are still to reach and, when the world has fur, the guide curves.
-The header (JSON) names everything and carries the geometry, so exporters (USD,
-glTF) need nothing but the take.
+sucker, and the tracks the world's plugins add (`ecs_tentacles.take_tracks`): the
+goals still to reach (points, from locomotion) and, when the world has fur, the guide
+curves (curves, from fur), plus any track a plugin declares. The header (JSON) names
+everything and carries the geometry, so exporters (USD, glTF) need nothing but the take.
 
-The file is a zip of `.npy` arrays in this fixed order (`ARRAYS`); every entry is
-dated 1980-01-01, so the same scene and seed give byte-identical files:
+The file is a zip of `.npy` arrays in this fixed order; every entry is dated
+1980-01-01, so the same scene and seed give byte-identical files:
 
     header           uint8    UTF-8 JSON (see `Take.header`)
     pos              float32  (frames, bodies, 3)  body centres, metres, z up
     quat             float32  (frames, bodies, 4)  body orientations (w, x, y, z)
     sucker_attached  bool     (frames, suckers)
     sucker_anchor    float32  (frames, suckers, 3) world anchor (kept after release)
-    goal_pos         float32  (goals, 3)
+    goal_pos         float32  (goals, 3)                       the standard points track
     goal_active      bool     (frames, goals)      still in its creature's path
-    guide_points     float32  (frames, guides, points, 3)   only with fur
-    guide_widths     float32  (frames, guides, points)      only with fur
+    guide_points     float32  (frames, guides, points, 3)   the standard curves track,
+    guide_widths     float32  (frames, guides, points)      only when guides are recorded
+    ...              the arrays of the tracks `header.tracks` declares, in its order
 
 Frame i is simulated time i / fps; frame 0 is the pose the scene was built in.
 Bodies: a mantle is a cylinder along its local +z (`length` = height), a link a
@@ -28,7 +30,7 @@ from __future__ import annotations
 import json
 import os
 import zipfile
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, BinaryIO
 
@@ -38,7 +40,6 @@ from ecs_tentacles.atomic import atomic_file
 from ecs_tentacles.take_read import (
     FORMAT,
     MAX_TAKE_BYTES,
-    OPTIONAL,
     VERSION,
     TakeError,
     data_problem,
@@ -46,31 +47,25 @@ from ecs_tentacles.take_read import (
     header_problem,
     read_take,
 )
+from ecs_tentacles.take_tracks import CORE_ARRAYS, STANDARD, TakeTrack, tracks_of
 
-ARRAYS = (
-    "header",
-    "pos",
-    "quat",
-    "sucker_attached",
-    "sucker_anchor",
-    "goal_pos",
-    "goal_active",
-    "guide_points",
-    "guide_widths",
-)
-__all__ = ["ARRAYS", "FORMAT", "VERSION", "Take", "TakeError", "write_npz"]
+# every array of a take without declared tracks, in file order
+ARRAYS = CORE_ARRAYS + tuple(name for track in STANDARD for name in track.arrays)
+__all__ = ["ARRAYS", "FORMAT", "VERSION", "Take", "TakeError", "TakeTrack", "write_npz"]
 _EPOCH = (1980, 1, 1, 0, 0, 0)  # the earliest zip date: no wall-clock time in the file
 
 
 @dataclass
 class Take:
-    """A recorded simulation: `header` (names, geometry, timing) and per-frame arrays.
+    """A recorded simulation: `header` (names, geometry, timing), per-frame body and
+    sucker arrays, and `tracks` (every track's arrays by file name: `tracks["goal_pos"]`).
 
     `header` keys: format, version, scene, scene_sha256, seed, fps, sim_fps, substeps,
     frames, creatures [{name, mantle (body index), tentacles [[body index per link]]}],
     bodies [{name, creature, shape cylinder|capsule, axis, radius, length}],
-    suckers [{name, body, offset (in the body's frame)}], goals [{name, creature,
-    radius}], guides (null, or {creatures: [creature index per guide]}).
+    suckers [{name, body, offset (in the body's frame)}], health, and one key per track
+    (`ecs_tentacles.take_tracks`): goals [{name, creature, radius}], guides (null, or
+    {creatures: [creature index per guide]}); `tracks` lists declared tracks, if any.
     """
 
     header: dict[str, Any]
@@ -78,10 +73,14 @@ class Take:
     quat: np.ndarray
     sucker_attached: np.ndarray
     sucker_anchor: np.ndarray
-    goal_pos: np.ndarray
-    goal_active: np.ndarray
-    guide_points: np.ndarray | None = None
-    guide_widths: np.ndarray | None = None
+    tracks: dict[str, np.ndarray] = field(default_factory=dict)
+
+    @classmethod
+    def from_arrays(cls, header: dict[str, Any], arrays: dict[str, np.ndarray]) -> Take:
+        """A take from its header and arrays by file name (as `read_take` returns them)."""
+        core = {k: arrays[k] for k in CORE_ARRAYS[1:]}
+        rest = {k: v for k, v in arrays.items() if k not in CORE_ARRAYS}
+        return cls(header=header, **core, tracks=rest)
 
     # -- reading -----------------------------------------------------------------------
     @property
@@ -111,12 +110,24 @@ class Take:
         except ValueError:
             raise KeyError(f"no body named {name!r} in this take") from None
 
+    def track_list(self) -> list[TakeTrack]:
+        """Every track of this take, in file order (`ecs_tentacles.take_tracks`)."""
+        return tracks_of(self.header)
+
+    def array(self, name: str) -> np.ndarray | None:
+        """A body, sucker or track array by its file name (None: a track not recorded)."""
+        if name in CORE_ARRAYS[1:]:
+            value: np.ndarray = getattr(self, name)
+            return value
+        return self.tracks.get(name)
+
     def arrays(self) -> dict[str, np.ndarray]:
         """The arrays to store, in file order (the header encoded as UTF-8 JSON bytes)."""
         text = json.dumps(self.header, sort_keys=True, separators=(",", ":"))
         out = {"header": np.frombuffer(text.encode(), dtype=np.uint8)}
-        for name in ARRAYS[1:]:
-            value = getattr(self, name)
+        names = [*CORE_ARRAYS[1:], *(a for t in self.track_list() for a in t.arrays)]
+        for name in names:
+            value = self.array(name)
             if value is not None:
                 out[name] = np.ascontiguousarray(value)
         return out
@@ -136,26 +147,32 @@ class Take:
         finite values) made before the exporters see the data.
         """
         header, arrays = read_take(Path(path), max_bytes)
-        return cls(header=header, **arrays)
+        return cls.from_arrays(header, arrays)
 
     def problem(self) -> str | None:
         """The first problem of this (in-memory) take, as `Take.load` would report it."""
         problem = header_problem(self.header)
         if problem:
             return problem
-        missing = [k for k in ARRAYS[1:] if k not in OPTIONAL and getattr(self, k) is None]
-        if missing:
-            return f"{missing[0]}: missing"
-        if (self.guide_points is None) != (self.header.get("guides") is None):
-            return "guide_points: present only when header.guides is"
-        points = None if self.guide_points is None else self.guide_points.shape[2:3]
-        shapes = expected_shapes(self.header, points[0] if points else -1)
-        for name, shape in shapes.items():
-            value = getattr(self, name)
+        tracks = self.track_list()
+        points: dict[str, int] = {}
+        for track in tracks:
+            first = self.tracks.get(track.arrays[0])
+            if track.kind == "curves" and (first is None) != (self.header[track.key] is None):
+                return f"{track.arrays[0]}: present only when header.{track.key} is"
+            if track.kind == "curves" and first is not None:
+                points[track.arrays[0]] = first.shape[2] if first.ndim == 4 else -1
+        known = {*CORE_ARRAYS, *(a for t in tracks for a in t.arrays)}
+        unknown = sorted(set(self.tracks) - known)
+        if unknown:
+            return f"{unknown[0]}: not a track of this take"
+        for name, shape in expected_shapes(self.header, points).items():
+            value = self.array(name)
             if value is None or value.shape != shape:
                 got = None if value is None else value.shape
                 return f"{name}: shape {got}, expected {shape} from the header"
-        return data_problem({k: v for k, v in self.arrays().items() if k != "header"})
+        arrays = {k: v for k, v in self.arrays().items() if k != "header"}
+        return data_problem(arrays, tracks)
 
     def check_exportable(self, path: str | os.PathLike[str]) -> None:
         """Raise `TakeError` (one line) unless exporters can write this take to `path`."""

@@ -4,11 +4,13 @@ A take may be hand-edited, truncated or hostile. `read_take` returns the header 
 the arrays only when all of this holds, else raises `TakeError` with one line:
 
 - the file is a regular file and a zip archive whose entries are exactly the arrays
-  the format defines (`take.ARRAYS`, no unknown or repeated entries);
+  the format defines: bodies, suckers and the tracks (`ecs_tentacles.take_tracks`:
+  the standard ones and those the header declares), no unknown or repeated entries;
 - the uncompressed size the zip directory claims is at most `max_bytes` (a zip bomb
   is refused before anything is inflated), and so is the size the header implies;
-- the header is UTF-8 JSON describing creatures, bodies, suckers, goals and guides
-  with the names, indices and numbers the exporters need (`header_problem`);
+- the header is UTF-8 JSON describing creatures, bodies, suckers and every track
+  (points: name, creature, radius each; curves: an owner per curve) with the names,
+  indices and numbers the exporters need (`header_problem`);
 - every array's stored dtype and shape (read from its `.npy` header before its data)
   are the ones the header implies, its data is complete and its CRC right;
 - every float is finite and every quaternion has a length.
@@ -27,22 +29,19 @@ from typing import IO, Any, cast
 
 import numpy as np
 
+from ecs_tentacles.take_tracks import TakeTrack, declared_problem, dtypes, tracks_of
+
 MAX_TAKE_BYTES = 2 * 1024**3  # uncompressed; a 10 s bake of 4 creatures is ~30 MB
 MAX_HEADER_BYTES = 64 * 1024**2
 FORMAT = "ecs_tentacles.take"
 VERSION = 1
-DTYPES: dict[str, np.dtype[Any]] = {
+CORE_DTYPES: dict[str, np.dtype[Any]] = {
     "header": np.dtype(np.uint8),
     "pos": np.dtype("<f4"),
     "quat": np.dtype("<f4"),
     "sucker_attached": np.dtype(np.bool_),
     "sucker_anchor": np.dtype("<f4"),
-    "goal_pos": np.dtype("<f4"),
-    "goal_active": np.dtype(np.bool_),
-    "guide_points": np.dtype("<f4"),
-    "guide_widths": np.dtype("<f4"),
 }
-OPTIONAL = ("guide_points", "guide_widths")
 AXES = ("X", "Y", "Z")
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 
@@ -116,7 +115,7 @@ def _body_problem(header: dict[str, Any]) -> str | None:
 
 
 def _parts_problem(header: dict[str, Any]) -> str | None:
-    bodies, creatures = header["bodies"], header["creatures"]
+    bodies = header["bodies"]
     for s, sucker in enumerate(header["suckers"]):
         where = f"header.suckers[{s}]"
         if not _index(sucker.get("body"), len(bodies)):
@@ -127,26 +126,45 @@ def _parts_problem(header: dict[str, Any]) -> str | None:
         offset = sucker.get("offset")
         if not isinstance(offset, list) or len(offset) != 3 or not all(map(_is_number, offset)):
             return f"{where}.offset: must be 3 finite numbers"
-    for g, goal in enumerate(header["goals"]):
-        where = f"header.goals[{g}]"
-        if not _index(goal.get("creature"), len(creatures)):
-            return f"{where}.creature: must be a creature index, got {goal.get('creature')!r}"
-        pattern = rf"^{creatures[goal['creature']]['name']}/goals/goal\d+$"
-        if not isinstance(goal.get("name"), str) or not re.match(pattern, goal["name"]):
-            return f"{where}.name: must be <creature>/goals/goal<n>"
-        if not _is_number(goal.get("radius")) or goal["radius"] < 0:
-            return f"{where}.radius: must be a finite number >= 0"
-    for key in ("suckers", "goals"):
-        names = [item["name"] for item in header[key]]
-        if len(set(names)) != len(names):
-            return f"header.{key}: two have the same name"
-    guides = header.get("guides")
-    if guides is not None:
-        owners = guides.get("creatures") if isinstance(guides, dict) else None
+    names = [item["name"] for item in header["suckers"]]
+    if len(set(names)) != len(names):
+        return "header.suckers: two have the same name"
+    for track in tracks_of(header):
+        problem = _track_problem(header, track)
+        if problem:
+            return problem
+    return None
+
+
+def _track_problem(header: dict[str, Any], track: TakeTrack) -> str | None:
+    """The first problem of a track's header entry (`take_tracks` describes both kinds)."""
+    creatures, key = header["creatures"], track.key
+    if track.kind == "curves":
+        curves = header.get(key)
+        if curves is None:
+            return None
+        owners = curves.get("creatures") if isinstance(curves, dict) else None
         if not isinstance(owners, list) or not all(
             _is_int(o) and -1 <= o < len(creatures) for o in owners
         ):
-            return "header.guides.creatures: must be a list of creature indices (or -1)"
+            return f"header.{key}.creatures: must be a list of creature indices (or -1)"
+        return None
+    problem = _list_of_dicts(header, key)
+    if problem:
+        return problem
+    for i, item in enumerate(header[key]):
+        where = f"header.{key}[{i}]"
+        if not _index(item.get("creature"), len(creatures)):
+            return f"{where}.creature: must be a creature index, got {item.get('creature')!r}"
+        stem = f"{track.folder}/{track.item}"
+        pattern = rf"^{creatures[item['creature']]['name']}/{stem}\d+$"
+        if not isinstance(item.get("name"), str) or not re.match(pattern, item["name"]):
+            return f"{where}.name: must be <creature>/{stem}<n>"
+        if not _is_number(item.get("radius")) or item["radius"] < 0:
+            return f"{where}.radius: must be a finite number >= 0"
+    names = [item["name"] for item in header[key]]
+    if len(set(names)) != len(names):
+        return f"header.{key}: two have the same name"
     return None
 
 
@@ -166,34 +184,50 @@ def header_problem(header: object) -> str | None:
             return f"header.{key}: missing or not a string"
     if not _is_int(header.get("seed")):
         return "header.seed: missing or not a whole number"
-    for key in ("creatures", "bodies", "suckers", "goals"):
+    for key in ("creatures", "bodies", "suckers"):
         problem = _list_of_dicts(header, key)
         if problem:
             return problem
     return (
-        _creature_problem(header["creatures"], len(header["bodies"]))
+        declared_problem(header)
+        or _creature_problem(header["creatures"], len(header["bodies"]))
         or _body_problem(header)
         or _parts_problem(header)
     )
 
 
-def expected_shapes(header: dict[str, Any], points: int | None) -> dict[str, tuple[int, ...]]:
-    """Array name -> shape implied by a sound header (guides' points: from the file)."""
-    frames, bodies = header["frames"], len(header["bodies"])
-    suckers, goals = len(header["suckers"]), len(header["goals"])
+def expected_shapes(
+    header: dict[str, Any], points: dict[str, int] | None = None
+) -> dict[str, tuple[int, ...]]:
+    """Array name -> shape implied by a sound header (curves' points per curve: from
+    `points`, by the curves' first array name; curves not in it are left out)."""
+    frames, bodies, suckers = header["frames"], len(header["bodies"]), len(header["suckers"])
     shapes: dict[str, tuple[int, ...]] = {
         "pos": (frames, bodies, 3),
         "quat": (frames, bodies, 4),
         "sucker_attached": (frames, suckers),
         "sucker_anchor": (frames, suckers, 3),
-        "goal_pos": (goals, 3),
-        "goal_active": (frames, goals),
     }
-    if header.get("guides") is not None and points is not None:
-        guides = len(header["guides"]["creatures"])
-        shapes["guide_points"] = (frames, guides, points, 3)
-        shapes["guide_widths"] = (frames, guides, points)
+    points = points or {}
+    for track in tracks_of(header):
+        first, second = track.arrays
+        if track.kind == "points":
+            items = len(header[track.key])
+            shapes[first], shapes[second] = (items, 3), (frames, items)
+        elif header.get(track.key) is not None and first in points:
+            curves = len(header[track.key]["creatures"])
+            shapes[first] = (frames, curves, points[first], 3)
+            shapes[second] = (frames, curves, points[first])
     return shapes
+
+
+def array_dtypes(header: dict[str, Any]) -> dict[str, np.dtype[Any]]:
+    """Every array a take with this (sound) header may hold -> its dtype, in file order."""
+    out = dict(CORE_DTYPES)
+    for track in tracks_of(header):
+        for name, dtype in zip(track.arrays, dtypes(track), strict=True):
+            out[name] = np.dtype(dtype)
+    return out
 
 
 def _npy_header(handle: IO[bytes], name: str) -> tuple[tuple[int, ...], bool, np.dtype]:
@@ -206,23 +240,25 @@ def _npy_header(handle: IO[bytes], name: str) -> tuple[tuple[int, ...], bool, np
         raise TakeError(f"{name}: not a .npy array ({exc})") from None
 
 
-def _read_entry(archive: zipfile.ZipFile, name: str, shape: tuple[int, ...] | None) -> np.ndarray:
+def _read_entry(
+    archive: zipfile.ZipFile, name: str, shape: tuple[int, ...] | None, wanted: np.dtype[Any]
+) -> np.ndarray:
     """Read `name`.npy, checking dtype and `shape` (None: any 4-d) before allocating."""
     entry = archive.getinfo(f"{name}.npy")
     with archive.open(entry) as handle:
         stored, fortran, dtype = _npy_header(handle, name)
-        if dtype != DTYPES[name]:
-            raise TakeError(f"{name}: dtype {dtype}, expected {DTYPES[name]}")
+        if dtype != wanted:
+            raise TakeError(f"{name}: dtype {dtype}, expected {wanted}")
         if math.prod(stored) * dtype.itemsize > entry.file_size:
             raise TakeError(f"{name}: shape {tuple(stored)} holds more than the stored data")
         if shape is None and (len(stored) != 4 or stored[2] < 2 or stored[3] != 3):
             raise TakeError(
-                f"{name}: shape {tuple(stored)}, expected (frames, guides, points >= 2, 3)"
+                f"{name}: shape {tuple(stored)}, expected (frames, curves, points >= 2, 3)"
             )
         if shape is not None and tuple(stored) != shape:
             raise TakeError(f"{name}: shape {tuple(stored)}, expected {shape} from the header")
         array = np.empty(stored[::-1], dtype).T if fortran else np.empty(stored, dtype)
-        empty = memoryview(b"")  # an empty array (a take without goals): nothing to read
+        empty = memoryview(b"")  # an empty array (a track with no items): nothing to read
         view = (
             memoryview(cast(Any, array.T if fortran else array)).cast("B") if array.size else empty
         )
@@ -237,14 +273,19 @@ def _read_entry(archive: zipfile.ZipFile, name: str, shape: tuple[int, ...] | No
     return array
 
 
-def data_problem(arrays: dict[str, np.ndarray]) -> str | None:
-    """The first non-finite number, negative width or zero quaternion in `arrays`, or None."""
+def data_problem(
+    arrays: dict[str, np.ndarray], tracks: list[TakeTrack] | None = None
+) -> str | None:
+    """The first non-finite number, negative width (of `tracks`' curves) or zero
+    quaternion in `arrays`, or None."""
     for name, array in arrays.items():
         if array.dtype.kind == "f" and not np.isfinite(array).all():
             where = np.argwhere(~np.isfinite(array))[0]
             return f"{name}: non-finite value {array[tuple(where)]} at {tuple(where.tolist())}"
-    if (arrays["guide_widths"] < 0).any() if "guide_widths" in arrays else False:
-        return "guide_widths: negative width"
+    for track in tracks or []:
+        widths = arrays.get(track.arrays[1]) if track.kind == "curves" else None
+        if widths is not None and (widths < 0).any():
+            return f"{track.arrays[1]}: negative width"
     lengths = np.linalg.norm(arrays["quat"].astype(np.float64), axis=-1)
     if (lengths < 1e-6).any():
         frame, body = np.argwhere(lengths < 1e-6)[0].tolist()
@@ -290,10 +331,6 @@ def _read_archive(
 ) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
     entries = archive.infolist()
     names = [entry.filename for entry in entries]
-    known = {f"{name}.npy" for name in DTYPES}
-    for name in names:
-        if name not in known:
-            raise TakeError(f"unknown entry {name!r} (a take holds {', '.join(sorted(known))})")
     if len(set(names)) != len(names):
         raise TakeError("an array is stored twice")
     claimed = sum(entry.file_size for entry in entries)
@@ -303,7 +340,7 @@ def _read_archive(
         raise TakeError("not a take file (no header)")
     if archive.getinfo("header.npy").file_size > MAX_HEADER_BYTES:
         raise TakeError(f"header: larger than {MAX_HEADER_BYTES} bytes")
-    raw = _read_entry(archive, "header", _header_shape(archive))
+    raw = _read_entry(archive, "header", _header_shape(archive), CORE_DTYPES["header"])
     try:
         header = json.loads(raw.tobytes().decode())
     except (UnicodeDecodeError, json.JSONDecodeError, RecursionError) as exc:
@@ -311,29 +348,37 @@ def _read_archive(
     problem = header_problem(header)
     if problem:
         raise TakeError(problem)
-    guided = header.get("guides") is not None
-    for name in OPTIONAL:
-        if (f"{name}.npy" in names) != guided:
-            raise TakeError(f"{name}: present only when header.guides is")
-    arrays: dict[str, np.ndarray] = {}
-    shapes = expected_shapes(header, points=0)
-    implied = sum(math.prod(s) * DTYPES[n].itemsize for n, s in shapes.items())
+    wanted = array_dtypes(header)
+    known = {f"{name}.npy" for name in wanted}
+    for name in names:
+        if name not in known:
+            raise TakeError(f"unknown entry {name!r} (a take holds {', '.join(sorted(known))})")
+    tracks = tracks_of(header)
+    optional = {a for t in tracks if t.kind == "curves" and header[t.key] is None for a in t.arrays}
+    for track in tracks:
+        if track.kind != "curves":
+            continue
+        for name in track.arrays:
+            if (f"{name}.npy" in names) != (header[track.key] is not None):
+                raise TakeError(f"{name}: present only when header.{track.key} is")
+    shapes = expected_shapes(header)
+    implied = sum(math.prod(s) * wanted[n].itemsize for n, s in shapes.items())
     if implied > max_bytes:
         raise TakeError(f"header implies {implied} bytes of arrays, over the {max_bytes} limit")
-    for name in DTYPES:
-        if name == "header" or name in OPTIONAL:
+    arrays: dict[str, np.ndarray] = {}
+    for name in wanted:
+        if name == "header" or name in optional:
             continue
         if f"{name}.npy" not in names:
             raise TakeError(f"{name}: missing")
-        arrays[name] = _read_entry(archive, name, shapes[name])
-    if guided:
-        arrays["guide_points"] = _read_entry(archive, "guide_points", None)
-        shapes = expected_shapes(header, points=arrays["guide_points"].shape[2])
-        for name in OPTIONAL:
-            if name in arrays and arrays[name].shape != shapes[name]:
+        if name not in shapes:  # the first array of curves: its points come from the file
+            arrays[name] = _read_entry(archive, name, None, wanted[name])
+            shapes = expected_shapes(header, {name: arrays[name].shape[2]})
+            if arrays[name].shape != shapes[name]:
                 raise TakeError(f"{name}: shape {arrays[name].shape}, expected {shapes[name]}")
-        arrays["guide_widths"] = _read_entry(archive, "guide_widths", shapes["guide_widths"])
-    problem = data_problem(arrays)
+            continue
+        arrays[name] = _read_entry(archive, name, shapes[name], wanted[name])
+    problem = data_problem(arrays, tracks)
     if problem:
         raise TakeError(problem)
     return header, arrays

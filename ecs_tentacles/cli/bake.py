@@ -185,16 +185,22 @@ def save(take: Take, path: Path, *, progress: bool, skin: Skin | None = None) ->
 
 
 def report(take: Take, path: Path) -> dict[str, Any]:
-    """What was written and the file's SHA-256 (equal for equal bakes)."""
+    """What was written and the file's SHA-256 (equal for equal bakes); counts of
+    creatures, bodies, suckers and of every points track's items (goals)."""
     header = take.header
     return {
         "out": str(path),
         "frames": take.frames,
         "fps": take.fps,
-        **{key: len(header[key]) for key in ("creatures", "bodies", "suckers", "goals")},
+        **{key: len(header[key]) for key in ("creatures", "bodies", "suckers", *_points(take))},
         "sha256": hashlib.sha256(path.read_bytes()).hexdigest(),
         "recoveries": header.get("health", {}).get("recoveries", 0),
     }
+
+
+def _points(take: Take) -> list[str]:
+    """The header keys of the take's points tracks (`goals`, ...)."""
+    return [track.key for track in take.track_list() if track.kind == "points"]
 
 
 def summary(take: Take, path: Path, as_json: bool = False, skinned: KeyReport | None = None) -> str:
@@ -204,9 +210,10 @@ def summary(take: Take, path: Path, as_json: bool = False, skinned: KeyReport | 
         r["skinned"] = skinned.line()
     if as_json:
         return json.dumps(r)
+    items = "".join(f", {r[key]} {key}" for key in _points(take))
     line = (
         f"{path}: {r['frames']} frames at {r['fps']:g} fps, {r['creatures']} creatures,"
-        f" {r['bodies']} bodies, {r['suckers']} suckers, {r['goals']} goals; sha256 {r['sha256']}"
+        f" {r['bodies']} bodies, {r['suckers']} suckers{items}; sha256 {r['sha256']}"
     )
     if skinned is None:
         return line

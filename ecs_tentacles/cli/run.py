@@ -1,4 +1,8 @@
-"""`ecs-tentacles run SCENE --frames N`: step a scene headless and report the speed."""
+"""`ecs-tentacles run SCENE --frames N`: step a scene headless and report the speed.
+
+The report holds timing, sizes, physics health and sucker attaches, and what the
+plugins add (`Plugin.run_summary`: locomotion's goals reached and left).
+"""
 
 from __future__ import annotations
 
@@ -9,7 +13,7 @@ import time
 from typing import Any
 
 from ecs_tentacles.components import Creature
-from ecs_tentacles.locomotion.goals import GoalBook
+from ecs_tentacles.plugin import RunSummary
 from ecs_tentacles.progress import step_frames
 from ecs_tentacles.scene.load import resolve_scene_path
 from ecs_tentacles.world import World
@@ -89,7 +93,9 @@ def handle(args: argparse.Namespace) -> int:
     )
     build_seconds = time.perf_counter() - build_start
     summary = simulate(world, args.frames, progress=not args.quiet)
+    texts = [found.text for found in plugin_summaries(world) if found.text]
     summary = {"scene": str(path), **summary, "build_seconds": round(build_seconds, 4)}
+    attaches = f"sucker attaches {summary['sucker_attaches']}"
     if args.json:
         print(json.dumps(summary))
     else:
@@ -98,8 +104,7 @@ def handle(args: argparse.Namespace) -> int:
             f" {summary['wall_seconds']:.2f} s wall,"
             f" real-time factor {summary['real_time_factor']:.2f}x"
             f" ({summary['creatures']} creatures, {summary['bodies']} bodies,"
-            f" {summary['dofs']} dofs); goals reached {summary['goals_reached']},"
-            f" left {summary['goals_left']}; sucker attaches {summary['sucker_attaches']}"
+            f" {summary['dofs']} dofs); {'; '.join([*texts, attaches])}"
         )
         if health_line(summary):
             print(f"warning: {health_line(summary)}", file=sys.stderr)
@@ -108,7 +113,8 @@ def handle(args: argparse.Namespace) -> int:
 
 
 def simulate(world: World, frames: int, *, progress: bool = True) -> dict[str, Any]:
-    """Step `world` for `frames` frames and return timing and size figures."""
+    """Step `world` for `frames` frames and return timing and size figures, physics
+    health, and the plugins' counts (`Plugin.run_summary`)."""
     physics = world.physics
     start_time = world.time
     wall_start = time.perf_counter()
@@ -129,15 +135,12 @@ def simulate(world: World, frames: int, *, progress: bool = True) -> dict[str, A
         "recoveries": physics.health.recoveries,
         "recovery_causes": dict(physics.health.causes),
         "frozen": physics.health.frozen,
-        "goals_reached": int(world.events.counts["goal_reached"]),
-        "goals_left": _goals_left(world),
+        **{k: v for found in plugin_summaries(world) for k, v in found.counts.items()},
         "sucker_attaches": int(world.events.counts["sucker_attached"]),
     }
 
 
-def _goals_left(world: World) -> int:
-    """Goals still in every creature's path (0 with the locomotion plugin off)."""
-    book = world.get_resource(GoalBook)
-    if book is None:
-        return 0
-    return int(sum(len(book.path(e)) for e, _ in world.query(Creature)))
+def plugin_summaries(world: World) -> list[RunSummary]:
+    """What the world's plugins report after a run (`Plugin.run_summary`), plugin order."""
+    found = (plugin.run_summary(world) for plugin in world.plugins)
+    return [summary for summary in found if summary is not None]

@@ -30,7 +30,7 @@ import numpy as np
 from tqdm import tqdm
 
 from ecs_tentacles.distributed.merge import merge_takes
-from ecs_tentacles.distributed.shards import ShardPlan, default_tasks, plan_shards
+from ecs_tentacles.distributed.shards import ShardPlan, default_tasks, plan_shards, scene_plugins
 from ecs_tentacles.distributed.spheres import meetings
 from ecs_tentacles.distributed.task import ShardResult, bake_shard
 from ecs_tentacles.distributed.work import load_shard, remove_work, save_shard, shard_key
@@ -107,7 +107,9 @@ def ray_bake(
     started = start_ray(address, cpus)
     try:
         stats = RayStats(workers=float(ray.cluster_resources().get("CPU", 1)))
-        stats.plan = plan_shards(plan.scene, plan.seconds, default_tasks(stats.workers))
+        plugins = scene_plugins(plan.scene, plan.folder, allow_systems=allow_systems)
+        tasks = default_tasks(stats.workers)
+        stats.plan = plan_shards(plan.scene, plan.seconds, tasks, plugins)
         note(f"ray: {stats.plan.describe()}")
         if not resume:
             remove_work(folder)

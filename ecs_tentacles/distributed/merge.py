@@ -1,9 +1,10 @@
 """Shard takes -> the take a local bake of the whole scene writes, byte for byte.
 
-A take lists creatures in scene order, then bodies, suckers, goals and fur guides
-creature by creature (`ecs_tentacles.export.recording`). A shard's take does the
-same for its own creatures, so merging is a stable sort of every table by the
-creature's index in the whole scene, with the header's indices renumbered.
+A take lists creatures in scene order, then bodies, suckers and every track's items
+(goals, fur guides, ...: `ecs_tentacles.take_tracks`) creature by creature
+(`ecs_tentacles.export.recording`). A shard's take does the same for its own
+creatures, so merging is a stable sort of every table by the creature's index in the
+whole scene, with the header's indices renumbered.
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from ecs_tentacles.take import Take
+from ecs_tentacles.take_tracks import TakeTrack
 
 
 def merge_takes(parts: Sequence[tuple[Sequence[int], Take]]) -> Take:
@@ -26,16 +28,17 @@ def merge_takes(parts: Sequence[tuple[Sequence[int], Take]]) -> Take:
         values = {repr(take.header[key]) for _, take in parts}
         if len(values) > 1:
             raise ValueError(f"shard takes differ in {key}: {sorted(values)}")
+    tracks = first.track_list()
     tables: dict[str, list[tuple[int, Any]]] = {
-        k: [] for k in ("creatures", "bodies", "suckers", "goals", "guides")
+        k: [] for k in ("creatures", "bodies", "suckers", *(t.key for t in tracks))
     }
     arrays: dict[str, list[tuple[np.ndarray, np.ndarray]]] = {}
+    axes: dict[str, int] = {}  # array name -> its item axis
     for members, take in parts:
         h = take.header
         glob = np.asarray(members, dtype=np.int64)  # shard creature index -> scene index
         body_owner = glob[[b["creature"] for b in h["bodies"]]].reshape(-1)
         sucker_owner = body_owner[[s["body"] for s in h["suckers"]]].reshape(-1)
-        goal_owner = glob[[g["creature"] for g in h["goals"]]].reshape(-1)
         body_base = len(tables["bodies"])  # placeholder ids, renumbered below
         for c, entry in enumerate(h["creatures"]):
             tables["creatures"].append((int(glob[c]), (body_base, entry)))
@@ -43,23 +46,18 @@ def merge_takes(parts: Sequence[tuple[Sequence[int], Take]]) -> Take:
             tables["bodies"].append((int(glob[b["creature"]]), b))
         for s in h["suckers"]:
             tables["suckers"].append((int(body_owner[s["body"]]), (body_base, s)))
-        for g in h["goals"]:
-            tables["goals"].append((int(glob[g["creature"]]), g))
         owners = {
             "pos": body_owner,
             "quat": body_owner,
             "sucker_attached": sucker_owner,
             "sucker_anchor": sucker_owner,
-            "goal_pos": goal_owner,
-            "goal_active": goal_owner,
         }
-        if h["guides"] is not None:
-            guide_owner = glob[h["guides"]["creatures"]].reshape(-1)
-            owners["guide_points"] = owners["guide_widths"] = guide_owner
-            tables["guides"] += [(int(o), None) for o in guide_owner]
+        for track in tracks:
+            _track_owners(track, h, glob, tables[track.key], owners, axes)
         for name, owner in owners.items():
-            axis = 0 if name == "goal_pos" else 1
-            arrays.setdefault(name, []).append((owner, np.moveaxis(getattr(take, name), axis, 0)))
+            value = take.array(name)
+            assert value is not None
+            arrays.setdefault(name, []).append((owner, np.moveaxis(value, axes.get(name, 1), 0)))
     body_map = _order([o for o, _ in tables["bodies"]])
     header["creatures"] = _creatures(tables["creatures"], body_map)
     header["bodies"] = _pick(tables["bodies"], body_map)
@@ -69,24 +67,47 @@ def merge_takes(parts: Sequence[tuple[Sequence[int], Take]]) -> Take:
     ]
     for i, body in enumerate(header["bodies"]):
         body["creature"] = tables["bodies"][body_map.old[i]][0]
-    goals = _order([o for o, _ in tables["goals"]])
-    header["goals"] = [
-        {**g, "creature": tables["goals"][goals.old[i]][0]}
-        for i, g in enumerate(_pick(tables["goals"], goals))
-    ]
-    if tables["guides"]:
-        guides = _order([o for o, _ in tables["guides"]])
-        header["guides"] = {"creatures": [tables["guides"][k][0] for k in guides.old.tolist()]}
+    for track in tracks:
+        table = tables[track.key]
+        order = _order([o for o, _ in table])
+        if track.kind == "points":
+            header[track.key] = [
+                {**item, "creature": table[order.old[i]][0]}
+                for i, item in enumerate(_pick(table, order))
+            ]
+        elif table:
+            header[track.key] = {"creatures": [table[k][0] for k in order.old.tolist()]}
     header["health"] = _health(parts)
     merged = {}
     for name, pieces in arrays.items():
         owner = np.concatenate([o for o, _ in pieces])
         stacked = np.concatenate([a for _, a in pieces], axis=0)
-        axis = 0 if name == "goal_pos" else 1
         merged[name] = np.ascontiguousarray(
-            np.moveaxis(stacked[np.argsort(owner, kind="stable")], 0, axis)
+            np.moveaxis(stacked[np.argsort(owner, kind="stable")], 0, axes.get(name, 1))
         )
-    return Take(header=header, **merged)
+    return Take.from_arrays(header, merged)
+
+
+def _track_owners(
+    track: TakeTrack,
+    header: dict[str, Any],
+    glob: np.ndarray,
+    table: list[tuple[int, Any]],
+    owners: dict[str, np.ndarray],
+    axes: dict[str, int],
+) -> None:
+    """Add one shard's items of `track` to its table, and its arrays' owners and axes."""
+    first, second = track.arrays
+    if track.kind == "points":
+        items = header[track.key]
+        owner = glob[[item["creature"] for item in items]].reshape(-1)
+        table += [(int(glob[item["creature"]]), item) for item in items]
+        owners[first] = owners[second] = owner
+        axes[first] = 0
+    elif header[track.key] is not None:
+        owner = glob[header[track.key]["creatures"]].reshape(-1)
+        owners[first] = owners[second] = owner
+        table += [(int(o), None) for o in owner]
 
 
 class _Order:

@@ -3,13 +3,14 @@
 Creatures meet through contact proxies (`ecs_tentacles.physics.proxies`): when their
 bounding spheres come within `MARGIN`. A shard plan is either the scene's own
 `shards` field, or worked out here from where each creature can get to during the
-bake: a capsule on the ground around the path toward its first goal, as long as the
-creature can crawl in the bake (`CRAWL_SPEED` x its locomotion speed x seconds),
-with the creature's reach plus `SLACK` as radius (a disc when it has no goal or its
-path turns within that length). Creatures whose capsules come within `MARGIN` are
-joined (union-find); each connected set is one island, and islands are packed into
-at most `tasks` shards of balanced size. Creatures marked `threat` and the creatures
-with an `emotion` they may rouse always share a shard (declared shards too).
+bake: a capsule on the ground around its body's reach plus `SLACK`, stretched and
+widened by what the plugins say it may move (`Plugin.shard_reach`; locomotion: its
+crawl toward its first goal, or a disc when it has none or may reach it). Creatures
+whose capsules come within `MARGIN` are joined (union-find); each connected set is
+one island, and islands are packed into at most `tasks` shards of balanced size.
+Sets of creatures a plugin says must bake together (`Plugin.shard_groups`; fur:
+threats and the emotional creatures they rouse) always share a shard (declared
+shards too).
 
 The plan is an estimate; the bake proves it (`ecs_tentacles.distributed.spheres`):
 shards whose creatures did come within contact range are baked again together.
@@ -18,6 +19,8 @@ shards whose creatures did come within contact range are baked again together.
 from __future__ import annotations
 
 import math
+import pathlib
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -25,8 +28,8 @@ import numpy as np
 
 from ecs_tentacles.creator.crowd import creature_reach
 from ecs_tentacles.physics.proxies import MARGIN
+from ecs_tentacles.plugin import Plugin, Reach, resolve
 
-CRAWL_SPEED = 0.25  # m/s per unit of `locomotion.speed`: twice the fastest crawl measured
 SLACK = 0.15  # metres: settling at the start, sideways drift, tentacles lifting
 
 
@@ -48,31 +51,42 @@ class ShardPlan:
         return f"{n} shard{'s' * (n != 1)} from {self.islands} sets of creatures that never meet"
 
 
-def plan_shards(scene: dict[str, Any], seconds: float, tasks: int) -> ShardPlan:
-    """The shards of `scene` (validated, defaults in) for a bake of `seconds`."""
+def plan_shards(
+    scene: dict[str, Any],
+    seconds: float,
+    tasks: int,
+    plugins: Sequence[Plugin] | None = None,
+) -> ShardPlan:
+    """The shards of `scene` (validated, defaults in) for a bake of `seconds`.
+
+    `plugins`: the scene's plugins (`scene_plugins`, the default, makes them).
+    """
     creatures = scene["creatures"]
     if not creatures:
         return ShardPlan([[]], 1, declared=False)
+    plugins = scene_plugins(scene) if plugins is None else plugins
+    together = [group for plugin in plugins for group in plugin.shard_groups(creatures)]
     if "shards" in scene:
         index = {c["name"]: i for i, c in enumerate(creatures)}
         shards = [sorted(index[name] for name in shard) for shard in scene["shards"]]
-        shards = _joined(shards, roused(creatures))
+        shards = _joined_all(shards, together)
         return ShardPlan(sorted(shards), len(shards), declared=True)
-    islands = _joined(islands_of(creatures, seconds), roused(creatures))
+    islands = _joined_all(islands_of(creatures, seconds, plugins), together)
     return ShardPlan(pack(islands, creatures, tasks), len(islands), declared=False)
 
 
-def roused(creatures: list[dict[str, Any]]) -> list[int]:
-    """Creatures that must share a shard because one rouses another's emotion.
+def scene_plugins(
+    scene: Mapping[str, Any], folder: str | None = None, *, allow_systems: bool = False
+) -> list[Plugin]:
+    """The plugins a loaded scene turns on (its `plugins` field), for their shard hooks."""
+    where = pathlib.Path(folder) if folder else None
+    return resolve(scene.get("plugins"), where, allow=allow_systems)
 
-    A creature marked `threat` rouses any creature with an `emotion` near it (the
-    emotion system), wherever their shards are: all of them bake together.
-    """
-    threats = {i for i, c in enumerate(creatures) if c.get("threat")}
-    emotional = {i for i, c in enumerate(creatures) if "emotion" in c}
-    if not threats or not (emotional - threats or (len(threats) > 1 and emotional)):
-        return []
-    return sorted(threats | emotional)
+
+def _joined_all(sets: list[list[int]], groups: list[list[int]]) -> list[list[int]]:
+    for group in groups:
+        sets = _joined(sets, group)
+    return sets
 
 
 def _joined(sets: list[list[int]], together: list[int]) -> list[list[int]]:
@@ -84,27 +98,38 @@ def _joined(sets: list[list[int]], together: list[int]) -> list[list[int]]:
     return sorted([merged, *(s for s in sets if not wanted & set(s))])
 
 
-def travel_capsules(creatures: list[dict[str, Any]], seconds: float) -> np.ndarray:
+def travel_capsules(
+    creatures: list[dict[str, Any]], seconds: float, plugins: Sequence[Plugin] = ()
+) -> np.ndarray:
     """(n, 5): start x, y, end x, y and radius of where each creature can get to."""
     out = np.zeros((len(creatures), 5))
     for i, creature in enumerate(creatures):
         start = np.asarray(creature["position"][:2], dtype=np.float64)
         reach = creature_reach(creature) + 0.5 * creature["mantle"]["height"] + SLACK
-        travel = CRAWL_SPEED * creature["locomotion"]["speed"] * seconds
-        end, radius = start, reach + travel
-        goals = creature["goals"]
-        if goals:
-            towards = np.asarray(goals[0]["position"][:2], dtype=np.float64) - start
-            length = float(np.linalg.norm(towards))
-            if length >= travel:  # it heads straight for the goal all the bake
-                end, radius = start + towards * (travel / length), reach
-        out[i] = (*start, *end, radius)
+        moves = [plugin.shard_reach(creature, seconds) for plugin in plugins]
+        towards, extra = _combined([m for m in moves if m is not None])
+        out[i] = (*start, *(start + towards), reach + extra)
     return out
 
 
-def islands_of(creatures: list[dict[str, Any]], seconds: float) -> list[list[int]]:
+def _combined(moves: list[Reach]) -> tuple[np.ndarray, float]:
+    """One capsule's stretch and widening holding every plugin's reach (exact when at
+    most one stretches: a capsule widened by discs; otherwise a disc around them all)."""
+    stretched = [m for m in moves if m.towards != (0.0, 0.0)]
+    if len(stretched) <= 1:
+        towards = np.asarray(stretched[0].towards if stretched else (0.0, 0.0), np.float64)
+        extra = 0.0
+        for move in moves:
+            extra += move.radius
+        return towards, extra
+    return np.zeros(2), sum(math.hypot(*m.towards) + m.radius for m in moves)
+
+
+def islands_of(
+    creatures: list[dict[str, Any]], seconds: float, plugins: Sequence[Plugin] = ()
+) -> list[list[int]]:
     """Sets of creature indices that may meet during the bake (union-find), sorted."""
-    capsules = travel_capsules(creatures, seconds)
+    capsules = travel_capsules(creatures, seconds, plugins)
     parent = list(range(len(creatures)))
 
     def find(i: int) -> int:

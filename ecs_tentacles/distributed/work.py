@@ -23,7 +23,7 @@ import numpy as np
 from ecs_tentacles.atomic import atomic_file
 from ecs_tentacles.distributed.task import ShardResult
 from ecs_tentacles.export.bake import BakePlan
-from ecs_tentacles.take import ARRAYS, Take, write_npz
+from ecs_tentacles.take import Take, write_npz
 
 _KEY = re.compile(r"^[0-9a-f]{24}\.npz$")
 
@@ -69,8 +69,9 @@ def load_shard(folder: Path, key: str) -> ShardResult | None:
     try:
         with np.load(path, allow_pickle=False) as data:
             header = json.loads(bytes(data["header"]).decode())
-            arrays = {k: data[k] for k in ARRAYS[1:] if k in data.files}
-            take = Take(header=header, **arrays)
+            own = ("header", "spheres", "members")
+            arrays = {k: data[k] for k in data.files if k not in own}
+            take = Take.from_arrays(header, arrays)
             result = ShardResult(data["members"].tolist(), take, data["spheres"])
     except (OSError, ValueError, KeyError, zipfile.BadZipFile):
         return None

@@ -20,7 +20,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from ecs_tentacles.export.recording import scene_sha256
+from ecs_tentacles.export.recording import Recording, scene_sha256
+from ecs_tentacles.plugin import builtin
 from ecs_tentacles.progress import step_frames
 from ecs_tentacles.scene.load import load_scene, resolve_scene_path
 from ecs_tentacles.take import Take
@@ -146,19 +147,17 @@ def bake(
     creatures at those scene indices (a shard); `on_steps(n)` is told of every `n`
     frames simulated.
     """
-    from ecs_tentacles.record.plugin import RecordPlugin
-
     world = plan.world(allow_systems=allow_systems, threads=threads, only=only)
     try:
         if on_world is not None:
             on_world(world)
-        recording = RecordPlugin(
-            every=plan.every, scene_sha256=plan.scene_sha256, capacity=plan.frames
+        recording = builtin(
+            "record", every=plan.every, scene_sha256=plan.scene_sha256, capacity=plan.frames
         )
+        assert isinstance(recording, Recording)  # the record plugin
         world.add_plugin(recording)
-        record = recording.system
         step_frames(world, plan.steps, progress=progress, desc="bake", on_steps=on_steps)
-        return record.take()
+        return recording.take()
     finally:
         world.close()
 

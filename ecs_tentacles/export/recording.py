@@ -1,53 +1,48 @@
 """Recording a live World into a `Take`, one frame at a time.
 
-`TakeRecorder(world)` fixes the layout once (which store rows are which bodies,
-suckers, goals) and `capture()` copies the current frame with one gather per array;
-the `record` system (`ecs_tentacles.systems.record.record`) calls it after physics_sync.
-Goals are discovered as they appear (scripts may add some); fur guides are read
-through the plugins' export hook (`plugin_curves`: the fur plugin's guides).
+`TakeRecorder(world)` fixes the layout once (which store rows are which bodies and
+suckers) and `capture()` copies the current frame with one gather per array; the
+`record` system (`ecs_tentacles.systems.record.record`) calls it after physics_sync.
+Everything else a take holds comes from the plugins' take tracks
+(`Plugin.take_tracks`: the locomotion plugin's goals, the fur plugin's guides, a
+user plugin's own), recorded by kind (`PointsTrack`, `CurvesTrack`); the standard
+tracks no plugin fills are written empty, as the format asks (`ecs_tentacles.take_tracks`).
 """
 
 from __future__ import annotations
 
 import hashlib
 import json
-from collections.abc import Callable
-from typing import TYPE_CHECKING, Any
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
 
 import numpy as np
 
 from ecs_tentacles.components import Creature, Link, Tentacle, Transform
-from ecs_tentacles.fur.stores import FurData
-from ecs_tentacles.locomotion.components import Goal
-from ecs_tentacles.plugin import GuideFrame
+from ecs_tentacles.plugin import CurvesFrame, PointsFrame, TrackSource
 from ecs_tentacles.take import FORMAT, VERSION, Take
+from ecs_tentacles.take_tracks import STANDARD, TakeTrack, declared_problem
 
 if TYPE_CHECKING:
     from ecs_tentacles.world import World
 
 
-GuideSource = Callable[["World"], GuideFrame | None]
+@runtime_checkable
+class Recording(Protocol):
+    """What records a world into a take (the record plugin, which bakes add by name)."""
+
+    def take(self) -> Take: ...
 
 
-def plugin_curves(world: World) -> GuideFrame | None:
-    """The curves the world's plugins export (`Plugin.export_curves`: the fur guides)."""
+def plugin_tracks(world: World) -> list[TrackSource]:
+    """The take tracks of the world's plugins, in plugin order."""
+    return [source for plugin in world.plugins for source in plugin.take_tracks(world)]
+
+
+def before_recording(world: World) -> None:
+    """Tell every plugin a recording starts (`Plugin.before_recording`)."""
     for plugin in world.plugins:
-        found = plugin.export_curves(world)
-        if found is not None:
-            return found
-    return None
-
-
-def pose_fur_at_build(world: World) -> None:
-    """Pose fur guides before the first frame, so a take's frame 0 has them.
-
-    The rig system poses guides during a frame; at the built pose nothing has run. A
-    fresh rig (its own dynamics state, thrown away) poses them once; it writes only
-    the rig's output buffers, which the real rig rewrites every frame.
-    """
-    fur = world.get_resource(FurData)
-    if world.frame == 0 and fur is not None and len(fur.guides) and "rig" in world.schedule:
-        type(world.schedule["rig"])().process(world, 0.0)
+        plugin.before_recording(world)
 
 
 def scene_sha256(scene: dict[str, Any] | None) -> str:
@@ -73,11 +68,11 @@ class TakeRecorder:
         fps: float | None = None,
         scene_sha256: str | None = None,
         capacity: int = 64,
-        guides: GuideSource = plugin_curves,
+        tracks: Sequence[TrackSource] = (),
     ):
         self.world = world
-        self.guides = guides
         self._layout(world)
+        self.tracks = self._tracks([*plugin_tracks(world), *tracks])
         self.header: dict[str, Any] = {
             "format": FORMAT,
             "version": VERSION,
@@ -91,29 +86,48 @@ class TakeRecorder:
             "creatures": self._creatures,
             "bodies": self._bodies,
             "suckers": self._suckers,
-            "goals": [],
-            "guides": None,
         }
+        for recorder in self.tracks:
+            self.header[recorder.track.key] = recorder.track.empty_header()
+        declared = [r.track.declaration() for r in self.tracks if r.track not in STANDARD]
+        if declared:
+            self.header["tracks"] = declared
         bodies, suckers = len(self._rows), len(self._suckers)
         capacity = max(1, capacity)
         self._pos = np.empty((capacity, bodies, 3), np.float32)
         self._quat = np.empty((capacity, bodies, 4), np.float32)
         self._attached = np.empty((capacity, suckers), np.bool_)
         self._anchor = np.empty((capacity, suckers, 3), np.float32)
-        self._goal_columns: dict[int, int] = {}  # goal entity -> column
-        self._goal_pos: list[np.ndarray] = []
-        self._goals_alive: list[list[int]] = []  # per frame, the live columns
-        self._points: list[np.ndarray] = []
-        self._widths: list[np.ndarray] = []
         self.count = 0
         # physics recoveries, marked on the take frame that follows them
         self._health: list[dict[str, Any]] = []
         world.events.on("creature_recovered", self._on_health("recovered"))
         world.events.on("creature_frozen", self._on_health("frozen"))
 
+    def _tracks(self, sources: list[TrackSource]) -> list[PointsTrack | CurvesTrack]:
+        """A recorder per track: the standard ones first (empty if no source fills them),
+        then the others in order; a later source of the same key replaces an earlier."""
+        standard = {track.key: track for track in STANDARD}
+        chosen: dict[str, TrackSource | None] = dict.fromkeys(standard)
+        for given in sources:
+            key = given.track.key
+            if key in standard and given.track != standard[key]:
+                raise ValueError(f"take track {key!r} must be declared as {standard[key]}")
+            chosen[key] = given
+        declared = [s.track.declaration() for k, s in chosen.items() if s and k not in standard]
+        problem = declared_problem({"tracks": declared})
+        if problem:
+            raise ValueError(f"a plugin's take track is not sound: {problem}")
+        made: list[PointsTrack | CurvesTrack] = []
+        for key, source in chosen.items():
+            track = source.track if source else standard[key]
+            kind = PointsTrack if track.kind == "points" else CurvesTrack
+            made.append(kind(track, source.sample if source else None, self))
+        return made
+
     def _on_health(self, what: str) -> Any:
         def handler(*, creature: int, cause: str, **_: Any) -> None:
-            index = self._creature_index[creature]
+            index = self.creature_index[creature]
             entry = {"frame": self.count, "creature": index, "event": what, "cause": cause}
             self._health.append(entry)
 
@@ -125,7 +139,8 @@ class TakeRecorder:
         self._bodies: list[dict[str, Any]] = []
         rows: list[int] = []
         by_entity = sorted(world.query(Creature), key=lambda item: item[1].row)
-        self._creature_index = {entity: i for i, (entity, _) in enumerate(by_entity)}
+        # creature entity -> its index in the take (tracks name their owners by it)
+        self.creature_index = {entity: i for i, (entity, _) in enumerate(by_entity)}
         for index, (entity, creature) in enumerate(by_entity):
             name = creature.name
             entry: dict[str, Any] = {"name": name, "mantle": len(rows), "tentacles": []}
@@ -165,44 +180,9 @@ class TakeRecorder:
         self._quat[i] = transforms.quat[self._rows]
         self._attached[i] = world.suckers.attached
         self._anchor[i] = world.suckers.anchor
-        goals = list(world.query(Goal))
-        new = [(e, g) for e, g in goals if e not in self._goal_columns]
-        # new goals in creature, then path order: never in entity-id order, which
-        # depends on which other creatures the world holds (a shard of a bake)
-        for entity, goal in sorted(
-            new, key=lambda eg: (self._creature_index[eg[1].owner], eg[1].order)
-        ):
-            self._add_goal(entity, goal)
-        alive = sorted(self._goal_columns[entity] for entity, _ in goals)
-        self._goals_alive.append(alive)
-        guides = self.guides(world)
-        if guides is not None:
-            self._add_guides(guides)
-        elif self._points:
-            raise ValueError("fur guides disappeared during the recording")
+        for recorder in self.tracks:
+            recorder.capture(world)
         self.count += 1
-
-    def _add_goal(self, entity: int, goal: Goal) -> int:
-        column = self._goal_columns[entity] = len(self._goal_pos)
-        creature = self._creature_index[goal.owner]
-        number = sum(g["creature"] == creature for g in self.header["goals"])
-        name = f"{self._creatures[creature]['name']}/goals/goal{number}"
-        self.header["goals"].append({"name": name, "creature": creature, "radius": goal.radius})
-        self._goal_pos.append(np.asarray(goal.position, dtype=np.float64))
-        return column
-
-    def _add_guides(self, guides: GuideFrame) -> None:
-        points = np.asarray(guides.points, dtype=np.float32)
-        widths = np.broadcast_to(np.asarray(guides.widths, dtype=np.float32), points.shape[:2])
-        if points.ndim != 3 or points.shape[2] != 3:
-            raise ValueError(f"fur guide points must be (guides, points, 3), got {points.shape}")
-        if self._points and points.shape != self._points[0].shape:
-            raise ValueError(f"fur guides changed shape: {self._points[0].shape} -> {points.shape}")
-        if not self._points:
-            owners = [self._creature_index.get(int(e), -1) for e in guides.creatures]
-            self.header["guides"] = {"creatures": owners}
-        self._points.append(points)
-        self._widths.append(np.array(widths))
 
     def _grow(self) -> None:
         for name in ("_pos", "_quat", "_attached", "_anchor"):
@@ -214,10 +194,6 @@ class TakeRecorder:
     def take(self) -> Take:
         """The frames captured so far as a Take (copies; recording may go on)."""
         n = self.count
-        goals = len(self._goal_pos)
-        active = np.zeros((n, goals), np.bool_)
-        for frame, alive in enumerate(self._goals_alive):
-            active[frame, alive] = True
         header = json.loads(json.dumps(self.header))  # a deep copy
         header["frames"] = n
         events = [e for e in self._health if e["frame"] < n]
@@ -226,17 +202,94 @@ class TakeRecorder:
             "frozen": sum(e["event"] == "frozen" for e in events),
             "events": events,
         }
+        tracks: dict[str, np.ndarray] = {}
+        for recorder in self.tracks:
+            tracks.update(recorder.arrays(n))
         return Take(
             header=header,
             pos=self._pos[:n].copy(),
             quat=self._quat[:n].copy(),
             sucker_attached=self._attached[:n].copy(),
             sucker_anchor=self._anchor[:n].copy(),
-            goal_pos=np.array(self._goal_pos, np.float32).reshape(goals, 3),
-            goal_active=active,
-            guide_points=np.stack(self._points) if self._points else None,
-            guide_widths=np.stack(self._widths) if self._widths else None,
+            tracks=tracks,
         )
+
+
+class PointsTrack:
+    """Records a points track: locators appear (in creature, then `order` order, never
+    in entity-id order, which depends on which other creatures the world holds: a
+    shard of a bake), keep their first position, and are live while sampled."""
+
+    def __init__(self, track: TakeTrack, sample: Any, recorder: TakeRecorder):
+        self.track, self.sample, self.recorder = track, sample, recorder
+        self.columns: dict[int, int] = {}  # key -> column
+        self.positions: list[np.ndarray] = []
+        self.alive: list[list[int]] = []  # per frame, the live columns
+
+    def capture(self, world: World) -> None:
+        frame: PointsFrame | None = self.sample(world) if self.sample else None
+        if frame is None:
+            self.alive.append([])
+            return
+        index = self.recorder.creature_index
+        items = list(
+            zip(frame.keys, frame.creatures, frame.order, range(len(frame.keys)), strict=True)
+        )
+        new = [item for item in items if item[0] not in self.columns]
+        for key, creature, _, i in sorted(new, key=lambda it: (index[it[1]], it[2])):
+            self._add(key, index[creature], frame.positions[i], frame.radii[i])
+        self.alive.append(sorted(self.columns[key] for key in frame.keys))
+
+    def _add(self, key: int, creature: int, position: Any, radius: float) -> None:
+        entries = self.recorder.header[self.track.key]
+        self.columns[key] = len(self.positions)
+        number = sum(entry["creature"] == creature for entry in entries)
+        owner = self.recorder.header["creatures"][creature]["name"]
+        name = f"{owner}/{self.track.folder}/{self.track.item}{number}"
+        entries.append({"name": name, "creature": creature, "radius": radius})
+        self.positions.append(np.asarray(position, dtype=np.float64))
+
+    def arrays(self, frames: int) -> dict[str, np.ndarray]:
+        count = len(self.positions)
+        live = np.zeros((frames, count), np.bool_)
+        for frame, alive in enumerate(self.alive[:frames]):
+            live[frame, alive] = True
+        where, shown = self.track.arrays
+        return {where: np.array(self.positions, np.float32).reshape(count, 3), shown: live}
+
+
+class CurvesTrack:
+    """Records a curves track: every frame the same curves (shape fixed by the first)."""
+
+    def __init__(self, track: TakeTrack, sample: Any, recorder: TakeRecorder):
+        self.track, self.sample, self.recorder = track, sample, recorder
+        self.points: list[np.ndarray] = []
+        self.widths: list[np.ndarray] = []
+
+    def capture(self, world: World) -> None:
+        frame: CurvesFrame | None = self.sample(world) if self.sample else None
+        key = self.track.key
+        if frame is None:
+            if self.points:
+                raise ValueError(f"take track {key!r} disappeared during the recording")
+            return
+        points = np.asarray(frame.points, dtype=np.float32)
+        widths = np.broadcast_to(np.asarray(frame.widths, dtype=np.float32), points.shape[:2])
+        if points.ndim != 3 or points.shape[2] != 3:
+            raise ValueError(f"{key} points must be (curves, points, 3), got {points.shape}")
+        if self.points and points.shape != self.points[0].shape:
+            raise ValueError(f"{key} changed shape: {self.points[0].shape} -> {points.shape}")
+        if not self.points:
+            owners = [self.recorder.creature_index.get(int(e), -1) for e in frame.creatures]
+            self.recorder.header[key] = {"creatures": owners}
+        self.points.append(points)
+        self.widths.append(np.array(widths))
+
+    def arrays(self, frames: int) -> dict[str, np.ndarray]:
+        if not self.points:
+            return {}
+        first, second = self.track.arrays
+        return {first: np.stack(self.points[:frames]), second: np.stack(self.widths[:frames])}
 
 
 def _body(name: str, creature: int, shape: str, axis: str, part: Any) -> dict[str, Any]:

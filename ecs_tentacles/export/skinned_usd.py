@@ -11,7 +11,8 @@
                                              primvars:skel:jointIndices / jointWeights (2)
         /suckers/t<k>/link<i>/sucker<n>      Xform: translate sampled (the sucker point),
                                              `ecs:attached` sampled
-        /goals/goal<j>, /fur/guides          as in the rigid form (`ecs_tentacles.export.usd`)
+        /goals/goal<j>, /fur/guides, ...     the take's tracks, as in the rigid form
+                                             (`ecs_tentacles.export.usd`)
 
 A SkelAnimation samples all its joints at once, so with reduced keys its time samples
 are the frames where any joint has a key (each joint's value there comes from its own
@@ -28,7 +29,7 @@ from typing import Any
 import numpy as np
 
 from ecs_tentacles.atomic import atomic_output
-from ecs_tentacles.export.usd import _goal, _guides, _pxr, new_stage
+from ecs_tentacles.export.usd import _pxr, new_stage, write_tracks
 from ecs_tentacles.mathutil import quat_rotate
 from ecs_tentacles.skin.keys import KeyReport
 from ecs_tentacles.skin.mesh import Detail
@@ -66,10 +67,7 @@ def build_skinned_stage(
         _creature(pxr, stage, creature)
     for index, sucker in enumerate(take.header["suckers"]):
         _sucker(pxr, stage, take, index, sucker)
-    for index, goal in enumerate(take.header["goals"]):
-        _goal(pxr, stage, take, index, goal)
-    if take.guide_points is not None:
-        _guides(pxr, stage, take)
+    write_tracks(pxr, stage, take)
     return stage, report
 
 

@@ -7,10 +7,16 @@
         /tentacles/t<k>/link<i>               Xform: time-sampled translate + orient
           /geom                               Capsule, axis X, radius, height = spine
           /sucker<n>                          Xform at the sucker, `ecs:attached` sampled
-        /goals/goal<j>                        Xform at the goal; visibility sampled
-                                              (invisible once reached), `ecs:radius`
-        /fur/guides                           BasisCurves (linear): points, widths sampled
-      /fur/guides                             guides not owned by a creature, if any
+        /<folder>/<item><j>                   a points track's locator (the goals:
+                                              /goals/goal<j>): Xform at its position,
+                                              visibility sampled (invisible once no
+                                              longer live: a goal reached), `ecs:radius`
+        /<folder>/<item>                      a curves track (the fur guides:
+                                              /fur/guides): BasisCurves (linear),
+                                              points and widths sampled
+      /<folder>/<item>                        curves owned by no creature, if any
+
+Tracks (`ecs_tentacles.take_tracks`) are written by kind, named as the take names them.
 
 Poses are world-space (every parent is an identity transform), so the time samples
 are the take's numbers: translate (double3) = pos, orient (quatf) = quat. Stage:
@@ -27,7 +33,7 @@ from typing import Any
 import numpy as np
 
 from ecs_tentacles.atomic import atomic_output
-from ecs_tentacles.take import Take
+from ecs_tentacles.take import Take, TakeTrack
 
 
 class UsdUnavailable(RuntimeError):
@@ -99,11 +105,18 @@ def build_stage(take: Take, progress: Callable[[int], object] | None = None) -> 
                     progress(1)
     for index, sucker in enumerate(header["suckers"]):
         _sucker(pxr, stage, take, index, sucker)
-    for index, goal in enumerate(header["goals"]):
-        _goal(pxr, stage, take, index, goal)
-    if take.guide_points is not None:
-        _guides(pxr, stage, take)
+    write_tracks(pxr, stage, take)
     return stage
+
+
+def write_tracks(pxr: Any, stage: Any, take: Take) -> None:
+    """Every track of the take onto the stage, by kind (locators or curves)."""
+    for track in take.track_list():
+        if track.kind == "points":
+            for index, item in enumerate(take.header[track.key]):
+                _locator(pxr, stage, take, track, index, item)
+        elif take.tracks.get(track.arrays[0]) is not None:
+            _curves(pxr, stage, take, track)
 
 
 def _body(pxr: Any, stage: Any, take: Take, index: int) -> None:
@@ -140,41 +153,44 @@ def _sucker(pxr: Any, stage: Any, take: Take, index: int, sucker: dict[str, Any]
         attached.Set(values[frame], frame)
 
 
-def _goal(pxr: Any, stage: Any, take: Take, index: int, goal: dict[str, Any]) -> None:
+def _locator(
+    pxr: Any, stage: Any, take: Take, track: TakeTrack, index: int, item: dict[str, Any]
+) -> None:
     Gf, Sdf, UsdGeom = pxr.Gf, pxr.Sdf, pxr.UsdGeom
-    path = f"/World/{goal['name']}"
-    UsdGeom.Xform.Define(stage, path.rsplit("/", 1)[0])  # the creature's goals folder
+    where, live = (take.tracks[name] for name in track.arrays)
+    path = f"/World/{item['name']}"
+    UsdGeom.Xform.Define(stage, path.rsplit("/", 1)[0])  # the creature's folder of them
     xform = UsdGeom.Xform.Define(stage, path)
-    xform.AddTranslateOp().Set(Gf.Vec3d(*take.goal_pos[index].astype(np.float64).tolist()))
-    xform.GetPrim().CreateAttribute("ecs:radius", Sdf.ValueTypeNames.Double).Set(goal["radius"])
+    xform.AddTranslateOp().Set(Gf.Vec3d(*where[index].astype(np.float64).tolist()))
+    xform.GetPrim().CreateAttribute("ecs:radius", Sdf.ValueTypeNames.Double).Set(item["radius"])
     visibility = xform.CreateVisibilityAttr()
-    values = take.goal_active[:, index].tolist()
+    values = live[:, index].tolist()
     for frame in _changes(values):
         token = UsdGeom.Tokens.inherited if values[frame] else UsdGeom.Tokens.invisible
         visibility.Set(token, frame)
 
 
-def _guides(pxr: Any, stage: Any, take: Take) -> None:
+def _curves(pxr: Any, stage: Any, take: Take, track: TakeTrack) -> None:
     Gf, Vt, UsdGeom = pxr.Gf, pxr.Vt, pxr.UsdGeom
-    assert take.guide_points is not None and take.guide_widths is not None
-    owners = np.asarray(take.header["guides"]["creatures"], dtype=np.int64)
+    all_points, all_widths = (take.tracks[name] for name in track.arrays)
+    owners = np.asarray(take.header[track.key]["creatures"], dtype=np.int64)
     names = [c["name"] for c in take.header["creatures"]]
-    points_per_guide = take.guide_points.shape[2]
+    points_per_curve = all_points.shape[2]
     for owner in sorted(set(owners.tolist())):
         chosen = np.flatnonzero(owners == owner)
-        folder = f"/World/{names[owner]}" if 0 <= owner < len(names) else "/World"
-        UsdGeom.Xform.Define(stage, f"{folder}/fur")
-        curves = UsdGeom.BasisCurves.Define(stage, f"{folder}/fur/guides")
+        base = f"/World/{names[owner]}" if 0 <= owner < len(names) else "/World"
+        UsdGeom.Xform.Define(stage, f"{base}/{track.folder}")
+        curves = UsdGeom.BasisCurves.Define(stage, f"{base}/{track.folder}/{track.item}")
         curves.CreateTypeAttr(UsdGeom.Tokens.linear)
         curves.CreateWrapAttr(UsdGeom.Tokens.nonperiodic)
-        curves.CreateCurveVertexCountsAttr([points_per_guide] * len(chosen))
+        curves.CreateCurveVertexCountsAttr([points_per_curve] * len(chosen))
         points_attr = curves.CreatePointsAttr()
         widths_attr = curves.CreateWidthsAttr()
         curves.SetWidthsInterpolation(UsdGeom.Tokens.vertex)
         extent_attr = curves.CreateExtentAttr()
         for frame in range(take.frames):
-            points = take.guide_points[frame, chosen].reshape(-1, 3)
-            widths = take.guide_widths[frame, chosen].reshape(-1)
+            points = all_points[frame, chosen].reshape(-1, 3)
+            widths = all_widths[frame, chosen].reshape(-1)
             points_attr.Set(Vt.Vec3fArray.FromNumpy(points), frame)
             widths_attr.Set(Vt.FloatArray.FromNumpy(widths), frame)
             pad = 0.5 * float(widths.max(initial=0.0))

@@ -1,4 +1,4 @@
-"""Rendering and export hooks: guide polylines, child hairs, controls.
+"""Rendering and export hooks: guide polylines, child hairs, controls, take curves.
 
 The renderer and the exporter call these after a frame (the rig system has run):
 
@@ -22,7 +22,7 @@ from ecs_tentacles.fur import children
 from ecs_tentacles.fur.components import FurControl
 from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.mathutil import quat_rotate
-from ecs_tentacles.plugin import GuideFrame
+from ecs_tentacles.plugin import CurvesFrame
 
 if TYPE_CHECKING:
     from ecs_tentacles.world import World
@@ -132,11 +132,12 @@ def control_markers(world: World) -> list[ControlMarker]:
     return markers
 
 
-def take_guides(world: World) -> GuideFrame | None:
+def take_guides(world: World) -> CurvesFrame | None:
     """The world's fur guide curves as the rig posed them, or None without fur.
 
-    The fur plugin's export hook: world polylines and root widths (kept along each
-    guide, `ecs_tentacles.fur.hooks.guide_curves`); owners from the guides' fur sets.
+    The fur plugin's take track (`ecs_tentacles.fur.outputs`): world polylines and
+    root widths (kept along each guide, `ecs_tentacles.fur.hooks.guide_curves`);
+    owners from the guides' fur sets.
     """
     fur = world.get_resource(FurData)
     if fur is None:
@@ -146,4 +147,4 @@ def take_guides(world: World) -> GuideFrame | None:
         return None
     owners = np.asarray(fur.sets.creature)[np.asarray(fur.guides.fur_row)]
     widths = np.repeat(np.asarray(curves.width)[:, None], curves.points.shape[1], axis=1)
-    return GuideFrame(points=curves.points, widths=widths, creatures=owners)
+    return CurvesFrame(points=curves.points, widths=widths, creatures=owners)

@@ -2,19 +2,21 @@
 
 Scene keys: a creature's `fur` and `emotion` (`ecs_tentacles/fur/fur.schema.json`).
 Resources: `world.resource(FurData)` (`ecs_tentacles.fur.stores.FurData`). Systems: emotion, rig
-(stage animate). Export hook: the posed guide curves a take records. Sandbox hooks
+(stage animate). Output hooks (`ecs_tentacles.fur.outputs`): the posed guide curves a
+take records (posed at the built pose before a recording starts), and threats with
+the emotional creatures they rouse baked in one shard. Sandbox hooks
 (`ecs_tentacles.fur.render`): strands as ribbons, the controls' markers, the fur panel.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
 from ecs_tentacles.fur.build import build_emotion, build_fur
 from ecs_tentacles.fur.checks import fur_problems
 from ecs_tentacles.fur.stores import FurData
-from ecs_tentacles.plugin import GuideFrame, Plugin
+from ecs_tentacles.plugin import Plugin, TrackSource
 from ecs_tentacles.scene.validate import fragment
 from ecs_tentacles.system import System
 
@@ -67,10 +69,22 @@ class FurPlugin(Plugin):
         fur.curves[...] = curves
         fur.frames[...] = frames
 
-    def export_curves(self, world: World) -> GuideFrame | None:
-        from ecs_tentacles.fur.hooks import take_guides
+    # -- output hooks ----------------------------------------------------------------
+    def take_tracks(self, world: World) -> list[TrackSource]:
+        from ecs_tentacles.fur.outputs import GUIDE_TRACK
 
-        return take_guides(world)
+        return [GUIDE_TRACK]
+
+    def before_recording(self, world: World) -> None:
+        from ecs_tentacles.fur.outputs import pose_fur_at_build
+
+        pose_fur_at_build(world)
+
+    def shard_groups(self, creatures: Sequence[Mapping[str, Any]]) -> list[list[int]]:
+        from ecs_tentacles.fur.outputs import roused
+
+        together = roused(creatures)
+        return [together] if together else []
 
     # -- sandbox hooks: GL and ImGui are imported only when a sandbox calls these ------
     def render_lines(self, world: World, view: RenderView) -> list[Any]:

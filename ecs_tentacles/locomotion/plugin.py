@@ -10,6 +10,8 @@ Systems: goals, tentacle_selection (stage decide), action_queue, motor_targets (
 Sandbox hooks: goal rings and paths, goals set by clicks (`locomotion.render`), the
 Locomotion and Actions sections of the HUD (`locomotion.panel`). Hook: `wants_motion`
 (creatures with a goal stay awake).
+Output hooks (`ecs_tentacles.locomotion.outputs`): the goals a take records, how far a
+creature may crawl during a distributed bake, goals reached for `ecs-tentacles run`.
 """
 
 from __future__ import annotations
@@ -28,7 +30,7 @@ from ecs_tentacles.locomotion.components import Goal
 from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.locomotion.params import Locomotion
 from ecs_tentacles.locomotion.stores import LocomotionStores
-from ecs_tentacles.plugin import Plugin
+from ecs_tentacles.plugin import Plugin, Reach, RunSummary, TrackSource
 from ecs_tentacles.scene.parameters import apply_parameters
 from ecs_tentacles.scene.validate import fragment
 from ecs_tentacles.system import System
@@ -135,3 +137,19 @@ class LocomotionPlugin(Plugin):
         from ecs_tentacles.locomotion.panel import locomotion_panels
 
         return locomotion_panels(sandbox)
+
+    # -- output hooks ----------------------------------------------------------------
+    def take_tracks(self, world: World) -> list[TrackSource]:
+        from ecs_tentacles.locomotion.outputs import GOAL_TRACK
+
+        return [GOAL_TRACK]
+
+    def shard_reach(self, creature: Mapping[str, Any], seconds: float) -> Reach | None:
+        from ecs_tentacles.locomotion.outputs import crawl_reach
+
+        return crawl_reach(creature, seconds)
+
+    def run_summary(self, world: World) -> RunSummary | None:
+        from ecs_tentacles.locomotion.outputs import goal_summary
+
+        return goal_summary(world)

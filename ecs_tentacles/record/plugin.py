@@ -3,7 +3,7 @@
     record = RecordPlugin(every=2)        # a 30 fps take of a 60 fps world
     world.add_plugin(record)
     world.step(120)
-    take = record.system.take()
+    take = record.take()
 
 Systems: record (stage output), which captures the frame after everything else ran.
 """
@@ -14,11 +14,12 @@ from typing import Any
 
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.system import System
+from ecs_tentacles.take import Take
 
 
 class RecordPlugin(Plugin):
     name = "record"
-    description = "records every frame's poses, suckers, goals and fur guides into a take"
+    description = "records every frame's poses, suckers and the plugins' take tracks into a take"
 
     def __init__(self, config: dict[str, Any] | None = None, *, every: int = 1, **recorder: Any):
         super().__init__(config)
@@ -28,3 +29,7 @@ class RecordPlugin(Plugin):
 
     def systems(self) -> list[System]:
         return [self.system]
+
+    def take(self) -> Take:
+        """The frames recorded so far."""
+        return self.system.take()

@@ -1,21 +1,23 @@
 """record: appends the frame to a take (optional; `ecs-tentacles bake` adds it).
 
 Reads: Transform store (every mantle and link), Sucker store (attached, anchor),
-Goal components, fur guide curves when the world has fur. Writes: its
-`TakeRecorder`'s arrays; before the first frame only, the fur rig's output buffers
-(`pose_fur_at_build`), which the rig rewrites every frame.
+and whatever the plugins' take tracks sample (`Plugin.take_tracks`: goals, fur
+guide curves). Writes: its `TakeRecorder`'s arrays; before the first frame only,
+whatever the plugins' `before_recording` hooks write (the fur rig's output buffers,
+which the rig rewrites every frame).
 
 Runs in stage output, after everything else of the frame. It records the
-pose it finds when it joins the world (take frame 0; fur guides are posed for it
-if no frame has run yet), then every `every`-th frame, so a take at 30 fps of a
-60 fps world has `every=2`. The record plugin (`ecs_tentacles.record.plugin`) adds it.
+pose it finds when it joins the world (take frame 0; the plugins prepare it, e.g.
+fur guides are posed if no frame has run yet), then every `every`-th frame, so a
+take at 30 fps of a 60 fps world has `every=2`. The record plugin
+(`ecs_tentacles.record.plugin`) adds it.
 """
 
 from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from ecs_tentacles.export.recording import TakeRecorder, pose_fur_at_build
+from ecs_tentacles.export.recording import TakeRecorder, before_recording
 from ecs_tentacles.system import System
 from ecs_tentacles.take import Take
 
@@ -29,20 +31,21 @@ class Record(System):
     name = "record"
     calls_hooks = True  # the plugins' take hooks
     stage = "output"
-    reads = ("transforms", "suckers", "goals")
+    # and what the plugins' take tracks sample (their hook_reads: goals, fur guides)
+    reads = ("transforms.pos", "transforms.quat", "suckers.attached", "suckers.anchor")
 
     def __init__(self, every: int = 1, **recorder: Any):
         if every < 1:
             raise ValueError(f"every must be >= 1, got {every}")
         self.every = every
-        self._options = recorder  # TakeRecorder keywords: scene_sha256, capacity, guides
+        self._options = recorder  # TakeRecorder keywords: scene_sha256, capacity, tracks
         self.recorder: TakeRecorder | None = None
         self._start = 0
 
     def setup(self, world: World) -> None:
         fps = world.settings.fps / self.every
         self.recorder = TakeRecorder(world, fps=fps, **self._options)
-        pose_fur_at_build(world)
+        before_recording(world)
         self.recorder.capture()
         self._start = world.frame
 

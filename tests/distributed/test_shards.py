@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
 import pytest
 
-from ecs_tentacles.distributed.shards import pack, plan_shards, segment_distance
+from ecs_tentacles.distributed.shards import pack, plan_shards, scene_plugins, segment_distance
+from ecs_tentacles.plugin import Plugin, Reach
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.load import load_scene
 
@@ -98,3 +100,39 @@ def test_a_threat_creature_shares_a_shard_with_the_creatures_it_may_rouse() -> N
 
 def test_a_scene_without_creatures_is_one_empty_shard() -> None:
     assert plan_shards(load_scene({"version": 1}), seconds=1.0, tasks=8).shards == [[]]
+
+
+def test_without_locomotion_creatures_reach_only_as_far_as_their_bodies() -> None:
+    raw = scene((0, 0), (5, 0))
+    for creature in raw["creatures"]:
+        del creature["goals"]  # a locomotion key
+    raw["plugins"] = {"locomotion": False, "suckers": False}
+    # no crawl: however long the bake, 5 m apart never meet
+    assert plan_shards(load_scene(raw), seconds=200.0, tasks=8).shards == [[0], [1]]
+    del raw["plugins"]
+    assert plan_shards(load_scene(raw), seconds=200.0, tasks=8).shards == [[0, 1]]
+
+
+class Drifter(Plugin):
+    """Lets every creature drift 10 m in the bake, and keeps c0 and c3 in one shard."""
+
+    name = "drifter"
+
+    def shard_reach(self, creature: Mapping[str, Any], seconds: float) -> Reach:
+        return Reach(radius=10.0)
+
+    def shard_groups(self, creatures: Sequence[Mapping[str, Any]]) -> list[list[int]]:
+        return [[0, 3]]
+
+
+def test_plugins_widen_reaches_and_group_creatures() -> None:
+    data = load_scene(scene((0, 0), (50, 0), (65, 0), (150, 0)))
+    plugins = scene_plugins(data)
+    assert plan_shards(data, seconds=1.0, tasks=8, plugins=plugins).shards == [
+        [0],
+        [1],
+        [2],
+        [3],
+    ]
+    drifting = plan_shards(data, seconds=1.0, tasks=8, plugins=[*plugins, Drifter()])
+    assert drifting.shards == [[0, 3], [1, 2]] and drifting.islands == 2

@@ -19,6 +19,14 @@ import numpy as np
 from ecs_tentacles.take import write_npz
 
 Entries = dict[str, Any]  # name -> ndarray, or bytes for a raw .npy entry
+# a plugin's points track as a take header declares it (`ecs_tentacles.take_tracks`)
+BEACONS = {
+    "key": "beacons",
+    "kind": "points",
+    "arrays": ["beacon_pos", "beacon_live"],
+    "folder": "marks",
+    "item": "beacon",
+}
 
 
 def _read(good: Path) -> tuple[dict[str, Any], Entries]:
@@ -137,6 +145,15 @@ BROKEN_TAKES: dict[str, Callable[[Path, Path], None]] = {
         )
     ),
     "sucker_offset_two_numbers": edit(lambda h, a: h["suckers"][0].update(offset=[0, 0])),
+    "declared_track_without_arrays": edit(
+        lambda h, a: h.update(tracks=[dict(BEACONS)], beacons=[])
+    ),
+    "declared_track_of_unknown_kind": edit(
+        lambda h, a: h.update(tracks=[{**BEACONS, "kind": "voxels"}], beacons=[])
+    ),
+    "declared_track_reusing_goal_arrays": edit(
+        lambda h, a: h.update(tracks=[{**BEACONS, "arrays": ["goal_pos", "x"]}], beacons=[])
+    ),
     "goal_of_no_creature": edit(lambda h, a: h["goals"][0].update(creature=7)),
     "guide_owner_out_of_range": edit(lambda h, a: h["guides"].update(creatures=[5, 0, 0])),
     "bodies_not_a_list": edit(lambda h, a: h.update(bodies={"0": 1})),

@@ -14,7 +14,8 @@ import pytest
 from ecs_tentacles.systems.record.record import Record
 
 from ecs_tentacles.components import Creature, Link, Tentacle, Transform
-from ecs_tentacles.export.recording import GuideFrame
+from ecs_tentacles.fur.outputs import GUIDES
+from ecs_tentacles.plugin import CurvesFrame, TrackSource
 from ecs_tentacles.take import Take
 from ecs_tentacles.world import World
 
@@ -34,7 +35,7 @@ SMALL_SCENE: dict[str, Any] = {
 }
 
 
-def link_centres(world: World) -> GuideFrame:
+def link_centres(world: World) -> CurvesFrame:
     """Synthetic fur: one guide per tentacle through its link centres (moves with it)."""
     points, widths, owners = [], [], []
     for entity, creature in world.query(Creature):
@@ -43,7 +44,10 @@ def link_centres(world: World) -> GuideFrame:
             points.append([world.component(e, Transform).pos for e in links])
             widths.append([2 * world.component(e, Link).radius for e in links])
             owners.append(entity)
-    return GuideFrame(np.array(points), np.array(widths), np.array(owners))
+    return CurvesFrame(np.array(points), np.array(widths), np.array(owners))
+
+
+LINK_CENTRES = TrackSource(GUIDES, link_centres)  # in place of the fur plugin's guides
 
 
 def record(
@@ -60,7 +64,7 @@ def record(
 @pytest.fixture(scope="session")
 def guided_take() -> Iterator[Take]:
     """0.2 s of the small scene at 30 fps (every 2nd frame of 60), with synthetic guides."""
-    world, system = record(SMALL_SCENE, 12, every=2, guides=link_centres)
+    world, system = record(SMALL_SCENE, 12, every=2, tracks=[LINK_CENTRES])
     yield system.take()
     world.close()
 

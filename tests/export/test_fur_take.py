@@ -32,7 +32,8 @@ def test_recording_poses_guides_at_frame_0_and_follows_the_rig(tmp_path: Path) -
     system = Record()
     recorded.add_system(system)
     take = system.take()
-    assert take.guide_points is not None and np.abs(take.guide_points[0]).max() > 0.1
+    points = take.tracks["guide_points"]
+    assert np.abs(points[0]).max() > 0.1
     recorded.step(4)
     plain.step(4)
     np.testing.assert_array_equal(
@@ -40,9 +41,9 @@ def test_recording_poses_guides_at_frame_0_and_follows_the_rig(tmp_path: Path) -
     )  # no side effects
     take = system.take()
     curves = hooks.guide_curves(plain)
-    assert take.guide_points is not None and take.guide_widths is not None
-    np.testing.assert_array_equal(take.guide_points[4], curves.points)
-    np.testing.assert_array_equal(take.guide_widths[4, :, 0], curves.width)
+    points, widths = take.tracks["guide_points"], take.tracks["guide_widths"]
+    np.testing.assert_array_equal(points[4], curves.points)
+    np.testing.assert_array_equal(widths[4, :, 0], curves.width)
     assert take.header["guides"]["creatures"] == [0] * len(curves.points)
     write_usd(take, tmp_path / "cat.usda")
     pxr = pytest.importorskip("pxr")

@@ -58,7 +58,8 @@ def test_the_skinned_stage_passes_the_compliance_checker(
     assert len(skeleton.GetRestTransformsAttr().Get()) == 13
     curves = UsdGeom.BasisCurves(stage.GetPrimAtPath("/World/octo/fur/guides"))
     np.testing.assert_array_equal(
-        np.array(curves.GetPointsAttr().Get(3)), guided_take.guide_points[3].reshape(-1, 3)
+        np.array(curves.GetPointsAttr().Get(3)),
+        guided_take.tracks["guide_points"][3].reshape(-1, 3),
     )
     sucker = stage.GetPrimAtPath("/World/octo/suckers/t0/link3/sucker0")
     assert sucker.GetAttribute("ecs:attached").Get(0) is False

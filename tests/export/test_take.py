@@ -15,7 +15,7 @@ from ecs_tentacles.export.bake import BakePlan, bake, simulation_rate
 from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.take import ARRAYS, Take, TakeError
 from ecs_tentacles.world import World
-from tests.export.conftest import SMALL_SCENE, link_centres
+from tests.export.conftest import LINK_CENTRES, SMALL_SCENE, link_centres
 
 
 def live_poses(world: World) -> dict[str, tuple[np.ndarray, np.ndarray]]:
@@ -35,7 +35,7 @@ def live_poses(world: World) -> dict[str, tuple[np.ndarray, np.ndarray]]:
 
 def test_take_round_trip_equals_the_live_world_at_sampled_frames(tmp_path: Path) -> None:
     world = World.from_scene(SMALL_SCENE)
-    system = Record(2, guides=link_centres)
+    system = Record(2, tracks=[LINK_CENTRES])
     world.add_system(system)
     live = {0: live_poses(world)}
     attached = {0: world.suckers.attached.copy()}
@@ -60,7 +60,9 @@ def test_take_round_trip_equals_the_live_world_at_sampled_frames(tmp_path: Path)
             np.testing.assert_array_equal(take.pos[frame, index], pos.astype(np.float32))
             np.testing.assert_array_equal(take.quat[frame, index], quat.astype(np.float32))
         np.testing.assert_array_equal(take.sucker_attached[frame], attached[frame])
-    np.testing.assert_array_equal(take.guide_points[6], guides_now.points.astype(np.float32))
+    np.testing.assert_array_equal(
+        take.tracks["guide_points"][6], guides_now.points.astype(np.float32)
+    )
     assert take.header["guides"] == {"creatures": [0, 0, 0]}
     tips = [world.component(e, Sucker) for e in world.suckers.entity]
     assert [s["name"] for s in take.header["suckers"]] == [
@@ -85,8 +87,8 @@ def test_goals_added_and_removed_while_recording_are_tracked() -> None:
         {"name": "octo/goals/goal0", "creature": 0, "radius": 0.2},
         {"name": "octo/goals/goal1", "creature": 0, "radius": 0.5},
     ]
-    np.testing.assert_array_equal(take.goal_pos, [[1.0, 0.0, 0.0], [0.0, 2.0, 0.0]])
-    np.testing.assert_array_equal(take.goal_active, [[1, 0], [1, 0], [1, 1], [1, 0]])
+    np.testing.assert_array_equal(take.tracks["goal_pos"], [[1.0, 0.0, 0.0], [0.0, 2.0, 0.0]])
+    np.testing.assert_array_equal(take.tracks["goal_active"], [[1, 0], [1, 0], [1, 1], [1, 0]])
     world.close()
 
 

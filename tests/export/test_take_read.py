@@ -83,4 +83,5 @@ def test_a_take_without_goals_loads(tmp_path: Path) -> None:
     out = tmp_path / "hedgehog.npz"
     assert main(["bake", "hedgehog_octopus", "--seconds", "0.1", "--out", str(out), "--quiet"]) == 0
     take = Take.load(out)
-    assert take.goal_pos.shape == (0, 3) and take.goal_active.shape == (take.frames, 0)
+    assert take.tracks["goal_pos"].shape == (0, 3)
+    assert take.tracks["goal_active"].shape == (take.frames, 0)

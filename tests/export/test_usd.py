@@ -82,9 +82,9 @@ def test_reopened_values_equal_the_take_at_sampled_time_codes(
             np.testing.assert_allclose(world, take.pos[frame, index], atol=1e-7)
         curves = UsdGeom.BasisCurves(stage.GetPrimAtPath("/World/octo/fur/guides"))
         points = np.array(curves.GetPointsAttr().Get(frame))
-        np.testing.assert_array_equal(points, take.guide_points[frame].reshape(-1, 3))
+        np.testing.assert_array_equal(points, take.tracks["guide_points"][frame].reshape(-1, 3))
         widths = np.array(curves.GetWidthsAttr().Get(frame))
-        np.testing.assert_array_equal(widths, take.guide_widths[frame].reshape(-1))
+        np.testing.assert_array_equal(widths, take.tracks["guide_widths"][frame].reshape(-1))
     assert list(curves.GetCurveVertexCountsAttr().Get()) == [4, 4, 4]
     assert curves.GetTypeAttr().Get() == "linear"
     assert curves.GetWidthsInterpolation() == "vertex"
@@ -136,11 +136,17 @@ def test_usdc_and_usda_hold_the_same_samples(guided_take: Take, tmp_path: Path) 
 def test_reached_goals_turn_invisible_and_suckers_switch(guided_take: Take) -> None:
     from dataclasses import replace
 
-    goals = guided_take.goal_active.copy()
+    goals = guided_take.tracks["goal_active"].copy()
     goals[3:, 0] = False  # reached at frame 3
     suckers = guided_take.sucker_attached.copy()
     suckers[:, 1] = [False, False, True, True, False, False, False]
-    stage = build_stage(replace(guided_take, goal_active=goals, sucker_attached=suckers))
+    stage = build_stage(
+        replace(
+            guided_take,
+            tracks={**guided_take.tracks, "goal_active": goals},
+            sucker_attached=suckers,
+        )
+    )
     goal = UsdGeom.Imageable(stage.GetPrimAtPath("/World/octo/goals/goal0"))
     assert [goal.ComputeVisibility(f) for f in (0, 2, 3, 6)] == [
         "inherited",

@@ -1,0 +1,67 @@
+"""What locomotion adds to the generic outputs (the locomotion plugin's output hooks).
+
+- take track `goals` (points): every goal a creature had during the recording, where
+  it was, and whether it was still in the creature's path at each frame;
+- shard reach: how far a creature may crawl during a bake (`CRAWL_SPEED` x its
+  `locomotion.speed` x the bake's seconds), straight toward its first goal when that
+  is farther than it can crawl, anywhere within that distance otherwise;
+- run summary: goals reached and goals left.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ecs_tentacles.components import Creature
+from ecs_tentacles.locomotion.components import Goal
+from ecs_tentacles.locomotion.goals import GoalBook
+from ecs_tentacles.plugin import PointsFrame, Reach, RunSummary, TrackSource
+from ecs_tentacles.take_tracks import TakeTrack
+
+if TYPE_CHECKING:
+    from ecs_tentacles.world import World
+
+GOALS = TakeTrack("goals", "points", ("goal_pos", "goal_active"), "goals", "goal")
+CRAWL_SPEED = 0.25  # m/s per unit of `locomotion.speed`: twice the fastest crawl measured
+
+
+def goal_points(world: World) -> PointsFrame:
+    """The live goals: each goal entity, its owner, its order in the path, where it is."""
+    goals = list(world.query(Goal))
+    return PointsFrame(
+        keys=[entity for entity, _ in goals],
+        creatures=[goal.owner for _, goal in goals],
+        order=[goal.order for _, goal in goals],
+        positions=[goal.position for _, goal in goals],
+        radii=[goal.radius for _, goal in goals],
+    )
+
+
+GOAL_TRACK = TrackSource(GOALS, goal_points)
+
+
+def crawl_reach(creature: Mapping[str, Any], seconds: float) -> Reach:
+    """Where a creature (scene entry, defaults in) may crawl in `seconds`, beyond its body."""
+    travel = CRAWL_SPEED * creature["locomotion"]["speed"] * seconds
+    goals = creature["goals"]
+    if goals:
+        start = np.asarray(creature["position"][:2], dtype=np.float64)
+        towards = np.asarray(goals[0]["position"][:2], dtype=np.float64) - start
+        length = float(np.linalg.norm(towards))
+        if length >= travel:  # it heads straight for the goal all the bake
+            x, y = (towards * (travel / length)).tolist()
+            return Reach(towards=(x, y))
+    return Reach(radius=travel)
+
+
+def goal_summary(world: World) -> RunSummary:
+    """Goals reached so far and goals still in every creature's path."""
+    reached = int(world.events.counts["goal_reached"])
+    book = world.resource(GoalBook)
+    left = int(sum(len(book.path(e)) for e, _ in world.query(Creature)))
+    return RunSummary(
+        {"goals_reached": reached, "goals_left": left}, f"goals reached {reached}, left {left}"
+    )
