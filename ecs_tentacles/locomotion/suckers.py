@@ -2,8 +2,9 @@
 
 Needs locomotion (its actions command attach and detach; its `locomotion` settings
 carry the release thresholds). Systems: suckers (stage act). The sucker bodies and
-their MuJoCo constraints are core (every creature has them; without this plugin they
-stay released unless a script attaches them with `world.attach`).
+their MuJoCo constraints are core (every creature has them); without this plugin they
+stay released unless a script attaches them (`ecs_tentacles.locomotion.grip`:
+`attach(world, sucker)`, `release(world, sucker)`, `sucker_points(world)`).
 """
 
 from __future__ import annotations

@@ -12,6 +12,7 @@ from numpy.testing import assert_array_equal
 from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.physics.sleep import SETTLE_FRAMES
 from ecs_tentacles.world import World
+from tests.conftest import NO_LOCOMOTION
 
 RESTING = {"count": 3, "links": 5, "wave_amplitude_deg": 0, "writhe": 0}
 
@@ -45,7 +46,7 @@ def test_a_still_idle_creature_sleeps_and_a_goal_wakes_it(
 
 
 def test_a_script_moving_a_servo_wakes_it(make_world: Callable[..., World]) -> None:
-    world = make_world(_scene(RESTING), locomotion=False)  # the script drives the servos
+    world = make_world(_scene(RESTING), plugins=NO_LOCOMOTION)  # the script drives the servos
     rest = world.physics.groups[0]
     world.step(240)
     assert rest.sleeping
