@@ -40,8 +40,8 @@ from typing import TYPE_CHECKING, Any, ClassVar
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
+    from ecs_tentacles.host import Host
     from ecs_tentacles.store import ArrayStore
-    from ecs_tentacles.world import World
 
 ENTRY_POINTS = "ecs_tentacles.plugins"
 # name -> where it lives; imported only when a world uses it
@@ -106,7 +106,7 @@ class Plugin:
         return []
 
     # -- building ------------------------------------------------------------------------
-    def resources(self, world: World) -> Sequence[object] | Mapping[str, object]:
+    def resources(self, world: Host) -> Sequence[object] | Mapping[str, object]:
         """Stores and APIs this plugin owns, reachable by type: `world.resource(MyStore)`.
 
         One object per type; give its class `provided_by = "<plugin name>"` so a world
@@ -114,16 +114,16 @@ class Plugin:
         """
         return ()
 
-    def stores(self, world: World) -> Mapping[str, ArrayStore]:
+    def stores(self, world: Host) -> Mapping[str, ArrayStore]:
         """This plugin's stores by name (`"fur.guides"`: starting with the plugin's name),
         called after `resources`. Systems declare reads and writes as `<store>.<field>`
         against these names; snapshots copy them."""
         return {}
 
-    def build_creature(self, world: World, creature: int, spec: Mapping[str, Any]) -> None:
+    def build_creature(self, world: Host, creature: int, spec: Mapping[str, Any]) -> None:
         """Called for each creature, after its body is built (spec: its scene entry)."""
 
-    def build_scene(self, world: World, scene: Mapping[str, Any]) -> None:
+    def build_scene(self, world: Host, scene: Mapping[str, Any]) -> None:
         """Called once after every creature is built, before physics is compiled."""
 
     def systems(self) -> list[System]:
@@ -131,19 +131,19 @@ class Plugin:
         return []
 
     # -- state ---------------------------------------------------------------------------
-    def snapshot(self, world: World) -> Any:
+    def snapshot(self, world: Host) -> Any:
         """A copy of this plugin's state between frames (for `world.snapshot()`)."""
         return None
 
-    def restore(self, world: World, state: Any) -> None:
+    def restore(self, world: Host, state: Any) -> None:
         """Put back what `snapshot` returned."""
 
     # -- hooks ---------------------------------------------------------------------------
-    def render_spheres(self, world: World) -> list[Marker]:
+    def render_spheres(self, world: Host) -> list[Marker]:
         """Marker spheres the sandbox draws this frame."""
         return []
 
-    def export_curves(self, world: World) -> GuideFrame | None:
+    def export_curves(self, world: Host) -> GuideFrame | None:
         """Curves a take records each frame (fur guides), or None."""
         return None
 

@@ -18,8 +18,8 @@ from ecs_tentacles.scene.validate import fragment
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
+    from ecs_tentacles.host import Host
     from ecs_tentacles.store import ArrayStore
-    from ecs_tentacles.world import World
 
 _FRAGMENT = fragment("ecs_tentacles.fur", "fur")
 STORES = ("guides", "controls", "sets", "emotions")
@@ -34,10 +34,10 @@ class FurPlugin(Plugin):
     def problems(self, scene: Mapping[str, Any]) -> list[tuple[tuple[str | int, ...], str]]:
         return fur_problems(scene)
 
-    def resources(self, world: World) -> list[object]:
+    def resources(self, world: Host) -> list[object]:
         return [FurData()]
 
-    def build_creature(self, world: World, creature: int, spec: Mapping[str, Any]) -> None:
+    def build_creature(self, world: Host, creature: int, spec: Mapping[str, Any]) -> None:
         if "fur" in spec:
             build_fur(world, creature, dict(spec["fur"]))
         if "emotion" in spec:
@@ -49,21 +49,21 @@ class FurPlugin(Plugin):
 
         return [EmotionSystem(), Rig()]
 
-    def stores(self, world: World) -> dict[str, ArrayStore]:
+    def stores(self, world: Host) -> dict[str, ArrayStore]:
         fur = world.resource(FurData)
         return {f"fur.{name}": getattr(fur, name) for name in STORES}
 
-    def snapshot(self, world: World) -> Any:
+    def snapshot(self, world: Host) -> Any:
         fur = world.resource(FurData)  # its stores are copied with every store
         return fur.curves.copy(), fur.frames.copy()
 
-    def restore(self, world: World, state: Any) -> None:
+    def restore(self, world: Host, state: Any) -> None:
         curves, frames = state
         fur = world.resource(FurData)
         fur.curves[...] = curves
         fur.frames[...] = frames
 
-    def export_curves(self, world: World) -> GuideFrame | None:
+    def export_curves(self, world: Host) -> GuideFrame | None:
         from ecs_tentacles.fur.hooks import take_guides
 
         return take_guides(world)

@@ -23,7 +23,7 @@ import numpy as np
 from ecs_tentacles.components import Tentacle
 
 if TYPE_CHECKING:
-    from ecs_tentacles.world import World
+    from ecs_tentacles.host import Host
 
 
 class Kind(IntEnum):
@@ -150,7 +150,7 @@ class ActionQueues:
     shares it. Built from the tentacles the world has now.
     """
 
-    def __init__(self, world: World):
+    def __init__(self, world: Host):
         self._tentacles = world.tentacles
         by_row = {t.row: world.component(e, ActionQueue) for e, t in world.query(Tentacle)}
         # a row without a tentacle entity (stores filled by hand) gets a queue of its own

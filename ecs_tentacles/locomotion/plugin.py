@@ -22,7 +22,7 @@ from ecs_tentacles.scene.validate import fragment
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
-    from ecs_tentacles.world import World
+    from ecs_tentacles.host import Host
 
 _FRAGMENT = fragment("ecs_tentacles.locomotion", "locomotion")
 
@@ -33,10 +33,10 @@ class LocomotionPlugin(Plugin):
     creature_schema = _FRAGMENT["creature"]
     defs = _FRAGMENT["$defs"]
 
-    def resources(self, world: World) -> list[object]:
+    def resources(self, world: Host) -> list[object]:
         return [GoalBook(world), Locomotion(world)]
 
-    def build_creature(self, world: World, creature: int, spec: Mapping[str, Any]) -> None:
+    def build_creature(self, world: Host, creature: int, spec: Mapping[str, Any]) -> None:
         row = world.component(creature, Creature).row
         apply_parameters(world, "locomotion", spec["locomotion"], creatures=row)
         for entity in world.component(creature, Creature).tentacles:
@@ -56,7 +56,7 @@ class LocomotionPlugin(Plugin):
 
         return [Goals(), TentacleSelection(), ActionQueueSystem(), MotorTargets()]
 
-    def snapshot(self, world: World) -> Any:
+    def snapshot(self, world: Host) -> Any:
         goals = {
             entity: [
                 (world.component(g, Goal).position.copy(), world.component(g, Goal).radius)
@@ -67,7 +67,7 @@ class LocomotionPlugin(Plugin):
         queues = {e: copy.deepcopy(q.pending) for e, q in world.query(ActionQueue)}
         return goals, queues
 
-    def restore(self, world: World, state: Any) -> None:
+    def restore(self, world: Host, state: Any) -> None:
         goals, queues = state
         for entity, path in goals.items():
             world.resource(GoalBook).clear(entity)

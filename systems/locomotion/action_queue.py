@@ -20,7 +20,7 @@ from ecs_tentacles.locomotion.actions import ATTACH_PATIENCE, STRENGTH, ActionQu
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
-    from ecs_tentacles.world import World
+    from ecs_tentacles.host import Host
 
 TIME_EPSILON = 1e-9  # sums of frame durations fall a hair short of whole durations
 ATTACH = int(Kind.ATTACH)
@@ -32,10 +32,10 @@ class ActionQueueSystem(System):
     reads = ("action_queues", "suckers.attached")
     writes = ("tentacles.action", "tentacles.timer", "tentacles.orient")
 
-    def setup(self, world: World) -> None:
+    def setup(self, world: Host) -> None:
         self.queues = ActionQueues(world)
 
-    def process(self, world: World, dt: float) -> None:
+    def process(self, world: Host, dt: float) -> None:
         t = world.tentacles
         if not len(t):
             return
@@ -53,7 +53,7 @@ class ActionQueueSystem(System):
         for row in np.flatnonzero(done):
             self._advance(world, int(row))
 
-    def _advance(self, world: World, row: int) -> None:
+    def _advance(self, world: Host, row: int) -> None:
         t = world.tentacles
         queue = self.queues[row].pending
         t.timer[row] = 0.0

@@ -15,7 +15,7 @@ from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
-    from ecs_tentacles.world import World
+    from ecs_tentacles.host import Host
 
 
 class Goals(System):
@@ -24,7 +24,7 @@ class Goals(System):
     reads = ("transforms.pos", "goals")
     writes = ("goals", "creatures.goal", "creatures.has_goal")
 
-    def process(self, world: World, dt: float) -> None:
+    def process(self, world: Host, dt: float) -> None:
         creatures = world.creatures
         if not creatures.has_goal.any():
             return

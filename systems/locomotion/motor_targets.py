@@ -24,7 +24,7 @@ from ecs_tentacles.locomotion.actions import ATTACH_PATIENCE, GRIPPING, Kind, Mo
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
-    from ecs_tentacles.world import World
+    from ecs_tentacles.host import Host
 
 # Constant pitch (radians, positive = tip down) of each action's pose.
 LIFT = np.zeros(len(Kind))
@@ -56,7 +56,7 @@ class MotorTargets(System):
     writes = ("motors.target", "motors.gain")
     state_attributes = ("eased",)
 
-    def setup(self, world: World) -> None:
+    def setup(self, world: Host) -> None:
         motors, tentacles = world.motors, world.tentacles
         rows = np.arange(len(motors))
         first = tentacles.first_link
@@ -72,7 +72,7 @@ class MotorTargets(System):
         # (user waves, the HUD) do not feed back into the easing
         self.eased = motors.target[:, :2].copy()
 
-    def process(self, world: World, dt: float) -> None:
+    def process(self, world: Host, dt: float) -> None:
         motors, t = world.motors, world.tentacles
         if not len(motors):
             return

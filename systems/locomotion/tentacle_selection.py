@@ -37,7 +37,7 @@ from ecs_tentacles.scene.parameters import parameter
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
-    from ecs_tentacles.world import World
+    from ecs_tentacles.host import Host
 
 PULL = int(Mode.PULL)
 PULL_TOLERANCE = 1e-9  # dot products this close to 0 count as the +-pi/2 boundary: pull
@@ -63,12 +63,12 @@ class TentacleSelection(System):
     reads = ("creatures.goal", "transforms.pos", "tentacles.action")
     writes = ("tentacles.driving", "tentacles.mode", "action_queues")
 
-    def setup(self, world: World) -> None:
+    def setup(self, world: Host) -> None:
         gait = parameter("locomotion", "gait")  # stored codes: the schema's choices' indices
         self.cyclic, self.coordinated = gait.code("cyclic"), gait.code("coordinated")
         self.queues = ActionQueues(world)
 
-    def process(self, world: World, dt: float) -> None:
+    def process(self, world: Host, dt: float) -> None:
         t, c = world.tentacles, world.creatures
         if not len(t) or not (c.has_goal.any() or t.driving.any()):
             return
@@ -104,7 +104,7 @@ class TentacleSelection(System):
 
     def _start_best(
         self,
-        world: World,
+        world: Host,
         creature_row: int,
         cos: np.ndarray,
         pull: np.ndarray,
@@ -129,7 +129,7 @@ class TentacleSelection(System):
         self._start(world, k, mode, orient=float(np.clip(turn, -limit, limit)))
         c.last_start[creature_row] = world.time
 
-    def _start(self, world: World, row: int, mode: Mode, orient: float | None) -> None:
+    def _start(self, world: Host, row: int, mode: Mode, orient: float | None) -> None:
         t = world.tentacles
         speed = float(t.speed[row] * world.creatures.speed[t.creature_row[row]])
         # queued after whatever is pending; the current action ends now
@@ -139,7 +139,7 @@ class TentacleSelection(System):
         t.mode[row] = mode
         t.started[row] = world.time
 
-    def _abort(self, world: World, row: int) -> None:
+    def _abort(self, world: Host, row: int) -> None:
         t = world.tentacles
         speed = float(t.speed[row] * world.creatures.speed[t.creature_row[row]])
         self.queues.replace(row, [action(Kind.DETACH, speed), action(Kind.SETTLE, speed)])
