@@ -20,7 +20,7 @@ from ecs_tentacles.mathutil import quat_about_z
 from ecs_tentacles.scene.parameters import apply_parameters, parameter
 
 if TYPE_CHECKING:
-    from ecs_tentacles.world import World
+    from ecs_tentacles.host import Host
 
 
 def creature_rng(seed: int, name: str) -> np.random.Generator:
@@ -34,7 +34,7 @@ def creature_rng(seed: int, name: str) -> np.random.Generator:
     return np.random.default_rng([int(seed), key])
 
 
-def build_creature(world: World, spec: dict[str, Any]) -> int:
+def build_creature(world: Host, spec: dict[str, Any]) -> int:
     """Create one creature's entities from its scene entry; return the creature entity."""
     mantle = spec["mantle"]
     tentacles = spec["tentacles"]
@@ -70,7 +70,7 @@ def build_creature(world: World, spec: dict[str, Any]) -> int:
 
 
 def _add_tentacle_row(
-    world: World,
+    world: Host,
     tentacle: Tentacle,
     creature_row: int,
     layout: CreatureLayout,
@@ -99,7 +99,7 @@ def _add_tentacle_row(
 
 
 def _build_links(
-    world: World,
+    world: Host,
     tentacle: Tentacle,
     tentacle_entity: int,
     layout: CreatureLayout,

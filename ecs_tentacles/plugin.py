@@ -47,8 +47,8 @@ if TYPE_CHECKING:
     import numpy as np
 
     from ecs_tentacles.drawing import Click, Panel, RenderView
+    from ecs_tentacles.host import Host
     from ecs_tentacles.store import ArrayStore
-    from ecs_tentacles.world import World
 
 ENTRY_POINTS = "ecs_tentacles.plugins"
 # name -> where it lives; imported only when a world uses it
@@ -107,7 +107,7 @@ class TrackSource:
     as the kind says, or None: nothing this frame)."""
 
     track: TakeTrack
-    sample: Callable[[World], PointsFrame | CurvesFrame | None]
+    sample: Callable[[Host], PointsFrame | CurvesFrame | None]
 
 
 @dataclass(frozen=True)
@@ -165,7 +165,7 @@ class Plugin:
         return []
 
     # -- building ------------------------------------------------------------------------
-    def resources(self, world: World) -> Sequence[object] | Mapping[str, object]:
+    def resources(self, world: Host) -> Sequence[object] | Mapping[str, object]:
         """Stores and APIs this plugin owns, reachable by type: `world.resource(MyStore)`.
 
         One object per type; give its class `provided_by = "<plugin name>"` so a world
@@ -173,16 +173,16 @@ class Plugin:
         """
         return ()
 
-    def stores(self, world: World) -> Mapping[str, ArrayStore]:
+    def stores(self, world: Host) -> Mapping[str, ArrayStore]:
         """This plugin's stores by name (`"fur.guides"`: starting with the plugin's name),
         called after `resources`. Systems declare reads and writes as `<store>.<field>`
         against these names; snapshots copy them."""
         return {}
 
-    def build_creature(self, world: World, creature: int, spec: Mapping[str, Any]) -> None:
+    def build_creature(self, world: Host, creature: int, spec: Mapping[str, Any]) -> None:
         """Called for each creature, after its body is built (spec: its scene entry)."""
 
-    def build_scene(self, world: World, scene: Mapping[str, Any]) -> None:
+    def build_scene(self, world: Host, scene: Mapping[str, Any]) -> None:
         """Called once after every creature is built, before physics is compiled."""
 
     def systems(self) -> list[System]:
@@ -190,31 +190,31 @@ class Plugin:
         return []
 
     # -- state ---------------------------------------------------------------------------
-    def snapshot(self, world: World) -> Any:
+    def snapshot(self, world: Host) -> Any:
         """A copy of this plugin's state between frames (for `world.snapshot()`)."""
         return None
 
-    def restore(self, world: World, state: Any) -> None:
+    def restore(self, world: Host, state: Any) -> None:
         """Put back what `snapshot` returned."""
 
     # -- hooks ---------------------------------------------------------------------------
-    def render_spheres(self, world: World) -> list[Marker]:
+    def render_spheres(self, world: Host) -> list[Marker]:
         """Marker spheres the sandbox draws this frame."""
         return []
 
     # -- sandbox hooks (the generic renderer, HUD and mouse call these) ------------------
-    def render_lines(self, world: World, view: RenderView) -> list[Any]:
+    def render_lines(self, world: Host, view: RenderView) -> list[Any]:
         """Line-list vertices (2n, 7: xyz rgba) the sandbox draws this frame, in its one
         line batch (`drawing.line_segments` makes them from polylines)."""
         return []
 
-    def render_draw(self, world: World, view: RenderView) -> int:
+    def render_draw(self, world: Host, view: RenderView) -> int:
         """Draw what spheres and lines cannot, with this plugin's own GL objects (made
         lazily here, kept in `view.state`); runs after the renderer's own draws with the
         depth test on. Returns the draw calls issued."""
         return 0
 
-    def render_points(self, world: World) -> Any:
+    def render_points(self, world: Host) -> Any:
         """Points (n, 3) the camera's "frame all" keeps in view besides the creatures, or None."""
         return None
 
@@ -223,19 +223,19 @@ class Plugin:
         asked once per sandbox: panels live across resets (`Panel.attach`)."""
         return []
 
-    def sandbox_click(self, world: World, click: Click) -> bool:
+    def sandbox_click(self, world: Host, click: Click) -> bool:
         """A click in the sandbox's 3D view; True: handled (later plugins do not see it)."""
         return False
 
     # -- output hooks (takes, shard plans, run reports) -------------------------------
-    def take_tracks(self, world: World) -> Sequence[TrackSource]:
+    def take_tracks(self, world: Host) -> Sequence[TrackSource]:
         """Tracks this plugin adds to every take recorded from `world` (the goals, the
         fur guides; `ecs_tentacles.take_tracks` describes the kinds). A track with a
         standard key (`goals`, `guides`) must be declared as the standard one; others
         are declared in the take's header, so a take file describes itself."""
         return ()
 
-    def before_recording(self, world: World) -> None:
+    def before_recording(self, world: Host) -> None:
         """Called once when a recording starts, before its first frame is captured
         (the fur plugin poses its guides at the built pose)."""
 
@@ -250,11 +250,11 @@ class Plugin:
         they are (fur: threats and the emotional creatures they rouse)."""
         return []
 
-    def run_summary(self, world: World) -> RunSummary | None:
+    def run_summary(self, world: Host) -> RunSummary | None:
         """Counts `ecs-tentacles run` reports after stepping `world` (goals reached)."""
         return None
 
-    def wants_motion(self, world: World) -> np.ndarray | None:
+    def wants_motion(self, world: Host) -> np.ndarray | None:
         """Which creatures this plugin wants to move now: bool per CreatureStore row, or
         None for none. Asked every frame before the physics step; a creature some plugin
         wants to move never falls asleep (`ecs_tentacles.physics.sleep`). Answer with

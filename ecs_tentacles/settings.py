@@ -1,27 +1,59 @@
-"""A world's settings: the fixed-step clock and the physics constants.
+"""`Settings`: a world's fixed-step clock and physics constants.
 
-Core: imports nothing of the engine, so the physics package and the World both use it.
-`World.from_scene` fills it from the scene's `physics` block; `ecs_tentacles.world`
-re-exports it (`from ecs_tentacles.world import Settings` keeps working).
+Their defaults are read from the core scene schema's `physics` properties
+(`assets/schema/core.schema.json`), the one place they are written, so a world built
+without a scene (`World()`) runs with the same constants as a scene that leaves
+`physics` out. `BUILD_ONLY` are the `physics` keys used while a scene is built, not
+while it runs.
 """
 
 from __future__ import annotations
 
+import importlib.resources
+import json
+from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any
+
+BUILD_ONLY = ("separate_overlaps",)  # read by scene validation, not kept in Settings
+
+
+def physics_defaults() -> dict[str, Any]:
+    """The `physics` defaults of the core scene schema, by key."""
+    schema = importlib.resources.files("ecs_tentacles.assets") / "schema" / "core.schema.json"
+    physics = json.loads(schema.read_text(encoding="utf-8"))["properties"]["physics"]
+    return {key: spec["default"] for key, spec in physics["properties"].items()}
+
+
+_DEFAULT = physics_defaults()
 
 
 @dataclass(frozen=True)
 class Settings:
-    """The fixed-step clock and physics constants of a world."""
+    """The fixed-step clock and physics constants of a world (a scene's `physics`)."""
 
-    fps: float = 60.0
-    substeps: int = 8
-    gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)
-    ground_friction: float = 1.0
-    sucker_timeconst: float = 0.005
-    max_speed: float = 12.0  # m/s: a body faster than this has blown up (physics/health.py)
-    max_penetration: float = 0.05  # m: a contact deeper than this has blown up
-    sleep: bool = True  # still, idle creatures are not stepped (physics/sleep.py)
+    fps: float = float(_DEFAULT["fps"])
+    substeps: int = int(_DEFAULT["substeps"])
+    gravity: tuple[float, float, float] = tuple(float(g) for g in _DEFAULT["gravity"])  # type: ignore[assignment]
+    ground_friction: float = float(_DEFAULT["ground_friction"])
+    sucker_timeconst: float = float(_DEFAULT["sucker_timeconst"])
+    max_speed: float = float(_DEFAULT["max_speed"])  # m/s: faster has blown up (physics/health.py)
+    max_penetration: float = float(_DEFAULT["max_penetration"])  # m: deeper has blown up
+    sleep: bool = bool(_DEFAULT["sleep"])  # still, idle creatures are not stepped (physics/sleep)
+
+    @classmethod
+    def from_physics(cls, physics: Mapping[str, Any]) -> Settings:
+        """The settings of a scene's `physics` object (defaults filled in)."""
+        return cls(
+            fps=float(physics["fps"]),
+            substeps=int(physics["substeps"]),
+            gravity=tuple(float(g) for g in physics["gravity"]),  # type: ignore[arg-type]
+            ground_friction=float(physics["ground_friction"]),
+            sucker_timeconst=float(physics["sucker_timeconst"]),
+            max_speed=float(physics["max_speed"]),
+            max_penetration=float(physics["max_penetration"]),
+            sleep=bool(physics["sleep"]),
+        )
 
     @property
     def dt(self) -> float:

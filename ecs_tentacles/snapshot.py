@@ -17,14 +17,19 @@ from __future__ import annotations
 
 import copy
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
 if TYPE_CHECKING:
+    from ecs_tentacles.host import Host
     from ecs_tentacles.physics.backend import PhysicsState
     from ecs_tentacles.store import ArrayStore
-    from ecs_tentacles.world import World
+
+    class Restorable(Host, Protocol):
+        """A world whose clock a restore sets (`ecs_tentacles.world.World` is one)."""
+
+        frame: int
 
 
 @dataclass
@@ -39,11 +44,11 @@ class Snapshot:
     systems: dict[str, dict[str, Any]] = field(default_factory=dict)
 
 
-def _stores(world: World) -> dict[str, ArrayStore]:
+def _stores(world: Restorable) -> dict[str, ArrayStore]:
     return world.stores  # the core's and every plugin's, by name
 
 
-def take(world: World) -> Snapshot:
+def take(world: Restorable) -> Snapshot:
     """Copy the world's state (see the module docstring)."""
     return Snapshot(
         frame=world.frame,
@@ -59,7 +64,7 @@ def take(world: World) -> Snapshot:
     )
 
 
-def restore(world: World, snapshot: Snapshot) -> None:
+def restore(world: Restorable, snapshot: Snapshot) -> None:
     """Put the world back in `snapshot`'s state."""
     world.frame = snapshot.frame
     world.rng.bit_generator.state = copy.deepcopy(snapshot.rng)

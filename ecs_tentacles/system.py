@@ -29,7 +29,7 @@ import traceback
 from typing import TYPE_CHECKING, ClassVar
 
 if TYPE_CHECKING:
-    from ecs_tentacles.world import World
+    from ecs_tentacles.host import Host
 
 STAGES = ("decide", "act", "physics", "sync", "animate", "output")
 DEFAULT_STAGE = "act"
@@ -51,13 +51,13 @@ class System:
     state_attributes: ClassVar[tuple[str, ...]] = ()
     plugin: str = ""  # the plugin that added this system ("" when added directly)
 
-    def setup(self, world: World) -> None:
+    def setup(self, world: Host) -> None:
         """Called once when the system joins a world (after physics is built)."""
 
-    def process(self, world: World, dt: float) -> None:
+    def process(self, world: Host, dt: float) -> None:
         """Called once per frame, in schedule order; `dt` is the frame duration."""
 
-    def substep(self, world: World, index: int, dt: float) -> None:
+    def substep(self, world: Host, index: int, dt: float) -> None:
         """Called before each physics substep `index` when overridden; `dt` per substep."""
 
     @classmethod

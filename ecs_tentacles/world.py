@@ -11,7 +11,6 @@ live side by side; every World method switches to its context first.
 
 from __future__ import annotations
 
-import importlib
 import os
 import pathlib
 import uuid
@@ -21,11 +20,10 @@ from typing import TYPE_CHECKING, Any, TypeVar
 import esper
 import numpy as np
 
-from ecs_tentacles.components import Creature, Sucker
+from ecs_tentacles.components import Creature
 from ecs_tentacles.events import Events
-from ecs_tentacles.mathutil import quat_rotate
 from ecs_tentacles.physics.backend import PhysicsBackend
-from ecs_tentacles.plugin import Plugin, SystemsPlugin, scene_first
+from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.schedule import Schedule
 from ecs_tentacles.settings import Settings as Settings  # re-exported: old imports work
 from ecs_tentacles.store import (
@@ -41,9 +39,10 @@ from ecs_tentacles.system import System, SystemFailure
 if TYPE_CHECKING:
     from ecs_tentacles.snapshot import Snapshot
 
+__all__ = ["MissingResource", "Settings", "World"]  # Settings lives in ecs_tentacles.settings
+
 C = TypeVar("C")
 R = TypeVar("R")
-LOCOMOTION_PLUGINS = ("locomotion", "suckers")  # their systems stay out with locomotion=False
 
 
 class World:
@@ -87,7 +86,6 @@ class World:
         *,
         seed: int | None = None,
         allow_systems: bool = False,
-        locomotion: bool = True,
         threads: int | None = None,
         only: Collection[int] | None = None,
         plugins: Mapping[str, Any] | None = None,
@@ -96,84 +94,32 @@ class World:
         """Build a world from a scene file, bundled scene name or dict.
 
         Validates, builds the entities (the creature bodies, then each plugin's build
-        hooks), compiles the physics, schedules the systems of every plugin on.
+        hooks), compiles the physics, schedules the systems of every plugin on
+        (`ecs_tentacles.world_loader`).
 
         Raises `SceneError` (one line per problem) before anything is built. Plugins
         from a file or module, and systems the scene names, are imported only with
         `allow_systems=True`; files are looked up in the scene's folder (`scene_dir` for
         a dict). `plugins` turns plugins on, off or configures them over what the scene
-        says. With `locomotion=False` the locomotion and suckers plugins build their data
-        but their systems do not run, so scripts drive the motors themselves. `threads`
-        steps the physics groups on that many threads (default: one per core); results
-        do not depend on it. `only` builds just the creatures at those scene indices (a
-        shard of a distributed bake); `world.scene` is still the whole scene.
+        says (`{"locomotion": False, "suckers": False}`: scripts drive the motors).
+        `threads` steps the physics groups on that many threads (default: one per
+        core); results do not depend on it. `only` builds just the creatures at those
+        scene indices (a shard of a distributed bake); `world.scene` is still the whole
+        scene.
         """
-        from ecs_tentacles.build import build_creature
-        from ecs_tentacles.physics.systems import physics_systems
-        from ecs_tentacles.scene.errors import SceneError
-        from ecs_tentacles.scene.load import load_scene_plugins, resolve_scene_path
+        from ecs_tentacles.world_loader import WorldClass, load_world
 
-        folder = pathlib.Path(scene_dir) if scene_dir is not None else None
-        if not isinstance(source, dict):
-            source = resolve_scene_path(os.fspath(source))  # a path, or a bundled scene's name
-            folder = source.resolve().parent
-        if plugins:  # the caller's choices over the scene's
-            raw = source if isinstance(source, dict) else _read_scene(source)
-            source = {**raw, "plugins": {**(raw.get("plugins") or {}), **plugins}}
-        data, chosen = load_scene_plugins(source, allow_systems=allow_systems, scene_dir=folder)
-        if data["systems"] and not allow_systems:  # checked before importing anything
-            raise SceneError(
-                [
-                    f"systems[{i}]: the scene asks to run {path!r}; allow it with --allow-systems"
-                    " (API: allow_systems=True)"
-                    for i, path in enumerate(data["systems"])
-                ]
-            )
-        if data["systems"]:
-            legacy = SystemsPlugin(_import_systems(data["systems"], folder))
-            legacy.key, legacy.source = "systems", "the scene's systems list"
-            chosen.append(legacy)
-        physics = data["physics"]
-        settings = Settings(
-            fps=float(physics["fps"]),
-            substeps=int(physics["substeps"]),
-            gravity=tuple(float(g) for g in physics["gravity"]),  # type: ignore[arg-type]
-            ground_friction=float(physics["ground_friction"]),
-            sucker_timeconst=float(physics["sucker_timeconst"]),
-            max_speed=float(physics["max_speed"]),
-            max_penetration=float(physics["max_penetration"]),
-            sleep=bool(physics["sleep"]),
+        world_class: WorldClass[World] = cls
+        return load_world(
+            world_class,
+            source,
+            seed=seed,
+            allow_systems=allow_systems,
+            threads=threads,
+            only=only,
+            plugins=plugins,
+            scene_dir=scene_dir,
         )
-        world = cls(
-            settings, seed=data["seed"] if seed is None else seed, name=data.get("name", "scene")
-        )
-        world.scene, world.scene_dir = data, folder
-        for plugin in chosen:
-            world._adopt(plugin)
-        for index, creature in enumerate(data["creatures"]):
-            if only is None or index in only:
-                entity = build_creature(world, creature)
-                for plugin in chosen:
-                    plugin.build_creature(world, entity, creature)
-        for plugin in chosen:
-            plugin.build_scene(world, data)
-        world.build_physics(threads)
-        systems = physics_systems()
-        try:
-            for plugin in chosen:
-                if locomotion or plugin.key not in LOCOMOTION_PLUGINS:
-                    try:
-                        systems += _owned(plugin)
-                    except Exception as exc:  # one line naming the plugin, as for an import
-                        text = f"{type(exc).__name__}: {' '.join(str(exc).split())}"
-                        raise SceneError(
-                            [f"plugins.{plugin.key}: systems() raised {text}"]
-                        ) from exc
-            world.add_systems(*systems)
-        except BaseException:  # a user's systems() or setup() raised
-            world.close()  # its physics threads and esper context
-            raise
-        return world
 
     def build_physics(self, threads: int | None = None) -> PhysicsBackend:
         """Compile the physics groups from the current entities and sync the Transform store.
@@ -200,11 +146,14 @@ class World:
         Build hooks are not run (the creatures exist already): plugins that build data
         per creature are turned on in the scene (`plugins`) instead.
         """
-        self._adopt(plugin)
-        self.add_systems(*_owned(plugin))
+        from ecs_tentacles.world_loader import owned_systems
+
+        self.adopt(plugin)
+        self.add_systems(*owned_systems(plugin))
         return plugin
 
-    def _adopt(self, plugin: Plugin) -> None:
+    def adopt(self, plugin: Plugin) -> None:
+        """Add a plugin's resources and stores, not its systems (scene loading's first step)."""
         if any(p.key == plugin.key for p in self.plugins):
             raise ValueError(f"plugin {plugin.key!r} is already on in this world")
         made = plugin.resources(self)
@@ -334,33 +283,6 @@ class World:
         """Simulated seconds since the start."""
         return self.frame * self.settings.dt
 
-    # -- suckers ------------------------------------------------------------------------
-    def sucker_points(self, rows: np.ndarray | None = None) -> np.ndarray:
-        """World position (n, 3) of every sucker (or of sucker `rows`), by sucker row."""
-        suckers = self.suckers
-        links = suckers.link_row if rows is None else suckers.link_row[rows]
-        offset = suckers.offset if rows is None else suckers.offset[rows]
-        return self.transforms.pos[links] + quat_rotate(self.transforms.quat[links], offset)
-
-    def attach(self, sucker_entity: int) -> None:
-        """Fix a sucker to the world where it is now; fires `sucker_attached`."""
-        sucker = self.component(sucker_entity, Sucker)
-        if sucker.attached:
-            return
-        sucker.anchor = self.sucker_points(np.array([sucker.row]))[0]
-        sucker.attached = True
-        self.events.emit(
-            "sucker_attached", world=self, sucker=sucker_entity, anchor=sucker.anchor.copy()
-        )
-
-    def release(self, sucker_entity: int, reason: str = "command") -> None:
-        """Let a sucker go; fires `sucker_released` with the `reason`."""
-        sucker = self.component(sucker_entity, Sucker)
-        if not sucker.attached:
-            return
-        sucker.attached = False
-        self.events.emit("sucker_released", world=self, sucker=sucker_entity, reason=reason)
-
     # -- entities ----------------------------------------------------------------------
     def activate(self) -> None:
         """Make this world's esper context the current one."""
@@ -429,50 +351,3 @@ class MissingResource(LookupError):
         super().__init__(
             f"this world has no {kind.__name__}: {which} (plugins on: {', '.join(on) or 'none'})"
         )
-
-
-def _owned(plugin: Plugin) -> list[System]:
-    """The plugin's systems, each tagged with the plugin's key."""
-    systems = plugin.systems()
-    for system in systems:
-        system.plugin = plugin.key
-    return systems
-
-
-def _read_scene(path: pathlib.Path) -> dict[str, Any]:
-    from ecs_tentacles.scene.errors import SceneError
-    from ecs_tentacles.scene.load import read_scene_json
-
-    data = read_scene_json(path)
-    if not isinstance(data, dict):
-        raise SceneError([f"{path}: scene: must be an object"])
-    return data
-
-
-def _import_systems(paths: list[str], folder: pathlib.Path | None) -> list[type[System]]:
-    """Resolve 'package.module:Class' paths to System subclasses (only when allowed).
-
-    The scene's folder is searched first, so a module beside the scene is found.
-    """
-    from ecs_tentacles.scene.errors import SceneError
-
-    found: list[type[System]] = []
-    problems: list[str] = []
-    for i, path in enumerate(paths):
-        module_name, _, attr = path.partition(":")
-        try:
-            with scene_first(folder):
-                factory = getattr(importlib.import_module(module_name), attr)
-        except (ImportError, AttributeError) as exc:
-            problems.append(f"systems[{i}]: cannot import {path!r}: {exc}")
-            continue
-        except Exception as exc:  # the user's module raised while importing: say which and why
-            problems.append(f"systems[{i}]: cannot import {path!r}: {type(exc).__name__}: {exc}")
-            continue
-        if not (isinstance(factory, type) and issubclass(factory, System)):
-            problems.append(f"systems[{i}]: {path!r} is not a System subclass")
-            continue
-        found.append(factory)
-    if problems:
-        raise SceneError(problems)
-    return found

@@ -9,6 +9,9 @@ import pytest
 
 from ecs_tentacles.world import World
 
+# plugins off where a test's script drives the motors: `make_world(scene, plugins=NO_LOCOMOTION)`
+NO_LOCOMOTION = {"locomotion": False, "suckers": False}
+
 
 def creature_scene(**tentacles: Any) -> dict[str, Any]:
     """A one-creature scene dict with the given tentacle settings."""

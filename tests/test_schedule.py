@@ -10,7 +10,7 @@ import pytest
 from ecs_tentacles.schedule import Schedule, ScheduleError
 from ecs_tentacles.system import System
 from ecs_tentacles.world import World
-from tests.conftest import creature_scene
+from tests.conftest import NO_LOCOMOTION, creature_scene
 
 
 def named(name: str, after: tuple[str, ...] = (), before: tuple[str, ...] = ()) -> System:
@@ -63,7 +63,7 @@ BUILTIN = [
 def test_builtin_order(make_world: Callable[..., World]) -> None:
     world = make_world(creature_scene(count=3, links=2))
     assert world.schedule.names == BUILTIN
-    physics_only = make_world(creature_scene(count=3, links=2), locomotion=False)
+    physics_only = make_world(creature_scene(count=3, links=2), plugins=NO_LOCOMOTION)
     assert physics_only.schedule.names == [
         "physics",
         "physics_sync",
@@ -79,7 +79,7 @@ def test_builtin_order(make_world: Callable[..., World]) -> None:
 
 
 def test_probe_records_frame_and_substep_order(make_world: Callable[..., World]) -> None:
-    world = make_world(creature_scene(count=3, links=2), locomotion=False)
+    world = make_world(creature_scene(count=3, links=2), plugins=NO_LOCOMOTION)
     Probe.log.clear()
     world.add_system(Late())
     world.add_system(SubstepProbe())

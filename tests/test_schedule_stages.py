@@ -10,7 +10,7 @@ import pytest
 from ecs_tentacles.schedule import Schedule, ScheduleError, ScheduleWarning
 from ecs_tentacles.system import System
 from ecs_tentacles.world import World
-from tests.conftest import creature_scene
+from tests.conftest import NO_LOCOMOTION, creature_scene
 
 
 def make(
@@ -80,7 +80,7 @@ def test_remove_replace_and_disable_a_builtin(make_world: Callable[..., World]) 
 
 
 def test_disabled_system_does_not_run(make_world: Callable[..., World]) -> None:
-    world = make_world(creature_scene(count=3, links=2), locomotion=False)
+    world = make_world(creature_scene(count=3, links=2), plugins=NO_LOCOMOTION)
     before = world.transforms.pos.copy()
     world.schedule.disable("physics")
     world.step(10)

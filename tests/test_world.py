@@ -125,3 +125,65 @@ def test_user_system_base_class_is_the_builtin_one() -> None:
     from ecs_tentacles.systems.physics.physics_sync import PhysicsSync
 
     assert issubclass(Physics, System) and issubclass(PhysicsSync, System)
+
+
+def test_settings_defaults_are_the_schemas_physics_defaults() -> None:
+    from dataclasses import asdict, fields
+
+    from ecs_tentacles.scene.validate import core_schema
+    from ecs_tentacles.settings import BUILD_ONLY, Settings
+
+    physics = core_schema()["properties"]["physics"]["properties"]
+    defaults = {key: spec["default"] for key, spec in physics.items() if key not in BUILD_ONLY}
+    made = asdict(Settings())
+    assert {f.name for f in fields(Settings)} == set(defaults)  # every runtime key, no other
+    assert made == {**defaults, "gravity": tuple(defaults["gravity"])}
+    assert Settings().ground_friction == 0.4  # was 1.0 by hand while the schema said 0.4
+
+
+def test_a_world_without_a_scene_runs_with_a_default_scenes_settings(
+    make_world: Callable[..., World],
+) -> None:
+    scene = make_world(creature_scene(count=3, links=2))
+    with World() as bare:
+        assert bare.settings == scene.settings
+
+
+def test_locomotion_is_an_ordinary_plugin_switch(make_world: Callable[..., World]) -> None:
+    off = make_world(
+        creature_scene(count=3, links=2), plugins={"locomotion": False, "suckers": False}
+    )
+    assert not {"goals", "motor_targets", "suckers"} & set(off.schedule.names)
+    assert [p.key for p in off.plugins] == ["threats", "fur"]
+    scene = {**creature_scene(count=3, links=2)}
+    scene["creatures"][0]["goals"] = [{"position": [1, 0]}]
+    with pytest.raises(SceneError, match=r"creatures\[0\]\.goals: unknown key"):
+        World.from_scene(scene, plugins={"locomotion": False, "suckers": False})
+    with pytest.raises(TypeError):
+        World.from_scene(creature_scene(count=3, links=2), locomotion=False)  # type: ignore[call-arg]
+
+
+def test_a_failing_plugin_systems_hook_closes_the_half_built_world(
+    tmp_path: Path,
+) -> None:
+    import esper
+
+    (tmp_path / "broken.py").write_text(
+        textwrap.dedent(
+            """
+            from ecs_tentacles.plugin import Plugin
+
+            class Broken(Plugin):
+                name = "broken"
+
+                def systems(self):
+                    raise RuntimeError("no systems today")
+            """
+        )
+    )
+    scene = creature_scene(count=3, links=2)
+    scene["plugins"] = {"broken": {"from": "broken.py"}}
+    before = set(esper.list_worlds())
+    with pytest.raises(SceneError, match=r"plugins\.broken: systems\(\) raised RuntimeError"):
+        World.from_scene(scene, allow_systems=True, scene_dir=tmp_path)
+    assert set(esper.list_worlds()) == before  # its esper context is gone

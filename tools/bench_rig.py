@@ -105,7 +105,7 @@ def bench_system(n: int, repeats: int, dynamic: bool) -> float:
             }
         ],
     }
-    world = World.from_scene(scene, locomotion=False)
+    world = World.from_scene(scene, plugins={"locomotion": False, "suckers": False})
     world.step(1)
     world.resource(FurData).controls.position[0] += (
         0.02,

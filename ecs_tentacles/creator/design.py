@@ -238,7 +238,7 @@ class CreatureDesign:
         """The World of this design as exported (physics compiled, nothing stepped)."""
         from ecs_tentacles.world import World
 
-        return World.from_scene(self.scene(), locomotion=False)
+        return World.from_scene(self.scene())
 
     @classmethod
     def from_scene(

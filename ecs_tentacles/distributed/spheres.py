@@ -22,7 +22,7 @@ from ecs_tentacles.physics.proxies import MARGIN
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
-    from ecs_tentacles.world import World
+    from ecs_tentacles.host import Host
 
 
 class ContactSpheres(System):
@@ -36,7 +36,7 @@ class ContactSpheres(System):
         self.spheres = np.zeros((0, 0, 4))
         self._frame = 0
 
-    def setup(self, world: World) -> None:
+    def setup(self, world: Host) -> None:
         rows, owner, bound = [], [], []
         creatures = sorted(world.query(Creature), key=lambda item: item[1].row)
         for index, (entity, creature) in enumerate(creatures):
@@ -57,7 +57,7 @@ class ContactSpheres(System):
         self._frame = 0
         self._capture(world)
 
-    def _capture(self, world: World) -> None:
+    def _capture(self, world: Host) -> None:
         if self._frame >= len(self.spheres) or not len(self.rows):
             return
         pos = world.transforms.pos[self.rows]
@@ -67,7 +67,7 @@ class ContactSpheres(System):
         self.spheres[self._frame, :, 3] = np.maximum.reduceat(reach, self.start)
         self._frame += 1
 
-    def process(self, world: World, dt: float) -> None:
+    def process(self, world: Host, dt: float) -> None:
         self._capture(world)
 
 

@@ -20,10 +20,10 @@ from ecs_tentacles.fur.stores import BEHAVIOURS, COLUMNS, FurData
 from ecs_tentacles.tracks import channels_from_keys
 
 if TYPE_CHECKING:
-    from ecs_tentacles.world import World
+    from ecs_tentacles.host import Host
 
 
-def _points_per_guide(world: World, spec: dict[str, Any]) -> int:
+def _points_per_guide(world: Host, spec: dict[str, Any]) -> int:
     """The world's shared point count: the largest any fur of the scene asks for."""
     if world.resource(FurData).points:
         return world.resource(FurData).points
@@ -33,7 +33,7 @@ def _points_per_guide(world: World, spec: dict[str, Any]) -> int:
     return max(asked)
 
 
-def build_fur(world: World, creature: int, spec: dict[str, Any]) -> int:
+def build_fur(world: Host, creature: int, spec: dict[str, Any]) -> int:
     """Controls and guides of `creature` from a defaults-filled `fur` spec; the Fur row."""
     fur = world.resource(FurData)
     info = world.component(creature, Creature)
@@ -67,7 +67,7 @@ def build_fur(world: World, creature: int, spec: dict[str, Any]) -> int:
 
 
 def _build_controls(
-    world: World, creature: int, fur_row: int, specs: list[dict[str, Any]]
+    world: Host, creature: int, fur_row: int, specs: list[dict[str, Any]]
 ) -> dict[str, tuple[int, int]]:
     """Control entities (mirrored twins included): name -> (entity, control row)."""
     store = world.resource(FurData).controls
@@ -96,7 +96,7 @@ def _build_controls(
 
 
 def _build_guides(
-    world: World,
+    world: Host,
     creature: int,
     fur_row: int,
     body: int,
@@ -143,7 +143,7 @@ def _build_guides(
     return entities
 
 
-def build_emotion(world: World, creature: int, spec: dict[str, Any]) -> int:
+def build_emotion(world: Host, creature: int, spec: dict[str, Any]) -> int:
     """The creature's Emotion (its controls get driven by it); returns the emotion row."""
     store = world.resource(FurData).emotions
     row = int(

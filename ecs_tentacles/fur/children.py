@@ -26,7 +26,7 @@ from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.mathutil import quat_rotate
 
 if TYPE_CHECKING:
-    from ecs_tentacles.world import World
+    from ecs_tentacles.host import Host
 
 NEIGHBOURS = 3
 CHUNK = 2048  # children whose guide distances are computed at once (memory bound)
@@ -51,7 +51,7 @@ _CACHE: weakref.WeakKeyDictionary[FurData, tuple[tuple[int, ...], ChildLayout]] 
 )
 
 
-def layout(world: World, per_guide: int | None = None, seed: int = 0) -> ChildLayout:
+def layout(world: Host, per_guide: int | None = None, seed: int = 0) -> ChildLayout:
     """The children of every fur (`per_guide` each, default each fur's `children`)."""
     fur = world.resource(FurData)
     key = (fur.version, len(fur.guides), -1 if per_guide is None else per_guide, seed)
@@ -70,7 +70,7 @@ def parents(fur: FurData, per_guide: int | None) -> np.ndarray:
     return np.repeat(np.arange(len(g)), counts)
 
 
-def _make_layout(world: World, per_guide: int | None, seed: int) -> ChildLayout:
+def _make_layout(world: Host, per_guide: int | None, seed: int) -> ChildLayout:
     fur = world.resource(FurData)
     g = fur.guides
     parent = parents(fur, per_guide)
@@ -139,7 +139,7 @@ def point_indices(points: int, keep: int | None) -> np.ndarray:
 
 
 def interpolated_children(
-    world: World, children: ChildLayout, keep: int | None = None
+    world: Host, children: ChildLayout, keep: int | None = None
 ) -> np.ndarray:
     """The children's world polylines (m, points, 3) float32, for this frame's guides.
 

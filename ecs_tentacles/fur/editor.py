@@ -29,7 +29,7 @@ from ecs_tentacles.tracks import EASINGS, TrackSet, channels_from_keys
 if TYPE_CHECKING:
     from pathlib import Path
 
-    from ecs_tentacles.world import World
+    from ecs_tentacles.host import Host
 
 VALUES = (*BEHAVIOURS, "emotion")
 ATTRIBUTES = tuple(COLUMNS)  # keyable
@@ -41,7 +41,7 @@ KEY_TOLERANCE = 1e-6  # seconds: a key set at the time of another replaces it
 class FurEditor:
     """The fur of one selected creature, edited in a world and in its scene document."""
 
-    def __init__(self, world: World, rebuild: Callable[[dict[str, Any]], World]):
+    def __init__(self, world: Host, rebuild: Callable[[dict[str, Any]], Host]):
         if world.scene is None:
             raise ValueError("the fur editor needs a world built from a scene")
         self.scene: dict[str, Any] = copy.deepcopy(world.scene)
@@ -95,7 +95,7 @@ class FurEditor:
         self.control = names[0] if names else None
 
     # -- the world -------------------------------------------------------------------
-    def attach(self, world: World) -> None:
+    def attach(self, world: Host) -> None:
         """Edit `world` from now on (after the sandbox rebuilt or reset it)."""
         self.world = world
         if self.control not in self.control_names():

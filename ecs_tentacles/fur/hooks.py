@@ -25,7 +25,7 @@ from ecs_tentacles.mathutil import quat_rotate
 from ecs_tentacles.plugin import CurvesFrame
 
 if TYPE_CHECKING:
-    from ecs_tentacles.world import World
+    from ecs_tentacles.host import Host
 
 
 @dataclass
@@ -38,7 +38,7 @@ class GuideCurves:
     guide: np.ndarray  # (n,) guide row each polyline belongs to (children: their parent)
 
 
-def guide_curves(world: World, colour_by: str = "fur") -> GuideCurves:
+def guide_curves(world: Host, colour_by: str = "fur") -> GuideCurves:
     """Every guide's world polyline; colour from its fur, or its control's (`"control"`)."""
     fur = world.resource(FurData)
     n = len(fur.guides)
@@ -55,7 +55,7 @@ def guide_curves(world: World, colour_by: str = "fur") -> GuideCurves:
 
 
 def child_hairs(
-    world: World,
+    world: Host,
     per_guide: int | None = None,
     radius: float | None = None,
     seed: int = 0,
@@ -115,7 +115,7 @@ class ControlMarker:
     size: float
 
 
-def control_markers(world: World) -> list[ControlMarker]:
+def control_markers(world: Host) -> list[ControlMarker]:
     """Every fur control, placed in world space by its creature's mantle pose."""
     fur = world.resource(FurData)
     markers = []
@@ -132,7 +132,7 @@ def control_markers(world: World) -> list[ControlMarker]:
     return markers
 
 
-def take_guides(world: World) -> CurvesFrame | None:
+def take_guides(world: Host) -> CurvesFrame | None:
     """The world's fur guide curves as the rig posed them, or None without fur.
 
     The fur plugin's take track (`ecs_tentacles.fur.outputs`): world polylines and

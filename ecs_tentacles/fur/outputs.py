@@ -18,13 +18,13 @@ from ecs_tentacles.plugin import TrackSource
 from ecs_tentacles.take_tracks import TakeTrack
 
 if TYPE_CHECKING:
-    from ecs_tentacles.world import World
+    from ecs_tentacles.host import Host
 
 GUIDES = TakeTrack("guides", "curves", ("guide_points", "guide_widths"), "fur", "guides")
 GUIDE_TRACK = TrackSource(GUIDES, take_guides)
 
 
-def pose_fur_at_build(world: World) -> None:
+def pose_fur_at_build(world: Host) -> None:
     """Pose fur guides before the first frame, so a take's frame 0 has them.
 
     The rig system poses guides during a frame; at the built pose nothing has run. A

@@ -22,8 +22,8 @@ from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
     from ecs_tentacles.drawing import Panel, RenderView
+    from ecs_tentacles.host import Host
     from ecs_tentacles.store import ArrayStore
-    from ecs_tentacles.world import World
 
 _FRAGMENT = fragment("ecs_tentacles.fur", "fur")
 STORES = ("guides", "controls", "sets", "emotions")
@@ -40,10 +40,10 @@ class FurPlugin(Plugin):
     def problems(self, scene: Mapping[str, Any]) -> list[tuple[tuple[str | int, ...], str]]:
         return fur_problems(scene)
 
-    def resources(self, world: World) -> list[object]:
+    def resources(self, world: Host) -> list[object]:
         return [FurData()]
 
-    def build_creature(self, world: World, creature: int, spec: Mapping[str, Any]) -> None:
+    def build_creature(self, world: Host, creature: int, spec: Mapping[str, Any]) -> None:
         if "fur" in spec:
             build_fur(world, creature, dict(spec["fur"]))
         if "emotion" in spec:
@@ -55,27 +55,27 @@ class FurPlugin(Plugin):
 
         return [EmotionSystem(), Rig()]
 
-    def stores(self, world: World) -> dict[str, ArrayStore]:
+    def stores(self, world: Host) -> dict[str, ArrayStore]:
         fur = world.resource(FurData)
         return {f"fur.{name}": getattr(fur, name) for name in STORES}
 
-    def snapshot(self, world: World) -> Any:
+    def snapshot(self, world: Host) -> Any:
         fur = world.resource(FurData)  # its stores are copied with every store
         return fur.curves.copy(), fur.frames.copy()
 
-    def restore(self, world: World, state: Any) -> None:
+    def restore(self, world: Host, state: Any) -> None:
         curves, frames = state
         fur = world.resource(FurData)
         fur.curves[...] = curves
         fur.frames[...] = frames
 
     # -- output hooks ----------------------------------------------------------------
-    def take_tracks(self, world: World) -> list[TrackSource]:
+    def take_tracks(self, world: Host) -> list[TrackSource]:
         from ecs_tentacles.fur.outputs import GUIDE_TRACK
 
         return [GUIDE_TRACK]
 
-    def before_recording(self, world: World) -> None:
+    def before_recording(self, world: Host) -> None:
         from ecs_tentacles.fur.outputs import pose_fur_at_build
 
         pose_fur_at_build(world)
@@ -87,12 +87,12 @@ class FurPlugin(Plugin):
         return [together] if together else []
 
     # -- sandbox hooks: GL and ImGui are imported only when a sandbox calls these ------
-    def render_lines(self, world: World, view: RenderView) -> list[Any]:
+    def render_lines(self, world: Host, view: RenderView) -> list[Any]:
         from ecs_tentacles.fur.render.strands import fur_lines
 
         return fur_lines(world, view)
 
-    def render_draw(self, world: World, view: RenderView) -> int:
+    def render_draw(self, world: Host, view: RenderView) -> int:
         from ecs_tentacles.fur.render.strands import draw_fur
 
         return draw_fur(world, view)

@@ -24,7 +24,7 @@ from ecs_tentacles.components import Tentacle
 from ecs_tentacles.locomotion.stores import LocomotionStores
 
 if TYPE_CHECKING:
-    from ecs_tentacles.world import World
+    from ecs_tentacles.host import Host
 
 
 class Kind(IntEnum):
@@ -151,7 +151,7 @@ class ActionQueues:
     shares it. Built from the tentacles the world has now.
     """
 
-    def __init__(self, world: World):
+    def __init__(self, world: Host):
         self._tentacles = world.resource(LocomotionStores).tentacles
         by_row = {t.row: world.component(e, ActionQueue) for e, t in world.query(Tentacle)}
         # a row without a tentacle entity (stores filled by hand) gets a queue of its own

@@ -20,7 +20,7 @@ from ecs_tentacles.locomotion.components import Goal
 from ecs_tentacles.locomotion.stores import LocomotionStores
 
 if TYPE_CHECKING:
-    from ecs_tentacles.world import World
+    from ecs_tentacles.host import Host
 
 DEFAULT_RADIUS = 0.3
 
@@ -30,7 +30,7 @@ class GoalBook:
 
     provided_by = "locomotion"  # the plugin that makes it (named by `world.resource` errors)
 
-    def __init__(self, world: World):
+    def __init__(self, world: Host):
         self._world = world
         self._paths: dict[int, list[int]] = {}
         self.version = 0  # bumped on every change, so views can cache what they drew

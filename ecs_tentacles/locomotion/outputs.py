@@ -22,13 +22,13 @@ from ecs_tentacles.plugin import PointsFrame, Reach, RunSummary, TrackSource
 from ecs_tentacles.take_tracks import TakeTrack
 
 if TYPE_CHECKING:
-    from ecs_tentacles.world import World
+    from ecs_tentacles.host import Host
 
 GOALS = TakeTrack("goals", "points", ("goal_pos", "goal_active"), "goals", "goal")
 CRAWL_SPEED = 0.25  # m/s per unit of `locomotion.speed`: twice the fastest crawl measured
 
 
-def goal_points(world: World) -> PointsFrame:
+def goal_points(world: Host) -> PointsFrame:
     """The live goals: each goal entity, its owner, its order in the path, where it is."""
     goals = list(world.query(Goal))
     return PointsFrame(
@@ -57,7 +57,7 @@ def crawl_reach(creature: Mapping[str, Any], seconds: float) -> Reach:
     return Reach(radius=travel)
 
 
-def goal_summary(world: World) -> RunSummary:
+def goal_summary(world: Host) -> RunSummary:
     """Goals reached so far and goals still in every creature's path."""
     reached = int(world.events.counts["goal_reached"])
     book = world.resource(GoalBook)

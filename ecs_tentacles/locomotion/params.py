@@ -29,7 +29,7 @@ from ecs_tentacles.scene.parameters import Parameter, parameters
 from ecs_tentacles.scene.ranges import damping_floor
 
 if TYPE_CHECKING:
-    from ecs_tentacles.world import World
+    from ecs_tentacles.host import Host
 
 # the stores whose rows `set` knows, and what one row of each is
 ROWS = {
@@ -53,7 +53,7 @@ class Locomotion:
 
     provided_by = "locomotion"  # the plugin that makes it (named by `world.resource` errors)
 
-    def __init__(self, world: World):
+    def __init__(self, world: Host):
         self._world = world
 
     def _tentacles(self, creature: int, tentacle: int | None) -> list[Tentacle]:

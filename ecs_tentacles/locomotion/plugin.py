@@ -39,8 +39,8 @@ if TYPE_CHECKING:
     import numpy as np
 
     from ecs_tentacles.drawing import Click, Panel, RenderView
+    from ecs_tentacles.host import Host
     from ecs_tentacles.store import ArrayStore
-    from ecs_tentacles.world import World
 
 _FRAGMENT = fragment("ecs_tentacles.locomotion", "locomotion")
 
@@ -53,14 +53,14 @@ class LocomotionPlugin(Plugin):
     hook_reads = ("locomotion.creatures.has_goal",)  # wants_motion
     defs = _FRAGMENT["$defs"]
 
-    def resources(self, world: World) -> list[object]:
+    def resources(self, world: Host) -> list[object]:
         return [LocomotionStores(), GoalBook(world), Locomotion(world)]
 
-    def stores(self, world: World) -> dict[str, ArrayStore]:
+    def stores(self, world: Host) -> dict[str, ArrayStore]:
         loco = world.resource(LocomotionStores)
         return {"locomotion.tentacles": loco.tentacles, "locomotion.creatures": loco.creatures}
 
-    def build_creature(self, world: World, creature: int, spec: Mapping[str, Any]) -> None:
+    def build_creature(self, world: Host, creature: int, spec: Mapping[str, Any]) -> None:
         loco = world.resource(LocomotionStores)
         body = world.component(creature, Creature)
         row = int(loco.creatures.add()[0])
@@ -93,11 +93,11 @@ class LocomotionPlugin(Plugin):
 
         return [Goals(), TentacleSelection(), ActionQueueSystem(), MotorTargets()]
 
-    def wants_motion(self, world: World) -> np.ndarray:
+    def wants_motion(self, world: Host) -> np.ndarray:
         """Creatures with a goal crawl: they never fall asleep."""
         return world.resource(LocomotionStores).creatures.has_goal
 
-    def snapshot(self, world: World) -> Any:
+    def snapshot(self, world: Host) -> Any:
         goals = {
             entity: [
                 (world.component(g, Goal).position.copy(), world.component(g, Goal).radius)
@@ -108,7 +108,7 @@ class LocomotionPlugin(Plugin):
         queues = {e: copy.deepcopy(q.pending) for e, q in world.query(ActionQueue)}
         return goals, queues
 
-    def restore(self, world: World, state: Any) -> None:
+    def restore(self, world: Host, state: Any) -> None:
         goals, queues = state
         for entity, path in goals.items():
             world.resource(GoalBook).clear(entity)
@@ -118,17 +118,17 @@ class LocomotionPlugin(Plugin):
             queue.pending = copy.deepcopy(queues[entity])
 
     # -- sandbox hooks -----------------------------------------------------------------
-    def render_lines(self, world: World, view: RenderView) -> list[Any]:
+    def render_lines(self, world: Host, view: RenderView) -> list[Any]:
         from ecs_tentacles.locomotion.render import path_lines
 
         return path_lines(world, view)
 
-    def render_points(self, world: World) -> Any:
+    def render_points(self, world: Host) -> Any:
         from ecs_tentacles.locomotion.render import goal_points
 
         return goal_points(world)
 
-    def sandbox_click(self, world: World, click: Click) -> bool:
+    def sandbox_click(self, world: Host, click: Click) -> bool:
         from ecs_tentacles.locomotion.render import click_goal
 
         return click_goal(world, click)
@@ -139,7 +139,7 @@ class LocomotionPlugin(Plugin):
         return locomotion_panels(sandbox)
 
     # -- output hooks ----------------------------------------------------------------
-    def take_tracks(self, world: World) -> list[TrackSource]:
+    def take_tracks(self, world: Host) -> list[TrackSource]:
         from ecs_tentacles.locomotion.outputs import GOAL_TRACK
 
         return [GOAL_TRACK]
@@ -149,7 +149,7 @@ class LocomotionPlugin(Plugin):
 
         return crawl_reach(creature, seconds)
 
-    def run_summary(self, world: World) -> RunSummary | None:
+    def run_summary(self, world: Host) -> RunSummary | None:
         from ecs_tentacles.locomotion.outputs import goal_summary
 
         return goal_summary(world)

@@ -25,7 +25,7 @@ from ecs_tentacles.locomotion.components import Goal
 from ecs_tentacles.locomotion.goals import GoalBook
 
 if TYPE_CHECKING:
-    from ecs_tentacles.world import World
+    from ecs_tentacles.host import Host
 
 GOALS = "locomotion.goals"  # the key of the cached geometry in the renderer's state
 LIFT = 0.005  # metres above the ground the lines are drawn
@@ -35,7 +35,7 @@ LIFT = 0.005  # metres above the ground the lines are drawn
 class GoalLines:
     """Rings, posts and legs between goals of one world at one `GoalBook.version`."""
 
-    world: World
+    world: Host
     version: int
     fixed: np.ndarray  # line-list vertices (2n, 7)
     leader_rows: np.ndarray  # Transform rows of the creatures that have a goal
@@ -43,7 +43,7 @@ class GoalLines:
     leader_colours: np.ndarray  # (n, 4)
 
 
-def goal_lines(world: World, view: RenderView) -> GoalLines:
+def goal_lines(world: Host, view: RenderView) -> GoalLines:
     """Every path's fixed geometry, from the goal book as it is now."""
     book = world.resource(GoalBook)
     fixed: list[np.ndarray] = []
@@ -72,7 +72,7 @@ def goal_lines(world: World, view: RenderView) -> GoalLines:
     )
 
 
-def path_lines(world: World, view: RenderView) -> list[np.ndarray]:
+def path_lines(world: Host, view: RenderView) -> list[np.ndarray]:
     """This frame's goal rings and paths (line-list vertices), the fixed part cached."""
     cached = view.state.get(GOALS)
     version = int(world.resource(GoalBook).version)
@@ -86,14 +86,14 @@ def path_lines(world: World, view: RenderView) -> list[np.ndarray]:
     return [cached.fixed, leaders]
 
 
-def goal_points(world: World) -> np.ndarray:
+def goal_points(world: Host) -> np.ndarray:
     """Every goal's position (n, 3), for the camera's "frame all"."""
     book = world.resource(GoalBook)
     paths = [book.positions(entity) for entity, _ in world.query(Creature)]
     return np.vstack(paths) if paths else np.zeros((0, 3))
 
 
-def remove_goal_at(world: World, point: np.ndarray) -> int | None:
+def remove_goal_at(world: Host, point: np.ndarray) -> int | None:
     """Remove the goal whose ring contains `point` (the nearest one); its entity."""
     best, best_distance = None, np.inf
     for entity, goal in world.query(Goal):
@@ -105,7 +105,7 @@ def remove_goal_at(world: World, point: np.ndarray) -> int | None:
     return best
 
 
-def click_goal(world: World, click: Click) -> bool:
+def click_goal(world: Host, click: Click) -> bool:
     """Set (left), append (shift-left) or remove (right) a goal; True if the click was one."""
     if click.ground is None:
         return False

@@ -2,9 +2,10 @@
 
 Needs locomotion (its actions command attach and detach; its `locomotion` settings
 carry the release thresholds). Systems: suckers (stage act). The sucker bodies and
-their MuJoCo constraints are core (every creature has them; without this plugin they
-stay released unless a script attaches them with `world.attach`). Render hook: each
-attached sucker as a small yellow sphere at its anchor.
+their MuJoCo constraints are core (every creature has them); without this plugin they
+stay released unless a script attaches them (`ecs_tentacles.locomotion.grip`:
+`attach(world, sucker)`, `release(world, sucker)`, `sucker_points(world)`). Render hook:
+each attached sucker as a small yellow sphere at its anchor.
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ from ecs_tentacles.plugin import Marker, Plugin
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
-    from ecs_tentacles.world import World
+    from ecs_tentacles.host import Host
 
 SUCKER_SIZE = (0.024, 0.024, 0.024)  # metres
 SUCKER_RGBA = (1.0, 0.92, 0.25, 1.0)
@@ -33,7 +34,7 @@ class SuckersPlugin(Plugin):
 
         return [Suckers()]
 
-    def render_spheres(self, world: World) -> list[Marker]:
+    def render_spheres(self, world: Host) -> list[Marker]:
         suckers = world.suckers
         held = np.flatnonzero(suckers.attached)
         if not len(held):

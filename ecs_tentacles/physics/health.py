@@ -181,8 +181,10 @@ class HealthCheck:
         if len(group.equality_ids):
             group.data.eq_active[group.equality_ids] = 0
         suckers = world.suckers
-        for row in group.sucker_rows[suckers.attached[group.sucker_rows]]:
-            world.release(int(suckers.entity[row]), "recovery")
+        for row in group.sucker_rows[suckers.attached[group.sucker_rows]]:  # core: no feature call
+            suckers.attached[row] = False
+            sucker = int(suckers.entity[row])
+            world.events.emit("sucker_released", world=world, sucker=sucker, reason="recovery")
         creature = group.creatures[0]
         self.recoveries += 1
         world.events.emit("creature_recovered", world=world, creature=creature, cause=cause)

@@ -51,6 +51,3 @@ class PhysicsHost(Protocol):
 
     def creature_name(self, entity: int) -> str:
         """The name of creature `entity`."""
-
-    def release(self, sucker_entity: int, reason: str = "command") -> None:
-        """Let a sucker go (fires `sucker_released`)."""

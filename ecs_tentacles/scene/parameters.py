@@ -37,12 +37,15 @@ import functools
 import math
 from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ecs_tentacles.scene.ranges import Range, schema_objects, schema_range
 from ecs_tentacles.scene.validate import format_path, load_schema
+
+if TYPE_CHECKING:
+    from ecs_tentacles.host import Host
 
 ANNOTATION = "x-parameter"
 DEGREE = math.radians(1.0)  # one scene degree in code's radians
@@ -203,7 +206,7 @@ def parameter(section: str, key: str, table: Iterable[Parameter] | None = None) 
 
 
 def apply_parameters(
-    world: Any,
+    world: Host,
     section: str,
     entry: Mapping[str, Any],
     rows: Mapping[str, Any],

@@ -19,7 +19,7 @@ from ecs_tentacles.store import ArrayStore, Field
 from ecs_tentacles.tracks import Channel, channels_from_keys
 
 if TYPE_CHECKING:
-    from ecs_tentacles.world import World
+    from ecs_tentacles.host import Host
 
 Problem = tuple[tuple[str | int, ...], str]
 
@@ -54,18 +54,18 @@ class ThreatData:
     def __len__(self) -> int:
         return len(self.store) + len(self.bodies)
 
-    def sources(self, world: World) -> tuple[np.ndarray, np.ndarray]:
+    def sources(self, world: Host) -> tuple[np.ndarray, np.ndarray]:
         """Every threat's world position (n, 3) and owner creature entity (-1: none)."""
         pos = np.concatenate([self.store.pos, world.transforms.pos[self.bodies]])
         owners = np.concatenate([np.full(len(self.store), -1), self.creatures])
         return pos, owners
 
-    def positions(self, world: World) -> dict[str, np.ndarray]:
+    def positions(self, world: Host) -> dict[str, np.ndarray]:
         """World position of every path threat, by name."""
         return {threat.name: threat.pos.copy() for _, threat in world.query(Threat)}
 
 
-def mark_creature(world: World, creature: int) -> None:
+def mark_creature(world: Host, creature: int) -> None:
     """Make a creature's mantle a threat to the others."""
     threats: ThreatData = world.resource(ThreatData)
     row = world.component(creature, Transform).row
@@ -73,7 +73,7 @@ def mark_creature(world: World, creature: int) -> None:
     threats.creatures = np.append(threats.creatures, creature)
 
 
-def build_threats(world: World, specs: Sequence[Mapping[str, Any]]) -> list[int]:
+def build_threats(world: Host, specs: Sequence[Mapping[str, Any]]) -> list[int]:
     """Threat entities that follow keyframed paths; returns their entities."""
     threats: ThreatData = world.resource(ThreatData)
     entities = []

@@ -18,8 +18,8 @@ from ecs_tentacles.system import System
 from ecs_tentacles.threats.data import ThreatData, build_threats, mark_creature, threat_problems
 
 if TYPE_CHECKING:
+    from ecs_tentacles.host import Host
     from ecs_tentacles.store import ArrayStore
-    from ecs_tentacles.world import World
 
 _FRAGMENT = fragment("ecs_tentacles.threats", "threats")
 THREAT_SIZE = (0.07, 0.045, 0.04)  # metres along x, y, z
@@ -36,14 +36,14 @@ class ThreatsPlugin(Plugin):
     def problems(self, scene: Mapping[str, Any]) -> list[tuple[tuple[str | int, ...], str]]:
         return threat_problems(scene)
 
-    def resources(self, world: World) -> list[object]:
+    def resources(self, world: Host) -> list[object]:
         return [ThreatData()]
 
-    def build_creature(self, world: World, creature: int, spec: Mapping[str, Any]) -> None:
+    def build_creature(self, world: Host, creature: int, spec: Mapping[str, Any]) -> None:
         if spec.get("threat"):
             mark_creature(world, creature)
 
-    def build_scene(self, world: World, scene: Mapping[str, Any]) -> None:
+    def build_scene(self, world: Host, scene: Mapping[str, Any]) -> None:
         build_threats(world, scene["threats"])
 
     def systems(self) -> list[System]:
@@ -51,10 +51,10 @@ class ThreatsPlugin(Plugin):
 
         return [ThreatPaths()]
 
-    def stores(self, world: World) -> dict[str, ArrayStore]:
+    def stores(self, world: Host) -> dict[str, ArrayStore]:
         return {"threats": world.resource(ThreatData).store}  # copied by snapshots
 
-    def render_spheres(self, world: World) -> list[Marker]:
+    def render_spheres(self, world: Host) -> list[Marker]:
         positions = list(world.resource(ThreatData).positions(world).values())
         if not positions:
             return []

@@ -28,7 +28,7 @@ from ecs_tentacles.system import System
 from ecs_tentacles.threats.data import ThreatData
 
 if TYPE_CHECKING:
-    from ecs_tentacles.world import World
+    from ecs_tentacles.host import Host
 
 
 class Flee(System):
@@ -53,10 +53,10 @@ class Flee(System):
         self.goal_radius = goal_radius
         self.every = 1
 
-    def setup(self, world: World) -> None:
+    def setup(self, world: Host) -> None:
         self.every = max(1, round(self.interval * world.settings.fps))
 
-    def process(self, world: World, dt: float) -> None:
+    def process(self, world: Host, dt: float) -> None:
         if world.frame % self.every:
             return
         threats, owners = world.resource(ThreatData).sources(world)

@@ -30,7 +30,7 @@ from ecs_tentacles.scene.validate import plugin_config
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
-    from ecs_tentacles.world import World
+    from ecs_tentacles.host import Host
 
 CRAWL_SPEED = 0.1  # m/s: a neighbour moving this fast aligns others fully
 
@@ -63,7 +63,7 @@ class Flock(System):
         self.every = 1
         self.last: np.ndarray | None = None
 
-    def setup(self, world: World) -> None:
+    def setup(self, world: Host) -> None:
         self.every = max(1, round(self.config["interval"] * world.settings.fps))
 
     def steering(self, pos: np.ndarray, vel: np.ndarray) -> np.ndarray:
@@ -86,7 +86,7 @@ class Flock(System):
         seek = _unit(np.asarray(toward, dtype=float)[None, :2] - pos) if toward else 0 * pos
         return np.stack([separate, align, cohere, seek])
 
-    def process(self, world: World, dt: float) -> None:
+    def process(self, world: Host, dt: float) -> None:
         if world.frame % self.every:
             return
         creatures = world.creatures

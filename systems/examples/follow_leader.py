@@ -31,7 +31,7 @@ from ecs_tentacles.scene.validate import plugin_config
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
-    from ecs_tentacles.world import World
+    from ecs_tentacles.host import Host
 
 KEY = "follow"  # the creature-level scene key
 
@@ -64,7 +64,7 @@ class FollowLeader(System):
         self.followers = np.zeros(0, dtype=np.int64)  # creature rows
         self.leaders = np.zeros(0, dtype=np.int64)  # their leaders' rows
 
-    def setup(self, world: World) -> None:
+    def setup(self, world: Host) -> None:
         self.every = max(1, round(self.interval * world.settings.fps))
         rows = {c.name: c.row for _, c in world.query(Creature)}  # a shard may lack some
         pairs = [
@@ -74,7 +74,7 @@ class FollowLeader(System):
         ]
         self.followers, self.leaders = np.array(pairs, dtype=np.int64).reshape(-1, 2).T
 
-    def process(self, world: World, dt: float) -> None:
+    def process(self, world: Host, dt: float) -> None:
         if world.frame % self.every or not len(self.followers):
             return
         creatures = world.creatures

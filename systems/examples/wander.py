@@ -28,7 +28,7 @@ from ecs_tentacles.scene.validate import plugin_config
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
-    from ecs_tentacles.world import World
+    from ecs_tentacles.host import Host
 
 
 class Wander(System):
@@ -59,7 +59,7 @@ class Wander(System):
         self.every = 1
         self.streams: list[np.random.Generator] = []  # by creature row
 
-    def setup(self, world: World) -> None:
+    def setup(self, world: Host) -> None:
         self.every = max(1, round(self.interval * world.settings.fps))
         creatures = world.creatures
         self.streams = [
@@ -67,7 +67,7 @@ class Wander(System):
             for row in range(creatures.count)
         ]
 
-    def process(self, world: World, dt: float) -> None:
+    def process(self, world: Host, dt: float) -> None:
         if world.frame % self.every:
             return
         creatures = world.creatures

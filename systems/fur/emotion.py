@@ -27,7 +27,7 @@ from ecs_tentacles.system import System
 from ecs_tentacles.threats.data import ThreatData
 
 if TYPE_CHECKING:
-    from ecs_tentacles.world import World
+    from ecs_tentacles.host import Host
 
 NINETY_PERCENT = 3.8897  # omega * t at which a critically damped step reaches 90 %
 
@@ -48,7 +48,7 @@ class EmotionSystem(System):
     )
     writes = ("fur.emotions", "fur.controls.drive_lift", "fur.controls.drive_random")
 
-    def process(self, world: World, dt: float) -> None:
+    def process(self, world: Host, dt: float) -> None:
         fur = world.resource(FurData)
         e = fur.emotions
         if not len(e):

@@ -31,7 +31,7 @@ from ecs_tentacles.system import System
 from ecs_tentacles.tracks import TrackSet
 
 if TYPE_CHECKING:
-    from ecs_tentacles.world import World
+    from ecs_tentacles.host import Host
 
 
 BLOCK = 16384  # guides per block
@@ -61,7 +61,7 @@ class Rig(System):
         self.strand_control = np.zeros(0, dtype=np.int64)  # the strands' controls
         self.strand_body = np.zeros(0, dtype=np.int64)  # the strands' bodies
 
-    def rebind(self, world: World) -> None:
+    def rebind(self, world: Host) -> None:
         """Re-read the bind pose, tracks and dynamic strands from the fur stores."""
         fur = world.resource(FurData)
         self.bind, self.bodies = make_bind(fur)
@@ -81,7 +81,7 @@ class Rig(System):
         self.parallel = use_parallel(n)
         self.version = fur.version
 
-    def process(self, world: World, dt: float) -> None:
+    def process(self, world: Host, dt: float) -> None:
         fur = world.resource(FurData)
         if not len(fur.guides):
             return

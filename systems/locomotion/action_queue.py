@@ -21,7 +21,7 @@ from ecs_tentacles.locomotion.stores import LocomotionStores
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
-    from ecs_tentacles.world import World
+    from ecs_tentacles.host import Host
 
 TIME_EPSILON = 1e-9  # sums of frame durations fall a hair short of whole durations
 ATTACH = int(Kind.ATTACH)
@@ -43,11 +43,11 @@ class ActionQueueSystem(System):
         "locomotion.tentacles.mode",
     )
 
-    def setup(self, world: World) -> None:
+    def setup(self, world: Host) -> None:
         self.queues = ActionQueues(world)
         self.strokes = world.resource(LocomotionStores).tentacles
 
-    def process(self, world: World, dt: float) -> None:
+    def process(self, world: Host, dt: float) -> None:
         t = self.strokes
         if not len(t):
             return
@@ -65,7 +65,7 @@ class ActionQueueSystem(System):
         for row in np.flatnonzero(done):
             self._advance(world, int(row))
 
-    def _advance(self, world: World, row: int) -> None:
+    def _advance(self, world: Host, row: int) -> None:
         t = self.strokes
         queue = self.queues[row].pending
         t.timer[row] = 0.0

@@ -17,7 +17,7 @@ from ecs_tentacles.locomotion.stores import LocomotionStores
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
-    from ecs_tentacles.world import World
+    from ecs_tentacles.host import Host
 
 
 class Goals(System):
@@ -39,7 +39,7 @@ class Goals(System):
         "locomotion.creatures.goal_radius",
     )
 
-    def process(self, world: World, dt: float) -> None:
+    def process(self, world: Host, dt: float) -> None:
         gaits = world.resource(LocomotionStores).creatures
         if not gaits.has_goal.any():
             return

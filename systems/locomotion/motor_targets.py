@@ -26,7 +26,7 @@ from ecs_tentacles.locomotion.stores import LocomotionStores
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
-    from ecs_tentacles.world import World
+    from ecs_tentacles.host import Host
 
 # Constant pitch (radians, positive = tip down) of each action's pose.
 LIFT = np.zeros(len(Kind))
@@ -65,7 +65,7 @@ class MotorTargets(System):
     writes = ("motors.target", "motors.gain")
     state_attributes = ("eased",)
 
-    def setup(self, world: World) -> None:
+    def setup(self, world: Host) -> None:
         motors, tentacles = world.motors, world.tentacles
         rows = np.arange(len(motors))
         first = tentacles.first_link
@@ -82,7 +82,7 @@ class MotorTargets(System):
         self.eased = motors.target[:, :2].copy()
         self.strokes = world.resource(LocomotionStores).tentacles
 
-    def process(self, world: World, dt: float) -> None:
+    def process(self, world: Host, dt: float) -> None:
         motors, t, body = world.motors, self.strokes, world.tentacles
         if not len(motors):
             return

@@ -21,11 +21,12 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ecs_tentacles.locomotion.actions import GRIPPING, Kind
+from ecs_tentacles.locomotion.grip import attach, release, sucker_points
 from ecs_tentacles.locomotion.stores import LocomotionStores
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
-    from ecs_tentacles.world import World
+    from ecs_tentacles.host import Host
 
 ATTACH_HEIGHT = 0.004  # metres above the ground a sucker may be and still grab
 ATTACH = int(Kind.ATTACH)
@@ -45,7 +46,7 @@ class Suckers(System):
     )
     writes = ("suckers.attached", "suckers.anchor")
 
-    def process(self, world: World, dt: float) -> None:
+    def process(self, world: Host, dt: float) -> None:
         s, t = world.suckers, world.tentacles
         loco = world.resource(LocomotionStores)
         action, c = loco.tentacles.action, loco.creatures
@@ -57,9 +58,9 @@ class Suckers(System):
         if len(reaching):
             rows = tip[reaching]
             rows = rows[~attached[rows]]
-            low = world.sucker_points(rows)[:, 2] <= ATTACH_HEIGHT
+            low = sucker_points(world, rows)[:, 2] <= ATTACH_HEIGHT
             for row in rows[low]:
-                world.attach(int(s.entity[row]))
+                attach(world, int(s.entity[row]))
 
         held = np.flatnonzero(attached)
         if not len(held):
@@ -68,7 +69,7 @@ class Suckers(System):
         creature = t.creature_row[tentacle]
         anchor = s.anchor[held]
         holding = GRIPPING[action[tentacle]] & (tip[tentacle] == held)
-        stretch = np.linalg.norm(world.sucker_points(held) - anchor, axis=1)
+        stretch = np.linalg.norm(sucker_points(world, held) - anchor, axis=1)
         base = world.transforms.pos[t.base_row[tentacle], :2]
         reach = np.linalg.norm(base - anchor[:, :2], axis=1)
         reasons = (
@@ -79,4 +80,4 @@ class Suckers(System):
         for reason, mask in reasons:
             for row in held[mask]:
                 if attached[row]:  # a sucker is released once, for the first reason
-                    world.release(int(s.entity[row]), reason)
+                    release(world, int(s.entity[row]), reason)

@@ -39,7 +39,7 @@ from ecs_tentacles.scene.parameters import parameter
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
-    from ecs_tentacles.world import World
+    from ecs_tentacles.host import Host
 
 PULL = int(Mode.PULL)
 PULL_TOLERANCE = 1e-9  # dot products this close to 0 count as the +-pi/2 boundary: pull
@@ -85,14 +85,14 @@ class TentacleSelection(System):
         "action_queues",
     )
 
-    def setup(self, world: World) -> None:
+    def setup(self, world: Host) -> None:
         gait = parameter("locomotion", "gait")  # stored codes: the schema's choices' indices
         self.cyclic, self.coordinated = gait.code("cyclic"), gait.code("coordinated")
         self.queues = ActionQueues(world)
         loco = world.resource(LocomotionStores)
         self.strokes, self.gaits = loco.tentacles, loco.creatures
 
-    def process(self, world: World, dt: float) -> None:
+    def process(self, world: Host, dt: float) -> None:
         t, c = world.tentacles, world.creatures
         s, g = self.strokes, self.gaits
         if not len(t) or not (g.has_goal.any() or s.driving.any()):
@@ -127,7 +127,7 @@ class TentacleSelection(System):
 
     def _start_best(
         self,
-        world: World,
+        world: Host,
         creature_row: int,
         cos: np.ndarray,
         pull: np.ndarray,
@@ -152,12 +152,12 @@ class TentacleSelection(System):
         self._start(world, k, mode, orient=float(np.clip(turn, -limit, limit)))
         self.gaits.last_start[creature_row] = world.time
 
-    def _speed(self, world: World, row: int) -> float:
+    def _speed(self, world: Host, row: int) -> float:
         """Tentacle `row`'s pace: its own speed times its creature's."""
         creature = world.tentacles.creature_row[row]
         return float(self.strokes.speed[row] * self.gaits.speed[creature])
 
-    def _start(self, world: World, row: int, mode: Mode, orient: float | None) -> None:
+    def _start(self, world: Host, row: int, mode: Mode, orient: float | None) -> None:
         s = self.strokes
         speed = self._speed(world, row)
         # queued after whatever is pending; the current action ends now
@@ -167,7 +167,7 @@ class TentacleSelection(System):
         s.mode[row] = mode
         s.started[row] = world.time
 
-    def _abort(self, world: World, row: int) -> None:
+    def _abort(self, world: Host, row: int) -> None:
         s = self.strokes
         speed = self._speed(world, row)
         self.queues.replace(row, [action(Kind.DETACH, speed), action(Kind.SETTLE, speed)])

@@ -19,7 +19,7 @@ import numpy as np
 from ecs_tentacles.system import System, SystemFailure
 
 if TYPE_CHECKING:
-    from ecs_tentacles.world import World
+    from ecs_tentacles.host import Host
 
 
 PROXY_ROUNDS = 4  # parts a frame is stepped in while creatures touch (proxies catch up)
@@ -42,7 +42,7 @@ class Physics(System):
     writes = ("physics",)
     calls_hooks = True  # wants_motion
 
-    def process(self, world: World, dt: float) -> None:
+    def process(self, world: Host, dt: float) -> None:
         backend = world.physics
         backend.write_controls(world.motors)
         backend.write_suckers(world.suckers)
@@ -75,7 +75,7 @@ class Physics(System):
         backend.step(world.settings.substeps, before_substep)
 
 
-def wanted_motion(world: World) -> np.ndarray | None:
+def wanted_motion(world: Host) -> np.ndarray | None:
     """Creatures (bool per CreatureStore row) some plugin wants to move, or None for none.
 
     The answers of every plugin's `wants_motion` hook, or-ed; one array operation per

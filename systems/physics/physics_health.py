@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
-    from ecs_tentacles.world import World
+    from ecs_tentacles.host import Host
 
 
 class PhysicsHealth(System):
@@ -27,6 +27,6 @@ class PhysicsHealth(System):
     reads = ("physics", "transforms.pos", "suckers.attached", "suckers.entity")
     writes = ("physics", "transforms.pos", "transforms.quat", "suckers.attached")
 
-    def process(self, world: World, dt: float) -> None:
+    def process(self, world: Host, dt: float) -> None:
         physics = world.physics
         physics.health.check(world, physics.time)

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
-    from ecs_tentacles.world import World
+    from ecs_tentacles.host import Host
 
 
 class PhysicsSync(System):
@@ -20,5 +20,5 @@ class PhysicsSync(System):
     reads = ("physics",)
     writes = ("transforms.pos", "transforms.quat")
 
-    def process(self, world: World, dt: float) -> None:
+    def process(self, world: Host, dt: float) -> None:
         world.physics.sync(world.transforms)

@@ -22,7 +22,7 @@ from ecs_tentacles.system import System
 from ecs_tentacles.take import Take
 
 if TYPE_CHECKING:
-    from ecs_tentacles.world import World
+    from ecs_tentacles.host import Host
 
 
 class Record(System):
@@ -42,14 +42,18 @@ class Record(System):
         self.recorder: TakeRecorder | None = None
         self._start = 0
 
-    def setup(self, world: World) -> None:
+    def setup(self, world: Host) -> None:
+        from ecs_tentacles.world import World  # a take needs the plugins' hooks and schedule
+
+        if not isinstance(world, World):
+            raise TypeError(f"record needs an ecs_tentacles World, got {type(world).__name__}")
         fps = world.settings.fps / self.every
         self.recorder = TakeRecorder(world, fps=fps, **self._options)
         before_recording(world)
         self.recorder.capture()
         self._start = world.frame
 
-    def process(self, world: World, dt: float) -> None:
+    def process(self, world: Host, dt: float) -> None:
         if (world.frame + 1 - self._start) % self.every == 0 and self.recorder is not None:
             self.recorder.capture()
 

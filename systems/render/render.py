@@ -12,8 +12,8 @@ from typing import TYPE_CHECKING
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
+    from ecs_tentacles.host import Host
     from ecs_tentacles.render.renderer import Renderer
-    from ecs_tentacles.world import World
 
 
 class RenderSync(System):
@@ -25,8 +25,8 @@ class RenderSync(System):
     def __init__(self, renderer: Renderer):
         self.renderer = renderer
 
-    def setup(self, world: World) -> None:
+    def setup(self, world: Host) -> None:
         self.renderer.sync()
 
-    def process(self, world: World, dt: float) -> None:
+    def process(self, world: Host, dt: float) -> None:
         self.renderer.sync()

@@ -14,7 +14,7 @@ from ecs_tentacles.threats.data import ThreatData
 from ecs_tentacles.tracks import TrackSet
 
 if TYPE_CHECKING:
-    from ecs_tentacles.world import World
+    from ecs_tentacles.host import Host
 
 
 class ThreatPaths(System):
@@ -27,7 +27,7 @@ class ThreatPaths(System):
         self.paths = TrackSet([])
         self.path_count = -1
 
-    def process(self, world: World, dt: float) -> None:
+    def process(self, world: Host, dt: float) -> None:
         threats = world.resource(ThreatData)
         if len(threats.paths) != self.path_count:
             self.paths = TrackSet(threats.paths)

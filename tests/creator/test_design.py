@@ -13,6 +13,7 @@ from ecs_tentacles.components import Creature, Link, Tentacle
 from ecs_tentacles.creator import CreatureDesign, DesignError, TentacleDesign
 from ecs_tentacles.scene.load import bundled_scene, load_scene
 from ecs_tentacles.world import World
+from tests.conftest import NO_LOCOMOTION
 
 
 def interactive_squid() -> CreatureDesign:
@@ -89,7 +90,7 @@ def test_loading_the_export_builds_exactly_the_creature_shown(tmp_path: Path) ->
     design = interactive_squid()
     shown = design.preview_world()
     design.export(tmp_path / "squid.json")
-    loaded = World.from_scene(tmp_path / "squid.json", locomotion=False)
+    loaded = World.from_scene(tmp_path / "squid.json", plugins=NO_LOCOMOTION)
     assert _creature_numbers(shown) == _creature_numbers(loaded)
     assert len(_creature_numbers(shown)) == 61
     np.testing.assert_array_equal(shown.transforms.pos, loaded.transforms.pos)

@@ -14,6 +14,7 @@ from ecs_tentacles.fur.groom import closest_surface_point
 from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.mathutil import quat_rotate
 from ecs_tentacles.world import World
+from tests.conftest import NO_LOCOMOTION
 
 SCENE = {
     "version": 1,
@@ -67,7 +68,8 @@ def test_child_roots_lie_on_the_skin_and_children_stay_above_it(
 
 
 def test_children_blend_their_guides_offsets(make_world: Callable[..., World]) -> None:
-    world = make_world(SCENE, locomotion=False)
+    still = [{k: v for k, v in c.items() if k != "goals"} for c in SCENE["creatures"]]
+    world = make_world({**SCENE, "creatures": still}, plugins=NO_LOCOMOTION)
     world.resource(FurData).controls.lift[:] = 0.8  # standing up: nothing to clamp
     world.step(3)
     made = layout(world)

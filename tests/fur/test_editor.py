@@ -13,6 +13,7 @@ from ecs_tentacles.fur.editor import FurEditor
 from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.world import World
+from tests.conftest import NO_LOCOMOTION
 
 
 @pytest.fixture
@@ -22,10 +23,10 @@ def editor() -> Any:
 
     def rebuild(scene: dict[str, Any]) -> World:
         made[-1].close()
-        made.append(World.from_scene(scene, locomotion=False))
+        made.append(World.from_scene(scene, plugins=NO_LOCOMOTION))
         return made[-1]
 
-    made.append(World.from_scene("hedgehog_octopus", locomotion=False))
+    made.append(World.from_scene("hedgehog_octopus", plugins=NO_LOCOMOTION))
     yield FurEditor(made[-1], rebuild)
     made[-1].close()
 

@@ -12,6 +12,7 @@ from ecs_tentacles.fur import child_hairs, control_markers, guide_curves
 from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.mathutil import quat_rotate
 from ecs_tentacles.world import World
+from tests.conftest import NO_LOCOMOTION
 
 SCENE = {
     "version": 1,
@@ -33,7 +34,7 @@ SCENE = {
 
 
 def test_guide_curves(make_world: Callable[..., World]) -> None:
-    world = make_world(SCENE, locomotion=False)
+    world = make_world(SCENE, plugins=NO_LOCOMOTION)
     world.step(1)
     curves = guide_curves(world)
     assert curves.points.shape == (40, 6, 3) and curves.points.dtype == np.float32
@@ -48,7 +49,7 @@ def test_guide_curves(make_world: Callable[..., World]) -> None:
 
 
 def test_child_hairs_follow_their_guide(make_world: Callable[..., World]) -> None:
-    world = make_world(SCENE, locomotion=False)
+    world = make_world(SCENE, plugins=NO_LOCOMOTION)
     world.step(1)
     kids = child_hairs(world, radius=0.01, seed=2, follow="own")
     assert kids.points.shape == (120, 6, 3)
@@ -70,7 +71,7 @@ def test_child_hairs_follow_their_guide(make_world: Callable[..., World]) -> Non
 
 
 def test_controls(make_world: Callable[..., World]) -> None:
-    world = make_world(SCENE, locomotion=False)
+    world = make_world(SCENE, plugins=NO_LOCOMOTION)
     world.step(1)
     (marker,) = control_markers(world)
     mantle = world.transforms.pos[world.resource(FurData).sets.body_row[0]]

@@ -15,11 +15,12 @@ from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.mathutil import quat_rotate
 from ecs_tentacles.scene.validate import validate_scene
 from ecs_tentacles.world import World
+from tests.conftest import NO_LOCOMOTION
 
 
 def fur_world(make: Callable[..., World], fur: dict[str, Any]) -> World:
     creature = {"name": "c", "tentacles": {"count": 3, "links": 2}, "fur": fur}
-    world = make({"version": 1, "creatures": [creature]}, locomotion=False)
+    world = make({"version": 1, "creatures": [creature]}, plugins=NO_LOCOMOTION)
     world.step(2)
     return world
 

@@ -10,9 +10,10 @@ import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
 from ecs_tentacles.components import Creature, Link, Motor, Sucker, Tentacle, Transform
+from ecs_tentacles.locomotion.grip import attach, release, sucker_points
 from ecs_tentacles.mathutil import quat_rotate
 from ecs_tentacles.world import World
-from tests.conftest import creature_scene
+from tests.conftest import NO_LOCOMOTION, creature_scene
 
 
 def _tentacle(world: World, k: int) -> Tentacle:
@@ -28,7 +29,7 @@ def _joint(world: World, link_entity: int, hinge: str) -> int:
 
 
 def test_model_options(make_world: Callable[..., World]) -> None:
-    world = make_world(creature_scene(count=3, links=2), locomotion=False)
+    world = make_world(creature_scene(count=3, links=2), plugins=NO_LOCOMOTION)
     model = world.physics.groups[0].model
     assert model.opt.integrator == mujoco.mjtIntegrator.mjINT_IMPLICITFAST
     assert model.opt.timestep == world.settings.substep_dt == 1 / 480
@@ -41,7 +42,7 @@ def test_model_options(make_world: Callable[..., World]) -> None:
 
 
 def test_creature_settles_on_the_ground(make_world: Callable[..., World]) -> None:
-    world = make_world(creature_scene(), locomotion=False)  # 8 tentacles x 10 links, r 0.025
+    world = make_world(creature_scene(), plugins=NO_LOCOMOTION)  # 8 tentacles x 10 links, r 0.025
     world.step(300)  # 5 simulated seconds
     data = world.physics.groups[0].data
     assert np.isfinite(data.qpos).all() and np.isfinite(data.qvel).all()
@@ -70,7 +71,7 @@ def test_servo_reaches_its_target(
 ) -> None:
     scene = creature_scene(count=4, links=5)
     scene["physics"] = {"gravity": gravity}
-    world = make_world(scene, locomotion=False)
+    world = make_world(scene, plugins=NO_LOCOMOTION)
     link = _tentacle(world, 0).links[link_index]
     world.component(link, Motor).target = target
     world.step(120)
@@ -82,7 +83,7 @@ def test_servo_reaches_its_target(
 def test_strength_change_at_run_time_changes_the_servo_force(
     make_world: Callable[..., World],
 ) -> None:
-    world = make_world(creature_scene(count=4, links=5), locomotion=False)
+    world = make_world(creature_scene(count=4, links=5), plugins=NO_LOCOMOTION)
     link = _tentacle(world, 1).links[0]
     motor = world.component(link, Motor)
     motor.target = [0.0, 0.4, 0.0]
@@ -121,26 +122,26 @@ def _wave_tentacle(world: World, tentacle: Tentacle, frames: int) -> np.ndarray:
         world.motors.target[rows, 0] = 0.6 * np.sin(2 * np.pi * 1.5 * t + np.arange(len(rows)))
         world.motors.target[rows, 1] = 0.6 * np.cos(2 * np.pi * 1.5 * t)
         world.step(1)
-        path.append(world.sucker_points()[sucker_row])
+        path.append(sucker_points(world)[sucker_row])
     return np.array(path)
 
 
 def test_attached_sucker_pins_the_tip_and_release_frees_it(
     make_world: Callable[..., World],
 ) -> None:
-    world = make_world(creature_scene(count=4, links=6), locomotion=False)
+    world = make_world(creature_scene(count=4, links=6), plugins=NO_LOCOMOTION)
     events: list[str] = []
     world.events.on("sucker_attached", lambda **kw: events.append("attached"))
     world.events.on("sucker_released", lambda **kw: events.append(kw["reason"]))
     world.step(30)
     tentacle = _tentacle(world, 0)
     sucker = world.component(tentacle.suckers[0], Sucker)
-    world.attach(tentacle.suckers[0])
+    attach(world, tentacle.suckers[0])
     anchor = sucker.anchor.copy()
-    assert_allclose(anchor, world.sucker_points()[sucker.row])
+    assert_allclose(anchor, sucker_points(world)[sucker.row])
     pinned = _wave_tentacle(world, tentacle, 120)
     assert np.linalg.norm(pinned - anchor, axis=1).max() < 0.005
-    world.release(tentacle.suckers[0])
+    release(world, tentacle.suckers[0])
     free = _wave_tentacle(world, tentacle, 120)
     assert np.linalg.norm(free - anchor, axis=1).max() > 0.03
     assert events == ["attached", "command"]
@@ -148,7 +149,7 @@ def test_attached_sucker_pins_the_tip_and_release_frees_it(
 
 
 def test_physics_sync_copies_poses_bit_for_bit(make_world: Callable[..., World]) -> None:
-    world = make_world(creature_scene(count=5, links=4), locomotion=False)
+    world = make_world(creature_scene(count=5, links=4), plugins=NO_LOCOMOTION)
     world.motors.target[:, 0] = 0.3
     world.step(20)
     data, ids = world.physics.groups[0].data, world.physics.groups[0].body_ids

@@ -13,6 +13,7 @@ from ecs_tentacles.creator.crowd import creature_reach
 from ecs_tentacles.physics.clearance import clearance
 from ecs_tentacles.scene.load import load_scene
 from ecs_tentacles.world import World
+from tests.conftest import NO_LOCOMOTION
 
 TOLERANCE = 0.005  # metres of interpenetration allowed, measured on the geoms
 
@@ -50,7 +51,7 @@ def test_proxies_stand_where_the_other_creatures_bodies_are(
             {"name": "far", "position": [9.0, 0.0], "tentacles": {"count": 3, "links": 4}},
         ],
     }
-    world = make_world(scene, locomotion=False)
+    world = make_world(scene, plugins=NO_LOCOMOTION)
     world.physics.proxies.update(world.transforms)  # as each frame starts
     a, b, far = world.physics.groups
     assert far.proxies_used == 0 and a.proxies_used > 0 and b.proxies_used > 0

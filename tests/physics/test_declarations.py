@@ -81,6 +81,6 @@ def test_a_world_has_everything_the_physics_asks_of_it(
 ) -> None:
     world = make_world(SCENE, plugins=OFF)
     wanted = [n for n in vars(PhysicsHost) if not n.startswith("_")]
-    assert {"settings", "transforms", "release", "component"} <= set(wanted)
+    assert {"settings", "transforms", "suckers", "component"} <= set(wanted)
     for name in wanted:
         assert hasattr(world, name), name

@@ -14,6 +14,7 @@ from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.physics.sleep import SETTLE_FRAMES
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.world import World
+from tests.conftest import NO_LOCOMOTION
 
 RESTING = {"count": 3, "links": 5, "wave_amplitude_deg": 0, "writhe": 0}
 
@@ -47,7 +48,8 @@ def test_a_still_idle_creature_sleeps_and_a_goal_wakes_it(
 
 
 def test_a_script_moving_a_servo_wakes_it(make_world: Callable[..., World]) -> None:
-    world = make_world(_scene(RESTING), locomotion=False)  # the script drives the servos
+    # the script drives the servos (waves and writhing are locomotion's keys: none here)
+    world = make_world(_scene({"count": 3, "links": 5}), plugins=NO_LOCOMOTION)
     rest = world.physics.groups[0]
     world.step(240)
     assert rest.sleeping
@@ -86,7 +88,8 @@ class NoOpinion(Plugin):
 def test_a_plugin_that_wants_a_creature_to_move_keeps_it_awake(
     make_world: Callable[..., World],
 ) -> None:
-    world = make_world(_scene(RESTING), locomotion=False)
+    off = {"locomotion": False, "suckers": False}  # nothing drives either creature
+    world = make_world(_scene({"count": 3, "links": 5}), plugins=off)
     world.add_plugin(KeepAwake("rest"))
     world.add_plugin(NoOpinion())
     rest, other = world.physics.groups  # no locomotion: nothing drives either one

@@ -14,7 +14,7 @@ import numpy as np
 from ecs_tentacles.fur.hooks import control_markers
 
 if TYPE_CHECKING:
-    from ecs_tentacles.world import World
+    from ecs_tentacles.host import Host
 
 
 def _ring(axis: int, n: int = 16) -> np.ndarray:
@@ -55,7 +55,7 @@ SHAPES = {
 }
 
 
-def marker_lines(world: World, selected: int | None = None) -> np.ndarray:
+def marker_lines(world: Host, selected: int | None = None) -> np.ndarray:
     """Line-list vertices (2n, 7) of every fur control; `selected`: its entity."""
     parts = []
     for marker in control_markers(world):

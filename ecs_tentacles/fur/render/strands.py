@@ -20,7 +20,7 @@ from ecs_tentacles.fur.stores import FurData
 
 if TYPE_CHECKING:
     from ecs_tentacles.drawing import RenderView
-    from ecs_tentacles.world import World
+    from ecs_tentacles.host import Host
 
 DISPLAY = "fur.display"  # keys in the renderer's `view.state`
 STRANDS = "fur.strands"
@@ -48,7 +48,7 @@ def fur_display(state: dict[str, Any]) -> FurDisplay:
     return display
 
 
-def fur_strands(world: World, display: FurDisplay) -> tuple[GuideCurves, GuideCurves]:
+def fur_strands(world: Host, display: FurDisplay) -> tuple[GuideCurves, GuideCurves]:
     """This frame's guides and child hairs as `display` asks (empty when hidden)."""
     fur = world.get_resource(FurData)  # None with the fur plugin off
     points = max(fur.points, 1) if fur is not None else 1
@@ -73,7 +73,7 @@ def fur_strands(world: World, display: FurDisplay) -> tuple[GuideCurves, GuideCu
     return guides, dense
 
 
-def fur_lines(world: World, view: RenderView) -> list[np.ndarray]:
+def fur_lines(world: Host, view: RenderView) -> list[np.ndarray]:
     """The controls' marker shapes (line-list vertices) while the sandbox shows overlays."""
     from ecs_tentacles.fur.render.markers import marker_lines
 
@@ -95,7 +95,7 @@ class FurStrands:
         self.guides = Ribbons()
         self.children = Ribbons()
 
-    def update(self, world: World, display: FurDisplay) -> None:
+    def update(self, world: Host, display: FurDisplay) -> None:
         """Upload this frame's strands as `display` asks."""
         guides, children = fur_strands(world, display)
         self.guides.update(guides)
@@ -129,7 +129,7 @@ def strands_of(state: dict[str, Any]) -> FurStrands:
     return strands
 
 
-def draw_fur(world: World, view: RenderView) -> int:
+def draw_fur(world: Host, view: RenderView) -> int:
     """Upload and draw this frame's strands; the draw calls (none without fur)."""
     fur = world.get_resource(FurData)
     if (fur is None or not len(fur.guides)) and STRANDS not in view.state:

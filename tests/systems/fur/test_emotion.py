@@ -12,6 +12,7 @@ from numpy.testing import assert_allclose
 from ecs_tentacles.fur import Emotion
 from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.world import World
+from tests.conftest import NO_LOCOMOTION
 
 FAR, NEAR = [5.0, 0.0, 0.1], [0.5, 0.0, 0.1]
 
@@ -41,7 +42,7 @@ def levels(world: World, frames: int) -> np.ndarray:
 
 
 def test_level_follows_a_critically_damped_rise(make_world: Callable[..., World]) -> None:
-    world = make_world(scene(0.0), locomotion=False)
+    world = make_world(scene(0.0), plugins=NO_LOCOMOTION)
     level = levels(world, 120)
     assert np.all(level[:60] == 0.0)  # frames at t < 1: calm
     t = (np.arange(60, 120) - 59) / 60.0  # seconds of arousal after each of those frames
@@ -51,7 +52,7 @@ def test_level_follows_a_critically_damped_rise(make_world: Callable[..., World]
 
 
 def test_anticipation_then_slow_out_and_decay(make_world: Callable[..., World]) -> None:
-    world = make_world(scene(0.4), locomotion=False)
+    world = make_world(scene(0.4), plugins=NO_LOCOMOTION)
     level = levels(world, 6 * 60)
     emotion = world.component(world.creature("hog"), Emotion)
     assert emotion.kind == "fear" and not emotion.threatened
@@ -66,7 +67,7 @@ def test_anticipation_then_slow_out_and_decay(make_world: Callable[..., World]) 
 
 
 def test_emotion_drives_the_controls(make_world: Callable[..., World]) -> None:
-    world = make_world(scene(0.3), locomotion=False)
+    world = make_world(scene(0.3), plugins=NO_LOCOMOTION)
     world.step(100)
     level = world.resource(FurData).emotions.level[0]
     c, sets = world.resource(FurData).controls, world.resource(FurData).sets
@@ -106,7 +107,7 @@ def test_a_creature_marked_threat_frightens_others_not_itself(
             {"name": "far", "position": [5, 0], "tentacles": tentacles, "emotion": {}},
         ],
     }
-    world = make_world(data, locomotion=False)
+    world = make_world(data, plugins=NO_LOCOMOTION)
     world.step(30)
     e = world.resource(FurData).emotions
     assert list(e.threatened) == [True, False, False]

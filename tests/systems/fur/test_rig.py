@@ -14,6 +14,7 @@ from ecs_tentacles.fur import FurControl, FurGuide
 from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.mathutil import quat_rotate
 from ecs_tentacles.world import World
+from tests.conftest import NO_LOCOMOTION
 
 
 def creature(name: str, x: float, fur: dict[str, Any], **extra: Any) -> dict[str, Any]:
@@ -76,7 +77,7 @@ def test_tracks_drive_control_attributes(make_world: Callable[..., World]) -> No
     ]
     tracks[0]["keys"][0]["easing"] = "linear"
     fur = {"groom": {"count": 30}, "controls": [{"name": "m", "tracks": tracks}]}
-    world = make_world({"version": 1, "creatures": [creature("a", 0, fur)]}, locomotion=False)
+    world = make_world({"version": 1, "creatures": [creature("a", 0, fur)]}, plugins=NO_LOCOMOTION)
     control = world.component(world.resource(FurData).controls.entity[0], FurControl)
     world.step(31)  # the last frame ran at t = 0.5
     assert control.lift == 0.5
@@ -90,7 +91,7 @@ def test_tracks_drive_control_attributes(make_world: Callable[..., World]) -> No
 
 def test_a_scripted_control_move_turns_its_guides(make_world: Callable[..., World]) -> None:
     fur = {"groom": {"count": 80, "region": "top"}, "controls": [{"name": "m", "direction": 1.0}]}
-    world = make_world({"version": 1, "creatures": [creature("a", 0, fur)]}, locomotion=False)
+    world = make_world({"version": 1, "creatures": [creature("a", 0, fur)]}, plugins=NO_LOCOMOTION)
     world.step(1)
     before = world.resource(FurData).frames[:, 0].copy()
     control = world.component(world.resource(FurData).controls.entity[0], FurControl)
@@ -105,7 +106,7 @@ def test_a_scripted_control_move_turns_its_guides(make_world: Callable[..., Worl
 
 def test_writing_a_guide_rebinds(make_world: Callable[..., World]) -> None:
     fur = {"groom": {"count": 10}}
-    world = make_world({"version": 1, "creatures": [creature("a", 0, fur)]}, locomotion=False)
+    world = make_world({"version": 1, "creatures": [creature("a", 0, fur)]}, plugins=NO_LOCOMOTION)
     world.step(1)
     version = world.resource(FurData).version
     guide = world.component(int(world.resource(FurData).guides.entity[3]), FurGuide)
@@ -132,7 +133,7 @@ def test_blocks_give_the_same_result_as_one_pass(
     for block, strands in [(10_000, 10_000), (16, 7)]:
         monkeypatch.setattr(rig_module, "BLOCK", block)
         monkeypatch.setattr(rig_module, "STRAND_BLOCK", strands)
-        world = make_world(scene, locomotion=False)
+        world = make_world(scene, plugins=NO_LOCOMOTION)
         world.resource(FurData).controls.lift[:] = 0.4
         world.resource(FurData).controls.random[:] = 0.6
         world.step(20)

@@ -17,6 +17,7 @@ from ecs_tentacles.locomotion.actions import (
     Kind,
     make_action,
 )
+from ecs_tentacles.locomotion.grip import sucker_points
 from ecs_tentacles.locomotion.params import Locomotion
 from ecs_tentacles.world import World
 from tests.conftest import creature_scene
@@ -132,10 +133,10 @@ def test_arched_tentacle_is_shorter(make_world: Callable[..., World]) -> None:
     tip = int(world.tentacles.tip_sucker[0])
     mantle = world.creatures.mantle_row[0]
     world.step(30)
-    straight = np.linalg.norm(world.sucker_points()[tip, :2] - world.transforms.pos[mantle, :2])
+    straight = np.linalg.norm(sucker_points(world)[tip, :2] - world.transforms.pos[mantle, :2])
     _arch(world, 0, np.radians(50))
     world.step(60)
-    arched = np.linalg.norm(world.sucker_points()[tip, :2] - world.transforms.pos[mantle, :2])
+    arched = np.linalg.norm(sucker_points(world)[tip, :2] - world.transforms.pos[mantle, :2])
     assert arched < straight - 0.02
 
 

@@ -12,6 +12,7 @@ from numpy.testing import assert_allclose, assert_array_equal
 
 from ecs_tentacles.components import Creature, Sucker, Tentacle
 from ecs_tentacles.locomotion.actions import Kind
+from ecs_tentacles.locomotion.grip import sucker_points
 from ecs_tentacles.world import World
 from tests.conftest import creature_scene
 
@@ -63,7 +64,7 @@ def _grab(world: World, row: int, frames: int = 40) -> np.ndarray:
     _hold(world, row, Kind.ATTACH)
     tip = int(world.tentacles.tip_sucker[row])
     for _ in range(frames):
-        before = world.sucker_points()[tip].copy()
+        before = sucker_points(world)[tip].copy()
         world.step(1)
         if world.suckers.attached[tip]:
             return before
@@ -80,7 +81,7 @@ def test_attach_only_near_the_ground(make_world: Callable[..., World]) -> None:
     lowest = np.inf
     for _ in range(40):
         world.step(1)
-        lowest = min(lowest, float(world.sucker_points()[:, 2].min()))
+        lowest = min(lowest, float(sucker_points(world)[:, 2].min()))
     assert lowest > 0.4
     assert world.suckers.attached.tolist() == [False, False]
     assert events.events == []
@@ -91,7 +92,7 @@ def test_tip_grabs_the_ground_where_it_touches(make_world: Callable[..., World])
     events = Recorder(world)
     world.step(5)
     tip = int(world.tentacles.tip_sucker[0])
-    assert world.sucker_points()[tip, 2] > ATTACH_HEIGHT  # a straight tentacle's tip hovers
+    assert sucker_points(world)[tip, 2] > ATTACH_HEIGHT  # a straight tentacle's tip hovers
     world.step(20)
     assert events.events == []  # idle tentacles never grab, even where they touch down
     where = _grab(world, 0)
@@ -106,7 +107,7 @@ def test_tip_grabs_the_ground_where_it_touches(make_world: Callable[..., World])
     assert world.suckers.attached.tolist() == [True, False]
     world.step(10)  # the hold lasts while the tentacle grips; the tip stays put
     assert world.suckers.attached.tolist() == [True, False]
-    assert np.linalg.norm(world.sucker_points()[tip] - where) < 0.01
+    assert np.linalg.norm(sucker_points(world)[tip] - where) < 0.01
     assert world.events.counts["sucker_attached"] == 1
 
 
@@ -141,7 +142,7 @@ def test_release_on_stretch(make_world: Callable[..., World]) -> None:
     assert stretch == 0.04  # the scene default
     anchor = world.suckers.anchor[row].copy()
     # just within the stretch: held (straight up, so the reach is unchanged)
-    world.suckers.anchor[row] = world.sucker_points()[row] + np.array([0.0, 0.0, 0.9 * stretch])
+    world.suckers.anchor[row] = sucker_points(world)[row] + np.array([0.0, 0.0, 0.9 * stretch])
     world.step(1)
     assert world.suckers.attached[row]
     world.suckers.anchor[row] = anchor + np.array([0.0, 0.0, 0.1])

@@ -1,0 +1,120 @@
+"""`Host`: what systems and plugins may use of the world they run in.
+
+`System.process/setup/substep`, the `Plugin` hooks, creature building and the scene
+helpers take a `Host`, not the concrete `ecs_tentacles.world.World`, so nothing the
+World imports has to import it back (no import circle, not even a type-only one).
+`World` satisfies it structurally; a user system annotated `world: Host` (or left
+unannotated) runs in any world.
+
+    from ecs_tentacles.host import Host
+
+    class Wobble(System):
+        def process(self, world: Host, dt: float) -> None:
+            world.motors.target[:, 0] += 0.1 * np.sin(world.time)
+
+Reads and writes nothing itself.
+"""
+
+from __future__ import annotations
+
+import pathlib
+from collections.abc import Iterator
+from typing import TYPE_CHECKING, Any, Protocol, TypeVar
+
+if TYPE_CHECKING:
+    import numpy as np
+
+    from ecs_tentacles.events import Events
+    from ecs_tentacles.physics.backend import PhysicsBackend
+    from ecs_tentacles.settings import Settings
+    from ecs_tentacles.store import (
+        ArrayStore,
+        CreatureStore,
+        MotorStore,
+        SuckerStore,
+        TentacleStore,
+        TransformStore,
+    )
+
+C = TypeVar("C")
+R = TypeVar("R")
+
+
+class Host(Protocol):
+    """The world as a system or plugin sees it: clock, stores, resources, entities, events."""
+
+    @property
+    def name(self) -> str: ...
+    @property
+    def seed(self) -> int: ...
+    @property
+    def rng(self) -> np.random.Generator: ...
+    @property
+    def settings(self) -> Settings: ...
+    @property
+    def frame(self) -> int:
+        """Frames stepped since the start."""
+
+    @property
+    def time(self) -> float:
+        """Simulated seconds since the start."""
+
+    @property
+    def scene(self) -> dict[str, Any] | None:
+        """The validated scene, defaults filled in (None for a world built by hand)."""
+
+    @property
+    def scene_dir(self) -> pathlib.Path | None: ...
+
+    # -- core stores (every store by name in `stores`) --------------------------------------
+    @property
+    def transforms(self) -> TransformStore: ...
+    @property
+    def motors(self) -> MotorStore: ...
+    @property
+    def suckers(self) -> SuckerStore: ...
+    @property
+    def creatures(self) -> CreatureStore: ...
+    @property
+    def tentacles(self) -> TentacleStore: ...
+    @property
+    def stores(self) -> dict[str, ArrayStore]: ...
+
+    @property
+    def events(self) -> Events: ...
+    @property
+    def physics(self) -> PhysicsBackend: ...
+    @property
+    def schedule(self) -> SystemsView:
+        """The frame's systems (`ecs_tentacles.schedule.Schedule`)."""
+
+    @property
+    def plugins(self) -> list[Any]:
+        """The plugins on (`ecs_tentacles.plugin.Plugin`), in build order."""
+
+    # -- plugins' resources, by type ------------------------------------------------------
+    def resource(self, kind: type[R]) -> R: ...
+    def get_resource(self, kind: type[R]) -> R | None: ...
+    def has_resource(self, kind: type) -> bool: ...
+
+    # -- entities ---------------------------------------------------------------------------
+    def activate(self) -> None: ...
+    def create_entity(self, *components: Any) -> int: ...
+    def add_component(self, entity: int, component: Any) -> None: ...
+    def component(self, entity: int, kind: type[C]) -> C: ...
+    def try_component(self, entity: int, kind: type[C]) -> C | None: ...
+    def query(self, *kinds: type) -> Iterator[tuple[int, Any]]: ...
+    def creature(self, name: str) -> int: ...
+    def creature_name(self, entity: int) -> str: ...
+
+
+class SystemsView(Protocol):
+    """What systems and plugins use of the schedule (`ecs_tentacles.schedule.Schedule`):
+    a system by name, whether one is scheduled, the substep hooks and a system's label.
+    (Typed loosely, so this module needs neither the Schedule nor System.)"""
+
+    def __contains__(self, name: object) -> bool: ...
+    def __getitem__(self, name: str) -> Any: ...
+    def __iter__(self) -> Iterator[Any]: ...
+    def substep_systems(self) -> list[Any]: ...
+    def label(self, system: Any) -> str: ...

@@ -1,0 +1,174 @@
+"""Scene -> a running world: validate, import, build, compile physics, schedule.
+
+`World.from_scene` delegates here; this module sits above everything it uses (scene
+validation, plugins, creature building, the core systems) and imports no `World`:
+the class to build is passed in (`WorldClass`), so world.py imports nothing that
+imports it back.
+
+Order: the scene is validated and its plugins imported (user code only with
+`allow_systems`); the world is made from the scene's `physics` settings; each plugin's
+resources and stores join it; every creature's body is built, then each plugin's
+`build_creature` and `build_scene` hooks run; the physics is compiled; the core
+systems and every plugin's systems are scheduled and set up. If a plugin's
+`systems()` or a system's `setup()` raises, the half-built world is closed (its
+physics threads and esper context) before the error goes on.
+"""
+
+from __future__ import annotations
+
+import importlib
+import os
+import pathlib
+from collections.abc import Collection, Mapping
+from typing import Any, Protocol, TypeVar
+
+from ecs_tentacles.build import build_creature
+from ecs_tentacles.host import Host
+from ecs_tentacles.physics.systems import physics_systems
+from ecs_tentacles.plugin import Plugin, SystemsPlugin, scene_first
+from ecs_tentacles.scene.errors import SceneError
+from ecs_tentacles.scene.load import load_scene_plugins, read_scene_json, resolve_scene_path
+from ecs_tentacles.settings import Settings
+from ecs_tentacles.system import System
+
+
+class SceneWorld(Host, Protocol):
+    """What loading needs of the world it builds (`ecs_tentacles.world.World`)."""
+
+    scene: dict[str, Any] | None
+    scene_dir: pathlib.Path | None
+
+    def adopt(self, plugin: Plugin) -> None: ...
+    def build_physics(self, threads: int | None = None) -> object: ...
+    def add_systems(self, *systems: System) -> None: ...
+    def close(self) -> None: ...
+
+
+W = TypeVar("W", bound=SceneWorld)
+W_co = TypeVar("W_co", bound=SceneWorld, covariant=True)
+
+
+class WorldClass(Protocol[W_co]):
+    """A world class: `World(settings, seed=..., name=...)`."""
+
+    def __call__(
+        self, settings: Settings | None = None, *, seed: int = 0, name: str = "world"
+    ) -> W_co: ...
+
+
+def load_world(
+    cls: WorldClass[W],
+    source: str | os.PathLike[str] | dict[str, Any],
+    *,
+    seed: int | None = None,
+    allow_systems: bool = False,
+    threads: int | None = None,
+    only: Collection[int] | None = None,
+    plugins: Mapping[str, Any] | None = None,
+    scene_dir: str | os.PathLike[str] | None = None,
+) -> W:
+    """A `cls` world built from a scene file, bundled scene name or dict (`World.from_scene`)."""
+    folder = pathlib.Path(scene_dir) if scene_dir is not None else None
+    if not isinstance(source, dict):
+        source = resolve_scene_path(os.fspath(source))  # a path, or a bundled scene's name
+        folder = source.resolve().parent
+    if plugins:  # the caller's choices over the scene's
+        raw = source if isinstance(source, dict) else _read_scene(source)
+        source = {**raw, "plugins": {**(raw.get("plugins") or {}), **plugins}}
+    data, chosen = load_scene_plugins(source, allow_systems=allow_systems, scene_dir=folder)
+    chosen += _scene_systems(data["systems"], folder, allow_systems)
+    world = cls(
+        Settings.from_physics(data["physics"]),
+        seed=data["seed"] if seed is None else seed,
+        name=data.get("name", "scene"),
+    )
+    world.scene, world.scene_dir = data, folder
+    for plugin in chosen:
+        world.adopt(plugin)
+    for index, creature in enumerate(data["creatures"]):
+        if only is None or index in only:
+            entity = build_creature(world, creature)
+            for plugin in chosen:
+                plugin.build_creature(world, entity, creature)
+    for plugin in chosen:
+        plugin.build_scene(world, data)
+    world.build_physics(threads)
+    try:
+        systems = physics_systems()
+        for plugin in chosen:
+            systems += _plugin_systems(plugin)
+        world.add_systems(*systems)
+    except BaseException:  # a user's systems() or setup() raised
+        world.close()  # its physics threads and esper context
+        raise
+    return world
+
+
+def owned_systems(plugin: Plugin) -> list[System]:
+    """The plugin's systems, each tagged with the plugin's key."""
+    systems = plugin.systems()
+    for system in systems:
+        system.plugin = plugin.key
+    return systems
+
+
+def _plugin_systems(plugin: Plugin) -> list[System]:
+    """`owned_systems`, a raising `systems()` as one SceneError line naming the plugin."""
+    try:
+        return owned_systems(plugin)
+    except Exception as exc:  # one line naming the plugin, as for an import
+        text = f"{type(exc).__name__}: {' '.join(str(exc).split())}"
+        raise SceneError([f"plugins.{plugin.key}: systems() raised {text}"]) from exc
+
+
+def _scene_systems(
+    paths: list[str], folder: pathlib.Path | None, allow_systems: bool
+) -> list[Plugin]:
+    """The scene's `systems` list as one plugin (none when empty); refused unless allowed."""
+    if not paths:
+        return []
+    if not allow_systems:  # checked before importing anything
+        raise SceneError(
+            [
+                f"systems[{i}]: the scene asks to run {path!r}; allow it with --allow-systems"
+                " (API: allow_systems=True)"
+                for i, path in enumerate(paths)
+            ]
+        )
+    legacy = SystemsPlugin(_import_systems(paths, folder))
+    legacy.key, legacy.source = "systems", "the scene's systems list"
+    return [legacy]
+
+
+def _read_scene(path: pathlib.Path) -> dict[str, Any]:
+    data = read_scene_json(path)
+    if not isinstance(data, dict):
+        raise SceneError([f"{path}: scene: must be an object"])
+    return data
+
+
+def _import_systems(paths: list[str], folder: pathlib.Path | None) -> list[type[System]]:
+    """Resolve 'package.module:Class' paths to System subclasses (only when allowed).
+
+    The scene's folder is searched first, so a module beside the scene is found.
+    """
+    found: list[type[System]] = []
+    problems: list[str] = []
+    for i, path in enumerate(paths):
+        module_name, _, attr = path.partition(":")
+        try:
+            with scene_first(folder):
+                factory = getattr(importlib.import_module(module_name), attr)
+        except (ImportError, AttributeError) as exc:
+            problems.append(f"systems[{i}]: cannot import {path!r}: {exc}")
+            continue
+        except Exception as exc:  # the user's module raised while importing: say which and why
+            problems.append(f"systems[{i}]: cannot import {path!r}: {type(exc).__name__}: {exc}")
+            continue
+        if not (isinstance(factory, type) and issubclass(factory, System)):
+            problems.append(f"systems[{i}]: {path!r} is not a System subclass")
+            continue
+        found.append(factory)
+    if problems:
+        raise SceneError(problems)
+    return found
