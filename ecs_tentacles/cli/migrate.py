@@ -1,9 +1,11 @@
 """`ecs-tentacles migrate SCENE`: write a scene in today's form (explicit `plugins`).
 
 Old scenes stay valid (the default plugins are on), so migrating is optional. It
-writes every plugin the scene runs under `plugins`, with its full config, and turns
+writes every plugin the scene runs under `plugins`, with its full config, turns
 the older `systems` list of import paths into plugin entries (`{"from": "module:Class"}`)
-so they are configured like any plugin. The result is validated before it is written,
+so they are configured like any plugin, and removes the keys of built-in plugins the
+scene turns off (an older scene with locomotion off may carry tentacle waves, which
+are the locomotion plugin's keys now). The result is validated before it is written,
 atomically, to `--out` (default: beside the scene, `<name>.migrated.json`) or over the
 scene with `--in-place`.
 """
@@ -17,9 +19,10 @@ import pathlib
 from typing import Any
 
 from ecs_tentacles.atomic import atomic_output
-from ecs_tentacles.plugin import DEFAULT_ON, FROM
+from ecs_tentacles.plugin import BUILTIN, DEFAULT_ON, FROM
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.load import load_scene_plugins, read_scene_json, resolve_scene_path
+from ecs_tentacles.scene.validate import builtin_keys
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
@@ -59,7 +62,41 @@ def migrate(raw: dict[str, Any]) -> tuple[dict[str, Any], list[str]]:
         plugins[key] = {FROM: target}
         changes.append(f"systems[{i}] -> plugins.{key} (from {target})")
     scene["plugins"] = plugins
+    changes += _drop_keys_of_plugins_off(scene, [n for n in BUILTIN if plugins.get(n) is False])
     return scene, changes
+
+
+def _drop_keys_of_plugins_off(scene: dict[str, Any], off: list[str]) -> list[str]:
+    """Remove the keys of built-in plugins the scene turns off (they would do nothing,
+    and are refused): scene keys, creature keys, tentacle keys and their overrides'.
+    Scenes written before the six locomotion tentacle keys moved out of the core schema
+    (speed, target_angle_deg, waves, writhe) with locomotion off need this."""
+    changes: list[str] = []
+    for name in off:
+        keys = builtin_keys(name)
+        for key in sorted(keys.get("scene", set()) & set(scene)):
+            del scene[key]
+            changes.append(f"{key}: removed (the {name} plugin is off)")
+        creatures = scene.get("creatures")
+        for i, creature in enumerate(creatures if isinstance(creatures, list) else []):
+            if not isinstance(creature, dict):
+                continue
+            for key in sorted(keys.get("creature", set()) & set(creature)):
+                del creature[key]
+                changes.append(f"creatures[{i}].{key}: removed (the {name} plugin is off)")
+            tentacles = creature.get("tentacles")
+            if not isinstance(tentacles, dict):
+                continue
+            places = [(f"creatures[{i}].tentacles", tentacles)] + [
+                (f"creatures[{i}].tentacles.overrides[{j}]", o)
+                for j, o in enumerate(tentacles.get("overrides") or [])
+                if isinstance(o, dict)
+            ]
+            for where, entry in places:
+                for key in sorted(keys.get("tentacles", set()) & set(entry)):
+                    del entry[key]
+                    changes.append(f"{where}.{key}: removed (the {name} plugin is off)")
+    return changes
 
 
 def handle(args: argparse.Namespace) -> int:
@@ -67,7 +104,6 @@ def handle(args: argparse.Namespace) -> int:
     raw = read_scene_json(path)
     if not isinstance(raw, dict):
         raise SceneError([f"{path}: scene: must be an object"])
-    load_scene_plugins(path, allow_systems=args.allow_systems)  # the old form is valid
     scene, changes = migrate(raw)
     folder = path.resolve().parent
     load_scene_plugins(scene, allow_systems=args.allow_systems, scene_dir=folder)

@@ -343,8 +343,53 @@ def validate_scene(data: object, plugins: Sequence[Plugin] | None = None) -> lis
         problems = _semantic_problems(full)
         for plugin in plugins:
             problems += plugin.problems(full)
+    problems = _name_plugins_that_are_off(problems, {p.name for p in plugins})
     unique = sorted(set(problems), key=_path_key)
     return [f"{format_path(path)}: {message}" for path, message in unique]
+
+
+def builtin_keys(name: str) -> dict[str, set[str]]:
+    """A built-in plugin's keys by place (`creature`, `tentacles`, `scene`), read from its
+    fragment file without importing the plugin; empty when it has none."""
+    from ecs_tentacles.plugin import BUILTIN
+
+    package = BUILTIN[name].partition(":")[0].rpartition(".")[0]
+    if not _fragment_file(package, name).is_file():
+        return {}
+    part = fragment(package, name)
+    return {place: set(part.get(place, {})) for place in ("creature", "tentacles", "scene")}
+
+
+def _place(path: JsonPath) -> str | None:
+    """Where a key at `path` sits: a creature's key, a tentacle key, a scene key."""
+    if len(path) == 1:
+        return "scene"
+    if len(path) == 3 and path[0] == "creatures":
+        return "creature"
+    tentacles = len(path) == 4 or (len(path) == 6 and path[3] == "overrides")
+    if tentacles and path[0] == "creatures" and path[2] == "tentacles":
+        return "tentacles"
+    return None
+
+
+def _name_plugins_that_are_off(problems: list[Problem], on: set[str]) -> list[Problem]:
+    """An unknown key that a built-in plugin which is off would know says so."""
+    from ecs_tentacles.plugin import BUILTIN
+
+    if not any(message.startswith("unknown key") for _, message in problems):
+        return problems
+    off = {name: builtin_keys(name) for name in BUILTIN if name not in on}
+    named: list[Problem] = []
+    for path, message in problems:
+        place = _place(path) if message.startswith("unknown key") else None
+        owner = next((n for n, keys in off.items() if path[-1] in keys.get(place or "", ())), None)
+        if owner is not None:
+            message = (
+                f"unknown key: the {owner} plugin's, which is off (turn it on, or remove"
+                " the key: `ecs-tentacles migrate` does)"
+            )
+        named.append((path, message))
+    return named
 
 
 def _too_deep(data: object) -> JsonPath | None:

@@ -97,3 +97,44 @@ def test_schema_writes_the_assembled_schema_an_editor_can_use(
     assert main(["schema", "follow_leader"]) == 0
     with_example = json.loads(capsys.readouterr().out)
     assert "follow" in with_example["$defs"]["creature"]["properties"]
+
+
+def test_a_scene_written_before_locomotion_owned_its_tentacle_keys_migrates(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # Before the feature-package refactor the waves and writhing were core keys, so a
+    # scene could set them with the locomotion plugin off; now they are locomotion's.
+    older = {
+        "version": 1,
+        "plugins": {"locomotion": False, "suckers": False},
+        "creatures": [
+            {
+                "name": "still",
+                "tentacles": {
+                    "count": 3, "links": 4, "wave_amplitude_deg": 0, "writhe": 0,
+                    "overrides": [{"index": 1, "speed": 2.0, "strength": 30.0}],
+                },
+            }
+        ],
+    }  # fmt: skip
+    path = tmp_path / "older.json"
+    path.write_text(json.dumps(older))
+    assert main(["run", str(path), "--frames", "2"]) == 2
+    err = capsys.readouterr().err
+    assert (
+        "creatures[0].tentacles.writhe: unknown key: the locomotion plugin's, which is off"
+        " (turn it on, or remove the key: `ecs-tentacles migrate` does)"
+    ) in err
+    assert "creatures[0].tentacles.overrides[0].speed: unknown key: the locomotion" in err
+    assert main(["migrate", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert (
+        "creatures[0].tentacles.wave_amplitude_deg: removed (the locomotion plugin is off)" in out
+    )
+    assert "creatures[0].tentacles.overrides[0].speed: removed" in out
+    migrated = json.loads((tmp_path / "older.migrated.json").read_text())
+    tentacles = migrated["creatures"][0]["tentacles"]
+    assert tentacles == {
+        "count": 3, "links": 4, "overrides": [{"index": 1, "strength": 30.0}]
+    }  # fmt: skip
+    assert main(["run", str(tmp_path / "older.migrated.json"), "--frames", "2"]) == 0
