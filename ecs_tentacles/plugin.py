@@ -154,6 +154,18 @@ class Plugin:
     tentacle_schema: ClassVar[dict[str, Any]] = {}
     defs: ClassVar[dict[str, Any]] = {}  # "$defs" the fragments refer to ("#/$defs/...")
 
+    # hooks of earlier versions, and what replaced them: a plugin that still defines
+    # one is refused when its class is made, instead of being silently never called
+    RENAMED_HOOKS: ClassVar[dict[str, str]] = {
+        "export_curves": "take_tracks (a TrackSource of kind 'curves'; README: Output hooks)"
+    }
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        for old, new in Plugin.RENAMED_HOOKS.items():
+            if old in vars(cls):
+                raise TypeError(f"{cls.__name__}.{old}: this hook is now {new}")
+
     def __init__(self, config: Mapping[str, Any] | None = None):
         self.config: dict[str, Any] = dict(config or {})
         self.key = self.name  # the name a scene turned it on by

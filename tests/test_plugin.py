@@ -265,3 +265,22 @@ def test_a_system_failure_survives_pickling(
     back = pickle.loads(pickle.dumps(caught.value))
     assert str(back) == str(caught.value) and (back.label, back.frame) == ("glow", 0)
     assert "in process" in back.user_traceback() and "TypeError" in back.user_traceback()
+
+
+def test_a_plugin_with_a_hook_of_an_earlier_version_is_refused_with_its_new_name(
+    tmp_path: Path,
+) -> None:
+    (tmp_path / "old.py").write_text(
+        "from ecs_tentacles.plugin import Plugin\n"
+        "class Old(Plugin):\n"
+        "    name = 'old'\n"
+        "    def export_curves(self, world):\n"
+        "        return None\n"
+    )
+    scene = {"version": 1, "plugins": {"old": {"from": "old.py"}}, "creatures": [{}]}
+    with pytest.raises(SceneError) as refused:
+        World.from_scene(scene, scene_dir=tmp_path, allow_systems=True)
+    assert str(refused.value) == (
+        "plugins.old: cannot import 'old.py': TypeError: Old.export_curves: this hook is now"
+        " take_tracks (a TrackSource of kind 'curves'; README: Output hooks)"
+    )

@@ -1,7 +1,7 @@
 """`ecs-tentacles schema [SCENE]`: the whole scene schema, for editors and tools.
 
 `assets/schema/core.schema.json` is the core only; each plugin adds its keys
-(`assets/schema/plugins/*.json` for the built-in ones). This writes the schema a scene
+(`<name>.schema.json` in each built-in feature package). This writes the schema a scene
 is checked against: the default plugins' keys, or those of the plugins SCENE turns on.
 Point an editor at the file with the scene's `"$schema"`. The bundled
 `assets/schema/scene.schema.json` is this command's output for the default plugins
