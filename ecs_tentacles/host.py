@@ -21,27 +21,22 @@ import pathlib
 from collections.abc import Iterator
 from typing import TYPE_CHECKING, Any, Protocol, TypeVar
 
+from ecs_tentacles.physics.host import PhysicsHost
+
 if TYPE_CHECKING:
     import numpy as np
 
-    from ecs_tentacles.events import Events
     from ecs_tentacles.physics.backend import PhysicsBackend
-    from ecs_tentacles.settings import Settings
-    from ecs_tentacles.store import (
-        ArrayStore,
-        CreatureStore,
-        MotorStore,
-        SuckerStore,
-        TentacleStore,
-        TransformStore,
-    )
+    from ecs_tentacles.store import ArrayStore, MotorStore, TentacleStore
 
 C = TypeVar("C")
 R = TypeVar("R")
 
 
-class Host(Protocol):
-    """The world as a system or plugin sees it: clock, stores, resources, entities, events."""
+class Host(PhysicsHost, Protocol):
+    """The world as a system or plugin sees it: what the physics sees (settings, clock,
+    transforms, suckers, creatures, events, components; `PhysicsHost`) and the rest of
+    the stores, the resources, the schedule, the plugins and entity creation."""
 
     @property
     def name(self) -> str: ...
@@ -50,38 +45,20 @@ class Host(Protocol):
     @property
     def rng(self) -> np.random.Generator: ...
     @property
-    def settings(self) -> Settings: ...
-    @property
-    def frame(self) -> int:
-        """Frames stepped since the start."""
-
-    @property
-    def time(self) -> float:
-        """Simulated seconds since the start."""
-
-    @property
     def scene(self) -> dict[str, Any] | None:
         """The validated scene, defaults filled in (None for a world built by hand)."""
 
     @property
     def scene_dir(self) -> pathlib.Path | None: ...
 
-    # -- core stores (every store by name in `stores`) --------------------------------------
-    @property
-    def transforms(self) -> TransformStore: ...
+    # -- the other core stores (every store by name in `stores`) ---------------------------
     @property
     def motors(self) -> MotorStore: ...
-    @property
-    def suckers(self) -> SuckerStore: ...
-    @property
-    def creatures(self) -> CreatureStore: ...
     @property
     def tentacles(self) -> TentacleStore: ...
     @property
     def stores(self) -> dict[str, ArrayStore]: ...
 
-    @property
-    def events(self) -> Events: ...
     @property
     def physics(self) -> PhysicsBackend: ...
     @property
@@ -101,11 +78,8 @@ class Host(Protocol):
     def activate(self) -> None: ...
     def create_entity(self, *components: Any) -> int: ...
     def add_component(self, entity: int, component: Any) -> None: ...
-    def component(self, entity: int, kind: type[C]) -> C: ...
     def try_component(self, entity: int, kind: type[C]) -> C | None: ...
-    def query(self, *kinds: type) -> Iterator[tuple[int, Any]]: ...
     def creature(self, name: str) -> int: ...
-    def creature_name(self, entity: int) -> str: ...
 
 
 class SystemsView(Protocol):
