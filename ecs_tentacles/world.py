@@ -209,7 +209,7 @@ class World:
 
     def has_resource(self, kind: type) -> bool:
         """Whether a plugin that is on provides a resource of type `kind`."""
-        return kind in self._resources
+        return self.get_resource(kind) is not None
 
     @property
     def resources(self) -> tuple[Any, ...]:

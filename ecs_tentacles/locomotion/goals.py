@@ -23,6 +23,14 @@ if TYPE_CHECKING:
     from ecs_tentacles.host import Host
 
 DEFAULT_RADIUS = 0.3
+# what a system that sets, appends, reaches or removes goals through the GoalBook writes
+# (its `writes`): the goal entities and the current goal's columns (`GoalBook._sync`)
+GOAL_WRITES = (
+    "goals",
+    "locomotion.creatures.goal",
+    "locomotion.creatures.has_goal",
+    "locomotion.creatures.goal_radius",
+)
 
 
 class GoalBook:

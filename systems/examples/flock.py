@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from ecs_tentacles.systems.examples import Problem, farther_than_reach, number, replanning
 
-from ecs_tentacles.locomotion.goals import GoalBook
+from ecs_tentacles.locomotion.goals import GOAL_WRITES, GoalBook
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.scene.validate import plugin_config
 from ecs_tentacles.system import System
@@ -49,12 +49,7 @@ class Flock(System):
     after = ("goals",)
     before = ("tentacle_selection",)
     reads = ("transforms.pos", "creatures.entity", "creatures.mantle_row")
-    writes = (
-        "goals",
-        "locomotion.creatures.goal",
-        "locomotion.creatures.has_goal",
-        "locomotion.creatures.goal_radius",
-    )
+    writes = GOAL_WRITES
     state_attributes = ("last",)  # positions at the last plan: velocities after a restore
 
     def __init__(self, config: Mapping[str, Any]):

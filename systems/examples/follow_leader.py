@@ -24,7 +24,7 @@ import numpy as np
 from ecs_tentacles.systems.examples import Problem, number, replanning
 
 from ecs_tentacles.components import Creature
-from ecs_tentacles.locomotion.goals import GoalBook
+from ecs_tentacles.locomotion.goals import GOAL_WRITES, GoalBook
 from ecs_tentacles.locomotion.stores import LocomotionStores
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.scene.validate import plugin_config
@@ -49,12 +49,7 @@ class FollowLeader(System):
         "creatures.entity",
         "creatures.mantle_row",
     )
-    writes = (
-        "goals",
-        "locomotion.creatures.goal",
-        "locomotion.creatures.has_goal",
-        "locomotion.creatures.goal_radius",
-    )
+    writes = GOAL_WRITES
 
     def __init__(self, gap: float, interval: float, goal_radius: float):
         self.gap = gap
@@ -83,12 +78,16 @@ class FollowLeader(System):
         gap = np.linalg.norm(ahead, axis=1)
         behind = gap > self.gap + self.goal_radius
         goals = mantles[self.leaders] - self.gap * ahead / np.maximum(gap, 1e-9)[:, None]
+        book, has_goal = (
+            world.resource(GoalBook),
+            world.resource(LocomotionStores).creatures.has_goal,
+        )
         for row, goal, far in zip(self.followers, goals, behind, strict=True):
             entity = int(creatures.entity[row])
             if far:
-                world.resource(GoalBook).set(entity, goal, self.goal_radius)
-            elif world.resource(LocomotionStores).creatures.has_goal[row]:
-                world.resource(GoalBook).clear(entity)
+                book.set(entity, goal, self.goal_radius)
+            elif has_goal[row]:
+                book.clear(entity)
 
 
 class FollowLeaderPlugin(Plugin):

@@ -21,7 +21,7 @@ import numpy as np
 from ecs_tentacles.systems.examples import Problem, farther_than_reach, number, replanning
 
 from ecs_tentacles.build import creature_rng
-from ecs_tentacles.locomotion.goals import GoalBook
+from ecs_tentacles.locomotion.goals import GOAL_WRITES, GoalBook
 from ecs_tentacles.locomotion.stores import LocomotionStores
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.scene.validate import plugin_config
@@ -44,12 +44,7 @@ class Wander(System):
         "creatures.entity",
         "creatures.mantle_row",
     )
-    writes = (
-        "goals",
-        "locomotion.creatures.goal",
-        "locomotion.creatures.has_goal",
-        "locomotion.creatures.goal_radius",
-    )
+    writes = GOAL_WRITES
     state_attributes = ("streams",)  # each creature's generator: snapshots repeat exactly
 
     def __init__(self, radius: float, interval: float, goal_radius: float):

@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ecs_tentacles.locomotion.goals import GoalBook
+from ecs_tentacles.locomotion.goals import GOAL_WRITES, GoalBook
 from ecs_tentacles.locomotion.stores import LocomotionStores
 from ecs_tentacles.system import System
 
@@ -32,12 +32,7 @@ class Goals(System):
         "locomotion.creatures.goal",
         "locomotion.creatures.goal_radius",
     )
-    writes = (
-        "goals",
-        "locomotion.creatures.goal",
-        "locomotion.creatures.has_goal",
-        "locomotion.creatures.goal_radius",
-    )
+    writes = GOAL_WRITES
 
     def process(self, world: Host, dt: float) -> None:
         gaits = world.resource(LocomotionStores).creatures
