@@ -1,8 +1,8 @@
 """The physics systems write only what they declare, and declare real columns.
 
-Every core store column no physics system declares in `writes` is made read-only
-(numpy `flags.writeable = False`); the physics then runs, through a blow-up and its
-recovery, and an undeclared write would raise.
+Each physics system runs with only the columns it declares (`tests/declarations.py`:
+others unreadable, those it does not write read-only), through contact and a blow-up
+and its recovery, so an undeclared read or write fails.
 """
 
 from __future__ import annotations
@@ -19,6 +19,7 @@ import ecs_tentacles.physics
 from ecs_tentacles.physics.host import PhysicsHost
 from ecs_tentacles.physics.systems import physics_systems
 from ecs_tentacles.world import World
+from tests.declarations import declared_only, step_declared
 
 OFF = {"locomotion": False, "suckers": False, "threats": False, "fur": False}
 SCENE: dict[str, Any] = {
@@ -46,19 +47,18 @@ def test_the_physics_writes_no_column_it_does_not_declare(
     make_world: Callable[..., World],
 ) -> None:
     world = make_world(SCENE, plugins=OFF)
-    declared = {w for system in world.schedule for w in system.writes}
     assert {system.name for system in world.schedule} == {
         "physics", "physics_sync", "physics_health"
     }  # fmt: skip
-    for name, store in world.stores.items():
-        for column, array in store._arrays.items():
-            array.flags.writeable = f"{name}.{column}" in declared
-    world.step(30)
+    step_declared(world, 30)  # each system with only its declared columns (tests/declarations)
     assert world.physics.proxies.in_use  # the creatures are near each other
     world.physics.groups[1].data.qvel[7] = np.nan
-    world.step(5)
+    step_declared(world, 5)
     assert world.physics.health.recoveries == 1
-    with pytest.raises(ValueError, match="read-only"):
+    with (
+        declared_only(world, world.schedule["physics"]),
+        pytest.raises(ValueError, match="read-only"),
+    ):
         world.motors.target[0, 0] = 1.0  # what the check relies on
 
 
