@@ -8,15 +8,8 @@ resources), its systems at a named stage, its validation, and optional hooks the
 generic layers call (they never name a feature): render hooks for the sandbox;
 output hooks for takes (`take_tracks`, `before_recording`), for distributed bakes'
 shard plans (`shard_reach`, `shard_groups`) and for `run`'s report (`run_summary`).
-A scene turns plugins on and configures them:
-
-    "plugins": {"wander": {"radius": 2.0}, "fur": false, "mine": {"from": "mine.py"}}
-
-Built-in plugins (`BUILTIN`) and the bundled examples (`BUNDLED`) are found by name;
-`DEFAULT_ON` are on unless a scene says `false`. Other plugins come from a file or
-module named by `from` (the scene's folder is searched first; a relative file may not
-leave it) or from the `ecs_tentacles.plugins` entry point group of an installed
-package. Those run user code, so they need `allow_systems` (`--allow-systems`).
+How a scene's `plugins` are found, trusted, imported and made is
+`ecs_tentacles.plugin_registry`.
 
     class Wander(Plugin):
         name = "wander"
@@ -29,15 +22,8 @@ package. Those run user code, so they need `allow_systems` (`--allow-systems`).
 
 from __future__ import annotations
 
-import contextlib
-import importlib
-import importlib.metadata
-import importlib.util
-import pathlib
-import sys
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
-from types import ModuleType
 from typing import TYPE_CHECKING, Any, ClassVar
 
 from ecs_tentacles.system import System
@@ -49,25 +35,6 @@ if TYPE_CHECKING:
     from ecs_tentacles.drawing import Click, Panel, RenderView
     from ecs_tentacles.host import Host
     from ecs_tentacles.store import ArrayStore
-
-ENTRY_POINTS = "ecs_tentacles.plugins"
-# name -> where it lives; imported only when a world uses it
-BUILTIN = {
-    "locomotion": "ecs_tentacles.locomotion.plugin:LocomotionPlugin",
-    "suckers": "ecs_tentacles.locomotion.suckers:SuckersPlugin",
-    "fur": "ecs_tentacles.fur.plugin:FurPlugin",
-    "threats": "ecs_tentacles.threats.plugin:ThreatsPlugin",
-    "record": "ecs_tentacles.record.plugin:RecordPlugin",
-    "render": "ecs_tentacles.render.plugin:RenderPlugin",
-}
-BUNDLED = {
-    "wander": "ecs_tentacles.systems.examples.wander:WanderPlugin",
-    "flee": "ecs_tentacles.systems.examples.flee:FleePlugin",
-    "follow_leader": "ecs_tentacles.systems.examples.follow_leader:FollowLeaderPlugin",
-    "flock": "ecs_tentacles.systems.examples.flock:FlockPlugin",
-}
-DEFAULT_ON = ("locomotion", "suckers", "threats", "fur")  # in build order
-FROM = "from"  # the config key naming where a plugin's code is
 
 
 @dataclass(frozen=True)
@@ -288,192 +255,3 @@ class SystemsPlugin(Plugin):
 
     def systems(self) -> list[System]:
         return [factory() for factory in self.factories]
-
-
-class PluginError(ValueError):
-    """A plugin cannot be found, imported or trusted; the message names the scene path."""
-
-
-@dataclass(frozen=True)
-class Found:
-    """Where a plugin's code is and whether running it needs the user's permission."""
-
-    target: str  # "module:Attr", "file.py" or "file.py:Attr"
-    trusted: bool
-
-
-def locate(key: str, config: Mapping[str, Any] | bool) -> Found:
-    """Where the plugin turned on as `key` lives (PluginError if nowhere)."""
-    if isinstance(config, Mapping) and FROM in config:
-        return Found(str(config[FROM]), trusted=False)
-    if key in BUILTIN:
-        return Found(BUILTIN[key], trusted=True)
-    if key in BUNDLED:
-        return Found(BUNDLED[key], trusted=True)
-    for entry in _entry_points():
-        if entry.name == key:
-            dist = getattr(entry, "dist", None)
-            ours = dist is not None and dist.name.replace("_", "-") == "ecs-tentacles"
-            return Found(entry.value, trusted=ours)
-    known = sorted({*BUILTIN, *BUNDLED, *(e.name for e in _entry_points())})
-    raise PluginError(
-        f"plugins.{key}: no plugin of that name (known: {', '.join(known)});"
-        f' name its code with {{"{FROM}": "file.py"}}'
-    )
-
-
-def _entry_points() -> list[importlib.metadata.EntryPoint]:
-    return list(importlib.metadata.entry_points(group=ENTRY_POINTS))
-
-
-def load(key: str, target: str, scene_dir: pathlib.Path | None) -> type[Plugin] | Plugin:
-    """Import the plugin class (or a SystemsPlugin of System classes) that `target` names."""
-    where = f"plugins.{key}"
-    module_part, _, attr = target.partition(":")
-    try:
-        if module_part.endswith(".py"):
-            module = import_file(_inside(module_part, scene_dir, where), key)
-        else:
-            with scene_first(scene_dir):
-                module = importlib.import_module(module_part)
-    except PluginError:
-        raise
-    except Exception as exc:  # the user's module failed to import: say which and why
-        raise PluginError(f"{where}: cannot import {target!r}: {_one_line(exc)}") from exc
-    return pick(module, attr, where, target)
-
-
-def pick(module: ModuleType, attr: str, where: str, target: str) -> type[Plugin] | Plugin:
-    """The Plugin class `attr` of `module` (or its only one), or its System classes wrapped."""
-    if attr:
-        found = getattr(module, attr, None)
-        if isinstance(found, type) and issubclass(found, Plugin):
-            return found
-        if isinstance(found, type) and issubclass(found, System):
-            return SystemsPlugin([found])
-        raise PluginError(f"{where}: {target!r} is not a Plugin or System subclass")
-    own = [
-        v for v in vars(module).values() if isinstance(v, type) and v.__module__ == module.__name__
-    ]
-    plugins = [v for v in own if issubclass(v, Plugin) and v is not Plugin]
-    if len(plugins) == 1:
-        return plugins[0]
-    systems = [v for v in own if issubclass(v, System)]
-    if not plugins and systems:
-        return SystemsPlugin(systems)
-    what = "several Plugin classes" if plugins else "no Plugin or System class"
-    raise PluginError(f"{where}: {target!r} defines {what}; name one as 'file.py:ClassName'")
-
-
-def _inside(relative: str, scene_dir: pathlib.Path | None, where: str) -> pathlib.Path:
-    base = (scene_dir or pathlib.Path.cwd()).resolve()
-    path = (base / relative).resolve()
-    if not path.is_relative_to(base):
-        raise PluginError(f"{where}: {relative!r} leaves the scene's folder {base}")
-    if not path.is_file():
-        raise PluginError(f"{where}: no file {relative!r} in the scene's folder {base}")
-    return path
-
-
-def import_file(path: pathlib.Path, key: str) -> ModuleType:
-    """Execute a plugin file as a fresh module (again on every call: hot reload uses it)."""
-    name = f"ecs_tentacles_user_plugins.{key}"
-    spec = importlib.util.spec_from_file_location(name, path)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module  # dataclasses and pickling look classes up here
-    with scene_first(path.parent):
-        try:
-            spec.loader.exec_module(module)
-        except BaseException:
-            sys.modules.pop(name, None)
-            raise
-    return module
-
-
-@contextlib.contextmanager
-def scene_first(folder: pathlib.Path | None) -> Iterator[None]:
-    """The scene's folder first on `sys.path` while importing, so modules beside it import."""
-    if folder is None:
-        yield
-        return
-    entry = str(folder.resolve())
-    sys.path.insert(0, entry)
-    try:
-        yield
-    finally:
-        with contextlib.suppress(ValueError):
-            sys.path.remove(entry)
-
-
-def instantiate(
-    made: type[Plugin] | Plugin, key: str, config: Mapping[str, Any], source: str | None
-) -> Plugin:
-    """The plugin `load` found, made with `config` and known as `key` (from `source`)."""
-    plugin = made if isinstance(made, Plugin) else made(dict(config))
-    plugin.config, plugin.key, plugin.source = dict(config), key, source
-    return plugin
-
-
-def builtin(key: str, **options: Any) -> Plugin:
-    """The built-in plugin `key`, made with keyword `options` (a bake's record plugin:
-    `builtin("record", every=2)`), so generic code needs no feature's import."""
-    if key not in BUILTIN:
-        raise PluginError(f"plugins.{key}: not a built-in plugin (known: {', '.join(BUILTIN)})")
-    made = load(key, BUILTIN[key], None)
-    return instantiate(made(**options) if isinstance(made, type) else made, key, {}, None)
-
-
-def resolve(
-    choices: Mapping[str, Any] | None,
-    scene_dir: pathlib.Path | None = None,
-    *,
-    allow: bool = False,
-    defaults: tuple[str, ...] = DEFAULT_ON,
-) -> list[Plugin]:
-    """Instances of the plugins a scene's `plugins` field turns on, defaults first.
-
-    `choices` maps names to `true`, `false` or a config (configs are not validated
-    here: the scene schema does that). Raises PluginError, one problem per line.
-    """
-    choices = dict(choices or {})
-    wanted = [n for n in defaults if choices.get(n, True) is not False]
-    wanted += [n for n in choices if n not in wanted and choices[n] is not False]
-    problems: list[str] = []
-    plugins: list[Plugin] = []
-    for key in wanted:
-        config = choices.get(key, True)
-        try:
-            found = locate(key, config)
-            if not found.trusted and not allow:
-                raise PluginError(
-                    f"plugins.{key}: runs code from {found.target!r}; allow it with"
-                    " --allow-systems (API: allow_systems=True)"
-                )
-            made = load(key, found.target, scene_dir)
-        except PluginError as exc:
-            problems.append(str(exc))
-            continue
-        settings = (
-            {k: v for k, v in config.items() if k != FROM} if isinstance(config, Mapping) else {}
-        )
-        try:
-            plugins.append(
-                instantiate(made, key, settings, None if found.trusted else found.target)
-            )
-        except Exception as exc:  # the user's plugin class failed to construct
-            problems.append(f"plugins.{key}: cannot make {found.target!r}: {_one_line(exc)}")
-    on = {p.key for p in plugins}
-    for plugin in plugins:
-        for need in plugin.requires:
-            if need not in on:
-                problems.append(f"plugins.{plugin.key}: needs the {need!r} plugin, which is off")
-    if problems:
-        raise PluginError("\n".join(problems))
-    return plugins
-
-
-def _one_line(error: BaseException) -> str:
-    """`Type: message` on one line (a user's exception, for a PluginError)."""
-    text = " ".join(str(error).split())
-    return type(error).__name__ + (f": {text}" if text else "")

@@ -28,7 +28,8 @@ import time
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
-from ecs_tentacles.plugin import Plugin, import_file, instantiate, pick
+from ecs_tentacles.plugin import Plugin
+from ecs_tentacles.plugin_registry import import_file, instantiate, pick
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:

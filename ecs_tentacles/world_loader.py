@@ -25,7 +25,8 @@ from typing import Any, Protocol, TypeVar
 from ecs_tentacles.build import build_creature
 from ecs_tentacles.host import Host
 from ecs_tentacles.physics.systems import physics_systems
-from ecs_tentacles.plugin import Plugin, SystemsPlugin, scene_first
+from ecs_tentacles.plugin import Plugin, SystemsPlugin
+from ecs_tentacles.plugin_registry import scene_first
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.load import load_scene_plugins, read_scene_json, resolve_scene_path
 from ecs_tentacles.settings import Settings

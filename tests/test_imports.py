@@ -138,7 +138,8 @@ def test_nothing_world_imports_imports_it_back() -> None:
 CORE = (
     "ecs_tentacles.world", "ecs_tentacles.world_loader", "ecs_tentacles.host",
     "ecs_tentacles.settings", "ecs_tentacles.schedule", "ecs_tentacles.system",
-    "ecs_tentacles.plugin", "ecs_tentacles.store", "ecs_tentacles.components",
+    "ecs_tentacles.plugin", "ecs_tentacles.plugin_registry", "ecs_tentacles.store",
+    "ecs_tentacles.components",
     "ecs_tentacles.build", "ecs_tentacles.construction", "ecs_tentacles.physics",
     "ecs_tentacles.snapshot", "ecs_tentacles.events", "ecs_tentacles.scene",
     "ecs_tentacles.systems.physics",

@@ -10,7 +10,8 @@ from __future__ import annotations
 import argparse
 import json
 
-from ecs_tentacles.plugin import BUNDLED, Plugin
+from ecs_tentacles.plugin import Plugin
+from ecs_tentacles.plugin_registry import BUNDLED
 from ecs_tentacles.scene.load import resolve_scene_path
 from ecs_tentacles.world import World
 

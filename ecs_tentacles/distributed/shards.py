@@ -28,7 +28,8 @@ import numpy as np
 
 from ecs_tentacles.creator.crowd import creature_reach
 from ecs_tentacles.physics.proxies import MARGIN
-from ecs_tentacles.plugin import Plugin, Reach, resolve
+from ecs_tentacles.plugin import Plugin, Reach
+from ecs_tentacles.plugin_registry import resolve
 
 SLACK = 0.15  # metres: settling at the start, sideways drift, tentacles lifting
 

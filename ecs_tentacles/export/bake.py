@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from ecs_tentacles.export.recording import Recording, scene_sha256
-from ecs_tentacles.plugin import builtin
+from ecs_tentacles.plugin_registry import builtin
 from ecs_tentacles.progress import step_frames
 from ecs_tentacles.scene.load import load_scene, resolve_scene_path
 from ecs_tentacles.take import Take

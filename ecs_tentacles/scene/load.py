@@ -22,7 +22,7 @@ import re
 import stat
 from typing import TYPE_CHECKING, Any
 
-from ecs_tentacles.plugin import PluginError, resolve
+from ecs_tentacles.plugin_registry import PluginError, resolve
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.physical import physically_checked
 from ecs_tentacles.scene.validate import plugin_config, validate_scene, with_defaults

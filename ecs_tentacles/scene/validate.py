@@ -134,7 +134,7 @@ def load_schema() -> dict[str, Any]:
 
     Assembled from the fragment files of the default plugins (their code is not imported).
     """
-    from ecs_tentacles.plugin import BUILTIN, DEFAULT_ON
+    from ecs_tentacles.plugin_registry import BUILTIN, DEFAULT_ON
 
     parts = []
     for name in DEFAULT_ON:
@@ -319,13 +319,13 @@ def validate_scene(data: object, plugins: Sequence[Plugin] | None = None) -> lis
     """Return every problem of ``data`` as a scene, sorted by JSON path; ``[]`` if it is valid.
 
     Each problem is one line ``"<json path>: <message>"``. ``plugins`` are the plugins
-    the scene turns on (`ecs_tentacles.plugin.resolve`; default: the default ones): their
+    the scene turns on (`ecs_tentacles.plugin_registry.resolve`; default: the default ones): their
     keys are part of the schema, and their own rules run. Semantic rules (override
     indices, unique names) are checked only once the schema passes; overlapping bodies
     are a physical problem (`ecs_tentacles.scene.physical`), checked when loading.
     """
     if plugins is None:
-        from ecs_tentacles.plugin import resolve
+        from ecs_tentacles.plugin_registry import resolve
 
         plugins = resolve(None)
     schema = schema_for(plugins)
@@ -351,7 +351,7 @@ def validate_scene(data: object, plugins: Sequence[Plugin] | None = None) -> lis
 def builtin_keys(name: str) -> dict[str, set[str]]:
     """A built-in plugin's keys by place (`creature`, `tentacles`, `scene`), read from its
     fragment file without importing the plugin; empty when it has none."""
-    from ecs_tentacles.plugin import BUILTIN
+    from ecs_tentacles.plugin_registry import BUILTIN
 
     package = BUILTIN[name].partition(":")[0].rpartition(".")[0]
     if not _fragment_file(package, name).is_file():
@@ -374,7 +374,7 @@ def _place(path: JsonPath) -> str | None:
 
 def _name_plugins_that_are_off(problems: list[Problem], on: set[str]) -> list[Problem]:
     """An unknown key that a built-in plugin which is off would know says so."""
-    from ecs_tentacles.plugin import BUILTIN
+    from ecs_tentacles.plugin_registry import BUILTIN
 
     if not any(message.startswith("unknown key") for _, message in problems):
         return problems
@@ -490,7 +490,7 @@ def with_defaults(data: dict[str, Any], plugins: Sequence[Plugin] | None = None)
     """
     result = copy.deepcopy(data)
     if plugins is None:
-        from ecs_tentacles.plugin import resolve
+        from ecs_tentacles.plugin_registry import resolve
 
         plugins = resolve(None)
     schema = schema_for(plugins)
