@@ -130,7 +130,7 @@ def test_user_system_base_class_is_the_builtin_one() -> None:
 def test_settings_defaults_are_the_schemas_physics_defaults() -> None:
     from dataclasses import asdict, fields
 
-    from ecs_tentacles.scene.validate import core_schema
+    from ecs_tentacles.scene.schema import core_schema
     from ecs_tentacles.settings import BUILD_ONLY, Settings
 
     physics = core_schema()["properties"]["physics"]["properties"]

@@ -24,7 +24,7 @@ import mujoco
 import numpy as np
 
 from ecs_tentacles.scene.errors import SceneError
-from ecs_tentacles.scene.validate import load_schema
+from ecs_tentacles.scene.schema import load_schema
 from ecs_tentacles.world import World
 
 

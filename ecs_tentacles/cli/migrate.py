@@ -22,7 +22,7 @@ from ecs_tentacles.atomic import atomic_output
 from ecs_tentacles.plugin_registry import BUILTIN, DEFAULT_ON, FROM
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.load import load_scene_plugins, read_scene_json, resolve_scene_path
-from ecs_tentacles.scene.validate import builtin_keys
+from ecs_tentacles.scene.schema import builtin_keys
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:

@@ -16,7 +16,7 @@ import pathlib
 
 from ecs_tentacles.atomic import atomic_output
 from ecs_tentacles.scene.load import load_scene_plugins, resolve_scene_path
-from ecs_tentacles.scene.validate import load_schema, schema_for
+from ecs_tentacles.scene.schema import load_schema, schema_for
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:

@@ -34,7 +34,7 @@ from ecs_tentacles.atomic import atomic_file
 from ecs_tentacles.construction import TentacleShape, tentacle_shape
 from ecs_tentacles.creator.limits import DesignError, checked, default
 from ecs_tentacles.scene.load import load_scene, resolve_scene_path
-from ecs_tentacles.scene.validate import load_schema
+from ecs_tentacles.scene.schema import load_schema
 
 if TYPE_CHECKING:
     from ecs_tentacles.world import World

@@ -17,7 +17,7 @@ from ecs_tentacles.fur.build import build_emotion, build_fur
 from ecs_tentacles.fur.checks import fur_problems
 from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.plugin import Plugin, TrackSource
-from ecs_tentacles.scene.validate import fragment
+from ecs_tentacles.scene.schema import fragment
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:

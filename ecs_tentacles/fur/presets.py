@@ -16,7 +16,8 @@ from __future__ import annotations
 import copy
 from typing import Any
 
-from ecs_tentacles.scene.validate import load_schema, with_defaults
+from ecs_tentacles.scene.schema import load_schema
+from ecs_tentacles.scene.validate import with_defaults
 
 
 def preset_names() -> list[str]:

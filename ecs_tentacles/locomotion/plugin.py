@@ -32,7 +32,7 @@ from ecs_tentacles.locomotion.params import Locomotion
 from ecs_tentacles.locomotion.stores import LocomotionStores
 from ecs_tentacles.plugin import Plugin, Reach, RunSummary, TrackSource
 from ecs_tentacles.scene.parameters import apply_parameters
-from ecs_tentacles.scene.validate import fragment
+from ecs_tentacles.scene.schema import fragment
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:

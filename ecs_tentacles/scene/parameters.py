@@ -42,7 +42,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ecs_tentacles.scene.ranges import Range, schema_objects, schema_range
-from ecs_tentacles.scene.validate import format_path, load_schema
+from ecs_tentacles.scene.schema import load_schema
+from ecs_tentacles.scene.validate import format_path
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host

@@ -17,7 +17,7 @@ from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, replace
 from typing import Any
 
-from ecs_tentacles.scene.validate import core_schema, load_schema
+from ecs_tentacles.scene.schema import core_schema, load_schema
 
 JsonPath = tuple[str | int, ...]
 SchemaObject = tuple[str, Mapping[str, Any], JsonPath]

@@ -3,18 +3,14 @@
 Every problem is one line ``"<json path>: <message>"``; paths look like
 ``creatures[1].tentacles.end_scale`` and the root itself is called ``scene``.
 
-The schema a scene is checked against is assembled: the core schema
-(`assets/schema/core.schema.json`: physics, creatures' bodies) plus the fragment of
-each plugin the scene turns on (creature keys, scene keys, `$defs`), and each plugin's
-`plugins.<name>` config against the plugin's own `config_schema`. `load_schema()` is the
-schema of a scene that says nothing about plugins (the default plugins on).
+The schema a scene is checked against is assembled (`ecs_tentacles.scene.schema`): the
+core schema plus the fragment of each plugin the scene turns on; each plugin's
+`plugins.<name>` config is checked against the plugin's own `config_schema`.
 """
 
 from __future__ import annotations
 
 import copy
-import functools
-import importlib.resources
 import json
 import re
 from collections.abc import Iterable, Mapping, Sequence
@@ -22,6 +18,7 @@ from typing import TYPE_CHECKING, Any
 
 from jsonschema import Draft202012Validator, ValidationError, validators
 
+from ecs_tentacles.scene.schema import builtin_keys, schema_for
 from ecs_tentacles.scene.shards import shard_problems
 
 if TYPE_CHECKING:
@@ -53,104 +50,6 @@ _StrictValidator = validators.extend(
     Draft202012Validator,
     type_checker=Draft202012Validator.TYPE_CHECKER.redefine("integer", _is_integer),
 )
-
-
-@functools.cache
-def core_schema() -> dict[str, Any]:
-    """The core scene schema bundled with the package, without any plugin's keys."""
-    resource = importlib.resources.files("ecs_tentacles.assets") / "schema" / "core.schema.json"
-    schema: dict[str, Any] = json.loads(resource.read_text(encoding="utf-8"))
-    return schema
-
-
-@functools.cache
-def fragment(package: str, name: str) -> dict[str, Any]:
-    """A built-in plugin's schema fragment: `<name>.schema.json` in its feature package."""
-    found: dict[str, Any] = json.loads(_fragment_file(package, name).read_text(encoding="utf-8"))
-    return found
-
-
-def schema_for(plugins: Sequence[Plugin]) -> dict[str, Any]:
-    """The core schema with each plugin's creature keys, scene keys and `$defs` added."""
-    parts = [(p.key, p.defs, p.creature_schema, p.scene_schema, p.tentacle_schema) for p in plugins]
-    if any(p.source is not None for p in plugins):  # users' plugins: assembled each time
-        return _assemble(parts)
-    key = tuple((p.key, type(p)) for p in plugins)  # built-in fragments never change
-    if key not in _SCHEMAS:
-        _SCHEMAS[key] = _assemble(parts)
-    return _SCHEMAS[key]
-
-
-def _fragment_file(package: str, name: str) -> importlib.resources.abc.Traversable:
-    """`<name>.schema.json` in a feature package, found without importing the package."""
-    top, *rest = package.split(".")
-    return importlib.resources.files(top).joinpath(*rest, f"{name}.schema.json")
-
-
-_SCHEMAS: dict[tuple[tuple[str, type], ...], dict[str, Any]] = {}
-Part = tuple[str, Mapping[str, Any], Mapping[str, Any], Mapping[str, Any], Mapping[str, Any]]
-NOT_IN_OVERRIDES = ("default", "x-parameter")  # an override's key only changes one tentacle
-
-
-def _assemble(parts: Sequence[Part]) -> dict[str, Any]:
-    """Core schema + (plugin key, $defs, creature keys, scene keys, tentacle keys) of each
-    plugin. Tentacle keys join the creature's `tentacles` and, without their default and
-    parameter annotation, each entry of its `overrides`."""
-    schema = copy.deepcopy(core_schema())
-    schema["$id"] = schema["$id"].replace("core.schema.json", "scene.schema.json")
-    owner: dict[tuple[str, str], str] = {}
-    places = {
-        "$defs": schema["$defs"],
-        "creature": schema["$defs"]["creature"]["properties"],
-        "scene": schema["properties"],
-        "tentacles": schema["$defs"]["creature"]["properties"]["tentacles"]["properties"],
-    }
-    overrides = schema["$defs"]["tentacle_override"]["properties"]
-    for key, defs, creature, scene, tentacles in parts:
-        for place, entries in (
-            ("$defs", defs),
-            ("creature", creature),
-            ("scene", scene),
-            ("tentacles", tentacles),
-        ):
-            for name, entry in entries.items():
-                if name in places[place] or (place, name) in owner:
-                    first = owner.get((place, name), "core")
-                    raise ValueError(
-                        f"plugins.{key}: its {place} key {name!r} is already {first}'s"
-                    )
-                owner[(place, name)] = key
-                places[place][name] = copy.deepcopy(entry)
-                if place == "tentacles":
-                    overrides[name] = {
-                        k: copy.deepcopy(v) for k, v in entry.items() if k not in NOT_IN_OVERRIDES
-                    }
-    return schema
-
-
-@functools.cache
-def load_schema() -> dict[str, Any]:
-    """The schema of a scene that turns no plugin on or off (the default plugins' keys).
-
-    Assembled from the fragment files of the default plugins (their code is not imported).
-    """
-    from ecs_tentacles.plugin_registry import BUILTIN, DEFAULT_ON
-
-    parts = []
-    for name in DEFAULT_ON:
-        package = BUILTIN[name].partition(":")[0].rpartition(".")[0]  # the feature package
-        if _fragment_file(package, name).is_file():
-            part = fragment(package, name)
-            parts.append(
-                (
-                    name,
-                    part.get("$defs", {}),
-                    part.get("creature", {}),
-                    part.get("scene", {}),
-                    part.get("tentacles", {}),
-                )
-            )
-    return _assemble(parts)
 
 
 _VALIDATORS: dict[int, tuple[dict[str, Any], Any]] = {}  # id -> (schema kept alive, validator)
@@ -346,18 +245,6 @@ def validate_scene(data: object, plugins: Sequence[Plugin] | None = None) -> lis
     problems = _name_plugins_that_are_off(problems, {p.name for p in plugins})
     unique = sorted(set(problems), key=_path_key)
     return [f"{format_path(path)}: {message}" for path, message in unique]
-
-
-def builtin_keys(name: str) -> dict[str, set[str]]:
-    """A built-in plugin's keys by place (`creature`, `tentacles`, `scene`), read from its
-    fragment file without importing the plugin; empty when it has none."""
-    from ecs_tentacles.plugin_registry import BUILTIN
-
-    package = BUILTIN[name].partition(":")[0].rpartition(".")[0]
-    if not _fragment_file(package, name).is_file():
-        return {}
-    part = fragment(package, name)
-    return {place: set(part.get(place, {})) for place in ("creature", "tentacles", "scene")}
 
 
 def _place(path: JsonPath) -> str | None:

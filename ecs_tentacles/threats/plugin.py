@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ecs_tentacles.plugin import Marker, Plugin
-from ecs_tentacles.scene.validate import fragment
+from ecs_tentacles.scene.schema import fragment
 from ecs_tentacles.system import System
 from ecs_tentacles.threats.data import ThreatData, build_threats, mark_creature, threat_problems
 

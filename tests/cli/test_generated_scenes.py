@@ -32,7 +32,7 @@ from hypothesis_jsonschema import from_schema
 
 from ecs_tentacles.cli import main
 from ecs_tentacles.fur.stores import FurData
-from ecs_tentacles.scene.validate import load_schema
+from ecs_tentacles.scene.schema import load_schema
 from ecs_tentacles.world import World
 
 FRAMES = 60

@@ -203,7 +203,7 @@ def test_create_from_a_scene_edits_one_creature(tmp_path: Path) -> None:
 def test_creator_sliders_come_from_the_schema_within_its_ranges() -> None:
     from ecs_tentacles.creator.limits import editor_setting
     from ecs_tentacles.scene.ranges import field_range
-    from ecs_tentacles.scene.validate import core_schema
+    from ecs_tentacles.scene.schema import core_schema
 
     tentacles = core_schema()["$defs"]["creature"]["properties"]["tentacles"]["properties"]
     assert tentacles["link_length"]["x-editor"]["label"] == "link length"  # in the schema file

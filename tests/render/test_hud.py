@@ -163,7 +163,7 @@ def test_the_strength_slider_stops_where_the_damping_holds(
 def test_the_sliders_are_the_parameter_tables() -> None:
     """Which sliders, their order, labels and units: the schema's `x-parameter` entries."""
     from ecs_tentacles.locomotion.panel import KNOBS
-    from ecs_tentacles.scene.validate import load_schema
+    from ecs_tentacles.scene.schema import load_schema
 
     tentacles = load_schema()["$defs"]["creature"]["properties"]["tentacles"]["properties"]
     marked = {

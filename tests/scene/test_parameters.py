@@ -20,7 +20,7 @@ from ecs_tentacles.scene.parameters import (
     read_parameters,
 )
 from ecs_tentacles.scene.ranges import Range
-from ecs_tentacles.scene.validate import load_schema
+from ecs_tentacles.scene.schema import load_schema
 from ecs_tentacles.world import World
 from tests.conftest import creature_scene
 

@@ -10,7 +10,7 @@ import pytest
 from ecs_tentacles.creator.limits import DesignError, checked
 from ecs_tentacles.locomotion.params import settable
 from ecs_tentacles.scene.ranges import Range, field_range, physics_range
-from ecs_tentacles.scene.validate import load_schema
+from ecs_tentacles.scene.schema import load_schema
 
 
 def test_ranges_are_the_schemas() -> None:
