@@ -9,10 +9,11 @@ How `bench` measures (every figure is milliseconds per frame, the median over bl
 
 * `build_s`: `World.from_scene` (validate, build entities, compile, schedule).
 * After `warmup` untimed frames, the run alternates blocks of `block` framework
-  frames (`world.step`) with blocks of as many bare frames: copies of every
-  group's MjData (taken outside the timing, so the world's own state is never
-  touched) stepped by `world.physics.step_bare` with the world's substeps, on the
-  world's thread pool, and nothing else. Alternating in the same run means both
+  frames (`world.step`) with blocks of as many bare frames: copies of the state rows
+  of the creatures the framework steps (taken outside the timing, so the world's own
+  state is never touched) stepped by `world.physics.step_bare` with the world's
+  substeps, on the world's threads and scratch data, and nothing else
+  (`mj_setState`, `mj_step`, `mj_getState` per creature). Alternating in the same run means both
   see the same machine load; which comes first alternates block by block.
 * `frame_ms`: a whole framework frame. `raw_mujoco_ms`: a bare frame.
   `overhead_ratio` = frame_ms / raw_mujoco_ms (the design's target is <= 1.10).
@@ -64,13 +65,13 @@ def time_systems(world: World) -> dict[str, list[float]]:
 
 
 def _bare_block(world: World, frames: int) -> float:
-    """Seconds to step copies of every group's data `frames` frames with nothing else."""
+    """Seconds to step copies of the active creatures' states `frames` frames, MuJoCo alone."""
     physics = world.physics
-    datas = [copy.copy(group.data) for group in physics.groups]
+    states = physics.bare_states()
     substeps = world.settings.substeps
     start = time.perf_counter()
     for _ in range(frames):
-        physics.step_bare(datas, substeps)
+        physics.step_bare(states, substeps)
     return time.perf_counter() - start
 
 
@@ -130,9 +131,10 @@ def bench(
 ) -> dict[str, Any]:
     """Build `source` (scene path, bundled name or dict), run `measure`, report sizes.
 
-    The keys, in order: creatures, bodies, groups, threads, build_s, frames, frame_ms,
+    The keys, in order: creatures, bodies, threads, build_s, frames, frame_ms,
     physics_ms, raw_mujoco_ms, overhead_ratio, realtime_factor, systems, rss_mb, then
-    asleep (groups asleep at the end), compiles (models compiled) and recoveries.
+    asleep (creatures asleep at the end), compiles (models compiled: one per
+    morphology, shared by its creatures) and recoveries.
     With `sleep=False` idle creatures are stepped like the rest (to show what sleep saves).
     """
     if not sleep:
@@ -141,11 +143,9 @@ def bench(
     world = World.from_scene(source, threads=threads, allow_systems=allow_systems)
     build_s = time.perf_counter() - start
     try:
-        groups = world.physics.groups
         sizes = {
-            "creatures": sum(len(group.creatures) for group in groups),
+            "creatures": len(world.physics),
             "bodies": world.physics.bodies,  # creature bodies, contact proxies not counted
-            "groups": len(groups),
             "threads": int(world.physics.threads),
             "build_s": build_s,
         }

@@ -15,7 +15,6 @@ from ecs_tentacles.world import World
 KEYS = [
     "creatures",
     "bodies",
-    "groups",
     "threads",
     "build_s",
     "frames",
@@ -39,7 +38,7 @@ def test_bench_reports_every_key_finite() -> None:
     assert all(math.isfinite(v) and v >= 0 for v in numbers)
     assert (result["creatures"], result["threads"], result["frames"]) == (2, 1, 4)
     assert (result["asleep"], result["recoveries"]) == (0, 0) and result["compiles"] >= 1
-    assert result["groups"] >= 1 and result["bodies"] >= 2 * (1 + 3 * 5)  # >= 3 x 5 links each
+    assert result["bodies"] >= 2 * (1 + 3 * 5)  # >= 3 x 5 links each
     assert {"goals", "physics", "physics_sync", "rig"} <= set(result["systems"])
     assert result["overhead_ratio"] == pytest.approx(result["frame_ms"] / result["raw_mujoco_ms"])
     assert result["realtime_factor"] == pytest.approx(1000 / 60 / result["frame_ms"])

@@ -28,7 +28,7 @@ from ecs_tentacles.atomic import atomic_output
 
 SIZES = (1, 4, 16, 64, 256, 1024)
 BENCH_KEYS = (
-    "groups",
+    "compiles",
     "bodies",
     "build_s",
     "frame_ms",

@@ -72,8 +72,7 @@ def run(world: World, case: str, seconds: float) -> dict[str, Any]:
         here = mantle.pos[:2]
         travelled += float(np.linalg.norm(here - previous))
         previous = here.copy()
-        if data.ncon:
-            deepest = max(deepest, float(-data.contact.dist[: data.ncon].min()))
+        deepest = max(deepest, -data.deepest_contact)
         flipped |= bool(quat_rotate(mantle.quat, np.array([0.0, 0.0, 1.0]))[2] < 0.0)
         if world.frame % 6 == 0:
             angles.append(data.qpos[7:].copy())

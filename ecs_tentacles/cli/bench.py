@@ -86,8 +86,8 @@ def handle(args: argparse.Namespace) -> int:
         return 0
     print(
         f"{label}: {result['creatures']} creatures, {result['bodies']} bodies,"
-        f" {result['groups']} physics groups ({result['compiles']} compiled,"
-        f" {result['asleep']} asleep at the end), {result['threads']} threads;"
+        f" {result['compiles']} shared models ({result['asleep']} creatures asleep at the"
+        f" end), {result['threads']} threads;"
         f" built in {result['build_s']:.2f} s"
     )
     print(

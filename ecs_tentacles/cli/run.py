@@ -65,7 +65,7 @@ def add_physics_arguments(parser: argparse.ArgumentParser) -> None:
         "--threads",
         type=positive_int,
         default=None,
-        help="threads that step the physics groups (default: one per core); results are the same",
+        help="threads that step the physics (default: one per core); results are the same",
     )
     parser.add_argument(
         "--strict",
@@ -130,7 +130,7 @@ def simulate(world: World, frames: int, *, progress: bool = True) -> dict[str, A
         "creatures": len(list(world.query(Creature))),
         "bodies": physics.bodies,
         "dofs": physics.dofs,
-        "groups": len(physics.groups),
+        "models": physics.compiles,
         "threads": physics.threads,
         "recoveries": physics.health.recoveries,
         "recovery_causes": dict(physics.health.causes),

@@ -1,44 +1,50 @@
-"""The physics groups of a world, stepped in parallel, with store-row index maps.
+"""The physics of a world: shared models, per-creature state in arrays, stepping threads.
 
-Built once per scene (`PhysicsBackend(world)`): every creature becomes a physics
-group (`ecs_tentacles.physics.group`); creatures of one morphology share one compiled
-model (`compiles` counts the compilations). Per frame only array copies run:
-`write_controls` (motor targets and gains scattered to every group), `write_suckers`
-(equality switches and anchors), `step` (`mj_step` x substeps for every active group,
-on a thread pool: MuJoCo releases the GIL) and `sync` (body poses gathered back into
-the Transform store). Systems stay whole-array and never see the groups.
+Built once per scene (`PhysicsBackend(world)`): creatures of one morphology form one
+`Batch` (`ecs_tentacles.physics.batch`) around one compiled model (`compiles` counts
+them); each creature is a row of its batch's arrays and has an index in this backend's
+per-creature arrays (`frozen`, `sleeping`, `soften`, `proxies_used`), in entity order.
+Per frame only whole-array work runs here: `write_controls` (motor targets into every
+row's ctrl, gains and torque limits into the overlay), `write_suckers` (sucker
+switches and anchors), `step` (every awake row advanced on the stepping threads, each
+thread with its own scratch MjData per batch) and `sync` (body poses scattered into
+the Transform store). Systems stay whole-array and never see a MuJoCo object.
 
 `state()` / `set_state()` copy everything that decides how the physics steps on
-(each group's integration state and flags, the health check's memory, the sleep
-counters, the clock): `ecs_tentacles.snapshot` saves and restores the physics
-through them alone. The backend sees a world as `PhysicsHost` (`physics.host`).
+(every batch's state rows and forces, the health check's memory, the sleep counters,
+the per-creature flags, the clock): `ecs_tentacles.snapshot` saves and restores the
+physics through them alone. The backend sees a world as `PhysicsHost` (`physics.host`).
 """
 
 from __future__ import annotations
 
-import itertools
 import logging
 import os
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Protocol
+from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
 
 from ecs_tentacles.components import Creature, Transform
-from ecs_tentacles.physics.group import GroupState, PhysicsGroup
+from ecs_tentacles.physics.batch import Batch
 from ecs_tentacles.physics.health import HealthCheck, HealthState
-from ecs_tentacles.physics.model import build_spec, model_layout
+from ecs_tentacles.physics.model import ModelLayout, build_spec, model_layout
 from ecs_tentacles.physics.proxies import ContactProxies
+from ecs_tentacles.physics.roster import Roster
 from ecs_tentacles.physics.sleep import Sleep, SleepState
+from ecs_tentacles.physics.stepping import Segment, bare_step, plan, step_segments
+from ecs_tentacles.physics.tiers import FULL, NAMES, REDUCED, reduced_substeps
+from ecs_tentacles.physics.view import CreatureView
 
 if TYPE_CHECKING:
     from ecs_tentacles.physics.host import PhysicsHost
     from ecs_tentacles.store import MotorStore, SuckerStore, TransformStore
 
 log = logging.getLogger("ecs_tentacles.mujoco")
+S = mujoco.mjtState
 
 
 def _log_mujoco_warning(message: str) -> None:
@@ -55,54 +61,100 @@ class PhysicsState:
     """The whole physics between frames (`PhysicsBackend.state()`); opaque to callers."""
 
     time: float
-    groups: list[GroupState]
+    states: list[np.ndarray]  # per batch: its state rows
+    poses: list[tuple[np.ndarray, np.ndarray]]  # per batch: xpos, xquat after the last step
+    applied: list[dict[int, np.ndarray]]  # per batch: forces scripts apply
+    frozen: np.ndarray
+    sleeping: np.ndarray
+    soften: np.ndarray
+    tier: np.ndarray
     health: HealthState
     sleep: SleepState
 
 
 class PhysicsBackend:
-    """Every creature's physics group, the thread pool that steps them, and index maps."""
+    """Every creature's physics: batches of shared models, stepped on a thread pool."""
 
     def __init__(self, world: PhysicsHost, threads: int | None = None):
         route_mujoco_messages()
         self.threads = max(1, threads if threads is not None else os.cpu_count() or 1)
-        self.compiles = 0
         self.time = 0.0
-        templates: dict[tuple, mujoco.MjModel] = {}
-        self.groups: list[PhysicsGroup] = []
-        for entity, (creature, transform) in sorted(world.query(Creature, Transform)):
+        creatures = sorted(world.query(Creature, Transform))
+        by_key: dict[tuple, list[int]] = {}
+        layouts: list[ModelLayout] = []
+        for index, (_, (creature, transform)) in enumerate(creatures):
             layout = model_layout(world, creature, transform)
-            template = templates.get(layout.key)
-            if template is None:
-                template = templates[layout.key] = build_spec(world, creature).compile()
-                self.compiles += 1
-            pose = (np.array(transform.pos), np.array(transform.quat))
-            group = PhysicsGroup(len(self.groups), entity, creature.row, layout, template, pose)
-            self.groups.append(group)
+            layouts.append(layout)
+            by_key.setdefault(layout.key, []).append(index)
+        count = len(creatures)
+        self.roster = roster = Roster(
+            np.array([e for e, _ in creatures], dtype=np.int64),
+            np.array([c.row for _, (c, _) in creatures], dtype=np.int64),
+        )
+        self.creature_entity, self.creature_row = roster.entity, roster.creature_row
+        self.batch_of, self.row_of, self.batches = roster.batch_of, roster.row_of, roster.batches
+        reduced_dt = world.settings.dt / reduced_substeps(world.settings.substeps)
+        for indices in by_key.values():
+            creature = creatures[indices[0]][1][0]
+            model = build_spec(world, creature).compile()
+
+            def compile_reduced(creature: Creature = creature) -> mujoco.MjModel:
+                return build_spec(world, creature, timestep=reduced_dt).compile()
+
+            batch = Batch(len(self.batches), model, [layouts[i] for i in indices], compile_reduced)
+            roster.add(batch, indices)
+            batch.prepare(FULL, self.threads)  # every thread's scratch, before threads run
+            for row, i in enumerate(indices):
+                transform = creatures[i][1][1]
+                batch.place(row, np.array(transform.pos), np.array(transform.quat))
+        self.compiles = len(self.batches)
         self.group_of_creature_row = np.full(len(world.creatures), -1, dtype=np.int64)
-        for group in self.groups:
-            self.group_of_creature_row[group.creature_row] = group.index
-        self.proxies = ContactProxies(self.groups)
-        self.health = HealthCheck(world, self.groups)
-        self.sleep = Sleep(self.groups)
+        self.group_of_creature_row[self.creature_row] = np.arange(count)
+        # per creature, in entity order (the roster's arrays)
+        self.frozen, self.sleeping, self.soften = roster.frozen, roster.sleeping, roster.soften
+        self.proxies_used, self.tier = roster.proxies_used, roster.tier
+        self.groups = [CreatureView(roster, i) for i in range(count)]
+        self.proxies = ContactProxies(roster)
+        self.health = HealthCheck(world, roster, self.proxies)
+        self.sleep = Sleep(roster)
         self.sleep.enabled = world.settings.sleep
         self._pool = ThreadPoolExecutor(self.threads) if self.threads > 1 else None
+
+    def __len__(self) -> int:
+        return len(self.creature_entity)
 
     # -- state -----------------------------------------------------------------------
     def state(self) -> PhysicsState:
         """A copy of the physics' state: restoring it steps on bit-identically."""
         return PhysicsState(
             time=self.time,
-            groups=[group.state() for group in self.groups],
+            states=[b.state.copy() for b in self.batches],
+            poses=[(b.xpos.copy(), b.xquat.copy()) for b in self.batches],
+            applied=[{r: f.copy() for r, f in b.applied.items()} for b in self.batches],
+            frozen=self.frozen.copy(),
+            sleeping=self.sleeping.copy(),
+            soften=self.soften.copy(),
+            tier=self.tier.copy(),
             health=self.health.state(),
             sleep=self.sleep.state(),
         )
 
     def set_state(self, state: PhysicsState) -> None:
-        """Go back to `state()` of this backend (same groups); it stays reusable."""
+        """Go back to `state()` of this backend (same creatures); it stays reusable.
+
+        Warnings counted since and a pending fatal error are dropped: neither is state.
+        """
         self.time = state.time
-        for group, saved in zip(self.groups, state.groups, strict=True):
-            group.set_state(saved)
+        for batch, rows, (xpos, xquat), applied in zip(
+            self.batches, state.states, state.poses, state.applied, strict=True
+        ):
+            batch.state[:] = rows
+            batch.xpos[:], batch.xquat[:] = xpos, xquat
+            batch.applied = {r: f.copy() for r, f in applied.items()}
+            batch.warnings[:] = 0
+            batch.errors.clear()
+        self.frozen[:], self.sleeping[:] = state.frozen, state.sleeping
+        self.soften[:], self.tier[:] = state.soften, state.tier
         self.health.set_state(state.health)
         self.sleep.set_state(state.sleep)
 
@@ -113,28 +165,62 @@ class PhysicsBackend:
         kp_all = motors.strength * motors.gain
         kv_all = motors.damping * motors.gain
         torque_all = motors.max_torque
-        for group in self.groups:
-            if group.frozen:
-                continue
-            m, rows = group.model, group.actuator_motor_rows
-            np.take(target, group.actuator_target_index, out=group.data.ctrl, mode="clip")
-            kp = kp_all[rows] * group.soften if group.soften != 1.0 else kp_all[rows]
-            m.actuator_gainprm[:, 0] = kp
-            m.actuator_biasprm[:, 1] = -kp
-            m.actuator_biasprm[:, 2] = -kv_all[rows]
-            torque = torque_all[rows]
-            m.actuator_forcerange[:, 0] = -torque
-            m.actuator_forcerange[:, 1] = torque
+        for batch in self.batches:
+            rows = batch.actuator_motor_rows
+            live = ~self.frozen[batch.members]
+            soften = self.soften[batch.members]
+            ctrl = np.take(target, batch.actuator_target_index, mode="clip")
+            kp = kp_all[rows] * soften[:, None]
+            if live.all():
+                batch.ctrl[:] = ctrl
+                batch.kp[:], batch.kv[:], batch.torque[:] = kp, kv_all[rows], torque_all[rows]
+            else:  # a frozen creature keeps what it had when it froze
+                batch.state[live, batch.slices[int(S.mjSTATE_CTRL)]] = ctrl[live]
+                batch.kp[live], batch.kv[live] = kp[live], kv_all[rows][live]
+                batch.torque[live] = torque_all[rows][live]
 
     def write_suckers(self, suckers: SuckerStore) -> None:
         """Switch sucker equalities on/off and place their world anchors."""
-        anchor, attached = suckers.anchor, suckers.attached
-        for group in self.groups:
-            if not len(group.equality_ids) or group.frozen:
+        for batch in self.batches:
+            if not len(batch.equality_ids):
                 continue
-            rows = group.sucker_rows
-            group.model.eq_data[group.equality_ids, 3:6] = anchor[rows]
-            group.data.eq_active[group.equality_ids] = attached[rows]
+            live = ~self.frozen[batch.members]
+            switches = suckers.attached[batch.sucker_rows].astype(np.float64)
+            batch.anchor[live] = suckers.anchor[batch.sucker_rows][live]
+            batch.state[live, batch.slices[int(S.mjSTATE_EQ_ACTIVE)]] = switches[live]
+
+    @property
+    def active(self) -> np.ndarray:
+        """Creatures stepped this frame (not frozen, not asleep, not kinematic)."""
+        return self.roster.active
+
+    def tier_counts(self) -> dict[str, int]:
+        """Creatures per level of detail, by tier name."""
+        counts = np.bincount(self.tier, minlength=len(NAMES))
+        return {name: int(n) for name, n in zip(NAMES, counts, strict=True)}
+
+    def set_tier(self, indices: np.ndarray, tier: int) -> None:
+        """Move creatures (backend indices) to `tier`. Between FULL and REDUCED the state
+        carries over exactly; a creature leaving KINEMATIC must get its pose first
+        (`place_joints`)."""
+        self.tier[indices] = tier
+
+    def place_joints(self, index: int, qpos: np.ndarray, qvel: np.ndarray) -> None:
+        """Start creature `index` from `qpos` / `qvel` (a promotion from replayed poses).
+
+        The warm start is cleared, the poses recomputed, and the health check's saved
+        states and the sleep counters restart from here.
+        """
+        batch = self.batches[int(self.batch_of[index])]
+        row = int(self.row_of[index])
+        batch.part(S.mjSTATE_QPOS, row)[:] = qpos
+        batch.part(S.mjSTATE_QVEL, row)[:] = qvel
+        batch.part(S.mjSTATE_WARMSTART, row)[:] = 0.0
+        batch.part(S.mjSTATE_TIME, row)[:] = self.time
+        batch.forward(row)
+        self.health.restart(index)
+        self.sleep.restart(index)
+        self.sleeping[index] = False
 
     def step(
         self,
@@ -143,69 +229,87 @@ class PhysicsBackend:
         rounds: int = 1,
         between: Callable[[], None] | None = None,
     ) -> None:
-        """Advance every active group `substeps` steps; `before_substep(i)` runs first if given.
+        """Advance every active creature `substeps` steps; `before_substep(i)` runs first if given.
 
         Without hooks the steps are taken in `rounds` batches with `between()` called
-        between them (the contact proxies catch up within the frame). Groups never read
-        each other's data while they step, so the result does not depend on the number
-        of threads. Asleep or frozen groups keep their state; the clock moves on.
+        between them (the contact proxies catch up within the frame). A creature's step
+        reads only its own row, so the result does not depend on the number of threads.
+        Asleep or frozen creatures keep their state; the clock moves on.
         """
-        active = [g for g in self.groups if g.active]
+        chunks = plan(self.batches, self.active, self.tier, self.threads)
+        reduced = reduced_substeps(substeps)
         if before_substep is not None:
             for i in range(substeps):
                 before_substep(i)
-                self._run(active, 1)
+                self._run(chunks, {FULL: 1, REDUCED: int(i < reduced)})
         else:
-            batches = [int(n) for n in np.diff(np.linspace(0, substeps, rounds + 1).round())]
-            for k, n in enumerate(b for b in batches if b):
+            full = _split(substeps, rounds)
+            for k, (n, r) in enumerate(zip(full, _split(reduced, rounds), strict=True)):
+                if not n:
+                    continue
                 if k and between is not None:
                     between()
-                self._run(active, n)
+                self._run(chunks, {FULL: n, REDUCED: r})
         self.time += substeps * self.substep_dt
 
-    def step_bare(self, datas: Sequence[mujoco.MjData], substeps: int) -> None:
-        """Step `datas` (one per group, in group order) on this pool, with nothing else.
+    def _run(self, chunks: list[list[Segment]], substeps: dict[int, int]) -> None:
+        if self._pool is None or len(chunks) < 2:
+            for thread, chunk in enumerate(chunks):
+                step_segments(chunk, substeps, thread)
+            return
+        futures = [
+            self._pool.submit(step_segments, chunk, substeps, thread)
+            for thread, chunk in enumerate(chunks)
+        ]
+        for future in futures:
+            future.result()
 
-        For benchmarks: the framework's cost is a frame minus this.
+    def bare_states(self) -> list[np.ndarray]:
+        """Copies of every batch's state rows, for `step_bare` (benchmarks)."""
+        return [batch.state.copy() for batch in self.batches]
+
+    def step_bare(self, states: list[np.ndarray], substeps: int) -> None:
+        """Step the rows of `states` that are active now with MuJoCo alone, on this pool.
+
+        Each row: `mj_setState`, `mj_step`, `mj_getState` on the threads' scratch data,
+        nothing of the framework. For benchmarks: the framework's cost is a frame minus
+        this.
         """
-        self._map([Bare(g.model, d) for g, d in zip(self.groups, datas, strict=True)], substeps)
-
-    def _run(self, groups: list[PhysicsGroup], substeps: int) -> None:
-        for group, error in zip(groups, self._map(groups, substeps), strict=True):
-            if error is not None:
-                group.error = error
-
-    def _map(self, groups: Sequence[Steppable], substeps: int) -> list[str | None]:
-        """Step each of `groups` (anything with `model` and `data`); MuJoCo's fatal errors
-        (a blown-up state overflowing its arena) come back per group instead of raising."""
-        if self._pool is None or len(groups) < 2:
-            return _step_chunk(groups, substeps)
-        chunks = _balanced_chunks(groups, self.threads)
-        futures = [self._pool.submit(_step_chunk, chunk, substeps) for chunk in chunks]
-        return [error for future in futures for error in future.result()]
+        chunks = plan(self.batches, self.active, self.tier, self.threads)
+        steps = {FULL: substeps, REDUCED: reduced_substeps(substeps)}
+        if self._pool is None or len(chunks) < 2:
+            for thread, chunk in enumerate(chunks):
+                bare_step(chunk, states, steps, thread)
+            return
+        futures = [
+            self._pool.submit(bare_step, chunk, states, steps, thread)
+            for thread, chunk in enumerate(chunks)
+        ]
+        for future in futures:
+            future.result()
 
     def sync(self, transforms: TransformStore) -> None:
-        """Copy every body's world pose into the Transform store (one gather per group)."""
-        for group in self.groups:
-            group.sync(transforms)
+        """Copy every body's world pose into the Transform store (one scatter per batch)."""
+        for batch in self.batches:
+            batch.sync(transforms)
 
     # -- queries ---------------------------------------------------------------------
     @property
     def substep_dt(self) -> float:
-        return float(self.groups[0].model.opt.timestep) if self.groups else 0.0
+        return float(self.batches[0].model.opt.timestep) if self.batches else 0.0
 
-    def group_of(self, creature: Creature) -> PhysicsGroup:
-        """The group that simulates `creature`."""
+    def group_of(self, creature: Creature) -> CreatureView:
+        """The physics of `creature` (its batch, row and ids)."""
         return self.groups[int(self.group_of_creature_row[creature.row])]
 
     @property
     def bodies(self) -> int:
-        """Creature bodies in all groups (proxies not counted)."""
-        return int(sum(len(g.body_ids) for g in self.groups))
+        """Creature bodies in all batches (proxies not counted)."""
+        return int(sum(len(b) * len(b.body_ids) for b in self.batches))
 
     @property
     def dofs(self) -> int:
-        return int(sum(g.model.nv for g in self.groups))
+        return int(sum(len(b) * b.model.nv for b in self.batches))
 
     def close(self) -> None:
         """Stop the thread pool."""
@@ -215,38 +319,11 @@ class PhysicsBackend:
 
     def __repr__(self) -> str:
         return (
-            f"<physics: {len(self.groups)} groups, {self.compiles} compiled models,"
+            f"<physics: {len(self)} creatures, {self.compiles} compiled models,"
             f" {self.threads} threads>"
         )
 
 
-class Steppable(Protocol):
-    model: mujoco.MjModel
-    data: mujoco.MjData
-
-
-@dataclass
-class Bare:
-    """A model with a data of its own, stepped without the framework (benchmarks)."""
-
-    model: mujoco.MjModel
-    data: mujoco.MjData
-
-
-def _step_chunk(groups: Sequence[Steppable], substeps: int) -> list[str | None]:
-    errors: list[str | None] = []
-    for group in groups:
-        try:
-            mujoco.mj_step(group.model, group.data, nstep=substeps)
-            errors.append(None)
-        except mujoco.FatalError as exc:
-            errors.append(str(exc).splitlines()[0])
-    return errors
-
-
-def _balanced_chunks(groups: Sequence[Steppable], threads: int) -> list[Sequence[Steppable]]:
-    """Split `groups` into at most `threads` contiguous runs of about equal dofs."""
-    cost = np.cumsum([g.model.nv + 1 for g in groups], dtype=np.float64)
-    cuts = np.searchsorted(cost, cost[-1] * np.arange(1, threads) / threads)
-    bounds = [0, *cuts.tolist(), len(groups)]
-    return [groups[a:b] for a, b in itertools.pairwise(bounds) if b > a]
+def _split(steps: int, rounds: int) -> list[int]:
+    """`steps` in `rounds` parts as equal as whole numbers allow."""
+    return [int(n) for n in np.diff(np.linspace(0, steps, rounds + 1).round())]

@@ -18,22 +18,23 @@ A failing creature is restored to a state saved at least `SAVE_EVERY` frames ear
 A creature that fails `FREEZE_AFTER`
 times within `FREEZE_WINDOW` seconds is frozen where it last was good
 (`creature_frozen`, and one logged warning). Other creatures are never touched: each
-is its own group. No system ever sees a bad pose, so a teleport never reaches a goal.
+is its own row of state. No system ever sees a bad pose, so a teleport never reaches a
+goal. Finding the failures is whole-array work; only failing creatures are visited.
 """
 
 from __future__ import annotations
 
-import copy
 import logging
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
 
 if TYPE_CHECKING:
-    from ecs_tentacles.physics.group import PhysicsGroup
     from ecs_tentacles.physics.host import PhysicsHost
+    from ecs_tentacles.physics.proxies import ContactProxies
+    from ecs_tentacles.physics.roster import Roster
 
 log = logging.getLogger("ecs_tentacles.physics")
 
@@ -47,21 +48,15 @@ FREEZE_AFTER = 3  # failures ...
 FREEZE_WINDOW = 2.0  # ... within this many seconds freeze a creature
 SOFT_GAIN = 0.2  # servo gain right after a recovery, back to 1 over SOFT_SECONDS
 SOFT_SECONDS = 0.5
-
-
-@dataclass
-class GroupHealth:
-    """What the health check remembers about one group."""
-
-    saved: list[np.ndarray] = field(default_factory=list)  # [older, newer] good states
-    failures: list[float] = field(default_factory=list)  # times of recent recoveries
+S = mujoco.mjtState
 
 
 @dataclass(frozen=True)
 class HealthState:
     """The health check between frames (`HealthCheck.state()`), for snapshots."""
 
-    groups: list[GroupHealth]
+    saved: list[np.ndarray]  # per batch: (rows, 2, state) older and newer good states
+    failures: dict[int, list[float]]
     recoveries: int
     frozen: int
     causes: dict[str, int]
@@ -69,31 +64,29 @@ class HealthState:
 
 
 class HealthCheck:
-    """Checks every group after each step and recovers the ones that failed."""
+    """Checks every creature after each step (whole arrays); recovers the ones that failed."""
 
-    def __init__(self, world: PhysicsHost, groups: list[PhysicsGroup]):
-        self.groups = groups
+    def __init__(self, world: PhysicsHost, roster: Roster, proxies: ContactProxies):
+        self.roster = roster
         self.max_speed = world.settings.max_speed
         self.max_penetration = world.settings.max_penetration
-        self.group_health = [GroupHealth() for _ in self.groups]
-        for group, health in zip(self.groups, self.group_health, strict=True):
-            start = group.integration_state()
-            health.saved = [start, start]
+        # per batch: two good states per row, [older, newer]; at first both the start
+        self.saved = [np.repeat(b.state[:, None, :], 2, axis=1) for b in roster.batches]
+        self.failures: dict[int, list[float]] = {}  # creature index -> recent recovery times
         self.recoveries = 0
         self.frozen = 0
         self.causes: dict[str, int] = {}
-        # every group's store rows, group by group, for whole-array speed checks
-        empty = np.zeros(0, dtype=np.int64)
-        self.rows = np.concatenate([g.body_rows for g in groups]) if groups else empty
-        counts = [len(g.body_rows) for g in groups]
-        self.start = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
+        # every creature's body rows, creature by creature, for whole-array speed checks
+        self.rows = proxies.rows
+        self.start = proxies.start
         self.previous = np.zeros((0, 3))  # last frame's poses (set on the first check)
 
     # -- state ---------------------------------------------------------------------
     def state(self) -> HealthState:
         """A copy of what the check remembers: saved good states, failures, counts, poses."""
         return HealthState(
-            copy.deepcopy(self.group_health),
+            [s.copy() for s in self.saved],
+            {k: list(v) for k, v in self.failures.items()},
             self.recoveries,
             self.frozen,
             dict(self.causes),
@@ -102,20 +95,32 @@ class HealthCheck:
 
     def set_state(self, state: HealthState) -> None:
         """Go back to `state()` (copied: one state can be restored many times)."""
-        self.group_health = copy.deepcopy(state.groups)
+        for saved, copy in zip(self.saved, state.saved, strict=True):
+            saved[:] = copy
+        self.failures = {k: list(v) for k, v in state.failures.items()}
         self.recoveries, self.frozen = state.recoveries, state.frozen
         self.causes = dict(state.causes)
         self.previous = state.previous.copy()
 
+    def restart(self, index: int) -> None:
+        """Creature `index` was placed anew: its good states are where it is now."""
+        roster = self.roster
+        batch = roster.batches[int(roster.batch_of[index])]
+        row = int(roster.row_of[index])
+        self.saved[batch.index][row] = batch.state[row]
+        if len(self.previous):
+            self.previous[batch.body_rows[row]] = batch.xpos[row]
+
     # -- per frame -------------------------------------------------------------------
     def check(self, world: PhysicsHost, physics_time: float) -> None:
-        """Check every active group stepped this frame; recover the ones that failed.
+        """Check every creature stepped this frame; recover the ones that failed.
 
         Runs right after `physics_sync`: speeds and non-finite poses are read from the
-        Transform store as whole arrays; a failing group's rows are put back before any
-        other system reads them. `physics_time` is the physics clock: a recovered
-        group's data is set to it.
+        Transform store as whole arrays, the rest from the batches' arrays; a failing
+        creature's rows are put back before any other system reads them.
+        `physics_time` is the physics clock: a recovered creature's state is set to it.
         """
+        roster = self.roster
         limit = self.max_speed * world.settings.dt
         save = world.frame % SAVE_EVERY == 0
         ramp = world.settings.dt / SOFT_SECONDS
@@ -125,78 +130,86 @@ class HealthCheck:
         moved = pos[self.rows] - self.previous[self.rows]
         step = np.einsum("ij,ij->i", moved, moved)  # nan where a pose is not finite
         fastest = np.sqrt(np.maximum.reduceat(step, self.start)) if len(step) else step
-        for group, health in zip(self.groups, self.group_health, strict=True):
-            if not group.active:
-                continue
-            cause = self._cause(group, float(fastest[group.index]), limit)
-            if cause is not None:
-                self._recover(world, group, health, cause, physics_time)
-                continue
-            if group.soften < 1.0:
-                group.soften = min(1.0, group.soften + ramp * (1.0 - SOFT_GAIN))
-            if save:
-                health.saved = [health.saved[1], group.integration_state()]
+        active = roster.active
+        bad = ~(fastest <= limit)  # also nan: a pose that is not finite
+        for batch in roster.batches:
+            members = batch.members
+            bad[members] |= batch.warnings.any(axis=1)
+            bad[members] |= ~np.isfinite(batch.qvel.sum(axis=1))
+            bad[members] |= batch.deepest < -self.max_penetration
+            for row in batch.errors:
+                bad[members[row]] = True
+        failing = np.flatnonzero(bad & active)
+        causes = {int(i): self._cause(int(i), float(fastest[i]), limit) for i in failing}
+        healthy = active & ~bad
+        softened = healthy & (roster.soften < 1.0)
+        roster.soften[softened] = np.minimum(
+            1.0, roster.soften[softened] + ramp * (1.0 - SOFT_GAIN)
+        )
+        if save:
+            for batch, saved in zip(roster.batches, self.saved, strict=True):
+                rows = np.flatnonzero(healthy[batch.members])
+                saved[rows, 0] = saved[rows, 1]
+                saved[rows, 1] = batch.state[rows]
+        for batch in roster.batches:
+            batch.warnings[:] = 0
+            batch.errors.clear()
+        for index, cause in causes.items():
+            self._recover(world, index, cause, physics_time)
         self.previous[:] = pos
 
-    def _cause(self, group: PhysicsGroup, fastest: float, limit: float) -> str | None:
-        d = group.data
-        if group.error is not None:
-            cause, group.error = f"fatal {group.error}", None
-            return cause
-        counts = d.warning.number
-        if int(counts.sum()) != group.warning_total:
-            raised = np.flatnonzero(counts > group.warnings)
-            group.warnings[:] = counts
-            group.warning_total = int(counts.sum())
+    def _cause(self, index: int, fastest: float, limit: float) -> str:
+        roster = self.roster
+        batch = roster.batches[int(roster.batch_of[index])]
+        row = int(roster.row_of[index])
+        if row in batch.errors:
+            return f"fatal {batch.errors[row]}"
+        raised = np.flatnonzero(batch.warnings[row])
+        if len(raised):
             names = sorted(WARNINGS.get(int(i), f"warning{i}") for i in raised)
             return f"mujoco {', '.join(names)}"
-        if not fastest <= limit:  # also nan: a pose that is not finite
+        if not fastest <= limit:
             if not np.isfinite(fastest):
                 return "non-finite state"
             return f"speed {fastest / limit * self.max_speed:.3g} m/s"
-        if not np.isfinite(d.qvel.sum()):
+        if not np.isfinite(batch.qvel[row].sum()):
             return "non-finite state"
-        if d.ncon and d.contact.dist.min() < -self.max_penetration:
-            return f"penetration {-1000 * d.contact.dist.min():.1f} mm"
-        return None
+        return f"penetration {-1000 * batch.deepest[row]:.1f} mm"
 
-    def _recover(
-        self,
-        world: PhysicsHost,
-        group: PhysicsGroup,
-        health: GroupHealth,
-        cause: str,
-        physics_time: float,
-    ) -> None:
+    def _recover(self, world: PhysicsHost, index: int, cause: str, physics_time: float) -> None:
+        roster = self.roster
+        batch = roster.batches[int(roster.batch_of[index])]
+        row = int(roster.row_of[index])
         now = world.time
-        health.failures = [t for t in health.failures if now - t < FREEZE_WINDOW] + [now]
+        failures = [t for t in self.failures.get(index, []) if now - t < FREEZE_WINDOW] + [now]
+        self.failures[index] = failures
         key = cause.split(" ")[0]
         self.causes[key] = self.causes.get(key, 0) + 1
-        group.set_integration_state(health.saved[0])
-        group.data.time = physics_time
-        group.warnings[:] = group.data.warning.number
-        group.warning_total = int(group.warnings.sum())
-        group.sync(world.transforms)  # its rows, before any other system reads them
-        group.soften = SOFT_GAIN
-        if len(group.equality_ids):
-            group.data.eq_active[group.equality_ids] = 0
+        batch.state[row] = self.saved[batch.index][row, 0]
+        batch.part(S.mjSTATE_TIME, row)[:] = physics_time
+        batch.forward(row)
+        world.transforms.pos[batch.body_rows[row]] = batch.xpos[row]  # before anyone reads
+        world.transforms.quat[batch.body_rows[row]] = batch.xquat[row]
+        roster.soften[index] = SOFT_GAIN
+        batch.part(S.mjSTATE_EQ_ACTIVE, row)[:] = 0.0
         suckers = world.suckers
-        for row in group.sucker_rows[suckers.attached[group.sucker_rows]]:  # core: no feature call
-            suckers.attached[row] = False
-            sucker = int(suckers.entity[row])
+        rows = batch.sucker_rows[row]
+        for sucker_row in rows[suckers.attached[rows]]:  # core: no feature call
+            suckers.attached[sucker_row] = False
+            sucker = int(suckers.entity[sucker_row])
             world.events.emit("sucker_released", world=world, sucker=sucker, reason="recovery")
-        creature = group.creatures[0]
+        creature = int(roster.entity[index])
         self.recoveries += 1
         world.events.emit("creature_recovered", world=world, creature=creature, cause=cause)
-        if len(health.failures) >= FREEZE_AFTER:
-            group.data.qvel[:] = 0.0
-            group.frozen = True
+        if len(failures) >= FREEZE_AFTER:
+            batch.part(S.mjSTATE_QVEL, row)[:] = 0.0
+            roster.frozen[index] = True
             self.frozen += 1
             name = world.creature_name(creature)
             log.warning(
                 "creature %r frozen: %d physics failures in %.1f s (last: %s)",
                 name,
-                len(health.failures),
+                len(failures),
                 FREEZE_WINDOW,
                 cause,
             )

@@ -127,13 +127,19 @@ def _hinges(link: Link) -> tuple[str, ...]:
     return ("curl", "sweep", "twist") if link.twist else ("curl", "sweep")
 
 
-def build_spec(world: PhysicsHost, creature: Creature) -> mujoco.MjSpec:
-    """An MjSpec of `creature` alone, its mantle at the origin, with the proxy pool."""
+def build_spec(
+    world: PhysicsHost, creature: Creature, timestep: float | None = None
+) -> mujoco.MjSpec:
+    """An MjSpec of `creature` alone, its mantle at the origin, with the proxy pool.
+
+    `timestep` (default: the scene's substep) gives a cheaper model of the same
+    creature (the REDUCED level of detail, `physics.tiers`).
+    """
     settings = world.settings
     spec = mujoco.MjSpec()
     spec.modelname = "ecs_tentacles_creature"
     spec.compiler.degree = False  # joint ranges are radians
-    spec.option.timestep = settings.substep_dt
+    spec.option.timestep = settings.substep_dt if timestep is None else timestep
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
     spec.option.gravity = list(settings.gravity)
     # The framework, not MuJoCo, decides what happens after a blow-up (physics/health.py).

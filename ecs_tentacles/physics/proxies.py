@@ -1,11 +1,12 @@
-"""Contact between physics groups: proxies of nearby creatures' bodies.
+"""Contact between creatures: proxies of nearby creatures' bodies.
 
 Each creature's model holds a pool of kinematic (mocap) capsules and cylinders
 (`ecs_tentacles.physics.model`). Before each frame's step, every creature near
 another gets proxies, sized and posed like the other creature's bodies as they were
-at the end of the last frame; MuJoCo then pushes the creature out of them. Both
-creatures see each other this way, so they push each other apart, wherever their
-groups are. Far from everyone, a creature's proxies stay parked out of reach.
+at the end of the last frame (poses into its state row, sizes into its batch's
+overlay); MuJoCo then pushes the creature out of them. Both creatures see each other
+this way, so they push each other apart. Far from everyone, a creature's proxies stay
+parked out of reach.
 
 All the per-frame work is array math over the bodies of creatures that are near
 someone: bounding spheres per creature, candidate bodies inside a neighbour's sphere,
@@ -14,105 +15,115 @@ and the nearest ones kept when more are near than the pool holds.
 
 from __future__ import annotations
 
-import itertools
 from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
 
-from ecs_tentacles.physics.model import PROXY_CAPSULES, PROXY_CYLINDERS
+from ecs_tentacles.physics.model import PROXY_CAPSULES, PROXY_CYLINDERS, PROXY_PARK
 
 if TYPE_CHECKING:
-    from ecs_tentacles.physics.group import PhysicsGroup
+    from ecs_tentacles.physics.roster import Roster
     from ecs_tentacles.store import TransformStore
 
+S = mujoco.mjtState
 MARGIN = 0.05  # metres: a body this close to a neighbour's sphere gets a proxy
 POOL = np.array([PROXY_CAPSULES, PROXY_CYLINDERS])
 CAPSULE, CYLINDER = 0, 1
+PARK = PROXY_PARK + np.outer(np.arange(PROXY_CAPSULES + PROXY_CYLINDERS) * 10.0, [1.0, 0.0, 0.0])
+_NONE = np.zeros(0, dtype=np.int64)
 
 
 class ContactProxies:
-    """Places every group's proxies from the Transform store, once per frame."""
+    """Places every creature's proxies from the Transform store, once per frame."""
 
-    def __init__(self, groups: list[PhysicsGroup]):
-        self.groups = groups
+    def __init__(self, roster: Roster):
+        self.roster = roster
         rows, owner, kind, size = [], [], [], []
-        for group in groups:
-            m = group.model
-            geoms = m.body_geomadr[group.body_ids]
-            rows.append(group.body_rows)
-            owner.append(np.full(len(geoms), group.index))
+        count = len(roster)
+        for batch in roster.batches:  # per batch, then scattered into creature order
+            m = batch.model
+            geoms = m.body_geomadr[batch.body_ids]
             cylinder = m.geom_type[geoms] == mujoco.mjtGeom.mjGEOM_CYLINDER
-            kind.append(np.where(cylinder, CYLINDER, CAPSULE))
-            size.append(m.geom_size[geoms, :2])
-        empty = np.zeros(0, dtype=np.int64)
-        self.rows = np.concatenate(rows) if rows else empty
-        self.owner = np.concatenate(owner) if owner else empty
-        self.kind = np.concatenate(kind) if kind else empty
-        self.size = np.concatenate(size) if size else np.zeros((0, 2))
+            n, nb = batch.body_rows.shape
+            rows.append(batch.body_rows)
+            owner.append(np.repeat(batch.members[:, None], nb, axis=1))
+            kind.append(np.broadcast_to(np.where(cylinder, CYLINDER, CAPSULE), (n, nb)))
+            size.append(np.broadcast_to(m.geom_size[geoms, :2], (n, nb, 2)))
+        owner_all = np.concatenate([o.reshape(-1) for o in owner]) if owner else np.zeros(0, int)
+        order = np.argsort(owner_all, kind="stable")  # creature by creature, bodies in order
+        self.rows = np.concatenate([r.reshape(-1) for r in rows])[order] if rows else owner_all
+        self.owner = owner_all[order]
+        self.kind = np.concatenate([k.reshape(-1) for k in kind])[order] if kind else owner_all
+        self.size = (
+            np.concatenate([z.reshape(-1, 2) for z in size])[order] if size else np.zeros((0, 2))
+        )
         radius, half = self.size[:, 0], self.size[:, 1]
         self.rbound = np.where(self.kind == CYLINDER, np.hypot(radius, half), radius + half)
-        self.aabb = np.zeros((len(self.rows), 6))
-        self.aabb[:, 3:5] = radius[:, None]
-        self.aabb[:, 5] = np.where(self.kind == CYLINDER, half, half + radius)
-        counts = np.bincount(self.owner, minlength=len(groups)) if len(groups) else empty
+        counts = np.bincount(self.owner, minlength=count).astype(np.int64)
         self.start = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
-        self.count = counts.astype(np.int64)
-        self.mantle = self.start  # a group's first body is its mantle
+        self.count = counts
+        self.mantle = self.start  # a creature's first body is its mantle
+        # each batch row's bodies in this order
+        self.index = [
+            self.start[batch.members][:, None] + np.arange(len(batch.body_ids))
+            for batch in roster.batches
+        ]
 
     def update(self, transforms: TransformStore) -> None:
         """Give every creature proxies of the other creatures' bodies near it."""
-        if len(self.groups) < 2:
+        if len(self.roster) < 2:
             return
         self._place(transforms.pos[self.rows], transforms.quat[self.rows])
 
     @property
     def in_use(self) -> bool:
         """Some creature is near another (its proxies are placed)."""
-        return any(group.proxies_used for group in self.groups)
+        return bool(self.roster.proxies_used.any())
 
     def refresh(self, transforms: TransformStore) -> None:
         """Move the proxies to where the bodies are now, within the frame.
 
-        Bodies of creatures near someone are read from their MuJoCo data (as of their
+        Bodies of creatures near someone are read from their last step (as of their
         last substep); every other body is as the frame started."""
         pos, quat = transforms.pos[self.rows], transforms.quat[self.rows]
-        for group in self.groups:
-            if group.proxies_used:
-                rows = slice(
-                    self.start[group.index], self.start[group.index] + self.count[group.index]
-                )
-                pos[rows] = group.data.xpos[group.body_ids]
-                quat[rows] = group.data.xquat[group.body_ids]
+        used = self.roster.proxies_used > 0
+        for batch, index in zip(self.roster.batches, self.index, strict=True):
+            rows = np.flatnonzero(used[batch.members])
+            if len(rows):
+                pos[index[rows]] = batch.xpos[rows]
+                quat[index[rows]] = batch.xquat[rows]
         self._place(pos, quat)
 
     def _place(self, pos: np.ndarray, quat: np.ndarray) -> None:
+        roster = self.roster
         centre = pos[self.mantle]
         reach = np.linalg.norm(pos - centre[self.owner], axis=1) + self.rbound
         radius = np.maximum.reduceat(reach, self.start)
         a, b = _near_pairs(centre, radius)
-        placed = self._assign(a, b, pos, centre, radius) if len(a) else {}
-        for group in self.groups:
-            found = placed.get(group.index)
-            if group.proxies_used:
-                _park(group)
-            if found is None:
-                continue
-            body, slot = found
-            m, d = group.model, group.data
-            geoms, mocap = group.proxy_geoms[slot], group.proxy_mocap[slot]
-            d.mocap_pos[mocap] = pos[body]
-            d.mocap_quat[mocap] = quat[body]
-            m.geom_size[geoms, :2] = self.size[body]
-            m.geom_rbound[geoms] = self.rbound[body]
-            m.geom_aabb[geoms] = self.aabb[body]
-            group.proxies_used = len(slot)
+        who, body, slot = self._assign(a, b, pos, centre, radius) if len(a) else (_NONE,) * 3
+        was_used = roster.proxies_used > 0
+        roster.proxies_used[:] = np.bincount(who, minlength=len(roster))
+        for batch in roster.batches:
+            mocap = batch.grid(S.mjSTATE_MOCAP_POS, 3)
+            parked = np.flatnonzero(was_used[batch.members])
+            if len(parked):
+                mocap[parked[:, None], batch.proxy_mocap] = PARK
+            mine = batch.index == roster.batch_of[who]
+            rows = roster.row_of[who[mine]]
+            if len(rows):
+                turns = batch.grid(S.mjSTATE_MOCAP_QUAT, 4)
+                mocap_ids = batch.proxy_mocap[slot[mine]]
+                mocap[rows, mocap_ids] = pos[body[mine]]
+                turns[rows, mocap_ids] = quat[body[mine]]
+                batch.proxy_size[rows, slot[mine]] = self.size[body[mine]]
+            batch.near[:] = roster.proxies_used[batch.members] > 0
 
     def _assign(
         self, a: np.ndarray, b: np.ndarray, pos: np.ndarray, centre: np.ndarray, radius: np.ndarray
-    ) -> dict[int, tuple[np.ndarray, np.ndarray]]:
-        """Group index -> (source bodies, proxy slots): b's bodies inside a's sphere, nearest
-        first, as many as the pool of each kind holds."""
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(creature, source body, proxy slot) triples: b's bodies inside a's sphere,
+        nearest first, as many as the pool of each kind holds."""
         per = self.count[b]
         pair = np.repeat(np.arange(len(a)), per)
         body = np.arange(per.sum()) - np.repeat(np.cumsum(per) - per, per) + self.start[b][pair]
@@ -121,8 +132,8 @@ class ContactProxies:
         keep = gap < MARGIN
         who, body, gap = who[keep], body[keep], gap[keep]
         if not len(who):
-            return {}
-        crowded = np.bincount(who, minlength=len(self.groups)) > POOL.min()
+            return (_NONE,) * 3
+        crowded = np.bincount(who, minlength=len(self.roster)) > POOL.min()
         if crowded[who].any():  # more candidates than proxies: rank by the nearest own body
             some = np.flatnonzero(crowded[who])
             gap[some] = self._body_gaps(who[some], body[some], pos)
@@ -133,8 +144,7 @@ class ContactProxies:
         fits = slot < POOL[self.kind[body]]
         who, body, slot = who[fits], body[fits], slot[fits]
         slot = slot + np.where(self.kind[body] == CYLINDER, PROXY_CAPSULES, 0)
-        bounds = np.flatnonzero(np.r_[True, who[1:] != who[:-1], True])
-        return {int(who[s]): (body[s:e], slot[s:e]) for s, e in itertools.pairwise(bounds)}
+        return who, body, slot
 
     def _body_gaps(self, who: np.ndarray, body: np.ndarray, pos: np.ndarray) -> np.ndarray:
         """Gap between each candidate body and the nearest body of creature `who`."""
@@ -144,11 +154,6 @@ class ContactProxies:
         gap = np.linalg.norm(pos[own] - pos[body[pair]], axis=1) - self.rbound[own]
         nearest = np.minimum.reduceat(gap, np.cumsum(per) - per)
         return nearest - self.rbound[body]
-
-
-def _park(group: PhysicsGroup) -> None:
-    group.data.mocap_pos[group.proxy_mocap] = group.proxy_park
-    group.proxies_used = 0
 
 
 def _near_pairs(centre: np.ndarray, radius: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -7,6 +7,7 @@ commands that did not change (targets and gains: no writhing, no waves) and ever
 velocity below `STILL_SPEED`. Its state then stays exactly as it was: asleep, it is
 not stepped at all, which is what makes idle crowds cheap. It wakes the frame any of
 those changes (a goal, a neighbour, a script moving a target), before the step.
+The decision is whole-array work over every batch's rows.
 """
 
 from __future__ import annotations
@@ -17,8 +18,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 if TYPE_CHECKING:
-    from ecs_tentacles.physics.group import PhysicsGroup
     from ecs_tentacles.physics.host import PhysicsHost
+    from ecs_tentacles.physics.roster import Roster
 
 SETTLE_FRAMES = 30  # frames of stillness before a creature sleeps
 STILL_SPEED = 1e-3  # m/s or rad/s: slower than this counts as still
@@ -29,62 +30,71 @@ COMMAND_CHANGE = 1e-9  # servo targets or gains that moved less than this did no
 class SleepState:
     """The sleep counters between frames (`Sleep.state()`), for snapshots."""
 
-    still: np.ndarray  # frames each group has been still
-    commands: list[np.ndarray]  # each group's last servo commands
+    still: np.ndarray  # frames each creature has been still
+    commands: list[np.ndarray]  # per batch: each row's last servo commands
+    known: np.ndarray  # creatures whose last commands are known
 
 
 class Sleep:
-    """Decides, each frame before the step, which groups sleep."""
+    """Decides, each frame before the step, which creatures sleep (whole arrays)."""
 
-    def __init__(self, groups: list[PhysicsGroup]):
-        self.groups = groups
-        self.still = np.zeros(len(groups), dtype=np.int64)  # frames each has been still
-        self.commands = [np.zeros(0) for _ in groups]  # last frame's ctrl and gains
+    def __init__(self, roster: Roster):
+        self.roster = roster
+        self.still = np.zeros(len(roster), dtype=np.int64)  # frames each has been still
+        self.commands = [np.zeros((len(b), 2 * b.model.nu)) for b in roster.batches]
+        self.known = np.zeros(len(roster), dtype=bool)  # `commands` hold last frame's
         self.enabled = True
 
     @property
     def asleep(self) -> int:
-        """Groups asleep now."""
-        return int(sum(g.sleeping for g in self.groups))
+        """Creatures asleep now."""
+        return int(self.roster.sleeping.sum())
 
     def state(self) -> SleepState:
         """A copy of the counters and last commands."""
-        return SleepState(self.still.copy(), [c.copy() for c in self.commands])
+        return SleepState(self.still.copy(), [c.copy() for c in self.commands], self.known.copy())
 
     def set_state(self, state: SleepState) -> None:
         """Go back to `state()` (copied: one state can be restored many times)."""
         self.still[:] = state.still
         self.commands = [c.copy() for c in state.commands]
+        self.known[:] = state.known
+
+    def restart(self, index: int) -> None:
+        """Creature `index` was placed anew: it has not been still, its commands unknown."""
+        self.still[index] = 0
+        self.known[index] = False
 
     def update(self, world: PhysicsHost, wants_motion: np.ndarray | None) -> None:
-        """Put still groups to sleep and wake the ones whose situation changed.
+        """Put still creatures to sleep and wake the ones whose situation changed.
 
         `wants_motion` (bool per CreatureStore row, or None for nobody) says which
         creatures some plugin wants to move (`Plugin.wants_motion`): those never sleep.
         """
-        if not self.enabled:  # nothing ever sleeps: no per-group work
+        if not self.enabled:  # nothing ever sleeps: no per-creature work
             return
+        roster = self.roster
         attached = world.suckers.attached
-        for group in self.groups:
-            if group.frozen:
-                continue
-            m, d = group.model, group.data
-            commands = np.concatenate((d.ctrl, m.actuator_gainprm[:, 0]))
-            previous = self.commands[group.index]
+        for batch, previous in zip(roster.batches, self.commands, strict=True):
+            members = batch.members
+            live = ~roster.frozen[members]
+            commands = np.concatenate((batch.ctrl, batch.kp), axis=1)
             calm = (
-                (wants_motion is None or not wants_motion[group.creature_row])
-                and not group.proxies_used
-                and not attached[group.sucker_rows].any()
-                and len(previous) == len(commands)
-                and float(np.abs(commands - previous).max(initial=0.0)) < COMMAND_CHANGE
+                live
+                & ~roster.proxies_used[members].astype(bool)
+                & ~attached[batch.sucker_rows].any(axis=1)
+                & self.known[members]
+                & (np.abs(commands - previous).max(axis=1, initial=0.0) < COMMAND_CHANGE)
             )
-            self.commands[group.index] = commands
-            if not calm:
-                self.still[group.index] = 0
-                group.sleeping = False
-                continue
-            if group.sleeping:
-                continue
-            moving = float(np.abs(d.qvel).max(initial=0.0)) >= STILL_SPEED
-            self.still[group.index] = 0 if moving else self.still[group.index] + 1
-            group.sleeping = bool(self.still[group.index] >= SETTLE_FRAMES)
+            if wants_motion is not None:
+                calm &= ~wants_motion[roster.creature_row[members]]
+            previous[live] = commands[live]
+            self.known[members[live]] = True
+            restless = members[live & ~calm]
+            self.still[restless] = 0
+            roster.sleeping[restless] = False
+            settling = calm & ~roster.sleeping[members]
+            moving = np.abs(batch.qvel).max(axis=1, initial=0.0) >= STILL_SPEED
+            who = members[settling]
+            self.still[who] = np.where(moving[settling], 0, self.still[who] + 1)
+            roster.sleeping[who] = self.still[who] >= SETTLE_FRAMES

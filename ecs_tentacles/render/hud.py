@@ -175,7 +175,7 @@ class Hud:
         physics = self.world.physics
         health = physics.health
         for name, text in (
-            ("groups", f"groups {len(physics.groups)} on {physics.threads} threads"),
+            ("models", f"models {physics.compiles} on {physics.threads} threads"),
             ("recoveries", f"recoveries {health.recoveries}   frozen {health.frozen}"),
         ):
             imgui.text(text)

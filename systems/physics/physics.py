@@ -2,11 +2,12 @@
 
 Reads: Motor store (target, strength, damping, max_torque, gain), Sucker store
 (attached, anchor), Transform store (pos, quat: where other creatures are), and which
-creatures the plugins want to move (`Plugin.wants_motion`). Writes, in every physics
-group: MjData (ctrl, eq_active, contact proxies' mocap poses), MjModel servo gains,
-sucker anchors and proxy sizes; puts still, idle creatures to sleep (`physics.sleep`)
-and wakes the others; then advances `world.settings.substeps` steps, the awake groups
-in parallel. Systems that override `System.substep` run before every substep, in
+creatures the plugins want to move (`Plugin.wants_motion`). Writes, in every batch
+of the physics (`physics.batch`): each creature's state row (ctrl, sucker switches,
+contact proxies' poses) and overlay (servo gains, torque limits, sucker anchors, proxy
+sizes); puts still, idle creatures to sleep (`physics.sleep`) and wakes the others;
+then advances `world.settings.substeps` steps, the awake creatures on the stepping
+threads. Systems that override `System.substep` run before every substep, in
 schedule order.
 """
 

@@ -1,9 +1,9 @@
 """physics_health: every creature's physics checked after the step; failures recovered.
 
-Reads: each physics group's MjData (warnings, velocities, contacts), the Transform
+Reads: every batch's step results (warnings, velocities, deepest contact), the Transform
 store (this frame's poses against last frame's, for speeds and non-finite poses),
 the Sucker store (attached, entity: which suckers a failing creature holds).
-Writes: the failing group's MjData (restored to its last good state) and its
+Writes: the failing creature's state row (restored to its last good state) and its
 Transform rows (pos, quat), Sucker store (attached: its suckers released), events
 `creature_recovered` / `creature_frozen` / `sucker_released`. Runs right after
 `physics_sync`, before any system that reads poses, so no system sees a blown-up

@@ -1,7 +1,8 @@
 """physics_sync: copies body poses from MuJoCo into the Transform store.
 
-Reads: MjData.xpos, MjData.xquat. Writes: Transform store (pos, quat) of every
-mantle and link, in one gather per field.
+Reads: every batch's body poses after the step (`physics.batch`: xpos, xquat).
+Writes: Transform store (pos, quat) of every mantle and link, one scatter per batch
+and field.
 """
 
 from __future__ import annotations

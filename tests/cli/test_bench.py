@@ -28,8 +28,8 @@ def test_human_summary_of_a_scene_file(capsys: pytest.CaptureFixture[str]) -> No
     lines = capsys.readouterr().out.splitlines()
     assert len(lines) == 3
     assert re.fullmatch(
-        r".*three_goals\.json: 1 creatures, 61 bodies, 1 physics groups \(1 compiled,"
-        r" 0 asleep at the end\), 1 threads;"
+        r".*three_goals\.json: 1 creatures, 61 bodies, 1 shared models \(0 creatures"
+        r" asleep at the end\), 1 threads;"
         r" built in \d+\.\d\d s",
         lines[0],
     )

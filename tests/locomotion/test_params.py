@@ -35,33 +35,33 @@ def _actuators(world: World, motor_rows: np.ndarray) -> np.ndarray:
 def test_strength_of_one_tentacle_reaches_its_servos(make_world: Callable[..., World]) -> None:
     world = _world(make_world)
     octo = world.creature("octo")
-    model = world.physics.groups[0].model
+    group = world.physics.groups[0]
     world.step(1)
-    before = model.actuator_gainprm[:, 0].copy()
+    before = group.kp.copy()
     world.resource(Locomotion).set(octo, tentacle=1, strength=40.0, damping=2.0)
     world.step(1)
     motors = world.motors
     links = _links(world, 1)
     base = _actuators(world, links[:1])
     assert len(base) == 2  # curl and sweep
-    assert_allclose(model.actuator_gainprm[base, 0], 40.0 * motors.gain[links[0]], rtol=1e-12)
-    assert_allclose(model.actuator_biasprm[base, 2], -2.0 * motors.gain[links[0]], rtol=1e-12)
+    assert_allclose(group.kp[base], 40.0 * motors.gain[links[0]], rtol=1e-12)
+    assert_allclose(group.kv[base], 2.0 * motors.gain[links[0]], rtol=1e-12)
     # every link of the tentacle, tapered by its scale
     rows = world.physics.groups[0].actuator_motor_rows
     mine = _actuators(world, links)
     assert_allclose(
-        model.actuator_gainprm[mine, 0],
+        group.kp[mine],
         40.0 * motors.scale[rows[mine]] * motors.gain[rows[mine]],
         rtol=1e-12,
     )
     # the other tentacles keep the scene's 25, times this frame's gain
-    others = np.setdiff1d(np.arange(model.nu), mine)
+    others = np.setdiff1d(np.arange(len(group.kp)), mine)
     assert_allclose(
-        model.actuator_gainprm[others, 0],
+        group.kp[others],
         25.0 * motors.scale[rows[others]] * motors.gain[rows[others]],
         rtol=1e-12,
     )
-    assert not np.allclose(model.actuator_gainprm[mine, 0], before[mine])
+    assert not np.allclose(group.kp[mine], before[mine])
     assert world.resource(Locomotion).get(octo, 1)["strength"] == 40.0
     assert world.resource(Locomotion).get(octo, 1)["damping"] == 2.0
     assert world.resource(Locomotion).get(octo, 2)["strength"] == 25.0

@@ -32,10 +32,12 @@ def test_one_compile_per_morphology(make_world: Callable[..., World]) -> None:
     physics = world.physics
     assert (len(physics.groups), physics.compiles) == (4, 2)
     assert [g.creatures for g in physics.groups] == [[world.creature(f"c{i}")] for i in range(4)]
-    # creatures that share a compiled model still own their data and servo gains
-    first, second = physics.groups[0], physics.groups[1]
-    assert first.model is not second.model and first.data is not second.data
-    assert first.key == second.key != physics.groups[2].key
+    # creatures of one morphology share its model; each owns its state and servo gains
+    first, second, third = physics.groups[0], physics.groups[1], physics.groups[2]
+    assert first.model is second.model is not third.model
+    assert first.batch is second.batch is not third.batch and first.row != second.row
+    assert not np.shares_memory(first.kp, second.kp)
+    assert not np.shares_memory(first.data.qpos, second.data.qpos)
 
 
 def test_trajectories_do_not_depend_on_the_thread_count(make_world: Callable[..., World]) -> None:
@@ -70,5 +72,5 @@ def test_groups_are_visible(make_world: Callable[..., World]) -> None:
     world = make_world(_far_apart([{"count": 3, "links": 4}] * 2), threads=2)
     octo = world.component(world.creature("c1"), Creature)
     assert world.physics.group_of(octo) is world.physics.groups[1]
-    assert repr(world.physics) == "<physics: 2 groups, 1 compiled models, 2 threads>"
+    assert repr(world.physics) == "<physics: 2 creatures, 1 compiled models, 2 threads>"
     assert world.physics.bodies == 2 * (1 + 3 * 4)

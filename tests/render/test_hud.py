@@ -36,7 +36,7 @@ def test_widgets_never_overlap_and_fit_the_panel(
     sandbox.hud.sections.append(("Extra", lambda gui: None))
     sandbox.render()
     rects = sandbox.hud.gui.rects
-    assert {"speed label", "speed", "wave_amplitude label", "gait label", "groups"} <= set(rects)
+    assert {"speed label", "speed", "wave_amplitude label", "gait label", "models"} <= set(rects)
     assert overlaps(rects) == []
     x0, y0, x1, y1 = sandbox.hud.gui.windows["panel"]
     assert (x0, y0, x1, y1) == (0, 0, panel_width(*size), size[1])
@@ -113,10 +113,10 @@ def test_slider_click_reaches_the_servo_gains(make_sandbox: Callable[..., Any]) 
         kp
     ] * 8  # "all"
     sandbox.step(1)
-    model = world.physics.groups[0].model
-    actuator = model.actuator("t3/l00/curl").id
+    group = world.physics.groups[0]
+    actuator = group.model.actuator("t3/l00/curl").id
     row = int(world.tentacles.first_link[3])
-    assert model.actuator_gainprm[actuator, 0] == pytest.approx(
+    assert group.kp[actuator] == pytest.approx(
         kp * world.motors.gain[row], rel=1e-12
     )
     x0, y0, x1, y1 = sandbox.hud.gui.rects["gait cyclic"]

@@ -16,7 +16,7 @@ pytestmark = pytest.mark.skipif(not TOOLS.is_dir(), reason="needs the source tre
 COLUMNS = [
     "creatures",
     "threads",
-    "groups",
+    "compiles",
     "bodies",
     "build_s",
     "build_s_per_creature",

@@ -1,0 +1,274 @@
+"""Every creature of one morphology: one shared compiled model, state in arrays.
+
+A `Batch` holds the compiled model of a morphology (`model_layout(...).key`) once, and
+each of its creatures as one row of contiguous arrays: the MuJoCo state (`state`:
+time, qpos, qvel, warm start, ctrl, sucker switches, proxy poses; `STATE`), what
+differs per creature in the model (servo gains and torque limits, sucker anchors,
+proxy sizes: the *overlay*), the body poses the last step produced (`xpos`, `xquat`)
+and what the health check needs from it (warnings raised, deepest contact, fatal
+errors). Nothing per creature is a MuJoCo object.
+
+A batch is stepped by `step_rows`: each stepping thread owns one scratch copy of the
+model and one MjData (`Scratch`), and steps its share of the rows one after another:
+overlay into the scratch model, `mj_setState`, `mj_step`, `mj_getState`, poses out. A
+creature's step therefore reads only its own row, so results never depend on the
+number of threads or on which thread stepped which creature, and a creature steps
+exactly as it would alone in its own model and data.
+"""
+
+from __future__ import annotations
+
+import copy
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import mujoco
+import numpy as np
+
+from ecs_tentacles.physics.model import PROXY_CAPSULES, PROXY_CYLINDERS, PROXY_PARK, ModelLayout
+from ecs_tentacles.physics.tiers import FULL
+
+if TYPE_CHECKING:
+    from ecs_tentacles.store import TransformStore
+
+S = mujoco.mjtState
+# Everything `mj_step` reads that this project changes: the physics (time, qpos, qvel,
+# act), the warm start (replays diverge without it), the servo targets, the sucker
+# switches and the proxies' poses. Applied forces are not state here (`applied`).
+STATE = (
+    S.mjSTATE_FULLPHYSICS
+    | S.mjSTATE_WARMSTART
+    | S.mjSTATE_CTRL
+    | S.mjSTATE_EQ_ACTIVE
+    | S.mjSTATE_MOCAP_POS
+    | S.mjSTATE_MOCAP_QUAT
+)
+PROXIES = PROXY_CAPSULES + PROXY_CYLINDERS
+WARNING_KINDS = len(mujoco.MjData(mujoco.MjModel.from_xml_string("<mujoco/>")).warning)
+
+
+def state_slices(model: mujoco.MjModel) -> dict[int, slice]:
+    """Where each part of `STATE` (by its mjtState bit) lies in a state vector."""
+    slices: dict[int, slice] = {}
+    start = 0
+    for bit in range(int(S.mjSTATE_INTEGRATION).bit_length()):
+        flag = 1 << bit
+        if int(STATE) & flag:
+            size = mujoco.mj_stateSize(model, flag)
+            slices[flag] = slice(start, start + size)
+            start += size
+    return slices
+
+
+def _ids(model: mujoco.MjModel, kind: mujoco.mjtObj, names: list[str]) -> np.ndarray:
+    return np.array([mujoco.mj_name2id(model, kind, n) for n in names], dtype=np.int64)
+
+
+@dataclass
+class Scratch:
+    """One stepping thread's copy of a batch's model and its one MjData."""
+
+    model: mujoco.MjModel
+    data: mujoco.MjData
+    forced: bool = False  # applied forces were written into `data` (zero them next time)
+
+
+class Batch:
+    """The creatures of one morphology: a shared model and their rows of state."""
+
+    def __init__(
+        self,
+        index: int,
+        model: mujoco.MjModel,
+        layouts: list[ModelLayout],
+        reduced: Callable[[], mujoco.MjModel] | None = None,
+    ):
+        self.index = index
+        self.model = model  # shared, never written: scratch copies take the overlay
+        self.models = {FULL: model}  # per tier; REDUCED compiled on first use
+        self._compile_reduced = reduced
+        m, obj = model, mujoco.mjtObj
+        n = len(layouts)
+        first = layouts[0]
+        self.body_ids = _ids(m, obj.mjOBJ_BODY, first.bodies)
+        actuators = _ids(m, obj.mjOBJ_ACTUATOR, first.actuators)
+        order = np.argsort(actuators)
+        self.equality_ids = _ids(m, obj.mjOBJ_EQUALITY, first.equalities)
+        proxies = [f"proxy/capsule{i}" for i in range(PROXY_CAPSULES)]
+        proxies += [f"proxy/cylinder{i}" for i in range(PROXY_CYLINDERS)]
+        self.proxy_geoms = _ids(m, obj.mjOBJ_GEOM, proxies)
+        self.proxy_mocap = m.body_mocapid[_ids(m, obj.mjOBJ_BODY, proxies)]
+        self.proxy_cylinder = m.geom_type[self.proxy_geoms] == mujoco.mjtGeom.mjGEOM_CYLINDER
+        self.root_qpos = int(m.jnt_qposadr[m.joint("root").id])
+        # store rows, one row of each per creature
+        self.body_rows = np.array([lay.body_rows for lay in layouts], dtype=np.int64)
+        motor_rows = np.array([lay.actuator_motor_rows for lay in layouts], dtype=np.int64)
+        axes = np.array([lay.actuator_axes for lay in layouts], dtype=np.int64)
+        self.actuator_motor_rows = motor_rows[:, order].reshape(n, -1)
+        self.actuator_target_index = (motor_rows * 3 + axes)[:, order].reshape(n, -1)
+        self.sucker_rows = np.array([lay.sucker_rows for lay in layouts], dtype=np.int64)
+        self.sucker_rows = self.sucker_rows.reshape(n, len(self.equality_ids))
+        self.members = np.zeros(n, dtype=np.int64)  # creature index (backend order) per row
+        # the state and its parts
+        self.slices = state_slices(m)
+        self.state = np.zeros((n, mujoco.mj_stateSize(m, STATE)))
+        # the overlay: what differs per creature in the model
+        self.kp = np.zeros((n, m.nu))
+        self.kv = np.zeros((n, m.nu))
+        self.torque = np.zeros((n, m.nu))
+        self.anchor = np.zeros((n, len(self.equality_ids), 3))
+        self.proxy_size = np.full((n, PROXIES, 2), 0.01)
+        self.near = np.zeros(n, dtype=bool)  # proxies placed (parked ones need no size)
+        self.applied: dict[int, np.ndarray] = {}  # row -> xfrc_applied, while a script pushes
+        # what the last step produced
+        self.xpos = np.zeros((n, len(self.body_ids), 3))
+        self.xquat = np.zeros((n, len(self.body_ids), 4))
+        self.warnings = np.zeros((n, WARNING_KINDS), dtype=np.int64)  # raised since checked
+        self.deepest = np.full(n, np.inf)  # deepest contact distance (m; < 0 penetrates)
+        self.errors: dict[int, str] = {}  # row -> MuJoCo's fatal error in the last step
+        self.scratch: dict[int, list[Scratch]] = {FULL: []}
+
+    def __len__(self) -> int:
+        return len(self.members)
+
+    # -- parts of the state --------------------------------------------------------
+    def part(self, flag: int, rows: slice | np.ndarray | int = slice(None)) -> np.ndarray:
+        """The `flag` part (an mjtState bit) of the state of `rows` (a view for slices/ints)."""
+        return self.state[rows, self.slices[int(flag)]]
+
+    @property
+    def qvel(self) -> np.ndarray:
+        return self.part(S.mjSTATE_QVEL)
+
+    @property
+    def ctrl(self) -> np.ndarray:
+        return self.part(S.mjSTATE_CTRL)
+
+    def grid(self, flag: int, width: int) -> np.ndarray:
+        """The `flag` part of every row as a (rows, items, width) view (mocap poses)."""
+        view = self.part(flag).view()
+        view.shape = (len(self), -1, width)  # raises rather than copy: writes must land
+        return view
+
+    # -- building ------------------------------------------------------------------
+    def prepare(self, tier: int, threads: int) -> None:
+        """Make `tier`'s model (compiled once) and a scratch for each of `threads`.
+
+        Call before the stepping threads run: they only read these.
+        """
+        if tier not in self.models:
+            if self._compile_reduced is None:
+                raise ValueError(f"batch {self.index} has no model for tier {tier}")
+            self.models[tier] = self._compile_reduced()
+        scratch = self.scratch.setdefault(tier, [])
+        while len(scratch) < threads:
+            model = copy.copy(self.models[tier])
+            scratch.append(Scratch(model, mujoco.MjData(model)))
+
+    def scratch_for(self, thread: int, tier: int = FULL) -> Scratch:
+        """Thread `thread`'s scratch model and data for `tier` (made on first use)."""
+        scratch = self.scratch.get(tier)
+        if scratch is None or len(scratch) <= thread:
+            self.prepare(tier, thread + 1)
+        return self.scratch[tier][thread]
+
+    def place(self, row: int, pos: np.ndarray, quat: np.ndarray) -> None:
+        """Row `row`: the mantle at `pos` / `quat`, every joint at rest, proxies parked."""
+        scratch = self.scratch_for(0)
+        m, d = scratch.model, scratch.data
+        mujoco.mj_resetData(m, d)
+        d.qpos[self.root_qpos : self.root_qpos + 3] = pos
+        d.qpos[self.root_qpos + 3 : self.root_qpos + 7] = quat
+        d.mocap_pos[self.proxy_mocap] = PROXY_PARK + np.outer(
+            np.arange(PROXIES) * 10.0, [1.0, 0.0, 0.0]
+        )
+        mujoco.mj_forward(m, d)
+        mujoco.mj_getState(m, d, self.state[row], STATE)
+        self.xpos[row] = d.xpos[self.body_ids]
+        self.xquat[row] = d.xquat[self.body_ids]
+
+    def standalone(self, row: int) -> tuple[mujoco.MjModel, mujoco.MjData]:
+        """A new model and data of row `row` alone, as its next step would see them.
+
+        For inspection (servo forces, contacts, a viewer): forward kinematics and
+        forces are computed; writing them changes nothing in the batch.
+        """
+        m = copy.copy(self.model)
+        d = mujoco.MjData(m)
+        _write_overlay(self, m, row)
+        if row in self.applied:
+            d.xfrc_applied[:] = self.applied[row]
+        mujoco.mj_setState(m, d, self.state[row], STATE)
+        mujoco.mj_forward(m, d)
+        return m, d
+
+    def forward(self, row: int) -> None:
+        """Recompute row `row`'s body poses from its state (after a restore)."""
+        scratch = self.scratch_for(0)
+        m, d = scratch.model, scratch.data
+        mujoco.mj_setState(m, d, self.state[row], STATE)
+        mujoco.mj_forward(m, d)
+        self.xpos[row] = d.xpos[self.body_ids]
+        self.xquat[row] = d.xquat[self.body_ids]
+
+    # -- per frame -----------------------------------------------------------------
+    def sync(self, transforms: TransformStore) -> None:
+        """Every row's body poses into the Transform store (one scatter per field)."""
+        transforms.pos[self.body_rows] = self.xpos
+        transforms.quat[self.body_rows] = self.xquat
+
+    def step_rows(self, rows: np.ndarray, substeps: int, thread: int, tier: int = FULL) -> None:
+        """Advance `rows` by `substeps` steps each of `tier`'s model, on `thread`'s scratch."""
+        scratch = self.scratch_for(thread, tier)
+        m, d = scratch.model, scratch.data
+        state, body_ids = self.state, self.body_ids
+        for row in rows.tolist():
+            _write_overlay(self, m, row)
+            pushed = self.applied.get(row)
+            if pushed is not None:
+                d.xfrc_applied[:] = pushed
+                scratch.forced = True
+            elif scratch.forced:
+                d.xfrc_applied[:] = 0.0
+                scratch.forced = False
+            mujoco.mj_setState(m, d, state[row], STATE)
+            d.warning.number[:] = 0
+            try:
+                mujoco.mj_step(m, d, nstep=substeps)
+            except mujoco.FatalError as exc:
+                self.errors[row] = str(exc).splitlines()[0]
+                mujoco.mj_resetData(m, d)
+                continue
+            mujoco.mj_getState(m, d, state[row], STATE)
+            self.xpos[row] = d.xpos[body_ids]
+            self.xquat[row] = d.xquat[body_ids]
+            self.warnings[row] += d.warning.number
+            self.deepest[row] = d.contact.dist.min() if d.ncon else np.inf
+
+
+def _write_overlay(batch: Batch, m: mujoco.MjModel, row: int) -> None:
+    """Row `row`'s servo gains, torque limits, sucker anchors and proxy sizes into `m`."""
+    kp, torque = batch.kp[row], batch.torque[row]
+    m.actuator_gainprm[:, 0] = kp
+    m.actuator_biasprm[:, 1] = -kp
+    m.actuator_biasprm[:, 2] = -batch.kv[row]
+    m.actuator_forcerange[:, 0] = -torque
+    m.actuator_forcerange[:, 1] = torque
+    if len(batch.equality_ids):
+        m.eq_data[batch.equality_ids, 3:6] = batch.anchor[row]
+    if batch.near[row]:
+        _size_proxies(m, batch.proxy_geoms, batch.proxy_cylinder, batch.proxy_size[row])
+
+
+def _size_proxies(
+    m: mujoco.MjModel, geoms: np.ndarray, cylinder: np.ndarray, size: np.ndarray
+) -> None:
+    """Proxy geoms sized `size` (radius, half length) with matching bounds."""
+    radius, half = size[:, 0], size[:, 1]
+    m.geom_size[geoms, :2] = size
+    m.geom_rbound[geoms] = np.where(cylinder, np.hypot(radius, half), radius + half)
+    aabb = np.zeros((len(geoms), 6))
+    aabb[:, 3:5] = radius[:, None]
+    aabb[:, 5] = np.where(cylinder, half, half + radius)
+    m.geom_aabb[geoms] = aabb

@@ -1,0 +1,84 @@
+"""Which thread steps which creatures: balanced contiguous shares of every batch's rows.
+
+`plan` splits the active rows of all batches into at most `threads` chunks of about
+equal cost (degrees of freedom), each a list of `Segment`s (a batch and some of its
+rows). Chunk k runs on the pool's k-th task with scratch k of each batch, so two
+threads never share a scratch MjData; which thread steps a row never changes its
+result (`ecs_tentacles.physics.batch`).
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from ecs_tentacles.physics.batch import STATE, Batch
+from ecs_tentacles.physics.tiers import FULL, REDUCED
+
+
+@dataclass(frozen=True)
+class Segment:
+    """Some rows of one batch, stepped at one tier."""
+
+    batch: Batch
+    rows: np.ndarray
+    tier: int = FULL
+
+
+def plan(
+    batches: list[Batch], active: np.ndarray, tier: np.ndarray, threads: int
+) -> list[list[Segment]]:
+    """Active rows (by creature index) of the stepped tiers in at most `threads` chunks of
+    about equal cost; every tier's model and scratch data are made first."""
+    pieces = []
+    for level, share in ((FULL, 1.0), (REDUCED, 0.5)):
+        for batch in batches:
+            rows = np.flatnonzero(active[batch.members] & (tier[batch.members] == level))
+            if len(rows):
+                batch.prepare(level, threads)
+                cost = np.full(len(rows), share * (batch.model.nv + 1.0))
+                pieces.append((batch, rows, cost, level))
+    if not pieces:
+        return []
+    cost = np.cumsum(np.concatenate([c for _, _, c, _ in pieces]))
+    cuts = np.searchsorted(cost, cost[-1] * np.arange(1, threads) / threads)
+    bounds = [0, *cuts.tolist(), len(cost)]
+    starts = np.cumsum([0] + [len(r) for _, r, _, _ in pieces])
+    chunks: list[list[Segment]] = []
+    for a, b in itertools.pairwise(bounds):
+        if b <= a:
+            continue
+        chunk = []
+        for (batch, rows, _, level), lo, hi in zip(pieces, starts[:-1], starts[1:], strict=True):
+            s, e = max(a, lo), min(b, hi)
+            if e > s:
+                chunk.append(Segment(batch, rows[s - lo : e - lo], level))
+        chunks.append(chunk)
+    return chunks
+
+
+def step_segments(chunk: list[Segment], substeps: dict[int, int], thread: int) -> None:
+    """Step every segment of `chunk` by its tier's `substeps` on scratch `thread` (runs on
+    a pool thread)."""
+    for segment in chunk:
+        n = substeps[segment.tier]
+        if n:
+            segment.batch.step_rows(segment.rows, n, thread, segment.tier)
+
+
+def bare_step(
+    chunk: list[Segment], states: list[np.ndarray], substeps: dict[int, int], thread: int
+) -> None:
+    """MuJoCo alone: set each row of `states`, step it, get it back (benchmarks)."""
+    for segment in chunk:
+        batch = segment.batch
+        scratch = batch.scratch_for(thread, segment.tier)
+        m, d, rows = scratch.model, scratch.data, states[batch.index]
+        n = substeps[segment.tier]
+        for row in segment.rows.tolist():
+            mujoco.mj_setState(m, d, rows[row], STATE)
+            mujoco.mj_step(m, d, nstep=n)
+            mujoco.mj_getState(m, d, rows[row], STATE)
