@@ -196,7 +196,7 @@ class Batch:
         """
         m = copy.copy(self.model)
         d = mujoco.MjData(m)
-        _write_overlay(self, m, row)
+        write_overlay(self, m, row)
         if row in self.applied:
             d.xfrc_applied[:] = self.applied[row]
         mujoco.mj_setState(m, d, self.state[row], STATE)
@@ -224,7 +224,7 @@ class Batch:
         m, d = scratch.model, scratch.data
         state, body_ids = self.state, self.body_ids
         for row in rows.tolist():
-            _write_overlay(self, m, row)
+            write_overlay(self, m, row)
             pushed = self.applied.get(row)
             if pushed is not None:
                 d.xfrc_applied[:] = pushed
@@ -247,7 +247,7 @@ class Batch:
             self.deepest[row] = d.contact.dist.min() if d.ncon else np.inf
 
 
-def _write_overlay(batch: Batch, m: mujoco.MjModel, row: int) -> None:
+def write_overlay(batch: Batch, m: mujoco.MjModel, row: int) -> None:
     """Row `row`'s servo gains, torque limits, sucker anchors and proxy sizes into `m`."""
     kp, torque = batch.kp[row], batch.torque[row]
     m.actuator_gainprm[:, 0] = kp

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from ecs_tentacles.physics.batch import STATE, Batch
+from ecs_tentacles.physics.batch import STATE, Batch, write_overlay
 from ecs_tentacles.physics.tiers import FULL, REDUCED
 
 
@@ -72,13 +72,15 @@ def step_segments(chunk: list[Segment], substeps: dict[int, int], thread: int) -
 def bare_step(
     chunk: list[Segment], states: list[np.ndarray], substeps: dict[int, int], thread: int
 ) -> None:
-    """MuJoCo alone: set each row of `states`, step it, get it back (benchmarks)."""
+    """MuJoCo alone: each row's model values, set its state, step it, get it back
+    (benchmarks)."""
     for segment in chunk:
         batch = segment.batch
         scratch = batch.scratch_for(thread, segment.tier)
         m, d, rows = scratch.model, scratch.data, states[batch.index]
         n = substeps[segment.tier]
         for row in segment.rows.tolist():
+            write_overlay(batch, m, row)
             mujoco.mj_setState(m, d, rows[row], STATE)
             mujoco.mj_step(m, d, nstep=n)
             mujoco.mj_getState(m, d, rows[row], STATE)
