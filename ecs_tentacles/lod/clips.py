@@ -84,11 +84,21 @@ class GaitClips:
     store_lag: float  # m: how far the Transform store lagged the recorded qpos (info)
 
     def __post_init__(self) -> None:
-        clips = (self.idle, self.crawl)
-        self._pos = np.concatenate([c.pos for c in clips])
-        self._quat = np.concatenate([c.quat for c in clips])
+        # Both clips stacked: row offset[kind] + frame holds that frame's pose (position,
+        # then rotation) and its change to the next frame of its loop (the rotation's
+        # sign chosen the shorter way round), so a fractional phase is one fused lerp.
+        pose, change = [], []
+        for clip in (self.idle, self.crawl):
+            here = np.concatenate([clip.pos, clip.quat], axis=-1)
+            after = np.roll(here, -1, axis=0)
+            flip = np.sum(here[..., 3:] * after[..., 3:], axis=-1) < 0.0
+            after[..., 3:][flip] *= -1.0
+            pose.append(here)
+            change.append(after - here)
+        self._pose = np.concatenate(pose)
+        self._change = np.concatenate(change)
         self._offset = np.array([0, self.idle.frames], dtype=np.int64)
-        self._frames = np.array([c.frames for c in clips], dtype=np.int64)
+        self._frames = np.array([self.idle.frames, self.crawl.frames], dtype=np.int64)
 
     @classmethod
     def record(
@@ -144,21 +154,19 @@ class GaitClips:
         frame's origin and `heading` (K,) its yaw (radians).
         """
         kind = np.asarray(kind, dtype=np.int64)
-        frames = self._frames[kind]
         phase = np.asarray(phase, dtype=np.float64)
+        frames = self._frames[kind]
         if interpolate:
             below = np.floor(phase)
-            t = phase - below
-            first = np.mod(below.astype(np.int64), frames)
-            second = np.mod(first + 1, frames)
-            a, b = self._offset[kind] + first, self._offset[kind] + second
-            pos = self._pos[a]
-            pos += (self._pos[b] - pos) * t[:, None, None]
-            quat = nlerp(self._quat[a], self._quat[b], t[:, None])
+            row = self._offset[kind] + np.mod(below.astype(np.int64), frames)
+            pose = self._pose[row]
+            pose += self._change[row] * (phase - below)[:, None, None]
+            quat = pose[..., 3:]
+            quat /= np.sqrt(np.einsum("kbi,kbi->kb", quat, quat))[..., None]
         else:
-            index = self._offset[kind] + np.mod(np.rint(phase).astype(np.int64), frames)
-            pos, quat = self._pos[index], self._quat[index]
-        _place(pos, quat, np.asarray(xy), np.asarray(heading, dtype=np.float64), out_pos, out_quat)
+            pose = self._pose[self._offset[kind] + np.mod(np.rint(phase).astype(np.int64), frames)]
+        xy = np.asarray(xy, dtype=np.float64)
+        _place(pose, xy, np.asarray(heading, dtype=np.float64), out_pos, out_quat)
 
     def joint_state_at(
         self, kind: int, phase: float, xy: np.ndarray, heading: float
@@ -185,27 +193,30 @@ class GaitClips:
 
 
 def _place(
-    pos: np.ndarray,
-    quat: np.ndarray,
-    xy: np.ndarray,
-    heading: np.ndarray,
-    out_pos: np.ndarray,
-    out_quat: np.ndarray,
+    pose: np.ndarray, xy: np.ndarray, heading: np.ndarray, out_pos: np.ndarray, out_quat: np.ndarray
 ) -> None:
-    """Ground-frame poses (K, B, ...) into the world at `xy` (K, 2) / `heading` (K,)."""
+    """Ground-frame poses (K, B, 7) into the world at `xy` (K, 2) / `heading` (K,)."""
     c = np.cos(heading)[:, None]
     s = np.sin(heading)[:, None]
-    x, y = pos[..., 0], pos[..., 1]
-    out_pos[..., 0] = c * x - s * y + xy[:, 0:1]
-    out_pos[..., 1] = s * x + c * y + xy[:, 1:2]
-    out_pos[..., 2] = pos[..., 2]
+    x, y = pose[..., 0], pose[..., 1]
+    np.multiply(c, x, out=out_pos[..., 0])
+    out_pos[..., 0] -= s * y
+    out_pos[..., 0] += xy[:, 0:1]
+    np.multiply(s, x, out=out_pos[..., 1])
+    out_pos[..., 1] += c * y
+    out_pos[..., 1] += xy[:, 1:2]
+    out_pos[..., 2] = pose[..., 2]
     hc = np.cos(0.5 * heading)[:, None]
     hs = np.sin(0.5 * heading)[:, None]
-    w, qx, qy, qz = quat[..., 0], quat[..., 1], quat[..., 2], quat[..., 3]
-    out_quat[..., 0] = hc * w - hs * qz
-    out_quat[..., 1] = hc * qx - hs * qy
-    out_quat[..., 2] = hc * qy + hs * qx
-    out_quat[..., 3] = hc * qz + hs * w
+    w, qx, qy, qz = pose[..., 3], pose[..., 4], pose[..., 5], pose[..., 6]
+    np.multiply(hc, w, out=out_quat[..., 0])
+    out_quat[..., 0] -= hs * qz
+    np.multiply(hc, qx, out=out_quat[..., 1])
+    out_quat[..., 1] -= hs * qy
+    np.multiply(hc, qy, out=out_quat[..., 2])
+    out_quat[..., 2] += hs * qx
+    np.multiply(hc, qz, out=out_quat[..., 3])
+    out_quat[..., 3] += hs * w
 
 
 def cut_loop(rec: Recording, kind: str, loop: tuple[float, float], *, close: bool = True) -> Clip:
