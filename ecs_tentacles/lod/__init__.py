@@ -1,0 +1,13 @@
+"""Level of detail for crowds: cheaper stand-ins for creatures far from the action.
+
+`clips` (gait clips: one morphology's crawl and idle loops recorded with the full
+physics, replayed for many creatures at once with no dynamics, and the joint state that
+promotes a replayed creature back to the full physics without a jump), `record` (the
+one-creature recording world), `frames` (ground-frame math), `cache` (clips shared by
+morphology). Imports the core and the physics; never the renderer or the CLI.
+"""
+
+from ecs_tentacles.lod.cache import ClipCache, morphology_key
+from ecs_tentacles.lod.clips import CRAWL, IDLE, Clip, GaitClips
+
+__all__ = ["CRAWL", "IDLE", "Clip", "ClipCache", "GaitClips", "morphology_key"]

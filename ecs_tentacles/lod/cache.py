@@ -1,0 +1,86 @@
+"""Gait clips shared by morphology: every creature whose physics model is the same
+(`model_layout(...).key`) replays one recording.
+
+    cache = ClipCache()
+    clips = cache.for_creature(world, entity)        # a creature of a built world
+    clips = cache.get(scene["creatures"][3], scene["physics"])   # a scene entry
+    cache.seconds                                    # recording cost per key
+
+Reads scene creature entries (from the world's `scene` for `for_creature`); records
+with `GaitClips.record` on a miss; keeps the clips and their cost.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from ecs_tentacles.build import build_creature
+from ecs_tentacles.components import Creature, Transform
+from ecs_tentacles.lod.clips import GaitClips
+from ecs_tentacles.physics.model import model_layout
+from ecs_tentacles.settings import Settings
+from ecs_tentacles.world import World
+
+
+class ClipCache:
+    """Clips by morphology key; `record_options` go to `GaitClips.record`."""
+
+    def __init__(self, **record_options: Any):
+        self.record_options = record_options
+        self.clips: dict[tuple[Any, ...], GaitClips] = {}
+
+    @property
+    def seconds(self) -> dict[tuple[Any, ...], float]:
+        """Wall-clock seconds each morphology's recording took."""
+        return {key: clips.seconds for key, clips in self.clips.items()}
+
+    def __len__(self) -> int:
+        return len(self.clips)
+
+    def get(self, creature: dict[str, Any], physics: dict[str, Any] | None = None) -> GaitClips:
+        """The clips of the morphology of `creature` (a scene creature entry, defaults
+        filled in as `load_scene` leaves them), recorded on first use."""
+        key = morphology_key(creature, physics)
+        return self._get(key, creature, physics)
+
+    def for_creature(self, world: World, entity: int) -> GaitClips:
+        """The clips of creature `entity` of `world` (built from a scene: its entry is
+        found by name in `world.scene`)."""
+        creature = world.component(entity, Creature)
+        key = model_layout(world, creature, world.component(entity, Transform)).key
+        if key in self.clips:
+            return self.clips[key]
+        if world.scene is None:
+            raise ValueError(f"creature {creature.name!r}: the world has no scene to record from")
+        entries = [c for c in world.scene["creatures"] if c.get("name") == creature.name]
+        if len(entries) != 1:
+            raise ValueError(
+                f"creature {creature.name!r}: {len(entries)} scene creatures have that name"
+            )
+        return self._get(key, entries[0], world.scene.get("physics"))
+
+    def _get(
+        self, key: tuple[Any, ...], creature: dict[str, Any], physics: dict[str, Any] | None
+    ) -> GaitClips:
+        clips = self.clips.get(key)
+        if clips is None:
+            clips = GaitClips.record(creature, physics, **self.record_options)
+            if clips.key != key:
+                raise RuntimeError(f"creature {creature.get('name')!r}: recorded another key")
+            self.clips[key] = clips
+        return clips
+
+
+def morphology_key(
+    creature: dict[str, Any], physics: dict[str, Any] | None = None
+) -> tuple[Any, ...]:
+    """The physics morphology key of a scene creature entry, compiling nothing."""
+    settings = Settings.from_physics(physics) if physics is not None else Settings()
+    world = World(settings, name="clip-key")
+    try:
+        entity = build_creature(world, creature)
+        return model_layout(
+            world, world.component(entity, Creature), world.component(entity, Transform)
+        ).key
+    finally:
+        world.close()

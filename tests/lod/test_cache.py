@@ -1,0 +1,46 @@
+"""Clip cache: one recording per morphology, whatever the creature's place or heading."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+from ecs_tentacles.lod.cache import ClipCache, morphology_key
+from ecs_tentacles.scene.load import load_scene
+from ecs_tentacles.world import World
+
+SMALL = {"count": 4, "links": 5}
+QUICK = {"warmup": 1.0, "seconds": 2.5, "loop": (0.5, 2.0)}  # short recordings for tests
+
+
+def _scene() -> dict[str, Any]:
+    """Two creatures of one small morphology (placed and turned apart) and one other."""
+    creatures = [
+        {"name": "a", "position": [0, 0], "tentacles": SMALL, "goals": [{"position": [0, 2]}]},
+        {"name": "b", "position": [4, 0], "heading_deg": 90, "tentacles": SMALL},
+        {"name": "c", "position": [8, 0], "tentacles": {"count": 5, "links": 5}},
+    ]
+    return {"version": 1, "creatures": creatures}
+
+
+def test_one_recording_per_morphology(make_world: Callable[..., World]) -> None:
+    world = make_world(_scene())
+    cache = ClipCache(**QUICK)
+    a, b, c = (cache.for_creature(world, world.creature(n)) for n in "abc")
+    assert a is b and a is not c
+    assert len(cache) == 2
+    for key, seconds in cache.seconds.items():
+        print(f"\nrecording {len(cache.clips[key].bodies)} bodies: {seconds:.2f} s")
+        assert seconds > 0
+    assert a.crawl.speed > 0 and c.crawl.speed > 0
+
+
+def test_scene_entries_find_the_same_clips(make_world: Callable[..., World]) -> None:
+    scene = load_scene(_scene())
+    world = make_world(scene)
+    cache = ClipCache(**QUICK)
+    first = cache.get(scene["creatures"][0], scene["physics"])
+    assert cache.get(scene["creatures"][1], scene["physics"]) is first
+    assert cache.for_creature(world, world.creature("b")) is first
+    assert morphology_key(scene["creatures"][2], scene["physics"]) != first.key
+    assert len(cache) == 1
