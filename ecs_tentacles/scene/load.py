@@ -30,7 +30,8 @@ from ecs_tentacles.scene.validate import plugin_config, validate_scene, with_def
 if TYPE_CHECKING:
     from ecs_tentacles.plugin import Plugin
 
-MAX_SCENE_BYTES = 8 * 1024**2  # bundled scenes are a few kB; 1024 goals x 64 creatures fit
+# bundled scenes are a few kB; `crowd 16384` (the most creatures a scene holds) writes 14 MB
+MAX_SCENE_BYTES = 16 * 1024**2
 _SCENE_NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.-]*$")
 
 
