@@ -177,6 +177,13 @@ def _creature(rng: np.random.Generator, name: str, plan: dict[str, Any]) -> dict
     return creature
 
 
+def _plan_reach(plan: dict[str, Any]) -> float:
+    """`creature_reach` of every creature of `plan`: their own overrides keep its shape."""
+    overrides = [{"index": k, **shape} for k, shape in plan["shape_overrides"].items()]
+    tentacles = {**plan["tentacles"], "overrides": overrides}
+    return creature_reach({"mantle": plan["mantle"], "tentacles": tentacles})
+
+
 def grid_shape(n: int) -> tuple[int, int]:
     """(columns, rows) of the squarest grid that holds `n` creatures."""
     columns = math.ceil(math.sqrt(n))
@@ -212,7 +219,7 @@ def crowd_scene(
     plan_of = rng.permutation(np.arange(n) % species)
     width = len(str(n - 1))
     creatures = [_creature(rng, f"c{i:0{width}d}", plans[p]) for i, p in enumerate(plan_of)]
-    largest = max(creature_reach(c) for c in creatures)
+    largest = max(_plan_reach(plans[p]) for p in sorted(set(plan_of.tolist())))
     least = 2.0 * largest
     if spacing is None:
         spacing = least + CLEARANCE
