@@ -10,7 +10,7 @@ built afterwards, from these entities (`ecs_tentacles.physics.model`).
 from __future__ import annotations
 
 import hashlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
@@ -64,8 +64,8 @@ def build_creature(world: Host, spec: dict[str, Any]) -> int:
         tentacle = Tentacle(creature=creature_entity, index=k, base_angle=float(angle))
         tentacle_entity = world.create_entity(tentacle)
         creature.tentacles.append(tentacle_entity)
-        _build_links(world, tentacle, tentacle_entity, layout, k)
-        _add_tentacle_row(world, tentacle, creature.row, layout, k)
+        rows = _build_links(world, tentacle, tentacle_entity, layout, k)
+        _add_tentacle_row(world, tentacle, creature.row, layout, k, rows)
     return creature_entity
 
 
@@ -75,27 +75,32 @@ def _add_tentacle_row(
     creature_row: int,
     layout: CreatureLayout,
     k: int,
+    rows: LinkRows,
 ) -> None:
     params, shape = layout.params[k], layout.shapes[k]
-    links = [world.component(e, Link) for e in tentacle.links]
-    motors = [world.component(e, Motor) for e in tentacle.links]
-    sucker = world.component(tentacle.suckers[-1], Sucker)
     tentacle.row = int(
         world.tentacles.add(
             creature_row=creature_row,
             base_angle=tentacle.base_angle,
-            first_link=motors[0].row,
-            links=len(links),
-            base_row=world.component(tentacle.links[0], Transform).row,
-            tip_sucker=sucker.row,
+            first_link=rows.motors[0],
+            links=len(rows.motors),
+            base_row=rows.transforms[0],
+            tip_sucker=rows.suckers[-1],
             length=shape.length,
             rest_pitch=shape.rest_pitch,
         )[0]
     )
     apply_parameters(world, "tentacles", params, {"tentacles": tentacle.row})
-    world.motors.tentacle_row[[m.row for m in motors]] = tentacle.row
-    sucker_rows = [world.component(e, Sucker).row for e in tentacle.suckers]
-    world.suckers.tentacle_row[sucker_rows] = tentacle.row
+    world.motors.tentacle_row[rows.motors] = tentacle.row
+    world.suckers.tentacle_row[rows.suckers] = tentacle.row
+
+
+class LinkRows(NamedTuple):
+    """The store rows of one tentacle's links (transforms, motors) and suckers, in order."""
+
+    transforms: list[int]
+    motors: list[int]
+    suckers: list[int]
 
 
 def _build_links(
@@ -104,7 +109,7 @@ def _build_links(
     tentacle_entity: int,
     layout: CreatureLayout,
     k: int,
-) -> None:
+) -> LinkRows:
     params, shape = layout.params[k], layout.shapes[k]
     mantle_radius = layout.mantle_radius
     quat = quat_about_z(layout.heading + tentacle.base_angle)
@@ -118,20 +123,13 @@ def _build_links(
     )
     apply_parameters(world, "tentacles", params, {"motors": motor_rows})  # tapered by `scale`
     limit = float(parameter("tentacles", "joint_limit_deg").from_scene(params["joint_limit_deg"]))
-    for i in range(n):
-        link = Link(
-            tentacle=tentacle_entity,
-            index=i,
-            length=float(shape.lengths[i]),
-            radius=float(shape.radii[i]),
-            scale=float(shape.scales[i]),
-            density=params["density"],
-            joint_limit=limit,
-            twist=params["twist"],
-        )
-        entity = world.create_entity(
-            link, Transform(world.transforms, int(rows[i])), Motor(world.motors, int(motor_rows[i]))
-        )
+    density, twist = params["density"], params["twist"]
+    lengths, radii, scales = shape.lengths.tolist(), shape.radii.tolist(), shape.scales.tolist()
+    transforms, motors = world.transforms, world.motors
+    found = LinkRows(rows.tolist(), motor_rows.tolist(), [])
+    for i, (row, motor_row) in enumerate(zip(found.transforms, found.motors, strict=True)):
+        link = Link(tentacle_entity, i, lengths[i], radii[i], scales[i], density, limit, twist)
+        entity = world.create_entity(link, Transform(transforms, row), Motor(motors, motor_row))
         tentacle.links.append(entity)
     carriers = range(n) if params["suckers"] == "every_link" else [n - 1]
     for i in carriers:
@@ -140,3 +138,5 @@ def _build_links(
         entity = world.create_entity(Sucker(world.suckers, sucker_row, tentacle.links[i]))
         world.suckers.entity[sucker_row] = entity
         tentacle.suckers.append(entity)
+        found.suckers.append(sucker_row)
+    return found

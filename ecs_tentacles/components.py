@@ -36,7 +36,7 @@ class RowField:
         getattr(component.store, self.name)[component.row] = value
 
 
-@dataclass(eq=False)
+@dataclass(eq=False, slots=True)
 class RowComponent:
     """Base of components whose numeric fields (`RowField`s) live in one store row."""
 
@@ -51,7 +51,7 @@ class RowComponent:
         return f"{type(self).__name__}(row={self.row}, {shown})"
 
 
-@dataclass(eq=False, repr=False)
+@dataclass(eq=False, repr=False, slots=True)
 class Transform(RowComponent):
     """World pose of a body: `pos` (3,) metres, `quat` (4,) unit quaternion (w, x, y, z)."""
 
@@ -60,7 +60,7 @@ class Transform(RowComponent):
     quat = RowField()
 
 
-@dataclass(eq=False, repr=False)
+@dataclass(eq=False, repr=False, slots=True)
 class Motor(RowComponent):
     """A link's servo: `target` (curl, sweep, twist) radians, `strength` kp, `damping` kv."""
 
@@ -71,7 +71,7 @@ class Motor(RowComponent):
     max_torque = RowField()
 
 
-@dataclass(eq=False, repr=False)
+@dataclass(eq=False, repr=False, slots=True)
 class Sucker(RowComponent):
     """A sucker under a link: `offset` in the link frame, `attached`, world `anchor`."""
 
@@ -83,7 +83,7 @@ class Sucker(RowComponent):
     anchor = RowField()
 
 
-@dataclass(eq=False)
+@dataclass(eq=False, slots=True)
 class Creature:
     """A creature: its mantle (a cylinder along +z) and its tentacles, counter-clockwise."""
 
@@ -95,7 +95,7 @@ class Creature:
     tentacles: list[int] = field(default_factory=list)
 
 
-@dataclass(eq=False)
+@dataclass(eq=False, slots=True)
 class Tentacle:
     """Tentacle `index` of `creature`; its axis is +x rotated by `base_angle` about +z."""
 
@@ -107,7 +107,7 @@ class Tentacle:
     suckers: list[int] = field(default_factory=list)
 
 
-@dataclass(eq=False)
+@dataclass(eq=False, slots=True)
 class Link:
     """Link `index` of `tentacle`: a capsule along its local +x, `scale` of the first link."""
 

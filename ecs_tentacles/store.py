@@ -40,6 +40,8 @@ class Field:
 class ArrayStore:
     """Rows of numbers for one kind of entity; subclasses declare `Field`s."""
 
+    _declared_fields: tuple[Field, ...]  # `fields()`, set on each class at its first call
+
     def __init__(self, capacity: int = 16):
         self.count = 0
         self._arrays: dict[str, np.ndarray] = {
@@ -48,13 +50,17 @@ class ArrayStore:
 
     @classmethod
     def fields(cls) -> list[Field]:
-        """The declared fields, in declaration order."""
-        found: dict[str, Field] = {}
-        for klass in reversed(cls.__mro__):
-            for name, value in vars(klass).items():
-                if isinstance(value, Field):
-                    found[name] = value
-        return list(found.values())
+        """The declared fields, in declaration order (looked up once per class)."""
+        known: tuple[Field, ...] | None = cls.__dict__.get("_declared_fields")
+        if known is None:
+            found: dict[str, Field] = {}
+            for klass in reversed(cls.__mro__):
+                for name, value in vars(klass).items():
+                    if isinstance(value, Field):
+                        found[name] = value
+            known = tuple(found.values())
+            cls._declared_fields = known  # on this class only: a subclass finds its own
+        return list(known)
 
     @property
     def capacity(self) -> int:
@@ -68,11 +74,11 @@ class ArrayStore:
         if unknown:
             raise KeyError(f"{type(self).__name__} has no field(s) {sorted(unknown)}")
         self._reserve(self.count + n)
-        rows = np.arange(self.count, self.count + n)
+        start, stop = self.count, self.count + n
         for field in self.fields():
-            self._arrays[field.name][rows] = values.get(field.name, field.default)
-        self.count += n
-        return rows
+            self._arrays[field.name][start:stop] = values.get(field.name, field.default)
+        self.count = stop
+        return np.arange(start, stop)
 
     def _reserve(self, needed: int) -> None:
         capacity = self.capacity
@@ -84,6 +90,17 @@ class ArrayStore:
             grown = np.empty((capacity, *array.shape[1:]), dtype=array.dtype)
             grown[: self.count] = array[: self.count]
             self._arrays[name] = grown
+
+    def fit(self) -> None:
+        """Free the spare room growth left: every array keeps just the live rows.
+
+        Loading a scene calls it once every creature is built (rows added by doubling
+        leave up to half of each array unused); the next `add` grows again.
+        """
+        if self.capacity == self.count:
+            return
+        for name, array in self._arrays.items():
+            self._arrays[name] = array[: self.count].copy()
 
     def __len__(self) -> int:
         return self.count

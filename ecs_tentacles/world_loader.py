@@ -8,7 +8,8 @@ imports it back.
 Order: the scene is validated and its plugins imported (user code only with
 `allow_systems`); the world is made from the scene's `physics` settings; each plugin's
 resources and stores join it; every creature's body is built, then each plugin's
-`build_creature` and `build_scene` hooks run; the physics is compiled; the core
+`build_creature` and `build_scene` hooks run; every store is cut to its rows
+(`ArrayStore.fit`); the physics is compiled; the core
 systems and every plugin's systems are scheduled and set up. If a plugin's
 `systems()` or a system's `setup()` raises, the half-built world is closed (its
 physics threads and esper context) before the error goes on.
@@ -93,6 +94,8 @@ def load_world(
                 plugin.build_creature(world, entity, creature)
     for plugin in chosen:
         plugin.build_scene(world, data)
+    for store in world.stores.values():
+        store.fit()  # a crowd's stores were grown by doubling: up to half unused
     world.build_physics(threads)
     try:
         systems = physics_systems()

@@ -56,3 +56,17 @@ def test_whole_array_math_on_live_rows() -> None:
     store.strength *= 1.5
     assert_array_equal(store.strength, [3.0, 3.0, 3.0])
     assert len(store.strength) == 3
+
+
+def test_fit_frees_the_spare_room_and_keeps_rows_and_components() -> None:
+    store = TransformStore(capacity=1)
+    store.add(100, pos=[1.0, 2.0, 3.0])
+    transform = Transform(store, 99)
+    assert store.capacity == 128
+    store.fit()
+    assert store.capacity == len(store) == 100
+    assert_array_equal(store.pos, [[1, 2, 3]] * 100)
+    transform.pos[0] = 5.0
+    assert store.pos[99, 0] == 5.0
+    assert_array_equal(store.add(1), [100])  # grows again
+    assert len(store) == 101 and store.pos[99, 0] == 5.0

@@ -48,6 +48,15 @@ def test_goals_become_entities_in_path_order(make_world: Callable[..., World]) -
     assert {g.owner for _, g in world.query(Goal)} == {world.creature("octo")}
 
 
+def test_a_built_world_keeps_no_spare_store_rows(make_world: Callable[..., World]) -> None:
+    """Stores grow by doubling while creatures are built; loading cuts them to their rows."""
+    world = make_world(creature_scene(count=5, links=3))
+    for name, store in world.stores.items():
+        assert store.capacity == len(store), name
+    world.step(2)  # the systems run on the cut stores
+    assert len(world.transforms) == 1 + 5 * 3
+
+
 def test_unknown_creature_name_lists_the_known_ones(make_world: Callable[..., World]) -> None:
     world = make_world(creature_scene(count=3, links=2))
     with pytest.raises(KeyError, match="no creature named 'squid'; this world has: octo"):

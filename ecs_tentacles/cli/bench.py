@@ -14,7 +14,7 @@ import json
 from typing import Any
 
 from ecs_tentacles.bench import BLOCK, WARMUP, bench
-from ecs_tentacles.cli.crowd import add_crowd_options, crowd_from_args
+from ecs_tentacles.cli.crowd import add_crowd_options, crowd_from_args, crowd_size
 from ecs_tentacles.cli.run import positive_int, seed_int
 from ecs_tentacles.scene.load import resolve_scene_path
 
@@ -32,7 +32,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     source.add_argument("scene", nargs="?", metavar="SCENE", help="scene file or bundled name")
     source.add_argument(
         "--crowd",
-        type=positive_int,
+        type=crowd_size,
         metavar="N",
         help="bench a crowd of N creatures (as `ecs-tentacles crowd N` writes)",
     )

@@ -14,8 +14,23 @@ from typing import Any
 from ecs_tentacles.cli.arguments import output_path
 from ecs_tentacles.cli.bake import positive_float
 from ecs_tentacles.cli.run import positive_int, seed_int
-from ecs_tentacles.creator.crowd import DEFAULT_SPECIES, crowd_scene, write_crowd_scene
+from ecs_tentacles.creator.crowd import (
+    DEFAULT_SPECIES,
+    crowd_scene,
+    max_creatures,
+    write_crowd_scene,
+)
 from ecs_tentacles.scene.errors import SceneError
+
+
+def crowd_size(text: str) -> int:
+    """argparse type: a number of creatures, 1 to the most a scene holds."""
+    value = positive_int(text)
+    if value > max_creatures():
+        raise argparse.ArgumentTypeError(
+            f"must be <= {max_creatures()} (the most creatures a scene holds), got {value}"
+        )
+    return value
 
 
 def fraction(text: str) -> float:
@@ -76,7 +91,9 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
             " on a jittered grid, each crawling to the far side of the crowd's centre."
         ),
     )
-    parser.add_argument("n", type=positive_int, metavar="N", help="number of creatures (>= 1)")
+    parser.add_argument(
+        "n", type=crowd_size, metavar="N", help=f"number of creatures (1 to {max_creatures()})"
+    )
     parser.add_argument(
         "--out", type=output_path(".json"), required=True, help="scene file to write (.json)"
     )

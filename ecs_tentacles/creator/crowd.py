@@ -45,6 +45,7 @@ from ecs_tentacles.atomic import atomic_output
 from ecs_tentacles.construction import tentacle_params, tentacle_shape
 from ecs_tentacles.creator.limits import default
 from ecs_tentacles.scene.load import load_scene
+from ecs_tentacles.scene.schema import core_schema
 
 DEFAULT_SPECIES = 8
 CLEARANCE = 0.4  # metres between the reach circles of two neighbours, before jitter
@@ -54,6 +55,11 @@ FUR_PRESETS = ("hedgehog", "cat", "bird")
 GROOM_COUNT = (16, 48)  # guides per furry creature: a look, not a hero groom
 # The octopus defaults' size (8 x 10 links of 0.07 m, radius 0.025): strength 25, torque 20.
 REFERENCE_WEIGHT_LENGTH = 0.025**2 * 0.7**2
+
+
+def max_creatures() -> int:
+    """The most creatures a scene holds (the schema's `creatures.maxItems`)."""
+    return int(core_schema()["properties"]["creatures"]["maxItems"])
 
 
 def _r(value: float) -> float:
@@ -171,6 +177,13 @@ def _creature(rng: np.random.Generator, name: str, plan: dict[str, Any]) -> dict
     return creature
 
 
+def _plan_reach(plan: dict[str, Any]) -> float:
+    """`creature_reach` of every creature of `plan`: their own overrides keep its shape."""
+    overrides = [{"index": k, **shape} for k, shape in plan["shape_overrides"].items()]
+    tentacles = {**plan["tentacles"], "overrides": overrides}
+    return creature_reach({"mantle": plan["mantle"], "tentacles": tentacles})
+
+
 def grid_shape(n: int) -> tuple[int, int]:
     """(columns, rows) of the squarest grid that holds `n` creatures."""
     columns = math.ceil(math.sqrt(n))
@@ -188,11 +201,14 @@ def crowd_scene(
 ) -> dict[str, Any]:
     """A scene dict of `n` varied creatures crossing the crowd (see the module docstring).
 
-    Raises ValueError naming the argument when `n < 1`, `idle` is outside [0, 1],
+    Raises ValueError naming the argument when `n` is outside [1, `max_creatures()`],
+    `idle` is outside [0, 1],
     `species < 1`, or `spacing` is too small for the creatures' reach.
     """
     if n < 1:
         raise ValueError(f"N: must be >= 1, got {n}")
+    if n > max_creatures():
+        raise ValueError(f"N: must be <= {max_creatures()}, the most a scene holds, got {n}")
     if not 0.0 <= idle <= 1.0:
         raise ValueError(f"idle: must be in [0, 1], got {idle}")
     if species < 1:
@@ -203,7 +219,7 @@ def crowd_scene(
     plan_of = rng.permutation(np.arange(n) % species)
     width = len(str(n - 1))
     creatures = [_creature(rng, f"c{i:0{width}d}", plans[p]) for i, p in enumerate(plan_of)]
-    largest = max(creature_reach(c) for c in creatures)
+    largest = max(_plan_reach(plans[p]) for p in sorted(set(plan_of.tolist())))
     least = 2.0 * largest
     if spacing is None:
         spacing = least + CLEARANCE

@@ -117,20 +117,53 @@ class FurData:
         self.sets = FurSetStore()
         self.emotions = EmotionStore()
         self.points = 0  # points per guide; set by the first fur built
-        self.shape = np.zeros((0, 0, 3))  # per guide: points in rest-frame (axis, up, side)
-        self.curves = np.zeros((0, 0, 3), dtype=np.float32)
-        self.frames = np.zeros((0, 4, 3), dtype=np.float32)
+        self._shape = np.zeros((0, 0, 3))
+        self._curves = np.zeros((0, 0, 3), dtype=np.float32)
+        self._frames = np.zeros((0, 4, 3), dtype=np.float32)
+        self._added: list[tuple[int, np.ndarray]] = []  # (guides then, shapes) not yet joined
         self.version = 0
         self.tracks: list[Channel] = []  # control attributes (columns: COLUMNS)
 
+    @property
+    def shape(self) -> np.ndarray:
+        """Per guide: its points in its rest frame (axis, up, side); (n_guides, points, 3)."""
+        self._join()
+        return self._shape
+
+    @property
+    def curves(self) -> np.ndarray:
+        self._join()
+        return self._curves
+
+    @property
+    def frames(self) -> np.ndarray:
+        self._join()
+        return self._frames
+
     def add_shapes(self, shapes: np.ndarray) -> None:
-        """Append rest shapes (k, points, 3) for guides just added; grow the buffers."""
-        n = len(self.guides)
-        kept = self.shape[: n - len(shapes)].reshape(n - len(shapes), self.points, 3)
-        self.shape = np.concatenate([kept, shapes])
-        self.curves = np.zeros((n, self.points, 3), dtype=np.float32)
-        self.frames = np.zeros((n, 4, 3), dtype=np.float32)
+        """Append rest shapes (k, points, 3) for guides just added; grow the buffers.
+
+        The arrays are joined (and the output buffers made anew, zeroed) when next read,
+        so a crowd whose creatures each add a few guides copies them once, not once each.
+        """
+        self._added.append((len(self.guides), shapes))
         self.version += 1
+
+    def _join(self) -> None:
+        if not self._added:
+            return
+        parts, rows = [self._shape], len(self._shape)
+        for n, shapes in self._added:
+            keep = n - len(shapes)  # the guides before these (all of them, when built in turn)
+            if keep != rows or len(parts) == 1:
+                joined = np.concatenate(parts) if len(parts) > 1 else parts[0]
+                parts = [joined[:keep].reshape(keep, self.points, 3)]
+            parts.append(shapes)
+            rows = n
+        self._added.clear()
+        self._shape = np.concatenate(parts)
+        self._curves = np.zeros((rows, self.points, 3), dtype=np.float32)
+        self._frames = np.zeros((rows, 4, 3), dtype=np.float32)
 
     def touch(self) -> None:
         """Mark the bind pose as changed (after writing guide arrays directly)."""

@@ -25,12 +25,13 @@ from typing import TYPE_CHECKING, Any
 from ecs_tentacles.plugin_registry import PluginError, resolve
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.physical import physically_checked
-from ecs_tentacles.scene.validate import plugin_config, validate_scene, with_defaults
+from ecs_tentacles.scene.validate import plugin_config, validated
 
 if TYPE_CHECKING:
     from ecs_tentacles.plugin import Plugin
 
-MAX_SCENE_BYTES = 8 * 1024**2  # bundled scenes are a few kB; 1024 goals x 64 creatures fit
+# bundled scenes are a few kB; `crowd 16384` (the most creatures a scene holds) writes 14 MB
+MAX_SCENE_BYTES = 16 * 1024**2
 _SCENE_NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.-]*$")
 
 
@@ -137,11 +138,11 @@ def load_scene_plugins(
         )
     except PluginError as exc:
         raise SceneError([prefix + line for line in str(exc).splitlines()]) from None
-    problems = validate_scene(data, plugins)
+    problems, completed = validated(data, plugins)
     if problems:
         raise SceneError([prefix + problem for problem in problems])
-    assert isinstance(data, dict)  # the schema requires an object
-    full = physically_checked(with_defaults(data, plugins), prefix)
+    assert isinstance(data, dict) and completed is not None  # the schema requires an object
+    full = physically_checked(completed, prefix)
     for plugin in plugins:
         config = plugin_config(plugin, (data.get("plugins") or {}).get(plugin.key))
         plugin.config = {k: v for k, v in config.items() if k != "from"}

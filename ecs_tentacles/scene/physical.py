@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import logging
 import math
-from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -82,14 +81,22 @@ def physical_problems(scene: dict[str, Any]) -> list[str]:
     """
     physics = scene["physics"]
     problems: list[tuple[Path, str]] = _timestep_problems(physics) + _gravity_problems(physics)
-    layouts = [creature_layout(creature) for creature in scene["creatures"]]
-    for i, (creature, layout) in enumerate(zip(scene["creatures"], layouts, strict=True)):
+    bodies: list[Bodies] = []  # each creature's capsules; its layout is dropped (crowds)
+    for i, creature in enumerate(scene["creatures"]):
+        layout = creature_layout(creature)
+        weights = [  # (links, 2) masses and inertias per tentacle, for both checks below
+            capsule_mass_inertia(shape.lengths, shape.radii, params["density"])
+            for params, shape in zip(layout.params, layout.shapes, strict=True)
+        ]
         # a body too light says enough; its proportions would be refused too
-        problems += _light_bodies(i, creature, layout) or _proportion_problems(i, creature, layout)
+        problems += _light_bodies(i, creature, layout, weights) or _proportion_problems(
+            i, creature, layout, weights
+        )
         problems += _servo_problems(i, creature, layout, _step(physics))
         problems += _below_ground(i, layout)
+        bodies.append(Bodies(*layout.capsules()))
     if not problems:
-        problems += _overlap_problems(scene, layouts)
+        problems += _overlap_problems(scene, bodies)
     return [f"{format_path(path)}: {message}" for path, message in problems]
 
 
@@ -141,7 +148,7 @@ def _tentacle_path(index: int, tentacles: dict[str, Any], k: int) -> Path:
 
 
 def _light_bodies(
-    index: int, creature: dict[str, Any], layout: CreatureLayout
+    index: int, creature: dict[str, Any], layout: CreatureLayout, weights: list[np.ndarray]
 ) -> list[tuple[Path, str]]:
     problems: list[tuple[Path, str]] = []
     mantle = creature["mantle"]
@@ -163,10 +170,9 @@ def _light_bodies(
             )
         )
     seen: set[Path] = set()
-    for k, (params, shape) in enumerate(zip(layout.params, layout.shapes, strict=True)):
+    for k, (shape, tentacle) in enumerate(zip(layout.shapes, weights, strict=True)):
         path = _tentacle_path(index, creature["tentacles"], k)
-        weights = capsule_mass_inertia(shape.lengths, shape.radii, params["density"])
-        light = (weights[:, 0] < MIN_MASS) | (weights[:, 1] < MIN_INERTIA)
+        light = (tentacle[:, 0] < MIN_MASS) | (tentacle[:, 1] < MIN_INERTIA)
         short = shape.lengths < MIN_LENGTH
         if path in seen or not (light.any() or short.any()):
             continue
@@ -179,14 +185,14 @@ def _light_bodies(
             advice = "raise link_length or end_scale"
         else:
             link = int(np.flatnonzero(light)[0])
-            why = f"is too light to simulate ({_weights(*weights[link])})"
+            why = f"is too light to simulate ({_weights(*tentacle[link])})"
             advice = "raise link_radius, end_scale or density"
         problems.append((path, f"link {link} of tentacle {k} {why}; {advice}"))
     return problems
 
 
 def _proportion_problems(
-    index: int, creature: dict[str, Any], layout: CreatureLayout
+    index: int, creature: dict[str, Any], layout: CreatureLayout, weights: list[np.ndarray]
 ) -> list[tuple[Path, str]]:
     problems: list[tuple[Path, str]] = []
     for k, params in enumerate(layout.params):
@@ -203,10 +209,7 @@ def _proportion_problems(
             break
     mantle = creature["mantle"]
     mantle_mass, _ = cylinder_mass_inertia(mantle["radius"], mantle["height"], mantle["density"])
-    tentacles = sum(
-        float(capsule_mass_inertia(shape.lengths, shape.radii, params["density"])[:, 0].sum())
-        for params, shape in zip(layout.params, layout.shapes, strict=True)
-    )
+    tentacles = sum(float(tentacle[:, 0].sum()) for tentacle in weights)
     ratio = mantle_mass / tentacles
     if not 1.0 / MAX_MASS_RATIO <= ratio <= MAX_MASS_RATIO:
         problems.append(
@@ -272,10 +275,7 @@ def _millimetres(metres: float) -> str:
     return f"{mm:.0f} mm" if mm >= 1 else f"{mm:.2g} mm"
 
 
-def _overlap_problems(
-    scene: dict[str, Any], layouts: Sequence[CreatureLayout]
-) -> list[tuple[Path, str]]:
-    bodies = [Bodies(*layout.capsules()) for layout in layouts]
+def _overlap_problems(scene: dict[str, Any], bodies: list[Bodies]) -> list[tuple[Path, str]]:
     if not scene["physics"]["separate_overlaps"]:
         advice = "move it or set physics.separate_overlaps"
         return [_overlap_line(overlap, advice) for overlap in find_overlaps(bodies)]

@@ -223,6 +223,17 @@ def validate_scene(data: object, plugins: Sequence[Plugin] | None = None) -> lis
     indices, unique names) are checked only once the schema passes; overlapping bodies
     are a physical problem (`ecs_tentacles.scene.physical`), checked when loading.
     """
+    return validated(data, plugins)[0]
+
+
+def validated(
+    data: object, plugins: Sequence[Plugin] | None = None
+) -> tuple[list[str], dict[str, Any] | None]:
+    """`validate_scene`'s problems, and `with_defaults(data)` when there are none.
+
+    The loader uses the scene completed here instead of completing it a second time
+    (a crowd of 10,000 creatures took 1.4 s each time).
+    """
     if plugins is None:
         from ecs_tentacles.plugin_registry import resolve
 
@@ -230,13 +241,14 @@ def validate_scene(data: object, plugins: Sequence[Plugin] | None = None) -> lis
     schema = schema_for(plugins)
     too_long = _limit_problems(data, schema, schema)  # iterative, stops at long arrays
     if too_long:  # checked first: validating a million goals would take minutes
-        return [f"{format_path(path)}: {message}" for path, message in too_long]
+        return [f"{format_path(path)}: {message}" for path, message in too_long], None
     deep = _too_deep(data)
     if deep is not None:  # before anything recursive (jsonschema, deepcopy, json.dumps)
-        return [f"{format_path(deep)}: nested deeper than {MAX_DEPTH} levels"]
+        return [f"{format_path(deep)}: nested deeper than {MAX_DEPTH} levels"], None
     problems = _schema_problems(data, _validator(schema))
     if isinstance(data, dict):
         problems += _plugin_configs(data, plugins)
+    full = None
     if not problems and isinstance(data, dict):
         full = with_defaults(data, plugins)
         problems = _semantic_problems(full)
@@ -244,7 +256,8 @@ def validate_scene(data: object, plugins: Sequence[Plugin] | None = None) -> lis
             problems += plugin.problems(full)
     problems = _name_plugins_that_are_off(problems, {p.name for p in plugins})
     unique = sorted(set(problems), key=_path_key)
-    return [f"{format_path(path)}: {message}" for path, message in unique]
+    lines = [f"{format_path(path)}: {message}" for path, message in unique]
+    return lines, None if lines else full
 
 
 def _place(path: JsonPath) -> str | None:

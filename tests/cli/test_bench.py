@@ -42,6 +42,7 @@ def test_human_summary_of_a_scene_file(capsys: pytest.CaptureFixture[str]) -> No
     [
         (["--crowd", "2", "--threads", "0"], "argument --threads: must be >= 1, got 0"),
         (["--crowd", "0"], "argument --crowd: must be >= 1, got 0"),
+        (["--crowd", "16385"], "argument --crowd: must be <= 16384 (the most creatures a scene"),
         (["octopus", "--crowd", "2"], "argument --crowd: not allowed with argument SCENE"),
         ([], "one of the arguments SCENE --crowd is required"),
     ],

@@ -146,13 +146,13 @@ def test_the_scene_size_cap_has_an_override(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     scene = tmp_path / "padded.json"
-    scene.write_text(json.dumps({"version": 1, "creatures": [{}]}) + " " * (9 << 20))
+    scene.write_text(json.dumps({"version": 1, "creatures": [{}]}) + " " * (17 << 20))
     assert main(["validate", str(scene)]) == 2
     assert capsys.readouterr().err == (
-        f"error: {scene}: cannot read scene: larger than 8 MB (raise the limit with"
+        f"error: {scene}: cannot read scene: larger than 16 MB (raise the limit with"
         " --max-scene-mb)\n"
     )
-    assert main(["--max-scene-mb", "10", "validate", str(scene)]) == 0
+    assert main(["--max-scene-mb", "18", "validate", str(scene)]) == 0
 
 
 def test_every_reporting_command_has_json(

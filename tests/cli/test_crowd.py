@@ -54,6 +54,7 @@ def test_too_small_spacing_is_one_line_and_writes_nothing(
     ("argv", "message"),
     [
         (["crowd", "0", "--out", "x.json"], "argument N: must be >= 1, got 0"),
+        (["crowd", "20000", "--out", "x.json"], "argument N: must be <= 16384 (the most creatures"),
         (["crowd", "many", "--out", "x.json"], "argument N: must be a whole number, got 'many'"),
         (["crowd", "3", "--out", "x.txt"], "argument --out: must end in .json, got 'x.txt'"),
         (["crowd", "3", "--out", "x.json", "--idle", "2"], "argument --idle: must be in [0, 1]"),

@@ -129,6 +129,7 @@ def test_one_creature_gets_a_goal_away_from_itself() -> None:
     ("kwargs", "message"),
     [
         ({"n": 0}, "N: must be >= 1, got 0"),
+        ({"n": 16385}, "N: must be <= 16384, the most a scene holds, got 16385"),
         ({"n": 4, "idle": 1.5}, "idle: must be in [0, 1], got 1.5"),
         ({"n": 4, "species": 0}, "species: must be >= 1, got 0"),
         ({"n": 4, "spacing": 0.5}, "spacing: must be >= "),

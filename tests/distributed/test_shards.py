@@ -69,7 +69,7 @@ def test_declared_shards_are_used_as_they_are() -> None:
         ([["c0", "c1"], ["c0"]], ['shards[1][0]: "c0" is already in shards[0][0]']),
         ([["c0"], ["c1", "c9"]], ['shards[1][1]: no creature named "c9"']),
         ([["c0"]], ['shards: creature "c1" is in no shard']),
-        ([], ["shards: must have 1 to 4096 items, got 0"]),
+        ([], ["shards: must have 1 to 16384 items, got 0"]),
     ],
 )
 def test_bad_shards_get_one_line_each_with_the_json_path(

@@ -7,7 +7,7 @@ from collections.abc import Callable
 import numpy as np
 
 from ecs_tentacles.fur import FurControl
-from ecs_tentacles.fur.stores import BEHAVIOURS, COLUMNS, ControlStore
+from ecs_tentacles.fur.stores import BEHAVIOURS, COLUMNS, ControlStore, FurData
 from ecs_tentacles.world import World
 
 
@@ -34,3 +34,20 @@ def test_a_scene_keys_every_attribute_and_each_lands_on_its_control_value(
     (made,) = [c for _, c in world.query(FurControl)]
     np.testing.assert_array_equal(made.position, [0.1, 0.05, 0.2])
     assert {name: float(getattr(made, name)) for name in BEHAVIOURS} == values
+
+
+def test_rest_shapes_added_creature_by_creature_are_joined_in_order() -> None:
+    fur = FurData()
+    fur.points = 4
+    batches = [np.full((k, 4, 3), float(i)) for i, k in enumerate([3, 1, 5])]
+    for batch in batches:
+        fur.guides.add(len(batch))
+        fur.add_shapes(batch)
+    np.testing.assert_array_equal(fur.shape, np.concatenate(batches))
+    assert fur.curves.shape == (9, 4, 3) and fur.frames.shape == (9, 4, 3)
+    fur.curves[0] = 1.0  # the rig's output stays until more guides are added
+    assert fur.curves[0, 0, 0] == 1.0
+    fur.guides.add(2)
+    fur.add_shapes(np.full((2, 4, 3), 7.0))
+    assert fur.shape.shape == (11, 4, 3) and fur.shape[-1, 0, 0] == 7.0
+    assert not fur.curves.any()  # made anew for the new guide count, as before

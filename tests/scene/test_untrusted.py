@@ -105,6 +105,13 @@ def test_a_million_goals_is_refused_in_well_under_a_second() -> None:
     assert time.perf_counter() - start < 5  # was more than 175 s
 
 
+def test_a_crowd_above_the_creature_limit_is_one_line_before_validating_creatures() -> None:
+    crowd = {"version": 1, "creatures": [{"name": "octo", "mantle": "big"}] * 16385}
+    assert validate_scene(crowd) == ["creatures: must have at most 16384 items, got 16385"]
+    crowd["creatures"] = crowd["creatures"][:10_000]  # 10,000 are allowed: the bad mantles tell
+    assert validate_scene(crowd)[0] == 'creatures[0].mantle: must be an object, got "big"'
+
+
 INTEGERS_AS_FLOATS = [
     ("seed", {"seed": 8.0}),
     ("creatures[0].tentacles.count", {"tentacles": {"count": 8.0}}),
