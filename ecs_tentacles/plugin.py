@@ -240,6 +240,12 @@ class Plugin:
         whole-array math (no per-creature loop); the array is only read."""
         return None
 
+    def travel_targets(self, world: Host) -> np.ndarray | None:
+        """Where creatures are heading: (CreatureStore rows, 2) x, y in metres, nan where
+        nowhere; None for no opinion. The level of detail moves kinematic creatures
+        toward these (`ecs_tentacles.lod.replay`). Whole-array math; only read."""
+        return None
+
     def __repr__(self) -> str:
         return f"<plugin {self.key}>"
 

@@ -37,6 +37,7 @@ BUILTIN = {
     "threats": "ecs_tentacles.threats.plugin:ThreatsPlugin",
     "record": "ecs_tentacles.record.plugin:RecordPlugin",
     "render": "ecs_tentacles.render.plugin:RenderPlugin",
+    "lod": "ecs_tentacles.lod.plugin:LodPlugin",
 }
 BUNDLED = {
     "wander": "ecs_tentacles.systems.examples.wander:WanderPlugin",
@@ -44,7 +45,7 @@ BUNDLED = {
     "follow_leader": "ecs_tentacles.systems.examples.follow_leader:FollowLeaderPlugin",
     "flock": "ecs_tentacles.systems.examples.flock:FlockPlugin",
 }
-DEFAULT_ON = ("locomotion", "suckers", "threats", "fur")  # in build order
+DEFAULT_ON = ("locomotion", "suckers", "threats", "fur", "lod")  # in build order
 FROM = "from"  # the config key naming where a plugin's code is
 
 

@@ -29,6 +29,32 @@ _DEFAULT = physics_defaults()
 
 
 @dataclass(frozen=True)
+class LodSettings:
+    """A scene's `physics.lod`: level-of-detail budgets (`ecs_tentacles.physics.lod`)."""
+
+    enabled: bool = bool(_DEFAULT["lod"]["enabled"])
+    full: int = int(_DEFAULT["lod"]["full"])
+    reduced: int = int(_DEFAULT["lod"]["reduced"])
+    hold_seconds: float = float(_DEFAULT["lod"]["hold_seconds"])
+    contact_margin: float = float(_DEFAULT["lod"]["contact_margin"])
+    focus: tuple[float, float, float] | None = None  # x, y, radius (m): always full inside
+
+    @classmethod
+    def from_json(cls, lod: Mapping[str, Any]) -> LodSettings:
+        defaults = cls()
+        return cls(
+            enabled=bool(lod.get("enabled", defaults.enabled)),
+            full=int(lod.get("full", defaults.full)),
+            reduced=int(lod.get("reduced", defaults.reduced)),
+            hold_seconds=float(lod.get("hold_seconds", defaults.hold_seconds)),
+            contact_margin=float(lod.get("contact_margin", defaults.contact_margin)),
+            focus=(*map(float, focus["center"]), float(focus["radius"]))  # type: ignore[arg-type]
+            if (focus := lod.get("focus"))
+            else None,
+        )
+
+
+@dataclass(frozen=True)
 class Settings:
     """The fixed-step clock and physics constants of a world (a scene's `physics`)."""
 
@@ -40,6 +66,7 @@ class Settings:
     max_speed: float = float(_DEFAULT["max_speed"])  # m/s: faster has blown up (physics/health.py)
     max_penetration: float = float(_DEFAULT["max_penetration"])  # m: deeper has blown up
     sleep: bool = bool(_DEFAULT["sleep"])  # still, idle creatures are not stepped (physics/sleep)
+    lod: LodSettings = LodSettings()  # level of detail (physics/lod)
 
     @classmethod
     def from_physics(cls, physics: Mapping[str, Any]) -> Settings:
@@ -53,6 +80,7 @@ class Settings:
             max_speed=float(physics["max_speed"]),
             max_penetration=float(physics["max_penetration"]),
             sleep=bool(physics["sleep"]),
+            lod=LodSettings.from_json(physics.get("lod", {})),
         )
 
     @property

@@ -37,6 +37,7 @@ from ecs_tentacles.store import (
 from ecs_tentacles.system import System, SystemFailure
 
 if TYPE_CHECKING:
+    from ecs_tentacles.physics.lod import LevelOfDetail
     from ecs_tentacles.snapshot import Snapshot
 
 __all__ = ["MissingResource", "Settings", "World"]  # Settings lives in ecs_tentacles.settings
@@ -90,6 +91,7 @@ class World:
         only: Collection[int] | None = None,
         plugins: Mapping[str, Any] | None = None,
         scene_dir: str | os.PathLike[str] | None = None,
+        lod: bool | None = None,
     ) -> World:
         """Build a world from a scene file, bundled scene name or dict.
 
@@ -105,7 +107,8 @@ class World:
         `threads` steps the physics groups on that many threads (default: one per
         core); results do not depend on it. `only` builds just the creatures at those
         scene indices (a shard of a distributed bake); `world.scene` is still the whole
-        scene.
+        scene. `lod=False` runs every creature at full physics whatever the scene's
+        `physics.lod` says (`True` turns level of detail on); None keeps the scene's.
         """
         from ecs_tentacles.world_loader import WorldClass, load_world
 
@@ -119,6 +122,7 @@ class World:
             only=only,
             plugins=plugins,
             scene_dir=scene_dir,
+            lod=lod,
         )
 
     def build_physics(self, threads: int | None = None) -> PhysicsBackend:
@@ -139,6 +143,11 @@ class World:
         if self._physics is None:
             raise RuntimeError("this world has no physics yet: call world.build_physics()")
         return self._physics
+
+    @property
+    def lod(self) -> LevelOfDetail:
+        """Level of detail (`ecs_tentacles.physics.lod`): `world.lod.promote(creature)`."""
+        return self.physics.lod
 
     def add_plugin(self, plugin: Plugin) -> Plugin:
         """Turn a plugin on in a built world: its resources, then its systems (set up).

@@ -21,6 +21,7 @@ import importlib
 import os
 import pathlib
 from collections.abc import Collection, Mapping
+from dataclasses import replace
 from typing import Any, Protocol, TypeVar
 
 from ecs_tentacles.build import build_creature
@@ -68,6 +69,7 @@ def load_world(
     only: Collection[int] | None = None,
     plugins: Mapping[str, Any] | None = None,
     scene_dir: str | os.PathLike[str] | None = None,
+    lod: bool | None = None,
 ) -> W:
     """A `cls` world built from a scene file, bundled scene name or dict (`World.from_scene`)."""
     folder = pathlib.Path(scene_dir) if scene_dir is not None else None
@@ -79,8 +81,11 @@ def load_world(
         source = {**raw, "plugins": {**(raw.get("plugins") or {}), **plugins}}
     data, chosen = load_scene_plugins(source, allow_systems=allow_systems, scene_dir=folder)
     chosen += _scene_systems(data["systems"], folder, allow_systems)
+    settings = Settings.from_physics(data["physics"])
+    if lod is not None:  # the caller's choice over the scene's
+        settings = replace(settings, lod=replace(settings.lod, enabled=lod))
     world = cls(
-        Settings.from_physics(data["physics"]),
+        settings,
         seed=data["seed"] if seed is None else seed,
         name=data.get("name", "scene"),
     )

@@ -105,8 +105,9 @@ def test_scene_systems_are_not_imported_unless_allowed(
         World.from_scene(scene)
     assert user_system_module not in sys.modules
     world = make_world(scene, allow_systems=True)
-    assert world.schedule.names[-7:] == [
+    assert world.schedule.names[-8:] == [
         "physics",
+        "lod_replay",  # after physics: kinematic creatures' poses
         "physics_sync",
         "physics_health",
         "counter",  # after physics_sync: the sync stage
@@ -146,7 +147,8 @@ def test_settings_defaults_are_the_schemas_physics_defaults() -> None:
     defaults = {key: spec["default"] for key, spec in physics.items() if key not in BUILD_ONLY}
     made = asdict(Settings())
     assert {f.name for f in fields(Settings)} == set(defaults)  # every runtime key, no other
-    assert made == {**defaults, "gravity": tuple(defaults["gravity"])}
+    lod = {**defaults["lod"], "focus": None}  # a focus region is set by a scene or a bake
+    assert made == {**defaults, "gravity": tuple(defaults["gravity"]), "lod": lod}
     assert Settings().ground_friction == 0.4  # was 1.0 by hand while the schema said 0.4
 
 
@@ -163,7 +165,7 @@ def test_locomotion_is_an_ordinary_plugin_switch(make_world: Callable[..., World
         creature_scene(count=3, links=2), plugins={"locomotion": False, "suckers": False}
     )
     assert not {"goals", "motor_targets", "suckers"} & set(off.schedule.names)
-    assert [p.key for p in off.plugins] == ["threats", "fur"]
+    assert [p.key for p in off.plugins] == ["threats", "fur", "lod"]
     scene = {**creature_scene(count=3, links=2)}
     scene["creatures"][0]["goals"] = [{"position": [1, 0]}]
     with pytest.raises(SceneError, match=r"creatures\[0\]\.goals: unknown key"):

@@ -50,7 +50,8 @@ class LocomotionPlugin(Plugin):
     description = "goal-directed crawling: goal paths, gait, action queues, motor targets"
     creature_schema = _FRAGMENT["creature"]
     tentacle_schema = _FRAGMENT["tentacles"]
-    hook_reads = ("locomotion.creatures.has_goal",)  # wants_motion
+    # wants_motion, travel_targets
+    hook_reads = ("locomotion.creatures.has_goal", "locomotion.creatures.goal")
     defs = _FRAGMENT["$defs"]
 
     def resources(self, world: Host) -> list[object]:
@@ -96,6 +97,11 @@ class LocomotionPlugin(Plugin):
     def wants_motion(self, world: Host) -> np.ndarray:
         """Creatures with a goal crawl: they never fall asleep."""
         return world.resource(LocomotionStores).creatures.has_goal
+
+    def travel_targets(self, world: Host) -> np.ndarray:
+        """Creatures crawl toward their current goal."""
+        creatures = world.resource(LocomotionStores).creatures
+        return np.where(creatures.has_goal[:, None], creatures.goal[:, :2], np.nan)
 
     def snapshot(self, world: Host) -> Any:
         goals = {

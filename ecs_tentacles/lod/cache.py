@@ -12,7 +12,7 @@ with `GaitClips.record` on a miss; keeps the clips and their cost.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ecs_tentacles.build import build_creature
 from ecs_tentacles.components import Creature, Transform
@@ -20,6 +20,9 @@ from ecs_tentacles.lod.clips import GaitClips
 from ecs_tentacles.physics.model import model_layout
 from ecs_tentacles.settings import Settings
 from ecs_tentacles.world import World
+
+if TYPE_CHECKING:
+    from ecs_tentacles.host import Host
 
 
 class ClipCache:
@@ -43,7 +46,7 @@ class ClipCache:
         key = morphology_key(creature, physics)
         return self._get(key, creature, physics)
 
-    def for_creature(self, world: World, entity: int) -> GaitClips:
+    def for_creature(self, world: Host, entity: int) -> GaitClips:
         """The clips of creature `entity` of `world` (built from a scene: its entry is
         found by name in `world.scene`)."""
         creature = world.component(entity, Creature)

@@ -31,6 +31,7 @@ import numpy as np
 from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.physics.batch import Batch
 from ecs_tentacles.physics.health import HealthCheck, HealthState
+from ecs_tentacles.physics.lod import LevelOfDetail
 from ecs_tentacles.physics.model import ModelLayout, build_spec, model_layout
 from ecs_tentacles.physics.proxies import ContactProxies
 from ecs_tentacles.physics.roster import Roster
@@ -68,6 +69,7 @@ class PhysicsState:
     sleeping: np.ndarray
     soften: np.ndarray
     tier: np.ndarray
+    lod: tuple[np.ndarray, ...]
     health: HealthState
     sleep: SleepState
 
@@ -118,6 +120,10 @@ class PhysicsBackend:
         self.health = HealthCheck(world, roster, self.proxies)
         self.sleep = Sleep(roster)
         self.sleep.enabled = world.settings.sleep
+        settings = world.settings
+        self.lod = LevelOfDetail(
+            roster, self.proxies, settings.lod, settings.fps, self.place_joints
+        )
         self._pool = ThreadPoolExecutor(self.threads) if self.threads > 1 else None
 
     def __len__(self) -> int:
@@ -135,6 +141,7 @@ class PhysicsBackend:
             sleeping=self.sleeping.copy(),
             soften=self.soften.copy(),
             tier=self.tier.copy(),
+            lod=self.lod.state(),
             health=self.health.state(),
             sleep=self.sleep.state(),
         )
@@ -155,6 +162,7 @@ class PhysicsBackend:
             batch.errors.clear()
         self.frozen[:], self.sleeping[:] = state.frozen, state.sleeping
         self.soften[:], self.tier[:] = state.soften, state.tier
+        self.lod.set_state(state.lod)
         self.health.set_state(state.health)
         self.sleep.set_state(state.sleep)
 

@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
+from scipy.spatial import cKDTree
 
 from ecs_tentacles.physics.model import PROXY_CAPSULES, PROXY_CYLINDERS, PROXY_PARK
 
@@ -30,6 +31,7 @@ S = mujoco.mjtState
 MARGIN = 0.05  # metres: a body this close to a neighbour's sphere gets a proxy
 POOL = np.array([PROXY_CAPSULES, PROXY_CYLINDERS])
 CAPSULE, CYLINDER = 0, 1
+DENSE_PAIRS = 256  # creatures up to which every pair is compared (no tree to build)
 PARK = PROXY_PARK + np.outer(np.arange(PROXY_CAPSULES + PROXY_CYLINDERS) * 10.0, [1.0, 0.0, 0.0])
 _NONE = np.zeros(0, dtype=np.int64)
 
@@ -95,12 +97,17 @@ class ContactProxies:
                 quat[index[rows]] = batch.xquat[rows]
         self._place(pos, quat)
 
-    def _place(self, pos: np.ndarray, quat: np.ndarray) -> None:
-        roster = self.roster
+    def spheres(self, pos: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Every creature's reach sphere (centre at its mantle, radius to its farthest
+        body's surface) from body positions `pos` in this class's order (`rows`)."""
         centre = pos[self.mantle]
         reach = np.linalg.norm(pos - centre[self.owner], axis=1) + self.rbound
-        radius = np.maximum.reduceat(reach, self.start)
-        a, b = _near_pairs(centre, radius)
+        return centre, np.maximum.reduceat(reach, self.start)
+
+    def _place(self, pos: np.ndarray, quat: np.ndarray) -> None:
+        roster = self.roster
+        centre, radius = self.spheres(pos)
+        a, b = near_pairs(centre, radius)
         who, body, slot = self._assign(a, b, pos, centre, radius) if len(a) else (_NONE,) * 3
         was_used = roster.proxies_used > 0
         roster.proxies_used[:] = np.bincount(who, minlength=len(roster))
@@ -156,18 +163,33 @@ class ContactProxies:
         return nearest - self.rbound[body]
 
 
-def _near_pairs(centre: np.ndarray, radius: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Ordered pairs (a, b), a != b, whose spheres come within MARGIN of each other."""
+def near_pairs(
+    centre: np.ndarray, radius: np.ndarray, margin: float = MARGIN
+) -> tuple[np.ndarray, np.ndarray]:
+    """Ordered pairs (a, b), a != b, whose spheres come within `margin` of each other,
+    sorted by a then b. Small crowds compare every pair; large ones ask a k-d tree for
+    the candidates (linear in creatures, not quadratic) and keep the same test."""
     n = len(centre)
+    if n > DENSE_PAIRS:
+        tree = cKDTree(centre)
+        i, j = tree.query_pairs(2.0 * float(radius.max()) + margin, output_type="ndarray").T
+        gap = np.linalg.norm(centre[i] - centre[j], axis=1) - (radius[i] + radius[j])
+        keep = gap < margin
+        a = np.concatenate((i[keep], j[keep]))
+        b = np.concatenate((j[keep], i[keep]))
+        order = np.lexsort((b, a))
+        return a[order].astype(np.int64), b[order].astype(np.int64)
     found_a, found_b = [], []
     block = max(1, 4_000_000 // max(n, 1))  # bound the (block, n) distance matrix
     for lo in range(0, n, block):
         hi = min(n, lo + block)
         gap = np.linalg.norm(centre[lo:hi, None, :] - centre[None, :, :], axis=2)
         gap -= radius[lo:hi, None] + radius[None, :]
-        near = gap < MARGIN
+        near = gap < margin
         near[np.arange(hi - lo), np.arange(lo, hi)] = False
         ia, ib = np.nonzero(near)
         found_a.append(ia + lo)
         found_b.append(ib)
+    if not found_a:
+        return _NONE, _NONE
     return np.concatenate(found_a), np.concatenate(found_b)

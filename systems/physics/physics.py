@@ -5,8 +5,9 @@ Reads: Motor store (target, strength, damping, max_torque, gain), Sucker store
 creatures the plugins want to move (`Plugin.wants_motion`). Writes, in every batch
 of the physics (`physics.batch`): each creature's state row (ctrl, sucker switches,
 contact proxies' poses) and overlay (servo gains, torque limits, sucker anchors, proxy
-sizes); puts still, idle creatures to sleep (`physics.sleep`) and wakes the others;
-then advances `world.settings.substeps` steps, the awake creatures on the stepping
+sizes); decides each creature's level of detail (`physics.lod`: promotions start
+from the shown pose); puts still, idle creatures to sleep (`physics.sleep`) and wakes
+the others; then advances `world.settings.substeps` steps, the awake creatures on the stepping
 threads. Systems that override `System.substep` run before every substep, in
 schedule order.
 """
@@ -47,6 +48,7 @@ class Physics(System):
         backend = world.physics
         backend.write_controls(world.motors)
         backend.write_suckers(world.suckers)
+        backend.lod.update(world)
         backend.proxies.update(world.transforms)
         backend.sleep.update(world, wanted_motion(world))
         hooks = world.schedule.substep_systems()

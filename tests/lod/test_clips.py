@@ -126,14 +126,10 @@ def _promote(world: World, qpos: np.ndarray, qvel: np.ndarray, bodies: list[str]
     """Set the creature's joint state in the full model and run forward kinematics; the
     bodies' world positions (B, 3)."""
     group = world.physics.groups[0]
-    model, data = group.model, group.data
-    data.qpos[:] = qpos
-    data.qvel[:] = qvel
-    mujoco.mj_forward(model, data)
-    group.sync(world.transforms)  # as a fresh build does: the health check sees no jump
-    world.physics.health.previous = world.transforms.pos.copy()
-    ids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, b) for b in bodies]
-    return np.array(data.xpos[ids])
+    world.physics.place_joints(group.index, qpos, qvel)  # as a promotion does
+    world.physics.sync(world.transforms)
+    ids = [mujoco.mj_name2id(group.model, mujoco.mjtObj.mjOBJ_BODY, b) for b in bodies]
+    return np.array(group.data.xpos[ids])
 
 
 @pytest.mark.parametrize("interpolate_phase", [False, True])

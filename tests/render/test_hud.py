@@ -116,9 +116,7 @@ def test_slider_click_reaches_the_servo_gains(make_sandbox: Callable[..., Any]) 
     group = world.physics.groups[0]
     actuator = group.model.actuator("t3/l00/curl").id
     row = int(world.tentacles.first_link[3])
-    assert group.kp[actuator] == pytest.approx(
-        kp * world.motors.gain[row], rel=1e-12
-    )
+    assert group.kp[actuator] == pytest.approx(kp * world.motors.gain[row], rel=1e-12)
     x0, y0, x1, y1 = sandbox.hud.gui.rects["gait cyclic"]
     click_gui(sandbox, (x0 + x1) / 2, (y0 + y1) / 2)
     assert world.resource(Locomotion).get(octo, 0)["gait"] == "cyclic"

@@ -82,6 +82,13 @@ def test_with_defaults_fills_nested_defaults_exactly() -> None:
             "max_speed": 12,
             "max_penetration": 0.05,
             "sleep": True,
+            "lod": {
+                "enabled": True,
+                "full": 32,
+                "reduced": 64,
+                "hold_seconds": 1.0,
+                "contact_margin": 0.3,
+            },
             "separate_overlaps": False,
         },
         "systems": [],
@@ -147,6 +154,13 @@ def test_with_defaults_keeps_given_values_and_names() -> None:
         "max_speed": 12,
         "max_penetration": 0.05,
         "sleep": True,
+        "lod": {
+            "enabled": True,
+            "full": 32,
+            "reduced": 64,
+            "hold_seconds": 1.0,
+            "contact_margin": 0.3,
+        },
         "separate_overlaps": False,
     }
 

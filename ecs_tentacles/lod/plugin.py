@@ -1,0 +1,38 @@
+"""The lod plugin: gait-clip replay for the KINEMATIC level of detail.
+
+The physics decides who runs at which tier (`ecs_tentacles.physics.lod`, `world.lod`);
+without this plugin nobody is ever kinematic (the cheapest tier is REDUCED). With it,
+the `lod_replay` system (stage physics, after the step) moves kinematic creatures with
+their morphology's gait clips (`ecs_tentacles.lod.replay`), toward where the plugins
+say they go (`Plugin.travel_targets`: the locomotion plugin's goals). Snapshots keep
+the replay's state.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+from ecs_tentacles.plugin import Plugin
+from ecs_tentacles.system import System
+
+if TYPE_CHECKING:
+    from ecs_tentacles.host import Host
+
+
+class LodPlugin(Plugin):
+    name = "lod"
+    description = "kinematic crowds: creatures far from the action replay gait clips"
+
+    def systems(self) -> list[System]:
+        from ecs_tentacles.systems.lod.lod_replay import LodReplay
+
+        return [LodReplay()]
+
+    def snapshot(self, world: Host) -> Any:
+        replay = world.physics.lod.replay
+        return None if replay is None else replay.state()  # type: ignore[attr-defined]
+
+    def restore(self, world: Host, state: Any) -> None:
+        replay = world.physics.lod.replay
+        if replay is not None and state is not None:
+            replay.set_state(state)  # type: ignore[attr-defined]

@@ -1,0 +1,149 @@
+"""Kinematic creatures moved by gait clips: the `Replay` the level of detail asks for poses.
+
+Per creature (roster order) it keeps a ground frame (`xy`, `heading`), a clip (`kind`:
+idle or crawl) and a `phase` in frames. Each frame (`advance`) every kinematic
+creature turns toward where the plugins say it is going (`Plugin.travel_targets`; at
+most `TURN_RATE`), moves along its heading at its morphology's crawl speed, steps its
+clip one frame on, and its body poses are written into its batch's pose rows, which
+`physics_sync` copies into the Transform store like any other. A creature that starts
+replaying (`start`) keeps where it stands and which way it faces; promoted again, it
+starts the physics from the joint state of the pose it was shown in (`joint_state`).
+
+Everything per frame is whole-array work per morphology; the clips are recorded once
+per morphology (`ClipCache`) the first time one of its creatures is kinematic.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ecs_tentacles.lod.cache import ClipCache
+from ecs_tentacles.lod.clips import CRAWL, IDLE, GaitClips, mantle_yaw
+from ecs_tentacles.physics.tiers import KINEMATIC
+
+if TYPE_CHECKING:
+    from ecs_tentacles.host import Host
+    from ecs_tentacles.physics.batch import Batch
+
+log = logging.getLogger("ecs_tentacles.lod")
+
+TURN_RATE = math.radians(60.0)  # rad/s a replayed creature turns toward its way
+ARRIVED = 0.05  # m: closer than this to its target, a replayed creature idles
+
+
+class ClipReplay:
+    """Gait-clip replay for every kinematic creature of one world."""
+
+    def __init__(self, world: Host, cache: ClipCache | None = None):
+        self.world = world
+        self.roster = roster = world.physics.roster
+        self.cache = cache if cache is not None else ClipCache()
+        count = len(roster)
+        self.xy = np.zeros((count, 2))
+        self.heading = np.zeros(count)
+        self.phase = np.zeros(count)
+        self.kind = np.full(count, IDLE, dtype=np.int64)
+        self.clips: dict[int, GaitClips] = {}  # batch index -> its morphology's clips
+
+    def clips_of(self, batch: Batch) -> GaitClips:
+        """The gait clips of `batch`'s morphology (recorded on first use)."""
+        clips = self.clips.get(batch.index)
+        if clips is None:
+            entity = int(self.roster.entity[batch.members[0]])
+            clips = self.cache.for_creature(self.world, entity)
+            log.info("gait clips for %s recorded in %.1f s", self.world.creature_name(entity),
+                     clips.seconds)  # fmt: skip
+            self.clips[batch.index] = clips
+        return clips
+
+    # -- the Replay protocol -----------------------------------------------------------
+    def start(self, indices: np.ndarray) -> None:
+        """Creatures `indices` replay from where they stand, facing where they face."""
+        roster = self.roster
+        targets = _targets(self.world, roster.creature_row[indices])
+        for batch in roster.batches:
+            here = roster.batch_of[indices] == batch.index
+            mine = indices[here]
+            if not len(mine):
+                continue
+            clips = self.clips_of(batch)
+            rows = roster.row_of[mine]
+            kind = np.where(np.isfinite(targets[here, 0]), CRAWL, IDLE)
+            mantle_pos, mantle_quat = batch.xpos[rows, 0], batch.xquat[rows, 0]
+            first = np.stack([clips.clip(k).pos[0, 0] for k in (IDLE, CRAWL)])
+            first_yaw = mantle_yaw(np.stack([clips.clip(k).quat[0, 0] for k in (IDLE, CRAWL)]))
+            heading = mantle_yaw(mantle_quat) - first_yaw[kind]
+            offset = first[kind][:, :2]
+            c, s = np.cos(heading), np.sin(heading)
+            self.xy[mine, 0] = mantle_pos[:, 0] - (c * offset[:, 0] - s * offset[:, 1])
+            self.xy[mine, 1] = mantle_pos[:, 1] - (s * offset[:, 0] + c * offset[:, 1])
+            self.heading[mine] = heading
+            self.kind[mine] = kind
+            self.phase[mine] = 0.0
+
+    def joint_state(self, index: int) -> tuple[np.ndarray, np.ndarray]:
+        """qpos and qvel of the pose creature `index` is shown in."""
+        batch, _ = self.roster.locate(index)
+        clips = self.clips[batch.index]
+        return clips.joint_state_at(
+            int(self.kind[index]), float(self.phase[index]), self.xy[index], self.heading[index]
+        )
+
+    # -- per frame -----------------------------------------------------------------------
+    def advance(self, world: Host, dt: float) -> None:
+        """Every kinematic creature one frame on its way; its poses into its batch rows."""
+        roster = self.roster
+        moving = np.flatnonzero(roster.tier == KINEMATIC)
+        if not len(moving):
+            return
+        targets = _targets(world, roster.creature_row[moving])
+        way = targets - self.xy[moving]
+        distance = np.hypot(way[:, 0], way[:, 1])
+        crawl = np.isfinite(distance) & (distance > ARRIVED)
+        wanted = np.arctan2(way[:, 1], way[:, 0])
+        turn = np.angle(np.exp(1j * (wanted - self.heading[moving])))
+        limit = TURN_RATE * dt
+        heading = self.heading[moving] + np.where(crawl, np.clip(turn, -limit, limit), 0.0)
+        self.heading[moving] = heading
+        self.kind[moving] = np.where(crawl, CRAWL, IDLE)
+        for batch in roster.batches:
+            here = roster.batch_of[moving] == batch.index
+            mine = moving[here]
+            if not len(mine):
+                continue
+            clips = self.clips_of(batch)
+            speed = np.where(crawl[here], clips.crawl.speed, 0.0)
+            step = speed * dt
+            self.xy[mine, 0] += step * np.cos(heading[here])
+            self.xy[mine, 1] += step * np.sin(heading[here])
+            self.phase[mine] += dt / clips.crawl.dt
+            rows = roster.row_of[mine]
+            pos = np.empty((len(mine), len(batch.body_ids), 3))
+            quat = np.empty((len(mine), len(batch.body_ids), 4))
+            clips.evaluate(self.kind[mine], self.phase[mine], self.xy[mine],
+                           self.heading[mine], pos, quat)  # fmt: skip
+            batch.xpos[rows] = pos
+            batch.xquat[rows] = quat
+
+    # -- snapshots -------------------------------------------------------------------------
+    def state(self) -> tuple[np.ndarray, ...]:
+        return self.xy.copy(), self.heading.copy(), self.phase.copy(), self.kind.copy()
+
+    def set_state(self, state: tuple[np.ndarray, ...]) -> None:
+        self.xy[:], self.heading[:], self.phase[:], self.kind[:] = state
+
+
+def _targets(world: Host, creature_rows: np.ndarray) -> np.ndarray:
+    """(len(creature_rows), 2) where the plugins say each creature goes; nan: nowhere."""
+    found = np.full((len(creature_rows), 2), np.nan)
+    for plugin in world.plugins:
+        answer = plugin.travel_targets(world)
+        if answer is not None:
+            mine = answer[creature_rows]
+            fill = np.isnan(found[:, 0]) & np.isfinite(mine[:, 0])
+            found[fill] = mine[fill]
+    return found

@@ -1,0 +1,188 @@
+"""Level of detail: which creature runs at which tier (`physics.tiers`), decided each frame.
+
+    world.lod.promote(creature)           # full physics until released
+    world.lod.release(creature)
+    world.lod.focus((2.0, -1.0), 3.0)     # creatures within 3 m of (2, -1) run full
+    world.lod.counts()                    # {"full": 32, "reduced": 64, "kinematic": 928}
+
+Reads: every creature's reach sphere (the contact proxies' geometry over the Transform
+store), who is asleep or frozen, the scene's `physics.lod` budgets, and what scripts,
+the sandbox or a bake asked for (`promote`, `select`, `focus`). Writes: the roster's
+`tier`; a creature leaving KINEMATIC starts from the joint state of the pose it was
+shown in (`Replay.joint_state`, then `PhysicsBackend.place_joints`: no pop); a
+creature entering KINEMATIC is handed to the replay (`Replay.start`).
+
+The rules, whole-array work every frame before the step:
+
+1. Lod off: everyone is FULL, always (`--lod off`, `lod=False`).
+2. Must be FULL: creatures whose reach spheres come within `contact_margin` of another
+   creature's (promoted before they touch), forced ones (`promote`, `select`), and
+   those inside the focus region.
+3. The other awake creatures are ranked: nearest the focus first (without one, all
+   equal), then the tier they hold (hysteresis), then creature order, so a bake's
+   decisions depend on nothing but the scene. The first `full` run FULL, the next
+   `reduced` REDUCED, the rest KINEMATIC (REDUCED while no replay is registered).
+4. Asleep creatures keep their tier and use no budget.
+5. Demotion waits until a creature has held its tier `hold_seconds`; promotion never
+   waits.
+
+A crowd within the full budget therefore runs exactly as with lod off.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable
+from typing import TYPE_CHECKING, Protocol
+
+import numpy as np
+
+from ecs_tentacles.physics.proxies import ContactProxies, near_pairs
+from ecs_tentacles.physics.tiers import FULL, KINEMATIC, NAMES, REDUCED
+
+if TYPE_CHECKING:
+    from ecs_tentacles.physics.host import PhysicsHost
+    from ecs_tentacles.physics.roster import Roster
+    from ecs_tentacles.settings import LodSettings
+
+
+class Replay(Protocol):
+    """What moves KINEMATIC creatures (registered by the `lod` plugin: gait clips)."""
+
+    def start(self, indices: np.ndarray) -> None:
+        """Creatures `indices` (roster order) leave the physics: replay from where they are."""
+
+    def joint_state(self, index: int) -> tuple[np.ndarray, np.ndarray]:
+        """The MuJoCo qpos and qvel of the pose creature `index` is shown in now."""
+        ...
+
+
+class LevelOfDetail:
+    """Tier decisions and the requests that steer them (`world.lod`)."""
+
+    def __init__(
+        self,
+        roster: Roster,
+        proxies: ContactProxies,
+        settings: LodSettings,
+        fps: float,
+        place: Callable[[int, np.ndarray, np.ndarray], None],
+    ):
+        self.roster = roster
+        self.proxies = proxies
+        self.settings = settings
+        self.enabled = settings.enabled
+        self.hold_frames = round(settings.hold_seconds * fps)
+        self._place = place
+        self.replay: Replay | None = None
+        count = len(roster)
+        self.scripted = np.zeros(count, dtype=bool)  # promote() / release()
+        self.selected = np.zeros(count, dtype=bool)  # the sandbox's selection
+        self.focus_region: tuple[np.ndarray, float] | None = None
+        if settings.focus is not None:
+            self.focus(settings.focus[:2], settings.focus[2])
+        self.held = np.zeros(count, dtype=np.int64)  # frames at the current tier
+        self.promotions = 0
+        self.demotions = 0
+
+    # -- requests --------------------------------------------------------------------
+    def index(self, creature: int) -> int:
+        """The roster index of creature entity `creature`."""
+        i = int(np.searchsorted(self.roster.entity, creature))
+        if i >= len(self.roster) or self.roster.entity[i] != creature:
+            raise KeyError(f"entity {creature} is not a creature of this physics")
+        return i
+
+    def promote(self, creature: int) -> None:
+        """Run `creature` (an entity) at full physics from the next frame until `release`."""
+        self.scripted[self.index(creature)] = True
+
+    def release(self, creature: int) -> None:
+        """Undo `promote`: `creature` competes for the budgets again."""
+        self.scripted[self.index(creature)] = False
+
+    def select(self, creatures: Iterable[int]) -> None:
+        """The sandbox's selection (entities): they run full while selected."""
+        self.selected[:] = False
+        for creature in creatures:
+            self.selected[self.index(creature)] = True
+
+    def focus(self, centre: tuple[float, float] | np.ndarray | None, radius: float = 0.0) -> None:
+        """Creatures whose mantle is within `radius` m of `centre` (x, y) run full and the
+        rest are ranked by distance to it; None: no focus (creature order decides)."""
+        if centre is None:
+            self.focus_region = None
+            return
+        if not radius >= 0:
+            raise ValueError(f"focus radius: must be >= 0, got {radius}")
+        self.focus_region = (np.asarray(centre, dtype=np.float64)[:2].copy(), float(radius))
+
+    def tier_of(self, creature: int) -> str:
+        """`"full"`, `"reduced"` or `"kinematic"`."""
+        return NAMES[int(self.roster.tier[self.index(creature)])]
+
+    def counts(self) -> dict[str, int]:
+        """Creatures per tier, by name."""
+        counts = np.bincount(self.roster.tier, minlength=len(NAMES))
+        return {name: int(n) for name, n in zip(NAMES, counts, strict=True)}
+
+    # -- state -----------------------------------------------------------------------
+    def state(self) -> tuple[np.ndarray, ...]:
+        """What decides the next frame's tiers, for snapshots (tiers are the roster's)."""
+        return self.scripted.copy(), self.selected.copy(), self.held.copy()
+
+    def set_state(self, state: tuple[np.ndarray, ...]) -> None:
+        self.scripted[:], self.selected[:], self.held[:] = state
+
+    # -- per frame -------------------------------------------------------------------
+    def update(self, world: PhysicsHost) -> None:
+        """Decide every creature's tier for this frame's step (rules in the module doc)."""
+        roster = self.roster
+        if not len(roster):
+            return
+        if not self.enabled:  # everyone full (at once, if lod was just switched off)
+            if (roster.tier != FULL).any():
+                self._move(world, np.full(len(roster), FULL, dtype=np.int8))
+            return
+        centre, radius = self.proxies.spheres(world.transforms.pos[self.proxies.rows])
+        must = self.scripted | self.selected
+        a, _ = near_pairs(centre, radius, self.settings.contact_margin)
+        must[a] = True
+        distance = np.zeros(len(roster))
+        if self.focus_region is not None:
+            point, reach = self.focus_region
+            distance = np.linalg.norm(centre[:, :2] - point, axis=1)
+            must |= distance <= reach
+        tier = roster.tier
+        want = np.full(len(roster), KINEMATIC if self.replay is not None else REDUCED, np.int8)
+        want[must] = FULL
+        awake = ~(roster.sleeping | roster.frozen)
+        ranked = np.flatnonzero(awake & ~must)
+        order = np.lexsort((ranked, tier[ranked], distance[ranked]))
+        full, reduced = self.settings.full, self.settings.reduced
+        want[ranked[order[:full]]] = FULL
+        want[ranked[order[full : full + reduced]]] = REDUCED
+        keep = ~awake & ~must  # asleep: keeps its tier
+        keep |= (want > tier) & (self.held < self.hold_frames)  # demotion waits
+        want[keep] = tier[keep]
+        self._move(world, want)
+
+    def _move(self, world: PhysicsHost, want: np.ndarray) -> None:
+        roster = self.roster
+        tier = roster.tier
+        changed = want != tier
+        self.held += 1
+        if not changed.any():
+            return
+        self.held[changed] = 0
+        self.promotions += int((changed & (want < tier)).sum())
+        self.demotions += int((changed & (want > tier)).sum())
+        leaving = np.flatnonzero(changed & (tier == KINEMATIC))
+        entering = np.flatnonzero(changed & (want == KINEMATIC))
+        for index in leaving.tolist():  # an event: only the creatures promoted this frame
+            if self.replay is None:
+                raise RuntimeError("a kinematic creature with no replay to take its pose from")
+            qpos, qvel = self.replay.joint_state(index)
+            self._place(index, qpos, qvel)
+        tier[:] = want
+        if len(entering) and self.replay is not None:
+            self.replay.start(entering)

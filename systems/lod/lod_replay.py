@@ -1,0 +1,35 @@
+"""lod_replay: kinematic creatures one frame along their way, replaying gait clips.
+
+Reads: the physics roster's tiers, each kinematic creature's morphology clips and the
+plugins' travel targets (`Plugin.travel_targets`). Writes: the kinematic creatures'
+body poses in their physics batch (copied into the Transform store by
+`physics_sync`, like every other creature's). Registers its replay with the level of
+detail when it joins a world, so demotions to KINEMATIC become possible
+(`ecs_tentacles.lod.replay`).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from ecs_tentacles.lod.replay import ClipReplay
+from ecs_tentacles.system import System
+
+if TYPE_CHECKING:
+    from ecs_tentacles.host import Host
+
+
+class LodReplay(System):
+    name = "lod_replay"
+    stage = "physics"
+    after = ("physics",)
+    reads = ("physics",)
+    writes = ("physics",)
+    calls_hooks = True  # travel_targets
+
+    def setup(self, world: Host) -> None:
+        self.replay = ClipReplay(world)
+        world.physics.lod.replay = self.replay
+
+    def process(self, world: Host, dt: float) -> None:
+        self.replay.advance(world, dt)
