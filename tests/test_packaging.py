@@ -49,7 +49,7 @@ def test_installed_package_beside_a_user_systems_package(tmp_path: Path) -> None
     result = _run(USER_CHECK.format(where=where), _user_project(tmp_path))
     assert result.returncode == 0, result.stderr
     assert result.stdout.strip().endswith(
-        "'physics', 'physics_sync', 'physics_health', 'threats', 'emotion', 'rig']"
+        "'physics', 'lod_replay', 'physics_sync', 'physics_health', 'threats', 'emotion', 'rig']"
     )
 
 

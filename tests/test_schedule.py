@@ -52,6 +52,7 @@ BUILTIN = [
     "motor_targets",
     "suckers",
     "physics",
+    "lod_replay",
     "physics_sync",
     "physics_health",
     "threats",
@@ -66,6 +67,7 @@ def test_builtin_order(make_world: Callable[..., World]) -> None:
     physics_only = make_world(creature_scene(count=3, links=2), plugins=NO_LOCOMOTION)
     assert physics_only.schedule.names == [
         "physics",
+        "lod_replay",
         "physics_sync",
         "physics_health",
         "threats",
@@ -73,7 +75,7 @@ def test_builtin_order(make_world: Callable[..., World]) -> None:
         "rig",
     ]
     assert [world.schedule.stage_of(n) for n in BUILTIN] == [
-        "decide", "decide", "act", "act", "act", "physics", "sync", "sync",
+        "decide", "decide", "act", "act", "act", "physics", "physics", "sync", "sync",
         "animate", "animate", "animate",
     ]  # fmt: skip
 
@@ -88,6 +90,7 @@ def test_probe_records_frame_and_substep_order(make_world: Callable[..., World])
         "substep_probe",
         "early",
         "physics",
+        "lod_replay",
         "physics_sync",
         "physics_health",
         "late",  # after physics_sync: joins the sync stage, before fur animates

@@ -66,7 +66,7 @@ def one_creature_scene(
 def record(scene: dict[str, Any], warmup: float, seconds: float) -> Recording:
     """Build `scene` (one creature), step `warmup` s, then record `seconds` s frame by frame."""
     start = time.perf_counter()
-    world = World.from_scene(scene, threads=1)
+    world = World.from_scene(scene, threads=1, lod=False)  # full physics, whatever the scene says
     try:
         _, (creature, transform) = next(iter(world.query(Creature, Transform)))
         layout = model_layout(world, creature, transform)

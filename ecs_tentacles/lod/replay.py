@@ -31,6 +31,7 @@ if TYPE_CHECKING:
 
 log = logging.getLogger("ecs_tentacles.lod")
 
+SHARED = ClipCache()  # clips by morphology, shared by every world of this process
 TURN_RATE = math.radians(60.0)  # rad/s a replayed creature turns toward its way
 ARRIVED = 0.05  # m: closer than this to its target, a replayed creature idles
 
@@ -41,7 +42,7 @@ class ClipReplay:
     def __init__(self, world: Host, cache: ClipCache | None = None):
         self.world = world
         self.roster = roster = world.physics.roster
-        self.cache = cache if cache is not None else ClipCache()
+        self.cache = cache if cache is not None else SHARED
         count = len(roster)
         self.xy = np.zeros((count, 2))
         self.heading = np.zeros(count)

@@ -30,7 +30,7 @@ import numpy as np
 
 from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.physics.batch import Batch
-from ecs_tentacles.physics.health import HealthCheck, HealthState
+from ecs_tentacles.physics.health import SOFT_GAIN, HealthCheck, HealthState
 from ecs_tentacles.physics.lod import LevelOfDetail
 from ecs_tentacles.physics.model import ModelLayout, build_spec, model_layout
 from ecs_tentacles.physics.proxies import ContactProxies
@@ -217,7 +217,9 @@ class PhysicsBackend:
         """Start creature `index` from `qpos` / `qvel` (a promotion from replayed poses).
 
         The warm start is cleared, the poses recomputed, and the health check's saved
-        states and the sleep counters restart from here.
+        states and the sleep counters restart from here. Its servos start soft and
+        stiffen over `health.SOFT_SECONDS`, as after a recovery: what the controller asks
+        need not match the pose it was shown in, and it must not yank.
         """
         batch = self.batches[int(self.batch_of[index])]
         row = int(self.row_of[index])
@@ -229,6 +231,7 @@ class PhysicsBackend:
         self.health.restart(index)
         self.sleep.restart(index)
         self.sleeping[index] = False
+        self.soften[index] = SOFT_GAIN
 
     def step(
         self,
@@ -239,25 +242,33 @@ class PhysicsBackend:
     ) -> None:
         """Advance every active creature `substeps` steps; `before_substep(i)` runs first if given.
 
-        Without hooks the steps are taken in `rounds` batches with `between()` called
-        between them (the contact proxies catch up within the frame). A creature's step
-        reads only its own row, so the result does not depend on the number of threads.
-        Asleep or frozen creatures keep their state; the clock moves on.
+        Without hooks, creatures near another (contact proxies placed) take their steps
+        in `rounds` batches with `between()` called between them (their proxies catch up
+        within the frame); every other creature takes all its steps at once, which
+        gives the same result (nothing it reads changes between rounds) for less
+        bookkeeping. A creature's step reads only its own row, so the result does not
+        depend on the number of threads. Asleep or frozen creatures keep their state;
+        the clock moves on.
         """
-        chunks = plan(self.batches, self.active, self.tier, self.threads)
         reduced = reduced_substeps(substeps)
         if before_substep is not None:
+            chunks = plan(self.batches, self.active, self.tier, self.threads)
             for i in range(substeps):
                 before_substep(i)
                 self._run(chunks, {FULL: 1, REDUCED: int(i < reduced)})
         else:
-            full = _split(substeps, rounds)
-            for k, (n, r) in enumerate(zip(full, _split(reduced, rounds), strict=True)):
-                if not n:
-                    continue
-                if k and between is not None:
-                    between()
-                self._run(chunks, {FULL: n, REDUCED: r})
+            near = self.proxies_used > 0 if rounds > 1 else np.zeros(len(self), dtype=bool)
+            alone = plan(self.batches, self.active & ~near, self.tier, self.threads)
+            self._run(alone, {FULL: substeps, REDUCED: reduced})
+            if near.any():
+                chunks = plan(self.batches, self.active & near, self.tier, self.threads)
+                full = _split(substeps, rounds)
+                for k, (n, r) in enumerate(zip(full, _split(reduced, rounds), strict=True)):
+                    if not n:
+                        continue
+                    if k and between is not None:
+                        between()
+                    self._run(chunks, {FULL: n, REDUCED: r})
         self.time += substeps * self.substep_dt
 
     def _run(self, chunks: list[list[Segment]], substeps: dict[int, int]) -> None:

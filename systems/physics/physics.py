@@ -46,9 +46,9 @@ class Physics(System):
 
     def process(self, world: Host, dt: float) -> None:
         backend = world.physics
+        backend.lod.update(world)  # first: a promoted creature's servos start soft
         backend.write_controls(world.motors)
         backend.write_suckers(world.suckers)
-        backend.lod.update(world)
         backend.proxies.update(world.transforms)
         backend.sleep.update(world, wanted_motion(world))
         hooks = world.schedule.substep_systems()

@@ -17,8 +17,8 @@ def test_systems_prints_the_frame_with_stages_plugins_and_fields(
     assert main(["systems", "hedgehog_octopus"]) == 0
     lines = capsys.readouterr().out.splitlines()
     assert (
-        lines[0]
-        == "plugins: locomotion (built in), suckers (built in), threats (built in), fur (built in)"
+        lines[0] == "plugins: locomotion (built in), suckers (built in), threats (built in),"
+        " fur (built in), lod (built in)"
     )
     assert lines[1].split() == ["stage", "system", "plugin", "reads", "writes"]
     rows = [line.split()[:3] for line in lines[2:]]
@@ -62,7 +62,8 @@ def test_migrate_makes_plugins_explicit_and_folds_the_systems_list(
     new = json.loads((tmp_path / "old.migrated.json").read_text())
     assert "systems" not in new
     assert new["plugins"] == {
-        "locomotion": {}, "suckers": {}, "threats": {}, "fur": {}, "wave": {"from": "mywave:Wave"}
+        "locomotion": {}, "suckers": {}, "threats": {}, "fur": {}, "lod": {},
+        "wave": {"from": "mywave:Wave"},
     }  # fmt: skip
     assert "systems[0] -> plugins.wave (from mywave:Wave)" in capsys.readouterr().out
     assert main(["systems", str(tmp_path / "old.migrated.json"), "--allow-systems"]) == 0

@@ -58,7 +58,7 @@ def test_frame_benchmark_splits_the_frame() -> None:
     row = bench.bench_scene("three_goals", frames=3, repeats=1)
     ms = row["ms_per_frame"]
     names = {"goals", "tentacle_selection", "action_queue", "motor_targets", "suckers"}
-    names |= {"threats", "emotion", "rig"}
+    names |= {"threats", "emotion", "rig", "lod_replay"}
     assert names | {"physics", "physics_health", "physics_sync", "total", "mj_step"} == set(ms)
     assert ms["total"] >= ms["mj_step"] > 0
 

@@ -1,0 +1,165 @@
+"""Level of detail: tiers that step right, promotions that start where the shown pose is."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+from numpy.testing import assert_array_equal
+
+from ecs_tentacles.components import Creature, Link, Tentacle, Transform
+from ecs_tentacles.mathutil import quat_rotate
+from ecs_tentacles.physics.proxies import MARGIN
+from ecs_tentacles.world import World
+
+SMALL = {"count": 4, "links": 5}  # a quick creature: reach about 0.45 m
+
+
+def _crowd(count: int, lod: dict[str, Any] | None = None, spacing: float = 2.0) -> dict[str, Any]:
+    """`count` small creatures on a grid, each crawling 1 m along +x."""
+    creatures = []
+    for i in range(count):
+        x, y = spacing * (i % 4), spacing * (i // 4)
+        creatures.append(
+            {
+                "name": f"c{i}",
+                "position": [x, y],
+                "tentacles": dict(SMALL),
+                "goals": [{"position": [x + 1.0, y]}],
+            }
+        )
+    return {"version": 1, "physics": {"lod": lod or {}}, "creatures": creatures}
+
+
+MIXED = {"full": 2, "reduced": 3, "hold_seconds": 0.1}  # 8 creatures: every tier in use
+
+
+def test_mixed_tiers_move_bit_identically_on_one_and_two_threads(
+    make_world: Callable[..., World],
+) -> None:
+    runs = []
+    for threads in (1, 2):
+        world = make_world(_crowd(8, MIXED), threads=threads)
+        poses, counts = [], []
+        for _ in range(8):
+            world.step(10)
+            poses.append(world.transforms.pos.copy())
+            counts.append(world.lod.counts())
+        runs.append((np.array(poses), counts))
+    assert_array_equal(runs[0][0], runs[1][0])
+    assert runs[0][1] == runs[1][1]
+    assert runs[0][1][-1] == {"full": 2, "reduced": 3, "kinematic": 3}
+    assert np.isfinite(runs[0][0]).all()
+
+
+def test_snapshot_and_restore_are_exact_with_tiers_mixed(make_world: Callable[..., World]) -> None:
+    world = make_world(_crowd(8, MIXED))
+    world.step(40)
+    assert min(world.lod.counts().values()) > 0
+    snap = world.snapshot()
+    world.step(45)  # tiers change on the way: creatures meet their goals, demotions
+    after, counts = world.transforms.pos.copy(), world.lod.counts()
+    world.restore(snap)
+    world.step(45)
+    assert_array_equal(world.transforms.pos, after)
+    assert world.lod.counts() == counts
+
+
+def test_lod_off_equals_the_full_simulation(make_world: Callable[..., World]) -> None:
+    within = make_world(_crowd(4))  # within the default budget: everyone full
+    off = make_world(_crowd(4), lod=False)
+    squeezed = make_world(_crowd(4, {"full": 1, "reduced": 0}), lod=False)
+    for _ in range(6):
+        for world in (within, off, squeezed):
+            world.step(10)
+        assert_array_equal(within.transforms.pos, off.transforms.pos)
+        assert_array_equal(squeezed.transforms.pos, off.transforms.pos)
+    assert squeezed.lod.counts() == {"full": 4, "reduced": 0, "kinematic": 0}
+    assert squeezed.lod.promotions == squeezed.lod.demotions == 0
+
+
+def test_a_reduced_creature_crawls_healthily(make_world: Callable[..., World]) -> None:
+    world = make_world(_crowd(2, {"full": 0, "reduced": 8, "hold_seconds": 0}))
+    start = world.transforms.pos[world.component(world.creature("c0"), Transform).row].copy()
+    world.step(180)
+    assert world.lod.counts() == {"full": 0, "reduced": 2, "kinematic": 0}
+    assert world.physics.health.recoveries == 0
+    end = world.transforms.pos[world.component(world.creature("c0"), Transform).row]
+    assert end[0] - start[0] > 0.05  # toward its goal at +x
+
+
+def _links(world: World, name: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Every link capsule of creature `name`: centres, half-axis vectors, radii."""
+    centres, halves, radii = [], [], []
+    creature = world.component(world.creature(name), Creature)
+    for tentacle in creature.tentacles:
+        for link in world.component(tentacle, Tentacle).links:
+            shape, pose = world.component(link, Link), world.component(link, Transform)
+            centres.append(np.array(pose.pos))
+            halves.append(quat_rotate(pose.quat, np.array([0.5 * shape.length, 0.0, 0.0])))
+            radii.append(shape.radius)
+    return np.array(centres), np.array(halves), np.array(radii)
+
+
+def _gap(world: World, a: str, b: str) -> float:
+    """Smallest surface distance (m) between the link capsules of `a` and `b` (< 0: overlap)."""
+    pa, ha, ra = _links(world, a)
+    pb, hb, rb = _links(world, b)
+    samples = np.linspace(-1.0, 1.0, 41)  # 41 points per axis: error under 0.2 mm
+    sa = pa[:, None, :] + samples[None, :, None] * ha[:, None, :]
+    sb = pb[:, None, :] + samples[None, :, None] * hb[:, None, :]
+    d = np.linalg.norm(sa.reshape(-1, 1, 3) - sb.reshape(1, -1, 3), axis=2)
+    d -= np.repeat(ra, len(samples))[:, None] + np.repeat(rb, len(samples))[None, :]
+    return float(d.min())
+
+
+def test_kinematic_creatures_driven_into_each_other_are_full_before_they_touch(
+    make_world: Callable[..., World],
+) -> None:
+    scene = {
+        "version": 1,
+        "physics": {"lod": {"full": 0, "reduced": 0, "hold_seconds": 0}},
+        "creatures": [
+            {"name": "a", "position": [-0.75, 0.0], "tentacles": dict(SMALL),
+             "goals": [{"position": [1.5, 0.0]}]},
+            {"name": "b", "position": [0.75, 0.0], "heading_deg": 180, "tentacles": dict(SMALL),
+             "goals": [{"position": [-1.5, 0.0]}]},
+        ],
+    }  # fmt: skip
+    world = make_world(scene)
+    world.step(2)
+    assert world.lod.counts()["kinematic"] == 2  # nothing happens to them yet
+    gaps, near_tiers = [], set()
+    for _ in range(420):
+        world.step(1)
+        gap = _gap(world, "a", "b")
+        gaps.append(gap)
+        if gap < MARGIN:  # as close as contact proxies start pushing
+            near_tiers |= {world.lod.tier_of(world.creature(n)) for n in "ab"}
+    assert min(gaps) < MARGIN  # they did meet
+    assert near_tiers == {"full"}
+    assert min(gaps) > -0.005  # never more than 5 mm into each other
+    assert world.lod.promotions >= 2 and world.physics.health.recoveries == 0
+
+
+def test_promotion_starts_from_the_shown_pose(make_world: Callable[..., World]) -> None:
+    world = make_world(_crowd(1, {"full": 0, "reduced": 0, "hold_seconds": 0}))
+    creature = world.creature("c0")
+    world.step(60)
+    assert world.lod.tier_of(creature) == "kinematic"
+    rows = world.physics.groups[0].body_rows
+    shown = world.transforms.pos[rows].copy()
+    world.step(1)
+    replayed = np.linalg.norm(world.transforms.pos[rows] - shown, axis=1).max()
+    shown = world.transforms.pos[rows].copy()
+    world.lod.promote(creature)
+    world.step(1)  # promoted before the step, then one frame of physics
+    assert world.lod.tier_of(creature) == "full"
+    jump = np.linalg.norm(world.transforms.pos[rows] - shown, axis=1).max()
+    assert jump <= 0.02, f"promotion moved a link {jump * 1000:.1f} mm (replay: {replayed:.4f})"
+    world.step(60)
+    assert world.physics.health.recoveries == 0
+    world.lod.release(creature)
+    world.step(2)
+    assert world.lod.tier_of(creature) == "kinematic"
