@@ -49,6 +49,7 @@ class ClipReplay:
         self.phase = np.zeros(count)
         self.kind = np.full(count, IDLE, dtype=np.int64)
         self.clips: dict[int, GaitClips] = {}  # batch index -> its morphology's clips
+        self._clip_shapes: dict[tuple[int, int], np.ndarray] = {}
 
     def clips_of(self, batch: Batch) -> GaitClips:
         """The gait clips of `batch`'s morphology (recorded on first use)."""
@@ -75,16 +76,36 @@ class ClipReplay:
             rows = roster.row_of[mine]
             kind = np.where(np.isfinite(targets[here, 0]), CRAWL, IDLE)
             mantle_pos, mantle_quat = batch.xpos[rows, 0], batch.xquat[rows, 0]
-            first = np.stack([clips.clip(k).pos[0, 0] for k in (IDLE, CRAWL)])
-            first_yaw = mantle_yaw(np.stack([clips.clip(k).quat[0, 0] for k in (IDLE, CRAWL)]))
-            heading = mantle_yaw(mantle_quat) - first_yaw[kind]
-            offset = first[kind][:, :2]
-            c, s = np.cos(heading), np.sin(heading)
-            self.xy[mine, 0] = mantle_pos[:, 0] - (c * offset[:, 0] - s * offset[:, 1])
-            self.xy[mine, 1] = mantle_pos[:, 1] - (s * offset[:, 0] + c * offset[:, 1])
-            self.heading[mine] = heading
+            yaw = mantle_yaw(mantle_quat)
+            shape = _mantle_frame(batch.xpos[rows], mantle_pos, yaw)
+            phase = np.zeros(len(mine), dtype=np.int64)
+            for k in (IDLE, CRAWL):
+                which = np.flatnonzero(kind == k)
+                if len(which):
+                    phase[which] = _nearest_frame(self._shapes(batch, clips, k), shape[which])
+            for k in (IDLE, CRAWL):
+                clip = clips.clip(k)
+                which = kind == k
+                f = phase[which]
+                heading = yaw[which] - mantle_yaw(clip.quat[f, 0])
+                offset = clip.pos[f, 0, :2]
+                c, s = np.cos(heading), np.sin(heading)
+                at = mine[which]
+                self.xy[at, 0] = mantle_pos[which, 0] - (c * offset[:, 0] - s * offset[:, 1])
+                self.xy[at, 1] = mantle_pos[which, 1] - (s * offset[:, 0] + c * offset[:, 1])
+                self.heading[at] = heading
             self.kind[mine] = kind
-            self.phase[mine] = 0.0
+            self.phase[mine] = phase
+
+    def _shapes(self, batch: Batch, clips: GaitClips, kind: int) -> np.ndarray:
+        """Every frame of a clip in its mantle's frame (F, bodies, 3), computed once."""
+        key = (batch.index, kind)
+        shapes = self._clip_shapes.get(key)
+        if shapes is None:
+            clip = clips.clip(kind)
+            shapes = _mantle_frame(clip.pos, clip.pos[:, 0], mantle_yaw(clip.quat[:, 0]))
+            self._clip_shapes[key] = shapes
+        return shapes
 
     def joint_state(self, index: int) -> tuple[np.ndarray, np.ndarray]:
         """qpos and qvel of the pose creature `index` is shown in."""
@@ -125,8 +146,9 @@ class ClipReplay:
             rows = roster.row_of[mine]
             pos = np.empty((len(mine), len(batch.body_ids), 3))
             quat = np.empty((len(mine), len(batch.body_ids), 4))
+            whole = bool(np.all(self.phase[mine] == np.round(self.phase[mine])))
             clips.evaluate(self.kind[mine], self.phase[mine], self.xy[mine],
-                           self.heading[mine], pos, quat)  # fmt: skip
+                           self.heading[mine], pos, quat, interpolate=not whole)  # fmt: skip
             batch.xpos[rows] = pos
             batch.xquat[rows] = quat
 
@@ -136,6 +158,27 @@ class ClipReplay:
 
     def set_state(self, state: tuple[np.ndarray, ...]) -> None:
         self.xy[:], self.heading[:], self.phase[:], self.kind[:] = state
+
+
+def _mantle_frame(pos: np.ndarray, mantle: np.ndarray, yaw: np.ndarray) -> np.ndarray:
+    """Body positions (K, B, 3) relative to their mantle (K, 3), yaw (K,) turned away."""
+    rel = pos - mantle[:, None, :]
+    c, s = np.cos(-yaw)[:, None], np.sin(-yaw)[:, None]
+    out = rel.copy()
+    out[..., 0] = c * rel[..., 0] - s * rel[..., 1]
+    out[..., 1] = s * rel[..., 0] + c * rel[..., 1]
+    return out
+
+
+def _nearest_frame(shapes: np.ndarray, shape: np.ndarray, chunk: int = 64) -> np.ndarray:
+    """For each pose `shape` (K, B, 3), the clip frame of `shapes` (F, B, 3) whose farthest
+    body is nearest (so a creature starts replaying from the pose most like its own)."""
+    best = np.zeros(len(shape), dtype=np.int64)
+    for lo in range(0, len(shape), chunk):
+        part = shape[lo : lo + chunk]
+        d = np.linalg.norm(part[:, None] - shapes[None], axis=-1).max(axis=-1)
+        best[lo : lo + chunk] = d.argmin(axis=1)
+    return best
 
 
 def _targets(world: Host, creature_rows: np.ndarray) -> np.ndarray:

@@ -37,7 +37,7 @@ from ecs_tentacles.physics.proxies import ContactProxies
 from ecs_tentacles.physics.roster import Roster
 from ecs_tentacles.physics.sleep import Sleep, SleepState
 from ecs_tentacles.physics.stepping import Segment, bare_step, plan, step_segments
-from ecs_tentacles.physics.tiers import FULL, NAMES, REDUCED, reduced_substeps
+from ecs_tentacles.physics.tiers import FULL, KINEMATIC, NAMES, REDUCED, reduced_substeps
 from ecs_tentacles.physics.view import CreatureView
 
 if TYPE_CHECKING:
@@ -174,28 +174,35 @@ class PhysicsBackend:
         kv_all = motors.damping * motors.gain
         torque_all = motors.max_torque
         for batch in self.batches:
-            rows = batch.actuator_motor_rows
-            live = ~self.frozen[batch.members]
+            live = ~self.frozen[batch.members] & (self.tier[batch.members] != KINEMATIC)
             soften = self.soften[batch.members]
-            ctrl = np.take(target, batch.actuator_target_index, mode="clip")
-            kp = kp_all[rows] * soften[:, None]
             if live.all():
-                batch.ctrl[:] = ctrl
-                batch.kp[:], batch.kv[:], batch.torque[:] = kp, kv_all[rows], torque_all[rows]
-            else:  # a frozen creature keeps what it had when it froze
-                batch.state[live, batch.slices[int(S.mjSTATE_CTRL)]] = ctrl[live]
-                batch.kp[live], batch.kv[live] = kp[live], kv_all[rows][live]
-                batch.torque[live] = torque_all[rows][live]
+                rows = batch.actuator_motor_rows
+                batch.ctrl[:] = np.take(target, batch.actuator_target_index, mode="clip")
+                batch.kp[:] = kp_all[rows] * soften[:, None]
+                batch.kv[:], batch.torque[:] = kv_all[rows], torque_all[rows]
+                continue
+            # a frozen creature keeps what it had when it froze; a kinematic one gets its
+            # commands the frame it is promoted (the level of detail decides first)
+            live = np.flatnonzero(live)
+            rows = batch.actuator_motor_rows[live]
+            ctrl = np.take(target, batch.actuator_target_index[live], mode="clip")
+            batch.state[live, batch.slices[int(S.mjSTATE_CTRL)]] = ctrl
+            batch.kp[live] = kp_all[rows] * soften[live, None]
+            batch.kv[live], batch.torque[live] = kv_all[rows], torque_all[rows]
 
     def write_suckers(self, suckers: SuckerStore) -> None:
         """Switch sucker equalities on/off and place their world anchors."""
         for batch in self.batches:
             if not len(batch.equality_ids):
                 continue
-            live = ~self.frozen[batch.members]
-            switches = suckers.attached[batch.sucker_rows].astype(np.float64)
-            batch.anchor[live] = suckers.anchor[batch.sucker_rows][live]
-            batch.state[live, batch.slices[int(S.mjSTATE_EQ_ACTIVE)]] = switches[live]
+            live = np.flatnonzero(
+                ~self.frozen[batch.members] & (self.tier[batch.members] != KINEMATIC)
+            )
+            rows = batch.sucker_rows[live]
+            batch.anchor[live] = suckers.anchor[rows]
+            switches = suckers.attached[rows].astype(np.float64)
+            batch.state[live, batch.slices[int(S.mjSTATE_EQ_ACTIVE)]] = switches
 
     @property
     def active(self) -> np.ndarray:

@@ -78,7 +78,7 @@ class HealthCheck:
         self.causes: dict[str, int] = {}
         # every creature's body rows, creature by creature, for whole-array speed checks
         self.rows = proxies.rows
-        self.start = proxies.start
+        self.start, self.count = proxies.start, proxies.count
         self.previous = np.zeros((0, 3))  # last frame's poses (set on the first check)
 
     # -- state ---------------------------------------------------------------------
@@ -127,10 +127,8 @@ class HealthCheck:
         pos = world.transforms.pos
         if len(self.previous) != len(pos):
             self.previous = pos.copy()
-        moved = pos[self.rows] - self.previous[self.rows]
-        step = np.einsum("ij,ij->i", moved, moved)  # nan where a pose is not finite
-        fastest = np.sqrt(np.maximum.reduceat(step, self.start)) if len(step) else step
         active = roster.active
+        fastest = self._fastest(pos, active)
         bad = ~(fastest <= limit)  # also nan: a pose that is not finite
         for batch in roster.batches:
             members = batch.members
@@ -157,6 +155,25 @@ class HealthCheck:
         for index, cause in causes.items():
             self._recover(world, index, cause, physics_time)
         self.previous[:] = pos
+
+    def _fastest(self, pos: np.ndarray, active: np.ndarray) -> np.ndarray:
+        """Per creature, its fastest body's move since last frame (m; 0 if not stepped)."""
+        fastest = np.zeros(len(active))
+        who = np.flatnonzero(active)
+        if len(who) == len(active):
+            rows, start = self.rows, self.start
+        else:
+            if not len(who):
+                return fastest
+            count = self.count[who]
+            first = np.repeat(self.start[who] - (np.cumsum(count) - count), count)
+            rows = self.rows[first + np.arange(count.sum())]
+            start = np.cumsum(count) - count
+        moved = pos[rows] - self.previous[rows]
+        step = np.einsum("ij,ij->i", moved, moved)  # nan where a pose is not finite
+        if len(step):
+            fastest[who] = np.sqrt(np.maximum.reduceat(step, start))
+        return fastest
 
     def _cause(self, index: int, fastest: float, limit: float) -> str:
         roster = self.roster

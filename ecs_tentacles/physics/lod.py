@@ -15,9 +15,10 @@ creature entering KINEMATIC is handed to the replay (`Replay.start`).
 The rules, whole-array work every frame before the step:
 
 1. Lod off: everyone is FULL, always (`--lod off`, `lod=False`).
-2. Must be FULL: creatures whose reach spheres come within `contact_margin` of another
-   creature's (promoted before they touch), forced ones (`promote`, `select`), and
-   those inside the focus region.
+2. Must be FULL: creatures with a body within `contact_margin` of another creature's
+   (the bodies' bounding spheres: promoted before they touch; a full one stays full
+   until it is `CLEAR` times that far), forced ones (`promote`, `select`), and those
+   inside the focus region.
 3. The other awake creatures are ranked: nearest the focus first (without one, all
    equal), then the tier they hold (hysteresis), then creature order, so a bake's
    decisions depend on nothing but the scene. The first `full` run FULL, the next
@@ -36,13 +37,16 @@ from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 
-from ecs_tentacles.physics.proxies import ContactProxies, near_pairs
+from ecs_tentacles.physics.proxies import ContactProxies
 from ecs_tentacles.physics.tiers import FULL, KINEMATIC, NAMES, REDUCED
 
 if TYPE_CHECKING:
     from ecs_tentacles.physics.host import PhysicsHost
     from ecs_tentacles.physics.roster import Roster
     from ecs_tentacles.settings import LodSettings
+
+
+CLEAR = 2.0  # a full creature near another stays full until this many margins away
 
 
 class Replay(Protocol):
@@ -80,7 +84,8 @@ class LevelOfDetail:
         self.focus_region: tuple[np.ndarray, float] | None = None
         if settings.focus is not None:
             self.focus(settings.focus[:2], settings.focus[2])
-        self.held = np.zeros(count, dtype=np.int64)  # frames at the current tier
+        # frames at the current tier; at the start nobody is held: first tiers come at once
+        self.held = np.full(count, self.hold_frames, dtype=np.int64)
         self.promotions = 0
         self.demotions = 0
 
@@ -143,16 +148,17 @@ class LevelOfDetail:
             if (roster.tier != FULL).any():
                 self._move(world, np.full(len(roster), FULL, dtype=np.int8))
             return
-        centre, radius = self.proxies.spheres(world.transforms.pos[self.proxies.rows])
-        must = self.scripted | self.selected
-        a, _ = near_pairs(centre, radius, self.settings.contact_margin)
-        must[a] = True
+        pos, _, centre, radius = self.proxies.sense(world.transforms, world.frame)
+        margin = self.settings.contact_margin
+        gap = self.proxies.closest(pos, centre, radius, CLEAR * margin)
+        tier = roster.tier
+        must = self.scripted | self.selected | (gap < margin)
+        must |= (gap < CLEAR * margin) & (tier == FULL)  # stays full until clear
         distance = np.zeros(len(roster))
         if self.focus_region is not None:
             point, reach = self.focus_region
             distance = np.linalg.norm(centre[:, :2] - point, axis=1)
             must |= distance <= reach
-        tier = roster.tier
         want = np.full(len(roster), KINEMATIC if self.replay is not None else REDUCED, np.int8)
         want[must] = FULL
         awake = ~(roster.sleeping | roster.frozen)

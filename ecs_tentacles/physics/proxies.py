@@ -31,9 +31,11 @@ S = mujoco.mjtState
 MARGIN = 0.05  # metres: a body this close to a neighbour's sphere gets a proxy
 POOL = np.array([PROXY_CAPSULES, PROXY_CYLINDERS])
 CAPSULE, CYLINDER = 0, 1
+PART = 1  # consecutive bodies bounded together when asking who is about to touch
 DENSE_PAIRS = 256  # creatures up to which every pair is compared (no tree to build)
 PARK = PROXY_PARK + np.outer(np.arange(PROXY_CAPSULES + PROXY_CYLINDERS) * 10.0, [1.0, 0.0, 0.0])
 _NONE = np.zeros(0, dtype=np.int64)
+Sensed = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]  # pos, quat, centre, radius
 
 
 class ContactProxies:
@@ -66,17 +68,29 @@ class ContactProxies:
         self.start = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
         self.count = counts
         self.mantle = self.start  # a creature's first body is its mantle
+        self._sensed: tuple[int, Sensed] | None = None  # (frame, sense())
         # each batch row's bodies in this order
         self.index = [
             self.start[batch.members][:, None] + np.arange(len(batch.body_ids))
             for batch in roster.batches
         ]
 
-    def update(self, transforms: TransformStore) -> None:
+    def sense(self, transforms: TransformStore, frame: int | None = None) -> Sensed:
+        """Body poses in this class's order and every creature's reach sphere: (pos, quat,
+        centre, radius). With `frame`, computed once per frame (the level of detail and
+        the proxies both ask, before anything moves)."""
+        if frame is not None and self._sensed is not None and self._sensed[0] == frame:
+            return self._sensed[1]
+        pos, quat = transforms.pos[self.rows], transforms.quat[self.rows]
+        sensed = (pos, quat, *self.spheres(pos))
+        self._sensed = None if frame is None else (frame, sensed)
+        return sensed
+
+    def update(self, transforms: TransformStore, frame: int | None = None) -> None:
         """Give every creature proxies of the other creatures' bodies near it."""
         if len(self.roster) < 2:
             return
-        self._place(transforms.pos[self.rows], transforms.quat[self.rows])
+        self._place(*self.sense(transforms, frame))
 
     @property
     def in_use(self) -> bool:
@@ -89,13 +103,14 @@ class ContactProxies:
         Bodies of creatures near someone are read from their last step (as of their
         last substep); every other body is as the frame started."""
         pos, quat = transforms.pos[self.rows], transforms.quat[self.rows]
+        self._sensed = None
         used = self.roster.proxies_used > 0
         for batch, index in zip(self.roster.batches, self.index, strict=True):
             rows = np.flatnonzero(used[batch.members])
             if len(rows):
                 pos[index[rows]] = batch.xpos[rows]
                 quat[index[rows]] = batch.xquat[rows]
-        self._place(pos, quat)
+        self._place(pos, quat, *self.spheres(pos))
 
     def spheres(self, pos: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Every creature's reach sphere (centre at its mantle, radius to its farthest
@@ -104,9 +119,52 @@ class ContactProxies:
         reach = np.linalg.norm(pos - centre[self.owner], axis=1) + self.rbound
         return centre, np.maximum.reduceat(reach, self.start)
 
-    def _place(self, pos: np.ndarray, quat: np.ndarray) -> None:
+    def closest(
+        self, pos: np.ndarray, centre: np.ndarray, radius: np.ndarray, margin: float
+    ) -> np.ndarray:
+        """Per creature, the gap (m) between its bodies and the nearest other creature's,
+        as far as it is under `margin` (inf where none comes that close).
+
+        Reach spheres find the candidate pairs; then each candidate's bodies, in runs of
+        `PART` consecutive bodies (a tentacle's links lie side by side), get bounding
+        spheres, and a pair counts when two of those come within `margin`. A creature's
+        whole reach sphere is far too coarse for a star of tentacles: neighbours in a
+        crowd are inside each other's spheres long before any tentacles meet.
+        """
+        near = np.full(len(self.roster), np.inf)
+        a, b = near_pairs(centre, radius, margin)
+        first = a < b
+        a, b = a[first], b[first]
+        if not len(a):
+            return near
+        who = np.unique(np.concatenate((a, b)))
+        bodies = np.concatenate([np.arange(s, s + n) for s, n in zip(self.start[who],
+                                 self.count[who], strict=True)])  # fmt: skip
+        parts = -(-self.count[who] // PART)  # runs per candidate creature
+        part_start = np.concatenate([[0], np.cumsum(parts)[:-1]])
+        within = bodies - np.repeat(self.start[who], self.count[who])
+        part = np.repeat(part_start, self.count[who]) + within // PART
+        edges = np.flatnonzero(np.r_[True, part[1:] != part[:-1]])
+        size = np.diff(np.r_[edges, len(part)])
+        middle = np.add.reduceat(pos[bodies], edges, axis=0) / size[:, None]
+        reach = np.linalg.norm(pos[bodies] - middle[part], axis=1) + self.rbound[bodies]
+        bound = np.maximum.reduceat(reach, edges)
+        slot = np.searchsorted(who, np.stack((a, b)))  # the pair's creatures among `who`
+        na, nb = parts[slot[0]], parts[slot[1]]
+        pair = np.repeat(np.arange(len(a)), na * nb)
+        k = np.arange(len(pair)) - np.repeat(np.cumsum(na * nb) - na * nb, na * nb)
+        pa = part_start[slot[0]][pair] + k // nb[pair]
+        pb = part_start[slot[1]][pair] + k % nb[pair]
+        gap = np.linalg.norm(middle[pa] - middle[pb], axis=1) - bound[pa] - bound[pb]
+        closest = np.minimum.reduceat(gap, np.cumsum(na * nb) - na * nb)
+        np.minimum.at(near, a, closest)
+        np.minimum.at(near, b, closest)
+        return near
+
+    def _place(
+        self, pos: np.ndarray, quat: np.ndarray, centre: np.ndarray, radius: np.ndarray
+    ) -> None:
         roster = self.roster
-        centre, radius = self.spheres(pos)
         a, b = near_pairs(centre, radius)
         who, body, slot = self._assign(a, b, pos, centre, radius) if len(a) else (_NONE,) * 3
         was_used = roster.proxies_used > 0

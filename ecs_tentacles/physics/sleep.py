@@ -17,6 +17,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ecs_tentacles.physics.tiers import KINEMATIC
+
 if TYPE_CHECKING:
     from ecs_tentacles.physics.host import PhysicsHost
     from ecs_tentacles.physics.roster import Roster
@@ -77,24 +79,26 @@ class Sleep:
         attached = world.suckers.attached
         for batch, previous in zip(roster.batches, self.commands, strict=True):
             members = batch.members
-            live = ~roster.frozen[members]
-            commands = np.concatenate((batch.ctrl, batch.kp), axis=1)
+            rows = np.flatnonzero(~roster.frozen[members] & (roster.tier[members] != KINEMATIC))
+            if not len(rows):
+                continue
+            who = members[rows]
+            commands = np.concatenate((batch.ctrl[rows], batch.kp[rows]), axis=1)
             calm = (
-                live
-                & ~roster.proxies_used[members].astype(bool)
-                & ~attached[batch.sucker_rows].any(axis=1)
-                & self.known[members]
-                & (np.abs(commands - previous).max(axis=1, initial=0.0) < COMMAND_CHANGE)
+                ~roster.proxies_used[who].astype(bool)
+                & ~attached[batch.sucker_rows[rows]].any(axis=1)
+                & self.known[who]
+                & (np.abs(commands - previous[rows]).max(axis=1, initial=0.0) < COMMAND_CHANGE)
             )
             if wants_motion is not None:
-                calm &= ~wants_motion[roster.creature_row[members]]
-            previous[live] = commands[live]
-            self.known[members[live]] = True
-            restless = members[live & ~calm]
+                calm &= ~wants_motion[roster.creature_row[who]]
+            previous[rows] = commands
+            self.known[who] = True
+            restless = who[~calm]
             self.still[restless] = 0
             roster.sleeping[restless] = False
-            settling = calm & ~roster.sleeping[members]
-            moving = np.abs(batch.qvel).max(axis=1, initial=0.0) >= STILL_SPEED
-            who = members[settling]
-            self.still[who] = np.where(moving[settling], 0, self.still[who] + 1)
-            roster.sleeping[who] = self.still[who] >= SETTLE_FRAMES
+            settling = calm & ~roster.sleeping[who]
+            moving = np.abs(batch.qvel[rows]).max(axis=1, initial=0.0) >= STILL_SPEED
+            them = who[settling]
+            self.still[them] = np.where(moving[settling], 0, self.still[them] + 1)
+            roster.sleeping[them] = self.still[them] >= SETTLE_FRAMES

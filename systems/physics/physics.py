@@ -49,7 +49,7 @@ class Physics(System):
         backend.lod.update(world)  # first: a promoted creature's servos start soft
         backend.write_controls(world.motors)
         backend.write_suckers(world.suckers)
-        backend.proxies.update(world.transforms)
+        backend.proxies.update(world.transforms, world.frame)
         backend.sleep.update(world, wanted_motion(world))
         hooks = world.schedule.substep_systems()
         if not hooks:
