@@ -118,7 +118,7 @@ def handle(args: argparse.Namespace) -> int:
             f" ({summary['creatures']} creatures, {summary['bodies']} bodies,"
             f" {summary['dofs']} dofs); {'; '.join([*texts, attaches])}"
         )
-        if summary["lod"]:
+        if summary["tiers"]["full"] < summary["creatures"]:  # level of detail did something
             print(f"  level of detail at the end: {tier_line(summary['tiers'])}")
         if health_line(summary):
             print(f"warning: {health_line(summary)}", file=sys.stderr)
