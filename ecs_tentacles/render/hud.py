@@ -192,12 +192,19 @@ class Hud:
         for i, (name, count) in enumerate(lod.counts().items()):
             text = f"{name} {count}"
             if i:
-                same_line_if_fits(imgui.calc_text_size(text).x + imgui.get_style().item_spacing.x)
+                same_line_if_fits(imgui.calc_text_size(text).x)
             imgui.text_colored(text_colour(name), text)
             gui.item(f"tier {name}")
-        changes = f"promotions {lod.promotions}   demotions {lod.demotions}"
-        imgui.text(changes if lod.enabled else "level of detail off: all full")
-        gui.item("promotions")
+        if lod.enabled:
+            imgui.text(f"promotions {lod.promotions}")
+            gui.item("promotions")
+            text = f"demotions {lod.demotions}"
+            same_line_if_fits(imgui.calc_text_size(text).x)
+            imgui.text(text)
+            gui.item("demotions")
+        else:
+            imgui.text("level of detail off")
+            gui.item("promotions")
         _, self.show_tiers = imgui.checkbox("show tiers", self.show_tiers)
         gui.item("show tiers")
 
