@@ -81,9 +81,8 @@ def test_no_hud_flag_and_h_key_hide_the_panel(
     assert _panel_pixels(sandbox.renderer.target.read(), background) == 0
     event(sandbox, "on_key_press", key.H, 0)
     sandbox.render()
-    assert (
-        sandbox.renderer.target.read()[:, : sandbox.hud.width] == shown[:, : sandbox.hud.width]
-    ).all()
+    again = sandbox.renderer.target.read()[:, : sandbox.hud.width]
+    assert _panel_pixels(again, background) > 0.5 * 360 * sandbox.hud.width
     shot = tmp_path / "bare.png"
     argv = ["play", "octopus", "--headless", "--frames", "2", "--quiet", "--no-hud"]
     assert main([*argv, "--width", "640", "--height", "360", "--screenshot", str(shot)]) == 0
