@@ -127,9 +127,10 @@ def plot(rows: list[dict[str, Any]], path: Path) -> None:
         axes.set_title(title)
         axes.grid(True, which="both", alpha=0.3)
         axes.legend()
-    memory.set_yscale("log")
-    memory.yaxis.set_major_formatter(plain)
-    memory.yaxis.set_minor_formatter(plain)
+    if any(not row["error"] for row in rows):  # a log scale needs a value
+        memory.set_yscale("log")
+        memory.yaxis.set_major_formatter(plain)
+        memory.yaxis.set_minor_formatter(plain)
     figure.suptitle("ecs-tentacles bench --crowd N --lod on|off")
     with atomic_output(path) as temporary:
         figure.savefig(temporary, dpi=110)
