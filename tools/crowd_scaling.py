@@ -193,7 +193,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     runs = [(n, lod, t) for n in args.sizes for lod in args.lod for t in args.threads]
     rows = []
-    extra = ("--idle", str(args.idle), "--warmup", str(args.warmup))
+    extra: tuple[str, ...] = ("--idle", str(args.idle), "--warmup", str(args.warmup))
     extra += () if args.varied else ("--uniform",)
     for i, (creatures, lod, threads) in enumerate(runs, 1):
         print(
