@@ -22,6 +22,13 @@ How `bench` measures (every figure is milliseconds per frame, the median over bl
   stepping) plus `physics_sync` (poses out).
 * `realtime_factor`: simulated seconds per wall second of framework frames.
 * `rss_mb`: the process's resident memory at the end (psutil).
+* `lod`: whether level of detail was on; `tiers`: creatures per physics tier at the
+  end (`world.lod.counts()`); `promotions` / `demotions`: tier changes over the run.
+  The bare frames step each creature at the tier the framework steps it at (KINEMATIC
+  ones not at all), so `raw_mujoco_ms` stays the MuJoCo share of the same work.
+
+With `progress`, tqdm bars on stderr (when it is a terminal) show the build, the
+warm-up and the timed frames.
 """
 
 from __future__ import annotations
@@ -30,12 +37,14 @@ import copy
 import math
 import os
 import statistics
+import sys
 import time
 from collections import defaultdict
 from collections.abc import Callable
 from typing import Any
 
 import psutil
+from tqdm import tqdm
 
 from ecs_tentacles.world import World
 
@@ -84,26 +93,38 @@ def _framework_block(world: World, frames: int, buckets: dict[str, list[float]])
     return time.perf_counter() - start
 
 
+def _bar(total: int, desc: str, progress: bool, **kwargs: Any) -> tqdm[Any]:
+    """A frame bar on stderr, shown only with `progress` and a terminal there."""
+    disable = None if progress else True
+    return tqdm(
+        total=total,
+        unit="frame",
+        desc=desc,
+        disable=disable,
+        file=sys.stderr,
+        leave=False,
+        **kwargs,
+    )
+
+
 def measure(
-    world: World, frames: int, *, block: int = BLOCK, warmup: int = WARMUP
+    world: World, frames: int, *, block: int = BLOCK, warmup: int = WARMUP, progress: bool = False
 ) -> dict[str, Any]:
     """Median ms per frame of `frames` framework frames and as many bare ones, interleaved."""
     if frames < 1 or block < 1 or warmup < 0:
         raise ValueError(f"frames and block must be >= 1, warmup >= 0; got {frames, block, warmup}")
-    world.step(warmup)
+    with _bar(warmup, "bench warm-up", progress) as bar:
+        for _ in range(warmup):
+            world.step(1)
+            bar.update(1)
     _bare_block(world, 1)  # the bare path's first call pays for its own warm-up
     buckets = time_systems(world)
     per_frame: dict[str, list[float]] = defaultdict(list)
-    for index, first in enumerate(range(0, frames, block)):
-        k = min(block, frames - first)
-        bare_first = index % 2 == 1
-        bare = _bare_block(world, k) if bare_first else 0.0
-        per_frame["frame"].append(_framework_block(world, k, buckets) * 1000 / k)
-        for name, bucket in buckets.items():
-            per_frame[name].append(bucket[0] * 1000 / k)
-        if not bare_first:
-            bare = _bare_block(world, k)
-        per_frame["raw"].append(bare * 1000 / k)
+    with _bar(frames, "bench frames", progress) as bar:
+        for index, first in enumerate(range(0, frames, block)):
+            k = min(block, frames - first)
+            _timed_block(world, k, buckets, per_frame, bare_first=index % 2 == 1)
+            bar.update(k)
     physics = zip(*(per_frame[name] for name in PHYSICS_SYSTEMS), strict=True)
     physics_ms = statistics.median(map(sum, physics))
     medians = {name: statistics.median(values) for name, values in per_frame.items()}
@@ -119,6 +140,25 @@ def measure(
     }
 
 
+def _timed_block(
+    world: World,
+    k: int,
+    buckets: dict[str, list[float]],
+    per_frame: dict[str, list[float]],
+    *,
+    bare_first: bool,
+) -> None:
+    """One block of `k` framework frames and `k` bare ones, in that order or the other;
+    appends each figure's ms per frame to `per_frame`."""
+    bare = _bare_block(world, k) if bare_first else 0.0
+    per_frame["frame"].append(_framework_block(world, k, buckets) * 1000 / k)
+    for name, bucket in buckets.items():
+        per_frame[name].append(bucket[0] * 1000 / k)
+    if not bare_first:
+        bare = _bare_block(world, k)
+    per_frame["raw"].append(bare * 1000 / k)
+
+
 def bench(
     source: str | os.PathLike[str] | dict[str, Any],
     *,
@@ -128,20 +168,28 @@ def bench(
     warmup: int = WARMUP,
     allow_systems: bool = False,
     sleep: bool = True,
+    lod: bool | None = None,
+    focus: tuple[float, float, float] | None = None,
+    progress: bool = False,
 ) -> dict[str, Any]:
     """Build `source` (scene path, bundled name or dict), run `measure`, report sizes.
 
     The keys, in order: creatures, bodies, threads, build_s, frames, frame_ms,
     physics_ms, raw_mujoco_ms, overhead_ratio, realtime_factor, systems, rss_mb, then
     asleep (creatures asleep at the end), compiles (models compiled: one per
-    morphology, shared by its creatures) and recoveries.
+    morphology, shared by its creatures), recoveries, lod, tiers, promotions, demotions.
     With `sleep=False` idle creatures are stepped like the rest (to show what sleep saves).
+    `lod` turns level of detail on or off over the scene's (None: the scene's);
+    `focus` (x, y, radius in m) is a region whose creatures always run full.
     """
     if not sleep:
         source = _without_sleep(source)
     start = time.perf_counter()
-    world = World.from_scene(source, threads=threads, allow_systems=allow_systems)
+    with _bar(1, "bench: building the world", progress, bar_format="{desc} ..."):
+        world = World.from_scene(source, threads=threads, allow_systems=allow_systems, lod=lod)
     build_s = time.perf_counter() - start
+    if focus is not None:
+        world.lod.focus(focus[:2], focus[2])
     try:
         sizes = {
             "creatures": len(world.physics),
@@ -149,11 +197,16 @@ def bench(
             "threads": int(world.physics.threads),
             "build_s": build_s,
         }
-        timings = measure(world, frames, block=block, warmup=warmup)
+        timings = measure(world, frames, block=block, warmup=warmup, progress=progress)
+        level = world.lod
         after = {
             "asleep": world.physics.sleep.asleep,
             "compiles": world.physics.compiles,
             "recoveries": world.physics.health.recoveries,
+            "lod": bool(level.enabled),
+            "tiers": level.counts(),
+            "promotions": level.promotions,
+            "demotions": level.demotions,
         }
     finally:
         world.close()

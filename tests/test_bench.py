@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 import pytest
@@ -28,13 +29,18 @@ KEYS = [
     "asleep",
     "compiles",
     "recoveries",
+    "lod",
+    "tiers",
+    "promotions",
+    "demotions",
 ]
 
 
 def test_bench_reports_every_key_finite() -> None:
     result = bench(crowd_scene(2, seed=4), frames=4, threads=1, block=2, warmup=2)
     assert list(result) == KEYS
-    numbers = [v for k, v in result.items() if k != "systems"] + list(result["systems"].values())
+    numbers = [v for k, v in result.items() if k not in ("systems", "tiers")]
+    numbers += list(result["systems"].values())
     assert all(math.isfinite(v) and v >= 0 for v in numbers)
     assert (result["creatures"], result["threads"], result["frames"]) == (2, 1, 4)
     assert (result["asleep"], result["recoveries"]) == (0, 0) and result["compiles"] >= 1
@@ -69,3 +75,30 @@ def test_timed_adds_each_call_to_its_bucket() -> None:
     doubled = timed(lambda x: 2 * x, bucket)
     assert doubled(21) == 42 and doubled(1) == 2
     assert 0 < bucket[0] < 1
+
+
+def lod_crowd(n: int = 6) -> dict[str, Any]:
+    """A crowd spread wide (no two creatures near) with budgets that force all three tiers."""
+    scene = crowd_scene(n, seed=2, spacing=4.0, uniform=True)
+    scene["physics"] = {"lod": {"full": 1, "reduced": 2, "hold_seconds": 0}}
+    return scene
+
+
+def test_bench_reports_the_tiers_and_lod_off_runs_everyone_full() -> None:
+    scene = lod_crowd()
+    on = bench(scene, frames=10, threads=1, block=2, warmup=2)
+    assert on["lod"] is True
+    assert on["tiers"] == {"full": 1, "reduced": 2, "kinematic": 3}
+    assert on["demotions"] >= 5 and on["promotions"] >= 0
+    off = bench(scene, frames=10, threads=1, block=2, warmup=2, lod=False)
+    assert off["lod"] is False
+    assert off["tiers"] == {"full": 6, "reduced": 0, "kinematic": 0}
+    assert (off["promotions"], off["demotions"]) == (0, 0)
+    # the bare frames step what the framework steps: 1 full, 2 at half rate, 3 not at all
+    assert on["raw_mujoco_ms"] < 0.75 * off["raw_mujoco_ms"]
+
+
+def test_a_focus_keeps_the_creatures_inside_it_full() -> None:
+    scene = lod_crowd()
+    everyone = bench(scene, frames=2, threads=1, block=2, warmup=1, focus=(0.0, 0.0, 1000.0))
+    assert everyone["tiers"] == {"full": 6, "reduced": 0, "kinematic": 0}

@@ -1,13 +1,15 @@
-"""Crowd scaling: build seconds and frame cost per creature, 1 to 1,024 creatures.
+"""Crowd scaling: frame cost per creature and memory, 16 to 10,000 creatures, LOD on and off.
 
-    python tools/crowd_scaling.py                          # 1 4 16 64 256 1024, 1 and all threads
-    python tools/crowd_scaling.py --sizes 1,4,16 --frames 60 --out build/scaling
+    python tools/crowd_scaling.py              # 16 64 256 1024 10000, lod on/off, 1 and all threads
+    python tools/crowd_scaling.py --sizes 1,4,16 --lod off --frames 60 --out build/scaling
 
-Each (creatures, threads) pair runs `ecs-tentacles bench --crowd N --threads T --json`
-in a fresh process, so one size's memory and compiled models never weigh on the
-next. Writes `<out>.csv` (one row per run; a failed run keeps its error and leaves
-the numbers empty) and `<out>.png`: build seconds and frame ms per creature against
-creatures (log x), one line per thread count. Progress goes to stderr.
+Each (creatures, lod, threads) run is `ecs-tentacles bench --crowd N --lod L --threads T
+--json` (uniform crowds unless `--varied`) in a fresh process, so one size's memory and
+compiled models never weigh on the next. Writes `<out>.csv` (one row per run, with the
+creatures per physics tier and the promotions at the end; a failed or timed-out run
+keeps its error and leaves the numbers empty) and `<out>.png`: frame ms per creature
+and resident memory (MB) against creatures (log x), one line per (lod, threads).
+Progress goes to stderr.
 """
 
 from __future__ import annotations
@@ -26,7 +28,12 @@ from matplotlib.ticker import FuncFormatter, NullFormatter
 
 from ecs_tentacles.atomic import atomic_output
 
-SIZES = (1, 4, 16, 64, 256, 1024)
+SIZES = (16, 64, 256, 1024, 10000)
+LODS = ("on", "off")
+TIERS = ("full", "reduced", "kinematic")
+# untimed frames before timing: every creature starts FULL and is demoted only after
+# `physics.lod.hold_seconds` (1 s, 60 frames), so the timing starts after that
+WARMUP = 90
 BENCH_KEYS = (
     "compiles",
     "bodies",
@@ -40,12 +47,15 @@ BENCH_KEYS = (
 )
 COLUMNS = (
     "creatures",
+    "lod",
     "threads",
     *BENCH_KEYS[:3],
     "build_s_per_creature",
     "frame_ms",
     "frame_ms_per_creature",
     *BENCH_KEYS[4:],
+    *TIERS,
+    "promotions",
     "error",
 )
 
@@ -57,16 +67,18 @@ def bench_once(
     seed: int,
     timeout: float,
     extra: tuple[str, ...] = (),
+    lod: str = "on",
 ) -> dict[str, Any]:
-    """One CSV row: `ecs-tentacles bench --crowd` (+ `extra` options) in a fresh process."""
+    """One CSV row: `ecs-tentacles bench --crowd --lod` (+ `extra` options) in a fresh
+    process, killed after `timeout` seconds (the row then says so)."""
     command = [sys.executable, "-m", "ecs_tentacles.cli", "bench", "--crowd", str(creatures)]
     command += ["--threads", str(threads), "--frames", str(frames), "--seed", str(seed), "--json"]
-    command += extra
-    row: dict[str, Any] = {"creatures": creatures, "threads": threads, "error": ""}
+    command += ["--lod", lod, "--quiet", *extra]
+    row: dict[str, Any] = {"creatures": creatures, "lod": lod, "threads": threads, "error": ""}
     try:
         done = subprocess.run(command, capture_output=True, text=True, timeout=timeout, check=False)
     except subprocess.TimeoutExpired:
-        row["error"] = f"timed out after {timeout:g} s"
+        row["error"] = f"timed out after {timeout:g} s (--timeout)"
         return row
     if done.returncode != 0:
         lines = done.stderr.strip().splitlines() or [f"exit code {done.returncode}"]
@@ -74,6 +86,8 @@ def bench_once(
         return row
     result = json.loads(done.stdout)
     row.update({key: result[key] for key in BENCH_KEYS})
+    row.update({tier: result["tiers"][tier] for tier in TIERS})
+    row["promotions"] = result["promotions"]
     row["build_s_per_creature"] = result["build_s"] / creatures
     row["frame_ms_per_creature"] = result["frame_ms"] / creatures
     return row
@@ -87,18 +101,25 @@ def write_csv(rows: list[dict[str, Any]], path: Path) -> None:
 
 
 def plot(rows: list[dict[str, Any]], path: Path) -> None:
-    """Build seconds and frame ms per creature against creatures, a line per thread count."""
+    """Frame ms per creature and resident MB against creatures, a line per (lod, threads)."""
     figure = Figure(figsize=(10, 4.2), layout="constrained")
-    build, frame = figure.subplots(1, 2)
-    for threads in sorted({row["threads"] for row in rows}):
-        ok = [r for r in rows if r["threads"] == threads and not r["error"]]
+    frame, memory = figure.subplots(1, 2)
+    runs = sorted({(row["lod"], row["threads"]) for row in rows})
+    colours = {t: f"C{i}" for i, t in enumerate(sorted({t for _, t in runs}))}
+    for lod, threads in runs:
+        ok = [r for r in rows if (r["lod"], r["threads"]) == (lod, threads) and not r["error"]]
         sizes = [r["creatures"] for r in ok]
-        label = f"{threads} thread" + ("s" if threads > 1 else "")
-        build.plot(sizes, [r["build_s"] for r in ok], marker="o", label=label)
-        frame.plot(sizes, [r["frame_ms_per_creature"] for r in ok], marker="o", label=label)
+        style = {
+            "marker": "o",
+            "color": colours[threads],
+            "linestyle": "-" if lod == "on" else "--",
+            "label": f"lod {lod}, {threads} thread" + ("s" if threads > 1 else ""),
+        }
+        frame.plot(sizes, [r["frame_ms_per_creature"] for r in ok], **style)
+        memory.plot(sizes, [r["rss_mb"] for r in ok], **style)
     plain = FuncFormatter(lambda value, _: f"{value:g}")
     sizes = sorted({row["creatures"] for row in rows})
-    for axes, title in ((build, "build (s)"), (frame, "frame ms per creature")):
+    for axes, title in ((frame, "frame ms per creature"), (memory, "resident memory (MB)")):
         axes.set_xscale("log")
         axes.set_xticks(sizes, [str(n) for n in sizes])
         axes.xaxis.set_minor_formatter(NullFormatter())
@@ -106,10 +127,11 @@ def plot(rows: list[dict[str, Any]], path: Path) -> None:
         axes.set_title(title)
         axes.grid(True, which="both", alpha=0.3)
         axes.legend()
-    build.set_yscale("log")
-    build.yaxis.set_major_formatter(plain)
-    build.yaxis.set_minor_formatter(plain)
-    figure.suptitle("ecs-tentacles bench --crowd N")
+    if any(not row["error"] for row in rows):  # a log scale needs a value
+        memory.set_yscale("log")
+        memory.yaxis.set_major_formatter(plain)
+        memory.yaxis.set_minor_formatter(plain)
+    figure.suptitle("ecs-tentacles bench --crowd N --lod on|off")
     with atomic_output(path) as temporary:
         figure.savefig(temporary, dpi=110)
 
@@ -126,6 +148,14 @@ def number_list(text: str) -> list[int]:
     return values
 
 
+def lod_list(text: str) -> list[str]:
+    """argparse type: `on`, `off` or `on,off`."""
+    values = text.split(",")
+    if not values or any(value not in LODS for value in values):
+        raise argparse.ArgumentTypeError(f"must be on, off or on,off, got {text!r}")
+    return list(dict.fromkeys(values))
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
     parser.add_argument("--sizes", type=number_list, default=list(SIZES), help="creature counts")
@@ -139,20 +169,38 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--frames", type=int, default=120, help="timed frames per run")
     parser.add_argument("--seed", type=int, default=0, help="crowd seed")
     parser.add_argument(
-        "--uniform", action="store_true", help="crowds of 8 x 10 octopuses (one morphology)"
+        "--lod", type=lod_list, default=list(LODS), help="level of detail: on, off or on,off"
     )
+    parser.add_argument(
+        "--varied",
+        action="store_true",
+        help="varied body plans (default: uniform crowds of 8 x 10 octopuses, one morphology)",
+    )
+    parser.add_argument("--uniform", action="store_true", help="uniform crowds (the default)")
     parser.add_argument("--idle", type=float, default=0.0, help="fraction of idle creatures")
-    parser.add_argument("--timeout", type=float, default=3600.0, help="seconds allowed per run")
+    parser.add_argument(
+        "--timeout", type=float, default=3600.0, help="seconds allowed per run (default 3600)"
+    )
+    parser.add_argument(
+        "--warmup",
+        type=int,
+        default=WARMUP,
+        help=f"untimed frames first (default {WARMUP}: past lod's first demotions)",
+    )
     parser.add_argument(
         "--out", type=Path, default=Path("crowd_scaling"), help="writes OUT.csv and OUT.png"
     )
     args = parser.parse_args(argv)
-    runs = [(n, t) for n in args.sizes for t in args.threads]
+    runs = [(n, lod, t) for n in args.sizes for lod in args.lod for t in args.threads]
     rows = []
-    for i, (creatures, threads) in enumerate(runs, 1):
-        print(f"[{i}/{len(runs)}] {creatures} creatures, {threads} threads ...", file=sys.stderr)
-        extra = ("--idle", str(args.idle)) + (("--uniform",) if args.uniform else ())
-        row = bench_once(creatures, threads, args.frames, args.seed, args.timeout, extra)
+    extra: tuple[str, ...] = ("--idle", str(args.idle), "--warmup", str(args.warmup))
+    extra += () if args.varied else ("--uniform",)
+    for i, (creatures, lod, threads) in enumerate(runs, 1):
+        print(
+            f"[{i}/{len(runs)}] {creatures} creatures, lod {lod}, {threads} threads ...",
+            file=sys.stderr,
+        )
+        row = bench_once(creatures, threads, args.frames, args.seed, args.timeout, extra, lod)
         rows.append(row)
         if row["error"]:
             print(f"    failed: {row['error']}", file=sys.stderr)
@@ -160,7 +208,8 @@ def main(argv: list[str] | None = None) -> int:
             print(
                 f"    build {row['build_s']:.2f} s, {row['frame_ms']:.2f} ms/frame"
                 f" ({row['frame_ms_per_creature']:.3f} per creature), overhead"
-                f" {row['overhead_ratio']:.3f}x, {row['rss_mb']:.0f} MB",
+                f" {row['overhead_ratio']:.3f}x, {row['rss_mb']:.0f} MB; tiers"
+                f" {'/'.join(str(row[t]) for t in TIERS)}, {row['promotions']} promotions",
                 file=sys.stderr,
             )
     csv_path, png_path = args.out.with_suffix(".csv"), args.out.with_suffix(".png")

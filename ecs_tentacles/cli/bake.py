@@ -4,7 +4,9 @@ FILE's suffix picks the format: `.npz` a take (the compact, reproducible record)
 `.usd`/`.usda`/`.usdc` a USD stage (needs the `usd` extra), `.glb` binary glTF. The
 output is written to a temporary file beside FILE and renamed at the end, so an
 interrupted bake never leaves a partial FILE (an existing FILE stays as it was).
-`--ray [ADDRESS]` bakes in shards on Ray and `--wedge PATH=VALUES` bakes variants
+`--lod on|off` and `--focus X,Y,R` are written into the plan's scene (`physics.lod`), so
+the take's scene hash says what the bake ran with and Ray shards and wedge variants
+get them too. `--ray [ADDRESS]` bakes in shards on Ray and `--wedge PATH=VALUES` bakes variants
 (`ecs_tentacles.cli.bake_ray`, `ecs_tentacles.distributed`).
 """
 
@@ -16,6 +18,7 @@ import importlib.util
 import json
 import math
 import sys
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -23,6 +26,7 @@ from tqdm import tqdm
 
 from ecs_tentacles.cli import bake_ray
 from ecs_tentacles.cli.arguments import output_path
+from ecs_tentacles.cli.lod_options import add_lod_arguments, apply_to_scene
 from ecs_tentacles.cli.run import seed_int
 from ecs_tentacles.cli.skin_options import add_arguments as add_skin_arguments
 from ecs_tentacles.cli.skin_options import skin_options
@@ -102,6 +106,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         action="store_true",
         help="write nothing and exit 1 if any creature's physics had to be recovered",
     )
+    add_lod_arguments(parser)
     parser.set_defaults(handler=handle)
 
 
@@ -118,6 +123,7 @@ def handle(args: argparse.Namespace) -> int:
         seed=args.seed,
         allow_systems=args.allow_systems,
     )
+    plan = replace(plan, scene=apply_to_scene(plan.scene, args))
     if plan.intervals < 1:
         print(
             f"error: argument --seconds: {args.seconds:g} s is less than one frame at"

@@ -2,6 +2,7 @@
 
     ecs-tentacles bench --crowd 64 --frames 120 --threads 2 --json
     ecs-tentacles bench octopus
+    ecs-tentacles bench --crowd 1024 --uniform --lod off
 
 What is measured, and how the bare MuJoCo figure is taken in the same run, is
 described in `ecs_tentacles.bench`.
@@ -15,7 +16,8 @@ from typing import Any
 
 from ecs_tentacles.bench import BLOCK, WARMUP, bench
 from ecs_tentacles.cli.crowd import add_crowd_options, crowd_from_args, crowd_size
-from ecs_tentacles.cli.run import positive_int, seed_int
+from ecs_tentacles.cli.lod_options import add_lod_arguments, lod_choice
+from ecs_tentacles.cli.run import positive_int, seed_int, tier_line
 from ecs_tentacles.scene.load import resolve_scene_path
 
 
@@ -55,6 +57,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         help=f"untimed frames before timing (default {WARMUP})",
     )
     parser.add_argument("--json", action="store_true", help="print the result as one JSON object")
+    parser.add_argument("--quiet", action="store_true", help="no progress bars")
     parser.add_argument(
         "--no-sleep", action="store_true", help="step idle creatures too (to see what sleep saves)"
     )
@@ -62,6 +65,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         "--allow-systems", action="store_true", help="import and run the systems the scene names"
     )
     add_crowd_options(parser)
+    add_lod_arguments(parser)
     parser.set_defaults(handler=handle)
 
 
@@ -80,6 +84,9 @@ def handle(args: argparse.Namespace) -> int:
         warmup=args.warmup,
         allow_systems=args.allow_systems,
         sleep=not args.no_sleep,
+        lod=lod_choice(args),
+        focus=args.focus,
+        progress=not args.quiet,
     )
     if args.json:
         print(json.dumps(result))
@@ -96,6 +103,9 @@ def handle(args: argparse.Namespace) -> int:
         f" bare MuJoCo {result['raw_mujoco_ms']:.2f} ms, overhead"
         f" {result['overhead_ratio']:.3f}x; {result['rss_mb']:.0f} MB resident"
     )
+    changes = f"on: {result['promotions']} promotions, {result['demotions']} demotions"
+    lod = changes if result["lod"] else "off"
+    print(f"  tiers at the end: {tier_line(result['tiers'])} (level of detail {lod})")
     systems = sorted(result["systems"].items(), key=lambda item: -item[1])
     print("  systems (ms/frame): " + ", ".join(f"{name} {ms:.3f}" for name, ms in systems))
     return 0

@@ -8,6 +8,7 @@ import sys
 from typing import Any
 
 from ecs_tentacles.cli.arguments import output_path, require_display
+from ecs_tentacles.cli.lod_options import add_lod_arguments, lod_choice
 from ecs_tentacles.cli.run import positive_int, seed_int
 from ecs_tentacles.scene.load import resolve_scene_path
 
@@ -48,6 +49,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.add_argument("--no-hud", action="store_true", help="start with the HUD hidden (h)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
     parser.add_argument("--json", action="store_true", help="headless: the summary as JSON")
+    add_lod_arguments(parser)  # without --focus, the focus follows the camera (render.sandbox)
     parser.set_defaults(handler=handle)
 
 
@@ -77,6 +79,8 @@ def handle(args: argparse.Namespace) -> int:
         seed=args.seed,
         allow_systems=args.allow_systems,
         hud=not args.no_hud,
+        lod=lod_choice(args),
+        focus=args.focus,
     )
     try:
         if args.headless:

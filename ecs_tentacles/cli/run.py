@@ -12,6 +12,7 @@ import sys
 import time
 from typing import Any
 
+from ecs_tentacles.cli.lod_options import add_lod_arguments, apply_focus, lod_choice
 from ecs_tentacles.components import Creature
 from ecs_tentacles.plugin import RunSummary
 from ecs_tentacles.progress import step_frames
@@ -60,7 +61,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 
 def add_physics_arguments(parser: argparse.ArgumentParser) -> None:
-    """`--threads` and `--strict`, shared by the commands that simulate."""
+    """`--threads`, `--strict`, `--lod` and `--focus`, shared by the commands that simulate."""
     parser.add_argument(
         "--threads",
         type=positive_int,
@@ -72,6 +73,7 @@ def add_physics_arguments(parser: argparse.ArgumentParser) -> None:
         action="store_true",
         help="exit 1 if any creature's physics had to be recovered or frozen",
     )
+    add_lod_arguments(parser)
 
 
 def health_line(summary: dict[str, Any]) -> str:
@@ -85,12 +87,22 @@ def health_line(summary: dict[str, Any]) -> str:
     )
 
 
+def tier_line(tiers: dict[str, int]) -> str:
+    """`full 32  reduced 64  kinematic 928` (creatures per physics tier)."""
+    return "  ".join(f"{name} {count}" for name, count in tiers.items())
+
+
 def handle(args: argparse.Namespace) -> int:
     path = resolve_scene_path(args.scene)
     build_start = time.perf_counter()
     world = World.from_scene(
-        path, seed=args.seed, allow_systems=args.allow_systems, threads=args.threads
+        path,
+        seed=args.seed,
+        allow_systems=args.allow_systems,
+        threads=args.threads,
+        lod=lod_choice(args),
     )
+    apply_focus(world, args.focus)
     build_seconds = time.perf_counter() - build_start
     summary = simulate(world, args.frames, progress=not args.quiet)
     texts = [found.text for found in plugin_summaries(world) if found.text]
@@ -106,6 +118,8 @@ def handle(args: argparse.Namespace) -> int:
             f" ({summary['creatures']} creatures, {summary['bodies']} bodies,"
             f" {summary['dofs']} dofs); {'; '.join([*texts, attaches])}"
         )
+        if summary["tiers"]["full"] < summary["creatures"]:  # level of detail did something
+            print(f"  level of detail at the end: {tier_line(summary['tiers'])}")
         if health_line(summary):
             print(f"warning: {health_line(summary)}", file=sys.stderr)
     world.close()
@@ -135,6 +149,9 @@ def simulate(world: World, frames: int, *, progress: bool = True) -> dict[str, A
         "recoveries": physics.health.recoveries,
         "recovery_causes": dict(physics.health.causes),
         "frozen": physics.health.frozen,
+        "lod": physics.lod.enabled,
+        "tiers": physics.lod.counts(),  # at the end
+        "promotions": physics.lod.promotions,
         **{k: v for found in plugin_summaries(world) for k, v in found.counts.items()},
         "sucker_attaches": int(world.events.counts["sucker_attached"]),
     }

@@ -3,12 +3,14 @@
 Drawn with Dear ImGui (`render.gui`): a panel on the left, as wide as the window
 allows, in collapsible sections. The HUD's own: "Stats" shows fps, physics ms,
 simulated time, real-time factor and attached suckers; "Physics" the groups, threads,
-recoveries and frozen creatures; "Plugins" the plugins on and every system, with a box
-to switch it off. Plugins add sections through `panels` (`ecs_tentacles.drawing.Panel`,
-from their `sandbox_panels` hooks: locomotion's sliders and actions, the fur tool),
-placed by their `order`; `sections` takes bare (title, draw) pairs and `windows` more
-ImGui windows. The HUD keeps the selection (a creature, and one tentacle or all) and
-tells every panel when it changes.
+recoveries and frozen creatures, the creatures per level-of-detail tier (coloured as
+the tier markers: the legend), promotions and demotions, and the "show tiers" box;
+"Plugins" the plugins on and every system, with a box to switch it off. Plugins add
+sections through `panels` (`ecs_tentacles.drawing.Panel`, from their `sandbox_panels`
+hooks: locomotion's sliders and actions, the fur tool), placed by their `order`;
+`sections` takes bare (title, draw) pairs and `windows` more ImGui windows. The HUD
+keeps the selection (a creature, and one tentacle or all) and tells every panel when
+it changes.
 """
 
 from __future__ import annotations
@@ -20,7 +22,8 @@ from imgui_bundle import imgui
 
 from ecs_tentacles.components import Creature
 from ecs_tentacles.drawing import Panel
-from ecs_tentacles.render.gui import Gui, gui_scale
+from ecs_tentacles.render.gui import Gui, gui_scale, same_line_if_fits
+from ecs_tentacles.render.tiers import text_colour
 
 PANEL_WIDTH = 300  # the panel's width at scale 1 (the creator still uses it as is)
 PANEL_SHARE = 0.4  # the panel never covers more than this share of the window's width
@@ -54,6 +57,7 @@ class Hud:
         self._fold: set[str] = set()  # sections to close on the next frame
         self.name_labels = False  # creatures' names over them (even with the panel hidden)
         self.label_at: Callable[[], list[tuple[str, float, float]]] = list  # (text, x, y)
+        self.show_tiers = False  # a marker over each creature, coloured by its physics tier
 
     # -- selection -------------------------------------------------------------------
     def select(self, creature: int | None, tentacle: int | None = None) -> None:
@@ -180,6 +184,29 @@ class Hud:
         ):
             imgui.text(text)
             gui.item(name)
+        self._tiers(gui)
+
+    def _tiers(self, gui: Gui) -> None:
+        """Creatures per tier in the markers' colours, tier changes, the "show tiers" box."""
+        lod = self.world.lod
+        for i, (name, count) in enumerate(lod.counts().items()):
+            text = f"{name} {count}"
+            if i:
+                same_line_if_fits(imgui.calc_text_size(text).x)
+            imgui.text_colored(text_colour(name), text)
+            gui.item(f"tier {name}")
+        if lod.enabled:
+            imgui.text(f"promotions {lod.promotions}")
+            gui.item("promotions")
+            text = f"demotions {lod.demotions}"
+            same_line_if_fits(imgui.calc_text_size(text).x)
+            imgui.text(text)
+            gui.item("demotions")
+        else:
+            imgui.text("level of detail off")
+            gui.item("promotions")
+        _, self.show_tiers = imgui.checkbox("show tiers", self.show_tiers)
+        gui.item("show tiers")
 
     def _plugins(self, gui: Gui) -> None:
         """The plugins on, and every system in frame order with a box to switch it off."""

@@ -3,17 +3,20 @@
 Systems: render (stage output). Other plugins draw, add HUD sections and take clicks
 through their sandbox hooks (`render_spheres`, `render_lines`, `render_draw`,
 `render_points`, `sandbox_panels`, `sandbox_click`: `ecs_tentacles.drawing`), which the
-renderer, HUD and sandbox call; none of them names a feature.
+renderer, HUD and sandbox call; none of them names a feature. Its own spheres: each
+creature's physics tier while the renderer's `show_tiers` is on (`render.tiers`).
 """
 
 from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from ecs_tentacles.plugin import Plugin
+from ecs_tentacles.plugin import Marker, Plugin
+from ecs_tentacles.render.tiers import tier_markers
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
+    from ecs_tentacles.host import Host
     from ecs_tentacles.render.renderer import Renderer
 
 
@@ -31,3 +34,6 @@ class RenderPlugin(Plugin):
         from ecs_tentacles.systems.render.render import RenderSync
 
         return [RenderSync(self.renderer)]
+
+    def render_spheres(self, world: Host) -> list[Marker]:
+        return tier_markers(self.renderer) if self.renderer.show_tiers else []

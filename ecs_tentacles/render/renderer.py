@@ -82,6 +82,7 @@ class Renderer:
         self.draw_calls = 0
         self.extra_lines: list[Callable[[World], np.ndarray]] = []  # -> (2n, 7) segments
         self.overlays = False  # editing aids wanted (the sandbox sets it while its HUD shows)
+        self.show_tiers = False  # a marker per creature coloured by physics tier (render.tiers)
         self.state: dict[str, Any] = {}  # what plugins keep here (GL objects), across worlds
         self.set_world(world)
 

@@ -11,6 +11,13 @@ removes the goal under a right click. Keys: space pause, . single step, r reset,
 h HUD, f follow, a frame all, tab next tentacle, F12 screenshot, v video,
 F5 save the state, F9 go back to it.
 
+Level of detail (`world.lod`): before every physics frame the sandbox tells it the
+selected creature (it runs full) and, unless a focus is pinned (`focus=`, `play
+--focus`, or the scene's `physics.lod.focus`), a focus of `FOCUS_RADIUS` m around the
+camera's target, so what you look at runs full. Headless runs (`play --headless`) do
+the same: the camera does not move there, so they stay deterministic; bakes have no
+camera and use only the scene's focus.
+
 Plugins add HUD sections (`sandbox_panels`, asked once per plugin and kept across
 rebuilds and resets: the locomotion sliders, the fur tool) and draw through the
 renderer's hooks; this module names no feature.
@@ -55,6 +62,7 @@ CLICK_PIXELS = 4  # a press and release closer than this is a click, not a drag
 BUTTONS = {mouse.LEFT: "left", mouse.RIGHT: "right", mouse.MIDDLE: "middle"}
 MAX_CATCH_UP = 0.25  # seconds of physics to catch up at most per display frame
 DISPLAY_HZ = 60
+FOCUS_RADIUS = 4.0  # m around the camera's target where creatures run full physics
 
 
 class Sandbox:
@@ -70,13 +78,19 @@ class Sandbox:
         seed: int | None = None,
         allow_systems: bool = False,
         hud: bool = True,
+        lod: bool | None = None,
+        focus: tuple[float, float, float] | None = None,
     ):
+        """`lod` turns level of detail on or off over the scene's (None: the scene's);
+        `focus` (x, y, radius in m) pins the full-physics region instead of the camera's."""
         self.scene, self.seed, self.allow_systems = scene, seed, allow_systems
+        self.lod, self.focus = lod, focus
         self.headless = headless
         self.window = pyglet.window.Window(
             width, height, caption="ecs_tentacles", visible=not headless, vsync=False
         )
-        self.world = World.from_scene(scene, seed=seed, allow_systems=allow_systems)
+        self.scene_dir: Path | None = None
+        self.world = self._build(scene)
         self.scene_dir = self.world.scene_dir  # plugin files of an edited (dict) scene
         self.hud = Hud(self.window, self.world, visible=hud)
         self.hud.label_at = self.creature_labels
@@ -140,14 +154,35 @@ class Sandbox:
         return self.world
 
     def _build(self, scene: str | os.PathLike[str] | dict[str, Any]) -> World:
-        return World.from_scene(
-            scene, seed=self.seed, allow_systems=self.allow_systems, scene_dir=self.scene_dir
+        world = World.from_scene(
+            scene,
+            seed=self.seed,
+            allow_systems=self.allow_systems,
+            scene_dir=self.scene_dir,
+            lod=self.lod,
         )
+        if self.focus is not None:
+            world.lod.focus(self.focus[:2], self.focus[2])
+        return world
+
+    @property
+    def camera_focus(self) -> bool:
+        """True when the level of detail's focus follows the camera (none is pinned)."""
+        return self.focus is None and self.world.lod.settings.focus is None
+
+    def steer_lod(self) -> None:
+        """Tell the level of detail what the player looks at: the selection, the camera."""
+        lod = self.world.lod
+        selected = self.renderer.selected
+        lod.select([] if selected is None else [selected])
+        if self.camera_focus:
+            lod.focus(self.renderer.camera.target[:2], FOCUS_RADIUS)
 
     # -- simulation --------------------------------------------------------------------
     def step(self, frames: int = 1) -> None:
         """Advance the world by whole physics frames; a system that raises is disabled."""
         start = time.perf_counter()
+        self.steer_lod()
         self.world.step(frames, on_failure=self.scripts.failed)
         self.stats["physics_ms"] = 1000 * (time.perf_counter() - start) / frames
 
@@ -197,6 +232,7 @@ class Sandbox:
         """Draw the world and the HUD off-screen; return the picture if recording."""
         alpha = 1.0 if self.paused else self.accumulator / self.world.settings.dt
         self.renderer.overlays = self.hud.visible  # editing aids (fur control markers)
+        self.renderer.show_tiers = self.hud.show_tiers
         self.renderer.draw(alpha)
         self._update_stats()
         gl.glDisable(gl.GL_DEPTH_TEST)
@@ -392,6 +428,7 @@ class Sandbox:
                 self.video = None
             raise
         result: dict[str, Any] = {"frames": frames, "sim_seconds": self.world.time}
+        result["tiers"] = self.world.lod.counts()  # creatures per physics tier at the end
         if self.video is not None:
             result["video"] = str(self.toggle_video())
         if screenshot is not None:

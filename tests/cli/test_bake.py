@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import hashlib
 import json
 import signal
 import subprocess
@@ -207,3 +208,35 @@ def test_resume_without_ray_is_refused(
         "error: argument --resume: only for a --ray bake without --wedge\n"
     )
     assert not out.exists()
+
+
+def test_lod_options_go_into_the_baked_scene(tmp_path: Path) -> None:
+    """`--lod off` / `--focus` bake exactly what a scene saying so bakes (same bytes)."""
+    from tests.test_bench import lod_crowd
+
+    crowd = lod_crowd(3)  # budgets: 1 full, 2 reduced
+    written = {}
+    for name, lod in (
+        ("scene", {}),
+        ("off", {"enabled": False}),
+        ("focus", {"focus": {"center": [-2.0, 2.0], "radius": 0.5}}),  # the third creature
+    ):
+        variant = json.loads(json.dumps(crowd))
+        variant["physics"]["lod"].update(lod)
+        written[name] = tmp_path / f"{name}.json"
+        written[name].write_text(json.dumps(variant))
+
+    def bake(scene: str, *options: str) -> tuple[str, str]:
+        out = tmp_path / "take.npz"
+        argv = ["bake", str(written[scene]), "--seconds", "0.1", "--out", str(out), "--quiet"]
+        assert main([*argv, *options]) == 0
+        take = Take.load(out)
+        motion = hashlib.sha256(np.ascontiguousarray(take.pos).tobytes()).hexdigest()
+        return take.header["scene_sha256"], motion
+
+    plain = bake("scene")
+    assert bake("scene", "--lod", "on") == plain
+    off = bake("scene", "--lod", "off")
+    assert off == bake("off") and off[1] != plain[1]  # the same scene, another motion
+    focus = bake("scene", "--focus=-2,2,0.5")
+    assert focus == bake("focus") and focus[1] not in (plain[1], off[1])

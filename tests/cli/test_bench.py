@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from ecs_tentacles.cli import main
-from tests.test_bench import KEYS
+from tests.test_bench import KEYS, lod_crowd
 
 
 def test_json_has_every_key_finite(capsys: pytest.CaptureFixture[str]) -> None:
@@ -18,7 +18,7 @@ def test_json_has_every_key_finite(capsys: pytest.CaptureFixture[str]) -> None:
     assert main([*argv, "--threads", "2", "--idle", "0.5", "--json"]) == 0
     result = json.loads(capsys.readouterr().out)
     assert list(result) == KEYS
-    assert all(math.isfinite(v) for k, v in result.items() if k != "systems")
+    assert all(math.isfinite(v) for k, v in result.items() if k not in ("systems", "tiers"))
     assert all(math.isfinite(v) for v in result["systems"].values())
     assert (result["creatures"], result["threads"], result["frames"]) == (2, 2, 4)
 
@@ -26,7 +26,7 @@ def test_json_has_every_key_finite(capsys: pytest.CaptureFixture[str]) -> None:
 def test_human_summary_of_a_scene_file(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["bench", "three_goals", "--frames", "2", "--warmup", "1", "--threads", "1"]) == 0
     lines = capsys.readouterr().out.splitlines()
-    assert len(lines) == 3
+    assert len(lines) == 4
     assert re.fullmatch(
         r".*three_goals\.json: 1 creatures, 61 bodies, 1 shared models \(0 creatures"
         r" asleep at the end\), 1 threads;"
@@ -34,7 +34,9 @@ def test_human_summary_of_a_scene_file(capsys: pytest.CaptureFixture[str]) -> No
         lines[0],
     )
     assert "2 frames: " in lines[1] and "bare MuJoCo" in lines[1] and "overhead" in lines[1]
-    assert lines[2].startswith("  systems (ms/frame): ")
+    tiers = "full 1  reduced 0  kinematic 0 (level of detail on: 0 promotions, 0 demotions)"
+    assert lines[2] == f"  tiers at the end: {tiers}"
+    assert lines[3].startswith("  systems (ms/frame): ")
 
 
 @pytest.mark.parametrize(
@@ -45,6 +47,10 @@ def test_human_summary_of_a_scene_file(capsys: pytest.CaptureFixture[str]) -> No
         (["--crowd", "16385"], "argument --crowd: must be <= 16384 (the most creatures a scene"),
         (["octopus", "--crowd", "2"], "argument --crowd: not allowed with argument SCENE"),
         ([], "one of the arguments SCENE --crowd is required"),
+        (["--crowd", "2", "--lod", "maybe"], "argument --lod: invalid choice: 'maybe'"),
+        (["--crowd", "2", "--focus", "1,2"], "argument --focus: must be X,Y,R (three numbers"),
+        (["--crowd", "2", "--focus=1,2,-3"], "argument --focus: radius must be in [0, 100000] m"),
+        (["--crowd", "2", "--focus", "a,b,c"], "argument --focus: must be X,Y,R"),
     ],
 )
 def test_bad_arguments_are_one_line_exit_2(
@@ -68,3 +74,19 @@ def test_bad_scene_is_one_line_exit_2(tmp_path: Path, capsys: pytest.CaptureFixt
     assert captured.out == ""
     assert main(["bench", "--crowd", "3", "--spacing", "0.2"]) == 2
     assert capsys.readouterr().err.count("\n") == 1
+
+
+def test_lod_off_and_a_focus_from_the_command_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    scene = tmp_path / "crowd.json"
+    scene.write_text(json.dumps(lod_crowd()))
+    argv = ["bench", str(scene), "--frames", "2", "--block", "2", "--warmup", "1", "--json"]
+    assert main([*argv, "--lod", "off"]) == 0
+    off = json.loads(capsys.readouterr().out)
+    assert (off["lod"], off["tiers"]["full"], off["demotions"]) == (False, 6, 0)
+    assert main([*argv, "--focus=-100,-100,1"]) == 0  # a focus far away: the budgets rule
+    on = json.loads(capsys.readouterr().out)
+    assert on["lod"] is True and on["tiers"] == {"full": 1, "reduced": 2, "kinematic": 3}
+    assert main([*argv, "--focus=0,0,1000"]) == 0  # everyone inside the focus
+    assert json.loads(capsys.readouterr().out)["tiers"]["full"] == 6

@@ -52,3 +52,25 @@ def test_without_locomotion_there_are_no_goal_counts_and_a_plugin_adds_its_own(
     assert summary["frames_seen"] == 4 and summary["sucker_attaches"] == 0
     assert main(argv) == 0
     assert capsys.readouterr().out.endswith("dofs); frames seen 4; sucker attaches 0\n")
+
+
+def test_lod_and_focus_options_decide_the_tiers(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from tests.test_bench import lod_crowd
+
+    scene = tmp_path / "crowd.json"
+    scene.write_text(json.dumps(lod_crowd()))  # 6 creatures, budgets 1 full and 2 reduced
+    argv = ["run", str(scene), "--frames", "3", "--quiet", "--threads", "1"]
+    assert main(argv) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[1] == "  level of detail at the end: full 1  reduced 2  kinematic 3"
+    runs = {}
+    for name, options in (("off", ["--lod", "off"]), ("focus", ["--focus=0,0,1000"])):
+        assert main([*argv, "--json", *options]) == 0
+        runs[name] = json.loads(capsys.readouterr().out)
+    assert runs["off"]["lod"] is False and runs["off"]["promotions"] == 0
+    assert (
+        runs["off"]["tiers"] == runs["focus"]["tiers"] == {"full": 6, "reduced": 0, "kinematic": 0}
+    )
+    assert runs["focus"]["lod"] is True

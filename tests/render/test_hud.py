@@ -71,7 +71,9 @@ def test_no_hud_flag_and_h_key_hide_the_panel(
     sandbox = make_sandbox("octopus")
     sandbox.render()
     shown = sandbox.renderer.target.read()
-    background = shown[350, 5]  # the panel's own colour, bottom left
+    panel = shown[:, : sandbox.hud.width].reshape(-1, 3)
+    colours, counts = np.unique(panel, axis=0, return_counts=True)
+    background = colours[counts.argmax()]  # the panel's own colour: most of it
     assert _panel_pixels(shown[:, : sandbox.hud.width], background) > 0.5 * 360 * sandbox.hud.width
     event(sandbox, "on_key_press", key.H, 0)
     assert sandbox.renderer.camera.shift_x == 0.0
@@ -79,7 +81,8 @@ def test_no_hud_flag_and_h_key_hide_the_panel(
     assert _panel_pixels(sandbox.renderer.target.read(), background) == 0
     event(sandbox, "on_key_press", key.H, 0)
     sandbox.render()
-    assert (sandbox.renderer.target.read()[350, 5] == background).all()
+    again = sandbox.renderer.target.read()[:, : sandbox.hud.width]
+    assert _panel_pixels(again, background) > 0.5 * 360 * sandbox.hud.width
     shot = tmp_path / "bare.png"
     argv = ["play", "octopus", "--headless", "--frames", "2", "--quiet", "--no-hud"]
     assert main([*argv, "--width", "640", "--height", "360", "--screenshot", str(shot)]) == 0

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import csv
-import os
 from pathlib import Path
 
 import pytest
@@ -15,6 +14,7 @@ pytestmark = pytest.mark.skipif(not TOOLS.is_dir(), reason="needs the source tre
 
 COLUMNS = [
     "creatures",
+    "lod",
     "threads",
     "compiles",
     "bodies",
@@ -27,6 +27,10 @@ COLUMNS = [
     "overhead_ratio",
     "realtime_factor",
     "rss_mb",
+    "full",
+    "reduced",
+    "kinematic",
+    "promotions",
     "error",
 ]
 
@@ -35,17 +39,21 @@ def test_tiny_sizes_write_the_csv_and_the_plot(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     scaling = _load("crowd_scaling")
-    assert scaling.main(["--sizes", "1,2", "--frames", "2", "--out", str(tmp_path / "s")]) == 0
+    argv = ["--sizes", "1,2", "--frames", "2", "--threads", "1", "--warmup", "2"]
+    argv += ["--out", str(tmp_path / "s")]
+    assert scaling.main(argv) == 0
     with open(tmp_path / "s.csv", newline="") as handle:
         reader = csv.DictReader(handle)
         rows = list(reader)
     assert reader.fieldnames == COLUMNS
-    all_threads = os.cpu_count() or 1
-    runs = {(n, t) for n in (1, 2) for t in {1, all_threads}}
-    assert {(int(r["creatures"]), int(r["threads"])) for r in rows} == runs
-    assert len(rows) == len(runs)
+    runs = {(n, lod) for n in (1, 2) for lod in ("on", "off")}
+    assert {(int(r["creatures"]), r["lod"]) for r in rows} == runs
+    assert len(rows) == len(runs) and {r["threads"] for r in rows} == {"1"}
     for row in rows:
         assert row["error"] == ""
+        # tiny crowds fit the full budget: everyone full, lod on or off
+        tiers = [int(row[t]) for t in ("full", "reduced", "kinematic")]
+        assert tiers == [int(row["creatures"]), 0, 0] and row["promotions"] == "0"
         assert float(row["build_s_per_creature"]) == pytest.approx(
             float(row["build_s"]) / int(row["creatures"])
         )
@@ -59,7 +67,7 @@ def test_tiny_sizes_write_the_csv_and_the_plot(
         assert image.format == "PNG" and image.size == (1100, 462)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["s.csv", "s.png"]
     err = capsys.readouterr().err
-    assert f"[1/{len(runs)}] 1 creatures, 1 threads ..." in err and "wrote " in err
+    assert f"[1/{len(runs)}] 1 creatures, lod on, 1 threads ..." in err and "wrote " in err
 
 
 def test_a_failed_run_keeps_its_error_line() -> None:
@@ -67,6 +75,22 @@ def test_a_failed_run_keeps_its_error_line() -> None:
     row = scaling.bench_once(1, 1, frames=0, seed=0, timeout=60)
     assert row == {
         "creatures": 1,
+        "lod": "on",
         "threads": 1,
         "error": "error: argument --frames: must be >= 1, got 0 (see ecs-tentacles bench --help)",
     }
+
+
+def test_a_run_past_its_timeout_is_an_error_row(tmp_path: Path) -> None:
+    scaling = _load("crowd_scaling")
+    row = scaling.bench_once(64, 1, frames=100000, seed=0, timeout=0.5, lod="off")
+    assert row == {
+        "creatures": 64,
+        "lod": "off",
+        "threads": 1,
+        "error": "timed out after 0.5 s (--timeout)",
+    }
+    rows = [row, {**row, "lod": "on"}]
+    scaling.write_csv(rows, tmp_path / "t.csv")
+    scaling.plot(rows, tmp_path / "t.png")  # a plot with no finished run still draws
+    assert (tmp_path / "t.png").read_bytes()[:4] == b"\x89PNG"
