@@ -1,8 +1,8 @@
 """The built-in scenes behave exactly as recorded: same take, byte for byte.
 
-The hashes in `tests/data/take_sha256.json` were recorded before the plugin refactor
-(issue 13) and the feature-package refactor (issue 19: flock, wander, a 16-creature
-crowd). MuJoCo and numpy releases may change floating-point results, so the test compares
+The hashes in `tests/data/take_sha256.json` were last re-recorded for issue 20 (its
+"about" says why: the motion arrays did not change, the header's scene defaults did).
+MuJoCo and numpy releases may change floating-point results, so the test compares
 only under the versions the hashes were recorded with (re-record them, on
 purpose, when upgrading: `ecs-tentacles bake SCENE --seconds 2 --out t.npz`).
 """
