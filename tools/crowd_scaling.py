@@ -28,6 +28,7 @@ from matplotlib.ticker import FuncFormatter, NullFormatter
 
 from ecs_tentacles.atomic import atomic_output
 
+LOD_OFF_MAX = 1024
 SIZES = (16, 64, 256, 1024, 10000)
 LODS = ("on", "off")
 TIERS = ("full", "reduced", "kinematic")
@@ -188,10 +189,23 @@ def main(argv: list[str] | None = None) -> int:
         help=f"untimed frames first (default {WARMUP}: past lod's first demotions)",
     )
     parser.add_argument(
+        "--lod-off-max",
+        type=int,
+        default=LOD_OFF_MAX,
+        help=f"largest crowd run with lod off (default {LOD_OFF_MAX}: 10,000 creatures at"
+        " full physics take about 10 s a frame)",
+    )
+    parser.add_argument(
         "--out", type=Path, default=Path("crowd_scaling"), help="writes OUT.csv and OUT.png"
     )
     args = parser.parse_args(argv)
-    runs = [(n, lod, t) for n in args.sizes for lod in args.lod for t in args.threads]
+    runs = [
+        (n, lod, t)
+        for n in args.sizes
+        for lod in args.lod
+        for t in args.threads
+        if lod == "on" or n <= args.lod_off_max
+    ]
     rows = []
     extra: tuple[str, ...] = ("--idle", str(args.idle), "--warmup", str(args.warmup))
     extra += () if args.varied else ("--uniform",)

@@ -87,7 +87,7 @@ def test_with_defaults_fills_nested_defaults_exactly() -> None:
                 "full": 32,
                 "reduced": 64,
                 "hold_seconds": 1.0,
-                "contact_margin": 0.3,
+                "contact_margin": 0.1,
             },
             "separate_overlaps": False,
         },
@@ -159,7 +159,7 @@ def test_with_defaults_keeps_given_values_and_names() -> None:
             "full": 32,
             "reduced": 64,
             "hold_seconds": 1.0,
-            "contact_margin": 0.3,
+            "contact_margin": 0.1,
         },
         "separate_overlaps": False,
     }
