@@ -31,7 +31,6 @@ S = mujoco.mjtState
 MARGIN = 0.05  # metres: a body this close to a neighbour's sphere gets a proxy
 POOL = np.array([PROXY_CAPSULES, PROXY_CYLINDERS])
 CAPSULE, CYLINDER = 0, 1
-PART = 1  # consecutive bodies bounded together when asking who is about to touch
 DENSE_PAIRS = 256  # creatures up to which every pair is compared (no tree to build)
 PARK = PROXY_PARK + np.outer(np.arange(PROXY_CAPSULES + PROXY_CYLINDERS) * 10.0, [1.0, 0.0, 0.0])
 _NONE = np.zeros(0, dtype=np.int64)
@@ -125,11 +124,11 @@ class ContactProxies:
         """Per creature, the gap (m) between its bodies and the nearest other creature's,
         as far as it is under `margin` (inf where none comes that close).
 
-        Reach spheres find the candidate pairs; then each candidate's bodies, in runs of
-        `PART` consecutive bodies (a tentacle's links lie side by side), get bounding
-        spheres, and a pair counts when two of those come within `margin`. A creature's
-        whole reach sphere is far too coarse for a star of tentacles: neighbours in a
-        crowd are inside each other's spheres long before any tentacles meet.
+        Reach spheres find the candidate pairs; of each pair, only the bodies inside the
+        other creature's sphere can be near it, and those are compared body against
+        body (bounding spheres). A creature's whole reach sphere alone is far too coarse
+        for a star of tentacles: neighbours in a crowd are inside each other's spheres
+        long before any tentacles meet.
         """
         near = np.full(len(self.roster), np.inf)
         a, b = near_pairs(centre, radius, margin)
@@ -137,29 +136,41 @@ class ContactProxies:
         a, b = a[first], b[first]
         if not len(a):
             return near
-        who = np.unique(np.concatenate((a, b)))
-        bodies = np.concatenate([np.arange(s, s + n) for s, n in zip(self.start[who],
-                                 self.count[who], strict=True)])  # fmt: skip
-        parts = -(-self.count[who] // PART)  # runs per candidate creature
-        part_start = np.concatenate([[0], np.cumsum(parts)[:-1]])
-        within = bodies - np.repeat(self.start[who], self.count[who])
-        part = np.repeat(part_start, self.count[who]) + within // PART
-        edges = np.flatnonzero(np.r_[True, part[1:] != part[:-1]])
-        size = np.diff(np.r_[edges, len(part)])
-        middle = np.add.reduceat(pos[bodies], edges, axis=0) / size[:, None]
-        reach = np.linalg.norm(pos[bodies] - middle[part], axis=1) + self.rbound[bodies]
-        bound = np.maximum.reduceat(reach, edges)
-        slot = np.searchsorted(who, np.stack((a, b)))  # the pair's creatures among `who`
-        na, nb = parts[slot[0]], parts[slot[1]]
-        pair = np.repeat(np.arange(len(a)), na * nb)
-        k = np.arange(len(pair)) - np.repeat(np.cumsum(na * nb) - na * nb, na * nb)
-        pa = part_start[slot[0]][pair] + k // nb[pair]
-        pb = part_start[slot[1]][pair] + k % nb[pair]
-        gap = np.linalg.norm(middle[pa] - middle[pb], axis=1) - bound[pa] - bound[pb]
-        closest = np.minimum.reduceat(gap, np.cumsum(na * nb) - na * nb)
-        np.minimum.at(near, a, closest)
-        np.minimum.at(near, b, closest)
+        pa, ba = self._inside(a, b, pos, centre, radius, margin)
+        pb, bb = self._inside(b, a, pos, centre, radius, margin)
+        na = np.bincount(pa, minlength=len(a))
+        nb = np.bincount(pb, minlength=len(a))
+        both = na * nb
+        if not both.any():
+            return near
+        pair = np.repeat(np.arange(len(a)), both)
+        k = np.arange(len(pair)) - np.repeat(np.cumsum(both) - both, both)
+        ia = ba[(np.cumsum(na) - na)[pair] + k // nb[pair]]
+        ib = bb[(np.cumsum(nb) - nb)[pair] + k % nb[pair]]
+        gap = np.linalg.norm(pos[ia] - pos[ib], axis=1) - self.rbound[ia] - self.rbound[ib]
+        gaps = np.full(len(a), np.inf)
+        np.minimum.at(gaps, pair, gap)
+        np.minimum.at(near, a, gaps)
+        np.minimum.at(near, b, gaps)
         return near
+
+    def _inside(
+        self,
+        x: np.ndarray,
+        y: np.ndarray,
+        pos: np.ndarray,
+        centre: np.ndarray,
+        radius: np.ndarray,
+        margin: float,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """(pair, body) for every body of creature x[pair] within `margin` of y[pair]'s
+        reach sphere, pair by pair."""
+        per = self.count[x]
+        pair = np.repeat(np.arange(len(x)), per)
+        body = np.arange(per.sum()) - np.repeat(np.cumsum(per) - per, per) + self.start[x][pair]
+        gap = np.linalg.norm(pos[body] - centre[y][pair], axis=1) - self.rbound[body]
+        keep = gap < radius[y][pair] + margin
+        return pair[keep], body[keep]
 
     def _place(
         self, pos: np.ndarray, quat: np.ndarray, centre: np.ndarray, radius: np.ndarray
