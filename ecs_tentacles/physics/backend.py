@@ -265,17 +265,26 @@ class PhysicsBackend:
                 self._run(chunks, {FULL: 1, REDUCED: int(i < reduced)})
         else:
             near = self.proxies_used > 0 if rounds > 1 else np.zeros(len(self), dtype=bool)
-            alone = plan(self.batches, self.active & ~near, self.tier, self.threads)
-            self._run(alone, {FULL: substeps, REDUCED: reduced})
-            if near.any():
-                chunks = plan(self.batches, self.active & near, self.tier, self.threads)
-                full = _split(substeps, rounds)
-                for k, (n, r) in enumerate(zip(full, _split(reduced, rounds), strict=True)):
-                    if not n:
-                        continue
-                    if k and between is not None:
+            near &= self.active
+            alone = self.active & ~near
+            whole = {FULL: substeps, REDUCED: reduced}
+            if not near.any():
+                self._run(plan(self.batches, alone, self.tier, self.threads), whole)
+            else:
+                parts = [
+                    {FULL: n, REDUCED: r}
+                    for n, r in zip(_split(substeps, rounds), _split(reduced, rounds), strict=True)
+                    if n
+                ]
+                # the first part of the near ones with all of the others: one balanced call
+                share = substeps / parts[0][FULL]
+                first = plan(self.batches, near, self.tier, self.threads, (alone, whole, share))
+                self._run(first, parts[0])
+                chunks = plan(self.batches, near, self.tier, self.threads)
+                for part in parts[1:]:
+                    if between is not None:
                         between()
-                    self._run(chunks, {FULL: n, REDUCED: r})
+                    self._run(chunks, part)
         self.time += substeps * self.substep_dt
 
     def _run(self, chunks: list[list[Segment]], substeps: dict[int, int]) -> None:

@@ -21,41 +21,58 @@ from ecs_tentacles.physics.tiers import FULL, REDUCED
 
 @dataclass(frozen=True)
 class Segment:
-    """Some rows of one batch, stepped at one tier."""
+    """Some rows of one batch, stepped at one tier; `steps` per tier when they differ from
+    the call's."""
 
     batch: Batch
     rows: np.ndarray
     tier: int = FULL
+    steps: dict[int, int] | None = None
 
 
 def plan(
-    batches: list[Batch], active: np.ndarray, tier: np.ndarray, threads: int
+    batches: list[Batch],
+    active: np.ndarray,
+    tier: np.ndarray,
+    threads: int,
+    also: tuple[np.ndarray, dict[int, int], float] | None = None,
 ) -> list[list[Segment]]:
     """Active rows (by creature index) of the stepped tiers in at most `threads` chunks of
-    about equal cost; every tier's model and scratch data are made first."""
+    about equal cost; every tier's model and scratch data are made first.
+
+    `also` = (more active creatures, their steps per tier, how many times the call's
+    steps that is): stepped in the same chunks, their cost weighed by it, so one
+    dispatch balances creatures that take different step counts.
+    """
     pieces = []
-    for level, share in ((FULL, 1.0), (REDUCED, 0.5)):
-        for batch in batches:
-            rows = np.flatnonzero(active[batch.members] & (tier[batch.members] == level))
-            if len(rows):
-                batch.prepare(level, threads)
-                cost = np.full(len(rows), share * (batch.model.nv + 1.0))
-                pieces.append((batch, rows, cost, level))
+    groups: list[tuple[np.ndarray, dict[int, int] | None, float]] = [(active, None, 1.0)]
+    if also is not None:
+        groups.append(also)
+    for mask, steps, weight in groups:
+        for level, share in ((FULL, 1.0), (REDUCED, 0.5)):
+            for batch in batches:
+                rows = np.flatnonzero(mask[batch.members] & (tier[batch.members] == level))
+                if len(rows):
+                    batch.prepare(level, threads)
+                    cost = np.full(len(rows), share * weight * (batch.model.nv + 1.0))
+                    pieces.append((batch, rows, cost, level, steps))
     if not pieces:
         return []
-    cost = np.cumsum(np.concatenate([c for _, _, c, _ in pieces]))
+    cost = np.cumsum(np.concatenate([c for _, _, c, _, _ in pieces]))
     cuts = np.searchsorted(cost, cost[-1] * np.arange(1, threads) / threads)
     bounds = [0, *cuts.tolist(), len(cost)]
-    starts = np.cumsum([0] + [len(r) for _, r, _, _ in pieces])
+    starts = np.cumsum([0] + [len(r) for _, r, _, _, _ in pieces])
     chunks: list[list[Segment]] = []
     for a, b in itertools.pairwise(bounds):
         if b <= a:
             continue
         chunk = []
-        for (batch, rows, _, level), lo, hi in zip(pieces, starts[:-1], starts[1:], strict=True):
+        for (batch, rows, _, level, steps), lo, hi in zip(
+            pieces, starts[:-1], starts[1:], strict=True
+        ):
             s, e = max(a, lo), min(b, hi)
             if e > s:
-                chunk.append(Segment(batch, rows[s - lo : e - lo], level))
+                chunk.append(Segment(batch, rows[s - lo : e - lo], level, steps))
         chunks.append(chunk)
     return chunks
 
@@ -64,7 +81,7 @@ def step_segments(chunk: list[Segment], substeps: dict[int, int], thread: int) -
     """Step every segment of `chunk` by its tier's `substeps` on scratch `thread` (runs on
     a pool thread)."""
     for segment in chunk:
-        n = substeps[segment.tier]
+        n = (segment.steps or substeps)[segment.tier]
         if n:
             segment.batch.step_rows(segment.rows, n, thread, segment.tier)
 
