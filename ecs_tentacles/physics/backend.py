@@ -37,7 +37,7 @@ from ecs_tentacles.physics.proxies import ContactProxies
 from ecs_tentacles.physics.roster import Roster
 from ecs_tentacles.physics.sleep import Sleep, SleepState
 from ecs_tentacles.physics.stepping import Segment, bare_step, plan, step_segments
-from ecs_tentacles.physics.tiers import FULL, KINEMATIC, NAMES, REDUCED, reduced_substeps
+from ecs_tentacles.physics.tiers import FULL, KINEMATIC, REDUCED, reduced_substeps
 from ecs_tentacles.physics.view import CreatureView
 
 if TYPE_CHECKING:
@@ -208,11 +208,6 @@ class PhysicsBackend:
     def active(self) -> np.ndarray:
         """Creatures stepped this frame (not frozen, not asleep, not kinematic)."""
         return self.roster.active
-
-    def tier_counts(self) -> dict[str, int]:
-        """Creatures per level of detail, by tier name."""
-        counts = np.bincount(self.tier, minlength=len(NAMES))
-        return {name: int(n) for name, n in zip(NAMES, counts, strict=True)}
 
     def set_tier(self, indices: np.ndarray, tier: int) -> None:
         """Move creatures (backend indices) to `tier`. Between FULL and REDUCED the state

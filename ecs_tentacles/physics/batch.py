@@ -26,7 +26,13 @@ from typing import TYPE_CHECKING
 import mujoco
 import numpy as np
 
-from ecs_tentacles.physics.model import PROXY_CAPSULES, PROXY_CYLINDERS, PROXY_PARK, ModelLayout
+from ecs_tentacles.physics.model import (
+    PROXY_CAPSULES,
+    PROXY_CYLINDERS,
+    PROXY_PARKED,
+    PROXY_SLOTS,
+    ModelLayout,
+)
 from ecs_tentacles.physics.tiers import FULL
 
 if TYPE_CHECKING:
@@ -44,7 +50,6 @@ STATE = (
     | S.mjSTATE_MOCAP_POS
     | S.mjSTATE_MOCAP_QUAT
 )
-PROXIES = PROXY_CAPSULES + PROXY_CYLINDERS
 WARNING_KINDS = len(mujoco.MjData(mujoco.MjModel.from_xml_string("<mujoco/>")).warning)
 
 
@@ -118,7 +123,7 @@ class Batch:
         self.kv = np.zeros((n, m.nu))
         self.torque = np.zeros((n, m.nu))
         self.anchor = np.zeros((n, len(self.equality_ids), 3))
-        self.proxy_size = np.full((n, PROXIES, 2), 0.01)
+        self.proxy_size = np.full((n, PROXY_SLOTS, 2), 0.01)
         self.near = np.zeros(n, dtype=bool)  # proxies placed (parked ones need no size)
         self.applied: dict[int, np.ndarray] = {}  # row -> xfrc_applied, while a script pushes
         # what the last step produced
@@ -180,9 +185,7 @@ class Batch:
         mujoco.mj_resetData(m, d)
         d.qpos[self.root_qpos : self.root_qpos + 3] = pos
         d.qpos[self.root_qpos + 3 : self.root_qpos + 7] = quat
-        d.mocap_pos[self.proxy_mocap] = PROXY_PARK + np.outer(
-            np.arange(PROXIES) * 10.0, [1.0, 0.0, 0.0]
-        )
+        d.mocap_pos[self.proxy_mocap] = PROXY_PARKED
         mujoco.mj_forward(m, d)
         mujoco.mj_getState(m, d, self.state[row], STATE)
         self.xpos[row] = d.xpos[self.body_ids]

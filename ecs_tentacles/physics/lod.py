@@ -144,9 +144,9 @@ class LevelOfDetail:
         roster = self.roster
         if not len(roster):
             return
-        if not self.enabled:  # everyone full (at once, if lod was just switched off)
-            if (roster.tier != FULL).any():
-                self._move(world, np.full(len(roster), FULL, dtype=np.int8))
+        fits = len(roster) <= self.settings.full  # everyone fits the full budget
+        if not self.enabled or fits:  # everyone full (at once, if that just became so)
+            self._move(world, np.full(len(roster), FULL, dtype=np.int8))
             return
         pos, _, centre, radius = self.proxies.sense(world.transforms, world.frame)
         margin = self.settings.contact_margin

@@ -46,6 +46,8 @@ GROUND_BIT, CREATURE_BIT, PROXY_BIT = 1, 2, 4
 PROXY_CAPSULES = 64
 PROXY_CYLINDERS = 4
 PROXY_PARK = np.array([1.0e4, 0.0, -1.0e4])  # unused proxies wait here, 10 m apart
+PROXY_SLOTS = PROXY_CAPSULES + PROXY_CYLINDERS
+PROXY_PARKED = PROXY_PARK + np.outer(np.arange(PROXY_SLOTS) * 10.0, [1.0, 0.0, 0.0])  # per slot
 
 ARENA_BYTES = 4 << 20
 
@@ -241,7 +243,7 @@ def _add_proxies(spec: mujoco.MjSpec) -> None:
     for kind, count, geom_type, quat in kinds:
         for i in range(count):
             body = spec.worldbody.add_body(
-                name=f"proxy/{kind}{i}", mocap=True, pos=PROXY_PARK + [10.0 * slot, 0.0, 0.0]
+                name=f"proxy/{kind}{i}", mocap=True, pos=PROXY_PARKED[slot]
             )
             body.add_geom(
                 name=f"proxy/{kind}{i}",

@@ -21,7 +21,7 @@ import mujoco
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ecs_tentacles.physics.model import PROXY_CAPSULES, PROXY_CYLINDERS, PROXY_PARK
+from ecs_tentacles.physics.model import PROXY_CAPSULES, PROXY_CYLINDERS, PROXY_PARKED
 
 if TYPE_CHECKING:
     from ecs_tentacles.physics.roster import Roster
@@ -32,7 +32,6 @@ MARGIN = 0.05  # metres: a body this close to a neighbour's sphere gets a proxy
 POOL = np.array([PROXY_CAPSULES, PROXY_CYLINDERS])
 CAPSULE, CYLINDER = 0, 1
 DENSE_PAIRS = 256  # creatures up to which every pair is compared (no tree to build)
-PARK = PROXY_PARK + np.outer(np.arange(PROXY_CAPSULES + PROXY_CYLINDERS) * 10.0, [1.0, 0.0, 0.0])
 _NONE = np.zeros(0, dtype=np.int64)
 Sensed = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]  # pos, quat, centre, radius
 
@@ -184,7 +183,7 @@ class ContactProxies:
             mocap = batch.grid(S.mjSTATE_MOCAP_POS, 3)
             parked = np.flatnonzero(was_used[batch.members])
             if len(parked):
-                mocap[parked[:, None], batch.proxy_mocap] = PARK
+                mocap[parked[:, None], batch.proxy_mocap] = PROXY_PARKED
             mine = batch.index == roster.batch_of[who]
             rows = roster.row_of[who[mine]]
             if len(rows):

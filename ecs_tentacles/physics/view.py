@@ -32,7 +32,7 @@ class StateView:
         self._batch, self._row = batch, row
 
     def _part(self, flag: int) -> np.ndarray:
-        return self._batch.state[self._row, self._batch.slices[int(flag)]]
+        return self._batch.part(flag, self._row)
 
     @property
     def qpos(self) -> np.ndarray:
