@@ -49,7 +49,10 @@ PROXY_PARK = np.array([1.0e4, 0.0, -1.0e4])  # unused proxies wait here, 10 m ap
 PROXY_SLOTS = PROXY_CAPSULES + PROXY_CYLINDERS
 PROXY_PARKED = PROXY_PARK + np.outer(np.arange(PROXY_SLOTS) * 10.0, [1.0, 0.0, 0.0])  # per slot
 
-ARENA_BYTES = 4 << 20
+# Each stepping thread has one MjData per model (physics/batch.py), never one per
+# creature, so the arena can hold the schema's largest creature (16 x 64 links needs more
+# than 4 MB at rest); pages it never touches are not resident.
+ARENA_BYTES = 64 << 20
 
 # MuJoCo takes the larger friction of two touching geoms: creature skin is zero so the
 # scene's ground_friction alone sets how creatures slide.
@@ -146,9 +149,8 @@ def build_spec(
     spec.option.gravity = list(settings.gravity)
     # The framework, not MuJoCo, decides what happens after a blow-up (physics/health.py).
     spec.option.disableflags |= mujoco.mjtDisableBit.mjDSBL_AUTORESET
-    # MuJoCo's default arena (24 MB for an octopus) is 80x what a crawling creature uses
-    # (0.3 MB): at 1,024 creatures that was 4-5 GB resident. A blow-up that overflows
-    # this one is caught as a fatal error and recovered (physics/health.py).
+    # One arena per stepping thread and model (ARENA_BYTES). A blow-up that overflows it
+    # is caught as a fatal error and recovered (physics/health.py).
     spec.memory = ARENA_BYTES
     spec.worldbody.add_geom(
         name="ground",

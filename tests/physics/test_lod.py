@@ -163,3 +163,23 @@ def test_promotion_starts_from_the_shown_pose(make_world: Callable[..., World]) 
     world.lod.release(creature)
     world.step(2)
     assert world.lod.tier_of(creature) == "kinematic"
+
+
+def test_the_schemas_largest_creature_steps_at_full_and_reduced(
+    make_world: Callable[..., World],
+) -> None:
+    largest = {"count": 16, "links": 64}  # the schema's maximum: 1,025 bodies
+    scene = {
+        "version": 1,
+        "physics": {"lod": {"full": 0, "reduced": 1, "hold_seconds": 0}},
+        "creatures": [
+            {"name": f"c{i}", "position": [12.0 * i, 0.0], "tentacles": dict(largest)}
+            for i in range(2)
+        ],
+    }
+    world = make_world(scene)  # its arena once overflowed while placing it at build
+    world.lod.promote(world.creature("c1"))
+    world.step(20)
+    assert world.lod.counts() == {"full": 1, "reduced": 1, "kinematic": 0}
+    assert world.physics.health.recoveries == 0
+    assert np.isfinite(world.transforms.pos).all()
