@@ -21,8 +21,10 @@ The rules, whole-array work every frame before the step:
    inside the focus region.
 3. The other awake creatures are ranked: nearest the focus first (without one, all
    equal), then the tier they hold (hysteresis), then creature order, so a bake's
-   decisions depend on nothing but the scene. The first `full` run FULL, the next
-   `reduced` REDUCED, the rest KINEMATIC (REDUCED while no replay is registered).
+   decisions depend on nothing but the scene. They fill what rule 2 left of the
+   `full` budget (the budget counts the creatures that must be full: it caps what
+   full physics costs unless more than `full` touch), then `reduced` run REDUCED,
+   the rest KINEMATIC (REDUCED while no replay is registered).
 4. Asleep creatures keep their tier and use no budget.
 5. Demotion waits until a creature has held its tier `hold_seconds`; promotion never
    waits.
@@ -164,7 +166,8 @@ class LevelOfDetail:
         awake = ~(roster.sleeping | roster.frozen)
         ranked = np.flatnonzero(awake & ~must)
         order = np.lexsort((ranked, tier[ranked], distance[ranked]))
-        full, reduced = self.settings.full, self.settings.reduced
+        full = max(0, self.settings.full - int(must.sum()))  # the budget counts the forced
+        reduced = self.settings.reduced
         want[ranked[order[:full]]] = FULL
         want[ranked[order[full : full + reduced]]] = REDUCED
         keep = ~awake & ~must  # asleep: keeps its tier

@@ -67,6 +67,7 @@ class ContactProxies:
         self.count = counts
         self.mantle = self.start  # a creature's first body is its mantle
         self._sensed: tuple[int, Sensed] | None = None  # (frame, sense())
+        self._within: Sensed | None = None  # the poses refresh() moves within a frame
         # each batch row's bodies in this order
         self.index = [
             self.start[batch.members][:, None] + np.arange(len(batch.body_ids))
@@ -86,6 +87,7 @@ class ContactProxies:
 
     def update(self, transforms: TransformStore, frame: int | None = None) -> None:
         """Give every creature proxies of the other creatures' bodies near it."""
+        self._within = None
         if len(self.roster) < 2:
             return
         self._place(*self.sense(transforms, frame))
@@ -99,16 +101,26 @@ class ContactProxies:
         """Move the proxies to where the bodies are now, within the frame.
 
         Bodies of creatures near someone are read from their last step (as of their
-        last substep); every other body is as the frame started."""
-        pos, quat = transforms.pos[self.rows], transforms.quat[self.rows]
-        self._sensed = None
+        last substep); every other body is as the frame started. Only the near
+        creatures' poses and reach spheres are recomputed: the frame's `sense` (or the
+        last refresh's) holds everyone else's, and is taken over (it is not the frame
+        start's any more, so `sense` computes afresh after this).
+        """
+        if self._sensed is not None:
+            self._within, self._sensed = self._sensed[1], None
+        if self._within is None:
+            self._within = self.sense(transforms)
+        pos, quat, centre, radius = self._within
         used = self.roster.proxies_used > 0
         for batch, index in zip(self.roster.batches, self.index, strict=True):
             rows = np.flatnonzero(used[batch.members])
             if len(rows):
                 pos[index[rows]] = batch.xpos[rows]
                 quat[index[rows]] = batch.xquat[rows]
-        self._place(pos, quat, *self.spheres(pos))
+        moved = np.flatnonzero(used)
+        if len(moved):
+            centre[moved], radius[moved] = self._spheres_of(pos, moved)
+        self._place(pos, quat, centre, radius)
 
     def spheres(self, pos: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Every creature's reach sphere (centre at its mantle, radius to its farthest
@@ -116,6 +128,16 @@ class ContactProxies:
         centre = pos[self.mantle]
         reach = np.linalg.norm(pos - centre[self.owner], axis=1) + self.rbound
         return centre, np.maximum.reduceat(reach, self.start)
+
+    def _spheres_of(self, pos: np.ndarray, creatures: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """`spheres` of `creatures` (roster indices) only: the same numbers, fewer bodies."""
+        per = self.count[creatures]
+        first = np.cumsum(per) - per
+        owner = np.repeat(np.arange(len(creatures)), per)
+        body = np.arange(per.sum()) - first[owner] + self.start[creatures][owner]
+        centre = pos[self.mantle[creatures]]
+        reach = np.linalg.norm(pos[body] - centre[owner], axis=1) + self.rbound[body]
+        return centre, np.maximum.reduceat(reach, first)
 
     def closest(
         self, pos: np.ndarray, centre: np.ndarray, radius: np.ndarray, margin: float

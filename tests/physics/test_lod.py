@@ -79,6 +79,22 @@ def test_lod_off_equals_the_full_simulation(make_world: Callable[..., World]) ->
     assert squeezed.lod.promotions == squeezed.lod.demotions == 0
 
 
+def test_the_full_budget_counts_the_creatures_that_must_be_full(
+    make_world: Callable[..., World],
+) -> None:
+    world = make_world(_crowd(8, {"full": 2, "reduced": 3, "hold_seconds": 0}))
+    world.step(2)
+    assert world.lod.counts() == {"full": 2, "reduced": 3, "kinematic": 3}
+    for name in ("c5", "c6", "c7"):  # more forced ones than the budget holds
+        world.lod.promote(world.creature(name))
+    world.step(2)
+    assert world.lod.counts() == {"full": 3, "reduced": 3, "kinematic": 2}
+    assert {world.lod.tier_of(world.creature(n)) for n in ("c5", "c6", "c7")} == {"full"}
+    world.lod.release(world.creature("c7"))
+    world.step(2)  # two forced ones fill the budget of 2 exactly
+    assert world.lod.counts() == {"full": 2, "reduced": 3, "kinematic": 3}
+
+
 def test_a_reduced_creature_crawls_healthily(make_world: Callable[..., World]) -> None:
     world = make_world(_crowd(2, {"full": 0, "reduced": 8, "hold_seconds": 0}))
     start = world.transforms.pos[world.component(world.creature("c0"), Transform).row].copy()

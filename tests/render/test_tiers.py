@@ -30,13 +30,13 @@ def test_the_camera_target_and_the_selection_run_full(make_sandbox: Callable[...
     near = np.linalg.norm(mantles[:, :2] - mantles[0, :2], axis=1) <= FOCUS_RADIUS
     assert 1 < near.sum() < 6
     assert all(lod.tier_of(c) == "full" for c in np.array(creatures)[near])
-    assert lod.counts()["full"] == near.sum() + 1  # and the budget's one
+    assert lod.counts()["full"] == near.sum()  # the budget of 1 counts them: none besides
     sandbox.renderer.camera.target = np.array([100.0, 100.0, 0.0])  # look far away
     selected = creatures[-1]
     sandbox.select(selected)
     sandbox.step(2)
-    assert lod.tier_of(selected) == "full"  # the selection, besides the budget's 1
-    assert lod.counts() == {"full": 2, "reduced": 2, "kinematic": 2}
+    assert lod.tier_of(selected) == "full"  # the selection uses the budget of 1
+    assert lod.counts() == {"full": 1, "reduced": 2, "kinematic": 3}
 
 
 def test_a_pinned_focus_ignores_the_camera(make_sandbox: Callable[..., Any]) -> None:
@@ -91,6 +91,6 @@ def test_play_lod_and_focus_options(tmp_path: Path, capsys: pytest.CaptureFixtur
     argv += ["--width", "320", "--height", "180"]
     assert main([*argv, "--focus=100,100,1"]) == 0
     tiers = json.loads(capsys.readouterr().out)["tiers"]
-    assert tiers["full"] == 2  # the budget's one and the selected (first) creature
+    assert tiers == {"full": 1, "reduced": 2, "kinematic": 3}  # the selected one fills the 1
     assert main([*argv, "--focus=100,100,1", "--lod", "off"]) == 0
     assert json.loads(capsys.readouterr().out)["tiers"]["full"] == 6
