@@ -14,9 +14,11 @@ fsynced and renamed onto the target, then the folder is fsynced.
 - Any exception (KeyboardInterrupt included, and SIGTERM once the CLI's handler turns
   it into an exception) removes the temporary file and leaves the target as it was.
 - Two runs writing one target at the same time: exactly one wins. Each remembers what
-  the target was when it started; at the end, under a lock on the folder, a run whose
-  target changed meanwhile discards its own output and raises `OutputConflict`
-  instead of overwriting the other run's file.
+  the target was when it started (`claim(target)`, which the CLI calls for every
+  output path as it reads its arguments, long before a bake has anything to write;
+  without a claim, when the writing starts); at the end, under a lock on the folder,
+  a run whose target changed meanwhile discards its own output and raises
+  `OutputConflict` instead of overwriting the other run's file.
 - A process killed outright (SIGKILL, power loss) can leave its hidden temporary file
   behind (USD's own `.take.3f9a1c2e.partial.XXXXXX` too), never a partial target. The
   next write to the same target removes such leftovers older than a day
@@ -150,6 +152,34 @@ def _folder_lock(folder: Path) -> Iterator[None]:
         os.close(descriptor)  # releases the lock
 
 
+_claims: dict[str, Identity] = {}  # absolute target path -> what it was when claimed
+
+
+def _claim_key(target: str | os.PathLike[str]) -> str:
+    return os.path.abspath(target)
+
+
+def claim(target: str | os.PathLike[str]) -> None:
+    """Remember what `target` is now: the next write to it in this process fails with
+    `OutputConflict` if another program wrote it in between (call as a run starts).
+
+    Raises OutputError when the folder does not exist or is not writable, so a long
+    run that could never save its output does not start.
+    """
+    path = Path(target)
+    folder = path.parent
+    if not folder.is_dir():
+        raise OutputError(f"{path}: folder {str(folder)!r} does not exist")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise OutputError(f"{path}: cannot write in folder {str(folder)!r} (permission denied)")
+    _claims[_claim_key(path)] = _identity(path)
+
+
+def release_claims() -> None:
+    """Forget every claim (a new run in the same process starts from scratch)."""
+    _claims.clear()
+
+
 class AtomicOutput:
     """One output in progress: `open()` the temporary file, then `commit()` or `discard()`.
 
@@ -166,7 +196,8 @@ class AtomicOutput:
     def open(self) -> int:
         """Clean stale leftovers, create the temporary file; returns its open descriptor."""
         remove_stale_partials(self.target)
-        self._before = _identity(self.target)
+        key = _claim_key(self.target)
+        self._before = _claims.pop(key) if key in _claims else _identity(self.target)
         self.temporary, descriptor = _create_exclusive(self.target)
         info = os.fstat(descriptor)
         self._created = (info.st_dev, info.st_ino)
@@ -208,8 +239,8 @@ class AtomicOutput:
             if _identity(self.target) != self._before:
                 self.discard()
                 raise OutputConflict(
-                    f"{self.target}: another program wrote this file while this run was"
-                    " writing it; kept theirs, discarded ours"
+                    f"{self.target}: another program wrote this file after this run"
+                    " started; kept theirs, discarded ours"
                 )
             try:
                 os.replace(temporary, self.target)

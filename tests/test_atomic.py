@@ -11,7 +11,14 @@ from pathlib import Path
 
 import pytest
 
-from ecs_tentacles.atomic import STALE_SECONDS, OutputConflict, atomic_file, atomic_output
+from ecs_tentacles.atomic import (
+    STALE_SECONDS,
+    OutputConflict,
+    OutputError,
+    atomic_file,
+    atomic_output,
+    claim,
+)
 
 
 def test_success_replaces_the_target_and_leaves_nothing_else(tmp_path: Path) -> None:
@@ -124,3 +131,23 @@ def test_two_writers_to_one_path_exactly_one_wins(tmp_path: Path) -> None:
     assert target.read_bytes() == b"second"  # the one that finished first
     assert str(caught.value).startswith(f"{target}: another program wrote this file")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["take.npz"]
+
+
+def test_a_claimed_target_written_by_another_before_the_write_starts_is_kept(
+    tmp_path: Path,
+) -> None:
+    target = tmp_path / "take.npz"
+    claim(target)  # a run starts: the file is absent
+    target.write_bytes(b"theirs")  # another program finishes first
+    with pytest.raises(OutputConflict):
+        with atomic_output(target) as mine:
+            mine.write_bytes(b"mine")
+    assert target.read_bytes() == b"theirs"
+    with atomic_output(target) as again:  # the claim was used: a later write is a new run
+        again.write_bytes(b"mine")
+    assert target.read_bytes() == b"mine"
+
+
+def test_claiming_in_a_missing_folder_is_refused(tmp_path: Path) -> None:
+    with pytest.raises(OutputError, match="does not exist"):
+        claim(tmp_path / "nowhere" / "take.npz")

@@ -21,7 +21,7 @@ from contextlib import contextmanager
 from types import FrameType
 
 from ecs_tentacles import __version__
-from ecs_tentacles.atomic import OutputError
+from ecs_tentacles.atomic import OutputError, release_claims
 from ecs_tentacles.cli import (
     bake,
     bench,
@@ -103,6 +103,7 @@ def scene_megabytes(text: str) -> float:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the `ecs-tentacles` console script; returns the exit code."""
+    release_claims()  # outputs are claimed afresh as this run's arguments are read
     args = build_parser().parse_args(argv)
     limit = load.MAX_SCENE_BYTES
     if args.max_scene_mb is not None:

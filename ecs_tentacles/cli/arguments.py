@@ -9,6 +9,8 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import NoReturn
 
+from ecs_tentacles.atomic import OutputError, claim
+
 
 class OneLineParser(argparse.ArgumentParser):
     """argparse, but a bad argument is one line `error: <where>: <what>` (exit 2).
@@ -45,7 +47,9 @@ def require_display(command: str) -> None:
 
 
 def output_path(*suffixes: str) -> Callable[[str], Path]:
-    """An argparse type: a file ending in one of `suffixes`, in a folder that exists."""
+    """An argparse type: a file ending in one of `suffixes`, in a folder this user may
+    write; the file is claimed (`atomic.claim`): if another program writes it before
+    this run does, this run keeps theirs and fails."""
 
     def check(text: str) -> Path:
         path = Path(text)
@@ -54,8 +58,10 @@ def output_path(*suffixes: str) -> Callable[[str], Path]:
             raise argparse.ArgumentTypeError(f"must end in {wanted}, got {text!r}")
         if path.is_dir():
             raise argparse.ArgumentTypeError(f"{text} is a folder")
-        if not path.parent.is_dir():
-            raise argparse.ArgumentTypeError(f"folder {str(path.parent)!r} does not exist")
+        try:  # what the file is now: a run that finds it changed at the end keeps theirs
+            claim(path)
+        except OutputError as error:
+            raise argparse.ArgumentTypeError(str(error).removeprefix(f"{path}: ")) from None
         return path
 
     return check
