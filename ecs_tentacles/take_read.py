@@ -81,7 +81,7 @@ def _creature_problem(creatures: list[dict[str, Any]], bodies: int) -> str | Non
     for c, creature in enumerate(creatures):
         where = f"header.creatures[{c}]"
         name = creature.get("name")
-        if not isinstance(name, str) or not _NAME.match(name) or name in names:
+        if not isinstance(name, str) or not _NAME.fullmatch(name) or name in names:
             return f"{where}.name: must be a unique identifier (letters, digits, _), got {name!r}"
         names.add(name)
         chains = creature.get("tentacles")
@@ -102,7 +102,7 @@ def _body_problem(header: dict[str, Any]) -> str | None:
         if not _index(owner, len(creatures)):
             return f"{where}.creature: must be a creature index, got {owner!r}"
         pattern = rf"^{creatures[owner]['name']}/(mantle|tentacles/t\d+/link\d+)$"
-        if not isinstance(body.get("name"), str) or not re.match(pattern, body["name"]):
+        if not isinstance(body.get("name"), str) or not re.fullmatch(pattern, body["name"]):
             return f"{where}.name: must be <creature>/mantle or .../tentacles/t<k>/link<i>"
         if body.get("shape") not in ("cylinder", "capsule") or body.get("axis") not in AXES:
             return f"{where}: shape must be cylinder or capsule, axis X, Y or Z"
@@ -121,7 +121,7 @@ def _parts_problem(header: dict[str, Any]) -> str | None:
         if not _index(sucker.get("body"), len(bodies)):
             return f"{where}.body: must be a body index, got {sucker.get('body')!r}"
         pattern = rf"^{re.escape(bodies[sucker['body']]['name'])}/sucker\d+$"
-        if not isinstance(sucker.get("name"), str) or not re.match(pattern, sucker["name"]):
+        if not isinstance(sucker.get("name"), str) or not re.fullmatch(pattern, sucker["name"]):
             return f"{where}.name: must be <body>/sucker<n>"
         offset = sucker.get("offset")
         if not isinstance(offset, list) or len(offset) != 3 or not all(map(_is_number, offset)):
@@ -158,7 +158,7 @@ def _track_problem(header: dict[str, Any], track: TakeTrack) -> str | None:
             return f"{where}.creature: must be a creature index, got {item.get('creature')!r}"
         stem = f"{track.folder}/{track.item}"
         pattern = rf"^{creatures[item['creature']]['name']}/{stem}\d+$"
-        if not isinstance(item.get("name"), str) or not re.match(pattern, item["name"]):
+        if not isinstance(item.get("name"), str) or not re.fullmatch(pattern, item["name"]):
             return f"{where}.name: must be <creature>/{stem}<n>"
         if not _is_number(item.get("radius")) or item["radius"] < 0:
             return f"{where}.radius: must be a finite number >= 0"

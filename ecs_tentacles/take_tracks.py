@@ -97,7 +97,7 @@ def declared_problem(header: dict[str, Any]) -> str | None:
             return f"{where}.arrays: must be two array names"
         for field in ("key", "folder", "item", *range(2)):
             value = names[field] if isinstance(field, int) else entry[field]
-            if not isinstance(value, str) or not _NAME.match(value):
+            if not isinstance(value, str) or not _NAME.fullmatch(value):
                 return f"{where}: {value!r} is not an identifier (letters, digits, _)"
         if entry["key"] in keys or entry["key"] in CORE_KEYS:
             return f"{where}.key: {entry['key']!r} is used twice"

@@ -100,7 +100,7 @@ class CreatureDesign:
     @name.setter
     def name(self, value: str) -> None:
         pattern = load_schema()["$defs"]["name"]["pattern"]
-        if not isinstance(value, str) or not re.match(pattern, value):
+        if not isinstance(value, str) or not re.fullmatch(pattern, value):
             raise DesignError(
                 "name", f"must be letters, digits and _, not starting with a digit, got {value!r}"
             )

@@ -176,7 +176,7 @@ def bundled_scene(name: str) -> pathlib.Path:
     """
     stem = name.removesuffix(".json")
     path = _scenes_dir() / f"{stem}.json"
-    if not _SCENE_NAME.match(stem) or not path.is_file():
+    if not _SCENE_NAME.fullmatch(stem) or not path.is_file():
         available = ", ".join(bundled_scene_names()) or "none"
         hint = _suggestion(pathlib.Path(name)) or f" (available: {available})"
         raise SceneError([f"{name}: no such bundled scene{hint}"])

@@ -99,6 +99,16 @@ def _flip_middle(data: bytes) -> bytes:
     return data[:at] + bytes([data[at] ^ 0xFF]) + data[at + 1 :]
 
 
+def _newline_in_creature_name(header: dict[str, Any], arrays: Entries) -> None:
+    """Creature 0 renamed `name + "\\n"`, everything it owns renamed to match."""
+    old = header["creatures"][0]["name"]
+    header["creatures"][0]["name"] = f"{old}\n"
+    items = [item for value in header.values() if isinstance(value, list) for item in value]
+    for item in items:
+        if isinstance(item, dict) and str(item.get("name", "")).startswith(f"{old}/"):
+            item["name"] = f"{old}\n{item['name'][len(old) :]}"
+
+
 BROKEN_TAKES: dict[str, Callable[[Path, Path], None]] = {
     "nan_position": edit(_set("pos", (1, 2, 0), np.nan)),
     "inf_quaternion": edit(_set("quat", (0, 0, 1), np.inf)),
@@ -135,6 +145,7 @@ BROKEN_TAKES: dict[str, Callable[[Path, Path], None]] = {
     "body_used_twice": edit(lambda h, a: h["creatures"][0]["tentacles"][1].__setitem__(0, 0)),
     "body_name_with_spaces": edit(lambda h, a: h["bodies"][1].update(name="octo/link 1")),
     "body_name_without_folder": edit(lambda h, a: h["bodies"][0].update(name="mantle")),
+    "creature_name_trailing_newline": edit(_newline_in_creature_name),
     "creature_name_slash": edit(lambda h, a: h["creatures"][0].update(name="a/b")),
     "body_radius_nan": edit(lambda h, a: h["bodies"][2].update(radius=float("nan"))),
     "body_shape_sphere": edit(lambda h, a: h["bodies"][2].update(shape="sphere")),

@@ -179,6 +179,12 @@ BAD_SCENES: list[tuple[str, object, str]] = [
         'got "my octo"',
     ),
     (
+        "name with a trailing newline",
+        scene({"name": "octo\n"}),
+        "creatures[0].name: must be letters, digits and _, not starting with a digit, "
+        'got "octo\\n"',
+    ),
+    (
         "name starting with a digit",
         scene({"name": "8arms"}),
         'creatures[0].name: must be letters, digits and _, not starting with a digit, got "8arms"',
