@@ -33,6 +33,8 @@ from ecs_tentacles.take_tracks import TakeTrack, declared_problem, dtypes, track
 
 MAX_TAKE_BYTES = 2 * 1024**3  # uncompressed; a 10 s bake of 4 creatures is ~30 MB
 MAX_HEADER_BYTES = 64 * 1024**2
+MAX_FRAMES = 1_000_000  # 4.6 hours at 60 fps: frames are bounded even with no bodies
+MAX_BODIES = 16384 * 1025  # the schema's most creatures x the bodies of its largest one
 FORMAT = "ecs_tentacles.take"
 VERSION = 1
 CORE_DTYPES: dict[str, np.dtype[Any]] = {
@@ -179,6 +181,8 @@ def header_problem(header: object) -> str | None:
         return f"header.fps: must be a finite number > 0, got {fps!r}"
     if not _is_int(header.get("frames")) or header["frames"] < 1:
         return f"header.frames: must be a whole number >= 1, got {header.get('frames')!r}"
+    if header["frames"] > MAX_FRAMES:
+        return f"header.frames: at most {MAX_FRAMES} in a take, got {header['frames']}"
     for key, check in (("scene", str), ("scene_sha256", str)):
         if not isinstance(header.get(key), check):
             return f"header.{key}: missing or not a string"
@@ -188,6 +192,8 @@ def header_problem(header: object) -> str | None:
         problem = _list_of_dicts(header, key)
         if problem:
             return problem
+        if len(header[key]) > MAX_BODIES:
+            return f"header.{key}: at most {MAX_BODIES} in a take, got {len(header[key])}"
     return (
         declared_problem(header)
         or _creature_problem(header["creatures"], len(header["bodies"]))

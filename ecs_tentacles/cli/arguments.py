@@ -46,6 +46,29 @@ def require_display(command: str) -> None:
         raise NoDisplay(f"{command}: {NoDisplay.advice(command)}")
 
 
+def bounded_int(minimum: int, maximum: int) -> Callable[[str], int]:
+    """An argparse type: a whole number in [minimum, maximum] (one line otherwise)."""
+
+    def check(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"must be a whole number, got {text!r}") from None
+        if not minimum <= value <= maximum:
+            raise argparse.ArgumentTypeError(f"must be in [{minimum}, {maximum}], got {value}")
+        return value
+
+    return check
+
+
+MAX_FRAMES = 10_000_000  # frames a command runs: 46 hours of simulated time at 60 fps
+MAX_SEED = 2**63 - 1
+MAX_THREADS = 256
+frame_count = bounded_int(1, MAX_FRAMES)
+seed_int = bounded_int(0, MAX_SEED)
+thread_count = bounded_int(1, MAX_THREADS)
+
+
 def output_path(*suffixes: str) -> Callable[[str], Path]:
     """An argparse type: a file ending in one of `suffixes`, in a folder this user may
     write; the file is claimed (`atomic.claim`): if another program writes it before

@@ -25,9 +25,8 @@ from typing import Any
 from tqdm import tqdm
 
 from ecs_tentacles.cli import bake_ray
-from ecs_tentacles.cli.arguments import output_path
+from ecs_tentacles.cli.arguments import output_path, seed_int
 from ecs_tentacles.cli.lod_options import add_lod_arguments, apply_to_scene
-from ecs_tentacles.cli.run import seed_int
 from ecs_tentacles.cli.skin_options import add_arguments as add_skin_arguments
 from ecs_tentacles.cli.skin_options import skin_options
 from ecs_tentacles.distributed.driver import ShardFailed
@@ -124,6 +123,10 @@ def handle(args: argparse.Namespace) -> int:
         allow_systems=args.allow_systems,
     )
     plan = replace(plan, scene=apply_to_scene(plan.scene, args))
+    problem = plan.size_problem()
+    if problem:
+        print(f"error: argument --seconds: {problem}", file=sys.stderr)
+        return 2
     if plan.intervals < 1:
         print(
             f"error: argument --seconds: {args.seconds:g} s is less than one frame at"

@@ -10,7 +10,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from ecs_tentacles.cli.run import positive_int, seed_int
+from ecs_tentacles.cli.arguments import bounded_int
 from ecs_tentacles.export.bake import BakePlan, bake
 from ecs_tentacles.take import Take
 
@@ -27,11 +27,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         " or start a local one",
     )
     parser.add_argument(
-        "--cpus", type=positive_int, default=None, help="CPUs of a local Ray (default: all of them)"
+        "--cpus",
+        type=bounded_int(1, 4096),
+        default=None,
+        help="CPUs of a local Ray (default: all of them)",
     )
     parser.add_argument(
         "--retries",
-        type=seed_int,  # a whole number >= 0
+        type=bounded_int(0, 100),
         default=3,
         help="runs of a failed Ray task after the first",
     )

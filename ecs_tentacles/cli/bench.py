@@ -15,9 +15,10 @@ import json
 from typing import Any
 
 from ecs_tentacles.bench import BLOCK, WARMUP, bench
+from ecs_tentacles.cli.arguments import bounded_int, thread_count
 from ecs_tentacles.cli.crowd import add_crowd_options, crowd_from_args, crowd_size
 from ecs_tentacles.cli.lod_options import add_lod_arguments, lod_choice
-from ecs_tentacles.cli.run import positive_int, seed_int, tier_line
+from ecs_tentacles.cli.run import tier_line
 from ecs_tentacles.scene.load import resolve_scene_path
 
 
@@ -39,20 +40,20 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         help="bench a crowd of N creatures (as `ecs-tentacles crowd N` writes)",
     )
     parser.add_argument(
-        "--frames", type=positive_int, default=120, help="timed frames (default 120)"
+        "--frames", type=bounded_int(1, 1_000_000), default=120, help="timed frames (default 120)"
     )
     parser.add_argument(
-        "--threads", type=positive_int, default=None, help="physics threads (default: all cores)"
+        "--threads", type=thread_count, default=None, help="physics threads (default: all cores)"
     )
     parser.add_argument(
         "--block",
-        type=positive_int,
+        type=bounded_int(1, 10_000),
         default=BLOCK,
         help=f"frames per interleaved framework / bare block (default {BLOCK})",
     )
     parser.add_argument(
         "--warmup",
-        type=seed_int,
+        type=bounded_int(0, 1_000_000),
         default=WARMUP,
         help=f"untimed frames before timing (default {WARMUP})",
     )

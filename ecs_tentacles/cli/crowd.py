@@ -11,9 +11,9 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from ecs_tentacles.cli.arguments import output_path
+from ecs_tentacles.cli.arguments import output_path, seed_int
 from ecs_tentacles.cli.bake import positive_float
-from ecs_tentacles.cli.run import positive_int, seed_int
+from ecs_tentacles.cli.run import positive_int
 from ecs_tentacles.creator.crowd import (
     DEFAULT_SPECIES,
     crowd_scene,

@@ -7,9 +7,8 @@ import json
 import sys
 from typing import Any
 
-from ecs_tentacles.cli.arguments import output_path, require_display
+from ecs_tentacles.cli.arguments import frame_count, output_path, require_display, seed_int
 from ecs_tentacles.cli.lod_options import add_lod_arguments, lod_choice
-from ecs_tentacles.cli.run import positive_int, seed_int
 from ecs_tentacles.scene.load import resolve_scene_path
 
 SIZE_RULE = "an even number of pixels in [64, 8192]"
@@ -39,7 +38,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("scene", metavar="SCENE", help="scene file or bundled scene name")
     parser.add_argument("--headless", action="store_true", help="no window: render off-screen")
-    parser.add_argument("--frames", type=positive_int, default=300, help="headless: frames to run")
+    parser.add_argument("--frames", type=frame_count, default=300, help="headless: frames to run")
     parser.add_argument("--screenshot", type=output_path(".png"), help="headless: final PNG")
     parser.add_argument("--video", type=output_path(".mp4"), help="headless: record an MP4")
     parser.add_argument("--width", type=even_size, default=1280, help=f"{SIZE_RULE} (default 1280)")

@@ -12,6 +12,7 @@ import sys
 import time
 from typing import Any
 
+from ecs_tentacles.cli.arguments import bounded_int, frame_count, seed_int, thread_count
 from ecs_tentacles.cli.lod_options import add_lod_arguments, apply_focus, lod_choice
 from ecs_tentacles.components import Creature
 from ecs_tentacles.plugin import RunSummary
@@ -20,24 +21,9 @@ from ecs_tentacles.scene.load import resolve_scene_path
 from ecs_tentacles.world import World
 
 
-def _whole_number(text: str, minimum: int) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"must be a whole number, got {text!r}") from None
-    if value < minimum:
-        raise argparse.ArgumentTypeError(f"must be >= {minimum}, got {value}")
-    return value
-
-
 def positive_int(text: str) -> int:
-    """argparse type: a whole number >= 1."""
-    return _whole_number(text, 1)
-
-
-def seed_int(text: str) -> int:
-    """argparse type: a whole number >= 0."""
-    return _whole_number(text, 0)
+    """argparse type: a whole number >= 1 (and at most a million: a count, not a size)."""
+    return bounded_int(1, 1_000_000)(text)
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
@@ -48,7 +34,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("scene", metavar="SCENE", help="scene file or bundled scene name")
     parser.add_argument(
-        "--frames", type=positive_int, default=600, help="frames to run (default 600)"
+        "--frames", type=frame_count, default=600, help="frames to run (default 600)"
     )
     parser.add_argument("--seed", type=seed_int, default=None, help="override the scene's seed")
     parser.add_argument("--json", action="store_true", help="print the summary as one JSON object")
@@ -64,7 +50,7 @@ def add_physics_arguments(parser: argparse.ArgumentParser) -> None:
     """`--threads`, `--strict`, `--lod` and `--focus`, shared by the commands that simulate."""
     parser.add_argument(
         "--threads",
-        type=positive_int,
+        type=thread_count,
         default=None,
         help="threads that step the physics (default: one per core); results are the same",
     )

@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import argparse
 
+from ecs_tentacles.cli.arguments import bounded_int
 from ecs_tentacles.export.skinned import Skin
-from ecs_tentacles.skin.mesh import Detail
+from ecs_tentacles.skin.mesh import MAX_RINGS_PER_LINK, MAX_SIDES, Detail
 from ecs_tentacles.skin.rig import KEY_MODES, Keys
 
 FLAGS = {
@@ -37,8 +38,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="DEG",
         help="with --keys reduced: the largest rotation error kept (degrees, default 0.5)",
     )
-    group.add_argument("--rings-per-link", type=int, default=4, help="mesh rings per link")
-    group.add_argument("--sides", type=int, default=12, help="mesh sides (a multiple of 4)")
+    group.add_argument(
+        "--rings-per-link",
+        type=bounded_int(1, MAX_RINGS_PER_LINK),
+        default=4,
+        help="mesh rings per link",
+    )
+    group.add_argument(
+        "--sides", type=bounded_int(8, MAX_SIDES), default=12, help="mesh sides (a multiple of 4)"
+    )
     group.add_argument("--sucker-discs", action="store_true", help="sucker discs underneath")
 
 

@@ -20,12 +20,37 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from ecs_tentacles.construction import tentacle_params
 from ecs_tentacles.export.recording import Recording, scene_sha256
 from ecs_tentacles.plugin_registry import builtin
 from ecs_tentacles.progress import step_frames
 from ecs_tentacles.scene.load import load_scene, resolve_scene_path
 from ecs_tentacles.take import Take
+from ecs_tentacles.take_read import MAX_FRAMES, MAX_TAKE_BYTES
 from ecs_tentacles.world import World
+
+
+def _count(value: float) -> str:
+    """A count for a message: 2,400,001, or 6e+301 where digits would run on."""
+    return f"{value:,.0f}" if value < 1e15 else f"{value:.3g}"
+
+
+POSE_BYTES = 7 * 4  # a body's position and quaternion in a frame (float32)
+SUCKER_BYTES = 1 + 3 * 4  # attached flag and anchor
+
+
+def scene_sizes(scene: dict[str, Any]) -> tuple[int, int]:
+    """(bodies, suckers) a loaded scene's creatures have: mantles and links; suckers at
+    most (the suckers plugin may be off)."""
+    bodies = suckers = 0
+    for creature in scene["creatures"]:
+        tentacles = creature["tentacles"]
+        for k in range(tentacles["count"]):
+            params = tentacle_params(tentacles, k)
+            bodies += params["links"]
+            suckers += params["links"] if params.get("suckers") == "every_link" else 1
+        bodies += 1
+    return bodies, suckers
 
 
 @dataclass(frozen=True)
@@ -94,6 +119,28 @@ class BakePlan:
     def steps(self) -> int:
         """Simulated frames the bake runs."""
         return self.intervals * self.every
+
+    def size_problem(self) -> str | None:
+        """Why the take this plan makes could not be held or read back (one line), or None.
+
+        Checked before anything is built: a take has at most `MAX_FRAMES` frames and
+        `MAX_TAKE_BYTES` of arrays (poses are 28 bytes per body and frame).
+        """
+        frames = self.seconds * self.fps + 1  # a float: no overflow, whatever was asked
+        if frames > MAX_FRAMES + 0.5:
+            return (
+                f"{self.seconds:g} s at {self.fps:g} fps is {_count(frames)} frames; a take holds"
+                f" at most {MAX_FRAMES} (bake fewer seconds or at a lower --fps)"
+            )
+        bodies, suckers = scene_sizes(self.scene)
+        size = self.frames * (bodies * POSE_BYTES + suckers * SUCKER_BYTES)
+        if size > MAX_TAKE_BYTES:
+            return (
+                f"{self.frames} frames of {bodies} bodies would be {size / 1024**3:.1f} GiB;"
+                f" a take holds at most {MAX_TAKE_BYTES / 1024**3:g} GiB (bake fewer seconds"
+                " or at a lower --fps)"
+            )
+        return None
 
     @property
     def scene_sha256(self) -> str:

@@ -34,6 +34,10 @@ class MeshError(ValueError):
     """A creature cannot be meshed (one line naming the creature and the problem)."""
 
 
+MAX_RINGS_PER_LINK = 64  # past these a mesh only costs memory: 64 x 256 is 16k vertices a link
+MAX_SIDES = 256
+
+
 @dataclass(frozen=True)
 class Detail:
     """Level of detail: rings per link, sides (a multiple of 4), tip cap rings, suckers."""
@@ -45,10 +49,14 @@ class Detail:
     blend: float = 0.35
 
     def __post_init__(self) -> None:
-        if self.rings_per_link < 1:
-            raise ValueError(f"rings_per_link: must be >= 1, got {self.rings_per_link}")
-        if self.sides < 8 or self.sides % 4:
-            raise ValueError(f"sides: must be a multiple of 4 and >= 8, got {self.sides}")
+        if not 1 <= self.rings_per_link <= MAX_RINGS_PER_LINK:
+            raise ValueError(
+                f"rings_per_link: must be in [1, {MAX_RINGS_PER_LINK}], got {self.rings_per_link}"
+            )
+        if not 8 <= self.sides <= MAX_SIDES or self.sides % 4:
+            raise ValueError(
+                f"sides: must be a multiple of 4 in [8, {MAX_SIDES}], got {self.sides}"
+            )
         if self.cap_rings < 1:
             raise ValueError(f"cap_rings: must be >= 1, got {self.cap_rings}")
         if not 0.0 < self.blend <= 0.5:

@@ -162,3 +162,61 @@ def test_unexpected_failures_are_one_line_unless_debug(
     )
     with pytest.raises(RuntimeError):
         main(["--debug", *argv])
+
+
+TOO_BIG = {
+    ("bake", "octopus", "--seconds", "1e9"): (
+        "error: argument --seconds: 1e+09 s at 60 fps is 60,000,000,001 frames; a take holds"
+        " at most 1000000 (bake fewer seconds or at a lower --fps)"
+    ),
+    ("bake", "octopus", "--seconds", "1e300"): (
+        "error: argument --seconds: 1e+300 s at 60 fps is 6e+301 frames; a take holds at most"
+        " 1000000 (bake fewer seconds or at a lower --fps)"
+    ),
+    ("bake", "octopus", "--seconds", "16000"): (
+        "error: argument --seconds: 960001 frames of 81 bodies would be 2.1 GiB; a take holds"
+        " at most 2 GiB (bake fewer seconds or at a lower --fps)"
+    ),
+    ("bake", "octopus", "--seconds", "1", "--rings-per-link", "100000000"): (
+        "error: argument --rings-per-link: must be in [1, 64], got 100000000"
+        " (see ecs-tentacles bake --help)"
+    ),
+    ("bake", "octopus", "--seconds", "1", "--sides", "4096"): (
+        "error: argument --sides: must be in [8, 256], got 4096 (see ecs-tentacles bake --help)"
+    ),
+    ("bake", "octopus", "--seconds", "1", "--seed", "1" + "0" * 30): (
+        "error: argument --seed: must be in [0, 9223372036854775807], got 1"
+        + "0" * 30
+        + " (see ecs-tentacles bake --help)"
+    ),
+    ("run", "octopus", "--frames", "100000000000"): (
+        "error: argument --frames: must be in [1, 10000000], got 100000000000"
+        " (see ecs-tentacles run --help)"
+    ),
+    ("bench", "--crowd", "4", "--frames", "10000000000"): (
+        "error: argument --frames: must be in [1, 1000000], got 10000000000"
+        " (see ecs-tentacles bench --help)"
+    ),
+    ("bench", "octopus", "--threads", "100000"): (
+        "error: argument --threads: must be in [1, 256], got 100000"
+        " (see ecs-tentacles bench --help)"
+    ),
+}
+
+
+@pytest.mark.parametrize("argv", sorted(TOO_BIG))
+def test_numbers_too_big_to_run_are_refused_up_front(
+    argv: tuple[str, ...], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    args = list(argv)
+    if args[0] == "bake":
+        args += ["--out", str(tmp_path / "take.npz")]
+    try:
+        code = main(args)
+    except SystemExit as stop:
+        code = int(stop.code or 0)
+    captured = capsys.readouterr()
+    assert code == 2
+    lines = [line for line in captured.err.splitlines() if not line.startswith("bake: ")]
+    assert lines == [TOO_BIG[argv]]
+    assert list(tmp_path.iterdir()) == []

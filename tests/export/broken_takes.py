@@ -99,6 +99,21 @@ def _flip_middle(data: bytes) -> bytes:
     return data[:at] + bytes([data[at] ^ 0xFF]) + data[at + 1 :]
 
 
+def _trillion_empty_frames(header: dict[str, Any], arrays: Entries) -> None:
+    """A take that lies about its size: 10^12 frames of nothing, 0 bytes of arrays."""
+    from ecs_tentacles.take_read import array_dtypes, expected_shapes
+
+    header.update(frames=10**12, creatures=[], bodies=[], suckers=[], guides=None)
+    for key in ("goals",):
+        header[key] = []
+    dtypes = array_dtypes(header)
+    shapes = expected_shapes(header)
+    arrays.clear()
+    arrays["header"] = np.frombuffer(json.dumps(header).encode(), np.uint8)
+    for name, shape in shapes.items():
+        arrays[name] = np.zeros(shape, dtypes[name])
+
+
 def _newline_in_creature_name(header: dict[str, Any], arrays: Entries) -> None:
     """Creature 0 renamed `name + "\\n"`, everything it owns renamed to match."""
     old = header["creatures"][0]["name"]
@@ -138,6 +153,7 @@ BROKEN_TAKES: dict[str, Callable[[Path, Path], None]] = {
     "frames_zero": edit(lambda h, a: h.update(frames=0)),
     "frames_float": edit(lambda h, a: h.update(frames=float(h["frames"]))),
     "frames_billions": edit(lambda h, a: h.update(frames=10**9)),
+    "frames_trillion_without_bodies": edit(_trillion_empty_frames),
     "version_2": edit(lambda h, a: h.update(version=2)),
     "no_format": edit(lambda h, a: h.pop("format")),
     "header_not_json": edit(lambda h, a: a.update(header=_npy(np.frombuffer(b"{oops", np.uint8)))),
