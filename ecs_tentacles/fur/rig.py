@@ -37,7 +37,6 @@ control uses is skipped by both.
 from __future__ import annotations
 
 import contextlib
-import importlib
 import os
 import threading
 from contextlib import AbstractContextManager
@@ -49,6 +48,7 @@ import numpy as np
 
 from ecs_tentacles.fur.scratch import Scratch
 from ecs_tentacles.fur.vectors import TINY
+from ecs_tentacles.optional_kernels import OptionalKernels
 
 F32 = np.float32
 
@@ -256,22 +256,12 @@ def skin_directions(bind: Bind, values: ControlValues) -> tuple[Coords, Coords |
 
 # "auto": the numba kernels when numba imports, else numpy; "numpy": numpy always.
 BACKEND = os.environ.get("ECS_TENTACLES_RIG", "auto")
-_kernels: ModuleType | bool | None = False  # False: not looked for yet
+_KERNELS = OptionalKernels("ecs_tentacles.fur.kernels")
 
 
 def kernels() -> ModuleType | None:
     """The numba kernels (`ecs_tentacles.fur.kernels`), or None: numpy does the work."""
-    global _kernels
-    if BACKEND == "numpy":
-        return None
-    if _kernels is False:
-        module: ModuleType | None
-        try:
-            module = importlib.import_module("ecs_tentacles.fur.kernels")
-        except ImportError:  # numba is optional (the dev extra installs it)
-            module = None
-        _kernels = module
-    return _kernels if isinstance(_kernels, ModuleType) else None
+    return None if BACKEND == "numpy" else _KERNELS.get()
 
 
 PARALLEL_GUIDES = 20_000  # below, serial kernels were as fast (tools/bench_rig.py, 2 cores)

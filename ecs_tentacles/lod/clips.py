@@ -25,7 +25,9 @@ writes only the caller's `out` arrays.
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
+from types import ModuleType
 from typing import Any
 
 import numpy as np
@@ -33,6 +35,7 @@ import numpy as np
 from ecs_tentacles.lod.frames import nlerp, quat_power, rotate_z, to_ground, yaw_times
 from ecs_tentacles.lod.record import Recording, forward_poses, one_creature_scene, record
 from ecs_tentacles.mathutil import quat_multiply
+from ecs_tentacles.optional_kernels import OptionalKernels
 
 IDLE, CRAWL = 0, 1
 KINDS = ("idle", "crawl")
@@ -156,6 +159,16 @@ class GaitClips:
         kind = np.asarray(kind, dtype=np.int64)
         phase = np.asarray(phase, dtype=np.float64)
         frames = self._frames[kind]
+        fast = kernels()
+        if fast is not None:
+            below = np.floor(phase) if interpolate else np.rint(phase)
+            row = self._offset[kind] + np.mod(below.astype(np.int64), frames)
+            where = np.ascontiguousarray(xy, dtype=np.float64)
+            turn = np.ascontiguousarray(heading, dtype=np.float64)
+            fraction = phase - below
+            fast.place(self._pose, self._change, row, fraction, interpolate, where, turn,
+                       out_pos, out_quat)  # fmt: skip
+            return
         if interpolate:
             below = np.floor(phase)
             row = self._offset[kind] + np.mod(below.astype(np.int64), frames)
@@ -190,6 +203,16 @@ class GaitClips:
         qpos[3:7] = yaw_times(heading, qpos[3:7])
         qvel[0:3] = rotate_z(qvel[0:3], heading)  # angular velocity is in the body frame
         return qpos, qvel
+
+
+# "auto": the numba kernel when numba imports, else numpy; "numpy": numpy always.
+BACKEND = os.environ.get("ECS_TENTACLES_REPLAY", "auto")
+_KERNELS = OptionalKernels("ecs_tentacles.lod.kernels")
+
+
+def kernels() -> ModuleType | None:
+    """The numba kernel (`ecs_tentacles.lod.kernels`), or None: numpy does the work."""
+    return None if BACKEND == "numpy" else _KERNELS.get()
 
 
 def _place(

@@ -183,3 +183,29 @@ def test_thousand_creatures_evaluate_at_once(clips: GaitClips) -> None:
     print(f"\nevaluate K=1000, {len(clips.bodies)} bodies: {1e6 * per:.1f} us per creature")
     assert np.isfinite(pos).all()
     np.testing.assert_allclose(np.linalg.norm(quat, axis=-1), 1.0, atol=1e-12)
+
+
+@pytest.mark.parametrize("interpolate", [True, False])
+def test_the_replay_kernel_equals_the_numpy_path(
+    clips: GaitClips, interpolate: bool, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from ecs_tentacles.lod import clips as module
+
+    assert module.kernels() is not None  # numba comes with the dev extra
+    rng = np.random.default_rng(5)
+    count = 300
+    kind = rng.integers(0, 2, count)
+    phase = rng.uniform(-50.0, 500.0, count)
+    xy = rng.uniform(-30.0, 30.0, (count, 2))
+    heading = rng.uniform(-7.0, 7.0, count)
+    shape = (count, len(clips.bodies))
+    results = []
+    for backend in ("auto", "numpy"):
+        monkeypatch.setattr(module, "BACKEND", backend)
+        pos, quat = np.empty((*shape, 3)), np.empty((*shape, 4))
+        clips.evaluate(kind, phase, xy, heading, pos, quat, interpolate=interpolate)
+        results.append((pos, quat))
+    (pos, quat), (pos_np, quat_np) = results
+    np.testing.assert_allclose(pos, pos_np, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(quat, quat_np, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(np.linalg.norm(quat, axis=-1), 1.0, atol=1e-12)
