@@ -25,9 +25,7 @@ writes only the caller's `out` arrays.
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass
-from types import ModuleType
 from typing import Any
 
 import numpy as np
@@ -159,7 +157,7 @@ class GaitClips:
         kind = np.asarray(kind, dtype=np.int64)
         phase = np.asarray(phase, dtype=np.float64)
         frames = self._frames[kind]
-        fast = kernels()
+        fast = KERNELS.get()
         if fast is not None:
             below = np.floor(phase) if interpolate else np.rint(phase)
             row = self._offset[kind] + np.mod(below.astype(np.int64), frames)
@@ -205,14 +203,7 @@ class GaitClips:
         return qpos, qvel
 
 
-# "auto": the numba kernel when numba imports, else numpy; "numpy": numpy always.
-BACKEND = os.environ.get("ECS_TENTACLES_REPLAY", "auto")
-_KERNELS = OptionalKernels("ecs_tentacles.lod.kernels")
-
-
-def kernels() -> ModuleType | None:
-    """The numba kernel (`ecs_tentacles.lod.kernels`), or None: numpy does the work."""
-    return None if BACKEND == "numpy" else _KERNELS.get()
+KERNELS = OptionalKernels("ecs_tentacles.lod.kernels", "ECS_TENTACLES_REPLAY")
 
 
 def _place(

@@ -21,6 +21,7 @@ import mujoco
 import numpy as np
 from scipy.spatial import cKDTree
 
+from ecs_tentacles.optional_kernels import OptionalKernels
 from ecs_tentacles.physics.model import PROXY_CAPSULES, PROXY_CYLINDERS, PROXY_PARKED
 
 if TYPE_CHECKING:
@@ -34,6 +35,7 @@ CAPSULE, CYLINDER = 0, 1
 DENSE_PAIRS = 256  # creatures up to which every pair is compared (no tree to build)
 _NONE = np.zeros(0, dtype=np.int64)
 Sensed = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]  # pos, quat, centre, radius
+KERNELS = OptionalKernels("ecs_tentacles.physics.kernels", "ECS_TENTACLES_SENSE")
 
 
 class ContactProxies:
@@ -80,8 +82,16 @@ class ContactProxies:
         the proxies both ask, before anything moves)."""
         if frame is not None and self._sensed is not None and self._sensed[0] == frame:
             return self._sensed[1]
-        pos, quat = transforms.pos[self.rows], transforms.quat[self.rows]
-        sensed = (pos, quat, *self.spheres(pos))
+        fast = KERNELS.get()
+        if fast is None:
+            pos, quat = transforms.pos[self.rows], transforms.quat[self.rows]
+            centre, radius = self.spheres(pos)
+        else:  # the same numbers in one pass
+            pos, quat = np.empty((len(self.rows), 3)), np.empty((len(self.rows), 4))
+            centre, radius = np.empty((len(self.start), 3)), np.empty(len(self.start))
+            fast.sense(transforms.pos, transforms.quat, self.rows, self.start, self.count,
+                       self.rbound, pos, quat, centre, radius)  # fmt: skip
+        sensed = (pos, quat, centre, radius)
         self._sensed = None if frame is None else (frame, sensed)
         return sensed
 

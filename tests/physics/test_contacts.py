@@ -7,6 +7,7 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
+import pytest
 from numpy.testing import assert_allclose
 
 from ecs_tentacles.creator.crowd import creature_reach
@@ -119,3 +120,20 @@ def test_sixteen_creatures_with_crossing_goals_stay_apart_for_20_seconds(
     assert world.physics.health.recoveries == 0
     end = world.transforms.pos[world.creatures.mantle_row]
     assert np.median(np.linalg.norm(end[:, :2] - start[:, :2], axis=1)) > 0.3  # they crawled
+
+
+def test_the_sense_kernel_gives_the_numpy_numbers_bit_for_bit(
+    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from ecs_tentacles.creator.crowd import crowd_scene
+    from ecs_tentacles.physics import proxies as module
+
+    world = make_world(crowd_scene(12, seed=3))  # 8 body plans: bodies per creature vary
+    world.step(20)
+    assert module.KERNELS.get() is not None  # numba comes with the dev extra
+    sensed = []
+    for backend in ("auto", "numpy"):
+        monkeypatch.setattr(module.KERNELS, "backend", backend)
+        sensed.append(world.physics.proxies.sense(world.transforms))
+    for kernel, numpy_path in zip(*sensed, strict=True):
+        np.testing.assert_array_equal(kernel, numpy_path)
