@@ -24,6 +24,7 @@ import re
 import stat
 import zipfile
 import zlib
+from collections.abc import Iterator
 from pathlib import Path
 from typing import IO, Any, cast
 
@@ -269,8 +270,9 @@ def _read_entry(
             memoryview(cast(Any, array.T if fortran else array)).cast("B") if array.size else empty
         )
         filled = 0
-        while filled < len(view):
-            count = handle.readinto(view[filled:])  # type: ignore[attr-defined]
+        while filled < len(view):  # in pieces: zip's readinto reads all it is asked into a copy
+            piece = view[filled : filled + READ_PIECE]
+            count = handle.readinto(piece)  # type: ignore[attr-defined]
             if not count:
                 raise TakeError(f"{name}: data is cut short ({filled} of {len(view)} bytes)")
             filled += count
@@ -279,23 +281,46 @@ def _read_entry(
     return array
 
 
+READ_PIECE = 4 * 1024**2  # bytes an entry is read in at a time
+CHECK_BYTES = 16 * 1024**2  # the checks below look at this much of an array at a time
+
+
+def _blocks(array: np.ndarray) -> Iterator[tuple[int, np.ndarray]]:
+    """(first frame, view) blocks of `array` along its first axis, about CHECK_BYTES each,
+    so checking a take costs a few blocks of memory on top of the take, not copies of it."""
+    if array.ndim == 0 or not len(array):
+        if array.size:
+            yield 0, array
+        return
+    per_row = max(1, array[0].nbytes)
+    rows = max(1, CHECK_BYTES // per_row)
+    for first in range(0, len(array), rows):
+        yield first, array[first : first + rows]
+
+
 def data_problem(
     arrays: dict[str, np.ndarray], tracks: list[TakeTrack] | None = None
 ) -> str | None:
     """The first non-finite number, negative width (of `tracks`' curves) or zero
-    quaternion in `arrays`, or None."""
+    quaternion in `arrays`, or None. Checked block by block (`CHECK_BYTES`)."""
     for name, array in arrays.items():
-        if array.dtype.kind == "f" and not np.isfinite(array).all():
-            where = np.argwhere(~np.isfinite(array))[0]
-            return f"{name}: non-finite value {array[tuple(where)]} at {tuple(where.tolist())}"
+        if array.dtype.kind != "f":
+            continue
+        for first, block in _blocks(array):
+            bad = ~np.isfinite(block)
+            if bad.any():
+                where = np.argwhere(bad)[0]
+                where[0] += first if array.ndim else 0
+                return f"{name}: non-finite value {array[tuple(where)]} at {tuple(where.tolist())}"
     for track in tracks or []:
         widths = arrays.get(track.arrays[1]) if track.kind == "curves" else None
-        if widths is not None and (widths < 0).any():
+        if widths is not None and any((block < 0).any() for _, block in _blocks(widths)):
             return f"{track.arrays[1]}: negative width"
-    lengths = np.linalg.norm(arrays["quat"].astype(np.float64), axis=-1)
-    if (lengths < 1e-6).any():
-        frame, body = np.argwhere(lengths < 1e-6)[0].tolist()
-        return f"quat: zero-length quaternion at frame {frame}, body {body}"
+    for first, block in _blocks(arrays["quat"]):
+        short = np.einsum("...i,...i->...", block, block) < 1e-12  # length under 1e-6
+        if short.any():
+            frame, body = np.argwhere(short)[0].tolist()
+            return f"quat: zero-length quaternion at frame {first + frame}, body {body}"
     return None
 
 

@@ -85,3 +85,33 @@ def test_a_take_without_goals_loads(tmp_path: Path) -> None:
     take = Take.load(out)
     assert take.tracks["goal_pos"].shape == (0, 3)
     assert take.tracks["goal_active"].shape == (take.frames, 0)
+
+
+def test_loading_a_large_take_costs_about_its_size_once(good_take: Path, tmp_path: Path) -> None:
+    import json
+    import tracemalloc
+
+    from ecs_tentacles.take import write_npz
+
+    with np.load(good_take) as npz:
+        arrays = {name: npz[name] for name in npz.files}
+    header = json.loads(arrays["header"].tobytes())
+    frames = header["frames"]
+    repeat = -(-(96 * 1024**2) // arrays["pos"].nbytes)  # about 100 MB of poses and more
+    for name, array in arrays.items():
+        if name != "header" and array.ndim and len(array) == frames:
+            arrays[name] = np.concatenate([array] * repeat)
+    header["frames"] = frames * repeat
+    arrays["header"] = np.frombuffer(json.dumps(header).encode(), np.uint8)
+    big = tmp_path / "big.npz"
+    write_npz(big, arrays)
+    raw = sum(a.nbytes for n, a in arrays.items() if n != "header")
+    del arrays
+    tracemalloc.start()
+    try:
+        _, loaded = read_take(big)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert sum(a.nbytes for a in loaded.values()) >= raw
+    assert peak < 1.05 * raw + 32 * 1024**2, f"peak {peak / 1e6:.0f} MB for {raw / 1e6:.0f} MB"
