@@ -91,13 +91,13 @@ def load(key: str, target: str, scene_dir: pathlib.Path | None) -> type[Plugin] 
     module_part, _, attr = target.partition(":")
     try:
         if module_part.endswith(".py"):
-            module = import_file(_inside(module_part, scene_dir, where), key)
+            module = import_file(inside_scene_folder(module_part, scene_dir, where), key)
         else:
             with scene_first(scene_dir):
                 module = importlib.import_module(module_part)
     except PluginError:
         raise
-    except Exception as exc:  # the user's module failed to import: say which and why
+    except (Exception, SystemExit, KeyboardInterrupt) as exc:  # the user's module failed
         raise PluginError(f"{where}: cannot import {target!r}: {_one_line(exc)}") from exc
     return pick(module, attr, where, target)
 
@@ -124,7 +124,9 @@ def pick(module: ModuleType, attr: str, where: str, target: str) -> type[Plugin]
     raise PluginError(f"{where}: {target!r} defines {what}; name one as 'file.py:ClassName'")
 
 
-def _inside(relative: str, scene_dir: pathlib.Path | None, where: str) -> pathlib.Path:
+def inside_scene_folder(relative: str, scene_dir: pathlib.Path | None, where: str) -> pathlib.Path:
+    """`relative` resolved (symlinks followed) in the scene's folder; PluginError if it
+    leaves the folder or is not a file."""
     base = (scene_dir or pathlib.Path.cwd()).resolve()
     path = (base / relative).resolve()
     if not path.is_relative_to(base):
@@ -220,7 +222,7 @@ def resolve(
             plugins.append(
                 instantiate(made, key, settings, None if found.trusted else found.target)
             )
-        except Exception as exc:  # the user's plugin class failed to construct
+        except (Exception, SystemExit) as exc:  # the user's plugin class failed to construct
             problems.append(f"plugins.{key}: cannot make {found.target!r}: {_one_line(exc)}")
     on = {p.key for p in plugins}
     for plugin in plugins:

@@ -14,7 +14,10 @@ counter. A system keeps the `state_attributes` its old and new classes both decl
 A swapped system runs even if it was disabled (the usual case: it failed, the user
 fixed the file). If the file fails to import, or the plugin or its systems fail to
 be made or set up, nothing is swapped: the old systems keep running and the
-`Reload` says why in one line.
+`Reload` says why in one line. That includes code that calls `sys.exit` or raises
+KeyboardInterrupt, a file that has become a symlink out of the scene's folder (the
+folder rule is applied again on every reload) and an import or setup that takes longer
+than `import_seconds` (5 s; the main thread's timer interrupts it).
 
 The sandbox polls it from its clock; it needs no window (`ecs_tentacles.render` is
 not imported).
@@ -22,20 +25,26 @@ not imported).
 
 from __future__ import annotations
 
+import contextlib
 import pathlib
+import signal
 import sys
+import threading
 import time
+from collections.abc import Iterator
 from dataclasses import dataclass, field
+from types import FrameType
 from typing import TYPE_CHECKING
 
 from ecs_tentacles.plugin import Plugin
-from ecs_tentacles.plugin_registry import import_file, instantiate, pick
+from ecs_tentacles.plugin_registry import import_file, inside_scene_folder, instantiate, pick
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
     from ecs_tentacles.world import World
 
 INTERVAL = 0.5  # seconds between two looks at the files
+IMPORT_SECONDS = 5.0  # longest a reload may take to import and set up a plugin
 
 
 @dataclass
@@ -62,6 +71,8 @@ class Reload:
 @dataclass
 class _Watched:
     key: str
+    relative: str  # the file as the scene names it, in `folder`
+    folder: pathlib.Path
     path: pathlib.Path
     attr: str  # the class named after ':' in `from`, or ''
     stamp: tuple[int, int] | None
@@ -70,9 +81,12 @@ class _Watched:
 class Reloader:
     """Watches the files of a world's plugins and swaps in their new code."""
 
-    def __init__(self, world: World, *, interval: float = INTERVAL):
+    def __init__(
+        self, world: World, *, interval: float = INTERVAL, import_seconds: float = IMPORT_SECONDS
+    ):
         self.world = world
         self.interval = interval
+        self.import_seconds = import_seconds
         self._last = time.monotonic()
         self.watched: dict[str, _Watched] = {}
         for plugin in world.plugins:
@@ -82,7 +96,8 @@ class Reloader:
                 continue  # built in, a module or an entry point: not watched
             folder = world.scene_dir or pathlib.Path.cwd()
             path = (folder / module_part).resolve()
-            self.watched[plugin.key] = _Watched(plugin.key, path, attr, _stamp(path))
+            watched = _Watched(plugin.key, module_part, folder, path, attr, _stamp(path))
+            self.watched[plugin.key] = watched
 
     def poll(self, now: float | None = None) -> list[Reload]:
         """`check()` when `interval` seconds have passed since the last look, else []."""
@@ -109,8 +124,9 @@ class Reloader:
         result = Reload(key, watched.path)
         try:
             old = self.world.plugin(key)
-            fresh, systems = self._make(watched, old)
-        except Exception as error:  # the user's code is broken: keep the old code running
+            with time_limit(self.import_seconds):
+                fresh, systems = self._make(watched, old)
+        except (Exception, SystemExit, KeyboardInterrupt) as error:  # keep the old code running
             text = " ".join(str(error).split())
             result.error = f"{type(error).__name__}" + (f": {text}" if text else "")
             return result
@@ -121,8 +137,10 @@ class Reloader:
         """The new plugin and its systems, set up; raises if any of it fails."""
         name = f"ecs_tentacles_user_plugins.{watched.key}"
         previous = sys.modules.get(name)
-        try:
-            module = import_file(watched.path, watched.key)
+        where = f"plugins.{watched.key}"
+        try:  # the folder rule again: the file may have become a symlink out of it
+            module = import_file(inside_scene_folder(watched.relative, watched.folder, where),
+                                 watched.key)  # fmt: skip
         except BaseException:
             if previous is not None:  # the old classes still look themselves up here
                 sys.modules[name] = previous
@@ -166,6 +184,27 @@ class Reloader:
                 result.removed.append(name)
         plugins = self.world.plugins
         plugins[plugins.index(old)] = fresh
+
+
+@contextlib.contextmanager
+def time_limit(seconds: float) -> Iterator[None]:
+    """Raise TimeoutError in the block after `seconds` (main thread, POSIX; else no limit)."""
+    if threading.current_thread() is not threading.main_thread() or not hasattr(
+        signal, "setitimer"
+    ):
+        yield
+        return
+
+    def expire(signum: int, frame: FrameType | None) -> None:
+        raise TimeoutError(f"took longer than {seconds:g} s")
+
+    previous = signal.signal(signal.SIGALRM, expire)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
 
 
 def _stamp(path: pathlib.Path) -> tuple[int, int] | None:

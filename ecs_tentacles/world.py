@@ -239,7 +239,7 @@ class World:
         for system in systems:
             try:
                 system.setup(self)
-            except Exception as error:  # name the system, as a failing process() is
+            except (Exception, SystemExit) as error:  # name the system, as process() does
                 label = self.schedule.label(system)
                 raise SystemFailure(system, label, self.frame, error) from error
 
@@ -265,7 +265,7 @@ class World:
                     if on_failure is None:
                         raise
                     on_failure(named)
-                except Exception as error:  # name the system and the frame; cause kept
+                except (Exception, SystemExit) as error:  # name system and frame; cause kept
                     failure = SystemFailure(system, self.schedule.label(system), self.frame, error)
                     if on_failure is None:
                         raise failure from error

@@ -165,3 +165,40 @@ def test_poll_looks_at_most_every_interval_and_skips_a_missing_file(
     assert [r.swapped for r in reloader.poll(start + 0.6)] == [["mark"]]
     (tmp_path / "mark.py").unlink()  # an editor between delete and write
     assert reloader.poll(start + 1.2) == []
+
+
+@pytest.mark.parametrize(
+    ("code", "error"),
+    [
+        ("import sys\nsys.exit(0)\n", "SystemExit: 0"),
+        ("raise KeyboardInterrupt\n", "KeyboardInterrupt"),
+        ("while True:\n    pass\n", "TimeoutError: took longer than 0.5 s"),
+    ],
+)
+def test_a_file_that_exits_or_hangs_is_not_reloaded(
+    world: World, tmp_path: Path, code: str, error: str
+) -> None:
+    reloader = Reloader(world, import_seconds=0.5)
+    world.step(2)
+    (tmp_path / "mark.py").write_text(code)
+    os.utime(tmp_path / "mark.py", ns=(1, 3_000_000_000_000))
+    [done] = reloader.check()
+    assert done.message == f"mark.py: not reloaded, old code keeps running: {error}"
+    world.step(2)
+    assert _values(world, range(0, 4)) == [10.0] * 4
+
+
+def test_a_file_replaced_by_a_symlink_out_of_the_folder_is_not_run(
+    world: World, tmp_path: Path, tmp_path_factory: pytest.TempPathFactory
+) -> None:
+    reloader = Reloader(world)
+    world.step(2)
+    outside = tmp_path_factory.mktemp("elsewhere") / "evil.py"
+    outside.write_text("raise RuntimeError('outside code ran')\n")
+    (tmp_path / "mark.py").unlink()
+    (tmp_path / "mark.py").symlink_to(outside)
+    [done] = reloader.check()
+    assert done.error is not None and "leaves the scene's folder" in done.error
+    assert "outside code ran" not in done.message
+    world.step(2)
+    assert _values(world, range(0, 4)) == [10.0] * 4

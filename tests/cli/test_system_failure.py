@@ -42,6 +42,19 @@ class Ready(System):
         world.waves
 
 
+class Quit(System):
+    """Calls sys.exit(0) at frame 3."""
+
+    name = "quit"
+    stage = "act"
+
+    def process(self, world, dt):
+        if world.frame == 3:
+            import sys
+
+            sys.exit(0)
+
+
 class Shake(System):
     """A substep hook that fails at frame 2."""
 
@@ -157,4 +170,32 @@ def test_a_failing_setup_is_named_with_its_traceback(
     assert (
         _user_traceback(err)[1]
         == f'File "{failing.parent / "failing.py"}", line {_line("world.waves")}, in setup'
+    )
+
+
+def test_a_system_that_calls_sys_exit_fails_the_bake_with_one_line(
+    failing: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    scene = json.loads(failing.read_text())
+    scene["plugins"] = {"quitter": {"from": "failing.py:Quit"}}
+    failing.write_text(json.dumps(scene))
+    out = failing.parent / "take.npz"
+    args = ["bake", str(failing), "--seconds", "1", "--out", str(out), "--allow-systems"]
+    assert main([*args, "--quiet"]) == 1
+    err = capsys.readouterr().err.splitlines()
+    assert err[1] == "error: system 'quit' (plugin 'quitter') failed at frame 3: SystemExit: 0"
+    assert err[-1] == "SystemExit: 0"
+    assert not out.exists()
+
+
+def test_a_plugin_that_exits_while_importing_is_a_scene_error(
+    failing: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    (failing.parent / "exits.py").write_text("import sys\nsys.exit(3)\n")
+    scene = json.loads(failing.read_text())
+    scene["plugins"] = {"exits": {"from": "exits.py"}}
+    failing.write_text(json.dumps(scene))
+    assert main(["run", str(failing), "--frames", "2", "--allow-systems", "--quiet"]) == 2
+    assert capsys.readouterr().err == (
+        f"error: {failing}: plugins.exits: cannot import 'exits.py': SystemExit: 3\n"
     )
