@@ -92,6 +92,13 @@ def failing(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
     return path
 
 
+def _use_plugin(scene_path: Path, key: str, source: str) -> None:
+    """The scene at `scene_path` turns on plugin `key` from `source` instead."""
+    scene = json.loads(scene_path.read_text())
+    scene["plugins"] = {key: {"from": source}}
+    scene_path.write_text(json.dumps(scene))
+
+
 def _user_traceback(err: str) -> list[str]:
     """The traceback's File lines and the last line, without Python's ~~^~~ markers."""
     return [
@@ -131,9 +138,7 @@ def test_bake_exits_1_and_writes_nothing(failing: Path, capsys: pytest.CaptureFi
 def test_a_failing_substep_hook_is_named_not_physics(
     failing: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    scene = json.loads(failing.read_text())
-    scene["plugins"] = {"shaker": {"from": "failing.py:Shake"}}
-    failing.write_text(json.dumps(scene))
+    _use_plugin(failing, "shaker", "failing.py:Shake")
     assert main(["run", str(failing), "--frames", "10", "--allow-systems", "--quiet"]) == 1
     err = capsys.readouterr().err
     assert err.splitlines()[0] == (
@@ -158,9 +163,7 @@ def test_debug_shows_the_whole_chain(failing: Path) -> None:
 def test_a_failing_setup_is_named_with_its_traceback(
     failing: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    scene = json.loads(failing.read_text())
-    scene["plugins"] = {"mine": {"from": "failing.py:Ready"}}
-    failing.write_text(json.dumps(scene))
+    _use_plugin(failing, "mine", "failing.py:Ready")
     assert main(["run", str(failing), "--frames", "10", "--allow-systems", "--quiet"]) == 1
     err = capsys.readouterr().err
     assert err.splitlines()[0].startswith(
@@ -176,9 +179,7 @@ def test_a_failing_setup_is_named_with_its_traceback(
 def test_a_system_that_calls_sys_exit_fails_the_bake_with_one_line(
     failing: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    scene = json.loads(failing.read_text())
-    scene["plugins"] = {"quitter": {"from": "failing.py:Quit"}}
-    failing.write_text(json.dumps(scene))
+    _use_plugin(failing, "quitter", "failing.py:Quit")
     out = failing.parent / "take.npz"
     args = ["bake", str(failing), "--seconds", "1", "--out", str(out), "--allow-systems"]
     assert main([*args, "--quiet"]) == 1
@@ -192,9 +193,7 @@ def test_a_plugin_that_exits_while_importing_is_a_scene_error(
     failing: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     (failing.parent / "exits.py").write_text("import sys\nsys.exit(3)\n")
-    scene = json.loads(failing.read_text())
-    scene["plugins"] = {"exits": {"from": "exits.py"}}
-    failing.write_text(json.dumps(scene))
+    _use_plugin(failing, "exits", "exits.py")
     assert main(["run", str(failing), "--frames", "2", "--allow-systems", "--quiet"]) == 2
     assert capsys.readouterr().err == (
         f"error: {failing}: plugins.exits: cannot import 'exits.py': SystemExit: 3\n"
