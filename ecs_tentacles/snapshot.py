@@ -64,8 +64,30 @@ def take(world: Restorable) -> Snapshot:
     )
 
 
+class SnapshotMismatch(ValueError):
+    """A snapshot that does not fit this world; the world was left as it was."""
+
+
+def mismatch(world: Restorable, snapshot: Snapshot) -> str | None:
+    """Why `snapshot` does not fit `world` (one line), or None: checked before a restore
+    changes anything."""
+    for name, store in _stores(world).items():
+        if name in snapshot.stores:
+            problem = store.rows_problem(snapshot.stores[name])
+            if problem:
+                return f"store {name!r}: the snapshot has {problem}"
+    problem = world.physics.state_problem(snapshot.physics)
+    return f"physics: the snapshot has {problem}" if problem else None
+
+
 def restore(world: Restorable, snapshot: Snapshot) -> None:
-    """Put the world back in `snapshot`'s state."""
+    """Put the world back in `snapshot`'s state.
+
+    Raises SnapshotMismatch (and changes nothing) when the snapshot is of another world
+    whose stores or physics do not have the same shape."""
+    problem = mismatch(world, snapshot)
+    if problem:
+        raise SnapshotMismatch(f"cannot restore a snapshot of another world: {problem}")
     world.frame = snapshot.frame
     world.rng.bit_generator.state = copy.deepcopy(snapshot.rng)
     for name, store in _stores(world).items():

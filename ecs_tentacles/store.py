@@ -109,6 +109,20 @@ class ArrayStore:
         """A copy of the live rows (for snapshots)."""
         return self.count, {f: a[: self.count].copy() for f, a in self._arrays.items()}
 
+    def rows_problem(self, state: tuple[int, dict[str, np.ndarray]]) -> str | None:
+        """Why `put_rows(state)` would not fit this store (one line), or None."""
+        count, arrays = state
+        if set(arrays) != set(self._arrays):
+            return f"fields {sorted(arrays)}, here {sorted(self._arrays)}"
+        if count > self.capacity:
+            return f"{count} rows, here room for {self.capacity}"
+        for name, values in arrays.items():
+            here = self._arrays[name]
+            if values.shape != (count, *here.shape[1:]) or values.dtype != here.dtype:
+                shape = (count, *here.shape[1:])
+                return f"{name}: {values.dtype}{values.shape}, here {here.dtype}{shape}"
+        return None
+
     def put_rows(self, state: tuple[int, dict[str, np.ndarray]]) -> None:
         """Put back what `copy_rows` copied (the store must still have room for the rows)."""
         self.count, arrays = state

@@ -134,7 +134,13 @@ class Take:
 
     # -- files -------------------------------------------------------------------------
     def save(self, path: str | os.PathLike[str]) -> None:
-        """Write the take to `path` atomically (see `ecs_tentacles.atomic`)."""
+        """Write the take to `path` atomically (see `ecs_tentacles.atomic`).
+
+        Raises `TakeError` (one line, nothing written) when `Take.load` would refuse the
+        result: a plugin that wrote NaN into the poses makes a take nobody can read."""
+        problem = self.problem()
+        if problem:
+            raise TakeError(f"{path}: cannot write this take: {problem}")
         with atomic_file(path) as handle:
             write_npz(handle, self.arrays())
 

@@ -34,6 +34,8 @@ from ecs_tentacles.take_tracks import TakeTrack, declared_problem, dtypes, track
 
 MAX_TAKE_BYTES = 2 * 1024**3  # uncompressed; a 10 s bake of 4 creatures is ~30 MB
 MAX_HEADER_BYTES = 64 * 1024**2
+MAX_FPS = 1000  # the scene schema's and `bake --fps`'s highest rate
+MAX_COORDINATE = 1e6  # metres: a position farther out is a blow-up, not a creature
 MAX_FRAMES = 1_000_000  # 4.6 hours at 60 fps: frames are bounded even with no bodies
 MAX_BODIES = 16384 * 1025  # the schema's most creatures x the bodies of its largest one
 FORMAT = "ecs_tentacles.take"
@@ -178,8 +180,8 @@ def header_problem(header: object) -> str | None:
     if header.get("version") != VERSION:
         return f"header.version: this reader knows version {VERSION}, got {header.get('version')!r}"
     fps: Any = header.get("fps")
-    if not _is_number(fps) or fps <= 0:
-        return f"header.fps: must be a finite number > 0, got {fps!r}"
+    if not _is_number(fps) or not 0 < fps <= MAX_FPS:
+        return f"header.fps: must be a number in (0, {MAX_FPS}], got {fps!r}"
     if not _is_int(header.get("frames")) or header["frames"] < 1:
         return f"header.frames: must be a whole number >= 1, got {header.get('frames')!r}"
     if header["frames"] > MAX_FRAMES:
@@ -301,8 +303,9 @@ def _blocks(array: np.ndarray) -> Iterator[tuple[int, np.ndarray]]:
 def data_problem(
     arrays: dict[str, np.ndarray], tracks: list[TakeTrack] | None = None
 ) -> str | None:
-    """The first non-finite number, negative width (of `tracks`' curves) or zero
-    quaternion in `arrays`, or None. Checked block by block (`CHECK_BYTES`)."""
+    """The first non-finite number, number beyond `MAX_COORDINATE`, negative width (of
+    `tracks`' curves) or zero quaternion in `arrays`, or None. Checked block by block
+    (`CHECK_BYTES`)."""
     for name, array in arrays.items():
         if array.dtype.kind != "f":
             continue
@@ -312,6 +315,14 @@ def data_problem(
                 where = np.argwhere(bad)[0]
                 where[0] += first if array.ndim else 0
                 return f"{name}: non-finite value {array[tuple(where)]} at {tuple(where.tolist())}"
+            far = np.abs(block) > MAX_COORDINATE
+            if far.any():
+                where = np.argwhere(far)[0]
+                where[0] += first if array.ndim else 0
+                value = array[tuple(where)]
+                return (
+                    f"{name}: {value:g} at {tuple(where.tolist())} is beyond {MAX_COORDINATE:g} m"
+                )
     for track in tracks or []:
         widths = arrays.get(track.arrays[1]) if track.kind == "curves" else None
         if widths is not None and any((block < 0).any() for _, block in _blocks(widths)):

@@ -59,3 +59,28 @@ def test_world_is_a_context_manager() -> None:
         context = world.context
         world.step(2)
     assert context not in esper.list_worlds()
+
+
+def test_a_snapshot_of_another_world_is_refused_and_changes_nothing(
+    make_world: Callable[..., World],
+) -> None:
+    import pytest
+
+    from ecs_tentacles.snapshot import SnapshotMismatch
+
+    def small(count: int) -> dict[str, object]:
+        creatures = [{"name": f"c{i}", "position": [3.0 * i, 0.0]} for i in range(count)]
+        return {"version": 1, "creatures": creatures}
+
+    world, twin, other = make_world(small(1)), make_world(small(1)), make_world(small(2))
+    for w in (world, twin):
+        w.step(7)
+    other.step(5)
+    bodies = len(world.transforms)
+    with pytest.raises(SnapshotMismatch, match="cannot restore a snapshot of another world: "):
+        world.restore(other.snapshot())
+    assert world.frame == 7 and len(world.transforms) == bodies
+    for w in (world, twin):
+        w.step(10)
+    for mine, theirs in zip(_state(world), _state(twin), strict=True):
+        assert_array_equal(mine, theirs)  # as if the restore had never been asked for

@@ -12,7 +12,13 @@ import sys
 import time
 from typing import Any
 
-from ecs_tentacles.cli.arguments import bounded_int, frame_count, seed_int, thread_count
+from ecs_tentacles.cli.arguments import (
+    add_threads_argument,
+    bounded_int,
+    counted,
+    frame_count,
+    seed_int,
+)
 from ecs_tentacles.cli.lod_options import add_lod_arguments, apply_focus, lod_choice
 from ecs_tentacles.components import Creature
 from ecs_tentacles.plugin import RunSummary
@@ -48,12 +54,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 def add_physics_arguments(parser: argparse.ArgumentParser) -> None:
     """`--threads`, `--strict`, `--lod` and `--focus`, shared by the commands that simulate."""
-    parser.add_argument(
-        "--threads",
-        type=thread_count,
-        default=None,
-        help="threads that step the physics (default: one per core); results are the same",
-    )
+    add_threads_argument(parser)
     parser.add_argument(
         "--strict",
         action="store_true",
@@ -101,15 +102,17 @@ def handle(args: argparse.Namespace) -> int:
             f"{path}: {summary['frames']} frames, {summary['sim_seconds']:.2f} s simulated in"
             f" {summary['wall_seconds']:.2f} s wall,"
             f" real-time factor {summary['real_time_factor']:.2f}x"
-            f" ({summary['creatures']} creatures, {summary['bodies']} bodies,"
+            f" ({counted(summary['creatures'], 'creature')}, {summary['bodies']} bodies,"
             f" {summary['dofs']} dofs); {'; '.join([*texts, attaches])}"
         )
         if summary["tiers"]["full"] < summary["creatures"]:  # level of detail did something
             print(f"  level of detail at the end: {tier_line(summary['tiers'])}")
-        if health_line(summary):
-            print(f"warning: {health_line(summary)}", file=sys.stderr)
+    failed = bool(args.strict and summary["recoveries"])
+    if health_line(summary) and (failed or not args.json):  # --strict: an error, even with --json
+        kind = "error" if failed else "warning"
+        print(f"{kind}: {health_line(summary)}", file=sys.stderr)
     world.close()
-    return 1 if args.strict and summary["recoveries"] else 0
+    return 1 if failed else 0
 
 
 def simulate(world: World, frames: int, *, progress: bool = True) -> dict[str, Any]:

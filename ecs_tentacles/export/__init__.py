@@ -39,6 +39,8 @@ def write(
     is returned; without, rigid bodies.
     """
     kind = output_kind(path)
+    if kind != "take":  # a take refuses itself (`Take.save`), with its own verb
+        take.check_exportable(path)
     if skin is not None and kind in ("usd", "gltf"):
         from ecs_tentacles.export.skinned import write_skinned
 

@@ -146,6 +146,17 @@ class PhysicsBackend:
             sleep=self.sleep.state(),
         )
 
+    def state_problem(self, state: PhysicsState) -> str | None:
+        """Why `set_state(state)` would not fit this backend (one line), or None."""
+        if len(state.states) != len(self.batches):
+            return f"{len(state.states)} physics batches, here {len(self.batches)}"
+        for batch, rows, (xpos, _) in zip(self.batches, state.states, state.poses, strict=True):
+            if rows.shape != batch.state.shape or xpos.shape != batch.xpos.shape:
+                return f"batch {batch.index}: state {rows.shape}, here {batch.state.shape}"
+        if state.tier.shape != self.tier.shape:
+            return f"{len(state.tier)} creatures, here {len(self.tier)}"
+        return None
+
     def set_state(self, state: PhysicsState) -> None:
         """Go back to `state()` of this backend (same creatures); it stays reusable.
 

@@ -55,6 +55,17 @@ class Quit(System):
             sys.exit(0)
 
 
+class Poison(System):
+    """Writes NaN into the first body's position at frame 2, after the physics."""
+
+    name = "poison"
+    stage = "output"
+
+    def process(self, world, dt):
+        if world.frame == 2:
+            world.transforms.pos[0, 0] = float("nan")
+
+
 class Shake(System):
     """A substep hook that fails at frame 2."""
 
@@ -198,3 +209,19 @@ def test_a_plugin_that_exits_while_importing_is_a_scene_error(
     assert capsys.readouterr().err == (
         f"error: {failing}: plugins.exits: cannot import 'exits.py': SystemExit: 3\n"
     )
+
+
+@pytest.mark.parametrize("suffix", [".npz", ".glb"])
+def test_a_bake_whose_plugin_wrote_nan_writes_nothing(
+    failing: Path, suffix: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    _use_plugin(failing, "poison", "failing.py:Poison")
+    out = failing.parent / f"take{suffix}"
+    args = ["bake", str(failing), "--seconds", "0.2", "--out", str(out), "--allow-systems"]
+    assert main([*args, "--quiet"]) == 1
+    err = capsys.readouterr().err.splitlines()
+    verb = "write" if suffix == ".npz" else "export"
+    assert err[1:] == [
+        f"error: {out}: cannot {verb} this take: pos: non-finite value nan at (3, 0, 0)"
+    ]
+    assert not out.exists()

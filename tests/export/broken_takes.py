@@ -148,6 +148,8 @@ BROKEN_TAKES: dict[str, Callable[[Path, Path], None]] = {
     "npy_data_cut_short": edit(lambda h, a: a.update(pos=_npy(a["pos"], lambda b: b[:-40]))),
     "fps_zero": edit(lambda h, a: h.update(fps=0)),
     "fps_huge_negative": edit(lambda h, a: h.update(fps=-1e308)),
+    "fps_huge": edit(lambda h, a: h.update(fps=1e308)),
+    "position_far_out": edit(_set("pos", (1, 2, 0), 3e38)),
     "fps_string": edit(lambda h, a: h.update(fps="30")),
     "fps_nan": edit(lambda h, a: h.update(fps=float("nan"))),
     "frames_zero": edit(lambda h, a: h.update(frames=0)),

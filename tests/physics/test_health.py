@@ -151,7 +151,10 @@ def test_run_reports_recoveries_and_strict_exits_1(
     assert main(args) == 0
     err = capsys.readouterr().err
     assert "warning: physics recovered 1 times (non-finite 1), 0 creatures frozen" in err
-    assert main([*args, "--strict"]) == 1
+    error = "error: physics recovered 1 times (non-finite 1), 0 creatures frozen\n"
+    for extra in ([], ["--json"]):  # exit 1 says why, in one line, with or without --json
+        assert main([*args, "--strict", *extra]) == 1
+        assert capsys.readouterr().err == error
     assert not (faulty_scene.parent / "MUJOCO_LOG.TXT").exists()
 
 
