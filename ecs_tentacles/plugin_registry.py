@@ -191,11 +191,14 @@ def resolve(
     *,
     allow: bool = False,
     defaults: tuple[str, ...] = DEFAULT_ON,
+    problems_out: list[str] | None = None,
 ) -> list[Plugin]:
     """Instances of the plugins a scene's `plugins` field turns on, defaults first.
 
     `choices` maps names to `true`, `false` or a config (configs are not validated
-    here: the scene schema does that). Raises PluginError, one problem per line.
+    here: the scene schema does that). Raises PluginError, one problem per line; with
+    `problems_out`, the problems go there instead and the plugins that could be made
+    are returned (the loader goes on to check the rest of the scene).
     """
     choices = dict(choices or {})
     wanted = [n for n in defaults if choices.get(n, True) is not False]
@@ -229,8 +232,10 @@ def resolve(
         for need in plugin.requires:
             if need not in on:
                 problems.append(f"plugins.{plugin.key}: needs the {need!r} plugin, which is off")
-    if problems:
+    if problems and problems_out is None:
         raise PluginError("\n".join(problems))
+    if problems_out is not None:
+        problems_out += problems
     return plugins
 
 

@@ -22,10 +22,10 @@ import re
 import stat
 from typing import TYPE_CHECKING, Any
 
-from ecs_tentacles.plugin_registry import PluginError, resolve
+from ecs_tentacles.plugin_registry import resolve
 from ecs_tentacles.scene.errors import SceneError
-from ecs_tentacles.scene.physical import physically_checked
-from ecs_tentacles.scene.validate import plugin_config, validated
+from ecs_tentacles.scene.physical import physical_problems, physically_checked
+from ecs_tentacles.scene.validate import plugin_config, repaired, validated, with_defaults
 
 if TYPE_CHECKING:
     from ecs_tentacles.plugin import Plugin
@@ -112,6 +112,22 @@ def load_scene(
     return load_scene_plugins(source, allow_systems=allow_systems)[0]
 
 
+def _later_problems(data: object, found: list[str], plugins: list[Plugin]) -> list[str]:
+    """The problems the later stages find in `data` while earlier ones are reported:
+    semantic checks once the schema's are taken out (`validate.repaired`), physical
+    checks once both are; each problem once, after those already `found`."""
+    fixed = repaired(data, plugins)
+    if fixed is None:
+        return []
+    semantic, completed = validated(fixed, plugins)
+    later = [problem for problem in semantic if problem not in found]
+    try:  # a semantic problem (an override of a tentacle that is not there) may stop it
+        physical = physical_problems(completed or with_defaults(fixed, plugins))
+    except (KeyError, IndexError, TypeError, ValueError):
+        physical = []
+    return later + [problem for problem in physical if problem not in found]
+
+
 def load_scene_plugins(
     source: str | os.PathLike[str] | dict[str, Any],
     *,
@@ -132,14 +148,16 @@ def load_scene_plugins(
         prefix = f"{path}: "
         scene_dir = path.resolve().parent
     chosen = data.get("plugins") if isinstance(data, dict) else None
-    try:
-        plugins = resolve(
-            chosen if _plugin_choices(chosen) else None, scene_dir, allow=allow_systems
-        )
-    except PluginError as exc:
-        raise SceneError([prefix + line for line in str(exc).splitlines()]) from None
+    plugin_problems: list[str] = []
+    plugins = resolve(
+        chosen if _plugin_choices(chosen) else None,
+        scene_dir,
+        allow=allow_systems,
+        problems_out=plugin_problems,
+    )
     problems, completed = validated(data, plugins)
-    if problems:
+    if plugin_problems or problems:
+        problems = plugin_problems + problems + _later_problems(data, problems, plugins)
         raise SceneError([prefix + problem for problem in problems])
     assert isinstance(data, dict) and completed is not None  # the schema requires an object
     full = physically_checked(completed, prefix)

@@ -290,6 +290,46 @@ def validated(
     return lines, None if lines else full
 
 
+def repaired(data: object, plugins: Sequence[Plugin]) -> dict[str, Any] | None:
+    """`data` with every value the schema refuses taken out (so its default applies) and
+    unknown keys dropped: a scene the later stages (semantic and physical checks) can
+    look at while the schema's problems are reported, so one run reports them all.
+
+    None when that cannot be done without guessing: a required key missing, a list item
+    or the whole scene of the wrong kind, or problems that remain after the repair.
+    """
+    schema = schema_for(plugins)
+    if not isinstance(data, dict) or _limit_problems(data, schema, schema):
+        return None  # too long to look at twice
+    if _too_deep(data) is not None:
+        return None  # copying it would recurse too deep
+    fixed = copy.deepcopy(data)
+    validator = _validator(schema)
+    errors = list(validator.iter_errors(fixed))
+    for error in sorted(errors, key=lambda e: -len(e.absolute_path)):  # deepest first
+        path = tuple(error.absolute_path)
+        try:
+            node: Any = fixed
+            for part in path[:-1] if path else ():
+                node = node[part]
+            if error.validator == "additionalProperties":
+                container = node[path[-1]] if path else node
+                allowed = (
+                    error.schema.get("properties", {}) if isinstance(error.schema, dict) else {}
+                )
+                for key in [k for k in container if k not in allowed]:
+                    del container[key]
+            elif error.validator == "required" or not path or not isinstance(node, dict):
+                return None  # a missing key, the scene itself, or a list item (renumbering)
+            else:
+                node.pop(path[-1], None)
+        except (KeyError, IndexError, TypeError):
+            return None
+    if _schema_problems(fixed, validator) or _plugin_configs(fixed, plugins):
+        return None
+    return fixed
+
+
 def _place(path: JsonPath) -> str | None:
     """Where a key at `path` sits: a creature's key, a tentacle key, a scene key."""
     if len(path) == 1:

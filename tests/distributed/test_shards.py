@@ -75,7 +75,7 @@ def test_declared_shards_are_used_as_they_are() -> None:
 def test_bad_shards_get_one_line_each_with_the_json_path(
     shards: list[list[str]], problems: list[str]
 ) -> None:
-    raw = scene((0, 0), (1, 0))
+    raw = scene((0, 0), (1.5, 0))  # apart: the only problems are the shards'
     raw["shards"] = shards
     with pytest.raises(SceneError) as caught:
         load_scene(raw)

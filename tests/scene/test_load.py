@@ -166,3 +166,30 @@ def test_existing_path_wins_over_bundled_name(
 @pytest.mark.parametrize("name", bundled_scene_names())
 def test_every_bundled_scene_loads(name: str) -> None:
     assert load_scene(bundled_scene(name))["version"] == 1
+
+
+def test_one_run_reports_the_problems_of_every_stage(tmp_path: pathlib.Path) -> None:
+    scene = {
+        "version": 1,
+        "plugins": {"wobble": True},  # stage 1: no such plugin
+        "physics": {"gravity": [0, 0, 9.81]},  # stage 4: gravity points up
+        "creatures": [
+            {"name": "a", "position": [0, 0], "mantle": {"radius": -1}},  # stage 2: schema
+            {"name": "a", "position": [3, 0]},  # stage 3: a duplicate name
+            {"name": "b", "position": [0.05, 0]},  # stage 4: overlaps the first
+        ],
+    }
+    path = tmp_path / "nine.json"
+    path.write_text(json.dumps(scene))
+    with pytest.raises(SceneError) as caught:
+        load_scene(path)
+    lines = caught.value.problems
+    assert len(lines) == len(set(lines))
+    wanted = [
+        "plugins.wobble: ",
+        "creatures[0].mantle.radius: must be ",
+        'creatures[1].name: duplicate name "a"',
+        "physics.gravity: points up",
+    ]
+    for start in wanted:
+        assert any(line.startswith(f"{path}: {start}") for line in lines), (start, lines)
