@@ -10,6 +10,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from ecs_tentacles.atomic import claim
 from ecs_tentacles.cli.arguments import bounded_int
 from ecs_tentacles.export.bake import BakePlan, bake
 from ecs_tentacles.take import Take
@@ -105,19 +106,39 @@ def run_wedge(args: argparse.Namespace, plan: BakePlan, save: Any) -> int:
     """Bake every variant (on Ray with --ray, else here), write each output and wedge.json."""
     from ecs_tentacles.distributed.wedge import (
         output_for,
+        outputs_problem,
         parse_parameter,
         variants,
         write_index,
     )
 
     parameters = [parse_parameter(text) for text in args.wedge]
-    every = variants(plan.scene, parameters, plan.source)
+    folder = Path(plan.folder) if plan.folder else None
+    allow = args.allow_systems
+    every = variants(plan.scene, parameters, plan.source, allow_systems=allow, scene_dir=folder)
     pattern: Path = args.out
     if len(every) > 1 and "{name}" not in pattern.name:
         print("error: argument --out: a wedge needs {name} in the file name", file=sys.stderr)
         return 2
+    problem = outputs_problem(pattern, every)
+    if problem:
+        print(f"error: {problem}", file=sys.stderr)
+        return 2
+    index = pattern.parent / "wedge.json"
+    for out in [output_for(pattern, v.name) for v in every] + [index]:
+        claim(out)  # what each file is now: another run writing one meanwhile wins it
+    if index.exists():
+        print(f"note: {index} exists: this wedge replaces it", file=sys.stderr)
     plans = [
-        BakePlan.make(v.scene, seconds=plan.seconds, fps=plan.fps, seed=args.seed) for v in every
+        BakePlan.make(
+            v.scene,
+            seconds=plan.seconds,
+            fps=plan.fps,
+            seed=args.seed,
+            allow_systems=allow,
+            scene_dir=plan.folder,
+        )
+        for v in every
     ]
     print(f"wedge: {len(every)} variants -> {pattern.parent}", file=sys.stderr, flush=True)
     takes = _wedge_takes(args, plans)

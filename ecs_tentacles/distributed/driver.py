@@ -20,7 +20,9 @@ every running task (`ray.cancel`) and keeps the finished shards there too.
 from __future__ import annotations
 
 import logging
+import signal
 import sys
+import threading
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -64,11 +66,22 @@ def start_ray(address: str | None, cpus: int | None) -> bool:
         return False
     options: dict[str, Any] = {"include_dashboard": False, "log_to_driver": False}
     options["logging_level"] = logging.ERROR
+    ours = _signal_handlers()
     if address:
         ray.init(address=address, **options)
     else:
         ray.init(num_cpus=cpus, **options)
+    for number, handler in ours.items():  # Ray installs its own: SIGTERM must stay ours
+        signal.signal(number, handler)  # (one line, exit 143, Ray shut down on the way out)
     return True
+
+
+def _signal_handlers() -> dict[int, Any]:
+    """This process's SIGTERM, SIGINT and SIGHUP handlers (none off the main thread)."""
+    if threading.current_thread() is not threading.main_thread():
+        return {}
+    numbers = (signal.SIGTERM, signal.SIGINT, signal.SIGHUP)
+    return {n: h for n in numbers if (h := signal.getsignal(n)) is not None}
 
 
 def _run_shard(plan: BakePlan, members: list[int], key: str, counter: Any, allow: bool) -> Any:

@@ -29,7 +29,7 @@ from typing import Any
 
 from ecs_tentacles.atomic import atomic_file
 from ecs_tentacles.scene.errors import SceneError
-from ecs_tentacles.scene.load import load_scene
+from ecs_tentacles.scene.load import load_scene_plugins
 from ecs_tentacles.scene.validate import format_path
 
 _TOKEN = re.compile(r'\.?([A-Za-z_][A-Za-z0-9_]*)|\[(\d+)\]|\[("(?:[^"\\]|\\.)*")\]')
@@ -81,6 +81,10 @@ def parse_parameter(text: str) -> Parameter:
         low, high = int(span[1]), int(span[2])
         if high < low:
             raise WedgeError(f"argument --wedge: {path_text}: empty range {values_text}")
+        if high - low + 1 > MAX_VARIANTS:  # refused before the range is made
+            raise WedgeError(
+                f"argument --wedge: {path_text}: {high - low + 1} values, more than {MAX_VARIANTS}"
+            )
         values: list[Any] = list(range(low, high + 1))
     else:
         values = [_value(v.strip()) for v in values_text.split(",")]
@@ -108,9 +112,17 @@ def variant_name(values: dict[str, Any]) -> str:
     return "_".join(parts)
 
 
-def variants(raw: dict[str, Any], parameters: list[Parameter], source: str = "") -> list[Variant]:
+def variants(
+    raw: dict[str, Any],
+    parameters: list[Parameter],
+    source: str = "",
+    *,
+    allow_systems: bool = False,
+    scene_dir: Path | None = None,
+) -> list[Variant]:
     """Every combination's validated scene (WedgeError/SceneError before any bake);
-    `source` (the scene file) starts each SceneError line."""
+    `source` (the scene file) starts each SceneError line. Plugins from files are found
+    in `scene_dir` and imported only with `allow_systems`, as for the scene itself."""
     count = 1
     for parameter in parameters:
         count *= len(parameter.values)
@@ -125,7 +137,7 @@ def variants(raw: dict[str, Any], parameters: list[Parameter], source: str = "")
             _set(scene, parameter.path, value)
             values[parameter.text] = value
         try:
-            loaded = load_scene(scene)
+            loaded, _ = load_scene_plugins(scene, allow_systems=allow_systems, scene_dir=scene_dir)
         except SceneError as error:
             shown = ", ".join(f"{k}={json.dumps(v)}" for k, v in values.items())
             where = f"{source}: " if source else ""
@@ -160,9 +172,25 @@ def _set(scene: Any, path: tuple[str | int, ...], value: Any) -> None:
             node = node[part]
 
 
+MAX_NAME_BYTES = 255  # the longest file name common file systems take
+
+
 def output_for(pattern: Path, name: str) -> Path:
     """The output file of variant `name`."""
     return pattern.with_name(pattern.name.replace("{name}", name))
+
+
+def outputs_problem(pattern: Path, every: list[Variant]) -> str | None:
+    """Why the outputs could not all be written (checked before any bake), or None."""
+    for variant in every:
+        out = output_for(pattern, variant.name)
+        if len(out.name.encode()) > MAX_NAME_BYTES:
+            return (
+                f"argument --out: the file name of variant {variant.name!r} is"
+                f" {len(out.name.encode())} bytes, more than the {MAX_NAME_BYTES} a file name"
+                " may have (wedge fewer parameters or shorten the pattern)"
+            )
+    return None
 
 
 def write_index(pattern: Path, base: dict[str, Any], rows: list[dict[str, Any]]) -> Path:

@@ -24,7 +24,7 @@ from ecs_tentacles.construction import tentacle_params
 from ecs_tentacles.export.recording import Recording, scene_sha256
 from ecs_tentacles.plugin_registry import builtin
 from ecs_tentacles.progress import step_frames
-from ecs_tentacles.scene.load import load_scene, resolve_scene_path
+from ecs_tentacles.scene.load import load_scene, load_scene_plugins, resolve_scene_path
 from ecs_tentacles.take import Take
 from ecs_tentacles.take_read import MAX_FRAMES, MAX_TAKE_BYTES
 from ecs_tentacles.world import World
@@ -75,14 +75,18 @@ class BakePlan:
         fps: float | None = None,
         seed: int | None = None,
         allow_systems: bool = False,
+        scene_dir: str | os.PathLike[str] | None = None,
     ) -> BakePlan:
         """Load and validate `scene` (SceneError if bad) and work out the frame rates.
 
-        `allow_systems` lets the scene's plugins from files or modules be imported.
+        `allow_systems` lets the scene's plugins from files or modules be imported; those
+        of a dict scene are found in `scene_dir` (default: the current folder).
         """
-        folder = None
+        folder = None if scene_dir is None else str(Path(scene_dir).resolve())
         if isinstance(scene, dict):
-            source, data = "<dict>", load_scene(scene, allow_systems=allow_systems)
+            where = None if folder is None else Path(folder)
+            data = load_scene_plugins(scene, allow_systems=allow_systems, scene_dir=where)[0]
+            source = "<dict>"
         else:
             path = resolve_scene_path(os.fspath(scene))
             source, data = str(path), load_scene(path, allow_systems=allow_systems)

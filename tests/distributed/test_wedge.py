@@ -26,6 +26,7 @@ def test_parameters_parse_ranges_lists_and_json_paths() -> None:
     [
         ("seed", "argument --wedge: expected PATH=VALUES, got 'seed'"),
         ("seed=3..1", "argument --wedge: seed: empty range 3..1"),
+        ("seed=0..99999999999", "argument --wedge: seed: 100000000000 values, more than 10000"),
         ("creatures[x]=1", "argument --wedge: 'creatures[x]' is not a JSON path like a.b[0].c"),
     ],
 )
@@ -81,3 +82,53 @@ def test_a_local_wedge_without_ray(tmp_path: Path) -> None:
     one = tmp_path / "one.npz"
     assert main(["bake", str(variant), "--seconds", "0.1", "--out", str(one), "--quiet"]) == 0
     assert one.read_bytes() == (tmp_path / "w_seed-6.npz").read_bytes()
+
+
+def test_a_wedge_whose_file_names_are_too_long_writes_nothing(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    scene = tmp_path / "small.json"
+    scene.write_text(json.dumps(SMALL_SCENE))
+    out = str(tmp_path / ("x" * 200 + "_{name}.npz"))
+    argv = ["bake", str(scene), "--seconds", "0.1", "--out", out, "--quiet"]
+    assert main([*argv, "--wedge", "seed=1,2", "--wedge", "description=" + "d" * 60]) == 2
+    err = capsys.readouterr().err
+    assert (
+        err.startswith("error: argument --out: the file name of variant ") and err.count("\n") == 1
+    )
+    assert "more than the 255 a file name may have" in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["small.json"]
+
+
+PLUGIN = """
+from ecs_tentacles.system import System
+
+
+class Still(System):
+    name = "still"
+    stage = "act"
+
+    def process(self, world, dt):
+        pass
+"""
+
+
+def test_a_wedge_of_a_scene_with_a_plugin_file_needs_and_honours_allow_systems(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    (tmp_path / "still.py").write_text(PLUGIN)
+    scene = tmp_path / "small.json"
+    scene.write_text(json.dumps({**SMALL_SCENE, "plugins": {"still": {"from": "still.py"}}}))
+    out = str(tmp_path / "w_{name}.npz")
+    argv = ["bake", str(scene), "--seconds", "0.1", "--out", out, "--quiet", "--wedge", "seed=1,2"]
+    assert main(argv) == 2  # plugin code runs only when asked
+    assert "--allow-systems" in capsys.readouterr().err
+    assert main([*argv, "--allow-systems"]) == 0
+    assert capsys.readouterr().err.splitlines() == [f"wedge: 2 variants -> {tmp_path}"]
+    index = json.loads((tmp_path / "wedge.json").read_text())
+    assert [row["file"] for row in index["outputs"]] == ["w_seed-1.npz", "w_seed-2.npz"]
+    assert main([*argv, "--allow-systems"]) == 0  # again: says it replaces the index
+    assert capsys.readouterr().err.splitlines() == [
+        f"note: {tmp_path / 'wedge.json'} exists: this wedge replaces it",
+        f"wedge: 2 variants -> {tmp_path}",
+    ]
