@@ -16,9 +16,11 @@ import argparse
 import copy
 import json
 import pathlib
+import sys
 from typing import Any
 
-from ecs_tentacles.atomic import atomic_output
+from ecs_tentacles.atomic import atomic_output, claim
+from ecs_tentacles.cli.arguments import output_path, read_only_problem
 from ecs_tentacles.plugin_registry import BUILTIN, DEFAULT_ON, FROM
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.load import load_scene_plugins, read_scene_json, resolve_scene_path
@@ -33,10 +35,24 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         " its config) and its `systems` list turned into plugin entries. The output is"
         " validated, then written atomically.",
     )
-    parser.add_argument("scene", metavar="SCENE", help="scene file")
+    parser.add_argument(
+        "scene",
+        metavar="SCENE",
+        help="scene file or bundled scene name (bundled scenes are read-only: their copy is"
+        " written to the current folder)",
+    )
     where = parser.add_mutually_exclusive_group()
-    where.add_argument("--out", metavar="FILE", help="output file (default SCENE.migrated.json)")
-    where.add_argument("--in-place", action="store_true", help="replace the scene file")
+    where.add_argument(
+        "--out",
+        type=output_path(".json"),
+        metavar="FILE",
+        help="output file (default SCENE.migrated.json beside the scene)",
+    )
+    where.add_argument(
+        "--in-place",
+        action="store_true",
+        help="replace the scene file (a symlink stays a link: its target is replaced)",
+    )
     parser.add_argument(
         "--allow-systems",
         action="store_true",
@@ -107,7 +123,23 @@ def handle(args: argparse.Namespace) -> int:
     scene, changes = migrate(raw)
     folder = path.resolve().parent
     load_scene_plugins(scene, allow_systems=args.allow_systems, scene_dir=folder)
-    target = path if args.in_place else pathlib.Path(args.out or path.with_suffix(".migrated.json"))
+    bundled = read_only_problem(path)
+    if args.in_place:
+        if bundled:
+            raise SceneError(
+                [f"{args.scene}: a bundled scene is read-only; write a copy with --out FILE"]
+            )
+        target = path.resolve()  # through a symlink: the link stays, its file is rewritten
+        claim(target)
+    elif args.out is not None:
+        target = args.out
+    else:
+        target = path.with_suffix(".migrated.json")
+        if bundled:
+            target = pathlib.Path(f"{path.stem}.migrated.json")
+            print(f"migrate: {args.scene} is a bundled scene: writing the copy to ./{target}",
+                  file=sys.stderr)  # fmt: skip
+        claim(target)
     with atomic_output(target) as temporary:
         temporary.write_text(json.dumps(scene, indent=2) + "\n", encoding="utf-8")
     if args.json:

@@ -12,9 +12,10 @@ from __future__ import annotations
 
 import argparse
 import json
-import pathlib
+import sys
 
 from ecs_tentacles.atomic import atomic_output
+from ecs_tentacles.cli.arguments import output_path
 from ecs_tentacles.scene.load import load_scene_plugins, resolve_scene_path
 from ecs_tentacles.scene.schema import load_schema, schema_for
 
@@ -26,8 +27,19 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         description="Print (or write with --out) the scene schema assembled from the core"
         " schema and the plugins' fragments: the default plugins, or those SCENE turns on.",
     )
-    parser.add_argument("scene", nargs="?", metavar="SCENE", help="scene whose plugins to add")
-    parser.add_argument("--out", metavar="FILE", help="write it here (atomically) instead")
+    parser.add_argument(
+        "scene",
+        nargs="?",
+        metavar="SCENE",
+        help="scene (file or bundled name) whose plugins to add",
+    )
+    parser.add_argument(
+        "--out",
+        type=output_path(".json"),
+        metavar="FILE",
+        help="write it here (atomically); without it the schema goes to stdout when that is"
+        " a pipe or a file, not a terminal",
+    )
     parser.add_argument(
         "--allow-systems", action="store_true", help="import the plugins SCENE names from files"
     )
@@ -43,9 +55,16 @@ def handle(args: argparse.Namespace) -> int:
         schema = schema_for(plugins)
     text = json.dumps(schema, indent=2) + "\n"
     if args.out is None:
+        if sys.stdout.isatty():
+            print(
+                f"error: schema: {len(text) // 1024} KB of JSON is not for a terminal;"
+                " write it with --out FILE.json or pipe it (ecs-tentacles schema | less)",
+                file=sys.stderr,
+            )
+            return 2
         print(text, end="")
         return 0
-    with atomic_output(pathlib.Path(args.out)) as temporary:
+    with atomic_output(args.out) as temporary:
         temporary.write_text(text, encoding="utf-8")
     print(f"schema: wrote {args.out}")
     return 0

@@ -139,3 +139,57 @@ def test_a_scene_written_before_locomotion_owned_its_tentacle_keys_migrates(
         "count": 3, "links": 4, "overrides": [{"index": 1, "strength": 30.0}]
     }  # fmt: skip
     assert main(["run", str(tmp_path / "older.migrated.json"), "--frames", "2"]) == 0
+
+
+def test_migrate_never_writes_into_the_installed_package(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    bundled = bundled_scene("octopus")
+    before = bundled.read_bytes()
+    siblings = sorted(p.name for p in bundled.parent.iterdir())
+    monkeypatch.chdir(tmp_path)
+    assert main(["migrate", "octopus", "--in-place"]) == 2
+    assert capsys.readouterr().err == (
+        "error: octopus: a bundled scene is read-only; write a copy with --out FILE\n"
+    )
+    with pytest.raises(SystemExit) as stop:
+        main(["migrate", "octopus", "--out", str(bundled.with_name("x.json"))])
+    assert stop.value.code == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: argument --out: ") and "bundled files are read-only" in err
+    assert main(["migrate", "octopus"]) == 0
+    captured = capsys.readouterr()
+    assert captured.err == (
+        "migrate: octopus is a bundled scene: writing the copy to ./octopus.migrated.json\n"
+    )
+    assert json.loads((tmp_path / "octopus.migrated.json").read_text())["plugins"]
+    assert bundled.read_bytes() == before
+    assert sorted(p.name for p in bundled.parent.iterdir()) == siblings
+
+
+def test_migrate_in_place_through_a_symlink_keeps_the_link(tmp_path: Path) -> None:
+    real = tmp_path / "real.json"
+    real.write_text(json.dumps({"version": 1, "systems": []}))
+    link = tmp_path / "link.json"
+    link.symlink_to(real)
+    assert main(["migrate", str(link), "--in-place"]) == 0
+    assert link.is_symlink() and link.resolve() == real
+    assert "plugins" in json.loads(real.read_text())
+
+
+def test_schema_refuses_an_output_that_is_not_json_or_a_terminal(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    with pytest.raises(SystemExit) as stop:
+        main(["schema", "--out", str(tmp_path / "x.py")])
+    assert stop.value.code == 2
+    assert capsys.readouterr().err == (
+        f"error: argument --out: must end in .json, got '{tmp_path / 'x.py'}'"
+        " (see ecs-tentacles schema --help)\n"
+    )
+    monkeypatch.setattr("sys.stdout.isatty", lambda: True)
+    assert main(["schema"]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    assert captured.err.startswith("error: schema: ") and "--out FILE.json" in captured.err
+    assert list(tmp_path.iterdir()) == []
