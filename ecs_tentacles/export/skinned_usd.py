@@ -58,6 +58,7 @@ def build_skinned_stage(
     """An in-memory `Usd.Stage` with one SkelRoot per creature, and the key report."""
     pxr = _pxr()
     importlib.import_module("pxr.UsdSkel")  # the skel schemas, into the `pxr` namespace
+    importlib.import_module("pxr.UsdShade")
 
     UsdGeom = pxr.UsdGeom
     stage = new_stage(take)
@@ -112,7 +113,7 @@ def _creature(pxr: Any, stage: Any, creature: SkinnedCreature) -> None:
     skin.SetNormalsInterpolation(UsdGeom.Tokens.vertex)
     low, high = mesh.positions.min(axis=0), mesh.positions.max(axis=0)
     skin.CreateExtentAttr([Gf.Vec3f(*low.tolist()), Gf.Vec3f(*high.tolist())])
-    skin.CreateDisplayColorAttr([Gf.Vec3f(0.85, 0.45, 0.5)])
+    skin.CreateDisplayColorAttr([Gf.Vec3f(*SKIN_COLOUR)])
     primvars = UsdGeom.PrimvarsAPI(skin.GetPrim())
     st = primvars.CreatePrimvar(
         "st", Sdf.ValueTypeNames.TexCoord2fArray, UsdGeom.Tokens.faceVarying
@@ -127,6 +128,27 @@ def _creature(pxr: Any, stage: Any, creature: SkinnedCreature) -> None:
         Vt.FloatArray.FromNumpy(mesh.weights.reshape(-1).astype(np.float32))
     )
     bound.CreateGeomBindTransformAttr(Gf.Matrix4d(1.0))
+    material = _skin_material(pxr, stage, f"{base}/materials")
+    pxr.UsdShade.MaterialBindingAPI.Apply(skin.GetPrim()).Bind(material)
+
+
+SKIN_COLOUR = (0.85, 0.45, 0.5)  # the rose of the glTF export's skin texture
+SKIN_ROUGHNESS = 0.6  # as the glTF material's
+
+
+def _skin_material(pxr: Any, stage: Any, folder: str) -> Any:
+    """`<folder>/skin`: a UsdPreviewSurface of the skin's colour and roughness."""
+    Sdf, UsdShade = pxr.Sdf, pxr.UsdShade
+    path = f"{folder}/skin"
+    pxr.UsdGeom.Scope.Define(stage, folder)
+    material = UsdShade.Material.Define(stage, path)
+    shader = UsdShade.Shader.Define(stage, f"{path}/surface")
+    shader.CreateIdAttr("UsdPreviewSurface")
+    shader.CreateInput("diffuseColor", Sdf.ValueTypeNames.Color3f).Set(SKIN_COLOUR)
+    shader.CreateInput("roughness", Sdf.ValueTypeNames.Float).Set(SKIN_ROUGHNESS)
+    shader.CreateInput("metallic", Sdf.ValueTypeNames.Float).Set(0.0)
+    material.CreateSurfaceOutput().ConnectToSource(shader.ConnectableAPI(), "surface")
+    return material
 
 
 def _sucker(pxr: Any, stage: Any, take: Take, index: int, sucker: dict[str, Any]) -> None:

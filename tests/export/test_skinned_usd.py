@@ -49,6 +49,7 @@ def test_the_skinned_stage_passes_the_compliance_checker(
     assert [p.GetName() for p in root.GetChildren()] == [
         "skeleton",
         "skin",
+        "materials",
         "suckers",
         "goals",
         "fur",
@@ -124,3 +125,27 @@ def test_reduced_keys_stay_within_the_tolerance_through_usd_interpolation(
         assert angle_between(got, expected[frame]).max() <= 0.5 + 1e-3
     assert report.after < report.before // 2
     assert report.max_rotation_error_deg <= 0.5
+
+
+def test_the_skin_has_a_preview_surface_of_the_gltf_colour(
+    guided_take: Take, tmp_path: Path
+) -> None:
+    from pxr import UsdShade
+
+    from ecs_tentacles.export.skinned_gltf import skin_texture
+
+    path = tmp_path / "take.usda"
+    write_skinned_usd(guided_take, path)
+    stage = Usd.Stage.Open(str(path))
+    skin = stage.GetPrimAtPath("/World/octo/skin")
+    material, _ = UsdShade.MaterialBindingAPI(skin).ComputeBoundMaterial()
+    assert material and material.GetPath() == "/World/octo/materials/skin"
+    source = material.ComputeSurfaceSource()[0]
+    assert source.GetIdAttr().Get() == "UsdPreviewSurface"
+    colour = np.array(source.GetInput("diffuseColor").Get())
+    from io import BytesIO
+
+    from PIL import Image
+
+    texture = np.asarray(Image.open(BytesIO(skin_texture()))).reshape(-1, 3) / 255
+    assert np.abs(colour - np.median(texture, axis=0)).max() < 0.08  # the glb's rose skin
