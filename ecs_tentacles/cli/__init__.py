@@ -53,18 +53,30 @@ def build_parser() -> argparse.ArgumentParser:
         description="Tentacled creatures from JSON scenes, simulated with MuJoCo.",
     )
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
-    parser.add_argument(
-        "--max-scene-mb",
-        type=scene_megabytes,
-        default=None,
-        metavar="MB",
-        help=f"largest scene file read (default {load.MAX_SCENE_BYTES >> 20})",
-    )
-    parser.add_argument("--debug", action="store_true", help="show tracebacks of failures")
+    _add_shared_options(parser, None)
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for module in COMMANDS.values():
         module.add_parser(commands)
+    for command in commands.choices.values():  # also after the command: `run octopus --debug`
+        _add_shared_options(command, argparse.SUPPRESS)
     return parser
+
+
+def _add_shared_options(parser: argparse.ArgumentParser, default: object) -> None:
+    """--max-scene-mb and --debug; a command's copies default to SUPPRESS, so they only
+    set what is given after the command and leave the top-level value otherwise."""
+    group = parser.add_argument_group("options of every command")
+    group.add_argument(
+        "--max-scene-mb",
+        type=scene_megabytes,
+        default=default,
+        metavar="MB",
+        help=f"largest scene file read (default {load.MAX_SCENE_BYTES >> 20})",
+    )
+    debug_default = False if default is None else default
+    group.add_argument(
+        "--debug", action="store_true", default=debug_default, help="show tracebacks of failures"
+    )
 
 
 class Terminated(BaseException):
@@ -140,15 +152,26 @@ def _run(args: argparse.Namespace) -> int:
     except Terminated as stop:
         print(f"error: stopped by {stop}; partial outputs removed", file=sys.stderr)
         return 143
+    except SystemError as error:  # a signal's exception raised inside C code (Ray's wait)
+        cause = error.__cause__ or error.__context__
+        if not isinstance(cause, Terminated):
+            return _failed(args, error)
+        print(f"error: stopped by {cause}; partial outputs removed", file=sys.stderr)
+        return 143
     except Exception as error:
-        if args.debug:
-            raise
-        if type(error).__name__ == "NoSuchDisplayException":  # pyglet's, from any platform
-            print(f"error: {args.command}: {NoDisplay.advice(args.command)}", file=sys.stderr)
-            return 2
-        text = " ".join(str(error).split()) or "no details"
-        print(
-            f"error: {args.command}: {type(error).__name__}: {text} (--debug shows where)",
-            file=sys.stderr,
-        )
-        return 1
+        return _failed(args, error)
+
+
+def _failed(args: argparse.Namespace, error: Exception) -> int:
+    """An unexpected failure: one line (the traceback with --debug)."""
+    if args.debug:
+        raise error
+    if type(error).__name__ == "NoSuchDisplayException":  # pyglet's, from any platform
+        print(f"error: {args.command}: {NoDisplay.advice(args.command)}", file=sys.stderr)
+        return 2
+    text = " ".join(str(error).split()) or "no details"
+    print(
+        f"error: {args.command}: {type(error).__name__}: {text} (--debug shows where)",
+        file=sys.stderr,
+    )
+    return 1

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import importlib.resources
 import os
 import sys
 from collections.abc import Callable
@@ -46,6 +47,11 @@ def require_display(command: str) -> None:
         raise NoDisplay(f"{command}: {NoDisplay.advice(command)}")
 
 
+def counted(count: int, noun: str) -> str:
+    """`1 creature`, `2 creatures`, `0 goals` (nouns that take an s)."""
+    return f"{count} {noun if count == 1 else noun + 's'}"
+
+
 def bounded_int(minimum: int, maximum: int) -> Callable[[str], int]:
     """An argparse type: a whole number in [minimum, maximum] (one line otherwise)."""
 
@@ -54,8 +60,10 @@ def bounded_int(minimum: int, maximum: int) -> Callable[[str], int]:
             value = int(text)
         except ValueError:
             raise argparse.ArgumentTypeError(f"must be a whole number, got {text!r}") from None
-        if not minimum <= value <= maximum:
-            raise argparse.ArgumentTypeError(f"must be in [{minimum}, {maximum}], got {value}")
+        if value < minimum:
+            raise argparse.ArgumentTypeError(f"must be >= {minimum}, got {value}")
+        if value > maximum:
+            raise argparse.ArgumentTypeError(f"must be <= {maximum}, got {value}")
         return value
 
     return check
@@ -67,6 +75,35 @@ MAX_THREADS = 256
 frame_count = bounded_int(1, MAX_FRAMES)
 seed_int = bounded_int(0, MAX_SEED)
 thread_count = bounded_int(1, MAX_THREADS)
+
+
+def installed_folders() -> set[Path]:
+    """The package's folders (its code, bundled scenes and systems): read-only inputs."""
+    import ecs_tentacles
+
+    folders = {Path(ecs_tentacles.__file__).resolve().parent}
+    for package in ("ecs_tentacles.assets", "ecs_tentacles.systems"):
+        folders.add(Path(str(importlib.resources.files(package))).resolve())
+    return folders
+
+
+def read_only_problem(path: Path) -> str | None:
+    """Why `path` may not be written (it is inside the installed package), or None."""
+    resolved = path.resolve()
+    for folder in sorted(installed_folders()):
+        if resolved.is_relative_to(folder):
+            return f"{path} is inside the installed package ({folder}): bundled files are read-only"
+    return None
+
+
+def add_threads_argument(parser: argparse.ArgumentParser) -> None:
+    """`--threads N`, the same on every command that steps the physics."""
+    parser.add_argument(
+        "--threads",
+        type=thread_count,
+        default=None,
+        help="threads that step the physics (default: one per core); results are the same",
+    )
 
 
 def output_path(*suffixes: str) -> Callable[[str], Path]:
@@ -81,6 +118,9 @@ def output_path(*suffixes: str) -> Callable[[str], Path]:
             raise argparse.ArgumentTypeError(f"must end in {wanted}, got {text!r}")
         if path.is_dir():
             raise argparse.ArgumentTypeError(f"{text} is a folder")
+        problem = read_only_problem(path)
+        if problem:
+            raise argparse.ArgumentTypeError(f"{problem}; write somewhere else")
         try:  # what the file is now: a run that finds it changed at the end keeps theirs
             claim(path)
         except OutputError as error:

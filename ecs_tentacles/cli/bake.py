@@ -25,7 +25,7 @@ from typing import Any
 from tqdm import tqdm
 
 from ecs_tentacles.cli import bake_ray
-from ecs_tentacles.cli.arguments import output_path, seed_int
+from ecs_tentacles.cli.arguments import add_threads_argument, counted, output_path, seed_int
 from ecs_tentacles.cli.lod_options import add_lod_arguments, apply_to_scene
 from ecs_tentacles.cli.skin_options import add_arguments as add_skin_arguments
 from ecs_tentacles.cli.skin_options import skin_options
@@ -36,7 +36,7 @@ from ecs_tentacles.export.bake import BakePlan, bake, output_kind
 from ecs_tentacles.export.skinned import Skin
 from ecs_tentacles.skin.keys import KeyReport
 from ecs_tentacles.skin.mesh import MeshError
-from ecs_tentacles.take import Take
+from ecs_tentacles.take import Take, TakeError
 
 
 def positive_float(text: str) -> float:
@@ -106,6 +106,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         help="write nothing and exit 1 if any creature's physics had to be recovered",
     )
     add_lod_arguments(parser)
+    add_threads_argument(parser)
     parser.set_defaults(handler=handle)
 
 
@@ -158,7 +159,9 @@ def handle(args: argparse.Namespace) -> int:
             print(f"error: {error}", file=sys.stderr)
             return 1
     else:
-        take = bake(plan, progress=not args.quiet, allow_systems=args.allow_systems)
+        take = bake(
+            plan, progress=not args.quiet, allow_systems=args.allow_systems, threads=args.threads
+        )
     health = take.header["health"]
     if health["recoveries"]:
         frames = sorted({e["frame"] for e in health["events"]})
@@ -176,6 +179,9 @@ def handle(args: argparse.Namespace) -> int:
     except MeshError as error:  # e.g. tentacle bases that overlap on the mantle
         print(f"error: {error}", file=sys.stderr)
         return 2
+    except TakeError as error:  # the run made numbers no take may hold (a plugin's NaN)
+        print(f"error: {error}", file=sys.stderr)
+        return 1
     getattr(args, "after_write", lambda: None)()
     print(summary(take, args.out, args.json, skinned))
     return 0
@@ -219,10 +225,10 @@ def summary(take: Take, path: Path, as_json: bool = False, skinned: KeyReport | 
         r["skinned"] = skinned.line()
     if as_json:
         return json.dumps(r)
-    items = "".join(f", {r[key]} {key}" for key in _points(take))
+    items = "".join(f", {counted(r[key], key.removesuffix('s'))}" for key in _points(take))
     line = (
-        f"{path}: {r['frames']} frames at {r['fps']:g} fps, {r['creatures']} creatures,"
-        f" {r['bodies']} bodies, {r['suckers']} suckers{items}; sha256 {r['sha256']}"
+        f"{path}: {r['frames']} frames at {r['fps']:g} fps, {counted(r['creatures'], 'creature')},"
+        f" {r['bodies']} bodies, {counted(r['suckers'], 'sucker')}{items}; sha256 {r['sha256']}"
     )
     if skinned is None:
         return line

@@ -15,7 +15,7 @@ import json
 from typing import Any
 
 from ecs_tentacles.bench import BLOCK, WARMUP, bench
-from ecs_tentacles.cli.arguments import bounded_int, thread_count
+from ecs_tentacles.cli.arguments import add_threads_argument, bounded_int, counted
 from ecs_tentacles.cli.crowd import add_crowd_options, crowd_from_args, crowd_size
 from ecs_tentacles.cli.lod_options import add_lod_arguments, lod_choice
 from ecs_tentacles.cli.run import tier_line
@@ -42,9 +42,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--frames", type=bounded_int(1, 1_000_000), default=120, help="timed frames (default 120)"
     )
-    parser.add_argument(
-        "--threads", type=thread_count, default=None, help="physics threads (default: all cores)"
-    )
+    add_threads_argument(parser)
     parser.add_argument(
         "--block",
         type=bounded_int(1, 10_000),
@@ -93,9 +91,9 @@ def handle(args: argparse.Namespace) -> int:
         print(json.dumps(result))
         return 0
     print(
-        f"{label}: {result['creatures']} creatures, {result['bodies']} bodies,"
-        f" {result['compiles']} shared models ({result['asleep']} creatures asleep at the"
-        f" end), {result['threads']} threads;"
+        f"{label}: {counted(result['creatures'], 'creature')}, {result['bodies']} bodies,"
+        f" {counted(result['compiles'], 'shared model')} ({result['asleep']} asleep at the"
+        f" end), {counted(result['threads'], 'thread')};"
         f" built in {result['build_s']:.2f} s"
     )
     print(

@@ -7,7 +7,13 @@ import json
 import sys
 from typing import Any
 
-from ecs_tentacles.cli.arguments import frame_count, output_path, require_display, seed_int
+from ecs_tentacles.cli.arguments import (
+    add_threads_argument,
+    frame_count,
+    output_path,
+    require_display,
+    seed_int,
+)
 from ecs_tentacles.cli.lod_options import add_lod_arguments, lod_choice
 from ecs_tentacles.scene.load import resolve_scene_path
 
@@ -45,10 +51,26 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.add_argument("--height", type=even_size, default=720, help=f"{SIZE_RULE} (default 720)")
     parser.add_argument("--seed", type=seed_int, default=None, help="override the scene's seed")
     parser.add_argument("--allow-systems", action="store_true", help="run systems the scene names")
-    parser.add_argument("--no-hud", action="store_true", help="start with the HUD hidden (h)")
+    shown = parser.add_mutually_exclusive_group()
+    shown.add_argument(
+        "--hud",
+        dest="hud",
+        action="store_const",
+        const=True,
+        default=None,
+        help="show the HUD (default: shown, except in a --video: a film has no sliders in it)",
+    )
+    shown.add_argument(
+        "--no-hud",
+        dest="hud",
+        action="store_const",
+        const=False,
+        help="start with the HUD hidden (h)",
+    )
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
     parser.add_argument("--json", action="store_true", help="headless: the summary as JSON")
-    add_lod_arguments(parser)  # without --focus, the focus follows the camera (render.sandbox)
+    add_lod_arguments(parser)
+    add_threads_argument(parser)  # without --focus, the focus follows the camera (render.sandbox)
     parser.set_defaults(handler=handle)
 
 
@@ -56,6 +78,13 @@ def handle(args: argparse.Namespace) -> int:
     if not args.headless and (args.screenshot or args.video):
         print(
             "error: argument --screenshot/--video: needs --headless (in the window: F12, v)",
+            file=sys.stderr,
+        )
+        return 2
+    if args.headless and not (args.screenshot or args.video or args.json):
+        print(
+            "error: play: --headless keeps nothing without --screenshot FILE.png,"
+            " --video FILE.mp4 or --json",
             file=sys.stderr,
         )
         return 2
@@ -77,9 +106,10 @@ def handle(args: argparse.Namespace) -> int:
         headless=args.headless,
         seed=args.seed,
         allow_systems=args.allow_systems,
-        hud=not args.no_hud,
+        hud=args.hud if args.hud is not None else not args.video,
         lod=lod_choice(args),
         focus=args.focus,
+        threads=args.threads,
     )
     try:
         if args.headless:

@@ -7,6 +7,7 @@ import json
 import sys
 from typing import Any
 
+from ecs_tentacles.cli.arguments import counted
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.load import load_scene_plugins, resolve_scene_path
 
@@ -22,7 +23,11 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "scenes", nargs="+", metavar="SCENE", help="scene file or bundled scene name"
     )
-    parser.add_argument("--json", action="store_true", help="one JSON object per valid scene")
+    parser.add_argument(
+        "--json",
+        action="store_true",
+        help='one JSON object per scene ({"ok": false, "problems": [...]} for a bad one)',
+    )
     parser.add_argument(
         "--allow-systems",
         action="store_true",
@@ -36,6 +41,7 @@ def summary(path: str, data: dict[str, Any], plugins: list[str]) -> dict[str, An
     creatures = data["creatures"]
     return {
         "scene": path,
+        "ok": True,
         "creatures": len(creatures),
         "tentacles": sum(c["tentacles"]["count"] for c in creatures),
         "systems": list(data.get("systems", [])),
@@ -44,9 +50,10 @@ def summary(path: str, data: dict[str, Any], plugins: list[str]) -> dict[str, An
 
 
 def sentence(report: dict[str, Any]) -> str:
-    """`octopus.json: ok (1 creatures, 8 tentacles)`, plus the systems it asks for."""
+    """`octopus.json: ok (1 creature, 8 tentacles)`, plus the systems it asks for."""
     text = (
-        f"{report['scene']}: ok ({report['creatures']} creatures, {report['tentacles']} tentacles)"
+        f"{report['scene']}: ok ({counted(report['creatures'], 'creature')},"
+        f" {counted(report['tentacles'], 'tentacle')})"
     )
     if report["systems"]:
         text += (
@@ -66,6 +73,8 @@ def handle(args: argparse.Namespace) -> int:
             failed = True
             for problem in error.problems:
                 print(f"error: {problem}", file=sys.stderr)
+            if args.json:
+                print(json.dumps({"scene": scene, "ok": False, "problems": error.problems}))
             continue
         report = summary(str(path), data, [plugin.key for plugin in plugins])
         print(json.dumps(report) if args.json else sentence(report))

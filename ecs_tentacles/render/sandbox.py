@@ -80,9 +80,12 @@ class Sandbox:
         hud: bool = True,
         lod: bool | None = None,
         focus: tuple[float, float, float] | None = None,
+        threads: int | None = None,
     ):
         """`lod` turns level of detail on or off over the scene's (None: the scene's);
-        `focus` (x, y, radius in m) pins the full-physics region instead of the camera's."""
+        `focus` (x, y, radius in m) pins the full-physics region instead of the camera's;
+        `threads` step the physics (None: one per core)."""
+        self.threads = threads
         self.scene, self.seed, self.allow_systems = scene, seed, allow_systems
         self.lod, self.focus = lod, focus
         self.headless = headless
@@ -160,6 +163,7 @@ class Sandbox:
             allow_systems=self.allow_systems,
             scene_dir=self.scene_dir,
             lod=self.lod,
+            threads=self.threads,
         )
         if self.focus is not None:
             world.lod.focus(self.focus[:2], self.focus[2])

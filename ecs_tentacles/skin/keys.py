@@ -31,7 +31,9 @@ class KeyReport:
     frames: int
 
     def line(self) -> str:
-        """One line for the CLI."""
+        """One line for the CLI: what was kept, and what reducing cost (when it did)."""
+        if self.after == self.before:
+            return f"{self.after} keys (every frame: nothing reduced; --keys reduced keeps fewer)"
         return (
             f"keys {self.before} -> {self.after} (frames with a key: {self.sample_frames} of"
             f" {self.frames}); max error {self.max_rotation_error_deg:.3f} deg,"

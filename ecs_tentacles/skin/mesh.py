@@ -49,14 +49,16 @@ class Detail:
     blend: float = 0.35
 
     def __post_init__(self) -> None:
-        if not 1 <= self.rings_per_link <= MAX_RINGS_PER_LINK:
+        if self.rings_per_link < 1:
+            raise ValueError(f"rings_per_link: must be >= 1, got {self.rings_per_link}")
+        if self.rings_per_link > MAX_RINGS_PER_LINK:
             raise ValueError(
-                f"rings_per_link: must be in [1, {MAX_RINGS_PER_LINK}], got {self.rings_per_link}"
+                f"rings_per_link: must be <= {MAX_RINGS_PER_LINK}, got {self.rings_per_link}"
             )
-        if not 8 <= self.sides <= MAX_SIDES or self.sides % 4:
-            raise ValueError(
-                f"sides: must be a multiple of 4 in [8, {MAX_SIDES}], got {self.sides}"
-            )
+        if self.sides < 8 or self.sides % 4:
+            raise ValueError(f"sides: must be a multiple of 4 and >= 8, got {self.sides}")
+        if self.sides > MAX_SIDES:
+            raise ValueError(f"sides: must be <= {MAX_SIDES}, got {self.sides}")
         if self.cap_rings < 1:
             raise ValueError(f"cap_rings: must be >= 1, got {self.cap_rings}")
         if not 0.0 < self.blend <= 0.5:

@@ -37,7 +37,7 @@ def test_bake_writes_a_take_and_reports_it(
     )
     take = Take.load(out)
     assert captured.out.startswith(
-        f"{out}: 7 frames at 30 fps, 1 creatures, 13 bodies, 3 suckers, 1 goals; sha256 "
+        f"{out}: 7 frames at 30 fps, 1 creature, 13 bodies, 3 suckers, 1 goal; sha256 "
     )
     assert (take.frames, take.fps, take.header["scene"]) == (7, 30.0, "small")
     assert main([*argv, "--seed", "9"]) == 0  # overwrites atomically

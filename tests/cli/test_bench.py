@@ -28,8 +28,8 @@ def test_human_summary_of_a_scene_file(capsys: pytest.CaptureFixture[str]) -> No
     lines = capsys.readouterr().out.splitlines()
     assert len(lines) == 4
     assert re.fullmatch(
-        r".*three_goals\.json: 1 creatures, 61 bodies, 1 shared models \(0 creatures"
-        r" asleep at the end\), 1 threads;"
+        r".*three_goals\.json: 1 creature, 61 bodies, 1 shared model \(0"
+        r" asleep at the end\), 1 thread;"
         r" built in \d+\.\d\d s",
         lines[0],
     )

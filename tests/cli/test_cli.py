@@ -15,10 +15,10 @@ from ecs_tentacles.scene.load import bundled_scene, bundled_scene_names
 from tests.scene.bad_scenes import BAD_SCENES
 
 BUNDLED = {
-    "asymmetric": "1 creatures, 5 tentacles",
-    "octopus": "1 creatures, 8 tentacles",
+    "asymmetric": "1 creature, 5 tentacles",
+    "octopus": "1 creature, 8 tentacles",
     "thesis_four_by_six": "4 creatures, 24 tentacles",
-    "three_goals": "1 creatures, 6 tentacles",
+    "three_goals": "1 creature, 6 tentacles",
 }
 
 
@@ -45,7 +45,7 @@ def test_validate_reports_each_problem_and_exits_2(
         captured.err
         == f"error: {scene}: creatures[0].tentacles.end_scale: must be in (0, 1], got 1.7\n"
     )
-    assert "octopus.json: ok (1 creatures, 8 tentacles)" in captured.out
+    assert "octopus.json: ok (1 creature, 8 tentacles)" in captured.out
 
 
 def test_run_prints_one_json_summary(capsys: pytest.CaptureFixture[str]) -> None:
@@ -129,12 +129,13 @@ def test_validate_names_the_systems_a_scene_asks_for(
     )
     assert main(["validate", str(scene)]) == 0
     assert capsys.readouterr().out == (
-        f"{scene}: ok (1 creatures, 8 tentacles); asks to run systems mine.wiggle:Wiggle"
+        f"{scene}: ok (1 creature, 8 tentacles); asks to run systems mine.wiggle:Wiggle"
         " (run, bake and play need --allow-systems)\n"
     )
     assert main(["validate", "--json", str(scene)]) == 0
     assert json.loads(capsys.readouterr().out) == {
         "scene": str(scene),
+        "ok": True,
         "creatures": 1,
         "tentacles": 8,
         "systems": ["mine.wiggle:Wiggle"],
@@ -182,3 +183,34 @@ def test_the_module_docstring_names_every_command() -> None:
     first_line = " ".join((cli.__doc__ or "").split("\n\n")[0].split())
     named = first_line.split(":", 1)[1].strip(" .").split(", ")
     assert named == list(commands.choices)
+
+
+def test_validate_json_reports_a_bad_scene_as_json_too(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    scene = tmp_path / "bad.json"
+    scene.write_text(json.dumps({"version": 1, "creatures": [{"mantle": {"radius": -1}}]}))
+    assert main(["validate", "--json", str(scene), "octopus"]) == 2
+    captured = capsys.readouterr()
+    first, second = (json.loads(line) for line in captured.out.splitlines())
+    assert first["ok"] is False and first["scene"] == str(scene)
+    assert first["problems"] == [line.removeprefix("error: ") for line in captured.err.splitlines()]
+    assert first["problems"] and second["ok"] is True and second["creatures"] == 1
+
+
+def test_shared_options_work_after_the_command_and_on_every_simulating_one(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert main(["validate", "octopus", "--debug", "--max-scene-mb", "1"]) == 0
+    capsys.readouterr()
+    hashes = []
+    for threads in ("1", "2"):
+        out = tmp_path / f"t{threads}.npz"
+        argv = ["bake", "three_goals", "--seconds", "0.1", "--out", str(out), "--quiet"]
+        assert main([*argv, "--threads", threads, "--json"]) == 0
+        hashes.append(json.loads(capsys.readouterr().out)["sha256"])
+    assert hashes[0] == hashes[1]  # results do not depend on the thread count
+    shot = tmp_path / "shot.png"
+    argv = ["play", "three_goals", "--headless", "--frames", "2", "--quiet", "--threads", "1"]
+    assert main([*argv, "--width", "320", "--height", "180", "--screenshot", str(shot)]) == 0
+    assert shot.is_file()

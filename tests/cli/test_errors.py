@@ -178,28 +178,27 @@ TOO_BIG = {
         " at most 2 GiB (bake fewer seconds or at a lower --fps)"
     ),
     ("bake", "octopus", "--seconds", "1", "--rings-per-link", "100000000"): (
-        "error: argument --rings-per-link: must be in [1, 64], got 100000000"
+        "error: argument --rings-per-link: must be <= 64, got 100000000"
         " (see ecs-tentacles bake --help)"
     ),
     ("bake", "octopus", "--seconds", "1", "--sides", "4096"): (
-        "error: argument --sides: must be in [8, 256], got 4096 (see ecs-tentacles bake --help)"
+        "error: argument --sides: must be <= 256, got 4096 (see ecs-tentacles bake --help)"
     ),
     ("bake", "octopus", "--seconds", "1", "--seed", "1" + "0" * 30): (
-        "error: argument --seed: must be in [0, 9223372036854775807], got 1"
+        "error: argument --seed: must be <= 9223372036854775807, got 1"
         + "0" * 30
         + " (see ecs-tentacles bake --help)"
     ),
     ("run", "octopus", "--frames", "100000000000"): (
-        "error: argument --frames: must be in [1, 10000000], got 100000000000"
+        "error: argument --frames: must be <= 10000000, got 100000000000"
         " (see ecs-tentacles run --help)"
     ),
     ("bench", "--crowd", "4", "--frames", "10000000000"): (
-        "error: argument --frames: must be in [1, 1000000], got 10000000000"
+        "error: argument --frames: must be <= 1000000, got 10000000000"
         " (see ecs-tentacles bench --help)"
     ),
     ("bench", "octopus", "--threads", "100000"): (
-        "error: argument --threads: must be in [1, 256], got 100000"
-        " (see ecs-tentacles bench --help)"
+        "error: argument --threads: must be <= 256, got 100000 (see ecs-tentacles bench --help)"
     ),
 }
 

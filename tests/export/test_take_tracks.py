@@ -76,7 +76,7 @@ def test_a_user_plugins_tracks_are_baked_into_the_take_and_load_back(
     out = tmp_path / "take.npz"
     argv = ["bake", str(beacon_scene), "--seconds", "0.1", "--out", str(out), "--quiet"]
     assert main([*argv, "--allow-systems"]) == 0
-    assert ", 1 goals, 1 beacons; sha256" in capsys.readouterr().out
+    assert ", 1 goal, 1 beacon; sha256" in capsys.readouterr().out
     take = Take.load(out)
     assert [t["key"] for t in take.header["tracks"]] == ["beacons", "masts"]
     assert take.header["beacons"] == [{"name": "octo/marks/beacon0", "creature": 0, "radius": 0.1}]

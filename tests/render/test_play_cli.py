@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 from PIL import Image
 
@@ -49,3 +50,35 @@ def test_bad_play_arguments_exit_2(
         code = int(exit_.code or 0)
     assert code == 2
     assert message in capsys.readouterr().err
+
+
+def test_headless_play_with_nothing_to_keep_is_refused(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["play", "octopus", "--headless", "--frames", "2", "--quiet"]) == 2
+    assert capsys.readouterr().err == (
+        "error: play: --headless keeps nothing without --screenshot FILE.png,"
+        " --video FILE.mp4 or --json\n"
+    )
+
+
+def _last_frame(video: Path) -> np.ndarray:
+    """The last frame of an MP4 as (height, width, 3) uint8 (decoded by imageio-ffmpeg)."""
+    import imageio_ffmpeg
+
+    frames = imageio_ffmpeg.read_frames(str(video))
+    meta = next(frames)
+    width, height = meta["size"]
+    *_, last = frames
+    return np.frombuffer(last, np.uint8).reshape(height, width, 3)
+
+
+def test_a_headless_video_has_no_hud_unless_asked(tmp_path: Path) -> None:
+    argv = ["play", "octopus", "--headless", "--frames", "3", "--quiet"]
+    size = ["--width", "640", "--height", "360"]
+    bare, shown = tmp_path / "bare.mp4", tmp_path / "hud.mp4"
+    assert main([*argv, *size, "--video", str(bare)]) == 0
+    assert main([*argv, *size, "--video", str(shown), "--hud"]) == 0
+    left = (slice(None), slice(0, 200))  # where the HUD's panel sits
+    a, b = _last_frame(bare).astype(int), _last_frame(shown).astype(int)
+    right = (slice(None), slice(-120, None))
+    panel, elsewhere = np.abs(a[left] - b[left]).mean(), np.abs(a[right] - b[right]).mean()
+    assert panel > 10 and panel > 3 * elsewhere  # the panel covers the view only there

@@ -54,6 +54,9 @@ def test_the_report_counts_every_channel(octopus_take: Take) -> None:
     assert reduced.before == everything.before and reduced.after < reduced.before // 2
     assert reduced.max_rotation_error_deg <= 0.5
     assert "keys 9922 -> " in reduced.line()
+    assert everything.line() == (
+        "9922 keys (every frame: nothing reduced; --keys reduced keeps fewer)"
+    )
 
 
 @pytest.mark.parametrize(
