@@ -178,6 +178,13 @@ class PhysicsBackend:
         self.sleep.set_state(state.sleep)
 
     # -- per frame -------------------------------------------------------------------
+    def kinematic_creatures(self, creatures: int) -> np.ndarray:
+        """(creatures,) bool by creature-store row: replayed, not simulated, as the last
+        frame decided (systems that only feed the physics may skip them)."""
+        out = np.zeros(creatures, dtype=bool)
+        out[self.roster.creature_row] = self.tier == KINEMATIC
+        return out
+
     def write_controls(self, motors: MotorStore) -> None:
         """Targets into `ctrl`; kp = strength x gain, kv = damping x gain; torque limits."""
         target = motors.target.reshape(-1)

@@ -7,12 +7,14 @@ underside lies on the ground, or an arch for compress/pull: link pitch
 J0(angle) of its length), the orient sweep on the first two joints, plus travelling sine waves
 (amplitude, frequency, wavelength in tentacle lengths, per-tentacle phase) on curl
 and sweep; targets ease toward that (time constant SMOOTHING_SECONDS) so light
-tips never whip. Writhing (thesis IV.B): the servo gain is modulated by the same wave,
+tips never whip. Creatures the level of detail replays (KINEMATIC, as the last frame
+decided: `PhysicsBackend.kinematic_creatures`) are skipped: their servos drive nothing.
+Writhing (thesis IV.B): the servo gain is modulated by the same wave,
 scaled by the action's strength.
 
 Reads: locomotion's tentacle store (action, action_angle, action_strength, orient,
-mode, wave parameters), TentacleStore (rest pitch, link rows), MotorStore
-(tentacle_row, arc). Writes: MotorStore (target, gain).
+mode, wave parameters), TentacleStore (rest pitch, link rows, creature), MotorStore
+(tentacle_row, arc), the physics' tiers. Writes: MotorStore (target, gain).
 """
 
 from __future__ import annotations
@@ -59,6 +61,7 @@ class MotorTargets(System):
         "tentacles.rest_pitch",
         "tentacles.first_link",
         "tentacles.links",
+        "tentacles.creature_row",
         "motors.arc",
         "motors.tentacle_row",
     )
@@ -73,6 +76,7 @@ class MotorTargets(System):
         inner[first] = False
         self.inner = rows[inner]  # links whose joint turns relative to a previous link
         self.previous = self.inner - 1
+        self.previous_of = np.where(inner, rows - 1, -1)  # per link: the one before, or -1
         self.orient_share = np.zeros(len(motors))
         self.orient_share[first] = 0.5
         self.orient_share[np.minimum(first + 1, first + tentacles.links - 1)] += 0.5
@@ -83,11 +87,38 @@ class MotorTargets(System):
         self.strokes = world.resource(LocomotionStores).tentacles
 
     def process(self, world: Host, dt: float) -> None:
-        motors, t, body = world.motors, self.strokes, world.tentacles
+        motors = world.motors
         if not len(motors):
             return
-        row = motors.tentacle_row
-        arc = motors.arc
+        kinematic = world.physics.kinematic_creatures(len(world.creatures))
+        if not kinematic.any():
+            self._targets(world, dt, slice(None), self.inner, self.previous)
+            return
+        # creatures the level of detail replays: their servos drive nothing, so their
+        # links are left out (a promoted one eases from its last targets, servos soft)
+        links = np.flatnonzero(~kinematic[world.tentacles.creature_row[motors.tentacle_row]])
+        if not len(links):
+            return
+        position = np.full(len(motors), -1, dtype=np.int64)
+        position[links] = np.arange(len(links))
+        before = self.previous_of[links]  # whole tentacles are left out, never a part
+        inner = np.flatnonzero(before >= 0)
+        previous = position[before[inner]]
+        self._targets(world, dt, links, inner, previous)
+
+    def _targets(
+        self,
+        world: Host,
+        dt: float,
+        links: slice | np.ndarray,
+        inner: np.ndarray,
+        previous: np.ndarray,
+    ) -> None:
+        """The targets and gains of motor rows `links`; `inner` and `previous` index
+        within them (a link whose joint turns relative to the one before, and that one)."""
+        motors, t, body = world.motors, self.strokes, world.tentacles
+        row = motors.tentacle_row[links]
+        arc = motors.arc[links]
         action = t.action
         # per tentacle (few rows) where it saves work, then gathered to every link
         progress = np.minimum(t.timer / np.maximum(t.duration, 1e-9), ATTACH_PATIENCE)
@@ -99,10 +130,10 @@ class MotorTargets(System):
         droop = (2.0 * body.rest_pitch + np.where(action == ATTACH, ATTACH_PRESS * progress, 0.0))[
             row
         ]
-        pitch = arch * self.arch_shape + LIFT[action][row] + droop * arc
+        pitch = arch * self.arch_shape[links] + LIFT[action][row] + droop * arc
         curl = pitch.copy()
-        curl[self.inner] -= pitch[self.previous]
-        sweep = np.where(ORIENTED[action], t.orient, 0.0)[row] * self.orient_share
+        curl[inner] -= pitch[previous]
+        sweep = np.where(ORIENTED[action], t.orient, 0.0)[row] * self.orient_share[links]
 
         phase = (2 * np.pi * t.wave_frequency * world.time + t.phase)[row] - (
             2 * np.pi / t.wavelength
@@ -113,10 +144,12 @@ class MotorTargets(System):
         curl_amp = (amplitude * np.where(gripping, GRIP_CURL_WAVE, 1.0))[row]
         sweep_amp = (amplitude * np.where(gripping, GRIP_SWEEP_WAVE, 1.0))[row]
         ease = 1.0 - np.exp(-dt / SMOOTHING_SECONDS)
-        eased = self.eased
+        eased = self.eased[links]  # a view of every row, or a copy of some (written back)
         eased[:, 0] += ease * (curl + curl_amp * sin - eased[:, 0])
         eased[:, 1] += ease * (sweep + sweep_amp * cos - eased[:, 1])
-        motors.target[:, :2] = eased
+        self.eased[links] = eased
+        motors.target[links, :2] = eased
         # writhing: sin(phase + pi/3), from the sine and cosine already at hand
         strength = t.action_strength
-        motors.gain = strength[row] + (strength * t.writhe)[row] * (0.5 * sin + HALF_ROOT3 * cos)
+        gain = strength[row] + (strength * t.writhe)[row] * (0.5 * sin + HALF_ROOT3 * cos)
+        motors.gain[links] = gain
