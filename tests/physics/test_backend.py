@@ -157,3 +157,22 @@ def test_physics_sync_copies_poses_bit_for_bit(make_world: Callable[..., World])
     link = _tentacle(world, 3).links[2]
     body = world.physics.groups[0].model.body("t3/l02").id
     assert_array_equal(world.component(link, Transform).pos, data.xpos[body])
+
+
+def test_the_schemas_longest_tentacles_crawl_without_a_recovery(
+    make_world: Callable[..., World],
+) -> None:
+    scene = {
+        "version": 1,
+        "creatures": [
+            {
+                "name": "long",
+                "tentacles": {"count": 4, "links": 64},  # the schema's most links
+                "goals": [{"position": [2.0, 0.0]}],
+            }
+        ],
+    }
+    world = make_world(scene)  # once: arena warnings, then frozen within half a second
+    world.step(45)
+    assert world.physics.health.recoveries == 0 and not world.physics.frozen.any()
+    assert np.isfinite(world.transforms.pos).all()
