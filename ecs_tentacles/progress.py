@@ -1,9 +1,12 @@
-"""Stepping a world for many frames with a progress bar (`ecs-tentacles run`, bakes)."""
+"""Progress on stderr: stepping a world for many frames with a bar (`run`, bakes), and a
+status line for work that has no count (`status`: loading, building, validating)."""
 
 from __future__ import annotations
 
+import contextlib
 import sys
-from collections.abc import Callable
+import time
+from collections.abc import Callable, Iterator
 from typing import TYPE_CHECKING
 
 from tqdm import tqdm
@@ -43,3 +46,27 @@ def step_frames(
             bar.update(n)
             if on_steps is not None:
                 on_steps(n)
+
+
+@contextlib.contextmanager
+def status(text: str, *, progress: bool = True) -> Iterator[None]:
+    """`text ...` on stderr while the block runs, when `progress` and stderr is a terminal;
+    the line is cleared at the end, or kept with the seconds it took when that was long
+    (`LONG_SECONDS`), so a slow step says where the time went."""
+    stream = sys.stderr
+    shown = progress and stream.isatty()
+    if shown:
+        stream.write(f"{text} ...")
+        stream.flush()
+    start = time.perf_counter()
+    try:
+        yield
+    finally:
+        if shown:
+            took = time.perf_counter() - start
+            end = f" {took:.1f} s\n" if took >= LONG_SECONDS else "\r\x1b[K"
+            stream.write(end)
+            stream.flush()
+
+
+LONG_SECONDS = 2.0

@@ -5,6 +5,7 @@ from __future__ import annotations
 import io
 import sys
 from collections.abc import Callable
+from pathlib import Path
 
 import pytest
 
@@ -42,3 +43,22 @@ def test_the_bar_is_drawn_only_with_progress(
     drawn = terminal.getvalue()
     assert ("bake:" in drawn and "/12 [" in drawn) == progress
     assert drawn == "" or progress
+
+
+@pytest.mark.parametrize("terminal", [True, False])
+def test_long_commands_say_what_they_are_doing_on_a_terminal(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path, terminal: bool
+) -> None:
+    from ecs_tentacles.cli import main
+
+    err: io.StringIO = Terminal() if terminal else io.StringIO()
+    monkeypatch.setattr(sys, "stderr", err)
+    monkeypatch.setattr("ecs_tentacles.progress.LONG_SECONDS", 0.0)  # keep every line
+    out = tmp_path / "crowd.json"
+    assert main(["crowd", "8", "--out", str(out)]) == 0
+    assert main(["validate", str(out)]) == 0
+    assert main(["run", str(out), "--frames", "2"]) == 0
+    shown = err.getvalue()
+    for doing in ("crowd: making and checking 8 creatures ...", f"validate: checking {out} ...",
+                  f"run: building {out} ..."):  # fmt: skip
+        assert (doing in shown) == terminal, (doing, shown)

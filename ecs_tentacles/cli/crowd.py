@@ -20,6 +20,7 @@ from ecs_tentacles.creator.crowd import (
     max_creatures,
     write_crowd_scene,
 )
+from ecs_tentacles.progress import status
 from ecs_tentacles.scene.errors import SceneError
 
 
@@ -102,8 +103,9 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 
 def handle(args: argparse.Namespace) -> int:
-    scene = crowd_from_args(args.n, args)
-    write_crowd_scene(scene, args.out)
+    with status(f"crowd: making and checking {args.n} creatures"):
+        scene = crowd_from_args(args.n, args)
+        write_crowd_scene(scene, args.out)
     creatures = scene["creatures"]
     furry = sum("fur" in c for c in creatures)
     idle = sum("goals" not in c for c in creatures)

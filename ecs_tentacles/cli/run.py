@@ -22,7 +22,7 @@ from ecs_tentacles.cli.arguments import (
 from ecs_tentacles.cli.lod_options import add_lod_arguments, apply_focus, lod_choice
 from ecs_tentacles.components import Creature
 from ecs_tentacles.plugin import RunSummary
-from ecs_tentacles.progress import step_frames
+from ecs_tentacles.progress import status, step_frames
 from ecs_tentacles.scene.load import resolve_scene_path
 from ecs_tentacles.world import World
 
@@ -82,13 +82,14 @@ def tier_line(tiers: dict[str, int]) -> str:
 def handle(args: argparse.Namespace) -> int:
     path = resolve_scene_path(args.scene)
     build_start = time.perf_counter()
-    world = World.from_scene(
-        path,
-        seed=args.seed,
-        allow_systems=args.allow_systems,
-        threads=args.threads,
-        lod=lod_choice(args),
-    )
+    with status(f"run: building {path}", progress=not args.quiet):
+        world = World.from_scene(
+            path,
+            seed=args.seed,
+            allow_systems=args.allow_systems,
+            threads=args.threads,
+            lod=lod_choice(args),
+        )
     apply_focus(world, args.focus)
     build_seconds = time.perf_counter() - build_start
     summary = simulate(world, args.frames, progress=not args.quiet)

@@ -8,6 +8,7 @@ import sys
 from typing import Any
 
 from ecs_tentacles.cli.arguments import counted
+from ecs_tentacles.progress import status
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.load import load_scene_plugins, resolve_scene_path
 
@@ -68,7 +69,8 @@ def handle(args: argparse.Namespace) -> int:
     for scene in args.scenes:
         try:
             path = resolve_scene_path(scene)
-            data, plugins = load_scene_plugins(path, allow_systems=args.allow_systems)
+            with status(f"validate: checking {path}"):
+                data, plugins = load_scene_plugins(path, allow_systems=args.allow_systems)
         except SceneError as error:
             failed = True
             for problem in error.problems:

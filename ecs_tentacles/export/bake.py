@@ -23,7 +23,7 @@ from typing import Any
 from ecs_tentacles.construction import tentacle_params
 from ecs_tentacles.export.recording import Recording, scene_sha256
 from ecs_tentacles.plugin_registry import builtin
-from ecs_tentacles.progress import step_frames
+from ecs_tentacles.progress import status, step_frames
 from ecs_tentacles.scene.load import load_scene, load_scene_plugins, resolve_scene_path
 from ecs_tentacles.take import Take
 from ecs_tentacles.take_read import MAX_FRAMES, MAX_TAKE_BYTES
@@ -198,7 +198,8 @@ def bake(
     creatures at those scene indices (a shard); `on_steps(n)` is told of every `n`
     frames simulated.
     """
-    world = plan.world(allow_systems=allow_systems, threads=threads, only=only)
+    with status("bake: building the world", progress=progress):
+        world = plan.world(allow_systems=allow_systems, threads=threads, only=only)
     try:
         if on_world is not None:
             on_world(world)
