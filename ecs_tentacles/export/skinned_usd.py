@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 
 from ecs_tentacles.atomic import atomic_output
-from ecs_tentacles.export.usd import _pxr, new_stage, write_tracks
+from ecs_tentacles.export.usd import _pxr, mark_rate, new_stage, write_tracks
 from ecs_tentacles.mathutil import quat_rotate
 from ecs_tentacles.skin.keys import KeyReport
 from ecs_tentacles.skin.mesh import Detail
@@ -66,6 +66,7 @@ def build_skinned_stage(
     creatures, report = skinned_creatures(take, detail, keys)
     for creature in creatures:
         _creature(pxr, stage, creature)
+        mark_rate(stage, f"/World/{creature.skeleton.layout.name}", take)
     for index, sucker in enumerate(take.header["suckers"]):
         _sucker(pxr, stage, take, index, sucker)
     write_tracks(pxr, stage, take)

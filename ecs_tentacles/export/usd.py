@@ -82,6 +82,16 @@ def new_stage(take: Take) -> Any:
     return stage
 
 
+def mark_rate(stage: Any, path: str, take: Take) -> None:
+    """`ecs:fps` and `ecs:frames` on the prim at `path` (a creature's root): importers that
+    ignore the stage's frame rate (Blender's) bring these along as custom properties, and
+    `tools/blender_import.py` sets the scene from them."""
+    Sdf = _pxr().Sdf
+    prim = stage.GetPrimAtPath(path)
+    prim.CreateAttribute("ecs:fps", Sdf.ValueTypeNames.Double, custom=True).Set(float(take.fps))
+    prim.CreateAttribute("ecs:frames", Sdf.ValueTypeNames.Int, custom=True).Set(take.frames)
+
+
 def build_stage(take: Take, progress: Callable[[int], object] | None = None) -> Any:
     """An in-memory `Usd.Stage` holding the take; `progress(1)` after each body."""
     pxr = _pxr()
@@ -93,6 +103,7 @@ def build_stage(take: Take, progress: Callable[[int], object] | None = None) -> 
     for creature in header["creatures"]:
         base = f"/World/{creature['name']}"
         UsdGeom.Xform.Define(stage, base)
+        mark_rate(stage, base, take)
         _body(pxr, stage, take, creature["mantle"])
         if progress is not None:
             progress(1)

@@ -1,0 +1,56 @@
+"""tools/blender_import.py in Blender (bpy 5.0.1): exports open at their own frame rate
+and range, with one material and names as written."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+from pathlib import Path
+
+import pytest
+
+from ecs_tentacles.cli import main
+
+BLENDER = os.environ.get("ECS_TENTACLES_BLENDER_PYTHON", "")
+TOOL = Path(__file__).resolve().parents[2] / "tools" / "blender_import.py"
+READ = """
+import json, sys, bpy
+bpy.ops.wm.open_mainfile(filepath=sys.argv[1])
+scene = bpy.context.scene
+meshes = [o for o in bpy.data.objects if o.type == "MESH" and o.data.materials]
+print(json.dumps({
+    "fps": scene.render.fps / scene.render.fps_base,
+    "range": [scene.frame_start, scene.frame_end],
+    "actions": [list(a.frame_range) for a in bpy.data.actions],
+    "materials": sorted({m.name for o in meshes for m in o.data.materials}),
+}))
+"""
+
+pytestmark = pytest.mark.skipif(
+    not Path(BLENDER).is_file(),
+    reason="set ECS_TENTACLES_BLENDER_PYTHON to a Python with bpy (CI installs bpy==5.0.1)",
+)
+
+
+@pytest.mark.parametrize("suffix", [".usdc", ".glb"])
+def test_an_export_opens_in_blender_at_its_rate_and_range(tmp_path: Path, suffix: str) -> None:
+    take = tmp_path / f"take{suffix}"
+    argv = ["bake", "octopus", "--seconds", "1", "--fps", "30", "--out", str(take), "--quiet"]
+    assert main(argv) == 0
+    blend = tmp_path / "take.blend"
+    done = subprocess.run(
+        [BLENDER, str(TOOL), str(take), "--out", str(blend)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.splitlines()[-1] == f"{blend}: {take.name} at 30 fps, frames 0-30"
+    read = subprocess.run(
+        [BLENDER, "-c", READ, str(blend)], capture_output=True, text=True, timeout=120
+    )
+    found = json.loads(read.stdout.splitlines()[-1])
+    assert found["fps"] == 30 and found["range"] == [0, 30]  # 31 frames, 1 s at 30 fps
+    assert found["actions"] and all(a == [0.0, 30.0] for a in found["actions"])
+    assert found["materials"] == ["skin"]  # USD imports it too, not grey
