@@ -1,0 +1,66 @@
+"""The README's sandbox pictures, made headless with the current HUD: the four-creature
+sandbox, the HUD at 640 x 360, and the skinned octopus (the fur pictures are
+`tools/fur_screenshots.py`'s, the crowd plot `tools/crowd_scaling.py`'s).
+
+    python tools/readme_screenshots.py                       # into assets/screenshots/
+    python tools/readme_screenshots.py --out-dir shots/ --only hud_640x360
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from ecs_tentacles.cli import main as cli
+
+# name -> (scene, frames, width, height): what each README picture shows
+SHOTS = {
+    "sandbox": ("thesis_four_by_six", 240, 1280, 720),  # four creatures round a square
+    "hud_640x360": ("octopus", 60, 640, 360),  # the HUD scaled to a small window
+}
+CLOSE_UP = ("octopus", 120, 960, 540)  # skinned_sandbox: the skinned octopus, no HUD, near
+DEFAULT_DIR = Path(__file__).resolve().parents[1] / "assets" / "screenshots"
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
+    parser.add_argument("--out-dir", type=Path, default=DEFAULT_DIR)
+    names = sorted([*SHOTS, "skinned_sandbox"])
+    parser.add_argument("--only", choices=names, action="append", help="one picture")
+    args = parser.parse_args(argv)
+    args.out_dir.mkdir(parents=True, exist_ok=True)
+    for name in args.only or names:
+        if name == "skinned_sandbox":
+            _close_up(args.out_dir / f"{name}.png")
+            continue
+        scene, frames, width, height = SHOTS[name]
+        out = args.out_dir / f"{name}.png"
+        argv_play = ["play", scene, "--headless", "--frames", str(frames), "--hud", "--quiet"]
+        argv_play += ["--width", str(width), "--height", str(height), "--screenshot", str(out)]
+        code = cli(argv_play)
+        if code:
+            return code
+        print(f"{out}: {scene} after {frames} frames, {width} x {height}", file=sys.stderr)
+    return 0
+
+
+def _close_up(out: Path) -> None:
+    """The octopus after `CLOSE_UP` frames, framed close, HUD hidden (through the API:
+    the command line has no camera)."""
+    from ecs_tentacles.render import configure
+
+    configure(headless=True)
+    from ecs_tentacles.render.sandbox import Sandbox
+
+    scene, frames, width, height = CLOSE_UP
+    sandbox = Sandbox(scene, width=width, height=height, headless=True, hud=False)
+    sandbox.step(frames)
+    sandbox.renderer.frame_all()
+    sandbox.renderer.camera.distance *= 0.45
+    sandbox.screenshot(out)
+    print(f"{out}: {scene} after {frames} frames, {width} x {height}, close up", file=sys.stderr)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
