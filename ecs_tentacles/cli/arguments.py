@@ -78,12 +78,20 @@ thread_count = bounded_int(1, MAX_THREADS)
 
 
 def installed_folders() -> set[Path]:
-    """The package's folders (its code, bundled scenes and systems): read-only inputs."""
+    """The package's folders (its code, bundled scenes, schemas and systems): read-only
+    inputs. (The repository's other assets, such as the README's pictures, are not.)"""
     import ecs_tentacles
 
     folders = {Path(ecs_tentacles.__file__).resolve().parent}
     for package in ("ecs_tentacles.assets", "ecs_tentacles.systems"):
-        folders.add(Path(str(importlib.resources.files(package))).resolve())
+        found = importlib.resources.files(package)
+        # an editable install may give a MultiplexedPath: every folder it joins
+        for root in getattr(found, "_paths", [found]):
+            root = Path(str(root)).resolve()
+            if package.endswith("assets"):
+                folders |= {root / "scenes", root / "schema"}
+            else:
+                folders.add(root)
     return folders
 
 

@@ -141,19 +141,24 @@ class LocomotionPanel(Panel):
         imgui.same_line()
         imgui.text("all tentacles" if self.tentacle is None else f"tentacle {self.tentacle}")
         gui.item("tentacle")
+        # the values and their units in a column beside the sliders, where a handle never
+        # covers them
+        column = max(text_width(k.unit % v) for k in KNOBS for v in (k.low, k.high))
+        column += imgui.get_style().item_spacing.x
         for knob in KNOBS:
             imgui.text(knob.label)
             gui.item(f"{knob.name} label")
-            imgui.set_next_item_width(-1.0)
             shown = float(self.values[knob.name]) * knob.to_shown
             high = knob.high
             if knob.name == "strength":  # no stronger than the servos' damping holds
                 high = self.world.resource(Locomotion).strength_limit(self.creature, self.tentacle)
             flags = imgui.SliderFlags_.logarithmic.value if knob.log else 0
-            changed, shown = imgui.slider_float(
-                f"##{knob.name}", shown, knob.low, high, knob.unit, flags
-            )
+            imgui.set_next_item_width(-column)
+            changed, shown = imgui.slider_float(f"##{knob.name}", shown, knob.low, high, "", flags)
             gui.item(knob.name)
+            imgui.same_line()
+            imgui.text(knob.unit % shown)
+            gui.item(f"{knob.name} value")
             if changed:
                 self.set_parameter(knob.name, min(shown, high) / knob.to_shown)
         gaits = parameter("locomotion", "gait")

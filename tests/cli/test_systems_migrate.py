@@ -148,6 +148,16 @@ def test_migrate_never_writes_into_the_installed_package(
     before = bundled.read_bytes()
     siblings = sorted(p.name for p in bundled.parent.iterdir())
     monkeypatch.chdir(tmp_path)
+    try:
+        _refuses_and_copies(bundled, tmp_path, capsys)
+    finally:  # if the guard ever fails, the checkout gets its scene back
+        if bundled.read_bytes() != before:
+            bundled.write_bytes(before)
+            pytest.fail("migrate wrote into the bundled scene")
+    assert sorted(p.name for p in bundled.parent.iterdir()) == siblings
+
+
+def _refuses_and_copies(bundled: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["migrate", "octopus", "--in-place"]) == 2
     assert capsys.readouterr().err == (
         "error: octopus: a bundled scene is read-only; write a copy with --out FILE\n"
@@ -163,8 +173,6 @@ def test_migrate_never_writes_into_the_installed_package(
         "migrate: octopus is a bundled scene: writing the copy to ./octopus.migrated.json\n"
     )
     assert json.loads((tmp_path / "octopus.migrated.json").read_text())["plugins"]
-    assert bundled.read_bytes() == before
-    assert sorted(p.name for p in bundled.parent.iterdir()) == siblings
 
 
 def test_migrate_in_place_through_a_symlink_keeps_the_link(tmp_path: Path) -> None:

@@ -202,3 +202,21 @@ def test_a_world_without_locomotion_has_no_locomotion_sections(
     sandbox.render()
     assert "Locomotion" not in sandbox.hud.gui.rects and "Actions" not in sandbox.hud.gui.rects
     assert "Plugins" in sandbox.hud.gui.rects
+
+
+def test_slider_values_sit_beside_the_sliders_where_no_handle_covers_them(
+    make_sandbox: Callable[..., Any],
+) -> None:
+    from imgui_bundle import imgui
+
+    sandbox = make_sandbox("octopus")
+    sandbox.render()
+    pixels = sandbox.renderer.target.read()
+    grab = np.array(imgui.get_style().color_(imgui.Col_.slider_grab.value))[:3] * 255
+    rects = sandbox.hud.gui.rects
+    for name in ("speed", "target_angle", "strength", "wave_amplitude", "wave_frequency"):
+        x0, y0, x1, y1 = (round(v) for v in rects[f"{name} value"])
+        assert x0 >= rects[name][2]  # right of its slider
+        patch = pixels[y0:y1, x0:x1].reshape(-1, 3).astype(float)
+        assert (patch.mean(axis=1) < 128).any()  # the text is there
+        assert not (np.abs(patch - grab).max(axis=1) < 30).any(), name  # and no handle on it
