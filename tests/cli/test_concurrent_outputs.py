@@ -17,7 +17,7 @@ def _bakes(out: Path, writers: int) -> list[subprocess.CompletedProcess[str]]:
     """`writers` real processes baking different seeds of the octopus to `out` at once."""
     processes = [
         subprocess.Popen(
-            [sys.executable, "-m", "ecs_tentacles", "bake", "octopus", "--seconds", "6"]
+            [sys.executable, "-m", "ecs_tentacles", "bake", "octopus", "--seconds", "3"]
             + ["--seed", str(seed), "--out", out.name, "--json", "--quiet"],
             stdout=subprocess.PIPE,
             stderr=subprocess.PIPE,

@@ -164,7 +164,7 @@ def _cli(*args: str) -> tuple[int, str]:
 
 
 @settings(
-    max_examples=200,
+    max_examples=150,
     deadline=None,
     suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],
 )

@@ -97,7 +97,7 @@ def test_loading_a_large_take_costs_about_its_size_once(good_take: Path, tmp_pat
         arrays = {name: npz[name] for name in npz.files}
     header = json.loads(arrays["header"].tobytes())
     frames = header["frames"]
-    repeat = -(-(96 * 1024**2) // arrays["pos"].nbytes)  # about 100 MB of poses and more
+    repeat = -(-(40 * 1024**2) // arrays["pos"].nbytes)  # about 40 MB of poses and more
     for name, array in arrays.items():
         if name != "header" and array.ndim and len(array) == frames:
             arrays[name] = np.concatenate([array] * repeat)

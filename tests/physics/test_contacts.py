@@ -115,7 +115,7 @@ def test_sixteen_creatures_with_crossing_goals_stay_apart_for_20_seconds(
 ) -> None:
     world = make_world(_crossing_crowd(4))
     start = world.transforms.pos[world.creatures.mantle_row].copy()
-    worst = _worst_clearance(world, 20 * 60, every=6)
+    worst = _worst_clearance(world, 20 * 60, every=9)
     assert worst > -TOLERANCE
     assert world.physics.health.recoveries == 0
     end = world.transforms.pos[world.creatures.mantle_row]

@@ -195,7 +195,7 @@ def test_the_schemas_largest_creature_steps_at_full_and_reduced(
     }
     world = make_world(scene)  # its arena once overflowed while placing it at build
     world.lod.promote(world.creature("c1"))
-    world.step(20)
+    world.step(8)
     assert world.lod.counts() == {"full": 1, "reduced": 1, "kinematic": 0}
     assert world.physics.health.recoveries == 0
     assert np.isfinite(world.transforms.pos).all()
