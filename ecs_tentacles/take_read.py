@@ -290,12 +290,7 @@ CHECK_BYTES = 16 * 1024**2  # the checks below look at this much of an array at 
 def _blocks(array: np.ndarray) -> Iterator[tuple[int, np.ndarray]]:
     """(first frame, view) blocks of `array` along its first axis, about CHECK_BYTES each,
     so checking a take costs a few blocks of memory on top of the take, not copies of it."""
-    if array.ndim == 0 or not len(array):
-        if array.size:
-            yield 0, array
-        return
-    per_row = max(1, array[0].nbytes)
-    rows = max(1, CHECK_BYTES // per_row)
+    rows = max(1, CHECK_BYTES // max(1, array[:1].nbytes))
     for first in range(0, len(array), rows):
         yield first, array[first : first + rows]
 
@@ -313,12 +308,12 @@ def data_problem(
             bad = ~np.isfinite(block)
             if bad.any():
                 where = np.argwhere(bad)[0]
-                where[0] += first if array.ndim else 0
+                where[0] += first
                 return f"{name}: non-finite value {array[tuple(where)]} at {tuple(where.tolist())}"
             far = np.abs(block) > MAX_COORDINATE
             if far.any():
                 where = np.argwhere(far)[0]
-                where[0] += first if array.ndim else 0
+                where[0] += first
                 value = array[tuple(where)]
                 return (
                     f"{name}: {value:g} at {tuple(where.tolist())} is beyond {MAX_COORDINATE:g} m"

@@ -11,14 +11,14 @@ core schema plus the fragment of each plugin the scene turns on; each plugin's
 from __future__ import annotations
 
 import copy
-import functools
 import json
 import re
-from collections.abc import Iterable, Iterator, Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
-from jsonschema import Draft202012Validator, ValidationError, validators
+from jsonschema import ValidationError
 
+from ecs_tentacles.scene.json_validator import StrictValidator, validator_for
 from ecs_tentacles.scene.schema import builtin_keys, schema_for
 from ecs_tentacles.scene.shards import shard_problems
 
@@ -40,59 +40,6 @@ _TYPE_NAMES = {
 }
 _MAX_SHOWN = 60
 MAX_DEPTH = 32  # a scene is about 8 levels deep; deeper data is refused before recursing
-
-
-def _is_integer(checker: object, value: object) -> bool:
-    """JSON Schema calls 8.0 an integer; a scene's counts and seeds must be written 8."""
-    return isinstance(value, int) and not isinstance(value, bool)
-
-
-@functools.lru_cache(maxsize=256)
-def ecma_pattern(pattern: str) -> re.Pattern[str]:
-    """`pattern` as JSON Schema (ECMA 262) reads it: `$` is the end of the text.
-
-    Python's `$` also matches before a trailing newline, which let `"octo\\n"` pass as a
-    name; here every `$` outside a character class becomes `\\Z`.
-    """
-    out, escaped, in_class = [], False, False
-    for char in pattern:
-        if escaped:
-            escaped = False
-        elif char == "\\":
-            escaped = True
-        elif char == "[":
-            in_class = True
-        elif char == "]":
-            in_class = False
-        elif char == "$" and not in_class:
-            char = r"\Z"
-        out.append(char)
-    return re.compile("".join(out))
-
-
-def _pattern(validator: Any, pattern: str, instance: object, schema: object) -> Iterator[Any]:
-    if isinstance(instance, str) and not ecma_pattern(pattern).search(instance):
-        yield ValidationError(f"{instance!r} does not match {pattern!r}")
-
-
-_StrictValidator = validators.extend(
-    Draft202012Validator,
-    validators={"pattern": _pattern},
-    type_checker=Draft202012Validator.TYPE_CHECKER.redefine("integer", _is_integer),
-)
-
-
-_VALIDATORS: dict[int, tuple[dict[str, Any], Any]] = {}  # id -> (schema kept alive, validator)
-
-
-def _validator(schema: dict[str, Any]) -> Any:
-    """A validator per schema object (assembled schemas are cached, so this is too)."""
-    found = _VALIDATORS.get(id(schema))
-    if found is None or found[0] is not schema:
-        if len(_VALIDATORS) > 64:
-            _VALIDATORS.clear()
-        found = _VALIDATORS[id(schema)] = (schema, _StrictValidator(schema))
-    return found[1]
 
 
 def format_path(path: Iterable[str | int]) -> str:
@@ -239,7 +186,7 @@ def _plugin_configs(data: Mapping[str, Any], plugins: Sequence[Plugin]) -> list[
         config = chosen.get(plugin.key, {}) if isinstance(chosen, Mapping) else {}
         if isinstance(config, Mapping):
             config = {k: v for k, v in config.items() if k != "from"}
-            validator = _StrictValidator(plugin.config_schema)
+            validator = StrictValidator(plugin.config_schema)
             problems += _schema_problems(config, validator, ("plugins", plugin.key))
     return problems
 
@@ -275,7 +222,7 @@ def validated(
     deep = _too_deep(data)
     if deep is not None:  # before anything recursive (jsonschema, deepcopy, json.dumps)
         return [f"{format_path(deep)}: nested deeper than {MAX_DEPTH} levels"], None
-    problems = _schema_problems(data, _validator(schema))
+    problems = _schema_problems(data, validator_for(schema))
     if isinstance(data, dict):
         problems += _plugin_configs(data, plugins)
     full = None
@@ -304,7 +251,7 @@ def repaired(data: object, plugins: Sequence[Plugin]) -> dict[str, Any] | None:
     if _too_deep(data) is not None:
         return None  # copying it would recurse too deep
     fixed = copy.deepcopy(data)
-    validator = _validator(schema)
+    validator = validator_for(schema)
     errors = list(validator.iter_errors(fixed))
     for error in sorted(errors, key=lambda e: -len(e.absolute_path)):  # deepest first
         path = tuple(error.absolute_path)
