@@ -16,6 +16,7 @@ import numpy as np
 
 from ecs_tentacles.components import Creature, Link, Motor, Sucker, Tentacle, Transform
 from ecs_tentacles.construction import CreatureLayout, creature_layout
+from ecs_tentacles.ground import ground_of
 from ecs_tentacles.mathutil import quat_about_z
 from ecs_tentacles.scene.parameters import apply_parameters, parameter
 
@@ -38,7 +39,7 @@ def build_creature(world: Host, spec: dict[str, Any]) -> int:
     """Create one creature's entities from its scene entry; return the creature entity."""
     mantle = spec["mantle"]
     tentacles = spec["tentacles"]
-    layout = creature_layout(spec)
+    layout = creature_layout(spec, ground_of(world))
     turn = quat_about_z(layout.heading)
 
     creature = Creature(

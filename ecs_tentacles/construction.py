@@ -18,10 +18,16 @@ build (`ecs_tentacles.build`) and the load-time physical checks
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
+
+from ecs_tentacles.ground import FLAT, Ground
+
+# metres between a creature placed on terrain and the surface (it settles in the first
+# steps); the plane needs none: its creatures start exactly resting
+TERRAIN_CLEARANCE = 0.003
 
 
 def link_scales(links: int, end_scale: float) -> np.ndarray:
@@ -135,8 +141,13 @@ class CreatureLayout:
         return np.concatenate(starts), np.concatenate(ends), np.concatenate(radii)
 
 
-def creature_layout(spec: dict[str, Any]) -> CreatureLayout:
-    """The build-time layout of a creature from its scene entry (defaults filled in)."""
+def creature_layout(spec: dict[str, Any], ground: Ground = FLAT) -> CreatureLayout:
+    """The build-time layout of a creature from its scene entry (defaults filled in).
+
+    A 2-d `position` rests the creature on `ground`: on the plane its thickest first
+    link touches z = 0; on terrain the whole body is raised until its lowest point
+    rests on the surface under it (plus `TERRAIN_CLEARANCE`).
+    """
     mantle, tentacles = spec["mantle"], spec["tentacles"]
     position = [float(v) for v in spec["position"]]
     if len(position) == 2:
@@ -148,7 +159,7 @@ def creature_layout(spec: dict[str, Any]) -> CreatureLayout:
         )
         for p in params
     ]
-    return CreatureLayout(
+    layout = CreatureLayout(
         origin=np.asarray(position, dtype=np.float64),
         heading=float(np.radians(spec["heading_deg"])),
         mantle_radius=float(mantle["radius"]),
@@ -157,6 +168,23 @@ def creature_layout(spec: dict[str, Any]) -> CreatureLayout:
         params=params,
         shapes=shapes,
     )
+    if len(spec["position"]) == 2 and ground.heightfield is not None:
+        lift = ground.lift(*_resting_points(layout)) + TERRAIN_CLEARANCE
+        layout = replace(layout, origin=layout.origin + [0.0, 0.0, lift])
+    return layout
+
+
+def _resting_points(layout: CreatureLayout) -> tuple[np.ndarray, np.ndarray]:
+    """Balls (centres (n, 3), radii (n,)) covering the body's underside: each link's ends
+    and centre, and the rim and centre of the mantle's base."""
+    starts, ends, radii = layout.capsules()
+    rim = np.linspace(0.0, 2.0 * np.pi, 8, endpoint=False)
+    base = layout.origin + layout.mantle_radius * np.stack(
+        [np.cos(rim), np.sin(rim), np.zeros_like(rim)], axis=1
+    )
+    centres = np.concatenate([starts[1:], ends[1:], 0.5 * (starts[1:] + ends[1:]), base])
+    balls = np.concatenate([radii[1:], radii[1:], radii[1:], np.zeros(len(base))])
+    return np.vstack([centres, layout.origin]), np.append(balls, 0.0)
 
 
 def capsule_mass_inertia(length: np.ndarray, radius: np.ndarray, density: float) -> np.ndarray:

@@ -16,6 +16,7 @@ import esper
 import numpy as np
 
 from ecs_tentacles.components import Creature
+from ecs_tentacles.ground import ground_of
 from ecs_tentacles.locomotion.components import Goal
 from ecs_tentacles.locomotion.stores import LocomotionStores
 
@@ -81,6 +82,8 @@ class GoalBook:
         self._world.component(creature, Creature)  # raises KeyError for a non-creature
         point = np.zeros(3)
         point[: len(values)] = values
+        if len(values) == 2:  # on the ground under it (the plane: z = 0)
+            point[2] = ground_of(self._world).height(values)[0]
         return point
 
     def _append(self, creature: int, point: np.ndarray, radius: float) -> int:

@@ -83,8 +83,8 @@ class LocomotionPlugin(Plugin):
             apply_parameters(world, "tentacles", params, {"locomotion.tentacles": added})
             world.add_component(entity, ActionQueue())
         for goal in spec["goals"]:
-            point = list(goal["position"]) + ([0.0] if len(goal["position"]) == 2 else [])
-            world.resource(GoalBook).append(creature, point, goal["radius"])
+            # a 2-d goal is on the ground under it (`GoalBook` puts it there)
+            world.resource(GoalBook).append(creature, goal["position"], goal["radius"])
 
     def systems(self) -> list[System]:
         from ecs_tentacles.systems.locomotion.action_queue import ActionQueueSystem

@@ -31,6 +31,7 @@ import mujoco
 import numpy as np
 
 from ecs_tentacles.components import Creature, Link, Motor, Sucker, Tentacle, Transform
+from ecs_tentacles.ground import ground_of
 from ecs_tentacles.mathutil import quat_about_z
 
 if TYPE_CHECKING:
@@ -152,14 +153,9 @@ def build_spec(
     # One arena per stepping thread and model (ARENA_BYTES). A blow-up that overflows it
     # is caught as a fatal error and recovered (physics/health.py).
     spec.memory = ARENA_BYTES
-    spec.worldbody.add_geom(
-        name="ground",
-        type=mujoco.mjtGeom.mjGEOM_PLANE,
-        size=[0.0, 0.0, 1.0],
-        friction=[settings.ground_friction, 0.005, 0.0001],
-        contype=GROUND_BIT,
-        conaffinity=CREATURE_BIT,
-        solref=CONTACT_SOLREF,
+    # the plane z = 0, or the terrain's heightfield and solids (`ecs_tentacles.ground`)
+    ground_of(world).add_to_spec(
+        spec, settings.ground_friction, GROUND_BIT, CREATURE_BIT, CONTACT_SOLREF
     )
     _add_creature(spec, world, creature)
     _add_proxies(spec)

@@ -1,7 +1,8 @@
 """suckers: grab and let go.
 
 * attach: a tentacle in its attach action grabs with its tip sucker once the sucker
-  touches the ground (within ATTACH_HEIGHT); the anchor is where the sucker is now.
+  touches the ground, a slope, a wall or any obstacle (within ATTACH_HEIGHT of the
+  world's `Ground`); the anchor is where the sucker is now.
 * release on command: when the tentacle's action no longer grips (detach, settle,
   idle, ...).
 * release on stretch: the sucker is pulled farther than the creature's
@@ -11,7 +12,8 @@
 Each change fires `sucker_attached` / `sucker_released` (with the reason).
 
 Reads: locomotion's stores (action; release thresholds), TentacleStore (tip_sucker,
-length, base, creature), Sucker store, Transform store. Writes: Sucker store (attached, anchor).
+length, base, creature), Sucker store, Transform store, the Ground. Writes: Sucker store
+(attached, anchor).
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ecs_tentacles.ground import ground_of
 from ecs_tentacles.locomotion.actions import GRIPPING, Kind
 from ecs_tentacles.locomotion.grip import attach, release, sucker_points
 from ecs_tentacles.locomotion.stores import LocomotionStores
@@ -58,7 +61,7 @@ class Suckers(System):
         if len(reaching):
             rows = tip[reaching]
             rows = rows[~attached[rows]]
-            low = sucker_points(world, rows)[:, 2] <= ATTACH_HEIGHT
+            low = ground_of(world).distance(sucker_points(world, rows)) <= ATTACH_HEIGHT
             for row in rows[low]:
                 attach(world, int(s.entity[row]))
 

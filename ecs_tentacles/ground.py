@@ -1,0 +1,283 @@
+"""The static world the creatures stand on: the plane z = 0, or a heightfield, and solids.
+
+Core knows only this description; where it comes from (a scene's `terrain`, noise,
+images, mesh files) is the terrain plugin's business (`ecs_tentacles.terrain`), which
+provides a `Ground` resource. Without one the world has `FLAT`: the plane z = 0,
+exactly as before terrain existed.
+
+    ground = ground_of(world)
+    ground.height(xy)            # (n,) surface height under points (n, 2)
+    ground.distance(points)      # (n,) metres from points (n, 3) to the nearest surface
+    ground.normal(points)        # (n, 3) unit normals of that surface
+
+Reads: nothing of the world. Used by the physics model (`add_to_spec`: every group's
+model gets the same static geoms), creature placement (`ecs_tentacles.construction`),
+the suckers (they grip any static surface) and the renderer and exporters (`mesh`).
+"""
+
+from __future__ import annotations
+
+import hashlib
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Protocol
+
+import mujoco
+import numpy as np
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+SHAPES = ("box", "cylinder", "sphere", "mesh")
+FAR = 1e6  # metres: "no surface" for distances
+
+
+@dataclass(frozen=True)
+class Heightfield:
+    """Heights on a grid centred on the origin: `heights` (rows along y from -y/2,
+    columns along x from -x/2) in metres over `size` (x, y) metres."""
+
+    size: tuple[float, float]
+    heights: np.ndarray
+
+    @property
+    def cell(self) -> tuple[float, float]:
+        """Metres between samples along x and y."""
+        rows, cols = self.heights.shape
+        return self.size[0] / (cols - 1), self.size[1] / (rows - 1)
+
+    def height(self, xy: np.ndarray) -> np.ndarray:
+        """Heights under points `xy` (n, 2), as MuJoCo's triangles give them; the edge
+        height past the border."""
+        rows, cols = self.heights.shape
+        u = np.clip((xy[:, 0] / self.size[0] + 0.5) * (cols - 1), 0.0, cols - 1.0)
+        v = np.clip((xy[:, 1] / self.size[1] + 0.5) * (rows - 1), 0.0, rows - 1.0)
+        i = np.minimum(v.astype(np.int64), rows - 2)
+        j = np.minimum(u.astype(np.int64), cols - 2)
+        fu, fv = u - j, v - i
+        h = self.heights
+        h00, h01, h10, h11 = h[i, j], h[i, j + 1], h[i + 1, j], h[i + 1, j + 1]
+        # each cell is two triangles split along (i, j) - (i + 1, j + 1)
+        lower = fu >= fv  # below the diagonal: (i, j), (i, j + 1), (i + 1, j + 1)
+        below = h00 + fu * (h01 - h00) + fv * (h11 - h01)
+        above = h00 + fv * (h10 - h00) + fu * (h11 - h10)
+        return np.where(lower, below, above)
+
+    def slope_normal(self, xy: np.ndarray) -> np.ndarray:
+        """Unit surface normals (n, 3) under `xy` (n, 2), from the heights' gradient."""
+        dx, dy = self.cell
+        ex, ey = np.array([0.5 * dx, 0.0]), np.array([0.0, 0.5 * dy])
+        gx = (self.height(xy + ex) - self.height(xy - ex)) / dx
+        gy = (self.height(xy + ey) - self.height(xy - ey)) / dy
+        n = np.stack([-gx, -gy, np.ones_like(gx)], axis=1)
+        return n / np.linalg.norm(n, axis=1, keepdims=True)
+
+
+@dataclass(frozen=True)
+class Solid:
+    """A static shape: `kind` one of SHAPES; `position` its centre; `rotation` (3, 3) its
+    frame; `size` half extents (box), (radius, half height) (cylinder, along its z) or
+    (radius,) (sphere); a mesh's convex `pieces`, each a (k, 3) vertex array in its frame."""
+
+    kind: str
+    position: np.ndarray
+    rotation: np.ndarray
+    size: tuple[float, ...] = ()
+    pieces: tuple[np.ndarray, ...] = ()
+    planes: tuple[np.ndarray, ...] = field(default=(), compare=False)
+
+    def signed_distance(self, points: np.ndarray) -> np.ndarray:
+        """Metres from points (n, 3) to the surface, negative inside."""
+        local = (points - self.position) @ self.rotation
+        if self.kind == "sphere":
+            return np.linalg.norm(local, axis=1) - self.size[0]
+        if self.kind == "box":
+            return _box_distance(local, np.asarray(self.size))
+        if self.kind == "cylinder":
+            flat = np.stack([np.hypot(local[:, 0], local[:, 1]), local[:, 2]], axis=1)
+            return _box_distance(flat, np.asarray(self.size))
+        # convex pieces: the largest plane distance (exact inside, a lower bound outside)
+        return np.min([np.max(local @ p[:, :3].T - p[:, 3], axis=1) for p in self.planes], axis=0)
+
+
+def _box_distance(local: np.ndarray, half: np.ndarray) -> np.ndarray:
+    q = np.abs(local) - half
+    outside = np.linalg.norm(np.maximum(q, 0.0), axis=1)
+    return outside + np.minimum(q.max(axis=1), 0.0)
+
+
+def convex_planes(vertices: np.ndarray) -> np.ndarray:
+    """The faces of the convex hull of `vertices` as planes (k, 4): outward normal, offset."""
+    from scipy.spatial import ConvexHull
+
+    hull = ConvexHull(vertices)
+    return np.asarray(hull.equations[:, :4] * [1.0, 1.0, 1.0, -1.0])
+
+
+class StaticSpec(Protocol):
+    """What `Ground.add_to_spec` needs of a `mujoco.MjSpec`."""
+
+    worldbody: mujoco.MjsBody
+
+    def add_hfield(self, **kwargs: object) -> mujoco.MjsHField: ...
+    def add_mesh(self, **kwargs: object) -> mujoco.MjsMesh: ...
+
+
+@dataclass(frozen=True)
+class Ground:
+    """The plane z = 0 (`heightfield` None) or a heightfield, plus static `solids`;
+    `friction` overrides the scene's `physics.ground_friction` when given."""
+
+    provided_by = "terrain"
+
+    heightfield: Heightfield | None = None
+    solids: tuple[Solid, ...] = ()
+    friction: float | None = None
+
+    @property
+    def flat(self) -> bool:
+        """The plane z = 0 and nothing on it."""
+        return self.heightfield is None and not self.solids
+
+    def digest(self) -> str:
+        """Identifies this ground's geometry (model sharing, takes)."""
+        if self.flat and self.friction is None:
+            return "plane"
+        h = hashlib.sha256()
+        if self.heightfield is not None:
+            h.update(np.asarray(self.heightfield.size, np.float64).tobytes())
+            h.update(np.ascontiguousarray(self.heightfield.heights, np.float64).tobytes())
+        for solid in self.solids:
+            h.update(solid.kind.encode())
+            for part in (solid.position, solid.rotation, np.asarray(solid.size), *solid.pieces):
+                h.update(np.ascontiguousarray(part, np.float64).tobytes())
+        h.update(repr(self.friction).encode())
+        return h.hexdigest()[:16]
+
+    # -- queries -------------------------------------------------------------------------
+    def height(self, xy: np.ndarray) -> np.ndarray:
+        """The ground's height (heightfield or plane, not solids) under points `xy` (n, 2)."""
+        xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
+        if self.heightfield is None:
+            return np.zeros(len(xy))
+        return self.heightfield.height(xy)
+
+    def distance(self, points: np.ndarray) -> np.ndarray:
+        """Metres from points (n, 3) to the nearest static surface (negative: inside).
+
+        The heightfield's part is the height above it times the normal's z (exact on a
+        plane, close on gentle slopes); solids give their signed distance.
+        """
+        points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+        if self.heightfield is None:
+            best = points[:, 2].copy()
+        else:
+            xy = points[:, :2]
+            best = (points[:, 2] - self.heightfield.height(xy)) * self.heightfield.slope_normal(xy)[
+                :, 2
+            ]
+        for solid in self.solids:
+            best = np.minimum(best, solid.signed_distance(points))
+        return best
+
+    def inside_solid(self, points: np.ndarray, radii: np.ndarray | float = 0.0) -> np.ndarray:
+        """(n,) index of the first solid each ball (`points` (n, 3), `radii`) reaches into,
+        -1 for none."""
+        points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+        which = np.full(len(points), -1, dtype=np.int64)
+        for k, solid in enumerate(self.solids):
+            hit = (which < 0) & (solid.signed_distance(points) < radii)
+            which[hit] = k
+        return which
+
+    def normal(self, points: np.ndarray) -> np.ndarray:
+        """Unit normals (n, 3) of the surface nearest each point (`distance`'s gradient)."""
+        points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+        if self.flat:
+            return np.tile([0.0, 0.0, 1.0], (len(points), 1))
+        step = 1e-4
+        grad = np.empty_like(points)
+        for axis in range(3):
+            e = np.zeros(3)
+            e[axis] = step
+            grad[:, axis] = self.distance(points + e) - self.distance(points - e)
+        norm = np.linalg.norm(grad, axis=1, keepdims=True)
+        up = np.array([0.0, 0.0, 1.0])
+        return np.where(norm > 1e-12, grad / np.maximum(norm, 1e-12), up)
+
+    def lift(self, points: np.ndarray, radii: np.ndarray) -> float:
+        """How far to raise balls (`points`, `radii`) laid out on the plane z = 0 so they
+        rest on this ground: the largest (ground height - ball bottom)."""
+        if self.heightfield is None:
+            return 0.0
+        bottoms = points[:, 2] - radii
+        return float(np.max(self.heightfield.height(points[:, :2]) - bottoms))
+
+    # -- the physics ---------------------------------------------------------------------
+    def add_to_spec(
+        self,
+        spec: StaticSpec,
+        friction: float,
+        contype: int,
+        conaffinity: int,
+        solref: Sequence[float],
+    ) -> None:
+        """Add the ground's static geoms (named `ground...`) to a creature's model spec."""
+        common = {
+            "friction": [self.friction if self.friction is not None else friction, 0.005, 1e-4],
+            "contype": contype,
+            "conaffinity": conaffinity,
+            "solref": list(solref),
+        }
+        body = spec.worldbody
+        if self.heightfield is None:
+            body.add_geom(
+                name="ground", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0, 0, 1.0], **common
+            )
+        else:
+            field_ = self.heightfield
+            low, high = float(field_.heights.min()), float(field_.heights.max())
+            relief = max(high - low, 1e-6)
+            rows, cols = field_.heights.shape
+            spec.add_hfield(
+                name="ground",
+                size=[0.5 * field_.size[0], 0.5 * field_.size[1], relief, 0.5],
+                nrow=rows,
+                ncol=cols,
+                userdata=((field_.heights - low) / relief).ravel().tolist(),
+            )
+            body.add_geom(
+                name="ground",
+                type=mujoco.mjtGeom.mjGEOM_HFIELD,
+                hfieldname="ground",
+                pos=[0.0, 0.0, low],
+                **common,
+            )
+        for k, solid in enumerate(self.solids):
+            quat = np.zeros(4)
+            mujoco.mju_mat2Quat(quat, np.ascontiguousarray(solid.rotation).ravel())
+            place = {"pos": solid.position.tolist(), "quat": quat.tolist()}
+            if solid.kind == "mesh":
+                for p, piece in enumerate(solid.pieces):
+                    name = f"ground/solid{k}/piece{p}"
+                    spec.add_mesh(name=name, uservert=np.asarray(piece).ravel().tolist())
+                    body.add_geom(
+                        name=name, type=mujoco.mjtGeom.mjGEOM_MESH, meshname=name, **place, **common
+                    )
+                continue
+            kind = {
+                "box": mujoco.mjtGeom.mjGEOM_BOX,
+                "cylinder": mujoco.mjtGeom.mjGEOM_CYLINDER,
+                "sphere": mujoco.mjtGeom.mjGEOM_SPHERE,
+            }[solid.kind]
+            size = [*solid.size, 0.0, 0.0][:3]
+            body.add_geom(name=f"ground/solid{k}", type=kind, size=size, **place, **common)
+
+
+FLAT = Ground()
+
+
+def ground_of(world: object) -> Ground:
+    """The world's `Ground` resource (the terrain plugin's), or `FLAT`."""
+    getter = getattr(world, "get_resource", None)
+    found = getter(Ground) if getter is not None else None
+    return found if found is not None else FLAT

@@ -1,0 +1,68 @@
+"""The ground description (core): heights as MuJoCo's triangles give them, distances to
+solids, and the static geoms every physics model gets."""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+import pytest
+
+from ecs_tentacles.ground import FLAT, Ground, Heightfield, Solid, convex_planes
+
+
+def _ray_height(model: mujoco.MjModel, x: float, y: float) -> float:
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    hit = np.zeros(1, dtype=np.int32)
+    dist = mujoco.mj_ray(
+        model, data, np.array([x, y, 50.0]), np.array([0, 0, -1.0]), None, 1, -1, hit
+    )
+    return 50.0 - dist
+
+
+def _static_model(ground: Ground) -> mujoco.MjModel:
+    spec = mujoco.MjSpec()
+    ground.add_to_spec(spec, 1.0, 1, 2, [0.02, 1.0])
+    return spec.compile()
+
+
+def test_heights_match_what_mujoco_collides_with() -> None:
+    """The heightfield's `height` is the surface MuJoCo builds (rows along y from -y/2)."""
+    rng = np.random.default_rng(4)
+    heights = rng.uniform(-0.3, 0.5, size=(7, 9))
+    ground = Ground(Heightfield((4.0, 3.0), heights))
+    model = _static_model(ground)
+    points = rng.uniform([-1.99, -1.49], [1.99, 1.49], size=(40, 2))
+    mine = ground.height(points)
+    theirs = np.array([_ray_height(model, x, y) for x, y in points])
+    np.testing.assert_allclose(mine, theirs, atol=1e-6)
+    # the corner sample (row 0, column 0) is at (-x/2, -y/2)
+    assert ground.height(np.array([[-2.0, -1.5]]))[0] == pytest.approx(heights[0, 0])
+
+
+def test_the_plane_is_what_it_always_was() -> None:
+    points = np.array([[0.3, -2.0, 0.25], [5.0, 1.0, -0.01]])
+    np.testing.assert_array_equal(FLAT.distance(points), points[:, 2])
+    np.testing.assert_array_equal(FLAT.height(points[:, :2]), [0.0, 0.0])
+    spec = mujoco.MjSpec()
+    FLAT.add_to_spec(spec, 0.4, 1, 2, [0.006, 1.0])
+    model = spec.compile()
+    assert model.ngeom == 1 and model.geom_type[0] == mujoco.mjtGeom.mjGEOM_PLANE
+
+
+def test_solid_distances_and_normals() -> None:
+    turn = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])  # 90 deg yaw
+    box = Solid("box", np.array([1.0, 0.0, 0.5]), turn, (0.1, 2.0, 0.5))  # long along x now
+    ground = Ground(solids=(box,))
+    assert box.signed_distance(np.array([[1.0, 0.0, 0.5]]))[0] == pytest.approx(-0.1)
+    # beside the wall (its long side faces +-y after the turn)
+    beside = np.array([[1.5, 0.3, 0.5]])
+    assert ground.distance(beside)[0] == pytest.approx(0.2)
+    np.testing.assert_allclose(ground.normal(beside)[0], [0.0, 1.0, 0.0], atol=1e-6)
+    cube = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], float)
+    piece = Solid("mesh", np.zeros(3), np.eye(3), pieces=(cube,), planes=(convex_planes(cube),))
+    assert piece.signed_distance(np.array([[0.5, 0.5, 0.25]]))[0] == pytest.approx(-0.25)
+    assert piece.signed_distance(np.array([[0.5, 0.5, 1.5]]))[0] == pytest.approx(0.5)
+    assert Ground(solids=(piece,)).inside_solid(
+        np.array([[0.5, 0.5, 1.05], [3, 3, 3]]), 0.1
+    ).tolist() == [0, -1]
