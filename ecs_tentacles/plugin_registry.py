@@ -38,6 +38,7 @@ BUILTIN = {
     "record": "ecs_tentacles.record.plugin:RecordPlugin",
     "render": "ecs_tentacles.render.plugin:RenderPlugin",
     "lod": "ecs_tentacles.lod.plugin:LodPlugin",
+    "terrain": "ecs_tentacles.terrain.plugin:TerrainPlugin",
 }
 BUNDLED = {
     "wander": "ecs_tentacles.systems.examples.wander:WanderPlugin",
@@ -45,7 +46,7 @@ BUNDLED = {
     "follow_leader": "ecs_tentacles.systems.examples.follow_leader:FollowLeaderPlugin",
     "flock": "ecs_tentacles.systems.examples.flock:FlockPlugin",
 }
-DEFAULT_ON = ("locomotion", "suckers", "threats", "fur", "lod")  # in build order
+DEFAULT_ON = ("locomotion", "suckers", "threats", "fur", "lod", "terrain")  # in build order
 FROM = "from"  # the config key naming where a plugin's code is
 
 

@@ -11,17 +11,21 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
+import numpy as np
+
 from ecs_tentacles.cli.arguments import output_path, seed_int
 from ecs_tentacles.cli.bake import positive_float
 from ecs_tentacles.cli.run import positive_int
 from ecs_tentacles.creator.crowd import (
     DEFAULT_SPECIES,
+    creature_reach,
     crowd_scene,
     max_creatures,
     write_crowd_scene,
 )
 from ecs_tentacles.progress import status
 from ecs_tentacles.scene.errors import SceneError
+from ecs_tentacles.terrain import presets
 
 
 def crowd_size(text: str) -> int:
@@ -46,7 +50,8 @@ def fraction(text: str) -> float:
 
 
 def add_crowd_options(parser: argparse.ArgumentParser) -> None:
-    """--seed, --spacing, --idle, --species, --uniform: shared by `crowd` and `bench --crowd`."""
+    """--seed, --spacing, --idle, --species, --uniform, --terrain: shared by `crowd` and
+    `bench --crowd`."""
     parser.add_argument("--seed", type=seed_int, default=0, help="random seed (default 0)")
     parser.add_argument(
         "--spacing",
@@ -71,16 +76,29 @@ def add_crowd_options(parser: argparse.ArgumentParser) -> None:
         action="store_true",
         help="every creature the default 8 x 10 octopus (one morphology; behaviour still varies)",
     )
+    parser.add_argument(
+        "--terrain",
+        choices=presets.NAMES,
+        default="flat",
+        help="the ground: flat (the plane, default) or rocky (a noise heightfield under the"
+        " whole crowd with rocks between the creatures)",
+    )
 
 
 def crowd_from_args(n: int, args: argparse.Namespace) -> dict[str, Any]:
     """The crowd scene of `n` creatures the options ask for; SceneError names a bad option."""
     try:
-        return crowd_scene(
+        scene = crowd_scene(
             n, args.seed, args.spacing, idle=args.idle, species=args.species, uniform=args.uniform
         )
     except ValueError as error:  # only --spacing can be wrong once argparse has checked
         raise SceneError([f"--{error}"]) from None
+    if args.terrain == "rocky":
+        creatures = scene["creatures"]
+        positions = np.array([c["position"] for c in creatures], dtype=np.float64)
+        reach = max(creature_reach(c) for c in creatures)
+        scene["terrain"] = presets.rocky(positions, reach, args.seed)
+    return scene
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:

@@ -99,7 +99,7 @@ def test_bad_scene_in_a_real_process_has_no_traceback(tmp_path: Path) -> None:
     assert result.stdout == ""
     assert result.stderr.splitlines() == [
         f"error: {scene}: colour: unknown key (allowed: $schema, creatures, description, name,"
-        " physics, plugins, seed, shards, systems, threats, version)",
+        " physics, plugins, seed, shards, systems, terrain, threats, version)",
         f"error: {scene}: creatures[0].tentacles.links: must be in [1, 64], got 0",
     ]
     assert "Traceback" not in result.stderr
@@ -139,7 +139,7 @@ def test_validate_names_the_systems_a_scene_asks_for(
         "creatures": 1,
         "tentacles": 8,
         "systems": ["mine.wiggle:Wiggle"],
-        "plugins": ["locomotion", "suckers", "threats", "fur", "lod"],
+        "plugins": ["locomotion", "suckers", "threats", "fur", "lod", "terrain"],
     }
 
 

@@ -18,7 +18,7 @@ def test_systems_prints_the_frame_with_stages_plugins_and_fields(
     lines = capsys.readouterr().out.splitlines()
     assert (
         lines[0] == "plugins: locomotion (built in), suckers (built in), threats (built in),"
-        " fur (built in), lod (built in)"
+        " fur (built in), lod (built in), terrain (built in)"
     )
     assert lines[1].split() == ["stage", "system", "plugin", "reads", "writes"]
     rows = [line.split()[:3] for line in lines[2:]]
@@ -62,7 +62,7 @@ def test_migrate_makes_plugins_explicit_and_folds_the_systems_list(
     new = json.loads((tmp_path / "old.migrated.json").read_text())
     assert "systems" not in new
     assert new["plugins"] == {
-        "locomotion": {}, "suckers": {}, "threats": {}, "fur": {}, "lod": {},
+        "locomotion": {}, "suckers": {}, "threats": {}, "fur": {}, "lod": {}, "terrain": {},
         "wave": {"from": "mywave:Wave"},
     }  # fmt: skip
     assert "systems[0] -> plugins.wave (from mywave:Wave)" in capsys.readouterr().out

@@ -10,8 +10,8 @@ TENTACLE_KEYS = (
     "wave_amplitude_deg, wave_frequency, wavelength, writhe"
 )
 TOP_KEYS = (
-    "$schema, creatures, description, name, physics, plugins, seed, shards, systems, threats,"
-    " version"
+    "$schema, creatures, description, name, physics, plugins, seed, shards, systems, terrain,"
+    " threats, version"
 )
 CREATURE_KEYS = (
     "emotion, fur, goals, heading_deg, locomotion, mantle, name, position, tentacles, threat"

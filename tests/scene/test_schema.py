@@ -187,5 +187,5 @@ def test_the_bundled_scene_schema_is_the_assembled_default_one() -> None:
     folder = importlib.resources.files("ecs_tentacles.assets") / "schema"
     written = json.loads((folder / "scene.schema.json").read_text(encoding="utf-8"))
     assert written == load_schema(), (
-        "regenerate: ecs-tentacles schema --out assets/schema/scene.schema.json"
+        "regenerate: ecs-tentacles schema > assets/schema/scene.schema.json"
     )

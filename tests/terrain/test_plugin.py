@@ -1,0 +1,236 @@
+"""The terrain plugin as a scene uses it: creatures rest on the surface, goals snap to it,
+suckers grip slopes and obstacles, and bad terrain input is one line naming the field."""
+
+from __future__ import annotations
+
+import json
+import pathlib
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from ecs_tentacles.cli import main
+from ecs_tentacles.construction import creature_layout
+from ecs_tentacles.ground import ground_of
+from ecs_tentacles.locomotion.goals import GoalBook
+from ecs_tentacles.scene.errors import SceneError
+from ecs_tentacles.world import World
+
+ROCKY = {
+    "heightfield": {
+        "size": [12, 12],
+        "resolution": 64,
+        "height": 0.5,
+        "noise": {"seed": 3, "scale": 4.0, "octaves": 3},
+    },
+    "obstacles": [
+        {"shape": "box", "position": [3, 0, 0.3], "size": [0.3, 4, 0.6]},
+        {"shape": "cylinder", "position": [-3, 2, 0.4], "radius": 0.5, "height": 0.8},
+        {"shape": "sphere", "position": [0, -3, 0], "radius": 0.7},
+    ],
+}
+
+
+def scene(
+    terrain: dict[str, Any], *positions: list[float], goal: list[float] | None = None
+) -> dict[str, Any]:
+    creatures = [{"name": f"c{i}", "position": p} for i, p in enumerate(positions)]
+    if goal is not None:
+        creatures[0]["goals"] = [{"position": goal}]
+    return {"version": 1, "terrain": terrain, "creatures": creatures}
+
+
+def _bodies_clearance(world: World, spec: dict[str, Any]) -> float:
+    """The smallest gap (m) between any link capsule's axis points and the ground, less
+    the link's radius, at build."""
+    starts, ends, radii = creature_layout(spec, ground_of(world)).capsules()
+    ground = ground_of(world)
+    gaps = [ground.distance(p)[1:] - radii[1:] for p in (starts, ends, 0.5 * (starts + ends))]
+    return float(np.min(gaps))
+
+
+def test_creatures_start_on_the_surface_and_settle_without_faults(
+    make_world: Callable[..., World],
+) -> None:
+    world = make_world(scene(ROCKY, [0, 0], [-1.5, 1.2], [1.2, 2.5], [-1.0, -1.5]))
+    for spec in world.scene["creatures"]:  # type: ignore[index]
+        gap = _bodies_clearance(world, spec)
+        assert 0.0 <= gap < 0.02, spec["name"]  # resting on it, not inside, not floating
+    for _ in range(60):
+        world.step()
+    assert world.physics.health.recoveries == 0
+    deepest = min(float(b.deepest.min()) for b in world.physics.batches)
+    assert deepest > -0.005  # never sunk more than 5 mm into the terrain
+    mantles = world.transforms.pos[world.creatures.mantle_row]
+    assert (mantles[:, 2] - ground_of(world).height(mantles[:, :2]) > 0.0).all()
+
+
+def test_goals_snap_to_the_surface(make_world: Callable[..., World]) -> None:
+    world = make_world(scene(ROCKY, [0, 0], goal=[1.5, 1.0]))
+    goal = world.resource(GoalBook).positions(world.creature("c0"))[0]
+    assert goal[2] == pytest.approx(ground_of(world).height(goal[None, :2])[0])
+    assert goal[2] > 0.01  # the noise is not flat there
+
+
+def test_heights_rows_run_along_y_from_minus_y(make_world: Callable[..., World]) -> None:
+    """A ramp given as `heights` (rising along +y): a creature placed high sits high."""
+    rows = [[0.1 * r] * 5 for r in range(9)]  # 0 at y = -4, 0.8 at y = +4
+    world = make_world(scene({"heightfield": {"size": [4, 8], "heights": rows}}, [0, 2.0]))
+    mantle = world.transforms.pos[world.creatures.mantle_row[0]]
+    assert mantle[2] > 0.55  # the surface under y = 2 is 0.6 m up
+
+
+def test_a_16_bit_image_gives_the_heights(tmp_path: pathlib.Path) -> None:
+    pixels = np.zeros((5, 5), dtype=np.uint16)
+    pixels[0, :] = 65535  # the picture's top row: +y
+    Image.fromarray(pixels).save(tmp_path / "hill.png")
+    terrain = {"heightfield": {"size": [4, 4], "image": "hill.png", "height": 0.4}}
+    (tmp_path / "s.json").write_text(json.dumps(scene(terrain, [0, 0])))
+    world = World.from_scene(tmp_path / "s.json")
+    try:
+        ground = ground_of(world)
+        assert ground.height(np.array([[0.0, 2.0], [0.0, -2.0]])).tolist() == pytest.approx(
+            [0.4, 0.0]
+        )
+    finally:
+        world.close()
+
+
+def test_suckers_grip_a_slope(make_world: Callable[..., World]) -> None:
+    """On a 12 degree slope the suckers attach where the tips touch it, well above z = 0."""
+    rise = float(np.tan(np.radians(12.0)))
+    rows = [[rise * (x - 3.0) + 3.0 * rise for x in np.linspace(0, 6, 13)] for _ in range(5)]
+    world = make_world(
+        scene({"heightfield": {"size": [6, 4], "heights": rows}}, [0, 0], goal=[1.5, 0])
+    )
+    anchors: list[np.ndarray] = []
+    world.events.on("sucker_attached", lambda **kw: anchors.append(kw["anchor"]))
+    for _ in range(240):
+        world.step()
+    assert len(anchors) >= 4
+    anchors_ = np.array(anchors)
+    ground = ground_of(world)
+    assert (anchors_[:, 2] > 0.3).all()  # on the slope, far above the old plane
+    assert np.abs(ground.distance(anchors_)).max() < 0.01  # on its surface
+
+
+def _validate(
+    tmp_path: pathlib.Path, data: dict[str, Any], capsys: pytest.CaptureFixture[str]
+) -> tuple[int, str]:
+    """`ecs-tentacles run SCENE --frames 1` in this process: (exit code, stderr)."""
+    path = tmp_path / "scene.json"
+    path.write_text(json.dumps(data))
+    code = main(["run", str(path), "--frames", "1", "--quiet"])
+    return code, capsys.readouterr().err
+
+
+BAD = {
+    "image missing": (
+        {"heightfield": {"size": [4, 4], "image": "nowhere.png"}},
+        "terrain.heightfield.image: nowhere.png: no such file in the scene's folder",
+    ),
+    "mesh escaping the folder": (
+        {"obstacles": [{"shape": "mesh", "file": "../rock.obj", "position": [3, 0, 0]}]},
+        "terrain.obstacles[0].file: ../rock.obj: must be a file in the scene's folder",
+    ),
+    "resolution 1": (
+        {"heightfield": {"size": [4, 4], "resolution": 1, "noise": {}}},
+        "terrain.heightfield.resolution: must be in [3, 1024], got 1",
+    ),
+    "two sources": (
+        {"heightfield": {"size": [4, 4], "noise": {}, "image": "x.png"}},
+        "terrain.heightfield: give exactly one of noise, image or heights (has: noise, image)",
+    ),
+    "a sphere without radius": (
+        {"obstacles": [{"shape": "sphere", "position": [3, 0, 0]}]},
+        "terrain.obstacles[0]: a sphere needs 'radius'",
+    ),
+    "a creature inside a rock": (
+        {"obstacles": [{"shape": "sphere", "position": [0.5, 0, 0], "radius": 0.3}]},
+        "creatures[0].position: c0 is inside terrain.obstacles[0]; move it or the obstacle",
+    ),
+}
+
+
+@pytest.mark.parametrize("case", BAD, ids=list(BAD))
+def test_bad_terrain_is_one_line_naming_the_field(
+    tmp_path: pathlib.Path, case: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    terrain, message = BAD[case]
+    (tmp_path.parent / "rock.obj").write_text(
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 2 4\nf 1 3 4\nf 2 3 4\n"
+    )
+    code, err = _validate(tmp_path, scene(terrain, [0, 0]), capsys)
+    assert code == 2, err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and message in lines[0], lines
+
+
+def test_nan_heights_and_a_hundred_thousand_obstacles_are_refused(
+    tmp_path: pathlib.Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    path = tmp_path / "nan.json"
+    rows = [[0.0, 0.0, 0.0], [0.0, float("nan"), 0.0], [0.0, 0.0, 0.0]]
+    data = scene({"heightfield": {"size": [4, 4], "heights": rows}}, [0, 0])
+    path.write_text(json.dumps(data))  # Python writes NaN; JSON has no such number
+    assert main(["validate", str(path)]) == 2
+    assert "NaN is not valid JSON" in capsys.readouterr().err
+    with pytest.raises(
+        SceneError, match=r"terrain\.heightfield\.heights\[1\]\[1\]: must be a finite"
+    ):
+        World.from_scene(data)  # a dict from a script can hold one
+    many = [{"shape": "sphere", "position": [50, 50, 0], "radius": 0.1}] * 100_000
+    code, err = _validate(tmp_path, scene({"obstacles": many}, [0, 0]), capsys)
+    assert code == 2
+    assert "terrain.obstacles: must have at most 1000 items" in err, err[:300]
+
+
+def test_a_concave_mesh_is_split_into_convex_pieces(
+    tmp_path: pathlib.Path, make_world: Callable[..., World]
+) -> None:
+    import trimesh
+
+    arch = trimesh.util.concatenate(
+        [
+            trimesh.creation.box(
+                (0.3, 1.0, 1.0), trimesh.transformations.translation_matrix((x, 0, 0.5))
+            )
+            for x in (-0.6, 0.6)
+        ]
+        + [
+            trimesh.creation.box(
+                (1.5, 1.0, 0.3), trimesh.transformations.translation_matrix((0, 0, 1.15))
+            )
+        ]
+    )
+    arch.export(tmp_path / "arch.obj")
+    terrain = {
+        "obstacles": [{"shape": "mesh", "file": "arch.obj", "position": [3, 0, 0], "scale": 1.0}]
+    }
+    world = make_world(scene(terrain, [0, 0]), scene_dir=tmp_path)
+    solid = ground_of(world).solids[0]
+    assert len(solid.pieces) >= 3  # two legs and a lintel, not one hull
+    # the hollow under the arch stays hollow: its middle is outside every piece
+    assert solid.signed_distance(np.array([[3.0, 0.0, 0.4]]))[0] > 0.2
+
+
+def test_on_terrain_no_creature_replays_flat_ground_clips(make_world: Callable[..., World]) -> None:
+    """Gait clips are recorded on the plane: past the budgets, terrain crowds run REDUCED."""
+    data = scene(ROCKY, [0, 0], [-2.0, 1.5], [1.2, 2.5], [-1.0, -2.0])
+    data["physics"] = {"lod": {"full": 1, "reduced": 1, "hold_seconds": 0.1}}
+    world = make_world(data)
+    for _ in range(20):
+        world.step()
+    counts = world.lod.counts()  # type: ignore[attr-defined]
+    assert counts["kinematic"] == 0 and counts["reduced"] >= 2, counts
+
+
+def test_crowd_on_rocky_terrain_is_a_valid_scene(tmp_path: pathlib.Path) -> None:
+    out = tmp_path / "crowd.json"
+    assert main(["crowd", "9", "--terrain", "rocky", "--out", str(out)]) == 0
+    data = json.loads(out.read_text())
+    assert data["terrain"]["heightfield"]["noise"]["seed"] == 0
+    assert main(["run", str(out), "--frames", "30", "--strict", "--quiet"]) == 0
