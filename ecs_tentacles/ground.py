@@ -28,7 +28,7 @@ if TYPE_CHECKING:
     from collections.abc import Sequence
 
 SHAPES = ("box", "cylinder", "sphere", "mesh")
-FAR = 1e6  # metres: "no surface" for distances
+NORMAL_PROBE = 0.005  # metres above a surface point where its normal is measured
 
 
 @dataclass(frozen=True)
@@ -84,6 +84,13 @@ class Solid:
     size: tuple[float, ...] = ()
     pieces: tuple[np.ndarray, ...] = ()
     planes: tuple[np.ndarray, ...] = field(default=(), compare=False)
+
+    @property
+    def bound(self) -> float:
+        """The radius of a sphere about `position` that holds the whole solid."""
+        if self.pieces:
+            return float(max(np.linalg.norm(p, axis=1).max() for p in self.pieces))
+        return float(np.linalg.norm(self.size)) if self.kind != "sphere" else self.size[0]
 
     def signed_distance(self, points: np.ndarray) -> np.ndarray:
         """Metres from points (n, 3) to the surface, negative inside."""
@@ -203,6 +210,68 @@ class Ground:
         norm = np.linalg.norm(grad, axis=1, keepdims=True)
         up = np.array([0.0, 0.0, 1.0])
         return np.where(norm > 1e-12, grad / np.maximum(norm, 1e-12), up)
+
+    def normal_under(self, xy: np.ndarray) -> np.ndarray:
+        """(n, 3) unit normals of the topmost surface under points `xy` (n, 2): the plane
+        a creature standing there crawls in."""
+        xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
+        if self.flat:
+            return np.tile([0.0, 0.0, 1.0], (len(xy), 1))
+        if not self.solids and self.heightfield is not None:
+            return self.heightfield.slope_normal(xy)
+        points = np.column_stack([xy, self.surface(xy) + NORMAL_PROBE])
+        return self.normal(points)
+
+    def ray(self, origin: np.ndarray, direction: np.ndarray) -> np.ndarray | None:
+        """Where the ray from `origin` along `direction` first meets the ground or a solid
+        (None: it never does; on the plane, only rays going down meet it)."""
+        origin = np.asarray(origin, dtype=np.float64).reshape(3)
+        direction = np.asarray(direction, dtype=np.float64).reshape(3)
+        if self.flat:
+            if direction[2] >= 0.0 or origin[2] <= 0.0:
+                return None
+            return origin + direction * (-origin[2] / direction[2])
+        model, data = self._static()
+        hit = np.zeros(1, dtype=np.int32)
+        length = float(np.linalg.norm(direction))
+        if length == 0.0:
+            return None
+        unit = direction / length
+        distance = mujoco.mj_ray(model, data, origin, unit, None, 1, -1, hit)
+        return None if distance < 0 else origin + unit * distance
+
+    def surface(self, xy: np.ndarray) -> np.ndarray:
+        """(n,) the height of the topmost surface (ground or solid) under points `xy` (n, 2)."""
+        xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
+        if not self.solids:
+            return self.height(xy)
+        top = self._top()
+        out = self.height(xy)
+        for i, (x, y) in enumerate(xy):
+            hit = self.ray(np.array([x, y, top]), np.array([0.0, 0.0, -1.0]))
+            if hit is not None:
+                out[i] = max(out[i], hit[2])
+        return out
+
+    def _top(self) -> float:
+        """A height above everything."""
+        high = 0.0 if self.heightfield is None else float(self.heightfield.heights.max())
+        for solid in self.solids:
+            high = max(high, float(solid.position[2]) + solid.bound)
+        return high + 1.0
+
+    def _static(self) -> tuple[mujoco.MjModel, mujoco.MjData]:
+        """A model of the ground alone (made once), for ray casts."""
+        cached = self.__dict__.get("_static_model")
+        if cached is None:
+            spec = mujoco.MjSpec()
+            self.add_to_spec(spec, 1.0, 1, 1, (0.02, 1.0))
+            model = spec.compile()
+            data = mujoco.MjData(model)
+            mujoco.mj_forward(model, data)
+            cached = (model, data)
+            object.__setattr__(self, "_static_model", cached)  # a cache, not a field
+        return cached
 
     def lift(self, points: np.ndarray, radii: np.ndarray) -> float:
         """How far to raise balls (`points`, `radii`) laid out on the plane z = 0 so they

@@ -82,8 +82,8 @@ class GoalBook:
         self._world.component(creature, Creature)  # raises KeyError for a non-creature
         point = np.zeros(3)
         point[: len(values)] = values
-        if len(values) == 2:  # on the ground under it (the plane: z = 0)
-            point[2] = ground_of(self._world).height(values)[0]
+        if len(values) == 2:  # on the topmost surface under it (the plane: z = 0)
+            point[2] = ground_of(self._world).surface(values)[0]
         return point
 
     def _append(self, creature: int, point: np.ndarray, radius: float) -> int:

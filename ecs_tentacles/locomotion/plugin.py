@@ -28,6 +28,7 @@ from ecs_tentacles.construction import tentacle_params
 from ecs_tentacles.locomotion.actions import STRENGTH, ActionQueue, Kind
 from ecs_tentacles.locomotion.components import Goal
 from ecs_tentacles.locomotion.goals import GoalBook
+from ecs_tentacles.locomotion.navigation import Navigator
 from ecs_tentacles.locomotion.params import Locomotion
 from ecs_tentacles.locomotion.stores import LocomotionStores
 from ecs_tentacles.plugin import Plugin, Reach, RunSummary, TrackSource
@@ -55,7 +56,7 @@ class LocomotionPlugin(Plugin):
     defs = _FRAGMENT["$defs"]
 
     def resources(self, world: Host) -> list[object]:
-        return [LocomotionStores(), GoalBook(world), Locomotion(world)]
+        return [LocomotionStores(), GoalBook(world), Locomotion(world), Navigator()]
 
     def stores(self, world: Host) -> dict[str, ArrayStore]:
         loco = world.resource(LocomotionStores)
@@ -68,6 +69,7 @@ class LocomotionPlugin(Plugin):
         if row != body.row:
             raise RuntimeError("locomotion's creature rows must line up with the body's")
         apply_parameters(world, "locomotion", spec["locomotion"], {"locomotion.creatures": row})
+        loco.creatures.navigate[row] = bool(spec.get("navigation", True))
         rng = creature_rng(world.seed, spec["name"])  # the creature's own stream
         tentacles = spec["tentacles"]
         for k, entity in enumerate(body.tentacles):
@@ -99,9 +101,9 @@ class LocomotionPlugin(Plugin):
         return world.resource(LocomotionStores).creatures.has_goal
 
     def travel_targets(self, world: Host) -> np.ndarray:
-        """Creatures crawl toward their current goal."""
+        """Creatures crawl toward their current goal (or the waypoint on the way to it)."""
         creatures = world.resource(LocomotionStores).creatures
-        return np.where(creatures.has_goal[:, None], creatures.goal[:, :2], np.nan)
+        return np.where(creatures.has_goal[:, None], creatures.steer[:, :2], np.nan)
 
     def snapshot(self, world: Host) -> Any:
         goals = {
@@ -112,16 +114,17 @@ class LocomotionPlugin(Plugin):
             for entity, _ in world.query(Creature)
         }
         queues = {e: copy.deepcopy(q.pending) for e, q in world.query(ActionQueue)}
-        return goals, queues
+        return goals, queues, world.resource(Navigator).state()
 
     def restore(self, world: Host, state: Any) -> None:
-        goals, queues = state
+        goals, queues, navigation = state
         for entity, path in goals.items():
             world.resource(GoalBook).clear(entity)
             for position, radius in path:
                 world.resource(GoalBook).append(entity, position.tolist(), radius)
         for entity, queue in world.query(ActionQueue):
             queue.pending = copy.deepcopy(queues[entity])
+        world.resource(Navigator).set_state(navigation)
 
     # -- sandbox hooks -----------------------------------------------------------------
     def render_lines(self, world: Host, view: RenderView) -> list[Any]:

@@ -3,7 +3,8 @@
 The locomotion plugin's sandbox hooks call these. Each creature's path is a ring and
 a short post at every goal and the legs between them, in a light tint of the
 creature's colour, plus the leg from the creature to its current goal, which moves
-with it. The rings and legs between goals are rebuilt only when a goal changes
+with it, and (with obstacles) the path navigation planned around them, through its
+waypoints. The rings and legs between goals are rebuilt only when a goal changes
 (`GoalBook.version`); the moving legs are one vectorised pass a frame.
 
 Mouse (`sandbox_click`): a left click on the ground sets the selected creature's goal,
@@ -21,8 +22,10 @@ import numpy as np
 
 from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.drawing import CIRCLE, Click, RenderView, line_segments
+from ecs_tentacles.ground import ground_of
 from ecs_tentacles.locomotion.components import Goal
 from ecs_tentacles.locomotion.goals import GoalBook
+from ecs_tentacles.locomotion.navigation import Navigator
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
@@ -79,11 +82,34 @@ def path_lines(world: Host, view: RenderView) -> list[np.ndarray]:
     if not isinstance(cached, GoalLines) or cached.world is not world or cached.version != version:
         cached = view.state[GOALS] = goal_lines(world, view)
     # each creature's leg to its current goal moves with it: one vectorised pass
+    start = view.pos[cached.leader_rows]
+    start[:, 2] = ground_of(world).height(start[:, :2]) + LIFT
     leaders = np.empty((2 * len(cached.leader_rows), 7))
-    leaders[0::2, :3] = view.pos[cached.leader_rows] * [1, 1, 0] + [0, 0, LIFT]
+    leaders[0::2, :3] = start
     leaders[1::2, :3] = cached.leader_ends
     leaders[:, 3:] = np.repeat(cached.leader_colours, 2, axis=0)
-    return [cached.fixed, leaders]
+    return [cached.fixed, leaders, *_routes(world, cached, start)]
+
+
+def _routes(world: Host, cached: GoalLines, start: np.ndarray) -> list[np.ndarray]:
+    """The legs of the paths navigation planned around obstacles: from each creature
+    through its waypoints (a bright dashed-looking polyline over its straight leg)."""
+    navigation = world.resource(Navigator)
+    if not navigation.routes or not len(cached.leader_rows):
+        return []
+    mantle_rows = world.creatures.mantle_row
+    lines = []
+    for i, row in enumerate(cached.leader_rows.tolist()):
+        creature = np.flatnonzero(mantle_rows == row)
+        if not len(creature):
+            continue
+        route = navigation.waypoints(int(creature[0]))
+        if not len(route):
+            continue
+        points = np.vstack([start[i], route + [0, 0, LIFT], cached.leader_ends[i]])
+        colour = np.append(np.minimum(cached.leader_colours[i, :3] * 1.3 + 0.2, 1.0), 1.0)
+        lines.append(line_segments(points, colour))
+    return lines
 
 
 def goal_points(world: Host) -> np.ndarray:

@@ -62,6 +62,8 @@ class CreatureGaitStore(ArrayStore):
     has_goal = Field(dtype=np.bool_, default=False)
     goal = Field((3,))  # the current goal's position (valid when has_goal)
     goal_radius = Field()
+    navigate = Field(dtype=np.bool_, default=True)  # plan paths around obstacles (navigation)
+    steer = Field((3,))  # where it crawls this frame: the goal or a waypoint (navigation)
 
 
 class LocomotionStores:

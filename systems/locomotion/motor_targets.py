@@ -11,10 +11,16 @@ tips never whip. Creatures the level of detail replays (KINEMATIC, as the last f
 decided: `PhysicsBackend.kinematic_creatures`) are skipped: their servos drive nothing.
 Writhing (thesis IV.B): the servo gain is modulated by the same wave,
 scaled by the action's strength.
+On terrain every tentacle also follows the ground ahead (`ground_follow`): where the
+surface under its reach falls away from the creature's own plane (a crest, a dip) or
+rises into it (a step, the foot of a slope), its droop ramp bends the tip down or up
+by that much, the way procedural legs probe the ground under each foot. On the plane
+this term is never computed (the motion stays exactly the thesis's).
 
 Reads: locomotion's tentacle store (action, action_angle, action_strength, orient,
 mode, wave parameters), TentacleStore (rest pitch, link rows, creature), MotorStore
-(tentacle_row, arc), the physics' tiers. Writes: MotorStore (target, gain).
+(tentacle_row, arc), the physics' tiers, on terrain the Transform store (mantle, base
+and tip poses) and the Ground. Writes: MotorStore (target, gain).
 """
 
 from __future__ import annotations
@@ -23,8 +29,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ecs_tentacles.ground import Ground, ground_of
 from ecs_tentacles.locomotion.actions import ATTACH_PATIENCE, GRIPPING, Kind, Mode
 from ecs_tentacles.locomotion.stores import LocomotionStores
+from ecs_tentacles.mathutil import quat_rotate
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
@@ -50,6 +58,24 @@ ATTACH_PRESS = 0.15  # extra tip-down pitch (at the tip) per attach duration wit
 # and its sideways wave quietens.
 GRIP_CURL_WAVE, GRIP_SWEEP_WAVE = 0.0, 0.3
 SMOOTHING_SECONDS = 0.06  # targets ease toward each new pose (slow-in) instead of jumping
+FOLLOW_LIMIT = 0.8  # radians: the most the droop ramp bends to follow the ground
+
+
+def ground_follow(world: Host, ground: Ground) -> np.ndarray:
+    """(tentacles,) extra droop (radians, positive: tip down) that brings each tentacle's
+    reach onto the ground: the tip of the tentacle stretched along its creature's plane
+    would be `gap` above the surface; a droop ramp of 2 atan(gap / length) lowers it so."""
+    t, pos = world.tentacles, world.transforms.pos
+    creature = t.creature_row
+    up = quat_rotate(world.transforms.quat[world.creatures.mantle_row], np.array([0.0, 0.0, 1.0]))
+    up = up[creature]
+    base = pos[t.base_row]
+    along = pos[t.base_row + t.links - 1] - base
+    along -= np.sum(along * up, axis=1, keepdims=True) * up
+    along /= np.maximum(np.linalg.norm(along, axis=1, keepdims=True), 1e-9)
+    reach = base + t.length[:, None] * along
+    gap = ground.distance(reach)
+    return np.clip(2.0 * np.arctan2(gap, t.length), -FOLLOW_LIMIT, FOLLOW_LIMIT)
 
 
 class MotorTargets(System):
@@ -85,11 +111,14 @@ class MotorTargets(System):
         # (user waves, the HUD) do not feed back into the easing
         self.eased = motors.target[:, :2].copy()
         self.strokes = world.resource(LocomotionStores).tentacles
+        self.follow: np.ndarray | None = None  # on terrain: `ground_follow` this frame
 
     def process(self, world: Host, dt: float) -> None:
         motors = world.motors
         if not len(motors):
             return
+        ground = ground_of(world)
+        self.follow = None if ground.flat else ground_follow(world, ground)
         kinematic = world.physics.kinematic_creatures(len(world.creatures))
         if not kinematic.any():
             self._targets(world, dt, slice(None), self.inner, self.previous)
@@ -127,9 +156,10 @@ class MotorTargets(System):
         # along the tentacle: the rest droop, and an attaching tip pressing down further
         # the longer it takes to touch the ground
         arch = np.where(ARCHED[action, t.mode], -t.action_angle, 0.0)[row]
-        droop = (2.0 * body.rest_pitch + np.where(action == ATTACH, ATTACH_PRESS * progress, 0.0))[
-            row
-        ]
+        droop = 2.0 * body.rest_pitch + np.where(action == ATTACH, ATTACH_PRESS * progress, 0.0)
+        if self.follow is not None:
+            droop = droop + self.follow
+        droop = droop[row]
         pitch = arch * self.arch_shape[links] + LIFT[action][row] + droop * arc
         curl = pitch.copy()
         curl[inner] -= pitch[previous]

@@ -2,7 +2,10 @@
 
 Push or pull follows the thesis: compare the unit vectors mantle -> goal and
 mantle -> tentacle base (in the ground plane); an angle within +-pi/2 (dot >= 0)
-means the tentacle lies between mantle and goal: pull; otherwise push.
+means the tentacle lies between mantle and goal: pull; otherwise push. On the plane
+the ground plane is world xy; on terrain it is the plane of the surface under each
+mantle (`ground_plane`): vectors are projected onto it, so a creature on a slope or a
+ramp chooses and orients its strokes along the slope, not along their shadows.
 
 * cyclic gait (the thesis): one driving tentacle at a time, in turn; a tentacle
   classifies itself only when its stroke is queued.
@@ -13,10 +16,15 @@ means the tentacle lies between mantle and goal: pull; otherwise push.
   to their other side.
 * no goal: drives stop (the sucker lets go) and every tentacle idles.
 
-Reads: locomotion's stores (goal, gait, drivers, speed; action, mode, driving),
-CreatureStore and TentacleStore (mantle, tentacle rows, bases), Transform store.
+First it has the `Navigator` set each creature's steer point: its goal, or the next
+waypoint of a path around obstacles (`ecs_tentacles.locomotion.navigation`).
+
+Reads: locomotion's stores (goal, navigate, steer; gait, drivers, speed; action, mode,
+driving),
+CreatureStore and TentacleStore (mantle, tentacle rows, bases), Transform store, the
+Ground.
 Writes: locomotion's tentacle store (driving, mode, started) and creature store
-(next_driver, last_start), ActionQueues (a started drive is queued and
+(steer, next_driver, last_start), ActionQueues (a started drive is queued and
 the current action interrupted; an abort replaces the queue with detach, settle).
 """
 
@@ -26,6 +34,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ecs_tentacles.ground import ground_of
 from ecs_tentacles.locomotion.actions import (
     BASE_SECONDS,
     ActionQueues,
@@ -34,6 +43,7 @@ from ecs_tentacles.locomotion.actions import (
     drive_sequence,
 )
 from ecs_tentacles.locomotion.actions import make_action as action
+from ecs_tentacles.locomotion.navigation import Navigator
 from ecs_tentacles.locomotion.stores import LocomotionStores
 from ecs_tentacles.scene.parameters import parameter
 from ecs_tentacles.system import System
@@ -58,6 +68,22 @@ def classify(to_goal: np.ndarray, to_base: np.ndarray) -> tuple[np.ndarray, np.n
     return cos >= -PULL_TOLERANCE, cos
 
 
+def ground_plane(normals: np.ndarray) -> np.ndarray:
+    """(n, 2, 3) two unit axes spanning the plane normal to each of `normals` (n, 3): the
+    first is world x laid onto that plane (world y where x is nearly the normal)."""
+    x = np.tile([1.0, 0.0, 0.0], (len(normals), 1))
+    steep = np.abs(normals[:, 0]) > 0.9
+    x[steep] = [0.0, 1.0, 0.0]
+    first = x - np.sum(x * normals, axis=1, keepdims=True) * normals
+    first /= np.linalg.norm(first, axis=1, keepdims=True)
+    return np.stack([first, np.cross(normals, first)], axis=1)
+
+
+def _in_plane(basis: np.ndarray, vectors: np.ndarray) -> np.ndarray:
+    """(n, 2) coordinates of `vectors` (n, 3) along each row's plane axes (n, 2, 3)."""
+    return np.einsum("nij,nj->ni", basis, vectors)
+
+
 class TentacleSelection(System):
     name = "tentacle_selection"
     stage = "decide"
@@ -74,8 +100,11 @@ class TentacleSelection(System):
         "locomotion.tentacles.action",
         "locomotion.tentacles.speed",
         "locomotion.tentacles.target_angle",
+        "creatures.mantle_radius",
+        "tentacles.length",
     )
     writes = (
+        "locomotion.creatures.steer",
         "locomotion.tentacles.driving",
         "locomotion.tentacles.mode",
         "locomotion.tentacles.started",
@@ -95,13 +124,21 @@ class TentacleSelection(System):
     def process(self, world: Host, dt: float) -> None:
         t, c = world.tentacles, world.creatures
         s, g = self.strokes, self.gaits
+        world.resource(Navigator).steer(world)  # the goal, or a waypoint on the way to it
         if not len(t) or not (g.has_goal.any() or s.driving.any()):
             return
         creature = t.creature_row
         pos = world.transforms.pos
-        mantle = pos[c.mantle_row, :2]
-        to_goal = (g.goal[:, :2] - mantle)[creature]
-        to_base = pos[t.base_row, :2] - mantle[creature]
+        ground = ground_of(world)
+        if ground.flat:
+            mantle = pos[c.mantle_row, :2]
+            to_goal = (g.steer[:, :2] - mantle)[creature]
+            to_base = pos[t.base_row, :2] - mantle[creature]
+        else:
+            mantle3 = pos[c.mantle_row]
+            basis = ground_plane(ground.normal_under(mantle3[:, :2]))[creature]  # (n, 2, 3)
+            to_goal = _in_plane(basis, (g.steer - mantle3)[creature])
+            to_base = _in_plane(basis, pos[t.base_row] - mantle3[creature])
         pull, cos = classify(to_goal, to_base)
         has_goal = g.has_goal[creature]
         driving_now = s.driving

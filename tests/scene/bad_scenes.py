@@ -14,7 +14,8 @@ TOP_KEYS = (
     " threats, version"
 )
 CREATURE_KEYS = (
-    "emotion, fur, goals, heading_deg, locomotion, mantle, name, position, tentacles, threat"
+    "emotion, fur, goals, heading_deg, locomotion, mantle, name, navigation, position, tentacles,"
+    " threat"
 )
 
 

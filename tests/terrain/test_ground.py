@@ -66,3 +66,14 @@ def test_solid_distances_and_normals() -> None:
     assert Ground(solids=(piece,)).inside_solid(
         np.array([[0.5, 0.5, 1.05], [3, 3, 3]]), 0.1
     ).tolist() == [0, -1]
+
+
+def test_rays_and_the_topmost_surface() -> None:
+    table = Solid("box", np.array([2.0, 0.0, 0.5]), np.eye(3), (0.5, 0.5, 0.5))
+    ground = Ground(Heightfield((8.0, 8.0), np.full((5, 5), 0.1)), (table,))
+    assert ground.surface(np.array([[2.0, 0.0], [-2.0, 0.0]])).tolist() == pytest.approx([1.0, 0.1])
+    hit = ground.ray(np.array([0.0, 0.0, 3.0]), np.array([1.0, 0.0, -1.0]))
+    assert hit is not None and hit.tolist() == pytest.approx([2.0, 0.0, 1.0])  # the table top
+    assert ground.ray(np.array([0.0, 0.0, 3.0]), np.array([0.0, 0.0, 1.0])) is None
+    flat = FLAT.ray(np.array([1.0, 1.0, 2.0]), np.array([0.0, 1.0, -1.0]))
+    assert flat is not None and flat.tolist() == pytest.approx([1.0, 3.0, 0.0])

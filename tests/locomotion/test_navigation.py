@@ -1,0 +1,82 @@
+"""Navigation: creatures reach goals behind obstacles by paths around them; without
+it they crawl straight and stay stuck behind the wall."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+import pytest
+
+from ecs_tentacles.drawing import RenderView
+from ecs_tentacles.ground import Ground, Solid
+from ecs_tentacles.locomotion.navigation import CostGrid, Navigator
+from ecs_tentacles.locomotion.render import path_lines
+from ecs_tentacles.world import World
+
+WALL = {"shape": "box", "position": [-1.6, 0, 0.3], "size": [4.8, 0.2, 0.6]}  # ends at x = 0.8
+
+
+def behind_the_wall(navigation: bool) -> dict[str, Any]:
+    creature = {"name": "o", "position": [0, -1.6], "goals": [{"position": [0, 1.6]}]}
+    if not navigation:
+        creature["navigation"] = False
+    return {"version": 1, "terrain": {"obstacles": [WALL]}, "creatures": [creature]}
+
+
+@pytest.mark.parametrize("navigation", [True, False], ids=["navigation on", "navigation off"])
+def test_a_goal_behind_a_wall_is_reached_only_by_navigation(
+    make_world: Callable[..., World], navigation: bool
+) -> None:
+    world = make_world(behind_the_wall(navigation))
+    reached: list[float] = []
+    world.events.on("goal_reached", lambda **_: reached.append(world.time))
+    while world.time < 50.0 and not reached:
+        world.step()
+    mantle = world.transforms.pos[world.creatures.mantle_row[0]]
+    if navigation:
+        assert reached and mantle[1] > 0.5, mantle  # around the wall's end, at the goal
+    else:
+        assert not reached and mantle[1] < -0.3, mantle  # still pressed against the wall
+    assert world.physics.health.recoveries == 0
+
+
+def test_the_sandbox_can_draw_the_planned_path(make_world: Callable[..., World]) -> None:
+    world = make_world(behind_the_wall(True))
+    world.step()
+    route = world.resource(Navigator).waypoints(0)
+    assert len(route) >= 1
+    assert (route[:, 0] > 0.8).all()  # every waypoint is past the wall's end
+    creature = world.creature("o")
+    view = RenderView(
+        world.transforms.pos.copy(),
+        world.transforms.quat.copy(),
+        [creature],
+        {creature: np.array([0.8, 0.3, 0.2])},
+    )
+    lines = np.concatenate([np.asarray(seg).reshape(-1, 7) for seg in path_lines(world, view)])
+    for waypoint in route:  # a drawn vertex at every waypoint
+        assert np.min(np.linalg.norm(lines[:, :2] - waypoint[:2], axis=1)) < 1e-6
+
+
+def test_routes_go_around_and_none_when_walled_in() -> None:
+    wall = Solid("box", np.array([0.0, 0.0, 0.5]), np.eye(3), (2.0, 0.1, 0.5))
+    grid = CostGrid.of(Ground(solids=(wall,)), 0.5, np.array([[0.0, -3.0], [0.0, 3.0]]))
+    assert grid is not None
+    route = grid.route(np.array([0.0, -3.0]), np.array([0.0, 3.0]))
+    assert route is not None and route[-1].tolist() == [0.0, 3.0]
+    assert np.abs(route[:-1, 0]).min() > 2.0  # around one end of the wall, not through it
+    ring = tuple(
+        Solid("box", np.array([x, y, 0.5]), np.eye(3), (sx, sy, 0.5))
+        for x, y, sx, sy in (
+            (0, 2, 2.1, 0.1),
+            (0, -2, 2.1, 0.1),
+            (2, 0, 0.1, 2.1),
+            (-2, 0, 0.1, 2.1),
+        )
+    )
+    inside = CostGrid.of(Ground(solids=ring), 0.3, np.array([[0.0, 0.0], [5.0, 5.0]]))
+    assert inside is not None
+    assert inside.route(np.array([0.0, 0.0]), np.array([5.0, 5.0])) is None
+    assert CostGrid.of(Ground(), 0.5, np.zeros((1, 2))) is None  # nothing to steer around
