@@ -1,4 +1,5 @@
-"""Draws a World: ground grid and creatures, and what the plugins hand it.
+"""Draws a World: the ground (the plane's grid, or the terrain and obstacles as lit
+meshes, `ecs_tentacles.ground_mesh`), creatures, and what the plugins hand it.
 
 Creatures are drawn skinned by default (`view = "skinned"`: one continuous mesh per
 creature, skinned on the GPU, all creatures in one draw; `ecs_tentacles.render.skinned`)
@@ -26,6 +27,8 @@ from pyglet import gl
 
 from ecs_tentacles.components import Creature, Link, Tentacle, Transform
 from ecs_tentacles.drawing import CIRCLE, RenderView, line_segments
+from ecs_tentacles.ground import ground_of
+from ecs_tentacles.ground_mesh import ground_meshes
 from ecs_tentacles.render import shaders
 from ecs_tentacles.render.camera import OrbitCamera
 from ecs_tentacles.render.gpu import (
@@ -37,11 +40,13 @@ from ecs_tentacles.render.gpu import (
     program,
     set_matrix,
 )
-from ecs_tentacles.render.meshes import CAPSULE_LODS, CYLINDER_LOD, SPHERE_LOD
+from ecs_tentacles.render.meshes import CAPSULE_LODS, CYLINDER_LOD, SPHERE_LOD, Mesh
 from ecs_tentacles.render.skinned import SkinnedCreatures
 from ecs_tentacles.world import World
 
 SKY = (0.70, 0.76, 0.82)
+TERRAIN_RGB = (0.62, 0.56, 0.44)  # sand and earth
+ROCK_RGB = (0.50, 0.50, 0.52)
 LIGHT = np.array([0.35, -0.45, 0.82]) / np.linalg.norm([0.35, -0.45, 0.82])
 LOD_DISTANCE = 6.0  # metres from the eye beyond which links use the lean mesh
 VIEWS = ("skinned", "capsules")
@@ -69,6 +74,9 @@ class Renderer:
         self.lit = program(shaders.INSTANCED_VERTEX, shaders.LIT_FRAGMENT)
         self.ground_program = program(shaders.GROUND_VERTEX, shaders.GROUND_FRAGMENT)
         self.line_program = program(shaders.LINE_VERTEX, shaders.LINE_FRAGMENT)
+        self.terrain_program = program(shaders.INSTANCED_VERTEX, shaders.TERRAIN_FRAGMENT)
+        self.ground_meshes: list[InstancedMesh] = []  # the terrain and obstacles, if any
+        self.ground_key = "plane"
         self.skinned_program = program(shaders.SKINNED_VERTEX, shaders.LIT_FRAGMENT)
         self.skinned = SkinnedCreatures()
         self.view = "skinned"
@@ -128,10 +136,38 @@ class Renderer:
         self.link_instances = np.zeros((len(link_rows), INSTANCE_FLOATS), np.float32)
         if link_rows:
             self.link_instances[:, 7:] = np.array(link_static)
+        self._build_ground()
         self.skinned.build(world, self.creature_entities, self.creature_colour)
         meshed = set(self.skinned.creatures)
         self.mantle_skinned = np.array([e in meshed for e in self.creature_entities], bool)
         self.link_skinned = self.mantle_skinned[np.array(link_creature, dtype=np.int64)]
+
+    def _build_ground(self) -> None:
+        """The ground's meshes (terrain, obstacles) as two one-instance meshes; rebuilt
+        only when the ground changed."""
+        ground = ground_of(self.world)
+        key = ground.digest()
+        if key == self.ground_key:
+            return
+        self.ground_key = key
+        self.ground_meshes = []
+        terrain, solids = ground_meshes(ground)
+        for mesh, colour, grid in ((terrain, TERRAIN_RGB, 1.0), (solids, ROCK_RGB, 0.0)):
+            if mesh is None:
+                continue
+            template = Mesh(
+                mesh.vertices.astype(np.float32),
+                mesh.normals.astype(np.float32),
+                np.zeros(len(mesh.vertices), np.float32),
+                mesh.triangles.astype(np.uint32).ravel(),
+            )
+            drawn = InstancedMesh(template)
+            instance = np.zeros((1, INSTANCE_FLOATS), np.float32)
+            instance[0, 3] = 1.0  # identity quaternion (w first)
+            instance[0, 7:10] = 1.0  # unit scale
+            instance[0, 11:15] = (*colour, grid)  # alpha: how much of the metre grid shows
+            drawn.update(instance)
+            self.ground_meshes.append(drawn)
 
     def toggle_view(self) -> str:
         """Switch between the skinned and the capsule view; returns the new view."""
@@ -231,12 +267,20 @@ class Renderer:
         view_projection = self.camera.view_projection()
         eye = tuple(self.camera.eye.astype(np.float32))
         calls = 0
-        self.ground_program.use()
-        set_matrix(self.ground_program, "u_view_projection", view_projection)
-        self.ground_program["u_eye"] = eye
-        gl.glDisable(gl.GL_CULL_FACE)
-        calls += self.ground.draw()
-        gl.glEnable(gl.GL_CULL_FACE)
+        if ground_of(self.world).heightfield is None:  # the plane's grid
+            self.ground_program.use()
+            set_matrix(self.ground_program, "u_view_projection", view_projection)
+            self.ground_program["u_eye"] = eye
+            gl.glDisable(gl.GL_CULL_FACE)
+            calls += self.ground.draw()
+            gl.glEnable(gl.GL_CULL_FACE)
+        if self.ground_meshes:  # terrain and obstacles: lit, two draws whatever their size
+            self.terrain_program.use()
+            set_matrix(self.terrain_program, "u_view_projection", view_projection)
+            self.terrain_program["u_light"] = tuple(LIGHT.astype(np.float32))
+            self.terrain_program["u_eye"] = eye
+            for mesh in self.ground_meshes:
+                calls += mesh.draw()
         self.lit.use()
         set_matrix(self.lit, "u_view_projection", view_projection)
         self.lit["u_light"] = tuple(LIGHT.astype(np.float32))

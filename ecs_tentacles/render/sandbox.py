@@ -45,6 +45,7 @@ from tqdm import tqdm
 
 from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.drawing import Click, Panel
+from ecs_tentacles.ground import ground_of
 from ecs_tentacles.render.camera import ray_sphere
 from ecs_tentacles.render.hud import Hud
 from ecs_tentacles.render.output import VideoWriter, save_png
@@ -312,6 +313,13 @@ class Sandbox:
         best = int(np.argmin(hits))
         return self.renderer.creature_entities[best] if np.isfinite(hits[best]) else None
 
+    def ground_point(self, x: float, y: float) -> np.ndarray | None:
+        """Where the ray through pixel (x, y) first meets the ground: the terrain or an
+        obstacle when the world has them (the plane z = 0 past their edge)."""
+        origin, direction = self.renderer.camera.ray(x, y)
+        hit = ground_of(self.world).ray(origin, direction)
+        return hit if hit is not None else self.renderer.camera.ground_point(x, y)
+
     def click(self, x: float, y: float, button: int, modifiers: int) -> None:
         """What a click at pixel (x, y) does: a left click on a creature selects it; then
         the plugins' `sandbox_click` hooks see it, in plugin order, until one takes it."""
@@ -323,7 +331,7 @@ class Sandbox:
         click = Click(
             button=BUTTONS.get(button, "other"),
             shift=bool(modifiers & key.MOD_SHIFT),
-            ground=self.renderer.camera.ground_point(x, y),
+            ground=self.ground_point(x, y),
             creature=picked,
             selected=self.renderer.selected,
         )

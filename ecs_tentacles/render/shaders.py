@@ -61,24 +61,51 @@ void main() {
 }
 """
 
+# lines on the ground every `spacing` metres, `width` pixels wide (1 on a line, 0 off it)
+_GRID = """float grid(vec2 p, float spacing, float width) {
+    vec2 g = abs(fract(p / spacing - 0.5) - 0.5) / fwidth(p / spacing);
+    return 1.0 - min(min(g.x, g.y) / width, 1.0);
+}
+"""
+# the ground fades into the sky colour with distance
+_FOG = """    float fog = clamp(length(v_world - u_eye) / 60.0, 0.0, 1.0);
+    f_colour = vec4(mix(colour, vec3(0.70, 0.76, 0.82), fog * fog), 1.0);
+"""
+
 GROUND_FRAGMENT = """
 #version 330 core
 in vec3 v_world;
 uniform vec3 u_eye;
 out vec4 f_colour;
-float grid(vec2 p, float spacing, float width) {
-    vec2 g = abs(fract(p / spacing - 0.5) - 0.5) / fwidth(p / spacing);
-    return 1.0 - min(min(g.x, g.y) / width, 1.0);
-}
+// @grid
 void main() {
     vec3 base = vec3(0.56, 0.60, 0.55);
     float fine = grid(v_world.xy, 0.25, 1.0) * 0.10;
     float coarse = grid(v_world.xy, 1.0, 1.5) * 0.25;
     vec3 colour = mix(base, vec3(0.30, 0.33, 0.30), fine + coarse);
-    float fog = clamp(length(v_world - u_eye) / 60.0, 0.0, 1.0);
-    f_colour = vec4(mix(colour, vec3(0.70, 0.76, 0.82), fog * fog), 1.0);
+    // @fog
 }
-"""
+""".replace("// @grid\n", _GRID).replace("    // @fog\n", _FOG)
+
+TERRAIN_FRAGMENT = """
+#version 330 core
+in vec3 v_normal;
+in vec4 v_colour;
+in vec3 v_world;
+uniform vec3 u_light;
+uniform vec3 u_eye;
+out vec4 f_colour;
+// @grid
+void main() {
+    vec3 n = normalize(gl_FrontFacing ? v_normal : -v_normal);
+    float diffuse = max(dot(n, u_light), 0.0);
+    float sky = 0.5 + 0.5 * n.z;
+    vec3 colour = v_colour.rgb * (0.30 + 0.25 * sky + 0.62 * diffuse);
+    // a faint metre grid on the ground (scale at a glance), as on the plane
+    colour = mix(colour, colour * 0.6, grid(v_world.xy, 1.0, 1.5) * 0.35 * v_colour.a);
+    // @fog
+}
+""".replace("// @grid\n", _GRID).replace("    // @fog\n", _FOG)
 
 LINE_VERTEX = """
 #version 330 core

@@ -1,0 +1,62 @@
+"""The sandbox on terrain: the heightfield and obstacles are drawn as lit solids in two
+draws, and a click lands on what is under the cursor (an obstacle's top, a hill)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+from pyglet.window import mouse
+
+from ecs_tentacles.locomotion.goals import GoalBook
+from tests.render.conftest import event
+
+TABLE = {"shape": "box", "position": [1.0, 1.4, 0.25], "size": [0.8, 0.8, 0.5]}
+HILLS = {"size": [8, 8], "resolution": 33, "height": 0.4, "noise": {"seed": 1}}
+
+
+def terrain_scene() -> dict[str, Any]:
+    return {
+        "version": 1,
+        "terrain": {"heightfield": HILLS, "obstacles": [TABLE]},
+        "creatures": [
+            {"name": "octo", "position": [-0.5, 0], "goals": [{"position": [0.8, -1.2]}]}
+        ],
+    }
+
+
+def test_terrain_and_obstacles_are_drawn_and_clicks_land_on_them(
+    make_sandbox: Callable[..., Any],
+) -> None:
+    sandbox = make_sandbox(terrain_scene())
+    sandbox.hud.visible = False
+    calls = sandbox.renderer.draw()
+    assert calls == 7 + 1  # the grid's draw gives way to the terrain's and the obstacles'
+    pixels = sandbox.renderer.target.read().astype(int)
+    camera = sandbox.renderer.camera
+    top = np.array([[1.0, 1.4, 0.5]])  # the table's top
+    tx, ty = camera.project(top)[0]
+    r, g, b = pixels[camera.height - round(ty), round(tx)]
+    assert abs(r - g) < 25 and abs(g - b) < 25  # grey rock, not sky or sand
+    r, g, b = pixels[camera.height - 8, camera.width // 2]  # bottom middle: the hills
+    assert r > b + 30  # sand, lit (the plane's grid would be grey-green)
+
+    octo = sandbox.world.creature("octo")
+    sandbox.select(octo)
+    book = sandbox.world.resource(GoalBook)
+    for x, y in (top[0, :2], (-1.0, -1.2)):
+        point = np.array([[x, y, 0.0]])
+        point[0, 2] = top[0, 2] if x == top[0, 0] else _hill_height(sandbox, x, y)
+        px, py = camera.project(point)[0]
+        event(sandbox, "on_mouse_press", round(px), round(py), mouse.LEFT, 0)
+        event(sandbox, "on_mouse_release", round(px), round(py), mouse.LEFT, 0)
+        goal = book.positions(octo)[0]
+        assert np.linalg.norm(goal[:2] - point[0, :2]) < 0.05
+        assert abs(goal[2] - point[0, 2]) < 0.02  # on what was clicked, not at z = 0
+
+
+def _hill_height(sandbox: Any, x: float, y: float) -> float:
+    from ecs_tentacles.ground import ground_of
+
+    return float(ground_of(sandbox.world).height(np.array([[x, y]]))[0])
