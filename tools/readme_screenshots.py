@@ -1,5 +1,6 @@
 """The README's sandbox pictures, made headless with the current HUD: the four-creature
-sandbox, the HUD at 640 x 360, and the skinned octopus (the fur pictures are
+sandbox, the HUD at 640 x 360, the skinned octopus and the three terrain scenes (rocky
+shore, ramp, maze; HUD hidden) (the fur pictures are
 `tools/fur_screenshots.py`'s, the crowd plot `tools/crowd_scaling.py`'s).
 
     python tools/readme_screenshots.py                       # into assets/screenshots/
@@ -14,10 +15,13 @@ from pathlib import Path
 
 from ecs_tentacles.cli import main as cli
 
-# name -> (scene, frames, width, height): what each README picture shows
+# name -> (scene, frames, width, height, HUD shown): what each README picture shows
 SHOTS = {
-    "sandbox": ("thesis_four_by_six", 240, 1280, 720),  # four creatures round a square
-    "hud_640x360": ("octopus", 60, 640, 360),  # the HUD scaled to a small window
+    "sandbox": ("thesis_four_by_six", 240, 1280, 720, True),  # four creatures round a square
+    "hud_640x360": ("octopus", 60, 640, 360, True),  # the HUD scaled to a small window
+    "rocky_shore": ("rocky_shore", 900, 960, 540, False),  # terrain: six crossing the rocks
+    "ramp": ("ramp", 2700, 960, 540, False),  # terrain: cresting the ramp
+    "maze": ("maze", 600, 960, 540, False),  # terrain: the path navigation planned
 }
 CLOSE_UP = ("octopus", 120, 960, 540)  # skinned_sandbox: the skinned octopus, no HUD, near
 DEFAULT_DIR = Path(__file__).resolve().parents[1] / "assets" / "screenshots"
@@ -34,9 +38,10 @@ def main(argv: list[str] | None = None) -> int:
         if name == "skinned_sandbox":
             _close_up(args.out_dir / f"{name}.png")
             continue
-        scene, frames, width, height = SHOTS[name]
+        scene, frames, width, height, hud = SHOTS[name]
         out = args.out_dir / f"{name}.png"
-        argv_play = ["play", scene, "--headless", "--frames", str(frames), "--hud", "--quiet"]
+        argv_play = ["play", scene, "--headless", "--frames", str(frames), "--quiet"]
+        argv_play += ["--hud"] if hud else ["--no-hud"]
         argv_play += ["--width", str(width), "--height", str(height), "--screenshot", str(out)]
         code = cli(argv_play)
         if code:
