@@ -17,6 +17,8 @@ import numpy as np
 
 from ecs_tentacles.ground import Ground, Solid
 
+# how the sandbox and the exporters colour them (rgb 0..1): sand and earth, grey rock
+COLOURS = {"terrain": (0.62, 0.56, 0.44), "obstacles": (0.50, 0.50, 0.52)}
 CYLINDER_SEGMENTS = 24
 SPHERE_SEGMENTS, SPHERE_RINGS = 24, 12
 

@@ -36,6 +36,7 @@ from typing import Any, BinaryIO
 
 import numpy as np
 
+from ecs_tentacles import take_ground
 from ecs_tentacles.atomic import atomic_file
 from ecs_tentacles.take_read import (
     FORMAT,
@@ -65,7 +66,9 @@ class Take:
     bodies [{name, creature, shape cylinder|capsule, axis, radius, length}],
     suckers [{name, body, offset (in the body's frame)}], health, and one key per track
     (`ecs_tentacles.take_tracks`): goals [{name, creature, radius}], guides (null, or
-    {creatures: [creature index per guide]}); `tracks` lists declared tracks, if any.
+    {creatures: [creature index per guide]}); `tracks` lists declared tracks, if any;
+    `ground` the terrain's and obstacles' meshes on terrain (`ecs_tentacles.take_ground`;
+    their arrays are in `tracks` too, by file name: `ground_meshes()` gives them).
     """
 
     header: dict[str, Any]
@@ -110,6 +113,10 @@ class Take:
         except ValueError:
             raise KeyError(f"no body named {name!r} in this take") from None
 
+    def ground_meshes(self) -> list[tuple[str, Any]]:
+        """(name, `StaticMesh`) of the terrain and obstacles (none on the plane)."""
+        return take_ground.meshes_of(self.header, self.tracks)
+
     def track_list(self) -> list[TakeTrack]:
         """Every track of this take, in file order (`ecs_tentacles.take_tracks`)."""
         return tracks_of(self.header)
@@ -126,6 +133,7 @@ class Take:
         text = json.dumps(self.header, sort_keys=True, separators=(",", ":"))
         out = {"header": np.frombuffer(text.encode(), dtype=np.uint8)}
         names = [*CORE_ARRAYS[1:], *(a for t in self.track_list() for a in t.arrays)]
+        names += list(take_ground.dtypes(self.header))
         for name in names:
             value = self.array(name)
             if value is not None:
@@ -169,6 +177,7 @@ class Take:
             if track.kind == "curves" and first is not None:
                 points[track.arrays[0]] = first.shape[2] if first.ndim == 4 else -1
         known = {*CORE_ARRAYS, *(a for t in tracks for a in t.arrays)}
+        known |= set(take_ground.dtypes(self.header))
         unknown = sorted(set(self.tracks) - known)
         if unknown:
             return f"{unknown[0]}: not a track of this take"
@@ -178,7 +187,7 @@ class Take:
                 got = None if value is None else value.shape
                 return f"{name}: shape {got}, expected {shape} from the header"
         arrays = {k: v for k, v in self.arrays().items() if k != "header"}
-        return data_problem(arrays, tracks)
+        return data_problem(arrays, tracks) or take_ground.index_problem(self.header, arrays)
 
     def check_exportable(self, path: str | os.PathLike[str]) -> None:
         """Raise `TakeError` (one line) unless exporters can write this take to `path`."""

@@ -10,7 +10,8 @@ the arrays only when all of this holds, else raises `TakeError` with one line:
   is refused before anything is inflated), and so is the size the header implies;
 - the header is UTF-8 JSON describing creatures, bodies, suckers and every track
   (points: name, creature, radius each; curves: an owner per curve) with the names,
-  indices and numbers the exporters need (`header_problem`);
+  indices and numbers the exporters need (`header_problem`), and the ground's meshes
+  when there are any (`ecs_tentacles.take_ground`; their triangle indices in range);
 - every array's stored dtype and shape (read from its `.npy` header before its data)
   are the ones the header implies, its data is complete and its CRC right;
 - every float is finite and every quaternion has a length.
@@ -30,6 +31,7 @@ from typing import IO, Any, cast
 
 import numpy as np
 
+from ecs_tentacles import take_ground
 from ecs_tentacles.take_tracks import TakeTrack, declared_problem, dtypes, tracks_of
 
 MAX_TAKE_BYTES = 2 * 1024**3  # uncompressed; a 10 s bake of 4 creatures is ~30 MB
@@ -202,6 +204,7 @@ def header_problem(header: object) -> str | None:
         or _creature_problem(header["creatures"], len(header["bodies"]))
         or _body_problem(header)
         or _parts_problem(header)
+        or take_ground.problem(header)
     )
 
 
@@ -227,6 +230,7 @@ def expected_shapes(
             curves = len(header[track.key]["creatures"])
             shapes[first] = (frames, curves, points[first], 3)
             shapes[second] = (frames, curves, points[first])
+    shapes.update(take_ground.shapes(header))
     return shapes
 
 
@@ -236,6 +240,7 @@ def array_dtypes(header: dict[str, Any]) -> dict[str, np.dtype[Any]]:
     for track in tracks_of(header):
         for name, dtype in zip(track.arrays, dtypes(track), strict=True):
             out[name] = np.dtype(dtype)
+    out.update(take_ground.dtypes(header))
     return out
 
 
@@ -415,7 +420,7 @@ def _read_archive(
                 raise TakeError(f"{name}: shape {arrays[name].shape}, expected {shapes[name]}")
             continue
         arrays[name] = _read_entry(archive, name, shapes[name], wanted[name])
-    problem = data_problem(arrays, tracks)
+    problem = data_problem(arrays, tracks) or take_ground.index_problem(header, arrays)
     if problem:
         raise TakeError(problem)
     return header, arrays

@@ -4,7 +4,8 @@ A take lists creatures in scene order, then bodies, suckers and every track's it
 (goals, fur guides, ...: `ecs_tentacles.take_tracks`) creature by creature
 (`ecs_tentacles.export.recording`). A shard's take does the same for its own
 creatures, so merging is a stable sort of every table by the creature's index in the
-whole scene, with the header's indices renumbered.
+whole scene, with the header's indices renumbered. The ground's meshes
+(`ecs_tentacles.take_ground`) are the scene's, the same in every shard: kept once.
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from ecs_tentacles import take_ground
 from ecs_tentacles.take import Take
 from ecs_tentacles.take_tracks import TakeTrack
 
@@ -24,8 +26,8 @@ def merge_takes(parts: Sequence[tuple[Sequence[int], Take]]) -> Take:
     header: dict[str, Any] = {
         k: v for k, v in first.header.items() if k not in ("creatures", "bodies", "suckers")
     }
-    for key in ("frames", "fps", "seed", "scene_sha256"):
-        values = {repr(take.header[key]) for _, take in parts}
+    for key in ("frames", "fps", "seed", "scene_sha256", take_ground.KEY):
+        values = {repr(take.header.get(key)) for _, take in parts}
         if len(values) > 1:
             raise ValueError(f"shard takes differ in {key}: {sorted(values)}")
     tracks = first.track_list()
@@ -85,6 +87,8 @@ def merge_takes(parts: Sequence[tuple[Sequence[int], Take]]) -> Take:
         merged[name] = np.ascontiguousarray(
             np.moveaxis(stacked[np.argsort(owner, kind="stable")], 0, axes.get(name, 1))
         )
+    # the ground is the scene's, the same in every shard (checked above): the first's
+    merged.update({name: first.tracks[name] for name in take_ground.dtypes(first.header)})
     return Take.from_arrays(header, merged)
 
 

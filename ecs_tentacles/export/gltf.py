@@ -25,11 +25,12 @@ import numpy as np
 
 from ecs_tentacles import __version__
 from ecs_tentacles.atomic import atomic_file
+from ecs_tentacles.export.ground import add_gltf_ground
 from ecs_tentacles.export.meshes import Mesh, body_mesh
 from ecs_tentacles.take import Take
 
 Z_UP_TO_Y_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
-_FLOAT, _USHORT = 5126, 5123
+_FLOAT, _USHORT, _UINT = 5126, 5123, 5125
 _ARRAY_BUFFER, _ELEMENT_ARRAY_BUFFER = 34962, 34963
 _GLB_MAGIC, _JSON_CHUNK, _BIN_CHUNK = 0x46546C67, 0x4E4F534A, 0x004E4942
 
@@ -56,7 +57,7 @@ class _Buffer:
         self.accessors: list[dict[str, Any]] = []
 
     def add(self, array: np.ndarray, kind: str, target: int | None = None) -> int:
-        """Append `array` (float32 or uint16), return its accessor index."""
+        """Append `array` (float32, uint16 or uint32), return its accessor index."""
         raw = np.ascontiguousarray(array).tobytes()
         view: dict[str, Any] = {"buffer": 0, "byteOffset": len(self.data), "byteLength": len(raw)}
         if target is not None:
@@ -65,7 +66,9 @@ class _Buffer:
         self.views.append(view)
         accessor: dict[str, Any] = {
             "bufferView": len(self.views) - 1,
-            "componentType": _FLOAT if array.dtype == np.float32 else _USHORT,
+            "componentType": {np.dtype(np.float32): _FLOAT, np.dtype(np.uint32): _UINT}.get(
+                array.dtype, _USHORT
+            ),
             "count": int(array.shape[0]),
             "type": kind,
         }
@@ -117,6 +120,19 @@ def build_gltf(take: Take) -> tuple[dict[str, Any], bytes]:
             folder = node(f"t{k}", tentacles)
             for index in chain:
                 body(index, folder)
+    materials: list[dict[str, Any]] = [
+        {
+            "name": "skin",
+            "pbrMetallicRoughness": {
+                "baseColorFactor": [0.85, 0.45, 0.5, 1.0],
+                "metallicFactor": 0.0,
+                "roughnessFactor": 0.6,
+            },
+        }
+    ]
+    ground = add_gltf_ground(take, buffer, nodes, meshes, materials, to_y_up_points)
+    if ground is not None:
+        nodes[0]["children"].append(ground)
     document: dict[str, Any] = {
         "asset": {
             "version": "2.0",
@@ -127,16 +143,7 @@ def build_gltf(take: Take) -> tuple[dict[str, Any], bytes]:
         "scenes": [{"name": str(header["scene"]), "nodes": [0]}],
         "nodes": nodes,
         "meshes": meshes,
-        "materials": [
-            {
-                "name": "skin",
-                "pbrMetallicRoughness": {
-                    "baseColorFactor": [0.85, 0.45, 0.5, 1.0],
-                    "metallicFactor": 0.0,
-                    "roughnessFactor": 0.6,
-                },
-            }
-        ],
+        "materials": materials,
     }
     document["animations"] = [_animation(buffer, take, body_nodes, translations, rotations)]
     document["buffers"] = [{"byteLength": len(buffer.data)}]

@@ -18,7 +18,9 @@ from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
 
 import numpy as np
 
+from ecs_tentacles import take_ground
 from ecs_tentacles.components import Creature, Link, Tentacle, Transform
+from ecs_tentacles.ground import ground_of
 from ecs_tentacles.plugin import CurvesFrame, PointsFrame, TrackSource
 from ecs_tentacles.take import FORMAT, VERSION, Take
 from ecs_tentacles.take_tracks import STANDARD, TakeTrack, declared_problem
@@ -92,6 +94,10 @@ class TakeRecorder:
         declared = [r.track.declaration() for r in self.tracks if r.track not in STANDARD]
         if declared:
             self.header["tracks"] = declared
+        # the terrain and obstacles as static meshes (nothing on the plane)
+        ground, self._ground_arrays = take_ground.header_entry_and_arrays(ground_of(world))
+        if ground is not None:
+            self.header[take_ground.KEY] = ground
         bodies, suckers = len(self._rows), len(self._suckers)
         capacity = max(1, capacity)
         self._pos = np.empty((capacity, bodies, 3), np.float32)
@@ -205,6 +211,7 @@ class TakeRecorder:
         tracks: dict[str, np.ndarray] = {}
         for recorder in self.tracks:
             tracks.update(recorder.arrays(n))
+        tracks.update({name: a.copy() for name, a in self._ground_arrays.items()})
         return Take(
             header=header,
             pos=self._pos[:n].copy(),

@@ -30,6 +30,7 @@ from ecs_tentacles.export.gltf import (
     to_y_up_points,
     to_y_up_rotations,
 )
+from ecs_tentacles.export.ground import add_gltf_ground
 from ecs_tentacles.skin.keys import KeyReport
 from ecs_tentacles.skin.mesh import Detail, SkinMesh
 from ecs_tentacles.skin.rig import Keys, SkinnedCreature, skinned_creatures
@@ -105,6 +106,19 @@ def build_skinned_gltf(
             }
         )
         _channels(buffer, take, creature, first, samplers, channels, times)
+    materials: list[dict[str, Any]] = [
+        {
+            "name": "skin",
+            "pbrMetallicRoughness": {
+                "baseColorTexture": {"index": 0},
+                "metallicFactor": 0.0,
+                "roughnessFactor": 0.6,
+            },
+        }
+    ]
+    ground = add_gltf_ground(take, buffer, nodes, meshes, materials, to_y_up_points)
+    if ground is not None:
+        nodes[0]["children"].append(ground)
     document: dict[str, Any] = {
         "asset": {
             "version": "2.0",
@@ -116,16 +130,7 @@ def build_skinned_gltf(
         "nodes": nodes,
         "meshes": meshes,
         "skins": skins,
-        "materials": [
-            {
-                "name": "skin",
-                "pbrMetallicRoughness": {
-                    "baseColorTexture": {"index": 0},
-                    "metallicFactor": 0.0,
-                    "roughnessFactor": 0.6,
-                },
-            }
-        ],
+        "materials": materials,
         "textures": [{"sampler": 0, "source": 0}],
         "samplers": [{"magFilter": 9729, "minFilter": 9729}],
         "images": [{"bufferView": _image(buffer, skin_texture()), "mimeType": "image/png"}],

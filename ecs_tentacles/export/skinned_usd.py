@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 
 from ecs_tentacles.atomic import atomic_output
+from ecs_tentacles.export.ground import write_usd_ground
 from ecs_tentacles.export.usd import _pxr, mark_rate, new_stage, write_tracks
 from ecs_tentacles.mathutil import quat_rotate
 from ecs_tentacles.skin.keys import KeyReport
@@ -70,6 +71,7 @@ def build_skinned_stage(
     for index, sucker in enumerate(take.header["suckers"]):
         _sucker(pxr, stage, take, index, sucker)
     write_tracks(pxr, stage, take)
+    write_usd_ground(pxr, stage, take)
     return stage, report
 
 

@@ -33,6 +33,7 @@ from typing import Any
 import numpy as np
 
 from ecs_tentacles.atomic import atomic_output
+from ecs_tentacles.export.ground import write_usd_ground
 from ecs_tentacles.take import Take, TakeTrack
 
 
@@ -117,6 +118,7 @@ def build_stage(take: Take, progress: Callable[[int], object] | None = None) -> 
     for index, sucker in enumerate(header["suckers"]):
         _sucker(pxr, stage, take, index, sucker)
     write_tracks(pxr, stage, take)
+    write_usd_ground(pxr, stage, take)
     return stage
 
 

@@ -19,13 +19,14 @@ import numpy as np
 import pytest
 
 from ecs_tentacles.cli import main
-from ecs_tentacles.creator.crowd import crowd_scene
+from ecs_tentacles.creator.crowd import creature_reach, crowd_scene
 from ecs_tentacles.distributed.merge import merge_takes
 from ecs_tentacles.distributed.shards import default_tasks, plan_shards
 from ecs_tentacles.distributed.task import CRASH_DIR, bake_shard
 from ecs_tentacles.distributed.work import shard_key, work_folder
 from ecs_tentacles.export.bake import BakePlan
 from ecs_tentacles.take import Take
+from ecs_tentacles.terrain.presets import rocky
 
 ray = pytest.importorskip("ray", reason="the `ray` extra is not installed")
 
@@ -74,6 +75,25 @@ def test_sharded_bake_equals_local_bake_byte_for_byte(
     assert f"ray: {len(shards)} shard(s) baked, 0 resumed, 0 re-baked" in err
     assert not work_folder(tmp_path / "ray.npz").exists()
     assert sorted(p.name for p in tmp_path.iterdir()) == ["crowd.json", "local.npz", "ray.npz"]
+
+
+def test_a_sharded_bake_on_terrain_equals_the_local_bake(
+    cluster: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Every shard builds the same heightfield and rocks; the merged take holds them once."""
+    scene = crowd_scene(6, seed=3)
+    positions = np.array([c["position"] for c in scene["creatures"]], dtype=np.float64)
+    scene["terrain"] = rocky(positions, max(creature_reach(c) for c in scene["creatures"]), 3)
+    path = tmp_path / "rocky.json"
+    path.write_text(json.dumps(scene))
+    assert len(shards_of(path)[1]) >= 2
+    assert bake(path, tmp_path / "local.npz") == 0
+    assert bake(path, tmp_path / "ray.npz", "--ray") == 0
+    assert (tmp_path / "ray.npz").read_bytes() == (tmp_path / "local.npz").read_bytes()
+    assert [name for name, _ in Take.load(tmp_path / "ray.npz").ground_meshes()] == [
+        "terrain",
+        "obstacles",
+    ]
 
 
 def test_creatures_of_declared_shards_that_meet_are_baked_again_together(

@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import json
 import os
 import shutil
+import subprocess
 import sys
 from collections.abc import Iterator
 from pathlib import Path
@@ -85,3 +87,19 @@ def gltf_validator() -> tuple[str, Path]:
             " ECS_TENTACLES_GLTF_VALIDATOR"
         )
     return node, package
+
+
+def khronos_report(path: Path, validator: tuple[str, Path]) -> dict[str, Any]:
+    """The Khronos glTF validator's JSON report on `path` (it must run and exit 0)."""
+    node, package = validator
+    tool = Path(__file__).resolve().parents[2] / "tools" / "validate_gltf.cjs"
+    result = subprocess.run(
+        [node, str(tool), str(path), str(package)],
+        capture_output=True,
+        text=True,
+        check=False,
+        timeout=120,
+    )
+    assert result.returncode == 0, result.stdout + result.stderr
+    report: dict[str, Any] = json.loads(result.stdout)
+    return report

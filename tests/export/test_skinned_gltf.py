@@ -3,8 +3,6 @@ joints, keys and inverse bind matrices puts the tubes on the simulated links."""
 
 from __future__ import annotations
 
-import json
-import subprocess
 from pathlib import Path
 from typing import Any
 
@@ -19,6 +17,7 @@ from ecs_tentacles.skin.rig import Keys
 from ecs_tentacles.skin.skeleton import creature_skeleton, joint_world_poses
 from ecs_tentacles.skin.skinning import skin_points, skinning_matrices
 from ecs_tentacles.take import Take
+from tests.export.conftest import khronos_report
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -128,19 +127,10 @@ def test_skinning_the_file_lands_on_the_simulated_links(
 def test_the_khronos_validator_finds_nothing_in_a_skinned_file(
     guided_take: Take, tmp_path: Path, gltf_validator: tuple[str, Path]
 ) -> None:
-    node, package = gltf_validator
     for keys in ("all", "reduced"):
         path = tmp_path / f"{keys}.glb"
         write_skinned_glb(guided_take, path, keys=Keys(keys, 0.5))
-        result = subprocess.run(
-            [node, str(ROOT / "tools" / "validate_gltf.cjs"), str(path), str(package)],
-            capture_output=True,
-            text=True,
-            check=False,
-            timeout=120,
-        )
-        assert result.returncode == 0, result.stdout + result.stderr
-        report = json.loads(result.stdout)
+        report = khronos_report(path, gltf_validator)
         assert report["issues"]["messages"] == []
         assert (report["issues"]["numErrors"], report["issues"]["numWarnings"]) == (0, 0)
         assert report["info"]["animationCount"] == 1 and report["info"]["drawCallCount"] == 1

@@ -1,0 +1,111 @@
+"""The ground of a take (`Take.ground_meshes`: terrain and obstacles) in USD and glTF.
+
+USD: an Xform `/World/terrain` holding a Mesh per ground mesh (`surface`: the
+heightfield, `obstacles`: every obstacle), normals per vertex, a display colour and a
+bound UsdPreviewSurface (`/World/terrain/materials/<mesh>`). glTF: a node `terrain`
+with a child node per mesh (`terrain/surface`, `terrain/obstacles`), each with a mesh
+and a material of the same colour. A take recorded on the plane has neither. If a
+creature is called `terrain`, the ground's root is `terrain_ground` instead.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ecs_tentacles.ground_mesh import COLOURS
+from ecs_tentacles.take import Take
+
+EXPORT_NAMES = {"terrain": "surface", "obstacles": "obstacles"}
+ROUGHNESS = 0.9
+
+
+def root_name(take: Take) -> str:
+    """`terrain`, unless a creature has that name."""
+    names = {creature["name"] for creature in take.header["creatures"]}
+    return "terrain" if "terrain" not in names else "terrain_ground"
+
+
+def write_usd_ground(pxr: Any, stage: Any, take: Take) -> None:
+    """The take's ground meshes under `/World/<root_name>` (nothing on the plane)."""
+    meshes = take.ground_meshes()
+    if not meshes:
+        return
+    import importlib
+
+    importlib.import_module("pxr.UsdShade")
+    Gf, Sdf, UsdGeom, UsdShade, Vt = pxr.Gf, pxr.Sdf, pxr.UsdGeom, pxr.UsdShade, pxr.Vt
+    base = f"/World/{root_name(take)}"
+    UsdGeom.Xform.Define(stage, base)
+    UsdGeom.Scope.Define(stage, f"{base}/materials")
+    for name, mesh in meshes:
+        label = EXPORT_NAMES[name]
+        prim = UsdGeom.Mesh.Define(stage, f"{base}/{label}")
+        prim.CreateSubdivisionSchemeAttr(UsdGeom.Tokens.none)
+        points = np.asarray(mesh.vertices, dtype=np.float32)
+        prim.CreatePointsAttr(Vt.Vec3fArray.FromNumpy(points))
+        counts = np.full(len(mesh.triangles), 3, np.int32)
+        prim.CreateFaceVertexCountsAttr(Vt.IntArray.FromNumpy(counts))
+        indices = np.asarray(mesh.triangles, dtype=np.int32).reshape(-1)
+        prim.CreateFaceVertexIndicesAttr(Vt.IntArray.FromNumpy(indices))
+        prim.CreateNormalsAttr(Vt.Vec3fArray.FromNumpy(np.asarray(mesh.normals, np.float32)))
+        prim.SetNormalsInterpolation(UsdGeom.Tokens.vertex)
+        low, high = points.min(axis=0), points.max(axis=0)
+        prim.CreateExtentAttr([Gf.Vec3f(*low.tolist()), Gf.Vec3f(*high.tolist())])
+        prim.CreateDisplayColorAttr([Gf.Vec3f(*COLOURS[name])])
+        path = f"{base}/materials/{label}"
+        material = UsdShade.Material.Define(stage, path)
+        shader = UsdShade.Shader.Define(stage, f"{path}/surface")
+        shader.CreateIdAttr("UsdPreviewSurface")
+        shader.CreateInput("diffuseColor", Sdf.ValueTypeNames.Color3f).Set(COLOURS[name])
+        shader.CreateInput("roughness", Sdf.ValueTypeNames.Float).Set(ROUGHNESS)
+        shader.CreateInput("metallic", Sdf.ValueTypeNames.Float).Set(0.0)
+        material.CreateSurfaceOutput().ConnectToSource(shader.ConnectableAPI(), "surface")
+        UsdShade.MaterialBindingAPI.Apply(prim.GetPrim()).Bind(material)
+
+
+def add_gltf_ground(
+    take: Take,
+    buffer: Any,
+    nodes: list[dict[str, Any]],
+    meshes: list[dict[str, Any]],
+    materials: list[dict[str, Any]],
+    to_y_up: Any,
+) -> int | None:
+    """Append the ground's node (and its meshes and materials); its index, or None."""
+    found = take.ground_meshes()
+    if not found:
+        return None
+    root = root_name(take)
+    holder = len(nodes)
+    nodes.append({"name": root, "children": []})
+    for name, mesh in found:
+        label = EXPORT_NAMES[name]
+        materials.append(
+            {
+                "name": f"{root}/{label}",
+                "pbrMetallicRoughness": {
+                    "baseColorFactor": [*COLOURS[name], 1.0],
+                    "metallicFactor": 0.0,
+                    "roughnessFactor": ROUGHNESS,
+                },
+            }
+        )
+        positions = to_y_up(np.asarray(mesh.vertices, np.float64)).astype(np.float32)
+        normals = to_y_up(np.asarray(mesh.normals, np.float64)).astype(np.float32)
+        attributes = {
+            "POSITION": buffer.add(positions, "VEC3", 34962),
+            "NORMAL": buffer.add(normals, "VEC3", 34962),
+        }
+        indices = buffer.add(np.asarray(mesh.triangles, np.uint32).reshape(-1), "SCALAR", 34963)
+        primitive = {
+            "attributes": attributes,
+            "indices": indices,
+            "material": len(materials) - 1,
+            "mode": 4,
+        }
+        meshes.append({"name": f"{root}/{label}", "primitives": [primitive]})
+        nodes[holder]["children"].append(len(nodes))
+        nodes.append({"name": f"{root}/{label}", "mesh": len(meshes) - 1})
+    return holder

@@ -1,0 +1,144 @@
+"""The terrain in takes and exports: a take on terrain carries the heightfield and the
+obstacles as meshes, readers refuse a hand-edited one, and the USD and glTF exports
+(rigid and skinned) hold them as static meshes with a material, clean for the checkers."""
+
+from __future__ import annotations
+
+import json
+import zipfile
+from collections.abc import Iterator
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from ecs_tentacles.export.gltf import read_glb, write_glb
+from ecs_tentacles.export.skinned_gltf import write_skinned_glb
+from ecs_tentacles.ground import ground_of
+from ecs_tentacles.ground_mesh import ground_meshes
+from ecs_tentacles.take import Take, write_npz
+from ecs_tentacles.take_read import TakeError
+from tests.export.conftest import khronos_report, record
+from tests.export.test_usd import compliance
+
+ROOT = Path(__file__).resolve().parents[2]
+TERRAIN_SCENE = {
+    "version": 1,
+    "terrain": {
+        "heightfield": {"size": [6, 6], "resolution": 17, "height": 0.3, "noise": {"seed": 2}},
+        "obstacles": [
+            {"shape": "box", "position": [1.8, 0, 0.2], "size": [0.4, 1.0, 0.4]},
+            {"shape": "sphere", "position": [-1.8, 1.0, 0.1], "radius": 0.3},
+        ],
+    },
+    "creatures": [{"name": "octo", "position": [0, 0], "tentacles": {"count": 3, "links": 3}}],
+}
+
+
+@pytest.fixture(scope="module")
+def terrain_take() -> Iterator[Take]:
+    world, system = record(TERRAIN_SCENE, 6)
+    take = system.take()
+    surface, solids = ground_meshes(ground_of(world))
+    assert surface is not None and solids is not None
+    yield take
+    world.close()
+
+
+def test_a_take_on_terrain_holds_its_meshes_and_reads_back(
+    terrain_take: Take, tmp_path: Path
+) -> None:
+    names = [name for name, _ in terrain_take.ground_meshes()]
+    assert names == ["terrain", "obstacles"]
+    terrain_take.save(tmp_path / "t.npz")
+    again = Take.load(tmp_path / "t.npz")
+    for (name, mesh), (_, back) in zip(
+        terrain_take.ground_meshes(), again.ground_meshes(), strict=True
+    ):
+        np.testing.assert_array_equal(mesh.triangles, back.triangles, err_msg=name)
+        np.testing.assert_array_equal(mesh.vertices, back.vertices, err_msg=name)
+    assert again.header["ground"]["meshes"][0] == {
+        "name": "terrain",
+        "vertices": 17 * 17,
+        "triangles": 2 * 16 * 16,
+    }
+
+
+def _rewrite(path: Path, out: Path, change: dict[str, np.ndarray]) -> None:
+    with np.load(path) as data:
+        arrays = {name: data[name] for name in data.files}
+    arrays.update(change)
+    write_npz(out, arrays)
+
+
+def test_a_hand_edited_ground_is_refused_with_one_line(terrain_take: Take, tmp_path: Path) -> None:
+    terrain_take.save(tmp_path / "t.npz")
+    triangles = terrain_take.tracks["ground_obstacles_triangles"].copy()
+    triangles[0, 0] = 10**6
+    _rewrite(tmp_path / "t.npz", tmp_path / "bad.npz", {"ground_obstacles_triangles": triangles})
+    with pytest.raises(TakeError, match=r"ground_obstacles_triangles: index 1000000 past the"):
+        Take.load(tmp_path / "bad.npz")
+    header = dict(terrain_take.header)
+    header["ground"] = {"digest": "x", "meshes": [{"name": "lava", "vertices": 3, "triangles": 1}]}
+    text = json.dumps(header).encode()
+    _rewrite(tmp_path / "t.npz", tmp_path / "lava.npz", {"header": np.frombuffer(text, np.uint8)})
+    with pytest.raises(TakeError, match=r"header.ground.meshes\[0\].name: must be one of"):
+        Take.load(tmp_path / "lava.npz")
+    without = dict(terrain_take.header)
+    without.pop("ground")  # arrays the header no longer declares
+    text = json.dumps(without).encode()
+    _rewrite(tmp_path / "t.npz", tmp_path / "extra.npz", {"header": np.frombuffer(text, np.uint8)})
+    with pytest.raises(TakeError, match=r"unknown entry 'ground_terrain_points.npy'"):
+        Take.load(tmp_path / "extra.npz")
+    with zipfile.ZipFile(tmp_path / "t.npz") as archive:
+        assert "ground_terrain_points.npy" in archive.namelist()
+
+
+def test_the_plane_writes_no_ground(tmp_path: Path) -> None:
+    scene = {**TERRAIN_SCENE, "terrain": {}}
+    world, system = record(scene, 2)
+    take = system.take()
+    world.close()
+    assert "ground" not in take.header and take.ground_meshes() == []
+
+
+@pytest.mark.parametrize("skinned", [False, True], ids=["rigid", "skinned"])
+def test_usd_holds_the_terrain_as_meshes_with_materials(
+    terrain_take: Take, tmp_path: Path, skinned: bool
+) -> None:
+    pytest.importorskip("pxr", reason="USD export needs usd-core")
+    from pxr import Usd, UsdGeom, UsdShade
+
+    from ecs_tentacles.export.skinned_usd import write_skinned_usd
+    from ecs_tentacles.export.usd import write_usd
+
+    path = tmp_path / "take.usda"
+    (write_skinned_usd if skinned else write_usd)(terrain_take, path)
+    assert compliance(path) == {"errors": [], "failed": [], "warnings": []}
+    stage = Usd.Stage.Open(str(path))
+    for label, name in (("surface", "terrain"), ("obstacles", "obstacles")):
+        prim = stage.GetPrimAtPath(f"/World/terrain/{label}")
+        mesh = dict(terrain_take.ground_meshes())[name]
+        assert prim.IsA(UsdGeom.Mesh)
+        assert len(UsdGeom.Mesh(prim).GetFaceVertexCountsAttr().Get()) == len(mesh.triangles)
+        bound = UsdShade.MaterialBindingAPI(prim).ComputeBoundMaterial()[0]
+        assert bound.GetPath() == f"/World/terrain/materials/{label}"
+
+
+@pytest.mark.parametrize("skinned", [False, True], ids=["rigid", "skinned"])
+def test_gltf_holds_the_terrain_node_and_validates(
+    terrain_take: Take, tmp_path: Path, skinned: bool, gltf_validator: tuple[str, Path]
+) -> None:
+    path = tmp_path / "take.glb"
+    if skinned:
+        write_skinned_glb(terrain_take, path)
+    else:
+        write_glb(terrain_take, path)
+    document, _ = read_glb(path.read_bytes())
+    nodes = {node["name"]: node for node in document["nodes"]}
+    assert {"terrain", "terrain/surface", "terrain/obstacles"} <= set(nodes)
+    surface = document["meshes"][nodes["terrain/surface"]["mesh"]]["primitives"][0]
+    indices = document["accessors"][surface["indices"]]
+    assert indices["count"] == 3 * 2 * 16 * 16 and indices["componentType"] == 5125
+    report = khronos_report(path, gltf_validator)
+    assert (report["issues"]["numErrors"], report["issues"]["numWarnings"]) == (0, 0)
