@@ -216,6 +216,14 @@ class World:
                     return obj
         return found
 
+    def replace_resource(self, obj: object) -> None:
+        """Put `obj` in place of the resource of its type a plugin provided (the terrain's
+        editor swaps the `Ground` this way); KeyError if there is none to replace."""
+        kind = type(obj)
+        if kind not in self._resources:
+            raise KeyError(f"this world has no {kind.__name__} to replace")
+        self._resources[kind] = obj
+
     def has_resource(self, kind: type) -> bool:
         """Whether a plugin that is on provides a resource of type `kind`."""
         return self.get_resource(kind) is not None

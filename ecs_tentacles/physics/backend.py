@@ -126,6 +126,21 @@ class PhysicsBackend:
         )
         self._pool = ThreadPoolExecutor(self.threads) if self.threads > 1 else None
 
+    def rebuild_models(self, world: PhysicsHost) -> None:
+        """Compile every morphology's model again (the static ground changed: terrain
+        edits), keeping every creature's state: no creature moves, nothing is rebuilt but
+        the models and the stepping threads' copies of them."""
+        reduced_dt = world.settings.dt / reduced_substeps(world.settings.substeps)
+        for batch in self.batches:
+            entity = int(self.creature_entity[batch.members[0]])
+            creature = world.component(entity, Creature)
+
+            def compile_reduced(creature: Creature = creature) -> mujoco.MjModel:
+                return build_spec(world, creature, timestep=reduced_dt).compile()
+
+            batch.swap_model(build_spec(world, creature).compile(), compile_reduced)
+            batch.prepare(FULL, self.threads)
+
     def __len__(self) -> int:
         return len(self.creature_entity)
 

@@ -157,6 +157,22 @@ class Batch:
         return view
 
     # -- building ------------------------------------------------------------------
+    def swap_model(
+        self, model: mujoco.MjModel, reduced: Callable[[], mujoco.MjModel] | None
+    ) -> None:
+        """Step with `model` from now on: the same creature on other static ground (its
+        state vector has the same layout; only the ids of the geoms after the ground's
+        may move). The scratch copies are made again on the next `prepare`."""
+        if mujoco.mj_stateSize(model, STATE) != self.state.shape[1]:
+            raise ValueError("the new model's state differs: not the same creature")
+        obj = mujoco.mjtObj
+        proxies = [mujoco.mj_id2name(self.model, obj.mjOBJ_GEOM, int(g)) for g in self.proxy_geoms]
+        self.proxy_geoms = _ids(model, obj.mjOBJ_GEOM, proxies)
+        self.model = model
+        self.models = {FULL: model}
+        self._compile_reduced = reduced
+        self.scratch = {}
+
     def prepare(self, tier: int, threads: int) -> None:
         """Make `tier`'s model (compiled once) and a scratch for each of `threads`.
 

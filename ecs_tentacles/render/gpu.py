@@ -98,6 +98,12 @@ class InstancedMesh:
             self.capacity,
         )
 
+    def delete(self) -> None:
+        """Free its GL buffers and vertex array (a mesh that is replaced: an edited terrain)."""
+        buffers = (gl.GLuint * 3)(self.vertices, self.indices, self.instances)
+        gl.glDeleteBuffers(3, buffers)
+        gl.glDeleteVertexArrays(1, ctypes.byref(gl.GLuint(self.vao)))
+
     def draw(self) -> int:
         """Draw every instance (zero instances still make the one call); returns 1."""
         gl.glBindVertexArray(self.vao)

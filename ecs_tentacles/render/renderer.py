@@ -28,7 +28,7 @@ from pyglet import gl
 from ecs_tentacles.components import Creature, Link, Tentacle, Transform
 from ecs_tentacles.drawing import CIRCLE, RenderView, line_segments
 from ecs_tentacles.ground import ground_of
-from ecs_tentacles.ground_mesh import ground_meshes
+from ecs_tentacles.ground_mesh import COLOURS, ground_meshes
 from ecs_tentacles.render import shaders
 from ecs_tentacles.render.camera import OrbitCamera
 from ecs_tentacles.render.gpu import (
@@ -45,8 +45,6 @@ from ecs_tentacles.render.skinned import SkinnedCreatures
 from ecs_tentacles.world import World
 
 SKY = (0.70, 0.76, 0.82)
-TERRAIN_RGB = (0.62, 0.56, 0.44)  # sand and earth
-ROCK_RGB = (0.50, 0.50, 0.52)
 LIGHT = np.array([0.35, -0.45, 0.82]) / np.linalg.norm([0.35, -0.45, 0.82])
 LOD_DISTANCE = 6.0  # metres from the eye beyond which links use the lean mesh
 VIEWS = ("skinned", "capsules")
@@ -76,7 +74,7 @@ class Renderer:
         self.line_program = program(shaders.LINE_VERTEX, shaders.LINE_FRAGMENT)
         self.terrain_program = program(shaders.INSTANCED_VERTEX, shaders.TERRAIN_FRAGMENT)
         self.ground_meshes: list[InstancedMesh] = []  # the terrain and obstacles, if any
-        self.ground_key = "plane"
+        self.ground_drawn: object = None  # the Ground they were made from
         self.skinned_program = program(shaders.SKINNED_VERTEX, shaders.LIT_FRAGMENT)
         self.skinned = SkinnedCreatures()
         self.view = "skinned"
@@ -143,16 +141,20 @@ class Renderer:
         self.link_skinned = self.mantle_skinned[np.array(link_creature, dtype=np.int64)]
 
     def _build_ground(self) -> None:
-        """The ground's meshes (terrain, obstacles) as two one-instance meshes; rebuilt
-        only when the ground changed."""
+        """The ground's meshes (terrain, obstacles) as two one-instance meshes; made again
+        only when the world has another ground (a new world, a terrain edit)."""
         ground = ground_of(self.world)
-        key = ground.digest()
-        if key == self.ground_key:
+        if ground is self.ground_drawn:
             return
-        self.ground_key = key
+        self.ground_drawn = ground
+        for old in self.ground_meshes:
+            old.delete()
         self.ground_meshes = []
         terrain, solids = ground_meshes(ground)
-        for mesh, colour, grid in ((terrain, TERRAIN_RGB, 1.0), (solids, ROCK_RGB, 0.0)):
+        for mesh, colour, grid in (
+            (terrain, COLOURS["terrain"], 1.0),
+            (solids, COLOURS["obstacles"], 0.0),
+        ):
             if mesh is None:
                 continue
             template = Mesh(
@@ -267,6 +269,7 @@ class Renderer:
         view_projection = self.camera.view_projection()
         eye = tuple(self.camera.eye.astype(np.float32))
         calls = 0
+        self._build_ground()  # nothing to do unless the terrain was edited
         if ground_of(self.world).heightfield is None:  # the plane's grid
             self.ground_program.use()
             set_matrix(self.ground_program, "u_view_projection", view_projection)

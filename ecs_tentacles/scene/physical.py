@@ -93,7 +93,8 @@ def physical_problems(scene: dict[str, Any]) -> list[str]:
             i, creature, layout, weights
         )
         problems += _servo_problems(i, creature, layout, _step(physics))
-        problems += _below_ground(i, layout)
+        if not (scene.get("terrain") or {}).get("heightfield"):  # terrain checks its own
+            problems += _below_ground(i, layout)
         bodies.append(Bodies(*layout.capsules()))
     if not problems:
         problems += _overlap_problems(scene, bodies)

@@ -1,11 +1,13 @@
 """The terrain plugin: scene key `terrain` -> the world's `Ground` (heightfield, obstacles).
 
-Scene key: `terrain` (`ecs_tentacles/terrain/terrain.schema.json`). Resource: the core
+Scene key: `terrain` (`ecs_tentacles/terrain/terrain.schema.json`). Resources: the core
 `ecs_tentacles.ground.Ground` (`ground_of(world)`), which every physics model, the
-creatures' placement and the suckers read; without a `terrain` key it is the plane z = 0
-and nothing changes. Checks: one heightfield source, each obstacle's keys, files next
-to the scene; at build, no creature or goal inside an obstacle (with
-`physics.separate_overlaps` a creature is moved out instead, and says so).
+creatures' placement and the suckers read (without a `terrain` key it is the plane
+z = 0 and nothing changes), and the `TerrainEditor` (`ecs_tentacles.terrain.editing`).
+Sandbox: the "Terrain" HUD section (`ecs_tentacles.terrain.panel`).
+Checks: one heightfield source, each obstacle's keys, files next to the scene; at
+build, no creature inside an obstacle, and none given a 3-d position inside the
+heightfield (goals rest on the topmost surface, so they are never inside).
 """
 
 from __future__ import annotations
@@ -16,18 +18,21 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ecs_tentacles.construction import creature_layout
-from ecs_tentacles.ground import FLAT, Ground, ground_of
+from ecs_tentacles.ground import ground_of
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.schema import fragment
-from ecs_tentacles.scene.validate import format_path
-from ecs_tentacles.terrain.heights import TerrainError, heightfield, source_problems
-from ecs_tentacles.terrain.solids import obstacle_problems, solids
+from ecs_tentacles.terrain.editing import TerrainEditor
+from ecs_tentacles.terrain.heights import source_problems
+from ecs_tentacles.terrain.scene_ground import build_ground
+from ecs_tentacles.terrain.solids import obstacle_problems
 
 if TYPE_CHECKING:
+    from ecs_tentacles.drawing import Panel
     from ecs_tentacles.host import Host
 
 _FRAGMENT = fragment("ecs_tentacles.terrain", "terrain")
+SINK_TOLERANCE = 0.001  # metres a 3-d placed creature may start inside the heightfield
 
 
 class TerrainPlugin(Plugin):
@@ -44,39 +49,41 @@ class TerrainPlugin(Plugin):
         return found + obstacle_problems(terrain.get("obstacles", []))
 
     def resources(self, world: Host) -> list[object]:
-        return [build_ground((world.scene or {}).get("terrain") or {}, world.scene_dir)]
+        ground = build_ground((world.scene or {}).get("terrain") or {}, world.scene_dir)
+        return [ground, TerrainEditor()]
+
+    def sandbox_panels(self, sandbox: Any) -> list[Panel]:
+        from ecs_tentacles.terrain.panel import TerrainPanel
+
+        return [TerrainPanel(sandbox)]
 
     def build_scene(self, world: Host, scene: Mapping[str, Any]) -> None:
         ground = ground_of(world)
-        if not ground.solids:
+        if ground.flat:
             return
         problems = []
         for i, creature in enumerate(scene["creatures"]):
             starts, ends, radii = creature_layout(creature, ground).capsules()
             points = np.concatenate([starts, ends, 0.5 * (starts + ends)])
-            hit = ground.inside_solid(points, np.concatenate([radii, radii, radii]))
+            balls = np.concatenate([radii, radii, radii])
+            where = f"creatures[{i}].position: {creature['name']}"
+            hit = ground.inside_solid(points, balls)
             if (hit >= 0).any():
                 problems.append(
-                    f"creatures[{i}].position: {creature['name']} is inside"
-                    f" terrain.obstacles[{int(hit[hit >= 0][0])}]; move it or the obstacle"
+                    f"{where} is inside terrain.obstacles[{int(hit[hit >= 0][0])}];"
+                    " move it or the obstacle"
                 )
+            elif len(creature["position"]) == 3 and ground.heightfield is not None:
+                # a 2-d position is placed on the surface; a 3-d one must be above it (the
+                # links' balls, and the mantle's flat base: not its capsule's round end)
+                links = np.concatenate([starts[1:], ends[1:], 0.5 * (starts + ends)[1:]])
+                low = np.concatenate([links[:, 2] - np.tile(radii[1:], 3), [starts[0, 2]]])
+                xy = np.concatenate([links[:, :2], starts[:1, :2]])
+                sunk = float(np.max(ground.height(xy) - low))
+                if sunk > SINK_TOLERANCE:
+                    problems.append(
+                        f"{where} starts {1e3 * sunk:.0f} mm inside the terrain; raise its z"
+                        " or give [x, y] to rest it on the surface"
+                    )
         if problems:
             raise SceneError(problems)
-
-
-def build_ground(terrain: Mapping[str, Any], folder: Any) -> Ground:
-    """The `Ground` a scene's `terrain` describes (FLAT for `{}`); SceneError names the
-    field when a file is missing or bad."""
-    if (
-        not terrain.get("heightfield")
-        and not terrain.get("obstacles")
-        and "friction" not in terrain
-    ):
-        return FLAT
-    try:
-        field = heightfield(terrain["heightfield"], folder) if terrain.get("heightfield") else None
-        shapes = solids(terrain.get("obstacles", []), folder)
-    except TerrainError as error:
-        raise SceneError([f"{format_path(error.path)}: {error}"]) from None
-    friction = terrain.get("friction")
-    return Ground(field, shapes, None if friction is None else float(friction))

@@ -60,3 +60,43 @@ def _hill_height(sandbox: Any, x: float, y: float) -> float:
     from ecs_tentacles.ground import ground_of
 
     return float(ground_of(sandbox.world).height(np.array([[x, y]]))[0])
+
+
+def test_the_terrain_section_places_moves_and_deletes_with_the_mouse(
+    make_sandbox: Callable[..., Any],
+) -> None:
+    from ecs_tentacles.terrain.panel import TerrainPanel
+
+    sandbox = make_sandbox(
+        {"version": 1, "terrain": {"heightfield": HILLS}, "creatures": [{"name": "octo"}]}
+    )
+    sandbox.hud.visible = False
+    assert sandbox.renderer.draw() == 7  # the terrain in place of the grid, no obstacles
+    panel = next(p for p in sandbox.hud.panels if isinstance(p, TerrainPanel))
+    camera = sandbox.renderer.camera
+    spot = np.array([[1.5, -1.2, _hill_height(sandbox, 1.5, -1.2)]])
+    px, py = (round(v) for v in camera.project(spot)[0])
+
+    panel.tool = "box"
+    event(sandbox, "on_mouse_press", px, py, mouse.LEFT, 0)
+    event(sandbox, "on_mouse_release", px, py, mouse.LEFT, 0)
+    (box,) = sandbox.world.scene["terrain"]["obstacles"]
+    assert np.linalg.norm(np.array(box["position"][:2]) - spot[0, :2]) < 0.05
+    assert sandbox.renderer.draw() == 8  # and the obstacles
+    assert panel.message == "placed"
+
+    panel.tool = "delete"
+    top = np.array([[1.5, -1.2, box["position"][2] + box["size"][2] / 2]])
+    tx, ty = (round(v) for v in camera.project(top)[0])
+    event(sandbox, "on_mouse_press", tx, ty, mouse.LEFT, 0)
+    event(sandbox, "on_mouse_release", tx, ty, mouse.LEFT, 0)
+    assert sandbox.world.scene["terrain"]["obstacles"] == []
+    assert sandbox.renderer.draw() == 7
+
+    panel.tool = "raise"
+    before = _hill_height(sandbox, 1.5, -1.2)
+    event(sandbox, "on_mouse_press", px, py, mouse.LEFT, 0)
+    event(sandbox, "on_mouse_release", px, py, mouse.LEFT, 0)
+    assert _hill_height(sandbox, 1.5, -1.2) > before + 0.5 * panel.strength
+    sandbox.step(5)  # the world goes on
+    assert sandbox.world.physics.health.recoveries == 0

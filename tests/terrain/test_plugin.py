@@ -234,3 +234,16 @@ def test_crowd_on_rocky_terrain_is_a_valid_scene(tmp_path: pathlib.Path) -> None
     data = json.loads(out.read_text())
     assert data["terrain"]["heightfield"]["noise"]["seed"] == 0
     assert main(["run", str(out), "--frames", "30", "--strict", "--quiet"]) == 0
+
+
+def test_a_3d_position_is_checked_against_the_terrain_not_z_0(
+    make_world: Callable[..., World],
+) -> None:
+    sunk = {"heightfield": {"size": [4, 4], "heights": [[0.5] * 3] * 3}}
+    with pytest.raises(
+        SceneError, match=r"creatures\[0\].position: c0 starts \d+ mm inside the terrain"
+    ):
+        World.from_scene(scene(sunk, [0, 0, 0.3]))
+    low = {"heightfield": {"size": [4, 4], "heights": [[-0.5] * 3] * 3}}
+    world = make_world(scene(low, [0, 0, -0.45]))  # below z = 0, above the ground there
+    assert world.transforms.pos[world.creatures.mantle_row[0], 2] < 0.0
