@@ -180,6 +180,7 @@ class Navigator:
         self.since = np.zeros(0)  # when `best` last improved
         self.grid: CostGrid | None = None
         self._ground: Ground | None = None
+        self.plans = 0  # routes planned so far (first plans and re-plans)
 
     def state(self) -> Any:
         """What a snapshot keeps (the grid is remade from the ground)."""
@@ -251,6 +252,7 @@ class Navigator:
         if self.grid is None or self.grid.clear_line(mantle[:2], g.goal[row, :2]):
             return  # the goal is in plain sight
         route = self.grid.route(mantle[:2], g.goal[row, :2])
+        self.plans += 1
         if route is None or len(route) < 2:
             return  # nowhere to go around: straight at the goal, as without navigation
         assert self._ground is not None

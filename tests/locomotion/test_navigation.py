@@ -11,7 +11,7 @@ import pytest
 
 from ecs_tentacles.drawing import RenderView
 from ecs_tentacles.ground import Ground, Solid
-from ecs_tentacles.locomotion.navigation import CostGrid, Navigator
+from ecs_tentacles.locomotion.navigation import STUCK_SECONDS, CostGrid, Navigator
 from ecs_tentacles.locomotion.render import path_lines
 from ecs_tentacles.world import World
 
@@ -80,3 +80,15 @@ def test_routes_go_around_and_none_when_walled_in() -> None:
     assert inside is not None
     assert inside.route(np.array([0.0, 0.0]), np.array([5.0, 5.0])) is None
     assert CostGrid.of(Ground(), 0.5, np.zeros((1, 2))) is None  # nothing to steer around
+
+
+def test_a_creature_stuck_on_its_way_is_planned_again(make_world: Callable[..., World]) -> None:
+    world = make_world(behind_the_wall(True))
+    world.step()
+    navigator = world.resource(Navigator)
+    assert navigator.plans == 1 and len(navigator.waypoints(0))
+    world.physics.frozen[:] = True  # held in place: no progress toward the waypoint
+    while world.time < 1.0 + STUCK_SECONDS:
+        world.step()
+    assert navigator.plans == 2  # once, not every frame
+    world.physics.frozen[:] = False

@@ -66,11 +66,16 @@ def test_proxies_stand_where_the_other_creatures_bodies_are(
     assert (a.data.mocap_pos[parked, 2] < -1000).all()  # the rest wait out of reach
 
 
+HILLS = {"heightfield": {"size": [8, 4], "resolution": 41, "height": 0.3, "noise": {"seed": 7}}}
+
+
+@pytest.mark.parametrize("terrain", [{}, HILLS], ids=["plane", "rough ground"])
 def test_two_creatures_driven_head_on_never_interpenetrate(
-    make_world: Callable[..., World],
+    make_world: Callable[..., World], terrain: dict[str, Any]
 ) -> None:
     scene = {
         "version": 1,
+        "terrain": terrain,
         "creatures": [
             {"name": "a", "position": [-1.2, 0.0], "goals": [{"position": [2.4, 0.0]}]},
             {
