@@ -29,6 +29,7 @@ if TYPE_CHECKING:
 
 SHAPES = ("box", "cylinder", "sphere", "mesh")
 NORMAL_PROBE = 0.005  # metres above a surface point where its normal is measured
+BEYOND_DROP = 0.002  # metres the plane past a heightfield's edge lies under its lowest point
 
 
 @dataclass(frozen=True)
@@ -46,9 +47,10 @@ class Heightfield:
         return self.size[0] / (cols - 1), self.size[1] / (rows - 1)
 
     def height(self, xy: np.ndarray) -> np.ndarray:
-        """Heights under points `xy` (n, 2), as MuJoCo's triangles give them; the edge
-        height past the border."""
+        """Heights under points `xy` (n, 2), as MuJoCo's triangles give them; past the
+        border, the plane at the lowest height that catches what leaves the field."""
         rows, cols = self.heights.shape
+        outside = (np.abs(xy[:, 0]) > 0.5 * self.size[0]) | (np.abs(xy[:, 1]) > 0.5 * self.size[1])
         u = np.clip((xy[:, 0] / self.size[0] + 0.5) * (cols - 1), 0.0, cols - 1.0)
         v = np.clip((xy[:, 1] / self.size[1] + 0.5) * (rows - 1), 0.0, rows - 1.0)
         i = np.minimum(v.astype(np.int64), rows - 2)
@@ -60,7 +62,7 @@ class Heightfield:
         lower = fu >= fv  # below the diagonal: (i, j), (i, j + 1), (i + 1, j + 1)
         below = h00 + fu * (h01 - h00) + fv * (h11 - h01)
         above = h00 + fv * (h10 - h00) + fu * (h11 - h10)
-        return np.where(lower, below, above)
+        return np.where(outside, self.heights.min(), np.where(lower, below, above))
 
     def slope_normal(self, xy: np.ndarray) -> np.ndarray:
         """Unit surface normals (n, 3) under `xy` (n, 2), from the heights' gradient."""
@@ -319,6 +321,15 @@ class Ground:
                 type=mujoco.mjtGeom.mjGEOM_HFIELD,
                 hfieldname="ground",
                 pos=[0.0, 0.0, low],
+                **common,
+            )
+            # past the field's edge the world goes on as a plane at its lowest height (a
+            # creature that crawls off the edge drops onto it instead of falling forever)
+            body.add_geom(
+                name="ground/beyond",
+                type=mujoco.mjtGeom.mjGEOM_PLANE,
+                size=[0, 0, 1.0],
+                pos=[0.0, 0.0, low - BEYOND_DROP],
                 **common,
             )
         for k, solid in enumerate(self.solids):

@@ -247,3 +247,19 @@ def test_a_3d_position_is_checked_against_the_terrain_not_z_0(
     low = {"heightfield": {"size": [4, 4], "heights": [[-0.5] * 3] * 3}}
     world = make_world(scene(low, [0, 0, -0.45]))  # below z = 0, above the ground there
     assert world.transforms.pos[world.creatures.mantle_row[0], 2] < 0.0
+
+
+def test_past_the_heightfields_edge_the_ground_goes_on_at_its_lowest_height(
+    make_world: Callable[..., World],
+) -> None:
+    rows = [[0.2 + 0.01 * (r % 2)] * 7 for r in range(7)]  # 0.2-0.21 m up, 3 m across
+    world = make_world(
+        scene({"heightfield": {"size": [3, 3], "heights": rows}}, [0.4, 0], goal=[3.5, 0])
+    )
+    ground = ground_of(world)
+    assert ground.height(np.array([[5.0, 0.0]]))[0] == pytest.approx(0.2)
+    while world.time < 30.0:
+        world.step()
+    mantle = world.transforms.pos[world.creatures.mantle_row[0]]
+    assert mantle[0] > 1.8  # it crawled off the edge
+    assert mantle[2] > 0.2  # onto the plane beyond, not down forever
