@@ -28,7 +28,8 @@ if TYPE_CHECKING:
     from collections.abc import Sequence
 
 SHAPES = ("box", "cylinder", "sphere", "mesh")
-NORMAL_PROBE = 0.005  # metres above a surface point where its normal is measured
+NORMAL_SPAN = 0.05  # metres either side over which the slope under a point is measured
+NEAR = 0.5  # metres past a solid's bounding sphere within which distances to it are exact
 BEYOND_DROP = 0.002  # metres the plane past a heightfield's edge lies under its lowest point
 
 
@@ -94,6 +95,43 @@ class Solid:
             return float(max(np.linalg.norm(p, axis=1).max() for p in self.pieces))
         return float(np.linalg.norm(self.size)) if self.kind != "sphere" else self.size[0]
 
+    def top(self, xy: np.ndarray) -> np.ndarray:
+        """(n,) the height of this solid's top above points `xy` (n, 2), -inf where it is
+        not above them (a vertical line through the point misses it). Exact for boxes,
+        spheres and convex pieces; cylinders as 48-sided prisms (under 0.3% of the radius)."""
+        if self.kind == "sphere":
+            d2 = np.sum((xy - self.position[:2]) ** 2, axis=1)
+            r2 = self.size[0] ** 2
+            return np.where(d2 <= r2, self.position[2] + np.sqrt(np.maximum(r2 - d2, 0.0)), -np.inf)
+        out = np.full(len(xy), -np.inf)
+        for planes in self._world_planes():
+            normal, offset = planes[:, :3], planes[:, 3]
+            rest = offset[None, :] - xy @ normal[:, :2].T  # n_z z <= rest, per plane
+            up, down = normal[:, 2] > 1e-12, normal[:, 2] < -1e-12
+            side = ~(up | down)
+            high = np.min(rest[:, up] / normal[up, 2], axis=1) if up.any() else np.inf
+            low = np.max(rest[:, down] / normal[down, 2], axis=1) if down.any() else -np.inf
+            inside = np.all(rest[:, side] >= -1e-12, axis=1) if side.any() else True
+            out = np.maximum(out, np.where(inside & (high >= low), high, -np.inf))
+        return out
+
+    def _world_planes(self) -> list[np.ndarray]:
+        """Each convex part as world-frame planes (k, 4): outward normal, offset (made once)."""
+        cached = self.__dict__.get("_planes_world")
+        if cached is None:
+            if self.kind == "box":
+                local = [_box_planes(np.asarray(self.size))]
+            elif self.kind == "cylinder":
+                local = [_prism_planes(self.size[0], self.size[1])]
+            else:
+                local = list(self.planes)
+            cached = []
+            for p in local:
+                normal = p[:, :3] @ self.rotation.T
+                cached.append(np.column_stack([normal, p[:, 3] + normal @ self.position]))
+            object.__setattr__(self, "_planes_world", cached)  # a cache, not a field
+        return cached
+
     def signed_distance(self, points: np.ndarray) -> np.ndarray:
         """Metres from points (n, 3) to the surface, negative inside."""
         local = (points - self.position) @ self.rotation
@@ -106,6 +144,21 @@ class Solid:
             return _box_distance(flat, np.asarray(self.size))
         # convex pieces: the largest plane distance (exact inside, a lower bound outside)
         return np.min([np.max(local @ p[:, :3].T - p[:, 3], axis=1) for p in self.planes], axis=0)
+
+
+def _box_planes(half: np.ndarray) -> np.ndarray:
+    normals = np.vstack([np.eye(3), -np.eye(3)])
+    return np.column_stack([normals, np.concatenate([half, half])])
+
+
+def _prism_planes(radius: float, half: float, sides: int = 48) -> np.ndarray:
+    """A cylinder along z as a `sides`-gon prism whose faces touch the circle."""
+    angle = 2.0 * np.pi * np.arange(sides) / sides
+    around = np.column_stack(
+        [np.cos(angle), np.sin(angle), np.zeros(sides), np.full(sides, radius)]
+    )
+    caps = np.array([[0.0, 0.0, 1.0, half], [0.0, 0.0, -1.0, half]])
+    return np.vstack([around, caps])
 
 
 def _box_distance(local: np.ndarray, half: np.ndarray) -> np.ndarray:
@@ -174,26 +227,57 @@ class Ground:
         """Metres from points (n, 3) to the nearest static surface (negative: inside).
 
         The heightfield's part is the height above it times the normal's z (exact on a
-        plane, close on gentle slopes); solids give their signed distance.
+        plane, close on gentle slopes); solids give their signed distance to points within
+        `NEAR` m of their bounding sphere (exact there; farther points may get a larger
+        value: every use asks about points at or near a surface).
         """
         points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
         if self.heightfield is None:
             best = points[:, 2].copy()
         else:
             xy = points[:, :2]
-            best = (points[:, 2] - self.heightfield.height(xy)) * self.heightfield.slope_normal(xy)[
-                :, 2
-            ]
-        for solid in self.solids:
-            best = np.minimum(best, solid.signed_distance(points))
+            normal_z = self.heightfield.slope_normal(xy)[:, 2]
+            best = (points[:, 2] - self.heightfield.height(xy)) * normal_z
+        if not self.solids:
+            return best
+        bounds = self._bounds()[1]
+        for k, solid in enumerate(self.solids):
+            near = np.flatnonzero(
+                np.sum((points - solid.position) ** 2, axis=1) <= (bounds[k] + NEAR) ** 2
+            )
+            if len(near):
+                best[near] = np.minimum(best[near], solid.signed_distance(points[near]))
         return best
 
-    def inside_solid(self, points: np.ndarray, radii: np.ndarray | float = 0.0) -> np.ndarray:
-        """(n,) index of the first solid each ball (`points` (n, 3), `radii`) reaches into,
-        -1 for none."""
+    def _bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """(k, 2) solid centres in x, y and (k,) bounding radii (made once)."""
+        cached = self.__dict__.get("_bounds_cache")
+        if cached is None:
+            centres = np.array([s.position[:2] for s in self.solids]).reshape(-1, 2)
+            cached = (centres, np.array([s.bound for s in self.solids]))
+            object.__setattr__(self, "_bounds_cache", cached)  # a cache, not a field
+        return cached
+
+    def solids_near(self, xy: np.ndarray, radius: float) -> np.ndarray:
+        """Indices of the solids that may come within `radius` m of point `xy` (x, y):
+        their bounding spheres do (a cull before exact tests; a crowd of thousands among
+        hundreds of rocks tests each creature against a few)."""
+        centres, bounds = self._bounds()
+        distance = np.linalg.norm(centres - np.asarray(xy, dtype=np.float64)[:2], axis=1)
+        return np.flatnonzero(distance <= bounds + radius)
+
+    def inside_solid(
+        self,
+        points: np.ndarray,
+        radii: np.ndarray | float = 0.0,
+        only: np.ndarray | None = None,
+    ) -> np.ndarray:
+        """(n,) index of the first solid (of `only`, default all) each ball (`points`
+        (n, 3), `radii`) reaches into, -1 for none."""
         points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
         which = np.full(len(points), -1, dtype=np.int64)
-        for k, solid in enumerate(self.solids):
+        for k in range(len(self.solids)) if only is None else only.tolist():
+            solid = self.solids[k]
             hit = (which < 0) & (solid.signed_distance(points) < radii)
             which[hit] = k
         return which
@@ -221,8 +305,12 @@ class Ground:
             return np.tile([0.0, 0.0, 1.0], (len(xy), 1))
         if not self.solids and self.heightfield is not None:
             return self.heightfield.slope_normal(xy)
-        points = np.column_stack([xy, self.surface(xy) + NORMAL_PROBE])
-        return self.normal(points)
+        # the topmost surface's slope, over NORMAL_SPAN either way
+        ex, ey = np.array([NORMAL_SPAN, 0.0]), np.array([0.0, NORMAL_SPAN])
+        gx = (self.surface(xy + ex) - self.surface(xy - ex)) / (2 * NORMAL_SPAN)
+        gy = (self.surface(xy + ey) - self.surface(xy - ey)) / (2 * NORMAL_SPAN)
+        n = np.stack([-gx, -gy, np.ones_like(gx)], axis=1)
+        return n / np.linalg.norm(n, axis=1, keepdims=True)
 
     def ray(self, origin: np.ndarray, direction: np.ndarray) -> np.ndarray | None:
         """Where the ray from `origin` along `direction` first meets the ground or a solid
@@ -245,22 +333,15 @@ class Ground:
     def surface(self, xy: np.ndarray) -> np.ndarray:
         """(n,) the height of the topmost surface (ground or solid) under points `xy` (n, 2)."""
         xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
-        if not self.solids:
-            return self.height(xy)
-        top = self._top()
         out = self.height(xy)
-        for i, (x, y) in enumerate(xy):
-            hit = self.ray(np.array([x, y, top]), np.array([0.0, 0.0, -1.0]))
-            if hit is not None:
-                out[i] = max(out[i], hit[2])
+        if not self.solids:
+            return out
+        centres, bounds = self._bounds()
+        for k, solid in enumerate(self.solids):  # only the points under its bounding circle
+            rows = np.flatnonzero(np.sum((xy - centres[k]) ** 2, axis=1) <= bounds[k] ** 2)
+            if len(rows):
+                out[rows] = np.maximum(out[rows], solid.top(xy[rows]))
         return out
-
-    def _top(self) -> float:
-        """A height above everything."""
-        high = 0.0 if self.heightfield is None else float(self.heightfield.heights.max())
-        for solid in self.solids:
-            high = max(high, float(solid.position[2]) + solid.bound)
-        return high + 1.0
 
     def _static(self) -> tuple[mujoco.MjModel, mujoco.MjData]:
         """A model of the ground alone (made once), for ray casts."""

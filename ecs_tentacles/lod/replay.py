@@ -8,6 +8,10 @@ clip one frame on, and its body poses are written into its batch's pose rows, wh
 `physics_sync` copies into the Transform store like any other. A creature that starts
 replaying (`start`) keeps where it stands and which way it faces; promoted again, it
 starts the physics from the joint state of the pose it was shown in (`joint_state`).
+On terrain the clips (recorded on the plane) are draped over the heightfield: each body
+is raised by the ground's height under it, so the tips stay on the ground; promoted, a
+creature starts from the clip's pose raised until it rests on the highest ground under
+it (the relief under it is the most a body can jump then).
 
 Everything per frame is whole-array work per morphology; the clips are recorded once
 per morphology (`ClipCache`) the first time one of its creatures is kinematic.
@@ -21,6 +25,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ecs_tentacles.ground import ground_of
 from ecs_tentacles.lod.cache import ClipCache
 from ecs_tentacles.lod.clips import CRAWL, IDLE, GaitClips, mantle_yaw
 from ecs_tentacles.physics.tiers import KINEMATIC
@@ -109,11 +114,18 @@ class ClipReplay:
 
     def joint_state(self, index: int) -> tuple[np.ndarray, np.ndarray]:
         """qpos and qvel of the pose creature `index` is shown in."""
-        batch, _ = self.roster.locate(index)
+        batch, row = self.roster.locate(index)
         clips = self.clips[batch.index]
-        return clips.joint_state_at(
+        qpos, qvel = clips.joint_state_at(
             int(self.kind[index]), float(self.phase[index]), self.xy[index], self.heading[index]
         )
+        ground = ground_of(self.world)
+        if ground.heightfield is not None:  # the clip's flat pose, raised onto the terrain
+            shown = batch.xpos[row]
+            lift = float(np.max(ground.height(shown[:, :2])))
+            qpos = qpos.copy()
+            qpos[batch.root_qpos + 2] += lift
+        return qpos, qvel
 
     # -- per frame -----------------------------------------------------------------------
     def advance(self, world: Host, dt: float) -> None:
@@ -122,6 +134,7 @@ class ClipReplay:
         moving = np.flatnonzero(roster.tier == KINEMATIC)
         if not len(moving):
             return
+        ground = ground_of(world)
         targets = _targets(world, roster.creature_row[moving])
         way = targets - self.xy[moving]
         distance = np.hypot(way[:, 0], way[:, 1])
@@ -149,6 +162,8 @@ class ClipReplay:
             whole = bool(np.all(self.phase[mine] == np.round(self.phase[mine])))
             clips.evaluate(self.kind[mine], self.phase[mine], self.xy[mine],
                            self.heading[mine], pos, quat, interpolate=not whole)  # fmt: skip
+            if ground.heightfield is not None:  # draped over the terrain, body by body
+                pos[..., 2] += ground.height(pos[..., :2].reshape(-1, 2)).reshape(pos.shape[:2])
             batch.xpos[rows] = pos
             batch.xquat[rows] = quat
 

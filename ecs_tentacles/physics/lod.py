@@ -17,8 +17,9 @@ The rules, whole-array work every frame before the step:
 1. Lod off: everyone is FULL, always (`--lod off`, `lod=False`).
 2. Must be FULL: creatures with a body within `contact_margin` of another creature's
    (the bodies' bounding spheres: promoted before they touch; a full one stays full
-   until it is `CLEAR` times that far), forced ones (`promote`, `select`), and those
-   inside the focus region.
+   until it is `CLEAR` times that far) or whose reach comes within it of an obstacle
+   (`Ground.solids`), forced ones (`promote`, `select`), and those inside the focus
+   region.
 3. The other awake creatures are ranked: nearest the focus first (without one, all
    equal), then the tier they hold (hysteresis), then creature order, so a bake's
    decisions depend on nothing but the scene. They fill what rule 2 left of the
@@ -39,6 +40,7 @@ from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 
+from ecs_tentacles.ground import ground_of
 from ecs_tentacles.physics.proxies import ContactProxies
 from ecs_tentacles.physics.tiers import FULL, KINEMATIC, NAMES, REDUCED
 
@@ -155,6 +157,7 @@ class LevelOfDetail:
         gap = self.proxies.closest(pos, centre, radius, CLEAR * margin)
         tier = roster.tier
         must = self.scripted | self.selected | (gap < margin)
+        must |= _near_obstacles(world, centre, radius + margin)
         must |= (gap < CLEAR * margin) & (tier == FULL)  # stays full until clear
         distance = np.zeros(len(roster))
         if self.focus_region is not None:
@@ -195,3 +198,16 @@ class LevelOfDetail:
         tier[:] = want
         if len(entering) and self.replay is not None:
             self.replay.start(entering)
+
+
+def _near_obstacles(world: PhysicsHost, centre: np.ndarray, reach: np.ndarray) -> np.ndarray:
+    """(creatures,) whose reach sphere (`centre`, `reach`) meets an obstacle: about to
+    touch it. Bounding spheres cull, then each obstacle's signed distance decides."""
+    ground = ground_of(world)
+    near = np.zeros(len(centre), dtype=bool)
+    for solid in ground.solids:
+        close = np.sum((centre - solid.position) ** 2, axis=1) <= (reach + solid.bound) ** 2
+        rows = np.flatnonzero(close & ~near)
+        if len(rows):
+            near[rows] = solid.signed_distance(centre[rows]) <= reach[rows]
+    return near

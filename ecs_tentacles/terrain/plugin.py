@@ -6,8 +6,9 @@ creatures' placement and the suckers read (without a `terrain` key it is the pla
 z = 0 and nothing changes), and the `TerrainEditor` (`ecs_tentacles.terrain.editing`).
 Sandbox: the "Terrain" HUD section (`ecs_tentacles.terrain.panel`).
 Checks: one heightfield source, each obstacle's keys, files next to the scene; at
-build, no creature inside an obstacle, and none given a 3-d position inside the
-heightfield (goals rest on the topmost surface, so they are never inside).
+build, no creature inside an obstacle, none given a 3-d position inside the
+heightfield, and no 3-d goal inside an obstacle (a 2-d goal rests on the topmost
+surface: on top of an obstacle, never inside).
 """
 
 from __future__ import annotations
@@ -67,13 +68,24 @@ class TerrainPlugin(Plugin):
             points = np.concatenate([starts, ends, 0.5 * (starts + ends)])
             balls = np.concatenate([radii, radii, radii])
             where = f"creatures[{i}].position: {creature['name']}"
-            hit = ground.inside_solid(points, balls)
+            reach = float(np.max(np.linalg.norm(points[:, :2] - starts[0, :2], axis=1)))
+            near = ground.solids_near(starts[0, :2], reach + float(balls.max()))
+            hit = ground.inside_solid(points, balls, near)
             if (hit >= 0).any():
                 problems.append(
                     f"{where} is inside terrain.obstacles[{int(hit[hit >= 0][0])}];"
                     " move it or the obstacle"
                 )
-            elif len(creature["position"]) == 3 and ground.heightfield is not None:
+            for j, goal in enumerate(creature.get("goals", [])):
+                if len(goal["position"]) == 3:  # a 2-d goal rests on the topmost surface
+                    inside = ground.inside_solid(np.asarray(goal["position"], dtype=float))
+                    if inside[0] >= 0:
+                        problems.append(
+                            f"creatures[{i}].goals[{j}].position: inside"
+                            f" terrain.obstacles[{int(inside[0])}]; give [x, y] to put it"
+                            " on top, or move it"
+                        )
+            if len(creature["position"]) == 3 and ground.heightfield is not None:
                 # a 2-d position is placed on the surface; a 3-d one must be above it (the
                 # links' balls, and the mantle's flat base: not its capsule's round end)
                 links = np.concatenate([starts[1:], ends[1:], 0.5 * (starts + ends)[1:]])

@@ -61,21 +61,23 @@ SMOOTHING_SECONDS = 0.06  # targets ease toward each new pose (slow-in) instead 
 FOLLOW_LIMIT = 0.8  # radians: the most the droop ramp bends to follow the ground
 
 
-def ground_follow(world: Host, ground: Ground) -> np.ndarray:
-    """(tentacles,) extra droop (radians, positive: tip down) that brings each tentacle's
-    reach onto the ground: the tip of the tentacle stretched along its creature's plane
-    would be `gap` above the surface; a droop ramp of 2 atan(gap / length) lowers it so."""
+def ground_follow(world: Host, ground: Ground, rows: np.ndarray) -> np.ndarray:
+    """(len(rows),) extra droop (radians, positive: tip down) that brings tentacle
+    `rows`' reach onto the ground: the tip of the tentacle stretched along its creature's
+    plane would be `gap` above the surface; a droop ramp of 2 atan(gap / length) lowers
+    it so."""
     t, pos = world.tentacles, world.transforms.pos
-    creature = t.creature_row
-    up = quat_rotate(world.transforms.quat[world.creatures.mantle_row], np.array([0.0, 0.0, 1.0]))
-    up = up[creature]
-    base = pos[t.base_row]
-    along = pos[t.base_row + t.links - 1] - base
+    creature = t.creature_row[rows]
+    mantle_quat = world.transforms.quat[world.creatures.mantle_row[creature]]
+    up = quat_rotate(mantle_quat, np.array([0.0, 0.0, 1.0]))
+    base = pos[t.base_row[rows]]
+    along = pos[t.base_row[rows] + t.links[rows] - 1] - base
     along -= np.sum(along * up, axis=1, keepdims=True) * up
     along /= np.maximum(np.linalg.norm(along, axis=1, keepdims=True), 1e-9)
-    reach = base + t.length[:, None] * along
+    length = t.length[rows]
+    reach = base + length[:, None] * along
     gap = ground.distance(reach)
-    return np.clip(2.0 * np.arctan2(gap, t.length), -FOLLOW_LIMIT, FOLLOW_LIMIT)
+    return np.clip(2.0 * np.arctan2(gap, length), -FOLLOW_LIMIT, FOLLOW_LIMIT)
 
 
 class MotorTargets(System):
@@ -118,8 +120,12 @@ class MotorTargets(System):
         if not len(motors):
             return
         ground = ground_of(world)
-        self.follow = None if ground.flat else ground_follow(world, ground)
         kinematic = world.physics.kinematic_creatures(len(world.creatures))
+        self.follow = None
+        if not ground.flat:  # for the tentacles the physics drives (kinematic ones replay)
+            driven = np.flatnonzero(~kinematic[world.tentacles.creature_row])
+            self.follow = np.zeros(len(world.tentacles))
+            self.follow[driven] = ground_follow(world, ground, driven)
         if not kinematic.any():
             self._targets(world, dt, slice(None), self.inner, self.previous)
             return

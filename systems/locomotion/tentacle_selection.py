@@ -134,9 +134,12 @@ class TentacleSelection(System):
             mantle = pos[c.mantle_row, :2]
             to_goal = (g.steer[:, :2] - mantle)[creature]
             to_base = pos[t.base_row, :2] - mantle[creature]
-        else:
+        else:  # creatures the level of detail replays keep world xy: their strokes drive nothing
             mantle3 = pos[c.mantle_row]
-            basis = ground_plane(ground.normal_under(mantle3[:, :2]))[creature]  # (n, 2, 3)
+            normals = np.tile([0.0, 0.0, 1.0], (len(c), 1))
+            driven = ~world.physics.kinematic_creatures(len(c)) & g.has_goal
+            normals[driven] = ground.normal_under(mantle3[driven, :2])
+            basis = ground_plane(normals)[creature]  # (n, 2, 3)
             to_goal = _in_plane(basis, (g.steer - mantle3)[creature])
             to_base = _in_plane(basis, pos[t.base_row] - mantle3[creature])
         pull, cos = classify(to_goal, to_base)

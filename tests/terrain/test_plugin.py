@@ -16,6 +16,7 @@ from ecs_tentacles.cli import main
 from ecs_tentacles.construction import creature_layout
 from ecs_tentacles.ground import ground_of
 from ecs_tentacles.locomotion.goals import GoalBook
+from ecs_tentacles.physics.tiers import FULL, KINEMATIC
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.world import World
 
@@ -217,15 +218,24 @@ def test_a_concave_mesh_is_split_into_convex_pieces(
     assert solid.signed_distance(np.array([[3.0, 0.0, 0.4]]))[0] > 0.2
 
 
-def test_on_terrain_no_creature_replays_flat_ground_clips(make_world: Callable[..., World]) -> None:
-    """Gait clips are recorded on the plane: past the budgets, terrain crowds run REDUCED."""
-    data = scene(ROCKY, [0, 0], [-2.0, 1.5], [1.2, 2.5], [-1.0, -2.0])
-    data["physics"] = {"lod": {"full": 1, "reduced": 1, "hold_seconds": 0.1}}
+def test_kinematic_creatures_are_draped_over_the_terrain(make_world: Callable[..., World]) -> None:
+    """Gait clips are recorded on the plane; on terrain every replayed body is raised by
+    the ground under it (tips on the ground), and one about to meet a rock runs full."""
+    hills = {"heightfield": ROCKY["heightfield"]}
+    rock = {"shape": "sphere", "position": [-1.5, -3.0, 0.2], "radius": 0.4}
+    data = scene({**hills, "obstacles": [rock]}, [0, 0], [3.0, 2.0], [-3.0, 2.5], [-1.5, -1.9])
+    data["physics"] = {"lod": {"full": 0, "reduced": 0, "hold_seconds": 0.1}}
     world = make_world(data)
     for _ in range(20):
         world.step()
-    counts = world.lod.counts()  # type: ignore[attr-defined]
-    assert counts["kinematic"] == 0 and counts["reduced"] >= 2, counts
+    tiers = world.physics.tier
+    assert (tiers == KINEMATIC).sum() == 3 and tiers[3] == FULL  # the one by the rock
+    ground = ground_of(world)
+    for index in np.flatnonzero(tiers == KINEMATIC).tolist():
+        batch, row = world.physics.roster.locate(index)
+        pos = batch.xpos[row]
+        above = pos[:, 2] - ground.height(pos[:, :2])
+        assert above.min() > -0.005 and np.median(above) < 0.08  # on it, not in or over it
 
 
 def test_crowd_on_rocky_terrain_is_a_valid_scene(tmp_path: pathlib.Path) -> None:
