@@ -17,6 +17,7 @@ import argparse
 import csv
 import json
 import math
+import multiprocessing
 import os
 import sys
 from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -108,6 +109,12 @@ def plot(rows: list[dict[str, Any]], path: Path, seconds: float) -> None:
         figure.savefig(temporary, format="png", dpi=110)
 
 
+def _said(row: dict[str, Any]) -> dict[str, Any]:
+    got = f"reached in {row['seconds']} s" if row["reached"] else f"{row['climbed_m']} m up"
+    print(f"slope {row['slope_deg']:g} deg: {got}", file=sys.stderr)
+    return row
+
+
 def number_list(text: str) -> list[float]:
     try:
         values = [float(v) for v in text.split(",") if v.strip()]
@@ -131,17 +138,25 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--out", type=Path, default=Path("slope_climb"), help="output prefix (default slope_climb)"
     )
+    parser.add_argument(
+        "--jobs", type=int, default=os.cpu_count() or 1, help="slopes run at once (default: cores)"
+    )
     args = parser.parse_args(argv)
+    if args.jobs < 1:
+        parser.error("--jobs: must be >= 1")
     if not 1.0 <= args.seconds <= 3600.0:
         parser.error("--seconds: must be in [1, 3600]")
     rows = []
-    with ProcessPoolExecutor(max_workers=os.cpu_count() or 1) as pool:
-        futures = {pool.submit(climb, s, args.seconds): s for s in args.slopes}
-        for future in as_completed(futures):
-            row = future.result()
-            rows.append(row)
-            got = f"reached in {row['seconds']} s" if row["reached"] else f"{row['climbed_m']} m up"
-            print(f"slope {row['slope_deg']:g} deg: {got}", file=sys.stderr)
+    if args.jobs == 1:
+        results = (climb(s, args.seconds) for s in args.slopes)
+        for row in results:
+            rows.append(_said(row))
+    else:  # fresh interpreters: forking a process that runs threads can deadlock
+        context = multiprocessing.get_context("spawn")
+        with ProcessPoolExecutor(max_workers=args.jobs, mp_context=context) as pool:
+            futures = [pool.submit(climb, s, args.seconds) for s in args.slopes]
+            for future in as_completed(futures):
+                rows.append(_said(future.result()))
     rows.sort(key=lambda r: r["slope_deg"])
     args.out.parent.mkdir(parents=True, exist_ok=True)
     write_csv(rows, args.out.with_suffix(".csv"))
