@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from ecs_tentacles.drawing import RenderView
-from ecs_tentacles.ground import Ground, Solid
+from ecs_tentacles.ground import Ground, Solid, ground_of
 from ecs_tentacles.locomotion.navigation import STUCK_SECONDS, CostGrid, Navigator
 from ecs_tentacles.locomotion.render import path_lines
 from ecs_tentacles.world import World
@@ -32,6 +32,8 @@ def test_a_goal_behind_a_wall_is_reached_only_by_navigation(
     world = make_world(behind_the_wall(navigation))
     reached: list[float] = []
     world.events.on("goal_reached", lambda **_: reached.append(world.time))
+    anchors: list[np.ndarray] = []
+    world.events.on("sucker_attached", lambda **kw: anchors.append(kw["anchor"]))
     while world.time < 50.0 and not reached:
         world.step()
     mantle = world.transforms.pos[world.creatures.mantle_row[0]]
@@ -39,6 +41,9 @@ def test_a_goal_behind_a_wall_is_reached_only_by_navigation(
         assert reached and mantle[1] > 0.5, mantle  # around the wall's end, at the goal
     else:
         assert not reached and mantle[1] < -0.3, mantle  # still pressed against the wall
+        # pressed against it, the suckers grip the wall's face too, not only the ground
+        normals = ground_of(world).normal(np.array(anchors))
+        assert (np.abs(normals[:, 2]) < 0.5).sum() >= 1
     assert world.physics.health.recoveries == 0
 
 
