@@ -54,3 +54,37 @@ def test_an_export_opens_in_blender_at_its_rate_and_range(tmp_path: Path, suffix
     assert found["fps"] == 30 and found["range"] == [0, 30]  # 31 frames, 1 s at 30 fps
     assert found["actions"] and all(a == [0.0, 30.0] for a in found["actions"])
     assert found["materials"] == ["skin"]  # USD imports it too, not grey
+
+
+GROUND = """
+import json, sys, bpy
+bpy.ops.wm.open_mainfile(filepath=sys.argv[1])
+found = {o.name: [m.name for m in o.data.materials] for o in bpy.data.objects
+         if o.type == "MESH" and ("surface" in o.name or "obstacles" in o.name)}
+print(json.dumps(found))
+"""
+
+
+@pytest.mark.parametrize("suffix", [".usdc", ".glb"])
+def test_the_terrain_comes_into_blender_as_meshes_with_materials(
+    tmp_path: Path, suffix: str
+) -> None:
+    take = tmp_path / f"shore{suffix}"
+    argv = ["bake", "rocky_shore", "--seconds", "0.2", "--fps", "30", "--out", str(take)]
+    assert main([*argv, "--quiet"]) == 0
+    blend = tmp_path / "shore.blend"
+    done = subprocess.run(
+        [BLENDER, str(TOOL), str(take), "--out", str(blend)],
+        capture_output=True,
+        text=True,
+        timeout=180,
+    )
+    assert done.returncode == 0, done.stderr
+    read = subprocess.run(
+        [BLENDER, "-c", GROUND, str(blend)], capture_output=True, text=True, timeout=120
+    )
+    found = json.loads(read.stdout.splitlines()[-1])
+    # USD keeps the prim names (surface, obstacles); glTF the node names (terrain/...)
+    surface = next(name for name in found if name.endswith("surface"))
+    obstacles = next(name for name in found if name.endswith("obstacles"))
+    assert found[surface] and found[obstacles]  # each with its material, not grey
