@@ -31,6 +31,7 @@ from ecs_tentacles.ground import ground_of
 from ecs_tentacles.ground_mesh import COLOURS, ground_meshes
 from ecs_tentacles.render import shaders
 from ecs_tentacles.render.camera import OrbitCamera
+from ecs_tentacles.render.decals import QUAD, SUCKER_DISC, shadow_instances, sucker_instances
 from ecs_tentacles.render.gpu import (
     INSTANCE_FLOATS,
     InstancedMesh,
@@ -47,6 +48,7 @@ from ecs_tentacles.world import World
 SKY = (0.70, 0.76, 0.82)
 LIGHT = np.array([0.35, -0.45, 0.82]) / np.linalg.norm([0.35, -0.45, 0.82])
 LOD_DISTANCE = 6.0  # metres from the eye beyond which links use the lean mesh
+SHADOW_EVERY = 3  # a blob under every third link (each wider), and under every mantle
 VIEWS = ("skinned", "capsules")
 
 
@@ -83,6 +85,9 @@ class Renderer:
         self.links_near = InstancedMesh(CAPSULE_LODS[0])
         self.links_far = InstancedMesh(CAPSULE_LODS[1])
         self.spheres = InstancedMesh(SPHERE_LOD)  # the plugins' `render_spheres`
+        self.blob_program = program(shaders.BLOB_VERTEX, shaders.BLOB_FRAGMENT)
+        self.shadows = InstancedMesh(QUAD)  # a soft blob under every mantle and link
+        self.sucker_discs = InstancedMesh(SUCKER_DISC)
         self.lines = Lines()
         self.selected: int | None = None  # creature entity
         self.draw_calls = 0
@@ -115,7 +120,7 @@ class Renderer:
             mantle[i, 7:11] = (r, r, h / 2, 0.0)
             mantle[i, 11:15] = (*colours[i], 1.0)
         self.mantle_instances = mantle
-        link_rows, link_static, link_creature = [], [], []
+        link_rows, link_static, link_creature, link_index = [], [], [], []
         for i, entity in enumerate(self.creature_entities):
             creature = world.component(entity, Creature)
             for tentacle_entity in creature.tentacles:
@@ -126,6 +131,7 @@ class Renderer:
                     shade = 1.0 - 0.35 * link.index / max(n - 1, 1)
                     link_rows.append(world.component(link_entity, Transform).row)
                     link_creature.append(i)
+                    link_index.append(link.index)
                     colour = np.clip(colours[i] * shade + 0.08 * (1 - shade), 0, 1)
                     link_static.append(
                         (link.radius, link.radius, link.radius, link.length / 2, *colour, 1.0)
@@ -139,6 +145,18 @@ class Renderer:
         meshed = set(self.skinned.creatures)
         self.mantle_skinned = np.array([e in meshed for e in self.creature_entities], bool)
         self.link_skinned = self.mantle_skinned[np.array(link_creature, dtype=np.int64)]
+        # shadows: every mantle and every SHADOW_EVERY-th link (blended quads are what
+        # software GL pays for), by transform row; suckers: their links' sizes
+        shadowed = np.array(link_index, dtype=np.int64) % SHADOW_EVERY == 0
+        self.shadow_rows = np.concatenate([self.mantle_rows, self.link_rows[shadowed]])
+        self.shadow_radii = np.concatenate(
+            [mantle[:, 7], SHADOW_EVERY * self.link_instances[shadowed, 7]]
+        ).astype(np.float64)
+        suckers = world.suckers
+        radius_of_row = dict(zip(link_rows, self.link_instances[:, 7].tolist(), strict=True))
+        self.sucker_radii = np.array(
+            [radius_of_row.get(int(r), 0.0) for r in suckers.link_row[: len(suckers)]]
+        )
 
     def _build_ground(self) -> None:
         """The ground's meshes (terrain, obstacles) as two one-instance meshes; made again
@@ -207,6 +225,18 @@ class Renderer:
         if skinned:
             self.skinned.update(pos, quat)
         self.view_of_frame(pos, quat)
+        ground = ground_of(self.world)
+        self.shadows.update(
+            shadow_instances(ground, pos[self.shadow_rows], self.shadow_radii, LIGHT)
+        )
+        suckers = self.world.suckers
+        n = len(suckers)
+        self.sucker_discs.update(
+            sucker_instances(
+                pos, quat, suckers.link_row[:n], suckers.offset[:n], self.sucker_radii,
+                suckers.attached[:n],
+            )
+        )  # fmt: skip
         self.spheres.update(self._sphere_instances())
         self.lines.update(self._line_vertices(pos))
 
@@ -284,12 +314,24 @@ class Renderer:
             self.terrain_program["u_eye"] = eye
             for mesh in self.ground_meshes:
                 calls += mesh.draw()
+        # the blob shadows: blended over the ground, never hiding what is drawn after
+        self.blob_program.use()
+        set_matrix(self.blob_program, "u_view_projection", view_projection)
+        gl.glEnable(gl.GL_BLEND)
+        gl.glBlendFunc(gl.GL_SRC_ALPHA, gl.GL_ONE_MINUS_SRC_ALPHA)
+        gl.glDepthMask(gl.GL_FALSE)
+        gl.glDisable(gl.GL_CULL_FACE)
+        calls += self.shadows.draw()
+        gl.glEnable(gl.GL_CULL_FACE)
+        gl.glDepthMask(gl.GL_TRUE)
+        gl.glDisable(gl.GL_BLEND)
         self.lit.use()
         set_matrix(self.lit, "u_view_projection", view_projection)
         self.lit["u_light"] = tuple(LIGHT.astype(np.float32))
         self.lit["u_eye"] = eye
         for mesh in (self.mantles, self.links_near, self.links_far, self.spheres):
             calls += mesh.draw()
+        calls += self.sucker_discs.draw()
         if self.view == "skinned":
             self.skinned_program.use()
             set_matrix(self.skinned_program, "u_view_projection", view_projection)

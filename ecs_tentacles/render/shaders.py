@@ -79,10 +79,14 @@ uniform vec3 u_eye;
 out vec4 f_colour;
 // @grid
 void main() {
-    vec3 base = vec3(0.56, 0.60, 0.55);
-    float fine = grid(v_world.xy, 0.25, 1.0) * 0.10;
-    float coarse = grid(v_world.xy, 1.0, 1.5) * 0.25;
-    vec3 colour = mix(base, vec3(0.30, 0.33, 0.30), fine + coarse);
+    // sand, lit as the terrain is from straight above, with a faint quarter-metre and
+    // a clearer metre grid for scale; low-frequency mottling so it reads as ground
+    vec2 p = v_world.xy;
+    float mottle = 0.04 * sin(p.x * 1.7 + sin(p.y * 1.3)) * sin(p.y * 2.1 + sin(p.x * 0.9));
+    vec3 base = vec3(0.66, 0.59, 0.47) * (1.0 + mottle);
+    float fine = grid(p, 0.25, 1.0) * 0.06;
+    float coarse = grid(p, 1.0, 1.5) * 0.18;
+    vec3 colour = mix(base, base * 0.62, fine + coarse);
     // @fog
 }
 """.replace("// @grid\n", _GRID).replace("    // @fog\n", _FOG)
@@ -106,6 +110,36 @@ void main() {
     // @fog
 }
 """.replace("// @grid\n", _GRID).replace("    // @fog\n", _FOG)
+
+BLOB_VERTEX = """
+#version 330 core
+layout(location = 0) in vec3 a_position;
+layout(location = 3) in vec3 i_position;
+layout(location = 5) in vec4 i_scale;
+layout(location = 6) in vec4 i_colour;
+uniform mat4 u_view_projection;
+out vec2 v_local;
+out vec4 v_colour;
+void main() {
+    v_local = a_position.xy;
+    v_colour = i_colour;
+    vec3 world = i_position + vec3(a_position.xy * i_scale.xy, 0.0);
+    gl_Position = u_view_projection * vec4(world, 1.0);
+}
+"""
+
+BLOB_FRAGMENT = """
+#version 330 core
+in vec2 v_local;
+in vec4 v_colour;
+out vec4 f_colour;
+void main() {
+    float r = length(v_local);
+    float alpha = v_colour.a * (1.0 - smoothstep(0.2, 1.0, r));
+    if (alpha <= 0.003) discard;
+    f_colour = vec4(v_colour.rgb, alpha);
+}
+"""
 
 LINE_VERTEX = """
 #version 330 core

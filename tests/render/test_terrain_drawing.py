@@ -32,7 +32,7 @@ def test_terrain_and_obstacles_are_drawn_and_clicks_land_on_them(
     sandbox = make_sandbox(terrain_scene())
     sandbox.hud.visible = False
     calls = sandbox.renderer.draw()
-    assert calls == 7 + 1  # the grid's draw gives way to the terrain's and the obstacles'
+    assert calls == 9 + 1  # the grid's draw gives way to the terrain's and the obstacles'
     pixels = sandbox.renderer.target.read().astype(int)
     camera = sandbox.renderer.camera
     top = np.array([[1.0, 1.4, 0.5]])  # the table's top
@@ -71,7 +71,7 @@ def test_the_terrain_section_places_moves_and_deletes_with_the_mouse(
         {"version": 1, "terrain": {"heightfield": HILLS}, "creatures": [{"name": "octo"}]}
     )
     sandbox.hud.visible = False
-    assert sandbox.renderer.draw() == 7  # the terrain in place of the grid, no obstacles
+    assert sandbox.renderer.draw() == 9  # the terrain in place of the grid, no obstacles
     panel = next(p for p in sandbox.hud.panels if isinstance(p, TerrainPanel))
     camera = sandbox.renderer.camera
     spot = np.array([[1.5, -1.2, _hill_height(sandbox, 1.5, -1.2)]])
@@ -82,7 +82,7 @@ def test_the_terrain_section_places_moves_and_deletes_with_the_mouse(
     event(sandbox, "on_mouse_release", px, py, mouse.LEFT, 0)
     (box,) = sandbox.world.scene["terrain"]["obstacles"]
     assert np.linalg.norm(np.array(box["position"][:2]) - spot[0, :2]) < 0.05
-    assert sandbox.renderer.draw() == 8  # and the obstacles
+    assert sandbox.renderer.draw() == 10  # and the obstacles
     assert panel.message == "placed"
 
     panel.tool = "delete"
@@ -91,7 +91,7 @@ def test_the_terrain_section_places_moves_and_deletes_with_the_mouse(
     event(sandbox, "on_mouse_press", tx, ty, mouse.LEFT, 0)
     event(sandbox, "on_mouse_release", tx, ty, mouse.LEFT, 0)
     assert sandbox.world.scene["terrain"]["obstacles"] == []
-    assert sandbox.renderer.draw() == 7
+    assert sandbox.renderer.draw() == 9
 
     panel.tool = "raise"
     before = _hill_height(sandbox, 1.5, -1.2)
