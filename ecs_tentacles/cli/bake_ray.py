@@ -173,7 +173,7 @@ def _wedge_takes(args: argparse.Namespace, plans: list[BakePlan]) -> list[Take]:
             return out
         import ray
 
-        from ecs_tentacles.distributed.driver import start_ray
+        from ecs_tentacles.distributed.driver import start_ray, stop_ray
 
         started = start_ray(args.ray or None, args.cpus)
         try:
@@ -193,5 +193,4 @@ def _wedge_takes(args: argparse.Namespace, plans: list[BakePlan]) -> list[Take]:
                     ray.cancel(ref, force=True)
                 raise
         finally:
-            if started:
-                ray.shutdown()
+            stop_ray(started)

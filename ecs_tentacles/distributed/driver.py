@@ -32,6 +32,7 @@ import numpy as np
 from tqdm import tqdm
 
 from ecs_tentacles.distributed.merge import merge_takes
+from ecs_tentacles.distributed.reaper import Reaper
 from ecs_tentacles.distributed.shards import ShardPlan, default_tasks, plan_shards, scene_plugins
 from ecs_tentacles.distributed.spheres import meetings
 from ecs_tentacles.distributed.task import ShardResult, bake_shard
@@ -67,13 +68,31 @@ def start_ray(address: str | None, cpus: int | None) -> bool:
     options: dict[str, Any] = {"include_dashboard": False, "log_to_driver": False}
     options["logging_level"] = logging.ERROR
     ours = _signal_handlers()
+    global _REAPER
     if address:
         ray.init(address=address, **options)
     else:
         ray.init(num_cpus=cpus, **options)
+        _REAPER = Reaper.start()  # a local Ray never outlives a killed bake
     for number, handler in ours.items():  # Ray installs its own: SIGTERM must stay ours
         signal.signal(number, handler)  # (one line, exit 143, Ray shut down on the way out)
     return True
+
+
+def stop_ray(started: bool) -> None:
+    """Shut down the Ray `start_ray` started (nothing when it joined one already running)."""
+    global _REAPER
+    if not started:
+        return
+    import ray
+
+    ray.shutdown()
+    if _REAPER is not None:
+        _REAPER.stop()
+        _REAPER = None
+
+
+_REAPER: Reaper | None = None
 
 
 def _signal_handlers() -> dict[int, Any]:
@@ -148,8 +167,7 @@ def ray_bake(
         take = merge_takes([(r.members, r.take) for r in results.values()])
         return take, stats
     finally:
-        if started:
-            ray.shutdown()
+        stop_ray(started)
 
 
 def _run_all(

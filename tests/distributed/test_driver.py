@@ -224,3 +224,55 @@ def test_ctrl_c_or_sigterm_cancels_the_bake_and_leaves_no_output(
     assert sorted(p.name for p in tmp_path.iterdir()) == ["crowd.json"]
     time.sleep(0.5)
     assert ray.available_resources().get("CPU") == 2  # the cancelled tasks freed their CPUs
+
+
+def _ray_processes() -> set[tuple[int, float]]:
+    """(pid, start time) of every process that is part of some Ray on this machine."""
+    import psutil
+
+    found = set()
+    for process in psutil.process_iter(["pid", "name", "cmdline", "create_time"]):
+        text = " ".join([process.info["name"] or "", *(process.info["cmdline"] or [])])
+        if "raylet" in text or "gcs_server" in text or "ray/_private" in text or "ray::" in text:
+            found.add((process.info["pid"], process.info["create_time"]))
+    return found
+
+
+def test_a_killed_bake_leaves_no_ray_processes_behind(crowd: Path, tmp_path: Path) -> None:
+    """SIGKILL cannot be handled: the watchdog `bake --ray` starts with its local Ray
+    ends that Ray's processes (GCS, raylet, agents, workers) instead."""
+    before = _ray_processes()
+    argv = [sys.executable, "-m", "ecs_tentacles", "bake", str(crowd), "--seconds", "20"]
+    process = subprocess.Popen(
+        [*argv, "--out", str(tmp_path / "ray.npz"), "--ray", "--cpus", "1", "--quiet"],
+        stderr=subprocess.PIPE,
+        text=True,
+        cwd=tmp_path,
+    )
+    assert process.stderr is not None
+    line = process.stderr.readline()
+    while line and not line.startswith("ray:"):
+        line = process.stderr.readline()
+    time.sleep(1.0)  # its Ray runs the tasks
+    started = _ray_processes() - before
+    assert started  # a local Ray of its own
+    process.kill()
+    process.wait(timeout=30)
+    deadline = time.monotonic() + 20.0
+    left = started & _ray_processes()
+    while left and time.monotonic() < deadline:
+        time.sleep(0.5)
+        left = started & _ray_processes()
+    names = sorted(_describe(pid) for pid, _ in left)
+    assert not left, (
+        f"{len(left)} of {len(started)} Ray processes outlived the killed bake: {names}"
+    )
+
+
+def _describe(pid: int) -> str:
+    import psutil
+
+    try:
+        return " ".join(psutil.Process(pid).cmdline())[:120]
+    except psutil.Error:
+        return f"{pid} (gone)"

@@ -1,0 +1,129 @@
+"""A watchdog that ends the local Ray a bake started if the bake itself is killed.
+
+`ray.init` starts a head node (GCS, raylet, agents, workers) as this process's
+descendants. A bake killed with SIGKILL cannot shut them down, and some of them
+outlived it by minutes (80 MB each). `Reaper.start()` records those processes and
+starts a small watchdog in a session of its own, connected by a pipe. Every second
+the watchdog notes the bake's descendants (Ray starts agents and workers later). When
+the bake ends normally it closes the pipe first (`Reaper.stop`: the watchdog leaves);
+when the bake dies, the kernel closes the pipe, the watchdog sees its parent gone and
+ends every process it noted (unless its pid was reused) and whatever they started.
+
+    python -m ecs_tentacles.distributed.reaper PARENT_PID '[[pid, create_time], ...]'
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import select
+import subprocess
+import sys
+import time
+from typing import Any
+
+import psutil
+
+GRACE_SECONDS = 2.0  # SIGTERM first; SIGKILL whatever still runs after this
+WATCH_SECONDS = 1.0  # how often the watchdog notes what the bake's Ray has started
+
+
+class Reaper:
+    """The watchdog of this process's Ray (see the module doc)."""
+
+    def __init__(self, process: subprocess.Popen[bytes] | None):
+        self.process = process
+
+    @classmethod
+    def start(cls) -> Reaper:
+        """Record this process's descendants (Ray's, just started) and watch over them."""
+        me = psutil.Process()
+        recorded = []
+        for child in me.children(recursive=True):
+            try:
+                recorded.append([child.pid, child.create_time()])
+            except psutil.Error:
+                continue
+        if not recorded:
+            return cls(None)
+        process = subprocess.Popen(
+            [sys.executable, "-m", __name__, str(os.getpid()), json.dumps(recorded)],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+            start_new_session=True,  # Ctrl-C or a killed process group must not reach it
+        )
+        return cls(process)
+
+    def stop(self) -> None:
+        """The bake is done and Ray shut down: let the watchdog go."""
+        if self.process is None or self.process.stdin is None:
+            return
+        self.process.stdin.close()
+        try:
+            self.process.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            self.process.kill()
+
+
+def _alive(pid: int) -> bool:
+    try:
+        return psutil.Process(pid).status() != psutil.STATUS_ZOMBIE
+    except psutil.Error:
+        return False
+
+
+def reap(recorded: list[list[Any]]) -> None:
+    """Terminate the recorded processes (if they are still the same ones) and their
+    descendants; kill what is left after `GRACE_SECONDS`."""
+    victims: list[psutil.Process] = []
+    for pid, created in recorded:
+        try:
+            process = psutil.Process(int(pid))
+            if abs(process.create_time() - float(created)) > 0.01:
+                continue  # the pid was reused
+            victims += [process, *process.children(recursive=True)]
+        except psutil.Error:
+            continue
+    for process in victims:
+        try:
+            process.terminate()
+        except psutil.Error:
+            pass
+    _, alive = psutil.wait_procs(victims, timeout=GRACE_SECONDS)
+    for process in alive:
+        try:
+            process.kill()
+        except psutil.Error:
+            pass
+
+
+def _descendants(pid: int) -> list[list[Any]]:
+    try:
+        return [[p.pid, p.create_time()] for p in psutil.Process(pid).children(recursive=True)]
+    except psutil.Error:
+        return []
+
+
+def main(argv: list[str]) -> int:
+    parent, recorded = int(argv[0]), json.loads(argv[1])
+    known = {int(pid): created for pid, created in recorded}
+    while True:  # until the bake closes the pipe, or dies and the kernel does
+        ready, _, _ = select.select([sys.stdin.buffer], [], [], WATCH_SECONDS)
+        if ready and not os.read(sys.stdin.fileno(), 4096):
+            break
+        # Ray starts agents and workers later, under its raylet: keep them on the list,
+        # for the raylet may be gone (and they re-parented) by the time the bake dies
+        known.update({pid: created for pid, created in _descendants(parent) if pid != os.getpid()})
+    recorded = [[pid, created] for pid, created in known.items()]
+    deadline = time.monotonic() + 1.0
+    while _alive(parent) and time.monotonic() < deadline:
+        time.sleep(0.05)  # a bake that closed the pipe itself is about to exit
+    if _alive(parent):
+        return 0  # a normal end: the bake shut Ray down itself
+    reap(recorded)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
