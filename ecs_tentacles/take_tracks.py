@@ -6,7 +6,7 @@ A track is named per-frame data of one of two kinds, each stored as two arrays:
              header[key]  [{name "<creature>/<folder>/<item><n>", creature, radius}]
              arrays[0]    float32 (items, 3)          position, metres
              arrays[1]    bool    (frames, items)     live (visible) at that frame
-    curves   polylines posed every frame (USD: BasisCurves `<creature>/<folder>/<item>`)
+    curves   polylines posed every frame (USD: BasisCurves `<c>/<c>_<folder>/<c>_<item>`)
              header[key]  null, or {creatures: [creature index per curve, or -1]}
              arrays[0]    float32 (frames, curves, points, 3)   world metres
              arrays[1]    float32 (frames, curves, points)      widths, metres

@@ -1,9 +1,10 @@
 """Take -> binary glTF 2.0 (.glb) for game engines: one animated node per body.
 
-Nodes mirror the USD layout: `World` / `<creature>` / `mantle` and
-`tentacles` / `t<k>` / `link<i>`. Parents carry no transform, so each body node's
-translation and rotation are its world pose; one animation (`take`) has a
-translation and a rotation channel per body (LINEAR, a key per take frame, time =
+Nodes mirror the USD layout and names: `World` / `<c>` / `<c>_mantle` and
+`<c>_tentacles` / `<c>_t<k>` / `<c>_t<k>_link<i>` (unique: `ecs_tentacles.export.names`).
+Parents carry no transform, so each body node's translation and rotation are its world
+pose; one animation (`<scene>_animation`) has a translation and a rotation channel per
+body (LINEAR, a key per take frame, time =
 frame / fps). Bodies carry lean meshes (capsules along +x, the mantle's cylinder)
 sharing one material.
 
@@ -27,6 +28,7 @@ from ecs_tentacles import __version__
 from ecs_tentacles.atomic import atomic_file
 from ecs_tentacles.export.ground import add_gltf_ground
 from ecs_tentacles.export.meshes import Mesh, body_mesh
+from ecs_tentacles.export.names import part, unique_leaf
 from ecs_tentacles.take import Take
 
 Z_UP_TO_Y_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
@@ -104,7 +106,7 @@ def build_gltf(take: Take) -> tuple[dict[str, Any], bytes]:
             meshes.append(_mesh(buffer, body_mesh(*key), info["shape"]))
         body_nodes.append(
             node(
-                info["name"].rsplit("/", 1)[1],
+                unique_leaf(info["name"]),
                 parent,
                 mesh=mesh_of[key],
                 translation=translations[0, index].tolist(),
@@ -115,9 +117,10 @@ def build_gltf(take: Take) -> tuple[dict[str, Any], bytes]:
     for creature in header["creatures"]:
         root = node(creature["name"], 0)
         body(creature["mantle"], root)
-        tentacles = node("tentacles", root)
+        name = creature["name"]
+        tentacles = node(unique_leaf(f"{name}/tentacles"), root)
         for k, chain in enumerate(creature["tentacles"]):
-            folder = node(f"t{k}", tentacles)
+            folder = node(unique_leaf(f"{name}/tentacles/t{k}"), tentacles)
             for index in chain:
                 body(index, folder)
     materials: list[dict[str, Any]] = [
@@ -185,7 +188,8 @@ def _animation(
             channels.append(
                 {"sampler": len(samplers) - 1, "target": {"node": target, "path": path}}
             )
-    return {"name": "take", "samplers": samplers, "channels": channels}
+    return {"name": part(str(take.header["scene"]), "animation"), "samplers": samplers,
+            "channels": channels}  # fmt: skip
 
 
 def glb_bytes(document: dict[str, Any], binary: bytes) -> bytes:

@@ -1,12 +1,14 @@
 """Take -> binary glTF (.glb) with skinned creatures: a skin per creature, its joints
 animated by rotation keys (and the root by translation keys).
 
-    scene nodes: World -> <creature> -> mantle -> t0_link0 -> t0_link1 ...   (joints)
-                 <creature>/skin   {mesh, skin}   (a root node: glTF ignores the
-                                                   transform of a skinned mesh's node)
-Joint nodes carry their rest (bind) transforms; the one animation has a rotation
-channel per joint and a translation channel on each mantle, each with its own key
-times when keys are reduced. The mesh: POSITION, NORMAL, TEXCOORD_0 (a vertex is split
+    scene nodes: World -> <c>_skeleton -> mantle -> t0_link0 -> t0_link1 ...   (joints)
+                 <c>_skin   {mesh, skin}   (a root node: glTF ignores the transform of
+                                            a skinned mesh's node)
+Named as the USD export names them (`ecs_tentacles.export.names`: Blender makes the
+same armature, mesh and action names from either). Joint nodes carry their rest
+(bind) transforms; each creature's animation (`<c>_animation`) has a rotation channel
+per joint and a translation channel on its mantle, each with its own key times when
+keys are reduced. The mesh: POSITION, NORMAL, TEXCOORD_0 (a vertex is split
 where its UVs differ), JOINTS_0/WEIGHTS_0 (two influences used of four). Everything is
 turned to glTF's y-up like the rigid form (`ecs_tentacles.export.gltf`).
 """
@@ -31,6 +33,7 @@ from ecs_tentacles.export.gltf import (
     to_y_up_rotations,
 )
 from ecs_tentacles.export.ground import add_gltf_ground
+from ecs_tentacles.export.names import part
 from ecs_tentacles.skin.keys import KeyReport
 from ecs_tentacles.skin.mesh import Detail, SkinMesh
 from ecs_tentacles.skin.rig import Keys, SkinnedCreature, skinned_creatures
@@ -66,11 +69,12 @@ def build_skinned_gltf(
     meshes, skins = [], []
     samplers: list[dict[str, Any]] = []
     channels: list[dict[str, Any]] = []
+    animations: list[dict[str, Any]] = []
     times: dict[bytes, int] = {}
     for creature in creatures:
         skeleton = creature.skeleton
         holder = len(nodes)
-        nodes.append({"name": skeleton.layout.name, "children": []})
+        nodes.append({"name": part(skeleton.layout.name, "skeleton"), "children": []})
         nodes[0]["children"].append(holder)
         first = len(nodes)
         rotation = to_y_up_rotations(skeleton.rest_rotation).astype(np.float32)
@@ -100,12 +104,20 @@ def build_skinned_gltf(
         roots.append(len(nodes))
         nodes.append(
             {
-                "name": f"{skeleton.layout.name}/skin",
+                "name": part(skeleton.layout.name, "skin"),
                 "mesh": len(meshes) - 1,
                 "skin": len(skins) - 1,
             }
         )
+        samplers, channels = [], []  # one animation per creature, named after it
         _channels(buffer, take, creature, first, samplers, channels, times)
+        animations.append(
+            {
+                "name": part(skeleton.layout.name, "animation"),
+                "samplers": samplers,
+                "channels": channels,
+            }
+        )
     materials: list[dict[str, Any]] = [
         {
             "name": "skin",
@@ -134,7 +146,7 @@ def build_skinned_gltf(
         "textures": [{"sampler": 0, "source": 0}],
         "samplers": [{"magFilter": 9729, "minFilter": 9729}],
         "images": [{"bufferView": _image(buffer, skin_texture()), "mimeType": "image/png"}],
-        "animations": [{"name": "take", "samplers": samplers, "channels": channels}],
+        "animations": animations,
         "buffers": [{"byteLength": len(buffer.data)}],
         "bufferViews": buffer.views,
         "accessors": buffer.accessors,

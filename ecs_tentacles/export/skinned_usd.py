@@ -1,15 +1,17 @@
 """Take -> USD stage with skinned creatures (UsdSkel), the form artists animate.
 
     /World                                   Xform, the default prim
-      /<creature>                            SkelRoot
-        /skeleton                            Skeleton: joints (mantle/t0_link0/...),
+      /<c>                                   SkelRoot (c: the creature's name)
+        /<c>_skeleton                        Skeleton: joints (mantle/t0_link0/...),
                                              bindTransforms (world), restTransforms (local)
-          /animation                         SkelAnimation: rotations, translations
+          /<c>_animation                     SkelAnimation: rotations, translations
                                              (time-sampled), scales (constant 1)
-        /skin                                Mesh (bound to the skeleton): points in the
+        /<c>_skin                            Mesh (bound to the skeleton): points in the
                                              bind pose, normals, primvars:st (faceVarying),
-                                             primvars:skel:jointIndices / jointWeights (2)
-        /suckers/t<k>/link<i>/sucker<n>      Xform: translate sampled (the sucker point),
+                                             primvars:skel:jointIndices / jointWeights (2),
+                                             bound to the shared /World/materials/skin
+        /<c>_suckers/<c>_t<k>/<c>_t<k>_link<i>/<c>_t<k>_link<i>_sucker<n>
+                                             Xform: translate sampled (the sucker point),
                                              `ecs:attached` sampled
         /goals/goal<j>, /fur/guides, ...     the take's tracks, as in the rigid form
                                              (`ecs_tentacles.export.usd`)
@@ -30,6 +32,7 @@ import numpy as np
 
 from ecs_tentacles.atomic import atomic_output
 from ecs_tentacles.export.ground import write_usd_ground
+from ecs_tentacles.export.names import part, unique_path
 from ecs_tentacles.export.usd import _pxr, mark_rate, new_stage, write_tracks
 from ecs_tentacles.mathutil import quat_rotate
 from ecs_tentacles.skin.keys import KeyReport
@@ -85,14 +88,15 @@ def _creature(pxr: Any, stage: Any, creature: SkinnedCreature) -> None:
     skeleton, mesh = creature.skeleton, creature.mesh
     base = f"/World/{skeleton.layout.name}"
     UsdSkel.Root.Define(stage, base)
-    skel = UsdSkel.Skeleton.Define(stage, f"{base}/skeleton")
+    name = skeleton.layout.name
+    skel = UsdSkel.Skeleton.Define(stage, f"{base}/{part(name, 'skeleton')}")
     skel.CreateJointsAttr(skeleton.names)
     skel.CreateJointNamesAttr(skeleton.leaf_names)
     skel.CreateBindTransformsAttr(_matrices(pxr, skeleton.bind))
     rest = transforms(skeleton.rest_rotation, skeleton.rest_translation)
     skel.CreateRestTransformsAttr(_matrices(pxr, rest))
 
-    anim = UsdSkel.Animation.Define(stage, f"{base}/skeleton/animation")
+    anim = UsdSkel.Animation.Define(stage, f"{skel.GetPath()}/{part(name, 'animation')}")
     anim.CreateJointsAttr(skeleton.names)
     frames = creature.sample_frames
     rotations = creature.rotations_at(frames).astype(np.float32)
@@ -107,7 +111,7 @@ def _creature(pxr: Any, stage: Any, creature: SkinnedCreature) -> None:
     binding = UsdSkel.BindingAPI.Apply(skel.GetPrim())
     binding.CreateAnimationSourceRel().SetTargets([anim.GetPath()])
 
-    skin = UsdGeom.Mesh.Define(stage, f"{base}/skin")
+    skin = UsdGeom.Mesh.Define(stage, f"{base}/{part(name, 'skin')}")
     skin.CreateSubdivisionSchemeAttr(UsdGeom.Tokens.none)
     skin.CreatePointsAttr(Vt.Vec3fArray.FromNumpy(mesh.positions.astype(np.float32)))
     skin.CreateFaceVertexCountsAttr(Vt.IntArray.FromNumpy(np.full(len(mesh.faces), 3, np.int32)))
@@ -131,7 +135,7 @@ def _creature(pxr: Any, stage: Any, creature: SkinnedCreature) -> None:
         Vt.FloatArray.FromNumpy(mesh.weights.reshape(-1).astype(np.float32))
     )
     bound.CreateGeomBindTransformAttr(Gf.Matrix4d(1.0))
-    material = _skin_material(pxr, stage, f"{base}/materials")
+    material = _skin_material(pxr, stage, "/World/materials")  # one, shared (as in glTF)
     pxr.UsdShade.MaterialBindingAPI.Apply(skin.GetPrim()).Bind(material)
 
 
@@ -143,6 +147,8 @@ def _skin_material(pxr: Any, stage: Any, folder: str) -> Any:
     """`<folder>/skin`: a UsdPreviewSurface of the skin's colour and roughness."""
     Sdf, UsdShade = pxr.Sdf, pxr.UsdShade
     path = f"{folder}/skin"
+    if stage.GetPrimAtPath(path):
+        return UsdShade.Material(stage.GetPrimAtPath(path))
     pxr.UsdGeom.Scope.Define(stage, folder)
     material = UsdShade.Material.Define(stage, path)
     shader = UsdShade.Shader.Define(stage, f"{path}/surface")
@@ -158,7 +164,7 @@ def _sucker(pxr: Any, stage: Any, take: Take, index: int, sucker: dict[str, Any]
     """The sucker point as a world-space sampled translate, under the creature's `suckers`."""
     Gf, Sdf, UsdGeom = pxr.Gf, pxr.Sdf, pxr.UsdGeom
     creature, _, rest = sucker["name"].split("/", 2)
-    path = f"/World/{creature}/suckers/{rest}"
+    path = f"/World/{unique_path(f'{creature}/suckers/{rest}')}"
     parts = path.split("/")
     for depth in range(4, len(parts)):
         UsdGeom.Xform.Define(stage, "/".join(parts[:depth]))

@@ -1,22 +1,26 @@
 """Take -> USD stage (needs the `usd` extra: `pip install 'ecs-tentacles[usd]'`).
 
     /World                                    Xform, the default prim
-      /<creature>                             Xform
-        /mantle                               Xform: time-sampled translate + orient
-          /geom                               Cylinder, axis Z, radius, height
-        /tentacles/t<k>/link<i>               Xform: time-sampled translate + orient
-          /geom                               Capsule, axis X, radius, height = spine
-          /sucker<n>                          Xform at the sucker, `ecs:attached` sampled
-        /<folder>/<item><j>                   a points track's locator (the goals:
-                                              /goals/goal<j>): Xform at its position,
-                                              visibility sampled (invisible once no
-                                              longer live: a goal reached), `ecs:radius`
-        /<folder>/<item>                      a curves track (the fur guides:
-                                              /fur/guides): BasisCurves (linear),
+      /<c>                                    Xform (c: the creature's name)
+        /<c>_mantle                           Xform: time-sampled translate + orient
+          /<c>_mantle_geom                    Cylinder, axis Z, radius, height
+        /<c>_tentacles/<c>_t<k>/<c>_t<k>_link<i>   Xform: time-sampled translate + orient
+          /<c>_t<k>_link<i>_geom              Capsule, axis X, radius, height = spine
+          /<c>_t<k>_link<i>_sucker<n>         Xform at the sucker, `ecs:attached` sampled
+        /<c>_<folder>/<c>_<item><j>           a points track's locator (the goals:
+                                              <c>_goals/<c>_goal<j>): Xform at its
+                                              position, visibility sampled (invisible
+                                              once no longer live), `ecs:radius`
+        /<c>_<folder>/<c>_<item>              a curves track (the fur guides:
+                                              <c>_fur/<c>_guides): BasisCurves (linear),
                                               points and widths sampled
       /<folder>/<item>                        curves owned by no creature, if any
+      /terrain                                the ground's meshes, on terrain
+                                              (`ecs_tentacles.export.ground`)
 
-Tracks (`ecs_tentacles.take_tracks`) are written by kind, named as the take names them.
+Every prim name is unique in the file (`ecs_tentacles.export.names`: importers name
+objects globally and would add `.001` suffixes); tracks (`ecs_tentacles.take_tracks`)
+are written by kind.
 
 Poses are world-space (every parent is an identity transform), so the time samples
 are the take's numbers: translate (double3) = pos, orient (quatf) = quat. Stage:
@@ -34,6 +38,7 @@ import numpy as np
 
 from ecs_tentacles.atomic import atomic_output
 from ecs_tentacles.export.ground import write_usd_ground
+from ecs_tentacles.export.names import FOLDERS, unique_path
 from ecs_tentacles.take import Take, TakeTrack
 
 
@@ -108,9 +113,10 @@ def build_stage(take: Take, progress: Callable[[int], object] | None = None) -> 
         _body(pxr, stage, take, creature["mantle"])
         if progress is not None:
             progress(1)
-        UsdGeom.Xform.Define(stage, f"{base}/tentacles")
+        UsdGeom.Xform.Define(stage, f"/World/{unique_path(creature['name'] + '/tentacles')}")
         for k, chain in enumerate(creature["tentacles"]):
-            UsdGeom.Xform.Define(stage, f"{base}/tentacles/t{k}")
+            folder = unique_path(f"{creature['name']}/tentacles/t{k}")
+            UsdGeom.Xform.Define(stage, f"/World/{folder}")
             for index in chain:
                 _body(pxr, stage, take, index)
                 if progress is not None:
@@ -135,7 +141,7 @@ def write_tracks(pxr: Any, stage: Any, take: Take) -> None:
 def _body(pxr: Any, stage: Any, take: Take, index: int) -> None:
     Gf, UsdGeom = pxr.Gf, pxr.UsdGeom
     body = take.header["bodies"][index]
-    xform = UsdGeom.Xform.Define(stage, f"/World/{body['name']}")
+    xform = UsdGeom.Xform.Define(stage, f"/World/{unique_path(body['name'])}")
     translate = xform.AddTranslateOp()  # double3
     orient = xform.AddOrientOp()  # quatf
     pos = take.pos[:, index].astype(np.float64).tolist()
@@ -145,7 +151,8 @@ def _body(pxr: Any, stage: Any, take: Take, index: int) -> None:
         w, x, y, z = quat[frame]
         orient.Set(Gf.Quatf(w, Gf.Vec3f(x, y, z)), frame)
     radius, length = float(body["radius"]), float(body["length"])
-    path = f"/World/{body['name']}/geom"
+    unique = unique_path(body["name"])
+    path = f"/World/{unique}/{unique.rsplit('/', 1)[-1]}_geom"
     kind = UsdGeom.Cylinder if body["shape"] == "cylinder" else UsdGeom.Capsule
     geom = kind.Define(stage, path)
     geom.CreateAxisAttr(body["axis"])
@@ -158,7 +165,7 @@ def _body(pxr: Any, stage: Any, take: Take, index: int) -> None:
 
 def _sucker(pxr: Any, stage: Any, take: Take, index: int, sucker: dict[str, Any]) -> None:
     Gf, Sdf, UsdGeom = pxr.Gf, pxr.Sdf, pxr.UsdGeom
-    xform = UsdGeom.Xform.Define(stage, f"/World/{sucker['name']}")
+    xform = UsdGeom.Xform.Define(stage, f"/World/{unique_path(sucker['name'])}")
     xform.AddTranslateOp().Set(Gf.Vec3d(*sucker["offset"]))
     attached = xform.GetPrim().CreateAttribute("ecs:attached", Sdf.ValueTypeNames.Bool)
     values = take.sucker_attached[:, index].tolist()
@@ -171,7 +178,7 @@ def _locator(
 ) -> None:
     Gf, Sdf, UsdGeom = pxr.Gf, pxr.Sdf, pxr.UsdGeom
     where, live = (take.tracks[name] for name in track.arrays)
-    path = f"/World/{item['name']}"
+    path = f"/World/{unique_path(item['name'], FOLDERS | {track.folder})}"
     UsdGeom.Xform.Define(stage, path.rsplit("/", 1)[0])  # the creature's folder of them
     xform = UsdGeom.Xform.Define(stage, path)
     xform.AddTranslateOp().Set(Gf.Vec3d(*where[index].astype(np.float64).tolist()))
@@ -191,9 +198,13 @@ def _curves(pxr: Any, stage: Any, take: Take, track: TakeTrack) -> None:
     points_per_curve = all_points.shape[2]
     for owner in sorted(set(owners.tolist())):
         chosen = np.flatnonzero(owners == owner)
-        base = f"/World/{names[owner]}" if 0 <= owner < len(names) else "/World"
-        UsdGeom.Xform.Define(stage, f"{base}/{track.folder}")
-        curves = UsdGeom.BasisCurves.Define(stage, f"{base}/{track.folder}/{track.item}")
+        if 0 <= owner < len(names):
+            name = f"{names[owner]}/{track.folder}/{track.item}"
+            path = f"/World/{unique_path(name, FOLDERS | {track.folder})}"
+        else:  # curves no creature owns
+            path = f"/World/{track.folder}/{track.item}"
+        UsdGeom.Xform.Define(stage, path.rsplit("/", 1)[0])
+        curves = UsdGeom.BasisCurves.Define(stage, path)
         curves.CreateTypeAttr(UsdGeom.Tokens.linear)
         curves.CreateWrapAttr(UsdGeom.Tokens.nonperiodic)
         curves.CreateCurveVertexCountsAttr([points_per_curve] * len(chosen))

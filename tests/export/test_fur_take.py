@@ -48,7 +48,7 @@ def test_recording_poses_guides_at_frame_0_and_follows_the_rig(tmp_path: Path) -
     write_usd(take, tmp_path / "cat.usda")
     pxr = pytest.importorskip("pxr")
     stage = pxr.Usd.Stage.Open(str(tmp_path / "cat.usda"))
-    guides = pxr.UsdGeom.BasisCurves(stage.GetPrimAtPath("/World/cat/fur/guides"))
+    guides = pxr.UsdGeom.BasisCurves(stage.GetPrimAtPath("/World/cat/cat_fur/cat_guides"))
     assert len(guides.GetCurveVertexCountsAttr().Get()) == len(curves.points)
     recorded.close()
     plain.close()

@@ -30,8 +30,10 @@ def test_nodes_and_animation_hold_the_take_turned_y_up(guided_take: Take, tmp_pa
     creature = nodes[nodes[0]["children"][0]]
     assert creature["name"] == "octo"
     mantle, tentacles = (nodes[i] for i in creature["children"])
-    assert (mantle["name"], tentacles["name"]) == ("mantle", "tentacles")
-    assert [nodes[i]["name"] for i in tentacles["children"]] == ["t0", "t1", "t2"]
+    assert (mantle["name"], tentacles["name"]) == ("octo_mantle", "octo_tentacles")
+    assert [nodes[i]["name"] for i in tentacles["children"]] == ["octo_t0", "octo_t1", "octo_t2"]
+    names = [node["name"] for node in nodes]
+    assert len(set(names)) == len(names)  # every node its own name: importers rename none
     (animation,) = document["animations"]
     assert len(animation["channels"]) == 2 * len(take.header["bodies"])
     by_target = {(c["target"]["node"], c["target"]["path"]): c for c in animation["channels"]}

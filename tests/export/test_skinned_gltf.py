@@ -88,7 +88,7 @@ def test_skinning_the_file_lands_on_the_simulated_links(
     document, binary = read_glb((tmp_path / "skinned.glb").read_bytes())
     (skin,) = document["skins"]
     mesh_node = next(n for n in document["nodes"] if "skin" in n)
-    assert mesh_node["name"] == "octopus/skin" and "translation" not in mesh_node
+    assert mesh_node["name"] == "octopus_skin" and "translation" not in mesh_node
     primitive = document["meshes"][mesh_node["mesh"]]["primitives"][0]
     attributes = primitive["attributes"]
     positions = _accessor(document, binary, attributes["POSITION"]).astype(np.float64)

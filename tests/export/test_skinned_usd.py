@@ -46,23 +46,24 @@ def test_the_skinned_stage_passes_the_compliance_checker(
     stage = Usd.Stage.Open(str(path))
     root = stage.GetPrimAtPath("/World/octo")
     assert root.GetTypeName() == "SkelRoot"
-    assert [p.GetName() for p in root.GetChildren()] == [
-        "skeleton",
-        "skin",
-        "materials",
-        "suckers",
-        "goals",
-        "fur",
+    assert [p.GetName() for p in root.GetChildren()] == [  # unique names, after it
+        "octo_skeleton",
+        "octo_skin",
+        "octo_suckers",
+        "octo_goals",
+        "octo_fur",
     ]
-    skeleton = UsdSkel.Skeleton(stage.GetPrimAtPath("/World/octo/skeleton"))
+    skeleton = UsdSkel.Skeleton(stage.GetPrimAtPath("/World/octo/octo_skeleton"))
     assert len(skeleton.GetJointsAttr().Get()) == 1 + 3 * 4
     assert len(skeleton.GetRestTransformsAttr().Get()) == 13
-    curves = UsdGeom.BasisCurves(stage.GetPrimAtPath("/World/octo/fur/guides"))
+    curves = UsdGeom.BasisCurves(stage.GetPrimAtPath("/World/octo/octo_fur/octo_guides"))
     np.testing.assert_array_equal(
         np.array(curves.GetPointsAttr().Get(3)),
         guided_take.tracks["guide_points"][3].reshape(-1, 3),
     )
-    sucker = stage.GetPrimAtPath("/World/octo/suckers/t0/link3/sucker0")
+    sucker = stage.GetPrimAtPath(
+        "/World/octo/octo_suckers/octo_t0/octo_t0_link3/octo_t0_link3_sucker0"
+    )
     assert sucker.GetAttribute("ecs:attached").Get(0) is False
 
 
@@ -71,8 +72,10 @@ def _skinned(stage: Any, creature: str, frame: int) -> np.ndarray:
     cache = UsdSkel.Cache()
     root = UsdSkel.Root(stage.GetPrimAtPath(f"/World/{creature}"))
     cache.Populate(root, Usd.TraverseInstanceProxies())
-    skel = cache.GetSkelQuery(UsdSkel.Skeleton(stage.GetPrimAtPath(f"/World/{creature}/skeleton")))
-    skinning = cache.GetSkinningQuery(stage.GetPrimAtPath(f"/World/{creature}/skin"))
+    skel = cache.GetSkelQuery(
+        UsdSkel.Skeleton(stage.GetPrimAtPath(f"/World/{creature}/{creature}_skeleton"))
+    )
+    skinning = cache.GetSkinningQuery(stage.GetPrimAtPath(f"/World/{creature}/{creature}_skin"))
     xforms = skel.ComputeSkinningTransforms(frame)
     points = Vt.Vec3fArray(UsdGeom.Mesh(skinning.GetPrim()).GetPointsAttr().Get())
     assert skinning.ComputeSkinnedPoints(xforms, points, frame)
@@ -114,7 +117,9 @@ def test_reduced_keys_stay_within_the_tolerance_through_usd_interpolation(
     octopus_take: Take,
 ) -> None:
     stage, report = build_skinned_stage(octopus_take, keys=Keys("reduced", 0.5))
-    animation = UsdSkel.Animation(stage.GetPrimAtPath("/World/octopus/skeleton/animation"))
+    animation = UsdSkel.Animation(
+        stage.GetPrimAtPath("/World/octopus/octopus_skeleton/octopus_animation")
+    )
     samples = animation.GetRotationsAttr().GetTimeSamples()
     assert 3 <= len(samples) <= octopus_take.frames
     expected = creature_animation(creature_skeleton(octopus_take, 0), octopus_take).rotation
@@ -137,9 +142,9 @@ def test_the_skin_has_a_preview_surface_of_the_gltf_colour(
     path = tmp_path / "take.usda"
     write_skinned_usd(guided_take, path)
     stage = Usd.Stage.Open(str(path))
-    skin = stage.GetPrimAtPath("/World/octo/skin")
+    skin = stage.GetPrimAtPath("/World/octo/octo_skin")
     material, _ = UsdShade.MaterialBindingAPI(skin).ComputeBoundMaterial()
-    assert material and material.GetPath() == "/World/octo/materials/skin"
+    assert material and material.GetPath() == "/World/materials/skin"
     source = material.ComputeSurfaceSource()[0]
     assert source.GetIdAttr().Get() == "UsdPreviewSurface"
     colour = np.array(source.GetInput("diffuseColor").Get())

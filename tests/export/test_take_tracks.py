@@ -95,11 +95,11 @@ def test_a_user_plugins_tracks_are_baked_into_the_take_and_load_back(
     pxr = pytest.importorskip("pxr")
     write(take, tmp_path / "take.usda")
     stage = pxr.Usd.Stage.Open(str(tmp_path / "take.usda"))
-    beacon = pxr.UsdGeom.Imageable(stage.GetPrimAtPath("/World/octo/marks/beacon0"))
+    beacon = pxr.UsdGeom.Imageable(stage.GetPrimAtPath("/World/octo/octo_marks/octo_beacon0"))
     assert beacon.ComputeVisibility(0) == "inherited"
     assert beacon.ComputeVisibility(take.frames - 1) == "invisible"
-    assert stage.GetPrimAtPath("/World/octo/marks/masts").GetTypeName() == "BasisCurves"
-    assert stage.GetPrimAtPath("/World/octo/goals/goal0").IsValid()
+    assert stage.GetPrimAtPath("/World/octo/octo_marks/octo_masts").GetTypeName() == "BasisCurves"
+    assert stage.GetPrimAtPath("/World/octo/octo_goals/octo_goal0").IsValid()
 
 
 def test_a_take_with_an_undeclared_or_unsound_track_is_refused(
@@ -174,6 +174,6 @@ def test_a_world_without_locomotion_or_fur_records_empty_standard_tracks(tmp_pat
     pxr = pytest.importorskip("pxr")
     write(loaded, tmp_path / "bare.usda")
     stage = pxr.Usd.Stage.Open(str(tmp_path / "bare.usda"))
-    assert stage.GetPrimAtPath("/World/octo/mantle").IsValid()
-    assert not stage.GetPrimAtPath("/World/octo/goals").IsValid()
-    assert not stage.GetPrimAtPath("/World/octo/fur").IsValid()
+    assert stage.GetPrimAtPath("/World/octo/octo_mantle").IsValid()
+    assert not stage.GetPrimAtPath("/World/octo/octo_goals").IsValid()
+    assert not stage.GetPrimAtPath("/World/octo/octo_fur").IsValid()

@@ -7,6 +7,7 @@ import json
 import os
 import subprocess
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -73,6 +74,45 @@ def test_the_terrain_comes_into_blender_as_meshes_with_materials(
     argv = ["bake", "rocky_shore", "--seconds", "0.2", "--fps", "30", "--out", str(take)]
     assert main([*argv, "--quiet"]) == 0
     blend = tmp_path / "shore.blend"
+    found = _imported(take, blend, GROUND)
+    # USD keeps the prim names (surface, obstacles); glTF the node names (terrain/...)
+    surface = next(name for name in found if name.endswith("surface"))
+    obstacles = next(name for name in found if name.endswith("obstacles"))
+    assert found[surface] and found[obstacles]  # each with its material, not grey
+
+
+NAMES = """
+import json, re, sys, bpy
+bpy.ops.wm.open_mainfile(filepath=sys.argv[1])
+print(json.dumps({
+    "suffixed": [o.name for o in bpy.data.objects if re.search(r"[.][0-9]{3}$", o.name)
+                 and not o.name.startswith("Icosphere")],  # the glTF importer's bone shapes
+    "armatures": sorted(o.name for o in bpy.data.objects if o.type == "ARMATURE"),
+    "meshes": sorted(o.name for o in bpy.data.objects if o.type == "MESH"),
+    "actions": sorted(a.name for a in bpy.data.actions),
+}))
+"""
+
+
+def test_four_creatures_import_with_their_own_names_in_usd_and_glb(tmp_path: Path) -> None:
+    """No `.001` suffixes (every prim and node is named uniquely, after its creature), and
+    the same armature, mesh and action names from USD and from glTF."""
+    found = {}
+    for suffix in (".usdc", ".glb"):
+        take = tmp_path / f"four{suffix}"
+        argv = ["bake", "thesis_four_by_six", "--seconds", "0.2", "--fps", "30"]
+        assert main([*argv, "--out", str(take), "--quiet"]) == 0
+        blend = tmp_path / f"four{suffix}.blend"
+        found[suffix] = _imported(take, blend, NAMES)
+        assert found[suffix]["suffixed"] == []
+    usd, glb = found[".usdc"], found[".glb"]
+    assert usd["armatures"] == glb["armatures"] == [f"creature_{i}_skeleton" for i in range(4)]
+    assert usd["actions"] == glb["actions"] == [f"creature_{i}_animation" for i in range(4)]
+    assert {f"creature_{i}_skin" for i in range(4)} <= set(usd["meshes"]) & set(glb["meshes"])
+
+
+def _imported(take: Path, blend: Path, script: str) -> dict[str, Any]:
+    """Import `take` with the tool into `blend`, then what `script` prints of it (JSON)."""
     done = subprocess.run(
         [BLENDER, str(TOOL), str(take), "--out", str(blend)],
         capture_output=True,
@@ -81,10 +121,7 @@ def test_the_terrain_comes_into_blender_as_meshes_with_materials(
     )
     assert done.returncode == 0, done.stderr
     read = subprocess.run(
-        [BLENDER, "-c", GROUND, str(blend)], capture_output=True, text=True, timeout=120
+        [BLENDER, "-c", script, str(blend)], capture_output=True, text=True, timeout=120
     )
-    found = json.loads(read.stdout.splitlines()[-1])
-    # USD keeps the prim names (surface, obstacles); glTF the node names (terrain/...)
-    surface = next(name for name in found if name.endswith("surface"))
-    obstacles = next(name for name in found if name.endswith("obstacles"))
-    assert found[surface] and found[obstacles]  # each with its material, not grey
+    found: dict[str, Any] = json.loads(read.stdout.splitlines()[-1])
+    return found
