@@ -1,7 +1,8 @@
-"""The README's sandbox pictures, made headless with the current HUD: the four-creature
-sandbox, the HUD at 640 x 360, the skinned octopus and the three terrain scenes (rocky
-shore, ramp, maze; HUD hidden) (the fur pictures are
-`tools/fur_screenshots.py`'s, the crowd plot `tools/crowd_scaling.py`'s).
+"""Every README picture of the sandbox, made headless with the current HUD: the
+four-creature sandbox, the HUD at 640 x 360, the skinned octopus, the three terrain
+scenes (rocky shore, ramp, maze; HUD hidden) and, through `tools/fur_screenshots.py`
+(`--only fur`), the fur pictures. (The plots are the benchmarks': `tools/crowd_scaling.py`,
+`tools/slope_climb.py`.)
 
     python tools/readme_screenshots.py                       # into assets/screenshots/
     python tools/readme_screenshots.py --out-dir shots/ --only hud_640x360
@@ -10,6 +11,7 @@ shore, ramp, maze; HUD hidden) (the fur pictures are
 from __future__ import annotations
 
 import argparse
+import subprocess
 import sys
 from pathlib import Path
 
@@ -30,11 +32,17 @@ DEFAULT_DIR = Path(__file__).resolve().parents[1] / "assets" / "screenshots"
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
     parser.add_argument("--out-dir", type=Path, default=DEFAULT_DIR)
-    names = sorted([*SHOTS, "skinned_sandbox"])
+    names = sorted([*SHOTS, "skinned_sandbox", "fur"])
     parser.add_argument("--only", choices=names, action="append", help="one picture")
     args = parser.parse_args(argv)
     args.out_dir.mkdir(parents=True, exist_ok=True)
     for name in args.only or names:
+        if name == "fur":  # the fur pictures: their own script, in a process of its own
+            script = Path(__file__).with_name("fur_screenshots.py")
+            done = subprocess.run([sys.executable, str(script), "--out-dir", str(args.out_dir)])
+            if done.returncode:
+                return done.returncode
+            continue
         if name == "skinned_sandbox":
             _close_up(args.out_dir / f"{name}.png")
             continue
