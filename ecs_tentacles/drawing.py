@@ -36,7 +36,8 @@ class RenderView:
     `pixel` (metres one pixel spans at the camera's target): the camera; `overlays`:
     editing aids (the fur controls' markers) are wanted (the sandbox's HUD is showing);
     `state`: objects plugins keep for as long as the renderer lives, across worlds
-    (their GL buffers and display settings), by a key starting with the plugin's name.
+    (their GL buffers and display settings), by a key starting with the plugin's name;
+    `selected`: the creature the sandbox has selected (None: none).
     """
 
     pos: np.ndarray
@@ -49,6 +50,7 @@ class RenderView:
     pixel: float = 0.0
     overlays: bool = False
     state: dict[str, Any] = field(default_factory=dict)
+    selected: int | None = None  # the sandbox's selected creature (an entity), if any
 
 
 @dataclass(frozen=True)

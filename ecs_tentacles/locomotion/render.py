@@ -16,7 +16,7 @@ Writes: goals, through `GoalBook`.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -31,6 +31,9 @@ if TYPE_CHECKING:
     from ecs_tentacles.host import Host
 
 GOALS = "locomotion.goals"  # the key of the cached geometry in the renderer's state
+ALL_PATHS = 8  # up to this many creatures every path is drawn in full
+FADED = 0.35  # how much of its colour a crowd creature's ring keeps
+FADE_TO = np.array([0.62, 0.56, 0.44])  # toward the ground's colour
 LIFT = 0.005  # metres above the ground the lines are drawn
 
 
@@ -39,7 +42,7 @@ class GoalLines:
     """Rings, posts and legs between goals of one world at one `GoalBook.version`."""
 
     world: Host
-    version: int
+    version: Any  # (the goal book's version, the selection) it was made for
     fixed: np.ndarray  # line-list vertices (2n, 7)
     leader_rows: np.ndarray  # Transform rows of the creatures that have a goal
     leader_ends: np.ndarray  # (n, 3) their current goals
@@ -47,27 +50,38 @@ class GoalLines:
 
 
 def goal_lines(world: Host, view: RenderView) -> GoalLines:
-    """Every path's fixed geometry, from the goal book as it is now."""
+    """Every path's fixed geometry, from the goal book as it is now. In a crowd (more
+    than `ALL_PATHS` creatures) only the selected creature's path is drawn in full and
+    led to from the creature; the others' rings are faded, without legs, so a crowd's
+    picture is not a starburst of lines."""
     book = world.resource(GoalBook)
     fixed: list[np.ndarray] = []
     leaders, firsts, colours = [], [], []
+    crowd = len(view.creatures) > ALL_PATHS
     for entity in view.creatures:
         goals = book.path(entity)
         if not goals:
             continue
+        shown = not crowd or entity == view.selected
         colour = np.append(view.colours[entity] * 0.6 + 0.4, 1.0)
+        if not shown:
+            colour = np.append(colour[:3] * FADED + (1.0 - FADED) * FADE_TO, 1.0)
         points = book.positions(entity) + [0, 0, LIFT]
-        fixed.append(line_segments(points, colour))
-        for goal, point in zip(goals, points, strict=True):
+        if shown:
+            fixed.append(line_segments(points, colour))
+        for goal, point in zip(goals if shown else goals[:1], points, strict=False):
             radius = world.component(goal, Goal).radius
             fixed.append(line_segments(point + radius * CIRCLE, colour))
-            fixed.append(line_segments(np.array([point, point + [0, 0, 0.3]]), colour))
+            if shown:
+                fixed.append(line_segments(np.array([point, point + [0, 0, 0.3]]), colour))
+        if not shown:
+            continue
         leaders.append(world.component(entity, Transform).row)
         firsts.append(points[0])
         colours.append(colour)
     return GoalLines(
         world,
-        int(book.version),
+        (int(book.version), view.selected),
         np.vstack(fixed) if fixed else np.zeros((0, 7)),
         np.array(leaders, dtype=np.int64),
         np.array(firsts).reshape(-1, 3),
@@ -78,7 +92,7 @@ def goal_lines(world: Host, view: RenderView) -> GoalLines:
 def path_lines(world: Host, view: RenderView) -> list[np.ndarray]:
     """This frame's goal rings and paths (line-list vertices), the fixed part cached."""
     cached = view.state.get(GOALS)
-    version = int(world.resource(GoalBook).version)
+    version = (int(world.resource(GoalBook).version), view.selected)
     if not isinstance(cached, GoalLines) or cached.world is not world or cached.version != version:
         cached = view.state[GOALS] = goal_lines(world, view)
     # each creature's leg to its current goal moves with it: one vectorised pass

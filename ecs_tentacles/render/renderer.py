@@ -254,6 +254,7 @@ class Renderer:
             light=LIGHT,
             pixel=float(pixel),
             overlays=self.overlays,
+            selected=self.selected,
             state=self.state,
         )
         return self.render_view

@@ -212,3 +212,21 @@ def _rows(world: World) -> dict[str, int]:
         f"{world.component(c.creature, Creature).name}/{c.name}": c.row
         for _, c in world.query(FurControl)
     }
+
+
+def test_the_timeline_shows_only_for_a_creature_with_fur(make_sandbox: Callable[..., Any]) -> None:
+    import json
+
+    from ecs_tentacles.scene.load import bundled_scene
+
+    scene = json.loads(bundled_scene("hedgehog_octopus").read_text())
+    bare = {"name": "bare", "position": [3.0, 0.0]}  # no fur
+    scene["creatures"].append(bare)
+    sandbox = make_sandbox(scene)
+    sandbox.select(sandbox.world.creature("hedgehog"))
+    sandbox.render()
+    assert "timeline" in sandbox.hud.gui.windows
+    sandbox.select(sandbox.world.creature("bare"))
+    sandbox.render()
+    assert "no fur" in sandbox.hud.gui.rects  # the section says so
+    assert "timeline" not in sandbox.hud.gui.windows  # and shows no timeline

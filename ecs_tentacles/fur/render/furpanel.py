@@ -107,7 +107,8 @@ class FurPanel(Panel):
         self.select_creature(creature)
 
     def windows(self, gui: Gui) -> None:
-        self.timeline.draw(gui, self.sandbox.hud.width)
+        if self.editor.creature is not None:  # a selection without fur has no timeline
+            self.timeline.draw(gui, self.sandbox.hud.width)
 
     # -- selection -------------------------------------------------------------------
     def select_creature(self, entity: int | None) -> None:
