@@ -57,6 +57,8 @@ class Hud:
         self._fold: set[str] = set()  # sections to close on the next frame
         self.name_labels = False  # creatures' names over them (even with the panel hidden)
         self.label_at: Callable[[], list[tuple[str, float, float]]] = list  # (text, x, y)
+        # the selected creature's name over it, while the panel shows (labels off)
+        self.selection_label: Callable[[], list[tuple[str, float, float]]] = list
         self.show_tiers = False  # a marker over each creature, coloured by its physics tier
 
     # -- selection -------------------------------------------------------------------
@@ -115,7 +117,9 @@ class Hud:
         gui = self.gui
         gui.begin_frame()
         if self.name_labels:
-            self._name_labels()
+            self._name_labels(self.label_at())
+        elif self.visible:
+            self._name_labels(self.selection_label())
         if not self.visible:
             return
         imgui.set_next_window_pos((0.0, 0.0))
@@ -148,11 +152,11 @@ class Hud:
         for panel in self.panels:
             panel.windows(gui)
 
-    def _name_labels(self) -> None:
-        """Each `label_at` text centred at its pixel (pyglet's y), on a dark plate."""
+    def _name_labels(self, labels: list[tuple[str, float, float]]) -> None:
+        """Each (text, x, y) centred at its pixel (pyglet's y), on a dark plate."""
         draw = imgui.get_foreground_draw_list()
         pad = 4.0 * self.gui.scale
-        for text, x, y in self.label_at():
+        for text, x, y in labels:
             size = imgui.calc_text_size(text)
             left, top = x - size.x / 2, self.window.height - y - size.y / 2
             plate = imgui.get_color_u32((0.1, 0.1, 0.12, 0.75))

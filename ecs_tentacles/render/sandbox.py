@@ -98,6 +98,7 @@ class Sandbox:
         self.scene_dir = self.world.scene_dir  # plugin files of an edited (dict) scene
         self.hud = Hud(self.window, self.world, visible=hud)
         self.hud.label_at = self.creature_labels
+        self.hud.selection_label = self.selected_label
         self.scripts = Scripts(self.window)
         self.hud.windows.append(self.scripts.draw)
         self.paused = False
@@ -276,6 +277,18 @@ class Sandbox:
         tops[:, 2] += [c.mantle_height * 1.8 + 0.05 for c in names]
         pixels = self.renderer.camera.project(tops)
         return [(c.name, float(x), float(y)) for c, (x, y) in zip(names, pixels, strict=True)]
+
+    def selected_label(self) -> list[tuple[str, float, float]]:
+        """The selected creature's name above it (a crowd's one label), or nothing."""
+        selected = self.renderer.selected
+        if selected is None or selected not in self.renderer.creature_entities:
+            return []
+        index = self.renderer.creature_entities.index(selected)
+        creature = self.world.component(selected, Creature)
+        top = self.world.transforms.pos[self.renderer.mantle_rows[index]].copy()
+        top[2] += creature.mantle_height * 1.8 + 0.05
+        x, y = self.renderer.camera.project(top[None])[0]
+        return [(creature.name, float(x), float(y))]
 
     def screenshot(self, path: str | os.PathLike[str] | None = None) -> Path:
         """Save what the camera sees (with the HUD) as a PNG."""

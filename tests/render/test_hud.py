@@ -220,3 +220,21 @@ def test_slider_values_sit_beside_the_sliders_where_no_handle_covers_them(
         patch = pixels[y0:y1, x0:x1].reshape(-1, 3).astype(float)
         assert (patch.mean(axis=1) < 128).any()  # the text is there
         assert not (np.abs(patch - grab).max(axis=1) < 30).any(), name  # and no handle on it
+
+
+def test_the_selection_has_a_name_plate_over_it(make_sandbox: Callable[..., Any]) -> None:
+    """A crowd shows one compact label: the selected creature's name on a dark plate."""
+    sandbox = make_sandbox(
+        {
+            "version": 1,
+            "creatures": [{"name": f"c{i}", "position": [3.0 * i, 0]} for i in range(12)],
+        }
+    )
+    chosen = sandbox.world.creature("c5")
+    sandbox.select(chosen)
+    ((text, x, y),) = sandbox.selected_label()
+    assert text == "c5"
+    sandbox.render()
+    pixels = sandbox.renderer.target.read().astype(int)
+    r, g, b = pixels[sandbox.window.height - round(y), round(x)]
+    assert max(r, g, b) < 80  # the plate (or its white letters' dark ground) is there
