@@ -27,7 +27,6 @@ import numpy as np
 if TYPE_CHECKING:
     from collections.abc import Sequence
 
-SHAPES = ("box", "cylinder", "sphere", "mesh")
 NORMAL_SPAN = 0.05  # metres either side over which the slope under a point is measured
 NEAR = 0.5  # metres past a solid's bounding sphere within which distances to it are exact
 BEYOND_DROP = 0.002  # metres the plane past a heightfield's edge lies under its lowest point

@@ -178,6 +178,7 @@ class Navigator:
         self.planned = np.zeros((0, 3))  # the goal each route was planned for
         self.best = np.zeros(0)  # closest to the current waypoint so far
         self.since = np.zeros(0)  # when `best` last improved
+        self.target = np.zeros((0, 3))  # each route's next waypoint (NaN: none), for arrays
         self.grid: CostGrid | None = None
         self._ground: Ground | None = None
         self.plans = 0  # routes planned so far (first plans and re-plans)
@@ -193,6 +194,9 @@ class Navigator:
             *(a.copy() for a in state[1:]),
         )
         self.routes = routes
+        self.target = np.full((len(self.best), 3), np.nan)
+        for row, route in routes.items():
+            self.target[row] = route[0]
 
     def waypoints(self, row: int) -> np.ndarray:
         """(k, 3) the waypoints creature `row` still has to pass (none: straight on)."""
@@ -213,23 +217,23 @@ class Navigator:
         for row in np.flatnonzero(changed).tolist():
             self._plan(world, g, row, mantle[row])
         self.planned[~steering] = np.nan
-        for row in [r for r in self.routes if not steering[r]]:
-            del self.routes[row]
-        if not self.routes:
+        routed = ~np.isnan(self.target[:, 0])
+        for row in np.flatnonzero(routed & ~steering).tolist():  # goal gone or navigation off
+            self._drop(row)
+        rows = np.flatnonzero(routed & steering)
+        if not len(rows):
             return
-        rows = np.fromiter(self.routes, dtype=np.int64, count=len(self.routes))
-        target = np.array([self.routes[r][0] for r in rows.tolist()])
-        distance = np.linalg.norm(mantle[rows, :2] - target[:, :2], axis=1)
-        for row in rows[distance < WAYPOINT_RADIUS].tolist():
+        distance = np.linalg.norm(mantle[rows, :2] - self.target[rows, :2], axis=1)
+        for row in rows[distance < WAYPOINT_RADIUS].tolist():  # events: a waypoint passed
             self._advance(world, row)
         improved = distance < self.best[rows] - PROGRESS
         self.best[rows[improved]] = distance[improved]
         self.since[rows[improved]] = world.time
-        for row in rows[world.time - self.since[rows] > STUCK_SECONDS].tolist():
-            if row in self.routes:
-                self._plan(world, g, row, mantle[row])
-        for row, route in self.routes.items():
-            g.steer[row] = route[0]
+        stuck = rows[world.time - self.since[rows] > STUCK_SECONDS]
+        for row in stuck[~np.isnan(self.target[stuck, 0])].tolist():
+            self._plan(world, g, row, mantle[row])
+        routed = np.flatnonzero(~np.isnan(self.target[:, 0]))
+        g.steer[routed] = self.target[routed]
 
     def _start(self, world: Host, ground: Ground) -> None:
         n = len(world.creatures)
@@ -238,6 +242,7 @@ class Navigator:
         self.planned = np.full((n, 3), np.nan)
         self.best = np.full(n, np.inf)
         self.since = np.zeros(n)
+        self.target = np.full((n, 3), np.nan)
         longest = np.zeros(n)
         np.maximum.at(longest, world.tentacles.creature_row, world.tentacles.length)
         reach = float((world.creatures.mantle_radius + longest).max())
@@ -247,7 +252,7 @@ class Navigator:
 
     def _plan(self, world: Host, g: Any, row: int, mantle: np.ndarray) -> None:
         self.planned[row] = g.goal[row]
-        self.routes.pop(row, None)
+        self._drop(row)
         self._reset_progress(world, row)
         if self.grid is None or self.grid.clear_line(mantle[:2], g.goal[row, :2]):
             return  # the goal is in plain sight
@@ -256,15 +261,23 @@ class Navigator:
         if route is None or len(route) < 2:
             return  # nowhere to go around: straight at the goal, as without navigation
         assert self._ground is not None
-        self.routes[row] = np.column_stack([route[:-1], self._ground.surface(route[:-1])])
+        self._set(row, np.column_stack([route[:-1], self._ground.surface(route[:-1])]))
 
     def _advance(self, world: Host, row: int) -> None:
-        route = self.routes[row][1:]
-        if len(route):
-            self.routes[row] = route
-        else:
-            del self.routes[row]
+        self._set(row, self.routes[row][1:])
         self._reset_progress(world, row)
+
+    def _set(self, row: int, route: np.ndarray) -> None:
+        """Creature `row` follows `route` (waypoints; none: straight at its goal)."""
+        if not len(route):
+            self._drop(row)
+            return
+        self.routes[row] = route
+        self.target[row] = route[0]
+
+    def _drop(self, row: int) -> None:
+        self.routes.pop(row, None)
+        self.target[row] = np.nan
 
     def _reset_progress(self, world: Host, row: int) -> None:
         self.best[row] = np.inf

@@ -46,8 +46,8 @@ from tqdm import tqdm
 from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.drawing import Click, Panel
 from ecs_tentacles.ground import ground_of
-from ecs_tentacles.render.camera import ray_sphere
 from ecs_tentacles.render.hud import Hud
+from ecs_tentacles.render.on_screen import creature_at, labels_over
 from ecs_tentacles.render.output import VideoWriter, save_png
 from ecs_tentacles.render.plugin import RenderPlugin
 from ecs_tentacles.render.renderer import Renderer
@@ -269,26 +269,12 @@ class Sandbox:
 
     def creature_labels(self) -> list[tuple[str, float, float]]:
         """Each creature's name at the pixel above its mantle (for `hud.name_labels`)."""
-        rows = self.renderer.mantle_rows
-        if not len(rows):
-            return []
-        tops = self.world.transforms.pos[rows].copy()
-        names = [self.world.component(e, Creature) for e in self.renderer.creature_entities]
-        tops[:, 2] += [c.mantle_height * 1.8 + 0.05 for c in names]
-        pixels = self.renderer.camera.project(tops)
-        return [(c.name, float(x), float(y)) for c, (x, y) in zip(names, pixels, strict=True)]
+        return labels_over(self.world, self.renderer, self.renderer.creature_entities)
 
     def selected_label(self) -> list[tuple[str, float, float]]:
         """The selected creature's name above it (a crowd's one label), or nothing."""
         selected = self.renderer.selected
-        if selected is None or selected not in self.renderer.creature_entities:
-            return []
-        index = self.renderer.creature_entities.index(selected)
-        creature = self.world.component(selected, Creature)
-        top = self.world.transforms.pos[self.renderer.mantle_rows[index]].copy()
-        top[2] += creature.mantle_height * 1.8 + 0.05
-        x, y = self.renderer.camera.project(top[None])[0]
-        return [(creature.name, float(x), float(y))]
+        return [] if selected is None else labels_over(self.world, self.renderer, [selected])
 
     def screenshot(self, path: str | os.PathLike[str] | None = None) -> Path:
         """Save what the camera sees (with the HUD) as a PNG."""
@@ -316,15 +302,7 @@ class Sandbox:
 
     def pick_creature(self, x: float, y: float) -> int | None:
         """The creature whose mantle is under pixel (x, y), nearest first."""
-        if not self.renderer.creature_entities:
-            return None
-        origin, direction = self.renderer.camera.ray(x, y)
-        creatures = [self.world.component(e, Creature) for e in self.renderer.creature_entities]
-        centres = self.world.transforms.pos[self.renderer.mantle_rows]
-        radii = np.array([max(c.mantle_radius, c.mantle_height / 2) * 1.25 for c in creatures])
-        hits = ray_sphere(origin, direction, centres, radii)
-        best = int(np.argmin(hits))
-        return self.renderer.creature_entities[best] if np.isfinite(hits[best]) else None
+        return creature_at(self.world, self.renderer, x, y)
 
     def ground_point(self, x: float, y: float) -> np.ndarray | None:
         """Where the ray through pixel (x, y) first meets the ground: the terrain or an

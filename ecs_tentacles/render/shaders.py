@@ -29,7 +29,8 @@ void main() {
 }
 """
 
-LIT_FRAGMENT = """
+# what a lit surface's fragment shader takes (the instanced vertex shader's outputs)
+_LIT_HEAD = """
 #version 330 core
 in vec3 v_normal;
 in vec4 v_colour;
@@ -37,7 +38,11 @@ in vec3 v_world;
 uniform vec3 u_light;
 uniform vec3 u_eye;
 out vec4 f_colour;
-void main() {
+"""
+
+LIT_FRAGMENT = (
+    _LIT_HEAD
+    + """void main() {
     vec3 n = normalize(v_normal);
     float diffuse = max(dot(n, u_light), 0.0);
     float sky = 0.5 + 0.5 * n.z;                       // hemisphere ambient
@@ -49,6 +54,7 @@ void main() {
     f_colour = vec4(colour, v_colour.a);
 }
 """
+)
 
 GROUND_VERTEX = """
 #version 330 core
@@ -91,15 +97,9 @@ void main() {
 }
 """.replace("// @grid\n", _GRID).replace("    // @fog\n", _FOG)
 
-TERRAIN_FRAGMENT = """
-#version 330 core
-in vec3 v_normal;
-in vec4 v_colour;
-in vec3 v_world;
-uniform vec3 u_light;
-uniform vec3 u_eye;
-out vec4 f_colour;
-// @grid
+TERRAIN_FRAGMENT = (
+    _LIT_HEAD
+    + """// @grid
 void main() {
     vec3 n = normalize(gl_FrontFacing ? v_normal : -v_normal);
     float diffuse = max(dot(n, u_light), 0.0);
@@ -110,6 +110,7 @@ void main() {
     // @fog
 }
 """.replace("// @grid\n", _GRID).replace("    // @fog\n", _FOG)
+)
 
 BLOB_VERTEX = """
 #version 330 core

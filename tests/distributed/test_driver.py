@@ -203,20 +203,8 @@ def test_a_failed_shard_is_named_and_resume_bakes_only_the_others(
 def test_ctrl_c_or_sigterm_cancels_the_bake_and_leaves_no_output(
     cluster: Path, crowd: Path, tmp_path: Path, stop: int, code: int, message: str
 ) -> None:
-    out = tmp_path / "ray.npz"
     address = ray.get_runtime_context().gcs_address
-    argv = [sys.executable, "-m", "ecs_tentacles", "bake", str(crowd), "--seconds", "20"]
-    process = subprocess.Popen(
-        [*argv, "--out", str(out), "--ray", address, "--quiet"],
-        stderr=subprocess.PIPE,
-        text=True,
-        cwd=tmp_path,
-    )
-    assert process.stderr is not None
-    line = process.stderr.readline()
-    while line and not line.startswith("ray:"):
-        line = process.stderr.readline()
-    time.sleep(1.0)  # the tasks are running
+    process = _running_bake(crowd, tmp_path, "--ray", address)
     process.send_signal(stop)
     _, err = process.communicate(timeout=60)
     assert process.returncode == code, err
@@ -224,6 +212,24 @@ def test_ctrl_c_or_sigterm_cancels_the_bake_and_leaves_no_output(
     assert sorted(p.name for p in tmp_path.iterdir()) == ["crowd.json"]
     time.sleep(0.5)
     assert ray.available_resources().get("CPU") == 2  # the cancelled tasks freed their CPUs
+
+
+def _running_bake(scene: Path, folder: Path, *ray: str) -> subprocess.Popen[str]:
+    """A 20 s `bake SCENE --out FOLDER/ray.npz` on Ray (options `ray`) in a process of its
+    own, returned once its tasks run (a second after it reports the shards)."""
+    argv = [sys.executable, "-m", "ecs_tentacles", "bake", str(scene), "--seconds", "20"]
+    process = subprocess.Popen(
+        [*argv, "--out", str(folder / "ray.npz"), *ray, "--quiet"],
+        stderr=subprocess.PIPE,
+        text=True,
+        cwd=folder,
+    )
+    assert process.stderr is not None
+    line = process.stderr.readline()
+    while line and not line.startswith("ray:"):
+        line = process.stderr.readline()
+    time.sleep(1.0)  # the tasks are running
+    return process
 
 
 def _ray_processes() -> set[tuple[int, float]]:
@@ -242,18 +248,7 @@ def test_a_killed_bake_leaves_no_ray_processes_behind(crowd: Path, tmp_path: Pat
     """SIGKILL cannot be handled: the watchdog `bake --ray` starts with its local Ray
     ends that Ray's processes (GCS, raylet, agents, workers) instead."""
     before = _ray_processes()
-    argv = [sys.executable, "-m", "ecs_tentacles", "bake", str(crowd), "--seconds", "20"]
-    process = subprocess.Popen(
-        [*argv, "--out", str(tmp_path / "ray.npz"), "--ray", "--cpus", "1", "--quiet"],
-        stderr=subprocess.PIPE,
-        text=True,
-        cwd=tmp_path,
-    )
-    assert process.stderr is not None
-    line = process.stderr.readline()
-    while line and not line.startswith("ray:"):
-        line = process.stderr.readline()
-    time.sleep(1.0)  # its Ray runs the tasks
+    process = _running_bake(crowd, tmp_path, "--ray", "--cpus", "1")
     started = _ray_processes() - before
     assert started  # a local Ray of its own
     process.kill()
