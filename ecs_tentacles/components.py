@@ -38,10 +38,25 @@ class RowField:
 
 @dataclass(eq=False, slots=True)
 class RowComponent:
-    """Base of components whose numeric fields (`RowField`s) live in one store row."""
+    """Base of components whose numeric fields (`RowField`s) live in one store row.
+
+    Made as `Transform(store, row)`; it keeps the row's handle (`ArrayStore.row_of`), so
+    `row` stays right when a despawn moves the rows after a removed creature's up.
+    """
 
     store: ArrayStore
-    row: int
+    handle: int  # given a row when made; kept as that row's handle
+
+    def __post_init__(self) -> None:
+        self.handle = self.store.handle_at(self.handle)
+
+    @property
+    def row(self) -> int:
+        """The store row this component's numbers are in now."""
+        row = self.store.row_of(self.handle)
+        if row < 0:
+            raise LookupError(f"this {type(self).__name__}'s creature was despawned")
+        return row
 
     def __repr__(self) -> str:
         names = [

@@ -18,8 +18,8 @@ Reads and writes nothing itself.
 from __future__ import annotations
 
 import pathlib
-from collections.abc import Iterator
-from typing import TYPE_CHECKING, Any, Protocol, TypeVar
+from collections.abc import Iterator, Mapping, Sequence
+from typing import TYPE_CHECKING, Any, Literal, Protocol, TypeVar
 
 from ecs_tentacles.physics.host import PhysicsHost
 
@@ -50,6 +50,20 @@ class Host(PhysicsHost, Protocol):
 
     @property
     def scene_dir(self) -> pathlib.Path | None: ...
+    @property
+    def creature_specs(self) -> dict[int, dict[str, Any]]:
+        """Every creature's entry (validated, defaults in) by entity, spawned ones too."""
+
+    # -- creatures that come and go (`ecs_tentacles.spawning`) ----------------------------
+    def spawn(
+        self,
+        creature: Mapping[str, Any],
+        *,
+        position: Sequence[float] | None = None,
+        heading_deg: float | None = None,
+        on_overlap: Literal["refuse", "move"] = "refuse",
+    ) -> int: ...
+    def despawn(self, creature: int) -> None: ...
 
     # -- the other core stores (every store by name in `stores`) ---------------------------
     @property

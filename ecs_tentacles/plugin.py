@@ -26,6 +26,7 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, ClassVar
 
+from ecs_tentacles.roster_change import RosterChange
 from ecs_tentacles.system import System
 from ecs_tentacles.take_tracks import TakeTrack
 
@@ -163,6 +164,15 @@ class Plugin:
 
     def build_scene(self, world: Host, scene: Mapping[str, Any]) -> None:
         """Called once after every creature is built, before physics is compiled."""
+
+    def roster_changed(self, world: Host, change: RosterChange) -> None:
+        """A creature was spawned (after `build_creature` and its physics) or despawned
+        (after its rows left every store): follow it in anything kept beside the stores
+        (`ecs_tentacles.roster_change`). Before a despawn, `despawning` is called."""
+
+    def despawning(self, world: Host, creature: int) -> None:
+        """Creature `creature` is about to be despawned (its rows and entities still
+        exist): remove what this plugin made for it outside the stores (goal entities)."""
 
     def systems(self) -> list[System]:
         """Fresh instances of this plugin's systems (each declares its stage)."""

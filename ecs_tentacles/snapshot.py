@@ -9,8 +9,12 @@ A snapshot holds every store's live rows, the physics' own state
 health check's memory, the sleep counters, the physics clock), what each plugin saves
 (`Plugin.snapshot`: goal paths and action queues, fur stores, threats), the state
 systems declare (`System.state_attributes`), the frame counter and the random
-generator. It lives in
-memory and belongs to the world it came from (same entities, same groups).
+generator, and the roster (every creature's entry, by entity). It lives in memory and
+belongs to the world it came from.
+
+Creatures spawned since the snapshot are despawned by a restore (the world goes back
+to the roster it had). A creature despawned since cannot come back with its old
+entity: such a restore is refused, and nothing changes.
 """
 
 from __future__ import annotations
@@ -42,6 +46,8 @@ class Snapshot:
     physics: PhysicsState
     plugins: dict[str, Any]
     systems: dict[str, dict[str, Any]] = field(default_factory=dict)
+    roster: dict[int, str] = field(default_factory=dict)  # creature entity -> name
+    origin: str = ""  # the world it was taken of (its esper context)
 
 
 def _stores(world: Restorable) -> dict[str, ArrayStore]:
@@ -61,7 +67,15 @@ def take(world: Restorable) -> Snapshot:
             for system in world.schedule
             if system.state_attributes
         },
+        roster={entity: creature.name for entity, creature in _creatures(world)},
+        origin=getattr(world, "context", ""),
     )
+
+
+def _creatures(world: Restorable) -> list[tuple[int, Any]]:
+    from ecs_tentacles.components import Creature
+
+    return sorted(world.query(Creature))
 
 
 class SnapshotMismatch(ValueError):
@@ -84,7 +98,19 @@ def restore(world: Restorable, snapshot: Snapshot) -> None:
     """Put the world back in `snapshot`'s state.
 
     Raises SnapshotMismatch (and changes nothing) when the snapshot is of another world
-    whose stores or physics do not have the same shape."""
+    whose stores or physics do not have the same shape, or names a creature despawned
+    since. Creatures spawned since are despawned."""
+    alive = {entity for entity, _ in _creatures(world)}
+    same = snapshot.origin == getattr(world, "context", "")  # else: shapes must fit as they are
+    gone = [name for entity, name in snapshot.roster.items() if entity not in alive]
+    if same and gone:
+        raise SnapshotMismatch(
+            f"cannot restore this snapshot: creature {gone[0]!r} was despawned since"
+            " (spawn it again from world.creature_specs, or restore a later snapshot)"
+        )
+    if same:
+        for entity in sorted(alive - set(snapshot.roster), reverse=True):
+            world.despawn(entity)
     problem = mismatch(world, snapshot)
     if problem:
         raise SnapshotMismatch(f"cannot restore a snapshot of another world: {problem}")

@@ -4,25 +4,40 @@ Each store owns one contiguous numpy array per field, with a row per entity of i
 kind. Built-in systems do whole-array math on `store.<field>` (a view of the live
 rows); components (`ecs_tentacles.components`) hold a store and a row and expose
 the same fields as writable views, so scripts can write
-`world.component(link, Motor).target`. Rows are never removed; stores grow by
-doubling, which is why components look their field up on every access instead of
-keeping an old view.
+`world.component(link, Motor).target`. Stores grow by doubling, which is why
+components look their field up on every access instead of keeping an old view.
+
+Rows are removed when a creature is despawned (`ArrayStore.remove`): the rows after
+them move up, so every row keeps its order (a tentacle's links stay contiguous). A
+column that holds rows of another store says so (`Field(refers="transforms")`) and is
+renumbered with it; a store whose rows line up with another's (`lines_up_with`) loses
+the same rows. Components keep a *handle* to their row, which never changes, so a
+component made before a removal still finds its numbers after it.
 """
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
+
+HANDLE = "__handle__"  # the key of the rows' handles among a store's arrays
 
 
 class Field:
     """A column of an `ArrayStore`: per-row shape, dtype and the value new rows get."""
 
-    def __init__(self, shape: tuple[int, ...] = (), dtype: Any = np.float64, default: Any = 0):
+    def __init__(
+        self,
+        shape: tuple[int, ...] = (),
+        dtype: Any = np.float64,
+        default: Any = 0,
+        refers: str | None = None,
+    ):
         self.shape = shape
         self.dtype = np.dtype(dtype)
         self.default = default
+        self.refers = refers  # a store name ("transforms"): these are its rows (-1: none)
         self.name = ""
 
     def __set_name__(self, owner: type, name: str) -> None:
@@ -41,12 +56,19 @@ class ArrayStore:
     """Rows of numbers for one kind of entity; subclasses declare `Field`s."""
 
     _declared_fields: tuple[Field, ...]  # `fields()`, set on each class at its first call
+    # the store (by name in `world.stores`) whose rows this one's line up with, row for
+    # row: it loses the same rows when a creature is despawned
+    lines_up_with: ClassVar[str | None] = None
 
     def __init__(self, capacity: int = 16):
         self.count = 0
         self._arrays: dict[str, np.ndarray] = {
             f.name: np.empty((capacity, *f.shape), dtype=f.dtype) for f in self.fields()
         }
+        # every row's handle (not a field: systems never see it), kept with the rows
+        self._arrays[HANDLE] = np.empty(capacity, dtype=np.int64)
+        self._row_of_handle = np.full(capacity, -1, dtype=np.int64)
+        self._handles = 0  # handles issued
 
     @classmethod
     def fields(cls) -> list[Field]:
@@ -77,8 +99,57 @@ class ArrayStore:
         start, stop = self.count, self.count + n
         for field in self.fields():
             self._arrays[field.name][start:stop] = values.get(field.name, field.default)
+        # (the handles are set below)
+        handles = np.arange(self._handles, self._handles + n)
+        self._arrays[HANDLE][start:stop] = handles
+        self._handles += n
+        if self._handles > len(self._row_of_handle):
+            grown = np.full(max(2 * len(self._row_of_handle), self._handles), -1, np.int64)
+            grown[: len(self._row_of_handle)] = self._row_of_handle
+            self._row_of_handle = grown
+        self._row_of_handle[handles] = np.arange(start, stop)
         self.count = stop
         return np.arange(start, stop)
+
+    def handle_at(self, row: int) -> int:
+        """The handle of row `row`: it names that row whatever rows are removed before it."""
+        if not 0 <= row < self.count:
+            raise IndexError(f"{type(self).__name__} has no row {row} ({self.count} rows)")
+        return int(self._arrays[HANDLE][row])
+
+    def row_of(self, handle: int) -> int:
+        """The row that handle `handle` names now, or -1 when it was removed."""
+        return int(self._row_of_handle[handle])
+
+    def remove(self, rows: np.ndarray) -> np.ndarray:
+        """Remove `rows`; the rows after them move up. Returns every old row's new row
+        (-1: removed), for renumbering what refers to this store (`renumber`)."""
+        rows = np.unique(np.asarray(rows, dtype=np.int64))
+        new = np.arange(self.count) - np.searchsorted(rows, np.arange(self.count))
+        new[rows] = -1
+        if not len(rows):
+            return new
+        self._row_of_handle[self._arrays[HANDLE][rows]] = -1
+        first, last, count = int(rows[0]), int(rows[-1]) + 1, self.count
+        if last - first == len(rows):  # one run (a creature's rows): move the tail up
+            for array in self._arrays.values():
+                array[first : count - len(rows)] = array[last:count]
+        else:
+            keep = new >= 0
+            for array in self._arrays.values():
+                kept = array[:count][keep]
+                array[: len(kept)] = kept
+        self.count = count - len(rows)
+        self._row_of_handle[self._arrays[HANDLE][: self.count]] = np.arange(self.count)
+        return new
+
+    def renumber(self, store: str, new: np.ndarray) -> None:
+        """Rows of `store` moved (`remove`'s answer): every field that refers to it follows."""
+        for field in self.fields():
+            if field.refers == store:
+                values = self._arrays[field.name][: self.count]
+                valid = values >= 0
+                values[valid] = new[values[valid]]
 
     def _reserve(self, needed: int) -> None:
         capacity = self.capacity
@@ -86,7 +157,7 @@ class ArrayStore:
             return
         while capacity < needed:
             capacity = max(2 * capacity, 16)
-        for name, array in self._arrays.items():
+        for name, array in self._arrays.items():  # (handles are in `_arrays` too)
             grown = np.empty((capacity, *array.shape[1:]), dtype=array.dtype)
             grown[: self.count] = array[: self.count]
             self._arrays[name] = grown
@@ -128,6 +199,13 @@ class ArrayStore:
         self.count, arrays = state
         for f, values in arrays.items():
             self._arrays[f][: self.count] = values
+        self._row_of_handle[:] = -1
+        handles = self._arrays[HANDLE][: self.count]
+        if len(handles):
+            self._handles = max(self._handles, int(handles.max()) + 1)
+        if self._handles > len(self._row_of_handle):
+            self._row_of_handle = np.full(self._handles, -1, np.int64)
+        self._row_of_handle[handles] = np.arange(self.count)
 
 
 class TransformStore(ArrayStore):
@@ -152,7 +230,7 @@ class MotorStore(ArrayStore):
     damping = Field()
     max_torque = Field()
     gain = Field(default=1.0)
-    tentacle_row = Field(dtype=np.int64)
+    tentacle_row = Field(dtype=np.int64, refers="tentacles")
     arc = Field()
     scale = Field(default=1.0)  # the link's construction scale (tapers strength)
 
@@ -165,12 +243,12 @@ class TentacleStore(ArrayStore):
     in that feature's stores, row for row (`ecs_tentacles.locomotion.stores`).
     """
 
-    creature_row = Field(dtype=np.int64)
+    creature_row = Field(dtype=np.int64, refers="creatures")
     base_angle = Field()
-    first_link = Field(dtype=np.int64)
+    first_link = Field(dtype=np.int64, refers="motors")
     links = Field(dtype=np.int64)
-    base_row = Field(dtype=np.int64)  # transform row of the first link
-    tip_sucker = Field(dtype=np.int64)  # sucker row on the tip link
+    base_row = Field(dtype=np.int64, refers="transforms")  # transform row of the first link
+    tip_sucker = Field(dtype=np.int64, refers="suckers")  # sucker row on the tip link
     length = Field()
     joint_limit = Field()
     rest_pitch = Field()  # tilt that lays a tapering tentacle's underside on the ground
@@ -180,17 +258,17 @@ class CreatureStore(ArrayStore):
     """Per creature: its mantle row and size and its tentacle rows (features keep the rest)."""
 
     entity = Field(dtype=np.int64)
-    mantle_row = Field(dtype=np.int64)
+    mantle_row = Field(dtype=np.int64, refers="transforms")
     mantle_radius = Field()
-    first_tentacle = Field(dtype=np.int64)
+    first_tentacle = Field(dtype=np.int64, refers="tentacles")
     tentacles = Field(dtype=np.int64)
 
 
 class SuckerStore(ArrayStore):
     """Suckers: the link body row they sit on, offset in the link frame, attachment state."""
 
-    link_row = Field(dtype=np.int64)
-    tentacle_row = Field(dtype=np.int64)
+    link_row = Field(dtype=np.int64, refers="transforms")
+    tentacle_row = Field(dtype=np.int64, refers="tentacles")
     entity = Field(dtype=np.int64)
     offset = Field((3,))
     attached = Field(dtype=np.bool_, default=False)

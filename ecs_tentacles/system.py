@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING, ClassVar
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
+    from ecs_tentacles.roster_change import RosterChange
 
 STAGES = ("decide", "act", "physics", "sync", "animate", "output")
 DEFAULT_STAGE = "act"
@@ -53,6 +54,10 @@ class System:
 
     def setup(self, world: Host) -> None:
         """Called once when the system joins a world (after physics is built)."""
+
+    def roster_changed(self, world: Host, change: RosterChange) -> None:
+        """A creature was spawned or despawned (`ecs_tentacles.roster_change`): rebuild
+        whatever `setup` made per row or per creature. Default: nothing."""
 
     def process(self, world: Host, dt: float) -> None:
         """Called once per frame, in schedule order; `dt` is the frame duration."""

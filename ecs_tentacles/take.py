@@ -36,7 +36,7 @@ from typing import Any, BinaryIO
 
 import numpy as np
 
-from ecs_tentacles import take_ground
+from ecs_tentacles import take_ground, take_roster
 from ecs_tentacles.atomic import atomic_file
 from ecs_tentacles.take_read import (
     FORMAT,
@@ -68,7 +68,9 @@ class Take:
     (`ecs_tentacles.take_tracks`): goals [{name, creature, radius}], guides (null, or
     {creatures: [creature index per guide]}); `tracks` lists declared tracks, if any;
     `ground` the terrain's and obstacles' meshes on terrain (`ecs_tentacles.take_ground`;
-    their arrays are in `tracks` too, by file name: `ground_meshes()` gives them).
+    their arrays are in `tracks` too, by file name: `ground_meshes()` gives them);
+    `roster` when creatures came or went during the recording (`ecs_tentacles.take_roster`:
+    `visible()` gives which creatures are there at each frame).
     """
 
     header: dict[str, Any]
@@ -117,6 +119,11 @@ class Take:
         """(name, `StaticMesh`) of the terrain and obstacles (none on the plane)."""
         return take_ground.meshes_of(self.header, self.tracks)
 
+    def visible(self) -> np.ndarray:
+        """(frames, creatures) bool: which creatures are there at each frame (all of them
+        unless the roster changed while recording; `ecs_tentacles.take_roster`)."""
+        return take_roster.visible(self.header, self.tracks)
+
     def track_list(self) -> list[TakeTrack]:
         """Every track of this take, in file order (`ecs_tentacles.take_tracks`)."""
         return tracks_of(self.header)
@@ -134,6 +141,7 @@ class Take:
         out = {"header": np.frombuffer(text.encode(), dtype=np.uint8)}
         names = [*CORE_ARRAYS[1:], *(a for t in self.track_list() for a in t.arrays)]
         names += list(take_ground.dtypes(self.header))
+        names += list(take_roster.dtypes(self.header))
         for name in names:
             value = self.array(name)
             if value is not None:
@@ -177,7 +185,7 @@ class Take:
             if track.kind == "curves" and first is not None:
                 points[track.arrays[0]] = first.shape[2] if first.ndim == 4 else -1
         known = {*CORE_ARRAYS, *(a for t in tracks for a in t.arrays)}
-        known |= set(take_ground.dtypes(self.header))
+        known |= set(take_ground.dtypes(self.header)) | set(take_roster.dtypes(self.header))
         unknown = sorted(set(self.tracks) - known)
         if unknown:
             return f"{unknown[0]}: not a track of this take"

@@ -31,7 +31,7 @@ from typing import IO, Any, cast
 
 import numpy as np
 
-from ecs_tentacles import take_ground
+from ecs_tentacles import take_ground, take_roster
 from ecs_tentacles.take_tracks import TakeTrack, declared_problem, dtypes, tracks_of
 
 MAX_TAKE_BYTES = 2 * 1024**3  # uncompressed; a 10 s bake of 4 creatures is ~30 MB
@@ -205,6 +205,7 @@ def header_problem(header: object) -> str | None:
         or _body_problem(header)
         or _parts_problem(header)
         or take_ground.problem(header)
+        or take_roster.problem(header)
     )
 
 
@@ -231,6 +232,7 @@ def expected_shapes(
             shapes[first] = (frames, curves, points[first], 3)
             shapes[second] = (frames, curves, points[first])
     shapes.update(take_ground.shapes(header))
+    shapes.update(take_roster.shapes(header))
     return shapes
 
 
@@ -241,6 +243,7 @@ def array_dtypes(header: dict[str, Any]) -> dict[str, np.dtype[Any]]:
         for name, dtype in zip(track.arrays, dtypes(track), strict=True):
             out[name] = np.dtype(dtype)
     out.update(take_ground.dtypes(header))
+    out.update(take_roster.dtypes(header))
     return out
 
 

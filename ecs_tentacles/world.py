@@ -14,8 +14,8 @@ from __future__ import annotations
 import os
 import pathlib
 import uuid
-from collections.abc import Callable, Collection, Iterator, Mapping
-from typing import TYPE_CHECKING, Any, TypeVar
+from collections.abc import Callable, Collection, Iterator, Mapping, Sequence
+from typing import TYPE_CHECKING, Any, Literal, TypeVar
 
 import esper
 import numpy as np
@@ -77,6 +77,8 @@ class World:
         self._physics: PhysicsBackend | None = None
         self.scene: dict[str, Any] | None = None  # the validated scene, defaults filled in
         self.scene_dir: pathlib.Path | None = None  # its folder: plugin files are found there
+        # every creature's entry (validated, defaults in) by entity: the scene's and spawns'
+        self.creature_specs: dict[int, dict[str, Any]] = {}
         self.frame = 0
 
     # -- construction ------------------------------------------------------------------
@@ -124,6 +126,36 @@ class World:
             scene_dir=scene_dir,
             lod=lod,
         )
+
+    # -- creatures that come and go ------------------------------------------------------
+    def spawn(
+        self,
+        creature: Mapping[str, Any],
+        *,
+        position: Sequence[float] | None = None,
+        heading_deg: float | None = None,
+        on_overlap: Literal["refuse", "move"] = "refuse",
+    ) -> int:
+        """Build one creature (a scene-style entry) into this running world; its entity.
+
+        Validated as a scene entry (`SpawnError`, one line per problem); a taken name
+        gets a suffix (`octo_2`). Overlapping a creature or an obstacle is refused, or
+        with `on_overlap="move"` moved to the nearest free spot. Other creatures step
+        on exactly as if it never came. Emits `creature_spawned`
+        (`ecs_tentacles.spawning`).
+        """
+        from ecs_tentacles.spawning import spawn
+
+        return spawn(
+            self, creature, position=position, heading_deg=heading_deg, on_overlap=on_overlap
+        )
+
+    def despawn(self, creature: int) -> None:
+        """Remove creature `creature` (an entity) and all it owns; others step on as if it
+        had stayed away from them. Emits `creature_despawned` (`ecs_tentacles.spawning`)."""
+        from ecs_tentacles.spawning import despawn
+
+        despawn(self, creature)
 
     def build_physics(self, threads: int | None = None) -> PhysicsBackend:
         """Compile the physics groups from the current entities and sync the Transform store.

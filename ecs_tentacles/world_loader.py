@@ -40,6 +40,7 @@ class SceneWorld(Host, Protocol):
 
     scene: dict[str, Any] | None
     scene_dir: pathlib.Path | None
+    creature_specs: dict[int, dict[str, Any]]
 
     def adopt(self, plugin: Plugin) -> None: ...
     def build_physics(self, threads: int | None = None) -> object: ...
@@ -95,6 +96,7 @@ def load_world(
     for index, creature in enumerate(data["creatures"]):
         if only is None or index in only:
             entity = build_creature(world, creature)
+            world.creature_specs[entity] = creature
             for plugin in chosen:
                 plugin.build_creature(world, entity, creature)
     for plugin in chosen:

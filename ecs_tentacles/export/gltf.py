@@ -3,8 +3,9 @@
 Nodes mirror the USD layout and names: `World` / `<c>` / `<c>_mantle` and
 `<c>_tentacles` / `<c>_t<k>` / `<c>_t<k>_link<i>` (unique: `ecs_tentacles.export.names`).
 Parents carry no transform, so each body node's translation and rotation are its world
-pose; one animation (`<scene>_animation`) has a translation and a rotation channel per
-body (LINEAR, a key per take frame, time =
+pose (a creature that comes or goes during the take has its root's scale keyed to zero
+while it is not there: `scale_visibility`); one animation (`<scene>_animation`) has a
+translation and a rotation channel per body (LINEAR, a key per take frame, time =
 frame / fps). Bodies carry lean meshes (capsules along +x, the mantle's cylinder)
 sharing one material.
 
@@ -30,6 +31,7 @@ from ecs_tentacles.export.ground import add_gltf_ground
 from ecs_tentacles.export.meshes import Mesh, body_mesh
 from ecs_tentacles.export.names import part, unique_leaf
 from ecs_tentacles.take import Take
+from ecs_tentacles.take_roster import spans
 
 Z_UP_TO_Y_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
 _FLOAT, _USHORT, _UINT = 5126, 5123, 5125
@@ -114,8 +116,10 @@ def build_gltf(take: Take) -> tuple[dict[str, Any], bytes]:
             )
         )
 
+    roots = []
     for creature in header["creatures"]:
         root = node(creature["name"], 0)
+        roots.append(root)
         body(creature["mantle"], root)
         name = creature["name"]
         tentacles = node(unique_leaf(f"{name}/tentacles"), root)
@@ -148,11 +152,40 @@ def build_gltf(take: Take) -> tuple[dict[str, Any], bytes]:
         "meshes": meshes,
         "materials": materials,
     }
-    document["animations"] = [_animation(buffer, take, body_nodes, translations, rotations)]
+    animation = _animation(buffer, take, body_nodes, translations, rotations)
+    shown = take.visible()
+    for index, root in enumerate(roots):
+        scale_visibility(buffer, take, shown[:, index], nodes[root], root, animation)
+    document["animations"] = [animation]
     document["buffers"] = [{"byteLength": len(buffer.data)}]
     document["bufferViews"] = buffer.views
     document["accessors"] = buffer.accessors
     return document, bytes(buffer.data)
+
+
+def scale_visibility(
+    buffer: _Buffer,
+    take: Take,
+    shown: np.ndarray,
+    node: dict[str, Any],
+    index: int,
+    animation: dict[str, Any],
+) -> None:
+    """Hide node `index` (`node`: its entry) while a creature is not there
+    (`ecs_tentacles.take_roster`): glTF has no visibility, so its scale is keyed to zero
+    (STEP keys where `shown` changes), the way engines read a hidden object. Nothing is
+    written for a creature there all along."""
+    if shown.all():
+        return
+    keys = spans(shown)
+    times = np.array([frame / take.fps for frame, _ in keys], dtype=np.float32)
+    scales = np.array([[1.0] * 3 if visible else [0.0] * 3 for _, visible in keys], np.float32)
+    if not keys[0][1]:
+        node["scale"] = [0.0, 0.0, 0.0]  # as the animation starts
+    samplers, channels = animation["samplers"], animation["channels"]
+    sampler = {"input": buffer.add(times, "SCALAR"), "output": buffer.add(scales, "VEC3")}
+    samplers.append({**sampler, "interpolation": "STEP"})
+    channels.append({"sampler": len(samplers) - 1, "target": {"node": index, "path": "scale"}})
 
 
 def _mesh(buffer: _Buffer, mesh: Mesh, name: str) -> dict[str, Any]:

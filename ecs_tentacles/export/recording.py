@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
 
 import numpy as np
 
-from ecs_tentacles import take_ground
+from ecs_tentacles import take_ground, take_roster
 from ecs_tentacles.components import Creature, Link, Tentacle, Transform
 from ecs_tentacles.ground import ground_of
 from ecs_tentacles.plugin import CurvesFrame, PointsFrame, TrackSource
@@ -26,6 +26,7 @@ from ecs_tentacles.take import FORMAT, VERSION, Take
 from ecs_tentacles.take_tracks import STANDARD, TakeTrack, declared_problem
 
 if TYPE_CHECKING:
+    from ecs_tentacles.roster_change import RosterChange
     from ecs_tentacles.world import World
 
 
@@ -104,6 +105,9 @@ class TakeRecorder:
         self._quat = np.empty((capacity, bodies, 4), np.float32)
         self._attached = np.empty((capacity, suckers), np.bool_)
         self._anchor = np.empty((capacity, suckers, 3), np.float32)
+        self._visible = np.empty((capacity, len(self._creatures)), np.bool_)
+        self._alive = np.ones(len(self._creatures), dtype=bool)
+        self._changes = 0  # spawns and despawns while recording
         self.count = 0
         # physics recoveries, marked on the take frame that follows them
         self._health: list[dict[str, Any]] = []
@@ -143,55 +147,94 @@ class TakeRecorder:
         """Body and sucker tables in take order: creature by creature, mantle then links."""
         self._creatures: list[dict[str, Any]] = []
         self._bodies: list[dict[str, Any]] = []
-        rows: list[int] = []
-        by_entity = sorted(world.query(Creature), key=lambda item: item[1].row)
-        # creature entity -> its index in the take (tracks name their owners by it)
-        self.creature_index = {entity: i for i, (entity, _) in enumerate(by_entity)}
-        for index, (entity, creature) in enumerate(by_entity):
-            name = creature.name
-            entry: dict[str, Any] = {"name": name, "mantle": len(rows), "tentacles": []}
-            rows.append(world.component(entity, Transform).row)
-            self._bodies.append(_body(f"{name}/mantle", index, "cylinder", "Z", creature))
-            for tentacle_entity in creature.tentacles:
-                tentacle = world.component(tentacle_entity, Tentacle)
-                chain = []
-                for link_entity in tentacle.links:
-                    link = world.component(link_entity, Link)
-                    chain.append(len(rows))
-                    rows.append(world.component(link_entity, Transform).row)
-                    body = f"{name}/tentacles/t{tentacle.index}/link{link.index}"
-                    self._bodies.append(_body(body, index, "capsule", "X", link))
-                entry["tentacles"].append(chain)
-            self._creatures.append(entry)
-        self._rows = np.asarray(rows, dtype=np.int64)
-        body_of_row = {row: i for i, row in enumerate(rows)}
         self._suckers: list[dict[str, Any]] = []
-        seen: dict[int, int] = {}
+        self.creature_index: dict[int, int] = {}  # creature entity -> its index in the take
+        self._rows = np.zeros(0, dtype=np.int64)  # take body -> Transform row (-1: gone)
+        self._sucker_rows = np.zeros(0, dtype=np.int64)  # take sucker -> Sucker row
+        by_row = sorted(world.query(Creature), key=lambda item: item[1].row)
+        for entity, creature in by_row:
+            self._add_creature(world, entity, creature)
+
+    def _add_creature(self, world: World, entity: int, creature: Creature) -> None:
+        """Append one creature's bodies and suckers to the take's tables."""
+        index = self.creature_index[entity] = len(self._creatures)
+        name = creature.name
+        first = len(self._bodies)
+        rows = [world.component(entity, Transform).row]
+        entry: dict[str, Any] = {"name": name, "mantle": first, "tentacles": []}
+        self._bodies.append(_body(f"{name}/mantle", index, "cylinder", "Z", creature))
+        for tentacle_entity in creature.tentacles:
+            tentacle = world.component(tentacle_entity, Tentacle)
+            chain = []
+            for link_entity in tentacle.links:
+                link = world.component(link_entity, Link)
+                chain.append(first + len(rows))
+                rows.append(world.component(link_entity, Transform).row)
+                body = f"{name}/tentacles/t{tentacle.index}/link{link.index}"
+                self._bodies.append(_body(body, index, "capsule", "X", link))
+            entry["tentacles"].append(chain)
+        self._creatures.append(entry)
+        self._rows = np.concatenate([self._rows, rows]).astype(np.int64)
+        body_of_row = {row: first + i for i, row in enumerate(rows)}
         suckers = world.suckers
-        for link_row, offset in zip(
-            suckers.link_row.tolist(), suckers.offset.tolist(), strict=True
-        ):
-            carrier = body_of_row[link_row]
+        mine = np.flatnonzero(np.isin(suckers.link_row, rows))
+        seen: dict[int, int] = {}
+        for row in mine.tolist():
+            carrier = body_of_row[int(suckers.link_row[row])]
             n = seen[carrier] = seen.get(carrier, -1) + 1
-            name = f"{self._bodies[carrier]['name']}/sucker{n}"
-            self._suckers.append({"name": name, "body": carrier, "offset": offset})
+            sucker = f"{self._bodies[carrier]['name']}/sucker{n}"
+            offset = suckers.offset[row].tolist()
+            self._suckers.append({"name": sucker, "body": carrier, "offset": offset})
+        self._sucker_rows = np.concatenate([self._sucker_rows, mine]).astype(np.int64)
+
+    # -- creatures that come and go --------------------------------------------------
+    def roster_changed(self, change: RosterChange) -> None:
+        """A creature was spawned (its bodies join the take, hidden before now) or
+        despawned (its bodies hold their last pose, hidden from now on)."""
+        world = self.world
+        self._changes += 1
+        if not change.spawned:
+            self._alive[self.creature_index[change.creature]] = False
+            for rows, store in ((self._rows, "transforms"), (self._sucker_rows, "suckers")):
+                moved = change.moved.get(store)
+                if moved is not None:
+                    live = rows >= 0
+                    rows[live] = moved[rows[live]]
+            return
+        bodies, suckers = len(self._bodies), len(self._suckers)
+        self._add_creature(world, change.creature, world.component(change.creature, Creature))
+        self._alive = np.append(self._alive, True)
+        new_rows = self._rows[bodies:]
+        self._pos = _widen(self._pos, world.transforms.pos[new_rows])
+        self._quat = _widen(self._quat, world.transforms.quat[new_rows])
+        added = len(self._suckers) - suckers
+        self._attached = _widen(self._attached, np.zeros(added, np.bool_))
+        self._anchor = _widen(self._anchor, np.zeros((added, 3)))
+        self._visible = _widen(self._visible, np.zeros(1, np.bool_))
 
     def capture(self) -> None:
         """Append the world's current frame."""
         world, i = self.world, self.count
         if i == len(self._pos):
             self._grow()
-        transforms = world.transforms
-        self._pos[i] = transforms.pos[self._rows]
-        self._quat[i] = transforms.quat[self._rows]
-        self._attached[i] = world.suckers.attached
-        self._anchor[i] = world.suckers.anchor
+        transforms, suckers = world.transforms, world.suckers
+        if not self._changes:  # every body and sucker there, in store order
+            self._pos[i] = transforms.pos[self._rows]
+            self._quat[i] = transforms.quat[self._rows]
+            self._attached[i] = suckers.attached
+            self._anchor[i] = suckers.anchor
+        else:
+            _gather(self._pos, i, transforms.pos, self._rows)
+            _gather(self._quat, i, transforms.quat, self._rows)
+            _gather(self._attached, i, suckers.attached, self._sucker_rows, fill=False)
+            _gather(self._anchor, i, suckers.anchor, self._sucker_rows)
+        self._visible[i] = self._alive
         for recorder in self.tracks:
             recorder.capture(world)
         self.count += 1
 
     def _grow(self) -> None:
-        for name in ("_pos", "_quat", "_attached", "_anchor"):
+        for name in ("_pos", "_quat", "_attached", "_anchor", "_visible"):
             old = getattr(self, name)
             grown = np.empty((2 * len(old), *old.shape[1:]), old.dtype)
             grown[: len(old)] = old
@@ -200,6 +243,10 @@ class TakeRecorder:
     def take(self) -> Take:
         """The frames captured so far as a Take (copies; recording may go on)."""
         n = self.count
+        tracks: dict[str, np.ndarray] = {}
+        for recorder in self.tracks:  # first: a curves track may name new owners
+            tracks.update(recorder.arrays(n))
+        tracks.update({name: a.copy() for name, a in self._ground_arrays.items()})
         header = json.loads(json.dumps(self.header))  # a deep copy
         header["frames"] = n
         events = [e for e in self._health if e["frame"] < n]
@@ -208,10 +255,9 @@ class TakeRecorder:
             "frozen": sum(e["event"] == "frozen" for e in events),
             "events": events,
         }
-        tracks: dict[str, np.ndarray] = {}
-        for recorder in self.tracks:
-            tracks.update(recorder.arrays(n))
-        tracks.update({name: a.copy() for name, a in self._ground_arrays.items()})
+        if self._changes:
+            header[take_roster.KEY] = {"changes": self._changes}
+            tracks[take_roster.ARRAY] = self._visible[:n].copy()
         return Take(
             header=header,
             pos=self._pos[:n].copy(),
@@ -220,6 +266,28 @@ class TakeRecorder:
             sucker_anchor=self._anchor[:n].copy(),
             tracks=tracks,
         )
+
+
+def _widen(frames: np.ndarray, now: np.ndarray) -> np.ndarray:
+    """`frames` (capacity, items, ...) with items appended, every frame holding `now`."""
+    extra = np.broadcast_to(np.asarray(now, dtype=frames.dtype), (len(frames), *now.shape))
+    return np.concatenate([frames, extra], axis=1)
+
+
+def _gather(
+    frames: np.ndarray, i: int, values: np.ndarray, rows: np.ndarray, fill: Any = None
+) -> None:
+    """Frame `i` of `frames` from `values[rows]`; items whose row is gone (-1) hold the
+    previous frame's value (or `fill`)."""
+    live = rows >= 0
+    frames[i, live] = values[rows[live]]
+    if not live.all():
+        if fill is not None:
+            frames[i, ~live] = fill
+        elif i:
+            frames[i, ~live] = frames[i - 1, ~live]
+        else:
+            frames[i, ~live] = 0
 
 
 class PointsTrack:
@@ -266,12 +334,20 @@ class PointsTrack:
 
 
 class CurvesTrack:
-    """Records a curves track: every frame the same curves (shape fixed by the first)."""
+    """Records a curves track: the curves of every creature, each frame.
+
+    Curves are columns by owner (the k-th curve of a creature is always one column), so
+    when a creature comes or goes during the recording its curves join (holding their
+    first shape before) or hold their last shape after; points per curve never change.
+    """
 
     def __init__(self, track: TakeTrack, sample: Any, recorder: TakeRecorder):
         self.track, self.sample, self.recorder = track, sample, recorder
         self.points: list[np.ndarray] = []
         self.widths: list[np.ndarray] = []
+        self.columns: list[np.ndarray] = []  # per frame: the column of each curve sampled
+        self._column: dict[tuple[int, int], int] = {}  # (owner entity, k-th) -> column
+        self._owners: list[int] = []  # per column: the take's creature index (-1: none)
 
     def capture(self, world: World) -> None:
         frame: CurvesFrame | None = self.sample(world) if self.sample else None
@@ -284,19 +360,50 @@ class CurvesTrack:
         widths = np.broadcast_to(np.asarray(frame.widths, dtype=np.float32), points.shape[:2])
         if points.ndim != 3 or points.shape[2] != 3:
             raise ValueError(f"{key} points must be (curves, points, 3), got {points.shape}")
-        if self.points and points.shape != self.points[0].shape:
+        if (self.points and points.shape[2:] != self.points[0].shape[2:]) or (
+            self.points and points.shape[1] != self.points[0].shape[1]
+        ):
             raise ValueError(f"{key} changed shape: {self.points[0].shape} -> {points.shape}")
-        if not self.points:
-            owners = [self.recorder.creature_index.get(int(e), -1) for e in frame.creatures]
-            self.recorder.header[key] = {"creatures": owners}
+        self.columns.append(self._columns_of([int(e) for e in frame.creatures]))
         self.points.append(points)
         self.widths.append(np.array(widths))
+        owners = self._owners
+        self.recorder.header[key] = {"creatures": list(owners)}
+
+    def _columns_of(self, creatures: list[int]) -> np.ndarray:
+        index, seen = self.recorder.creature_index, dict[int, int]()
+        out = np.empty(len(creatures), dtype=np.int64)
+        for i, entity in enumerate(creatures):
+            k = seen[entity] = seen.get(entity, -1) + 1
+            column = self._column.get((entity, k))
+            if column is None:
+                column = self._column[entity, k] = len(self._owners)
+                self._owners.append(index.get(entity, -1))
+            out[i] = column
+        return out
 
     def arrays(self, frames: int) -> dict[str, np.ndarray]:
         if not self.points:
             return {}
         first, second = self.track.arrays
-        return {first: np.stack(self.points[:frames]), second: np.stack(self.widths[:frames])}
+        count = len(self._owners)
+        if all(len(c) == count and (c == np.arange(count)).all() for c in self.columns[:frames]):
+            return {first: np.stack(self.points[:frames]), second: np.stack(self.widths[:frames])}
+        size = self.points[0].shape[1]
+        points = np.empty((frames, count, size, 3), np.float32)
+        widths = np.empty((frames, count, size), np.float32)
+        seen = np.zeros(count, dtype=bool)  # before a curve's first frame: its first shape
+        for f in range(frames):
+            fresh = ~seen[self.columns[f]]
+            columns = self.columns[f][fresh]
+            points[0, columns], widths[0, columns] = self.points[f][fresh], self.widths[f][fresh]
+            seen[columns] = True
+        for f in range(frames):
+            if f:  # curves not sampled now hold their last shape
+                points[f], widths[f] = points[f - 1], widths[f - 1]
+            points[f, self.columns[f]] = self.points[f]
+            widths[f, self.columns[f]] = self.widths[f]
+        return {first: points, second: widths}
 
 
 def _body(name: str, creature: int, shape: str, axis: str, part: Any) -> dict[str, Any]:

@@ -29,6 +29,7 @@ from ecs_tentacles.export.gltf import (
     Z_UP_TO_Y_UP,
     _Buffer,
     glb_bytes,
+    scale_visibility,
     to_y_up_points,
     to_y_up_rotations,
 )
@@ -71,6 +72,8 @@ def build_skinned_gltf(
     channels: list[dict[str, Any]] = []
     animations: list[dict[str, Any]] = []
     times: dict[bytes, int] = {}
+    shown = take.visible()
+    index = {c["name"]: i for i, c in enumerate(header["creatures"])}
     for creature in creatures:
         skeleton = creature.skeleton
         holder = len(nodes)
@@ -111,13 +114,15 @@ def build_skinned_gltf(
         )
         samplers, channels = [], []  # one animation per creature, named after it
         _channels(buffer, take, creature, first, samplers, channels, times)
-        animations.append(
-            {
-                "name": part(skeleton.layout.name, "animation"),
-                "samplers": samplers,
-                "channels": channels,
-            }
-        )
+        animation = {
+            "name": part(skeleton.layout.name, "animation"),
+            "samplers": samplers,
+            "channels": channels,
+        }
+        # while the creature is not there: its root joint (and so its skin) scaled to zero
+        seen = shown[:, index[skeleton.layout.name]]
+        scale_visibility(buffer, take, seen, nodes[first], first, animation)
+        animations.append(animation)
     materials: list[dict[str, Any]] = [
         {
             "name": "skin",

@@ -33,7 +33,7 @@ import numpy as np
 from ecs_tentacles.atomic import atomic_output
 from ecs_tentacles.export.ground import write_usd_ground
 from ecs_tentacles.export.names import part, unique_path
-from ecs_tentacles.export.usd import _pxr, mark_rate, new_stage, write_tracks
+from ecs_tentacles.export.usd import _pxr, key_visibility, mark_rate, new_stage, write_tracks
 from ecs_tentacles.mathutil import quat_rotate
 from ecs_tentacles.skin.keys import KeyReport
 from ecs_tentacles.skin.mesh import Detail
@@ -68,9 +68,13 @@ def build_skinned_stage(
     stage = new_stage(take)
     stage.SetDefaultPrim(UsdGeom.Xform.Define(stage, "/World").GetPrim())
     creatures, report = skinned_creatures(take, detail, keys)
+    shown = take.visible()
+    of_name = {c["name"]: i for i, c in enumerate(take.header["creatures"])}
     for creature in creatures:
         _creature(pxr, stage, creature)
-        mark_rate(stage, f"/World/{creature.skeleton.layout.name}", take)
+        name = creature.skeleton.layout.name
+        mark_rate(stage, f"/World/{name}", take)
+        key_visibility(stage, f"/World/{name}", shown[:, of_name[name]])
     for index, sucker in enumerate(take.header["suckers"]):
         _sucker(pxr, stage, take, index, sucker)
     write_tracks(pxr, stage, take)

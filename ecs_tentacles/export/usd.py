@@ -40,6 +40,7 @@ from ecs_tentacles.atomic import atomic_output
 from ecs_tentacles.export.ground import write_usd_ground
 from ecs_tentacles.export.names import FOLDERS, unique_path
 from ecs_tentacles.take import Take, TakeTrack
+from ecs_tentacles.take_roster import spans
 
 
 class UsdUnavailable(RuntimeError):
@@ -98,6 +99,19 @@ def mark_rate(stage: Any, path: str, take: Take) -> None:
     prim.CreateAttribute("ecs:frames", Sdf.ValueTypeNames.Int, custom=True).Set(take.frames)
 
 
+def key_visibility(stage: Any, path: str, shown: np.ndarray) -> None:
+    """Visibility keys on the prim at `path` (a creature's root) where `shown` (per frame)
+    changes: invisible while the creature is not there (`ecs_tentacles.take_roster`).
+    Nothing is written for a creature there all along."""
+    if shown.all():
+        return
+    UsdGeom = _pxr().UsdGeom
+    attribute = UsdGeom.Imageable(stage.GetPrimAtPath(path)).CreateVisibilityAttr()
+    for frame, visible in spans(shown):
+        token = UsdGeom.Tokens.inherited if visible else UsdGeom.Tokens.invisible
+        attribute.Set(token, frame)
+
+
 def build_stage(take: Take, progress: Callable[[int], object] | None = None) -> Any:
     """An in-memory `Usd.Stage` holding the take; `progress(1)` after each body."""
     pxr = _pxr()
@@ -106,10 +120,12 @@ def build_stage(take: Take, progress: Callable[[int], object] | None = None) -> 
     root = UsdGeom.Xform.Define(stage, "/World")
     stage.SetDefaultPrim(root.GetPrim())
     header = take.header
-    for creature in header["creatures"]:
+    shown = take.visible()
+    for index, creature in enumerate(header["creatures"]):
         base = f"/World/{creature['name']}"
         UsdGeom.Xform.Define(stage, base)
         mark_rate(stage, base, take)
+        key_visibility(stage, base, shown[:, index])
         _body(pxr, stage, take, creature["mantle"])
         if progress is not None:
             progress(1)

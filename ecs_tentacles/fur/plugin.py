@@ -23,6 +23,7 @@ from ecs_tentacles.system import System
 if TYPE_CHECKING:
     from ecs_tentacles.drawing import Panel, RenderView
     from ecs_tentacles.host import Host
+    from ecs_tentacles.roster_change import RosterChange
     from ecs_tentacles.store import ArrayStore
 
 _FRAGMENT = fragment("ecs_tentacles.fur", "fur")
@@ -48,6 +49,10 @@ class FurPlugin(Plugin):
             build_fur(world, creature, dict(spec["fur"]))
         if "emotion" in spec:
             build_emotion(world, creature, dict(spec["emotion"]))
+
+    def roster_changed(self, world: Host, change: RosterChange) -> None:
+        if not change.spawned:  # a spawn's fur was added by `build_creature`
+            world.resource(FurData).drop(change.moved)
 
     def systems(self) -> list[System]:
         from ecs_tentacles.systems.fur.emotion import EmotionSystem

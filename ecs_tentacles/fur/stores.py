@@ -1,8 +1,9 @@
 """Struct-of-array stores of the fur rig: guides, controls, furs, emotions.
 
-`FurData` (``world.resource(FurData)``) holds them. Rows are never removed. Guides of all creatures
-share one point count (`FurData.points`): the first fur built sets it and guides of
-later furs with another count are resampled along their length.
+`FurData` (``world.resource(FurData)``) holds them. Rows go when their creature is
+despawned. Guides of all creatures share one point count (`FurData.points`): the first
+fur built sets it and guides of later furs with another count are resampled along their
+length.
 
 Anything that changes the bind pose (roots, normals, rest directions, shapes,
 multipliers, control assignment) must bump `FurData.version` so the rig re-binds;
@@ -10,6 +11,8 @@ the `FurGuide` component does that on every write.
 """
 
 from __future__ import annotations
+
+from dataclasses import replace
 
 import numpy as np
 
@@ -32,9 +35,9 @@ class GuideStore(ArrayStore):
     """
 
     entity = Field(dtype=np.int64)
-    body_row = Field(dtype=np.int64)  # Transform row of the mantle
-    fur_row = Field(dtype=np.int64)
-    control_row = Field(dtype=np.int64)
+    body_row = Field(dtype=np.int64, refers="transforms")  # Transform row of the mantle
+    fur_row = Field(dtype=np.int64, refers="fur.sets")
+    control_row = Field(dtype=np.int64, refers="fur.controls")
     root = Field((3,))
     normal = Field((3,), default=(0.0, 0.0, 1.0))
     rest = Field((3,), default=(1.0, 0.0, 0.0))
@@ -51,8 +54,8 @@ class ControlStore(ArrayStore):
     """
 
     entity = Field(dtype=np.int64)
-    fur_row = Field(dtype=np.int64)
-    emotion_row = Field(dtype=np.int64, default=-1)
+    fur_row = Field(dtype=np.int64, refers="fur.sets")
+    emotion_row = Field(dtype=np.int64, default=-1, refers="fur.emotions")
     position = Field((3,))
     rest_position = Field((3,))
     lift = Field()
@@ -71,7 +74,7 @@ class FurSetStore(ArrayStore):
     """Per creature with fur: which behaviours it has and the rig's constants."""
 
     creature = Field(dtype=np.int64)
-    body_row = Field(dtype=np.int64)
+    body_row = Field(dtype=np.int64, refers="transforms")
     enabled = Field((len(BEHAVIOURS),), default=1.0)  # 1 on / 0 off, in BEHAVIOURS order
     twist_max = Field()  # radians of twist at random = 1 for multiplier 1
     reach = Field(default=0.1)  # metres: direction target distance along the guide
@@ -90,7 +93,7 @@ class EmotionStore(ArrayStore):
     """Per creature with an emotion: sensing, timing and the current level."""
 
     creature = Field(dtype=np.int64)
-    body_row = Field(dtype=np.int64)
+    body_row = Field(dtype=np.int64, refers="transforms")
     radius = Field(default=1.0)
     rise = Field(default=0.4)  # seconds to 90 % of a rise
     decay = Field(default=2.0)  # seconds to 90 % of a decay
@@ -164,6 +167,25 @@ class FurData:
         self._shape = np.concatenate(parts)
         self._curves = np.zeros((rows, self.points, 3), dtype=np.float32)
         self._frames = np.zeros((rows, 4, 3), dtype=np.float32)
+
+    def drop(self, moved: dict[str, np.ndarray]) -> None:
+        """A despawn took rows out of the fur stores (`moved`: old row -> new row, -1
+        removed, by store name): the guides' shapes and outputs and the control tracks
+        follow; the rig re-binds."""
+        guides = moved.get("fur.guides")
+        if guides is not None:
+            self._join()
+            keep = guides >= 0
+            self._shape, self._curves = self._shape[keep], self._curves[keep]
+            self._frames = self._frames[keep]
+        controls = moved.get("fur.controls")
+        if controls is not None:
+            self.tracks = [
+                replace(channel, row=int(controls[channel.row]))
+                for channel in self.tracks
+                if controls[channel.row] >= 0
+            ]
+        self.version += 1
 
     def touch(self) -> None:
         """Mark the bind pose as changed (after writing guide arrays directly)."""

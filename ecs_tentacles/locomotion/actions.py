@@ -20,11 +20,12 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ecs_tentacles.components import Tentacle
+from ecs_tentacles.components import Creature, Tentacle
 from ecs_tentacles.locomotion.stores import LocomotionStores
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
+    from ecs_tentacles.roster_change import RosterChange
 
 
 class Kind(IntEnum):
@@ -158,6 +159,15 @@ class ActionQueues:
         self._queues = [
             by_row[row] if row in by_row else ActionQueue() for row in range(len(world.tentacles))
         ]
+
+    def roster_changed(self, world: Host, change: RosterChange) -> None:
+        """Follow a spawn (its tentacles' queues appended) or a despawn (its dropped)."""
+        if not change.spawned:
+            keep = change.moved["tentacles"] >= 0
+            self._queues = [q for q, k in zip(self._queues, keep, strict=True) if k]
+            return
+        creature = world.component(change.creature, Creature)
+        self._queues += [world.component(t, ActionQueue) for t in creature.tentacles]
 
     def __getitem__(self, row: int) -> ActionQueue:
         return self._queues[row]

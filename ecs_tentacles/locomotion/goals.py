@@ -106,6 +106,11 @@ class GoalBook:
         for goal in self.path(creature):
             self.remove(goal)
 
+    def forget(self, creature: int) -> None:
+        """The creature is being despawned: delete its goals and its path."""
+        self.clear(creature)
+        self._paths.pop(creature, None)
+
     def reach(self, creature: int) -> None:
         """The current goal was reached: remove it, fire `goal_reached`, move to the next."""
         goal = self.current(creature)

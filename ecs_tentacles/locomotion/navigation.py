@@ -29,6 +29,7 @@ from ecs_tentacles.locomotion.stores import LocomotionStores
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
+    from ecs_tentacles.roster_change import RosterChange
 
 CELL = 0.1  # metres a side
 MARGIN = 2.0  # metres of grid around obstacles and the creatures' points
@@ -197,6 +198,18 @@ class Navigator:
         self.target = np.full((len(self.best), 3), np.nan)
         for row, route in routes.items():
             self.target[row] = route[0]
+
+    def roster_changed(self, change: RosterChange) -> None:
+        """A creature came (no route yet) or went (its route dropped, rows renumbered)."""
+        if not len(self.best) and not self.routes:
+            return  # not started: `_start` sizes everything from the world
+        moved = change.moved.get("creatures")
+        if moved is not None:
+            self.routes = {int(moved[r]): w for r, w in self.routes.items() if moved[r] >= 0}
+        self.planned = change.follow(self.planned, "creatures", np.nan)
+        self.best = change.follow(self.best, "creatures", np.inf)
+        self.since = change.follow(self.since, "creatures", 0.0)
+        self.target = change.follow(self.target, "creatures", np.nan)
 
     def waypoints(self, row: int) -> np.ndarray:
         """(k, 3) the waypoints creature `row` still has to pass (none: straight on)."""

@@ -41,6 +41,7 @@ if TYPE_CHECKING:
 
     from ecs_tentacles.drawing import Click, Panel, RenderView
     from ecs_tentacles.host import Host
+    from ecs_tentacles.roster_change import RosterChange
     from ecs_tentacles.store import ArrayStore
 
 _FRAGMENT = fragment("ecs_tentacles.locomotion", "locomotion")
@@ -87,6 +88,12 @@ class LocomotionPlugin(Plugin):
         for goal in spec["goals"]:
             # a 2-d goal is on the ground under it (`GoalBook` puts it there)
             world.resource(GoalBook).append(creature, goal["position"], goal["radius"])
+
+    def despawning(self, world: Host, creature: int) -> None:
+        world.resource(GoalBook).forget(creature)
+
+    def roster_changed(self, world: Host, change: RosterChange) -> None:
+        world.resource(Navigator).roster_changed(change)
 
     def systems(self) -> list[System]:
         from ecs_tentacles.systems.locomotion.action_queue import ActionQueueSystem

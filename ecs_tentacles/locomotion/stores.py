@@ -29,6 +29,8 @@ class TentacleGaitStore(ArrayStore):
     """
 
     # parameters
+    lines_up_with = "tentacles"
+
     speed = Field(default=1.0)
     target_angle = Field()
     wave_amplitude = Field()
@@ -51,6 +53,8 @@ class TentacleGaitStore(ArrayStore):
 
 class CreatureGaitStore(ArrayStore):
     """Per creature: gait, speed, drivers, sucker release thresholds and the current goal."""
+
+    lines_up_with = "creatures"
 
     gait = Field(dtype=np.int64)  # index into the schema's gait choices (scene.parameters)
     speed = Field(default=1.0)

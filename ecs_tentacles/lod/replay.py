@@ -33,6 +33,7 @@ from ecs_tentacles.physics.tiers import KINEMATIC
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
     from ecs_tentacles.physics.batch import Batch
+    from ecs_tentacles.roster_change import RosterChange
 
 log = logging.getLogger("ecs_tentacles.lod")
 
@@ -55,6 +56,13 @@ class ClipReplay:
         self.kind = np.full(count, IDLE, dtype=np.int64)
         self.clips: dict[int, GaitClips] = {}  # batch index -> its morphology's clips
         self._clip_shapes: dict[tuple[int, int], np.ndarray] = {}
+
+    def roster_changed(self, change: RosterChange) -> None:
+        """A creature came or went: its replay entries (a new one idles where it is)."""
+        self.xy = change.follow_creatures(self.xy)
+        self.heading = change.follow_creatures(self.heading)
+        self.phase = change.follow_creatures(self.phase)
+        self.kind = change.follow_creatures(self.kind, IDLE)
 
     def clips_of(self, batch: Batch) -> GaitClips:
         """The gait clips of `batch`'s morphology (recorded on first use)."""

@@ -88,13 +88,11 @@ class PhysicsBackend:
             layout = model_layout(world, creature, transform)
             layouts.append(layout)
             by_key.setdefault(layout.key, []).append(index)
-        count = len(creatures)
         self.roster = roster = Roster(
             np.array([e for e, _ in creatures], dtype=np.int64),
             np.array([c.row for _, (c, _) in creatures], dtype=np.int64),
         )
-        self.creature_entity, self.creature_row = roster.entity, roster.creature_row
-        self.batch_of, self.row_of, self.batches = roster.batch_of, roster.row_of, roster.batches
+        self.batches = roster.batches
         reduced_dt = world.settings.dt / reduced_substeps(world.settings.substeps)
         for indices in by_key.values():
             creature = creatures[indices[0]][1][0]
@@ -110,12 +108,9 @@ class PhysicsBackend:
                 transform = creatures[i][1][1]
                 batch.place(row, np.array(transform.pos), np.array(transform.quat))
         self.compiles = len(self.batches)
-        self.group_of_creature_row = np.full(len(world.creatures), -1, dtype=np.int64)
-        self.group_of_creature_row[self.creature_row] = np.arange(count)
-        # per creature, in entity order (the roster's arrays)
-        self.frozen, self.sleeping, self.soften = roster.frozen, roster.sleeping, roster.soften
-        self.proxies_used, self.tier = roster.proxies_used, roster.tier
-        self.groups = [CreatureView(roster, i) for i in range(count)]
+        self.group_of_creature_row = np.zeros(0, dtype=np.int64)
+        self.groups: list[CreatureView] = []
+        self._index_groups(len(world.creatures))
         self.proxies = ContactProxies(roster)
         self.health = HealthCheck(world, roster, self.proxies)
         self.sleep = Sleep(roster)
@@ -125,6 +120,83 @@ class PhysicsBackend:
             roster, self.proxies, settings.lod, settings.fps, self.place_joints
         )
         self._pool = ThreadPoolExecutor(self.threads) if self.threads > 1 else None
+
+    # per creature, in entity order: the roster's arrays (replaced when creatures come
+    # and go, so read through these, never kept)
+    creature_entity = property(lambda self: self.roster.entity)
+    creature_row = property(lambda self: self.roster.creature_row)
+    batch_of = property(lambda self: self.roster.batch_of)
+    row_of = property(lambda self: self.roster.row_of)
+    frozen = property(lambda self: self.roster.frozen)
+    sleeping = property(lambda self: self.roster.sleeping)
+    soften = property(lambda self: self.roster.soften)
+    proxies_used = property(lambda self: self.roster.proxies_used)
+    tier = property(lambda self: self.roster.tier)
+
+    def _index_groups(self, creature_rows: int) -> None:
+        """Each creature's `CreatureView`, and where to find it by creature-store row."""
+        roster = self.roster
+        self.groups = [CreatureView(roster, i) for i in range(len(roster))]
+        self.group_of_creature_row = np.full(creature_rows, -1, dtype=np.int64)
+        self.group_of_creature_row[roster.creature_row] = np.arange(len(roster))
+
+    # -- creatures that come and go (`ecs_tentacles.spawning`) ------------------------
+    def add_creature(self, world: PhysicsHost, entity: int) -> int:
+        """Give the just-built creature `entity` its physics, at its built pose: a row in
+        the batch of its morphology (a model is compiled only for a new morphology).
+        Nothing of any other creature changes. Returns its roster index."""
+        creature, transform = world.component(entity, Creature), world.component(entity, Transform)
+        layout = model_layout(world, creature, transform)
+        roster = self.roster
+        index = len(roster)
+        batch = next((b for b in self.batches if b.key == layout.key), None)
+        if batch is None:
+            reduced_dt = world.settings.dt / reduced_substeps(world.settings.substeps)
+
+            def compile_reduced(creature: Creature = creature) -> mujoco.MjModel:
+                return build_spec(world, creature, timestep=reduced_dt).compile()
+
+            model = build_spec(world, creature).compile()
+            batch = Batch(len(self.batches), model, [layout], compile_reduced)
+            batch.members[:] = index
+            self.batches.append(batch)
+            self.compiles += 1
+            row = 0
+        else:
+            row = batch.append(layout, index)
+        batch.prepare(FULL, self.threads)
+        batch.place(row, np.array(transform.pos), np.array(transform.quat))
+        batch.part(S.mjSTATE_TIME, row)[:] = self.time
+        roster.append(entity, creature.row, batch, row)
+        self.proxies.reindex()
+        self.health.grow(batch.index, batch.state[row], world.transforms.pos[batch.body_rows[row]],
+                         self.proxies)  # fmt: skip
+        self.sleep.grow(batch.index, 2 * batch.model.nu)
+        self.lod.grow()
+        self._index_groups(len(world.creatures))
+        return index
+
+    def remove_creature(
+        self, world: PhysicsHost, entity: int, moved: dict[str, np.ndarray]
+    ) -> None:
+        """Take creature `entity` out (its stores' rows are already removed; `moved`:
+        every old row's new row by store name, as `ArrayStore.remove` answered). Its
+        batch keeps its model for the next creature of that shape."""
+        roster = self.roster
+        index = self.lod.index(entity)
+        batch, row = roster.locate(index)
+        roster.remove(index)
+        for each in self.batches:
+            each.renumber(moved)
+        if "creatures" in moved:
+            roster.creature_row = moved["creatures"][roster.creature_row]
+        self.proxies.reindex()
+        rows = len(world.transforms)
+        kept = moved["transforms"] >= 0 if "transforms" in moved else np.ones(rows, dtype=bool)
+        self.health.remove(index, batch.index, row, kept, self.proxies)
+        self.sleep.remove(index, batch.index, row)
+        self.lod.remove(index)
+        self._index_groups(len(world.creatures))
 
     def rebuild_models(self, world: PhysicsHost) -> None:
         """Compile every morphology's model again (the static ground changed: terrain
@@ -163,9 +235,10 @@ class PhysicsBackend:
 
     def state_problem(self, state: PhysicsState) -> str | None:
         """Why `set_state(state)` would not fit this backend (one line), or None."""
-        if len(state.states) != len(self.batches):
+        later = self.batches[len(state.states) :]  # models compiled since for spawns
+        if len(state.states) > len(self.batches) or any(len(b) for b in later):
             return f"{len(state.states)} physics batches, here {len(self.batches)}"
-        for batch, rows, (xpos, _) in zip(self.batches, state.states, state.poses, strict=True):
+        for batch, rows, (xpos, _) in zip(self.batches, state.states, state.poses, strict=False):
             if rows.shape != batch.state.shape or xpos.shape != batch.xpos.shape:
                 return f"batch {batch.index}: state {rows.shape}, here {batch.state.shape}"
         if state.tier.shape != self.tier.shape:
@@ -179,8 +252,8 @@ class PhysicsBackend:
         """
         self.time = state.time
         for batch, rows, (xpos, xquat), applied in zip(
-            self.batches, state.states, state.poses, state.applied, strict=True
-        ):
+            self.batches, state.states, state.poses, state.applied, strict=False
+        ):  # batches compiled since are empty (`state_problem`)
             batch.state[:] = rows
             batch.xpos[:], batch.xquat[:] = xpos, xquat
             batch.applied = {r: f.copy() for r, f in applied.items()}

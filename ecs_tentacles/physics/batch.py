@@ -106,14 +106,11 @@ class Batch:
         self.proxy_mocap = m.body_mocapid[_ids(m, obj.mjOBJ_BODY, proxies)]
         self.proxy_cylinder = m.geom_type[self.proxy_geoms] == mujoco.mjtGeom.mjGEOM_CYLINDER
         self.root_qpos = int(m.jnt_qposadr[m.joint("root").id])
+        self.key = first.key  # the morphology (`ModelLayout.key`)
+        self._order = order
         # store rows, one row of each per creature
-        self.body_rows = np.array([lay.body_rows for lay in layouts], dtype=np.int64)
-        motor_rows = np.array([lay.actuator_motor_rows for lay in layouts], dtype=np.int64)
-        axes = np.array([lay.actuator_axes for lay in layouts], dtype=np.int64)
-        self.actuator_motor_rows = motor_rows[:, order].reshape(n, -1)
-        self.actuator_target_index = (motor_rows * 3 + axes)[:, order].reshape(n, -1)
-        self.sucker_rows = np.array([lay.sucker_rows for lay in layouts], dtype=np.int64)
-        self.sucker_rows = self.sucker_rows.reshape(n, len(self.equality_ids))
+        (self.body_rows, self.actuator_motor_rows, self.actuator_target_index,
+         self.sucker_rows) = self._store_rows(layouts)  # fmt: skip
         self.members = np.zeros(n, dtype=np.int64)  # creature index (backend order) per row
         # the state and its parts
         self.slices = state_slices(m)
@@ -137,6 +134,63 @@ class Batch:
     def __len__(self) -> int:
         return len(self.members)
 
+    # the per-row arrays, in the order `append` and `remove` treat them
+    PER_ROW = ("body_rows", "actuator_motor_rows", "actuator_target_index", "sucker_rows",
+               "members", "state", "kp", "kv", "torque", "anchor", "proxy_size", "near",
+               "xpos", "xquat", "warnings", "deepest")  # fmt: skip
+
+    def _store_rows(
+        self, layouts: list[ModelLayout]
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Body, actuator motor, actuator target and sucker rows of `layouts`, a row each."""
+        n, order = len(layouts), self._order
+        body_rows = np.array([lay.body_rows for lay in layouts], dtype=np.int64)
+        motor_rows = np.array([lay.actuator_motor_rows for lay in layouts], dtype=np.int64)
+        axes = np.array([lay.actuator_axes for lay in layouts], dtype=np.int64)
+        sucker_rows = np.array([lay.sucker_rows for lay in layouts], dtype=np.int64)
+        return (
+            body_rows,
+            motor_rows[:, order].reshape(n, -1),
+            (motor_rows * 3 + axes)[:, order].reshape(n, -1),
+            sucker_rows.reshape(n, len(self.equality_ids)),
+        )
+
+    # -- roster changes (spawn, despawn) ------------------------------------------------
+    def append(self, layout: ModelLayout, member: int) -> int:
+        """One more creature of this morphology (roster index `member`); its row, zeroed
+        (`place` it next). No other row moves."""
+        if layout.key != self.key:
+            raise ValueError("a creature of another morphology cannot join this batch")
+        added = (*self._store_rows([layout]), np.array([member]))
+        for name, value in zip(self.PER_ROW[:5], added, strict=True):
+            setattr(self, name, np.concatenate([getattr(self, name), value]))
+        for name in self.PER_ROW[5:]:
+            array = getattr(self, name)
+            fill = np.inf if name == "deepest" else 0.01 if name == "proxy_size" else 0
+            grown = np.full((len(array) + 1, *array.shape[1:]), fill, dtype=array.dtype)
+            grown[:-1] = array
+            setattr(self, name, grown)
+        return len(self) - 1
+
+    def remove(self, row: int) -> None:
+        """Take row `row` out; the rows after it move up one (forces and errors with them)."""
+        for name in self.PER_ROW:
+            setattr(self, name, np.delete(getattr(self, name), row, axis=0))
+        self.applied = {r - (r > row): f for r, f in self.applied.items() if r != row}
+        self.errors = {r - (r > row): e for r, e in self.errors.items() if r != row}
+
+    def renumber(self, moved: dict[str, np.ndarray]) -> None:
+        """Store rows moved (`ArrayStore.remove`'s answers by store name): follow them."""
+        if "transforms" in moved:
+            self.body_rows = moved["transforms"][self.body_rows]
+        if "motors" in moved:
+            motors = moved["motors"]
+            self.actuator_motor_rows = motors[self.actuator_motor_rows]
+            index = self.actuator_target_index
+            self.actuator_target_index = motors[index // 3] * 3 + index % 3
+        if "suckers" in moved:
+            self.sucker_rows = moved["suckers"][self.sucker_rows]
+
     # -- parts of the state --------------------------------------------------------
     def part(self, flag: int, rows: slice | np.ndarray | int = slice(None)) -> np.ndarray:
         """The `flag` part (an mjtState bit) of the state of `rows` (a view for slices/ints)."""
@@ -153,7 +207,8 @@ class Batch:
     def grid(self, flag: int, width: int) -> np.ndarray:
         """The `flag` part of every row as a (rows, items, width) view (mocap poses)."""
         view = self.part(flag).view()
-        view.shape = (len(self), -1, width)  # raises rather than copy: writes must land
+        items = view.shape[1] // width
+        view.shape = (len(self), items, width)  # raises rather than copy: writes must land
         return view
 
     # -- building ------------------------------------------------------------------

@@ -77,8 +77,7 @@ class HealthCheck:
         self.frozen = 0
         self.causes: dict[str, int] = {}
         # every creature's body rows, creature by creature, for whole-array speed checks
-        self.rows = proxies.rows
-        self.start, self.count = proxies.start, proxies.count
+        self.follow(proxies)
         self.previous = np.zeros((0, 3))  # last frame's poses (set on the first check)
 
     # -- state ---------------------------------------------------------------------
@@ -95,12 +94,41 @@ class HealthCheck:
 
     def set_state(self, state: HealthState) -> None:
         """Go back to `state()` (copied: one state can be restored many times)."""
-        for saved, copy in zip(self.saved, state.saved, strict=True):
+        for saved, copy in zip(self.saved, state.saved, strict=False):  # later ones: empty
             saved[:] = copy
         self.failures = {k: list(v) for k, v in state.failures.items()}
         self.recoveries, self.frozen = state.recoveries, state.frozen
         self.causes = dict(state.causes)
         self.previous = state.previous.copy()
+
+    # -- roster changes --------------------------------------------------------------
+    def grow(
+        self, batch: int, state: np.ndarray, poses: np.ndarray, proxies: ContactProxies
+    ) -> None:
+        """A creature was appended to batch `batch` at `state`, its bodies at `poses`
+        (the new rows at the Transform store's end)."""
+        if batch == len(self.saved):
+            self.saved.append(np.zeros((0, 2, len(state))))
+        self.saved[batch] = np.concatenate([self.saved[batch], np.repeat(state[None, None], 2, 1)])
+        if len(self.previous):
+            self.previous = np.concatenate([self.previous, poses])
+        self.follow(proxies)
+
+    def remove(
+        self, index: int, batch: int, row: int, kept: np.ndarray, proxies: ContactProxies
+    ) -> None:
+        """Creature `index` (row `row` of batch `batch`) was taken out; `kept`: which
+        Transform rows are left."""
+        self.saved[batch] = np.delete(self.saved[batch], row, axis=0)
+        self.failures = {i - (i > index): times for i, times in self.failures.items() if i != index}
+        if len(self.previous):
+            self.previous = self.previous[kept]
+        self.follow(proxies)
+
+    def follow(self, proxies: ContactProxies) -> None:
+        """Read the bodies' order from `proxies` again (after it was rebuilt)."""
+        self.rows = proxies.rows
+        self.start, self.count = proxies.start, proxies.count
 
     def restart(self, index: int) -> None:
         """Creature `index` was placed anew: its good states are where it is now."""

@@ -134,6 +134,18 @@ class LevelOfDetail:
         counts = np.bincount(self.roster.tier, minlength=len(NAMES))
         return {name: int(n) for name, n in zip(NAMES, counts, strict=True)}
 
+    # -- roster changes --------------------------------------------------------------
+    def grow(self) -> None:
+        """A creature was appended: not scripted, not selected, free to change tier."""
+        self.scripted = np.append(self.scripted, False)
+        self.selected = np.append(self.selected, False)
+        self.held = np.append(self.held, self.hold_frames)
+
+    def remove(self, index: int) -> None:
+        """Creature `index` was taken out."""
+        for name in ("scripted", "selected", "held"):
+            setattr(self, name, np.delete(getattr(self, name), index))
+
     # -- state -----------------------------------------------------------------------
     def state(self) -> tuple[np.ndarray, ...]:
         """What decides the next frame's tiers, for snapshots (tiers are the roster's)."""

@@ -43,6 +43,12 @@ class ContactProxies:
 
     def __init__(self, roster: Roster):
         self.roster = roster
+        self.reindex()
+
+    def reindex(self) -> None:
+        """Every creature's bodies in roster order, from the batches (after a spawn or
+        despawn changed them)."""
+        roster = self.roster
         rows, owner, kind, size = [], [], [], []
         count = len(roster)
         for batch in roster.batches:  # per batch, then scattered into creature order

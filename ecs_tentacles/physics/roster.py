@@ -40,6 +40,27 @@ class Roster:
         self.row_of[indices] = np.arange(len(indices))
         self.batches.append(batch)
 
+    PER_CREATURE = ("entity", "creature_row", "batch_of", "row_of", "frozen", "sleeping",
+                    "soften", "proxies_used", "tier")  # fmt: skip
+
+    def append(self, entity: int, creature_row: int, batch: Batch, row: int) -> int:
+        """One more creature (full, awake), at the end; its index."""
+        values = (entity, creature_row, batch.index, row, False, False, 1.0, 0, FULL)
+        for name, value in zip(self.PER_CREATURE, values, strict=True):
+            array = getattr(self, name)
+            setattr(self, name, np.append(array, np.array([value], dtype=array.dtype)))
+        return len(self) - 1
+
+    def remove(self, index: int) -> None:
+        """Take creature `index` out (its batch row too); later indices move down one."""
+        batch, row = self.locate(index)
+        batch.remove(row)
+        for name in self.PER_CREATURE:
+            setattr(self, name, np.delete(getattr(self, name), index))
+        self.row_of[(self.batch_of == batch.index) & (self.row_of > row)] -= 1
+        for each in self.batches:
+            each.members[each.members > index] -= 1
+
     def locate(self, index: int) -> tuple[Batch, int]:
         """The batch and row of creature `index`."""
         return self.batches[int(self.batch_of[index])], int(self.row_of[index])

@@ -59,8 +59,22 @@ class Sleep:
     def set_state(self, state: SleepState) -> None:
         """Go back to `state()` (copied: one state can be restored many times)."""
         self.still[:] = state.still
-        self.commands = [c.copy() for c in state.commands]
+        kept = [c.copy() for c in state.commands]
+        self.commands = kept + self.commands[len(kept) :]  # batches compiled since: empty
         self.known[:] = state.known
+
+    def grow(self, batch: int, width: int) -> None:
+        """A creature was appended (to batch `batch`, `width` commands a row; or a new batch)."""
+        self.still = np.append(self.still, 0)
+        self.known = np.append(self.known, False)
+        if batch == len(self.commands):
+            self.commands.append(np.zeros((0, width)))
+        self.commands[batch] = np.concatenate([self.commands[batch], np.zeros((1, width))])
+
+    def remove(self, index: int, batch: int, row: int) -> None:
+        """Creature `index` (row `row` of batch `batch`) was taken out."""
+        self.still, self.known = np.delete(self.still, index), np.delete(self.known, index)
+        self.commands[batch] = np.delete(self.commands[batch], row, axis=0)
 
     def restart(self, index: int) -> None:
         """Creature `index` was placed anew: it has not been still, its commands unknown."""

@@ -43,6 +43,7 @@ from ecs_tentacles.render.gpu import (
 )
 from ecs_tentacles.render.meshes import CAPSULE_LODS, CYLINDER_LOD, SPHERE_LOD, Mesh
 from ecs_tentacles.render.skinned import SkinnedCreatures
+from ecs_tentacles.roster_change import RosterChange
 from ecs_tentacles.world import World
 
 SKY = (0.70, 0.76, 0.82)
@@ -101,17 +102,34 @@ class Renderer:
         """Draw `world` from now on (same GPU objects, new instance tables)."""
         self.world = world
         self.selected = None
+        self._colour_index: dict[int, int] = {}  # creature entity -> its colour, kept
         self._build_static()
         self.previous = (world.transforms.pos.copy(), world.transforms.quat.copy())
         self.current = self.previous
         self.view_of_frame(*self.current)
 
+    def roster_changed(self, change: RosterChange) -> None:
+        """A creature came or went: new instance tables (everyone keeps its colour), the
+        poses from now (nothing to blend from), the camera's followed body renumbered."""
+        if self.selected == change.creature and not change.spawned:
+            self.selected = None
+        follow = self.camera.follow
+        if follow is not None and not change.spawned:
+            row = int(change.moved["transforms"][follow])
+            self.camera.follow = row if row >= 0 else None
+        self._build_static()
+        self.current = (self.world.transforms.pos.copy(), self.world.transforms.quat.copy())
+        self.previous = self.current
+
     # -- static per-instance data ------------------------------------------------------
     def _build_static(self) -> None:
         world = self.world
         creatures = sorted(world.query(Creature, Transform))
-        colours = creature_colours(len(creatures))
         self.creature_entities = [e for e, _ in creatures]
+        for entity in self.creature_entities:  # the next colour for a newcomer
+            self._colour_index.setdefault(entity, len(self._colour_index))
+        palette = creature_colours(len(self._colour_index))
+        colours = palette[[self._colour_index[e] for e in self.creature_entities]].reshape(-1, 3)
         self.creature_colour = {e: colours[i] for i, e in enumerate(self.creature_entities)}
         mantle = np.zeros((len(creatures), INSTANCE_FLOATS), np.float32)
         self.mantle_rows = np.array([t.row for _, (_, t) in creatures], dtype=np.int64)

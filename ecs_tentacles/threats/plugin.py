@@ -19,6 +19,7 @@ from ecs_tentacles.threats.data import ThreatData, build_threats, mark_creature,
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
+    from ecs_tentacles.roster_change import RosterChange
     from ecs_tentacles.store import ArrayStore
 
 _FRAGMENT = fragment("ecs_tentacles.threats", "threats")
@@ -42,6 +43,14 @@ class ThreatsPlugin(Plugin):
     def build_creature(self, world: Host, creature: int, spec: Mapping[str, Any]) -> None:
         if spec.get("threat"):
             mark_creature(world, creature)
+
+    def roster_changed(self, world: Host, change: RosterChange) -> None:
+        if change.spawned:
+            return  # `build_creature` marked it, if it is a threat
+        threats = world.resource(ThreatData)
+        keep = threats.creatures != change.creature
+        threats.creatures = threats.creatures[keep]
+        threats.bodies = change.moved["transforms"][threats.bodies[keep]]
 
     def build_scene(self, world: Host, scene: Mapping[str, Any]) -> None:
         build_threats(world, scene["threats"])

@@ -31,6 +31,7 @@ from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
+    from ecs_tentacles.roster_change import RosterChange
 
 CRAWL_SPEED = 0.1  # m/s: a neighbour moving this fast aligns others fully
 
@@ -60,6 +61,11 @@ class Flock(System):
 
     def setup(self, world: Host) -> None:
         self.every = max(1, round(self.config["interval"] * world.settings.fps))
+
+    def roster_changed(self, world: Host, change: RosterChange) -> None:
+        if self.last is not None:  # a newcomer starts still
+            mantle = world.transforms.pos[world.creatures.mantle_row[-1:], :2]
+            self.last = change.follow(self.last, "creatures", mantle)
 
     def steering(self, pos: np.ndarray, vel: np.ndarray) -> np.ndarray:
         """The four unweighted rules (4, n, 2) from (n, 2) mantle positions and velocities."""

@@ -32,6 +32,7 @@ from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
+    from ecs_tentacles.roster_change import RosterChange
 
 KEY = "follow"  # the creature-level scene key
 
@@ -64,10 +65,13 @@ class FollowLeader(System):
         rows = {c.name: c.row for _, c in world.query(Creature)}  # a shard may lack some
         pairs = [
             (rows[spec["name"]], rows[spec[KEY]])
-            for spec in (world.scene or {}).get("creatures", [])
+            for spec in world.creature_specs.values()
             if KEY in spec and spec["name"] in rows and spec[KEY] in rows
         ]
         self.followers, self.leaders = np.array(pairs, dtype=np.int64).reshape(-1, 2).T
+
+    def roster_changed(self, world: Host, change: RosterChange) -> None:
+        self.setup(world)  # the pairs by creature row
 
     def process(self, world: Host, dt: float) -> None:
         if world.frame % self.every or not len(self.followers):

@@ -29,6 +29,7 @@ from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
+    from ecs_tentacles.roster_change import RosterChange
 
 
 class Wander(System):
@@ -61,6 +62,14 @@ class Wander(System):
             creature_rng(world.seed, world.creature_name(int(creatures.entity[row])) + ":wander")
             for row in range(creatures.count)
         ]
+
+    def roster_changed(self, world: Host, change: RosterChange) -> None:
+        if change.spawned:  # its own stream, as if it had been in the scene
+            name = world.creature_name(change.creature)
+            self.streams.append(creature_rng(world.seed, name + ":wander"))
+        else:
+            keep = change.moved["creatures"] >= 0
+            self.streams = [s for s, k in zip(self.streams, keep, strict=True) if k]
 
     def process(self, world: Host, dt: float) -> None:
         if world.frame % self.every:

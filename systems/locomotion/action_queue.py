@@ -22,6 +22,7 @@ from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
+    from ecs_tentacles.roster_change import RosterChange
 
 TIME_EPSILON = 1e-9  # sums of frame durations fall a hair short of whole durations
 ATTACH = int(Kind.ATTACH)
@@ -46,6 +47,9 @@ class ActionQueueSystem(System):
     def setup(self, world: Host) -> None:
         self.queues = ActionQueues(world)
         self.strokes = world.resource(LocomotionStores).tentacles
+
+    def roster_changed(self, world: Host, change: RosterChange) -> None:
+        self.queues.roster_changed(world, change)  # the queues by tentacle row
 
     def process(self, world: Host, dt: float) -> None:
         t = self.strokes

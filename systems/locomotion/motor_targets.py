@@ -37,6 +37,7 @@ from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
+    from ecs_tentacles.roster_change import RosterChange
 
 # Constant pitch (radians, positive = tip down) of each action's pose.
 LIFT = np.zeros(len(Kind))
@@ -114,6 +115,14 @@ class MotorTargets(System):
         self.eased = motors.target[:, :2].copy()
         self.strokes = world.resource(LocomotionStores).tentacles
         self.follow: np.ndarray | None = None  # on terrain: `ground_follow` this frame
+
+    def roster_changed(self, world: Host, change: RosterChange) -> None:
+        eased = change.follow(self.eased, "motors")
+        self.setup(world)
+        self.eased = eased
+        if change.spawned:
+            added = change.added.get("motors", slice(0))
+            self.eased[added] = world.motors.target[added, :2]
 
     def process(self, world: Host, dt: float) -> None:
         motors = world.motors

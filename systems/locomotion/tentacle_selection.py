@@ -50,6 +50,7 @@ from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
+    from ecs_tentacles.roster_change import RosterChange
 
 PULL = int(Mode.PULL)
 PULL_TOLERANCE = 1e-9  # dot products this close to 0 count as the +-pi/2 boundary: pull
@@ -120,6 +121,9 @@ class TentacleSelection(System):
         self.queues = ActionQueues(world)
         loco = world.resource(LocomotionStores)
         self.strokes, self.gaits = loco.tentacles, loco.creatures
+
+    def roster_changed(self, world: Host, change: RosterChange) -> None:
+        self.queues.roster_changed(world, change)  # the queues by tentacle row
 
     def process(self, world: Host, dt: float) -> None:
         t, c = world.tentacles, world.creatures

@@ -17,6 +17,7 @@ from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
+    from ecs_tentacles.roster_change import RosterChange
 
 
 class LodReplay(System):
@@ -30,6 +31,9 @@ class LodReplay(System):
     def setup(self, world: Host) -> None:
         self.replay = ClipReplay(world)
         world.physics.lod.replay = self.replay
+
+    def roster_changed(self, world: Host, change: RosterChange) -> None:
+        self.replay.roster_changed(change)
 
     def process(self, world: Host, dt: float) -> None:
         self.replay.advance(world, dt)

@@ -23,6 +23,7 @@ from ecs_tentacles.take import Take
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
+    from ecs_tentacles.roster_change import RosterChange
 
 
 class Record(System):
@@ -52,6 +53,10 @@ class Record(System):
         before_recording(world)
         self.recorder.capture()
         self._start = world.frame
+
+    def roster_changed(self, world: Host, change: RosterChange) -> None:
+        if self.recorder is not None:  # the take's roster follows (`take_roster`)
+            self.recorder.roster_changed(change)
 
     def process(self, world: Host, dt: float) -> None:
         if (world.frame + 1 - self._start) % self.every == 0 and self.recorder is not None:

@@ -14,6 +14,7 @@ from ecs_tentacles.system import System
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
     from ecs_tentacles.render.renderer import Renderer
+    from ecs_tentacles.roster_change import RosterChange
 
 
 class RenderSync(System):
@@ -27,6 +28,9 @@ class RenderSync(System):
 
     def setup(self, world: Host) -> None:
         self.renderer.sync()
+
+    def roster_changed(self, world: Host, change: RosterChange) -> None:
+        self.renderer.roster_changed(change)
 
     def process(self, world: Host, dt: float) -> None:
         self.renderer.sync()

@@ -13,11 +13,16 @@ import pytest
 CONFLICT = "another program wrote this file after this run started; kept theirs, discarded ours"
 
 
+# simulated seconds per bake: long enough (about 2 s of work) that the bakes overlap even
+# when a loaded machine starts the second process a few seconds after the first
+SECONDS = "10"
+
+
 def _bakes(out: Path, writers: int) -> list[subprocess.CompletedProcess[str]]:
     """`writers` real processes baking different seeds of the octopus to `out` at once."""
     processes = [
         subprocess.Popen(
-            [sys.executable, "-m", "ecs_tentacles", "bake", "octopus", "--seconds", "3"]
+            [sys.executable, "-m", "ecs_tentacles", "bake", "octopus", "--seconds", SECONDS]
             + ["--seed", str(seed), "--out", out.name, "--json", "--quiet"],
             stdout=subprocess.PIPE,
             stderr=subprocess.PIPE,

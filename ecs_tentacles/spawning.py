@@ -1,0 +1,322 @@
+"""Creatures that come and go while a world runs (`World.spawn`, `World.despawn`).
+
+    octo = world.spawn({"name": "octo", "tentacles": {"count": 6}}, position=(2, 0))
+    world.step(60)
+    world.despawn(octo)
+
+Spawn validates the creature entry as a scene would (one line per problem, its path
+starting at `creature`), builds its body and every plugin's part of it (rows appended
+to every store: nothing else moves), gives it a row in the physics batch of its
+morphology (a model is compiled only for a new morphology) and tells plugins and
+systems (`roster_changed`). Other creatures step on bit-identically: each is its own
+row of state. A creature asked to spawn overlapping another creature or inside an
+obstacle is refused (`SpawnError`), or with `on_overlap="move"` placed at the nearest
+free spot (the `creature_spawned` event and the log say where).
+
+Despawn removes the creature's rows from every store (the rows after them move up;
+columns that refer to a store's rows follow, `store.Field.refers`), deletes its
+entities, takes it out of the physics and tells plugins and systems. Events:
+`creature_spawned(world, creature, creature_name, moved_to)` and
+`creature_despawned(world, creature, creature_name)`.
+
+This module sits above the world (as `world_loader`): `World.spawn` delegates here.
+"""
+
+from __future__ import annotations
+
+import copy
+import logging
+import re
+from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING, Any, Literal
+
+import esper
+import numpy as np
+
+from ecs_tentacles.build import build_creature
+from ecs_tentacles.components import Creature, Tentacle
+from ecs_tentacles.construction import CreatureLayout, creature_layout
+from ecs_tentacles.ground import ground_of
+from ecs_tentacles.mathutil import quat_rotate
+from ecs_tentacles.roster_change import RosterChange
+from ecs_tentacles.scene.overlap import segment_distances
+from ecs_tentacles.scene.physical import physical_problems
+from ecs_tentacles.scene.validate import validated
+
+if TYPE_CHECKING:
+    from ecs_tentacles.host import Host as World  # any world (`ecs_tentacles.world.World`)
+
+log = logging.getLogger("ecs_tentacles.spawning")
+
+CORE_STORES = ("transforms", "motors", "tentacles", "suckers", "creatures")
+OnOverlap = Literal["refuse", "move"]
+SEARCH_RINGS = 40  # rings of candidate spots around an occupied one ...
+SPOTS_PER_RING = 16  # ... each this many spots, a quarter of the creature's reach apart
+
+
+class SpawnError(ValueError):
+    """A creature that cannot be spawned: one line per problem, nothing built."""
+
+    def __init__(self, problems: Sequence[str]):
+        self.problems = list(problems)
+        super().__init__("\n".join(self.problems))
+
+
+# -- the creature entry ------------------------------------------------------------------
+def creature_entry(
+    world: World,
+    spec: Mapping[str, Any],
+    position: Sequence[float] | None = None,
+    heading_deg: float | None = None,
+) -> dict[str, Any]:
+    """`spec` validated as a scene's creature entry, defaults filled in, placed at
+    `position` / `heading_deg` when given, its name made unique in `world` (`octo` ->
+    `octo_2`). Raises SpawnError (one line per problem) when it is not a valid entry."""
+    if not isinstance(spec, Mapping):
+        raise SpawnError([f"creature: must be an object, got {type(spec).__name__}"])
+    entry = copy.deepcopy(dict(spec))
+    if position is not None:
+        entry["position"] = [float(v) for v in position]
+    if heading_deg is not None:
+        entry["heading_deg"] = float(heading_deg)
+    entry.setdefault("name", "creature")
+    entry.setdefault("position", [0.0, 0.0])
+    if isinstance(entry["name"], str):
+        entry["name"] = unique_name(world, entry["name"])
+    mini: dict[str, Any] = {"version": 1, "creatures": [entry]}
+    if world.scene is not None:
+        mini["version"], mini["physics"] = world.scene["version"], world.scene["physics"]
+    problems, completed = validated(mini, world.plugins)
+    if completed is not None and not problems:
+        problems = physical_problems(completed)
+    if problems:
+        raise SpawnError([_as_creature(p) for p in problems])
+    assert completed is not None
+    full: dict[str, Any] = completed["creatures"][0]
+    return full
+
+
+def _as_creature(problem: str) -> str:
+    return re.sub(r"^creatures\[0\]", "creature", problem)
+
+
+def unique_name(world: World, name: str) -> str:
+    """`name`, or `name_2`, `name_3`... : the first no creature of `world` has."""
+    taken = {c.name for _, c in world.query(Creature)}
+    if name not in taken:
+        return name
+    base = re.sub(r"_\d+$", "", name)
+    n = 2
+    while f"{base}_{n}" in taken:
+        n += 1
+    return f"{base}_{n}"
+
+
+# -- overlap with the creatures there and the obstacles ------------------------------------
+def obstruction(world: World, layout: CreatureLayout) -> str | None:
+    """What a creature built as `layout` would overlap now: `"creature 'octo'"`, `"an
+    obstacle"`, or None when the spot is free."""
+    starts, ends, radii = layout.capsules()
+    points = np.concatenate([starts, ends, 0.5 * (starts + ends)])
+    ground = ground_of(world)
+    if ground.solids and (ground.inside_solid(points, np.tile(radii, 3)) >= 0).any():
+        return "an obstacle"
+    physics = world.physics
+    if not len(physics):
+        return None
+    proxies = physics.proxies
+    pos, quat, centre, reach = proxies.sense(world.transforms)
+    middle = layout.origin
+    own_reach = float(np.max(np.linalg.norm(points - middle, axis=1)) + radii.max())
+    near = np.flatnonzero(np.linalg.norm(centre - middle, axis=1) < reach + own_reach)
+    for index in near.tolist():
+        body = proxies.start[index] + np.arange(proxies.count[index])
+        radius, half = proxies.size[body, 0], proxies.size[body, 1]
+        along = np.where(proxies.kind[body, None] == 1, [0.0, 0.0, 1.0], [1.0, 0.0, 0.0])
+        axis = quat_rotate(quat[body], along) * half[:, None]
+        gap = segment_distances(
+            starts[:, None], ends[:, None], (pos[body] - axis)[None], (pos[body] + axis)[None]
+        )
+        if (gap < radii[:, None] + radius[None]).any():
+            name = world.creature_name(int(physics.creature_entity[index]))
+            return f"creature {name!r}"
+    return None
+
+
+def free_spot(world: World, entry: dict[str, Any]) -> tuple[dict[str, Any], str | None]:
+    """`entry` where it asked to be if free, else moved to the nearest free spot on rings
+    around it; and what was in the way (None: not moved). SpawnError if none is free."""
+    layout = creature_layout(entry, ground_of(world))
+    blocker = obstruction(world, layout)
+    if blocker is None:
+        return entry, None
+    _, ends, radii = layout.capsules()
+    reach = float(np.max(np.linalg.norm(ends[:, :2] - layout.origin[:2], axis=1)) + radii.max())
+    x, y = entry["position"][:2]
+    for ring in range(1, SEARCH_RINGS + 1):
+        distance = ring * 0.25 * reach
+        turns = np.arange(SPOTS_PER_RING) * 2.0 * np.pi / SPOTS_PER_RING + 0.5 * ring
+        for angle in turns.tolist():
+            moved = copy.deepcopy(entry)
+            spot = [x + distance * np.cos(angle), y + distance * np.sin(angle)]
+            moved["position"] = spot + list(entry["position"][2:])
+            if obstruction(world, creature_layout(moved, ground_of(world))) is None:
+                return moved, blocker
+    farthest = SEARCH_RINGS * 0.25 * reach
+    line = f"creature {entry['name']!r}: no free spot within {farthest:.1f} m of ({x:g}, {y:g})"
+    raise SpawnError([f"{line}: it overlaps {blocker}"])
+
+
+# -- spawn and despawn ---------------------------------------------------------------------
+def spawn(
+    world: World,
+    spec: Mapping[str, Any],
+    *,
+    position: Sequence[float] | None = None,
+    heading_deg: float | None = None,
+    on_overlap: OnOverlap = "refuse",
+) -> int:
+    """Build one creature into the running `world`; its entity (module docstring)."""
+    if on_overlap not in ("refuse", "move"):
+        raise ValueError(f"on_overlap: must be 'refuse' or 'move', got {on_overlap!r}")
+    world.activate()
+    entry = creature_entry(world, spec, position, heading_deg)
+    moved_to = None
+    if on_overlap == "move":
+        placed, blocker = free_spot(world, entry)
+        if blocker is not None:
+            moved_to = tuple(placed["position"])
+            log.info(
+                "spawn %r: (%s) overlaps %s; moved to (%s)",
+                entry["name"],
+                ", ".join(f"{v:g}" for v in entry["position"]),
+                blocker,
+                ", ".join(f"{v:.2f}" for v in moved_to),
+            )
+        entry = placed
+    else:
+        blocker = obstruction(world, creature_layout(entry, ground_of(world)))
+        if blocker is not None:
+            where = ", ".join(f"{v:g}" for v in entry["position"])
+            line = f"creature {entry['name']!r} at ({where}): overlaps {blocker}"
+            raise SpawnError([f"{line} (pick a free spot, or on_overlap='move')"])
+    before = {name: len(store) for name, store in world.stores.items()}
+    entity = build_creature(world, entry)
+    for plugin in world.plugins:
+        plugin.build_creature(world, entity, entry)
+    index = world.physics.add_creature(world, entity)
+    added = {
+        name: np.arange(before.get(name, 0), len(store))
+        for name, store in world.stores.items()
+        if len(store) > before.get(name, 0)
+    }
+    world.creature_specs[entity] = entry
+    _tell(world, RosterChange(entity, spawned=True, index=index, added=added))
+    world.events.emit(
+        "creature_spawned",
+        world=world,
+        creature=entity,
+        creature_name=entry["name"],
+        moved_to=moved_to,
+    )
+    return entity
+
+
+def despawn(world: World, entity: int) -> None:
+    """Remove creature `entity` and everything it owns (module docstring)."""
+    world.activate()
+    creature = world.try_component(entity, Creature)
+    if creature is None:
+        raise KeyError(f"entity {entity} is not a creature of this world")
+    name = creature.name
+    for plugin in world.plugins:
+        plugin.despawning(world, entity)
+    dead = _owned_rows(world, creature)
+    moved = {key: world.stores[key].remove(rows) for key, rows in dead.items() if len(rows)}
+    for store in world.stores.values():
+        for key, new in moved.items():
+            store.renumber(key, new)
+    _renumber_components(world, entity, moved)
+    _delete_entities(world, entity, creature)
+    index = world.physics.lod.index(entity)
+    world.physics.remove_creature(world, entity, moved)
+    world.creature_specs.pop(entity, None)
+    _tell(world, RosterChange(entity, spawned=False, index=index, moved=moved))
+    world.events.emit("creature_despawned", world=world, creature=entity, creature_name=name)
+
+
+def _owned_rows(world: World, creature: Creature) -> dict[str, np.ndarray]:
+    """Every store's rows that belong to `creature`: the body's, then every store whose
+    rows line up with a body store's or refer to rows that go (fur guides -> mantle)."""
+    c = creature.row
+    first, count = int(world.creatures.first_tentacle[c]), int(world.creatures.tentacles[c])
+    tentacles = np.arange(first, first + count)
+    t = world.tentacles
+    links = np.concatenate(
+        [
+            np.arange(a, a + n)
+            for a, n in zip(t.first_link[tentacles], t.links[tentacles], strict=True)
+        ]
+    )
+    bodies = np.concatenate(
+        [[world.creatures.mantle_row[c]]]
+        + [
+            np.arange(a, a + n)
+            for a, n in zip(t.base_row[tentacles], t.links[tentacles], strict=True)
+        ]
+    )
+    dead: dict[str, np.ndarray] = {
+        "creatures": np.array([c]),
+        "tentacles": tentacles,
+        "motors": links,
+        "suckers": np.flatnonzero(np.isin(world.suckers.tentacle_row, tentacles)),
+        "transforms": np.sort(bodies.astype(np.int64)),
+    }
+    others = [name for name in world.stores if name not in CORE_STORES]
+    for _ in range(len(others) + 1):  # until nothing more goes (chains: controls -> sets)
+        changed = False
+        for name in others:
+            store = world.stores[name]
+            gone = np.zeros(len(store), dtype=bool)
+            partner = type(store).lines_up_with
+            if partner is not None and partner in dead:
+                gone[dead[partner]] = True
+            for field in store.fields():
+                if field.refers in dead:
+                    values = getattr(store, field.name)
+                    gone |= np.isin(values, dead[field.refers]) & (values >= 0)
+            rows = np.flatnonzero(gone)
+            if len(rows) != len(dead.get(name, ())):
+                dead[name], changed = rows, True
+        if not changed:
+            break
+    return dead
+
+
+def _renumber_components(world: World, entity: int, moved: dict[str, np.ndarray]) -> None:
+    """Creature and tentacle components keep plain row numbers: the ones after the
+    removed creature's move up (row components keep handles and need nothing). A
+    creature's tentacles are the rows from its `first_tentacle` on, in order."""
+    old_row = int(np.flatnonzero(moved["creatures"] < 0)[0])
+    creatures = world.creatures
+    for row in range(old_row, len(creatures)):  # the creatures that moved up, new rows
+        creature = esper.component_for_entity(int(creatures.entity[row]), Creature)
+        creature.row = row
+        first = int(creatures.first_tentacle[row])
+        for k, tentacle_entity in enumerate(creature.tentacles):
+            esper.component_for_entity(tentacle_entity, Tentacle).row = first + k
+
+
+def _delete_entities(world: World, entity: int, creature: Creature) -> None:
+    for tentacle_entity in creature.tentacles:
+        tentacle = world.component(tentacle_entity, Tentacle)
+        for owned in (*tentacle.links, *tentacle.suckers, tentacle_entity):
+            esper.delete_entity(owned, immediate=True)
+    esper.delete_entity(entity, immediate=True)
+
+
+def _tell(world: World, change: RosterChange) -> None:
+    for plugin in world.plugins:
+        plugin.roster_changed(world, change)
+    for system in world.schedule:
+        system.roster_changed(world, change)

@@ -1,0 +1,91 @@
+"""Creatures that come and go in a take: visibility in USD (rigid and skinned) and glTF."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from pathlib import Path
+
+import numpy as np
+import pytest
+from ecs_tentacles.systems.record.record import Record
+
+from ecs_tentacles.export.gltf import read_glb, write_glb
+from ecs_tentacles.export.skinned_gltf import write_skinned_glb
+from ecs_tentacles.export.skinned_usd import write_skinned_usd
+from ecs_tentacles.export.usd import write_usd
+from ecs_tentacles.take import Take
+from ecs_tentacles.world import World
+
+from .conftest import khronos_report
+
+
+def _creature(name: str, x: float) -> dict:
+    return {"name": name, "position": [x, 0.0], "tentacles": {"count": 3, "links": 3}}
+
+
+@pytest.fixture(scope="module")
+def roster_take() -> Iterator[Take]:
+    """12 frames: `b` despawned after frame 4, `late` spawned after frame 6."""
+    scene = {"version": 1, "creatures": [_creature("a", 0.0), _creature("b", 3.0)]}
+    with World.from_scene(scene) as world:
+        record = world.add_system(Record())
+        world.step(4)
+        world.despawn(world.creature("b"))
+        world.step(2)
+        world.spawn(_creature("late", 6.0))
+        world.step(5)
+        yield record.take()
+
+
+def test_the_take_knows_who_is_there(roster_take: Take) -> None:
+    shown = roster_take.visible()
+    assert [c["name"] for c in roster_take.header["creatures"]] == ["a", "b", "late"]
+    assert shown[:, 0].all()
+    assert shown[:5, 1].all() and not shown[5:, 1].any()
+    assert not shown[:7, 2].any() and shown[7:, 2].all()
+
+
+@pytest.mark.parametrize("skinned", [False, True])
+def test_usd_keys_visibility_of_creatures_that_come_and_go(
+    roster_take: Take, tmp_path: Path, skinned: bool
+) -> None:
+    pxr = pytest.importorskip("pxr.Usd")
+    path = tmp_path / "roster.usda"
+    (write_skinned_usd if skinned else write_usd)(roster_take, path)
+    stage = pxr.Stage.Open(str(path))
+    from pxr import UsdGeom
+
+    def shown_at(name: str, frame: int) -> bool:
+        prim = stage.GetPrimAtPath(f"/World/{name}")
+        return UsdGeom.Imageable(prim).ComputeVisibility(frame) != UsdGeom.Tokens.invisible
+
+    assert all(shown_at("a", f) for f in range(12))
+    assert [shown_at("b", f) for f in range(12)] == [True] * 5 + [False] * 7
+    assert [shown_at("late", f) for f in range(12)] == [False] * 7 + [True] * 5
+    attribute = UsdGeom.Imageable(stage.GetPrimAtPath("/World/a")).GetVisibilityAttr()
+    assert not attribute.GetTimeSamples()  # nothing keyed for a creature there all along
+
+
+@pytest.mark.parametrize("skinned", [False, True])
+def test_gltf_scales_a_creature_to_zero_while_it_is_away_and_validates(
+    roster_take: Take, tmp_path: Path, gltf_validator: tuple[str, Path], skinned: bool
+) -> None:
+    path = tmp_path / "roster.glb"
+    (write_skinned_glb if skinned else write_glb)(roster_take, path)
+    report = khronos_report(path, gltf_validator)
+    assert report["issues"]["messages"] == []
+    document, binary = read_glb(path.read_bytes())
+    from ecs_tentacles.export.gltf import accessor_array
+
+    scaled = []
+    for animation in document["animations"]:
+        for channel in animation["channels"]:
+            if channel["target"]["path"] == "scale":
+                sampler = animation["samplers"][channel["sampler"]]
+                assert sampler["interpolation"] == "STEP"
+                times = accessor_array(document, binary, sampler["input"])
+                scales = accessor_array(document, binary, sampler["output"])
+                frames = np.round(times * roster_take.fps).astype(int).tolist()
+                scaled.append((frames, scales[:, 0].tolist()))
+    # b hidden from frame 5, late shown from frame 7; a (there all along) has no keys
+    assert sorted(scaled) == [([0, 5], [1.0, 0.0]), ([0, 7], [0.0, 1.0])]

@@ -1,0 +1,213 @@
+"""Spawning and despawning creatures in a running world (real MuJoCo throughout)."""
+
+from __future__ import annotations
+
+import copy
+from collections.abc import Iterator
+from contextlib import contextmanager
+
+import numpy as np
+import pytest
+
+from ecs_tentacles.components import Creature, Motor, Tentacle, Transform
+from ecs_tentacles.spawning import SpawnError
+from ecs_tentacles.world import World
+
+
+def _creature(name: str, x: float, y: float = 0.0, goal: tuple[float, float] | None = None):
+    spec = {"name": name, "position": [x, y], "tentacles": {"count": 5, "links": 6}}
+    if goal is not None:
+        spec["goals"] = [{"position": list(goal)}]
+    return spec
+
+
+def _scene(creatures: list[dict]) -> dict:
+    return {"version": 1, "name": "spawning", "creatures": creatures}
+
+
+APART = [
+    _creature("a", 0.0, goal=(0.0, 3.0)),
+    _creature("b", 6.0, goal=(6.0, -3.0)),
+    _creature("c", 12.0, goal=(12.0, 3.0)),
+]
+
+
+def _bodies(world: World, name: str) -> np.ndarray:
+    """Every body pose of creature `name` (mantle then links), as one array."""
+    creature = world.component(world.creature(name), Creature)
+    view = world.physics.group_of(creature)
+    rows = view.body_rows
+    return np.concatenate([world.transforms.pos[rows], world.transforms.quat[rows]], axis=1)
+
+
+@contextmanager
+def _twins() -> Iterator[tuple[World, World]]:
+    """Two identical worlds of `APART`, 20 frames in, stepped on two threads."""
+    with World.from_scene(_scene(APART), threads=2) as one:
+        with World.from_scene(_scene(APART), threads=2) as two:
+            one.step(20)
+            two.step(20)
+            yield one, two
+
+
+def test_a_spawn_leaves_every_bystander_bit_identical():
+    with _twins() as (quiet, busy):
+        newcomer = busy.spawn(_creature("d", 30.0, goal=(30.0, 3.0)))
+        quiet.step(90)
+        busy.step(90)
+        for name in ("a", "b", "c"):
+            assert np.array_equal(_bodies(quiet, name), _bodies(busy, name)), name
+        # the newcomer is a creature like the others: it crawled toward its goal
+        start = np.array([30.0, 0.0])
+        moved = busy.component(newcomer, Transform).pos[:2] - start
+        assert moved[1] > 0.05
+        assert busy.physics.compiles == 1  # same morphology: no model compiled
+
+
+def test_a_despawn_leaves_every_bystander_bit_identical():
+    with _twins() as (kept, cut):
+        cut.despawn(cut.creature("b"))
+        kept.step(90)
+        cut.step(90)
+        for name in ("a", "c"):
+            assert np.array_equal(_bodies(kept, name), _bodies(cut, name)), name
+        assert [c.name for _, c in cut.query(Creature)] == ["a", "c"]
+        assert len(cut.physics) == 2
+        # every row of the removed creature left every store
+        loco_rows = {name: len(store) for name, store in cut.stores.items()}
+        assert loco_rows["tentacles"] == loco_rows["locomotion.tentacles"] == 10
+        assert loco_rows["creatures"] == loco_rows["locomotion.creatures"] == 2
+        assert loco_rows["motors"] == 60 and loco_rows["transforms"] == 62
+
+
+def test_components_made_before_a_despawn_still_find_their_rows():
+    with World.from_scene(_scene(APART)) as world:
+        c = world.component(world.creature("c"), Creature)
+        first_link = world.component(c.tentacles[0], Tentacle).links[0]
+        motor = world.component(first_link, Motor)
+        motor.strength = 7.25
+        pose = world.component(world.creature("c"), Transform)
+        before = np.array(pose.pos)
+        world.despawn(world.creature("a"))
+        assert motor.strength == 7.25
+        assert np.array_equal(pose.pos, before)
+        assert world.creatures.mantle_row[c.row] == pose.row
+        world.step(5)  # the physics reads the renumbered rows
+        assert world.physics.group_of(c).creature == world.creature("c")
+
+
+def test_despawn_then_spawn_reuses_the_batch_and_steps_on():
+    with World.from_scene(_scene(APART)) as world:
+        world.step(10)
+        spec = copy.deepcopy(world.creature_specs[world.creature("b")])
+        world.despawn(world.creature("b"))
+        again = world.spawn(spec, position=(6.0, 0.0))
+        assert world.creature_name(again) == "b"
+        assert world.physics.compiles == 1
+        world.step(30)
+        assert world.physics.health.recoveries == 0
+
+
+def test_a_spawn_onto_a_creature_is_refused_in_one_line_or_moved():
+    with World.from_scene(_scene(APART)) as world:
+        with pytest.raises(SpawnError) as refused:
+            world.spawn(_creature("d", 0.1))
+        (line,) = str(refused.value).splitlines()
+        assert "overlaps creature 'a'" in line and "on_overlap='move'" in line
+        assert len(world.physics) == 3  # nothing was built
+        seen = []
+        world.events.on("creature_spawned", lambda **e: seen.append(e))
+        moved = world.spawn(_creature("d", 0.1), on_overlap="move")
+        (event,) = seen
+        assert event["creature"] == moved and event["moved_to"] is not None
+        x, y = event["moved_to"][:2]
+        assert np.hypot(x - 0.1, y) > 0.3
+        assert world.component(moved, Transform).pos[0] == pytest.approx(x, abs=0.01)
+        world.step(20)
+        assert world.physics.health.recoveries == 0
+
+
+def test_a_bad_creature_entry_names_the_field_in_one_line():
+    with World.from_scene(_scene(APART)) as world:
+        with pytest.raises(SpawnError) as bad:
+            world.spawn({"name": "d", "position": [20, 0], "tentacles": {"count": 0}})
+        assert str(bad.value).startswith("creature.tentacles.count:")
+        with pytest.raises(SpawnError, match=r"^creature: must be an object"):
+            world.spawn(["not", "a", "creature"])  # type: ignore[arg-type]
+        with pytest.raises(KeyError, match="not a creature"):
+            world.despawn(10_000)
+        assert len(world.physics) == 3
+
+
+def test_a_taken_name_gets_a_suffix():
+    with World.from_scene(_scene(APART)) as world:
+        first = world.spawn(_creature("a", 20.0))
+        second = world.spawn(_creature("a", 26.0))
+        assert world.creature_name(first) == "a_2"
+        assert world.creature_name(second) == "a_3"
+
+
+def test_restoring_a_snapshot_from_before_a_spawn_removes_the_newcomer():
+    with World.from_scene(_scene(APART)) as world:
+        world.step(10)
+        snap = world.snapshot()
+        world.step(40)
+        expected = {name: _bodies(world, name) for name in ("a", "b", "c")}
+        world.restore(snap)
+        gone = []
+        world.events.on("creature_despawned", lambda **e: gone.append(e["creature_name"]))
+        world.spawn(_creature("d", 30.0, goal=(30.0, 3.0)))
+        world.spawn({**_creature("e", -30.0), "tentacles": {"count": 7}})  # a new model
+        world.step(25)
+        world.restore(snap)
+        assert sorted(gone) == ["d", "e"]
+        assert [c.name for _, c in world.query(Creature)] == ["a", "b", "c"]
+        world.step(40)  # as if the newcomers had never come
+        for name, poses in expected.items():
+            assert np.array_equal(_bodies(world, name), poses), name
+
+
+def test_a_snapshot_naming_a_despawned_creature_is_refused_and_changes_nothing():
+    from ecs_tentacles.snapshot import SnapshotMismatch
+
+    with World.from_scene(_scene(APART)) as world:
+        snap = world.snapshot()
+        world.despawn(world.creature("b"))
+        newcomer = world.spawn(_creature("d", 30.0))
+        with pytest.raises(SnapshotMismatch, match="creature 'b' was despawned since"):
+            world.restore(snap)
+        assert world.creature_name(newcomer) == "d"  # still there: nothing changed
+        world.step(5)
+
+
+def test_a_take_records_the_roster_per_frame(tmp_path):
+    from ecs_tentacles.systems.record.record import Record
+
+    from ecs_tentacles.take import Take
+
+    with World.from_scene(_scene(APART)) as world:
+        record = world.add_system(Record())
+        world.step(10)
+        newcomer = world.spawn(_creature("d", 30.0, goal=(30.0, 3.0)))
+        world.step(10)
+        world.despawn(world.creature("b"))
+        world.step(10)
+        world.despawn(newcomer)
+        world.step(5)
+        path = tmp_path / "roster.npz"
+        record.take().save(path)
+    take = Take.load(path)  # checked as any take
+    assert take.problem() is None
+    names = [c["name"] for c in take.header["creatures"]]
+    assert names == ["a", "b", "c", "d"]
+    shown = take.visible()
+    assert shown.shape == (36, 4)
+    assert shown[:, [0, 2]].all()  # a and c: always there
+    assert shown[:21, 1].all() and not shown[21:, 1].any()  # b: gone after frame 20
+    assert not shown[:11, 3].any() and shown[11:31, 3].all() and not shown[31:, 3].any()
+    mantle_b = take.header["creatures"][1]["mantle"]
+    assert np.array_equal(take.pos[21:, mantle_b], np.repeat(take.pos[20:21, mantle_b], 15, 0))
+    mantle_d = take.header["creatures"][3]["mantle"]
+    held = take.pos[:11, mantle_d]  # before it came: the pose it came in
+    assert np.array_equal(held, np.repeat(held[:1], 11, 0)) and held[0, 0] == 30.0
+    assert not np.array_equal(take.pos[30, mantle_d], take.pos[11, mantle_d])  # it moved
