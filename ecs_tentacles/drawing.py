@@ -37,7 +37,8 @@ class RenderView:
     editing aids (the fur controls' markers) are wanted (the sandbox's HUD is showing);
     `state`: objects plugins keep for as long as the renderer lives, across worlds
     (their GL buffers and display settings), by a key starting with the plugin's name;
-    `selected`: the creature the sandbox has selected (None: none).
+    `selected`: the creature the sandbox has selected (None: none), the last picked of
+    `selection` (every selected creature).
     """
 
     pos: np.ndarray
@@ -51,6 +52,7 @@ class RenderView:
     overlays: bool = False
     state: dict[str, Any] = field(default_factory=dict)
     selected: int | None = None  # the sandbox's selected creature (an entity), if any
+    selection: tuple[int, ...] = ()  # every selected creature
 
 
 @dataclass(frozen=True)
@@ -60,7 +62,9 @@ class Click:
     `button`: "left", "right" or "middle"; `shift`: held; `ground`: where the ray under
     the pointer meets the ground plane (world metres, (3,)), None above the horizon;
     `creature`: the creature under the pointer (the sandbox selects it on a left click
-    before plugins see it), None if none; `selected`: the selected creature.
+    before plugins see it), None if none; `selected`: the selected creature (the last
+    picked); `selection`: every selected creature (the sandbox may select many);
+    `ctrl`: held.
     """
 
     button: str
@@ -68,6 +72,15 @@ class Click:
     ground: np.ndarray | None
     creature: int | None
     selected: int | None
+    selection: tuple[int, ...] = ()
+    ctrl: bool = False
+
+    @property
+    def chosen(self) -> tuple[int, ...]:
+        """The creatures a click acts on: the selection, else the selected one."""
+        if self.selection:
+            return self.selection
+        return () if self.selected is None else (self.selected,)
 
 
 class Panel:
@@ -79,7 +92,8 @@ class Panel:
     `closed`. A panel lives as long as the sandbox: `attach` tells it the world was
     rebuilt or reset, `select` that the selection changed. It may draw more ImGui
     windows (`windows`) and take the mouse: `press` at a pixel of the 3D view returns
-    True to grab it, then `drag` and `release` follow.
+    True to grab it, then `drag` and `release` follow; `key` sees keys before the
+    sandbox does.
     """
 
     title: str = ""
@@ -97,6 +111,11 @@ class Panel:
 
     def select(self, creature: int | None, tentacle: int | None) -> None:
         """The sandbox selected `creature` (and tentacle index `tentacle`, None: all)."""
+
+    def key(self, symbol: int, modifiers: int) -> bool:
+        """A key went down (pyglet's symbol and modifiers) while the 3D view has the
+        keyboard; True: handled (the sandbox does nothing more with it)."""
+        return False
 
     def press(self, x: float, y: float) -> bool:
         """A left press at pyglet pixel (x, y) of the 3D view; True takes the drag."""

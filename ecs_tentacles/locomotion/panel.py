@@ -1,10 +1,11 @@
 """Locomotion's HUD sections: tune the selected creature's tentacles, see their actions.
 
-"Locomotion" (first in the panel) has a slider for each parameter the scene schema
-marks with one (`ecs_tentacles.scene.parameters`: speed, target angle, strength, wave
-amplitude and frequency), over its range and with its label and units (strength stops
-where the servos' damping can hold it), the gait's choices, and a tentacle selector
-("all" or one tentacle; tab steps it too). Every change goes through
+"Locomotion" (first in the panel) has, for every selected creature, a slider for each
+parameter the scene schema marks with one (`ecs_tentacles.scene.parameters`: speed,
+target angle, strength, wave amplitude and frequency), over its range and with its
+label and units (strength stops where the servos' damping can hold it), the gait's
+choices, a tentacle selector ("all" or one tentacle; tab steps it too), and the shape
+a goal click sends a group in (`ecs_tentacles.locomotion.formations`). Every change goes through
 `world.resource(Locomotion).set`, the same API scripts use, so it reaches the servos
 on the next physics step. "Actions" (last, folded) lists each tentacle's action.
 The locomotion plugin's `sandbox_panels` hook makes both. Reads and writes the
@@ -19,6 +20,7 @@ from typing import Any
 from imgui_bundle import imgui
 
 from ecs_tentacles.drawing import Panel
+from ecs_tentacles.locomotion.formations import SHAPES, FormationChoice
 from ecs_tentacles.locomotion.params import Locomotion, settable
 from ecs_tentacles.render.gui import Gui, same_line_if_fits, text_width
 from ecs_tentacles.scene.parameters import Parameter, parameter
@@ -106,16 +108,31 @@ class LocomotionPanel(Panel):
         self.creature, self.tentacle = creature, tentacle
         self.refresh()
 
+    @property
+    def chosen(self) -> tuple[int, ...]:
+        """Every selected creature (the sandbox may select many), else the one shown."""
+        selection = getattr(self.sandbox, "selection", None)
+        if selection is not None and len(selection):
+            return tuple(selection.entities)
+        return () if self.creature is None else (self.creature,)
+
     def set_parameter(self, name: str, value: float | str) -> None:
-        """Apply a parameter to the selection through the locomotion API."""
+        """Apply a parameter to every selected creature through the locomotion API (a
+        chosen tentacle: to each creature that has it; strength: within each one's
+        limit)."""
         if self.creature is None:
             return
-        if name not in settable()[0]:  # creature-wide (the gait)
-            self.world.resource(Locomotion).set(self.creature, **{name: value})
-        else:
-            self.world.resource(Locomotion).set(
-                self.creature, tentacle=self.tentacle, **{name: float(value)}
-            )
+        api = self.world.resource(Locomotion)
+        for creature in self.chosen:
+            if name not in settable()[0]:  # creature-wide (the gait)
+                api.set(creature, **{name: value})
+                continue
+            if self.tentacle is not None and self.tentacle >= api.tentacle_count(creature):
+                continue
+            number = float(value)
+            if name == "strength":
+                number = min(number, api.strength_limit(creature, self.tentacle))
+            api.set(creature, tentacle=self.tentacle, **{name: number})
         self.refresh()
 
     def refresh(self) -> None:
@@ -170,6 +187,20 @@ class LocomotionPanel(Panel):
             if imgui.radio_button(gait, self.values["gait"] == gait):
                 self.set_parameter("gait", gait)
             gui.item(f"gait {gait}")
+        self._formation(gui)
+
+    def _formation(self, gui: Gui) -> None:
+        """How many creatures the sliders move, and the shape a group goal click takes."""
+        count = len(self.chosen)
+        imgui.text(f"{count} selected: formation" if count > 1 else "group formation")
+        gui.item("formation label")
+        choice = self.world.resource(FormationChoice)
+        for i, shape in enumerate(SHAPES):
+            if i:
+                same_line_if_fits(text_width(shape))
+            if imgui.radio_button(shape, choice.shape == shape):
+                choice.shape = shape
+            gui.item(f"formation {shape}")
 
 
 class ActionsPanel(Panel):

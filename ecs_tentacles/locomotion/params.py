@@ -143,6 +143,10 @@ class Locomotion:
                     f" physics step ({1e3 * step:.3g} ms), got damping {damping:g}"
                 )
 
+    def tentacle_count(self, creature: int) -> int:
+        """How many tentacles creature `creature` has."""
+        return len(self._world.component(creature, Creature).tentacles)
+
     def strength_limit(self, creature: int, tentacle: int | None = None) -> float:
         """The highest strength `set` accepts now: the schema's, or what the damping holds."""
         step = self._world.settings.substep_dt

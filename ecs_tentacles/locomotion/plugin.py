@@ -27,6 +27,7 @@ from ecs_tentacles.components import Creature, Tentacle
 from ecs_tentacles.construction import tentacle_params
 from ecs_tentacles.locomotion.actions import STRENGTH, ActionQueue, Kind
 from ecs_tentacles.locomotion.components import Goal
+from ecs_tentacles.locomotion.formations import FormationChoice
 from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.locomotion.navigation import Navigator
 from ecs_tentacles.locomotion.params import Locomotion
@@ -57,7 +58,8 @@ class LocomotionPlugin(Plugin):
     defs = _FRAGMENT["$defs"]
 
     def resources(self, world: Host) -> list[object]:
-        return [LocomotionStores(), GoalBook(world), Locomotion(world), Navigator()]
+        return [LocomotionStores(), GoalBook(world), Locomotion(world), Navigator(),
+                FormationChoice()]  # fmt: skip
 
     def stores(self, world: Host) -> dict[str, ArrayStore]:
         loco = world.resource(LocomotionStores)

@@ -7,8 +7,9 @@ with it, and (with obstacles) the path navigation planned around them, through i
 waypoints. The rings and legs between goals are rebuilt only when a goal changes
 (`GoalBook.version`); the moving legs are one vectorised pass a frame.
 
-Mouse (`sandbox_click`): a left click on the ground sets the selected creature's goal,
-shift-click appends one to its path, a right click inside a goal's ring removes it.
+Mouse (`sandbox_click`): a left click on the ground sets the selected creature's goal
+(several selected: one goal each, in formation around the point), shift-click appends
+one to the path, a right click inside a goal's ring removes it.
 Reads: `GoalBook` (paths, positions), `Goal` radii, the Transform store.
 Writes: goals, through `GoalBook`.
 """
@@ -24,6 +25,7 @@ from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.drawing import CIRCLE, Click, RenderView, line_segments
 from ecs_tentacles.ground import ground_of
 from ecs_tentacles.locomotion.components import Goal
+from ecs_tentacles.locomotion.formations import FormationChoice, formation_goals
 from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.locomotion.navigation import Navigator
 
@@ -51,18 +53,19 @@ class GoalLines:
 
 def goal_lines(world: Host, view: RenderView) -> GoalLines:
     """Every path's fixed geometry, from the goal book as it is now. In a crowd (more
-    than `ALL_PATHS` creatures) only the selected creature's path is drawn in full and
+    than `ALL_PATHS` creatures) only the selected creatures' paths are drawn in full and
     led to from the creature; the others' rings are faded, without legs, so a crowd's
     picture is not a starburst of lines."""
     book = world.resource(GoalBook)
     fixed: list[np.ndarray] = []
     leaders, firsts, colours = [], [], []
     crowd = len(view.creatures) > ALL_PATHS
+    chosen = set(view.selection) | ({view.selected} if view.selected is not None else set())
     for entity in view.creatures:
         goals = book.path(entity)
         if not goals:
             continue
-        shown = not crowd or entity == view.selected
+        shown = not crowd or entity in chosen
         colour = np.append(view.colours[entity] * 0.6 + 0.4, 1.0)
         if not shown:
             colour = np.append(colour[:3] * FADED + (1.0 - FADED) * FADE_TO, 1.0)
@@ -81,7 +84,7 @@ def goal_lines(world: Host, view: RenderView) -> GoalLines:
         colours.append(colour)
     return GoalLines(
         world,
-        (int(book.version), view.selected),
+        (int(book.version), view.selected, view.selection),
         np.vstack(fixed) if fixed else np.zeros((0, 7)),
         np.array(leaders, dtype=np.int64),
         np.array(firsts).reshape(-1, 3),
@@ -92,7 +95,7 @@ def goal_lines(world: Host, view: RenderView) -> GoalLines:
 def path_lines(world: Host, view: RenderView) -> list[np.ndarray]:
     """This frame's goal rings and paths (line-list vertices), the fixed part cached."""
     cached = view.state.get(GOALS)
-    version = (int(world.resource(GoalBook).version), view.selected)
+    version = (int(world.resource(GoalBook).version), view.selected, view.selection)
     if not isinstance(cached, GoalLines) or cached.world is not world or cached.version != version:
         cached = view.state[GOALS] = goal_lines(world, view)
     # each creature's leg to its current goal moves with it: one vectorised pass
@@ -146,12 +149,19 @@ def remove_goal_at(world: Host, point: np.ndarray) -> int | None:
 
 
 def click_goal(world: Host, click: Click) -> bool:
-    """Set (left), append (shift-left) or remove (right) a goal; True if the click was one."""
+    """Set (left), append (shift-left) or remove (right) a goal; True if the click was one.
+
+    With several creatures selected each gets its own goal in the chosen formation
+    around the point (`ecs_tentacles.locomotion.formations`)."""
     if click.ground is None:
         return False
-    if click.button == "left" and click.creature is None and click.selected is not None:
+    chosen = click.chosen
+    if click.button == "left" and click.creature is None and chosen:
         book = world.resource(GoalBook)
-        (book.append if click.shift else book.set)(click.selected, click.ground[:2].tolist())
+        shape = world.resource(FormationChoice).shape
+        goals = formation_goals(world, chosen, click.ground[:2], shape)
+        for creature, goal in zip(chosen, goals, strict=True):
+            (book.append if click.shift else book.set)(creature, goal.tolist())
         return True
     if click.button == "right":
         return remove_goal_at(world, click.ground) is not None

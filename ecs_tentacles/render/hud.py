@@ -59,6 +59,7 @@ class Hud:
         self.label_at: Callable[[], list[tuple[str, float, float]]] = list  # (text, x, y)
         # the selected creature's name over it, while the panel shows (labels off)
         self.selection_label: Callable[[], list[tuple[str, float, float]]] = list
+        self.band: tuple[float, float, float, float] | None = None  # a rubber band (pixels)
         self.show_tiers = False  # a marker over each creature, coloured by its physics tier
 
     # -- selection -------------------------------------------------------------------
@@ -104,7 +105,7 @@ class Hud:
 
     def draw(self) -> int:
         """Build and draw the panel; return the GL draw calls it issued."""
-        if not self.visible and not self.name_labels:
+        if not self.visible and not self.name_labels and self.band is None:
             self.gui.skip_frame()
             return 0
         if not self.gui.frames:  # windows that fit their content know their size from frame 2
@@ -120,6 +121,8 @@ class Hud:
             self._name_labels(self.label_at())
         elif self.visible:
             self._name_labels(self.selection_label())
+        if self.band is not None:
+            self._band(*self.band)
         if not self.visible:
             return
         imgui.set_next_window_pos((0.0, 0.0))
@@ -151,6 +154,14 @@ class Hud:
             window(gui)
         for panel in self.panels:
             panel.windows(gui)
+
+    def _band(self, x0: float, y0: float, x1: float, y1: float) -> None:
+        """The rectangle a shift-drag selects in (pyglet pixels), outlined and tinted."""
+        draw = imgui.get_foreground_draw_list()
+        height = self.window.height
+        corner, other = (min(x0, x1), height - max(y0, y1)), (max(x0, x1), height - min(y0, y1))
+        draw.add_rect_filled(corner, other, imgui.get_color_u32((0.6, 0.8, 1.0, 0.12)))
+        draw.add_rect(corner, other, imgui.get_color_u32((0.6, 0.8, 1.0, 0.9)))
 
     def _name_labels(self, labels: list[tuple[str, float, float]]) -> None:
         """Each (text, x, y) centred at its pixel (pyglet's y), on a dark plate."""

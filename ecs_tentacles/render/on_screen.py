@@ -1,5 +1,6 @@
 """Creatures on the screen: the names written over them (every creature's, or the
-selection's, for the HUD) and which creature is under a pixel (for clicks).
+selection's, for the HUD), which creature is under a pixel (for clicks) and which
+are inside a rectangle (for a rubber-band selection).
 
 Reads the Transform store (mantle poses), `Creature` sizes and names, the camera.
 """
@@ -30,6 +31,23 @@ def labels_over(world: Any, renderer: Any, entities: Sequence[int]) -> list[Labe
     tops[:, 2] += [c.mantle_height * ABOVE + 0.05 for c in creatures]
     pixels = renderer.camera.project(tops)
     return [(c.name, float(x), float(y)) for c, (x, y) in zip(creatures, pixels, strict=True)]
+
+
+def creatures_in(
+    world: Any, renderer: Any, corner: Sequence[float], other: Sequence[float]
+) -> list[int]:
+    """The creatures whose mantle centre projects inside the pixel rectangle between
+    `corner` and `other` (x, y; any two opposite corners), in drawing order."""
+    entities = renderer.creature_entities
+    if not entities:
+        return []
+    camera = renderer.camera
+    centres = world.transforms.pos[renderer.mantle_rows]
+    pixels = camera.project(centres)
+    ahead = (centres - camera.eye) @ (camera.target - camera.eye) > 0  # not behind the eye
+    low, high = np.minimum(corner, other), np.maximum(corner, other)
+    inside = np.all((pixels >= low) & (pixels <= high), axis=1) & ahead
+    return [entities[i] for i in np.flatnonzero(inside)]
 
 
 def creature_at(world: Any, renderer: Any, x: float, y: float) -> int | None:

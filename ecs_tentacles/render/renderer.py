@@ -90,7 +90,8 @@ class Renderer:
         self.shadows = InstancedMesh(QUAD)  # a soft blob under every mantle and link
         self.sucker_discs = InstancedMesh(SUCKER_DISC)
         self.lines = Lines()
-        self.selected: int | None = None  # creature entity
+        self.selected: int | None = None  # creature entity (the HUD's)
+        self.selection: tuple[int, ...] = ()  # every selected creature (a ring each)
         self.draw_calls = 0
         self.extra_lines: list[Callable[[World], np.ndarray]] = []  # -> (2n, 7) segments
         self.overlays = False  # editing aids wanted (the sandbox sets it while its HUD shows)
@@ -102,6 +103,7 @@ class Renderer:
         """Draw `world` from now on (same GPU objects, new instance tables)."""
         self.world = world
         self.selected = None
+        self.selection = ()
         self._colour_index: dict[int, int] = {}  # creature entity -> its colour, kept
         self._build_static()
         self.previous = (world.transforms.pos.copy(), world.transforms.quat.copy())
@@ -111,8 +113,10 @@ class Renderer:
     def roster_changed(self, change: RosterChange) -> None:
         """A creature came or went: new instance tables (everyone keeps its colour), the
         poses from now (nothing to blend from), the camera's followed body renumbered."""
-        if self.selected == change.creature and not change.spawned:
-            self.selected = None
+        if not change.spawned:
+            self.selection = tuple(e for e in self.selection if e != change.creature)
+            if self.selected == change.creature:
+                self.selected = None
         follow = self.camera.follow
         if follow is not None and not change.spawned:
             row = int(change.moved["transforms"][follow])
@@ -273,6 +277,7 @@ class Renderer:
             pixel=float(pixel),
             overlays=self.overlays,
             selected=self.selected,
+            selection=self.selection,
             state=self.state,
         )
         return self.render_view
@@ -293,14 +298,14 @@ class Renderer:
         return out
 
     def _line_vertices(self, pos: np.ndarray) -> np.ndarray:
-        """The plugins' line segments, the selected creature's ring, `extra_lines`."""
+        """The plugins' line segments, a ring round each selected creature, `extra_lines`."""
         view = self.render_view
         segments = [np.zeros((0, 7))]
         for plugin in self.world.plugins:
             segments += plugin.render_lines(self.world, view)
-        if self.selected is not None:
-            row = self.world.component(self.selected, Transform).row
-            creature = self.world.component(self.selected, Creature)
+        for entity in self.selection or ((self.selected,) if self.selected is not None else ()):
+            row = self.world.component(entity, Transform).row
+            creature = self.world.component(entity, Creature)
             ring = pos[row] * [1, 1, 0] + [0, 0, 0.01] + creature.mantle_radius * 1.6 * CIRCLE
             segments.append(line_segments(ring, np.array([1.0, 1.0, 1.0, 1.0])))
         for provider in self.extra_lines:

@@ -4,15 +4,19 @@ Physics runs at the scene's fixed frame rate with its own accumulator; drawing
 happens at display rate and interpolates between the last two physics frames.
 
 Mouse: left-drag orbits, right- or middle-drag pans, wheel zooms; click a creature
-to select it. Every other click in the 3D view goes to the plugins' `sandbox_click`
-hooks (`ecs_tentacles.drawing.Click`): the locomotion plugin's sets the selected
-creature's goal on a click on the ground, appends to its path on shift-click and
-removes the goal under a right click. Keys: space pause, . single step, r reset,
-h HUD, f follow, a frame all, tab next tentacle, F12 screenshot, v video,
-F5 save the state, F9 go back to it.
+to select it, shift-click one to add it to the selection or take it out, shift-drag a
+rectangle to select the creatures in it (`render.selection`). Every other click in the
+3D view goes to the plugins' `sandbox_click` hooks (`ecs_tentacles.drawing.Click`):
+the locomotion plugin's sends the selection to a click on the ground (in formation
+when there are several), appends to their paths on shift-click and removes the goal
+under a right click. Keys: space pause, . single step, r reset, h HUD, f follow,
+a frame all, Ctrl+A select every creature, Esc select none, tab next tentacle, F12
+screenshot, v video, F5 save the state, F9 go back to it. The HUD's panels see keys
+and mouse presses first (`Panel.key`, `Panel.press`; `modifiers` and `keys` say what
+is held).
 
 Level of detail (`world.lod`): before every physics frame the sandbox tells it the
-selected creature (it runs full) and, unless a focus is pinned (`focus=`, `play
+selected creatures (they run full) and, unless a focus is pinned (`focus=`, `play
 --focus`, or the scene's `physics.lod.focus`), a focus of `FOCUS_RADIUS` m around the
 camera's target, so what you look at runs full. Headless runs (`play --headless`) do
 the same: the camera does not move there, so they stay deterministic; bakes have no
@@ -47,11 +51,12 @@ from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.drawing import Click, Panel
 from ecs_tentacles.ground import ground_of
 from ecs_tentacles.render.hud import Hud
-from ecs_tentacles.render.on_screen import creature_at, labels_over
+from ecs_tentacles.render.on_screen import creature_at, creatures_in, labels_over
 from ecs_tentacles.render.output import VideoWriter, save_png
 from ecs_tentacles.render.plugin import RenderPlugin
 from ecs_tentacles.render.renderer import Renderer
 from ecs_tentacles.render.scripts import Scripts
+from ecs_tentacles.render.selection import Selection
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.system import SystemFailure
 from ecs_tentacles.world import World
@@ -102,6 +107,7 @@ class Sandbox:
         self.scripts = Scripts(self.window)
         self.hud.windows.append(self.scripts.draw)
         self.paused = False
+        self.selection = Selection()
         self.panels: dict[str, list[Panel]] = {}  # each plugin's HUD sections, by plugin key
         self._grab: Panel | None = None  # the panel holding the mouse (a dragged marker)
         self._attach_world()
@@ -111,6 +117,10 @@ class Sandbox:
         self.video: VideoWriter | None = None
         self.screenshots = 0
         self._press: tuple[float, float] | None = None
+        self.band: tuple[float, float, float, float] | None = None  # a rectangle being dragged
+        self.modifiers = 0  # the modifier keys held at the last mouse press or key
+        self.keys = key.KeyStateHandler()  # which keys are down (panels: `keys[key.S]`)
+        self.window.push_handlers(self.keys)
         self.stats = {"fps": 0.0, "physics_ms": 0.0, "sim_time": 0.0, "rtf": 0.0, "attached": 0}
         self._wall_start = time.perf_counter()
         self._last_draw: float | None = None
@@ -124,8 +134,15 @@ class Sandbox:
         self.hud.world = self.world
         self.scripts.attach(self.world)
         self._attach_panels()
+        self.world.events.on("creature_despawned", self._forget)
         first = self.renderer.creature_entities[0] if self.renderer.creature_entities else None
         self.select(first)
+
+    def _forget(self, *, creature: int, **_: Any) -> None:
+        """A despawned creature leaves the selection."""
+        if creature in self.selection:
+            self.selection.discard(creature)
+            self._selection_changed()
 
     def _attach_panels(self) -> None:
         """Tell the kept panels about the new world; ask plugins seen first for theirs."""
@@ -179,8 +196,7 @@ class Sandbox:
     def steer_lod(self) -> None:
         """Tell the level of detail what the player looks at: the selection, the camera."""
         lod = self.world.lod
-        selected = self.renderer.selected
-        lod.select([] if selected is None else [selected])
+        lod.select(self.selection.entities)
         if self.camera_focus:
             lod.focus(self.renderer.camera.target[:2], FOCUS_RADIUS)
 
@@ -297,8 +313,20 @@ class Sandbox:
 
     # -- selection and clicks ------------------------------------------------------------
     def select(self, creature: int | None) -> None:
-        self.renderer.selected = creature
-        self.hud.select(creature)  # and every panel
+        """Select just `creature` (None: nothing)."""
+        self.selection.only(creature)
+        self._selection_changed()
+
+    def select_many(self, creatures: Any) -> None:
+        """Select `creatures` (entities; the last is the HUD's)."""
+        self.selection.replace(creatures)
+        self._selection_changed()
+
+    def _selection_changed(self) -> None:
+        primary = self.selection.primary
+        self.renderer.selected = primary
+        self.renderer.selection = self.selection.entities
+        self.hud.select(primary)  # and every panel
 
     def pick_creature(self, x: float, y: float) -> int | None:
         """The creature whose mantle is under pixel (x, y), nearest first."""
@@ -317,14 +345,21 @@ class Sandbox:
         if self.hud.contains(x, y):
             return
         picked = self.pick_creature(x, y)
+        shift = bool(modifiers & key.MOD_SHIFT)
         if button == mouse.LEFT and picked is not None:
+            if shift:  # in or out of the selection
+                self.selection.toggle(picked)
+                self._selection_changed()
+                return
             self.select(picked)
         click = Click(
             button=BUTTONS.get(button, "other"),
-            shift=bool(modifiers & key.MOD_SHIFT),
+            shift=shift,
             ground=self.ground_point(x, y),
             creature=picked,
             selected=self.renderer.selected,
+            selection=self.selection.entities,
+            ctrl=bool(modifiers & key.MOD_CTRL),
         )
         for plugin in self.world.plugins:
             if plugin.sandbox_click(self.world, click):
@@ -332,6 +367,7 @@ class Sandbox:
 
     # -- window events -------------------------------------------------------------------
     def on_mouse_press(self, x: int, y: int, button: int, modifiers: int) -> None:
+        self.modifiers = modifiers
         self._press = (x, y) if not self.hud.contains(x, y) else None
         if self._press is not None and button == mouse.LEFT:
             for panel in self.hud.panels:
@@ -343,7 +379,11 @@ class Sandbox:
         for panel in self.hud.panels:
             panel.release()
         self._grab = None
-        if (
+        if self.band is not None:
+            x0, y0, x1, y1 = self.band
+            self.band = self.hud.band = None
+            self.select_many(creatures_in(self.world, self.renderer, (x0, y0), (x1, y1)))
+        elif (
             self._press is not None
             and np.hypot(x - self._press[0], y - self._press[1]) < CLICK_PIXELS
         ):
@@ -356,7 +396,9 @@ class Sandbox:
             return
         if self._press is None:
             return
-        if buttons & mouse.LEFT:
+        if buttons & mouse.LEFT and (self.band is not None or modifiers & key.MOD_SHIFT):
+            self.band = self.hud.band = (*self._press, float(x), float(y))  # rubber band
+        elif buttons & mouse.LEFT:
             self.renderer.camera.orbit(dx, dy)
         elif buttons & (mouse.RIGHT | mouse.MIDDLE):
             self.renderer.camera.pan(dx, dy)
@@ -365,11 +407,23 @@ class Sandbox:
         if not self.hud.contains(x, y):
             self.renderer.camera.zoom(scroll_y)
 
-    def on_key_press(self, symbol: int, modifiers: int) -> None:
+    def on_key_press(self, symbol: int, modifiers: int) -> bool | None:
+        self._key(symbol, modifiers)
+        # Esc clears the selection; pyglet's own handler would close the window
+        return pyglet.event.EVENT_HANDLED if symbol == key.ESCAPE else None
+
+    def _key(self, symbol: int, modifiers: int) -> None:
         camera = self.renderer.camera
         if self.hud.visible and self.hud.gui.wants_keyboard:
             return  # typing into a text field
-        if symbol == key.SPACE:
+        self.modifiers = modifiers
+        if any(panel.key(symbol, modifiers) for panel in self.hud.panels):
+            return  # a panel's key (the palette's Delete, Ctrl+Z, ...)
+        if symbol == key.A and modifiers & key.MOD_CTRL:
+            self.select_many(self.renderer.creature_entities)
+        elif symbol == key.ESCAPE:
+            self.select(None)
+        elif symbol == key.SPACE:
             self.paused = not self.paused
         elif symbol == key.PERIOD:
             self.paused = True
