@@ -212,6 +212,24 @@ class Plugin:
         asked once per sandbox: panels live across resets (`Panel.attach`)."""
         return []
 
+    def sandbox_state(self, world: Host) -> Any:
+        """What of this plugin's state the sandbox's undo puts back (the locomotion
+        plugin's goals and tentacle parameters, by creature name), or None; compared
+        with ==, so plain data and numpy arrays (`ecs_tentacles.render.undo`)."""
+        return None
+
+    def sandbox_restore(self, world: Host, state: Any) -> None:
+        """Put back what `sandbox_state` returned (creatures no longer there are skipped)."""
+
+    def save_creature(self, world: Host, creature: int, entry: dict[str, Any]) -> None:
+        """Write what this plugin knows of `creature` now into its scene entry `entry`
+        (its goals, its parameters), for saving a directed crowd as a scene
+        (`ecs_tentacles.roster_save`)."""
+
+    def save_scene(self, world: Host, scene: dict[str, Any]) -> None:
+        """Write this plugin's scene-level state into `scene` when a running world is
+        saved (`ecs_tentacles.roster_save`; the threats plugin: threats dropped since)."""
+
     def sandbox_click(self, world: Host, click: Click) -> bool:
         """A click in the sandbox's 3D view; True: handled (later plugins do not see it)."""
         return False

@@ -39,6 +39,7 @@ BUILTIN = {
     "render": "ecs_tentacles.render.plugin:RenderPlugin",
     "lod": "ecs_tentacles.lod.plugin:LodPlugin",
     "terrain": "ecs_tentacles.terrain.plugin:TerrainPlugin",
+    "director": "ecs_tentacles.director.plugin:DirectorPlugin",
 }
 BUNDLED = {
     "wander": "ecs_tentacles.systems.examples.wander:WanderPlugin",
@@ -47,6 +48,7 @@ BUNDLED = {
     "flock": "ecs_tentacles.systems.examples.flock:FlockPlugin",
 }
 DEFAULT_ON = ("locomotion", "suckers", "threats", "fur", "lod", "terrain")  # in build order
+SANDBOX_ON = ("director",)  # added by the sandbox (`play`) to the world it shows
 FROM = "from"  # the config key naming where a plugin's code is
 
 
@@ -184,6 +186,11 @@ def builtin(key: str, **options: Any) -> Plugin:
         raise PluginError(f"plugins.{key}: not a built-in plugin (known: {', '.join(BUILTIN)})")
     made = load(key, BUILTIN[key], None)
     return instantiate(made(**options) if isinstance(made, type) else made, key, {}, None)
+
+
+def sandbox_plugins() -> list[Plugin]:
+    """The built-in plugins every sandbox adds to its world (`SANDBOX_ON`)."""
+    return [builtin(key) for key in SANDBOX_ON]
 
 
 def resolve(

@@ -200,6 +200,14 @@ def spawn(
             where = ", ".join(f"{v:g}" for v in entry["position"])
             line = f"creature {entry['name']!r} at ({where}): overlaps {blocker}"
             raise SpawnError([f"{line} (pick a free spot, or on_overlap='move')"])
+    return place(world, entry, moved_to)
+
+
+def place(world: World, entry: dict[str, Any], moved_to: tuple[float, ...] | None = None) -> int:
+    """Build a creature entry `creature_entry` made (checked, defaults in, its name
+    unique) where it says, without looking for overlaps: `spawn`'s last step, and how
+    `scatter` places many copies of one checked entry at spots it knows are free."""
+    world.activate()
     before = {name: len(store) for name, store in world.stores.items()}
     entity = build_creature(world, entry)
     for plugin in world.plugins:

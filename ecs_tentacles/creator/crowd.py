@@ -177,6 +177,16 @@ def _creature(rng: np.random.Generator, name: str, plan: dict[str, Any]) -> dict
     return creature
 
 
+def species_creatures(count: int = DEFAULT_SPECIES, seed: int = 0) -> list[dict[str, Any]]:
+    """One creature of each of the generator's first `count` species (the bodies a crowd
+    mixes), named `species1` ..., at the origin: the director's palette lists them."""
+    plans = _species(np.random.default_rng(seed), count)
+    return [
+        _creature(np.random.default_rng([seed, k]), f"species{k}", plan)
+        for k, plan in enumerate(plans, start=1)
+    ]
+
+
 def _plan_reach(plan: dict[str, Any]) -> float:
     """`creature_reach` of every creature of `plan`: their own overrides keep its shape."""
     overrides = [{"index": k, **shape} for k, shape in plan["shape_overrides"].items()]

@@ -122,6 +122,14 @@ class LocomotionPanel(Panel):
         limit)."""
         if self.creature is None:
             return
+        undo = getattr(self.sandbox, "undo", None)
+        if undo is not None:  # one undoable edit (a drag of the slider too)
+            undo.record(self.world, f"set {name}", lambda: self._apply(name, value))
+        else:
+            self._apply(name, value)
+        self.refresh()
+
+    def _apply(self, name: str, value: float | str) -> None:
         api = self.world.resource(Locomotion)
         for creature in self.chosen:
             if name not in settable()[0]:  # creature-wide (the gait)
@@ -133,7 +141,6 @@ class LocomotionPanel(Panel):
             if name == "strength":
                 number = min(number, api.strength_limit(creature, self.tentacle))
             api.set(creature, tentacle=self.tentacle, **{name: number})
-        self.refresh()
 
     def refresh(self) -> None:
         """Read the selection's current values from the world."""

@@ -146,6 +146,21 @@ class LocomotionPlugin(Plugin):
 
         return goal_points(world)
 
+    def sandbox_state(self, world: Host) -> Any:
+        from ecs_tentacles.locomotion.directing import sandbox_state
+
+        return sandbox_state(world)
+
+    def sandbox_restore(self, world: Host, state: Any) -> None:
+        from ecs_tentacles.locomotion.directing import sandbox_restore
+
+        sandbox_restore(world, state)
+
+    def save_creature(self, world: Host, creature: int, entry: dict[str, Any]) -> None:
+        from ecs_tentacles.locomotion.directing import save_creature
+
+        save_creature(world, creature, entry)
+
     def sandbox_click(self, world: Host, click: Click) -> bool:
         from ecs_tentacles.locomotion.render import click_goal
 

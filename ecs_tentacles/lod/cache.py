@@ -47,20 +47,17 @@ class ClipCache:
         return self._get(key, creature, physics)
 
     def for_creature(self, world: Host, entity: int) -> GaitClips:
-        """The clips of creature `entity` of `world` (built from a scene: its entry is
-        found by name in `world.scene`)."""
+        """The clips of creature `entity` of `world`, from its entry (the scene's, or the
+        one it was spawned from: `world.creature_specs`)."""
         creature = world.component(entity, Creature)
         key = model_layout(world, creature, world.component(entity, Transform)).key
         if key in self.clips:
             return self.clips[key]
-        if world.scene is None:
-            raise ValueError(f"creature {creature.name!r}: the world has no scene to record from")
-        entries = [c for c in world.scene["creatures"] if c.get("name") == creature.name]
-        if len(entries) != 1:
-            raise ValueError(
-                f"creature {creature.name!r}: {len(entries)} scene creatures have that name"
-            )
-        return self._get(key, entries[0], world.scene.get("physics"))
+        entry = world.creature_specs.get(entity)
+        if entry is None:
+            raise ValueError(f"creature {creature.name!r}: no entry to record its clips from")
+        physics = world.scene.get("physics") if world.scene is not None else None
+        return self._get(key, entry, physics)
 
     def _get(
         self, key: tuple[Any, ...], creature: dict[str, Any], physics: dict[str, Any] | None

@@ -10,8 +10,10 @@ rectangle to select the creatures in it (`render.selection`). Every other click 
 the locomotion plugin's sends the selection to a click on the ground (in formation
 when there are several), appends to their paths on shift-click and removes the goal
 under a right click. Keys: space pause, . single step, r reset, h HUD, f follow,
-a frame all, Ctrl+A select every creature, Esc select none, tab next tentacle, F12
-screenshot, v video, F5 save the state, F9 go back to it. The HUD's panels see keys
+a frame all, Ctrl+A select every creature, Esc select none, Ctrl+Z undo and
+Ctrl+Shift+Z redo an edit (goals, parameters, the director's; `render.undo`), Ctrl+S
+save the roster as a scene (`roster_save`), tab next tentacle, F12 screenshot, v
+video, F5 save the state, F9 go back to it. The HUD's panels see keys
 and mouse presses first (`Panel.key`, `Panel.press`; `modifiers` and `keys` say what
 is held).
 
@@ -50,6 +52,7 @@ from tqdm import tqdm
 from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.drawing import Click, Panel
 from ecs_tentacles.ground import ground_of
+from ecs_tentacles.plugin_registry import sandbox_plugins
 from ecs_tentacles.render.hud import Hud
 from ecs_tentacles.render.on_screen import creature_at, creatures_in, labels_over
 from ecs_tentacles.render.output import VideoWriter, save_png
@@ -57,6 +60,8 @@ from ecs_tentacles.render.plugin import RenderPlugin
 from ecs_tentacles.render.renderer import Renderer
 from ecs_tentacles.render.scripts import Scripts
 from ecs_tentacles.render.selection import Selection
+from ecs_tentacles.render.undo import UndoStack
+from ecs_tentacles.roster_save import save_roster
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.system import SystemFailure
 from ecs_tentacles.world import World
@@ -129,14 +134,24 @@ class Sandbox:
     def _attach_world(self) -> None:
         self.renderer = Renderer(self.world, self.window.width, self.window.height)
         self.renderer.camera.shift_x = self.hud.width / 2
-        self.world.add_plugin(RenderPlugin(renderer=self.renderer))
+        self._add_sandbox_plugins()
         self.renderer.frame_all()
         self.hud.world = self.world
         self.scripts.attach(self.world)
         self._attach_panels()
-        self.world.events.on("creature_despawned", self._forget)
         first = self.renderer.creature_entities[0] if self.renderer.creature_entities else None
         self.select(first)
+
+    def _add_sandbox_plugins(self) -> None:
+        """The sandbox's own plugins join the world: its drawing, and the ones the
+        registry turns on in sandboxes (`plugin_registry.SANDBOX_ON`: the director)."""
+        self.world.add_plugin(RenderPlugin(renderer=self.renderer))
+        on = {plugin.key for plugin in self.world.plugins}
+        for plugin in sandbox_plugins():
+            if plugin.key not in on:
+                self.world.add_plugin(plugin)
+        self.world.events.on("creature_despawned", self._forget)
+        self.undo = UndoStack()  # edits name the world they were made in
 
     def _forget(self, *, creature: int, **_: Any) -> None:
         """A despawned creature leaves the selection."""
@@ -168,7 +183,7 @@ class Sandbox:
         self.scene = scene
         self.world = self._build(scene)
         self.renderer.set_world(self.world)
-        self.world.add_plugin(RenderPlugin(renderer=self.renderer))
+        self._add_sandbox_plugins()
         self.hud.world = self.world
         self.scripts.attach(self.world)
         self._attach_panels()
@@ -311,6 +326,20 @@ class Sandbox:
         video, self.video = self.video, None
         return video.close()
 
+    def save_roster(self, path: str | os.PathLike[str] | None = None) -> Path | None:
+        """Write the roster, goals and settings as they are now to a scene file (Ctrl+S:
+        `<scene>_directed.json` in the working folder); None and a message if it would
+        not load (`ecs_tentacles.roster_save`)."""
+        name = (self.world.scene or {}).get("name", "scene")
+        target = Path(path) if path is not None else Path(f"{name}_directed.json")
+        try:
+            saved = save_roster(self.world, target)
+        except (SceneError, OSError) as error:
+            self.scripts.say(False, f"not saved: {' '.join(str(error).split())}")
+            return None
+        self.scripts.say(True, f"saved {saved}")
+        return saved
+
     # -- selection and clicks ------------------------------------------------------------
     def select(self, creature: int | None) -> None:
         """Select just `creature` (None: nothing)."""
@@ -361,9 +390,11 @@ class Sandbox:
             selection=self.selection.entities,
             ctrl=bool(modifiers & key.MOD_CTRL),
         )
-        for plugin in self.world.plugins:
-            if plugin.sandbox_click(self.world, click):
-                return
+        self.undo.record(self.world, "goals", lambda: self._offer(click))
+
+    def _offer(self, click: Click) -> bool:
+        """The plugins' `sandbox_click` hooks, in plugin order, until one takes `click`."""
+        return any(plugin.sandbox_click(self.world, click) for plugin in self.world.plugins)
 
     # -- window events -------------------------------------------------------------------
     def on_mouse_press(self, x: int, y: int, button: int, modifiers: int) -> None:
@@ -419,8 +450,14 @@ class Sandbox:
         self.modifiers = modifiers
         if any(panel.key(symbol, modifiers) for panel in self.hud.panels):
             return  # a panel's key (the palette's Delete, Ctrl+Z, ...)
-        if symbol == key.A and modifiers & key.MOD_CTRL:
+        ctrl, shift = modifiers & key.MOD_CTRL, modifiers & key.MOD_SHIFT
+        if symbol == key.A and ctrl:
             self.select_many(self.renderer.creature_entities)
+        elif symbol == key.Z and ctrl:
+            label = (self.undo.redo if shift else self.undo.undo)(self.world)
+            self.scripts.say(True, f"{'redo' if shift else 'undo'}: {label or 'nothing to do'}")
+        elif symbol == key.S and ctrl:
+            self.save_roster()
         elif symbol == key.ESCAPE:
             self.select(None)
         elif symbol == key.SPACE:

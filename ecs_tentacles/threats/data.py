@@ -9,12 +9,14 @@ reads `world.resource(ThreatData).sources()` to rouse creatures nearby.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
+import esper
 import numpy as np
 
 from ecs_tentacles.components import RowComponent, RowField, Transform
+from ecs_tentacles.ground import ground_of
 from ecs_tentacles.store import ArrayStore, Field
 from ecs_tentacles.tracks import Channel, channels_from_keys
 
@@ -50,6 +52,7 @@ class ThreatData:
         self.paths: list[Channel] = []  # positions (columns 0, 1, 2) by store row
         self.bodies = np.zeros(0, dtype=np.int64)  # mantle transform rows of threat creatures
         self.creatures = np.zeros(0, dtype=np.int64)  # their creature entities
+        self.version = 0  # bumped when a path threat is dropped or removed at run time
 
     def __len__(self) -> int:
         return len(self.store) + len(self.bodies)
@@ -59,6 +62,34 @@ class ThreatData:
         pos = np.concatenate([self.store.pos, world.transforms.pos[self.bodies]])
         owners = np.concatenate([np.full(len(self.store), -1), self.creatures])
         return pos, owners
+
+    def drop(self, world: Host, position: Sequence[float], name: str = "roach") -> int:
+        """A path threat standing at `position` (x, y[, z]; on the ground when 2-d) from
+        now on, named `name` (made unique); its entity. Creatures react as to any threat."""
+        point = [float(v) for v in position]
+        if len(point) == 2:
+            point.append(float(ground_of(world).surface(np.array(point))[0]))
+        taken = set(self.positions(world))
+        unique, n = name, 2
+        while unique in taken:
+            unique, n = f"{name}_{n}", n + 1
+        path = [{"time": 0.0, "position": point}]
+        (entity,) = build_threats(world, [{"name": unique, "path": path}])
+        self.version += 1
+        return entity
+
+    def remove(self, world: Host, threat: int) -> None:
+        """Take path threat `threat` (an entity) away."""
+        row = world.component(threat, Threat).row
+        moved = self.store.remove(np.array([row]))
+        self.paths = [replace(c, row=int(moved[c.row])) for c in self.paths if moved[c.row] >= 0]
+        world.activate()
+        esper.delete_entity(threat, immediate=True)
+        self.version += 1
+
+    def entities(self, world: Host) -> dict[int, str]:
+        """Every path threat's name, by entity."""
+        return {entity: threat.name for entity, threat in world.query(Threat)}
 
     def positions(self, world: Host) -> dict[str, np.ndarray]:
         """World position of every path threat, by name."""

@@ -52,6 +52,19 @@ class ThreatsPlugin(Plugin):
         threats.creatures = threats.creatures[keep]
         threats.bodies = change.moved["transforms"][threats.bodies[keep]]
 
+    def save_scene(self, world: Host, scene: dict[str, Any]) -> None:
+        """The scene's threats still there, and the ones dropped since (where they stand)."""
+        here = world.resource(ThreatData).positions(world)
+        kept = [t for t in scene.get("threats", []) if t.get("name") in here]
+        named = {t.get("name") for t in kept}
+        dropped = [
+            {"name": name, "path": [{"time": 0.0, "position": [round(float(v), 6) for v in pos]}]}
+            for name, pos in here.items()
+            if name not in named
+        ]
+        if kept or dropped:
+            scene["threats"] = kept + dropped
+
     def build_scene(self, world: Host, scene: Mapping[str, Any]) -> None:
         build_threats(world, scene["threats"])
 

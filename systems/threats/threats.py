@@ -25,12 +25,13 @@ class ThreatPaths(System):
 
     def __init__(self) -> None:
         self.paths = TrackSet([])
-        self.path_count = -1
+        self.path_count: tuple[int, int] = (-1, -1)
 
     def process(self, world: Host, dt: float) -> None:
         threats = world.resource(ThreatData)
-        if len(threats.paths) != self.path_count:
+        seen = (len(threats.paths), threats.version)  # threats dropped or removed at run time
+        if seen != self.path_count:
             self.paths = TrackSet(threats.paths)
-            self.path_count = len(threats.paths)
+            self.path_count = seen
         if len(self.paths):
             threats.store.pos[self.paths.rows, self.paths.columns] = self.paths.evaluate(world.time)

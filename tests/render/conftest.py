@@ -39,6 +39,20 @@ def event(sandbox: Any, name: str, *args: Any) -> None:
     EventDispatcher.dispatch_event(sandbox.window, name, *args)
 
 
+def pixel(sandbox: Any, point: Any) -> tuple[int, int]:
+    """The window pixel (pyglet's: from the bottom left) where world `point` is drawn."""
+    import numpy as np
+
+    x, y = sandbox.renderer.camera.project(np.asarray(point, dtype=float)[None])[0]
+    return round(float(x)), round(float(y))
+
+
+def click_at(sandbox: Any, at: tuple[int, int], modifiers: int = 0) -> None:
+    """A left press and release at pixel `at` with `modifiers` held."""
+    event(sandbox, "on_mouse_press", *at, mouse.LEFT, modifiers)
+    event(sandbox, "on_mouse_release", *at, mouse.LEFT, modifiers)
+
+
 def click_gui(sandbox: Any, x: float, top: float) -> None:
     """Press and release at (x, top) in GUI pixels (from the top left), drawing between."""
     y = round(sandbox.window.height - top)

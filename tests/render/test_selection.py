@@ -13,17 +13,7 @@ from ecs_tentacles.locomotion.formations import FormationChoice, reach
 from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.locomotion.params import Locomotion
 
-from .conftest import click_gui, event
-
-
-def _pixel(sandbox: Any, point: Any) -> tuple[int, int]:
-    x, y = sandbox.renderer.camera.project(np.asarray(point, dtype=float)[None])[0]
-    return round(x), round(y)
-
-
-def _click(sandbox: Any, at: tuple[int, int], modifiers: int = 0) -> None:
-    event(sandbox, "on_mouse_press", *at, mouse.LEFT, modifiers)
-    event(sandbox, "on_mouse_release", *at, mouse.LEFT, modifiers)
+from .conftest import click_at, click_gui, event, pixel
 
 
 def _mantle(sandbox: Any, name: str) -> Any:
@@ -46,8 +36,8 @@ def test_shift_drag_selects_the_creatures_in_the_rectangle(make_sandbox: Callabl
     camera.pitch, camera.yaw = camera.MAX_PITCH, -np.pi / 2  # from above, rows across
     world = sandbox.world
     # a rectangle round the first row (c0..c3) only
-    low = np.array(_pixel(sandbox, _mantle(sandbox, "c0")))
-    high = np.array(_pixel(sandbox, _mantle(sandbox, "c3")))
+    low = np.array(pixel(sandbox, _mantle(sandbox, "c0")))
+    high = np.array(pixel(sandbox, _mantle(sandbox, "c3")))
     corner = np.minimum(low, high) - 12
     other = np.maximum(low, high) + 12
     event(sandbox, "on_mouse_press", *corner.tolist(), mouse.LEFT, key.MOD_SHIFT)
@@ -60,8 +50,8 @@ def test_shift_drag_selects_the_creatures_in_the_rectangle(make_sandbox: Callabl
     assert sandbox.hud.band is None
     assert set(sandbox.renderer.selection) == set(sandbox.selection.entities)
     # shift-click takes one out and puts another in
-    _click(sandbox, _pixel(sandbox, _mantle(sandbox, "c1")), key.MOD_SHIFT)
-    _click(sandbox, _pixel(sandbox, _mantle(sandbox, "c5")), key.MOD_SHIFT)
+    click_at(sandbox, pixel(sandbox, _mantle(sandbox, "c1")), key.MOD_SHIFT)
+    click_at(sandbox, pixel(sandbox, _mantle(sandbox, "c5")), key.MOD_SHIFT)
     names = sorted(world.creature_name(e) for e in sandbox.selection.entities)
     assert names == ["c0", "c2", "c3", "c5"]
     assert sandbox.renderer.selected == world.creature("c5")  # the last picked: the HUD's
@@ -86,7 +76,7 @@ def test_a_click_sends_the_selection_in_formation(make_sandbox: Callable[..., An
     for shape in ("ring", "grid", "line"):
         sandbox.select_many(chosen)
         world.resource(FormationChoice).shape = shape
-        _click(sandbox, _pixel(sandbox, point))
+        click_at(sandbox, pixel(sandbox, point))
         goals = np.array([book.positions(c)[0] for c in chosen])
         assert all(len(book.path(c)) == 1 for c in chosen)  # one goal each, none shared
         gap = np.linalg.norm(goals[:, None, :2] - goals[None, :, :2], axis=2)
@@ -95,7 +85,7 @@ def test_a_click_sends_the_selection_in_formation(make_sandbox: Callable[..., An
         assert (gap >= reaches[:, None] + reaches[None, :]).all(), shape  # no overlap
         assert np.linalg.norm(goals[:, :2].mean(axis=0) - point[:2]) < 2 * reaches.max()
     # shift-click: a waypoint appended to every selected creature's path
-    _click(sandbox, _pixel(sandbox, [-4.0, 9.0, 0.0]), key.MOD_SHIFT)
+    click_at(sandbox, pixel(sandbox, [-4.0, 9.0, 0.0]), key.MOD_SHIFT)
     assert [len(book.path(c)) for c in chosen] == [2] * 5
     assert all(len(book.path(world.creature(n))) == 0 for n in ("c3", "c4", "c7"))
 

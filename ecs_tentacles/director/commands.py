@@ -1,0 +1,127 @@
+"""The director's edits, for the sandbox's undo stack (`ecs_tentacles.render.undo`).
+
+Creatures are named, not numbered: an undone despawn builds the creature again (a new
+entity, the same name), and later edits still find it. The physics is not rewound: an
+undone despawn puts the creature back resting where it was, an undone move puts its
+joints back where they were when it was grabbed.
+
+* `Spawned`: creatures placed (one, a scatter, a duplicate); undo despawns them.
+* `Despawned`: creatures removed; undo builds them again where they were, with their
+  goals and parameters at the time (`roster_save.entry_now`).
+* `Moved`: a creature dragged or thrown; undo puts it back as it was grabbed.
+* `ThreatDropped`: a threat placed from the palette; undo takes it away.
+"""
+
+from __future__ import annotations
+
+import copy
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ecs_tentacles.components import Creature
+from ecs_tentacles.roster_save import entry_now
+from ecs_tentacles.spawning import place
+from ecs_tentacles.threats.data import ThreatData
+
+if TYPE_CHECKING:
+    from ecs_tentacles.host import Host
+
+
+def named(world: Host, name: str) -> int | None:
+    """The entity of the creature called `name`, or None."""
+    for entity, creature in world.query(Creature):
+        if creature.name == name:
+            return entity
+    return None
+
+
+def _despawn_named(world: Host, names: list[str]) -> None:
+    for name in names:
+        entity = named(world, name)
+        if entity is not None:
+            world.despawn(entity)
+
+
+def _place_all(world: Host, entries: list[dict[str, Any]]) -> None:
+    for entry in entries:
+        if named(world, entry["name"]) is None:  # its name is free again
+            place(world, copy.deepcopy(entry))
+
+
+@dataclass
+class Spawned:
+    label: str
+    entries: list[dict[str, Any]]  # as they were placed (checked, names unique)
+
+    @classmethod
+    def of(cls, world: Host, label: str, entities: list[int]) -> Spawned:
+        return cls(label, [copy.deepcopy(world.creature_specs[e]) for e in entities])
+
+    def undo(self, world: Host) -> None:
+        _despawn_named(world, [e["name"] for e in self.entries])
+
+    def redo(self, world: Host) -> None:
+        _place_all(world, self.entries)
+
+
+@dataclass
+class Despawned:
+    label: str
+    entries: list[dict[str, Any]] = field(default_factory=list)  # as they were when removed
+
+    @classmethod
+    def remove(cls, world: Host, label: str, entities: list[int]) -> Despawned:
+        """Despawn `entities`, keeping what undo needs to build them again."""
+        made = cls(label, [entry_now(world, e) for e in entities])
+        for entity in entities:
+            world.despawn(entity)
+        return made
+
+    def undo(self, world: Host) -> None:
+        _place_all(world, self.entries)
+
+    def redo(self, world: Host) -> None:
+        _despawn_named(world, [e["name"] for e in self.entries])
+
+
+@dataclass
+class Moved:
+    label: str
+    name: str
+    before: np.ndarray  # its joints (qpos) when grabbed
+    after: np.ndarray  # and when let go
+
+    def _put(self, world: Host, qpos: np.ndarray) -> None:
+        entity = named(world, self.name)
+        if entity is None:
+            return
+        physics = world.physics
+        index = physics.lod.index(entity)
+        view = physics.groups[index]
+        physics.place_joints(index, qpos, np.zeros(view.model.nv))
+        view.batch.sync(world.transforms)
+
+    def undo(self, world: Host) -> None:
+        self._put(world, self.before)
+
+    def redo(self, world: Host) -> None:
+        self._put(world, self.after)
+
+
+@dataclass
+class ThreatDropped:
+    label: str
+    name: str
+    position: list[float]
+    entity: int = -1
+
+    def undo(self, world: Host) -> None:
+        threats = world.resource(ThreatData)
+        for entity, name in threats.entities(world).items():
+            if name == self.name:
+                threats.remove(world, entity)
+
+    def redo(self, world: Host) -> None:
+        self.entity = world.resource(ThreatData).drop(world, self.position, self.name)

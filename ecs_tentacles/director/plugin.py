@@ -1,0 +1,67 @@
+"""The director plugin: the sandbox's crowd-directing tools (`ecs_tentacles.director`).
+
+The sandbox turns it on (`plugin_registry.SANDBOX_ON`); scenes and bakes never see it.
+Resource: `Director` (the creature held by the mouse, the scatter brush). System: grab
+(stage act; `systems/director/grab.py`). Sandbox hooks: the "Director" HUD section
+with the palette and the mouse and keys (`director.panel`); lines for the grab's
+spring and the brush. Hook `wants_motion`: a held creature never sleeps.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ecs_tentacles.components import Creature
+from ecs_tentacles.director.state import Director
+from ecs_tentacles.drawing import CIRCLE, line_segments
+from ecs_tentacles.plugin import Plugin
+
+if TYPE_CHECKING:
+    from ecs_tentacles.drawing import Panel, RenderView
+    from ecs_tentacles.host import Host
+    from ecs_tentacles.system import System
+
+GRAB_RGBA = np.array([1.0, 0.85, 0.2, 1.0])
+BRUSH_RGBA = np.array([0.6, 0.8, 1.0, 1.0])
+
+
+class DirectorPlugin(Plugin):
+    name = "director"
+    description = "the sandbox's crowd tools: palette, scatter, delete, duplicate, grab and throw"
+
+    def resources(self, world: Host) -> list[object]:
+        return [Director()]
+
+    def systems(self) -> list[System]:
+        from ecs_tentacles.systems.director.grab import GrabSpring
+
+        return [GrabSpring()]
+
+    def sandbox_panels(self, sandbox: Any) -> list[Panel]:
+        from ecs_tentacles.director.panel import DirectorPanel
+
+        return [DirectorPanel(sandbox)]
+
+    def wants_motion(self, world: Host) -> np.ndarray | None:
+        grab = world.resource(Director).grab
+        if grab is None:
+            return None
+        wanted = np.zeros(len(world.creatures), dtype=bool)
+        wanted[world.component(grab.creature, Creature).row] = True
+        return wanted
+
+    def render_lines(self, world: Host, view: RenderView) -> list[Any]:
+        director = world.resource(Director)
+        lines = []
+        grab = director.grab
+        if grab is not None and world.try_component(grab.creature, Creature) is not None:
+            rows = world.physics.group_of(world.component(grab.creature, Creature)).body_rows
+            held = view.pos[rows[grab.body]]
+            lines.append(line_segments(np.array([held, grab.target]), GRAB_RGBA))
+        if director.brush is not None:
+            centre, radius = director.brush
+            ring = centre + [0.0, 0.0, 0.02] + radius * CIRCLE
+            lines.append(line_segments(ring, BRUSH_RGBA))
+        return lines

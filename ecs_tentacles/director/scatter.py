@@ -1,0 +1,114 @@
+"""Scatter: many copies of one creature in a disc, none overlapping, seeded.
+
+    entities = scatter(world, preset.creature(), centre=(4, 2), radius=3.0, count=20, seed=7)
+
+Spots are drawn uniformly in the disc (a random heading each) from a generator seeded
+with `seed`, and kept when the creature's reach circle (mantle plus longest tentacle,
+`GAP` more) is clear of every creature there (their reach spheres now) and of every
+spot kept before, and no obstacle is within its reach. The same world, entry and seed
+give the same spots. Fewer than `count` come back when the disc is full (say so). The
+entry is checked once (`World.spawn`'s rules); every copy then costs only its build
+(`spawning.place`): 100 creatures in well under a second.
+"""
+
+from __future__ import annotations
+
+import copy
+from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ecs_tentacles.construction import creature_layout
+from ecs_tentacles.ground import ground_of
+from ecs_tentacles.spawning import creature_entry, place, unique_name
+
+if TYPE_CHECKING:
+    from ecs_tentacles.host import Host
+
+GAP = 0.1  # metres between two creatures' reach circles
+TRIES = 40  # candidate spots drawn per creature wanted
+
+
+def reach_of(entry: dict[str, Any]) -> float:
+    """How far a creature built from `entry` reaches from its mantle's axis (metres)."""
+    layout = creature_layout({**entry, "position": [0.0, 0.0]})
+    _, ends, radii = layout.capsules()
+    return float(np.max(np.linalg.norm(ends[:, :2], axis=1)) + radii.max())
+
+
+def spots(
+    world: Host,
+    entry: dict[str, Any],
+    centre: Sequence[float] | np.ndarray,
+    radius: float,
+    count: int,
+    seed: int,
+) -> np.ndarray:
+    """Up to `count` free spots (k, 3): x, y, heading in degrees (module docstring)."""
+    if count < 0 or not radius >= 0:
+        raise ValueError(f"scatter: count must be >= 0 and radius >= 0, got {count}, {radius}")
+    rng = np.random.default_rng(seed)
+    reach = reach_of(entry)
+    tries = max(1, TRIES * count)
+    distance = radius * np.sqrt(rng.random(tries))
+    angle = rng.uniform(0.0, 2.0 * np.pi, tries)
+    heading = rng.uniform(-180.0, 180.0, tries)
+    middle = np.asarray(centre, dtype=np.float64)[:2]
+    candidates = middle + distance[:, None] * np.column_stack([np.cos(angle), np.sin(angle)])
+    clear = _clear_of_creatures(world, candidates, reach) & _clear_of_obstacles(
+        world, candidates, reach
+    )
+    kept: list[int] = []
+    for i in np.flatnonzero(clear).tolist():
+        if len(kept) == count:
+            break
+        if kept:
+            gap = np.linalg.norm(candidates[kept] - candidates[i], axis=1)
+            if (gap < 2.0 * reach + GAP).any():
+                continue
+        kept.append(i)
+    return np.column_stack([candidates[kept], heading[kept]]).reshape(-1, 3)
+
+
+def _clear_of_creatures(world: Host, points: np.ndarray, reach: float) -> np.ndarray:
+    physics = world.physics
+    if not len(physics):
+        return np.ones(len(points), dtype=bool)
+    _, _, centres, reaches = physics.proxies.sense(world.transforms)
+    gap = np.linalg.norm(points[:, None, :] - centres[None, :, :2], axis=2)
+    return bool_all(gap >= reaches[None, :] + reach + GAP)
+
+
+def bool_all(matrix: np.ndarray) -> np.ndarray:
+    """Row-wise `all` of a (n, m) bool matrix (True for m = 0)."""
+    return np.asarray(matrix.all(axis=1), dtype=bool)
+
+
+def _clear_of_obstacles(world: Host, points: np.ndarray, reach: float) -> np.ndarray:
+    ground = ground_of(world)
+    if not ground.solids:
+        return np.ones(len(points), dtype=bool)
+    raised = np.column_stack([points, ground.height(points)])
+    return np.asarray(ground.inside_solid(raised, reach) < 0)
+
+
+def scatter(
+    world: Host,
+    spec: Mapping[str, Any],
+    centre: Sequence[float] | np.ndarray,
+    radius: float,
+    count: int,
+    seed: int = 0,
+) -> list[int]:
+    """Spawn up to `count` copies of creature `spec` at `spots`; their entities."""
+    entry = creature_entry(world, spec)  # checked once: SpawnError names the field
+    made = []
+    for x, y, heading in spots(world, entry, centre, radius, count, seed).tolist():
+        copy_of = copy.deepcopy(entry)
+        copy_of["name"] = unique_name(world, entry["name"])
+        copy_of["position"] = [x, y]
+        copy_of["heading_deg"] = heading
+        copy_of["goals"] = []
+        made.append(place(world, copy_of))
+    return made

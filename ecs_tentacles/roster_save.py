@@ -1,0 +1,73 @@
+"""A running world written back as a scene: the roster, goals and settings as they are now.
+
+    save_roster(world, "directed.json")      # atomic; validated before it is written
+
+Every creature there now (spawned ones too, despawned ones not) is written from the
+entry it was built from (`world.creature_specs`), at its mantle's current position and
+heading, with what each plugin knows of it now (`Plugin.save_creature`: the locomotion
+plugin's goals and parameters); the scene's other keys are the world's scene's, and
+each plugin adds what it has at the scene level (`Plugin.save_scene`: threats dropped
+in the sandbox). Loading the file builds the same roster with the same goals and
+settings (creatures rest on the ground where their mantles were). This module sits
+above the world (as `world_loader`).
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+import os
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ecs_tentacles.atomic import atomic_file
+from ecs_tentacles.components import Creature, Transform
+from ecs_tentacles.scene.load import load_scene
+
+if TYPE_CHECKING:
+    from ecs_tentacles.host import Host
+
+
+def heading_deg(quat: np.ndarray) -> float:
+    """The heading (degrees about +z) of a body with orientation `quat` (w, x, y, z)."""
+    w, x, y, z = (float(v) for v in quat)
+    return float(np.degrees(np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))))
+
+
+def entry_now(world: Host, entity: int) -> dict[str, Any]:
+    """Creature `entity`'s scene entry as it is now: where its mantle is, which way it
+    heads, and what every plugin knows of it (`Plugin.save_creature`)."""
+    name = world.component(entity, Creature).name
+    entry = copy.deepcopy(world.creature_specs.get(entity) or {"name": name})
+    pose = world.component(entity, Transform)
+    entry["position"] = [round(float(v), 6) for v in pose.pos[:2]]
+    entry["heading_deg"] = round(heading_deg(pose.quat), 6)
+    for plugin in world.plugins:
+        plugin.save_creature(world, entity, entry)
+    return entry
+
+
+def roster_scene(world: Host) -> dict[str, Any]:
+    """The scene dict of `world` as it is now (module docstring); not yet validated."""
+    scene: dict[str, Any] = copy.deepcopy(world.scene) if world.scene is not None else {}
+    scene.setdefault("version", 1)
+    by_row = sorted(world.query(Creature), key=lambda item: item[1].row)
+    scene["creatures"] = [entry_now(world, entity) for entity, _ in by_row]
+    for plugin in world.plugins:
+        plugin.save_scene(world, scene)
+    return scene
+
+
+def save_roster(world: Host, path: str | os.PathLike[str]) -> Path:
+    """Write `roster_scene(world)` to `path` as JSON, validated and atomically; the path.
+
+    Raises SceneError (one line per problem) and writes nothing when the scene would
+    not load."""
+    scene = roster_scene(world)
+    load_scene(scene, allow_systems=True)  # checked as any scene: SceneError, one line each
+    target = Path(path)
+    with atomic_file(target) as handle:
+        handle.write((json.dumps(scene, indent=2) + "\n").encode())
+    return target

@@ -1,0 +1,1 @@
+"""The director's system (`ecs_tentacles.director`): grab (stage act)."""

@@ -1,0 +1,34 @@
+"""The grab spring: bounded by the creature's mass, aimed on the plane facing the camera."""
+
+from __future__ import annotations
+
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from ecs_tentacles.director.grab import MAX_ACCELERATION, Grab, spring_force
+
+vectors = st.lists(st.floats(-1e3, 1e3), min_size=3, max_size=3).map(np.array)
+
+
+@settings(max_examples=200, deadline=None)
+@given(vectors, vectors, vectors, st.floats(0.01, 500.0))
+def test_the_force_never_exceeds_the_creature_mass_times_the_limit(pos, vel, target, mass):
+    force = spring_force(pos, vel, target, mass)
+    assert np.linalg.norm(force) <= mass * MAX_ACCELERATION * (1 + 1e-9)
+
+
+def test_the_spring_pulls_toward_the_target_and_damps_the_speed():
+    pulled = spring_force(np.zeros(3), np.zeros(3), np.array([0.01, 0.0, 0.0]), 2.0)
+    assert pulled[0] > 0 and np.allclose(pulled[1:], 0.0)
+    damped = spring_force(np.zeros(3), np.array([0.0, 0.1, 0.0]), np.zeros(3), 2.0)
+    assert damped[1] < 0
+
+
+def test_the_mouse_ray_meets_the_plane_through_the_grab_point():
+    point = np.array([1.0, 2.0, 0.3])
+    grab = Grab(7, 0, point.copy(), point.copy(), np.array([0.0, -1.0, 0.0]))
+    grab.aim(np.array([0.0, -5.0, 1.0]), np.array([0.0, 1.0, 0.0]))
+    assert np.allclose(grab.target, [0.0, 2.0, 1.0])
+    grab.aim(np.array([0.0, -5.0, 1.0]), np.array([1.0, 0.0, 0.0]))  # parallel: unchanged
+    assert np.allclose(grab.target, [0.0, 2.0, 1.0])

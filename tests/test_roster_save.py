@@ -1,0 +1,58 @@
+"""A running world saved as a scene: spawned creatures in, despawned out, same goals."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from ecs_tentacles.components import Creature, Transform
+from ecs_tentacles.locomotion.goals import GoalBook
+from ecs_tentacles.mathutil import quat_about_z
+from ecs_tentacles.roster_save import heading_deg, roster_scene, save_roster
+from ecs_tentacles.world import World
+
+
+def test_heading_is_the_turn_about_z() -> None:
+    for degrees in (-170.0, -30.0, 0.0, 45.0, 179.0):
+        assert heading_deg(quat_about_z(np.radians(degrees))) == pytest.approx(degrees)
+
+
+def test_the_saved_roster_loads_to_the_same_creatures_goals_and_places(tmp_path: Path) -> None:
+    scene = {"version": 1, "name": "mine", "creatures": [
+        {"name": "a", "position": [0, 0], "goals": [{"position": [0, 2]}]},
+        {"name": "b", "position": [5, 0]},
+    ]}  # fmt: skip
+    with World.from_scene(scene) as world:
+        world.step(30)
+        c = world.spawn({"name": "c", "tentacles": {"count": 5}}, position=(10, 0), heading_deg=30)
+        world.resource(GoalBook).append(c, [10, 3])
+        world.resource(GoalBook).append(c, [12, 3])
+        world.despawn(world.creature("b"))
+        path = save_roster(world, tmp_path / "saved.json")
+        text = path.read_text()
+        names = [cr.name for _, cr in sorted(world.query(Creature), key=lambda i: i[1].row)]
+        with World.from_scene(path) as again:
+            assert [cr.name for _, cr in again.query(Creature)] == names == ["a", "c"]
+            for name in names:
+                here, there = world.creature(name), again.creature(name)
+                assert np.allclose(
+                    again.resource(GoalBook).positions(there),
+                    world.resource(GoalBook).positions(here),
+                    atol=1e-6,
+                )
+                mantle = world.component(here, Transform).pos[:2]
+                assert np.allclose(again.component(there, Transform).pos[:2], mantle, atol=1e-5)
+            saved = json.loads(text)
+            assert saved["name"] == "mine"
+            assert saved["creatures"][1]["heading_deg"] == pytest.approx(30.0, abs=2.0)
+
+
+def test_a_save_that_cannot_be_written_leaves_nothing(tmp_path: Path) -> None:
+    with World.from_scene("octopus") as world:
+        assert roster_scene(world)["creatures"][0]["name"] == "octopus"
+        with pytest.raises(OSError):
+            save_roster(world, tmp_path / "no_such_folder" / "x.json")
+        assert not (tmp_path / "no_such_folder").exists()
