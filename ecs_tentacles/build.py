@@ -50,14 +50,13 @@ def build_creature(world: Host, spec: dict[str, Any]) -> int:
     )
     centre = layout.origin + np.array([0.0, 0.0, 0.5 * mantle["height"]])
     row = int(world.transforms.add(pos=centre, quat=turn)[0])
-    creature.row = int(
-        world.creatures.add(
-            mantle_row=row,
-            mantle_radius=mantle["radius"],
-            first_tentacle=len(world.tentacles),
-            tentacles=tentacles["count"],
-        )[0]
+    added = world.creatures.add(
+        mantle_row=row,
+        mantle_radius=mantle["radius"],
+        first_tentacle=len(world.tentacles),
+        tentacles=tentacles["count"],
     )
+    creature.attach(world.creatures, int(added[0]))
     creature_entity = world.create_entity(creature, Transform(world.transforms, row))
     world.creatures.entity[creature.row] = creature_entity
 
@@ -79,18 +78,17 @@ def _add_tentacle_row(
     rows: LinkRows,
 ) -> None:
     params, shape = layout.params[k], layout.shapes[k]
-    tentacle.row = int(
-        world.tentacles.add(
-            creature_row=creature_row,
-            base_angle=tentacle.base_angle,
-            first_link=rows.motors[0],
-            links=len(rows.motors),
-            base_row=rows.transforms[0],
-            tip_sucker=rows.suckers[-1],
-            length=shape.length,
-            rest_pitch=shape.rest_pitch,
-        )[0]
+    added = world.tentacles.add(
+        creature_row=creature_row,
+        base_angle=tentacle.base_angle,
+        first_link=rows.motors[0],
+        links=len(rows.motors),
+        base_row=rows.transforms[0],
+        tip_sucker=rows.suckers[-1],
+        length=shape.length,
+        rest_pitch=shape.rest_pitch,
     )
+    tentacle.attach(world.tentacles, int(added[0]))
     apply_parameters(world, "tentacles", params, {"tentacles": tentacle.row})
     world.motors.tentacle_row[rows.motors] = tentacle.row
     world.suckers.tentacle_row[rows.suckers] = tentacle.row

@@ -15,7 +15,7 @@ Components are never added or removed per frame.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ecs_tentacles.store import ArrayStore, MotorStore, SuckerStore, TransformStore
 
@@ -98,28 +98,51 @@ class Sucker(RowComponent):
     anchor = RowField()
 
 
+class _StoreRow:
+    """A structural component's row in its store, kept as the row's handle (so a
+    despawn that moves rows up never leaves it stale); -1 until `attach`."""
+
+    if TYPE_CHECKING:  # the dataclasses below declare them
+        store: ArrayStore | None
+        handle: int
+
+    def attach(self, store: ArrayStore, row: int) -> None:
+        """This component's numbers are in row `row` of `store`."""
+        self.store, self.handle = store, store.handle_at(row)
+
+    @property
+    def row(self) -> int:
+        return -1 if self.store is None else self.store.row_of(self.handle)
+
+
 @dataclass(eq=False, slots=True)
-class Creature:
-    """A creature: its mantle (a cylinder along +z) and its tentacles, counter-clockwise."""
+class Creature(_StoreRow):
+    """A creature: its mantle (a cylinder along +z) and its tentacles, counter-clockwise.
+
+    `row` is its CreatureStore row (-1 before it is built)."""
 
     name: str
     mantle_radius: float
     mantle_height: float
     mantle_density: float
-    row: int = -1  # CreatureStore row
     tentacles: list[int] = field(default_factory=list)
+    store: ArrayStore | None = None
+    handle: int = -1
 
 
 @dataclass(eq=False, slots=True)
-class Tentacle:
-    """Tentacle `index` of `creature`; its axis is +x rotated by `base_angle` about +z."""
+class Tentacle(_StoreRow):
+    """Tentacle `index` of `creature`; its axis is +x rotated by `base_angle` about +z.
+
+    `row` is its TentacleStore row (-1 before it is built)."""
 
     creature: int
     index: int
     base_angle: float
-    row: int = -1  # TentacleStore row
     links: list[int] = field(default_factory=list)
     suckers: list[int] = field(default_factory=list)
+    store: ArrayStore | None = None
+    handle: int = -1
 
 
 @dataclass(eq=False, slots=True)

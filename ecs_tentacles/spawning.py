@@ -240,11 +240,15 @@ def despawn(world: World, entity: int) -> None:
     for plugin in world.plugins:
         plugin.despawning(world, entity)
     dead = _owned_rows(world, creature)
+    suckers = world.suckers
+    for row in dead["suckers"][suckers.attached[dead["suckers"]]].tolist():  # let go first
+        suckers.attached[row] = False
+        sucker = int(suckers.entity[row])
+        world.events.emit("sucker_released", world=world, sucker=sucker, reason="despawn")
     moved = {key: world.stores[key].remove(rows) for key, rows in dead.items() if len(rows)}
     for store in world.stores.values():
         for key, new in moved.items():
             store.renumber(key, new)
-    _renumber_components(world, entity, moved)
     _delete_entities(world, entity, creature)
     index = world.physics.lod.index(entity)
     world.physics.remove_creature(world, entity, moved)
@@ -299,20 +303,6 @@ def _owned_rows(world: World, creature: Creature) -> dict[str, np.ndarray]:
         if not changed:
             break
     return dead
-
-
-def _renumber_components(world: World, entity: int, moved: dict[str, np.ndarray]) -> None:
-    """Creature and tentacle components keep plain row numbers: the ones after the
-    removed creature's move up (row components keep handles and need nothing). A
-    creature's tentacles are the rows from its `first_tentacle` on, in order."""
-    old_row = int(np.flatnonzero(moved["creatures"] < 0)[0])
-    creatures = world.creatures
-    for row in range(old_row, len(creatures)):  # the creatures that moved up, new rows
-        creature = esper.component_for_entity(int(creatures.entity[row]), Creature)
-        creature.row = row
-        first = int(creatures.first_tentacle[row])
-        for k, tentacle_entity in enumerate(creature.tentacles):
-            esper.component_for_entity(tentacle_entity, Tentacle).row = first + k
 
 
 def _delete_entities(world: World, entity: int, creature: Creature) -> None:

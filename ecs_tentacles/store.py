@@ -56,6 +56,7 @@ class ArrayStore:
     """Rows of numbers for one kind of entity; subclasses declare `Field`s."""
 
     _declared_fields: tuple[Field, ...]  # `fields()`, set on each class at its first call
+    _referring: dict[str, list[Field]]  # `referring()`, likewise
     # the store (by name in `world.stores`) whose rows this one's line up with, row for
     # row: it loses the same rows when a creature is despawned
     lines_up_with: ClassVar[str | None] = None
@@ -143,13 +144,24 @@ class ArrayStore:
         self._row_of_handle[self._arrays[HANDLE][: self.count]] = np.arange(self.count)
         return new
 
+    @classmethod
+    def referring(cls) -> dict[str, list[Field]]:
+        """The fields that hold rows of another store, by that store's name."""
+        known: dict[str, list[Field]] | None = cls.__dict__.get("_referring")
+        if known is None:
+            known = {}
+            for field in cls.fields():
+                if field.refers is not None:
+                    known.setdefault(field.refers, []).append(field)
+            cls._referring = known  # on this class only, as `fields`
+        return known
+
     def renumber(self, store: str, new: np.ndarray) -> None:
         """Rows of `store` moved (`remove`'s answer): every field that refers to it follows."""
-        for field in self.fields():
-            if field.refers == store:
-                values = self._arrays[field.name][: self.count]
-                valid = values >= 0
-                values[valid] = new[values[valid]]
+        for field in self.referring().get(store, ()):
+            values = self._arrays[field.name][: self.count]
+            valid = values >= 0
+            values[valid] = new[values[valid]]
 
     def _reserve(self, needed: int) -> None:
         capacity = self.capacity

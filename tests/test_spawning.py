@@ -211,3 +211,81 @@ def test_a_take_records_the_roster_per_frame(tmp_path):
     held = take.pos[:11, mantle_d]  # before it came: the pose it came in
     assert np.array_equal(held, np.repeat(held[:1], 11, 0)) and held[0, 0] == 30.0
     assert not np.array_equal(take.pos[30, mantle_d], take.pos[11, mantle_d])  # it moved
+
+
+def test_furred_bystanders_keep_their_fur_through_a_despawn_and_a_spawn():
+    from ecs_tentacles.fur.stores import FurData
+
+    with World.from_scene("fur_presets") as world, World.from_scene("fur_presets") as twin:
+        world.step(60)
+        twin.step(60)
+        first = sorted(world.creature_specs)[0]  # the hedgehog: its guides come first
+        world.despawn(first)
+        world.step(1)
+        twin.step(1)
+        here, there = world.resource(FurData).curves, twin.resource(FurData).curves
+        assert len(here) < len(there)
+        assert np.array_equal(here, there[len(there) - len(here) :])  # dynamic strands too
+        cat = copy.deepcopy(twin.creature_specs[sorted(twin.creature_specs)[1]])
+        world.spawn(cat, position=(20.0, 20.0))
+        world.step(1)
+        twin.step(1)
+        kept = len(here)
+        assert np.array_equal(
+            world.resource(FurData).curves[:kept], twin.resource(FurData).curves[-kept:]
+        )
+        world.step(10)
+        assert world.physics.health.recoveries == 0
+
+
+def test_a_threat_dropped_at_run_time_rouses_the_fur_of_creatures_near_it():
+    from ecs_tentacles.fur.stores import FurData
+    from ecs_tentacles.threats.data import ThreatData
+
+    with World.from_scene("hedgehog_octopus") as world:
+        world.step(30)
+        emotion = world.resource(FurData)
+        calm = float(emotion.emotions.level.max())
+        hedgehog = world.component(sorted(world.creature_specs)[0], Transform).pos
+        roach = world.resource(ThreatData).drop(world, [hedgehog[0] + 0.4, hedgehog[1]])
+        world.step(60)
+        assert float(emotion.emotions.level.max()) > calm + 0.3
+        world.resource(ThreatData).remove(world, roach)
+        world.step(5)
+        assert roach not in world.resource(ThreatData).entities(world)
+
+
+def test_a_despawned_creature_lets_go_of_the_ground_first():
+    with World.from_scene("octopus") as world:
+        world.step(120)
+        held = int(world.suckers.attached.sum())
+        assert held > 0
+        reasons = []
+        world.events.on("sucker_released", lambda **e: reasons.append(e["reason"]))
+        world.despawn(world.creature("octopus"))
+        assert reasons == ["despawn"] * held
+        assert len(world.suckers) == 0 and len(world.physics) == 0
+        world.step(5)  # an empty world steps on
+
+
+def test_what_a_despawn_updates_in_place_equals_what_a_rebuild_makes():
+    """The fast paths (contact proxies, motor target tables) against building afresh."""
+    from ecs_tentacles.creator.crowd import crowd_scene
+
+    with World.from_scene(crowd_scene(12, seed=3)) as world:
+        world.step(3)
+        for entity in sorted(world.creature_specs)[2:9:3]:
+            world.despawn(entity)
+        proxies = world.physics.proxies
+        fast = {name: getattr(proxies, name).copy() for name in ("rows", "owner", "start", "count")}
+        index = [i.copy() for i in proxies.index]
+        proxies.reindex()
+        for name, values in fast.items():
+            assert np.array_equal(values, getattr(proxies, name)), name
+        assert all(np.array_equal(a, b) for a, b in zip(index, proxies.index, strict=True))
+        targets = world.schedule["motor_targets"]
+        kept = {name: getattr(targets, name).copy() for name in
+                ("inner", "previous", "previous_of", "orient_share", "arch_shape")}  # fmt: skip
+        targets.setup(world)
+        for name, values in kept.items():
+            assert np.array_equal(values, getattr(targets, name)), name

@@ -10,8 +10,9 @@
 * `scatter_100_ms`: the director's scatter of 100 creatures into the same world;
 * `frame_ms`: one physics frame of that world, for scale (2 threads);
 * sandbox, 64 creatures running (headless, 1280 x 720): `click_ms` (a goal click for a
-  selection of 16, formation and undo record included), `place_ms` (a palette click),
-  `frame_draw_ms` (one drawn frame); the change shows in the next drawn frame.
+  selection of 16, formation and undo record included), `place_ms` (a palette click
+  and the frame that draws the newcomer), `frame_draw_ms` (one drawn frame); a click's
+  change shows in the next drawn frame.
 
 Progress on stderr; `--json` prints one object on stdout.
 """
@@ -118,6 +119,7 @@ def sandbox_costs(repeats: int) -> dict[str, Any]:
         sandbox.select(None)
         start = time.perf_counter()
         press([-20.0 - 3.0 * i, 20.0, 0.0])
+        sandbox.render()  # the newcomer drawn: input to visible change
         places.append(time.perf_counter() - start)
         panel.placing = False
         sandbox.step(1)

@@ -1,7 +1,8 @@
 """Every README picture of the sandbox, made headless with the current HUD: the
 four-creature sandbox, the HUD at 640 x 360, the skinned octopus, the three terrain
 scenes (rocky shore, ramp, maze; HUD hidden) and, through `tools/fur_screenshots.py`
-(`--only fur`), the fur pictures. (The plots are the benchmarks': `tools/crowd_scaling.py`,
+(`--only fur`), the fur pictures and, through `tools/director_screenshots.py` (`--only
+director`), the crowd director's sequence. (The plots are the benchmarks': `tools/crowd_scaling.py`,
 `tools/slope_climb.py`.)
 
     python tools/readme_screenshots.py                       # into assets/screenshots/
@@ -32,13 +33,13 @@ DEFAULT_DIR = Path(__file__).resolve().parents[1] / "assets" / "screenshots"
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
     parser.add_argument("--out-dir", type=Path, default=DEFAULT_DIR)
-    names = sorted([*SHOTS, "skinned_sandbox", "fur"])
+    names = sorted([*SHOTS, "skinned_sandbox", "fur", "director"])
     parser.add_argument("--only", choices=names, action="append", help="one picture")
     args = parser.parse_args(argv)
     args.out_dir.mkdir(parents=True, exist_ok=True)
     for name in args.only or names:
-        if name == "fur":  # the fur pictures: their own script, in a process of its own
-            script = Path(__file__).with_name("fur_screenshots.py")
+        if name in ("fur", "director"):  # their own scripts, each in a process of its own
+            script = Path(__file__).with_name(f"{name}_screenshots.py")
             done = subprocess.run([sys.executable, str(script), "--out-dir", str(args.out_dir)])
             if done.returncode:
                 return done.returncode

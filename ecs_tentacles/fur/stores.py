@@ -169,9 +169,9 @@ class FurData:
         self._frames = np.zeros((rows, 4, 3), dtype=np.float32)
 
     def drop(self, moved: dict[str, np.ndarray]) -> None:
-        """A despawn took rows out of the fur stores (`moved`: old row -> new row, -1
+        """A despawn took rows out of the stores (`moved`: old row -> new row, -1
         removed, by store name): the guides' shapes and outputs and the control tracks
-        follow; the rig re-binds."""
+        follow; the rig re-binds if fur went with it."""
         guides = moved.get("fur.guides")
         if guides is not None:
             self._join()
@@ -185,7 +185,8 @@ class FurData:
                 for channel in self.tracks
                 if controls[channel.row] >= 0
             ]
-        self.version += 1
+        if any(name.startswith("fur.") for name in moved):
+            self.version += 1  # (a creature without fur leaves the bind pose alone)
 
     def touch(self) -> None:
         """Mark the bind pose as changed (after writing guide arrays directly)."""

@@ -163,8 +163,8 @@ class ActionQueues:
     def roster_changed(self, world: Host, change: RosterChange) -> None:
         """Follow a spawn (its tentacles' queues appended) or a despawn (its dropped)."""
         if not change.spawned:
-            keep = change.moved["tentacles"] >= 0
-            self._queues = [q for q, k in zip(self._queues, keep, strict=True) if k]
+            kept = np.flatnonzero(change.moved["tentacles"] >= 0).tolist()
+            self._queues = [self._queues[i] for i in kept]
             return
         creature = world.component(change.creature, Creature)
         self._queues += [world.component(t, ActionQueue) for t in creature.tentacles]

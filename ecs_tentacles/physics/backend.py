@@ -20,10 +20,10 @@ from __future__ import annotations
 
 import logging
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, overload
 
 import mujoco
 import numpy as np
@@ -109,7 +109,7 @@ class PhysicsBackend:
                 batch.place(row, np.array(transform.pos), np.array(transform.quat))
         self.compiles = len(self.batches)
         self.group_of_creature_row = np.zeros(0, dtype=np.int64)
-        self.groups: list[CreatureView] = []
+        self.groups = CreatureViews(self.roster)
         self._index_groups(len(world.creatures))
         self.proxies = ContactProxies(roster)
         self.health = HealthCheck(world, roster, self.proxies)
@@ -136,7 +136,7 @@ class PhysicsBackend:
     def _index_groups(self, creature_rows: int) -> None:
         """Each creature's `CreatureView`, and where to find it by creature-store row."""
         roster = self.roster
-        self.groups = [CreatureView(roster, i) for i in range(len(roster))]
+        self.groups = CreatureViews(roster)
         self.group_of_creature_row = np.full(creature_rows, -1, dtype=np.int64)
         self.group_of_creature_row[roster.creature_row] = np.arange(len(roster))
 
@@ -190,8 +190,11 @@ class PhysicsBackend:
             each.renumber(moved)
         if "creatures" in moved:
             roster.creature_row = moved["creatures"][roster.creature_row]
-        self.proxies.reindex()
         rows = len(world.transforms)
+        if "transforms" in moved:
+            self.proxies.remove(index, moved["transforms"])
+        else:
+            self.proxies.reindex()
         kept = moved["transforms"] >= 0 if "transforms" in moved else np.ones(rows, dtype=bool)
         self.health.remove(index, batch.index, row, kept, self.proxies)
         self.sleep.remove(index, batch.index, row)
@@ -458,6 +461,34 @@ class PhysicsBackend:
             f"<physics: {len(self)} creatures, {self.compiles} compiled models,"
             f" {self.threads} threads>"
         )
+
+
+class CreatureViews(Sequence[CreatureView]):
+    """`physics.groups`: each creature's `CreatureView`, by roster index, made when asked
+    (a spawn or despawn into a big crowd makes none)."""
+
+    def __init__(self, roster: Roster):
+        self._roster = roster
+        self._made: dict[int, CreatureView] = {}
+
+    def __len__(self) -> int:
+        return len(self._roster)
+
+    @overload
+    def __getitem__(self, index: int) -> CreatureView: ...
+    @overload
+    def __getitem__(self, index: slice) -> list[CreatureView]: ...
+    def __getitem__(self, index: int | slice) -> CreatureView | list[CreatureView]:
+        if isinstance(index, slice):
+            return [self[i] for i in range(len(self))[index]]
+        count = len(self)
+        if not -count <= index < count:
+            raise IndexError(f"creature {index}: the physics has {count}")
+        index %= count
+        view = self._made.get(index)
+        if view is None:
+            view = self._made[index] = CreatureView(self._roster, index)
+        return view
 
 
 def _split(steps: int, rounds: int) -> list[int]:

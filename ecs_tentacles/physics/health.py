@@ -31,6 +31,8 @@ from typing import TYPE_CHECKING
 import mujoco
 import numpy as np
 
+from ecs_tentacles.physics.batch import without_row
+
 if TYPE_CHECKING:
     from ecs_tentacles.physics.host import PhysicsHost
     from ecs_tentacles.physics.proxies import ContactProxies
@@ -119,7 +121,7 @@ class HealthCheck:
     ) -> None:
         """Creature `index` (row `row` of batch `batch`) was taken out; `kept`: which
         Transform rows are left."""
-        self.saved[batch] = np.delete(self.saved[batch], row, axis=0)
+        self.saved[batch] = without_row(self.saved[batch], row)
         self.failures = {i - (i > index): times for i, times in self.failures.items() if i != index}
         if len(self.previous):
             self.previous = self.previous[kept]

@@ -82,6 +82,23 @@ class ContactProxies:
             for batch in roster.batches
         ]
 
+    def remove(self, index: int, moved: np.ndarray) -> None:
+        """Creature `index` left the roster (already out of its batch); `moved`: every old
+        Transform row's new row. The same tables `reindex` would make, without the sort."""
+        keep = self.owner != index
+        self.rows = moved[self.rows[keep]]
+        self.owner = self.owner[keep]
+        self.owner[self.owner > index] -= 1
+        self.kind, self.size, self.rbound = self.kind[keep], self.size[keep], self.rbound[keep]
+        self.count = np.delete(self.count, index)
+        self.start = np.concatenate([[0], np.cumsum(self.count)[:-1]]).astype(np.int64)
+        self.mantle = self.start
+        self._sensed = self._within = None
+        self.index = [
+            self.start[batch.members][:, None] + np.arange(len(batch.body_ids))
+            for batch in self.roster.batches
+        ]
+
     def sense(self, transforms: TransformStore, frame: int | None = None) -> Sensed:
         """Body poses in this class's order and every creature's reach sphere: (pos, quat,
         centre, radius). With `frame`, computed once per frame (the level of detail and

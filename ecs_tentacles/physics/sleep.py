@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ecs_tentacles.physics.batch import without_row
 from ecs_tentacles.physics.tiers import KINEMATIC
 
 if TYPE_CHECKING:
@@ -74,7 +75,7 @@ class Sleep:
     def remove(self, index: int, batch: int, row: int) -> None:
         """Creature `index` (row `row` of batch `batch`) was taken out."""
         self.still, self.known = np.delete(self.still, index), np.delete(self.known, index)
-        self.commands[batch] = np.delete(self.commands[batch], row, axis=0)
+        self.commands[batch] = without_row(self.commands[batch], row)
 
     def restart(self, index: int) -> None:
         """Creature `index` was placed anew: it has not been still, its commands unknown."""

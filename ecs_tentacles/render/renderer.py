@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import colorsys
 from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -51,6 +52,17 @@ LIGHT = np.array([0.35, -0.45, 0.82]) / np.linalg.norm([0.35, -0.45, 0.82])
 LOD_DISTANCE = 6.0  # metres from the eye beyond which links use the lean mesh
 SHADOW_EVERY = 3  # a blob under every third link (each wider), and under every mantle
 VIEWS = ("skinned", "capsules")
+
+
+@dataclass(frozen=True)
+class CreatureStatic:
+    """One creature's links for the instance tables: Transform rows relative to its
+    mantle's, (radius, length), index along the tentacle and the tentacle's link count."""
+
+    rows: np.ndarray
+    sizes: np.ndarray
+    index: np.ndarray
+    chain: np.ndarray
 
 
 def creature_colours(count: int) -> np.ndarray:
@@ -105,80 +117,132 @@ class Renderer:
         self.selected = None
         self.selection = ()
         self._colour_index: dict[int, int] = {}  # creature entity -> its colour, kept
+        self._static: dict[int, CreatureStatic] = {}  # creature entity -> its link table
+        self.skinned.forget_all()
+        self._stale = False
         self._build_static()
         self.previous = (world.transforms.pos.copy(), world.transforms.quat.copy())
         self.current = self.previous
         self.view_of_frame(*self.current)
 
     def roster_changed(self, change: RosterChange) -> None:
-        """A creature came or went: new instance tables (everyone keeps its colour), the
-        poses from now (nothing to blend from), the camera's followed body renumbered."""
+        """A creature came or went: the selection and the followed body follow now; the
+        instance tables are made again before the next frame is drawn (once, however many
+        creatures a scatter added), everyone keeping their colour."""
         if not change.spawned:
             self.selection = tuple(e for e in self.selection if e != change.creature)
             if self.selected == change.creature:
                 self.selected = None
-        follow = self.camera.follow
-        if follow is not None and not change.spawned:
-            row = int(change.moved["transforms"][follow])
-            self.camera.follow = row if row >= 0 else None
+            follow = self.camera.follow
+            if follow is not None:
+                row = int(change.moved["transforms"][follow])
+                self.camera.follow = row if row >= 0 else None
+            self._static.pop(change.creature, None)
+            self.skinned.forget(change.creature)
+        self._stale = True
+
+    def _refresh(self) -> None:
+        """The instance tables and poses of the creatures there now (after a roster change)."""
+        if not self._stale:
+            return
+        self._stale = False
         self._build_static()
         self.current = (self.world.transforms.pos.copy(), self.world.transforms.quat.copy())
         self.previous = self.current
 
+    @property
+    def creature_entities(self) -> list[int]:
+        """The creatures drawn, in entity order."""
+        self._refresh()
+        return self._entities
+
+    @property
+    def mantle_rows(self) -> np.ndarray:
+        """Each drawn creature's mantle row of the Transform store."""
+        self._refresh()
+        return self._mantle_rows
+
     # -- static per-instance data ------------------------------------------------------
+    def _creature_static(self, entity: int, creature: Creature, mantle_row: int) -> CreatureStatic:
+        """One creature's link table, its rows relative to its mantle's (kept: a creature's
+        body rows stay together and in order whatever is removed around them)."""
+        cached = self._static.get(entity)
+        if cached is not None:
+            return cached
+        world = self.world
+        rows, sizes, index, length = [], [], [], []
+        for tentacle_entity in creature.tentacles:
+            tentacle = world.component(tentacle_entity, Tentacle)
+            for link_entity in tentacle.links:
+                link = world.component(link_entity, Link)
+                rows.append(world.component(link_entity, Transform).row - mantle_row)
+                sizes.append((link.radius, link.length))
+                index.append(link.index)
+                length.append(len(tentacle.links))
+        made = CreatureStatic(
+            np.array(rows, dtype=np.int64),
+            np.array(sizes, dtype=np.float64).reshape(-1, 2),
+            np.array(index, dtype=np.int64),
+            np.array(length, dtype=np.int64),
+        )
+        self._static[entity] = made
+        return made
+
     def _build_static(self) -> None:
         world = self.world
         creatures = sorted(world.query(Creature, Transform))
-        self.creature_entities = [e for e, _ in creatures]
-        for entity in self.creature_entities:  # the next colour for a newcomer
+        self._entities = [e for e, _ in creatures]
+        for entity in self._entities:  # the next colour for a newcomer
             self._colour_index.setdefault(entity, len(self._colour_index))
         palette = creature_colours(len(self._colour_index))
-        colours = palette[[self._colour_index[e] for e in self.creature_entities]].reshape(-1, 3)
-        self.creature_colour = {e: colours[i] for i, e in enumerate(self.creature_entities)}
+        colours = palette[[self._colour_index[e] for e in self._entities]].reshape(-1, 3)
+        self.creature_colour = {e: colours[i] for i, e in enumerate(self._entities)}
         mantle = np.zeros((len(creatures), INSTANCE_FLOATS), np.float32)
-        self.mantle_rows = np.array([t.row for _, (_, t) in creatures], dtype=np.int64)
+        self._mantle_rows = np.array([t.row for _, (_, t) in creatures], dtype=np.int64)
         for i, (_, (creature, _)) in enumerate(creatures):
             r, h = creature.mantle_radius, creature.mantle_height
             mantle[i, 7:11] = (r, r, h / 2, 0.0)
             mantle[i, 11:15] = (*colours[i], 1.0)
         self.mantle_instances = mantle
-        link_rows, link_static, link_creature, link_index = [], [], [], []
-        for i, entity in enumerate(self.creature_entities):
-            creature = world.component(entity, Creature)
-            for tentacle_entity in creature.tentacles:
-                tentacle = world.component(tentacle_entity, Tentacle)
-                n = len(tentacle.links)
-                for link_entity in tentacle.links:
-                    link = world.component(link_entity, Link)
-                    shade = 1.0 - 0.35 * link.index / max(n - 1, 1)
-                    link_rows.append(world.component(link_entity, Transform).row)
-                    link_creature.append(i)
-                    link_index.append(link.index)
-                    colour = np.clip(colours[i] * shade + 0.08 * (1 - shade), 0, 1)
-                    link_static.append(
-                        (link.radius, link.radius, link.radius, link.length / 2, *colour, 1.0)
-                    )
-        self.link_rows = np.array(link_rows, dtype=np.int64)
-        self.link_instances = np.zeros((len(link_rows), INSTANCE_FLOATS), np.float32)
-        if link_rows:
-            self.link_instances[:, 7:] = np.array(link_static)
+        tables = [
+            self._creature_static(e, c, int(row))
+            for (e, (c, _)), row in zip(creatures, self._mantle_rows, strict=True)
+        ]
+        counts = np.array([len(t.rows) for t in tables], dtype=np.int64)
+        link_creature = np.repeat(np.arange(len(tables)), counts)
+        if len(link_creature):
+            rel = np.concatenate([t.rows for t in tables])
+            sizes = np.concatenate([t.sizes for t in tables])
+            index = np.concatenate([t.index for t in tables])
+            chain = np.concatenate([t.chain for t in tables])
+        else:
+            rel, sizes = np.zeros(0, np.int64), np.zeros((0, 2))
+            index, chain = np.zeros(0, np.int64), np.ones(0, np.int64)
+        self.link_rows = rel + self._mantle_rows[link_creature]
+        self.link_instances = np.zeros((len(self.link_rows), INSTANCE_FLOATS), np.float32)
+        shade = 1.0 - 0.35 * index / np.maximum(chain - 1, 1)
+        tint = np.clip(colours[link_creature] * shade[:, None] + 0.08 * (1 - shade[:, None]), 0, 1)
+        radius = sizes[:, 0]
+        self.link_instances[:, 7:10] = radius[:, None]
+        self.link_instances[:, 10] = sizes[:, 1] / 2
+        self.link_instances[:, 11:14] = tint
+        self.link_instances[:, 14] = 1.0
         self._build_ground()
-        self.skinned.build(world, self.creature_entities, self.creature_colour)
+        self.skinned.build(world, self._entities, self.creature_colour)
         meshed = set(self.skinned.creatures)
-        self.mantle_skinned = np.array([e in meshed for e in self.creature_entities], bool)
-        self.link_skinned = self.mantle_skinned[np.array(link_creature, dtype=np.int64)]
+        self.mantle_skinned = np.array([e in meshed for e in self._entities], bool)
+        self.link_skinned = self.mantle_skinned[link_creature]
         # shadows: every mantle and every SHADOW_EVERY-th link (blended quads are what
         # software GL pays for), by transform row; suckers: their links' sizes
-        shadowed = np.array(link_index, dtype=np.int64) % SHADOW_EVERY == 0
-        self.shadow_rows = np.concatenate([self.mantle_rows, self.link_rows[shadowed]])
+        shadowed = index % SHADOW_EVERY == 0
+        self.shadow_rows = np.concatenate([self._mantle_rows, self.link_rows[shadowed]])
         self.shadow_radii = np.concatenate(
             [mantle[:, 7], SHADOW_EVERY * self.link_instances[shadowed, 7]]
         ).astype(np.float64)
+        radius_of_row = np.zeros(len(world.transforms))
+        radius_of_row[self.link_rows] = self.link_instances[:, 7]
         suckers = world.suckers
-        radius_of_row = dict(zip(link_rows, self.link_instances[:, 7].tolist(), strict=True))
-        self.sucker_radii = np.array(
-            [radius_of_row.get(int(r), 0.0) for r in suckers.link_row[: len(suckers)]]
-        )
+        self.sucker_radii = radius_of_row[suckers.link_row[: len(suckers)]]
 
     def _build_ground(self) -> None:
         """The ground's meshes (terrain, obstacles) as two one-instance meshes; made again
@@ -219,6 +283,7 @@ class Renderer:
     # -- per frame -----------------------------------------------------------------------
     def sync(self) -> None:
         """Remember the newest physics poses (the render system calls this each frame)."""
+        self._refresh()
         self.previous = self.current
         self.current = (self.world.transforms.pos.copy(), self.world.transforms.quat.copy())
 
@@ -231,6 +296,7 @@ class Renderer:
 
     def upload(self, alpha: float = 1.0) -> None:
         """Fill and upload every instance array and the line list."""
+        self._refresh()
         pos, quat = self.poses(alpha)
         if self.camera.follow is not None:
             self.camera.target = pos[self.camera.follow] * [1, 1, 0]

@@ -12,6 +12,7 @@ blends the vertex's two joints. However many creatures, that is one draw call.
 from __future__ import annotations
 
 import ctypes
+from dataclasses import replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -90,16 +91,42 @@ class SkinnedCreatures:
         self.offset = np.zeros(0)
         self.inverse_bind = np.zeros((0, 4, 4))
         self.creatures: list[int] = []  # entities drawn skinned
+        # kept across rebuilds: each creature's skeleton (and its mantle row then), and
+        # each body shape's mesh (None: it cannot be meshed)
+        self._skeletons: dict[int, tuple[Skeleton, int]] = {}
+        self._meshes: dict[tuple[object, ...], SkinMesh | None] = {}
+
+    def forget(self, creature: int) -> None:
+        """Creature `creature` was despawned: drop its skeleton."""
+        self._skeletons.pop(creature, None)
+
+    def forget_all(self) -> None:
+        """Another world: nothing of the last one's creatures is kept."""
+        self._skeletons.clear()
+
+    def _skeleton(self, world: World, entity: int) -> Skeleton:
+        """`world_skeleton`, kept per creature: its body rows move with its mantle's (a
+        creature's rows stay together whatever is removed around them)."""
+        mantle = world.component(entity, Transform).row
+        kept = self._skeletons.get(entity)
+        if kept is None:
+            skeleton = world_skeleton(world, entity)
+            self._skeletons[entity] = (skeleton, mantle)
+            return skeleton
+        skeleton, then = kept
+        if then == mantle:
+            return skeleton
+        return replace(skeleton, bodies=skeleton.bodies + (mantle - then))
 
     def build(self, world: World, entities: list[int], colours: dict[int, np.ndarray]) -> None:
         """Mesh every creature that can be meshed (others stay capsules: `self.creatures`)."""
         parts, indices = [], []
         rows, offsets, binds = [], [], []
-        cache: dict[tuple[object, ...], SkinMesh] = {}
+        cache = self._meshes
         first_vertex = first_joint = 0
         self.creatures = []
         for entity in entities:
-            skeleton = world_skeleton(world, entity)
+            skeleton = self._skeleton(world, entity)
             layout = skeleton.layout
             key = (
                 layout.mantle_radius,
@@ -110,8 +137,10 @@ class SkinnedCreatures:
                 try:
                     cache[key] = creature_mesh(skeleton, SANDBOX_DETAIL)
                 except MeshError:
-                    continue  # tentacle bases overlap: this one keeps its capsules
+                    cache[key] = None
             mesh = cache[key]
+            if mesh is None:
+                continue  # tentacle bases overlap: this one keeps its capsules
             data = np.empty((len(mesh.positions), VERTEX_FLOATS), np.float32)
             data[:, 0:3] = mesh.positions
             data[:, 3:6] = mesh.normals

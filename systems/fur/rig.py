@@ -32,6 +32,7 @@ from ecs_tentacles.tracks import TrackSet
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
+    from ecs_tentacles.roster_change import RosterChange
 
 
 BLOCK = 16384  # guides per block
@@ -80,6 +81,34 @@ class Rig(System):
             self.strand_body = self.bind.body[guides]
         self.parallel = use_parallel(n)
         self.version = fur.version
+
+    def roster_changed(self, world: Host, change: RosterChange) -> None:
+        """A creature came or went: bind again now, every other strand keeping its state
+        (a furred newcomer does not make the others' dynamic fur jump)."""
+        old = self.strands
+        fur = world.resource(FurData)
+        if self.version < 0 or not len(fur.guides):
+            return  # not bound yet: the first frame binds
+        if self.version == fur.version:  # no fur came or went: its bodies' rows moved
+            moved = change.moved.get("transforms")
+            if moved is not None:
+                self.bodies = moved[self.bodies]
+            return
+        self.rebind(world)
+        new = self.strands
+        if old is None or new is None or old.pos is None or old.prev is None:
+            return
+        moved = change.moved.get("fur.guides")
+        now = old.guides if moved is None else moved[old.guides]  # old strands' rows now
+        column = {int(row): i for i, row in enumerate(now.tolist()) if row >= 0}
+        pairs = [(j, column[g]) for j, g in enumerate(new.guides.tolist()) if g in column]
+        if not pairs:
+            return
+        into, out = (np.array(side) for side in zip(*pairs, strict=True))
+        pos, prev, fresh = new._state()
+        pos[:, :, into], prev[:, :, into] = old.pos[:, :, out], old.prev[:, :, out]
+        if old.fresh is not None:
+            fresh[into] = old.fresh[out]
 
     def process(self, world: Host, dt: float) -> None:
         fur = world.resource(FurData)

@@ -117,12 +117,25 @@ class MotorTargets(System):
         self.follow: np.ndarray | None = None  # on terrain: `ground_follow` this frame
 
     def roster_changed(self, world: Host, change: RosterChange) -> None:
+        """A spawn: the tables made again, everyone's easing kept; a despawn: the removed
+        links' entries dropped and the rest renumbered (what `setup` would make)."""
+        moved = change.moved.get("motors")
+        if not change.spawned:
+            if moved is None:
+                return
+            keep = moved >= 0
+            self.eased = self.eased[keep]
+            self.arch_shape, self.orient_share = self.arch_shape[keep], self.orient_share[keep]
+            before = self.previous_of[keep]  # a link's previous one goes with it, or stays
+            self.previous_of = np.where(before >= 0, moved[before], -1)
+            self.inner = np.flatnonzero(self.previous_of >= 0)
+            self.previous = self.previous_of[self.inner]
+            return
         eased = change.follow(self.eased, "motors")
         self.setup(world)
         self.eased = eased
-        if change.spawned:
-            added = change.added.get("motors", slice(0))
-            self.eased[added] = world.motors.target[added, :2]
+        added = change.added.get("motors", slice(0))
+        self.eased[added] = world.motors.target[added, :2]
 
     def process(self, world: Host, dt: float) -> None:
         motors = world.motors
