@@ -269,13 +269,15 @@ def test_a_despawned_creature_lets_go_of_the_ground_first():
 
 
 def test_what_a_despawn_updates_in_place_equals_what_a_rebuild_makes():
-    """The fast paths (contact proxies, motor target tables) against building afresh."""
+    """The fast paths (contact proxies, motor target tables) against building afresh,
+    after despawns and a spawn."""
     from ecs_tentacles.creator.crowd import crowd_scene
 
     with World.from_scene(crowd_scene(12, seed=3)) as world:
         world.step(3)
         for entity in sorted(world.creature_specs)[2:9:3]:
             world.despawn(entity)
+        world.spawn({"name": "late", "tentacles": {"count": 4}}, position=(60.0, 0.0))
         proxies = world.physics.proxies
         fast = {name: getattr(proxies, name).copy() for name in ("rows", "owner", "start", "count")}
         index = [i.copy() for i in proxies.index]

@@ -76,8 +76,13 @@ def _clear_of_creatures(world: Host, points: np.ndarray, reach: float) -> np.nda
     if not len(physics):
         return np.ones(len(points), dtype=bool)
     _, _, centres, reaches = physics.proxies.sense(world.transforms)
-    gap = np.linalg.norm(points[:, None, :] - centres[None, :, :2], axis=2)
-    return bool_all(gap >= reaches[None, :] + reach + GAP)
+    middle, spread = (
+        points.mean(axis=0),
+        float(np.linalg.norm(points - points.mean(axis=0), axis=1).max()),
+    )
+    near = np.linalg.norm(centres[:, :2] - middle, axis=1) < spread + reaches + reach + GAP
+    gap = np.linalg.norm(points[:, None, :] - centres[None, near, :2], axis=2)
+    return bool_all(gap >= reaches[None, near] + reach + GAP)
 
 
 def bool_all(matrix: np.ndarray) -> np.ndarray:

@@ -168,7 +168,7 @@ class PhysicsBackend:
         batch.place(row, np.array(transform.pos), np.array(transform.quat))
         batch.part(S.mjSTATE_TIME, row)[:] = self.time
         roster.append(entity, creature.row, batch, row)
-        self.proxies.reindex()
+        self.proxies.append(batch, row)
         self.health.grow(batch.index, batch.state[row], world.transforms.pos[batch.body_rows[row]],
                          self.proxies)  # fmt: skip
         self.sleep.grow(batch.index, 2 * batch.model.nu)

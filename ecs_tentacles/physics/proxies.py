@@ -25,6 +25,7 @@ from ecs_tentacles.optional_kernels import OptionalKernels
 from ecs_tentacles.physics.model import PROXY_CAPSULES, PROXY_CYLINDERS, PROXY_PARKED
 
 if TYPE_CHECKING:
+    from ecs_tentacles.physics.batch import Batch
     from ecs_tentacles.physics.roster import Roster
     from ecs_tentacles.store import TransformStore
 
@@ -80,6 +81,31 @@ class ContactProxies:
         self.index = [
             self.start[batch.members][:, None] + np.arange(len(batch.body_ids))
             for batch in roster.batches
+        ]
+
+    def append(self, batch: Batch, row: int) -> None:
+        """Creature `batch.members[row]` joined the roster last: its bodies at the end of
+        the tables (what `reindex` would make, without the sort)."""
+        m = batch.model
+        geoms = m.body_geomadr[batch.body_ids]
+        cylinder = m.geom_type[geoms] == mujoco.mjtGeom.mjGEOM_CYLINDER
+        kind = np.where(cylinder, CYLINDER, CAPSULE)
+        size = m.geom_size[geoms, :2]
+        radius, half = size[:, 0], size[:, 1]
+        index = int(batch.members[row])
+        self.rows = np.concatenate([self.rows, batch.body_rows[row]])
+        self.owner = np.concatenate([self.owner, np.full(len(geoms), index)])
+        self.kind = np.concatenate([self.kind, kind])
+        self.size = np.concatenate([self.size, size])
+        bound = np.where(kind == CYLINDER, np.hypot(radius, half), radius + half)
+        self.rbound = np.concatenate([self.rbound, bound])
+        self.count = np.append(self.count, len(geoms))
+        self.start = np.concatenate([[0], np.cumsum(self.count)[:-1]]).astype(np.int64)
+        self.mantle = self.start
+        self._sensed = self._within = None
+        self.index = [
+            self.start[each.members][:, None] + np.arange(len(each.body_ids))
+            for each in self.roster.batches
         ]
 
     def remove(self, index: int, moved: np.ndarray) -> None:

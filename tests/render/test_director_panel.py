@@ -37,6 +37,8 @@ def test_place_scatter_delete_copy_and_undo_them(make_sandbox: Callable[..., Any
     panel.placing = True
     click_at(sandbox, pixel(sandbox, [2.0, 1.5, 0.0]))
     assert _names(world) == ["octopus", "octopus_2"]
+    sandbox.render()  # the next frame draws it
+    assert world.creature("octopus_2") in sandbox.renderer.creature_entities
     placed = world.component(world.creature("octopus_2"), Transform).pos
     assert np.hypot(placed[0] - 2.0, placed[1] - 1.5) < 0.05
     panel.placing = False
