@@ -69,18 +69,19 @@ class ContactProxies:
         self.size = (
             np.concatenate([z.reshape(-1, 2) for z in size])[order] if size else np.zeros((0, 2))
         )
-        radius, half = self.size[:, 0], self.size[:, 1]
-        self.rbound = np.where(self.kind == CYLINDER, np.hypot(radius, half), radius + half)
-        counts = np.bincount(self.owner, minlength=count).astype(np.int64)
-        self.start = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
+        self.rbound = _bounds(self.kind, self.size)
+        self._counted(np.bincount(self.owner, minlength=count).astype(np.int64))
+
+    def _counted(self, counts: np.ndarray) -> None:
+        """Where each creature's bodies start from their counts, and each batch row's."""
         self.count = counts
+        self.start = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
         self.mantle = self.start  # a creature's first body is its mantle
         self._sensed: tuple[int, Sensed] | None = None  # (frame, sense())
         self._within: Sensed | None = None  # the poses refresh() moves within a frame
-        # each batch row's bodies in this order
-        self.index = [
+        self.index = [  # each batch row's bodies in this order
             self.start[batch.members][:, None] + np.arange(len(batch.body_ids))
-            for batch in roster.batches
+            for batch in self.roster.batches
         ]
 
     def append(self, batch: Batch, row: int) -> None:
@@ -91,22 +92,12 @@ class ContactProxies:
         cylinder = m.geom_type[geoms] == mujoco.mjtGeom.mjGEOM_CYLINDER
         kind = np.where(cylinder, CYLINDER, CAPSULE)
         size = m.geom_size[geoms, :2]
-        radius, half = size[:, 0], size[:, 1]
-        index = int(batch.members[row])
         self.rows = np.concatenate([self.rows, batch.body_rows[row]])
-        self.owner = np.concatenate([self.owner, np.full(len(geoms), index)])
+        self.owner = np.concatenate([self.owner, np.full(len(geoms), int(batch.members[row]))])
         self.kind = np.concatenate([self.kind, kind])
         self.size = np.concatenate([self.size, size])
-        bound = np.where(kind == CYLINDER, np.hypot(radius, half), radius + half)
-        self.rbound = np.concatenate([self.rbound, bound])
-        self.count = np.append(self.count, len(geoms))
-        self.start = np.concatenate([[0], np.cumsum(self.count)[:-1]]).astype(np.int64)
-        self.mantle = self.start
-        self._sensed = self._within = None
-        self.index = [
-            self.start[each.members][:, None] + np.arange(len(each.body_ids))
-            for each in self.roster.batches
-        ]
+        self.rbound = np.concatenate([self.rbound, _bounds(kind, size)])
+        self._counted(np.append(self.count, len(geoms)))
 
     def remove(self, index: int, moved: np.ndarray) -> None:
         """Creature `index` left the roster (already out of its batch); `moved`: every old
@@ -116,14 +107,7 @@ class ContactProxies:
         self.owner = self.owner[keep]
         self.owner[self.owner > index] -= 1
         self.kind, self.size, self.rbound = self.kind[keep], self.size[keep], self.rbound[keep]
-        self.count = np.delete(self.count, index)
-        self.start = np.concatenate([[0], np.cumsum(self.count)[:-1]]).astype(np.int64)
-        self.mantle = self.start
-        self._sensed = self._within = None
-        self.index = [
-            self.start[batch.members][:, None] + np.arange(len(batch.body_ids))
-            for batch in self.roster.batches
-        ]
+        self._counted(np.delete(self.count, index))
 
     def sense(self, transforms: TransformStore, frame: int | None = None) -> Sensed:
         """Body poses in this class's order and every creature's reach sphere: (pos, quat,
@@ -342,3 +326,9 @@ def near_pairs(
     if not found_a:
         return _NONE, _NONE
     return np.concatenate(found_a), np.concatenate(found_b)
+
+
+def _bounds(kind: np.ndarray, size: np.ndarray) -> np.ndarray:
+    """Bounding-sphere radii of bodies of `kind` and `size` (radius, half length)."""
+    radius, half = size[:, 0], size[:, 1]
+    return np.where(kind == CYLINDER, np.hypot(radius, half), radius + half)
