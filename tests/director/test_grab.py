@@ -32,3 +32,25 @@ def test_the_mouse_ray_meets_the_plane_through_the_grab_point():
     assert np.allclose(grab.target, [0.0, 2.0, 1.0])
     grab.aim(np.array([0.0, -5.0, 1.0]), np.array([1.0, 0.0, 0.0]))  # parallel: unchanged
     assert np.allclose(grab.target, [0.0, 2.0, 1.0])
+
+
+def test_the_grab_system_touches_only_what_it_declares_and_lets_go() -> None:
+    from ecs_tentacles.components import Transform
+    from ecs_tentacles.director.plugin import DirectorPlugin
+    from ecs_tentacles.director.state import Director
+    from ecs_tentacles.world import World
+    from tests.declarations import step_declared
+
+    with World.from_scene("octopus") as world:
+        world.add_plugin(DirectorPlugin())
+        octo = world.creature("octopus")
+        start = world.component(octo, Transform).pos.copy()
+        up = start + [0.0, 0.0, 0.6]
+        world.resource(Director).grab = Grab(octo, 0, up, start.copy(), np.array([0, -1.0, 0]))
+        step_declared(world, 40)  # the spring's system with only its declared columns
+        assert world.component(octo, Transform).pos[2] > start[2] + 0.2
+        world.resource(Director).grab = None
+        world.step(1)
+        assert not world.physics.groups[0].batch.applied  # the force is gone
+        world.step(120)
+        assert world.physics.health.recoveries == 0
