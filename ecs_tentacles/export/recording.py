@@ -233,6 +233,11 @@ class TakeRecorder:
             recorder.capture(world)
         self.count += 1
 
+    @property
+    def roster_changes(self) -> int:
+        """Spawns and despawns since the recording started."""
+        return self._changes
+
     def _grow(self) -> None:
         for name in ("_pos", "_quat", "_attached", "_anchor", "_visible"):
             old = getattr(self, name)
@@ -339,6 +344,8 @@ class CurvesTrack:
     Curves are columns by owner (the k-th curve of a creature is always one column), so
     when a creature comes or goes during the recording its curves join (holding their
     first shape before) or hold their last shape after; points per curve never change.
+    A track first sampled after frame 0 (the first furred creature spawned then) holds
+    its first shapes before.
     """
 
     def __init__(self, track: TakeTrack, sample: Any, recorder: TakeRecorder):
@@ -348,13 +355,20 @@ class CurvesTrack:
         self.columns: list[np.ndarray] = []  # per frame: the column of each curve sampled
         self._column: dict[tuple[int, int], int] = {}  # (owner entity, k-th) -> column
         self._owners: list[int] = []  # per column: the take's creature index (-1: none)
+        self.start = 0  # the take frame of the first sample
 
     def capture(self, world: World) -> None:
         frame: CurvesFrame | None = self.sample(world) if self.sample else None
         key = self.track.key
         if frame is None:
-            if self.points:
+            if not self.points:
+                return
+            if not self.recorder.roster_changes:
                 raise ValueError(f"take track {key!r} disappeared during the recording")
+            shape = self.points[0].shape  # its creatures were despawned: every curve holds
+            self.columns.append(np.zeros(0, dtype=np.int64))
+            self.points.append(np.zeros((0, *shape[1:]), np.float32))
+            self.widths.append(np.zeros((0, shape[1]), np.float32))
             return
         points = np.asarray(frame.points, dtype=np.float32)
         widths = np.broadcast_to(np.asarray(frame.widths, dtype=np.float32), points.shape[:2])
@@ -364,6 +378,8 @@ class CurvesTrack:
             self.points and points.shape[1] != self.points[0].shape[1]
         ):
             raise ValueError(f"{key} changed shape: {self.points[0].shape} -> {points.shape}")
+        if not self.points:
+            self.start = self.recorder.count
         self.columns.append(self._columns_of([int(e) for e in frame.creatures]))
         self.points.append(points)
         self.widths.append(np.array(widths))
@@ -386,23 +402,29 @@ class CurvesTrack:
         if not self.points:
             return {}
         first, second = self.track.arrays
-        count = len(self._owners)
-        if all(len(c) == count and (c == np.arange(count)).all() for c in self.columns[:frames]):
+        count, start = len(self._owners), self.start
+        sampled = range(max(0, min(frames - start, len(self.columns))))
+        if start == 0 and all(
+            len(self.columns[s]) == count and (self.columns[s] == np.arange(count)).all()
+            for s in sampled
+        ):
             return {first: np.stack(self.points[:frames]), second: np.stack(self.widths[:frames])}
         size = self.points[0].shape[1]
         points = np.empty((frames, count, size, 3), np.float32)
         widths = np.empty((frames, count, size), np.float32)
-        seen = np.zeros(count, dtype=bool)  # before a curve's first frame: its first shape
-        for f in range(frames):
-            fresh = ~seen[self.columns[f]]
-            columns = self.columns[f][fresh]
-            points[0, columns], widths[0, columns] = self.points[f][fresh], self.widths[f][fresh]
+        seen = np.zeros(count, dtype=bool)  # before a curve's first sample: its first shape
+        for s in range(len(self.columns)):
+            fresh = ~seen[self.columns[s]]
+            columns = self.columns[s][fresh]
+            points[0, columns], widths[0, columns] = self.points[s][fresh], self.widths[s][fresh]
             seen[columns] = True
         for f in range(frames):
             if f:  # curves not sampled now hold their last shape
                 points[f], widths[f] = points[f - 1], widths[f - 1]
-            points[f, self.columns[f]] = self.points[f]
-            widths[f, self.columns[f]] = self.widths[f]
+            if f - start in sampled:
+                s = f - start
+                points[f, self.columns[s]] = self.points[s]
+                widths[f, self.columns[s]] = self.widths[s]
         return {first: points, second: widths}
 
 

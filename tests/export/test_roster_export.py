@@ -89,3 +89,23 @@ def test_gltf_scales_a_creature_to_zero_while_it_is_away_and_validates(
                 scaled.append((frames, scales[:, 0].tolist()))
     # b hidden from frame 5, late shown from frame 7; a (there all along) has no keys
     assert sorted(scaled) == [([0, 5], [1.0, 0.0]), ([0, 7], [0.0, 1.0])]
+
+
+def test_fur_that_comes_late_or_goes_away_is_held_in_the_take(tmp_path: Path) -> None:
+    with World.from_scene({"version": 1, "creatures": [_creature("bare", 0.0)]}) as world:
+        record = world.add_system(Record())
+        world.step(3)
+        cat = world.spawn({"name": "cat", "fur": {"preset": "cat"}}, position=(4.0, 0.0))
+        world.step(3)
+        world.despawn(cat)  # every curve of the take gone from the world
+        world.step(3)
+        take = record.take()
+    take.save(tmp_path / "fur.npz")
+    again = Take.load(tmp_path / "fur.npz")
+    assert again.problem() is None
+    points = again.tracks["guide_points"]
+    assert points.shape[0] == again.frames == 10
+    assert set(again.header["guides"]["creatures"]) == {1}  # the cat's, take index 1
+    assert np.array_equal(points[0], points[4])  # before it came: its first shape
+    assert np.array_equal(points[7], points[9])  # after it went: its last shape
+    assert not again.visible()[:4, 1].any() and again.visible()[4:7, 1].all()
