@@ -291,3 +291,18 @@ def test_what_a_despawn_updates_in_place_equals_what_a_rebuild_makes():
         targets.setup(world)
         for name, values in kept.items():
             assert np.array_equal(values, getattr(targets, name)), name
+
+
+def test_a_newcomer_meets_the_creatures_there_through_contact():
+    octopus = {"name": "a", "position": [0.0, 0.0], "goals": [{"position": [3.0, 0.0]}]}
+    with World.from_scene(_scene([octopus])) as world:
+        world.step(5)
+        b = world.spawn({"name": "b", "goals": [{"position": [-3.0, 0.0]}]}, position=(2.2, 0))
+        deepest, met = 0.0, 0
+        for _ in range(400):  # head-on: they crawl into each other
+            world.step(1)
+            met = max(met, int(world.physics.proxies_used.max()))
+            views = (world.physics.group_of(world.component(e, Creature)) for e in (b,))
+            deepest = min(deepest, *(v.data.deepest_contact for v in views))
+        assert met > 0  # each felt the other's bodies
+        assert deepest > -0.01 and world.physics.health.recoveries == 0
