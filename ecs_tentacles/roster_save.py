@@ -8,7 +8,9 @@ heading, with what each plugin knows of it now (`Plugin.save_creature`: the loco
 plugin's goals and parameters); the scene's other keys are the world's scene's, and
 each plugin adds what it has at the scene level (`Plugin.save_scene`: threats dropped
 in the sandbox). Loading the file builds the same roster with the same goals and
-settings (creatures rest on the ground where their mantles were). This module sits
+settings (creatures rest on the ground where their mantles were; one that crawled
+too close to another or to a rock to be built there at rest goes to the nearest spot
+where it fits). This module sits
 above the world (as `world_loader`).
 """
 
@@ -16,6 +18,7 @@ from __future__ import annotations
 
 import copy
 import json
+import logging
 import os
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -24,7 +27,13 @@ import numpy as np
 
 from ecs_tentacles.atomic import atomic_file
 from ecs_tentacles.components import Creature, Transform
+from ecs_tentacles.construction import creature_layout
+from ecs_tentacles.ground import ground_of
 from ecs_tentacles.scene.load import load_scene
+from ecs_tentacles.scene.overlap import segment_distances
+from ecs_tentacles.spawning import nearest_free
+
+log = logging.getLogger("ecs_tentacles.roster_save")
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
@@ -60,12 +69,65 @@ def roster_scene(world: Host) -> dict[str, Any]:
     return scene
 
 
+def fit_at_rest(world: Host, entries: list[dict[str, Any]]) -> int:
+    """Move entries (in order) whose creature, built at rest where it is, would overlap
+    an obstacle or a creature placed before it to the nearest spot where it fits
+    (`spawning.nearest_free`); how many moved."""
+    ground = ground_of(world)
+    starts: list[np.ndarray] = []
+    ends: list[np.ndarray] = []
+    radii: list[np.ndarray] = []
+    centres, reaches = np.zeros((0, 2)), np.zeros(0)
+    names: list[str] = []
+
+    def blocked(entry: dict[str, Any]) -> str | None:
+        if ground.solids:  # as the terrain plugin checks a scene: resting on the ground
+            s, e, r = creature_layout(entry, ground).capsules()
+            points = np.concatenate([s, e, 0.5 * (s + e)])
+            if (ground.inside_solid(points, np.tile(r, 3)) >= 0).any():
+                return "an obstacle"
+        layout = creature_layout(entry)  # as the scene's overlap check: on the plane
+        s, e, r = layout.capsules()
+        points = np.concatenate([s, e])
+        centre = layout.origin[:2]
+        reach = float(np.max(np.linalg.norm(points[:, :2] - centre, axis=1)) + r.max())
+        near = np.flatnonzero(np.linalg.norm(centres - centre, axis=1) < reaches + reach)
+        for i in near.tolist():
+            gap = segment_distances(s[:, None], e[:, None], starts[i][None], ends[i][None])
+            if (gap < r[:, None] + radii[i][None]).any():
+                return f"creature {names[i]!r}"
+        return None
+
+    moved = 0
+    for k, entry in enumerate(entries):
+        fitted, blocker = nearest_free(entry, blocked)
+        if blocker is not None:
+            entries[k] = fitted
+            moved += 1
+        layout = creature_layout(fitted)
+        s, e, r = layout.capsules()
+        starts.append(s)
+        ends.append(e)
+        radii.append(r)
+        centre = layout.origin[:2]
+        reach = float(np.max(np.linalg.norm(np.concatenate([s, e])[:, :2] - centre, axis=1)))
+        centres = np.vstack([centres, centre])
+        reaches = np.append(reaches, reach + float(r.max()))
+        names.append(fitted["name"])
+    return moved
+
+
 def save_roster(world: Host, path: str | os.PathLike[str]) -> Path:
     """Write `roster_scene(world)` to `path` as JSON, validated and atomically; the path.
 
-    Raises SceneError (one line per problem) and writes nothing when the scene would
-    not load."""
+    Creatures that crawled close to each other or to a rock would overlap when built
+    again at rest (tentacles spread): they are written at the nearest spot where they
+    fit (`fit_at_rest`; logged). Raises SceneError (one line per problem) and writes
+    nothing when the scene would not load."""
     scene = roster_scene(world)
+    moved = fit_at_rest(world, scene["creatures"])
+    if moved:
+        log.info("%s: %d creature(s) moved to where they fit with tentacles spread", path, moved)
     load_scene(scene, allow_systems=True)  # checked as any scene: SceneError, one line each
     target = Path(path)
     with atomic_file(target) as handle:

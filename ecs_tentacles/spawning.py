@@ -27,7 +27,7 @@ from __future__ import annotations
 import copy
 import logging
 import re
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any, Literal
 
 import esper
@@ -146,8 +146,18 @@ def obstruction(world: World, layout: CreatureLayout) -> str | None:
 def free_spot(world: World, entry: dict[str, Any]) -> tuple[dict[str, Any], str | None]:
     """`entry` where it asked to be if free, else moved to the nearest free spot on rings
     around it; and what was in the way (None: not moved). SpawnError if none is free."""
-    layout = creature_layout(entry, ground_of(world))
-    blocker = obstruction(world, layout)
+    ground = ground_of(world)
+    return nearest_free(entry, lambda e: obstruction(world, creature_layout(e, ground)))
+
+
+def nearest_free(
+    entry: dict[str, Any], blocked: Callable[[dict[str, Any]], str | None]
+) -> tuple[dict[str, Any], str | None]:
+    """`entry` if `blocked` finds nothing in the way of it, else a copy at the nearest
+    spot on rings around it (a quarter of its reach apart) where nothing is; and what
+    was in the way first (None: not moved). SpawnError if no spot is free."""
+    layout = creature_layout(entry)
+    blocker = blocked(entry)
     if blocker is None:
         return entry, None
     _, ends, radii = layout.capsules()
@@ -160,7 +170,7 @@ def free_spot(world: World, entry: dict[str, Any]) -> tuple[dict[str, Any], str 
             moved = copy.deepcopy(entry)
             spot = [x + distance * np.cos(angle), y + distance * np.sin(angle)]
             moved["position"] = spot + list(entry["position"][2:])
-            if obstruction(world, creature_layout(moved, ground_of(world))) is None:
+            if blocked(moved) is None:
                 return moved, blocker
     farthest = SEARCH_RINGS * 0.25 * reach
     line = f"creature {entry['name']!r}: no free spot within {farthest:.1f} m of ({x:g}, {y:g})"

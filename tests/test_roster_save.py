@@ -56,3 +56,26 @@ def test_a_save_that_cannot_be_written_leaves_nothing(tmp_path: Path) -> None:
         with pytest.raises(OSError):
             save_roster(world, tmp_path / "no_such_folder" / "x.json")
         assert not (tmp_path / "no_such_folder").exists()
+
+
+def test_creatures_too_close_to_be_built_at_rest_are_saved_where_they_fit(tmp_path: Path):
+    from ecs_tentacles.roster_save import fit_at_rest
+    from ecs_tentacles.scene.load import load_scene
+    from ecs_tentacles.scene.validate import with_defaults
+
+    rock = {"obstacles": [{"shape": "box", "position": [6.0, 0.0, 0.5], "size": [2, 2, 1]}]}
+    scene = {"version": 1, "terrain": rock, "creatures": [{"name": "far", "position": [-9, 0]}]}
+    with World.from_scene(scene) as world:
+        entries = with_defaults({"version": 1, "creatures": [
+            {"name": "a", "position": [0.0, 0.0]},
+            {"name": "b", "position": [0.4, 0.0]},  # its tentacles through a's at rest
+            {"name": "c", "position": [6.5, 0.0]},  # inside the rock
+            {"name": "d", "position": [0.0, 8.0]},  # free: stays
+        ]})["creatures"]  # fmt: skip
+        assert fit_at_rest(world, entries) == 2
+        assert entries[0]["position"] == [0.0, 0.0] and entries[3]["position"] == [0.0, 8.0]
+        assert np.hypot(entries[1]["position"][0] - 0.4, entries[1]["position"][1]) > 0.3
+        saved = {**scene, "creatures": entries}
+        load_scene(saved)  # no overlap left: the scene's own check agrees
+        with World.from_scene(saved) as again:  # and the terrain's build check
+            again.step(5)
