@@ -306,3 +306,15 @@ def test_a_newcomer_meets_the_creatures_there_through_contact():
             deepest = min(deepest, *(v.data.deepest_contact for v in views))
         assert met > 0  # each felt the other's bodies
         assert deepest > -0.01 and world.physics.health.recoveries == 0
+
+
+def test_a_spawn_inside_a_rock_is_refused_or_moved_out_of_it():
+    rock = {"obstacles": [{"shape": "box", "position": [5.0, 0.0, 0.5], "size": [2, 2, 1]}]}
+    with World.from_scene({**_scene(APART[:1]), "terrain": rock}) as world:
+        with pytest.raises(SpawnError, match="overlaps an obstacle"):
+            world.spawn(_creature("d", 5.0))
+        moved = world.spawn(_creature("d", 5.0), on_overlap="move")
+        x, y = world.component(moved, Transform).pos[:2]
+        assert max(abs(x - 5.0), abs(y)) > 1.0  # out of the 2 m box
+        world.step(20)
+        assert world.physics.health.recoveries == 0

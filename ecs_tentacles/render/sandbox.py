@@ -63,6 +63,7 @@ from ecs_tentacles.render.selection import Selection
 from ecs_tentacles.render.undo import UndoStack
 from ecs_tentacles.roster_save import save_roster
 from ecs_tentacles.scene.errors import SceneError
+from ecs_tentacles.snapshot import SnapshotMismatch
 from ecs_tentacles.system import SystemFailure
 from ecs_tentacles.world import World
 
@@ -239,10 +240,15 @@ class Sandbox:
         self.saved_state = self.world.snapshot()
 
     def load_state(self) -> bool:
-        """Go back to the state saved with F5 (F9); False if none was saved."""
+        """Go back to the state saved with F5 (F9); False if none was saved, or if it
+        names a creature removed since (the Scripts window says so)."""
         if self.saved_state is None:
             return False
-        self.world.restore(self.saved_state)
+        try:
+            self.world.restore(self.saved_state)
+        except SnapshotMismatch as error:
+            self.scripts.say(False, str(error))
+            return False
         self.world.schedule["render"].process(self.world, 0.0)  # show it now
         self.accumulator = 0.0
         return True

@@ -176,3 +176,23 @@ def test_ctrl_s_saves_a_scene_that_reloads_to_the_same_setup(
         assert set(again.resource(ThreatData).positions(again)) == set(
             world.resource(ThreatData).positions(world)
         )
+
+
+def test_f9_goes_back_past_a_spawn_and_refuses_past_a_removal(
+    make_sandbox: Callable[..., Any],
+) -> None:
+    sandbox = make_sandbox("octopus")
+    world = sandbox.world
+    _key(sandbox, key.F5)
+    newcomer = world.spawn({"name": "late"}, position=(4.0, 0.0))
+    sandbox.select(newcomer)
+    sandbox.step(5)
+    _key(sandbox, key.F9)  # back to before it came: it goes again
+    assert _names(world) == ["octopus"] and sandbox.renderer.selected is None
+    sandbox.render()
+    _key(sandbox, key.F5)
+    sandbox.step(3)
+    world.despawn(world.creature("octopus"))
+    _key(sandbox, key.F9)  # it cannot come back with its old entity: said, nothing changes
+    assert _names(world) == [] and sandbox.world.frame == 3
+    assert any("despawned since" in line for _, line in sandbox.scripts.notes)
