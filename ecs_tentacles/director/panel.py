@@ -127,7 +127,12 @@ class DirectorPanel(Panel):
             where = np.array(world.transforms.pos[world.creatures.mantle_row[
                 world.component(entity, Creature).row]][:2])  # fmt: skip
             step = 2.0 * reach_of(creature_entry(world, entry)) + 0.1
-            made.append(world.spawn(entry, position=where + [step, 0.0], on_overlap="move"))
+            try:
+                made.append(world.spawn(entry, position=where + [step, 0.0], on_overlap="move"))
+            except SpawnError as error:  # no free spot near it: said, the others copied
+                self.message = str(error).splitlines()[0]
+        if not made:
+            return made
         self._push(Spawned.of(world, f"copy {len(made)}", made))
         self.sandbox.select_many(made)
         self.message = f"copied {len(made)} creature(s)"
