@@ -124,6 +124,16 @@ def _newline_in_creature_name(header: dict[str, Any], arrays: Entries) -> None:
             item["name"] = f"{old}\n{item['name'][len(old) :]}"
 
 
+def _roster(visible: Callable[[int, int], np.ndarray]) -> Callable[[dict[str, Any], Entries], None]:
+    """A roster header with a `creature_visible` array made by `visible(frames, creatures)`."""
+
+    def change(header: dict[str, Any], arrays: Entries) -> None:
+        header["roster"] = {"changes": 1}
+        arrays["creature_visible"] = visible(header["frames"], len(header["creatures"]))
+
+    return change
+
+
 BROKEN_TAKES: dict[str, Callable[[Path, Path], None]] = {
     "nan_position": edit(_set("pos", (1, 2, 0), np.nan)),
     "inf_quaternion": edit(_set("quat", (0, 0, 1), np.inf)),
@@ -191,6 +201,17 @@ BROKEN_TAKES: dict[str, Callable[[Path, Path], None]] = {
             guide_points=a["guide_points"][:, :, :1].copy(),
             guide_widths=a["guide_widths"][:, :, :1].copy(),
         )
+    ),
+    # the roster (`ecs_tentacles.take_roster`): a take that says creatures came and went
+    "roster_without_visible_array": edit(lambda h, a: h.update(roster={"changes": 1})),
+    "roster_changes_zero": edit(lambda h, a: h.update(roster={"changes": 0})),
+    "roster_not_an_object": edit(lambda h, a: h.update(roster=[1])),
+    "roster_visible_one_frame_short": edit(
+        _roster(lambda frames, n: np.ones((frames - 1, n), bool))
+    ),
+    "roster_visible_as_numbers": edit(_roster(lambda frames, n: np.ones((frames, n), np.int32))),
+    "roster_visible_without_header": edit(
+        lambda h, a: a.update(creature_visible=np.ones((h["frames"], len(h["creatures"])), bool))
     ),
     "zip_bomb_directory": raw(_claim_huge),
     "corrupt_compressed_data": raw(_flip_middle),
