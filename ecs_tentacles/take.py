@@ -19,6 +19,9 @@ The file is a zip of `.npy` arrays in this fixed order; every entry is dated
     guide_points     float32  (frames, guides, points, 3)   the standard curves track,
     guide_widths     float32  (frames, guides, points)      only when guides are recorded
     ...              the arrays of the tracks `header.tracks` declares, in its order
+    ground_*         the terrain's meshes, on terrain (`ecs_tentacles.take_ground`)
+    creature_visible bool     (frames, creatures)  only when creatures came or went
+                                                   (`ecs_tentacles.take_roster`)
 
 Frame i is simulated time i / fps; frame 0 is the pose the scene was built in.
 Bodies: a mantle is a cylinder along its local +z (`length` = height), a link a
