@@ -1,8 +1,8 @@
 """Locomotion's part in directing a crowd: what an undo puts back, what a save writes.
 
-* `sandbox_state` / `sandbox_restore` (the sandbox's undo, `ecs_tentacles.render.undo`):
-  every creature's goal path and run-time parameters (the columns the parameter table
-  names, `locomotion.params.settable`), by creature name;
+* `DirectedStates.capture` / `sandbox_restore` (the sandbox's undo,
+  `ecs_tentacles.render.undo`): every creature's goal path and run-time parameters (the
+  columns the parameter table names, `locomotion.params.settable`), put back by name;
 * `save_creature` (saving the roster as a scene, `ecs_tentacles.roster_save`): a
   creature's goals and its current parameters into its scene entry (tentacles that
   differ from the first as `overrides`).
@@ -13,6 +13,7 @@ stores.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -26,35 +27,7 @@ if TYPE_CHECKING:
     from ecs_tentacles.host import Host
 
 
-def _rows(world: Host, creature: int, kind: str) -> Any:
-    row = world.component(creature, Creature).row
-    if kind == "creature":
-        return row
-    first, count = int(world.creatures.first_tentacle[row]), int(world.creatures.tentacles[row])
-    tentacles = np.arange(first, first + count)
-    if kind == "tentacle":
-        return tentacles
-    starts, counts = world.tentacles.first_link[tentacles], world.tentacles.links[tentacles]
-    return np.concatenate([np.arange(a, a + n) for a, n in zip(starts, counts, strict=True)])
-
-
-def capture(world: Host, creature: int) -> dict[str, Any]:
-    """The creature's run-time parameter columns, as stored."""
-    per_tentacle, per_creature = settable()
-    out = {}
-    for p in {**per_tentacle, **per_creature}.values():
-        values = getattr(world.stores[p.store], p.field)[_rows(world, creature, ROWS[p.store])]
-        out[p.column] = np.array(values, copy=True)
-    return out
-
-
-def put(world: Host, creature: int, captured: dict[str, Any]) -> None:
-    """Write back what `capture` returned."""
-    per_tentacle, per_creature = settable()
-    for p in {**per_tentacle, **per_creature}.values():
-        if p.column in captured:
-            rows = _rows(world, creature, ROWS[p.store])
-            getattr(world.stores[p.store], p.field)[rows] = captured[p.column]
+LAYOUT = {"creatures": ("first_tentacle", "tentacles"), "tentacles": ("first_link", "links")}
 
 
 def goal_path(world: Host, creature: int) -> list[tuple[tuple[float, ...], float]]:
@@ -62,26 +35,82 @@ def goal_path(world: Host, creature: int) -> list[tuple[tuple[float, ...], float
     return [(tuple(g.position.tolist()), float(g.radius)) for g in goals]
 
 
-def sandbox_state(world: Host) -> dict[str, Any]:
-    """Every creature's goal path and parameters, by creature name."""
-    return {
-        creature.name: (goal_path(world, entity), capture(world, entity))
-        for entity, creature in world.query(Creature)
-    }
+def _parameters() -> list[Any]:
+    per_tentacle, per_creature = settable()
+    return list({**per_tentacle, **per_creature}.values())
 
 
-def sandbox_restore(world: Host, state: dict[str, Any]) -> None:
+@dataclass(eq=False)
+class Directed:
+    """Every creature's goals and run-time parameters at one moment (an undo memento):
+    the parameter columns copied whole, the rows each creature had then, the goal paths
+    by name. Two are equal when nothing a user directs differs."""
+
+    names: list[str]  # by creature row
+    rows: dict[str, np.ndarray]  # where each creature's tentacles and links were
+    columns: dict[str, np.ndarray]  # parameter column ("store.field") -> its values
+    version: int  # the goal book's, when `goals` were read
+    goals: dict[str, list[tuple[tuple[float, ...], float]]]
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Directed):
+            return NotImplemented
+        return (
+            self.names == other.names
+            and (self.version == other.version or self.goals == other.goals)
+            and all(np.array_equal(a, other.columns[k]) for k, a in self.columns.items())
+        )
+
+    def span(self, kind: str, row: int) -> np.ndarray:
+        """The rows of `kind` ("creature", "tentacle", "link") creature row `row` had."""
+        if kind == "creature":
+            return np.array([row])
+        first, count = (self.rows[k][row] for k in LAYOUT["creatures"])
+        tentacles = np.arange(first, first + count)
+        if kind == "tentacle":
+            return tentacles
+        starts, counts = (self.rows[k][tentacles] for k in LAYOUT["tentacles"])
+        return np.concatenate([np.arange(a, a + n) for a, n in zip(starts, counts, strict=True)])
+
+
+class DirectedStates:
+    """Makes `Directed` mementos; the goal paths are read again only when the goal book
+    changed (a slider drag captures every frame: whole-column copies, no per-creature
+    Python)."""
+
+    def __init__(self) -> None:
+        self._goals: tuple[int, dict[str, list[tuple[tuple[float, ...], float]]]] | None = None
+
+    def capture(self, world: Host) -> Directed:
+        book = world.resource(GoalBook)
+        entities = world.creatures.entity.tolist()
+        names = [world.creature_name(e) for e in entities]
+        if self._goals is None or self._goals[0] != book.version:
+            paths = {n: goal_path(world, e) for n, e in zip(names, entities, strict=True)}
+            self._goals = (book.version, {n: p for n, p in paths.items() if p})
+        rows = {k: getattr(world.stores[s], k).copy() for s, ks in LAYOUT.items() for k in ks}
+        columns = {p.column: getattr(world.stores[p.store], p.field).copy() for p in _parameters()}
+        return Directed(names, rows, columns, *self._goals)
+
+
+def sandbox_restore(world: Host, state: Directed) -> None:
     """Put back goal paths and parameters of the creatures still there (by name)."""
     book = world.resource(GoalBook)
+    now = DirectedStates().capture(world)
+    was = {name: row for row, name in enumerate(state.names)}
     for entity, creature in world.query(Creature):
-        if creature.name not in state:
+        old = was.get(creature.name)
+        if old is None:
             continue
-        path, captured = state[creature.name]
-        if goal_path(world, entity) != path:
+        path = state.goals.get(creature.name, [])
+        if now.goals.get(creature.name, []) != path:
             book.clear(entity)
             for position, radius in path:
                 book.append(entity, list(position), radius)
-        put(world, entity, captured)
+        for p in _parameters():
+            kind = ROWS[p.store]
+            column = getattr(world.stores[p.store], p.field)
+            column[now.span(kind, creature.row)] = state.columns[p.column][state.span(kind, old)]
 
 
 def save_creature(world: Host, creature: int, entry: dict[str, Any]) -> None:

@@ -57,6 +57,8 @@ class LocomotionPlugin(Plugin):
     hook_reads = ("locomotion.creatures.has_goal", "locomotion.creatures.goal")
     defs = _FRAGMENT["$defs"]
 
+    _directed: Any = None  # the sandbox's undo mementos (`locomotion.directing`)
+
     def resources(self, world: Host) -> list[object]:
         return [LocomotionStores(), GoalBook(world), Locomotion(world), Navigator(),
                 FormationChoice()]  # fmt: skip
@@ -147,9 +149,11 @@ class LocomotionPlugin(Plugin):
         return goal_points(world)
 
     def sandbox_state(self, world: Host) -> Any:
-        from ecs_tentacles.locomotion.directing import sandbox_state
+        from ecs_tentacles.locomotion.directing import DirectedStates
 
-        return sandbox_state(world)
+        if self._directed is None:
+            self._directed = DirectedStates()
+        return self._directed.capture(world)
 
     def sandbox_restore(self, world: Host, state: Any) -> None:
         from ecs_tentacles.locomotion.directing import sandbox_restore
