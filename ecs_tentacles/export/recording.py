@@ -356,6 +356,7 @@ class CurvesTrack:
         self._column: dict[tuple[int, int], int] = {}  # (owner entity, k-th) -> column
         self._owners: list[int] = []  # per column: the take's creature index (-1: none)
         self.start = 0  # the take frame of the first sample
+        self._last: tuple[np.ndarray, np.ndarray] | None = None  # owners and their columns
 
     def capture(self, world: World) -> None:
         frame: CurvesFrame | None = self.sample(world) if self.sample else None
@@ -380,11 +381,13 @@ class CurvesTrack:
             raise ValueError(f"{key} changed shape: {self.points[0].shape} -> {points.shape}")
         if not self.points:
             self.start = self.recorder.count
-        self.columns.append(self._columns_of([int(e) for e in frame.creatures]))
+        owners = np.asarray(frame.creatures, dtype=np.int64)
+        if self._last is None or not np.array_equal(owners, self._last[0]):
+            self._last = (owners, self._columns_of(owners.tolist()))  # the curves changed
+        self.columns.append(self._last[1])
         self.points.append(points)
         self.widths.append(np.array(widths))
-        owners = self._owners
-        self.recorder.header[key] = {"creatures": list(owners)}
+        self.recorder.header[key] = {"creatures": list(self._owners)}
 
     def _columns_of(self, creatures: list[int]) -> np.ndarray:
         index, seen = self.recorder.creature_index, dict[int, int]()

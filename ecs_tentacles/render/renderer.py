@@ -27,7 +27,7 @@ import numpy as np
 from pyglet import gl
 
 from ecs_tentacles.components import Creature, Link, Tentacle, Transform
-from ecs_tentacles.drawing import CIRCLE, RenderView, line_segments
+from ecs_tentacles.drawing import CIRCLE, RenderView
 from ecs_tentacles.ground import ground_of
 from ecs_tentacles.ground_mesh import COLOURS, ground_meshes
 from ecs_tentacles.render import shaders
@@ -192,6 +192,7 @@ class Renderer:
         world = self.world
         creatures = sorted(world.query(Creature, Transform))
         self._entities = [e for e, _ in creatures]
+        self._index_of = {e: i for i, e in enumerate(self._entities)}
         for entity in self._entities:  # the next colour for a newcomer
             self._colour_index.setdefault(entity, len(self._colour_index))
         palette = creature_colours(len(self._colour_index))
@@ -369,11 +370,14 @@ class Renderer:
         segments = [np.zeros((0, 7))]
         for plugin in self.world.plugins:
             segments += plugin.render_lines(self.world, view)
-        for entity in self.selection or ((self.selected,) if self.selected is not None else ()):
-            row = self.world.component(entity, Transform).row
-            creature = self.world.component(entity, Creature)
-            ring = pos[row] * [1, 1, 0] + [0, 0, 0.01] + creature.mantle_radius * 1.6 * CIRCLE
-            segments.append(line_segments(ring, np.array([1.0, 1.0, 1.0, 1.0])))
+        chosen = self.selection or ((self.selected,) if self.selected is not None else ())
+        if chosen:  # one ring round each, in one pass
+            drawn = [self._index_of[e] for e in chosen if e in self._index_of]
+            centres = pos[self._mantle_rows[drawn]] * [1, 1, 0] + [0, 0, 0.01]
+            radii = 1.6 * self.mantle_instances[drawn, 7].astype(np.float64)
+            rings = centres[:, None, :] + radii[:, None, None] * CIRCLE
+            pairs = np.stack([rings[:, :-1], rings[:, 1:]], axis=2).reshape(-1, 3)
+            segments.append(np.hstack([pairs, np.ones((len(pairs), 4))]))
         for provider in self.extra_lines:
             segments.append(provider(self.world))
         return np.vstack(segments).astype(np.float32)
