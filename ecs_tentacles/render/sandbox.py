@@ -3,19 +3,9 @@
 Physics runs at the scene's fixed frame rate with its own accumulator; drawing
 happens at display rate and interpolates between the last two physics frames.
 
-Mouse: left-drag orbits, right- or middle-drag pans, wheel zooms; click a creature
-to select it, shift-click one to add it to the selection or take it out, shift-drag a
-rectangle to select the creatures in it (`render.selection`). Every other click in the
-3D view goes to the plugins' `sandbox_click` hooks (`ecs_tentacles.drawing.Click`):
-the locomotion plugin's sends the selection to a click on the ground (in formation
-when there are several), appends to their paths on shift-click and removes the goal
-under a right click. Keys: space pause, . single step, r reset, h HUD, f follow,
-a frame all, Ctrl+A select every creature, Esc select none, Ctrl+Z undo and
-Ctrl+Shift+Z redo an edit (goals, parameters, the director's; `render.undo`), Ctrl+S
-save the roster as a scene (`roster_save`), tab next tentacle, F12 screenshot, v
-video, F5 save the state, F9 go back to it. The HUD's panels see keys
-and mouse presses first (`Panel.key`, `Panel.press`; `modifiers` and `keys` say what
-is held).
+The mouse and the keys are `render.sandbox_input` (selecting one creature or many,
+goal clicks through the plugins' `sandbox_click` hooks as undoable edits, the HUD's
+panels seeing presses and keys first, the key map).
 
 Level of detail (`world.lod`): before every physics frame the sandbox tells it the
 selected creatures (they run full) and, unless a focus is pinned (`focus=`, `play
@@ -46,18 +36,19 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pyglet
 from pyglet import gl
-from pyglet.window import key, mouse
+from pyglet.window import key
 from tqdm import tqdm
 
-from ecs_tentacles.components import Creature, Transform
-from ecs_tentacles.drawing import Click, Panel
+from ecs_tentacles.components import Creature
+from ecs_tentacles.drawing import Panel
 from ecs_tentacles.ground import ground_of
 from ecs_tentacles.plugin_registry import sandbox_plugins
 from ecs_tentacles.render.hud import Hud
-from ecs_tentacles.render.on_screen import creature_at, creatures_in, labels_over
+from ecs_tentacles.render.on_screen import creature_at, labels_over
 from ecs_tentacles.render.output import VideoWriter, save_png
 from ecs_tentacles.render.plugin import RenderPlugin
 from ecs_tentacles.render.renderer import Renderer
+from ecs_tentacles.render.sandbox_input import SandboxInput
 from ecs_tentacles.render.scripts import Scripts
 from ecs_tentacles.render.selection import Selection
 from ecs_tentacles.render.undo import UndoStack
@@ -70,8 +61,6 @@ from ecs_tentacles.world import World
 if TYPE_CHECKING:
     from ecs_tentacles.snapshot import Snapshot
 
-CLICK_PIXELS = 4  # a press and release closer than this is a click, not a drag
-BUTTONS = {mouse.LEFT: "left", mouse.RIGHT: "right", mouse.MIDDLE: "middle"}
 MAX_CATCH_UP = 0.25  # seconds of physics to catch up at most per display frame
 DISPLAY_HZ = 60
 FOCUS_RADIUS = 4.0  # m around the camera's target where creatures run full physics
@@ -115,16 +104,14 @@ class Sandbox:
         self.paused = False
         self.selection = Selection()
         self.panels: dict[str, list[Panel]] = {}  # each plugin's HUD sections, by plugin key
-        self._grab: Panel | None = None  # the panel holding the mouse (a dragged marker)
         self._attach_world()
-        self.window.push_handlers(self)
+        self.input = SandboxInput(self)  # the mouse and the keys
+        self.window.push_handlers(self)  # (on_draw)
+        self.window.push_handlers(self.input)
         self.window.push_handlers(self.hud.gui)  # the GUI sees every event first
         self.accumulator = 0.0
         self.video: VideoWriter | None = None
         self.screenshots = 0
-        self._press: tuple[float, float] | None = None
-        self.band: tuple[float, float, float, float] | None = None  # a rectangle being dragged
-        self.modifiers = 0  # the modifier keys held at the last mouse press or key
         self.keys = key.KeyStateHandler()  # which keys are down (panels: `keys[key.S]`)
         self.window.push_handlers(self.keys)
         self.stats = {"fps": 0.0, "physics_ms": 0.0, "sim_time": 0.0, "rtf": 0.0, "attached": 0}
@@ -346,7 +333,12 @@ class Sandbox:
         self.scripts.say(True, f"saved {saved}")
         return saved
 
-    # -- selection and clicks ------------------------------------------------------------
+    @property
+    def modifiers(self) -> int:
+        """The modifier keys held at the last mouse press or key (panels read it)."""
+        return self.input.modifiers
+
+    # -- selection -----------------------------------------------------------------------
     def select(self, creature: int | None) -> None:
         """Select just `creature` (None: nothing)."""
         self.selection.only(creature)
@@ -355,6 +347,11 @@ class Sandbox:
     def select_many(self, creatures: Any) -> None:
         """Select `creatures` (entities; the last is the HUD's)."""
         self.selection.replace(creatures)
+        self._selection_changed()
+
+    def toggle(self, creature: int) -> None:
+        """Add `creature` to the selection, or take it out (shift-click)."""
+        self.selection.toggle(creature)
         self._selection_changed()
 
     def _selection_changed(self) -> None:
@@ -373,129 +370,6 @@ class Sandbox:
         origin, direction = self.renderer.camera.ray(x, y)
         hit = ground_of(self.world).ray(origin, direction)
         return hit if hit is not None else self.renderer.camera.ground_point(x, y)
-
-    def click(self, x: float, y: float, button: int, modifiers: int) -> None:
-        """What a click at pixel (x, y) does: a left click on a creature selects it; then
-        the plugins' `sandbox_click` hooks see it, in plugin order, until one takes it."""
-        if self.hud.contains(x, y):
-            return
-        picked = self.pick_creature(x, y)
-        shift = bool(modifiers & key.MOD_SHIFT)
-        if button == mouse.LEFT and picked is not None:
-            if shift:  # in or out of the selection
-                self.selection.toggle(picked)
-                self._selection_changed()
-                return
-            self.select(picked)
-        click = Click(
-            button=BUTTONS.get(button, "other"),
-            shift=shift,
-            ground=self.ground_point(x, y),
-            creature=picked,
-            selected=self.renderer.selected,
-            selection=self.selection.entities,
-            ctrl=bool(modifiers & key.MOD_CTRL),
-        )
-        self.undo.record(self.world, "goals", lambda: self._offer(click))
-
-    def _offer(self, click: Click) -> bool:
-        """The plugins' `sandbox_click` hooks, in plugin order, until one takes `click`."""
-        return any(plugin.sandbox_click(self.world, click) for plugin in self.world.plugins)
-
-    # -- window events -------------------------------------------------------------------
-    def on_mouse_press(self, x: int, y: int, button: int, modifiers: int) -> None:
-        self.modifiers = modifiers
-        self._press = (x, y) if not self.hud.contains(x, y) else None
-        if self._press is not None and button == mouse.LEFT:
-            for panel in self.hud.panels:
-                if panel.press(x, y):  # a fur control's marker: drag it over the body
-                    self._press, self._grab = None, panel
-                    break
-
-    def on_mouse_release(self, x: int, y: int, button: int, modifiers: int) -> None:
-        for panel in self.hud.panels:
-            panel.release()
-        self._grab = None
-        if self.band is not None:
-            x0, y0, x1, y1 = self.band
-            self.band = self.hud.band = None
-            self.select_many(creatures_in(self.world, self.renderer, (x0, y0), (x1, y1)))
-        elif (
-            self._press is not None
-            and np.hypot(x - self._press[0], y - self._press[1]) < CLICK_PIXELS
-        ):
-            self.click(x, y, button, modifiers)
-        self._press = None
-
-    def on_mouse_drag(self, x: int, y: int, dx: int, dy: int, buttons: int, modifiers: int) -> None:
-        if self._grab is not None:
-            self._grab.drag(x, y)
-            return
-        if self._press is None:
-            return
-        if buttons & mouse.LEFT and (self.band is not None or modifiers & key.MOD_SHIFT):
-            self.band = self.hud.band = (*self._press, float(x), float(y))  # rubber band
-        elif buttons & mouse.LEFT:
-            self.renderer.camera.orbit(dx, dy)
-        elif buttons & (mouse.RIGHT | mouse.MIDDLE):
-            self.renderer.camera.pan(dx, dy)
-
-    def on_mouse_scroll(self, x: int, y: int, scroll_x: float, scroll_y: float) -> None:
-        if not self.hud.contains(x, y):
-            self.renderer.camera.zoom(scroll_y)
-
-    def on_key_press(self, symbol: int, modifiers: int) -> bool | None:
-        self._key(symbol, modifiers)
-        # Esc clears the selection; pyglet's own handler would close the window
-        return pyglet.event.EVENT_HANDLED if symbol == key.ESCAPE else None
-
-    def _key(self, symbol: int, modifiers: int) -> None:
-        camera = self.renderer.camera
-        if self.hud.visible and self.hud.gui.wants_keyboard:
-            return  # typing into a text field
-        self.modifiers = modifiers
-        if any(panel.key(symbol, modifiers) for panel in self.hud.panels):
-            return  # a panel's key (the palette's Delete, Ctrl+Z, ...)
-        ctrl, shift = modifiers & key.MOD_CTRL, modifiers & key.MOD_SHIFT
-        if symbol == key.A and ctrl:
-            self.select_many(self.renderer.creature_entities)
-        elif symbol == key.Z and ctrl:
-            label = (self.undo.redo if shift else self.undo.undo)(self.world)
-            self.scripts.say(True, f"{'redo' if shift else 'undo'}: {label or 'nothing to do'}")
-        elif symbol == key.S and ctrl:
-            self.save_roster()
-        elif symbol == key.ESCAPE:
-            self.select(None)
-        elif symbol == key.SPACE:
-            self.paused = not self.paused
-        elif symbol == key.PERIOD:
-            self.paused = True
-            self.step(1)
-        elif symbol == key.R:
-            self.reset()
-        elif symbol == key.H:
-            self.hud.visible = not self.hud.visible
-            self.renderer.camera.shift_x = self.hud.width / 2
-        elif symbol == key.F and self.renderer.selected is not None:
-            row = self.world.component(self.renderer.selected, Transform).row
-            camera.follow = None if camera.follow == row else row
-        elif symbol == key.A:
-            self.renderer.frame_all()
-        elif symbol == key.C:
-            print(f"view: {self.renderer.toggle_view()}")
-        elif symbol == key.TAB:
-            self.hud.step_tentacle(-1 if modifiers & key.MOD_SHIFT else 1)
-        elif symbol == key.F5:
-            self.save_state()
-            print(f"state saved at {self.world.time:.2f} s (F9 to go back)")
-        elif symbol == key.F9:
-            print(f"state restored to {self.world.time:.2f} s" if self.load_state() else
-                  "no saved state: F5 saves one")  # fmt: skip
-        elif symbol == key.F12:
-            print(f"saved {self.screenshot()}")
-        elif symbol == key.V:
-            finished = self.toggle_video()
-            print(f"saved {finished}" if finished else "recording video (v to stop)")
 
     # -- running -------------------------------------------------------------------------
     def run(self) -> None:
