@@ -318,3 +318,16 @@ def test_a_spawn_inside_a_rock_is_refused_or_moved_out_of_it():
         assert max(abs(x - 5.0), abs(y)) > 1.0  # out of the 2 m box
         world.step(20)
         assert world.physics.health.recoveries == 0
+
+
+def test_models_rebuilt_after_a_body_plan_left_retire_its_empty_batch():
+    with World.from_scene(_scene(APART)) as world:
+        odd = world.spawn({"name": "odd", "tentacles": {"count": 3}}, position=(30.0, 0.0))
+        assert world.physics.compiles == 2
+        world.despawn(odd)
+        world.physics.rebuild_models(world)  # (a terrain edit): nobody left to build it from
+        again = world.spawn({"name": "odd", "tentacles": {"count": 3}}, position=(30.0, 0.0))
+        assert world.physics.compiles == 3  # a new batch for the shape
+        assert world.physics.group_of(world.component(again, Creature)).batch.index == 2
+        world.step(10)
+        assert world.physics.health.recoveries == 0

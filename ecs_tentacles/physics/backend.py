@@ -20,10 +20,10 @@ from __future__ import annotations
 
 import logging
 import os
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, overload
+from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
@@ -32,13 +32,14 @@ from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.physics.batch import Batch
 from ecs_tentacles.physics.health import SOFT_GAIN, HealthCheck, HealthState
 from ecs_tentacles.physics.lod import LevelOfDetail
-from ecs_tentacles.physics.model import ModelLayout, build_spec, model_layout
+from ecs_tentacles.physics.membership import Membership, compile_models
+from ecs_tentacles.physics.model import ModelLayout, model_layout
 from ecs_tentacles.physics.proxies import ContactProxies
 from ecs_tentacles.physics.roster import Roster
 from ecs_tentacles.physics.sleep import Sleep, SleepState
 from ecs_tentacles.physics.stepping import Segment, bare_step, plan, step_segments
 from ecs_tentacles.physics.tiers import FULL, KINEMATIC, REDUCED, reduced_substeps
-from ecs_tentacles.physics.view import CreatureView
+from ecs_tentacles.physics.view import CreatureView, CreatureViews
 
 if TYPE_CHECKING:
     from ecs_tentacles.physics.host import PhysicsHost
@@ -74,8 +75,10 @@ class PhysicsState:
     sleep: SleepState
 
 
-class PhysicsBackend:
-    """Every creature's physics: batches of shared models, stepped on a thread pool."""
+class PhysicsBackend(Membership):
+    """Every creature's physics: batches of shared models, stepped on a thread pool;
+    creatures join and leave it while it runs (`Membership`: `add_creature`,
+    `remove_creature`)."""
 
     def __init__(self, world: PhysicsHost, threads: int | None = None):
         route_mujoco_messages()
@@ -93,15 +96,9 @@ class PhysicsBackend:
             np.array([c.row for _, (c, _) in creatures], dtype=np.int64),
         )
         self.batches = roster.batches
-        reduced_dt = world.settings.dt / reduced_substeps(world.settings.substeps)
         for indices in by_key.values():
-            creature = creatures[indices[0]][1][0]
-            model = build_spec(world, creature).compile()
-
-            def compile_reduced(creature: Creature = creature) -> mujoco.MjModel:
-                return build_spec(world, creature, timestep=reduced_dt).compile()
-
-            batch = Batch(len(self.batches), model, [layouts[i] for i in indices], compile_reduced)
+            model, reduced = compile_models(world, creatures[indices[0]][1][0])
+            batch = Batch(len(self.batches), model, [layouts[i] for i in indices], reduced)
             roster.add(batch, indices)
             batch.prepare(FULL, self.threads)  # every thread's scratch, before threads run
             for row, i in enumerate(indices):
@@ -140,80 +137,18 @@ class PhysicsBackend:
         self.group_of_creature_row = np.full(creature_rows, -1, dtype=np.int64)
         self.group_of_creature_row[roster.creature_row] = np.arange(len(roster))
 
-    # -- creatures that come and go (`ecs_tentacles.spawning`) ------------------------
-    def add_creature(self, world: PhysicsHost, entity: int) -> int:
-        """Give the just-built creature `entity` its physics, at its built pose: a row in
-        the batch of its morphology (a model is compiled only for a new morphology).
-        Nothing of any other creature changes. Returns its roster index."""
-        creature, transform = world.component(entity, Creature), world.component(entity, Transform)
-        layout = model_layout(world, creature, transform)
-        roster = self.roster
-        index = len(roster)
-        batch = next((b for b in self.batches if b.key == layout.key), None)
-        if batch is None:
-            reduced_dt = world.settings.dt / reduced_substeps(world.settings.substeps)
-
-            def compile_reduced(creature: Creature = creature) -> mujoco.MjModel:
-                return build_spec(world, creature, timestep=reduced_dt).compile()
-
-            model = build_spec(world, creature).compile()
-            batch = Batch(len(self.batches), model, [layout], compile_reduced)
-            batch.members[:] = index
-            self.batches.append(batch)
-            self.compiles += 1
-            row = 0
-        else:
-            row = batch.append(layout, index)
-        batch.prepare(FULL, self.threads)
-        batch.place(row, np.array(transform.pos), np.array(transform.quat))
-        batch.part(S.mjSTATE_TIME, row)[:] = self.time
-        roster.append(entity, creature.row, batch, row)
-        self.proxies.append(batch, row)
-        self.health.grow(batch.index, batch.state[row], world.transforms.pos[batch.body_rows[row]],
-                         self.proxies)  # fmt: skip
-        self.sleep.grow(batch.index, 2 * batch.model.nu)
-        self.lod.grow()
-        self._index_groups(len(world.creatures))
-        return index
-
-    def remove_creature(
-        self, world: PhysicsHost, entity: int, moved: dict[str, np.ndarray]
-    ) -> None:
-        """Take creature `entity` out (its stores' rows are already removed; `moved`:
-        every old row's new row by store name, as `ArrayStore.remove` answered). Its
-        batch keeps its model for the next creature of that shape."""
-        roster = self.roster
-        index = self.lod.index(entity)
-        batch, row = roster.locate(index)
-        roster.remove(index)
-        for each in self.batches:
-            each.renumber(moved)
-        if "creatures" in moved:
-            roster.creature_row = moved["creatures"][roster.creature_row]
-        rows = len(world.transforms)
-        if "transforms" in moved:
-            self.proxies.remove(index, moved["transforms"])
-        else:
-            self.proxies.reindex()
-        kept = moved["transforms"] >= 0 if "transforms" in moved else np.ones(rows, dtype=bool)
-        self.health.remove(index, batch.index, row, kept, self.proxies)
-        self.sleep.remove(index, batch.index, row)
-        self.lod.remove(index)
-        self._index_groups(len(world.creatures))
-
     def rebuild_models(self, world: PhysicsHost) -> None:
         """Compile every morphology's model again (the static ground changed: terrain
         edits), keeping every creature's state: no creature moves, nothing is rebuilt but
-        the models and the stepping threads' copies of them."""
-        reduced_dt = world.settings.dt / reduced_substeps(world.settings.substeps)
+        the models and the stepping threads' copies of them. A batch whose creatures were
+        all despawned is retired (no creature of it is left to build it from): the next
+        creature of its shape gets a new one."""
         for batch in self.batches:
+            if not len(batch):
+                batch.key = None
+                continue
             entity = int(self.creature_entity[batch.members[0]])
-            creature = world.component(entity, Creature)
-
-            def compile_reduced(creature: Creature = creature) -> mujoco.MjModel:
-                return build_spec(world, creature, timestep=reduced_dt).compile()
-
-            batch.swap_model(build_spec(world, creature).compile(), compile_reduced)
+            batch.swap_model(*compile_models(world, world.component(entity, Creature)))
             batch.prepare(FULL, self.threads)
 
     def __len__(self) -> int:
@@ -461,34 +396,6 @@ class PhysicsBackend:
             f"<physics: {len(self)} creatures, {self.compiles} compiled models,"
             f" {self.threads} threads>"
         )
-
-
-class CreatureViews(Sequence[CreatureView]):
-    """`physics.groups`: each creature's `CreatureView`, by roster index, made when asked
-    (a spawn or despawn into a big crowd makes none)."""
-
-    def __init__(self, roster: Roster):
-        self._roster = roster
-        self._made: dict[int, CreatureView] = {}
-
-    def __len__(self) -> int:
-        return len(self._roster)
-
-    @overload
-    def __getitem__(self, index: int) -> CreatureView: ...
-    @overload
-    def __getitem__(self, index: slice) -> list[CreatureView]: ...
-    def __getitem__(self, index: int | slice) -> CreatureView | list[CreatureView]:
-        if isinstance(index, slice):
-            return [self[i] for i in range(len(self))[index]]
-        count = len(self)
-        if not -count <= index < count:
-            raise IndexError(f"creature {index}: the physics has {count}")
-        index %= count
-        view = self._made.get(index)
-        if view is None:
-            view = self._made[index] = CreatureView(self._roster, index)
-        return view
 
 
 def _split(steps: int, rounds: int) -> list[int]:

@@ -106,7 +106,7 @@ class Batch:
         self.proxy_mocap = m.body_mocapid[_ids(m, obj.mjOBJ_BODY, proxies)]
         self.proxy_cylinder = m.geom_type[self.proxy_geoms] == mujoco.mjtGeom.mjGEOM_CYLINDER
         self.root_qpos = int(m.jnt_qposadr[m.joint("root").id])
-        self.key = first.key  # the morphology (`ModelLayout.key`)
+        self.key: tuple | None = first.key  # the morphology (None: retired, `rebuild_models`)
         self._order = order
         # store rows, one row of each per creature
         (self.body_rows, self.actuator_motor_rows, self.actuator_target_index,

@@ -13,7 +13,8 @@ back to zero). Nothing here runs per frame: the backend steps whole arrays.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, overload
 
 import mujoco
 import numpy as np
@@ -185,3 +186,31 @@ class CreatureView:
         state = "frozen" if self.frozen else "asleep" if self.sleeping else "active"
         bodies = len(self.body_ids)
         return f"<creature {self.index} physics: {bodies} bodies, {self.model.nv} dofs, {state}>"
+
+
+class CreatureViews(Sequence[CreatureView]):
+    """`physics.groups`: each creature's `CreatureView`, by roster index, made when asked
+    (a spawn or despawn into a big crowd makes none)."""
+
+    def __init__(self, roster: Roster):
+        self._roster = roster
+        self._made: dict[int, CreatureView] = {}
+
+    def __len__(self) -> int:
+        return len(self._roster)
+
+    @overload
+    def __getitem__(self, index: int) -> CreatureView: ...
+    @overload
+    def __getitem__(self, index: slice) -> list[CreatureView]: ...
+    def __getitem__(self, index: int | slice) -> CreatureView | list[CreatureView]:
+        if isinstance(index, slice):
+            return [self[i] for i in range(len(self))[index]]
+        count = len(self)
+        if not -count <= index < count:
+            raise IndexError(f"creature {index}: the physics has {count}")
+        index %= count
+        view = self._made.get(index)
+        if view is None:
+            view = self._made[index] = CreatureView(self._roster, index)
+        return view

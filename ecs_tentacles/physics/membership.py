@@ -1,0 +1,116 @@
+"""Creatures joining and leaving a running physics (`World.spawn` / `despawn`).
+
+`add_creature` gives a just-built creature a row in the batch of its morphology
+(compiling a model only for a new morphology) and a place in every per-creature table
+(roster, contact proxies, health, sleep, level of detail); `remove_creature` takes one
+out after its store rows were removed, renumbering the store rows the batches hold.
+Nothing of any other creature changes: each is its own row of state. `Membership` is
+part of `PhysicsBackend` (its parts are declared here for the type checker).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import TYPE_CHECKING
+
+import mujoco
+import numpy as np
+
+from ecs_tentacles.components import Creature, Transform
+from ecs_tentacles.physics.batch import Batch
+from ecs_tentacles.physics.model import build_spec, model_layout
+from ecs_tentacles.physics.tiers import FULL, reduced_substeps
+
+if TYPE_CHECKING:
+    from ecs_tentacles.physics.health import HealthCheck
+    from ecs_tentacles.physics.host import PhysicsHost
+    from ecs_tentacles.physics.lod import LevelOfDetail
+    from ecs_tentacles.physics.proxies import ContactProxies
+    from ecs_tentacles.physics.roster import Roster
+    from ecs_tentacles.physics.sleep import Sleep
+
+S = mujoco.mjtState
+
+
+def compile_models(
+    world: PhysicsHost, creature: Creature
+) -> tuple[mujoco.MjModel, Callable[[], mujoco.MjModel]]:
+    """The compiled model of `creature`'s morphology, and how to compile its reduced one
+    (the REDUCED level of detail: fewer, longer substeps) when first needed."""
+    reduced_dt = world.settings.dt / reduced_substeps(world.settings.substeps)
+
+    def reduced() -> mujoco.MjModel:
+        return build_spec(world, creature, timestep=reduced_dt).compile()
+
+    return build_spec(world, creature).compile(), reduced
+
+
+class Membership:
+    """Adding and removing creatures (module docstring)."""
+
+    roster: Roster
+    batches: list[Batch]
+    threads: int
+    time: float
+    compiles: int
+    proxies: ContactProxies
+    health: HealthCheck
+    sleep: Sleep
+    lod: LevelOfDetail
+
+    def _index_groups(self, creature_rows: int) -> None: ...
+
+    def add_creature(self, world: PhysicsHost, entity: int) -> int:
+        """Give the just-built creature `entity` its physics, at its built pose: a row in
+        the batch of its morphology (a model is compiled only for a new morphology).
+        Nothing of any other creature changes. Returns its roster index."""
+        creature, transform = world.component(entity, Creature), world.component(entity, Transform)
+        layout = model_layout(world, creature, transform)
+        roster = self.roster
+        index = len(roster)
+        batch = next((b for b in self.batches if b.key == layout.key), None)
+        if batch is None:
+            model, reduced = compile_models(world, creature)
+            batch = Batch(len(self.batches), model, [layout], reduced)
+            batch.members[:] = index
+            self.batches.append(batch)
+            self.compiles += 1
+            row = 0
+        else:
+            row = batch.append(layout, index)
+        batch.prepare(FULL, self.threads)
+        batch.place(row, np.array(transform.pos), np.array(transform.quat))
+        batch.part(S.mjSTATE_TIME, row)[:] = self.time
+        roster.append(entity, creature.row, batch, row)
+        self.proxies.append(batch, row)
+        poses = world.transforms.pos[batch.body_rows[row]]
+        self.health.grow(batch.index, batch.state[row], poses, self.proxies)
+        self.sleep.grow(batch.index, 2 * batch.model.nu)
+        self.lod.grow()
+        self._index_groups(len(world.creatures))
+        return index
+
+    def remove_creature(
+        self, world: PhysicsHost, entity: int, moved: dict[str, np.ndarray]
+    ) -> None:
+        """Take creature `entity` out (its stores' rows are already removed; `moved`:
+        every old row's new row by store name, as `ArrayStore.remove` answered). Its
+        batch keeps its model for the next creature of that shape."""
+        roster = self.roster
+        index = self.lod.index(entity)
+        batch, row = roster.locate(index)
+        roster.remove(index)
+        for each in self.batches:
+            each.renumber(moved)
+        if "creatures" in moved:
+            roster.creature_row = moved["creatures"][roster.creature_row]
+        rows = len(world.transforms)
+        if "transforms" in moved:
+            self.proxies.remove(index, moved["transforms"])
+        else:
+            self.proxies.reindex()
+        kept = moved["transforms"] >= 0 if "transforms" in moved else np.ones(rows, dtype=bool)
+        self.health.remove(index, batch.index, row, kept, self.proxies)
+        self.sleep.remove(index, batch.index, row)
+        self.lod.remove(index)
+        self._index_groups(len(world.creatures))
