@@ -20,13 +20,12 @@ from __future__ import annotations
 
 import colorsys
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from pyglet import gl
 
-from ecs_tentacles.components import Creature, Link, Tentacle, Transform
+from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.drawing import CIRCLE, RenderView
 from ecs_tentacles.ground import ground_of
 from ecs_tentacles.ground_mesh import COLOURS, ground_meshes
@@ -42,6 +41,7 @@ from ecs_tentacles.render.gpu import (
     program,
     set_matrix,
 )
+from ecs_tentacles.render.instances import CreatureStatic, creature_links, link_instances
 from ecs_tentacles.render.meshes import CAPSULE_LODS, CYLINDER_LOD, SPHERE_LOD, Mesh
 from ecs_tentacles.render.skinned import SkinnedCreatures
 from ecs_tentacles.roster_change import RosterChange
@@ -52,17 +52,6 @@ LIGHT = np.array([0.35, -0.45, 0.82]) / np.linalg.norm([0.35, -0.45, 0.82])
 LOD_DISTANCE = 6.0  # metres from the eye beyond which links use the lean mesh
 SHADOW_EVERY = 3  # a blob under every third link (each wider), and under every mantle
 VIEWS = ("skinned", "capsules")
-
-
-@dataclass(frozen=True)
-class CreatureStatic:
-    """One creature's links for the instance tables: Transform rows relative to its
-    mantle's, (radius, length), index along the tentacle and the tentacle's link count."""
-
-    rows: np.ndarray
-    sizes: np.ndarray
-    index: np.ndarray
-    chain: np.ndarray
 
 
 def creature_colours(count: int) -> np.ndarray:
@@ -163,31 +152,6 @@ class Renderer:
         return self._mantle_rows
 
     # -- static per-instance data ------------------------------------------------------
-    def _creature_static(self, entity: int, creature: Creature, mantle_row: int) -> CreatureStatic:
-        """One creature's link table, its rows relative to its mantle's (kept: a creature's
-        body rows stay together and in order whatever is removed around them)."""
-        cached = self._static.get(entity)
-        if cached is not None:
-            return cached
-        world = self.world
-        rows, sizes, index, length = [], [], [], []
-        for tentacle_entity in creature.tentacles:
-            tentacle = world.component(tentacle_entity, Tentacle)
-            for link_entity in tentacle.links:
-                link = world.component(link_entity, Link)
-                rows.append(world.component(link_entity, Transform).row - mantle_row)
-                sizes.append((link.radius, link.length))
-                index.append(link.index)
-                length.append(len(tentacle.links))
-        made = CreatureStatic(
-            np.array(rows, dtype=np.int64),
-            np.array(sizes, dtype=np.float64).reshape(-1, 2),
-            np.array(index, dtype=np.int64),
-            np.array(length, dtype=np.int64),
-        )
-        self._static[entity] = made
-        return made
-
     def _build_static(self) -> None:
         world = self.world
         creatures = sorted(world.query(Creature, Transform))
@@ -205,29 +169,14 @@ class Renderer:
             mantle[i, 7:11] = (r, r, h / 2, 0.0)
             mantle[i, 11:15] = (*colours[i], 1.0)
         self.mantle_instances = mantle
-        tables = [
-            self._creature_static(e, c, int(row))
-            for (e, (c, _)), row in zip(creatures, self._mantle_rows, strict=True)
-        ]
-        counts = np.array([len(t.rows) for t in tables], dtype=np.int64)
-        link_creature = np.repeat(np.arange(len(tables)), counts)
-        if len(link_creature):
-            rel = np.concatenate([t.rows for t in tables])
-            sizes = np.concatenate([t.sizes for t in tables])
-            index = np.concatenate([t.index for t in tables])
-            chain = np.concatenate([t.chain for t in tables])
-        else:
-            rel, sizes = np.zeros(0, np.int64), np.zeros((0, 2))
-            index, chain = np.zeros(0, np.int64), np.ones(0, np.int64)
-        self.link_rows = rel + self._mantle_rows[link_creature]
-        self.link_instances = np.zeros((len(self.link_rows), INSTANCE_FLOATS), np.float32)
-        shade = 1.0 - 0.35 * index / np.maximum(chain - 1, 1)
-        tint = np.clip(colours[link_creature] * shade[:, None] + 0.08 * (1 - shade[:, None]), 0, 1)
-        radius = sizes[:, 0]
-        self.link_instances[:, 7:10] = radius[:, None]
-        self.link_instances[:, 10] = sizes[:, 1] / 2
-        self.link_instances[:, 11:14] = tint
-        self.link_instances[:, 14] = 1.0
+        tables = []
+        for (entity, (creature, _)), row in zip(creatures, self._mantle_rows, strict=True):
+            if entity not in self._static:  # kept: a creature's rows stay together
+                self._static[entity] = creature_links(world, creature, int(row))
+            tables.append(self._static[entity])
+        links = link_instances(tables, self._mantle_rows, colours)
+        self.link_rows, self.link_instances = links.rows, links.instances
+        link_creature, index = links.creature, links.index
         self._build_ground()
         self.skinned.build(world, self._entities, self.creature_colour)
         meshed = set(self.skinned.creatures)
