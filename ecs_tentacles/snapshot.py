@@ -25,6 +25,8 @@ from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
+from ecs_tentacles.components import Creature
+
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
     from ecs_tentacles.physics.backend import PhysicsState
@@ -73,8 +75,6 @@ def take(world: Restorable) -> Snapshot:
 
 
 def _creatures(world: Restorable) -> list[tuple[int, Any]]:
-    from ecs_tentacles.components import Creature
-
     return sorted(world.query(Creature))
 
 

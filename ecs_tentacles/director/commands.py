@@ -115,7 +115,6 @@ class ThreatDropped:
     label: str
     name: str
     position: list[float]
-    entity: int = -1
 
     def undo(self, world: Host) -> None:
         threats = world.resource(ThreatData)
@@ -124,4 +123,4 @@ class ThreatDropped:
                 threats.remove(world, entity)
 
     def redo(self, world: Host) -> None:
-        self.entity = world.resource(ThreatData).drop(world, self.position, self.name)
+        world.resource(ThreatData).drop(world, self.position, self.name)

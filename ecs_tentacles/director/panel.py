@@ -188,7 +188,7 @@ class DirectorPanel(Panel):
             point = [float(v) for v in ground]
             entity = world.resource(ThreatData).drop(world, point, preset.entry["threat"])
             name = world.resource(ThreatData).entities(world)[entity]
-            self._push(ThreatDropped(f"drop {name}", name, point, entity))
+            self._push(ThreatDropped(f"drop {name}", name, point))
             self.message = f"dropped {name}"
             return entity
         try:

@@ -76,18 +76,11 @@ def _clear_of_creatures(world: Host, points: np.ndarray, reach: float) -> np.nda
     if not len(physics):
         return np.ones(len(points), dtype=bool)
     _, _, centres, reaches = physics.proxies.sense(world.transforms)
-    middle, spread = (
-        points.mean(axis=0),
-        float(np.linalg.norm(points - points.mean(axis=0), axis=1).max()),
-    )
+    middle = points.mean(axis=0)
+    spread = float(np.linalg.norm(points - middle, axis=1).max())
     near = np.linalg.norm(centres[:, :2] - middle, axis=1) < spread + reaches + reach + GAP
     gap = np.linalg.norm(points[:, None, :] - centres[None, near, :2], axis=2)
-    return bool_all(gap >= reaches[None, near] + reach + GAP)
-
-
-def bool_all(matrix: np.ndarray) -> np.ndarray:
-    """Row-wise `all` of a (n, m) bool matrix (True for m = 0)."""
-    return np.asarray(matrix.all(axis=1), dtype=bool)
+    return np.asarray((gap >= reaches[None, near] + reach + GAP).all(axis=1))
 
 
 def _clear_of_obstacles(world: Host, points: np.ndarray, reach: float) -> np.ndarray:
