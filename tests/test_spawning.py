@@ -139,6 +139,17 @@ def test_a_bad_creature_entry_names_the_field_in_one_line():
         assert len(world.physics) == 3
 
 
+@pytest.mark.parametrize("bad", [float("nan"), float("inf"), -float("inf")])
+def test_a_position_or_heading_that_is_not_finite_is_refused(bad: float):
+    """NaN passes every numeric bound; spawned, it froze the creature after three blow-ups."""
+    with World.from_scene(_scene(APART)) as world:
+        with pytest.raises(SpawnError, match=r"^creature.position\[0\]: must be a finite number"):
+            world.spawn(_creature("d", 20.0), position=(bad, 0.0))
+        with pytest.raises(SpawnError, match=r"^creature.heading_deg: must be a finite number"):
+            world.spawn(_creature("d", 20.0), heading_deg=bad)
+        assert len(world.physics) == 3
+
+
 def test_a_taken_name_gets_a_suffix():
     with World.from_scene(_scene(APART)) as world:
         first = world.spawn(_creature("a", 20.0))

@@ -2,6 +2,8 @@
 scene needs it.
 
 * `integer` means written as an integer (`8`, not `8.0`);
+* `number` means a finite number: a scene given as Python data (`World.from_scene(dict)`,
+  `World.spawn`) can hold `nan` or `inf`, which pass every numeric bound;
 * `pattern` reads `$` as the end of the text, as JSON Schema (ECMA 262) does; Python's
   `$` also matches before a trailing newline (`"octo\\n"` passed as a name).
 
@@ -11,6 +13,7 @@ scene needs it.
 from __future__ import annotations
 
 import functools
+import math
 import re
 from collections.abc import Iterator
 from typing import Any
@@ -21,6 +24,13 @@ from jsonschema import Draft202012Validator, ValidationError, validators
 def _is_integer(checker: object, value: object) -> bool:
     """JSON Schema calls 8.0 an integer; a scene's counts and seeds must be written 8."""
     return isinstance(value, int) and not isinstance(value, bool)
+
+
+def _is_number(checker: object, value: object) -> bool:
+    """A finite number: NaN compares false with every bound, so a range cannot refuse it."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return False
+    return isinstance(value, int) or math.isfinite(value)
 
 
 @functools.lru_cache(maxsize=256)
@@ -54,7 +64,9 @@ def _pattern(validator: Any, pattern: str, instance: object, schema: object) -> 
 StrictValidator = validators.extend(
     Draft202012Validator,
     validators={"pattern": _pattern},
-    type_checker=Draft202012Validator.TYPE_CHECKER.redefine("integer", _is_integer),
+    type_checker=Draft202012Validator.TYPE_CHECKER.redefine_many(
+        {"integer": _is_integer, "number": _is_number}
+    ),
 )
 
 

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import copy
 import json
+import math
 import re
 from collections.abc import Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any
@@ -101,6 +102,8 @@ def _describe(error: ValidationError) -> list[Problem]:
     expected: Any = error.validator_value
     kind = error.validator
     got = f"got {_show(value)}"
+    if kind == "type" and isinstance(value, float) and not math.isfinite(value):
+        return [(path, f"must be a finite number, {got}")]
     if kind == "type":
         names = [expected] if isinstance(expected, str) else list(expected)
         return [(path, f"must be {' or '.join(_TYPE_NAMES.get(t, t) for t in names)}, {got}")]

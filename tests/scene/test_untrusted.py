@@ -143,3 +143,18 @@ def test_integers_written_as_floats_are_refused_with_their_path(
         scene["creatures"][0].update(change)
     got = "8.0" if "8.0" in repr(change) else ("1.0" if "1.0" in repr(change) else "7.0")
     assert validate_scene(scene) == [f"{where}: must be an integer, got {got}"]
+
+
+@pytest.mark.parametrize("bad", [float("nan"), float("inf")])
+def test_a_scene_given_as_data_with_a_value_that_is_not_finite_is_refused(bad: float) -> None:
+    """A file cannot hold NaN (the loader refuses the literal), but a dict from Python can."""
+    scene = copy.deepcopy(BASE)
+    scene["creatures"][0]["position"] = [0.0, bad]
+    scene["creatures"][0]["tentacles"] = {"strength": bad}
+    shown = "NaN" if bad != bad else "Infinity"
+    assert validate_scene(scene) == [
+        f"creatures[0].position[1]: must be a finite number, got {shown}",
+        f"creatures[0].tentacles.strength: must be a finite number, got {shown}",
+    ]
+    with pytest.raises(SceneError, match="must be a finite number"):
+        World.from_scene(scene)
