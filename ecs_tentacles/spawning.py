@@ -304,9 +304,10 @@ def _owned_rows(world: World, creature: Creature) -> dict[str, np.ndarray]:
             if partner is not None and partner in dead:
                 gone[dead[partner]] = True
             for field in store.fields():
-                if field.refers in dead:
-                    values = getattr(store, field.name)
-                    gone |= np.isin(values, dead[field.refers]) & (values >= 0)
+                if field.refers in dead:  # a gather per row, not a sort (`np.isin`)
+                    going = np.zeros(len(world.stores[field.refers]) + 1, dtype=bool)
+                    going[dead[field.refers]] = True  # (the last entry, for row -1, stays False)
+                    gone |= going[getattr(store, field.name)]
             rows = np.flatnonzero(gone)
             if len(rows) != len(dead.get(name, ())):
                 dead[name], changed = rows, True

@@ -52,6 +52,25 @@ class Field:
         store._arrays[self.name][: store.count] = value
 
 
+def without_rows(
+    array: np.ndarray, new: np.ndarray, removed: np.ndarray | None = None
+) -> np.ndarray:
+    """`array` (a row per old row) without the rows that `new` (old row -> new row, -1
+    removed) drops, the rows after them moved up in place: no new buffer (a despawn in a
+    big crowd moves megabytes). `removed` (the dropped rows, sorted) if known. Returns
+    the view of the rows left; `array` itself is changed."""
+    rows = np.flatnonzero(new < 0) if removed is None else removed
+    if not len(rows):
+        return array
+    first, last, count = int(rows[0]), int(rows[-1]) + 1, len(new)
+    if last - first == len(rows):  # one run (a creature's rows): move the tail up
+        array[first : count - len(rows)] = array[last:count]
+    else:
+        kept = array[:count][new >= 0]
+        array[: len(kept)] = kept
+    return array[: count - len(rows)]
+
+
 class ArrayStore:
     """Rows of numbers for one kind of entity; subclasses declare `Field`s."""
 
@@ -126,20 +145,19 @@ class ArrayStore:
         """Remove `rows`; the rows after them move up. Returns every old row's new row
         (-1: removed), for renumbering what refers to this store (`renumber`)."""
         rows = np.unique(np.asarray(rows, dtype=np.int64))
-        new = np.arange(self.count) - np.searchsorted(rows, np.arange(self.count))
-        new[rows] = -1
+        new = np.arange(self.count)
         if not len(rows):
             return new
-        self._row_of_handle[self._arrays[HANDLE][rows]] = -1
-        first, last, count = int(rows[0]), int(rows[-1]) + 1, self.count
-        if last - first == len(rows):  # one run (a creature's rows): move the tail up
-            for array in self._arrays.values():
-                array[first : count - len(rows)] = array[last:count]
+        first, last = int(rows[0]), int(rows[-1]) + 1
+        if last - first == len(rows):  # one run (a creature's rows)
+            new[last:] -= len(rows)
         else:
-            keep = new >= 0
-            for array in self._arrays.values():
-                kept = array[:count][keep]
-                array[: len(kept)] = kept
+            new -= np.searchsorted(rows, new)
+        new[rows] = -1
+        self._row_of_handle[self._arrays[HANDLE][rows]] = -1
+        count = self.count
+        for array in self._arrays.values():
+            without_rows(array[:count], new, rows)
         self.count = count - len(rows)
         self._row_of_handle[self._arrays[HANDLE][: self.count]] = np.arange(self.count)
         return new
@@ -158,10 +176,13 @@ class ArrayStore:
 
     def renumber(self, store: str, new: np.ndarray) -> None:
         """Rows of `store` moved (`remove`'s answer): every field that refers to it follows."""
-        for field in self.referring().get(store, ()):
+        fields = self.referring().get(store, ())
+        if not fields:
+            return
+        to = np.append(new, -1)  # row -1 (none) stays -1
+        for field in fields:
             values = self._arrays[field.name][: self.count]
-            valid = values >= 0
-            values[valid] = new[values[valid]]
+            np.take(to, values, out=values)
 
     def _reserve(self, needed: int) -> None:
         capacity = self.capacity

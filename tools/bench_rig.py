@@ -26,9 +26,9 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
-from ecs_tentacles.systems.fur.rig import BLOCK
 
 from ecs_tentacles.fur import rig as rig_math
+from ecs_tentacles.fur.blocks import BLOCK
 from ecs_tentacles.fur.dynamics import Strands, blend_profile
 from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.fur.synthetic import synthetic_rig

@@ -31,29 +31,33 @@ def cone_angles(shape: np.ndarray) -> np.ndarray:
     return np.asarray(angles.max(axis=1) if chord.shape[1] else np.zeros(len(shape)))
 
 
-def make_bind(fur: FurData) -> tuple[Bind, np.ndarray]:
-    """The rig's bind pose of every guide, and the Transform rows of its bodies."""
+def make_bind(fur: FurData, rows: slice = slice(None)) -> tuple[Bind, np.ndarray]:
+    """The rig's bind pose of the guides `rows` (default every guide), and the Transform
+    rows of their bodies (sorted; `Bind.body` indexes them). Each guide's bind depends
+    on that guide alone, so binding a creature's guides gives what binding all gives."""
     g = fur.guides
-    bodies, body_index = np.unique(g.body_row, return_inverse=True)
-    floor = fur.sets.min_elevation[g.fur_row] + cone_angles(fur.shape)
+    body_row, fur_row = g.body_row[rows], g.fur_row[rows]
+    shape = fur.shape[rows]
+    bodies, body_index = np.unique(body_row, return_inverse=True)
+    floor = fur.sets.min_elevation[fur_row] + cone_angles(shape)
     tan_min = np.tan(np.minimum(floor, MAX_ELEVATION)).astype(F32)
-    normal = normalize(g.normal.T.astype(F32))
-    rest = clamp_to_cap(normalize(g.rest.T.astype(F32)), normal, tan_min)
+    normal = normalize(g.normal[rows].T.astype(F32))
+    rest = clamp_to_cap(normalize(g.rest[rows].T.astype(F32)), normal, tan_min)
     rest_sin = dot(rest, normal)
     along = rest - rest_sin * normal
     upright = dot(along, along) < 1e-12  # a guide standing on its normal: its side decides
-    along[:, upright] = cross(g.side.T.astype(F32)[:, upright], normal[:, upright])
+    along[:, upright] = cross(g.side[rows].T.astype(F32)[:, upright], normal[:, upright])
     along = normalize(along)
-    shape_h = np.ones((len(g), fur.points, 4), dtype=F32)
-    shape_h[..., :3] = fur.shape
+    shape_h = np.ones((len(shape), fur.points, 4), dtype=F32)
+    shape_h[..., :3] = shape
     bind = Bind(
-        root=np.ascontiguousarray(g.root.T, dtype=F32),
+        root=np.ascontiguousarray(g.root[rows].T, dtype=F32),
         basis=np.stack([along, cross(normal, along), normal]),
         rest_cos=np.sqrt(np.maximum(1.0 - rest_sin * rest_sin, 0.0)),
         rest_sin=rest_sin,
         tan_min=tan_min,
-        multiplier=g.multiplier.astype(F32),
-        control=g.control_row.copy(),
+        multiplier=g.multiplier[rows].astype(F32),
+        control=g.control_row[rows].copy(),
         body=body_index.astype(np.int64),
         shape_h=shape_h,
     )

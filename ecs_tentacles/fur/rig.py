@@ -53,6 +53,10 @@ from ecs_tentacles.optional_kernels import OptionalKernels
 F32 = np.float32
 
 
+# the per-guide (n,) arrays of a `Bind`
+PER_GUIDE = ("rest_cos", "rest_sin", "tan_min", "multiplier", "control", "body")
+
+
 @dataclass
 class Bind:
     """The rig's bind pose of n guides (float32, body-local, vectors as (3, n)).
@@ -84,16 +88,16 @@ class Bind:
         # the kernels index without checks: `evaluate` compares these with its tables
         self.controls_needed = int(self.control.max()) + 1 if len(self.control) else 0
         self.bodies_needed = int(self.body.max()) + 1 if len(self.body) else 0
-        bodies = np.unique(self.body)
-        self.one_body: int | None = int(bodies[0]) if len(bodies) == 1 else None
+        lone = len(self.body) and self.body.min() == self.body.max()
+        self.one_body: int | None = int(self.body[0]) if lone else None
 
     def __len__(self) -> int:
         return len(self.control)
 
-    def part(self, rows: slice) -> Bind:
-        """The guides `rows`, as contiguous copies (blocks that stay in cache)."""
-        scalars = ("rest_cos", "rest_sin", "tan_min", "multiplier", "control", "body")
-        parts = {k: np.ascontiguousarray(getattr(self, k)[rows]) for k in scalars}
+    def part(self, rows: slice | np.ndarray) -> Bind:
+        """The guides `rows` (a slice, indices or a mask), as contiguous copies (blocks
+        that stay in cache)."""
+        parts = {k: np.ascontiguousarray(getattr(self, k)[rows]) for k in PER_GUIDE}
         return Bind(
             root=np.ascontiguousarray(self.root[:, rows]),
             basis=np.ascontiguousarray(self.basis[:, :, rows]),

@@ -6,8 +6,9 @@ fur built sets it and guides of later furs with another count are resampled alon
 length.
 
 Anything that changes the bind pose (roots, normals, rest directions, shapes,
-multipliers, control assignment) must bump `FurData.version` so the rig re-binds;
-the `FurGuide` component does that on every write.
+multipliers, control assignment) must call `FurData.touch()` so the rig re-binds;
+the `FurGuide` component does that on every write. (Creatures coming and going bump
+`version` alone: the rig then binds or cuts out just their guides.)
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ecs_tentacles.store import ArrayStore, Field
+from ecs_tentacles.store import ArrayStore, Field, without_rows
 from ecs_tentacles.tracks import Channel
 
 # The rig's behaviours, in order: a fur switches each on or off (`FurSetStore.enabled`),
@@ -124,7 +125,8 @@ class FurData:
         self._curves = np.zeros((0, 0, 3), dtype=np.float32)
         self._frames = np.zeros((0, 4, 3), dtype=np.float32)
         self._added: list[tuple[int, np.ndarray]] = []  # (guides then, shapes) not yet joined
-        self.version = 0
+        self.version = 0  # bumped by any change of the bind pose ...
+        self.touches = 0  # ... and this too when not by a creature coming or going
         self.tracks: list[Channel] = []  # control attributes (columns: COLUMNS)
 
     @property
@@ -175,9 +177,9 @@ class FurData:
         guides = moved.get("fur.guides")
         if guides is not None:
             self._join()
-            keep = guides >= 0
-            self._shape, self._curves = self._shape[keep], self._curves[keep]
-            self._frames = self._frames[keep]
+            self._shape = without_rows(self._shape, guides)
+            self._curves = without_rows(self._curves, guides)
+            self._frames = without_rows(self._frames, guides)
         controls = moved.get("fur.controls")
         if controls is not None:
             self.tracks = [
@@ -191,3 +193,4 @@ class FurData:
     def touch(self) -> None:
         """Mark the bind pose as changed (after writing guide arrays directly)."""
         self.version += 1
+        self.touches += 1

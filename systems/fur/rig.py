@@ -12,7 +12,8 @@ per frame), by numba kernels when numba is installed, else whole-array numpy.
 
 Reads: Transform store (mantle rows), fur ControlStore (position, rest position,
 behaviour values, drives), GuideStore and FurSetStore (bind pose, re-read when
-`world.resource(FurData).version` changes). Writes: ControlStore (tracked attributes),
+`world.resource(FurData).version` changes; when a creature spawns or is despawned only
+its guides are bound or cut out, `ecs_tentacles.fur.blocks`). Writes: ControlStore (tracked attributes),
 FurData's `frames` (axis, up, side, root per guide) and `curves` (polylines).
 """
 
@@ -22,7 +23,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ecs_tentacles.fur.bind import ControlTracks, control_values, make_bind, make_strands
+from ecs_tentacles.fur.bind import ControlTracks, control_values, make_strands
+from ecs_tentacles.fur.blocks import BindBlocks
 from ecs_tentacles.fur.dynamics import Strands
 from ecs_tentacles.fur.rig import Bind, Scratch, control_table, evaluate, use_parallel
 from ecs_tentacles.fur.stores import FurData
@@ -35,7 +37,6 @@ if TYPE_CHECKING:
     from ecs_tentacles.roster_change import RosterChange
 
 
-BLOCK = 16384  # guides per block
 STRAND_BLOCK = 4096  # dynamic guides per block (their arrays are 8x larger)
 
 
@@ -48,12 +49,11 @@ class Rig(System):
 
     def __init__(self) -> None:
         self.version = -1
-        self.bind: Bind | None = None
-        self.bodies = np.zeros(0, dtype=np.int64)
+        self.touches = 0  # the fur's `touches` when bound: an edit since means bind anew
+        # every guide's bind pose, in blocks evaluated one after the other (in cache)
+        self.binds: BindBlocks | None = None
         self.tracks = ControlTracks(TrackSet([]))
         self.strands: Strands | None = None
-        # blocks of guides evaluated one after the other, so temporaries stay in cache
-        self.blocks: list[tuple[slice, Bind]] = []
         self.scratch = Scratch()  # work buffers, shared by the blocks and kept
         self.parallel = False  # numba's kernels on all cores (large furs only)
         self.track_time: float | None = None  # tracks played at this time, not the world's
@@ -62,49 +62,73 @@ class Rig(System):
         self.strand_control = np.zeros(0, dtype=np.int64)  # the strands' controls
         self.strand_body = np.zeros(0, dtype=np.int64)  # the strands' bodies
 
+    @property
+    def bind(self) -> Bind | None:
+        """Every guide's bind pose as one `Bind` (None before the first bind)."""
+        return None if self.binds is None else self.binds.whole
+
     def rebind(self, world: Host) -> None:
         """Re-read the bind pose, tracks and dynamic strands from the fur stores."""
+        self.binds = BindBlocks.of(world.resource(FurData))
+        self._bound(world)
+
+    def _bound(self, world: Host) -> None:
+        """After the blocks changed: tracks, dynamic strands and the version followed."""
         fur = world.resource(FurData)
-        self.bind, self.bodies = make_bind(fur)
-        n = len(self.bind)
-        self.blocks = [
-            (rows, self.bind.part(rows))
-            for rows in (slice(s, min(s + BLOCK, n)) for s in range(0, n, BLOCK))
-        ]
+        assert self.binds is not None
         self.tracks = ControlTracks(TrackSet(fur.tracks))
         gravity = np.asarray(world.settings.gravity, dtype=np.float64)
         self.strands = make_strands(fur, gravity, world.settings.dt)
         if self.strands is not None:  # the strands' skin normals and controls, gathered once
-            guides = self.strands.guides
-            self.strand_normal = np.ascontiguousarray(self.bind.normal[:, guides], np.float32)
-            self.strand_control = self.bind.control[guides]
-            self.strand_body = self.bind.body[guides]
-        self.parallel = use_parallel(n)
-        self.version = fur.version
+            guides, bind = self.strands.guides, self.binds.whole
+            self.strand_normal = np.ascontiguousarray(bind.normal[:, guides], np.float32)
+            self.strand_control = bind.control[guides]
+            self.strand_body = bind.body[guides]
+        self.parallel = use_parallel(len(self.binds))
+        self.version, self.touches = fur.version, fur.touches
 
     def roster_changed(self, world: Host, change: RosterChange) -> None:
-        """A creature came or went: bind again now, every other strand keeping its state
-        (a furred newcomer does not make the others' dynamic fur jump)."""
+        """A creature came or went: its guides are bound or cut out now (the others'
+        bind is kept: `BindBlocks`), every other strand keeping its state (a furred
+        newcomer does not make the others' dynamic fur jump)."""
         old = self.strands
         fur = world.resource(FurData)
-        if self.version < 0 or not len(fur.guides):
-            return  # not bound yet: the first frame binds
-        if self.version == fur.version:  # no fur came or went: its bodies' rows moved
-            moved = change.moved.get("transforms")
-            if moved is not None:
-                self.bodies = moved[self.bodies]
+        binds = self.binds
+        if self.version < 0 or binds is None or not len(fur.guides):
+            self.version, self.binds = -1, None  # not bound (or no fur left): the next frame binds
             return
-        self.rebind(world)
+        moved = change.moved.get("fur.guides")
+        if self.version == fur.version:  # no fur came or went: its bodies' rows moved
+            transforms = change.moved.get("transforms")
+            if transforms is not None:
+                binds.removed(np.arange(len(binds)), None, transforms)
+            return
+        if self.touches != fur.touches:
+            self.rebind(world)  # an edit not yet bound as well: bind everything
+        elif change.spawned:
+            if not binds.added(fur, change.added.get("fur.guides", np.zeros(0, np.int64))):
+                self.rebind(world)
+            else:
+                self._bound(world)
+        else:
+            assert moved is not None
+            binds.removed(moved, change.moved.get("fur.controls"), change.moved.get("transforms"))
+            self._bound(world)
+        self._keep_strands(old, moved)
+
+    def _keep_strands(self, old: Strands | None, moved: np.ndarray | None) -> None:
+        """Strands that were there before a roster change keep their positions and speeds."""
         new = self.strands
         if old is None or new is None or old.pos is None or old.prev is None:
             return
-        moved = change.moved.get("fur.guides")
         now = old.guides if moved is None else moved[old.guides]  # old strands' rows now
-        column = {int(row): i for i, row in enumerate(now.tolist()) if row >= 0}
-        pairs = [(j, column[g]) for j, g in enumerate(new.guides.tolist()) if g in column]
-        if not pairs:
+        out = np.flatnonzero(now >= 0)
+        into = np.searchsorted(new.guides, now[out])  # both sorted: guide rows ascending
+        found = into < len(new.guides)
+        found[found] = new.guides[into[found]] == now[out][found]
+        into, out = into[found], out[found]
+        if not len(into):
             return
-        into, out = (np.array(side) for side in zip(*pairs, strict=True))
         pos, prev, fresh = new._state()
         pos[:, :, into], prev[:, :, into] = old.pos[:, :, out], old.prev[:, :, out]
         if old.fresh is not None:
@@ -114,18 +138,18 @@ class Rig(System):
         fur = world.resource(FurData)
         if not len(fur.guides):
             return
-        if self.version != fur.version:
+        if self.version != fur.version or self.binds is None:
             self.rebind(world)
-        bind = self.bind
-        assert bind is not None
+        binds = self.binds
+        assert binds is not None
         if self.play_tracks:
             time = world.time if self.track_time is None else self.track_time
             self.tracks.apply(fur.controls, time)
         values, dynamic = control_values(fur)
         plan = control_table(values)  # per-control values and skips, once a frame
-        rotation = quat_matrices(world.transforms.quat[self.bodies])
-        position = world.transforms.pos[self.bodies]
-        for rows, part in self.blocks:
+        rotation = quat_matrices(world.transforms.quat[binds.bodies])
+        position = world.transforms.pos[binds.bodies]
+        for rows, part in binds.blocks:
             evaluate(
                 part,
                 plan,
@@ -137,13 +161,12 @@ class Rig(System):
                 self.parallel,
             )
         if self.strands is not None:
-            self._dynamics(fur.frames, fur.curves, bind, rotation, dynamic)
+            self._dynamics(fur.frames, fur.curves, rotation, dynamic)
 
     def _dynamics(
         self,
         frames: np.ndarray,
         curves: np.ndarray,
-        bind: Bind,
         rotation: np.ndarray,
         dynamic: np.ndarray,
     ) -> None:

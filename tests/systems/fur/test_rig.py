@@ -11,6 +11,7 @@ from ecs_tentacles.systems.fur import rig as rig_module
 from numpy.testing import assert_allclose
 
 from ecs_tentacles.fur import FurControl, FurGuide
+from ecs_tentacles.fur import blocks as blocks_module
 from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.mathutil import quat_rotate
 from ecs_tentacles.world import World
@@ -131,7 +132,7 @@ def test_blocks_give_the_same_result_as_one_pass(
     }
     results = []
     for block, strands in [(10_000, 10_000), (16, 7)]:
-        monkeypatch.setattr(rig_module, "BLOCK", block)
+        monkeypatch.setattr(blocks_module, "BLOCK", block)
         monkeypatch.setattr(rig_module, "STRAND_BLOCK", strands)
         world = make_world(scene, plugins=NO_LOCOMOTION)
         world.resource(FurData).controls.lift[:] = 0.4
