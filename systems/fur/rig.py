@@ -13,8 +13,9 @@ per frame), by numba kernels when numba is installed, else whole-array numpy.
 Reads: Transform store (mantle rows), fur ControlStore (position, rest position,
 behaviour values, drives), GuideStore and FurSetStore (bind pose, re-read when
 `world.resource(FurData).version` changes; when a creature spawns or is despawned only
-its guides are bound or cut out, `ecs_tentacles.fur.blocks`). Writes: ControlStore (tracked attributes),
-FurData's `frames` (axis, up, side, root per guide) and `curves` (polylines).
+its guides are bound or cut out, `ecs_tentacles.fur.blocks`). Writes: ControlStore
+(tracked attributes), FurData's `frames` (axis, up, side, root per guide) and `curves`
+(polylines).
 """
 
 from __future__ import annotations
