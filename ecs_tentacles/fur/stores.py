@@ -121,7 +121,8 @@ class FurData:
         self.sets = FurSetStore()
         self.emotions = EmotionStore()
         self.points = 0  # points per guide; set by the first fur built
-        self._shape = np.zeros((0, 0, 3))
+        self._rows = 0  # guides whose shapes are joined: the buffers' live rows
+        self._shape = np.zeros((0, 0, 3))  # buffers with room to grow (doubling)
         self._curves = np.zeros((0, 0, 3), dtype=np.float32)
         self._frames = np.zeros((0, 4, 3), dtype=np.float32)
         self._added: list[tuple[int, np.ndarray]] = []  # (guides then, shapes) not yet joined
@@ -133,23 +134,24 @@ class FurData:
     def shape(self) -> np.ndarray:
         """Per guide: its points in its rest frame (axis, up, side); (n_guides, points, 3)."""
         self._join()
-        return self._shape
+        return self._shape[: self._rows]
 
     @property
     def curves(self) -> np.ndarray:
         self._join()
-        return self._curves
+        return self._curves[: self._rows]
 
     @property
     def frames(self) -> np.ndarray:
         self._join()
-        return self._frames
+        return self._frames[: self._rows]
 
     def add_shapes(self, shapes: np.ndarray) -> None:
         """Append rest shapes (k, points, 3) for guides just added; grow the buffers.
 
-        The arrays are joined (and the output buffers made anew, zeroed) when next read,
-        so a crowd whose creatures each add a few guides copies them once, not once each.
+        The shapes are joined when next read (the new guides' outputs zeroed), so a
+        crowd whose creatures each add a few guides is joined once; the buffers grow by
+        doubling, so a creature spawned into a big furred crowd copies no one else's.
         """
         self._added.append((len(self.guides), shapes))
         self.version += 1
@@ -157,18 +159,34 @@ class FurData:
     def _join(self) -> None:
         if not self._added:
             return
-        parts, rows = [self._shape], len(self._shape)
         for n, shapes in self._added:
             keep = n - len(shapes)  # the guides before these (all of them, when built in turn)
-            if keep != rows or len(parts) == 1:
-                joined = np.concatenate(parts) if len(parts) > 1 else parts[0]
-                parts = [joined[:keep].reshape(keep, self.points, 3)]
-            parts.append(shapes)
-            rows = n
+            if keep > self._rows:
+                raise ValueError(f"fur shapes for guides {keep}..{n}, but only {self._rows} known")
+            self._rows = keep
+            self._reserve(n)
+            self._shape[keep:n] = shapes
+            self._curves[keep:n] = 0.0
+            self._frames[keep:n] = 0.0
+            self._rows = n
         self._added.clear()
-        self._shape = np.concatenate(parts)
-        self._curves = np.zeros((rows, self.points, 3), dtype=np.float32)
-        self._frames = np.zeros((rows, 4, 3), dtype=np.float32)
+
+    def _reserve(self, rows: int) -> None:
+        """Room for `rows` guides of `points` points in the buffers (the live rows kept)."""
+        room = len(self._shape)
+        if rows <= room and self._shape.shape[1] == self.points:
+            return
+        room = rows if not self._rows else max(rows, 2 * room)
+        live = self._rows
+        for name, dtype, tail in (
+            ("_shape", np.float64, (self.points, 3)),
+            ("_curves", np.float32, (self.points, 3)),
+            ("_frames", np.float32, (4, 3)),
+        ):
+            grown = np.zeros((room, *tail), dtype=dtype)
+            if live:
+                grown[:live] = getattr(self, name)[:live]
+            setattr(self, name, grown)
 
     def drop(self, moved: dict[str, np.ndarray]) -> None:
         """A despawn took rows out of the stores (`moved`: old row -> new row, -1
@@ -177,9 +195,10 @@ class FurData:
         guides = moved.get("fur.guides")
         if guides is not None:
             self._join()
-            self._shape = without_rows(self._shape, guides)
-            self._curves = without_rows(self._curves, guides)
-            self._frames = without_rows(self._frames, guides)
+            rows = self._rows
+            for buffer in (self._shape, self._curves, self._frames):
+                without_rows(buffer[:rows], guides)  # in place: the buffers keep their room
+            self._rows = rows - int(np.count_nonzero(guides < 0))
         controls = moved.get("fur.controls")
         if controls is not None:
             self.tracks = [

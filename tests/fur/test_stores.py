@@ -45,9 +45,12 @@ def test_rest_shapes_added_creature_by_creature_are_joined_in_order() -> None:
         fur.add_shapes(batch)
     np.testing.assert_array_equal(fur.shape, np.concatenate(batches))
     assert fur.curves.shape == (9, 4, 3) and fur.frames.shape == (9, 4, 3)
-    fur.curves[0] = 1.0  # the rig's output stays until more guides are added
+    fur.curves[0] = 1.0  # the rig's output stays, also when more guides are added
     assert fur.curves[0, 0, 0] == 1.0
-    fur.guides.add(2)
-    fur.add_shapes(np.full((2, 4, 3), 7.0))
-    assert fur.shape.shape == (11, 4, 3) and fur.shape[-1, 0, 0] == 7.0
-    assert not fur.curves.any()  # made anew for the new guide count, as before
+    for more in range(2, 40):  # the buffers grow by doubling: earlier rows are kept
+        fur.guides.add(more)
+        fur.add_shapes(np.full((more, 4, 3), float(more)))
+        assert fur.shape.shape == (len(fur.guides), 4, 3) and fur.shape[-1, 0, 0] == more
+        assert fur.curves.shape == (len(fur.guides), 4, 3)
+        assert fur.curves[0, 0, 0] == 1.0 and not fur.curves[1:].any()  # the new ones zeroed
+    np.testing.assert_array_equal(fur.shape[:9], np.concatenate(batches))
