@@ -201,7 +201,7 @@ class Navigator:
 
     def roster_changed(self, change: RosterChange) -> None:
         """A creature came (no route yet) or went (its route dropped, rows renumbered)."""
-        if not len(self.best) and not self.routes:
+        if self._ground is None:
             return  # not started: `_start` sizes everything from the world
         moved = change.moved.get("creatures")
         if moved is not None:

@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 import pytest
 
+from ecs_tentacles.components import Creature
 from ecs_tentacles.drawing import RenderView
 from ecs_tentacles.ground import Ground, Solid, ground_of
 from ecs_tentacles.locomotion.navigation import STUCK_SECONDS, CostGrid, Navigator
@@ -97,3 +98,16 @@ def test_a_creature_stuck_on_its_way_is_planned_again(make_world: Callable[..., 
         world.step()
     assert navigator.plans == 2  # once, not every frame
     world.physics.frozen[:] = False
+
+
+def test_a_creature_spawned_after_the_last_one_left_is_routed(
+    make_world: Callable[..., World],
+) -> None:
+    world = make_world(behind_the_wall(True))
+    world.step()
+    world.despawn(world.creature("o"))  # the world is empty, its navigation started
+    world.step()
+    entity = world.spawn({"name": "p", "goals": [{"position": [0, 1.6]}]}, position=(0, -1.6))
+    world.step(2)
+    route = world.resource(Navigator).waypoints(world.component(entity, Creature).row)
+    assert len(route) and (route[:, 0] > 0.8).all()  # around the wall's end, as the first
