@@ -4,7 +4,8 @@ The sandbox turns it on (`plugin_registry.SANDBOX_ON`); scenes and bakes never s
 Resource: `Director` (the creature held by the mouse, the scatter brush). System: grab
 (stage act; `systems/director/grab.py`). Sandbox hooks: the "Director" HUD section
 with the palette and the mouse and keys (`director.panel`); lines for the grab's
-spring and the brush. Hook `wants_motion`: a held creature never sleeps.
+spring and the brush. Hook `wants_motion`: a held creature never sleeps; `despawning`:
+removing the held creature ends the grab.
 """
 
 from __future__ import annotations
@@ -43,6 +44,12 @@ class DirectorPlugin(Plugin):
         from ecs_tentacles.director.panel import DirectorPanel
 
         return [DirectorPanel(sandbox)]
+
+    def despawning(self, world: Host, creature: int) -> None:
+        """A held creature removed (Delete while dragging, undo, F9): the grab ends."""
+        director = world.resource(Director)
+        if director.grab is not None and director.grab.creature == creature:
+            director.grab = None
 
     def wants_motion(self, world: Host) -> np.ndarray | None:
         grab = world.resource(Director).grab

@@ -136,6 +136,36 @@ def test_ctrl_drag_lifts_and_throws_a_creature_with_a_bounded_force(
     assert np.hypot(*(world.component(octo, Transform).pos[:2] - start[:2])) < 0.05
 
 
+def test_removing_the_creature_being_dragged_ends_the_grab(
+    make_sandbox: Callable[..., Any],
+) -> None:
+    sandbox = make_sandbox("thesis_four_by_six")
+    world = sandbox.world
+    held, other = sorted(c.name for _, c in world.query(Creature))[:2]
+    position = world.component(world.creature(held), Transform).pos.copy()
+    x, y = pixel(sandbox, position)
+    event(sandbox, "on_mouse_press", x, y, mouse.LEFT, key.MOD_CTRL)
+    event(sandbox, "on_mouse_drag", x, y + 20, 0, 20, mouse.LEFT, key.MOD_CTRL)
+    sandbox.step(2)
+    sandbox.select_many([world.creature(held)])
+    _key(sandbox, key.DELETE)  # still dragging
+    assert world.resource(Director).grab is None
+    event(sandbox, "on_mouse_drag", x, y + 40, 0, 20, mouse.LEFT, key.MOD_CTRL)
+    before = world.frame
+    sandbox.step(3)  # the physics steps on (it raised for the creature gone, switched off)
+    event(sandbox, "on_mouse_release", x, y + 40, mouse.LEFT, key.MOD_CTRL)
+    sandbox.render()
+    assert world.frame == before + 3 and held not in _names(world)
+    assert not world.schedule.disabled()  # no system failed and was switched off
+    assert world.physics.health.recoveries == 0
+    assert not any(batch.applied for batch in world.physics.batches)
+    other_view = world.physics.group_of(world.component(world.creature(other), Creature))
+    moved = world.transforms.pos[other_view.body_rows[0]]
+    assert np.isfinite(moved).all()
+    _key(sandbox, key.Z, key.MOD_CTRL)  # the removal undone: it is back
+    assert held in _names(world)
+
+
 def test_ctrl_s_saves_a_scene_that_reloads_to_the_same_setup(
     make_sandbox: Callable[..., Any], tmp_path: Path
 ) -> None:
