@@ -342,3 +342,30 @@ def test_models_rebuilt_after_a_body_plan_left_retire_its_empty_batch():
         assert world.physics.group_of(world.component(again, Creature)).batch.index == 2
         world.step(10)
         assert world.physics.health.recoveries == 0
+
+
+def test_a_despawn_leaves_no_entity_the_creature_owned() -> None:
+    """Links, suckers, tentacles, goals, fur controls and guides: every entity made for a
+    creature goes with it (a left-over fur control was still drawn, and raised)."""
+    import esper
+
+    from ecs_tentacles.fur.components import FurControl
+
+    with World.from_scene("hedgehog_octopus") as world:
+        world.step(5)
+        spec = copy.deepcopy(next(iter(world.creature_specs.values())))
+        spec["goals"] = [{"position": [8.0, 3.0]}, {"position": [9.0, 0.0]}]
+        before = world.create_entity()  # entity numbers count up: the spawn's lie between
+        entity = world.spawn(spec, position=(8.0, 0.0))
+        after = world.create_entity()
+        made = [e for e in range(before + 1, after) if esper.entity_exists(e)]
+        assert len(made) > 500  # the creature, its body, two goals, fur guides and controls
+        controls = sum(1 for _ in world.query(FurControl))
+        world.step(2)
+        world.despawn(entity)
+        world.activate()
+        assert [e for e in made if esper.entity_exists(e)] == []
+        assert sum(1 for _ in world.query(FurControl)) < controls
+        for _, control in world.query(FurControl):
+            assert control.row >= 0  # every control left belongs to a creature still here
+        world.step(2)
