@@ -36,8 +36,9 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         "play",
         help="open the sandbox: watch, click goals, tune tentacles (or render headless)",
         description=(
-            "Open a scene in the sandbox window. Mouse: left-drag orbit, right-drag pan, wheel "
-            "zoom, click a creature to select it, click the ground to set its goal, shift-click "
+            "Open a scene in the sandbox window. Mouse: left-drag select in a rectangle, "
+            "right-drag orbit, middle-drag pan, wheel zoom, click a creature to select it, "
+            "click the ground to set its goal, shift-click "
             "to append, right-click a goal to remove it. Keys: space pause, . step, r reset, "
             "h HUD, f follow, a frame all, tab next tentacle, F12 screenshot, v video."
         ),

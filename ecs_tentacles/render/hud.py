@@ -156,7 +156,7 @@ class Hud:
             panel.windows(gui)
 
     def _band(self, x0: float, y0: float, x1: float, y1: float) -> None:
-        """The rectangle a shift-drag selects in (pyglet pixels), outlined and tinted."""
+        """The rectangle a drag selects in (pyglet pixels), outlined and tinted."""
         draw = imgui.get_foreground_draw_list()
         height = self.window.height
         corner, other = (min(x0, x1), height - max(y0, y1)), (max(x0, x1), height - min(y0, y1))

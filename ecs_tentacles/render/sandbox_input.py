@@ -1,8 +1,9 @@
 """The sandbox's mouse and keys (`Sandbox.input`, a pyglet handler on its window).
 
-Mouse: left-drag orbits, right- or middle-drag pans, wheel zooms; a click on a creature
-selects it, shift-click adds it to the selection or takes it out, shift-drag selects
-the creatures in a rectangle (drawn by the HUD while it is dragged); every other click
+Mouse: left-drag selects the creatures in a rectangle (drawn by the HUD while it is
+dragged; with shift they are added to the selection), right-drag orbits, middle- or
+shift+right-drag pans, wheel zooms; a click on a creature selects it, shift-click adds
+it to the selection or takes it out; every other click
 goes to the plugins' `sandbox_click` hooks as one undoable edit. A left press is
 offered to the HUD's panels first (`Panel.press`: a fur marker, the director's tools),
 and keys too (`Panel.key`). Keys: space pause, . single step, r reset, h HUD,
@@ -85,7 +86,10 @@ class SandboxInput:
         if self.band is not None:
             x0, y0, x1, y1 = self.band
             self.band = sandbox.hud.band = None
-            sandbox.select_many(creatures_in(sandbox.world, sandbox.renderer, (x0, y0), (x1, y1)))
+            inside = creatures_in(sandbox.world, sandbox.renderer, (x0, y0), (x1, y1))
+            if modifiers & key.MOD_SHIFT:  # held as the band is let go: added to the selection
+                inside = [*sandbox.selection.entities, *inside]
+            sandbox.select_many(inside)
         elif (
             self._press is not None
             and np.hypot(x - self._press[0], y - self._press[1]) < CLICK_PIXELS
@@ -100,9 +104,11 @@ class SandboxInput:
             return
         if self._press is None:
             return
-        if buttons & mouse.LEFT and (self.band is not None or modifiers & key.MOD_SHIFT):
-            self.band = sandbox.hud.band = (*self._press, float(x), float(y))  # rubber band
-        elif buttons & mouse.LEFT:
+        if buttons & mouse.LEFT:  # a rubber band, once the pointer is past a click's jitter
+            x0, y0 = self._press
+            if self.band is not None or np.hypot(x - x0, y - y0) >= CLICK_PIXELS:
+                self.band = sandbox.hud.band = (x0, y0, float(x), float(y))
+        elif buttons & mouse.RIGHT and not modifiers & key.MOD_SHIFT:
             sandbox.renderer.camera.orbit(dx, dy)
         elif buttons & (mouse.RIGHT | mouse.MIDDLE):
             sandbox.renderer.camera.pan(dx, dy)

@@ -155,3 +155,32 @@ def test_f5_saves_the_state_and_f9_goes_back(make_sandbox: Callable[..., Any]) -
     assert np.array_equal(sandbox.world.transforms.pos, saved)
     sandbox.step(40)
     assert np.array_equal(sandbox.world.transforms.pos, later)  # the same 40 frames again
+
+
+def test_right_drag_orbits_middle_drag_pans_and_a_shaky_click_stays_a_click(
+    make_sandbox: Callable[..., Any],
+) -> None:
+    sandbox = make_sandbox("octopus")
+    camera = sandbox.renderer.camera
+    yaw, target = camera.yaw, camera.target.copy()
+    x, y = sandbox.window.width * 3 // 4, sandbox.window.height // 3  # beside the HUD
+    _event(sandbox, "on_mouse_press", x, y, mouse.RIGHT, 0)
+    _event(sandbox, "on_mouse_drag", x + 40, y, 40, 0, mouse.RIGHT, 0)
+    _event(sandbox, "on_mouse_release", x + 40, y, mouse.RIGHT, 0)
+    assert camera.yaw != yaw and np.array_equal(camera.target, target)
+    _event(sandbox, "on_mouse_press", x, y, mouse.MIDDLE, 0)
+    _event(sandbox, "on_mouse_drag", x + 40, y, 40, 0, mouse.MIDDLE, 0)
+    _event(sandbox, "on_mouse_release", x + 40, y, mouse.MIDDLE, 0)
+    assert not np.array_equal(camera.target, target)
+    # a click whose pointer shakes by a pixel or two sets a goal: no rubber band
+    octo = sandbox.world.creature("octopus")
+    sandbox.select_many([octo])
+    ground = np.array([1.5, -1.0, 0.0])
+    gx, gy = (round(float(v)) for v in camera.project(ground[None])[0])
+    _event(sandbox, "on_mouse_press", gx, gy, mouse.LEFT, 0)
+    _event(sandbox, "on_mouse_drag", gx + 2, gy + 1, 2, 1, mouse.LEFT, 0)
+    assert sandbox.hud.band is None
+    _event(sandbox, "on_mouse_release", gx + 2, gy + 1, mouse.LEFT, 0)
+    goal = sandbox.world.resource(GoalBook).positions(octo)[-1]
+    assert np.hypot(*(goal[:2] - ground[:2])) < 0.1
+    assert sandbox.selection.entities == (octo,)

@@ -30,25 +30,42 @@ def _crowd(count: int) -> dict[str, Any]:
     return {"version": 1, "creatures": creatures}
 
 
-def test_shift_drag_selects_the_creatures_in_the_rectangle(make_sandbox: Callable[..., Any]):
+def _band(sandbox: Any, first: str, last: str, modifiers: int = 0) -> None:
+    """Left-drag a rectangle round the mantles of creatures `first` and `last`."""
+    low = np.array(pixel(sandbox, _mantle(sandbox, first)))
+    high = np.array(pixel(sandbox, _mantle(sandbox, last)))
+    corner = np.minimum(low, high) - 12
+    other = np.maximum(low, high) + 12
+    event(sandbox, "on_mouse_press", *corner.tolist(), mouse.LEFT, modifiers)
+    event(sandbox, "on_mouse_drag", *other.tolist(), 5, 5, mouse.LEFT, modifiers)
+    assert sandbox.hud.band is not None  # the rubber band is drawn while dragging
+    sandbox.render()
+    event(sandbox, "on_mouse_release", *other.tolist(), mouse.LEFT, modifiers)
+    assert sandbox.hud.band is None
+
+
+def test_a_drag_selects_the_creatures_in_the_rectangle(make_sandbox: Callable[..., Any]):
     sandbox = make_sandbox(_crowd(8))
     camera = sandbox.renderer.camera
     camera.pitch, camera.yaw = camera.MAX_PITCH, -np.pi / 2  # from above, rows across
+    view = (camera.pitch, camera.yaw, camera.distance)
     world = sandbox.world
-    # a rectangle round the first row (c0..c3) only
-    low = np.array(pixel(sandbox, _mantle(sandbox, "c0")))
-    high = np.array(pixel(sandbox, _mantle(sandbox, "c3")))
-    corner = np.minimum(low, high) - 12
-    other = np.maximum(low, high) + 12
-    event(sandbox, "on_mouse_press", *corner.tolist(), mouse.LEFT, key.MOD_SHIFT)
-    event(sandbox, "on_mouse_drag", *other.tolist(), 5, 5, mouse.LEFT, key.MOD_SHIFT)
-    assert sandbox.hud.band is not None  # the rubber band is drawn while dragging
-    sandbox.render()
-    event(sandbox, "on_mouse_release", *other.tolist(), mouse.LEFT, key.MOD_SHIFT)
+    _band(sandbox, "c4", "c5")  # a rectangle round c4 and c5 only
+    names = sorted(world.creature_name(e) for e in sandbox.selection.entities)
+    assert names == ["c4", "c5"]
+    assert (camera.pitch, camera.yaw, camera.distance) == view  # the camera stays
+    _band(sandbox, "c0", "c3")  # a new rectangle: the first row instead
     names = sorted(world.creature_name(e) for e in sandbox.selection.entities)
     assert names == ["c0", "c1", "c2", "c3"]
-    assert sandbox.hud.band is None
+    _band(sandbox, "c4", "c4", key.MOD_SHIFT)  # shift-drag adds
+    names = sorted(world.creature_name(e) for e in sandbox.selection.entities)
+    assert names == ["c0", "c1", "c2", "c3", "c4"]
+    _band(sandbox, "c4", "c4")
+    _band(sandbox, "c0", "c3", key.MOD_SHIFT)
+    names = sorted(world.creature_name(e) for e in sandbox.selection.entities)
+    assert names == ["c0", "c1", "c2", "c3", "c4"]
     assert set(sandbox.renderer.selection) == set(sandbox.selection.entities)
+    _band(sandbox, "c0", "c3")
     # shift-click takes one out and puts another in
     click_at(sandbox, pixel(sandbox, _mantle(sandbox, "c1")), key.MOD_SHIFT)
     click_at(sandbox, pixel(sandbox, _mantle(sandbox, "c5")), key.MOD_SHIFT)
