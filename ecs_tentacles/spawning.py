@@ -15,7 +15,9 @@ free spot (the `creature_spawned` event and the log say where).
 
 Despawn removes the creature's rows from every store (the rows after them move up;
 columns that refer to a store's rows follow, `store.Field.refers`), deletes its
-entities, takes it out of the physics and tells plugins and systems. Events:
+entities (its body's, and those a plugin store's going rows name in an `entity`
+column: fur guides and controls), takes it out of the physics and tells plugins and
+systems. Events:
 `creature_spawned(world, creature, creature_name, moved_to)` and
 `creature_despawned(world, creature, creature_name)`.
 
@@ -255,11 +257,12 @@ def despawn(world: World, entity: int) -> None:
         suckers.attached[row] = False
         sucker = int(suckers.entity[row])
         world.events.emit("sucker_released", world=world, sucker=sucker, reason="despawn")
+    owned = _row_entities(world, dead)  # read before the rows go
     moved = {key: world.stores[key].remove(rows) for key, rows in dead.items() if len(rows)}
     for store in world.stores.values():
         for key, new in moved.items():
             store.renumber(key, new)
-    _delete_entities(world, entity, creature)
+    _delete_entities(world, entity, creature, owned)
     index = world.physics.lod.index(entity)
     world.physics.remove_creature(world, entity, moved)
     world.creature_specs.pop(entity, None)
@@ -316,7 +319,20 @@ def _owned_rows(world: World, creature: Creature) -> dict[str, np.ndarray]:
     return dead
 
 
-def _delete_entities(world: World, entity: int, creature: Creature) -> None:
+def _row_entities(world: World, dead: dict[str, np.ndarray]) -> list[int]:
+    """The entities that the going rows of plugin stores with an `entity` column stand
+    for (fur guides and controls): they go with their rows."""
+    owned: list[int] = []
+    for name, rows in dead.items():
+        store = world.stores[name]
+        if name not in CORE_STORES and any(f.name == "entity" for f in store.fields()):
+            owned += store.entity[rows].tolist()  # type: ignore[attr-defined]
+    return owned
+
+
+def _delete_entities(world: World, entity: int, creature: Creature, rows: list[int]) -> None:
+    for row_entity in rows:
+        esper.delete_entity(row_entity, immediate=True)
     for tentacle_entity in creature.tentacles:
         tentacle = world.component(tentacle_entity, Tentacle)
         for owned in (*tentacle.links, *tentacle.suckers, tentacle_entity):

@@ -13,8 +13,6 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
-import esper
-
 from ecs_tentacles.fur.build import build_emotion, build_fur
 from ecs_tentacles.fur.checks import fur_problems
 from ecs_tentacles.fur.stores import FurData
@@ -51,12 +49,6 @@ class FurPlugin(Plugin):
             build_fur(world, creature, dict(spec["fur"]))
         if "emotion" in spec:
             build_emotion(world, creature, dict(spec["emotion"]))
-
-    def despawning(self, world: Host, creature: int) -> None:
-        """Its fur's control and guide entities go (their rows go with every store's)."""
-        world.activate()
-        for entity in world.resource(FurData).entities_of(creature).tolist():
-            esper.delete_entity(entity, immediate=True)
 
     def roster_changed(self, world: Host, change: RosterChange) -> None:
         if not change.spawned:  # a spawn's fur was added by `build_creature`

@@ -146,13 +146,6 @@ class FurData:
         self._join()
         return self._frames[: self._rows]
 
-    def entities_of(self, creature: int) -> np.ndarray:
-        """The control and guide entities of `creature`'s fur (none: empty)."""
-        sets = np.zeros(len(self.sets) + 1, dtype=bool)  # (the last entry, for row -1)
-        sets[np.flatnonzero(self.sets.creature == creature)] = True
-        controls = self.controls.entity[sets[self.controls.fur_row]]
-        return np.concatenate([controls, self.guides.entity[sets[self.guides.fur_row]]])
-
     def add_shapes(self, shapes: np.ndarray) -> None:
         """Append rest shapes (k, points, 3) for guides just added; grow the buffers.
 
