@@ -369,3 +369,21 @@ def test_a_despawn_leaves_no_entity_the_creature_owned() -> None:
         for _, control in world.query(FurControl):
             assert control.row >= 0  # every control left belongs to a creature still here
         world.step(2)
+
+
+def test_a_body_plan_whose_first_creature_left_still_gets_its_reduced_model():
+    """The reduced model is compiled lazily, when a creature of the plan first drops to the
+    reduced tier; it was built from the plan's first creature, gone by then (KeyError: the
+    physics system failed and the sandbox froze)."""
+    scene = {**_scene(APART), "physics": {"lod": {"full": 1, "reduced": 64}}}
+    seven = {**_creature("e", -30.0), "tentacles": {"count": 7, "links": 4}}
+    with World.from_scene(scene) as world:
+        snap = world.snapshot()
+        world.step(5)
+        world.despawn(world.spawn(seven))
+        world.restore(snap)
+        for i in range(6):
+            world.spawn({**seven, "name": f"e{i}", "position": [-30.0 + 3 * i, 8.0]})
+        world.step(30)
+        assert world.lod.counts()["reduced"] >= 5
+        assert world.physics.health.recoveries == 0

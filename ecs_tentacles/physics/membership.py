@@ -36,13 +36,21 @@ def compile_models(
     world: PhysicsHost, creature: Creature
 ) -> tuple[mujoco.MjModel, Callable[[], mujoco.MjModel]]:
     """The compiled model of `creature`'s morphology, and how to compile its reduced one
-    (the REDUCED level of detail: fewer, longer substeps) when first needed."""
+    (the REDUCED level of detail: fewer, longer substeps) when first needed.
+
+    The reduced model is compiled later from the spec built now: by then `creature` may
+    have been despawned (the batch outlives its first member), so nothing of the world
+    is read again.
+    """
+    spec = build_spec(world, creature)
+    model = spec.compile()
     reduced_dt = world.settings.dt / reduced_substeps(world.settings.substeps)
 
     def reduced() -> mujoco.MjModel:
-        return build_spec(world, creature, timestep=reduced_dt).compile()
+        spec.option.timestep = reduced_dt
+        return spec.compile()
 
-    return build_spec(world, creature).compile(), reduced
+    return model, reduced
 
 
 class Membership:
