@@ -54,6 +54,7 @@ from ecs_tentacles.render.selection import Selection
 from ecs_tentacles.render.undo import UndoStack
 from ecs_tentacles.roster_save import save_roster
 from ecs_tentacles.scene.errors import SceneError
+from ecs_tentacles.scene.save import default_file_name
 from ecs_tentacles.snapshot import SnapshotMismatch
 from ecs_tentacles.system import SystemFailure
 from ecs_tentacles.world import World
@@ -321,10 +322,11 @@ class Sandbox:
 
     def save_roster(self, path: str | os.PathLike[str] | None = None) -> Path | None:
         """Write the roster, goals and settings as they are now to a scene file (Ctrl+S:
-        `<scene>_directed.json` in the working folder); None and a message if it would
-        not load (`ecs_tentacles.roster_save`)."""
-        name = (self.world.scene or {}).get("name", "scene")
-        target = Path(path) if path is not None else Path(f"{name}_directed.json")
+        `<scene>_directed.json` in the working folder, the name made safe: a scene's
+        name never chooses a folder); None and a message if it would not load
+        (`ecs_tentacles.roster_save`)."""
+        name = (self.world.scene or {}).get("name")
+        target = Path(path) if path is not None else Path(default_file_name(name, "_directed.json"))
         try:
             saved = save_roster(self.world, target)
         except (SceneError, OSError) as error:

@@ -30,6 +30,7 @@ from ecs_tentacles.drawing import Panel
 from ecs_tentacles.render.gui import Gui, same_line_if_fits, text_width
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.load import resolve_scene_path
+from ecs_tentacles.scene.save import default_file_name
 from ecs_tentacles.terrain.editing import BRUSHES, SHAPES, TerrainEditError, TerrainEditor
 
 TOOLS = ("none", *SHAPES, "move", "delete", *BRUSHES)
@@ -48,8 +49,8 @@ class TerrainPanel(Panel):
         self.strength = 0.03  # metres a brush step raises or lowers at its centre
         self.moving: int | None = None  # the obstacle being moved
         self.last: np.ndarray | None = None  # where the mouse is while moving
-        name = (sandbox.world.scene or {}).get("name", "scene")
-        self.save_path = f"{name}_terrain.json"  # in the current folder
+        name = (sandbox.world.scene or {}).get("name")  # any string: made a safe file name
+        self.save_path = default_file_name(name, "_terrain.json")  # in the current folder
         self.message = ""
 
     @property
