@@ -2,8 +2,11 @@
 
 Creatures are named, not numbered: an undone despawn builds the creature again (a new
 entity, the same name), and later edits still find it. The physics is not rewound: an
-undone despawn puts the creature back resting where it was, an undone move puts its
-joints back where they were when it was grabbed.
+undone despawn puts the creature back resting where it was (or, when something took
+its place since, at the nearest free spot, as `spawn(on_overlap="move")`), an undone
+move puts its joints back where they were when it was grabbed. Building creatures
+again is whole or nothing: when one of them finds no free spot, none is built and the
+edit raises `SpawnError` (the sandbox says so and keeps the edit to try again).
 
 * `Spawned`: creatures placed (one, a scatter, a duplicate); undo despawns them.
 * `Despawned`: creatures removed; undo builds them again where they were, with their
@@ -22,7 +25,7 @@ import numpy as np
 
 from ecs_tentacles.components import Creature
 from ecs_tentacles.roster_save import entry_now
-from ecs_tentacles.spawning import place
+from ecs_tentacles.spawning import SpawnError, free_spot, place
 from ecs_tentacles.threats.data import ThreatData
 
 if TYPE_CHECKING:
@@ -45,9 +48,18 @@ def _despawn_named(world: Host, names: list[str]) -> None:
 
 
 def _place_all(world: Host, entries: list[dict[str, Any]]) -> None:
-    for entry in entries:
-        if named(world, entry["name"]) is None:  # its name is free again
-            place(world, copy.deepcopy(entry))
+    """Build `entries` again, each where it was or at the nearest free spot; all or none."""
+    built: list[int] = []
+    try:
+        for entry in entries:
+            if named(world, entry["name"]) is None:  # its name is free again
+                spot, blocker = free_spot(world, copy.deepcopy(entry))
+                moved_to = None if blocker is None else tuple(spot["position"])
+                built.append(place(world, spot, moved_to))
+    except SpawnError:
+        for entity in built:
+            world.despawn(entity)
+        raise
 
 
 @dataclass

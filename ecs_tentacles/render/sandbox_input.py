@@ -24,6 +24,7 @@ from pyglet.window import key, mouse
 from ecs_tentacles.components import Transform
 from ecs_tentacles.drawing import Click, Panel
 from ecs_tentacles.render.on_screen import creatures_in
+from ecs_tentacles.spawning import SpawnError
 
 CLICK_PIXELS = 4  # a press and release closer than this is a click, not a drag
 BUTTONS = {mouse.LEFT: "left", mouse.RIGHT: "right", mouse.MIDDLE: "middle"}
@@ -135,8 +136,13 @@ class SandboxInput:
         if symbol == key.A and ctrl:
             sandbox.select_many(sandbox.renderer.creature_entities)
         elif symbol == key.Z and ctrl:
-            label = (sandbox.undo.redo if shift else sandbox.undo.undo)(sandbox.world)
-            sandbox.scripts.say(True, f"{'redo' if shift else 'undo'}: {label or 'nothing to do'}")
+            what = "redo" if shift else "undo"
+            try:
+                label = (sandbox.undo.redo if shift else sandbox.undo.undo)(sandbox.world)
+            except SpawnError as refused:  # no free spot to put a creature back
+                sandbox.scripts.say(False, f"{what} refused: {refused}")
+            else:
+                sandbox.scripts.say(True, f"{what}: {label or 'nothing to do'}")
         elif symbol == key.S and ctrl:
             sandbox.save_roster()
         elif symbol == key.ESCAPE:

@@ -102,18 +102,18 @@ class UndoStack:
         """Undo the newest edit; its label, or None when there is nothing to undo."""
         if not self.done:
             return None
-        edit = self.done.pop()
-        edit.undo(world)
-        self.undone.append(edit)
+        edit = self.done[-1]
+        edit.undo(world)  # an edit that refuses (raises) stays where it was
+        self.undone.append(self.done.pop())
         return edit.label
 
     def redo(self, world: Any) -> str | None:
         """Do the newest undone edit again; its label, or None."""
         if not self.undone:
             return None
-        edit = self.undone.pop()
+        edit = self.undone[-1]
         edit.redo(world)
-        self.done.append(edit)
+        self.done.append(self.undone.pop())
         return edit.label
 
 

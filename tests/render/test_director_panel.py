@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pytest
 from pyglet.window import key, mouse
 
 from ecs_tentacles.components import Creature, Transform
@@ -226,3 +227,50 @@ def test_f9_goes_back_past_a_spawn_and_refuses_past_a_removal(
     _key(sandbox, key.F9)  # it cannot come back with its old entity: said, nothing changes
     assert _names(world) == [] and sandbox.world.frame == 3
     assert any("despawned since" in line for _, line in sandbox.scripts.notes)
+
+
+def test_undoing_a_removal_puts_the_creature_beside_whatever_took_its_place(
+    make_sandbox: Callable[..., Any],
+) -> None:
+    """Delete `a`, a script spawns a creature on its spot, Ctrl+Z: `a` came back inside the newcomer
+    and both blew up within 2 s (QACC NaN, 6 recoveries)."""
+    sandbox = make_sandbox("thesis_four_by_six")
+    world = sandbox.world
+    gone = sorted(c.name for _, c in world.query(Creature))[0]
+    spot = world.component(world.creature(gone), Transform).pos.copy()
+    sandbox.select_many([world.creature(gone)])
+    _key(sandbox, key.DELETE)
+    entry = {"name": "newcomer", "tentacles": {"count": 6, "links": 4}}
+    newcomer = world.creature_name(world.spawn(entry, position=spot[:2]))  # a script's
+    _key(sandbox, key.Z, key.MOD_CTRL)
+    assert gone in _names(world) and newcomer in _names(world)
+    back = world.component(world.creature(gone), Transform).pos
+    there = world.component(world.creature(newcomer), Transform).pos
+    assert np.hypot(*(back - there)[:2]) > 0.5  # beside it, not inside
+    sandbox.step(120)
+    assert world.physics.health.recoveries == 0
+    assert not world.schedule.disabled()
+
+
+def test_an_edit_that_refuses_stays_on_the_undo_stack() -> None:
+    from ecs_tentacles.render.undo import UndoStack
+    from ecs_tentacles.spawning import SpawnError
+
+    class NoRoom:
+        label = "remove 1"
+        tries = 0
+
+        def undo(self, world: Any) -> None:
+            self.tries += 1
+            if self.tries == 1:
+                raise SpawnError(["creature 'a': no free spot within 3.0 m of (0, 0)"])
+
+        def redo(self, world: Any) -> None:
+            pass
+
+    stack, edit = UndoStack(), NoRoom()
+    stack.push(edit)
+    with pytest.raises(SpawnError):
+        stack.undo(None)
+    assert stack.done == [edit] and not stack.undone
+    assert stack.undo(None) == "remove 1" and stack.undone == [edit]
