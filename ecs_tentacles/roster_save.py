@@ -29,8 +29,8 @@ from ecs_tentacles.atomic import atomic_file
 from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.construction import creature_layout
 from ecs_tentacles.ground import ground_of
-from ecs_tentacles.scene.load import load_scene
 from ecs_tentacles.scene.overlap import segment_distances
+from ecs_tentacles.scene.save import checked_scene
 from ecs_tentacles.spawning import nearest_free
 
 log = logging.getLogger("ecs_tentacles.roster_save")
@@ -128,7 +128,9 @@ def save_roster(world: Host, path: str | os.PathLike[str]) -> Path:
     moved = fit_at_rest(world, scene["creatures"])
     if moved:
         log.info("%s: %d creature(s) moved to where they fit with tentacles spread", path, moved)
-    load_scene(scene, allow_systems=True)  # checked as any scene: SceneError, one line each
+    # checked as any scene (SceneError, one line each) by the world's own plugins: none
+    # is looked up or imported again, so no file in the current folder is run
+    checked_scene(scene, world.plugins)
     target = Path(path)
     with atomic_file(target) as handle:
         handle.write((json.dumps(scene, indent=2) + "\n").encode())

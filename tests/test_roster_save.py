@@ -79,3 +79,33 @@ def test_creatures_too_close_to_be_built_at_rest_are_saved_where_they_fit(tmp_pa
         load_scene(saved)  # no overlap left: the scene's own check agrees
         with World.from_scene(saved) as again:  # and the terrain's build check
             again.step(5)
+
+
+PLUGIN = (
+    "import pathlib\n"
+    "from ecs_tentacles.plugin import Plugin\n"
+    "pathlib.Path('{marker}').write_text('ran')\n"
+    "class Spawner(Plugin):\n"
+    "    name = 'spawner'\n"
+)
+
+
+def test_saving_imports_no_plugin_file_from_the_current_folder(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The world's scene turns on a plugin from a file beside it; a file of that name in
+    the folder the sandbox runs in is someone else's code: a save must not run it."""
+    scenes, work = tmp_path / "scenes", tmp_path / "work"
+    scenes.mkdir()
+    work.mkdir()
+    (scenes / "spawner.py").write_text(PLUGIN.format(marker=scenes / "loaded.marker"))
+    (work / "spawner.py").write_text(PLUGIN.format(marker=work / "hostile.marker"))
+    scene = {"version": 1, "plugins": {"spawner": {"from": "spawner.py"}},
+             "creatures": [{"name": "a", "position": [0, 0]}]}  # fmt: skip
+    (scenes / "mine.json").write_text(json.dumps(scene))
+    with World.from_scene(scenes / "mine.json", allow_systems=True) as world:
+        assert (scenes / "loaded.marker").exists()  # the scene's own plugin, allowed
+        monkeypatch.chdir(work)
+        saved = save_roster(world, scenes / "saved.json")
+    assert not (work / "hostile.marker").exists()
+    assert json.loads(saved.read_text())["plugins"]["spawner"] == {"from": "spawner.py"}

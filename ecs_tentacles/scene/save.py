@@ -10,11 +10,18 @@ from __future__ import annotations
 import json
 import os
 import re
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ecs_tentacles.atomic import atomic_output
+from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.load import load_scene
+from ecs_tentacles.scene.physical import physically_checked
+from ecs_tentacles.scene.validate import validated
+
+if TYPE_CHECKING:
+    from ecs_tentacles.plugin import Plugin
 
 MAX_STEM = 64  # characters of the scene's name a default file name keeps
 _ANSI = re.compile(r"\x1b(\[[0-?]*[ -/]*[@-~]|[@-_])")  # colour codes etc., taken out whole
@@ -34,9 +41,27 @@ def default_file_name(name: object, suffix: str, fallback: str = "scene") -> str
     return stem + suffix
 
 
-def save_scene(scene: dict[str, Any], path: str | os.PathLike[str]) -> Path:
-    """Validate `scene` (SceneError listing the problems if not) and write it atomically."""
-    load_scene(scene)
+def checked_scene(scene: dict[str, Any], plugins: Sequence[Plugin] | None = None) -> dict[str, Any]:
+    """`scene` validated and completed as `load_scene` does (SceneError, one line per
+    problem), by `plugins`: a running world's, already made, so no plugin is looked up
+    or imported again (a `spawner.py` in the current folder never runs). Without them,
+    by the plugins the scene names, of which only trusted ones are imported."""
+    if plugins is None:
+        return load_scene(scene)
+    problems, completed = validated(scene, plugins)
+    if problems or completed is None:
+        raise SceneError(problems or ["the scene is not an object"])
+    return physically_checked(completed)
+
+
+def save_scene(
+    scene: dict[str, Any],
+    path: str | os.PathLike[str],
+    plugins: Sequence[Plugin] | None = None,
+) -> Path:
+    """Validate `scene` (`checked_scene`: SceneError listing the problems if not) and
+    write it atomically."""
+    checked_scene(scene, plugins)
     target = Path(path)
     with atomic_output(target) as temporary:
         temporary.write_text(json.dumps(scene, indent=1) + "\n", encoding="utf-8")

@@ -146,7 +146,7 @@ class TerrainEditor:
         validated and atomically (`ecs_tentacles.scene.save`)."""
         scene = copy.deepcopy(raw)
         scene["terrain"] = self._terrain(world)
-        return save_scene(scene, path)
+        return save_scene(scene, path, world.plugins)
 
     # -- internals -------------------------------------------------------------------------
     def _terrain(self, world: Host) -> dict[str, Any]:
