@@ -40,6 +40,7 @@ _TYPE_NAMES = {
     "null": "null",
 }
 _MAX_SHOWN = 60
+_ATOMS = {int, float, str, bool, type(None)}  # JSON values that hold no others
 MAX_DEPTH = 32  # a scene is about 8 levels deep; deeper data is refused before recursing
 
 
@@ -321,9 +322,17 @@ def _too_deep(data: object) -> JsonPath | None:
             return path
         if isinstance(value, dict):
             stack.extend(((*path, str(k)), v) for k, v in value.items())
-        elif isinstance(value, list):
-            stack.extend(((*path, i), v) for i, v in enumerate(value))
+        elif isinstance(value, list):  # numbers and strings go no deeper: not stacked
+            stack.extend(((*path, i), v) for i, v in _nested(value))
     return None
+
+
+def _nested(values: list[Any]) -> list[tuple[int, Any]]:
+    """The (index, item) of the objects and lists in `values` (a list of a million numbers
+    is passed over at C speed)."""
+    if set(map(type, values)) <= _ATOMS:
+        return []
+    return [(i, v) for i, v in enumerate(values) if isinstance(v, (dict, list))]
 
 
 def _limit_problems(
@@ -341,7 +350,8 @@ def _limit_problems(
                     (path, f"must have {_count_bounds(node, 'Items')}, got {len(value)}")
                 )
             elif isinstance(node.get("items"), Mapping):
-                stack.extend(((*path, i), item, node["items"]) for i, item in enumerate(value))
+                items = node["items"]
+                stack.extend(((*path, i), v, items) for i, v in _nested(value))
         elif isinstance(value, dict):
             properties = node.get("properties", {})
             stack.extend(
@@ -378,7 +388,7 @@ def _fill(value: Any, schema: Mapping[str, Any], root: Mapping[str, Any]) -> Non
             if key in value:
                 _fill(value[key], sub, root)
     elif isinstance(value, list) and isinstance(schema.get("items"), Mapping):
-        for item in value:
+        for _, item in _nested(value):  # defaults go into objects only
             _fill(item, schema["items"], root)
 
 
@@ -389,6 +399,19 @@ def _merge_under(value: dict[str, Any], base: Mapping[str, Any]) -> None:
             value[key] = copy.deepcopy(item)
         elif isinstance(value[key], dict) and isinstance(item, Mapping):
             _merge_under(value[key], item)
+
+
+def _copied(data: Any) -> Any:
+    """A deep copy of scene data (JSON-like; anything else through `copy.deepcopy`); a
+    list of numbers is copied at once (a million heights took a second one by one)."""
+    kind = type(data)
+    if kind is dict:
+        return {key: _copied(value) for key, value in data.items()}
+    if kind is list:
+        if set(map(type, data)) <= _ATOMS:
+            return list(data)  # immutable items: nothing to copy further
+        return [_copied(value) for value in data]
+    return data if kind in _ATOMS else copy.deepcopy(data)
 
 
 def plugin_config(plugin: Plugin, given: object) -> dict[str, Any]:
@@ -408,7 +431,7 @@ def with_defaults(data: dict[str, Any], plugins: Sequence[Plugin] | None = None)
     stay absent; ``data`` is not modified. ``plugins`` (default: the default ones) add
     their keys' defaults, and each plugin's config gets its defaults under `plugins`.
     """
-    result = copy.deepcopy(data)
+    result = _copied(data)
     if plugins is None:
         from ecs_tentacles.plugin_registry import resolve
 
