@@ -22,7 +22,8 @@ How a scene's `plugins` are found, trusted, imported and made is
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, ClassVar
 
@@ -103,6 +104,22 @@ class Marker:
     positions: Any
     size: tuple[float, float, float]
     rgba: tuple[float, float, float, float]
+
+
+class HookFailure(RuntimeError):
+    """A plugin's hook called `sys.exit` (raised SystemExit): a failure like any other,
+    one line naming the plugin and the hook (the command line exits 1), never a quiet
+    exit with nothing done."""
+
+
+@contextmanager
+def calling(plugin: Plugin, hook: str) -> Iterator[None]:
+    """Around a call of `plugin`'s `hook`: SystemExit becomes `HookFailure`."""
+    try:
+        yield
+    except SystemExit as exc:
+        code = "" if exc.code is None else f"({exc.code!r})"
+        raise HookFailure(f"plugins.{plugin.key}: its {hook}() hook called sys.exit{code}") from exc
 
 
 class Plugin:
@@ -229,6 +246,12 @@ class Plugin:
     def save_scene(self, world: Host, scene: dict[str, Any]) -> None:
         """Write this plugin's scene-level state into `scene` when a running world is
         saved (`ecs_tentacles.roster_save`; the threats plugin: threats dropped since)."""
+
+    def scene_files(self, scene: Mapping[str, Any]) -> list[tuple[tuple[str | int, ...], str]]:
+        """The files this plugin's keys of `scene` name, each as (its JSON path, the name
+        as written, relative to the scene's folder): a save to another folder takes them
+        along (`ecs_tentacles.scene.save`; the terrain plugin: height images, meshes)."""
+        return []
 
     def sandbox_click(self, world: Host, click: Click) -> bool:
         """A click in the sandbox's 3D view; True: handled (later plugins do not see it)."""

@@ -40,6 +40,7 @@ from ecs_tentacles.components import Creature, Tentacle
 from ecs_tentacles.construction import CreatureLayout, creature_layout
 from ecs_tentacles.ground import ground_of
 from ecs_tentacles.mathutil import quat_rotate
+from ecs_tentacles.plugin import calling
 from ecs_tentacles.roster_change import RosterChange
 from ecs_tentacles.scene.overlap import segment_distances
 from ecs_tentacles.scene.physical import physical_problems
@@ -223,7 +224,8 @@ def place(world: World, entry: dict[str, Any], moved_to: tuple[float, ...] | Non
     before = {name: len(store) for name, store in world.stores.items()}
     entity = build_creature(world, entry)
     for plugin in world.plugins:
-        plugin.build_creature(world, entity, entry)
+        with calling(plugin, "build_creature"):
+            plugin.build_creature(world, entity, entry)
     index = world.physics.add_creature(world, entity)
     added = {
         name: np.arange(before.get(name, 0), len(store))

@@ -23,7 +23,7 @@ import numpy as np
 from ecs_tentacles.components import Creature
 from ecs_tentacles.events import Events
 from ecs_tentacles.physics.backend import PhysicsBackend
-from ecs_tentacles.plugin import Plugin
+from ecs_tentacles.plugin import Plugin, calling
 from ecs_tentacles.schedule import Schedule
 from ecs_tentacles.settings import Settings as Settings  # re-exported: old imports work
 from ecs_tentacles.store import (
@@ -197,7 +197,8 @@ class World:
         """Add a plugin's resources and stores, not its systems (scene loading's first step)."""
         if any(p.key == plugin.key for p in self.plugins):
             raise ValueError(f"plugin {plugin.key!r} is already on in this world")
-        made = plugin.resources(self)
+        with calling(plugin, "resources"):
+            made = plugin.resources(self)
         objects = list(made.values() if isinstance(made, Mapping) else made)
         for obj in objects:
             if type(obj) in self._resources:

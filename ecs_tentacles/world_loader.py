@@ -27,7 +27,7 @@ from typing import Any, Protocol, TypeVar
 from ecs_tentacles.build import build_creature
 from ecs_tentacles.host import Host
 from ecs_tentacles.physics.systems import physics_systems
-from ecs_tentacles.plugin import Plugin, SystemsPlugin
+from ecs_tentacles.plugin import HookFailure, Plugin, SystemsPlugin, calling
 from ecs_tentacles.plugin_registry import scene_first
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.load import load_scene_plugins, read_scene_json, resolve_scene_path
@@ -98,7 +98,8 @@ def load_world(
             entity = build_creature(world, creature)
             world.creature_specs[entity] = creature
             for plugin in chosen:
-                plugin.build_creature(world, entity, creature)
+                with calling(plugin, "build_creature"):
+                    plugin.build_creature(world, entity, creature)
     for plugin in chosen:
         plugin.build_scene(world, data)
     for store in world.stores.values():
@@ -117,7 +118,8 @@ def load_world(
 
 def owned_systems(plugin: Plugin) -> list[System]:
     """The plugin's systems, each tagged with the plugin's key."""
-    systems = plugin.systems()
+    with calling(plugin, "systems"):
+        systems = plugin.systems()
     for system in systems:
         system.plugin = plugin.key
     return systems
@@ -127,6 +129,8 @@ def _plugin_systems(plugin: Plugin) -> list[System]:
     """`owned_systems`, a raising `systems()` as one SceneError line naming the plugin."""
     try:
         return owned_systems(plugin)
+    except HookFailure:
+        raise
     except Exception as exc:  # one line naming the plugin, as for an import
         text = f"{type(exc).__name__}: {' '.join(str(exc).split())}"
         raise SceneError([f"plugins.{plugin.key}: systems() raised {text}"]) from exc

@@ -36,6 +36,7 @@ from ecs_tentacles.cli import (
     validate,
 )
 from ecs_tentacles.cli.arguments import NoDisplay, OneLineParser
+from ecs_tentacles.plugin import HookFailure
 from ecs_tentacles.scene import load
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.system import SystemFailure
@@ -158,11 +159,18 @@ def _run(args: argparse.Namespace) -> int:
             return _failed(args, error)
         print(f"error: stopped by {cause}; partial outputs removed", file=sys.stderr)
         return 143
+    except HookFailure as failure:  # a plugin hook called sys.exit: named, one line
+        if args.debug:
+            raise
+        print(f"error: {failure}", file=sys.stderr)
+        return 1
     except Exception as error:
+        return _failed(args, error)
+    except BaseException as error:  # SystemExit or the user's own BaseException subclass
         return _failed(args, error)
 
 
-def _failed(args: argparse.Namespace, error: Exception) -> int:
+def _failed(args: argparse.Namespace, error: BaseException) -> int:
     """An unexpected failure: one line (the traceback with --debug)."""
     if args.debug:
         raise error

@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Any
 
 from jsonschema import ValidationError
 
+from ecs_tentacles.plugin import calling
 from ecs_tentacles.scene.json_validator import StrictValidator, validator_for
 from ecs_tentacles.scene.schema import builtin_keys, schema_for
 from ecs_tentacles.scene.shards import shard_problems
@@ -234,7 +235,8 @@ def validated(
         full = with_defaults(data, plugins)
         problems = _semantic_problems(full)
         for plugin in plugins:
-            problems += plugin.problems(full)
+            with calling(plugin, "problems"):
+                problems += plugin.problems(full)
     problems = _name_plugins_that_are_off(problems, {p.name for p in plugins})
     unique = sorted(set(problems), key=_path_key)
     lines = [f"{format_path(path)}: {message}" for path, message in unique]
