@@ -17,7 +17,6 @@ above the world (as `world_loader`).
 from __future__ import annotations
 
 import copy
-import json
 import logging
 import os
 from pathlib import Path
@@ -25,12 +24,11 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ecs_tentacles.atomic import atomic_file
 from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.construction import creature_layout
 from ecs_tentacles.ground import ground_of
 from ecs_tentacles.scene.overlap import segment_distances
-from ecs_tentacles.scene.save import checked_scene
+from ecs_tentacles.scene.save import save_scene
 from ecs_tentacles.spawning import nearest_free
 
 log = logging.getLogger("ecs_tentacles.roster_save")
@@ -129,9 +127,6 @@ def save_roster(world: Host, path: str | os.PathLike[str]) -> Path:
     if moved:
         log.info("%s: %d creature(s) moved to where they fit with tentacles spread", path, moved)
     # checked as any scene (SceneError, one line each) by the world's own plugins: none
-    # is looked up or imported again, so no file in the current folder is run
-    checked_scene(scene, world.plugins)
-    target = Path(path)
-    with atomic_file(target) as handle:
-        handle.write((json.dumps(scene, indent=2) + "\n").encode())
-    return target
+    # is looked up or imported again, so no file in the current folder is run; saved in
+    # another folder, the files the scene names (terrain images, meshes) go along
+    return save_scene(scene, path, world.plugins, source_dir=world.scene_dir, indent=2)

@@ -107,5 +107,72 @@ def test_saving_imports_no_plugin_file_from_the_current_folder(
         assert (scenes / "loaded.marker").exists()  # the scene's own plugin, allowed
         monkeypatch.chdir(work)
         saved = save_roster(world, scenes / "saved.json")
+        # saved beside that other file, the scene would run it when loaded: refused
+        from ecs_tentacles.scene.errors import SceneError
+
+        with pytest.raises(SceneError, match=r"^plugins\.spawner\.from: .*work/spawner\.py is"):
+            save_roster(world, work / "saved.json")
     assert not (work / "hostile.marker").exists()
+    assert not (work / "saved.json").exists()
     assert json.loads(saved.read_text())["plugins"]["spawner"] == {"from": "spawner.py"}
+
+
+TETRA = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n"
+
+
+def _terrain_scene(folder: Path) -> dict:
+    """A scene in `folder` naming a 16-bit height image (in a subfolder) and a mesh."""
+    from PIL import Image
+
+    (folder / "maps").mkdir()
+    pixels = np.zeros((16, 16), dtype=np.uint16)
+    pixels[:4, :] = 65535
+    Image.fromarray(pixels).save(folder / "maps" / "sixteen.png")
+    (folder / "rock.obj").write_text(TETRA)
+    return {"version": 1, "name": "shore", "terrain": {
+        "heightfield": {"size": [8, 8], "image": "maps/sixteen.png", "height": 0.3},
+        "obstacles": [{"shape": "mesh", "file": "rock.obj", "position": [3, 3, 0]}],
+    }, "creatures": [{"name": "a", "position": [-2, -2]}]}  # fmt: skip
+
+
+def test_a_scene_naming_terrain_files_saved_in_another_folder_loads_from_there(
+    tmp_path: Path,
+) -> None:
+    from ecs_tentacles.ground import ground_of
+
+    scenes, other = tmp_path / "scenes", tmp_path / "other"
+    scenes.mkdir()
+    other.mkdir()
+    (scenes / "shore.json").write_text(json.dumps(_terrain_scene(scenes)))
+    with World.from_scene(scenes / "shore.json") as world:
+        world.step(5)
+        saved = save_roster(world, other / "saved.json")
+        digest = ground_of(world).digest()
+    assert saved == other / "saved.json"
+    assert (other / "maps" / "sixteen.png").read_bytes() == (
+        scenes / "maps" / "sixteen.png"
+    ).read_bytes()
+    assert (other / "rock.obj").read_text() == TETRA
+    with World.from_scene(saved) as again:  # from its own folder, not the first scene's
+        assert ground_of(again).digest() == digest
+        assert [c.name for _, c in again.query(Creature)] == ["a"]
+
+
+def test_a_save_that_would_overwrite_another_file_of_the_same_name_is_refused(
+    tmp_path: Path,
+) -> None:
+    from ecs_tentacles.scene.errors import SceneError
+
+    scenes, other = tmp_path / "scenes", tmp_path / "other"
+    scenes.mkdir()
+    (other / "maps").mkdir(parents=True)
+    (other / "maps" / "sixteen.png").write_bytes(b"someone else's picture")
+    (scenes / "shore.json").write_text(json.dumps(_terrain_scene(scenes)))
+    with World.from_scene(scenes / "shore.json") as world:
+        with pytest.raises(SceneError) as error:
+            save_roster(world, other / "saved.json")
+    (line,) = str(error.value).splitlines()
+    assert line.startswith("terrain.heightfield.image: ")
+    assert str(other / "maps" / "sixteen.png") in line
+    assert (other / "maps" / "sixteen.png").read_bytes() == b"someone else's picture"
+    assert sorted(p.name for p in other.rglob("*")) == ["maps", "sixteen.png"]  # no copy

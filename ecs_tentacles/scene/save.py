@@ -1,5 +1,10 @@
 """Writing a scene: validated first, then JSON written through the one atomic writer.
 
+A scene names files relative to its folder (a heightfield image, meshes, plugin code).
+Saved in another folder, it takes copies of them along (`carried_files`), at the same
+names beside it, so the saved file loads from there; another file already at such a
+name is never overwritten: the save is refused, saying which.
+
 `default_file_name` makes the file name a save offers by default from the scene's
 `name`, which is any string a scene file says: it only ever names a file in the current
 folder, never a folder (no separators, `..`, control characters or ANSI codes).
@@ -7,18 +12,22 @@ folder, never a folder (no separators, `..`, control characters or ANSI codes).
 
 from __future__ import annotations
 
+import contextlib
+import copy
+import filecmp
 import json
 import os
 import re
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ecs_tentacles.atomic import atomic_output
+from ecs_tentacles.atomic import AtomicOutput, OutputError
 from ecs_tentacles.scene.errors import SceneError
-from ecs_tentacles.scene.load import load_scene
+from ecs_tentacles.scene.load import load_scene_plugins
 from ecs_tentacles.scene.physical import physically_checked
-from ecs_tentacles.scene.validate import validated
+from ecs_tentacles.scene.validate import format_path, validated
 
 if TYPE_CHECKING:
     from ecs_tentacles.plugin import Plugin
@@ -41,28 +50,159 @@ def default_file_name(name: object, suffix: str, fallback: str = "scene") -> str
     return stem + suffix
 
 
-def checked_scene(scene: dict[str, Any], plugins: Sequence[Plugin] | None = None) -> dict[str, Any]:
+def checked_scene(
+    scene: dict[str, Any], plugins: Sequence[Plugin] | None = None
+) -> tuple[dict[str, Any], list[Plugin]]:
     """`scene` validated and completed as `load_scene` does (SceneError, one line per
-    problem), by `plugins`: a running world's, already made, so no plugin is looked up
-    or imported again (a `spawner.py` in the current folder never runs). Without them,
-    by the plugins the scene names, of which only trusted ones are imported."""
+    problem), and the plugins that checked it: `plugins`, a running world's, already
+    made, so no plugin is looked up or imported again (a `spawner.py` in the current
+    folder never runs); without them, the plugins the scene names, of which only
+    trusted ones are imported."""
     if plugins is None:
-        return load_scene(scene)
+        return load_scene_plugins(scene)
     problems, completed = validated(scene, plugins)
     if problems or completed is None:
         raise SceneError(problems or ["the scene is not an object"])
-    return physically_checked(completed)
+    return physically_checked(completed), list(plugins)
+
+
+@dataclass(frozen=True)
+class Carried:
+    """A file a scene names, copied beside the scene saved in another folder."""
+
+    where: str  # its JSON path
+    source: Path  # in the scene's folder (resolved)
+    destination: Path  # in the saved scene's folder
+
+
+def named_files(
+    scene: Mapping[str, Any], plugins: Sequence[Plugin]
+) -> list[tuple[tuple[str | int, ...], str]]:
+    """Every file `scene` names relative to its folder, as (JSON path, name): plugin code
+    (`plugins.<key>.from: "file.py"`) and what each plugin's keys name
+    (`Plugin.scene_files`)."""
+    found: list[tuple[tuple[str | int, ...], str]] = []
+    chosen = scene.get("plugins")
+    for key, config in chosen.items() if isinstance(chosen, Mapping) else ():
+        target = config.get("from") if isinstance(config, Mapping) else None
+        if isinstance(target, str) and target.partition(":")[0].endswith(".py"):
+            found.append((("plugins", key, "from"), target))
+    for plugin in plugins:
+        found += plugin.scene_files(scene)
+    return found
+
+
+def carried_files(
+    scene: dict[str, Any], plugins: Sequence[Plugin], source_dir: Path | None, target: Path
+) -> list[Carried]:
+    """The files `scene` (from `source_dir`) names that a copy saved as `target` in
+    another folder needs beside it, at the same names; `scene` is changed where a name
+    has to be (an absolute path in its folder becomes relative). Nothing when it is
+    saved in its own folder. SceneError, one line each, when a file is not in the
+    scene's folder or another file already has its name in the new one."""
+    if source_dir is None:  # a scene from a dict: it cannot have named files
+        return []
+    base, folder = source_dir.resolve(), target.parent.resolve()
+    if folder == base:
+        return []
+    carried: dict[Path, Carried] = {}
+    problems: list[str] = []
+    for path, written in named_files(scene, plugins):
+        where = format_path(path)
+        name, colon, attribute = (
+            written.partition(":") if path[0] == "plugins" else (written, "", "")
+        )
+        source = (base / name).resolve()
+        if not source.is_relative_to(base) or not source.is_file():
+            problems.append(f"{where}: {name}: no such file in the scene's folder ({base})")
+            continue
+        lexical = Path(os.path.normpath(base / name))
+        relative = lexical.relative_to(base) if lexical.is_relative_to(base) else None
+        relative = relative or source.relative_to(base)
+        destination = folder / relative
+        if relative.as_posix() != name:
+            _set(scene, path, relative.as_posix() + colon + attribute)
+        if destination in carried or destination.resolve() == source:
+            continue
+        if os.path.lexists(destination) and not _same_content(source, destination):
+            problems.append(
+                f"{where}: {destination} is another file already; save the scene in another"
+                f" folder or in {base}"
+            )
+            continue
+        if not os.path.lexists(destination):
+            carried[destination] = Carried(where, source, destination)
+    if problems:
+        raise SceneError(problems)
+    return list(carried.values())
+
+
+def _same_content(source: Path, destination: Path) -> bool:
+    """True when `destination` is a regular file (not a link) holding what `source` holds."""
+    try:
+        return (
+            not destination.is_symlink()
+            and destination.is_file()
+            and filecmp.cmp(source, destination, shallow=False)
+        )
+    except OSError:
+        return False
+
+
+def _set(scene: dict[str, Any], path: tuple[str | int, ...], value: str) -> None:
+    node: Any = scene
+    for step in path[:-1]:
+        node = node[step]
+    node[path[-1]] = value
 
 
 def save_scene(
     scene: dict[str, Any],
     path: str | os.PathLike[str],
     plugins: Sequence[Plugin] | None = None,
+    *,
+    source_dir: Path | None = None,
+    indent: int = 1,
 ) -> Path:
     """Validate `scene` (`checked_scene`: SceneError listing the problems if not) and
-    write it atomically."""
-    checked_scene(scene, plugins)
+    write it to `path`; in another folder than its own (`source_dir`), with copies of
+    the files it names beside it (`carried_files`). The copies and the scene are written
+    whole or not at all: a copy already made is removed if a later file fails."""
+    _, checking = checked_scene(scene, plugins)
     target = Path(path)
-    with atomic_output(target) as temporary:
-        temporary.write_text(json.dumps(scene, indent=1) + "\n", encoding="utf-8")
+    if not target.parent.is_dir():
+        raise OutputError(f"{target}: folder {str(target.parent)!r} does not exist")
+    scene = copy.deepcopy(scene)
+    carried = carried_files(scene, checking, source_dir, target)
+    folder = target.parent.resolve()
+    outputs: list[AtomicOutput] = []
+    made: list[Path] = []  # copies and folders that were not there before
+    try:
+        for item in carried:
+            needed = [p for p in item.destination.parents if p.is_relative_to(folder)]
+            for parent in reversed(needed):  # "maps/hill.png": the folder maps first
+                if not parent.exists():
+                    parent.mkdir()
+                    made.append(parent)
+            outputs.append(_written(item.destination, item.source.read_bytes()))
+        text = json.dumps(scene, indent=indent) + "\n"
+        outputs.append(_written(target, text.encode("utf-8")))
+        for output in outputs[:-1]:  # the copies first: the scene appears last
+            made.append(output.commit(same_file=True))
+        outputs[-1].commit(same_file=True)
+    except BaseException:
+        for output in outputs:
+            output.discard()
+        for leftover in reversed(made):
+            with contextlib.suppress(OSError):
+                leftover.rmdir() if leftover.is_dir() else leftover.unlink()
+        raise
     return target
+
+
+def _written(target: Path, data: bytes) -> AtomicOutput:
+    """An opened `AtomicOutput` for `target` holding `data`, to commit."""
+    output = AtomicOutput(target)
+    with os.fdopen(output.open(), "wb") as handle:
+        handle.write(data)
+    return output

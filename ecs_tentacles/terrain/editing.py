@@ -143,10 +143,11 @@ class TerrainEditor:
     # -- saving ----------------------------------------------------------------------------
     def save(self, world: Host, raw: dict[str, Any], path: str | os.PathLike[str]) -> Path:
         """Write scene `raw` (the file as it was read) with the edited terrain to `path`,
-        validated and atomically (`ecs_tentacles.scene.save`)."""
+        validated and atomically, with the files it names beside it when `path` is in
+        another folder than the scene's (`ecs_tentacles.scene.save`)."""
         scene = copy.deepcopy(raw)
         scene["terrain"] = self._terrain(world)
-        return save_scene(scene, path, world.plugins)
+        return save_scene(scene, path, world.plugins, source_dir=world.scene_dir)
 
     # -- internals -------------------------------------------------------------------------
     def _terrain(self, world: Host) -> dict[str, Any]:

@@ -12,8 +12,8 @@ where the cursor's ray meets the ground (or an obstacle) instead of selecting:
 
 Each edit goes through `TerrainEditor` (`ecs_tentacles.terrain.editing`): the physics
 models are recompiled, nothing else is rebuilt, the creatures keep going. "Save scene"
-writes the scene file with the edits (to the path in the box; a scene with mesh
-obstacles must be saved in its own folder, where the meshes are).
+writes the scene file with the edits (to the path in the box; in another folder than
+the scene's, with copies of the height image and meshes it names beside it).
 Reads and writes the terrain through `TerrainEditor`.
 """
 
@@ -148,13 +148,6 @@ class TerrainPanel(Panel):
         try:
             target = Path(self.save_path)
             raw = self._raw_scene()
-            terrain = (self.sandbox.world.scene or {}).get("terrain") or {}
-            meshes = any("file" in o for o in terrain.get("obstacles", []))
-            folder = self.sandbox.world.scene_dir
-            if meshes and folder is not None and target.resolve().parent != folder.resolve():
-                raise TerrainEditError(
-                    f"the mesh obstacles' files are in {folder}: save the scene there"
-                )
             saved = self.editor.save(self.sandbox.world, raw, target)
         except (TerrainEditError, SceneError, OSError) as error:
             self.message = f"not saved: {' '.join(str(error).split())}"

@@ -49,6 +49,17 @@ class TerrainPlugin(Plugin):
             found += source_problems(terrain["heightfield"])
         return found + obstacle_problems(terrain.get("obstacles", []))
 
+    def scene_files(self, scene: Mapping[str, Any]) -> list[tuple[tuple[str | int, ...], str]]:
+        terrain = scene.get("terrain") or {}
+        files: list[tuple[tuple[str | int, ...], str]] = []
+        field = terrain.get("heightfield") or {}
+        if isinstance(field.get("image"), str):
+            files.append((("terrain", "heightfield", "image"), field["image"]))
+        for i, obstacle in enumerate(terrain.get("obstacles") or []):
+            if isinstance(obstacle.get("file"), str):
+                files.append((("terrain", "obstacles", i, "file"), obstacle["file"]))
+        return files
+
     def resources(self, world: Host) -> list[object]:
         ground = build_ground((world.scene or {}).get("terrain") or {}, world.scene_dir)
         return [ground, TerrainEditor()]

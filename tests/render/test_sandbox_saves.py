@@ -58,3 +58,36 @@ def test_a_scene_name_never_chooses_the_folder_or_odd_characters_of_a_save(
         f"{expected}_directed.json",
         f"{expected}_terrain.json",
     ]
+
+
+def test_the_terrain_section_saves_a_scene_with_its_files_into_another_folder(
+    make_sandbox: Callable[..., Any], tmp_path: Path
+) -> None:
+    import json
+
+    import numpy as np
+    from PIL import Image
+
+    from ecs_tentacles.ground import ground_of
+    from ecs_tentacles.world import World
+
+    scenes, other = tmp_path / "scenes", tmp_path / "other"
+    scenes.mkdir()
+    other.mkdir()
+    Image.fromarray(np.tile(np.arange(16, dtype=np.uint8) * 8, (16, 1))).save(scenes / "hill.png")
+    (scenes / "rock.obj").write_text(
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n"
+    )
+    scene = {"version": 1, "name": "hill", "terrain": {
+        "heightfield": {"size": [8, 8], "image": "hill.png", "height": 0.3},
+        "obstacles": [{"shape": "mesh", "file": "rock.obj", "position": [3, 3, 0]}],
+    }, "creatures": [{"name": "a", "position": [-2, -2]}]}  # fmt: skip
+    (scenes / "hill.json").write_text(json.dumps(scene))
+    sandbox = make_sandbox(str(scenes / "hill.json"))
+    panel = sandbox.panel("Terrain")
+    panel.save_path = str(other / "edited.json")
+    panel.save()
+    assert panel.message == f"saved {other / 'edited.json'}"
+    assert sorted(p.name for p in other.iterdir()) == ["edited.json", "hill.png", "rock.obj"]
+    with World.from_scene(other / "edited.json") as again:
+        assert ground_of(again).digest() == ground_of(sandbox.world).digest()
