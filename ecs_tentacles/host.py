@@ -54,6 +54,10 @@ class Host(PhysicsHost, Protocol):
     def creature_specs(self) -> dict[int, dict[str, Any]]:
         """Every creature's entry (validated, defaults in) by entity, spawned ones too."""
 
+    @property
+    def kept_names(self) -> set[str]:
+        """Names no new creature may take (a recording's creatures, despawned ones too)."""
+
     # -- creatures that come and go (`ecs_tentacles.spawning`) ----------------------------
     def spawn(
         self,

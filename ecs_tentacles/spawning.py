@@ -104,8 +104,9 @@ def _as_creature(problem: str) -> str:
 
 
 def unique_name(world: World, name: str) -> str:
-    """`name`, or `name_2`, `name_3`... : the first no creature of `world` has."""
-    taken = {c.name for _, c in world.query(Creature)}
+    """`name`, or `name_2`, `name_3`... : the first no creature of `world` has and no
+    take being recorded has seen (`World.kept_names`)."""
+    taken = {c.name for _, c in world.query(Creature)} | world.kept_names
     if name not in taken:
         return name
     base = re.sub(r"_\d+$", "", name)
@@ -221,6 +222,11 @@ def place(world: World, entry: dict[str, Any], moved_to: tuple[float, ...] | Non
     unique) where it says, without looking for overlaps: `spawn`'s last step, and how
     `scatter` places many copies of one checked entry at spots it knows are free."""
     world.activate()
+    wanted = entry["name"]
+    if wanted in world.kept_names or any(c.name == wanted for _, c in world.query(Creature)):
+        raise SpawnError(  # a take would name two creatures alike: unwritable at the end
+            [f"creature.name: {wanted!r} is taken (by a creature here or in the take recorded)"]
+        )
     before = {name: len(store) for name, store in world.stores.items()}
     entity = build_creature(world, entry)
     for plugin in world.plugins:

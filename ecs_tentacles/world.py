@@ -79,6 +79,9 @@ class World:
         self.scene_dir: pathlib.Path | None = None  # its folder: plugin files are found there
         # every creature's entry (validated, defaults in) by entity: the scene's and spawns'
         self.creature_specs: dict[int, dict[str, Any]] = {}
+        # names no new creature may take although no creature has them now: a take being
+        # recorded names each creature once (`TakeRecorder` keeps its creatures' here)
+        self.kept_names: set[str] = set()
         self.frame = 0
 
     # -- construction ------------------------------------------------------------------

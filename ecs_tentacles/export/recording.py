@@ -159,6 +159,7 @@ class TakeRecorder:
         """Append one creature's bodies and suckers to the take's tables."""
         index = self.creature_index[entity] = len(self._creatures)
         name = creature.name
+        world.kept_names.add(name)  # a later spawn of this name gets a suffix (spawning)
         first = len(self._bodies)
         rows = [world.component(entity, Transform).row]
         entry: dict[str, Any] = {"name": name, "mantle": first, "tentacles": []}
