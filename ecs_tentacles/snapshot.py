@@ -14,7 +14,9 @@ belongs to the world it came from.
 
 Creatures spawned since the snapshot are despawned by a restore (the world goes back
 to the roster it had). A creature despawned since cannot come back with its old
-entity: such a restore is refused, and nothing changes.
+entity: such a restore is refused, and nothing changes. A restore is whole or nothing:
+the events it emits (`creature_despawned`) reach their handlers after it is complete
+(`World.restore` holds them), so a handler that spawns spawns into the restored world.
 """
 
 from __future__ import annotations

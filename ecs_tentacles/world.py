@@ -329,7 +329,8 @@ class World:
         from ecs_tentacles import snapshot
 
         self.activate()
-        snapshot.restore(self, state)
+        with self.events.held():  # handlers run after: a restore is whole or nothing
+            snapshot.restore(self, state)
 
     @property
     def time(self) -> float:

@@ -84,3 +84,39 @@ def test_a_snapshot_of_another_world_is_refused_and_changes_nothing(
         w.step(10)
     for mine, theirs in zip(_state(world), _state(twin), strict=True):
         assert_array_equal(mine, theirs)  # as if the restore had never been asked for
+
+
+def test_a_handler_that_spawns_during_a_restore_runs_after_it_whole() -> None:
+    """A `creature_despawned` handler spawning while a restore despawned the newcomers left
+    the world half-restored (roster altered, frame and state not), then SnapshotMismatch."""
+    from ecs_tentacles.components import Creature
+
+    def octo(name: str, x: float) -> dict:
+        return {"name": name, "position": [x, 0.0], "tentacles": {"count": 4, "links": 3}}
+
+    scene = {"version": 1, "creatures": [octo("a", 0.0), octo("b", 5.0)]}
+    with World.from_scene(scene) as world, World.from_scene(scene) as twin:
+        world.step(5)
+        twin.step(5)
+        snap = world.snapshot()
+        world.spawn(octo("c", 10.0))
+        world.step(7)
+        seen: list[tuple[str, int]] = []
+
+        def replace(**event: object) -> None:
+            seen.append((str(event["creature_name"]), world.frame))
+            world.spawn(octo("d", -10.0))  # as a script that keeps a crowd at full strength
+
+        world.events.on("creature_despawned", replace)
+        world.restore(snap)
+        assert seen == [("c", 5)]  # after the restore: at the snapshot's frame
+        assert world.frame == 5
+        assert sorted(c.name for _, c in world.query(Creature)) == ["a", "b", "d"]
+        world.step(20)
+        twin.step(20)
+        for name in ("a", "b"):  # restored exactly: as if c had never come
+            mine = world.physics.group_of(world.component(world.creature(name), Creature))
+            theirs = twin.physics.group_of(twin.component(twin.creature(name), Creature))
+            assert_array_equal(
+                world.transforms.pos[mine.body_rows], twin.transforms.pos[theirs.body_rows]
+            )
