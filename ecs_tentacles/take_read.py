@@ -94,6 +94,11 @@ def _creature_problem(creatures: list[dict[str, Any]], bodies: int) -> str | Non
         chains = creature.get("tentacles")
         if not isinstance(chains, list) or not all(isinstance(k, list) for k in chains):
             return f"{where}.tentacles: must be a list of lists of body indices"
+        if not chains:  # the exporters' skeletons need a tentacle of a link at least
+            return f"{where}.tentacles: a creature needs at least one tentacle, got 0"
+        empty = next((k for k, chain in enumerate(chains) if not chain), None)
+        if empty is not None:
+            return f"{where}.tentacles[{empty}]: a tentacle needs at least one link, got 0"
         for index in [creature.get("mantle"), *(i for chain in chains for i in chain)]:
             if not _index(index, bodies) or index in used:
                 return f"{where}: body index {index!r} is out of range or used twice"

@@ -170,6 +170,8 @@ BROKEN_TAKES: dict[str, Callable[[Path, Path], None]] = {
     "no_format": edit(lambda h, a: h.pop("format")),
     "header_not_json": edit(lambda h, a: a.update(header=_npy(np.frombuffer(b"{oops", np.uint8)))),
     "body_index_out_of_range": edit(lambda h, a: h["creatures"][0]["tentacles"][0].append(999)),
+    "creature_without_tentacles": edit(lambda h, a: h["creatures"][0].update(tentacles=[])),
+    "tentacle_without_links": edit(lambda h, a: h["creatures"][0]["tentacles"].__setitem__(2, [])),
     "body_used_twice": edit(lambda h, a: h["creatures"][0]["tentacles"][1].__setitem__(0, 0)),
     "body_name_with_spaces": edit(lambda h, a: h["bodies"][1].update(name="octo/link 1")),
     "body_name_without_folder": edit(lambda h, a: h["bodies"][0].update(name="mantle")),
