@@ -28,6 +28,7 @@ fsynced and renamed onto the target, then the folder is fsynced.
 from __future__ import annotations
 
 import contextlib
+import errno
 import fcntl
 import os
 import re
@@ -47,6 +48,25 @@ Identity = tuple[int, int, int, int, int] | None
 
 class OutputError(OSError):
     """An output could not be written; the message is one line naming the file."""
+
+
+_DISK_FULL = (errno.ENOSPC, errno.EDQUOT, errno.EFBIG)
+
+
+def disk_full(target: Path, error: BaseException) -> OutputError | None:
+    """`error` (a writer's, while writing `target`) as one line naming `target` when the
+    disk or quota is full or the file too large, else None. Writers say it their way:
+    an OSError's errno (numpy, zipfile, JSON), or only in the text (USD's
+    `Tf.ErrorException` repeats "No space left on device" for every buffer it flushes)."""
+    if isinstance(error, OutputError):
+        return None
+    code = error.errno if isinstance(error, OSError) else None
+    if code not in _DISK_FULL:
+        text = str(error)
+        code = next((c for c in _DISK_FULL if os.strerror(c) in text), None)
+        if code is None or not isinstance(error, Exception):
+            return None
+    return OutputError(f"{target}: cannot write: {os.strerror(code).lower()}; nothing written")
 
 
 class OutputConflict(OutputError):
@@ -230,8 +250,11 @@ class AtomicOutput:
                     " writing; nothing written"
                 )
             os.fsync(descriptor)
-        except BaseException:
+        except BaseException as error:
             self.discard()
+            full = disk_full(self.target, error)
+            if full is not None:
+                raise full from None
             raise
         finally:
             os.close(descriptor)
@@ -271,8 +294,11 @@ def atomic_output(target: str | os.PathLike[str]) -> Iterator[Path]:
     assert output.temporary is not None
     try:
         yield output.temporary
-    except BaseException:
+    except BaseException as error:
         output.discard()
+        full = disk_full(output.target, error)
+        if full is not None:
+            raise full from None
         raise
     output.commit()
 
@@ -288,7 +314,10 @@ def atomic_file(target: str | os.PathLike[str]) -> Iterator[BinaryIO]:
     try:
         with os.fdopen(descriptor, "wb") as handle:
             yield handle
-    except BaseException:
+    except BaseException as error:
         output.discard()
+        full = disk_full(output.target, error)
+        if full is not None:
+            raise full from None
         raise
     output.commit(same_file=True)

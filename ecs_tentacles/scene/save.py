@@ -23,7 +23,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ecs_tentacles.atomic import AtomicOutput, OutputError
+from ecs_tentacles.atomic import AtomicOutput, OutputError, disk_full
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.load import load_scene_plugins
 from ecs_tentacles.scene.physical import physically_checked
@@ -201,8 +201,16 @@ def save_scene(
 
 
 def _written(target: Path, data: bytes) -> AtomicOutput:
-    """An opened `AtomicOutput` for `target` holding `data`, to commit."""
+    """An opened `AtomicOutput` for `target` holding `data`, to commit (a full disk is
+    one line naming `target`)."""
     output = AtomicOutput(target)
-    with os.fdopen(output.open(), "wb") as handle:
-        handle.write(data)
+    try:
+        with os.fdopen(output.open(), "wb") as handle:
+            handle.write(data)
+    except BaseException as error:
+        output.discard()
+        full = disk_full(target, error)
+        if full is not None:
+            raise full from None
+        raise
     return output
