@@ -125,7 +125,22 @@ def _later_problems(data: object, found: list[str], plugins: list[Plugin]) -> li
         physical = physical_problems(completed or with_defaults(fixed, plugins))
     except (KeyError, IndexError, TypeError, ValueError):
         physical = []
-    return later + [problem for problem in physical if problem not in found]
+    later += [problem for problem in physical if problem not in found]
+    return [problem for problem in later if not _caused_by_repair(problem, found)]
+
+
+def _caused_by_repair(problem: str, found: list[str]) -> bool:
+    """True when `problem`, found in the repaired scene, is about an object one of whose
+    keys the repair took out because of a problem `found`, and names that key (a NaN
+    `radius` taken out is not also a sphere that "needs 'radius'"; a numpy `heights`
+    not also a heightfield without one of "noise, image or heights")."""
+    where, _, message = problem.partition(": ")
+    for earlier in found:
+        path = earlier.partition(": ")[0]
+        key = path[len(where) + 1 :] if path.startswith(where + ".") else ""
+        if key.isidentifier() and re.search(rf"\b{key}\b", message):
+            return True
+    return False
 
 
 def load_scene_plugins(

@@ -63,7 +63,10 @@ def _show(value: object) -> str:
     try:
         text = json.dumps(value)
     except (TypeError, ValueError):
-        text = repr(value)
+        shape = getattr(value, "shape", None)
+        if isinstance(shape, tuple) and hasattr(value, "tolist"):  # a script's numpy array
+            return f"a numpy array of shape {shape} (give a list: .tolist())"
+        text = " ".join(repr(value).split())  # one line, whatever the object prints
     return text if len(text) <= _MAX_SHOWN else text[: _MAX_SHOWN - 3] + "..."
 
 
