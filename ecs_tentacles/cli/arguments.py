@@ -5,23 +5,59 @@ from __future__ import annotations
 import argparse
 import importlib.resources
 import os
+import re
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import NoReturn
 
 from ecs_tentacles.atomic import OutputError, claim
+
+# options whose value may start with "-" (`--focus -2,1,3`): argparse takes "-2,1,3" for
+# an option and says "expected one argument"; such a value is joined to its option
+NEGATIVE_VALUES = ("--focus",)
+_NUMBER_START = re.compile(r"^-\.?\d")
+
+
+def joined_negative_values(argv: Sequence[str]) -> list[str]:
+    """`argv` with `--focus -2,1,3` written `--focus=-2,1,3` (a value that starts with a
+    minus and a digit, after an option of `NEGATIVE_VALUES`)."""
+    out: list[str] = []
+    words = list(argv)
+    i = 0
+    while i < len(words):
+        word = words[i]
+        if word == "--":  # the rest is positional
+            out += words[i:]
+            break
+        if word in NEGATIVE_VALUES and i + 1 < len(words) and _NUMBER_START.match(words[i + 1]):
+            out.append(f"{word}={words[i + 1]}")
+            i += 2
+            continue
+        out.append(word)
+        i += 1
+    return out
 
 
 class OneLineParser(argparse.ArgumentParser):
     """argparse, but a bad argument is one line `error: <where>: <what>` (exit 2).
 
     `<where>` is the argument argparse names, or the command; `--help` shows usage.
+    A value starting with "-" after `--focus` is taken as its value (`NEGATIVE_VALUES`).
     """
+
+    def parse_known_args(  # type: ignore[override]
+        self, args: Sequence[str] | None = None, namespace: argparse.Namespace | None = None
+    ) -> tuple[argparse.Namespace, list[str]]:
+        words = sys.argv[1:] if args is None else args
+        return super().parse_known_args(joined_negative_values(words), namespace)
 
     def error(self, message: str) -> NoReturn:
         text = " ".join(message.split())
         where = "" if text.startswith("argument ") else f"{self.prog}: "
+        if "expected one argument" in text:  # its value began with "-": `--opt=-value`
+            option = text.removeprefix("argument ").split(":")[0].split("/")[-1]
+            text += f"; a value that starts with '-' is written {option}=VALUE"
         self.exit(2, f"error: {where}{text} (see {self.prog} --help)\n")
 
 

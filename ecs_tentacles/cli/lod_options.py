@@ -51,8 +51,8 @@ def add_lod_arguments(parser: argparse.ArgumentParser) -> None:
         type=focus_region,
         default=None,
         metavar="X,Y,R",
-        help="creatures within R m of (X, Y) always run full physics (a negative X needs"
-        " --focus=X,Y,R)",
+        help="creatures within R m of (X, Y) always run full physics (--focus -2,1,3"
+        " and --focus=-2,1,3 both work)",
     )
 
 
