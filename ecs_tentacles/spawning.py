@@ -111,9 +111,15 @@ def unique_name(world: World, name: str) -> str:
         return name
     base = re.sub(r"_\d+$", "", name)
     n = 2
-    while f"{base}_{n}" in taken:
+    while _suffixed(base, n) in taken:
         n += 1
-    return f"{base}_{n}"
+    return _suffixed(base, n)
+
+
+def _suffixed(base: str, n: int, longest: int = 64) -> str:
+    """`base_n`, `base` shortened so it stays within the schema's `longest` name."""
+    suffix = f"_{n}"
+    return base[: longest - len(suffix)] + suffix
 
 
 # -- overlap with the creatures there and the obstacles ------------------------------------
