@@ -8,7 +8,10 @@ Per frame only whole-array work runs here: `write_controls` (motor targets into 
 row's ctrl, gains and torque limits into the overlay), `write_suckers` (sucker
 switches and anchors), `step` (every awake row advanced on the stepping threads, each
 thread with its own scratch MjData per batch) and `sync` (body poses scattered into
-the Transform store). Systems stay whole-array and never see a MuJoCo object.
+the Transform store). Systems stay whole-array and never see a MuJoCo object. Every
+`heap.TRIM_FRAMES` frames `step` gives the C heap's free pages back, and building one fixes
+glibc's thresholds (`ecs_tentacles.heap`): the frames' numpy temporaries would otherwise
+leave a long run growing.
 
 `state()` / `set_state()` copy everything that decides how the physics steps on
 (every batch's state rows and forces, the health check's memory, the sleep counters,
@@ -28,6 +31,7 @@ from typing import TYPE_CHECKING
 import mujoco
 import numpy as np
 
+from ecs_tentacles import heap
 from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.physics.batch import Batch
 from ecs_tentacles.physics.health import SOFT_GAIN, HealthCheck, HealthState
@@ -82,6 +86,7 @@ class PhysicsBackend(Membership):
 
     def __init__(self, world: PhysicsHost, threads: int | None = None):
         route_mujoco_messages()
+        heap.settle()  # a long run must not grow (`ecs_tentacles.heap`)
         self.threads = max(1, threads if threads is not None else os.cpu_count() or 1)
         self.time = 0.0
         creatures = sorted(world.query(Creature, Transform))
@@ -117,6 +122,7 @@ class PhysicsBackend(Membership):
             roster, self.proxies, settings.lod, settings.fps, self.place_joints
         )
         self._pool = ThreadPoolExecutor(self.threads) if self.threads > 1 else None
+        self._untrimmed = 0  # frames stepped since the C heap was last trimmed
 
     # per creature, in entity order: the roster's arrays (replaced when creatures come
     # and go, so read through these, never kept)
@@ -325,6 +331,10 @@ class PhysicsBackend(Membership):
                         between()
                     self._run(chunks, part)
         self.time += substeps * self.substep_dt
+        self._untrimmed += 1
+        if self._untrimmed >= heap.TRIM_FRAMES:
+            self._untrimmed = 0
+            heap.trim()
 
     def _run(self, chunks: list[list[Segment]], substeps: dict[int, int]) -> None:
         if self._pool is None or len(chunks) < 2:
