@@ -1,0 +1,166 @@
+"""Soak test: run a command (a headless simulation) for a while and watch its memory.
+
+    python tools/soak.py --crowd 64 --terrain rocky --minutes 30
+    python tools/soak.py --scene octopus --minutes 5 --every 10
+    python tools/soak.py --minutes 60 -- ecs-tentacles bake crowd.json --seconds 900 --out t.npz
+
+The command runs in a process of its own (`--crowd N` writes that crowd scene with
+`ecs-tentacles crowd` and runs it; `--scene` runs a scene file or bundled scene:
+`ecs-tentacles run SCENE --frames <many> --quiet --threads T`). Its resident set size
+(psutil; `--tree` adds its descendants') is sampled every `--every` seconds until
+`--minutes` have passed, then the command is stopped (SIGTERM) if it still runs.
+
+The table lists every sample: seconds since the start, RSS, and RSS against the
+baseline. The baseline is the median of the samples in the first minute after
+`--warmup` seconds (building the scene and the first frames grow a process for real);
+the end is the median of the last minute. The verdict compares end - baseline with
+`--threshold` MB (exit 0 within it, 1 over it or when the command failed) and gives
+the peak after warm-up and the least-squares slope in MB per hour. Medians, because a
+process that frees memory in bursts (the C heap is trimmed every few seconds) saws up
+and down by a few MB.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import signal
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+import psutil
+
+MB = 1024.0**2
+
+
+def resident(process: psutil.Process, tree: bool) -> float:
+    """RSS of `process` (and its descendants with `tree`) in MB."""
+    processes = [process, *process.children(recursive=True)] if tree else [process]
+    total = 0
+    for p in processes:
+        try:
+            total += p.memory_info().rss
+        except psutil.Error:
+            continue
+    return total / MB
+
+
+def command_of(args: argparse.Namespace, folder: Path) -> list[str]:
+    """The command to soak: the one given after `--`, or `run` of the scene / crowd."""
+    if args.command:
+        return args.command
+    cli = [sys.executable, "-m", "ecs_tentacles"]
+    scene = args.scene
+    if args.crowd is not None:
+        scene = str(folder / f"crowd{args.crowd}.json")
+        write = [*cli, "crowd", str(args.crowd), "--out", scene, "--seed", str(args.seed)]
+        subprocess.run([*write, "--terrain", args.terrain], check=True, stdout=subprocess.DEVNULL)
+    frames = ["--frames", "1000000", "--quiet", "--threads", str(args.threads)]
+    return [*cli, "run", scene, *frames]
+
+
+def window(samples: list[tuple[float, float]], start: float, end: float) -> list[float]:
+    return [rss for t, rss in samples if start <= t <= end]
+
+
+def verdict(
+    samples: list[tuple[float, float]], warmup: float, threshold: float
+) -> tuple[bool, str]:
+    """(within the threshold, the verdict line) from (seconds, MB) samples."""
+    after = [(t, rss) for t, rss in samples if t >= warmup]
+    if len(after) < 2:
+        return False, "FAIL: fewer than two samples after the warm-up (run longer)"
+    first_t, last_t = after[0][0], after[-1][0]
+    span = min(60.0, (last_t - first_t) / 4)
+    base = statistics.median(window(after, first_t, first_t + span))
+    end = statistics.median(window(after, last_t - span, last_t))
+    peak_t, peak = max(after, key=lambda s: s[1])
+    t = np.array([s[0] for s in after])
+    rss = np.array([s[1] for s in after])
+    slope = float(np.polyfit(t, rss, 1)[0]) * 3600.0
+    growth = end - base
+    ok = growth <= threshold
+    word = "PASS" if ok else "FAIL"
+    return ok, (
+        f"{word}: resident memory after warm-up {base:.1f} -> {end:.1f} MB"
+        f" ({growth:+.1f} MB over {(last_t - first_t) / 60:.1f} min, threshold +{threshold:g} MB);"
+        f" peak {peak:.1f} MB at {peak_t:.0f} s ({peak - base:+.1f}); slope {slope:+.2f} MB/h"
+    )
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    what = parser.add_mutually_exclusive_group()
+    what.add_argument("--crowd", type=int, metavar="N", help="run a crowd scene of N creatures")
+    what.add_argument("--scene", default="octopus", help="scene file or bundled scene to run")
+    parser.add_argument("--terrain", default="rocky", help="the crowd's ground (default rocky)")
+    parser.add_argument("--seed", type=int, default=0, help="the crowd's seed (default 0)")
+    parser.add_argument("--threads", type=int, default=1, help="stepping threads (default 1)")
+    parser.add_argument("--minutes", type=float, default=30.0, help="how long (default 30)")
+    parser.add_argument("--every", type=float, default=30.0, help="seconds between samples")
+    parser.add_argument("--warmup", type=float, default=180.0, help="seconds not judged")
+    parser.add_argument("--threshold", type=float, default=5.0, help="MB allowed to grow")
+    parser.add_argument("--tree", action="store_true", help="add the descendants' RSS")
+    parser.add_argument("command", nargs="*", help="the command to soak (after --)")
+    args = parser.parse_args(argv)
+
+    with tempfile.TemporaryDirectory(prefix="soak-") as tmp:
+        command = command_of(args, Path(tmp))
+        print(f"soak: {' '.join(command)}", flush=True)
+        print(
+            f"soak: {args.minutes:g} min, a sample every {args.every:g} s,"
+            f" warm-up {args.warmup:g} s, threshold +{args.threshold:g} MB",
+            flush=True,
+        )
+        with open(Path(tmp) / "output.txt", "w+") as log:
+            child = subprocess.Popen(command, stdout=log, stderr=subprocess.STDOUT)
+            samples, ended = sample(child, args)
+            log.seek(0)
+            tail = log.read().splitlines()[-5:]
+    if ended:
+        print(f"FAIL: the command ended early (exit {child.returncode}):", *tail, sep="\n")
+        return 1
+    ok, line = verdict(samples, args.warmup, args.threshold)
+    print(line, flush=True)
+    return 0 if ok else 1
+
+
+def sample(
+    child: subprocess.Popen[bytes], args: argparse.Namespace
+) -> tuple[list[tuple[float, float]], bool]:
+    """(seconds, MB) samples of `child` until the time is up, a row printed for each; then
+    the child is stopped. Also whether it ended by itself before that."""
+    process = psutil.Process(child.pid)
+    start = time.monotonic()
+    samples: list[tuple[float, float]] = []
+    print(f"{'seconds':>8} {'RSS MB':>9} {'vs base':>8}", flush=True)
+    try:
+        while (now := time.monotonic() - start) < args.minutes * 60:
+            if child.poll() is not None:
+                break
+            rss = resident(process, args.tree)
+            samples.append((now, rss))
+            after = window(samples, args.warmup, now)
+            base = f"{rss - after[0]:+8.1f}" if after else f"{'':>8}"
+            print(f"{now:8.0f} {rss:9.1f} {base}", flush=True)
+            time.sleep(max(0.0, args.every - (time.monotonic() - start - now)))
+    finally:
+        ended = child.poll() is not None
+        if not ended:
+            child.send_signal(signal.SIGTERM)
+            try:
+                child.wait(timeout=30)
+            except subprocess.TimeoutExpired:
+                child.kill()
+                child.wait()
+    return samples, ended
+
+
+if __name__ == "__main__":
+    os.environ.setdefault("PYTHONUNBUFFERED", "1")
+    sys.exit(main())
