@@ -1,0 +1,37 @@
+"""tools/soak.py's verdict: growth after warm-up, medians against a sawtooth."""
+
+from __future__ import annotations
+
+import importlib.util
+import sys
+from pathlib import Path
+from types import ModuleType
+
+import pytest
+
+TOOLS = Path(__file__).resolve().parents[2] / "tools"
+
+pytestmark = pytest.mark.skipif(not TOOLS.is_dir(), reason="needs the source tree")
+
+
+def soak() -> ModuleType:
+    spec = importlib.util.spec_from_file_location("soak", TOOLS / "soak.py")
+    assert spec and spec.loader
+    module = importlib.util.module_from_spec(spec)
+    sys.modules["soak"] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_a_flat_sawtooth_after_warm_up_passes_and_a_creep_fails() -> None:
+    tool = soak()
+    warm = [(float(t), 100.0 + t) for t in range(0, 180, 30)]  # the build grows for real
+    saw = [(float(t), 300.0 + 4.0 * (t // 30 % 2)) for t in range(180, 1800, 30)]
+    ok, line = tool.verdict(warm + saw, 180.0, 5.0)
+    assert ok, line
+    assert line.startswith("PASS: resident memory after warm-up")
+    creep = [(float(t), 300.0 + t / 200.0) for t in range(180, 1800, 30)]
+    ok, line = tool.verdict(warm + creep, 180.0, 5.0)
+    assert not ok
+    assert line.startswith("FAIL:") and "slope +18.00 MB/h" in line
+    assert not tool.verdict(warm, 180.0, 5.0)[0]  # nothing after the warm-up
