@@ -71,8 +71,15 @@ def load_world(
     plugins: Mapping[str, Any] | None = None,
     scene_dir: str | os.PathLike[str] | None = None,
     lod: bool | None = None,
+    checks_only: bool = False,
 ) -> W:
-    """A `cls` world built from a scene file, bundled scene name or dict (`World.from_scene`)."""
+    """A `cls` world built from a scene file, bundled scene name or dict (`World.from_scene`).
+
+    `checks_only` stops once every check a run makes before it simulates has run (the
+    scene, the plugins' resources with the files they read, the build hooks, the plugins'
+    systems): no physics models are compiled and nothing is scheduled; a scene's own
+    `systems` are imported only when allowed (`validate`; close the world after).
+    """
     folder = pathlib.Path(scene_dir) if scene_dir is not None else None
     if not isinstance(source, dict):
         source = resolve_scene_path(os.fspath(source))  # a path, or a bundled scene's name
@@ -81,7 +88,8 @@ def load_world(
         raw = source if isinstance(source, dict) else _read_scene(source)
         source = {**raw, "plugins": {**(raw.get("plugins") or {}), **plugins}}
     data, chosen = load_scene_plugins(source, allow_systems=allow_systems, scene_dir=folder)
-    chosen += _scene_systems(data["systems"], folder, allow_systems)
+    if allow_systems or not checks_only:  # validate says what a scene asks to run
+        chosen += _scene_systems(data["systems"], folder, allow_systems)
     settings = Settings.from_physics(data["physics"])
     if lod is not None:  # the caller's choice over the scene's
         settings = replace(settings, lod=replace(settings.lod, enabled=lod))
@@ -91,17 +99,25 @@ def load_world(
         name=data.get("name", "scene"),
     )
     world.scene, world.scene_dir = data, folder
-    for plugin in chosen:
-        world.adopt(plugin)
-    for index, creature in enumerate(data["creatures"]):
-        if only is None or index in only:
-            entity = build_creature(world, creature)
-            world.creature_specs[entity] = creature
+    try:
+        for plugin in chosen:
+            world.adopt(plugin)
+        for index, creature in enumerate(data["creatures"]):
+            if only is None or index in only:
+                entity = build_creature(world, creature)
+                world.creature_specs[entity] = creature
+                for plugin in chosen:
+                    with calling(plugin, "build_creature"):
+                        plugin.build_creature(world, entity, creature)
+        for plugin in chosen:
+            plugin.build_scene(world, data)
+        if checks_only:
             for plugin in chosen:
-                with calling(plugin, "build_creature"):
-                    plugin.build_creature(world, entity, creature)
-    for plugin in chosen:
-        plugin.build_scene(world, data)
+                _plugin_systems(plugin)
+            return world
+    except BaseException:  # a bad file, a creature inside a rock, a user's hook
+        world.close()  # its esper context
+        raise
     for store in world.stores.values():
         store.fit()  # a crowd's stores were grown by doubling: up to half unused
     world.build_physics(threads)

@@ -42,3 +42,18 @@ def octopus_take() -> Any:
     from ecs_tentacles.export.bake import BakePlan, bake
 
     return bake(BakePlan.make("octopus", seconds=4.0, fps=30.0), progress=False)
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _private_cache(tmp_path_factory: pytest.TempPathFactory) -> Iterator[None]:
+    """Decomposed meshes are cached in a folder of the test session's own, not the user's
+    (`ecs_tentacles.terrain.meshes.cache_folder`); the CLI processes tests start inherit it."""
+    import os
+
+    before = os.environ.get("XDG_CACHE_HOME")
+    os.environ["XDG_CACHE_HOME"] = str(tmp_path_factory.mktemp("cache"))
+    yield
+    if before is None:
+        os.environ.pop("XDG_CACHE_HOME", None)
+    else:
+        os.environ["XDG_CACHE_HOME"] = before

@@ -1,25 +1,35 @@
-"""`ecs-tentacles validate SCENE...`: check scene files without building anything."""
+"""`ecs-tentacles validate SCENE...`: check scene files as `run` does before it simulates.
+
+Every check a run makes before its first frame runs here: the schema and the scene's
+rules, then the world is built as far as a run builds it before compiling the physics
+(each plugin's resources, the files they read, such as the terrain's height image and
+meshes, its build hooks, its systems), and thrown away.
+"""
 
 from __future__ import annotations
 
 import argparse
 import json
+import pathlib
 import sys
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ecs_tentacles.cli.arguments import counted
 from ecs_tentacles.progress import status
 from ecs_tentacles.scene.errors import SceneError
-from ecs_tentacles.scene.load import load_scene_plugins, resolve_scene_path
+from ecs_tentacles.scene.load import resolve_scene_path
+
+if TYPE_CHECKING:
+    from ecs_tentacles.plugin import Plugin
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
     parser = commands.add_parser(
         "validate",
         help="check scene files against the schema (exit 0 if all are valid, 2 if not)",
-        description="Check scene files; print one line per problem with its JSON path, and"
-        " the systems a scene asks for (run, bake and play import them only with"
-        " --allow-systems).",
+        description="Check scene files as run does before it simulates (the files a scene"
+        " names included); print one line per problem with its JSON path, and the systems a"
+        " scene asks for (run, bake and play import them only with --allow-systems).",
     )
     parser.add_argument(
         "scenes", nargs="+", metavar="SCENE", help="scene file or bundled scene name"
@@ -64,13 +74,32 @@ def sentence(report: dict[str, Any]) -> str:
     return text
 
 
+def checked(path: pathlib.Path, allow_systems: bool) -> tuple[dict[str, Any], list[Plugin]]:
+    """The scene at `path`, completed, and its plugins, once every check a run makes
+    before simulating has passed (SceneError otherwise, each line led by the path)."""
+    from ecs_tentacles.world import World
+    from ecs_tentacles.world_loader import load_world
+
+    try:
+        world = load_world(World, path, allow_systems=allow_systems, checks_only=True)
+    except SceneError as error:
+        prefix = f"{path}: "
+        lines = [p if p.startswith(prefix) else prefix + p for p in error.problems]
+        raise SceneError(lines) from None
+    try:
+        assert world.scene is not None
+        return world.scene, list(world.plugins)
+    finally:
+        world.close()
+
+
 def handle(args: argparse.Namespace) -> int:
     failed = False
     for scene in args.scenes:
         try:
             path = resolve_scene_path(scene)
             with status(f"validate: checking {path}"):
-                data, plugins = load_scene_plugins(path, allow_systems=args.allow_systems)
+                data, plugins = checked(path, args.allow_systems)
         except SceneError as error:
             failed = True
             for problem in error.problems:

@@ -3,7 +3,10 @@
 Boxes, cylinders and spheres are MuJoCo primitives. A mesh (.obj, .stl, .glb next to
 the scene, at most `MAX_MESH_BYTES`) is read with trimesh; a convex one is one piece,
 any other is split into convex pieces with CoACD (MuJoCo collides a mesh as its convex
-hull, so a concave rock would otherwise fill in its hollows).
+hull, so a concave rock would otherwise fill in its hollows). Both run in a worker
+process with a time and memory budget, once per distinct file
+(`ecs_tentacles.terrain.meshes`); a mesh whose coordinates (times its scale) reach past
+1000 m, or without a volume (collinear points, one triangle), is refused.
 """
 
 from __future__ import annotations
@@ -16,23 +19,11 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from ecs_tentacles.ground import Solid, convex_planes
-from ecs_tentacles.scene.load import MAX_SCENE_BYTES
-from ecs_tentacles.terrain.heights import Problem, TerrainError, beside_scene
+from ecs_tentacles.terrain.heights import Problem, TerrainError
+from ecs_tentacles.terrain.meshes import MAX_MESH_BYTES, MESH_SUFFIXES, MeshReader
 
-MAX_MESH_BYTES = MAX_SCENE_BYTES  # the same cap as a scene file
-MESH_SUFFIXES = (".obj", ".stl", ".glb")
-MAX_PIECES = 16  # convex pieces per concave mesh (CoACD's max_convex_hull)
-# CoACD's search, coarser than its defaults: a 3-box arch splits the same (4 pieces) in
-# 2.6 s instead of 14 s; rocks for crawling creatures need no finer hulls
-COACD = {
-    "max_convex_hull": MAX_PIECES,
-    "seed": 0,
-    "threshold": 0.1,
-    "preprocess_resolution": 30,
-    "resolution": 500,
-    "mcts_iterations": 60,
-    "mcts_max_depth": 2,
-}
+__all__ = ["MAX_MESH_BYTES", "MESH_SUFFIXES", "obstacle_problems", "solids"]
+
 NEEDS = {
     "box": ("size",),
     "cylinder": ("radius", "height"),
@@ -69,10 +60,11 @@ def solids(
     """Every obstacle as a `Solid` (schema-valid entries)."""
     for path, message in obstacle_problems(obstacles):
         raise TerrainError(path, message)
-    return tuple(_solid(i, o, folder) for i, o in enumerate(obstacles))
+    with MeshReader(folder) as reader:
+        return tuple(_solid(i, o, reader) for i, o in enumerate(obstacles))
 
 
-def _solid(index: int, obstacle: Mapping[str, Any], folder: pathlib.Path | None) -> Solid:
+def _solid(index: int, obstacle: Mapping[str, Any], reader: MeshReader) -> Solid:
     shape = obstacle["shape"]
     position = np.asarray(obstacle["position"], dtype=np.float64)
     angles = obstacle.get("rotation_deg", [0.0, 0.0, 0.0])
@@ -85,36 +77,10 @@ def _solid(index: int, obstacle: Mapping[str, Any], folder: pathlib.Path | None)
     if shape == "sphere":
         return Solid("sphere", position, rotation, (float(obstacle["radius"]),))
     here = ("terrain", "obstacles", index, "file")
-    pieces = mesh_pieces(obstacle["file"], folder, float(obstacle.get("scale", 1.0)), here)
-    planes = tuple(convex_planes(p) for p in pieces)
-    return Solid("mesh", position, rotation, pieces=pieces, planes=planes)
-
-
-def mesh_pieces(
-    name: str, folder: pathlib.Path | None, scale: float, here: tuple[str | int, ...]
-) -> tuple[np.ndarray, ...]:
-    """The convex pieces (vertex arrays, metres) of mesh file `name` scaled by `scale`."""
-    import trimesh
-
-    path = beside_scene(name, folder, here)
-    if path.suffix.lower() not in MESH_SUFFIXES:
-        raise TerrainError(here, f"{name}: a mesh must be one of {', '.join(MESH_SUFFIXES)}")
-    if path.stat().st_size > MAX_MESH_BYTES:
-        raise TerrainError(here, f"{name}: larger than {MAX_MESH_BYTES >> 20} MB")
+    pieces = reader.pieces(obstacle["file"], float(obstacle.get("scale", 1.0)), here)
     try:
-        mesh = trimesh.load(path, force="mesh")
-    except Exception as error:  # trimesh raises many kinds for a bad file
-        raise TerrainError(here, f"{name}: not a readable mesh ({error})") from None
-    vertices = np.asarray(getattr(mesh, "vertices", np.zeros((0, 3))), dtype=np.float64) * scale
-    faces = np.asarray(getattr(mesh, "faces", np.zeros((0, 3))), dtype=np.int64)
-    if len(faces) == 0 or not np.isfinite(vertices).all():
-        raise TerrainError(here, f"{name}: the file holds no triangles with finite vertices")
-    if np.ptp(vertices, axis=0).min() <= 1e-9:
-        raise TerrainError(here, f"{name}: the mesh is flat (no volume to collide with)")
-    if getattr(mesh, "is_convex", False):
-        return (vertices,)
-    import coacd
-
-    coacd.set_log_level("error")
-    parts = coacd.run_coacd(coacd.Mesh(vertices, faces), **COACD)
-    return tuple(np.asarray(v, dtype=np.float64) for v, _ in parts)
+        planes = tuple(convex_planes(p) for p in pieces)
+    except (RuntimeError, ValueError):  # scipy's QhullError: a piece too thin for faces
+        message = f"{obstacle['file']}: a convex piece of it has no volume"
+        raise TerrainError(here, message) from None
+    return Solid("mesh", position, rotation, pieces=pieces, planes=planes)

@@ -1,0 +1,297 @@
+"""Mesh obstacles: a mesh file next to the scene -> its convex pieces, within a budget.
+
+    with MeshReader(folder) as reader:
+        pieces = reader.pieces("rock.obj", scale, json_path)   # (k, 3) arrays, metres
+
+Each distinct file (by content, suffix and scale) is read and decomposed once: the
+pieces are kept for the rest of the process and in the user's cache folder
+(`cache_folder()`: `$XDG_CACHE_HOME/ecs_tentacles/meshes`, else `~/.cache/...`), written
+atomically (a temporary file renamed into place), so a thousand references to one rock,
+and the `run` after a `validate`, cost one decomposition.
+
+The reading, the checks (finite coordinates within `MAX_EXTENT` of the mesh's origin,
+a volume) and CoACD run in a worker process (`ecs_tentacles.terrain.mesh_worker`) that
+this process watches and kills when a mesh takes longer than `MESH_SECONDS` or more
+resident memory than `MESH_MEMORY_MB`, when the scene's meshes together take longer
+than `SCENE_MESH_SECONDS`, or when this process is interrupted (SIGTERM, Ctrl-C).
+Every refusal is a `TerrainError` naming the obstacle's `file` field.
+
+Budgets (defaults; a concave rock of a few thousand triangles takes 1-3 s and under
+300 MB): 60 s and 1024 MB per mesh, 300 s for all of a scene's meshes not yet cached.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import pathlib
+import select
+import subprocess
+import sys
+import tempfile
+import time
+from types import TracebackType
+from typing import IO
+
+import numpy as np
+
+from ecs_tentacles.scene.load import MAX_SCENE_BYTES
+from ecs_tentacles.terrain import mesh_worker
+from ecs_tentacles.terrain.heights import TerrainError, beside_scene
+
+MESH_SECONDS = 60.0  # per mesh: reading, checks and decomposition
+MESH_MEMORY_MB = 1024  # the worker's resident memory while it works on one mesh
+SCENE_MESH_SECONDS = 300.0  # all of one scene's meshes that are not cached yet
+MESH_SUFFIXES = (".obj", ".stl", ".glb")
+MAX_MESH_BYTES = MAX_SCENE_BYTES  # the same cap as a scene file
+CACHE_VERSION = 1  # part of every cache key: bump when the pieces a file gives change
+START = 60.0  # seconds the worker may take to start (its imports), not part of a budget
+POLL = 0.05  # seconds between looks at the worker's time and memory
+
+JsonPath = tuple[str | int, ...]
+_KNOWN: dict[str, tuple[np.ndarray, ...] | str] = {}  # key -> pieces or the refusal
+
+
+def cache_folder() -> pathlib.Path:
+    """Where decomposed meshes are kept between runs."""
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return pathlib.Path(base) / "ecs_tentacles" / "meshes"
+
+
+def _key(data: bytes, suffix: str, scale: float) -> str:
+    import coacd
+
+    h = hashlib.sha256(data)
+    settings = {
+        "suffix": suffix,
+        "scale": repr(float(scale)),
+        "coacd": getattr(coacd, "__version__", "") or _coacd_version(),
+        "settings": mesh_worker.COACD,
+        "checks": [mesh_worker.MAX_EXTENT, mesh_worker.MIN_WIDTH, mesh_worker.FLAT_RATIO],
+        "version": CACHE_VERSION,
+    }
+    h.update(json.dumps(settings, sort_keys=True).encode())
+    return h.hexdigest()
+
+
+def _coacd_version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("coacd")
+    except PackageNotFoundError:
+        return "unknown"
+
+
+def _cached(key: str) -> tuple[np.ndarray, ...] | None:
+    """The pieces kept on disk under `key`, or None (absent, unreadable or not sane)."""
+    path = cache_folder() / f"{key}.npz"
+    try:
+        with np.load(path, allow_pickle=False) as stored:
+            pieces = tuple(np.asarray(stored[f"arr_{i}"], np.float64) for i in range(len(stored)))
+    except (OSError, ValueError, KeyError, EOFError):
+        return None
+    sane = pieces and all(
+        p.ndim == 2
+        and p.shape[1] == 3
+        and 4 <= len(p) <= 4 * mesh_worker.MAX_PIECE_VERTICES
+        and np.isfinite(p).all()
+        and np.abs(p).max() <= mesh_worker.MAX_EXTENT * 1.01
+        for p in pieces
+    )
+    return pieces if sane and len(pieces) <= mesh_worker.MAX_PIECES else None
+
+
+def _keep(key: str, pieces: tuple[np.ndarray, ...]) -> None:
+    """Write the pieces to the cache atomically (temporary file, then rename); a cache
+    that cannot be written is skipped silently (the next run decomposes again)."""
+    folder = cache_folder()
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        descriptor, temporary = tempfile.mkstemp(prefix=f".{key[:16]}.", suffix=".npz", dir=folder)
+        try:
+            with os.fdopen(descriptor, "wb") as handle:
+                np.savez(handle, *pieces)
+            os.replace(temporary, folder / f"{key}.npz")
+        except BaseException:
+            os.unlink(temporary)
+            raise
+    except OSError:
+        pass
+
+
+class _Worker:
+    """One worker process, fed one mesh at a time."""
+
+    def __init__(self) -> None:
+        self.process = subprocess.Popen(
+            [sys.executable, "-m", "ecs_tentacles.terrain.mesh_worker", str(MESH_MEMORY_MB)],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.DEVNULL,
+        )
+        self.buffer = b""
+        self.ready = self._read_until(lambda: b"\n" in self.buffer, time.monotonic() + START)
+        if isinstance(self.ready, bytes):
+            self.buffer = self.buffer.partition(b"\n")[2]
+
+    def close(self) -> None:
+        if self.process.poll() is None:
+            self.process.kill()
+        self.process.wait()
+        for stream in (self.process.stdin, self.process.stdout):
+            if stream is not None:
+                stream.close()
+
+    def resident_mb(self) -> float:
+        """The worker's resident memory now (0 where /proc is not there)."""
+        try:
+            with open(f"/proc/{self.process.pid}/statm") as handle:
+                pages = int(handle.read().split()[1])
+        except (OSError, ValueError, IndexError):
+            return 0.0
+        return pages * os.sysconf("SC_PAGE_SIZE") / 1024**2
+
+    def ask(self, data: bytes, suffix: str, scale: float, seconds: float) -> dict[str, object]:
+        """Send one mesh; the answer, or {"over": "time" | "memory" | "crash"}."""
+        assert self.process.stdin is not None
+        if not isinstance(self.ready, bytes):  # it did not start
+            return self.ready if self.ready.get("over") != "time" else {"over": "crash"}
+        request = json.dumps({"suffix": suffix, "scale": scale, "size": len(data)})
+        try:
+            self.process.stdin.write(request.encode() + b"\n" + data)
+            self.process.stdin.flush()
+        except BrokenPipeError:
+            return {"over": "crash"}
+        deadline = time.monotonic() + seconds
+        line = self._read_until(lambda: b"\n" in self.buffer, deadline)
+        if not isinstance(line, bytes):
+            return line
+        head, _, self.buffer = self.buffer.partition(b"\n")
+        answer: dict[str, object] = json.loads(head)
+        sizes = answer.get("pieces")
+        if isinstance(sizes, list):
+            need = 24 * sum(int(k) for k in sizes)
+            body = self._read_until(lambda: len(self.buffer) >= need, deadline)
+            if not isinstance(body, bytes):
+                return body
+            raw, self.buffer = self.buffer[:need], self.buffer[need:]
+            flat = np.frombuffer(raw, dtype="<f8").reshape(-1, 3)
+            cuts = np.cumsum([int(k) for k in sizes])[:-1]
+            answer["arrays"] = tuple(np.array(p) for p in np.split(flat, cuts))
+        return answer
+
+    def _read_until(self, done: object, deadline: float) -> bytes | dict[str, object]:
+        stdout: IO[bytes] | None = self.process.stdout
+        assert stdout is not None and callable(done)
+        descriptor = stdout.fileno()
+        while not done():
+            left = deadline - time.monotonic()
+            if left <= 0:
+                return {"over": "time"}
+            if self.resident_mb() > MESH_MEMORY_MB:
+                return {"over": "memory"}
+            ready, _, _ = select.select([descriptor], [], [], min(POLL, left))
+            if ready:
+                chunk = os.read(descriptor, 1 << 20)
+                if not chunk:
+                    return {"over": "crash"}
+                self.buffer += chunk
+        return b""
+
+
+class MeshReader:
+    """Reads a scene's mesh files (see the module's notes); use it as a context manager,
+    so its worker ends with the scene build."""
+
+    def __init__(self, folder: pathlib.Path | None) -> None:
+        self.folder = folder
+        self.worker: _Worker | None = None
+        self.deadline = time.monotonic() + SCENE_MESH_SECONDS
+        self.over: dict[str, str] = {}  # key -> why it went over a budget (this build)
+
+    def __enter__(self) -> MeshReader:
+        return self
+
+    def __exit__(
+        self,
+        kind: type[BaseException] | None,
+        error: BaseException | None,
+        trace: TracebackType | None,
+    ) -> None:
+        self.close()
+
+    def close(self) -> None:
+        if self.worker is not None:
+            self.worker.close()
+            self.worker = None
+
+    def pieces(self, name: str, scale: float, here: JsonPath) -> tuple[np.ndarray, ...]:
+        """The convex pieces of mesh file `name` (next to the scene) scaled by `scale`."""
+        path = beside_scene(name, self.folder, here)
+        if path.suffix.lower() not in MESH_SUFFIXES:
+            raise TerrainError(here, f"{name}: a mesh must be one of {', '.join(MESH_SUFFIXES)}")
+        try:
+            with open(path, "rb") as handle:
+                data = handle.read(MAX_MESH_BYTES + 1)
+        except OSError as error:
+            raise TerrainError(here, f"{name}: cannot read it ({error.strerror})") from None
+        if len(data) > MAX_MESH_BYTES:
+            raise TerrainError(here, f"{name}: larger than {MAX_MESH_BYTES >> 20} MB")
+        suffix = path.suffix.lower()
+        key = _key(data, suffix, scale)
+        known = _KNOWN.get(key) or self.over.get(key)
+        if known is None:
+            known = _cached(key)
+        if known is None:
+            if self.deadline - time.monotonic() <= 0:  # tried again by the next build
+                raise TerrainError(here, f"{name}: {self._over_scene()}")
+            known, lasting = self._decompose(data, suffix, scale)
+            if not isinstance(known, str):
+                _keep(key, known)
+            if not lasting and isinstance(known, str):  # over a budget: this build only
+                self.over[key] = known
+        if key not in self.over:
+            _KNOWN[key] = known
+        if isinstance(known, str):
+            raise TerrainError(here, f"{name}: {known}")
+        return known
+
+    def _decompose(
+        self, data: bytes, suffix: str, scale: float
+    ) -> tuple[tuple[np.ndarray, ...] | str, bool]:
+        """The pieces or why not, and whether that holds for good (not a budget's)."""
+        seconds = min(MESH_SECONDS, self.deadline - time.monotonic())
+        if self.worker is None:
+            self.worker = _Worker()
+        answer = self.worker.ask(data, suffix, scale, seconds)
+        over = answer.get("over") or ("memory" if answer.get("memory") else None)
+        if over is not None or self.worker.resident_mb() > MESH_MEMORY_MB / 2:
+            self.close()  # a fresh worker for the next mesh
+        if over == "time":
+            if seconds < MESH_SECONDS:
+                return self._over_scene(), False
+            return (
+                f"reading and splitting it into convex pieces took over {MESH_SECONDS:g} s"
+                " (the budget per mesh); simplify it or split it into convex parts yourself"
+            ), False
+        if over == "memory":
+            return (
+                f"splitting it into convex pieces needed over {MESH_MEMORY_MB} MB (the"
+                " budget per mesh); simplify it or split it into convex parts yourself"
+            ), False
+        if over == "crash":
+            return "reading or splitting it into convex pieces failed (the worker stopped)", False
+        if "error" in answer:
+            return str(answer["error"]), True
+        arrays = answer["arrays"]
+        assert isinstance(arrays, tuple)
+        return arrays, True
+
+    @staticmethod
+    def _over_scene() -> str:
+        return (
+            f"not read: the scene's meshes took over {SCENE_MESH_SECONDS:g} s in all (the"
+            " budget per scene; meshes read before are cached, so running again goes further)"
+        )
