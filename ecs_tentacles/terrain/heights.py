@@ -4,10 +4,19 @@ Exactly one source: `noise` (OpenSimplex octaves, the same for the same seed),
 `image` (a grayscale PNG next to the scene, 8 or 16 bit) or `heights` (rows along y
 from -y/2). Problems come back as (JSON path, message) pairs; `heightfield` raises
 `TerrainError` with the first one.
+
+An image is bounded as the other sources are: at most `MAX_RESOLUTION` (1024) pixels a
+side, like `resolution` and `heights` (a larger one is refused, not resampled: scale it
+down with any image tool, and see what you get); its size is read from the PNG's header
+before anything is decoded, so a decompression bomb costs nothing. Only PNG files are
+read (by their signature, whatever the name), and heights are clamped to [0, height].
+A 1024 x 1024 heightfield takes 8 MB here and 4 MB in each compiled physics model
+(each body plan's, and each stepping thread's copy of it).
 """
 
 from __future__ import annotations
 
+import os
 import pathlib
 from collections.abc import Mapping
 from typing import Any
@@ -19,9 +28,10 @@ from ecs_tentacles.ground import Heightfield
 Problem = tuple[tuple[str | int, ...], str]
 SOURCES = ("noise", "image", "heights")
 HERE = ("terrain", "heightfield")
-MAX_IMAGE_SIDE = 4096
-MAX_IMAGE_BYTES = 64 << 20
 MAX_RESOLUTION = 1024  # samples a side (the schema's maximum)
+MAX_IMAGE_SIDE = MAX_RESOLUTION  # pixels a side: an image is no bigger than `resolution`
+MAX_IMAGE_BYTES = 64 << 20
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
 
 class TerrainError(ValueError):
@@ -87,31 +97,49 @@ def noise_heights(
     return (total - low) / (high - low) if high > low else np.zeros_like(total)
 
 
+def png_size(head: bytes) -> tuple[int, int] | None:
+    """(width, height) from a PNG file's first 24 bytes; None if it is not a PNG."""
+    if len(head) < 24 or not head.startswith(PNG_SIGNATURE) or head[12:16] != b"IHDR":
+        return None
+    return int.from_bytes(head[16:20], "big"), int.from_bytes(head[20:24], "big")
+
+
 def _image_heights(name: str, folder: pathlib.Path | None) -> np.ndarray:
     """Heights 0..1 from a grayscale PNG next to the scene; row 0 of the array at -y."""
     from PIL import Image
 
-    path = beside_scene(name, folder, HERE + ("image",))
-    if path.stat().st_size > MAX_IMAGE_BYTES:
-        raise TerrainError(HERE + ("image",), f"{name}: larger than {MAX_IMAGE_BYTES >> 20} MB")
+    here = HERE + ("image",)
+    path = beside_scene(name, folder, here)
     try:
-        with Image.open(path) as image:
-            if max(image.size) > MAX_IMAGE_SIDE or min(image.size) < 3:
-                raise TerrainError(
-                    HERE + ("image",),
-                    f"{name}: {image.size[0]} x {image.size[1]} pixels; sides must be 3 to"
-                    f" {MAX_IMAGE_SIDE}",
-                )
-            if image.mode not in ("L", "I;16", "I;16B", "I", "LA", "P", "RGB", "RGBA"):
-                raise TerrainError(
-                    HERE + ("image",), f"{name}: unsupported image mode {image.mode}"
-                )
+        with open(path, "rb") as handle:
+            head = handle.read(24)
+            size = os.fstat(handle.fileno()).st_size
+    except OSError as error:
+        raise TerrainError(here, f"{name}: cannot read it ({error.strerror})") from None
+    if size > MAX_IMAGE_BYTES:
+        raise TerrainError(here, f"{name}: larger than {MAX_IMAGE_BYTES >> 20} MB")
+    sides = png_size(head)
+    if sides is None:
+        raise TerrainError(here, f"{name}: not a PNG image (its first bytes are not a PNG's)")
+    if max(sides) > MAX_IMAGE_SIDE or min(sides) < 3:
+        raise TerrainError(
+            here,
+            f"{name}: {sides[0]} x {sides[1]} pixels; sides must be 3 to {MAX_IMAGE_SIDE}"
+            + (" (as resolution's): scale it down" if max(sides) > MAX_IMAGE_SIDE else ""),
+        )
+    try:
+        with Image.open(path, formats=["PNG"]) as image:
+            if image.size != sides:  # the header read above and Pillow's disagree
+                raise TerrainError(here, f"{name}: not a readable PNG (its header is damaged)")
+            if image.mode not in ("1", "L", "I;16", "I;16B", "I", "LA", "P", "RGB", "RGBA"):
+                raise TerrainError(here, f"{name}: unsupported image mode {image.mode}")
             wide = image.mode.startswith("I")
             pixels = np.asarray(image if wide else image.convert("L"), dtype=np.float64)
-    except (OSError, SyntaxError) as error:  # PIL's "cannot identify image file"
-        raise TerrainError(HERE + ("image",), f"{name}: not a readable PNG ({error})") from None
+    except (OSError, SyntaxError, ValueError, Image.DecompressionBombError) as error:
+        reason = " ".join(str(error).split())[:120] or "damaged"
+        raise TerrainError(here, f"{name}: not a readable PNG ({reason})") from None
     top = 65535.0 if wide else 255.0
-    return np.flipud(pixels) / top  # the picture's top row is +y
+    return np.clip(np.flipud(pixels) / top, 0.0, 1.0)  # the picture's top row is +y
 
 
 def beside_scene(
@@ -120,8 +148,13 @@ def beside_scene(
     """`name` as a file in the scene's folder (no path may lead out of it)."""
     if folder is None:
         raise TerrainError(path, f"{name}: a scene given as a dict has no folder to find it in")
+    if "\x00" in name:
+        raise TerrainError(path, f"{name!r}: a file name cannot hold a NUL character")
     base = folder.resolve()
-    found = (base / name).resolve()
+    try:
+        found = (base / name).resolve()
+    except (OSError, RuntimeError) as error:  # a symlink loop, a name too long
+        raise TerrainError(path, f"{name}: cannot find it ({error})") from None
     if not found.is_relative_to(base):
         raise TerrainError(path, f"{name}: must be a file in the scene's folder ({base})")
     if not found.is_file():

@@ -242,6 +242,97 @@ def test_sigterm_ends_a_mesh_decomposition_promptly(tmp_path: pathlib.Path) -> N
     assert not any(_alive(pid) for pid in workers)
 
 
+def png(path: pathlib.Path, pixels: np.ndarray) -> None:
+    from PIL import Image
+
+    Image.fromarray(pixels).save(path, format="PNG")
+
+
+def bomb(path: pathlib.Path, side: int) -> None:
+    """A real `side` x `side` single-colour 8-bit PNG, written row by row (a few hundred
+    kB that decode to side^2 bytes)."""
+    import struct
+    import zlib
+
+    def chunk(kind: bytes, data: bytes) -> bytes:
+        body = kind + data
+        return struct.pack(">I", len(data)) + body + struct.pack(">I", zlib.crc32(body))
+
+    squeeze = zlib.compressobj(1)
+    row = bytes(side + 1)  # filter byte 0, then black pixels
+    stream = b"".join(squeeze.compress(row) for _ in range(side)) + squeeze.flush()
+    header = struct.pack(">IIBBBBB", side, side, 8, 0, 0, 0, 0)
+    path.write_bytes(
+        b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", stream) + chunk(b"IEND", b"")
+    )
+
+
+def image_terrain(file: str, height: float = 1.0) -> dict[str, Any]:
+    return {"heightfield": {"size": [8, 8], "image": file, "height": height}}
+
+
+def test_height_images_are_capped_like_resolution(
+    tmp_path: pathlib.Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A 16 KB 4096 x 4096 PNG cost 1.1-2.5 GB; sides are now at most 1024."""
+    png(tmp_path / "big.png", np.full((1025, 64), 128, np.uint8))
+    line = check(tmp_path, image_terrain("big.png"), capsys)
+    assert "terrain.heightfield.image: big.png: 64 x 1025 pixels; sides must be 3 to 1024" in line
+
+
+def test_a_decompression_bomb_exits_2_naming_the_field(
+    tmp_path: pathlib.Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    bomb(tmp_path / "bomb.png", 20_000)
+    line = check(tmp_path, image_terrain("bomb.png"), capsys)
+    assert "terrain.heightfield.image: bomb.png: 20000 x 20000 pixels; sides must be 3" in line
+    assert "Error" not in line  # no Pillow class name
+
+
+def test_only_real_pngs_are_read(
+    tmp_path: pathlib.Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A 32-bit TIFF named .png gave heights of 3,277 km."""
+    from PIL import Image
+
+    Image.fromarray(np.full((64, 64), 70_000, np.int32)).save(tmp_path / "tiff.png", format="TIFF")
+    line = check(tmp_path, image_terrain("tiff.png"), capsys)
+    assert "terrain.heightfield.image: tiff.png: not a PNG image" in line
+
+
+def test_heights_from_an_image_stay_within_0_and_height(tmp_path: pathlib.Path) -> None:
+    from ecs_tentacles.terrain.heights import heightfield
+
+    pixels = np.zeros((8, 8), np.uint16)
+    pixels[2, 3] = 65535
+    png(tmp_path / "hill.png", pixels)
+    field = heightfield(image_terrain("hill.png", 0.4)["heightfield"], tmp_path)
+    assert field.heights.min() == 0.0 and field.heights.max() == pytest.approx(0.4)
+
+
+@pytest.mark.parametrize(
+    ("make", "says"),
+    [
+        (None, "no such file in the scene's folder"),
+        ("one pixel", "1 x 1 pixels; sides must be 3 to 1024"),
+        ("text", "not a PNG image"),
+        ("nul", "a file name cannot hold a NUL character"),
+    ],
+    ids=["missing", "one pixel", "text", "nul"],
+)
+def test_validate_reads_the_terrain_files_as_run_does(
+    tmp_path: pathlib.Path, capsys: pytest.CaptureFixture[str], make: str | None, says: str
+) -> None:
+    """`validate` said ok where `run` refused (the files were not read)."""
+    name = "a\x00b.png" if make == "nul" else "ground.png"
+    if make == "one pixel":
+        png(tmp_path / name, np.zeros((1, 1), np.uint8))
+    elif make == "text":
+        (tmp_path / name).write_text("not an image\n")
+    line = check(tmp_path, image_terrain(name), capsys)
+    assert "terrain.heightfield.image: " in line and says in line
+
+
 def test_validate_checks_creatures_against_the_obstacles(
     tmp_path: pathlib.Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
