@@ -32,7 +32,7 @@ import numpy as np
 from tqdm import tqdm
 
 from ecs_tentacles.distributed.merge import merge_takes
-from ecs_tentacles.distributed.reaper import Reaper
+from ecs_tentacles.distributed.reaper import Reaper, descendants, end_started_since
 from ecs_tentacles.distributed.shards import ShardPlan, default_tasks, plan_shards, scene_plugins
 from ecs_tentacles.distributed.spheres import meetings
 from ecs_tentacles.distributed.task import ShardResult, bake_shard
@@ -60,7 +60,14 @@ class RayStats:
 
 
 def start_ray(address: str | None, cpus: int | None) -> bool:
-    """Join `address` or start a local Ray; False when this process already had Ray."""
+    """Join `address` or start a local Ray; False when this process already had Ray.
+
+    A signal while Ray starts (Ctrl-C, SIGTERM: `ray.init` takes seconds) ends what it
+    had started before the exception goes on (`_abandon`). `ray.init` installs its own
+    SIGTERM handler first thing (`sys.exit(15)`: no line, exit 15); a SIGTERM it caught
+    is handed to the handler that was there before it (the command line's: one line,
+    exit 143), as after the start.
+    """
     import ray
 
     if ray.is_initialized():
@@ -68,15 +75,53 @@ def start_ray(address: str | None, cpus: int | None) -> bool:
     options: dict[str, Any] = {"include_dashboard": False, "log_to_driver": False}
     options["logging_level"] = logging.ERROR
     ours = _signal_handlers()
+    before = descendants()
     global _REAPER
-    if address:
-        ray.init(address=address, **options)
-    else:
-        ray.init(num_cpus=cpus, **options)
-        _REAPER = Reaper.start()  # a local Ray never outlives a killed bake
-    for number, handler in ours.items():  # Ray installs its own: SIGTERM must stay ours
-        signal.signal(number, handler)  # (one line, exit 143, Ray shut down on the way out)
+    try:
+        try:
+            if address:
+                ray.init(address=address, **options)
+            else:
+                ray.init(num_cpus=cpus, **options)
+                session = ray.get_runtime_context().get_session_name()
+                _REAPER = Reaper.start(session)  # a local Ray never outlives a killed bake
+        finally:
+            for number, handler in ours.items():  # Ray installs its own: SIGTERM must stay
+                signal.signal(number, handler)  # ours (one line, exit 143, Ray shut down)
+    except SystemExit as stop:  # Ray's SIGTERM handler ran while Ray started
+        _abandon(before, ours)
+        handler = ours.get(signal.SIGTERM)
+        if stop.code == signal.SIGTERM and callable(handler):
+            handler(signal.SIGTERM, None)  # ours raises (the command line's Terminated)
+        raise
+    except BaseException:  # Ctrl-C, or SIGTERM before Ray's handler was in place
+        _abandon(before, ours)
+        raise
     return True
+
+
+def _abandon(before: set[tuple[int, float]], ours: dict[int, Any]) -> None:
+    """A Ray start cut short: shut down what `ray.init` made of it, then end every
+    process started since `before` that is still there (its node was perhaps not yet
+    known to `ray.shutdown`). SIGTERM, SIGINT and SIGHUP are ignored meanwhile (seconds):
+    the bake is stopping already, and a second one must not cut this short."""
+    import ray
+
+    global _REAPER
+    for number in ours:
+        signal.signal(number, signal.SIG_IGN)
+    try:
+        try:
+            ray.shutdown()
+        except Exception:  # half started: whatever it cannot shut down is ended below
+            pass
+        if _REAPER is not None:
+            _REAPER.stop()
+            _REAPER = None
+        end_started_since(before)
+    finally:
+        for number, handler in ours.items():
+            signal.signal(number, handler)
 
 
 def stop_ray(started: bool) -> None:

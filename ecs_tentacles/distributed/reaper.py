@@ -7,9 +7,12 @@ starts a small watchdog in a session of its own, connected by a pipe. Every seco
 the watchdog notes the bake's descendants (Ray starts agents and workers later). When
 the bake ends normally it closes the pipe first (`Reaper.stop`: the watchdog leaves);
 when the bake dies, the kernel closes the pipe, the watchdog sees its parent gone and
-ends every process it noted (unless its pid was reused) and whatever they started.
+ends every process it noted (unless its pid was reused) and whatever they started,
+and every process whose command line names the bake's Ray session (`session`): one
+started in the last second (a worker, an agent) was not noted yet, and the raylet that
+started it may already be gone.
 
-    python -m ecs_tentacles.distributed.reaper PARENT_PID '[[pid, create_time], ...]'
+    python -m ecs_tentacles.distributed.reaper PARENT_PID '[[pid, create_time], ...]' [SESSION]
 """
 
 from __future__ import annotations
@@ -35,8 +38,9 @@ class Reaper:
         self.process = process
 
     @classmethod
-    def start(cls) -> Reaper:
-        """Record this process's descendants (Ray's, just started) and watch over them."""
+    def start(cls, session: str | None = None) -> Reaper:
+        """Record this process's descendants (Ray's, just started) and watch over them and
+        the processes of Ray session `session` (`get_session_name()`)."""
         me = psutil.Process()
         recorded = []
         for child in me.children(recursive=True):
@@ -47,7 +51,14 @@ class Reaper:
         if not recorded:
             return cls(None)
         process = subprocess.Popen(
-            [sys.executable, "-m", __name__, str(os.getpid()), json.dumps(recorded)],
+            [
+                sys.executable,
+                "-m",
+                __name__,
+                str(os.getpid()),
+                json.dumps(recorded),
+                *([session] if session else []),
+            ],
             stdin=subprocess.PIPE,
             stdout=subprocess.DEVNULL,
             stderr=subprocess.DEVNULL,
@@ -98,6 +109,21 @@ def reap(recorded: list[list[Any]]) -> None:
             pass
 
 
+def descendants() -> set[tuple[int, float]]:
+    """(pid, start time) of every descendant of this process."""
+    return {(int(pid), float(created)) for pid, created in _descendants(os.getpid())}
+
+
+def end_started_since(before: set[tuple[int, float]], rounds: int = 5) -> None:
+    """End every descendant of this process not in `before` (a Ray start cut short) and
+    theirs, as `reap` does; again while new ones appear (a raylet was starting agents)."""
+    for _ in range(rounds):
+        new = descendants() - before
+        if not new:
+            return
+        reap([[pid, created] for pid, created in new])
+
+
 def _descendants(pid: int) -> list[list[Any]]:
     try:
         return [[p.pid, p.create_time()] for p in psutil.Process(pid).children(recursive=True)]
@@ -105,8 +131,20 @@ def _descendants(pid: int) -> list[list[Any]]:
         return []
 
 
+def of_session(session: str) -> list[list[Any]]:
+    """[pid, create_time] of every living process whose command line names `session`."""
+    found = []
+    for process in psutil.process_iter(["cmdline", "create_time", "status"]):
+        if process.info["status"] == psutil.STATUS_ZOMBIE:
+            continue
+        if any(session in part for part in process.info["cmdline"] or ()):
+            found.append([process.pid, process.info["create_time"]])
+    return found
+
+
 def main(argv: list[str]) -> int:
     parent, recorded = int(argv[0]), json.loads(argv[1])
+    session = argv[2] if len(argv) > 2 else None
     known = {int(pid): created for pid, created in recorded}
     while True:  # until the bake closes the pipe, or dies and the kernel does
         ready, _, _ = select.select([sys.stdin.buffer], [], [], WATCH_SECONDS)
@@ -115,13 +153,14 @@ def main(argv: list[str]) -> int:
         # Ray starts agents and workers later, under its raylet: keep them on the list,
         # for the raylet may be gone (and they re-parented) by the time the bake dies
         known.update({pid: created for pid, created in _descendants(parent) if pid != os.getpid()})
-    recorded = [[pid, created] for pid, created in known.items()]
     deadline = time.monotonic() + 1.0
     while _alive(parent) and time.monotonic() < deadline:
         time.sleep(0.05)  # a bake that closed the pipe itself is about to exit
     if _alive(parent):
         return 0  # a normal end: the bake shut Ray down itself
-    reap(recorded)
+    if session:  # what started since the last look, wherever it was re-parented
+        known.update({pid: created for pid, created in of_session(session) if pid != os.getpid()})
+    reap([[pid, created] for pid, created in known.items()])
     return 0
 
 
