@@ -3,7 +3,7 @@
     world.lod.promote(creature)           # full physics until released
     world.lod.release(creature)
     world.lod.focus((2.0, -1.0), 3.0)     # creatures within 3 m of (2, -1) run full
-    world.lod.counts()                    # {"full": 32, "reduced": 64, "kinematic": 928}
+    world.lod.counts()                    # {"full": 8, "reduced": 128, "kinematic": 888}
 
 Reads: every creature's reach sphere (the contact proxies' geometry over the Transform
 store), who is asleep or frozen, the scene's `physics.lod` budgets, and what scripts,
@@ -15,19 +15,22 @@ creature entering KINEMATIC is handed to the replay (`Replay.start`).
 The rules, whole-array work every frame before the step:
 
 1. Lod off: everyone is FULL, always (`--lod off`, `lod=False`).
-2. Must be FULL: creatures with a body within `contact_margin` of another creature's
-   (the bodies' bounding spheres: promoted before they touch; a full one stays full
-   until it is `CLEAR` times that far) or whose reach comes within it of an obstacle
-   (`Ground.solids`), forced ones (`promote`, `select`), and those inside the focus
-   region.
-3. The other awake creatures are ranked: nearest the focus first (without one, all
-   equal), then the tier they hold (hysteresis), then creature order, so a bake's
-   decisions depend on nothing but the scene. They fill what rule 2 left of the
-   `full` budget (the budget counts the creatures that must be full: it caps what
-   full physics costs unless more than `full` touch), then `reduced` run REDUCED,
-   the rest KINEMATIC (REDUCED while no replay is registered).
-4. Asleep creatures keep their tier and use no budget.
-5. Demotion waits until a creature has held its tier `hold_seconds`; promotion never
+2. Heroes must be FULL: forced ones (`promote`: scripts, a grabbed creature; `select`:
+   the sandbox's selection), those inside the focus region, and whatever has a body
+   within `contact_margin` of a hero's (the bodies' bounding spheres; it stays full
+   until it is `CLEAR` times that far).
+3. Contact must be physical, never replayed: creatures with a body within
+   `contact_margin` of another creature's, or whose reach comes within it of an
+   obstacle (`Ground.solids`), run at least REDUCED, whatever the budgets (promoted
+   before they touch; one simulated stays so until it is `CLEAR` times that far).
+4. The other awake creatures (those of rule 3 too) are ranked: nearest the focus first
+   (without one, all equal), then the tier they hold (hysteresis), then creature
+   order, so a bake's decisions depend on nothing but the scene. They fill what rule 2
+   left of the `full` budget (it counts the heroes: it caps what full physics costs
+   unless more than `full` are heroes), then what rule 3 left of the `reduced` budget
+   runs REDUCED, the rest KINEMATIC (REDUCED while no replay is registered).
+5. Asleep creatures keep their tier and use no budget.
+6. Demotion waits until a creature has held its tier `hold_seconds`; promotion never
    waits.
 
 A crowd within the full budget therefore runs exactly as with lod off.
@@ -41,7 +44,7 @@ from typing import TYPE_CHECKING, Protocol
 import numpy as np
 
 from ecs_tentacles.ground import ground_of
-from ecs_tentacles.physics.proxies import ContactProxies
+from ecs_tentacles.physics.proxies import ContactProxies, nearest_gap
 from ecs_tentacles.physics.tiers import FULL, KINEMATIC, NAMES, REDUCED
 
 if TYPE_CHECKING:
@@ -164,28 +167,37 @@ class LevelOfDetail:
         if not self.enabled or fits:  # everyone full (at once, if that just became so)
             self._move(world, np.full(len(roster), FULL, dtype=np.int8))
             return
+        count = len(roster)
         pos, _, centre, radius = self.proxies.sense(world.transforms, world.frame)
         margin = self.settings.contact_margin
-        gap = self.proxies.closest(pos, centre, radius, CLEAR * margin)
+        pairs = self.proxies.pair_gaps(pos, centre, radius, CLEAR * margin)
         tier = roster.tier
-        must = self.scripted | self.selected | (gap < margin)
-        must |= _near_obstacles(world, centre, radius + margin)
-        must |= (gap < CLEAR * margin) & (tier == FULL)  # stays full until clear
-        distance = np.zeros(len(roster))
+        hero = self.scripted | self.selected
+        distance = np.zeros(count)
         if self.focus_region is not None:
             point, reach = self.focus_region
             distance = np.linalg.norm(centre[:, :2] - point, axis=1)
-            must |= distance <= reach
-        want = np.full(len(roster), KINEMATIC if self.replay is not None else REDUCED, np.int8)
+            hero |= distance <= reach
+        to_hero = nearest_gap(count, *pairs, among=hero)
+        must = hero | (to_hero < margin) | ((to_hero < CLEAR * margin) & (tier == FULL))
+        gap = nearest_gap(count, *pairs)
+        simulated = tier != KINEMATIC  # stays so until clear (CLEAR margins away)
+        clear = np.where(simulated, CLEAR * margin, margin)
+        contact = (gap < clear) | _near_obstacles(world, centre, radius + clear)
+        contact &= ~must
+        want = np.full(count, KINEMATIC if self.replay is not None else REDUCED, np.int8)
         want[must] = FULL
+        want[contact] = REDUCED
         awake = ~(roster.sleeping | roster.frozen)
         ranked = np.flatnonzero(awake & ~must)
-        order = np.lexsort((ranked, tier[ranked], distance[ranked]))
-        full = max(0, self.settings.full - int(must.sum()))  # the budget counts the forced
-        reduced = self.settings.reduced
-        want[ranked[order[:full]]] = FULL
-        want[ranked[order[full : full + reduced]]] = REDUCED
-        keep = ~awake & ~must  # asleep: keeps its tier
+        order = ranked[np.lexsort((ranked, tier[ranked], distance[ranked]))]
+        full = max(0, self.settings.full - int(must.sum()))  # the budget counts the heroes
+        want[order[:full]] = FULL
+        rest = order[full:]
+        rest = rest[~contact[rest]]  # in contact: REDUCED already, and counted below
+        reduced = max(0, self.settings.reduced - int(contact[order[full:]].sum()))
+        want[rest[:reduced]] = REDUCED
+        keep = ~awake & ~must & ~(contact & (tier == KINEMATIC))  # asleep: keeps its tier
         keep |= (want > tier) & (self.held < self.hold_frames)  # demotion waits
         want[keep] = tier[keep]
         self._move(world, want)

@@ -186,7 +186,14 @@ class ContactProxies:
         self, pos: np.ndarray, centre: np.ndarray, radius: np.ndarray, margin: float
     ) -> np.ndarray:
         """Per creature, the gap (m) between its bodies and the nearest other creature's,
-        as far as it is under `margin` (inf where none comes that close).
+        as far as it is under `margin` (inf where none comes that close)."""
+        return nearest_gap(len(self.roster), *self.pair_gaps(pos, centre, radius, margin))
+
+    def pair_gaps(
+        self, pos: np.ndarray, centre: np.ndarray, radius: np.ndarray, margin: float
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The pairs of creatures (a, b; a < b) whose bodies may come within `margin` of
+        each other, and each pair's gap (m) between its nearest bodies (inf: not within).
 
         Reach spheres find the candidate pairs; of each pair, only the bodies inside the
         other creature's sphere can be near it, and those are compared body against
@@ -194,29 +201,26 @@ class ContactProxies:
         for a star of tentacles: neighbours in a crowd are inside each other's spheres
         long before any tentacles meet.
         """
-        near = np.full(len(self.roster), np.inf)
         a, b = near_pairs(centre, radius, margin)
         first = a < b
         a, b = a[first], b[first]
+        gaps = np.full(len(a), np.inf)
         if not len(a):
-            return near
+            return a, b, gaps
         pa, ba = self._inside(a, b, pos, centre, radius, margin)
         pb, bb = self._inside(b, a, pos, centre, radius, margin)
         na = np.bincount(pa, minlength=len(a))
         nb = np.bincount(pb, minlength=len(a))
         both = na * nb
         if not both.any():
-            return near
+            return a, b, gaps
         pair = np.repeat(np.arange(len(a)), both)
         k = np.arange(len(pair)) - np.repeat(np.cumsum(both) - both, both)
         ia = ba[(np.cumsum(na) - na)[pair] + k // nb[pair]]
         ib = bb[(np.cumsum(nb) - nb)[pair] + k % nb[pair]]
         gap = np.linalg.norm(pos[ia] - pos[ib], axis=1) - self.rbound[ia] - self.rbound[ib]
-        gaps = np.full(len(a), np.inf)
         np.minimum.at(gaps, pair, gap)
-        np.minimum.at(near, a, gaps)
-        np.minimum.at(near, b, gaps)
-        return near
+        return a, b, gaps
 
     def _inside(
         self,
@@ -332,3 +336,19 @@ def _bounds(kind: np.ndarray, size: np.ndarray) -> np.ndarray:
     """Bounding-sphere radii of bodies of `kind` and `size` (radius, half length)."""
     radius, half = size[:, 0], size[:, 1]
     return np.where(kind == CYLINDER, np.hypot(radius, half), radius + half)
+
+
+def nearest_gap(
+    count: int, a: np.ndarray, b: np.ndarray, gaps: np.ndarray, among: np.ndarray | None = None
+) -> np.ndarray:
+    """(count,) each creature's smallest gap of the pairs (`ContactProxies.pair_gaps`),
+    counting only partners in `among` ((count,) bool) when given; inf where none."""
+    near = np.full(count, np.inf)
+    if among is None:
+        np.minimum.at(near, a, gaps)
+        np.minimum.at(near, b, gaps)
+    else:
+        to_b, to_a = among[b], among[a]
+        np.minimum.at(near, a[to_b], gaps[to_b])
+        np.minimum.at(near, b[to_a], gaps[to_a])
+    return near

@@ -130,9 +130,9 @@ def _gap(world: World, a: str, b: str) -> float:
     return float(d.min())
 
 
-def test_kinematic_creatures_driven_into_each_other_are_full_before_they_touch(
-    make_world: Callable[..., World],
-) -> None:
+def _head_on(hero: str | None) -> tuple[set[str], set[str], list[float], World]:
+    """Two kinematic creatures crawl into each other (with `hero` promoted); the tiers
+    each had while the gap was under MARGIN, and the gaps."""
     scene = {
         "version": 1,
         "physics": {"lod": {"full": 0, "reduced": 0, "hold_seconds": 0}},
@@ -143,20 +143,41 @@ def test_kinematic_creatures_driven_into_each_other_are_full_before_they_touch(
              "goals": [{"position": [-1.5, 0.0]}]},
         ],
     }  # fmt: skip
-    world = make_world(scene)
+    world = World.from_scene(scene)
     world.step(2)
-    assert world.lod.counts()["kinematic"] == 2  # nothing happens to them yet
-    gaps, near_tiers = [], set()
+    if hero is not None:
+        world.lod.promote(world.creature(hero))
+    else:
+        assert world.lod.counts()["kinematic"] == 2  # nothing happens to them yet
+    gaps: list[float] = []
+    tiers: dict[str, set[str]] = {"a": set(), "b": set()}
     for _ in range(420):
         world.step(1)
         gap = _gap(world, "a", "b")
         gaps.append(gap)
         if gap < MARGIN:  # as close as contact proxies start pushing
-            near_tiers |= {world.lod.tier_of(world.creature(n)) for n in "ab"}
-    assert min(gaps) < MARGIN  # they did meet
-    assert near_tiers == {"full"}
-    assert min(gaps) > -0.005  # never more than 5 mm into each other
-    assert world.lod.promotions >= 2 and world.physics.health.recoveries == 0
+            for n in "ab":
+                tiers[n].add(world.lod.tier_of(world.creature(n)))
+    return tiers["a"], tiers["b"], gaps, world
+
+
+def test_creatures_driven_into_each_other_are_simulated_reduced_before_they_touch() -> None:
+    """Contact promotes to a physical tier, not to full (full is for heroes)."""
+    a, b, gaps, world = _head_on(hero=None)
+    with world:
+        assert min(gaps) < MARGIN  # they did meet
+        assert a == b == {"reduced"}
+        assert min(gaps) > -0.005  # never more than 5 mm into each other
+        assert world.lod.promotions >= 2 and world.physics.health.recoveries == 0
+
+
+def test_whatever_touches_a_hero_runs_full() -> None:
+    a, b, gaps, world = _head_on(hero="a")
+    with world:
+        assert min(gaps) < MARGIN
+        assert a == b == {"full"}
+        assert min(gaps) > -0.005
+        assert world.physics.health.recoveries == 0
 
 
 def test_promotion_starts_from_the_shown_pose(make_world: Callable[..., World]) -> None:

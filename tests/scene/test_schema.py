@@ -84,8 +84,8 @@ def test_with_defaults_fills_nested_defaults_exactly() -> None:
             "sleep": True,
             "lod": {
                 "enabled": True,
-                "full": 32,
-                "reduced": 64,
+                "full": 8,
+                "reduced": 128,
                 "hold_seconds": 1.0,
                 "contact_margin": 0.1,
             },
@@ -156,8 +156,8 @@ def test_with_defaults_keeps_given_values_and_names() -> None:
         "sleep": True,
         "lod": {
             "enabled": True,
-            "full": 32,
-            "reduced": 64,
+            "full": 8,
+            "reduced": 128,
             "hold_seconds": 1.0,
             "contact_margin": 0.1,
         },

@@ -16,7 +16,7 @@ from ecs_tentacles.cli import main
 from ecs_tentacles.construction import creature_layout
 from ecs_tentacles.ground import ground_of
 from ecs_tentacles.locomotion.goals import GoalBook
-from ecs_tentacles.physics.tiers import FULL, KINEMATIC
+from ecs_tentacles.physics.tiers import KINEMATIC, REDUCED
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.world import World
 
@@ -220,7 +220,8 @@ def test_a_concave_mesh_is_split_into_convex_pieces(
 
 def test_kinematic_creatures_are_draped_over_the_terrain(make_world: Callable[..., World]) -> None:
     """Gait clips are recorded on the plane; on terrain every replayed body is raised by
-    the ground under it (tips on the ground), and one about to meet a rock runs full."""
+    the ground under it (tips on the ground), and one about to meet a rock is simulated
+    (reduced: contact promotes to a physical tier, full is for heroes)."""
     hills = {"heightfield": ROCKY["heightfield"]}
     rock = {"shape": "sphere", "position": [-1.5, -3.0, 0.2], "radius": 0.4}
     data = scene({**hills, "obstacles": [rock]}, [0, 0], [3.0, 2.0], [-3.0, 2.5], [-1.5, -1.9])
@@ -229,7 +230,7 @@ def test_kinematic_creatures_are_draped_over_the_terrain(make_world: Callable[..
     for _ in range(20):
         world.step()
     tiers = world.physics.tier
-    assert (tiers == KINEMATIC).sum() == 3 and tiers[3] == FULL  # the one by the rock
+    assert (tiers == KINEMATIC).sum() == 3 and tiers[3] == REDUCED  # the one by the rock
     ground = ground_of(world)
     for index in np.flatnonzero(tiers == KINEMATIC).tolist():
         batch, row = world.physics.roster.locate(index)
