@@ -35,7 +35,7 @@ def test_a_million_heights_validate_without_a_python_call_per_number(
 ) -> None:
     """1024 x 1024 `heights` (the schema's largest) are checked with numpy, not number by
     number (31 s before); a bad one among them is still named by its path."""
-    heights = (np.arange(1024 * 1024).reshape(1024, 1024) % 7).tolist()
+    heights: list[list[Any]] = (np.arange(1024 * 1024).reshape(1024, 1024) % 7).tolist()
     path = write_scene(tmp_path, {"heightfield": {"size": [10, 10], "heights": heights}})
     assert main(["validate", str(path)]) == 0  # imports and caches warmed
     capsys.readouterr()
