@@ -22,6 +22,7 @@ Budgets (defaults; a concave rock of a few thousand triangles takes 1-3 s and un
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import os
@@ -60,13 +61,11 @@ def cache_folder() -> pathlib.Path:
 
 
 def _key(data: bytes, suffix: str, scale: float) -> str:
-    import coacd
-
     h = hashlib.sha256(data)
     settings = {
         "suffix": suffix,
         "scale": repr(float(scale)),
-        "coacd": getattr(coacd, "__version__", "") or _coacd_version(),
+        "coacd": _coacd_version(),
         "settings": mesh_worker.COACD,
         "checks": [mesh_worker.MAX_EXTENT, mesh_worker.MIN_WIDTH, mesh_worker.FLAT_RATIO],
         "version": CACHE_VERSION,
@@ -75,6 +74,7 @@ def _key(data: bytes, suffix: str, scale: float) -> str:
     return h.hexdigest()
 
 
+@functools.cache
 def _coacd_version() -> str:
     from importlib.metadata import PackageNotFoundError, version
 

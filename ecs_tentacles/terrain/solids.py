@@ -60,11 +60,17 @@ def solids(
     """Every obstacle as a `Solid` (schema-valid entries)."""
     for path, message in obstacle_problems(obstacles):
         raise TerrainError(path, message)
+    planes: dict[int, tuple[np.ndarray, ...]] = {}  # id(pieces) -> their planes, made once
     with MeshReader(folder) as reader:
-        return tuple(_solid(i, o, reader) for i, o in enumerate(obstacles))
+        return tuple(_solid(i, o, reader, planes) for i, o in enumerate(obstacles))
 
 
-def _solid(index: int, obstacle: Mapping[str, Any], reader: MeshReader) -> Solid:
+def _solid(
+    index: int,
+    obstacle: Mapping[str, Any],
+    reader: MeshReader,
+    known: dict[int, tuple[np.ndarray, ...]],
+) -> Solid:
     shape = obstacle["shape"]
     position = np.asarray(obstacle["position"], dtype=np.float64)
     angles = obstacle.get("rotation_deg", [0.0, 0.0, 0.0])
@@ -78,9 +84,11 @@ def _solid(index: int, obstacle: Mapping[str, Any], reader: MeshReader) -> Solid
         return Solid("sphere", position, rotation, (float(obstacle["radius"]),))
     here = ("terrain", "obstacles", index, "file")
     pieces = reader.pieces(obstacle["file"], float(obstacle.get("scale", 1.0)), here)
-    try:
-        planes = tuple(convex_planes(p) for p in pieces)
-    except (RuntimeError, ValueError):  # scipy's QhullError: a piece too thin for faces
-        message = f"{obstacle['file']}: a convex piece of it has no volume"
-        raise TerrainError(here, message) from None
+    planes = known.get(id(pieces))
+    if planes is None:
+        try:
+            planes = known[id(pieces)] = tuple(convex_planes(p) for p in pieces)
+        except (RuntimeError, ValueError):  # scipy's QhullError: a piece too thin for faces
+            message = f"{obstacle['file']}: a convex piece of it has no volume"
+            raise TerrainError(here, message) from None
     return Solid("mesh", position, rotation, pieces=pieces, planes=planes)
