@@ -6,9 +6,11 @@ animated by rotation keys (and the root by translation keys).
                                             a skinned mesh's node)
 Named as the USD export names them (`ecs_tentacles.export.names`: Blender makes the
 same armature, mesh and action names from either). Joint nodes carry their rest
-(bind) transforms; each creature's animation (`<c>_animation`) has a rotation channel
-per joint and a translation channel on its mantle, each with its own key times when
-keys are reduced. The mesh: POSITION, NORMAL, TEXCOORD_0 (a vertex is split
+(bind) transforms; one animation, `take`, drives every creature: a rotation channel
+per joint and a translation channel on each mantle, each with its own key times when
+keys are reduced (one animation, not one per creature: Blender's importer plays only
+the first animation of a file and stashes the others in muted NLA tracks, and game
+engines read one animation as one clip). The mesh: POSITION, NORMAL, TEXCOORD_0 (a vertex is split
 where its UVs differ), JOINTS_0/WEIGHTS_0 (two influences used of four). Everything is
 turned to glTF's y-up like the rigid form (`ecs_tentacles.export.gltf`).
 """
@@ -68,9 +70,7 @@ def build_skinned_gltf(
     nodes: list[dict[str, Any]] = [{"name": "World", "children": []}]
     roots = [0]
     meshes, skins = [], []
-    samplers: list[dict[str, Any]] = []
-    channels: list[dict[str, Any]] = []
-    animations: list[dict[str, Any]] = []
+    animation: dict[str, Any] = {"name": "take", "samplers": [], "channels": []}
     times: dict[bytes, int] = {}
     shown = take.visible()
     index = {c["name"]: i for i, c in enumerate(header["creatures"])}
@@ -112,17 +112,10 @@ def build_skinned_gltf(
                 "skin": len(skins) - 1,
             }
         )
-        samplers, channels = [], []  # one animation per creature, named after it
-        _channels(buffer, take, creature, first, samplers, channels, times)
-        animation = {
-            "name": part(skeleton.layout.name, "animation"),
-            "samplers": samplers,
-            "channels": channels,
-        }
+        _channels(buffer, take, creature, first, animation, times)
         # while the creature is not there: its root joint (and so its skin) scaled to zero
         seen = shown[:, index[skeleton.layout.name]]
         scale_visibility(buffer, take, seen, nodes[first], first, animation)
-        animations.append(animation)
     materials: list[dict[str, Any]] = [
         {
             "name": "skin",
@@ -151,7 +144,7 @@ def build_skinned_gltf(
         "textures": [{"sampler": 0, "source": 0}],
         "samplers": [{"magFilter": 9729, "minFilter": 9729}],
         "images": [{"bufferView": _image(buffer, skin_texture()), "mimeType": "image/png"}],
-        "animations": animations,
+        "animations": [animation],
         "buffers": [{"byteLength": len(buffer.data)}],
         "bufferViews": buffer.views,
         "accessors": buffer.accessors,
@@ -226,15 +219,15 @@ def _channels(
     take: Take,
     creature: SkinnedCreature,
     first: int,
-    samplers: list[dict[str, Any]],
-    channels: list[dict[str, Any]],
+    animation: dict[str, Any],
     times: dict[bytes, int],
 ) -> None:
-    """A rotation channel per joint and the root's translation channel, with their keys."""
+    """A rotation channel per joint and the root's translation channel, with their keys,
+    added to `animation`."""
+    samplers, channels = animation["samplers"], animation["channels"]
     seconds = take.times.astype(np.float32)
     interpolation = "LINEAR" if take.frames > 1 else "STEP"
-    animation = creature.animation
-    rotation = to_y_up_rotations(animation.rotation).astype(np.float32)
+    rotation = to_y_up_rotations(creature.animation.rotation).astype(np.float32)
     root = to_y_up_points(creature.translations_at(np.arange(take.frames))[:, 0])
 
     def sampler(keep: np.ndarray, values: np.ndarray, kind: str, node: int, path: str) -> None:

@@ -109,3 +109,24 @@ def test_fur_that_comes_late_or_goes_away_is_held_in_the_take(tmp_path: Path) ->
     assert np.array_equal(points[0], points[4])  # before it came: its first shape
     assert np.array_equal(points[7], points[9])  # after it went: its last shape
     assert not again.visible()[:4, 1].any() and again.visible()[4:7, 1].all()
+
+
+@pytest.mark.parametrize("skinned", [False, True])
+def test_one_animation_drives_every_creature(
+    roster_take: Take, tmp_path: Path, skinned: bool
+) -> None:
+    """Blender plays only a file's first animation (the others go to muted NLA tracks) and
+    engines read an animation as one clip: one animation must move every creature."""
+    path = tmp_path / "roster.glb"
+    (write_skinned_glb if skinned else write_glb)(roster_take, path)
+    document, _ = read_glb(path.read_bytes())
+    (animation,) = document["animations"]
+    driven = {c["target"]["node"] for c in animation["channels"] if c["target"]["path"] != "scale"}
+    if skinned:
+        assert animation["name"] == "take"
+        joints = {j for skin in document["skins"] for j in skin["joints"]}
+        assert len(document["skins"]) == 3 and joints <= driven
+    else:  # a node per body, named after its creature
+        names = {document["nodes"][n]["name"] for n in driven}
+        for creature in ("a", "b", "late"):
+            assert any(name.startswith(creature) for name in names), creature

@@ -107,7 +107,8 @@ def test_four_creatures_import_with_their_own_names_in_usd_and_glb(tmp_path: Pat
         assert found[suffix]["suffixed"] == []
     usd, glb = found[".usdc"], found[".glb"]
     assert usd["armatures"] == glb["armatures"] == [f"creature_{i}_skeleton" for i in range(4)]
-    assert usd["actions"] == glb["actions"] == [f"creature_{i}_animation" for i in range(4)]
+    assert usd["actions"] == [f"creature_{i}_animation" for i in range(4)]
+    assert glb["actions"] == ["take"]  # one clip driving every creature (a slot each)
     assert {f"creature_{i}_skin" for i in range(4)} <= set(usd["meshes"]) & set(glb["meshes"])
 
 
@@ -125,3 +126,38 @@ def _imported(take: Path, blend: Path, script: str) -> dict[str, Any]:
     )
     found: dict[str, Any] = json.loads(read.stdout.splitlines()[-1])
     return found
+
+
+PLAYING = """
+import json, sys, bpy
+bpy.ops.wm.open_mainfile(filepath=sys.argv[1])
+scene = bpy.context.scene
+def poses(frame):
+    scene.frame_set(frame)
+    return {o.name: [list(map(list, b.matrix)) for b in o.pose.bones]
+            for o in bpy.data.objects if o.type == "ARMATURE"}
+first, later = poses(0), poses(20)
+print(json.dumps({
+    o.name: {
+        "action": bool(o.animation_data and o.animation_data.action),
+        "moved": max(abs(x - y) for a, b in zip(first[o.name], later[o.name])
+                     for ra, rb in zip(a, b) for x, y in zip(ra, rb)),
+    }
+    for o in bpy.data.objects if o.type == "ARMATURE"
+}))
+"""
+
+
+@pytest.mark.parametrize("suffix", [".usdc", ".glb"])
+def test_every_creature_plays_in_blender(tmp_path: Path, suffix: str) -> None:
+    """Every armature has an active action and its bones move between two frames (a glb
+    with one animation per creature played one creature: Blender stashes all but the
+    first animation in muted NLA tracks)."""
+    take = tmp_path / f"four{suffix}"
+    argv = ["bake", "thesis_four_by_six", "--seconds", "1", "--fps", "30"]
+    assert main([*argv, "--out", str(take), "--quiet"]) == 0
+    found = _imported(take, tmp_path / "four.blend", PLAYING)
+    assert sorted(found) == [f"creature_{i}_skeleton" for i in range(4)]
+    for name, armature in found.items():
+        assert armature["action"], f"{name} has no active action"
+        assert armature["moved"] > 0.01, f"{name} does not move"
