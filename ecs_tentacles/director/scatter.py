@@ -5,7 +5,8 @@
 Spots are drawn uniformly in the disc (a random heading each) from a generator seeded
 with `seed`, and kept when the creature's reach circle (mantle plus longest tentacle,
 `GAP` more) is clear of every creature there (their reach spheres now) and of every
-spot kept before, and no obstacle is within its reach. The same world, entry and seed
+spot kept before, no obstacle is within its reach, and on a heightfield the whole reach
+circle lies on it (a creature past its edge drops off it). The same world, entry and seed
 give the same spots. Fewer than `count` come back when the disc is full (say so). The
 entry is checked once (`World.spawn`'s rules); every copy then costs only its build
 (`spawning.place`): 100 creatures in well under a second.
@@ -59,6 +60,7 @@ def spots(
     clear = _clear_of_creatures(world, candidates, reach) & _clear_of_obstacles(
         world, candidates, reach
     )
+    clear &= _on_the_heightfield(world, candidates, reach)
     kept: list[int] = []
     for i in np.flatnonzero(clear).tolist():
         if len(kept) == count:
@@ -81,6 +83,15 @@ def _clear_of_creatures(world: Host, points: np.ndarray, reach: float) -> np.nda
     near = np.linalg.norm(centres[:, :2] - middle, axis=1) < spread + reaches + reach + GAP
     gap = np.linalg.norm(points[:, None, :] - centres[None, near, :2], axis=2)
     return np.asarray((gap >= reaches[None, near] + reach + GAP).all(axis=1))
+
+
+def _on_the_heightfield(world: Host, points: np.ndarray, reach: float) -> np.ndarray:
+    """(n,) whose reach circle lies inside the heightfield (all of them without one)."""
+    field = ground_of(world).heightfield
+    if field is None:
+        return np.ones(len(points), dtype=bool)
+    half = 0.5 * np.asarray(field.size, dtype=np.float64) - reach
+    return np.asarray((np.abs(points) <= half).all(axis=1))
 
 
 def _clear_of_obstacles(world: Host, points: np.ndarray, reach: float) -> np.ndarray:

@@ -67,3 +67,23 @@ def test_a_bad_entry_is_one_line_naming_the_field():
             scatter(world, {"tentacles": {"links": 0}}, (0, 0), 3.0, 5)
         with pytest.raises(ValueError, match="count must be >= 0"):
             spots(world, creature_entry(world, OCTO), (0, 0), 3.0, -1, 0)
+
+
+def test_scatter_keeps_every_creature_on_the_heightfield():
+    """On rocky_shore (a 14 x 10 m heightfield) a brush over its edge placed creatures at
+    x = -7.16 and 7.26: they dropped off it."""
+    with World.from_scene("rocky_shore") as world:
+        entry = creature_entry(world, {"name": "s", "tentacles": {"count": 5, "links": 4}})
+        reach = reach_of(entry)
+        found = np.concatenate(
+            [spots(world, entry, centre, 3.0, 12, seed) for seed in range(4)
+             for centre in ((-7.0, 0.0), (7.0, 4.5), (0.0, -5.0))]
+        )  # fmt: skip
+        assert len(found) >= 12  # the inner half of each disc still takes creatures
+        assert (np.abs(found[:, 0]) + reach <= 7.0).all()
+        assert (np.abs(found[:, 1]) + reach <= 5.0).all()
+        made = scatter(world, entry, (-7.0, 0.0), 3.0, 6, seed=1)
+        world.step(30)
+        for entity in made:
+            x, y = world.component(entity, Transform).pos[:2]
+            assert abs(x) < 7.0 and abs(y) < 5.0
