@@ -32,7 +32,12 @@ import numpy as np
 from tqdm import tqdm
 
 from ecs_tentacles.distributed.merge import merge_takes
-from ecs_tentacles.distributed.reaper import Reaper, descendants, end_started_since
+from ecs_tentacles.distributed.reaper import (
+    Reaper,
+    adopt_orphans,
+    descendants,
+    end_started_since,
+)
 from ecs_tentacles.distributed.shards import ShardPlan, default_tasks, plan_shards, scene_plugins
 from ecs_tentacles.distributed.spheres import meetings
 from ecs_tentacles.distributed.task import ShardResult, bake_shard
@@ -72,22 +77,11 @@ def start_ray(address: str | None, cpus: int | None) -> bool:
 
     if ray.is_initialized():
         return False
-    options: dict[str, Any] = {"include_dashboard": False, "log_to_driver": False}
-    options["logging_level"] = logging.ERROR
     ours = _signal_handlers()
     before = descendants()
-    global _REAPER
+    adopt_orphans(True)  # a start cut short may orphan agents: they must stay ours to end
     try:
-        try:
-            if address:
-                ray.init(address=address, **options)
-            else:
-                ray.init(num_cpus=cpus, **options)
-                session = ray.get_runtime_context().get_session_name()
-                _REAPER = Reaper.start(session)  # a local Ray never outlives a killed bake
-        finally:
-            for number, handler in ours.items():  # Ray installs its own: SIGTERM must stay
-                signal.signal(number, handler)  # ours (one line, exit 143, Ray shut down)
+        _init(address, cpus, ours)
     except SystemExit as stop:  # Ray's SIGTERM handler ran while Ray started
         _abandon(before, ours)
         handler = ours.get(signal.SIGTERM)
@@ -97,7 +91,28 @@ def start_ray(address: str | None, cpus: int | None) -> bool:
     except BaseException:  # Ctrl-C, or SIGTERM before Ray's handler was in place
         _abandon(before, ours)
         raise
+    finally:
+        adopt_orphans(False)
     return True
+
+
+def _init(address: str | None, cpus: int | None, ours: dict[int, Any]) -> None:
+    """`ray.init`, quiet; a local Ray gets its watchdog; our signal handlers back."""
+    import ray
+
+    global _REAPER
+    options: dict[str, Any] = {"include_dashboard": False, "log_to_driver": False}
+    options["logging_level"] = logging.ERROR
+    try:
+        if address:
+            ray.init(address=address, **options)
+        else:
+            ray.init(num_cpus=cpus, **options)
+            session = ray.get_runtime_context().get_session_name()
+            _REAPER = Reaper.start(session)  # a local Ray never outlives a killed bake
+    finally:
+        for number, handler in ours.items():  # Ray installs its own: SIGTERM must stay
+            signal.signal(number, handler)  # ours (one line, exit 143, Ray shut down)
 
 
 def _abandon(before: set[tuple[int, float]], ours: dict[int, Any]) -> None:

@@ -8,15 +8,16 @@ the watchdog notes the bake's descendants (Ray starts agents and workers later).
 the bake ends normally it closes the pipe first (`Reaper.stop`: the watchdog leaves);
 when the bake dies, the kernel closes the pipe, the watchdog sees its parent gone and
 ends every process it noted (unless its pid was reused) and whatever they started,
-and every process whose command line names the bake's Ray session (`session`): one
-started in the last second (a worker, an agent) was not noted yet, and the raylet that
-started it may already be gone.
+and every process of the bake's Ray session (`session`: named on its command line or in
+its open files): one started in the last second (a worker, an agent) was not noted yet,
+and the raylet that started it may already be gone.
 
     python -m ecs_tentacles.distributed.reaper PARENT_PID '[[pid, create_time], ...]' [SESSION]
 """
 
 from __future__ import annotations
 
+import ctypes
 import json
 import os
 import select
@@ -29,6 +30,7 @@ import psutil
 
 GRACE_SECONDS = 2.0  # SIGTERM first; SIGKILL whatever still runs after this
 WATCH_SECONDS = 1.0  # how often the watchdog notes what the bake's Ray has started
+_PR_SET_CHILD_SUBREAPER = 36  # prctl's option number (linux/prctl.h)
 
 
 class Reaper:
@@ -109,6 +111,20 @@ def reap(recorded: list[list[Any]]) -> None:
             pass
 
 
+def adopt_orphans(on: bool) -> bool:
+    """Linux: make this process the reaper of its orphaned descendants (or stop), so
+    that a process whose parent dies stays a descendant of this one
+    (`PR_SET_CHILD_SUBREAPER`): a raylet ended while it started its agents leaves them
+    to us, not to init, and `end_started_since` still finds them. False elsewhere."""
+    if not sys.platform.startswith("linux"):
+        return False
+    try:
+        prctl = ctypes.CDLL(None, use_errno=True).prctl
+    except (OSError, AttributeError):
+        return False
+    return bool(prctl(_PR_SET_CHILD_SUBREAPER, int(on), 0, 0, 0) == 0)
+
+
 def descendants() -> set[tuple[int, float]]:
     """(pid, start time) of every descendant of this process."""
     return {(int(pid), float(created)) for pid, created in _descendants(os.getpid())}
@@ -132,12 +148,19 @@ def _descendants(pid: int) -> list[list[Any]]:
 
 
 def of_session(session: str) -> list[list[Any]]:
-    """[pid, create_time] of every living process whose command line names `session`."""
+    """[pid, create_time] of every living process of Ray session `session`: its command
+    line names it (GCS, raylet), or a file it has open does (agents and workers retitle
+    themselves `ray::...`, but keep their logs in the session's folder open)."""
     found = []
     for process in psutil.process_iter(["cmdline", "create_time", "status"]):
         if process.info["status"] == psutil.STATUS_ZOMBIE:
             continue
-        if any(session in part for part in process.info["cmdline"] or ()):
+        named = any(session in part for part in process.info["cmdline"] or ())
+        try:
+            named = named or any(session in f.path for f in process.open_files())
+        except psutil.Error:  # gone, or another user's
+            continue
+        if named:
             found.append([process.pid, process.info["create_time"]])
     return found
 

@@ -238,8 +238,9 @@ def _running_bake(scene: Path, folder: Path, *ray: str) -> subprocess.Popen[str]
 def _ray_processes_of(bake: int) -> set[tuple[int, float]]:
     """(pid, start time) of every living process of the Ray that process `bake` started:
     its descendants and whatever names its Ray session (`session_<date>_<bake pid>`,
-    Ray's own naming; an agent or worker may have been re-parented). Zombies are dead:
-    they hold no memory, and whether they are reaped is up to whoever adopted them."""
+    Ray's own naming) on its command line or in its open files (an agent or worker may
+    have been re-parented). Zombies are dead: they hold no memory, and whether they are
+    reaped is up to whoever adopted them."""
     import psutil
 
     found = set()
@@ -257,7 +258,11 @@ def _ray_processes_of(bake: int) -> set[tuple[int, float]]:
     for process in psutil.process_iter(["cmdline", "create_time", "status"]):
         if process.info["status"] == psutil.STATUS_ZOMBIE:
             continue
-        if session.search(" ".join(process.info["cmdline"] or ())):
+        try:  # agents and workers retitle themselves `ray::...`: their open logs name it
+            names = [*(process.info["cmdline"] or ()), *(f.path for f in process.open_files())]
+        except psutil.Error:
+            continue
+        if session.search(" ".join(names)):
             found.add((process.pid, process.info["create_time"]))
     return found
 
