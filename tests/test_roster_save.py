@@ -176,3 +176,20 @@ def test_a_save_that_would_overwrite_another_file_of_the_same_name_is_refused(
     assert str(other / "maps" / "sixteen.png") in line
     assert (other / "maps" / "sixteen.png").read_bytes() == b"someone else's picture"
     assert sorted(p.name for p in other.rglob("*")) == ["maps", "sixteen.png"]  # no copy
+
+
+def test_a_saved_scenes_schema_reference_resolves_from_where_it_is_saved(tmp_path: Path) -> None:
+    """The bundled scenes say `"$schema": "../schema/scene.schema.json"`; a save kept it,
+    pointing nowhere from the folder it was saved in (editors lost completion)."""
+    from importlib.resources import files
+
+    bundled = json.loads(
+        (files("ecs_tentacles.assets") / "schema" / "scene.schema.json").read_text()
+    )
+    for folder in (tmp_path, tmp_path / "deep" / "er"):
+        folder.mkdir(parents=True, exist_ok=True)
+        with World.from_scene("octopus") as world:
+            saved = save_roster(world, folder / "octopus_directed.json")
+        reference = json.loads(saved.read_text())["$schema"]
+        assert not Path(reference).is_absolute()
+        assert json.loads((saved.parent / reference).read_text()) == bundled

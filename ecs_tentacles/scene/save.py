@@ -20,6 +20,7 @@ import os
 import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from importlib.resources import files
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -173,6 +174,7 @@ def save_scene(
     if not target.parent.is_dir():
         raise OutputError(f"{target}: folder {str(target.parent)!r} does not exist")
     scene = copy.deepcopy(scene)
+    point_schema(scene, target.parent)
     carried = carried_files(scene, checking, source_dir, target)
     folder = target.parent.resolve()
     outputs: list[AtomicOutput] = []
@@ -198,6 +200,19 @@ def save_scene(
                 leftover.rmdir() if leftover.is_dir() else leftover.unlink()
         raise
     return target
+
+
+def point_schema(scene: dict[str, Any], folder: Path) -> None:
+    """A scene's `$schema` (what editors complete and check against) rewritten to reach
+    the bundled schema from `folder`, where the scene is saved; dropped when no relative
+    path reaches it (another drive): loading validates by the bundled schema anyway."""
+    if "$schema" not in scene:
+        return
+    bundled = Path(str(files("ecs_tentacles.assets") / "schema" / "scene.schema.json"))
+    try:
+        scene["$schema"] = Path(os.path.relpath(bundled, folder.resolve())).as_posix()
+    except ValueError:
+        del scene["$schema"]
 
 
 def _written(target: Path, data: bytes) -> AtomicOutput:
