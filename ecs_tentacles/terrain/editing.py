@@ -69,7 +69,8 @@ class TerrainEditor:
         half = keys["size"][2] / 2 if shape == "box" else keys.get("height", 2 * keys["radius"]) / 2
         if shape == "sphere":
             half = 0.6 * keys["radius"]  # sunk a little: a boulder, not a ball on a plane
-        obstacle = {"shape": shape, "position": [round(x, 4), round(y, 4), round(base + half, 4)]}
+        z = base + half - _field_height(world, x, y)  # on_ground: from the ground under it
+        obstacle = {"shape": shape, "position": [round(x, 4), round(y, 4), round(z, 4)]}
         obstacle.update(keys)
         terrain = self._terrain(world)
         terrain.setdefault("obstacles", []).append(obstacle)
@@ -83,9 +84,13 @@ class TerrainEditor:
         if not 0 <= index < len(obstacles):
             raise TerrainEditError(f"terrain.obstacles[{index}]: there is no such obstacle")
         obstacle = obstacles[index]
+        x, y = float(point[0]), float(point[1])
+        if obstacle.get("on_ground", True):  # its z is measured from the ground under it
+            obstacle["position"] = [round(x, 4), round(y, 4), obstacle["position"][2]]
+            self._apply(world, terrain)
+            return
         old = ground_of(world).surface(np.array(obstacle["position"][:2], dtype=float))[0]
         lift = obstacle["position"][2] - old
-        x, y = float(point[0]), float(point[1])
         others = Ground(ground_of(world).heightfield)  # the ground without the obstacles
         base = float(others.surface(np.array([[x, y]]))[0])
         obstacle["position"] = [round(x, 4), round(y, 4), round(base + lift, 4)]
@@ -193,3 +198,9 @@ def _bodies(world: Host, entity: int) -> tuple[np.ndarray, np.ndarray]:
             rows.append(world.component(link, Transform).row)
             radii.append(world.component(link, Link).radius)
     return np.array(rows, dtype=np.int64), np.array(radii)
+
+
+def _field_height(world: Host, x: float, y: float) -> float:
+    """The heightfield's height under (x, y): what an `on_ground` obstacle's z is above."""
+    field = ground_of(world).heightfield
+    return 0.0 if field is None else float(field.height(np.array([[x, y]]))[0])

@@ -27,7 +27,7 @@ def build_ground(terrain: Mapping[str, Any], folder: Any) -> Ground:
         return FLAT
     try:
         field = heightfield(terrain["heightfield"], folder) if terrain.get("heightfield") else None
-        shapes = solids(terrain.get("obstacles", []), folder)
+        shapes = solids(terrain.get("obstacles", []), folder, field)
     except TerrainError as error:
         raise SceneError([f"{format_path(error.path)}: {error}"]) from None
     friction = terrain.get("friction")

@@ -11,6 +11,7 @@ process with a time and memory budget, once per distinct file
 
 from __future__ import annotations
 
+import dataclasses
 import pathlib
 from collections.abc import Mapping, Sequence
 from typing import Any
@@ -18,7 +19,7 @@ from typing import Any
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from ecs_tentacles.ground import Solid, convex_planes
+from ecs_tentacles.ground import Heightfield, Solid, convex_planes
 from ecs_tentacles.terrain.heights import Problem, TerrainError
 from ecs_tentacles.terrain.meshes import MAX_MESH_BYTES, MESH_SUFFIXES, MeshReader
 
@@ -55,14 +56,25 @@ def obstacle_problems(obstacles: Sequence[Mapping[str, Any]]) -> list[Problem]:
 
 
 def solids(
-    obstacles: Sequence[Mapping[str, Any]], folder: pathlib.Path | None
+    obstacles: Sequence[Mapping[str, Any]],
+    folder: pathlib.Path | None,
+    field: Heightfield | None = None,
 ) -> tuple[Solid, ...]:
-    """Every obstacle as a `Solid` (schema-valid entries)."""
+    """Every obstacle as a `Solid` (schema-valid entries); on `field`, those `on_ground`
+    (the default) raised by the ground's height under their centre."""
     for path, message in obstacle_problems(obstacles):
         raise TerrainError(path, message)
     planes: dict[int, tuple[np.ndarray, ...]] = {}  # id(pieces) -> their planes, made once
     with MeshReader(folder) as reader:
-        return tuple(_solid(i, o, reader, planes) for i, o in enumerate(obstacles))
+        made = [_solid(i, o, reader, planes) for i, o in enumerate(obstacles)]
+    if field is None:
+        return tuple(made)
+    standing = [i for i, o in enumerate(obstacles) if o.get("on_ground", True)]
+    if standing:
+        centres = np.array([made[i].position[:2] for i in standing])
+        for i, lift in zip(standing, field.height(centres).tolist(), strict=True):
+            made[i] = dataclasses.replace(made[i], position=made[i].position + [0.0, 0.0, lift])
+    return tuple(made)
 
 
 def _solid(

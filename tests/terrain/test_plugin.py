@@ -274,3 +274,36 @@ def test_past_the_heightfields_edge_the_ground_goes_on_at_its_lowest_height(
     mantle = world.transforms.pos[world.creatures.mantle_row[0]]
     assert mantle[0] > 1.8  # it crawled off the edge
     assert mantle[2] > 0.2  # onto the plane beyond, not down forever
+
+
+def _above_ground(world: World) -> np.ndarray:
+    """Per obstacle, how far its top rises above the ground under its centre (m)."""
+    ground = ground_of(world)
+    assert ground.heightfield is not None
+    centres = np.array([solid.position[:2] for solid in ground.solids])
+    tops = np.array([s.top(c[None])[0] for s, c in zip(ground.solids, centres, strict=True)])
+    return tops - ground.heightfield.height(centres)
+
+
+def test_rocks_stand_on_the_terrain_not_in_it(tmp_path: pathlib.Path) -> None:
+    """rocky_shore's ledge was 0.13 m under the surface, and 5 of 6 rocks of `crowd 40
+    --terrain rocky` had their tops below the ground: the ground read as plain sand."""
+    out = tmp_path / "crowd.json"
+    assert main(["crowd", "40", "--terrain", "rocky", "--out", str(out)]) == 0
+    for source in ("rocky_shore", str(out)):
+        with World.from_scene(source) as world:
+            assert (_above_ground(world) > 0.1).all(), source
+
+
+def test_on_ground_false_measures_z_from_zero_and_the_plane_is_unchanged() -> None:
+    rock = {"shape": "sphere", "position": [-1.5, -3.0, 0.0], "radius": 0.2}
+    buried = {**rock, "on_ground": False}
+    hills = {"heightfield": ROCKY["heightfield"]}
+    sunk = scene({**hills, "obstacles": [rock, buried]}, [3.0, 3.0])
+    with World.from_scene(sunk) as world:
+        standing, under = _above_ground(world)
+        assert standing == pytest.approx(0.2) and under < 0.2
+        height = ground_of(world).heightfield.height(np.array([[-1.5, -3.0]]))[0]
+        assert under == pytest.approx(0.2 - height)
+    with World.from_scene(scene({"obstacles": [rock]}, [3.0, 3.0])) as world:
+        assert ground_of(world).solids[0].position.tolist() == [-1.5, -3.0, 0.0]
