@@ -130,6 +130,10 @@ class Batch:
         self.deepest = np.full(n, np.inf)  # deepest contact distance (m; < 0 penetrates)
         self.errors: dict[int, str] = {}  # row -> MuJoCo's fatal error in the last step
         self.scratch: dict[int, list[Scratch]] = {FULL: []}
+        # `body_rows` as one slice of the Transform store when they are consecutive (a
+        # uniform crowd): `sync` then copies instead of scattering, 6x faster at 10,000
+        self._span: slice | None = None
+        self._span_of: np.ndarray | None = None  # the body_rows the span was found for
 
     def __len__(self) -> int:
         return len(self.members)
@@ -288,9 +292,26 @@ class Batch:
 
     # -- per frame -----------------------------------------------------------------
     def sync(self, transforms: TransformStore) -> None:
-        """Every row's body poses into the Transform store (one scatter per field)."""
-        transforms.pos[self.body_rows] = self.xpos
-        transforms.quat[self.body_rows] = self.xquat
+        """Every row's body poses into the Transform store (one scatter per field, or one
+        copy when the rows are consecutive)."""
+        span = self.body_span()
+        if span is None:
+            transforms.pos[self.body_rows] = self.xpos
+            transforms.quat[self.body_rows] = self.xquat
+        else:
+            transforms.pos[span] = self.xpos.reshape(-1, 3)
+            transforms.quat[span] = self.xquat.reshape(-1, 4)
+
+    def body_span(self) -> slice | None:
+        """`body_rows` (rows, bodies) as one slice of store rows when they are consecutive
+        in row order, else None; found again only when `body_rows` was replaced."""
+        rows = self.body_rows
+        if self._span_of is not rows:
+            flat = rows.ravel()
+            consecutive = len(flat) > 0 and bool((np.diff(flat) == 1).all())
+            self._span = slice(int(flat[0]), int(flat[-1]) + 1) if consecutive else None
+            self._span_of = rows
+        return self._span
 
     def step_rows(self, rows: np.ndarray, substeps: int, thread: int, tier: int = FULL) -> None:
         """Advance `rows` by `substeps` steps each of `tier`'s model, on `thread`'s scratch."""

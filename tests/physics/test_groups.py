@@ -74,3 +74,26 @@ def test_groups_are_visible(make_world: Callable[..., World]) -> None:
     assert world.physics.group_of(octo) is world.physics.groups[1]
     assert repr(world.physics) == "<physics: 2 creatures, 1 compiled models, 2 threads>"
     assert world.physics.bodies == 2 * (1 + 3 * 4)
+
+
+def test_sync_copies_consecutive_rows_as_one_slice_and_follows_a_despawn() -> None:
+    """A uniform crowd's bodies are consecutive store rows: one copy instead of a scatter
+    (the pose of every body must land exactly where the scatter put it)."""
+    from ecs_tentacles.creator.crowd import crowd_scene
+
+    with World.from_scene(crowd_scene(6, seed=0, uniform=True)) as world:
+        world.step(3)
+        (batch,) = world.physics.batches
+        assert batch.body_span() == slice(0, batch.body_rows.size)
+        world.despawn(world.creature(world.creature_name(int(world.creatures.entity[2]))))
+        world.step(2)
+        for scattered in (False, True):  # consecutive after the despawn; then not
+            if scattered:
+                batch.body_rows = batch.body_rows[::-1].copy()  # rows in another order
+                assert batch.body_span() is None
+            world.transforms.pos[:] = np.nan
+            world.transforms.quat[:] = np.nan
+            batch.sync(world.transforms)
+            np.testing.assert_array_equal(world.transforms.pos[batch.body_rows], batch.xpos)
+            np.testing.assert_array_equal(world.transforms.quat[batch.body_rows], batch.xquat)
+            assert np.isfinite(world.transforms.pos[batch.body_rows]).all()
