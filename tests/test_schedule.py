@@ -47,6 +47,7 @@ class Late(Probe):
 
 BUILTIN = [
     "goals",
+    "avoidance",
     "tentacle_selection",
     "action_queue",
     "motor_targets",
@@ -75,7 +76,7 @@ def test_builtin_order(make_world: Callable[..., World]) -> None:
         "rig",
     ]
     assert [world.schedule.stage_of(n) for n in BUILTIN] == [
-        "decide", "decide", "act", "act", "act", "physics", "physics", "sync", "sync",
+        "decide", "decide", "decide", "act", "act", "act", "physics", "physics", "sync", "sync",
         "animate", "animate", "animate",
     ]  # fmt: skip
 

@@ -306,7 +306,9 @@ def test_what_a_despawn_updates_in_place_equals_what_a_rebuild_makes():
 
 def test_a_newcomer_meets_the_creatures_there_through_contact():
     octopus = {"name": "a", "position": [0.0, 0.0], "goals": [{"position": [3.0, 0.0]}]}
-    with World.from_scene(_scene([octopus])) as world:
+    scene = _scene([octopus])
+    scene["avoidance"] = {"enabled": False}  # straight into each other, not around
+    with World.from_scene(scene) as world:
         world.step(5)
         b = world.spawn({"name": "b", "goals": [{"position": [-3.0, 0.0]}]}, position=(2.2, 0))
         deepest, met = 0.0, 0

@@ -1,12 +1,15 @@
 """The locomotion plugin: goal paths, gait and the action queues that crawl toward goals.
 
-Scene keys: a creature's `goals` and `locomotion` (`locomotion.schema.json` beside this file).
+Scene keys: a creature's `goals`, `locomotion`, `navigation` and `avoid`, the scene's
+`avoidance` (`locomotion.schema.json` beside this file).
 Resources: `LocomotionStores` (per-tentacle and per-creature columns, row for row with
 the body's stores; `world.stores` "locomotion.tentacles" / "locomotion.creatures"),
-`GoalBook` (goal paths) and `Locomotion` (parameters at run time), by type:
-`world.resource(GoalBook)`. Scene keys also include six tentacle parameters (speed,
-target angle, waves, writhe; `tentacles` and its `overrides`).
-Systems: goals, tentacle_selection (stage decide), action_queue, motor_targets (act).
+`GoalBook` (goal paths), `Locomotion` (parameters at run time) and `Avoidance` (the
+scene's `avoidance` settings), by type: `world.resource(GoalBook)`. Scene keys also
+include six tentacle parameters (speed, target angle, waves, writhe; `tentacles` and its
+`overrides`).
+Systems: goals, avoidance, tentacle_selection (stage decide), action_queue, motor_targets
+(act).
 Sandbox hooks: goal rings and paths, goals set by clicks (`locomotion.render`), the
 Locomotion and Actions sections of the HUD (`locomotion.panel`). Hook: `wants_motion`
 (creatures with a goal stay awake).
@@ -26,6 +29,7 @@ from ecs_tentacles.build import creature_rng
 from ecs_tentacles.components import Creature, Tentacle
 from ecs_tentacles.construction import tentacle_params
 from ecs_tentacles.locomotion.actions import STRENGTH, ActionQueue, Kind
+from ecs_tentacles.locomotion.avoidance import Avoidance, bent
 from ecs_tentacles.locomotion.components import Goal
 from ecs_tentacles.locomotion.formations import FormationChoice
 from ecs_tentacles.locomotion.goals import GoalBook
@@ -53,15 +57,23 @@ class LocomotionPlugin(Plugin):
     description = "goal-directed crawling: goal paths, gait, action queues, motor targets"
     creature_schema = _FRAGMENT["creature"]
     tentacle_schema = _FRAGMENT["tentacles"]
+    scene_schema = _FRAGMENT["scene"]
     # wants_motion, travel_targets
-    hook_reads = ("locomotion.creatures.has_goal", "locomotion.creatures.goal")
+    hook_reads = (
+        "locomotion.creatures.has_goal",
+        "locomotion.creatures.goal",
+        "locomotion.creatures.steer",
+        "locomotion.creatures.avoidance",
+        "transforms.pos",
+        "creatures.mantle_row",
+    )
     defs = _FRAGMENT["$defs"]
 
     _directed: Any = None  # the sandbox's undo mementos (`locomotion.directing`)
 
     def resources(self, world: Host) -> list[object]:
         return [LocomotionStores(), GoalBook(world), Locomotion(world), Navigator(),
-                FormationChoice()]  # fmt: skip
+                FormationChoice(), Avoidance()]  # fmt: skip
 
     def stores(self, world: Host) -> dict[str, ArrayStore]:
         loco = world.resource(LocomotionStores)
@@ -75,6 +87,7 @@ class LocomotionPlugin(Plugin):
             raise RuntimeError("locomotion's creature rows must line up with the body's")
         apply_parameters(world, "locomotion", spec["locomotion"], {"locomotion.creatures": row})
         loco.creatures.navigate[row] = bool(spec.get("navigation", True))
+        loco.creatures.avoid[row] = bool(spec.get("avoid", True))
         rng = creature_rng(world.seed, spec["name"])  # the creature's own stream
         tentacles = spec["tentacles"]
         for k, entity in enumerate(body.tentacles):
@@ -93,6 +106,9 @@ class LocomotionPlugin(Plugin):
             # a 2-d goal is on the ground under it (`GoalBook` puts it there)
             world.resource(GoalBook).append(creature, goal["position"], goal["radius"])
 
+    def build_scene(self, world: Host, scene: Mapping[str, Any]) -> None:
+        world.resource(Avoidance).configure(scene)
+
     def despawning(self, world: Host, creature: int) -> None:
         world.resource(GoalBook).forget(creature)
 
@@ -101,20 +117,28 @@ class LocomotionPlugin(Plugin):
 
     def systems(self) -> list[System]:
         from ecs_tentacles.systems.locomotion.action_queue import ActionQueueSystem
+        from ecs_tentacles.systems.locomotion.avoidance import CrowdAvoidance
         from ecs_tentacles.systems.locomotion.goals import Goals
         from ecs_tentacles.systems.locomotion.motor_targets import MotorTargets
         from ecs_tentacles.systems.locomotion.tentacle_selection import TentacleSelection
 
-        return [Goals(), TentacleSelection(), ActionQueueSystem(), MotorTargets()]
+        return [Goals(), CrowdAvoidance(), TentacleSelection(), ActionQueueSystem(),
+                MotorTargets()]  # fmt: skip
 
     def wants_motion(self, world: Host) -> np.ndarray:
         """Creatures with a goal crawl: they never fall asleep."""
         return world.resource(LocomotionStores).creatures.has_goal
 
     def travel_targets(self, world: Host) -> np.ndarray:
-        """Creatures crawl toward their current goal (or the waypoint on the way to it)."""
+        """Creatures crawl toward their current goal (or the waypoint on the way to it),
+        turned by avoidance where a neighbour is near."""
         creatures = world.resource(LocomotionStores).creatures
-        return np.where(creatures.has_goal[:, None], creatures.steer[:, :2], np.nan)
+        target = creatures.steer[:, :2].copy()
+        turned = np.flatnonzero(np.any(creatures.avoidance != 0.0, axis=1))
+        if len(turned):  # the others keep their steer point exactly
+            mantle = world.transforms.pos[world.creatures.mantle_row[turned], :2]
+            target[turned] = mantle + bent(target[turned] - mantle, creatures.avoidance[turned])
+        return np.where(creatures.has_goal[:, None], target, np.nan)
 
     def snapshot(self, world: Host) -> Any:
         goals = {

@@ -52,7 +52,8 @@ class TentacleGaitStore(ArrayStore):
 
 
 class CreatureGaitStore(ArrayStore):
-    """Per creature: gait, speed, drivers, sucker release thresholds and the current goal."""
+    """Per creature: gait, speed, drivers, sucker release thresholds, the current goal and
+    where it steers (navigation, avoidance)."""
 
     lines_up_with = "creatures"
 
@@ -68,6 +69,8 @@ class CreatureGaitStore(ArrayStore):
     goal_radius = Field()
     navigate = Field(dtype=np.bool_, default=True)  # plan paths around obstacles (navigation)
     steer = Field((3,))  # where it crawls this frame: the goal or a waypoint (navigation)
+    avoid = Field(dtype=np.bool_, default=True)  # steers around other creatures (avoidance)
+    avoidance = Field((2,))  # the avoidance term this frame, in ground xy (0: straight on)
 
 
 class LocomotionStores:

@@ -17,10 +17,13 @@ ramp chooses and orients its strokes along the slope, not along their shadows.
 * no goal: drives stop (the sucker lets go) and every tentacle idles.
 
 First it has the `Navigator` set each creature's steer point: its goal, or the next
-waypoint of a path around obstacles (`ecs_tentacles.locomotion.navigation`).
+waypoint of a path around obstacles (`ecs_tentacles.locomotion.navigation`). The
+direction toward it is turned by the crowd-avoidance term the avoidance system wrote
+(`ecs_tentacles.locomotion.avoidance.bent`; zero, and so no change, where no other
+creature is near): that is the "goal" direction every choice below is made against.
 
-Reads: locomotion's stores (goal, navigate, steer; gait, drivers, speed; action, mode,
-driving),
+Reads: locomotion's stores (goal, navigate, steer, avoidance; gait, drivers, speed; action,
+mode, driving),
 CreatureStore and TentacleStore (mantle, tentacle rows, bases), Transform store, the
 Ground.
 Writes: locomotion's tentacle store (driving, mode, started) and creature store
@@ -43,6 +46,7 @@ from ecs_tentacles.locomotion.actions import (
     drive_sequence,
 )
 from ecs_tentacles.locomotion.actions import make_action as action
+from ecs_tentacles.locomotion.avoidance import bent
 from ecs_tentacles.locomotion.navigation import Navigator
 from ecs_tentacles.locomotion.stores import LocomotionStores
 from ecs_tentacles.scene.parameters import parameter
@@ -136,7 +140,7 @@ class TentacleSelection(System):
         ground = ground_of(world)
         if ground.flat:
             mantle = pos[c.mantle_row, :2]
-            to_goal = (g.steer[:, :2] - mantle)[creature]
+            to_goal = bent(g.steer[:, :2] - mantle, g.avoidance)[creature]
             to_base = pos[t.base_row, :2] - mantle[creature]
         else:  # creatures the level of detail replays keep world xy: their strokes drive nothing
             mantle3 = pos[c.mantle_row]
@@ -144,7 +148,7 @@ class TentacleSelection(System):
             driven = ~world.physics.kinematic_creatures(len(c)) & g.has_goal
             normals[driven] = ground.normal_under(mantle3[driven, :2])
             basis = ground_plane(normals)[creature]  # (n, 2, 3)
-            to_goal = _in_plane(basis, (g.steer - mantle3)[creature])
+            to_goal = _in_plane(basis, bent(g.steer - mantle3, g.avoidance)[creature])
             to_base = _in_plane(basis, pos[t.base_row] - mantle3[creature])
         pull, cos = classify(to_goal, to_base)
         has_goal = g.has_goal[creature]

@@ -26,7 +26,7 @@ def test_systems_prints_the_frame_with_stages_plugins_and_fields(
     assert ["physics", "physics", "core"] in rows and rows[-1] == ["animate", "rig", "fur"]
     assert main(["systems", "octopus", "--json"]) == 0
     report = json.loads(capsys.readouterr().out)
-    assert report["warnings"] == [] and report["systems"][3]["system"] == "motor_targets"
+    assert report["warnings"] == [] and report["systems"][4]["system"] == "motor_targets"
 
 
 def test_systems_warns_about_unordered_writers(

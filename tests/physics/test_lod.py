@@ -136,6 +136,7 @@ def _head_on(hero: str | None) -> tuple[set[str], set[str], list[float], World]:
     scene = {
         "version": 1,
         "physics": {"lod": {"full": 0, "reduced": 0, "hold_seconds": 0}},
+        "avoidance": {"enabled": False},  # straight into each other, not around
         "creatures": [
             {"name": "a", "position": [-0.75, 0.0], "tentacles": dict(SMALL),
              "goals": [{"position": [1.5, 0.0]}]},

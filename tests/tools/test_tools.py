@@ -57,7 +57,8 @@ def test_frame_benchmark_splits_the_frame() -> None:
     bench = _load("bench_frame")
     row = bench.bench_scene("three_goals", frames=3, repeats=1)
     ms = row["ms_per_frame"]
-    names = {"goals", "tentacle_selection", "action_queue", "motor_targets", "suckers"}
+    names = {"goals", "avoidance", "tentacle_selection", "action_queue", "motor_targets"}
+    names |= {"suckers"}
     names |= {"threats", "emotion", "rig", "lod_replay"}
     assert names | {"physics", "physics_health", "physics_sync", "total", "mj_step"} == set(ms)
     assert ms["total"] >= ms["mj_step"] > 0

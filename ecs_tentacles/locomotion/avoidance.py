@@ -1,0 +1,123 @@
+"""Crowd avoidance: creatures steer around each other instead of crawling into contact.
+
+    world.resource(Avoidance).enabled = False          # the whole scene crawls straight
+    scene: "avoidance": {"enabled": false}             # the same, from the scene
+    creature: "avoid": false                           # this one crawls straight (others
+                                                       # still steer around it)
+
+A social-force term, whole-array work over every pair of creatures near each other: each
+creature has a personal circle on the ground (`personal_radius`: its mantle radius plus
+its longest tentacle: crawling, the tentacles lie spread out); the pairs whose circles
+come within the scene's `range` of each other are found by the same near-pair search the
+contact proxies use (`ecs_tentacles.physics.proxies.near_pairs`: every pair in small
+crowds, a k-d tree in large ones). A neighbour pushes a creature away along the line
+between them and to its right (both sides of a head-on meeting step aside the same way
+and pass), more when the circles are closer (zero at `range`, one at touch, up to two
+overlapped) and more when the neighbour is ahead of where it is going than behind it.
+The sum, times `strength`, is the creature's `bend`: added to the unit direction toward
+its steer point, it is the direction the creature crawls (`bent`: tentacle selection's
+push/pull choice and strokes, and the kinematic replay's heading). It fades out within a
+personal radius of the goal, so a creature still reaches a goal someone stands beside.
+
+A creature with no neighbour within `range` gets exactly zero and crawls exactly as
+without avoidance (bit for bit): scenes whose creatures stay apart do not change.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ecs_tentacles.physics.proxies import near_pairs
+from ecs_tentacles.scene.schema import fragment
+
+BEHIND = 0.3  # a neighbour straight behind weighs this much of one straight ahead
+SIDESTEP = 1.0  # the push to the right (keep right), relative to the push away
+_SCENE = fragment("ecs_tentacles.locomotion", "locomotion")["scene"]["avoidance"]
+
+
+def _default(key: str) -> Any:
+    return _SCENE["properties"][key]["default"]
+
+
+@dataclass
+class Avoidance:
+    """`world.resource(Avoidance)`: the scene's avoidance settings (`avoidance` key)."""
+
+    provided_by = "locomotion"
+
+    enabled: bool = _default("enabled")
+    range: float = _default("range")  # m between personal circles where it starts
+    strength: float = _default("strength")
+
+    def configure(self, scene: Mapping[str, Any]) -> None:
+        """Take the scene's `avoidance` object (its defaults where it says nothing)."""
+        given = scene.get("avoidance", {})
+        self.enabled = bool(given.get("enabled", _default("enabled")))
+        self.range = float(given.get("range", _default("range")))
+        self.strength = float(given.get("strength", _default("strength")))
+
+
+def personal_radius(
+    mantle_radius: np.ndarray, tentacle_creature: np.ndarray, tentacle_length: np.ndarray
+) -> np.ndarray:
+    """(creatures,) each creature's personal circle: mantle radius + its longest tentacle
+    (tentacles given by their creature row and length)."""
+    longest = np.zeros(len(mantle_radius))
+    np.maximum.at(longest, tentacle_creature, tentacle_length)
+    return mantle_radius + longest
+
+
+def bend(
+    pos: np.ndarray,
+    radius: np.ndarray,
+    heading: np.ndarray,
+    steering: np.ndarray,
+    to_goal: np.ndarray,
+    reach: float,
+    strength: float,
+) -> np.ndarray:
+    """(n, 2) each creature's avoidance term (module doc); zero where none applies.
+
+    `pos` (n, 2): mantles on the ground; `radius` (n,): personal circles; `heading`
+    (n, 2): unit directions toward where each crawls (zero: going nowhere); `steering`
+    (n,) bool: who steers (the others are only avoided); `to_goal` (n,): ground distance
+    to the steer point; `reach`: the scene's range (m); `strength`: its gain.
+    """
+    out = np.zeros((len(pos), 2))
+    if len(pos) < 2 or not steering.any() or strength == 0.0:
+        return out
+    a, b = near_pairs(pos, radius, reach)
+    keep = steering[a]
+    a, b = a[keep], b[keep]
+    if not len(a):
+        return out
+    d = pos[b] - pos[a]
+    distance = np.hypot(d[:, 0], d[:, 1])
+    toward = d / np.maximum(distance, 1e-9)[:, None]  # unit, a -> b
+    gap = distance - radius[a] - radius[b]
+    push = np.clip(1.0 - gap / reach, 0.0, 2.0) ** 2
+    ahead = np.einsum("ij,ij->i", toward, heading[a])  # cos of the neighbour off the way
+    weight = push * (BEHIND + (1.0 - BEHIND) * 0.5 * (1.0 + ahead))
+    right = np.column_stack([toward[:, 1], -toward[:, 0]])
+    force = (SIDESTEP * np.maximum(ahead, 0.0)[:, None] * right - toward) * weight[:, None]
+    np.add.at(out, a, force)
+    fade = np.clip(to_goal / np.maximum(radius, 1e-9), 0.0, 1.0)  # near the goal: let it in
+    out *= (strength * fade)[:, None]
+    return out
+
+
+def bent(to_goal: np.ndarray, term: np.ndarray) -> np.ndarray:
+    """`to_goal` (n, 2 or 3: toward each steer point) turned by avoidance `term` (n, 2):
+    unit direction + term, at the length of `to_goal`'s ground part. Rows whose term is
+    zero are returned as they were, bit for bit (the same array when every row is)."""
+    rows = np.flatnonzero(np.any(term != 0.0, axis=1))
+    if not len(rows):
+        return to_goal
+    out = to_goal.copy()
+    length = np.hypot(to_goal[rows, 0], to_goal[rows, 1])
+    out[rows, :2] += length[:, None] * term[rows]
+    return out
