@@ -275,6 +275,15 @@ class Plugin:
         creatures whose reaches may meet in one shard."""
         return None
 
+    def meeting_reach(self, scene: Mapping[str, Any]) -> list[float] | None:
+        """Per creature of `scene` (defaults in; scene order), a distance (m) from its
+        mantle on the ground: this plugin lets two creatures act on each other without
+        touching when their mantles come within the sum of theirs (locomotion: crowd
+        avoidance, its personal radius and half the range); None: only through contact.
+        A distributed bake bakes again as one the shards whose creatures came that close
+        (`distributed.spheres.meetings`)."""
+        return None
+
     def shard_groups(self, creatures: Sequence[Mapping[str, Any]]) -> list[list[int]]:
         """Sets of creature indices (scene order) that must bake in one shard wherever
         they are (fur: threats and the emotional creatures they rouse)."""

@@ -23,7 +23,7 @@ import logging
 import signal
 import sys
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -43,6 +43,7 @@ from ecs_tentacles.distributed.spheres import meetings
 from ecs_tentacles.distributed.task import ShardResult, bake_shard
 from ecs_tentacles.distributed.work import load_shard, remove_work, save_shard, shard_key
 from ecs_tentacles.export.bake import BakePlan
+from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.take import Take
 
 
@@ -208,7 +209,7 @@ def ray_bake(
         shards = stats.plan.shards
         results = _run_all(plan, shards, folder, resume, retries, progress, allow_systems, stats)
         while True:
-            met = _meetings(plan, results)
+            met = _meetings(plan, results, plugins)
             if not met:
                 break
             shards = _join(shards, met)
@@ -302,7 +303,9 @@ def _run_all(
     return results
 
 
-def _meetings(plan: BakePlan, results: dict[tuple[int, ...], ShardResult]) -> list:
+def _meetings(
+    plan: BakePlan, results: dict[tuple[int, ...], ShardResult], plugins: Sequence[Plugin]
+) -> list:
     n = len(plan.scene["creatures"])
     first = next(iter(results.values())).spheres
     spheres = np.zeros((len(first), n, 4))
@@ -310,7 +313,12 @@ def _meetings(plan: BakePlan, results: dict[tuple[int, ...], ShardResult]) -> li
     for k, result in enumerate(results.values()):
         spheres[:, result.members] = result.spheres
         shard_of[result.members] = k
-    return meetings(spheres, shard_of)
+    reach = np.zeros(n)
+    for plugin in plugins:
+        extra = plugin.meeting_reach(plan.scene)
+        if extra is not None:
+            reach += np.asarray(extra, dtype=np.float64)
+    return meetings(spheres, shard_of, reach)
 
 
 def _join(shards: list[list[int]], met: list[tuple[int, int, int]]) -> list[list[int]]:

@@ -7,8 +7,10 @@ its own array `spheres` (frames + 1, creatures, 4): centre x, y, z and radius, i
 world's creature order, frame 0 the built pose. Runs after physics_sync.
 
 `meetings` then finds creatures of different shards whose spheres came within the
-proxies' `MARGIN` in the same frame: exactly when a local bake would have given
-them proxies of each other, so a bake with no meetings equals the local bake.
+proxies' `MARGIN` in the same frame, or whose mantles came within the distance at which
+a plugin lets them act on each other without touching (`Plugin.meeting_reach`: crowd
+avoidance): exactly when a local bake would have given them proxies of each other, or
+steered them, so a bake with no meetings equals the local bake.
 """
 
 from __future__ import annotations
@@ -71,27 +73,40 @@ class ContactSpheres(System):
         self._capture(world)
 
 
-def meetings(spheres: np.ndarray, shard_of: np.ndarray) -> list[tuple[int, int, int]]:
+def meetings(
+    spheres: np.ndarray, shard_of: np.ndarray, reach: np.ndarray | None = None
+) -> list[tuple[int, int, int]]:
     """(creature i, creature j, first frame) for creatures of different shards that met.
 
-    `spheres` (frames, creatures, 4) in scene order; `shard_of` the shard of each creature.
+    `spheres` (frames, creatures, 4) in scene order, centred on each mantle; `shard_of`
+    the shard of each creature; `reach` (creatures,) how far from its mantle, on the
+    ground, each acts on others without touching (`Plugin.meeting_reach`): two also
+    meet when their mantles come within the sum of their reaches.
     """
     centre, radius = spheres[..., :3], spheres[..., 3]
     start = centre[0]
     extent = (np.linalg.norm(centre - start, axis=2) + radius).max(axis=0)
+    acts = np.zeros(len(start)) if reach is None else np.asarray(reach, dtype=np.float64)
+    travel = np.linalg.norm(centre[..., :2] - start[:, :2], axis=2).max(axis=0)
     found: list[tuple[int, int, int]] = []
     n = len(start)
     block = max(1, 2_000_000 // max(n, 1))
     for lo in range(0, n, block):
         hi = min(n, lo + block)
         gap = np.linalg.norm(start[lo:hi, None] - start[None], axis=2)
-        gap -= extent[lo:hi, None] + extent[None]
-        i, j = np.nonzero(gap < MARGIN)
+        touch = gap - (extent[lo:hi, None] + extent[None]) < MARGIN
+        flat = np.linalg.norm(start[lo:hi, None, :2] - start[None, :, :2], axis=2)
+        steer = flat - (travel + acts)[lo:hi, None] - (travel + acts)[None] < 0.0
+        i, j = np.nonzero(touch | steer)
         i += lo
         keep = (i < j) & (shard_of[i] != shard_of[j])
         for a, b in zip(i[keep].tolist(), j[keep].tolist(), strict=True):
             distance = np.linalg.norm(centre[:, a] - centre[:, b], axis=1)
-            close = np.flatnonzero(distance - radius[:, a] - radius[:, b] < MARGIN)
-            if len(close):
-                found.append((a, b, int(close[0])))
+            close = distance - radius[:, a] - radius[:, b] < MARGIN
+            if reach is not None:
+                ground = np.linalg.norm(centre[:, a, :2] - centre[:, b, :2], axis=1)
+                close |= ground < acts[a] + acts[b]
+            frames = np.flatnonzero(close)
+            if len(frames):
+                found.append((a, b, int(frames[0])))
     return found

@@ -31,6 +31,7 @@ from typing import Any
 
 import numpy as np
 
+from ecs_tentacles.construction import tentacle_params, tentacle_shape
 from ecs_tentacles.physics.proxies import near_pairs
 from ecs_tentacles.scene.schema import fragment
 
@@ -120,4 +121,25 @@ def bent(to_goal: np.ndarray, term: np.ndarray) -> np.ndarray:
     out = to_goal.copy()
     length = np.hypot(to_goal[rows, 0], to_goal[rows, 1])
     out[rows, :2] += length[:, None] * term[rows]
+    return out
+
+
+def meeting_reach(scene: Mapping[str, Any]) -> list[float] | None:
+    """Per creature of `scene`, its personal radius and half the range: two creatures
+    steer each other exactly when their mantles come within the sum of theirs (their
+    personal circles within the range; `Plugin.meeting_reach`); None with avoidance off."""
+    settings = Avoidance()
+    settings.configure(scene)
+    if not settings.enabled:
+        return None
+    out = []
+    keys = ("link_length", "link_radius", "links", "end_scale")
+    for creature in scene["creatures"]:
+        tentacles, radius = creature["tentacles"], float(creature["mantle"]["radius"])
+        longest = 0.0
+        for k in range(tentacles["count"]):
+            params = tentacle_params(tentacles, k)
+            shape = tentacle_shape(radius, *(params[key] for key in keys))
+            longest = max(longest, float(shape.lengths.sum()))
+        out.append(radius + longest + 0.5 * settings.range)
     return out

@@ -210,6 +210,11 @@ class LocomotionPlugin(Plugin):
 
         return crawl_reach(creature, seconds)
 
+    def meeting_reach(self, scene: Mapping[str, Any]) -> list[float] | None:
+        from ecs_tentacles.locomotion.avoidance import meeting_reach
+
+        return meeting_reach(scene)
+
     def run_summary(self, world: Host) -> RunSummary | None:
         from ecs_tentacles.locomotion.outputs import goal_summary
 

@@ -41,3 +41,34 @@ def test_interleaved_shards_with_different_fur_merge_into_the_local_take() -> No
         shard_of[r.members] = k
     assert meetings(spheres, shard_of) == []
     assert (spheres[..., 3] > 0.3).all()
+
+
+def test_shards_that_would_have_steered_each_other_are_found_to_have_met() -> None:
+    """Avoidance acts without contact: two creatures of different shards whose personal
+    circles come within its range steer each other in the local bake only; the meetings
+    check must say they met (the driver then bakes their shards again as one), or the
+    sharded bake silently differs from the local one."""
+    from ecs_tentacles.locomotion.plugin import LocomotionPlugin
+
+    def octopus(name: str, x: float) -> dict:
+        entry = {"name": name, "position": [x, 0.0], "tentacles": {"count": 6, "links": 4}}
+        return {**entry, "goals": [{"position": [x, 3.0]}]}
+
+    # side by side, personal circles (0.33 m) 0.3 m apart: close enough to steer, not to
+    # touch (their contact spheres stay further apart than the proxies' margin)
+    scene = {"version": 1, "creatures": [octopus("a", -0.48), octopus("b", 0.48)]}
+    plan = BakePlan.make(scene, seconds=1.0, fps=30)
+    results = [bake_shard(plan, [k]) for k in (0, 1)]
+    merged = merge_takes([(r.members, r.take) for r in results])
+    local = bake(plan, progress=False)
+    assert data(merged) != data(local)  # they steered each other locally
+    spheres = np.zeros((plan.steps + 1, 2, 4))
+    for r in results:
+        spheres[:, r.members] = r.spheres
+    shard_of = np.array([0, 1])
+    assert meetings(spheres, shard_of) == []  # contact alone misses it
+    reach = LocomotionPlugin().meeting_reach(plan.scene)
+    assert reach is not None and len(reach) == 2
+    assert meetings(spheres, shard_of, np.asarray(reach))  # the widened check finds it
+    quiet = {**plan.scene, "avoidance": {"enabled": False}}
+    assert LocomotionPlugin().meeting_reach(quiet) is None
