@@ -10,12 +10,12 @@ TENTACLE_KEYS = (
     "wave_amplitude_deg, wave_frequency, wavelength, writhe"
 )
 TOP_KEYS = (
-    "$schema, creatures, description, name, physics, plugins, seed, shards, systems, terrain,"
-    " threats, version"
+    "$schema, avoidance, creatures, description, name, physics, plugins, seed, shards, systems,"
+    " terrain, threats, version"
 )
 CREATURE_KEYS = (
-    "emotion, fur, goals, heading_deg, locomotion, mantle, name, navigation, position, tentacles,"
-    " threat"
+    "avoid, emotion, fur, goals, heading_deg, locomotion, mantle, name, navigation, position,"
+    " tentacles, threat"
 )
 
 
