@@ -18,7 +18,7 @@ from ecs_tentacles.construction import (
     tentacle_angles,
     tentacle_shape,
 )
-from ecs_tentacles.scene.validate import with_defaults
+from ecs_tentacles.scene.defaults import with_defaults
 from ecs_tentacles.world import World
 
 S = np.sqrt(0.5)

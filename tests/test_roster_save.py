@@ -60,8 +60,8 @@ def test_a_save_that_cannot_be_written_leaves_nothing(tmp_path: Path) -> None:
 
 def test_creatures_too_close_to_be_built_at_rest_are_saved_where_they_fit(tmp_path: Path):
     from ecs_tentacles.roster_save import fit_at_rest
+    from ecs_tentacles.scene.defaults import with_defaults
     from ecs_tentacles.scene.load import load_scene
-    from ecs_tentacles.scene.validate import with_defaults
 
     rock = {"obstacles": [{"shape": "box", "position": [6.0, 0.0, 0.5], "size": [2, 2, 1]}]}
     scene = {"version": 1, "terrain": rock, "creatures": [{"name": "far", "position": [-9, 0]}]}

@@ -2,7 +2,7 @@
 
 The schema's ``$defs.fur["x-presets"]`` is the one place they are written, so a
 scene's `fur.preset` fills exactly these values (then schema defaults) through
-`ecs_tentacles.scene.validate.with_defaults`; any field the scene gives wins.
+`ecs_tentacles.scene.defaults.with_defaults`; any field the scene gives wins.
 
 - hedgehog: stiff quills along the back folding toward the rear; they lift and
   interlock (random twist); no dynamics.
@@ -16,8 +16,8 @@ from __future__ import annotations
 import copy
 from typing import Any
 
+from ecs_tentacles.scene.defaults import with_defaults
 from ecs_tentacles.scene.schema import load_schema
-from ecs_tentacles.scene.validate import with_defaults
 
 
 def preset_names() -> list[str]:

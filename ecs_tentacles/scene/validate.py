@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any
 from jsonschema import ValidationError
 
 from ecs_tentacles.plugin import calling
+from ecs_tentacles.scene.defaults import nested, resolve, with_defaults
 from ecs_tentacles.scene.json_validator import StrictValidator, validator_for
 from ecs_tentacles.scene.schema import builtin_keys, schema_for
 from ecs_tentacles.scene.shards import shard_problems
@@ -41,7 +42,6 @@ _TYPE_NAMES = {
     "null": "null",
 }
 _MAX_SHOWN = 60
-_ATOMS = {int, float, str, bool, type(None)}  # JSON values that hold no others
 MAX_DEPTH = 32  # a scene is about 8 levels deep; deeper data is refused before recursing
 
 
@@ -328,16 +328,8 @@ def _too_deep(data: object) -> JsonPath | None:
         if isinstance(value, dict):
             stack.extend(((*path, str(k)), v) for k, v in value.items())
         elif isinstance(value, list):  # numbers and strings go no deeper: not stacked
-            stack.extend(((*path, i), v) for i, v in _nested(value))
+            stack.extend(((*path, i), v) for i, v in nested(value))
     return None
-
-
-def _nested(values: list[Any]) -> list[tuple[int, Any]]:
-    """The (index, item) of the objects and lists in `values` (a list of a million numbers
-    is passed over at C speed)."""
-    if set(map(type, values)) <= _ATOMS:
-        return []
-    return [(i, v) for i, v in enumerate(values) if isinstance(v, (dict, list))]
 
 
 def _limit_problems(
@@ -348,7 +340,7 @@ def _limit_problems(
     stack: list[tuple[JsonPath, object, Mapping[str, Any]]] = [((), data, schema)]
     while stack:
         path, value, node = stack.pop()
-        node = _resolve(node, root)
+        node = resolve(node, root)
         if isinstance(value, list):
             if len(value) > node.get("maxItems", len(value)):
                 problems.append(
@@ -356,100 +348,10 @@ def _limit_problems(
                 )
             elif isinstance(node.get("items"), Mapping):
                 items = node["items"]
-                stack.extend(((*path, i), v, items) for i, v in _nested(value))
+                stack.extend(((*path, i), v, items) for i, v in nested(value))
         elif isinstance(value, dict):
             properties = node.get("properties", {})
             stack.extend(
                 ((*path, k), v, properties[k]) for k, v in value.items() if k in properties
             )
     return sorted(problems, key=_path_key)
-
-
-def _resolve(schema: Mapping[str, Any], root: Mapping[str, Any]) -> Mapping[str, Any]:
-    """Follow local ``$ref``s; keywords beside a ``$ref`` (like ``default``) win."""
-    seen: set[str] = set()
-    while isinstance(schema.get("$ref"), str) and schema["$ref"] not in seen:
-        ref: str = schema["$ref"]
-        seen.add(ref)
-        target: Any = root
-        for part in ref.removeprefix("#").strip("/").split("/"):
-            if part:
-                target = target[part.replace("~1", "/").replace("~0", "~")]
-        schema = {**target, **{k: v for k, v in schema.items() if k != "$ref"}}
-    return schema
-
-
-def _fill(value: Any, schema: Mapping[str, Any], root: Mapping[str, Any]) -> None:
-    """Fill schema defaults into ``value`` in place, recursing into objects and arrays."""
-    schema = _resolve(schema, root)
-    if isinstance(value, dict):
-        presets = schema.get("x-presets", {})
-        if value.get("preset") in presets:  # a preset fills what the scene leaves out
-            _merge_under(value, presets[value["preset"]])
-        for key, sub in schema.get("properties", {}).items():
-            sub = _resolve(sub, root)
-            if key not in value and "default" in sub:
-                value[key] = copy.deepcopy(sub["default"])
-            if key in value:
-                _fill(value[key], sub, root)
-    elif isinstance(value, list) and isinstance(schema.get("items"), Mapping):
-        for _, item in _nested(value):  # defaults go into objects only
-            _fill(item, schema["items"], root)
-
-
-def _merge_under(value: dict[str, Any], base: Mapping[str, Any]) -> None:
-    """Copy into ``value`` every key of ``base`` it lacks, merging nested objects."""
-    for key, item in base.items():
-        if key not in value:
-            value[key] = copy.deepcopy(item)
-        elif isinstance(value[key], dict) and isinstance(item, Mapping):
-            _merge_under(value[key], item)
-
-
-def _copied(data: Any) -> Any:
-    """A deep copy of scene data (JSON-like; anything else through `copy.deepcopy`); a
-    list of numbers is copied at once (a million heights took a second one by one)."""
-    kind = type(data)
-    if kind is dict:
-        return {key: _copied(value) for key, value in data.items()}
-    if kind is list:
-        if set(map(type, data)) <= _ATOMS:
-            return list(data)  # immutable items: nothing to copy further
-        return [_copied(value) for value in data]
-    return data if kind in _ATOMS else copy.deepcopy(data)
-
-
-def plugin_config(plugin: Plugin, given: object) -> dict[str, Any]:
-    """A plugin's config as a scene gives it (`true`, absent or an object), defaults filled."""
-    config = copy.deepcopy(dict(given)) if isinstance(given, Mapping) else {}
-    _fill(config, plugin.config_schema, plugin.config_schema)
-    return config
-
-
-def with_defaults(data: dict[str, Any], plugins: Sequence[Plugin] | None = None) -> dict[str, Any]:
-    """Return a deep copy of ``data`` with every schema ``default`` filled in.
-
-    Works recursively through nested objects (objects defaulting to ``{}`` get their own
-    defaults too), array items and ``$ref``s. An object whose schema has ``x-presets``
-    and whose ``preset`` names one first takes the preset's values it lacks. Creatures
-    without a name are called ``creature_<index>``. Optional fields without a default
-    stay absent; ``data`` is not modified. ``plugins`` (default: the default ones) add
-    their keys' defaults, and each plugin's config gets its defaults under `plugins`.
-    """
-    result = _copied(data)
-    if plugins is None:
-        from ecs_tentacles.plugin_registry import resolve
-
-        plugins = resolve(None)
-    schema = schema_for(plugins)
-    _fill(result, schema, schema)
-    chosen = result.get("plugins")
-    if isinstance(chosen, dict):  # absent (most scenes): the defaults are the plugins' own
-        for plugin in plugins:
-            chosen[plugin.key] = plugin_config(plugin, chosen.get(plugin.key))
-    creatures = result.get("creatures")
-    if isinstance(creatures, list):
-        for i, creature in enumerate(creatures):
-            if isinstance(creature, dict):
-                creature.setdefault("name", f"creature_{i}")
-    return result

@@ -12,7 +12,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from ecs_tentacles.plugin import Plugin
-from ecs_tentacles.scene.validate import plugin_config
+from ecs_tentacles.scene.defaults import plugin_config
 
 Problem = tuple[tuple[str | int, ...], str]
 

@@ -24,7 +24,7 @@ from ecs_tentacles.build import creature_rng
 from ecs_tentacles.locomotion.goals import GOAL_WRITES, GoalBook
 from ecs_tentacles.locomotion.stores import LocomotionStores
 from ecs_tentacles.plugin import Plugin
-from ecs_tentacles.scene.validate import plugin_config
+from ecs_tentacles.scene.defaults import plugin_config
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:

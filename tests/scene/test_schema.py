@@ -9,8 +9,9 @@ from typing import Any
 
 from jsonschema import Draft202012Validator
 
+from ecs_tentacles.scene.defaults import with_defaults
 from ecs_tentacles.scene.schema import load_schema
-from ecs_tentacles.scene.validate import validate_scene, with_defaults
+from ecs_tentacles.scene.validate import validate_scene
 
 
 def subschemas(node: Any, where: str = "#") -> Iterator[tuple[str, dict[str, Any]]]:
