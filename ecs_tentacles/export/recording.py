@@ -158,8 +158,7 @@ class TakeRecorder:
     def _add_creature(self, world: World, entity: int, creature: Creature) -> None:
         """Append one creature's bodies and suckers to the take's tables."""
         index = self.creature_index[entity] = len(self._creatures)
-        name = creature.name
-        world.kept_names.add(name)  # a later spawn of this name gets a suffix (spawning)
+        world.kept_names.add(name := creature.name)  # a later spawn of it gets a suffix
         first = len(self._bodies)
         rows = [world.component(entity, Transform).row]
         entry: dict[str, Any] = {"name": name, "mantle": first, "tentacles": []}
