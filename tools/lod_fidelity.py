@@ -1,0 +1,186 @@
+"""Level-of-detail fidelity: the same crossing crowd with level of detail and with it off.
+
+    python tools/lod_fidelity.py                      # 64 creatures, 20 s, both runs
+    python tools/lod_fidelity.py --creatures 160 --seconds 10 --json
+
+Runs `crowd_scene(N)` (every creature crawling across the crowd, so they meet) once with
+the scene's level of detail (default budgets) and once with `lod=False` (everyone full),
+in two processes, and compares what a crowd tool's user would notice:
+
+* progress: how much closer to its goal each creature got (metres), the crowd's mean,
+  and the ratio of the two runs' means (1.0: the same);
+* goals: which creatures reached their goal, and how far apart (seconds) the same
+  creature's arrival times are in the two runs;
+* interpenetration: the deepest overlap of two creatures' link capsules (sampled every
+  `--every` frames: the capsules of creatures whose bodies come near, segment against
+  segment), in millimetres;
+* recoveries (physics blow-ups restored), the tiers at the end, promotions, wall time.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from concurrent.futures import ProcessPoolExecutor
+from typing import Any
+
+import numpy as np
+
+from ecs_tentacles.components import Creature, Link, Tentacle, Transform
+from ecs_tentacles.creator.crowd import crowd_scene
+from ecs_tentacles.mathutil import quat_rotate
+from ecs_tentacles.physics.proxies import near_pairs
+from ecs_tentacles.scene.overlap import segment_distances
+from ecs_tentacles.world import World
+
+
+def _capsules(world: World) -> tuple[list[np.ndarray], np.ndarray, np.ndarray]:
+    """Per creature (store order) its links' Transform rows; every link's half length and
+    radius, in that order."""
+    rows, halves, radii = [], [], []
+    for _, creature in sorted(world.query(Creature), key=lambda item: item[1].row):
+        mine = []
+        for tentacle in creature.tentacles:
+            for link in world.component(tentacle, Tentacle).links:
+                shape = world.component(link, Link)
+                mine.append(world.component(link, Transform).row)
+                halves.append(0.5 * shape.length)
+                radii.append(shape.radius)
+        rows.append(np.asarray(mine, dtype=np.int64))
+    return rows, np.asarray(halves), np.asarray(radii)
+
+
+def deepest_overlap(
+    world: World, rows: list[np.ndarray], half: np.ndarray, radius: np.ndarray
+) -> float:
+    """The deepest overlap (m, >= 0) of two different creatures' link capsules now."""
+    pos, quat = world.transforms.pos, world.transforms.quat
+    centres = np.array([pos[r].mean(axis=0) for r in rows])
+    reach = np.array(
+        [np.linalg.norm(pos[r] - c, axis=1).max() + 0.2 for r, c in zip(rows, centres, strict=True)]
+    )
+    a, b = near_pairs(centres, reach, 0.0)
+    starts = np.cumsum([0] + [len(r) for r in rows])
+    deepest = 0.0
+    for i, j in zip(a.tolist(), b.tolist(), strict=True):
+        if i > j:
+            continue
+        ends = []
+        for k in (i, j):
+            link = slice(starts[k], starts[k + 1])
+            axis = quat_rotate(quat[rows[k]], np.array([1.0, 0.0, 0.0])) * half[link, None]
+            ends.append((pos[rows[k]] - axis, pos[rows[k]] + axis, radius[link]))
+        (p1, q1, r1), (p2, q2, r2) = ends
+        gap = (
+            segment_distances(p1[:, None], q1[:, None], p2[None], q2[None]) - r1[:, None] - r2[None]
+        )
+        deepest = max(deepest, float(-gap.min()))
+    return deepest
+
+
+def run(creatures: int, seconds: float, lod: bool, every: int, seed: int) -> dict[str, Any]:
+    """One run; its figures."""
+    scene = crowd_scene(creatures, seed=seed)
+    goals = {
+        c["name"]: np.asarray(c["goals"][0]["position"][:2], float) for c in scene["creatures"]
+    }
+    reached: dict[str, float] = {}
+    deepest = 0.0
+    start = time.perf_counter()
+    with World.from_scene(scene, lod=lod) as world:
+        names = {e: c.name for e, c in world.query(Creature)}
+
+        def arrived(**event: Any) -> None:
+            reached.setdefault(names[event["creature"]], world.time)
+
+        world.events.on("goal_reached", arrived)
+        first = {n: world.component(e, Transform).pos[:2].copy() for e, n in names.items()}
+        rows, half, radius = _capsules(world)
+        frames = round(seconds * world.settings.fps)
+        for frame in range(frames):
+            world.step()
+            if frame % every == 0:
+                deepest = max(deepest, deepest_overlap(world, rows, half, radius))
+        last = {n: world.component(e, Transform).pos[:2].copy() for e, n in names.items()}
+        progress = {
+            n: float(np.linalg.norm(goals[n] - first[n]) - np.linalg.norm(goals[n] - last[n]))
+            for n in names.values()
+        }
+        return {
+            "lod": lod,
+            "progress": progress,
+            "reached": reached,
+            "deepest_mm": 1000.0 * deepest,
+            "recoveries": world.physics.health.recoveries,
+            "tiers": world.lod.counts(),
+            "promotions": world.lod.promotions,
+            "wall_s": time.perf_counter() - start,
+        }
+
+
+def compare(on: dict[str, Any], off: dict[str, Any]) -> dict[str, Any]:
+    """The figures the two runs are judged by."""
+    mean_on = float(np.mean(list(on["progress"].values())))
+    mean_off = float(np.mean(list(off["progress"].values())))
+    both = sorted(set(on["reached"]) & set(off["reached"]))
+    apart = [abs(on["reached"][n] - off["reached"][n]) for n in both]
+    return {
+        "mean_progress_m": {"lod": mean_on, "off": mean_off},
+        "progress_ratio": mean_on / mean_off if mean_off else float("nan"),
+        "reached": {"lod": len(on["reached"]), "off": len(off["reached"]), "both": len(both)},
+        "only_one_run_reached": sorted(set(on["reached"]) ^ set(off["reached"])),
+        "arrival_apart_s_max": max(apart, default=0.0),
+        "deepest_mm": {"lod": on["deepest_mm"], "off": off["deepest_mm"]},
+        "recoveries": {"lod": on["recoveries"], "off": off["recoveries"]},
+        "tiers_at_end": on["tiers"],
+        "promotions": on["promotions"],
+        "wall_s": {"lod": on["wall_s"], "off": off["wall_s"]},
+    }
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--creatures", type=int, default=64)
+    parser.add_argument("--seconds", type=float, default=20.0)
+    parser.add_argument("--every", type=int, default=5, help="frames between overlap samples")
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--json", action="store_true", help="one JSON object")
+    args = parser.parse_args(argv)
+    with ProcessPoolExecutor(2) as pool:
+        runs = [
+            pool.submit(run, args.creatures, args.seconds, lod, args.every, args.seed)
+            for lod in (True, False)
+        ]
+        on, off = (r.result() for r in runs)
+    result = {"creatures": args.creatures, "seconds": args.seconds, **compare(on, off)}
+    if args.json:
+        print(json.dumps(result))
+        return 0
+    progress = result["mean_progress_m"]
+    print(
+        f"{args.creatures} creatures, {args.seconds:g} s, lod on (tiers at the end"
+        f" {result['tiers_at_end']}, {result['promotions']} promotions) against lod off"
+    )
+    print(
+        f"  mean progress toward goals: {progress['lod']:.3f} m against {progress['off']:.3f} m "
+        f"(ratio {result['progress_ratio']:.3f})"
+    )
+    reached = result["reached"]
+    print(
+        f"  goals reached: {reached['lod']} against {reached['off']} ({reached['both']} in"
+        f" both; arrival times at most {result['arrival_apart_s_max']:.2f} s apart; only in"
+        f" one run: {', '.join(result['only_one_run_reached']) or 'none'})"
+    )
+    deepest = result["deepest_mm"]
+    print(f"  deepest interpenetration: {deepest['lod']:.1f} mm against {deepest['off']:.1f} mm")
+    recoveries = result["recoveries"]
+    print(
+        f"  recoveries: {recoveries['lod']} against {recoveries['off']}; wall "
+        f"{result['wall_s']['lod']:.0f} s against {result['wall_s']['off']:.0f} s"
+    )
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
