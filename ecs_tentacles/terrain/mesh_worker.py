@@ -156,15 +156,18 @@ def _die_with_parent() -> None:
 
 
 def _limit_memory(megabytes: int) -> None:
-    """A backstop under the parent's watch of resident memory: the address space may
-    grow by at most `megabytes` past what the imports took."""
+    """A backstop under the parent's watch of resident memory (`megabytes`, the budget):
+    the address space may grow by at most twice that and 512 MB past what the imports
+    took. Address space runs ahead of resident memory (thread stacks, glibc's 64 MB
+    arenas per thread): a backstop at the budget itself could stop the worker before
+    the parent saw the budget passed, and the user got "the worker stopped" instead."""
     try:
         import resource
 
         with open("/proc/self/statm") as handle:
             pages = int(handle.read().split()[0])
         now = pages * resource.getpagesize()
-        limit = now + megabytes * 1024 * 1024
+        limit = now + (2 * megabytes + 512) * 1024 * 1024
         resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
     except (OSError, ValueError, ImportError):
         pass
