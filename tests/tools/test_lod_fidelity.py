@@ -3,32 +3,19 @@ short comparison reports what its doc promises."""
 
 from __future__ import annotations
 
-import importlib.util
-import sys
-from pathlib import Path
-from types import ModuleType
-
 import numpy as np
 import pytest
 
 from ecs_tentacles.components import Transform
 from ecs_tentacles.world import World
+from tests.tools.loader import TOOLS, load_tool
 
-TOOL = Path(__file__).resolve().parents[2] / "tools" / "lod_fidelity.py"
-
-
-def _tool() -> ModuleType:
-    spec = importlib.util.spec_from_file_location("lod_fidelity", TOOL)
-    assert spec and spec.loader
-    module = importlib.util.module_from_spec(spec)
-    sys.modules["lod_fidelity"] = module
-    spec.loader.exec_module(module)
-    return module
+TOOL = TOOLS / "lod_fidelity.py"
 
 
 @pytest.mark.skipif(not TOOL.is_file(), reason="needs the source tree")
 def test_the_overlap_probe_measures_capsules_pushed_into_each_other() -> None:
-    tool = _tool()
+    tool = load_tool("lod_fidelity")
     octo = {"tentacles": {"count": 4, "links": 3}}
     scene = {
         "version": 1,
@@ -46,7 +33,7 @@ def test_the_overlap_probe_measures_capsules_pushed_into_each_other() -> None:
 
 @pytest.mark.skipif(not TOOL.is_file(), reason="needs the source tree")
 def test_a_short_comparison_reports_progress_goals_overlap_and_recoveries() -> None:
-    tool = _tool()
+    tool = load_tool("lod_fidelity")
     on, off = (tool.run(4, 0.2, lod, 5, 0) for lod in (True, False))
     result = tool.compare(on, off)
     assert set(on["progress"]) == set(off["progress"]) and len(on["progress"]) == 4

@@ -2,29 +2,15 @@
 
 from __future__ import annotations
 
-import importlib.util
-import sys
-from pathlib import Path
-from types import ModuleType
-
 import pytest
 
-TOOLS = Path(__file__).resolve().parents[2] / "tools"
+from tests.tools.loader import TOOLS, load_tool
 
 pytestmark = pytest.mark.skipif(not TOOLS.is_dir(), reason="needs the source tree")
 
 
-def _load(name: str) -> ModuleType:
-    spec = importlib.util.spec_from_file_location(name, TOOLS / f"{name}.py")
-    assert spec and spec.loader
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module
-    spec.loader.exec_module(module)
-    return module
-
-
 def test_locomotion_report_row_has_the_issue_fields() -> None:
-    report = _load("locomotion_report")
+    report = load_tool("locomotion_report")
     from ecs_tentacles.world import World
 
     world = World.from_scene(report.case_scene(4, "coordinated", 0.0))
@@ -54,7 +40,7 @@ def test_locomotion_report_row_has_the_issue_fields() -> None:
 
 
 def test_frame_benchmark_splits_the_frame() -> None:
-    bench = _load("bench_frame")
+    bench = load_tool("bench_frame")
     row = bench.bench_scene("three_goals", frames=3, repeats=1)
     ms = row["ms_per_frame"]
     names = {"goals", "avoidance", "tentacle_selection", "action_queue", "motor_targets"}
@@ -65,7 +51,7 @@ def test_frame_benchmark_splits_the_frame() -> None:
 
 
 def test_scene_corners_builds_or_refuses_every_corner_scene() -> None:
-    corners = _load("scene_corners")
+    corners = load_tool("scene_corners")
     result = corners.search(scenes=60, seed=1, frames=10)
     counts = result["counts"]
     assert sum(counts.values()) == 60
