@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 from PIL import Image
 
-from tests.tools.test_tools import TOOLS, _load
+from tests.tools.loader import TOOLS, load_tool
 
 pytestmark = pytest.mark.skipif(not TOOLS.is_dir(), reason="needs the source tree")
 
@@ -38,7 +38,7 @@ COLUMNS = [
 def test_tiny_sizes_write_the_csv_and_the_plot(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    scaling = _load("crowd_scaling")
+    scaling = load_tool("crowd_scaling")
     argv = ["--sizes", "1,2", "--frames", "2", "--threads", "1", "--warmup", "2"]
     argv += ["--out", str(tmp_path / "s")]
     assert scaling.main(argv) == 0
@@ -71,7 +71,7 @@ def test_tiny_sizes_write_the_csv_and_the_plot(
 
 
 def test_a_failed_run_keeps_its_error_line() -> None:
-    scaling = _load("crowd_scaling")
+    scaling = load_tool("crowd_scaling")
     row = scaling.bench_once(1, 1, frames=0, seed=0, timeout=60)
     assert row == {
         "creatures": 1,
@@ -82,7 +82,7 @@ def test_a_failed_run_keeps_its_error_line() -> None:
 
 
 def test_a_run_past_its_timeout_is_an_error_row(tmp_path: Path) -> None:
-    scaling = _load("crowd_scaling")
+    scaling = load_tool("crowd_scaling")
     row = scaling.bench_once(64, 1, frames=100000, seed=0, timeout=0.5, lod="off")
     assert row == {
         "creatures": 64,

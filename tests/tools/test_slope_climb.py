@@ -13,13 +13,13 @@ from PIL import Image
 
 from ecs_tentacles.ground import ground_of
 from ecs_tentacles.world import World
-from tests.tools.test_tools import TOOLS, _load
+from tests.tools.loader import TOOLS, load_tool
 
 pytestmark = pytest.mark.skipif(not TOOLS.is_dir(), reason="needs the source tree")
 
 
 def test_the_ramp_rises_at_the_slope_past_the_foot() -> None:
-    slope = _load("slope_climb")
+    slope = load_tool("slope_climb")
     scene = slope.ramp_scene(20.0)
     world = World.from_scene(scene)
     try:
@@ -35,7 +35,7 @@ def test_the_ramp_rises_at_the_slope_past_the_foot() -> None:
 
 
 def test_short_runs_write_the_csv_and_the_plot(tmp_path: Path) -> None:
-    slope = _load("slope_climb")
+    slope = load_tool("slope_climb")
     argv = ["--slopes", "0,30", "--seconds", "2", "--jobs", "1", "--out", str(tmp_path / "s")]
     assert slope.main(argv) == 0
     with open(tmp_path / "s.csv", newline="") as handle:
