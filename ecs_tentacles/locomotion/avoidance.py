@@ -31,7 +31,7 @@ from typing import Any
 
 import numpy as np
 
-from ecs_tentacles.construction import tentacle_params, tentacle_shape
+from ecs_tentacles.construction import creature_layout
 from ecs_tentacles.physics.proxies import near_pairs
 from ecs_tentacles.scene.schema import fragment
 
@@ -133,13 +133,8 @@ def meeting_reach(scene: Mapping[str, Any]) -> list[float] | None:
     if not settings.enabled:
         return None
     out = []
-    keys = ("link_length", "link_radius", "links", "end_scale")
     for creature in scene["creatures"]:
-        tentacles, radius = creature["tentacles"], float(creature["mantle"]["radius"])
-        longest = 0.0
-        for k in range(tentacles["count"]):
-            params = tentacle_params(tentacles, k)
-            shape = tentacle_shape(radius, *(params[key] for key in keys))
-            longest = max(longest, float(shape.lengths.sum()))
-        out.append(radius + longest + 0.5 * settings.range)
+        layout = creature_layout(creature)  # the shapes the built creature has
+        longest = max((shape.length for shape in layout.shapes), default=0.0)
+        out.append(float(creature["mantle"]["radius"]) + longest + 0.5 * settings.range)
     return out
