@@ -106,7 +106,7 @@ def _as_creature(problem: str) -> str:
 def unique_name(world: World, name: str) -> str:
     """`name`, or `name_2`, `name_3`... : the first no creature of `world` has and no
     take being recorded has seen (`World.kept_names`)."""
-    taken = {c.name for _, c in world.query(Creature)} | world.kept_names
+    taken = taken_names(world)
     if name not in taken:
         return name
     base = re.sub(r"_\d+$", "", name)
@@ -114,6 +114,11 @@ def unique_name(world: World, name: str) -> str:
     while _suffixed(base, n) in taken:
         n += 1
     return _suffixed(base, n)
+
+
+def taken_names(world: World) -> set[str]:
+    """Names a new creature may not take: every creature's now and `World.kept_names`."""
+    return {c.name for _, c in world.query(Creature)} | world.kept_names
 
 
 def _suffixed(base: str, n: int, longest: int = 64) -> str:
@@ -229,7 +234,7 @@ def place(world: World, entry: dict[str, Any], moved_to: tuple[float, ...] | Non
     `scatter` places many copies of one checked entry at spots it knows are free."""
     world.activate()
     wanted = entry["name"]
-    if wanted in world.kept_names or any(c.name == wanted for _, c in world.query(Creature)):
+    if wanted in taken_names(world):
         raise SpawnError(  # a take would name two creatures alike: unwritable at the end
             [f"creature.name: {wanted!r} is taken (by a creature here or in the take recorded)"]
         )
