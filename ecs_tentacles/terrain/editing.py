@@ -69,7 +69,8 @@ class TerrainEditor:
         half = keys["size"][2] / 2 if shape == "box" else keys.get("height", 2 * keys["radius"]) / 2
         if shape == "sphere":
             half = 0.6 * keys["radius"]  # sunk a little: a boulder, not a ball on a plane
-        z = base + half - _field_height(world, x, y)  # on_ground: from the ground under it
+        ground = float(ground_of(world).height(np.array([[x, y]]))[0])
+        z = base + half - ground  # on_ground: its z is measured from the ground under it
         obstacle = {"shape": shape, "position": [round(x, 4), round(y, 4), round(z, 4)]}
         obstacle.update(keys)
         terrain = self._terrain(world)
@@ -198,9 +199,3 @@ def _bodies(world: Host, entity: int) -> tuple[np.ndarray, np.ndarray]:
             rows.append(world.component(link, Transform).row)
             radii.append(world.component(link, Link).radius)
     return np.array(rows, dtype=np.int64), np.array(radii)
-
-
-def _field_height(world: Host, x: float, y: float) -> float:
-    """The heightfield's height under (x, y): what an `on_ground` obstacle's z is above."""
-    field = ground_of(world).heightfield
-    return 0.0 if field is None else float(field.height(np.array([[x, y]]))[0])
