@@ -18,13 +18,13 @@ with GL objects the plugin makes and keeps in `state`), handing them a `RenderVi
 
 from __future__ import annotations
 
-import colorsys
 from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 from pyglet import gl
 
+from ecs_tentacles.colours import creature_colours
 from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.drawing import CIRCLE, RenderView
 from ecs_tentacles.ground import ground_of
@@ -52,12 +52,6 @@ LIGHT = np.array([0.35, -0.45, 0.82]) / np.linalg.norm([0.35, -0.45, 0.82])
 LOD_DISTANCE = 6.0  # metres from the eye beyond which links use the lean mesh
 SHADOW_EVERY = 3  # a blob under every third link (each wider), and under every mantle
 VIEWS = ("skinned", "capsules")
-
-
-def creature_colours(count: int) -> np.ndarray:
-    """Distinct warm colours (count, 3), octopus-like."""
-    hues = (0.02 + 0.61803 * np.arange(count)) % 1.0
-    return np.array([colorsys.hsv_to_rgb(h, 0.65, 0.85) for h in hues]).reshape(-1, 3)
 
 
 def _nlerp(a: np.ndarray, b: np.ndarray, t: float) -> np.ndarray:
