@@ -15,13 +15,16 @@ from ecs_tentacles.atomic import OutputError, claim
 
 # options whose value may start with "-" (`--focus -2,1,3`): argparse takes "-2,1,3" for
 # an option and says "expected one argument"; such a value is joined to its option
-NEGATIVE_VALUES = ("--focus",)
+NEGATIVE_VALUES = ("--focus", "--camera")
 _NUMBER_START = re.compile(r"^-\.?\d")
+# options whose value may be two words (`--camera follow NAME`): joined into one value
+TWO_WORD_VALUES = {"--camera": "follow"}
 
 
 def joined_negative_values(argv: Sequence[str]) -> list[str]:
     """`argv` with `--focus -2,1,3` written `--focus=-2,1,3` (a value that starts with a
-    minus and a digit, after an option of `NEGATIVE_VALUES`)."""
+    minus and a digit, after an option of `NEGATIVE_VALUES`) and `--camera follow NAME`
+    written `--camera=follow NAME` (`TWO_WORD_VALUES`)."""
     out: list[str] = []
     words = list(argv)
     i = 0
@@ -33,6 +36,11 @@ def joined_negative_values(argv: Sequence[str]) -> list[str]:
         if word in NEGATIVE_VALUES and i + 1 < len(words) and _NUMBER_START.match(words[i + 1]):
             out.append(f"{word}={words[i + 1]}")
             i += 2
+            continue
+        first = TWO_WORD_VALUES.get(word)
+        if first is not None and i + 2 < len(words) and words[i + 1] == first:
+            out.append(f"{word}={first} {words[i + 2]}")
+            i += 3
             continue
         out.append(word)
         i += 1

@@ -31,6 +31,16 @@ def even_size(text: str) -> int:
     return value
 
 
+def camera_option(text: str) -> Any:
+    """argparse type: `frame-all`, `follow NAME` or `X,Y,Z,TX,TY,TZ` (a `CameraChoice`)."""
+    from ecs_tentacles.render.camera import parse_camera
+
+    try:
+        return parse_camera(text)
+    except ValueError as error:
+        raise argparse.ArgumentTypeError(str(error)) from None
+
+
 def add_parser(commands: argparse._SubParsersAction) -> None:
     parser = commands.add_parser(
         "play",
@@ -50,6 +60,17 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.add_argument("--video", type=output_path(".mp4"), help="headless: record an MP4")
     parser.add_argument("--width", type=even_size, default=1280, help=f"{SIZE_RULE} (default 1280)")
     parser.add_argument("--height", type=even_size, default=720, help=f"{SIZE_RULE} (default 720)")
+    parser.add_argument(
+        "--camera",
+        type=camera_option,
+        default=None,
+        metavar="VIEW",
+        help=(
+            "frame-all (every creature and goal in view; headless: kept so while they move),"
+            " follow NAME (that creature at the centre) or X,Y,Z,TX,TY,TZ (stand at X,Y,Z,"
+            " look at TX,TY,TZ); default: every creature framed at the start"
+        ),
+    )
     parser.add_argument("--seed", type=seed_int, default=None, help="override the scene's seed")
     parser.add_argument("--allow-systems", action="store_true", help="run systems the scene names")
     shown = parser.add_mutually_exclusive_group()
@@ -113,6 +134,12 @@ def handle(args: argparse.Namespace) -> int:
         threads=args.threads,
     )
     try:
+        if args.camera is not None:
+            try:
+                sandbox.aim(args.camera)
+            except KeyError as error:
+                print(f"error: argument --camera: {error.args[0]}", file=sys.stderr)
+                return 2
         if args.headless:
             result = sandbox.run_headless(
                 args.frames, screenshot=args.screenshot, video=args.video, progress=not args.quiet

@@ -1,4 +1,5 @@
-"""An orbit camera (orbit, pan, zoom, frame all, follow) and mouse picking.
+"""An orbit camera (orbit, pan, zoom, frame all, follow) and mouse picking, and the
+camera a command line chooses (`CameraChoice`: `play --camera`).
 
 Pure numpy: matrices are column-vector convention (p_clip = P @ V @ p_world) and are
 sent to OpenGL transposed (column-major).
@@ -9,6 +10,54 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+
+CAMERA_RULE = "frame-all, follow NAME or X,Y,Z,TX,TY,TZ (eye, then the point looked at)"
+FIT_BORDER = 0.06  # share of the picture left free round what `fit` frames
+_DIRECTIONS = 96  # directions whose extreme points stand for a large point set in `fit`
+
+
+@dataclass(frozen=True)
+class CameraChoice:
+    """Where a command line puts the camera: `kind` "frame-all" (every creature and goal
+    in view, kept so in a headless run), "follow" (`name`'s creature at the centre) or
+    "fixed" (from `eye` looking at `target`)."""
+
+    kind: str
+    name: str | None = None
+    eye: tuple[float, float, float] | None = None
+    target: tuple[float, float, float] | None = None
+
+
+def parse_camera(text: str) -> CameraChoice:
+    """`frame-all`, `follow NAME` (or `follow=NAME`) or `X,Y,Z,TX,TY,TZ`; ValueError (one
+    line, what was wrong) otherwise."""
+    words = text.strip()
+    if words == "frame-all":
+        return CameraChoice("frame-all")
+    for joint in (" ", "=", ":"):
+        if words.startswith(f"follow{joint}"):
+            name = words[len("follow") + 1 :].strip()
+            if name:
+                return CameraChoice("follow", name=name)
+    if words == "follow":
+        raise ValueError("follow needs a creature's name: follow NAME")
+    parts = words.split(",")
+    if len(parts) != 6:
+        raise ValueError(f"must be {CAMERA_RULE}, got {text!r}")
+    try:
+        numbers = [float(part) for part in parts]
+    except ValueError:
+        raise ValueError(f"must be {CAMERA_RULE}, got {text!r}") from None
+    if not np.isfinite(numbers).all():
+        raise ValueError(f"the six numbers must be finite, got {text!r}")
+    eye, target = np.array(numbers[:3]), np.array(numbers[3:])
+    offset = eye - target
+    length = float(np.linalg.norm(offset))
+    if length < 1e-6:
+        raise ValueError(f"the eye and the point looked at are the same point, got {text!r}")
+    if abs(offset[2]) / length > np.sin(OrbitCamera.MAX_PITCH):
+        raise ValueError(f"looks straight up or down (tilt it a little), got {text!r}")
+    return CameraChoice("fixed", eye=tuple(numbers[:3]), target=tuple(numbers[3:]))  # type: ignore[arg-type]
 
 
 def perspective(fov_y: float, aspect: float, near: float, far: float) -> np.ndarray:
@@ -96,6 +145,64 @@ class OrbitCamera:
         radius = max(float(np.linalg.norm(high - low)) / 2, 0.3)
         self.distance = margin * radius / np.sin(self.fov_y / 2)
 
+    def look_from(self, eye: np.ndarray, target: np.ndarray) -> None:
+        """Stand at `eye` and look at `target` (both world points; no follow)."""
+        eye, target = np.asarray(eye, dtype=np.float64), np.asarray(target, dtype=np.float64)
+        offset = eye - target
+        self.target = target.copy()
+        self.distance = float(np.linalg.norm(offset))
+        self.yaw = float(np.arctan2(offset[1], offset[0]))
+        self.pitch = float(np.arcsin(np.clip(offset[2] / self.distance, -1.0, 1.0)))
+        self.follow = None
+
+    def fit(self, points: np.ndarray, border: float = FIT_BORDER) -> None:
+        """Centre on `points` (n, 3) and come as close as keeps every one of them inside
+        the picture's free part (right of the side panel, `shift_x`), `border` of it
+        left round them; the view's direction stays."""
+        points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+        if not len(points):
+            return
+        if len(points) > 4 * _DIRECTIONS:  # the hull's extreme points decide the framing
+            points = points[np.unique(np.argmax(points @ _sphere_directions().T, axis=0))]
+        self.frame(points, margin=1.05)  # far enough: the bounding sphere fits
+        self.target[2] = float(np.median(points[:, 2]))
+        for _ in range(3):  # nearer points look bigger: fit, recentre, fit again
+            self.distance = self._fitting_distance(points, border)
+            pixels = self.project(points)
+            left = 2.0 * self.shift_x
+            middle = (pixels.min(axis=0) + pixels.max(axis=0)) / 2
+            centre = np.array([(left + self.width) / 2, self.height / 2])
+            dx, dy = middle - centre
+            follow = self.follow
+            self.pan(-dx, -dy)
+            self.follow = follow
+        self.distance = self._fitting_distance(points, border)
+
+    def _fitting_distance(self, points: np.ndarray, border: float) -> float:
+        """The least distance (bisection) at which `points` stay inside the free part."""
+        left = 2.0 * self.shift_x / self.width  # the panel's share of the picture
+        low_x = -1.0 + 2.0 * left + 2.0 * border * (1.0 - left)
+        high = 1.0 - 2.0 * border
+
+        def fits(distance: float) -> bool:
+            self.distance = distance
+            clip = np.hstack([points, np.ones((len(points), 1))]) @ self.view_projection().T
+            if (clip[:, 3] <= 1e-6).any():
+                return False
+            ndc = clip[:, :2] / clip[:, 3:4]
+            return bool(
+                (ndc[:, 0] >= low_x).all() and (ndc[:, 0] <= high).all()
+                and (np.abs(ndc[:, 1]) <= high).all()
+            )  # fmt: skip
+
+        near, far = 0.2, max(self.distance, 0.2)
+        while not fits(far) and far < 1e4:
+            far *= 2.0
+        for _ in range(40):
+            middle = (near + far) / 2
+            near, far = (near, middle) if fits(middle) else (middle, far)
+        return far
+
     def ray(self, x: float, y: float) -> tuple[np.ndarray, np.ndarray]:
         """World ray (origin, unit direction) through pixel (x, y), origin bottom-left."""
         ndc = np.array([2 * x / self.width - 1, 2 * y / self.height - 1])
@@ -131,3 +238,12 @@ def ray_sphere(
     inside = radii**2 - closest_sq
     hit = (inside >= 0) & (along > 0)
     return np.where(hit, along - np.sqrt(np.maximum(inside, 0)), np.inf)
+
+
+def _sphere_directions() -> np.ndarray:
+    """`_DIRECTIONS` unit vectors spread evenly over the sphere (a golden spiral)."""
+    k = np.arange(_DIRECTIONS) + 0.5
+    z = 1.0 - 2.0 * k / _DIRECTIONS
+    angle = np.pi * (3.0 - np.sqrt(5.0)) * k
+    ring = np.sqrt(1.0 - z**2)
+    return np.stack([ring * np.cos(angle), ring * np.sin(angle), z], axis=1)

@@ -171,6 +171,7 @@ class Renderer:
         links = link_instances(tables, self._mantle_rows, colours)
         self.link_rows, self.link_instances = links.rows, links.instances
         link_creature, index = links.creature, links.index
+        self.link_creature = link_creature  # each link's creature (index in entity order)
         self._build_ground()
         self.skinned.build(world, self._entities, self.creature_colour)
         meshed = set(self.skinned.creatures)
@@ -242,8 +243,10 @@ class Renderer:
         """Fill and upload every instance array and the line list."""
         self._refresh()
         pos, quat = self.poses(alpha)
-        if self.camera.follow is not None:
-            self.camera.target = pos[self.camera.follow] * [1, 1, 0]
+        if self.camera.follow is not None:  # on the ground under the followed mantle
+            under = pos[self.camera.follow]
+            height = ground_of(self.world).height(under[None, :2])[0]
+            self.camera.target = np.array([under[0], under[1], height])
         skinned = self.view == "skinned"
         m = self.mantle_instances
         m[:, 0:3], m[:, 3:7] = pos[self.mantle_rows], quat[self.mantle_rows]
@@ -395,4 +398,17 @@ class Renderer:
             if extra is not None:
                 points.append(np.asarray(extra, dtype=np.float64).reshape(-1, 3))
         self.camera.follow = None
-        self.camera.frame(np.vstack(points), margin=1.0)
+        self.camera.fit(np.vstack(points))
+
+    def follow(self, creature: int, span: float = 3.0) -> None:
+        """Keep `creature` at the centre of the picture, near enough that its body and
+        tentacles fill about 1 / `span` of it."""
+        index = self._index_of[creature]
+        pos = self.current[0]
+        links = self.link_rows[self.link_creature == index]
+        rows = np.concatenate([[self.mantle_rows[index]], links])
+        self.camera.follow = None
+        self.camera.fit(pos[rows])
+        self.camera.distance *= span
+        self.camera.follow = int(self.mantle_rows[index])
+        self.upload()  # the target on the creature now

@@ -43,6 +43,7 @@ from ecs_tentacles.components import Creature
 from ecs_tentacles.drawing import Panel
 from ecs_tentacles.ground import ground_of
 from ecs_tentacles.plugin_registry import sandbox_plugins
+from ecs_tentacles.render.camera import CameraChoice
 from ecs_tentacles.render.hud import Hud
 from ecs_tentacles.render.on_screen import creature_at, labels_over
 from ecs_tentacles.render.output import VideoWriter, save_png
@@ -62,6 +63,7 @@ from ecs_tentacles.world import World
 if TYPE_CHECKING:
     from ecs_tentacles.snapshot import Snapshot
 
+FRAME_EASE = 0.08  # share of the way to the new framing a video frame moves (frame-all)
 MAX_CATCH_UP = 0.25  # seconds of physics to catch up at most per display frame
 DISPLAY_HZ = 60
 FOCUS_RADIUS = 4.0  # m around the camera's target where creatures run full physics
@@ -105,6 +107,7 @@ class Sandbox:
         self.paused = False
         self.selection = Selection()
         self.panels: dict[str, list[Panel]] = {}  # each plugin's HUD sections, by plugin key
+        self.camera_choice: CameraChoice | None = None  # `aim`'s, kept across resets
         self._attach_world()
         self.input = SandboxInput(self)  # the mouse and the keys
         self.window.push_handlers(self)  # (on_draw)
@@ -120,6 +123,31 @@ class Sandbox:
         self._last_draw: float | None = None
         self.saved_state: Snapshot | None = None
 
+    def aim(self, choice: CameraChoice | None) -> None:
+        """Put the camera where `choice` says (`play --camera`), now and after a reset;
+        None: every creature framed. KeyError (one line) when it follows a creature this
+        world does not have."""
+        renderer = self.renderer
+        if choice is None or choice.kind == "frame-all":
+            renderer.frame_all()
+        elif choice.kind == "follow":
+            assert choice.name is not None
+            renderer.follow(self.world.creature(choice.name))
+        else:
+            renderer.camera.look_from(np.array(choice.eye), np.array(choice.target))
+        self.camera_choice = choice
+
+    def keep_framed(self, ease: float = 1.0) -> None:
+        """With `--camera frame-all`: move `ease` of the way to framing every creature and
+        goal as they are now (a video eases; a screenshot snaps)."""
+        if self.camera_choice is None or self.camera_choice.kind != "frame-all":
+            return
+        camera = self.renderer.camera
+        target, distance = camera.target.copy(), camera.distance
+        self.renderer.frame_all()
+        camera.target = target + ease * (camera.target - target)
+        camera.distance = distance * (camera.distance / distance) ** ease
+
     def _attach_world(self) -> None:
         self.renderer = Renderer(self.world, self.window.width, self.window.height)
         self.renderer.camera.shift_x = self.hud.width / 2
@@ -128,6 +156,8 @@ class Sandbox:
         self.hud.world = self.world
         self.scripts.attach(self.world)
         self._attach_panels()
+        if self.camera_choice is not None:  # after a reset, as asked
+            self.aim(self.camera_choice)
         first = self.renderer.creature_entities[0] if self.renderer.creature_entities else None
         self.select(first)
 
@@ -397,6 +427,7 @@ class Sandbox:
             ):
                 self.step(1)
                 if self.video is not None:
+                    self.keep_framed(FRAME_EASE)
                     self.render()
         except BaseException:
             if self.video is not None:
@@ -408,6 +439,7 @@ class Sandbox:
         if self.video is not None:
             result["video"] = str(self.toggle_video())
         if screenshot is not None:
+            self.keep_framed()
             result["screenshot"] = str(self.screenshot(screenshot))
         return result
 

@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from numpy.testing import assert_allclose
 
-from ecs_tentacles.render.camera import OrbitCamera, ray_sphere
+from ecs_tentacles.render.camera import CameraChoice, OrbitCamera, parse_camera, ray_sphere
 
 
 def test_ground_point_inverts_projection() -> None:
@@ -51,3 +52,54 @@ def test_ray_sphere_hits_the_nearest_surface() -> None:
         np.array([1.0, 0.4, 1.0]),
     )
     assert hits[0] == 4.0 and np.isinf(hits[1]) and np.isinf(hits[2])
+
+
+@pytest.mark.parametrize(
+    ("text", "expected"),
+    [
+        ("frame-all", CameraChoice("frame-all")),
+        ("follow west0", CameraChoice("follow", name="west0")),
+        ("follow=west0", CameraChoice("follow", name="west0")),
+        ("4,-6,3,0,0,0.5", CameraChoice("fixed", eye=(4.0, -6.0, 3.0), target=(0.0, 0.0, 0.5))),
+    ],
+)
+def test_parse_camera(text: str, expected: CameraChoice) -> None:
+    assert parse_camera(text) == expected
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("frame", "must be frame-all, follow NAME or X,Y,Z,TX,TY,TZ"),
+        ("follow", "follow needs a creature's name"),
+        ("1,2,3", "must be frame-all, follow NAME or X,Y,Z,TX,TY,TZ"),
+        ("1,2,x,0,0,0", "must be frame-all, follow NAME or X,Y,Z,TX,TY,TZ"),
+        ("1,2,nan,0,0,0", "the six numbers must be finite"),
+        ("1,1,1,1,1,1", "the eye and the point looked at are the same point"),
+        ("0,0,5,0,0,0", "looks straight up or down"),
+    ],
+)
+def test_parse_camera_refuses(text: str, message: str) -> None:
+    with pytest.raises(ValueError, match=message):
+        parse_camera(text)
+
+
+def test_look_from_puts_the_eye_there() -> None:
+    camera = OrbitCamera(640, 360, shift_x=100.0)
+    camera.look_from(np.array([4.0, -6.0, 3.0]), np.array([0.0, 1.0, 0.5]))
+    assert_allclose(camera.eye, [4.0, -6.0, 3.0], atol=1e-9)
+    assert_allclose(camera.project(np.array([[0.0, 1.0, 0.5]]))[0], [320 + 100, 180], atol=1e-6)
+
+
+def test_fit_fills_the_free_part_of_the_picture() -> None:
+    camera = OrbitCamera(640, 360, shift_x=80.0)  # a 160 pixel panel on the left
+    rng = np.random.default_rng(3)
+    points = rng.uniform([-5, -2, 0], [3, 6, 0.4], (500, 3))
+    camera.fit(points, border=0.05)
+    pixels = camera.project(points)
+    low, high = pixels.min(axis=0), pixels.max(axis=0)
+    assert low[0] >= 160 + 0.05 * 480 - 1e-6 and high[0] <= 640 - 0.05 * 640 + 1e-6
+    assert low[1] >= 0.05 * 360 - 1e-6 and high[1] <= 360 - 0.05 * 360 + 1e-6
+    # tight: one side or the other touches the border (not a loose bounding sphere)
+    slack = np.array([low[0] - (160 + 24), 640 - 32 - high[0], low[1] - 18, 342 - high[1]])
+    assert slack.min() < 2.0

@@ -82,3 +82,33 @@ def test_a_headless_video_has_no_hud_unless_asked(tmp_path: Path) -> None:
     right = (slice(None), slice(-120, None))
     panel, elsewhere = np.abs(a[left] - b[left]).mean(), np.abs(a[right] - b[right]).mean()
     assert panel > 10 and panel > 3 * elsewhere  # the panel covers the view only there
+
+
+@pytest.mark.parametrize(
+    ("camera", "message"),
+    [
+        (["--camera", "sideways"], "error: argument --camera: must be frame-all, follow NAME or"),
+        (["--camera", "1,2,3"], "error: argument --camera: must be frame-all, follow NAME or"),
+        (["--camera", "-1,-1,-1,-1,-1,-1"], "error: argument --camera: the eye and the point"),
+        (["--camera", "follow", "nobody"], "error: argument --camera: no creature named 'nobody'"),
+    ],
+)
+def test_a_bad_camera_is_one_line_and_exit_2(
+    tmp_path: Path, camera: list[str], message: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    argv = ["play", "octopus", "--headless", "--frames", "1", "--quiet", *camera]
+    try:
+        code = main([*argv, "--width", "128", "--height", "72", "--json"])
+    except SystemExit as exit_:
+        code = int(exit_.code or 0)
+    err = capsys.readouterr().err
+    assert code == 2
+    assert message in err and len(err.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("camera", ["frame-all", "follow octopus", "-3,-4,2,0,0,0"])
+def test_play_takes_a_camera(tmp_path: Path, camera: str) -> None:
+    shot = tmp_path / "shot.png"
+    argv = ["play", "octopus", "--headless", "--frames", "2", "--quiet", "--no-hud"]
+    assert main([*argv, "--camera", *camera.split(" ", 1), "--screenshot", str(shot)]) == 0
+    assert shot.exists()

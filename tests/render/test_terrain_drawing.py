@@ -31,11 +31,13 @@ def test_terrain_and_obstacles_are_drawn_and_clicks_land_on_them(
 ) -> None:
     sandbox = make_sandbox(terrain_scene())
     sandbox.hud.visible = False
+    camera = sandbox.renderer.camera
+    top = np.array([[1.0, 1.4, 0.5 + _hill_height(sandbox, 1.0, 1.4)]])  # the table's top
+    camera.shift_x = 0.0
+    camera.fit(np.vstack([top, [[-1.0, -1.2, 0.0], [-0.5, 0.0, 0.0]]]), border=0.2)
     calls = sandbox.renderer.draw()
     assert calls == 9 + 1  # the grid's draw gives way to the terrain's and the obstacles'
     pixels = sandbox.renderer.target.read().astype(int)
-    camera = sandbox.renderer.camera
-    top = np.array([[1.0, 1.4, 0.5 + _hill_height(sandbox, 1.0, 1.4)]])  # the table's top
     tx, ty = camera.project(top)[0]
     r, g, b = pixels[camera.height - round(ty), round(tx)]
     assert abs(r - g) < 25 and abs(g - b) < 25  # grey rock, not sky or sand
