@@ -175,7 +175,7 @@ def handle(args: argparse.Namespace) -> int:
         if args.strict:
             return 1
     try:
-        skinned = save(take, args.out, progress=not args.quiet, skin=skin)
+        skinned = save(take, args.out, progress=not args.quiet, skin=skin, locators=args.locators)
     except MeshError as error:  # e.g. tentacle bases that overlap on the mantle
         print(f"error: {error}", file=sys.stderr)
         return 2
@@ -187,16 +187,23 @@ def handle(args: argparse.Namespace) -> int:
     return 0
 
 
-def save(take: Take, path: Path, *, progress: bool, skin: Skin | None = None) -> KeyReport | None:
+def save(
+    take: Take,
+    path: Path,
+    *,
+    progress: bool,
+    skin: Skin | None = None,
+    locators: bool | None = None,
+) -> KeyReport | None:
     """Write `take` to `path` in the format its suffix names (a bar for slow, rigid USD
-    output); returns the key report when skinned."""
+    output); returns the key report when skinned. `locators`: as `export.write`."""
     slow = output_kind(path) == "usd"
     bodies = len(take.header["bodies"])
     disable = None if progress and slow else True
     with tqdm(
         total=bodies, unit="body", desc="usd", disable=disable, file=sys.stderr, leave=False
     ) as bar:
-        return write(take, path, bar.update, skin)
+        return write(take, path, bar.update, skin, locators)
 
 
 def report(take: Take, path: Path) -> dict[str, Any]:

@@ -2,7 +2,9 @@
 
 The suffix of FILE picks the format (`.usd`, `.usda`, `.usdc`, `.glb`); the file is
 written atomically. Creatures are skinned (a mesh on a joint skeleton with rotation
-keys) unless `--rigid`. A file that is not a take gives one line naming it and exit 2.
+keys) unless `--rigid`; each creature gets a material of its sandbox colour. Suckers and
+goals are locators with `--locators` (the default for `--rigid`; `--no-locators` leaves
+them out). A file that is not a take gives one line naming it and exit 2.
 """
 
 from __future__ import annotations
@@ -55,7 +57,7 @@ def handle(args: argparse.Namespace) -> int:
         return 2
     take = Take.load(args.take)  # TakeError: one line, exit 2
     try:
-        skinned = save(take, args.out, progress=not args.quiet, skin=skin)
+        skinned = save(take, args.out, progress=not args.quiet, skin=skin, locators=args.locators)
     except MeshError as error:  # e.g. tentacle bases that overlap on the mantle
         print(f"error: {error}", file=sys.stderr)
         return 2

@@ -18,7 +18,8 @@ FLAGS = {
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """`--rigid`, `--keys`, `--key-tolerance`, `--rings-per-link`, `--sides`, `--sucker-discs`."""
+    """`--rigid`, `--keys`, `--key-tolerance`, `--rings-per-link`, `--sides`, `--sucker-discs`,
+    `--locators`."""
     group = parser.add_argument_group(
         "skinned creatures (USD and glTF; the default)",
         "one mesh per creature on a joint skeleton with rotation keys",
@@ -48,6 +49,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--sides", type=bounded_int(8, MAX_SIDES), default=12, help="mesh sides (a multiple of 4)"
     )
     group.add_argument("--sucker-discs", action="store_true", help="sucker discs underneath")
+    group.add_argument(
+        "--locators",
+        action=argparse.BooleanOptionalAction,
+        default=None,
+        help="suckers and goals as locators (USD Xforms, glTF nodes; empties in Blender):"
+        " off by default for skinned creatures, on for --rigid",
+    )
 
 
 def skin_options(args: argparse.Namespace) -> Skin | None:

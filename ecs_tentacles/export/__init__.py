@@ -31,12 +31,14 @@ def write(
     path: str | os.PathLike[str],
     progress: Callable[[int], object] | None = None,
     skin: Skin | None = None,
+    locators: bool | None = None,
 ) -> KeyReport | None:
     """Write `take` in the format its suffix names (see `SUFFIXES`), atomically.
 
     `progress(n)` hears of bodies written, for the slow format (USD). With `skin`, USD
     and glTF get skinned creatures (`ecs_tentacles.export.skinned`) and the key report
-    is returned; without, rigid bodies.
+    is returned; without, rigid bodies. `locators`: suckers and goals as locators (USD
+    Xforms, glTF nodes); None is the form's default: off when skinned, on when rigid.
     """
     kind = output_kind(path)
     if kind != "take":  # a take refuses itself (`Take.save`), with its own verb
@@ -44,17 +46,17 @@ def write(
     if skin is not None and kind in ("usd", "gltf"):
         from ecs_tentacles.export.skinned import write_skinned
 
-        return write_skinned(take, path, skin)
+        return write_skinned(take, path, skin, bool(locators))
     if kind == "take":
         take.save(path)
     elif kind == "usd":
         from ecs_tentacles.export.usd import write_usd
 
-        write_usd(take, path, progress)
+        write_usd(take, path, progress, locators is not False)
     elif kind == "gltf":
         from ecs_tentacles.export.gltf import write_glb
 
-        write_glb(take, path)
+        write_glb(take, path, locators is not False)
     else:
         raise ValueError(f"{path}: unknown output format (use {', '.join(SUFFIXES)})")
     return None

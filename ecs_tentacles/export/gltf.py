@@ -7,7 +7,13 @@ pose (a creature that comes or goes during the take has its root's scale keyed t
 while it is not there: `scale_visibility`); one animation (`<scene>_animation`) has a
 translation and a rotation channel per body (LINEAR, a key per take frame, time =
 frame / fps). Bodies carry lean meshes (capsules along +x, the mantle's cylinder)
-sharing one material.
+bound to their creature's material (`<c>_skin`, its sandbox colour:
+`ecs_tentacles.export.materials`).
+
+Locators (on by default in the rigid form, `locators=False` leaves them out): each sucker
+is a node under its link (`<c>_t<k>_link<i>_sucker<n>`, at the sucker), each goal a node
+under `<c>_goals` (`<c>_goal<j>`, at the goal, its scale keyed to zero once reached);
+their `extras` say what they are (`ecs:locator`: sucker or goal; a goal's `ecs:radius`).
 
 glTF is y-up, our world z-up: everything is turned by -90 degrees about x on the
 way out, (x, y, z) -> (x, z, -y) for points and for quaternion vector parts, so an
@@ -28,8 +34,9 @@ import numpy as np
 from ecs_tentacles import __version__
 from ecs_tentacles.atomic import atomic_file
 from ecs_tentacles.export.ground import add_gltf_ground
+from ecs_tentacles.export.materials import gltf_material, take_colours
 from ecs_tentacles.export.meshes import Mesh, body_mesh
-from ecs_tentacles.export.names import part, unique_leaf
+from ecs_tentacles.export.names import FOLDERS, part, unique_leaf, unique_path
 from ecs_tentacles.take import Take
 from ecs_tentacles.take_roster import spans
 
@@ -84,12 +91,14 @@ class _Buffer:
         return len(self.accessors) - 1
 
 
-def build_gltf(take: Take) -> tuple[dict[str, Any], bytes]:
-    """The glTF JSON document and its binary buffer."""
+def build_gltf(take: Take, locators: bool = True) -> tuple[dict[str, Any], bytes]:
+    """The glTF JSON document and its binary buffer (with `locators`: sucker and goal nodes)."""
     header = take.header
     buffer = _Buffer()
     meshes: list[dict[str, Any]] = []
-    mesh_of: dict[tuple[str, str, float, float], int] = {}
+    mesh_of: dict[tuple[str, str, float, float, int], int] = {}
+    materials: list[dict[str, Any]] = []
+    node_of_body: dict[int, int] = {}
     nodes: list[dict[str, Any]] = [{"name": "World", "children": []}]
     body_nodes: list[int] = []
     translations = to_y_up_points(take.pos).astype(np.float32)
@@ -100,12 +109,14 @@ def build_gltf(take: Take) -> tuple[dict[str, Any], bytes]:
         nodes[parent].setdefault("children", []).append(len(nodes) - 1)
         return len(nodes) - 1
 
-    def body(index: int, parent: int) -> None:
+    def body(index: int, parent: int, material: int) -> None:
         info = header["bodies"][index]
-        key = (info["shape"], info["axis"], float(info["radius"]), float(info["length"]))
+        shape = (info["shape"], info["axis"], float(info["radius"]), float(info["length"]))
+        key = (*shape, material)  # a mesh per shape and creature: the material is the mesh's
         if key not in mesh_of:
             mesh_of[key] = len(meshes)
-            meshes.append(_mesh(buffer, body_mesh(*key), info["shape"]))
+            meshes.append(_mesh(buffer, body_mesh(*shape), info["shape"], material))
+        node_of_body[index] = len(nodes)
         body_nodes.append(
             node(
                 unique_leaf(info["name"]),
@@ -117,26 +128,22 @@ def build_gltf(take: Take) -> tuple[dict[str, Any], bytes]:
         )
 
     roots = []
+    colours = take_colours(take)
     for creature in header["creatures"]:
-        root = node(creature["name"], 0)
-        roots.append(root)
-        body(creature["mantle"], root)
         name = creature["name"]
+        materials.append(gltf_material(name, colours[name]))
+        root = node(name, 0)
+        roots.append(root)
+        body(creature["mantle"], root, len(materials) - 1)
         tentacles = node(unique_leaf(f"{name}/tentacles"), root)
         for k, chain in enumerate(creature["tentacles"]):
             folder = node(unique_leaf(f"{name}/tentacles/t{k}"), tentacles)
             for index in chain:
-                body(index, folder)
-    materials: list[dict[str, Any]] = [
-        {
-            "name": "skin",
-            "pbrMetallicRoughness": {
-                "baseColorFactor": [0.85, 0.45, 0.5, 1.0],
-                "metallicFactor": 0.0,
-                "roughnessFactor": 0.6,
-            },
-        }
-    ]
+                body(index, folder, len(materials) - 1)
+    if locators:
+        for creature in header["creatures"]:
+            for parent, child in sucker_nodes(take, creature["name"]):
+                node(child.pop("name"), node_of_body[parent], **child)
     ground = add_gltf_ground(take, buffer, nodes, meshes, materials, to_y_up_points)
     if ground is not None:
         nodes[0]["children"].append(ground)
@@ -156,6 +163,8 @@ def build_gltf(take: Take) -> tuple[dict[str, Any], bytes]:
     shown = take.visible()
     for index, root in enumerate(roots):
         scale_visibility(buffer, take, shown[:, index], nodes[root], root, animation)
+    if locators:
+        add_gltf_goals(take, buffer, nodes, animation)
     document["animations"] = [animation]
     document["buffers"] = [{"byteLength": len(buffer.data)}]
     document["bufferViews"] = buffer.views
@@ -188,7 +197,54 @@ def scale_visibility(
     channels.append({"sampler": len(samplers) - 1, "target": {"node": index, "path": "scale"}})
 
 
-def _mesh(buffer: _Buffer, mesh: Mesh, name: str) -> dict[str, Any]:
+def sucker_nodes(
+    take: Take, creature: str, joint_offsets: dict[int, float] | None = None
+) -> list[tuple[int, dict[str, Any]]]:
+    """(body, node) for each sucker of `creature`: a node named as USD names it, placed at
+    the sucker in its body's frame (y-up), or, with `joint_offsets` (body -> the joint's
+    origin along the body's x: `Skeleton.offset`), in the frame of that body's joint."""
+    out = []
+    for sucker in take.header["suckers"]:
+        if sucker["name"].split("/", 1)[0] != creature:
+            continue
+        body = int(sucker["body"])
+        local = np.asarray(sucker["offset"], dtype=np.float64)
+        if joint_offsets is not None:
+            local = local - [joint_offsets[body], 0.0, 0.0]
+        point = to_y_up_points(local).astype(np.float32).tolist()
+        extras = {"ecs:locator": "sucker"}  # what it is (an importer's custom property)
+        out.append((body, {"name": unique_leaf(sucker["name"]), "translation": point,
+                           "extras": extras}))  # fmt: skip
+    return out
+
+
+def add_gltf_goals(
+    take: Take, buffer: _Buffer, nodes: list[dict[str, Any]], animation: dict[str, Any]
+) -> None:
+    """Every points track's items (the goals) as nodes under World: `<c>_goals/<c>_goal<j>`
+    at the item's place (y-up), its scale keyed to zero while it is not live."""
+    folders: dict[str, int] = {}
+    for track in take.track_list():
+        if track.kind != "points":
+            continue
+        where, live = (take.tracks[name] for name in track.arrays)
+        for index, item in enumerate(take.header[track.key]):
+            *path, leaf = unique_path(item["name"], FOLDERS | {track.folder}).split("/")
+            folder = path[-1] if len(path) > 1 else track.folder
+            if folder not in folders:
+                folders[folder] = len(nodes)
+                nodes.append({"name": folder})
+                nodes[0].setdefault("children", []).append(folders[folder])
+            point = to_y_up_points(where[index]).astype(np.float32).tolist()
+            extras = {"ecs:locator": track.item, "ecs:radius": item.get("radius")}
+            extras = {key: value for key, value in extras.items() if value is not None}
+            nodes.append({"name": leaf, "translation": point, "extras": extras})
+            nodes[folders[folder]].setdefault("children", []).append(len(nodes) - 1)
+            own = len(nodes) - 1
+            scale_visibility(buffer, take, live[:, index], nodes[own], own, animation)
+
+
+def _mesh(buffer: _Buffer, mesh: Mesh, name: str, material: int) -> dict[str, Any]:
     positions = to_y_up_points(mesh.positions).astype(np.float32)
     normals = to_y_up_points(mesh.normals).astype(np.float32)
     attributes = {
@@ -196,7 +252,7 @@ def _mesh(buffer: _Buffer, mesh: Mesh, name: str) -> dict[str, Any]:
         "NORMAL": buffer.add(normals, "VEC3", _ARRAY_BUFFER),
     }
     indices = buffer.add(mesh.indices, "SCALAR", _ELEMENT_ARRAY_BUFFER)
-    primitive = {"attributes": attributes, "indices": indices, "material": 0, "mode": 4}
+    primitive = {"attributes": attributes, "indices": indices, "material": material, "mode": 4}
     return {"name": name, "primitives": [primitive]}
 
 
@@ -265,9 +321,10 @@ def accessor_array(document: dict[str, Any], binary: bytes, index: int) -> np.nd
     return flat.reshape(accessor["count"], width) if width > 1 else flat
 
 
-def write_glb(take: Take, path: str | os.PathLike[str]) -> None:
-    """Write `take` as a .glb file, atomically; `TakeError` for a take glTF cannot hold."""
+def write_glb(take: Take, path: str | os.PathLike[str], locators: bool = True) -> None:
+    """Write `take` as a .glb file, atomically; `TakeError` for a take glTF cannot hold.
+    `locators=False` leaves the sucker and goal nodes out."""
     take.check_exportable(path)
-    data = glb_bytes(*build_gltf(take))
+    data = glb_bytes(*build_gltf(take, locators))
     with atomic_file(path) as handle:
         handle.write(data)

@@ -26,15 +26,18 @@ class Skin:
     keys: Keys = field(default_factory=Keys)
 
 
-def write_skinned(take: Take, path: str | os.PathLike[str], skin: Skin) -> KeyReport:
-    """Write `take` with skinned creatures as USD or glTF (by suffix), atomically."""
+def write_skinned(
+    take: Take, path: str | os.PathLike[str], skin: Skin, locators: bool = False
+) -> KeyReport:
+    """Write `take` with skinned creatures as USD or glTF (by suffix), atomically; with
+    `locators`, suckers and goals too."""
     kind = output_kind(path)
     if kind == "usd":
         from ecs_tentacles.export.skinned_usd import write_skinned_usd
 
-        return write_skinned_usd(take, path, skin.detail, skin.keys)
+        return write_skinned_usd(take, path, skin.detail, skin.keys, locators)
     if kind == "gltf":
         from ecs_tentacles.export.skinned_gltf import write_skinned_glb
 
-        return write_skinned_glb(take, path, skin.detail, skin.keys)
+        return write_skinned_glb(take, path, skin.detail, skin.keys, locators)
     raise ValueError(f"{path}: skinned creatures are written as USD or glTF, not {kind}")

@@ -11,13 +11,18 @@ per joint and a translation channel on each mantle, each with its own key times 
 keys are reduced (one animation, not one per creature: Blender's importer plays only
 the first animation of a file and stashes the others in muted NLA tracks, and game
 engines read one animation as one clip). The mesh: POSITION, NORMAL, TEXCOORD_0 (a vertex is split
-where its UVs differ), JOINTS_0/WEIGHTS_0 (two influences used of four). Everything is
-turned to glTF's y-up like the rigid form (`ecs_tentacles.export.gltf`).
+where its UVs differ), JOINTS_0/WEIGHTS_0 (two influences used of four), bound to the
+creature's material `<c>_skin`: a texture of its sandbox colour
+(`ecs_tentacles.export.materials`). Everything is turned to glTF's y-up like the rigid
+form (`ecs_tentacles.export.gltf`).
+
+Locators (suckers and goals) only with `locators=True` (`--locators`): each sucker a
+node under its link's joint (so it follows the joint), each goal a node under
+`<c>_goals`, as in the rigid form.
 """
 
 from __future__ import annotations
 
-import io
 import os
 from typing import Any
 
@@ -30,12 +35,15 @@ from ecs_tentacles.export.gltf import (
     _ELEMENT_ARRAY_BUFFER,
     Z_UP_TO_Y_UP,
     _Buffer,
+    add_gltf_goals,
     glb_bytes,
     scale_visibility,
+    sucker_nodes,
     to_y_up_points,
     to_y_up_rotations,
 )
 from ecs_tentacles.export.ground import add_gltf_ground
+from ecs_tentacles.export.materials import gltf_material, skin_texture, take_colours
 from ecs_tentacles.export.names import part
 from ecs_tentacles.skin.keys import KeyReport
 from ecs_tentacles.skin.mesh import Detail, SkinMesh
@@ -51,9 +59,11 @@ def write_skinned_glb(
     path: str | os.PathLike[str],
     detail: Detail | None = None,
     keys: Keys | None = None,
+    locators: bool = False,
 ) -> KeyReport:
-    """Write `take` as a skinned .glb atomically; returns the key counts and errors."""
-    document, binary, report = build_skinned_gltf(take, detail, keys)
+    """Write `take` as a skinned .glb atomically; returns the key counts and errors.
+    With `locators`, suckers and goals are nodes too (the module doc)."""
+    document, binary, report = build_skinned_gltf(take, detail, keys, locators)
     data = glb_bytes(document, binary)
     with atomic_output(path) as temporary:
         temporary.write_bytes(data)
@@ -61,7 +71,7 @@ def write_skinned_glb(
 
 
 def build_skinned_gltf(
-    take: Take, detail: Detail | None = None, keys: Keys | None = None
+    take: Take, detail: Detail | None = None, keys: Keys | None = None, locators: bool = False
 ) -> tuple[dict[str, Any], bytes, KeyReport]:
     """The glTF JSON document, its binary buffer and the key report."""
     header = take.header
@@ -70,6 +80,9 @@ def build_skinned_gltf(
     nodes: list[dict[str, Any]] = [{"name": "World", "children": []}]
     roots = [0]
     meshes, skins = [], []
+    colours = take_colours(take)
+    materials: list[dict[str, Any]] = []
+    images: list[dict[str, Any]] = []
     animation: dict[str, Any] = {"name": "take", "samplers": [], "channels": []}
     times: dict[bytes, int] = {}
     shown = take.visible()
@@ -103,7 +116,11 @@ def build_skinned_gltf(
                 "inverseBindMatrices": buffer.add(inverse.astype(np.float32), "MAT4"),
             }
         )
-        meshes.append(_mesh(buffer, creature.mesh, skeleton.layout.name))
+        name = skeleton.layout.name
+        images.append({"bufferView": _image(buffer, skin_texture(colours[name])),
+                       "mimeType": "image/png"})  # fmt: skip
+        materials.append(gltf_material(name, colours[name], texture=len(images) - 1))
+        meshes.append(_mesh(buffer, creature.mesh, name, len(materials) - 1))
         roots.append(len(nodes))
         nodes.append(
             {
@@ -116,16 +133,14 @@ def build_skinned_gltf(
         # while the creature is not there: its root joint (and so its skin) scaled to zero
         seen = shown[:, index[skeleton.layout.name]]
         scale_visibility(buffer, take, seen, nodes[first], first, animation)
-    materials: list[dict[str, Any]] = [
-        {
-            "name": "skin",
-            "pbrMetallicRoughness": {
-                "baseColorTexture": {"index": 0},
-                "metallicFactor": 0.0,
-                "roughnessFactor": 0.6,
-            },
-        }
-    ]
+        if locators:  # each sucker a child of its link's joint, at the sucker
+            joint_of = {int(b): first + j for j, b in enumerate(skeleton.bodies)}
+            offsets = dict(zip(skeleton.bodies.tolist(), skeleton.offset.tolist(), strict=True))
+            for parent, child in sucker_nodes(take, name, offsets):
+                nodes.append(child)
+                nodes[joint_of[parent]].setdefault("children", []).append(len(nodes) - 1)
+    if locators:
+        add_gltf_goals(take, buffer, nodes, animation)
     ground = add_gltf_ground(take, buffer, nodes, meshes, materials, to_y_up_points)
     if ground is not None:
         nodes[0]["children"].append(ground)
@@ -141,33 +156,15 @@ def build_skinned_gltf(
         "meshes": meshes,
         "skins": skins,
         "materials": materials,
-        "textures": [{"sampler": 0, "source": 0}],
+        "textures": [{"sampler": 0, "source": i} for i in range(len(images))],
         "samplers": [{"magFilter": 9729, "minFilter": 9729}],
-        "images": [{"bufferView": _image(buffer, skin_texture()), "mimeType": "image/png"}],
+        "images": images,
         "animations": [animation],
         "buffers": [{"byteLength": len(buffer.data)}],
         "bufferViews": buffer.views,
         "accessors": buffer.accessors,
     }
     return document, bytes(buffer.data), report
-
-
-def skin_texture(size: int = 64) -> bytes:
-    """A PNG laid out on the tentacle UVs: rose skin, rings along v, a pale underside
-    (u from 0.75 to 1 is the strip facing down in the bind pose)."""
-    from PIL import Image
-
-    # image rows run top to bottom, glTF's v; the mesh's v (USD's) runs bottom to top
-    u = (np.arange(size) + 0.5) / size
-    v = (np.arange(size) + 0.5) / size
-    rings = 0.9 + 0.1 * np.cos(2 * np.pi * 12 * v)[:, None]
-    underside = np.clip(1 - np.abs(u - 0.875) / 0.125, 0.0, 1.0)[None, :] ** 0.5
-    rose, pale = np.array([0.85, 0.45, 0.5]), np.array([0.95, 0.85, 0.8])
-    colour = rose + underside[..., None] * (pale - rose)
-    pixels = np.clip(255 * rings[..., None] * colour, 0, 255).astype(np.uint8)
-    out = io.BytesIO()
-    Image.fromarray(pixels[::-1], "RGB").save(out, format="PNG", optimize=False)
-    return out.getvalue()
 
 
 def _image(buffer: _Buffer, png: bytes) -> int:
@@ -186,7 +183,7 @@ def split_by_uv(mesh: SkinMesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return unique[:, 0].astype(np.int64), unique[:, 1:].astype(np.float32), inverse.reshape(-1, 3)
 
 
-def _mesh(buffer: _Buffer, mesh: SkinMesh, name: str) -> dict[str, Any]:
+def _mesh(buffer: _Buffer, mesh: SkinMesh, name: str, material: int) -> dict[str, Any]:
     source, uv, triangles = split_by_uv(mesh)
     if len(source) > 65535:
         raise ValueError(
@@ -210,7 +207,7 @@ def _mesh(buffer: _Buffer, mesh: SkinMesh, name: str) -> dict[str, Any]:
         "WEIGHTS_0": buffer.add(weights, "VEC4", _ARRAY_BUFFER),
     }
     indices = buffer.add(triangles.reshape(-1).astype(np.uint16), "SCALAR", _ELEMENT_ARRAY_BUFFER)
-    primitive = {"attributes": attributes, "indices": indices, "material": 0, "mode": 4}
+    primitive = {"attributes": attributes, "indices": indices, "material": material, "mode": 4}
     return {"name": f"{name}/skin", "primitives": [primitive]}
 
 

@@ -9,12 +9,15 @@
         /<c>_skin                            Mesh (bound to the skeleton): points in the
                                              bind pose, normals, primvars:st (faceVarying),
                                              primvars:skel:jointIndices / jointWeights (2),
-                                             bound to the shared /World/materials/skin
+                                             bound to /World/materials/<c>_skin
         /<c>_suckers/<c>_t<k>/<c>_t<k>_link<i>/<c>_t<k>_link<i>_sucker<n>
-                                             Xform: translate sampled (the sucker point),
-                                             `ecs:attached` sampled
-        /goals/goal<j>, /fur/guides, ...     the take's tracks, as in the rigid form
-                                             (`ecs_tentacles.export.usd`)
+                                             locator (`locators=True`): Xform, translate
+                                             sampled (the sucker point), `ecs:attached`
+        /<c>_goals/<c>_goal<j>, /<c>_fur/... the take's tracks, as in the rigid form
+                                             (`ecs_tentacles.export.usd`); the goals only
+                                             with `locators=True`
+      /materials/<c>_skin                    each creature's material, its sandbox colour
+                                             (`ecs_tentacles.export.materials`)
 
 A SkelAnimation samples all its joints at once, so with reduced keys its time samples
 are the frames where any joint has a key (each joint's value there comes from its own
@@ -32,6 +35,7 @@ import numpy as np
 
 from ecs_tentacles.atomic import atomic_output
 from ecs_tentacles.export.ground import write_usd_ground
+from ecs_tentacles.export.materials import bind_usd, take_colours, usd_material
 from ecs_tentacles.export.names import part, unique_path
 from ecs_tentacles.export.usd import _pxr, key_visibility, mark_rate, new_stage, write_tracks
 from ecs_tentacles.mathutil import quat_rotate
@@ -47,9 +51,11 @@ def write_skinned_usd(
     path: str | os.PathLike[str],
     detail: Detail | None = None,
     keys: Keys | None = None,
+    locators: bool = False,
 ) -> KeyReport:
-    """Write `take` as a skinned USD file (.usda, .usdc, .usd) atomically; returns the keys."""
-    stage, report = build_skinned_stage(take, detail, keys)
+    """Write `take` as a skinned USD file (.usda, .usdc, .usd) atomically; returns the keys.
+    With `locators`, suckers and goals are written too."""
+    stage, report = build_skinned_stage(take, detail, keys, locators)
     with atomic_output(path) as temporary:
         if not stage.GetRootLayer().Export(str(temporary)):
             raise OSError(f"{path}: USD could not write the file")
@@ -57,7 +63,7 @@ def write_skinned_usd(
 
 
 def build_skinned_stage(
-    take: Take, detail: Detail | None = None, keys: Keys | None = None
+    take: Take, detail: Detail | None = None, keys: Keys | None = None, locators: bool = False
 ) -> tuple[Any, KeyReport]:
     """An in-memory `Usd.Stage` with one SkelRoot per creature, and the key report."""
     pxr = _pxr()
@@ -70,14 +76,16 @@ def build_skinned_stage(
     creatures, report = skinned_creatures(take, detail, keys)
     shown = take.visible()
     of_name = {c["name"]: i for i, c in enumerate(take.header["creatures"])}
+    colours = take_colours(take)
     for creature in creatures:
-        _creature(pxr, stage, creature)
         name = creature.skeleton.layout.name
+        _creature(pxr, stage, creature, colours[name])
         mark_rate(stage, f"/World/{name}", take)
         key_visibility(stage, f"/World/{name}", shown[:, of_name[name]])
-    for index, sucker in enumerate(take.header["suckers"]):
-        _sucker(pxr, stage, take, index, sucker)
-    write_tracks(pxr, stage, take)
+    if locators:
+        for index, sucker in enumerate(take.header["suckers"]):
+            _sucker(pxr, stage, take, index, sucker)
+    write_tracks(pxr, stage, take, locators)
     write_usd_ground(pxr, stage, take)
     return stage, report
 
@@ -87,7 +95,7 @@ def _matrices(pxr: Any, matrices: np.ndarray) -> Any:
     return pxr.Vt.Matrix4dArray.FromNumpy(np.ascontiguousarray(np.swapaxes(matrices, -1, -2)))
 
 
-def _creature(pxr: Any, stage: Any, creature: SkinnedCreature) -> None:
+def _creature(pxr: Any, stage: Any, creature: SkinnedCreature, colour: np.ndarray) -> None:
     Gf, Sdf, UsdGeom, UsdSkel, Vt = pxr.Gf, pxr.Sdf, pxr.UsdGeom, pxr.UsdSkel, pxr.Vt
     skeleton, mesh = creature.skeleton, creature.mesh
     base = f"/World/{skeleton.layout.name}"
@@ -124,7 +132,6 @@ def _creature(pxr: Any, stage: Any, creature: SkinnedCreature) -> None:
     skin.SetNormalsInterpolation(UsdGeom.Tokens.vertex)
     low, high = mesh.positions.min(axis=0), mesh.positions.max(axis=0)
     skin.CreateExtentAttr([Gf.Vec3f(*low.tolist()), Gf.Vec3f(*high.tolist())])
-    skin.CreateDisplayColorAttr([Gf.Vec3f(*SKIN_COLOUR)])
     primvars = UsdGeom.PrimvarsAPI(skin.GetPrim())
     st = primvars.CreatePrimvar(
         "st", Sdf.ValueTypeNames.TexCoord2fArray, UsdGeom.Tokens.faceVarying
@@ -139,29 +146,8 @@ def _creature(pxr: Any, stage: Any, creature: SkinnedCreature) -> None:
         Vt.FloatArray.FromNumpy(mesh.weights.reshape(-1).astype(np.float32))
     )
     bound.CreateGeomBindTransformAttr(Gf.Matrix4d(1.0))
-    material = _skin_material(pxr, stage, "/World/materials")  # one, shared (as in glTF)
-    pxr.UsdShade.MaterialBindingAPI.Apply(skin.GetPrim()).Bind(material)
-
-
-SKIN_COLOUR = (0.85, 0.45, 0.5)  # the rose of the glTF export's skin texture
-SKIN_ROUGHNESS = 0.6  # as the glTF material's
-
-
-def _skin_material(pxr: Any, stage: Any, folder: str) -> Any:
-    """`<folder>/skin`: a UsdPreviewSurface of the skin's colour and roughness."""
-    Sdf, UsdShade = pxr.Sdf, pxr.UsdShade
-    path = f"{folder}/skin"
-    if stage.GetPrimAtPath(path):
-        return UsdShade.Material(stage.GetPrimAtPath(path))
-    pxr.UsdGeom.Scope.Define(stage, folder)
-    material = UsdShade.Material.Define(stage, path)
-    shader = UsdShade.Shader.Define(stage, f"{path}/surface")
-    shader.CreateIdAttr("UsdPreviewSurface")
-    shader.CreateInput("diffuseColor", Sdf.ValueTypeNames.Color3f).Set(SKIN_COLOUR)
-    shader.CreateInput("roughness", Sdf.ValueTypeNames.Float).Set(SKIN_ROUGHNESS)
-    shader.CreateInput("metallic", Sdf.ValueTypeNames.Float).Set(0.0)
-    material.CreateSurfaceOutput().ConnectToSource(shader.ConnectableAPI(), "surface")
-    return material
+    material = usd_material(pxr, stage, name, colour)
+    bind_usd(pxr, skin.GetPrim(), material, colour)
 
 
 def _sucker(pxr: Any, stage: Any, take: Take, index: int, sucker: dict[str, Any]) -> None:

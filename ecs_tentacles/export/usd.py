@@ -6,7 +6,8 @@
           /<c>_mantle_geom                    Cylinder, axis Z, radius, height
         /<c>_tentacles/<c>_t<k>/<c>_t<k>_link<i>   Xform: time-sampled translate + orient
           /<c>_t<k>_link<i>_geom              Capsule, axis X, radius, height = spine
-          /<c>_t<k>_link<i>_sucker<n>         Xform at the sucker, `ecs:attached` sampled
+          /<c>_t<k>_link<i>_sucker<n>         locator: Xform at the sucker, `ecs:attached`
+                                              sampled
         /<c>_<folder>/<c>_<item><j>           a points track's locator (the goals:
                                               <c>_goals/<c>_goal<j>): Xform at its
                                               position, visibility sampled (invisible
@@ -15,8 +16,14 @@
                                               <c>_fur/<c>_guides): BasisCurves (linear),
                                               points and widths sampled
       /<folder>/<item>                        curves owned by no creature, if any
+      /materials/<c>_skin                     each creature's material: its sandbox
+                                              colour (`ecs_tentacles.export.materials`),
+                                              bound to its mantle and capsules
       /terrain                                the ground's meshes, on terrain
                                               (`ecs_tentacles.export.ground`)
+
+Locators (suckers and points tracks' items: the goals) are written unless
+`locators=False`; curves tracks (fur guides) always.
 
 Every prim name is unique in the file (`ecs_tentacles.export.names`: importers name
 objects globally and would add `.001` suffixes); tracks (`ecs_tentacles.take_tracks`)
@@ -30,6 +37,7 @@ time codes 0 .. frames - 1 (time code i is frame i, i / fps seconds).
 
 from __future__ import annotations
 
+import importlib
 import os
 from collections.abc import Callable
 from typing import Any
@@ -38,6 +46,7 @@ import numpy as np
 
 from ecs_tentacles.atomic import atomic_output
 from ecs_tentacles.export.ground import write_usd_ground
+from ecs_tentacles.export.materials import bind_usd, take_colours, usd_material
 from ecs_tentacles.export.names import FOLDERS, unique_path
 from ecs_tentacles.take import Take, TakeTrack
 from ecs_tentacles.take_roster import spans
@@ -62,15 +71,19 @@ def _pxr() -> Any:
 
 
 def write_usd(
-    take: Take, path: str | os.PathLike[str], progress: Callable[[int], object] | None = None
+    take: Take,
+    path: str | os.PathLike[str],
+    progress: Callable[[int], object] | None = None,
+    locators: bool = True,
 ) -> None:
     """Write `take` as a USD file (.usda text, .usdc or .usd binary), atomically.
 
-    `progress(n)` is called as bodies are written (n bodies at a time). Raises
-    `TakeError` (one line) for a take USD cannot hold (non-finite numbers, bad names).
+    `progress(n)` is called as bodies are written (n bodies at a time); `locators=False`
+    leaves suckers and goals out. Raises `TakeError` (one line) for a take USD cannot
+    hold (non-finite numbers, bad names).
     """
     take.check_exportable(path)
-    stage = build_stage(take, progress)
+    stage = build_stage(take, progress, locators)
     with atomic_output(path) as temporary:
         if not stage.GetRootLayer().Export(str(temporary)):
             raise OSError(f"{path}: USD could not write the file")
@@ -112,21 +125,27 @@ def key_visibility(stage: Any, path: str, shown: np.ndarray) -> None:
         attribute.Set(token, frame)
 
 
-def build_stage(take: Take, progress: Callable[[int], object] | None = None) -> Any:
+def build_stage(
+    take: Take, progress: Callable[[int], object] | None = None, locators: bool = True
+) -> Any:
     """An in-memory `Usd.Stage` holding the take; `progress(1)` after each body."""
     pxr = _pxr()
+    importlib.import_module("pxr.UsdShade")
     UsdGeom = pxr.UsdGeom
     stage = new_stage(take)
     root = UsdGeom.Xform.Define(stage, "/World")
     stage.SetDefaultPrim(root.GetPrim())
     header = take.header
     shown = take.visible()
+    colours = take_colours(take)
     for index, creature in enumerate(header["creatures"]):
         base = f"/World/{creature['name']}"
         UsdGeom.Xform.Define(stage, base)
         mark_rate(stage, base, take)
         key_visibility(stage, base, shown[:, index])
-        _body(pxr, stage, take, creature["mantle"])
+        colour = colours[creature["name"]]
+        skin = (usd_material(pxr, stage, creature["name"], colour), colour)
+        _body(pxr, stage, take, creature["mantle"], skin)
         if progress is not None:
             progress(1)
         UsdGeom.Xform.Define(stage, f"/World/{unique_path(creature['name'] + '/tentacles')}")
@@ -134,27 +153,31 @@ def build_stage(take: Take, progress: Callable[[int], object] | None = None) -> 
             folder = unique_path(f"{creature['name']}/tentacles/t{k}")
             UsdGeom.Xform.Define(stage, f"/World/{folder}")
             for index in chain:
-                _body(pxr, stage, take, index)
+                _body(pxr, stage, take, index, skin)
                 if progress is not None:
                     progress(1)
-    for index, sucker in enumerate(header["suckers"]):
-        _sucker(pxr, stage, take, index, sucker)
-    write_tracks(pxr, stage, take)
+    if locators:
+        for index, sucker in enumerate(header["suckers"]):
+            _sucker(pxr, stage, take, index, sucker)
+    write_tracks(pxr, stage, take, locators)
     write_usd_ground(pxr, stage, take)
     return stage
 
 
-def write_tracks(pxr: Any, stage: Any, take: Take) -> None:
-    """Every track of the take onto the stage, by kind (locators or curves)."""
+def write_tracks(pxr: Any, stage: Any, take: Take, locators: bool = True) -> None:
+    """Every track of the take onto the stage, by kind: curves, and with `locators` the
+    points tracks' locators."""
     for track in take.track_list():
         if track.kind == "points":
+            if not locators:
+                continue
             for index, item in enumerate(take.header[track.key]):
                 _locator(pxr, stage, take, track, index, item)
         elif take.tracks.get(track.arrays[0]) is not None:
             _curves(pxr, stage, take, track)
 
 
-def _body(pxr: Any, stage: Any, take: Take, index: int) -> None:
+def _body(pxr: Any, stage: Any, take: Take, index: int, skin: tuple[Any, np.ndarray]) -> None:
     Gf, UsdGeom = pxr.Gf, pxr.UsdGeom
     body = take.header["bodies"][index]
     xform = UsdGeom.Xform.Define(stage, f"/World/{unique_path(body['name'])}")
@@ -177,6 +200,7 @@ def _body(pxr: Any, stage: Any, take: Take, index: int) -> None:
     half = [radius, radius, radius]
     half["XYZ".index(body["axis"])] = 0.5 * length + (radius if kind is UsdGeom.Capsule else 0.0)
     geom.CreateExtentAttr([Gf.Vec3f(*(-h for h in half)), Gf.Vec3f(*half)])
+    bind_usd(pxr, geom.GetPrim(), *skin)  # the creature's material (skin, colour)
 
 
 def _sucker(pxr: Any, stage: Any, take: Take, index: int, sucker: dict[str, Any]) -> None:
