@@ -161,6 +161,24 @@ class Quad:
         return 1
 
 
+class ScreenTriangle:
+    """One triangle that covers the whole picture (normalised device coordinates): the sky."""
+
+    def __init__(self) -> None:
+        data = np.array([[-1.0, -1.0], [3.0, -1.0], [-1.0, 3.0]], np.float32)
+        self.vao = _vertex_array()
+        gl.glBindVertexArray(self.vao)
+        self.buffer = _buffer()
+        _upload(gl.GL_ARRAY_BUFFER, self.buffer, data, [0])
+        _attribute(0, 2, 2 * FLOAT, 0)
+        gl.glBindVertexArray(0)
+
+    def draw(self) -> int:
+        gl.glBindVertexArray(self.vao)
+        gl.glDrawArrays(gl.GL_TRIANGLES, 0, 3)
+        return 1
+
+
 @dataclass
 class Target:
     """An off-screen RGBA8 colour + depth framebuffer of a fixed size."""

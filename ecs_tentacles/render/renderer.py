@@ -1,5 +1,7 @@
-"""Draws a World: the ground (the plane's grid, or the terrain and obstacles as lit
-meshes, `ecs_tentacles.ground_mesh`), creatures, and what the plugins hand it.
+"""Draws a World: the sky, the ground (the plane's grid, or the terrain and obstacles as
+lit meshes, `ecs_tentacles.ground_mesh`, with the ground beyond the terrain out to the
+horizon, `render.horizon`), creatures, and what the plugins hand it; distance fog in the
+sky's horizon colour joins the ground to the sky.
 
 Creatures are drawn skinned by default (`view = "skinned"`: one continuous mesh per
 creature, skinned on the GPU, all creatures in one draw; `ecs_tentacles.render.skinned`)
@@ -37,17 +39,19 @@ from ecs_tentacles.render.gpu import (
     InstancedMesh,
     Lines,
     Quad,
+    ScreenTriangle,
     Target,
     program,
     set_matrix,
 )
+from ecs_tentacles.render.horizon import HORIZON, REACH, ZENITH, beyond_mesh, fog_range
 from ecs_tentacles.render.instances import CreatureStatic, creature_links, link_instances
 from ecs_tentacles.render.meshes import CAPSULE_LODS, CYLINDER_LOD, SPHERE_LOD, Mesh
 from ecs_tentacles.render.skinned import SkinnedCreatures
 from ecs_tentacles.roster_change import RosterChange
 from ecs_tentacles.world import World
 
-SKY = (0.70, 0.76, 0.82)
+SKY = HORIZON  # what is behind everything at the horizon (the sky is drawn over it)
 LIGHT = np.array([0.35, -0.45, 0.82]) / np.linalg.norm([0.35, -0.45, 0.82])
 LOD_DISTANCE = 6.0  # metres from the eye beyond which links use the lean mesh
 SHADOW_EVERY = 3  # a blob under every third link (each wider), and under every mantle
@@ -76,7 +80,9 @@ class Renderer:
         self.skinned_program = program(shaders.SKINNED_VERTEX, shaders.LIT_FRAGMENT)
         self.skinned = SkinnedCreatures()
         self.view = "skinned"
-        self.ground = Quad(200.0)
+        self.ground = Quad(REACH)  # the plane, out to where the fog has hidden it
+        self.sky_program = program(shaders.SKY_VERTEX, shaders.SKY_FRAGMENT)
+        self.sky = ScreenTriangle()
         self.mantles = InstancedMesh(CYLINDER_LOD)
         self.links_near = InstancedMesh(CAPSULE_LODS[0])
         self.links_far = InstancedMesh(CAPSULE_LODS[1])
@@ -190,8 +196,9 @@ class Renderer:
         self.sucker_radii = radius_of_row[suckers.link_row[: len(suckers)]]
 
     def _build_ground(self) -> None:
-        """The ground's meshes (terrain, obstacles) as two one-instance meshes; made again
-        only when the world has another ground (a new world, a terrain edit)."""
+        """The ground's meshes (terrain, the ground beyond it, obstacles) as one-instance
+        meshes; made again only when the world has another ground (a new world, a terrain
+        edit)."""
         ground = ground_of(self.world)
         if ground is self.ground_drawn:
             return
@@ -202,6 +209,7 @@ class Renderer:
         terrain, solids = ground_meshes(ground)
         for mesh, colour, grid in (
             (terrain, COLOURS["terrain"], 1.0),
+            (beyond_mesh(ground), COLOURS["terrain"], 0.0),  # on to the horizon, no grid
             (solids, COLOURS["obstacles"], 0.0),
         ):
             if mesh is None:
@@ -338,20 +346,23 @@ class Renderer:
         gl.glEnable(gl.GL_CULL_FACE)
         view_projection = self.camera.view_projection()
         eye = tuple(self.camera.eye.astype(np.float32))
-        calls = 0
+        calls = self._draw_sky(view_projection)
+        fog = fog_range(self.camera.distance)
         self._build_ground()  # nothing to do unless the terrain was edited
         if ground_of(self.world).heightfield is None:  # the plane's grid
             self.ground_program.use()
             set_matrix(self.ground_program, "u_view_projection", view_projection)
             self.ground_program["u_eye"] = eye
+            _set_fog(self.ground_program, fog)
             gl.glDisable(gl.GL_CULL_FACE)
             calls += self.ground.draw()
             gl.glEnable(gl.GL_CULL_FACE)
-        if self.ground_meshes:  # terrain and obstacles: lit, two draws whatever their size
+        if self.ground_meshes:  # terrain, beyond it, obstacles: lit, three draws at most
             self.terrain_program.use()
             set_matrix(self.terrain_program, "u_view_projection", view_projection)
             self.terrain_program["u_light"] = tuple(LIGHT.astype(np.float32))
             self.terrain_program["u_eye"] = eye
+            _set_fog(self.terrain_program, fog)
             for mesh in self.ground_meshes:
                 calls += mesh.draw()
         # the blob shadows: blended over the ground, never hiding what is drawn after
@@ -369,6 +380,7 @@ class Renderer:
         set_matrix(self.lit, "u_view_projection", view_projection)
         self.lit["u_light"] = tuple(LIGHT.astype(np.float32))
         self.lit["u_eye"] = eye
+        _set_fog(self.lit, fog)
         for mesh in (self.mantles, self.links_near, self.links_far, self.spheres):
             calls += mesh.draw()
         calls += self.sucker_discs.draw()
@@ -377,6 +389,7 @@ class Renderer:
             set_matrix(self.skinned_program, "u_view_projection", view_projection)
             self.skinned_program["u_light"] = tuple(LIGHT.astype(np.float32))
             self.skinned_program["u_eye"] = eye
+            _set_fog(self.skinned_program, fog)
             self.skinned_program["u_palette"] = 0
             calls += self.skinned.draw()
         self.line_program.use()
@@ -388,6 +401,19 @@ class Renderer:
         gl.glBindVertexArray(0)
         gl.glUseProgram(0)
         self.draw_calls = calls
+        return calls
+
+    def _draw_sky(self, view_projection: np.ndarray) -> int:
+        """The sky's gradient behind everything (no depth written)."""
+        self.sky_program.use()
+        set_matrix(self.sky_program, "u_inverse_view_projection", np.linalg.inv(view_projection))
+        self.sky_program["u_horizon"] = HORIZON
+        self.sky_program["u_zenith"] = ZENITH
+        gl.glDisable(gl.GL_DEPTH_TEST)
+        gl.glDepthMask(gl.GL_FALSE)
+        calls = self.sky.draw()
+        gl.glDepthMask(gl.GL_TRUE)
+        gl.glEnable(gl.GL_DEPTH_TEST)
         return calls
 
     def frame_all(self) -> None:
@@ -412,3 +438,9 @@ class Renderer:
         self.camera.distance *= span
         self.camera.follow = int(self.mantle_rows[index])
         self.upload()  # the target on the creature now
+
+
+def _set_fog(prog: Any, fog: tuple[float, float]) -> None:
+    """The distance fog's uniforms (`render.horizon`) on a program that fogs."""
+    prog["u_fog_colour"] = HORIZON
+    prog["u_fog_start"], prog["u_fog_end"] = fog

@@ -40,8 +40,24 @@ uniform vec3 u_eye;
 out vec4 f_colour;
 """
 
+# distance fog: what is far off fades into the sky's colour at the horizon; it starts
+# beyond the point looked at (`u_fog_start`) and is all but complete at `u_fog_end` (the
+# renderer sets both from the camera's distance), so the ground meets the sky
+_FOG_FUNCTION = """uniform vec3 u_fog_colour;
+uniform float u_fog_start;
+uniform float u_fog_end;
+float fog_amount(vec3 world) {
+    float t = max(length(world - u_eye) - u_fog_start, 0.0) / (u_fog_end - u_fog_start);
+    return 1.0 - exp(-3.0 * t);  // a haze that thickens, 95 % at u_fog_end
+}
+vec3 fogged(vec3 colour, vec3 world) {
+    return mix(colour, u_fog_colour, fog_amount(world));
+}
+"""
+
 LIT_FRAGMENT = (
     _LIT_HEAD
+    + _FOG_FUNCTION
     + """void main() {
     vec3 n = normalize(v_normal);
     float diffuse = max(dot(n, u_light), 0.0);
@@ -51,7 +67,7 @@ LIT_FRAGMENT = (
     vec3 half_vector = normalize(u_light + view);
     float specular = pow(max(dot(n, half_vector), 0.0), 24.0) * 0.25;
     vec3 colour = v_colour.rgb * (0.32 + 0.25 * sky + 0.6 * diffuse) + rim + specular;
-    f_colour = vec4(colour, v_colour.a);
+    f_colour = vec4(fogged(colour, v_world), v_colour.a);
 }
 """
 )
@@ -73,32 +89,39 @@ _GRID = """float grid(vec2 p, float spacing, float width) {
     return 1.0 - min(min(g.x, g.y) / width, 1.0);
 }
 """
-# the ground fades into the sky colour with distance
-_FOG = """    float fog = clamp(length(v_world - u_eye) / 60.0, 0.0, 1.0);
-    f_colour = vec4(mix(colour, vec3(0.70, 0.76, 0.82), fog * fog), 1.0);
+# the ground fades into the sky's colour at the horizon with distance
+_FOG = """    f_colour = vec4(fogged(colour, v_world), 1.0);
 """
 
-GROUND_FRAGMENT = """
+GROUND_FRAGMENT = (
+    """
 #version 330 core
 in vec3 v_world;
 uniform vec3 u_eye;
 out vec4 f_colour;
 // @grid
+// @fog_function
 void main() {
     // sand, lit as the terrain is from straight above, with a faint quarter-metre and
-    // a clearer metre grid for scale; low-frequency mottling so it reads as ground
+    // a clearer metre grid for scale (gone in the haze, where it would only shimmer);
+    // low-frequency mottling so it reads as ground
     vec2 p = v_world.xy;
     float mottle = 0.04 * sin(p.x * 1.7 + sin(p.y * 1.3)) * sin(p.y * 2.1 + sin(p.x * 0.9));
     vec3 base = vec3(0.66, 0.59, 0.47) * (1.0 + mottle);
-    float fine = grid(p, 0.25, 1.0) * 0.06;
-    float coarse = grid(p, 1.0, 1.5) * 0.18;
+    float clear = 1.0 - fog_amount(v_world);
+    float fine = grid(p, 0.25, 1.0) * 0.06 * clear;
+    float coarse = grid(p, 1.0, 1.5) * 0.18 * clear;
     vec3 colour = mix(base, base * 0.62, fine + coarse);
     // @fog
 }
-""".replace("// @grid\n", _GRID).replace("    // @fog\n", _FOG)
+""".replace("// @grid\n", _GRID)
+    .replace("// @fog_function\n", _FOG_FUNCTION)
+    .replace("    // @fog\n", _FOG)
+)
 
 TERRAIN_FRAGMENT = (
     _LIT_HEAD
+    + _FOG_FUNCTION
     + """// @grid
 void main() {
     vec3 n = normalize(gl_FrontFacing ? v_normal : -v_normal);
@@ -106,11 +129,40 @@ void main() {
     float sky = 0.5 + 0.5 * n.z;
     vec3 colour = v_colour.rgb * (0.30 + 0.25 * sky + 0.62 * diffuse);
     // a faint metre grid on the ground (scale at a glance), as on the plane
-    colour = mix(colour, colour * 0.6, grid(v_world.xy, 1.0, 1.5) * 0.35 * v_colour.a);
+    float clear = 1.0 - fog_amount(v_world);
+    colour = mix(colour, colour * 0.6, grid(v_world.xy, 1.0, 1.5) * 0.35 * v_colour.a * clear);
     // @fog
 }
 """.replace("// @grid\n", _GRID).replace("    // @fog\n", _FOG)
 )
+
+# the sky behind everything: a full-screen triangle whose pixels look along their view
+# ray, hazy at the horizon (the fog's colour) and bluer toward the zenith
+SKY_VERTEX = """
+#version 330 core
+layout(location = 0) in vec2 a_position;
+out vec2 v_ndc;
+void main() {
+    v_ndc = a_position;
+    gl_Position = vec4(a_position, 1.0, 1.0);
+}
+"""
+
+SKY_FRAGMENT = """
+#version 330 core
+in vec2 v_ndc;
+uniform mat4 u_inverse_view_projection;
+uniform vec3 u_horizon;
+uniform vec3 u_zenith;
+out vec4 f_colour;
+void main() {
+    vec4 near = u_inverse_view_projection * vec4(v_ndc, -1.0, 1.0);
+    vec4 far = u_inverse_view_projection * vec4(v_ndc, 1.0, 1.0);
+    vec3 direction = normalize(far.xyz / far.w - near.xyz / near.w);
+    float up = clamp(direction.z, 0.0, 1.0);
+    f_colour = vec4(mix(u_horizon, u_zenith, pow(up, 0.55)), 1.0);
+}
+"""
 
 BLOB_VERTEX = """
 #version 330 core

@@ -104,7 +104,7 @@ def test_a_user_plugin_draws_adds_a_panel_and_takes_clicks(
     assert {"Beacon", "beacon text"} <= set(sandbox.hud.gui.rects)  # its HUD section
     sandbox.hud.visible = False
     calls = sandbox.renderer.draw()
-    assert calls == 9 + 1  # the renderer's own (skinned view) and the plugin's
+    assert calls == 10 + 1  # the renderer's own (skinned view, the sky) and the plugin's
     pixels = sandbox.renderer.target.read()
     assert tuple(pixels[-3, 3]) == (0, 255, 255)  # its own GL drawing, bottom left
     sx, sy = camera.project(np.array([module.SPHERE]))[0]
@@ -143,7 +143,7 @@ def test_the_sandbox_runs_with_fur_and_locomotion_off(
     assert {"Stats", "Physics", "Plugins"} <= set(rects)
     assert not {"Locomotion", "Actions", "Fur"} & set(rects)
     # ground, shadows, 4 meshes, sucker discs, skinned, lines
-    assert sandbox.renderer.draw_calls == 9
+    assert sandbox.renderer.draw_calls == 10
     pixels = sandbox.renderer.target.read().astype(int)
     top = sandbox.world.transforms.pos[sandbox.renderer.mantle_rows[0]]
     mx, my = sandbox.renderer.camera.project(top[None])[0]

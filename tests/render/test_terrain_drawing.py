@@ -36,7 +36,8 @@ def test_terrain_and_obstacles_are_drawn_and_clicks_land_on_them(
     camera.shift_x = 0.0
     camera.fit(np.vstack([top, [[-1.0, -1.2, 0.0], [-0.5, 0.0, 0.0]]]), border=0.2)
     calls = sandbox.renderer.draw()
-    assert calls == 9 + 1  # the grid's draw gives way to the terrain's and the obstacles'
+    # the grid's draw gives way to the terrain's, the ground beyond it and the obstacles'
+    assert calls == 10 + 2
     pixels = sandbox.renderer.target.read().astype(int)
     tx, ty = camera.project(top)[0]
     r, g, b = pixels[camera.height - round(ty), round(tx)]
@@ -73,7 +74,7 @@ def test_the_terrain_section_places_moves_and_deletes_with_the_mouse(
         {"version": 1, "terrain": {"heightfield": HILLS}, "creatures": [{"name": "octo"}]}
     )
     sandbox.hud.visible = False
-    assert sandbox.renderer.draw() == 9  # the terrain in place of the grid, no obstacles
+    assert sandbox.renderer.draw() == 11  # the terrain and beyond for the grid, no obstacles
     panel = next(p for p in sandbox.hud.panels if isinstance(p, TerrainPanel))
     camera = sandbox.renderer.camera
     spot = np.array([[1.5, -1.2, _hill_height(sandbox, 1.5, -1.2)]])
@@ -84,7 +85,7 @@ def test_the_terrain_section_places_moves_and_deletes_with_the_mouse(
     event(sandbox, "on_mouse_release", px, py, mouse.LEFT, 0)
     (box,) = sandbox.world.scene["terrain"]["obstacles"]
     assert np.linalg.norm(np.array(box["position"][:2]) - spot[0, :2]) < 0.05
-    assert sandbox.renderer.draw() == 10  # and the obstacles
+    assert sandbox.renderer.draw() == 12  # and the obstacles
     assert panel.message == "placed"
 
     panel.tool = "delete"
@@ -93,7 +94,7 @@ def test_the_terrain_section_places_moves_and_deletes_with_the_mouse(
     event(sandbox, "on_mouse_press", tx, ty, mouse.LEFT, 0)
     event(sandbox, "on_mouse_release", tx, ty, mouse.LEFT, 0)
     assert sandbox.world.scene["terrain"]["obstacles"] == []
-    assert sandbox.renderer.draw() == 9
+    assert sandbox.renderer.draw() == 11
 
     panel.tool = "raise"
     before = _hill_height(sandbox, 1.5, -1.2)
