@@ -1,5 +1,7 @@
 """tools/blender_import.py in Blender (bpy 5.0.1): exports open at their own frame rate
-and range, with one material and names as written."""
+and range, each creature in a material of its sandbox colour, names as written, and no
+objects an artist did not ask for (locators only with --locators, no bone shapes, no
+empties for material scopes)."""
 
 from __future__ import annotations
 
@@ -9,9 +11,11 @@ import subprocess
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 
 from ecs_tentacles.cli import main
+from ecs_tentacles.colours import creature_colours, to_linear
 
 BLENDER = os.environ.get("ECS_TENTACLES_BLENDER_PYTHON", "")
 TOOL = Path(__file__).resolve().parents[2] / "tools" / "blender_import.py"
@@ -54,7 +58,7 @@ def test_an_export_opens_in_blender_at_its_rate_and_range(tmp_path: Path, suffix
     found = json.loads(read.stdout.splitlines()[-1])
     assert found["fps"] == 30 and found["range"] == [0, 30]  # 31 frames, 1 s at 30 fps
     assert found["actions"] and all(a == [0.0, 30.0] for a in found["actions"])
-    assert found["materials"] == ["skin"]  # USD imports it too, not grey
+    assert found["materials"] == ["octopus_skin"]  # USD imports it too, not grey
 
 
 GROUND = """
@@ -161,3 +165,103 @@ def test_every_creature_plays_in_blender(tmp_path: Path, suffix: str) -> None:
     for name, armature in found.items():
         assert armature["action"], f"{name} has no active action"
         assert armature["moved"] > 0.01, f"{name} does not move"
+
+
+LOOKS = """
+import json, sys, bpy
+bpy.ops.wm.open_mainfile(filepath=sys.argv[1])
+def colour(material):
+    nodes = material.node_tree.nodes
+    image = next((n.image for n in nodes if n.type == "TEX_IMAGE"), None)
+    if image is not None:  # a texture: its mean over the half away from the underside
+        w, h = image.size
+        px = list(image.pixels)
+        rows = [px[4 * (y * w + x): 4 * (y * w + x) + 3] for y in range(h) for x in range(w // 2)]
+        return ["texture", [sum(r[i] for r in rows) / len(rows) for i in range(3)]]
+    bsdf = next(n for n in nodes if n.type == "BSDF_PRINCIPLED")
+    return ["factor", list(bsdf.inputs["Base Color"].default_value)[:3]]
+print(json.dumps({
+    "all_objects": sorted(o.name for o in bpy.data.objects),
+    "meshes": {o.name: [m.name for m in o.data.materials]
+               for o in bpy.data.objects if o.type == "MESH"},
+    "colours": {m.name: colour(m) for m in bpy.data.materials},
+}))
+"""
+FOUR = [f"creature_{i}" for i in range(4)]
+
+
+@pytest.fixture(scope="module")
+def four_take(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """thesis_four_by_six, 0.5 s at 30 fps: four creatures of six tentacles, a goal each."""
+    take = tmp_path_factory.mktemp("four") / "four.npz"
+    argv = ["bake", "thesis_four_by_six", "--seconds", "0.5", "--fps", "30", "--quiet"]
+    assert main([*argv, "--out", str(take)]) == 0
+    return take
+
+
+def _report(take: Path, blend: Path) -> tuple[dict[str, Any], dict[str, Any]]:
+    """Import `take` with `--report`: (the tool's report, what LOOKS reads back)."""
+    done = subprocess.run(
+        [BLENDER, str(TOOL), str(take), "--out", str(blend), "--report"],
+        capture_output=True,
+        text=True,
+        timeout=180,
+    )
+    assert done.returncode == 0, done.stderr
+    report: dict[str, Any] = json.loads(done.stdout.splitlines()[-2])
+    read = subprocess.run(
+        [BLENDER, "-c", LOOKS, str(blend)], capture_output=True, text=True, timeout=120
+    )
+    return report, json.loads(read.stdout.splitlines()[-1])
+
+
+@pytest.mark.parametrize("suffix", [".glb", ".usdc"])
+def test_a_skinned_import_holds_what_the_artist_animates_and_nothing_else(
+    four_take: Path, tmp_path: Path, suffix: str
+) -> None:
+    """Four armatures that animate, four skins each in its creature's sandbox colour, the
+    World (and in USD each creature's SkelRoot) as the only empties: no locators unless
+    asked for, no `materials` scope empties, no Icosphere bone shapes."""
+    out = tmp_path / f"four{suffix}"
+    assert main(["export", str(four_take), "--out", str(out), "--quiet"]) == 0
+    report, looks = _report(out, tmp_path / "four.blend")
+    roots = FOUR if suffix == ".usdc" else []
+    assert report["empties"] == sorted(["World", *roots])
+    assert report["by_type"] == {"ARMATURE": 4, "EMPTY": 1 + len(roots), "MESH": 4}
+    assert (report["armatures"], report["animating"], report["outside_scene"]) == (4, 4, [])
+    assert not [n for n in looks["all_objects"] if "Icosphere" in n or "materials" in n]
+    assert looks["meshes"] == {f"{c}_skin": [f"{c}_skin"] for c in FOUR}
+    for c, srgb in zip(FOUR, creature_colours(4), strict=True):
+        kind, colour = looks["colours"][f"{c}_skin"]
+        if kind == "texture":  # sRGB bytes as Blender reads them; rings: 0.9 on average
+            np.testing.assert_allclose(np.array(colour) / 0.9, srgb, atol=0.02)
+        else:
+            np.testing.assert_allclose(colour, to_linear(srgb), atol=1e-4)
+
+
+@pytest.mark.parametrize("suffix", [".glb", ".usdc"])
+def test_locators_come_in_as_empties_only_with_the_option(
+    four_take: Path, tmp_path: Path, suffix: str
+) -> None:
+    out = tmp_path / f"four{suffix}"
+    argv = ["export", str(four_take), "--out", str(out), "--quiet", "--locators"]
+    assert main(argv) == 0
+    report, _ = _report(out, tmp_path / "four.blend")
+    suckers = [e for e in report["empties"] if "_sucker" in e and not e.endswith("_suckers")]
+    goals = [e for e in report["empties"] if e.endswith("_goal0")]
+    assert (len(suckers), len(goals)) == (4 * 6, 4)  # a tip sucker per tentacle, a goal each
+    assert report["animating"] == 4
+
+
+def test_a_rigid_usd_gives_every_capsule_its_creatures_material(
+    four_take: Path, tmp_path: Path
+) -> None:
+    """Blender's USD importer binds no material to Capsule and Cylinder prims: the tool
+    binds each to its creature's."""
+    out = tmp_path / "rigid.usdc"
+    assert main(["export", str(four_take), "--out", str(out), "--quiet", "--rigid"]) == 0
+    report, looks = _report(out, tmp_path / "rigid.blend")
+    assert report["by_type"]["MESH"] == 4 * (1 + 6 * 10)
+    for mesh, materials in looks["meshes"].items():
+        assert materials == [f"{mesh.split('_')[0]}_{mesh.split('_')[1]}_skin"], mesh
+    assert sorted(looks["colours"]) == [f"{c}_skin" for c in FOUR]
