@@ -1,16 +1,17 @@
 """The heads-up display: the selected creature, live stats, and the plugins' sections.
 
 Drawn with Dear ImGui (`render.gui`): a panel on the left, as wide as the window
-allows, in collapsible sections. The HUD's own: "Stats" shows fps, physics ms,
-simulated time, real-time factor and attached suckers; "Physics" the groups, threads,
-recoveries and frozen creatures, the creatures per level-of-detail tier (coloured as
-the tier markers: the legend), promotions and demotions, and the "show tiers" box;
-"Plugins" the plugins on and every system, with a box to switch it off. Plugins add
-sections through `panels` (`ecs_tentacles.drawing.Panel`, from their `sandbox_panels`
-hooks: locomotion's sliders and actions, the fur tool), placed by their `order`;
-`sections` takes bare (title, draw) pairs and `windows` more ImGui windows. The HUD
-keeps the selection (a creature, and one tentacle or all) and tells every panel when
-it changes.
+allows, in collapsible sections, one open at a time (opening one folds the others, so
+every header stays in view at 720p, whatever a creature brings: `open`, `unfold`).
+The HUD's own: "Stats" shows fps, physics ms, simulated time, real-time factor and
+attached suckers; "Physics" the groups, threads, recoveries and frozen creatures, the
+creatures per level-of-detail tier (coloured as the tier markers: the legend),
+promotions and demotions, and the "show tiers" box; "Plugins" the plugins on and every
+system, with a box to switch it off. Plugins add sections through `panels`
+(`ecs_tentacles.drawing.Panel`, from their `sandbox_panels` hooks: locomotion's sliders
+and actions, the fur tool), placed by their `order`; `sections` takes bare (title,
+draw) pairs and `windows` more ImGui windows. The HUD keeps the selection (a creature,
+and one tentacle or all) and tells every panel when it changes.
 """
 
 from __future__ import annotations
@@ -37,7 +38,8 @@ def panel_width(width: int, height: int) -> int:
     return int(min(PANEL_WIDTH * gui_scale(height), PANEL_SHARE * width))
 
 
-CLOSED = ("Plugins",)  # own sections that start folded
+CLOSED = ("Plugins", "View")  # own and bare sections that start folded
+UNSET = "\0"  # `Hud.open` before the first frame
 
 
 class Hud:
@@ -55,6 +57,9 @@ class Hud:
         self.sections: list[tuple[str, Callable[[Gui], None]]] = []  # (title, draw)
         self.windows: list[Callable[[Gui], None]] = []  # more ImGui windows (the timeline)
         self._fold: set[str] = set()  # sections to close on the next frame
+        # one section open at a time (opening one folds the others): its title, None for
+        # all folded, UNSET until the first frame picks the first that starts open
+        self.open: str | None = UNSET
         self.name_labels = False  # creatures' names over them (even with the panel hidden)
         self.label_at: Callable[[], list[tuple[str, float, float]]] = list  # (text, x, y)
         # the selected creature's name over it, while the panel shows (labels off)
@@ -93,6 +98,10 @@ class Hud:
     def fold(self, *sections: str) -> None:
         """Close these sections (as a click on their headers would)."""
         self._fold.update(sections)
+
+    def unfold(self, section: str) -> None:
+        """Open `section` (the others fold, as a click on its header would do)."""
+        self.open = section
 
     def contains(self, x: float, y: float) -> bool:
         """True when pyglet pixel (x, y) is over the panel (clicks there are not for the world)."""
@@ -139,16 +148,24 @@ class Hud:
         ]
         plugged = [(p.order, p.title, p.draw, p.closed) for p in self.panels]
         bare = [(SECTION_ORDER, name, build, name in CLOSED) for name, build in self.sections]
-        for _, name, build, closed in sorted([*own, *plugged, *bare], key=lambda s: s[0]):
-            if name in self._fold:
-                imgui.set_next_item_open(False)
-                self._fold.discard(name)
-            opened = imgui.collapsing_header(
-                name, imgui.TreeNodeFlags_.default_open if not closed else 0
-            )
+        sections = sorted([*own, *plugged, *bare], key=lambda s: s[0])
+        if self.open == UNSET:  # the first section that starts open is the one open
+            self.open = next((name for _, name, _, closed in sections if not closed), None)
+        if self.open in self._fold:
+            self.open = None
+        self._fold.clear()
+        chosen = self.open
+        for _, name, build, _ in sections:
+            imgui.set_next_item_open(name == self.open, imgui.Cond_.always)
+            opened = imgui.collapsing_header(name)
             gui.item(name)
+            if opened and name != self.open:
+                chosen = name  # opened by a click: the others fold from the next frame
+            elif not opened and name == self.open:
+                chosen = None if chosen == name else chosen  # folded by a click
             if opened:
                 build(gui)
+        self.open = chosen
         imgui.end()
         for window in self.windows:
             window(gui)

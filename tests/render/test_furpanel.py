@@ -22,13 +22,13 @@ from tests.render.conftest import click_item, event
 
 
 def tool(make_sandbox: Callable[..., Any]) -> Any:
-    """The hedgehog in a tall window, paused after one frame, the other sections folded."""
+    """The hedgehog in a tall window, paused after one frame, the Fur section opened (the
+    others fold)."""
     sandbox = make_sandbox("hedgehog_octopus", width=1280, height=1440)
     sandbox.step(1)
     sandbox.paused = True
     sandbox.render()
-    for section in ("Locomotion", "Stats", "Physics"):
-        click_item(sandbox, section)
+    click_item(sandbox, "Fur")
     assert "speed" not in sandbox.hud.gui.rects
     return sandbox
 
@@ -230,6 +230,7 @@ def test_the_timeline_shows_only_for_a_creature_with_fur(make_sandbox: Callable[
     sandbox.render()
     assert "timeline" in sandbox.hud.gui.windows
     sandbox.select(sandbox.world.creature("bare"))
+    sandbox.hud.unfold("Fur")
     sandbox.render()
     assert "no fur" in sandbox.hud.gui.rects  # the section says so
     assert "timeline" not in sandbox.hud.gui.windows  # and shows no timeline

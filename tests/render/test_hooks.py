@@ -100,6 +100,7 @@ def test_a_user_plugin_draws_adds_a_panel_and_takes_clicks(
     assert sandbox.hud.width < x < 640 and 0 < y < 360
 
     sandbox.step(2)
+    sandbox.hud.unfold("Beacon")
     sandbox.render()
     assert {"Beacon", "beacon text"} <= set(sandbox.hud.gui.rects)  # its HUD section
     sandbox.hud.visible = False

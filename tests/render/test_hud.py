@@ -35,9 +35,13 @@ def test_widgets_never_overlap_and_fit_the_panel(
     sandbox = make_sandbox("hedgehog_octopus", width=size[0], height=size[1])
     sandbox.hud.sections.append(("Extra", lambda gui: None))
     sandbox.render()
-    rects = sandbox.hud.gui.rects
-    assert {"speed label", "speed", "wave_amplitude label", "gait label", "models"} <= set(rects)
+    rects = dict(sandbox.hud.gui.rects)
+    assert {"speed label", "speed", "wave_amplitude label", "gait label"} <= set(rects)
     assert overlaps(rects) == []
+    sandbox.hud.unfold("Physics")  # one section open at a time: Locomotion folds
+    sandbox.render()
+    assert "models" in sandbox.hud.gui.rects and "speed" not in sandbox.hud.gui.rects
+    assert overlaps(sandbox.hud.gui.rects) == []
     x0, y0, x1, y1 = sandbox.hud.gui.windows["panel"]
     assert (x0, y0, x1, y1) == (0, 0, panel_width(*size), size[1])
     assert x1 <= PANEL_SHARE * size[0]

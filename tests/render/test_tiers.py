@@ -60,6 +60,7 @@ def test_hud_counts_tiers_and_its_box_shows_a_marker_per_creature(
     sandbox = make_sandbox(lod_crowd(), focus=(100.0, 100.0, 1.0))
     sandbox.select(None)
     sandbox.step(2)
+    sandbox.hud.unfold("Physics")
     sandbox.render()
     rects = sandbox.hud.gui.rects
     assert {"tier full", "tier reduced", "tier kinematic", "promotions", "show tiers"} <= set(rects)
