@@ -71,6 +71,13 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
             " look at TX,TY,TZ); default: every creature framed at the start"
         ),
     )
+    parser.add_argument(
+        "--palette",
+        choices=("natural", "debug"),
+        default="natural",
+        help="creature colours: natural (muted skin tones, one per species; the default)"
+        " or debug (a bright colour per creature)",
+    )
     parser.add_argument("--seed", type=seed_int, default=None, help="override the scene's seed")
     parser.add_argument("--allow-systems", action="store_true", help="run systems the scene names")
     shown = parser.add_mutually_exclusive_group()
@@ -132,6 +139,7 @@ def handle(args: argparse.Namespace) -> int:
         lod=lod_choice(args),
         focus=args.focus,
         threads=args.threads,
+        palette=args.palette,
     )
     try:
         if args.camera is not None:

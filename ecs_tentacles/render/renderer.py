@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 from pyglet import gl
 
-from ecs_tentacles.colours import creature_colours
+from ecs_tentacles.colours import PALETTES, Look, creature_colour, look_in_world
 from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.drawing import CIRCLE, RenderView
 from ecs_tentacles.ground import ground_of
@@ -98,6 +98,7 @@ class Renderer:
         self.overlays = False  # editing aids wanted (the sandbox sets it while its HUD shows)
         self.show_tiers = False  # a marker per creature coloured by physics tier (render.tiers)
         self.state: dict[str, Any] = {}  # what plugins keep here (GL objects), across worlds
+        self.palette = "natural"  # the creatures' colours (`ecs_tentacles.colours`)
         self.set_world(world)
 
     def set_world(self, world: World) -> None:
@@ -105,7 +106,8 @@ class Renderer:
         self.world = world
         self.selected = None
         self.selection = ()
-        self._colour_index: dict[int, int] = {}  # creature entity -> its colour, kept
+        self._colour_index: dict[int, int] = {}  # creature entity -> its place, kept
+        self._looks: dict[int, Look] = {}  # creature entity -> what its colour is from
         self._static: dict[int, CreatureStatic] = {}  # creature entity -> its link table
         self.skinned.forget_all()
         self._stale = False
@@ -157,10 +159,13 @@ class Renderer:
         creatures = sorted(world.query(Creature, Transform))
         self._entities = [e for e, _ in creatures]
         self._index_of = {e: i for i, e in enumerate(self._entities)}
-        for entity in self._entities:  # the next colour for a newcomer
+        for entity in self._entities:  # the next place (debug colour) for a newcomer
             self._colour_index.setdefault(entity, len(self._colour_index))
-        palette = creature_colours(len(self._colour_index))
-        colours = palette[[self._colour_index[e] for e in self._entities]].reshape(-1, 3)
+            if entity not in self._looks:
+                self._looks[entity] = look_in_world(world, entity, self._colour_index[entity])
+        colours = np.array(
+            [creature_colour(self._looks[e], self.palette) for e in self._entities]
+        ).reshape(-1, 3)
         self.creature_colour = {e: colours[i] for i, e in enumerate(self._entities)}
         mantle = np.zeros((len(creatures), INSTANCE_FLOATS), np.float32)
         self._mantle_rows = np.array([t.row for _, (_, t) in creatures], dtype=np.int64)
@@ -227,6 +232,15 @@ class Renderer:
             instance[0, 11:15] = (*colour, grid)  # alpha: how much of the metre grid shows
             drawn.update(instance)
             self.ground_meshes.append(drawn)
+
+    def set_palette(self, palette: str) -> None:
+        """Colour the creatures from `palette` ("natural" or "debug") from the next frame."""
+        if palette not in PALETTES:
+            raise ValueError(f"palette must be one of {', '.join(PALETTES)}, got {palette!r}")
+        if palette == self.palette:
+            return
+        self.palette = palette
+        self._stale = True  # the instance tables are made again, in the new colours
 
     def toggle_view(self) -> str:
         """Switch between the skinned and the capsule view; returns the new view."""

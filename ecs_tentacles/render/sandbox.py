@@ -35,15 +35,18 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pyglet
+from imgui_bundle import imgui
 from pyglet import gl
 from pyglet.window import key
 from tqdm import tqdm
 
+from ecs_tentacles.colours import PALETTES
 from ecs_tentacles.components import Creature
 from ecs_tentacles.drawing import Panel
 from ecs_tentacles.ground import ground_of
 from ecs_tentacles.plugin_registry import sandbox_plugins
 from ecs_tentacles.render.camera import CameraChoice
+from ecs_tentacles.render.gui import Gui, same_line_if_fits, text_width
 from ecs_tentacles.render.hud import Hud
 from ecs_tentacles.render.on_screen import creature_at, labels_over
 from ecs_tentacles.render.output import VideoWriter, save_png
@@ -85,10 +88,12 @@ class Sandbox:
         lod: bool | None = None,
         focus: tuple[float, float, float] | None = None,
         threads: int | None = None,
+        palette: str = "natural",
     ):
         """`lod` turns level of detail on or off over the scene's (None: the scene's);
         `focus` (x, y, radius in m) pins the full-physics region instead of the camera's;
-        `threads` step the physics (None: one per core)."""
+        `threads` step the physics (None: one per core); `palette` colours the creatures
+        ("natural" or "debug": `ecs_tentacles.colours`)."""
         self.threads = threads
         self.scene, self.seed, self.allow_systems = scene, seed, allow_systems
         self.lod, self.focus = lod, focus
@@ -104,10 +109,12 @@ class Sandbox:
         self.hud.selection_label = self.selected_label
         self.scripts = Scripts(self.window)
         self.hud.windows.append(self.scripts.draw)
+        self.hud.sections.append(("View", self._view_section))
         self.paused = False
         self.selection = Selection()
         self.panels: dict[str, list[Panel]] = {}  # each plugin's HUD sections, by plugin key
         self.camera_choice: CameraChoice | None = None  # `aim`'s, kept across resets
+        self.palette = palette  # kept across resets (the HUD's View section changes it)
         self._attach_world()
         self.input = SandboxInput(self)  # the mouse and the keys
         self.window.push_handlers(self)  # (on_draw)
@@ -148,8 +155,20 @@ class Sandbox:
         camera.target = target + ease * (camera.target - target)
         camera.distance = distance * (camera.distance / distance) ** ease
 
+    def _view_section(self, gui: Gui) -> None:
+        """The HUD's "View": the creatures' palette."""
+        imgui.text("colours")
+        gui.item("colours")
+        for name in PALETTES:
+            same_line_if_fits(text_width(name))
+            if imgui.radio_button(name, self.renderer.palette == name):
+                self.palette = name
+                self.renderer.set_palette(name)
+            gui.item(f"palette {name}")
+
     def _attach_world(self) -> None:
         self.renderer = Renderer(self.world, self.window.width, self.window.height)
+        self.renderer.set_palette(self.palette)
         self.renderer.camera.shift_x = self.hud.width / 2
         self._add_sandbox_plugins()
         self.renderer.frame_all()
