@@ -114,9 +114,11 @@ class InstancedMesh:
 
 
 class Lines:
-    """A list of coloured line segments, drawn in one call."""
+    """A list of coloured line segments (or, `triangles`, coloured triangles), drawn in
+    one call."""
 
-    def __init__(self) -> None:
+    def __init__(self, triangles: bool = False) -> None:
+        self.mode = gl.GL_TRIANGLES if triangles else gl.GL_LINES
         self.vao = _vertex_array()
         gl.glBindVertexArray(self.vao)
         self.buffer = _buffer()
@@ -136,7 +138,7 @@ class Lines:
 
     def draw(self) -> int:
         gl.glBindVertexArray(self.vao)
-        gl.glDrawArrays(gl.GL_LINES, 0, self.count)
+        gl.glDrawArrays(self.mode, 0, self.count)
         return 1
 
 

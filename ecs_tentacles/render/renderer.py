@@ -47,6 +47,7 @@ from ecs_tentacles.render.gpu import (
 from ecs_tentacles.render.horizon import HORIZON, REACH, ZENITH, beyond_mesh, fog_range
 from ecs_tentacles.render.instances import CreatureStatic, creature_links, link_instances
 from ecs_tentacles.render.meshes import CAPSULE_LODS, CYLINDER_LOD, SPHERE_LOD, Mesh
+from ecs_tentacles.render.outlines import outlined_ribbons
 from ecs_tentacles.render.skinned import SkinnedCreatures
 from ecs_tentacles.roster_change import RosterChange
 from ecs_tentacles.world import World
@@ -90,7 +91,7 @@ class Renderer:
         self.blob_program = program(shaders.BLOB_VERTEX, shaders.BLOB_FRAGMENT)
         self.shadows = InstancedMesh(QUAD)  # a soft blob under every mantle and link
         self.sucker_discs = InstancedMesh(SUCKER_DISC)
-        self.lines = Lines()
+        self.lines = Lines(triangles=True)  # every line as an outlined ribbon
         self.selected: int | None = None  # creature entity (the HUD's)
         self.selection: tuple[int, ...] = ()  # every selected creature (a ring each)
         self.draw_calls = 0
@@ -295,7 +296,9 @@ class Renderer:
             )
         )  # fmt: skip
         self.spheres.update(self._sphere_instances())
-        self.lines.update(self._line_vertices(pos))
+        camera = self.camera
+        per_metre = 2.0 * np.tan(camera.fov_y / 2) / camera.height  # a pixel 1 m away
+        self.lines.update(outlined_ribbons(self._line_vertices(pos), camera.eye, per_metre))
 
     def view_of_frame(self, pos: np.ndarray, quat: np.ndarray) -> RenderView:
         """The `RenderView` the plugins' hooks get this frame (kept in `render_view`)."""
@@ -341,14 +344,26 @@ class Renderer:
         chosen = self.selection or ((self.selected,) if self.selected is not None else ())
         if chosen:  # one ring round each, in one pass
             drawn = [self._index_of[e] for e in chosen if e in self._index_of]
-            centres = pos[self._mantle_rows[drawn]] * [1, 1, 0] + [0, 0, 0.01]
-            radii = 1.6 * self.mantle_instances[drawn, 7].astype(np.float64)
+            mantles = pos[self._mantle_rows[drawn]]
+            height = ground_of(self.world).height(mantles[:, :2])
+            centres = np.column_stack([mantles[:, :2], height + 0.01])
+            radii = self._reach(pos)[drawn]  # round the tentacles, not under them
             rings = centres[:, None, :] + radii[:, None, None] * CIRCLE
             pairs = np.stack([rings[:, :-1], rings[:, 1:]], axis=2).reshape(-1, 3)
             segments.append(np.hstack([pairs, np.ones((len(pairs), 4))]))
         for provider in self.extra_lines:
             segments.append(provider(self.world))
         return np.vstack(segments).astype(np.float32)
+
+    def _reach(self, pos: np.ndarray) -> np.ndarray:
+        """Each drawn creature's reach in the ground plane now (m): its farthest link
+        from its mantle, at least 1.6 mantle radii."""
+        reach = 1.6 * self.mantle_instances[:, 7].astype(np.float64)
+        if len(self.link_rows):
+            mantle = pos[self._mantle_rows[self.link_creature], :2]
+            far = np.linalg.norm(pos[self.link_rows, :2] - mantle, axis=1)
+            np.maximum.at(reach, self.link_creature, far + self.link_instances[:, 7])
+        return reach
 
     def draw(self, alpha: float = 1.0) -> int:
         """Render into the off-screen target; returns the number of draw calls."""
@@ -406,10 +421,21 @@ class Renderer:
             _set_fog(self.skinned_program, fog)
             self.skinned_program["u_palette"] = 0
             calls += self.skinned.draw()
+        # the ribbons: over what they lie on (pulled toward the eye), the bright cores
+        # over their dark edges (no depth written between them)
         self.line_program.use()
         set_matrix(self.line_program, "u_view_projection", view_projection)
-        gl.glLineWidth(1.0)
+        gl.glEnable(gl.GL_BLEND)
+        gl.glBlendFunc(gl.GL_SRC_ALPHA, gl.GL_ONE_MINUS_SRC_ALPHA)
+        gl.glDisable(gl.GL_CULL_FACE)
+        gl.glDepthMask(gl.GL_FALSE)
+        gl.glEnable(gl.GL_POLYGON_OFFSET_FILL)
+        gl.glPolygonOffset(-2.0, -8.0)
         calls += self.lines.draw()
+        gl.glDisable(gl.GL_POLYGON_OFFSET_FILL)
+        gl.glDepthMask(gl.GL_TRUE)
+        gl.glEnable(gl.GL_CULL_FACE)
+        gl.glDisable(gl.GL_BLEND)
         for plugin in self.world.plugins:  # what spheres and lines cannot say (fur)
             calls += plugin.render_draw(self.world, self.render_view)
         gl.glBindVertexArray(0)

@@ -70,9 +70,10 @@ def test_a_take_and_its_world_give_the_same_looks() -> None:
         for k, name in enumerate(("a", "b", "c")):
             in_world = look_in_world(world, world.creature(name), k)
             assert look_in_take(take.header, k) == in_world
-        assert look_in_world(world, world.creature("a"), 0).body != look_in_world(
-            world, world.creature("c"), 2
-        ).body
+        assert (
+            look_in_world(world, world.creature("a"), 0).body
+            != look_in_world(world, world.creature("c"), 2).body
+        )
     finally:
         world.close()
 
