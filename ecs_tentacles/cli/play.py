@@ -41,6 +41,17 @@ def camera_option(text: str) -> Any:
         raise argparse.ArgumentTypeError(str(error)) from None
 
 
+def ui_scale(text: str) -> float:
+    """argparse type: a factor in [0.5, 3]."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not 0.5 <= value <= 3.0:
+        raise argparse.ArgumentTypeError(f"must be a number in [0.5, 3], got {text!r}")
+    return value
+
+
 def add_parser(commands: argparse._SubParsersAction) -> None:
     parser = commands.add_parser(
         "play",
@@ -77,6 +88,14 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         default="natural",
         help="creature colours: natural (muted skin tones, one per species; the default)"
         " or debug (a bright colour per creature)",
+    )
+    parser.add_argument(
+        "--ui-scale",
+        type=ui_scale,
+        default=1.0,
+        metavar="FACTOR",
+        help="draw the HUD FACTOR times larger, in [0.5, 3] (default 1: scaled with the"
+        " window's height)",
     )
     parser.add_argument("--seed", type=seed_int, default=None, help="override the scene's seed")
     parser.add_argument("--allow-systems", action="store_true", help="run systems the scene names")
@@ -123,6 +142,9 @@ def handle(args: argparse.Namespace) -> int:
     from ecs_tentacles.render import configure
 
     configure(headless=args.headless)
+    from ecs_tentacles.render.gui import set_ui_scale
+
+    set_ui_scale(args.ui_scale)
     from ecs_tentacles.scene.load import load_scene
 
     load_scene(path, allow_systems=args.allow_systems)  # a bad scene fails before a window opens

@@ -47,9 +47,20 @@ _KEYS = {
 _BUTTONS = {mouse.LEFT: 0, mouse.RIGHT: 1, mouse.MIDDLE: 2}
 
 
+UI_SCALE = {"scale": 1.0}  # the user's factor over the window's own (`play --ui-scale`)
+
+
 def gui_scale(height: int) -> float:
-    """Text and spacing scale for a window `height` pixels tall (0.7 to 1.5)."""
-    return min(1.5, max(0.7, height / BASE_HEIGHT))
+    """Text and spacing scale for a window `height` pixels tall (0.7 to 1.5), times the
+    user's `UI_SCALE` (0.5 to 3)."""
+    return min(1.5, max(0.7, height / BASE_HEIGHT)) * UI_SCALE["scale"]
+
+
+def set_ui_scale(factor: float) -> None:
+    """Draw every GUI `factor` times larger (0.5 to 3; `play --ui-scale`)."""
+    if not 0.5 <= factor <= 3.0:
+        raise ValueError(f"the UI scale must be in [0.5, 3], got {factor}")
+    UI_SCALE["scale"] = float(factor)
 
 
 def same_line_if_fits(width: float) -> None:

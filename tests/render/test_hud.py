@@ -15,7 +15,7 @@ from pyglet.window import key
 from ecs_tentacles.cli import main
 from ecs_tentacles.locomotion.params import Locomotion
 from ecs_tentacles.render.hud import PANEL_SHARE, panel_width
-from tests.render.conftest import click_gui, event
+from tests.render.conftest import click_gui, click_item, event
 
 
 def overlaps(rects: dict[str, tuple[float, float, float, float]]) -> list[tuple[str, str]]:
@@ -243,3 +243,33 @@ def test_the_selection_has_a_name_plate_over_it(make_sandbox: Callable[..., Any]
     top, left = sandbox.window.height - round(y), round(x)
     around = pixels[top - 4 : top + 5, left - 4 : left + 5].max(axis=2)
     assert np.median(around) < 80  # the dark plate is there (its white letters a minority)
+
+
+def test_the_director_is_in_reach_at_720p_with_locomotion_open_and_fur(
+    make_sandbox: Callable[..., Any],
+) -> None:
+    sandbox = make_sandbox("hedgehog_octopus", width=1280, height=720)
+    sandbox.render()
+    rects = sandbox.hud.gui.rects
+    assert "speed" in rects and "Fur" in rects  # Locomotion open, a furred creature
+    assert rects["Director"][3] <= 720  # its header is on screen: no scrolling
+    click_item(sandbox, "Director")
+    assert "speed" not in sandbox.hud.gui.rects  # opening it folded Locomotion
+    director = [r for n, r in sandbox.hud.gui.rects.items() if r[1] > rects["Director"][3]]
+    assert director and all(r[3] <= 720 for r in director)  # its widgets fit too
+
+
+def test_ui_scale_makes_the_hud_larger(make_sandbox: Callable[..., Any]) -> None:
+    from ecs_tentacles.render.gui import set_ui_scale
+
+    heights = []
+    for factor in (1.0, 1.5):
+        set_ui_scale(factor)
+        try:
+            sandbox = make_sandbox("octopus", width=1280, height=720)
+            sandbox.render()
+            rect = sandbox.hud.gui.rects["speed label"]
+            heights.append(rect[3] - rect[1])
+        finally:
+            set_ui_scale(1.0)
+    assert heights[1] > 1.3 * heights[0]
