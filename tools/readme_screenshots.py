@@ -18,13 +18,15 @@ from pathlib import Path
 
 from ecs_tentacles.cli import main as cli
 
-# name -> (scene, frames, width, height, HUD shown): what each README picture shows
+# name -> (scene, frames, width, height, HUD shown, camera or None): what each README
+# picture shows (camera: `play --camera`; None frames the creatures at the start)
 SHOTS = {
-    "sandbox": ("thesis_four_by_six", 240, 1280, 720, True),  # four creatures round a square
-    "hud_640x360": ("octopus", 60, 640, 360, True),  # the HUD scaled to a small window
-    "rocky_shore": ("rocky_shore", 900, 960, 540, False),  # terrain: six crossing the rocks
-    "ramp": ("ramp", 2700, 960, 540, False),  # terrain: cresting the ramp
-    "maze": ("maze", 600, 960, 540, False),  # terrain: the path navigation planned
+    "sandbox": ("thesis_four_by_six", 240, 1280, 720, True, None),  # four round a square
+    "hud_640x360": ("octopus", 60, 640, 360, True, None),  # the HUD in a small window
+    # terrain: six crossing the rocks, seen low from the shore, the sky behind
+    "rocky_shore": ("rocky_shore", 900, 960, 540, False, "-6.2,-7.0,2.7,0.4,0.6,0.2"),
+    "ramp": ("ramp", 2700, 960, 540, False, None),  # terrain: cresting the ramp
+    "maze": ("maze", 600, 960, 540, False, None),  # terrain: the path navigation planned
 }
 CLOSE_UP = ("octopus", 120, 960, 540)  # skinned_sandbox: the skinned octopus, no HUD, near
 DEFAULT_DIR = Path(__file__).resolve().parents[1] / "assets" / "screenshots"
@@ -47,11 +49,12 @@ def main(argv: list[str] | None = None) -> int:
         if name == "skinned_sandbox":
             _close_up(args.out_dir / f"{name}.png")
             continue
-        scene, frames, width, height, hud = SHOTS[name]
+        scene, frames, width, height, hud, camera = SHOTS[name]
         out = args.out_dir / f"{name}.png"
         argv_play = ["play", scene, "--headless", "--frames", str(frames), "--quiet"]
         argv_play += ["--hud"] if hud else ["--no-hud"]
         argv_play += ["--width", str(width), "--height", str(height), "--screenshot", str(out)]
+        argv_play += [f"--camera={camera}"] if camera else []
         code = cli(argv_play)
         if code:
             return code
@@ -61,7 +64,7 @@ def main(argv: list[str] | None = None) -> int:
 
 def _close_up(out: Path) -> None:
     """The octopus after `CLOSE_UP` frames, framed close, HUD hidden (through the API:
-    the command line has no camera)."""
+    nearer than any `--camera` choice frames it)."""
     from ecs_tentacles.render import configure
 
     configure(headless=True)
