@@ -69,6 +69,7 @@ class PhysicsState:
     time: float
     states: list[np.ndarray]  # per batch: its state rows
     poses: list[tuple[np.ndarray, np.ndarray]]  # per batch: xpos, xquat after the last step
+    reduced: list[tuple[np.ndarray, np.ndarray]]  # per batch: rstate, rsource (REDUCED rows)
     applied: list[dict[int, np.ndarray]]  # per batch: forces scripts apply
     frozen: np.ndarray
     sleeping: np.ndarray
@@ -167,6 +168,7 @@ class PhysicsBackend(Membership):
             time=self.time,
             states=[b.state.copy() for b in self.batches],
             poses=[(b.xpos.copy(), b.xquat.copy()) for b in self.batches],
+            reduced=[(b.rstate.copy(), b.rsource.copy()) for b in self.batches],
             applied=[{r: f.copy() for r, f in b.applied.items()} for b in self.batches],
             frozen=self.frozen.copy(),
             sleeping=self.sleeping.copy(),
@@ -195,11 +197,15 @@ class PhysicsBackend(Membership):
         Warnings counted since and a pending fatal error are dropped: neither is state.
         """
         self.time = state.time
-        for batch, rows, (xpos, xquat), applied in zip(
-            self.batches, state.states, state.poses, state.applied, strict=False
+        for batch, rows, (xpos, xquat), (rstate, rsource), applied in zip(
+            self.batches, state.states, state.poses, state.reduced, state.applied, strict=False
         ):  # batches compiled since are empty (`state_problem`)
             batch.state[:] = rows
             batch.xpos[:], batch.xquat[:] = xpos, xquat
+            if rstate.shape == batch.rstate.shape:
+                batch.rstate[:], batch.rsource[:] = rstate, rsource
+            else:  # compiled since: no row was REDUCED then; each fits on its first step
+                batch.rsource[:] = np.nan
             batch.applied = {r: f.copy() for r, f in applied.items()}
             batch.warnings[:] = 0
             batch.errors.clear()
@@ -348,11 +354,23 @@ class PhysicsBackend(Membership):
         for future in futures:
             future.result()
 
-    def bare_states(self) -> list[np.ndarray]:
-        """Copies of every batch's state rows, for `step_bare` (benchmarks)."""
-        return [batch.state.copy() for batch in self.batches]
+    def bare_states(self) -> list[dict[int, np.ndarray]]:
+        """Copies of every batch's state rows per tier (REDUCED rows fitted as their next
+        step would), for `step_bare` (benchmarks)."""
+        out = []
+        for batch in self.batches:
+            states = {FULL: batch.state.copy()}
+            reduced = np.flatnonzero(self.tier[batch.members] == REDUCED)
+            if len(reduced):
+                batch.prepare(REDUCED, self.threads)
+                assert batch.reduced is not None
+                states[REDUCED] = batch.rstate.copy()
+                for row in reduced.tolist():
+                    batch.reduced.fit_state(batch.state[row], states[REDUCED][row])
+            out.append(states)
+        return out
 
-    def step_bare(self, states: list[np.ndarray], substeps: int) -> None:
+    def step_bare(self, states: list[dict[int, np.ndarray]], substeps: int) -> None:
         """Step the rows of `states` that are active now with MuJoCo alone, on this pool.
 
         Each row: `mj_setState`, `mj_step`, `mj_getState` on the threads' scratch data,

@@ -33,9 +33,10 @@ from ecs_tentacles.physics.model import (
     PROXY_SLOTS,
     ModelLayout,
 )
-from ecs_tentacles.physics.tiers import FULL
+from ecs_tentacles.physics.tiers import FULL, REDUCED
 
 if TYPE_CHECKING:
+    from ecs_tentacles.physics.reduced import ReducedModel
     from ecs_tentacles.store import TransformStore
 
 S = mujoco.mjtState
@@ -87,12 +88,13 @@ class Batch:
         index: int,
         model: mujoco.MjModel,
         layouts: list[ModelLayout],
-        reduced: Callable[[], mujoco.MjModel] | None = None,
+        reduced: Callable[[], ReducedModel] | None = None,
     ):
         self.index = index
         self.model = model  # shared, never written: scratch copies take the overlay
         self.models = {FULL: model}  # per tier; REDUCED compiled on first use
         self._compile_reduced = reduced
+        self.reduced: ReducedModel | None = None  # the REDUCED tier's model (`physics.reduced`)
         m, obj = model, mujoco.mjtObj
         n = len(layouts)
         first = layouts[0]
@@ -129,6 +131,11 @@ class Batch:
         self.warnings = np.zeros((n, WARNING_KINDS), dtype=np.int64)  # raised since checked
         self.deepest = np.full(n, np.inf)  # deepest contact distance (m; < 0 penetrates)
         self.errors: dict[int, str] = {}  # row -> MuJoCo's fatal error in the last step
+        # REDUCED rows: their reduced model's state, and the part of the full state the
+        # last reduced step wrote (when it differs, someone else wrote it: fit again).
+        # No columns until the reduced model is compiled.
+        self.rstate = np.zeros((n, 0))
+        self.rsource = np.zeros((n, 0))
         self.scratch: dict[int, list[Scratch]] = {FULL: []}
         # `body_rows` as one slice of the Transform store when they are consecutive (a
         # uniform crowd): `sync` then copies instead of scattering, 6x faster at 10,000
@@ -141,7 +148,7 @@ class Batch:
     # the per-row arrays, in the order `append` and `remove` treat them
     PER_ROW = ("body_rows", "actuator_motor_rows", "actuator_target_index", "sucker_rows",
                "members", "state", "kp", "kv", "torque", "anchor", "proxy_size", "near",
-               "xpos", "xquat", "warnings", "deepest")  # fmt: skip
+               "xpos", "xquat", "warnings", "deepest", "rstate", "rsource")  # fmt: skip
 
     def _store_rows(
         self, layouts: list[ModelLayout]
@@ -170,7 +177,7 @@ class Batch:
             setattr(self, name, np.concatenate([getattr(self, name), value]))
         for name in self.PER_ROW[5:]:
             array = getattr(self, name)
-            fill = np.inf if name == "deepest" else 0.01 if name == "proxy_size" else 0
+            fill = {"deepest": np.inf, "proxy_size": 0.01, "rsource": np.nan}.get(name, 0)
             grown = np.full((len(array) + 1, *array.shape[1:]), fill, dtype=array.dtype)
             grown[:-1] = array
             setattr(self, name, grown)
@@ -216,9 +223,7 @@ class Batch:
         return view
 
     # -- building ------------------------------------------------------------------
-    def swap_model(
-        self, model: mujoco.MjModel, reduced: Callable[[], mujoco.MjModel] | None
-    ) -> None:
+    def swap_model(self, model: mujoco.MjModel, reduced: Callable[[], ReducedModel] | None) -> None:
         """Step with `model` from now on: the same creature on other static ground (its
         state vector has the same layout; only the ids of the geoms after the ground's
         may move). The scratch copies are made again on the next `prepare`."""
@@ -230,6 +235,7 @@ class Batch:
         self.model = model
         self.models = {FULL: model}
         self._compile_reduced = reduced
+        self.reduced = None  # compiled again on the next `prepare` (its state rows stay)
         self.scratch = {}
 
     def prepare(self, tier: int, threads: int) -> None:
@@ -238,13 +244,30 @@ class Batch:
         Call before the stepping threads run: they only read these.
         """
         if tier not in self.models:
-            if self._compile_reduced is None:
+            if tier != REDUCED or self._compile_reduced is None:
                 raise ValueError(f"batch {self.index} has no model for tier {tier}")
-            self.models[tier] = self._compile_reduced()
+            self._make_reduced(self._compile_reduced())
         scratch = self.scratch.setdefault(tier, [])
         while len(scratch) < threads:
             model = copy.copy(self.models[tier])
             scratch.append(Scratch(model, mujoco.MjData(model)))
+
+    def _make_reduced(self, reduced: ReducedModel) -> None:
+        reduced.name_ids(self, self.model)
+        self.reduced = reduced
+        self.models[REDUCED] = reduced.model
+        width = (reduced.size, reduced.watched.stop - reduced.watched.start)
+        if self.rstate.shape[1] != width[0]:  # first compile: every row fits on first step
+            self.rstate = np.zeros((len(self), width[0]))
+            self.rsource = np.full((len(self), width[1]), np.nan)
+
+    @property
+    def reduced_share(self) -> float:
+        """What stepping a REDUCED row costs against a FULL one (degrees of freedom times
+        steps; about 0.25 before its model is compiled)."""
+        if self.reduced is None:
+            return 0.25
+        return 0.5 * (self.reduced.model.nv + 1.0) / (self.model.nv + 1.0)
 
     def scratch_for(self, thread: int, tier: int = FULL) -> Scratch:
         """Thread `thread`'s scratch model and data for `tier` (made on first use)."""
@@ -315,6 +338,9 @@ class Batch:
 
     def step_rows(self, rows: np.ndarray, substeps: int, thread: int, tier: int = FULL) -> None:
         """Advance `rows` by `substeps` steps each of `tier`'s model, on `thread`'s scratch."""
+        if tier == REDUCED:
+            self._step_reduced(rows, substeps, thread)
+            return
         scratch = self.scratch_for(thread, tier)
         m, d = scratch.model, scratch.data
         state, body_ids = self.state, self.body_ids
@@ -341,6 +367,48 @@ class Batch:
             self.warnings[row] += d.warning.number
             self.deepest[row] = d.contact.dist.min() if d.ncon else np.inf
 
+    def _step_reduced(self, rows: np.ndarray, substeps: int, thread: int) -> None:
+        """Step `rows` with the reduced model (`physics.reduced`): each row's reduced state
+        fitted again if its full state was written from outside, the frame's inputs
+        pulled in, stepped, and shown as the full state and the full model's poses."""
+        reduced = self.reduced
+        assert reduced is not None  # `prepare(REDUCED)` ran before the threads
+        scratch, full = self.scratch_for(thread, REDUCED), self.scratch_for(thread, FULL)
+        m, d, fm, fd = scratch.model, scratch.data, full.model, full.data
+        state, rstate, rsource, watched = self.state, self.rstate, self.rsource, reduced.watched
+        qpos = self.slices[int(S.mjSTATE_QPOS)]
+        body_ids = self.body_ids
+        for row in rows.tolist():
+            if np.array_equal(state[row, watched], rsource[row]):
+                reduced.pull_inputs(state[row], rstate[row])
+            else:
+                reduced.fit_state(state[row], rstate[row])
+            reduced.write_overlay(self, m, row)
+            pushed = self.applied.get(row)
+            if pushed is not None:
+                d.xfrc_applied[:] = reduced.body_group @ pushed
+                scratch.forced = True
+            elif scratch.forced:
+                d.xfrc_applied[:] = 0.0
+                scratch.forced = False
+            mujoco.mj_setState(m, d, rstate[row], STATE)
+            d.warning.number[:] = 0
+            try:
+                mujoco.mj_step(m, d, nstep=substeps)
+            except mujoco.FatalError as exc:
+                self.errors[row] = str(exc).splitlines()[0]
+                mujoco.mj_resetData(m, d)
+                continue
+            mujoco.mj_getState(m, d, rstate[row], STATE)
+            reduced.expand_state(rstate[row], state[row])
+            rsource[row] = state[row, watched]
+            fd.qpos[:] = state[row, qpos]
+            mujoco.mj_kinematics(fm, fd)
+            self.xpos[row] = fd.xpos[body_ids]
+            self.xquat[row] = fd.xquat[body_ids]
+            self.warnings[row] += d.warning.number
+            self.deepest[row] = d.contact.dist.min() if d.ncon else np.inf
+
 
 def without_row(array: np.ndarray, row: int) -> np.ndarray:
     """`array` without row `row`: the rows after it moved up in place (no new buffer,
@@ -360,10 +428,10 @@ def write_overlay(batch: Batch, m: mujoco.MjModel, row: int) -> None:
     if len(batch.equality_ids):
         m.eq_data[batch.equality_ids, 3:6] = batch.anchor[row]
     if batch.near[row]:
-        _size_proxies(m, batch.proxy_geoms, batch.proxy_cylinder, batch.proxy_size[row])
+        size_proxies(m, batch.proxy_geoms, batch.proxy_cylinder, batch.proxy_size[row])
 
 
-def _size_proxies(
+def size_proxies(
     m: mujoco.MjModel, geoms: np.ndarray, cylinder: np.ndarray, size: np.ndarray
 ) -> None:
     """Proxy geoms sized `size` (radius, half length) with matching bounds."""

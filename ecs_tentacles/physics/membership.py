@@ -19,6 +19,7 @@ import numpy as np
 from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.physics.batch import Batch
 from ecs_tentacles.physics.model import build_spec, model_layout
+from ecs_tentacles.physics.reduced import ReducedModel, chains, reduced_spec
 from ecs_tentacles.physics.tiers import FULL, reduced_substeps
 
 if TYPE_CHECKING:
@@ -34,21 +35,21 @@ S = mujoco.mjtState
 
 def compile_models(
     world: PhysicsHost, creature: Creature
-) -> tuple[mujoco.MjModel, Callable[[], mujoco.MjModel]]:
+) -> tuple[mujoco.MjModel, Callable[[], ReducedModel]]:
     """The compiled model of `creature`'s morphology, and how to compile its reduced one
-    (the REDUCED level of detail: fewer, longer substeps) when first needed.
+    (the REDUCED level of detail, `physics.reduced`) when first needed.
 
     The reduced model is compiled later from the spec built now: by then `creature` may
     have been despawned (the batch outlives its first member), so nothing of the world
     is read again.
     """
-    spec = build_spec(world, creature)
-    model = spec.compile()
+    model = build_spec(world, creature).compile()
     reduced_dt = world.settings.dt / reduced_substeps(world.settings.substeps)
+    spec = reduced_spec(world, creature, reduced_dt)
+    tentacles = chains(world, creature)
 
-    def reduced() -> mujoco.MjModel:
-        spec.option.timestep = reduced_dt
-        return spec.compile()
+    def reduced() -> ReducedModel:
+        return ReducedModel(model, spec.compile(), tentacles)
 
     return model, reduced
 

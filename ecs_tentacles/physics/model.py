@@ -105,7 +105,7 @@ def model_layout(world: PhysicsHost, creature: Creature, transform: Transform) -
             layout.bodies.append(prefix)
             layout.body_rows.append(world.component(link_entity, Transform).row)
             motor = world.component(link_entity, Motor)
-            for hinge in _hinges(link):
+            for hinge in hinges(link):
                 layout.actuators.append(f"{prefix}/{hinge}")
                 layout.actuator_motor_rows.append(motor.row)
                 layout.actuator_axes.append(AXIS_INDEX[hinge])
@@ -129,7 +129,7 @@ def _settings_key(settings: Settings) -> tuple[Any, ...]:
             settings.sucker_timeconst)  # fmt: skip
 
 
-def _hinges(link: Link) -> tuple[str, ...]:
+def hinges(link: Link) -> tuple[str, ...]:
     return ("curl", "sweep", "twist") if link.twist else ("curl", "sweep")
 
 
@@ -141,6 +141,15 @@ def build_spec(
     `timestep` (default: the scene's substep) gives a cheaper model of the same
     creature (the REDUCED level of detail, `physics.tiers`).
     """
+    spec = new_spec(world, timestep)
+    _add_creature(spec, world, creature)
+    add_proxies(spec)
+    return spec
+
+
+def new_spec(world: PhysicsHost, timestep: float | None = None) -> mujoco.MjSpec:
+    """An MjSpec with the scene's options (`timestep`, default the scene's substep) and
+    its ground, before any creature is added."""
     settings = world.settings
     spec = mujoco.MjSpec()
     spec.modelname = "ecs_tentacles_creature"
@@ -157,8 +166,6 @@ def build_spec(
     ground_of(world).add_to_spec(
         spec, settings.ground_friction, GROUND_BIT, CREATURE_BIT, CONTACT_SOLREF
     )
-    _add_creature(spec, world, creature)
-    _add_proxies(spec)
     return spec
 
 
@@ -208,8 +215,8 @@ def _add_creature(spec: mujoco.MjSpec, world: PhysicsHost, creature: Creature) -
                 **skin,
             )
             motor = world.component(link_entity, Motor)
-            for hinge in _hinges(link):
-                _add_servo(spec, body, f"{prefix}/{hinge}", hinge, link, motor)
+            for hinge in hinges(link):
+                add_servo(spec, body, f"{prefix}/{hinge}", hinge, link, motor)
             parent, previous = body, link
         for sucker_entity in tentacle.suckers:
             sucker = world.component(sucker_entity, Sucker)
@@ -230,7 +237,7 @@ def _add_creature(spec: mujoco.MjSpec, world: PhysicsHost, creature: Creature) -
             equalities += 1
 
 
-def _add_proxies(spec: mujoco.MjSpec) -> None:
+def add_proxies(spec: mujoco.MjSpec) -> None:
     """Kinematic stand-ins for other creatures' bodies; sized and placed per frame."""
     z_to_x = [np.sqrt(0.5), 0.0, np.sqrt(0.5), 0.0]  # capsules lie along +x like links
     kinds = (
@@ -259,7 +266,7 @@ def _add_proxies(spec: mujoco.MjSpec) -> None:
             slot += 1
 
 
-def _add_servo(
+def add_servo(
     spec: mujoco.MjSpec, body: mujoco.MjsBody, name: str, hinge: str, link: Link, motor: Motor
 ) -> None:
     body.add_joint(

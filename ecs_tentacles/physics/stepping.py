@@ -49,11 +49,14 @@ def plan(
     if also is not None:
         groups.append(also)
     for mask, steps, weight in groups:
-        for level, share in ((FULL, 1.0), (REDUCED, 0.5)):
+        for level in (FULL, REDUCED):
             for batch in batches:
                 rows = np.flatnonzero(mask[batch.members] & (tier[batch.members] == level))
                 if len(rows):
                     batch.prepare(level, threads)
+                    if level == REDUCED:
+                        batch.prepare(FULL, threads)  # its poses come from the full model
+                    share = 1.0 if level == FULL else batch.reduced_share
                     cost = np.full(len(rows), share * weight * (batch.model.nv + 1.0))
                     pieces.append((batch, rows, cost, level, steps))
     if not pieces:
@@ -87,17 +90,23 @@ def step_segments(chunk: list[Segment], substeps: dict[int, int], thread: int) -
 
 
 def bare_step(
-    chunk: list[Segment], states: list[np.ndarray], substeps: dict[int, int], thread: int
+    chunk: list[Segment],
+    states: list[dict[int, np.ndarray]],
+    substeps: dict[int, int],
+    thread: int,
 ) -> None:
     """MuJoCo alone: each row's model values, set its state, step it, get it back
     (benchmarks)."""
     for segment in chunk:
         batch = segment.batch
         scratch = batch.scratch_for(thread, segment.tier)
-        m, d, rows = scratch.model, scratch.data, states[batch.index]
+        m, d, rows = scratch.model, scratch.data, states[batch.index][segment.tier]
         n = substeps[segment.tier]
         for row in segment.rows.tolist():
-            write_overlay(batch, m, row)
+            if segment.tier == REDUCED and batch.reduced is not None:
+                batch.reduced.write_overlay(batch, m, row)
+            else:
+                write_overlay(batch, m, row)
             mujoco.mj_setState(m, d, rows[row], STATE)
             mujoco.mj_step(m, d, nstep=n)
             mujoco.mj_getState(m, d, rows[row], STATE)

@@ -1,0 +1,379 @@
+"""The REDUCED tier's model: about half the links per tentacle at a quarter of the rate.
+
+Per morphology (one `Batch`), the reduced creature is built from the full one
+(`reduced_spec`): each tentacle's links are joined in consecutive groups (`groups`:
+about half as many links, at least 3, or all of them when there are fewer), a group
+becoming one capsule as long as its links together, as heavy, as thick on average,
+bending as far as they do together. It steps at a quarter of the scene's rate
+(`tiers.reduced_substeps`: 120 Hz at the default 480 Hz). Its geoms touch the ground
+and the contact proxies (other creatures) as the full ones do: with ground contact at
+the tips alone the creature stands on its mantle, 2.5 cm lower than a full one (a pop
+at every tier move), for 13 % less cost. Its suckers hang from the links that hold
+theirs, at the same places.
+
+`ReducedModel` maps states between the two models, tentacle by tentacle and hinge axis
+by hinge axis, through each link's heading along the tentacle (the sum of its joint
+angles from the mantle): a reduced chain is shown as the full chain whose headings are
+the reduced ones interpolated at the full links' centres (`expand`: a smooth curve
+through the reduced links, sampled at the full links), and a full chain becomes the
+reduced chain whose links' ends and headings are nearest its own (`fit`, least
+squares). Servo targets are fitted the same way; a reduced servo is the full servos of
+its group in series (stiffness 1 / sum of 1 / kp), as strong as the first of them.
+
+The batch keeps every creature's state in the full model's layout, so drawing,
+export, health, sleep, snapshots and the contact proxies never see a reduced model: a
+REDUCED row keeps a second state (`Batch.rstate`) that `step_rows` fits again whenever
+the full state was written from outside (a recovery, a promotion from replay, a
+restore), steps, and shows as the full state (joint angles expanded, poses from the
+full model's kinematics).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import mujoco
+import numpy as np
+
+from ecs_tentacles.components import Creature, Link, Motor, Sucker, Tentacle
+from ecs_tentacles.mathutil import quat_about_z
+from ecs_tentacles.physics.batch import STATE, Batch, size_proxies, state_slices
+from ecs_tentacles.physics.model import (
+    CONTACT_SOLREF,
+    CREATURE_BIT,
+    GROUND_BIT,
+    PROXY_BIT,
+    SKIN_FRICTION,
+    SUCKER_SOLIMP,
+    add_proxies,
+    add_servo,
+    hinges,
+    new_spec,
+)
+
+if TYPE_CHECKING:
+    from ecs_tentacles.physics.host import PhysicsHost
+
+S = mujoco.mjtState
+# A reduced servo is its group's servos in series, this much softer: a joined link bends
+# its whole length at one joint, and the servos in series alone crawled 19 % faster than
+# the full creature (8 creatures for 10 s: 1.07 m against 0.90 m; with 0.8, 0.92 m).
+SERIES_GAIN = 0.8
+AXES = ("curl", "sweep", "twist")
+
+
+def groups(links: int) -> list[np.ndarray]:
+    """The full links (indices) each reduced link of a `links`-link tentacle stands for."""
+    count = links if links <= 3 else max(3, (links + 1) // 2)
+    return np.array_split(np.arange(links), count)
+
+
+@dataclass(frozen=True)
+class _Chain:
+    """One tentacle as the reduced model sees it: full link lengths and the groups."""
+
+    tentacle: int
+    lengths: np.ndarray  # full links
+    groups: list[np.ndarray]
+    axes: tuple[str, ...]  # hinge axes of the full links (the reduced ones have the same)
+
+    @property
+    def reduced_lengths(self) -> np.ndarray:
+        return np.array([self.lengths[g].sum() for g in self.groups])
+
+
+def reduced_spec(world: PhysicsHost, creature: Creature, timestep: float) -> mujoco.MjSpec:
+    """An MjSpec of `creature`'s reduced model (module docstring), mantle at the origin."""
+    spec = new_spec(world, timestep)
+    mantle = spec.worldbody.add_body(name="mantle")
+    mantle.add_freejoint(name="root")
+    mantle.add_geom(
+        name="mantle",
+        type=mujoco.mjtGeom.mjGEOM_CYLINDER,
+        size=[creature.mantle_radius, 0.5 * creature.mantle_height, 0.0],
+        density=creature.mantle_density,
+        **_skin(),
+    )
+    equalities = 0
+    for tentacle_entity in creature.tentacles:
+        tentacle = world.component(tentacle_entity, Tentacle)
+        links = [world.component(e, Link) for e in tentacle.links]
+        motors = [world.component(e, Motor) for e in tentacle.links]
+        parts = groups(len(links))
+        twist = all(lk.twist for lk in links)  # a twist hinge where every link has one
+        parent, previous = mantle, 0.0
+        centres = []  # each reduced link's centre along the tentacle
+        arc = 0.0
+        for k, group in enumerate(parts):
+            joined = _joined([links[i] for i in group], twist)
+            prefix = f"t{tentacle.index}/l{k:02d}"
+            if k == 0:
+                angle = tentacle.base_angle
+                distance = creature.mantle_radius + 0.5 * joined.length
+                pos = [distance * np.cos(angle), distance * np.sin(angle),
+                       -0.5 * creature.mantle_height]  # fmt: skip
+                quat = quat_about_z(angle)
+            else:
+                pos = [0.5 * (previous + joined.length), 0.0, 0.0]
+                quat = np.array([1.0, 0.0, 0.0, 0.0])
+            body = parent.add_body(name=prefix, pos=pos, quat=quat)
+            body.add_geom(
+                name=prefix,
+                type=mujoco.mjtGeom.mjGEOM_CAPSULE,
+                fromto=[-0.5 * joined.length, 0, 0, 0.5 * joined.length, 0, 0],
+                size=[joined.radius, 0.0, 0.0],
+                density=joined.density,
+                **_skin(),
+            )
+            for hinge in hinges(joined):
+                add_servo(spec, body, f"{prefix}/{hinge}", hinge, joined, motors[int(group[0])])
+            centres.append(arc + 0.5 * joined.length)
+            arc += joined.length
+            parent, previous = body, joined.length
+        full_centres = np.cumsum([0.0] + [lk.length for lk in links])[:-1]
+        full_centres += 0.5 * np.array([lk.length for lk in links])
+        for sucker_entity in tentacle.suckers:
+            sucker = world.component(sucker_entity, Sucker)
+            i = tentacle.links.index(sucker.link)
+            k = next(k for k, g in enumerate(parts) if i in g)
+            equality = spec.add_equality(
+                name=f"t{tentacle.index}/sucker{equalities}",
+                type=mujoco.mjtEq.mjEQ_CONNECT,
+                objtype=mujoco.mjtObj.mjOBJ_BODY,
+                name1=f"t{tentacle.index}/l{k:02d}",
+                name2="world",
+                active=False,
+                solref=[world.settings.sucker_timeconst, 1.0],
+                solimp=SUCKER_SOLIMP,
+            )
+            data = np.array(equality.data)
+            data[0:3] = np.asarray(sucker.offset) + [full_centres[i] - centres[k], 0.0, 0.0]
+            equality.data = data
+            equalities += 1
+    add_proxies(spec)
+    return spec
+
+
+def _skin() -> dict[str, object]:
+    """A reduced geom touches the ground and the proxies, as a full one does."""
+    return {
+        "contype": CREATURE_BIT,
+        "conaffinity": GROUND_BIT | PROXY_BIT,
+        "friction": SKIN_FRICTION,
+        "solref": CONTACT_SOLREF,
+    }
+
+
+def _joined(links: list[Link], twist: bool) -> Link:
+    """One link standing for `links` end to end: as long and as heavy, as thick on
+    average, bending as far."""
+    length = sum(lk.length for lk in links)
+    radius = sum(lk.radius * lk.length for lk in links) / length
+    mass = sum(lk.density * _capsule_volume(lk.radius, lk.length) for lk in links)
+    first = links[0]
+    return Link(
+        tentacle=first.tentacle,
+        index=first.index,
+        length=length,
+        radius=radius,
+        scale=first.scale,
+        density=mass / _capsule_volume(radius, length),
+        joint_limit=min(float(np.pi), sum(lk.joint_limit for lk in links)),
+        twist=twist,
+    )
+
+
+def _capsule_volume(radius: float, length: float) -> float:
+    return float(np.pi * radius**2 * length + 4.0 / 3.0 * np.pi * radius**3)
+
+
+def chains(world: PhysicsHost, creature: Creature) -> list[_Chain]:
+    """`creature`'s tentacles as `ReducedModel` needs them."""
+    out = []
+    for tentacle_entity in creature.tentacles:
+        tentacle = world.component(tentacle_entity, Tentacle)
+        links = [world.component(e, Link) for e in tentacle.links]
+        axes = AXES if all(lk.twist for lk in links) else AXES[:2]
+        out.append(
+            _Chain(tentacle.index, np.array([lk.length for lk in links]), groups(len(links)), axes)
+        )
+    return out
+
+
+def _expansion(chain: _Chain) -> tuple[np.ndarray, np.ndarray]:
+    """(E, F) for one axis of `chain`: full angles = E @ reduced angles (headings
+    interpolated at the full links' centres); reduced = F @ full (least squares on the
+    links' ends and headings, small angles)."""
+    lengths, reduced = chain.lengths, chain.reduced_lengths
+    n, k = len(lengths), len(reduced)
+    centres = np.cumsum(lengths) - 0.5 * lengths
+    reduced_centres = np.cumsum(reduced) - 0.5 * reduced
+    interp = np.zeros((n, k))  # full headings from reduced headings
+    for i, c in enumerate(centres):
+        j = int(np.searchsorted(reduced_centres, c))
+        if j == 0:
+            interp[i, 0] = 1.0
+        elif j >= k:
+            interp[i, k - 1] = 1.0
+        else:
+            t = (c - reduced_centres[j - 1]) / (reduced_centres[j] - reduced_centres[j - 1])
+            interp[i, j - 1], interp[i, j] = 1.0 - t, t
+    heading_n = np.tril(np.ones((n, n)))  # headings = cumulative angles
+    heading_k = np.tril(np.ones((k, k)))
+    difference = np.linalg.inv(heading_n)
+    expand = difference @ interp @ heading_k
+    ends = np.tril(np.ones((n, n))) * lengths[None, :]  # small-angle offsets of link ends
+    scale = float(lengths.mean())
+    measure = np.vstack([ends @ heading_n, scale * heading_n])
+    fit = np.linalg.pinv(measure @ expand) @ measure
+    return expand, fit
+
+
+class ReducedModel:
+    """A batch's reduced model and the maps between its states and the full model's."""
+
+    def __init__(self, full: mujoco.MjModel, model: mujoco.MjModel, tentacles: list[_Chain]):
+        self.model = model
+        self.full_slices = state_slices(full)
+        self.slices = state_slices(model)
+        full_q, red_q, full_v, red_v, full_u, red_u = [], [], [], [], [], []
+        blocks_e, blocks_f, series, first, limits = [], [], [], [], []
+        offset = 0  # full hinges so far
+        for chain in tentacles:
+            for axis in chain.axes:
+                full_names = [
+                    f"t{chain.tentacle}/l{i:02d}/{axis}" for i in range(len(chain.lengths))
+                ]
+                red_names = [f"t{chain.tentacle}/l{k:02d}/{axis}" for k in range(len(chain.groups))]
+                fj = [full.joint(n) for n in full_names]
+                rj = [model.joint(n) for n in red_names]
+                full_q += [int(j.qposadr[0]) for j in fj]
+                full_v += [int(j.dofadr[0]) for j in fj]
+                red_q += [int(j.qposadr[0]) for j in rj]
+                red_v += [int(j.dofadr[0]) for j in rj]
+                full_u += [full.actuator(n).id for n in full_names]
+                red_u += [model.actuator(n).id for n in red_names]
+                limits += [float(j.range[1]) for j in fj]
+                expand, fit = _expansion(chain)
+                blocks_e.append(expand)
+                blocks_f.append(fit)
+                member = np.zeros((len(chain.groups), len(chain.lengths)))
+                for k, group in enumerate(chain.groups):
+                    member[k, group] = 1.0
+                series.append(member)
+                first += [offset + int(g[0]) for g in chain.groups]
+                offset += len(chain.lengths)
+        self.expand = _block_diagonal(blocks_e)  # (full hinges, reduced hinges)
+        self.fit = _block_diagonal(blocks_f)  # (reduced hinges, full hinges)
+        self.series = _block_diagonal(series)  # reduced hinge <- its group's full hinges
+        self.first = np.array(first, dtype=np.int64)  # each reduced hinge's first full one
+        self.limit = np.array(limits)
+        self.full_q, self.red_q = np.array(full_q), np.array(red_q)
+        self.full_v, self.red_v = np.array(full_v), np.array(red_v)
+        self.full_u, self.red_u = np.array(full_u), np.array(red_u)
+        self.root_q = int(full.joint("root").qposadr[0])
+        self.root_v = int(full.joint("root").dofadr[0])
+        self.red_root_q = int(model.joint("root").qposadr[0])
+        self.red_root_v = int(model.joint("root").dofadr[0])
+        self.full_nq, self.full_nv = full.nq, full.nv
+        self.size = mujoco.mj_stateSize(model, STATE)
+        # the part of a full state a reduced step writes, to know when someone else did
+        q, v = self.full_slices[int(S.mjSTATE_QPOS)], self.full_slices[int(S.mjSTATE_QVEL)]
+        self.watched = slice(q.start, v.stop)
+        obj = mujoco.mjtObj
+        names = [mujoco.mj_id2name(full, obj.mjOBJ_BODY, b) for b in range(full.nbody)]
+        self.body_group = np.zeros((model.nbody, full.nbody))  # applied forces: summed
+        for b, name in enumerate(names):
+            target = _reduced_body(name, tentacles)
+            if target is not None:
+                self.body_group[model.body(target).id, b] = 1.0
+
+    # -- states ----------------------------------------------------------------------
+    def fit_state(self, full_state: np.ndarray, out: np.ndarray) -> None:
+        """`out` (a reduced state) nearest the full state `full_state`; warm start cleared."""
+        fs, rs = self.full_slices, self.slices
+        out[:] = 0.0
+        fq, rq = full_state[fs[int(S.mjSTATE_QPOS)]], out[rs[int(S.mjSTATE_QPOS)]]
+        fv, rv = full_state[fs[int(S.mjSTATE_QVEL)]], out[rs[int(S.mjSTATE_QVEL)]]
+        rq[self.red_root_q : self.red_root_q + 7] = fq[self.root_q : self.root_q + 7]
+        rv[self.red_root_v : self.red_root_v + 6] = fv[self.root_v : self.root_v + 6]
+        rq[self.red_q] = self.fit @ fq[self.full_q]
+        rv[self.red_v] = self.fit @ fv[self.full_v]
+        self.pull_inputs(full_state, out)
+
+    def pull_inputs(self, full_state: np.ndarray, out: np.ndarray) -> None:
+        """What the systems wrote into the full state this frame (servo targets fitted,
+        sucker switches, proxy poses, the clock) into the reduced state `out`."""
+        fs, rs = self.full_slices, self.slices
+        for flag in (S.mjSTATE_TIME, S.mjSTATE_EQ_ACTIVE, S.mjSTATE_MOCAP_POS,
+                     S.mjSTATE_MOCAP_QUAT):  # fmt: skip
+            out[rs[int(flag)]] = full_state[fs[int(flag)]]
+        ctrl = full_state[fs[int(S.mjSTATE_CTRL)]]
+        out[rs[int(S.mjSTATE_CTRL)]][self.red_u] = self.fit @ ctrl[self.full_u]
+
+    def expand_state(self, reduced_state: np.ndarray, out: np.ndarray) -> None:
+        """The full state `out` shows the reduced state: root and clock copied, joint
+        angles and speeds expanded (within the full joints' limits), warm start cleared."""
+        fs, rs = self.full_slices, self.slices
+        out[fs[int(S.mjSTATE_TIME)]] = reduced_state[rs[int(S.mjSTATE_TIME)]]
+        rq, fq = reduced_state[rs[int(S.mjSTATE_QPOS)]], out[fs[int(S.mjSTATE_QPOS)]]
+        rv, fv = reduced_state[rs[int(S.mjSTATE_QVEL)]], out[fs[int(S.mjSTATE_QVEL)]]
+        fq[self.root_q : self.root_q + 7] = rq[self.red_root_q : self.red_root_q + 7]
+        fv[self.root_v : self.root_v + 6] = rv[self.red_root_v : self.red_root_v + 6]
+        fq[self.full_q] = np.clip(self.expand @ rq[self.red_q], -self.limit, self.limit)
+        fv[self.full_v] = self.expand @ rv[self.red_v]
+        out[fs[int(S.mjSTATE_WARMSTART)]] = 0.0
+
+    # -- model values ----------------------------------------------------------------
+    def write_overlay(self, batch: Batch, m: mujoco.MjModel, row: int) -> None:
+        """Row `row`'s servos (each reduced one its group's in series), sucker anchors and
+        proxy sizes into the reduced scratch model `m`."""
+        kp = SERIES_GAIN / (self.series @ (1.0 / np.maximum(batch.kp[row][self.full_u], 1e-12)))
+
+        kv = 1.0 / (self.series @ (1.0 / np.maximum(batch.kv[row][self.full_u], 1e-12)))
+        torque = batch.torque[row][self.full_u][self.first]
+        u = self.red_u
+        m.actuator_gainprm[u, 0] = kp
+        m.actuator_biasprm[u, 1] = -kp
+        m.actuator_biasprm[u, 2] = -kv
+        m.actuator_forcerange[u, 0] = -torque
+        m.actuator_forcerange[u, 1] = torque
+        if len(batch.equality_ids):
+            m.eq_data[self.equality_ids, 3:6] = batch.anchor[row]
+        if batch.near[row]:
+            size_proxies(m, self.proxy_geoms, batch.proxy_cylinder, batch.proxy_size[row])
+
+    def name_ids(self, batch: Batch, full: mujoco.MjModel) -> None:
+        """The reduced model's ids of the batch's equalities and proxy geoms (same names)."""
+        obj = mujoco.mjtObj
+        self.equality_ids = np.array(
+            [mujoco.mj_name2id(self.model, obj.mjOBJ_EQUALITY,
+                               mujoco.mj_id2name(full, obj.mjOBJ_EQUALITY, int(e)))
+             for e in batch.equality_ids], dtype=np.int64)  # fmt: skip
+        self.proxy_geoms = np.array(
+            [mujoco.mj_name2id(self.model, obj.mjOBJ_GEOM,
+                               mujoco.mj_id2name(full, obj.mjOBJ_GEOM, int(g)))
+             for g in batch.proxy_geoms], dtype=np.int64)  # fmt: skip
+
+
+def _reduced_body(name: str | None, tentacles: list[_Chain]) -> str | None:
+    """The reduced body standing for full body `name` (None for proxies and the world)."""
+    if name == "mantle":
+        return "mantle"
+    if not name or not name.startswith("t") or "/l" not in name:
+        return None
+    tentacle, link = name[1:].split("/l")
+    chain = next(c for c in tentacles if c.tentacle == int(tentacle))
+    k = next(k for k, g in enumerate(chain.groups) if int(link) in g)
+    return f"t{tentacle}/l{k:02d}"
+
+
+def _block_diagonal(blocks: list[np.ndarray]) -> np.ndarray:
+    rows, cols = sum(b.shape[0] for b in blocks), sum(b.shape[1] for b in blocks)
+    out = np.zeros((rows, cols))
+    r = c = 0
+    for b in blocks:
+        out[r : r + b.shape[0], c : c + b.shape[1]] = b
+        r, c = r + b.shape[0], c + b.shape[1]
+    return out

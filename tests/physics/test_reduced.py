@@ -1,0 +1,130 @@
+"""The REDUCED tier's cheaper model (`ecs_tentacles.physics.reduced`), seen as users see it:
+the full skeleton drawn, no pop at tier moves, the same crawl."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import mujoco
+import numpy as np
+import pytest
+
+from ecs_tentacles.components import Transform
+from ecs_tentacles.physics.batch import STATE
+from ecs_tentacles.physics.tiers import FULL, REDUCED
+from ecs_tentacles.terrain.presets import rocky
+from ecs_tentacles.world import World
+
+S = mujoco.mjtState
+
+
+def _crowd(count: int, lod: dict[str, Any], terrain: bool = False) -> dict[str, Any]:
+    """`count` default creatures 3 m apart, each crawling 3 m along +x."""
+    creatures = []
+    for i in range(count):
+        x, y = 3.0 * (i % 4) - 4.0, 3.0 * (i // 4) - 2.0
+        creatures.append({"name": f"c{i}", "position": [x, y], "goals": [{"position": [x + 3, y]}]})
+    scene: dict[str, Any] = {"version": 1, "physics": {"lod": lod}, "creatures": creatures}
+    if terrain:
+        scene["terrain"] = rocky(np.array([c["position"] for c in creatures]), 1.0, 0)
+    return scene
+
+
+def _segment_distance(points: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """(points,) distance of each point to the nearest of the segments a[j] -> b[j]."""
+    ab = b - a
+    t = np.einsum("pjk,jk->pj", points[:, None, :] - a[None], ab) / np.sum(ab * ab, axis=1)
+    nearest = a[None] + np.clip(t, 0.0, 1.0)[..., None] * ab[None]
+    return np.linalg.norm(points[:, None, :] - nearest, axis=2).min(axis=1)
+
+
+def test_a_reduced_creature_draws_the_full_skeleton_on_its_chain(
+    make_world: Callable[..., World],
+) -> None:
+    world = make_world(_crowd(2, {"full": 0, "reduced": 8, "hold_seconds": 0}))
+    world.step(90)
+    assert world.lod.counts()["reduced"] == 2
+    batch = world.physics.batches[0]
+    reduced = batch.reduced
+    assert reduced is not None and reduced.model.nbody < batch.model.nbody - 30  # cheaper
+    scratch = batch.scratch_for(0, REDUCED)
+    m, d = scratch.model, scratch.data
+    for row in range(len(batch)):
+        shown = world.transforms.pos[batch.body_rows[row]]
+        assert shown.shape == (len(batch.body_ids), 3) and np.isfinite(shown).all()
+        mujoco.mj_setState(m, d, batch.rstate[row], STATE)
+        mujoco.mj_kinematics(m, d)
+        links = [i for i in range(1, m.nbody) if not m.body_mocapid[i] >= 0]
+        axis = np.array([d.xmat[i].reshape(3, 3)[:, 0] for i in links])
+        half = np.array([m.geom_size[m.body_geomadr[i], 1] for i in links])[:, None]
+        centre = d.xpos[links]
+        distance = _segment_distance(shown[1:], centre - half * axis, centre + half * axis)
+        assert distance.max() <= 0.01, f"a link is {distance.max() * 1000:.1f} mm off the chain"
+
+
+@pytest.mark.parametrize("terrain", [False, True], ids=["plane", "rocky"])
+def test_tier_moves_do_not_pop(make_world: Callable[..., World], terrain: bool) -> None:
+    """Demotion shows the fitted reduced chain: within 2 cm of the full pose; promotion
+    starts the full model from exactly the reduced pose shown."""
+    world = make_world(_crowd(4, {"full": 8, "reduced": 8}, terrain))
+    batch = world.physics.batches[0]
+    batch.prepare(REDUCED, 1)
+    reduced = batch.reduced
+    assert reduced is not None
+    full = batch.scratch_for(0, FULL)
+    worst = 0.0
+    for _ in range(12):
+        world.step(10)
+        for row in range(len(batch)):
+            fitted = np.zeros(reduced.size)
+            reduced.fit_state(batch.state[row], fitted)
+            shown = batch.state[row].copy()
+            reduced.expand_state(fitted, shown)
+            full.data.qpos[:] = shown[batch.slices[int(S.mjSTATE_QPOS)]]
+            mujoco.mj_kinematics(full.model, full.data)
+            jump = np.linalg.norm(full.data.xpos[batch.body_ids] - batch.xpos[row], axis=1)
+            worst = max(worst, float(jump.max()))
+    assert worst <= 0.02, f"a demotion moves a link {worst * 1000:.1f} mm"
+    # promotion: the full state is the one the reduced creature was shown in
+    world = make_world(_crowd(2, {"full": 0, "reduced": 8, "hold_seconds": 0}, terrain))
+    world.step(30)
+    batch = world.physics.batches[0]
+    before = batch.state.copy()
+    world.lod.promote(world.creature("c0"))
+    world.lod.update(world)
+    assert world.lod.tier_of(world.creature("c0")) == "full"
+    np.testing.assert_array_equal(batch.state, before)
+
+
+def test_a_reduced_crowd_crawls_like_a_full_one(make_world: Callable[..., World]) -> None:
+    progress = {}
+    for tier, lod in (("full", {"full": 8}), ("reduced", {"full": 0, "reduced": 8})):
+        world = make_world(_crowd(4, lod))
+        rows = [world.component(world.creature(f"c{i}"), Transform).row for i in range(4)]
+        start = world.transforms.pos[rows, 0].copy()
+        world.step(300)
+        assert world.lod.counts()[tier] == 4
+        assert world.physics.health.recoveries == 0
+        progress[tier] = float(np.mean(world.transforms.pos[rows, 0] - start))
+    assert progress["full"] > 0.2
+    assert abs(progress["reduced"] / progress["full"] - 1.0) < 0.25, progress
+
+
+def test_recovering_one_reduced_creature_leaves_the_others_alone(
+    make_world: Callable[..., World],
+) -> None:
+    runs = []
+    for broken in (False, True):
+        world = make_world(_crowd(4, {"full": 0, "reduced": 8, "hold_seconds": 0}))
+        world.step(20)
+        if broken:
+            batch = world.physics.batches[0]
+            batch.state[1, batch.slices[int(S.mjSTATE_QVEL)]] = np.nan  # c1 blows up
+        world.step(20)
+        runs.append(world)
+    assert runs[1].physics.health.recoveries >= 1
+    for name in ("c0", "c2", "c3"):
+        rows = runs[0].physics.groups[int(name[1])].body_rows
+        np.testing.assert_array_equal(runs[0].transforms.pos[rows], runs[1].transforms.pos[rows])
+    assert np.isfinite(runs[1].transforms.pos).all()
