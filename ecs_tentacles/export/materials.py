@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from ecs_tentacles.colours import PALE, creature_colours, to_linear
+from ecs_tentacles.colours import PALE, creature_colour, look_in_take, to_linear
 from ecs_tentacles.export.names import part
 from ecs_tentacles.take import Take
 
@@ -34,9 +34,10 @@ def material_name(creature: str) -> str:
 
 
 def take_colours(take: Take) -> dict[str, np.ndarray]:
-    """Each creature's display colour (rgb 0..1), by name, in the take's order."""
+    """Each creature's display colour (rgb 0..1) in the sandbox's default (natural)
+    palette, by name, in the take's order."""
     names = [str(c["name"]) for c in take.header["creatures"]]
-    return dict(zip(names, creature_colours(len(names)), strict=True))
+    return {name: creature_colour(look_in_take(take.header, k)) for k, name in enumerate(names)}
 
 
 def usd_material(pxr: Any, stage: Any, creature: str, colour: np.ndarray) -> Any:

@@ -13,10 +13,11 @@ import numpy as np
 import pytest
 
 from ecs_tentacles.cli import main
-from ecs_tentacles.colours import creature_colours, to_linear
+from ecs_tentacles.colours import creature_colour, look_in_world, to_linear
 from ecs_tentacles.export.gltf import read_glb, write_glb
 from ecs_tentacles.export.skinned_gltf import write_skinned_glb
 from ecs_tentacles.take import Take
+from ecs_tentacles.world import World
 from tests.export.conftest import khronos_report, record
 
 NAMES = ["red", "green", "blue"]
@@ -34,7 +35,22 @@ SCENE: dict[str, Any] = {
         for k, name in enumerate(NAMES)
     ],
 }
-COLOURS = dict(zip(NAMES, creature_colours(3), strict=True))  # as the sandbox draws them
+
+
+def _sandbox_colours() -> dict[str, np.ndarray]:
+    """Each creature's colour as the sandbox draws it (its default, natural palette)."""
+    world = World.from_scene(SCENE)
+    try:
+        entities = [world.creature(name) for name in NAMES]
+        return {
+            name: creature_colour(look_in_world(world, entity, k))
+            for k, (name, entity) in enumerate(zip(NAMES, entities, strict=True))
+        }
+    finally:
+        world.close()
+
+
+COLOURS = _sandbox_colours()
 
 
 @pytest.fixture(scope="module")
