@@ -31,14 +31,13 @@ full model's kinematics).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Protocol
 
 import mujoco
 import numpy as np
 
 from ecs_tentacles.components import Creature, Link, Motor, Sucker, Tentacle
 from ecs_tentacles.mathutil import quat_about_z
-from ecs_tentacles.physics.batch import STATE, Batch, size_proxies, state_slices
 from ecs_tentacles.physics.model import (
     CONTACT_SOLREF,
     CREATURE_BIT,
@@ -51,9 +50,25 @@ from ecs_tentacles.physics.model import (
     hinges,
     new_spec,
 )
+from ecs_tentacles.physics.state_layout import STATE, size_proxies, state_slices
 
 if TYPE_CHECKING:
     from ecs_tentacles.physics.host import PhysicsHost
+
+
+class Rows(Protocol):
+    """What the reduced model reads of a batch's rows (`physics.batch.Batch`)."""
+
+    kp: np.ndarray
+    kv: np.ndarray
+    torque: np.ndarray
+    anchor: np.ndarray
+    near: np.ndarray
+    proxy_size: np.ndarray
+    proxy_cylinder: np.ndarray
+    proxy_geoms: np.ndarray
+    equality_ids: np.ndarray
+
 
 S = mujoco.mjtState
 # A reduced servo is its group's servos in series, this much softer: a joined link bends
@@ -326,7 +341,7 @@ class ReducedModel:
         out[fs[int(S.mjSTATE_WARMSTART)]] = 0.0
 
     # -- model values ----------------------------------------------------------------
-    def write_overlay(self, batch: Batch, m: mujoco.MjModel, row: int) -> None:
+    def write_overlay(self, batch: Rows, m: mujoco.MjModel, row: int) -> None:
         """Row `row`'s servos (each reduced one its group's in series), sucker anchors and
         proxy sizes into the reduced scratch model `m`."""
         kp = SERIES_GAIN / (self.series @ (1.0 / np.maximum(batch.kp[row][self.full_u], 1e-12)))
@@ -344,7 +359,7 @@ class ReducedModel:
         if batch.near[row]:
             size_proxies(m, self.proxy_geoms, batch.proxy_cylinder, batch.proxy_size[row])
 
-    def name_ids(self, batch: Batch, full: mujoco.MjModel) -> None:
+    def name_ids(self, batch: Rows, full: mujoco.MjModel) -> None:
         """The reduced model's ids of the batch's equalities and proxy geoms (same names)."""
         obj = mujoco.mjtObj
         self.equality_ids = np.array(

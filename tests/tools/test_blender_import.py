@@ -15,7 +15,9 @@ import numpy as np
 import pytest
 
 from ecs_tentacles.cli import main
-from ecs_tentacles.colours import creature_colours, to_linear
+from ecs_tentacles.colours import to_linear
+from ecs_tentacles.export.materials import take_colours
+from ecs_tentacles.take import Take
 
 BLENDER = os.environ.get("ECS_TENTACLES_BLENDER_PYTHON", "")
 TOOL = Path(__file__).resolve().parents[2] / "tools" / "blender_import.py"
@@ -231,7 +233,9 @@ def test_a_skinned_import_holds_what_the_artist_animates_and_nothing_else(
     assert (report["armatures"], report["animating"], report["outside_scene"]) == (4, 4, [])
     assert not [n for n in looks["all_objects"] if "Icosphere" in n or "materials" in n]
     assert looks["meshes"] == {f"{c}_skin": [f"{c}_skin"] for c in FOUR}
-    for c, srgb in zip(FOUR, creature_colours(4), strict=True):
+    sandbox = take_colours(Take.load(four_take))  # the sandbox's default palette
+    for c in FOUR:
+        srgb = sandbox[c]
         kind, colour = looks["colours"][f"{c}_skin"]
         if kind == "texture":  # sRGB bytes as Blender reads them; rings: 0.9 on average
             np.testing.assert_allclose(np.array(colour) / 0.9, srgb, atol=0.02)
