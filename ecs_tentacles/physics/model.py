@@ -169,13 +169,16 @@ def new_spec(world: PhysicsHost, timestep: float | None = None) -> mujoco.MjSpec
     return spec
 
 
-def _add_creature(spec: mujoco.MjSpec, world: PhysicsHost, creature: Creature) -> None:
-    skin = {
-        "contype": CREATURE_BIT,
-        "conaffinity": GROUND_BIT | PROXY_BIT,
-        "friction": SKIN_FRICTION,
-        "solref": CONTACT_SOLREF,
-    }
+SKIN = {
+    "contype": CREATURE_BIT,
+    "conaffinity": GROUND_BIT | PROXY_BIT,
+    "friction": SKIN_FRICTION,
+    "solref": CONTACT_SOLREF,
+}  # a creature's geoms touch the ground and the proxies, never each other
+
+
+def add_mantle(spec: mujoco.MjSpec, creature: Creature) -> mujoco.MjsBody:
+    """The mantle body: a free joint and a cylinder, at the origin."""
     mantle = spec.worldbody.add_body(name="mantle")
     mantle.add_freejoint(name="root")
     mantle.add_geom(
@@ -183,8 +186,50 @@ def _add_creature(spec: mujoco.MjSpec, world: PhysicsHost, creature: Creature) -
         type=mujoco.mjtGeom.mjGEOM_CYLINDER,
         size=[creature.mantle_radius, 0.5 * creature.mantle_height, 0.0],
         density=creature.mantle_density,
-        **skin,
+        **SKIN,
     )
+    return mantle
+
+
+def add_link(
+    spec: mujoco.MjSpec,
+    parent: mujoco.MjsBody,
+    creature: Creature,
+    base_angle: float,
+    prefix: str,
+    link: Link,
+    motor: Motor,
+    previous: float | None,
+) -> mujoco.MjsBody:
+    """Link body `prefix` (capsule and servos) on `parent`: at the mantle's base edge at
+    `base_angle` when `previous` (the parent link's length) is None, else end to end."""
+    if previous is None:  # base of the tentacle: edge of the mantle's base
+        distance = creature.mantle_radius + 0.5 * link.length
+        pos = [
+            distance * np.cos(base_angle),
+            distance * np.sin(base_angle),
+            -0.5 * creature.mantle_height,
+        ]
+        quat = quat_about_z(base_angle)
+    else:
+        pos = [0.5 * (previous + link.length), 0.0, 0.0]
+        quat = np.array([1.0, 0.0, 0.0, 0.0])
+    body = parent.add_body(name=prefix, pos=pos, quat=quat)
+    body.add_geom(
+        name=prefix,
+        type=mujoco.mjtGeom.mjGEOM_CAPSULE,
+        fromto=[-0.5 * link.length, 0, 0, 0.5 * link.length, 0, 0],
+        size=[link.radius, 0.0, 0.0],
+        density=link.density,
+        **SKIN,
+    )
+    for hinge in hinges(link):
+        add_servo(spec, body, f"{prefix}/{hinge}", hinge, link, motor)
+    return body
+
+
+def _add_creature(spec: mujoco.MjSpec, world: PhysicsHost, creature: Creature) -> None:
+    mantle = add_mantle(spec, creature)
     equalities = 0
     for tentacle_entity in creature.tentacles:
         tentacle = world.component(tentacle_entity, Tentacle)
@@ -193,30 +238,11 @@ def _add_creature(spec: mujoco.MjSpec, world: PhysicsHost, creature: Creature) -
         for link_entity in tentacle.links:
             link = world.component(link_entity, Link)
             prefix = f"t{tentacle.index}/l{link.index:02d}"
-            if previous is None:  # base of the tentacle: edge of the mantle's base
-                angle = tentacle.base_angle
-                distance = creature.mantle_radius + 0.5 * link.length
-                pos = [
-                    distance * np.cos(angle),
-                    distance * np.sin(angle),
-                    -0.5 * creature.mantle_height,
-                ]
-                quat = quat_about_z(angle)
-            else:
-                pos = [0.5 * (previous.length + link.length), 0.0, 0.0]
-                quat = np.array([1.0, 0.0, 0.0, 0.0])
-            body = parent.add_body(name=prefix, pos=pos, quat=quat)
-            body.add_geom(
-                name=prefix,
-                type=mujoco.mjtGeom.mjGEOM_CAPSULE,
-                fromto=[-0.5 * link.length, 0, 0, 0.5 * link.length, 0, 0],
-                size=[link.radius, 0.0, 0.0],
-                density=link.density,
-                **skin,
-            )
             motor = world.component(link_entity, Motor)
-            for hinge in hinges(link):
-                add_servo(spec, body, f"{prefix}/{hinge}", hinge, link, motor)
+            length = None if previous is None else previous.length
+            body = add_link(
+                spec, parent, creature, tentacle.base_angle, prefix, link, motor, length
+            )
             parent, previous = body, link
         for sucker_entity in tentacle.suckers:
             sucker = world.component(sucker_entity, Sucker)

@@ -37,17 +37,11 @@ import mujoco
 import numpy as np
 
 from ecs_tentacles.components import Creature, Link, Motor, Sucker, Tentacle
-from ecs_tentacles.mathutil import quat_about_z
 from ecs_tentacles.physics.model import (
-    CONTACT_SOLREF,
-    CREATURE_BIT,
-    GROUND_BIT,
-    PROXY_BIT,
-    SKIN_FRICTION,
     SUCKER_SOLIMP,
+    add_link,
+    add_mantle,
     add_proxies,
-    add_servo,
-    hinges,
     new_spec,
 )
 from ecs_tentacles.physics.state_layout import STATE, size_proxies, state_slices
@@ -101,15 +95,7 @@ class _Chain:
 def reduced_spec(world: PhysicsHost, creature: Creature, timestep: float) -> mujoco.MjSpec:
     """An MjSpec of `creature`'s reduced model (module docstring), mantle at the origin."""
     spec = new_spec(world, timestep)
-    mantle = spec.worldbody.add_body(name="mantle")
-    mantle.add_freejoint(name="root")
-    mantle.add_geom(
-        name="mantle",
-        type=mujoco.mjtGeom.mjGEOM_CYLINDER,
-        size=[creature.mantle_radius, 0.5 * creature.mantle_height, 0.0],
-        density=creature.mantle_density,
-        **_skin(),
-    )
+    mantle = add_mantle(spec, creature)
     equalities = 0
     for tentacle_entity in creature.tentacles:
         tentacle = world.component(tentacle_entity, Tentacle)
@@ -117,32 +103,17 @@ def reduced_spec(world: PhysicsHost, creature: Creature, timestep: float) -> muj
         motors = [world.component(e, Motor) for e in tentacle.links]
         parts = groups(len(links))
         twist = all(lk.twist for lk in links)  # a twist hinge where every link has one
-        parent, previous = mantle, 0.0
+        parent: mujoco.MjsBody = mantle
+        previous: float | None = None
         centres = []  # each reduced link's centre along the tentacle
         arc = 0.0
         for k, group in enumerate(parts):
             joined = _joined([links[i] for i in group], twist)
             prefix = f"t{tentacle.index}/l{k:02d}"
-            if k == 0:
-                angle = tentacle.base_angle
-                distance = creature.mantle_radius + 0.5 * joined.length
-                pos = [distance * np.cos(angle), distance * np.sin(angle),
-                       -0.5 * creature.mantle_height]  # fmt: skip
-                quat = quat_about_z(angle)
-            else:
-                pos = [0.5 * (previous + joined.length), 0.0, 0.0]
-                quat = np.array([1.0, 0.0, 0.0, 0.0])
-            body = parent.add_body(name=prefix, pos=pos, quat=quat)
-            body.add_geom(
-                name=prefix,
-                type=mujoco.mjtGeom.mjGEOM_CAPSULE,
-                fromto=[-0.5 * joined.length, 0, 0, 0.5 * joined.length, 0, 0],
-                size=[joined.radius, 0.0, 0.0],
-                density=joined.density,
-                **_skin(),
+            motor = motors[int(group[0])]
+            body = add_link(
+                spec, parent, creature, tentacle.base_angle, prefix, joined, motor, previous
             )
-            for hinge in hinges(joined):
-                add_servo(spec, body, f"{prefix}/{hinge}", hinge, joined, motors[int(group[0])])
             centres.append(arc + 0.5 * joined.length)
             arc += joined.length
             parent, previous = body, joined.length
@@ -168,16 +139,6 @@ def reduced_spec(world: PhysicsHost, creature: Creature, timestep: float) -> muj
             equalities += 1
     add_proxies(spec)
     return spec
-
-
-def _skin() -> dict[str, object]:
-    """A reduced geom touches the ground and the proxies, as a full one does."""
-    return {
-        "contype": CREATURE_BIT,
-        "conaffinity": GROUND_BIT | PROXY_BIT,
-        "friction": SKIN_FRICTION,
-        "solref": CONTACT_SOLREF,
-    }
 
 
 def _joined(links: list[Link], twist: bool) -> Link:
