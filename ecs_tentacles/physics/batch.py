@@ -322,26 +322,40 @@ class Batch:
         state, body_ids = self.state, self.body_ids
         for row in rows.tolist():
             write_overlay(self, m, row)
-            pushed = self.applied.get(row)
-            if pushed is not None:
-                d.xfrc_applied[:] = pushed
-                scratch.forced = True
-            elif scratch.forced:
-                d.xfrc_applied[:] = 0.0
-                scratch.forced = False
-            mujoco.mj_setState(m, d, state[row], STATE)
-            d.warning.number[:] = 0
-            try:
-                mujoco.mj_step(m, d, nstep=substeps)
-            except mujoco.FatalError as exc:
-                self.errors[row] = str(exc).splitlines()[0]
-                mujoco.mj_resetData(m, d)
-                continue
-            mujoco.mj_getState(m, d, state[row], STATE)
-            self.xpos[row] = d.xpos[body_ids]
-            self.xquat[row] = d.xquat[body_ids]
-            self.warnings[row] += d.warning.number
-            self.deepest[row] = d.contact.dist.min() if d.ncon else np.inf
+            if self._advance(scratch, row, state[row], self.applied.get(row), substeps):
+                self.xpos[row] = d.xpos[body_ids]
+                self.xquat[row] = d.xquat[body_ids]
+
+    def _advance(
+        self,
+        scratch: Scratch,
+        row: int,
+        vector: np.ndarray,
+        forces: np.ndarray | None,
+        substeps: int,
+    ) -> bool:
+        """Step state `vector` (row `row`'s, in `scratch`'s model layout) in place under
+        `forces` (xfrc_applied, or none); warnings and the deepest contact recorded. False
+        when MuJoCo failed (the error is kept for the health check; `vector` unchanged)."""
+        m, d = scratch.model, scratch.data
+        if forces is not None:
+            d.xfrc_applied[:] = forces
+            scratch.forced = True
+        elif scratch.forced:
+            d.xfrc_applied[:] = 0.0
+            scratch.forced = False
+        mujoco.mj_setState(m, d, vector, STATE)
+        d.warning.number[:] = 0
+        try:
+            mujoco.mj_step(m, d, nstep=substeps)
+        except mujoco.FatalError as exc:
+            self.errors[row] = str(exc).splitlines()[0]
+            mujoco.mj_resetData(m, d)
+            return False
+        mujoco.mj_getState(m, d, vector, STATE)
+        self.warnings[row] += d.warning.number
+        self.deepest[row] = d.contact.dist.min() if d.ncon else np.inf
+        return True
 
     def _step_reduced(self, rows: np.ndarray, substeps: int, thread: int) -> None:
         """Step `rows` with the reduced model (`physics.reduced`): each row's reduced state
@@ -350,7 +364,7 @@ class Batch:
         reduced = self.reduced
         assert reduced is not None  # `prepare(REDUCED)` ran before the threads
         scratch, full = self.scratch_for(thread, REDUCED), self.scratch_for(thread, FULL)
-        m, d, fm, fd = scratch.model, scratch.data, full.model, full.data
+        m, fm, fd = scratch.model, full.model, full.data
         state, rstate, rsource, watched = self.state, self.rstate, self.rsource, reduced.watched
         qpos = self.slices[int(S.mjSTATE_QPOS)]
         body_ids = self.body_ids
@@ -361,29 +375,15 @@ class Batch:
                 reduced.fit_state(state[row], rstate[row])
             reduced.write_overlay(self, m, row)
             pushed = self.applied.get(row)
-            if pushed is not None:
-                d.xfrc_applied[:] = reduced.body_group @ pushed
-                scratch.forced = True
-            elif scratch.forced:
-                d.xfrc_applied[:] = 0.0
-                scratch.forced = False
-            mujoco.mj_setState(m, d, rstate[row], STATE)
-            d.warning.number[:] = 0
-            try:
-                mujoco.mj_step(m, d, nstep=substeps)
-            except mujoco.FatalError as exc:
-                self.errors[row] = str(exc).splitlines()[0]
-                mujoco.mj_resetData(m, d)
+            forces = None if pushed is None else reduced.body_group @ pushed
+            if not self._advance(scratch, row, rstate[row], forces, substeps):
                 continue
-            mujoco.mj_getState(m, d, rstate[row], STATE)
             reduced.expand_state(rstate[row], state[row])
             rsource[row] = state[row, watched]
             fd.qpos[:] = state[row, qpos]
             mujoco.mj_kinematics(fm, fd)
             self.xpos[row] = fd.xpos[body_ids]
             self.xquat[row] = fd.xquat[body_ids]
-            self.warnings[row] += d.warning.number
-            self.deepest[row] = d.contact.dist.min() if d.ncon else np.inf
 
 
 def without_row(array: np.ndarray, row: int) -> np.ndarray:
