@@ -1,7 +1,8 @@
-"""Draws a World: the sky, the ground (the plane's grid, or the terrain and obstacles as
-lit meshes, `ecs_tentacles.ground_mesh`, with the ground beyond the terrain out to the
-horizon, `render.horizon`), creatures, and what the plugins hand it; distance fog in the
-sky's horizon colour joins the ground to the sky.
+"""Draws a World: the sky and the ground (`render.scenery`: the plane's grid, or the
+terrain, the ground beyond it to the horizon and the obstacles), creatures, and what the
+plugins hand it; distance fog in the sky's horizon colour joins the ground to the sky.
+Reads the world's stores (Transform, creatures, suckers) and its plugins' hooks; writes
+its off-screen target (`target`) and the `RenderView` the hooks get (`render_view`).
 
 Creatures are drawn skinned by default (`view = "skinned"`: one continuous mesh per
 creature, skinned on the GPU, all creatures in one draw; `ecs_tentacles.render.skinned`)
@@ -30,7 +31,6 @@ from ecs_tentacles.colours import PALETTES, Look, creature_colour, look_in_world
 from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.drawing import CIRCLE, RenderView
 from ecs_tentacles.ground import ground_of
-from ecs_tentacles.ground_mesh import COLOURS, ground_meshes
 from ecs_tentacles.render import shaders
 from ecs_tentacles.render.camera import OrbitCamera
 from ecs_tentacles.render.decals import QUAD, SUCKER_DISC, shadow_instances, sucker_instances
@@ -38,16 +38,15 @@ from ecs_tentacles.render.gpu import (
     INSTANCE_FLOATS,
     InstancedMesh,
     Lines,
-    Quad,
-    ScreenTriangle,
     Target,
     program,
     set_matrix,
 )
-from ecs_tentacles.render.horizon import HORIZON, REACH, ZENITH, beyond_mesh, fog_range
+from ecs_tentacles.render.horizon import HORIZON, fog_range
 from ecs_tentacles.render.instances import CreatureStatic, creature_links, link_instances
-from ecs_tentacles.render.meshes import CAPSULE_LODS, CYLINDER_LOD, SPHERE_LOD, Mesh
+from ecs_tentacles.render.meshes import CAPSULE_LODS, CYLINDER_LOD, SPHERE_LOD
 from ecs_tentacles.render.outlines import outlined_ribbons
+from ecs_tentacles.render.scenery import Scenery, set_fog
 from ecs_tentacles.render.skinned import SkinnedCreatures
 from ecs_tentacles.roster_change import RosterChange
 from ecs_tentacles.world import World
@@ -73,17 +72,11 @@ class Renderer:
         self.target = Target(width, height)
         self.camera = OrbitCamera(width, height)
         self.lit = program(shaders.INSTANCED_VERTEX, shaders.LIT_FRAGMENT)
-        self.ground_program = program(shaders.GROUND_VERTEX, shaders.GROUND_FRAGMENT)
         self.line_program = program(shaders.LINE_VERTEX, shaders.LINE_FRAGMENT)
-        self.terrain_program = program(shaders.INSTANCED_VERTEX, shaders.TERRAIN_FRAGMENT)
-        self.ground_meshes: list[InstancedMesh] = []  # the terrain and obstacles, if any
-        self.ground_drawn: object = None  # the Ground they were made from
+        self.scenery = Scenery()  # the sky and the ground (`render.scenery`)
         self.skinned_program = program(shaders.SKINNED_VERTEX, shaders.LIT_FRAGMENT)
         self.skinned = SkinnedCreatures()
         self.view = "skinned"
-        self.ground = Quad(REACH)  # the plane, out to where the fog has hidden it
-        self.sky_program = program(shaders.SKY_VERTEX, shaders.SKY_FRAGMENT)
-        self.sky = ScreenTriangle()
         self.mantles = InstancedMesh(CYLINDER_LOD)
         self.links_near = InstancedMesh(CAPSULE_LODS[0])
         self.links_far = InstancedMesh(CAPSULE_LODS[1])
@@ -184,7 +177,7 @@ class Renderer:
         self.link_rows, self.link_instances = links.rows, links.instances
         link_creature, index = links.creature, links.index
         self.link_creature = link_creature  # each link's creature (index in entity order)
-        self._build_ground()
+        self.scenery.build(ground_of(world))
         self.skinned.build(world, self._entities, self.creature_colour)
         meshed = set(self.skinned.creatures)
         self.mantle_skinned = np.array([e in meshed for e in self._entities], bool)
@@ -200,39 +193,6 @@ class Renderer:
         radius_of_row[self.link_rows] = self.link_instances[:, 7]
         suckers = world.suckers
         self.sucker_radii = radius_of_row[suckers.link_row[: len(suckers)]]
-
-    def _build_ground(self) -> None:
-        """The ground's meshes (terrain, the ground beyond it, obstacles) as one-instance
-        meshes; made again only when the world has another ground (a new world, a terrain
-        edit)."""
-        ground = ground_of(self.world)
-        if ground is self.ground_drawn:
-            return
-        self.ground_drawn = ground
-        for old in self.ground_meshes:
-            old.delete()
-        self.ground_meshes = []
-        terrain, solids = ground_meshes(ground)
-        for mesh, colour, grid in (
-            (terrain, COLOURS["terrain"], 1.0),
-            (beyond_mesh(ground), COLOURS["terrain"], 0.0),  # on to the horizon, no grid
-            (solids, COLOURS["obstacles"], 0.0),
-        ):
-            if mesh is None:
-                continue
-            template = Mesh(
-                mesh.vertices.astype(np.float32),
-                mesh.normals.astype(np.float32),
-                np.zeros(len(mesh.vertices), np.float32),
-                mesh.triangles.astype(np.uint32).ravel(),
-            )
-            drawn = InstancedMesh(template)
-            instance = np.zeros((1, INSTANCE_FLOATS), np.float32)
-            instance[0, 3] = 1.0  # identity quaternion (w first)
-            instance[0, 7:10] = 1.0  # unit scale
-            instance[0, 11:15] = (*colour, grid)  # alpha: how much of the metre grid shows
-            drawn.update(instance)
-            self.ground_meshes.append(drawn)
 
     def set_palette(self, palette: str) -> None:
         """Colour the creatures from `palette` ("natural" or "debug") from the next frame."""
@@ -375,25 +335,8 @@ class Renderer:
         gl.glEnable(gl.GL_CULL_FACE)
         view_projection = self.camera.view_projection()
         eye = tuple(self.camera.eye.astype(np.float32))
-        calls = self._draw_sky(view_projection)
         fog = fog_range(self.camera.distance)
-        self._build_ground()  # nothing to do unless the terrain was edited
-        if ground_of(self.world).heightfield is None:  # the plane's grid
-            self.ground_program.use()
-            set_matrix(self.ground_program, "u_view_projection", view_projection)
-            self.ground_program["u_eye"] = eye
-            _set_fog(self.ground_program, fog)
-            gl.glDisable(gl.GL_CULL_FACE)
-            calls += self.ground.draw()
-            gl.glEnable(gl.GL_CULL_FACE)
-        if self.ground_meshes:  # terrain, beyond it, obstacles: lit, three draws at most
-            self.terrain_program.use()
-            set_matrix(self.terrain_program, "u_view_projection", view_projection)
-            self.terrain_program["u_light"] = tuple(LIGHT.astype(np.float32))
-            self.terrain_program["u_eye"] = eye
-            _set_fog(self.terrain_program, fog)
-            for mesh in self.ground_meshes:
-                calls += mesh.draw()
+        calls = self.scenery.draw(ground_of(self.world), view_projection, eye, LIGHT, fog)
         # the blob shadows: blended over the ground, never hiding what is drawn after
         self.blob_program.use()
         set_matrix(self.blob_program, "u_view_projection", view_projection)
@@ -409,7 +352,7 @@ class Renderer:
         set_matrix(self.lit, "u_view_projection", view_projection)
         self.lit["u_light"] = tuple(LIGHT.astype(np.float32))
         self.lit["u_eye"] = eye
-        _set_fog(self.lit, fog)
+        set_fog(self.lit, fog)
         for mesh in (self.mantles, self.links_near, self.links_far, self.spheres):
             calls += mesh.draw()
         calls += self.sucker_discs.draw()
@@ -418,7 +361,7 @@ class Renderer:
             set_matrix(self.skinned_program, "u_view_projection", view_projection)
             self.skinned_program["u_light"] = tuple(LIGHT.astype(np.float32))
             self.skinned_program["u_eye"] = eye
-            _set_fog(self.skinned_program, fog)
+            set_fog(self.skinned_program, fog)
             self.skinned_program["u_palette"] = 0
             calls += self.skinned.draw()
         # the ribbons: over what they lie on (pulled toward the eye), the bright cores
@@ -443,19 +386,6 @@ class Renderer:
         self.draw_calls = calls
         return calls
 
-    def _draw_sky(self, view_projection: np.ndarray) -> int:
-        """The sky's gradient behind everything (no depth written)."""
-        self.sky_program.use()
-        set_matrix(self.sky_program, "u_inverse_view_projection", np.linalg.inv(view_projection))
-        self.sky_program["u_horizon"] = HORIZON
-        self.sky_program["u_zenith"] = ZENITH
-        gl.glDisable(gl.GL_DEPTH_TEST)
-        gl.glDepthMask(gl.GL_FALSE)
-        calls = self.sky.draw()
-        gl.glDepthMask(gl.GL_TRUE)
-        gl.glEnable(gl.GL_DEPTH_TEST)
-        return calls
-
     def frame_all(self) -> None:
         """Point the camera so every creature and what plugins point at (goals) is in view."""
         points = [self.world.transforms.pos]
@@ -478,9 +408,3 @@ class Renderer:
         self.camera.distance *= span
         self.camera.follow = int(self.mantle_rows[index])
         self.upload()  # the target on the creature now
-
-
-def _set_fog(prog: Any, fog: tuple[float, float]) -> None:
-    """The distance fog's uniforms (`render.horizon`) on a program that fogs."""
-    prog["u_fog_colour"] = HORIZON
-    prog["u_fog_start"], prog["u_fog_end"] = fog

@@ -3,9 +3,10 @@
 Physics runs at the scene's fixed frame rate with its own accumulator; drawing
 happens at display rate and interpolates between the last two physics frames.
 
-The mouse and the keys are `render.sandbox_input` (selecting one creature or many,
-goal clicks through the plugins' `sandbox_click` hooks as undoable edits, the HUD's
-panels seeing presses and keys first, the key map).
+Each frame's picture (drawn into the off-screen target, shown, kept as a PNG or an
+MP4) is `render.sandbox_picture`. The mouse and the keys are `render.sandbox_input`
+(selecting one creature or many, goal clicks through the plugins' `sandbox_click` hooks
+as undoable edits, the HUD's panels seeing presses and keys first, the key map).
 
 Level of detail (`world.lod`): before every physics frame the sandbox tells it the
 selected creatures (they run full) and, unless a focus is pinned (`focus=`, `play
@@ -36,7 +37,6 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pyglet
 from imgui_bundle import imgui
-from pyglet import gl
 from pyglet.window import key
 from tqdm import tqdm
 
@@ -48,11 +48,11 @@ from ecs_tentacles.plugin_registry import sandbox_plugins
 from ecs_tentacles.render.camera import CameraChoice
 from ecs_tentacles.render.gui import Gui, same_line_if_fits, text_width
 from ecs_tentacles.render.hud import Hud
-from ecs_tentacles.render.on_screen import creature_at, labels_over
-from ecs_tentacles.render.output import VideoWriter, save_png
+from ecs_tentacles.render.on_screen import creature_at
 from ecs_tentacles.render.plugin import RenderPlugin
 from ecs_tentacles.render.renderer import Renderer
 from ecs_tentacles.render.sandbox_input import SandboxInput
+from ecs_tentacles.render.sandbox_picture import SandboxPicture
 from ecs_tentacles.render.scripts import Scripts
 from ecs_tentacles.render.selection import Selection
 from ecs_tentacles.render.undo import UndoStack
@@ -72,7 +72,7 @@ DISPLAY_HZ = 60
 FOCUS_RADIUS = 4.0  # m around the camera's target where creatures run full physics
 
 
-class Sandbox:
+class Sandbox(SandboxPicture):
     """One scene in a window, with the renderer, HUD and input."""
 
     def __init__(
@@ -121,13 +121,9 @@ class Sandbox:
         self.window.push_handlers(self.input)
         self.window.push_handlers(self.hud.gui)  # the GUI sees every event first
         self.accumulator = 0.0
-        self.video: VideoWriter | None = None
-        self.screenshots = 0
+        self._start_picture()
         self.keys = key.KeyStateHandler()  # which keys are down (panels: `keys[key.S]`)
         self.window.push_handlers(self.keys)
-        self.stats = {"fps": 0.0, "physics_ms": 0.0, "sim_time": 0.0, "rtf": 0.0, "attached": 0}
-        self._wall_start = time.perf_counter()
-        self._last_draw: float | None = None
         self.saved_state: Snapshot | None = None
 
     def aim(self, choice: CameraChoice | None) -> None:
@@ -143,17 +139,6 @@ class Sandbox:
         else:
             renderer.camera.look_from(np.array(choice.eye), np.array(choice.target))
         self.camera_choice = choice
-
-    def keep_framed(self, ease: float = 1.0) -> None:
-        """With `--camera frame-all`: move `ease` of the way to framing every creature and
-        goal as they are now (a video eases; a screenshot snaps)."""
-        if self.camera_choice is None or self.camera_choice.kind != "frame-all":
-            return
-        camera = self.renderer.camera
-        target, distance = camera.target.copy(), camera.distance
-        self.renderer.frame_all()
-        camera.target = target + ease * (camera.target - target)
-        camera.distance = distance * (camera.distance / distance) ** ease
 
     def _view_section(self, gui: Gui) -> None:
         """The HUD's "View": the creatures' palette."""
@@ -306,68 +291,6 @@ class Sandbox:
         self.world = world
         self._attach_world()
         return True
-
-    # -- drawing -----------------------------------------------------------------------
-    def render(self) -> np.ndarray | None:
-        """Draw the world and the HUD off-screen; return the picture if recording."""
-        alpha = 1.0 if self.paused else self.accumulator / self.world.settings.dt
-        self.renderer.overlays = self.hud.visible  # editing aids (fur control markers)
-        self.renderer.show_tiers = self.hud.show_tiers
-        self.renderer.draw(alpha)
-        self._update_stats()
-        gl.glDisable(gl.GL_DEPTH_TEST)
-        gl.glDisable(gl.GL_CULL_FACE)
-        self.hud.draw()
-        pixels = None
-        if self.video is not None:
-            pixels = self.renderer.target.read()
-            self.video.add(pixels)
-        if not self.headless:
-            self.renderer.target.blit_to_window(*self.window.get_framebuffer_size())
-        return pixels
-
-    def on_draw(self) -> None:
-        now = time.perf_counter()
-        if self._last_draw is not None:
-            self.stats["fps"] = 0.9 * self.stats["fps"] + 0.1 / max(now - self._last_draw, 1e-6)
-        self._last_draw = now
-        self.window.clear()
-        self.render()
-
-    def _update_stats(self) -> None:
-        wall = time.perf_counter() - self._wall_start
-        self.stats["sim_time"] = self.world.time
-        self.stats["rtf"] = self.world.time / wall if wall > 0 else 0.0
-        self.stats["attached"] = int(self.world.suckers.attached.sum())
-        self.hud.update(self.stats)
-
-    def creature_labels(self) -> list[tuple[str, float, float]]:
-        """Each creature's name at the pixel above its mantle (for `hud.name_labels`)."""
-        return labels_over(self.world, self.renderer, self.renderer.creature_entities)
-
-    def selected_label(self) -> list[tuple[str, float, float]]:
-        """The selected creature's name above it (a crowd's one label), or nothing."""
-        selected = self.renderer.selected
-        return [] if selected is None else labels_over(self.world, self.renderer, [selected])
-
-    def screenshot(self, path: str | os.PathLike[str] | None = None) -> Path:
-        """Save what the camera sees (with the HUD) as a PNG."""
-        self.render()
-        if path is None:
-            self.screenshots += 1
-            path = f"ecs_tentacles_{self.screenshots:03d}.png"
-        return save_png(self.renderer.target.read(), path)
-
-    def toggle_video(self, path: str | os.PathLike[str] | None = None) -> Path | None:
-        """Start recording, or stop and return the finished file."""
-        if self.video is None:
-            target = path or f"ecs_tentacles_{int(time.time())}.mp4"
-            self.video = VideoWriter(
-                target, self.window.width, self.window.height, self.world.settings.fps
-            )
-            return None
-        video, self.video = self.video, None
-        return video.close()
 
     def save_roster(self, path: str | os.PathLike[str] | None = None) -> Path | None:
         """Write the roster, goals and settings as they are now to a scene file (Ctrl+S:

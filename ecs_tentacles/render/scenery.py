@@ -1,0 +1,123 @@
+"""What is drawn before the creatures: the sky's gradient, then the ground (the plane's
+metre grid, or the terrain, the ground beyond it out to the horizon (`render.horizon`)
+and the obstacles as lit meshes, `ecs_tentacles.ground_mesh`), fogged with distance in
+the sky's horizon colour so the ground joins the sky.
+
+Reads the world's `Ground` (`ground_of`), the camera's view, the light; writes only the
+framebuffer bound by the caller (`Renderer.draw`) and its own GL objects. The ground's
+meshes are made again only when the world has another `Ground` (a new world, a terrain
+edit). `set_fog` puts the same fog on the renderer's other programs.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from pyglet import gl
+
+from ecs_tentacles.ground import Ground
+from ecs_tentacles.ground_mesh import COLOURS, ground_meshes
+from ecs_tentacles.render import shaders
+from ecs_tentacles.render.gpu import (
+    INSTANCE_FLOATS,
+    InstancedMesh,
+    Quad,
+    ScreenTriangle,
+    program,
+    set_matrix,
+)
+from ecs_tentacles.render.horizon import HORIZON, REACH, ZENITH, beyond_mesh
+from ecs_tentacles.render.meshes import Mesh
+
+
+def set_fog(prog: Any, fog: tuple[float, float]) -> None:
+    """The distance fog's uniforms (`render.horizon.fog_range`) on a program that fogs."""
+    prog["u_fog_colour"] = HORIZON
+    prog["u_fog_start"], prog["u_fog_end"] = fog
+
+
+class Scenery:
+    """The sky and the ground's GPU objects, and their draws."""
+
+    def __init__(self) -> None:
+        self.sky_program = program(shaders.SKY_VERTEX, shaders.SKY_FRAGMENT)
+        self.sky = ScreenTriangle()
+        self.ground_program = program(shaders.GROUND_VERTEX, shaders.GROUND_FRAGMENT)
+        self.plane = Quad(REACH)  # the plane, out to where the fog has hidden it
+        self.terrain_program = program(shaders.INSTANCED_VERTEX, shaders.TERRAIN_FRAGMENT)
+        self.ground_meshes: list[InstancedMesh] = []  # the terrain and obstacles, if any
+        self.ground_drawn: object = None  # the Ground they were made from
+
+    def build(self, ground: Ground) -> None:
+        """The ground's meshes (terrain, the ground beyond it, obstacles) as one-instance
+        meshes; nothing to do when they were made from this `ground` already."""
+        if ground is self.ground_drawn:
+            return
+        self.ground_drawn = ground
+        for old in self.ground_meshes:
+            old.delete()
+        self.ground_meshes = []
+        terrain, solids = ground_meshes(ground)
+        for mesh, colour, grid in (
+            (terrain, COLOURS["terrain"], 1.0),
+            (beyond_mesh(ground), COLOURS["terrain"], 0.0),  # on to the horizon, no grid
+            (solids, COLOURS["obstacles"], 0.0),
+        ):
+            if mesh is None:
+                continue
+            template = Mesh(
+                mesh.vertices.astype(np.float32),
+                mesh.normals.astype(np.float32),
+                np.zeros(len(mesh.vertices), np.float32),
+                mesh.triangles.astype(np.uint32).ravel(),
+            )
+            drawn = InstancedMesh(template)
+            instance = np.zeros((1, INSTANCE_FLOATS), np.float32)
+            instance[0, 3] = 1.0  # identity quaternion (w first)
+            instance[0, 7:10] = 1.0  # unit scale
+            instance[0, 11:15] = (*colour, grid)  # alpha: how much of the metre grid shows
+            drawn.update(instance)
+            self.ground_meshes.append(drawn)
+
+    def draw(
+        self,
+        ground: Ground,
+        view_projection: np.ndarray,
+        eye: tuple[float, ...],
+        light: np.ndarray,
+        fog: tuple[float, float],
+    ) -> int:
+        """The sky, then the ground as `ground` is now; returns the draw calls."""
+        calls = self.draw_sky(view_projection)
+        self.build(ground)  # nothing to do unless the terrain was edited
+        if ground.heightfield is None:  # the plane's grid
+            self.ground_program.use()
+            set_matrix(self.ground_program, "u_view_projection", view_projection)
+            self.ground_program["u_eye"] = eye
+            set_fog(self.ground_program, fog)
+            gl.glDisable(gl.GL_CULL_FACE)
+            calls += self.plane.draw()
+            gl.glEnable(gl.GL_CULL_FACE)
+        if self.ground_meshes:  # terrain, beyond it, obstacles: lit, three draws at most
+            self.terrain_program.use()
+            set_matrix(self.terrain_program, "u_view_projection", view_projection)
+            self.terrain_program["u_light"] = tuple(light.astype(np.float32))
+            self.terrain_program["u_eye"] = eye
+            set_fog(self.terrain_program, fog)
+            for mesh in self.ground_meshes:
+                calls += mesh.draw()
+        return calls
+
+    def draw_sky(self, view_projection: np.ndarray) -> int:
+        """The sky's gradient behind everything (no depth written)."""
+        self.sky_program.use()
+        set_matrix(self.sky_program, "u_inverse_view_projection", np.linalg.inv(view_projection))
+        self.sky_program["u_horizon"] = HORIZON
+        self.sky_program["u_zenith"] = ZENITH
+        gl.glDisable(gl.GL_DEPTH_TEST)
+        gl.glDepthMask(gl.GL_FALSE)
+        calls = self.sky.draw()
+        gl.glDepthMask(gl.GL_TRUE)
+        gl.glEnable(gl.GL_DEPTH_TEST)
+        return calls
