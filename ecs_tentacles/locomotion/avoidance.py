@@ -9,7 +9,7 @@ A social-force term, whole-array work over every pair of creatures near each oth
 creature has a personal circle on the ground (`personal_radius`: its mantle radius plus
 its longest tentacle: crawling, the tentacles lie spread out); the pairs whose circles
 come within the scene's `range` of each other are found by the same near-pair search the
-contact proxies use (`ecs_tentacles.physics.proxies.near_pairs`: every pair in small
+contact proxies use (`ecs_tentacles.physics.pairs.near_pairs`: every pair in small
 crowds, a k-d tree in large ones). A neighbour pushes a creature away along the line
 between them and to its right (both sides of a head-on meeting step aside the same way
 and pass), more when the circles are closer (zero at `range`, one at touch, up to two
@@ -25,18 +25,19 @@ without avoidance (bit for bit): scenes whose creatures stay apart do not change
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from ecs_tentacles.construction import creature_layout
-from ecs_tentacles.physics.proxies import near_pairs
+from ecs_tentacles.physics.pairs import near_pairs
 from ecs_tentacles.scene.schema import fragment
 
 BEHIND = 0.3  # a neighbour straight behind weighs this much of one straight ahead
 SIDESTEP = 1.0  # the push to the right (keep right), relative to the push away
+PairFinder = Callable[[np.ndarray, np.ndarray, float], tuple[np.ndarray, np.ndarray]]
 _SCENE = fragment("ecs_tentacles.locomotion", "locomotion")["scene"]["avoidance"]
 
 
@@ -80,18 +81,20 @@ def bend(
     to_goal: np.ndarray,
     reach: float,
     strength: float,
+    pairs: PairFinder = near_pairs,
 ) -> np.ndarray:
     """(n, 2) each creature's avoidance term (module doc); zero where none applies.
 
     `pos` (n, 2): mantles on the ground; `radius` (n,): personal circles; `heading`
     (n, 2): unit directions toward where each crawls (zero: going nowhere); `steering`
     (n,) bool: who steers (the others are only avoided); `to_goal` (n,): ground distance
-    to the steer point; `reach`: the scene's range (m); `strength`: its gain.
+    to the steer point; `reach`: the scene's range (m); `strength`: its gain; `pairs`:
+    what finds the neighbours (`near_pairs`, or a `NearPairCache` kept between frames).
     """
     out = np.zeros((len(pos), 2))
     if len(pos) < 2 or not steering.any() or strength == 0.0:
         return out
-    a, b = near_pairs(pos, radius, reach)
+    a, b = pairs(pos, radius, reach)
     keep = steering[a]
     a, b = a[keep], b[keep]
     if not len(a):

@@ -19,10 +19,10 @@ from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
-from scipy.spatial import cKDTree
 
 from ecs_tentacles.optional_kernels import OptionalKernels
 from ecs_tentacles.physics.model import PROXY_CAPSULES, PROXY_CYLINDERS, PROXY_PARKED
+from ecs_tentacles.physics.pairs import NearPairCache
 
 if TYPE_CHECKING:
     from ecs_tentacles.physics.batch import Batch
@@ -33,7 +33,6 @@ S = mujoco.mjtState
 MARGIN = 0.05  # metres: a body this close to a neighbour's sphere gets a proxy
 POOL = np.array([PROXY_CAPSULES, PROXY_CYLINDERS])
 CAPSULE, CYLINDER = 0, 1
-DENSE_PAIRS = 256  # creatures up to which every pair is compared (no tree to build)
 _NONE = np.zeros(0, dtype=np.int64)
 Sensed = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]  # pos, quat, centre, radius
 KERNELS = OptionalKernels("ecs_tentacles.physics.kernels", "ECS_TENTACLES_SENSE")
@@ -44,6 +43,7 @@ class ContactProxies:
 
     def __init__(self, roster: Roster):
         self.roster = roster
+        self._pairs = NearPairCache()  # the frame's pairs, asked for several times
         self.reindex()
 
     def reindex(self) -> None:
@@ -201,7 +201,7 @@ class ContactProxies:
         for a star of tentacles: neighbours in a crowd are inside each other's spheres
         long before any tentacles meet.
         """
-        a, b = near_pairs(centre, radius, margin)
+        a, b = self._pairs(centre, radius, margin)
         first = a < b
         a, b = a[first], b[first]
         gaps = np.full(len(a), np.inf)
@@ -244,7 +244,7 @@ class ContactProxies:
         self, pos: np.ndarray, quat: np.ndarray, centre: np.ndarray, radius: np.ndarray
     ) -> None:
         roster = self.roster
-        a, b = near_pairs(centre, radius)
+        a, b = self._pairs(centre, radius, MARGIN)
         who, body, slot = self._assign(a, b, pos, centre, radius) if len(a) else (_NONE,) * 3
         was_used = roster.proxies_used > 0
         roster.proxies_used[:] = np.bincount(who, minlength=len(roster))
@@ -298,38 +298,6 @@ class ContactProxies:
         gap = np.linalg.norm(pos[own] - pos[body[pair]], axis=1) - self.rbound[own]
         nearest = np.minimum.reduceat(gap, np.cumsum(per) - per)
         return nearest - self.rbound[body]
-
-
-def near_pairs(
-    centre: np.ndarray, radius: np.ndarray, margin: float = MARGIN
-) -> tuple[np.ndarray, np.ndarray]:
-    """Ordered pairs (a, b), a != b, whose spheres come within `margin` of each other,
-    sorted by a then b. Small crowds compare every pair; large ones ask a k-d tree for
-    the candidates (linear in creatures, not quadratic) and keep the same test."""
-    n = len(centre)
-    if n > DENSE_PAIRS:
-        tree = cKDTree(centre)
-        i, j = tree.query_pairs(2.0 * float(radius.max()) + margin, output_type="ndarray").T
-        gap = np.linalg.norm(centre[i] - centre[j], axis=1) - (radius[i] + radius[j])
-        keep = gap < margin
-        a = np.concatenate((i[keep], j[keep]))
-        b = np.concatenate((j[keep], i[keep]))
-        order = np.lexsort((b, a))
-        return a[order].astype(np.int64), b[order].astype(np.int64)
-    found_a, found_b = [], []
-    block = max(1, 4_000_000 // max(n, 1))  # bound the (block, n) distance matrix
-    for lo in range(0, n, block):
-        hi = min(n, lo + block)
-        gap = np.linalg.norm(centre[lo:hi, None, :] - centre[None, :, :], axis=2)
-        gap -= radius[lo:hi, None] + radius[None, :]
-        near = gap < margin
-        near[np.arange(hi - lo), np.arange(lo, hi)] = False
-        ia, ib = np.nonzero(near)
-        found_a.append(ia + lo)
-        found_b.append(ib)
-    if not found_a:
-        return _NONE, _NONE
-    return np.concatenate(found_a), np.concatenate(found_b)
 
 
 def _bounds(kind: np.ndarray, size: np.ndarray) -> np.ndarray:

@@ -24,6 +24,7 @@ import numpy as np
 from ecs_tentacles.locomotion.avoidance import Avoidance, bend, personal_radius
 from ecs_tentacles.locomotion.navigation import Navigator
 from ecs_tentacles.locomotion.stores import LocomotionStores
+from ecs_tentacles.physics.pairs import NearPairCache
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
@@ -51,6 +52,7 @@ class CrowdAvoidance(System):
     def setup(self, world: Host) -> None:
         self.gaits = world.resource(LocomotionStores).creatures
         self.settings = world.resource(Avoidance)
+        self.pairs = NearPairCache()  # neighbours kept between frames while nobody moved far
         self._radii(world)
 
     def roster_changed(self, world: Host, change: RosterChange) -> None:
@@ -73,8 +75,9 @@ class CrowdAvoidance(System):
         going = (steering & (distance > 0.0))[:, None]
         heading = np.where(going, to_goal / np.maximum(distance, 1e-12)[:, None], 0.0)
         g.avoidance[:] = bend(
-            mantle, self.radius, heading, steering, distance, settings.range, settings.strength
-        )
+            mantle, self.radius, heading, steering, distance, settings.range, settings.strength,
+            pairs=self.pairs,
+        )  # fmt: skip
 
 
 def _heading_point(world: Host, goal: np.ndarray) -> np.ndarray:

@@ -1,0 +1,94 @@
+"""Pairs of creatures near each other: `near_pairs` (the test) and `NearPairCache` (the
+same answers, kept from one call to the next while nothing moved far: a Verlet list).
+
+    a, b = near_pairs(centre, radius, margin)  # spheres within margin of each other
+    pairs = NearPairCache(slack=0.25)
+    a, b = pairs(centre, radius, margin)  # what near_pairs(centre, radius, margin) gives
+
+A large crowd's pairs come from a k-d tree, built and queried on every call: at 10,000
+creatures about 3 ms each, and a frame asks several times (the level of detail, the
+proxies and their refreshes within the frame, crowd avoidance). The cache asks the tree
+once for the pairs within `margin + slack` and keeps them while every sphere has moved
+(centre) and grown (radius) by less than half the slack since: a pair can only have come
+within `margin` if it was within `margin + slack` then. Each call filters the kept pairs
+with near_pairs's own test, so the answer is the same pairs in the same order; the tree
+is asked again only when some creature travelled far. Crowds small enough for the dense
+comparison are not cached (it is cheap, and it stays the one code path they take).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+SLACK = 0.25  # metres of extra reach the kept pairs are found with
+DENSE_PAIRS = 256  # creatures up to which every pair is compared (no tree to build)
+_NONE = np.zeros(0, dtype=np.int64)
+
+
+class NearPairCache:
+    """`near_pairs` for one caller's spheres, answered from pairs kept between calls."""
+
+    def __init__(self, slack: float = SLACK):
+        if not slack > 0:
+            raise ValueError(f"slack: must be > 0, got {slack}")
+        self.slack = slack
+        self.queries = 0  # times the tree was asked (for benchmarks and tests)
+        self._kept: tuple[np.ndarray, np.ndarray] | None = None
+        self._centre = np.zeros((0, 3))
+        self._radius = np.zeros(0)
+        self._reach = 0.0
+
+    def __call__(
+        self, centre: np.ndarray, radius: np.ndarray, margin: float
+    ) -> tuple[np.ndarray, np.ndarray]:
+        if len(centre) <= DENSE_PAIRS:
+            return near_pairs(centre, radius, margin)
+        if not self._still_valid(centre, radius, margin):
+            reach = margin + self.slack
+            self._kept = near_pairs(centre, radius, reach)
+            self._centre, self._radius, self._reach = centre.copy(), radius.copy(), reach
+            self.queries += 1
+        assert self._kept is not None
+        a, b = self._kept
+        gap = np.linalg.norm(centre[a] - centre[b], axis=1) - (radius[a] + radius[b])
+        keep = gap < margin
+        return a[keep], b[keep]
+
+    def _still_valid(self, centre: np.ndarray, radius: np.ndarray, margin: float) -> bool:
+        if self._kept is None or self._centre.shape != centre.shape:
+            return False
+        moved = np.linalg.norm(centre - self._centre, axis=1) + np.maximum(radius - self._radius, 0)
+        return bool(margin + 2.0 * moved.max() < self._reach)  # NaN: never valid
+
+
+def near_pairs(
+    centre: np.ndarray, radius: np.ndarray, margin: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Ordered pairs (a, b), a != b, whose spheres come within `margin` of each other,
+    sorted by a then b. Small crowds compare every pair; large ones ask a k-d tree for
+    the candidates (linear in creatures, not quadratic) and keep the same test."""
+    n = len(centre)
+    if n > DENSE_PAIRS:
+        tree = cKDTree(centre)
+        i, j = tree.query_pairs(2.0 * float(radius.max()) + margin, output_type="ndarray").T
+        gap = np.linalg.norm(centre[i] - centre[j], axis=1) - (radius[i] + radius[j])
+        keep = gap < margin
+        a = np.concatenate((i[keep], j[keep]))
+        b = np.concatenate((j[keep], i[keep]))
+        order = np.lexsort((b, a))
+        return a[order].astype(np.int64), b[order].astype(np.int64)
+    found_a, found_b = [], []
+    block = max(1, 4_000_000 // max(n, 1))  # bound the (block, n) distance matrix
+    for lo in range(0, n, block):
+        hi = min(n, lo + block)
+        gap = np.linalg.norm(centre[lo:hi, None, :] - centre[None, :, :], axis=2)
+        gap -= radius[lo:hi, None] + radius[None, :]
+        near = gap < margin
+        near[np.arange(hi - lo), np.arange(lo, hi)] = False
+        ia, ib = np.nonzero(near)
+        found_a.append(ia + lo)
+        found_b.append(ib)
+    if not found_a:
+        return _NONE, _NONE
+    return np.concatenate(found_a), np.concatenate(found_b)

@@ -1,0 +1,57 @@
+"""near_pairs and NearPairCache: the cache answers exactly what near_pairs would."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from numpy.testing import assert_array_equal
+
+from ecs_tentacles.physics.pairs import DENSE_PAIRS, NearPairCache, near_pairs
+
+
+def _crowd(rng: np.random.Generator, n: int) -> tuple[np.ndarray, np.ndarray]:
+    side = np.sqrt(n) * 1.2  # about one creature per 1.4 square metres: many neighbours
+    centre = np.column_stack([rng.uniform(0, side, (n, 2)), np.full(n, 0.1)])
+    return centre, rng.uniform(0.2, 0.6, n)
+
+
+def test_the_cache_gives_near_pairs_answers_as_creatures_wander() -> None:
+    rng = np.random.default_rng(3)
+    n = 2 * DENSE_PAIRS  # large enough for the tree
+    centre, radius = _crowd(rng, n)
+    cache = NearPairCache(slack=0.2)
+    calls = 0
+    for frame in range(120):
+        centre[:, :2] += rng.normal(0.0, 0.01, (n, 2))  # a crawl: ~1 cm a frame
+        radius = np.clip(radius + rng.normal(0.0, 0.005, n), 0.1, 0.7)  # tentacles reach
+        if frame == 60:
+            centre[7, :2] += 3.0  # one creature thrown far: the kept pairs are stale
+        for margin in (0.05, 0.2):  # the proxies' margin, the level of detail's
+            got = cache(centre, radius, margin)
+            want = near_pairs(centre, radius, margin)
+            calls += 1
+            assert_array_equal(got[0], want[0])
+            assert_array_equal(got[1], want[1])
+            assert len(want[0]) > 0
+    assert 2 <= cache.queries < calls // 4  # the tree asked again now and then, not each call
+
+
+def test_the_cache_asks_again_when_the_crowd_changes_size() -> None:
+    rng = np.random.default_rng(4)
+    centre, radius = _crowd(rng, 300)
+    cache = NearPairCache()
+    cache(centre, radius, 0.1)
+    fewer = cache(centre[:-1], radius[:-1], 0.1)
+    want = near_pairs(centre[:-1], radius[:-1], 0.1)
+    assert_array_equal(fewer[0], want[0])
+    assert cache.queries == 2
+
+
+def test_small_crowds_and_bad_slack() -> None:
+    rng = np.random.default_rng(5)
+    centre, radius = _crowd(rng, 20)
+    cache = NearPairCache()
+    assert_array_equal(cache(centre, radius, 0.1)[0], near_pairs(centre, radius, 0.1)[0])
+    assert cache.queries == 0  # the dense comparison: nothing kept
+    with pytest.raises(ValueError, match="slack"):
+        NearPairCache(slack=0.0)
