@@ -1,7 +1,9 @@
 """action_queue: advances every tentacle's action timer and starts the next action.
 
 An interrupted tentacle (`ActionQueues.interrupt`: tentacle_selection starting or
-aborting a drive, or a script) moves on at once, whatever its timer.
+aborting a drive, or a script) moves on at once, whatever its timer. The tentacles of
+creatures the level of detail replays (KINEMATIC, as the last frame decided) move on
+to nothing: their actions pause, and go on (an overdue one ends) once promoted.
 
 Reads: locomotion's tentacle store (timer, duration, action, interrupted),
 TentacleStore (tip sucker), Sucker store (attached: an attach action waits for its
@@ -65,7 +67,10 @@ class ActionQueueSystem(System):
         interrupted = t.interrupted
         if interrupted.any():
             done |= interrupted
-            interrupted[:] = False
+        replayed = world.physics.kinematic_creatures(len(world.creatures))
+        if replayed.any():  # their actions pause (an interruption waits): the clip carries them
+            done &= ~replayed[world.tentacles.creature_row]
+        interrupted[done] = False
         for row in np.flatnonzero(done):
             self._advance(world, int(row))
 

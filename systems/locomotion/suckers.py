@@ -9,11 +9,15 @@
   `release_stretch` from its anchor (the elastic energy of the hold is too high).
 * release on reach: the tentacle's base is farther from the anchor than
   `release_reach` tentacle lengths, so a creature never drags a sucker behind it.
+* release on replay: the level of detail replays the creature (KINEMATIC, as the last
+  frame decided): nothing of it is simulated, so it grips nothing, and a promoted
+  creature starts free instead of yanked toward an anchor left behind. Replayed
+  creatures never attach; their suckers cost nothing a frame.
 Each change fires `sucker_attached` / `sucker_released` (with the reason).
 
 Reads: locomotion's stores (action; release thresholds), TentacleStore (tip_sucker,
-length, base, creature), Sucker store, Transform store, the Ground. Writes: Sucker store
-(attached, anchor).
+length, base, creature), Sucker store, Transform store, the Ground, the physics' tiers.
+Writes: Sucker store (attached, anchor).
 """
 
 from __future__ import annotations
@@ -57,7 +61,8 @@ class Suckers(System):
             return
         attached = s.attached
         tip = t.tip_sucker
-        reaching = np.flatnonzero(action == ATTACH)
+        replayed = world.physics.kinematic_creatures(len(world.creatures))[t.creature_row]
+        reaching = np.flatnonzero((action == ATTACH) & ~replayed)
         if len(reaching):
             rows = tip[reaching]
             rows = rows[~attached[rows]]
@@ -76,6 +81,7 @@ class Suckers(System):
         base = world.transforms.pos[t.base_row[tentacle], :2]
         reach = np.linalg.norm(base - anchor[:, :2], axis=1)
         reasons = (
+            ("replayed", replayed[tentacle]),
             ("command", ~holding),
             ("stretch", stretch > c.release_stretch[creature]),
             ("reach", reach > c.release_reach[creature] * t.length[tentacle]),

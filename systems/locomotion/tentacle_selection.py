@@ -15,6 +15,9 @@ ramp chooses and orients its strokes along the slope, not along their shadows.
   direction; drivers are re-classified every frame and abort when the goal has moved
   to their other side.
 * no goal: drives stop (the sucker lets go) and every tentacle idles.
+* replayed creatures (KINEMATIC, as the last frame decided) start and abort nothing:
+  their tentacles drive nothing, the gait clip carries them; a promoted creature
+  picks up its strokes where they paused.
 
 First it has the `Navigator` set each creature's steer point: its goal, or the next
 waypoint of a path around obstacles (`ecs_tentacles.locomotion.navigation`). The
@@ -25,7 +28,7 @@ creature is near): that is the "goal" direction every choice below is made again
 Reads: locomotion's stores (goal, navigate, steer, avoidance; gait, drivers, speed; action,
 mode, driving),
 CreatureStore and TentacleStore (mantle, tentacle rows, bases), Transform store, the
-Ground.
+Ground, the physics' tiers.
 Writes: locomotion's tentacle store (driving, mode, started) and creature store
 (steer, next_driver, last_start), ActionQueues (a started drive is queued and
 the current action interrupted; an abort replaces the queue with detach, settle).
@@ -138,6 +141,7 @@ class TentacleSelection(System):
         creature = t.creature_row
         pos = world.transforms.pos
         ground = ground_of(world)
+        replayed = world.physics.kinematic_creatures(len(c))  # their strokes drive nothing
         if ground.flat:
             mantle = pos[c.mantle_row, :2]
             to_goal = bent(g.steer[:, :2] - mantle, g.avoidance)[creature]
@@ -145,7 +149,7 @@ class TentacleSelection(System):
         else:  # creatures the level of detail replays keep world xy: their strokes drive nothing
             mantle3 = pos[c.mantle_row]
             normals = np.tile([0.0, 0.0, 1.0], (len(c), 1))
-            driven = ~world.physics.kinematic_creatures(len(c)) & g.has_goal
+            driven = ~replayed & g.has_goal
             normals[driven] = ground.normal_under(mantle3[driven, :2])
             basis = ground_plane(normals)[creature]  # (n, 2, 3)
             to_goal = _in_plane(basis, bent(g.steer - mantle3, g.avoidance)[creature])
@@ -157,10 +161,11 @@ class TentacleSelection(System):
             wrong_side = (g.gait[creature] == self.coordinated) & np.where(
                 s.mode == PULL, cos < -ABORT_MARGIN, cos > ABORT_MARGIN
             )
-            for row in np.flatnonzero(driving_now & (~has_goal | wrong_side)):
+            abort = driving_now & (~has_goal | wrong_side) & ~replayed[creature]
+            for row in np.flatnonzero(abort):
                 self._abort(world, int(row))
         driving = np.bincount(creature, weights=s.driving, minlength=len(c))
-        idle_goal = g.has_goal & (driving < g.drivers)
+        idle_goal = g.has_goal & (driving < g.drivers) & ~replayed
         if not idle_goal.any():
             return
         cyclic = g.gait == self.cyclic

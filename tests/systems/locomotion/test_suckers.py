@@ -191,3 +191,44 @@ def test_each_release_is_counted(make_world: Callable[..., World]) -> None:
     assert events.reasons() == ["stretch", "command"]
     assert world.events.counts["sucker_attached"] == 2
     assert world.events.counts["sucker_released"] == 2
+
+
+def _crowd(count: int) -> dict[str, Any]:
+    """`count` small creatures on a grid, each crawling 1.5 m along +x; few full and
+    reduced slots, so most are replayed (KINEMATIC) after 0.1 s."""
+    creatures = []
+    for i in range(count):
+        x, y = 2.0 * (i % 4), 2.0 * (i // 4)
+        creatures.append(
+            {
+                "name": f"c{i}",
+                "position": [x, y],
+                "tentacles": {"count": 4, "links": 5},
+                "goals": [{"position": [x + 1.5, y]}],
+            }
+        )
+    lod = {"full": 1, "reduced": 1, "hold_seconds": 0.1}
+    return {"version": 1, "physics": {"lod": lod}, "creatures": creatures}
+
+
+def test_replayed_creatures_hold_no_sucker_and_a_promoted_one_starts_free(
+    make_world: Callable[..., World],
+) -> None:
+    world = make_world(_crowd(8))
+    creature_of_sucker = world.tentacles.creature_row[world.suckers.tentacle_row]
+    replayed_before = np.zeros(len(world.creatures), dtype=bool)
+    held_by_replayed = 0
+    for _ in range(150):
+        world.step(1)
+        replayed = world.physics.kinematic_creatures(len(world.creatures))
+        steady = replayed & replayed_before  # replayed since the last frame's decisions
+        held_by_replayed += int(world.suckers.attached[steady[creature_of_sucker]].sum())
+        replayed_before = replayed
+    assert replayed.sum() >= 4  # most of the crowd is replayed
+    assert held_by_replayed == 0
+    # a promoted creature starts free: no anchor left behind pulls it
+    row = int(np.flatnonzero(replayed)[0])
+    world.lod.promote(int(world.creatures.entity[row]))
+    world.step(1)
+    assert not world.physics.kinematic_creatures(len(world.creatures))[row]
+    assert not world.suckers.attached[creature_of_sucker == row].any()
