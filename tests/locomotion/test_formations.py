@@ -5,7 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ecs_tentacles.locomotion.formations import SHAPES, formation_goals, reach, slots
+from ecs_tentacles.components import Creature, Transform
+from ecs_tentacles.director.scatter import scatter
+from ecs_tentacles.ground import ground_of
+from ecs_tentacles.locomotion.formations import SHAPES, formation_goals, reach, slots, spacing
+from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.world import World
 
 
@@ -61,3 +65,70 @@ def test_no_goal_lands_inside_an_obstacle() -> None:
         goals = formation_goals(world, chosen, (20.0, 0.0), "grid")
         inside = np.abs(goals - [20.0, 0.0]).max(axis=1) < 1.5 + 0.3
         assert not inside.any()
+
+
+def _spread_crowd_on_the_shore(world: World) -> list[int]:
+    """rocky_shore's 6 creatures and 23 more scattered over its 14 x 10 m heightfield."""
+    scatter(world, world.creature_specs[world.creature("west0")], (0.0, 0.0), 7.0, 23, seed=0)
+    chosen = [entity for entity, _ in world.query(Creature)]
+    assert len(chosen) == 29
+    return chosen
+
+
+def _where(world: World, creatures: list[int]) -> np.ndarray:
+    return np.array([world.component(c, Transform).pos[:2] for c in creatures])
+
+
+CLICK = np.array([1.0, 0.5])  # near the middle of the shore, between its rocks
+
+
+@pytest.mark.parametrize("shape", SHAPES)
+def test_a_formation_gathers_a_spread_crowd_round_the_click(shape: str) -> None:
+    """29 creatures spread over rocky_shore sent to a point got goals 1.5-5.7 m from it,
+    each 0.3-1.9 m from where the creature already was: the group did not gather."""
+    with World.from_scene("rocky_shore") as world:
+        chosen = _spread_crowd_on_the_shore(world)
+        goals = formation_goals(world, chosen, CLICK, shape)
+        step = spacing([reach(world, c) for c in chosen])
+        # reachable: every creature stands on the heightfield, none on a rock
+        ground = ground_of(world)
+        assert ground.heightfield is not None
+        inside = 0.5 * np.asarray(ground.heightfield.size) - reach(world, chosen[0])
+        assert (np.abs(goals) <= inside + 1e-9).all()
+        on_top = np.column_stack([goals, ground.surface(goals)])
+        assert (ground.inside_solid(on_top, 0.5 * step) < 0).all()
+        gap = np.linalg.norm(goals[:, None] - goals[None], axis=2)
+        np.fill_diagonal(gap, np.inf)
+        assert gap.min() >= step - 1e-9
+        # compact: 29 slots a spacing apart packed round the click (a hexagonal disc)
+        # lie on average 2/3 of its radius away; a formation may lose a little to rocks
+        # and the shore's edge but not spread back over the crowd
+        disc = step * np.sqrt(len(chosen) * np.sqrt(3.0) / (2.0 * np.pi))
+        distance = np.linalg.norm(goals - CLICK, axis=1)
+        before = np.linalg.norm(_where(world, chosen) - CLICK, axis=1)
+        assert distance.mean() <= 0.85 * before.mean()
+        if shape != "line":  # a line is as long as the group; here it folds into rows
+            assert distance.mean() <= 1.45 * (2.0 / 3.0) * disc
+            assert distance.max() <= disc + 1.5 * step
+
+
+def test_a_crowd_sent_to_a_point_crawls_there() -> None:
+    with World.from_scene("rocky_shore") as world:
+        chosen = _spread_crowd_on_the_shore(world)
+        goals = formation_goals(world, chosen, CLICK, "ring")
+        book = world.resource(GoalBook)
+        for creature, goal in zip(chosen, goals, strict=True):
+            book.set(creature, goal.tolist())
+        start = _where(world, chosen)
+        world.step(round(8.0 / world.settings.dt))
+        now = _where(world, chosen)
+        far = np.linalg.norm(goals - start, axis=1) > 1.0
+        assert far.sum() >= 10  # most have somewhere to go
+        # every creature with a way to go went its way
+        assert (
+            np.linalg.norm(goals - now, axis=1)[far] < np.linalg.norm(goals - start, axis=1)[far]
+        ).all()
+        before = np.linalg.norm(start - CLICK, axis=1).mean()
+        after = np.linalg.norm(now - CLICK, axis=1).mean()
+        assert after < before - 0.15
+        assert world.physics.health.recoveries == 0
