@@ -93,10 +93,12 @@ class Gui:
             raise RuntimeError("Dear ImGui could not initialise its OpenGL 3 renderer")
         self.rects: dict[str, tuple[float, float, float, float]] = {}
         self.windows: dict[str, tuple[float, float, float, float]] = {}
+        self.clips: dict[str, tuple[float, float, float, float]] = {}  # what of each shows
         self._last = time.perf_counter()
         self._in_frame = False
         self.draw_commands = 0
         self.frames = 0  # frames built so far
+        self.remeasure = False  # this frame is to be built again before it is drawn
 
     # -- events: pyglet -> ImGui -------------------------------------------------------
     def _use(self) -> Any:
@@ -164,6 +166,8 @@ class Gui:
         imgui.new_frame()
         self.rects.clear()
         self.windows.clear()
+        self.clips.clear()
+        self.remeasure = False
         self._in_frame = True
 
     def item(self, name: str) -> None:
@@ -172,9 +176,19 @@ class Gui:
         self.rects[name] = (low.x, low.y, high.x, high.y)
 
     def window_rect(self, name: str) -> None:
-        """Record the current ImGui window's rectangle (call between begin and end)."""
+        """Record the current ImGui window's rectangle (`windows`) and the part of it
+        where its widgets show unclipped (`clips`: inside the frame, padding, title bar
+        and scroll bars); call between begin and end."""
         pos, size = imgui.get_window_pos(), imgui.get_window_size()
         self.windows[name] = (pos.x, pos.y, pos.x + size.x, pos.y + size.y)
+        clip = imgui.internal.get_current_window().inner_clip_rect
+        self.clips[name] = (clip.min.x, clip.min.y, clip.max.x, clip.max.y)
+
+    def measure_again(self) -> None:
+        """A window sized to its content changed it this frame: ImGui sizes such a window
+        from the content it had the frame before, so build this frame once more before
+        drawing it (`Hud.draw`), or it shows clipped for a frame."""
+        self.remeasure = True
 
     def end_frame(self, draw: bool = True) -> int:
         """Draw the frame into the bound framebuffer; return the GL draw calls issued."""
@@ -195,6 +209,7 @@ class Gui:
         """No GUI this frame (hidden): forget last frame's rectangles."""
         self.rects.clear()
         self.windows.clear()
+        self.clips.clear()
 
     def contains(self, x: float, y: float) -> bool:
         """True when pyglet pixel (x, y) is over one of last frame's GUI windows."""

@@ -117,10 +117,12 @@ class Hud:
         if not self.visible and not self.name_labels and self.band is None:
             self.gui.skip_frame()
             return 0
-        if not self.gui.frames:  # windows that fit their content know their size from frame 2
-            self._build()
-            self.gui.end_frame(draw=False)
         self._build()
+        if not self.gui.frames or self.gui.remeasure:
+            # windows that fit their content know their size from the next build: on the
+            # first frame, and when one's content changed (`Gui.measure_again`)
+            self.gui.end_frame(draw=False)
+            self._build()
         return self.gui.end_frame()
 
     def _build(self) -> None:

@@ -9,7 +9,8 @@ reload adds a line ("reloaded mywave.py (wave)", or why the old code keeps runni
 a reloaded system runs again, so its failure leaves the list.
 
 The window sits at the top right, over the 3D view, and only when it has something
-to say.
+to say. It is measured before it is drawn whenever its lines change (`Gui.measure_again`:
+an ImGui window sized to its content otherwise shows last frame's size for a frame).
 """
 
 from __future__ import annotations
@@ -32,7 +33,9 @@ log = logging.getLogger("ecs_tentacles.scripting")
 RED = (0.78, 0.05, 0.05, 1.0)
 GREEN = (0.05, 0.45, 0.15, 1.0)
 NOTES = 4  # reload lines kept
-WIDTH = 0.42  # of the window's width, at most
+WIDTH = 0.42  # of the window's width (wider at a large UI scale, where there is room)
+EMS = 24  # the least width in font heights, room allowing (the lines wrap less)
+MARGIN = 8.0  # pixels from the window's edges
 
 
 @dataclass(frozen=True)
@@ -59,6 +62,7 @@ class Scripts:
         self.notes: deque[tuple[bool, str]] = deque(maxlen=NOTES)  # (ok, line)
         self.world: World | None = None
         self.reloader: Reloader | None = None
+        self._drawn: tuple[tuple[Failure, ...], tuple[tuple[bool, str], ...]] | None = None
 
     def attach(self, world: World) -> None:
         """Watch a (new) world's plugin files; forget the old world's failures."""
@@ -111,16 +115,32 @@ class Scripts:
 
     # -- drawing -----------------------------------------------------------------------
     def draw(self, gui: Gui) -> None:
-        """The window at the top right, when there is a failure or a reload to show."""
+        """The window at the top right, when there is a failure or a reload to show: as
+        tall as its lines (never past the screen's bottom: it scrolls then), "clear" on
+        its first row, every button whole at any UI scale."""
         if not self.failures and not self.notes:
+            self._drawn = None
             return
-        width = float(self.window.width) * WIDTH
-        imgui.set_next_window_pos((float(self.window.width) - 8.0, 8.0), 0, (1.0, 0.0))
+        shown = (tuple(self.failures), tuple(self.notes))
+        if shown != self._drawn:  # sized from the last frame's lines: measure these first
+            gui.measure_again()
+            self._drawn = shown
+        screen_w, screen_h = float(self.window.width), float(self.window.height)
+        panel = gui.windows.get("panel")  # the HUD's panel on the left, if it shows
+        room = screen_w - (panel[2] if panel is not None else 0.0) - 2 * MARGIN
+        wide = max(WIDTH * screen_w, EMS * imgui.get_font_size())
+        width = max(min(wide, room), WIDTH * screen_w)  # beside the HUD when it can be
+        imgui.set_next_window_pos((screen_w - MARGIN, MARGIN), 0, (1.0, 0.0))
         imgui.set_next_window_size((width, 0.0))  # as tall as its lines need
+        imgui.set_next_window_size_constraints((width, 0.0), (width, screen_h - 2 * MARGIN))
         flags = imgui.WindowFlags_.no_move | imgui.WindowFlags_.no_resize
         flags |= imgui.WindowFlags_.no_collapse | imgui.WindowFlags_.no_saved_settings
         imgui.begin("Scripts", None, flags)
         gui.window_rect("scripts")
+        if self.notes:
+            if imgui.small_button("clear"):
+                self.notes.clear()
+            gui.item("clear notes")
         for failure in list(self.failures):
             imgui.push_style_color(imgui.Col_.text, RED)
             imgui.text_wrapped(failure.headline)
@@ -128,7 +148,7 @@ class Scripts:
             imgui.text_wrapped(failure.error)
             gui.item(f"error {failure.label}")
             imgui.pop_style_color()
-            if imgui.button(f"re-enable {failure.label}"):
+            if imgui.button(f"re-enable##{failure.label}"):  # the headline names it
                 self.enable(failure.label)
             gui.item(f"enable {failure.label}")
         for i, (ok, line) in enumerate(self.notes):
@@ -136,7 +156,4 @@ class Scripts:
             imgui.text_wrapped(line)
             imgui.pop_style_color()
             gui.item(f"note {i}")
-        if self.notes and imgui.small_button("clear"):
-            self.notes.clear()
-        gui.item("clear notes")
         imgui.end()

@@ -145,3 +145,47 @@ def test_reset_with_broken_code_keeps_the_world_and_says_why(
     assert sandbox.world is not world and sandbox.world.frame == 0
     assert sandbox.scripts.failures == [] and sandbox.scripts.reloader is not None
     assert sandbox.scripts.reloader.world is sandbox.world
+
+
+def _inside(rect: tuple[float, ...], region: tuple[float, ...]) -> bool:
+    return (
+        region[0] <= rect[0]
+        and rect[2] <= region[2]
+        and region[1] <= rect[1]
+        and rect[3] <= region[3]
+    )
+
+
+@pytest.mark.parametrize(
+    ("scale", "size"),
+    [(0.5, (1280, 720)), (1.0, (1280, 720)), (2.0, (1280, 720)), (3.0, (1280, 720)),
+     (1.0, (640, 360)), (3.0, (640, 360))],
+)  # fmt: skip
+def test_the_scripts_window_never_clips_its_buttons(
+    scene: Path, make_sandbox: Callable[..., Any], scale: float, size: tuple[int, int]
+) -> None:
+    """The "clear" and "re-enable" buttons lie whole inside the window's visible content,
+    on the very frame a line is added (a screenshot taken then), at every UI scale."""
+    from ecs_tentacles.render.gui import set_ui_scale
+
+    set_ui_scale(scale)
+    try:
+        sandbox = make_sandbox(scene, allow_systems=True, width=size[0], height=size[1])
+    finally:
+        set_ui_scale(1.0)
+    sandbox.render()  # nothing to say yet: no Scripts window
+    assert "scripts" not in sandbox.hud.gui.windows
+    sandbox.step(6)  # the wave fails at frame 5
+    sandbox.scripts.say(True, "saved octopus_directed.json")
+    lines = ["not reset: creatures[0].tentacles.links: must be >= 2, got 0", "reloaded mywave.py"]
+    for line in ["", *lines]:
+        if line:
+            sandbox.scripts.say(False, line)  # the window grows on this frame
+        sandbox.render()
+        gui = sandbox.hud.gui
+        window, visible = gui.windows["scripts"], gui.clips["scripts"]
+        assert _inside(window, (0, 0, *size))
+        for name in ("clear notes", "enable wave"):
+            assert _inside(gui.rects[name], visible), (name, gui.rects[name], visible)
+    click_item(sandbox, "clear notes")
+    assert not sandbox.scripts.notes
