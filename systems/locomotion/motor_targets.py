@@ -115,6 +115,7 @@ class MotorTargets(System):
         self.eased = motors.target[:, :2].copy()
         self.strokes = world.resource(LocomotionStores).tentacles
         self.follow: np.ndarray | None = None  # on terrain: `ground_follow` this frame
+        self.link_creature = tentacles.creature_row[motors.tentacle_row]  # per motor row
 
     def roster_changed(self, world: Host, change: RosterChange) -> None:
         """A spawn: the tables made again, everyone's easing kept; a despawn: the removed
@@ -130,6 +131,7 @@ class MotorTargets(System):
             self.previous_of = np.where(before >= 0, moved[before], -1)
             self.inner = np.flatnonzero(self.previous_of >= 0)
             self.previous = self.previous_of[self.inner]
+            self.link_creature = world.tentacles.creature_row[world.motors.tentacle_row]
             return
         eased = change.follow(self.eased, "motors")
         self.setup(world)
@@ -153,7 +155,7 @@ class MotorTargets(System):
             return
         # creatures the level of detail replays: their servos drive nothing, so their
         # links are left out (a promoted one eases from its last targets, servos soft)
-        links = np.flatnonzero(~kinematic[world.tentacles.creature_row[motors.tentacle_row]])
+        links = np.flatnonzero(~kinematic[self.link_creature])
         if not len(links):
             return
         position = np.full(len(motors), -1, dtype=np.int64)

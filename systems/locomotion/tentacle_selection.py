@@ -139,22 +139,11 @@ class TentacleSelection(System):
         if not len(t) or not (g.has_goal.any() or s.driving.any()):
             return
         creature = t.creature_row
-        pos = world.transforms.pos
-        ground = ground_of(world)
         replayed = world.physics.kinematic_creatures(len(c))  # their strokes drive nothing
-        if ground.flat:
-            mantle = pos[c.mantle_row, :2]
-            to_goal = bent(g.steer[:, :2] - mantle, g.avoidance)[creature]
-            to_base = pos[t.base_row, :2] - mantle[creature]
-        else:  # creatures the level of detail replays keep world xy: their strokes drive nothing
-            mantle3 = pos[c.mantle_row]
-            normals = np.tile([0.0, 0.0, 1.0], (len(c), 1))
-            driven = ~replayed & g.has_goal
-            normals[driven] = ground.normal_under(mantle3[driven, :2])
-            basis = ground_plane(normals)[creature]  # (n, 2, 3)
-            to_goal = _in_plane(basis, bent(g.steer - mantle3, g.avoidance)[creature])
-            to_base = _in_plane(basis, pos[t.base_row] - mantle3[creature])
-        pull, cos = classify(to_goal, to_base)
+        live = np.flatnonzero(~replayed[creature])  # tentacle rows worth classifying
+        to_goal, to_base = self._vectors(world, live, ~replayed & g.has_goal)
+        pull, cos = np.zeros(len(t), dtype=bool), np.zeros(len(t))
+        pull[live], cos[live] = classify(to_goal[live], to_base[live])
         has_goal = g.has_goal[creature]
         driving_now = s.driving
         if driving_now.any():
@@ -177,6 +166,32 @@ class TentacleSelection(System):
         ready = idle_goal & ~cyclic & (world.time - g.last_start >= stagger)
         for row in np.flatnonzero(ready):
             self._start_best(world, int(row), cos, pull, to_goal, to_base)
+
+    def _vectors(
+        self, world: Host, live: np.ndarray, driven: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """(tentacles, 2) ground-plane vectors mantle -> goal (turned by avoidance) and
+        mantle -> base, filled at tentacle rows `live` (zero elsewhere); on terrain the
+        plane is the one under each mantle of the `driven` creatures (world xy else)."""
+        t, c, g = world.tentacles, world.creatures, self.gaits
+        to_goal, to_base = np.zeros((len(t), 2)), np.zeros((len(t), 2))
+        if not len(live):
+            return to_goal, to_base
+        creature = t.creature_row[live]
+        pos = world.transforms.pos
+        ground = ground_of(world)
+        if ground.flat:
+            mantle = pos[c.mantle_row, :2]
+            to_goal[live] = bent(g.steer[:, :2] - mantle, g.avoidance)[creature]
+            to_base[live] = pos[t.base_row[live], :2] - mantle[creature]
+            return to_goal, to_base
+        mantle3 = pos[c.mantle_row]
+        normals = np.tile([0.0, 0.0, 1.0], (len(c), 1))
+        normals[driven] = ground.normal_under(mantle3[driven, :2])
+        basis = ground_plane(normals)[creature]  # (n, 2, 3)
+        to_goal[live] = _in_plane(basis, bent(g.steer - mantle3, g.avoidance)[creature])
+        to_base[live] = _in_plane(basis, pos[t.base_row[live]] - mantle3[creature])
+        return to_goal, to_base
 
     def _start_best(
         self,
