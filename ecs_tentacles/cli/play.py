@@ -92,10 +92,10 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--ui-scale",
         type=ui_scale,
-        default=1.0,
+        default=None,
         metavar="FACTOR",
-        help="draw the HUD FACTOR times larger, in [0.5, 3] (default 1: scaled with the"
-        " window's height)",
+        help="draw the HUD FACTOR times larger, in [0.5, 3] (default: as the display asks,"
+        " its DPI over 96; 1 headless); either way it also grows with the window's height",
     )
     parser.add_argument("--seed", type=seed_int, default=None, help="override the scene's seed")
     parser.add_argument("--allow-systems", action="store_true", help="run systems the scene names")

@@ -13,9 +13,11 @@ says whether a pixel belongs to the GUI (clicks there are not for the world).
 
 from __future__ import annotations
 
+import math
 import time
 from typing import Any
 
+import pyglet
 from imgui_bundle import imgui
 from pyglet.window import key, mouse
 
@@ -47,20 +49,47 @@ _KEYS = {
 _BUTTONS = {mouse.LEFT: 0, mouse.RIGHT: 1, mouse.MIDDLE: 2}
 
 
-UI_SCALE = {"scale": 1.0}  # the user's factor over the window's own (`play --ui-scale`)
+UI_SCALE: dict[str, float | None] = {"scale": None}  # the user's factor (`play --ui-scale`)
+SCALE_RANGE = (0.5, 3.0)  # the least and the largest factor, the user's or the display's
 
 
-def gui_scale(height: int) -> float:
+def display_scale(window: Any) -> float:
+    """How much larger the display wants the GUI drawn: the window's DPI scale (pyglet's
+    `Window.scale`, its DPI over 96) over the stretch its framebuffer already gives the
+    picture (a Retina framebuffer is twice the window: what is drawn at window size is
+    magnified already), within `SCALE_RANGE`. 1 headless (no display: a picture does not
+    depend on the machine) and when the platform does not say."""
+    if pyglet.options["headless"]:
+        return 1.0
+    try:
+        dpi_scale = float(window.scale)
+        stretch = window.get_framebuffer_size()[0] / window.width
+    except (AttributeError, NotImplementedError, TypeError, ZeroDivisionError):
+        return 1.0
+    ratio = dpi_scale / stretch if stretch > 0 else dpi_scale
+    if not math.isfinite(ratio) or ratio <= 0:
+        return 1.0
+    return min(SCALE_RANGE[1], max(SCALE_RANGE[0], ratio))
+
+
+def ui_factor(display: float = 1.0) -> float:
+    """The user's factor (`set_ui_scale`), or `display` (`display_scale`) if none was given."""
+    user = UI_SCALE["scale"]
+    return display if user is None else user
+
+
+def gui_scale(height: int, display: float = 1.0) -> float:
     """Text and spacing scale for a window `height` pixels tall (0.7 to 1.5), times the
-    user's `UI_SCALE` (0.5 to 3)."""
-    return min(1.5, max(0.7, height / BASE_HEIGHT)) * UI_SCALE["scale"]
+    user's `UI_SCALE` (0.5 to 3) or, when none was given, the display's (`display`)."""
+    return min(1.5, max(0.7, height / BASE_HEIGHT)) * ui_factor(display)
 
 
-def set_ui_scale(factor: float) -> None:
-    """Draw every GUI `factor` times larger (0.5 to 3; `play --ui-scale`)."""
-    if not 0.5 <= factor <= 3.0:
+def set_ui_scale(factor: float | None) -> None:
+    """Draw every GUI `factor` times larger (0.5 to 3; `play --ui-scale`); None: as large
+    as the display asks (`display_scale`: its DPI, 1 headless)."""
+    if factor is not None and not SCALE_RANGE[0] <= factor <= SCALE_RANGE[1]:
         raise ValueError(f"the UI scale must be in [0.5, 3], got {factor}")
-    UI_SCALE["scale"] = float(factor)
+    UI_SCALE["scale"] = None if factor is None else float(factor)
 
 
 def same_line_if_fits(width: float) -> None:
@@ -89,6 +118,7 @@ class Gui:
         style = imgui.get_style()
         style.window_rounding = 0.0
         self.scale = 1.0
+        self.display = display_scale(window)  # the display's factor, read once
         if not imgui.backends.opengl3_init("#version 330"):
             raise RuntimeError("Dear ImGui could not initialise its OpenGL 3 renderer")
         self.rects: dict[str, tuple[float, float, float, float]] = {}
@@ -156,8 +186,8 @@ class Gui:
         now = time.perf_counter()
         io.delta_time = max(now - self._last, 1e-4)
         self._last = now
-        scale = gui_scale(self.window.height)
-        if scale != self.scale:  # only when the window is resized
+        scale = gui_scale(self.window.height, self.display)
+        if scale != self.scale:  # only when the window is resized (or the user's factor set)
             style = imgui.get_style()
             style.scale_all_sizes(scale / self.scale)
             style.font_scale_main = scale

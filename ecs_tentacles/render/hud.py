@@ -33,9 +33,10 @@ OWN_ORDER = 0  # the HUD's own sections' place among the panels' (`Panel.order`)
 SECTION_ORDER = 10  # where bare `sections` go
 
 
-def panel_width(width: int, height: int) -> int:
-    """The HUD panel's width in pixels for a window of this size."""
-    return int(min(PANEL_WIDTH * gui_scale(height), PANEL_SHARE * width))
+def panel_width(width: int, height: int, display: float = 1.0) -> int:
+    """The HUD panel's width in pixels for a window of this size on a display that asks
+    for `display` times larger GUIs (`render.gui.display_scale`)."""
+    return int(min(PANEL_WIDTH * gui_scale(height, display), PANEL_SHARE * width))
 
 
 CLOSED = ("Plugins", "View")  # own and bare sections that start folded
@@ -110,7 +111,9 @@ class Hud:
     @property
     def width(self) -> int:
         """Pixels the panel covers on the left (0 when hidden)."""
-        return panel_width(self.window.width, self.window.height) if self.visible else 0
+        if not self.visible:
+            return 0
+        return panel_width(self.window.width, self.window.height, self.gui.display)
 
     def draw(self) -> int:
         """Build and draw the panel; return the GL draw calls it issued."""

@@ -15,6 +15,16 @@ from pyglet.event import EventDispatcher  # noqa: E402  (after configure: pyglet
 from pyglet.window import mouse  # noqa: E402
 
 
+@pytest.fixture(autouse=True)
+def ui_scale_as_the_display_asks() -> Iterator[None]:
+    """Each test starts and ends with no user UI scale (`play --ui-scale` sets one)."""
+    from ecs_tentacles.render.gui import set_ui_scale
+
+    set_ui_scale(None)
+    yield
+    set_ui_scale(None)
+
+
 @pytest.fixture
 def make_sandbox() -> Iterator[Callable[..., Any]]:
     """Headless sandboxes (640 x 360 unless told), closed after the test."""

@@ -168,11 +168,8 @@ def test_the_scripts_window_never_clips_its_buttons(
     on the very frame a line is added (a screenshot taken then), at every UI scale."""
     from ecs_tentacles.render.gui import set_ui_scale
 
-    set_ui_scale(scale)
-    try:
-        sandbox = make_sandbox(scene, allow_systems=True, width=size[0], height=size[1])
-    finally:
-        set_ui_scale(1.0)
+    set_ui_scale(scale)  # (tests/render/conftest.py sets it back)
+    sandbox = make_sandbox(scene, allow_systems=True, width=size[0], height=size[1])
     sandbox.render()  # nothing to say yet: no Scripts window
     assert "scripts" not in sandbox.hud.gui.windows
     sandbox.step(6)  # the wave fails at frame 5
