@@ -146,8 +146,10 @@ class GaitClips:
         out_quat: np.ndarray,
         *,
         interpolate: bool = True,
+        rows: np.ndarray | None = None,
     ) -> None:
-        """Body poses of K creatures into `out_pos` (K, B, 3) and `out_quat` (K, B, 4).
+        """Body poses of K creatures into `out_pos` (K, B, 3) and `out_quat` (K, B, 4),
+        or into their rows `rows` (K,) of larger (N, B, .) arrays (a batch's poses).
 
         `kind` (K,) is `IDLE` or `CRAWL`; `phase` (K,) the frame in that clip (any real
         number: it wraps; fractions interpolate positions linearly and rotations by
@@ -164,8 +166,17 @@ class GaitClips:
             where = np.ascontiguousarray(xy, dtype=np.float64)
             turn = np.ascontiguousarray(heading, dtype=np.float64)
             fraction = phase - below
+            into = np.arange(len(kind)) if rows is None else np.asarray(rows, dtype=np.int64)
             fast.place(self._pose, self._change, row, fraction, interpolate, where, turn,
-                       out_pos, out_quat)  # fmt: skip
+                       into, out_pos, out_quat)  # fmt: skip
+            return
+        if rows is not None:  # numpy: whole arrays, then one scatter
+            pos, quat = (
+                np.empty((len(kind), *out_pos.shape[1:])),
+                np.empty((len(kind), *out_quat.shape[1:])),
+            )
+            self.evaluate(kind, phase, xy, heading, pos, quat, interpolate=interpolate)
+            out_pos[rows], out_quat[rows] = pos, quat
             return
         if interpolate:
             below = np.floor(phase)

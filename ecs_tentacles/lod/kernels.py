@@ -27,17 +27,20 @@ def place(
     interpolate: bool,
     xy: np.ndarray,
     heading: np.ndarray,
+    out_rows: np.ndarray,
     out_pos: np.ndarray,
     out_quat: np.ndarray,
 ) -> None:
     """Creature k shows clip table row `row[k]` (+ `fraction[k]` of `change` when
-    `interpolate`, quaternions renormalised) moved to `xy[k]` and turned by `heading[k]`.
+    `interpolate`, quaternions renormalised) moved to `xy[k]` and turned by `heading[k]`,
+    written to row `out_rows[k]` of the outputs (a batch's pose arrays: no copy after).
 
     `pose` and `change` are (rows, B, 7) ground-frame tables (position, quaternion);
-    the outputs are (K, B, 3) and (K, B, 4).
+    the outputs are (N, B, 3) and (N, B, 4).
     """
     for k in range(len(row)):
         r = row[k]
+        o = out_rows[k]
         t = fraction[k]
         c, s = math.cos(heading[k]), math.sin(heading[k])
         hc, hs = math.cos(0.5 * heading[k]), math.sin(0.5 * heading[k])
@@ -52,10 +55,10 @@ def place(
                 w, qx, qy, qz = w + d[3] * t, qx + d[4] * t, qy + d[5] * t, qz + d[6] * t
                 norm = math.sqrt(w * w + qx * qx + qy * qy + qz * qz)
                 w, qx, qy, qz = w / norm, qx / norm, qy / norm, qz / norm
-            out_pos[k, b, 0] = c * x - s * y + ox
-            out_pos[k, b, 1] = s * x + c * y + oy
-            out_pos[k, b, 2] = z
-            out_quat[k, b, 0] = hc * w - hs * qz
-            out_quat[k, b, 1] = hc * qx - hs * qy
-            out_quat[k, b, 2] = hc * qy + hs * qx
-            out_quat[k, b, 3] = hc * qz + hs * w
+            out_pos[o, b, 0] = c * x - s * y + ox
+            out_pos[o, b, 1] = s * x + c * y + oy
+            out_pos[o, b, 2] = z
+            out_quat[o, b, 0] = hc * w - hs * qz
+            out_quat[o, b, 1] = hc * qx - hs * qy
+            out_quat[o, b, 2] = hc * qy + hs * qx
+            out_quat[o, b, 3] = hc * qz + hs * w

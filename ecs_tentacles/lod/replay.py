@@ -165,15 +165,13 @@ class ClipReplay:
             self.xy[mine, 1] += step * np.sin(heading[here])
             self.phase[mine] += dt / clips.crawl.dt
             rows = roster.row_of[mine]
-            pos = np.empty((len(mine), len(batch.body_ids), 3))
-            quat = np.empty((len(mine), len(batch.body_ids), 4))
             whole = bool(np.all(self.phase[mine] == np.round(self.phase[mine])))
-            clips.evaluate(self.kind[mine], self.phase[mine], self.xy[mine],
-                           self.heading[mine], pos, quat, interpolate=not whole)  # fmt: skip
+            clips.evaluate(self.kind[mine], self.phase[mine], self.xy[mine], self.heading[mine],
+                           batch.xpos, batch.xquat, interpolate=not whole, rows=rows)  # fmt: skip
             if ground.heightfield is not None:  # draped over the terrain, body by body
-                pos[..., 2] += ground.height(pos[..., :2].reshape(-1, 2)).reshape(pos.shape[:2])
-            batch.xpos[rows] = pos
-            batch.xquat[rows] = quat
+                pos = batch.xpos[rows]
+                lift = ground.height(pos[..., :2].reshape(-1, 2)).reshape(pos.shape[:2])
+                batch.xpos[rows, :, 2] += lift
 
     # -- snapshots -------------------------------------------------------------------------
     def state(self) -> tuple[np.ndarray, ...]:

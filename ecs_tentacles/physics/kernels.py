@@ -50,3 +50,67 @@ def sense(
             if reach > radius:
                 radius = reach
         out_radius[c] = radius
+
+
+@njit(cache=True, nogil=True)
+def pair_gaps(
+    pos: np.ndarray,
+    centre: np.ndarray,
+    radius: np.ndarray,
+    rbound: np.ndarray,
+    start: np.ndarray,
+    count: np.ndarray,
+    a: np.ndarray,
+    b: np.ndarray,
+    margin: float,
+    out_gaps: np.ndarray,
+) -> None:
+    """For each pair (a[p], b[p]), the gap between their nearest bodies into `out_gaps[p]`
+    (left as it is where no body of one comes within `margin` of the other's reach
+    sphere): `ContactProxies.pair_gaps`'s numbers, pair by pair, without the arrays of
+    every candidate body (at 10,000 creatures about 7 ms a frame in numpy)."""
+    most = 0
+    for c in range(len(count)):
+        most = max(most, count[c])
+    near_a = np.empty(most, dtype=np.int64)
+    near_b = np.empty(most, dtype=np.int64)
+    for p in range(len(a)):
+        na = _inside(pos, centre, radius, rbound, start, count, a[p], b[p], margin, near_a)
+        if na == 0:
+            continue
+        nb = _inside(pos, centre, radius, rbound, start, count, b[p], a[p], margin, near_b)
+        best = out_gaps[p]
+        for i in range(na):
+            u = near_a[i]
+            for j in range(nb):
+                v = near_b[j]
+                dx, dy, dz = pos[u, 0] - pos[v, 0], pos[u, 1] - pos[v, 1], pos[u, 2] - pos[v, 2]
+                gap = math.sqrt(dx * dx + dy * dy + dz * dz) - rbound[u] - rbound[v]
+                if gap < best:
+                    best = gap
+        out_gaps[p] = best
+
+
+@njit(cache=True, nogil=True)
+def _inside(
+    pos: np.ndarray,
+    centre: np.ndarray,
+    radius: np.ndarray,
+    rbound: np.ndarray,
+    start: np.ndarray,
+    count: np.ndarray,
+    x: int,
+    y: int,
+    margin: float,
+    out: np.ndarray,
+) -> int:
+    """Bodies of creature x within `margin` of y's reach sphere into `out`; how many."""
+    n = 0
+    cx, cy, cz = centre[y, 0], centre[y, 1], centre[y, 2]
+    limit = radius[y] + margin
+    for body in range(start[x], start[x] + count[x]):
+        dx, dy, dz = pos[body, 0] - cx, pos[body, 1] - cy, pos[body, 2] - cz
+        if math.sqrt(dx * dx + dy * dy + dz * dz) - rbound[body] < limit:
+            out[n] = body
+            n += 1
+    return n

@@ -207,6 +207,11 @@ class ContactProxies:
         gaps = np.full(len(a), np.inf)
         if not len(a):
             return a, b, gaps
+        fast = KERNELS.get()
+        if fast is not None:  # the same numbers, pair by pair
+            fast.pair_gaps(pos, centre, radius, self.rbound, self.start, self.count, a, b,
+                           float(margin), gaps)  # fmt: skip
+            return a, b, gaps
         pa, ba = self._inside(a, b, pos, centre, radius, margin)
         pb, bb = self._inside(b, a, pos, centre, radius, margin)
         na = np.bincount(pa, minlength=len(a))

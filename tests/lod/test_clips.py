@@ -209,3 +209,25 @@ def test_the_replay_kernel_equals_the_numpy_path(
     np.testing.assert_allclose(pos, pos_np, rtol=0, atol=1e-12)
     np.testing.assert_allclose(quat, quat_np, rtol=0, atol=1e-12)
     np.testing.assert_allclose(np.linalg.norm(quat, axis=-1), 1.0, atol=1e-12)
+
+
+@pytest.mark.parametrize("backend", ["auto", "numpy"])
+def test_poses_written_into_rows_of_a_batch_array_are_the_poses_evaluated(
+    clips: GaitClips, backend: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from ecs_tentacles.lod import clips as module
+
+    monkeypatch.setattr(module.KERNELS, "backend", backend)
+    rng = np.random.default_rng(6)
+    count, bodies = 40, len(clips.bodies)
+    kind, phase = rng.integers(0, 2, count), rng.uniform(0.0, 90.0, count)
+    xy, heading = rng.uniform(-5.0, 5.0, (count, 2)), rng.uniform(-3.0, 3.0, count)
+    pos, quat = np.empty((count, bodies, 3)), np.empty((count, bodies, 4))
+    clips.evaluate(kind, phase, xy, heading, pos, quat)
+    rows = rng.permutation(100)[:count]  # scattered rows of a 100-row batch
+    batch_pos, batch_quat = np.full((100, bodies, 3), 7.0), np.full((100, bodies, 4), 7.0)
+    clips.evaluate(kind, phase, xy, heading, batch_pos, batch_quat, rows=rows)
+    np.testing.assert_array_equal(batch_pos[rows], pos)
+    np.testing.assert_array_equal(batch_quat[rows], quat)
+    others = np.setdiff1d(np.arange(100), rows)
+    assert (batch_pos[others] == 7.0).all() and (batch_quat[others] == 7.0).all()  # untouched

@@ -142,3 +142,23 @@ def test_the_sense_kernel_gives_the_numpy_numbers_bit_for_bit(
         sensed.append(world.physics.proxies.sense(world.transforms))
     for kernel, numpy_path in zip(*sensed, strict=True):
         np.testing.assert_array_equal(kernel, numpy_path)
+
+
+def test_the_pair_gaps_kernel_gives_the_numpy_numbers_bit_for_bit(
+    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from ecs_tentacles.creator.crowd import crowd_scene
+    from ecs_tentacles.physics import proxies as module
+
+    world = make_world(crowd_scene(12, seed=3, spacing=1.6))  # packed: spheres overlap
+    world.step(20)
+    proxies = world.physics.proxies
+    pos, _, centre, radius = proxies.sense(world.transforms)
+    found = []
+    for backend in ("auto", "numpy"):
+        monkeypatch.setattr(module.KERNELS, "backend", backend)
+        found.append(proxies.pair_gaps(pos, centre, radius, 0.5))
+    for kernel, numpy_path in zip(*found, strict=True):
+        np.testing.assert_array_equal(kernel, numpy_path)
+    gaps = found[0][2]
+    assert np.isfinite(gaps).sum() >= 3 and np.isinf(gaps).sum() >= 1  # near and not quite
