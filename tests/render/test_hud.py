@@ -14,7 +14,7 @@ from pyglet.window import key
 
 from ecs_tentacles.cli import main
 from ecs_tentacles.locomotion.params import Locomotion
-from ecs_tentacles.render.hud import PANEL_SHARE, panel_width
+from ecs_tentacles.render.hud import PANEL_SHARE, PANEL_WIDTH, panel_width
 from tests.render.conftest import click_gui, click_item, event
 
 
@@ -273,3 +273,25 @@ def test_ui_scale_makes_the_hud_larger(make_sandbox: Callable[..., Any]) -> None
         finally:
             set_ui_scale(1.0)
     assert heights[1] > 1.3 * heights[0]
+
+
+def test_at_720p_every_section_fits_the_panel(make_sandbox: Callable[..., Any]) -> None:
+    """At 1280 x 720, its text at scale 1, no section's widget runs past the panel's
+    edges (each section opened in turn)."""
+    sandbox = make_sandbox("hedgehog_octopus", width=1280, height=720)  # fur: every section
+    sandbox.render()
+    gui = sandbox.hud.gui
+    x0, _, x1, _ = gui.windows["panel"]
+    assert x1 - x0 == PANEL_WIDTH and gui.scale == 1.0
+    sections = ["Stats", "Physics", "Plugins", "Locomotion", "Fur", "View", "Director"]
+    sections += ["Terrain", "Actions"]
+    for name in sections:
+        sandbox.hud.unfold(name)
+        sandbox.render()
+        left, _, right, _ = gui.clips["panel"]  # where the panel's widgets show unclipped
+        mine = {n: r for n, r in gui.rects.items() if x0 <= r[0] < x1}  # not the timeline's
+        below = [mine[s][1] for s in sections if mine[s][1] > mine[name][3]]
+        end = min(below, default=float("inf"))  # the next header's top
+        inside = [n for n, r in mine.items() if mine[name][3] <= r[1] < end]
+        assert len(inside) >= 2, name  # the section is open: its widgets between the headers
+        assert [n for n, r in mine.items() if r[2] > right or r[0] < left] == [], name

@@ -16,6 +16,7 @@ from PIL import Image
 from ecs_tentacles.cli import main
 from ecs_tentacles.render import gui
 from ecs_tentacles.render.gui import display_scale, set_ui_scale
+from ecs_tentacles.render.hud import PANEL_SHARE, PANEL_WIDTH
 
 
 @dataclass
@@ -64,7 +65,8 @@ def test_the_users_factor_wins_over_the_displays(
         sandbox = make_sandbox("octopus", width=1280, height=720)
         sandbox.render()
         sizes[factor] = (sandbox.hud.gui.scale, sandbox.hud.width)
-    assert sizes == {None: (1.5, 450), 1.0: (1.0, 300), 2.0: (2.0, 512)}  # 512: 40 % of 1280
+    wide = PANEL_WIDTH
+    assert sizes == {None: (1.5, 1.5 * wide), 1.0: (1.0, wide), 2.0: (2.0, PANEL_SHARE * 1280)}
 
 
 def _panel_width(shot: Path) -> int:
@@ -87,5 +89,5 @@ def test_play_scales_the_hud_by_ui_scale_and_by_1_headless_without(tmp_path: Pat
         scale = [] if factor is None else ["--ui-scale", factor]
         assert main([*argv, *size, *scale, "--screenshot", str(shot)]) == 0
         widths[factor] = _panel_width(shot)
-    assert widths[None] == widths["1"] == pytest.approx(300, abs=2)  # the panel at scale 1
-    assert widths["0.8"] == pytest.approx(240, abs=2)
+    assert widths[None] == widths["1"] == pytest.approx(PANEL_WIDTH, abs=2)  # at scale 1
+    assert widths["0.8"] == pytest.approx(0.8 * PANEL_WIDTH, abs=2)
