@@ -1,8 +1,9 @@
 """Ready-made terrains for generated scenes (`ecs-tentacles crowd N --terrain rocky`).
 
 `rocky(positions, reach, seed)`: a noise heightfield under the whole crowd (cells about
-`CELL` metres, the default's density) with rocks between the creatures' start places,
-none closer to a start than the creature's reach.
+`CELL` metres, the default's density; `ROCKY_HEIGHT` from its lowest to its highest
+point) with rocks between the creatures' start places, none closer to a start than the
+creature's reach; each stands on the ground (the scene's `on_ground` default).
 """
 
 from __future__ import annotations
@@ -14,7 +15,9 @@ import numpy as np
 from ecs_tentacles.terrain.heights import MAX_RESOLUTION
 
 CELL = 20.0 / 128  # metres between samples: the schema default's density on 20 m
-ROCKY_HEIGHT = 0.4  # metres from the lowest to the highest point
+# metres from the lowest to the highest point: twice the tallest mantle a generated crowd
+# has (0.25 m) and more, so a hill hides a creature behind it from a camera at its height
+ROCKY_HEIGHT = 0.6
 NAMES = ("flat", "rocky")
 
 

@@ -14,10 +14,12 @@ from PIL import Image
 
 from ecs_tentacles.cli import main
 from ecs_tentacles.construction import creature_layout
-from ecs_tentacles.ground import ground_of
+from ecs_tentacles.ground import Ground, Solid, ground_of
 from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.physics.tiers import KINEMATIC, REDUCED
 from ecs_tentacles.scene.errors import SceneError
+from ecs_tentacles.scene.load import bundled_scene
+from ecs_tentacles.terrain.scene_ground import build_ground
 from ecs_tentacles.world import World
 
 ROCKY = {
@@ -128,7 +130,7 @@ def _validate(
     return code, capsys.readouterr().err
 
 
-BAD = {
+BAD: dict[str, tuple[dict[str, Any], str]] = {
     "image missing": (
         {"heightfield": {"size": [4, 4], "image": "nowhere.png"}},
         "terrain.heightfield.image: nowhere.png: no such file in the scene's folder",
@@ -285,14 +287,69 @@ def _above_ground(world: World) -> np.ndarray:
     return tops - ground.heightfield.height(centres)
 
 
+def _footprint(solid: Solid, ground: Ground) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Over the points (k, 2) a 2 cm grid puts under `solid`: its lowest and highest
+    point on each vertical line there and the ground's height."""
+    side = np.arange(-solid.bound, solid.bound + 0.02, 0.02)
+    xy = solid.position[:2] + np.stack(np.meshgrid(side, side), axis=-1).reshape(-1, 2)
+    top = solid.top(xy)
+    xy, top = xy[np.isfinite(top)], top[np.isfinite(top)]
+    depth = np.linspace(0.0, 2.0 * solid.bound, 401)  # 1 cm or finer, down from the top
+    z = top[:, None] - depth[None, :]
+    inside = (
+        solid.signed_distance(
+            np.column_stack([np.repeat(xy, len(depth), axis=0), z.ravel()])
+        ).reshape(z.shape)
+        <= 1e-9
+    )
+    lowest = z[np.arange(len(xy)), len(depth) - 1 - np.argmax(inside[:, ::-1], axis=1)]
+    return lowest, top, ground.height(xy)
+
+
+def _rocky_scenes(tmp_path: pathlib.Path) -> list[tuple[str, dict[str, Any], Any]]:
+    """rocky_shore and `crowd N --terrain rocky` for a small and a large crowd."""
+    shore = bundled_scene("rocky_shore")
+    made = [("rocky_shore", json.loads(shore.read_text()), shore.parent)]
+    for count in (40, 256):
+        out = tmp_path / f"crowd{count}.json"
+        assert main(["crowd", str(count), "--terrain", "rocky", "--out", str(out)]) == 0
+        made.append((f"crowd {count}", json.loads(out.read_text()), tmp_path))
+    return made
+
+
 def test_rocks_stand_on_the_terrain_not_in_it(tmp_path: pathlib.Path) -> None:
     """rocky_shore's ledge was 0.13 m under the surface, and 5 of 6 rocks of `crowd 40
-    --terrain rocky` had their tops below the ground: the ground read as plain sand."""
-    out = tmp_path / "crowd.json"
-    assert main(["crowd", "40", "--terrain", "rocky", "--out", str(out)]) == 0
-    for source in ("rocky_shore", str(out)):
-        with World.from_scene(source) as world:
-            assert (_above_ground(world) > 0.1).all(), source
+    --terrain rocky` had their tops below the ground (of 34 with 256 creatures, 8 stuck
+    out more than 5 cm): the ground read as plain sand. Every obstacle a scene does not
+    bury on purpose (`on_ground`: false) now rests on the ground, its lowest point at
+    or under the lowest ground beneath it (no gap under a side), and rises 5 cm or more
+    above the highest ground beneath it (seen from any side)."""
+    for name, scene, folder in _rocky_scenes(tmp_path):
+        terrain = scene["terrain"]
+        ground = build_ground(terrain, folder)
+        standing = [o.get("on_ground", True) for o in terrain["obstacles"]]
+        assert len(ground.solids) == len(standing) >= 4, name
+        for k, solid in enumerate(ground.solids):
+            if not standing[k]:
+                continue
+            lowest, top, under = _footprint(solid, ground)
+            assert lowest.min() <= under.min() + 0.005, f"{name}: obstacle {k} floats"
+            assert top.max() - under.max() >= 0.05, f"{name}: obstacle {k} is buried"
+
+
+def test_rocky_ground_has_relief_an_artist_notices(tmp_path: pathlib.Path) -> None:
+    """The heightfield rises and falls 0.5 m or more where the creatures are: twice the
+    tallest mantle a generated crowd has (0.25 m), so from a camera at a creature's
+    height a hill hides a creature behind it (the preset had 0.4 m, rocky_shore 0.47 m
+    where its creatures are)."""
+    for name, scene, folder in _rocky_scenes(tmp_path):
+        field = build_ground(scene["terrain"], folder).heightfield
+        assert field is not None
+        starts = np.array([c["position"][:2] for c in scene["creatures"]])
+        low, high = starts.min(axis=0), starts.max(axis=0)
+        xs, ys = (np.linspace(low[i], high[i], 200) for i in range(2))
+        heights = field.height(np.stack(np.meshgrid(xs, ys), axis=-1).reshape(-1, 2))
+        assert heights.max() - heights.min() >= 0.5, name
 
 
 def test_on_ground_false_measures_z_from_zero_and_the_plane_is_unchanged() -> None:
@@ -303,7 +360,9 @@ def test_on_ground_false_measures_z_from_zero_and_the_plane_is_unchanged() -> No
     with World.from_scene(sunk) as world:
         standing, under = _above_ground(world)
         assert standing == pytest.approx(0.2) and under < 0.2
-        height = ground_of(world).heightfield.height(np.array([[-1.5, -3.0]]))[0]
+        field = ground_of(world).heightfield
+        assert field is not None
+        height = field.height(np.array([[-1.5, -3.0]]))[0]
         assert under == pytest.approx(0.2 - height)
     with World.from_scene(scene({"obstacles": [rock]}, [3.0, 3.0])) as world:
         assert ground_of(world).solids[0].position.tolist() == [-1.5, -3.0, 0.0]
