@@ -6,6 +6,10 @@ bound UsdPreviewSurface (`/World/terrain/materials/<mesh>`). glTF: a node `terra
 with a child node per mesh (`terrain/surface`, `terrain/obstacles`), each with a mesh
 and a material of the same colour. A take recorded on the plane has neither. If a
 creature is called `terrain`, the ground's root is `terrain_ground` instead.
+
+Colours are the sandbox's (`ground_mesh.COLOURS`, display sRGB) as linear light
+(`colours.to_linear`), the space USD's colours and glTF's `baseColorFactor` are in, as
+the creatures' materials are: an importer shows the ground the sandbox drew.
 """
 
 from __future__ import annotations
@@ -14,11 +18,17 @@ from typing import Any
 
 import numpy as np
 
+from ecs_tentacles.colours import to_linear
 from ecs_tentacles.ground_mesh import COLOURS
 from ecs_tentacles.take import Take
 
 EXPORT_NAMES = {"terrain": "surface", "obstacles": "obstacles"}
 ROUGHNESS = 0.9
+
+
+def linear_colour(name: str) -> list[float]:
+    """Ground mesh `name`'s colour as the sandbox draws it, in linear light (rgb)."""
+    return [float(v) for v in to_linear(COLOURS[name])]
 
 
 def root_name(take: Take) -> str:
@@ -53,12 +63,13 @@ def write_usd_ground(pxr: Any, stage: Any, take: Take) -> None:
         prim.SetNormalsInterpolation(UsdGeom.Tokens.vertex)
         low, high = points.min(axis=0), points.max(axis=0)
         prim.CreateExtentAttr([Gf.Vec3f(*low.tolist()), Gf.Vec3f(*high.tolist())])
-        prim.CreateDisplayColorAttr([Gf.Vec3f(*COLOURS[name])])
+        colour = Gf.Vec3f(*linear_colour(name))
+        prim.CreateDisplayColorAttr([colour])
         path = f"{base}/materials/{label}"
         material = UsdShade.Material.Define(stage, path)
         shader = UsdShade.Shader.Define(stage, f"{path}/surface")
         shader.CreateIdAttr("UsdPreviewSurface")
-        shader.CreateInput("diffuseColor", Sdf.ValueTypeNames.Color3f).Set(COLOURS[name])
+        shader.CreateInput("diffuseColor", Sdf.ValueTypeNames.Color3f).Set(colour)
         shader.CreateInput("roughness", Sdf.ValueTypeNames.Float).Set(ROUGHNESS)
         shader.CreateInput("metallic", Sdf.ValueTypeNames.Float).Set(0.0)
         material.CreateSurfaceOutput().ConnectToSource(shader.ConnectableAPI(), "surface")
@@ -86,7 +97,7 @@ def add_gltf_ground(
             {
                 "name": f"{root}/{label}",
                 "pbrMetallicRoughness": {
-                    "baseColorFactor": [*COLOURS[name], 1.0],
+                    "baseColorFactor": [*linear_colour(name), 1.0],
                     "metallicFactor": 0.0,
                     "roughnessFactor": ROUGHNESS,
                 },

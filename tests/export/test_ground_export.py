@@ -12,10 +12,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from ecs_tentacles.colours import to_linear
 from ecs_tentacles.export.gltf import read_glb, write_glb
 from ecs_tentacles.export.skinned_gltf import write_skinned_glb
 from ecs_tentacles.ground import ground_of
-from ecs_tentacles.ground_mesh import ground_meshes
+from ecs_tentacles.ground_mesh import COLOURS, ground_meshes
 from ecs_tentacles.take import Take, write_npz
 from ecs_tentacles.take_read import TakeError
 from tests.export.conftest import khronos_report, record
@@ -123,6 +124,12 @@ def test_usd_holds_the_terrain_as_meshes_with_materials(
         assert len(UsdGeom.Mesh(prim).GetFaceVertexCountsAttr().Get()) == len(mesh.triangles)
         bound = UsdShade.MaterialBindingAPI(prim).ComputeBoundMaterial()[0]
         assert bound.GetPath() == f"/World/terrain/materials/{label}"
+        # USD colours are linear: the sandbox's sand and rock, not paler
+        shader = UsdShade.Shader(stage.GetPrimAtPath(f"{bound.GetPath()}/surface"))
+        diffuse = np.array(shader.GetInput("diffuseColor").Get())
+        np.testing.assert_allclose(diffuse, to_linear(COLOURS[name]), atol=1e-6)
+        shown = np.array(UsdGeom.Mesh(prim).GetDisplayColorAttr().Get()[0])
+        np.testing.assert_allclose(shown, to_linear(COLOURS[name]), atol=1e-6)
 
 
 @pytest.mark.parametrize("skinned", [False, True], ids=["rigid", "skinned"])
@@ -142,3 +149,21 @@ def test_gltf_holds_the_terrain_node_and_validates(
     assert indices["count"] == 3 * 2 * 16 * 16 and indices["componentType"] == 5125
     report = khronos_report(path, gltf_validator)
     assert (report["issues"]["numErrors"], report["issues"]["numWarnings"]) == (0, 0)
+
+
+@pytest.mark.parametrize("skinned", [False, True], ids=["rigid", "skinned"])
+def test_gltf_ground_materials_are_the_sandbox_colours_in_linear_light(
+    terrain_take: Take, tmp_path: Path, skinned: bool
+) -> None:
+    """glTF's baseColorFactor is linear: written as the sandbox's display values, the
+    sand and rock came out paler in every importer than the sandbox drew them."""
+    path = tmp_path / "take.glb"
+    (write_skinned_glb if skinned else write_glb)(terrain_take, path)
+    document, _ = read_glb(path.read_bytes())
+    nodes = {node["name"]: node for node in document["nodes"]}
+    for label, name in (("surface", "terrain"), ("obstacles", "obstacles")):
+        primitive = document["meshes"][nodes[f"terrain/{label}"]["mesh"]]["primitives"][0]
+        factor = document["materials"][primitive["material"]]["pbrMetallicRoughness"]
+        np.testing.assert_allclose(
+            factor["baseColorFactor"], [*to_linear(COLOURS[name]), 1.0], atol=1e-6
+        )
