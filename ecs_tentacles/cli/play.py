@@ -85,9 +85,9 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--palette",
         choices=("natural", "debug"),
-        default="natural",
-        help="creature colours: natural (muted skin tones, one per species; the default)"
-        " or debug (a bright colour per creature)",
+        default=None,
+        help="creature colours: natural (muted skin tones, one per species) or debug (a"
+        " bright colour per creature); default: the scene's render.palette, else natural",
     )
     parser.add_argument(
         "--ui-scale",

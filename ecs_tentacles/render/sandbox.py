@@ -72,6 +72,11 @@ DISPLAY_HZ = 60
 FOCUS_RADIUS = 4.0  # m around the camera's target where creatures run full physics
 
 
+def scene_palette(scene: dict[str, Any] | None) -> str:
+    """The creature palette a scene asks for (`render.palette`), natural if none."""
+    return str(((scene or {}).get("render") or {}).get("palette", "natural"))
+
+
 class Sandbox(SandboxPicture):
     """One scene in a window, with the renderer, HUD and input."""
 
@@ -88,12 +93,13 @@ class Sandbox(SandboxPicture):
         lod: bool | None = None,
         focus: tuple[float, float, float] | None = None,
         threads: int | None = None,
-        palette: str = "natural",
+        palette: str | None = None,
     ):
         """`lod` turns level of detail on or off over the scene's (None: the scene's);
         `focus` (x, y, radius in m) pins the full-physics region instead of the camera's;
         `threads` step the physics (None: one per core); `palette` colours the creatures
-        ("natural" or "debug": `ecs_tentacles.colours`)."""
+        ("natural" or "debug": `ecs_tentacles.colours`; None: the scene's `render.palette`,
+        natural if it says none)."""
         self.threads = threads
         self.scene, self.seed, self.allow_systems = scene, seed, allow_systems
         self.lod, self.focus = lod, focus
@@ -114,7 +120,8 @@ class Sandbox(SandboxPicture):
         self.selection = Selection()
         self.panels: dict[str, list[Panel]] = {}  # each plugin's HUD sections, by plugin key
         self.camera_choice: CameraChoice | None = None  # `aim`'s, kept across resets
-        self.palette = palette  # kept across resets (the HUD's View section changes it)
+        # kept across resets (the HUD's View section changes it)
+        self.palette = palette if palette is not None else scene_palette(self.world.scene)
         self._attach_world()
         self.input = SandboxInput(self)  # the mouse and the keys
         self.window.push_handlers(self)  # (on_draw)

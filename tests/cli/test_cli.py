@@ -99,7 +99,8 @@ def test_bad_scene_in_a_real_process_has_no_traceback(tmp_path: Path) -> None:
     assert result.stdout == ""
     assert result.stderr.splitlines() == [
         f"error: {scene}: colour: unknown key (allowed: $schema, avoidance, creatures,"
-        " description, name, physics, plugins, seed, shards, systems, terrain, threats, version)",
+        " description, name, physics, plugins, render, seed, shards, systems, terrain, threats,"
+        " version)",
         f"error: {scene}: creatures[0].tentacles.links: must be in [1, 64], got 0",
     ]
     assert "Traceback" not in result.stderr

@@ -4,12 +4,15 @@ and debug (a bright colour per creature), chosen in one function for sandbox and
 from __future__ import annotations
 
 import colorsys
+import json
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
+from PIL import Image
 
 from ecs_tentacles.cli import main
 from ecs_tentacles.colours import (
@@ -99,3 +102,46 @@ def test_play_palette_option(capsys: pytest.CaptureFixture[str]) -> None:
         code = int(exit_.code or 0)
     assert code == 2
     assert "argument --palette: invalid choice: 'neon'" in capsys.readouterr().err
+
+
+def test_a_scene_chooses_its_palette_and_play_palette_wins(
+    make_sandbox: Callable[..., Any], tmp_path: Path
+) -> None:
+    scene = {**MIXED, "render": {"palette": "debug"}}
+    sandbox = make_sandbox(scene, hud=False)
+    renderer = sandbox.renderer
+    entity = renderer.creature_entities[0]
+    sandbox.render()
+    assert renderer.palette == "debug"
+    assert_allclose(
+        renderer.creature_colour[entity],
+        creature_colour(look_in_world(sandbox.world, entity, 0), "debug"),
+    )
+    shots = {}
+    for name, data, option in (
+        ("debug scene", scene, []),
+        ("debug scene, --palette natural", scene, ["--palette", "natural"]),
+        ("no palette in the scene", MIXED, []),
+    ):
+        path = tmp_path / f"{len(shots)}.json"
+        path.write_text(json.dumps(data))
+        shot = tmp_path / f"{len(shots)}.png"
+        argv = ["play", str(path), "--headless", "--frames", "1", "--quiet", "--no-hud"]
+        assert (
+            main([*argv, *option, "--width", "320", "--height", "180", "--screenshot", str(shot)])
+            == 0
+        )
+        with Image.open(shot) as image:
+            shots[name] = np.asarray(image).astype(int)
+    assert np.array_equal(shots["debug scene, --palette natural"], shots["no palette in the scene"])
+    assert np.abs(shots["debug scene"] - shots["no palette in the scene"]).max() > 60
+
+
+def test_a_bad_palette_in_a_scene_is_one_line_naming_the_field(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    path = tmp_path / "neon.json"
+    path.write_text(json.dumps({**MIXED, "render": {"palette": "neon"}}))
+    assert main(["play", str(path), "--headless", "--json"]) == 2
+    err = capsys.readouterr().err
+    assert err == f'error: {path}: render.palette: must be one of "natural", "debug", got "neon"\n'

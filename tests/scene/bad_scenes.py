@@ -10,8 +10,8 @@ TENTACLE_KEYS = (
     "wave_amplitude_deg, wave_frequency, wavelength, writhe"
 )
 TOP_KEYS = (
-    "$schema, avoidance, creatures, description, name, physics, plugins, seed, shards, systems,"
-    " terrain, threats, version"
+    "$schema, avoidance, creatures, description, name, physics, plugins, render, seed, shards,"
+    " systems, terrain, threats, version"
 )
 CREATURE_KEYS = (
     "avoid, emotion, fur, goals, heading_deg, locomotion, mantle, name, navigation, position,"
