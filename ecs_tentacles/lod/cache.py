@@ -1,6 +1,12 @@
 """Gait clips shared by morphology: every creature whose physics model is the same
 (`model_layout(...).key`) replays one recording.
 
+A world records each morphology once, from its first creature of that morphology. The
+cache keeps a recording under its morphology *and* what it was recorded from (that
+creature's entry as `one_creature_scene` stages it, less its name): a world whose first
+creature of a morphology behaves otherwise (gait, speed, waves) records its own, so what
+a world replays never depends on which worlds this process built before it.
+
     cache = ClipCache()
     clips = cache.for_creature(world, entity)        # a creature of a built world
     clips = cache.get(scene["creatures"][3], scene["physics"])   # a scene entry
@@ -12,11 +18,13 @@ with `GaitClips.record` on a miss; keeps the clips and their cost.
 
 from __future__ import annotations
 
+import json
 from typing import TYPE_CHECKING, Any
 
 from ecs_tentacles.build import build_creature
 from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.lod.clips import GaitClips
+from ecs_tentacles.lod.record import one_creature_scene
 from ecs_tentacles.physics.model import model_layout
 from ecs_tentacles.settings import Settings
 from ecs_tentacles.world import World
@@ -43,16 +51,13 @@ class ClipCache:
     def get(self, creature: dict[str, Any], physics: dict[str, Any] | None = None) -> GaitClips:
         """The clips of the morphology of `creature` (a scene creature entry, defaults
         filled in as `load_scene` leaves them), recorded on first use."""
-        key = morphology_key(creature, physics)
-        return self._get(key, creature, physics)
+        return self._get(morphology_key(creature, physics), creature, physics)
 
     def for_creature(self, world: Host, entity: int) -> GaitClips:
         """The clips of creature `entity` of `world`, from its entry (the scene's, or the
         one it was spawned from: `world.creature_specs`)."""
         creature = world.component(entity, Creature)
         key = model_layout(world, creature, world.component(entity, Transform)).key
-        if key in self.clips:
-            return self.clips[key]
         entry = world.creature_specs.get(entity)
         if entry is None:
             raise ValueError(f"creature {creature.name!r}: no entry to record its clips from")
@@ -62,13 +67,22 @@ class ClipCache:
     def _get(
         self, key: tuple[Any, ...], creature: dict[str, Any], physics: dict[str, Any] | None
     ) -> GaitClips:
-        clips = self.clips.get(key)
+        full_key = (key, recording_input(creature, physics))
+        clips = self.clips.get(full_key)
         if clips is None:
             clips = GaitClips.record(creature, physics, **self.record_options)
             if clips.key != key:
                 raise RuntimeError(f"creature {creature.get('name')!r}: recorded another key")
-            self.clips[key] = clips
+            self.clips[full_key] = clips
         return clips
+
+
+def recording_input(creature: dict[str, Any], physics: dict[str, Any] | None = None) -> str:
+    """What a recording of `creature` is made from (its entry staged alone at the origin,
+    without its name), as canonical JSON: equal strings record equal clips."""
+    scene = one_creature_scene(creature, physics)
+    scene["creatures"][0].pop("name", None)
+    return json.dumps(scene, sort_keys=True, default=str)
 
 
 def morphology_key(

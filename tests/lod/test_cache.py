@@ -44,3 +44,19 @@ def test_scene_entries_find_the_same_clips(make_world: Callable[..., World]) -> 
     assert cache.for_creature(world, world.creature("b")) is first
     assert morphology_key(scene["creatures"][2], scene["physics"]) != first.key
     assert len(cache) == 1
+
+
+def test_what_a_world_replays_does_not_depend_on_the_worlds_built_before() -> None:
+    # the same morphology, creatures that behave otherwise: each is recorded from itself,
+    # so a process that first met the slow one does not replay it for the fast one
+    slow = load_scene(_scene())["creatures"][0]
+    fast = load_scene(_scene())["creatures"][0]
+    fast["locomotion"] = {**fast.get("locomotion", {}), "speed": 1.6}
+    cache = ClipCache(**QUICK)
+    from_slow, from_fast = cache.get(slow), cache.get(fast)
+    assert from_slow.key == from_fast.key  # one morphology
+    assert from_slow is not from_fast and len(cache) == 2
+    assert from_fast.crawl.speed > from_slow.crawl.speed
+    assert cache.get(dict(fast, name="renamed", position=[3.0, 1.0])) is from_fast
+    fresh = ClipCache(**QUICK).get(fast)
+    assert fresh.crawl.speed == from_fast.crawl.speed  # as in a process that met it first
