@@ -226,26 +226,27 @@ class PhysicsBackend(Membership):
     def write_controls(self, motors: MotorStore) -> None:
         """Targets into `ctrl`; kp = strength x gain, kv = damping x gain; torque limits."""
         target = motors.target.reshape(-1)
-        kp_all = motors.strength * motors.gain
-        kv_all = motors.damping * motors.gain
-        torque_all = motors.max_torque
+        strength, gain, damping = motors.strength, motors.gain, motors.damping
         for batch in self.batches:
             live = ~self.frozen[batch.members] & (self.tier[batch.members] != KINEMATIC)
             soften = self.soften[batch.members]
             if live.all():
                 rows = batch.actuator_motor_rows
                 batch.ctrl[:] = np.take(target, batch.actuator_target_index, mode="clip")
-                batch.kp[:] = kp_all[rows] * soften[:, None]
-                batch.kv[:], batch.torque[:] = kv_all[rows], torque_all[rows]
+                batch.kp[:] = strength[rows] * gain[rows] * soften[:, None]
+                batch.kv[:] = damping[rows] * gain[rows]
+                batch.torque[:] = motors.max_torque[rows]
                 continue
             # a frozen creature keeps what it had when it froze; a kinematic one gets its
-            # commands the frame it is promoted (the level of detail decides first)
+            # commands the frame it is promoted (the level of detail decides first); only
+            # the live rows' products are formed (a crowd's motors are mostly replayed)
             live = np.flatnonzero(live)
             rows = batch.actuator_motor_rows[live]
             ctrl = np.take(target, batch.actuator_target_index[live], mode="clip")
             batch.state[live, batch.slices[int(S.mjSTATE_CTRL)]] = ctrl
-            batch.kp[live] = kp_all[rows] * soften[live, None]
-            batch.kv[live], batch.torque[live] = kv_all[rows], torque_all[rows]
+            batch.kp[live] = strength[rows] * gain[rows] * soften[live, None]
+            batch.kv[live] = damping[rows] * gain[rows]
+            batch.torque[live] = motors.max_torque[rows]
 
     def write_suckers(self, suckers: SuckerStore) -> None:
         """Switch sucker equalities on/off and place their world anchors."""

@@ -161,12 +161,13 @@ class HealthCheck:
         fastest = self._fastest(pos, active)
         bad = ~(fastest <= limit)  # also nan: a pose that is not finite
         for batch in roster.batches:
-            members = batch.members
-            bad[members] |= batch.warnings.any(axis=1)
-            bad[members] |= ~np.isfinite(batch.qvel.sum(axis=1))
-            bad[members] |= batch.deepest < -self.max_penetration
+            rows = np.flatnonzero(active[batch.members])  # what was stepped: the rest waits
+            at = batch.members[rows]
+            bad[at] |= batch.warnings[rows].any(axis=1)
+            bad[at] |= ~np.isfinite(batch.qvel[rows].sum(axis=1))
+            bad[at] |= batch.deepest[rows] < -self.max_penetration
             for row in batch.errors:
-                bad[members[row]] = True
+                bad[batch.members[row]] = True
         failing = np.flatnonzero(bad & active)
         causes = {int(i): self._cause(int(i), float(fastest[i]), limit) for i in failing}
         healthy = active & ~bad

@@ -115,7 +115,6 @@ class MotorTargets(System):
         self.eased = motors.target[:, :2].copy()
         self.strokes = world.resource(LocomotionStores).tentacles
         self.follow: np.ndarray | None = None  # on terrain: `ground_follow` this frame
-        self.link_creature = tentacles.creature_row[motors.tentacle_row]  # per motor row
 
     def roster_changed(self, world: Host, change: RosterChange) -> None:
         """A spawn: the tables made again, everyone's easing kept; a despawn: the removed
@@ -131,7 +130,6 @@ class MotorTargets(System):
             self.previous_of = np.where(before >= 0, moved[before], -1)
             self.inner = np.flatnonzero(self.previous_of >= 0)
             self.previous = self.previous_of[self.inner]
-            self.link_creature = world.tentacles.creature_row[world.motors.tentacle_row]
             return
         eased = change.follow(self.eased, "motors")
         self.setup(world)
@@ -155,7 +153,7 @@ class MotorTargets(System):
             return
         # creatures the level of detail replays: their servos drive nothing, so their
         # links are left out (a promoted one eases from its last targets, servos soft)
-        links = np.flatnonzero(~kinematic[self.link_creature])
+        links = _links_of(world, np.flatnonzero(~kinematic[world.tentacles.creature_row]))
         if not len(links):
             return
         position = np.full(len(motors), -1, dtype=np.int64)
@@ -213,3 +211,13 @@ class MotorTargets(System):
         strength = t.action_strength
         gain = strength[row] + (strength * t.writhe)[row] * (0.5 * sin + HALF_ROOT3 * cos)
         motors.gain[links] = gain
+
+
+def _links_of(world: Host, tentacles: np.ndarray) -> np.ndarray:
+    """The motor rows of tentacle rows `tentacles`, ascending (each tentacle's links are
+    the consecutive rows from its first): work for these tentacles, not for every motor."""
+    t = world.tentacles
+    order = tentacles[np.argsort(t.first_link[tentacles], kind="stable")]
+    first, count = t.first_link[order], t.links[order]
+    starts = np.repeat(first - (np.cumsum(count) - count), count)
+    return starts + np.arange(int(count.sum()))

@@ -6,10 +6,11 @@ from collections.abc import Callable
 
 import numpy as np
 import pytest
-from ecs_tentacles.systems.locomotion.motor_targets import LIFT, SMOOTHING_SECONDS
+from ecs_tentacles.systems.locomotion.motor_targets import LIFT, SMOOTHING_SECONDS, _links_of
 from numpy.testing import assert_allclose, assert_array_equal
 
 from ecs_tentacles.components import Creature
+from ecs_tentacles.creator.crowd import crowd_scene
 from ecs_tentacles.locomotion.actions import (
     STRENGTH,
     ActionQueue,
@@ -170,3 +171,16 @@ def test_writhing_modulates_the_gain_in_time(make_world: Callable[..., World]) -
     assert_allclose(gains.max(axis=0), strength * 1.5, rtol=2e-3)
     assert_allclose(gains.min(axis=0), strength * 0.5, rtol=4e-3)
     assert_allclose(gains.mean(axis=0), strength, rtol=1e-9)
+
+
+def test_the_links_of_simulated_creatures_are_every_motor_row_they_own(
+    make_world: Callable[..., World],
+) -> None:
+    world = make_world(crowd_scene(24, seed=2))  # 8 body plans: 3 to 8 tentacles, links vary
+    world.despawn(int(world.creatures.entity[5]))  # rows renumbered
+    rng = np.random.default_rng(0)
+    for _ in range(10):
+        replayed = rng.random(len(world.creatures)) < 0.7
+        owned = ~replayed[world.tentacles.creature_row[world.motors.tentacle_row]]
+        live_tentacles = np.flatnonzero(~replayed[world.tentacles.creature_row])
+        assert_array_equal(_links_of(world, live_tentacles), np.flatnonzero(owned))
