@@ -114,3 +114,20 @@ def _inside(
             out[n] = body
             n += 1
     return n
+
+
+@njit(cache=True, nogil=True)
+def spheres_within(
+    centre: np.ndarray, radius: np.ndarray, a: np.ndarray, b: np.ndarray, margin: float
+) -> np.ndarray:
+    """(pairs,) bool: the spheres a[p] and b[p] (centres of any dimension) come within
+    `margin` of each other; `pairs.spheres_within`'s numbers without its temporaries."""
+    out = np.empty(len(a), dtype=np.bool_)
+    for p in range(len(a)):
+        i, j = a[p], b[p]
+        total = 0.0
+        for k in range(centre.shape[1]):
+            d = centre[i, k] - centre[j, k]
+            total += d * d
+        out[p] = math.sqrt(total) - (radius[i] + radius[j]) < margin
+    return out

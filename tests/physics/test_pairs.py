@@ -55,3 +55,22 @@ def test_small_crowds_and_bad_slack() -> None:
     assert cache.queries == 0  # the dense comparison: nothing kept
     with pytest.raises(ValueError, match="slack"):
         NearPairCache(slack=0.0)
+
+
+@pytest.mark.parametrize("dimensions", [2, 3])
+def test_the_sphere_test_kernel_gives_the_numpy_answers(
+    dimensions: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from ecs_tentacles.physics import pairs as module
+
+    assert module.KERNELS.get() is not None  # numba comes with the dev extra
+    rng = np.random.default_rng(7)
+    centre, radius = _crowd(rng, 600)
+    centre = centre[:, :dimensions]
+    a, b = rng.integers(0, 600, 5000), rng.integers(0, 600, 5000)
+    found = []
+    for backend in ("auto", "numpy"):
+        monkeypatch.setattr(module.KERNELS, "backend", backend)
+        found.append(module.spheres_within(centre, radius, a, b, 0.3))
+    assert_array_equal(found[0], found[1])
+    assert 0 < found[0].sum() < len(a)
