@@ -11,9 +11,11 @@ as undoable edits, the HUD's panels seeing presses and keys first, the key map).
 Level of detail (`world.lod`): before every physics frame the sandbox tells it the
 selected creatures (they run full) and, unless a focus is pinned (`focus=`, `play
 --focus`, or the scene's `physics.lod.focus`), a focus of `FOCUS_RADIUS` m around the
-camera's target, so what you look at runs full. Headless runs (`play --headless`) do
-the same: the camera does not move there, so they stay deterministic; bakes have no
-camera and use only the scene's focus.
+camera's target: the creatures there must run full, and the rest of the full budget
+goes to the ones nearest it, so what you look at runs full and a crowd framed whole
+costs the budget, not every creature within metres of the centre. Headless runs (`play
+--headless`) do the same: the camera does not move there, so they stay deterministic;
+bakes have no camera and use only the scene's focus.
 
 Plugins add HUD sections (`sandbox_panels`, asked once per plugin and kept across
 rebuilds and resets: the locomotion sliders, the fur tool) and draw through the
@@ -69,7 +71,7 @@ if TYPE_CHECKING:
 FRAME_EASE = 0.08  # share of the way to the new framing a video frame moves (frame-all)
 MAX_CATCH_UP = 0.25  # seconds of physics to catch up at most per display frame
 DISPLAY_HZ = 60
-FOCUS_RADIUS = 4.0  # m around the camera's target where creatures run full physics
+FOCUS_RADIUS = 1.5  # m around the camera's target where creatures must run full physics
 
 
 def scene_palette(scene: dict[str, Any] | None) -> str:

@@ -27,10 +27,16 @@ def test_the_camera_target_and_the_selection_run_full(make_sandbox: Callable[...
     sandbox.renderer.camera.target = np.array([*mantles[0, :2], 0.0])  # look at the first
     sandbox.step(2)
     lod = sandbox.world.lod
-    near = np.linalg.norm(mantles[:, :2] - mantles[0, :2], axis=1) <= FOCUS_RADIUS
-    assert 1 < near.sum() < 6
-    assert all(lod.tier_of(c) == "full" for c in np.array(creatures)[near])
-    assert lod.counts()["full"] == near.sum()  # the budget of 1 counts them: none besides
+    distance = np.linalg.norm(mantles[:, :2] - mantles[0, :2], axis=1)
+    near = distance <= FOCUS_RADIUS
+    assert near.sum() == 1  # the one looked at
+    assert lod.tier_of(creatures[0]) == "full"
+    assert lod.counts()["full"] == 1  # the budget of 1 counts it: none besides
+    sandbox.renderer.camera.target = np.array([*(mantles[0, :2] + [FOCUS_RADIUS + 0.5, 0.0]), 0])
+    sandbox.step(2)  # nobody inside the focus: the budget goes to the nearest
+    assert lod.tier_of(creatures[int(np.argmin(np.linalg.norm(
+        mantles[:, :2] - sandbox.renderer.camera.target[:2], axis=1)))]) == "full"  # fmt: skip
+    assert lod.counts()["full"] == 1
     sandbox.renderer.camera.target = np.array([100.0, 100.0, 0.0])  # look far away
     selected = creatures[-1]
     sandbox.select(selected)
