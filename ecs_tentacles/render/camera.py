@@ -60,6 +60,9 @@ def parse_camera(text: str) -> CameraChoice:
     return CameraChoice("fixed", eye=tuple(numbers[:3]), target=tuple(numbers[3:]))  # type: ignore[arg-type]
 
 
+FIT_TOLERANCE = 1e-4  # relative: the bisection of a fitting distance stops this close
+
+
 def perspective(fov_y: float, aspect: float, near: float, far: float) -> np.ndarray:
     f = 1.0 / np.tan(fov_y / 2)
     m = np.zeros((4, 4))
@@ -71,12 +74,19 @@ def perspective(fov_y: float, aspect: float, near: float, far: float) -> np.ndar
     return m
 
 
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """a x b of two 3-vectors (np.cross's checks cost more than the product here)."""
+    return np.array(
+        [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    )
+
+
 def look_at(eye: np.ndarray, target: np.ndarray, up: np.ndarray) -> np.ndarray:
     forward = target - eye
     forward = forward / np.linalg.norm(forward)
-    right = np.cross(forward, up)
+    right = _cross(forward, up)
     right = right / np.linalg.norm(right)
-    true_up = np.cross(right, forward)
+    true_up = _cross(right, forward)
     m = np.eye(4)
     m[0, :3], m[1, :3], m[2, :3] = right, true_up, -forward
     m[:3, 3] = -m[:3, :3] @ eye
@@ -198,7 +208,9 @@ class OrbitCamera:
         near, far = 0.2, max(self.distance, 0.2)
         while not fits(far) and far < 1e4:
             far *= 2.0
-        for _ in range(40):
+        for _ in range(40):  # to a ten-thousandth of the distance: far below a pixel
+            if far - near <= FIT_TOLERANCE * far:
+                break
             middle = (near + far) / 2
             near, far = (near, middle) if fits(middle) else (middle, far)
         return far

@@ -241,6 +241,9 @@ class Renderer:
         self.links_near.update(links[near & capsules])
         self.links_far.update(links[~near & capsules])
         if skinned:
+            camera = self.camera
+            per_metre = 2.0 * np.tan(camera.fov_y / 2) / camera.height  # a pixel 1 m away
+            self.skinned.choose_detail(pos, camera.eye, per_metre)
             self.skinned.update(pos, quat)
         self.view_of_frame(pos, quat)
         ground = ground_of(self.world)

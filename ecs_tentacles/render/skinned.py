@@ -7,6 +7,13 @@ turns the body poses into the palette (a 3 x 4 world * bind^-1 matrix per joint)
 one upload puts it in a float texture (512 joints a row); the vertex shader
 (`shaders.SKINNED_VERTEX`)
 blends the vertex's two joints. However many creatures, that is one draw call.
+
+Each creature is meshed at two levels of detail (`DETAILS`): the sandbox's, and a coarse
+one (a ring per link, eight sides: under a third of the triangles) for creatures the
+camera sees smaller than `COARSE_PIXELS` across, where the difference is under a pixel
+or two. The level is chosen per creature each frame (`choose_detail`), and the one draw
+call becomes one `glMultiDrawElements` over each creature's chosen index range: a crowd
+framed whole costs what its pixels need, not what a close-up does.
 """
 
 from __future__ import annotations
@@ -27,6 +34,9 @@ if TYPE_CHECKING:
     from ecs_tentacles.world import World
 
 SANDBOX_DETAIL = Detail(rings_per_link=3, sides=12, cap_rings=2)
+COARSE_DETAIL = Detail(rings_per_link=1, sides=8, cap_rings=1)
+DETAILS = (SANDBOX_DETAIL, COARSE_DETAIL)
+COARSE_PIXELS = 160.0  # a creature whose reach spans fewer pixels than this is drawn coarse
 VERTEX_FLOATS = 3 + 3 + 3 + 2 + 1  # position, normal, colour, two joints, second weight
 ROW_JOINTS = 512  # joints per palette texture row (the shader's `j % 512`)
 PALE = np.array([0.96, 0.86, 0.78])  # the underside of a tentacle
@@ -86,7 +96,11 @@ class SkinnedCreatures:
         texture = gl.GLuint()
         gl.glGenTextures(1, ctypes.byref(texture))
         self.texture = texture.value
-        self.count = 0
+        self.first = np.zeros((len(DETAILS), 0), np.int64)  # per level, per creature: byte offset
+        self.counts = np.zeros((len(DETAILS), 0), np.int32)  # ... and index count
+        self.mantle_rows = np.zeros(0, np.int64)  # per creature: its mantle's store row
+        self.reach = np.zeros(0)  # per creature: mantle radius + its longest tentacle (m)
+        self.level = np.zeros(0, np.int64)  # per creature: the level it is drawn at
         self.rows = np.zeros(0, np.int64)
         self.offset = np.zeros(0)
         self.inverse_bind = np.zeros((0, 4, 4))
@@ -122,39 +136,46 @@ class SkinnedCreatures:
         """Mesh every creature that can be meshed (others stay capsules: `self.creatures`)."""
         parts, indices = [], []
         rows, offsets, binds = [], [], []
-        cache = self._meshes
-        first_vertex = first_joint = 0
+        first, counts, mantles, reach = [], [], [], []
+        first_vertex = first_joint = first_index = 0
         self.creatures = []
         for entity in entities:
             skeleton = self._skeleton(world, entity)
-            layout = skeleton.layout
-            key = (
-                layout.mantle_radius,
-                layout.mantle_height,
-                *((t.angle, t.lengths.tobytes(), t.radii.tobytes()) for t in layout.tentacles),
-            )
-            if key not in cache:
-                try:
-                    cache[key] = creature_mesh(skeleton, SANDBOX_DETAIL)
-                except MeshError:
-                    cache[key] = None
-            mesh = cache[key]
-            if mesh is None:
+            meshes = [self._mesh(skeleton, level) for level in range(len(DETAILS))]
+            if any(mesh is None for mesh in meshes):
                 continue  # tentacle bases overlap: this one keeps its capsules
-            data = np.empty((len(mesh.positions), VERTEX_FLOATS), np.float32)
-            data[:, 0:3] = mesh.positions
-            data[:, 3:6] = mesh.normals
-            data[:, 6:9] = vertex_colours(mesh, skeleton, colours[entity])
-            data[:, 9:11] = mesh.joints + first_joint
-            data[:, 11] = mesh.weights[:, 1]
-            parts.append(data)
-            indices.append(mesh.faces.reshape(-1) + first_vertex)
+            starts, sizes = [], []
+            for mesh in meshes:
+                assert mesh is not None
+                data = np.empty((len(mesh.positions), VERTEX_FLOATS), np.float32)
+                data[:, 0:3] = mesh.positions
+                data[:, 3:6] = mesh.normals
+                data[:, 6:9] = vertex_colours(mesh, skeleton, colours[entity])
+                data[:, 9:11] = mesh.joints + first_joint
+                data[:, 11] = mesh.weights[:, 1]
+                parts.append(data)
+                indices.append(mesh.faces.reshape(-1) + first_vertex)
+                starts.append(first_index)
+                sizes.append(mesh.faces.size)
+                first_vertex += len(mesh.positions)
+                first_index += mesh.faces.size
+            first.append(starts)
+            counts.append(sizes)
             rows.append(skeleton.bodies)
             offsets.append(skeleton.offset)
             binds.append(skeleton.bind)
-            first_vertex += len(mesh.positions)
+            mantles.append(skeleton.bodies[0])
+            layout = skeleton.layout
+            longest = max((float(t.lengths.sum()) for t in layout.tentacles), default=0.0)
+            reach.append(layout.mantle_radius + longest)
             first_joint += len(skeleton.names)
             self.creatures.append(entity)
+        levels = len(DETAILS)
+        self.first = (np.array(first, np.int64).reshape(-1, levels).T * 4).copy()  # bytes
+        self.counts = np.array(counts, np.int32).reshape(-1, levels).T.copy()
+        self.mantle_rows = np.array(mantles, np.int64)
+        self.reach = np.array(reach)
+        self.level = np.zeros(len(self.creatures), np.int64)
         vertex_data = np.vstack(parts) if parts else np.zeros((0, VERTEX_FLOATS), np.float32)
         index_data = (
             np.concatenate(indices).astype(np.uint32) if indices else np.zeros(0, np.uint32)
@@ -163,10 +184,35 @@ class SkinnedCreatures:
         _upload(gl.GL_ARRAY_BUFFER, self.vertices, vertex_data, self.vertex_capacity)
         _upload(gl.GL_ELEMENT_ARRAY_BUFFER, self.indices, index_data, self.index_capacity)
         gl.glBindVertexArray(0)
-        self.count = len(index_data)
         self.rows = np.concatenate(rows) if rows else np.zeros(0, np.int64)
         self.offset = np.concatenate(offsets) if offsets else np.zeros(0)
         self.inverse_bind = np.linalg.inv(np.concatenate(binds)) if binds else np.zeros((0, 4, 4))
+
+    def _mesh(self, skeleton: Skeleton, level: int) -> SkinMesh | None:
+        """The mesh of `skeleton`'s body shape at detail `level`, made once per shape
+        (None: it cannot be meshed)."""
+        layout = skeleton.layout
+        key = (
+            level,
+            layout.mantle_radius,
+            layout.mantle_height,
+            *((t.angle, t.lengths.tobytes(), t.radii.tobytes()) for t in layout.tentacles),
+        )
+        if key not in self._meshes:
+            try:
+                self._meshes[key] = creature_mesh(skeleton, DETAILS[level])
+            except MeshError:
+                self._meshes[key] = None
+        return self._meshes[key]
+
+    def choose_detail(self, pos: np.ndarray, eye: np.ndarray, per_metre: float) -> None:
+        """Each creature's level for this frame: coarse when its reach spans fewer than
+        `COARSE_PIXELS` pixels seen from `eye` (`per_metre`: a pixel's size 1 m away)."""
+        if not len(self.mantle_rows):
+            return
+        distance = np.linalg.norm(pos[self.mantle_rows] - eye, axis=1)
+        pixels = 2.0 * self.reach / np.maximum(distance * per_metre, 1e-9)
+        self.level = (pixels < COARSE_PIXELS).astype(np.int64)
 
     def palette(self, pos: np.ndarray, quat: np.ndarray) -> np.ndarray:
         """(J, 3, 4) float32 world * bind^-1 of every joint for body poses `pos`, `quat`."""
@@ -203,11 +249,29 @@ class SkinnedCreatures:
         gl.glTexParameteri(gl.GL_TEXTURE_2D, gl.GL_TEXTURE_MAX_LEVEL, 0)
         gl.glBindTexture(gl.GL_TEXTURE_2D, 0)
 
+    @property
+    def triangles(self) -> int:
+        """Triangles drawn at the levels chosen for this frame."""
+        creatures = np.arange(len(self.level))
+        return int(self.counts[self.level, creatures].sum()) // 3
+
     def draw(self) -> int:
-        """One indexed draw of every skinned creature; returns 1."""
+        """One multi-draw of every skinned creature, each at its level; returns 1."""
+        n = len(self.level)
+        if not n:
+            return 0
+        creatures = np.arange(n)
+        counts = np.ascontiguousarray(self.counts[self.level, creatures], np.int32)
+        starts = np.ascontiguousarray(self.first[self.level, creatures], np.uintp)
         gl.glActiveTexture(gl.GL_TEXTURE0)
         gl.glBindTexture(gl.GL_TEXTURE_2D, self.texture)
         gl.glBindVertexArray(self.vao)
-        gl.glDrawElements(gl.GL_TRIANGLES, self.count, gl.GL_UNSIGNED_INT, None)
+        gl.glMultiDrawElements(
+            gl.GL_TRIANGLES,
+            counts.ctypes.data_as(ctypes.POINTER(gl.GLsizei)),
+            gl.GL_UNSIGNED_INT,
+            starts.ctypes.data_as(ctypes.POINTER(ctypes.c_void_p)),
+            n,
+        )
         gl.glBindTexture(gl.GL_TEXTURE_2D, 0)
         return 1

@@ -7,6 +7,7 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
+import pytest
 
 from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.mathutil import quat_rotate
@@ -62,3 +63,30 @@ def test_skinned_view_draws_one_smooth_creature(make_sandbox: Callable[..., Any]
     warm = lambda p: ((p[..., 0] > p[..., 1] + 60) & (p[..., 0] > p[..., 2] + 60)).sum()  # noqa: E731
     assert 0.5 < warm(skinned) / warm(capsules) < 2.0  # the same creature, not a blob
     assert (np.abs(skinned - capsules).sum(axis=2) > 30).sum() > 200  # but drawn differently
+
+
+def test_creatures_seen_small_are_drawn_coarse_and_look_the_same(
+    make_sandbox: Callable[..., Any], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from ecs_tentacles.render import skinned as module
+
+    sandbox = make_sandbox("octopus")
+    sandbox.step(30)
+    sandbox.hud.visible = False
+    skinned = sandbox.renderer.skinned
+    sandbox.render()
+    assert skinned.level.tolist() == [0]  # close: the sandbox's detail
+    close = skinned.triangles
+    sandbox.renderer.camera.distance = 5.0  # the creature about 140 px across
+    sandbox.render()
+    assert skinned.level.tolist() == [1]
+    assert skinned.triangles * 3 < close
+    coarse = sandbox.renderer.target.read().astype(int)
+    monkeypatch.setattr(module, "COARSE_PIXELS", 0.0)  # the same view in full detail
+    sandbox.render()
+    assert skinned.level.tolist() == [0]
+    fine = sandbox.renderer.target.read().astype(int)
+    warm = (fine[..., 0] > fine[..., 1] + 40) & (fine[..., 0] > fine[..., 2] + 40)
+    assert warm.sum() > 300  # the creature is in the picture
+    changed = np.abs(coarse - fine).sum(axis=2) > 60
+    assert changed.sum() < 0.15 * warm.sum()  # a few edge pixels differ, not the creature
