@@ -26,7 +26,7 @@ import os
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import mujoco
 import numpy as np
@@ -344,16 +344,26 @@ class PhysicsBackend(Membership):
             heap.trim()
 
     def _run(self, chunks: list[list[Segment]], substeps: dict[int, int]) -> None:
+        self._dispatch(step_segments, chunks, substeps)
+
+    def _dispatch(self, work: Callable[..., None], chunks: list[Any], *args: Any) -> None:
+        """`work(chunk, *args, thread)` for every chunk: the first on this thread, the
+        others on the pool (this thread steps instead of waiting idle; chunk k always
+        uses scratch k, so which thread runs it changes nothing)."""
         if self._pool is None or len(chunks) < 2:
             for thread, chunk in enumerate(chunks):
-                step_segments(chunk, substeps, thread)
+                work(chunk, *args, thread)
             return
         futures = [
-            self._pool.submit(step_segments, chunk, substeps, thread)
+            self._pool.submit(work, chunk, *args, thread)
             for thread, chunk in enumerate(chunks)
+            if thread > 0
         ]
-        for future in futures:
-            future.result()
+        try:
+            work(chunks[0], *args, 0)
+        finally:
+            for future in futures:
+                future.result()
 
     def bare_states(self) -> list[dict[int, np.ndarray]]:
         """Copies of every batch's state rows per tier (REDUCED rows fitted as their next
@@ -380,16 +390,7 @@ class PhysicsBackend(Membership):
         """
         chunks = plan(self.batches, self.active, self.tier, self.threads)
         steps = {FULL: substeps, REDUCED: reduced_substeps(substeps)}
-        if self._pool is None or len(chunks) < 2:
-            for thread, chunk in enumerate(chunks):
-                bare_step(chunk, states, steps, thread)
-            return
-        futures = [
-            self._pool.submit(bare_step, chunk, states, steps, thread)
-            for thread, chunk in enumerate(chunks)
-        ]
-        for future in futures:
-            future.result()
+        self._dispatch(bare_step, chunks, states, steps)
 
     def sync(self, transforms: TransformStore) -> None:
         """Copy every body's world pose into the Transform store (one scatter per batch)."""
