@@ -62,7 +62,10 @@ class SandboxInput:
             selection=sandbox.selection.entities,
             ctrl=bool(modifiers & key.MOD_CTRL),
         )
-        sandbox.undo.record(sandbox.world, "goals", lambda: self._offer(click))
+        try:
+            sandbox.undo.record(sandbox.world, "goals", lambda: self._offer(click))
+        except ValueError as refused:  # e.g. a formation with no room there: say so, go on
+            sandbox.scripts.say(False, f"click refused: {refused}")
 
     def _offer(self, click: Click) -> bool:
         """The plugins' `sandbox_click` hooks, in plugin order, until one takes `click`."""

@@ -184,3 +184,21 @@ def test_right_drag_orbits_middle_drag_pans_and_a_shaky_click_stays_a_click(
     goal = sandbox.world.resource(GoalBook).positions(octo)[-1]
     assert np.hypot(*(goal[:2] - ground[:2])) < 0.1
     assert sandbox.selection.entities == (octo,)
+
+
+def test_a_goal_click_the_plugins_refuse_is_a_red_line_not_a_crash(
+    make_sandbox: Callable[..., Any],
+) -> None:
+    from ecs_tentacles.locomotion.formations import FormationChoice
+    from tests.render.conftest import click_at, pixel
+
+    sandbox = make_sandbox("rocky_shore")
+    sandbox.hud.visible = False
+    sandbox.select_many(sandbox.renderer.creature_entities)
+    sandbox.world.resource(FormationChoice).shape = "spiral"  # as a script might set it
+    point = np.array([1.0, 0.5, 0.0])
+    sandbox.renderer.camera.target = point.copy()
+    click_at(sandbox, pixel(sandbox, point))
+    ok, line = sandbox.scripts.notes[-1]
+    assert not ok and line.startswith("click refused: formation: must be one of")
+    sandbox.step(1)  # the sandbox goes on
