@@ -24,7 +24,7 @@ from scipy.spatial import cKDTree
 from ecs_tentacles.optional_kernels import OptionalKernels
 
 SLACK = 0.25  # metres of extra reach the kept pairs are found with
-DENSE_PAIRS = 256  # creatures up to which every pair is compared (no tree to build)
+DENSE_PAIRS = 32  # creatures up to which every pair is compared (no tree to build)
 _NONE = np.zeros(0, dtype=np.int64)
 KERNELS = OptionalKernels("ecs_tentacles.physics.kernels", "ECS_TENTACLES_SENSE")
 

@@ -17,7 +17,7 @@ def _crowd(rng: np.random.Generator, n: int) -> tuple[np.ndarray, np.ndarray]:
 
 def test_the_cache_gives_near_pairs_answers_as_creatures_wander() -> None:
     rng = np.random.default_rng(3)
-    n = 2 * DENSE_PAIRS  # large enough for the tree
+    n = max(2 * DENSE_PAIRS, 300)  # large enough for the tree
     centre, radius = _crowd(rng, n)
     cache = NearPairCache(slack=0.2)
     calls = 0
