@@ -269,3 +269,52 @@ def test_a_rigid_usd_gives_every_capsule_its_creatures_material(
     for mesh, materials in looks["meshes"].items():
         assert materials == [f"{mesh.split('_')[0]}_{mesh.split('_')[1]}_skin"], mesh
     assert sorted(looks["colours"]) == [f"{c}_skin" for c in FOUR]
+
+
+SKY_SRGB = (206, 219, 231)  # the tool's sky, (0.62, 0.71, 0.80) linear, as 8-bit sRGB
+
+
+@pytest.mark.parametrize("suffix", [".glb", ".usdc"])
+def test_a_still_of_the_import_shows_every_creature_in_its_colour_on_the_ground(
+    tmp_path: Path, suffix: str
+) -> None:
+    """`--render`: a 960x540 PNG, mostly not sky, with the sandbox's creature colours on
+    the left and on the right (rocky_shore has three creatures on each side) and the
+    ground's colour, written whole."""
+    from PIL import Image
+
+    from ecs_tentacles.ground_mesh import COLOURS
+
+    take = tmp_path / "shore.npz"
+    argv = ["bake", "rocky_shore", "--seconds", "0.4", "--fps", "30", "--quiet"]
+    assert main([*argv, "--out", str(take)]) == 0
+    out = tmp_path / f"shore{suffix}"
+    assert main(["export", str(take), "--out", str(out), "--quiet"]) == 0
+    png = tmp_path / "shot.png"
+    done = subprocess.run(
+        [BLENDER, str(TOOL), str(out), "--render", str(png), "--frame", "6"],
+        capture_output=True,
+        text=True,
+        timeout=180,
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.splitlines()[-2].startswith(f"{png}: 960x540, frame 6, 6 creature meshes")
+    assert [p.name for p in tmp_path.iterdir() if p.suffix == ".png"] == ["shot.png"]
+    with Image.open(png) as image:
+        assert image.size == (960, 540)
+        pixels = np.asarray(image.convert("RGB")).astype(float)
+    sky = np.abs(pixels - SKY_SRGB).max(axis=2) <= 3
+    assert 0.05 < sky.mean() < 0.5  # a sky above the ground, the picture mostly scene
+
+    def near(srgb: np.ndarray) -> np.ndarray:
+        """Pixels of `srgb`'s hue, however lit (chromaticity within 0.03)."""
+        chroma = pixels / np.maximum(pixels.sum(axis=2, keepdims=True), 1.0)
+        return np.abs(chroma - srgb / srgb.sum()).max(axis=2) < 0.03
+
+    creatures = np.zeros(pixels.shape[:2], bool)
+    for colour in take_colours(Take.load(take)).values():
+        creatures |= near(colour)
+    third = pixels.shape[1] // 3
+    left, right = creatures[:, :third].sum(), creatures[:, -third:].sum()
+    assert left > 1000 and right > 1000, (left, right)  # west's three, east's three
+    assert near(np.asarray(COLOURS["terrain"], float)).mean() > 0.25  # the sand
