@@ -26,19 +26,24 @@ def outlined_ribbons(segments: np.ndarray, eye: np.ndarray, metres_per_pixel: fl
     a, b = ends[:, 0, :3], ends[:, 1, :3]
     along = b - a
     view = 0.5 * (a + b) - eye
-    side = np.cross(along, view)
-    length = np.linalg.norm(side, axis=1, keepdims=True)
+    side = np.empty_like(along)  # along x view, written out (np.cross's checks cost more)
+    side[:, 0] = along[:, 1] * view[:, 2] - along[:, 2] * view[:, 1]
+    side[:, 1] = along[:, 2] * view[:, 0] - along[:, 0] * view[:, 2]
+    side[:, 2] = along[:, 0] * view[:, 1] - along[:, 1] * view[:, 0]
+    length = np.sqrt(np.einsum("ij,ij->i", side, side))[:, None]
     side = np.where(length > 1e-12, side / np.maximum(length, 1e-12), 0.0)
-    reach_a = np.linalg.norm(a - eye, axis=1, keepdims=True) * metres_per_pixel / 2
-    reach_b = np.linalg.norm(b - eye, axis=1, keepdims=True) * metres_per_pixel / 2
+    to_a, to_b = a - eye, b - eye
+    reach_a = np.sqrt(np.einsum("ij,ij->i", to_a, to_a))[:, None] * metres_per_pixel / 2
+    reach_b = np.sqrt(np.einsum("ij,ij->i", to_b, to_b))[:, None] * metres_per_pixel / 2
     core = ends[:, 0, 3:7].copy()
     dullness = 1.0 - core[:, :3] @ [0.2126, 0.7152, 0.0722]  # bright colours stay as they are
     core[:, :3] += LIFT * dullness[:, None] * (1.0 - core[:, :3])
-    passes = []
-    for width, colour in ((OUTLINE_PIXELS, np.tile(OUTLINE, (len(a), 1))), (LINE_PIXELS, core)):
+    out = np.empty((2, len(a), 6, 7), np.float32)  # (pass, segment, corner, xyz rgba)
+    edge = np.broadcast_to(np.asarray(OUTLINE), core.shape)
+    for index, (width, colour) in enumerate(((OUTLINE_PIXELS, edge), (LINE_PIXELS, core))):
         a0, a1 = a - side * reach_a * width, a + side * reach_a * width
         b0, b1 = b - side * reach_b * width, b + side * reach_b * width
-        corners = np.stack([a0, b0, b1, a0, b1, a1], axis=1)  # (n, 6, 3)
-        rgba = np.repeat(colour[:, None, :], 6, axis=1)
-        passes.append(np.concatenate([corners, rgba], axis=2).reshape(-1, 7))
-    return np.vstack(passes).astype(np.float32)
+        for corner, point in enumerate((a0, b0, b1, a0, b1, a1)):
+            out[index, :, corner, :3] = point
+        out[index, :, :, 3:] = colour[:, None, :]
+    return out.reshape(-1, 7)
