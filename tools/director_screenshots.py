@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from ecs_tentacles.atomic import atomic_output
 from ecs_tentacles.render import configure
 
 DEFAULT_DIR = Path(__file__).resolve().parents[1] / "assets" / "screenshots"
@@ -100,11 +101,13 @@ def run(out_dir: Path, seconds: float) -> None:
     sheet = Image.new("RGB", (2 * w, 2 * h))
     for i, picture in enumerate((first, scattered, sent, last)):
         sheet.paste(picture, ((i % 2) * w, (i // 2) * h))
-    sheet.save(out_dir / "director_sequence.png", optimize=True)
+    with atomic_output(out_dir / "director_sequence.png") as temporary:
+        sheet.save(temporary, format="PNG", optimize=True)
     small = [f.resize((GIF_WIDTH, GIF_WIDTH * h // w)).quantize(64) for f in [first, *frames]]
-    small[0].save(
-        out_dir / "director.gif", save_all=True, append_images=small[1:], duration=300, loop=0
-    )
+    with atomic_output(out_dir / "director.gif") as temporary:
+        small[0].save(
+            temporary, format="GIF", save_all=True, append_images=small[1:], duration=300, loop=0
+        )
     print(f"{out_dir / 'director_sequence.png'}, {out_dir / 'director.gif'}", file=sys.stderr)
 
 
