@@ -25,7 +25,7 @@ goal. Finding the failures is whole-array work; only failing creatures are visit
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import mujoco
@@ -63,6 +63,7 @@ class HealthState:
     frozen: int
     causes: dict[str, int]
     previous: np.ndarray  # last frame's poses
+    allowed: dict[int, tuple[float, float]] = field(default_factory=dict)  # `allow_speed`
 
 
 class HealthCheck:
@@ -75,6 +76,8 @@ class HealthCheck:
         # per batch: two good states per row, [older, newer]; at first both the start
         self.saved = [np.repeat(b.state[:, None, :], 2, axis=1) for b in roster.batches]
         self.failures: dict[int, list[float]] = {}  # creature index -> recent recovery times
+        # creature index -> (speed m/s, until world time): a thrown creature may fly faster
+        self.allowed: dict[int, tuple[float, float]] = {}
         self.recoveries = 0
         self.frozen = 0
         self.causes: dict[str, int] = {}
@@ -92,6 +95,7 @@ class HealthCheck:
             self.frozen,
             dict(self.causes),
             self.previous.copy(),
+            dict(self.allowed),
         )
 
     def set_state(self, state: HealthState) -> None:
@@ -102,6 +106,7 @@ class HealthCheck:
         self.recoveries, self.frozen = state.recoveries, state.frozen
         self.causes = dict(state.causes)
         self.previous = state.previous.copy()
+        self.allowed = dict(state.allowed)
 
     # -- roster changes --------------------------------------------------------------
     def grow(
@@ -123,6 +128,7 @@ class HealthCheck:
         Transform rows are left."""
         self.saved[batch] = without_row(self.saved[batch], row)
         self.failures = {i - (i > index): times for i, times in self.failures.items() if i != index}
+        self.allowed = {i - (i > index): a for i, a in self.allowed.items() if i != index}
         if len(self.previous):
             self.previous = self.previous[kept]
         self.follow(proxies)
@@ -131,6 +137,14 @@ class HealthCheck:
         """Read the bodies' order from `proxies` again (after it was rebuilt)."""
         self.rows = proxies.rows
         self.start, self.count = proxies.start, proxies.count
+
+    def allow_speed(self, index: int, speed: float, until: float) -> None:
+        """Creature `index` may move its bodies up to `speed` m/s (instead of the scene's
+        `max_speed`) until world time `until`: one thrown or dragged by hand, whose
+        tentacles whip faster than any crawl, is not taken for a blow-up."""
+        if not speed > 0:
+            raise ValueError(f"speed: must be > 0, got {speed}")
+        self.allowed[index] = (float(speed), float(until))
 
     def restart(self, index: int) -> None:
         """Creature `index` was placed anew: its good states are where it is now."""
@@ -151,7 +165,12 @@ class HealthCheck:
         `physics_time` is the physics clock: a recovered creature's state is set to it.
         """
         roster = self.roster
-        limit = self.max_speed * world.settings.dt
+        limit = np.full(len(roster), self.max_speed * world.settings.dt)
+        for index, (speed, until) in list(self.allowed.items()):
+            if world.time > until:
+                del self.allowed[index]
+            else:
+                limit[index] = max(self.max_speed, speed) * world.settings.dt
         save = world.frame % SAVE_EVERY == 0
         ramp = world.settings.dt / SOFT_SECONDS
         pos = world.transforms.pos
@@ -169,7 +188,10 @@ class HealthCheck:
             for row in batch.errors:
                 bad[batch.members[row]] = True
         failing = np.flatnonzero(bad & active)
-        causes = {int(i): self._cause(int(i), float(fastest[i]), limit) for i in failing}
+        dt = world.settings.dt
+        causes = {
+            int(i): self._cause(int(i), float(fastest[i]), float(limit[i]), dt) for i in failing
+        }
         healthy = active & ~bad
         softened = healthy & (roster.soften < 1.0)
         roster.soften[softened] = np.minimum(
@@ -206,7 +228,7 @@ class HealthCheck:
             fastest[who] = np.sqrt(np.maximum.reduceat(step, start))
         return fastest
 
-    def _cause(self, index: int, fastest: float, limit: float) -> str:
+    def _cause(self, index: int, fastest: float, limit: float, dt: float) -> str:
         roster = self.roster
         batch = roster.batches[int(roster.batch_of[index])]
         row = int(roster.row_of[index])
@@ -219,7 +241,7 @@ class HealthCheck:
         if not fastest <= limit:
             if not np.isfinite(fastest):
                 return "non-finite state"
-            return f"speed {fastest / limit * self.max_speed:.3g} m/s"
+            return f"speed {fastest / dt:.3g} m/s"
         if not np.isfinite(batch.qvel[row].sum()):
             return "non-finite state"
         return f"penetration {-1000 * batch.deepest[row]:.1f} mm"

@@ -3,7 +3,9 @@
 Reads: `world.resource(Director).grab` (creature, body, target), the Transform store
 (the body's position, last frame's for its speed), the creature's mass (its model).
 Writes: the creature's applied force on that body (`xfrc_applied`, stepped with every
-substep of the frame) and `grab.force`; when the grab ends, the force is removed. The
+substep of the frame) and `grab.force`; when the grab ends, the force is removed. While
+held and for a while after, the health check allows the creature a throw's speeds
+(`HealthCheck.allow_speed`): a landing's whipping tentacles are not a blow-up. The
 director plugin (`ecs_tentacles.director.plugin`) adds it, in the sandbox only.
 """
 
@@ -17,6 +19,9 @@ from ecs_tentacles.components import Creature
 from ecs_tentacles.director.grab import spring_force
 from ecs_tentacles.director.state import Director
 from ecs_tentacles.system import System
+
+THROWN_SPEED = 40.0  # m/s a held or thrown creature's bodies may reach (the scene's: 12)
+THROWN_SECONDS = 4.0  # how long after it is let go (a fall and its landing)
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
@@ -49,6 +54,13 @@ class GrabSpring(System):
         applied[:] = 0.0
         applied[body_id, :3] = grab.force
         self.held = (grab.creature, body_id)
+        self._allow_flight(world, grab.creature)
+
+    def _allow_flight(self, world: Host, creature: int) -> None:
+        """A creature held or just let go flies and lands faster than a crawl (its
+        tentacles whip): the health check allows it `THROWN_SPEED` for `THROWN_SECONDS`."""
+        index = world.physics.lod.index(creature)
+        world.physics.health.allow_speed(index, THROWN_SPEED, world.time + THROWN_SECONDS)
 
     def release(self, world: Host) -> None:
         """No force any more on the creature held last frame (if it is still there)."""

@@ -203,3 +203,27 @@ def test_bake_marks_recoveries_in_the_take_and_strict_writes_nothing(
     assert not strict.exists()
     left = {p.name for p in faulty_scene.parent.iterdir()} - {"__pycache__"}
     assert left == {"faulty.json", "faulty_system.py", "take.npz"}  # no partial, no log
+
+
+def test_an_allowed_speed_lets_one_creature_fly_for_a_while(
+    make_world: Callable[..., World],
+) -> None:
+    def jump(world: World) -> None:  # 0.5 m in one frame: 30 m/s, over the scene's 12
+        world.physics.groups[0].data.qpos[2] += 0.5  # straight up: nothing is in the way
+        world.step(1)
+
+    world = make_world(SCENE)
+    world.step(10)
+    health = world.physics.health
+    health.allow_speed(0, 40.0, world.time + 0.5)
+    snap = world.snapshot()
+    jump(world)
+    assert health.recoveries == 0  # within what it was allowed
+    world.step(40)  # the allowance ends
+    jump(world)
+    assert health.causes == {"speed": 1}
+    world.restore(snap)  # the allowance is part of the state
+    jump(world)
+    assert world.physics.health.recoveries == 0
+    with pytest.raises(ValueError, match="speed"):
+        health.allow_speed(1, 0.0, 1.0)

@@ -98,8 +98,9 @@ def test_goal_and_slider_edits_undo_and_redo(make_sandbox: Callable[..., Any]) -
     assert np.allclose(book.positions(octo)[0, :2], [1.0, -1.0], atol=0.01)
 
 
+@pytest.mark.parametrize("offset", [0, -2, 4])  # px beside the mantle's centre: other throws
 def test_ctrl_drag_lifts_and_throws_a_creature_with_a_bounded_force(
-    make_sandbox: Callable[..., Any],
+    make_sandbox: Callable[..., Any], offset: int
 ) -> None:
     sandbox = make_sandbox("octopus")
     world = sandbox.world
@@ -108,6 +109,7 @@ def test_ctrl_drag_lifts_and_throws_a_creature_with_a_bounded_force(
     assert world.suckers.attached.any()
     start = world.component(octo, Transform).pos.copy()
     x, y = pixel(sandbox, start)
+    x += offset
     event(sandbox, "on_mouse_press", x, y, mouse.LEFT, key.MOD_CTRL)
     grab = world.resource(Director).grab
     assert grab is not None and grab.creature == octo
