@@ -24,12 +24,13 @@ from pyglet.gui import Frame, PushButton, Slider
 from ecs_tentacles.components import Creature, Tentacle, Transform
 from ecs_tentacles.creator import CreatureDesign, DesignError
 from ecs_tentacles.creator.limits import Setting, editor_setting
-from ecs_tentacles.render.hud import PANEL_WIDTH, TEXT
+from ecs_tentacles.render.hud import TEXT
 from ecs_tentacles.render.output import save_png
 from ecs_tentacles.render.renderer import Renderer
 
 SELECTED = (1.0, 0.85, 0.2, 1.0)
 ROW = 30
+PANEL_WIDTH = 300  # the creator's panel: pyglet widgets placed at fixed pixels
 
 
 # the sliders: labels and ranges from the scene schema's `x-editor` marks

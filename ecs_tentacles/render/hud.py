@@ -26,7 +26,7 @@ from ecs_tentacles.drawing import Panel
 from ecs_tentacles.render.gui import Gui, gui_scale, same_line_if_fits
 from ecs_tentacles.render.tiers import text_colour
 
-PANEL_WIDTH = 300  # the panel's width at scale 1 (the creator still uses it as is)
+PANEL_WIDTH = 280  # the panel's width at scale 1: under 22 % of a 1280 x 720 window
 PANEL_SHARE = 0.4  # the panel never covers more than this share of the window's width
 TEXT = (20, 24, 28, 255)
 OWN_ORDER = 0  # the HUD's own sections' place among the panels' (`Panel.order`)

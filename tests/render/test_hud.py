@@ -276,13 +276,13 @@ def test_ui_scale_makes_the_hud_larger(make_sandbox: Callable[..., Any]) -> None
 
 
 def test_at_720p_every_section_fits_the_panel(make_sandbox: Callable[..., Any]) -> None:
-    """At 1280 x 720, its text at scale 1, no section's widget runs past the panel's
-    edges (each section opened in turn)."""
+    """At 1280 x 720 the panel leaves the view at least 78 % of the width, its text at
+    scale 1, and no section's widget runs past the panel's edges (each opened in turn)."""
     sandbox = make_sandbox("hedgehog_octopus", width=1280, height=720)  # fur: every section
     sandbox.render()
     gui = sandbox.hud.gui
     x0, _, x1, _ = gui.windows["panel"]
-    assert x1 - x0 == PANEL_WIDTH and gui.scale == 1.0
+    assert x1 - x0 == PANEL_WIDTH <= 0.22 * 1280 and gui.scale == 1.0
     sections = ["Stats", "Physics", "Plugins", "Locomotion", "Fur", "View", "Director"]
     sections += ["Terrain", "Actions"]
     for name in sections:

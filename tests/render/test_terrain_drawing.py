@@ -78,7 +78,9 @@ def test_the_terrain_section_places_moves_and_deletes_with_the_mouse(
     panel = next(p for p in sandbox.hud.panels if isinstance(p, TerrainPanel))
     camera = sandbox.renderer.camera
     spot = np.array([[1.5, -1.2, _hill_height(sandbox, 1.5, -1.2)]])
+    camera.target, camera.distance = spot[0].copy(), 6.0  # the spot in the picture
     px, py = (round(v) for v in camera.project(spot)[0])
+    assert 0 <= px < camera.width and 0 <= py < camera.height
 
     panel.tool = "box"
     event(sandbox, "on_mouse_press", px, py, mouse.LEFT, 0)
