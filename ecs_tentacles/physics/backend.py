@@ -34,6 +34,7 @@ import numpy as np
 from ecs_tentacles import heap
 from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.physics.batch import Batch
+from ecs_tentacles.physics.blas import quiet_blas
 from ecs_tentacles.physics.health import SOFT_GAIN, HealthCheck, HealthState
 from ecs_tentacles.physics.lod import LevelOfDetail
 from ecs_tentacles.physics.membership import Membership, compile_models
@@ -123,6 +124,8 @@ class PhysicsBackend(Membership):
             roster, self.proxies, settings.lod, settings.fps, self.place_joints
         )
         self._pool = ThreadPoolExecutor(self.threads) if self.threads > 1 else None
+        if self._pool is not None:
+            quiet_blas()  # spinning BLAS threads would take the stepping threads' cores
         self._untrimmed = 0  # frames stepped since the C heap was last trimmed
 
     # per creature, in entity order: the roster's arrays (replaced when creatures come

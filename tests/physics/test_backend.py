@@ -176,3 +176,20 @@ def test_the_schemas_longest_tentacles_crawl_without_a_recovery(
     world.step(36)  # 0.6 s: past the half second they once froze within
     assert world.physics.health.recoveries == 0 and not world.physics.frozen.any()
     assert np.isfinite(world.transforms.pos).all()
+
+
+def test_a_world_stepping_on_two_threads_keeps_blas_to_one(
+    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from threadpoolctl import threadpool_info
+
+    from ecs_tentacles.physics import blas
+
+    for name in blas.CHOSEN_BY_USER:
+        monkeypatch.delenv(name, raising=False)
+    make_world({"version": 1, "creatures": [{"name": "a"}, {"name": "b", "position": [2, 0]}]},
+               threads=2)  # fmt: skip
+    pools = [p for p in threadpool_info() if p["user_api"] == "blas"]
+    assert pools and all(p["num_threads"] == 1 for p in pools)
+    monkeypatch.setenv("OPENBLAS_NUM_THREADS", "2")  # the user's choice stands
+    assert blas.quiet_blas() is False
