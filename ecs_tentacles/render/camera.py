@@ -189,10 +189,33 @@ class OrbitCamera:
         self.distance = self._fitting_distance(points, border)
 
     def _fitting_distance(self, points: np.ndarray, border: float) -> float:
-        """The least distance (bisection) at which `points` stay inside the free part."""
+        """The least distance (at least 0.2 m) at which `points` stay inside the free part.
+
+        The view's rotation does not depend on the distance, so a point's camera
+        coordinates are q - (0, 0, d) with q fixed, and each bound of the picture asks
+        for d at least some figure of q: the answer is the largest, in one pass over the
+        points (a bisection of the same test when a bound cannot be met)."""
         left = 2.0 * self.shift_x / self.width  # the panel's share of the picture
         low_x = -1.0 + 2.0 * left + 2.0 * border * (1.0 - left)
         high = 1.0 - 2.0 * border
+        shift = -2.0 * self.shift_x / self.width  # the lens shift (projection's [0, 2])
+        if high <= 0 or high + shift <= 0 or low_x + shift >= 0:
+            return self._bisected_distance(points, low_x, high)
+        rotation = self.view()[:3, :3]
+        q = (points - self.target) @ rotation.T  # camera coordinates at distance 0
+        focal = 1.0 / np.tan(self.fov_y / 2)
+        across = focal * self.height / self.width
+        # w = d - q_z in front; ndc x = across q_x / w - shift, ndc y = focal q_y / w
+        need = np.maximum.reduce([
+            np.full(len(q), 1e-6),
+            across * q[:, 0] / (high + shift),
+            across * q[:, 0] / (low_x + shift),
+            focal * np.abs(q[:, 1]) / high,
+        ])  # fmt: skip
+        return max(0.2, float(np.max(q[:, 2] + need)) * (1.0 + 1e-9))
+
+    def _bisected_distance(self, points: np.ndarray, low_x: float, high: float) -> float:
+        """`_fitting_distance` by bisection, for bounds no distance can meet."""
 
         def fits(distance: float) -> bool:
             self.distance = distance

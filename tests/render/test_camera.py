@@ -103,3 +103,23 @@ def test_fit_fills_the_free_part_of_the_picture() -> None:
     # tight: one side or the other touches the border (not a loose bounding sphere)
     slack = np.array([low[0] - (160 + 24), 640 - 32 - high[0], low[1] - 18, 342 - high[1]])
     assert slack.min() < 2.0
+
+
+@pytest.mark.parametrize("shift_x", [0.0, 140.0])  # no panel, the HUD's panel
+def test_fit_frames_every_point_tightly_whatever_the_view(shift_x: float) -> None:
+    from ecs_tentacles.render.camera import FIT_BORDER
+
+    rng = np.random.default_rng(11)
+    for _ in range(40):
+        camera = OrbitCamera(yaw=rng.uniform(-3, 3), pitch=rng.uniform(0.1, 1.4), shift_x=shift_x)
+        points = rng.normal(0.0, rng.uniform(0.5, 20.0), (int(rng.integers(2, 400)), 3))
+        points[:, 2] = np.abs(points[:, 2]) * 0.1  # a crowd on the ground
+        camera.fit(points)
+        x, y = camera.project(points).T
+        left = 2 * shift_x + FIT_BORDER * (camera.width - 2 * shift_x)  # right of the panel
+        right = camera.width * (1 - FIT_BORDER)
+        bottom, top = FIT_BORDER * camera.height, camera.height * (1 - FIT_BORDER)
+        assert (x >= left - 1).all() and (x <= right + 1).all()
+        assert (y >= bottom - 1).all() and (y <= top + 1).all()
+        gaps = [x.min() - left, right - x.max(), y.min() - bottom, top - y.max()]
+        assert min(gaps) < 1.0  # as near as it can be: some point touches a bound
