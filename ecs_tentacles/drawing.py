@@ -19,7 +19,7 @@ headless worlds never load pyglet.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -140,3 +140,17 @@ RING_SEGMENTS = 48
 _ANGLES = np.linspace(0, 2 * np.pi, RING_SEGMENTS + 1)
 CIRCLE = np.stack([np.cos(_ANGLES), np.sin(_ANGLES), np.zeros_like(_ANGLES)], axis=1)
 """A unit circle in the ground plane, (RING_SEGMENTS + 1, 3): scale and move it for rings."""
+
+
+class HasHeight(Protocol):
+    """What `draped` needs of a ground: its height under points (the `Ground` resource)."""
+
+    def height(self, xy: np.ndarray) -> np.ndarray: ...
+
+
+def draped(points: np.ndarray, ground: HasHeight, lift: float) -> np.ndarray:
+    """`points` (n, 3) put on the ground under them, `lift` m above it: a ring round a
+    goal or a creature on a hillside follows the slope instead of sinking into it."""
+    out = np.array(points, dtype=np.float64)
+    out[:, 2] = ground.height(out[:, :2]) + lift
+    return out

@@ -16,7 +16,8 @@ import numpy as np
 
 from ecs_tentacles.components import Creature
 from ecs_tentacles.director.state import Director
-from ecs_tentacles.drawing import CIRCLE, line_segments
+from ecs_tentacles.drawing import CIRCLE, draped, line_segments
+from ecs_tentacles.ground import ground_of
 from ecs_tentacles.plugin import Plugin
 
 if TYPE_CHECKING:
@@ -69,6 +70,6 @@ class DirectorPlugin(Plugin):
             lines.append(line_segments(np.array([held, grab.target]), GRAB_RGBA))
         if director.brush is not None:
             centre, radius = director.brush
-            ring = centre + [0.0, 0.0, 0.02] + radius * CIRCLE
+            ring = draped(centre + radius * CIRCLE, ground_of(world), 0.02)
             lines.append(line_segments(ring, BRUSH_RGBA))
         return lines

@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ecs_tentacles.components import Creature, Transform
-from ecs_tentacles.drawing import CIRCLE, Click, RenderView, line_segments
+from ecs_tentacles.drawing import CIRCLE, Click, RenderView, draped, line_segments
 from ecs_tentacles.ground import ground_of
 from ecs_tentacles.locomotion.components import Goal
 from ecs_tentacles.locomotion.formations import FormationChoice, formation_goals
@@ -72,9 +72,10 @@ def goal_lines(world: Host, view: RenderView) -> GoalLines:
         points = book.positions(entity) + [0, 0, LIFT]
         if shown:
             fixed.append(line_segments(points, colour))
+        ground = ground_of(world)
         for goal, point in zip(goals if shown else goals[:1], points, strict=False):
             radius = world.component(goal, Goal).radius
-            fixed.append(line_segments(point + radius * CIRCLE, colour))
+            fixed.append(line_segments(draped(point + radius * CIRCLE, ground, LIFT), colour))
             if shown:
                 fixed.append(line_segments(np.array([point, point + [0, 0, 0.3]]), colour))
         if not shown:

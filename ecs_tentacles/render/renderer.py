@@ -29,7 +29,7 @@ from pyglet import gl
 
 from ecs_tentacles.colours import PALETTES, Look, creature_colour, look_in_world
 from ecs_tentacles.components import Creature, Transform
-from ecs_tentacles.drawing import CIRCLE, RenderView
+from ecs_tentacles.drawing import CIRCLE, RenderView, draped
 from ecs_tentacles.ground import ground_of
 from ecs_tentacles.render import shaders
 from ecs_tentacles.render.camera import OrbitCamera
@@ -308,10 +308,10 @@ class Renderer:
         if chosen:  # one ring round each, in one pass
             drawn = [self._index_of[e] for e in chosen if e in self._index_of]
             mantles = pos[self._mantle_rows[drawn]]
-            height = ground_of(self.world).height(mantles[:, :2])
-            centres = np.column_stack([mantles[:, :2], height + 0.01])
+            centres = np.column_stack([mantles[:, :2], np.zeros(len(drawn))])
             radii = self._reach(pos)[drawn]  # round the tentacles, not under them
             rings = centres[:, None, :] + radii[:, None, None] * CIRCLE
+            rings = draped(rings.reshape(-1, 3), ground_of(self.world), 0.01).reshape(rings.shape)
             pairs = np.stack([rings[:, :-1], rings[:, 1:]], axis=2).reshape(-1, 3)
             segments.append(np.hstack([pairs, np.ones((len(pairs), 4))]))
         for provider in self.extra_lines:

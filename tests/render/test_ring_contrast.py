@@ -64,3 +64,19 @@ def test_a_ring_stands_out_on_sand_and_on_rock(make_sandbox: Callable[..., Any])
         # the creature's own colour was 29 darker than sand: hard to see)
         assert np.percentile(change[changed], 10) < -CONTRAST, where
         assert np.percentile(np.abs(change[changed]), 90) > 1.5 * CONTRAST, where
+
+
+def test_goal_and_selection_rings_follow_the_hills(make_sandbox: Callable[..., Any]) -> None:
+    sandbox = make_sandbox("rocky_shore")  # 0.7 m of relief: rings cross slopes
+    world = sandbox.world
+    ground = ground_of(world)
+    sandbox.select_many(sandbox.renderer.creature_entities)
+    lines = sandbox.renderer._line_vertices(world.transforms.pos).astype(np.float64)
+    assert len(lines) > 1000
+    under = ground.height(lines[:, :2])
+    above = lines[:, 2] - under
+    # rings lie 5-10 mm over the ground under every vertex; before, a ring kept its
+    # centre's height and sank up to the hill's rise under its far side
+    near_ground = np.abs(above) < 0.05
+    assert near_ground.mean() > 0.8  # the rings (goal posts and legs rise above them)
+    assert (above[near_ground] > 0.0).all()
