@@ -73,8 +73,8 @@ def _close_up(out: Path) -> None:
     scene, frames, width, height = CLOSE_UP
     sandbox = Sandbox(scene, width=width, height=height, headless=True, hud=False)
     sandbox.step(frames)
-    sandbox.renderer.frame_all()
-    sandbox.renderer.camera.distance *= 0.45
+    # on the octopus alone (`frame_all` also takes in its far goal), its ring inside
+    sandbox.renderer.follow(sandbox.renderer.creature_entities[0], span=1.5)
     sandbox.screenshot(out)
     print(f"{out}: {scene} after {frames} frames, {width} x {height}, close up", file=sys.stderr)
 
