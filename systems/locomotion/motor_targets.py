@@ -156,12 +156,10 @@ class MotorTargets(System):
         links = _links_of(world, np.flatnonzero(~kinematic[world.tentacles.creature_row]))
         if not len(links):
             return
-        position = np.full(len(motors), -1, dtype=np.int64)
-        position[links] = np.arange(len(links))
-        before = self.previous_of[links]  # whole tentacles are left out, never a part
-        inner = np.flatnonzero(before >= 0)
-        previous = position[before[inner]]
-        self._targets(world, dt, links, inner, previous)
+        # whole tentacles, each a run of consecutive rows in `links`: an inner link's
+        # previous one is the entry before it (no table over every motor row)
+        inner = np.flatnonzero(self.previous_of[links] >= 0)
+        self._targets(world, dt, links, inner, inner - 1)
 
     def _targets(
         self,

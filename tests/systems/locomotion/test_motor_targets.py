@@ -184,3 +184,14 @@ def test_the_links_of_simulated_creatures_are_every_motor_row_they_own(
         owned = ~replayed[world.tentacles.creature_row[world.motors.tentacle_row]]
         live_tentacles = np.flatnonzero(~replayed[world.tentacles.creature_row])
         assert_array_equal(_links_of(world, live_tentacles), np.flatnonzero(owned))
+
+
+def test_an_inner_links_previous_is_the_entry_before_it(make_world: Callable[..., World]) -> None:
+    world = make_world(crowd_scene(24, seed=2))
+    rng = np.random.default_rng(1)
+    for _ in range(5):
+        replayed = rng.random(len(world.creatures)) < 0.6
+        links = _links_of(world, np.flatnonzero(~replayed[world.tentacles.creature_row]))
+        first = world.tentacles.first_link[world.motors.tentacle_row[links]]
+        inner = np.flatnonzero(links != first)
+        assert_array_equal(links[inner - 1], links[inner] - 1)  # the link before, in `links`
