@@ -71,8 +71,8 @@ def spheres_within(
     kernel when numba is installed: the same numbers, without a pass per operation)."""
     fast = KERNELS.get()
     if fast is not None:
-        return fast.spheres_within(centre, radius, a.astype(np.int64), b.astype(np.int64),
-                                   float(margin))  # fmt: skip
+        ia, ib = np.asarray(a, np.int64), np.asarray(b, np.int64)  # no copy when they are
+        return fast.spheres_within(centre, radius, ia, ib, float(margin))
     gap = np.linalg.norm(centre[a] - centre[b], axis=1) - (radius[a] + radius[b])
     return gap < margin
 
