@@ -25,7 +25,8 @@ SHOTS = {
     "hud_640x360": ("octopus", 60, 640, 360, True, None),  # the HUD in a small window
     # terrain: six crossing the rocks, seen low from the shore, the sky behind
     "rocky_shore": ("rocky_shore", 900, 960, 540, False, "-6.2,-7.0,2.7,0.4,0.6,0.2"),
-    "ramp": ("ramp", 2700, 960, 540, False, None),  # terrain: cresting the ramp
+    # terrain: cresting the ramp, the goal's platform beyond (framing the start cut it off)
+    "ramp": ("ramp", 2700, 960, 540, False, "0.3,-3.6,2.4,2.2,0.0,0.4"),
     "maze": ("maze", 600, 960, 540, False, None),  # terrain: the path navigation planned
 }
 CLOSE_UP = ("octopus", 120, 960, 540)  # skinned_sandbox: the skinned octopus, no HUD, near
