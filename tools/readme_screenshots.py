@@ -27,7 +27,8 @@ SHOTS = {
     "rocky_shore": ("rocky_shore", 900, 960, 540, False, "-6.2,-7.0,2.7,0.4,0.6,0.2"),
     # terrain: cresting the ramp, the goal's platform beyond (framing the start cut it off)
     "ramp": ("ramp", 2700, 960, 540, False, "0.3,-3.6,2.4,2.2,0.0,0.4"),
-    "maze": ("maze", 600, 960, 540, False, None),  # terrain: the path navigation planned
+    # terrain: the path navigation planned, the maze whole (framing the start cut it off)
+    "maze": ("maze", 600, 960, 540, False, "3.5,-7.5,5.5,0.0,-0.3,0.0"),
 }
 CLOSE_UP = ("octopus", 120, 960, 540)  # skinned_sandbox: the skinned octopus, no HUD, near
 DEFAULT_DIR = Path(__file__).resolve().parents[1] / "assets" / "screenshots"
