@@ -142,15 +142,16 @@ CIRCLE = np.stack([np.cos(_ANGLES), np.sin(_ANGLES), np.zeros_like(_ANGLES)], ax
 """A unit circle in the ground plane, (RING_SEGMENTS + 1, 3): scale and move it for rings."""
 
 
-class HasHeight(Protocol):
-    """What `draped` needs of a ground: its height under points (the `Ground` resource)."""
+class HasSurface(Protocol):
+    """What `draped` needs of a ground: the topmost surface under points (`Ground`)."""
 
-    def height(self, xy: np.ndarray) -> np.ndarray: ...
+    def surface(self, xy: np.ndarray) -> np.ndarray: ...
 
 
-def draped(points: np.ndarray, ground: HasHeight, lift: float) -> np.ndarray:
-    """`points` (n, 3) put on the ground under them, `lift` m above it: a ring round a
-    goal or a creature on a hillside follows the slope instead of sinking into it."""
+def draped(points: np.ndarray, ground: HasSurface, lift: float) -> np.ndarray:
+    """`points` (n, 3) put on the topmost surface under them (the ground, or a solid: a
+    ramp, a platform), `lift` m above it: a ring round a goal or a creature on a hillside
+    or a ledge follows it instead of sinking into it."""
     out = np.array(points, dtype=np.float64)
-    out[:, 2] = ground.height(out[:, :2]) + lift
+    out[:, 2] = ground.surface(out[:, :2]) + lift
     return out
