@@ -32,9 +32,8 @@ def main() -> None:
     presets.hud.name_labels = True
     presets.renderer.camera.shift_x = 0.0
     presets.step(90)
-    presets.renderer.frame_all()
-    presets.renderer.camera.distance *= 0.7
     presets.renderer.camera.pitch = np.radians(30)
+    presets.renderer.frame_all()  # every preset whole (the fit is tight: no zoom after it)
     print(presets.screenshot(args.out_dir / "fur_presets.png"))
     camera = presets.renderer.camera
     for name in ("cat", "bird"):  # close-ups: the strands' shading and taper
@@ -49,7 +48,8 @@ def main() -> None:
     tool.paused = True
     fur = tool.panel("Fur")
     assert isinstance(fur, FurPanel)
-    tool.hud.fold("Locomotion", "Stats", "Physics")  # the fur panel in view
+    tool.hud.fold("Locomotion", "Stats", "Physics")
+    tool.hud.unfold("Fur")  # one section open at a time: the fur panel in view
     fur.editor.create("L_cheek", shape="cube", colour=(0.2, 0.7, 1.0), mirror="y")
     fur.editor.set_value("L_cheek", "lift", 0.8)
     fur.editor.set_key("crown", "lift", 1.0, "slow_in")
