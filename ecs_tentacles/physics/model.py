@@ -247,20 +247,33 @@ def _add_creature(spec: mujoco.MjSpec, world: PhysicsHost, creature: Creature) -
         for sucker_entity in tentacle.suckers:
             sucker = world.component(sucker_entity, Sucker)
             link_index = tentacle.links.index(sucker.link)
-            equality = spec.add_equality(
-                name=f"t{tentacle.index}/sucker{equalities}",
-                type=mujoco.mjtEq.mjEQ_CONNECT,
-                objtype=mujoco.mjtObj.mjOBJ_BODY,
-                name1=f"t{tentacle.index}/l{link_index:02d}",
-                name2="world",
-                active=False,
-                solref=[world.settings.sucker_timeconst, 1.0],
-                solimp=SUCKER_SOLIMP,
-            )
-            data = np.array(equality.data)
-            data[0:3] = sucker.offset  # anchor in the link frame; the world anchor is set at attach
-            equality.data = data
+            add_sucker(spec, world, tentacle.index, equalities, link_index, sucker.offset)
             equalities += 1
+
+
+def add_sucker(
+    spec: mujoco.MjSpec,
+    world: PhysicsHost,
+    tentacle: int,
+    number: int,
+    link: int,
+    offset: Any,
+) -> None:
+    """Sucker equality `number`: link `link` of tentacle `tentacle` held to the world at
+    `offset` in the link's frame (off until it attaches; the world anchor is set then)."""
+    equality = spec.add_equality(
+        name=f"t{tentacle}/sucker{number}",
+        type=mujoco.mjtEq.mjEQ_CONNECT,
+        objtype=mujoco.mjtObj.mjOBJ_BODY,
+        name1=f"t{tentacle}/l{link:02d}",
+        name2="world",
+        active=False,
+        solref=[world.settings.sucker_timeconst, 1.0],
+        solimp=SUCKER_SOLIMP,
+    )
+    data = np.array(equality.data)
+    data[0:3] = offset
+    equality.data = data
 
 
 def add_proxies(spec: mujoco.MjSpec) -> None:

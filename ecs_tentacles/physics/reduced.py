@@ -38,10 +38,10 @@ import numpy as np
 
 from ecs_tentacles.components import Creature, Link, Motor, Sucker, Tentacle
 from ecs_tentacles.physics.model import (
-    SUCKER_SOLIMP,
     add_link,
     add_mantle,
     add_proxies,
+    add_sucker,
     new_spec,
 )
 from ecs_tentacles.physics.state_layout import STATE, size_proxies, state_slices
@@ -123,19 +123,8 @@ def reduced_spec(world: PhysicsHost, creature: Creature, timestep: float) -> muj
             sucker = world.component(sucker_entity, Sucker)
             i = tentacle.links.index(sucker.link)
             k = next(k for k, g in enumerate(parts) if i in g)
-            equality = spec.add_equality(
-                name=f"t{tentacle.index}/sucker{equalities}",
-                type=mujoco.mjtEq.mjEQ_CONNECT,
-                objtype=mujoco.mjtObj.mjOBJ_BODY,
-                name1=f"t{tentacle.index}/l{k:02d}",
-                name2="world",
-                active=False,
-                solref=[world.settings.sucker_timeconst, 1.0],
-                solimp=SUCKER_SOLIMP,
-            )
-            data = np.array(equality.data)
-            data[0:3] = np.asarray(sucker.offset) + [full_centres[i] - centres[k], 0.0, 0.0]
-            equality.data = data
+            offset = np.asarray(sucker.offset) + [full_centres[i] - centres[k], 0.0, 0.0]
+            add_sucker(spec, world, tentacle.index, equalities, k, offset)
             equalities += 1
     add_proxies(spec)
     return spec
