@@ -240,9 +240,9 @@ class Renderer:
         capsules = ~self.link_skinned if skinned else np.ones(len(links), bool)
         self.links_near.update(links[near & capsules])
         self.links_far.update(links[~near & capsules])
+        camera = self.camera
+        per_metre = 2.0 * np.tan(camera.fov_y / 2) / camera.height  # a pixel 1 m away
         if skinned:
-            camera = self.camera
-            per_metre = 2.0 * np.tan(camera.fov_y / 2) / camera.height  # a pixel 1 m away
             self.skinned.choose_detail(pos, camera.eye, per_metre)
             self.skinned.update(pos, quat)
         self.view_of_frame(pos, quat)
@@ -259,8 +259,6 @@ class Renderer:
             )
         )  # fmt: skip
         self.spheres.update(self._sphere_instances())
-        camera = self.camera
-        per_metre = 2.0 * np.tan(camera.fov_y / 2) / camera.height  # a pixel 1 m away
         self.lines.update(outlined_ribbons(self._line_vertices(pos), camera.eye, per_metre))
 
     def view_of_frame(self, pos: np.ndarray, quat: np.ndarray) -> RenderView:
