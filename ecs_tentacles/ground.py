@@ -18,6 +18,7 @@ the suckers (they grip any static surface) and the renderer and exporters (`mesh
 from __future__ import annotations
 
 import hashlib
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Protocol
 
@@ -239,14 +240,35 @@ class Ground:
             best = (points[:, 2] - self.heightfield.height(xy)) * normal_z
         if not self.solids:
             return best
-        bounds = self._bounds()[1]
-        for k, solid in enumerate(self.solids):
-            near = np.flatnonzero(
-                np.sum((points - solid.position) ** 2, axis=1) <= (bounds[k] + NEAR) ** 2
-            )
-            if len(near):
-                best[near] = np.minimum(best[near], solid.signed_distance(points[near]))
+        for k, near in self._under_bounds(points, NEAR):
+            best[near] = np.minimum(best[near], self.solids[k].signed_distance(points[near]))
         return best
+
+    def _under_bounds(self, points: np.ndarray, pad: float) -> Iterator[tuple[int, np.ndarray]]:
+        """(solid, rows of `points`) for each solid whose bounding sphere grown by `pad`
+        holds some of `points` (n, 3), or whose bounding circle does for points (n, 2):
+        one array test for all solids, then only the solids that hold any point."""
+        centres, bounds = self._bounds()
+        reach = (bounds + pad) ** 2
+        dims = points.shape[1]
+        per_chunk = max(1, (1 << 20) // max(len(self.solids), 1))
+        for start in range(0, len(points), per_chunk):
+            part = points[start : start + per_chunk]
+            if dims == 2:
+                gaps = part[:, None, :] - centres[None, :, :]
+            else:
+                gaps = part[:, None, :] - self._positions()[None, :, :]
+            inside = np.einsum("nkd,nkd->nk", gaps, gaps) <= reach
+            for k in np.flatnonzero(inside.any(axis=0)).tolist():
+                yield k, start + np.flatnonzero(inside[:, k])
+
+    def _positions(self) -> np.ndarray:
+        """(k, 3) the solids' centres (made once)."""
+        cached = self.__dict__.get("_positions_cache")
+        if cached is None:
+            cached = np.array([s.position for s in self.solids]).reshape(-1, 3)
+            object.__setattr__(self, "_positions_cache", cached)  # a cache, not a field
+        return cached
 
     def _bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """(k, 2) solid centres in x, y and (k,) bounding radii (made once)."""
@@ -335,11 +357,8 @@ class Ground:
         out = self.height(xy)
         if not self.solids:
             return out
-        centres, bounds = self._bounds()
-        for k, solid in enumerate(self.solids):  # only the points under its bounding circle
-            rows = np.flatnonzero(np.sum((xy - centres[k]) ** 2, axis=1) <= bounds[k] ** 2)
-            if len(rows):
-                out[rows] = np.maximum(out[rows], solid.top(xy[rows]))
+        for k, rows in self._under_bounds(xy, 0.0):  # the points under its bounding circle
+            out[rows] = np.maximum(out[rows], self.solids[k].top(xy[rows]))
         return out
 
     def _static(self) -> tuple[mujoco.MjModel, mujoco.MjData]:
