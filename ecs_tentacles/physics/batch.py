@@ -19,6 +19,7 @@ exactly as it would alone in its own model and data.
 from __future__ import annotations
 
 import copy
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -34,7 +35,7 @@ from ecs_tentacles.physics.model import (
     ModelLayout,
 )
 from ecs_tentacles.physics.state_layout import STATE, S, size_proxies, state_slices
-from ecs_tentacles.physics.tiers import FULL, REDUCED
+from ecs_tentacles.physics.tiers import FULL, REDUCED, REDUCED_RATE
 
 if TYPE_CHECKING:
     from ecs_tentacles.physics.reduced import ReducedModel
@@ -107,6 +108,9 @@ class Batch:
         self.warnings = np.zeros((n, WARNING_KINDS), dtype=np.int64)  # raised since checked
         self.deepest = np.full(n, np.inf)  # deepest contact distance (m; < 0 penetrates)
         self.errors: dict[int, str] = {}  # row -> MuJoCo's fatal error in the last step
+        # seconds one step of a row took lately, per tier (FULL, REDUCED): how `plan`
+        # shares rows between threads (a creature on rocks costs more than one at rest)
+        self.step_cost = np.zeros((n, 2))
         # REDUCED rows: their reduced model's state, and the part of the full state the
         # last reduced step wrote (when it differs, someone else wrote it: fit again).
         # No columns until the reduced model is compiled.
@@ -124,7 +128,8 @@ class Batch:
     # the per-row arrays, in the order `append` and `remove` treat them
     PER_ROW = ("body_rows", "actuator_motor_rows", "actuator_target_index", "sucker_rows",
                "members", "state", "kp", "kv", "torque", "anchor", "proxy_size", "near",
-               "xpos", "xquat", "warnings", "deepest", "rstate", "rsource")  # fmt: skip
+               "xpos", "xquat", "warnings", "deepest", "rstate", "rsource",
+               "step_cost")  # fmt: skip
 
     def _store_rows(
         self, layouts: list[ModelLayout]
@@ -237,13 +242,17 @@ class Batch:
             self.rstate = np.zeros((len(self), width[0]))
             self.rsource = np.full((len(self), width[1]), np.nan)
 
-    @property
-    def reduced_share(self) -> float:
-        """What stepping a REDUCED row costs against a FULL one (degrees of freedom times
-        steps; about 0.25 before its model is compiled)."""
-        if self.reduced is None:
-            return 0.25
-        return 0.5 * (self.reduced.model.nv + 1.0) / (self.model.nv + 1.0)
+    def frame_cost(self, rows: np.ndarray, tier: int) -> np.ndarray:
+        """(len(rows),) what stepping each row at `tier` costs a frame, in seconds of a
+        FULL step: the time its steps took lately (`step_cost`), or, before its first, a
+        guess from the degrees of freedom. For sharing rows between threads."""
+        measured = self.step_cost[rows, tier]
+        if tier == REDUCED:
+            nv = self.reduced.model.nv if self.reduced is not None else self.model.nv // 2
+            guess, steps = 2e-6 * (nv + 1.0), 1.0 / REDUCED_RATE
+        else:
+            guess, steps = 1e-6 * (self.model.nv + 1.0), 1.0
+        return np.where(measured > 0.0, measured, guess) * steps
 
     def scratch_for(self, thread: int, tier: int = FULL) -> Scratch:
         """Thread `thread`'s scratch model and data for `tier` (made on first use)."""
@@ -321,10 +330,17 @@ class Batch:
         m, d = scratch.model, scratch.data
         state, body_ids = self.state, self.body_ids
         for row in rows.tolist():
+            began = time.perf_counter()
             write_overlay(self, m, row)
             if self._advance(scratch, row, state[row], self.applied.get(row), substeps):
                 self.xpos[row] = d.xpos[body_ids]
                 self.xquat[row] = d.xquat[body_ids]
+            self._took(row, FULL, time.perf_counter() - began, substeps)
+
+    def _took(self, row: int, tier: int, seconds: float, substeps: int) -> None:
+        """Row `row`'s `substeps` steps at `tier` took `seconds`: into its `step_cost`."""
+        took, last = seconds / substeps, self.step_cost[row, tier]
+        self.step_cost[row, tier] = took if last == 0.0 else 0.75 * last + 0.25 * took
 
     def _advance(
         self,
@@ -369,6 +385,7 @@ class Batch:
         qpos = self.slices[int(S.mjSTATE_QPOS)]
         body_ids = self.body_ids
         for row in rows.tolist():
+            began = time.perf_counter()
             if np.array_equal(state[row, watched], rsource[row]):
                 reduced.pull_inputs(state[row], rstate[row])
             else:
@@ -376,14 +393,14 @@ class Batch:
             reduced.write_overlay(self, m, row)
             pushed = self.applied.get(row)
             forces = None if pushed is None else reduced.body_group @ pushed
-            if not self._advance(scratch, row, rstate[row], forces, substeps):
-                continue
-            reduced.expand_state(rstate[row], state[row])
-            rsource[row] = state[row, watched]
-            fd.qpos[:] = state[row, qpos]
-            mujoco.mj_kinematics(fm, fd)
-            self.xpos[row] = fd.xpos[body_ids]
-            self.xquat[row] = fd.xquat[body_ids]
+            if self._advance(scratch, row, rstate[row], forces, substeps):
+                reduced.expand_state(rstate[row], state[row])
+                rsource[row] = state[row, watched]
+                fd.qpos[:] = state[row, qpos]
+                mujoco.mj_kinematics(fm, fd)
+                self.xpos[row] = fd.xpos[body_ids]
+                self.xquat[row] = fd.xquat[body_ids]
+            self._took(row, REDUCED, time.perf_counter() - began, substeps)
 
 
 def without_row(array: np.ndarray, row: int) -> np.ndarray:

@@ -1,10 +1,10 @@
 """Which thread steps which creatures: balanced contiguous shares of every batch's rows.
 
 `plan` splits the active rows of all batches into at most `threads` chunks of about
-equal cost (degrees of freedom), each a list of `Segment`s (a batch and some of its
-rows). Chunk k runs on the pool's k-th task with scratch k of each batch, so two
-threads never share a scratch MjData; which thread steps a row never changes its
-result (`ecs_tentacles.physics.batch`).
+equal cost (the time each row's steps took lately, `Batch.frame_cost`), each a list of
+`Segment`s (a batch and some of its rows). Chunk k runs on the pool's k-th task with
+scratch k of each batch, so two threads never share a scratch MjData; which thread
+steps a row never changes its result (`ecs_tentacles.physics.batch`).
 """
 
 from __future__ import annotations
@@ -56,8 +56,7 @@ def plan(
                     batch.prepare(level, threads)
                     if level == REDUCED:
                         batch.prepare(FULL, threads)  # its poses come from the full model
-                    share = 1.0 if level == FULL else batch.reduced_share
-                    cost = np.full(len(rows), share * weight * (batch.model.nv + 1.0))
+                    cost = batch.frame_cost(rows, level) * weight
                     pieces.append((batch, rows, cost, level, steps))
     if not pieces:
         return []

@@ -17,7 +17,10 @@ FULL, REDUCED, KINEMATIC = 0, 1, 2
 NAMES = ("full", "reduced", "kinematic")
 
 
+REDUCED_RATE = 4  # a FULL creature takes this many steps for one of a REDUCED one
+
+
 def reduced_substeps(substeps: int) -> int:
     """Steps a REDUCED creature takes per frame where a FULL one takes `substeps`: a
     quarter, rounded up (120 Hz at the default 480 Hz)."""
-    return max(1, -(-substeps // 4))
+    return max(1, -(-substeps // REDUCED_RATE))
