@@ -27,8 +27,9 @@ The rules, whole-array work every frame before the step:
    (without one, all equal), then the tier they hold (hysteresis), then creature
    order, so a bake's decisions depend on nothing but the scene. They fill what rule 2
    left of the `full` budget (it counts the heroes: it caps what full physics costs
-   unless more than `full` are heroes), then what rule 3 left of the `reduced` budget
-   runs REDUCED, the rest KINEMATIC (REDUCED while no replay is registered).
+   unless more than `full` are heroes; with `focus(..., fill=False)`, as the sandbox
+   asks, only heroes run full), then what rule 3 left of the `reduced` budget runs
+   REDUCED, the rest KINEMATIC (REDUCED while no replay is registered).
 5. Asleep creatures keep their tier and use no budget.
 6. Demotion waits until a creature has held its tier `hold_seconds`; promotion never
    waits.
@@ -89,6 +90,7 @@ class LevelOfDetail:
         self.scripted = np.zeros(count, dtype=bool)  # promote() / release()
         self.selected = np.zeros(count, dtype=bool)  # the sandbox's selection
         self.focus_region: tuple[np.ndarray, float] | None = None
+        self.fill = True  # non-heroes may take what heroes leave of the full budget
         if settings.focus is not None:
             self.focus(settings.focus[:2], settings.focus[2])
         # frames at the current tier; at the start nobody is held: first tiers come at once
@@ -118,9 +120,18 @@ class LevelOfDetail:
         for creature in creatures:
             self.selected[self.index(creature)] = True
 
-    def focus(self, centre: tuple[float, float] | np.ndarray | None, radius: float = 0.0) -> None:
+    def focus(
+        self,
+        centre: tuple[float, float] | np.ndarray | None,
+        radius: float = 0.0,
+        fill: bool = True,
+    ) -> None:
         """Creatures whose mantle is within `radius` m of `centre` (x, y) run full and the
-        rest are ranked by distance to it; None: no focus (creature order decides)."""
+        rest are ranked by distance to it; None: no focus (creature order decides).
+        `fill=False`: what the heroes leave of the full budget stays unused (the sandbox:
+        a creature far from what the camera looks at gains nothing visible from full
+        physics, and the frame time it would take is what keeps the crowd real time)."""
+        self.fill = fill
         if centre is None:
             self.focus_region = None
             return
@@ -191,7 +202,7 @@ class LevelOfDetail:
         awake = ~(roster.sleeping | roster.frozen)
         ranked = np.flatnonzero(awake & ~must)
         order = ranked[np.lexsort((ranked, tier[ranked], distance[ranked]))]
-        full = max(0, self.settings.full - int(must.sum()))  # the budget counts the heroes
+        full = max(0, self.settings.full - int(must.sum())) if self.fill else 0  # heroes count
         want[order[:full]] = FULL
         rest = order[full:]
         rest = rest[~contact[rest]]  # in contact: REDUCED already, and counted below

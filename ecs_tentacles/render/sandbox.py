@@ -11,9 +11,9 @@ as undoable edits, the HUD's panels seeing presses and keys first, the key map).
 Level of detail (`world.lod`): before every physics frame the sandbox tells it the
 selected creatures (they run full) and, unless a focus is pinned (`focus=`, `play
 --focus`, or the scene's `physics.lod.focus`), a focus of `FOCUS_RADIUS` m around the
-camera's target: the creatures there must run full, and the rest of the full budget
-goes to the ones nearest it, so what you look at runs full and a crowd framed whole
-costs the budget, not every creature within metres of the centre. Headless runs (`play
+camera's target: the creatures there run full and the others at most reduced (the
+full budget is not filled with creatures the camera is not on: a crowd framed whole
+then keeps real time), so what you look at runs full. Headless runs (`play
 --headless`) do the same: the camera does not move there, so they stay deterministic;
 bakes have no camera and use only the scene's focus.
 
@@ -245,7 +245,7 @@ class Sandbox(SandboxPicture):
         lod = self.world.lod
         lod.select(self.selection.entities)
         if self.camera_focus:
-            lod.focus(self.renderer.camera.target[:2], FOCUS_RADIUS)
+            lod.focus(self.renderer.camera.target[:2], FOCUS_RADIUS, fill=False)
 
     # -- simulation --------------------------------------------------------------------
     def step(self, frames: int = 1) -> None:

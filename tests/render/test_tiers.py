@@ -33,10 +33,11 @@ def test_the_camera_target_and_the_selection_run_full(make_sandbox: Callable[...
     assert lod.tier_of(creatures[0]) == "full"
     assert lod.counts()["full"] == 1  # the budget of 1 counts it: none besides
     sandbox.renderer.camera.target = np.array([*(mantles[0, :2] + [FOCUS_RADIUS + 0.5, 0.0]), 0])
-    sandbox.step(2)  # nobody inside the focus: the budget goes to the nearest
-    assert lod.tier_of(creatures[int(np.argmin(np.linalg.norm(
-        mantles[:, :2] - sandbox.renderer.camera.target[:2], axis=1)))]) == "full"  # fmt: skip
-    assert lod.counts()["full"] == 1
+    sandbox.step(2)  # nobody inside the focus: nobody full, the nearest reduced
+    nearest = creatures[int(np.argmin(np.linalg.norm(
+        mantles[:, :2] - sandbox.renderer.camera.target[:2], axis=1)))]  # fmt: skip
+    assert lod.tier_of(nearest) == "reduced"
+    assert lod.counts() == {"full": 0, "reduced": 2, "kinematic": 4}
     sandbox.renderer.camera.target = np.array([100.0, 100.0, 0.0])  # look far away
     selected = creatures[-1]
     sandbox.select(selected)
