@@ -42,7 +42,7 @@ from ecs_tentacles.physics.model import ModelLayout, model_layout
 from ecs_tentacles.physics.proxies import ContactProxies
 from ecs_tentacles.physics.roster import Roster
 from ecs_tentacles.physics.sleep import Sleep, SleepState
-from ecs_tentacles.physics.stepping import Segment, bare_step, plan, step_segments
+from ecs_tentacles.physics.stepping import Segment, Work, bare_step, plan, step_segments
 from ecs_tentacles.physics.tiers import FULL, KINEMATIC, REDUCED, reduced_substeps
 from ecs_tentacles.physics.view import CreatureView, CreatureViews
 
@@ -314,10 +314,10 @@ class PhysicsBackend(Membership):
         """
         reduced = reduced_substeps(substeps)
         if before_substep is not None:
-            chunks = plan(self.batches, self.active, self.tier, self.threads)
+            segments = plan(self.batches, self.active, self.tier, self.threads)
             for i in range(substeps):
                 before_substep(i)
-                self._run(chunks, {FULL: 1, REDUCED: int(i < reduced)})
+                self._run(segments, {FULL: 1, REDUCED: int(i < reduced)})
         else:
             near = self.proxies_used > 0 if rounds > 1 else np.zeros(len(self), dtype=bool)
             near &= self.active
@@ -331,39 +331,37 @@ class PhysicsBackend(Membership):
                     for n, r in zip(_split(substeps, rounds), _split(reduced, rounds), strict=True)
                     if n
                 ]
-                # the first part of the near ones with all of the others: one balanced call
+                # the first part of the near ones with all of the others: one dispatch
                 share = substeps / parts[0][FULL]
                 first = plan(self.batches, near, self.tier, self.threads, (alone, whole, share))
                 self._run(first, parts[0])
-                chunks = plan(self.batches, near, self.tier, self.threads)
+                segments = plan(self.batches, near, self.tier, self.threads)
                 for part in parts[1:]:
                     if between is not None:
                         between()
-                    self._run(chunks, part)
+                    self._run(segments, part)
         self.time += substeps * self.substep_dt
         self._untrimmed += 1
         if self._untrimmed >= heap.TRIM_FRAMES:
             self._untrimmed = 0
             heap.trim()
 
-    def _run(self, chunks: list[list[Segment]], substeps: dict[int, int]) -> None:
-        self._dispatch(step_segments, chunks, substeps)
+    def _run(self, segments: list[Segment], substeps: dict[int, int]) -> None:
+        self._dispatch(step_segments, segments, substeps)
 
-    def _dispatch(self, work: Callable[..., None], chunks: list[Any], *args: Any) -> None:
-        """`work(chunk, *args, thread)` for every chunk: the first on this thread, the
-        others on the pool (this thread steps instead of waiting idle; chunk k always
-        uses scratch k, so which thread runs it changes nothing)."""
-        if self._pool is None or len(chunks) < 2:
-            for thread, chunk in enumerate(chunks):
-                work(chunk, *args, thread)
+    def _dispatch(self, step: Callable[..., None], segments: list[Segment], *args: Any) -> None:
+        """`step(work, *args, thread)` on this thread and every pool thread at once, each
+        taking segments from one shared `Work` until none is left (this thread steps too
+        instead of waiting idle; thread k always uses scratch k, and which thread steps a
+        row changes nothing)."""
+        work = Work(segments)
+        helpers = min(self.threads, len(segments)) - 1
+        if self._pool is None or helpers < 1:
+            step(work, *args, 0)
             return
-        futures = [
-            self._pool.submit(work, chunk, *args, thread)
-            for thread, chunk in enumerate(chunks)
-            if thread > 0
-        ]
+        futures = [self._pool.submit(step, work, *args, thread) for thread in range(1, helpers + 1)]
         try:
-            work(chunks[0], *args, 0)
+            step(work, *args, 0)
         finally:
             for future in futures:
                 future.result()
@@ -391,9 +389,9 @@ class PhysicsBackend(Membership):
         nothing of the framework. For benchmarks: the framework's cost is a frame minus
         this.
         """
-        chunks = plan(self.batches, self.active, self.tier, self.threads)
+        segments = plan(self.batches, self.active, self.tier, self.threads)
         steps = {FULL: substeps, REDUCED: reduced_substeps(substeps)}
-        self._dispatch(bare_step, chunks, states, steps)
+        self._dispatch(bare_step, segments, states, steps)
 
     def sync(self, transforms: TransformStore) -> None:
         """Copy every body's world pose into the Transform store (one scatter per batch)."""

@@ -1,10 +1,13 @@
-"""Which thread steps which creatures: balanced contiguous shares of every batch's rows.
+"""Which thread steps which creatures: rows handed out one by one to whichever asks.
 
-`plan` splits the active rows of all batches into at most `threads` chunks of about
-equal cost (the time each row's steps took lately, `Batch.frame_cost`), each a list of
-`Segment`s (a batch and some of its rows). Chunk k runs on the pool's k-th task with
-scratch k of each batch, so two threads never share a scratch MjData; which thread
-steps a row never changes its result (`ecs_tentacles.physics.batch`).
+`plan` lists the active rows of all batches as `Segment`s (a batch, one row, a tier),
+the costliest first (`Batch.frame_cost`: the time its steps took lately). Each thread
+of a dispatch takes the next segment from a shared `Work` queue until none is left, so
+no thread idles while another still has creatures (a static split by estimated cost
+left the second of two threads 1-1.5 ms a frame behind: a row's measured time depends
+on what the other thread does meanwhile). Thread k always steps on scratch k of each
+batch, so two threads never share a scratch MjData; which thread steps a row never
+changes its result (`ecs_tentacles.physics.batch`).
 """
 
 from __future__ import annotations
@@ -30,21 +33,34 @@ class Segment:
     steps: dict[int, int] | None = None
 
 
+class Work:
+    """`segments` handed out one at a time to the threads of one dispatch."""
+
+    def __init__(self, segments: list[Segment]) -> None:
+        self.segments = segments
+        self._next = itertools.count()  # its next() is atomic under the GIL
+
+    def take(self) -> Segment | None:
+        """The next segment nobody has taken, or None when all are taken."""
+        i = next(self._next)
+        return self.segments[i] if i < len(self.segments) else None
+
+
 def plan(
     batches: list[Batch],
     active: np.ndarray,
     tier: np.ndarray,
     threads: int,
     also: tuple[np.ndarray, dict[int, int], float] | None = None,
-) -> list[list[Segment]]:
-    """Active rows (by creature index) of the stepped tiers in at most `threads` chunks of
-    about equal cost; every tier's model and scratch data are made first.
+) -> list[Segment]:
+    """Active rows (by creature index) of the stepped tiers, a segment each, the costliest
+    first (so the last ones taken are short); every tier's model and scratch data for
+    `threads` threads are made first.
 
     `also` = (more active creatures, their steps per tier, how many times the call's
-    steps that is): stepped in the same chunks, their cost weighed by it, so one
-    dispatch balances creatures that take different step counts.
+    steps that is): stepped in the same dispatch, their cost weighed by it.
     """
-    pieces = []
+    pieces: list[tuple[float, int, Segment]] = []
     groups: list[tuple[np.ndarray, dict[int, int] | None, float]] = [(active, None, 1.0)]
     if also is not None:
         groups.append(also)
@@ -57,46 +73,32 @@ def plan(
                     if level == REDUCED:
                         batch.prepare(FULL, threads)  # its poses come from the full model
                     cost = batch.frame_cost(rows, level) * weight
-                    pieces.append((batch, rows, cost, level, steps))
-    if not pieces:
-        return []
-    cost = np.cumsum(np.concatenate([c for _, _, c, _, _ in pieces]))
-    cuts = np.searchsorted(cost, cost[-1] * np.arange(1, threads) / threads)
-    bounds = [0, *cuts.tolist(), len(cost)]
-    starts = np.cumsum([0] + [len(r) for _, r, _, _, _ in pieces])
-    chunks: list[list[Segment]] = []
-    for a, b in itertools.pairwise(bounds):
-        if b <= a:
-            continue
-        chunk = []
-        for (batch, rows, _, level, steps), lo, hi in zip(
-            pieces, starts[:-1], starts[1:], strict=True
-        ):
-            s, e = max(a, lo), min(b, hi)
-            if e > s:
-                chunk.append(Segment(batch, rows[s - lo : e - lo], level, steps))
-        chunks.append(chunk)
-    return chunks
+                    pieces.extend(
+                        (-c, len(pieces) + k, Segment(batch, rows[k : k + 1], level, steps))
+                        for k, c in enumerate(cost.tolist())
+                    )
+    pieces.sort(key=lambda piece: piece[:2])
+    return [segment for _, _, segment in pieces]
 
 
-def step_segments(chunk: list[Segment], substeps: dict[int, int], thread: int) -> None:
-    """Step every segment of `chunk` by its tier's `substeps` on scratch `thread` (runs on
-    a pool thread)."""
-    for segment in chunk:
+def step_segments(work: Work, substeps: dict[int, int], thread: int) -> None:
+    """Step segments taken from `work` by their tier's `substeps` on scratch `thread`
+    until none is left (runs on each thread of a dispatch)."""
+    while (segment := work.take()) is not None:
         n = (segment.steps or substeps)[segment.tier]
         if n:
             segment.batch.step_rows(segment.rows, n, thread, segment.tier)
 
 
 def bare_step(
-    chunk: list[Segment],
+    work: Work,
     states: list[dict[int, np.ndarray]],
     substeps: dict[int, int],
     thread: int,
 ) -> None:
     """MuJoCo alone: each row's model values, set its state, step it, get it back
     (benchmarks)."""
-    for segment in chunk:
+    while (segment := work.take()) is not None:
         batch = segment.batch
         scratch = batch.scratch_for(thread, segment.tier)
         m, d, rows = scratch.model, scratch.data, states[batch.index][segment.tier]
