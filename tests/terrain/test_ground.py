@@ -77,3 +77,27 @@ def test_rays_and_the_topmost_surface() -> None:
     assert ground.ray(np.array([0.0, 0.0, 3.0]), np.array([0.0, 0.0, 1.0])) is None
     flat = FLAT.ray(np.array([1.0, 1.0, 2.0]), np.array([0.0, 1.0, -1.0]))
     assert flat is not None and flat.tolist() == pytest.approx([1.0, 3.0, 0.0])
+
+
+def test_the_height_kernel_gives_the_numpy_numbers_bit_for_bit(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Inside, on sample lines, on the borders and outside the field."""
+    from ecs_tentacles import ground as module
+
+    rng = np.random.default_rng(7)
+    field_ = Heightfield((6.0, 4.0), rng.uniform(-0.3, 0.5, size=(33, 49)))
+    ground = Ground(field_)
+    samples = np.linspace(-3.0, 3.0, 49)
+    points = np.vstack([
+        rng.uniform([-3.5, -2.5], [3.5, 2.5], size=(20_000, 2)),
+        np.column_stack([samples, np.linspace(-2.0, 2.0, 49)]),
+        [[3.0, 0.0], [-3.0, 2.0], [0.0, -2.0], [3.0 + 1e-9, 0.0], [0.0, -50.0]],
+    ])  # fmt: skip
+    assert module.KERNELS.get() is not None  # numba comes with the dev extra
+    found = []
+    for backend in ("auto", "numpy"):
+        monkeypatch.setattr(module.KERNELS, "backend", backend)
+        found.append(ground.height(points))
+    np.testing.assert_array_equal(found[0], found[1])
+    assert found[0][-1] == found[0][-2] == field_.heights.min()  # outside: the lowest
