@@ -1,7 +1,8 @@
 """Which thread steps which creatures: rows handed out one by one to whichever asks.
 
 `plan` lists the active rows of all batches as `Segment`s (a batch, one row, a tier),
-the costliest first (`Batch.frame_cost`: the time its steps took lately). Each thread
+grouped by batch and tier, the costliest groups first (`Batch.frame_cost`: the time
+its steps took lately). Each thread
 of a dispatch takes the next segment from a shared `Work` queue until none is left, so
 no thread idles while another still has creatures (a static split by estimated cost
 left the second of two threads 1-1.5 ms a frame behind: a row's measured time depends
@@ -53,14 +54,15 @@ def plan(
     threads: int,
     also: tuple[np.ndarray, dict[int, int], float] | None = None,
 ) -> list[Segment]:
-    """Active rows (by creature index) of the stepped tiers, a segment each, the costliest
-    first (so the last ones taken are short); every tier's model and scratch data for
-    `threads` threads are made first.
+    """Active rows (by creature index) of the stepped tiers, a segment each: the rows of
+    one batch at one tier together (a thread taking them in turn keeps that model in its
+    caches), the groups whose rows cost most first (so the last ones taken are short);
+    every tier's model and scratch data for `threads` threads are made first.
 
     `also` = (more active creatures, their steps per tier, how many times the call's
     steps that is): stepped in the same dispatch, their cost weighed by it.
     """
-    pieces: list[tuple[float, int, Segment]] = []
+    found: list[tuple[float, int, list[Segment]]] = []
     groups: list[tuple[np.ndarray, dict[int, int] | None, float]] = [(active, None, 1.0)]
     if also is not None:
         groups.append(also)
@@ -72,13 +74,13 @@ def plan(
                     batch.prepare(level, threads)
                     if level == REDUCED:
                         batch.prepare(FULL, threads)  # its poses come from the full model
-                    cost = batch.frame_cost(rows, level) * weight
-                    pieces.extend(
-                        (-c, len(pieces) + k, Segment(batch, rows[k : k + 1], level, steps))
-                        for k, c in enumerate(cost.tolist())
-                    )
-    pieces.sort(key=lambda piece: piece[:2])
-    return [segment for _, _, segment in pieces]
+                    cost = float(batch.frame_cost(rows, level).mean()) * weight
+                    segments = [
+                        Segment(batch, rows[k : k + 1], level, steps) for k in range(len(rows))
+                    ]
+                    found.append((-cost, len(found), segments))
+    found.sort(key=lambda group: group[:2])
+    return [segment for _, _, segments in found for segment in segments]
 
 
 def step_segments(work: Work, substeps: dict[int, int], thread: int) -> None:
