@@ -351,14 +351,14 @@ class PhysicsBackend(Membership):
 
     def _dispatch(self, step: Callable[..., None], segments: list[Segment], *args: Any) -> None:
         """`step(work, *args, thread)` on this thread and every pool thread at once, each
-        taking segments from one shared `Work` until none is left (this thread steps too
-        instead of waiting idle; thread k always uses scratch k, and which thread steps a
-        row changes nothing)."""
-        work = Work(segments)
-        helpers = min(self.threads, len(segments)) - 1
+        taking shares of `segments` from one shared `Work` until none is left (this
+        thread steps too instead of waiting idle; thread k always uses scratch k, and
+        which thread steps a row changes nothing)."""
+        helpers = min(self.threads, sum(len(s.rows) for s in segments)) - 1
         if self._pool is None or helpers < 1:
-            step(work, *args, 0)
+            step(Work(segments, 1), *args, 0)
             return
+        work = Work(segments, helpers + 1)
         futures = [self._pool.submit(step, work, *args, thread) for thread in range(1, helpers + 1)]
         try:
             step(work, *args, 0)

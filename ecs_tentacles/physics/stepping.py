@@ -1,20 +1,22 @@
-"""Which thread steps which creatures: rows handed out one by one to whichever asks.
+"""Which thread steps which creatures: shares of rows handed out to whichever asks.
 
-`plan` lists the active rows of all batches as `Segment`s (a batch, one row, a tier),
-grouped by batch and tier, the costliest groups first (`Batch.frame_cost`: the time
-its steps took lately). Each thread
-of a dispatch takes the next segment from a shared `Work` queue until none is left, so
-no thread idles while another still has creatures (a static split by estimated cost
-left the second of two threads 1-1.5 ms a frame behind: a row's measured time depends
-on what the other thread does meanwhile). Thread k always steps on scratch k of each
-batch, so two threads never share a scratch MjData; which thread steps a row never
-changes its result (`ecs_tentacles.physics.batch`).
+`plan` groups the active rows of all batches by batch and tier (a thread taking a
+group's rows in turn keeps that model in its caches), the groups whose rows cost most
+first, each row with its cost (`Batch.frame_cost`: the time its steps took lately).
+Each thread of a dispatch takes shares from one `Work` until none is left: a share is
+half of what is left divided among the threads (guided scheduling), so the first are
+large (little bookkeeping) and the last small (no thread idles long while another
+finishes). A split fixed before the step, by estimated cost, left the second of two
+threads 1-1.5 ms a frame behind: a row's time depends on what the other thread does
+meanwhile. Thread k always steps on scratch k of each batch, so two threads never
+share a scratch MjData; which thread steps a row never changes its result
+(`ecs_tentacles.physics.batch`).
 """
 
 from __future__ import annotations
 
-import itertools
-from dataclasses import dataclass
+import threading
+from dataclasses import dataclass, field
 
 import mujoco
 import numpy as np
@@ -32,19 +34,41 @@ class Segment:
     rows: np.ndarray
     tier: int = FULL
     steps: dict[int, int] | None = None
+    cost: np.ndarray = field(default_factory=lambda: np.zeros(0))  # per row, when planned
 
 
 class Work:
-    """`segments` handed out one at a time to the threads of one dispatch."""
+    """The segments of a plan handed out in shares to the `threads` threads of one
+    dispatch (one thread: each segment whole)."""
 
-    def __init__(self, segments: list[Segment]) -> None:
-        self.segments = segments
-        self._next = itertools.count()  # its next() is atomic under the GIL
+    def __init__(self, segments: list[Segment], threads: int) -> None:
+        self._segments = segments
+        self._threads = threads
+        self._lock = threading.Lock()
+        self._totals = [np.cumsum(s.cost) if len(s.cost) else None for s in segments]
+        self._left = float(sum(t[-1] for t in self._totals if t is not None))
+        self._at = (0, 0)  # the next segment and row not taken
 
     def take(self) -> Segment | None:
-        """The next segment nobody has taken, or None when all are taken."""
-        i = next(self._next)
-        return self.segments[i] if i < len(self.segments) else None
+        """The next share nobody has taken, or None when all are taken."""
+        with self._lock:
+            index, row = self._at
+            while index < len(self._segments) and row >= len(self._segments[index].rows):
+                index, row = index + 1, 0
+            if index == len(self._segments):
+                self._at = (index, 0)
+                return None
+            segment, totals = self._segments[index], self._totals[index]
+            end = len(segment.rows)
+            if self._threads > 1 and totals is not None:
+                before = float(totals[row - 1]) if row else 0.0
+                want = before + self._left / (2 * self._threads)
+                end = min(max(int(np.searchsorted(totals, want)) + 1, row + 1), end)
+                self._left -= float(totals[end - 1]) - before
+            self._at = (index, end)
+        if row == 0 and end == len(segment.rows):
+            return segment
+        return Segment(segment.batch, segment.rows[row:end], segment.tier, segment.steps)
 
 
 def plan(
@@ -54,15 +78,14 @@ def plan(
     threads: int,
     also: tuple[np.ndarray, dict[int, int], float] | None = None,
 ) -> list[Segment]:
-    """Active rows (by creature index) of the stepped tiers, a segment each: the rows of
-    one batch at one tier together (a thread taking them in turn keeps that model in its
-    caches), the groups whose rows cost most first (so the last ones taken are short);
-    every tier's model and scratch data for `threads` threads are made first.
+    """Active rows (by creature index) of the stepped tiers: a segment per batch and tier
+    with each row's cost, the segments whose rows cost most first; every tier's model
+    and scratch data for `threads` threads are made first.
 
     `also` = (more active creatures, their steps per tier, how many times the call's
     steps that is): stepped in the same dispatch, their cost weighed by it.
     """
-    found: list[tuple[float, int, list[Segment]]] = []
+    found: list[tuple[float, int, Segment]] = []
     groups: list[tuple[np.ndarray, dict[int, int] | None, float]] = [(active, None, 1.0)]
     if also is not None:
         groups.append(also)
@@ -74,13 +97,11 @@ def plan(
                     batch.prepare(level, threads)
                     if level == REDUCED:
                         batch.prepare(FULL, threads)  # its poses come from the full model
-                    cost = float(batch.frame_cost(rows, level).mean()) * weight
-                    segments = [
-                        Segment(batch, rows[k : k + 1], level, steps) for k in range(len(rows))
-                    ]
-                    found.append((-cost, len(found), segments))
+                    cost = batch.frame_cost(rows, level) * weight
+                    segment = Segment(batch, rows, level, steps, cost)
+                    found.append((-float(cost.mean()), len(found), segment))
     found.sort(key=lambda group: group[:2])
-    return [segment for _, _, segments in found for segment in segments]
+    return [segment for _, _, segment in found]
 
 
 def step_segments(work: Work, substeps: dict[int, int], thread: int) -> None:
