@@ -34,9 +34,27 @@ def test_the_overlap_probe_measures_capsules_pushed_into_each_other() -> None:
 @pytest.mark.skipif(not TOOL.is_file(), reason="needs the source tree")
 def test_a_short_comparison_reports_progress_goals_overlap_and_recoveries() -> None:
     tool = load_tool("lod_fidelity")
-    on, off = (tool.run(4, 0.2, lod, 5, 0) for lod in (True, False))
+    on, off = (tool.run(4, 0.2, lod, 5, 0, None) for lod in (True, False))
     result = tool.compare(on, off)
     assert set(on["progress"]) == set(off["progress"]) and len(on["progress"]) == 4
     assert np.isfinite(result["progress_ratio"])
     assert result["recoveries"] == {"lod": 0, "off": 0}
     assert result["deepest_mm"]["lod"] >= 0.0 and result["reached"]["both"] >= 0
+
+
+@pytest.mark.skipif(not TOOL.is_file(), reason="needs the source tree")
+def test_goals_brought_near_keep_their_direction_and_are_reached_in_both_runs() -> None:
+    from ecs_tentacles.creator.crowd import crowd_scene
+
+    tool = load_tool("lod_fidelity")
+    far = crowd_scene(4, seed=0)
+    near = tool.goals_within(crowd_scene(4, seed=0), 0.3)
+    for old, new in zip(far["creatures"], near["creatures"], strict=True):
+        start = np.asarray(old["position"][:2])
+        was, now = (np.asarray(c["goals"][0]["position"][:2]) - start for c in (old, new))
+        assert np.linalg.norm(now) == pytest.approx(min(0.3, np.linalg.norm(was)))
+        assert np.dot(was, now) > 0.999 * np.linalg.norm(was) * np.linalg.norm(now)
+    on, off = (tool.run(4, 4.0, lod, 50, 0, 0.3) for lod in (True, False))
+    result = tool.compare(on, off)
+    assert result["reached"] == {"lod": 4, "off": 4, "both": 4}
+    assert result["arrival_apart_s_max"] < 2.0
