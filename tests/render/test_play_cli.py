@@ -21,12 +21,16 @@ def test_headless_play_writes_the_screenshot(
     size = ["--width", "320", "--height", "180"]
     assert main([*argv, "--screenshot", str(shot), *size]) == 0
     scene = bundled_scene("three_goals")
-    assert capsys.readouterr().out == f"{scene}: 3 frames (0.05 s simulated); wrote {shot}\n"
+    out = capsys.readouterr().out
+    assert out.startswith(f"{scene}: 3 frames (0.05 s simulated, physics ")
+    assert out.endswith(f" real time); wrote {shot}\n")
     with Image.open(shot) as image:
         assert image.size == (320, 180)
     assert main([*argv, "--screenshot", str(shot), *size, "--json"]) == 0
     result = json.loads(capsys.readouterr().out)
     assert (result["frames"], result["screenshot"]) == (3, str(shot))
+    assert result["physics_ms"] > 0  # the median frame's physics, and what it means
+    assert result["realtime_factor"] == pytest.approx(1000 / 60 / result["physics_ms"], rel=1e-2)
 
 
 @pytest.mark.parametrize(
