@@ -115,12 +115,16 @@ class ControlMarker:
     size: float
 
 
-def control_markers(world: Host) -> list[ControlMarker]:
-    """Every fur control, placed in world space by its creature's mantle pose."""
+def control_markers(world: Host, creature: int | None = None) -> list[ControlMarker]:
+    """Every fur control (`creature`: only that creature entity's), placed in world space
+    by its creature's mantle pose."""
     fur = world.resource(FurData)
     markers = []
     for entity, control in world.query(FurControl):
-        body = fur.sets.body_row[control.store.fur_row[control.row]]
+        fur_row = control.store.fur_row[control.row]
+        if creature is not None and fur.sets.creature[fur_row] != creature:
+            continue
+        body = fur.sets.body_row[fur_row]
         pos = world.transforms.pos[body] + quat_rotate(
             world.transforms.quat[body], control.position
         )

@@ -234,3 +234,35 @@ def test_the_timeline_shows_only_for_a_creature_with_fur(make_sandbox: Callable[
     sandbox.render()
     assert "no fur" in sandbox.hud.gui.rects  # the section says so
     assert "timeline" not in sandbox.hud.gui.windows  # and shows no timeline
+
+
+def test_only_the_edited_creatures_controls_are_drawn(make_sandbox: Callable[..., Any]) -> None:
+    """A crowd's every control drawn was clutter: the markers follow the fur tool."""
+    import json
+
+    from ecs_tentacles.fur.render.strands import fur_display, fur_lines
+    from ecs_tentacles.scene.load import bundled_scene
+
+    scene = json.loads(bundled_scene("hedgehog_octopus").read_text())
+    twin = json.loads(json.dumps(scene["creatures"][0]))
+    twin.update(name="twin", position=[3.0, 0.0])
+    scene["creatures"].append(twin)
+    sandbox = make_sandbox(scene)
+    sandbox.step(1)
+    world = sandbox.world
+    mantle = {n: world.component(world.creature(n), Transform).row for n in ("hedgehog", "twin")}
+
+    def drawn_near() -> set[str]:
+        (lines,) = fur_lines(world, sandbox.renderer.render_view)
+        assert len(lines)
+        centres = world.transforms.pos[list(mantle.values())]
+        nearest = np.argmin(
+            np.linalg.norm(lines[:, None, :3] - centres[None].astype(np.float32), axis=2), axis=1
+        )
+        return {list(mantle)[k] for k in set(nearest.tolist())}
+
+    for name in ("hedgehog", "twin"):
+        sandbox.select(world.creature(name))
+        sandbox.render()
+        assert fur_display(sandbox.renderer.state).creature == world.creature(name)
+        assert drawn_near() == {name}

@@ -127,8 +127,9 @@ class FurPanel(Panel):
         display = self.display
         editor = self.editor
         display.selected_control = None
+        world = self.sandbox.world
+        display.creature = None if editor.creature is None else world.creature(editor.creature)
         if editor.creature is not None and editor.control is not None:
-            world = self.sandbox.world
             fur_controls = world.resource(FurData).controls
             display.selected_control = int(fur_controls.entity[editor.rows()[editor.control]])
         self.refresh_rig()

@@ -55,10 +55,13 @@ SHAPES = {
 }
 
 
-def marker_lines(world: Host, selected: int | None = None) -> np.ndarray:
-    """Line-list vertices (2n, 7) of every fur control; `selected`: its entity."""
+def marker_lines(
+    world: Host, selected: int | None = None, creature: int | None = None
+) -> np.ndarray:
+    """Line-list vertices (2n, 7) of every fur control (`creature`: only that creature
+    entity's); `selected`: the highlighted control's entity."""
     parts = []
-    for marker in control_markers(world):
+    for marker in control_markers(world, creature):
         chosen = marker.entity == selected
         template = SHAPES.get(marker.shape, SHAPES["sphere"])
         segments = marker.position + template * marker.size * (1.5 if chosen else 1.0)

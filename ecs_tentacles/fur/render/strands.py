@@ -38,6 +38,9 @@ class FurDisplay:
     child_points: int | None = 3  # points per child hair drawn (level of detail); None: all
     markers: bool = True  # the controls' shapes, while the sandbox shows its overlays (HUD)
     selected_control: int | None = None  # a control entity, drawn highlighted
+    # the creature entity the fur tool edits: only its controls are drawn (None: none;
+    # a crowd's every control drawn was clutter, and 5 ms a frame at 64 furred creatures)
+    creature: int | None = None
 
 
 def fur_display(state: dict[str, Any]) -> FurDisplay:
@@ -74,14 +77,17 @@ def fur_strands(world: Host, display: FurDisplay) -> tuple[GuideCurves, GuideCur
 
 
 def fur_lines(world: Host, view: RenderView) -> list[np.ndarray]:
-    """The controls' marker shapes (line-list vertices) while the sandbox shows overlays."""
+    """The marker shapes (line-list vertices) of the controls of the creature the fur tool
+    edits, while the sandbox shows overlays."""
     from ecs_tentacles.fur.render.markers import marker_lines
 
     fur = world.get_resource(FurData)
     display = fur_display(view.state)
     if fur is None or not len(fur.guides) or not (display.markers and view.overlays):
         return []
-    return [marker_lines(world, display.selected_control)]
+    if display.creature is None:
+        return []
+    return [marker_lines(world, display.selected_control, display.creature)]
 
 
 class FurStrands:
