@@ -246,6 +246,37 @@ class ReducedModel:
         # the part of a full state a reduced step writes, to know when someone else did
         q, v = self.full_slices[int(S.mjSTATE_QPOS)], self.full_slices[int(S.mjSTATE_QVEL)]
         self.watched = slice(q.start, v.stop)
+        # the state entries each map reads and writes, as index arrays: one gather a map
+        rs, fs = self.slices, self.full_slices
+
+        def entries(slices: dict[int, slice], flags: tuple[mujoco.mjtState, ...]) -> np.ndarray:
+            parts = [slices[int(f)] for f in flags]
+            return np.concatenate([np.arange(p.start, p.stop) for p in parts])
+
+        inputs = (S.mjSTATE_TIME, S.mjSTATE_EQ_ACTIVE, S.mjSTATE_MOCAP_POS, S.mjSTATE_MOCAP_QUAT)
+        self._inputs = (entries(fs, inputs), entries(rs, inputs))  # (full, reduced)
+        self._controls = (
+            fs[int(S.mjSTATE_CTRL)].start + self.full_u,
+            rs[int(S.mjSTATE_CTRL)].start + self.red_u,
+        )
+        rq, rv = rs[int(S.mjSTATE_QPOS)], rs[int(S.mjSTATE_QVEL)]
+        fq, fv = fs[int(S.mjSTATE_QPOS)], fs[int(S.mjSTATE_QVEL)]
+        self._shown = (  # (reduced, full): the clock and the root, copied
+            np.concatenate([
+                np.arange(rs[int(S.mjSTATE_TIME)].start, rs[int(S.mjSTATE_TIME)].stop),
+                rq.start + np.arange(self.red_root_q, self.red_root_q + 7),
+                rv.start + np.arange(self.red_root_v, self.red_root_v + 6),
+            ]),
+            np.concatenate([
+                np.arange(fs[int(S.mjSTATE_TIME)].start, fs[int(S.mjSTATE_TIME)].stop),
+                fq.start + np.arange(self.root_q, self.root_q + 7),
+                fv.start + np.arange(self.root_v, self.root_v + 6),
+            ]),
+        )  # fmt: skip
+        self._angles = (rq.start + self.red_q, fq.start + self.full_q)
+        self._speeds = (rv.start + self.red_v, fv.start + self.full_v)
+        self._torque_u = self.full_u[self.first]
+        self._low = -self.limit
         obj = mujoco.mjtObj
         names = [mujoco.mj_id2name(full, obj.mjOBJ_BODY, b) for b in range(full.nbody)]
         self.body_group = np.zeros((model.nbody, full.nbody))  # applied forces: summed
@@ -270,34 +301,30 @@ class ReducedModel:
     def pull_inputs(self, full_state: np.ndarray, out: np.ndarray) -> None:
         """What the systems wrote into the full state this frame (servo targets fitted,
         sucker switches, proxy poses, the clock) into the reduced state `out`."""
-        fs, rs = self.full_slices, self.slices
-        for flag in (S.mjSTATE_TIME, S.mjSTATE_EQ_ACTIVE, S.mjSTATE_MOCAP_POS,
-                     S.mjSTATE_MOCAP_QUAT):  # fmt: skip
-            out[rs[int(flag)]] = full_state[fs[int(flag)]]
-        ctrl = full_state[fs[int(S.mjSTATE_CTRL)]]
-        out[rs[int(S.mjSTATE_CTRL)]][self.red_u] = self.fit @ ctrl[self.full_u]
+        source, target = self._inputs
+        out[target] = full_state[source]
+        source, target = self._controls
+        out[target] = self.fit @ full_state[source]
 
     def expand_state(self, reduced_state: np.ndarray, out: np.ndarray) -> None:
         """The full state `out` shows the reduced state: root and clock copied, joint
         angles and speeds expanded (within the full joints' limits), warm start cleared."""
-        fs, rs = self.full_slices, self.slices
-        out[fs[int(S.mjSTATE_TIME)]] = reduced_state[rs[int(S.mjSTATE_TIME)]]
-        rq, fq = reduced_state[rs[int(S.mjSTATE_QPOS)]], out[fs[int(S.mjSTATE_QPOS)]]
-        rv, fv = reduced_state[rs[int(S.mjSTATE_QVEL)]], out[fs[int(S.mjSTATE_QVEL)]]
-        fq[self.root_q : self.root_q + 7] = rq[self.red_root_q : self.red_root_q + 7]
-        fv[self.root_v : self.root_v + 6] = rv[self.red_root_v : self.red_root_v + 6]
-        fq[self.full_q] = np.clip(self.expand @ rq[self.red_q], -self.limit, self.limit)
-        fv[self.full_v] = self.expand @ rv[self.red_v]
-        out[fs[int(S.mjSTATE_WARMSTART)]] = 0.0
+        source, target = self._shown
+        out[target] = reduced_state[source]
+        source, target = self._angles
+        angles = self.expand @ reduced_state[source]
+        out[target] = np.minimum(np.maximum(angles, self._low, out=angles), self.limit)
+        source, target = self._speeds
+        out[target] = self.expand @ reduced_state[source]
+        out[self.full_slices[int(S.mjSTATE_WARMSTART)]] = 0.0
 
     # -- model values ----------------------------------------------------------------
     def write_overlay(self, batch: Rows, m: mujoco.MjModel, row: int) -> None:
         """Row `row`'s servos (each reduced one its group's in series), sucker anchors and
         proxy sizes into the reduced scratch model `m`."""
-        kp = SERIES_GAIN / (self.series @ (1.0 / np.maximum(batch.kp[row][self.full_u], 1e-12)))
-
-        kv = 1.0 / (self.series @ (1.0 / np.maximum(batch.kv[row][self.full_u], 1e-12)))
-        torque = batch.torque[row][self.full_u][self.first]
+        kp = SERIES_GAIN / (self.series @ (1.0 / np.maximum(batch.kp[row, self.full_u], 1e-12)))
+        kv = 1.0 / (self.series @ (1.0 / np.maximum(batch.kv[row, self.full_u], 1e-12)))
+        torque = batch.torque[row, self._torque_u]
         u = self.red_u
         m.actuator_gainprm[u, 0] = kp
         m.actuator_biasprm[u, 1] = -kp
