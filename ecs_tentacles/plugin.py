@@ -4,10 +4,12 @@ Core is the World, its Schedule and the physics. Everything else (locomotion,
 suckers, fur, threats, recording, the sandbox's drawing, users' behaviours) is a
 `Plugin`: a schema fragment (creature-level and scene-level keys, and the schema of
 its own `plugins.<name>` config), a per-creature build hook, its stores (world
-resources), its systems at a named stage, its validation, and optional hooks the
-generic layers call (they never name a feature): render hooks for the sandbox;
-output hooks for takes (`take_tracks`, `before_recording`), for distributed bakes'
-shard plans (`shard_reach`, `shard_groups`) and for `run`'s report (`run_summary`).
+resources), its systems at a named stage, its validation, its entries in the registries
+of the layers above core (`build(app)`, `ecs_tentacles.registry`: the renderer's and
+the sandbox's in `ecs_tentacles.render.registries`), and optional hooks the generic
+layers call (they never name a feature): output hooks for takes (`take_tracks`,
+`before_recording`), for distributed bakes' shard plans (`shard_reach`,
+`shard_groups`) and for `run`'s report (`run_summary`).
 How a scene's `plugins` are found, trusted, imported and made is
 `ecs_tentacles.plugin_registry`.
 
@@ -34,8 +36,8 @@ from ecs_tentacles.take_tracks import TakeTrack
 if TYPE_CHECKING:
     import numpy as np
 
-    from ecs_tentacles.drawing import Click, Panel, RenderView
     from ecs_tentacles.host import Host
+    from ecs_tentacles.registry import App
     from ecs_tentacles.store import ArrayStore
 
 
@@ -97,15 +99,6 @@ class RunSummary:
     text: str = ""
 
 
-@dataclass(frozen=True)
-class Marker:
-    """Spheres a plugin asks the renderer to draw: centres (n, 3), size (x, y, z), rgba."""
-
-    positions: Any
-    size: tuple[float, float, float]
-    rgba: tuple[float, float, float, float]
-
-
 class HookFailure(RuntimeError):
     """A plugin's hook called `sys.exit` (raised SystemExit): a failure like any other,
     one line naming the plugin and the hook (the command line exits 1), never a quiet
@@ -142,7 +135,20 @@ class Plugin:
     # hooks of earlier versions, and what replaced them: a plugin that still defines
     # one is refused when its class is made, instead of being silently never called
     RENAMED_HOOKS: ClassVar[dict[str, str]] = {
-        "export_curves": "take_tracks (a TrackSource of kind 'curves'; README: Output hooks)"
+        "export_curves": "take_tracks (a TrackSource of kind 'curves'; README: Output hooks)",
+        **{
+            hook: f"a {kind} entry added in build(app) (ecs_tentacles.render.registries)"
+            for hook, kind in (
+                ("render_spheres", "Spheres"),
+                ("render_lines", "Lines"),
+                ("render_draw", "Draws"),
+                ("render_points", "FramedPoints"),
+                ("sandbox_panels", "Panels"),
+                ("sandbox_click", "Clicks"),
+                ("sandbox_state", "UndoStates"),
+                ("sandbox_restore", "UndoStates"),
+            )
+        },
     }
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
@@ -155,6 +161,13 @@ class Plugin:
         self.config: dict[str, Any] = dict(config or {})
         self.key = self.name  # the name a scene turned it on by
         self.source: str | None = None  # the file or module it came from, if not built in
+
+    # -- registries ----------------------------------------------------------------------
+    def build(self, app: App) -> None:
+        """Add this plugin's entries to the registries of the layers that call them
+        (`app.add(kind, entry)`; `ecs_tentacles.registry`): drawing, HUD sections, clicks
+        and undo states (`ecs_tentacles.render.registries`). Runs once per world, after
+        `resources` and `stores`."""
 
     # -- scene ---------------------------------------------------------------------------
     def problems(self, scene: Mapping[str, Any]) -> list[tuple[tuple[str | int, ...], str]]:
@@ -203,41 +216,7 @@ class Plugin:
     def restore(self, world: Host, state: Any) -> None:
         """Put back what `snapshot` returned."""
 
-    # -- hooks ---------------------------------------------------------------------------
-    def render_spheres(self, world: Host) -> list[Marker]:
-        """Marker spheres the sandbox draws this frame."""
-        return []
-
-    # -- sandbox hooks (the generic renderer, HUD and mouse call these) ------------------
-    def render_lines(self, world: Host, view: RenderView) -> list[Any]:
-        """Line-list vertices (2n, 7: xyz rgba) the sandbox draws this frame, in its one
-        line batch (`drawing.line_segments` makes them from polylines)."""
-        return []
-
-    def render_draw(self, world: Host, view: RenderView) -> int:
-        """Draw what spheres and lines cannot, with this plugin's own GL objects (made
-        lazily here, kept in `view.state`); runs after the renderer's own draws with the
-        depth test on. Returns the draw calls issued."""
-        return 0
-
-    def render_points(self, world: Host) -> Any:
-        """Points (n, 3) the camera's "frame all" keeps in view besides the creatures, or None."""
-        return None
-
-    def sandbox_panels(self, sandbox: Any) -> list[Panel]:
-        """HUD sections this plugin adds to a sandbox (`ecs_tentacles.render.sandbox`);
-        asked once per sandbox: panels live across resets (`Panel.attach`)."""
-        return []
-
-    def sandbox_state(self, world: Host) -> Any:
-        """What of this plugin's state the sandbox's undo puts back (the locomotion
-        plugin's goals and tentacle parameters, by creature name), or None; compared
-        with ==, so plain data and numpy arrays (`ecs_tentacles.render.undo`)."""
-        return None
-
-    def sandbox_restore(self, world: Host, state: Any) -> None:
-        """Put back what `sandbox_state` returned (creatures no longer there are skipped)."""
-
+    # -- saving --------------------------------------------------------------------------
     def save_creature(self, world: Host, creature: int, entry: dict[str, Any]) -> None:
         """Write what this plugin knows of `creature` now into its scene entry `entry`
         (its goals, its parameters), for saving a directed crowd as a scene
@@ -252,10 +231,6 @@ class Plugin:
         as written, relative to the scene's folder): a save to another folder takes them
         along (`ecs_tentacles.scene.save`; the terrain plugin: height images, meshes)."""
         return []
-
-    def sandbox_click(self, world: Host, click: Click) -> bool:
-        """A click in the sandbox's 3D view; True: handled (later plugins do not see it)."""
-        return False
 
     # -- output hooks (takes, shard plans, run reports) -------------------------------
     def take_tracks(self, world: Host) -> Sequence[TrackSource]:

@@ -36,8 +36,9 @@ from dataclasses import dataclass, field
 from types import FrameType
 from typing import TYPE_CHECKING
 
-from ecs_tentacles.plugin import Plugin
+from ecs_tentacles.plugin import Plugin, calling
 from ecs_tentacles.plugin_registry import import_file, inside_scene_folder, instantiate, pick
+from ecs_tentacles.registry import App
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
@@ -184,6 +185,9 @@ class Reloader:
                 result.removed.append(name)
         plugins = self.world.plugins
         plugins[plugins.index(old)] = fresh
+        self.world.registries.drop(old.key)  # the old entries go with the old plugin
+        with calling(fresh, "build"):
+            fresh.build(App(self.world.registries, fresh, self.world))
 
 
 @contextlib.contextmanager

@@ -24,6 +24,7 @@ from ecs_tentacles.components import Creature
 from ecs_tentacles.events import Events
 from ecs_tentacles.physics.backend import PhysicsBackend
 from ecs_tentacles.plugin import Plugin, calling
+from ecs_tentacles.registry import App, Registries, Registry
 from ecs_tentacles.schedule import Schedule
 from ecs_tentacles.settings import Settings as Settings  # re-exported: old imports work
 from ecs_tentacles.store import (
@@ -44,6 +45,7 @@ __all__ = ["MissingResource", "Settings", "World"]  # Settings lives in ecs_tent
 
 C = TypeVar("C")
 R = TypeVar("R")
+G = TypeVar("G", bound=Registry[Any])
 
 
 class World:
@@ -72,6 +74,7 @@ class World:
         }
         self.plugins: list[Plugin] = []
         self._resources: dict[type, Any] = {}  # plugins' stores and APIs, by type
+        self.registries = Registries()  # what the layers call, filled in plugins' build(app)
         self.schedule = Schedule()
         self.events = Events()
         self._physics: PhysicsBackend | None = None
@@ -218,6 +221,13 @@ class World:
                     f" with {plugin.name!r}"
                 )
             self.stores[name] = store
+        with calling(plugin, "build"):
+            plugin.build(App(self.registries, plugin, self))
+
+    def registry(self, kind: type[G]) -> G:
+        """The world's `kind` registry (`ecs_tentacles.registry`): the entries plugins added
+        in `build(app)`, in plugin order."""
+        return self.registries.get(kind)
 
     def plugin(self, key: str) -> Plugin:
         """The plugin on as `key`."""

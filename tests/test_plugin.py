@@ -181,10 +181,14 @@ CORE_ALONE = textwrap.dedent(
         fell = float(start[:, 2].mean() - world.transforms.pos[:, 2].mean())
         print(world.schedule.names, round(fell, 3) >= 0)
         columns = {name: [f.name for f in store.fields()] for name, store in world.stores.items()}
+    # the render layer's registries (pure data) are what a plugin's build(app) fills:
+    # the terrain plugin, on, adds its panel; nothing of the renderer itself, no pyglet
+    registries = ("ecs_tentacles.render", "ecs_tentacles.render.registries")
     loaded = sorted(m for m in sys.modules if m.startswith(("ecs_tentacles.record",
         "ecs_tentacles.locomotion", "ecs_tentacles.fur", "ecs_tentacles.threats",
         "ecs_tentacles.render", "ecs_tentacles.export", "ecs_tentacles.systems.locomotion",
-        "ecs_tentacles.systems.fur", "ecs_tentacles.systems.threats")))
+        "ecs_tentacles.systems.fur", "ecs_tentacles.systems.threats", "pyglet"))
+        and m not in registries)
     print(loaded)
     print(sorted(columns.items()))
     """

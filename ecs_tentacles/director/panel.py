@@ -30,8 +30,8 @@ from ecs_tentacles.director.grab import Grab
 from ecs_tentacles.director.palette import Preset, presets
 from ecs_tentacles.director.scatter import reach_of, scatter
 from ecs_tentacles.director.state import Director
-from ecs_tentacles.drawing import Panel
 from ecs_tentacles.render.gui import Gui
+from ecs_tentacles.render.registries import Panel
 from ecs_tentacles.spawning import SpawnError, creature_entry
 from ecs_tentacles.threats.data import ThreatData
 

@@ -16,13 +16,15 @@ import numpy as np
 
 from ecs_tentacles.components import Creature
 from ecs_tentacles.director.state import Director
-from ecs_tentacles.drawing import CIRCLE, draped, line_segments
 from ecs_tentacles.ground import ground_of
 from ecs_tentacles.plugin import Plugin
+from ecs_tentacles.render.registries import Lines, Panels
+from ecs_tentacles.render.rings import CIRCLE, draped, line_segments
 
 if TYPE_CHECKING:
-    from ecs_tentacles.drawing import Panel, RenderView
     from ecs_tentacles.host import Host
+    from ecs_tentacles.registry import App
+    from ecs_tentacles.render.registries import Panel, RenderView
     from ecs_tentacles.system import System
 
 GRAB_RGBA = np.array([1.0, 0.85, 0.2, 1.0])
@@ -41,7 +43,12 @@ class DirectorPlugin(Plugin):
 
         return [GrabSpring()]
 
-    def sandbox_panels(self, sandbox: Any) -> list[Panel]:
+    def build(self, app: App) -> None:
+        """Its drawing, HUD sections and clicks (`ecs_tentacles.render.registries`)."""
+        app.add(Lines, self._lines)
+        app.add(Panels, self._panels)
+
+    def _panels(self, sandbox: Any) -> list[Panel]:
         from ecs_tentacles.director.panel import DirectorPanel
 
         return [DirectorPanel(sandbox)]
@@ -60,7 +67,7 @@ class DirectorPlugin(Plugin):
         wanted[world.component(grab.creature, Creature).row] = True
         return wanted
 
-    def render_lines(self, world: Host, view: RenderView) -> list[Any]:
+    def _lines(self, world: Host, view: RenderView) -> list[Any]:
         director = world.resource(Director)
         lines = []
         grab = director.grab

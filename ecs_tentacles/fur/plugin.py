@@ -17,12 +17,14 @@ from ecs_tentacles.fur.build import build_emotion, build_fur
 from ecs_tentacles.fur.checks import fur_problems
 from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.plugin import Plugin, TrackSource
+from ecs_tentacles.render.registries import Draws, Lines, Panels
 from ecs_tentacles.scene.schema import fragment
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
-    from ecs_tentacles.drawing import Panel, RenderView
     from ecs_tentacles.host import Host
+    from ecs_tentacles.registry import App
+    from ecs_tentacles.render.registries import Panel, RenderView
     from ecs_tentacles.roster_change import RosterChange
     from ecs_tentacles.store import ArrayStore
 
@@ -91,18 +93,24 @@ class FurPlugin(Plugin):
         together = roused(creatures)
         return [together] if together else []
 
-    # -- sandbox hooks: GL and ImGui are imported only when a sandbox calls these ------
-    def render_lines(self, world: Host, view: RenderView) -> list[Any]:
+    # -- sandbox entries (build): GL and ImGui are imported only when a sandbox calls them
+    def build(self, app: App) -> None:
+        """Its drawing, HUD sections and clicks (`ecs_tentacles.render.registries`)."""
+        app.add(Lines, self._lines)
+        app.add(Draws, self._draw)
+        app.add(Panels, self._panels)
+
+    def _lines(self, world: Host, view: RenderView) -> list[Any]:
         from ecs_tentacles.fur.render.strands import fur_lines
 
         return fur_lines(world, view)
 
-    def render_draw(self, world: Host, view: RenderView) -> int:
+    def _draw(self, world: Host, view: RenderView) -> int:
         from ecs_tentacles.fur.render.strands import draw_fur
 
         return draw_fur(world, view)
 
-    def sandbox_panels(self, sandbox: Any) -> list[Panel]:
+    def _panels(self, sandbox: Any) -> list[Panel]:
         from ecs_tentacles.fur.render.furpanel import fur_panels
 
         return fur_panels(sandbox)

@@ -8,7 +8,7 @@ choices, a tentacle selector ("all" or one tentacle; tab steps it too), and the 
 a goal click sends a group in (`ecs_tentacles.locomotion.formations`). Every change goes through
 `world.resource(Locomotion).set`, the same API scripts use, so it reaches the servos
 on the next physics step. "Actions" (last, folded) lists each tentacle's action.
-The locomotion plugin's `sandbox_panels` hook makes both. Reads and writes the
+The locomotion plugin's `Panels` entry makes both. Reads and writes the
 parameters through `Locomotion`.
 """
 
@@ -19,10 +19,10 @@ from typing import Any
 
 from imgui_bundle import imgui
 
-from ecs_tentacles.drawing import Panel
 from ecs_tentacles.locomotion.formations import SHAPES, FormationChoice
 from ecs_tentacles.locomotion.params import Locomotion, settable
 from ecs_tentacles.render.gui import Gui, same_line_if_fits, text_width
+from ecs_tentacles.render.registries import Panel
 from ecs_tentacles.scene.parameters import Parameter, parameter
 
 

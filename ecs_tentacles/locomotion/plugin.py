@@ -37,6 +37,14 @@ from ecs_tentacles.locomotion.navigation import Navigator
 from ecs_tentacles.locomotion.params import Locomotion
 from ecs_tentacles.locomotion.stores import LocomotionStores
 from ecs_tentacles.plugin import Plugin, Reach, RunSummary, TrackSource
+from ecs_tentacles.render.registries import (
+    Clicks,
+    FramedPoints,
+    Lines,
+    Panels,
+    UndoState,
+    UndoStates,
+)
 from ecs_tentacles.scene.parameters import apply_parameters
 from ecs_tentacles.scene.schema import fragment
 from ecs_tentacles.system import System
@@ -44,8 +52,9 @@ from ecs_tentacles.system import System
 if TYPE_CHECKING:
     import numpy as np
 
-    from ecs_tentacles.drawing import Click, Panel, RenderView
     from ecs_tentacles.host import Host
+    from ecs_tentacles.registry import App
+    from ecs_tentacles.render.registries import Click, Panel, RenderView
     from ecs_tentacles.roster_change import RosterChange
     from ecs_tentacles.store import ArrayStore
 
@@ -161,25 +170,33 @@ class LocomotionPlugin(Plugin):
             queue.pending = copy.deepcopy(queues[entity])
         world.resource(Navigator).set_state(navigation)
 
-    # -- sandbox hooks -----------------------------------------------------------------
-    def render_lines(self, world: Host, view: RenderView) -> list[Any]:
+    # -- sandbox entries (build) -------------------------------------------------------
+    def build(self, app: App) -> None:
+        """Its drawing, HUD sections and clicks (`ecs_tentacles.render.registries`)."""
+        app.add(Lines, self._lines)
+        app.add(FramedPoints, self._framed_points)
+        app.add(Panels, self._panels)
+        app.add(Clicks, self._click)
+        app.add(UndoStates, UndoState(self._undo_capture, self._undo_restore))
+
+    def _lines(self, world: Host, view: RenderView) -> list[Any]:
         from ecs_tentacles.locomotion.render import path_lines
 
         return path_lines(world, view)
 
-    def render_points(self, world: Host) -> Any:
+    def _framed_points(self, world: Host) -> Any:
         from ecs_tentacles.locomotion.render import goal_points
 
         return goal_points(world)
 
-    def sandbox_state(self, world: Host) -> Any:
+    def _undo_capture(self, world: Host) -> Any:
         from ecs_tentacles.locomotion.directing import DirectedStates
 
         if self._directed is None:
             self._directed = DirectedStates()
         return self._directed.capture(world)
 
-    def sandbox_restore(self, world: Host, state: Any) -> None:
+    def _undo_restore(self, world: Host, state: Any) -> None:
         from ecs_tentacles.locomotion.directing import sandbox_restore
 
         sandbox_restore(world, state)
@@ -189,12 +206,12 @@ class LocomotionPlugin(Plugin):
 
         save_creature(world, creature, entry)
 
-    def sandbox_click(self, world: Host, click: Click) -> bool:
+    def _click(self, world: Host, click: Click) -> bool:
         from ecs_tentacles.locomotion.render import click_goal
 
         return click_goal(world, click)
 
-    def sandbox_panels(self, sandbox: Any) -> list[Panel]:
+    def _panels(self, sandbox: Any) -> list[Panel]:
         from ecs_tentacles.locomotion.panel import locomotion_panels
 
         return locomotion_panels(sandbox)

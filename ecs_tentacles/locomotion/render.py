@@ -1,13 +1,13 @@
 """Locomotion in the sandbox: goal rings and paths drawn, goals set and removed by clicks.
 
-The locomotion plugin's sandbox hooks call these. Each creature's path is a ring and
+The locomotion plugin's sandbox entries (its build) call these. Each creature's path is a ring and
 a short post at every goal and the legs between them, in a light tint of the
 creature's colour, plus the leg from the creature to its current goal, which moves
 with it, and (with obstacles) the path navigation planned around them, through its
 waypoints. The rings and legs between goals are rebuilt only when a goal changes
 (`GoalBook.version`); the moving legs are one vectorised pass a frame.
 
-Mouse (`sandbox_click`): a left click on the ground sets the selected creature's goal
+Mouse (the plugin's `Clicks` entry): a left click on the ground sets the selected creature's goal
 (several selected: one goal each, in formation around the point), shift-click appends
 one to the path, a right click inside a goal's ring removes it.
 Reads: `GoalBook` (paths, positions), `Goal` radii, the Transform store.
@@ -22,12 +22,13 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ecs_tentacles.components import Creature, Transform
-from ecs_tentacles.drawing import CIRCLE, Click, RenderView, draped, line_segments
 from ecs_tentacles.ground import ground_of
 from ecs_tentacles.locomotion.components import Goal
 from ecs_tentacles.locomotion.formations import FormationChoice, formation_goals
 from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.locomotion.navigation import Navigator
+from ecs_tentacles.render.registries import Click, RenderView
+from ecs_tentacles.render.rings import CIRCLE, draped, line_segments
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host

@@ -14,11 +14,13 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ecs_tentacles.plugin import Marker, Plugin
+from ecs_tentacles.plugin import Plugin
+from ecs_tentacles.render.registries import Marker, Spheres
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
+    from ecs_tentacles.registry import App
 
 SUCKER_SIZE = (0.024, 0.024, 0.024)  # metres
 SUCKER_RGBA = (1.0, 0.92, 0.25, 1.0)
@@ -34,7 +36,11 @@ class SuckersPlugin(Plugin):
 
         return [Suckers()]
 
-    def render_spheres(self, world: Host) -> list[Marker]:
+    def build(self, app: App) -> None:
+        """Its drawing, HUD sections and clicks (`ecs_tentacles.render.registries`)."""
+        app.add(Spheres, self._spheres)
+
+    def _spheres(self, world: Host) -> list[Marker]:
         suckers = world.suckers
         held = np.flatnonzero(suckers.attached)
         if not len(held):

@@ -8,7 +8,7 @@ attached suckers; "Physics" the groups, threads, recoveries and frozen creatures
 creatures per level-of-detail tier (coloured as the tier markers: the legend),
 promotions and demotions, and the "show tiers" box; "Plugins" the plugins on and every
 system, with a box to switch it off. Plugins add sections through `panels`
-(`ecs_tentacles.drawing.Panel`, from their `sandbox_panels` hooks: locomotion's sliders
+(`ecs_tentacles.render.registries.Panel`, from their `Panels` entries: locomotion's sliders
 and actions, the fur tool), placed by their `order`; `sections` takes bare (title,
 draw) pairs and `windows` more ImGui windows. The HUD keeps the selection (a creature,
 and one tentacle or all) and tells every panel when it changes.
@@ -22,8 +22,8 @@ from typing import Any
 from imgui_bundle import imgui
 
 from ecs_tentacles.components import Creature
-from ecs_tentacles.drawing import Panel
 from ecs_tentacles.render.gui import Gui, gui_scale, same_line_if_fits
+from ecs_tentacles.render.registries import Panel
 from ecs_tentacles.render.tiers import text_colour
 
 PANEL_WIDTH = 280  # the panel's width at scale 1: under 22 % of a 1280 x 720 window

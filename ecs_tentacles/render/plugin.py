@@ -1,8 +1,8 @@
 """The render plugin: the sandbox's renderer gets each frame's poses (`play` adds it).
 
 Systems: render (stage output). Other plugins draw, add HUD sections and take clicks
-through their sandbox hooks (`render_spheres`, `render_lines`, `render_draw`,
-`render_points`, `sandbox_panels`, `sandbox_click`: `ecs_tentacles.drawing`), which the
+through the render layer's registries (`Spheres`, `Lines`, `Draws`, `FramedPoints`,
+`Panels`, `Clicks`, `UndoStates`: `ecs_tentacles.render.registries`), which the
 renderer, HUD and sandbox call; none of them names a feature. Its own spheres: each
 creature's physics tier while the renderer's `show_tiers` is on (`render.tiers`).
 """
@@ -11,12 +11,14 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from ecs_tentacles.plugin import Marker, Plugin
+from ecs_tentacles.plugin import Plugin
+from ecs_tentacles.render.registries import Marker, Spheres
 from ecs_tentacles.render.tiers import tier_markers
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
+    from ecs_tentacles.registry import App
     from ecs_tentacles.render.renderer import Renderer
 
 
@@ -35,5 +37,9 @@ class RenderPlugin(Plugin):
 
         return [RenderSync(self.renderer)]
 
-    def render_spheres(self, world: Host) -> list[Marker]:
+    def build(self, app: App) -> None:
+        """Its drawing, HUD sections and clicks (`ecs_tentacles.render.registries`)."""
+        app.add(Spheres, self._spheres)
+
+    def _spheres(self, world: Host) -> list[Marker]:
         return tier_markers(self.renderer) if self.renderer.show_tiers else []

@@ -12,11 +12,12 @@ Transform store (interpolated between the last two physics frames), one upload p
 kind, one draw per kind (capsule links in two levels of detail). Draw calls do not
 grow with the number of creatures.
 
-The renderer names no feature: each frame it asks every plugin (`ecs_tentacles.drawing`)
-for spheres (`render_spheres`: attached suckers, threats; one instanced batch), line
-segments (`render_lines`: goal rings and paths, fur control markers; one line batch
-with the selected creature's ring) and its own drawing (`render_draw`: fur's ribbons,
-with GL objects the plugin makes and keeps in `state`), handing them a `RenderView`.
+The renderer names no feature: each frame it calls the entries plugins added to its
+registries (`ecs_tentacles.render.registries`) for spheres (`Spheres`: attached
+suckers, threats; one instanced batch), line segments (`Lines`: goal rings and paths,
+fur control markers; one line batch with the selected creature's ring) and their own
+drawing (`Draws`: fur's ribbons, with GL objects the plugin makes and keeps in
+`state`), handing them a `RenderView`; "frame all" keeps `FramedPoints` in view.
 """
 
 from __future__ import annotations
@@ -29,7 +30,6 @@ from pyglet import gl
 
 from ecs_tentacles.colours import PALETTES, Look, creature_colour, look_in_world
 from ecs_tentacles.components import Creature, Transform
-from ecs_tentacles.drawing import CIRCLE, RenderView, draped
 from ecs_tentacles.ground import ground_of
 from ecs_tentacles.render import shaders
 from ecs_tentacles.render.camera import OrbitCamera
@@ -46,6 +46,9 @@ from ecs_tentacles.render.horizon import HORIZON, fog_range
 from ecs_tentacles.render.instances import CreatureStatic, creature_links, link_instances
 from ecs_tentacles.render.meshes import CAPSULE_LODS, CYLINDER_LOD, SPHERE_LOD
 from ecs_tentacles.render.outlines import outlined_ribbons
+from ecs_tentacles.render.registries import Draws, FramedPoints, RenderView, Spheres
+from ecs_tentacles.render.registries import Lines as LineEntries
+from ecs_tentacles.render.rings import CIRCLE, draped
 from ecs_tentacles.render.scenery import Scenery, set_fog
 from ecs_tentacles.render.skinned import SkinnedCreatures
 from ecs_tentacles.roster_change import RosterChange
@@ -80,7 +83,7 @@ class Renderer:
         self.mantles = InstancedMesh(CYLINDER_LOD)
         self.links_near = InstancedMesh(CAPSULE_LODS[0])
         self.links_far = InstancedMesh(CAPSULE_LODS[1])
-        self.spheres = InstancedMesh(SPHERE_LOD)  # the plugins' `render_spheres`
+        self.spheres = InstancedMesh(SPHERE_LOD)  # the plugins' `Spheres` entries
         self.blob_program = program(shaders.BLOB_VERTEX, shaders.BLOB_FRAGMENT)
         self.shadows = InstancedMesh(QUAD)  # a soft blob under every mantle and link
         self.sucker_discs = InstancedMesh(SUCKER_DISC)
@@ -283,7 +286,7 @@ class Renderer:
 
     def _sphere_instances(self) -> np.ndarray:
         """The plugins' spheres (attached suckers, threats): one instanced batch."""
-        markers = [m for plugin in self.world.plugins for m in plugin.render_spheres(self.world)]
+        markers = [m for spheres in self.world.registry(Spheres) for m in spheres(self.world)]
         count = sum(len(m.positions) for m in markers)
         out = np.zeros((count, INSTANCE_FLOATS), np.float32)
         out[:, 3] = 1.0
@@ -300,8 +303,8 @@ class Renderer:
         """The plugins' line segments, a ring round each selected creature, `extra_lines`."""
         view = self.render_view
         segments = [np.zeros((0, 7))]
-        for plugin in self.world.plugins:
-            segments += plugin.render_lines(self.world, view)
+        for lines in self.world.registry(LineEntries):
+            segments += lines(self.world, view)
         chosen = self.selection or ((self.selected,) if self.selected is not None else ())
         if chosen:  # one ring round each, in one pass
             drawn = [self._index_of[e] for e in chosen if e in self._index_of]
@@ -380,8 +383,8 @@ class Renderer:
         gl.glDepthMask(gl.GL_TRUE)
         gl.glEnable(gl.GL_CULL_FACE)
         gl.glDisable(gl.GL_BLEND)
-        for plugin in self.world.plugins:  # what spheres and lines cannot say (fur)
-            calls += plugin.render_draw(self.world, self.render_view)
+        for draw in self.world.registry(Draws):  # what spheres and lines cannot say (fur)
+            calls += draw(self.world, self.render_view)
         gl.glBindVertexArray(0)
         gl.glUseProgram(0)
         self.draw_calls = calls
@@ -390,8 +393,8 @@ class Renderer:
     def frame_all(self) -> None:
         """Point the camera so every creature and what plugins point at (goals) is in view."""
         points = [self.world.transforms.pos]
-        for plugin in self.world.plugins:
-            extra = plugin.render_points(self.world)
+        for framed in self.world.registry(FramedPoints):
+            extra = framed(self.world)
             if extra is not None:
                 points.append(np.asarray(extra, dtype=np.float64).reshape(-1, 3))
         self.camera.follow = None

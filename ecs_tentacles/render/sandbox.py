@@ -5,7 +5,7 @@ happens at display rate and interpolates between the last two physics frames.
 
 Each frame's picture (drawn into the off-screen target, shown, kept as a PNG or an
 MP4) is `render.sandbox_picture`. The mouse and the keys are `render.sandbox_input`
-(selecting one creature or many, goal clicks through the plugins' `sandbox_click` hooks
+(selecting one creature or many, goal clicks through the plugins' `Clicks` entries
 as undoable edits, the HUD's panels seeing presses and keys first, the key map).
 
 Level of detail (`world.lod`): before every physics frame the sandbox tells it the
@@ -17,9 +17,9 @@ then keeps real time), so what you look at runs full. Headless runs (`play
 --headless`) do the same: the camera does not move there, so they stay deterministic;
 bakes have no camera and use only the scene's focus.
 
-Plugins add HUD sections (`sandbox_panels`, asked once per plugin and kept across
-rebuilds and resets: the locomotion sliders, the fur tool) and draw through the
-renderer's hooks; this module names no feature.
+Plugins add HUD sections (`Panels` entries, `ecs_tentacles.render.registries`, made
+once per plugin and kept across rebuilds and resets: the locomotion sliders, the fur
+tool) and draw through the renderer's registries; this module names no feature.
 
 User code: a system that raises is disabled and shown in red at the top right (with
 a button to run it again) while the sandbox keeps running; a plugin file that changes
@@ -44,7 +44,6 @@ from tqdm import tqdm
 
 from ecs_tentacles.colours import PALETTES
 from ecs_tentacles.components import Creature
-from ecs_tentacles.drawing import Panel
 from ecs_tentacles.ground import ground_of
 from ecs_tentacles.plugin_registry import sandbox_plugins
 from ecs_tentacles.render.camera import CameraChoice
@@ -52,6 +51,7 @@ from ecs_tentacles.render.gui import Gui, same_line_if_fits, text_width
 from ecs_tentacles.render.hud import Hud
 from ecs_tentacles.render.on_screen import creature_at
 from ecs_tentacles.render.plugin import RenderPlugin
+from ecs_tentacles.render.registries import Panel, Panels
 from ecs_tentacles.render.renderer import Renderer
 from ecs_tentacles.render.sandbox_input import SandboxInput
 from ecs_tentacles.render.sandbox_picture import SandboxPicture
@@ -197,9 +197,13 @@ class Sandbox(SandboxPicture):
         for name in names:
             for panel in self.panels.get(name, []):
                 panel.attach(self.world)
-        for plugin in self.world.plugins:
-            if plugin.key not in self.panels:
-                self.panels[plugin.key] = list(plugin.sandbox_panels(self))
+        made: dict[str, list[Panel]] = {}
+        for owner, make in self.world.registry(Panels).items():
+            if owner not in self.panels:
+                made.setdefault(owner, []).extend(make(self))
+        self.panels.update(made)
+        for name in names:
+            self.panels.setdefault(name, [])  # seen: a plugin's panels are made once
         self.hud.panels = [panel for name in names for panel in self.panels[name]]
 
     def panel(self, title: str) -> Panel | None:

@@ -4,7 +4,7 @@ Mouse: left-drag selects the creatures in a rectangle (drawn by the HUD while it
 dragged; with shift they are added to the selection), right-drag orbits, middle- or
 shift+right-drag pans, wheel zooms; a click on a creature selects it, shift-click adds
 it to the selection or takes it out; every other click
-goes to the plugins' `sandbox_click` hooks as one undoable edit. A left press is
+goes to the plugins' `Clicks` entries as one undoable edit. A left press is
 offered to the HUD's panels first (`Panel.press`: a fur marker, the director's tools),
 and keys too (`Panel.key`). Keys: space pause, . single step, r reset, h HUD,
 f follow, a frame all, Ctrl+A select every creature, Esc select none, Ctrl+Z /
@@ -22,8 +22,8 @@ import pyglet
 from pyglet.window import key, mouse
 
 from ecs_tentacles.components import Transform
-from ecs_tentacles.drawing import Click, Panel
 from ecs_tentacles.render.on_screen import creatures_in
+from ecs_tentacles.render.registries import Click, Clicks, Panel
 from ecs_tentacles.spawning import SpawnError
 
 CLICK_PIXELS = 4  # a press and release closer than this is a click, not a drag
@@ -42,7 +42,7 @@ class SandboxInput:
 
     def click(self, x: float, y: float, button: int, modifiers: int) -> None:
         """What a click at pixel (x, y) does: a left click on a creature selects it; then
-        the plugins' `sandbox_click` hooks see it, in plugin order, until one takes it."""
+        the plugins' `Clicks` entries see it, in plugin order, until one takes it."""
         sandbox = self.sandbox
         if sandbox.hud.contains(x, y):
             return
@@ -68,9 +68,9 @@ class SandboxInput:
             sandbox.scripts.say(False, f"click refused: {refused}")
 
     def _offer(self, click: Click) -> bool:
-        """The plugins' `sandbox_click` hooks, in plugin order, until one takes `click`."""
-        sandbox = self.sandbox
-        return any(plugin.sandbox_click(sandbox.world, click) for plugin in sandbox.world.plugins)
+        """The plugins' `Clicks` entries, in plugin order, until one takes `click`."""
+        world = self.sandbox.world
+        return any(take(world, click) for take in world.registry(Clicks))
 
     def on_mouse_press(self, x: int, y: int, button: int, modifiers: int) -> None:
         sandbox = self.sandbox

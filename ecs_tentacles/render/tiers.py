@@ -2,7 +2,7 @@
 
 Reads the level of detail's tiers (`world.lod.roster.tier`, `physics.tiers`), the
 renderer's interpolated poses and creature list, and the camera's metres per pixel;
-returns `Marker`s (one batch per tier) for the render plugin's `render_spheres` when
+returns `Marker`s (one batch per tier) for the render plugin's `Spheres` entry when
 the HUD's "show tiers" box is ticked. The HUD's tier counts use the same `COLOURS`,
 so the counts are the legend. One numpy pass per frame, whatever the crowd's size.
 """
@@ -15,7 +15,7 @@ import numpy as np
 
 from ecs_tentacles.components import Creature
 from ecs_tentacles.physics.tiers import NAMES
-from ecs_tentacles.plugin import Marker
+from ecs_tentacles.render.registries import Marker
 
 if TYPE_CHECKING:
     from ecs_tentacles.render.renderer import Renderer

@@ -4,7 +4,7 @@ An edit is an `Edit`: something that can be undone and redone (`undo(world)`,
 `redo(world)`), with a label the sandbox prints. Two kinds exist:
 
 * `Memento`: what the plugins keep of the world's directable state (goals, tentacle
-  parameters: `Plugin.sandbox_state` / `sandbox_restore`), before and after one
+  parameters: the plugins' `UndoStates` entries), before and after one
   click or slider drag; `Sandbox.edit` makes them;
 * the director's roster edits (spawn, despawn, move: `ecs_tentacles.director.commands`).
 
@@ -21,6 +21,8 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any, Protocol
 
+from ecs_tentacles.render.registries import UndoStates
+
 LIMIT = 200  # edits kept
 MERGE_SECONDS = 1.0  # a slider dragged: one edit while it keeps changing this often
 
@@ -32,20 +34,20 @@ class Edit(Protocol):
     def redo(self, world: Any) -> None: ...
 
 
-def plugin_state(world: Any) -> dict[str, Any]:
-    """Every plugin's directable state (`Plugin.sandbox_state`), by plugin key."""
+def plugin_state(world: Any) -> dict[tuple[str, int], Any]:
+    """Every plugin's directable state (its `UndoStates` entries), by (plugin key, entry)."""
     found = {}
-    for plugin in world.plugins:
-        state = plugin.sandbox_state(world)
+    for index, (owner, undo) in enumerate(world.registry(UndoStates).items()):
+        state = undo.capture(world)
         if state is not None:
-            found[plugin.key] = state
+            found[(owner, index)] = state
     return found
 
 
-def restore_plugin_state(world: Any, state: dict[str, Any]) -> None:
-    for plugin in world.plugins:
-        if plugin.key in state:
-            plugin.sandbox_restore(world, state[plugin.key])
+def restore_plugin_state(world: Any, state: dict[tuple[str, int], Any]) -> None:
+    for index, (owner, undo) in enumerate(world.registry(UndoStates).items()):
+        if (owner, index) in state:
+            undo.restore(world, state[(owner, index)])
 
 
 @dataclass
@@ -53,8 +55,8 @@ class Memento:
     """The plugins' directable state before and after one edit."""
 
     label: str
-    before: dict[str, Any]
-    after: dict[str, Any]
+    before: dict[tuple[str, int], Any]
+    after: dict[tuple[str, int], Any]
     at: float = field(default_factory=time.monotonic)
 
     def undo(self, world: Any) -> None:

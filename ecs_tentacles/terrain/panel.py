@@ -26,8 +26,8 @@ from typing import Any
 import numpy as np
 from imgui_bundle import imgui
 
-from ecs_tentacles.drawing import Panel
 from ecs_tentacles.render.gui import Gui, same_line_if_fits, text_width
+from ecs_tentacles.render.registries import Panel
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.load import resolve_scene_path
 from ecs_tentacles.scene.save import default_file_name

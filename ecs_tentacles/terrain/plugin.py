@@ -21,6 +21,7 @@ import numpy as np
 from ecs_tentacles.construction import creature_layout
 from ecs_tentacles.ground import ground_of
 from ecs_tentacles.plugin import Plugin
+from ecs_tentacles.render.registries import Panels
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.schema import fragment
 from ecs_tentacles.terrain.editing import TerrainEditor
@@ -29,8 +30,9 @@ from ecs_tentacles.terrain.scene_ground import build_ground
 from ecs_tentacles.terrain.solids import obstacle_problems
 
 if TYPE_CHECKING:
-    from ecs_tentacles.drawing import Panel
     from ecs_tentacles.host import Host
+    from ecs_tentacles.registry import App
+    from ecs_tentacles.render.registries import Panel
 
 _FRAGMENT = fragment("ecs_tentacles.terrain", "terrain")
 SINK_TOLERANCE = 0.001  # metres a 3-d placed creature may start inside the heightfield
@@ -64,7 +66,11 @@ class TerrainPlugin(Plugin):
         ground = build_ground((world.scene or {}).get("terrain") or {}, world.scene_dir)
         return [ground, TerrainEditor()]
 
-    def sandbox_panels(self, sandbox: Any) -> list[Panel]:
+    def build(self, app: App) -> None:
+        """Its drawing, HUD sections and clicks (`ecs_tentacles.render.registries`)."""
+        app.add(Panels, self._panels)
+
+    def _panels(self, sandbox: Any) -> list[Panel]:
         from ecs_tentacles.terrain.panel import TerrainPanel
 
         return [TerrainPanel(sandbox)]

@@ -2,7 +2,7 @@
 
 Scene keys: `threats` and a creature's `threat` (`ecs_tentacles/threats/threats.schema.json`).
 Resources: `world.resource(ThreatData)` (`ecs_tentacles.threats.ThreatData`). Systems: threats
-(stage animate). The fur plugin's emotion reads them; render hook: dark red markers.
+(stage animate). The fur plugin's emotion reads them; its `Spheres` entry: dark red markers.
 """
 
 from __future__ import annotations
@@ -12,13 +12,15 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ecs_tentacles.plugin import Marker, Plugin
+from ecs_tentacles.plugin import Plugin
+from ecs_tentacles.render.registries import Marker, Spheres
 from ecs_tentacles.scene.schema import fragment
 from ecs_tentacles.system import System
 from ecs_tentacles.threats.data import ThreatData, build_threats, mark_creature, threat_problems
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
+    from ecs_tentacles.registry import App
     from ecs_tentacles.roster_change import RosterChange
     from ecs_tentacles.store import ArrayStore
 
@@ -76,7 +78,11 @@ class ThreatsPlugin(Plugin):
     def stores(self, world: Host) -> dict[str, ArrayStore]:
         return {"threats": world.resource(ThreatData).store}  # copied by snapshots
 
-    def render_spheres(self, world: Host) -> list[Marker]:
+    def build(self, app: App) -> None:
+        """Its drawing, HUD sections and clicks (`ecs_tentacles.render.registries`)."""
+        app.add(Spheres, self._spheres)
+
+    def _spheres(self, world: Host) -> list[Marker]:
         positions = list(world.resource(ThreatData).positions(world).values())
         if not positions:
             return []

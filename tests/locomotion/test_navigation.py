@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 
 from ecs_tentacles.components import Creature
-from ecs_tentacles.drawing import RenderView
 from ecs_tentacles.ground import Ground, Solid, ground_of
 from ecs_tentacles.locomotion.navigation import STUCK_SECONDS, CostGrid, Navigator
 from ecs_tentacles.locomotion.render import path_lines
+from ecs_tentacles.render.registries import RenderView
 from ecs_tentacles.world import World
 
 WALL = {"shape": "box", "position": [-1.6, 0, 0.3], "size": [4.8, 0.2, 0.6]}  # ends at x = 0.8

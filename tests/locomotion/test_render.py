@@ -7,8 +7,8 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ecs_tentacles.drawing import RenderView
 from ecs_tentacles.locomotion.render import ALL_PATHS, path_lines
+from ecs_tentacles.render.registries import RenderView
 from ecs_tentacles.world import World
 
 

@@ -34,7 +34,7 @@ def tool(make_sandbox: Callable[..., Any]) -> Any:
 
 
 def fur_panel(sandbox: Any) -> FurPanel:
-    """The fur plugin's HUD section (its `sandbox_panels` hook made it)."""
+    """The fur plugin's HUD section (its `Panels` entry made it)."""
     panel = sandbox.panel("Fur")
     assert isinstance(panel, FurPanel)
     return panel

@@ -1,5 +1,7 @@
-"""The sandbox's plugin hooks: a user's plugin draws, adds a HUD section and takes clicks;
-the sandbox runs with the fur and locomotion plugins off."""
+"""The sandbox's registries: a user's plugin draws, adds a HUD section and takes clicks
+(entries added in its `build(app)`); an old-style render hook is refused by name; every
+entry belongs to a plugin that is on; the sandbox runs with the fur and locomotion
+plugins off."""
 
 from __future__ import annotations
 
@@ -14,12 +16,15 @@ from pyglet.window import mouse
 from tests.render.conftest import event
 
 BEACON = '''
-"""A user's plugin that draws through every sandbox hook."""
+"""A user's plugin that draws through every registry of the sandbox."""
 import numpy as np
 from pyglet import gl
 
-from ecs_tentacles.drawing import Panel, line_segments
-from ecs_tentacles.plugin import Marker, Plugin
+from ecs_tentacles.plugin import Plugin
+from ecs_tentacles.render.registries import (
+    Clicks, Draws, FramedPoints, Lines, Marker, Panel, Panels, Spheres,
+)
+from ecs_tentacles.render.rings import line_segments
 
 SPHERE = (0.0, -1.0, 0.3)
 LINE = ((-1.5, 1.0, 0.02), (1.5, 1.0, 0.02))
@@ -43,13 +48,21 @@ class BeaconPlugin(Plugin):
         super().__init__(config)
         self.clicks = []
 
-    def render_spheres(self, world):
+    def build(self, app):
+        app.add(Spheres, self.spheres)
+        app.add(Lines, self.lines)
+        app.add(Draws, self.draw)
+        app.add(FramedPoints, self.points)
+        app.add(Panels, lambda sandbox: [BeaconPanel()])
+        app.add(Clicks, self.click)
+
+    def spheres(self, world):
         return [Marker(np.array([SPHERE]), (0.25, 0.25, 0.25), (1.0, 0.0, 1.0, 1.0))]
 
-    def render_lines(self, world, view):
+    def lines(self, world, view):
         return [line_segments(np.array(LINE), np.array([0.0, 1.0, 0.0, 1.0]))]
 
-    def render_draw(self, world, view):
+    def draw(self, world, view):
         view.state["beacon.frames"] = view.state.get("beacon.frames", 0) + 1
         gl.glEnable(gl.GL_SCISSOR_TEST)  # a cyan square in the bottom-left corner
         gl.glScissor(0, 0, 12, 12)
@@ -58,13 +71,10 @@ class BeaconPlugin(Plugin):
         gl.glDisable(gl.GL_SCISSOR_TEST)
         return 1
 
-    def render_points(self, world):
+    def points(self, world):
         return np.array([FAR])
 
-    def sandbox_panels(self, sandbox):
-        return [BeaconPanel()]
-
-    def sandbox_click(self, world, click):
+    def click(self, world, click):
         self.clicks.append(click)
         return True
 '''
@@ -150,3 +160,52 @@ def test_the_sandbox_runs_with_fur_and_locomotion_off(
     mx, my = sandbox.renderer.camera.project(top[None])[0]
     r, g, b = pixels[360 - round(my), round(mx)]
     assert r > g + 60 and r > b + 60  # the creature is drawn
+
+
+def test_an_old_style_render_hook_is_refused_by_name() -> None:
+    import pytest
+
+    from ecs_tentacles.plugin import Plugin
+
+    with pytest.raises(TypeError, match=r"Old\.render_lines: this hook is now a Lines entry"):
+        type("Old", (Plugin,), {"render_lines": lambda self, world, view: []})
+
+
+def test_every_registry_entry_belongs_to_a_plugin_that_is_on(
+    make_sandbox: Callable[..., Any], tmp_path: Path
+) -> None:
+    """Walk every registry the sandbox's world has (every built-in plugin that draws,
+    adds a panel, takes clicks or keeps undo state, and a user's), before and after a
+    rebuild without one of them."""
+    from ecs_tentacles.render.registries import (
+        Clicks,
+        Draws,
+        FramedPoints,
+        Lines,
+        Panels,
+        Spheres,
+        UndoStates,
+    )
+
+    sandbox = make_sandbox(_beacon_scene(tmp_path), allow_systems=True)
+
+    def owners() -> dict[str, set[str]]:
+        world = sandbox.world
+        on = {plugin.key for plugin in world.plugins}
+        found = {}
+        for kind, registry in world.registries.all().items():
+            keys = {owner for owner, _ in registry.items()}
+            assert keys <= on, (kind.__name__, keys - on)
+            found[kind.__name__] = keys
+        return found
+
+    seen = owners()
+    kinds = {Spheres, Lines, Draws, FramedPoints, Panels, Clicks, UndoStates}
+    assert {k.__name__ for k in kinds} <= set(seen)
+    assert "beacon" in seen["Clicks"] and "locomotion" in seen["Clicks"]
+    assert {"render", "suckers", "threats", "beacon"} <= seen["Spheres"]
+    assert "locomotion" in seen["UndoStates"]
+    scene = json.loads((tmp_path / "beacon_scene.json").read_text())
+    scene["plugins"]["threats"] = False
+    sandbox.rebuild(scene)
+    assert "threats" not in owners()["Spheres"]

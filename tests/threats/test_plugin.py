@@ -8,6 +8,7 @@ from typing import Any
 import numpy as np
 from numpy.testing import assert_allclose, assert_array_equal
 
+from ecs_tentacles.render.registries import Marker, Spheres
 from ecs_tentacles.threats.data import ThreatData
 from ecs_tentacles.threats.plugin import THREAT_RGBA, THREAT_SIZE
 from ecs_tentacles.world import World
@@ -24,10 +25,17 @@ SCENE: dict[str, Any] = {
 }
 
 
-def test_the_render_hook_marks_every_path_threat(make_world: Callable[..., World]) -> None:
+def _threat_spheres(world: World) -> list[Marker]:
+    """The markers of the threats plugin's `Spheres` entries."""
+    entries = [e for owner, e in world.registry(Spheres).items() if owner == "threats"]
+    assert entries
+    return [marker for spheres in entries for marker in spheres(world)]
+
+
+def test_its_spheres_mark_every_path_threat(make_world: Callable[..., World]) -> None:
     world = make_world(SCENE)
     world.step(31)  # t = 0.5 s
-    (marker,) = world.plugin("threats").render_spheres(world)
+    (marker,) = _threat_spheres(world)
     assert marker.size == THREAT_SIZE and marker.rgba == THREAT_RGBA
     where = np.array([[0.5, 2.0, 0.1], [2.0, 2.0, 0.1]])  # roach halfway, moth at its key
     assert_allclose(marker.positions, where + [0.0, 0.0, 0.04])  # drawn just above
@@ -36,7 +44,7 @@ def test_the_render_hook_marks_every_path_threat(make_world: Callable[..., World
 def test_no_path_threat_no_marker(make_world: Callable[..., World]) -> None:
     marked = {"tentacles": TENTACLES, "threat": True}  # a threat creature draws as itself
     world = make_world({"version": 1, "creatures": [marked]})
-    assert world.plugin("threats").render_spheres(world) == []
+    assert _threat_spheres(world) == []
     assert (
         world.resource(ThreatData).positions(world) == {} and len(world.resource(ThreatData)) == 1
     )

@@ -7,7 +7,7 @@ marker over the body) and sliders for lift, aim, direction, random, dynamic and 
 emotion weight; display options (colour by control, guides, child hairs, children per
 guide); and `Save scene`, which writes the edited scene through the atomic writer.
 The timeline (`fur.render.timeline`, a window of this panel) keys the picked control.
-The fur plugin's `sandbox_panels` hook makes it (`fur_panels`) when the scene has fur;
+The fur plugin's `Panels` entry makes it (`fur_panels`) when the scene has fur;
 the display options live in the renderer's state (`fur.render.strands.fur_display`).
 """
 
@@ -19,7 +19,6 @@ import numpy as np
 from imgui_bundle import imgui
 
 from ecs_tentacles.components import Creature, Transform
-from ecs_tentacles.drawing import Panel
 from ecs_tentacles.fur.editor import MIRRORS, SHAPES, VALUES, FurEditor
 from ecs_tentacles.fur.groom import closest_surface_point
 from ecs_tentacles.fur.render.strands import FurDisplay, fur_display
@@ -27,6 +26,7 @@ from ecs_tentacles.fur.render.timeline import Timeline
 from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.mathutil import quat_rotate
 from ecs_tentacles.render.gui import Gui, same_line_if_fits, text_width
+from ecs_tentacles.render.registries import Panel
 
 PICK_PIXELS = 14  # a click this close to a control's marker picks it
 

@@ -1,6 +1,6 @@
 """Fur in the sandbox's 3D view: guides and child hairs as ribbons, controls as markers.
 
-The fur plugin's render hooks call `fur_lines` (the controls' marker shapes, joined
+The fur plugin's `Lines` and `Draws` entries call `fur_lines` (the controls' marker shapes, joined
 into the renderer's line batch while the HUD shows) and `draw_fur` (the strands: one
 draw for the guides, one for the child hairs). The GL objects (`FurStrands`: the
 ribbon program and two ribbon buffers) are made on the first frame with fur and kept
@@ -19,8 +19,8 @@ from ecs_tentacles.fur.hooks import GuideCurves, child_hairs, guide_curves
 from ecs_tentacles.fur.stores import FurData
 
 if TYPE_CHECKING:
-    from ecs_tentacles.drawing import RenderView
     from ecs_tentacles.host import Host
+    from ecs_tentacles.render.registries import RenderView
 
 DISPLAY = "fur.display"  # keys in the renderer's `view.state`
 STRANDS = "fur.strands"

@@ -1,34 +1,57 @@
-"""What plugins hand the sandbox, and what it hands them: the data of the render hooks.
+"""What the renderer and the sandbox call, and what they hand the plugins: the render
+layer's registries (`ecs_tentacles.registry`) and their data.
 
 The generic renderer, HUD and mouse handling (`ecs_tentacles.render`) name no feature;
-each frame they ask every plugin (`ecs_tentacles.plugin.Plugin`):
+plugins add entries in `build(app)` (`app.add(Spheres, entry)`), and the layer calls
+every entry, in plugin order:
 
-- `render_spheres(world)` -> `plugin.Marker`s: instanced spheres (suckers, threats);
-- `render_lines(world, view)` -> line-list vertices (2n, 7: xyz rgba), joined into the
-  renderer's one line batch (goal rings and paths, fur control markers);
-- `render_draw(world, view)` -> draw calls: anything else, drawn with the plugin's own
-  GL objects, made lazily inside the hook and kept in `view.state` (fur's ribbons);
-- `render_points(world)` -> points (n, 3) "frame all" keeps in view (goals);
-- `sandbox_panels(sandbox)` -> `Panel`s: HUD sections, their windows and mouse grabs;
-- `sandbox_click(world, click)`: a click in the 3D view (`Click`; goals are set so).
+- `Spheres`: `entry(world)` -> `Marker`s: instanced spheres (suckers, threats, tiers);
+- `Lines`: `entry(world, view)` -> a list of line-list vertex arrays (2n, 7: xyz rgba),
+  joined into the renderer's one line batch (goal rings and paths, fur control markers);
+- `Draws`: `entry(world, view)` -> draw calls made: anything else, drawn with the
+  plugin's own GL objects, made lazily inside the entry and kept in `view.state`
+  (fur's ribbons);
+- `FramedPoints`: `entry(world)` -> points (n, 3) that "frame all" keeps in view, or
+  None (goals);
+- `Panels`: `entry(sandbox)` -> `Panel`s: HUD sections, their windows and mouse grabs,
+  made once per sandbox and kept across rebuilds and resets;
+- `Clicks`: `entry(world, click)` -> True when it took the click in the 3D view
+  (`Click`; goals are set so); the first to take it ends the offer;
+- `UndoStates`: (`capture(world)`, `restore(world, state)`): what the sandbox's undo
+  keeps of a plugin's directable state (each creature's goals, the locomotion sliders).
 
-This module is pure data (numpy only, no GL): importing a plugin stays cheap and
-headless worlds never load pyglet.
+This module is pure data (numpy only, no GL): importing it keeps a headless world free
+of pyglet.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any, Protocol
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+from ecs_tentacles.registry import Registry
+
+if TYPE_CHECKING:
+    from ecs_tentacles.host import Host
 
 LINE_FLOATS = 7  # a line vertex: x, y, z, r, g, b, a
 
 
+@dataclass(frozen=True)
+class Marker:
+    """Spheres a plugin asks the renderer to draw: centres (n, 3), size (x, y, z), rgba."""
+
+    positions: Any
+    size: tuple[float, float, float]
+    rgba: tuple[float, float, float, float]
+
+
 @dataclass
 class RenderView:
-    """The frame being drawn, as the renderer hands it to `render_lines` / `render_draw`.
+    """The frame being drawn, as the renderer hands it to the `Lines` and `Draws` entries.
 
     `pos`, `quat`: body poses (rows of the Transform store) interpolated between the last
     two physics frames; `creatures`: the creature entities drawn, `colours` each one's
@@ -57,7 +80,7 @@ class RenderView:
 
 @dataclass(frozen=True)
 class Click:
-    """A click in the sandbox's 3D view (not on the HUD), offered to `sandbox_click`.
+    """A click in the sandbox's 3D view (not on the HUD), offered to the `Clicks` entries.
 
     `button`: "left", "right" or "middle"; `shift`: held; `ground`: where the ray under
     the pointer meets the ground plane (world metres, (3,)), None above the horizon;
@@ -84,7 +107,7 @@ class Click:
 
 
 class Panel:
-    """A section of the sandbox's HUD that a plugin adds (`Plugin.sandbox_panels`).
+    """A section of the sandbox's HUD that a plugin adds (a `Panels` entry makes it).
 
     `title` heads the section; `draw(gui)` builds its widgets (Dear ImGui through
     `ecs_tentacles.render.gui.Gui`). Sections are ordered by `order` (the sandbox's own
@@ -128,30 +151,37 @@ class Panel:
         """The mouse button went up."""
 
 
-def line_segments(polyline: np.ndarray, colour: np.ndarray) -> np.ndarray:
-    """Line-list vertices (2(n-1), 7) for a polyline (n, 3) in one rgba colour."""
-    starts, ends = polyline[:-1], polyline[1:]
-    pairs = np.empty((2 * len(starts), 3))
-    pairs[0::2], pairs[1::2] = starts, ends
-    return np.hstack([pairs, np.tile(colour, (len(pairs), 1))])
+class Spheres(Registry[Callable[["Host"], list[Marker]]]):
+    """Instanced spheres to draw this frame."""
 
 
-RING_SEGMENTS = 48
-_ANGLES = np.linspace(0, 2 * np.pi, RING_SEGMENTS + 1)
-CIRCLE = np.stack([np.cos(_ANGLES), np.sin(_ANGLES), np.zeros_like(_ANGLES)], axis=1)
-"""A unit circle in the ground plane, (RING_SEGMENTS + 1, 3): scale and move it for rings."""
+class Lines(Registry[Callable[["Host", RenderView], list[np.ndarray]]]):
+    """Line-list vertices to join into the frame's line batch."""
 
 
-class HasSurface(Protocol):
-    """What `draped` needs of a ground: the topmost surface under points (`Ground`)."""
-
-    def surface(self, xy: np.ndarray) -> np.ndarray: ...
+class Draws(Registry[Callable[["Host", RenderView], int]]):
+    """A plugin's own GL drawing; returns the draw calls it made."""
 
 
-def draped(points: np.ndarray, ground: HasSurface, lift: float) -> np.ndarray:
-    """`points` (n, 3) put on the topmost surface under them (the ground, or a solid: a
-    ramp, a platform), `lift` m above it: a ring round a goal or a creature on a hillside
-    or a ledge follows it instead of sinking into it."""
-    out = np.array(points, dtype=np.float64)
-    out[:, 2] = ground.surface(out[:, :2]) + lift
-    return out
+class FramedPoints(Registry[Callable[["Host"], "np.ndarray | None"]]):
+    """Points "frame all" keeps in view besides the creatures."""
+
+
+class Panels(Registry[Callable[[Any], list["Panel"]]]):
+    """HUD sections, made once per sandbox (the entry gets the sandbox)."""
+
+
+class Clicks(Registry[Callable[["Host", Click], bool]]):
+    """Clicks in the 3D view, offered in plugin order until one is taken."""
+
+
+@dataclass(frozen=True)
+class UndoState:
+    """A plugin's directable state as the sandbox's undo keeps it."""
+
+    capture: Callable[[Host], Any]
+    restore: Callable[[Host, Any], None]
+
+
+class UndoStates(Registry[UndoState]):
+    """What the sandbox's undo captures and restores of each plugin."""
