@@ -34,8 +34,6 @@ from ecs_tentacles.system import System
 from ecs_tentacles.take_tracks import TakeTrack
 
 if TYPE_CHECKING:
-    import numpy as np
-
     from ecs_tentacles.host import Host
     from ecs_tentacles.registry import App
     from ecs_tentacles.store import ArrayStore
@@ -122,7 +120,7 @@ class Plugin:
     description: ClassVar[str] = ""
     requires: ClassVar[tuple[str, ...]] = ()  # plugins that must be on too
     # store columns this plugin's hooks read when a generic system calls them
-    # (`wants_motion`, take and render hooks): they count as that system's reads
+    # (registry entries and take hooks): they count as that system's reads
     hook_reads: ClassVar[tuple[str, ...]] = ()
     # JSON Schema of this plugin's `plugins.<name>` config (defaults are filled in)
     config_schema: ClassVar[dict[str, Any]] = {"type": "object", "additionalProperties": False}
@@ -149,6 +147,8 @@ class Plugin:
                 ("sandbox_restore", "UndoStates"),
             )
         },
+        "wants_motion": "a MotionWants entry added in build(app) (physics.registries)",
+        "travel_targets": "a TravelTargets entry added in build(app) (physics.registries)",
     }
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
@@ -266,19 +266,6 @@ class Plugin:
 
     def run_summary(self, world: Host) -> RunSummary | None:
         """Counts `ecs-tentacles run` reports after stepping `world` (goals reached)."""
-        return None
-
-    def wants_motion(self, world: Host) -> np.ndarray | None:
-        """Which creatures this plugin wants to move now: bool per CreatureStore row, or
-        None for none. Asked every frame before the physics step; a creature some plugin
-        wants to move never falls asleep (`ecs_tentacles.physics.sleep`). Answer with
-        whole-array math (no per-creature loop); the array is only read."""
-        return None
-
-    def travel_targets(self, world: Host) -> np.ndarray | None:
-        """Where creatures are heading: (CreatureStore rows, 2) x, y in metres, nan where
-        nowhere; None for no opinion. The level of detail moves kinematic creatures
-        toward these (`ecs_tentacles.lod.replay`). Whole-array math; only read."""
         return None
 
     def __repr__(self) -> str:

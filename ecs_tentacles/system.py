@@ -45,7 +45,8 @@ class System:
     before: ClassVar[tuple[str, ...]] = ()
     reads: ClassVar[tuple[str, ...]] = ()  # "store.field" names, e.g. "motors.target"
     writes: ClassVar[tuple[str, ...]] = ()
-    # a generic system that calls plugins' hooks (physics: wants_motion; record; render)
+    # a generic system that calls plugins' hooks or registry entries (physics: MotionWants;
+    # record; render)
     # also reads what those hooks declare (`Plugin.hook_reads`)
     calls_hooks: ClassVar[bool] = False
     # attributes that carry simulation state from frame to frame (copied by snapshots)

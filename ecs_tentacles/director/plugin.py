@@ -4,7 +4,7 @@ The sandbox turns it on (`plugin_registry.SANDBOX_ON`); scenes and bakes never s
 Resource: `Director` (the creature held by the mouse, the scatter brush). System: grab
 (stage act; `systems/director/grab.py`). Sandbox hooks: the "Director" HUD section
 with the palette and the mouse and keys (`director.panel`); lines for the grab's
-spring and the brush. Hook `wants_motion`: a held creature never sleeps; `despawning`:
+spring and the brush. Its `MotionWants` entry: a held creature never sleeps; `despawning`:
 removing the held creature ends the grab.
 """
 
@@ -17,6 +17,7 @@ import numpy as np
 from ecs_tentacles.components import Creature
 from ecs_tentacles.director.state import Director
 from ecs_tentacles.ground import ground_of
+from ecs_tentacles.physics.registries import MotionWants
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.render.registries import Lines, Panels
 from ecs_tentacles.render.rings import CIRCLE, draped, line_segments
@@ -45,6 +46,7 @@ class DirectorPlugin(Plugin):
 
     def build(self, app: App) -> None:
         """Its drawing, HUD sections and clicks (`ecs_tentacles.render.registries`)."""
+        app.add(MotionWants, self._wants_motion)
         app.add(Lines, self._lines)
         app.add(Panels, self._panels)
 
@@ -59,7 +61,7 @@ class DirectorPlugin(Plugin):
         if director.grab is not None and director.grab.creature == creature:
             director.grab = None
 
-    def wants_motion(self, world: Host) -> np.ndarray | None:
+    def _wants_motion(self, world: Host) -> np.ndarray | None:
         grab = world.resource(Director).grab
         if grab is None:
             return None

@@ -11,7 +11,7 @@ include six tentacle parameters (speed, target angle, waves, writhe; `tentacles`
 Systems: goals, avoidance, tentacle_selection (stage decide), action_queue, motor_targets
 (act).
 Sandbox hooks: goal rings and paths, goals set by clicks (`locomotion.render`), the
-Locomotion and Actions sections of the HUD (`locomotion.panel`). Hook: `wants_motion`
+Locomotion and Actions sections of the HUD (`locomotion.panel`). Registry entry `MotionWants`
 (creatures with a goal stay awake).
 Output hooks (`ecs_tentacles.locomotion.outputs`): the goals a take records, how far a
 creature may crawl during a distributed bake, goals reached for `ecs-tentacles run`.
@@ -36,6 +36,7 @@ from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.locomotion.navigation import Navigator
 from ecs_tentacles.locomotion.params import Locomotion
 from ecs_tentacles.locomotion.stores import LocomotionStores
+from ecs_tentacles.physics.registries import MotionWants, TravelTargets
 from ecs_tentacles.plugin import Plugin, Reach, RunSummary, TrackSource
 from ecs_tentacles.render.registries import (
     Clicks,
@@ -67,7 +68,7 @@ class LocomotionPlugin(Plugin):
     creature_schema = _FRAGMENT["creature"]
     tentacle_schema = _FRAGMENT["tentacles"]
     scene_schema = _FRAGMENT["scene"]
-    # wants_motion, travel_targets
+    # its MotionWants and TravelTargets entries
     hook_reads = (
         "locomotion.creatures.has_goal",
         "locomotion.creatures.goal",
@@ -134,11 +135,11 @@ class LocomotionPlugin(Plugin):
         return [Goals(), CrowdAvoidance(), TentacleSelection(), ActionQueueSystem(),
                 MotorTargets()]  # fmt: skip
 
-    def wants_motion(self, world: Host) -> np.ndarray:
+    def _wants_motion(self, world: Host) -> np.ndarray:
         """Creatures with a goal crawl: they never fall asleep."""
         return world.resource(LocomotionStores).creatures.has_goal
 
-    def travel_targets(self, world: Host) -> np.ndarray:
+    def _travel_targets(self, world: Host) -> np.ndarray:
         """Creatures crawl toward their current goal (or the waypoint on the way to it),
         turned by avoidance where a neighbour is near."""
         creatures = world.resource(LocomotionStores).creatures
@@ -172,12 +173,15 @@ class LocomotionPlugin(Plugin):
 
     # -- sandbox entries (build) -------------------------------------------------------
     def build(self, app: App) -> None:
-        """Its drawing, HUD sections and clicks (`ecs_tentacles.render.registries`)."""
+        """Its drawing, HUD sections, clicks and undo state (`render.registries`); which
+        creatures it moves and where they go (`physics.registries`)."""
         app.add(Lines, self._lines)
         app.add(FramedPoints, self._framed_points)
         app.add(Panels, self._panels)
         app.add(Clicks, self._click)
         app.add(UndoStates, UndoState(self._undo_capture, self._undo_restore))
+        app.add(MotionWants, self._wants_motion)
+        app.add(TravelTargets, self._travel_targets)
 
     def _lines(self, world: Host, view: RenderView) -> list[Any]:
         from ecs_tentacles.locomotion.render import path_lines

@@ -4,7 +4,7 @@ The physics decides who runs at which tier (`ecs_tentacles.physics.lod`, `world.
 without this plugin nobody is ever kinematic (the cheapest tier is REDUCED). With it,
 the `lod_replay` system (stage physics, after the step) moves kinematic creatures with
 their morphology's gait clips (`ecs_tentacles.lod.replay`), toward where the plugins
-say they go (`Plugin.travel_targets`: the locomotion plugin's goals). Snapshots keep
+say they go (`TravelTargets` entries: the locomotion plugin's goals). Snapshots keep
 the replay's state.
 """
 

@@ -2,7 +2,7 @@
 
 Per creature (roster order) it keeps a ground frame (`xy`, `heading`), a clip (`kind`:
 idle or crawl) and a `phase` in frames. Each frame (`advance`) every kinematic
-creature turns toward where the plugins say it is going (`Plugin.travel_targets`; at
+creature turns toward where the plugins say it is going (the `TravelTargets` entries; at
 most `TURN_RATE`), moves along its heading at its morphology's crawl speed, steps its
 clip one frame on, and its body poses are written into its batch's pose rows, which
 `physics_sync` copies into the Transform store like any other. A creature that starts
@@ -28,6 +28,7 @@ import numpy as np
 from ecs_tentacles.ground import ground_of
 from ecs_tentacles.lod.cache import ClipCache
 from ecs_tentacles.lod.clips import CRAWL, IDLE, GaitClips, mantle_yaw
+from ecs_tentacles.physics.registries import TravelTargets
 from ecs_tentacles.physics.tiers import KINEMATIC
 
 if TYPE_CHECKING:
@@ -205,8 +206,8 @@ def _nearest_frame(shapes: np.ndarray, shape: np.ndarray, chunk: int = 64) -> np
 def _targets(world: Host, creature_rows: np.ndarray) -> np.ndarray:
     """(len(creature_rows), 2) where the plugins say each creature goes; nan: nowhere."""
     found = np.full((len(creature_rows), 2), np.nan)
-    for plugin in world.plugins:
-        answer = plugin.travel_targets(world)
+    for targets in world.registry(TravelTargets):
+        answer = targets(world)
         if answer is not None:
             mine = answer[creature_rows]
             fill = np.isnan(found[:, 0]) & np.isfinite(mine[:, 0])

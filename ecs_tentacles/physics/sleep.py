@@ -1,7 +1,7 @@
 """Idle creatures sleep: their group is not stepped until something changes.
 
 A creature falls asleep after `SETTLE_FRAMES` frames in which no plugin wanted it to
-move (`Plugin.wants_motion`: the locomotion plugin wants creatures with a goal), no
+move (the `MotionWants` entries: the locomotion plugin wants creatures with a goal), no
 other creature near it (no contact proxies in use), no sucker attached, servo
 commands that did not change (targets and gains: no writhing, no waves) and every
 velocity below `STILL_SPEED`. Its state then stays exactly as it was: asleep, it is
@@ -86,7 +86,7 @@ class Sleep:
         """Put still creatures to sleep and wake the ones whose situation changed.
 
         `wants_motion` (bool per CreatureStore row, or None for nobody) says which
-        creatures some plugin wants to move (`Plugin.wants_motion`): those never sleep.
+        creatures some plugin wants to move (`MotionWants` entries): those never sleep.
         """
         if not self.enabled:  # nothing ever sleeps: no per-creature work
             return

@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ecs_tentacles.physics.registries import MotionWants
 from ecs_tentacles.system import System, SystemFailure
 
 if TYPE_CHECKING:
@@ -81,12 +82,12 @@ class Physics(System):
 def wanted_motion(world: Host) -> np.ndarray | None:
     """Creatures (bool per CreatureStore row) some plugin wants to move, or None for none.
 
-    The answers of every plugin's `wants_motion` hook, or-ed; one array operation per
-    plugin that answers.
+    The answers of every `MotionWants` entry (`ecs_tentacles.physics.registries`), or-ed;
+    one array operation per entry that answers.
     """
     wanted: np.ndarray | None = None
-    for plugin in world.plugins:
-        answer = plugin.wants_motion(world)
+    for wants in world.registry(MotionWants):
+        answer = wants(world)
         if answer is not None:
             wanted = answer if wanted is None else wanted | answer
     return wanted

@@ -10,9 +10,12 @@ import numpy as np
 from numpy.testing import assert_array_equal
 
 from ecs_tentacles.components import Creature
+from ecs_tentacles.host import Host
 from ecs_tentacles.locomotion.goals import GoalBook
+from ecs_tentacles.physics.registries import MotionWants
 from ecs_tentacles.physics.sleep import SETTLE_FRAMES
 from ecs_tentacles.plugin import Plugin
+from ecs_tentacles.registry import App
 from ecs_tentacles.world import World
 from tests.conftest import NO_LOCOMOTION
 
@@ -66,7 +69,7 @@ def test_sleep_can_be_switched_off(make_world: Callable[..., World]) -> None:
 
 
 class KeepAwake(Plugin):
-    """Wants the creature called `name` to move (a user plugin answering the hook)."""
+    """Wants the creature called `name` to move (a user plugin's `MotionWants` entry)."""
 
     name = "keep_awake"
 
@@ -74,7 +77,10 @@ class KeepAwake(Plugin):
         super().__init__()
         self.creature = creature
 
-    def wants_motion(self, world: World) -> np.ndarray:
+    def build(self, app: App) -> None:
+        app.add(MotionWants, self.keep)
+
+    def keep(self, world: Host) -> np.ndarray:
         row = [c.row for _, c in world.query(Creature) if c.name == self.creature]
         wanted = np.zeros(len(world.creatures), dtype=bool)
         wanted[row] = True
@@ -82,7 +88,7 @@ class KeepAwake(Plugin):
 
 
 class NoOpinion(Plugin):
-    name = "no_opinion"  # wants_motion: None, like every plugin by default
+    name = "no_opinion"  # no MotionWants entry, like most plugins
 
 
 def test_a_plugin_that_wants_a_creature_to_move_keeps_it_awake(
