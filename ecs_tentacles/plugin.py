@@ -31,7 +31,7 @@ from typing import TYPE_CHECKING, Any, ClassVar
 
 from ecs_tentacles.roster_change import RosterChange
 from ecs_tentacles.system import System
-from ecs_tentacles.take_tracks import TakeTrack
+from ecs_tentacles.take.tracks import TakeTrack
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
@@ -71,7 +71,7 @@ class PointsFrame:
 
 @dataclass(frozen=True)
 class TrackSource:
-    """A track a plugin adds to takes: its declaration (`ecs_tentacles.take_tracks`) and
+    """A track a plugin adds to takes: its declaration (`ecs_tentacles.take.tracks`) and
     `sample(world)`, called at every recorded frame (a `PointsFrame` or `CurvesFrame`
     as the kind says, or None: nothing this frame)."""
 
@@ -235,7 +235,7 @@ class Plugin:
     # -- output hooks (takes, shard plans, run reports) -------------------------------
     def take_tracks(self, world: Host) -> Sequence[TrackSource]:
         """Tracks this plugin adds to every take recorded from `world` (the goals, the
-        fur guides; `ecs_tentacles.take_tracks` describes the kinds). A track with a
+        fur guides; `ecs_tentacles.take.tracks` describes the kinds). A track with a
         standard key (`goals`, `guides`) must be declared as the standard one; others
         are declared in the take's header, so a take file describes itself."""
         return ()

@@ -1,11 +1,11 @@
 """Shard takes -> the take a local bake of the whole scene writes, byte for byte.
 
 A take lists creatures in scene order, then bodies, suckers and every track's items
-(goals, fur guides, ...: `ecs_tentacles.take_tracks`) creature by creature
+(goals, fur guides, ...: `ecs_tentacles.take.tracks`) creature by creature
 (`ecs_tentacles.export.recording`). A shard's take does the same for its own
 creatures, so merging is a stable sort of every table by the creature's index in the
 whole scene, with the header's indices renumbered. The ground's meshes
-(`ecs_tentacles.take_ground`) are the scene's, the same in every shard: kept once.
+(`ecs_tentacles.take.ground`) are the scene's, the same in every shard: kept once.
 """
 
 from __future__ import annotations
@@ -15,9 +15,9 @@ from typing import Any
 
 import numpy as np
 
-from ecs_tentacles import take_ground
 from ecs_tentacles.take import Take
-from ecs_tentacles.take_tracks import TakeTrack
+from ecs_tentacles.take import ground as take_ground
+from ecs_tentacles.take.tracks import TakeTrack
 
 
 def merge_takes(parts: Sequence[tuple[Sequence[int], Take]]) -> Take:

@@ -26,7 +26,7 @@ from ecs_tentacles.plugin_registry import builtin
 from ecs_tentacles.progress import status, step_frames
 from ecs_tentacles.scene.load import load_scene, load_scene_plugins, resolve_scene_path
 from ecs_tentacles.take import Take
-from ecs_tentacles.take_read import MAX_FRAMES, MAX_TAKE_BYTES
+from ecs_tentacles.take.read import MAX_FRAMES, MAX_TAKE_BYTES
 from ecs_tentacles.world import World
 
 

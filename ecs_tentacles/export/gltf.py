@@ -38,7 +38,7 @@ from ecs_tentacles.export.materials import gltf_material, take_colours
 from ecs_tentacles.export.meshes import Mesh, body_mesh
 from ecs_tentacles.export.names import FOLDERS, part, unique_leaf, unique_path
 from ecs_tentacles.take import Take
-from ecs_tentacles.take_roster import spans
+from ecs_tentacles.take.roster import spans
 
 Z_UP_TO_Y_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
 _FLOAT, _USHORT, _UINT = 5126, 5123, 5125
@@ -181,7 +181,7 @@ def scale_visibility(
     animation: dict[str, Any],
 ) -> None:
     """Hide node `index` (`node`: its entry) while a creature is not there
-    (`ecs_tentacles.take_roster`): glTF has no visibility, so its scale is keyed to zero
+    (`ecs_tentacles.take.roster`): glTF has no visibility, so its scale is keyed to zero
     (STEP keys where `shown` changes), the way engines read a hidden object. Nothing is
     written for a creature there all along."""
     if shown.all():

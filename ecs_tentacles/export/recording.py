@@ -6,7 +6,7 @@ suckers) and `capture()` copies the current frame with one gather per array; the
 Everything else a take holds comes from the plugins' take tracks
 (`Plugin.take_tracks`: the locomotion plugin's goals, the fur plugin's guides, a
 user plugin's own), recorded by kind (`PointsTrack`, `CurvesTrack`); the standard
-tracks no plugin fills are written empty, as the format asks (`ecs_tentacles.take_tracks`).
+tracks no plugin fills are written empty, as the format asks (`ecs_tentacles.take.tracks`).
 """
 
 from __future__ import annotations
@@ -18,12 +18,13 @@ from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
 
 import numpy as np
 
-from ecs_tentacles import take_ground, take_roster
 from ecs_tentacles.components import Creature, Link, Tentacle, Transform
 from ecs_tentacles.ground import ground_of
 from ecs_tentacles.plugin import CurvesFrame, PointsFrame, TrackSource
 from ecs_tentacles.take import FORMAT, VERSION, Take
-from ecs_tentacles.take_tracks import STANDARD, TakeTrack, declared_problem
+from ecs_tentacles.take import ground as take_ground
+from ecs_tentacles.take import roster as take_roster
+from ecs_tentacles.take.tracks import STANDARD, TakeTrack, declared_problem
 
 if TYPE_CHECKING:
     from ecs_tentacles.roster_change import RosterChange

@@ -26,7 +26,7 @@ Locators (suckers and points tracks' items: the goals) are written unless
 `locators=False`; curves tracks (fur guides) always.
 
 Every prim name is unique in the file (`ecs_tentacles.export.names`: importers name
-objects globally and would add `.001` suffixes); tracks (`ecs_tentacles.take_tracks`)
+objects globally and would add `.001` suffixes); tracks (`ecs_tentacles.take.tracks`)
 are written by kind.
 
 Poses are world-space (every parent is an identity transform), so the time samples
@@ -49,7 +49,7 @@ from ecs_tentacles.export.ground import write_usd_ground
 from ecs_tentacles.export.materials import bind_usd, take_colours, usd_material
 from ecs_tentacles.export.names import FOLDERS, unique_path
 from ecs_tentacles.take import Take, TakeTrack
-from ecs_tentacles.take_roster import spans
+from ecs_tentacles.take.roster import spans
 
 
 class UsdUnavailable(RuntimeError):
@@ -114,7 +114,7 @@ def mark_rate(stage: Any, path: str, take: Take) -> None:
 
 def key_visibility(stage: Any, path: str, shown: np.ndarray) -> None:
     """Visibility keys on the prim at `path` (a creature's root) where `shown` (per frame)
-    changes: invisible while the creature is not there (`ecs_tentacles.take_roster`).
+    changes: invisible while the creature is not there (`ecs_tentacles.take.roster`).
     Nothing is written for a creature there all along."""
     if shown.all():
         return

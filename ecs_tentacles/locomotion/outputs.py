@@ -19,7 +19,7 @@ from ecs_tentacles.components import Creature
 from ecs_tentacles.locomotion.components import Goal
 from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.plugin import PointsFrame, Reach, RunSummary, TrackSource
-from ecs_tentacles.take_tracks import TakeTrack
+from ecs_tentacles.take.tracks import TakeTrack
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host

@@ -55,7 +55,7 @@ class Record(System):
         self._start = world.frame
 
     def roster_changed(self, world: Host, change: RosterChange) -> None:
-        if self.recorder is not None:  # the take's roster follows (`take_roster`)
+        if self.recorder is not None:  # the take's roster follows (`take.roster`)
             self.recorder.roster_changed(change)
 
     def process(self, world: Host, dt: float) -> None:

@@ -19,7 +19,7 @@ import numpy as np
 from ecs_tentacles.take import write_npz
 
 Entries = dict[str, Any]  # name -> ndarray, or bytes for a raw .npy entry
-# a plugin's points track as a take header declares it (`ecs_tentacles.take_tracks`)
+# a plugin's points track as a take header declares it (`ecs_tentacles.take.tracks`)
 BEACONS = {
     "key": "beacons",
     "kind": "points",
@@ -101,7 +101,7 @@ def _flip_middle(data: bytes) -> bytes:
 
 def _trillion_empty_frames(header: dict[str, Any], arrays: Entries) -> None:
     """A take that lies about its size: 10^12 frames of nothing, 0 bytes of arrays."""
-    from ecs_tentacles.take_read import array_dtypes, expected_shapes
+    from ecs_tentacles.take.read import array_dtypes, expected_shapes
 
     header.update(frames=10**12, creatures=[], bodies=[], suckers=[], guides=None)
     for key in ("goals",):
@@ -204,7 +204,7 @@ BROKEN_TAKES: dict[str, Callable[[Path, Path], None]] = {
             guide_widths=a["guide_widths"][:, :, :1].copy(),
         )
     ),
-    # the roster (`ecs_tentacles.take_roster`): a take that says creatures came and went
+    # the roster (`ecs_tentacles.take.roster`): a take that says creatures came and went
     "roster_without_visible_array": edit(lambda h, a: h.update(roster={"changes": 1})),
     "roster_changes_zero": edit(lambda h, a: h.update(roster={"changes": 0})),
     "roster_not_an_object": edit(lambda h, a: h.update(roster=[1])),

@@ -7,7 +7,7 @@ import grimp
 import pytest
 
 FEATURES = ("locomotion", "fur", "threats", "record", "render")
-GENERIC = ("export", "distributed", "take", "take_read", "take_tracks", "cli.run", "cli.bake")
+GENERIC = ("export", "distributed", "take", "take.read", "take.tracks", "cli.run", "cli.bake")
 
 
 @pytest.fixture(scope="module")

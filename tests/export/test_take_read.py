@@ -10,7 +10,7 @@ import pytest
 
 from ecs_tentacles.cli import main
 from ecs_tentacles.take import Take, TakeError
-from ecs_tentacles.take_read import read_take
+from ecs_tentacles.take.read import read_take
 from tests.export.broken_takes import BROKEN_TAKES
 
 

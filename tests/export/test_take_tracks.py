@@ -17,7 +17,7 @@ from ecs_tentacles.export.gltf import read_glb
 from ecs_tentacles.plugin import Plugin, PointsFrame, TrackSource
 from ecs_tentacles.system import SystemFailure
 from ecs_tentacles.take import Take, TakeError
-from ecs_tentacles.take_tracks import TakeTrack
+from ecs_tentacles.take.tracks import TakeTrack
 from ecs_tentacles.world import World
 from tests.export.conftest import SMALL_SCENE
 
@@ -28,7 +28,7 @@ BEACONS = textwrap.dedent(
     import numpy as np
     from ecs_tentacles.components import Creature, Transform
     from ecs_tentacles.plugin import CurvesFrame, Plugin, PointsFrame, TrackSource
-    from ecs_tentacles.take_tracks import TakeTrack
+    from ecs_tentacles.take.tracks import TakeTrack
 
     BEACONS = TakeTrack("beacons", "points", ("beacon_pos", "beacon_live"), "marks", "beacon")
     MASTS = TakeTrack("masts", "curves", ("mast_points", "mast_widths"), "marks", "masts")

@@ -1,7 +1,7 @@
 """Takes: every frame of a simulation in one compact, reproducible npz file.
 
 A take holds, per frame, the pose of every mantle and link, the state of every
-sucker, and the tracks the world's plugins add (`ecs_tentacles.take_tracks`): the
+sucker, and the tracks the world's plugins add (`ecs_tentacles.take.tracks`): the
 goals still to reach (points, from locomotion) and, when the world has fur, the guide
 curves (curves, from fur), plus any track a plugin declares. The header (JSON) names
 everything and carries the geometry, so exporters (USD, glTF) need nothing but the take.
@@ -19,9 +19,9 @@ The file is a zip of `.npy` arrays in this fixed order; every entry is dated
     guide_points     float32  (frames, guides, points, 3)   the standard curves track,
     guide_widths     float32  (frames, guides, points)      only when guides are recorded
     ...              the arrays of the tracks `header.tracks` declares, in its order
-    ground_*         the terrain's meshes, on terrain (`ecs_tentacles.take_ground`)
+    ground_*         the terrain's meshes, on terrain (`ecs_tentacles.take.ground`)
     creature_visible bool     (frames, creatures)  only when creatures came or went
-                                                   (`ecs_tentacles.take_roster`)
+                                                   (`ecs_tentacles.take.roster`)
 
 Frame i is simulated time i / fps; frame 0 is the pose the scene was built in.
 Bodies: a mantle is a cylinder along its local +z (`length` = height), a link a
@@ -39,9 +39,10 @@ from typing import Any, BinaryIO
 
 import numpy as np
 
-from ecs_tentacles import take_ground, take_roster
 from ecs_tentacles.atomic import atomic_file
-from ecs_tentacles.take_read import (
+from ecs_tentacles.take import ground as take_ground
+from ecs_tentacles.take import roster as take_roster
+from ecs_tentacles.take.read import (
     FORMAT,
     MAX_TAKE_BYTES,
     VERSION,
@@ -51,7 +52,7 @@ from ecs_tentacles.take_read import (
     header_problem,
     read_take,
 )
-from ecs_tentacles.take_tracks import CORE_ARRAYS, STANDARD, TakeTrack, tracks_of
+from ecs_tentacles.take.tracks import CORE_ARRAYS, STANDARD, TakeTrack, tracks_of
 
 # every array of a take without declared tracks, in file order
 ARRAYS = CORE_ARRAYS + tuple(name for track in STANDARD for name in track.arrays)
@@ -68,11 +69,11 @@ class Take:
     frames, creatures [{name, mantle (body index), tentacles [[body index per link]]}],
     bodies [{name, creature, shape cylinder|capsule, axis, radius, length}],
     suckers [{name, body, offset (in the body's frame)}], health, and one key per track
-    (`ecs_tentacles.take_tracks`): goals [{name, creature, radius}], guides (null, or
+    (`ecs_tentacles.take.tracks`): goals [{name, creature, radius}], guides (null, or
     {creatures: [creature index per guide]}); `tracks` lists declared tracks, if any;
-    `ground` the terrain's and obstacles' meshes on terrain (`ecs_tentacles.take_ground`;
+    `ground` the terrain's and obstacles' meshes on terrain (`ecs_tentacles.take.ground`;
     their arrays are in `tracks` too, by file name: `ground_meshes()` gives them);
-    `roster` when creatures came or went during the recording (`ecs_tentacles.take_roster`:
+    `roster` when creatures came or went during the recording (`ecs_tentacles.take.roster`:
     `visible()` gives which creatures are there at each frame).
     """
 
@@ -124,11 +125,11 @@ class Take:
 
     def visible(self) -> np.ndarray:
         """(frames, creatures) bool: which creatures are there at each frame (all of them
-        unless the roster changed while recording; `ecs_tentacles.take_roster`)."""
+        unless the roster changed while recording; `ecs_tentacles.take.roster`)."""
         return take_roster.visible(self.header, self.tracks)
 
     def track_list(self) -> list[TakeTrack]:
-        """Every track of this take, in file order (`ecs_tentacles.take_tracks`)."""
+        """Every track of this take, in file order (`ecs_tentacles.take.tracks`)."""
         return tracks_of(self.header)
 
     def array(self, name: str) -> np.ndarray | None:
@@ -167,7 +168,7 @@ class Take:
     def load(cls, path: str | os.PathLike[str], max_bytes: int = MAX_TAKE_BYTES) -> Take:
         """Read a take; raises `TakeError` (one line) when the file is not a sound take.
 
-        Takes are untrusted input: see `ecs_tentacles.take_read` for every check
+        Takes are untrusted input: see `ecs_tentacles.take.read` for every check
         (zip-bomb cap `max_bytes` on the uncompressed size, header, dtypes, shapes,
         finite values) made before the exporters see the data.
         """

@@ -4,14 +4,14 @@ A take may be hand-edited, truncated or hostile. `read_take` returns the header 
 the arrays only when all of this holds, else raises `TakeError` with one line:
 
 - the file is a regular file and a zip archive whose entries are exactly the arrays
-  the format defines: bodies, suckers and the tracks (`ecs_tentacles.take_tracks`:
+  the format defines: bodies, suckers and the tracks (`ecs_tentacles.take.tracks`:
   the standard ones and those the header declares), no unknown or repeated entries;
 - the uncompressed size the zip directory claims is at most `max_bytes` (a zip bomb
   is refused before anything is inflated), and so is the size the header implies;
 - the header is UTF-8 JSON describing creatures, bodies, suckers and every track
   (points: name, creature, radius each; curves: an owner per curve) with the names,
   indices and numbers the exporters need (`header_problem`), and the ground's meshes
-  when there are any (`ecs_tentacles.take_ground`; their triangle indices in range);
+  when there are any (`ecs_tentacles.take.ground`; their triangle indices in range);
 - every array's stored dtype and shape (read from its `.npy` header before its data)
   are the ones the header implies, its data is complete and its CRC right;
 - every float is finite and every quaternion has a length.
@@ -31,8 +31,9 @@ from typing import IO, Any, cast
 
 import numpy as np
 
-from ecs_tentacles import take_ground, take_roster
-from ecs_tentacles.take_tracks import TakeTrack, declared_problem, dtypes, tracks_of
+from ecs_tentacles.take import ground as take_ground
+from ecs_tentacles.take import roster as take_roster
+from ecs_tentacles.take.tracks import TakeTrack, declared_problem, dtypes, tracks_of
 
 MAX_TAKE_BYTES = 2 * 1024**3  # uncompressed; a 10 s bake of 4 creatures is ~30 MB
 MAX_HEADER_BYTES = 64 * 1024**2
