@@ -6,10 +6,10 @@ suckers, fur, threats, recording, the sandbox's drawing, users' behaviours) is a
 its own `plugins.<name>` config), a per-creature build hook, its stores (world
 resources), its systems at a named stage, its validation, its entries in the registries
 of the layers above core (`build(app)`, `ecs_tentacles.registry`: the renderer's and
-the sandbox's in `ecs_tentacles.render.registries`), and optional hooks the generic
-layers call (they never name a feature): output hooks for takes (`take_tracks`,
-`before_recording`), for distributed bakes' shard plans (`shard_reach`,
-`shard_groups`) and for `run`'s report (`run_summary`).
+the sandbox's in `ecs_tentacles.render.registries`, the physics' in
+`physics.registries`, the recorder's in `take.registries`), and optional hooks the
+generic layers call (they never name a feature): for distributed bakes' shard plans
+(`shard_reach`, `shard_groups`) and for `run`'s report (`run_summary`).
 How a scene's `plugins` are found, trusted, imported and made is
 `ecs_tentacles.plugin_registry`.
 
@@ -24,59 +24,18 @@ How a scene's `plugins` are found, trusted, imported and made is
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, ClassVar
 
 from ecs_tentacles.roster_change import RosterChange
 from ecs_tentacles.system import System
-from ecs_tentacles.take.tracks import TakeTrack
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
     from ecs_tentacles.registry import App
     from ecs_tentacles.store import ArrayStore
-
-
-@dataclass(frozen=True)
-class CurvesFrame:
-    """A curves track at one frame (`TrackSource.sample`; the fur guides):
-    `points` (curves, points, 3) world metres, `widths` (curves, points) metres,
-    `creatures` (curves,) owning creature entities."""
-
-    points: Any
-    widths: Any
-    creatures: Any
-
-
-GuideFrame = CurvesFrame  # its older name
-
-
-@dataclass(frozen=True)
-class PointsFrame:
-    """A points track at one frame (`TrackSource.sample`; the goals): the live locators.
-
-    `keys` identify each across frames (an entity id); `creatures` are their owners'
-    entities; `order` sorts locators that appear in the same frame within a creature;
-    `positions` (n, 3) and `radii` (n,) are kept from the frame a locator first appears.
-    """
-
-    keys: Sequence[int]
-    creatures: Sequence[int]
-    order: Sequence[int]
-    positions: Any
-    radii: Sequence[float]
-
-
-@dataclass(frozen=True)
-class TrackSource:
-    """A track a plugin adds to takes: its declaration (`ecs_tentacles.take.tracks`) and
-    `sample(world)`, called at every recorded frame (a `PointsFrame` or `CurvesFrame`
-    as the kind says, or None: nothing this frame)."""
-
-    track: TakeTrack
-    sample: Callable[[Host], PointsFrame | CurvesFrame | None]
 
 
 @dataclass(frozen=True)
@@ -133,7 +92,7 @@ class Plugin:
     # hooks of earlier versions, and what replaced them: a plugin that still defines
     # one is refused when its class is made, instead of being silently never called
     RENAMED_HOOKS: ClassVar[dict[str, str]] = {
-        "export_curves": "take_tracks (a TrackSource of kind 'curves'; README: Output hooks)",
+        "export_curves": "a TakeTracks entry (a TrackSource of kind 'curves'; README)",
         **{
             hook: f"a {kind} entry added in build(app) (ecs_tentacles.render.registries)"
             for hook, kind in (
@@ -149,6 +108,8 @@ class Plugin:
         },
         "wants_motion": "a MotionWants entry added in build(app) (physics.registries)",
         "travel_targets": "a TravelTargets entry added in build(app) (physics.registries)",
+        "take_tracks": "a TakeTracks entry added in build(app) (ecs_tentacles.take.registries)",
+        "before_recording": "a RecordingStarts entry added in build(app) (take.registries)",
     }
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
@@ -233,17 +194,6 @@ class Plugin:
         return []
 
     # -- output hooks (takes, shard plans, run reports) -------------------------------
-    def take_tracks(self, world: Host) -> Sequence[TrackSource]:
-        """Tracks this plugin adds to every take recorded from `world` (the goals, the
-        fur guides; `ecs_tentacles.take.tracks` describes the kinds). A track with a
-        standard key (`goals`, `guides`) must be declared as the standard one; others
-        are declared in the take's header, so a take file describes itself."""
-        return ()
-
-    def before_recording(self, world: Host) -> None:
-        """Called once when a recording starts, before its first frame is captured
-        (the fur plugin poses its guides at the built pose)."""
-
     def shard_reach(self, creature: Mapping[str, Any], seconds: float) -> Reach | None:
         """How far `creature` (its scene entry, defaults in) may move during a bake of
         `seconds`, beyond its body (locomotion: its crawl). Distributed bakes keep

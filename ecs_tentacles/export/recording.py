@@ -4,7 +4,7 @@
 suckers) and `capture()` copies the current frame with one gather per array; the
 `record` system (`ecs_tentacles.systems.record.record`) calls it after physics_sync.
 Everything else a take holds comes from the plugins' take tracks
-(`Plugin.take_tracks`: the locomotion plugin's goals, the fur plugin's guides, a
+(the `TakeTracks` entries: the locomotion plugin's goals, the fur plugin's guides, a
 user plugin's own), recorded by kind (`PointsTrack`, `CurvesTrack`); the standard
 tracks no plugin fills are written empty, as the format asks (`ecs_tentacles.take.tracks`).
 """
@@ -20,10 +20,16 @@ import numpy as np
 
 from ecs_tentacles.components import Creature, Link, Tentacle, Transform
 from ecs_tentacles.ground import ground_of
-from ecs_tentacles.plugin import CurvesFrame, PointsFrame, TrackSource
 from ecs_tentacles.take import FORMAT, VERSION, Take
 from ecs_tentacles.take import ground as take_ground
 from ecs_tentacles.take import roster as take_roster
+from ecs_tentacles.take.registries import (
+    CurvesFrame,
+    PointsFrame,
+    RecordingStarts,
+    TakeTracks,
+    TrackSource,
+)
 from ecs_tentacles.take.tracks import STANDARD, TakeTrack, declared_problem
 
 if TYPE_CHECKING:
@@ -39,14 +45,14 @@ class Recording(Protocol):
 
 
 def plugin_tracks(world: World) -> list[TrackSource]:
-    """The take tracks of the world's plugins, in plugin order."""
-    return [source for plugin in world.plugins for source in plugin.take_tracks(world)]
+    """The take tracks of the world's plugins (`TakeTracks` entries), in plugin order."""
+    return [source for tracks in world.registry(TakeTracks) for source in tracks(world)]
 
 
 def before_recording(world: World) -> None:
-    """Tell every plugin a recording starts (`Plugin.before_recording`)."""
-    for plugin in world.plugins:
-        plugin.before_recording(world)
+    """Tell every plugin a recording starts (its `RecordingStarts` entries)."""
+    for starts in world.registry(RecordingStarts):
+        starts(world)
 
 
 def scene_sha256(scene: dict[str, Any] | None) -> str:

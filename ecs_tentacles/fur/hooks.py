@@ -22,7 +22,7 @@ from ecs_tentacles.fur import children
 from ecs_tentacles.fur.components import FurControl
 from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.mathutil import quat_rotate
-from ecs_tentacles.plugin import CurvesFrame
+from ecs_tentacles.take.registries import CurvesFrame
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host

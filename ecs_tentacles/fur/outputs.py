@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any
 
 from ecs_tentacles.fur.hooks import take_guides
 from ecs_tentacles.fur.stores import FurData
-from ecs_tentacles.plugin import TrackSource
+from ecs_tentacles.take.registries import TrackSource
 from ecs_tentacles.take.tracks import TakeTrack
 
 if TYPE_CHECKING:

@@ -16,10 +16,11 @@ from typing import TYPE_CHECKING, Any
 from ecs_tentacles.fur.build import build_emotion, build_fur
 from ecs_tentacles.fur.checks import fur_problems
 from ecs_tentacles.fur.stores import FurData
-from ecs_tentacles.plugin import Plugin, TrackSource
+from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.render.registries import Draws, Lines, Panels
 from ecs_tentacles.scene.schema import fragment
 from ecs_tentacles.system import System
+from ecs_tentacles.take.registries import RecordingStarts, TakeTracks, TrackSource
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
@@ -76,13 +77,13 @@ class FurPlugin(Plugin):
         fur.curves[...] = curves
         fur.frames[...] = frames
 
-    # -- output hooks ----------------------------------------------------------------
-    def take_tracks(self, world: Host) -> list[TrackSource]:
+    # -- outputs (take tracks: build; shard plans, run report: hooks) ----------------
+    def _take_tracks(self, world: Host) -> list[TrackSource]:
         from ecs_tentacles.fur.outputs import GUIDE_TRACK
 
         return [GUIDE_TRACK]
 
-    def before_recording(self, world: Host) -> None:
+    def _before_recording(self, world: Host) -> None:
         from ecs_tentacles.fur.outputs import pose_fur_at_build
 
         pose_fur_at_build(world)
@@ -96,6 +97,8 @@ class FurPlugin(Plugin):
     # -- sandbox entries (build): GL and ImGui are imported only when a sandbox calls them
     def build(self, app: App) -> None:
         """Its drawing, HUD sections and clicks (`ecs_tentacles.render.registries`)."""
+        app.add(TakeTracks, self._take_tracks)
+        app.add(RecordingStarts, self._before_recording)
         app.add(Lines, self._lines)
         app.add(Draws, self._draw)
         app.add(Panels, self._panels)

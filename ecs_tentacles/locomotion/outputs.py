@@ -18,7 +18,8 @@ import numpy as np
 from ecs_tentacles.components import Creature
 from ecs_tentacles.locomotion.components import Goal
 from ecs_tentacles.locomotion.goals import GoalBook
-from ecs_tentacles.plugin import PointsFrame, Reach, RunSummary, TrackSource
+from ecs_tentacles.plugin import Reach, RunSummary
+from ecs_tentacles.take.registries import PointsFrame, TrackSource
 from ecs_tentacles.take.tracks import TakeTrack
 
 if TYPE_CHECKING:

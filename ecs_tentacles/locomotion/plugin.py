@@ -37,7 +37,7 @@ from ecs_tentacles.locomotion.navigation import Navigator
 from ecs_tentacles.locomotion.params import Locomotion
 from ecs_tentacles.locomotion.stores import LocomotionStores
 from ecs_tentacles.physics.registries import MotionWants, TravelTargets
-from ecs_tentacles.plugin import Plugin, Reach, RunSummary, TrackSource
+from ecs_tentacles.plugin import Plugin, Reach, RunSummary
 from ecs_tentacles.render.registries import (
     Clicks,
     FramedPoints,
@@ -49,6 +49,7 @@ from ecs_tentacles.render.registries import (
 from ecs_tentacles.scene.parameters import apply_parameters
 from ecs_tentacles.scene.schema import fragment
 from ecs_tentacles.system import System
+from ecs_tentacles.take.registries import TakeTracks, TrackSource
 
 if TYPE_CHECKING:
     import numpy as np
@@ -175,6 +176,7 @@ class LocomotionPlugin(Plugin):
     def build(self, app: App) -> None:
         """Its drawing, HUD sections, clicks and undo state (`render.registries`); which
         creatures it moves and where they go (`physics.registries`)."""
+        app.add(TakeTracks, self._take_tracks)
         app.add(Lines, self._lines)
         app.add(FramedPoints, self._framed_points)
         app.add(Panels, self._panels)
@@ -220,8 +222,8 @@ class LocomotionPlugin(Plugin):
 
         return locomotion_panels(sandbox)
 
-    # -- output hooks ----------------------------------------------------------------
-    def take_tracks(self, world: Host) -> list[TrackSource]:
+    # -- outputs (take tracks: build; shard plans, run report: hooks) ----------------
+    def _take_tracks(self, world: Host) -> list[TrackSource]:
         from ecs_tentacles.locomotion.outputs import GOAL_TRACK
 
         return [GOAL_TRACK]

@@ -1,9 +1,9 @@
 """record: appends the frame to a take (optional; `ecs-tentacles bake` adds it).
 
 Reads: Transform store (every mantle and link), Sucker store (attached, anchor),
-and whatever the plugins' take tracks sample (`Plugin.take_tracks`: goals, fur
+and whatever the plugins' take tracks sample (`TakeTracks` entries: goals, fur
 guide curves). Writes: its `TakeRecorder`'s arrays; before the first frame only,
-whatever the plugins' `before_recording` hooks write (the fur rig's output buffers,
+whatever the plugins' `RecordingStarts` entries write (the fur rig's output buffers,
 which the rig rewrites every frame).
 
 Runs in stage output, after everything else of the frame. It records the

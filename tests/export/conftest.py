@@ -17,8 +17,8 @@ from ecs_tentacles.systems.record.record import Record
 
 from ecs_tentacles.components import Creature, Link, Tentacle, Transform
 from ecs_tentacles.fur.outputs import GUIDES
-from ecs_tentacles.plugin import CurvesFrame, TrackSource
 from ecs_tentacles.take import Take
+from ecs_tentacles.take.registries import CurvesFrame, TrackSource
 from ecs_tentacles.world import World
 
 # One creature, three tentacles of four links, tip suckers, a goal 1 m ahead.

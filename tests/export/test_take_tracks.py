@@ -14,9 +14,12 @@ from ecs_tentacles.systems.record.record import Record
 from ecs_tentacles.cli import main
 from ecs_tentacles.export import write
 from ecs_tentacles.export.gltf import read_glb
-from ecs_tentacles.plugin import Plugin, PointsFrame, TrackSource
+from ecs_tentacles.host import Host
+from ecs_tentacles.plugin import Plugin
+from ecs_tentacles.registry import App
 from ecs_tentacles.system import SystemFailure
 from ecs_tentacles.take import Take, TakeError
+from ecs_tentacles.take.registries import PointsFrame, TakeTracks, TrackSource
 from ecs_tentacles.take.tracks import TakeTrack
 from ecs_tentacles.world import World
 from tests.export.conftest import SMALL_SCENE
@@ -27,7 +30,8 @@ BEACONS = textwrap.dedent(
     """
     import numpy as np
     from ecs_tentacles.components import Creature, Transform
-    from ecs_tentacles.plugin import CurvesFrame, Plugin, PointsFrame, TrackSource
+    from ecs_tentacles.plugin import Plugin
+    from ecs_tentacles.take.registries import CurvesFrame, PointsFrame, TakeTracks, TrackSource
     from ecs_tentacles.take.tracks import TakeTrack
 
     BEACONS = TakeTrack("beacons", "points", ("beacon_pos", "beacon_live"), "marks", "beacon")
@@ -55,7 +59,10 @@ BEACONS = textwrap.dedent(
     class Beacons(Plugin):
         name = "beacons"
 
-        def take_tracks(self, world):
+        def build(self, app):
+            app.add(TakeTracks, self.tracks)
+
+        def tracks(self, world):
             return [TrackSource(BEACONS, beacons), TrackSource(MASTS, masts)]
     """
 )
@@ -133,7 +140,10 @@ def _save_raw(take: Take, path: Path) -> None:
 class BadGoals(Plugin):
     name = "bad_goals"
 
-    def take_tracks(self, world: World) -> list[TrackSource]:
+    def build(self, app: App) -> None:
+        app.add(TakeTracks, self.tracks)
+
+    def tracks(self, world: Host) -> list[TrackSource]:
         track = TakeTrack("goals", "points", ("goal_xyz", "goal_on"), "goals", "goal")
         return [TrackSource(track, lambda w: PointsFrame([], [], [], [], []))]
 
