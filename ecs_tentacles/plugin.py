@@ -7,9 +7,8 @@ its own `plugins.<name>` config), a per-creature build hook, its stores (world
 resources), its systems at a named stage, its validation, its entries in the registries
 of the layers above core (`build(app)`, `ecs_tentacles.registry`: the renderer's and
 the sandbox's in `ecs_tentacles.render.registries`, the physics' in
-`physics.registries`, the recorder's in `take.registries`), and optional hooks the
-generic layers call (they never name a feature): for distributed bakes' shard plans
-(`shard_reach`, `shard_groups`) and for `run`'s report (`run_summary`).
+`physics.registries`, the recorder's in `take.registries`, the shard planner's in
+`distributed.registries`, `run`'s report's in `cli.registries`).
 How a scene's `plugins` are found, trusted, imported and made is
 `ecs_tentacles.plugin_registry`.
 
@@ -26,7 +25,6 @@ from __future__ import annotations
 
 from collections.abc import Iterator, Mapping, Sequence
 from contextlib import contextmanager
-from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, ClassVar
 
 from ecs_tentacles.roster_change import RosterChange
@@ -36,24 +34,6 @@ if TYPE_CHECKING:
     from ecs_tentacles.host import Host
     from ecs_tentacles.registry import App
     from ecs_tentacles.store import ArrayStore
-
-
-@dataclass(frozen=True)
-class Reach:
-    """How far a creature may get during a bake, beyond its body: a capsule from its
-    start along `towards` (x, y metres), widened by `radius` metres."""
-
-    towards: tuple[float, float] = (0.0, 0.0)
-    radius: float = 0.0
-
-
-@dataclass(frozen=True)
-class RunSummary:
-    """What a plugin adds to `ecs-tentacles run`'s report: counts for `--json` and a
-    phrase for the line (`"goals reached 2, left 0"`)."""
-
-    counts: dict[str, int] = field(default_factory=dict)
-    text: str = ""
 
 
 class HookFailure(RuntimeError):
@@ -110,6 +90,10 @@ class Plugin:
         "travel_targets": "a TravelTargets entry added in build(app) (physics.registries)",
         "take_tracks": "a TakeTracks entry added in build(app) (ecs_tentacles.take.registries)",
         "before_recording": "a RecordingStarts entry added in build(app) (take.registries)",
+        "shard_reach": "a ShardReaches entry added in build(app) (distributed.registries)",
+        "meeting_reach": "a MeetingReaches entry added in build(app) (distributed.registries)",
+        "shard_groups": "a ShardGroups entry added in build(app) (distributed.registries)",
+        "run_summary": "a RunSummaries entry added in build(app) (cli.registries)",
     }
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
@@ -194,30 +178,6 @@ class Plugin:
         return []
 
     # -- output hooks (takes, shard plans, run reports) -------------------------------
-    def shard_reach(self, creature: Mapping[str, Any], seconds: float) -> Reach | None:
-        """How far `creature` (its scene entry, defaults in) may move during a bake of
-        `seconds`, beyond its body (locomotion: its crawl). Distributed bakes keep
-        creatures whose reaches may meet in one shard."""
-        return None
-
-    def meeting_reach(self, scene: Mapping[str, Any]) -> list[float] | None:
-        """Per creature of `scene` (defaults in; scene order), a distance (m) from its
-        mantle on the ground: this plugin lets two creatures act on each other without
-        touching when their mantles come within the sum of theirs (locomotion: crowd
-        avoidance, its personal radius and half the range); None: only through contact.
-        A distributed bake bakes again as one the shards whose creatures came that close
-        (`distributed.spheres.meetings`)."""
-        return None
-
-    def shard_groups(self, creatures: Sequence[Mapping[str, Any]]) -> list[list[int]]:
-        """Sets of creature indices (scene order) that must bake in one shard wherever
-        they are (fur: threats and the emotional creatures they rouse)."""
-        return []
-
-    def run_summary(self, world: Host) -> RunSummary | None:
-        """Counts `ecs-tentacles run` reports after stepping `world` (goals reached)."""
-        return None
-
     def __repr__(self) -> str:
         return f"<plugin {self.key}>"
 

@@ -20,8 +20,8 @@ from ecs_tentacles.cli.arguments import (
     seed_int,
 )
 from ecs_tentacles.cli.lod_options import add_lod_arguments, apply_focus, lod_choice
+from ecs_tentacles.cli.registries import RunSummaries, RunSummary
 from ecs_tentacles.components import Creature
-from ecs_tentacles.plugin import RunSummary
 from ecs_tentacles.progress import status, step_frames
 from ecs_tentacles.scene.load import resolve_scene_path
 from ecs_tentacles.world import World
@@ -148,6 +148,6 @@ def simulate(world: World, frames: int, *, progress: bool = True) -> dict[str, A
 
 
 def plugin_summaries(world: World) -> list[RunSummary]:
-    """What the world's plugins report after a run (`Plugin.run_summary`), plugin order."""
-    found = (plugin.run_summary(world) for plugin in world.plugins)
+    """What the world's plugins report after a run (`RunSummaries` entries), plugin order."""
+    found = (summary(world) for summary in world.registry(RunSummaries))
     return [summary for summary in found if summary is not None]

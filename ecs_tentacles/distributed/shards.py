@@ -27,9 +27,11 @@ from typing import Any
 import numpy as np
 
 from ecs_tentacles.creator.crowd import creature_reach
+from ecs_tentacles.distributed.registries import Reach, ShardGroups, ShardReaches
 from ecs_tentacles.physics.proxies import MARGIN
-from ecs_tentacles.plugin import Plugin, Reach
+from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.plugin_registry import resolve
+from ecs_tentacles.registry import built
 
 SLACK = 0.15  # metres: settling at the start, sideways drift, tentacles lifting
 
@@ -66,7 +68,7 @@ def plan_shards(
     if not creatures:
         return ShardPlan([[]], 1, declared=False)
     plugins = scene_plugins(scene) if plugins is None else plugins
-    together = [group for plugin in plugins for group in plugin.shard_groups(creatures)]
+    together = [g for groups in built(plugins).get(ShardGroups) for g in groups(creatures)]
     if "shards" in scene:
         index = {c["name"]: i for i, c in enumerate(creatures)}
         shards = [sorted(index[name] for name in shard) for shard in scene["shards"]]
@@ -79,7 +81,7 @@ def plan_shards(
 def scene_plugins(
     scene: Mapping[str, Any], folder: str | None = None, *, allow_systems: bool = False
 ) -> list[Plugin]:
-    """The plugins a loaded scene turns on (its `plugins` field), for their shard hooks."""
+    """The plugins a loaded scene turns on (its `plugins` field), for their shard entries."""
     where = pathlib.Path(folder) if folder else None
     return resolve(scene.get("plugins"), where, allow=allow_systems)
 
@@ -104,10 +106,11 @@ def travel_capsules(
 ) -> np.ndarray:
     """(n, 5): start x, y, end x, y and radius of where each creature can get to."""
     out = np.zeros((len(creatures), 5))
+    reaches = list(built(plugins).get(ShardReaches))
     for i, creature in enumerate(creatures):
         start = np.asarray(creature["position"][:2], dtype=np.float64)
         reach = creature_reach(creature) + 0.5 * creature["mantle"]["height"] + SLACK
-        moves = [plugin.shard_reach(creature, seconds) for plugin in plugins]
+        moves = [reach(creature, seconds) for reach in reaches]
         towards, extra = _combined([m for m in moves if m is not None])
         out[i] = (*start, *(start + towards), reach + extra)
     return out

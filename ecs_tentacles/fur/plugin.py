@@ -13,6 +13,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
+from ecs_tentacles.distributed.registries import ShardGroups
 from ecs_tentacles.fur.build import build_emotion, build_fur
 from ecs_tentacles.fur.checks import fur_problems
 from ecs_tentacles.fur.stores import FurData
@@ -88,7 +89,7 @@ class FurPlugin(Plugin):
 
         pose_fur_at_build(world)
 
-    def shard_groups(self, creatures: Sequence[Mapping[str, Any]]) -> list[list[int]]:
+    def _shard_groups(self, creatures: Sequence[Mapping[str, Any]]) -> list[list[int]]:
         from ecs_tentacles.fur.outputs import roused
 
         together = roused(creatures)
@@ -97,6 +98,7 @@ class FurPlugin(Plugin):
     # -- sandbox entries (build): GL and ImGui are imported only when a sandbox calls them
     def build(self, app: App) -> None:
         """Its drawing, HUD sections and clicks (`ecs_tentacles.render.registries`)."""
+        app.add(ShardGroups, self._shard_groups)
         app.add(TakeTracks, self._take_tracks)
         app.add(RecordingStarts, self._before_recording)
         app.add(Lines, self._lines)

@@ -15,10 +15,11 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ecs_tentacles.cli.registries import RunSummary
 from ecs_tentacles.components import Creature
+from ecs_tentacles.distributed.registries import Reach
 from ecs_tentacles.locomotion.components import Goal
 from ecs_tentacles.locomotion.goals import GoalBook
-from ecs_tentacles.plugin import Reach, RunSummary
 from ecs_tentacles.take.registries import PointsFrame, TrackSource
 from ecs_tentacles.take.tracks import TakeTrack
 

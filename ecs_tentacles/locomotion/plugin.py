@@ -26,8 +26,10 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ecs_tentacles.build import creature_rng
+from ecs_tentacles.cli.registries import RunSummaries, RunSummary
 from ecs_tentacles.components import Creature, Tentacle
 from ecs_tentacles.construction import tentacle_params
+from ecs_tentacles.distributed.registries import MeetingReaches, Reach, ShardReaches
 from ecs_tentacles.locomotion.actions import STRENGTH, ActionQueue, Kind
 from ecs_tentacles.locomotion.avoidance import Avoidance, bent
 from ecs_tentacles.locomotion.components import Goal
@@ -37,7 +39,7 @@ from ecs_tentacles.locomotion.navigation import Navigator
 from ecs_tentacles.locomotion.params import Locomotion
 from ecs_tentacles.locomotion.stores import LocomotionStores
 from ecs_tentacles.physics.registries import MotionWants, TravelTargets
-from ecs_tentacles.plugin import Plugin, Reach, RunSummary
+from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.render.registries import (
     Clicks,
     FramedPoints,
@@ -176,6 +178,9 @@ class LocomotionPlugin(Plugin):
     def build(self, app: App) -> None:
         """Its drawing, HUD sections, clicks and undo state (`render.registries`); which
         creatures it moves and where they go (`physics.registries`)."""
+        app.add(ShardReaches, self._shard_reach)
+        app.add(MeetingReaches, self._meeting_reach)
+        app.add(RunSummaries, self._run_summary)
         app.add(TakeTracks, self._take_tracks)
         app.add(Lines, self._lines)
         app.add(FramedPoints, self._framed_points)
@@ -228,17 +233,17 @@ class LocomotionPlugin(Plugin):
 
         return [GOAL_TRACK]
 
-    def shard_reach(self, creature: Mapping[str, Any], seconds: float) -> Reach | None:
+    def _shard_reach(self, creature: Mapping[str, Any], seconds: float) -> Reach | None:
         from ecs_tentacles.locomotion.outputs import crawl_reach
 
         return crawl_reach(creature, seconds)
 
-    def meeting_reach(self, scene: Mapping[str, Any]) -> list[float] | None:
+    def _meeting_reach(self, scene: Mapping[str, Any]) -> list[float] | None:
         from ecs_tentacles.locomotion.avoidance import meeting_reach
 
         return meeting_reach(scene)
 
-    def run_summary(self, world: Host) -> RunSummary | None:
+    def _run_summary(self, world: Host) -> RunSummary | None:
         from ecs_tentacles.locomotion.outputs import goal_summary
 
         return goal_summary(world)

@@ -1,4 +1,4 @@
-"""`run` reports what the scene's plugins count (`Plugin.run_summary`), and nothing else."""
+"""`run` reports what the scene's plugins count (`RunSummaries` entries), and nothing else."""
 
 from __future__ import annotations
 
@@ -14,13 +14,17 @@ from ecs_tentacles.cli import main
 CREATURE = {"name": "octo", "position": [0, 0], "tentacles": {"count": 3, "links": 4}}
 COUNTER = textwrap.dedent(
     """
-    from ecs_tentacles.plugin import Plugin, RunSummary
+    from ecs_tentacles.cli.registries import RunSummaries, RunSummary
+    from ecs_tentacles.plugin import Plugin
 
 
     class Counter(Plugin):
         name = "counter"
 
-        def run_summary(self, world):
+        def build(self, app):
+            app.add(RunSummaries, self.count)
+
+        def count(self, world):
             return RunSummary({"frames_seen": world.frame}, f"frames seen {world.frame}")
     """
 )

@@ -8,8 +8,10 @@ from typing import Any
 import numpy as np
 import pytest
 
+from ecs_tentacles.distributed.registries import Reach, ShardGroups, ShardReaches
 from ecs_tentacles.distributed.shards import pack, plan_shards, scene_plugins, segment_distance
-from ecs_tentacles.plugin import Plugin, Reach
+from ecs_tentacles.plugin import Plugin
+from ecs_tentacles.registry import App
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.load import load_scene
 
@@ -118,10 +120,14 @@ class Drifter(Plugin):
 
     name = "drifter"
 
-    def shard_reach(self, creature: Mapping[str, Any], seconds: float) -> Reach:
+    def build(self, app: App) -> None:
+        app.add(ShardReaches, self.reach)
+        app.add(ShardGroups, self.groups)
+
+    def reach(self, creature: Mapping[str, Any], seconds: float) -> Reach:
         return Reach(radius=10.0)
 
-    def shard_groups(self, creatures: Sequence[Mapping[str, Any]]) -> list[list[int]]:
+    def groups(self, creatures: Sequence[Mapping[str, Any]]) -> list[list[int]]:
         return [[0, 3]]
 
 
