@@ -70,7 +70,7 @@ def creature_colour(creature: Look, palette: str = "natural") -> np.ndarray:
     """The colour (3,) display rgb in 0..1 of `creature` in `palette` ("natural" or
     "debug"); the one function the sandbox and the exporters choose colours with."""
     if palette == "debug":
-        return creature_colours(creature.index + 1)[creature.index]
+        return np.asarray(creature_colours(creature.index + 1)[creature.index])
     if palette != "natural":
         raise ValueError(f"palette must be one of {', '.join(PALETTES)}, got {palette!r}")
     # the species' place round the ring of tones, between two neighbours

@@ -122,7 +122,7 @@ class CreatureLayout:
 
     def link_centres(self, k: int) -> np.ndarray:
         """World positions (links, 3) of tentacle `k`'s link centres."""
-        return self.origin + self.shapes[k].centres[:, None] * self.axis(k)
+        return np.asarray(self.origin + self.shapes[k].centres[:, None] * self.axis(k))
 
     def capsules(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Every body as a capsule: segment starts (n, 3), ends (n, 3) and radii (n,).

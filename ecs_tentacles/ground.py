@@ -86,7 +86,7 @@ class Heightfield:
         gx = (self.height(xy + ex) - self.height(xy - ex)) / dx
         gy = (self.height(xy + ey) - self.height(xy - ey)) / dy
         n = np.stack([-gx, -gy, np.ones_like(gx)], axis=1)
-        return n / np.linalg.norm(n, axis=1, keepdims=True)
+        return np.asarray(n / np.linalg.norm(n, axis=1, keepdims=True))
 
 
 @dataclass(frozen=True)
@@ -150,14 +150,16 @@ class Solid:
         """Metres from points (n, 3) to the surface, negative inside."""
         local = (points - self.position) @ self.rotation
         if self.kind == "sphere":
-            return np.linalg.norm(local, axis=1) - self.size[0]
+            return np.asarray(np.linalg.norm(local, axis=1) - self.size[0])
         if self.kind == "box":
             return _box_distance(local, np.asarray(self.size))
         if self.kind == "cylinder":
             flat = np.stack([np.hypot(local[:, 0], local[:, 1]), local[:, 2]], axis=1)
             return _box_distance(flat, np.asarray(self.size))
         # convex pieces: the largest plane distance (exact inside, a lower bound outside)
-        return np.min([np.max(local @ p[:, :3].T - p[:, 3], axis=1) for p in self.planes], axis=0)
+        return np.asarray(
+            np.min([np.max(local @ p[:, :3].T - p[:, 3], axis=1) for p in self.planes], axis=0)
+        )
 
 
 def _box_planes(half: np.ndarray) -> np.ndarray:
@@ -178,7 +180,7 @@ def _prism_planes(radius: float, half: float, sides: int = 48) -> np.ndarray:
 def _box_distance(local: np.ndarray, half: np.ndarray) -> np.ndarray:
     q = np.abs(local) - half
     outside = np.linalg.norm(np.maximum(q, 0.0), axis=1)
-    return outside + np.minimum(q.max(axis=1), 0.0)
+    return np.asarray(outside + np.minimum(q.max(axis=1), 0.0))
 
 
 def convex_planes(vertices: np.ndarray) -> np.ndarray:
@@ -345,7 +347,7 @@ class Ground:
         gx = (self.surface(xy + ex) - self.surface(xy - ex)) / (2 * NORMAL_SPAN)
         gy = (self.surface(xy + ey) - self.surface(xy - ey)) / (2 * NORMAL_SPAN)
         n = np.stack([-gx, -gy, np.ones_like(gx)], axis=1)
-        return n / np.linalg.norm(n, axis=1, keepdims=True)
+        return np.asarray(n / np.linalg.norm(n, axis=1, keepdims=True))
 
     def ray(self, origin: np.ndarray, direction: np.ndarray) -> np.ndarray | None:
         """Where the ray from `origin` along `direction` first meets the ground or a solid
@@ -355,7 +357,7 @@ class Ground:
         if self.flat:
             if direction[2] >= 0.0 or origin[2] <= 0.0:
                 return None
-            return origin + direction * (-origin[2] / direction[2])
+            return np.asarray(origin + direction * (-origin[2] / direction[2]))
         model, data = self._static()
         hit = np.zeros(1, dtype=np.int32)
         length = float(np.linalg.norm(direction))

@@ -24,7 +24,7 @@ def quat_rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
     w = q[..., :1]
     u = q[..., 1:]
     t = 2.0 * _cross(u, v)
-    return v + w * t + _cross(u, t)
+    return np.asarray(v + w * t + _cross(u, t))
 
 
 def quat_multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -259,7 +259,8 @@ class World:
             name = (kind.__module__, kind.__qualname__)
             for made, obj in self._resources.items():
                 if (made.__module__, made.__qualname__) == name:
-                    return obj
+                    same: R = obj  # the same class, imported again
+                    return same
         return found
 
     def replace_resource(self, obj: object) -> None:

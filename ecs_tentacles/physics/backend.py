@@ -92,7 +92,7 @@ class PhysicsBackend(Membership):
         self.threads = max(1, threads if threads is not None else os.cpu_count() or 1)
         self.time = 0.0
         creatures = sorted(world.query(Creature, Transform))
-        by_key: dict[tuple, list[int]] = {}
+        by_key: dict[tuple[object, ...], list[int]] = {}
         layouts: list[ModelLayout] = []
         for index, (_, (creature, transform)) in enumerate(creatures):
             layout = model_layout(world, creature, transform)

@@ -85,7 +85,8 @@ class Batch:
         self.proxy_mocap = m.body_mocapid[_ids(m, obj.mjOBJ_BODY, proxies)]
         self.proxy_cylinder = m.geom_type[self.proxy_geoms] == mujoco.mjtGeom.mjGEOM_CYLINDER
         self.root_qpos = int(m.jnt_qposadr[m.joint("root").id])
-        self.key: tuple | None = first.key  # the morphology (None: retired, `rebuild_models`)
+        # the morphology (None: retired, `rebuild_models`)
+        self.key: tuple[object, ...] | None = first.key
         self._order = order
         # store rows, one row of each per creature
         (self.body_rows, self.actuator_motor_rows, self.actuator_target_index,
@@ -252,7 +253,7 @@ class Batch:
             guess, steps = 2e-6 * (nv + 1.0), 1.0 / REDUCED_RATE
         else:
             guess, steps = 1e-6 * (self.model.nv + 1.0), 1.0
-        return np.where(measured > 0.0, measured, guess) * steps
+        return np.asarray(np.where(measured > 0.0, measured, guess) * steps)
 
     def scratch_for(self, thread: int, tier: int = FULL) -> Scratch:
         """Thread `thread`'s scratch model and data for `tier` (made on first use)."""

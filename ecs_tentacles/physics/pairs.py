@@ -72,9 +72,9 @@ def spheres_within(
     fast = KERNELS.get()
     if fast is not None:
         ia, ib = np.asarray(a, np.int64), np.asarray(b, np.int64)  # no copy when they are
-        return fast.spheres_within(centre, radius, ia, ib, float(margin))
+        return np.asarray(fast.spheres_within(centre, radius, ia, ib, float(margin)))
     gap = np.linalg.norm(centre[a] - centre[b], axis=1) - (radius[a] + radius[b])
-    return gap < margin
+    return np.asarray(gap < margin)
 
 
 def near_pairs(

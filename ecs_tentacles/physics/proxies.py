@@ -302,13 +302,13 @@ class ContactProxies:
         own = np.arange(per.sum()) - np.repeat(np.cumsum(per) - per, per) + self.start[who][pair]
         gap = np.linalg.norm(pos[own] - pos[body[pair]], axis=1) - self.rbound[own]
         nearest = np.minimum.reduceat(gap, np.cumsum(per) - per)
-        return nearest - self.rbound[body]
+        return np.asarray(nearest - self.rbound[body])
 
 
 def _bounds(kind: np.ndarray, size: np.ndarray) -> np.ndarray:
     """Bounding-sphere radii of bodies of `kind` and `size` (radius, half length)."""
     radius, half = size[:, 0], size[:, 1]
-    return np.where(kind == CYLINDER, np.hypot(radius, half), radius + half)
+    return np.asarray(np.where(kind == CYLINDER, np.hypot(radius, half), radius + half))
 
 
 def nearest_gap(

@@ -68,4 +68,4 @@ class Roster:
     @property
     def active(self) -> np.ndarray:
         """Creatures stepped this frame (not frozen, not asleep, not kinematic)."""
-        return ~(self.frozen | self.sleeping) & (self.tier != KINEMATIC)
+        return np.asarray(~(self.frozen | self.sleeping) & (self.tier != KINEMATIC))

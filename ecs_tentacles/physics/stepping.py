@@ -21,7 +21,8 @@ from dataclasses import dataclass, field
 import mujoco
 import numpy as np
 
-from ecs_tentacles.physics.batch import STATE, Batch, write_overlay
+from ecs_tentacles.physics.batch import Batch, write_overlay
+from ecs_tentacles.physics.state_layout import STATE
 from ecs_tentacles.physics.tiers import FULL, REDUCED
 
 

@@ -121,26 +121,26 @@ class CreatureView:
 
     def integration_state(self) -> np.ndarray:
         """A copy of this creature's state row (`physics.batch.STATE`)."""
-        return self.batch.state[self.row].copy()
+        return np.asarray(self.batch.state[self.row].copy())
 
     @property
     def kp(self) -> np.ndarray:
         """Servo stiffness per actuator as the next step uses it (strength x gain x soften)."""
-        return self.batch.kp[self.row]
+        return np.asarray(self.batch.kp[self.row])
 
     @property
     def kv(self) -> np.ndarray:
         """Servo damping per actuator (damping x gain)."""
-        return self.batch.kv[self.row]
+        return np.asarray(self.batch.kv[self.row])
 
     @property
     def torque(self) -> np.ndarray:
         """Torque limit per actuator."""
-        return self.batch.torque[self.row]
+        return np.asarray(self.batch.torque[self.row])
 
     @property
     def proxy_mocap(self) -> np.ndarray:
-        return self.batch.proxy_mocap
+        return np.asarray(self.batch.proxy_mocap)
 
     @property
     def body_ids(self) -> np.ndarray:
@@ -148,11 +148,11 @@ class CreatureView:
 
     @property
     def body_rows(self) -> np.ndarray:
-        return self.batch.body_rows[self.row]
+        return np.asarray(self.batch.body_rows[self.row])
 
     @property
     def actuator_motor_rows(self) -> np.ndarray:
-        return self.batch.actuator_motor_rows[self.row]
+        return np.asarray(self.batch.actuator_motor_rows[self.row])
 
     @property
     def equality_ids(self) -> np.ndarray:
@@ -160,7 +160,7 @@ class CreatureView:
 
     @property
     def sucker_rows(self) -> np.ndarray:
-        return self.batch.sucker_rows[self.row]
+        return np.asarray(self.batch.sucker_rows[self.row])
 
     @property
     def frozen(self) -> bool:

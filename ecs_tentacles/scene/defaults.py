@@ -115,4 +115,5 @@ def with_defaults(data: dict[str, Any], plugins: Sequence[Plugin] | None = None)
         for i, creature in enumerate(creatures):
             if isinstance(creature, dict):
                 creature.setdefault("name", f"creature_{i}")
-    return result
+    filled: dict[str, Any] = result
+    return filled

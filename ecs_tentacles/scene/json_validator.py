@@ -114,7 +114,7 @@ def _items(validator: Any, items: Any, instance: object, schema: Any) -> Iterato
     yield from _STANDARD_ITEMS(validator, items, instance, schema)
 
 
-StrictValidator = validators.extend(
+StrictValidator = cast(Any, validators.extend)(  # jsonschema leaves extend untyped
     Draft202012Validator,
     validators={"pattern": _pattern, "items": _items},
     type_checker=Draft202012Validator.TYPE_CHECKER.redefine_many(

@@ -48,7 +48,7 @@ def segment_distances(p1: np.ndarray, q1: np.ndarray, p2: np.ndarray, q2: np.nda
     s = np.where(t < 0.0, np.clip(-c / a, 0, 1), np.where(t > 1.0, np.clip((b - c) / a, 0, 1), s))
     t = np.clip(t, 0.0, 1.0)
     gap = (p1 + d1 * s[..., None]) - (p2 + d2 * t[..., None])
-    return np.sqrt(np.einsum("...i,...i", gap, gap))
+    return np.asarray(np.sqrt(np.einsum("...i,...i", gap, gap)))
 
 
 @dataclass

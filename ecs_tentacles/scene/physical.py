@@ -103,7 +103,7 @@ def physical_problems(scene: dict[str, Any]) -> list[str]:
 
 def _step(physics: dict[str, Any]) -> float:
     """The physics step 1 / (fps * substeps), in seconds."""
-    return 1.0 / (physics["fps"] * physics["substeps"])
+    return float(1.0 / (physics["fps"] * physics["substeps"]))
 
 
 def _timestep_problems(physics: dict[str, Any]) -> list[tuple[Path, str]]:
