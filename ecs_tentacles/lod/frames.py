@@ -16,21 +16,11 @@ def to_ground(
     pos: np.ndarray, quat: np.ndarray, xy: np.ndarray, heading: np.ndarray | float
 ) -> tuple[np.ndarray, np.ndarray]:
     """World poses `pos` (..., B, 3) / `quat` (..., B, 4) in the ground frames (xy (..., 2),
-    heading (...)): the inverse of `from_ground`."""
+    heading (...))."""
     heading = np.asarray(heading, dtype=np.float64)
     shifted = np.array(pos, dtype=np.float64)
     shifted[..., :2] -= np.asarray(xy, dtype=np.float64)[..., None, :]
     return rotate_z(shifted, -heading[..., None]), yaw_times(-heading[..., None], quat)
-
-
-def from_ground(
-    pos: np.ndarray, quat: np.ndarray, xy: np.ndarray, heading: np.ndarray | float
-) -> tuple[np.ndarray, np.ndarray]:
-    """Ground-frame poses (..., B, 3) / (..., B, 4) placed at `xy` (..., 2) facing `heading`."""
-    heading = np.asarray(heading, dtype=np.float64)
-    world = rotate_z(np.asarray(pos, dtype=np.float64), heading[..., None])
-    world[..., :2] += np.asarray(xy, dtype=np.float64)[..., None, :]
-    return world, yaw_times(heading[..., None], quat)
 
 
 def rotate_z(v: np.ndarray, angle: np.ndarray | float) -> np.ndarray:

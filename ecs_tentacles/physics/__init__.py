@@ -1,7 +1,7 @@
 """The MuJoCo backend: model building from entities, stepping and syncing.
 
 `backend` (the groups, stepped in parallel; `state()` / `set_state()`), `group`,
-`model`, `proxies`, `health`, `sleep`, `clearance`; `host` is what the physics needs
+`model`, `proxies`, `health`, `sleep`, `registries`; `host` is what the physics needs
 of a world (a Protocol: nothing here imports `ecs_tentacles.world`); `systems`
 declares the physics systems every world runs (their code is in `systems/physics/`).
 """

@@ -269,12 +269,6 @@ class PhysicsBackend(Membership):
         """Creatures stepped this frame (not frozen, not asleep, not kinematic)."""
         return self.roster.active
 
-    def set_tier(self, indices: np.ndarray, tier: int) -> None:
-        """Move creatures (backend indices) to `tier`. Between FULL and REDUCED the state
-        carries over exactly; a creature leaving KINEMATIC must get its pose first
-        (`place_joints`)."""
-        self.tier[indices] = tier
-
     def place_joints(self, index: int, qpos: np.ndarray, qvel: np.ndarray) -> None:
         """Start creature `index` from `qpos` / `qvel` (a promotion from replayed poses).
 

@@ -182,13 +182,6 @@ class ContactProxies:
         reach = np.linalg.norm(pos[body] - centre[owner], axis=1) + self.rbound[body]
         return centre, np.maximum.reduceat(reach, first)
 
-    def closest(
-        self, pos: np.ndarray, centre: np.ndarray, radius: np.ndarray, margin: float
-    ) -> np.ndarray:
-        """Per creature, the gap (m) between its bodies and the nearest other creature's,
-        as far as it is under `margin` (inf where none comes that close)."""
-        return nearest_gap(len(self.roster), *self.pair_gaps(pos, centre, radius, margin))
-
     def pair_gaps(
         self, pos: np.ndarray, centre: np.ndarray, radius: np.ndarray, margin: float
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -241,7 +241,6 @@ class ReducedModel:
         self.root_v = int(full.joint("root").dofadr[0])
         self.red_root_q = int(model.joint("root").qposadr[0])
         self.red_root_v = int(model.joint("root").dofadr[0])
-        self.full_nq, self.full_nv = full.nq, full.nv
         self.size = mujoco.mj_stateSize(model, STATE)
         # the part of a full state a reduced step writes, to know when someone else did
         q, v = self.full_slices[int(S.mjSTATE_QPOS)], self.full_slices[int(S.mjSTATE_QVEL)]

@@ -15,9 +15,9 @@ from ecs_tentacles.skin.keys import slerp
 from ecs_tentacles.skin.mesh import creature_mesh
 from ecs_tentacles.skin.rig import Keys
 from ecs_tentacles.skin.skeleton import creature_skeleton, joint_world_poses
-from ecs_tentacles.skin.skinning import skin_points, skinning_matrices
 from ecs_tentacles.take import Take
 from tests.export.conftest import khronos_report
+from tests.skin.cpu_skinning import skin_points, skinning_matrices
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -16,8 +16,8 @@ from ecs_tentacles.skin.keys import angle_between
 from ecs_tentacles.skin.mesh import Detail, creature_mesh
 from ecs_tentacles.skin.rig import Keys
 from ecs_tentacles.skin.skeleton import creature_animation, creature_skeleton, joint_world_poses
-from ecs_tentacles.skin.skinning import skin_points, skinning_matrices
 from ecs_tentacles.take import Take
+from tests.skin.cpu_skinning import skin_points, skinning_matrices
 
 pxr = pytest.importorskip("pxr", reason="USD export needs usd-core (the usd / dev extras)")
 from pxr import Usd, UsdGeom, UsdSkel, UsdUtils, Vt  # noqa: E402

@@ -11,10 +11,10 @@ import pytest
 from numpy.testing import assert_allclose
 
 from ecs_tentacles.creator.crowd import creature_reach
-from ecs_tentacles.physics.clearance import clearance
 from ecs_tentacles.scene.load import load_scene
 from ecs_tentacles.world import World
 from tests.conftest import NO_LOCOMOTION
+from tests.physics.clearance import clearance
 
 TOLERANCE = 0.005  # metres of interpenetration allowed, measured on the geoms
 

@@ -13,7 +13,7 @@ from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.mathutil import quat_rotate
 from ecs_tentacles.render.skinned import SANDBOX_DETAIL, world_skeleton
 from ecs_tentacles.skin.mesh import creature_mesh
-from ecs_tentacles.skin.skinning import skin_points
+from tests.skin.cpu_skinning import skin_points
 
 
 def test_the_palette_puts_the_tubes_on_the_simulated_links(

@@ -12,8 +12,8 @@ from ecs_tentacles.skin.skeleton import (
     joint_world_poses,
     transforms,
 )
-from ecs_tentacles.skin.skinning import skin_points, skinning_matrices
 from ecs_tentacles.take import Take
+from tests.skin.cpu_skinning import skin_points, skinning_matrices
 
 
 def test_one_joint_per_body_mantle_first_links_chained(octopus_take: Take) -> None:

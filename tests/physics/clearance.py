@@ -4,8 +4,8 @@ Measured on the geometry the physics uses, from the Transform store: link capsul
 (segment along the link's +x, radius) exactly, segment to segment
 (`ecs_tentacles.scene.overlap.segment_distances`, shared with the build check); the mantle
 cylinder against link capsules by sampling each link's segment at a few points
-(exact point-to-cylinder distances). For tests and scripts (how close did two
-creatures come?); never per frame in the engine.
+(exact point-to-cylinder distances). For the tests (how close did two creatures
+come?); never per frame in the engine.
 """
 
 from __future__ import annotations
