@@ -12,7 +12,8 @@ edit raises `SpawnError` (the sandbox says so and keeps the edit to try again).
 * `Despawned`: creatures removed; undo builds them again where they were, with their
   goals and parameters at the time (`roster_save.entry_now`).
 * `Moved`: a creature dragged or thrown; undo puts it back as it was grabbed.
-* `ThreatDropped`: a threat placed from the palette; undo takes it away.
+* `ThreatDropped`: a danger (a threat) placed from the palette (`senses.placeable`);
+  undo takes it away.
 """
 
 from __future__ import annotations
@@ -25,8 +26,8 @@ import numpy as np
 
 from ecs_tentacles.components import Creature
 from ecs_tentacles.roster_save import entry_now
+from ecs_tentacles.senses import placeable
 from ecs_tentacles.spawning import SpawnError, free_spot, place
-from ecs_tentacles.threats.data import ThreatData
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
@@ -129,10 +130,14 @@ class ThreatDropped:
     position: list[float]
 
     def undo(self, world: Host) -> None:
-        threats = world.resource(ThreatData)
-        for entity, name in threats.entities(world).items():
+        source = placeable(world)
+        if source is None or source.placed is None or source.remove is None:
+            return  # the plugin that placed it is off now: nothing left to take away
+        for entity, name in source.placed(world).items():
             if name == self.name:
-                threats.remove(world, entity)
+                source.remove(world, entity)
 
     def redo(self, world: Host) -> None:
-        world.resource(ThreatData).drop(world, self.position, self.name)
+        source = placeable(world)
+        if source is not None and source.drop is not None:
+            source.drop(world, self.position, self.name)

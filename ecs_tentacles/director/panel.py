@@ -12,7 +12,8 @@
 
 Every one of these is one edit on the sandbox's undo stack (`director.commands`;
 Ctrl+Z, Ctrl+Shift+Z). Reads the sandbox's selection, camera and keys; writes the
-world through `World.spawn` / `despawn`, `ThreatData` and the `Director` resource.
+world through `World.spawn` / `despawn`, the dangers' sources (`senses.placeable`) and
+the `Director` resource.
 """
 
 from __future__ import annotations
@@ -32,8 +33,8 @@ from ecs_tentacles.director.scatter import reach_of, scatter
 from ecs_tentacles.director.state import Director
 from ecs_tentacles.render.gui import Gui
 from ecs_tentacles.render.registries import Panel
+from ecs_tentacles.senses import placeable
 from ecs_tentacles.spawning import SpawnError, creature_entry
-from ecs_tentacles.threats.data import ThreatData
 
 log = logging.getLogger("ecs_tentacles.director")
 
@@ -182,12 +183,13 @@ class DirectorPanel(Panel):
         """The chosen preset at `ground`: a creature (the nearest free spot) or a threat."""
         world, preset = self.world, self.preset
         if preset.is_threat:
-            if not world.has_resource(ThreatData):
+            source = placeable(world)
+            if source is None or source.drop is None:
                 self.message = "threats are off in this scene"
                 return None
             point = [float(v) for v in ground]
-            entity = world.resource(ThreatData).drop(world, point, preset.entry["threat"])
-            name = world.resource(ThreatData).entities(world)[entity]
+            entity = source.drop(world, point, preset.entry["threat"])
+            name = source.placed(world)[entity] if source.placed else preset.entry["threat"]
             self._push(ThreatDropped(f"drop {name}", name, point))
             self.message = f"dropped {name}"
             return entity

@@ -15,6 +15,7 @@ import numpy as np
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.render.registries import Marker, Spheres
 from ecs_tentacles.scene.schema import fragment
+from ecs_tentacles.senses import Dangers, DangerSource
 from ecs_tentacles.system import System
 from ecs_tentacles.threats.data import ThreatData, build_threats, mark_creature, threat_problems
 
@@ -35,6 +36,7 @@ class ThreatsPlugin(Plugin):
     creature_schema = _FRAGMENT["creature"]
     scene_schema = _FRAGMENT["scene"]
     defs = _FRAGMENT["$defs"]
+    hook_reads = ("threats", "transforms.pos")  # its Dangers entry (`senses.dangers`)
 
     def problems(self, scene: Mapping[str, Any]) -> list[tuple[tuple[str | int, ...], str]]:
         return threat_problems(scene)
@@ -79,7 +81,16 @@ class ThreatsPlugin(Plugin):
         return {"threats": world.resource(ThreatData).store}  # copied by snapshots
 
     def build(self, app: App) -> None:
-        """Its drawing, HUD sections and clicks (`ecs_tentacles.render.registries`)."""
+        """Its dangers (`ecs_tentacles.senses`) and its spheres (`render.registries`)."""
+        app.add(
+            Dangers,
+            DangerSource(
+                sense=lambda world: world.resource(ThreatData).sources(world),
+                drop=lambda world, at, name: world.resource(ThreatData).drop(world, at, name),
+                remove=lambda world, threat: world.resource(ThreatData).remove(world, threat),
+                placed=lambda world: world.resource(ThreatData).entities(world),
+            ),
+        )
         app.add(Spheres, self._spheres)
 
     def _spheres(self, world: Host) -> list[Marker]:

@@ -3,13 +3,13 @@
     "plugins": {"flee": {"distance": 1.5, "run": 1.0}}
 
 Every `interval` seconds the `flee` system (stage decide) measures, for every creature
-at once, the ground distance to every threat (`world.resource(ThreatData).sources`: the scene's
+at once, the ground distance to every danger (`ecs_tentacles.senses.dangers`: the scene's
 keyframed threats and creatures marked `"threat": true`, never a creature's own
 mantle). A creature with threats closer than `distance` gets a goal `run` metres away
 in the direction that leads away from them, each threat weighted by how close it is.
 Creatures out of reach keep whatever goal they had.
 
-Reads: `world.resource(ThreatData)` (positions and owners), CreatureStore (mantle_row, entity),
+Reads: `dangers(world)` (positions and owners), CreatureStore (mantle_row, entity),
 Transform store (mantle positions). Writes: goals, through `world.resource(GoalBook).set`.
 """
 
@@ -24,8 +24,8 @@ from ecs_tentacles.systems.examples import Problem, farther_than_reach, number, 
 from ecs_tentacles.locomotion.goals import GOAL_WRITES, GoalBook
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.scene.defaults import plugin_config
+from ecs_tentacles.senses import dangers
 from ecs_tentacles.system import System
-from ecs_tentacles.threats.data import ThreatData
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
@@ -38,7 +38,8 @@ class Flee(System):
     stage = "decide"
     after = ("goals",)
     before = ("tentacle_selection",)
-    reads = ("threats.pos", "transforms.pos", "creatures.entity", "creatures.mantle_row")
+    calls_hooks = True  # the Dangers entries (`senses.dangers`)
+    reads = ("transforms.pos", "creatures.entity", "creatures.mantle_row")
     writes = GOAL_WRITES
 
     def __init__(self, distance: float, run: float, interval: float, goal_radius: float):
@@ -54,7 +55,7 @@ class Flee(System):
     def process(self, world: Host, dt: float) -> None:
         if world.frame % self.every:
             return
-        threats, owners = world.resource(ThreatData).sources(world)
+        threats, owners = dangers(world)
         creatures = world.creatures
         if not len(threats) or not creatures.count:
             return
@@ -75,7 +76,7 @@ class Flee(System):
 class FleePlugin(Plugin):
     name = "flee"
     description = "creatures near a threat crawl away from it"
-    requires = ("locomotion", "threats")
+    requires = ("locomotion",)  # dangers from any plugin (`senses.dangers`), threats or yours
     config_schema = {
         "type": "object",
         "additionalProperties": False,

@@ -1,7 +1,8 @@
 """emotion: fear or aggression that rises near a threat and raises the fur (piloerection).
 
-Threats come from the threats plugin (`world.resource(ThreatData)`: path threats, moved by the
-`threats` system, and creatures marked `threat`); without it nothing frightens. A
+Dangers come from the plugins that make them (`ecs_tentacles.senses.dangers`: the
+threats plugin's path threats, moved by its `threats` system, and creatures marked
+`threat`); without one nothing frightens. A
 creature with an `Emotion` is roused while any threat other than itself is within its
 radius of its mantle. Its emotion follows a critically damped response toward 1
 (roused) or 0 (calm), reaching 90 % in
@@ -11,7 +12,7 @@ first dips (the fur flattens a little, anticipation), before it falls it first s
 Each of the creature's controls gets ``level * control.emotion * fur.piloerection``
 added to its lift and random (clipped to 0..1 by the rig). No emotions: nothing done.
 
-Reads: `world.resource(ThreatData)` (positions), Transform store (mantles of emotional and threat
+Reads: `dangers(world)` (positions), Transform store (mantles of emotional and threat
 creatures), EmotionStore settings and state. Writes: EmotionStore (state, speed, level,
 threatened), ControlStore (drive_lift, drive_random).
 """
@@ -23,8 +24,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ecs_tentacles.fur.stores import FurData
+from ecs_tentacles.senses import dangers
 from ecs_tentacles.system import System
-from ecs_tentacles.threats.data import ThreatData
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
@@ -37,8 +38,8 @@ class EmotionSystem(System):
     stage = "animate"
     after = ("threats",)
     before = ("rig",)
+    calls_hooks = True  # the Dangers entries (`senses.dangers`)
     reads = (
-        "threats",
         "transforms.pos",
         "fur.emotions",
         "fur.sets",
@@ -53,11 +54,7 @@ class EmotionSystem(System):
         e = fur.emotions
         if not len(e):
             return
-        threats = world.get_resource(ThreatData)
-        if threats is not None:
-            sources, owners = threats.sources(world)
-        else:  # the threats plugin is off: nothing frightens anyone
-            sources, owners = np.zeros((0, 3)), np.zeros(0, dtype=np.int64)
+        sources, owners = dangers(world)  # none without a plugin that makes them
         if len(sources):
             here = world.transforms.pos[e.body_row]
             distance = np.linalg.norm(here[:, None, :] - sources[None, :, :], axis=2)

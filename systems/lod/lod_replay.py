@@ -26,7 +26,7 @@ class LodReplay(System):
     after = ("physics",)
     reads = ("physics",)
     writes = ("physics",)
-    calls_hooks = True  # travel_targets
+    calls_hooks = True  # the TravelTargets entries
 
     def setup(self, world: Host) -> None:
         self.replay = ClipReplay(world)

@@ -43,7 +43,7 @@ class Physics(System):
         "transforms.quat",
     )
     writes = ("physics",)
-    calls_hooks = True  # wants_motion
+    calls_hooks = True  # the MotionWants entries
 
     def process(self, world: Host, dt: float) -> None:
         backend = world.physics

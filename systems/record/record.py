@@ -30,7 +30,7 @@ class Record(System):
     """Record the world into a take; `record.take()` returns it."""
 
     name = "record"
-    calls_hooks = True  # the plugins' take hooks
+    calls_hooks = True  # the plugins' TakeTracks entries
     stage = "output"
     # and what the plugins' take tracks sample (their hook_reads: goals, fur guides)
     reads = ("transforms.pos", "transforms.quat", "suckers.attached", "suckers.anchor")

@@ -19,7 +19,7 @@ if TYPE_CHECKING:
 
 class RenderSync(System):
     name = "render"
-    calls_hooks = True  # the plugins' drawing hooks
+    calls_hooks = True  # the plugins' drawing entries
     stage = "output"
     reads = ("transforms.pos", "transforms.quat")
 

@@ -70,10 +70,11 @@ def test_a_run_inside_the_goal_radius_is_refused() -> None:
         World.from_scene(scene)
 
 
-def test_flee_needs_the_threats_plugin() -> None:
+def test_flee_reads_dangers_from_any_plugin_and_without_one_nobody_flees() -> None:
     scene = _scene()
     del scene["threats"]
-    scene["plugins"]["threats"] = False
-    needs = r"plugins\.flee: needs the 'threats' plugin, which is off"
-    with pytest.raises(SceneError, match=needs):
-        World.from_scene(scene)
+    scene["plugins"]["threats"] = False  # fine: dangers may come from any plugin
+    with World.from_scene(scene) as world:
+        world.step(30)
+        book = world.resource(GoalBook)
+        assert all(book.current(world.creature(n)) is None for n in ("west", "east"))
