@@ -95,9 +95,11 @@ class FurPlugin(Plugin):
         together = roused(creatures)
         return [together] if together else []
 
-    # -- sandbox entries (build): GL and ImGui are imported only when a sandbox calls them
+    # -- registry entries (GL and ImGui are imported only when a sandbox calls them) ------
     def build(self, app: App) -> None:
-        """Its drawing, HUD sections and clicks (`ecs_tentacles.render.registries`)."""
+        """Threats and who they rouse bake together (`distributed.registries`); the guides
+        in every take (`take.registries`); strands, markers and the Fur section in the
+        sandbox (`render.registries`)."""
         app.add(ShardGroups, self._shard_groups)
         app.add(TakeTracks, self._take_tracks)
         app.add(RecordingStarts, self._before_recording)

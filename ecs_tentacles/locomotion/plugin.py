@@ -174,10 +174,12 @@ class LocomotionPlugin(Plugin):
             queue.pending = copy.deepcopy(queues[entity])
         world.resource(Navigator).set_state(navigation)
 
-    # -- sandbox entries (build) -------------------------------------------------------
+    # -- registry entries ---------------------------------------------------------------
     def build(self, app: App) -> None:
-        """Its drawing, HUD sections, clicks and undo state (`render.registries`); which
-        creatures it moves and where they go (`physics.registries`)."""
+        """How far creatures crawl and act in a bake (`distributed.registries`); goals
+        reached for `run` (`cli.registries`); the goals track (`take.registries`); paths,
+        goal clicks, sliders and undo in the sandbox (`render.registries`); creatures with
+        a goal stay awake and head for it (`physics.registries`)."""
         app.add(ShardReaches, self._shard_reach)
         app.add(MeetingReaches, self._meeting_reach)
         app.add(RunSummaries, self._run_summary)
