@@ -12,7 +12,7 @@ edit raises `SpawnError` (the sandbox says so and keeps the edit to try again).
 * `Despawned`: creatures removed; undo builds them again where they were, with their
   goals and parameters at the time (`roster_save.entry_now`).
 * `Moved`: a creature dragged or thrown; undo puts it back as it was grabbed.
-* `ThreatDropped`: a danger (a threat) placed from the palette (`senses.placeable`);
+* `ThreatDropped`: a danger (a threat) placed from the palette (`behaviour.placeable`);
   undo takes it away.
 """
 
@@ -24,9 +24,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ecs_tentacles.behaviour import placeable
 from ecs_tentacles.components import Creature
 from ecs_tentacles.roster_save import entry_now
-from ecs_tentacles.senses import placeable
 from ecs_tentacles.spawning import SpawnError, free_spot, place
 
 if TYPE_CHECKING:

@@ -12,7 +12,7 @@
 
 Every one of these is one edit on the sandbox's undo stack (`director.commands`;
 Ctrl+Z, Ctrl+Shift+Z). Reads the sandbox's selection, camera and keys; writes the
-world through `World.spawn` / `despawn`, the dangers' sources (`senses.placeable`) and
+world through `World.spawn` / `despawn`, the dangers' sources (`behaviour.placeable`) and
 the `Director` resource.
 """
 
@@ -25,6 +25,7 @@ import numpy as np
 from imgui_bundle import imgui
 from pyglet.window import key
 
+from ecs_tentacles.behaviour import placeable
 from ecs_tentacles.components import Creature
 from ecs_tentacles.director.commands import Despawned, Moved, Spawned, ThreatDropped
 from ecs_tentacles.director.grab import Grab
@@ -33,7 +34,6 @@ from ecs_tentacles.director.scatter import reach_of, scatter
 from ecs_tentacles.director.state import Director
 from ecs_tentacles.render.gui import Gui
 from ecs_tentacles.render.registries import Panel
-from ecs_tentacles.senses import placeable
 from ecs_tentacles.spawning import SpawnError, creature_entry
 
 log = logging.getLogger("ecs_tentacles.director")

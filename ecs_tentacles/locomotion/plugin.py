@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ecs_tentacles.behaviour import Destinations, Travel
 from ecs_tentacles.build import creature_rng
 from ecs_tentacles.cli.registries import RunSummaries, RunSummary
 from ecs_tentacles.components import Creature, Tentacle
@@ -179,7 +180,8 @@ class LocomotionPlugin(Plugin):
         """How far creatures crawl and act in a bake (`distributed.registries`); goals
         reached for `run` (`cli.registries`); the goals track (`take.registries`); paths,
         goal clicks, sliders and undo in the sandbox (`render.registries`); creatures with
-        a goal stay awake and head for it (`physics.registries`)."""
+        a goal stay awake and head for it (`physics.registries`); behaviours send
+        creatures through its goals (`behaviour.Destinations`)."""
         app.add(ShardReaches, self._shard_reach)
         app.add(MeetingReaches, self._meeting_reach)
         app.add(RunSummaries, self._run_summary)
@@ -191,6 +193,16 @@ class LocomotionPlugin(Plugin):
         app.add(UndoStates, UndoState(self._undo_capture, self._undo_restore))
         app.add(MotionWants, self._wants_motion)
         app.add(TravelTargets, self._travel_targets)
+        app.add(
+            Destinations,
+            Travel(
+                send=lambda world, creature, point, radius: world.resource(GoalBook).set(
+                    creature, point, radius
+                ),
+                stop=lambda world, creature: world.resource(GoalBook).clear(creature),
+                going=lambda world: world.resource(LocomotionStores).creatures.has_goal,
+            ),
+        )
 
     def _lines(self, world: Host, view: RenderView) -> list[Any]:
         from ecs_tentacles.locomotion.render import path_lines

@@ -12,10 +12,10 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ecs_tentacles.behaviour import Dangers, DangerSource
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.render.registries import Marker, Spheres
 from ecs_tentacles.scene.schema import fragment
-from ecs_tentacles.senses import Dangers, DangerSource
 from ecs_tentacles.system import System
 from ecs_tentacles.threats.data import ThreatData, build_threats, mark_creature, threat_problems
 
@@ -36,7 +36,7 @@ class ThreatsPlugin(Plugin):
     creature_schema = _FRAGMENT["creature"]
     scene_schema = _FRAGMENT["scene"]
     defs = _FRAGMENT["$defs"]
-    hook_reads = ("threats", "transforms.pos")  # its Dangers entry (`senses.dangers`)
+    hook_reads = ("threats", "transforms.pos")  # its Dangers entry (`behaviour.dangers`)
 
     def problems(self, scene: Mapping[str, Any]) -> list[tuple[tuple[str | int, ...], str]]:
         return threat_problems(scene)
@@ -81,7 +81,7 @@ class ThreatsPlugin(Plugin):
         return {"threats": world.resource(ThreatData).store}  # copied by snapshots
 
     def build(self, app: App) -> None:
-        """Its dangers (`ecs_tentacles.senses`) and its spheres (`render.registries`)."""
+        """Its dangers (`ecs_tentacles.behaviour`) and its spheres (`render.registries`)."""
         app.add(
             Dangers,
             DangerSource(

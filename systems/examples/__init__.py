@@ -1,9 +1,11 @@
 """Example plugins (not on by default): wander, flee, follow_leader, flock.
 
-Each is one file: a `Plugin` and the stage-`decide` `System` it brings, which writes
-goals (`world.resource(GoalBook)`) every `interval` seconds rather than every frame, so
-strokes can finish. What their config schemas share is here: a number setting, the two re-planning
-settings, and the check that a goal set some distance away is not reached at once.
+Each is one file: a `Plugin` and the stage-`decide` `System` it brings, which sends
+creatures somewhere (`ecs_tentacles.behaviour.travel`: the locomotion plugin's goals,
+though no example names it) every `interval` seconds rather than every frame, so
+strokes can finish. What they share is here: a number setting, the two re-planning
+settings, the check that a goal set some distance away is not reached at once, and the
+columns sending a creature writes (`DESTINATION_WRITES`, what each system declares).
 """
 
 from __future__ import annotations
@@ -15,6 +17,15 @@ from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.scene.defaults import plugin_config
 
 Problem = tuple[tuple[str | int, ...], str]
+
+# the store columns the `Destinations` entry writes when a system sends or stops a
+# creature (the locomotion plugin's goals): a system that calls it declares them
+DESTINATION_WRITES = (
+    "goals",
+    "locomotion.creatures.goal",
+    "locomotion.creatures.has_goal",
+    "locomotion.creatures.goal_radius",
+)
 
 
 def number(low: float, high: float, default: float, description: str) -> dict[str, Any]:

@@ -3,14 +3,15 @@
     "plugins": {"flee": {"distance": 1.5, "run": 1.0}}
 
 Every `interval` seconds the `flee` system (stage decide) measures, for every creature
-at once, the ground distance to every danger (`ecs_tentacles.senses.dangers`: the scene's
+at once, the ground distance to every danger (`ecs_tentacles.behaviour.dangers`: the scene's
 keyframed threats and creatures marked `"threat": true`, never a creature's own
 mantle). A creature with threats closer than `distance` gets a goal `run` metres away
 in the direction that leads away from them, each threat weighted by how close it is.
 Creatures out of reach keep whatever goal they had.
 
 Reads: `dangers(world)` (positions and owners), CreatureStore (mantle_row, entity),
-Transform store (mantle positions). Writes: goals, through `world.resource(GoalBook).set`.
+Transform store (mantle positions). Writes: goals, through `travel(world).send`
+(`ecs_tentacles.behaviour`).
 """
 
 from __future__ import annotations
@@ -19,12 +20,17 @@ from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from ecs_tentacles.systems.examples import Problem, farther_than_reach, number, replanning
+from ecs_tentacles.systems.examples import (
+    DESTINATION_WRITES,
+    Problem,
+    farther_than_reach,
+    number,
+    replanning,
+)
 
-from ecs_tentacles.locomotion.goals import GOAL_WRITES, GoalBook
+from ecs_tentacles.behaviour import dangers, travel
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.scene.defaults import plugin_config
-from ecs_tentacles.senses import dangers
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
@@ -38,9 +44,9 @@ class Flee(System):
     stage = "decide"
     after = ("goals",)
     before = ("tentacle_selection",)
-    calls_hooks = True  # the Dangers entries (`senses.dangers`)
+    calls_hooks = True  # the Dangers entries (`behaviour.dangers`)
     reads = ("transforms.pos", "creatures.entity", "creatures.mantle_row")
-    writes = GOAL_WRITES
+    writes = DESTINATION_WRITES
 
     def __init__(self, distance: float, run: float, interval: float, goal_radius: float):
         self.distance = distance
@@ -70,13 +76,13 @@ class Flee(System):
         fleeing = np.flatnonzero(length > 1e-9)
         goals = mantles[fleeing] + self.run * push[fleeing] / length[fleeing, None]
         for row, goal in zip(fleeing, goals, strict=True):
-            world.resource(GoalBook).set(int(creatures.entity[row]), goal, self.goal_radius)
+            travel(world).send(world, int(creatures.entity[row]), goal, self.goal_radius)
 
 
 class FleePlugin(Plugin):
     name = "flee"
     description = "creatures near a threat crawl away from it"
-    requires = ("locomotion",)  # dangers from any plugin (`senses.dangers`), threats or yours
+    requires = ("locomotion",)  # dangers from any plugin (`behaviour.dangers`), threats or yours
     config_schema = {
         "type": "object",
         "additionalProperties": False,

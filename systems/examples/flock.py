@@ -13,7 +13,7 @@ The weighted sum is a direction; the creature's goal is set `step` metres along 
 A creature with nothing to steer by keeps its goal.
 
 Reads: CreatureStore (mantle_row, entity), Transform store (mantle positions).
-Writes: goals, through `world.resource(GoalBook).set`.
+Writes: goals, through `travel(world).send` (`ecs_tentacles.behaviour`).
 """
 
 from __future__ import annotations
@@ -22,9 +22,15 @@ from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from ecs_tentacles.systems.examples import Problem, farther_than_reach, number, replanning
+from ecs_tentacles.systems.examples import (
+    DESTINATION_WRITES,
+    Problem,
+    farther_than_reach,
+    number,
+    replanning,
+)
 
-from ecs_tentacles.locomotion.goals import GOAL_WRITES, GoalBook
+from ecs_tentacles.behaviour import travel
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.scene.defaults import plugin_config
 from ecs_tentacles.system import System
@@ -50,7 +56,7 @@ class Flock(System):
     after = ("goals",)
     before = ("tentacle_selection",)
     reads = ("transforms.pos", "creatures.entity", "creatures.mantle_row")
-    writes = GOAL_WRITES
+    writes = DESTINATION_WRITES
     state_attributes = ("last",)  # positions at the last plan: velocities after a restore
 
     def __init__(self, config: Mapping[str, Any]):
@@ -99,9 +105,7 @@ class Flock(System):
         steer = np.flatnonzero(np.linalg.norm(direction, axis=1) > 1e-6)
         goals = pos[steer] + self.config["step"] * _unit(direction[steer])
         for row, goal in zip(steer, goals, strict=True):
-            world.resource(GoalBook).set(
-                int(creatures.entity[row]), goal, self.config["goal_radius"]
-            )
+            travel(world).send(world, int(creatures.entity[row]), goal, self.config["goal_radius"])
 
 
 class FlockPlugin(Plugin):

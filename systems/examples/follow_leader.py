@@ -11,8 +11,8 @@ The scene check refuses a leader that is not a creature of the scene, or the cre
 itself.
 
 Reads: CreatureStore (mantle_row, entity), Transform store (mantle positions), the
-scene's `follow` keys (once, at setup). Writes: goals, through `world.resource(GoalBook).set` and
-`world.resource(GoalBook).clear`.
+scene's `follow` keys (once, at setup). Writes: goals, through `travel(world).send` and
+`.stop` (`ecs_tentacles.behaviour`).
 """
 
 from __future__ import annotations
@@ -21,11 +21,10 @@ from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from ecs_tentacles.systems.examples import Problem, number, replanning
+from ecs_tentacles.systems.examples import DESTINATION_WRITES, Problem, number, replanning
 
+from ecs_tentacles.behaviour import travel
 from ecs_tentacles.components import Creature
-from ecs_tentacles.locomotion.goals import GOAL_WRITES, GoalBook
-from ecs_tentacles.locomotion.stores import LocomotionStores
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.scene.defaults import plugin_config
 from ecs_tentacles.system import System
@@ -50,7 +49,7 @@ class FollowLeader(System):
         "creatures.entity",
         "creatures.mantle_row",
     )
-    writes = GOAL_WRITES
+    writes = DESTINATION_WRITES
 
     def __init__(self, gap: float, interval: float, goal_radius: float):
         self.gap = gap
@@ -82,16 +81,14 @@ class FollowLeader(System):
         gap = np.linalg.norm(ahead, axis=1)
         behind = gap > self.gap + self.goal_radius
         goals = mantles[self.leaders] - self.gap * ahead / np.maximum(gap, 1e-9)[:, None]
-        book, has_goal = (
-            world.resource(GoalBook),
-            world.resource(LocomotionStores).creatures.has_goal,
-        )
+        way = travel(world)
+        going = way.going(world)
         for row, goal, far in zip(self.followers, goals, behind, strict=True):
             entity = int(creatures.entity[row])
             if far:
-                book.set(entity, goal, self.goal_radius)
-            elif has_goal[row]:
-                book.clear(entity)
+                way.send(world, entity, goal, self.goal_radius)
+            elif going[row]:
+                way.stop(world, entity)
 
 
 class FollowLeaderPlugin(Plugin):

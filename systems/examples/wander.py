@@ -9,7 +9,8 @@ creature (`creature_rng` of the world's seed and the creature's name): a run rep
 exactly, and a creature draws the same goals whichever other creatures exist.
 
 Reads: CreatureStore (has_goal, mantle_row), Transform store (mantle positions).
-Writes: goals, through `world.resource(GoalBook).set` (only for creatures that have none).
+Writes: goals, through `travel(world).send` (`ecs_tentacles.behaviour`; only for
+creatures that have none).
 """
 
 from __future__ import annotations
@@ -18,11 +19,16 @@ from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from ecs_tentacles.systems.examples import Problem, farther_than_reach, number, replanning
+from ecs_tentacles.systems.examples import (
+    DESTINATION_WRITES,
+    Problem,
+    farther_than_reach,
+    number,
+    replanning,
+)
 
+from ecs_tentacles.behaviour import travel
 from ecs_tentacles.build import creature_rng
-from ecs_tentacles.locomotion.goals import GOAL_WRITES, GoalBook
-from ecs_tentacles.locomotion.stores import LocomotionStores
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.scene.defaults import plugin_config
 from ecs_tentacles.system import System
@@ -45,7 +51,7 @@ class Wander(System):
         "creatures.entity",
         "creatures.mantle_row",
     )
-    writes = GOAL_WRITES
+    writes = DESTINATION_WRITES
     state_attributes = ("streams",)  # each creature's generator: snapshots repeat exactly
 
     def __init__(self, radius: float, interval: float, goal_radius: float):
@@ -75,7 +81,7 @@ class Wander(System):
         if world.frame % self.every:
             return
         creatures = world.creatures
-        idle = np.flatnonzero(~world.resource(LocomotionStores).creatures.has_goal)
+        idle = np.flatnonzero(~travel(world).going(world))
         if not len(idle):
             return
         # two uniform draws per idle creature, each from its own stream
@@ -85,7 +91,7 @@ class Wander(System):
         mantles = world.transforms.pos[creatures.mantle_row[idle], :2]
         goals = mantles + distance[:, None] * np.column_stack([np.cos(angle), np.sin(angle)])
         for row, goal in zip(idle, goals, strict=True):
-            world.resource(GoalBook).set(int(creatures.entity[row]), goal, self.goal_radius)
+            travel(world).send(world, int(creatures.entity[row]), goal, self.goal_radius)
 
 
 class WanderPlugin(Plugin):

@@ -1,6 +1,6 @@
 """emotion: fear or aggression that rises near a threat and raises the fur (piloerection).
 
-Dangers come from the plugins that make them (`ecs_tentacles.senses.dangers`: the
+Dangers come from the plugins that make them (`ecs_tentacles.behaviour.dangers`: the
 threats plugin's path threats, moved by its `threats` system, and creatures marked
 `threat`); without one nothing frightens. A
 creature with an `Emotion` is roused while any threat other than itself is within its
@@ -23,8 +23,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ecs_tentacles.behaviour import dangers
 from ecs_tentacles.fur.stores import FurData
-from ecs_tentacles.senses import dangers
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
@@ -38,7 +38,7 @@ class EmotionSystem(System):
     stage = "animate"
     after = ("threats",)
     before = ("rig",)
-    calls_hooks = True  # the Dangers entries (`senses.dangers`)
+    calls_hooks = True  # the Dangers entries (`behaviour.dangers`)
     reads = (
         "transforms.pos",
         "fur.emotions",

@@ -1,15 +1,24 @@
-"""What creatures sense beyond their own bodies: the dangers of the world, through a
-registry (`ecs_tentacles.registry`) that plugins fill in `build(app)`.
+"""What behaviours read and drive, whoever implements it: the dangers creatures fear and
+where creatures are sent, through registries (`ecs_tentacles.registry`) that plugins
+fill in `build(app)`. Behaviours (fur's emotion, the example plugins, the director's
+palette) use these and never name the plugin behind them.
 
     positions, owners = dangers(world)      # every danger now: (n, 3), (n,) entities
+    travel(world).send(world, creature, (x, y), 0.2)   # go there (arrive within 0.2 m)
 
 A `Dangers` entry is a `DangerSource`: `sense(world)` -> the positions (n, 3) of the
 dangers it knows now and the creature entity each one is (-1: none; a creature never
 fears itself); optionally `drop(world, position, name)` -> the entity of a danger
 placed there from now on, `remove(world, entity)` and `placed(world)` -> {entity: name}
-of the dangers placed so (the sandbox's palette and its undo). Behaviours that react to
-danger (fur's emotion, the flee example) read `dangers(world)` and never name the
-plugin that makes them; without any entry nothing frightens anyone.
+of the dangers placed so (the sandbox's palette and its undo). Without any entry
+nothing frightens anyone.
+
+A `Destinations` entry is a `Travel`: `send(world, creature, point, radius)` (crawl to
+`point`, x, y[, z], arriving within `radius` m, instead of wherever it was going),
+`stop(world, creature)` (nowhere to go) and `going(world)` (bool per CreatureStore row:
+has somewhere to go). The locomotion plugin adds one (its goals). A system that sends
+creatures declares the store columns that writes as its own writes (the examples:
+`systems/examples`, `DESTINATION_WRITES`).
 """
 
 from __future__ import annotations
@@ -53,3 +62,24 @@ def dangers(world: Host) -> tuple[np.ndarray, np.ndarray]:
 def placeable(world: Host) -> DangerSource | None:
     """The first source that can place dangers (`drop`), or None."""
     return next((s for s in world.registry(Dangers) if s.drop is not None), None)
+
+
+@dataclass(frozen=True)
+class Travel:
+    """How a plugin sends creatures toward points (the locomotion plugin: goals)."""
+
+    send: Callable[[Host, int, Sequence[float], float], object]  # what it returns is unused
+    stop: Callable[[Host, int], None]
+    going: Callable[[Host], np.ndarray]
+
+
+class Destinations(Registry[Travel]):
+    """Who moves creatures toward points."""
+
+
+def travel(world: Host) -> Travel:
+    """The world's first `Travel` (`Destinations` entry); LookupError without one."""
+    found = next(iter(world.registry(Destinations)), None)
+    if found is None:
+        raise LookupError("no plugin sends creatures anywhere (turn the locomotion plugin on)")
+    return found

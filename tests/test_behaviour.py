@@ -1,4 +1,4 @@
-"""Dangers (`ecs_tentacles.senses`): whoever makes them, whoever fears them. A user's
+"""Dangers (`ecs_tentacles.behaviour`): whoever makes them, whoever fears them. A user's
 plugin's danger makes the flee example run with the threats plugin off; sources join;
 without any, nothing is dangerous."""
 
@@ -8,11 +8,12 @@ import json
 
 import numpy as np
 
+from ecs_tentacles.behaviour import Dangers, DangerSource, dangers, placeable
+from ecs_tentacles.components import Creature
 from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.registry import App
 from ecs_tentacles.scene.load import bundled_scene
-from ecs_tentacles.senses import Dangers, DangerSource, dangers, placeable
 from ecs_tentacles.world import World
 
 SPOT = np.array([[-0.4, 0.0, 0.0]])  # just east of "west" (at -0.8, 0)
@@ -59,3 +60,30 @@ def test_sources_join_and_the_threats_plugin_places_and_removes() -> None:
         assert source.placed(world)[entity] == "moth" and len(dangers(world)[0]) == 3
         source.remove(world, entity)
         assert len(dangers(world)[0]) == 2
+
+
+def test_travel_sends_and_stops_a_creature_through_locomotions_goals() -> None:
+    from ecs_tentacles.behaviour import travel
+
+    with World.from_scene(_scene(False), plugins={"threats": False}) as world:
+        west = world.creature("west")
+        row = world.component(west, Creature).row
+        way = travel(world)
+        assert not way.going(world)[row]
+        way.send(world, west, (-3.0, 1.0), 0.25)
+        assert way.going(world)[row]
+        goal = world.resource(GoalBook).positions(west)[0]
+        np.testing.assert_allclose(goal[:2], [-3.0, 1.0])
+        way.stop(world, west)
+        assert not way.going(world)[row] and world.resource(GoalBook).current(west) is None
+
+
+def test_without_locomotion_travel_says_so_in_one_line() -> None:
+    import pytest
+
+    from ecs_tentacles.behaviour import travel
+
+    with World.from_scene({"version": 1, "creatures": [{}]}, plugins={"locomotion": False,
+                          "suckers": False}) as world:  # fmt: skip
+        with pytest.raises(LookupError, match=r"^no plugin sends creatures anywhere"):
+            travel(world)
