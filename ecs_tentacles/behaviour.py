@@ -81,5 +81,7 @@ def travel(world: Host) -> Travel:
     """The world's first `Travel` (`Destinations` entry); LookupError without one."""
     found = next(iter(world.registry(Destinations)), None)
     if found is None:
-        raise LookupError("no plugin sends creatures anywhere (turn the locomotion plugin on)")
+        raise LookupError(
+            "no plugin sends creatures anywhere (none of those on adds a Destinations entry)"
+        )
     return found

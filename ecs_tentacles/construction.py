@@ -27,7 +27,7 @@ from ecs_tentacles.ground import FLAT, Ground
 
 # metres between a creature placed on terrain and the surface (it settles in the first
 # steps); the plane needs none: its creatures start exactly resting
-TERRAIN_CLEARANCE = 0.003
+GROUND_CLEARANCE = 0.003
 
 
 def link_scales(links: int, end_scale: float) -> np.ndarray:
@@ -146,7 +146,7 @@ def creature_layout(spec: dict[str, Any], ground: Ground = FLAT) -> CreatureLayo
 
     A 2-d `position` rests the creature on `ground`: on the plane its thickest first
     link touches z = 0; on terrain the whole body is raised until its lowest point
-    rests on the surface under it (plus `TERRAIN_CLEARANCE`).
+    rests on the surface under it (plus `GROUND_CLEARANCE`).
     """
     mantle, tentacles = spec["mantle"], spec["tentacles"]
     position = [float(v) for v in spec["position"]]
@@ -169,7 +169,7 @@ def creature_layout(spec: dict[str, Any], ground: Ground = FLAT) -> CreatureLayo
         shapes=shapes,
     )
     if len(spec["position"]) == 2 and ground.heightfield is not None:
-        lift = ground.lift(*_resting_points(layout)) + TERRAIN_CLEARANCE
+        lift = ground.lift(*_resting_points(layout)) + GROUND_CLEARANCE
         layout = replace(layout, origin=layout.origin + [0.0, 0.0, lift])
     return layout
 

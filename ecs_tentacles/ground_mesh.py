@@ -33,12 +33,10 @@ class StaticMesh:
 
 
 def ground_meshes(ground: Ground) -> tuple[StaticMesh | None, StaticMesh | None]:
-    """(terrain, solids) meshes of `ground`; None where it has none."""
-    terrain = None
-    if ground.heightfield is not None:
-        terrain = heightfield_mesh(ground)
+    """(heightfield, solids) meshes of `ground`; None where it has none."""
+    field = heightfield_mesh(ground) if ground.heightfield is not None else None
     solids = [solid_mesh(s) for s in ground.solids]
-    return terrain, (merge(solids) if solids else None)
+    return field, (merge(solids) if solids else None)
 
 
 def heightfield_mesh(ground: Ground) -> StaticMesh:

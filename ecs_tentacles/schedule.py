@@ -272,11 +272,11 @@ def _unordered_writers(
             if other in by_label and by_label[other].stage == slot.stage:
                 edges[slot.label].add(other)
 
-    def reaches(start: str, goal: str) -> bool:
+    def reaches(start: str, end: str) -> bool:
         stack, seen = [start], set()
         while stack:
             here = stack.pop()
-            if here == goal:
+            if here == end:
                 return True
             if here not in seen:
                 seen.add(here)
