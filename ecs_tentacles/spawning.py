@@ -38,6 +38,7 @@ import numpy as np
 from ecs_tentacles.build import build_creature
 from ecs_tentacles.components import Creature, Tentacle
 from ecs_tentacles.construction import CreatureLayout, creature_layout
+from ecs_tentacles.events import CreatureDespawned, CreatureSpawned, SuckerReleased
 from ecs_tentacles.ground import ground_of
 from ecs_tentacles.mathutil import quat_rotate
 from ecs_tentacles.plugin import calling
@@ -251,13 +252,7 @@ def place(world: World, entry: dict[str, Any], moved_to: tuple[float, ...] | Non
     }
     world.creature_specs[entity] = entry
     _tell(world, RosterChange(entity, spawned=True, index=index, added=added))
-    world.events.emit(
-        "creature_spawned",
-        world=world,
-        creature=entity,
-        creature_name=entry["name"],
-        moved_to=moved_to,
-    )
+    world.events.emit(CreatureSpawned(world, entity, entry["name"], moved_to))
     return entity
 
 
@@ -275,7 +270,7 @@ def despawn(world: World, entity: int) -> None:
     for row in dead["suckers"][suckers.attached[dead["suckers"]]].tolist():  # let go first
         suckers.attached[row] = False
         sucker = int(suckers.entity[row])
-        world.events.emit("sucker_released", world=world, sucker=sucker, reason="despawn")
+        world.events.emit(SuckerReleased(world, sucker, "despawn"))
     owned = _row_entities(world, dead)  # read before the rows go
     moved = {key: world.stores[key].remove(rows) for key, rows in dead.items() if len(rows)}
     for store in world.stores.values():
@@ -286,7 +281,7 @@ def despawn(world: World, entity: int) -> None:
     world.physics.remove_creature(world, entity, moved)
     world.creature_specs.pop(entity, None)
     _tell(world, RosterChange(entity, spawned=False, index=index, moved=moved))
-    world.events.emit("creature_despawned", world=world, creature=entity, creature_name=name)
+    world.events.emit(CreatureDespawned(world, entity, name))
 
 
 def _owned_rows(world: World, creature: Creature) -> dict[str, np.ndarray]:

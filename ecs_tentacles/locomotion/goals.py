@@ -18,6 +18,7 @@ import numpy as np
 from ecs_tentacles.components import Creature
 from ecs_tentacles.ground import ground_of
 from ecs_tentacles.locomotion.components import Goal
+from ecs_tentacles.locomotion.events import GoalReached
 from ecs_tentacles.locomotion.stores import LocomotionStores
 
 if TYPE_CHECKING:
@@ -118,9 +119,7 @@ class GoalBook:
             return
         position = self._world.component(goal, Goal).position.copy()
         self.remove(goal)
-        self._world.events.emit(
-            "goal_reached", world=self._world, creature=creature, goal=goal, position=position
-        )
+        self._world.events.emit(GoalReached(self._world, creature, goal, position))
 
     def _sync(self, creature: int) -> None:
         self.version += 1

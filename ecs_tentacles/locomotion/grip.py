@@ -20,6 +20,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ecs_tentacles.components import Sucker
+from ecs_tentacles.events import SuckerReleased
+from ecs_tentacles.locomotion.events import SuckerAttached
 from ecs_tentacles.mathutil import quat_rotate
 
 if TYPE_CHECKING:
@@ -41,9 +43,7 @@ def attach(world: Host, sucker_entity: int) -> None:
         return
     sucker.anchor = sucker_points(world, np.array([sucker.row]))[0]
     sucker.attached = True
-    world.events.emit(
-        "sucker_attached", world=world, sucker=sucker_entity, anchor=sucker.anchor.copy()
-    )
+    world.events.emit(SuckerAttached(world, sucker_entity, sucker.anchor.copy()))
 
 
 def release(world: Host, sucker_entity: int, reason: str = "command") -> None:
@@ -52,4 +52,4 @@ def release(world: Host, sucker_entity: int, reason: str = "command") -> None:
     if not sucker.attached:
         return
     sucker.attached = False
-    world.events.emit("sucker_released", world=world, sucker=sucker_entity, reason=reason)
+    world.events.emit(SuckerReleased(world, sucker_entity, reason))

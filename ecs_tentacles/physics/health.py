@@ -31,6 +31,7 @@ from typing import TYPE_CHECKING
 import mujoco
 import numpy as np
 
+from ecs_tentacles.events import CreatureFrozen, CreatureRecovered, SuckerReleased
 from ecs_tentacles.physics.batch import without_row
 
 if TYPE_CHECKING:
@@ -267,10 +268,10 @@ class HealthCheck:
         for sucker_row in rows[suckers.attached[rows]]:  # core: no feature call
             suckers.attached[sucker_row] = False
             sucker = int(suckers.entity[sucker_row])
-            world.events.emit("sucker_released", world=world, sucker=sucker, reason="recovery")
+            world.events.emit(SuckerReleased(world, sucker, "recovery"))
         creature = int(roster.entity[index])
         self.recoveries += 1
-        world.events.emit("creature_recovered", world=world, creature=creature, cause=cause)
+        world.events.emit(CreatureRecovered(world, creature, cause))
         if len(failures) >= FREEZE_AFTER:
             batch.part(S.mjSTATE_QVEL, row)[:] = 0.0
             roster.frozen[index] = True
@@ -283,4 +284,4 @@ class HealthCheck:
                 FREEZE_WINDOW,
                 cause,
             )
-            world.events.emit("creature_frozen", world=world, creature=creature, cause=cause)
+            world.events.emit(CreatureFrozen(world, creature, cause))
