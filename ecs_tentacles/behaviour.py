@@ -6,6 +6,9 @@ palette) use these and never name the plugin behind them.
     positions, owners = dangers(world)      # every danger now: (n, 3), (n,) entities
     travel(world).send(world, creature, (x, y), 0.2)   # go there (arrive within 0.2 m)
 
+The phases: `DANGERS_MOVED`, `ARRIVALS`, `DESTINATIONS_READ` (schedule sets the plugins
+behind the registries join and behaviours order against).
+
 A `Dangers` entry is a `DangerSource`: `sense(world)` -> the positions (n, 3) of the
 dangers it knows now and the creature entity each one is (-1: none; a creature never
 fears itself); optionally `drop(world, position, name)` -> the entity of a danger
@@ -33,6 +36,14 @@ from ecs_tentacles.registry import Registry
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
+
+# the behaviour phases of a frame, as schedule sets (`System.sets`): what moves dangers,
+# what settles who arrived, what reads where creatures go. A behaviour orders against
+# these, never against another feature's systems: `after = (ARRIVALS,)`,
+# `before = (DESTINATIONS_READ,)` (the example plugins), `after = (DANGERS_MOVED,)` (fur)
+DANGERS_MOVED = "dangers_moved"  # the dangers are where they are this frame
+ARRIVALS = "arrivals"  # creatures that reached where they went have let it go
+DESTINATIONS_READ = "destinations_read"  # where creatures go is read for this frame
 
 
 @dataclass(frozen=True)

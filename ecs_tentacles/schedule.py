@@ -38,6 +38,9 @@ class _Slot:
     stage: str = DEFAULT_STAGE  # the stage it runs in
     after: tuple[str, ...] = ()
     before: tuple[str, ...] = ()
+    # what `after` / `before` mean now: set labels replaced by their members (`_resolve`)
+    order_after: tuple[str, ...] = ()
+    order_before: tuple[str, ...] = ()
 
 
 class Schedule:
@@ -188,6 +191,7 @@ class Schedule:
     # -- resolving -----------------------------------------------------------------------
     def _resolve(self, slots: list[_Slot]) -> None:
         by_label = {s.label: s for s in slots}
+        _expand_sets(slots, by_label)
         _assign_stages(slots, by_label)
         ordered: list[_Slot] = []
         for stage in STAGES:
@@ -205,6 +209,27 @@ class Schedule:
         self._running = [s.system for s in ordered if s.enabled]
 
 
+def _expand_sets(slots: list[_Slot], by_label: dict[str, _Slot]) -> None:
+    """Each slot's `after` / `before` with set labels (`System.sets`) replaced by the
+    systems in the set (itself aside): a feature orders against the labels others
+    export, not against their systems' names. A label is a set or a system, never both."""
+    members: dict[str, list[str]] = {}
+    for slot in slots:
+        for label in slot.system.sets:
+            if label in by_label:
+                raise ScheduleError(
+                    f"system {slot.label!r}: set {label!r} has the name of a system"
+                )
+            members.setdefault(label, []).append(slot.label)
+    for slot in slots:
+        slot.order_after = tuple(
+            n for name in slot.after for n in members.get(name, [name]) if n != slot.label
+        )
+        slot.order_before = tuple(
+            n for name in slot.before for n in members.get(name, [name]) if n != slot.label
+        )
+
+
 def _assign_stages(slots: list[_Slot], by_label: dict[str, _Slot]) -> None:
     """Declared stages as given; the others from the systems they order against."""
     free = [s for s in slots if s.declared is None]
@@ -215,8 +240,12 @@ def _assign_stages(slots: list[_Slot], by_label: dict[str, _Slot]) -> None:
         slot.stage = ""
     for _ in range(len(free) + 1):  # inferred stages can chain; settles in len(free) rounds
         for slot in free:
-            after = [by_label[n].stage for n in slot.after if n in by_label and by_label[n].stage]
-            before = [by_label[n].stage for n in slot.before if n in by_label and by_label[n].stage]
+            after = [
+                by_label[n].stage for n in slot.order_after if n in by_label and by_label[n].stage
+            ]
+            before = [
+                by_label[n].stage for n in slot.order_before if n in by_label and by_label[n].stage
+            ]
             if after:
                 slot.stage = max(after, key=STAGES.index)
             elif before:
@@ -231,8 +260,8 @@ def _order_stage(members: list[_Slot], by_label: dict[str, _Slot]) -> list[_Slot
     inside = {s.label for s in members}
     preds: dict[str, set[str]] = {s.label: set() for s in members}
     for slot in members:
-        for other, slot_first in [(n, False) for n in slot.after] + [
-            (n, True) for n in slot.before
+        for other, slot_first in [(n, False) for n in slot.order_after] + [
+            (n, True) for n in slot.order_before
         ]:
             target = by_label.get(other)
             if target is None:
@@ -265,10 +294,10 @@ def _unordered_writers(
     """(field, first, second) for enabled same-stage writers with no path between them."""
     edges: dict[str, set[str]] = {s.label: set() for s in ordered}
     for slot in ordered:
-        for other in slot.after:
+        for other in slot.order_after:
             if other in by_label and by_label[other].stage == slot.stage:
                 edges[other].add(slot.label)
-        for other in slot.before:
+        for other in slot.order_before:
             if other in by_label and by_label[other].stage == slot.stage:
                 edges[slot.label].add(other)
 

@@ -41,8 +41,11 @@ class System:
 
     name: ClassVar[str] = ""
     stage: ClassVar[str | None] = None  # one of STAGES; None: inferred from after/before
-    after: ClassVar[tuple[str, ...]] = ()
+    after: ClassVar[tuple[str, ...]] = ()  # systems or sets this one runs after
     before: ClassVar[tuple[str, ...]] = ()
+    # labels this system belongs to, that others order against (`after = ("arrivals",)`):
+    # a feature exports its sets (core's behaviour labels: `ecs_tentacles.behaviour`)
+    sets: ClassVar[tuple[str, ...]] = ()
     reads: ClassVar[tuple[str, ...]] = ()  # "store.field" names, e.g. "motors.target"
     writes: ClassVar[tuple[str, ...]] = ()
     # a generic system that calls plugins' hooks or registry entries (physics: MotionWants;

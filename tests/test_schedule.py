@@ -149,3 +149,39 @@ def test_refused_system_leaves_the_schedule_unchanged() -> None:
     with pytest.raises(ScheduleError):
         schedule.add(named("b", after=("a",), before=("a",)))
     assert schedule.names == ["a"] and "b" not in schedule
+
+
+def test_a_system_orders_against_a_set_another_feature_exports() -> None:
+    """`after` / `before` name a set (`System.sets`): every system in it, whatever its
+    name, so a behaviour never names another feature's systems."""
+
+    def member(name: str, sets: tuple[str, ...]) -> System:
+        return type(name, (System,), {"name": name, "sets": sets, "stage": "decide"})()
+
+    def user(name: str, after: tuple[str, ...], before: tuple[str, ...]) -> System:
+        cls = type(name, (System,), {"name": name, "after": after, "before": before})
+        return cls()
+
+    schedule = Schedule()
+    schedule.add(
+        member("pick", ("read",)),
+        user("mine", ("settled",), ("read",)),
+        member("check", ("settled",)),
+        member("also_check", ("settled",)),
+    )
+    assert schedule.names == ["check", "also_check", "mine", "pick"]
+    assert schedule.stage_of("mine") == "decide"  # inferred from the set it runs after
+    with pytest.raises(ScheduleError, match="set 'pick' has the name of a system"):
+        schedule.add(member("odd", ("pick",)))
+    assert "odd" not in schedule.names
+
+
+def test_the_behaviour_phases_order_the_examples_as_their_names_did(
+    make_world: Callable[..., World],
+) -> None:
+    scene = creature_scene(count=3, links=2)
+    scene["plugins"] = {"wander": {}}
+    world = make_world(scene)
+    names = world.schedule.names
+    assert names.index("goals") < names.index("wander") < names.index("tentacle_selection")
+    assert names.index("threats") < names.index("emotion")

@@ -28,7 +28,7 @@ from ecs_tentacles.systems.examples import (
     replanning,
 )
 
-from ecs_tentacles.behaviour import dangers, travel
+from ecs_tentacles.behaviour import ARRIVALS, DESTINATIONS_READ, dangers, travel
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.scene.defaults import plugin_config
 from ecs_tentacles.system import System
@@ -42,8 +42,8 @@ class Flee(System):
 
     name = "flee"
     stage = "decide"
-    after = ("goals",)
-    before = ("tentacle_selection",)
+    after = (ARRIVALS,)
+    before = (DESTINATIONS_READ,)
     calls_hooks = True  # the Dangers entries (`behaviour.dangers`)
     reads = ("transforms.pos", "creatures.entity", "creatures.mantle_row")
     writes = DESTINATION_WRITES

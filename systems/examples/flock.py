@@ -30,7 +30,7 @@ from ecs_tentacles.systems.examples import (
     replanning,
 )
 
-from ecs_tentacles.behaviour import travel
+from ecs_tentacles.behaviour import ARRIVALS, DESTINATIONS_READ, travel
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.scene.defaults import plugin_config
 from ecs_tentacles.system import System
@@ -53,8 +53,8 @@ class Flock(System):
 
     name = "flock"
     stage = "decide"
-    after = ("goals",)
-    before = ("tentacle_selection",)
+    after = (ARRIVALS,)
+    before = (DESTINATIONS_READ,)
     reads = ("transforms.pos", "creatures.entity", "creatures.mantle_row")
     writes = DESTINATION_WRITES
     state_attributes = ("last",)  # positions at the last plan: velocities after a restore

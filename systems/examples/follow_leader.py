@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from ecs_tentacles.systems.examples import DESTINATION_WRITES, Problem, number, replanning
 
-from ecs_tentacles.behaviour import travel
+from ecs_tentacles.behaviour import ARRIVALS, DESTINATIONS_READ, travel
 from ecs_tentacles.components import Creature
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.scene.defaults import plugin_config
@@ -41,8 +41,8 @@ class FollowLeader(System):
 
     name = "follow_leader"
     stage = "decide"
-    after = ("goals",)
-    before = ("tentacle_selection",)
+    after = (ARRIVALS,)
+    before = (DESTINATIONS_READ,)
     reads = (
         "transforms.pos",
         "locomotion.creatures.has_goal",

@@ -27,7 +27,7 @@ from ecs_tentacles.systems.examples import (
     replanning,
 )
 
-from ecs_tentacles.behaviour import travel
+from ecs_tentacles.behaviour import ARRIVALS, DESTINATIONS_READ, travel
 from ecs_tentacles.build import creature_rng
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.scene.defaults import plugin_config
@@ -43,8 +43,8 @@ class Wander(System):
 
     name = "wander"
     stage = "decide"
-    after = ("goals",)  # goals just reached are gone: those creatures are idle now
-    before = ("tentacle_selection",)
+    after = (ARRIVALS,)  # goals just reached are gone: those creatures are idle now
+    before = (DESTINATIONS_READ,)
     reads = (
         "locomotion.creatures.has_goal",
         "transforms.pos",

@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ecs_tentacles.behaviour import dangers
+from ecs_tentacles.behaviour import DANGERS_MOVED, dangers
 from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.system import System
 
@@ -36,7 +36,7 @@ NINETY_PERCENT = 3.8897  # omega * t at which a critically damped step reaches 9
 class EmotionSystem(System):
     name = "emotion"
     stage = "animate"
-    after = ("threats",)
+    after = (DANGERS_MOVED,)
     before = ("rig",)
     calls_hooks = True  # the Dangers entries (`behaviour.dangers`)
     reads = (

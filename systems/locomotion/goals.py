@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ecs_tentacles.behaviour import ARRIVALS
 from ecs_tentacles.locomotion.goals import GOAL_WRITES, GoalBook
 from ecs_tentacles.locomotion.stores import LocomotionStores
 from ecs_tentacles.system import System
@@ -23,6 +24,7 @@ if TYPE_CHECKING:
 class Goals(System):
     name = "goals"
     stage = "decide"
+    sets = (ARRIVALS,)
     reads = (
         "transforms.pos",
         "goals",

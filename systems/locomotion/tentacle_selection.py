@@ -40,6 +40,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ecs_tentacles.behaviour import DESTINATIONS_READ
 from ecs_tentacles.ground import ground_of
 from ecs_tentacles.locomotion.actions import (
     BASE_SECONDS,
@@ -96,6 +97,7 @@ class TentacleSelection(System):
     name = "tentacle_selection"
     stage = "decide"
     after = ("goals",)
+    sets = (DESTINATIONS_READ,)
     reads = (
         "transforms.pos",
         "tentacles.creature_row",

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from ecs_tentacles.behaviour import DANGERS_MOVED
 from ecs_tentacles.system import System
 from ecs_tentacles.threats.data import ThreatData
 from ecs_tentacles.tracks import TrackSet
@@ -20,6 +21,7 @@ if TYPE_CHECKING:
 class ThreatPaths(System):
     name = "threats"
     stage = "animate"
+    sets = (DANGERS_MOVED,)
     reads = ("threats",)  # ThreatData: its paths and store
     writes = ("threats.pos",)
 
