@@ -67,7 +67,7 @@ def bench_math(n: int, repeats: int, dynamic: bool) -> float:
         profile=blend_profile(POINTS)[:, None, None],
     )
     weight = np.full(n, 0.6, dtype=np.float32)
-    scratch = rig_math.Scratch()
+    scratch = rig_math.RigBuffers()
     blocks = [(rows, bind.part(rows)) for rows in (slice(s, s + BLOCK) for s in range(0, n, BLOCK))]
 
     many = rig_math.use_parallel(n)

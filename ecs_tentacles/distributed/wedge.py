@@ -42,7 +42,7 @@ class WedgeError(ValueError):
 
 
 @dataclass(frozen=True)
-class Parameter:
+class WedgeAxis:
     """One `--wedge PATH=VALUES`."""
 
     path: tuple[str | int, ...]
@@ -62,8 +62,8 @@ class Variant:
     scene: dict[str, Any]
 
 
-def parse_parameter(text: str) -> Parameter:
-    """`PATH=VALUES` -> Parameter (WedgeError naming the problem)."""
+def parse_parameter(text: str) -> WedgeAxis:
+    """`PATH=VALUES` -> WedgeAxis (WedgeError naming the problem)."""
     path_text, sep, values_text = text.partition("=")
     if not sep or not path_text or not values_text:
         raise WedgeError(f"argument --wedge: expected PATH=VALUES, got {text!r}")
@@ -88,7 +88,7 @@ def parse_parameter(text: str) -> Parameter:
         values: list[Any] = list(range(low, high + 1))
     else:
         values = [_value(v.strip()) for v in values_text.split(",")]
-    return Parameter(tuple(path), tuple(values))
+    return WedgeAxis(tuple(path), tuple(values))
 
 
 def _value(text: str) -> Any:
@@ -114,7 +114,7 @@ def variant_name(values: dict[str, Any]) -> str:
 
 def variants(
     raw: dict[str, Any],
-    parameters: list[Parameter],
+    parameters: list[WedgeAxis],
     source: str = "",
     *,
     allow_systems: bool = False,

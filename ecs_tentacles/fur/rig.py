@@ -24,7 +24,7 @@ Arrays are float32; vectors are (3, n), one row per axis.
 
 Speed (tools/bench_rig.py): `evaluate` is the per-frame entry point, called block by
 block with one `control_table` (per-control values and the behaviours in use, once a
-frame) and one `Scratch` (work buffers kept between frames). With numba installed
+frame) and one `RigBuffers` (work buffers kept between frames). With numba installed
 (the ``dev`` extra) the kernels of `ecs_tentacles.fur.kernels` do the work, guide by
 guide, on all cores for furs of `PARALLEL_GUIDES` guides or more and serially below
 (numba's thread pool costs small furs more than it saves and competes with the
@@ -46,7 +46,7 @@ from typing import Any
 
 import numpy as np
 
-from ecs_tentacles.fur.scratch import Scratch
+from ecs_tentacles.fur.scratch import RigBuffers
 from ecs_tentacles.fur.vectors import TINY
 from ecs_tentacles.optional_kernels import OptionalKernels
 
@@ -294,7 +294,7 @@ def _kernel_frames(
     k: ModuleType,
     bind: Bind,
     plan: Plan,
-    s: Scratch,
+    s: RigBuffers,
     rotation: np.ndarray,
     position: np.ndarray,
     local: np.ndarray,
@@ -337,7 +337,7 @@ def evaluate(
     position: np.ndarray,
     frames: np.ndarray,
     curves: np.ndarray,
-    scratch: Scratch | None = None,
+    scratch: RigBuffers | None = None,
     parallel: bool | None = None,
 ) -> None:
     """World frames (n, 4, 3) and posed curves (n, points, 3) of every guide, in place.
@@ -347,7 +347,7 @@ def evaluate(
     bodies' poses. `parallel`: the kernels for all cores (default: for a block of
     `PARALLEL_GUIDES` or more; callers going block by block pass the whole fur's).
     """
-    s = Scratch() if scratch is None else scratch
+    s = RigBuffers() if scratch is None else scratch
     plan = values if isinstance(values, Plan) else control_table(values)
     if bind.controls_needed > plan.table.shape[1] or bind.bodies_needed > len(rotation):
         raise IndexError("a guide names a control or a body that the values do not have")
@@ -367,16 +367,16 @@ def local_frames(
     bind: Bind,
     values: ControlValues | Plan,
     out: np.ndarray | None = None,
-    scratch: Scratch | None = None,
+    scratch: RigBuffers | None = None,
 ) -> np.ndarray:
     """Body-local frames (4, 3, n): result axis, up (axis x side), side, and the root.
 
     Give a `Plan` (`control_table(values)`) to share it between blocks of guides and a
-    `Scratch` kept between frames for the kernels' work buffers.
+    `RigBuffers` kept between frames for the kernels' work buffers.
     """
     n = len(bind)
     out = np.empty((4, 3, n), dtype=F32) if out is None else out
-    s = Scratch() if scratch is None else scratch
+    s = RigBuffers() if scratch is None else scratch
     plan = values if isinstance(values, Plan) else control_table(values)
     k = kernels()
     if k is not None:
@@ -409,7 +409,7 @@ def world_frames(
     rotation: np.ndarray,
     position: np.ndarray,
     out: np.ndarray,
-    scratch: Scratch | None = None,
+    scratch: RigBuffers | None = None,
 ) -> np.ndarray:
     """Frames (4, 3, n) to world space, written into `out` (n, 4, 3) for `pose`.
 

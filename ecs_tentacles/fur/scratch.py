@@ -7,7 +7,7 @@ import numpy as np
 F32 = np.float32
 
 
-class Scratch:
+class RigBuffers:
     """Float32 work buffers, made on first use and kept: no allocation per frame.
 
     One scratch serves blocks of guides one after the other (`use(n)` before each), so
@@ -19,7 +19,7 @@ class Scratch:
         self._memory: dict[tuple[str, tuple[int, ...]], np.ndarray] = {}
         self._views: dict[tuple[str, tuple[int, ...], int], np.ndarray] = {}
 
-    def use(self, n: int) -> Scratch:
+    def use(self, n: int) -> RigBuffers:
         """Hand out buffers for n guides from now on."""
         self.n = n
         return self

@@ -31,7 +31,7 @@ from typing import Any
 import numpy as np
 
 from ecs_tentacles.lod.frames import nlerp, quat_power, rotate_z, to_ground, yaw_times
-from ecs_tentacles.lod.record import Recording, forward_poses, one_creature_scene, record
+from ecs_tentacles.lod.record import GaitRecording, forward_poses, one_creature_scene, record
 from ecs_tentacles.mathutil import quat_multiply
 from ecs_tentacles.optional_kernels import OptionalKernels
 
@@ -244,7 +244,9 @@ def _place(
     out_quat[..., 3] += hs * w
 
 
-def cut_loop(rec: Recording, kind: str, loop: tuple[float, float], *, close: bool = True) -> Clip:
+def cut_loop(
+    rec: GaitRecording, kind: str, loop: tuple[float, float], *, close: bool = True
+) -> Clip:
     """The loop of `rec` whose end best matches its start, as a ground-frame `Clip`.
 
     The origin moves from the mantle's first to its last ground point at constant

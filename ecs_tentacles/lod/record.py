@@ -1,4 +1,4 @@
-"""Recording one creature with the full physics: a one-creature world, stepped frame by frame.
+"""GaitRecording one creature with the full physics: a one-creature world, stepped frame by frame.
 
 `one_creature_scene` turns a scene creature entry (a `load_scene(...)["creatures"][i]`
 or a `crowd_scene` entry) into a scene holding that creature alone at the origin,
@@ -8,7 +8,7 @@ state (`_joint_state`, the one place that reads the backend's data) and the body
 poses forward kinematics gives for it (mantle first, then each tentacle's links, the
 order of `model_layout(...).bodies`). Poses come from the recorded qpos, not from the
 Transform store, so a clip's poses and joint state agree exactly (the store lags the
-state by one substep: `Recording.store_lag` says by how much).
+state by one substep: `GaitRecording.store_lag` says by how much).
 """
 
 from __future__ import annotations
@@ -31,7 +31,7 @@ NOT_RECORDED = ("fur",)
 
 
 @dataclass
-class Recording:
+class GaitRecording:
     """Frames of one creature's full simulation; shapes (F, ...), world frame."""
 
     key: tuple[Any, ...]  # the physics morphology key (`model_layout(...).key`)
@@ -63,7 +63,7 @@ def one_creature_scene(
     return scene
 
 
-def record(scene: dict[str, Any], warmup: float, seconds: float) -> Recording:
+def record(scene: dict[str, Any], warmup: float, seconds: float) -> GaitRecording:
     """Build `scene` (one creature), step `warmup` s, then record `seconds` s frame by frame."""
     start = time.perf_counter()
     world = World.from_scene(scene, threads=1, lod=False)  # full physics, whatever the scene says
@@ -87,7 +87,7 @@ def record(scene: dict[str, Any], warmup: float, seconds: float) -> Recording:
     qpos_all = np.array(qpos)
     pos, quat = forward_poses(model, layout.bodies, qpos_all)
     lag = float(np.linalg.norm(pos - np.array(stored), axis=-1).max())
-    return Recording(
+    return GaitRecording(
         layout.key, model, dt, list(layout.bodies), pos, quat, qpos_all, np.array(qvel), lag,
         time.perf_counter() - start,
     )  # fmt: skip

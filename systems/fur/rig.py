@@ -27,7 +27,7 @@ import numpy as np
 from ecs_tentacles.fur.bind import ControlTracks, control_values, make_strands
 from ecs_tentacles.fur.blocks import BindBlocks
 from ecs_tentacles.fur.dynamics import Strands
-from ecs_tentacles.fur.rig import Bind, Scratch, control_table, evaluate, use_parallel
+from ecs_tentacles.fur.rig import Bind, RigBuffers, control_table, evaluate, use_parallel
 from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.fur.vectors import quat_matrices
 from ecs_tentacles.system import System
@@ -55,7 +55,7 @@ class Rig(System):
         self.binds: BindBlocks | None = None
         self.tracks = ControlTracks(TrackSet([]))
         self.strands: Strands | None = None
-        self.scratch = Scratch()  # work buffers, shared by the blocks and kept
+        self.scratch = RigBuffers()  # work buffers, shared by the blocks and kept
         self.parallel = False  # numba's kernels on all cores (large furs only)
         self.track_time: float | None = None  # tracks played at this time, not the world's
         self.play_tracks = True  # False: the tool holds an edit until time moves again

@@ -8,14 +8,14 @@ from pathlib import Path
 import pytest
 
 from ecs_tentacles.cli import main
-from ecs_tentacles.distributed.wedge import Parameter, WedgeError, parse_parameter, variant_name
+from ecs_tentacles.distributed.wedge import WedgeAxis, WedgeError, parse_parameter, variant_name
 from tests.export.conftest import SMALL_SCENE
 
 
 def test_parameters_parse_ranges_lists_and_json_paths() -> None:
-    assert parse_parameter("seed=1..3") == Parameter(("seed",), (1, 2, 3))
+    assert parse_parameter("seed=1..3") == WedgeAxis(("seed",), (1, 2, 3))
     strength = parse_parameter("creatures[0].tentacles.strength=20,25.5")
-    assert strength == Parameter(("creatures", 0, "tentacles", "strength"), (20, 25.5))
+    assert strength == WedgeAxis(("creatures", 0, "tentacles", "strength"), (20, 25.5))
     assert strength.text == "creatures[0].tentacles.strength"
     gait = parse_parameter('creatures[1].locomotion.gait=cyclic,"coordinated"')
     assert gait.values == ("cyclic", "coordinated")

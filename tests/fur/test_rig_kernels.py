@@ -11,7 +11,7 @@ from numpy.testing import assert_allclose, assert_array_equal
 from ecs_tentacles.fur import rig
 from ecs_tentacles.fur.rig import (
     ControlValues,
-    Scratch,
+    RigBuffers,
     control_table,
     evaluate,
     local_frames,
@@ -117,7 +117,7 @@ def test_kernels_match_numpy(
     assert_allclose(local, expected_local, atol=5e-5)
     frames = np.zeros((900, 4, 3), np.float32)
     curves = np.zeros((900, 8, 3), np.float32)
-    evaluate(bind, values, rotation, position, frames, curves, Scratch())
+    evaluate(bind, values, rotation, position, frames, curves, RigBuffers())
     expected_frames, expected_curves = np.zeros_like(frames), np.zeros_like(curves)
     run_numpy(
         monkeypatch, evaluate, bind, values, rotation, position, expected_frames, expected_curves
@@ -140,7 +140,7 @@ def test_worlds_on_two_threads_take_turns_in_the_kernels(kernels_on: None) -> No
         bind, values = binds[index]
         frames = np.zeros((2000, 4, 3), np.float32)
         curves = np.zeros((2000, 8, 3), np.float32)
-        scratch = Scratch()
+        scratch = RigBuffers()
         for _ in range(20):
             evaluate(bind, values, rotation, position, frames, curves, scratch)
         return curves
