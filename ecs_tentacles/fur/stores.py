@@ -17,8 +17,8 @@ from dataclasses import replace
 
 import numpy as np
 
+from ecs_tentacles.keyframes import Channel
 from ecs_tentacles.store import ArrayStore, Field, without_rows
-from ecs_tentacles.tracks import Channel
 
 # The rig's behaviours, in order: a fur switches each on or off (`FurSetStore.enabled`),
 # and a control drives each through its ControlStore field of the same name.

@@ -17,8 +17,8 @@ import numpy as np
 
 from ecs_tentacles.components import RowComponent, RowField, Transform
 from ecs_tentacles.ground import ground_of
+from ecs_tentacles.keyframes import Channel, channels_from_keys
 from ecs_tentacles.store import ArrayStore, Field
-from ecs_tentacles.tracks import Channel, channels_from_keys
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host

@@ -16,8 +16,8 @@ from typing import Any
 from imgui_bundle import imgui
 
 from ecs_tentacles.fur.editor import ATTRIBUTES
+from ecs_tentacles.keyframes import EASINGS
 from ecs_tentacles.render.gui import Gui, same_line_if_fits, text_width
-from ecs_tentacles.tracks import EASINGS
 
 MIN_SPAN = 5.0  # seconds the scrubber shows at least
 TICK = (0.85, 0.2, 0.15, 1.0)  # key markers
