@@ -35,7 +35,7 @@ from typing import TYPE_CHECKING, Any, Literal
 import esper
 import numpy as np
 
-from ecs_tentacles.build import build_creature
+from ecs_tentacles.body import build_creature
 from ecs_tentacles.components import Creature, Tentacle
 from ecs_tentacles.construction import CreatureLayout, creature_layout
 from ecs_tentacles.events import CreatureDespawned, CreatureSpawned, SuckerReleased

@@ -24,7 +24,7 @@ from collections.abc import Collection, Mapping
 from dataclasses import replace
 from typing import Any, Protocol, TypeVar
 
-from ecs_tentacles.build import build_creature
+from ecs_tentacles.body import build_creature
 from ecs_tentacles.host import Host
 from ecs_tentacles.physics.systems import physics_systems
 from ecs_tentacles.plugin import HookFailure, Plugin, SystemsPlugin, calling

@@ -140,7 +140,7 @@ CORE = (
     "ecs_tentacles.settings", "ecs_tentacles.schedule", "ecs_tentacles.system",
     "ecs_tentacles.plugin", "ecs_tentacles.plugin_registry", "ecs_tentacles.store",
     "ecs_tentacles.components",
-    "ecs_tentacles.build", "ecs_tentacles.construction", "ecs_tentacles.physics",
+    "ecs_tentacles.body", "ecs_tentacles.construction", "ecs_tentacles.physics",
     "ecs_tentacles.snapshot", "ecs_tentacles.events", "ecs_tentacles.scene",
     "ecs_tentacles.systems.physics",
 )  # fmt: skip

@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ecs_tentacles.behaviour import Destinations, Travel
-from ecs_tentacles.build import creature_rng
+from ecs_tentacles.body import creature_rng
 from ecs_tentacles.cli.registries import RunSummaries, RunSummary
 from ecs_tentacles.components import Creature, Tentacle
 from ecs_tentacles.construction import tentacle_params

@@ -21,7 +21,7 @@ from __future__ import annotations
 import json
 from typing import TYPE_CHECKING, Any
 
-from ecs_tentacles.build import build_creature
+from ecs_tentacles.body import build_creature
 from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.lod.clips import GaitClips
 from ecs_tentacles.lod.record import one_creature_scene
