@@ -33,7 +33,7 @@ from ecs_tentacles.director.palette import Preset, presets
 from ecs_tentacles.director.scatter import reach_of, scatter
 from ecs_tentacles.director.state import Director
 from ecs_tentacles.render.gui import Gui
-from ecs_tentacles.render.registries import Panel
+from ecs_tentacles.render.registries import Panel, SandboxView
 from ecs_tentacles.spawning import SpawnError, creature_entry
 
 log = logging.getLogger("ecs_tentacles.director")
@@ -47,7 +47,7 @@ class DirectorPanel(Panel):
     title = "Director"
     order = 15  # after the sandbox's own sections and the fur tool, before terrain
 
-    def __init__(self, sandbox: Any):
+    def __init__(self, sandbox: SandboxView):
         self.sandbox = sandbox
         self.presets: list[Preset] = presets(sandbox.scene_dir)
         self.chosen = 0

@@ -25,7 +25,7 @@ from ecs_tentacles.render.rings import CIRCLE, draped, line_segments
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
     from ecs_tentacles.registry import App
-    from ecs_tentacles.render.registries import Panel, RenderView
+    from ecs_tentacles.render.registries import Panel, RenderView, SandboxView
     from ecs_tentacles.system import System
 
 GRAB_RGBA = np.array([1.0, 0.85, 0.2, 1.0])
@@ -50,7 +50,7 @@ class DirectorPlugin(Plugin):
         app.add(Lines, self._lines)
         app.add(Panels, self._panels)
 
-    def _panels(self, sandbox: Any) -> list[Panel]:
+    def _panels(self, sandbox: SandboxView) -> list[Panel]:
         from ecs_tentacles.director.panel import DirectorPanel
 
         return [DirectorPanel(sandbox)]

@@ -26,7 +26,7 @@ from ecs_tentacles.take.registries import RecordingStarts, TakeTracks, TrackSour
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
     from ecs_tentacles.registry import App
-    from ecs_tentacles.render.registries import Panel, RenderView
+    from ecs_tentacles.render.registries import Panel, RenderView, SandboxView
     from ecs_tentacles.roster_change import RosterChange
     from ecs_tentacles.store import ArrayStore
 
@@ -117,7 +117,7 @@ class FurPlugin(Plugin):
 
         return draw_fur(world, view)
 
-    def _panels(self, sandbox: Any) -> list[Panel]:
+    def _panels(self, sandbox: SandboxView) -> list[Panel]:
         from ecs_tentacles.fur.render.furpanel import fur_panels
 
         return fur_panels(sandbox)

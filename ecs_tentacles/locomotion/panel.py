@@ -22,7 +22,7 @@ from imgui_bundle import imgui
 from ecs_tentacles.locomotion.formations import SHAPES, FormationChoice
 from ecs_tentacles.locomotion.params import Locomotion, settable
 from ecs_tentacles.render.gui import Gui, same_line_if_fits, text_width
-from ecs_tentacles.render.registries import Panel
+from ecs_tentacles.render.registries import Panel, SandboxView
 from ecs_tentacles.scene.parameters import Parameter, parameter
 
 
@@ -83,7 +83,7 @@ def knobs() -> tuple[Knob, ...]:
 KNOBS = knobs()
 
 
-def locomotion_panels(sandbox: Any) -> list[Panel]:
+def locomotion_panels(sandbox: SandboxView) -> list[Panel]:
     """The Locomotion and Actions sections for a sandbox."""
     return [LocomotionPanel(sandbox), ActionsPanel(sandbox)]
 
@@ -94,7 +94,7 @@ class LocomotionPanel(Panel):
     title = "Locomotion"
     order = -10  # before the sandbox's own sections
 
-    def __init__(self, sandbox: Any):
+    def __init__(self, sandbox: SandboxView):
         self.sandbox = sandbox  # its world and HUD (the tentacle selector steps the HUD's)
         self.creature: int | None = None
         self.tentacle: int | None = None  # None: all tentacles
@@ -217,7 +217,7 @@ class ActionsPanel(Panel):
     order = 90  # after every other section
     closed = True
 
-    def __init__(self, sandbox: Any):
+    def __init__(self, sandbox: SandboxView):
         self.sandbox = sandbox
         self.creature: int | None = None
 

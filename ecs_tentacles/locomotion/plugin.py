@@ -59,7 +59,7 @@ if TYPE_CHECKING:
 
     from ecs_tentacles.host import Host
     from ecs_tentacles.registry import App
-    from ecs_tentacles.render.registries import Click, Panel, RenderView
+    from ecs_tentacles.render.registries import Click, Panel, RenderView, SandboxView
     from ecs_tentacles.roster_change import RosterChange
     from ecs_tentacles.store import ArrayStore
 
@@ -236,7 +236,7 @@ class LocomotionPlugin(Plugin):
 
         return click_goal(world, click)
 
-    def _panels(self, sandbox: Any) -> list[Panel]:
+    def _panels(self, sandbox: SandboxView) -> list[Panel]:
         from ecs_tentacles.locomotion.panel import locomotion_panels
 
         return locomotion_panels(sandbox)

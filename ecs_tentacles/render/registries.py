@@ -14,7 +14,8 @@ every entry, in plugin order:
 - `FramedPoints`: `entry(world)` -> points (n, 3) that "frame all" keeps in view, or
   None (goals);
 - `Panels`: `entry(sandbox)` -> `Panel`s: HUD sections, their windows and mouse grabs,
-  made once per sandbox and kept across rebuilds and resets;
+  made once per sandbox and kept across rebuilds and resets; `sandbox` is a
+  `SandboxView`, what a panel may use of the sandbox;
 - `Clicks`: `entry(world, click)` -> True when it took the click in the 3D view
   (`Click`; goals are set so); the first to take it ends the offer;
 - `UndoStates`: (`capture(world)`, `restore(world, state)`): what the sandbox's undo
@@ -26,9 +27,11 @@ of pyglet.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import os
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
@@ -36,6 +39,10 @@ from ecs_tentacles.registry import Registry
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
+    from ecs_tentacles.render.hud import Hud
+    from ecs_tentacles.render.renderer import Renderer
+    from ecs_tentacles.render.selection import Selection
+    from ecs_tentacles.world import World
 
 LINE_FLOATS = 7  # a line vertex: x, y, z, r, g, b, a
 
@@ -167,8 +174,31 @@ class FramedPoints(Registry[Callable[["Host"], "np.ndarray | None"]]):
     """Points "frame all" keeps in view besides the creatures."""
 
 
-class Panels(Registry[Callable[[Any], list["Panel"]]]):
-    """HUD sections, made once per sandbox (the entry gets the sandbox)."""
+class SandboxView(Protocol):
+    """What a HUD section (a `Panels` entry, its `Panel`s) sees of the sandbox: the world
+    it draws, the camera and HUD, the window, the keys and mouse, the selection, and
+    rebuilding the world from an edited scene (`render.sandbox.Sandbox` is one)."""
+
+    world: World
+    paused: bool
+    renderer: Renderer
+    hud: Hud
+    window: Any  # the pyglet window (width, height)
+    selection: Selection
+    keys: Any  # pyglet's KeyStateHandler: keys[key.S] is True while S is down
+    scene: str | os.PathLike[str] | dict[str, Any]  # what the world was built from
+    scene_dir: Path | None
+
+    @property
+    def modifiers(self) -> int: ...
+    def ground_point(self, x: float, y: float) -> np.ndarray | None: ...
+    def pick_creature(self, x: float, y: float) -> int | None: ...
+    def select_many(self, creatures: Iterable[int]) -> None: ...
+    def rebuild(self, scene: dict[str, Any]) -> World: ...
+
+
+class Panels(Registry[Callable[[SandboxView], list["Panel"]]]):
+    """HUD sections, made once per sandbox (the entry gets the sandbox's view)."""
 
 
 class Clicks(Registry[Callable[["Host", Click], bool]]):

@@ -27,7 +27,7 @@ import numpy as np
 from imgui_bundle import imgui
 
 from ecs_tentacles.render.gui import Gui, same_line_if_fits, text_width
-from ecs_tentacles.render.registries import Panel
+from ecs_tentacles.render.registries import Panel, SandboxView
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.load import resolve_scene_path
 from ecs_tentacles.scene.save import default_file_name
@@ -41,7 +41,7 @@ class TerrainPanel(Panel):
     order = 20
     closed = True
 
-    def __init__(self, sandbox: Any):
+    def __init__(self, sandbox: SandboxView):
         self.sandbox = sandbox
         self.tool = "none"
         self.size = 0.6  # metres across a new obstacle

@@ -32,7 +32,7 @@ from ecs_tentacles.terrain.solids import obstacle_problems
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
     from ecs_tentacles.registry import App
-    from ecs_tentacles.render.registries import Panel
+    from ecs_tentacles.render.registries import Panel, SandboxView
 
 _FRAGMENT = fragment("ecs_tentacles.terrain", "terrain")
 SINK_TOLERANCE = 0.001  # metres a 3-d placed creature may start inside the heightfield
@@ -70,7 +70,7 @@ class TerrainPlugin(Plugin):
         """Its drawing, HUD sections and clicks (`ecs_tentacles.render.registries`)."""
         app.add(Panels, self._panels)
 
-    def _panels(self, sandbox: Any) -> list[Panel]:
+    def _panels(self, sandbox: SandboxView) -> list[Panel]:
         from ecs_tentacles.terrain.panel import TerrainPanel
 
         return [TerrainPanel(sandbox)]

@@ -26,7 +26,7 @@ from ecs_tentacles.fur.render.timeline import Timeline
 from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.mathutil import quat_rotate
 from ecs_tentacles.render.gui import Gui, same_line_if_fits, text_width
-from ecs_tentacles.render.registries import Panel
+from ecs_tentacles.render.registries import Panel, SandboxView
 
 PICK_PIXELS = 14  # a click this close to a control's marker picks it
 
@@ -69,7 +69,7 @@ def choice(gui: Gui, name: str, options: tuple[str, ...], current: int) -> tuple
     return changed, chosen
 
 
-def fur_panels(sandbox: Any) -> list[Panel]:
+def fur_panels(sandbox: SandboxView) -> list[Panel]:
     """The fur tool for a sandbox whose scene has fur (none otherwise)."""
     scene = sandbox.world.scene
     if scene is None or not any("fur" in c for c in scene["creatures"]):
@@ -82,12 +82,13 @@ class FurPanel(Panel):
 
     title = "Fur"
 
-    def __init__(self, sandbox: Any):
+    def __init__(self, sandbox: SandboxView):
         self.sandbox = sandbox
         self.editor = FurEditor(sandbox.world, sandbox.rebuild)
         self.new_name, self.new_count, self.new_shape = "control", 1, 0
         self.new_colour, self.new_mirror = [0.2, 0.7, 1.0], 0
-        self.save_path = f"{sandbox.world.scene.get('name', 'scene')}_fur.json"  # in the cwd
+        name = (sandbox.world.scene or {}).get("name", "scene")
+        self.save_path = f"{name}_fur.json"  # in the working folder
         self.message = ""
         self.dragging = False
         self.timeline = Timeline(sandbox, self)
@@ -141,7 +142,7 @@ class FurPanel(Panel):
         (the timeline scrubs or plays), so it can be keyed.
         """
         world = self.sandbox.world
-        rig = world.schedule["rig"]
+        rig: Any = world.schedule["rig"]  # the fur rig system: play_tracks pins its clock
         rig.play_tracks = not edit if self.sandbox.paused else True
         if self.sandbox.paused and len(world.resource(FurData).guides):
             rig.process(world, world.settings.dt)

@@ -18,6 +18,7 @@ from imgui_bundle import imgui
 from ecs_tentacles.fur.editor import ATTRIBUTES
 from ecs_tentacles.keyframes import EASINGS
 from ecs_tentacles.render.gui import Gui, same_line_if_fits, text_width
+from ecs_tentacles.render.registries import SandboxView
 
 MIN_SPAN = 5.0  # seconds the scrubber shows at least
 TICK = (0.85, 0.2, 0.15, 1.0)  # key markers
@@ -26,7 +27,7 @@ TICK = (0.85, 0.2, 0.15, 1.0)  # key markers
 class Timeline:
     """The timeline window over a sandbox and its fur panel."""
 
-    def __init__(self, sandbox: Any, panel: Any):
+    def __init__(self, sandbox: SandboxView, panel: Any):
         self.sandbox = sandbox
         self.panel = panel
         self.attribute = ATTRIBUTES.index("lift")
@@ -42,11 +43,15 @@ class Timeline:
         keys = self.panel.editor.key_times()
         return max(MIN_SPAN, self.sandbox.world.time, keys[-1] if keys else 0.0)
 
+    def _rig(self) -> Any:
+        """The running rig system (its `track_time` pins the tracks' clock)."""
+        return self.sandbox.world.schedule["rig"]
+
     def scrub(self, time: float) -> None:
         """Pause and show the fur at `time`."""
         self.sandbox.paused = True
         self.scrubbed = max(0.0, float(time))
-        self.sandbox.world.schedule["rig"].track_time = self.scrubbed
+        self._rig().track_time = self.scrubbed
         self.panel.refresh_rig()  # time moved: the tracks play again
 
     def play(self, playing: bool) -> None:
@@ -54,7 +59,7 @@ class Timeline:
         self.sandbox.paused = not playing
         if playing:
             self.scrubbed = None
-            self.sandbox.world.schedule["rig"].track_time = None
+            self._rig().track_time = None
 
     def set_key(self) -> None:
         editor = self.panel.editor
