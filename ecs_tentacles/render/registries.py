@@ -179,16 +179,20 @@ class SandboxView(Protocol):
     it draws, the camera and HUD, the window, the keys and mouse, the selection, and
     rebuilding the world from an edited scene (`render.sandbox.Sandbox` is one)."""
 
-    world: World
+    @property
+    def world(self) -> World: ...
+
     paused: bool
     renderer: Renderer
     hud: Hud
     window: Any  # the pyglet window (width, height)
     selection: Selection
     keys: Any  # pyglet's KeyStateHandler: keys[key.S] is True while S is down
-    scene: str | os.PathLike[str] | dict[str, Any]  # what the world was built from
-    scene_dir: Path | None
 
+    @property
+    def scene(self) -> str | os.PathLike[str] | dict[str, Any]: ...  # the world's source
+    @property
+    def scene_dir(self) -> Path | None: ...
     @property
     def modifiers(self) -> int: ...
     def ground_point(self, x: float, y: float) -> np.ndarray | None: ...

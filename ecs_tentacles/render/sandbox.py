@@ -1,7 +1,10 @@
 """The sandbox: a window (or an off-screen one) where players watch, click and tune.
 
-Physics runs at the scene's fixed frame rate with its own accumulator; drawing
-happens at display rate and interpolates between the last two physics frames.
+The window side of a session (`render.session.SandboxSession`: the world, rebuilt and
+reset, stepped at the scene's fixed rate with its own accumulator, saved and restored,
+its level of detail steered): drawing happens at display rate and interpolates between
+the last two physics frames; the sandbox turns the mouse and keys into the session's
+calls and the panels' (`render.registries.SandboxView` is what panels see of it).
 
 Each frame's picture (drawn into the off-screen target, shown, kept as a PNG or an
 MP4) is `render.sandbox_picture`. The mouse and the keys are `render.sandbox_input`
@@ -10,7 +13,7 @@ as undoable edits, the HUD's panels seeing presses and keys first, the key map).
 
 Level of detail (`world.lod`): before every physics frame the sandbox tells it the
 selected creatures (they run full) and, unless a focus is pinned (`focus=`, `play
---focus`, or the scene's `physics.lod.focus`), a focus of `FOCUS_RADIUS` m around the
+--focus`, or the scene's `physics.lod.focus`), a focus of `session.FOCUS_RADIUS` m around the
 camera's target: the creatures there run full and the others at most reduced (the
 full budget is not filled with creatures the camera is not on: a crowd framed whole
 then keeps real time), so what you look at runs full. Headless runs (`play
@@ -57,21 +60,15 @@ from ecs_tentacles.render.sandbox_input import SandboxInput
 from ecs_tentacles.render.sandbox_picture import SandboxPicture
 from ecs_tentacles.render.scripts import Scripts
 from ecs_tentacles.render.selection import Selection
+from ecs_tentacles.render.session import SandboxSession
 from ecs_tentacles.render.undo import UndoStack
-from ecs_tentacles.roster_save import save_roster
-from ecs_tentacles.scene.errors import SceneError
-from ecs_tentacles.scene.save import default_file_name
-from ecs_tentacles.snapshot import SnapshotMismatch
-from ecs_tentacles.system import SystemFailure
 from ecs_tentacles.world import World
 
 if TYPE_CHECKING:
     from ecs_tentacles.snapshot import Snapshot
 
 FRAME_EASE = 0.08  # share of the way to the new framing a video frame moves (frame-all)
-MAX_CATCH_UP = 0.25  # seconds of physics to catch up at most per display frame
 DISPLAY_HZ = 60
-FOCUS_RADIUS = 1.5  # m around the camera's target where creatures must run full physics
 
 
 def scene_palette(scene: dict[str, Any] | None) -> str:
@@ -102,23 +99,26 @@ class Sandbox(SandboxPicture):
         `threads` step the physics (None: one per core); `palette` colours the creatures
         ("natural" or "debug": `ecs_tentacles.colours`; None: the scene's `render.palette`,
         natural if it says none)."""
-        self.threads = threads
-        self.scene, self.seed, self.allow_systems = scene, seed, allow_systems
-        self.lod, self.focus = lod, focus
         self.headless = headless
         self.window = pyglet.window.Window(
             width, height, caption="ecs_tentacles", visible=not headless, vsync=False
         )
-        self.scene_dir: Path | None = None
-        self.world = self._build(scene)
-        self.scene_dir = self.world.scene_dir  # plugin files of an edited (dict) scene
+        # the simulation (world, rebuild, reset, stepping, saves): `render.session`
+        self.session = SandboxSession(
+            scene,
+            seed=seed,
+            allow_systems=allow_systems,
+            lod=lod,
+            focus=focus,
+            threads=threads,
+            say=lambda ok, text: self.scripts.say(ok, text),
+        )
         self.hud = Hud(self.window, self.world, visible=hud)
         self.hud.label_at = self.creature_labels
         self.hud.selection_label = self.selected_label
         self.scripts = Scripts(self.window)
         self.hud.windows.append(self.scripts.draw)
         self.hud.sections.append(("View", self._view_section))
-        self.paused = False
         self.selection = Selection()
         self.panels: dict[str, list[Panel]] = {}  # each plugin's HUD sections, by plugin key
         self.camera_choice: CameraChoice | None = None  # `aim`'s, kept across resets
@@ -129,11 +129,35 @@ class Sandbox(SandboxPicture):
         self.window.push_handlers(self)  # (on_draw)
         self.window.push_handlers(self.input)
         self.window.push_handlers(self.hud.gui)  # the GUI sees every event first
-        self.accumulator = 0.0
         self._start_picture()
         self.keys = key.KeyStateHandler()  # which keys are down (panels: `keys[key.S]`)
         self.window.push_handlers(self.keys)
-        self.saved_state: Snapshot | None = None
+
+    # -- the session's state, as panels and scripts read it -----------------------------
+    @property
+    def scene(self) -> str | os.PathLike[str] | dict[str, Any]:
+        """What the world was built from (a file, a bundled name or an edited scene)."""
+        return self.session.scene
+
+    @property
+    def scene_dir(self) -> Path | None:
+        return self.session.scene_dir
+
+    @property
+    def focus(self) -> tuple[float, float, float] | None:
+        return self.session.focus
+
+    @property
+    def paused(self) -> bool:
+        return self.session.paused
+
+    @paused.setter
+    def paused(self, value: bool) -> None:
+        self.session.paused = value
+
+    @property
+    def saved_state(self) -> Snapshot | None:
+        return self.session.saved_state
 
     def aim(self, choice: CameraChoice | None) -> None:
         """Put the camera where `choice` says (`play --camera`), now and after a reset;
@@ -214,10 +238,7 @@ class Sandbox(SandboxPicture):
         """Rebuild the world from an edited scene; the camera and the selection stay."""
         selected = self.renderer.selected
         name = None if selected is None else self.world.component(selected, Creature).name
-        self.world.close()
-        self.saved_state = None  # a snapshot belongs to the world it came from
-        self.scene = scene
-        self.world = self._build(scene)
+        self.session.rebuild(scene)
         self.renderer.set_world(self.world)
         self._add_sandbox_plugins()
         self.hud.world = self.world
@@ -226,30 +247,14 @@ class Sandbox(SandboxPicture):
         self.select(self.world.creature(name) if name is not None else None)
         return self.world
 
-    def _build(self, scene: str | os.PathLike[str] | dict[str, Any]) -> World:
-        world = World.from_scene(
-            scene,
-            seed=self.seed,
-            allow_systems=self.allow_systems,
-            scene_dir=self.scene_dir,
-            lod=self.lod,
-            threads=self.threads,
-        )
-        if self.focus is not None:
-            world.lod.focus(self.focus[:2], self.focus[2])
-        return world
-
     @property
     def camera_focus(self) -> bool:
         """True when the level of detail's focus follows the camera (none is pinned)."""
-        return self.focus is None and self.world.lod.settings.focus is None
+        return self.session.camera_focus
 
     def steer_lod(self) -> None:
         """Tell the level of detail what the player looks at: the selection, the camera."""
-        lod = self.world.lod
-        lod.select(self.selection.entities)
-        if self.camera_focus:
-            lod.focus(self.renderer.camera.target[:2], FOCUS_RADIUS, fill=False)
+        self.session.steer_lod(self.renderer.camera.target, self.selection.entities)
 
     # -- simulation --------------------------------------------------------------------
     def step(self, frames: int = 1) -> None:
@@ -262,30 +267,19 @@ class Sandbox(SandboxPicture):
     def tick(self, dt: float) -> None:
         """Clock callback: reload changed plugin files, run the physics frames that are due."""
         self.scripts.poll()
-        if self.paused:
-            return
-        frame = self.world.settings.dt
-        self.accumulator = min(self.accumulator + dt, MAX_CATCH_UP)
-        while self.accumulator >= frame:
+        for _ in range(self.session.due(dt)):
             self.step(1)
-            self.accumulator -= frame
 
     def save_state(self) -> None:
         """Remember the whole simulation state (F5)."""
-        self.saved_state = self.world.snapshot()
+        self.session.save_state()
 
     def load_state(self) -> bool:
         """Go back to the state saved with F5 (F9); False if none was saved, or if it
         names a creature removed since (the Scripts window says so)."""
-        if self.saved_state is None:
-            return False
-        try:
-            self.world.restore(self.saved_state)
-        except SnapshotMismatch as error:
-            self.scripts.say(False, str(error))
+        if not self.session.load_state():
             return False
         self.world.schedule["render"].process(self.world, 0.0)  # show it now
-        self.accumulator = 0.0
         return True
 
     def reset(self) -> bool:
@@ -294,31 +288,14 @@ class Sandbox(SandboxPicture):
         If the scene or a plugin's code cannot be built now, the world stays as it is
         and the Scripts window says why (False).
         """
-        try:
-            world = self._build(self.scene)
-        except (SceneError, SystemFailure) as error:
-            self.scripts.say(False, f"not reset: {' '.join(str(error).split())}")
+        if self.session.reset() is None:
             return False
-        self.saved_state = None
-        self.world.close()
-        self.world = world
         self._attach_world()
         return True
 
     def save_roster(self, path: str | os.PathLike[str] | None = None) -> Path | None:
-        """Write the roster, goals and settings as they are now to a scene file (Ctrl+S:
-        `<scene>_directed.json` in the working folder, the name made safe: a scene's
-        name never chooses a folder); None and a message if it would not load
-        (`ecs_tentacles.roster_save`)."""
-        name = (self.world.scene or {}).get("name")
-        target = Path(path) if path is not None else Path(default_file_name(name, "_directed.json"))
-        try:
-            saved = save_roster(self.world, target)
-        except (SceneError, OSError) as error:
-            self.scripts.say(False, f"not saved: {' '.join(str(error).split())}")
-            return None
-        self.scripts.say(True, f"saved {saved}")
-        return saved
+        """Write the world as it is now to a scene file (Ctrl+S; `SandboxSession.save_roster`)."""
+        return self.session.save_roster(path)
 
     @property
     def modifiers(self) -> int:

@@ -2,7 +2,7 @@
 target, shown in the window, and kept as a screenshot (PNG) or a video (MP4).
 
 `SandboxPicture` is a part of `render.sandbox.Sandbox` (one of its bases). It reads the
-sandbox's world, renderer, HUD, clock (`paused`, `accumulator`) and camera choice;
+sandbox's session (its world and clock: `render.session`), renderer, HUD and camera choice;
 it writes the window, the HUD's live numbers (`stats`), the files it is asked for and
 its own state (`video`, `screenshots`). Nothing here steps the world.
 """
@@ -24,6 +24,7 @@ if TYPE_CHECKING:
     from ecs_tentacles.render.camera import CameraChoice
     from ecs_tentacles.render.hud import Hud
     from ecs_tentacles.render.renderer import Renderer
+    from ecs_tentacles.render.session import SandboxSession
     from ecs_tentacles.world import World
 
 
@@ -31,14 +32,17 @@ class SandboxPicture:
     """Drawing a sandbox's frame and keeping it (module docstring)."""
 
     # the sandbox's own, read here
-    world: World
+    session: SandboxSession
     renderer: Renderer
     hud: Hud
     window: Any
     headless: bool
-    paused: bool
-    accumulator: float
     camera_choice: CameraChoice | None
+
+    @property
+    def world(self) -> World:
+        """The world being played (the session's)."""
+        return self.session.world
 
     def _start_picture(self) -> None:
         """No video, no screenshot yet; the live numbers from zero."""
@@ -61,7 +65,8 @@ class SandboxPicture:
 
     def render(self) -> np.ndarray | None:
         """Draw the world and the HUD off-screen; return the picture if recording."""
-        alpha = 1.0 if self.paused else self.accumulator / self.world.settings.dt
+        session = self.session
+        alpha = 1.0 if session.paused else session.accumulator / session.world.settings.dt
         self.renderer.overlays = self.hud.visible  # editing aids (fur control markers)
         self.renderer.show_tiers = self.hud.show_tiers
         self.renderer.draw(alpha)

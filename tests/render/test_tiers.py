@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from ecs_tentacles.cli import main
-from ecs_tentacles.render.sandbox import FOCUS_RADIUS
+from ecs_tentacles.render.session import FOCUS_RADIUS
 from ecs_tentacles.render.tiers import COLOURS, tier_markers
 from tests.render.conftest import click_item
 from tests.test_bench import lod_crowd
