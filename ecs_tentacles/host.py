@@ -27,12 +27,10 @@ if TYPE_CHECKING:
     import numpy as np
 
     from ecs_tentacles.physics.backend import PhysicsBackend
-    from ecs_tentacles.registry import Registry
     from ecs_tentacles.store import ArrayStore, MotorStore, TentacleStore
 
 C = TypeVar("C")
 R = TypeVar("R")
-G = TypeVar("G", bound="Registry[Any]")
 
 
 class Host(PhysicsHost, Protocol):
@@ -94,8 +92,6 @@ class Host(PhysicsHost, Protocol):
     def get_resource(self, kind: type[R]) -> R | None: ...
     def has_resource(self, kind: type) -> bool: ...
     def replace_resource(self, obj: object) -> None: ...
-    def registry(self, kind: type[G]) -> G:
-        """The world's `kind` registry (`ecs_tentacles.registry`), plugins' entries in it."""
 
     # -- entities ---------------------------------------------------------------------------
     def activate(self) -> None: ...

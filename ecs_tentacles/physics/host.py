@@ -8,13 +8,17 @@ structurally, and the physics package never imports the module that builds on it
 from __future__ import annotations
 
 from collections.abc import Iterator
-from typing import Any, Protocol, TypeVar
+from typing import TYPE_CHECKING, Any, Protocol, TypeVar
 
 from ecs_tentacles.events import Events
 from ecs_tentacles.settings import Settings
 from ecs_tentacles.store import CreatureStore, SuckerStore, TransformStore
 
+if TYPE_CHECKING:
+    from ecs_tentacles.registry import Registry
+
 C = TypeVar("C")
+G = TypeVar("G", bound="Registry[Any]")
 
 
 class PhysicsHost(Protocol):
@@ -51,3 +55,6 @@ class PhysicsHost(Protocol):
 
     def creature_name(self, entity: int) -> str:
         """The name of creature `entity`."""
+
+    def registry(self, kind: type[G]) -> G:
+        """The world's `kind` registry (`ecs_tentacles.registry`)."""

@@ -31,8 +31,9 @@ import mujoco
 import numpy as np
 
 from ecs_tentacles.components import Creature, Link, Motor, Sucker, Tentacle, Transform
-from ecs_tentacles.ground import ground_of
+from ecs_tentacles.ground import FLAT
 from ecs_tentacles.mathutil import quat_about_z
+from ecs_tentacles.physics.registries import StaticGeometry
 
 if TYPE_CHECKING:
     from ecs_tentacles.physics.host import PhysicsHost
@@ -162,10 +163,10 @@ def new_spec(world: PhysicsHost, timestep: float | None = None) -> mujoco.MjSpec
     # One arena per stepping thread and model (ARENA_BYTES). A blow-up that overflows it
     # is caught as a fatal error and recovered (physics/health.py).
     spec.memory = ARENA_BYTES
-    # the plane z = 0, or the terrain's heightfield and solids (`ecs_tentacles.ground`)
-    ground_of(world).add_to_spec(
-        spec, settings.ground_friction, GROUND_BIT, CREATURE_BIT, CONTACT_SOLREF
-    )
+    # the static geometry plugins add (a heightfield, solids), else the plane z = 0
+    statics = list(world.registry(StaticGeometry))
+    for add in statics or [FLAT.add_to_spec]:
+        add(spec, settings.ground_friction, GROUND_BIT, CREATURE_BIT, CONTACT_SOLREF)
     return spec
 
 

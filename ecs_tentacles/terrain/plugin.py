@@ -20,6 +20,7 @@ import numpy as np
 
 from ecs_tentacles.construction import creature_layout
 from ecs_tentacles.ground import ground_of
+from ecs_tentacles.physics.registries import StaticGeometry
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.render.registries import Panels
 from ecs_tentacles.scene.errors import SceneError
@@ -67,7 +68,12 @@ class TerrainPlugin(Plugin):
         return [ground, TerrainEditor()]
 
     def build(self, app: App) -> None:
-        """Its drawing, HUD sections and clicks (`ecs_tentacles.render.registries`)."""
+        """Its heightfield and solids in every creature's model (`physics.registries`:
+        the world's ground as it is when a model is built, edits included) and its HUD
+        section (`render.registries`)."""
+        world = app.world
+        if world is not None:  # (a shard planner builds plugins without a world)
+            app.add(StaticGeometry, lambda spec, *args: ground_of(world).add_to_spec(spec, *args))
         app.add(Panels, self._panels)
 
     def _panels(self, sandbox: SandboxView) -> list[Panel]:
