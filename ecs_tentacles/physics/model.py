@@ -24,6 +24,7 @@ lists, in model order, which store rows they belong to.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -31,9 +32,9 @@ import mujoco
 import numpy as np
 
 from ecs_tentacles.components import Creature, Link, Motor, Sucker, Tentacle, Transform
-from ecs_tentacles.ground import FLAT
+from ecs_tentacles.ground import FLAT, StaticSpec
 from ecs_tentacles.mathutil import quat_about_z
-from ecs_tentacles.physics.registries import StaticGeometry
+from ecs_tentacles.registry import Registry
 
 if TYPE_CHECKING:
     from ecs_tentacles.physics.host import PhysicsHost
@@ -128,6 +129,13 @@ def model_layout(world: PhysicsHost, creature: Creature, transform: Transform) -
 def _settings_key(settings: Settings) -> tuple[Any, ...]:
     return (settings.substep_dt, tuple(settings.gravity), settings.ground_friction,
             settings.sucker_timeconst)  # fmt: skip
+
+
+class StaticGeometry(Registry[Callable[[StaticSpec, float, int, int, Sequence[float]], None]]):
+    """Static geoms in every creature's model, filled in plugins' `build(app)`: an entry
+    `(spec, friction, contype, conaffinity, solref)` adds them to a creature's MjSpec,
+    named `ground...` (the terrain plugin: its heightfield, the plane beyond it, its
+    solids). Without an entry the model has the plane z = 0 (`ground.FLAT`)."""
 
 
 def hinges(link: Link) -> tuple[str, ...]:

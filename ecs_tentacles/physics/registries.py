@@ -4,10 +4,8 @@
   CreatureStore row) or None for none; asked every frame before the step, or-ed: a
   creature some plugin wants to move never falls asleep (`physics.sleep`). Locomotion:
   creatures with a goal; the director: the grabbed creature.
-- `StaticGeometry`: `entry(spec, friction, contype, conaffinity, solref)` adds the
-  world's static geoms to a creature's MjSpec (named `ground...`; the terrain plugin:
-  its heightfield, the plane beyond it and its solids). Without an entry the ground is
-  the plane z = 0 (`ground.FLAT`).
+- `StaticGeometry` (in `physics.model`, which calls it): the static geoms in every
+  creature's model.
 - `TravelTargets`: `entry(world)` -> where creatures are heading, (CreatureStore rows,
   2) x, y metres, nan where nowhere, or None; the level of detail moves kinematic
   creatures toward the first answer that is not nan (`ecs_tentacles.lod.replay`).
@@ -17,7 +15,7 @@ Entries answer with whole-array math (no per-creature loop); their arrays are on
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -25,7 +23,6 @@ import numpy as np
 from ecs_tentacles.registry import Registry
 
 if TYPE_CHECKING:
-    from ecs_tentacles.ground import StaticSpec
     from ecs_tentacles.host import Host
 
 
@@ -35,7 +32,3 @@ class MotionWants(Registry[Callable[["Host"], np.ndarray | None]]):
 
 class TravelTargets(Registry[Callable[["Host"], np.ndarray | None]]):
     """Where creatures are heading, for the creatures the level of detail replays."""
-
-
-class StaticGeometry(Registry[Callable[["StaticSpec", float, int, int, Sequence[float]], None]]):
-    """Static geoms every creature's model holds (the ground, solids)."""

@@ -39,8 +39,7 @@ from ecs_tentacles.registry import Registry
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
-    from ecs_tentacles.render.hud import Hud
-    from ecs_tentacles.render.renderer import Renderer
+    from ecs_tentacles.render.camera import OrbitCamera
     from ecs_tentacles.render.selection import Selection
     from ecs_tentacles.world import World
 
@@ -174,6 +173,23 @@ class FramedPoints(Registry[Callable[["Host"], "np.ndarray | None"]]):
     """Points "frame all" keeps in view besides the creatures."""
 
 
+class RendererView(Protocol):
+    """What a panel uses of the sandbox's renderer."""
+
+    @property
+    def camera(self) -> OrbitCamera: ...
+    @property
+    def state(self) -> dict[str, Any]: ...  # plugins' objects kept across worlds
+
+
+class HudView(Protocol):
+    """What a panel uses of the sandbox's HUD."""
+
+    @property
+    def width(self) -> int: ...  # pixels of the window the HUD column takes
+    def step_tentacle(self, step: int) -> None: ...  # select the next (+1) or previous one
+
+
 class SandboxView(Protocol):
     """What a HUD section (a `Panels` entry, its `Panel`s) sees of the sandbox: the world
     it draws, the camera and HUD, the window, the keys and mouse, the selection, and
@@ -183,8 +199,12 @@ class SandboxView(Protocol):
     def world(self) -> World: ...
 
     paused: bool
-    renderer: Renderer
-    hud: Hud
+
+    @property
+    def renderer(self) -> RendererView: ...
+    @property
+    def hud(self) -> HudView: ...
+
     window: Any  # the pyglet window (width, height)
     selection: Selection
     keys: Any  # pyglet's KeyStateHandler: keys[key.S] is True while S is down

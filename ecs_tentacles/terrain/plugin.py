@@ -20,7 +20,7 @@ import numpy as np
 
 from ecs_tentacles.construction import creature_layout
 from ecs_tentacles.ground import ground_of
-from ecs_tentacles.physics.registries import StaticGeometry
+from ecs_tentacles.physics.model import StaticGeometry
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.render.registries import Panels
 from ecs_tentacles.scene.errors import SceneError
