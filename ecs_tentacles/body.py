@@ -35,11 +35,14 @@ def creature_rng(seed: int, name: str) -> np.random.Generator:
     return np.random.default_rng([int(seed), key])
 
 
-def build_creature(world: Host, spec: dict[str, Any]) -> int:
-    """Create one creature's entities from its scene entry; return the creature entity."""
+def build_creature(world: Host, spec: dict[str, Any], layout: CreatureLayout | None = None) -> int:
+    """Create one creature's entities from its scene entry; return the creature entity.
+    `layout`: the entry's `creature_layout` on this world's ground, when the caller has
+    it already (a spawn checked the spot with it)."""
     mantle = spec["mantle"]
     tentacles = spec["tentacles"]
-    layout = creature_layout(spec, ground_of(world))
+    if layout is None:
+        layout = creature_layout(spec, ground_of(world))
     turn = quat_about_z(layout.heading)
 
     creature = Creature(

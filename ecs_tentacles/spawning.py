@@ -162,8 +162,27 @@ def obstruction(world: World, layout: CreatureLayout) -> str | None:
 def free_spot(world: World, entry: dict[str, Any]) -> tuple[dict[str, Any], str | None]:
     """`entry` where it asked to be if free, else moved to the nearest free spot on rings
     around it; and what was in the way (None: not moved). SpawnError if none is free."""
+    placed, blocker, _ = free_spot_layout(world, entry)
+    return placed, blocker
+
+
+def free_spot_layout(
+    world: World, entry: dict[str, Any]
+) -> tuple[dict[str, Any], str | None, CreatureLayout]:
+    """`free_spot`, and the layout on this world's ground of the entry it returns (the
+    one it last checked: a spawn builds from it instead of working it out again)."""
     ground = ground_of(world)
-    return nearest_free(entry, lambda e: obstruction(world, creature_layout(e, ground)))
+    last: list[tuple[dict[str, Any], CreatureLayout]] = []
+
+    def blocked(candidate: dict[str, Any]) -> str | None:
+        layout = creature_layout(candidate, ground)
+        last[:] = [(candidate, layout)]
+        return obstruction(world, layout)
+
+    placed, blocker = nearest_free(entry, blocked)
+    checked, layout = last[0]
+    assert checked is placed  # the last spot checked is the free one returned
+    return placed, blocker, layout
 
 
 def nearest_free(
@@ -172,10 +191,10 @@ def nearest_free(
     """`entry` if `blocked` finds nothing in the way of it, else a copy at the nearest
     spot on rings around it (a quarter of its reach apart) where nothing is; and what
     was in the way first (None: not moved). SpawnError if no spot is free."""
-    layout = creature_layout(entry)
     blocker = blocked(entry)
     if blocker is None:
         return entry, None
+    layout = creature_layout(entry)  # on the plane: only its reach is wanted
     _, ends, radii = layout.capsules()
     reach = float(np.max(np.linalg.norm(ends[:, :2] - layout.origin[:2], axis=1)) + radii.max())
     x, y = entry["position"][:2]
@@ -209,7 +228,7 @@ def spawn(
     entry = creature_entry(world, spec, position, heading_deg)
     moved_to = None
     if on_overlap == "move":
-        placed, blocker = free_spot(world, entry)
+        placed, blocker, layout = free_spot_layout(world, entry)
         if blocker is not None:
             moved_to = tuple(placed["position"])
             log.info(
@@ -221,15 +240,21 @@ def spawn(
             )
         entry = placed
     else:
-        blocker = obstruction(world, creature_layout(entry, ground_of(world)))
+        layout = creature_layout(entry, ground_of(world))
+        blocker = obstruction(world, layout)
         if blocker is not None:
             where = ", ".join(f"{v:g}" for v in entry["position"])
             line = f"creature {entry['name']!r} at ({where}): overlaps {blocker}"
             raise SpawnError([f"{line} (pick a free spot, or on_overlap='move')"])
-    return place(world, entry, moved_to)
+    return place(world, entry, moved_to, layout)
 
 
-def place(world: World, entry: dict[str, Any], moved_to: tuple[float, ...] | None = None) -> int:
+def place(
+    world: World,
+    entry: dict[str, Any],
+    moved_to: tuple[float, ...] | None = None,
+    layout: CreatureLayout | None = None,
+) -> int:
     """Build a creature entry `creature_entry` made (checked, defaults in, its name
     unique) where it says, without looking for overlaps: `spawn`'s last step, and how
     `scatter` places many copies of one checked entry at spots it knows are free."""
@@ -240,7 +265,7 @@ def place(world: World, entry: dict[str, Any], moved_to: tuple[float, ...] | Non
             [f"creature.name: {wanted!r} is taken (by a creature here or in the take recorded)"]
         )
     before = {name: len(store) for name, store in world.stores.items()}
-    entity = build_creature(world, entry)
+    entity = build_creature(world, entry, layout)
     for plugin in world.plugins:
         with calling(plugin, "build_creature"):
             plugin.build_creature(world, entity, entry)

@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 import copy
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from typing import Any
 
 import numpy as np
 import pytest
@@ -389,3 +390,33 @@ def test_a_body_plan_whose_first_creature_left_still_gets_its_reduced_model():
         world.step(30)
         assert world.lod.counts()["reduced"] >= 5
         assert world.physics.health.recoveries == 0
+
+
+def test_a_spawn_works_out_the_creatures_layout_once(
+    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The spot check's layout is the one the creature is built from (it was worked out
+    two or three times a spawn)."""
+    from ecs_tentacles import body, construction, spawning
+
+    calls: list[str] = []
+    real = construction.creature_layout
+
+    def counted(*args: Any, **kwargs: Any) -> Any:
+        calls.append("layout")
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(spawning, "creature_layout", counted)
+    monkeypatch.setattr(body, "creature_layout", counted)
+    world = make_world("octopus")
+    calls.clear()  # building the scene's own creature
+    new = {"tentacles": {"count": 3, "links": 3}}
+    world.spawn({**new, "name": "a"}, position=(4.0, 4.0))
+    assert calls == ["layout"]
+    calls.clear()
+    world.spawn({**new, "name": "b"}, position=(4.0, 4.0), on_overlap="move")  # on "a"
+    free = len(calls)
+    assert free >= 2  # the taken spot, then spots on rings until a free one
+    calls.clear()
+    world.spawn({**new, "name": "c"}, position=(-4.0, -4.0), on_overlap="move")  # free
+    assert calls == ["layout"]
