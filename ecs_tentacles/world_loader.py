@@ -26,7 +26,7 @@ from typing import Any, Protocol, TypeVar
 
 from ecs_tentacles.body import build_creature
 from ecs_tentacles.host import Host
-from ecs_tentacles.physics.systems import physics_systems
+from ecs_tentacles.physics.frame_systems import physics_systems
 from ecs_tentacles.plugin import HookFailure, Plugin, SystemsPlugin, calling
 from ecs_tentacles.plugin_registry import scene_first
 from ecs_tentacles.scene.errors import SceneError

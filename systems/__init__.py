@@ -14,7 +14,7 @@ sync     physics_sync        MuJoCo body poses -> Transform store (core)
          physics_health      blow-ups found per creature and recovered (core)
 
 The core systems (`physics/`) are declared by the physics package
-(`ecs_tentacles.physics.systems.physics_systems`) and run in every world.
+(`ecs_tentacles.physics.frame_systems.physics_systems`) and run in every world.
 animate  threats             path threats follow their keyframes (threats)
          emotion             threats near -> fear -> fur lift and random (fur)
          rig                 fur guides posed from mantle poses and controls (fur)

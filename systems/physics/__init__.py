@@ -1,3 +1,3 @@
 """The physics systems, declared by the physics package
-(`ecs_tentacles.physics.systems.physics_systems`): physics (stage physics),
+(`ecs_tentacles.physics.frame_systems.physics_systems`): physics (stage physics),
 physics_sync, physics_health (stage sync)."""

@@ -16,8 +16,8 @@ import numpy as np
 import pytest
 
 import ecs_tentacles.physics
+from ecs_tentacles.physics.frame_systems import physics_systems
 from ecs_tentacles.physics.host import PhysicsHost
-from ecs_tentacles.physics.systems import physics_systems
 from ecs_tentacles.world import World
 from tests.declarations import declared_only, step_declared
 
