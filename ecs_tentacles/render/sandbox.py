@@ -65,7 +65,7 @@ from ecs_tentacles.render.undo import UndoStack
 from ecs_tentacles.world import World
 
 if TYPE_CHECKING:
-    from ecs_tentacles.snapshot import Snapshot
+    pass
 
 FRAME_EASE = 0.08  # share of the way to the new framing a video frame moves (frame-all)
 DISPLAY_HZ = 60
@@ -144,20 +144,12 @@ class Sandbox(SandboxPicture):
         return self.session.scene_dir
 
     @property
-    def focus(self) -> tuple[float, float, float] | None:
-        return self.session.focus
-
-    @property
     def paused(self) -> bool:
         return self.session.paused
 
     @paused.setter
     def paused(self, value: bool) -> None:
         self.session.paused = value
-
-    @property
-    def saved_state(self) -> Snapshot | None:
-        return self.session.saved_state
 
     def aim(self, choice: CameraChoice | None) -> None:
         """Put the camera where `choice` says (`play --camera`), now and after a reset;
