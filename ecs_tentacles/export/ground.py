@@ -7,7 +7,7 @@ with a child node per mesh (`terrain/surface`, `terrain/obstacles`), each with a
 and a material of the same colour. A take recorded on the plane has neither. If a
 creature is called `terrain`, the ground's root is `terrain_ground` instead.
 
-Colours are the sandbox's (`ground_mesh.COLOURS`, display sRGB) as linear light
+Colours are the sandbox's (`ground.meshes.COLOURS`, display sRGB) as linear light
 (`colours.to_linear`), the space USD's colours and glTF's `baseColorFactor` are in, as
 the creatures' materials are: an importer shows the ground the sandbox drew.
 """
@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from ecs_tentacles.colours import to_linear
-from ecs_tentacles.ground_mesh import COLOURS
+from ecs_tentacles.ground.meshes import COLOURS
 from ecs_tentacles.take import Take
 
 EXPORT_NAMES = {"terrain": "surface", "obstacles": "obstacles"}

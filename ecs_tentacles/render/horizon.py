@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from ecs_tentacles.ground import BEYOND_DROP, Ground
-from ecs_tentacles.ground_mesh import StaticMesh
+from ecs_tentacles.ground.meshes import StaticMesh
 
 REACH = 4000.0  # m from the origin to the outer edge of the ground beyond the field
 HORIZON = (0.78, 0.82, 0.85)  # the sky at the horizon, and the fog's colour

@@ -1,6 +1,6 @@
 """What is drawn before the creatures: the sky's gradient, then the ground (the plane's
 metre grid, or the terrain, the ground beyond it out to the horizon (`render.horizon`)
-and the obstacles as lit meshes, `ecs_tentacles.ground_mesh`), fogged with distance in
+and the obstacles as lit meshes, `ecs_tentacles.ground.meshes`), fogged with distance in
 the sky's horizon colour so the ground joins the sky.
 
 Reads the world's `Ground` (`ground_of`), the camera's view, the light; writes only the
@@ -17,7 +17,7 @@ import numpy as np
 from pyglet import gl
 
 from ecs_tentacles.ground import Ground
-from ecs_tentacles.ground_mesh import COLOURS, ground_meshes
+from ecs_tentacles.ground.meshes import COLOURS, ground_meshes
 from ecs_tentacles.render import shaders
 from ecs_tentacles.render.gpu import (
     INSTANCE_FLOATS,

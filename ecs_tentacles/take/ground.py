@@ -12,7 +12,7 @@ with, per mesh (in that order, after the tracks' arrays), three arrays:
     ground_<name>_normals    float32 (n, 3)   unit normals
     ground_<name>_triangles  uint32  (m, 3)   vertex indices, counter-clockwise from outside
 
-Mesh names are `MESH_NAMES` (`ecs_tentacles.ground_mesh`: the heightfield's surface and
+Mesh names are `MESH_NAMES` (`ecs_tentacles.ground.meshes`: the heightfield's surface and
 every obstacle in one mesh). Readers check the entry and that every triangle index is
 below its mesh's vertex count before an exporter sees them.
 """
@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 
 from ecs_tentacles.ground import Ground
-from ecs_tentacles.ground_mesh import StaticMesh, ground_meshes
+from ecs_tentacles.ground.meshes import StaticMesh, ground_meshes
 
 KEY = "ground"
 MESH_NAMES = ("terrain", "obstacles")

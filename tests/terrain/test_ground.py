@@ -83,7 +83,7 @@ def test_the_height_kernel_gives_the_numpy_numbers_bit_for_bit(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
     """Inside, on sample lines, on the borders and outside the field."""
-    from ecs_tentacles import ground as module
+    from ecs_tentacles.ground import heightfield as module
 
     rng = np.random.default_rng(7)
     field_ = Heightfield((6.0, 4.0), rng.uniform(-0.3, 0.5, size=(33, 49)))

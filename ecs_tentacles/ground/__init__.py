@@ -10,6 +10,9 @@ exactly as before terrain existed.
     ground.distance(points)      # (n,) metres from points (n, 3) to the nearest surface
     ground.normal(points)        # (n, 3) unit normals of that surface
 
+Modules: this one (`Ground`, `FLAT`, `ground_of`), `heightfield`, `solids`, `meshes`
+(triangle meshes for drawing and export).
+
 Reads: nothing of the world. Used by the physics model (`add_to_spec`: every group's
 model gets the same static geoms), creature placement (`ecs_tentacles.construction`),
 the suckers (they grip any static surface) and the renderer and exporters (`mesh`).
@@ -19,13 +22,14 @@ from __future__ import annotations
 
 import hashlib
 from collections.abc import Iterator
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Protocol
 
 import mujoco
 import numpy as np
 
-from ecs_tentacles.optional_kernels import OptionalKernels
+from ecs_tentacles.ground.heightfield import Heightfield
+from ecs_tentacles.ground.solids import Solid, convex_planes
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
@@ -33,162 +37,9 @@ if TYPE_CHECKING:
 NORMAL_SPAN = 0.05  # metres either side over which the slope under a point is measured
 NEAR = 0.5  # metres past a solid's bounding sphere within which distances to it are exact
 BEYOND_DROP = 0.002  # metres the plane past a heightfield's edge lies under its lowest point
-# the heightfield kernel (numba, when installed; numpy otherwise: the same numbers)
-KERNELS = OptionalKernels("ecs_tentacles.physics.kernels", "ECS_TENTACLES_SENSE")
 
-
-@dataclass(frozen=True)
-class Heightfield:
-    """Heights on a grid centred on the origin: `heights` (rows along y from -y/2,
-    columns along x from -x/2) in metres over `size` (x, y) metres."""
-
-    size: tuple[float, float]
-    heights: np.ndarray
-
-    @property
-    def cell(self) -> tuple[float, float]:
-        """Metres between samples along x and y."""
-        rows, cols = self.heights.shape
-        return self.size[0] / (cols - 1), self.size[1] / (rows - 1)
-
-    def height(self, xy: np.ndarray) -> np.ndarray:
-        """Heights under points `xy` (n, 2), as MuJoCo's triangles give them; past the
-        border, the plane at the lowest height that catches what leaves the field."""
-        xy = np.asarray(xy, dtype=np.float64)
-        lowest = self.__dict__.get("_lowest")
-        if lowest is None:
-            lowest = float(self.heights.min())
-            object.__setattr__(self, "_lowest", lowest)  # a cache, not a field
-        fast = KERNELS.get()
-        if fast is not None:  # the same numbers, in one pass instead of twenty
-            out = np.empty(len(xy))
-            fast.field_heights(self.heights, self.size[0], self.size[1], lowest, xy, out)
-            return out
-        rows, cols = self.heights.shape
-        outside = (np.abs(xy[:, 0]) > 0.5 * self.size[0]) | (np.abs(xy[:, 1]) > 0.5 * self.size[1])
-        u = np.clip((xy[:, 0] / self.size[0] + 0.5) * (cols - 1), 0.0, cols - 1.0)
-        v = np.clip((xy[:, 1] / self.size[1] + 0.5) * (rows - 1), 0.0, rows - 1.0)
-        i = np.minimum(v.astype(np.int64), rows - 2)
-        j = np.minimum(u.astype(np.int64), cols - 2)
-        fu, fv = u - j, v - i
-        h = self.heights
-        h00, h01, h10, h11 = h[i, j], h[i, j + 1], h[i + 1, j], h[i + 1, j + 1]
-        # each cell is two triangles split along (i, j) - (i + 1, j + 1)
-        lower = fu >= fv  # below the diagonal: (i, j), (i, j + 1), (i + 1, j + 1)
-        below = h00 + fu * (h01 - h00) + fv * (h11 - h01)
-        above = h00 + fv * (h10 - h00) + fu * (h11 - h10)
-        return np.where(outside, lowest, np.where(lower, below, above))
-
-    def slope_normal(self, xy: np.ndarray) -> np.ndarray:
-        """Unit surface normals (n, 3) under `xy` (n, 2), from the heights' gradient."""
-        dx, dy = self.cell
-        ex, ey = np.array([0.5 * dx, 0.0]), np.array([0.0, 0.5 * dy])
-        gx = (self.height(xy + ex) - self.height(xy - ex)) / dx
-        gy = (self.height(xy + ey) - self.height(xy - ey)) / dy
-        n = np.stack([-gx, -gy, np.ones_like(gx)], axis=1)
-        return np.asarray(n / np.linalg.norm(n, axis=1, keepdims=True))
-
-
-@dataclass(frozen=True)
-class Solid:
-    """A static shape: `kind` one of SHAPES; `position` its centre; `rotation` (3, 3) its
-    frame; `size` half extents (box), (radius, half height) (cylinder, along its z) or
-    (radius,) (sphere); a mesh's convex `pieces`, each a (k, 3) vertex array in its frame."""
-
-    kind: str
-    position: np.ndarray
-    rotation: np.ndarray
-    size: tuple[float, ...] = ()
-    pieces: tuple[np.ndarray, ...] = ()
-    planes: tuple[np.ndarray, ...] = field(default=(), compare=False)
-
-    @property
-    def bound(self) -> float:
-        """The radius of a sphere about `position` that holds the whole solid."""
-        if self.pieces:
-            return float(max(np.linalg.norm(p, axis=1).max() for p in self.pieces))
-        return float(np.linalg.norm(self.size)) if self.kind != "sphere" else self.size[0]
-
-    def top(self, xy: np.ndarray) -> np.ndarray:
-        """(n,) the height of this solid's top above points `xy` (n, 2), -inf where it is
-        not above them (a vertical line through the point misses it). Exact for boxes,
-        spheres and convex pieces; cylinders as 48-sided prisms (under 0.3% of the radius)."""
-        if self.kind == "sphere":
-            d2 = np.sum((xy - self.position[:2]) ** 2, axis=1)
-            r2 = self.size[0] ** 2
-            return np.where(d2 <= r2, self.position[2] + np.sqrt(np.maximum(r2 - d2, 0.0)), -np.inf)
-        out = np.full(len(xy), -np.inf)
-        for planes in self._world_planes():
-            normal, offset = planes[:, :3], planes[:, 3]
-            rest = offset[None, :] - xy @ normal[:, :2].T  # n_z z <= rest, per plane
-            up, down = normal[:, 2] > 1e-12, normal[:, 2] < -1e-12
-            side = ~(up | down)
-            high = np.min(rest[:, up] / normal[up, 2], axis=1) if up.any() else np.inf
-            low = np.max(rest[:, down] / normal[down, 2], axis=1) if down.any() else -np.inf
-            inside = np.all(rest[:, side] >= -1e-12, axis=1) if side.any() else True
-            out = np.maximum(out, np.where(inside & (high >= low), high, -np.inf))
-        return out
-
-    def _world_planes(self) -> list[np.ndarray]:
-        """Each convex part as world-frame planes (k, 4): outward normal, offset (made once)."""
-        cached = self.__dict__.get("_planes_world")
-        if cached is None:
-            if self.kind == "box":
-                local = [_box_planes(np.asarray(self.size))]
-            elif self.kind == "cylinder":
-                local = [_prism_planes(self.size[0], self.size[1])]
-            else:
-                local = list(self.planes)
-            cached = []
-            for p in local:
-                normal = p[:, :3] @ self.rotation.T
-                cached.append(np.column_stack([normal, p[:, 3] + normal @ self.position]))
-            object.__setattr__(self, "_planes_world", cached)  # a cache, not a field
-        return cached
-
-    def signed_distance(self, points: np.ndarray) -> np.ndarray:
-        """Metres from points (n, 3) to the surface, negative inside."""
-        local = (points - self.position) @ self.rotation
-        if self.kind == "sphere":
-            return np.asarray(np.linalg.norm(local, axis=1) - self.size[0])
-        if self.kind == "box":
-            return _box_distance(local, np.asarray(self.size))
-        if self.kind == "cylinder":
-            flat = np.stack([np.hypot(local[:, 0], local[:, 1]), local[:, 2]], axis=1)
-            return _box_distance(flat, np.asarray(self.size))
-        # convex pieces: the largest plane distance (exact inside, a lower bound outside)
-        return np.asarray(
-            np.min([np.max(local @ p[:, :3].T - p[:, 3], axis=1) for p in self.planes], axis=0)
-        )
-
-
-def _box_planes(half: np.ndarray) -> np.ndarray:
-    normals = np.vstack([np.eye(3), -np.eye(3)])
-    return np.column_stack([normals, np.concatenate([half, half])])
-
-
-def _prism_planes(radius: float, half: float, sides: int = 48) -> np.ndarray:
-    """A cylinder along z as a `sides`-gon prism whose faces touch the circle."""
-    angle = 2.0 * np.pi * np.arange(sides) / sides
-    around = np.column_stack(
-        [np.cos(angle), np.sin(angle), np.zeros(sides), np.full(sides, radius)]
-    )
-    caps = np.array([[0.0, 0.0, 1.0, half], [0.0, 0.0, -1.0, half]])
-    return np.vstack([around, caps])
-
-
-def _box_distance(local: np.ndarray, half: np.ndarray) -> np.ndarray:
-    q = np.abs(local) - half
-    outside = np.linalg.norm(np.maximum(q, 0.0), axis=1)
-    return np.asarray(outside + np.minimum(q.max(axis=1), 0.0))
-
-
-def convex_planes(vertices: np.ndarray) -> np.ndarray:
-    """The faces of the convex hull of `vertices` as planes (k, 4): outward normal, offset."""
-    from scipy.spatial import ConvexHull
-
-    hull = ConvexHull(vertices)
-    return np.asarray(hull.equations[:, :4] * [1.0, 1.0, 1.0, -1.0])
+__all__ = ["BEYOND_DROP", "FLAT", "NEAR", "NORMAL_SPAN", "Ground", "Heightfield", "Solid",
+           "StaticSpec", "convex_planes", "ground_of"]  # fmt: skip
 
 
 class StaticSpec(Protocol):
