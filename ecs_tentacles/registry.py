@@ -21,7 +21,7 @@ from.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterator
 from typing import Any, Generic, Protocol, TypeVar
 
 Entry = TypeVar("Entry")
@@ -83,8 +83,6 @@ class Owner(Protocol):
     key: str
     config: dict[str, Any]
 
-    def build(self, app: App) -> None: ...
-
 
 class App:
     """What a plugin's `build(app)` registers into: registries (a world's, or a planner's
@@ -104,11 +102,3 @@ class App:
     def add(self, kind: type[Registry[Entry]], entry: Entry) -> None:
         """Add `entry` to the `kind` registry, as this plugin's."""
         self.registries.get(kind).add(self.plugin.key, entry)
-
-
-def built(plugins: Iterable[Owner]) -> Registries:
-    """The registries `plugins` fill, built without a world (each plugin's `build`)."""
-    registries = Registries()
-    for plugin in plugins:
-        plugin.build(App(registries, plugin))
-    return registries

@@ -39,13 +39,18 @@ from ecs_tentacles.distributed.reaper import (
     end_started_since,
 )
 from ecs_tentacles.distributed.registries import MeetingReaches
-from ecs_tentacles.distributed.shards import ShardPlan, default_tasks, plan_shards, scene_plugins
+from ecs_tentacles.distributed.shards import (
+    ShardPlan,
+    default_tasks,
+    entries,
+    plan_shards,
+    scene_plugins,
+)
 from ecs_tentacles.distributed.spheres import meetings
 from ecs_tentacles.distributed.task import ShardResult, bake_shard
 from ecs_tentacles.distributed.work import load_shard, remove_work, save_shard, shard_key
 from ecs_tentacles.export.bake import BakePlan
 from ecs_tentacles.plugin import Plugin
-from ecs_tentacles.registry import built
 from ecs_tentacles.take import Take
 
 
@@ -316,7 +321,7 @@ def _meetings(
         spheres[:, result.members] = result.spheres
         shard_of[result.members] = k
     reach = np.zeros(n)
-    for meeting in built(plugins).get(MeetingReaches):
+    for meeting in entries(plugins).get(MeetingReaches):
         extra = meeting(plan.scene)
         if extra is not None:
             reach += np.asarray(extra, dtype=np.float64)

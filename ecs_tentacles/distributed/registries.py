@@ -1,6 +1,6 @@
 """What the shard planner of a distributed bake asks the plugins: the distributed
 layer's registries (`ecs_tentacles.registry`), filled in plugins' `build(app)`. The
-planner builds the scene's plugins without a world (`registry.built`).
+planner builds the scene's plugins without a world (`shards.entries`).
 
 - `ShardReaches`: `entry(creature, seconds)` -> how far `creature` (its scene entry,
   defaults in) may move during a bake of `seconds`, beyond its body (`Reach`;

@@ -29,9 +29,9 @@ import numpy as np
 from ecs_tentacles.creator.crowd import creature_reach
 from ecs_tentacles.distributed.registries import Reach, ShardGroups, ShardReaches
 from ecs_tentacles.physics.proxies import MARGIN
-from ecs_tentacles.plugin import Plugin
+from ecs_tentacles.plugin import Plugin, calling
 from ecs_tentacles.plugin_registry import resolve
-from ecs_tentacles.registry import built
+from ecs_tentacles.registry import App, Registries
 
 SLACK = 0.15  # metres: settling at the start, sideways drift, tentacles lifting
 
@@ -68,7 +68,7 @@ def plan_shards(
     if not creatures:
         return ShardPlan([[]], 1, declared=False)
     plugins = scene_plugins(scene) if plugins is None else plugins
-    together = [g for groups in built(plugins).get(ShardGroups) for g in groups(creatures)]
+    together = [g for groups in entries(plugins).get(ShardGroups) for g in groups(creatures)]
     if "shards" in scene:
         index = {c["name"]: i for i, c in enumerate(creatures)}
         shards = [sorted(index[name] for name in shard) for shard in scene["shards"]]
@@ -84,6 +84,16 @@ def scene_plugins(
     """The plugins a loaded scene turns on (its `plugins` field), for their shard entries."""
     where = pathlib.Path(folder) if folder else None
     return resolve(scene.get("plugins"), where, allow=allow_systems)
+
+
+def entries(plugins: Sequence[Plugin]) -> Registries:
+    """The registries the scene's `plugins` fill, built without a world; a `build` that
+    calls sys.exit is a one-line `HookFailure` naming the plugin, as in a world."""
+    registries = Registries()
+    for plugin in plugins:
+        with calling(plugin, "build"):
+            plugin.build(App(registries, plugin))
+    return registries
 
 
 def _joined_all(sets: list[list[int]], groups: list[list[int]]) -> list[list[int]]:
@@ -106,7 +116,7 @@ def travel_capsules(
 ) -> np.ndarray:
     """(n, 5): start x, y, end x, y and radius of where each creature can get to."""
     out = np.zeros((len(creatures), 5))
-    reaches = list(built(plugins).get(ShardReaches))
+    reaches = list(entries(plugins).get(ShardReaches))
     for i, creature in enumerate(creatures):
         start = np.asarray(creature["position"][:2], dtype=np.float64)
         reach = creature_reach(creature) + 0.5 * creature["mantle"]["height"] + SLACK

@@ -107,3 +107,23 @@ def test_a_base_exception_of_the_users_own_is_one_line_without_debug(tmp_path: P
     assert run.stderr.splitlines() == ["error: run: Odd: not an Exception (--debug shows where)"]
     debug = _cli(tmp_path, "--debug", "run", str(scene), "--frames", "5", "--allow-systems")
     assert "Traceback" in debug.stderr and debug.returncode == 1
+
+
+def test_sys_exit_in_build_while_planning_shards_is_one_line() -> None:
+    """The shard planner builds the scene's plugins without a world; a `build` that calls
+    sys.exit there fails as it does in a world: one line naming the plugin."""
+    import pytest
+
+    from ecs_tentacles.distributed.shards import entries
+    from ecs_tentacles.plugin import HookFailure, Plugin
+
+    class Quits(Plugin):
+        name = "quits"
+
+        def build(self, app: object) -> None:
+            raise SystemExit(3)
+
+    with pytest.raises(
+        HookFailure, match=r"^plugins\.quits: its build\(\) hook called sys\.exit\(3\)$"
+    ):
+        entries([Quits()])

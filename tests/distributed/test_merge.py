@@ -9,10 +9,10 @@ import numpy as np
 from ecs_tentacles.creator.crowd import crowd_scene
 from ecs_tentacles.distributed.merge import merge_takes
 from ecs_tentacles.distributed.registries import MeetingReaches
+from ecs_tentacles.distributed.shards import entries
 from ecs_tentacles.distributed.spheres import meetings
 from ecs_tentacles.distributed.task import bake_shard
 from ecs_tentacles.export.bake import BakePlan, bake
-from ecs_tentacles.registry import built
 from ecs_tentacles.take import Take, write_npz
 
 
@@ -69,7 +69,7 @@ def test_shards_that_would_have_steered_each_other_are_found_to_have_met() -> No
         spheres[:, r.members] = r.spheres
     shard_of = np.array([0, 1])
     assert meetings(spheres, shard_of) == []  # contact alone misses it
-    (meeting,) = built([LocomotionPlugin()]).get(MeetingReaches)
+    (meeting,) = entries([LocomotionPlugin()]).get(MeetingReaches)
     reach = meeting(plan.scene)
     assert reach is not None and len(reach) == 2
     assert meetings(spheres, shard_of, np.asarray(reach))  # the widened check finds it
