@@ -58,7 +58,7 @@ class Host(PhysicsHost, Protocol):
     def kept_names(self) -> set[str]:
         """Names no new creature may take (a recording's creatures, despawned ones too)."""
 
-    # -- creatures that come and go (`ecs_tentacles.spawning`) ----------------------------
+    # -- creatures that come and go (`ecs_tentacles.creatures.spawning`) ---------------
     def spawn(
         self,
         creature: Mapping[str, Any],

@@ -10,7 +10,7 @@ the sandbox's in `ecs_tentacles.render.registries`, the physics' in
 `physics.registries`, the recorder's in `take.registries`, the shard planner's in
 `distributed.registries`, `run`'s report's in `cli.registries`).
 How a scene's `plugins` are found, trusted, imported and made is
-`ecs_tentacles.plugin_registry`.
+`ecs_tentacles.scene.plugins`.
 
     class Wander(Plugin):
         name = "wander"
@@ -165,11 +165,11 @@ class Plugin:
     def save_creature(self, world: Host, creature: int, entry: dict[str, Any]) -> None:
         """Write what this plugin knows of `creature` now into its scene entry `entry`
         (its goals, its parameters), for saving a directed crowd as a scene
-        (`ecs_tentacles.roster_save`)."""
+        (`ecs_tentacles.creatures.roster_save`)."""
 
     def save_scene(self, world: Host, scene: dict[str, Any]) -> None:
         """Write this plugin's scene-level state into `scene` when a running world is
-        saved (`ecs_tentacles.roster_save`; the threats plugin: threats dropped since)."""
+        saved (`ecs_tentacles.creatures.roster_save`; the threats plugin: threats dropped since)."""
 
     def scene_files(self, scene: Mapping[str, Any]) -> list[tuple[tuple[str | int, ...], str]]:
         """The files this plugin's keys of `scene` name, each as (its JSON path, the name

@@ -37,8 +37,8 @@ from types import FrameType
 from typing import TYPE_CHECKING
 
 from ecs_tentacles.plugin import Plugin, calling
-from ecs_tentacles.plugin_registry import import_file, inside_scene_folder, instantiate, pick
 from ecs_tentacles.registry import App
+from ecs_tentacles.scene.plugins import import_file, inside_scene_folder, instantiate, pick
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:

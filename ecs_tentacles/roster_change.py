@@ -1,6 +1,6 @@
 """`RosterChange`: what plugins and systems are told when a creature comes or goes.
 
-`World.spawn` and `World.despawn` (`ecs_tentacles.spawning`) call every plugin's and
+`World.spawn` and `World.despawn` (`ecs_tentacles.creatures.spawning`) call every plugin's and
 every system's `roster_changed(world, change)` once the stores and the physics have
 changed, so anything kept beside the stores (arrays by row, lists by creature, GPU
 instance tables) can follow. Store columns need no hook: they move with their store.

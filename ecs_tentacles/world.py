@@ -105,7 +105,7 @@ class World:
 
         Validates, builds the entities (the creature bodies, then each plugin's build
         hooks), compiles the physics, schedules the systems of every plugin on
-        (`ecs_tentacles.world_loader`).
+        (`ecs_tentacles.creatures.loading`).
 
         Raises `SceneError` (one line per problem) before anything is built. Plugins
         from a file or module, and systems the scene names, are imported only with
@@ -118,7 +118,7 @@ class World:
         scene. `lod=False` runs every creature at full physics whatever the scene's
         `physics.lod` says (`True` turns level of detail on); None keeps the scene's.
         """
-        from ecs_tentacles.world_loader import WorldClass, load_world
+        from ecs_tentacles.creatures.loading import WorldClass, load_world
 
         world_class: WorldClass[World] = cls
         return load_world(
@@ -148,9 +148,9 @@ class World:
         gets a suffix (`octo_2`). Overlapping a creature or an obstacle is refused, or
         with `on_overlap="move"` moved to the nearest free spot. Other creatures step
         on exactly as if it never came. Emits `creature_spawned`
-        (`ecs_tentacles.spawning`).
+        (`ecs_tentacles.creatures.spawning`).
         """
-        from ecs_tentacles.spawning import spawn
+        from ecs_tentacles.creatures.spawning import spawn
 
         return spawn(
             self, creature, position=position, heading_deg=heading_deg, on_overlap=on_overlap
@@ -158,8 +158,9 @@ class World:
 
     def despawn(self, creature: int) -> None:
         """Remove creature `creature` (an entity) and all it owns; others step on as if it
-        had stayed away from them. Emits `creature_despawned` (`ecs_tentacles.spawning`)."""
-        from ecs_tentacles.spawning import despawn
+        had stayed away from them. Emits `creature_despawned`
+        (`ecs_tentacles.creatures.spawning`)."""
+        from ecs_tentacles.creatures.spawning import despawn
 
         despawn(self, creature)
 
@@ -193,7 +194,7 @@ class World:
         Build hooks are not run (the creatures exist already): plugins that build data
         per creature are turned on in the scene (`plugins`) instead.
         """
-        from ecs_tentacles.world_loader import owned_systems
+        from ecs_tentacles.creatures.loading import owned_systems
 
         self.adopt(plugin)
         self.add_systems(*owned_systems(plugin))

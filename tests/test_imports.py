@@ -117,7 +117,7 @@ def _report(found: list[list[str]]) -> str:
 def test_the_scan_sees_type_only_and_function_level_imports() -> None:
     graph = import_graph()
     assert "ecs_tentacles.host" in graph["ecs_tentacles.system"]  # under TYPE_CHECKING
-    assert "ecs_tentacles.world_loader" in graph[WORLD]  # inside World.from_scene
+    assert "ecs_tentacles.creatures.loading" in graph[WORLD]  # inside World.from_scene
     assert "ecs_tentacles.systems.locomotion.suckers" in graph["ecs_tentacles.locomotion.suckers"]
     assert circles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c", "a"]]
 
@@ -129,18 +129,18 @@ def test_no_import_circle() -> None:
 
 def test_nothing_world_imports_imports_it_back() -> None:
     graph = import_graph()
-    below = graph[WORLD] - {"ecs_tentacles.world_loader"}  # the loader sits above
+    below = graph[WORLD] - {"ecs_tentacles.creatures.loading"}  # the loader sits above
     back = sorted(m for m in below if WORLD in graph[m])
     assert not back, f"imported by world.py and importing it: {back}"
-    assert WORLD not in graph["ecs_tentacles.world_loader"]
+    assert WORLD not in graph["ecs_tentacles.creatures.loading"]
 
 
 CORE = (
-    "ecs_tentacles.world", "ecs_tentacles.world_loader", "ecs_tentacles.host",
+    "ecs_tentacles.world", "ecs_tentacles.creatures.loading", "ecs_tentacles.host",
     "ecs_tentacles.settings", "ecs_tentacles.schedule", "ecs_tentacles.system",
-    "ecs_tentacles.plugin", "ecs_tentacles.plugin_registry", "ecs_tentacles.store",
+    "ecs_tentacles.plugin", "ecs_tentacles.scene.plugins", "ecs_tentacles.store",
     "ecs_tentacles.components",
-    "ecs_tentacles.body", "ecs_tentacles.construction", "ecs_tentacles.physics",
+    "ecs_tentacles.creatures.body", "ecs_tentacles.scene.construction", "ecs_tentacles.physics",
     "ecs_tentacles.snapshot", "ecs_tentacles.events", "ecs_tentacles.scene",
     "ecs_tentacles.systems.physics",
 )  # fmt: skip

@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 from ecs_tentacles.fur.stores import FurData
-from ecs_tentacles.plugin_registry import PluginError, resolve
 from ecs_tentacles.scene.errors import SceneError
+from ecs_tentacles.scene.plugins import PluginError, resolve
 from ecs_tentacles.world import MissingResource, World
 
 GLOW = '''

@@ -17,7 +17,7 @@ import time
 from collections import defaultdict
 from typing import Any
 
-from ecs_tentacles.bench import time_systems, timed
+from ecs_tentacles.cli.measure import time_systems, timed
 from ecs_tentacles.scene.load import bundled_scene_names
 from ecs_tentacles.world import World
 

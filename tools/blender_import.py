@@ -163,14 +163,14 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def atomic_output(target: Path) -> AbstractContextManager[Path]:
-    """`ecs_tentacles.atomic.atomic_output` (the project's one output writer), from the
+    """`ecs_tentacles.output.atomic.atomic_output` (the project's one output writer), from the
     repository this tool sits in when the Python running it (Blender's) lacks the
     project; the module needs only the standard library."""
     module: ModuleType
     try:
-        from ecs_tentacles import atomic as module
+        from ecs_tentacles.output import atomic as module
     except ImportError:
-        file = Path(__file__).resolve().parents[1] / "ecs_tentacles" / "atomic.py"
+        file = Path(__file__).resolve().parents[1] / "ecs_tentacles" / "output" / "atomic.py"
         spec = importlib.util.spec_from_file_location("ecs_tentacles_atomic", file)
         if spec is None or spec.loader is None:
             raise SystemExit(f"error: --render needs {file} (the project's writer)") from None

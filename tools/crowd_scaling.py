@@ -26,7 +26,7 @@ from typing import Any
 from matplotlib.figure import Figure
 from matplotlib.ticker import FuncFormatter, NullFormatter
 
-from ecs_tentacles.atomic import atomic_output
+from ecs_tentacles.output.atomic import atomic_output
 
 LOD_OFF_MAX = 1024
 SIZES = (16, 64, 256, 1024, 10000)

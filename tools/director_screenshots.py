@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from ecs_tentacles.atomic import atomic_output
+from ecs_tentacles.output.atomic import atomic_output
 from ecs_tentacles.render import configure
 
 DEFAULT_DIR = Path(__file__).resolve().parents[1] / "assets" / "screenshots"

@@ -25,7 +25,7 @@ from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.locomotion.params import Locomotion
 from ecs_tentacles.locomotion.stores import LocomotionStores
-from ecs_tentacles.mathutil import quat_rotate
+from ecs_tentacles.numeric.quaternions import quat_rotate
 from ecs_tentacles.scene.load import bundled_scene
 from ecs_tentacles.scene.parameters import parameter
 from ecs_tentacles.world import World

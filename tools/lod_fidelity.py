@@ -31,7 +31,7 @@ import numpy as np
 
 from ecs_tentacles.components import Creature, Link, Tentacle, Transform
 from ecs_tentacles.creator.crowd import crowd_scene
-from ecs_tentacles.mathutil import quat_rotate
+from ecs_tentacles.numeric.quaternions import quat_rotate
 from ecs_tentacles.physics.pairs import near_pairs
 from ecs_tentacles.scene.overlap import segment_distances
 from ecs_tentacles.world import World

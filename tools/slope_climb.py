@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 from matplotlib.figure import Figure
 
-from ecs_tentacles.atomic import atomic_output
+from ecs_tentacles.output.atomic import atomic_output
 
 START = 0.9  # metres from the mantle to the foot of the ramp
 UP = 2.0  # metres along the slope from the foot to the goal

@@ -11,7 +11,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import NoReturn
 
-from ecs_tentacles.atomic import OutputError, claim
+from ecs_tentacles.output.atomic import OutputError, claim
 
 # options whose value may start with "-" (`--focus -2,1,3`): argparse takes "-2,1,3" for
 # an option and says "expected one argument"; such a value is joined to its option

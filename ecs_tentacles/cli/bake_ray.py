@@ -10,9 +10,9 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from ecs_tentacles.atomic import claim
 from ecs_tentacles.cli.arguments import bounded_int
 from ecs_tentacles.export.bake import BakePlan, bake
+from ecs_tentacles.output.atomic import claim
 from ecs_tentacles.take import Take
 
 

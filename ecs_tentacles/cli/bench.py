@@ -5,7 +5,7 @@
     ecs-tentacles bench --crowd 1024 --uniform --lod off
 
 What is measured, and how the bare MuJoCo figure is taken in the same run, is
-described in `ecs_tentacles.bench`.
+described in `ecs_tentacles.cli.measure`.
 """
 
 from __future__ import annotations
@@ -14,10 +14,10 @@ import argparse
 import json
 from typing import Any
 
-from ecs_tentacles.bench import BLOCK, WARMUP, bench
 from ecs_tentacles.cli.arguments import add_threads_argument, bounded_int, counted
 from ecs_tentacles.cli.crowd import add_crowd_options, crowd_from_args, crowd_size
 from ecs_tentacles.cli.lod_options import add_lod_arguments, lod_choice
+from ecs_tentacles.cli.measure import BLOCK, WARMUP, bench
 from ecs_tentacles.cli.run import tier_line
 from ecs_tentacles.scene.load import resolve_scene_path
 

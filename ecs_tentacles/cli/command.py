@@ -11,7 +11,6 @@ from contextlib import contextmanager
 from types import FrameType
 
 from ecs_tentacles import __version__
-from ecs_tentacles.atomic import OutputError, release_claims
 from ecs_tentacles.cli import (
     bake,
     bench,
@@ -26,6 +25,7 @@ from ecs_tentacles.cli import (
     validate,
 )
 from ecs_tentacles.cli.arguments import NoDisplay, OneLineParser
+from ecs_tentacles.output.atomic import OutputError, release_claims
 from ecs_tentacles.plugin import HookFailure
 from ecs_tentacles.scene import load
 from ecs_tentacles.scene.errors import SceneError

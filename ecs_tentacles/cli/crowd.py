@@ -23,7 +23,7 @@ from ecs_tentacles.creator.crowd import (
     max_creatures,
     write_crowd_scene,
 )
-from ecs_tentacles.progress import status
+from ecs_tentacles.output.progress import status
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.terrain import presets
 

@@ -19,11 +19,11 @@ import pathlib
 import sys
 from typing import Any
 
-from ecs_tentacles.atomic import atomic_output, claim
 from ecs_tentacles.cli.arguments import output_path, read_only_problem
-from ecs_tentacles.plugin_registry import BUILTIN, DEFAULT_ON, FROM
+from ecs_tentacles.output.atomic import atomic_output, claim
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.load import load_scene_plugins, read_scene_json, resolve_scene_path
+from ecs_tentacles.scene.plugins import BUILTIN, DEFAULT_ON, FROM
 from ecs_tentacles.scene.schema import builtin_keys
 
 

@@ -22,7 +22,7 @@ from ecs_tentacles.cli.arguments import (
 from ecs_tentacles.cli.lod_options import add_lod_arguments, apply_focus, lod_choice
 from ecs_tentacles.cli.registries import RunSummaries, RunSummary
 from ecs_tentacles.components import Creature
-from ecs_tentacles.progress import status, step_frames
+from ecs_tentacles.output.progress import status, step_frames
 from ecs_tentacles.scene.load import resolve_scene_path
 from ecs_tentacles.world import World
 

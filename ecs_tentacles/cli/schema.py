@@ -14,8 +14,8 @@ import argparse
 import json
 import sys
 
-from ecs_tentacles.atomic import atomic_output
 from ecs_tentacles.cli.arguments import output_path
+from ecs_tentacles.output.atomic import atomic_output
 from ecs_tentacles.scene.load import load_scene_plugins, resolve_scene_path
 from ecs_tentacles.scene.schema import load_schema, schema_for
 

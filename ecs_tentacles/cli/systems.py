@@ -11,8 +11,8 @@ import argparse
 import json
 
 from ecs_tentacles.plugin import Plugin
-from ecs_tentacles.plugin_registry import BUNDLED
 from ecs_tentacles.scene.load import resolve_scene_path
+from ecs_tentacles.scene.plugins import BUNDLED
 from ecs_tentacles.world import World
 
 

@@ -15,7 +15,7 @@ import sys
 from typing import TYPE_CHECKING, Any
 
 from ecs_tentacles.cli.arguments import counted
-from ecs_tentacles.progress import status
+from ecs_tentacles.output.progress import status
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.load import resolve_scene_path
 
@@ -77,8 +77,8 @@ def sentence(report: dict[str, Any]) -> str:
 def checked(path: pathlib.Path, allow_systems: bool) -> tuple[dict[str, Any], list[Plugin]]:
     """The scene at `path`, completed, and its plugins, once every check a run makes
     before simulating has passed (SceneError otherwise, each line led by the path)."""
+    from ecs_tentacles.creatures.loading import load_world
     from ecs_tentacles.world import World
-    from ecs_tentacles.world_loader import load_world
 
     try:
         world = load_world(World, path, allow_systems=allow_systems, checks_only=True)

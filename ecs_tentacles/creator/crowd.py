@@ -41,9 +41,9 @@ from typing import Any
 
 import numpy as np
 
-from ecs_tentacles.atomic import atomic_output
-from ecs_tentacles.construction import tentacle_params, tentacle_shape
 from ecs_tentacles.creator.limits import default
+from ecs_tentacles.output.atomic import atomic_output
+from ecs_tentacles.scene.construction import tentacle_params, tentacle_shape
 from ecs_tentacles.scene.load import load_scene
 from ecs_tentacles.scene.schema import core_schema
 

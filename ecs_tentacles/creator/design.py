@@ -30,9 +30,9 @@ import re
 from dataclasses import asdict, dataclass, replace
 from typing import TYPE_CHECKING, Any
 
-from ecs_tentacles.atomic import atomic_file
-from ecs_tentacles.construction import TentacleShape, tentacle_shape
 from ecs_tentacles.creator.limits import DesignError, checked, default
+from ecs_tentacles.output.atomic import atomic_file
+from ecs_tentacles.scene.construction import TentacleShape, tentacle_shape
 from ecs_tentacles.scene.load import load_scene, resolve_scene_path
 from ecs_tentacles.scene.schema import load_schema
 

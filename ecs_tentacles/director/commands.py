@@ -26,8 +26,8 @@ import numpy as np
 
 from ecs_tentacles.behaviour import placeable
 from ecs_tentacles.components import Creature
-from ecs_tentacles.roster_save import entry_now
-from ecs_tentacles.spawning import SpawnError, free_spot, place
+from ecs_tentacles.creatures.roster_save import entry_now
+from ecs_tentacles.creatures.spawning import SpawnError, free_spot, place
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host

@@ -27,6 +27,7 @@ from pyglet.window import key
 
 from ecs_tentacles.behaviour import placeable
 from ecs_tentacles.components import Creature
+from ecs_tentacles.creatures.spawning import SpawnError, creature_entry
 from ecs_tentacles.director.commands import Despawned, Moved, Spawned, ThreatDropped
 from ecs_tentacles.director.grab import Grab
 from ecs_tentacles.director.palette import Preset, presets
@@ -34,7 +35,6 @@ from ecs_tentacles.director.scatter import reach_of, scatter
 from ecs_tentacles.director.state import Director
 from ecs_tentacles.render.gui import Gui
 from ecs_tentacles.render.registries import Panel, SandboxView
-from ecs_tentacles.spawning import SpawnError, creature_entry
 
 log = logging.getLogger("ecs_tentacles.director")
 

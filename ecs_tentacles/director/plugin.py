@@ -1,6 +1,6 @@
 """The director plugin: the sandbox's crowd-directing tools (`ecs_tentacles.director`).
 
-The sandbox turns it on (`plugin_registry.SANDBOX_ON`); scenes and bakes never see it.
+The sandbox turns it on (`scene.plugins.SANDBOX_ON`); scenes and bakes never see it.
 Resource: `Director` (the creature held by the mouse, the scatter brush). System: grab
 (stage act; `systems/director/grab.py`). Sandbox hooks: the "Director" HUD section
 with the palette and the mouse and keys (`director.panel`); lines for the grab's

@@ -20,9 +20,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ecs_tentacles.construction import creature_layout
+from ecs_tentacles.creatures.spawning import creature_entry, place, unique_name
 from ecs_tentacles.ground import ground_of
-from ecs_tentacles.spawning import creature_entry, place, unique_name
+from ecs_tentacles.scene.construction import creature_layout
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host

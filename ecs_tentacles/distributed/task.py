@@ -4,7 +4,7 @@
 the plan's scene and bakes them exactly as a local bake would (same seed, rates and
 scene in the header and for everything scene-wide, such as the fur's shared point
 count and the threats; each creature draws its own random values, see
-`ecs_tentacles.body.creature_rng`), recording each creature's contact sphere every
+`ecs_tentacles.creatures.body.creature_rng`), recording each creature's contact sphere every
 frame (`ecs_tentacles.distributed.spheres`). Physics steps on one thread: a worker
 is one CPU.
 

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from ecs_tentacles.atomic import atomic_file
+from ecs_tentacles.output.atomic import atomic_file
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.load import load_scene_plugins
 from ecs_tentacles.scene.validate import format_path

@@ -20,9 +20,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ecs_tentacles.atomic import atomic_file
 from ecs_tentacles.distributed.task import ShardResult
 from ecs_tentacles.export.bake import BakePlan
+from ecs_tentacles.output.atomic import atomic_file
 from ecs_tentacles.take import Take, write_npz
 
 _KEY = re.compile(r"^[0-9a-f]{24}\.npz$")

@@ -20,11 +20,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from ecs_tentacles.construction import tentacle_params
 from ecs_tentacles.export.recording import Recording, scene_sha256
-from ecs_tentacles.plugin_registry import builtin
-from ecs_tentacles.progress import status, step_frames
+from ecs_tentacles.output.progress import status, step_frames
+from ecs_tentacles.scene.construction import tentacle_params
 from ecs_tentacles.scene.load import load_scene, load_scene_plugins, resolve_scene_path
+from ecs_tentacles.scene.plugins import builtin
 from ecs_tentacles.take import Take
 from ecs_tentacles.take.read import MAX_FRAMES, MAX_TAKE_BYTES
 from ecs_tentacles.world import World

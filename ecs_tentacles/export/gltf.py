@@ -32,11 +32,11 @@ from typing import Any
 import numpy as np
 
 from ecs_tentacles import __version__
-from ecs_tentacles.atomic import atomic_file
 from ecs_tentacles.export.ground import add_gltf_ground
 from ecs_tentacles.export.materials import gltf_material, take_colours
 from ecs_tentacles.export.meshes import Mesh, body_mesh
 from ecs_tentacles.export.names import FOLDERS, part, unique_leaf, unique_path
+from ecs_tentacles.output.atomic import atomic_file
 from ecs_tentacles.take import Take
 from ecs_tentacles.take.roster import spans
 

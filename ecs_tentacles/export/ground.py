@@ -18,8 +18,8 @@ from typing import Any
 
 import numpy as np
 
-from ecs_tentacles.colours import to_linear
 from ecs_tentacles.ground.meshes import COLOURS
+from ecs_tentacles.skin.colours import to_linear
 from ecs_tentacles.take import Take
 
 EXPORT_NAMES = {"terrain": "surface", "obstacles": "obstacles"}

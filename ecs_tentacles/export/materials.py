@@ -1,4 +1,4 @@
-"""Each creature's material in USD and glTF: its sandbox colour (`ecs_tentacles.colours`).
+"""Each creature's material in USD and glTF: its sandbox colour (`ecs_tentacles.skin.colours`).
 
 The k-th creature of a take gets the sandbox's k-th colour, in a material named
 `<c>_skin` (`ecs_tentacles.export.names.part`): the skinned mesh and, in the rigid
@@ -20,8 +20,8 @@ from typing import Any
 
 import numpy as np
 
-from ecs_tentacles.colours import PALE, creature_colour, look_in_take, to_linear
 from ecs_tentacles.export.names import part
+from ecs_tentacles.skin.colours import PALE, creature_colour, look_in_take, to_linear
 from ecs_tentacles.take import Take
 
 FOLDER = "/World/materials"  # USD: the scope holding the creatures' materials

@@ -29,7 +29,6 @@ from typing import Any
 import numpy as np
 
 from ecs_tentacles import __version__
-from ecs_tentacles.atomic import atomic_output
 from ecs_tentacles.export.gltf import (
     _ARRAY_BUFFER,
     _ELEMENT_ARRAY_BUFFER,
@@ -45,6 +44,7 @@ from ecs_tentacles.export.gltf import (
 from ecs_tentacles.export.ground import add_gltf_ground
 from ecs_tentacles.export.materials import gltf_material, skin_texture, take_colours
 from ecs_tentacles.export.names import part
+from ecs_tentacles.output.atomic import atomic_output
 from ecs_tentacles.skin.keys import KeyReport
 from ecs_tentacles.skin.mesh import Detail, SkinMesh
 from ecs_tentacles.skin.rig import Keys, SkinnedCreature, skinned_creatures

@@ -33,12 +33,12 @@ from typing import Any
 
 import numpy as np
 
-from ecs_tentacles.atomic import atomic_output
 from ecs_tentacles.export.ground import write_usd_ground
 from ecs_tentacles.export.materials import bind_usd, take_colours, usd_material
 from ecs_tentacles.export.names import part, unique_path
 from ecs_tentacles.export.usd import _pxr, key_visibility, mark_rate, new_stage, write_tracks
-from ecs_tentacles.mathutil import quat_rotate
+from ecs_tentacles.numeric.quaternions import quat_rotate
+from ecs_tentacles.output.atomic import atomic_output
 from ecs_tentacles.skin.keys import KeyReport
 from ecs_tentacles.skin.mesh import Detail
 from ecs_tentacles.skin.rig import Keys, SkinnedCreature, skinned_creatures

@@ -44,10 +44,10 @@ from typing import Any
 
 import numpy as np
 
-from ecs_tentacles.atomic import atomic_output
 from ecs_tentacles.export.ground import write_usd_ground
 from ecs_tentacles.export.materials import bind_usd, take_colours, usd_material
 from ecs_tentacles.export.names import FOLDERS, unique_path
+from ecs_tentacles.output.atomic import atomic_output
 from ecs_tentacles.take import Take, TakeTrack
 from ecs_tentacles.take.roster import spans
 

@@ -17,7 +17,7 @@ from ecs_tentacles.fur.dynamics import Strands, blend_profile
 from ecs_tentacles.fur.rig import F32, Bind, ControlValues
 from ecs_tentacles.fur.stores import BEHAVIOURS, COLUMNS, ControlStore, FurData
 from ecs_tentacles.fur.vectors import clamp_to_cap, cross, dot, normalize
-from ecs_tentacles.keyframes import TrackSet
+from ecs_tentacles.numeric.keyframes import TrackSet
 
 MAX_ELEVATION = np.radians(80.0)  # the cap never shrinks to nothing, even for bent guides
 LIFT, AIM, DIRECTION, RANDOM, DYNAMIC = range(5)

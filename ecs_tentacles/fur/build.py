@@ -17,7 +17,7 @@ from ecs_tentacles.fur import groom as grooming
 from ecs_tentacles.fur.components import Emotion, Fur, FurControl, FurGuide
 from ecs_tentacles.fur.controls import expand_mirrors, nearest_control
 from ecs_tentacles.fur.stores import BEHAVIOURS, COLUMNS, FurData
-from ecs_tentacles.keyframes import channels_from_keys
+from ecs_tentacles.numeric.keyframes import channels_from_keys
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host

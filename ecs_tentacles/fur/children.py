@@ -23,7 +23,7 @@ import numpy as np
 from ecs_tentacles.components import Creature
 from ecs_tentacles.fur.groom import closest_surface_point
 from ecs_tentacles.fur.stores import FurData
-from ecs_tentacles.mathutil import quat_rotate
+from ecs_tentacles.numeric.quaternions import quat_rotate
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host

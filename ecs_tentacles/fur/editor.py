@@ -23,7 +23,7 @@ from ecs_tentacles.components import Creature
 from ecs_tentacles.fur.components import Fur, FurControl
 from ecs_tentacles.fur.controls import expand_mirrors, mirror_name, mirror_point, nearest_control
 from ecs_tentacles.fur.stores import BEHAVIOURS, COLUMNS, FurData
-from ecs_tentacles.keyframes import EASINGS, TrackSet, channels_from_keys
+from ecs_tentacles.numeric.keyframes import EASINGS, TrackSet, channels_from_keys
 from ecs_tentacles.scene.save import save_scene
 
 if TYPE_CHECKING:

@@ -21,7 +21,7 @@ import numpy as np
 from ecs_tentacles.fur import children
 from ecs_tentacles.fur.components import FurControl
 from ecs_tentacles.fur.stores import FurData
-from ecs_tentacles.mathutil import quat_rotate
+from ecs_tentacles.numeric.quaternions import quat_rotate
 from ecs_tentacles.take.registries import CurvesFrame
 
 if TYPE_CHECKING:

@@ -48,7 +48,7 @@ import numpy as np
 
 from ecs_tentacles.fur.scratch import RigBuffers
 from ecs_tentacles.fur.vectors import TINY
-from ecs_tentacles.optional_kernels import OptionalKernels
+from ecs_tentacles.numeric.optional_kernels import OptionalKernels
 
 F32 = np.float32
 

@@ -17,7 +17,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ecs_tentacles.keyframes import Channel
+from ecs_tentacles.numeric.keyframes import Channel
 from ecs_tentacles.store import ArrayStore, Field, without_rows
 
 # The rig's behaviours, in order: a fur switches each on or off (`FurSetStore.enabled`),

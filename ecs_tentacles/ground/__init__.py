@@ -14,7 +14,7 @@ Modules: this one (`Ground`, `FLAT`, `ground_of`), `heightfield`, `solids`, `mes
 (triangle meshes for drawing and export).
 
 Reads: nothing of the world. Used by the physics model (`add_to_spec`: every group's
-model gets the same static geoms), creature placement (`ecs_tentacles.construction`),
+model gets the same static geoms), creature placement (`ecs_tentacles.scene.construction`),
 the suckers (they grip any static surface) and the renderer and exporters (`mesh`).
 """
 

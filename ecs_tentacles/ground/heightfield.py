@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ecs_tentacles.optional_kernels import OptionalKernels
+from ecs_tentacles.numeric.optional_kernels import OptionalKernels
 
 # the heightfield kernel (numba, when installed; numpy otherwise: the same numbers)
 KERNELS = OptionalKernels("ecs_tentacles.physics.kernels", "ECS_TENTACLES_SENSE")

@@ -31,8 +31,8 @@ from typing import Any
 
 import numpy as np
 
-from ecs_tentacles.construction import creature_layout
 from ecs_tentacles.physics.pairs import near_pairs
+from ecs_tentacles.scene.construction import creature_layout
 from ecs_tentacles.scene.schema import fragment
 
 BEHIND = 0.3  # a neighbour straight behind weighs this much of one straight ahead

@@ -3,7 +3,7 @@
 * `DirectedStates.capture` / `sandbox_restore` (the sandbox's undo,
   `ecs_tentacles.render.undo`): every creature's goal path and run-time parameters (the
   columns the parameter table names, `locomotion.params.settable`), put back by name;
-* `save_creature` (saving the roster as a scene, `ecs_tentacles.roster_save`): a
+* `save_creature` (saving the roster as a scene, `ecs_tentacles.creatures.roster_save`): a
   creature's goals and its current parameters into its scene entry (tentacles that
   differ from the first as `overrides`).
 

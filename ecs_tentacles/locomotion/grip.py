@@ -22,7 +22,7 @@ import numpy as np
 from ecs_tentacles.components import Sucker
 from ecs_tentacles.events import SuckerReleased
 from ecs_tentacles.locomotion.events import SuckerAttached
-from ecs_tentacles.mathutil import quat_rotate
+from ecs_tentacles.numeric.quaternions import quat_rotate
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host

@@ -26,10 +26,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ecs_tentacles.behaviour import Destinations, Travel
-from ecs_tentacles.body import creature_rng
 from ecs_tentacles.cli.registries import RunSummaries, RunSummary
 from ecs_tentacles.components import Creature, Tentacle
-from ecs_tentacles.construction import tentacle_params
+from ecs_tentacles.creatures.body import creature_rng
 from ecs_tentacles.distributed.registries import MeetingReaches, Reach, ShardReaches
 from ecs_tentacles.locomotion.actions import STRENGTH, ActionQueue, Kind
 from ecs_tentacles.locomotion.avoidance import Avoidance, bent
@@ -49,6 +48,7 @@ from ecs_tentacles.render.registries import (
     UndoState,
     UndoStates,
 )
+from ecs_tentacles.scene.construction import tentacle_params
 from ecs_tentacles.scene.parameters import apply_parameters
 from ecs_tentacles.scene.schema import fragment
 from ecs_tentacles.system import System

@@ -32,8 +32,8 @@ import numpy as np
 
 from ecs_tentacles.lod.frames import nlerp, quat_power, rotate_z, to_ground, yaw_times
 from ecs_tentacles.lod.record import GaitRecording, forward_poses, one_creature_scene, record
-from ecs_tentacles.mathutil import quat_multiply
-from ecs_tentacles.optional_kernels import OptionalKernels
+from ecs_tentacles.numeric.optional_kernels import OptionalKernels
+from ecs_tentacles.numeric.quaternions import quat_multiply
 
 IDLE, CRAWL = 0, 1
 KINDS = ("idle", "crawl")

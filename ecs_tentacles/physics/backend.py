@@ -10,7 +10,7 @@ switches and anchors), `step` (every awake row advanced on the stepping threads,
 thread with its own scratch MjData per batch) and `sync` (body poses scattered into
 the Transform store). Systems stay whole-array and never see a MuJoCo object. Every
 `heap.TRIM_FRAMES` frames `step` gives the C heap's free pages back, and building one fixes
-glibc's thresholds (`ecs_tentacles.heap`): the frames' numpy temporaries would otherwise
+glibc's thresholds (`ecs_tentacles.physics.heap`): the frames' numpy temporaries would otherwise
 leave a long run growing.
 
 `state()` / `set_state()` copy everything that decides how the physics steps on
@@ -31,8 +31,8 @@ from typing import TYPE_CHECKING, Any
 import mujoco
 import numpy as np
 
-from ecs_tentacles import heap
 from ecs_tentacles.components import Creature, Transform
+from ecs_tentacles.physics import heap
 from ecs_tentacles.physics.batch import Batch
 from ecs_tentacles.physics.blas import quiet_blas
 from ecs_tentacles.physics.health import SOFT_GAIN, HealthCheck, HealthState
@@ -88,7 +88,7 @@ class PhysicsBackend(Membership):
 
     def __init__(self, world: PhysicsHost, threads: int | None = None):
         route_mujoco_messages()
-        heap.settle()  # a long run must not grow (`ecs_tentacles.heap`)
+        heap.settle()  # a long run must not grow (`ecs_tentacles.physics.heap`)
         self.threads = max(1, threads if threads is not None else os.cpu_count() or 1)
         self.time = 0.0
         creatures = sorted(world.query(Creature, Transform))

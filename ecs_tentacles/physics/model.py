@@ -33,7 +33,7 @@ import numpy as np
 
 from ecs_tentacles.components import Creature, Link, Motor, Sucker, Tentacle, Transform
 from ecs_tentacles.ground import FLAT, StaticSpec
-from ecs_tentacles.mathutil import quat_about_z
+from ecs_tentacles.numeric.quaternions import quat_about_z
 from ecs_tentacles.registry import Registry
 
 if TYPE_CHECKING:

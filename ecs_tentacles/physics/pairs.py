@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ecs_tentacles.optional_kernels import OptionalKernels
+from ecs_tentacles.numeric.optional_kernels import OptionalKernels
 
 SLACK = 0.25  # metres of extra reach the kept pairs are found with
 DENSE_PAIRS = 32  # creatures up to which every pair is compared (no tree to build)

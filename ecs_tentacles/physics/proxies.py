@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING
 import mujoco
 import numpy as np
 
-from ecs_tentacles.optional_kernels import OptionalKernels
+from ecs_tentacles.numeric.optional_kernels import OptionalKernels
 from ecs_tentacles.physics.model import PROXY_CAPSULES, PROXY_CYLINDERS, PROXY_PARKED
 from ecs_tentacles.physics.pairs import NearPairCache
 

@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from ecs_tentacles.ground import Ground
-from ecs_tentacles.mathutil import quat_rotate
+from ecs_tentacles.numeric.quaternions import quat_rotate
 from ecs_tentacles.render.gpu import INSTANCE_FLOATS
 from ecs_tentacles.render.meshes import Mesh, cylinder
 

@@ -1,6 +1,6 @@
 """Screenshots (PNG) and videos (MP4 through ffmpeg), written by the one atomic writer.
 
-Both go through `ecs_tentacles.atomic`: an exclusive temporary file beside the
+Both go through `ecs_tentacles.output.atomic`: an exclusive temporary file beside the
 target, renamed into place when complete. The video's ffmpeg (imageio-ffmpeg's
 binary) writes to that temporary file; it is killed when the recording is aborted
 (an error, Ctrl-C, SIGTERM) and, on Linux, when this process dies (SIGKILL).
@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 from PIL import Image
 
-from ecs_tentacles.atomic import AtomicOutput, OutputError, atomic_file
+from ecs_tentacles.output.atomic import AtomicOutput, OutputError, atomic_file
 
 
 def save_png(pixels: np.ndarray, path: str | os.PathLike[str]) -> Path:

@@ -28,7 +28,6 @@ from typing import Any
 import numpy as np
 from pyglet import gl
 
-from ecs_tentacles.colours import PALETTES, Look, creature_colour, look_in_world
 from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.ground import ground_of
 from ecs_tentacles.render import shaders
@@ -52,6 +51,7 @@ from ecs_tentacles.render.rings import CIRCLE, draped
 from ecs_tentacles.render.scenery import Scenery, set_fog
 from ecs_tentacles.render.skinned import SkinnedCreatures
 from ecs_tentacles.roster_change import RosterChange
+from ecs_tentacles.skin.colours import PALETTES, Look, creature_colour, look_in_world
 from ecs_tentacles.world import World
 
 SKY = HORIZON  # what is behind everything at the horizon (the sky is drawn over it)
@@ -95,7 +95,7 @@ class Renderer:
         self.overlays = False  # editing aids wanted (the sandbox sets it while its HUD shows)
         self.show_tiers = False  # a marker per creature coloured by physics tier (render.tiers)
         self.state: dict[str, Any] = {}  # what plugins keep here (GL objects), across worlds
-        self.palette = "natural"  # the creatures' colours (`ecs_tentacles.colours`)
+        self.palette = "natural"  # the creatures' colours (`ecs_tentacles.skin.colours`)
         self.set_world(world)
 
     def set_world(self, world: World) -> None:

@@ -45,10 +45,8 @@ from imgui_bundle import imgui
 from pyglet.window import key
 from tqdm import tqdm
 
-from ecs_tentacles.colours import PALETTES
 from ecs_tentacles.components import Creature
 from ecs_tentacles.ground import ground_of
-from ecs_tentacles.plugin_registry import sandbox_plugins
 from ecs_tentacles.render.camera import CameraChoice
 from ecs_tentacles.render.gui import Gui, same_line_if_fits, text_width
 from ecs_tentacles.render.hud import Hud
@@ -62,6 +60,8 @@ from ecs_tentacles.render.scripts import Scripts
 from ecs_tentacles.render.selection import Selection
 from ecs_tentacles.render.session import SandboxSession
 from ecs_tentacles.render.undo import UndoStack
+from ecs_tentacles.scene.plugins import sandbox_plugins
+from ecs_tentacles.skin.colours import PALETTES
 from ecs_tentacles.world import World
 
 if TYPE_CHECKING:
@@ -97,7 +97,7 @@ class Sandbox(SandboxPicture):
         """`lod` turns level of detail on or off over the scene's (None: the scene's);
         `focus` (x, y, radius in m) pins the full-physics region instead of the camera's;
         `threads` step the physics (None: one per core); `palette` colours the creatures
-        ("natural" or "debug": `ecs_tentacles.colours`; None: the scene's `render.palette`,
+        ("natural" or "debug": `ecs_tentacles.skin.colours`; None: the scene's `render.palette`,
         natural if it says none)."""
         self.headless = headless
         self.window = pyglet.window.Window(
@@ -192,7 +192,7 @@ class Sandbox(SandboxPicture):
 
     def _add_sandbox_plugins(self) -> None:
         """The sandbox's own plugins join the world: its drawing, and the ones the
-        registry turns on in sandboxes (`plugin_registry.SANDBOX_ON`: the director)."""
+        registry turns on in sandboxes (`scene.plugins.SANDBOX_ON`: the director)."""
         self.world.add_plugin(RenderPlugin(renderer=self.renderer))
         on = {plugin.key for plugin in self.world.plugins}
         for plugin in sandbox_plugins():

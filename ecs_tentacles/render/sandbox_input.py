@@ -22,9 +22,9 @@ import pyglet
 from pyglet.window import key, mouse
 
 from ecs_tentacles.components import Transform
+from ecs_tentacles.creatures.spawning import SpawnError
 from ecs_tentacles.render.on_screen import creatures_in
 from ecs_tentacles.render.registries import Click, Clicks, Panel
-from ecs_tentacles.spawning import SpawnError
 
 CLICK_PIXELS = 4  # a press and release closer than this is a click, not a drag
 BUTTONS = {mouse.LEFT: "left", mouse.RIGHT: "right", mouse.MIDDLE: "middle"}

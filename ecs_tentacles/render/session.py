@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from ecs_tentacles.roster_save import save_roster
+from ecs_tentacles.creatures.roster_save import save_roster
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.save import default_file_name
 from ecs_tentacles.snapshot import Snapshot, SnapshotMismatch
@@ -146,7 +146,7 @@ class SandboxSession:
         """Write the roster, goals and settings as they are now to a scene file (Ctrl+S:
         `<scene>_directed.json` in the working folder, the name made safe: a scene's
         name never chooses a folder); None and a message if it would not load
-        (`ecs_tentacles.roster_save`)."""
+        (`ecs_tentacles.creatures.roster_save`)."""
         name = (self.world.scene or {}).get("name")
         target = Path(path) if path is not None else Path(default_file_name(name, "_directed.json"))
         try:

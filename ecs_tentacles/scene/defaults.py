@@ -101,7 +101,7 @@ def with_defaults(data: dict[str, Any], plugins: Sequence[Plugin] | None = None)
     """
     result = copied(data)
     if plugins is None:
-        from ecs_tentacles.plugin_registry import resolve
+        from ecs_tentacles.scene.plugins import resolve
 
         plugins = resolve(None)
     schema = schema_for(plugins)

@@ -22,10 +22,10 @@ import re
 import stat
 from typing import TYPE_CHECKING, Any
 
-from ecs_tentacles.plugin_registry import resolve
 from ecs_tentacles.scene.defaults import plugin_config, with_defaults
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.physical import physical_problems, physically_checked
+from ecs_tentacles.scene.plugins import resolve
 from ecs_tentacles.scene.validate import repaired, validated
 
 if TYPE_CHECKING:

@@ -2,7 +2,7 @@
 
 Run by `ecs_tentacles.scene.load.load_scene` on a schema-valid scene with defaults
 filled in, before anything is built. The creatures are laid out by the same
-construction code as the build (`ecs_tentacles.construction.creature_layout`), and
+construction code as the build (`ecs_tentacles.scene.construction.creature_layout`), and
 each problem is one line naming its JSON path, like the validator's:
 
 * the physics step `1 / (fps * substeps)` longer than `MAX_SUBSTEP` (servos at the
@@ -30,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from ecs_tentacles.construction import (
+from ecs_tentacles.scene.construction import (
     CreatureLayout,
     capsule_mass_inertia,
     creature_layout,

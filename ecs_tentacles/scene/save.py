@@ -24,7 +24,7 @@ from importlib.resources import files
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ecs_tentacles.atomic import AtomicOutput, OutputError, disk_full
+from ecs_tentacles.output.atomic import AtomicOutput, OutputError, disk_full
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.load import load_scene_plugins
 from ecs_tentacles.scene.physical import physically_checked

@@ -48,7 +48,7 @@ def _fragment_file(package: str, name: str) -> importlib.resources.abc.Traversab
 
 def builtin_fragment(name: str) -> dict[str, Any]:
     """The fragment of built-in plugin `name` ({} when it has none), its code not imported."""
-    from ecs_tentacles.plugin_registry import BUILTIN
+    from ecs_tentacles.scene.plugins import BUILTIN
 
     package = BUILTIN[name].partition(":")[0].rpartition(".")[0]  # the feature package
     return fragment(package, name) if _fragment_file(package, name).is_file() else {}
@@ -82,7 +82,7 @@ def load_schema() -> dict[str, Any]:
 
     Assembled from the fragment files of the default plugins (their code is not imported).
     """
-    from ecs_tentacles.plugin_registry import DEFAULT_ON
+    from ecs_tentacles.scene.plugins import DEFAULT_ON
 
     parts = [(name, builtin_fragment(name)) for name in DEFAULT_ON]
     return _assemble([(name, tuple(part.get(p, {}) for p in PLACES)) for name, part in parts])

@@ -203,7 +203,7 @@ def validate_scene(data: object, plugins: Sequence[Plugin] | None = None) -> lis
     """Return every problem of ``data`` as a scene, sorted by JSON path; ``[]`` if it is valid.
 
     Each problem is one line ``"<json path>: <message>"``. ``plugins`` are the plugins
-    the scene turns on (`ecs_tentacles.plugin_registry.resolve`; default: the default ones): their
+    the scene turns on (`ecs_tentacles.scene.plugins.resolve`; default: the default ones): their
     keys are part of the schema, and their own rules run. Semantic rules (override
     indices, unique names) are checked only once the schema passes; overlapping bodies
     are a physical problem (`ecs_tentacles.scene.physical`), checked when loading.
@@ -220,7 +220,7 @@ def validated(
     (a crowd of 10,000 creatures took 1.4 s each time).
     """
     if plugins is None:
-        from ecs_tentacles.plugin_registry import resolve
+        from ecs_tentacles.scene.plugins import resolve
 
         plugins = resolve(None)
     schema = schema_for(plugins)
@@ -300,7 +300,7 @@ def _place(path: JsonPath) -> str | None:
 
 def _name_plugins_that_are_off(problems: list[Problem], on: set[str]) -> list[Problem]:
     """An unknown key that a built-in plugin which is off would know says so."""
-    from ecs_tentacles.plugin_registry import BUILTIN
+    from ecs_tentacles.scene.plugins import BUILTIN
 
     if not any(message.startswith("unknown key") for _, message in problems):
         return problems

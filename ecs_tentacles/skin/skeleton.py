@@ -5,7 +5,7 @@ parent is the previous link of its tentacle, the first link's parent the mantle.
 A link's joint sits at the link's base (where MuJoCo's hinges are: local x = -L/2),
 oriented like the link body; the mantle's joint is the mantle body itself.
 
-Bind pose = the construction pose (`ecs_tentacles.construction`: tentacle k straight
+Bind pose = the construction pose (`ecs_tentacles.scene.construction`: tentacle k straight
 out along 360 deg * k / N about the mantle's +z, its base on the edge of the mantle's
 base) placed at the mantle's frame-0 pose. A take's frame 0 is the pose the scene was
 built in, so the bind pose is frame 0; tests check that they agree.
@@ -21,8 +21,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ecs_tentacles.construction import tentacle_angles
-from ecs_tentacles.mathutil import quat_about_z, quat_multiply, quat_rotate
+from ecs_tentacles.numeric.quaternions import quat_about_z, quat_multiply, quat_rotate
+from ecs_tentacles.scene.construction import tentacle_angles
 from ecs_tentacles.take import Take
 
 

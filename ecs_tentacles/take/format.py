@@ -39,7 +39,7 @@ from typing import Any, BinaryIO
 
 import numpy as np
 
-from ecs_tentacles.atomic import atomic_file
+from ecs_tentacles.output.atomic import atomic_file
 from ecs_tentacles.take import ground as take_ground
 from ecs_tentacles.take import roster as take_roster
 from ecs_tentacles.take.read import (
@@ -154,7 +154,7 @@ class Take:
 
     # -- files -------------------------------------------------------------------------
     def save(self, path: str | os.PathLike[str]) -> None:
-        """Write the take to `path` atomically (see `ecs_tentacles.atomic`).
+        """Write the take to `path` atomically (see `ecs_tentacles.output.atomic`).
 
         Raises `TakeError` (one line, nothing written) when `Take.load` would refuse the
         result: a plugin that wrote NaN into the poses makes a take nobody can read."""

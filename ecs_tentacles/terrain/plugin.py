@@ -18,11 +18,11 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ecs_tentacles.construction import creature_layout
 from ecs_tentacles.ground import ground_of
 from ecs_tentacles.physics.model import StaticGeometry
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.render.registries import Panels
+from ecs_tentacles.scene.construction import creature_layout
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.schema import fragment
 from ecs_tentacles.terrain.editing import TerrainEditor

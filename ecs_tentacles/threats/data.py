@@ -17,7 +17,7 @@ import numpy as np
 
 from ecs_tentacles.components import RowComponent, RowField, Transform
 from ecs_tentacles.ground import ground_of
-from ecs_tentacles.keyframes import Channel, channels_from_keys
+from ecs_tentacles.numeric.keyframes import Channel, channels_from_keys
 from ecs_tentacles.store import ArrayStore, Field
 
 if TYPE_CHECKING:

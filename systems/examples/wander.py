@@ -28,7 +28,7 @@ from ecs_tentacles.systems.examples import (
 )
 
 from ecs_tentacles.behaviour import ARRIVALS, DESTINATIONS_READ, travel
-from ecs_tentacles.body import creature_rng
+from ecs_tentacles.creatures.body import creature_rng
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.scene.defaults import plugin_config
 from ecs_tentacles.system import System

@@ -30,7 +30,7 @@ from ecs_tentacles.fur.dynamics import Strands
 from ecs_tentacles.fur.rig import Bind, RigBuffers, control_table, evaluate, use_parallel
 from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.fur.vectors import quat_matrices
-from ecs_tentacles.keyframes import TrackSet
+from ecs_tentacles.numeric.keyframes import TrackSet
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:

@@ -32,7 +32,7 @@ import numpy as np
 from ecs_tentacles.ground import Ground, ground_of
 from ecs_tentacles.locomotion.actions import ATTACH_PATIENCE, GRIPPING, Kind, Mode
 from ecs_tentacles.locomotion.stores import LocomotionStores
-from ecs_tentacles.mathutil import quat_rotate
+from ecs_tentacles.numeric.quaternions import quat_rotate
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:

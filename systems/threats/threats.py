@@ -10,7 +10,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from ecs_tentacles.behaviour import DANGERS_MOVED
-from ecs_tentacles.keyframes import TrackSet
+from ecs_tentacles.numeric.keyframes import TrackSet
 from ecs_tentacles.system import System
 from ecs_tentacles.threats.data import ThreatData
 

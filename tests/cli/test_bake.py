@@ -212,7 +212,7 @@ def test_resume_without_ray_is_refused(
 
 def test_lod_options_go_into_the_baked_scene(tmp_path: Path) -> None:
     """`--lod off` / `--focus` bake exactly what a scene saying so bakes (same bytes)."""
-    from tests.test_bench import lod_crowd
+    from tests.cli.test_measure import lod_crowd
 
     crowd = lod_crowd(3)  # budgets: 1 full, 2 reduced
     written = {}

@@ -61,7 +61,7 @@ def test_without_locomotion_there_are_no_goal_counts_and_a_plugin_adds_its_own(
 def test_lod_and_focus_options_decide_the_tiers(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    from tests.test_bench import lod_crowd
+    from tests.cli.test_measure import lod_crowd
 
     scene = tmp_path / "crowd.json"
     scene.write_text(json.dumps(lod_crowd()))  # 6 creatures, budgets 1 full and 2 reduced

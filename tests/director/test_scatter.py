@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from ecs_tentacles.components import Creature, Transform
+from ecs_tentacles.creatures.spawning import SpawnError, creature_entry
 from ecs_tentacles.director.scatter import GAP, reach_of, scatter, spots
-from ecs_tentacles.spawning import SpawnError, creature_entry
 from ecs_tentacles.world import World
 
 OCTO = {"name": "octo", "tentacles": {"count": 6, "links": 5}}

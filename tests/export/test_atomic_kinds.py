@@ -17,9 +17,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ecs_tentacles.atomic import STALE_SECONDS, OutputConflict
 from ecs_tentacles.creator import CreatureDesign
 from ecs_tentacles.export import write
+from ecs_tentacles.output.atomic import STALE_SECONDS, OutputConflict
 from ecs_tentacles.render.output import VideoWriter, save_png
 from ecs_tentacles.take import Take
 
@@ -188,7 +188,7 @@ def test_symlinks_planted_at_every_temporary_name_are_never_followed(
     for link in planted:
         (out / link).symlink_to(victim)
     tokens = iter(["deadbeef", "deadbeef", "0badf00d"])
-    monkeypatch.setattr("ecs_tentacles.atomic.secrets.token_hex", lambda n: next(tokens))
+    monkeypatch.setattr("ecs_tentacles.output.atomic.secrets.token_hex", lambda n: next(tokens))
     _write_one(name, guided_take, out)
     assert victim.read_text() == "precious"
     assert (out / name).is_file() and not (out / name).is_symlink()
@@ -199,7 +199,7 @@ def test_symlinks_planted_at_every_temporary_name_are_never_followed(
 def test_a_temporary_file_swapped_for_a_symlink_mid_video_is_not_followed(
     tmp_path: Path,
 ) -> None:
-    from ecs_tentacles.atomic import OutputError
+    from ecs_tentacles.output.atomic import OutputError
 
     victim = tmp_path / "victim.txt"
     victim.write_text("precious")

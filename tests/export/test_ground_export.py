@@ -12,11 +12,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ecs_tentacles.colours import to_linear
 from ecs_tentacles.export.gltf import read_glb, write_glb
 from ecs_tentacles.export.skinned_gltf import write_skinned_glb
 from ecs_tentacles.ground import ground_of
 from ecs_tentacles.ground.meshes import COLOURS, ground_meshes
+from ecs_tentacles.skin.colours import to_linear
 from ecs_tentacles.take import Take, write_npz
 from ecs_tentacles.take.read import TakeError
 from tests.export.conftest import khronos_report, record

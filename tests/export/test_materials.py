@@ -1,4 +1,4 @@
-"""Each creature's material carries its sandbox colour (`ecs_tentacles.colours`) in the
+"""Each creature's material carries its sandbox colour (`ecs_tentacles.skin.colours`) in the
 four exports, and suckers and goals are locators only when asked for (skinned) or unless
 left out (rigid)."""
 
@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 
 from ecs_tentacles.cli import main
-from ecs_tentacles.colours import creature_colour, look_in_world, to_linear
 from ecs_tentacles.export.gltf import read_glb, write_glb
 from ecs_tentacles.export.skinned_gltf import write_skinned_glb
+from ecs_tentacles.skin.colours import creature_colour, look_in_world, to_linear
 from ecs_tentacles.take import Take
 from ecs_tentacles.world import World
 from tests.export.conftest import khronos_report, record
@@ -209,7 +209,7 @@ def test_a_glb_sucker_locator_sits_at_its_sucker(three: Take, form: str) -> None
     the sucker's point of the take, turned y-up."""
     from ecs_tentacles.export.gltf import build_gltf, to_y_up_points
     from ecs_tentacles.export.skinned_gltf import build_skinned_gltf
-    from ecs_tentacles.mathutil import quat_rotate
+    from ecs_tentacles.numeric.quaternions import quat_rotate
     from ecs_tentacles.skin.skeleton import quat_matrix
 
     if form == "rigid":

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from ecs_tentacles.export.skinned_usd import build_skinned_stage, write_skinned_usd
-from ecs_tentacles.mathutil import quat_rotate
+from ecs_tentacles.numeric.quaternions import quat_rotate
 from ecs_tentacles.skin.keys import angle_between
 from ecs_tentacles.skin.mesh import Detail, creature_mesh
 from ecs_tentacles.skin.rig import Keys

@@ -12,7 +12,7 @@ from ecs_tentacles.fur import child_hairs
 from ecs_tentacles.fur.children import layout
 from ecs_tentacles.fur.groom import closest_surface_point
 from ecs_tentacles.fur.stores import FurData
-from ecs_tentacles.mathutil import quat_rotate
+from ecs_tentacles.numeric.quaternions import quat_rotate
 from ecs_tentacles.world import World
 from tests.conftest import NO_LOCOMOTION
 

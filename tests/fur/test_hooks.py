@@ -10,7 +10,7 @@ from numpy.testing import assert_allclose, assert_array_equal
 
 from ecs_tentacles.fur import child_hairs, control_markers, guide_curves
 from ecs_tentacles.fur.stores import FurData
-from ecs_tentacles.mathutil import quat_rotate
+from ecs_tentacles.numeric.quaternions import quat_rotate
 from ecs_tentacles.world import World
 from tests.conftest import NO_LOCOMOTION
 

@@ -12,7 +12,7 @@ from numpy.testing import assert_allclose, assert_array_equal
 from ecs_tentacles.fur.presets import preset, preset_names, resolve
 from ecs_tentacles.fur.rig import pose
 from ecs_tentacles.fur.stores import FurData
-from ecs_tentacles.mathutil import quat_rotate
+from ecs_tentacles.numeric.quaternions import quat_rotate
 from ecs_tentacles.scene.validate import validate_scene
 from ecs_tentacles.world import World
 from tests.conftest import NO_LOCOMOTION

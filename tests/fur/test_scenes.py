@@ -8,7 +8,7 @@ import numpy as np
 
 from ecs_tentacles.fur import Fur, guide_curves
 from ecs_tentacles.fur.stores import FurData
-from ecs_tentacles.mathutil import quat_rotate
+from ecs_tentacles.numeric.quaternions import quat_rotate
 from ecs_tentacles.world import World
 
 

@@ -12,7 +12,7 @@ import pytest
 
 from ecs_tentacles.lod.clips import CRAWL, IDLE, GaitClips
 from ecs_tentacles.lod.record import one_creature_scene, record
-from ecs_tentacles.mathutil import quat_about_z, quat_multiply, quat_rotate
+from ecs_tentacles.numeric.quaternions import quat_about_z, quat_multiply, quat_rotate
 from ecs_tentacles.scene.load import load_scene, resolve_scene_path
 from ecs_tentacles.world import World
 

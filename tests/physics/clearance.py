@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ecs_tentacles.components import Creature, Link, Tentacle, Transform
-from ecs_tentacles.mathutil import quat_rotate
+from ecs_tentacles.numeric.quaternions import quat_rotate
 from ecs_tentacles.scene.overlap import segment_distances
 
 if TYPE_CHECKING:

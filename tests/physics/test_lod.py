@@ -9,7 +9,7 @@ import numpy as np
 from numpy.testing import assert_array_equal
 
 from ecs_tentacles.components import Creature, Link, Tentacle, Transform
-from ecs_tentacles.mathutil import quat_rotate
+from ecs_tentacles.numeric.quaternions import quat_rotate
 from ecs_tentacles.physics.proxies import MARGIN
 from ecs_tentacles.world import World
 

@@ -255,8 +255,8 @@ def test_undoing_a_removal_puts_the_creature_beside_whatever_took_its_place(
 
 
 def test_an_edit_that_refuses_stays_on_the_undo_stack() -> None:
+    from ecs_tentacles.creatures.spawning import SpawnError
     from ecs_tentacles.render.undo import UndoStack
-    from ecs_tentacles.spawning import SpawnError
 
     class NoRoom:
         label = "remove 1"

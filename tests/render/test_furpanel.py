@@ -15,7 +15,7 @@ from ecs_tentacles.fur.components import FurControl
 from ecs_tentacles.fur.controls import nearest_control
 from ecs_tentacles.fur.render.furpanel import FurPanel
 from ecs_tentacles.fur.stores import FurData
-from ecs_tentacles.mathutil import quat_rotate
+from ecs_tentacles.numeric.quaternions import quat_rotate
 from ecs_tentacles.scene.load import load_scene
 from ecs_tentacles.world import World
 from tests.render.conftest import click_item, event

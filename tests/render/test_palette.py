@@ -15,7 +15,7 @@ from numpy.testing import assert_allclose
 from PIL import Image
 
 from ecs_tentacles.cli import main
-from ecs_tentacles.colours import (
+from ecs_tentacles.skin.colours import (
     Look,
     creature_colour,
     creature_colours,

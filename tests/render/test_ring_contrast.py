@@ -9,10 +9,10 @@ from typing import Any
 import numpy as np
 import pytest
 
-from ecs_tentacles.colours import Look, creature_colour
 from ecs_tentacles.ground import ground_of
 from ecs_tentacles.render.camera import CameraChoice
 from ecs_tentacles.render.rings import CIRCLE
+from ecs_tentacles.skin.colours import Look, creature_colour
 
 ROCK = {"shape": "box", "position": [1.0, 1.0, 0.3], "size": [1.4, 1.4, 0.6]}
 SAND = (-1.2, -1.0)

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from ecs_tentacles.components import Creature, Transform
-from ecs_tentacles.mathutil import quat_rotate
+from ecs_tentacles.numeric.quaternions import quat_rotate
 from ecs_tentacles.render.skinned import SANDBOX_DETAIL, world_skeleton
 from ecs_tentacles.skin.mesh import creature_mesh
 from tests.skin.cpu_skinning import skin_points

@@ -10,12 +10,12 @@ from typing import Any
 
 import numpy as np
 import pytest
+from tests.cli.test_measure import lod_crowd
 
 from ecs_tentacles.cli import main
 from ecs_tentacles.render.session import FOCUS_RADIUS
 from ecs_tentacles.render.tiers import COLOURS, tier_markers
 from tests.render.conftest import click_item
-from tests.test_bench import lod_crowd
 
 
 def test_the_camera_target_and_the_selection_run_full(make_sandbox: Callable[..., Any]) -> None:

@@ -13,7 +13,7 @@ import pytest
 
 from ecs_tentacles.cli import main
 from ecs_tentacles.components import Creature, Tentacle, Transform
-from ecs_tentacles.construction import creature_layout
+from ecs_tentacles.scene.construction import creature_layout
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.load import load_scene
 from ecs_tentacles.scene.overlap import Bodies, find_overlaps

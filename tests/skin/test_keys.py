@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ecs_tentacles.mathutil import quat_about_z
+from ecs_tentacles.numeric.quaternions import quat_about_z
 from ecs_tentacles.skin.keys import (
     angle_between,
     interpolate_points,

@@ -13,10 +13,10 @@ import pytest
 from PIL import Image
 
 from ecs_tentacles.cli import main
-from ecs_tentacles.construction import creature_layout
 from ecs_tentacles.ground import Ground, Solid, ground_of
 from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.physics.tiers import KINEMATIC, REDUCED
+from ecs_tentacles.scene.construction import creature_layout
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.load import bundled_scene
 from ecs_tentacles.terrain.scene_ground import build_ground

@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 
 from ecs_tentacles.cli import main
-from ecs_tentacles.colours import to_linear
 from ecs_tentacles.export.materials import take_colours
+from ecs_tentacles.skin.colours import to_linear
 from ecs_tentacles.take import Take
 
 BLENDER = os.environ.get("ECS_TENTACLES_BLENDER_PYTHON", "")

@@ -24,7 +24,7 @@ from ecs_tentacles.fur.groom import closest_surface_point
 from ecs_tentacles.fur.render.strands import FurDisplay, fur_display
 from ecs_tentacles.fur.render.timeline import Timeline
 from ecs_tentacles.fur.stores import FurData
-from ecs_tentacles.mathutil import quat_rotate
+from ecs_tentacles.numeric.quaternions import quat_rotate
 from ecs_tentacles.render.gui import Gui, same_line_if_fits, text_width
 from ecs_tentacles.render.registries import Panel, SandboxView
 

@@ -16,7 +16,7 @@ from typing import Any
 from imgui_bundle import imgui
 
 from ecs_tentacles.fur.editor import ATTRIBUTES
-from ecs_tentacles.keyframes import EASINGS
+from ecs_tentacles.numeric.keyframes import EASINGS
 from ecs_tentacles.render.gui import Gui, same_line_if_fits, text_width
 from ecs_tentacles.render.registries import SandboxView
 

@@ -82,7 +82,7 @@ def test_emotion_drives_the_controls(make_world: Callable[..., World]) -> None:
     elevation = np.einsum("ij,ij->i", g.rest, g.normal)
     assert elevation.max() < 0.2  # quills rest flat ...
     # ... and stand up: the rig's result is lifted toward each normal
-    from ecs_tentacles.mathutil import quat_rotate
+    from ecs_tentacles.numeric.quaternions import quat_rotate
 
     normals = quat_rotate(world.transforms.quat[g.body_row], g.normal)
     raised = np.sum(world.resource(FurData).frames[:, 0] * normals, axis=1)

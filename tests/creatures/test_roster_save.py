@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from ecs_tentacles.components import Creature, Transform
+from ecs_tentacles.creatures.roster_save import heading_deg, roster_scene, save_roster
 from ecs_tentacles.locomotion.goals import GoalBook
-from ecs_tentacles.mathutil import quat_about_z
-from ecs_tentacles.roster_save import heading_deg, roster_scene, save_roster
+from ecs_tentacles.numeric.quaternions import quat_about_z
 from ecs_tentacles.world import World
 
 
@@ -59,7 +59,7 @@ def test_a_save_that_cannot_be_written_leaves_nothing(tmp_path: Path) -> None:
 
 
 def test_creatures_too_close_to_be_built_at_rest_are_saved_where_they_fit(tmp_path: Path):
-    from ecs_tentacles.roster_save import fit_at_rest
+    from ecs_tentacles.creatures.roster_save import fit_at_rest
     from ecs_tentacles.scene.defaults import with_defaults
     from ecs_tentacles.scene.load import load_scene
 

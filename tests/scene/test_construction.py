@@ -10,7 +10,7 @@ import pytest
 from numpy.testing import assert_allclose
 
 from ecs_tentacles.components import Creature, Link, Tentacle, Transform
-from ecs_tentacles.construction import (
+from ecs_tentacles.scene.construction import (
     capsule_mass_inertia,
     creature_layout,
     cylinder_mass_inertia,

@@ -1,4 +1,4 @@
-"""The C heap gives freed memory back during a long run (`ecs_tentacles.heap`): glibc's
+"""The C heap gives freed memory back during a long run (`ecs_tentacles.physics.heap`): glibc's
 thresholds are fixed once a simulation is built, and the physics trims the heap every
 `TRIM_FRAMES` frames. Skipped where the C library is not glibc."""
 
@@ -10,7 +10,7 @@ from collections.abc import Callable
 
 import pytest
 
-from ecs_tentacles import heap
+from ecs_tentacles.physics import heap
 from ecs_tentacles.world import World
 from tests.conftest import creature_scene
 

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from ecs_tentacles.atomic import (
+from ecs_tentacles.output.atomic import (
     STALE_SECONDS,
     OutputConflict,
     OutputError,
@@ -47,7 +47,7 @@ def test_an_error_while_writing_keeps_the_old_file(tmp_path: Path, error: BaseEx
 
 KILLED_WRITER = """
 import sys, time
-from ecs_tentacles.atomic import atomic_output
+from ecs_tentacles.output.atomic import atomic_output
 with atomic_output(sys.argv[1]) as temporary:
     with open(temporary, "wb") as handle:
         handle.write(b"half a file")
@@ -110,7 +110,7 @@ def test_a_planted_symlink_at_a_temporary_name_is_never_followed(
     victim = tmp_path / "victim.txt"
     victim.write_text("precious")
     tokens = iter(["deadbeef", "deadbeef", "0badf00d"])
-    monkeypatch.setattr("ecs_tentacles.atomic.secrets.token_hex", lambda n: next(tokens))
+    monkeypatch.setattr("ecs_tentacles.output.atomic.secrets.token_hex", lambda n: next(tokens))
     for name in (".out.deadbeef.partial.png", ".out.partial.png"):
         (tmp_path / name).symlink_to(victim)
     with atomic_file(tmp_path / "out.png") as handle:

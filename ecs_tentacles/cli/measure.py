@@ -1,6 +1,6 @@
 """Headless benchmark of a world: build time, frame time, and MuJoCo stepped bare.
 
-    from ecs_tentacles.bench import bench
+    from ecs_tentacles.cli.measure import bench
     from ecs_tentacles.creator.crowd import crowd_scene
     result = bench(crowd_scene(16), frames=120, threads=2)
     print(result["frame_ms"], result["raw_mujoco_ms"], result["overhead_ratio"])

@@ -12,7 +12,7 @@
   position rests the thickest first link on the ground. Tentacles are straight at build.
 
 These functions are pure: numbers (or a creature's scene entry) in, numpy arrays out. The
-build (`ecs_tentacles.body`) and the load-time physical checks
+build (`ecs_tentacles.creatures.body`) and the load-time physical checks
 (`ecs_tentacles.scene.physical`) both place creatures with them.
 """
 

@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from ecs_tentacles.bench import bench, measure, timed
+from ecs_tentacles.cli.measure import bench, measure, timed
 from ecs_tentacles.creator.crowd import crowd_scene
 from ecs_tentacles.world import World
 

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from ecs_tentacles.components import Creature, Motor, Tentacle, Transform
-from ecs_tentacles.spawning import SpawnError
+from ecs_tentacles.creatures.spawning import SpawnError
 from ecs_tentacles.world import World
 
 
@@ -397,7 +397,8 @@ def test_a_spawn_works_out_the_creatures_layout_once(
 ) -> None:
     """The spot check's layout is the one the creature is built from (it was worked out
     two or three times a spawn)."""
-    from ecs_tentacles import body, construction, spawning
+    from ecs_tentacles.creatures import body, spawning
+    from ecs_tentacles.scene import construction
 
     calls: list[str] = []
     real = construction.creature_layout

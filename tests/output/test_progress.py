@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from ecs_tentacles.progress import step_frames
+from ecs_tentacles.output.progress import step_frames
 from ecs_tentacles.world import World
 from tests.conftest import creature_scene
 
@@ -53,7 +53,7 @@ def test_long_commands_say_what_they_are_doing_on_a_terminal(
 
     err: io.StringIO = Terminal() if terminal else io.StringIO()
     monkeypatch.setattr(sys, "stderr", err)
-    monkeypatch.setattr("ecs_tentacles.progress.LONG_SECONDS", 0.0)  # keep every line
+    monkeypatch.setattr("ecs_tentacles.output.progress.LONG_SECONDS", 0.0)  # keep every line
     out = tmp_path / "crowd.json"
     assert main(["crowd", "8", "--out", str(out)]) == 0
     assert main(["validate", str(out)]) == 0

@@ -24,13 +24,13 @@ from collections.abc import Collection, Mapping
 from dataclasses import replace
 from typing import Any, Protocol, TypeVar
 
-from ecs_tentacles.body import build_creature
+from ecs_tentacles.creatures.body import build_creature
 from ecs_tentacles.host import Host
 from ecs_tentacles.physics.frame_systems import physics_systems
 from ecs_tentacles.plugin import HookFailure, Plugin, SystemsPlugin, calling
-from ecs_tentacles.plugin_registry import scene_first
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.load import load_scene_plugins, read_scene_json, resolve_scene_path
+from ecs_tentacles.scene.plugins import scene_first
 from ecs_tentacles.settings import Settings
 from ecs_tentacles.system import System
 

@@ -2,7 +2,7 @@
 
 Takes a validated scene dict with defaults applied (`ecs_tentacles.scene.load`)
 and creates the entities with their components and store rows, posed by the
-construction rules (`ecs_tentacles.construction`). Plugins then add what they own to
+construction rules (`ecs_tentacles.scene.construction`). Plugins then add what they own to
 each creature (goals, action queues, fur: their `build_creature` hooks). Physics is
 built afterwards, from these entities (`ecs_tentacles.physics.model`).
 """
@@ -15,9 +15,9 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 import numpy as np
 
 from ecs_tentacles.components import Creature, Link, Motor, Sucker, Tentacle, Transform
-from ecs_tentacles.construction import CreatureLayout, creature_layout
 from ecs_tentacles.ground import ground_of
-from ecs_tentacles.mathutil import quat_about_z
+from ecs_tentacles.numeric.quaternions import quat_about_z
+from ecs_tentacles.scene.construction import CreatureLayout, creature_layout
 from ecs_tentacles.scene.parameters import apply_parameters, parameter
 
 if TYPE_CHECKING:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ecs_tentacles.colours import creature_colours, to_linear
+from ecs_tentacles.skin.colours import creature_colours, to_linear
 
 
 def test_the_first_colours_are_distinct_warm_first_and_stable() -> None:

@@ -11,7 +11,7 @@ in the sandbox). Loading the file builds the same roster with the same goals and
 settings (creatures rest on the ground where their mantles were; one that crawled
 too close to another or to a rock to be built there at rest goes to the nearest spot
 where it fits). This module sits
-above the world (as `world_loader`).
+above the world (as `loading`).
 """
 
 from __future__ import annotations
@@ -25,13 +25,13 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ecs_tentacles.components import Creature, Transform
-from ecs_tentacles.construction import creature_layout
+from ecs_tentacles.creatures.spawning import nearest_free
 from ecs_tentacles.ground import ground_of
+from ecs_tentacles.scene.construction import creature_layout
 from ecs_tentacles.scene.overlap import segment_distances
 from ecs_tentacles.scene.save import save_scene
-from ecs_tentacles.spawning import nearest_free
 
-log = logging.getLogger("ecs_tentacles.roster_save")
+log = logging.getLogger("ecs_tentacles.creatures.roster_save")
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from ecs_tentacles.keyframes import EASING_CODE, TrackSet, channels_from_keys, ease
+from ecs_tentacles.numeric.keyframes import EASING_CODE, TrackSet, channels_from_keys, ease
 
 U = np.linspace(0.0, 1.0, 11)
 

@@ -8,7 +8,7 @@ import numpy as np
 from numpy.testing import assert_allclose
 
 from ecs_tentacles.components import Creature, Link, Motor, Sucker, Tentacle, Transform
-from ecs_tentacles.construction import tentacle_shape
+from ecs_tentacles.scene.construction import tentacle_shape
 from ecs_tentacles.world import World
 
 SCENE = {

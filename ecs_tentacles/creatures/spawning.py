@@ -21,7 +21,7 @@ systems. Events:
 `creature_spawned(world, creature, creature_name, moved_to)` and
 `creature_despawned(world, creature, creature_name)`.
 
-This module sits above the world (as `world_loader`): `World.spawn` delegates here.
+This module sits above the world (as `loading`): `World.spawn` delegates here.
 """
 
 from __future__ import annotations
@@ -35,14 +35,14 @@ from typing import TYPE_CHECKING, Any, Literal
 import esper
 import numpy as np
 
-from ecs_tentacles.body import build_creature
 from ecs_tentacles.components import Creature, Tentacle
-from ecs_tentacles.construction import CreatureLayout, creature_layout
+from ecs_tentacles.creatures.body import build_creature
 from ecs_tentacles.events import CreatureDespawned, CreatureSpawned, SuckerReleased
 from ecs_tentacles.ground import ground_of
-from ecs_tentacles.mathutil import quat_rotate
+from ecs_tentacles.numeric.quaternions import quat_rotate
 from ecs_tentacles.plugin import calling
 from ecs_tentacles.roster_change import RosterChange
+from ecs_tentacles.scene.construction import CreatureLayout, creature_layout
 from ecs_tentacles.scene.overlap import segment_distances
 from ecs_tentacles.scene.physical import physical_problems
 from ecs_tentacles.scene.validate import validated
@@ -50,7 +50,7 @@ from ecs_tentacles.scene.validate import validated
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host as World  # any world (`ecs_tentacles.world.World`)
 
-log = logging.getLogger("ecs_tentacles.spawning")
+log = logging.getLogger("ecs_tentacles.creatures.spawning")
 
 CORE_STORES = ("transforms", "motors", "tentacles", "suckers", "creatures")
 OnOverlap = Literal["refuse", "move"]
