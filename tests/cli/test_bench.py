@@ -8,9 +8,9 @@ import re
 from pathlib import Path
 
 import pytest
-from tests.cli.test_measure import KEYS, lod_crowd
 
 from ecs_tentacles.cli import main
+from tests.cli.test_measure import KEYS, lod_crowd
 
 
 def test_json_has_every_key_finite(capsys: pytest.CaptureFixture[str]) -> None:

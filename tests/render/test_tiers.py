@@ -10,11 +10,11 @@ from typing import Any
 
 import numpy as np
 import pytest
-from tests.cli.test_measure import lod_crowd
 
 from ecs_tentacles.cli import main
 from ecs_tentacles.render.session import FOCUS_RADIUS
 from ecs_tentacles.render.tiers import COLOURS, tier_markers
+from tests.cli.test_measure import lod_crowd
 from tests.render.conftest import click_item
 
 
