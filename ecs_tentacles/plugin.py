@@ -140,6 +140,11 @@ class Plugin:
     def build_scene(self, world: Host, scene: Mapping[str, Any]) -> None:
         """Called once after every creature is built, before physics is compiled."""
 
+    def ready(self, world: Host) -> None:
+        """Called once the world is built, its physics compiled and its systems
+        scheduled, before its first frame (`World.from_scene`): the state a level starts
+        from, for a plugin that keeps it (a game mode restarting from a snapshot)."""
+
     def roster_changed(self, world: Host, change: RosterChange) -> None:
         """A creature was spawned (after `build_creature` and its physics) or despawned
         (after its rows left every store): follow it in anything kept beside the stores

@@ -10,9 +10,10 @@ Order: the scene is validated and its plugins imported (user code only with
 resources and stores join it; every creature's body is built, then each plugin's
 `build_creature` and `build_scene` hooks run; every store is cut to its rows
 (`ArrayStore.fit`); the physics is compiled; the core
-systems and every plugin's systems are scheduled and set up. If a plugin's
-`systems()` or a system's `setup()` raises, the half-built world is closed (its
-physics threads and esper context) before the error goes on.
+systems and every plugin's systems are scheduled and set up; each plugin's `ready`
+hook sees the world before its first frame. If a plugin's `systems()`, a system's
+`setup()` or a `ready` raises, the half-built world is closed (its physics threads
+and esper context) before the error goes on.
 """
 
 from __future__ import annotations
@@ -126,7 +127,10 @@ def load_world(
         for plugin in chosen:
             systems += _plugin_systems(plugin)
         world.add_systems(*systems)
-    except BaseException:  # a user's systems() or setup() raised
+        for plugin in chosen:
+            with calling(plugin, "ready"):
+                plugin.ready(world)
+    except BaseException:  # a user's systems(), setup() or ready() raised
         world.close()  # its physics threads and esper context
         raise
     return world
