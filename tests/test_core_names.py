@@ -14,7 +14,7 @@ import tokenize
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent / "ecs_tentacles"
-FEATURES = re.compile(r"(?i)\b(locomotion|fur|goals?|guides?|terrain|threats?|director)\b")
+FEATURES = re.compile(r"(?i)\b(locomotion|fur|goals?|guides?|terrain|threats?|director|herding)\b")
 CORE = [*ROOT.glob("*.py")] + [
     p
     for d in ("creatures", "ground", "numeric", "output", "physics", "scene", "take")
@@ -38,6 +38,8 @@ ALLOWED = {
             '"ecs_tentacles.terrain.plugin:TerrainPlugin"',
             '"director"',
             '"ecs_tentacles.director.plugin:DirectorPlugin"',
+            '"herding"',
+            '"ecs_tentacles.herding.plugin:HerdingPlugin"',
         )
     },
     # still to move: the ground is terrain's (its type, meshes and the take's ground

@@ -187,7 +187,8 @@ CORE_ALONE = textwrap.dedent(
     loaded = sorted(m for m in sys.modules if m.startswith(("ecs_tentacles.record",
         "ecs_tentacles.locomotion", "ecs_tentacles.fur", "ecs_tentacles.threats",
         "ecs_tentacles.render", "ecs_tentacles.export", "ecs_tentacles.systems.locomotion",
-        "ecs_tentacles.systems.fur", "ecs_tentacles.systems.threats", "pyglet"))
+        "ecs_tentacles.systems.fur", "ecs_tentacles.systems.threats", "pyglet",
+        "ecs_tentacles.herding", "ecs_tentacles.systems.herding", "filelock", "platformdirs"))
         and m not in registries)
     print(loaded)
     print(sorted(columns.items()))

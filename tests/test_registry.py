@@ -69,6 +69,8 @@ def strangers(world: Any) -> list[str]:
 def everything_on() -> World:
     scene = json.loads((SCENES / "rocky_shore.json").read_text())
     scene["plugins"] = {key: {} for key in EVERY}
+    scene["game"] = {"mode": "herding", "pen": {"centre": [9, 9], "radius": 1}, "need": 1,
+                     "seconds": 30}  # fmt: skip
     with pytest.warns(Warning):  # the examples all steer goals, unordered among themselves
         return World.from_scene(scene)
 

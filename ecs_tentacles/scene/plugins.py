@@ -40,6 +40,7 @@ BUILTIN = {
     "lod": "ecs_tentacles.lod.plugin:LodPlugin",
     "terrain": "ecs_tentacles.terrain.plugin:TerrainPlugin",
     "director": "ecs_tentacles.director.plugin:DirectorPlugin",
+    "herding": "ecs_tentacles.herding.plugin:HerdingPlugin",
 }
 BUNDLED = {
     "wander": "ecs_tentacles.systems.examples.wander:WanderPlugin",

@@ -1,0 +1,115 @@
+"""The herding game in the sandbox: the HUD's Game section, the banner, mouse and keys.
+
+The section shows the level, creatures penned of those needed, the time left and the
+level's best time. Holding the left button in the view and dragging points the
+predator (it follows at its own speed); R restarts the level from its start, P
+pauses. When the game ends a banner says how, with the time and the best time; a
+win is written to the best-times file once (`ecs_tentacles.herding.best_times`).
+"""
+
+from __future__ import annotations
+
+import warnings
+from typing import TYPE_CHECKING, Any
+
+from imgui_bundle import imgui
+from pyglet.window import key
+
+from ecs_tentacles.herding import best_times
+from ecs_tentacles.herding.game import LOST, WON, HerdingGame
+from ecs_tentacles.render.registries import Panel
+
+if TYPE_CHECKING:
+    from ecs_tentacles.render.registries import SandboxView
+
+BANNER_WIDTH = 360.0
+
+
+class GamePanel(Panel):
+    title = "Game"
+    order = 1
+
+    def __init__(self, sandbox: SandboxView):
+        self.sandbox = sandbox
+        self.recorded: tuple[float, bool] | None = None  # (best, new) once a win is written
+        self.message = ""
+
+    @property
+    def game(self) -> HerdingGame:
+        return self.sandbox.world.resource(HerdingGame)
+
+    def attach(self, world: Any) -> None:
+        self.recorded, self.message = None, ""
+
+    def _record(self) -> None:
+        game = self.game
+        if game.outcome != WON or self.recorded is not None:
+            return
+        try:
+            with warnings.catch_warnings(record=True) as said:
+                self.recorded = best_times.record_win(game.level, game.elapsed)
+            self.message = str(said[0].message) if said else ""
+        except OSError as error:  # a read-only data folder: the game goes on
+            self.recorded, self.message = (game.elapsed, False), f"best time not saved: {error}"
+
+    def draw(self, gui: Any) -> None:
+        game = self.game
+        self._record()
+        imgui.text(game.level)
+        gui.item("game level")
+        imgui.text(f"penned {game.penned} of {game.need}")
+        gui.item("game penned")
+        imgui.text(f"time left {game.left:5.1f} s")
+        gui.item("game time")
+        best = best_times.best_time(game.level) if self.recorded is None else self.recorded[0]
+        imgui.text(f"best {best:.1f} s" if best is not None else "best: not won yet")
+        gui.item("game best")
+        imgui.text_wrapped("drag: move the predator  R: restart  P: pause")
+        if self.message:
+            imgui.text_wrapped(self.message)
+
+    def windows(self, gui: Any) -> None:
+        game = self.game
+        if game.outcome not in (WON, LOST):
+            return
+        self._record()
+        width, height = self.sandbox.window.width, self.sandbox.window.height
+        imgui.set_next_window_pos((width / 2, height * 0.3), 0, (0.5, 0.5))
+        imgui.set_next_window_size((BANNER_WIDTH, 0.0))
+        flags = imgui.WindowFlags_.no_move | imgui.WindowFlags_.no_resize
+        flags |= imgui.WindowFlags_.no_collapse | imgui.WindowFlags_.no_title_bar
+        imgui.begin("Game over", None, flags)
+        gui.window_rect("game banner")
+        imgui.push_font(None, 2.0 * imgui.get_style().font_size_base)
+        imgui.text("You won!" if game.outcome == WON else "Time's up")
+        imgui.pop_font()
+        if game.outcome == WON:
+            best, new = self.recorded or (game.elapsed, False)
+            imgui.text(f"{game.penned} penned in {game.elapsed:.1f} s")
+            imgui.text("a new best time!" if new else f"best time {best:.1f} s")
+        else:
+            imgui.text(f"{game.penned} of {game.need} penned")
+        imgui.text("R: play again")
+        imgui.end()
+
+    def key(self, symbol: int, modifiers: int) -> bool:
+        if symbol == key.R:
+            self.game.restart(self.sandbox.world)
+            self.attach(self.sandbox.world)
+            return True
+        if symbol == key.P:
+            self.sandbox.paused = not self.sandbox.paused
+            return True
+        return False
+
+    def press(self, x: float, y: float) -> bool:
+        point = self.sandbox.ground_point(x, y)
+        if point is None:
+            return False
+        self.game.aim(self.sandbox.world, (float(point[0]), float(point[1])))
+        return True
+
+    def drag(self, x: float, y: float) -> None:
+        point = self.sandbox.ground_point(x, y)
+        if point is not None:
+            self.game.aim(self.sandbox.world, (float(point[0]), float(point[1])))

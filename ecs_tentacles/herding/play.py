@@ -1,0 +1,119 @@
+"""Playing a herding level without a window: the bot, recorded inputs, replays.
+
+    world = World.from_scene("herding_1_field")
+    result = play(world, Bot())                  # the bot plays until the game ends
+    again = play(World.from_scene(...), Replay(result["log"]))   # the same game, exactly
+
+`play` steps the world, asking the player (a `Bot`, a `Replay`, or anything with
+`decide(world, game)`) where to aim the predator every `every` frames (0.25 s), until
+the game is won or lost (or `max_seconds` of game time pass). It returns the game's
+summary, the input log and the wall time.
+
+`Bot` is a simple, honest strategy: of the creatures not yet penned, take the one
+farthest from the pen, get behind it (on the side away from the pen, `behind` metres
+off) and push it toward the pen; to get behind it, go around it, never through it.
+Pushing the rearmost creature drives the whole flock from behind, as a sheepdog does.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Any, Protocol
+
+import numpy as np
+
+from ecs_tentacles.herding.game import PLAYING, HerdingGame
+
+if TYPE_CHECKING:
+    from ecs_tentacles.host import Host
+    from ecs_tentacles.world import World
+
+
+class Player(Protocol):
+    def decide(self, world: Host, game: HerdingGame) -> Sequence[float] | None: ...
+
+
+class Bot:
+    """Push the creature farthest from the pen toward it, from behind; go around it."""
+
+    def __init__(self, behind: float = 0.9):
+        self.behind = behind  # metres behind the creature pushed
+
+    def decide(self, world: Host, game: HerdingGame) -> Sequence[float] | None:
+        creatures = world.creatures
+        xy = world.transforms.pos[creatures.mantle_row, :2]
+        left = ~np.isin(creatures.entity, game.state.penned)
+        if not left.any():
+            return None
+        flock = xy[left]
+        gaps = np.hypot(*(flock - game.pen_centre).T)
+        pushed = flock[int(np.argmax(gaps))]
+        to_pen = (game.pen_centre - pushed) / max(float(gaps.max()), 1e-9)
+        target = pushed - self.behind * to_pen
+        x, y = self._around(game.predator, pushed, 0.8 * self.behind, target)
+        return (float(x), float(y))
+
+    @staticmethod
+    def _around(at: np.ndarray, centre: np.ndarray, keep: float, target: np.ndarray) -> np.ndarray:
+        """`target`, or a point on the circle of radius `keep` about `centre` that leads
+        there without crossing the circle (the flock)."""
+        seg = target - at
+        length = float(np.hypot(*seg))
+        if length < 1e-9:
+            return target
+        t = np.clip(np.dot(centre - at, seg) / length**2, 0.0, 1.0)
+        if np.hypot(*(at + t * seg - centre)) >= keep:
+            return target
+        # step around: the tangent direction turning toward the target's side
+        radial = (at - centre) / max(float(np.hypot(*(at - centre))), 1e-9)
+        side = np.array([-radial[1], radial[0]])
+        if np.dot(side, target - centre) < 0:
+            side = -side
+        return centre + keep * (radial + side) / np.sqrt(2.0) * 1.2
+
+
+class Replay:
+    """Aims where a recorded log aimed, at the same frames."""
+
+    def __init__(self, log: Sequence[tuple[int, float, float]]):
+        self.log = sorted(log)
+        self.next = 0
+
+    def frames_to_next(self, frame: int, most: int) -> int:
+        """Frames to step before the next logged aim is due (at most `most`)."""
+        if self.next >= len(self.log):
+            return most
+        return max(1, min(most, self.log[self.next][0] - frame))
+
+    def due(self, frame: int) -> list[tuple[float, float]]:
+        out = []
+        while self.next < len(self.log) and self.log[self.next][0] <= frame:
+            out.append((self.log[self.next][1], self.log[self.next][2]))
+            self.next += 1
+        return out
+
+
+def play(
+    world: World,
+    player: Bot | Replay | Any,
+    *,
+    every: float = 0.25,
+    max_seconds: float | None = None,
+) -> dict[str, Any]:
+    """Play the world's level to its end; the game's summary, `log`, `wall_s`."""
+    game = world.resource(HerdingGame)
+    block = max(1, round(every * world.settings.fps))
+    limit = game.seconds if max_seconds is None else max_seconds
+    started = time.perf_counter()
+    while game.outcome == PLAYING and world.time < limit + 1.0:
+        if isinstance(player, Replay):
+            for point in player.due(world.frame):
+                game.aim(world, point)
+            world.step(player.frames_to_next(world.frame, block))
+            continue
+        aim = player.decide(world, game)
+        if aim is not None:
+            game.aim(world, aim)
+        world.step(block)
+    return {**game.summary(), "log": list(game.state.log), "wall_s": time.perf_counter() - started}

@@ -1,0 +1,85 @@
+"""`HerdingPlugin`: the herding game as a plugin (`"plugins": {"herding": {}}`).
+
+Scene key `game` (`ecs_tentacles.herding.schema`); resource `HerdingGame`
+(`ecs_tentacles.herding.game`); systems `Predator` and `Referee` (`systems/herding/`).
+It needs the flee plugin (what makes creatures run from the predator) and locomotion.
+
+What it adds to the registries in `build`:
+- `Dangers` (`ecs_tentacles.behaviour`): the predator, so everything that fears
+  dangers fears it (the flee plugin runs, fur's emotion raises quills);
+- `Lines` and `Spheres` (the renderer): the pen's ring on the ground, the predator
+  and the ring of its reach;
+- `Panels` (the sandbox): the game's HUD section and its banner, which also takes the
+  mouse (drag: the predator follows) and the keys R (restart) and P (pause);
+- `RunSummaries` (the command line): the game's outcome in `run`'s report;
+- `TakeTracks` (takes): the game's events as a points track (`game`), one locator
+  per penned creature where it was penned, and one at the pen when the game ends.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ecs_tentacles.behaviour import Dangers, DangerSource
+from ecs_tentacles.herding.game import HerdingGame
+from ecs_tentacles.herding.schema import GAME, game_problems
+from ecs_tentacles.plugin import Plugin
+
+if TYPE_CHECKING:
+    from ecs_tentacles.host import Host
+    from ecs_tentacles.registry import App
+    from ecs_tentacles.system import System
+
+
+class HerdingPlugin(Plugin):
+    name = "herding"
+    description = "the herding game: drive creatures into a pen with a predator"
+    requires = ("locomotion", "flee")
+    scene_schema = {"game": GAME}
+
+    def problems(self, scene: Mapping[str, Any]) -> list[tuple[tuple[str | int, ...], str]]:
+        return game_problems(scene)
+
+    def resources(self, world: Host) -> list[object]:
+        scene = world.scene or {}
+        name = str(scene.get("name") or "level")
+        return [HerdingGame(scene["game"], name, world.settings.fps)]
+
+    def ready(self, world: Host) -> None:
+        world.resource(HerdingGame).start = world.snapshot()
+
+    def systems(self) -> list[System]:
+        from ecs_tentacles.systems.herding.predator import Predator
+        from ecs_tentacles.systems.herding.referee import Referee
+
+        return [Predator(), Referee()]
+
+    def snapshot(self, world: Host) -> Any:
+        return world.resource(HerdingGame).state.copy()
+
+    def restore(self, world: Host, state: Any) -> None:
+        world.resource(HerdingGame).state = state.copy()
+
+    def build(self, app: App) -> None:
+        from ecs_tentacles.cli.registries import RunSummaries
+        from ecs_tentacles.herding import drawing
+        from ecs_tentacles.render.registries import Lines, Panels, Spheres
+        from ecs_tentacles.take.registries import TakeTracks
+
+        app.add(Dangers, DangerSource(sense=_predator_danger))
+        app.add(Lines, drawing.lines)
+        app.add(Spheres, drawing.spheres)
+        app.add(Panels, drawing.panels)
+        app.add(RunSummaries, drawing.run_summary)
+        app.add(TakeTracks, drawing.take_tracks)
+
+
+def _predator_danger(world: Host) -> tuple[np.ndarray, np.ndarray]:
+    from ecs_tentacles.ground import ground_of
+
+    xy = world.resource(HerdingGame).predator
+    z = ground_of(world).height(xy[None])[0]
+    return np.array([[xy[0], xy[1], z]]), np.array([-1])

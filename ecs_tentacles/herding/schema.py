@@ -1,0 +1,46 @@
+"""The scene's `game` key, as the herding plugin adds it to the scene schema
+(`herding.schema.json` beside this module, read without importing the plugin when a
+scene names the key with the plugin off).
+
+    "game": {"mode": "herding", "level": "Open field",
+             "pen": {"centre": [3.0, 0.0], "radius": 1.2},
+             "need": 4, "seconds": 60,
+             "predator": {"position": [-3.0, 0.0], "speed": 0.8, "reach": 1.5}}
+
+`need` creatures must enter the pen (a disc on the ground) within `seconds` of game
+time; the predator starts at `position` and moves toward where the player aims it at
+up to `speed` m/s. `reach` is only drawn: the flee plugin's `distance` is what scares.
+Rules the schema cannot say (`problems`): `need` at most the scene's creatures, the
+predator not starting inside the pen.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from ecs_tentacles.scene.schema import fragment
+
+GAME = fragment("ecs_tentacles.herding", "herding")["scene"]["game"]
+
+Problem = tuple[tuple[str | int, ...], str]
+
+
+def game_problems(scene: Mapping[str, Any]) -> list[Problem]:
+    """What the schema cannot say about a defaults-filled scene's `game`."""
+    game = scene.get("game")
+    if game is None:
+        return [(("game",), "required when the herding plugin is on (the level's rules)")]
+    found: list[Problem] = []
+    creatures = len(scene.get("creatures") or [])
+    if game["need"] > creatures:
+        found.append(
+            (("game", "need"), f"{game['need']} is more than the scene's {creatures} creatures")
+        )
+    pen = game["pen"]
+    start = (game.get("predator") or {}).get("position", [0.0, -3.0])
+    if np.hypot(*np.subtract(start, pen["centre"])) < pen["radius"]:
+        found.append((("game", "predator", "position"), "inside the pen: start it outside"))
+    return found
