@@ -3,6 +3,7 @@
 - `lines`: the pen's ring on the ground (green; gold once won, red once lost) and the
   ring of the predator's reach;
 - `spheres`: the predator, a dark sphere above the ground;
+- `framed_points`: the pen and the predator, which "frame all" keeps in view;
 - `panels`: the HUD's Game section and the win/lose banner (`ecs_tentacles.herding.hud`);
 - `run_summary`: `run`'s report gets the outcome (`game won in 41.2 s, 5 of 4 penned`);
 - `take_tracks`: a points track `game`: one locator per penned creature, where and from
@@ -17,7 +18,7 @@ import numpy as np
 
 from ecs_tentacles.cli.registries import RunSummary
 from ecs_tentacles.ground import ground_of
-from ecs_tentacles.herding.game import LOST, WON, HerdingGame
+from ecs_tentacles.herding.game import LOST, PLAYING, WON, HerdingGame
 from ecs_tentacles.render.registries import Marker
 from ecs_tentacles.take.registries import PointsFrame, TrackSource
 from ecs_tentacles.take.tracks import TakeTrack
@@ -29,9 +30,9 @@ if TYPE_CHECKING:
 SEGMENTS = 64
 LIFT = 0.01  # metres the rings float over the ground
 PEN_RGBA = {
-    "playing": (0.25, 0.85, 0.35, 1.0),
-    WON: (1.0, 0.8, 0.2, 1.0),
-    LOST: (0.9, 0.2, 0.2, 1.0),
+    PLAYING: (0.25, 0.85, 0.35, 1.0),  # green
+    WON: (1.0, 0.8, 0.2, 1.0),  # gold
+    LOST: (0.9, 0.2, 0.2, 1.0),  # red
 }
 REACH_RGBA = (0.55, 0.1, 0.1, 1.0)
 PREDATOR_SIZE = (0.09, 0.09, 0.09)
@@ -55,6 +56,14 @@ def lines(world: Host, view: RenderView) -> list[np.ndarray]:
     game = world.resource(HerdingGame)
     pen = ring(world, game.pen_centre, game.pen_radius, PEN_RGBA[game.outcome])
     return [pen, ring(world, game.predator, game.reach, REACH_RGBA)]
+
+
+def framed_points(world: Host) -> np.ndarray:
+    """What "frame all" keeps in view besides the creatures: the pen and the predator."""
+    game = world.resource(HerdingGame)
+    pen = ring(world, game.pen_centre, game.pen_radius, PEN_RGBA[PLAYING])[0::8, :3]
+    predator = np.append(game.predator, ground_of(world).height(game.predator[None])[0])
+    return np.vstack([pen, predator[None]])
 
 
 def spheres(world: Host) -> list[Marker]:

@@ -27,7 +27,7 @@ BANNER_WIDTH = 360.0
 
 class GamePanel(Panel):
     title = "Game"
-    order = 1
+    order = -20  # first, before the selected creature's Locomotion (-10): the game is the point
 
     def __init__(self, sandbox: SandboxView):
         self.sandbox = sandbox
@@ -75,10 +75,12 @@ class GamePanel(Panel):
         self._record()
         width, height = self.sandbox.window.width, self.sandbox.window.height
         imgui.set_next_window_pos((width / 2, height * 0.3), 0, (0.5, 0.5))
-        imgui.set_next_window_size((BANNER_WIDTH, 0.0))
+        # a fixed height: a window sized to fit its contents is hidden on its first frame
+        line = imgui.get_text_line_height_with_spacing()
+        imgui.set_next_window_size((BANNER_WIDTH * line / 17.0, 6.5 * line))
         flags = imgui.WindowFlags_.no_move | imgui.WindowFlags_.no_resize
         flags |= imgui.WindowFlags_.no_collapse | imgui.WindowFlags_.no_title_bar
-        imgui.begin("Game over", None, flags)
+        imgui.begin("Game over", None, flags | imgui.WindowFlags_.no_scrollbar)
         gui.window_rect("game banner")
         imgui.push_font(None, 2.0 * imgui.get_style().font_size_base)
         imgui.text("You won!" if game.outcome == WON else "Time's up")

@@ -7,8 +7,8 @@ It needs the flee plugin (what makes creatures run from the predator) and locomo
 What it adds to the registries in `build`:
 - `Dangers` (`ecs_tentacles.behaviour`): the predator, so everything that fears
   dangers fears it (the flee plugin runs, fur's emotion raises quills);
-- `Lines` and `Spheres` (the renderer): the pen's ring on the ground, the predator
-  and the ring of its reach;
+- `Lines`, `Spheres` and `FramedPoints` (the renderer): the pen's ring on the ground,
+  the predator and the ring of its reach, kept in view by "frame all";
 - `Panels` (the sandbox): the game's HUD section and its banner, which also takes the
   mouse (drag: the predator follows) and the keys R (restart) and P (pause);
 - `RunSummaries` (the command line): the game's outcome in `run`'s report;
@@ -66,12 +66,13 @@ class HerdingPlugin(Plugin):
     def build(self, app: App) -> None:
         from ecs_tentacles.cli.registries import RunSummaries
         from ecs_tentacles.herding import drawing
-        from ecs_tentacles.render.registries import Lines, Panels, Spheres
+        from ecs_tentacles.render.registries import FramedPoints, Lines, Panels, Spheres
         from ecs_tentacles.take.registries import TakeTracks
 
         app.add(Dangers, DangerSource(sense=_predator_danger))
         app.add(Lines, drawing.lines)
         app.add(Spheres, drawing.spheres)
+        app.add(FramedPoints, drawing.framed_points)
         app.add(Panels, drawing.panels)
         app.add(RunSummaries, drawing.run_summary)
         app.add(TakeTracks, drawing.take_tracks)

@@ -1,0 +1,78 @@
+"""The herding game in the sandbox (headless): the Game section, dragging the predator,
+R restarting, P pausing, the banner and the best time written once."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from ecs_tentacles.render import configure
+
+configure(headless=True)
+
+from pyglet.window import key, mouse  # noqa: E402  (after configure: pyglet reads it)
+
+from ecs_tentacles.herding.game import HerdingGame  # noqa: E402
+from tests.herding.levels import level  # noqa: E402
+from tests.render.conftest import event, pixel  # noqa: E402
+
+
+@pytest.fixture
+def sandbox(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[Any]:
+    from ecs_tentacles.render.sandbox import Sandbox
+
+    monkeypatch.setenv("ECS_TENTACLES_DATA", str(tmp_path / "data"))
+    made = Sandbox(level(need=1, seconds=30), headless=True, width=640, height=360)
+    try:
+        yield made
+    finally:
+        made.close()
+
+
+def test_the_game_section_comes_first_and_open(sandbox: Any) -> None:
+    sandbox.render()
+    rects = sandbox.hud.gui.rects
+    assert {"game level", "game penned", "game time", "game best"} <= set(rects)
+    assert rects["Game"][1] < rects["Stats"][1]  # above the sandbox's own sections
+    assert "game banner" not in sandbox.hud.gui.windows
+
+
+def test_dragging_in_the_view_aims_the_predator_and_keys_restart_and_pause(sandbox: Any) -> None:
+    game = sandbox.world.resource(HerdingGame)
+    sandbox.render()
+    at = pixel(sandbox, (-0.5, 0.4, 0.0))
+    event(sandbox, "on_mouse_press", *at, mouse.LEFT, 0)
+    to = pixel(sandbox, (-0.8, -0.3, 0.0))
+    event(sandbox, "on_mouse_drag", *to, to[0] - at[0], to[1] - at[1], mouse.LEFT, 0)
+    event(sandbox, "on_mouse_release", *to, mouse.LEFT, 0)
+    assert len(game.state.log) == 2
+    np.testing.assert_allclose(game.state.aim, (-0.8, -0.3), atol=0.03)  # a pixel's width
+    sandbox.step(30)
+    assert game.state.frames == 30
+    event(sandbox, "on_key_press", key.R, 0)  # restart: the level's start
+    assert game.state.frames == 0 and sandbox.world.frame == 0 and game.state.log == []
+    paused = sandbox.paused
+    event(sandbox, "on_key_press", key.P, 0)
+    assert sandbox.paused is not paused
+
+
+def test_a_win_shows_the_banner_and_writes_the_best_time_once(sandbox: Any, tmp_path: Path) -> None:
+    game = sandbox.world.resource(HerdingGame)
+    while game.outcome == "playing" and game.elapsed < 30:
+        a = sandbox.world.transforms.pos[sandbox.world.creatures.mantle_row[0], :2]
+        game.aim(sandbox.world, (float(a[0]) - 0.7, float(a[1])))
+        sandbox.step(15)
+    assert game.outcome == "won"
+    sandbox.render()
+    sandbox.render()
+    assert "game banner" in sandbox.hud.gui.windows
+    saved = json.loads((tmp_path / "data" / "best_times.json").read_text())
+    assert saved["best_seconds"] == {"test level": round(game.elapsed, 3)}
+    mtime = (tmp_path / "data" / "best_times.json").stat().st_mtime_ns
+    sandbox.render()
+    assert (tmp_path / "data" / "best_times.json").stat().st_mtime_ns == mtime  # once
