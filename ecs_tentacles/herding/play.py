@@ -7,7 +7,8 @@
 `play` steps the world, asking the player (a `Bot`, a `Replay`, or anything with
 `decide(world, game)`) where to aim the predator every `every` frames (0.25 s), until
 the game is won or lost (or `max_seconds` of game time pass). It returns the game's
-summary, the input log and the wall time.
+summary, the input log, the wall time and the median frame's step time (`frame_ms`:
+physics and every system) with its real-time factor.
 
 `Bot` is a simple, honest strategy: of the creatures not yet penned, take the one
 farthest from the pen, get behind it (on the side away from the pen, `behind` metres
@@ -106,14 +107,25 @@ def play(
     block = max(1, round(every * world.settings.fps))
     limit = game.seconds if max_seconds is None else max_seconds
     started = time.perf_counter()
+    frame_ms: list[float] = []  # a frame's step (physics and every system), by block
     while game.outcome == PLAYING and world.time < limit + 1.0:
         if isinstance(player, Replay):
             for point in player.due(world.frame):
                 game.aim(world, point)
-            world.step(player.frames_to_next(world.frame, block))
-            continue
-        aim = player.decide(world, game)
-        if aim is not None:
-            game.aim(world, aim)
-        world.step(block)
-    return {**game.summary(), "log": list(game.state.log), "wall_s": time.perf_counter() - started}
+            frames = player.frames_to_next(world.frame, block)
+        else:
+            aim = player.decide(world, game)
+            if aim is not None:
+                game.aim(world, aim)
+            frames = block
+        before = time.perf_counter()
+        world.step(frames)
+        frame_ms.append(1000.0 * (time.perf_counter() - before) / frames)
+    median = float(np.median(frame_ms)) if frame_ms else 0.0
+    return {
+        **game.summary(),
+        "log": list(game.state.log),
+        "wall_s": round(time.perf_counter() - started, 2),
+        "frame_ms": round(median, 2),  # median over the game's blocks
+        "realtime_factor": round(1000.0 * world.settings.dt / median, 2) if median else None,
+    }

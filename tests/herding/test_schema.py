@@ -41,3 +41,27 @@ def test_the_herding_plugin_needs_a_game_and_a_game_needs_the_plugin() -> None:
     scene["plugins"]["herding"] = False
     with pytest.raises(SceneError, match=r"game: unknown key: the herding plugin's, which is off"):
         World.from_scene(scene)
+
+
+def test_the_levels_schema_for_editors_is_the_assembled_one_and_every_level_is_valid() -> None:
+    """`herding.schema.json` (what the levels' "$schema" names) is `ecs-tentacles schema
+    herding_1_field`'s output, and every bundled level passes it."""
+    import importlib.resources
+    import json
+
+    import jsonschema
+
+    from ecs_tentacles.scene.load import bundled_scene, load_scene_plugins
+    from ecs_tentacles.scene.schema import schema_for
+
+    folder = importlib.resources.files("ecs_tentacles.assets")
+    written = json.loads((folder / "schema" / "herding.schema.json").read_text())
+    _, plugins = load_scene_plugins(bundled_scene("herding_1_field"))
+    assert written == schema_for(plugins), (
+        "regenerate: ecs-tentacles schema herding_1_field > assets/schema/herding.schema.json"
+    )
+    for name in ("herding_1_field", "herding_2_shore", "herding_3_maze"):
+        scene = json.loads(bundled_scene(name).read_text())
+        assert scene["$schema"] == "../schema/herding.schema.json"
+        jsonschema.validate(scene, written)
+        World.from_scene(scene).close()  # and it builds
