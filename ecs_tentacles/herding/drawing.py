@@ -35,7 +35,7 @@ PEN_RGBA = {
     LOST: (0.9, 0.2, 0.2, 1.0),  # red
 }
 REACH_RGBA = (0.55, 0.1, 0.1, 1.0)
-PREDATOR_SIZE = (0.09, 0.09, 0.09)
+PREDATOR_SIZE = (0.13, 0.13, 0.13)
 PREDATOR_RGBA = (0.25, 0.05, 0.05, 1.0)
 GAME_TRACK = TakeTrack("game", "points", ("game_pos", "game_live"), "game", "penned")
 

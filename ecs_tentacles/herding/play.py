@@ -10,10 +10,11 @@ the game is won or lost (or `max_seconds` of game time pass). It returns the gam
 summary, the input log, the wall time and the median frame's step time (`frame_ms`:
 physics and every system) with its real-time factor.
 
-`Bot` is a simple, honest strategy: of the creatures not yet penned, take the one
-farthest from the pen, get behind it (on the side away from the pen, `behind` metres
-off) and push it toward the pen; to get behind it, go around it, never through it.
-Pushing the rearmost creature drives the whole flock from behind, as a sheepdog does.
+`Bot` is a simple, honest strategy, a sheepdog's: herd the group of creatures nearest
+the pen, as many as are still needed and a spare; take the one of them farthest from
+the pen, get behind it (on the side away from the pen, `behind` metres off) and push it
+toward the pen; to get behind it, go around it, never through it. Pushing the group's
+rearmost creature drives the group from behind.
 """
 
 from __future__ import annotations
@@ -36,10 +37,11 @@ class Player(Protocol):
 
 
 class Bot:
-    """Push the creature farthest from the pen toward it, from behind; go around it."""
+    """Push the laggard of the creatures nearest the pen toward it; go around it."""
 
-    def __init__(self, behind: float = 0.9):
+    def __init__(self, behind: float = 0.9, spare: int = 2):
         self.behind = behind  # metres behind the creature pushed
+        self.spare = spare  # creatures herded beyond those still needed
 
     def decide(self, world: Host, game: HerdingGame) -> Sequence[float] | None:
         creatures = world.creatures
@@ -49,8 +51,11 @@ class Bot:
             return None
         flock = xy[left]
         gaps = np.hypot(*(flock - game.pen_centre).T)
-        pushed = flock[int(np.argmax(gaps))]
-        to_pen = (game.pen_centre - pushed) / max(float(gaps.max()), 1e-9)
+        # the group herded: the creatures still needed (and a spare), those nearest the pen
+        group = np.argsort(gaps, kind="stable")[: game.need - game.penned + self.spare]
+        laggard = group[int(np.argmax(gaps[group]))]
+        pushed = flock[laggard]
+        to_pen = (game.pen_centre - pushed) / max(float(gaps[laggard]), 1e-9)
         target = pushed - self.behind * to_pen
         x, y = self._around(game.predator, pushed, 0.8 * self.behind, target)
         return (float(x), float(y))
