@@ -42,17 +42,11 @@ ALLOWED = {
             '"ecs_tentacles.herding.plugin:HerdingPlugin"',
         )
     },
-    # still to move: the ground is terrain's (its type, meshes and the take's ground
-    # arrays, whose names are part of the file format), and the take format's standard
-    # goals and guides tracks are still declared in core
-    ("ground/__init__.py", '"terrain"'): "Ground.provided_by: the ground is still core's type",
+    # still to move: the ground is terrain's (its meshes and the take's ground arrays,
+    # whose names are part of the file format, and the below-ground check)
     ("ground/meshes.py", '"terrain"'): "the heightfield mesh's colour key (sandbox, exporters)",
     ("take/ground.py", '"terrain"'): "the take's ground_terrain_* arrays (file format)",
     ("scene/physical.py", '"terrain"'): "below-ground check skipped on a heightfield",
-    ("take/tracks.py", '"goals"'): "the standard goals track",
-    ("take/tracks.py", '"goal"'): "the standard goals track's USD prim name",
-    ("take/tracks.py", '"guides"'): "the standard guides track",
-    ("take/tracks.py", '"fur"'): "the standard guides track's USD folder",
 }
 
 

@@ -56,8 +56,6 @@ class Ground:
     """The plane z = 0 (`heightfield` None) or a heightfield, plus static `solids`;
     `friction` overrides the scene's `physics.ground_friction` when given."""
 
-    provided_by = "terrain"
-
     heightfield: Heightfield | None = None
     solids: tuple[Solid, ...] = ()
     friction: float | None = None

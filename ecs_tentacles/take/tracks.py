@@ -12,16 +12,19 @@ A track is named per-frame data of one of two kinds, each stored as two arrays:
              arrays[1]    float32 (frames, curves, points)      widths, metres
              (both arrays are in the file only when header[key] is not null)
 
-Version 1 takes always hold the two tracks of `STANDARD`, in that order after the
-body and sucker arrays: `goals` (points; the locomotion plugin fills it) and `guides`
-(curves; the fur plugin's guide curves). A take recorded without those plugins holds
-them empty (no goals, `guides` null), so every version 1 file has the same layout.
+Version 1 takes always hold the two tracks of `STANDARD` (`version1.json`, the file
+format's data), in that order after the body and sucker arrays: `goals` (points; the
+locomotion plugin fills it) and `guides` (curves; the fur plugin's guide curves). A
+take recorded without those plugins holds them empty (no goals, `guides` null), so
+every version 1 file has the same layout.
 Any other track a plugin adds is declared in `header["tracks"]` (absent when there is
 none) and stored after them, in the order declared.
 """
 
 from __future__ import annotations
 
+import importlib.resources
+import json
 import re
 from dataclasses import asdict, dataclass
 from typing import Any
@@ -51,11 +54,17 @@ class TakeTrack:
         return [] if self.kind == "points" else None
 
 
-# Version 1 files always carry these (their names predate declared tracks).
-STANDARD = (
-    TakeTrack("goals", "points", ("goal_pos", "goal_active"), "goals", "goal"),
-    TakeTrack("guides", "curves", ("guide_points", "guide_widths"), "fur", "guides"),
-)
+def _version1() -> tuple[TakeTrack, ...]:
+    """The tracks every version 1 file carries (`version1.json`: part of the file format,
+    data beside this module; the plugins that fill them declare the same tracks)."""
+    text = importlib.resources.files("ecs_tentacles.take").joinpath("version1.json").read_text()
+    return tuple(
+        TakeTrack(t["key"], t["kind"], (t["arrays"][0], t["arrays"][1]), t["folder"], t["item"])
+        for t in json.loads(text)["tracks"]
+    )
+
+
+STANDARD = _version1()
 CORE_KEYS = (
     "format",
     "version",
