@@ -119,6 +119,12 @@ class Plugin:
         """Rules the schema cannot say, on a defaults-filled scene: (json path, message)."""
         return []
 
+    def shapes_ground(self, scene: Mapping[str, Any]) -> bool:
+        """True when this plugin's keys of `scene` give the ground a shape (a heightfield)
+        under the creatures: core's check that no creature starts below the plane z = 0
+        is then left to this plugin (`problems` or `build_scene`)."""
+        return False
+
     # -- building ------------------------------------------------------------------------
     def resources(self, world: Host) -> Sequence[object] | Mapping[str, object]:
         """Stores and APIs this plugin owns, reachable by type: `world.resource(MyStore)`.

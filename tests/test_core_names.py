@@ -42,11 +42,6 @@ ALLOWED = {
             '"ecs_tentacles.herding.plugin:HerdingPlugin"',
         )
     },
-    # still to move: the ground is terrain's (its meshes and the take's ground arrays,
-    # whose names are part of the file format, and the below-ground check)
-    ("ground/meshes.py", '"terrain"'): "the heightfield mesh's colour key (sandbox, exporters)",
-    ("take/ground.py", '"terrain"'): "the take's ground_terrain_* arrays (file format)",
-    ("scene/physical.py", '"terrain"'): "below-ground check skipped on a heightfield",
 }
 
 

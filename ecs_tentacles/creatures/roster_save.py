@@ -79,7 +79,7 @@ def fit_at_rest(world: Host, entries: list[dict[str, Any]]) -> int:
     names: list[str] = []
 
     def blocked(entry: dict[str, Any]) -> str | None:
-        if ground.solids:  # as the terrain plugin checks a scene: resting on the ground
+        if ground.has_obstacles:  # as the terrain checks a scene: resting on the ground
             s, e, r = creature_layout(entry, ground).capsules()
             points = np.concatenate([s, e, 0.5 * (s + e)])
             if (ground.inside_solid(points, np.tile(r, 3)) >= 0).any():

@@ -135,7 +135,7 @@ def obstruction(world: World, layout: CreatureLayout) -> str | None:
     starts, ends, radii = layout.capsules()
     points = np.concatenate([starts, ends, 0.5 * (starts + ends)])
     ground = ground_of(world)
-    if ground.solids and (ground.inside_solid(points, np.tile(radii, 3)) >= 0).any():
+    if ground.has_obstacles and (ground.inside_solid(points, np.tile(radii, 3)) >= 0).any():
         return "an obstacle"
     physics = world.physics
     if not len(physics):

@@ -87,16 +87,16 @@ def _clear_of_creatures(world: Host, points: np.ndarray, reach: float) -> np.nda
 
 def _on_the_heightfield(world: Host, points: np.ndarray, reach: float) -> np.ndarray:
     """(n,) whose reach circle lies inside the heightfield (all of them without one)."""
-    field = ground_of(world).heightfield
-    if field is None:
+    extent = ground_of(world).extent
+    if extent is None:
         return np.ones(len(points), dtype=bool)
-    half = 0.5 * np.asarray(field.size, dtype=np.float64) - reach
+    half = extent - reach
     return np.asarray((np.abs(points) <= half).all(axis=1))
 
 
 def _clear_of_obstacles(world: Host, points: np.ndarray, reach: float) -> np.ndarray:
     ground = ground_of(world)
-    if not ground.solids:
+    if not ground.has_obstacles:
         return np.ones(len(points), dtype=bool)
     raised = np.column_stack([points, ground.height(points)])
     return np.asarray(ground.inside_solid(raised, reach) < 0)

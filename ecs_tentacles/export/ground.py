@@ -7,8 +7,9 @@ with a child node per mesh (`terrain/surface`, `terrain/obstacles`), each with a
 and a material of the same colour. A take recorded on the plane has neither. If a
 creature is called `terrain`, the ground's root is `terrain_ground` instead.
 
-Colours are the sandbox's (`ground.meshes.COLOURS`, display sRGB) as linear light
-(`colours.to_linear`), the space USD's colours and glTF's `baseColorFactor` are in, as
+Colours are the sandbox's (each mesh's `rgb` in the take, display sRGB; `EARLIER` for
+takes written before meshes carried it) as linear light (`colours.to_linear`), the
+space USD's colours and glTF's `baseColorFactor` are in, as
 the creatures' materials are: an importer shows the ground the sandbox drew.
 """
 
@@ -18,7 +19,6 @@ from typing import Any
 
 import numpy as np
 
-from ecs_tentacles.ground.meshes import COLOURS
 from ecs_tentacles.skin.colours import to_linear
 from ecs_tentacles.take import Take
 
@@ -26,9 +26,16 @@ EXPORT_NAMES = {"terrain": "surface", "obstacles": "obstacles"}
 ROUGHNESS = 0.9
 
 
-def linear_colour(name: str) -> list[float]:
+# colours of takes written before a take's ground meshes carried theirs (the terrain
+# plugin's sand and rock), and of a mesh with neither
+EARLIER = {"terrain": (0.62, 0.56, 0.44), "obstacles": (0.50, 0.50, 0.52)}
+GREY = (0.5, 0.5, 0.5)
+
+
+def linear_colour(take: Take, name: str) -> list[float]:
     """Ground mesh `name`'s colour as the sandbox draws it, in linear light (rgb)."""
-    return [float(v) for v in to_linear(COLOURS[name])]
+    rgb = take.ground_colours().get(name) or EARLIER.get(name, GREY)
+    return [float(v) for v in to_linear(rgb)]
 
 
 def root_name(take: Take) -> str:
@@ -50,7 +57,7 @@ def write_usd_ground(pxr: Any, stage: Any, take: Take) -> None:
     UsdGeom.Xform.Define(stage, base)
     UsdGeom.Scope.Define(stage, f"{base}/materials")
     for name, mesh in meshes:
-        label = EXPORT_NAMES[name]
+        label = EXPORT_NAMES.get(name, name)
         prim = UsdGeom.Mesh.Define(stage, f"{base}/{label}")
         prim.CreateSubdivisionSchemeAttr(UsdGeom.Tokens.none)
         points = np.asarray(mesh.vertices, dtype=np.float32)
@@ -63,7 +70,7 @@ def write_usd_ground(pxr: Any, stage: Any, take: Take) -> None:
         prim.SetNormalsInterpolation(UsdGeom.Tokens.vertex)
         low, high = points.min(axis=0), points.max(axis=0)
         prim.CreateExtentAttr([Gf.Vec3f(*low.tolist()), Gf.Vec3f(*high.tolist())])
-        colour = Gf.Vec3f(*linear_colour(name))
+        colour = Gf.Vec3f(*linear_colour(take, name))
         prim.CreateDisplayColorAttr([colour])
         path = f"{base}/materials/{label}"
         material = UsdShade.Material.Define(stage, path)
@@ -92,12 +99,12 @@ def add_gltf_ground(
     holder = len(nodes)
     nodes.append({"name": root, "children": []})
     for name, mesh in found:
-        label = EXPORT_NAMES[name]
+        label = EXPORT_NAMES.get(name, name)
         materials.append(
             {
                 "name": f"{root}/{label}",
                 "pbrMetallicRoughness": {
-                    "baseColorFactor": [*linear_colour(name), 1.0],
+                    "baseColorFactor": [*linear_colour(take, name), 1.0],
                     "metallicFactor": 0.0,
                     "roughnessFactor": ROUGHNESS,
                 },

@@ -1,45 +1,36 @@
-"""The static world the creatures stand on: the plane z = 0, or a heightfield, and solids.
+"""The ground creatures stand on, as core asks about it: a protocol and the flat default.
 
-Core knows only this description; where it comes from (a scene's `terrain`, noise,
-images, mesh files) is the terrain plugin's business (`ecs_tentacles.terrain`), which
-provides a `Ground` resource. Without one the world has `FLAT`: the plane z = 0,
-exactly as before terrain existed.
+Core knows no heightfield and no rock: what shapes the ground (a scene's `terrain`:
+heightfields, obstacles, mesh files) is the terrain plugin's, which provides a
+`Ground` as a resource (`WorldGround`: an `ecs_tentacles.terrain.ground.TerrainGround`).
+Without one the world has `FLAT`: the plane z = 0 and nothing on it.
 
     ground = ground_of(world)
-    ground.height(xy)            # (n,) surface height under points (n, 2)
+    ground.height(xy)            # (n,) height of the ground (not obstacles) under (n, 2)
+    ground.surface(xy)           # (n,) height of the topmost surface, obstacles too
+    ground.normal_under(xy)      # (n, 3) unit normals of the topmost surface there
     ground.distance(points)      # (n,) metres from points (n, 3) to the nearest surface
-    ground.normal(points)        # (n, 3) unit normals of that surface
+    ground.inside_solid(balls)   # (n,) the obstacle each ball reaches into, -1: none
+    ground.meshes()              # what the renderer draws and takes record
 
-Modules: this one (`Ground`, `FLAT`, `ground_of`), `heightfield`, `solids`, `meshes`
-(triangle meshes for drawing and export).
-
-Reads: nothing of the world. Used by the physics model (`add_to_spec`: every group's
-model gets the same static geoms), creature placement (`ecs_tentacles.scene.construction`),
-the suckers (they grip any static surface) and the renderer and exporters (`mesh`).
+Reads: nothing of the world. Used by the physics model (`add_to_spec`), creature
+placement (`ecs_tentacles.scene.construction`), the suckers (they grip any static
+surface), the level of detail (obstacles promote), navigation and formations, and the
+renderer and take format (`meshes`).
 """
 
 from __future__ import annotations
 
-import hashlib
-from collections.abc import Iterator
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Protocol
+from typing import Protocol
 
 import mujoco
 import numpy as np
 
-from ecs_tentacles.ground.heightfield import Heightfield
-from ecs_tentacles.ground.solids import Solid, convex_planes
-
-if TYPE_CHECKING:
-    from collections.abc import Sequence
-
-NORMAL_SPAN = 0.05  # metres either side over which the slope under a point is measured
-NEAR = 0.5  # metres past a solid's bounding sphere within which distances to it are exact
-BEYOND_DROP = 0.002  # metres the plane past a heightfield's edge lies under its lowest point
-
-__all__ = ["BEYOND_DROP", "FLAT", "NEAR", "NORMAL_SPAN", "Ground", "Heightfield", "Solid",
-           "StaticSpec", "convex_planes", "ground_of"]  # fmt: skip
+__all__ = [
+    "FLAT", "Ground", "GroundMesh", "Plane", "StaticMesh", "StaticSpec", "WorldGround", "ground_of",
+]  # fmt: skip
 
 
 class StaticSpec(Protocol):
@@ -52,202 +43,70 @@ class StaticSpec(Protocol):
 
 
 @dataclass(frozen=True)
-class Ground:
-    """The plane z = 0 (`heightfield` None) or a heightfield, plus static `solids`;
-    `friction` overrides the scene's `physics.ground_friction` when given."""
+class StaticMesh:
+    """Vertices (n, 3), unit normals (n, 3) and triangles (m, 3) of vertex indices."""
 
-    heightfield: Heightfield | None = None
-    solids: tuple[Solid, ...] = ()
-    friction: float | None = None
+    vertices: np.ndarray
+    normals: np.ndarray
+    triangles: np.ndarray
+
+
+@dataclass(frozen=True)
+class GroundMesh:
+    """A named mesh of the ground in world metres: its colour (display rgb, 0..1), how
+    strongly the sandbox draws its grid lines on it (0: none), and whether takes record
+    it (a picture-only part, the ground beyond a heightfield's edge, is not)."""
+
+    name: str
+    mesh: StaticMesh
+    rgb: tuple[float, float, float]
+    grid: float = 0.0
+    recorded: bool = True
+
+
+class Ground(Protocol):
+    """What core and the layers above ask of the ground (`ground_of(world)`)."""
+
+    @property
+    def friction(self) -> float | None:
+        """Overrides the scene's `physics.ground_friction` when given."""
 
     @property
     def flat(self) -> bool:
         """The plane z = 0 and nothing on it."""
-        return self.heightfield is None and not self.solids
 
+    @property
+    def extent(self) -> np.ndarray | None:
+        """(2,) half sizes in x, y of the shaped ground (about the origin); None: the
+        plane, without edges."""
+
+    @property
+    def has_obstacles(self) -> bool: ...
     def digest(self) -> str:
-        """Identifies this ground's geometry (model sharing, takes)."""
-        if self.flat and self.friction is None:
-            return "plane"
-        h = hashlib.sha256()
-        if self.heightfield is not None:
-            h.update(np.asarray(self.heightfield.size, np.float64).tobytes())
-            h.update(np.ascontiguousarray(self.heightfield.heights, np.float64).tobytes())
-        for solid in self.solids:
-            h.update(solid.kind.encode())
-            for part in (solid.position, solid.rotation, np.asarray(solid.size), *solid.pieces):
-                h.update(np.ascontiguousarray(part, np.float64).tobytes())
-        h.update(repr(self.friction).encode())
-        return h.hexdigest()[:16]
+        """Identifies the geometry (model sharing, takes); "plane" for `FLAT`."""
 
-    # -- queries -------------------------------------------------------------------------
-    def height(self, xy: np.ndarray) -> np.ndarray:
-        """The ground's height (heightfield or plane, not solids) under points `xy` (n, 2)."""
-        xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
-        if self.heightfield is None:
-            return np.zeros(len(xy))
-        return self.heightfield.height(xy)
-
-    def distance(self, points: np.ndarray) -> np.ndarray:
-        """Metres from points (n, 3) to the nearest static surface (negative: inside).
-
-        The heightfield's part is the height above it times the normal's z (exact on a
-        plane, close on gentle slopes); solids give their signed distance to points within
-        `NEAR` m of their bounding sphere (exact there; farther points may get a larger
-        value: every use asks about points at or near a surface).
-        """
-        points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
-        if self.heightfield is None:
-            best = points[:, 2].copy()
-        else:
-            xy = points[:, :2]
-            normal_z = self.heightfield.slope_normal(xy)[:, 2]
-            best = (points[:, 2] - self.heightfield.height(xy)) * normal_z
-        if not self.solids:
-            return best
-        for k, near in self._under_bounds(points, NEAR):
-            best[near] = np.minimum(best[near], self.solids[k].signed_distance(points[near]))
-        return best
-
-    def _under_bounds(self, points: np.ndarray, pad: float) -> Iterator[tuple[int, np.ndarray]]:
-        """(solid, rows of `points`) for each solid whose bounding sphere grown by `pad`
-        holds some of `points` (n, 3), or whose bounding circle does for points (n, 2):
-        one array test for all solids, then only the solids that hold any point."""
-        centres, bounds = self._bounds()
-        reach = (bounds + pad) ** 2
-        dims = points.shape[1]
-        per_chunk = max(1, (1 << 20) // max(len(self.solids), 1))
-        for start in range(0, len(points), per_chunk):
-            part = points[start : start + per_chunk]
-            if dims == 2:
-                gaps = part[:, None, :] - centres[None, :, :]
-            else:
-                gaps = part[:, None, :] - self._positions()[None, :, :]
-            inside = np.einsum("nkd,nkd->nk", gaps, gaps) <= reach
-            for k in np.flatnonzero(inside.any(axis=0)).tolist():
-                yield k, start + np.flatnonzero(inside[:, k])
-
-    def _positions(self) -> np.ndarray:
-        """(k, 3) the solids' centres (made once)."""
-        cached = self.__dict__.get("_positions_cache")
-        if cached is None:
-            cached = np.array([s.position for s in self.solids]).reshape(-1, 3)
-            object.__setattr__(self, "_positions_cache", cached)  # a cache, not a field
-        return cached
-
-    def _bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        """(k, 2) solid centres in x, y and (k,) bounding radii (made once)."""
-        cached = self.__dict__.get("_bounds_cache")
-        if cached is None:
-            centres = np.array([s.position[:2] for s in self.solids]).reshape(-1, 2)
-            cached = (centres, np.array([s.bound for s in self.solids]))
-            object.__setattr__(self, "_bounds_cache", cached)  # a cache, not a field
-        return cached
-
-    def solids_near(self, xy: np.ndarray, radius: float) -> np.ndarray:
-        """Indices of the solids that may come within `radius` m of point `xy` (x, y):
-        their bounding spheres do (a cull before exact tests; a crowd of thousands among
-        hundreds of rocks tests each creature against a few)."""
-        centres, bounds = self._bounds()
-        distance = np.linalg.norm(centres - np.asarray(xy, dtype=np.float64)[:2], axis=1)
-        return np.flatnonzero(distance <= bounds + radius)
+    def height(self, xy: np.ndarray) -> np.ndarray: ...
+    def surface(self, xy: np.ndarray) -> np.ndarray: ...
+    def distance(self, points: np.ndarray) -> np.ndarray: ...
+    def normal(self, points: np.ndarray) -> np.ndarray: ...
+    def normal_under(self, xy: np.ndarray) -> np.ndarray: ...
+    def ray(self, origin: np.ndarray, direction: np.ndarray) -> np.ndarray | None: ...
+    def lift(self, points: np.ndarray, radii: np.ndarray) -> float:
+        """How far to raise balls laid out on z = 0 so they rest on this ground."""
 
     def inside_solid(
-        self,
-        points: np.ndarray,
-        radii: np.ndarray | float = 0.0,
-        only: np.ndarray | None = None,
-    ) -> np.ndarray:
-        """(n,) index of the first solid (of `only`, default all) each ball (`points`
-        (n, 3), `radii`) reaches into, -1 for none."""
-        points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
-        which = np.full(len(points), -1, dtype=np.int64)
-        for k in range(len(self.solids)) if only is None else only.tolist():
-            solid = self.solids[k]
-            hit = (which < 0) & (solid.signed_distance(points) < radii)
-            which[hit] = k
-        return which
+        self, points: np.ndarray, radii: np.ndarray | float = 0.0, only: np.ndarray | None = None
+    ) -> np.ndarray: ...
+    def solids_near(self, xy: np.ndarray, radius: float) -> np.ndarray:
+        """Indices of the obstacles that may come within `radius` m of point `xy`."""
 
-    def normal(self, points: np.ndarray) -> np.ndarray:
-        """Unit normals (n, 3) of the surface nearest each point (`distance`'s gradient)."""
-        points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
-        if self.flat:
-            return np.tile([0.0, 0.0, 1.0], (len(points), 1))
-        step = 1e-4
-        grad = np.empty_like(points)
-        for axis in range(3):
-            e = np.zeros(3)
-            e[axis] = step
-            grad[:, axis] = self.distance(points + e) - self.distance(points - e)
-        norm = np.linalg.norm(grad, axis=1, keepdims=True)
-        up = np.array([0.0, 0.0, 1.0])
-        return np.where(norm > 1e-12, grad / np.maximum(norm, 1e-12), up)
+    def touches_obstacle(self, centres: np.ndarray, reach: np.ndarray) -> np.ndarray:
+        """(n,) whose sphere (`centres` (n, 3), `reach` (n,)) meets an obstacle."""
 
-    def normal_under(self, xy: np.ndarray) -> np.ndarray:
-        """(n, 3) unit normals of the topmost surface under points `xy` (n, 2): the plane
-        a creature standing there crawls in."""
-        xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
-        if self.flat:
-            return np.tile([0.0, 0.0, 1.0], (len(xy), 1))
-        if not self.solids and self.heightfield is not None:
-            return self.heightfield.slope_normal(xy)
-        # the topmost surface's slope, over NORMAL_SPAN either way
-        ex, ey = np.array([NORMAL_SPAN, 0.0]), np.array([0.0, NORMAL_SPAN])
-        gx = (self.surface(xy + ex) - self.surface(xy - ex)) / (2 * NORMAL_SPAN)
-        gy = (self.surface(xy + ey) - self.surface(xy - ey)) / (2 * NORMAL_SPAN)
-        n = np.stack([-gx, -gy, np.ones_like(gx)], axis=1)
-        return np.asarray(n / np.linalg.norm(n, axis=1, keepdims=True))
+    def obstacle_spans(self) -> tuple[np.ndarray, np.ndarray]:
+        """(k, 2) the obstacles' centres in x, y and (k,) their largest half extents."""
 
-    def ray(self, origin: np.ndarray, direction: np.ndarray) -> np.ndarray | None:
-        """Where the ray from `origin` along `direction` first meets the ground or a solid
-        (None: it never does; on the plane, only rays going down meet it)."""
-        origin = np.asarray(origin, dtype=np.float64).reshape(3)
-        direction = np.asarray(direction, dtype=np.float64).reshape(3)
-        if self.flat:
-            if direction[2] >= 0.0 or origin[2] <= 0.0:
-                return None
-            return np.asarray(origin + direction * (-origin[2] / direction[2]))
-        model, data = self._static()
-        hit = np.zeros(1, dtype=np.int32)
-        length = float(np.linalg.norm(direction))
-        if length == 0.0:
-            return None
-        unit = direction / length
-        distance = mujoco.mj_ray(model, data, origin, unit, None, 1, -1, hit)
-        return None if distance < 0 else origin + unit * distance
-
-    def surface(self, xy: np.ndarray) -> np.ndarray:
-        """(n,) the height of the topmost surface (ground or solid) under points `xy` (n, 2)."""
-        xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
-        out = self.height(xy)
-        if not self.solids:
-            return out
-        for k, rows in self._under_bounds(xy, 0.0):  # the points under its bounding circle
-            out[rows] = np.maximum(out[rows], self.solids[k].top(xy[rows]))
-        return out
-
-    def _static(self) -> tuple[mujoco.MjModel, mujoco.MjData]:
-        """A model of the ground alone (made once), for ray casts."""
-        cached = self.__dict__.get("_static_model")
-        if cached is None:
-            spec = mujoco.MjSpec()
-            self.add_to_spec(spec, 1.0, 1, 1, (0.02, 1.0))
-            model = spec.compile()
-            data = mujoco.MjData(model)
-            mujoco.mj_forward(model, data)
-            cached = (model, data)
-            object.__setattr__(self, "_static_model", cached)  # a cache, not a field
-        return cached
-
-    def lift(self, points: np.ndarray, radii: np.ndarray) -> float:
-        """How far to raise balls (`points`, `radii`) laid out on the plane z = 0 so they
-        rest on this ground: the largest (ground height - ball bottom)."""
-        if self.heightfield is None:
-            return 0.0
-        bottoms = points[:, 2] - radii
-        return float(np.max(self.heightfield.height(points[:, :2]) - bottoms))
-
-    # -- the physics ---------------------------------------------------------------------
+    def meshes(self) -> list[GroundMesh]: ...
     def add_to_spec(
         self,
         spec: StaticSpec,
@@ -257,72 +116,106 @@ class Ground:
         solref: Sequence[float],
     ) -> None:
         """Add the ground's static geoms (named `ground...`) to a creature's model spec."""
-        common = {
-            "friction": [self.friction if self.friction is not None else friction, 0.005, 1e-4],
-            "contype": contype,
-            "conaffinity": conaffinity,
-            "solref": list(solref),
-        }
-        body = spec.worldbody
-        if self.heightfield is None:
-            body.add_geom(
-                name="ground", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0, 0, 1.0], **common
-            )
-        else:
-            field_ = self.heightfield
-            low, high = float(field_.heights.min()), float(field_.heights.max())
-            relief = max(high - low, 1e-6)
-            rows, cols = field_.heights.shape
-            spec.add_hfield(
-                name="ground",
-                size=[0.5 * field_.size[0], 0.5 * field_.size[1], relief, 0.5],
-                nrow=rows,
-                ncol=cols,
-                # an array, not a list: a million Python floats took 32 MB per model built
-                userdata=((field_.heights - low) / relief).astype(np.float32).ravel(),
-            )
-            body.add_geom(
-                name="ground",
-                type=mujoco.mjtGeom.mjGEOM_HFIELD,
-                hfieldname="ground",
-                pos=[0.0, 0.0, low],
-                **common,
-            )
-            # past the field's edge the world goes on as a plane at its lowest height (a
-            # creature that crawls off the edge drops onto it instead of falling forever)
-            body.add_geom(
-                name="ground/beyond",
-                type=mujoco.mjtGeom.mjGEOM_PLANE,
-                size=[0, 0, 1.0],
-                pos=[0.0, 0.0, low - BEYOND_DROP],
-                **common,
-            )
-        for k, solid in enumerate(self.solids):
-            quat = np.zeros(4)
-            mujoco.mju_mat2Quat(quat, np.ascontiguousarray(solid.rotation).ravel())
-            place = {"pos": solid.position.tolist(), "quat": quat.tolist()}
-            if solid.kind == "mesh":
-                for p, piece in enumerate(solid.pieces):
-                    name = f"ground/solid{k}/piece{p}"
-                    spec.add_mesh(name=name, uservert=np.asarray(piece).ravel().tolist())
-                    body.add_geom(
-                        name=name, type=mujoco.mjtGeom.mjGEOM_MESH, meshname=name, **place, **common
-                    )
-                continue
-            kind = {
-                "box": mujoco.mjtGeom.mjGEOM_BOX,
-                "cylinder": mujoco.mjtGeom.mjGEOM_CYLINDER,
-                "sphere": mujoco.mjtGeom.mjGEOM_SPHERE,
-            }[solid.kind]
-            size = [*solid.size, 0.0, 0.0][:3]
-            body.add_geom(name=f"ground/solid{k}", type=kind, size=size, **place, **common)
 
 
-FLAT = Ground()
+@dataclass(frozen=True)
+class Plane:
+    """The plane z = 0 with nothing on it: the world's ground without a terrain."""
+
+    friction: float | None = None
+
+    @property
+    def flat(self) -> bool:
+        return True
+
+    @property
+    def extent(self) -> np.ndarray | None:
+        return None
+
+    @property
+    def has_obstacles(self) -> bool:
+        return False
+
+    def digest(self) -> str:
+        return "plane" if self.friction is None else f"plane {self.friction!r}"
+
+    def height(self, xy: np.ndarray) -> np.ndarray:
+        return np.zeros(len(np.asarray(xy, dtype=np.float64).reshape(-1, 2)))
+
+    def surface(self, xy: np.ndarray) -> np.ndarray:
+        return self.height(xy)
+
+    def distance(self, points: np.ndarray) -> np.ndarray:
+        return np.asarray(points, dtype=np.float64).reshape(-1, 3)[:, 2].copy()
+
+    def normal(self, points: np.ndarray) -> np.ndarray:
+        count = len(np.asarray(points, dtype=np.float64).reshape(-1, 3))
+        return np.tile([0.0, 0.0, 1.0], (count, 1))
+
+    def normal_under(self, xy: np.ndarray) -> np.ndarray:
+        count = len(np.asarray(xy, dtype=np.float64).reshape(-1, 2))
+        return np.tile([0.0, 0.0, 1.0], (count, 1))
+
+    def ray(self, origin: np.ndarray, direction: np.ndarray) -> np.ndarray | None:
+        """Where a ray going down meets the plane (None: it never does)."""
+        origin = np.asarray(origin, dtype=np.float64).reshape(3)
+        direction = np.asarray(direction, dtype=np.float64).reshape(3)
+        if direction[2] >= 0.0 or origin[2] <= 0.0:
+            return None
+        return np.asarray(origin + direction * (-origin[2] / direction[2]))
+
+    def lift(self, points: np.ndarray, radii: np.ndarray) -> float:
+        return 0.0
+
+    def inside_solid(
+        self, points: np.ndarray, radii: np.ndarray | float = 0.0, only: np.ndarray | None = None
+    ) -> np.ndarray:
+        return np.full(len(np.asarray(points).reshape(-1, 3)), -1, dtype=np.int64)
+
+    def solids_near(self, xy: np.ndarray, radius: float) -> np.ndarray:
+        return np.zeros(0, dtype=np.int64)
+
+    def touches_obstacle(self, centres: np.ndarray, reach: np.ndarray) -> np.ndarray:
+        return np.zeros(len(centres), dtype=bool)
+
+    def obstacle_spans(self) -> tuple[np.ndarray, np.ndarray]:
+        return np.zeros((0, 2)), np.zeros(0)
+
+    def meshes(self) -> list[GroundMesh]:
+        return []  # the renderer draws the plane's grid; takes hold no ground
+
+    def add_to_spec(
+        self,
+        spec: StaticSpec,
+        friction: float,
+        contype: int,
+        conaffinity: int,
+        solref: Sequence[float],
+    ) -> None:
+        spec.worldbody.add_geom(
+            name="ground",
+            type=mujoco.mjtGeom.mjGEOM_PLANE,
+            size=[0, 0, 1.0],
+            friction=[self.friction if self.friction is not None else friction, 0.005, 1e-4],
+            contype=contype,
+            conaffinity=conaffinity,
+            solref=list(solref),
+        )
+
+
+FLAT = Plane()
+
+
+@dataclass(frozen=True)
+class WorldGround:
+    """The world's ground as a resource: the plugin that shapes the ground provides one
+    (the terrain plugin; its editor swaps it: `world.replace_resource(WorldGround(new))`)."""
+
+    ground: Ground
 
 
 def ground_of(world: object) -> Ground:
-    """The world's `Ground` resource (the terrain plugin's), or `FLAT`."""
+    """The world's ground (its `WorldGround` resource's), or `FLAT`."""
     getter = getattr(world, "get_resource", None)
-    found = getter(Ground) if getter is not None else None
-    return found if found is not None else FLAT
+    found = getter(WorldGround) if getter is not None else None
+    return found.ground if found is not None else FLAT

@@ -168,10 +168,10 @@ def _reachable(world: Host, centre: np.ndarray, step: float, reach: float) -> Us
     """Which slots a creature can stand on: clear of obstacles by half a `step`, and on
     the heightfield (its whole `reach` circle) when `centre` is."""
     ground = ground_of(world)
-    field = ground.heightfield
+    extent = ground.extent
     half = None
-    if field is not None:
-        half = 0.5 * np.asarray(field.size, dtype=np.float64) - reach
+    if extent is not None:
+        half = extent - reach
         if (np.abs(centre) > half).any():
             half = None  # clicked past the edge: the group goes there
 
@@ -179,7 +179,7 @@ def _reachable(world: Host, centre: np.ndarray, step: float, reach: float) -> Us
         ok = np.ones(len(points), dtype=bool)
         if half is not None:
             ok &= (np.abs(points) <= half).all(axis=1)
-        if ground.solids and ok.any():
+        if ground.has_obstacles and ok.any():
             raised = np.column_stack([points[ok], ground.surface(points[ok])])
             ok[ok] = ground.inside_solid(raised, 0.5 * step) < 0
         return ok

@@ -58,7 +58,7 @@ class CostGrid:
     ) -> CostGrid | None:
         """The grid for creatures of `reach` m whose bodies need `body` m of room; None
         when the ground has no obstacles."""
-        if not ground.solids:
+        if not ground.has_obstacles:
             return None
         from scipy.ndimage import distance_transform_edt
 
@@ -147,15 +147,12 @@ class CostGrid:
 
 def _extent(ground: Ground, around: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(low, high) x, y corners of the area to plan in."""
-    if ground.heightfield is not None:
-        half = 0.5 * np.asarray(ground.heightfield.size)
+    half = ground.extent
+    if half is not None:
         return -half, half
-    centres = [s.position[:2] for s in ground.solids]
-    spans = [
-        max(s.size) if s.size else max(np.abs(p).max() for p in s.pieces) for s in ground.solids
-    ]
-    points = np.vstack([np.array(centres), around]) if len(around) else np.array(centres)
-    span = max(spans) if spans else 0.0
+    centres, spans = ground.obstacle_spans()
+    points = np.vstack([centres, around]) if len(around) else centres
+    span = float(spans.max()) if len(spans) else 0.0
     return points.min(axis=0) - MARGIN - span, points.max(axis=0) + MARGIN + span
 
 
@@ -220,7 +217,7 @@ class Navigator:
         g = world.resource(LocomotionStores).creatures
         g.steer[:] = g.goal
         ground = ground_of(world)
-        if not ground.solids or not g.has_goal.any():
+        if not ground.has_obstacles or not g.has_goal.any():
             return
         if ground is not self._ground:
             self._start(world, ground)

@@ -129,7 +129,7 @@ class ClipReplay:
             int(self.kind[index]), float(self.phase[index]), self.xy[index], self.heading[index]
         )
         ground = ground_of(self.world)
-        if ground.heightfield is not None:  # the clip's flat pose, raised onto the terrain
+        if ground.extent is not None:  # the clip's flat pose, raised onto the terrain
             shown = batch.xpos[row]
             lift = float(np.max(ground.height(shown[:, :2])))
             qpos = qpos.copy()
@@ -169,7 +169,7 @@ class ClipReplay:
             whole = bool(np.all(self.phase[mine] == np.round(self.phase[mine])))
             clips.evaluate(self.kind[mine], self.phase[mine], self.xy[mine], self.heading[mine],
                            batch.xpos, batch.xquat, interpolate=not whole, rows=rows)  # fmt: skip
-            if ground.heightfield is not None:  # draped over the terrain, body by body
+            if ground.extent is not None:  # draped over the terrain, body by body
                 pos = batch.xpos[rows]
                 lift = ground.height(pos[..., :2].reshape(-1, 2)).reshape(pos.shape[:2])
                 batch.xpos[rows, :, 2] += lift

@@ -21,7 +21,7 @@ The rules, whole-array work every frame before the step:
    until it is `CLEAR` times that far).
 3. Contact must be physical, never replayed: creatures with a body within
    `contact_margin` of another creature's, or whose reach comes within it of an
-   obstacle (`Ground.solids`), run at least REDUCED, whatever the budgets (promoted
+   obstacle (`Ground.touches_obstacle`), run at least REDUCED, whatever the budgets (promoted
    before they touch; one simulated stays so until it is `CLEAR` times that far).
 4. The other awake creatures (those of rule 3 too) are ranked: nearest the focus first
    (without one, all equal), then the tier they hold (hysteresis), then creature
@@ -238,11 +238,4 @@ class LevelOfDetail:
 def _near_obstacles(world: PhysicsHost, centre: np.ndarray, reach: np.ndarray) -> np.ndarray:
     """(creatures,) whose reach sphere (`centre`, `reach`) meets an obstacle: about to
     touch it. Bounding spheres cull, then each obstacle's signed distance decides."""
-    ground = ground_of(world)
-    near = np.zeros(len(centre), dtype=bool)
-    for solid in ground.solids:
-        close = np.sum((centre - solid.position) ** 2, axis=1) <= (reach + solid.bound) ** 2
-        rows = np.flatnonzero(close & ~near)
-        if len(rows):
-            near[rows] = solid.signed_distance(centre[rows]) <= reach[rows]
-    return near
+    return np.asarray(ground_of(world).touches_obstacle(centre, reach), dtype=bool)

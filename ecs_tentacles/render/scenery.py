@@ -1,6 +1,6 @@
 """What is drawn before the creatures: the sky's gradient, then the ground (the plane's
-metre grid, or the terrain, the ground beyond it out to the horizon (`render.horizon`)
-and the obstacles as lit meshes, `ecs_tentacles.ground.meshes`), fogged with distance in
+metre grid, or the ground's meshes: the terrain, the ground beyond it out to the
+horizon and the obstacles, lit: `Ground.meshes`), fogged with distance in
 the sky's horizon colour so the ground joins the sky.
 
 Reads the world's `Ground` (`ground_of`), the camera's view, the light; writes only the
@@ -17,7 +17,6 @@ import numpy as np
 from pyglet import gl
 
 from ecs_tentacles.ground import Ground
-from ecs_tentacles.ground.meshes import COLOURS, ground_meshes
 from ecs_tentacles.render import shaders
 from ecs_tentacles.render.gpu import (
     INSTANCE_FLOATS,
@@ -27,7 +26,7 @@ from ecs_tentacles.render.gpu import (
     program,
     set_matrix,
 )
-from ecs_tentacles.render.horizon import HORIZON, REACH, ZENITH, beyond_mesh
+from ecs_tentacles.render.horizon import HORIZON, REACH, ZENITH
 from ecs_tentacles.render.meshes import Mesh
 
 
@@ -58,14 +57,8 @@ class Scenery:
         for old in self.ground_meshes:
             old.delete()
         self.ground_meshes = []
-        terrain, solids = ground_meshes(ground)
-        for mesh, colour, grid in (
-            (terrain, COLOURS["terrain"], 1.0),
-            (beyond_mesh(ground), COLOURS["terrain"], 0.0),  # on to the horizon, no grid
-            (solids, COLOURS["obstacles"], 0.0),
-        ):
-            if mesh is None:
-                continue
+        for part in ground.meshes():  # the terrain's: surface, beyond it, obstacles
+            mesh, colour, grid = part.mesh, part.rgb, part.grid
             template = Mesh(
                 mesh.vertices.astype(np.float32),
                 mesh.normals.astype(np.float32),
@@ -91,7 +84,7 @@ class Scenery:
         """The sky, then the ground as `ground` is now; returns the draw calls."""
         calls = self.draw_sky(view_projection)
         self.build(ground)  # nothing to do unless the terrain was edited
-        if ground.heightfield is None:  # the plane's grid
+        if ground.extent is None:  # the plane's grid
             self.ground_program.use()
             set_matrix(self.ground_program, "u_view_projection", view_projection)
             self.ground_program["u_eye"] = eye

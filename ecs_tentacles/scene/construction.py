@@ -168,7 +168,7 @@ def creature_layout(spec: dict[str, Any], ground: Ground = FLAT) -> CreatureLayo
         params=params,
         shapes=shapes,
     )
-    if len(spec["position"]) == 2 and ground.heightfield is not None:
+    if len(spec["position"]) == 2 and ground.extent is not None:  # shaped: rest on it
         lift = ground.lift(*_resting_points(layout)) + GROUND_CLEARANCE
         layout = replace(layout, origin=layout.origin + [0.0, 0.0, lift])
     return layout

@@ -20,6 +20,7 @@ import os
 import pathlib
 import re
 import stat
+from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
 from ecs_tentacles.scene.defaults import plugin_config, with_defaults
@@ -123,11 +124,18 @@ def _later_problems(data: object, found: list[str], plugins: list[Plugin]) -> li
     semantic, completed = validated(fixed, plugins)
     later = [problem for problem in semantic if problem not in found]
     try:  # a semantic problem (an override of a tentacle that is not there) may stop it
-        physical = physical_problems(completed or with_defaults(fixed, plugins))
+        whole = completed or with_defaults(fixed, plugins)
+        physical = physical_problems(whole, on_plane(whole, plugins))
     except (KeyError, IndexError, TypeError, ValueError):
         physical = []
     later += [problem for problem in physical if problem not in found]
     return [problem for problem in later if not _caused_by_repair(problem, found)]
+
+
+def on_plane(scene: Mapping[str, Any], plugins: Sequence[Plugin]) -> bool:
+    """Whether the creatures of `scene` stand on the plane z = 0: no plugin on shapes the
+    ground there (`Plugin.shapes_ground`)."""
+    return not any(plugin.shapes_ground(scene) for plugin in plugins)
 
 
 def _caused_by_repair(problem: str, found: list[str]) -> bool:
@@ -176,7 +184,7 @@ def load_scene_plugins(
         problems = plugin_problems + problems + _later_problems(data, problems, plugins)
         raise SceneError([prefix + problem for problem in problems])
     assert isinstance(data, dict) and completed is not None  # the schema requires an object
-    full = physically_checked(completed, prefix)
+    full = physically_checked(completed, prefix, on_plane(completed, plugins))
     for plugin in plugins:
         config = plugin_config(plugin, (data.get("plugins") or {}).get(plugin.key))
         plugin.config = {k: v for k, v in config.items() if k != "from"}

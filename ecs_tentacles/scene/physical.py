@@ -61,19 +61,26 @@ SHAPE_KEYS = ("links", "link_length", "link_radius", "end_scale")
 Path = tuple[str | int, ...]
 
 
-def physically_checked(scene: dict[str, Any], prefix: str = "") -> dict[str, Any]:
+def physically_checked(
+    scene: dict[str, Any], prefix: str = "", plane: bool = True
+) -> dict[str, Any]:
     """`scene` (creatures moved apart if it asks), or SceneError with every physical problem.
 
-    `prefix` starts each problem line (the loader passes `"<file>: "`).
+    `prefix` starts each problem line (the loader passes `"<file>: "`); `plane`: as
+    `physical_problems`.
     """
-    problems = physical_problems(scene)
+    problems = physical_problems(scene, plane)
     if problems:
         raise SceneError([prefix + problem for problem in problems])
     return scene
 
 
-def physical_problems(scene: dict[str, Any]) -> list[str]:
+def physical_problems(scene: dict[str, Any], plane: bool = True) -> list[str]:
     """Every physical problem of a schema-valid scene (defaults filled in), one line each.
+
+    `plane`: the ground under the creatures is the plane z = 0, so no part may start
+    below it; False when a plugin shapes the ground (`Plugin.shapes_ground`), which then
+    checks that itself.
 
     With `physics.separate_overlaps` true, overlapping creatures are moved apart by
     changing their `position` in `scene`; only a crowd that cannot be pulled apart is
@@ -93,7 +100,7 @@ def physical_problems(scene: dict[str, Any]) -> list[str]:
             i, creature, layout, weights
         )
         problems += _servo_problems(i, creature, layout, _step(physics))
-        if not (scene.get("terrain") or {}).get("heightfield"):  # terrain checks its own
+        if plane:  # a plugin that shapes the ground checks its own
             problems += _below_ground(i, layout)
         bodies.append(Bodies(*layout.capsules()))
     if not problems:

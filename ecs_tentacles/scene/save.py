@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING, Any
 
 from ecs_tentacles.output.atomic import AtomicOutput, OutputError, disk_full
 from ecs_tentacles.scene.errors import SceneError
-from ecs_tentacles.scene.load import load_scene_plugins
+from ecs_tentacles.scene.load import load_scene_plugins, on_plane
 from ecs_tentacles.scene.physical import physically_checked
 from ecs_tentacles.scene.validate import format_path, validated
 
@@ -64,7 +64,7 @@ def checked_scene(
     problems, completed = validated(scene, plugins)
     if problems or completed is None:
         raise SceneError(problems or ["the scene is not an object"])
-    return physically_checked(completed), list(plugins)
+    return physically_checked(completed, plane=on_plane(completed, plugins)), list(plugins)
 
 
 @dataclass(frozen=True)

@@ -120,8 +120,12 @@ class Take:
             raise KeyError(f"no body named {name!r} in this take") from None
 
     def ground_meshes(self) -> list[tuple[str, Any]]:
-        """(name, `StaticMesh`) of the terrain and obstacles (none on the plane)."""
+        """(name, `StaticMesh`) of the ground's meshes (none on the plane)."""
         return take_ground.meshes_of(self.header, self.tracks)
+
+    def ground_colours(self) -> dict[str, tuple[float, float, float]]:
+        """Ground mesh name -> its display colour, where the take records one."""
+        return take_ground.colours(self.header)
 
     def visible(self) -> np.ndarray:
         """(frames, creatures) bool: which creatures are there at each frame (all of them

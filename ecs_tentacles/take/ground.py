@@ -4,7 +4,7 @@ A take recorded on the plane has no `header["ground"]` (or null): nothing change
 it. On terrain, `header["ground"]` is
 
     {"digest": "<Ground.digest()>",
-     "meshes": [{"name": "terrain", "vertices": n, "triangles": m}, ...]}
+     "meshes": [{"name": "terrain", "vertices": n, "triangles": m, "rgb": [r, g, b]}, ...]}
 
 with, per mesh (in that order, after the tracks' arrays), three arrays:
 
@@ -12,22 +12,26 @@ with, per mesh (in that order, after the tracks' arrays), three arrays:
     ground_<name>_normals    float32 (n, 3)   unit normals
     ground_<name>_triangles  uint32  (m, 3)   vertex indices, counter-clockwise from outside
 
-Mesh names are `MESH_NAMES` (`ecs_tentacles.ground.meshes`: the heightfield's surface and
-every obstacle in one mesh). Readers check the entry and that every triangle index is
-below its mesh's vertex count before an exporter sees them.
+The meshes are those the world's ground records (`Ground.meshes`, each with its name
+and colour: the terrain plugin's heightfield surface and its obstacles in one mesh); a
+name is an identifier, each once, at most `MAX_MESHES`; `rgb` (display colour, 0..1)
+is absent in takes written before meshes carried it. Readers check the entry and that
+every triangle index is below its mesh's vertex count before an exporter sees them.
 """
 
 from __future__ import annotations
 
+import math
+import re
 from typing import Any
 
 import numpy as np
 
-from ecs_tentacles.ground import Ground
-from ecs_tentacles.ground.meshes import StaticMesh, ground_meshes
+from ecs_tentacles.ground import Ground, StaticMesh
 
 KEY = "ground"
-MESH_NAMES = ("terrain", "obstacles")
+MAX_MESHES = 8
+_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]{0,39}$")
 MAX_VERTICES = 1025 * 1025 * 4  # the largest heightfield's grid, with room for obstacles
 PARTS = (("points", "<f4", 3), ("normals", "<f4", 3), ("triangles", "<u4", 3))
 
@@ -38,15 +42,20 @@ def array_name(mesh: str, part: str) -> str:
 
 def header_entry_and_arrays(ground: Ground) -> tuple[dict[str, Any] | None, dict[str, np.ndarray]]:
     """`header["ground"]` and the arrays for `ground` (None and none on the plane)."""
-    meshes = dict(zip(MESH_NAMES, ground_meshes(ground), strict=True))
-    present = {name: mesh for name, mesh in meshes.items() if mesh is not None}
+    present = [part for part in ground.meshes() if part.recorded]
     if not present:
         return None, {}
     arrays: dict[str, np.ndarray] = {}
     entries = []
-    for name, mesh in present.items():
+    for part in present:
+        name, mesh = part.name, part.mesh
         entries.append(
-            {"name": name, "vertices": len(mesh.vertices), "triangles": len(mesh.triangles)}
+            {
+                "name": name,
+                "vertices": len(mesh.vertices),
+                "triangles": len(mesh.triangles),
+                "rgb": [round(float(c), 6) for c in part.rgb],
+            }
         )
         arrays[array_name(name, "points")] = mesh.vertices.astype("<f4")
         arrays[array_name(name, "normals")] = mesh.normals.astype("<f4")
@@ -70,15 +79,25 @@ def problem(header: dict[str, Any]) -> str | None:
     if not isinstance(ground["digest"], str):
         return f"header.{KEY}.digest: must be a string"
     meshes = ground["meshes"]
-    if not isinstance(meshes, list) or not 1 <= len(meshes) <= len(MESH_NAMES):
-        return f"header.{KEY}.meshes: must list 1 to {len(MESH_NAMES)} meshes"
+    if not isinstance(meshes, list) or not 1 <= len(meshes) <= MAX_MESHES:
+        return f"header.{KEY}.meshes: must list 1 to {MAX_MESHES} meshes"
     seen = set()
     for i, mesh in enumerate(meshes):
         where = f"header.{KEY}.meshes[{i}]"
-        if not isinstance(mesh, dict) or set(mesh) != {"name", "vertices", "triangles"}:
-            return f"{where}: must be an object with name, vertices and triangles"
-        if mesh["name"] not in MESH_NAMES or mesh["name"] in seen:
-            return f"{where}.name: must be one of {', '.join(MESH_NAMES)}, each once"
+        if not isinstance(mesh, dict) or set(mesh) - {"rgb"} != {"name", "vertices", "triangles"}:
+            return f"{where}: must be an object with name, vertices, triangles (and rgb)"
+        if not isinstance(mesh["name"], str) or not _NAME.fullmatch(mesh["name"]):
+            return f"{where}.name: must be an identifier (letters, digits, _; at most 40)"
+        if mesh["name"] in seen:
+            return f"{where}.name: {mesh['name']!r} is used twice"
+        rgb = mesh.get("rgb", [0.0, 0.0, 0.0])
+        if not (
+            isinstance(rgb, list)
+            and len(rgb) == 3
+            and all(isinstance(c, (int, float)) and not isinstance(c, bool) for c in rgb)
+            and all(math.isfinite(c) and 0.0 <= c <= 1.0 for c in rgb)
+        ):
+            return f"{where}.rgb: must be three numbers in [0, 1]"
         seen.add(mesh["name"])
         for key in ("vertices", "triangles"):
             value = mesh[key]
@@ -118,6 +137,16 @@ def index_problem(header: dict[str, Any], arrays: dict[str, np.ndarray]) -> str 
         if triangles is not None and len(triangles) and int(triangles.max()) >= mesh["vertices"]:
             return f"{name}: index {int(triangles.max())} past the {mesh['vertices']} vertices"
     return None
+
+
+def colours(header: dict[str, Any]) -> dict[str, tuple[float, float, float]]:
+    """Mesh name -> its colour (display rgb) for the meshes a sound header gives one
+    (takes before meshes carried their colour give none)."""
+    return {
+        mesh["name"]: (float(mesh["rgb"][0]), float(mesh["rgb"][1]), float(mesh["rgb"][2]))
+        for mesh in entries(header)
+        if "rgb" in mesh
+    }
 
 
 def meshes_of(

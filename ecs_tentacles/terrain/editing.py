@@ -26,8 +26,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ecs_tentacles.ground import Ground, ground_of
+from ecs_tentacles.ground import Ground, WorldGround, ground_of
 from ecs_tentacles.scene.save import save_scene
+from ecs_tentacles.terrain.ground import TerrainGround, terrain_ground
 from ecs_tentacles.terrain.heights import heightfield
 from ecs_tentacles.terrain.scene_ground import build_ground
 
@@ -92,14 +93,14 @@ class TerrainEditor:
             return
         old = ground_of(world).surface(np.array(obstacle["position"][:2], dtype=float))[0]
         lift = obstacle["position"][2] - old
-        others = Ground(ground_of(world).heightfield)  # the ground without the obstacles
+        others = TerrainGround(terrain_ground(world).heightfield)  # without the obstacles
         base = float(others.surface(np.array([[x, y]]))[0])
         obstacle["position"] = [round(x, 4), round(y, 4), round(base + lift, 4)]
         self._apply(world, terrain)
 
     def obstacle_at(self, world: Host, point: Any) -> int | None:
         """The index of the obstacle at (or within `PICK_DISTANCE` of) `point`, or None."""
-        solids = ground_of(world).solids
+        solids = terrain_ground(world).solids
         if not solids:
             return None
         where = np.asarray(point, dtype=np.float64).reshape(1, 3)
@@ -166,14 +167,14 @@ class TerrainEditor:
         _refuse_creatures_inside(world, ground)
         if world.scene is not None:
             world.scene["terrain"] = terrain
-        world.replace_resource(ground)
+        world.replace_resource(WorldGround(ground))
         world.physics.rebuild_models(world)
         self.edits += 1
 
 
 def _refuse_creatures_inside(world: Host, ground: Ground) -> None:
     """TerrainEditError naming a creature an obstacle of `ground` would be inside."""
-    if not ground.solids:
+    if not ground.has_obstacles:
         return
     from ecs_tentacles.components import Creature
 

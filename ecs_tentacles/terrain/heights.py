@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from ecs_tentacles.ground import Heightfield
+from ecs_tentacles.terrain.heightfield import Heightfield
 
 Problem = tuple[tuple[str | int, ...], str]
 SOURCES = ("noise", "image", "heights")

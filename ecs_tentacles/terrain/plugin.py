@@ -1,9 +1,10 @@
 """The terrain plugin: scene key `terrain` -> the world's `Ground` (heightfield, obstacles).
 
-Scene key: `terrain` (`ecs_tentacles/terrain/terrain.schema.json`). Resources: the core
-`ecs_tentacles.ground.Ground` (`ground_of(world)`), which every physics model, the
-creatures' placement and the suckers read (without a `terrain` key it is the plane
-z = 0 and nothing changes), and the `TerrainEditor` (`ecs_tentacles.terrain.editing`).
+Scene key: `terrain` (`ecs_tentacles/terrain/terrain.schema.json`). Resources: the
+world's ground (`WorldGround` of a `TerrainGround`: `ground_of(world)`), which every
+physics model (its `StaticGeometry` entry), the creatures' placement, the suckers, the
+renderer and takes read (without a `terrain` key it is the plane z = 0 and nothing
+changes), and the `TerrainEditor` (`ecs_tentacles.terrain.editing`).
 Sandbox: the "Terrain" HUD section (`ecs_tentacles.terrain.panel`).
 Checks: one heightfield source, each obstacle's keys, files next to the scene; at
 build, no creature inside an obstacle, none given a 3-d position inside the
@@ -18,7 +19,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ecs_tentacles.ground import ground_of
+from ecs_tentacles.ground import WorldGround, ground_of
 from ecs_tentacles.physics.model import StaticGeometry
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.render.registries import Panels
@@ -65,7 +66,11 @@ class TerrainPlugin(Plugin):
 
     def resources(self, world: Host) -> list[object]:
         ground = build_ground((world.scene or {}).get("terrain") or {}, world.scene_dir)
-        return [ground, TerrainEditor()]
+        return [WorldGround(ground), TerrainEditor()]
+
+    def shapes_ground(self, scene: Mapping[str, Any]) -> bool:
+        """A heightfield: its own check (`build_scene`) puts creatures above it."""
+        return bool((scene.get("terrain") or {}).get("heightfield"))
 
     def build(self, app: App) -> None:
         """Its heightfield and solids in every creature's model (`physics.registries`:
@@ -108,7 +113,7 @@ class TerrainPlugin(Plugin):
                             f" terrain.obstacles[{int(inside[0])}]; give [x, y] to put it"
                             " on top, or move it"
                         )
-            if len(creature["position"]) == 3 and ground.heightfield is not None:
+            if len(creature["position"]) == 3 and ground.extent is not None:
                 # a 2-d position is placed on the surface; a 3-d one must be above it (the
                 # links' balls, and the mantle's flat base: not its capsule's round end)
                 links = np.concatenate([starts[1:], ends[1:], 0.5 * (starts + ends)[1:]])

@@ -12,6 +12,7 @@ from typing import Any
 from ecs_tentacles.ground import FLAT, Ground
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.validate import format_path
+from ecs_tentacles.terrain.ground import TerrainGround
 from ecs_tentacles.terrain.heights import TerrainError, heightfield
 from ecs_tentacles.terrain.solids import solids
 
@@ -31,4 +32,4 @@ def build_ground(terrain: Mapping[str, Any], folder: Any) -> Ground:
     except TerrainError as error:
         raise SceneError([f"{format_path(error.path)}: {error}"]) from None
     friction = terrain.get("friction")
-    return Ground(field, shapes, None if friction is None else float(friction))
+    return TerrainGround(field, shapes, None if friction is None else float(friction))

@@ -19,9 +19,10 @@ from typing import Any
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from ecs_tentacles.ground import Heightfield, Solid, convex_planes
+from ecs_tentacles.terrain.heightfield import Heightfield
 from ecs_tentacles.terrain.heights import Problem, TerrainError
 from ecs_tentacles.terrain.meshes import MAX_MESH_BYTES, MESH_SUFFIXES, MeshReader
+from ecs_tentacles.terrain.shapes import Solid, convex_planes
 
 __all__ = ["MAX_MESH_BYTES", "MESH_SUFFIXES", "obstacle_problems", "solids"]
 

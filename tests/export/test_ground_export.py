@@ -15,10 +15,10 @@ import pytest
 from ecs_tentacles.export.gltf import read_glb, write_glb
 from ecs_tentacles.export.skinned_gltf import write_skinned_glb
 from ecs_tentacles.ground import ground_of
-from ecs_tentacles.ground.meshes import COLOURS, ground_meshes
 from ecs_tentacles.skin.colours import to_linear
 from ecs_tentacles.take import Take, write_npz
 from ecs_tentacles.take.read import TakeError
+from ecs_tentacles.terrain.ground_meshes import COLOURS
 from tests.export.conftest import khronos_report, record
 from tests.export.test_usd import compliance
 
@@ -40,8 +40,8 @@ TERRAIN_SCENE = {
 def terrain_take() -> Iterator[Take]:
     world, system = record(TERRAIN_SCENE, 6)
     take = system.take()
-    surface, solids = ground_meshes(ground_of(world))
-    assert surface is not None and solids is not None
+    names = [part.name for part in ground_of(world).meshes() if part.recorded]
+    assert names == ["terrain", "obstacles"]
     yield take
     world.close()
 
@@ -62,7 +62,9 @@ def test_a_take_on_terrain_holds_its_meshes_and_reads_back(
         "name": "terrain",
         "vertices": 17 * 17,
         "triangles": 2 * 16 * 16,
+        "rgb": list(COLOURS["terrain"]),  # the colour it was drawn in travels with it
     }
+    assert again.ground_colours() == {name: COLOURS[name] for name in ("terrain", "obstacles")}
 
 
 def _rewrite(path: Path, out: Path, change: dict[str, np.ndarray]) -> None:
@@ -80,11 +82,20 @@ def test_a_hand_edited_ground_is_refused_with_one_line(terrain_take: Take, tmp_p
     with pytest.raises(TakeError, match=r"ground_obstacles_triangles: index 1000000 past the"):
         Take.load(tmp_path / "bad.npz")
     header = dict(terrain_take.header)
-    header["ground"] = {"digest": "x", "meshes": [{"name": "lava", "vertices": 3, "triangles": 1}]}
-    text = json.dumps(header).encode()
-    _rewrite(tmp_path / "t.npz", tmp_path / "lava.npz", {"header": np.frombuffer(text, np.uint8)})
-    with pytest.raises(TakeError, match=r"header.ground.meshes\[0\].name: must be one of"):
-        Take.load(tmp_path / "lava.npz")
+    for mesh, says in (
+        (
+            {"name": "lava flow", "vertices": 3, "triangles": 1},
+            r"\[0\]\.name: must be an identifier",
+        ),
+        ({"name": "lava", "vertices": 3, "triangles": 1, "rgb": [2, 0, 0]}, r"\[0\]\.rgb: must be"),
+        ({"name": "lava", "vertices": 3, "triangles": 1}, r"unknown entry 'ground_terrain_points"),
+    ):
+        header["ground"] = {"digest": "x", "meshes": [mesh]}
+        text = json.dumps(header).encode()
+        lava = tmp_path / "lava.npz"
+        _rewrite(tmp_path / "t.npz", lava, {"header": np.frombuffer(text, np.uint8)})
+        with pytest.raises(TakeError, match=says):
+            Take.load(lava)
     without = dict(terrain_take.header)
     without.pop("ground")  # arrays the header no longer declares
     text = json.dumps(without).encode()
@@ -167,3 +178,21 @@ def test_gltf_ground_materials_are_the_sandbox_colours_in_linear_light(
         np.testing.assert_allclose(
             factor["baseColorFactor"], [*to_linear(COLOURS[name]), 1.0], atol=1e-6
         )
+
+
+def test_a_take_from_before_meshes_carried_their_colour_exports_in_the_old_colours(
+    terrain_take: Take, tmp_path: Path
+) -> None:
+    from ecs_tentacles.export.ground import linear_colour
+    from ecs_tentacles.skin.colours import to_linear
+
+    terrain_take.save(tmp_path / "t.npz")
+    header = json.loads(json.dumps(terrain_take.header))
+    for mesh in header["ground"]["meshes"]:
+        del mesh["rgb"]  # as written before the colour was in the take
+    text = json.dumps(header).encode()
+    _rewrite(tmp_path / "t.npz", tmp_path / "old.npz", {"header": np.frombuffer(text, np.uint8)})
+    old = Take.load(tmp_path / "old.npz")
+    assert old.ground_colours() == {}
+    for name in ("terrain", "obstacles"):
+        np.testing.assert_allclose(linear_colour(old, name), to_linear(COLOURS[name]))

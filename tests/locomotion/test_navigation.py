@@ -10,10 +10,12 @@ import numpy as np
 import pytest
 
 from ecs_tentacles.components import Creature
-from ecs_tentacles.ground import Ground, Solid, ground_of
+from ecs_tentacles.ground import ground_of
 from ecs_tentacles.locomotion.navigation import STUCK_SECONDS, CostGrid, Navigator
 from ecs_tentacles.locomotion.render import path_lines
 from ecs_tentacles.render.registries import RenderView
+from ecs_tentacles.terrain.ground import TerrainGround
+from ecs_tentacles.terrain.shapes import Solid
 from ecs_tentacles.world import World
 
 WALL = {"shape": "box", "position": [-1.6, 0, 0.3], "size": [4.8, 0.2, 0.6]}  # ends at x = 0.8
@@ -68,7 +70,7 @@ def test_the_sandbox_can_draw_the_planned_path(make_world: Callable[..., World])
 
 def test_routes_go_around_and_none_when_walled_in() -> None:
     wall = Solid("box", np.array([0.0, 0.0, 0.5]), np.eye(3), (2.0, 0.1, 0.5))
-    grid = CostGrid.of(Ground(solids=(wall,)), 0.5, np.array([[0.0, -3.0], [0.0, 3.0]]))
+    grid = CostGrid.of(TerrainGround(solids=(wall,)), 0.5, np.array([[0.0, -3.0], [0.0, 3.0]]))
     assert grid is not None
     route = grid.route(np.array([0.0, -3.0]), np.array([0.0, 3.0]))
     assert route is not None and route[-1].tolist() == [0.0, 3.0]
@@ -82,10 +84,10 @@ def test_routes_go_around_and_none_when_walled_in() -> None:
             (-2, 0, 0.1, 2.1),
         )
     )
-    inside = CostGrid.of(Ground(solids=ring), 0.3, np.array([[0.0, 0.0], [5.0, 5.0]]))
+    inside = CostGrid.of(TerrainGround(solids=ring), 0.3, np.array([[0.0, 0.0], [5.0, 5.0]]))
     assert inside is not None
     assert inside.route(np.array([0.0, 0.0]), np.array([5.0, 5.0])) is None
-    assert CostGrid.of(Ground(), 0.5, np.zeros((1, 2))) is None  # nothing to steer around
+    assert CostGrid.of(TerrainGround(), 0.5, np.zeros((1, 2))) is None  # nothing to steer around
 
 
 def test_a_creature_stuck_on_its_way_is_planned_again(make_world: Callable[..., World]) -> None:

@@ -9,8 +9,10 @@ from typing import Any
 import numpy as np
 import pytest
 
-from ecs_tentacles.ground import FLAT, Ground, Heightfield
+from ecs_tentacles.ground import FLAT
 from ecs_tentacles.render.decals import SHADOW_ALPHA, shadow_instances, sucker_instances
+from ecs_tentacles.terrain.ground import TerrainGround
+from ecs_tentacles.terrain.heightfield import Heightfield
 
 UP = np.array([0.0, 0.0, 1.0])
 
@@ -20,7 +22,7 @@ def test_a_blob_lies_on_the_ground_under_its_body_and_fades_as_it_rises() -> Non
     rows = shadow_instances(FLAT, centres, np.array([0.03, 0.03]), UP)
     assert rows[:, 0:2].tolist() == [[1.0, 2.0], [1.0, 2.0]]  # a light from above: under it
     assert rows[0, 14] == pytest.approx(SHADOW_ALPHA) and rows[1, 14] == 0.0  # gone up high
-    hill = Ground(Heightfield((4.0, 4.0), np.full((3, 3), 0.5)))
+    hill = TerrainGround(Heightfield((4.0, 4.0), np.full((3, 3), 0.5)))
     on_hill = shadow_instances(hill, np.array([[0.0, 0.0, 0.53]]), np.array([0.03]), UP)
     assert on_hill[0, 2] == pytest.approx(0.504)  # on the terrain, not at z = 0
 

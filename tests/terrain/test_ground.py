@@ -7,7 +7,10 @@ import mujoco
 import numpy as np
 import pytest
 
-from ecs_tentacles.ground import FLAT, Ground, Heightfield, Solid, convex_planes
+from ecs_tentacles.ground import FLAT
+from ecs_tentacles.terrain.ground import TerrainGround
+from ecs_tentacles.terrain.heightfield import Heightfield
+from ecs_tentacles.terrain.shapes import Solid, convex_planes
 
 
 def _ray_height(model: mujoco.MjModel, x: float, y: float) -> float:
@@ -20,7 +23,7 @@ def _ray_height(model: mujoco.MjModel, x: float, y: float) -> float:
     return 50.0 - dist
 
 
-def _static_model(ground: Ground) -> mujoco.MjModel:
+def _static_model(ground: TerrainGround) -> mujoco.MjModel:
     spec = mujoco.MjSpec()
     ground.add_to_spec(spec, 1.0, 1, 2, [0.02, 1.0])
     return spec.compile()
@@ -30,7 +33,7 @@ def test_heights_match_what_mujoco_collides_with() -> None:
     """The heightfield's `height` is the surface MuJoCo builds (rows along y from -y/2)."""
     rng = np.random.default_rng(4)
     heights = rng.uniform(-0.3, 0.5, size=(7, 9))
-    ground = Ground(Heightfield((4.0, 3.0), heights))
+    ground = TerrainGround(Heightfield((4.0, 3.0), heights))
     model = _static_model(ground)
     points = rng.uniform([-1.99, -1.49], [1.99, 1.49], size=(40, 2))
     mine = ground.height(points)
@@ -53,7 +56,7 @@ def test_the_plane_is_what_it_always_was() -> None:
 def test_solid_distances_and_normals() -> None:
     turn = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])  # 90 deg yaw
     box = Solid("box", np.array([1.0, 0.0, 0.5]), turn, (0.1, 2.0, 0.5))  # long along x now
-    ground = Ground(solids=(box,))
+    ground = TerrainGround(solids=(box,))
     assert box.signed_distance(np.array([[1.0, 0.0, 0.5]]))[0] == pytest.approx(-0.1)
     # beside the wall (its long side faces +-y after the turn)
     beside = np.array([[1.5, 0.3, 0.5]])
@@ -63,14 +66,14 @@ def test_solid_distances_and_normals() -> None:
     piece = Solid("mesh", np.zeros(3), np.eye(3), pieces=(cube,), planes=(convex_planes(cube),))
     assert piece.signed_distance(np.array([[0.5, 0.5, 0.25]]))[0] == pytest.approx(-0.25)
     assert piece.signed_distance(np.array([[0.5, 0.5, 1.5]]))[0] == pytest.approx(0.5)
-    assert Ground(solids=(piece,)).inside_solid(
+    assert TerrainGround(solids=(piece,)).inside_solid(
         np.array([[0.5, 0.5, 1.05], [3, 3, 3]]), 0.1
     ).tolist() == [0, -1]
 
 
 def test_rays_and_the_topmost_surface() -> None:
     table = Solid("box", np.array([2.0, 0.0, 0.5]), np.eye(3), (0.5, 0.5, 0.5))
-    ground = Ground(Heightfield((8.0, 8.0), np.full((5, 5), 0.1)), (table,))
+    ground = TerrainGround(Heightfield((8.0, 8.0), np.full((5, 5), 0.1)), (table,))
     assert ground.surface(np.array([[2.0, 0.0], [-2.0, 0.0]])).tolist() == pytest.approx([1.0, 0.1])
     hit = ground.ray(np.array([0.0, 0.0, 3.0]), np.array([1.0, 0.0, -1.0]))
     assert hit is not None and hit.tolist() == pytest.approx([2.0, 0.0, 1.0])  # the table top
@@ -83,11 +86,11 @@ def test_the_height_kernel_gives_the_numpy_numbers_bit_for_bit(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
     """Inside, on sample lines, on the borders and outside the field."""
-    from ecs_tentacles.ground import heightfield as module
+    from ecs_tentacles.terrain import heightfield as module
 
     rng = np.random.default_rng(7)
     field_ = Heightfield((6.0, 4.0), rng.uniform(-0.3, 0.5, size=(33, 49)))
-    ground = Ground(field_)
+    ground = TerrainGround(field_)
     samples = np.linspace(-3.0, 3.0, 49)
     points = np.vstack([
         rng.uniform([-3.5, -2.5], [3.5, 2.5], size=(20_000, 2)),

@@ -13,13 +13,15 @@ import pytest
 from PIL import Image
 
 from ecs_tentacles.cli import main
-from ecs_tentacles.ground import Ground, Solid, ground_of
+from ecs_tentacles.ground import ground_of
 from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.physics.tiers import KINEMATIC, REDUCED
 from ecs_tentacles.scene.construction import creature_layout
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.load import bundled_scene
+from ecs_tentacles.terrain.ground import TerrainGround
 from ecs_tentacles.terrain.scene_ground import build_ground
+from ecs_tentacles.terrain.shapes import Solid
 from ecs_tentacles.world import World
 
 ROCKY = {
@@ -287,7 +289,7 @@ def _above_ground(world: World) -> np.ndarray:
     return tops - ground.heightfield.height(centres)
 
 
-def _footprint(solid: Solid, ground: Ground) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _footprint(solid: Solid, ground: TerrainGround) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Over the points (k, 2) a 2 cm grid puts under `solid`: its lowest and highest
     point on each vertical line there and the ground's height."""
     side = np.arange(-solid.bound, solid.bound + 0.02, 0.02)

@@ -283,7 +283,7 @@ def test_a_still_of_the_import_shows_every_creature_in_its_colour_on_the_ground(
     ground's colour, written whole."""
     from PIL import Image
 
-    from ecs_tentacles.ground.meshes import COLOURS
+    from ecs_tentacles.terrain.ground_meshes import COLOURS
 
     take = tmp_path / "shore.npz"
     argv = ["bake", "rocky_shore", "--seconds", "0.4", "--fps", "30", "--quiet"]

@@ -12,6 +12,8 @@ import numpy as np
 
 from ecs_tentacles.numeric.optional_kernels import OptionalKernels
 
+BEYOND_DROP = 0.002  # metres the plane past a heightfield's edge lies under its lowest point
+
 # the heightfield kernel (numba, when installed; numpy otherwise: the same numbers)
 KERNELS = OptionalKernels("ecs_tentacles.physics.kernels", "ECS_TENTACLES_SENSE")
 
