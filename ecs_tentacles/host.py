@@ -27,6 +27,7 @@ if TYPE_CHECKING:
     import numpy as np
 
     from ecs_tentacles.physics.backend import PhysicsBackend
+    from ecs_tentacles.scene.spec import CreatureSpec
     from ecs_tentacles.store import ArrayStore, MotorStore, TentacleStore
 
 C = TypeVar("C")
@@ -51,7 +52,7 @@ class Host(PhysicsHost, Protocol):
     @property
     def scene_dir(self) -> pathlib.Path | None: ...
     @property
-    def creature_specs(self) -> dict[int, dict[str, Any]]:
+    def creature_specs(self) -> dict[int, CreatureSpec]:
         """Every creature's entry (validated, defaults in) by entity, spawned ones too."""
 
     @property

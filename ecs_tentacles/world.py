@@ -39,6 +39,7 @@ from ecs_tentacles.system import System, SystemFailure
 
 if TYPE_CHECKING:
     from ecs_tentacles.physics.lod import LevelOfDetail
+    from ecs_tentacles.scene.spec import CreatureSpec
     from ecs_tentacles.snapshot import Snapshot
 
 __all__ = ["MissingResource", "Settings", "World"]  # Settings lives in ecs_tentacles.settings
@@ -81,7 +82,7 @@ class World:
         self.scene: dict[str, Any] | None = None  # the validated scene, defaults filled in
         self.scene_dir: pathlib.Path | None = None  # its folder: plugin files are found there
         # every creature's entry (validated, defaults in) by entity: the scene's and spawns'
-        self.creature_specs: dict[int, dict[str, Any]] = {}
+        self.creature_specs: dict[int, CreatureSpec] = {}  # by entity, spawned ones too
         # names no new creature may take although no creature has them now: a take being
         # recorded names each creature once (`TakeRecorder` keeps its creatures' here)
         self.kept_names: set[str] = set()

@@ -53,7 +53,7 @@ def world_costs(crowd: int, repeats: int, fur: dict[str, Any] | None = None) -> 
             entry["fur"] = copy.deepcopy(fur)
     with World.from_scene(scene, threads=2, lod=False) as world:
         world.step(5)
-        known = copy.deepcopy(next(iter(world.creature_specs.values())))
+        known = dict(copy.deepcopy(next(iter(world.creature_specs.values()))))
         for key in ("goals", "position", "heading_deg"):
             known.pop(key, None)
         spawn, fresh, despawn, frame = [], [], [], []

@@ -10,7 +10,7 @@ built afterwards, from these entities (`ecs_tentacles.physics.model`).
 from __future__ import annotations
 
 import hashlib
-from typing import TYPE_CHECKING, Any, NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
@@ -22,6 +22,7 @@ from ecs_tentacles.scene.parameters import apply_parameters, parameter
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
+    from ecs_tentacles.scene.spec import CreatureSpec
 
 
 def creature_rng(seed: int, name: str) -> np.random.Generator:
@@ -35,7 +36,7 @@ def creature_rng(seed: int, name: str) -> np.random.Generator:
     return np.random.default_rng([int(seed), key])
 
 
-def build_creature(world: Host, spec: dict[str, Any], layout: CreatureLayout | None = None) -> int:
+def build_creature(world: Host, spec: CreatureSpec, layout: CreatureLayout | None = None) -> int:
     """Create one creature's entities from its scene entry; return the creature entity.
     `layout`: the entry's `creature_layout` on this world's ground, when the caller has
     it already (a spawn checked the spot with it)."""

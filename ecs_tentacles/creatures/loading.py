@@ -32,6 +32,7 @@ from ecs_tentacles.plugin import HookFailure, Plugin, SystemsPlugin, calling
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.load import load_scene_plugins, read_scene_json, resolve_scene_path
 from ecs_tentacles.scene.plugins import scene_first
+from ecs_tentacles.scene.spec import CreatureSpec, creature_specs
 from ecs_tentacles.settings import Settings
 from ecs_tentacles.system import System
 
@@ -41,7 +42,7 @@ class SceneWorld(Host, Protocol):
 
     scene: dict[str, Any] | None
     scene_dir: pathlib.Path | None
-    creature_specs: dict[int, dict[str, Any]]
+    creature_specs: dict[int, CreatureSpec]
 
     def adopt(self, plugin: Plugin) -> None: ...
     def build_physics(self, threads: int | None = None) -> object: ...
@@ -103,7 +104,7 @@ def load_world(
     try:
         for plugin in chosen:
             world.adopt(plugin)
-        for index, creature in enumerate(data["creatures"]):
+        for index, creature in enumerate(creature_specs(data)):
             if only is None or index in only:
                 entity = build_creature(world, creature)
                 world.creature_specs[entity] = creature

@@ -30,6 +30,7 @@ from ecs_tentacles.ground import ground_of
 from ecs_tentacles.scene.construction import creature_layout
 from ecs_tentacles.scene.overlap import segment_distances
 from ecs_tentacles.scene.save import save_scene
+from ecs_tentacles.scene.spec import CreatureSpec, as_spec
 
 log = logging.getLogger("ecs_tentacles.creatures.roster_save")
 
@@ -47,7 +48,7 @@ def entry_now(world: Host, entity: int) -> dict[str, Any]:
     """Creature `entity`'s scene entry as it is now: where its mantle is, which way it
     heads, and what every plugin knows of it (`Plugin.save_creature`)."""
     name = world.component(entity, Creature).name
-    entry = copy.deepcopy(world.creature_specs.get(entity) or {"name": name})
+    entry: dict[str, Any] = copy.deepcopy(dict(world.creature_specs.get(entity) or {"name": name}))
     pose = world.component(entity, Transform)
     entry["position"] = [round(float(v), 6) for v in pose.pos[:2]]
     entry["heading_deg"] = round(heading_deg(pose.quat), 6)
@@ -78,7 +79,7 @@ def fit_at_rest(world: Host, entries: list[dict[str, Any]]) -> int:
     centres, reaches = np.zeros((0, 2)), np.zeros(0)
     names: list[str] = []
 
-    def blocked(entry: dict[str, Any]) -> str | None:
+    def blocked(entry: CreatureSpec) -> str | None:
         if ground.has_obstacles:  # as the terrain checks a scene: resting on the ground
             s, e, r = creature_layout(entry, ground).capsules()
             points = np.concatenate([s, e, 0.5 * (s + e)])
@@ -98,9 +99,9 @@ def fit_at_rest(world: Host, entries: list[dict[str, Any]]) -> int:
 
     moved = 0
     for k, entry in enumerate(entries):
-        fitted, blocker = nearest_free(entry, blocked)
+        fitted, blocker = nearest_free(as_spec(entry), blocked)
         if blocker is not None:
-            entries[k] = fitted
+            entries[k] = dict(fitted)
             moved += 1
         layout = creature_layout(fitted)
         s, e, r = layout.capsules()

@@ -45,6 +45,7 @@ from ecs_tentacles.roster_change import RosterChange
 from ecs_tentacles.scene.construction import CreatureLayout, creature_layout
 from ecs_tentacles.scene.overlap import segment_distances
 from ecs_tentacles.scene.physical import physical_problems
+from ecs_tentacles.scene.spec import CreatureSpec, creature_specs
 from ecs_tentacles.scene.validate import validated
 
 if TYPE_CHECKING:
@@ -72,7 +73,7 @@ def creature_entry(
     spec: Mapping[str, Any],
     position: Sequence[float] | None = None,
     heading_deg: float | None = None,
-) -> dict[str, Any]:
+) -> CreatureSpec:
     """`spec` validated as a scene's creature entry, defaults filled in, placed at
     `position` / `heading_deg` when given, its name made unique in `world` (`octo` ->
     `octo_2`). Raises SpawnError (one line per problem) when it is not a valid entry."""
@@ -96,8 +97,7 @@ def creature_entry(
     if problems:
         raise SpawnError([_as_creature(p) for p in problems])
     assert completed is not None
-    full: dict[str, Any] = completed["creatures"][0]
-    return full
+    return creature_specs(completed)[0]
 
 
 def _as_creature(problem: str) -> str:
@@ -159,7 +159,7 @@ def obstruction(world: World, layout: CreatureLayout) -> str | None:
     return None
 
 
-def free_spot(world: World, entry: dict[str, Any]) -> tuple[dict[str, Any], str | None]:
+def free_spot(world: World, entry: CreatureSpec) -> tuple[CreatureSpec, str | None]:
     """`entry` where it asked to be if free, else moved to the nearest free spot on rings
     around it; and what was in the way (None: not moved). SpawnError if none is free."""
     placed, blocker, _ = free_spot_layout(world, entry)
@@ -167,14 +167,14 @@ def free_spot(world: World, entry: dict[str, Any]) -> tuple[dict[str, Any], str 
 
 
 def free_spot_layout(
-    world: World, entry: dict[str, Any]
-) -> tuple[dict[str, Any], str | None, CreatureLayout]:
+    world: World, entry: CreatureSpec
+) -> tuple[CreatureSpec, str | None, CreatureLayout]:
     """`free_spot`, and the layout on this world's ground of the entry it returns (the
     one it last checked: a spawn builds from it instead of working it out again)."""
     ground = ground_of(world)
-    last: list[tuple[dict[str, Any], CreatureLayout]] = []
+    last: list[tuple[CreatureSpec, CreatureLayout]] = []
 
-    def blocked(candidate: dict[str, Any]) -> str | None:
+    def blocked(candidate: CreatureSpec) -> str | None:
         layout = creature_layout(candidate, ground)
         last[:] = [(candidate, layout)]
         return obstruction(world, layout)
@@ -186,8 +186,8 @@ def free_spot_layout(
 
 
 def nearest_free(
-    entry: dict[str, Any], blocked: Callable[[dict[str, Any]], str | None]
-) -> tuple[dict[str, Any], str | None]:
+    entry: CreatureSpec, blocked: Callable[[CreatureSpec], str | None]
+) -> tuple[CreatureSpec, str | None]:
     """`entry` if `blocked` finds nothing in the way of it, else a copy at the nearest
     spot on rings around it (a quarter of its reach apart) where nothing is; and what
     was in the way first (None: not moved). SpawnError if no spot is free."""
@@ -251,7 +251,7 @@ def spawn(
 
 def place(
     world: World,
-    entry: dict[str, Any],
+    entry: CreatureSpec,
     moved_to: tuple[float, ...] | None = None,
     layout: CreatureLayout | None = None,
 ) -> int:

@@ -28,6 +28,7 @@ from ecs_tentacles.behaviour import placeable
 from ecs_tentacles.components import Creature
 from ecs_tentacles.creatures.roster_save import entry_now
 from ecs_tentacles.creatures.spawning import SpawnError, free_spot, place
+from ecs_tentacles.scene.spec import as_spec
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
@@ -54,7 +55,7 @@ def _place_all(world: Host, entries: list[dict[str, Any]]) -> None:
     try:
         for entry in entries:
             if named(world, entry["name"]) is None:  # its name is free again
-                spot, blocker = free_spot(world, copy.deepcopy(entry))
+                spot, blocker = free_spot(world, as_spec(copy.deepcopy(entry)))
                 moved_to = None if blocker is None else tuple(spot["position"])
                 built.append(place(world, spot, moved_to))
     except SpawnError:
@@ -70,7 +71,7 @@ class Spawned:
 
     @classmethod
     def of(cls, world: Host, label: str, entities: list[int]) -> Spawned:
-        return cls(label, [copy.deepcopy(world.creature_specs[e]) for e in entities])
+        return cls(label, [copy.deepcopy(dict(world.creature_specs[e])) for e in entities])
 
     def undo(self, world: Host) -> None:
         _despawn_named(world, [e["name"] for e in self.entries])

@@ -23,6 +23,7 @@ import numpy as np
 from ecs_tentacles.creatures.spawning import creature_entry, place, unique_name
 from ecs_tentacles.ground import ground_of
 from ecs_tentacles.scene.construction import creature_layout
+from ecs_tentacles.scene.spec import as_spec
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
@@ -31,16 +32,16 @@ GAP = 0.1  # metres between two creatures' reach circles
 TRIES = 40  # candidate spots drawn per creature wanted
 
 
-def reach_of(entry: dict[str, Any]) -> float:
+def reach_of(entry: Mapping[str, Any]) -> float:
     """How far a creature built from `entry` reaches from its mantle's axis (metres)."""
-    layout = creature_layout({**entry, "position": [0.0, 0.0]})
+    layout = creature_layout(as_spec({**entry, "position": [0.0, 0.0]}))
     _, ends, radii = layout.capsules()
     return float(np.max(np.linalg.norm(ends[:, :2], axis=1)) + radii.max())
 
 
 def spots(
     world: Host,
-    entry: dict[str, Any],
+    entry: Mapping[str, Any],
     centre: Sequence[float] | np.ndarray,
     radius: float,
     count: int,
@@ -114,10 +115,10 @@ def scatter(
     entry = creature_entry(world, spec)  # checked once: SpawnError names the field
     made = []
     for x, y, heading in spots(world, entry, centre, radius, count, seed).tolist():
-        copy_of = copy.deepcopy(entry)
+        copy_of: dict[str, Any] = copy.deepcopy(dict(entry))
         copy_of["name"] = unique_name(world, entry["name"])
         copy_of["position"] = [x, y]
         copy_of["heading_deg"] = heading
         copy_of["goals"] = []
-        made.append(place(world, copy_of))
+        made.append(place(world, as_spec(copy_of)))
     return made

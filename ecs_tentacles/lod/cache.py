@@ -26,6 +26,7 @@ from ecs_tentacles.creatures.body import build_creature
 from ecs_tentacles.lod.clips import GaitClips
 from ecs_tentacles.lod.record import one_creature_scene
 from ecs_tentacles.physics.model import model_layout
+from ecs_tentacles.scene.spec import as_spec
 from ecs_tentacles.settings import Settings
 from ecs_tentacles.world import World
 
@@ -62,7 +63,7 @@ class ClipCache:
         if entry is None:
             raise ValueError(f"creature {creature.name!r}: no entry to record its clips from")
         physics = world.scene.get("physics") if world.scene is not None else None
-        return self._get(key, entry, physics)
+        return self._get(key, dict(entry), physics)
 
     def _get(
         self, key: tuple[Any, ...], creature: dict[str, Any], physics: dict[str, Any] | None
@@ -92,7 +93,7 @@ def morphology_key(
     settings = Settings.from_physics(physics) if physics is not None else Settings()
     world = World(settings, name="clip-key")
     try:
-        entity = build_creature(world, creature)
+        entity = build_creature(world, as_spec(creature))
         return model_layout(
             world, world.component(entity, Creature), world.component(entity, Transform)
         ).key

@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 
 from ecs_tentacles.ground import FLAT, Ground
+from ecs_tentacles.scene.spec import CreatureSpec
 
 # metres between a creature placed on terrain and the surface (it settles in the first
 # steps); the plane needs none: its creatures start exactly resting
@@ -141,7 +142,7 @@ class CreatureLayout:
         return np.concatenate(starts), np.concatenate(ends), np.concatenate(radii)
 
 
-def creature_layout(spec: dict[str, Any], ground: Ground = FLAT) -> CreatureLayout:
+def creature_layout(spec: CreatureSpec, ground: Ground = FLAT) -> CreatureLayout:
     """The build-time layout of a creature from its scene entry (defaults filled in).
 
     A 2-d `position` rests the creature on `ground`: on the plane its thickest first

@@ -39,6 +39,7 @@ from ecs_tentacles.scene.construction import (
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.overlap import Bodies, Overlap, find_overlaps, separate
 from ecs_tentacles.scene.ranges import damping_floor
+from ecs_tentacles.scene.spec import CreatureSpec, creature_specs
 from ecs_tentacles.scene.validate import format_path
 
 log = logging.getLogger(__name__)
@@ -89,7 +90,7 @@ def physical_problems(scene: dict[str, Any], plane: bool = True) -> list[str]:
     physics = scene["physics"]
     problems: list[tuple[Path, str]] = _timestep_problems(physics) + _gravity_problems(physics)
     bodies: list[Bodies] = []  # each creature's capsules; its layout is dropped (crowds)
-    for i, creature in enumerate(scene["creatures"]):
+    for i, creature in enumerate(creature_specs(scene)):
         layout = creature_layout(creature)
         weights = [  # (links, 2) masses and inertias per tentacle, for both checks below
             capsule_mass_inertia(shape.lengths, shape.radii, params["density"])
@@ -156,7 +157,7 @@ def _tentacle_path(index: int, tentacles: dict[str, Any], k: int) -> Path:
 
 
 def _light_bodies(
-    index: int, creature: dict[str, Any], layout: CreatureLayout, weights: list[np.ndarray]
+    index: int, creature: CreatureSpec, layout: CreatureLayout, weights: list[np.ndarray]
 ) -> list[tuple[Path, str]]:
     problems: list[tuple[Path, str]] = []
     mantle = creature["mantle"]
@@ -200,7 +201,7 @@ def _light_bodies(
 
 
 def _proportion_problems(
-    index: int, creature: dict[str, Any], layout: CreatureLayout, weights: list[np.ndarray]
+    index: int, creature: CreatureSpec, layout: CreatureLayout, weights: list[np.ndarray]
 ) -> list[tuple[Path, str]]:
     problems: list[tuple[Path, str]] = []
     for k, params in enumerate(layout.params):
@@ -232,7 +233,7 @@ def _proportion_problems(
 
 
 def _servo_problems(
-    index: int, creature: dict[str, Any], layout: CreatureLayout, step: float
+    index: int, creature: CreatureSpec, layout: CreatureLayout, step: float
 ) -> list[tuple[Path, str]]:
     problems: list[tuple[Path, str]] = []
     seen: set[Path] = set()

@@ -62,10 +62,11 @@ class FollowLeader(System):
     def setup(self, world: Host) -> None:
         self.every = max(1, round(self.interval * world.settings.fps))
         rows = {c.name: c.row for _, c in world.query(Creature)}  # a shard may lack some
+        entries: list[Mapping[str, Any]] = list(world.creature_specs.values())  # our key too
         pairs = [
-            (rows[spec["name"]], rows[spec[KEY]])
-            for spec in world.creature_specs.values()
-            if KEY in spec and spec["name"] in rows and spec[KEY] in rows
+            (rows[entry["name"]], rows[entry[KEY]])
+            for entry in entries
+            if KEY in entry and entry["name"] in rows and entry[KEY] in rows
         ]
         self.followers, self.leaders = np.array(pairs, dtype=np.int64).reshape(-1, 2).T
 
