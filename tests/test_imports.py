@@ -144,7 +144,7 @@ CORE = (
     "ecs_tentacles.snapshot", "ecs_tentacles.events", "ecs_tentacles.scene",
     "ecs_tentacles.systems.physics",
 )  # fmt: skip
-FEATURES = ("locomotion", "fur", "threats", "record", "lod")
+FEATURES = ("locomotion", "fur", "threats", "record", "clips")
 
 
 def _within(module: str, prefixes: tuple[str, ...]) -> bool:

@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from ecs_tentacles.lod.clips import GaitClips
+from ecs_tentacles.clips.clips import GaitClips
 from ecs_tentacles.scene.load import load_scene, resolve_scene_path
 
 

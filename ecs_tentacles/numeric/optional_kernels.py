@@ -1,6 +1,6 @@
 """Optional numba kernels: a module imported on first use, or None (numpy does the work).
 
-    KERNELS = OptionalKernels("ecs_tentacles.lod.kernels", "ECS_TENTACLES_REPLAY")
+    KERNELS = OptionalKernels("ecs_tentacles.clips.kernels", "ECS_TENTACLES_REPLAY")
     fast = KERNELS.get()         # the module, or None: numpy does the work
 
 numba is optional (the ``dev`` extra installs it). The environment variable, when

@@ -8,7 +8,7 @@
   creature's model.
 - `TravelTargets`: `entry(world)` -> where creatures are heading, (CreatureStore rows,
   2) x, y metres, nan where nowhere, or None; the level of detail moves kinematic
-  creatures toward the first answer that is not nan (`ecs_tentacles.lod.replay`).
+  creatures toward the first answer that is not nan (`ecs_tentacles.clips.replay`).
 
 Entries answer with whole-array math (no per-creature loop); their arrays are only read.
 """

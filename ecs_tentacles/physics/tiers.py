@@ -5,9 +5,9 @@
   a quarter of the rate, `reduced_substeps`), shown as the full creature; a move
   between FULL and REDUCED fits one model's state to the other's.
 * `KINEMATIC`: not stepped; its poses are written from outside (gait clips,
-  `ecs_tentacles.lod`) and its state row is set when it is promoted again.
+  `ecs_tentacles.clips`) and its state row is set when it is promoted again.
 
-Which creature is at which tier is decided elsewhere (`ecs_tentacles.lod`); the
+Which creature is at which tier is decided elsewhere (`ecs_tentacles.clips`); the
 backend only steps each tier as it says.
 """
 

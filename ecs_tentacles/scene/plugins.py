@@ -37,7 +37,7 @@ BUILTIN = {
     "threats": "ecs_tentacles.threats.plugin:ThreatsPlugin",
     "record": "ecs_tentacles.record.plugin:RecordPlugin",
     "render": "ecs_tentacles.render.plugin:RenderPlugin",
-    "lod": "ecs_tentacles.lod.plugin:LodPlugin",
+    "lod": "ecs_tentacles.clips.plugin:ClipsPlugin",
     "terrain": "ecs_tentacles.terrain.plugin:TerrainPlugin",
     "director": "ecs_tentacles.director.plugin:DirectorPlugin",
     "herding": "ecs_tentacles.herding.plugin:HerdingPlugin",

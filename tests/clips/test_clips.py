@@ -10,8 +10,8 @@ import mujoco
 import numpy as np
 import pytest
 
-from ecs_tentacles.lod.clips import CRAWL, IDLE, GaitClips
-from ecs_tentacles.lod.record import one_creature_scene, record
+from ecs_tentacles.clips.clips import CRAWL, IDLE, GaitClips
+from ecs_tentacles.clips.record import one_creature_scene, record
 from ecs_tentacles.numeric.quaternions import quat_about_z, quat_multiply, quat_rotate
 from ecs_tentacles.scene.load import load_scene, resolve_scene_path
 from ecs_tentacles.world import World
@@ -189,7 +189,7 @@ def test_thousand_creatures_evaluate_at_once(clips: GaitClips) -> None:
 def test_the_replay_kernel_equals_the_numpy_path(
     clips: GaitClips, interpolate: bool, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    from ecs_tentacles.lod import clips as module
+    from ecs_tentacles.clips import clips as module
 
     assert module.KERNELS.get() is not None  # numba comes with the dev extra
     rng = np.random.default_rng(5)
@@ -215,7 +215,7 @@ def test_the_replay_kernel_equals_the_numpy_path(
 def test_poses_written_into_rows_of_a_batch_array_are_the_poses_evaluated(
     clips: GaitClips, backend: str, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    from ecs_tentacles.lod import clips as module
+    from ecs_tentacles.clips import clips as module
 
     monkeypatch.setattr(module.KERNELS, "backend", backend)
     rng = np.random.default_rng(6)

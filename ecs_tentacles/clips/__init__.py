@@ -1,4 +1,6 @@
-"""Level of detail for crowds: cheaper stand-ins for creatures far from the action.
+"""Gait clips, the kinematic tier of crowds' level of detail: cheaper stand-ins for
+creatures far from the action (plugin `lod`: scenes and takes keep that name; the
+tiers' rules are the physics', `ecs_tentacles.physics.lod`).
 
 `clips` (gait clips: one morphology's crawl and idle loops recorded with the full
 physics, replayed for many creatures at once with no dynamics, and the joint state that
@@ -7,7 +9,7 @@ one-creature recording world), `frames` (ground-frame math), `cache` (clips shar
 morphology). Imports the core and the physics; never the renderer or the CLI.
 """
 
-from ecs_tentacles.lod.cache import ClipCache, morphology_key
-from ecs_tentacles.lod.clips import CRAWL, IDLE, Clip, GaitClips
+from ecs_tentacles.clips.cache import ClipCache, morphology_key
+from ecs_tentacles.clips.clips import CRAWL, IDLE, Clip, GaitClips
 
 __all__ = ["CRAWL", "IDLE", "Clip", "ClipCache", "GaitClips", "morphology_key"]

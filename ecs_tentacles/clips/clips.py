@@ -30,8 +30,8 @@ from typing import Any
 
 import numpy as np
 
-from ecs_tentacles.lod.frames import nlerp, quat_power, rotate_z, to_ground, yaw_times
-from ecs_tentacles.lod.record import GaitRecording, forward_poses, one_creature_scene, record
+from ecs_tentacles.clips.frames import nlerp, quat_power, rotate_z, to_ground, yaw_times
+from ecs_tentacles.clips.record import GaitRecording, forward_poses, one_creature_scene, record
 from ecs_tentacles.numeric.optional_kernels import OptionalKernels
 from ecs_tentacles.numeric.quaternions import quat_multiply
 
@@ -214,7 +214,7 @@ class GaitClips:
         return qpos, qvel
 
 
-KERNELS = OptionalKernels("ecs_tentacles.lod.kernels", "ECS_TENTACLES_REPLAY")
+KERNELS = OptionalKernels("ecs_tentacles.clips.kernels", "ECS_TENTACLES_REPLAY")
 
 
 def _place(

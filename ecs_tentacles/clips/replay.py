@@ -25,9 +25,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ecs_tentacles.clips.cache import ClipCache
+from ecs_tentacles.clips.clips import CRAWL, IDLE, GaitClips, mantle_yaw
 from ecs_tentacles.ground import ground_of
-from ecs_tentacles.lod.cache import ClipCache
-from ecs_tentacles.lod.clips import CRAWL, IDLE, GaitClips, mantle_yaw
 from ecs_tentacles.physics.registries import TravelTargets
 from ecs_tentacles.physics.tiers import KINEMATIC
 
@@ -36,7 +36,7 @@ if TYPE_CHECKING:
     from ecs_tentacles.physics.batch import Batch
     from ecs_tentacles.roster_change import RosterChange
 
-log = logging.getLogger("ecs_tentacles.lod")
+log = logging.getLogger("ecs_tentacles.clips")
 
 SHARED = ClipCache()  # clips by morphology, shared by every world of this process
 TURN_RATE = math.radians(60.0)  # rad/s a replayed creature turns toward its way

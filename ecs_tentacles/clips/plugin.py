@@ -3,7 +3,7 @@
 The physics decides who runs at which tier (`ecs_tentacles.physics.lod`, `world.lod`);
 without this plugin nobody is ever kinematic (the cheapest tier is REDUCED). With it,
 the `lod_replay` system (stage physics, after the step) moves kinematic creatures with
-their morphology's gait clips (`ecs_tentacles.lod.replay`), toward where the plugins
+their morphology's gait clips (`ecs_tentacles.clips.replay`), toward where the plugins
 say they go (`TravelTargets` entries: the locomotion plugin's goals). Snapshots keep
 the replay's state.
 """
@@ -19,12 +19,12 @@ if TYPE_CHECKING:
     from ecs_tentacles.host import Host
 
 
-class LodPlugin(Plugin):
+class ClipsPlugin(Plugin):
     name = "lod"
     description = "kinematic crowds: creatures far from the action replay gait clips"
 
     def systems(self) -> list[System]:
-        from ecs_tentacles.systems.lod.lod_replay import LodReplay
+        from ecs_tentacles.systems.clips.replay import LodReplay
 
         return [LodReplay()]
 

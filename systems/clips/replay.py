@@ -5,14 +5,14 @@ plugins' travel targets (`Plugin.travel_targets`). Writes: the kinematic creatur
 body poses in their physics batch (copied into the Transform store by
 `physics_sync`, like every other creature's). Registers its replay with the level of
 detail when it joins a world, so demotions to KINEMATIC become possible
-(`ecs_tentacles.lod.replay`; on terrain the clips are draped over the heightfield).
+(`ecs_tentacles.clips.replay`; on terrain the clips are draped over the heightfield).
 """
 
 from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from ecs_tentacles.lod.replay import ClipReplay
+from ecs_tentacles.clips.replay import ClipReplay
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:

@@ -21,10 +21,10 @@ from __future__ import annotations
 import json
 from typing import TYPE_CHECKING, Any
 
+from ecs_tentacles.clips.clips import GaitClips
+from ecs_tentacles.clips.record import one_creature_scene
 from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.creatures.body import build_creature
-from ecs_tentacles.lod.clips import GaitClips
-from ecs_tentacles.lod.record import one_creature_scene
 from ecs_tentacles.physics.model import model_layout
 from ecs_tentacles.scene.spec import as_spec
 from ecs_tentacles.settings import Settings

@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from ecs_tentacles.lod.cache import ClipCache, morphology_key
+from ecs_tentacles.clips.cache import ClipCache, morphology_key
 from ecs_tentacles.scene.load import load_scene
 from ecs_tentacles.world import World
 

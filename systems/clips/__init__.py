@@ -1,0 +1,1 @@
+"""The lod plugin's systems (`ecs_tentacles.clips`)."""

@@ -1,1 +1,0 @@
-"""The lod plugin's systems (`ecs_tentacles.lod`)."""
