@@ -65,17 +65,17 @@ class HerdingPlugin(Plugin):
 
     def build(self, app: App) -> None:
         from ecs_tentacles.cli.registries import RunSummaries
-        from ecs_tentacles.herding import drawing
+        from ecs_tentacles.herding import entries
         from ecs_tentacles.render.registries import FramedPoints, Lines, Panels, Spheres
         from ecs_tentacles.take.registries import TakeTracks
 
         app.add(Dangers, DangerSource(sense=_predator_danger))
-        app.add(Lines, drawing.lines)
-        app.add(Spheres, drawing.spheres)
-        app.add(FramedPoints, drawing.framed_points)
-        app.add(Panels, drawing.panels)
-        app.add(RunSummaries, drawing.run_summary)
-        app.add(TakeTracks, drawing.take_tracks)
+        app.add(Lines, entries.lines)
+        app.add(Spheres, entries.spheres)
+        app.add(FramedPoints, entries.framed_points)
+        app.add(Panels, entries.panels)
+        app.add(RunSummaries, entries.run_summary)
+        app.add(TakeTracks, entries.take_tracks)
 
 
 def _predator_danger(world: Host) -> tuple[np.ndarray, np.ndarray]:
