@@ -1,9 +1,8 @@
 """Core's code names no feature: no `locomotion`, `fur`, `goals`, `guides`, `terrain`,
-`threat` or `director` in the names and strings of the package top, `creatures/`,
-`ground/`, `numeric/`, `output/`, `physics/`, `scene/` and `take/` (docstrings and
-comments aside). What is left is listed below with
-why: the list of built-in plugins, and what still has to move out of core; a new one
-fails here."""
+`threat`, `director` or `herding` in the names and strings of the package top,
+`creatures/`, `ground/`, `numeric/`, `output/`, `physics/`, `scene/` and `take/`
+(docstrings, comments and data files aside). The one exception, listed below: the list
+of built-in plugins, where core finds them by name; a new one fails here."""
 
 from __future__ import annotations
 
