@@ -9,8 +9,9 @@ inside the package. A win is written under a lock beside the file (`filelock`): 
 file is read, the level's time kept if it beats the best, and the whole file written
 to a temporary file and renamed (`ecs_tentacles.output.atomic`), so two games that
 finish at once both count and the file is always one whole JSON object. A file that
-is not one (hand-edited, truncated by another program) is set aside as
-`best_times.json.bad` and a fresh one started, with a one-line warning.
+is not one (hand-edited, truncated by another program) reads as no best times; the
+next win, under the lock, sets it aside as `best_times.json.bad` and starts a fresh
+one, with a one-line warning (reading never moves a file).
 """
 
 from __future__ import annotations
@@ -41,33 +42,27 @@ def path() -> Path:
     return data_folder() / FILE
 
 
-def _read(file: Path) -> dict[str, float]:
-    """Level -> best seconds; a file that is not ours is set aside, not trusted."""
+def _read(file: Path) -> tuple[dict[str, float], str | None]:
+    """Level -> best seconds, and what is wrong with the file (None: nothing)."""
     try:
         raw: Any = json.loads(file.read_text())
     except FileNotFoundError:
-        return {}
-    except (OSError, ValueError) as error:
-        return _set_aside(file, f"not JSON ({error})")
+        return {}, None
+    except ValueError as error:  # an unreadable folder (OSError) is the caller's to say
+        return {}, f"not JSON ({error})"
     times = raw.get("best_seconds") if isinstance(raw, dict) else None
     if not isinstance(times, dict) or not all(
         isinstance(k, str) and isinstance(v, (int, float)) and math.isfinite(v) and v > 0
         for k, v in times.items()
     ):
-        return _set_aside(file, "not a best-times file (best_seconds: level -> seconds)")
-    return {k: float(v) for k, v in times.items()}
-
-
-def _set_aside(file: Path, why: str) -> dict[str, float]:
-    aside = file.with_name(file.name + ".bad")
-    os.replace(file, aside)
-    warnings.warn(f"{file}: {why}; kept as {aside.name}, starting a new one", stacklevel=3)
-    return {}
+        return {}, "not a best-times file (best_seconds: level -> seconds)"
+    return {k: float(v) for k, v in times.items()}, None
 
 
 def best_times() -> dict[str, float]:
-    """Every level's best time, seconds."""
-    return _read(path())
+    """Every level's best time, seconds (none from a file that is not one: only a win,
+    under the lock, sets such a file aside)."""
+    return _read(path())[0]
 
 
 def best_time(level: str) -> float | None:
@@ -81,7 +76,13 @@ def record_win(level: str, seconds: float) -> tuple[float, bool]:
     file = path()
     file.parent.mkdir(parents=True, exist_ok=True)
     with FileLock(str(file) + ".lock", timeout=30):
-        times = _read(file)
+        times, wrong = _read(file)
+        if wrong is not None:  # set aside, not trusted
+            aside = file.with_name(file.name + ".bad")
+            os.replace(file, aside)
+            warnings.warn(
+                f"{file}: {wrong}; kept as {aside.name}, starting a new one", stacklevel=2
+            )
         old = times.get(level)
         if old is not None and old <= seconds:
             return old, False

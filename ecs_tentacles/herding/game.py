@@ -12,6 +12,7 @@ its frame (`log`), so a game replays from its inputs (`ecs_tentacles.herding.pla
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
@@ -38,10 +39,8 @@ class GameState:
     log: list[tuple[int, float, float]] = field(default_factory=list)  # (frame, x, y)
 
     def copy(self) -> GameState:
-        return GameState(
-            self.predator.copy(), self.aim.copy(), self.frames, list(self.penned),
-            list(self.penned_at), self.outcome, list(self.log),
-        )  # fmt: skip
+        """A copy sharing nothing mutable (every field, whatever is added later)."""
+        return copy.deepcopy(self)
 
 
 class HerdingGame:

@@ -33,6 +33,7 @@ class GamePanel(Panel):
         self.sandbox = sandbox
         self.recorded: tuple[float, bool] | None = None  # (best, new) once a win is written
         self.message = ""
+        self.best = self._best()  # read once a game, not every frame
 
     @property
     def game(self) -> HerdingGame:
@@ -40,6 +41,13 @@ class GamePanel(Panel):
 
     def attach(self, world: Any) -> None:
         self.recorded, self.message = None, ""
+        self.best = self._best()
+
+    def _best(self) -> float | None:
+        try:
+            return best_times.best_time(self.game.level)
+        except OSError:  # an unreadable data folder: no best time shown
+            return None
 
     def _record(self) -> None:
         game = self.game
@@ -61,7 +69,7 @@ class GamePanel(Panel):
         gui.item("game penned")
         imgui.text(f"time left {game.left:5.1f} s")
         gui.item("game time")
-        best = best_times.best_time(game.level) if self.recorded is None else self.recorded[0]
+        best = self.best if self.recorded is None else self.recorded[0]
         imgui.text(f"best {best:.1f} s" if best is not None else "best: not won yet")
         gui.item("game best")
         imgui.text_wrapped("drag: move the predator  R: restart  P: pause")

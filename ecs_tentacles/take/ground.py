@@ -90,13 +90,7 @@ def problem(header: dict[str, Any]) -> str | None:
             return f"{where}.name: must be an identifier (letters, digits, _; at most 40)"
         if mesh["name"] in seen:
             return f"{where}.name: {mesh['name']!r} is used twice"
-        rgb = mesh.get("rgb", [0.0, 0.0, 0.0])
-        if not (
-            isinstance(rgb, list)
-            and len(rgb) == 3
-            and all(isinstance(c, (int, float)) and not isinstance(c, bool) for c in rgb)
-            and all(math.isfinite(c) and 0.0 <= c <= 1.0 for c in rgb)
-        ):
+        if "rgb" in mesh and not _is_colour(mesh["rgb"]):  # absent in older takes
             return f"{where}.rgb: must be three numbers in [0, 1]"
         seen.add(mesh["name"])
         for key in ("vertices", "triangles"):
@@ -108,6 +102,16 @@ def problem(header: dict[str, Any]) -> str | None:
             ):
                 return f"{where}.{key}: must be a whole number in [1, {MAX_VERTICES * 2}]"
     return None
+
+
+def _is_colour(rgb: object) -> bool:
+    """Three finite numbers in [0, 1] (display rgb)."""
+    return (
+        isinstance(rgb, list)
+        and len(rgb) == 3
+        and all(isinstance(c, (int, float)) and not isinstance(c, bool) for c in rgb)
+        and all(math.isfinite(c) and 0.0 <= c <= 1.0 for c in rgb)
+    )
 
 
 def shapes(header: dict[str, Any]) -> dict[str, tuple[int, ...]]:

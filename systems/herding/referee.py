@@ -41,14 +41,13 @@ class Referee(System):
         creatures = world.creatures
         mantles = world.transforms.pos[creatures.mantle_row]
         inside = game.in_pen(mantles[:, :2])
-        already = set(state.penned)
-        for row in np.flatnonzero(inside):
+        arrived = inside & ~np.isin(creatures.entity, state.penned)  # in for the first time
+        for row in np.flatnonzero(arrived).tolist():
             entity = int(creatures.entity[row])
-            if entity not in already:
-                state.penned.append(entity)
-                x, y, z = (float(v) for v in mantles[row])
-                state.penned_at.append((x, y, z))
-                world.events.emit(CreaturePenned(world, entity, game.elapsed, len(state.penned)))
+            state.penned.append(entity)
+            x, y, z = (float(v) for v in mantles[row])
+            state.penned_at.append((x, y, z))
+            world.events.emit(CreaturePenned(world, entity, game.elapsed, len(state.penned)))
         if len(state.penned) >= game.need:
             state.outcome = WON
             world.events.emit(GameWon(world, game.elapsed, len(state.penned)))

@@ -72,6 +72,8 @@ def test_two_game_processes_finishing_at_once_leave_one_valid_file(
 def test_a_broken_file_is_set_aside_with_a_warning(data_folder: Path) -> None:
     data_folder.mkdir()
     (data_folder / "best_times.json").write_text('{"best_seconds": {"x": ')  # cut short
+    assert best_times.best_time("x") is None  # reading it says nothing and moves nothing
+    assert not (data_folder / "best_times.json.bad").exists()
     with pytest.warns(UserWarning, match="not JSON.*best_times.json.bad"):
         assert best_times.record_win("x", 12.0) == (12.0, True)
     assert (data_folder / "best_times.json.bad").read_text().startswith('{"best_seconds"')
