@@ -9,12 +9,14 @@ How `bench` measures (every figure is milliseconds per frame, the median over bl
 
 * `build_s`: `World.from_scene` (validate, build entities, compile, schedule).
 * After `warmup` untimed frames, the run alternates blocks of `block` framework
-  frames (`world.step`) with blocks of as many bare frames: copies of the state rows
-  of the creatures the framework steps (taken outside the timing, so the world's own
-  state is never touched) stepped by `world.physics.step_bare` with the world's
-  substeps, on the world's threads and scratch data, and nothing else
-  (`mj_setState`, `mj_step`, `mj_getState` per creature). Alternating in the same run means both
-  see the same machine load; which comes first alternates block by block.
+  frames (`world.step`) with blocks of as many bare frames. Each framework frame's
+  stepping inputs are recorded just before its step (`ecs_tentacles.physics.bare`:
+  every stepped row's state and overlay; the recording's own time is taken out of the
+  frame's and the physics system's); a bare block steps the last recorded block's
+  frames with MuJoCo alone (`mj_setState`, `mj_step`, `mj_getState` per creature) on
+  the world's threads and scratch data, never touching the world's state. So both do
+  the same MuJoCo work, and alternating in the same run means both see the same
+  machine load; which comes first alternates block by block.
 * `frame_ms`: a whole framework frame. `raw_mujoco_ms`: a bare frame.
   `overhead_ratio` = frame_ms / raw_mujoco_ms (the design's target is <= 1.10).
 * `systems`: each system's `process`, wrapped with `timed`; `physics_ms` is the
@@ -25,7 +27,7 @@ How `bench` measures (every figure is milliseconds per frame, the median over bl
 * `lod`: whether level of detail was on; `tiers`: creatures per physics tier at the
   end (`world.lod.counts()`); `promotions` / `demotions`: tier changes over the run.
   The bare frames step each creature at the tier the framework steps it at (KINEMATIC
-  ones not at all), so `raw_mujoco_ms` stays the MuJoCo share of the same work.
+  ones not at all): they step the framework's own inputs.
 
 With `progress`, tqdm bars on stderr (when it is a terminal) show the build, the
 warm-up and the timed frames.
@@ -46,6 +48,7 @@ from typing import Any
 import psutil
 from tqdm import tqdm
 
+from ecs_tentacles.physics.bare import BareFrame
 from ecs_tentacles.world import World
 
 BLOCK = 10  # frames per interleaved block
@@ -73,24 +76,51 @@ def time_systems(world: World) -> dict[str, list[float]]:
     return buckets
 
 
-def _bare_block(world: World, frames: int) -> float:
-    """Seconds to step copies of the active creatures' states `frames` frames, MuJoCo alone."""
-    physics = world.physics
-    states = physics.bare_states()
-    substeps = world.settings.substeps
+class _Recorder:
+    """Wraps `world.physics.step`: each frame's stepping inputs recorded first
+    (`physics.bare.record`), the seconds that took kept apart."""
+
+    def __init__(self, world: World) -> None:
+        self.physics = physics = world.physics
+        self.frames: list[BareFrame] = []
+        self.seconds = 0.0
+        step = physics.step
+
+        def recorded_step(*args: Any, **kwargs: Any) -> None:
+            began = time.perf_counter()
+            self.frames.append(physics.bare_frame())
+            self.seconds += time.perf_counter() - began
+            step(*args, **kwargs)
+
+        physics.step = recorded_step  # type: ignore[method-assign]
+
+    def close(self) -> None:
+        del self.physics.step  # the class's again
+
+
+def _bare_block(world: World, frames: list[BareFrame], k: int) -> float:
+    """Seconds to step the first `k` of `frames` with MuJoCo alone."""
+    physics, substeps = world.physics, world.settings.substeps
     start = time.perf_counter()
-    for _ in range(frames):
-        physics.step_bare(states, substeps)
+    for frame in frames[:k]:
+        physics.step_bare(frame, substeps)
     return time.perf_counter() - start
 
 
-def _framework_block(world: World, frames: int, buckets: dict[str, list[float]]) -> float:
-    """Seconds to run `frames` framework frames; `buckets` hold each system's seconds."""
+def _framework_block(
+    world: World, frames: int, buckets: dict[str, list[float]], recorder: _Recorder
+) -> float:
+    """Seconds to run `frames` framework frames, less the recording (recorded into
+    `recorder`); `buckets` hold each system's seconds, the physics' less the recording."""
     for bucket in buckets.values():
         bucket[0] = 0.0
+    recorder.frames, recorder.seconds = [], 0.0
     start = time.perf_counter()
     world.step(frames)
-    return time.perf_counter() - start
+    took = time.perf_counter() - start
+    if "physics" in buckets:
+        buckets["physics"][0] -= recorder.seconds
+    return took - recorder.seconds
 
 
 def _bar(total: int, desc: str, progress: bool, **kwargs: Any) -> tqdm[Any]:
@@ -113,18 +143,23 @@ def measure(
     """Median ms per frame of `frames` framework frames and as many bare ones, interleaved."""
     if frames < 1 or block < 1 or warmup < 0:
         raise ValueError(f"frames and block must be >= 1, warmup >= 0; got {frames, block, warmup}")
-    with _bar(warmup, "bench warm-up", progress) as bar:
-        for _ in range(warmup):
-            world.step(1)
-            bar.update(1)
-    _bare_block(world, 1)  # the bare path's first call pays for its own warm-up
-    buckets = time_systems(world)
-    per_frame: dict[str, list[float]] = defaultdict(list)
-    with _bar(frames, "bench frames", progress) as bar:
-        for index, first in enumerate(range(0, frames, block)):
-            k = min(block, frames - first)
-            _timed_block(world, k, buckets, per_frame, bare_first=index % 2 == 1)
-            bar.update(k)
+    recorder = _Recorder(world)
+    try:
+        with _bar(warmup, "bench warm-up", progress) as bar:
+            for _ in range(warmup):
+                recorder.frames = []  # the last warm-up frame is kept
+                world.step(1)
+                bar.update(1)
+        _bare_block(world, recorder.frames, 1)  # the bare path's first call warms it up
+        buckets = time_systems(world)
+        per_frame: dict[str, list[float]] = defaultdict(list)
+        with _bar(frames, "bench frames", progress) as bar:
+            for index, first in enumerate(range(0, frames, block)):
+                k = min(block, frames - first)
+                _timed_block(world, k, buckets, recorder, per_frame, bare_first=index % 2 == 1)
+                bar.update(k)
+    finally:
+        recorder.close()
     physics = zip(*(per_frame[name] for name in PHYSICS_SYSTEMS), strict=True)
     physics_ms = statistics.median(map(sum, physics))
     medians = {name: statistics.median(values) for name, values in per_frame.items()}
@@ -144,18 +179,20 @@ def _timed_block(
     world: World,
     k: int,
     buckets: dict[str, list[float]],
+    recorder: _Recorder,
     per_frame: dict[str, list[float]],
     *,
     bare_first: bool,
 ) -> None:
-    """One block of `k` framework frames and `k` bare ones, in that order or the other;
-    appends each figure's ms per frame to `per_frame`."""
-    bare = _bare_block(world, k) if bare_first else 0.0
-    per_frame["frame"].append(_framework_block(world, k, buckets) * 1000 / k)
+    """One block of `k` framework frames and `k` bare ones, in that order or the other
+    (bare first steps the frames the last block recorded); appends each figure's ms per
+    frame to `per_frame`."""
+    bare = _bare_block(world, recorder.frames, k) if bare_first else 0.0
+    per_frame["frame"].append(_framework_block(world, k, buckets, recorder) * 1000 / k)
     for name, bucket in buckets.items():
         per_frame[name].append(bucket[0] * 1000 / k)
     if not bare_first:
-        bare = _bare_block(world, k)
+        bare = _bare_block(world, recorder.frames, k)
     per_frame["raw"].append(bare * 1000 / k)
 
 

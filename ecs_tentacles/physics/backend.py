@@ -33,6 +33,7 @@ import numpy as np
 
 from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.physics import heap
+from ecs_tentacles.physics.bare import BareFrame, record, step_recorded
 from ecs_tentacles.physics.batch import Batch
 from ecs_tentacles.physics.blas import quiet_blas
 from ecs_tentacles.physics.health import SOFT_GAIN, HealthCheck, HealthState
@@ -42,7 +43,7 @@ from ecs_tentacles.physics.model import ModelLayout, model_layout
 from ecs_tentacles.physics.proxies import ContactProxies
 from ecs_tentacles.physics.roster import Roster
 from ecs_tentacles.physics.sleep import Sleep, SleepState
-from ecs_tentacles.physics.stepping import Segment, Work, bare_step, plan, step_segments
+from ecs_tentacles.physics.stepping import Segment, Work, plan, step_segments
 from ecs_tentacles.physics.tiers import FULL, KINEMATIC, REDUCED, reduced_substeps
 from ecs_tentacles.physics.view import CreatureView, CreatureViews
 
@@ -360,32 +361,18 @@ class PhysicsBackend(Membership):
             for future in futures:
                 future.result()
 
-    def bare_states(self) -> list[dict[int, np.ndarray]]:
-        """Copies of every batch's state rows per tier (REDUCED rows fitted as their next
-        step would), for `step_bare` (benchmarks)."""
-        out = []
-        for batch in self.batches:
-            states = {FULL: batch.state.copy()}
-            reduced = np.flatnonzero(self.tier[batch.members] == REDUCED)
-            if len(reduced):
-                batch.prepare(REDUCED, self.threads)
-                assert batch.reduced is not None
-                states[REDUCED] = batch.rstate.copy()
-                for row in reduced.tolist():
-                    batch.reduced.fit_state(batch.state[row], states[REDUCED][row])
-            out.append(states)
-        return out
+    def bare_frame(self) -> BareFrame:
+        """What the next `step` will read, copied, for `step_bare` (benchmarks; call it
+        right before the step)."""
+        return record(self)
 
-    def step_bare(self, states: list[dict[int, np.ndarray]], substeps: int) -> None:
-        """Step the rows of `states` that are active now with MuJoCo alone, on this pool.
-
-        Each row: `mj_setState`, `mj_step`, `mj_getState` on the threads' scratch data,
-        nothing of the framework. For benchmarks: the framework's cost is a frame minus
-        this.
-        """
-        segments = plan(self.batches, self.active, self.tier, self.threads)
+    def step_bare(self, frame: BareFrame, substeps: int) -> None:
+        """Step `frame`'s rows with MuJoCo alone on this pool (`ecs_tentacles.physics.bare`),
+        nothing of the framework and nothing of the world's state: the framework's cost is
+        a frame minus this. `frame` can be stepped again."""
+        segments = plan(self.batches, frame.active, frame.tier, self.threads)
         steps = {FULL: substeps, REDUCED: reduced_substeps(substeps)}
-        self._dispatch(bare_step, segments, states, steps)
+        self._dispatch(step_recorded, segments, frame, steps)
 
     def sync(self, transforms: TransformStore) -> None:
         """Copy every body's world pose into the Transform store (one scatter per batch)."""

@@ -38,7 +38,7 @@ from ecs_tentacles.physics.state_layout import STATE, S, size_proxies, state_sli
 from ecs_tentacles.physics.tiers import FULL, REDUCED, REDUCED_RATE
 
 if TYPE_CHECKING:
-    from ecs_tentacles.physics.reduced import ReducedModel
+    from ecs_tentacles.physics.reduced import ReducedModel, Rows
     from ecs_tentacles.store import TransformStore
 
 WARNING_KINDS = len(mujoco.MjData(mujoco.MjModel.from_xml_string("<mujoco/>")).warning)
@@ -411,7 +411,7 @@ def without_row(array: np.ndarray, row: int) -> np.ndarray:
     return array[:-1]
 
 
-def write_overlay(batch: Batch, m: mujoco.MjModel, row: int) -> None:
+def write_overlay(batch: Rows, m: mujoco.MjModel, row: int) -> None:
     """Row `row`'s servo gains, torque limits, sucker anchors and proxy sizes into `m`."""
     kp, torque = batch.kp[row], batch.torque[row]
     m.actuator_gainprm[:, 0] = kp

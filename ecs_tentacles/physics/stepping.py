@@ -18,11 +18,9 @@ from __future__ import annotations
 import threading
 from dataclasses import dataclass, field
 
-import mujoco
 import numpy as np
 
-from ecs_tentacles.physics.batch import Batch, write_overlay
-from ecs_tentacles.physics.state_layout import STATE
+from ecs_tentacles.physics.batch import Batch
 from ecs_tentacles.physics.tiers import FULL, REDUCED
 
 
@@ -112,26 +110,3 @@ def step_segments(work: Work, substeps: dict[int, int], thread: int) -> None:
         n = (segment.steps or substeps)[segment.tier]
         if n:
             segment.batch.step_rows(segment.rows, n, thread, segment.tier)
-
-
-def bare_step(
-    work: Work,
-    states: list[dict[int, np.ndarray]],
-    substeps: dict[int, int],
-    thread: int,
-) -> None:
-    """MuJoCo alone: each row's model values, set its state, step it, get it back
-    (benchmarks)."""
-    while (segment := work.take()) is not None:
-        batch = segment.batch
-        scratch = batch.scratch_for(thread, segment.tier)
-        m, d, rows = scratch.model, scratch.data, states[batch.index][segment.tier]
-        n = substeps[segment.tier]
-        for row in segment.rows.tolist():
-            if segment.tier == REDUCED and batch.reduced is not None:
-                batch.reduced.write_overlay(batch, m, row)
-            else:
-                write_overlay(batch, m, row)
-            mujoco.mj_setState(m, d, rows[row], STATE)
-            mujoco.mj_step(m, d, nstep=n)
-            mujoco.mj_getState(m, d, rows[row], STATE)
