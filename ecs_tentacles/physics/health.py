@@ -138,6 +138,9 @@ class HealthCheck:
         """Read the bodies' order from `proxies` again (after it was rebuilt)."""
         self.rows = proxies.rows
         self.start, self.count = proxies.start, proxies.count
+        rows = self.rows  # one run of consecutive Transform rows (a crowd): read as a slice
+        together = len(rows) > 0 and bool(np.all(np.diff(rows) == 1))
+        self.span = slice(int(rows[0]), int(rows[-1]) + 1) if together else None
 
     def allow_speed(self, index: int, speed: float, until: float) -> None:
         """Creature `index` may move its bodies up to `speed` m/s (instead of the scene's
@@ -166,11 +169,13 @@ class HealthCheck:
         `physics_time` is the physics clock: a recovered creature's state is set to it.
         """
         roster = self.roster
-        limit = np.full(len(roster), self.max_speed * world.settings.dt)
+        limit: float | np.ndarray = self.max_speed * world.settings.dt
         for index, (speed, until) in list(self.allowed.items()):
             if world.time > until:
                 del self.allowed[index]
             else:
+                if not isinstance(limit, np.ndarray):
+                    limit = np.full(len(roster), limit)
                 limit[index] = max(self.max_speed, speed) * world.settings.dt
         save = world.frame % SAVE_EVERY == 0
         ramp = world.settings.dt / SOFT_SECONDS
@@ -181,7 +186,8 @@ class HealthCheck:
         fastest = self._fastest(pos, active)
         bad = ~(fastest <= limit)  # also nan: a pose that is not finite
         for batch in roster.batches:
-            rows = np.flatnonzero(active[batch.members])  # what was stepped: the rest waits
+            stepped = active[batch.members]  # what was stepped: the rest waits
+            rows = slice(None) if stepped.all() else np.flatnonzero(stepped)
             at = batch.members[rows]
             bad[at] |= batch.warnings[rows].any(axis=1)
             bad[at] |= ~np.isfinite(batch.qvel[rows].sum(axis=1))
@@ -190,8 +196,9 @@ class HealthCheck:
                 bad[batch.members[row]] = True
         failing = np.flatnonzero(bad & active)
         dt = world.settings.dt
+        limits = np.broadcast_to(limit, bad.shape)
         causes = {
-            int(i): self._cause(int(i), float(fastest[i]), float(limit[i]), dt) for i in failing
+            int(i): self._cause(int(i), float(fastest[i]), float(limits[i]), dt) for i in failing
         }
         healthy = active & ~bad
         softened = healthy & (roster.soften < 1.0)
@@ -214,8 +221,9 @@ class HealthCheck:
         """Per creature, its fastest body's move since last frame (m; 0 if not stepped)."""
         fastest = np.zeros(len(active))
         who = np.flatnonzero(active)
+        rows: slice | np.ndarray
         if len(who) == len(active):
-            rows, start = self.rows, self.start
+            rows, start = self.rows if self.span is None else self.span, self.start
         else:
             if not len(who):
                 return fastest

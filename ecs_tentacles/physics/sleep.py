@@ -94,26 +94,35 @@ class Sleep:
         attached = world.suckers.attached
         for batch, previous in zip(roster.batches, self.commands, strict=True):
             members = batch.members
-            rows = np.flatnonzero(~roster.frozen[members] & (roster.tier[members] != KINEMATIC))
-            if not len(rows):
-                continue
+            stepped = ~roster.frozen[members] & (roster.tier[members] != KINEMATIC)
+            every = bool(stepped.all())
+            rows: slice | np.ndarray = slice(None) if every else np.flatnonzero(stepped)
             who = members[rows]
-            commands = np.concatenate((batch.ctrl[rows], batch.kp[rows]), axis=1)
-            calm = (
-                ~roster.proxies_used[who].astype(bool)
-                & ~attached[batch.sucker_rows[rows]].any(axis=1)
-                & self.known[who]
-                & (np.abs(commands - previous[rows]).max(axis=1, initial=0.0) < COMMAND_CHANGE)
-            )
+            if not len(who):
+                continue
+            ctrl, kp = batch.ctrl[rows], batch.kp[rows]
+            # the cheap tests first; the commands are compared only where they still decide
+            calm = ~roster.proxies_used[who].astype(bool) & self.known[who]
             if wants_motion is not None:
                 calm &= ~wants_motion[roster.creature_row[who]]
-            previous[rows] = commands
+            if calm.any():
+                calm &= ~attached[batch.sucker_rows[rows]].any(axis=1)
+            if calm.any():
+                commands = np.concatenate((ctrl[calm], kp[calm]), axis=1)
+                last = previous[rows][calm]
+                changed = ~(np.abs(commands - last).max(axis=1, initial=0.0) < COMMAND_CHANGE)
+                calm[np.flatnonzero(calm)[changed]] = False
+            nu = ctrl.shape[1]
+            previous[rows, :nu], previous[rows, nu:] = ctrl, kp
             self.known[who] = True
             restless = who[~calm]
             self.still[restless] = 0
             roster.sleeping[restless] = False
             settling = calm & ~roster.sleeping[who]
-            moving = np.abs(batch.qvel[rows]).max(axis=1, initial=0.0) >= STILL_SPEED
+            if not settling.any():
+                continue
+            qvel = batch.qvel[rows][settling]
+            moving = np.abs(qvel).max(axis=1, initial=0.0) >= STILL_SPEED
             them = who[settling]
-            self.still[them] = np.where(moving[settling], 0, self.still[them] + 1)
+            self.still[them] = np.where(moving, 0, self.still[them] + 1)
             roster.sleeping[them] = self.still[them] >= SETTLE_FRAMES
