@@ -103,10 +103,12 @@ def bend(
     distance = np.hypot(d[:, 0], d[:, 1])
     toward = d / np.maximum(distance, 1e-9)[:, None]  # unit, a -> b
     gap = distance - radius[a] - radius[b]
-    push = np.clip(1.0 - gap / reach, 0.0, 2.0) ** 2
+    push = np.minimum(np.maximum(1.0 - gap / reach, 0.0), 2.0)  # `np.clip`'s numbers
+    push *= push
     ahead = np.einsum("ij,ij->i", toward, heading[a])  # cos of the neighbour off the way
     weight = push * (BEHIND + (1.0 - BEHIND) * 0.5 * (1.0 + ahead))
-    right = np.column_stack([toward[:, 1], -toward[:, 0]])
+    right = np.empty_like(toward)
+    right[:, 0], right[:, 1] = toward[:, 1], -toward[:, 0]
     force = (SIDESTEP * np.maximum(ahead, 0.0)[:, None] * right - toward) * weight[:, None]
     np.add.at(out, a, force)
     fade = np.clip(to_goal / np.maximum(radius, 1e-9), 0.0, 1.0)  # near the goal: let it in

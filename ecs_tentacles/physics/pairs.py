@@ -96,10 +96,11 @@ def near_pairs(
     block = max(1, 4_000_000 // max(n, 1))  # bound the (block, n) distance matrix
     for lo in range(0, n, block):
         hi = min(n, lo + block)
-        gap = np.linalg.norm(centre[lo:hi, None, :] - centre[None, :, :], axis=2)
+        apart = centre[lo:hi, None, :] - centre[None, :, :]
+        gap = np.sqrt(np.add.reduce(apart * apart, axis=2))  # `np.linalg.norm`'s numbers
         gap -= radius[lo:hi, None] + radius[None, :]
         near = gap < margin
-        near[np.arange(hi - lo), np.arange(lo, hi)] = False
+        near.reshape(-1)[lo :: n + 1] = False  # each sphere and itself: (i, lo + i)
         ia, ib = np.nonzero(near)
         found_a.append(ia + lo)
         found_b.append(ib)
