@@ -3,6 +3,7 @@
     python tools/lod_fidelity.py                      # 64 creatures, 20 s, both runs
     python tools/lod_fidelity.py --creatures 160 --seconds 10 --json
     python tools/lod_fidelity.py --goals-within 0.8   # goals near enough to arrive
+    python tools/lod_fidelity.py --goals-within 0.8 --nudge 0.0001   # the floor: full vs full
 
 Runs `crowd_scene(N)` (every creature crawling across the crowd, so they meet) once with
 the scene's level of detail (default budgets) and once with `lod=False` (everyone full),
@@ -17,12 +18,17 @@ in two processes, and compares what a crowd tool's user would notice:
   `--every` frames: the capsules of creatures whose bodies come near, segment against
   segment), in millimetres;
 * recoveries (physics blow-ups restored), the tiers at the end, promotions, wall time.
+
+With `--nudge M` the first run is lod off too, with every creature's start moved M
+metres along x: how far apart two full runs drift on their own, the floor any level of
+detail is compared against.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import math
 import time
 from concurrent.futures import ProcessPoolExecutor
 from typing import Any
@@ -96,12 +102,20 @@ def goals_within(scene: dict[str, Any], metres: float) -> dict[str, Any]:
 
 
 def run(
-    creatures: int, seconds: float, lod: bool, every: int, seed: int, within: float | None
+    creatures: int,
+    seconds: float,
+    lod: bool,
+    every: int,
+    seed: int,
+    within: float | None,
+    nudge: float = 0.0,
 ) -> dict[str, Any]:
-    """One run; its figures."""
+    """One run (every start moved `nudge` metres along x); its figures."""
     scene = crowd_scene(creatures, seed=seed)
     if within is not None:
         scene = goals_within(scene, within)
+    for creature in scene["creatures"]:
+        creature["position"][0] += nudge
     goals = {
         c["name"]: np.asarray(c["goals"][0]["position"][:2], float) for c in scene["creatures"]
     }
@@ -151,6 +165,9 @@ def compare(on: dict[str, Any], off: dict[str, Any]) -> dict[str, Any]:
         "reached": {"lod": len(on["reached"]), "off": len(off["reached"]), "both": len(both)},
         "only_one_run_reached": sorted(set(on["reached"]) ^ set(off["reached"])),
         "arrival_apart_s_max": max(apart, default=0.0),
+        "arrival_apart_s_median": float(np.median(apart)) if apart else 0.0,
+        "arrivals_within_2s": sum(a <= 2.0 for a in apart),
+        "arrival_apart_s": {n: a for n, a in zip(both, apart, strict=True) if a > 2.0},
         "deepest_mm": {"lod": on["deepest_mm"], "off": off["deepest_mm"]},
         "recoveries": {"lod": on["recoveries"], "off": off["recoveries"]},
         "tiers_at_end": on["tiers"],
@@ -172,34 +189,51 @@ def main(argv: list[str] | None = None) -> int:
         metavar="M",
         help="bring every goal to at most M metres from its start (arrivals within the run)",
     )
+    parser.add_argument(
+        "--nudge",
+        type=float,
+        default=None,
+        metavar="M",
+        help="compare lod off with lod off, every start moved M metres: how far apart two"
+        " full runs drift on their own (the floor of the comparison)",
+    )
     parser.add_argument("--json", action="store_true", help="one JSON object")
     args = parser.parse_args(argv)
     if args.creatures < 1 or args.seconds <= 0 or args.every < 1:
         parser.error("--creatures and --every must be >= 1, --seconds > 0")
     if args.goals_within is not None and not args.goals_within > 0:
         parser.error(f"--goals-within: must be > 0 metres, got {args.goals_within}")
+    if args.nudge is not None and not (math.isfinite(args.nudge) and args.nudge != 0.0):
+        parser.error(f"--nudge: must be a distance other than 0, got {args.nudge}")
+    first = (True, 0.0) if args.nudge is None else (False, args.nudge)
     with ProcessPoolExecutor(2) as pool:
+        common = (args.creatures, args.seconds)
         runs = [
-            pool.submit(
-                run, args.creatures, args.seconds, lod, args.every, args.seed, args.goals_within
-            )
-            for lod in (True, False)
+            pool.submit(run, *common, lod, args.every, args.seed, args.goals_within, nudge)
+            for lod, nudge in (first, (False, 0.0))
         ]
         on, off = (r.result() for r in runs)
     result = {
         "creatures": args.creatures,
         "seconds": args.seconds,
         "goals_within_m": args.goals_within,
+        "nudge_m": args.nudge,
         **compare(on, off),
     }
     if args.json:
         print(json.dumps(result))
         return 0
     progress = result["mean_progress_m"]
-    print(
-        f"{args.creatures} creatures, {args.seconds:g} s, lod on (tiers at the end"
-        f" {result['tiers_at_end']}, {result['promotions']} promotions) against lod off"
-    )
+    if args.nudge is None:
+        print(
+            f"{args.creatures} creatures, {args.seconds:g} s, lod on (tiers at the end"
+            f" {result['tiers_at_end']}, {result['promotions']} promotions) against lod off"
+        )
+    else:
+        print(
+            f"{args.creatures} creatures, {args.seconds:g} s, lod off with every start moved"
+            f" {args.nudge:g} m against lod off (the 'lod' figures are the moved run's)"
+        )
     print(
         f"  mean progress toward goals: {progress['lod']:.3f} m against {progress['off']:.3f} m "
         f"(ratio {result['progress_ratio']:.3f})"
@@ -207,9 +241,13 @@ def main(argv: list[str] | None = None) -> int:
     reached = result["reached"]
     print(
         f"  goals reached: {reached['lod']} against {reached['off']} ({reached['both']} in"
-        f" both; arrival times at most {result['arrival_apart_s_max']:.2f} s apart; only in"
-        f" one run: {', '.join(result['only_one_run_reached']) or 'none'})"
+        f" both; arrival times a median {result['arrival_apart_s_median']:.2f} s and at most"
+        f" {result['arrival_apart_s_max']:.2f} s apart, {result['arrivals_within_2s']} within"
+        f" 2 s; only in one run: {', '.join(result['only_one_run_reached']) or 'none'})"
     )
+    late = result["arrival_apart_s"]
+    if late:
+        print("  more than 2 s apart: " + ", ".join(f"{n} {a:.1f} s" for n, a in late.items()))
     deepest = result["deepest_mm"]
     print(f"  deepest interpenetration: {deepest['lod']:.1f} mm against {deepest['off']:.1f} mm")
     recoveries = result["recoveries"]

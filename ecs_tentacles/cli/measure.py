@@ -48,6 +48,7 @@ from typing import Any
 import psutil
 from tqdm import tqdm
 
+from ecs_tentacles.physics import heap
 from ecs_tentacles.physics.bare import BareFrame
 from ecs_tentacles.world import World
 
@@ -160,6 +161,8 @@ def measure(
                 bar.update(k)
     finally:
         recorder.close()
+        recorder.frames = []
+        heap.trim()  # the recordings' memory goes back: `rss_mb` is the world's
     physics = zip(*(per_frame[name] for name in PHYSICS_SYSTEMS), strict=True)
     physics_ms = statistics.median(map(sum, physics))
     medians = {name: statistics.median(values) for name, values in per_frame.items()}

@@ -361,10 +361,10 @@ class PhysicsBackend(Membership):
             for future in futures:
                 future.result()
 
-    def bare_frame(self) -> BareFrame:
+    def bare_frame(self, keep: bool = False) -> BareFrame:
         """What the next `step` will read, copied, for `step_bare` (benchmarks; call it
-        right before the step)."""
-        return record(self)
+        right before the step); `keep`: keep the bare steps' results too."""
+        return record(self, keep)
 
     def step_bare(self, frame: BareFrame, substeps: int) -> None:
         """Step `frame`'s rows with MuJoCo alone on this pool (`ecs_tentacles.physics.bare`),

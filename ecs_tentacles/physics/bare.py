@@ -6,7 +6,8 @@ will read of every row it steps: the state (a REDUCED row's reduced state, fitte
 with the frame's inputs pulled in as its step will), the overlay (servo gains, torque
 limits, sucker anchors, proxy sizes) and the forces scripts apply. `step_recorded`
 later steps those copies with MuJoCo alone on the backend's threads (overlay into the
-thread's scratch model, `mj_setState`, `mj_step`, `mj_getState` into `after`), shares
+thread's scratch model, `mj_setState`, `mj_step`, `mj_getState`; into `after` when
+the frame was recorded with `keep`, else into a scratch vector), shares
 handed out as the framework's are. A recorded frame can be stepped again and again:
 its inputs are never written.
 
@@ -53,11 +54,7 @@ class RecordedRows:
     proxy_geoms: np.ndarray  # the batch's
     equality_ids: np.ndarray  # the batch's
     forces: dict[int, np.ndarray] = field(default_factory=dict)  # by position: xfrc_applied
-    after: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))  # the steps' results
-
-    def __post_init__(self) -> None:
-        if not self.after.size:
-            self.after = np.zeros_like(self.states)
+    after: np.ndarray | None = None  # the steps' results (recorded with `keep`)
 
 
 @dataclass(frozen=True)
@@ -69,8 +66,9 @@ class BareFrame:
     rows: list[dict[int, RecordedRows]]  # per batch, per stepped tier
 
 
-def record(backend: PhysicsBackend) -> BareFrame:
-    """What `backend.step` would read now, copied (call it just before the step)."""
+def record(backend: PhysicsBackend, keep: bool = False) -> BareFrame:
+    """What `backend.step` would read now, copied (call it just before the step); with
+    `keep`, room for the bare steps' results (`RecordedRows.after`)."""
     active, tier = backend.active.copy(), backend.tier.copy()
     per_batch: list[dict[int, RecordedRows]] = []
     for batch in backend.batches:
@@ -92,6 +90,7 @@ def record(backend: PhysicsBackend) -> BareFrame:
                 batch.torque[rows].copy(), batch.anchor[rows].copy(), batch.near[rows].copy(),
                 batch.proxy_size[rows].copy(), batch.proxy_cylinder, batch.proxy_geoms,
                 batch.equality_ids, {p: f.copy() for p, f in applied.items()},
+                np.zeros_like(states) if keep else None,
             )  # fmt: skip
         per_batch.append(recorded)
     assert KINEMATIC not in {level for r in per_batch for level in r}
@@ -118,14 +117,16 @@ def _reduced_states(backend: PhysicsBackend, index: int, rows: np.ndarray) -> np
 
 def step_recorded(work: Work, frame: BareFrame, substeps: dict[int, int], thread: int) -> None:
     """Step shares of `frame`'s rows taken from `work` with MuJoCo alone on scratch
-    `thread`, each by its tier's `substeps`, results into `after` (runs on each thread
-    of a dispatch)."""
+    `thread`, each by its tier's `substeps`, results into `after` if kept (runs on each
+    thread of a dispatch)."""
     while (segment := work.take()) is not None:
         batch = segment.batch
         recorded = frame.rows[batch.index][segment.tier]
         scratch = batch.scratch_for(thread, segment.tier)
         m, d, n = scratch.model, scratch.data, substeps[segment.tier]
         reduced = batch.reduced if segment.tier == REDUCED else None
+        kept = recorded.after
+        out = kept if kept is not None else np.empty((1, recorded.states.shape[1]))
         if scratch.forced:  # the framework's last step there applied forces
             d.xfrc_applied[:] = 0.0
             scratch.forced = False
@@ -139,6 +140,6 @@ def step_recorded(work: Work, frame: BareFrame, substeps: dict[int, int], thread
                 d.xfrc_applied[:] = forces
             mujoco.mj_setState(m, d, recorded.states[position], STATE)
             mujoco.mj_step(m, d, nstep=n)
-            mujoco.mj_getState(m, d, recorded.after[position], STATE)
+            mujoco.mj_getState(m, d, out[position if kept is not None else 0], STATE)
             if forces is not None:
                 d.xfrc_applied[:] = 0.0

@@ -21,7 +21,7 @@ def _recorded_then_stepped(world: World) -> tuple[BareFrame, list[np.ndarray], l
     step = physics.step
 
     def recording(*args: object, **kwargs: object) -> None:
-        frames.append(physics.bare_frame())
+        frames.append(physics.bare_frame(keep=True))
         step(*args, **kwargs)  # type: ignore[arg-type]
 
     physics.step = recording  # type: ignore[method-assign]

@@ -58,3 +58,16 @@ def test_goals_brought_near_keep_their_direction_and_are_reached_in_both_runs() 
     result = tool.compare(on, off)
     assert result["reached"] == {"lod": 4, "off": 4, "both": 4}
     assert result["arrival_apart_s_max"] < 2.0
+    assert result["arrivals_within_2s"] == 4 and result["arrival_apart_s"] == {}
+    assert 0.0 <= result["arrival_apart_s_median"] <= result["arrival_apart_s_max"]
+
+
+@pytest.mark.skipif(not TOOL.is_file(), reason="needs the source tree")
+def test_a_nudged_run_starts_every_creature_moved() -> None:
+    tool = load_tool("lod_fidelity")
+    plain, moved = (tool.run(2, 0.05, False, 5, 0, None, nudge) for nudge in (0.0, 0.25))
+    # the goals stay: moved along x, each creature's distance to its goal changed
+    assert plain["progress"].keys() == moved["progress"].keys()
+    assert plain["progress"] != moved["progress"]
+    with pytest.raises(SystemExit):
+        tool.main(["--nudge", "0"])
