@@ -14,6 +14,7 @@ unwind like Ctrl-C, so no partial output is left behind.
 from __future__ import annotations
 
 import importlib
+import importlib.util
 from collections.abc import Sequence
 from typing import Any
 
@@ -29,7 +30,11 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 def __getattr__(name: str) -> Any:
     """The command line's other names (`build_parser`, `Terminated`, ...), loaded when
-    first asked for."""
+    first asked for. A submodule's name is the submodule (`from ecs_tentacles.cli import
+    bake_ray` asks here first: loading every command then would import the module that
+    asked, half made, in a circle)."""
+    if importlib.util.find_spec(f"{__name__}.{name}") is not None:
+        return importlib.import_module(f"{__name__}.{name}")
     command = importlib.import_module("ecs_tentacles.cli.command")
     try:
         return getattr(command, name)
