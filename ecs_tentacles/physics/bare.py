@@ -23,18 +23,30 @@ octopuses), and the framework looked 19 % dearer than MuJoCo where it is not.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Protocol
 
 import mujoco
 import numpy as np
 
-from ecs_tentacles.physics.batch import write_overlay
+from ecs_tentacles.physics.batch import Batch, write_overlay
 from ecs_tentacles.physics.state_layout import STATE
 from ecs_tentacles.physics.tiers import FULL, KINEMATIC, REDUCED
 
 if TYPE_CHECKING:
-    from ecs_tentacles.physics.backend import PhysicsBackend
     from ecs_tentacles.physics.stepping import Work
+
+
+class Stepped(Protocol):
+    """What `record` reads of the physics (`PhysicsBackend`)."""
+
+    batches: list[Batch]
+    threads: int
+
+    @property
+    def active(self) -> np.ndarray: ...
+
+    @property
+    def tier(self) -> np.ndarray: ...
 
 
 @dataclass
@@ -66,7 +78,7 @@ class BareFrame:
     rows: list[dict[int, RecordedRows]]  # per batch, per stepped tier
 
 
-def record(backend: PhysicsBackend, keep: bool = False) -> BareFrame:
+def record(backend: Stepped, keep: bool = False) -> BareFrame:
     """What `backend.step` would read now, copied (call it just before the step); with
     `keep`, room for the bare steps' results (`RecordedRows.after`)."""
     active, tier = backend.active.copy(), backend.tier.copy()
@@ -97,7 +109,7 @@ def record(backend: PhysicsBackend, keep: bool = False) -> BareFrame:
     return BareFrame(active, tier, per_batch)
 
 
-def _reduced_states(backend: PhysicsBackend, index: int, rows: np.ndarray) -> np.ndarray:
+def _reduced_states(backend: Stepped, index: int, rows: np.ndarray) -> np.ndarray:
     """The reduced states REDUCED `rows` of batch `index` will start their step from:
     fitted again where the full state was written from outside, else the frame's
     inputs pulled in (`Batch._step_reduced`)."""
