@@ -49,7 +49,7 @@ import psutil
 from tqdm import tqdm
 
 from ecs_tentacles.physics import heap
-from ecs_tentacles.physics.bare import BareFrame
+from ecs_tentacles.physics.bare import BareFrame, Recorder
 from ecs_tentacles.world import World
 
 BLOCK = 10  # frames per interleaved block
@@ -77,28 +77,6 @@ def time_systems(world: World) -> dict[str, list[float]]:
     return buckets
 
 
-class _Recorder:
-    """Wraps `world.physics.step`: each frame's stepping inputs recorded first
-    (`physics.bare.record`), the seconds that took kept apart."""
-
-    def __init__(self, world: World) -> None:
-        self.physics = physics = world.physics
-        self.frames: list[BareFrame] = []
-        self.seconds = 0.0
-        step = physics.step
-
-        def recorded_step(*args: Any, **kwargs: Any) -> None:
-            began = time.perf_counter()
-            self.frames.append(physics.bare_frame())
-            self.seconds += time.perf_counter() - began
-            step(*args, **kwargs)
-
-        physics.step = recorded_step  # type: ignore[method-assign]
-
-    def close(self) -> None:
-        del self.physics.step  # the class's again
-
-
 def _bare_block(world: World, frames: list[BareFrame], k: int) -> float:
     """Seconds to step the first `k` of `frames` with MuJoCo alone."""
     physics, substeps = world.physics, world.settings.substeps
@@ -109,7 +87,7 @@ def _bare_block(world: World, frames: list[BareFrame], k: int) -> float:
 
 
 def _framework_block(
-    world: World, frames: int, buckets: dict[str, list[float]], recorder: _Recorder
+    world: World, frames: int, buckets: dict[str, list[float]], recorder: Recorder
 ) -> float:
     """Seconds to run `frames` framework frames, less the recording (recorded into
     `recorder`); `buckets` hold each system's seconds, the physics' less the recording."""
@@ -144,7 +122,7 @@ def measure(
     """Median ms per frame of `frames` framework frames and as many bare ones, interleaved."""
     if frames < 1 or block < 1 or warmup < 0:
         raise ValueError(f"frames and block must be >= 1, warmup >= 0; got {frames, block, warmup}")
-    recorder = _Recorder(world)
+    recorder = Recorder(world.physics)
     try:
         with _bar(warmup, "bench warm-up", progress) as bar:
             for _ in range(warmup):
@@ -182,7 +160,7 @@ def _timed_block(
     world: World,
     k: int,
     buckets: dict[str, list[float]],
-    recorder: _Recorder,
+    recorder: Recorder,
     per_frame: dict[str, list[float]],
     *,
     bare_first: bool,

@@ -33,7 +33,7 @@ import numpy as np
 
 from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.physics import heap
-from ecs_tentacles.physics.bare import BareFrame, record, step_recorded
+from ecs_tentacles.physics.bare import BareFrame, step_recorded
 from ecs_tentacles.physics.batch import Batch
 from ecs_tentacles.physics.blas import quiet_blas
 from ecs_tentacles.physics.health import SOFT_GAIN, HealthCheck, HealthState
@@ -361,15 +361,10 @@ class PhysicsBackend(Membership):
             for future in futures:
                 future.result()
 
-    def bare_frame(self, keep: bool = False) -> BareFrame:
-        """What the next `step` will read, copied, for `step_bare` (benchmarks; call it
-        right before the step); `keep`: keep the bare steps' results too."""
-        return record(self, keep)
-
     def step_bare(self, frame: BareFrame, substeps: int) -> None:
-        """Step `frame`'s rows with MuJoCo alone on this pool (`ecs_tentacles.physics.bare`),
-        nothing of the framework and nothing of the world's state: the framework's cost is
-        a frame minus this. `frame` can be stepped again."""
+        """Step `frame`'s rows (recorded by `physics.bare.Recorder`) with MuJoCo alone on
+        this pool: nothing of the framework and nothing of the world's state, so the
+        framework's cost is a frame minus this. `frame` can be stepped again."""
         segments = plan(self.batches, frame.active, frame.tier, self.threads)
         steps = {FULL: substeps, REDUCED: reduced_substeps(substeps)}
         self._dispatch(step_recorded, segments, frame, steps)

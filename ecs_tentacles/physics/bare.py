@@ -1,15 +1,16 @@
 """MuJoCo alone on the framework's own inputs: what a frame's stepping costs without
 the framework (benchmarks, `ecs_tentacles.cli.measure`).
 
-`record(backend)`, called just before the backend steps a frame, copies what that step
-will read of every row it steps: the state (a REDUCED row's reduced state, fitted or
-with the frame's inputs pulled in as its step will), the overlay (servo gains, torque
-limits, sucker anchors, proxy sizes) and the forces scripts apply. `step_recorded`
-later steps those copies with MuJoCo alone on the backend's threads (overlay into the
-thread's scratch model, `mj_setState`, `mj_step`, `mj_getState`; into `after` when
-the frame was recorded with `keep`, else into a scratch vector), shares
-handed out as the framework's are. A recorded frame can be stepped again and again:
-its inputs are never written.
+`Recorder(world.physics)` calls `record(physics)` just before each frame's step (until
+`close()`), which copies what that step will read of every row it steps: the state (a
+REDUCED row's reduced state, fitted or with the frame's inputs pulled in as its step
+will), the overlay (servo gains, torque limits, sucker anchors, proxy sizes) and the
+forces scripts apply. `step_recorded` (`PhysicsBackend.step_bare`) later steps those
+copies with MuJoCo alone on the backend's threads (overlay into the thread's scratch
+model, `mj_setState`, `mj_step`, `mj_getState`; into `after` when the frame was
+recorded with `keep`, else into a scratch vector), shares handed out as the
+framework's are. A recorded frame can be stepped again and again: its inputs are never
+written.
 
 So a bare frame does the framework frame's very work: the same states, contacts and
 solver iterations, and the same results (a test). Only creatures near another differ:
@@ -22,15 +23,17 @@ octopuses), and the framework looked 19 % dearer than MuJoCo where it is not.
 
 from __future__ import annotations
 
+import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 import mujoco
 import numpy as np
 
 from ecs_tentacles.physics.batch import Batch, write_overlay
 from ecs_tentacles.physics.state_layout import STATE
-from ecs_tentacles.physics.tiers import FULL, KINEMATIC, REDUCED
+from ecs_tentacles.physics.tiers import FULL, REDUCED
 
 if TYPE_CHECKING:
     from ecs_tentacles.physics.stepping import Work
@@ -47,6 +50,18 @@ class Stepped(Protocol):
 
     @property
     def tier(self) -> np.ndarray: ...
+
+
+class Steps(Stepped, Protocol):
+    """The physics a `Recorder` follows: what `record` reads, and its step."""
+
+    def step(
+        self,
+        substeps: int,
+        before_substep: Callable[[int], None] | None = None,
+        rounds: int = 1,
+        between: Callable[[], None] | None = None,
+    ) -> None: ...
 
 
 @dataclass
@@ -89,9 +104,10 @@ def record(backend: Stepped, keep: bool = False) -> BareFrame:
             rows = np.flatnonzero(active[batch.members] & (tier[batch.members] == level))
             if not len(rows):
                 continue
-            states = batch.state[rows].copy()
             if level == REDUCED:
                 states = _reduced_states(backend, batch.index, rows)
+            else:
+                states = batch.state[rows].copy()
             applied = {int(p): batch.applied[int(r)] for p, r in enumerate(rows)
                        if int(r) in batch.applied}  # fmt: skip
             if level == REDUCED and applied:
@@ -105,8 +121,31 @@ def record(backend: Stepped, keep: bool = False) -> BareFrame:
                 np.zeros_like(states) if keep else None,
             )  # fmt: skip
         per_batch.append(recorded)
-    assert KINEMATIC not in {level for r in per_batch for level in r}
     return BareFrame(active, tier, per_batch)
+
+
+class Recorder:
+    """Records each frame's stepping inputs (`record`) just before `physics` steps it,
+    by wrapping its `step` until `close()`; `seconds` is what the recording took (the
+    bench takes it out of the framework's time). `keep`: as in `record`."""
+
+    def __init__(self, physics: Steps, keep: bool = False) -> None:
+        self.physics = physics
+        self.frames: list[BareFrame] = []
+        self.seconds = 0.0
+        step = physics.step
+
+        def recorded_step(*args: Any, **kwargs: Any) -> None:
+            began = time.perf_counter()
+            self.frames.append(record(physics, keep))
+            self.seconds += time.perf_counter() - began
+            step(*args, **kwargs)
+
+        physics.step = recorded_step  # type: ignore[method-assign]
+
+    def close(self) -> None:
+        """Stop recording: `physics.step` is its class's again."""
+        del self.physics.step
 
 
 def _reduced_states(backend: Stepped, index: int, rows: np.ndarray) -> np.ndarray:

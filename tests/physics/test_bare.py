@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from ecs_tentacles.creator.crowd import crowd_scene
-from ecs_tentacles.physics.bare import BareFrame
+from ecs_tentacles.physics.bare import BareFrame, Recorder
 from ecs_tentacles.physics.tiers import FULL, REDUCED
 from ecs_tentacles.world import World
 
@@ -17,17 +17,10 @@ def _recorded_then_stepped(world: World) -> tuple[BareFrame, list[np.ndarray], l
     """Record the next frame's inputs, run the frame; the frame and every batch's full
     and reduced state rows after it."""
     physics = world.physics
-    frames: list[BareFrame] = []
-    step = physics.step
-
-    def recording(*args: object, **kwargs: object) -> None:
-        frames.append(physics.bare_frame(keep=True))
-        step(*args, **kwargs)  # type: ignore[arg-type]
-
-    physics.step = recording  # type: ignore[method-assign]
+    recorder = Recorder(physics, keep=True)
     world.step(1)
-    del physics.step
-    (frame,) = frames
+    recorder.close()
+    (frame,) = recorder.frames
     batches = physics.batches
     return frame, [b.state.copy() for b in batches], [b.rstate.copy() for b in batches]
 
