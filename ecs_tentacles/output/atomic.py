@@ -241,21 +241,16 @@ class AtomicOutput:
                 f" removed or replaced while writing ({error.strerror})"
             ) from None
         try:
-            info = os.fstat(descriptor)
-            if not stat.S_ISREG(info.st_mode) or (
-                same_file and (info.st_dev, info.st_ino) != self._created
-            ):
-                raise OutputError(
-                    f"{self.target}: the temporary file {temporary.name} was replaced while"
-                    " writing; nothing written"
-                )
-            os.fsync(descriptor)
-        except BaseException as error:
-            self.discard()
-            full = disk_full(self.target, error)
-            if full is not None:
-                raise full from None
-            raise
+            with self.discarded_on_error():
+                info = os.fstat(descriptor)
+                if not stat.S_ISREG(info.st_mode) or (
+                    same_file and (info.st_dev, info.st_ino) != self._created
+                ):
+                    raise OutputError(
+                        f"{self.target}: the temporary file {temporary.name} was replaced"
+                        " while writing; nothing written"
+                    )
+                os.fsync(descriptor)
         finally:
             os.close(descriptor)
         with _folder_lock(self.target.parent):
@@ -273,6 +268,19 @@ class AtomicOutput:
         self.temporary = None
         _fsync_folder(self.target.parent)
         return self.target
+
+    @contextlib.contextmanager
+    def discarded_on_error(self) -> Iterator[None]:
+        """On any exception inside: the temporary file removed, the target untouched, and
+        a full disk or quota said in one line naming the target (`disk_full`)."""
+        try:
+            yield
+        except BaseException as error:
+            self.discard()
+            full = disk_full(self.target, error)
+            if full is not None:
+                raise full from None
+            raise
 
     def discard(self) -> None:
         """Remove the temporary file (if any); the target stays as it was."""
@@ -292,14 +300,8 @@ def atomic_output(target: str | os.PathLike[str]) -> Iterator[Path]:
     output = AtomicOutput(target)
     os.close(output.open())
     assert output.temporary is not None
-    try:
+    with output.discarded_on_error():
         yield output.temporary
-    except BaseException as error:
-        output.discard()
-        full = disk_full(output.target, error)
-        if full is not None:
-            raise full from None
-        raise
     output.commit()
 
 
@@ -311,13 +313,6 @@ def atomic_file(target: str | os.PathLike[str]) -> Iterator[BinaryIO]:
     """
     output = AtomicOutput(target)
     descriptor = output.open()
-    try:
-        with os.fdopen(descriptor, "wb") as handle:
-            yield handle
-    except BaseException as error:
-        output.discard()
-        full = disk_full(output.target, error)
-        if full is not None:
-            raise full from None
-        raise
+    with output.discarded_on_error(), os.fdopen(descriptor, "wb") as handle:
+        yield handle
     output.commit(same_file=True)
