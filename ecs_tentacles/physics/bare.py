@@ -108,8 +108,8 @@ def record(backend: Stepped, keep: bool = False) -> BareFrame:
                 states = _reduced_states(backend, batch.index, rows)
             else:
                 states = batch.state[rows].copy()
-            applied = {int(p): batch.applied[int(r)] for p, r in enumerate(rows)
-                       if int(r) in batch.applied}  # fmt: skip
+            at = {int(r): p for p, r in enumerate(rows.tolist())} if batch.applied else {}
+            applied = {at[r]: f for r, f in batch.applied.items() if r in at}  # few: scripts
             if level == REDUCED and applied:
                 assert batch.reduced is not None
                 applied = {p: batch.reduced.body_group @ f for p, f in applied.items()}

@@ -45,6 +45,20 @@ def test_a_bare_frame_ends_where_the_framework_frame_ended(
             np.testing.assert_array_equal(rows.states, before[tier])
 
 
+def test_a_pushed_creature_is_pushed_in_the_bare_frame_too(
+    make_world: Callable[..., World],
+) -> None:
+    world = make_world(crowd_scene(3, seed=2, spacing=4.0, uniform=True), lod=False)
+    world.step(2)
+    view = world.physics.groups[1]
+    view.data.xfrc_applied[view.body_ids[0], 2] = 50.0  # a script pushes its mantle up
+    frame, states, _ = _recorded_then_stepped(world)
+    full = frame.rows[0][FULL]
+    assert list(full.forces) == [1]  # creature 1's row, by its position among the rows
+    world.physics.step_bare(frame, world.settings.substeps)
+    np.testing.assert_array_equal(full.after, states[0][full.rows])
+
+
 def test_bare_frames_leave_the_world_alone(make_world: Callable[..., World]) -> None:
     scene = crowd_scene(2, seed=1, uniform=True)
     measured, plain = make_world(scene), make_world(scene)
