@@ -20,8 +20,10 @@ from typing import Any
 
 import numpy as np
 
-from ecs_tentacles.output.atomic import atomic_output
 from ecs_tentacles.render import configure
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from picture_sequence import save_sequence
 
 DEFAULT_DIR = Path(__file__).resolve().parents[1] / "assets" / "screenshots"
 SIZE = (800, 450)
@@ -97,18 +99,9 @@ def run(out_dir: Path, seconds: float) -> None:
         print(f"{(step + 1) * GIF_SECONDS:.0f} s of {seconds:g}", file=sys.stderr)
     last = frames[-1]
     sandbox.close()
-    w, h = SIZE
-    sheet = Image.new("RGB", (2 * w, 2 * h))
-    for i, picture in enumerate((first, scattered, sent, last)):
-        sheet.paste(picture, ((i % 2) * w, (i // 2) * h))
-    with atomic_output(out_dir / "director_sequence.png") as temporary:
-        sheet.save(temporary, format="PNG", optimize=True)
-    small = [f.resize((GIF_WIDTH, GIF_WIDTH * h // w)).quantize(64) for f in [first, *frames]]
-    with atomic_output(out_dir / "director.gif") as temporary:
-        small[0].save(
-            temporary, format="GIF", save_all=True, append_images=small[1:], duration=300, loop=0
-        )
-    print(f"{out_dir / 'director_sequence.png'}, {out_dir / 'director.gif'}", file=sys.stderr)
+    pictures = [first, scattered, sent, last]
+    png, gif = save_sequence(out_dir, "director", pictures, [first, *frames], GIF_WIDTH, 300)
+    print(f"{png}, {gif}", file=sys.stderr)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -21,8 +21,10 @@ from typing import Any
 
 import numpy as np
 
-from ecs_tentacles.output.atomic import atomic_output
 from ecs_tentacles.render import configure
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from picture_sequence import save_sequence
 
 DEFAULT_DIR = Path(__file__).resolve().parents[1] / "assets" / "screenshots"
 SIZE = (800, 450)
@@ -80,18 +82,10 @@ def run(out_dir: Path, level: str) -> None:
     frames += [moments["end"]] * 4  # the banner stays a moment
     print(f"{game.level}: {game.outcome} in {game.elapsed:.1f} s", file=sys.stderr)
     sandbox.close()
-    w, h = SIZE
-    sheet = Image.new("RGB", (2 * w, 2 * h))
-    for i, name in enumerate(("start", "behind", "penned", "end")):
-        sheet.paste(moments.get(name, moments["end"]), ((i % 2) * w, (i // 2) * h))
-    with atomic_output(out_dir / "herding_sequence.png") as temporary:
-        sheet.save(temporary, format="PNG", optimize=True)
-    small = [f.resize((GIF_WIDTH, GIF_WIDTH * h // w)).quantize(64) for f in frames]
-    with atomic_output(out_dir / "herding.gif") as temporary:
-        small[0].save(
-            temporary, format="GIF", save_all=True, append_images=small[1:], duration=150, loop=0
-        )
-    print(f"{out_dir / 'herding_sequence.png'}, {out_dir / 'herding.gif'}", file=sys.stderr)
+    order = ("start", "behind", "penned", "end")
+    pictures = [moments.get(name, moments["end"]) for name in order]
+    png, gif = save_sequence(out_dir, "herding", pictures, frames, GIF_WIDTH, 150)
+    print(f"{png}, {gif}", file=sys.stderr)
 
 
 def main(argv: list[str] | None = None) -> int:
