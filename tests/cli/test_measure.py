@@ -65,6 +65,27 @@ def test_bare_stepping_leaves_the_world_as_plain_stepping_would(
     np.testing.assert_array_equal(measured.transforms.quat, plain.transforms.quat)
 
 
+def test_creatures_that_meet_are_measured_and_left_as_plain_stepping_would(
+    make_world: Callable[..., World],
+) -> None:
+    # driven head-on, no avoidance: near each other from frame 90 (frames in 4 parts)
+    octo = {"tentacles": {"count": 8, "links": 10}}
+    scene = {
+        "version": 1,
+        "avoidance": {"enabled": False},
+        "creatures": [
+            {**octo, "name": "a", "position": [0, 0], "goals": [{"position": [3, 0]}]},
+            {**octo, "name": "b", "position": [1.4, 0], "goals": [{"position": [-2, 0]}]},
+        ],
+    }
+    measured, plain = make_world(scene, threads=2), make_world(scene, threads=2)
+    timings = measure(measured, 10, block=5, warmup=100)
+    assert (measured.physics.proxies_used > 0).all()
+    assert timings["raw_mujoco_ms"] > 0 and math.isfinite(timings["overhead_ratio"])
+    plain.step(110)
+    np.testing.assert_array_equal(measured.transforms.pos, plain.transforms.pos)
+
+
 def test_measure_refuses_no_frames(make_world: Callable[..., World]) -> None:
     with pytest.raises(ValueError, match="frames and block must be >= 1"):
         measure(make_world(crowd_scene(1)), 0)
