@@ -69,6 +69,7 @@ def declared_only(world: World, system: System) -> Iterator[None]:
         arrays = store._arrays
         saved[name] = arrays
         allowed = {field for (s, field) in readable if s == name}
+        store.cache_views = False  # every read goes through the guarded table
         store._arrays = _Guarded(arrays, allowed, name)
         for field, array in arrays.items():
             array.flags.writeable = (name, field) in writes
@@ -80,6 +81,7 @@ def declared_only(world: World, system: System) -> Iterator[None]:
             store._arrays = arrays
             for array in arrays.values():
                 array.flags.writeable = True
+            store.cache_views = True
 
 
 def step_declared(world: World, frames: int) -> None:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import pickle
+
 import numpy as np
 from numpy.testing import assert_array_equal
 
@@ -70,3 +72,45 @@ def test_fit_frees_the_spare_room_and_keeps_rows_and_components() -> None:
     assert store.pos[99, 0] == 5.0
     assert_array_equal(store.add(1), [100])  # grows again
     assert len(store) == 101 and store.pos[99, 0] == 5.0
+
+
+def test_field_views_follow_removal_restore_and_assignment() -> None:
+    store = TransformStore(capacity=2)
+    store.add(4, pos=[[0.0, 0, 0], [1, 0, 0], [2, 0, 0], [3, 0, 0]])
+    saved = store.copy_rows()
+    store.remove(np.array([1]))
+    assert_array_equal(store.pos[:, 0], [0, 2, 3])
+    store.put_rows(saved)
+    assert_array_equal(store.pos[:, 0], [0, 1, 2, 3])
+    store.pos = [9.0, 9.0, 9.0]  # into the live rows, the field stays a view of them
+    assert_array_equal(store._arrays["pos"][:4], [[9, 9, 9]] * 4)
+    store.pos[0, 0] = 1.0
+    assert store._arrays["pos"][0, 0] == 1.0
+
+
+def test_a_copied_store_reads_and_writes_its_own_arrays() -> None:
+    store = TransformStore()
+    store.add(2, pos=[1.0, 2.0, 3.0])
+    twin = pickle.loads(pickle.dumps(store))
+    twin.pos[0, 0] = 7.0
+    assert twin._arrays["pos"][0, 0] == 7.0 and store.pos[0, 0] == 1.0
+    twin.add(1)
+    assert len(twin.pos) == 3 and len(store.pos) == 2
+
+
+def test_without_kept_views_every_read_goes_through_the_column_table() -> None:
+    store = TransformStore()
+    store.add(2)
+    store.cache_views = False
+    read: list[str] = []
+
+    class Watched(dict):  # type: ignore[type-arg]
+        def __getitem__(self, name: str) -> np.ndarray:
+            read.append(name)
+            return super().__getitem__(name)
+
+    store._arrays = Watched(store._arrays)
+    store.pos[1, 2] = 4.0
+    assert read == ["pos"] and store._arrays["pos"][1, 2] == 4.0
+    store.cache_views = True
+    assert "pos" in vars(store)  # kept again
