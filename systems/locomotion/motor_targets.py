@@ -16,6 +16,8 @@ surface under its reach falls away from the creature's own plane (a crest, a dip
 rises into it (a step, the foot of a slope), its droop ramp bends the tip down or up
 by that much, the way procedural legs probe the ground under each foot. On the plane
 this term is never computed (the motion stays exactly the thesis's).
+With numba installed, two kernels (`ecs_tentacles.locomotion.kernels`) do the per-link
+math in one pass each, the same numbers bit for bit (the sines stay numpy's).
 
 Reads: locomotion's tentacle store (action, action_angle, action_strength, orient,
 mode, wave parameters), TentacleStore (rest pitch, link rows, creature), MotorStore
@@ -25,6 +27,7 @@ and tip poses) and the Ground. Writes: MotorStore (target, gain).
 
 from __future__ import annotations
 
+from types import ModuleType
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -32,6 +35,7 @@ import numpy as np
 from ecs_tentacles.ground import Ground, ground_of
 from ecs_tentacles.locomotion.actions import ATTACH_PATIENCE, GRIPPING, Kind, Mode
 from ecs_tentacles.locomotion.stores import LocomotionStores
+from ecs_tentacles.numeric.optional_kernels import OptionalKernels
 from ecs_tentacles.numeric.quaternions import quat_rotate
 from ecs_tentacles.system import System
 
@@ -60,6 +64,12 @@ ATTACH_PRESS = 0.15  # extra tip-down pitch (at the tip) per attach duration wit
 GRIP_CURL_WAVE, GRIP_SWEEP_WAVE = 0.0, 0.3
 SMOOTHING_SECONDS = 0.06  # targets ease toward each new pose (slow-in) instead of jumping
 FOLLOW_LIMIT = 0.8  # radians: the most the droop ramp bends to follow the ground
+# numba's kernels when installed (the same numbers bit for bit; "numpy": never)
+KERNELS = OptionalKernels("ecs_tentacles.locomotion.kernels", "ECS_TENTACLES_LOCOMOTION")
+KERNEL_CONSTANTS = np.array(
+    [ATTACH_PATIENCE, ATTACH_PRESS, GRIP_CURL_WAVE, GRIP_SWEEP_WAVE, HALF_ROOT3]
+)
+NO_FOLLOW = np.zeros(0)
 
 
 def ground_follow(world: Host, ground: Ground, rows: np.ndarray) -> np.ndarray:
@@ -171,6 +181,10 @@ class MotorTargets(System):
     ) -> None:
         """The targets and gains of motor rows `links`; `inner` and `previous` index
         within them (a link whose joint turns relative to the one before, and that one)."""
+        fast = KERNELS.get()
+        if fast is not None:
+            self._kernel_targets(fast, world, dt, links)
+            return
         motors, t, body = world.motors, self.strokes, world.tentacles
         row = motors.tentacle_row[links]
         arc = motors.arc[links]
@@ -209,6 +223,26 @@ class MotorTargets(System):
         strength = t.action_strength
         gain = strength[row] + (strength * t.writhe)[row] * (0.5 * sin + HALF_ROOT3 * cos)
         motors.gain[links] = gain
+
+    def _kernel_targets(
+        self, fast: ModuleType, world: Host, dt: float, links: slice | np.ndarray
+    ) -> None:
+        """`_targets` by `ecs_tentacles.locomotion.kernels` (whole tentacles `links`)."""
+        motors, t = world.motors, self.strokes
+        rows = np.arange(len(motors)) if isinstance(links, slice) else links
+        row, arc = motors.tentacle_row, motors.arc
+        phase = np.empty(len(rows))
+        fast.wave_phase(world.time, t.wave_frequency, t.phase, t.wavelength, row, arc, rows, phase)
+        sin, cos = np.sin(phase), np.cos(phase)
+        ease = float(1.0 - np.exp(-dt / SMOOTHING_SECONDS))
+        follow = NO_FOLLOW if self.follow is None else self.follow
+        fast.targets(
+            rows, self.previous_of, row, arc, self.arch_shape, self.orient_share,
+            t.action, t.mode, t.timer, t.duration, t.action_angle,
+            world.tentacles.rest_pitch, follow, t.orient, t.wave_amplitude,
+            t.action_strength, t.writhe, ARCHED, LIFT, ORIENTED, GRIPPING, ATTACH,
+            KERNEL_CONSTANTS, sin, cos, ease, self.eased, motors.target, motors.gain,
+        )  # fmt: skip
 
 
 def _links_of(world: Host, tentacles: np.ndarray) -> np.ndarray:

@@ -6,7 +6,13 @@ from collections.abc import Callable
 
 import numpy as np
 import pytest
-from ecs_tentacles.systems.locomotion.motor_targets import LIFT, SMOOTHING_SECONDS, _links_of
+from ecs_tentacles.systems.locomotion.motor_targets import (
+    KERNELS,
+    LIFT,
+    SMOOTHING_SECONDS,
+    MotorTargets,
+    _links_of,
+)
 from numpy.testing import assert_allclose, assert_array_equal
 
 from ecs_tentacles.components import Creature
@@ -195,3 +201,53 @@ def test_an_inner_links_previous_is_the_entry_before_it(make_world: Callable[...
         first = world.tentacles.first_link[world.motors.tentacle_row[links]]
         inner = np.flatnonzero(links != first)
         assert_array_equal(links[inner - 1], links[inner] - 1)  # the link before, in `links`
+
+
+def _motor_targets(world: World) -> MotorTargets:
+    return next(s for s in world.schedule if isinstance(s, MotorTargets))
+
+
+@pytest.mark.parametrize("follow", [False, True])
+def test_the_kernels_give_the_numpy_paths_targets_bit_for_bit(
+    make_world: Callable[..., World], follow: bool, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Every link, and whole tentacles of some creatures (the others replayed); on the
+    plane and with a ground-follow droop per tentacle (terrain)."""
+    assert KERNELS.get() is not None  # numba comes with the dev extra
+    world = make_world(crowd_scene(24, seed=2))  # 8 body plans; strokes, grips, waves
+    world.step(60)
+    system = _motor_targets(world)
+    rng = np.random.default_rng(3)
+    if follow:
+        system.follow = rng.uniform(-0.8, 0.8, len(world.tentacles))
+    start = system.eased.copy(), world.motors.target.copy(), world.motors.gain.copy()
+    replayed = rng.random(len(world.creatures)) < 0.5
+    some = _links_of(world, np.flatnonzero(~replayed[world.tentacles.creature_row]))
+    inner = np.flatnonzero(system.previous_of[some] >= 0)
+    calls: list[tuple[slice | np.ndarray, np.ndarray, np.ndarray]] = [
+        (slice(None), system.inner, system.previous),
+        (some, inner, inner - 1),
+    ]
+    for links, inner_links, previous in calls:
+        results = []
+        for backend in ("auto", "numpy"):
+            monkeypatch.setattr(KERNELS, "backend", backend)
+            system.eased[:], world.motors.target[:], world.motors.gain[:] = start
+            system._targets(world, world.settings.dt, links, inner_links, previous)
+            motors = world.motors
+            results.append((system.eased.copy(), motors.target.copy(), motors.gain.copy()))
+        for kernel, numpy_path in zip(*results, strict=True):
+            assert_array_equal(kernel, numpy_path)
+        assert not np.array_equal(results[0][0], start[0])  # the targets moved
+
+
+def test_a_crowd_moves_the_same_with_and_without_the_kernels(
+    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    poses = []
+    for backend in ("auto", "numpy"):
+        monkeypatch.setattr(KERNELS, "backend", backend)
+        world = make_world(crowd_scene(6, seed=4))
+        world.step(90)
+        poses.append(world.transforms.pos.copy())
+    assert_array_equal(*poses)
