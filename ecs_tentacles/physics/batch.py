@@ -21,7 +21,7 @@ from __future__ import annotations
 import copy
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import mujoco
@@ -48,6 +48,13 @@ def _ids(model: mujoco.MjModel, kind: mujoco.mjtObj, names: list[str]) -> np.nda
     return np.array([mujoco.mj_name2id(model, kind, n) for n in names], dtype=np.int64)
 
 
+def _as_slice(ids: np.ndarray) -> slice | np.ndarray:
+    """`ids` as a slice when they are consecutive and ascending, else `ids`."""
+    if len(ids) and np.array_equal(ids, np.arange(ids[0], ids[0] + len(ids))):
+        return slice(int(ids[0]), int(ids[0]) + len(ids))
+    return ids
+
+
 @dataclass
 class Scratch:
     """One stepping thread's copy of a batch's model and its one MjData."""
@@ -55,6 +62,10 @@ class Scratch:
     model: mujoco.MjModel
     data: mujoco.MjData
     forced: bool = False  # applied forces were written into `data` (zero them next time)
+    warnings: np.ndarray = field(init=False)  # `data.warning.number`, looked up once
+
+    def __post_init__(self) -> None:
+        self.warnings = self.data.warning.number
 
 
 class Batch:
@@ -76,6 +87,8 @@ class Batch:
         n = len(layouts)
         first = layouts[0]
         self.body_ids = _ids(m, obj.mjOBJ_BODY, first.bodies)
+        # the same rows as a slice when they are one run (a copy without a gather)
+        self.model_bodies = _as_slice(self.body_ids)
         actuators = _ids(m, obj.mjOBJ_ACTUATOR, first.actuators)
         order = np.argsort(actuators)
         self.equality_ids = _ids(m, obj.mjOBJ_EQUALITY, first.equalities)
@@ -329,14 +342,15 @@ class Batch:
             return
         scratch = self.scratch_for(thread, tier)
         m, d = scratch.model, scratch.data
-        state, body_ids = self.state, self.body_ids
+        state, bodies, applied = self.state, self.model_bodies, self.applied
+        xpos, xquat, clock = self.xpos, self.xquat, time.perf_counter
         for row in rows.tolist():
-            began = time.perf_counter()
+            began = clock()
             write_overlay(self, m, row)
-            if self._advance(scratch, row, state[row], self.applied.get(row), substeps):
-                self.xpos[row] = d.xpos[body_ids]
-                self.xquat[row] = d.xquat[body_ids]
-            self._took(row, FULL, time.perf_counter() - began, substeps)
+            if self._advance(scratch, row, state[row], applied.get(row), substeps):
+                xpos[row] = d.xpos[bodies]
+                xquat[row] = d.xquat[bodies]
+            self._took(row, FULL, clock() - began, substeps)
 
     def _took(self, row: int, tier: int, seconds: float, substeps: int) -> None:
         """Row `row`'s `substeps` steps at `tier` took `seconds`: into its `step_cost`."""
@@ -362,7 +376,8 @@ class Batch:
             d.xfrc_applied[:] = 0.0
             scratch.forced = False
         mujoco.mj_setState(m, d, vector, STATE)
-        d.warning.number[:] = 0
+        warnings = scratch.warnings
+        warnings[:] = 0
         try:
             mujoco.mj_step(m, d, nstep=substeps)
         except mujoco.FatalError as exc:
@@ -370,7 +385,7 @@ class Batch:
             mujoco.mj_resetData(m, d)
             return False
         mujoco.mj_getState(m, d, vector, STATE)
-        self.warnings[row] += d.warning.number
+        self.warnings[row] += warnings
         self.deepest[row] = d.contact.dist.min() if d.ncon else np.inf
         return True
 
