@@ -245,6 +245,10 @@ class ContactProxies:
         a, b = self._pairs(centre, radius, MARGIN)
         who, body, slot = self._assign(a, b, pos, centre, radius) if len(a) else (_NONE,) * 3
         was_used = roster.proxies_used > 0
+        if not len(who) and not was_used.any():  # nobody near, before or now: none move
+            for batch in roster.batches:
+                batch.near[:] = False
+            return
         roster.proxies_used[:] = np.bincount(who, minlength=len(roster))
         for batch in roster.batches:
             mocap = batch.grid(S.mjSTATE_MOCAP_POS, 3)
