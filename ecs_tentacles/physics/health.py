@@ -196,10 +196,13 @@ class HealthCheck:
                 bad[batch.members[row]] = True
         failing = np.flatnonzero(bad & active)
         dt = world.settings.dt
-        limits = np.broadcast_to(limit, bad.shape)
-        causes = {
-            int(i): self._cause(int(i), float(fastest[i]), float(limits[i]), dt) for i in failing
-        }
+        causes: dict[int, str] = {}
+        if len(failing):  # (rare: `broadcast_to` alone cost more than the rest of a check)
+            limits = np.broadcast_to(limit, bad.shape)
+            causes = {
+                int(i): self._cause(int(i), float(fastest[i]), float(limits[i]), dt)
+                for i in failing
+            }
         healthy = active & ~bad
         softened = healthy & (roster.soften < 1.0)
         roster.soften[softened] = np.minimum(
