@@ -4,6 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from ecs_tentacles.numeric.optional_kernels import OptionalKernels
+
+# numba's kernel when installed (the same numbers bit for bit; "numpy": never)
+KERNELS = OptionalKernels("ecs_tentacles.numeric.quaternion_kernels", "ECS_TENTACLES_QUATERNIONS")
+
 
 def quat_about_z(angle: np.ndarray | float) -> np.ndarray:
     """Unit quaternions rotating by `angle` radians about +z; shape (..., 4)."""
@@ -21,6 +26,16 @@ def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 def quat_rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
     """Rotate vectors `v` (..., 3) by unit quaternions `q` (..., 4)."""
+    if (
+        isinstance(v, np.ndarray)
+        and q.ndim == v.ndim == 2
+        and len(q) == len(v)
+        and q.dtype == v.dtype == np.float64
+        and (fast := KERNELS.get()) is not None
+    ):  # one quaternion per vector: one pass
+        out = np.empty((len(q), 3))
+        fast.rotate(q, v, out)
+        return out
     w = q[..., :1]
     u = q[..., 1:]
     t = 2.0 * _cross(u, v)
