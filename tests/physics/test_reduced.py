@@ -19,12 +19,18 @@ from ecs_tentacles.world import World
 S = mujoco.mjtState
 
 
-def _crowd(count: int, lod: dict[str, Any], terrain: bool = False) -> dict[str, Any]:
-    """`count` default creatures 3 m apart, each crawling 3 m along +x."""
+def _crowd(
+    count: int, lod: dict[str, Any], terrain: bool = False, mantle: float | None = None
+) -> dict[str, Any]:
+    """`count` default creatures 3 m apart, each crawling 3 m along +x (mantle radius
+    `mantle`, if given)."""
     creatures = []
     for i in range(count):
         x, y = 3.0 * (i % 4) - 4.0, 3.0 * (i // 4) - 2.0
-        creatures.append({"name": f"c{i}", "position": [x, y], "goals": [{"position": [x + 3, y]}]})
+        entry = {"name": f"c{i}", "position": [x, y], "goals": [{"position": [x + 3, y]}]}
+        if mantle is not None:
+            entry["mantle"] = {"radius": mantle}
+        creatures.append(entry)
     scene: dict[str, Any] = {"version": 1, "physics": {"lod": lod}, "creatures": creatures}
     if terrain:
         scene["terrain"] = rocky(np.array([c["position"] for c in creatures]), 1.0, 0)
@@ -109,6 +115,29 @@ def test_a_reduced_crowd_crawls_like_a_full_one(make_world: Callable[..., World]
         progress[tier] = float(np.mean(world.transforms.pos[rows, 0] - start))
     assert progress["full"] > 0.2
     assert abs(progress["reduced"] / progress["full"] - 1.0) < 0.25, progress
+
+
+def test_a_heavy_mantle_slows_a_reduced_creature_no_more_than_a_full_one(
+    make_world: Callable[..., World],
+) -> None:
+    """The reduced servos match their groups' stiffness at the tip, where a gripping
+    stroke pulls: softer ones let a heavy creature's tentacles sag more than the full
+    ones do, and it crawled slower than itself (servos in series at 0.8: 0.94 of full
+    against 1.07 with a light mantle)."""
+    pace = {}
+    for radius in (0.12, 0.19):
+        progress = {}
+        for tier, lod in (("full", {"full": 8}), ("reduced", {"full": 0, "reduced": 8})):
+            world = make_world(_crowd(4, lod, mantle=radius))
+            rows = [world.component(world.creature(f"c{i}"), Transform).row for i in range(4)]
+            start = world.transforms.pos[rows, 0].copy()
+            world.step(300)
+            assert world.lod.counts()[tier] == 4
+            progress[tier] = world.transforms.pos[rows, 0] - start
+        ratio = progress["reduced"] / progress["full"]
+        assert np.all(np.abs(ratio - 1.0) < 0.2), (radius, ratio)
+        pace[radius] = float(ratio.mean())
+    assert abs(pace[0.19] - pace[0.12]) < 0.06, pace
 
 
 def test_recovering_one_reduced_creature_leaves_the_others_alone(
