@@ -1,0 +1,25 @@
+"""tools/reduced_pace.py: a short comparison runs one crowd reduced and full and reports
+per-creature figures."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from tests.tools.loader import TOOLS, load_tool
+
+TOOL = TOOLS / "reduced_pace.py"
+
+
+@pytest.mark.skipif(not TOOL.is_file(), reason="needs the source tree")
+def test_a_short_comparison_runs_everyone_reduced_against_everyone_full() -> None:
+    tool = load_tool("reduced_pace")
+    reduced, full = (tool.run(4, 1.0, 0, 8.0, tier) for tier in (True, False))
+    assert reduced["tiers"] == {"full": 0, "reduced": 4, "kinematic": 0}
+    assert full["tiers"] == {"full": 4, "reduced": 0, "kinematic": 0}
+    assert min(full["progress"]) > 0.0  # they crawl toward their goals
+    result = tool.summary([(reduced, full)])
+    assert result["creatures"] == 4
+    assert 0.5 < result["progress_ratio"] < 1.5
+    assert result["ratio_min"] <= result["ratio_max"] and np.isfinite(result["ratio_sd"])
+    assert result["big_mantle_ratio"] is not None or result["small_mantle_ratio"] is not None
