@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING
 import mujoco
 import numpy as np
 
+from ecs_tentacles.numeric.rows import run_slice
 from ecs_tentacles.physics.model import (
     PROXY_CAPSULES,
     PROXY_CYLINDERS,
@@ -46,13 +47,6 @@ WARNING_KINDS = len(mujoco.MjData(mujoco.MjModel.from_xml_string("<mujoco/>")).w
 
 def _ids(model: mujoco.MjModel, kind: mujoco.mjtObj, names: list[str]) -> np.ndarray:
     return np.array([mujoco.mj_name2id(model, kind, n) for n in names], dtype=np.int64)
-
-
-def _as_slice(ids: np.ndarray) -> slice | np.ndarray:
-    """`ids` as a slice when they are consecutive and ascending, else `ids`."""
-    if len(ids) and np.array_equal(ids, np.arange(ids[0], ids[0] + len(ids))):
-        return slice(int(ids[0]), int(ids[0]) + len(ids))
-    return ids
 
 
 @dataclass
@@ -88,7 +82,8 @@ class Batch:
         first = layouts[0]
         self.body_ids = _ids(m, obj.mjOBJ_BODY, first.bodies)
         # the same rows as a slice when they are one run (a copy without a gather)
-        self.model_bodies = _as_slice(self.body_ids)
+        span = run_slice(self.body_ids)
+        self.model_bodies: slice | np.ndarray = self.body_ids if span is None else span
         actuators = _ids(m, obj.mjOBJ_ACTUATOR, first.actuators)
         order = np.argsort(actuators)
         self.equality_ids = _ids(m, obj.mjOBJ_EQUALITY, first.equalities)
@@ -329,9 +324,7 @@ class Batch:
         in row order, else None; found again only when `body_rows` was replaced."""
         rows = self.body_rows
         if self._span_of is not rows:
-            flat = rows.ravel()
-            consecutive = len(flat) > 0 and bool((np.diff(flat) == 1).all())
-            self._span = slice(int(flat[0]), int(flat[-1]) + 1) if consecutive else None
+            self._span = run_slice(rows.ravel())
             self._span_of = rows
         return self._span
 

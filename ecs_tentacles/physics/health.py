@@ -32,6 +32,7 @@ import mujoco
 import numpy as np
 
 from ecs_tentacles.events import CreatureFrozen, CreatureRecovered, SuckerReleased
+from ecs_tentacles.numeric.rows import run_slice
 from ecs_tentacles.physics.batch import without_row
 
 if TYPE_CHECKING:
@@ -138,9 +139,7 @@ class HealthCheck:
         """Read the bodies' order from `proxies` again (after it was rebuilt)."""
         self.rows = proxies.rows
         self.start, self.count = proxies.start, proxies.count
-        rows = self.rows  # one run of consecutive Transform rows (a crowd): read as a slice
-        together = len(rows) > 0 and bool(np.all(np.diff(rows) == 1))
-        self.span = slice(int(rows[0]), int(rows[-1]) + 1) if together else None
+        self.span = run_slice(self.rows)  # one run of Transform rows (a crowd): a slice
 
     def allow_speed(self, index: int, speed: float, until: float) -> None:
         """Creature `index` may move its bodies up to `speed` m/s (instead of the scene's
