@@ -159,32 +159,27 @@ class MotorTargets(System):
             self.follow = np.zeros(len(world.tentacles))
             self.follow[driven] = ground_follow(world, ground, driven)
         if not kinematic.any():
-            self._targets(world, dt, slice(None), self.inner, self.previous)
+            self._targets(world, dt, slice(None))
             return
         # creatures the level of detail replays: their servos drive nothing, so their
         # links are left out (a promoted one eases from its last targets, servos soft)
         links = _links_of(world, np.flatnonzero(~kinematic[world.tentacles.creature_row]))
-        if not len(links):
-            return
-        # whole tentacles, each a run of consecutive rows in `links`: an inner link's
-        # previous one is the entry before it (no table over every motor row)
-        inner = np.flatnonzero(self.previous_of[links] >= 0)
-        self._targets(world, dt, links, inner, inner - 1)
+        if len(links):
+            self._targets(world, dt, links)
 
-    def _targets(
-        self,
-        world: Host,
-        dt: float,
-        links: slice | np.ndarray,
-        inner: np.ndarray,
-        previous: np.ndarray,
-    ) -> None:
-        """The targets and gains of motor rows `links`; `inner` and `previous` index
-        within them (a link whose joint turns relative to the one before, and that one)."""
+    def _targets(self, world: Host, dt: float, links: slice | np.ndarray) -> None:
+        """The targets and gains of motor rows `links`: every row, or whole tentacles."""
         fast = KERNELS.get()
         if fast is not None:
             self._kernel_targets(fast, world, dt, links)
             return
+        if isinstance(links, slice):
+            inner, previous = self.inner, self.previous
+        else:
+            # whole tentacles, each a run of consecutive rows in `links`: an inner link's
+            # previous one is the entry before it (no table over every motor row)
+            inner = np.flatnonzero(self.previous_of[links] >= 0)
+            previous = inner - 1
         motors, t, body = world.motors, self.strokes, world.tentacles
         row = motors.tentacle_row[links]
         arc = motors.arc[links]

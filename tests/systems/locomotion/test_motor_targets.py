@@ -223,17 +223,12 @@ def test_the_kernels_give_the_numpy_paths_targets_bit_for_bit(
     start = system.eased.copy(), world.motors.target.copy(), world.motors.gain.copy()
     replayed = rng.random(len(world.creatures)) < 0.5
     some = _links_of(world, np.flatnonzero(~replayed[world.tentacles.creature_row]))
-    inner = np.flatnonzero(system.previous_of[some] >= 0)
-    calls: list[tuple[slice | np.ndarray, np.ndarray, np.ndarray]] = [
-        (slice(None), system.inner, system.previous),
-        (some, inner, inner - 1),
-    ]
-    for links, inner_links, previous in calls:
+    for links in (slice(None), some):
         results = []
         for backend in ("auto", "numpy"):
             monkeypatch.setattr(KERNELS, "backend", backend)
             system.eased[:], world.motors.target[:], world.motors.gain[:] = start
-            system._targets(world, world.settings.dt, links, inner_links, previous)
+            system._targets(world, world.settings.dt, links)
             motors = world.motors
             results.append((system.eased.copy(), motors.target.copy(), motors.gain.copy()))
         for kernel, numpy_path in zip(*results, strict=True):
