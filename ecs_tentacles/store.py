@@ -109,11 +109,11 @@ class ArrayStore:
     def __setattr__(self, name: str, value: Any) -> None:
         """`store.field = values` writes into the live rows (the field's view is kept);
         `count`, `_arrays` and `cache_views` make the views again."""
-        if name in self.__dict__ and isinstance(getattr(type(self), name, None), Field):
-            self.__dict__[name][...] = value
-            return
-        if isinstance(getattr(type(self), name, None), Field):  # views not kept
-            self._arrays[name][: self.count] = value
+        if isinstance(getattr(type(self), name, None), Field):
+            view = self.__dict__.get(name)  # None while views are not kept
+            if view is None:
+                view = self._arrays[name][: self.count]
+            view[...] = value
             return
         object.__setattr__(self, name, value)
         if name in ("count", "_arrays", "cache_views") and "cache_views" in self.__dict__:
