@@ -182,15 +182,16 @@ def step_recorded(work: Work, frame: BareFrame, substeps: dict[int, int], thread
             d.xfrc_applied[:] = 0.0
             scratch.forced = False
         for position in np.searchsorted(recorded.rows, segment.rows).tolist():
+            split = 1
             if reduced is not None:
-                reduced.write_overlay(recorded, m, position)
+                split = reduced.write_overlay(recorded, m, position)
             else:
                 write_overlay(recorded, m, position)
             forces = recorded.forces.get(position)
             if forces is not None:
                 d.xfrc_applied[:] = forces
             mujoco.mj_setState(m, d, recorded.states[position], STATE)
-            mujoco.mj_step(m, d, nstep=n)
+            mujoco.mj_step(m, d, nstep=n * split)
             mujoco.mj_getState(m, d, out[position if kept is not None else 0], STATE)
             if forces is not None:
                 d.xfrc_applied[:] = 0.0

@@ -399,10 +399,10 @@ class Batch:
                 reduced.pull_inputs(state[row], rstate[row])
             else:
                 reduced.fit_state(state[row], rstate[row])
-            reduced.write_overlay(self, m, row)
+            split = reduced.write_overlay(self, m, row)
             pushed = self.applied.get(row)
             forces = None if pushed is None else reduced.body_group @ pushed
-            if self._advance(scratch, row, rstate[row], forces, substeps):
+            if self._advance(scratch, row, rstate[row], forces, substeps * split):
                 reduced.expand_state(rstate[row], state[row])
                 rsource[row] = state[row, watched]
                 fd.qpos[:] = state[row, qpos]

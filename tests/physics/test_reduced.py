@@ -10,7 +10,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from ecs_tentacles.components import Transform
+from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.physics.batch import STATE
 from ecs_tentacles.physics.tiers import FULL, REDUCED
 from ecs_tentacles.terrain.presets import rocky
@@ -138,6 +138,34 @@ def test_a_heavy_mantle_slows_a_reduced_creature_no_more_than_a_full_one(
         assert np.all(np.abs(ratio - 1.0) < 0.2), (radius, ratio)
         pace[radius] = float(ratio.mean())
     assert abs(pace[0.19] - pace[0.12]) < 0.06, pace
+
+
+@pytest.mark.parametrize("damping", [2.1, 100.0], ids=["least-damping", "heavy-damping"])
+def test_the_stiffest_servos_the_schema_allows_simulate_at_the_reduced_tier(
+    make_world: Callable[..., World], damping: float
+) -> None:
+    """Strength 1000 (the schema's maximum) with the least damping the scene allows
+    (strength x physics step) and with heavy damping: the 120 Hz reduced step blew these
+    creatures up (4 to 6 recoveries in 3 s, frozen since), the full model never; a row
+    this stiff takes shorter reduced steps. A default creature keeps the one step."""
+    scene = _crowd(2, {"full": 0, "reduced": 8})
+    for creature in scene["creatures"]:
+        creature["tentacles"] = {"strength": 1000.0, "damping": damping}
+    scene["creatures"].append({"name": "plain", "position": [0.0, 4.0]})
+    world = make_world(scene)
+    rows = [world.component(world.creature(f"c{i}"), Transform).row for i in range(2)]
+    start = world.transforms.pos[rows, 0].copy()
+    world.step(180)
+    assert world.lod.counts()["reduced"] == 3
+    assert world.physics.health.recoveries == 0
+    assert np.all(world.transforms.pos[rows, 0] - start > 0.03)  # they crawl, not frozen
+    splits = []
+    for name in ("c0", "plain"):
+        view = world.physics.group_of(world.component(world.creature(name), Creature))
+        reduced, model = view.batch.reduced, view.batch.scratch_for(0, REDUCED).model
+        assert reduced is not None
+        splits.append(reduced.write_overlay(view.batch, model, view.row))
+    assert splits[0] > 1 and splits[1] == 1
 
 
 def test_recovering_one_reduced_creature_leaves_the_others_alone(
