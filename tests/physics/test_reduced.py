@@ -168,6 +168,27 @@ def test_the_stiffest_servos_the_schema_allows_simulate_at_the_reduced_tier(
     assert splits[0] > 1 and splits[1] == 1
 
 
+def test_a_heavily_damped_reduced_creature_crawls_like_its_full_self(
+    make_world: Callable[..., World],
+) -> None:
+    """Damping 5 (ten times the default): a servo this damped creeps to its target at
+    kp / kv, and the reduced tier's extra damping (which calms the swing of a chain
+    matched at the tip) once halved that pace: 0.58 of full."""
+    progress = {}
+    for tier, lod in (("full", {"full": 8}), ("reduced", {"full": 0, "reduced": 8})):
+        scene = _crowd(2, lod)
+        for creature in scene["creatures"]:
+            creature["tentacles"] = {"damping": 5.0}
+        world = make_world(scene)
+        rows = [world.component(world.creature(f"c{i}"), Transform).row for i in range(2)]
+        start = world.transforms.pos[rows, 0].copy()
+        world.step(300)
+        assert world.lod.counts()[tier] == 2
+        progress[tier] = float(np.mean(world.transforms.pos[rows, 0] - start))
+    assert progress["full"] > 0.2
+    assert abs(progress["reduced"] / progress["full"] - 1.0) < 0.15, progress
+
+
 def test_recovering_one_reduced_creature_leaves_the_others_alone(
     make_world: Callable[..., World],
 ) -> None:
