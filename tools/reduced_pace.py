@@ -3,6 +3,7 @@ with every creature reduced over its progress with every creature full.
 
     python tools/reduced_pace.py                       # 32 creatures, 10 s, seeds 0-3
     python tools/reduced_pace.py --seeds 0 --seconds 5 --json
+    python tools/reduced_pace.py --servos 25/0.5,25/5,100/0.5   # servo settings instead
 
 Runs `crowd_scene(N, seed)` (eight body plans, varied behaviour) with the grid spread
 wide (`--spacing`, 8 m: nobody meets anybody, so contact and avoidance play no part)
@@ -14,6 +15,11 @@ crowd's mean looks right), their correlation with the mantle radius (a heavy cre
 whose reduced tentacles sag more than its full ones shows here) and the ratio for the
 big and the small mantles. The floor: two full runs with every start moved 1 cm give
 per-creature ratios with an sd of about 0.01.
+
+With `--servos STRENGTH/DAMPING,...` the crowds are of the default octopus instead
+(`--uniform`: one body plan, behaviour still varied), every tentacle's servos set to
+each given strength and damping in turn, and the progress ratio is reported per
+setting: how the reduced tier's pace holds up across the servo sliders.
 """
 
 from __future__ import annotations
@@ -32,10 +38,25 @@ from ecs_tentacles.world import World
 BIG_MANTLE = 0.16  # m: the body plans' mantle radii run about 0.11-0.19
 
 
-def run(creatures: int, seconds: float, seed: int, spacing: float, reduced: bool) -> dict[str, Any]:
+def run(
+    creatures: int,
+    seconds: float,
+    seed: int,
+    spacing: float,
+    reduced: bool,
+    servo: tuple[float, float] | None = None,
+) -> dict[str, Any]:
     """One crowd, everyone reduced or everyone full: each creature's progress (m) toward
-    its goal in `seconds`, its mantle radius, the tiers at the end."""
-    scene = crowd_scene(creatures, seed=seed, spacing=spacing)
+    its goal in `seconds`, its mantle radius, the tiers at the end. With `servo`
+    (strength, damping): default octopuses, every servo set to it."""
+    scene = crowd_scene(creatures, seed=seed, spacing=spacing, uniform=servo is not None)
+    if servo is not None:
+        for creature in scene["creatures"]:
+            tentacles = creature.setdefault("tentacles", {})
+            tentacles["strength"], tentacles["damping"] = servo
+            for override in tentacles.get("overrides", []):
+                override.pop("strength", None)
+                override.pop("damping", None)
     if reduced:
         scene.setdefault("physics", {})["lod"] = {"full": 0, "reduced": creatures}
     with World.from_scene(scene, threads=1, lod=reduced) as world:
@@ -66,7 +87,9 @@ def summary(pairs: list[tuple[dict[str, Any], dict[str, Any]]]) -> dict[str, Any
         "ratio_sd": float(ratio.std()),
         "ratio_min": float(ratio.min()),
         "ratio_max": float(ratio.max()),
-        "mantle_correlation": float(np.corrcoef(radius, ratio)[0, 1]) if ratio.std() else 0.0,
+        "mantle_correlation": float(np.corrcoef(radius, ratio)[0, 1])
+        if ratio.std() and radius.std()
+        else 0.0,
         "big_mantle_ratio": float(reduced[big].sum() / full[big].sum()) if big.any() else None,
         "small_mantle_ratio": float(reduced[~big].sum() / full[~big].sum())
         if (~big).any()
@@ -75,12 +98,49 @@ def summary(pairs: list[tuple[dict[str, Any], dict[str, Any]]]) -> dict[str, Any
     }
 
 
+def servo_list(text: str) -> list[tuple[float, float]]:
+    """ "25/0.5,100/2" -> [(25.0, 0.5), (100.0, 2.0)]; ValueError naming a bad item."""
+    out = []
+    for item in text.split(","):
+        parts = item.split("/")
+        try:
+            strength, damping = (float(p) for p in parts)
+        except ValueError:
+            raise ValueError(f"STRENGTH/DAMPING pairs separated by commas, got {item!r}") from None
+        out.append((strength, damping))
+    return out
+
+
+def servo_sweep(
+    servos: list[tuple[float, float]],
+    creatures: int,
+    seconds: float,
+    seeds: list[int],
+    spacing: float,
+) -> list[dict[str, Any]]:
+    """Per servo setting: `summary` of its crowds run reduced and full, with the setting."""
+    out = []
+    with ProcessPoolExecutor(2) as pool:
+        for servo in servos:
+            pairs = []
+            for seed in seeds:
+                common = (creatures, seconds, seed, spacing)
+                reduced, full = (pool.submit(run, *common, tier, servo) for tier in (True, False))
+                pairs.append((reduced.result(), full.result()))
+            strength, damping = servo
+            out.append({"strength": strength, "damping": damping, **summary(pairs)})
+    return out
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--creatures", type=int, default=32, help="creatures per crowd")
     parser.add_argument("--seconds", type=float, default=10.0, help="simulated seconds")
     parser.add_argument("--seeds", default="0,1,2,3", help="crowd seeds, comma separated")
     parser.add_argument("--spacing", type=float, default=8.0, help="grid spacing (m)")
+    parser.add_argument(
+        "--servos", help="STRENGTH/DAMPING,...: default octopuses at each servo setting"
+    )
     parser.add_argument("--json", action="store_true", help="one JSON object")
     args = parser.parse_args()
     if args.creatures < 2 or not args.seconds > 0 or not args.spacing > 0:
@@ -89,6 +149,23 @@ def main() -> None:
         seeds = [int(s) for s in args.seeds.split(",")]
     except ValueError:
         parser.error(f"--seeds: comma-separated integers, got {args.seeds!r}")
+    if args.servos is not None:
+        try:
+            servos = servo_list(args.servos)
+        except ValueError as error:
+            parser.error(f"--servos: {error}")
+        by_servo = servo_sweep(servos, args.creatures, args.seconds, seeds, args.spacing)
+        if args.json:
+            print(json.dumps(by_servo))
+            return
+        print(f"default octopuses, {len(seeds)} crowds of {args.creatures}, {args.seconds:g} s,")
+        print("all reduced against all full, progress ratio per servo setting:")
+        for row in by_servo:
+            print(
+                f"  strength {row['strength']:g} / damping {row['damping']:g}:"
+                f" {row['progress_ratio']:.3f} (sd {row['ratio_sd']:.3f})"
+            )
+        return
     pairs = []
     with ProcessPoolExecutor(2) as pool:
         for seed in seeds:

@@ -23,3 +23,15 @@ def test_a_short_comparison_runs_everyone_reduced_against_everyone_full() -> Non
     assert 0.5 < result["progress_ratio"] < 1.5
     assert result["ratio_min"] <= result["ratio_max"] and np.isfinite(result["ratio_sd"])
     assert result["big_mantle_ratio"] is not None or result["small_mantle_ratio"] is not None
+
+
+@pytest.mark.skipif(not TOOL.is_file(), reason="needs the source tree")
+def test_a_servo_setting_runs_default_octopuses_with_those_servos() -> None:
+    tool = load_tool("reduced_pace")
+    assert tool.servo_list("25/0.5,100/2") == [(25.0, 0.5), (100.0, 2.0)]
+    with pytest.raises(ValueError, match="'25'"):
+        tool.servo_list("25,100/2")
+    rows = tool.servo_sweep([(25.0, 5.0)], 2, 1.0, [0], 8.0)
+    assert len(rows) == 1 and (rows[0]["strength"], rows[0]["damping"]) == (25.0, 5.0)
+    assert rows[0]["tiers_reduced_run"] == [{"full": 0, "reduced": 2, "kinematic": 0}]
+    assert 0.5 < rows[0]["progress_ratio"] < 1.5
