@@ -50,6 +50,7 @@ class Schedule:
         self._slots: list[_Slot] = []  # in the order added
         self._ordered: list[_Slot] = []
         self._running: list[System] = []
+        self._substep: tuple[System, ...] = ()  # of `_running`, those with a substep hook
         self.conflicts: list[tuple[str, str, str]] = []  # (field, system, system)
 
     # -- changing ------------------------------------------------------------------------
@@ -151,9 +152,9 @@ class Schedule:
     def stage_of(self, name: str) -> str:
         return self._slot(name).stage
 
-    def substep_systems(self) -> list[System]:
+    def substep_systems(self) -> tuple[System, ...]:
         """Enabled systems with a per-substep hook, in frame order."""
-        return [s for s in self._running if type(s).has_substep()]
+        return self._substep
 
     def rows(self) -> list[dict[str, str]]:
         """One row per scheduled system in frame order: its data flow, for `table`."""
@@ -207,6 +208,7 @@ class Schedule:
                 )
         self._slots, self._ordered, self.conflicts = slots, ordered, conflicts
         self._running = [s.system for s in ordered if s.enabled]
+        self._substep = tuple(s for s in self._running if type(s).has_substep())
 
 
 def _expand_sets(slots: list[_Slot], by_label: dict[str, _Slot]) -> None:

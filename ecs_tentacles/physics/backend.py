@@ -21,6 +21,7 @@ physics through them alone. The backend sees a world as `PhysicsHost` (`physics.
 
 from __future__ import annotations
 
+import functools
 import logging
 import os
 from collections.abc import Callable
@@ -405,6 +406,8 @@ class PhysicsBackend(Membership):
         )
 
 
-def _split(steps: int, rounds: int) -> list[int]:
-    """`steps` in `rounds` parts as equal as whole numbers allow."""
-    return [int(n) for n in np.diff(np.linspace(0, steps, rounds + 1).round())]
+@functools.cache
+def _split(steps: int, rounds: int) -> tuple[int, ...]:
+    """`steps` in `rounds` parts as equal as whole numbers allow (a world asks the same
+    few every frame: worked out once)."""
+    return tuple(int(n) for n in np.diff(np.linspace(0, steps, rounds + 1).round()))
