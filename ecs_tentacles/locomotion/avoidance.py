@@ -31,12 +31,14 @@ from typing import Any
 
 import numpy as np
 
+from ecs_tentacles.numeric.optional_kernels import OptionalKernels
 from ecs_tentacles.physics.pairs import near_pairs
 from ecs_tentacles.scene.construction import creature_layout
 from ecs_tentacles.scene.schema import fragment
 
 BEHIND = 0.3  # a neighbour straight behind weighs this much of one straight ahead
 SIDESTEP = 1.0  # the push to the right (keep right), relative to the push away
+KERNELS = OptionalKernels("ecs_tentacles.locomotion.avoidance_kernels", "ECS_TENTACLES_AVOIDANCE")
 PairFinder = Callable[[np.ndarray, np.ndarray, float], tuple[np.ndarray, np.ndarray]]
 _SCENE = fragment("ecs_tentacles.locomotion", "locomotion")["scene"]["avoidance"]
 
@@ -95,6 +97,11 @@ def bend(
     if len(pos) < 2 or not steering.any() or strength == 0.0:
         return out
     a, b = pairs(pos, radius, reach)
+    fast = KERNELS.get()
+    if fast is not None:  # the same numbers, pair by pair
+        fast.bend_pairs(pos, radius, heading, steering, to_goal, a, b, float(reach),
+                        float(strength), BEHIND, SIDESTEP, out)  # fmt: skip
+        return out
     keep = steering[a]
     a, b = a[keep], b[keep]
     if not len(a):

@@ -143,3 +143,47 @@ def test_a_crossing_crowd_touches_less_with_avoidance(make_world: Callable[..., 
     straight = contact_frames(make_world(scene), frames)
     assert straight > 0
     assert steering < straight
+
+
+def test_the_kernel_gives_the_numpy_paths_term_bit_for_bit(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Many creatures packed close (pairs overlapping, behind and ahead, some not
+    steering, some at their goal): the kernel's term and numpy's agree exactly."""
+    from ecs_tentacles.locomotion.avoidance import KERNELS
+
+    assert KERNELS.get() is not None  # numba comes with the dev extra
+    rng = np.random.default_rng(7)
+    n = 60
+    pos = rng.uniform(-2.0, 2.0, (n, 2))
+    radius = rng.uniform(0.2, 0.6, n)
+    angle = rng.uniform(0, 2 * np.pi, n)
+    heading = np.stack([np.cos(angle), np.sin(angle)], axis=1)
+    heading[::9] = 0.0  # going nowhere
+    steering = rng.random(n) < 0.8
+    to_goal = rng.uniform(0.0, 1.0, n)
+    terms = []
+    for backend in ("auto", "numpy"):
+        monkeypatch.setattr(KERNELS, "backend", backend)
+        terms.append(bend(pos, radius, heading, steering, to_goal, 0.5, 1.3))
+    np.testing.assert_array_equal(*terms)
+    assert np.count_nonzero(terms[0].any(axis=1)) > n // 2  # most are pushed
+
+
+def test_a_crossing_crowd_moves_the_same_with_and_without_the_kernel(
+    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from ecs_tentacles.locomotion.avoidance import KERNELS
+
+    runs = []
+    for backend in ("auto", "numpy"):
+        monkeypatch.setattr(KERNELS, "backend", backend)
+        world = make_world(crowd_scene(8, seed=1))
+        world.step(120)
+        runs.append(
+            (
+                world.transforms.pos.copy(),
+                world.resource(LocomotionStores).creatures.avoidance.copy(),
+            )
+        )
+    np.testing.assert_array_equal(runs[0][0], runs[1][0])
+    np.testing.assert_array_equal(runs[0][1], runs[1][1])
+    assert runs[0][1].any()  # they did steer around each other
