@@ -53,6 +53,7 @@ from ecs_tentacles.locomotion.actions import make_action as action
 from ecs_tentacles.locomotion.avoidance import bent
 from ecs_tentacles.locomotion.navigation import Navigator
 from ecs_tentacles.locomotion.stores import LocomotionStores
+from ecs_tentacles.numeric.optional_kernels import OptionalKernels
 from ecs_tentacles.scene.parameters import parameter
 from ecs_tentacles.system import System
 
@@ -60,6 +61,7 @@ if TYPE_CHECKING:
     from ecs_tentacles.host import Host
     from ecs_tentacles.roster_change import RosterChange
 
+KERNELS = OptionalKernels("ecs_tentacles.locomotion.selection_kernels", "ECS_TENTACLES_SELECTION")
 PULL = int(Mode.PULL)
 PULL_TOLERANCE = 1e-9  # dot products this close to 0 count as the +-pi/2 boundary: pull
 ABORT_MARGIN = 0.25  # coordinated drivers abort once cos is this far on the wrong side
@@ -143,9 +145,7 @@ class TentacleSelection(System):
         creature = t.creature_row
         replayed = world.physics.kinematic_creatures(len(c))  # their strokes drive nothing
         live = np.flatnonzero(~replayed[creature])  # tentacle rows worth classifying
-        to_goal, to_base = self._vectors(world, live, ~replayed & g.has_goal)
-        pull, cos = np.zeros(len(t), dtype=bool), np.zeros(len(t))
-        pull[live], cos[live] = classify(to_goal[live], to_base[live])
+        to_goal, to_base, pull, cos = self._classified(world, live, ~replayed & g.has_goal)
         has_goal = g.has_goal[creature]
         driving_now = s.driving
         if driving_now.any():
@@ -168,6 +168,25 @@ class TentacleSelection(System):
         ready = idle_goal & ~cyclic & (world.time - g.last_start >= stagger)
         for row in np.flatnonzero(ready):
             self._start_best(world, int(row), cos, pull, to_goal, to_base)
+
+    def _classified(
+        self, world: Host, live: np.ndarray, driven: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(to_goal, to_base, pull, cos) per tentacle row, filled at rows `live` (`_vectors`
+        and `classify`; on the plane by one kernel when numba is installed)."""
+        t = world.tentacles
+        pull, cos = np.zeros(len(t), dtype=bool), np.zeros(len(t))
+        fast = KERNELS.get()
+        if fast is not None and len(live) and ground_of(world).flat:
+            to_goal, to_base = np.zeros((len(t), 2)), np.zeros((len(t), 2))
+            g = self.gaits
+            fast.flat_vectors(world.transforms.pos, world.creatures.mantle_row, g.steer,
+                              g.avoidance, t.base_row, t.creature_row, live, PULL_TOLERANCE,
+                              to_goal, to_base, pull, cos)  # fmt: skip
+            return to_goal, to_base, pull, cos
+        to_goal, to_base = self._vectors(world, live, driven)
+        pull[live], cos[live] = classify(to_goal[live], to_base[live])
+        return to_goal, to_base, pull, cos
 
     def _vectors(
         self, world: Host, live: np.ndarray, driven: np.ndarray

@@ -7,8 +7,14 @@ from typing import Any
 
 import numpy as np
 import pytest
-from ecs_tentacles.systems.locomotion.tentacle_selection import STROKE_SECONDS, classify
+from ecs_tentacles.systems.locomotion.tentacle_selection import (
+    KERNELS,
+    STROKE_SECONDS,
+    TentacleSelection,
+    classify,
+)
 
+from ecs_tentacles.creator.crowd import crowd_scene
 from ecs_tentacles.locomotion.actions import Kind, Mode, drive_sequence
 from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.locomotion.params import Locomotion
@@ -291,3 +297,41 @@ def test_coordinated_drivers_cap_and_stagger(
         starts.update(times.tolist())
     assert most == drivers
     assert min(starts) == 0.0  # the first drive starts on the first frame
+
+
+# -- the kernel on the plane --------------------------------------------------------------
+
+
+def test_the_kernel_gives_the_numpy_paths_vectors_and_choices_bit_for_bit(
+    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A crossing crowd (avoidance turning some creatures' goal directions), every
+    tentacle and some creatures' only: the same vectors, cosines and push/pull."""
+    assert KERNELS.get() is not None  # numba comes with the dev extra
+    world = make_world(crowd_scene(12, seed=1))
+    world.step(90)
+    system = next(s for s in world.schedule if isinstance(s, TentacleSelection))
+    assert system.gaits.avoidance.any()  # some goal directions are turned
+    driven = system.gaits.has_goal.copy()
+    every = np.arange(len(world.tentacles))
+    some = np.flatnonzero(world.tentacles.creature_row % 3 == 0)
+    for live in (every, some):
+        results = []
+        for backend in ("auto", "numpy"):
+            monkeypatch.setattr(KERNELS, "backend", backend)
+            results.append(system._classified(world, live, driven))
+        for kernel, numpy_path in zip(*results, strict=True):
+            np.testing.assert_array_equal(kernel, numpy_path)
+        assert results[0][2][live].any() and not results[0][2][live].all()  # pulls and pushes
+
+
+def test_a_crowd_chooses_the_same_strokes_with_and_without_the_kernel(
+    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    poses = []
+    for backend in ("auto", "numpy"):
+        monkeypatch.setattr(KERNELS, "backend", backend)
+        world = make_world(crowd_scene(8, seed=1))
+        world.step(120)
+        poses.append(world.transforms.pos.copy())
+    np.testing.assert_array_equal(*poses)
