@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ecs_tentacles.numeric.quaternions import KERNELS as QUATERNIONS
+
 TINY = 1e-12
 
 
@@ -40,7 +42,12 @@ def clamp_to_cap(v: np.ndarray, normal: np.ndarray, tan_min: np.ndarray) -> np.n
 
 
 def quat_matrices(quat: np.ndarray) -> np.ndarray:
-    """Rotation matrices (n, 3, 3) of unit quaternions (n, 4) (w, x, y, z)."""
+    """Rotation matrices (n, 3, 3) of unit quaternions (n, 4) (w, x, y, z); by one numba
+    pass when numba is installed (the same numbers: `numeric.quaternion_kernels`)."""
+    if quat.dtype == np.float64 and quat.ndim == 2 and (fast := QUATERNIONS.get()) is not None:
+        matrices = np.empty((len(quat), 3, 3))
+        fast.matrices(quat, matrices)
+        return matrices
     w, x, y, z = quat.T
     xx, yy, zz = x * x, y * y, z * z
     xy, xz, yz = x * y, x * z, y * z

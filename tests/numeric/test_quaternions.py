@@ -39,3 +39,18 @@ def test_one_vector_turned_by_many_quaternions_takes_the_numpy_path() -> None:
     q = _unit_quaternions(rng, 4)
     up = quat_rotate(q, np.array([0.0, 0.0, 1.0]))  # broadcast: (4, 3)
     assert_allclose(up, quat_rotate(q, np.tile([0.0, 0.0, 1.0], (4, 1))), rtol=0, atol=0)
+
+
+@pytest.mark.parametrize("n", [0, 1, 40])
+def test_the_matrix_kernel_gives_numpys_rotation_matrices_bit_for_bit(
+    n: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from ecs_tentacles.fur.vectors import quat_matrices
+
+    rng = np.random.default_rng(10 + n)
+    q, v = _unit_quaternions(rng, n), rng.normal(size=(n, 3))
+    fast = quat_matrices(q)
+    monkeypatch.setattr(quaternions.KERNELS, "backend", "numpy")
+    assert_array_equal(fast, quat_matrices(q))
+    assert fast.shape == (n, 3, 3)
+    assert_allclose(np.einsum("nij,nj->ni", fast, v), quat_rotate(q, v), atol=1e-12)
