@@ -134,3 +134,38 @@ def test_the_khronos_validator_finds_nothing_in_a_skinned_file(
         assert report["issues"]["messages"] == []
         assert (report["issues"]["numErrors"], report["issues"]["numWarnings"]) == (0, 0)
         assert report["info"]["animationCount"] == 1 and report["info"]["drawCallCount"] == 1
+
+
+def test_a_crowd_on_all_three_tiers_exports_every_creatures_full_skeleton(
+    tmp_path: Path,
+) -> None:
+    """1 full, 2 reduced and 3 replayed creatures: each has its own skin with the full
+    skeleton's joints, and every joint plays on the links the take recorded (the reduced
+    ones shown on the full skeleton, the replayed ones from their clips)."""
+    from ecs_tentacles.export.bake import BakePlan, bake
+    from ecs_tentacles.world import World
+    from tests.cli.test_measure import lod_crowd
+
+    scene = lod_crowd(6)
+    with World.from_scene(scene) as world:
+        world.step(60)
+        assert world.lod.counts() == {"full": 1, "reduced": 2, "kinematic": 3}
+    take = bake(BakePlan.make(scene, seconds=1.0, fps=30.0), progress=False)
+    write_skinned_glb(take, tmp_path / "crowd.glb", keys=Keys("all", 0.5))
+    document, binary = read_glb((tmp_path / "crowd.glb").read_bytes())
+    assert len(document["skins"]) == 6
+    for creature, skin in enumerate(document["skins"]):
+        skeleton = creature_skeleton(take, creature)
+        assert len(skin["joints"]) == len(skeleton.names)
+        _, origin = joint_world_poses(skeleton, take)
+        assert np.isfinite(origin).all()
+        for frame in (0, 15, 30):
+            world_pose = _pose(document, binary, frame / take.fps)
+            played = np.stack([world_pose[j][:3, 3] for j in skin["joints"]])
+            expected = to_y_up_points(origin[frame])
+            assert np.linalg.norm(played - expected, axis=1).max() < 1e-3, (creature, frame)
+        assert np.ptp(origin[:, 0], axis=0).max() > 0.01  # it moved
+        child = np.flatnonzero(np.asarray(skeleton.parents) >= 0)
+        parent = np.asarray(skeleton.parents)[child]
+        bone = np.linalg.norm(origin[:, child] - origin[:, parent], axis=2)  # (frames, bones)
+        assert np.ptp(bone, axis=0).max() < 1e-3  # a chain of rigid links, never stretched
