@@ -98,6 +98,7 @@ DAMPING_CAP = 1.0
 # step failed from 9.4 (strength 500 and damping 1.1 to 3, a default body) and held at
 # 7.6 (strength 400): 4 is the undamped limit of the integrator (omega h <= 2).
 STIFF_STEP = 4.0
+MAX_SPLIT = 64  # at most this many shorter steps (a script's gain far past the schema's)
 AXES = ("curl", "sweep", "twist")
 
 
@@ -357,7 +358,9 @@ class ReducedModel:
         full = self.full_u
         kp = STIFFNESS_GAIN / (self.compliance @ (1.0 / np.maximum(batch.kp[row, full], 1e-12)))
         stiff = float(np.max(kp * self._stiff_per_kp))
-        split = 1 if stiff <= STIFF_STEP else int(np.ceil(np.sqrt(stiff / STIFF_STEP)))
+        split = 1  # (and where a gain is not finite: the health check sees the failure)
+        if STIFF_STEP < stiff < np.inf:
+            split = min(int(np.ceil(np.sqrt(stiff / STIFF_STEP))), MAX_SPLIT)
         m.opt.timestep = self.timestep / split
         matched_kv = 1.0 / (self.compliance @ (1.0 / np.maximum(batch.kv[row, full], 1e-12)))
         critical = np.sqrt(kp) * self._critical_per_sqrt_kp

@@ -168,6 +168,27 @@ def test_the_stiffest_servos_the_schema_allows_simulate_at_the_reduced_tier(
     assert splits[0] > 1 and splits[1] == 1
 
 
+def test_a_gain_past_any_schema_value_splits_the_step_within_bounds(
+    make_world: Callable[..., World],
+) -> None:
+    """A script may set gains the schema never allows: a huge one takes at most
+    MAX_SPLIT shorter steps, and one that is not finite no split at all (its blow-up is
+    the health check's to see), never an exception in a stepping thread."""
+    from ecs_tentacles.physics.reduced import MAX_SPLIT
+
+    world = make_world(_crowd(1, {"full": 0, "reduced": 8}))
+    world.step(2)
+    batch = world.physics.batches[0]
+    reduced, model = batch.reduced, batch.scratch_for(0, REDUCED).model
+    assert reduced is not None
+    splits = []
+    for gain in (25.0, 1e9, np.nan, np.inf):
+        batch.kp[0] = gain
+        with np.errstate(divide="ignore"):
+            splits.append(reduced.write_overlay(batch, model, 0))
+    assert splits == [1, MAX_SPLIT, 1, 1]
+
+
 def test_a_heavily_damped_reduced_creature_crawls_like_its_full_self(
     make_world: Callable[..., World],
 ) -> None:
