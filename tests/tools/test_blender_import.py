@@ -169,6 +169,26 @@ def test_every_creature_plays_in_blender(tmp_path: Path, suffix: str) -> None:
         assert armature["moved"] > 0.01, f"{name} does not move"
 
 
+@pytest.mark.parametrize("suffix", [".usdc", ".glb"])
+def test_every_creature_of_a_crowd_on_all_three_tiers_plays_in_blender(
+    tmp_path: Path, suffix: str
+) -> None:
+    """1 full, 2 reduced and 3 replayed creatures (level of detail): all six come in as
+    armatures with an active action, and every one moves."""
+    from tests.cli.test_measure import lod_crowd
+
+    scene = tmp_path / "crowd.json"
+    scene.write_text(json.dumps(lod_crowd(6)))
+    take = tmp_path / f"crowd{suffix}"
+    argv = ["bake", str(scene), "--seconds", "1", "--fps", "30"]
+    assert main([*argv, "--out", str(take), "--quiet"]) == 0
+    found = _imported(take, tmp_path / "crowd.blend", PLAYING)
+    assert len(found) == 6
+    for name, armature in found.items():
+        assert armature["action"], f"{name} has no active action"
+        assert armature["moved"] > 0.01, f"{name} does not move"
+
+
 LOOKS = """
 import json, sys, bpy
 bpy.ops.wm.open_mainfile(filepath=sys.argv[1])
