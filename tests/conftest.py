@@ -13,6 +13,24 @@ from ecs_tentacles.world import World
 NO_LOCOMOTION = {"locomotion": False, "suckers": False}
 
 
+def worlds_by_backend(
+    make_world: Callable[..., World],
+    kernels: Any,
+    monkeypatch: pytest.MonkeyPatch,
+    scene: dict[str, Any],
+    frames: int,
+) -> list[World]:
+    """`scene` stepped `frames` frames twice: with `kernels` (an `OptionalKernels`) on
+    numba's path, then on numpy's; the two worlds, in that order."""
+    worlds = []
+    for backend in ("auto", "numpy"):
+        monkeypatch.setattr(kernels, "backend", backend)
+        world = make_world(scene)
+        world.step(frames)
+        worlds.append(world)
+    return worlds
+
+
 def creature_scene(**tentacles: Any) -> dict[str, Any]:
     """A one-creature scene dict with the given tentacle settings."""
     return {

@@ -87,10 +87,11 @@ DAMPING_GAIN = 2.0
 # The damping DAMPING_GAIN adds over STIFFNESS_GAIN's share is at most DAMPING_CAP of the
 # hinge's critical damping (2 sqrt(kp I), I its inertia at rest): it calms the faster
 # swing of a chain matched at the tip, an inertial effect. A heavily damped servo is not
-# swinging but creeping, at kp / kv, and doubled damping halved its pace: default
-# creatures with damping 2, 5 and 25 crawled reduced at 0.88, 0.58 and 0.35 of their
-# full selves (now 1.03, 1.01, 1.07). Default creatures are below the cap (1.04 of
-# full, sd 0.089 over `tools/reduced_pace.py`'s 128 creatures; 1.03 and 0.088 without).
+# swinging but creeping, at kp / kv, and doubled damping slowed it: default octopuses
+# with damping 2, 5 and 25 crawled reduced at 0.92, 0.66 and 0.70 of their full selves,
+# now 1.08, 1.06 and 1.28 (`tools/reduced_pace.py --servos`, README "Crowds"). The
+# crowd barely moves (1.04 of full, sd 0.089 over the tool's 128 creatures; 1.03 and
+# 0.088 without the cap).
 DAMPING_CAP = 1.0
 # The stiffest a reduced servo may be at the reduced step h: kp h^2 / I <= STIFF_STEP, I
 # the hinge's inertia at rest (`dof_M0`). Stiffer rows take shorter steps, as many more

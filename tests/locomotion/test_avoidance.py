@@ -9,11 +9,12 @@ import numpy as np
 import pytest
 
 from ecs_tentacles.creator.crowd import crowd_scene
-from ecs_tentacles.locomotion.avoidance import Avoidance, bend, bent
+from ecs_tentacles.locomotion.avoidance import KERNELS, Avoidance, bend, bent
 from ecs_tentacles.locomotion.stores import LocomotionStores
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.load import load_scene
 from ecs_tentacles.world import World
+from tests.conftest import worlds_by_backend
 
 
 def _pair(apart: float, **creature: Any) -> dict[str, Any]:
@@ -148,8 +149,6 @@ def test_a_crossing_crowd_touches_less_with_avoidance(make_world: Callable[..., 
 def test_the_kernel_gives_the_numpy_paths_term_bit_for_bit(monkeypatch: pytest.MonkeyPatch) -> None:
     """Many creatures packed close (pairs overlapping, behind and ahead, some not
     steering, some at their goal): the kernel's term and numpy's agree exactly."""
-    from ecs_tentacles.locomotion.avoidance import KERNELS
-
     assert KERNELS.get() is not None  # numba comes with the dev extra
     rng = np.random.default_rng(7)
     n = 60
@@ -171,19 +170,10 @@ def test_the_kernel_gives_the_numpy_paths_term_bit_for_bit(monkeypatch: pytest.M
 def test_a_crossing_crowd_moves_the_same_with_and_without_the_kernel(
     make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    from ecs_tentacles.locomotion.avoidance import KERNELS
-
-    runs = []
-    for backend in ("auto", "numpy"):
-        monkeypatch.setattr(KERNELS, "backend", backend)
-        world = make_world(crowd_scene(8, seed=1))
-        world.step(120)
-        runs.append(
-            (
-                world.transforms.pos.copy(),
-                world.resource(LocomotionStores).creatures.avoidance.copy(),
-            )
-        )
-    np.testing.assert_array_equal(runs[0][0], runs[1][0])
-    np.testing.assert_array_equal(runs[0][1], runs[1][1])
-    assert runs[0][1].any()  # they did steer around each other
+    kernel, numpy_path = worlds_by_backend(
+        make_world, KERNELS, monkeypatch, crowd_scene(8, seed=1), 120
+    )
+    np.testing.assert_array_equal(kernel.transforms.pos, numpy_path.transforms.pos)
+    terms = [w.resource(LocomotionStores).creatures.avoidance for w in (kernel, numpy_path)]
+    np.testing.assert_array_equal(*terms)
+    assert terms[0].any()  # they did steer around each other

@@ -19,7 +19,7 @@ from ecs_tentacles.locomotion.actions import Kind, Mode, drive_sequence
 from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.locomotion.params import Locomotion
 from ecs_tentacles.world import World
-from tests.conftest import creature_scene
+from tests.conftest import creature_scene, worlds_by_backend
 
 
 def _scene(
@@ -328,10 +328,7 @@ def test_the_kernel_gives_the_numpy_paths_vectors_and_choices_bit_for_bit(
 def test_a_crowd_chooses_the_same_strokes_with_and_without_the_kernel(
     make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    poses = []
-    for backend in ("auto", "numpy"):
-        monkeypatch.setattr(KERNELS, "backend", backend)
-        world = make_world(crowd_scene(8, seed=1))
-        world.step(120)
-        poses.append(world.transforms.pos.copy())
-    np.testing.assert_array_equal(*poses)
+    kernel, numpy_path = worlds_by_backend(
+        make_world, KERNELS, monkeypatch, crowd_scene(8, seed=1), 120
+    )
+    np.testing.assert_array_equal(kernel.transforms.pos, numpy_path.transforms.pos)
