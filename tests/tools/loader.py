@@ -12,7 +12,10 @@ TOOLS = Path(__file__).resolve().parents[2] / "tools"
 
 def load_tool(name: str) -> ModuleType:
     """`tools/<name>.py` imported as the module `name` (registered, so dataclasses and
-    process pools find it)."""
+    process pools find it), with `tools/` on the import path as when it runs as a script
+    (a tool may import another's helpers)."""
+    if str(TOOLS) not in sys.path:
+        sys.path.append(str(TOOLS))
     spec = importlib.util.spec_from_file_location(name, TOOLS / f"{name}.py")
     assert spec and spec.loader
     module = importlib.util.module_from_spec(spec)

@@ -23,6 +23,30 @@ def test_a_short_comparison_runs_everyone_reduced_against_everyone_full() -> Non
     assert 0.5 < result["progress_ratio"] < 1.5
     assert result["ratio_min"] <= result["ratio_max"] and np.isfinite(result["ratio_sd"])
     assert result["big_mantle_ratio"] is not None or result["small_mantle_ratio"] is not None
+    # creatures of one body plan share a plan number, and their mantle
+    plans, radii = np.asarray(full["plan"]), np.asarray(full["mantle_radius"])
+    assert plans.tolist() == reduced["plan"]
+    for plan in set(plans.tolist()):
+        assert len(set(radii[plans == plan].tolist())) == 1
+    assert result["plans"] == len(set(plans.tolist())) >= 2
+    assert result["plan_ratio_min"] <= result["progress_ratio"] <= result["plan_ratio_max"]
+    assert np.isfinite(result["within_plan_sd"])
+
+
+@pytest.mark.skipif(not TOOL.is_file(), reason="needs the source tree")
+def test_another_reduced_model_is_used_by_the_reduced_run() -> None:
+    tool = load_tool("reduced_pace")
+    model = {"links": 1.0, "rate": 1.0, "gain": 1.0, "damping": 1.0}
+    # every link at the full rate with the full gains: the full creature again
+    try:
+        reduced, full = (tool.run(4, 1.0, 0, 8.0, tier, None, model) for tier in (True, False))
+    finally:
+        tool.use_model(None)  # the rest of this process's tests: the default model
+    ratio = np.asarray(reduced["progress"]) / np.asarray(full["progress"])
+    assert np.allclose(ratio, 1.0, atol=0.05)
+    # and the default model differs from it, and is the one a later run gets back
+    default = tool.run(4, 1.0, 0, 8.0, True)
+    assert not np.allclose(default["progress"], reduced["progress"], atol=1e-4)
 
 
 @pytest.mark.skipif(not TOOL.is_file(), reason="needs the source tree")
