@@ -71,3 +71,22 @@ def test_a_nudged_run_starts_every_creature_moved() -> None:
     assert plain["progress"] != moved["progress"]
     with pytest.raises(SystemExit):
         tool.main(["--nudge", "0"])
+
+
+@pytest.mark.skipif(not TOOL.is_file(), reason="needs the source tree")
+def test_a_run_where_nobody_arrives_says_no_arrival_times_were_compared(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    tool = load_tool("lod_fidelity")
+    assert tool.main(["--creatures", "2", "--seconds", "0.1"]) == 0
+    out = capsys.readouterr().out
+    assert "none in either run, so no arrival times to compare" in out
+    assert "--goals-within" in out and "at most 0.00 s apart" not in out
+
+
+@pytest.mark.skipif(not TOOL.is_file(), reason="needs the source tree")
+def test_a_bad_reduced_model_is_refused_naming_the_key(capsys: pytest.CaptureFixture[str]) -> None:
+    tool = load_tool("lod_fidelity")
+    with pytest.raises(SystemExit):
+        tool.main(["--model", "rate=0"])
+    assert "--model: rate: must be an integer >= 1, got 0" in capsys.readouterr().err
