@@ -181,10 +181,16 @@ def step_recorded(work: Work, frame: BareFrame, substeps: dict[int, int], thread
         if scratch.forced:  # the framework's last step there applied forces
             d.xfrc_applied[:] = 0.0
             scratch.forced = False
-        for position in np.searchsorted(recorded.rows, segment.rows).tolist():
+        positions = np.searchsorted(recorded.rows, segment.rows)
+        servos = None
+        if reduced is not None:  # as `Batch._step_reduced` forms them: for all at once
+            servos = reduced.servos(
+                recorded.kp[positions], recorded.kv[positions], recorded.torque[positions]
+            )
+        for at, position in enumerate(positions.tolist()):
             split = 1
             if reduced is not None:
-                split = reduced.write_overlay(recorded, m, position)
+                split = reduced.write_overlay(recorded, m, position, servos, at)
             else:
                 write_overlay(recorded, m, position)
             forces = recorded.forces.get(position)

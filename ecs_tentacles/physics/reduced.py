@@ -71,6 +71,18 @@ class Rows(Protocol):
     equality_ids: np.ndarray
 
 
+@dataclass(frozen=True)
+class Servos:
+    """Some rows' reduced servos (`ReducedModel.servos`), row by row: gains, torque limits
+    and the number of shorter steps each row's step is split in (`STIFF_STEP`)."""
+
+    kp: np.ndarray  # (rows, reduced servos)
+    minus_kp: np.ndarray
+    minus_kv: np.ndarray
+    torque: np.ndarray
+    split: np.ndarray  # (rows,) int
+
+
 S = mujoco.mjtState
 # The reduced servos' gains over the full ones' (module docstring). The servos in series
 # (stiffness 1 / sum 1 / kp) had to be softened to 0.8 to crawl as fast as the full
@@ -268,6 +280,7 @@ class ReducedModel:
         self.fit = _block_diagonal(blocks_f)  # (reduced hinges, full hinges)
         # reduced hinge <- its group's full hinges, each weighted (d_i / d_1)^2
         self.compliance = _block_diagonal(weights)
+        self._members, self._weights = _padded(self.compliance)
         self.first = np.array(first, dtype=np.int64)  # each reduced hinge's first full one
         self.limit = np.array(limits)
         self.full_q, self.red_q = np.array(full_q), np.array(red_q)
@@ -358,28 +371,45 @@ class ReducedModel:
         out[self.full_slices[int(S.mjSTATE_WARMSTART)]] = 0.0
 
     # -- model values ----------------------------------------------------------------
-    def write_overlay(self, batch: Rows, m: mujoco.MjModel, row: int) -> int:
-        """Row `row`'s servos (each reduced one its group's, matched at the tip), sucker
-        anchors and proxy sizes into the reduced scratch model `m`, and its step: the
-        reduced step split in as many as its stiffest servo needs (`STIFF_STEP`), that
-        number returned (1 but for servos far stiffer than a default creature's)."""
+    def servos(self, kp: np.ndarray, kv: np.ndarray, torque: np.ndarray) -> Servos:
+        """The reduced servos of rows whose full servos have gains `kp`, `kv` and torque
+        limits `torque` (rows, full actuators): each reduced one its group's, matched at
+        the tip, and each row's step split in as many as its stiffest servo needs
+        (`STIFF_STEP`; 1 but for servos far stiffer than a default creature's, and where a
+        gain is not finite: the health check sees that failure). Summed group member by
+        group member, not by a matrix product, so a row gets the same bits whatever rows
+        it is computed with (a frame's rows are shared among threads as they free up)."""
         full = self.full_u
-        kp = STIFFNESS_GAIN / (self.compliance @ (1.0 / np.maximum(batch.kp[row, full], 1e-12)))
-        stiff = float(np.max(kp * self._stiff_per_kp))
-        split = 1  # (and where a gain is not finite: the health check sees the failure)
-        if STIFF_STEP < stiff < np.inf:
-            split = min(int(np.ceil(np.sqrt(stiff / STIFF_STEP))), MAX_SPLIT)
-        m.opt.timestep = self.timestep / split
-        matched_kv = 1.0 / (self.compliance @ (1.0 / np.maximum(batch.kv[row, full], 1e-12)))
-        critical = np.sqrt(kp) * self._critical_per_sqrt_kp
-        kv = np.minimum(
+        compliance = _group_sums(1.0 / np.maximum(kp[:, full], 1e-12), self._members, self._weights)
+        gains = STIFFNESS_GAIN / compliance
+        stiff = np.max(gains * self._stiff_per_kp, axis=1)
+        split = np.ones(len(gains), dtype=np.int64)
+        far = (stiff > STIFF_STEP) & (stiff < np.inf)
+        split[far] = np.minimum(np.ceil(np.sqrt(stiff[far] / STIFF_STEP)), MAX_SPLIT)
+        matched = _group_sums(1.0 / np.maximum(kv[:, full], 1e-12), self._members, self._weights)
+        matched_kv = 1.0 / matched
+        critical = np.sqrt(gains) * self._critical_per_sqrt_kp
+        damping = np.minimum(
             DAMPING_GAIN * matched_kv, STIFFNESS_GAIN * matched_kv + DAMPING_CAP * critical
         )
-        torque = batch.torque[row, self._torque_u]
+        return Servos(gains, -gains, -damping, torque[:, self._torque_u], split)
+
+    def write_overlay(
+        self, batch: Rows, m: mujoco.MjModel, row: int, servos: Servos | None = None, at: int = 0
+    ) -> int:
+        """Row `row`'s servos (`servos` row `at`, else computed for it: `servos`), sucker
+        anchors and proxy sizes into the reduced scratch model `m`, and its step split in
+        as many shorter ones as `servos` says, that number returned."""
+        if servos is None:
+            one = slice(row, row + 1)
+            servos, at = self.servos(batch.kp[one], batch.kv[one], batch.torque[one]), 0
+        split = int(servos.split[at])
+        m.opt.timestep = self.timestep / split
+        torque = servos.torque[at]
         u = self.red_u
-        m.actuator_gainprm[u, 0] = kp
-        m.actuator_biasprm[u, 1] = -kp
-        m.actuator_biasprm[u, 2] = -kv
+        m.actuator_gainprm[u, 0] = servos.kp[at]
+        m.actuator_biasprm[u, 1] = servos.minus_kp[at]
+        m.actuator_biasprm[u, 2] = servos.minus_kv[at]
         m.actuator_forcerange[u, 0] = -torque
         m.actuator_forcerange[u, 1] = torque
         if len(batch.equality_ids):
@@ -433,3 +463,27 @@ def _block_diagonal(blocks: list[np.ndarray]) -> np.ndarray:
         out[r : r + b.shape[0], c : c + b.shape[1]] = b
         r, c = r + b.shape[0], c + b.shape[1]
     return out
+
+
+def _padded(matrix: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(members, weights), each (rows, most nonzeros in a row): row i's nonzero columns
+    of `matrix` in order and their entries, padded with its first column at weight 0."""
+    width = max(1, int((matrix != 0).sum(axis=1).max(initial=0)))
+    members = np.zeros((len(matrix), width), dtype=np.int64)
+    weights = np.zeros((len(matrix), width))
+    for i, row in enumerate(matrix):
+        columns = np.flatnonzero(row)
+        members[i] = columns[0] if len(columns) else 0
+        members[i, : len(columns)] = columns
+        weights[i, : len(columns)] = row[columns]
+    return members, weights
+
+
+def _group_sums(values: np.ndarray, members: np.ndarray, weights: np.ndarray) -> np.ndarray:
+    """(rows, len(members)): per row of `values`, sum over p of values[members[:, p]] x
+    weights[:, p], p in order (`_padded`): elementwise, the same bits for a row however
+    many rows are summed at once."""
+    total: np.ndarray = values[:, members[:, 0]] * weights[:, 0]
+    for p in range(1, members.shape[1]):
+        total += values[:, members[:, p]] * weights[:, p]
+    return total

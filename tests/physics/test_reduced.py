@@ -227,3 +227,35 @@ def test_recovering_one_reduced_creature_leaves_the_others_alone(
         rows = runs[0].physics.groups[int(name[1])].body_rows
         np.testing.assert_array_equal(runs[0].transforms.pos[rows], runs[1].transforms.pos[rows])
     assert np.isfinite(runs[1].transforms.pos).all()
+
+
+def test_a_rows_reduced_servos_are_the_same_bits_whatever_rows_share_the_call(
+    make_world: Callable[..., World],
+) -> None:
+    """A frame's reduced rows are shared among the threads as they free up, so a row's
+    servos must not depend on which rows are computed with it (1 and 2 threads give the
+    same take): all rows at once, each alone and a shuffled half give the same bits."""
+    world = make_world(_crowd(6, {"full": 0, "reduced": 8}))
+    world.step(3)
+    batch = world.physics.batches[0]
+    reduced = batch.reduced
+    assert reduced is not None and len(batch) == 6
+    rng = np.random.default_rng(0)
+    factors = rng.uniform(0.5, 40.0, size=batch.kp.shape)  # every row different and stiff
+    factors[0] = 1.0  # but the first: a default creature's servos
+    batch.kp[:] *= factors
+    rows = np.arange(len(batch))
+    together = reduced.servos(batch.kp[rows], batch.kv[rows], batch.torque[rows])
+    assert together.split.max() > 1 == together.split.min()
+    some = rng.permutation(rows)[: len(rows) // 2]
+    half = reduced.servos(batch.kp[some], batch.kv[some], batch.torque[some])
+    for field in ("kp", "minus_kp", "minus_kv", "torque", "split"):
+        np.testing.assert_array_equal(getattr(half, field), getattr(together, field)[some])
+        for row in rows.tolist():
+            alone = reduced.servos(batch.kp[[row]], batch.kv[[row]], batch.torque[[row]])
+            np.testing.assert_array_equal(getattr(alone, field)[0], getattr(together, field)[row])
+    # and they are the gains the module docstring describes: matched at the tip, x 0.9
+    from ecs_tentacles.physics.reduced import STIFFNESS_GAIN
+
+    inverse = 1.0 / batch.kp[0, reduced.full_u]
+    np.testing.assert_allclose(together.kp[0], STIFFNESS_GAIN / (reduced.compliance @ inverse))
