@@ -393,29 +393,46 @@ class Batch:
         state, rstate, rsource, watched = self.state, self.rstate, self.rsource, reduced.watched
         qpos = self.slices[int(S.mjSTATE_QPOS)]
         body_ids = self.body_ids
-        # whole-array work for the rows at once: which full states were written from
-        # outside since their last step, and every row's reduced servos
+        # whole-array work for the rows at once (each row's bits as if alone): the frame's
+        # inputs pulled into the reduced states (fitted again where the full state was
+        # written from outside since the row's last step), every row's reduced servos
         began = time.perf_counter()
-        unchanged = (state[rows, watched] == rsource[rows]).all(axis=1).tolist()
+        unchanged = (state[rows, watched] == rsource[rows]).all(axis=1)
+        pulled = rows[unchanged]
+        if len(pulled):
+            block = rstate[pulled]
+            reduced.pull_rows(state[pulled], block)
+            rstate[pulled] = block
+        for row in rows[~unchanged].tolist():
+            reduced.fit_state(state[row], rstate[row])
         servos = reduced.servos(self.kp[rows], self.kv[rows], self.torque[rows])
-        shared = (time.perf_counter() - began) / max(len(rows), 1)
+        stepped = np.zeros(len(rows), dtype=bool)
+        took = np.zeros(len(rows))
+        shared = time.perf_counter() - began
         for at, row in enumerate(rows.tolist()):
-            began = time.perf_counter() - shared
-            if unchanged[at]:
-                reduced.pull_inputs(state[row], rstate[row])
-            else:
-                reduced.fit_state(state[row], rstate[row])
+            began = time.perf_counter()
             split = reduced.write_overlay(self, m, row, servos, at)
             pushed = self.applied.get(row)
             forces = None if pushed is None else reduced.body_group @ pushed
-            if self._advance(scratch, row, rstate[row], forces, substeps * split):
-                reduced.expand_state(rstate[row], state[row])
-                rsource[row] = state[row, watched]
-                fd.qpos[:] = state[row, qpos]
-                mujoco.mj_kinematics(fm, fd)
-                self.xpos[row] = fd.xpos[body_ids]
-                self.xquat[row] = fd.xquat[body_ids]
-            self._took(row, REDUCED, time.perf_counter() - began, substeps)
+            stepped[at] = self._advance(scratch, row, rstate[row], forces, substeps * split)
+            took[at] = time.perf_counter() - began
+        # the stepped rows shown as full states, their poses from the full model
+        began = time.perf_counter()
+        done = rows[stepped]
+        if len(done):
+            block = state[done]
+            reduced.expand_rows(rstate[done], block)
+            state[done] = block
+            rsource[done] = block[:, watched]
+        for row in done.tolist():
+            fd.qpos[:] = state[row, qpos]
+            mujoco.mj_kinematics(fm, fd)
+            self.xpos[row] = fd.xpos[body_ids]
+            self.xquat[row] = fd.xquat[body_ids]
+        shared = (shared + time.perf_counter() - began) / len(rows) if len(rows) else 0.0
+        took = (took + shared) / substeps  # as `_took` row by row
+        last = self.step_cost[rows, REDUCED]
+        self.step_cost[rows, REDUCED] = np.where(last == 0.0, took, 0.75 * last + 0.25 * took)
 
 
 def without_row(array: np.ndarray, row: int) -> np.ndarray:

@@ -280,7 +280,10 @@ class ReducedModel:
         self.fit = _block_diagonal(blocks_f)  # (reduced hinges, full hinges)
         # reduced hinge <- its group's full hinges, each weighted (d_i / d_1)^2
         self.compliance = _block_diagonal(weights)
+        # the three maps as padded group sums (`_group_sums`: a row's bits whatever rows
+        # share the call)
         self._members, self._weights = _padded(self.compliance)
+        self._fit_sums, self._expand_sums = _padded(self.fit), _padded(self.expand)
         self.first = np.array(first, dtype=np.int64)  # each reduced hinge's first full one
         self.limit = np.array(limits)
         self.full_q, self.red_q = np.array(full_q), np.array(red_q)
@@ -353,22 +356,32 @@ class ReducedModel:
     def pull_inputs(self, full_state: np.ndarray, out: np.ndarray) -> None:
         """What the systems wrote into the full state this frame (servo targets fitted,
         sucker switches, proxy poses, the clock) into the reduced state `out`."""
+        self.pull_rows(full_state[None], out[None])
+
+    def pull_rows(self, full_states: np.ndarray, out: np.ndarray) -> None:
+        """`pull_inputs` of many rows at once: (rows, full state) into (rows, reduced
+        state) `out`, in place; each row's bits as if pulled alone."""
         source, target = self._inputs
-        out[target] = full_state[source]
+        out[:, target] = full_states[:, source]
         source, target = self._controls
-        out[target] = self.fit @ full_state[source]
+        out[:, target] = _group_sums(full_states[:, source], *self._fit_sums)
 
     def expand_state(self, reduced_state: np.ndarray, out: np.ndarray) -> None:
         """The full state `out` shows the reduced state: root and clock copied, joint
         angles and speeds expanded (within the full joints' limits), warm start cleared."""
+        self.expand_rows(reduced_state[None], out[None])
+
+    def expand_rows(self, reduced_states: np.ndarray, out: np.ndarray) -> None:
+        """`expand_state` of many rows at once: (rows, reduced state) into (rows, full
+        state) `out`, in place; each row's bits as if expanded alone."""
         source, target = self._shown
-        out[target] = reduced_state[source]
+        out[:, target] = reduced_states[:, source]
         source, target = self._angles
-        angles = self.expand @ reduced_state[source]
-        out[target] = np.minimum(np.maximum(angles, self._low, out=angles), self.limit)
+        angles = _group_sums(reduced_states[:, source], *self._expand_sums)
+        out[:, target] = np.minimum(np.maximum(angles, self._low, out=angles), self.limit)
         source, target = self._speeds
-        out[target] = self.expand @ reduced_state[source]
-        out[self.full_slices[int(S.mjSTATE_WARMSTART)]] = 0.0
+        out[:, target] = _group_sums(reduced_states[:, source], *self._expand_sums)
+        out[:, self.full_slices[int(S.mjSTATE_WARMSTART)]] = 0.0
 
     # -- model values ----------------------------------------------------------------
     def servos(self, kp: np.ndarray, kv: np.ndarray, torque: np.ndarray) -> Servos:
