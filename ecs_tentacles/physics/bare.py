@@ -182,14 +182,14 @@ def step_recorded(work: Work, frame: BareFrame, substeps: dict[int, int], thread
             d.xfrc_applied[:] = 0.0
             scratch.forced = False
         positions = np.searchsorted(recorded.rows, segment.rows)
-        servos = None
-        if reduced is not None:  # as `Batch._step_reduced` forms them: for all at once
+        servos = None  # as `Batch._step_reduced` forms them: for all at once
+        if reduced is not None:
             servos = reduced.servos(
                 recorded.kp[positions], recorded.kv[positions], recorded.torque[positions]
             )
         for at, position in enumerate(positions.tolist()):
             split = 1
-            if reduced is not None:
+            if reduced is not None and servos is not None:
                 split = reduced.write_overlay(recorded, m, position, servos, at)
             else:
                 write_overlay(recorded, m, position)

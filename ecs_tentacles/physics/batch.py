@@ -337,18 +337,21 @@ class Batch:
         m, d = scratch.model, scratch.data
         state, bodies, applied = self.state, self.model_bodies, self.applied
         xpos, xquat, clock = self.xpos, self.xquat, time.perf_counter
-        for row in rows.tolist():
+        took = np.zeros(len(rows))
+        for at, row in enumerate(rows.tolist()):
             began = clock()
             write_overlay(self, m, row)
             if self._advance(scratch, row, state[row], applied.get(row), substeps):
                 xpos[row] = d.xpos[bodies]
                 xquat[row] = d.xquat[bodies]
-            self._took(row, FULL, clock() - began, substeps)
+            took[at] = clock() - began
+        self._took(rows, FULL, took, substeps)
 
-    def _took(self, row: int, tier: int, seconds: float, substeps: int) -> None:
-        """Row `row`'s `substeps` steps at `tier` took `seconds`: into its `step_cost`."""
-        took, last = seconds / substeps, self.step_cost[row, tier]
-        self.step_cost[row, tier] = took if last == 0.0 else 0.75 * last + 0.25 * took
+    def _took(self, rows: np.ndarray, tier: int, seconds: np.ndarray, substeps: int) -> None:
+        """Each of `rows`' `substeps` steps at `tier` took `seconds` (per row): into their
+        `step_cost`, a running mean."""
+        took, last = seconds / substeps, self.step_cost[rows, tier]
+        self.step_cost[rows, tier] = np.where(last == 0.0, took, 0.75 * last + 0.25 * took)
 
     def _advance(
         self,
@@ -430,9 +433,7 @@ class Batch:
             self.xpos[row] = fd.xpos[body_ids]
             self.xquat[row] = fd.xquat[body_ids]
         shared = (shared + time.perf_counter() - began) / len(rows) if len(rows) else 0.0
-        took = (took + shared) / substeps  # as `_took` row by row
-        last = self.step_cost[rows, REDUCED]
-        self.step_cost[rows, REDUCED] = np.where(last == 0.0, took, 0.75 * last + 0.25 * took)
+        self._took(rows, REDUCED, took + shared, substeps)
 
 
 def without_row(array: np.ndarray, row: int) -> np.ndarray:

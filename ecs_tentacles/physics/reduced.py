@@ -77,8 +77,7 @@ class Servos:
     and the number of shorter steps each row's step is split in (`STIFF_STEP`)."""
 
     kp: np.ndarray  # (rows, reduced servos)
-    minus_kp: np.ndarray
-    minus_kv: np.ndarray
+    kv: np.ndarray
     torque: np.ndarray
     split: np.ndarray  # (rows,) int
 
@@ -405,24 +404,21 @@ class ReducedModel:
         damping = np.minimum(
             DAMPING_GAIN * matched_kv, STIFFNESS_GAIN * matched_kv + DAMPING_CAP * critical
         )
-        return Servos(gains, -gains, -damping, torque[:, self._torque_u], split)
+        return Servos(gains, damping, torque[:, self._torque_u], split)
 
     def write_overlay(
-        self, batch: Rows, m: mujoco.MjModel, row: int, servos: Servos | None = None, at: int = 0
+        self, batch: Rows, m: mujoco.MjModel, row: int, servos: Servos, at: int
     ) -> int:
-        """Row `row`'s servos (`servos` row `at`, else computed for it: `servos`), sucker
-        anchors and proxy sizes into the reduced scratch model `m`, and its step split in
-        as many shorter ones as `servos` says, that number returned."""
-        if servos is None:
-            one = slice(row, row + 1)
-            servos, at = self.servos(batch.kp[one], batch.kv[one], batch.torque[one]), 0
+        """Row `row`'s servos (row `at` of `servos`), sucker anchors and proxy sizes into the
+        reduced scratch model `m`, and its step split in as many shorter ones as `servos`
+        says, that number returned."""
         split = int(servos.split[at])
         m.opt.timestep = self.timestep / split
         torque = servos.torque[at]
         u = self.red_u
         m.actuator_gainprm[u, 0] = servos.kp[at]
-        m.actuator_biasprm[u, 1] = servos.minus_kp[at]
-        m.actuator_biasprm[u, 2] = servos.minus_kv[at]
+        m.actuator_biasprm[u, 1] = -servos.kp[at]
+        m.actuator_biasprm[u, 2] = -servos.kv[at]
         m.actuator_forcerange[u, 0] = -torque
         m.actuator_forcerange[u, 1] = torque
         if len(batch.equality_ids):

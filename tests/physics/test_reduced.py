@@ -164,7 +164,9 @@ def test_the_stiffest_servos_the_schema_allows_simulate_at_the_reduced_tier(
         view = world.physics.group_of(world.component(world.creature(name), Creature))
         reduced, model = view.batch.reduced, view.batch.scratch_for(0, REDUCED).model
         assert reduced is not None
-        splits.append(reduced.write_overlay(view.batch, model, view.row))
+        batch, row = view.batch, view.row
+        servos = reduced.servos(batch.kp[[row]], batch.kv[[row]], batch.torque[[row]])
+        splits.append(reduced.write_overlay(batch, model, row, servos, 0))
     assert splits[0] > 1 and splits[1] == 1
 
 
@@ -185,7 +187,8 @@ def test_a_gain_past_any_schema_value_splits_the_step_within_bounds(
     for gain in (25.0, 1e9, np.nan, np.inf):
         batch.kp[0] = gain
         with np.errstate(divide="ignore"):
-            splits.append(reduced.write_overlay(batch, model, 0))
+            servos = reduced.servos(batch.kp[:1], batch.kv[:1], batch.torque[:1])
+            splits.append(reduced.write_overlay(batch, model, 0, servos, 0))
     assert splits == [1, MAX_SPLIT, 1, 1]
 
 
@@ -249,7 +252,7 @@ def test_a_rows_reduced_servos_are_the_same_bits_whatever_rows_share_the_call(
     assert together.split.max() > 1 == together.split.min()
     some = rng.permutation(rows)[: len(rows) // 2]
     half = reduced.servos(batch.kp[some], batch.kv[some], batch.torque[some])
-    for field in ("kp", "minus_kp", "minus_kv", "torque", "split"):
+    for field in ("kp", "kv", "torque", "split"):
         np.testing.assert_array_equal(getattr(half, field), getattr(together, field)[some])
         for row in rows.tolist():
             alone = reduced.servos(batch.kp[[row]], batch.kv[[row]], batch.torque[[row]])
