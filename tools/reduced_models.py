@@ -4,7 +4,7 @@ which part of the gap between a reduced creature and its full self.
 
     use_model(model_settings("links=1,rate=1,gain=1,damping=1"))  # then build a World
 
-Keys: `links` (reduced links per full link, `physics.reduced.LINK_SHARE`, 0.5; 1 keeps
+Keys: `links` (reduced links per full link, `physics.reduced_body.LINK_SHARE`, 0.5; 1 keeps
 every link), `rate` (full steps per reduced step, `physics.tiers.REDUCED_RATE`, 4; 1 is
 the full rate), `gain` and `damping` (`STIFFNESS_GAIN` 0.9 and `DAMPING_GAIN` 2; 1 and 1
 are the full servos' gains when every link is kept). `use_model` sets them for this
@@ -14,11 +14,11 @@ process: the worlds it builds after the call use them.
 from __future__ import annotations
 
 from ecs_tentacles.physics import reduced as reduced_model
-from ecs_tentacles.physics import tiers
+from ecs_tentacles.physics import reduced_body, tiers
 
 # the keys: (module, constant, the test of a valid value, what that test says)
 MODEL_KEYS = {
-    "links": (reduced_model, "LINK_SHARE", lambda v: 0.0 < v <= 1.0, "in (0, 1]"),
+    "links": (reduced_body, "LINK_SHARE", lambda v: 0.0 < v <= 1.0, "in (0, 1]"),
     "rate": (tiers, "REDUCED_RATE", lambda v: v >= 1 and v == int(v), "an integer >= 1"),
     "gain": (reduced_model, "STIFFNESS_GAIN", lambda v: v > 0.0, "> 0"),
     "damping": (reduced_model, "DAMPING_GAIN", lambda v: v > 0.0, "> 0"),

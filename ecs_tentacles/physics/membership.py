@@ -19,7 +19,8 @@ import numpy as np
 from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.physics.batch import Batch
 from ecs_tentacles.physics.model import build_spec, model_layout
-from ecs_tentacles.physics.reduced import ReducedModel, chains, reduced_spec
+from ecs_tentacles.physics.reduced import ReducedModel
+from ecs_tentacles.physics.reduced_body import chains, reduced_spec
 from ecs_tentacles.physics.tiers import FULL, reduced_substeps
 
 if TYPE_CHECKING:

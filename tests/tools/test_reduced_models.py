@@ -9,7 +9,7 @@ from types import ModuleType
 import pytest
 
 from ecs_tentacles.creator.crowd import crowd_scene
-from ecs_tentacles.physics import reduced, tiers
+from ecs_tentacles.physics import reduced_body, tiers
 from ecs_tentacles.world import World
 from tests.tools.loader import TOOLS, load_tool
 
@@ -65,4 +65,4 @@ def test_the_model_set_is_the_one_worlds_step_until_the_defaults_come_back(
     assert every_hinges == 2 * default_hinges  # the default octopus: 10 links, then 5
     assert (default_steps, every_steps) == (2, 4)  # 480 Hz scene: 120 Hz, then 240 Hz
     assert _reduced_links(tool, None) == (default_hinges, default_steps)
-    assert (reduced.LINK_SHARE, tiers.REDUCED_RATE) == (0.5, 4)
+    assert (reduced_body.LINK_SHARE, tiers.REDUCED_RATE) == (0.5, 4)
