@@ -31,8 +31,8 @@ from typing import TYPE_CHECKING, Any, Protocol
 import mujoco
 import numpy as np
 
-from ecs_tentacles.physics.batch import Batch, write_overlay
-from ecs_tentacles.physics.state_layout import STATE
+from ecs_tentacles.physics.batch import Batch
+from ecs_tentacles.physics.state_layout import STATE, write_overlay
 from ecs_tentacles.physics.tiers import FULL, REDUCED
 
 if TYPE_CHECKING:

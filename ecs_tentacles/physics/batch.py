@@ -35,11 +35,11 @@ from ecs_tentacles.physics.model import (
     PROXY_SLOTS,
     ModelLayout,
 )
-from ecs_tentacles.physics.state_layout import STATE, S, size_proxies, state_slices
+from ecs_tentacles.physics.state_layout import STATE, S, state_slices, write_overlay
 from ecs_tentacles.physics.tiers import FULL, REDUCED, REDUCED_RATE
 
 if TYPE_CHECKING:
-    from ecs_tentacles.physics.reduced import ReducedModel, Rows
+    from ecs_tentacles.physics.reduced import ReducedModel
     from ecs_tentacles.store import TransformStore
 
 WARNING_KINDS = len(mujoco.MjData(mujoco.MjModel.from_xml_string("<mujoco/>")).warning)
@@ -441,17 +441,3 @@ def without_row(array: np.ndarray, row: int) -> np.ndarray:
     unlike `np.delete`; a despawn in a big crowd moves megabytes of state)."""
     array[row:-1] = array[row + 1 :]
     return array[:-1]
-
-
-def write_overlay(batch: Rows, m: mujoco.MjModel, row: int) -> None:
-    """Row `row`'s servo gains, torque limits, sucker anchors and proxy sizes into `m`."""
-    kp, torque = batch.kp[row], batch.torque[row]
-    m.actuator_gainprm[:, 0] = kp
-    m.actuator_biasprm[:, 1] = -kp
-    m.actuator_biasprm[:, 2] = -batch.kv[row]
-    m.actuator_forcerange[:, 0] = -torque
-    m.actuator_forcerange[:, 1] = torque
-    if len(batch.equality_ids):
-        m.eq_data[batch.equality_ids, 3:6] = batch.anchor[row]
-    if batch.near[row]:
-        size_proxies(m, batch.proxy_geoms, batch.proxy_cylinder, batch.proxy_size[row])

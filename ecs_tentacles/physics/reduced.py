@@ -29,29 +29,15 @@ full model's kinematics).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Protocol
+from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
 
-from ecs_tentacles.physics.state_layout import STATE, size_proxies, state_slices
+from ecs_tentacles.physics.state_layout import STATE, Rows, size_proxies, state_slices
 
 if TYPE_CHECKING:
     from ecs_tentacles.physics.reduced_body import Chain
-
-
-class Rows(Protocol):
-    """What the reduced model reads of a batch's rows (`physics.batch.Batch`)."""
-
-    kp: np.ndarray
-    kv: np.ndarray
-    torque: np.ndarray
-    anchor: np.ndarray
-    near: np.ndarray
-    proxy_size: np.ndarray
-    proxy_cylinder: np.ndarray
-    proxy_geoms: np.ndarray
-    equality_ids: np.ndarray
 
 
 @dataclass(frozen=True)

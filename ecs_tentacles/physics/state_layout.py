@@ -1,8 +1,11 @@
-"""What a creature's row of MuJoCo state holds (`STATE`, `state_slices`) and the proxy
-sizes written into a model per row (`size_proxies`): shared by the full and the reduced
-models' batches (`physics.batch`, `physics.reduced`)."""
+"""What a creature's row of MuJoCo state holds (`STATE`, `state_slices`), what a batch
+keeps per row beside it (`Rows`) and what of it is written into a model per row
+(`write_overlay`, `size_proxies`): shared by the full and the reduced models' batches
+(`physics.batch`, `physics.reduced`) and the bare replay (`physics.bare`)."""
 
 from __future__ import annotations
+
+from typing import Protocol
 
 import mujoco
 import numpy as np
@@ -45,3 +48,32 @@ def size_proxies(
     aabb[:, 3:5] = radius[:, None]
     aabb[:, 5] = np.where(cylinder, half, half + radius)
     m.geom_aabb[geoms] = aabb
+
+
+class Rows(Protocol):
+    """What the model overlays read of a batch's rows (`physics.batch.Batch`, the bare
+    replay's recorded rows)."""
+
+    kp: np.ndarray
+    kv: np.ndarray
+    torque: np.ndarray
+    anchor: np.ndarray
+    near: np.ndarray
+    proxy_size: np.ndarray
+    proxy_cylinder: np.ndarray
+    proxy_geoms: np.ndarray
+    equality_ids: np.ndarray
+
+
+def write_overlay(batch: Rows, m: mujoco.MjModel, row: int) -> None:
+    """Row `row`'s servo gains, torque limits, sucker anchors and proxy sizes into `m`."""
+    kp, torque = batch.kp[row], batch.torque[row]
+    m.actuator_gainprm[:, 0] = kp
+    m.actuator_biasprm[:, 1] = -kp
+    m.actuator_biasprm[:, 2] = -batch.kv[row]
+    m.actuator_forcerange[:, 0] = -torque
+    m.actuator_forcerange[:, 1] = torque
+    if len(batch.equality_ids):
+        m.eq_data[batch.equality_ids, 3:6] = batch.anchor[row]
+    if batch.near[row]:
+        size_proxies(m, batch.proxy_geoms, batch.proxy_cylinder, batch.proxy_size[row])
