@@ -138,9 +138,11 @@ def _run(args: argparse.Namespace) -> int:
         print(failure.user_traceback(), end="", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
+        _quiet_finalizers()
         print("error: interrupted (Ctrl-C); partial outputs removed", file=sys.stderr)
         return 130
     except Terminated as stop:
+        _quiet_finalizers()
         print(f"error: stopped by {stop}; partial outputs removed", file=sys.stderr)
         return 143
     except SystemError as error:  # a signal's exception raised inside C code (Ray's wait)
@@ -158,6 +160,13 @@ def _run(args: argparse.Namespace) -> int:
         return _failed(args, error)
     except BaseException as error:  # SystemExit or the user's own BaseException subclass
         return _failed(args, error)
+
+
+def _quiet_finalizers() -> None:
+    """A run stopped by a signal ends in one line: objects the signal left half built
+    (numba's compiler, stopped mid-compile: "Exception ignored in OutputString.__del__")
+    are freed with the stopped frames, and their finalizers' errors are not news."""
+    sys.unraisablehook = lambda unraisable: None
 
 
 def _failed(args: argparse.Namespace, error: BaseException) -> int:

@@ -219,3 +219,45 @@ def test_numbers_too_big_to_run_are_refused_up_front(
     lines = [line for line in captured.err.splitlines() if not line.startswith("bake: ")]
     assert lines == [TOO_BIG[argv]]
     assert list(tmp_path.iterdir()) == []
+
+
+# A command stopped by a signal while an object with a failing finalizer lives in its
+# frames (numba's compiler stopped mid-compile leaves such objects: its OutputString's
+# __del__ raised AttributeError after the stop's line, so the bake's last line was that).
+_STOPPED_MID_WORK = """
+import argparse, os, signal, sys
+from ecs_tentacles.cli.command import _run, terminate_by_exception
+
+class HalfBuilt:
+    def __del__(self):
+        raise AttributeError("'OutputString' object has no attribute '_ptr'")
+
+def handler(args):
+    half = HalfBuilt()
+    {stop}
+
+with terminate_by_exception():
+    code = _run(argparse.Namespace(handler=handler, debug=False))
+sys.stderr.flush()
+sys.exit(code)
+"""
+
+
+@pytest.mark.parametrize(
+    ("stop", "code", "line"),
+    [
+        ("raise KeyboardInterrupt", 130, "error: interrupted (Ctrl-C); partial outputs removed"),
+        (
+            "os.kill(os.getpid(), signal.SIGTERM)",
+            143,
+            "error: stopped by SIGTERM; partial outputs removed",
+        ),
+    ],
+)
+def test_a_stopped_command_ends_in_its_one_line_whatever_finalizers_fail(
+    stop: str, code: int, line: str
+) -> None:
+    script = _STOPPED_MID_WORK.format(stop=stop)
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True)
+    assert done.returncode == code, done.stderr
+    assert done.stderr.strip().splitlines() == [line]
