@@ -167,6 +167,7 @@ def test_a_killed_bake_leaves_no_file_or_the_previous_one(tmp_path: Path) -> Non
         (signal.SIGTERM, 143, "error: stopped by SIGTERM; partial outputs removed"),
     ],
 )
+@pytest.mark.usefixtures("ctrl_c_reaches_children")
 def test_an_interrupted_bake_exits_with_one_line_and_leaves_nothing(
     tmp_path: Path, stop: signal.Signals, code: int, line: str
 ) -> None:

@@ -201,6 +201,7 @@ def test_a_failed_shard_is_named_and_resume_bakes_only_the_others(
         (signal.SIGTERM, 143, "error: stopped by SIGTERM; partial outputs removed"),
     ],
 )
+@pytest.mark.usefixtures("ctrl_c_reaches_children")
 def test_ctrl_c_or_sigterm_cancels_the_bake_and_leaves_no_output(
     cluster: Path, crowd: Path, tmp_path: Path, stop: int, code: int, message: str
 ) -> None:
