@@ -3,7 +3,7 @@
     world.lod.promote(creature)           # full physics until released
     world.lod.release(creature)
     world.lod.focus((2.0, -1.0), 3.0)     # creatures within 3 m of (2, -1) run full
-    world.lod.counts()                    # {"full": 8, "reduced": 128, "kinematic": 888}
+    world.lod.counts()                    # {"full": 0, "reduced": 128, "kinematic": 896}
 
 Reads: every creature's reach sphere (the contact proxies' geometry over the Transform
 store), who is asleep or frozen, the scene's `physics.lod` budgets, and what scripts,
@@ -25,10 +25,12 @@ The rules, whole-array work every frame before the step:
    before they touch; one simulated stays so until it is `CLEAR` times that far).
 4. The other awake creatures (those of rule 3 too) are ranked: nearest the focus first
    (without one, all equal), then the tier they hold (hysteresis), then creature
-   order, so a bake's decisions depend on nothing but the scene. They fill what rule 2
-   left of the `full` budget (it counts the heroes: it caps what full physics costs
-   unless more than `full` are heroes; with `focus(..., fill=False)`, as the sandbox
-   asks, only heroes run full), then what rule 3 left of the `reduced` budget runs
+   order, so a bake's decisions depend on nothing but the scene. With a focus region
+   they fill what rule 2 left of the `full` budget (it counts the heroes: it caps what
+   full physics costs unless more than `full` are heroes); without one, or with
+   `focus(..., fill=False)` as the sandbox asks, only heroes run full (creature order
+   is no reason for full physics: a 1,024 crowd's eight arbitrary full creatures cost
+   it a sixth of its frame). Then what rule 3 left of the `reduced` budget runs
    REDUCED, the rest KINEMATIC (REDUCED while no replay is registered).
 5. Asleep creatures keep their tier and use no budget.
 6. Demotion waits until a creature has held its tier `hold_seconds`; promotion never
@@ -90,7 +92,7 @@ class LevelOfDetail:
         self.scripted = np.zeros(count, dtype=bool)  # promote() / release()
         self.selected = np.zeros(count, dtype=bool)  # the sandbox's selection
         self.focus_region: tuple[np.ndarray, float] | None = None
-        self.fill = True  # non-heroes may take what heroes leave of the full budget
+        self.fill = True  # with a focus: non-heroes may take what heroes leave of `full`
         if settings.focus is not None:
             self.focus(settings.focus[:2], settings.focus[2])
         # frames at the current tier; at the start nobody is held: first tiers come at once
@@ -202,7 +204,8 @@ class LevelOfDetail:
         awake = ~(roster.sleeping | roster.frozen)
         ranked = np.flatnonzero(awake & ~must)
         order = ranked[np.lexsort((ranked, tier[ranked], distance[ranked]))]
-        full = max(0, self.settings.full - int(must.sum())) if self.fill else 0  # heroes count
+        fill = self.fill and self.focus_region is not None  # ranked by nothing: heroes only
+        full = max(0, self.settings.full - int(must.sum())) if fill else 0  # heroes count
         want[order[:full]] = FULL
         rest = order[full:]
         rest = rest[~contact[rest]]  # in contact: REDUCED already, and counted below

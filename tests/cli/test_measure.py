@@ -98,10 +98,14 @@ def test_timed_adds_each_call_to_its_bucket() -> None:
     assert 0 < bucket[0] < 1
 
 
-def lod_crowd(n: int = 6) -> dict[str, Any]:
-    """A crowd spread wide (no two creatures near) with budgets that force all three tiers."""
+def lod_crowd(n: int = 6, focus: bool = True) -> dict[str, Any]:
+    """A crowd spread wide (no two creatures near) with budgets that force all three tiers
+    (with `focus`, the creature nearest a focus at the origin takes the full one; without,
+    nobody runs full but heroes)."""
     scene = crowd_scene(n, seed=2, spacing=4.0, uniform=True)
     scene["physics"] = {"lod": {"full": 1, "reduced": 2, "hold_seconds": 0}}
+    if focus:
+        scene["physics"]["lod"]["focus"] = {"center": [0.0, 0.0], "radius": 0.0}
     return scene
 
 

@@ -30,7 +30,8 @@ def test_a_bare_frame_ends_where_the_framework_frame_ended(
     make_world: Callable[..., World], threads: int
 ) -> None:
     scene = crowd_scene(4, seed=3, spacing=4.0, uniform=True)  # nobody near anybody
-    scene["physics"] = {"lod": {"full": 2, "reduced": 2, "hold_seconds": 0}}
+    focus = {"center": [0.0, 0.0], "radius": 0.0}  # the two nearest it run full
+    scene["physics"] = {"lod": {"full": 2, "reduced": 2, "hold_seconds": 0, "focus": focus}}
     world = make_world(scene, threads=threads)
     world.step(8)  # two demoted to REDUCED
     frame, states, rstates = _recorded_then_stepped(world)

@@ -32,7 +32,9 @@ def _crowd(count: int, lod: dict[str, Any] | None = None, spacing: float = 2.0) 
     return {"version": 1, "physics": {"lod": lod or {}}, "creatures": creatures}
 
 
-MIXED = {"full": 2, "reduced": 3, "hold_seconds": 0.1}  # 8 creatures: every tier in use
+# 8 creatures: every tier in use (the two nearest a focus at the origin fill the full budget)
+FOCUS = {"center": [0.0, 0.0], "radius": 0.0}
+MIXED = {"full": 2, "reduced": 3, "hold_seconds": 0.1, "focus": FOCUS}
 
 
 def test_mixed_tiers_move_bit_identically_on_one_and_two_threads(
@@ -79,10 +81,24 @@ def test_lod_off_equals_the_full_simulation(make_world: Callable[..., World]) ->
     assert squeezed.lod.promotions == squeezed.lod.demotions == 0
 
 
+def test_without_a_focus_only_heroes_run_full(make_world: Callable[..., World]) -> None:
+    world = make_world(_crowd(8, {"full": 2, "reduced": 3, "hold_seconds": 0}))
+    world.step(2)
+    assert world.lod.counts() == {"full": 0, "reduced": 3, "kinematic": 5}
+    world.lod.promote(world.creature("c6"))
+    world.step(2)
+    assert world.lod.counts() == {"full": 1, "reduced": 3, "kinematic": 4}
+    assert world.lod.tier_of(world.creature("c6")) == "full"
+    world.lod.focus((0.0, 0.0), 0.0)  # a focus: the nearest fill what c6 leaves
+    world.step(2)
+    assert world.lod.counts() == {"full": 2, "reduced": 3, "kinematic": 3}
+    assert world.lod.tier_of(world.creature("c0")) == "full"
+
+
 def test_the_full_budget_counts_the_creatures_that_must_be_full(
     make_world: Callable[..., World],
 ) -> None:
-    world = make_world(_crowd(8, {"full": 2, "reduced": 3, "hold_seconds": 0}))
+    world = make_world(_crowd(8, {"full": 2, "reduced": 3, "hold_seconds": 0, "focus": FOCUS}))
     world.step(2)
     assert world.lod.counts() == {"full": 2, "reduced": 3, "kinematic": 3}
     for name in ("c5", "c6", "c7"):  # more forced ones than the budget holds

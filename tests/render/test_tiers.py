@@ -19,7 +19,9 @@ from tests.render.conftest import click_item
 
 
 def test_the_camera_target_and_the_selection_run_full(make_sandbox: Callable[..., Any]) -> None:
-    sandbox = make_sandbox(lod_crowd())  # 6 creatures 4 m apart; budgets 1 full + 2 reduced
+    sandbox = make_sandbox(
+        lod_crowd(focus=False)
+    )  # 6 creatures 4 m apart; budgets 1 full + 2 reduced
     assert sandbox.camera_focus
     sandbox.select(None)
     creatures = sandbox.renderer.creature_entities
