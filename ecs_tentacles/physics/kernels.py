@@ -1,6 +1,7 @@
 """The numba kernels of the physics' per-frame queries: the contact proxies' `sense`
-(gather every body and every reach sphere in one pass), the near pairs' tests, and the
-ground's heightfield heights (`ground.Heightfield.height`).
+(gather every body and every reach sphere in one pass) and `reach` (the spheres alone:
+a frame copies only the bodies it needs), the near pairs' tests (reading bodies where
+they are), and the ground's heightfield heights (`ground.Heightfield.height`).
 
 Optional, as the other kernels are: their users import this module only when numba is
 installed and fall back to numpy otherwise; both compute the same numbers bit for bit
@@ -34,6 +35,27 @@ def sense(
     creature: creature c owns `count[c]` bodies from `start[c]`, its mantle first); each
     creature's reach sphere (mantle centre, farthest body surface) into `out_centre` /
     `out_radius`."""
+    for i in range(len(rows)):
+        row = rows[i]
+        for j in range(3):
+            out_pos[i, j] = store_pos[row, j]
+        for j in range(4):
+            out_quat[i, j] = store_quat[row, j]
+    reach(store_pos, rows, start, count, rbound, out_centre, out_radius)
+
+
+@njit(cache=True, nogil=True)
+def reach(
+    store_pos: np.ndarray,
+    rows: np.ndarray,
+    start: np.ndarray,
+    count: np.ndarray,
+    rbound: np.ndarray,
+    out_centre: np.ndarray,
+    out_radius: np.ndarray,
+) -> None:
+    """`sense`'s reach spheres alone: no body is copied (a frame needs the bodies of the
+    creatures near another only, `ContactProxies.gather`)."""
     for c in range(len(start)):
         first = start[c]
         mantle = rows[first]
@@ -42,11 +64,7 @@ def sense(
         radius = -np.inf
         for i in range(first, first + count[c]):
             row = rows[i]
-            x, y, z = store_pos[row, 0], store_pos[row, 1], store_pos[row, 2]
-            out_pos[i, 0], out_pos[i, 1], out_pos[i, 2] = x, y, z
-            for j in range(4):
-                out_quat[i, j] = store_quat[row, j]
-            dx, dy, dz = x - cx, y - cy, z - cz
+            dx, dy, dz = store_pos[row, 0] - cx, store_pos[row, 1] - cy, store_pos[row, 2] - cz
             reach = math.sqrt(dx * dx + dy * dy + dz * dz) + rbound[i]
             if reach > radius:
                 radius = reach
@@ -56,6 +74,7 @@ def sense(
 @njit(cache=True, nogil=True)
 def pair_gaps(
     pos: np.ndarray,
+    where: np.ndarray,
     centre: np.ndarray,
     radius: np.ndarray,
     rbound: np.ndarray,
@@ -69,23 +88,27 @@ def pair_gaps(
     """For each pair (a[p], b[p]), the gap between their nearest bodies into `out_gaps[p]`
     (left as it is where no body of one comes within `margin` of the other's reach
     sphere): `ContactProxies.pair_gaps`'s numbers, pair by pair, without the arrays of
-    every candidate body (at 10,000 creatures about 7 ms a frame in numpy)."""
+    every candidate body (at 10,000 creatures about 7 ms a frame in numpy). Body i is at
+    `pos[where[i]]` (the Transform store and its rows: no body is copied first)."""
     most = 0
     for c in range(len(count)):
         most = max(most, count[c])
     near_a = np.empty(most, dtype=np.int64)
     near_b = np.empty(most, dtype=np.int64)
     for p in range(len(a)):
-        na = _inside(pos, centre, radius, rbound, start, count, a[p], b[p], margin, near_a)
+        na = _inside(pos, where, centre, radius, rbound, start, count, a[p], b[p], margin, near_a)
         if na == 0:
             continue
-        nb = _inside(pos, centre, radius, rbound, start, count, b[p], a[p], margin, near_b)
+        nb = _inside(pos, where, centre, radius, rbound, start, count, b[p], a[p], margin, near_b)
         best = out_gaps[p]
         for i in range(na):
             u = near_a[i]
+            pu = where[u]
             for j in range(nb):
                 v = near_b[j]
-                dx, dy, dz = pos[u, 0] - pos[v, 0], pos[u, 1] - pos[v, 1], pos[u, 2] - pos[v, 2]
+                pv = where[v]
+                dx, dy = pos[pu, 0] - pos[pv, 0], pos[pu, 1] - pos[pv, 1]
+                dz = pos[pu, 2] - pos[pv, 2]
                 gap = math.sqrt(dx * dx + dy * dy + dz * dz) - rbound[u] - rbound[v]
                 if gap < best:
                     best = gap
@@ -95,6 +118,7 @@ def pair_gaps(
 @njit(cache=True, nogil=True)
 def _inside(
     pos: np.ndarray,
+    where: np.ndarray,
     centre: np.ndarray,
     radius: np.ndarray,
     rbound: np.ndarray,
@@ -110,7 +134,8 @@ def _inside(
     cx, cy, cz = centre[y, 0], centre[y, 1], centre[y, 2]
     limit = radius[y] + margin
     for body in range(start[x], start[x] + count[x]):
-        dx, dy, dz = pos[body, 0] - cx, pos[body, 1] - cy, pos[body, 2] - cz
+        at = where[body]
+        dx, dy, dz = pos[at, 0] - cx, pos[at, 1] - cy, pos[at, 2] - cz
         if math.sqrt(dx * dx + dy * dy + dz * dz) - rbound[body] < limit:
             out[n] = body
             n += 1

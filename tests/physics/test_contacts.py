@@ -144,6 +144,38 @@ def test_the_sense_kernel_gives_the_numpy_numbers_bit_for_bit(
         np.testing.assert_array_equal(kernel, numpy_path)
 
 
+def test_a_frame_that_gathers_only_the_near_creatures_bodies_moves_as_one_that_copies_all(
+    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """With numba a frame's `sense` copies the bodies of the creatures near another only
+    (`ContactProxies.gather`); the numpy path copies every body: the same motion."""
+    from ecs_tentacles.physics import proxies as module
+
+    small = {"count": 3, "links": 4}
+    creatures = [
+        {"name": "a", "position": [0.0, 0.0], "tentacles": small},
+        {"name": "b", "position": [0.7, 0.0], "heading_deg": 180, "tentacles": small},
+    ]  # tentacle tips 3 cm apart: proxies from the first frame
+    creatures += [{"name": f"far{k}", "position": [9.0 + 3 * k, 0.0]} for k in range(7)]
+    scene = {"version": 1, "creatures": creatures}  # 9: past the full budget, lod decides
+    runs = []
+    for backend in ("auto", "numpy"):
+        monkeypatch.setattr(module.KERNELS, "backend", backend)
+        world = make_world(scene)
+        touching, gathered = 0, []
+        for _ in range(30):
+            world.step(1)
+            touching += world.physics.proxies.in_use
+            lazy = world.physics.proxies._lazy
+            gathered.append(-1 if lazy is None else int(lazy.gathered.sum()))
+        runs.append((world.transforms.pos.copy(), world.transforms.quat.copy(), touching))
+        if backend == "auto":
+            assert touching == 30  # proxies placed every frame: a's and b's bodies gathered
+            assert max(gathered) == 2  # theirs, and no one else's
+    for lazy_run, eager_run in zip(*runs, strict=True):
+        np.testing.assert_array_equal(lazy_run, eager_run)
+
+
 def test_the_pair_gaps_kernel_gives_the_numpy_numbers_bit_for_bit(
     make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
 ) -> None:
