@@ -246,7 +246,8 @@ class Sandbox(SandboxPicture):
 
     def steer_lod(self) -> None:
         """Tell the level of detail what the player looks at: the selection, the camera."""
-        self.session.steer_lod(self.renderer.camera.target, self.selection.entities)
+        camera = self.renderer.camera
+        self.session.steer_lod(camera.target, self.selection.entities, camera.distance)
 
     # -- simulation --------------------------------------------------------------------
     def step(self, frames: int = 1) -> None:

@@ -28,6 +28,10 @@ from ecs_tentacles.world import World
 
 MAX_CATCH_UP = 0.25  # seconds of physics to catch up at most per display frame
 FOCUS_RADIUS = 1.5  # m around the camera's target where creatures must run full physics
+# The camera's target region runs full only from this close (m): from here its 3 m fill a
+# third of the view's height (45 degrees); farther, its creatures are too small on screen
+# for full physics to show, and a crowd framed whole (64 creatures: 30 m) keeps its frame.
+CLOSE_UP = 12.0
 
 
 class SandboxSession:
@@ -101,15 +105,17 @@ class SandboxSession:
         """True when the level of detail's focus follows the camera (none is pinned)."""
         return self.focus is None and self.world.lod.settings.focus is None
 
-    def steer_lod(self, target: np.ndarray, selected: Iterable[int]) -> None:
+    def steer_lod(self, target: np.ndarray, selected: Iterable[int], distance: float) -> None:
         """Tell the level of detail what the player looks at: the selected creatures run
         full, and (unless a focus is pinned) those within `FOCUS_RADIUS` of the camera's
-        `target` (x, y); the full budget is not filled with creatures the camera is not
-        on (a crowd framed whole keeps real time)."""
+        `target` (x, y) while the camera is within `CLOSE_UP` of it (`distance`); the
+        full budget is not filled with creatures the camera is not on (a crowd framed
+        whole keeps real time)."""
         lod = self.world.lod
         lod.select(selected)
         if self.camera_focus:
-            lod.focus(np.asarray(target)[:2], FOCUS_RADIUS, fill=False)
+            close = distance <= CLOSE_UP
+            lod.focus(np.asarray(target)[:2] if close else None, FOCUS_RADIUS, fill=False)
 
     # -- time ----------------------------------------------------------------------------
     def due(self, dt: float) -> int:

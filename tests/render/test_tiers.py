@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from ecs_tentacles.cli import main
-from ecs_tentacles.render.session import FOCUS_RADIUS
+from ecs_tentacles.render.session import CLOSE_UP, FOCUS_RADIUS
 from ecs_tentacles.render.tiers import COLOURS, tier_markers
 from tests.cli.test_measure import lod_crowd
 from tests.render.conftest import click_item
@@ -26,7 +26,8 @@ def test_the_camera_target_and_the_selection_run_full(make_sandbox: Callable[...
     sandbox.select(None)
     creatures = sandbox.renderer.creature_entities
     mantles = sandbox.world.transforms.pos[sandbox.renderer.mantle_rows]
-    sandbox.renderer.camera.target = np.array([*mantles[0, :2], 0.0])  # look at the first
+    camera = sandbox.renderer.camera
+    camera.target, camera.distance = np.array([*mantles[0, :2], 0.0]), 4.0  # close, on the first
     sandbox.step(2)
     lod = sandbox.world.lod
     distance = np.linalg.norm(mantles[:, :2] - mantles[0, :2], axis=1)
@@ -34,6 +35,12 @@ def test_the_camera_target_and_the_selection_run_full(make_sandbox: Callable[...
     assert near.sum() == 1  # the one looked at
     assert lod.tier_of(creatures[0]) == "full"
     assert lod.counts()["full"] == 1  # the budget of 1 counts it: none besides
+    camera.distance = CLOSE_UP + 1.0  # backed off: too small on screen for full physics
+    sandbox.step(2)
+    assert lod.tier_of(creatures[0]) == "reduced" and lod.counts()["full"] == 0
+    camera.distance = CLOSE_UP
+    sandbox.step(2)
+    assert lod.tier_of(creatures[0]) == "full"
     sandbox.renderer.camera.target = np.array([*(mantles[0, :2] + [FOCUS_RADIUS + 0.5, 0.0]), 0])
     sandbox.step(2)  # nobody inside the focus: nobody full, the nearest reduced
     nearest = creatures[int(np.argmin(np.linalg.norm(
