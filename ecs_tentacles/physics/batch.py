@@ -395,7 +395,7 @@ class Batch:
         m, fm, fd = scratch.model, full.model, full.data
         state, rstate, rsource, watched = self.state, self.rstate, self.rsource, reduced.watched
         qpos = self.slices[int(S.mjSTATE_QPOS)]
-        body_ids = self.body_ids
+        bodies = self.model_bodies  # a slice when the bodies are one run: no gather
         # whole-array work for the rows at once (each row's bits as if alone): the frame's
         # inputs pulled into the reduced states (fitted again where the full state was
         # written from outside since the row's last step), every row's reduced servos
@@ -427,11 +427,12 @@ class Batch:
             reduced.expand_rows(rstate[done], block)
             state[done] = block
             rsource[done] = block[:, watched]
+        joints, poses, turns = fd.qpos, fd.xpos, fd.xquat  # MjData's arrays: fixed views
         for row in done.tolist():
-            fd.qpos[:] = state[row, qpos]
+            joints[:] = state[row, qpos]
             mujoco.mj_kinematics(fm, fd)
-            self.xpos[row] = fd.xpos[body_ids]
-            self.xquat[row] = fd.xquat[body_ids]
+            self.xpos[row] = poses[bodies]
+            self.xquat[row] = turns[bodies]
         shared = (shared + time.perf_counter() - began) / len(rows) if len(rows) else 0.0
         self._took(rows, REDUCED, took + shared, substeps)
 
