@@ -43,6 +43,7 @@ from ecs_tentacles.physics.membership import Membership, compile_models
 from ecs_tentacles.physics.model import ModelLayout, model_layout
 from ecs_tentacles.physics.proxies import ContactProxies
 from ecs_tentacles.physics.roster import Roster
+from ecs_tentacles.physics.rounds import Ready, Rounds
 from ecs_tentacles.physics.sleep import Sleep, SleepState
 from ecs_tentacles.physics.stepping import Segment, Work, plan, step_segments
 from ecs_tentacles.physics.tiers import FULL, KINEMATIC, REDUCED, reduced_substeps
@@ -296,17 +297,18 @@ class PhysicsBackend(Membership):
         substeps: int,
         before_substep: Callable[[int], None] | None = None,
         rounds: int = 1,
-        between: Callable[[], None] | None = None,
+        between: Callable[[Ready], None] | None = None,
     ) -> None:
         """Advance every active creature `substeps` steps; `before_substep(i)` runs first if given.
 
         Without hooks, creatures near another (contact proxies placed) take their steps
-        in `rounds` batches with `between()` called between them (their proxies catch up
-        within the frame); every other creature takes all its steps at once, which
-        gives the same result (nothing it reads changes between rounds) for less
-        bookkeeping. A creature's step reads only its own row, so the result does not
-        depend on the number of threads. Asleep or frozen creatures keep their state;
-        the clock moves on.
+        in `rounds` batches with `between(ready)` called between them (their proxies
+        catch up within the frame; `ready(creatures)` before it reads or writes those
+        creatures' rows, `physics.rounds`); every other creature takes all its steps at
+        once, on whichever thread the rounds leave idle, which gives the same result
+        (nothing it reads changes between rounds) for less bookkeeping. A creature's
+        step reads only its own row, so the result does not depend on the number of
+        threads. Asleep or frozen creatures keep their state; the clock moves on.
         """
         reduced = reduced_substeps(substeps)
         if before_substep is not None:
@@ -327,20 +329,44 @@ class PhysicsBackend(Membership):
                     for n, r in zip(_split(substeps, rounds), _split(reduced, rounds), strict=True)
                     if n
                 ]
-                # the first part of the near ones with all of the others: one dispatch
-                share = substeps / parts[0][FULL]
-                first = plan(self.batches, near, self.tier, self.threads, (alone, whole, share))
-                self._run(first, parts[0])
-                segments = plan(self.batches, near, self.tier, self.threads)
-                for part in parts[1:]:
-                    if between is not None:
-                        between()
-                    self._run(segments, part)
+                self._step_rounds(near, alone, whole, parts, between)
         self.time += substeps * self.substep_dt
         self._untrimmed += 1
         if self._untrimmed >= heap.TRIM_FRAMES:
             self._untrimmed = 0
             heap.trim()
+
+    def _step_rounds(
+        self,
+        near: np.ndarray,
+        rest: np.ndarray,
+        rest_steps: dict[int, int],
+        parts: list[dict[int, int]],
+        between: Callable[[Ready], None] | None,
+    ) -> None:
+        """The `near` creatures' steps in `parts` with `between(ready)` between them, the
+        `rest` (bool per creature) stepped whole by `rest_steps` on whichever thread the
+        rounds leave idle (`physics.rounds`)."""
+        helpers = self.threads - 1 if self._pool is not None else 0
+        segments = plan(self.batches, near, self.tier, self.threads)
+        rounds = Rounds(plan(self.batches, rest, self.tier, self.threads), rest_steps, helpers + 1)
+
+        def ready(creatures: np.ndarray) -> None:
+            if not rounds.settled and rest[creatures].any():
+                rounds.settle()
+
+        pool = self._pool
+        futures = [pool.submit(rounds.helper, k) for k in range(1, helpers + 1)] if pool else []
+        try:
+            for index, part in enumerate(parts):
+                if index and between is not None:
+                    between(ready)
+                rounds.round(segments, part)
+            rounds.settle()
+        finally:
+            rounds.close()
+            for future in futures:
+                future.result()
 
     def _run(self, segments: list[Segment], substeps: dict[int, int]) -> None:
         self._dispatch(step_segments, segments, substeps)

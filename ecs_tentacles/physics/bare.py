@@ -60,7 +60,7 @@ class Steps(Stepped, Protocol):
         substeps: int,
         before_substep: Callable[[int], None] | None = None,
         rounds: int = 1,
-        between: Callable[[], None] | None = None,
+        between: Callable[[Callable[[np.ndarray], None]], None] | None = None,
     ) -> None: ...
 
 

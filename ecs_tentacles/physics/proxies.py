@@ -28,6 +28,7 @@ from ecs_tentacles.physics.pairs import NearPairCache
 if TYPE_CHECKING:
     from ecs_tentacles.physics.batch import Batch
     from ecs_tentacles.physics.roster import Roster
+    from ecs_tentacles.physics.rounds import Ready
     from ecs_tentacles.store import TransformStore
 
 S = mujoco.mjtState
@@ -174,14 +175,16 @@ class ContactProxies:
         """Some creature is near another (its proxies are placed)."""
         return bool(self.roster.proxies_used.any())
 
-    def refresh(self, transforms: TransformStore) -> None:
+    def refresh(self, transforms: TransformStore, ready: Ready | None = None) -> None:
         """Move the proxies to where the bodies are now, within the frame.
 
         Bodies of creatures near someone are read from their last step (as of their
         last substep); every other body is as the frame started. Only the near
         creatures' poses and reach spheres are recomputed: the frame's `sense` (or the
         last refresh's) holds everyone else's, and is taken over (it is not the frame
-        start's any more, so `sense` computes afresh after this).
+        start's any more, so `sense` computes afresh after this). `ready(creatures)`
+        is called before the rows of `creatures` are read or written (other threads
+        may still be stepping other creatures, `physics.rounds`).
         """
         if self._sensed is not None:
             self._within, self._sensed = self._sensed[1], None
@@ -189,6 +192,8 @@ class ContactProxies:
             self._within = self.sense(transforms)
         pos, quat, centre, radius = self._within
         used = self.roster.proxies_used > 0
+        if ready is not None:
+            ready(used)
         lazy = self._lazy
         if lazy is not None and lazy.pos is pos:
             lazy.gathered[used] = True  # their bodies come from their last step, not the store
@@ -201,7 +206,7 @@ class ContactProxies:
         moved = np.flatnonzero(used)
         if len(moved):
             centre[moved], radius[moved] = self._spheres_of(pos, moved)
-        self._place(pos, quat, centre, radius)
+        self._place(pos, quat, centre, radius, ready)
 
     def spheres(self, pos: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Every creature's reach sphere (centre at its mantle, radius to its farthest
@@ -283,12 +288,19 @@ class ContactProxies:
         return pair[keep], body[keep]
 
     def _place(
-        self, pos: np.ndarray, quat: np.ndarray, centre: np.ndarray, radius: np.ndarray
+        self,
+        pos: np.ndarray,
+        quat: np.ndarray,
+        centre: np.ndarray,
+        radius: np.ndarray,
+        ready: Ready | None = None,
     ) -> None:
         roster = self.roster
         a, b = self._pairs(centre, radius, MARGIN)
         self.gather(pos, np.concatenate([a, b]))
         who, body, slot = self._assign(a, b, pos, centre, radius) if len(a) else (_NONE,) * 3
+        if ready is not None:
+            ready(who)  # their rows are written (those that had proxies were ready before)
         was_used = roster.proxies_used > 0
         if not len(who) and not was_used.any():  # nobody near, before or now: none move
             for batch in roster.batches:

@@ -26,13 +26,11 @@ from ecs_tentacles.physics.tiers import FULL, REDUCED
 
 @dataclass(frozen=True)
 class Segment:
-    """Some rows of one batch, stepped at one tier; `steps` per tier when they differ from
-    the call's."""
+    """Some rows of one batch, stepped at one tier."""
 
     batch: Batch
     rows: np.ndarray
     tier: int = FULL
-    steps: dict[int, int] | None = None
     cost: np.ndarray = field(default_factory=lambda: np.zeros(0))  # per row, when planned
 
 
@@ -67,7 +65,7 @@ class Work:
             self._at = (index, end)
         if row == 0 and end == len(segment.rows):
             return segment
-        return Segment(segment.batch, segment.rows[row:end], segment.tier, segment.steps)
+        return Segment(segment.batch, segment.rows[row:end], segment.tier)
 
 
 def plan(
@@ -75,30 +73,20 @@ def plan(
     active: np.ndarray,
     tier: np.ndarray,
     threads: int,
-    also: tuple[np.ndarray, dict[int, int], float] | None = None,
 ) -> list[Segment]:
     """Active rows (by creature index) of the stepped tiers: a segment per batch and tier
     with each row's cost, the segments whose rows cost most first; every tier's model
-    and scratch data for `threads` threads are made first.
-
-    `also` = (more active creatures, their steps per tier, how many times the call's
-    steps that is): stepped in the same dispatch, their cost weighed by it.
-    """
+    and scratch data for `threads` threads are made first."""
     found: list[tuple[float, int, Segment]] = []
-    groups: list[tuple[np.ndarray, dict[int, int] | None, float]] = [(active, None, 1.0)]
-    if also is not None:
-        groups.append(also)
-    for mask, steps, weight in groups:
-        for level in (FULL, REDUCED):
-            for batch in batches:
-                rows = np.flatnonzero(mask[batch.members] & (tier[batch.members] == level))
-                if len(rows):
-                    batch.prepare(level, threads)
-                    if level == REDUCED:
-                        batch.prepare(FULL, threads)  # its poses come from the full model
-                    cost = batch.frame_cost(rows, level) * weight
-                    segment = Segment(batch, rows, level, steps, cost)
-                    found.append((-float(cost.mean()), len(found), segment))
+    for level in (FULL, REDUCED):
+        for batch in batches:
+            rows = np.flatnonzero(active[batch.members] & (tier[batch.members] == level))
+            if len(rows):
+                batch.prepare(level, threads)
+                if level == REDUCED:
+                    batch.prepare(FULL, threads)  # its poses come from the full model
+                cost = batch.frame_cost(rows, level)
+                found.append((-float(cost.mean()), len(found), Segment(batch, rows, level, cost)))
     found.sort(key=lambda group: group[:2])
     return [segment for _, _, segment in found]
 
@@ -107,6 +95,6 @@ def step_segments(work: Work, substeps: dict[int, int], thread: int) -> None:
     """Step segments taken from `work` by their tier's `substeps` on scratch `thread`
     until none is left (runs on each thread of a dispatch)."""
     while (segment := work.take()) is not None:
-        n = (segment.steps or substeps)[segment.tier]
+        n = substeps[segment.tier]
         if n:
             segment.batch.step_rows(segment.rows, n, thread, segment.tier)

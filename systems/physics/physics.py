@@ -63,7 +63,7 @@ class Physics(System):
             backend.step(
                 world.settings.substeps,
                 rounds=PROXY_ROUNDS,
-                between=lambda: proxies.refresh(transforms),
+                between=lambda ready: proxies.refresh(transforms, ready),
             )
             return
         substep_dt = world.settings.substep_dt

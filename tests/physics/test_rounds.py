@@ -1,0 +1,82 @@
+"""A frame with creatures near another: rounds in order, the rest stepped around them."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+import pytest
+from numpy.testing import assert_array_equal
+
+from ecs_tentacles.physics.tiers import FULL
+from ecs_tentacles.world import World
+
+
+def _pair_and_others(others: int = 5) -> dict[str, Any]:
+    """Two creatures whose tentacle tips are 3 cm apart, and `others` far from everyone."""
+    creatures: list[dict[str, Any]] = [
+        {"name": "a", "position": [0.0, 0.0], "tentacles": {"count": 3, "links": 4}},
+        {
+            "name": "b",
+            "position": [0.7, 0.0],
+            "heading_deg": 180,
+            "tentacles": {"count": 3, "links": 4},
+            "goals": [{"position": [-2.0, 0.0]}],  # it crawls into a
+        },
+    ]
+    creatures += [
+        {
+            "name": f"far{i}",
+            "position": [6.0 + 4.0 * i, 0.0],
+            "tentacles": {"count": 3, "links": 4},
+            "goals": [{"position": [6.0 + 4.0 * i, 2.0]}],
+        }
+        for i in range(others)
+    ]
+    return {"version": 1, "creatures": creatures}
+
+
+@pytest.mark.parametrize("threads", [1, 2])
+def test_ready_steps_a_creature_of_the_rest_before_it_returns(
+    make_world: Callable[..., World], threads: int
+) -> None:
+    world = make_world(_pair_and_others(), threads=threads)
+    world.step(2)
+    physics = world.physics
+    physics.proxies.update(world.transforms)
+    near = physics.proxies_used > 0
+    assert near[:2].all() and not near[2:].any()
+    far = 2  # a creature of the rest
+    batch, row = physics.batches[int(physics.batch_of[far])], int(physics.row_of[far])
+    start = batch.state[row].copy()
+    seen: list[np.ndarray] = []
+
+    def between(ready: Callable[[np.ndarray], None]) -> None:
+        ready(np.array([far]))  # as the proxies' refresh does before it reads or writes it
+        seen.append(batch.state[row].copy())
+
+    substeps = world.settings.substeps
+    physics.step(substeps, rounds=4, between=between)
+    assert len(seen) == 3  # between the four rounds
+    assert not np.array_equal(seen[0], start)  # it took its steps before ready returned
+    for state in seen:  # and no more after
+        assert_array_equal(state, batch.state[row])
+
+
+def test_a_pair_that_meets_moves_the_same_on_one_and_two_threads(
+    make_world: Callable[..., World],
+) -> None:
+    runs, near_frames = [], []
+    for threads in (1, 2):
+        world = make_world(_pair_and_others(), threads=threads)
+        poses, near = [], 0
+        for _ in range(40):
+            world.step(1)
+            near += bool(world.physics.proxies.in_use)
+            poses.append(world.transforms.pos.copy())
+        assert (world.physics.tier == FULL).all()
+        runs.append(np.array(poses))
+        near_frames.append(near)
+    assert near_frames[0] == near_frames[1] >= 30  # the pair stepped in rounds
+    assert_array_equal(runs[0], runs[1])
