@@ -1,7 +1,8 @@
 """The numba kernels of the physics' per-frame queries: the contact proxies' `sense`
 (gather every body and every reach sphere in one pass) and `reach` (the spheres alone:
 a frame copies only the bodies it needs), the near pairs' tests (reading bodies where
-they are), and the ground's heightfield heights (`ground.Heightfield.height`).
+they are; every pair of a small crowd), and the ground's heightfield heights
+(`ground.Heightfield.height`).
 
 Optional, as the other kernels are: their users import this module only when numba is
 installed and fall back to numpy otherwise; both compute the same numbers bit for bit
@@ -157,6 +158,31 @@ def spheres_within(
             total += d * d
         out[p] = math.sqrt(total) - (radius[i] + radius[j]) < margin
     return out
+
+
+@njit(cache=True, nogil=True)
+def dense_pairs(
+    centre: np.ndarray, radius: np.ndarray, margin: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """`pairs.near_pairs` of a small crowd (every pair compared): the ordered pairs (a, b),
+    a != b, sorted by a then b, whose spheres come within `margin`; its numbers without
+    its dozen passes over an (n, n) array."""
+    n = centre.shape[0]
+    a = np.empty(max(n * (n - 1), 0), dtype=np.int64)
+    b = np.empty_like(a)
+    found = 0
+    for i in range(n):
+        for j in range(n):
+            if i == j:
+                continue
+            total = 0.0
+            for k in range(centre.shape[1]):
+                d = centre[i, k] - centre[j, k]
+                total += d * d
+            if math.sqrt(total) - (radius[i] + radius[j]) < margin:
+                a[found], b[found] = i, j
+                found += 1
+    return a[:found], b[:found]
 
 
 @njit(cache=True, nogil=True)

@@ -74,3 +74,28 @@ def test_the_sphere_test_kernel_gives_the_numpy_answers(
         found.append(module.spheres_within(centre, radius, a, b, 0.3))
     assert_array_equal(found[0], found[1])
     assert 0 < found[0].sum() < len(a)
+
+
+@pytest.mark.parametrize("dimensions", [2, 3])
+def test_a_small_crowds_pairs_are_the_same_with_the_kernel_and_numpy(
+    dimensions: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from ecs_tentacles.physics import pairs as module
+
+    assert module.KERNELS.get() is not None  # numba comes with the dev extra
+    rng = np.random.default_rng(11)
+    for n in (0, 1, 2, 16, DENSE_PAIRS):
+        centre, radius = _crowd(rng, n)
+        centre = centre[:, :dimensions]
+        if n > 2:  # two spheres exactly `margin` apart (not near) and one NaN (never near)
+            radius[1] = np.linalg.norm(centre[1] - centre[0]) - radius[0] - 0.3
+            centre[2] = np.nan
+        found = []
+        for backend in ("auto", "numpy"):
+            monkeypatch.setattr(module.KERNELS, "backend", backend)
+            found.append(near_pairs(centre, radius, 0.3))
+        for kernel, numpy in zip(found[0], found[1], strict=True):
+            assert kernel.dtype == numpy.dtype
+            assert_array_equal(kernel, numpy)
+        if n >= 16:
+            assert 0 < len(found[0][0]) < n * (n - 1)
