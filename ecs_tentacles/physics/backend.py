@@ -33,6 +33,7 @@ import mujoco
 import numpy as np
 
 from ecs_tentacles.components import Creature, Transform
+from ecs_tentacles.numeric.optional_kernels import OptionalKernels
 from ecs_tentacles.physics import heap
 from ecs_tentacles.physics.bare import BareFrame, step_recorded
 from ecs_tentacles.physics.batch import Batch
@@ -54,6 +55,7 @@ if TYPE_CHECKING:
     from ecs_tentacles.store import MotorStore, SuckerStore, TransformStore
 
 log = logging.getLogger("ecs_tentacles.mujoco")
+KERNELS = OptionalKernels("ecs_tentacles.physics.frame_kernels", "ECS_TENTACLES_PHYSICS_FRAME")
 S = mujoco.mjtState
 
 
@@ -233,9 +235,16 @@ class PhysicsBackend(Membership):
         """Targets into `ctrl`; kp = strength x gain, kv = damping x gain; torque limits."""
         target = motors.target.reshape(-1)
         strength, gain, damping = motors.strength, motors.gain, motors.damping
+        fast = KERNELS.get()
         for batch in self.batches:
             live = ~self.frozen[batch.members] & (self.tier[batch.members] != KINEMATIC)
             soften = self.soften[batch.members]
+            if fast is not None:  # the same numbers in one pass, live rows only
+                fast.servo_commands(target, batch.actuator_target_index, strength, gain, damping,
+                                    motors.max_torque, batch.actuator_motor_rows, soften,
+                                    np.flatnonzero(live), batch.ctrl, batch.kp, batch.kv,
+                                    batch.torque)  # fmt: skip
+                continue
             if live.all():
                 rows = batch.actuator_motor_rows
                 batch.ctrl[:] = np.take(target, batch.actuator_target_index, mode="clip")

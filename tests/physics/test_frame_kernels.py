@@ -1,0 +1,75 @@
+"""The physics' bookkeeping kernels give numpy's numbers bit for bit."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+import pytest
+from numpy.testing import assert_array_equal
+
+from ecs_tentacles.physics import backend as backend_module
+from ecs_tentacles.physics import health as health_module
+from ecs_tentacles.world import World
+
+SCENE: dict[str, Any] = {
+    "version": 1,
+    "creatures": [
+        {
+            "name": f"c{i}",
+            "position": [3.0 * i, 0.0],
+            "tentacles": {"count": 3, "links": 4},
+            "goals": [{"position": [3.0 * i, 1.5]}],
+        }
+        for i in range(4)
+    ],
+}
+
+
+def test_servo_commands_are_numpys(
+    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    assert backend_module.KERNELS.get() is not None  # numba comes with the dev extra
+    world = make_world(SCENE)
+    world.step(3)
+    physics, motors = world.physics, world.motors
+    physics.frozen[1] = True  # keeps what it had: neither path writes its row
+    physics.soften[2] = 0.37  # just recovered: softer servos
+    motors.strength *= np.linspace(0.5, 2.0, len(motors.strength))
+    batch = physics.batches[0]
+    index = batch.actuator_target_index.copy()
+    index[0, 0] = motors.target.size + 5  # out of range: clipped, as np.take's mode="clip"
+    batch.actuator_target_index = index
+    written = []
+    for backend in ("auto", "numpy"):
+        monkeypatch.setattr(backend_module.KERNELS, "backend", backend)
+        for part in (batch.ctrl, batch.kp, batch.kv, batch.torque):
+            part[:] = -7.0
+        physics.write_controls(motors)
+        written.append([batch.ctrl.copy(), batch.kp.copy(), batch.kv.copy(), batch.torque.copy()])
+    for kernel, numpy in zip(*written, strict=True):
+        assert_array_equal(kernel, numpy)
+    row = int(physics.row_of[1])
+    assert (written[0][1][row] == -7.0).all()  # the frozen creature's row untouched
+    assert not (np.delete(written[0][1], row, axis=0) == -7.0).any()
+
+
+def test_the_fastest_body_is_numpys(
+    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    assert health_module.KERNELS.get() is not None
+    world = make_world(SCENE)
+    world.step(2)
+    health = world.physics.health
+    rng = np.random.default_rng(4)
+    pos = world.transforms.pos + rng.normal(0.0, 0.05, world.transforms.pos.shape)
+    pos[health.rows[health.start[3] + 2], 1] = np.nan  # creature 3: a pose not finite
+    for active in (np.ones(4, bool), np.array([True, False, True, True])):
+        found = []
+        for backend in ("auto", "numpy"):
+            monkeypatch.setattr(health_module.KERNELS, "backend", backend)
+            found.append(health._fastest(pos, active))
+        assert_array_equal(found[0], found[1])
+        assert np.isnan(found[0][3]) and (found[0][~active] == 0.0).all()
+        assert (found[0][:3][active[:3]] > 0.0).all()
