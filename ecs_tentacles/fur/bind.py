@@ -10,14 +10,16 @@ keyframed tracks into the control store.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from types import ModuleType
 
 import numpy as np
 
 from ecs_tentacles.fur.dynamics import Strands, blend_profile
-from ecs_tentacles.fur.rig import F32, Bind, ControlValues
+from ecs_tentacles.fur.rig import F32, TABLE_ROWS, Bind, ControlValues, Plan, control_table, kernels
 from ecs_tentacles.fur.stores import BEHAVIOURS, COLUMNS, ControlStore, FurData
 from ecs_tentacles.fur.vectors import clamp_to_cap, cross, dot, normalize
 from ecs_tentacles.numeric.keyframes import TrackSet
+from ecs_tentacles.numeric.optional_kernels import OptionalKernels
 
 MAX_ELEVATION = np.radians(80.0)  # the cap never shrinks to nothing, even for bent guides
 LIFT, AIM, DIRECTION, RANDOM, DYNAMIC = range(5)
@@ -65,8 +67,9 @@ def make_bind(fur: FurData, rows: slice = slice(None)) -> tuple[Bind, np.ndarray
 
 
 def _unit_interval(x: np.ndarray) -> np.ndarray:
-    """x clipped to [0, 1] (np.clip's overhead is large for a few controls each frame)."""
-    return np.minimum(np.maximum(x, 0.0), 1.0)
+    """x clipped to [0, 1] (np.clip's overhead is large for a few controls each frame);
+    NaN stays NaN and -0.0 becomes 0.0 (np.maximum's zero sign depends on the CPU)."""
+    return np.minimum(np.maximum(x, 0.0), 1.0) + 0.0
 
 
 def control_values(fur: FurData) -> tuple[ControlValues, np.ndarray]:
@@ -85,6 +88,44 @@ def control_values(fur: FurData) -> tuple[ControlValues, np.ndarray]:
         offset=np.ascontiguousarray(offset.T, dtype=F32),
     )
     return values, (_unit_interval(c.dynamic) * on[:, DYNAMIC]).astype(F32)
+
+
+def control_plan(fur: FurData) -> tuple[Plan, np.ndarray]:
+    """`control_table(control_values(fur))` and `dynamic`: the frame's control values,
+    their table and which behaviours act (one numba kernel when the rig's kernels run:
+    the same numbers)."""
+    fast = control_kernels()
+    if fast is None:
+        values, dynamic = control_values(fur)
+        return control_table(values), dynamic
+    c, sets = fur.controls, fur.sets
+    n = len(c)
+    values = ControlValues(
+        lift=np.empty(n, F32),
+        aim=np.empty(n, F32),
+        direction=np.empty(n, F32),
+        twist=np.empty(n, F32),
+        position=np.empty((3, n), F32),
+        offset=np.empty((3, n), F32),
+    )
+    dynamic, table = np.empty(n, F32), np.empty((TABLE_ROWS, n), F32)
+    flags = fast.control_plan(
+        c.fur_row, c.position, c.rest_position, c.lift, c.drive_lift, c.aim, c.direction,
+        c.random, c.drive_random, c.dynamic, sets.enabled, sets.twist_max, sets.reach,
+        values.lift, values.aim, values.direction, values.twist, values.position,
+        values.offset, dynamic, table,
+    )  # fmt: skip
+    lifting, aiming, directing, twisting = (bool(flag) for flag in flags)
+    return Plan(values, table, lifting, aiming, directing, twisting), dynamic
+
+
+_CONTROL_KERNELS = OptionalKernels("ecs_tentacles.fur.control_kernels")
+
+
+def control_kernels() -> ModuleType | None:
+    """`control_plan`'s kernel, or None: numpy does the work (no numba, or
+    ``ECS_TENTACLES_RIG=numpy``)."""
+    return None if kernels() is None else _CONTROL_KERNELS.get()
 
 
 def make_strands(fur: FurData, gravity: np.ndarray, dt: float) -> Strands | None:

@@ -24,10 +24,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ecs_tentacles.fur.bind import ControlTracks, control_values, make_strands
+from ecs_tentacles.fur.bind import ControlTracks, control_plan, make_strands
 from ecs_tentacles.fur.blocks import BindBlocks
 from ecs_tentacles.fur.dynamics import Strands
-from ecs_tentacles.fur.rig import Bind, RigBuffers, control_table, evaluate, use_parallel
+from ecs_tentacles.fur.rig import Bind, RigBuffers, evaluate, use_parallel
 from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.fur.vectors import quat_matrices
 from ecs_tentacles.numeric.keyframes import TrackSet
@@ -146,8 +146,7 @@ class Rig(System):
         if self.play_tracks:
             time = world.time if self.track_time is None else self.track_time
             self.tracks.apply(fur.controls, time)
-        values, dynamic = control_values(fur)
-        plan = control_table(values)  # per-control values and skips, once a frame
+        plan, dynamic = control_plan(fur)  # per-control values and skips, once a frame
         rotation = quat_matrices(world.transforms.quat[binds.bodies])
         position = world.transforms.pos[binds.bodies]
         for rows, part in binds.blocks:
