@@ -1,6 +1,6 @@
 """The numba kernels of the physics' own per-frame bookkeeping: the servo commands into
-the batch rows (`PhysicsBackend.write_controls`) and the fastest body of every creature
-(`HealthCheck.check`).
+the batch rows (`PhysicsBackend.write_controls`), and the fastest body of every creature
+and the rows' faults (`HealthCheck.check`).
 
 Optional, as the other kernels are: their users import this module only when numba is
 installed and fall back to numpy otherwise; both compute the same numbers bit for bit
@@ -78,3 +78,32 @@ def fastest_moves(
                 if step != step:
                     break
         out[c] = math.sqrt(best) if count[c] else 0.0
+
+
+@njit(cache=True, nogil=True)
+def row_faults(
+    members: np.ndarray,
+    active: np.ndarray,
+    warnings: np.ndarray,
+    qvel: np.ndarray,
+    deepest: np.ndarray,
+    max_penetration: float,
+    bad: np.ndarray,
+) -> None:
+    """`bad[members[r]] = True` for each row r of a batch whose creature is `active` and
+    whose step raised a warning, left a velocity that is not finite, or a contact deeper
+    than `max_penetration`."""
+    for r in range(len(members)):
+        c = members[r]
+        if not active[c]:
+            continue
+        fault = deepest[r] < -max_penetration
+        for k in range(warnings.shape[1]):
+            if warnings[r, k] != 0:
+                fault = True
+        for k in range(qvel.shape[1]):
+            if not math.isfinite(qvel[r, k]):
+                fault = True
+                break
+        if fault:
+            bad[c] = True

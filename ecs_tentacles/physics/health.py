@@ -186,13 +186,18 @@ class HealthCheck:
         active = roster.active
         fastest = self._fastest(pos, active)
         bad = ~(fastest <= limit)  # also nan: a pose that is not finite
+        fast = KERNELS.get()
         for batch in roster.batches:
-            stepped = active[batch.members]  # what was stepped: the rest waits
-            rows = slice(None) if stepped.all() else np.flatnonzero(stepped)
-            at = batch.members[rows]
-            bad[at] |= batch.warnings[rows].any(axis=1)
-            bad[at] |= ~np.isfinite(batch.qvel[rows].sum(axis=1))
-            bad[at] |= batch.deepest[rows] < -self.max_penetration
+            if fast is not None:  # the same faults in one pass
+                fast.row_faults(batch.members, active, batch.warnings, batch.qvel,
+                                batch.deepest, self.max_penetration, bad)  # fmt: skip
+            else:
+                stepped = active[batch.members]  # what was stepped: the rest waits
+                rows = slice(None) if stepped.all() else np.flatnonzero(stepped)
+                at = batch.members[rows]
+                bad[at] |= batch.warnings[rows].any(axis=1)
+                bad[at] |= ~np.isfinite(batch.qvel[rows]).all(axis=1)
+                bad[at] |= batch.deepest[rows] < -self.max_penetration
             for row in batch.errors:
                 bad[batch.members[row]] = True
         failing = np.flatnonzero(bad & active)
@@ -260,7 +265,7 @@ class HealthCheck:
             if not np.isfinite(fastest):
                 return "non-finite state"
             return f"speed {fastest / dt:.3g} m/s"
-        if not np.isfinite(batch.qvel[row].sum()):
+        if not np.isfinite(batch.qvel[row]).all():
             return "non-finite state"
         return f"penetration {-1000 * batch.deepest[row]:.1f} mm"
 

@@ -73,3 +73,45 @@ def test_the_fastest_body_is_numpys(
         assert_array_equal(found[0], found[1])
         assert np.isnan(found[0][3]) and (found[0][~active] == 0.0).all()
         assert (found[0][:3][active[:3]] > 0.0).all()
+
+
+def test_the_health_check_finds_the_same_faults_with_and_without_kernels(
+    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    world = make_world(SCENE)
+    world.step(12)
+    physics = world.physics
+    batch, health = physics.batches[0], physics.health
+    row = [int(physics.row_of[i]) for i in range(4)]
+    start = world.snapshot()
+    deepest = batch.deepest.copy()  # a step's results, not in a snapshot
+
+    def fault(case: int) -> None:
+        if case == 1:
+            batch.warnings[row[0], 3] = 1
+        elif case == 2:
+            batch.qvel[row[1], 7] = np.inf
+        elif case == 3:
+            batch.deepest[row[2]] = -2.0 * health.max_penetration
+        elif case == 4:  # not stepped this frame (asleep): not its step's fault
+            batch.qvel[row[2], 0] = np.nan
+            physics.sleeping[2] = True
+
+    found = []
+    for backend in ("auto", "numpy"):
+        monkeypatch.setattr(health_module.KERNELS, "backend", backend)
+        for case in range(5):
+            world.restore(start)
+            batch.deepest[:], batch.warnings[:] = deepest, 0
+            fault(case)
+            health.check(world, physics.time)
+            found.append((sorted(health.failures), dict(health.causes)))
+    assert found[:5] == found[5:]
+    assert [failed for failed, _ in found[:5]] == [[], [0], [1], [2], []]
+    assert [causes for _, causes in found[:5]] == [
+        {},
+        {"mujoco": 1},
+        {"non-finite": 1},
+        {"penetration": 1},
+        {},
+    ]
