@@ -77,18 +77,20 @@ def plan(
     """Active rows (by creature index) of the stepped tiers: a segment per batch and tier
     with each row's cost, the segments whose rows cost most first; every tier's model
     and scratch data for `threads` threads are made first."""
-    found: list[tuple[float, int, Segment]] = []
+    found: list[Segment] = []
+    stepped = np.where(active, tier, -1)  # each creature's tier, -1 where not stepped
+    levels = [stepped[batch.members] for batch in batches]
     for level in (FULL, REDUCED):
-        for batch in batches:
-            rows = np.flatnonzero(active[batch.members] & (tier[batch.members] == level))
+        for batch, mine in zip(batches, levels, strict=True):
+            rows = np.flatnonzero(mine == level)
             if len(rows):
                 batch.prepare(level, threads)
                 if level == REDUCED:
                     batch.prepare(FULL, threads)  # its poses come from the full model
-                cost = batch.frame_cost(rows, level)
-                found.append((-float(cost.mean()), len(found), Segment(batch, rows, level, cost)))
-    found.sort(key=lambda group: group[:2])
-    return [segment for _, _, segment in found]
+                found.append(Segment(batch, rows, level, batch.frame_cost(rows, level)))
+    if len(found) > 1:  # dearest rows first; a stable sort keeps ties in this order
+        found.sort(key=lambda segment: -float(segment.cost.mean()))
+    return found
 
 
 def step_segments(work: Work, substeps: dict[int, int], thread: int) -> None:
