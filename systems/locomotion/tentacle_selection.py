@@ -146,28 +146,54 @@ class TentacleSelection(System):
         replayed = world.physics.kinematic_creatures(len(c))  # their strokes drive nothing
         live = np.flatnonzero(~replayed[creature])  # tentacle rows worth classifying
         to_goal, to_base, pull, cos = self._classified(world, live, ~replayed & g.has_goal)
-        has_goal = g.has_goal[creature]
-        driving_now = s.driving
-        if driving_now.any():
-            wrong_side = (g.gait[creature] == self.coordinated) & np.where(
-                s.mode == PULL, cos < -ABORT_MARGIN, cos > ABORT_MARGIN
-            )
-            abort = driving_now & (~has_goal | wrong_side) & ~replayed[creature]
-            for row in np.flatnonzero(abort):
-                self._abort(world, int(row))
-        driving = np.bincount(creature, weights=s.driving, minlength=len(c))
-        idle_goal = g.has_goal & (driving < g.drivers) & ~replayed
-        if not idle_goal.any():
-            return
-        cyclic = g.gait == self.cyclic
-        for row in np.flatnonzero(idle_goal & cyclic & (driving == 0)):
+        for row in self._aborts(creature, cos, replayed):
+            self._abort(world, int(row))
+        first, ready = self._starts(world.time, creature, replayed)
+        for row in first:  # cyclic gaits: the next tentacle in turn
             k = int(c.first_tentacle[row] + g.next_driver[row])
             self._start(world, k, Mode.PULL if pull[k] else Mode.PUSH, orient=None)
             g.next_driver[row] = (g.next_driver[row] + 1) % c.tentacles[row]
-        stagger = STROKE_SECONDS / (g.speed * g.drivers)
-        ready = idle_goal & ~cyclic & (world.time - g.last_start >= stagger)
-        for row in np.flatnonzero(ready):
+        for row in ready:  # the others: the best placed free tentacle
             self._start_best(world, int(row), cos, pull, to_goal, to_base)
+
+    def _aborts(self, creature: np.ndarray, cos: np.ndarray, replayed: np.ndarray) -> np.ndarray:
+        """Tentacle rows whose stroke stops: their creature lost its goal, or (coordinated
+        gaits) the goal is now well on the wrong side of the stroke."""
+        s, g = self.strokes, self.gaits
+        fast = KERNELS.get()
+        if fast is not None:  # the same rows in one pass
+            return np.asarray(fast.aborts(creature, g.has_goal, s.driving, g.gait,
+                                          self.coordinated, s.mode, PULL, cos, ABORT_MARGIN,
+                                          replayed))  # fmt: skip
+        if not s.driving.any():
+            return np.zeros(0, dtype=np.int64)
+        wrong_side = (g.gait[creature] == self.coordinated) & np.where(
+            s.mode == PULL, cos < -ABORT_MARGIN, cos > ABORT_MARGIN
+        )
+        abort = s.driving & (~g.has_goal[creature] | wrong_side) & ~replayed[creature]
+        return np.flatnonzero(abort)
+
+    def _starts(
+        self, now: float, creature: np.ndarray, replayed: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """(cyclic, ready) creature rows that start a stroke now: with a goal, simulated,
+        fewer tentacles driving than their drivers; cyclic ones with none driving, the
+        others a stagger after their last start."""
+        s, g = self.strokes, self.gaits
+        fast = KERNELS.get()
+        if fast is not None:  # the same rows in one pass
+            first, ready = fast.starts(creature, s.driving, g.has_goal, g.drivers, replayed,
+                                       g.gait, self.cyclic, g.speed, g.last_start, now,
+                                       STROKE_SECONDS)  # fmt: skip
+            return np.asarray(first), np.asarray(ready)
+        driving = np.bincount(creature, weights=s.driving, minlength=len(g.has_goal))
+        idle_goal = g.has_goal & (driving < g.drivers) & ~replayed
+        if not idle_goal.any():
+            return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+        cyclic = g.gait == self.cyclic
+        stagger = STROKE_SECONDS / (g.speed * g.drivers)
+        ready = idle_goal & ~cyclic & (now - g.last_start >= stagger)
+        return np.flatnonzero(idle_goal & cyclic & (driving == 0)), np.flatnonzero(ready)
 
     def _classified(
         self, world: Host, live: np.ndarray, driven: np.ndarray

@@ -332,3 +332,34 @@ def test_a_crowd_chooses_the_same_strokes_with_and_without_the_kernel(
         make_world, KERNELS, monkeypatch, crowd_scene(8, seed=1), 120
     )
     np.testing.assert_array_equal(kernel.transforms.pos, numpy_path.transforms.pos)
+
+
+def test_the_kernel_stops_and_starts_the_strokes_numpy_does(
+    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Every case of the decisions: goals lost, replayed creatures, both gaits, both modes,
+    a goal on the wrong side, strokes not yet due."""
+    world = make_world(crowd_scene(12, seed=1))
+    world.step(60)
+    system = next(s for s in world.schedule if isinstance(s, TentacleSelection))
+    g, s = system.gaits, system.strokes
+    creature = world.tentacles.creature_row
+    rng = np.random.default_rng(8)
+    g.gait[:] = np.where(np.arange(len(g.gait)) % 2, system.cyclic, system.coordinated)
+    g.has_goal[[1, 4]] = False
+    g.last_start[:] = world.time - rng.uniform(0.0, 4.0, len(g.last_start))
+    s.driving[:] = rng.random(len(s.driving)) < 0.12
+    s.mode[:] = np.where(rng.random(len(s.mode)) < 0.5, int(Mode.PULL), int(Mode.PUSH))
+    cos = rng.uniform(-1.0, 1.0, len(creature))
+    replayed = np.zeros(len(g.gait), bool)
+    replayed[[2, 7]] = True
+    found = []
+    for backend in ("auto", "numpy"):
+        monkeypatch.setattr(KERNELS, "backend", backend)
+        aborts = system._aborts(creature, cos, replayed)
+        first, ready = system._starts(world.time, creature, replayed)
+        found.append([aborts.tolist(), first.tolist(), ready.tolist()])
+    assert found[0] == found[1]
+    aborts, first, ready = found[0]
+    assert aborts and first and ready  # every decision taken somewhere
+    assert not {2, 7} & ({int(creature[k]) for k in aborts} | set(first) | set(ready))
