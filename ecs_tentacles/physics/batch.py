@@ -57,9 +57,11 @@ class Scratch:
     data: mujoco.MjData
     forced: bool = False  # applied forces were written into `data` (zero them next time)
     warnings: np.ndarray = field(init=False)  # `data.warning.number`, looked up once
+    no_warnings: bytes = field(init=False)  # its bytes when nothing was raised
 
     def __post_init__(self) -> None:
         self.warnings = self.data.warning.number
+        self.no_warnings = bytes(self.warnings.nbytes)
 
 
 class Batch:
@@ -375,8 +377,9 @@ class Batch:
             d.xfrc_applied[:] = 0.0
             scratch.forced = False
         mujoco.mj_setState(m, d, vector, STATE)
-        warnings = scratch.warnings
-        warnings[:] = 0
+        raised, none = scratch.warnings, scratch.no_warnings
+        if raised.tobytes() != none:  # (a bytes compare: a third of `.any()`'s time)
+            raised[:] = 0
         try:
             mujoco.mj_step(m, d, nstep=substeps)
         except mujoco.FatalError as exc:
@@ -384,8 +387,12 @@ class Batch:
             mujoco.mj_resetData(m, d)
             return False
         mujoco.mj_getState(m, d, vector, STATE)
-        self.warnings[row] += warnings
-        self.deepest[row] = d.contact.dist.min() if d.ncon else np.inf
+        if raised.tobytes() != none:
+            self.warnings[row] += raised
+            raised[:] = 0
+        # the deepest contact (NaN, from a state gone bad, is failed by the health check's
+        # velocity test first); a list's min is twice as fast as numpy's for a few contacts
+        self.deepest[row] = min(d.contact.dist.tolist()) if d.ncon else np.inf
         return True
 
     def _step_reduced(self, rows: np.ndarray, substeps: int, thread: int) -> None:
