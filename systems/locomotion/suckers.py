@@ -30,6 +30,7 @@ from ecs_tentacles.ground import ground_of
 from ecs_tentacles.locomotion.actions import GRIPPING, Kind
 from ecs_tentacles.locomotion.grip import attach, release, sucker_points
 from ecs_tentacles.locomotion.stores import LocomotionStores
+from ecs_tentacles.numeric.optional_kernels import OptionalKernels
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
@@ -37,6 +38,8 @@ if TYPE_CHECKING:
 
 ATTACH_HEIGHT = 0.004  # metres above the ground a sucker may be and still grab
 ATTACH = int(Kind.ATTACH)
+REASONS = ("replayed", "command", "stretch", "reach")  # in the order they are tested
+KERNELS = OptionalKernels("ecs_tentacles.locomotion.sucker_kernels", "ECS_TENTACLES_SUCKERS")
 
 
 class Suckers(System):
@@ -61,7 +64,8 @@ class Suckers(System):
             return
         attached = s.attached
         tip = t.tip_sucker
-        replayed = world.physics.kinematic_creatures(len(world.creatures))[t.creature_row]
+        kinematic = world.physics.kinematic_creatures(len(world.creatures))
+        replayed = kinematic[t.creature_row]
         reaching = np.flatnonzero((action == ATTACH) & ~replayed)
         if len(reaching):
             rows = tip[reaching]
@@ -72,6 +76,16 @@ class Suckers(System):
 
         held = np.flatnonzero(attached)
         if not len(held):
+            return
+        fast = KERNELS.get()
+        if fast is not None:  # the same reasons in one pass
+            reasons = fast.release_reasons(
+                held, s.tentacle_row, t.creature_row, action, GRIPPING, tip, kinematic,
+                s.link_row, s.offset, world.transforms.pos, world.transforms.quat, s.anchor,
+                t.base_row, c.release_stretch, c.release_reach, t.length,
+            )  # fmt: skip
+            for at in np.flatnonzero(reasons)[np.argsort(reasons[reasons > 0], kind="stable")]:
+                release(world, int(s.entity[held[at]]), REASONS[reasons[at] - 1])
             return
         tentacle = s.tentacle_row[held]
         creature = t.creature_row[tentacle]

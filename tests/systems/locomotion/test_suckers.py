@@ -232,3 +232,71 @@ def test_replayed_creatures_hold_no_sucker_and_a_promoted_one_starts_free(
     world.step(1)
     assert not world.physics.kinematic_creatures(len(world.creatures))[row]
     assert not world.suckers.attached[creature_of_sucker == row].any()
+
+
+def test_a_crowd_lets_go_for_the_same_reasons_with_and_without_the_kernel(
+    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from ecs_tentacles.systems.locomotion import suckers
+
+    from ecs_tentacles.creator.crowd import crowd_scene
+
+    assert suckers.KERNELS.get() is not None  # numba comes with the dev extra
+    runs = []
+    for backend in ("auto", "numpy"):
+        monkeypatch.setattr(suckers.KERNELS, "backend", backend)
+        world = make_world(crowd_scene(8, seed=1))
+        recorder = Recorder(world)
+        for frame in range(150):
+            world.step(1)
+            gaits = world.stores["locomotion.creatures"]
+            if frame == 90:  # every held sucker stretched too far
+                gaits.release_stretch[:], stretch = 0.0, gaits.release_stretch.copy()
+            if frame == 91:
+                gaits.release_stretch[:] = stretch
+            if frame == 120:  # every tentacle base too far from its anchor
+                gaits.release_reach[:] = 0.01
+        events = [
+            (name, frame, p["sucker"], p.get("reason"), tuple(p.get("anchor", ())))
+            for name, frame, p in recorder.events
+        ]
+        runs.append((world.transforms.pos.copy(), events))
+    assert_array_equal(runs[0][0], runs[1][0])
+    assert runs[0][1] == runs[1][1]  # the same suckers, frames and reasons, in order
+    reasons = {reason for name, _, _, reason, _ in runs[0][1] if name == "sucker_released"}
+    assert reasons == {"command", "stretch", "reach"}
+
+
+def test_a_sucker_stretched_exactly_to_its_limit_holds_with_and_without_the_kernel(
+    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Limits set to suckers' own stretches: the kernel must find every stretch to the
+    bit for the same suckers to let go."""
+    from ecs_tentacles.systems.locomotion import suckers
+
+    from ecs_tentacles.creator.crowd import crowd_scene
+
+    world = make_world(crowd_scene(8, seed=1))
+    world.step(60)
+    system = next(s for s in world.schedule if isinstance(s, suckers.Suckers))
+    gaits = world.stores["locomotion.creatures"]
+    held = np.flatnonzero(world.suckers.attached)
+    stretch = np.linalg.norm(sucker_points(world, held) - world.suckers.anchor[held], axis=1)
+    creature = world.tentacles.creature_row[world.suckers.tentacle_row[held]]
+    assert len(np.unique(creature)) >= 3
+    gaits.release_reach[:] = 1e9
+    for at, c in enumerate(np.unique(creature)):  # the least stretched sucker sits exactly
+        limit = stretch[creature == c].min()  # on the limit (holds) or one ulp past it
+        gaits.release_stretch[c] = limit if at % 2 else np.nextafter(limit, -np.inf)
+    start = world.snapshot()
+    released = []
+    for backend in ("auto", "numpy"):
+        monkeypatch.setattr(suckers.KERNELS, "backend", backend)
+        world.restore(start)
+        recorder = Recorder(world)
+        system.process(world, world.settings.dt)
+        released.append([(p["sucker"], p["reason"]) for _, _, p in recorder.events])
+    assert released[0] == released[1]
+    let_go = {sucker for sucker, _ in released[0]}
+    assert "stretch" in {reason for _, reason in released[0]}
+    assert len(let_go) < len(held)  # those exactly on their limit hold
