@@ -15,10 +15,13 @@ import numpy as np
 from ecs_tentacles.behaviour import ARRIVALS
 from ecs_tentacles.locomotion.goals import GOAL_WRITES, GoalBook
 from ecs_tentacles.locomotion.stores import LocomotionStores
+from ecs_tentacles.numeric.optional_kernels import OptionalKernels
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
+
+KERNELS = OptionalKernels("ecs_tentacles.locomotion.goal_kernels", "ECS_TENTACLES_GOALS")
 
 
 class Goals(System):
@@ -41,8 +44,13 @@ class Goals(System):
         if not gaits.has_goal.any():
             return
         creatures = world.creatures
-        offset = world.transforms.pos[creatures.mantle_row, :2] - gaits.goal[:, :2]
-        distance_sq = np.einsum("ij,ij->i", offset, offset)
-        reached = gaits.has_goal & (distance_sq <= gaits.goal_radius**2)
-        for row in np.flatnonzero(reached):
+        fast = KERNELS.get()
+        if fast is not None:  # the same creatures in one pass
+            reached = fast.reached(world.transforms.pos, creatures.mantle_row, gaits.goal,
+                                   gaits.goal_radius, gaits.has_goal)  # fmt: skip
+        else:
+            offset = world.transforms.pos[creatures.mantle_row, :2] - gaits.goal[:, :2]
+            distance_sq = np.einsum("ij,ij->i", offset, offset)
+            reached = np.flatnonzero(gaits.has_goal & (distance_sq <= gaits.goal_radius**2))
+        for row in reached:
             world.resource(GoalBook).reach(int(creatures.entity[row]))
