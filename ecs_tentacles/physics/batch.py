@@ -343,13 +343,15 @@ class Batch:
         state, bodies, applied = self.state, self.model_bodies, self.applied
         xpos, xquat, clock = self.xpos, self.xquat, time.perf_counter
         took = np.zeros(len(rows))
+        scratch.warnings[:] = 0  # `_advance` clears them after a row that raised one
+        began = clock()
         for at, row in enumerate(rows.tolist()):
-            began = clock()
             write_overlay(self, m, row)
             if self._advance(scratch, row, state[row], applied.get(row), substeps):
                 xpos[row] = d.xpos[bodies]
                 xquat[row] = d.xquat[bodies]
-            took[at] = clock() - began
+            ended = clock()
+            took[at], began = ended - began, ended
         self._took(rows, FULL, took, substeps)
 
     def _took(self, rows: np.ndarray, tier: int, seconds: np.ndarray, substeps: int) -> None:
@@ -377,9 +379,7 @@ class Batch:
             d.xfrc_applied[:] = 0.0
             scratch.forced = False
         mujoco.mj_setState(m, d, vector, STATE)
-        raised, none = scratch.warnings, scratch.no_warnings
-        if raised.tobytes() != none:  # (a bytes compare: a third of `.any()`'s time)
-            raised[:] = 0
+        raised, none = scratch.warnings, scratch.no_warnings  # zero: cleared by the caller
         try:
             mujoco.mj_step(m, d, nstep=substeps)
         except mujoco.FatalError as exc:
@@ -387,7 +387,7 @@ class Batch:
             mujoco.mj_resetData(m, d)
             return False
         mujoco.mj_getState(m, d, vector, STATE)
-        if raised.tobytes() != none:
+        if raised.tobytes() != none:  # (a bytes compare: a fifth of `.any()`'s time)
             self.warnings[row] += raised
             raised[:] = 0
         # the deepest contact (NaN, from a state gone bad, is failed by the health check's
@@ -422,6 +422,7 @@ class Batch:
         stepped = np.zeros(len(rows), dtype=bool)
         took = np.zeros(len(rows))
         shared = time.perf_counter() - began
+        scratch.warnings[:] = 0  # `_advance` clears them after a row that raised one
         for at, row in enumerate(rows.tolist()):
             began = time.perf_counter()
             split = reduced.write_overlay(self, m, row, servos, at)
