@@ -265,7 +265,7 @@ class Batch:
             guess, steps = 2e-6 * (nv + 1.0), 1.0 / REDUCED_RATE
         else:  # (asking MuJoCo's model for nv took 5 us right after a step)
             guess, steps = self._full_guess, 1.0
-        cost = np.where(measured > 0.0, measured, guess)
+        cost = np.asarray(np.where(measured > 0.0, measured, guess))
         return cost if steps == 1.0 else cost * steps
 
     def scratch_for(self, thread: int, tier: int = FULL) -> Scratch:
