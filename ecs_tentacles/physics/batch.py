@@ -21,7 +21,6 @@ from __future__ import annotations
 import copy
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import mujoco
@@ -35,6 +34,7 @@ from ecs_tentacles.physics.model import (
     PROXY_SLOTS,
     ModelLayout,
 )
+from ecs_tentacles.physics.scratch import Scratch
 from ecs_tentacles.physics.state_layout import STATE, S, state_slices, write_overlay
 from ecs_tentacles.physics.tiers import FULL, REDUCED, REDUCED_RATE
 
@@ -47,21 +47,6 @@ WARNING_KINDS = len(mujoco.MjData(mujoco.MjModel.from_xml_string("<mujoco/>")).w
 
 def _ids(model: mujoco.MjModel, kind: mujoco.mjtObj, names: list[str]) -> np.ndarray:
     return np.array([mujoco.mj_name2id(model, kind, n) for n in names], dtype=np.int64)
-
-
-@dataclass
-class Scratch:
-    """One stepping thread's copy of a batch's model and its one MjData."""
-
-    model: mujoco.MjModel
-    data: mujoco.MjData
-    forced: bool = False  # applied forces were written into `data` (zero them next time)
-    warnings: np.ndarray = field(init=False)  # `data.warning.number`, looked up once
-    no_warnings: bytes = field(init=False)  # its bytes when nothing was raised
-
-    def __post_init__(self) -> None:
-        self.warnings = self.data.warning.number
-        self.no_warnings = bytes(self.warnings.nbytes)
 
 
 class Batch:
