@@ -178,10 +178,7 @@ class LevelOfDetail:
             return
         fits = len(roster) <= self.settings.full  # everyone fits the full budget
         if not self.enabled or fits:  # everyone full (at once, if that just became so)
-            if (roster.tier == FULL).all():  # as they were: only the hold counters move
-                self.held += 1
-            else:
-                self._move(world, np.full(len(roster), FULL, dtype=np.int8))
+            self._move(world, np.full(len(roster), FULL, dtype=np.int8))
             return
         count = len(roster)
         pos, _, centre, radius = self.proxies.sense(world.transforms, world.frame)
