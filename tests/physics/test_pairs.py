@@ -2,11 +2,15 @@
 
 from __future__ import annotations
 
+import functools
+from collections.abc import Callable
+from typing import Any
+
 import numpy as np
 import pytest
 from numpy.testing import assert_array_equal
 
-from ecs_tentacles.physics.pairs import DENSE_PAIRS, NearPairCache, near_pairs
+from ecs_tentacles.physics.pairs import DENSE_PAIRS, NearPairCache, near_pairs, spheres_within
 
 
 def _crowd(rng: np.random.Generator, n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -57,21 +61,28 @@ def test_small_crowds_and_bad_slack() -> None:
         NearPairCache(slack=0.0)
 
 
+def _by_backend(monkeypatch: pytest.MonkeyPatch, call: Callable[[], Any]) -> list[Any]:
+    """`call()` with the kernels, then with numpy: [kernel's answer, numpy's]."""
+    from ecs_tentacles.physics import pairs as module
+
+    found = []
+    for backend in ("auto", "numpy"):
+        monkeypatch.setattr(module.KERNELS, "backend", backend)
+        if backend == "auto":
+            assert module.KERNELS.get() is not None  # numba comes with the dev extra
+        found.append(call())
+    return found
+
+
 @pytest.mark.parametrize("dimensions", [2, 3])
 def test_the_sphere_test_kernel_gives_the_numpy_answers(
     dimensions: int, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    from ecs_tentacles.physics import pairs as module
-
-    assert module.KERNELS.get() is not None  # numba comes with the dev extra
     rng = np.random.default_rng(7)
     centre, radius = _crowd(rng, 600)
     centre = centre[:, :dimensions]
     a, b = rng.integers(0, 600, 5000), rng.integers(0, 600, 5000)
-    found = []
-    for backend in ("auto", "numpy"):
-        monkeypatch.setattr(module.KERNELS, "backend", backend)
-        found.append(module.spheres_within(centre, radius, a, b, 0.3))
+    found = _by_backend(monkeypatch, lambda: spheres_within(centre, radius, a, b, 0.3))
     assert_array_equal(found[0], found[1])
     assert 0 < found[0].sum() < len(a)
 
@@ -80,9 +91,6 @@ def test_the_sphere_test_kernel_gives_the_numpy_answers(
 def test_a_small_crowds_pairs_are_the_same_with_the_kernel_and_numpy(
     dimensions: int, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    from ecs_tentacles.physics import pairs as module
-
-    assert module.KERNELS.get() is not None  # numba comes with the dev extra
     rng = np.random.default_rng(11)
     for n in (0, 1, 2, 16, DENSE_PAIRS):
         centre, radius = _crowd(rng, n)
@@ -90,10 +98,7 @@ def test_a_small_crowds_pairs_are_the_same_with_the_kernel_and_numpy(
         if n > 2:  # two spheres exactly `margin` apart (not near) and one NaN (never near)
             radius[1] = np.linalg.norm(centre[1] - centre[0]) - radius[0] - 0.3
             centre[2] = np.nan
-        found = []
-        for backend in ("auto", "numpy"):
-            monkeypatch.setattr(module.KERNELS, "backend", backend)
-            found.append(near_pairs(centre, radius, 0.3))
+        found = _by_backend(monkeypatch, functools.partial(near_pairs, centre, radius, 0.3))
         for kernel, numpy in zip(found[0], found[1], strict=True):
             assert kernel.dtype == numpy.dtype
             assert_array_equal(kernel, numpy)
