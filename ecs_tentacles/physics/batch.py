@@ -326,18 +326,18 @@ class Batch:
         scratch = self.scratch_for(thread, tier)
         m, d = scratch.model, scratch.data
         state, bodies, applied = self.state, self.model_bodies, self.applied
-        xpos, xquat, clock = self.xpos, self.xquat, time.perf_counter
-        took = np.zeros(len(rows))
+        xpos, xquat, clock, cost = self.xpos, self.xquat, time.perf_counter, self.step_cost
         scratch.warnings[:] = 0  # `_advance` clears them after a row that raised one
         began = clock()
-        for at, row in enumerate(rows.tolist()):
+        for row in rows.tolist():
             write_overlay(self, m, row)
             if self._advance(scratch, row, state[row], applied.get(row), substeps):
                 xpos[row] = d.xpos[bodies]
                 xquat[row] = d.xquat[bodies]
             ended = clock()
-            took[at], began = ended - began, ended
-        self._took(rows, FULL, took, substeps)
+            # `_took`'s running mean, a row at a time (scalars: no arrays per share)
+            took, last, began = (ended - began) / substeps, cost[row, FULL], ended
+            cost[row, FULL] = took if last == 0.0 else 0.75 * last + 0.25 * took
 
     def _took(self, rows: np.ndarray, tier: int, seconds: np.ndarray, substeps: int) -> None:
         """Each of `rows`' `substeps` steps at `tier` took `seconds` (per row): into their

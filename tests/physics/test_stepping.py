@@ -1,0 +1,75 @@
+"""Shares of rows handed out to the stepping threads, and the step costs they are cut by."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+import pytest
+
+from ecs_tentacles.physics.stepping import Segment, Work, plan
+from ecs_tentacles.physics.tiers import FULL
+from ecs_tentacles.world import World
+
+
+def _crawlers(n: int) -> dict[str, Any]:
+    """`n` small creatures far apart, each crawling to a goal."""
+    return {
+        "version": 1,
+        "creatures": [
+            {
+                "name": f"c{i}",
+                "position": [3.0 * i, 0.0],
+                "tentacles": {"count": 3, "links": 4},
+                "goals": [{"position": [3.0 * i, 2.0]}],
+            }
+            for i in range(n)
+        ],
+    }
+
+
+def _shares(work: Work) -> list[Segment]:
+    shares = []
+    while (share := work.take()) is not None:
+        shares.append(share)
+    return shares
+
+
+@pytest.mark.parametrize("threads", [1, 2, 3])
+def test_every_row_is_handed_out_once_in_order(
+    make_world: Callable[..., World], threads: int
+) -> None:
+    world = make_world(_crawlers(5))
+    physics = world.physics
+    segments = plan(physics.batches, physics.active, physics.tier, threads)
+    shares = _shares(Work(segments, threads))
+    handed = [(id(s.batch), int(r)) for s in shares for r in s.rows]
+    planned = [(id(s.batch), int(r)) for s in segments for r in s.rows]
+    assert handed == planned
+
+
+def test_shares_shrink_toward_the_end_and_cover_their_cost() -> None:
+    cost = np.full(16, 1.0)  # 16 rows of equal cost, 2 threads
+    segment = Segment(batch=None, rows=np.arange(16), tier=FULL, cost=cost)  # type: ignore[arg-type]
+    sizes = [len(share.rows) for share in _shares(Work([segment], 2))]
+    assert sum(sizes) == 16
+    assert sizes[0] == 4  # a quarter of what is left: half of it divided among 2 threads
+    assert sizes == sorted(sizes, reverse=True) and sizes[-1] == 1
+
+
+def test_stepped_rows_keep_a_running_mean_of_their_step_time(
+    make_world: Callable[..., World],
+) -> None:
+    world = make_world(_crawlers(3), threads=2)
+    physics = world.physics
+    batch = physics.batches[0]
+    rows = np.array([int(physics.row_of[i]) for i in range(3)])
+    assert (batch.step_cost[rows, FULL] == 0.0).all()  # nothing measured before a step
+    world.step(1)
+    first = batch.step_cost[rows, FULL].copy()
+    assert (first > 0.0).all() and (first < 0.05).all()  # seconds per substep
+    world.step(1)
+    second = batch.step_cost[rows, FULL]
+    assert (second != first).all()  # a mean moved by the new step: 0.75 old + 0.25 new
+    assert (second > 0.75 * first).all()
