@@ -34,6 +34,7 @@ from typing import TYPE_CHECKING
 import mujoco
 import numpy as np
 
+from ecs_tentacles.numeric.optional_kernels import OptionalKernels
 from ecs_tentacles.physics.state_layout import STATE, Rows, size_proxies, state_slices
 
 if TYPE_CHECKING:
@@ -52,6 +53,9 @@ class Servos:
 
 
 S = mujoco.mjtState
+# the maps' sums by numba when installed (`physics.reduced_kernels`); =numpy: numpy's
+KERNELS = OptionalKernels("ecs_tentacles.physics.reduced_kernels", "ECS_TENTACLES_REDUCED")
+_NO_CLIP = np.zeros(0)  # the kernel's bounds when a map is not clipped
 # The reduced servos' gains over the full ones' (module docstring). The servos in series
 # (stiffness 1 / sum 1 / kp) had to be softened to 0.8 to crawl as fast as the full
 # creature, and softening is not the same everywhere: under a heavy mantle the reduced
@@ -231,6 +235,11 @@ class ReducedModel:
         source, target = self._inputs
         out[:, target] = full_states[:, source]
         source, target = self._controls
+        fast = KERNELS.get()
+        if fast is not None:  # the same sums, the interpreter's lock released
+            fast.group_sums_into(full_states, source, *self._fit_sums, _NO_CLIP, _NO_CLIP,
+                                 out, target)  # fmt: skip
+            return
         out[:, target] = _group_sums(full_states[:, source], *self._fit_sums)
 
     def expand_state(self, reduced_state: np.ndarray, out: np.ndarray) -> None:
@@ -243,11 +252,20 @@ class ReducedModel:
         state) `out`, in place; each row's bits as if expanded alone."""
         source, target = self._shown
         out[:, target] = reduced_states[:, source]
-        source, target = self._angles
-        angles = _group_sums(reduced_states[:, source], *self._expand_sums)
-        out[:, target] = np.minimum(np.maximum(angles, self._low, out=angles), self.limit)
-        source, target = self._speeds
-        out[:, target] = _group_sums(reduced_states[:, source], *self._expand_sums)
+        fast = KERNELS.get()
+        if fast is not None:  # the same sums and clip, the interpreter's lock released
+            source, target = self._angles
+            fast.group_sums_into(reduced_states, source, *self._expand_sums, self._low,
+                                 self.limit, out, target)  # fmt: skip
+            source, target = self._speeds
+            fast.group_sums_into(reduced_states, source, *self._expand_sums, _NO_CLIP,
+                                 _NO_CLIP, out, target)  # fmt: skip
+        else:
+            source, target = self._angles
+            angles = _group_sums(reduced_states[:, source], *self._expand_sums)
+            out[:, target] = np.minimum(np.maximum(angles, self._low, out=angles), self.limit)
+            source, target = self._speeds
+            out[:, target] = _group_sums(reduced_states[:, source], *self._expand_sums)
         out[:, self.full_slices[int(S.mjSTATE_WARMSTART)]] = 0.0
 
     # -- model values ----------------------------------------------------------------
