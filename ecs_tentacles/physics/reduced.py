@@ -55,7 +55,6 @@ class Servos:
 S = mujoco.mjtState
 # the maps' sums by numba when installed (`physics.reduced_kernels`); =numpy: numpy's
 KERNELS = OptionalKernels("ecs_tentacles.physics.reduced_kernels", "ECS_TENTACLES_REDUCED")
-_NO_CLIP = np.zeros(0)  # the kernel's bounds when a map is not clipped
 # The reduced servos' gains over the full ones' (module docstring). The servos in series
 # (stiffness 1 / sum 1 / kp) had to be softened to 0.8 to crawl as fast as the full
 # creature, and softening is not the same everywhere: under a heavy mantle the reduced
@@ -85,6 +84,11 @@ DAMPING_CAP = 1.0
 # 7.6 (strength 400): 4 is the undamped limit of the integrator (omega h <= 2).
 STIFF_STEP = 4.0
 MAX_SPLIT = 64  # at most this many shorter steps (a script's gain far past the schema's)
+_NO_CLIP = np.zeros(0)  # the map kernel's bounds when a map is not clipped
+# the servos kernel's constants, in its order
+_SERVO_CONSTANTS = np.array(
+    [STIFFNESS_GAIN, DAMPING_GAIN, DAMPING_CAP, STIFF_STEP, MAX_SPLIT], dtype=np.float64
+)
 
 
 def _expansion(chain: Chain) -> tuple[np.ndarray, np.ndarray]:
@@ -277,6 +281,15 @@ class ReducedModel:
         gain is not finite: the health check sees that failure). Summed group member by
         group member, not by a matrix product, so a row gets the same bits whatever rows
         it is computed with (a frame's rows are shared among threads as they free up)."""
+        fast = KERNELS.get()
+        if fast is not None:  # the same numbers, the interpreter's lock released
+            rows, servos = len(kp), len(self._members)
+            gains, damping = np.empty((rows, servos)), np.empty((rows, servos))
+            split = np.empty(rows, dtype=np.int64)
+            fast.servos(kp, kv, self.full_u, self._members, self._weights,
+                        self._stiff_per_kp, self._critical_per_sqrt_kp, _SERVO_CONSTANTS,
+                        gains, damping, split)  # fmt: skip
+            return Servos(gains, damping, torque[:, self._torque_u], split)
         full = self.full_u
         compliance = _group_sums(1.0 / np.maximum(kp[:, full], 1e-12), self._members, self._weights)
         gains = STIFFNESS_GAIN / compliance

@@ -1,16 +1,18 @@
-"""The numba kernel of the reduced tier's maps (`physics.reduced`): the full servo
-commands pulled into a reduced state, and a reduced state's joints shown on the full
-skeleton, each a weighted sum over a group of columns.
+"""The numba kernels of the reduced tier (`physics.reduced`): its maps (the full servo
+commands pulled into a reduced state, a reduced state's joints shown on the full
+skeleton, each a weighted sum over a group of columns) and its servos' gains.
 
 Optional, as the other kernels are: `ReducedModel` imports this module only when numba
 is installed and falls back to numpy otherwise; both give the same numbers bit for bit
 (the same products summed in the same order, the same clip; tests/physics/
-test_reduced_kernels.py compares them). The maps run on the stepping threads, once a
+test_reduced_kernels.py compares them). Both run on the stepping threads, once a
 share: numpy's passes there hold the interpreter's lock, which the other thread then
-waits for between its steps; the kernel releases it.
+waits for between its steps; the kernels release it.
 """
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 from numba import njit
@@ -42,3 +44,53 @@ def group_sums_into(
                 if total > high[k]:
                     total = high[k]
             out[r, out_columns[k]] = total
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _softest(gain: float) -> float:
+    """1 / max(gain, 1e-12), NaN kept (as numpy's `1.0 / np.maximum(gain, 1e-12)`)."""
+    return 1.0 / (gain if gain >= 1e-12 or math.isnan(gain) else 1e-12)
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def servos(
+    kp: np.ndarray,
+    kv: np.ndarray,
+    full_u: np.ndarray,
+    members: np.ndarray,
+    weights: np.ndarray,
+    stiff_per_kp: np.ndarray,
+    critical_per_sqrt_kp: np.ndarray,
+    constants: np.ndarray,
+    gains: np.ndarray,
+    damping: np.ndarray,
+    split: np.ndarray,
+) -> None:
+    """`ReducedModel.servos`' numbers for each row of `kp` / `kv` (full actuators), into
+    `gains`, `damping` (rows, reduced servos) and `split` (rows,); `constants` are the
+    stiffness gain, damping gain, damping cap, stiff step and most splits. Division by
+    zero gives infinities, as numpy's (error_model="numpy")."""
+    stiffness_gain, damping_gain, cap = constants[0], constants[1], constants[2]
+    stiff_step, most = constants[3], constants[4]
+    width = members.shape[1]
+    for r in range(kp.shape[0]):
+        stiffest = -np.inf
+        for k in range(members.shape[0]):
+            compliance = _softest(kp[r, full_u[members[k, 0]]]) * weights[k, 0]
+            matched = _softest(kv[r, full_u[members[k, 0]]]) * weights[k, 0]
+            for p in range(1, width):
+                compliance += _softest(kp[r, full_u[members[k, p]]]) * weights[k, p]
+                matched += _softest(kv[r, full_u[members[k, p]]]) * weights[k, p]
+            gain = stiffness_gain / compliance
+            gains[r, k] = gain
+            stiff = gain * stiff_per_kp[k]
+            if not math.isnan(stiffest) and (stiff > stiffest or math.isnan(stiff)):
+                stiffest = stiff  # np.max: NaN wins
+            matched_kv = 1.0 / matched
+            critical = math.sqrt(gain) * critical_per_sqrt_kp[k]
+            soft = damping_gain * matched_kv
+            capped = stiffness_gain * matched_kv + cap * critical
+            damping[r, k] = soft if soft <= capped or math.isnan(soft) else capped
+        split[r] = 1
+        if stiffest > stiff_step and stiffest < np.inf:
+            split[r] = int(min(math.ceil(math.sqrt(stiffest / stiff_step)), most))

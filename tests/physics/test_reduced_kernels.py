@@ -71,3 +71,37 @@ def test_the_maps_are_numpys_bit_for_bit(
         finite = angles[np.isfinite(angles)]
         assert (np.abs(finite) <= reduced.limit.max()).all()  # clipped into the limits
         assert (np.abs(finite) == reduced.limit.max()).any()
+
+
+@pytest.mark.parametrize("rows", [0, 1, 9])
+def test_the_servos_are_numpys_bit_for_bit(
+    reduced: ReducedModel, monkeypatch: pytest.MonkeyPatch, rows: int
+) -> None:
+    actuators = int(reduced.full_u.max()) + 1
+    rng = np.random.default_rng(3)
+    kp = rng.uniform(5.0, 40.0, (rows, actuators))  # the schema's strengths
+    kv = rng.uniform(0.05, 2.0, (rows, actuators))
+    torque = rng.uniform(1.0, 5.0, (rows, actuators))
+    edges = [np.nan, np.inf, 0.0, -0.0, -3.0, 1e-12, np.nextafter(1e-12, 0.0), 1e-300]
+    for row in range(rows):  # an edge in some rows' groups, the rest ordinary
+        at = rng.choice(reduced.full_u, size=len(edges), replace=False)  # in the groups
+        kp[row, at] = edges if row % 3 == 1 else kp[row, at]
+        kv[row, at] = edges if row % 3 == 2 else kv[row, at]
+    if rows > 3:
+        kp[3] *= 1e4  # stiff: the step split in several
+        kp[4] = 1e12  # past any schema value: the most splits
+    results = []
+    for backend in ("auto", "numpy"):
+        monkeypatch.setattr(reduced_module.KERNELS, "backend", backend)
+        with np.errstate(all="ignore"):
+            servos = reduced.servos(kp, kv, torque)
+        results.append(servos)
+    kernel, numpy = results
+    for name in ("kp", "kv", "torque", "split"):
+        got, want = getattr(kernel, name), getattr(numpy, name)
+        assert got.dtype == want.dtype and got.shape == want.shape
+        assert got.tobytes() == want.tobytes(), name
+    if rows > 4:
+        assert kernel.split[3] > 1 and kernel.split[4] == reduced_module.MAX_SPLIT
+        assert np.isnan(kernel.kp[1]).any() and not np.isnan(kernel.kp[0]).any()
+        assert np.isnan(kernel.kv[2]).any()  # the edges reached the kernel's gains
