@@ -242,10 +242,18 @@ class TerrainGround:
         """(n,) whose sphere (`centres` (n, 3), `reach` (n,)) meets an obstacle: bounding
         spheres cull, then each obstacle's signed distance decides."""
         near = np.zeros(len(centres), dtype=bool)
-        for solid in self.solids:
-            close = np.sum((centres - solid.position) ** 2, axis=1) <= (reach + solid.bound) ** 2
-            rows = np.flatnonzero(close & ~near)
+        if not self.solids:
+            return near
+        # every sphere against every obstacle's bounding sphere at once (each distance
+        # summed over x, y, z as for one obstacle alone): only the obstacles something
+        # comes near are asked for their signed distance
+        positions, bounds = self._positions(), self._bounds()[1]
+        apart = np.sum((centres[:, None, :] - positions[None]) ** 2, axis=2)
+        close = apart <= (reach[:, None] + bounds[None]) ** 2
+        for index in np.flatnonzero(close.any(axis=0)).tolist():
+            rows = np.flatnonzero(close[:, index] & ~near)
             if len(rows):
+                solid = self.solids[index]
                 near[rows] = solid.signed_distance(centres[rows]) <= reach[rows]
         return near
 

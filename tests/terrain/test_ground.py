@@ -104,3 +104,32 @@ def test_the_height_kernel_gives_the_numpy_numbers_bit_for_bit(
         found.append(ground.height(points))
     np.testing.assert_array_equal(found[0], found[1])
     assert found[0][-1] == found[0][-2] == field_.heights.min()  # outside: the lowest
+
+
+def test_a_sphere_touches_an_obstacle_as_each_obstacle_alone_decides() -> None:
+    """Culling every obstacle at once drops no touch and adds none: sphere by sphere, an
+    obstacle whose bounding sphere it meets and whose signed distance is within its reach
+    (a convex mesh's is the planes' lower bound: the cull counts too)."""
+    rng = np.random.default_rng(5)
+    turn = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+    cube = np.array([[x, y, z] for x in (-0.3, 0.3) for y in (-0.3, 0.3) for z in (0, 0.6)])
+    solids = (
+        Solid("box", np.array([1.0, 0.0, 0.5]), turn, (0.1, 2.0, 0.5)),
+        Solid("sphere", np.array([-2.0, 1.0, 0.2]), np.eye(3), (0.8,)),
+        Solid("cylinder", np.array([0.0, -3.0, 0.0]), np.eye(3), (0.5, 1.0)),
+        Solid("mesh", np.array([3.0, 3.0, 0.0]), np.eye(3), pieces=(cube,),
+              planes=(convex_planes(cube),)),
+    )  # fmt: skip
+    ground = TerrainGround(solids=solids)
+    centres = rng.uniform([-5.0, -5.0, -0.5], [5.0, 5.0, 1.5], size=(400, 3))
+    reach = rng.uniform(0.0, 1.5, size=400)
+    reach[:5] = 0.0  # a point: inside an obstacle or not
+    touched = ground.touches_obstacle(centres, reach)
+    each = [
+        (np.linalg.norm(centres - solid.position, axis=1) <= reach + solid.bound)
+        & (solid.signed_distance(centres) <= reach)
+        for solid in solids
+    ]
+    assert (touched == np.any(each, axis=0)).all()
+    assert all(e.any() for e in each) and 40 < touched.sum() < 360  # every obstacle, both answers
+    assert not TerrainGround().touches_obstacle(centres, reach).any()  # no obstacles
