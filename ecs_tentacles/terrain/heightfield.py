@@ -36,10 +36,7 @@ class Heightfield:
         """Heights under points `xy` (n, 2), as MuJoCo's triangles give them; past the
         border, the plane at the lowest height that catches what leaves the field."""
         xy = np.asarray(xy, dtype=np.float64)
-        lowest = self.__dict__.get("_lowest")
-        if lowest is None:
-            lowest = float(self.heights.min())
-            object.__setattr__(self, "_lowest", lowest)  # a cache, not a field
+        lowest = self._lowest_height()
         fast = KERNELS.get()
         if fast is not None:  # the same numbers, in one pass instead of twenty
             out = np.empty(len(xy))
@@ -60,8 +57,24 @@ class Heightfield:
         above = h00 + fv * (h10 - h00) + fu * (h11 - h10)
         return np.where(outside, lowest, np.where(lower, below, above))
 
+    def _lowest_height(self) -> float:
+        """The lowest height of the field (made once)."""
+        lowest = self.__dict__.get("_lowest")
+        if lowest is None:
+            lowest = float(self.heights.min())
+            object.__setattr__(self, "_lowest", lowest)  # a cache, not a field
+        return float(lowest)
+
     def slope_normal(self, xy: np.ndarray) -> np.ndarray:
         """Unit surface normals (n, 3) under `xy` (n, 2), from the heights' gradient."""
+        fast = KERNELS.get()
+        if fast is not None:  # the same numbers, in one pass instead of fifteen
+            xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
+            out = np.empty((len(xy), 3))
+            cell = np.array(self.cell, dtype=np.float64)
+            fast.field_normals(self.heights, self.size[0], self.size[1], self._lowest_height(),
+                               cell, xy, out)  # fmt: skip
+            return out
         dx, dy = self.cell
         ex, ey = np.array([0.5 * dx, 0.0]), np.array([0.0, 0.5 * dy])
         gx = (self.height(xy + ex) - self.height(xy - ex)) / dx

@@ -106,6 +106,34 @@ def test_the_height_kernel_gives_the_numpy_numbers_bit_for_bit(
     assert found[0][-1] == found[0][-2] == field_.heights.min()  # outside: the lowest
 
 
+def test_the_normal_kernel_gives_the_numpy_numbers_bit_for_bit(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Inside, on sample lines, within half a cell of the borders and outside the field;
+    signed zeros too (the numpy path adds 0.0 to the coordinate it does not move)."""
+    from ecs_tentacles.terrain import heightfield as module
+
+    rng = np.random.default_rng(8)
+    field_ = Heightfield((6.0, 4.0), rng.uniform(-0.3, 0.5, size=(33, 49)))
+    dx, dy = field_.cell
+    samples = np.linspace(-3.0, 3.0, 49)
+    points = np.vstack([
+        rng.uniform([-3.5, -2.5], [3.5, 2.5], size=(20_000, 2)),
+        np.column_stack([samples, np.linspace(-2.0, 2.0, 49)]),
+        [[3.0 - 0.25 * dx, 0.0], [-3.0, 2.0 - 0.5 * dy], [-0.0, -0.0], [0.0, -50.0]],
+    ])  # fmt: skip
+    assert module.KERNELS.get() is not None  # numba comes with the dev extra
+    found = []
+    for backend in ("auto", "numpy"):
+        monkeypatch.setattr(module.KERNELS, "backend", backend)
+        found.append(field_.slope_normal(points))
+        found.append(field_.slope_normal(points[:, :2][::3]))  # a strided view
+    for kernel, numpy in zip(found[:2], found[2:], strict=True):
+        assert kernel.tobytes() == numpy.tobytes()
+    assert np.allclose(np.linalg.norm(found[0], axis=1), 1.0) and (found[0][:, 2] > 0).all()
+    assert (found[0][-1] == [0.0, 0.0, 1.0]).all()  # outside: the flat lowest plane
+
+
 def test_a_sphere_touches_an_obstacle_as_each_obstacle_alone_decides() -> None:
     """Culling every obstacle at once drops no touch and adds none: sphere by sphere, an
     obstacle whose bounding sphere it meets and whose signed distance is within its reach
