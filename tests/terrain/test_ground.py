@@ -161,3 +161,26 @@ def test_a_sphere_touches_an_obstacle_as_each_obstacle_alone_decides() -> None:
     assert (touched == np.any(each, axis=0)).all()
     assert all(e.any() for e in each) and 40 < touched.sum() < 360  # every obstacle, both answers
     assert not TerrainGround().touches_obstacle(centres, reach).any()  # no obstacles
+
+
+def test_the_normal_under_points_among_obstacles_is_the_slope_of_the_topmost_surface() -> None:
+    """Over the heightfield and over obstacles' tops: the surface's central differences,
+    NORMAL_SPAN either way, normalised; the same bits as asking side by side."""
+    from ecs_tentacles.terrain.ground import NORMAL_SPAN
+
+    rng = np.random.default_rng(9)
+    field_ = Heightfield((8.0, 8.0), rng.uniform(-0.2, 0.3, size=(17, 17)))
+    solids = (
+        Solid("box", np.array([1.0, 0.0, 0.5]), np.eye(3), (0.5, 0.5, 0.5)),
+        Solid("sphere", np.array([-2.0, 1.0, 0.2]), np.eye(3), (0.8,)),
+    )
+    ground = TerrainGround(field_, solids)
+    xy = np.vstack([rng.uniform(-4.5, 4.5, size=(300, 2)), [[1.0, 0.0], [-2.0, 1.0]]])
+    normals = ground.normal_under(xy)
+    ex, ey = np.array([NORMAL_SPAN, 0.0]), np.array([0.0, NORMAL_SPAN])
+    gx = (ground.surface(xy + ex) - ground.surface(xy - ex)) / (2 * NORMAL_SPAN)
+    gy = (ground.surface(xy + ey) - ground.surface(xy - ey)) / (2 * NORMAL_SPAN)
+    n = np.stack([-gx, -gy, np.ones_like(gx)], axis=1)
+    assert normals.tobytes() == (n / np.linalg.norm(n, axis=1, keepdims=True)).tobytes()
+    assert (normals[-2:] == [0.0, 0.0, 1.0]).all()  # on the box's top and the sphere's crown
+    assert (np.abs(normals[:300, :2]) > 1e-6).any(axis=1).sum() > 200  # sloped elsewhere
