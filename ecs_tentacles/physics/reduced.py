@@ -85,10 +85,6 @@ DAMPING_CAP = 1.0
 STIFF_STEP = 4.0
 MAX_SPLIT = 64  # at most this many shorter steps (a script's gain far past the schema's)
 _NO_CLIP = np.zeros(0)  # the map kernel's bounds when a map is not clipped
-# the servos kernel's constants, in its order
-_SERVO_CONSTANTS = np.array(
-    [STIFFNESS_GAIN, DAMPING_GAIN, DAMPING_CAP, STIFF_STEP, MAX_SPLIT], dtype=np.float64
-)
 
 
 def _expansion(chain: Chain) -> tuple[np.ndarray, np.ndarray]:
@@ -286,8 +282,12 @@ class ReducedModel:
             rows, servos = len(kp), len(self._members)
             gains, damping = np.empty((rows, servos)), np.empty((rows, servos))
             split = np.empty(rows, dtype=np.int64)
+            # read now, as numpy's path does: a tool may set another reduced model's gains
+            constants = np.array(
+                [STIFFNESS_GAIN, DAMPING_GAIN, DAMPING_CAP, STIFF_STEP, MAX_SPLIT], np.float64
+            )
             fast.servos(kp, kv, self.full_u, self._members, self._weights,
-                        self._stiff_per_kp, self._critical_per_sqrt_kp, _SERVO_CONSTANTS,
+                        self._stiff_per_kp, self._critical_per_sqrt_kp, constants,
                         gains, damping, split)  # fmt: skip
             return Servos(gains, damping, torque[:, self._torque_u], split)
         full = self.full_u
