@@ -53,7 +53,7 @@ class Servos:
 
 
 S = mujoco.mjtState
-# the maps' sums by numba when installed (`physics.reduced_kernels`); =numpy: numpy's
+# the maps and servo gains by numba when installed (`physics.reduced_kernels`); =numpy: numpy
 KERNELS = OptionalKernels("ecs_tentacles.physics.reduced_kernels", "ECS_TENTACLES_REDUCED")
 # The reduced servos' gains over the full ones' (module docstring). The servos in series
 # (stiffness 1 / sum 1 / kp) had to be softened to 0.8 to crawl as fast as the full
