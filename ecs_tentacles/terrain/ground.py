@@ -88,12 +88,15 @@ class TerrainGround:
             best[near] = np.minimum(best[near], self.solids[k].signed_distance(points[near]))
         return best
 
-    def _under_bounds(self, points: np.ndarray, pad: float) -> Iterator[tuple[int, np.ndarray]]:
+    def _under_bounds(
+        self, points: np.ndarray, pad: float | np.ndarray
+    ) -> Iterator[tuple[int, np.ndarray]]:
         """(solid, rows of `points`) for each solid whose bounding sphere grown by `pad`
-        holds some of `points` (n, 3), or whose bounding circle does for points (n, 2):
-        one array test for all solids, then only the solids that hold any point."""
+        (one for all points, or one per point) holds some of `points` (n, 3), or whose
+        bounding circle does for points (n, 2): one array test for all solids, then only
+        the solids that hold any point."""
         centres, bounds = self._bounds()
-        reach = (bounds + pad) ** 2
+        pads = np.broadcast_to(np.asarray(pad, dtype=np.float64), (len(points),))
         dims = points.shape[1]
         per_chunk = max(1, (1 << 20) // max(len(self.solids), 1))
         for start in range(0, len(points), per_chunk):
@@ -102,6 +105,7 @@ class TerrainGround:
                 gaps = part[:, None, :] - centres[None, :, :]
             else:
                 gaps = part[:, None, :] - self._positions()[None, :, :]
+            reach = (bounds[None, :] + pads[start : start + per_chunk, None]) ** 2
             inside = np.einsum("nkd,nkd->nk", gaps, gaps) <= reach
             for k in np.flatnonzero(inside.any(axis=0)).tolist():
                 yield k, start + np.flatnonzero(inside[:, k])
@@ -245,19 +249,10 @@ class TerrainGround:
         """(n,) whose sphere (`centres` (n, 3), `reach` (n,)) meets an obstacle: bounding
         spheres cull, then each obstacle's signed distance decides."""
         near = np.zeros(len(centres), dtype=bool)
-        if not self.solids:
-            return near
-        # every sphere against every obstacle's bounding sphere at once (each distance
-        # summed over x, y, z as for one obstacle alone): only the obstacles something
-        # comes near are asked for their signed distance
-        positions, bounds = self._positions(), self._bounds()[1]
-        apart = np.sum((centres[:, None, :] - positions[None]) ** 2, axis=2)
-        close = apart <= (reach[:, None] + bounds[None]) ** 2
-        for index in np.flatnonzero(close.any(axis=0)).tolist():
-            rows = np.flatnonzero(close[:, index] & ~near)
+        for k, rows in self._under_bounds(centres, reach):  # each sphere its own pad
+            rows = rows[~near[rows]]
             if len(rows):
-                solid = self.solids[index]
-                near[rows] = solid.signed_distance(centres[rows]) <= reach[rows]
+                near[rows] = self.solids[k].signed_distance(centres[rows]) <= reach[rows]
         return near
 
     def obstacle_spans(self) -> tuple[np.ndarray, np.ndarray]:
