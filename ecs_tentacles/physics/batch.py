@@ -335,15 +335,8 @@ class Batch:
                 xpos[row] = d.xpos[bodies]
                 xquat[row] = d.xquat[bodies]
             ended = clock()
-            # `_took`'s running mean, a row at a time (scalars: no arrays per share)
-            took, last, began = (ended - began) / substeps, cost[row, FULL], ended
-            cost[row, FULL] = took if last == 0.0 else 0.75 * last + 0.25 * took
-
-    def _took(self, rows: np.ndarray, tier: int, seconds: np.ndarray, substeps: int) -> None:
-        """Each of `rows`' `substeps` steps at `tier` took `seconds` (per row): into their
-        `step_cost`, a running mean."""
-        took, last = seconds / substeps, self.step_cost[rows, tier]
-        self.step_cost[rows, tier] = np.where(last == 0.0, took, 0.75 * last + 0.25 * took)
+            _took(cost, row, FULL, (ended - began) / substeps)
+            began = ended
 
     def _advance(
         self,
@@ -430,7 +423,15 @@ class Batch:
             self.xpos[row] = poses[bodies]
             self.xquat[row] = turns[bodies]
         shared = (shared + time.perf_counter() - began) / len(rows) if len(rows) else 0.0
-        self._took(rows, REDUCED, took + shared, substeps)
+        for row, seconds in zip(rows.tolist(), (took + shared).tolist(), strict=True):
+            _took(self.step_cost, row, REDUCED, seconds / substeps)
+
+
+def _took(cost: np.ndarray, row: int, tier: int, seconds: float) -> None:
+    """A step of `row` at `tier` took `seconds`: into `cost` (`Batch.step_cost`), a
+    running mean (scalars, a row at a time: no arrays per share of a frame)."""
+    last = cost[row, tier]
+    cost[row, tier] = seconds if last == 0.0 else 0.75 * last + 0.25 * seconds
 
 
 def without_row(array: np.ndarray, row: int) -> np.ndarray:

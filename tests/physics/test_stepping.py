@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from ecs_tentacles.physics.stepping import Segment, Work, plan
-from ecs_tentacles.physics.tiers import FULL
+from ecs_tentacles.physics.tiers import FULL, REDUCED
 from ecs_tentacles.world import World
 
 
@@ -73,3 +73,17 @@ def test_stepped_rows_keep_a_running_mean_of_their_step_time(
     second = batch.step_cost[rows, FULL]
     assert (second != first).all()  # a mean moved by the new step: 0.75 old + 0.25 new
     assert (second > 0.75 * first).all()
+
+
+def test_reduced_rows_keep_their_step_time_apart(make_world: Callable[..., World]) -> None:
+    scene = {**_crawlers(3), "physics": {"lod": {"full": 0, "reduced": 8, "hold_seconds": 0}}}
+    world = make_world(scene, threads=2)
+    world.step(3)
+    physics = world.physics
+    assert (physics.tier == REDUCED).all()
+    batch = physics.batches[0]
+    rows = np.array([int(physics.row_of[i]) for i in range(3)])
+    before = batch.step_cost[rows, REDUCED].copy()
+    world.step(1)
+    after = batch.step_cost[rows, REDUCED]
+    assert (after > 0.0).all() and (after != before).all() and (after > 0.75 * before).all()
