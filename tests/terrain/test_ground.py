@@ -82,21 +82,29 @@ def test_rays_and_the_topmost_surface() -> None:
     assert flat is not None and flat.tolist() == pytest.approx([1.0, 3.0, 0.0])
 
 
+def _field_and_points(seed: int, edges: list[list[float]]) -> tuple[Heightfield, np.ndarray]:
+    """A 6 x 4 m field of random heights (33 x 49 samples) and points on it for the
+    kernels' tests: 20,000 anywhere (some outside), a diagonal over sample lines, `edges`."""
+    rng = np.random.default_rng(seed)
+    field_ = Heightfield((6.0, 4.0), rng.uniform(-0.3, 0.5, size=(33, 49)))
+    samples = np.linspace(-3.0, 3.0, 49)
+    points = np.vstack([
+        rng.uniform([-3.5, -2.5], [3.5, 2.5], size=(20_000, 2)),
+        np.column_stack([samples, np.linspace(-2.0, 2.0, 49)]),
+        edges,
+    ])  # fmt: skip
+    return field_, points
+
+
 def test_the_height_kernel_gives_the_numpy_numbers_bit_for_bit(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
     """Inside, on sample lines, on the borders and outside the field."""
     from ecs_tentacles.terrain import heightfield as module
 
-    rng = np.random.default_rng(7)
-    field_ = Heightfield((6.0, 4.0), rng.uniform(-0.3, 0.5, size=(33, 49)))
+    field_, points = _field_and_points(7, [[3.0, 0.0], [-3.0, 2.0], [0.0, -2.0],
+                                           [3.0 + 1e-9, 0.0], [0.0, -50.0]])  # fmt: skip
     ground = TerrainGround(field_)
-    samples = np.linspace(-3.0, 3.0, 49)
-    points = np.vstack([
-        rng.uniform([-3.5, -2.5], [3.5, 2.5], size=(20_000, 2)),
-        np.column_stack([samples, np.linspace(-2.0, 2.0, 49)]),
-        [[3.0, 0.0], [-3.0, 2.0], [0.0, -2.0], [3.0 + 1e-9, 0.0], [0.0, -50.0]],
-    ])  # fmt: skip
     assert module.KERNELS.get() is not None  # numba comes with the dev extra
     found = []
     for backend in ("auto", "numpy"):
@@ -113,15 +121,10 @@ def test_the_normal_kernel_gives_the_numpy_numbers_bit_for_bit(
     signed zeros too (the numpy path adds 0.0 to the coordinate it does not move)."""
     from ecs_tentacles.terrain import heightfield as module
 
-    rng = np.random.default_rng(8)
-    field_ = Heightfield((6.0, 4.0), rng.uniform(-0.3, 0.5, size=(33, 49)))
-    dx, dy = field_.cell
-    samples = np.linspace(-3.0, 3.0, 49)
-    points = np.vstack([
-        rng.uniform([-3.5, -2.5], [3.5, 2.5], size=(20_000, 2)),
-        np.column_stack([samples, np.linspace(-2.0, 2.0, 49)]),
-        [[3.0 - 0.25 * dx, 0.0], [-3.0, 2.0 - 0.5 * dy], [-0.0, -0.0], [0.0, -50.0]],
-    ])  # fmt: skip
+    dx, dy = 6.0 / 48, 4.0 / 32  # the field's cell
+    edges = [[3.0 - 0.25 * dx, 0.0], [-3.0, 2.0 - 0.5 * dy], [-0.0, -0.0], [0.0, -50.0]]
+    field_, points = _field_and_points(8, edges)
+    assert field_.cell == (dx, dy)
     assert module.KERNELS.get() is not None  # numba comes with the dev extra
     found = []
     for backend in ("auto", "numpy"):
