@@ -229,10 +229,18 @@ class Renderer:
         """Fill and upload every instance array and the line list."""
         self._refresh()
         pos, quat = self.poses(alpha)
-        if self.camera.follow is not None:  # on the ground under the followed mantle
+        self._aim_at_followed(pos)
+        self._fill(pos, quat)
+
+    def _aim_at_followed(self, pos: np.ndarray) -> None:
+        """The camera's target on the ground under the followed mantle, if one is."""
+        if self.camera.follow is not None:
             under = pos[self.camera.follow]
             height = ground_of(self.world).height(under[None, :2])[0]
             self.camera.target = np.array([under[0], under[1], height])
+
+    def _fill(self, pos: np.ndarray, quat: np.ndarray) -> None:
+        """Every instance array and the line list for body poses `pos`, `quat`, uploaded."""
         skinned = self.view == "skinned"
         m = self.mantle_instances
         m[:, 0:3], m[:, 3:7] = pos[self.mantle_rows], quat[self.mantle_rows]
@@ -331,7 +339,9 @@ class Renderer:
 
     def draw(self, alpha: float = 1.0) -> int:
         """Render into the off-screen target; returns the number of draw calls."""
-        self.upload(alpha)
+        self._refresh()
+        pos, quat = self.poses(alpha)
+        self._aim_at_followed(pos)  # the view depends on it
         self.target.bind()
         gl.glClearColor(*SKY, 1.0)
         gl.glClear(gl.GL_COLOR_BUFFER_BIT | gl.GL_DEPTH_BUFFER_BIT)
@@ -341,6 +351,10 @@ class Renderer:
         eye = tuple(self.camera.eye.astype(np.float32))
         fog = fog_range(self.camera.distance)
         calls = self.scenery.draw(ground_of(self.world), view_projection, eye, LIGHT, fog)
+        # the ground is sent to be rasterised (software GL's threads fill it while this
+        # one fills the creatures' arrays: about 4 ms less of a crowd's 50 ms frame)
+        gl.glFlush()
+        self._fill(pos, quat)
         # the blob shadows: blended over the ground, never hiding what is drawn after
         self.blob_program.use()
         set_matrix(self.blob_program, "u_view_projection", view_projection)

@@ -1,7 +1,12 @@
-"""What is drawn before the creatures: the sky's gradient, then the ground (the plane's
-metre grid, or the ground's meshes: the terrain, the ground beyond it out to the
-horizon and the obstacles, lit: `Ground.meshes`), fogged with distance in
-the sky's horizon colour so the ground joins the sky.
+"""What is drawn before the creatures: the ground (the plane's metre grid, or the
+ground's meshes: the terrain, the ground beyond it out to the horizon and the
+obstacles, lit: `Ground.meshes`), fogged with distance in the sky's horizon colour so
+the ground joins the sky, then the sky's gradient where no ground was drawn.
+
+The sky comes last, at the far plane under a depth test, so only its visible pixels are
+shaded: drawn first it shaded all 1280 x 720 and the ground then covered most of them
+(7.5 of a 53 ms frame in software GL for a crowd framed from above; the pictures are
+the same to the bit).
 
 Reads the world's `Ground` (`ground_of`), the camera's view, the light; writes only the
 framebuffer bound by the caller (`Renderer.draw`) and its own GL objects. The ground's
@@ -81,8 +86,9 @@ class Scenery:
         light: np.ndarray,
         fog: tuple[float, float],
     ) -> int:
-        """The sky, then the ground as `ground` is now; returns the draw calls."""
-        calls = self.draw_sky(view_projection)
+        """The ground as `ground` is now, then the sky; returns the draw calls. The
+        caller has the depth test on and the depth buffer cleared."""
+        calls = 0
         self.build(ground)  # nothing to do unless the terrain was edited
         if ground.extent is None:  # the plane's grid
             self.ground_program.use()
@@ -100,17 +106,18 @@ class Scenery:
             set_fog(self.terrain_program, fog)
             for mesh in self.ground_meshes:
                 calls += mesh.draw()
-        return calls
+        return calls + self.draw_sky(view_projection)
 
     def draw_sky(self, view_projection: np.ndarray) -> int:
-        """The sky's gradient behind everything (no depth written)."""
+        """The sky's gradient at the far plane, on the pixels nothing nearer covers (the
+        depth test passes only where the depth is still the cleared 1.0; none written)."""
         self.sky_program.use()
         set_matrix(self.sky_program, "u_inverse_view_projection", np.linalg.inv(view_projection))
         self.sky_program["u_horizon"] = HORIZON
         self.sky_program["u_zenith"] = ZENITH
-        gl.glDisable(gl.GL_DEPTH_TEST)
+        gl.glDepthFunc(gl.GL_LEQUAL)
         gl.glDepthMask(gl.GL_FALSE)
         calls = self.sky.draw()
         gl.glDepthMask(gl.GL_TRUE)
-        gl.glEnable(gl.GL_DEPTH_TEST)
+        gl.glDepthFunc(gl.GL_LESS)
         return calls

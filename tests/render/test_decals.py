@@ -52,7 +52,7 @@ def test_the_ground_is_warm_and_shadows_darken_it_only_under_creatures(
     r, _, b = lit[8, 8]  # a corner of open ground
     assert r > b + 20  # sand, not the grey-green of a grid floor
     renderer.shadows.update(np.zeros((0, 15), np.float32))
-    renderer.upload = lambda alpha=1.0: None  # draw again as is, without the blobs
+    renderer._fill = lambda pos, quat: None  # draw again as is, without the blobs
     renderer.draw()
     bare = renderer.target.read().astype(int)
     darker = lit.sum(axis=2) < bare.sum(axis=2) - 6
