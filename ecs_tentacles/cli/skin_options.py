@@ -46,7 +46,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="mesh rings per link",
     )
     group.add_argument(
-        "--sides", type=bounded_int(8, MAX_SIDES), default=12, help="mesh sides (a multiple of 4)"
+        "--sides", type=bounded_int(4, MAX_SIDES), default=12, help="mesh sides (a multiple of 4)"
     )
     group.add_argument("--sucker-discs", action="store_true", help="sucker discs underneath")
     group.add_argument(

@@ -55,8 +55,8 @@ class Detail:
             raise ValueError(
                 f"rings_per_link: must be <= {MAX_RINGS_PER_LINK}, got {self.rings_per_link}"
             )
-        if self.sides < 8 or self.sides % 4:
-            raise ValueError(f"sides: must be a multiple of 4 and >= 8, got {self.sides}")
+        if self.sides < 4 or self.sides % 4:
+            raise ValueError(f"sides: must be a multiple of 4 and >= 4, got {self.sides}")
         if self.sides > MAX_SIDES:
             raise ValueError(f"sides: must be <= {MAX_SIDES}, got {self.sides}")
         if self.cap_rings < 1:

@@ -52,7 +52,7 @@ def test_reduced_keys_are_reported(
 @pytest.mark.parametrize(
     ("flags", "message"),
     [
-        (["--sides", "10"], "argument --sides: must be a multiple of 4 and >= 8, got 10"),
+        (["--sides", "10"], "argument --sides: must be a multiple of 4 and >= 4, got 10"),
         (
             ["--rings-per-link", "0"],
             "argument --rings-per-link: must be >= 1, got 0 (see ecs-tentacles export --help)",

@@ -90,3 +90,33 @@ def test_creatures_seen_small_are_drawn_coarse_and_look_the_same(
     assert warm.sum() > 300  # the creature is in the picture
     changed = np.abs(coarse - fine).sum(axis=2) > 60
     assert changed.sum() < 0.15 * warm.sum()  # a few edge pixels differ, not the creature
+
+
+def test_creatures_seen_tiny_have_half_the_coarse_triangles_and_look_the_same(
+    make_sandbox: Callable[..., Any], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from ecs_tentacles.render import skinned as module
+
+    sandbox = make_sandbox("octopus")
+    sandbox.step(30)
+    sandbox.hud.visible = False
+    skinned = sandbox.renderer.skinned
+    sandbox.renderer.camera.distance = 5.0  # about 140 px across: coarse
+    sandbox.render()
+    assert skinned.level.tolist() == [1]
+    coarse_triangles = skinned.triangles
+    sandbox.renderer.camera.distance = 8.0  # about 90 px across
+    sandbox.render()
+    assert skinned.level.tolist() == [2]
+    assert skinned.triangles < 0.6 * coarse_triangles
+    tiny = sandbox.renderer.target.read().astype(int)
+    monkeypatch.setattr(module, "TINY_PIXELS", 0.0)  # the same view, coarse
+    sandbox.render()
+    assert skinned.level.tolist() == [1]
+    coarse = sandbox.renderer.target.read().astype(int)
+    warm = (coarse[..., 0] > coarse[..., 1] + 40) & (coarse[..., 0] > coarse[..., 2] + 40)
+    assert warm.sum() > 100  # the creature is in the picture
+    tiny_warm = (tiny[..., 0] > tiny[..., 1] + 40) & (tiny[..., 0] > tiny[..., 2] + 40)
+    assert 0.8 < tiny_warm.sum() / warm.sum() < 1.1  # as big: its tentacles are not lost
+    changed = np.abs(tiny - coarse).sum(axis=2) > 60
+    assert changed.sum() < 0.2 * warm.sum()  # a few edge pixels differ, not the creature

@@ -17,7 +17,13 @@ def edges(faces: np.ndarray) -> np.ndarray:
 
 @pytest.mark.parametrize(
     "detail",
-    [Detail(), Detail(rings_per_link=1, sides=8, cap_rings=1), Detail(6, 16, 4, suckers=True)],
+    [
+        Detail(),
+        Detail(rings_per_link=1, sides=8, cap_rings=1),
+        Detail(rings_per_link=1, sides=4, cap_rings=1),  # the sandbox's tiny creatures
+        Detail(2, 4, 1, suckers=True),
+        Detail(6, 16, 4, suckers=True),
+    ],
 )
 def test_the_mesh_is_one_closed_outward_surface(octopus_take: Take, detail: Detail) -> None:
     mesh = creature_mesh(creature_skeleton(octopus_take, 0), detail)
@@ -104,7 +110,8 @@ def test_levels_of_detail_change_the_vertex_count(octopus_take: Take) -> None:
 @pytest.mark.parametrize(
     ("field", "value", "message"),
     [
-        ("sides", 10, "sides: must be a multiple of 4 and >= 8, got 10"),
+        ("sides", 10, "sides: must be a multiple of 4 and >= 4, got 10"),
+        ("sides", 0, "sides: must be a multiple of 4 and >= 4, got 0"),
         ("rings_per_link", 0, "rings_per_link: must be >= 1, got 0"),
     ],
 )
