@@ -11,6 +11,7 @@ from numpy.testing import assert_array_equal
 from ecs_tentacles.components import Creature, Link, Tentacle, Transform
 from ecs_tentacles.numeric.quaternions import quat_rotate
 from ecs_tentacles.physics.proxies import MARGIN
+from ecs_tentacles.scene.overlap import segment_distances
 from ecs_tentacles.world import World
 
 SMALL = {"count": 4, "links": 5}  # a quick creature: reach about 0.45 m
@@ -138,12 +139,11 @@ def _gap(world: World, a: str, b: str) -> float:
     """Smallest surface distance (m) between the link capsules of `a` and `b` (< 0: overlap)."""
     pa, ha, ra = _links(world, a)
     pb, hb, rb = _links(world, b)
-    samples = np.linspace(-1.0, 1.0, 41)  # 41 points per axis: error under 0.2 mm
-    sa = pa[:, None, :] + samples[None, :, None] * ha[:, None, :]
-    sb = pb[:, None, :] + samples[None, :, None] * hb[:, None, :]
-    d = np.linalg.norm(sa.reshape(-1, 1, 3) - sb.reshape(1, -1, 3), axis=2)
-    d -= np.repeat(ra, len(samples))[:, None] + np.repeat(rb, len(samples))[None, :]
-    return float(d.min())
+    # every pair of axes, exactly (it sampled 41 points per axis: 8 of the test's 17 s)
+    axes = segment_distances(
+        (pa - ha)[:, None], (pa + ha)[:, None], (pb - hb)[None, :], (pb + hb)[None, :]
+    )
+    return float((axes - ra[:, None] - rb[None, :]).min())
 
 
 def _head_on(hero: str | None) -> tuple[set[str], set[str], list[float], World]:
