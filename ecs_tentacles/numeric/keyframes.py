@@ -95,7 +95,8 @@ class TrackSet:
         nxt = np.minimum(key + 1, self.last)
         t0, t1 = self.times[key], self.times[nxt]
         gap = np.where(nxt > key, t1 - t0, 1.0)
-        u = np.where(nxt > key, (t - t0) / gap, 0.0)
+        with np.errstate(over="ignore"):  # keys a few ulps apart: +-inf, which `ease` clips
+            u = np.where(nxt > key, (t - t0) / gap, 0.0)
         v0 = self.values[key]
         result: np.ndarray = v0 + (self.values[nxt] - v0) * ease(u, self.easings[key])
         return result

@@ -61,3 +61,12 @@ def test_track_set_evaluates_every_channel_at_once() -> None:
 
 def test_empty_track_set() -> None:
     assert len(TrackSet([])) == 0 and TrackSet([]).evaluate(1.0).shape == (0,)
+
+
+def test_keys_a_few_ulps_apart_evaluate_quietly_to_their_values() -> None:
+    later = float(np.nextafter(1e-300, 1.0))
+    keys = [{"time": 1e-300, "value": 2.0, "easing": "linear"}, {"time": later, "value": 5.0}]
+    tracks = TrackSet(channels_from_keys(0, (0,), keys))
+    with np.errstate(all="raise"):  # no overflow warning for a time far past the gap
+        assert tracks.evaluate(1.0).tolist() == [5.0]
+        assert tracks.evaluate(1e-300).tolist() == [2.0]
