@@ -47,9 +47,18 @@ def creature_shapes(world: PhysicsHost, creature_entity: int) -> dict[str, np.nd
     }
 
 
-def clearance(world: PhysicsHost, a: int, b: int) -> float:
-    """Smallest gap (metres) between creatures `a` and `b`; negative when they overlap."""
-    sa, sb = creature_shapes(world, a), creature_shapes(world, b)
+def bounding_sphere(shapes: dict[str, np.ndarray]) -> tuple[np.ndarray, float]:
+    """A sphere round every shape of `creature_shapes`: the mantle's centre and the
+    farthest capsule or mantle surface from it."""
+    centre = shapes["centre"]
+    ends = np.concatenate([shapes["start"], shapes["end"]]) - centre
+    far = np.linalg.norm(ends, axis=1) + np.concatenate([shapes["radius"], shapes["radius"]])
+    return centre, max(float(far.max(initial=0.0)), float(np.hypot(*shapes["mantle"])))
+
+
+def clearance(sa: dict[str, np.ndarray], sb: dict[str, np.ndarray]) -> float:
+    """Smallest gap (metres) between two creatures given by their `creature_shapes`;
+    negative when they overlap."""
     gaps = [
         (segment_distances(sa["start"][:, None], sa["end"][:, None], sb["start"][None],
                            sb["end"][None])
