@@ -15,7 +15,7 @@ convex, so children stay outside the skin.
 from __future__ import annotations
 
 import weakref
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -61,6 +61,11 @@ def layout(world: Host, per_guide: int | None = None, seed: int = 0) -> ChildLay
     made = _make_layout(world, per_guide, seed)
     _CACHE[fur] = (key, made)
     return made
+
+
+def subset(made: ChildLayout, keep: np.ndarray) -> ChildLayout:
+    """The children of `made` where `keep` (a bool per child) is True, as they were."""
+    return ChildLayout(*(getattr(made, f.name)[keep] for f in fields(ChildLayout)))
 
 
 def parents(fur: FurData, per_guide: int | None) -> np.ndarray:

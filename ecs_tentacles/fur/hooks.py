@@ -61,8 +61,11 @@ def child_hairs(
     seed: int = 0,
     follow: str = "neighbours",
     points: int | None = None,
+    guides: np.ndarray | None = None,
 ) -> GuideCurves:
-    """Child hairs around each guide, for visual density (deterministic for `seed`).
+    """Child hairs around each guide, for visual density (deterministic for `seed`);
+    with `guides` (a bool per guide), only the children of those guides, each as it is
+    among all of them (the sandbox leaves out the hairs it sees too short to show).
 
     `follow="neighbours"` (the default): each child grows from the skin near its guide
     and blends its 3 nearest guides (`fur.children`); its colour is jittered per strand.
@@ -74,6 +77,8 @@ def child_hairs(
     """
     if follow == "neighbours":
         made = children.layout(world, per_guide, seed)
+        if guides is not None:
+            made = children.subset(made, guides[made.parent])
         base = guide_curves(world)
         colour = base.colour[made.parent].copy()
         colour[:, :3] *= made.jitter[:, None].astype(np.float32)
@@ -100,7 +105,10 @@ def child_hairs(
     dense = (root + offset[:, None, :] + scale * (curves - root)).astype(np.float32)
     dense = dense[:, children.point_indices(fur.points, points)]
     base = guide_curves(world)
-    return GuideCurves(dense, base.colour[parent], base.width[parent] * 0.5, parent)
+    kept = slice(None) if guides is None else guides[parent]
+    return GuideCurves(
+        dense[kept], base.colour[parent][kept], base.width[parent][kept] * 0.5, parent[kept]
+    )
 
 
 @dataclass

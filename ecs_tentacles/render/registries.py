@@ -62,7 +62,9 @@ class RenderView:
     `pos`, `quat`: body poses (rows of the Transform store) interpolated between the last
     two physics frames; `creatures`: the creature entities drawn, `colours` each one's
     rgb; `eye`, `view_projection` (4 x 4, column vectors), `light` (unit, towards it),
-    `pixel` (metres one pixel spans at the camera's target): the camera; `overlays`:
+    `pixel` (metres one pixel spans at the camera's target), `per_metre` (what one
+    pixel spans 1 m from the eye, so `per_metre * distance` at any distance; 0: not
+    known): the camera; `overlays`:
     editing aids (the fur controls' markers) are wanted (the sandbox's HUD is showing);
     `state`: objects plugins keep for as long as the renderer lives, across worlds
     (their GL buffers and display settings), by a key starting with the plugin's name;
@@ -78,6 +80,7 @@ class RenderView:
     view_projection: np.ndarray = field(default_factory=lambda: np.eye(4))
     light: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))
     pixel: float = 0.0
+    per_metre: float = 0.0
     overlays: bool = False
     state: dict[str, Any] = field(default_factory=dict)
     selected: int | None = None  # the sandbox's selected creature (an entity), if any

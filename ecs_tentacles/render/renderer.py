@@ -285,6 +285,7 @@ class Renderer:
             view_projection=camera.view_projection(),
             light=LIGHT,
             pixel=float(pixel),
+            per_metre=float(pixel / max(camera.distance, 1e-9)),
             overlays=self.overlays,
             selected=self.selected,
             selection=self.selection,

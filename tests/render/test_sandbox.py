@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import json
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pytest
 from numpy.testing import assert_allclose
 from PIL import Image
 from pyglet.event import EventDispatcher
@@ -139,6 +141,35 @@ def test_fur_and_threats_are_drawn(make_sandbox: Callable[..., Any]) -> None:
     assert renderer.draw_calls == 11
     attached = int(world.suckers.attached.sum())
     assert sandbox.renderer.spheres.count == attached + 1  # the roach
+
+
+def test_child_hairs_too_short_to_see_are_left_out(
+    make_sandbox: Callable[..., Any], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from ecs_tentacles.fur.hooks import child_hairs
+    from ecs_tentacles.fur.render import strands as module
+    from ecs_tentacles.scene.load import bundled_scene
+
+    scene = json.loads(bundled_scene("hedgehog_octopus").read_text())
+    scene["creatures"][0]["fur"]["children"] = 4  # 2,000 child hairs round 500 guides
+    sandbox = make_sandbox(scene, hud=False)
+    sandbox.step(3)
+    sandbox.render()
+    strands = module.strands_of(sandbox.renderer.state)
+    points = module.fur_display(sandbox.renderer.state).child_points
+    every = child_hairs(sandbox.world, points=points).points
+    assert every.shape[0] == 2000
+    assert strands.children.count == 6 * every.shape[0] * (every.shape[1] - 1)  # close: all
+    sandbox.renderer.camera.distance = 60.0  # the creature a few dozen pixels across
+    sandbox.render()
+    assert strands.children.count == 0 and strands.guides.count > 0
+    far = sandbox.renderer.target.read().astype(int)
+    monkeypatch.setattr(module, "CHILD_PIXELS", 0.0)  # the same view with every hair
+    sandbox.render()
+    assert strands.children.count > 0
+    every_hair = sandbox.renderer.target.read().astype(int)
+    changed = (np.abs(far - every_hair).sum(axis=2) > 30).sum()
+    assert changed < 40, changed  # a few pixels of a 640 x 360 picture
 
 
 def test_f5_saves_the_state_and_f9_goes_back(make_sandbox: Callable[..., Any]) -> None:

@@ -24,6 +24,10 @@ if TYPE_CHECKING:
 
 DISPLAY = "fur.display"  # keys in the renderer's `view.state`
 STRANDS = "fur.strands"
+# a guide's child hairs are drawn when the guide spans at least this many pixels: a
+# crowd framed whole (64 creatures) drew 8,880 hairs a pixel or two long, about 1 ms a
+# frame, and 110 pixels of the picture changed by more than a shade without them
+CHILD_PIXELS = 3.0
 
 
 @dataclass
@@ -51,8 +55,11 @@ def fur_display(state: dict[str, Any]) -> FurDisplay:
     return display
 
 
-def fur_strands(world: Host, display: FurDisplay) -> tuple[GuideCurves, GuideCurves]:
-    """This frame's guides and child hairs as `display` asks (empty when hidden)."""
+def fur_strands(
+    world: Host, display: FurDisplay, view: RenderView | None = None
+) -> tuple[GuideCurves, GuideCurves]:
+    """This frame's guides and child hairs as `display` asks (empty when hidden); seen
+    from `view`, only the children of guides at least `CHILD_PIXELS` long on screen."""
     fur = world.get_resource(FurData)  # None with the fur plugin off
     points = max(fur.points, 1) if fur is not None else 1
     empty = GuideCurves(
@@ -67,13 +74,23 @@ def fur_strands(world: Host, display: FurDisplay) -> tuple[GuideCurves, GuideCur
     if not display.children:
         return guides, empty
     dense = child_hairs(
-        world, display.per_guide, follow=display.follow, points=display.child_points
-    )
+        world, display.per_guide, follow=display.follow, points=display.child_points,
+        guides=None if view is None else seen_long(fur, view),
+    )  # fmt: skip
     if display.colour_by == "control":
         jitter = dense.colour[:, :3] / np.maximum(guide_curves(world).colour[dense.guide, :3], 1e-6)
         dense.colour = guide_curves(world, "control").colour[dense.guide]
         dense.colour[:, :3] *= jitter
     return guides, dense
+
+
+def seen_long(fur: FurData, view: RenderView) -> np.ndarray | None:
+    """A bool per guide: it spans at least `CHILD_PIXELS` pixels seen from `view`'s eye
+    (None: the view does not say how big a pixel is)."""
+    if view.per_metre <= 0.0:
+        return None
+    distance = np.linalg.norm(fur.frames[:, 3] - np.asarray(view.eye, np.float32), axis=1)
+    return np.asarray(fur.guides.length >= CHILD_PIXELS * view.per_metre * distance)
 
 
 def fur_lines(world: Host, view: RenderView) -> list[np.ndarray]:
@@ -101,9 +118,9 @@ class FurStrands:
         self.guides = Ribbons()
         self.children = Ribbons()
 
-    def update(self, world: Host, display: FurDisplay) -> None:
-        """Upload this frame's strands as `display` asks."""
-        guides, children = fur_strands(world, display)
+    def update(self, world: Host, display: FurDisplay, view: RenderView | None = None) -> None:
+        """Upload this frame's strands as `display` asks, seen from `view`."""
+        guides, children = fur_strands(world, display, view)
         self.guides.update(guides)
         self.children.update(children)
 
@@ -141,5 +158,5 @@ def draw_fur(world: Host, view: RenderView) -> int:
     if (fur is None or not len(fur.guides)) and STRANDS not in view.state:
         return 0  # no fur, and no GL objects made for it
     strands = strands_of(view.state)
-    strands.update(world, fur_display(view.state))
+    strands.update(world, fur_display(view.state), view)
     return strands.draw(view)
