@@ -59,14 +59,17 @@ def bounding_sphere(shapes: dict[str, np.ndarray]) -> tuple[np.ndarray, float]:
 def clearance(sa: dict[str, np.ndarray], sb: dict[str, np.ndarray]) -> float:
     """Smallest gap (metres) between two creatures given by their `creature_shapes`;
     negative when they overlap."""
-    gaps = [
-        (segment_distances(sa["start"][:, None], sa["end"][:, None], sb["start"][None],
-                           sb["end"][None])
-         - sa["radius"][:, None] - sb["radius"][None, :]).min(initial=np.inf),
-        _capsules_to_mantle(sa, sb),
-        _capsules_to_mantle(sb, sa),
-    ]  # fmt: skip
+    gaps = [capsule_clearance(sa, sb), _capsules_to_mantle(sa, sb), _capsules_to_mantle(sb, sa)]
     return float(min(gaps))
+
+
+def capsule_clearance(sa: dict[str, np.ndarray], sb: dict[str, np.ndarray]) -> float:
+    """Smallest gap (metres) between the link capsules of two `creature_shapes`, every
+    pair of axes exactly; negative when they overlap."""
+    axes = segment_distances(
+        sa["start"][:, None], sa["end"][:, None], sb["start"][None], sb["end"][None]
+    )
+    return float((axes - sa["radius"][:, None] - sb["radius"][None, :]).min(initial=np.inf))
 
 
 def _capsules_to_mantle(capsules: dict[str, np.ndarray], other: dict[str, np.ndarray]) -> float:

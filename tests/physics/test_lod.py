@@ -8,11 +8,10 @@ from typing import Any
 import numpy as np
 from numpy.testing import assert_array_equal
 
-from ecs_tentacles.components import Creature, Link, Tentacle, Transform
-from ecs_tentacles.numeric.quaternions import quat_rotate
+from ecs_tentacles.components import Transform
 from ecs_tentacles.physics.proxies import MARGIN
-from ecs_tentacles.scene.overlap import segment_distances
 from ecs_tentacles.world import World
+from tests.physics.clearance import capsule_clearance, creature_shapes
 
 SMALL = {"count": 4, "links": 5}  # a quick creature: reach about 0.45 m
 
@@ -122,28 +121,11 @@ def test_a_reduced_creature_crawls_healthily(make_world: Callable[..., World]) -
     assert end[0] - start[0] > 0.05  # toward its goal at +x
 
 
-def _links(world: World, name: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Every link capsule of creature `name`: centres, half-axis vectors, radii."""
-    centres, halves, radii = [], [], []
-    creature = world.component(world.creature(name), Creature)
-    for tentacle in creature.tentacles:
-        for link in world.component(tentacle, Tentacle).links:
-            shape, pose = world.component(link, Link), world.component(link, Transform)
-            centres.append(np.array(pose.pos))
-            halves.append(quat_rotate(pose.quat, np.array([0.5 * shape.length, 0.0, 0.0])))
-            radii.append(shape.radius)
-    return np.array(centres), np.array(halves), np.array(radii)
-
-
 def _gap(world: World, a: str, b: str) -> float:
     """Smallest surface distance (m) between the link capsules of `a` and `b` (< 0: overlap)."""
-    pa, ha, ra = _links(world, a)
-    pb, hb, rb = _links(world, b)
-    # every pair of axes, exactly (it sampled 41 points per axis: 8 of the test's 17 s)
-    axes = segment_distances(
-        (pa - ha)[:, None], (pa + ha)[:, None], (pb - hb)[None, :], (pb + hb)[None, :]
+    return capsule_clearance(
+        creature_shapes(world, world.creature(a)), creature_shapes(world, world.creature(b))
     )
-    return float((axes - ra[:, None] - rb[None, :]).min())
 
 
 def _head_on(hero: str | None) -> tuple[set[str], set[str], list[float], World]:
