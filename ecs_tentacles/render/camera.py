@@ -116,6 +116,11 @@ class OrbitCamera:
         offset = np.array([cp * np.cos(self.yaw), cp * np.sin(self.yaw), np.sin(self.pitch)])
         return self.target + self.distance * offset
 
+    @property
+    def per_metre(self) -> float:
+        """Metres one pixel spans 1 m from the eye (times a distance: a pixel's size there)."""
+        return float(2.0 * np.tan(self.fov_y / 2) / self.height)
+
     def view(self) -> np.ndarray:
         return look_at(self.eye, self.target, np.array([0.0, 0.0, 1.0]))
 

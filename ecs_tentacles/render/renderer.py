@@ -227,17 +227,18 @@ class Renderer:
 
     def upload(self, alpha: float = 1.0) -> None:
         """Fill and upload every instance array and the line list."""
+        self._fill(*self._posed(alpha))
+
+    def _posed(self, alpha: float) -> tuple[np.ndarray, np.ndarray]:
+        """This frame's body poses (`poses`), the camera's target on the ground under the
+        followed mantle if one is (the view depends on it)."""
         self._refresh()
         pos, quat = self.poses(alpha)
-        self._aim_at_followed(pos)
-        self._fill(pos, quat)
-
-    def _aim_at_followed(self, pos: np.ndarray) -> None:
-        """The camera's target on the ground under the followed mantle, if one is."""
         if self.camera.follow is not None:
             under = pos[self.camera.follow]
             height = ground_of(self.world).height(under[None, :2])[0]
             self.camera.target = np.array([under[0], under[1], height])
+        return pos, quat
 
     def _fill(self, pos: np.ndarray, quat: np.ndarray) -> None:
         """Every instance array and the line list for body poses `pos`, `quat`, uploaded."""
@@ -252,7 +253,7 @@ class Renderer:
         self.links_near.update(links[near & capsules])
         self.links_far.update(links[~near & capsules])
         camera = self.camera
-        per_metre = 2.0 * np.tan(camera.fov_y / 2) / camera.height  # a pixel 1 m away
+        per_metre = camera.per_metre
         if skinned:
             self.skinned.choose_detail(pos, camera.eye, per_metre)
             self.skinned.update(pos, quat)
@@ -285,7 +286,7 @@ class Renderer:
             view_projection=camera.view_projection(),
             light=LIGHT,
             pixel=float(pixel),
-            per_metre=float(pixel / max(camera.distance, 1e-9)),
+            per_metre=camera.per_metre,
             overlays=self.overlays,
             selected=self.selected,
             selection=self.selection,
@@ -340,9 +341,7 @@ class Renderer:
 
     def draw(self, alpha: float = 1.0) -> int:
         """Render into the off-screen target; returns the number of draw calls."""
-        self._refresh()
-        pos, quat = self.poses(alpha)
-        self._aim_at_followed(pos)  # the view depends on it
+        pos, quat = self._posed(alpha)
         self.target.bind()
         gl.glClearColor(*SKY, 1.0)
         gl.glClear(gl.GL_COLOR_BUFFER_BIT | gl.GL_DEPTH_BUFFER_BIT)
