@@ -44,10 +44,21 @@ def test_the_palette_puts_the_tubes_on_the_simulated_links(
     assert bend.max() > 10  # the tentacles are bent, not in the bind pose
 
 
-def test_skinned_view_draws_one_smooth_creature(make_sandbox: Callable[..., Any]) -> None:
+def _octopus(make_sandbox: Callable[..., Any]) -> Any:
+    """The octopus sandbox 30 frames in, the HUD hidden."""
     sandbox = make_sandbox("octopus")
     sandbox.step(30)
     sandbox.hud.visible = False
+    return sandbox
+
+
+def _warm(pixels: np.ndarray, margin: int) -> np.ndarray:
+    """Where `pixels` (h, w, 3) are redder than green and blue by `margin`: the creature."""
+    return (pixels[..., 0] > pixels[..., 1] + margin) & (pixels[..., 0] > pixels[..., 2] + margin)
+
+
+def test_skinned_view_draws_one_smooth_creature(make_sandbox: Callable[..., Any]) -> None:
+    sandbox = _octopus(make_sandbox)
     sandbox.render()
     skinned = sandbox.renderer.target.read().astype(int)
     sandbox.renderer.toggle_view()
@@ -60,8 +71,8 @@ def test_skinned_view_draws_one_smooth_creature(make_sandbox: Callable[..., Any]
     for pixels in (skinned, capsules):
         r, g, b = pixels[360 - round(y) + 3, round(x)]
         assert r > g + 60 and r > b + 60  # the warm red creature is there in both views
-    warm = lambda p: ((p[..., 0] > p[..., 1] + 60) & (p[..., 0] > p[..., 2] + 60)).sum()  # noqa: E731
-    assert 0.5 < warm(skinned) / warm(capsules) < 2.0  # the same creature, not a blob
+    warm = _warm(skinned, 60).sum() / _warm(capsules, 60).sum()
+    assert 0.5 < warm < 2.0  # the same creature, not a blob
     assert (np.abs(skinned - capsules).sum(axis=2) > 30).sum() > 200  # but drawn differently
 
 
@@ -70,9 +81,7 @@ def test_creatures_seen_small_are_drawn_coarse_and_look_the_same(
 ) -> None:
     from ecs_tentacles.render import skinned as module
 
-    sandbox = make_sandbox("octopus")
-    sandbox.step(30)
-    sandbox.hud.visible = False
+    sandbox = _octopus(make_sandbox)
     skinned = sandbox.renderer.skinned
     sandbox.render()
     assert skinned.level.tolist() == [0]  # close: the sandbox's detail
@@ -86,7 +95,7 @@ def test_creatures_seen_small_are_drawn_coarse_and_look_the_same(
     sandbox.render()
     assert skinned.level.tolist() == [0]
     fine = sandbox.renderer.target.read().astype(int)
-    warm = (fine[..., 0] > fine[..., 1] + 40) & (fine[..., 0] > fine[..., 2] + 40)
+    warm = _warm(fine, 40)
     assert warm.sum() > 300  # the creature is in the picture
     changed = np.abs(coarse - fine).sum(axis=2) > 60
     assert changed.sum() < 0.15 * warm.sum()  # a few edge pixels differ, not the creature
@@ -97,9 +106,7 @@ def test_creatures_seen_tiny_have_half_the_coarse_triangles_and_look_the_same(
 ) -> None:
     from ecs_tentacles.render import skinned as module
 
-    sandbox = make_sandbox("octopus")
-    sandbox.step(30)
-    sandbox.hud.visible = False
+    sandbox = _octopus(make_sandbox)
     skinned = sandbox.renderer.skinned
     sandbox.renderer.camera.distance = 5.0  # about 140 px across: coarse
     sandbox.render()
@@ -114,9 +121,8 @@ def test_creatures_seen_tiny_have_half_the_coarse_triangles_and_look_the_same(
     sandbox.render()
     assert skinned.level.tolist() == [1]
     coarse = sandbox.renderer.target.read().astype(int)
-    warm = (coarse[..., 0] > coarse[..., 1] + 40) & (coarse[..., 0] > coarse[..., 2] + 40)
+    warm = _warm(coarse, 40)
     assert warm.sum() > 100  # the creature is in the picture
-    tiny_warm = (tiny[..., 0] > tiny[..., 1] + 40) & (tiny[..., 0] > tiny[..., 2] + 40)
-    assert 0.8 < tiny_warm.sum() / warm.sum() < 1.1  # as big: its tentacles are not lost
+    assert 0.8 < _warm(tiny, 40).sum() / warm.sum() < 1.1  # as big: its tentacles are not lost
     changed = np.abs(tiny - coarse).sum(axis=2) > 60
     assert changed.sum() < 0.2 * warm.sum()  # a few edge pixels differ, not the creature
