@@ -7,8 +7,9 @@ the same fields as writable views, so scripts can write
 `world.component(link, Motor).target`. Stores grow by doubling, which is why
 components look their field up on every access instead of keeping an old view.
 The store itself keeps each field's view of the live rows as a plain attribute, made
-again whenever the rows or the arrays change: a frame reads fields some hundred times,
-and a descriptor that sliced the array on each read cost 0.12 us a read.
+again whenever the arrays change and at the first read after the rows do: a frame reads
+fields some hundred times, and a descriptor that sliced the array on each read cost 0.12
+us a read.
 
 Rows are removed when a creature is despawned (`ArrayStore.remove`): the rows after
 them move up, so every row keeps its order (a tentacle's links stay contiguous). A
@@ -47,11 +48,15 @@ class Field:
         self.name = name
 
     def __get__(self, store: ArrayStore | None, owner: type | None = None) -> Any:
-        # reached only while the store keeps no view (`ArrayStore.cache_views`): the
-        # view kept in the instance's attributes is found first (no `__set__` here)
+        # reached only while the store holds no view of this field: the view kept in the
+        # instance's attributes is found first (no `__set__` here). One is made here,
+        # and kept unless the store keeps none (`ArrayStore.cache_views`)
         if store is None:
             return self
-        return store._arrays[self.name][: store.count]
+        view = store._arrays[self.name][: store.count]
+        if store.__dict__.get("cache_views", True):
+            store.__dict__[self.name] = view
+        return view
 
 
 def without_rows(
@@ -97,14 +102,21 @@ class ArrayStore:
 
     def _views(self) -> None:
         """Keep each field's view of the live rows as an instance attribute (after the
-        rows or the arrays changed), or drop the kept views when `cache_views` is off."""
+        arrays changed), or drop the kept views when `cache_views` is off."""
         names = [f.name for f in self.fields()]
         if self.__dict__.get("cache_views", True):
             arrays, count = self._arrays, self.count
             self.__dict__.update({name: dict.__getitem__(arrays, name)[:count] for name in names})
         else:
-            for name in names:
-                self.__dict__.pop(name, None)
+            self._drop_views()
+
+    def _drop_views(self) -> None:
+        """Forget the kept views (the rows changed): each is made again at its next read
+        (`Field.__get__`). Building a crowd adds rows a creature at a time, 10,000
+        creatures some million times: making every view again at each took 3 s."""
+        state = self.__dict__
+        for field in self.fields():
+            state.pop(field.name, None)
 
     def __setattr__(self, name: str, value: Any) -> None:
         """`store.field = values` writes into the live rows (the field's view is kept);
@@ -116,7 +128,9 @@ class ArrayStore:
             view[...] = value
             return
         object.__setattr__(self, name, value)
-        if name in ("count", "_arrays", "cache_views") and "cache_views" in self.__dict__:
+        if name == "count":
+            self._drop_views()
+        elif name in ("_arrays", "cache_views") and "cache_views" in self.__dict__:
             self._views()
 
     def __getstate__(self) -> dict[str, Any]:
