@@ -134,10 +134,12 @@ def _build_links(
         link = Link(tentacle_entity, i, lengths[i], radii[i], scales[i], density, limit, twist)
         entity = world.create_entity(link, Transform(transforms, row), Motor(motors, motor_row))
         tentacle.links.append(entity)
-    carriers = range(n) if params["suckers"] == "every_link" else [n - 1]
-    for i in carriers:
-        offset = (0.5 * shape.lengths[i], 0.0, -shape.radii[i])
-        sucker_row = int(world.suckers.add(link_row=rows[i], offset=offset)[0])
+    carriers = np.arange(n) if params["suckers"] == "every_link" else np.array([n - 1])
+    offsets = np.zeros((len(carriers), 3))  # on the link's underside, half way along
+    offsets[:, 0] = 0.5 * shape.lengths[carriers]
+    offsets[:, 2] = -shape.radii[carriers]
+    sucker_rows = world.suckers.add(len(carriers), link_row=rows[carriers], offset=offsets)
+    for i, sucker_row in zip(carriers.tolist(), sucker_rows.tolist(), strict=True):
         entity = world.create_entity(Sucker(world.suckers, sucker_row, tentacle.links[i]))
         world.suckers.entity[sucker_row] = entity
         tentacle.suckers.append(entity)

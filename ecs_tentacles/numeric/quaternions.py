@@ -13,8 +13,10 @@ KERNELS = OptionalKernels("ecs_tentacles.numeric.quaternion_kernels", "ECS_TENTA
 def quat_about_z(angle: np.ndarray | float) -> np.ndarray:
     """Unit quaternions rotating by `angle` radians about +z; shape (..., 4)."""
     half = 0.5 * np.asarray(angle, dtype=np.float64)
-    zeros = np.zeros_like(half)
-    return np.stack([np.cos(half), zeros, zeros, np.sin(half)], axis=-1)
+    out = np.zeros((*half.shape, 4))  # (filled in place: `np.stack` was most of a call)
+    out[..., 0] = np.cos(half)
+    out[..., 3] = np.sin(half)
+    return out
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
