@@ -1,8 +1,8 @@
 """The numba kernels of the physics' per-frame queries: the contact proxies' `sense`
 (gather every body and every reach sphere in one pass) and `reach` (the spheres alone:
 a frame copies only the bodies it needs), the near pairs' tests (reading bodies where
-they are; every pair of a small crowd), and the ground's heightfield heights
-(`ground.Heightfield.height`).
+they are; every pair of a small crowd), the proxies' candidate bodies, and the ground's
+heightfield heights (`ground.Heightfield.height`).
 
 Optional, as the other kernels are: their users import this module only when numba is
 installed and fall back to numpy otherwise; both compute the same numbers bit for bit
@@ -141,6 +141,59 @@ def _inside(
             out[n] = body
             n += 1
     return n
+
+
+@njit(cache=True, nogil=True)
+def proxy_candidates(
+    pos: np.ndarray,
+    centre: np.ndarray,
+    radius: np.ndarray,
+    rbound: np.ndarray,
+    start: np.ndarray,
+    count: np.ndarray,
+    a: np.ndarray,
+    b: np.ndarray,
+    margin: float,
+    crowded_over: int,
+    creatures: int,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """`ContactProxies._assign`'s candidates, its numbers without its temporaries: for
+    each pair p, the bodies of b[p] within `margin` of a[p]'s reach sphere as (who = a[p],
+    body, gap); where a creature has more than `crowded_over` candidates, each of its
+    candidates' gap is to the creature's nearest own body instead (`_body_gaps`)."""
+    total = 0
+    for p in range(len(b)):
+        total += count[b[p]]
+    who = np.empty(total, dtype=np.int64)
+    body = np.empty(total, dtype=np.int64)
+    gap = np.empty(total)
+    found = 0
+    for p in range(len(a)):
+        w, other = a[p], b[p]
+        cx, cy, cz, r = centre[w, 0], centre[w, 1], centre[w, 2], radius[w]
+        for i in range(start[other], start[other] + count[other]):
+            dx, dy, dz = pos[i, 0] - cx, pos[i, 1] - cy, pos[i, 2] - cz
+            g = math.sqrt(dx * dx + dy * dy + dz * dz) - rbound[i] - r
+            if g < margin:
+                who[found], body[found], gap[found] = w, i, g
+                found += 1
+    per = np.zeros(creatures, dtype=np.int64)
+    for k in range(found):
+        per[who[k]] += 1
+    for k in range(found):
+        w, i = who[k], body[k]
+        if per[w] <= crowded_over:
+            continue
+        nearest = np.inf  # np.minimum.reduceat over the creature's own bodies (NaN sticks)
+        for own in range(start[w], start[w] + count[w]):
+            dx, dy, dz = pos[own, 0] - pos[i, 0], pos[own, 1] - pos[i, 1], pos[own, 2] - pos[i, 2]
+            g = math.sqrt(dx * dx + dy * dy + dz * dz) - rbound[own]
+            if g < nearest or g != g:
+                nearest = g
+            if nearest != nearest:
+                break
+        gap[k] = nearest - rbound[i]
+    return who[:found], body[:found], gap[:found]
 
 
 @njit(cache=True, nogil=True)

@@ -327,19 +327,16 @@ class ContactProxies:
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(creature, source body, proxy slot) triples: b's bodies inside a's sphere,
         nearest first, as many as the pool of each kind holds."""
-        per = self.count[b]
-        pair = np.repeat(np.arange(len(a)), per)
-        body = np.arange(per.sum()) - np.repeat(np.cumsum(per) - per, per) + self.start[b][pair]
-        who = a[pair]
-        gap = np.linalg.norm(pos[body] - centre[who], axis=1) - self.rbound[body] - radius[who]
-        keep = gap < MARGIN
-        who, body, gap = who[keep], body[keep], gap[keep]
+        fast = KERNELS.get()
+        if fast is not None:  # the same candidates in one pass (29 against 59 us at 16 creatures)
+            who, body, gap = fast.proxy_candidates(
+                pos, centre, radius, self.rbound, self.start, self.count, a, b,
+                float(MARGIN), int(POOL.min()), len(self.roster),
+            )  # fmt: skip
+        else:
+            who, body, gap = self._candidates(a, b, pos, centre, radius)
         if not len(who):
             return (_NONE,) * 3
-        crowded = np.bincount(who, minlength=len(self.roster)) > POOL.min()
-        if crowded[who].any():  # more candidates than proxies: rank by the nearest own body
-            some = np.flatnonzero(crowded[who])
-            gap[some] = self._body_gaps(who[some], body[some], pos)
         order = np.lexsort((gap, self.kind[body], who))
         who, body = who[order], body[order]
         group_kind = who * 2 + self.kind[body]
@@ -348,6 +345,24 @@ class ContactProxies:
         who, body, slot = who[fits], body[fits], slot[fits]
         slot = slot + np.where(self.kind[body] == CYLINDER, PROXY_CAPSULES, 0)
         return who, body, slot
+
+    def _candidates(
+        self, a: np.ndarray, b: np.ndarray, pos: np.ndarray, centre: np.ndarray, radius: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(creature, body, gap): b's bodies within `MARGIN` of a's sphere, pair by pair;
+        a creature with more of them than a pool holds ranks them by its nearest own body."""
+        per = self.count[b]
+        pair = np.repeat(np.arange(len(a)), per)
+        body = np.arange(per.sum()) - np.repeat(np.cumsum(per) - per, per) + self.start[b][pair]
+        who = a[pair]
+        gap = np.linalg.norm(pos[body] - centre[who], axis=1) - self.rbound[body] - radius[who]
+        keep = gap < MARGIN
+        who, body, gap = who[keep], body[keep], gap[keep]
+        crowded = np.bincount(who, minlength=len(self.roster)) > POOL.min()
+        if crowded[who].any():  # more candidates than proxies: rank by the nearest own body
+            some = np.flatnonzero(crowded[who])
+            gap[some] = self._body_gaps(who[some], body[some], pos)
+        return who, body, gap
 
     def _body_gaps(self, who: np.ndarray, body: np.ndarray, pos: np.ndarray) -> np.ndarray:
         """Gap between each candidate body and the nearest body of creature `who`."""

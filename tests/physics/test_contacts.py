@@ -201,3 +201,31 @@ def test_the_pair_gaps_kernel_gives_the_numpy_numbers_bit_for_bit(
         np.testing.assert_array_equal(kernel, numpy_path)
     gaps = found[0][2]
     assert np.isfinite(gaps).sum() >= 3 and np.isinf(gaps).sum() >= 1  # near and not quite
+
+
+def test_the_proxy_candidates_kernel_gives_the_numpy_numbers_bit_for_bit(
+    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Which bodies stand in as proxies, for whom and in which slot: the same with numba
+    and without, in a packed crowd where creatures have more candidates than a pool holds
+    (ranked by their nearest own body)."""
+    from ecs_tentacles.creator.crowd import crowd_scene
+    from ecs_tentacles.physics import proxies as module
+
+    world = make_world(crowd_scene(12, seed=3, spacing=1.6))  # packed: spheres overlap
+    world.step(20)
+    monkeypatch.setattr(module, "MARGIN", 0.5)  # as if the neighbours were 0.45 m nearer
+    proxies = world.physics.proxies
+    pos, _, centre, radius = proxies.sense(world.transforms)
+    a, b = proxies._pairs(centre, radius, module.MARGIN)
+    assert module.KERNELS.get() is not None
+    found = []
+    for backend in ("auto", "numpy"):
+        monkeypatch.setattr(module.KERNELS, "backend", backend)
+        found.append(proxies._assign(a, b, pos, centre, radius))
+    for kernel, numpy_path in zip(*found, strict=True):
+        np.testing.assert_array_equal(kernel, numpy_path)
+    who = proxies._candidates(a, b, pos, centre, radius)[0]
+    crowded = np.bincount(who) > module.POOL.min()
+    assert crowded.sum() >= 2 and (~crowded[who]).any()  # both rankings were compared
+    assert len(found[0][0]) >= 20 and len(np.unique(found[0][0])) >= 4
