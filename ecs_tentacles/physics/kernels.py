@@ -73,6 +73,45 @@ def reach(
 
 
 @njit(cache=True, nogil=True)
+def moved_bodies(
+    used: np.ndarray,
+    members: np.ndarray,
+    start: np.ndarray,
+    rbound: np.ndarray,
+    xpos: np.ndarray,
+    xquat: np.ndarray,
+    out_pos: np.ndarray,
+    out_quat: np.ndarray,
+    out_centre: np.ndarray,
+    out_radius: np.ndarray,
+) -> None:
+    """`ContactProxies.refresh` for one batch: the bodies of its rows whose creature is
+    `used` (`members[r]`, roster order) from their last step (`xpos[r]`, `xquat[r]`) into
+    `out_pos` / `out_quat` (creature c's bodies from `start[c]`), and those creatures'
+    reach spheres (`reach`'s numbers) into `out_centre` / `out_radius`."""
+    bodies = xpos.shape[1]
+    for r in range(len(members)):
+        c = members[r]
+        if not used[c]:
+            continue
+        first = start[c]
+        for j in range(bodies):
+            for k in range(3):
+                out_pos[first + j, k] = xpos[r, j, k]
+            for k in range(4):
+                out_quat[first + j, k] = xquat[r, j, k]
+        cx, cy, cz = out_pos[first, 0], out_pos[first, 1], out_pos[first, 2]
+        out_centre[c, 0], out_centre[c, 1], out_centre[c, 2] = cx, cy, cz
+        radius = -np.inf
+        for i in range(first, first + bodies):
+            dx, dy, dz = out_pos[i, 0] - cx, out_pos[i, 1] - cy, out_pos[i, 2] - cz
+            reach = math.sqrt(dx * dx + dy * dy + dz * dz) + rbound[i]
+            if reach > radius:
+                radius = reach
+        out_radius[c] = radius
+
+
+@njit(cache=True, nogil=True)
 def pair_gaps(
     pos: np.ndarray,
     where: np.ndarray,

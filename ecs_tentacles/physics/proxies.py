@@ -198,14 +198,20 @@ class ContactProxies:
         if lazy is not None and lazy.pos is pos:
             lazy.gathered[used] = True  # their bodies come from their last step, not the store
             lazy.moved = True
-        for batch, index in zip(self.roster.batches, self.index, strict=True):
-            rows = np.flatnonzero(used[batch.members])
-            if len(rows):
-                pos[index[rows]] = batch.xpos[rows]
-                quat[index[rows]] = batch.xquat[rows]
-        moved = np.flatnonzero(used)
-        if len(moved):
-            centre[moved], radius[moved] = self._spheres_of(pos, moved)
+        fast = KERNELS.get()
+        if fast is not None:  # the same numbers, a batch in one pass (4 numpy calls less)
+            for batch in self.roster.batches:
+                fast.moved_bodies(used, batch.members, self.start, self.rbound, batch.xpos,
+                                  batch.xquat, pos, quat, centre, radius)  # fmt: skip
+        else:
+            for batch, index in zip(self.roster.batches, self.index, strict=True):
+                rows = np.flatnonzero(used[batch.members])
+                if len(rows):
+                    pos[index[rows]] = batch.xpos[rows]
+                    quat[index[rows]] = batch.xquat[rows]
+            moved = np.flatnonzero(used)
+            if len(moved):
+                centre[moved], radius[moved] = self._spheres_of(pos, moved)
         self._place(pos, quat, centre, radius, ready)
 
     def spheres(self, pos: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

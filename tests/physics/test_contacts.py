@@ -229,3 +229,41 @@ def test_the_proxy_candidates_kernel_gives_the_numpy_numbers_bit_for_bit(
     crowded = np.bincount(who) > module.POOL.min()
     assert crowded.sum() >= 2 and (~crowded[who]).any()  # both rankings were compared
     assert len(found[0][0]) >= 20 and len(np.unique(found[0][0])) >= 4
+
+
+def test_the_refresh_kernel_gives_the_numpy_numbers_bit_for_bit(
+    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Between a frame's rounds the near creatures' bodies come from their last step and
+    their reach spheres are made again: the same numbers with numba and without."""
+    from ecs_tentacles.physics import proxies as module
+
+    small = {"count": 3, "links": 4}
+    creatures = [
+        {"name": "a", "position": [0.0, 0.0], "tentacles": small},
+        {"name": "b", "position": [0.7, 0.0], "heading_deg": 180, "tentacles": small},
+        {"name": "far", "position": [6.0, 0.0]},
+    ]  # a and b: tentacle tips 3 cm apart, proxies from the first frame
+    world = make_world({"version": 1, "creatures": creatures})
+    world.step(5)
+    proxies = world.physics.proxies
+    assert proxies.in_use
+    for batch in world.physics.batches:  # as if the near creatures had stepped on
+        batch.xpos += 0.01 * (1 + np.arange(batch.xpos.shape[1]))[None, :, None]
+    used = world.physics.proxies_used.copy()
+    found = []
+    for backend in ("auto", "numpy"):
+        monkeypatch.setattr(module.KERNELS, "backend", backend)
+        world.physics.proxies_used[:] = used
+        proxies._sensed = proxies._lazy = None
+        proxies._within = tuple(a.copy() for a in proxies.sense(world.transforms))
+        proxies.refresh(world.transforms)
+        found.append(proxies._within)
+    for kernel, numpy_path in zip(*found, strict=True):
+        np.testing.assert_array_equal(kernel, numpy_path)
+    pos, _, centre, radius = found[0]
+    before = proxies.sense(world.transforms)
+    moved = np.flatnonzero(used > 0)
+    assert len(moved) == 2 and not (pos == before[0]).all()  # a and b moved, far did not
+    assert (radius[moved] != before[3][moved]).all() and radius[2] == before[3][2]
+    assert (centre[moved] != before[2][moved]).all()
