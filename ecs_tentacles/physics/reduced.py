@@ -85,6 +85,7 @@ DAMPING_CAP = 1.0
 STIFF_STEP = 4.0
 MAX_SPLIT = 64  # at most this many shorter steps (a script's gain far past the schema's)
 _NO_CLIP = np.zeros(0)  # the map kernel's bounds when a map is not clipped
+_NO_EQUALITIES = np.zeros(0, dtype=np.int64)  # the overlay kernel's, without suckers
 
 
 def _expansion(chain: Chain) -> tuple[np.ndarray, np.ndarray]:
@@ -313,15 +314,22 @@ class ReducedModel:
         says, that number returned."""
         split = int(servos.split[at])
         m.opt.timestep = self.timestep / split
-        torque = servos.torque[at]
-        u = self.red_u
-        m.actuator_gainprm[u, 0] = servos.kp[at]
-        m.actuator_biasprm[u, 1] = -servos.kp[at]
-        m.actuator_biasprm[u, 2] = -servos.kv[at]
-        m.actuator_forcerange[u, 0] = -torque
-        m.actuator_forcerange[u, 1] = torque
-        if len(batch.equality_ids):
-            m.eq_data[self.equality_ids, 3:6] = batch.anchor[row]
+        fast = KERNELS.get()
+        if fast is not None:  # the same values in one call
+            equalities = self.equality_ids if len(batch.equality_ids) else _NO_EQUALITIES
+            fast.servo_overlay(m.actuator_gainprm, m.actuator_biasprm, m.actuator_forcerange,
+                               self.red_u, servos.kp[at], servos.kv[at], servos.torque[at],
+                               m.eq_data, equalities, batch.anchor[row])  # fmt: skip
+        else:
+            torque = servos.torque[at]
+            u = self.red_u
+            m.actuator_gainprm[u, 0] = servos.kp[at]
+            m.actuator_biasprm[u, 1] = -servos.kp[at]
+            m.actuator_biasprm[u, 2] = -servos.kv[at]
+            m.actuator_forcerange[u, 0] = -torque
+            m.actuator_forcerange[u, 1] = torque
+            if len(batch.equality_ids):
+                m.eq_data[self.equality_ids, 3:6] = batch.anchor[row]
         if batch.near[row]:
             size_proxies(m, self.proxy_geoms, batch.proxy_cylinder, batch.proxy_size[row])
         return split

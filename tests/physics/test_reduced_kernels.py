@@ -106,3 +106,37 @@ def test_the_servos_are_numpys_bit_for_bit(
         assert kernel.split[3] > 1 and kernel.split[4] == reduced_module.MAX_SPLIT
         assert np.isnan(kernel.kp[1]).any() and not np.isnan(kernel.kp[0]).any()
         assert np.isnan(kernel.kv[2]).any()  # the edges reached the kernel's gains
+
+
+def test_a_rows_overlay_is_numpys_bit_for_bit(
+    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The servos and sucker anchors a reduced row's step reads from the scratch model,
+    written by the kernel and by numpy: the same model arrays, for every row."""
+    from ecs_tentacles.creator.crowd import crowd_scene
+
+    world = make_world(crowd_scene(6, seed=2))  # several body plans, suckers on every link
+    world.step(3)
+    batch = world.physics.batches[0]
+    batch.prepare(REDUCED, 1)
+    reduced = batch.reduced
+    assert reduced is not None and len(batch.equality_ids)
+    rng = np.random.default_rng(0)
+    batch.anchor[:] = rng.normal(size=batch.anchor.shape)  # as if each row's suckers held
+    rows = np.arange(len(batch.members))
+    batch.kp[rows] *= rng.uniform(0.5, 2.0, size=batch.kp[rows].shape)  # each row its own
+    servos = reduced.servos(batch.kp[rows], batch.kv[rows], batch.torque[rows])
+    m = batch.scratch_for(0, REDUCED).model
+    for at, row in enumerate(rows.tolist()):
+        written = []
+        for backend in ("auto", "numpy"):
+            monkeypatch.setattr(reduced_module.KERNELS, "backend", backend)
+            for name in ("actuator_gainprm", "actuator_biasprm", "actuator_forcerange", "eq_data"):
+                getattr(m, name)[:] = -7.0
+            split = reduced.write_overlay(batch, m, row, servos, at)
+            written.append([split, m.opt.timestep, m.actuator_gainprm.copy(),
+                            m.actuator_biasprm.copy(), m.actuator_forcerange.copy(),
+                            m.eq_data.copy()])  # fmt: skip
+        for kernel, numpy_path in zip(*written, strict=True):
+            np.testing.assert_array_equal(kernel, numpy_path)
+        assert (written[0][5][reduced.equality_ids, 3:6] == batch.anchor[row]).all()
