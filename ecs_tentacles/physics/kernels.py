@@ -58,18 +58,34 @@ def reach(
     """`sense`'s reach spheres alone: no body is copied (a frame needs the bodies of the
     creatures near another only, `ContactProxies.gather`)."""
     for c in range(len(start)):
-        first = start[c]
-        mantle = rows[first]
-        cx, cy, cz = store_pos[mantle, 0], store_pos[mantle, 1], store_pos[mantle, 2]
-        out_centre[c, 0], out_centre[c, 1], out_centre[c, 2] = cx, cy, cz
-        radius = -np.inf
-        for i in range(first, first + count[c]):
-            row = rows[i]
-            dx, dy, dz = store_pos[row, 0] - cx, store_pos[row, 1] - cy, store_pos[row, 2] - cz
-            reach = math.sqrt(dx * dx + dy * dy + dz * dz) + rbound[i]
-            if reach > radius:
-                radius = reach
-        out_radius[c] = radius
+        _sphere(store_pos, rows, start[c], count[c], rbound, c, out_centre, out_radius)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _sphere(
+    pos: np.ndarray,
+    rows: np.ndarray,
+    first: int,
+    count: int,
+    rbound: np.ndarray,
+    c: int,
+    out_centre: np.ndarray,
+    out_radius: np.ndarray,
+) -> None:
+    """Creature c's reach sphere from its `count` bodies from `first` (body i at
+    `pos[rows[i]]`, its mantle first): centre at the mantle, radius to the farthest
+    body's surface."""
+    mantle = rows[first]
+    cx, cy, cz = pos[mantle, 0], pos[mantle, 1], pos[mantle, 2]
+    out_centre[c, 0], out_centre[c, 1], out_centre[c, 2] = cx, cy, cz
+    radius = -np.inf
+    for i in range(first, first + count):
+        row = rows[i]
+        dx, dy, dz = pos[row, 0] - cx, pos[row, 1] - cy, pos[row, 2] - cz
+        reach = math.sqrt(dx * dx + dy * dy + dz * dz) + rbound[i]
+        if reach > radius:
+            radius = reach
+    out_radius[c] = radius
 
 
 @njit(cache=True, nogil=True)
@@ -77,6 +93,7 @@ def moved_bodies(
     used: np.ndarray,
     members: np.ndarray,
     start: np.ndarray,
+    every: np.ndarray,
     rbound: np.ndarray,
     xpos: np.ndarray,
     xquat: np.ndarray,
@@ -88,7 +105,8 @@ def moved_bodies(
     """`ContactProxies.refresh` for one batch: the bodies of its rows whose creature is
     `used` (`members[r]`, roster order) from their last step (`xpos[r]`, `xquat[r]`) into
     `out_pos` / `out_quat` (creature c's bodies from `start[c]`), and those creatures'
-    reach spheres (`reach`'s numbers) into `out_centre` / `out_radius`."""
+    reach spheres (`reach`'s, body i at `out_pos[every[i]]`) into `out_centre` /
+    `out_radius`."""
     bodies = xpos.shape[1]
     for r in range(len(members)):
         c = members[r]
@@ -100,15 +118,7 @@ def moved_bodies(
                 out_pos[first + j, k] = xpos[r, j, k]
             for k in range(4):
                 out_quat[first + j, k] = xquat[r, j, k]
-        cx, cy, cz = out_pos[first, 0], out_pos[first, 1], out_pos[first, 2]
-        out_centre[c, 0], out_centre[c, 1], out_centre[c, 2] = cx, cy, cz
-        radius = -np.inf
-        for i in range(first, first + bodies):
-            dx, dy, dz = out_pos[i, 0] - cx, out_pos[i, 1] - cy, out_pos[i, 2] - cz
-            reach = math.sqrt(dx * dx + dy * dy + dz * dz) + rbound[i]
-            if reach > radius:
-                radius = reach
-        out_radius[c] = radius
+        _sphere(out_pos, every, first, bodies, rbound, c, out_centre, out_radius)
 
 
 @njit(cache=True, nogil=True)

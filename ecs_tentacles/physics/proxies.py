@@ -201,8 +201,8 @@ class ContactProxies:
         fast = KERNELS.get()
         if fast is not None:  # the same numbers, a batch in one pass (4 numpy calls less)
             for batch in self.roster.batches:
-                fast.moved_bodies(used, batch.members, self.start, self.rbound, batch.xpos,
-                                  batch.xquat, pos, quat, centre, radius)  # fmt: skip
+                fast.moved_bodies(used, batch.members, self.start, self._every, self.rbound,
+                                  batch.xpos, batch.xquat, pos, quat, centre, radius)  # fmt: skip
         else:
             for batch, index in zip(self.roster.batches, self.index, strict=True):
                 rows = np.flatnonzero(used[batch.members])
