@@ -21,12 +21,15 @@ import mujoco
 import numpy as np
 
 from ecs_tentacles.ground import GroundMesh, Plane, StaticSpec, ground_of
+from ecs_tentacles.numeric.optional_kernels import OptionalKernels
 from ecs_tentacles.terrain.ground_meshes import ground_meshes
 from ecs_tentacles.terrain.heightfield import BEYOND_DROP, Heightfield
 from ecs_tentacles.terrain.shapes import Solid
 
 NORMAL_SPAN = 0.05  # metres either side over which the slope under a point is measured
 NEAR = 0.5  # metres past a solid's bounding sphere within which distances to it are exact
+# the spheres' queries by numba when installed (`terrain.solid_kernels`); =numpy: numpy
+KERNELS = OptionalKernels("ecs_tentacles.terrain.solid_kernels", "ECS_TENTACLES_SOLIDS")
 
 
 @dataclass(frozen=True)
@@ -84,31 +87,62 @@ class TerrainGround:
             best = (points[:, 2] - self.heightfield.height(xy)) * normal_z
         if not self.solids:
             return best
-        for k, near in self._under_bounds(points, NEAR):
+        for k, near in self._under_bounds(points, NEAR, self._by_numpy()):
             best[near] = np.minimum(best[near], self.solids[k].signed_distance(points[near]))
+        fast = KERNELS.get()
+        if fast is not None and self._spheres()[0].size:  # the spheres, in one pass
+            fast.sphere_distances(points, *self._spheres()[1:], NEAR, best)
         return best
 
     def _under_bounds(
-        self, points: np.ndarray, pad: float | np.ndarray
+        self, points: np.ndarray, pad: float | np.ndarray, among: np.ndarray | None = None
     ) -> Iterator[tuple[int, np.ndarray]]:
-        """(solid, rows of `points`) for each solid whose bounding sphere grown by `pad`
-        (one for all points, or one per point) holds some of `points` (n, 3), or whose
-        bounding circle does for points (n, 2): one array test for all solids, then only
-        the solids that hold any point."""
+        """(solid, rows of `points`) for each solid (of `among`, default all) whose
+        bounding sphere grown by `pad` (one for all points, or one per point) holds some
+        of `points` (n, 3), or whose bounding circle does for points (n, 2): one array
+        test for all solids, then only the solids that hold any point. The squares are
+        summed (x^2 + y^2) + z^2, as the sphere kernels sum them."""
         centres, bounds = self._bounds()
+        solids = np.arange(len(self.solids)) if among is None else among
+        if not len(solids):
+            return
         pads = np.broadcast_to(np.asarray(pad, dtype=np.float64), (len(points),))
         dims = points.shape[1]
-        per_chunk = max(1, (1 << 20) // max(len(self.solids), 1))
+        per_chunk = max(1, (1 << 20) // len(solids))
+        middles = centres[solids] if dims == 2 else self._positions()[solids]
         for start in range(0, len(points), per_chunk):
             part = points[start : start + per_chunk]
-            if dims == 2:
-                gaps = part[:, None, :] - centres[None, :, :]
-            else:
-                gaps = part[:, None, :] - self._positions()[None, :, :]
-            reach = (bounds[None, :] + pads[start : start + per_chunk, None]) ** 2
-            inside = np.einsum("nkd,nkd->nk", gaps, gaps) <= reach
+            gaps = part[:, None, :] - middles[None, :, :]
+            squares = gaps[:, :, 0] ** 2 + gaps[:, :, 1] ** 2
+            if dims == 3:
+                squares += gaps[:, :, 2] ** 2
+            reach = (bounds[solids][None, :] + pads[start : start + per_chunk, None]) ** 2
+            inside = squares <= reach
             for k in np.flatnonzero(inside.any(axis=0)).tolist():
-                yield k, start + np.flatnonzero(inside[:, k])
+                yield int(solids[k]), start + np.flatnonzero(inside[:, k])
+
+    def _spheres(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The spheres among the solids: (k,) their indices, (k, 3) centres and (k,)
+        radii (made once)."""
+        cached = self.__dict__.get("_spheres_cache")
+        if cached is None:
+            ids = [k for k, s in enumerate(self.solids) if s.kind == "sphere"]
+            centres = np.array([self.solids[k].position for k in ids], dtype=np.float64)
+            radii = np.array([self.solids[k].size[0] for k in ids], dtype=np.float64)
+            cached = (np.array(ids, dtype=np.int64), centres.reshape(-1, 3), radii)
+            object.__setattr__(self, "_spheres_cache", cached)  # a cache, not a field
+        return cached
+
+    def _by_numpy(self) -> np.ndarray | None:
+        """The solids numpy answers for, solid by solid: all of them (None), or, when the
+        sphere kernels will answer for the spheres, the others."""
+        if KERNELS.get() is None or not self._spheres()[0].size:
+            return None
+        others = self.__dict__.get("_others_cache")
+        if others is None:
+            others = np.setdiff1d(np.arange(len(self.solids)), self._spheres()[0])
+            object.__setattr__(self, "_others_cache", others)  # a cache, not a field
+        return others
 
     def _positions(self) -> np.ndarray:
         """(k, 3) the solids' centres (made once)."""
@@ -177,11 +211,14 @@ class TerrainGround:
         # the topmost surface's slope, over NORMAL_SPAN either way
         ex, ey = np.array([NORMAL_SPAN, 0.0]), np.array([0.0, NORMAL_SPAN])
         # the four sides' heights in one call (each point's height is its own)
+        count = len(xy)
         sides = self.surface(np.vstack([xy + ex, xy - ex, xy + ey, xy - ey]))
-        east, west, north, south = np.split(sides, 4)
-        gx = (east - west) / (2 * NORMAL_SPAN)
-        gy = (north - south) / (2 * NORMAL_SPAN)
-        n = np.stack([-gx, -gy, np.ones_like(gx)], axis=1)
+        east, west = sides[:count], sides[count : 2 * count]
+        north, south = sides[2 * count : 3 * count], sides[3 * count :]
+        n = np.empty((count, 3))
+        n[:, 0] = -((east - west) / (2 * NORMAL_SPAN))
+        n[:, 1] = -((north - south) / (2 * NORMAL_SPAN))
+        n[:, 2] = 1.0
         return np.asarray(n / np.linalg.norm(n, axis=1, keepdims=True))
 
     def ray(self, origin: np.ndarray, direction: np.ndarray) -> np.ndarray | None:
@@ -208,8 +245,12 @@ class TerrainGround:
         out = self.height(xy)
         if not self.solids:
             return out
-        for k, rows in self._under_bounds(xy, 0.0):  # the points under its bounding circle
+        # the points under each solid's bounding circle
+        for k, rows in self._under_bounds(xy, 0.0, self._by_numpy()):
             out[rows] = np.maximum(out[rows], self.solids[k].top(xy[rows]))
+        fast = KERNELS.get()
+        if fast is not None and self._spheres()[0].size:  # the spheres, in one pass
+            fast.sphere_tops(xy, *self._spheres()[1:], out)
         return out
 
     def _static(self) -> tuple[mujoco.MjModel, mujoco.MjData]:
@@ -248,8 +289,14 @@ class TerrainGround:
     def touches_obstacle(self, centres: np.ndarray, reach: np.ndarray) -> np.ndarray:
         """(n,) whose sphere (`centres` (n, 3), `reach` (n,)) meets an obstacle: bounding
         spheres cull, then each obstacle's signed distance decides."""
+        centres = np.asarray(centres, dtype=np.float64).reshape(-1, 3)
+        reach = np.asarray(reach, dtype=np.float64).reshape(-1)
         near = np.zeros(len(centres), dtype=bool)
-        for k, rows in self._under_bounds(centres, reach):  # each sphere its own pad
+        fast = KERNELS.get()
+        if fast is not None and self._spheres()[0].size:  # the spheres, in one pass
+            fast.sphere_touches(centres, reach, *self._spheres()[1:], near)
+        # each ball its own pad
+        for k, rows in self._under_bounds(centres, reach, self._by_numpy()):
             rows = rows[~near[rows]]
             if len(rows):
                 near[rows] = self.solids[k].signed_distance(centres[rows]) <= reach[rows]

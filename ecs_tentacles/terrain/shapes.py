@@ -67,9 +67,9 @@ class Solid:
 
     def signed_distance(self, points: np.ndarray) -> np.ndarray:
         """Metres from points (n, 3) to the surface, negative inside."""
+        if self.kind == "sphere":  # turning a sphere changes nothing: not turned
+            return np.asarray(np.linalg.norm(points - self.position, axis=1) - self.size[0])
         local = (points - self.position) @ self.rotation
-        if self.kind == "sphere":
-            return np.asarray(np.linalg.norm(local, axis=1) - self.size[0])
         if self.kind == "box":
             return _box_distance(local, np.asarray(self.size))
         if self.kind == "cylinder":
