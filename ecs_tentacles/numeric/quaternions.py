@@ -19,8 +19,9 @@ def quat_about_z(angle: np.ndarray | float) -> np.ndarray:
     return out
 
 
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    # np.cross is general and slow for small arrays; this is the same for (..., 3)
+def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """`np.cross(a, b)` of (..., 3) arrays: the same products and differences, without
+    the general function's bookkeeping (four times the arithmetic for small arrays)."""
     a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
     b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
     return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
@@ -40,8 +41,8 @@ def quat_rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
         return out
     w = q[..., :1]
     u = q[..., 1:]
-    t = 2.0 * _cross(u, v)
-    return np.asarray(v + w * t + _cross(u, t))
+    t = 2.0 * cross(u, v)
+    return np.asarray(v + w * t + cross(u, t))
 
 
 def quat_multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -11,6 +11,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ecs_tentacles.numeric.quaternions import cross
+
 CAMERA_RULE = "frame-all, follow NAME or X,Y,Z,TX,TY,TZ (eye, then the point looked at)"
 FIT_BORDER = 0.06  # share of the picture left free round what `fit` frames
 _DIRECTIONS = 96  # directions whose extreme points stand for a large point set in `fit`
@@ -74,19 +76,12 @@ def perspective(fov_y: float, aspect: float, near: float, far: float) -> np.ndar
     return m
 
 
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """a x b of two 3-vectors (np.cross's checks cost more than the product here)."""
-    return np.array(
-        [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-    )
-
-
 def look_at(eye: np.ndarray, target: np.ndarray, up: np.ndarray) -> np.ndarray:
     forward = target - eye
     forward = forward / np.linalg.norm(forward)
-    right = _cross(forward, up)
+    right = cross(forward, up)
     right = right / np.linalg.norm(right)
-    true_up = _cross(right, forward)
+    true_up = cross(right, forward)
     m = np.eye(4)
     m[0, :3], m[1, :3], m[2, :3] = right, true_up, -forward
     m[:3, 3] = -m[:3, :3] @ eye
