@@ -80,7 +80,9 @@ def ground_follow(world: Host, ground: Ground, rows: np.ndarray) -> np.ndarray:
     t, pos = world.tentacles, world.transforms.pos
     creature = t.creature_row[rows]
     mantle_quat = world.transforms.quat[world.creatures.mantle_row[creature]]
-    up = quat_rotate(mantle_quat, np.array([0.0, 0.0, 1.0]))
+    up = np.zeros((len(rows), 3))
+    up[:, 2] = 1.0
+    up = quat_rotate(mantle_quat, up)  # (one vector a quaternion: quat_rotate's one pass)
     base = pos[t.base_row[rows]]
     along = pos[t.base_row[rows] + t.links[rows] - 1] - base
     along -= np.sum(along * up, axis=1, keepdims=True) * up
