@@ -381,22 +381,16 @@ class Batch:
         assert reduced is not None  # `prepare(REDUCED)` ran before the threads
         scratch, full = self.scratch_for(thread, REDUCED), self.scratch_for(thread, FULL)
         m, fm, fd = scratch.model, full.model, full.data
-        state, rstate, rsource, watched = self.state, self.rstate, self.rsource, reduced.watched
+        state, rstate, rsource = self.state, self.rstate, self.rsource
         qpos = self.slices[int(S.mjSTATE_QPOS)]
         bodies = self.model_bodies  # a slice when the bodies are one run: no gather
         # whole-array work for the rows at once (each row's bits as if alone): the frame's
         # inputs pulled into the reduced states (fitted again where the full state was
         # written from outside since the row's last step), every row's reduced servos
         began = time.perf_counter()
-        unchanged = (state[rows, watched] == rsource[rows]).all(axis=1)
-        pulled = rows[unchanged]
-        if len(pulled):
-            block = rstate[pulled]
-            reduced.pull_rows(state[pulled], block)
-            rstate[pulled] = block
-        for row in rows[~unchanged].tolist():
+        for row in reduced.pull_into(rows, state, rstate, rsource).tolist():
             reduced.fit_state(state[row], rstate[row])
-        servos = reduced.servos(self.kp[rows], self.kv[rows], self.torque[rows])
+        servos = reduced.servos(self.kp, self.kv, self.torque, rows)
         stepped = np.zeros(len(rows), dtype=bool)
         took = np.zeros(len(rows))
         shared = time.perf_counter() - began
@@ -412,10 +406,7 @@ class Batch:
         began = time.perf_counter()
         done = rows[stepped]
         if len(done):
-            block = state[done]
-            reduced.expand_rows(rstate[done], block)
-            state[done] = block
-            rsource[done] = block[:, watched]
+            reduced.show_rows(done, rstate, state, rsource)
         joints, poses, turns = fd.qpos, fd.xpos, fd.xquat  # MjData's arrays: fixed views
         for row in done.tolist():
             joints[:] = state[row, qpos]

@@ -198,6 +198,11 @@ class ReducedModel:
         )  # fmt: skip
         self._angles = (rq.start + self.red_q, fq.start + self.full_q)
         self._speeds = (rv.start + self.red_v, fv.start + self.full_v)
+        # the same for the row kernels: pairs stacked, slices as (start, stop)
+        self._input_pairs, self._shown_pairs = np.vstack(self._inputs), np.vstack(self._shown)
+        self._watched = np.array([self.watched.start, self.watched.stop])
+        warm = self.full_slices[int(S.mjSTATE_WARMSTART)]
+        self._warm = np.array([warm.start, warm.stop])
         self._torque_u = self.full_u[self.first]
         self.timestep = float(model.opt.timestep)
         # kp h^2 / I of each reduced servo per unit kp (STIFF_STEP)
@@ -225,6 +230,46 @@ class ReducedModel:
         rv[self.red_v] = self.fit @ fv[self.full_v]
         self.pull_inputs(full_state, out)
 
+    def pull_into(
+        self, rows: np.ndarray, state: np.ndarray, rstate: np.ndarray, rsource: np.ndarray
+    ) -> np.ndarray:
+        """The frame's inputs pulled into the reduced states of batch rows `rows` (`rstate`,
+        in place; `state` the batch's full states) where the full state is still as their
+        last step left it (`rsource`, the watched part); returns the others, whose full
+        state was written from outside since (to fit again)."""
+        fast = KERNELS.get()
+        if fast is not None:  # the same numbers, row by row in place: no gathered copies
+            changed = np.zeros(len(rows), dtype=bool)
+            commands, servos = self._controls
+            fast.pull_into(rows, state, rsource, self._watched, rstate, self._input_pairs,
+                           commands, *self._fit_sums, servos, changed)  # fmt: skip
+            return rows[changed]
+        unchanged = (state[rows, self.watched] == rsource[rows]).all(axis=1)
+        pulled = rows[unchanged]
+        if len(pulled):
+            block = rstate[pulled]
+            self.pull_rows(state[pulled], block)
+            rstate[pulled] = block
+        written: np.ndarray = rows[~unchanged]
+        return written
+
+    def show_rows(
+        self, rows: np.ndarray, rstate: np.ndarray, state: np.ndarray, rsource: np.ndarray
+    ) -> None:
+        """Batch rows `rows`' reduced states (`rstate`) shown as their full states (`state`,
+        in place: `expand_rows`), and the watched part kept in `rsource` (what `pull_into`
+        compares with next time)."""
+        fast = KERNELS.get()
+        if fast is not None:  # the same numbers, row by row in place: no gathered copies
+            fast.show_rows(rows, rstate, state, self._shown_pairs, *self._angles, *self._speeds,
+                           *self._expand_sums, self._low, self.limit, self._warm, self._watched,
+                           rsource)  # fmt: skip
+            return
+        block = state[rows]
+        self.expand_rows(rstate[rows], block)
+        state[rows] = block
+        rsource[rows] = block[:, self.watched]
+
     def pull_inputs(self, full_state: np.ndarray, out: np.ndarray) -> None:
         """What the systems wrote into the full state this frame (servo targets fitted,
         sucker switches, proxy poses, the clock) into the reduced state `out`."""
@@ -238,8 +283,8 @@ class ReducedModel:
         source, target = self._controls
         fast = KERNELS.get()
         if fast is not None:  # the same sums, the interpreter's lock released
-            fast.group_sums_into(full_states, source, *self._fit_sums, _NO_CLIP, _NO_CLIP,
-                                 out, target)  # fmt: skip
+            fast.group_sums_into(full_states, np.arange(len(out)), source, *self._fit_sums,
+                                 _NO_CLIP, _NO_CLIP, out, target)  # fmt: skip
             return
         out[:, target] = _group_sums(full_states[:, source], *self._fit_sums)
 
@@ -255,11 +300,12 @@ class ReducedModel:
         out[:, target] = reduced_states[:, source]
         fast = KERNELS.get()
         if fast is not None:  # the same sums and clip, the interpreter's lock released
+            rows = np.arange(len(out))
             source, target = self._angles
-            fast.group_sums_into(reduced_states, source, *self._expand_sums, self._low,
+            fast.group_sums_into(reduced_states, rows, source, *self._expand_sums, self._low,
                                  self.limit, out, target)  # fmt: skip
             source, target = self._speeds
-            fast.group_sums_into(reduced_states, source, *self._expand_sums, _NO_CLIP,
+            fast.group_sums_into(reduced_states, rows, source, *self._expand_sums, _NO_CLIP,
                                  _NO_CLIP, out, target)  # fmt: skip
         else:
             source, target = self._angles
@@ -270,9 +316,12 @@ class ReducedModel:
         out[:, self.full_slices[int(S.mjSTATE_WARMSTART)]] = 0.0
 
     # -- model values ----------------------------------------------------------------
-    def servos(self, kp: np.ndarray, kv: np.ndarray, torque: np.ndarray) -> Servos:
+    def servos(
+        self, kp: np.ndarray, kv: np.ndarray, torque: np.ndarray, rows: np.ndarray | None = None
+    ) -> Servos:
         """The reduced servos of rows whose full servos have gains `kp`, `kv` and torque
-        limits `torque` (rows, full actuators): each reduced one its group's, matched at
+        limits `torque` (rows, full actuators; with `rows`, of those rows of them only,
+        in that order): each reduced one its group's, matched at
         the tip, and each row's step split in as many as its stiffest servo needs
         (`STIFF_STEP`; 1 but for servos far stiffer than a default creature's, and where a
         gain is not finite: the health check sees that failure). Summed group member by
@@ -280,17 +329,20 @@ class ReducedModel:
         it is computed with (a frame's rows are shared among threads as they free up)."""
         fast = KERNELS.get()
         if fast is not None:  # the same numbers, the interpreter's lock released
-            rows, servos = len(kp), len(self._members)
-            gains, damping = np.empty((rows, servos)), np.empty((rows, servos))
-            split = np.empty(rows, dtype=np.int64)
+            picked = np.arange(len(kp)) if rows is None else rows
+            count, servos = len(picked), len(self._members)
+            gains, damping = np.empty((count, servos)), np.empty((count, servos))
+            split = np.empty(count, dtype=np.int64)
             # read now, as numpy's path does: a tool may set another reduced model's gains
             constants = np.array(
                 [STIFFNESS_GAIN, DAMPING_GAIN, DAMPING_CAP, STIFF_STEP, MAX_SPLIT], np.float64
             )
-            fast.servos(kp, kv, self.full_u, self._members, self._weights,
+            fast.servos(picked, kp, kv, self.full_u, self._members, self._weights,
                         self._stiff_per_kp, self._critical_per_sqrt_kp, constants,
                         gains, damping, split)  # fmt: skip
-            return Servos(gains, damping, torque[:, self._torque_u], split)
+            return Servos(gains, damping, torque[picked[:, None], self._torque_u], split)
+        if rows is not None:
+            kp, kv, torque = kp[rows], kv[rows], torque[rows]
         full = self.full_u
         compliance = _group_sums(1.0 / np.maximum(kp[:, full], 1e-12), self._members, self._weights)
         gains = STIFFNESS_GAIN / compliance

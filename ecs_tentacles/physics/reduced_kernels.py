@@ -1,7 +1,9 @@
 """The numba kernels of the reduced tier (`physics.reduced`): its maps (the full servo
 commands pulled into a reduced state, a reduced state's joints shown on the full
-skeleton, each a weighted sum over a group of columns), its servos' gains, and a row's
-servos written into the scratch model before its step.
+skeleton, each a weighted sum over a group of columns), a share's rows pulled and shown
+in place (the maps row by row, no gathered copies: a share of 64 crowd creatures on
+rocky ground spent about 120 us a call in numpy's gathers and scatters), its servos'
+gains, and a row's servos written into the scratch model before its step.
 
 Optional, as the other kernels are: `ReducedModel` imports this module only when numba
 is installed and falls back to numpy otherwise; both give the same numbers bit for bit
@@ -22,6 +24,7 @@ from numba import njit
 @njit(cache=True, nogil=True)
 def group_sums_into(
     values: np.ndarray,
+    rows: np.ndarray,
     columns: np.ndarray,
     members: np.ndarray,
     weights: np.ndarray,
@@ -30,11 +33,11 @@ def group_sums_into(
     out: np.ndarray,
     out_columns: np.ndarray,
 ) -> None:
-    """For each row r of `values` and each k: the sum over p, in order, of
+    """For each of `rows` r and each k: the sum over p, in order, of
     values[r, columns[members[k, p]]] x weights[k, p], clipped into [low[k], high[k]]
     when `low` is not empty (NaN stays NaN), into out[r, out_columns[k]]."""
     clip = low.shape[0] > 0
-    for r in range(values.shape[0]):
+    for r in rows:
         for k in range(members.shape[0]):
             total = values[r, columns[members[k, 0]]] * weights[k, 0]
             for p in range(1, members.shape[1]):
@@ -47,6 +50,82 @@ def group_sums_into(
             out[r, out_columns[k]] = total
 
 
+@njit(cache=True, nogil=True)
+def pull_into(
+    rows: np.ndarray,
+    state: np.ndarray,
+    source: np.ndarray,
+    watched: np.ndarray,
+    rstate: np.ndarray,
+    inputs: np.ndarray,
+    commands: np.ndarray,
+    members: np.ndarray,
+    weights: np.ndarray,
+    servos: np.ndarray,
+    changed: np.ndarray,
+) -> None:
+    """`ReducedModel.pull_into` in place: for each of `rows` whose full state's entries
+    watched[0]:watched[1] equal its `source` row (as its last step left them), the
+    frame's inputs copied (`inputs`: full columns, reduced columns) and its servo
+    commands (full columns `commands`) summed into its `rstate` row (columns `servos`);
+    the others marked in `changed` (a NaN there counts as changed, as numpy's ==)."""
+    start, stop = watched[0], watched[1]
+    pulled = np.empty(rows.shape[0], dtype=np.int64)
+    count = 0
+    for i in range(rows.shape[0]):
+        row = rows[i]
+        same = True
+        for c in range(start, stop):
+            if state[row, c] != source[row, c - start]:
+                same = False
+                break
+        if not same:
+            changed[i] = True
+            continue
+        for c in range(inputs.shape[1]):
+            rstate[row, inputs[1, c]] = state[row, inputs[0, c]]
+        pulled[count] = row
+        count += 1
+    none = np.zeros(0)
+    group_sums_into(state, pulled[:count], commands, members, weights, none, none, rstate, servos)
+
+
+@njit(cache=True, nogil=True)
+def show_rows(
+    rows: np.ndarray,
+    rstate: np.ndarray,
+    state: np.ndarray,
+    shown: np.ndarray,
+    angles: np.ndarray,
+    full_angles: np.ndarray,
+    speeds: np.ndarray,
+    full_speeds: np.ndarray,
+    members: np.ndarray,
+    weights: np.ndarray,
+    low: np.ndarray,
+    high: np.ndarray,
+    warm: np.ndarray,
+    watched: np.ndarray,
+    source: np.ndarray,
+) -> None:
+    """`ReducedModel.show_rows` in place: each of `rows`' reduced state shown as its full
+    state (`shown` (reduced columns, full columns) copied; the reduced columns `angles`
+    summed and clipped into [low, high] into the full columns `full_angles`, `speeds`
+    into `full_speeds`; the warm start warm[0]:warm[1] cleared), and
+    the full state's watched[0]:watched[1] kept in its `source` row."""
+    none = np.zeros(0)
+    group_sums_into(rstate, rows, angles, members, weights, low, high, state, full_angles)
+    group_sums_into(rstate, rows, speeds, members, weights, none, none, state, full_speeds)
+    for i in range(rows.shape[0]):
+        row = rows[i]
+        for c in range(shown.shape[1]):
+            state[row, shown[1, c]] = rstate[row, shown[0, c]]
+        for c in range(warm[0], warm[1]):
+            state[row, c] = 0.0
+        for c in range(watched[0], watched[1]):
+            source[row, c - watched[0]] = state[row, c]
+
+
 @njit(cache=True, nogil=True, inline="always")
 def _softest(gain: float) -> float:
     """1 / max(gain, 1e-12), NaN kept (as numpy's `1.0 / np.maximum(gain, 1e-12)`)."""
@@ -55,6 +134,7 @@ def _softest(gain: float) -> float:
 
 @njit(cache=True, nogil=True, error_model="numpy")
 def servos(
+    rows: np.ndarray,
     kp: np.ndarray,
     kv: np.ndarray,
     full_u: np.ndarray,
@@ -67,14 +147,15 @@ def servos(
     damping: np.ndarray,
     split: np.ndarray,
 ) -> None:
-    """`ReducedModel.servos`' numbers for each row of `kp` / `kv` (full actuators), into
-    `gains`, `damping` (rows, reduced servos) and `split` (rows,); `constants` are the
+    """`ReducedModel.servos`' numbers for rows `rows` of `kp` / `kv` (full actuators),
+    into `gains`, `damping` (len(rows), reduced servos) and `split`; `constants` are the
     stiffness gain, damping gain, damping cap, stiff step and most splits. Division by
     zero gives infinities, as numpy's (error_model="numpy")."""
     stiffness_gain, damping_gain, cap = constants[0], constants[1], constants[2]
     stiff_step, most = constants[3], constants[4]
     width = members.shape[1]
-    for r in range(kp.shape[0]):
+    for i in range(rows.shape[0]):
+        r = rows[i]
         stiffest = -np.inf
         for k in range(members.shape[0]):
             compliance = _softest(kp[r, full_u[members[k, 0]]]) * weights[k, 0]
@@ -83,7 +164,7 @@ def servos(
                 compliance += _softest(kp[r, full_u[members[k, p]]]) * weights[k, p]
                 matched += _softest(kv[r, full_u[members[k, p]]]) * weights[k, p]
             gain = stiffness_gain / compliance
-            gains[r, k] = gain
+            gains[i, k] = gain
             stiff = gain * stiff_per_kp[k]
             if not math.isnan(stiffest) and (stiff > stiffest or math.isnan(stiff)):
                 stiffest = stiff  # np.max: NaN wins
@@ -91,10 +172,10 @@ def servos(
             critical = math.sqrt(gain) * critical_per_sqrt_kp[k]
             soft = damping_gain * matched_kv
             capped = stiffness_gain * matched_kv + cap * critical
-            damping[r, k] = soft if soft <= capped or math.isnan(soft) else capped
-        split[r] = 1
+            damping[i, k] = soft if soft <= capped or math.isnan(soft) else capped
+        split[i] = 1
         if stiffest > stiff_step and stiffest < np.inf:
-            split[r] = int(min(math.ceil(math.sqrt(stiffest / stiff_step)), most))
+            split[i] = int(min(math.ceil(math.sqrt(stiffest / stiff_step)), most))
 
 
 @njit(cache=True, nogil=True)

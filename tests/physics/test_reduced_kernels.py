@@ -140,3 +140,45 @@ def test_a_rows_overlay_is_numpys_bit_for_bit(
         for kernel, numpy_path in zip(*written, strict=True):
             np.testing.assert_array_equal(kernel, numpy_path)
         assert (written[0][5][reduced.equality_ids, 3:6] == batch.anchor[row]).all()
+
+
+def test_a_shares_rows_are_pulled_and_shown_as_numpy_does_bit_for_bit(
+    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A share's rows, in place: the frame's inputs pulled into the reduced states of the
+    rows whose full state is as their last step left it (the others, written from outside,
+    handed back to be fitted), their servos picked by row, and stepped states shown on
+    the full skeleton with the compared part kept: the kernels' bits are numpy's."""
+    from ecs_tentacles.creator.crowd import crowd_scene
+
+    world = make_world(crowd_scene(6, seed=2, uniform=True))  # one body plan: one batch
+    world.step(3)
+    batch = world.physics.batches[0]
+    batch.prepare(REDUCED, 1)
+    reduced = batch.reduced
+    assert reduced is not None and len(batch.members) >= 5
+    rng = np.random.default_rng(4)
+    state = rng.normal(0.0, 0.5, (len(batch.members), batch.state.shape[1]))
+    rstate: np.ndarray = rng.normal(0.0, 0.5, (len(batch.members), reduced.size))
+    rsource = state[:, reduced.watched].copy()
+    rsource[1, 3] += 1e-9  # row 1's full state was written from outside
+    rsource[3, 0] = np.nan  # and row 3's holds a NaN: never "as its step left it"
+    state[3, reduced.watched.start] = np.nan
+    rows = np.array([4, 1, 3, 0])  # a share, in the order the plan hands it out
+    results = []
+    for backend in ("auto", "numpy"):
+        monkeypatch.setattr(reduced_module.KERNELS, "backend", backend)
+        mine = [state.copy(), rstate.copy(), rsource.copy()]
+        refit = reduced.pull_into(rows, mine[0], mine[1], mine[2])
+        servos = reduced.servos(batch.kp, batch.kv, batch.torque, rows)
+        stepped = mine[1] + 0.25  # as if the rows stepped
+        reduced.show_rows(rows[[0, 3]], stepped, mine[0], mine[2])
+        results.append((refit, servos.kp, servos.kv, servos.torque, servos.split, *mine))
+    for kernel, numpy_path in zip(*results, strict=True):
+        assert kernel.dtype == numpy_path.dtype and kernel.tobytes() == numpy_path.tobytes()
+    refit, kp, *_ = results[0]
+    assert refit.tolist() == [1, 3]  # written from outside: fitted, not pulled
+    shown_state, pulled, kept = results[0][5:]
+    assert not np.array_equal(pulled[4], rstate[4]) and np.array_equal(pulled[1], rstate[1])
+    assert np.array_equal(kept[4], shown_state[4, reduced.watched])  # shown: kept to compare
+    assert np.array_equal(kp, reduced.servos(batch.kp[rows], batch.kv[rows], batch.torque[rows]).kp)
