@@ -182,3 +182,24 @@ def test_a_shares_rows_are_pulled_and_shown_as_numpy_does_bit_for_bit(
     assert not np.array_equal(pulled[4], rstate[4]) and np.array_equal(pulled[1], rstate[1])
     assert np.array_equal(kept[4], shown_state[4, reduced.watched])  # shown: kept to compare
     assert np.array_equal(kp, reduced.servos(batch.kp[rows], batch.kv[rows], batch.torque[rows]).kp)
+
+
+def test_a_shares_step_costs_are_numpys_bit_for_bit(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The running mean of the reduced rows' step times (for sharing rows between
+    threads): first measures taken as they are, later ones averaged in."""
+    from ecs_tentacles.physics.batch import running_costs
+
+    rng = np.random.default_rng(6)
+    start = rng.uniform(1e-5, 1e-3, (9, 3))
+    start[[2, 5], REDUCED] = 0.0  # never measured yet
+    rows, took = np.array([5, 0, 2, 7]), rng.uniform(1e-5, 1e-3, 4)
+    found = []
+    for backend in ("auto", "numpy"):
+        monkeypatch.setattr(reduced_module.KERNELS, "backend", backend)
+        cost = start.copy()
+        running_costs(cost, rows, REDUCED, took, 3e-6, 2)
+        found.append(cost)
+    assert found[0].tobytes() == found[1].tobytes()
+    assert found[0][5, REDUCED] == (took[0] + 3e-6) / 2  # the first measure, as it is
+    assert found[0][0, REDUCED] == 0.75 * start[0, REDUCED] + 0.25 * (took[1] + 3e-6) / 2
+    assert np.array_equal(found[0][[1, 3, 4, 6, 8]], start[[1, 3, 4, 6, 8]])
