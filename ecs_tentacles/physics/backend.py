@@ -236,8 +236,9 @@ class PhysicsBackend(Membership):
         target = motors.target.reshape(-1)
         strength, gain, damping = motors.strength, motors.gain, motors.damping
         fast = KERNELS.get()
+        commanded = self.roster.commanded
         for batch in self.batches:
-            live = ~self.frozen[batch.members] & (self.tier[batch.members] != KINEMATIC)
+            live = commanded[batch.members]
             soften = self.soften[batch.members]
             if fast is not None:  # the same numbers in one pass, live rows only
                 fast.servo_commands(target, batch.actuator_target_index, strength, gain, damping,
@@ -265,12 +266,11 @@ class PhysicsBackend(Membership):
 
     def write_suckers(self, suckers: SuckerStore) -> None:
         """Switch sucker equalities on/off and place their world anchors."""
+        commanded = self.roster.commanded
         for batch in self.batches:
             if not len(batch.equality_ids):
                 continue
-            live = np.flatnonzero(
-                ~self.frozen[batch.members] & (self.tier[batch.members] != KINEMATIC)
-            )
+            live = np.flatnonzero(commanded[batch.members])
             rows = batch.sucker_rows[live]
             batch.anchor[live] = suckers.anchor[rows]
             switches = suckers.attached[rows].astype(np.float64)

@@ -66,6 +66,13 @@ class Roster:
         return self.batches[int(self.batch_of[index])], int(self.row_of[index])
 
     @property
+    def commanded(self) -> np.ndarray:
+        """Creatures whose commands are written (not frozen, not kinematic: an asleep one
+        too, which its commands may wake), whole-roster once a frame rather than batch by
+        batch."""
+        return np.asarray(~self.frozen & (self.tier != KINEMATIC))
+
+    @property
     def active(self) -> np.ndarray:
         """Creatures stepped this frame (not frozen, not asleep, not kinematic)."""
         return np.asarray(~(self.frozen | self.sleeping) & (self.tier != KINEMATIC))

@@ -18,7 +18,6 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ecs_tentacles.physics.batch import without_row
-from ecs_tentacles.physics.tiers import KINEMATIC
 
 if TYPE_CHECKING:
     from ecs_tentacles.physics.host import PhysicsHost
@@ -92,9 +91,10 @@ class Sleep:
             return
         roster = self.roster
         attached = world.suckers.attached
+        commanded = roster.commanded
         for batch, previous in zip(roster.batches, self.commands, strict=True):
             members = batch.members
-            stepped = ~roster.frozen[members] & (roster.tier[members] != KINEMATIC)
+            stepped = commanded[members]
             every = bool(stepped.all())
             rows: slice | np.ndarray = slice(None) if every else np.flatnonzero(stepped)
             who = members[rows]
