@@ -267,10 +267,16 @@ class PhysicsBackend(Membership):
     def write_suckers(self, suckers: SuckerStore) -> None:
         """Switch sucker equalities on/off and place their world anchors."""
         commanded = self.roster.commanded
+        fast = KERNELS.get()
         for batch in self.batches:
             if not len(batch.equality_ids):
                 continue
             live = np.flatnonzero(commanded[batch.members])
+            if fast is not None:  # the same values in one pass, no gathered copies
+                first = batch.slices[int(S.mjSTATE_EQ_ACTIVE)].start
+                fast.sucker_switches(live, batch.sucker_rows, suckers.anchor, suckers.attached,
+                                     batch.anchor, batch.state, first)  # fmt: skip
+                continue
             rows = batch.sucker_rows[live]
             batch.anchor[live] = suckers.anchor[rows]
             switches = suckers.attached[rows].astype(np.float64)

@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING
 import mujoco
 import numpy as np
 
+from ecs_tentacles.numeric.optional_kernels import OptionalKernels
 from ecs_tentacles.numeric.rows import run_slice
 from ecs_tentacles.physics.model import (
     PROXY_CAPSULES,
@@ -43,6 +44,10 @@ if TYPE_CHECKING:
     from ecs_tentacles.physics.reduced import ReducedModel
     from ecs_tentacles.store import TransformStore
 
+# the poses' scatter by numba when installed (`physics.frame_kernels`); =numpy: numpy
+FRAME_KERNELS = OptionalKernels(
+    "ecs_tentacles.physics.frame_kernels", "ECS_TENTACLES_PHYSICS_FRAME"
+)
 WARNING_KINDS = len(mujoco.MjData(mujoco.MjModel.from_xml_string("<mujoco/>")).warning)
 
 
@@ -303,7 +308,11 @@ class Batch:
         """Every row's body poses into the Transform store (one scatter per field, or one
         copy when the rows are consecutive)."""
         span = self.body_span()
-        if span is None:
+        fast = FRAME_KERNELS.get()
+        if span is None and fast is not None:  # the same copies, without numpy's indexing
+            fast.scatter_poses(self.body_rows, self.xpos, self.xquat, transforms.pos,
+                               transforms.quat)  # fmt: skip
+        elif span is None:
             transforms.pos[self.body_rows] = self.xpos
             transforms.quat[self.body_rows] = self.xquat
         else:

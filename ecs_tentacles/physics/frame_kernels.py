@@ -1,6 +1,7 @@
-"""The numba kernels of the physics' own per-frame bookkeeping: the servo commands into
-the batch rows (`PhysicsBackend.write_controls`), and the fastest body of every creature
-and the rows' faults (`HealthCheck.check`).
+"""The numba kernels of the physics' own per-frame bookkeeping: the servo commands and
+the sucker switches into the batch rows (`PhysicsBackend.write_controls`,
+`write_suckers`), the fastest body of every creature and the rows' faults
+(`HealthCheck.check`), and the body poses into the Transform store (`Batch.sync`).
 
 Optional, as the other kernels are: their users import this module only when numba is
 installed and fall back to numpy otherwise; both compute the same numbers bit for bit
@@ -107,3 +108,39 @@ def row_faults(
                 break
         if fault:
             bad[c] = True
+
+
+@njit(cache=True, nogil=True)
+def sucker_switches(
+    live: np.ndarray,
+    sucker_rows: np.ndarray,
+    anchors: np.ndarray,
+    attached: np.ndarray,
+    batch_anchor: np.ndarray,
+    state: np.ndarray,
+    first: int,
+) -> None:
+    """`PhysicsBackend.write_suckers` for one batch: each of batch rows `live` gets its
+    suckers' (store rows `sucker_rows[row]`) world anchors in `batch_anchor[row]` and
+    their switches (1.0 attached, else 0.0) in state[row, first:]."""
+    for row in live:
+        for e in range(sucker_rows.shape[1]):
+            sucker = sucker_rows[row, e]
+            for k in range(3):
+                batch_anchor[row, e, k] = anchors[sucker, k]
+            state[row, first + e] = 1.0 if attached[sucker] else 0.0
+
+
+@njit(cache=True, nogil=True)
+def scatter_poses(
+    body_rows: np.ndarray, xpos: np.ndarray, xquat: np.ndarray, pos: np.ndarray, quat: np.ndarray
+) -> None:
+    """`Batch.sync`: every row's body poses (xpos, xquat: rows, bodies, 3 / 4) into the
+    Transform store's rows `body_rows` (rows, bodies) of `pos` and `quat`."""
+    for r in range(body_rows.shape[0]):
+        for b in range(body_rows.shape[1]):
+            at = body_rows[r, b]
+            for k in range(3):
+                pos[at, k] = xpos[r, b, k]
+            for k in range(4):
+                quat[at, k] = xquat[r, b, k]

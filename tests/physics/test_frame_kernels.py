@@ -11,6 +11,7 @@ from numpy.testing import assert_array_equal
 
 from ecs_tentacles.physics import backend as backend_module
 from ecs_tentacles.physics import health as health_module
+from ecs_tentacles.physics.state_layout import S
 from ecs_tentacles.world import World
 
 SCENE: dict[str, Any] = {
@@ -115,3 +116,61 @@ def test_the_health_check_finds_the_same_faults_with_and_without_kernels(
         {"penetration": 1},
         {},
     ]
+
+
+def test_sucker_switches_are_numpys(
+    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    world = make_world(SCENE)
+    world.step(3)
+    physics, suckers = world.physics, world.suckers
+    rng = np.random.default_rng(2)
+    suckers.anchor[:] = rng.normal(size=suckers.anchor.shape)
+    suckers.attached[:] = rng.random(len(suckers.attached)) < 0.5
+    physics.frozen[2] = True  # keeps what it had: neither path writes its row
+    batch = physics.batches[0]
+    assert len(batch.equality_ids) and suckers.attached.any() and not suckers.attached.all()
+    written = []
+    for backend in ("auto", "numpy"):
+        monkeypatch.setattr(backend_module.KERNELS, "backend", backend)
+        batch.anchor[:] = -7.0
+        batch.state[:] = -7.0
+        physics.write_suckers(suckers)
+        written.append([batch.anchor.copy(), batch.state.copy()])
+    for kernel, numpy in zip(*written, strict=True):
+        assert kernel.tobytes() == numpy.tobytes()
+    anchor, state = written[0]
+    row = int(physics.row_of[2])
+    assert (anchor[row] == -7.0).all() and not (np.delete(anchor, row, axis=0) == -7.0).any()
+    switches = state[:, batch.slices[int(S.mjSTATE_EQ_ACTIVE)]]
+    live = np.delete(np.arange(len(state)), row)
+    assert set(np.unique(switches[live])) == {0.0, 1.0}
+
+
+def test_the_poses_scatter_is_numpys(
+    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Body poses copied into the Transform store where a batch's rows are not one run
+    of store rows (several body plans, their creatures interleaved)."""
+    from ecs_tentacles.creator.crowd import crowd_scene
+    from ecs_tentacles.physics import batch as batch_module
+
+    world = make_world(crowd_scene(16, seed=2))
+    world.step(2)
+    batches = world.physics.batches
+    assert any(b.body_span() is None for b in batches)  # the scattered case is reached
+    rng = np.random.default_rng(3)
+    for b in batches:
+        b.xpos[:] = rng.normal(size=b.xpos.shape)
+        b.xquat[:] = rng.normal(size=b.xquat.shape)
+    stores = []
+    for backend in ("auto", "numpy"):
+        monkeypatch.setattr(batch_module.FRAME_KERNELS, "backend", backend)
+        world.transforms.pos[:] = -7.0
+        world.transforms.quat[:] = -7.0
+        world.physics.sync(world.transforms)
+        stores.append([world.transforms.pos.copy(), world.transforms.quat.copy()])
+    for kernel, numpy in zip(*stores, strict=True):
+        assert kernel.tobytes() == numpy.tobytes()
+    for b in batches:
+        assert np.array_equal(stores[0][0][b.body_rows], b.xpos)
