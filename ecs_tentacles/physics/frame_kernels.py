@@ -144,3 +144,72 @@ def scatter_poses(
                 pos[at, k] = xpos[r, b, k]
             for k in range(4):
                 quat[at, k] = xquat[r, b, k]
+
+
+@njit(cache=True, nogil=True)
+def sleep_rows(
+    members: np.ndarray,
+    commanded: np.ndarray,
+    proxies_used: np.ndarray,
+    wants: np.ndarray,
+    creature_row: np.ndarray,
+    attached: np.ndarray,
+    sucker_rows: np.ndarray,
+    ctrl: np.ndarray,
+    kp: np.ndarray,
+    qvel: np.ndarray,
+    previous: np.ndarray,
+    limits: np.ndarray,
+    known: np.ndarray,
+    still: np.ndarray,
+    sleeping: np.ndarray,
+) -> None:
+    """`Sleep.update` for one batch's rows (`members`: their creatures): a commanded
+    creature is calm when it has no proxies, its last commands are known, no plugin
+    `wants` it to move (empty: none does), none of its suckers is attached and its
+    commands (ctrl, kp) moved less than limits[0] since `previous` (NaN: moved); its
+    commands are kept; a restless one is awake with its stillness count at 0, a calm
+    one awake counts a still frame when its fastest speed is below limits[1] (NaN: not
+    moving, as numpy's max and >=), else restarts, and sleeps at limits[2] frames."""
+    change, speed, settle = limits[0], limits[1], limits[2]
+    nu = ctrl.shape[1]
+    for r in range(members.shape[0]):
+        i = members[r]
+        if not commanded[i]:
+            continue
+        calm = proxies_used[i] == 0 and known[i]
+        if calm and wants.shape[0] and wants[creature_row[i]]:
+            calm = False
+        if calm:
+            for e in range(sucker_rows.shape[1]):
+                if attached[sucker_rows[r, e]]:
+                    calm = False
+                    break
+        if calm:
+            for j in range(nu):
+                if not (abs(ctrl[r, j] - previous[r, j]) < change):
+                    calm = False
+                    break
+                if not (abs(kp[r, j] - previous[r, nu + j]) < change):
+                    calm = False
+                    break
+        for j in range(nu):
+            previous[r, j] = ctrl[r, j]
+            previous[r, nu + j] = kp[r, j]
+        known[i] = True
+        if not calm:
+            still[i] = 0
+            sleeping[i] = False
+            continue
+        if sleeping[i]:
+            continue
+        fastest = 0.0
+        for j in range(qvel.shape[1]):
+            v = abs(qvel[r, j])
+            if v != v:
+                fastest = v
+                break
+            if v > fastest:
+                fastest = v
+        still[i] = 0 if fastest >= speed else still[i] + 1
+        sleeping[i] = still[i] >= settle

@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ecs_tentacles.numeric.optional_kernels import OptionalKernels
 from ecs_tentacles.physics.batch import without_row
 
 if TYPE_CHECKING:
@@ -26,6 +27,9 @@ if TYPE_CHECKING:
 SETTLE_FRAMES = 30  # frames of stillness before a creature sleeps
 STILL_SPEED = 1e-3  # m/s or rad/s: slower than this counts as still
 COMMAND_CHANGE = 1e-9  # servo targets or gains that moved less than this did not change
+# the decisions by numba when installed (`physics.frame_kernels`); =numpy: numpy
+KERNELS = OptionalKernels("ecs_tentacles.physics.frame_kernels", "ECS_TENTACLES_PHYSICS_FRAME")
+_NOBODY = np.zeros(0, dtype=bool)  # the kernel's `wants` when no plugin wants motion
 
 
 @dataclass(frozen=True)
@@ -92,6 +96,16 @@ class Sleep:
         roster = self.roster
         attached = world.suckers.attached
         commanded = roster.commanded
+        fast = KERNELS.get()
+        if fast is not None:  # the same decisions, a pass a batch
+            wants = _NOBODY if wants_motion is None else wants_motion
+            limits = np.array([COMMAND_CHANGE, STILL_SPEED, SETTLE_FRAMES], dtype=np.float64)
+            for batch, previous in zip(roster.batches, self.commands, strict=True):
+                fast.sleep_rows(batch.members, commanded, roster.proxies_used, wants,
+                                roster.creature_row, attached, batch.sucker_rows, batch.ctrl,
+                                batch.kp, batch.qvel, previous, limits, self.known, self.still,
+                                roster.sleeping)  # fmt: skip
+            return
         for batch, previous in zip(roster.batches, self.commands, strict=True):
             members = batch.members
             stepped = commanded[members]

@@ -7,6 +7,7 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
+import pytest
 from numpy.testing import assert_array_equal
 
 from ecs_tentacles.components import Creature
@@ -111,3 +112,65 @@ def test_with_locomotion_off_no_goal_keeps_anyone_awake(
     world = make_world(_scene({"count": 3, "links": 5}), plugins=off)
     world.step(240)
     assert world.physics.groups[0].sleeping
+
+
+def test_the_sleep_kernel_decides_as_numpy_bit_for_bit(
+    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Every way a creature stays awake or falls asleep, decided by the kernel and by
+    numpy from the same state: the same counters, commands and sleepers."""
+    from ecs_tentacles.creator.crowd import crowd_scene
+    from ecs_tentacles.physics import sleep as sleep_module
+
+    world = make_world(crowd_scene(12, seed=1, uniform=True))
+    world.step(2)
+    physics, sleep = world.physics, world.physics.sleep
+    batch = physics.batches[0]
+    rows = len(batch.members)
+    assert rows == 12 and len(batch.equality_ids)
+    rng = np.random.default_rng(5)
+    qvel = batch.qvel
+    qvel[:] = rng.uniform(-1e-4, 1e-4, qvel.shape)  # still
+    qvel[5, 3] = 0.5  # calm but moving
+    qvel[6, 2] = np.nan  # calm, a NaN speed: numpy's max and >= call it not moving,
+    qvel[6, 5] = 0.5  # even beside a fast joint
+    for creature, previous in zip(batch.members, sleep.commands[0], strict=True):
+        previous[:] = np.concatenate([batch.ctrl[physics.row_of[creature]],
+                                      batch.kp[physics.row_of[creature]]])  # fmt: skip
+    sleep.commands[0][7, 1] += 1.0  # its commands changed
+    sleep.commands[0][8, -1] = np.nan  # unknown last gain: changed
+    start_known = np.ones(rows, dtype=bool)
+    start_known[batch.members[9]] = False  # its last commands unknown
+    proxies = np.zeros(rows, dtype=np.int64)
+    proxies[batch.members[1]] = 2  # someone near
+    attached = np.zeros(len(world.suckers.attached), dtype=bool)
+    attached[batch.sucker_rows[2, 0]] = True  # a sucker holds
+    # creatures' store rows not their physics order (as after a despawn elsewhere)
+    monkeypatch.setattr(physics.roster, "creature_row", physics.roster.creature_row[::-1].copy())
+    wants = np.zeros(len(world.creatures), dtype=bool)
+    wants[physics.roster.creature_row[batch.members[3]]] = True  # a plugin wants it to move
+    still = np.full(rows, SETTLE_FRAMES - 1)  # one more still frame: asleep
+    still[batch.members[10]] = 4
+    sleeping = np.zeros(rows, dtype=bool)
+    sleeping[batch.members[11]] = True
+    physics.frozen[batch.members[4]] = True  # not commanded: untouched
+    monkeypatch.setattr(world.suckers, "attached", attached)
+    decided = []
+    for backend in ("auto", "numpy"):
+        monkeypatch.setattr(sleep_module.KERNELS, "backend", backend)
+        saved = [c.copy() for c in sleep.commands]
+        sleep.known[:], sleep.still[:] = start_known, still
+        physics.proxies_used[:], physics.sleeping[:] = proxies, sleeping
+        sleep.update(world, wants)
+        decided.append([sleep.known.copy(), sleep.still.copy(), physics.sleeping.copy(),
+                        *[c.copy() for c in sleep.commands]])  # fmt: skip
+        sleep.commands = saved
+    for kernel, numpy_path in zip(*decided, strict=True):
+        assert kernel.tobytes() == numpy_path.tobytes()
+    known, counted, asleep = decided[0][:3]
+    by_row = counted[batch.members]
+    assert by_row[[1, 2, 3, 7, 8, 9, 5]].tolist() == [0] * 7  # awake, count restarted
+    assert by_row[4] == SETTLE_FRAMES - 1 and not asleep[batch.members[4]]  # frozen: as it was
+    assert known.all()  # every commanded one's commands known now; the frozen one's were
+    assert asleep[batch.members[[0, 6]]].all() and by_row[10] == 5  # calm and still: counted
+    assert asleep[batch.members[11]] and by_row[11] == SETTLE_FRAMES - 1  # asleep: stays
