@@ -119,3 +119,38 @@ def targets(
         eased[link, 0], eased[link, 1] = e0, e1
         target[link, 0], target[link, 1] = e0, e1
         gain[link] = strength[t] + strength[t] * writhe[t] * (0.5 * sin[i] + half_root3 * cos[i])
+
+
+@njit(cache=True, nogil=True)
+def follow_reach(
+    pos: np.ndarray,
+    quat: np.ndarray,
+    mantles: np.ndarray,
+    bases: np.ndarray,
+    tips: np.ndarray,
+    length: np.ndarray,
+    out: np.ndarray,
+) -> None:
+    """`ground_follow`'s reach points: for tentacle i, its base (store row bases[i]) plus
+    length[i] along base -> tip (tips[i]) laid onto its mantle's (mantles[i]) plane, the
+    mantle's up being its quaternion turning (0, 0, 1) as `quat_rotate` does."""
+    for i in range(bases.shape[0]):
+        m = mantles[i]
+        w, x, y, z = quat[m, 0], quat[m, 1], quat[m, 2], quat[m, 3]
+        t0 = 2.0 * (y * 1.0 - z * 0.0)
+        t1 = 2.0 * (z * 0.0 - x * 1.0)
+        t2 = 2.0 * (x * 0.0 - y * 0.0)
+        u0 = 0.0 + w * t0 + (y * t2 - z * t1)
+        u1 = 0.0 + w * t1 + (z * t0 - x * t2)
+        u2 = 1.0 + w * t2 + (x * t1 - y * t0)
+        b, t = bases[i], tips[i]
+        a0, a1, a2 = pos[t, 0] - pos[b, 0], pos[t, 1] - pos[b, 1], pos[t, 2] - pos[b, 2]
+        along = (a0 * u0 + a1 * u1) + a2 * u2
+        a0, a1, a2 = a0 - along * u0, a1 - along * u1, a2 - along * u2
+        size = np.sqrt((a0 * a0 + a1 * a1) + a2 * a2)
+        if not (size >= 1e-9 or size != size):  # np.maximum(size, 1e-9): NaN kept
+            size = 1e-9
+        a0, a1, a2 = a0 / size, a1 / size, a2 / size
+        out[i, 0] = pos[b, 0] + length[i] * a0
+        out[i, 1] = pos[b, 1] + length[i] * a1
+        out[i, 2] = pos[b, 2] + length[i] * a2

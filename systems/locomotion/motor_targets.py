@@ -78,17 +78,23 @@ def ground_follow(world: Host, ground: Ground, rows: np.ndarray) -> np.ndarray:
     plane would be `gap` above the surface; a droop ramp of 2 atan(gap / length) lowers
     it so."""
     t, pos = world.tentacles, world.transforms.pos
-    creature = t.creature_row[rows]
-    mantle_quat = world.transforms.quat[world.creatures.mantle_row[creature]]
-    up = np.zeros((len(rows), 3))
-    up[:, 2] = 1.0
-    up = quat_rotate(mantle_quat, up)  # (one vector a quaternion: quat_rotate's one pass)
-    base = pos[t.base_row[rows]]
-    along = pos[t.base_row[rows] + t.links[rows] - 1] - base
-    along -= np.sum(along * up, axis=1, keepdims=True) * up
-    along /= np.maximum(np.linalg.norm(along, axis=1, keepdims=True), 1e-9)
     length = t.length[rows]
-    reach = base + length[:, None] * along
+    mantles = world.creatures.mantle_row[t.creature_row[rows]]
+    tips = t.base_row[rows] + t.links[rows] - 1
+    fast = KERNELS.get()
+    if fast is not None:  # the same points in one pass
+        reach = np.empty((len(rows), 3))
+        fast.follow_reach(pos, world.transforms.quat, mantles, t.base_row[rows], tips, length,
+                          reach)  # fmt: skip
+    else:
+        up = np.zeros((len(rows), 3))
+        up[:, 2] = 1.0
+        up = quat_rotate(world.transforms.quat[mantles], up)
+        base = pos[t.base_row[rows]]
+        along = pos[tips] - base
+        along -= np.sum(along * up, axis=1, keepdims=True) * up
+        along /= np.maximum(np.linalg.norm(along, axis=1, keepdims=True), 1e-9)
+        reach = base + length[:, None] * along
     gap = ground.distance(reach)
     return np.clip(2.0 * np.arctan2(gap, length), -FOLLOW_LIMIT, FOLLOW_LIMIT)
 

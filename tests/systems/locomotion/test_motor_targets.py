@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 from collections.abc import Callable
 
 import numpy as np
@@ -243,3 +244,34 @@ def test_a_crowd_moves_the_same_with_and_without_the_kernels(
         make_world, KERNELS, monkeypatch, crowd_scene(6, seed=4), 90
     )
     assert_array_equal(kernel.transforms.pos, numpy_path.transforms.pos)
+
+
+def test_the_ground_follow_kernel_reaches_numpys_points_bit_for_bit(
+    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The droop that lays tentacles onto terrain, with the mantles turned every way, a
+    tentacle folded straight up its mantle's axis (nothing left to lay down) and one NaN
+    pose: the kernel's reach points are numpy's."""
+    from ecs_tentacles.systems.locomotion.motor_targets import ground_follow
+
+    from ecs_tentacles.cli.crowd import crowd_from_args
+    from ecs_tentacles.ground import ground_of
+
+    args = argparse.Namespace(seed=2, spacing=None, idle=0.0, species=8, uniform=False)
+    world = make_world(crowd_from_args(12, argparse.Namespace(**vars(args), terrain="rocky")))
+    world.step(5)
+    t, transforms = world.tentacles, world.transforms
+    rng = np.random.default_rng(7)
+    quat = rng.normal(size=(len(world.creatures), 4))
+    transforms.quat[world.creatures.mantle_row] = quat / np.linalg.norm(quat, axis=1)[:, None]
+    transforms.quat[world.creatures.mantle_row[0]] = [1.0, 0.0, 0.0, 0.0]
+    base, tip = t.base_row[0], t.base_row[0] + t.links[0] - 1
+    transforms.pos[tip] = transforms.pos[base] + [0.0, 0.0, 0.3]  # along the mantle's up
+    transforms.pos[t.base_row[5]] = np.nan
+    rows = np.arange(len(t))
+    droops = []
+    for backend in ("auto", "numpy"):
+        monkeypatch.setattr(KERNELS, "backend", backend)
+        droops.append(ground_follow(world, ground_of(world), rows))
+    assert droops[0].tobytes() == droops[1].tobytes()
+    assert np.isnan(droops[0][5]) and np.isfinite(np.delete(droops[0], 5)).all()
