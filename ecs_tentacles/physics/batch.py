@@ -308,16 +308,17 @@ class Batch:
         """Every row's body poses into the Transform store (one scatter per field, or one
         copy when the rows are consecutive)."""
         span = self.body_span()
-        fast = FRAME_KERNELS.get()
-        if span is None and fast is not None:  # the same copies, without numpy's indexing
-            fast.scatter_poses(self.body_rows, self.xpos, self.xquat, transforms.pos,
-                               transforms.quat)  # fmt: skip
-        elif span is None:
-            transforms.pos[self.body_rows] = self.xpos
-            transforms.quat[self.body_rows] = self.xquat
-        else:
+        if span is not None:
             transforms.pos[span] = self.xpos.reshape(-1, 3)
             transforms.quat[span] = self.xquat.reshape(-1, 4)
+            return
+        fast = FRAME_KERNELS.get()
+        if fast is not None:  # the same copies, without numpy's indexing
+            fast.scatter_poses(self.body_rows, self.xpos, self.xquat, transforms.pos,
+                               transforms.quat)  # fmt: skip
+        else:
+            transforms.pos[self.body_rows] = self.xpos
+            transforms.quat[self.body_rows] = self.xquat
 
     def body_span(self) -> slice | None:
         """`body_rows` (rows, bodies) as one slice of store rows when they are consecutive
