@@ -290,7 +290,10 @@ class TerrainGround:
         """(n,) whose sphere (`centres` (n, 3), `reach` (n,)) meets an obstacle: bounding
         spheres cull, then each obstacle's signed distance decides."""
         centres = np.asarray(centres, dtype=np.float64).reshape(-1, 3)
-        reach = np.asarray(reach, dtype=np.float64).reshape(-1)
+        # one a ball, as the kernel reads them (a single reach is one for every ball)
+        reach = np.ascontiguousarray(
+            np.broadcast_to(np.asarray(reach, dtype=np.float64), (len(centres),))
+        )
         near = np.zeros(len(centres), dtype=bool)
         fast = KERNELS.get()
         if fast is not None and self._spheres()[0].size:  # the spheres, in one pass

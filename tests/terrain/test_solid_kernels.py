@@ -96,3 +96,13 @@ def test_a_turned_sphere_is_as_far_as_an_unturned_one() -> None:
     sphere = Solid("sphere", centre, turned, (0.4,))
     expected = np.linalg.norm(points - centre, axis=1) - 0.4
     assert np.array_equal(sphere.signed_distance(points), expected)
+
+
+def test_one_reach_for_every_ball_is_each_balls_reach() -> None:
+    """`touches_obstacle` given a single reach (not one a ball) reads it for every ball,
+    with the kernels as with numpy: none reads past the end of a one-entry array."""
+    ground = _ground()
+    points = _points(ground)
+    one = ground.touches_obstacle(points, np.array(0.2))
+    each = ground.touches_obstacle(points, np.full(len(points), 0.2))
+    assert np.array_equal(one, each) and one.any() and not one.all()
