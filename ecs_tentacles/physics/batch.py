@@ -445,8 +445,8 @@ def running_costs(
     if fast is not None:
         fast.running_costs(cost, rows, tier, took, shared, substeps)
         return
-    seconds, last = (took + shared) / substeps, cost[rows, tier]
-    cost[rows, tier] = np.where(last == 0.0, seconds, 0.75 * last + 0.25 * seconds)
+    for at, row in enumerate(rows.tolist()):
+        _took(cost, row, tier, (float(took[at]) + shared) / substeps)
 
 
 def without_row(array: np.ndarray, row: int) -> np.ndarray:
