@@ -22,7 +22,6 @@ physics through them alone. The backend sees a world as `PhysicsHost` (`physics.
 from __future__ import annotations
 
 import functools
-import logging
 import os
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
@@ -41,6 +40,7 @@ from ecs_tentacles.physics.blas import quiet_blas
 from ecs_tentacles.physics.health import SOFT_GAIN, HealthCheck, HealthState
 from ecs_tentacles.physics.lod import LevelOfDetail
 from ecs_tentacles.physics.membership import Membership, compile_models
+from ecs_tentacles.physics.messages import route_mujoco_messages
 from ecs_tentacles.physics.model import ModelLayout, model_layout
 from ecs_tentacles.physics.proxies import ContactProxies
 from ecs_tentacles.physics.roster import Roster
@@ -54,18 +54,8 @@ if TYPE_CHECKING:
     from ecs_tentacles.physics.host import PhysicsHost
     from ecs_tentacles.store import MotorStore, SuckerStore, TransformStore
 
-log = logging.getLogger("ecs_tentacles.mujoco")
 KERNELS = OptionalKernels("ecs_tentacles.physics.frame_kernels", "ECS_TENTACLES_PHYSICS_FRAME")
 S = mujoco.mjtState
-
-
-def _log_mujoco_warning(message: str) -> None:
-    log.warning("%s", message.strip())
-
-
-def route_mujoco_messages() -> None:
-    """Send MuJoCo's warnings to `logging`, never to MUJOCO_LOG.TXT in the working folder."""
-    mujoco.set_mju_user_warning(_log_mujoco_warning)
 
 
 @dataclass(frozen=True)

@@ -27,7 +27,7 @@ import mujoco
 import numpy as np
 
 from ecs_tentacles.numeric.optional_kernels import OptionalKernels
-from ecs_tentacles.numeric.rows import run_slice
+from ecs_tentacles.numeric.rows import run_slice, without_row
 from ecs_tentacles.physics.model import (
     PROXY_CAPSULES,
     PROXY_CYLINDERS,
@@ -447,10 +447,3 @@ def running_costs(
         return
     for at, row in enumerate(rows.tolist()):
         _took(cost, row, tier, (float(took[at]) + shared) / substeps)
-
-
-def without_row(array: np.ndarray, row: int) -> np.ndarray:
-    """`array` without row `row`: the rows after it moved up in place (no new buffer,
-    unlike `np.delete`; a despawn in a big crowd moves megabytes of state)."""
-    array[row:-1] = array[row + 1 :]
-    return array[:-1]

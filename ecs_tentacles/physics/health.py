@@ -33,8 +33,7 @@ import numpy as np
 
 from ecs_tentacles.events import CreatureFrozen, CreatureRecovered, SuckerReleased
 from ecs_tentacles.numeric.optional_kernels import OptionalKernels
-from ecs_tentacles.numeric.rows import run_slice
-from ecs_tentacles.physics.batch import without_row
+from ecs_tentacles.numeric.rows import run_slice, without_row
 
 if TYPE_CHECKING:
     from ecs_tentacles.physics.host import PhysicsHost

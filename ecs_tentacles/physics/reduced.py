@@ -1,7 +1,8 @@
 """The REDUCED tier's model: about half the links per tentacle at a quarter of the rate.
 
-The reduced creature's body is built in `physics.reduced_body`; it steps at a quarter
-of the scene's rate (`tiers.reduced_substeps`: 120 Hz at the default 480 Hz).
+The reduced creature's body is built in `physics.reduced_body`, the maps below in
+`physics.reduced_maps`; it steps at a quarter of the scene's rate
+(`tiers.reduced_substeps`: 120 Hz at the default 480 Hz).
 
 `ReducedModel` maps states between the two models, tentacle by tentacle and hinge axis
 by hinge axis, through each link's heading along the tentacle (the sum of its joint
@@ -35,6 +36,14 @@ import mujoco
 import numpy as np
 
 from ecs_tentacles.numeric.optional_kernels import OptionalKernels
+from ecs_tentacles.physics.reduced_maps import (
+    block_diagonal,
+    expansion,
+    group_sums,
+    padded,
+    reduced_body,
+    tip_compliance,
+)
 from ecs_tentacles.physics.state_layout import STATE, Rows, size_proxies, state_slices
 
 if TYPE_CHECKING:
@@ -88,35 +97,6 @@ _NO_CLIP = np.zeros(0)  # the map kernel's bounds when a map is not clipped
 _NO_EQUALITIES = np.zeros(0, dtype=np.int64)  # the overlay kernel's, without suckers
 
 
-def _expansion(chain: Chain) -> tuple[np.ndarray, np.ndarray]:
-    """(E, F) for one axis of `chain`: full angles = E @ reduced angles (headings
-    interpolated at the full links' centres); reduced = F @ full (least squares on the
-    links' ends and headings, small angles)."""
-    lengths, reduced = chain.lengths, chain.reduced_lengths
-    n, k = len(lengths), len(reduced)
-    centres = np.cumsum(lengths) - 0.5 * lengths
-    reduced_centres = np.cumsum(reduced) - 0.5 * reduced
-    interp = np.zeros((n, k))  # full headings from reduced headings
-    for i, c in enumerate(centres):
-        j = int(np.searchsorted(reduced_centres, c))
-        if j == 0:
-            interp[i, 0] = 1.0
-        elif j >= k:
-            interp[i, k - 1] = 1.0
-        else:
-            t = (c - reduced_centres[j - 1]) / (reduced_centres[j] - reduced_centres[j - 1])
-            interp[i, j - 1], interp[i, j] = 1.0 - t, t
-    heading_n = np.tril(np.ones((n, n)))  # headings = cumulative angles
-    heading_k = np.tril(np.ones((k, k)))
-    difference = np.linalg.inv(heading_n)
-    expand = difference @ interp @ heading_k
-    ends = np.tril(np.ones((n, n))) * lengths[None, :]  # small-angle offsets of link ends
-    scale = float(lengths.mean())
-    measure = np.vstack([ends @ heading_n, scale * heading_n])
-    fit = np.linalg.pinv(measure @ expand) @ measure
-    return expand, fit
-
-
 class ReducedModel:
     """A batch's reduced model and the maps between its states and the full model's."""
 
@@ -142,20 +122,20 @@ class ReducedModel:
                 full_u += [full.actuator(n).id for n in full_names]
                 red_u += [model.actuator(n).id for n in red_names]
                 limits += [float(j.range[1]) for j in fj]
-                expand, fit = _expansion(chain)
+                expand, fit = expansion(chain)
                 blocks_e.append(expand)
                 blocks_f.append(fit)
-                weights.append(_tip_compliance(chain))
+                weights.append(tip_compliance(chain))
                 first += [offset + int(g[0]) for g in chain.groups]
                 offset += len(chain.lengths)
-        self.expand = _block_diagonal(blocks_e)  # (full hinges, reduced hinges)
-        self.fit = _block_diagonal(blocks_f)  # (reduced hinges, full hinges)
+        self.expand = block_diagonal(blocks_e)  # (full hinges, reduced hinges)
+        self.fit = block_diagonal(blocks_f)  # (reduced hinges, full hinges)
         # reduced hinge <- its group's full hinges, each weighted (d_i / d_1)^2
-        self.compliance = _block_diagonal(weights)
-        # the three maps as padded group sums (`_group_sums`: a row's bits whatever rows
+        self.compliance = block_diagonal(weights)
+        # the three maps as padded group sums (`group_sums`: a row's bits whatever rows
         # share the call)
-        self._members, self._weights = _padded(self.compliance)
-        self._fit_sums, self._expand_sums = _padded(self.fit), _padded(self.expand)
+        self._members, self._weights = padded(self.compliance)
+        self._fit_sums, self._expand_sums = padded(self.fit), padded(self.expand)
         self.first = np.array(first, dtype=np.int64)  # each reduced hinge's first full one
         self.limit = np.array(limits)
         self.full_q, self.red_q = np.array(full_q), np.array(red_q)
@@ -213,7 +193,7 @@ class ReducedModel:
         names = [mujoco.mj_id2name(full, obj.mjOBJ_BODY, b) for b in range(full.nbody)]
         self.body_group = np.zeros((model.nbody, full.nbody))  # applied forces: summed
         for b, name in enumerate(names):
-            target = _reduced_body(name, tentacles)
+            target = reduced_body(name, tentacles)
             if target is not None:
                 self.body_group[model.body(target).id, b] = 1.0
 
@@ -286,7 +266,7 @@ class ReducedModel:
             fast.group_sums_into(full_states, np.arange(len(out)), source, *self._fit_sums,
                                  _NO_CLIP, _NO_CLIP, out, target)  # fmt: skip
             return
-        out[:, target] = _group_sums(full_states[:, source], *self._fit_sums)
+        out[:, target] = group_sums(full_states[:, source], *self._fit_sums)
 
     def expand_state(self, reduced_state: np.ndarray, out: np.ndarray) -> None:
         """The full state `out` shows the reduced state: root and clock copied, joint
@@ -309,10 +289,10 @@ class ReducedModel:
                                  _NO_CLIP, out, target)  # fmt: skip
         else:
             source, target = self._angles
-            angles = _group_sums(reduced_states[:, source], *self._expand_sums)
+            angles = group_sums(reduced_states[:, source], *self._expand_sums)
             out[:, target] = np.minimum(np.maximum(angles, self._low, out=angles), self.limit)
             source, target = self._speeds
-            out[:, target] = _group_sums(reduced_states[:, source], *self._expand_sums)
+            out[:, target] = group_sums(reduced_states[:, source], *self._expand_sums)
         out[:, self.full_slices[int(S.mjSTATE_WARMSTART)]] = 0.0
 
     # -- model values ----------------------------------------------------------------
@@ -344,13 +324,13 @@ class ReducedModel:
         if rows is not None:
             kp, kv, torque = kp[rows], kv[rows], torque[rows]
         full = self.full_u
-        compliance = _group_sums(1.0 / np.maximum(kp[:, full], 1e-12), self._members, self._weights)
+        compliance = group_sums(1.0 / np.maximum(kp[:, full], 1e-12), self._members, self._weights)
         gains = STIFFNESS_GAIN / compliance
         stiff = np.max(gains * self._stiff_per_kp, axis=1)
         split = np.ones(len(gains), dtype=np.int64)
         far = (stiff > STIFF_STEP) & (stiff < np.inf)
         split[far] = np.minimum(np.ceil(np.sqrt(stiff[far] / STIFF_STEP)), MAX_SPLIT)
-        matched = _group_sums(1.0 / np.maximum(kv[:, full], 1e-12), self._members, self._weights)
+        matched = group_sums(1.0 / np.maximum(kv[:, full], 1e-12), self._members, self._weights)
         matched_kv = 1.0 / matched
         critical = np.sqrt(gains) * self._critical_per_sqrt_kp
         damping = np.minimum(
@@ -397,61 +377,3 @@ class ReducedModel:
             [mujoco.mj_name2id(self.model, obj.mjOBJ_GEOM,
                                mujoco.mj_id2name(full, obj.mjOBJ_GEOM, int(g)))
              for g in batch.proxy_geoms], dtype=np.int64)  # fmt: skip
-
-
-def _tip_compliance(chain: Chain) -> np.ndarray:
-    """(reduced links, full links): row k weighs full joint i of group k by (d_i / d_1)^2,
-    d the joint's distance to the tentacle's tip and d_1 that of the group's first joint
-    (where the reduced joint is): the tip's give under a force there, joint by joint."""
-    lengths = chain.lengths
-    to_tip = lengths.sum() - (np.cumsum(lengths) - lengths)  # from each joint (link start)
-    weights = np.zeros((len(chain.groups), len(lengths)))
-    for k, group in enumerate(chain.groups):
-        weights[k, group] = (to_tip[group] / to_tip[group[0]]) ** 2
-    return weights
-
-
-def _reduced_body(name: str | None, tentacles: list[Chain]) -> str | None:
-    """The reduced body standing for full body `name` (None for proxies and the world)."""
-    if name == "mantle":
-        return "mantle"
-    if not name or not name.startswith("t") or "/l" not in name:
-        return None
-    tentacle, link = name[1:].split("/l")
-    chain = next(c for c in tentacles if c.tentacle == int(tentacle))
-    k = next(k for k, g in enumerate(chain.groups) if int(link) in g)
-    return f"t{tentacle}/l{k:02d}"
-
-
-def _block_diagonal(blocks: list[np.ndarray]) -> np.ndarray:
-    rows, cols = sum(b.shape[0] for b in blocks), sum(b.shape[1] for b in blocks)
-    out = np.zeros((rows, cols))
-    r = c = 0
-    for b in blocks:
-        out[r : r + b.shape[0], c : c + b.shape[1]] = b
-        r, c = r + b.shape[0], c + b.shape[1]
-    return out
-
-
-def _padded(matrix: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(members, weights), each (rows, most nonzeros in a row): row i's nonzero columns
-    of `matrix` in order and their entries, padded with its first column at weight 0."""
-    width = max(1, int((matrix != 0).sum(axis=1).max(initial=0)))
-    members = np.zeros((len(matrix), width), dtype=np.int64)
-    weights = np.zeros((len(matrix), width))
-    for i, row in enumerate(matrix):
-        columns = np.flatnonzero(row)
-        members[i] = columns[0] if len(columns) else 0
-        members[i, : len(columns)] = columns
-        weights[i, : len(columns)] = row[columns]
-    return members, weights
-
-
-def _group_sums(values: np.ndarray, members: np.ndarray, weights: np.ndarray) -> np.ndarray:
-    """(rows, len(members)): per row of `values`, sum over p of values[members[:, p]] x
-    weights[:, p], p in order (`_padded`): elementwise, the same bits for a row however
-    many rows are summed at once."""
-    total: np.ndarray = values[:, members[:, 0]] * weights[:, 0]
-    for p in range(1, members.shape[1]):
-        total += values[:, members[:, p]] * weights[:, p]
-    return total

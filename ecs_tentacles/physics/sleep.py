@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ecs_tentacles.numeric.optional_kernels import OptionalKernels
-from ecs_tentacles.physics.batch import without_row
+from ecs_tentacles.numeric.rows import without_row
 
 if TYPE_CHECKING:
     from ecs_tentacles.physics.host import PhysicsHost
