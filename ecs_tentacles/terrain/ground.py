@@ -110,13 +110,14 @@ class TerrainGround:
         dims = points.shape[1]
         per_chunk = max(1, (1 << 20) // len(solids))
         middles = centres[solids] if dims == 2 else self._positions()[solids]
+        reaches = bounds[solids]
         for start in range(0, len(points), per_chunk):
             part = points[start : start + per_chunk]
             gaps = part[:, None, :] - middles[None, :, :]
             squares = gaps[:, :, 0] ** 2 + gaps[:, :, 1] ** 2
             if dims == 3:
                 squares += gaps[:, :, 2] ** 2
-            reach = (bounds[solids][None, :] + pads[start : start + per_chunk, None]) ** 2
+            reach = (reaches[None, :] + pads[start : start + per_chunk, None]) ** 2
             inside = squares <= reach
             for k in np.flatnonzero(inside.any(axis=0)).tolist():
                 yield int(solids[k]), start + np.flatnonzero(inside[:, k])
