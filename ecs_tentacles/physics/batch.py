@@ -335,19 +335,21 @@ class Batch:
             self._step_reduced(rows, substeps, thread)
             return
         scratch = self.scratch_for(thread, tier)
-        m, d = scratch.model, scratch.data
+        m, poses, turns = scratch.model, scratch.xpos, scratch.xquat
         state, bodies, applied = self.state, self.model_bodies, self.applied
-        xpos, xquat, clock, cost = self.xpos, self.xquat, time.perf_counter, self.step_cost
+        xpos, xquat, clock = self.xpos, self.xquat, time.perf_counter
         scratch.warnings[:] = 0  # `_advance` clears them after a row that raised one
+        took = []  # each row's seconds, into the running costs at once after the share
         began = clock()
         for row in rows.tolist():
             write_overlay(self, m, row)
             if self._advance(scratch, row, state[row], applied.get(row), substeps):
-                xpos[row] = d.xpos[bodies]
-                xquat[row] = d.xquat[bodies]
+                xpos[row] = poses[bodies]
+                xquat[row] = turns[bodies]
             ended = clock()
-            _took(cost, row, FULL, (ended - began) / substeps)
+            took.append(ended - began)
             began = ended
+        running_costs(self.step_cost, rows, FULL, np.array(took), 0.0, substeps)
 
     def _advance(
         self,
@@ -430,7 +432,7 @@ class Batch:
 
 def _took(cost: np.ndarray, row: int, tier: int, seconds: float) -> None:
     """A step of `row` at `tier` took `seconds`: into `cost` (`Batch.step_cost`), a
-    running mean (scalars, a row at a time: no arrays per share of a frame)."""
+    running mean (`running_costs`' numpy path, a row at a time)."""
     last = cost[row, tier]
     cost[row, tier] = seconds if last == 0.0 else 0.75 * last + 0.25 * seconds
 

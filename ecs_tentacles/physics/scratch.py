@@ -19,7 +19,10 @@ class Scratch:
     forced: bool = False  # applied forces were written into `data` (zero them next time)
     warnings: np.ndarray = field(init=False)  # `data.warning.number`, looked up once
     no_warnings: bytes = field(init=False)  # its bytes when nothing was raised
+    xpos: np.ndarray = field(init=False)  # `data.xpos` and `data.xquat`, looked up once
+    xquat: np.ndarray = field(init=False)  # (views of MjData's buffer: they never move)
 
     def __post_init__(self) -> None:
         self.warnings = self.data.warning.number
         self.no_warnings = bytes(self.warnings.nbytes)
+        self.xpos, self.xquat = self.data.xpos, self.data.xquat
