@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any, Literal, TypeVar
 import esper
 import numpy as np
 
+from ecs_tentacles import stops
 from ecs_tentacles.components import Creature
 from ecs_tentacles.events import Events
 from ecs_tentacles.physics.backend import PhysicsBackend
@@ -311,10 +312,20 @@ class World:
         stays at the failed frame. With `on_failure`, it is called with the failure
         instead and the frame goes on with the next system (the sandbox disables the
         failed one there and keeps running).
+
+        Under the command line a Ctrl-C or SIGTERM arriving meanwhile is raised before
+        the next frame, not inside this one (a second one at once: `ecs_tentacles.stops`).
         """
         self.activate()
         dt = self.settings.dt
+        with stops.deferred():
+            self._frames(frames, dt, on_failure)
+
+    def _frames(
+        self, frames: int, dt: float, on_failure: Callable[[SystemFailure], None] | None
+    ) -> None:
         for _ in range(frames):
+            stops.check()
             for system in self.schedule:  # a disable() now does not change this frame's list
                 try:
                     system.process(self, dt)

@@ -4,13 +4,10 @@
 from __future__ import annotations
 
 import argparse
-import signal
 import sys
-from collections.abc import Iterator, Sequence
-from contextlib import contextmanager
-from types import FrameType
+from collections.abc import Sequence
 
-from ecs_tentacles import __version__
+from ecs_tentacles import __version__, stops
 from ecs_tentacles.cli import (
     bake,
     bench,
@@ -29,6 +26,7 @@ from ecs_tentacles.output.atomic import OutputError, release_claims
 from ecs_tentacles.plugin import HookFailure
 from ecs_tentacles.scene import load
 from ecs_tentacles.scene.errors import SceneError
+from ecs_tentacles.stops import Terminated, stops_by_exception
 from ecs_tentacles.system import SystemFailure
 from ecs_tentacles.take import TakeError
 
@@ -70,27 +68,7 @@ def _add_shared_options(parser: argparse.ArgumentParser, default: object) -> Non
     )
 
 
-class Terminated(BaseException):
-    """SIGTERM or SIGHUP arrived: unwinds like Ctrl-C so partial outputs are removed."""
-
-
-def _terminate(signum: int, frame: FrameType | None) -> None:
-    raise Terminated(signal.Signals(signum).name)
-
-
-@contextmanager
-def terminate_by_exception() -> Iterator[None]:
-    """While inside, SIGTERM and SIGHUP raise `Terminated` (main thread only)."""
-    wanted = (signal.SIGTERM, signal.SIGHUP)
-    try:
-        previous = {s: signal.signal(s, _terminate) for s in wanted}
-    except ValueError:  # not the main thread: leave signals alone
-        previous = {}
-    try:
-        yield
-    finally:
-        for number, handler in previous.items():
-            signal.signal(number, handler)
+terminate_by_exception = stops_by_exception  # (its name before Ctrl-C went there too)
 
 
 def scene_megabytes(text: str) -> float:
@@ -107,6 +85,7 @@ def scene_megabytes(text: str) -> float:
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the `ecs-tentacles` console script; returns the exit code."""
     release_claims()  # outputs are claimed afresh as this run's arguments are read
+    stops.taken()  # and no stop of an earlier command (in this process) is remembered
     args = build_parser().parse_args(argv)
     limit = load.MAX_SCENE_BYTES
     if args.max_scene_mb is not None:
@@ -121,45 +100,52 @@ def main(argv: Sequence[str] | None = None) -> int:
 def _run(args: argparse.Namespace) -> int:
     try:
         return int(args.handler(args))
-    except SceneError as error:
+    except (KeyboardInterrupt, Terminated) as stop:
+        return _stopped(stop)
+    except Exception as error:
+        arrived = stops.received()  # a stop inside C code can surface as another exception
+        if arrived is not None:  # (pybind11's TypeError, Ray's SystemError): report the stop
+            return _stopped(arrived)
+        return _failure(args, error)
+    except BaseException as error:  # SystemExit or the user's own BaseException subclass
+        return _failed(args, error)
+
+
+def _stopped(stop: BaseException) -> int:
+    """Ctrl-C (130) or SIGTERM / SIGHUP (143): one line; the stop is reported."""
+    stops.taken()
+    _quiet_finalizers()
+    if isinstance(stop, KeyboardInterrupt):
+        print("error: interrupted (Ctrl-C); partial outputs removed", file=sys.stderr)
+        return 130
+    print(f"error: stopped by {stop}; partial outputs removed", file=sys.stderr)
+    return 143
+
+
+def _failure(args: argparse.Namespace, error: Exception) -> int:
+    """The exit code and line of a command that raised `error` (no stop arrived)."""
+    if isinstance(error, SceneError):
         for problem in error.problems:
             print(f"error: {problem}", file=sys.stderr)
         return 2
-    except (TakeError, NoDisplay) as error:
+    if isinstance(error, (TakeError, NoDisplay)):
         print(f"error: {error}", file=sys.stderr)
         return 2
-    except OutputError as error:
+    if isinstance(error, OutputError):
         print(f"error: {error}", file=sys.stderr)
         return 1
-    except SystemFailure as failure:  # a user system raised: show where in their code
+    if isinstance(error, SystemFailure):  # a user system raised: show where in their code
         if args.debug:
-            raise
-        print(f"error: {failure}", file=sys.stderr)
-        print(failure.user_traceback(), end="", file=sys.stderr)
+            raise error
+        print(f"error: {error}", file=sys.stderr)
+        print(error.user_traceback(), end="", file=sys.stderr)
         return 1
-    except KeyboardInterrupt:
-        _quiet_finalizers()
-        print("error: interrupted (Ctrl-C); partial outputs removed", file=sys.stderr)
-        return 130
-    except Terminated as stop:
-        _quiet_finalizers()
-        print(f"error: stopped by {stop}; partial outputs removed", file=sys.stderr)
-        return 143
-    except SystemError as error:  # a signal's exception raised inside C code (Ray's wait)
-        cause = error.__cause__ or error.__context__
-        if not isinstance(cause, Terminated):
-            return _failed(args, error)
-        print(f"error: stopped by {cause}; partial outputs removed", file=sys.stderr)
-        return 143
-    except HookFailure as failure:  # a plugin hook called sys.exit: named, one line
+    if isinstance(error, HookFailure):  # a plugin hook called sys.exit: named, one line
         if args.debug:
-            raise
-        print(f"error: {failure}", file=sys.stderr)
+            raise error
+        print(f"error: {error}", file=sys.stderr)
         return 1
-    except Exception as error:
-        return _failed(args, error)
-    except BaseException as error:  # SystemExit or the user's own BaseException subclass
-        return _failed(args, error)
+    return _failed(args, error)
 
 
 def _quiet_finalizers() -> None:

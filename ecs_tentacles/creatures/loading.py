@@ -25,6 +25,7 @@ from collections.abc import Collection, Mapping
 from dataclasses import replace
 from typing import Any, Protocol, TypeVar
 
+from ecs_tentacles import stops
 from ecs_tentacles.creatures.body import build_creature
 from ecs_tentacles.host import Host
 from ecs_tentacles.physics.frame_systems import physics_systems
@@ -101,10 +102,25 @@ def load_world(
         name=data.get("name", "scene"),
     )
     world.scene, world.scene_dir = data, folder
+    with stops.deferred():  # a Ctrl-C waits for the next creature (`ecs_tentacles.stops`)
+        _build(world, data, chosen, only, checks_only, threads)
+    return world
+
+
+def _build(
+    world: SceneWorld,
+    data: dict[str, Any],
+    chosen: list[Plugin],
+    only: Collection[int] | None,
+    checks_only: bool,
+    threads: int | None,
+) -> None:
+    """`load_world`'s entities, physics and systems, built into `world`."""
     try:
         for plugin in chosen:
             world.adopt(plugin)
         for index, creature in enumerate(creature_specs(data)):
+            stops.check()
             if only is None or index in only:
                 entity = build_creature(world, creature)
                 world.creature_specs[entity] = creature
@@ -116,14 +132,16 @@ def load_world(
         if checks_only:
             for plugin in chosen:
                 _plugin_systems(plugin)
-            return world
-    except BaseException:  # a bad file, a creature inside a rock, a user's hook
+            return
+        stops.check()
+    except BaseException:  # a bad file, a creature inside a rock, a user's hook, a stop
         world.close()  # its esper context
         raise
     for store in world.stores.values():
         store.fit()  # a crowd's stores were grown by doubling: up to half unused
     world.build_physics(threads)
     try:
+        stops.check()
         systems = physics_systems()
         for plugin in chosen:
             systems += _plugin_systems(plugin)
@@ -131,10 +149,9 @@ def load_world(
         for plugin in chosen:
             with calling(plugin, "ready"):
                 plugin.ready(world)
-    except BaseException:  # a user's systems(), setup() or ready() raised
+    except BaseException:  # a user's systems(), setup() or ready() raised, or a stop
         world.close()  # its physics threads and esper context
         raise
-    return world
 
 
 def owned_systems(plugin: Plugin) -> list[System]:

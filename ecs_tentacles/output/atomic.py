@@ -242,6 +242,7 @@ class AtomicOutput:
             ) from None
         try:
             with self.discarded_on_error():
+                _stop_if_asked()
                 info = os.fstat(descriptor)
                 if not stat.S_ISREG(info.st_mode) or (
                     same_file and (info.st_dev, info.st_ino) != self._created
@@ -288,6 +289,16 @@ class AtomicOutput:
             with contextlib.suppress(FileNotFoundError):
                 self.temporary.unlink()
             self.temporary = None
+
+
+def _stop_if_asked() -> None:
+    """Raise a Ctrl-C or SIGTERM that arrived and was swallowed by some library before
+    reaching the command line (`ecs_tentacles.stops.check`): nothing is committed then.
+    Looked up, not imported: this module needs only the standard library (Blender's
+    Python loads it on its own, `tools/blender_import.py`)."""
+    stops = sys.modules.get("ecs_tentacles.stops")
+    if stops is not None:
+        stops.check()
 
 
 @contextlib.contextmanager

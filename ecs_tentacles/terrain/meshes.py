@@ -37,6 +37,7 @@ from typing import IO
 
 import numpy as np
 
+from ecs_tentacles import stops
 from ecs_tentacles.scene.load import MAX_SCENE_BYTES
 from ecs_tentacles.terrain import mesh_worker
 from ecs_tentacles.terrain.heights import TerrainError, beside_scene
@@ -187,6 +188,7 @@ class _Worker:
         assert stdout is not None and callable(done)
         descriptor = stdout.fileno()
         while not done():
+            stops.check()  # a Ctrl-C kept while the world is built: CoACD is cut short
             left = deadline - time.monotonic()
             if left <= 0:
                 return {"over": "time"}
