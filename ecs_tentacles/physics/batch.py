@@ -430,22 +430,18 @@ class Batch:
         running_costs(self.step_cost, rows, REDUCED, took, shared, substeps)
 
 
-def _took(cost: np.ndarray, row: int, tier: int, seconds: float) -> None:
-    """A step of `row` at `tier` took `seconds`: into `cost` (`Batch.step_cost`), a
-    running mean (`running_costs`' numpy path, a row at a time)."""
-    last = cost[row, tier]
-    cost[row, tier] = seconds if last == 0.0 else 0.75 * last + 0.25 * seconds
-
-
 def running_costs(
     cost: np.ndarray, rows: np.ndarray, tier: int, took: np.ndarray, shared: float, substeps: int
 ) -> None:
-    """`_took` for every one of `rows` at once: row rows[i]'s `substeps` steps at `tier`
-    took took[i] + `shared` seconds (by a numba kernel when installed: a share's call
-    spent 25 us in numpy's five passes over a few rows)."""
+    """Row rows[i]'s `substeps` steps at `tier` took took[i] + `shared` seconds: into
+    `cost` (`Batch.step_cost`), a running mean (the first as it is, then 3/4 of the last
+    plus 1/4 of the new); by a numba kernel when installed (a share's call spent 25 us
+    in numpy's five passes over a few rows), else row by row in scalars."""
     fast = REDUCED_KERNELS.get()
     if fast is not None:
         fast.running_costs(cost, rows, tier, took, shared, substeps)
         return
     for at, row in enumerate(rows.tolist()):
-        _took(cost, row, tier, (float(took[at]) + shared) / substeps)
+        seconds = (float(took[at]) + shared) / substeps
+        last = cost[row, tier]
+        cost[row, tier] = seconds if last == 0.0 else 0.75 * last + 0.25 * seconds
