@@ -19,11 +19,15 @@ every running task (`ray.cancel`) and keeps the finished shards there too.
 
 from __future__ import annotations
 
+import contextlib
 import logging
+import os
+import shutil
 import signal
 import sys
+import tempfile
 import threading
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -112,15 +116,39 @@ def _init(address: str | None, cpus: int | None, ours: dict[int, Any]) -> None:
     options: dict[str, Any] = {"include_dashboard": False, "log_to_driver": False}
     options["logging_level"] = logging.ERROR
     try:
-        if address:
-            ray.init(address=address, **options)
-        else:
-            ray.init(num_cpus=cpus, **options)
-            session = ray.get_runtime_context().get_session_name()
-            _REAPER = Reaper.start(session)  # a local Ray never outlives a killed bake
+        with _empty_working_folder():
+            if address:
+                ray.init(address=address, **options)
+            else:
+                ray.init(num_cpus=cpus, **options)
+                session = ray.get_runtime_context().get_session_name()
+                _REAPER = Reaper.start(session)  # a local Ray never outlives a killed bake
     finally:
         for number, handler in ours.items():  # Ray installs its own: SIGTERM must stay
             signal.signal(number, handler)  # ours (one line, exit 143, Ray shut down)
+
+
+@contextlib.contextmanager
+def _empty_working_folder() -> Iterator[None]:
+    """Ray puts the driver's working folder on its workers' import path and starts a
+    local node's processes in it: a `numpy.py` where the user runs `bake --ray` would
+    run in every worker. So Ray starts from an empty folder of this bake's own (kept
+    until `stop_ray`: the workers' working folder), and the working folder comes back."""
+    global _EMPTY
+    here = os.getcwd()
+    _EMPTY = tempfile.mkdtemp(prefix="ecs_tentacles_ray_")
+    os.chdir(_EMPTY)
+    try:
+        yield
+    finally:
+        os.chdir(here)
+
+
+def _remove_empty_folder() -> None:
+    global _EMPTY
+    if _EMPTY is not None:
+        shutil.rmtree(_EMPTY, ignore_errors=True)
+        _EMPTY = None
 
 
 def _abandon(before: set[tuple[int, float]], ours: dict[int, Any]) -> None:
@@ -142,6 +170,7 @@ def _abandon(before: set[tuple[int, float]], ours: dict[int, Any]) -> None:
             _REAPER.stop()
             _REAPER = None
         end_started_since(before)
+        _remove_empty_folder()
     finally:
         for number, handler in ours.items():
             signal.signal(number, handler)
@@ -158,9 +187,11 @@ def stop_ray(started: bool) -> None:
     if _REAPER is not None:
         _REAPER.stop()
         _REAPER = None
+    _remove_empty_folder()
 
 
 _REAPER: Reaper | None = None
+_EMPTY: str | None = None  # the folder Ray was started from (`_empty_working_folder`)
 
 
 def _signal_handlers() -> dict[int, Any]:

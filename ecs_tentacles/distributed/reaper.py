@@ -28,6 +28,8 @@ from typing import Any
 
 import psutil
 
+from ecs_tentacles.processes import python_module
+
 GRACE_SECONDS = 2.0  # SIGTERM first; SIGKILL whatever still runs after this
 WATCH_SECONDS = 1.0  # how often the watchdog notes what the bake's Ray has started
 _PR_SET_CHILD_SUBREAPER = 36  # prctl's option number (linux/prctl.h)
@@ -53,14 +55,9 @@ class Reaper:
         if not recorded:
             return cls(None)
         process = subprocess.Popen(
-            [
-                sys.executable,
-                "-m",
-                __name__,
-                str(os.getpid()),
-                json.dumps(recorded),
-                *([session] if session else []),
-            ],
+            python_module(
+                __name__, str(os.getpid()), json.dumps(recorded), *([session] if session else [])
+            ),
             stdin=subprocess.PIPE,
             stdout=subprocess.DEVNULL,
             stderr=subprocess.DEVNULL,

@@ -82,9 +82,10 @@ class BakePlan:
         `allow_systems` lets the scene's plugins from files or modules be imported; those
         of a dict scene are found in `scene_dir` (default: the current folder).
         """
-        folder = None if scene_dir is None else str(Path(scene_dir).resolve())
+        # absolute: a Ray worker runs in a folder of its own (distributed.driver)
+        folder = str(Path(os.getcwd() if scene_dir is None else scene_dir).resolve())
         if isinstance(scene, dict):
-            where = None if folder is None else Path(folder)
+            where = Path(folder)
             data = load_scene_plugins(scene, allow_systems=allow_systems, scene_dir=where)[0]
             source = "<dict>"
         else:

@@ -89,15 +89,24 @@ def _entry_points() -> list[importlib.metadata.EntryPoint]:
     return list(importlib.metadata.entry_points(group=ENTRY_POINTS))
 
 
-def load(key: str, target: str, scene_dir: pathlib.Path | None) -> type[Plugin] | Plugin:
-    """Import the plugin class (or a SystemsPlugin of System classes) that `target` names."""
+def load(
+    key: str, target: str, scene_dir: pathlib.Path | None, *, consented: bool = False
+) -> type[Plugin] | Plugin:
+    """Import the plugin class (or a SystemsPlugin of System classes) that `target` names.
+
+    The scene's folder is on the import path only while a `consented` user plugin is
+    imported: a built-in's first import of a library module (`filecmp`, `json`) must
+    never find a file of that name beside the scene.
+    """
     where = f"plugins.{key}"
     module_part, _, attr = target.partition(":")
     try:
         if module_part.endswith(".py"):
+            if not consented:
+                raise PluginError(f"{where}: runs code from {target!r}; allow it first")
             module = import_file(inside_scene_folder(module_part, scene_dir, where), key)
         else:
-            with scene_first(scene_dir):
+            with scene_first(scene_dir if consented else None):
                 module = importlib.import_module(module_part)
     except PluginError:
         raise
@@ -223,7 +232,7 @@ def resolve(
                     f"plugins.{key}: runs code from {found.target!r}; allow it with"
                     " --allow-systems (API: allow_systems=True)"
                 )
-            made = load(key, found.target, scene_dir)
+            made = load(key, found.target, scene_dir, consented=not found.trusted)
         except PluginError as exc:
             problems.append(str(exc))
             continue

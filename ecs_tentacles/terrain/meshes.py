@@ -29,7 +29,6 @@ import os
 import pathlib
 import select
 import subprocess
-import sys
 import tempfile
 import time
 from types import TracebackType
@@ -38,6 +37,7 @@ from typing import IO
 import numpy as np
 
 from ecs_tentacles import stops
+from ecs_tentacles.processes import python_module
 from ecs_tentacles.scene.load import MAX_SCENE_BYTES
 from ecs_tentacles.terrain import mesh_worker
 from ecs_tentacles.terrain.heights import TerrainError, beside_scene
@@ -127,7 +127,7 @@ class _Worker:
 
     def __init__(self) -> None:
         self.process = subprocess.Popen(
-            [sys.executable, "-m", "ecs_tentacles.terrain.mesh_worker", str(MESH_MEMORY_MB)],
+            python_module("ecs_tentacles.terrain.mesh_worker", str(MESH_MEMORY_MB)),
             stdin=subprocess.PIPE,
             stdout=subprocess.PIPE,
             stderr=subprocess.DEVNULL,
