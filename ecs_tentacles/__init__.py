@@ -5,3 +5,7 @@ systems in a named order -> MuJoCo physics -> Transform store -> renderer / expo
 """
 
 __version__ = "0.1.0"
+
+from ecs_tentacles.processes import no_library_search as _no_library_search
+
+_no_library_search()  # before anything imports mujoco (see ecs_tentacles.processes)
