@@ -3,12 +3,18 @@
     python tools/soak.py --crowd 64 --terrain rocky --minutes 30
     python tools/soak.py --scene octopus --minutes 5 --every 10
     python tools/soak.py --minutes 60 -- ecs-tentacles bake crowd.json --seconds 900 --out t.npz
+    python tools/soak.py --crowd 64 --terrain rocky --minutes 30 --in-process
 
 The command runs in a process of its own (`--crowd N` writes that crowd scene with
 `ecs-tentacles crowd` and runs it; `--scene` runs a scene file or bundled scene:
 `ecs-tentacles run SCENE --frames <many> --quiet --threads T`). Its resident set size
 (psutil; `--tree` adds its descendants') is sampled every `--every` seconds until
 `--minutes` have passed, then the command is stopped (SIGTERM) if it still runs.
+
+`--in-process` builds the scene in this process instead and steps it here (`World.step`,
+what `run` does), so each frame is timed as well: every row then also gives the median
+frame time of the frames since the last sample, and the verdict the median frame time of
+the first and of the last window.
 
 The table lists every sample: seconds since the start, RSS, and RSS against the first
 sample after `--warmup` seconds (building the scene and the first frames grow a process
@@ -56,14 +62,21 @@ def command_of(args: argparse.Namespace, folder: Path) -> list[str]:
     """The command to soak: the one given after `--`, or `run` of the scene / crowd."""
     if args.command:
         return args.command
-    cli = [sys.executable, "-m", "ecs_tentacles"]
-    scene = args.scene
-    if args.crowd is not None:
-        scene = str(folder / f"crowd{args.crowd}.json")
-        write = [*cli, "crowd", str(args.crowd), "--out", scene, "--seed", str(args.seed)]
-        subprocess.run([*write, "--terrain", args.terrain], check=True, stdout=subprocess.DEVNULL)
     frames = ["--frames", "1000000", "--quiet", "--threads", str(args.threads)]
-    return [*cli, "run", scene, *frames]
+    return [*CLI, "run", scene_of(args, folder), *frames]
+
+
+CLI = [sys.executable, "-P", "-m", "ecs_tentacles"]
+
+
+def scene_of(args: argparse.Namespace, folder: Path) -> str:
+    """The scene to soak: `--scene`, or the crowd of `--crowd` written into `folder`."""
+    if args.crowd is None:
+        return str(args.scene)
+    scene = str(folder / f"crowd{args.crowd}.json")
+    write = [*CLI, "crowd", str(args.crowd), "--out", scene, "--seed", str(args.seed)]
+    subprocess.run([*write, "--terrain", args.terrain], check=True, stdout=subprocess.DEVNULL)
+    return scene
 
 
 def window(samples: list[tuple[float, float]], start: float, end: float) -> list[float]:
@@ -112,8 +125,13 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--warmup", type=float, default=180.0, help="seconds not judged")
     parser.add_argument("--threshold", type=float, default=5.0, help="MB allowed to grow")
     parser.add_argument("--tree", action="store_true", help="add the descendants' RSS")
+    parser.add_argument(
+        "--in-process", action="store_true", help="step the scene here, timing every frame"
+    )
     parser.add_argument("command", nargs="*", help="the command to soak (after --)")
     args = parser.parse_args(argv)
+    if args.in_process:
+        return soak_here(args)
 
     with tempfile.TemporaryDirectory(prefix="soak-") as tmp:
         command = command_of(args, Path(tmp))
@@ -165,6 +183,52 @@ def sample(
                 child.kill()
                 child.wait()
     return samples, ended
+
+
+def soak_here(args: argparse.Namespace) -> int:
+    """`--in-process`: build the scene (or crowd) here and step it, sampling this process's
+    RSS and the frames' times; the verdict adds the median frame time at start and end."""
+    from ecs_tentacles.world import World
+
+    with tempfile.TemporaryDirectory(prefix="soak-") as tmp:
+        scene = scene_of(args, Path(tmp))
+        print(f"soak: {scene} stepped in this process, {args.threads} thread(s)", flush=True)
+        world = World.from_scene(scene, threads=args.threads)
+    process = psutil.Process()
+    samples: list[tuple[float, float]] = []
+    times: list[tuple[float, float]] = []  # (seconds since the start, frame ms)
+    print(f"{'seconds':>8} {'RSS MB':>9} {'vs base':>8} {'frame ms':>9} {'frames':>7}", flush=True)
+    start = last = time.monotonic()
+    since = 0
+    with world:
+        while (now := time.monotonic() - start) < args.minutes * 60:
+            began = time.perf_counter()
+            world.step()
+            times.append((now, (time.perf_counter() - began) * 1000.0))
+            if time.monotonic() - last >= args.every or not samples:
+                last = time.monotonic()
+                rss = resident(process, args.tree)
+                samples.append((now, rss))
+                recent = [ms for _, ms in times[since:]]
+                since = len(times)
+                after = window(samples, args.warmup, now)
+                base = f"{rss - after[0]:+8.1f}" if after else f"{'':>8}"
+                median = statistics.median(recent)
+                print(f"{now:8.0f} {rss:9.1f} {base} {median:9.2f} {len(recent):7d}", flush=True)
+    ok, line = verdict(samples, args.warmup, args.threshold)
+    print(line, flush=True)
+    after = [(t, ms) for t, ms in times if t >= args.warmup]
+    if after:
+        first_t, last_t = after[0][0], after[-1][0]
+        span = min(max(60.0, (last_t - first_t) / 10), (last_t - first_t) / 4)
+        head = statistics.median(ms for t, ms in after if t <= first_t + span)
+        tail = statistics.median(ms for t, ms in after if t >= last_t - span)
+        print(
+            f"frame time after warm-up (median of {span:.0f} s windows): {head:.2f} ms at the"
+            f" start, {tail:.2f} ms at the end ({tail / head:.3f}x), {len(times)} frames",
+            flush=True,
+        )
+    return 0 if ok else 1
 
 
 if __name__ == "__main__":

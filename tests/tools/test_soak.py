@@ -42,3 +42,19 @@ def test_a_flat_floor_after_warm_up_passes_with_spikes_and_a_creep_fails() -> No
     assert ok, line
     assert "floor slope" in line and "peak 324.0 MB at 270 s (+24.0" in line
     assert not tool.verdict(warm, 180.0, 5.0)[0]  # nothing after the warm-up
+
+
+def test_in_process_soak_times_frames_and_reports_the_medians_at_both_ends() -> None:
+    import subprocess
+
+    done = subprocess.run(
+        [sys.executable, "-P", str(TOOLS / "soak.py"), "--scene", "octopus", "--in-process",
+         "--minutes", "0.08", "--every", "1", "--warmup", "0"],
+        capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stdout + done.stderr
+    rows = [line.split() for line in done.stdout.splitlines() if line[:8].strip().isdigit()]
+    assert len(rows) >= 3
+    assert all(float(row[3]) > 0 for row in rows)  # a frame's median time on every row
+    ends = re.search(r"([0-9.]+) ms at the start, ([0-9.]+) ms at the end", done.stdout)
+    assert ends and float(ends.group(1)) > 0 and float(ends.group(2)) > 0, done.stdout
