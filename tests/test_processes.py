@@ -138,7 +138,13 @@ COMMANDS = {
     "run": ["run", "{scene}/shadowed.json", "--frames", "3"],
     "bake": ["bake", "{scene}/shadowed.json", "--seconds", "0.05", "--out", "plain.npz", "--quiet"],
     "play": ["play", "{scene}/herding.json", "--headless", "--frames", "3", "--width", "160",
-             "--height", "96", "--screenshot", "shot.png", "--quiet"],
+             "--height", "96", "--screenshot", "shot.png", "--video", "clip.mp4", "--quiet"],
+    "systems": ["systems", "{scene}/shadowed.json"],
+    "schema": ["schema", "{scene}/shadowed.json", "--out", "schema.json"],
+    "migrate": ["migrate", "{scene}/shadowed.json", "--out", "migrated.json"],
+    "create": ["create", "--from", "{scene}/shadowed.json", "--out", "created.json"],
+    "crowd": ["crowd", "4", "--terrain", "rocky", "--out", "crowd.json"],
+    "bench": ["bench", "--crowd", "4", "--frames", "3", "--warmup", "1", "--quiet"],
 }  # fmt: skip
 
 
