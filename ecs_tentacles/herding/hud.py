@@ -6,6 +6,10 @@ predator (it follows at its own speed); R restarts the level from its start, P
 pauses. When the game ends a banner says how, with the time and the best time; a
 win is written to the best-times file once (`ecs_tentacles.herding.best_times`), on
 the best-times thread (`win_recorder`): a frame never waits for the file or its lock.
+
+R goes back to the snapshot taken when the level was built; when that no longer fits
+the world (a creature removed since, with the director's Delete), the level is built
+again from its scene instead (`Sandbox.reset`), and the section says so.
 """
 
 from __future__ import annotations
@@ -18,6 +22,7 @@ from pyglet.window import key
 from ecs_tentacles.herding import best_times, win_recorder
 from ecs_tentacles.herding.game import LOST, WON, HerdingGame
 from ecs_tentacles.render.registries import Panel
+from ecs_tentacles.snapshot import SnapshotMismatch
 
 if TYPE_CHECKING:
     from ecs_tentacles.render.registries import SandboxView
@@ -63,6 +68,17 @@ class GamePanel(Panel):
                 self.best = done.best
             if done.message:
                 self.message = done.message
+
+    def restart(self) -> None:
+        """Back to the level's start: its snapshot, or (when a creature was removed since)
+        the level built again from its scene."""
+        try:
+            self.game.restart(self.sandbox.world)
+        except SnapshotMismatch:
+            if self.sandbox.reset():  # `attach` follows; the Scripts window says a failure
+                self.message = "restarted: built again from the scene (a creature was removed)"
+            return
+        self.attach(self.sandbox.world)
 
     def draw(self, gui: Any) -> None:
         game = self.game
@@ -115,8 +131,7 @@ class GamePanel(Panel):
 
     def key(self, symbol: int, modifiers: int) -> bool:
         if symbol == key.R:
-            self.game.restart(self.sandbox.world)
-            self.attach(self.sandbox.world)
+            self.restart()
             return True
         if symbol == key.P:
             self.sandbox.paused = not self.sandbox.paused

@@ -18,6 +18,7 @@ configure(headless=True)
 
 from pyglet.window import key, mouse  # noqa: E402  (after configure: pyglet reads it)
 
+from ecs_tentacles.components import Creature  # noqa: E402
 from ecs_tentacles.herding.game import HerdingGame  # noqa: E402
 from tests.herding.levels import level  # noqa: E402
 from tests.herding.lock_holder import lock_held  # noqa: E402
@@ -107,3 +108,22 @@ def test_a_win_while_another_game_holds_the_file_never_holds_up_a_frame(
     sandbox.render()
     assert json.loads(file.read_text())["best_seconds"] == {"test level": game.elapsed}
     assert panel.best == game.elapsed and panel.message == ""
+
+
+def test_r_after_a_creature_is_deleted_restarts_the_level(sandbox: Any) -> None:
+    world = sandbox.world
+    game = world.resource(HerdingGame)
+    sandbox.step(20)
+    sandbox.select(world.creature("a"))
+    event(sandbox, "on_key_press", key.DELETE, 0)  # the director's Delete
+    assert sorted(c.name for _, c in world.query(Creature)) == ["b"]
+    event(sandbox, "on_key_press", key.R, 0)  # the start's snapshot names a: built again
+    world = sandbox.world
+    game = world.resource(HerdingGame)
+    assert sorted(c.name for _, c in world.query(Creature)) == ["a", "b"]
+    assert world.frame == 0 and game.state.frames == 0 and game.state.log == []
+    assert "restarted" in sandbox.panel("Game").message
+    sandbox.render()
+    sandbox.step(10)
+    event(sandbox, "on_key_press", key.R, 0)  # and R goes on restarting from the snapshot
+    assert sandbox.world is world and world.frame == 0 and game.state.frames == 0
