@@ -4,20 +4,25 @@ The section shows the level, creatures penned of those needed, the time left and
 level's best time. Holding the left button in the view and dragging points the
 predator (it follows at its own speed); R restarts the level from its start, P
 pauses. When the game ends a banner says how, with the time and the best time; a
-win is written to the best-times file once (`ecs_tentacles.herding.best_times`).
+win is written to the best-times file once (`ecs_tentacles.herding.best_times`), on
+the best-times thread (`win_recorder`): a frame never waits for the file or its lock.
+
+R goes back to the snapshot taken when the level was built; when that no longer fits
+the world (a creature removed since, with the director's Delete), the level is built
+again from its scene instead (`Sandbox.reset`), and the section says so.
 """
 
 from __future__ import annotations
 
-import warnings
 from typing import TYPE_CHECKING, Any
 
 from imgui_bundle import imgui
 from pyglet.window import key
 
-from ecs_tentacles.herding import best_times
+from ecs_tentacles.herding import best_times, win_recorder
 from ecs_tentacles.herding.game import LOST, WON, HerdingGame
 from ecs_tentacles.render.registries import Panel
+from ecs_tentacles.snapshot import SnapshotMismatch
 
 if TYPE_CHECKING:
     from ecs_tentacles.render.registries import SandboxView
@@ -31,16 +36,18 @@ class GamePanel(Panel):
 
     def __init__(self, sandbox: SandboxView):
         self.sandbox = sandbox
-        self.recorded: tuple[float, bool] | None = None  # (best, new) once a win is written
+        self.win: win_recorder.PendingWin | None = None  # this game's win, once won
+        self.writing: list[win_recorder.PendingWin] = []  # wins not written yet (any game)
         self.message = ""
         self.best = self._best()  # read once a game, not every frame
+        win_recorder.start()  # now, not in the frame the game is won
 
     @property
     def game(self) -> HerdingGame:
         return self.sandbox.world.resource(HerdingGame)
 
     def attach(self, world: Any) -> None:
-        self.recorded, self.message = None, ""
+        self.win, self.message = None, ""
         self.best = self._best()
 
     def _best(self) -> float | None:
@@ -50,15 +57,28 @@ class GamePanel(Panel):
             return None
 
     def _record(self) -> None:
+        """Hand a win to the best-times thread once; take in the wins it has written."""
         game = self.game
-        if game.outcome != WON or self.recorded is not None:
-            return
+        if game.outcome == WON and self.win is None:
+            self.win = win_recorder.record_later(game.level, game.elapsed)
+            self.writing.append(self.win)
+        for done in [pending for pending in self.writing if pending.done]:
+            self.writing.remove(done)
+            if done.best is not None and done.level == game.level:
+                self.best = done.best
+            if done.message:
+                self.message = done.message
+
+    def restart(self) -> None:
+        """Back to the level's start: its snapshot, or (when a creature was removed since)
+        the level built again from its scene."""
         try:
-            with warnings.catch_warnings(record=True) as said:
-                self.recorded = best_times.record_win(game.level, game.elapsed)
-            self.message = str(said[0].message) if said else ""
-        except OSError as error:  # a read-only data folder: the game goes on
-            self.recorded, self.message = (game.elapsed, False), f"best time not saved: {error}"
+            self.game.restart(self.sandbox.world)
+        except SnapshotMismatch:
+            if self.sandbox.reset():  # `attach` follows; the Scripts window says a failure
+                self.message = "restarted: built again from the scene (a creature was removed)"
+            return
+        self.attach(self.sandbox.world)
 
     def draw(self, gui: Any) -> None:
         game = self.game
@@ -69,7 +89,7 @@ class GamePanel(Panel):
         gui.item("game penned")
         imgui.text(f"time left {game.left:5.1f} s")
         gui.item("game time")
-        best = self.best if self.recorded is None else self.recorded[0]
+        best = self.best
         imgui.text(f"best {best:.1f} s" if best is not None else "best: not won yet")
         gui.item("game best")
         imgui.text_wrapped("drag: move the predator  R: restart  P: pause")
@@ -94,18 +114,24 @@ class GamePanel(Panel):
         imgui.text("You won!" if game.outcome == WON else "Time's up")
         imgui.pop_font()
         if game.outcome == WON:
-            best, new = self.recorded or (game.elapsed, False)
             imgui.text(f"{game.penned} penned in {game.elapsed:.1f} s")
-            imgui.text("a new best time!" if new else f"best time {best:.1f} s")
+            imgui.text(self._best_line())
         else:
             imgui.text(f"{game.penned} of {game.need} penned")
         imgui.text("R: play again")
         imgui.end()
 
+    def _best_line(self) -> str:
+        win = self.win
+        if win is None or not win.done:
+            return "saving the best time..."
+        if win.best is None:
+            return "best time not saved"
+        return "a new best time!" if win.new else f"best time {win.best:.1f} s"
+
     def key(self, symbol: int, modifiers: int) -> bool:
         if symbol == key.R:
-            self.game.restart(self.sandbox.world)
-            self.attach(self.sandbox.world)
+            self.restart()
             return True
         if symbol == key.P:
             self.sandbox.paused = not self.sandbox.paused

@@ -196,7 +196,8 @@ class HudView(Protocol):
 class SandboxView(Protocol):
     """What a HUD section (a `Panels` entry, its `Panel`s) sees of the sandbox: the world
     it draws, the camera and HUD, the window, the keys and mouse, the selection, and
-    rebuilding the world from an edited scene (`render.sandbox.Sandbox` is one)."""
+    rebuilding the world from an edited scene or from its scene again (`reset`)
+    (`render.sandbox.Sandbox` is one)."""
 
     @property
     def world(self) -> World: ...
@@ -222,6 +223,7 @@ class SandboxView(Protocol):
     def pick_creature(self, x: float, y: float) -> int | None: ...
     def select_many(self, creatures: Iterable[int]) -> None: ...
     def rebuild(self, scene: dict[str, Any]) -> World: ...
+    def reset(self) -> bool: ...  # the world built again from its scene (False: it did not build)
 
 
 class Panels(Registry[Callable[[SandboxView], list["Panel"]]]):

@@ -4,6 +4,7 @@ R restarting, P pausing, the banner and the best time written once."""
 from __future__ import annotations
 
 import json
+import time
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -17,8 +18,10 @@ configure(headless=True)
 
 from pyglet.window import key, mouse  # noqa: E402  (after configure: pyglet reads it)
 
+from ecs_tentacles.components import Creature  # noqa: E402
 from ecs_tentacles.herding.game import HerdingGame  # noqa: E402
 from tests.herding.levels import level  # noqa: E402
+from tests.herding.lock_holder import lock_held  # noqa: E402
 from tests.render.conftest import event, pixel  # noqa: E402
 
 
@@ -61,18 +64,66 @@ def test_dragging_in_the_view_aims_the_predator_and_keys_restart_and_pause(sandb
     assert sandbox.paused is not paused
 
 
-def test_a_win_shows_the_banner_and_writes_the_best_time_once(sandbox: Any, tmp_path: Path) -> None:
+def _win(sandbox: Any) -> HerdingGame:
+    """Drive creature a into the pen (the predator just behind it) until the game is won."""
     game = sandbox.world.resource(HerdingGame)
     while game.outcome == "playing" and game.elapsed < 30:
         a = sandbox.world.transforms.pos[sandbox.world.creatures.mantle_row[0], :2]
         game.aim(sandbox.world, (float(a[0]) - 0.7, float(a[1])))
         sandbox.step(15)
     assert game.outcome == "won"
+    return game
+
+
+def test_a_win_shows_the_banner_and_writes_the_best_time_once(sandbox: Any, tmp_path: Path) -> None:
+    game = _win(sandbox)
     sandbox.render()
+    assert sandbox.panel("Game").win.wait(10)
     sandbox.render()
     assert "game banner" in sandbox.hud.gui.windows
     saved = json.loads((tmp_path / "data" / "best_times.json").read_text())
-    assert saved["best_seconds"] == {"test level": round(game.elapsed, 3)}
+    assert saved["best_seconds"] == {"test level": game.elapsed}  # as it is, not rounded
+    assert sandbox.panel("Game").best == game.elapsed
     mtime = (tmp_path / "data" / "best_times.json").stat().st_mtime_ns
     sandbox.render()
     assert (tmp_path / "data" / "best_times.json").stat().st_mtime_ns == mtime  # once
+
+
+def test_a_win_while_another_game_holds_the_file_never_holds_up_a_frame(
+    sandbox: Any, tmp_path: Path
+) -> None:
+    file = tmp_path / "data" / "best_times.json"
+    game = _win(sandbox)
+    panel = sandbox.panel("Game")
+    with lock_held(tmp_path / "data") as holder:
+        started = time.perf_counter()
+        sandbox.render()  # the frame the win is seen in (it was written from here)
+        sandbox.render()
+        took = time.perf_counter() - started
+        assert took < 2.0, f"two frames took {took:.1f} s"  # the lock: 30 s
+        assert "game banner" in sandbox.hud.gui.windows
+        assert not panel.win.done and not file.exists()  # the lock is still held
+        holder.release()
+        assert panel.win.wait(10)
+    sandbox.render()
+    assert json.loads(file.read_text())["best_seconds"] == {"test level": game.elapsed}
+    assert panel.best == game.elapsed and panel.message == ""
+
+
+def test_r_after_a_creature_is_deleted_restarts_the_level(sandbox: Any) -> None:
+    world = sandbox.world
+    game = world.resource(HerdingGame)
+    sandbox.step(20)
+    sandbox.select(world.creature("a"))
+    event(sandbox, "on_key_press", key.DELETE, 0)  # the director's Delete
+    assert sorted(c.name for _, c in world.query(Creature)) == ["b"]
+    event(sandbox, "on_key_press", key.R, 0)  # the start's snapshot names a: built again
+    world = sandbox.world
+    game = world.resource(HerdingGame)
+    assert sorted(c.name for _, c in world.query(Creature)) == ["a", "b"]
+    assert world.frame == 0 and game.state.frames == 0 and game.state.log == []
+    assert "restarted" in sandbox.panel("Game").message
+    sandbox.render()
+    sandbox.step(10)
+    event(sandbox, "on_key_press", key.R, 0)  # and R goes on restarting from the snapshot
+    assert sandbox.world is world and world.frame == 0 and game.state.frames == 0
