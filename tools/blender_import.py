@@ -17,9 +17,9 @@ a .blend:
 * a tidy outliner: the glTF importer's bone shapes (an `Icosphere` per armature, in a
   hidden collection linked to the scene) are not made (bones draw as Blender's own), and
   the empties the USD importer makes of the material scopes (`/World/materials`,
-  `/World/terrain/materials`: `materials`, `materials.001`) are removed;
+  `/World/terrain/terrain_materials`) are removed;
 * USD shapes: Blender's USD importer binds no material to a Capsule or Cylinder prim
-  (the rigid form's bodies), so each such mesh gets its creature's `<c>_skin` here.
+  (the rigid form's bodies), so each such mesh gets its creature's `<c>_material` here.
 
 `--report` prints, as JSON, what the artist finds: the scene's objects by type, objects
 made but kept out of the scene, how many armatures move through their active action.
@@ -53,7 +53,10 @@ from types import ModuleType
 from typing import Any
 
 USD = (".usd", ".usda", ".usdc")
-MATERIAL_SCOPE = re.compile(r"materials(\.[0-9]{3})?")  # a USD Scope of materials, as an empty
+# a USD Scope of materials, as an empty: `materials` (`materials_1` beside a creature
+# called materials), the ground's `terrain_materials` (`terrain_ground_materials` beside
+# a creature called terrain); `.001`: older exports
+MATERIAL_SCOPE = re.compile(r"(?:terrain(?:_ground)?_)?materials(?:_[0-9]+)?(?:\.[0-9]{3})?")
 
 
 def glb_fps(path: Path) -> float | None:
@@ -281,14 +284,14 @@ def render(bpy: object, path: Path, frame: int, pixels: tuple[int, int]) -> str:
 
 
 def bind_shapes(bpy: object) -> None:
-    """Give every mesh without a material its creature's `<c>_skin` (the creature: the
+    """Give every mesh without a material its creature's `<c>_material` (the creature: the
     ancestor right under `World`); a material nothing uses afterwards is removed."""
     data = bpy.data  # type: ignore[attr-defined]
     for mesh in [o for o in data.objects if o.type == "MESH" and not o.data.materials]:
         root = mesh
         while root.parent is not None and root.parent.name != "World":
             root = root.parent
-        material = data.materials.get(f"{root.name}_skin")
+        material = data.materials.get(f"{root.name}_material")
         if material is not None:
             mesh.data.materials.append(material)
     for material in list(data.materials):

@@ -83,8 +83,8 @@ def checked(path: pathlib.Path, allow_systems: bool) -> tuple[dict[str, Any], li
     try:
         world = load_world(World, path, allow_systems=allow_systems, checks_only=True)
     except SceneError as error:
-        prefix = f"{path}: "
-        lines = [p if p.startswith(prefix) else prefix + p for p in error.problems]
+        named = f"{path}:"  # `path: ...` or, located in the text, `path:5:3: ...`
+        lines = [p if p.startswith(named) else f"{named} {p}" for p in error.problems]
         raise SceneError(lines) from None
     try:
         assert world.scene is not None

@@ -26,6 +26,7 @@ from __future__ import annotations
 import copy
 import json
 import os
+import pathlib
 import re
 from dataclasses import asdict, dataclass, replace
 from typing import TYPE_CHECKING, Any
@@ -33,7 +34,8 @@ from typing import TYPE_CHECKING, Any
 from ecs_tentacles.creator.limits import DesignError, checked, default
 from ecs_tentacles.output.atomic import atomic_file
 from ecs_tentacles.scene.construction import TentacleShape, tentacle_shape
-from ecs_tentacles.scene.load import load_scene, resolve_scene_path
+from ecs_tentacles.scene.errors import SceneError
+from ecs_tentacles.scene.load import load_scene, read_scene_json, resolve_scene_path
 from ecs_tentacles.scene.schema import load_schema
 
 if TYPE_CHECKING:
@@ -274,6 +276,8 @@ class CreatureDesign:
 
 
 def _read(path: str | os.PathLike[str]) -> dict[str, Any]:
-    with open(path, encoding="utf-8-sig") as handle:
-        data: dict[str, Any] = json.load(handle)
+    """The scene file as written (defaults not filled in), read as every scene is."""
+    data = read_scene_json(pathlib.Path(path))
+    if not isinstance(data, dict):
+        raise SceneError([f"{path}: the scene is not an object"])
     return data

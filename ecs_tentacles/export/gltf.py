@@ -7,7 +7,7 @@ pose (a creature that comes or goes during the take has its root's scale keyed t
 while it is not there: `scale_visibility`); one animation (`<scene>_animation`) has a
 translation and a rotation channel per body (LINEAR, a key per take frame, time =
 frame / fps). Bodies carry lean meshes (capsules along +x, the mantle's cylinder)
-bound to their creature's material (`<c>_skin`, its sandbox colour:
+bound to their creature's material (`<c>_material`, its sandbox colour:
 `ecs_tentacles.export.materials`).
 
 Locators (on by default in the rigid form, `locators=False` leaves them out): each sucker

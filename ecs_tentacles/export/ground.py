@@ -2,10 +2,12 @@
 
 USD: an Xform `/World/terrain` holding a Mesh per ground mesh (`surface`: the
 heightfield, `obstacles`: every obstacle), normals per vertex, a display colour and a
-bound UsdPreviewSurface (`/World/terrain/materials/<mesh>`). glTF: a node `terrain`
-with a child node per mesh (`terrain/surface`, `terrain/obstacles`), each with a mesh
-and a material of the same colour. A take recorded on the plane has neither. If a
-creature is called `terrain`, the ground's root is `terrain_ground` instead.
+bound UsdPreviewSurface (`/World/terrain/terrain_materials/<mesh>_material`, its shader
+`<mesh>_material_shader`: no prim name twice in the file, as the creatures' parts).
+glTF: a node `terrain` with a child node per mesh (`terrain/surface`,
+`terrain/obstacles`), each with a mesh and a material of the same colour. A take
+recorded on the plane has neither. If a creature is called `terrain`, the ground's root
+is `terrain_ground` instead.
 
 Colours are the sandbox's (each mesh's `rgb` in the take, display sRGB; `EARLIER` for
 takes written before meshes carried it) as linear light (`colours.to_linear`), the
@@ -19,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from ecs_tentacles.export.materials import shader_name
 from ecs_tentacles.skin.colours import to_linear
 from ecs_tentacles.take import Take
 
@@ -55,7 +58,8 @@ def write_usd_ground(pxr: Any, stage: Any, take: Take) -> None:
     Gf, Sdf, UsdGeom, UsdShade, Vt = pxr.Gf, pxr.Sdf, pxr.UsdGeom, pxr.UsdShade, pxr.Vt
     base = f"/World/{root_name(take)}"
     UsdGeom.Xform.Define(stage, base)
-    UsdGeom.Scope.Define(stage, f"{base}/materials")
+    folder = f"{base}/{root_name(take)}_materials"
+    UsdGeom.Scope.Define(stage, folder)
     for name, mesh in meshes:
         label = EXPORT_NAMES.get(name, name)
         prim = UsdGeom.Mesh.Define(stage, f"{base}/{label}")
@@ -72,9 +76,9 @@ def write_usd_ground(pxr: Any, stage: Any, take: Take) -> None:
         prim.CreateExtentAttr([Gf.Vec3f(*low.tolist()), Gf.Vec3f(*high.tolist())])
         colour = Gf.Vec3f(*linear_colour(take, name))
         prim.CreateDisplayColorAttr([colour])
-        path = f"{base}/materials/{label}"
+        path = f"{folder}/{label}_material"
         material = UsdShade.Material.Define(stage, path)
-        shader = UsdShade.Shader.Define(stage, f"{path}/surface")
+        shader = UsdShade.Shader.Define(stage, f"{path}/{shader_name(f'{label}_material')}")
         shader.CreateIdAttr("UsdPreviewSurface")
         shader.CreateInput("diffuseColor", Sdf.ValueTypeNames.Color3f).Set(colour)
         shader.CreateInput("roughness", Sdf.ValueTypeNames.Float).Set(ROUGHNESS)

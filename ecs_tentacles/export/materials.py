@@ -1,13 +1,20 @@
 """Each creature's material in USD and glTF: its sandbox colour (`ecs_tentacles.skin.colours`).
 
 The k-th creature of a take gets the sandbox's k-th colour, in a material named
-`<c>_skin` (`ecs_tentacles.export.names.part`): the skinned mesh and, in the rigid
-form, the mantle and every capsule of the creature are bound to it.
+`<c>_material` (`ecs_tentacles.export.names.part`): the skinned mesh (`<c>_skin`) and,
+in the rigid form, the mantle and every capsule of the creature are bound to it.
 
-    USD   /World/materials/<c>_skin     UsdPreviewSurface: diffuseColor (linear), roughness
-    glTF  material <c>_skin             rigid: baseColorFactor (linear); skinned: a
-                                        texture of the colour (rings along the tentacle,
-                                        a pale underside) with a white factor
+    USD   /World/materials/<c>_material   UsdPreviewSurface (its shader
+          .../<c>_material_shader)        diffuseColor (linear), roughness; the scope
+                                          is `materials_1` if a creature is called
+                                          `materials` (`usd_folder`)
+    glTF  material <c>_material           rigid: baseColorFactor (linear); skinned: a
+                                          texture of the colour (rings along the
+                                          tentacle, a pale underside), a white factor
+
+The material, its shader and the mesh have names of their own: importers with one
+namespace for every prim (Blender's objects) rename a second `octopus_skin` to
+`octopus_skin.001`.
 
 Material colours are linear light (`to_linear`), textures sRGB, so an importer shows
 the colour the sandbox drew.
@@ -24,13 +31,18 @@ from ecs_tentacles.export.names import part
 from ecs_tentacles.skin.colours import PALE, creature_colour, look_in_take, to_linear
 from ecs_tentacles.take import Take
 
-FOLDER = "/World/materials"  # USD: the scope holding the creatures' materials
+FOLDER = "materials"  # USD: the scope under /World holding the creatures' materials
 ROUGHNESS = 0.6
 
 
 def material_name(creature: str) -> str:
-    """`<c>_skin`: creature `creature`'s material."""
-    return part(creature, "skin")
+    """`<c>_material`: creature `creature`'s material (its mesh is `<c>_skin`)."""
+    return part(creature, "material")
+
+
+def shader_name(material: str) -> str:
+    """`<material>_shader`: the UsdPreviewSurface shader of material `material`."""
+    return f"{material}_shader"
 
 
 def take_colours(take: Take) -> dict[str, np.ndarray]:
@@ -40,16 +52,27 @@ def take_colours(take: Take) -> dict[str, np.ndarray]:
     return {name: creature_colour(look_in_take(take.header, k)) for k, name in enumerate(names)}
 
 
-def usd_material(pxr: Any, stage: Any, creature: str, colour: np.ndarray) -> Any:
-    """`/World/materials/<c>_skin`, a UsdPreviewSurface of `colour` (display rgb): made
-    once, returned again after."""
+def usd_folder(take: Take) -> str:
+    """`/World/materials`, the scope of the creatures' materials; `/World/materials_1`
+    (`_2`, ...) if a creature is called `materials` (its root prim is `/World/<c>`)."""
+    names = {str(c["name"]) for c in take.header["creatures"]}
+    folder, k = FOLDER, 0
+    while folder in names:
+        k += 1
+        folder = f"{FOLDER}_{k}"
+    return f"/World/{folder}"
+
+
+def usd_material(pxr: Any, stage: Any, folder: str, creature: str, colour: np.ndarray) -> Any:
+    """`<folder>/<c>_material` (`folder`: `usd_folder(take)`), a UsdPreviewSurface of
+    `colour` (display rgb): made once, returned again after."""
     Sdf, UsdShade = pxr.Sdf, pxr.UsdShade
-    path = f"{FOLDER}/{material_name(creature)}"
+    path = f"{folder}/{material_name(creature)}"
     if stage.GetPrimAtPath(path):
         return UsdShade.Material(stage.GetPrimAtPath(path))
-    pxr.UsdGeom.Scope.Define(stage, FOLDER)
+    pxr.UsdGeom.Scope.Define(stage, folder)
     material = UsdShade.Material.Define(stage, path)
-    shader = UsdShade.Shader.Define(stage, f"{path}/surface")
+    shader = UsdShade.Shader.Define(stage, f"{path}/{shader_name(material_name(creature))}")
     shader.CreateIdAttr("UsdPreviewSurface")
     linear = pxr.Gf.Vec3f(*to_linear(colour).tolist())
     shader.CreateInput("diffuseColor", Sdf.ValueTypeNames.Color3f).Set(linear)

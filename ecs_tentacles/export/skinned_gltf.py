@@ -12,7 +12,7 @@ keys are reduced (one animation, not one per creature: Blender's importer plays 
 the first animation of a file and stashes the others in muted NLA tracks, and game
 engines read one animation as one clip). The mesh: POSITION, NORMAL, TEXCOORD_0 (a vertex is split
 where its UVs differ), JOINTS_0/WEIGHTS_0 (two influences used of four), bound to the
-creature's material `<c>_skin`: a texture of its sandbox colour
+creature's material `<c>_material`: a texture of its sandbox colour
 (`ecs_tentacles.export.materials`). Everything is turned to glTF's y-up like the rigid
 form (`ecs_tentacles.export.gltf`).
 

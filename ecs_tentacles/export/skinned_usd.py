@@ -9,14 +9,14 @@
         /<c>_skin                            Mesh (bound to the skeleton): points in the
                                              bind pose, normals, primvars:st (faceVarying),
                                              primvars:skel:jointIndices / jointWeights (2),
-                                             bound to /World/materials/<c>_skin
+                                             bound to /World/materials/<c>_material
         /<c>_suckers/<c>_t<k>/<c>_t<k>_link<i>/<c>_t<k>_link<i>_sucker<n>
                                              locator (`locators=True`): Xform, translate
                                              sampled (the sucker point), `ecs:attached`
         /<c>_goals/<c>_goal<j>, /<c>_fur/... the take's tracks, as in the rigid form
                                              (`ecs_tentacles.export.usd`); the goals only
                                              with `locators=True`
-      /materials/<c>_skin                    each creature's material, its sandbox colour
+      /materials/<c>_material                each creature's material, its sandbox colour
                                              (`ecs_tentacles.export.materials`)
 
 A SkelAnimation samples all its joints at once, so with reduced keys its time samples
@@ -34,7 +34,7 @@ from typing import Any
 import numpy as np
 
 from ecs_tentacles.export.ground import write_usd_ground
-from ecs_tentacles.export.materials import bind_usd, take_colours, usd_material
+from ecs_tentacles.export.materials import bind_usd, take_colours, usd_folder, usd_material
 from ecs_tentacles.export.names import part, unique_path
 from ecs_tentacles.export.usd import _pxr, key_visibility, mark_rate, new_stage, write_tracks
 from ecs_tentacles.numeric.quaternions import quat_rotate
@@ -76,10 +76,10 @@ def build_skinned_stage(
     creatures, report = skinned_creatures(take, detail, keys)
     shown = take.visible()
     of_name = {c["name"]: i for i, c in enumerate(take.header["creatures"])}
-    colours = take_colours(take)
+    colours, folder = take_colours(take), usd_folder(take)
     for creature in creatures:
         name = creature.skeleton.layout.name
-        _creature(pxr, stage, creature, colours[name])
+        _creature(pxr, stage, creature, colours[name], folder)
         mark_rate(stage, f"/World/{name}", take)
         key_visibility(stage, f"/World/{name}", shown[:, of_name[name]])
     if locators:
@@ -95,7 +95,9 @@ def _matrices(pxr: Any, matrices: np.ndarray) -> Any:
     return pxr.Vt.Matrix4dArray.FromNumpy(np.ascontiguousarray(np.swapaxes(matrices, -1, -2)))
 
 
-def _creature(pxr: Any, stage: Any, creature: SkinnedCreature, colour: np.ndarray) -> None:
+def _creature(
+    pxr: Any, stage: Any, creature: SkinnedCreature, colour: np.ndarray, folder: str
+) -> None:
     Gf, Sdf, UsdGeom, UsdSkel, Vt = pxr.Gf, pxr.Sdf, pxr.UsdGeom, pxr.UsdSkel, pxr.Vt
     skeleton, mesh = creature.skeleton, creature.mesh
     base = f"/World/{skeleton.layout.name}"
@@ -146,7 +148,7 @@ def _creature(pxr: Any, stage: Any, creature: SkinnedCreature, colour: np.ndarra
         Vt.FloatArray.FromNumpy(mesh.weights.reshape(-1).astype(np.float32))
     )
     bound.CreateGeomBindTransformAttr(Gf.Matrix4d(1.0))
-    material = usd_material(pxr, stage, name, colour)
+    material = usd_material(pxr, stage, folder, name, colour)
     bind_usd(pxr, skin.GetPrim(), material, colour)
 
 

@@ -16,7 +16,7 @@
                                               <c>_fur/<c>_guides): BasisCurves (linear),
                                               points and widths sampled
       /<folder>/<item>                        curves owned by no creature, if any
-      /materials/<c>_skin                     each creature's material: its sandbox
+      /materials/<c>_material                 each creature's material: its sandbox
                                               colour (`ecs_tentacles.export.materials`),
                                               bound to its mantle and capsules
       /terrain                                the ground's meshes, on terrain
@@ -45,7 +45,7 @@ from typing import Any
 import numpy as np
 
 from ecs_tentacles.export.ground import write_usd_ground
-from ecs_tentacles.export.materials import bind_usd, take_colours, usd_material
+from ecs_tentacles.export.materials import bind_usd, take_colours, usd_folder, usd_material
 from ecs_tentacles.export.names import FOLDERS, unique_path
 from ecs_tentacles.output.atomic import atomic_output
 from ecs_tentacles.take import Take, TakeTrack
@@ -137,14 +137,14 @@ def build_stage(
     stage.SetDefaultPrim(root.GetPrim())
     header = take.header
     shown = take.visible()
-    colours = take_colours(take)
+    colours, materials = take_colours(take), usd_folder(take)
     for index, creature in enumerate(header["creatures"]):
         base = f"/World/{creature['name']}"
         UsdGeom.Xform.Define(stage, base)
         mark_rate(stage, base, take)
         key_visibility(stage, base, shown[:, index])
         colour = colours[creature["name"]]
-        skin = (usd_material(pxr, stage, creature["name"], colour), colour)
+        skin = (usd_material(pxr, stage, materials, creature["name"], colour), colour)
         _body(pxr, stage, take, creature["mantle"], skin)
         if progress is not None:
             progress(1)

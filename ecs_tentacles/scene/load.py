@@ -1,6 +1,7 @@
 """Load a scene from a JSON file (or an already-parsed dict), validate it, fill defaults.
 
-Scenes are data only: they are parsed with :mod:`json`, and the only code imported is
+Scenes are data only: they are parsed with :mod:`json` (every key once in its object,
+numbers finite: `json_text.strict_loads`), and the only code imported is
 the plugins the scene turns on: built-in and bundled ones by name, others (a file
 beside the scene, a module, an installed entry point) only with ``allow_systems``.
 ``systems`` import paths are only strings at this stage.
@@ -25,6 +26,7 @@ from typing import TYPE_CHECKING, Any
 
 from ecs_tentacles.scene.defaults import plugin_config, with_defaults
 from ecs_tentacles.scene.errors import SceneError
+from ecs_tentacles.scene.json_text import DuplicateKey, strict_loads
 from ecs_tentacles.scene.physical import physical_problems, physically_checked
 from ecs_tentacles.scene.plugins import resolve
 from ecs_tentacles.scene.validate import repaired, validated
@@ -35,19 +37,6 @@ if TYPE_CHECKING:
 # bundled scenes are a few kB; `crowd 16384` (the most creatures a scene holds) writes 14 MB
 MAX_SCENE_BYTES = 16 * 1024**2
 _SCENE_NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.-]*$")
-
-
-def _finite_float(text: str) -> float:
-    """Parse a JSON number, refusing ones too large for a float (1e400 would be inf)."""
-    value = float(text)
-    if value in (float("inf"), float("-inf")):
-        raise ValueError(f"number {text} is too large")
-    return value
-
-
-def _refuse_constant(name: str) -> Any:
-    """Refuse the non-standard ``NaN``/``Infinity`` literals Python's json accepts."""
-    raise ValueError(f"{name} is not valid JSON")
 
 
 def _read_text(path: pathlib.Path) -> str:
@@ -91,9 +80,13 @@ def read_scene_json(path: pathlib.Path) -> object:
     except OSError as exc:
         raise SceneError([f"{path}: cannot read scene: {exc.strerror or exc}"]) from None
     try:
-        return json.loads(text, parse_float=_finite_float, parse_constant=_refuse_constant)
+        return strict_loads(text)
     except json.JSONDecodeError as exc:
         raise SceneError([f"{path}:{exc.lineno}:{exc.colno}: invalid JSON: {exc.msg}"]) from None
+    except DuplicateKey as exc:
+        where = f":{exc.line}:{exc.column}" if exc.line is not None else ""
+        key = json.dumps(exc.key, ensure_ascii=False)
+        raise SceneError([f"{path}{where}: invalid JSON: key {key} written twice"]) from None
     except ValueError as exc:
         raise SceneError([f"{path}: invalid JSON: {exc}"]) from None
     except RecursionError:

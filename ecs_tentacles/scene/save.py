@@ -7,7 +7,9 @@ name is never overwritten: the save is refused, saying which.
 
 `default_file_name` makes the file name a save offers by default from the scene's
 `name`, which is any string a scene file says: it only ever names a file in the current
-folder, never a folder (no separators, `..`, control characters or ANSI codes).
+folder, never a folder (no separators, `..`, control characters or ANSI codes), and one
+the file system takes: at most `NAME_MAX` bytes of UTF-8 with the atomic writer's
+temporary name (`.<name>.<token>.partial<suffix>`) included, cut between characters.
 """
 
 from __future__ import annotations
@@ -24,7 +26,7 @@ from importlib.resources import files
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ecs_tentacles.output.atomic import AtomicOutput, OutputError, disk_full
+from ecs_tentacles.output.atomic import AtomicOutput, OutputError, disk_full, temporary_name
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.load import load_scene_plugins, on_plane
 from ecs_tentacles.scene.physical import physically_checked
@@ -34,6 +36,9 @@ if TYPE_CHECKING:
     from ecs_tentacles.plugin import Plugin
 
 MAX_STEM = 64  # characters of the scene's name a default file name keeps
+NAME_MAX = 255  # bytes of a file name (ext4, XFS, btrfs, APFS; 64 four-byte letters are 256)
+# what the atomic writer's temporary name adds to the target's (`.` and `.<token>.partial`)
+_PARTIAL_BYTES = len(temporary_name(Path("x.json"), "0" * 8).name) - len("x.json")
 _ANSI = re.compile(r"\x1b(\[[0-?]*[ -/]*[@-~]|[@-_])")  # colour codes etc., taken out whole
 _UNSAFE = re.compile(r"[^\w.-]+")  # separators, spaces, controls, NUL, punctuation
 _DOTS = re.compile(r"\.{2,}")
@@ -43,11 +48,15 @@ def default_file_name(name: object, suffix: str, fallback: str = "scene") -> str
     """`<name><suffix>` as a bare file name (`"../x"` -> `"x_directed.json"`): a path's
     last part only; characters other than letters, digits, `_`, `.` and `-` become
     `_`, runs of dots one dot, the ends lose dots, `_` and `-`; at most `MAX_STEM`
-    characters; `fallback` if nothing is left (or `name` is not a string)."""
+    characters, and few enough bytes that the name and its temporary file's fit in
+    `NAME_MAX` (the stem cut between characters, `suffix` kept whole); `fallback` if
+    nothing is left (or `name` is not a string)."""
     text = _ANSI.sub("", name) if isinstance(name, str) else ""
     text = re.split(r"[/\\]", text)[-1]
     text = _DOTS.sub(".", _UNSAFE.sub("_", text)).strip("._-")
-    stem = text[:MAX_STEM].strip("._-") or fallback
+    room = NAME_MAX - _PARTIAL_BYTES - len(suffix.encode())
+    cut = text[:MAX_STEM].encode()[: max(room, 0)].decode(errors="ignore")
+    stem = cut.strip("._-") or fallback
     return stem + suffix
 
 

@@ -19,7 +19,6 @@ Reads and writes the terrain through `TerrainEditor`.
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Any
 
@@ -29,7 +28,7 @@ from imgui_bundle import imgui
 from ecs_tentacles.render.gui import Gui, same_line_if_fits, text_width
 from ecs_tentacles.render.registries import Panel, SandboxView
 from ecs_tentacles.scene.errors import SceneError
-from ecs_tentacles.scene.load import resolve_scene_path
+from ecs_tentacles.scene.load import read_scene_json, resolve_scene_path
 from ecs_tentacles.scene.save import default_file_name
 from ecs_tentacles.terrain.editing import BRUSHES, SHAPES, TerrainEditError, TerrainEditor
 
@@ -160,5 +159,7 @@ class TerrainPanel(Panel):
         if isinstance(source, dict):
             return dict(source)
         path = resolve_scene_path(str(source))
-        data: dict[str, Any] = json.loads(path.read_text(encoding="utf-8"))
+        data = read_scene_json(path)  # as a scene is read (SceneError: one line)
+        if not isinstance(data, dict):
+            raise SceneError([f"{path}: the scene is not an object"])
         return data

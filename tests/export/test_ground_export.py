@@ -134,9 +134,9 @@ def test_usd_holds_the_terrain_as_meshes_with_materials(
         assert prim.IsA(UsdGeom.Mesh)
         assert len(UsdGeom.Mesh(prim).GetFaceVertexCountsAttr().Get()) == len(mesh.triangles)
         bound = UsdShade.MaterialBindingAPI(prim).ComputeBoundMaterial()[0]
-        assert bound.GetPath() == f"/World/terrain/materials/{label}"
+        assert bound.GetPath() == f"/World/terrain/terrain_materials/{label}_material"
         # USD colours are linear: the sandbox's sand and rock, not paler
-        shader = UsdShade.Shader(stage.GetPrimAtPath(f"{bound.GetPath()}/surface"))
+        shader = bound.ComputeSurfaceSource()[0]
         diffuse = np.array(shader.GetInput("diffuseColor").Get())
         np.testing.assert_allclose(diffuse, to_linear(COLOURS[name]), atol=1e-6)
         shown = np.array(UsdGeom.Mesh(prim).GetDisplayColorAttr().Get()[0])

@@ -82,15 +82,15 @@ def test_the_rigid_glb_gives_each_creatures_bodies_its_colour(three: Take, tmp_p
     write_glb(three, tmp_path / "three.glb")
     document = _glb(tmp_path / "three.glb")
     by_name = {m["name"]: m for m in document["materials"]}
-    assert set(by_name) == {f"{name}_skin" for name in NAMES}
+    assert set(by_name) == {f"{name}_material" for name in NAMES}
     for name in NAMES:
-        factor = by_name[f"{name}_skin"]["pbrMetallicRoughness"]["baseColorFactor"]
+        factor = by_name[f"{name}_material"]["pbrMetallicRoughness"]["baseColorFactor"]
         np.testing.assert_allclose(factor, [*to_linear(COLOURS[name]), 1.0], atol=1e-6)
     used = _mesh_materials(document)
     bodies = [b["name"].split("/", 1)[0] for b in three.header["bodies"]]
     assert len(used) == len(bodies)  # every body has a mesh, none else
     for node, materials in used.items():
-        assert materials == {f"{node.split('_', 1)[0]}_skin"}, node
+        assert materials == {f"{node.split('_', 1)[0]}_material"}, node
 
 
 def test_the_skinned_glb_textures_each_creature_in_its_colour(three: Take, tmp_path: Path) -> None:
@@ -98,7 +98,7 @@ def test_the_skinned_glb_textures_each_creature_in_its_colour(three: Take, tmp_p
 
     write_skinned_glb(three, tmp_path / "three.glb")
     document = _glb(tmp_path / "three.glb")
-    assert _mesh_materials(document) == {f"{n}_skin": {f"{n}_skin"} for n in NAMES}
+    assert _mesh_materials(document) == {f"{n}_skin": {f"{n}_material"} for n in NAMES}
     for material in document["materials"]:
         texture = document["textures"][
             material["pbrMetallicRoughness"]["baseColorTexture"]["index"]
@@ -108,7 +108,7 @@ def test_the_skinned_glb_textures_each_creature_in_its_colour(three: Take, tmp_p
         png = document["binary"][start : start + view["byteLength"]]
         pixels = np.asarray(Image.open(BytesIO(png)), dtype=np.float64) / 255
         top = pixels[:, : pixels.shape[1] // 2].reshape(-1, 3).mean(axis=0) / 0.9  # rings: 0.9
-        name = material["name"].removesuffix("_skin")
+        name = material["name"].removesuffix("_material")
         np.testing.assert_allclose(top, COLOURS[name], atol=0.01)
 
 
@@ -148,7 +148,7 @@ def test_usd_binds_each_creature_to_a_material_of_its_colour(
     assert len(found) == expected  # capsules and mantles, or one skin each
     for prim, (material, colour) in found.items():
         name = prim.split("_", 1)[0]
-        assert material == f"/World/materials/{name}_skin", prim
+        assert material == f"/World/materials/{name}_material", prim
         np.testing.assert_allclose(colour, to_linear(COLOURS[name]), atol=1e-6)
 
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import re
 from collections.abc import Callable
 from pathlib import Path
@@ -11,6 +12,7 @@ import pytest
 from pyglet.window import key
 
 from ecs_tentacles.terrain.panel import TerrainPanel
+from ecs_tentacles.world import World
 
 from .conftest import event
 
@@ -91,3 +93,35 @@ def test_the_terrain_section_saves_a_scene_with_its_files_into_another_folder(
     assert sorted(p.name for p in other.iterdir()) == ["edited.json", "hill.png", "rock.obj"]
     with World.from_scene(other / "edited.json") as again:
         assert ground_of(again).digest() == ground_of(sandbox.world).digest()
+
+
+@pytest.mark.parametrize("lead", ["", "a", "ab", "abc"], ids=["0", "1", "2", "3"])
+def test_a_scene_named_in_many_four_byte_letters_saves_under_a_name_the_disk_takes(
+    make_sandbox: Callable[..., Any],
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    lead: str,
+) -> None:
+    # 80 letters of 4 bytes each (U+1D400, MATHEMATICAL BOLD CAPITAL A): 320 bytes, past
+    # a file name's 255; `lead` moves where a byte cut falls inside a letter
+    name = lead + "\U0001d400" * 80
+    monkeypatch.chdir(tmp_path)
+    scene = {"version": 1, "name": name, "creatures": [{"name": "a", "position": [0, 0]}]}
+    sandbox = make_sandbox(scene)
+    event(sandbox, "on_key_press", key.S, key.MOD_CTRL)  # Ctrl+S
+    event(sandbox, "on_key_release", key.S, key.MOD_CTRL)
+    ok, said = sandbox.scripts.notes[-1]
+    assert ok and said.startswith("saved "), said
+    panel = TerrainPanel(sandbox)
+    panel.save()
+    assert panel.message.startswith("saved "), panel.message
+    written = sorted(os.listdir(os.fsencode(tmp_path)))  # the bytes the file system holds
+    assert len(written) == 2, written
+    for raw, suffix in zip(written, (b"_directed.json", b"_terrain.json"), strict=True):
+        text = raw.decode("utf-8")  # whole letters only: valid UTF-8
+        assert raw.endswith(suffix)
+        assert len(raw) + len(b".") + len(b".01234567.partial") <= 255  # its temporary too
+        assert text.startswith(lead + "\U0001d400" * 50)
+        assert set(text[len(lead) : -len(suffix)]) == {"\U0001d400"}
+    with World.from_scene(tmp_path / written[0].decode()) as again:
+        assert again.scene is not None and again.scene["name"] == name

@@ -60,7 +60,7 @@ def test_an_export_opens_in_blender_at_its_rate_and_range(tmp_path: Path, suffix
     found = json.loads(read.stdout.splitlines()[-1])
     assert found["fps"] == 30 and found["range"] == [0, 30]  # 31 frames, 1 s at 30 fps
     assert found["actions"] and all(a == [0.0, 30.0] for a in found["actions"])
-    assert found["materials"] == ["octopus_skin"]  # USD imports it too, not grey
+    assert found["materials"] == ["octopus_material"]  # USD imports it too, not grey
 
 
 GROUND = """
@@ -252,11 +252,11 @@ def test_a_skinned_import_holds_what_the_artist_animates_and_nothing_else(
     assert report["by_type"] == {"ARMATURE": 4, "EMPTY": 1 + len(roots), "MESH": 4}
     assert (report["armatures"], report["animating"], report["outside_scene"]) == (4, 4, [])
     assert not [n for n in looks["all_objects"] if "Icosphere" in n or "materials" in n]
-    assert looks["meshes"] == {f"{c}_skin": [f"{c}_skin"] for c in FOUR}
+    assert looks["meshes"] == {f"{c}_skin": [f"{c}_material"] for c in FOUR}
     sandbox = take_colours(Take.load(four_take))  # the sandbox's default palette
     for c in FOUR:
         srgb = sandbox[c]
-        kind, colour = looks["colours"][f"{c}_skin"]
+        kind, colour = looks["colours"][f"{c}_material"]
         if kind == "texture":  # sRGB bytes as Blender reads them; rings: 0.9 on average
             np.testing.assert_allclose(np.array(colour) / 0.9, srgb, atol=0.02)
         else:
@@ -287,8 +287,8 @@ def test_a_rigid_usd_gives_every_capsule_its_creatures_material(
     report, looks = _report(out, tmp_path / "rigid.blend")
     assert report["by_type"]["MESH"] == 4 * (1 + 6 * 10)
     for mesh, materials in looks["meshes"].items():
-        assert materials == [f"{mesh.split('_')[0]}_{mesh.split('_')[1]}_skin"], mesh
-    assert sorted(looks["colours"]) == [f"{c}_skin" for c in FOUR]
+        assert materials == [f"{mesh.split('_')[0]}_{mesh.split('_')[1]}_material"], mesh
+    assert sorted(looks["colours"]) == [f"{c}_material" for c in FOUR]
 
 
 SKY_SRGB = (206, 219, 231)  # the tool's sky, (0.62, 0.71, 0.80) linear, as 8-bit sRGB
