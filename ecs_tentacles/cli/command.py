@@ -22,7 +22,7 @@ from ecs_tentacles.cli import (
     validate,
 )
 from ecs_tentacles.cli.arguments import NoDisplay, OneLineParser
-from ecs_tentacles.output.atomic import OutputError, release_claims
+from ecs_tentacles.output.atomic import OutputError, claimed_outputs, release_claims
 from ecs_tentacles.plugin import HookFailure
 from ecs_tentacles.scene import load
 from ecs_tentacles.scene.errors import SceneError
@@ -112,13 +112,22 @@ def _run(args: argparse.Namespace) -> int:
 
 
 def _stopped(stop: BaseException) -> int:
-    """Ctrl-C (130) or SIGTERM / SIGHUP (143): one line; the stop is reported."""
+    """Ctrl-C (130) or SIGTERM / SIGHUP (143): one line; the stop is reported. A stop
+    that came once every output of the command was written stopped nothing: exit 0, and
+    a note says the outputs are kept."""
     stops.taken()
     _quiet_finalizers()
+    written, unwritten = claimed_outputs()
+    names = ", ".join(map(str, written))
+    what = "Ctrl-C" if isinstance(stop, KeyboardInterrupt) else str(stop)
+    if written and not unwritten:
+        print(f"note: {what} came once every output was written: kept {names}", file=sys.stderr)
+        return 0
+    kept = f"; kept {names}, written whole" if written else ""
     if isinstance(stop, KeyboardInterrupt):
-        print("error: interrupted (Ctrl-C); partial outputs removed", file=sys.stderr)
+        print(f"error: interrupted (Ctrl-C); partial outputs removed{kept}", file=sys.stderr)
         return 130
-    print(f"error: stopped by {stop}; partial outputs removed", file=sys.stderr)
+    print(f"error: stopped by {stop}; partial outputs removed{kept}", file=sys.stderr)
     return 143
 
 

@@ -14,7 +14,10 @@ none meet. Then the takes are merged into the local bake's take.
 
 A shard that still fails after its retries fails the bake with one line naming it;
 the other shards finish and stay in the work folder for `--resume`. Ctrl-C cancels
-every running task (`ray.cancel`) and keeps the finished shards there too.
+every running task (`ray.cancel`) and keeps the finished shards there too. `--resume`
+uses a kept shard only when its signature is this user's (`work`); one that is not,
+or does not read, is baked again with one line naming it and why. Without the key
+(`secret`: a read-only home) no shard is kept or resumed, and one line says so.
 """
 
 from __future__ import annotations
@@ -52,7 +55,7 @@ from ecs_tentacles.distributed.shards import (
 )
 from ecs_tentacles.distributed.spheres import meetings
 from ecs_tentacles.distributed.task import ShardResult, bake_shard
-from ecs_tentacles.distributed.work import load_shard, remove_work, save_shard, shard_key
+from ecs_tentacles.distributed.work import WorkFolder, remove_work, shard_key
 from ecs_tentacles.export.bake import BakePlan
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.take import Take
@@ -244,8 +247,9 @@ def ray_bake(
         note(f"ray: {stats.plan.describe()}")
         if not resume:
             remove_work(folder)
+        work = WorkFolder.open(folder, resume=resume, note=note)
         shards = stats.plan.shards
-        results = _run_all(plan, shards, folder, resume, retries, progress, allow_systems, stats)
+        results = _run_all(plan, shards, work, retries, progress, allow_systems, stats)
         while True:
             met = _meetings(plan, results, plugins)
             if not met:
@@ -259,9 +263,7 @@ def ray_bake(
                 )
             todo = [s for s in shards if tuple(s) not in results]
             stats.rebaked += len(todo)
-            results.update(
-                _run_all(plan, todo, folder, resume, retries, progress, allow_systems, stats)
-            )
+            results.update(_run_all(plan, todo, work, retries, progress, allow_systems, stats))
             results = {tuple(s): results[tuple(s)] for s in shards}
         take = merge_takes([(r.members, r.take) for r in results.values()])
         return take, stats
@@ -272,8 +274,7 @@ def ray_bake(
 def _run_all(
     plan: BakePlan,
     shards: list[list[int]],
-    folder: Path,
-    resume: bool,
+    work: WorkFolder,
     retries: int,
     progress: bool,
     allow: bool,
@@ -285,7 +286,8 @@ def _run_all(
     keys = {tuple(s): shard_key(plan, s, allow) for s in shards}
     number = {tuple(s): i for i, s in enumerate(shards)}
     for shard in shards:
-        found = load_shard(folder, keys[tuple(shard)]) if resume else None
+        label = _label(plan, number[tuple(shard)], shard)
+        found = work.kept(keys[tuple(shard)], label)
         if found is not None:
             results[tuple(shard)] = found
             stats.resumed += 1
@@ -320,7 +322,7 @@ def _run_all(
                     except Exception as error:  # the task's error after its retries
                         failures.append(f"{label} failed: {_one_line(error)}")
                         continue
-                    save_shard(folder, keys[key], result)
+                    work.keep(keys[key], result)
                     results[key] = result
                     stats.baked += 1
                     stats.task_seconds.append(result.seconds)

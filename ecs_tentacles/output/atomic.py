@@ -13,6 +13,9 @@ fsynced and renamed onto the target, then the folder is fsynced.
 
 - Any exception (KeyboardInterrupt included, and SIGTERM once the CLI's handler turns
   it into an exception) removes the temporary file and leaves the target as it was.
+  Once renamed, a file is whole and stays: a stop that lands during the rename waits
+  until the run has noted the file as written (`claimed_outputs`), and the command line
+  then reports it as kept, not as removed (exit 0 when every output was written).
 - Two runs writing one target at the same time: exactly one wins. Each remembers what
   the target was when it started (`claim(target)`, which the CLI calls for every
   output path as it reads its arguments, long before a bake has anything to write;
@@ -173,6 +176,7 @@ def _folder_lock(folder: Path) -> Iterator[None]:
 
 
 _claims: dict[str, Identity] = {}  # absolute target path -> what it was when claimed
+_outputs: dict[str, bool] = {}  # every target claimed in this run -> written since
 
 
 def _claim_key(target: str | os.PathLike[str]) -> str:
@@ -193,11 +197,20 @@ def claim(target: str | os.PathLike[str]) -> None:
     if not os.access(folder, os.W_OK | os.X_OK):
         raise OutputError(f"{path}: cannot write in folder {str(folder)!r} (permission denied)")
     _claims[_claim_key(path)] = _identity(path)
+    _outputs[_claim_key(path)] = False
 
 
 def release_claims() -> None:
     """Forget every claim (a new run in the same process starts from scratch)."""
     _claims.clear()
+    _outputs.clear()
+
+
+def claimed_outputs() -> tuple[list[Path], list[Path]]:
+    """The outputs claimed in this run: those written whole (renamed into place), and
+    those not (yet), each in the order claimed."""
+    written = [Path(key) for key, done in _outputs.items() if done]
+    return written, [Path(key) for key, done in _outputs.items() if not done]
 
 
 class AtomicOutput:
@@ -254,20 +267,27 @@ class AtomicOutput:
                 os.fsync(descriptor)
         finally:
             os.close(descriptor)
-        with _folder_lock(self.target.parent):
-            if _identity(self.target) != self._before:
-                self.discard()
-                raise OutputConflict(
-                    f"{self.target}: another program wrote this file after this run"
-                    " started; kept theirs, discarded ours"
-                )
-            try:
-                os.replace(temporary, self.target)
-            except BaseException:
-                self.discard()
-                raise
-        self.temporary = None
-        _fsync_folder(self.target.parent)
+        # A stop landing as the file goes into place waits until the run has noted it
+        # there: the command line then says it was kept (`claimed_outputs`), never that
+        # partial outputs were removed while the whole file stays.
+        with _stops_deferred():
+            with _folder_lock(self.target.parent):
+                if _identity(self.target) != self._before:
+                    self.discard()
+                    raise OutputConflict(
+                        f"{self.target}: another program wrote this file after this run"
+                        " started; kept theirs, discarded ours"
+                    )
+                try:
+                    os.replace(temporary, self.target)
+                except BaseException:
+                    self.discard()
+                    raise
+                self.temporary = None
+                key = _claim_key(self.target)
+                if key in _outputs:
+                    _outputs[key] = True
+            _fsync_folder(self.target.parent)
         return self.target
 
     @contextlib.contextmanager
@@ -289,6 +309,13 @@ class AtomicOutput:
             with contextlib.suppress(FileNotFoundError):
                 self.temporary.unlink()
             self.temporary = None
+
+
+def _stops_deferred() -> contextlib.AbstractContextManager[None]:
+    """`ecs_tentacles.stops.deferred()` when the command line loaded it (looked up, as
+    in `_stop_if_asked`), else nothing: a stopping signal inside waits for its end."""
+    stops = sys.modules.get("ecs_tentacles.stops")
+    return stops.deferred() if stops is not None else contextlib.nullcontext()
 
 
 def _stop_if_asked() -> None:

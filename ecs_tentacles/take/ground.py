@@ -110,8 +110,8 @@ def _is_colour(rgb: object) -> bool:
         isinstance(rgb, list)
         and len(rgb) == 3
         and all(isinstance(c, (int, float)) and not isinstance(c, bool) for c in rgb)
-        and all(math.isfinite(c) and 0.0 <= c <= 1.0 for c in rgb)
-    )
+        and all(0.0 <= c <= 1.0 and math.isfinite(c) for c in rgb)  # range first: an int
+    )  # too large for a float is compared exactly, never converted
 
 
 def shapes(header: dict[str, Any]) -> dict[str, tuple[int, ...]]:

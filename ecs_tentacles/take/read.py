@@ -23,6 +23,7 @@ import json
 import math
 import re
 import stat
+import sys
 import zipfile
 import zlib
 from collections.abc import Iterator
@@ -31,6 +32,8 @@ from typing import IO, Any, cast
 
 import numpy as np
 
+from ecs_tentacles import bounded_json
+from ecs_tentacles.bounded_json import JsonLimit
 from ecs_tentacles.take import ground as take_ground
 from ecs_tentacles.take import roster as take_roster
 from ecs_tentacles.take.tracks import TakeTrack, declared_problem, dtypes, tracks_of
@@ -66,7 +69,10 @@ def _is_int(value: object) -> bool:
 
 
 def _is_number(value: object) -> bool:
-    return isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
+    """A finite number a float can hold (an int too large for one is not)."""
+    if isinstance(value, float):
+        return math.isfinite(value)
+    return _is_int(value) and abs(cast(int, value)) <= sys.float_info.max
 
 
 def _index(value: object, size: int) -> bool:
@@ -173,8 +179,8 @@ def _track_problem(header: dict[str, Any], track: TakeTrack) -> str | None:
         pattern = rf"^{creatures[item['creature']]['name']}/{stem}\d+$"
         if not isinstance(item.get("name"), str) or not re.fullmatch(pattern, item["name"]):
             return f"{where}.name: must be <creature>/{stem}<n>"
-        if not _is_number(item.get("radius")) or item["radius"] < 0:
-            return f"{where}.radius: must be a finite number >= 0"
+        if not _is_number(item.get("radius")) or not 0 <= item["radius"] <= MAX_COORDINATE:
+            return f"{where}.radius: must be a number in [0, {MAX_COORDINATE:g}] m"
     names = [item["name"] for item in header[key]]
     if len(set(names)) != len(names):
         return f"header.{key}: two have the same name"
@@ -393,8 +399,10 @@ def _read_archive(
         raise TakeError(f"header: larger than {MAX_HEADER_BYTES} bytes")
     raw = _read_entry(archive, "header", _header_shape(archive), CORE_DTYPES["header"])
     try:
-        header = json.loads(raw.tobytes().decode())
-    except (UnicodeDecodeError, json.JSONDecodeError, RecursionError) as exc:
+        header = bounded_json.loads(raw.tobytes().decode(), "header", max_bytes=MAX_HEADER_BYTES)
+    except JsonLimit as exc:
+        raise TakeError(str(exc)) from None
+    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise TakeError(f"header: not JSON ({str(exc).splitlines()[0]})") from None
     problem = header_problem(header)
     if problem:

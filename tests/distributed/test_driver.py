@@ -194,6 +194,52 @@ def test_a_failed_shard_is_named_and_resume_bakes_only_the_others(
     assert not work_folder(out).exists()
 
 
+def _tampered(path: Path, how: str) -> None:
+    """Rewrite the kept shard `path` as someone without the bake's key could: well-formed."""
+    from ecs_tentacles.take import write_npz
+
+    with np.load(path) as npz:
+        arrays = {name: npz[name] for name in npz.files}
+    header = json.loads(arrays["header"].tobytes())
+    if how == "every body moved 5 m":
+        arrays["pos"] = arrays["pos"] + np.float32(5.0)
+    text = {
+        "every body moved 5 m": json.dumps(header),
+        "a 400-digit fps": json.dumps({**header, "fps": 10**399}),
+        "a header nested 100000 deep": "[" * 100_000 + "]" * 100_000,
+    }[how]
+    write_npz(path, {**arrays, "header": np.frombuffer(text.encode(), np.uint8)})
+
+
+@pytest.mark.parametrize(
+    "how", ["every body moved 5 m", "a 400-digit fps", "a header nested 100000 deep"]
+)
+def test_a_changed_kept_shard_is_named_and_baked_again_on_resume(
+    cluster: Path, crowd: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], how: str
+) -> None:
+    """Before, the moved creatures were merged (exit 0) and the others failed every
+    --resume (exit 1: OverflowError, RecursionError)."""
+    plan, shards = shards_of(crowd)
+    (cluster / shard_key(plan, shards[-1], False)).write_text("crash")
+    out = tmp_path / "ray.npz"
+    assert bake(crowd, out, "--ray", "--retries", "0") == 1
+    _tampered(work_folder(out) / f"{shard_key(plan, shards[0], False)}.npz", how)
+    capsys.readouterr()
+    assert bake(crowd, out, "--ray", "--resume") == 0
+    err = capsys.readouterr().err.splitlines()
+    names = ", ".join(plan.scene["creatures"][i]["name"] for i in shards[0][:3])
+    said = [line for line in err if "kept result not used" in line]
+    assert len(said) == 1 and said[0].startswith(f"ray: shard 0 ({names}"), err
+    assert said[0].endswith(
+        "): kept result not used: it changed after this user's bake wrote it"
+        " (the signature differs); baking it again"
+    )
+    assert f"ray: 2 shard(s) baked, {len(shards) - 2} resumed, 0 re-baked" in "\n".join(err)
+    assert bake(crowd, tmp_path / "local.npz") == 0
+    assert out.read_bytes() == (tmp_path / "local.npz").read_bytes()
+    assert not work_folder(out).exists()
+
+
 @pytest.mark.parametrize(
     ("stop", "code", "message"),
     [

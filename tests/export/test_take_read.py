@@ -115,3 +115,59 @@ def test_loading_a_large_take_costs_about_its_size_once(good_take: Path, tmp_pat
         tracemalloc.stop()
     assert sum(a.nbytes for a in loaded.values()) >= raw
     assert peak < 1.05 * raw + 32 * 1024**2, f"peak {peak / 1e6:.0f} MB for {raw / 1e6:.0f} MB"
+
+
+HOSTILE_HEADERS = {  # header edit -> the one line `export` says after the file's name
+    "a 400-digit frame rate": (
+        lambda header: header.update(fps=10**399),
+        "header.fps: a number of 400 characters, at most 100",
+    ),
+    "a 400-digit radius": (
+        lambda header: header["bodies"][1].update(radius=-(10**399)),
+        "header.bodies[1].radius: a number of 401 characters, at most 100",
+    ),
+    "a key nested 500 deep": (
+        lambda header: header.update(notes=_nested(500)),
+        "header: nested deeper than 64 levels",
+    ),
+    "a key nested 100000 deep": (
+        lambda header: header.update(notes=_nested(100_000)),
+        "header: nested deeper than 64 levels",
+    ),
+}
+
+
+def _nested(depth: int) -> str:
+    return "@" * depth  # replaced by `depth` nested arrays once the header is JSON text
+
+
+@pytest.mark.parametrize("case", sorted(HOSTILE_HEADERS))
+def test_a_header_with_a_huge_number_or_deep_nesting_is_exit_2_naming_where(
+    case: str, good_take: Path, tmp_path: Path
+) -> None:
+    """In a real `export`: the 400-digit numbers failed with OverflowError (exit 1)."""
+    import json
+    import re
+    import subprocess
+    import sys
+
+    from ecs_tentacles.take import write_npz
+
+    with np.load(good_take) as npz:
+        arrays = {name: npz[name] for name in npz.files}
+    header = json.loads(arrays["header"].tobytes())
+    change, said = HOSTILE_HEADERS[case]
+    change(header)
+    text = re.sub(r'"(@+)"', lambda m: "[" * len(m[1]) + "]" * len(m[1]), json.dumps(header))
+    arrays["header"] = np.frombuffer(text.encode(), np.uint8)
+    bad = tmp_path / "bad.npz"
+    write_npz(bad, arrays)
+    out = tmp_path / "out.usda"
+    done = subprocess.run(
+        [sys.executable, "-P", "-m", "ecs_tentacles", "export", str(bad), "--out", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert (done.returncode, done.stderr) == (2, f"error: {bad}: {said}\n")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.npz"]

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import os
 import signal
 import subprocess
@@ -19,6 +20,7 @@ from ecs_tentacles.output.atomic import (
     atomic_output,
     claim,
 )
+from ecs_tentacles.take import Take
 
 
 def test_success_replaces_the_target_and_leaves_nothing_else(tmp_path: Path) -> None:
@@ -151,3 +153,78 @@ def test_a_claimed_target_written_by_another_before_the_write_starts_is_kept(
 def test_claiming_in_a_missing_folder_is_refused(tmp_path: Path) -> None:
     with pytest.raises(OutputError, match="does not exist"):
         claim(tmp_path / "nowhere" / "take.npz")
+
+
+# -- a stop that lands just after the rename -------------------------------------------
+
+AFTER_RENAME = """
+import os, signal, sys
+
+from ecs_tentacles.cli import main
+
+real, name, stop = os.replace, sys.argv[1], getattr(signal, sys.argv[2])
+
+
+def replace(source, target, **options):  # the real rename, then the signal at once
+    real(source, target, **options)
+    if os.path.basename(target) == name:
+        os.kill(os.getpid(), stop)
+
+
+os.replace = replace
+sys.exit(main(sys.argv[3:]))
+"""
+SCENE = {"version": 1, "creatures": [{"name": "octo", "tentacles": {"count": 3, "links": 2}}]}
+
+
+def _stopped_after_rename(folder: Path, name: str, stop: str, *argv: str) -> tuple[int, str]:
+    """Run the command line on `argv` in `folder`; the process sends itself `stop` just
+    after `name` is renamed into place. Exit code and stderr."""
+    (folder / "scene.json").write_text(json.dumps(SCENE))
+    done = subprocess.run(
+        [sys.executable, "-P", "-c", AFTER_RENAME, name, stop, *argv],
+        cwd=folder,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    return done.returncode, done.stderr
+
+
+@pytest.mark.parametrize(
+    ("stop", "argv", "said"),
+    [
+        ("SIGTERM", ["bake", "scene.json", "--seconds", "0.1", "--quiet"], "SIGTERM"),
+        ("SIGINT", ["migrate", "scene.json"], "Ctrl-C"),
+    ],
+)
+def test_a_stop_just_after_the_last_rename_keeps_the_output_and_exits_0(
+    tmp_path: Path, stop: str, argv: list[str], said: str
+) -> None:
+    """Before: exit 143 (130), "partial outputs removed", and the whole file there."""
+    out = tmp_path / ("take.npz" if argv[0] == "bake" else "scene.migrated.json")
+    if argv[0] == "bake":
+        argv = [*argv, "--out", out.name]
+    code, err = _stopped_after_rename(tmp_path, out.name, stop, *argv)
+    assert (code, err.splitlines()[-1]) == (
+        0,
+        f"note: {said} came once every output was written: kept {out}",
+    ), err
+    if argv[0] == "bake":
+        assert Take.load(out).frames == 7  # whole: 0.1 s at 60 fps
+    else:
+        assert json.loads(out.read_text())["creatures"][0]["name"] == "octo"
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(["scene.json", out.name])
+
+
+def test_a_stop_after_one_of_two_outputs_keeps_that_one_and_says_so(tmp_path: Path) -> None:
+    argv = ["bake", "scene.json", "--seconds", "0.05", "--quiet", "--out", "{name}.npz"]
+    argv += ["--wedge", "creatures[0].tentacles.count=3,4"]
+    first = tmp_path / "creatures0.tentacles.count-3.npz"  # the second and wedge.json: never
+    code, err = _stopped_after_rename(tmp_path, first.name, "SIGTERM", *argv)
+    assert (code, err.splitlines()[-1]) == (
+        143,
+        f"error: stopped by SIGTERM; partial outputs removed; kept {first}, written whole",
+    ), err
+    assert Take.load(first).frames == 4
+    assert sorted(p.name for p in tmp_path.iterdir()) == [first.name, "scene.json"]
