@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import signal
+import sys
 from collections.abc import Callable, Iterator
 from typing import Any
 
@@ -30,6 +31,23 @@ def worlds_by_backend(
         world.step(frames)
         worlds.append(world)
     return worlds
+
+
+def python_calls(action: Callable[[], object]) -> int:
+    """Python function calls (and generator resumptions) made while `action` runs: how
+    the work grows with a problem's size, counted rather than timed (no noise)."""
+    count = 0
+
+    def profile(frame: object, event: str, arg: object) -> None:
+        nonlocal count
+        count += event == "call"
+
+    sys.setprofile(profile)
+    try:
+        action()
+    finally:
+        sys.setprofile(None)
+    return count
 
 
 def creature_scene(**tentacles: Any) -> dict[str, Any]:

@@ -30,36 +30,58 @@ class Recorder(Protocol):
 class PointsTrack:
     """Records a points track: locators appear (in creature, then `order` order, never
     in entity-id order, which depends on which other creatures the world holds: a
-    shard of a bake), keep their first position, and are live while sampled."""
+    shard of a bake), keep their first position, and are live while sampled.
+
+    A frame costs array work over its locators (a frame like the last one: nothing more
+    than comparing its keys); only locators that appear cost Python work, once each.
+    """
 
     def __init__(self, track: TakeTrack, sample: Any, recorder: Recorder):
         self.track, self.sample, self.recorder = track, sample, recorder
-        self.columns: dict[int, int] = {}  # key -> column
         self.positions: list[np.ndarray] = []
-        self.alive: list[list[int]] = []  # per frame, the live columns
+        self.alive: list[np.ndarray] = []  # per frame, the live columns (shared while equal)
+        self._keys = np.zeros(0, dtype=np.int64)  # every key seen, sorted ...
+        self._columns = np.zeros(0, dtype=np.int64)  # ... and its column
+        self._numbers: dict[int, int] = {}  # take creature index -> its locators so far
+        self._last: tuple[np.ndarray, np.ndarray] = (_NONE, _NONE)  # keys, live columns
 
     def capture(self, world: World) -> None:
         frame: PointsFrame | None = self.sample(world) if self.sample else None
-        if frame is None:
-            self.alive.append([])
+        keys = _NONE if frame is None else np.asarray(frame.keys, dtype=np.int64).reshape(-1)
+        if np.array_equal(keys, self._last[0]):
+            self.alive.append(self._last[1])
             return
-        index = self.recorder.creature_index
-        items = list(
-            zip(frame.keys, frame.creatures, frame.order, range(len(frame.keys)), strict=True)
-        )
-        new = [item for item in items if item[0] not in self.columns]
-        for key, creature, _, i in sorted(new, key=lambda it: (index[it[1]], it[2])):
-            self._add(key, index[creature], frame.positions[i], frame.radii[i])
-        self.alive.append(sorted(self.columns[key] for key in frame.keys))
+        new = np.flatnonzero(~_found(self._keys, keys))
+        if frame is not None and len(new):
+            self._add(frame, new)
+        columns = self._columns[np.searchsorted(self._keys, keys)]
+        self._last = (keys, np.sort(columns))
+        self.alive.append(self._last[1])
 
-    def _add(self, key: int, creature: int, position: Any, radius: float) -> None:
+    def _add(self, frame: PointsFrame, new: np.ndarray) -> None:
+        """Columns and header entries for the locators `new` (indices into `frame`)."""
+        index = self.recorder.creature_index
         entries = self.recorder.header[self.track.key]
-        self.columns[key] = len(self.positions)
-        number = sum(entry["creature"] == creature for entry in entries)
-        owner = self.recorder.header["creatures"][creature]["name"]
-        name = f"{owner}/{self.track.folder}/{self.track.item}{number}"
-        entries.append({"name": name, "creature": creature, "radius": radius})
-        self.positions.append(np.asarray(position, dtype=np.float64))
+        names = self.recorder.header["creatures"]
+        keys = np.asarray(frame.keys, dtype=np.int64).reshape(-1)
+        owners = [index[int(e)] for e in np.asarray(frame.creatures)[new].tolist()]
+        orders = np.asarray(frame.order)[new].tolist()
+        first = len(self.positions)
+        added = []
+        for k in sorted(range(len(new)), key=lambda k: (owners[k], orders[k])):
+            i, creature = int(new[k]), owners[k]
+            number = self._numbers.get(creature, 0)
+            self._numbers[creature] = number + 1
+            name = f"{names[creature]['name']}/{self.track.folder}/{self.track.item}{number}"
+            radius = frame.radii[i]  # as given (a numpy number as the Python one)
+            radius = radius.item() if isinstance(radius, np.generic) else radius
+            entries.append({"name": name, "creature": creature, "radius": radius})
+            self.positions.append(np.asarray(frame.positions[i], dtype=np.float64))
+            added.append(keys[i])
+        every = np.concatenate([self._keys, np.asarray(added, dtype=np.int64)])
+        columns = np.concatenate([self._columns, np.arange(first, len(self.positions))])
+        order = np.argsort(every, kind="stable")
+        self._keys, self._columns = every[order], columns[order]
 
     def arrays(self, frames: int) -> dict[str, np.ndarray]:
         count = len(self.positions)
@@ -68,6 +90,15 @@ class PointsTrack:
             live[frame, alive] = True
         where, shown = self.track.arrays
         return {where: np.array(self.positions, np.float32).reshape(count, 3), shown: live}
+
+
+_NONE = np.zeros(0, dtype=np.int64)
+
+
+def _found(known: np.ndarray, keys: np.ndarray) -> np.ndarray:
+    """Which of `keys` are in `known` (sorted), as a bool array."""
+    at = np.minimum(np.searchsorted(known, keys), max(len(known) - 1, 0))
+    return known[at] == keys if len(known) else np.zeros(len(keys), dtype=np.bool_)
 
 
 class CurvesTrack:

@@ -10,6 +10,7 @@ reached), never per frame.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import esper
@@ -35,6 +36,18 @@ GOAL_WRITES = (
 )
 
 
+@dataclass(frozen=True)
+class GoalTable:
+    """Every goal at one moment: its entity, owner, order in the owner's path, position
+    (n, 3) and radius, in the owners' path order."""
+
+    keys: np.ndarray
+    owners: np.ndarray
+    orders: np.ndarray
+    positions: np.ndarray
+    radii: np.ndarray
+
+
 class GoalBook:
     """Each creature's ordered path of goal entities."""
 
@@ -44,6 +57,7 @@ class GoalBook:
         self._world = world
         self._paths: dict[int, list[int]] = {}
         self.version = 0  # bumped on every change, so views can cache what they drew
+        self._table: tuple[int, GoalTable] | None = None  # (version, every goal)
 
     def path(self, creature: int) -> list[int]:
         """The creature's goal entities in order (a copy)."""
@@ -58,6 +72,22 @@ class GoalBook:
         """(n, 3) positions of the creature's path, in order."""
         goals = [self._world.component(g, Goal).position for g in self._paths.get(creature, [])]
         return np.array(goals).reshape(-1, 3)
+
+    def table(self) -> GoalTable:
+        """Every goal of every path as arrays (the goals track samples it each frame):
+        built when the book has changed since it was last asked, shared until then."""
+        if self._table is None or self._table[0] != self.version:
+            keys = [goal for path in self._paths.values() for goal in path]
+            goals = [self._world.component(key, Goal) for key in keys]
+            table = GoalTable(
+                keys=np.array(keys, dtype=np.int64),
+                owners=np.array([g.owner for g in goals], dtype=np.int64),
+                orders=np.array([g.order for g in goals], dtype=np.int64),
+                positions=np.array([g.position for g in goals], dtype=np.float64).reshape(-1, 3),
+                radii=np.array([g.radius for g in goals], dtype=np.float64),
+            )
+            self._table = (self.version, table)
+        return self._table[1]
 
     def set(self, creature: int, position: Sequence[float], radius: float = DEFAULT_RADIUS) -> int:
         """Replace the creature's path with one goal; return the goal entity.
@@ -91,21 +121,40 @@ class GoalBook:
         path = self._paths.setdefault(creature, [])
         goal = self._world.create_entity(Goal(creature, len(path), point, float(radius)))
         path.append(goal)
-        self._sync(creature)
+        self.version += 1
+        if len(path) == 1:  # the goals before keep their order and the current one
+            self._sync(creature)
         return goal
 
     def remove(self, goal: int) -> None:
-        """Delete a goal wherever it is in its owner's path."""
+        """Delete a goal wherever it is in its owner's path (the goals after it move up)."""
         owner = self._world.component(goal, Goal).owner
-        self._paths[owner].remove(goal)
+        path = self._paths[owner]
+        index = path.index(goal)
+        del path[index]
         self._world.activate()
         esper.delete_entity(goal, immediate=True)
-        self._sync(owner)
+        for order in range(index, len(path)):
+            self._world.component(path[order], Goal).order = order
+        self.version += 1
+        if index == 0:
+            self._sync(owner)
 
     def clear(self, creature: int) -> None:
         """Delete all of the creature's goals."""
-        for goal in self.path(creature):
-            self.remove(goal)
+        path = self._paths.get(creature)
+        if not path:
+            return
+        self._world.activate()
+        for goal in path[:-1]:
+            esper.delete_entity(goal, immediate=True)
+        # the store keeps the last goal's place with has_goal off, as removing the goals
+        # one by one left it (snapshots of the columns stay the same)
+        del path[:-1]
+        self._sync(creature)
+        esper.delete_entity(path.pop(), immediate=True)
+        self.version += 1
+        self._sync(creature)
 
     def forget(self, creature: int) -> None:
         """The creature is being despawned: delete its goals and its path."""
@@ -122,10 +171,9 @@ class GoalBook:
         self._world.events.emit(GoalReached(self._world, creature, goal, position))
 
     def _sync(self, creature: int) -> None:
-        self.version += 1
+        """Mirror the creature's current goal into the CreatureStore (a goal's `order` is
+        kept by whoever changes the path: every call is linear in the goals it touches)."""
         path = self._paths.get(creature, [])
-        for order, goal in enumerate(path):
-            self._world.component(goal, Goal).order = order
         row = self._world.component(creature, Creature).row
         store = self._world.resource(LocomotionStores).creatures
         store.has_goal[row] = bool(path)

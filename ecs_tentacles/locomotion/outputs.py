@@ -18,7 +18,6 @@ import numpy as np
 from ecs_tentacles.cli.registries import RunSummary
 from ecs_tentacles.components import Creature
 from ecs_tentacles.distributed.registries import Reach
-from ecs_tentacles.locomotion.components import Goal
 from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.take.registries import PointsFrame, TrackSource
 from ecs_tentacles.take.tracks import TakeTrack
@@ -31,14 +30,15 @@ CRAWL_SPEED = 0.25  # m/s per unit of `locomotion.speed`: twice the fastest craw
 
 
 def goal_points(world: Host) -> PointsFrame:
-    """The live goals: each goal entity, its owner, its order in the path, where it is."""
-    goals = list(world.query(Goal))
+    """The live goals: each goal entity, its owner, its order in the path, where it is
+    (arrays the goal book keeps while no goal changes: no per-goal work per frame)."""
+    table = world.resource(GoalBook).table()
     return PointsFrame(
-        keys=[entity for entity, _ in goals],
-        creatures=[goal.owner for _, goal in goals],
-        order=[goal.order for _, goal in goals],
-        positions=[goal.position for _, goal in goals],
-        radii=[goal.radius for _, goal in goals],
+        keys=table.keys,
+        creatures=table.owners,
+        order=table.orders,
+        positions=table.positions,
+        radii=table.radii,
     )
 
 

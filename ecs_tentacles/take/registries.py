@@ -41,13 +41,15 @@ class PointsFrame:
     `keys` identify each across frames (an entity id); `creatures` are their owners'
     entities; `order` sorts locators that appear in the same frame within a creature;
     `positions` (n, 3) and `radii` (n,) are kept from the frame a locator first appears.
+    Each is a sequence or a numpy array; a sample that returns the very same `keys` as at
+    the last frame costs the recorder one comparison of them.
     """
 
-    keys: Sequence[int]
-    creatures: Sequence[int]
-    order: Sequence[int]
+    keys: Sequence[int] | Any
+    creatures: Sequence[int] | Any
+    order: Sequence[int] | Any
     positions: Any
-    radii: Sequence[float]
+    radii: Sequence[float] | Any
 
 
 @dataclass(frozen=True)
