@@ -97,7 +97,7 @@ def octopus_take() -> Any:
 @pytest.fixture(scope="session", autouse=True)
 def _private_cache(tmp_path_factory: pytest.TempPathFactory) -> Iterator[None]:
     """Decomposed meshes are cached in a folder of the test session's own, not the user's
-    (`ecs_tentacles.terrain.meshes.cache_folder`); the CLI processes tests start inherit it."""
+    (`ecs_tentacles.terrain.mesh_cache.cache_folder`); the CLI processes tests start inherit it."""
     import os
 
     before = os.environ.get("XDG_CACHE_HOME")

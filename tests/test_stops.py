@@ -187,3 +187,128 @@ def test_a_stop_swallowed_by_a_c_callback_is_not_committed(tmp_path: Path) -> No
         ctypes.CFUNCTYPE(None)(lambda: signal.raise_signal(signal.SIGINT))()  # ignored there
         assert temporary.read_bytes() == b"half a take"  # the writer went on
     assert list(tmp_path.iterdir()) == []
+
+
+BLOCKER = """
+from ecs_tentacles.plugin import Plugin
+
+
+class Blocker(Plugin):
+    name = "blocker"
+
+    def build_creature(self, world, creature, spec):
+        with open({fifo!r}, "rb") as pipe:  # blocks: the test opens it and writes nothing
+            pipe.read()
+"""
+
+
+def _reader_came(fifo: Path, process: subprocess.Popen[str]) -> int:
+    """The FIFO's write end, once `process` has opened its read end (the plugin is then in
+    its read, or a moment before it)."""
+    import errno
+    import os
+    import time
+
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and process.poll() is None:
+        try:
+            return os.open(fifo, os.O_WRONLY | os.O_NONBLOCK)
+        except OSError as error:  # ENXIO: no reader yet
+            assert error.errno == errno.ENXIO
+            time.sleep(0.05)
+    raise AssertionError(f"the build never read the FIFO: {process.communicate()}")
+
+
+@pytest.mark.parametrize("stop", ["SIGINT", "SIGTERM"])
+def test_the_first_signal_stops_a_build_blocked_in_a_read(tmp_path: Path, stop: str) -> None:
+    """A build blocked in a read (a FIFO no one writes) kept the first signal for a
+    creature that never came: validate waited forever. Now it stops within a second or
+    so, in one line, with the usual exit code."""
+    import os
+    import time
+
+    fifo = tmp_path / "pipe"
+    os.mkfifo(fifo)
+    (tmp_path / "blocker.py").write_text(BLOCKER.format(fifo=str(fifo)))
+    creature = {"name": "octo", "tentacles": {"count": 3, "links": 2}}
+    scene = {"version": 1, "plugins": {"blocker": {"from": "blocker.py:Blocker"}}}
+    (tmp_path / "scene.json").write_text(json.dumps({**scene, "creatures": [creature]}))
+    process = subprocess.Popen(
+        [sys.executable, "-P", "-m", "ecs_tentacles", "validate", "scene.json", "--allow-systems"],
+        cwd=tmp_path,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    writer = None
+    try:
+        writer = _reader_came(fifo, process)
+        process.send_signal(getattr(signal, stop))
+        sent = time.monotonic()
+        try:
+            _, err = process.communicate(timeout=30)
+        except subprocess.TimeoutExpired:
+            raise AssertionError("the signal was kept for a creature that never came") from None
+        took = time.monotonic() - sent
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.wait()
+        if writer is not None:
+            os.close(writer)
+    code, line = LINES[stop]
+    assert (process.returncode, err.splitlines()) == (code, [line])
+    assert took < 10
+
+
+@pytest.mark.usefixtures("installed")
+def test_a_kept_stop_is_raised_in_a_read_that_blocks() -> None:
+    """Inside a deferred region, a stop kept while the main thread sleeps in a read is
+    raised there, as a second signal would be, instead of waiting for a check."""
+    import os
+    import threading
+    import time
+
+    read_end, write_end = os.pipe()
+    main = threading.main_thread().ident
+    sender = threading.Timer(0.2, signal.pthread_kill, (main, signal.SIGINT))
+    rescue = threading.Timer(10.0, os.write, (write_end, b"x"))  # the old way: ends the read
+    try:
+        sender.start()
+        rescue.start()
+        started = time.monotonic()
+        with pytest.raises(KeyboardInterrupt), stops.deferred():
+            os.read(read_end, 1)  # nothing is ever written
+        assert time.monotonic() - started < 5
+    finally:
+        sender.cancel()
+        rescue.cancel()
+        os.close(read_end)
+        os.close(write_end)
+
+
+@pytest.mark.usefixtures("installed")
+def test_a_kept_stop_waits_for_the_check_while_the_main_thread_waits_for_a_thread() -> None:
+    """Waiting for a lock (a frame's physics threads) is not blocking in a read: the stop
+    stays kept until the frame's work is done and the next check comes."""
+    import threading
+    import time
+
+    done = threading.Event()
+    reached = []
+    main = threading.main_thread().ident
+    assert main is not None
+
+    def work() -> None:
+        signal.pthread_kill(main, signal.SIGINT)
+        time.sleep(1.0)  # longer than a kept stop waits for a read
+        done.set()
+
+    worker = threading.Thread(target=work)
+    with pytest.raises(KeyboardInterrupt), stops.deferred():
+        worker.start()
+        done.wait()
+        reached.append("the work")
+        stops.check()
+    worker.join()
+    assert reached == ["the work"]

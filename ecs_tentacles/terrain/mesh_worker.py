@@ -10,8 +10,11 @@ coordinates bounded (qhull crashed on 1e300), a volume (collinear points, one tr
 
 Protocol (stdin -> stdout): once its imports are done the worker writes `{"ready":
 true}`; then a request is one JSON line `{"suffix": ".obj", "scale": 1.0,
-"size": n}` and then the file's n bytes; the answer one JSON line, `{"pieces": [k, ...]}`
-followed by each piece's k x 3 float64 vertices, or `{"error": "one line"}`.
+"size": n, "want": "pieces"}` and then the file's n bytes; the answer one JSON line,
+`{"pieces": [k, ...]}` followed by each piece's k x 3 float64 vertices, or `{"error":
+"one line"}`. With `"want": "bounds"` the answer is the box of the mesh's vertices,
+scaled, after the same checks: `{"bounds": [[x, y, z], [x, y, z]]}` (lowest, highest
+corner; `ecs_tentacles.terrain.mesh_cache.fits` holds cached pieces to it).
 """
 
 from __future__ import annotations
@@ -93,10 +96,9 @@ def checked_vertices(vertices: np.ndarray, faces: np.ndarray, scale: float) -> n
     return scaled
 
 
-def pieces_of(data: bytes, suffix: str, scale: float) -> list[np.ndarray]:
-    """The convex pieces (vertex arrays, metres) of a mesh file's bytes, scaled."""
+def _loaded(data: bytes, suffix: str, scale: float) -> tuple[object, np.ndarray, np.ndarray]:
+    """A mesh file's bytes -> (the trimesh object, its checked vertices scaled, faces)."""
     import trimesh
-    from scipy.spatial import ConvexHull
 
     try:
         mesh = trimesh.load(io.BytesIO(data), file_type=suffix.lstrip("."), force="mesh")
@@ -105,7 +107,20 @@ def pieces_of(data: bytes, suffix: str, scale: float) -> list[np.ndarray]:
         raise Refused(f"not a readable mesh ({message})") from None
     vertices = np.asarray(getattr(mesh, "vertices", np.zeros((0, 3))), dtype=np.float64)
     faces = np.asarray(getattr(mesh, "faces", np.zeros((0, 3))), dtype=np.int64)
-    scaled = checked_vertices(vertices, faces, scale)
+    return mesh, checked_vertices(vertices, faces, scale), faces
+
+
+def bounds_of(data: bytes, suffix: str, scale: float) -> list[list[float]]:
+    """[lowest, highest] corner of the box around a mesh file's vertices, scaled."""
+    _, scaled, _ = _loaded(data, suffix, scale)
+    return [scaled.min(axis=0).tolist(), scaled.max(axis=0).tolist()]
+
+
+def pieces_of(data: bytes, suffix: str, scale: float) -> list[np.ndarray]:
+    """The convex pieces (vertex arrays, metres) of a mesh file's bytes, scaled."""
+    from scipy.spatial import ConvexHull
+
+    mesh, scaled, faces = _loaded(data, suffix, scale)
     if getattr(mesh, "is_convex", False):
         hull = ConvexHull(scaled)
         if len(hull.vertices) <= MAX_PIECE_VERTICES:
@@ -130,16 +145,21 @@ def _serve(requests: BinaryIO, answers: BinaryIO) -> None:
             return
         request = json.loads(line)
         data = requests.read(int(request["size"]))
+        suffix, scale = str(request["suffix"]), float(request["scale"])
+        pieces: list[np.ndarray] = []
         try:
-            pieces = pieces_of(data, str(request["suffix"]), float(request["scale"]))
+            if request.get("want") == "bounds":
+                answer: dict[str, object] = {"bounds": bounds_of(data, suffix, scale)}
+            else:
+                pieces = pieces_of(data, suffix, scale)
+                answer = {"pieces": [len(p) for p in pieces]}
         except Refused as refused:
-            answers.write(json.dumps({"error": str(refused)}).encode() + b"\n")
+            answer = {"error": str(refused)}
         except MemoryError:
-            answers.write(json.dumps({"memory": True}).encode() + b"\n")
-        else:
-            answers.write(json.dumps({"pieces": [len(p) for p in pieces]}).encode() + b"\n")
-            for piece in pieces:
-                answers.write(np.ascontiguousarray(piece, dtype="<f8").tobytes())
+            answer, pieces = {"memory": True}, []
+        answers.write(json.dumps(answer).encode() + b"\n")
+        for piece in pieces:
+            answers.write(np.ascontiguousarray(piece, dtype="<f8").tobytes())
         answers.flush()
 
 

@@ -5,9 +5,12 @@
 
 Each distinct file (by content, suffix and scale) is read and decomposed once: the
 pieces are kept for the rest of the process and in the user's cache folder
-(`cache_folder()`: `$XDG_CACHE_HOME/ecs_tentacles/meshes`, else `~/.cache/...`), written
-atomically (a temporary file renamed into place), so a thousand references to one rock,
-and the `run` after a `validate`, cost one decomposition.
+(`ecs_tentacles.terrain.mesh_cache`: `$XDG_CACHE_HOME/ecs_tentacles/meshes`, else
+`~/.cache/...`), so a thousand references to one rock, and the `run` after a `validate`,
+cost one decomposition. A cached entry is read as untrusted (a regular file of bounded
+size whose digests check, pieces with a volume) and used only if its pieces lie within
+the mesh file's own box, which the worker reads within the same budgets as a
+decomposition; any other entry is ignored, and the mesh decomposed and kept again.
 
 The reading, the checks (finite coordinates within `MAX_EXTENT` of the mesh's origin,
 a volume) and CoACD run in a worker process (`ecs_tentacles.terrain.mesh_worker`) that
@@ -29,7 +32,6 @@ import os
 import pathlib
 import select
 import subprocess
-import tempfile
 import time
 from types import TracebackType
 from typing import IO
@@ -39,7 +41,7 @@ import numpy as np
 from ecs_tentacles import stops
 from ecs_tentacles.processes import python_module
 from ecs_tentacles.scene.load import MAX_SCENE_BYTES
-from ecs_tentacles.terrain import mesh_worker
+from ecs_tentacles.terrain import mesh_cache, mesh_worker
 from ecs_tentacles.terrain.heights import TerrainError, beside_scene
 
 MESH_SECONDS = 60.0  # per mesh: reading, checks and decomposition
@@ -53,12 +55,6 @@ POLL = 0.05  # seconds between looks at the worker's time and memory
 
 JsonPath = tuple[str | int, ...]
 _KNOWN: dict[str, tuple[np.ndarray, ...] | str] = {}  # key -> pieces or the refusal
-
-
-def cache_folder() -> pathlib.Path:
-    """Where decomposed meshes are kept between runs."""
-    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
-    return pathlib.Path(base) / "ecs_tentacles" / "meshes"
 
 
 def _key(data: bytes, suffix: str, scale: float) -> str:
@@ -83,43 +79,6 @@ def _coacd_version() -> str:
         return version("coacd")
     except PackageNotFoundError:
         return "unknown"
-
-
-def _cached(key: str) -> tuple[np.ndarray, ...] | None:
-    """The pieces kept on disk under `key`, or None (absent, unreadable or not sane)."""
-    path = cache_folder() / f"{key}.npz"
-    try:
-        with np.load(path, allow_pickle=False) as stored:
-            pieces = tuple(np.asarray(stored[f"arr_{i}"], np.float64) for i in range(len(stored)))
-    except (OSError, ValueError, KeyError, EOFError):
-        return None
-    sane = pieces and all(
-        p.ndim == 2
-        and p.shape[1] == 3
-        and 4 <= len(p) <= 4 * mesh_worker.MAX_PIECE_VERTICES
-        and np.isfinite(p).all()
-        and np.abs(p).max() <= mesh_worker.MAX_EXTENT * 1.01
-        for p in pieces
-    )
-    return pieces if sane and len(pieces) <= mesh_worker.MAX_PIECES else None
-
-
-def _keep(key: str, pieces: tuple[np.ndarray, ...]) -> None:
-    """Write the pieces to the cache atomically (temporary file, then rename); a cache
-    that cannot be written is skipped silently (the next run decomposes again)."""
-    folder = cache_folder()
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-        descriptor, temporary = tempfile.mkstemp(prefix=f".{key[:16]}.", suffix=".npz", dir=folder)
-        try:
-            with os.fdopen(descriptor, "wb") as handle:
-                np.savez(handle, *pieces)
-            os.replace(temporary, folder / f"{key}.npz")
-        except BaseException:
-            os.unlink(temporary)
-            raise
-    except OSError:
-        pass
 
 
 class _Worker:
@@ -154,12 +113,15 @@ class _Worker:
             return 0.0
         return pages * os.sysconf("SC_PAGE_SIZE") / 1024**2
 
-    def ask(self, data: bytes, suffix: str, scale: float, seconds: float) -> dict[str, object]:
-        """Send one mesh; the answer, or {"over": "time" | "memory" | "crash"}."""
+    def ask(
+        self, want: str, data: bytes, suffix: str, scale: float, seconds: float
+    ) -> dict[str, object]:
+        """Send one mesh, for its "pieces" or "bounds"; the answer, or {"over": "time" |
+        "memory" | "crash"}."""
         assert self.process.stdin is not None
         if not isinstance(self.ready, bytes):  # it did not start
             return self.ready if self.ready.get("over") != "time" else {"over": "crash"}
-        request = json.dumps({"suffix": suffix, "scale": scale, "size": len(data)})
+        request = json.dumps({"suffix": suffix, "scale": scale, "size": len(data), "want": want})
         try:
             self.process.stdin.write(request.encode() + b"\n" + data)
             self.process.stdin.flush()
@@ -245,13 +207,9 @@ class MeshReader:
         key = _key(data, suffix, scale)
         known = _KNOWN.get(key) or self.over.get(key)
         if known is None:
-            known = _cached(key)
-        if known is None:
             if self.deadline - time.monotonic() <= 0:  # tried again by the next build
                 raise TerrainError(here, f"{name}: {self._over_scene()}")
-            known, lasting = self._decompose(data, suffix, scale)
-            if not isinstance(known, str):
-                _keep(key, known)
+            known, lasting = self._read(key, data, suffix, scale)
             if not lasting and isinstance(known, str):  # over a budget: this build only
                 self.over[key] = known
         if key not in self.over:
@@ -260,19 +218,40 @@ class MeshReader:
             raise TerrainError(here, f"{name}: {known}")
         return known
 
-    def _decompose(
-        self, data: bytes, suffix: str, scale: float
+    def _read(
+        self, key: str, data: bytes, suffix: str, scale: float
     ) -> tuple[tuple[np.ndarray, ...] | str, bool]:
-        """The pieces or why not, and whether that holds for good (not a budget's)."""
-        seconds = min(MESH_SECONDS, self.deadline - time.monotonic())
+        """The pieces or why not, and whether that holds for good (not a budget's): the
+        cached ones if they fit the mesh's box, else a decomposition's (then cached).
+        Both asks share the mesh's budget."""
+        until = min(time.monotonic() + MESH_SECONDS, self.deadline)
+        kept = mesh_cache.read(key)
+        if kept is not None:
+            answer = self._ask("bounds", data, suffix, scale, until)
+            if isinstance(answer, tuple):
+                return answer
+            if mesh_cache.fits(kept, np.asarray(answer["bounds"], dtype=np.float64)):
+                return kept, True
+        answer = self._ask("pieces", data, suffix, scale, until)
+        if isinstance(answer, tuple):
+            return answer
+        pieces = answer["arrays"]
+        assert isinstance(pieces, tuple)
+        mesh_cache.keep(key, pieces)
+        return pieces, True
+
+    def _ask(
+        self, want: str, data: bytes, suffix: str, scale: float, until: float
+    ) -> dict[str, object] | tuple[str, bool]:
+        """The worker's answer, or why there is none and whether that holds for good."""
         if self.worker is None:
             self.worker = _Worker()
-        answer = self.worker.ask(data, suffix, scale, seconds)
+        answer = self.worker.ask(want, data, suffix, scale, until - time.monotonic())
         over = answer.get("over") or ("memory" if answer.get("memory") else None)
         if over is not None or self.worker.resident_mb() > MESH_MEMORY_MB / 2:
             self.close()  # a fresh worker for the next mesh
         if over == "time":
-            if seconds < MESH_SECONDS:
+            if until >= self.deadline:  # the scene's budget ran out first
                 return self._over_scene(), False
             return (
                 f"reading and splitting it into convex pieces took over {MESH_SECONDS:g} s"
@@ -287,9 +266,7 @@ class MeshReader:
             return "reading or splitting it into convex pieces failed (the worker stopped)", False
         if "error" in answer:
             return str(answer["error"]), True
-        arrays = answer["arrays"]
-        assert isinstance(arrays, tuple)
-        return arrays, True
+        return answer
 
     @staticmethod
     def _over_scene() -> str:

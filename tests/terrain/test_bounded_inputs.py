@@ -140,7 +140,7 @@ def test_a_mesh_named_by_many_obstacles_is_decomposed_once_and_cached(
     tmp_path: pathlib.Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """1,000 references to one concave OBJ ran past 15 minutes (1.4 s of CoACD each)."""
-    from ecs_tentacles.terrain.meshes import cache_folder
+    from ecs_tentacles.terrain.mesh_cache import cache_folder
 
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
     arch(tmp_path / "arch.obj")
@@ -151,7 +151,7 @@ def test_a_mesh_named_by_many_obstacles_is_decomposed_once_and_cached(
     path = write_scene(tmp_path, {"obstacles": rocks})
     assert main(["validate", str(path)]) == 0, capsys.readouterr().err
     kept = sorted(cache_folder().iterdir())
-    assert len(kept) == 1 and kept[0].suffix == ".npz"  # one entry, no temporary left
+    assert len(kept) == 1 and kept[0].suffix == ".pieces"  # one entry, no temporary left
     stamp = kept[0].stat().st_mtime_ns
     assert main(["run", str(path), "--frames", "1", "--quiet"]) == 0, capsys.readouterr().err
     assert sorted(cache_folder().iterdir()) == kept and kept[0].stat().st_mtime_ns == stamp
