@@ -217,12 +217,12 @@ def soak_here(args: argparse.Namespace) -> int:
                 print(f"{now:8.0f} {rss:9.1f} {base} {median:9.2f} {len(recent):7d}", flush=True)
     ok, line = verdict(samples, args.warmup, args.threshold)
     print(line, flush=True)
-    after = [(t, ms) for t, ms in times if t >= args.warmup]
-    if after:
-        first_t, last_t = after[0][0], after[-1][0]
+    warm = [(t, ms) for t, ms in times if t >= args.warmup]
+    if warm:
+        first_t, last_t = warm[0][0], warm[-1][0]
         span = min(max(60.0, (last_t - first_t) / 10), (last_t - first_t) / 4)
-        head = statistics.median(ms for t, ms in after if t <= first_t + span)
-        tail = statistics.median(ms for t, ms in after if t >= last_t - span)
+        head = statistics.median(ms for t, ms in warm if t <= first_t + span)
+        tail = statistics.median(ms for t, ms in warm if t >= last_t - span)
         print(
             f"frame time after warm-up (median of {span:.0f} s windows): {head:.2f} ms at the"
             f" start, {tail:.2f} ms at the end ({tail / head:.3f}x), {len(times)} frames",

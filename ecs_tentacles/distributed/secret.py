@@ -19,10 +19,11 @@ from __future__ import annotations
 import contextlib
 import os
 import secrets
-import stat
 from pathlib import Path
 
 from platformdirs import user_state_dir
+
+from ecs_tentacles.untrusted.files import TooLarge, Unfit, regular_file
 
 FILE = "shard.key"
 SIZE = 32
@@ -53,27 +54,24 @@ def shard_secret() -> bytes:
 
 def _read(path: Path) -> bytes:
     try:
-        descriptor = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC)
+        with regular_file(path, SIZE, follow=False) as handle:
+            info = os.fstat(handle.fileno())
+            problem = (
+                "not this user's"
+                if info.st_uid != os.getuid()
+                else "readable by other users"
+                if info.st_mode & 0o077
+                else None
+            )
+            data = b"" if problem else handle.read(SIZE + 1)
     except FileNotFoundError:
         raise
+    except TooLarge:
+        problem = f"larger than {SIZE} bytes"
+    except Unfit as unfit:
+        problem = unfit.reason
     except OSError as error:
         raise SecretUnavailable(f"{path}: cannot read the shard key: {_reason(error)}") from None
-    info = os.fstat(descriptor)
-    problem = (
-        "not a regular file"
-        if not stat.S_ISREG(info.st_mode)
-        else "not this user's"
-        if info.st_uid != os.getuid()
-        else "readable by other users"
-        if info.st_mode & 0o077
-        else None
-    )
-    data = b""
-    if problem is None:
-        with os.fdopen(descriptor, "rb") as handle:
-            data = handle.read(SIZE + 1)
-    else:
-        os.close(descriptor)
     if problem is None and len(data) != SIZE:
         problem = f"{len(data)} bytes, not {SIZE}"
     if problem:

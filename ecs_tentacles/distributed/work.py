@@ -19,15 +19,12 @@ shows that this user's bake wrote these bytes for this key; it does not hide the
 from __future__ import annotations
 
 import contextlib
-import errno
 import hashlib
 import hmac
 import io
 import json
-import os
 import re
 import shutil
-import stat
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -35,13 +32,14 @@ from typing import BinaryIO
 
 import numpy as np
 
-from ecs_tentacles import bounded_json
 from ecs_tentacles.distributed.secret import SecretUnavailable, shard_secret
 from ecs_tentacles.distributed.task import ShardResult
 from ecs_tentacles.export.bake import BakePlan
 from ecs_tentacles.output.atomic import atomic_file
 from ecs_tentacles.take import Take, write_npz
 from ecs_tentacles.take.read import MAX_HEADER_BYTES, MAX_TAKE_BYTES
+from ecs_tentacles.untrusted import bounded_json
+from ecs_tentacles.untrusted.files import Unfit, regular_file
 
 _KEY = re.compile(r"^[0-9a-f]{24}\.npz(\.hmac)?$")
 MAX_SHARD_BYTES = MAX_TAKE_BYTES  # a shard file larger than a take may be is baked again
@@ -137,27 +135,15 @@ def load_shard(folder: Path, key: str, secret: bytes) -> ShardResult | None:
 def _regular(path: Path, limit: int, what: str) -> Iterator[BinaryIO]:
     """`path` open for reading if it is a regular file (not followed if a link) of at
     most `limit` bytes, else `ShardUnusable` (a FIFO is never waited on)."""
-    flags = os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC
-    try:
-        descriptor = os.open(path, flags)
-    except FileNotFoundError:
-        raise ShardUnusable(f"{what} is missing") from None
-    except OSError as error:
-        if error.errno == errno.ELOOP:
-            raise ShardUnusable(f"{what} is a symbolic link") from None
-        raise ShardUnusable(f"{what} cannot be opened ({error.strerror})") from None
-    info = os.fstat(descriptor)
-    problem = (
-        "not a regular file"
-        if not stat.S_ISREG(info.st_mode)
-        else f"larger than {limit} bytes"
-        if info.st_size > limit
-        else None
-    )
-    if problem:
-        os.close(descriptor)
-        raise ShardUnusable(f"{what} is {problem}")
-    with os.fdopen(descriptor, "rb") as handle:
+    with contextlib.ExitStack() as stack:
+        try:
+            handle = stack.enter_context(regular_file(path, limit, follow=False))
+        except FileNotFoundError:
+            raise ShardUnusable(f"{what} is missing") from None
+        except Unfit as unfit:
+            raise ShardUnusable(f"{what} is {unfit.reason}") from None
+        except OSError as error:
+            raise ShardUnusable(f"{what} cannot be opened ({error.strerror})") from None
         yield handle
 
 

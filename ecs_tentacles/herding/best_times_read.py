@@ -18,11 +18,11 @@ from __future__ import annotations
 
 import json
 import math
-import os
-import stat
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
+
+from ecs_tentacles.untrusted.files import TooLarge, Unfit, read_regular
 
 MAX_BYTES = 1 << 20  # 1 MiB: about 20,000 levels' best times
 MAX_DIGITS = 20  # an integer of more digits is no game's time (and no float holds it)
@@ -82,15 +82,13 @@ def _text(file: Path) -> str | None:
     """The file's text (None: there is none), read within `MAX_BYTES`; ValueError says
     why it cannot be read as a best-times file."""
     try:  # non-blocking: a FIFO opens at once (and is then refused), never waits
-        fd = os.open(file, os.O_RDONLY | os.O_NONBLOCK | os.O_CLOEXEC)
+        data = read_regular(file, MAX_BYTES)
     except FileNotFoundError:
         return None  # an unreadable folder (another OSError) is the caller's to say
-    with os.fdopen(fd, "rb") as handle:
-        if not stat.S_ISREG(os.fstat(fd).st_mode):
-            raise ValueError("not a regular file")
-        data = handle.read(MAX_BYTES + 1)
-    if len(data) > MAX_BYTES:
-        raise ValueError(f"larger than {MAX_BYTES >> 20} MiB")
+    except TooLarge:
+        raise ValueError(f"larger than {MAX_BYTES >> 20} MiB") from None
+    except Unfit:
+        raise ValueError("not a regular file") from None
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as error:

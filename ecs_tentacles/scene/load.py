@@ -1,7 +1,7 @@
 """Load a scene from a JSON file (or an already-parsed dict), validate it, fill defaults.
 
 Scenes are data only: they are parsed with :mod:`json` (every key once in its object,
-numbers finite: `json_text.strict_loads`), and the only code imported is
+numbers finite: `untrusted.strict_json.strict_loads`), and the only code imported is
 the plugins the scene turns on: built-in and bundled ones by name, others (a file
 beside the scene, a module, an installed entry point) only with ``allow_systems``.
 ``systems`` import paths are only strings at this stage.
@@ -20,16 +20,16 @@ import json
 import os
 import pathlib
 import re
-import stat
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
 from ecs_tentacles.scene.defaults import plugin_config, with_defaults
 from ecs_tentacles.scene.errors import SceneError
-from ecs_tentacles.scene.json_text import DuplicateKey, strict_loads
 from ecs_tentacles.scene.physical import physical_problems, physically_checked
 from ecs_tentacles.scene.plugins import resolve
 from ecs_tentacles.scene.validate import repaired, validated
+from ecs_tentacles.untrusted.files import TooLarge, Unfit, read_regular
+from ecs_tentacles.untrusted.strict_json import DuplicateKey, strict_loads
 
 if TYPE_CHECKING:
     from ecs_tentacles.plugin import Plugin
@@ -41,27 +41,17 @@ _SCENE_NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.-]*$")
 
 def _read_text(path: pathlib.Path) -> str:
     """The file's text: a regular file of at most `MAX_SCENE_BYTES`, opened without blocking."""
-    descriptor = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_CLOEXEC)
-    mode = os.fstat(descriptor).st_mode
-    if not stat.S_ISREG(mode):
-        os.close(descriptor)
-        kind = (
-            "a folder"
-            if stat.S_ISDIR(mode)
-            else "a FIFO"
-            if stat.S_ISFIFO(mode)
-            else "a device or socket"
-        )
-        raise SceneError([f"{path}: cannot read scene: {kind}, not a regular file"])
-    with os.fdopen(descriptor, "rb") as handle:
-        data = handle.read(MAX_SCENE_BYTES + 1)
-    if len(data) > MAX_SCENE_BYTES:
+    try:
+        data = read_regular(path, MAX_SCENE_BYTES)
+    except TooLarge:
         raise SceneError(
             [
                 f"{path}: cannot read scene: larger than {MAX_SCENE_BYTES / 1024**2:g} MB"
                 " (raise the limit with --max-scene-mb)"
             ]
-        )
+        ) from None
+    except Unfit as unfit:
+        raise SceneError([f"{path}: cannot read scene: {unfit.reason}"]) from None
     return data.decode("utf-8-sig")
 
 

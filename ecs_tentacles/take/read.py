@@ -32,11 +32,11 @@ from typing import IO, Any, cast
 
 import numpy as np
 
-from ecs_tentacles import bounded_json
-from ecs_tentacles.bounded_json import JsonLimit
 from ecs_tentacles.take import ground as take_ground
 from ecs_tentacles.take import roster as take_roster
 from ecs_tentacles.take.tracks import TakeTrack, declared_problem, dtypes, tracks_of
+from ecs_tentacles.untrusted import bounded_json
+from ecs_tentacles.untrusted.bounded_json import JsonLimit
 
 MAX_TAKE_BYTES = 2 * 1024**3  # uncompressed; a 10 s bake of 4 creatures is ~30 MB
 MAX_HEADER_BYTES = 64 * 1024**2

@@ -42,7 +42,6 @@ from __future__ import annotations
 import hashlib
 import os
 import pathlib
-import stat
 import struct
 from collections.abc import Sequence
 
@@ -50,6 +49,7 @@ import numpy as np
 
 from ecs_tentacles.output.atomic import atomic_file
 from ecs_tentacles.terrain.mesh_worker import MAX_PIECE_VERTICES, MAX_PIECES, has_volume
+from ecs_tentacles.untrusted.files import Unfit, read_regular
 
 MAGIC = b"ECSTPCS1"
 SUFFIX = ".pieces"
@@ -58,7 +58,6 @@ _DIGEST = 32
 _HEAD = len(MAGIC) + _DIGEST + 4  # magic, the key's digest, the number of pieces
 MAX_ENTRY_BYTES = _HEAD + MAX_PIECES * (4 + 24 * MAX_ENTRY_VERTICES) + _DIGEST
 TOLERANCE = 0.05  # of the source box's diagonal: how far past the box a piece may reach
-_OPEN = os.O_RDONLY | os.O_NONBLOCK | os.O_NOFOLLOW | os.O_NOCTTY | os.O_CLOEXEC
 
 Pieces = tuple[np.ndarray, ...]
 
@@ -133,25 +132,10 @@ def read(key: str) -> Pieces | None:
     """The pieces kept under `key`, or None: absent, not a regular file, larger than
     `MAX_ENTRY_BYTES`, unreadable, or failing a check (`decode`)."""
     try:
-        descriptor = os.open(entry(key), _OPEN)
-    except OSError:  # absent, a symlink (ELOOP), no permission
+        data = read_regular(entry(key), MAX_ENTRY_BYTES, follow=False)
+    except (OSError, Unfit):  # absent, a link, a FIFO, too large, no permission
         return None
-    try:
-        info = os.fstat(descriptor)
-        if not stat.S_ISREG(info.st_mode) or info.st_size > MAX_ENTRY_BYTES:
-            return None
-        chunks, left = [], MAX_ENTRY_BYTES + 1
-        while left > 0:
-            chunk = os.read(descriptor, left)
-            if not chunk:
-                break
-            chunks.append(chunk)
-            left -= len(chunk)
-    except OSError:
-        return None
-    finally:
-        os.close(descriptor)
-    return decode(key, b"".join(chunks))
+    return decode(key, data)
 
 
 def fits(pieces: Pieces, box: np.ndarray) -> bool:

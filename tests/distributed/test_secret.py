@@ -45,7 +45,7 @@ def test_bakes_starting_at_once_share_one_key(state: Path) -> None:
     [
         (lambda p: (p.write_bytes(b"k" * 32), p.chmod(0o644)), "readable by other users"),
         (lambda p: (p.write_bytes(b"short"), p.chmod(0o600)), "5 bytes, not 32"),
-        (lambda p: os.mkfifo(p, 0o600), "not a regular file"),
+        (lambda p: os.mkfifo(p, 0o600), "a FIFO, not a regular file"),
     ],
 )
 def test_a_key_file_that_is_not_private_or_whole_is_refused_naming_it(

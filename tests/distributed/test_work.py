@@ -73,9 +73,9 @@ def _moved(arrays: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
         ("a header nested 100000 deep", CHANGED),
         ("signed with another user's key", CHANGED),
         ("its signature removed", "its signature is missing"),
-        ("a FIFO", "it is not a regular file"),
+        ("a FIFO", "it is a FIFO, not a regular file"),
         ("a symbolic link", "it is a symbolic link"),
-        ("a folder", "it is not a regular file"),
+        ("a folder", "it is a folder, not a regular file"),
     ],
 )
 def test_a_changed_or_strange_shard_is_refused_with_its_reason(

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from ecs_tentacles.scene.json_text import DuplicateKey, strict_loads
+from ecs_tentacles.untrusted.strict_json import DuplicateKey, strict_loads
 
 TWICE = """{
   "version": 1,

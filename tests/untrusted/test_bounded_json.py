@@ -6,7 +6,7 @@ import json
 
 import pytest
 
-from ecs_tentacles.bounded_json import JsonLimit, loads
+from ecs_tentacles.untrusted.bounded_json import JsonLimit, loads
 
 SOUND = {"fps": 30.0, "seed": 2**63 - 1, "bodies": [{"radius": 0.05, "tip": [1, -2.5e-3]}]}
 
