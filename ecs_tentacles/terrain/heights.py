@@ -16,7 +16,7 @@ A 1024 x 1024 heightfield takes 8 MB here and 4 MB in each compiled physics mode
 
 from __future__ import annotations
 
-import os
+import io
 import pathlib
 from collections.abc import Mapping
 from typing import Any
@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 
 from ecs_tentacles.terrain.heightfield import Heightfield
+from ecs_tentacles.untrusted.files import TooLarge, Unfit, read_regular
 
 Problem = tuple[tuple[str | int, ...], str]
 SOURCES = ("noise", "image", "heights")
@@ -110,15 +111,15 @@ def _image_heights(name: str, folder: pathlib.Path | None) -> np.ndarray:
 
     here = HERE + ("image",)
     path = beside_scene(name, folder, here)
-    try:
-        with open(path, "rb") as handle:
-            head = handle.read(24)
-            size = os.fstat(handle.fileno()).st_size
+    try:  # read once, as it is now: what `beside_scene` found may have been swapped
+        data = read_regular(path, MAX_IMAGE_BYTES)
+    except TooLarge:
+        raise TerrainError(here, f"{name}: larger than {MAX_IMAGE_BYTES >> 20} MB") from None
+    except Unfit as unfit:
+        raise TerrainError(here, f"{name}: cannot read it ({unfit.reason})") from None
     except OSError as error:
         raise TerrainError(here, f"{name}: cannot read it ({error.strerror})") from None
-    if size > MAX_IMAGE_BYTES:
-        raise TerrainError(here, f"{name}: larger than {MAX_IMAGE_BYTES >> 20} MB")
-    sides = png_size(head)
+    sides = png_size(data[:24])
     if sides is None:
         raise TerrainError(here, f"{name}: not a PNG image (its first bytes are not a PNG's)")
     if max(sides) > MAX_IMAGE_SIDE or min(sides) < 3:
@@ -128,7 +129,7 @@ def _image_heights(name: str, folder: pathlib.Path | None) -> np.ndarray:
             + (" (as resolution's): scale it down" if max(sides) > MAX_IMAGE_SIDE else ""),
         )
     try:
-        with Image.open(path, formats=["PNG"]) as image:
+        with Image.open(io.BytesIO(data), formats=["PNG"]) as image:
             if image.size != sides:  # the header read above and Pillow's disagree
                 raise TerrainError(here, f"{name}: not a readable PNG (its header is damaged)")
             if image.mode not in ("1", "L", "I;16", "I;16B", "I", "LA", "P", "RGB", "RGBA"):

@@ -43,6 +43,7 @@ from ecs_tentacles.processes import python_module
 from ecs_tentacles.scene.load import MAX_SCENE_BYTES
 from ecs_tentacles.terrain import mesh_cache, mesh_worker
 from ecs_tentacles.terrain.heights import TerrainError, beside_scene
+from ecs_tentacles.untrusted.files import TooLarge, Unfit, read_regular
 
 MESH_SECONDS = 60.0  # per mesh: reading, checks and decomposition
 MESH_MEMORY_MB = 1024  # the worker's resident memory while it works on one mesh
@@ -196,13 +197,14 @@ class MeshReader:
         path = beside_scene(name, self.folder, here)
         if path.suffix.lower() not in MESH_SUFFIXES:
             raise TerrainError(here, f"{name}: a mesh must be one of {', '.join(MESH_SUFFIXES)}")
-        try:
-            with open(path, "rb") as handle:
-                data = handle.read(MAX_MESH_BYTES + 1)
+        try:  # what `beside_scene` found may have been swapped since: checked as read
+            data = read_regular(path, MAX_MESH_BYTES)
+        except TooLarge:
+            raise TerrainError(here, f"{name}: larger than {MAX_MESH_BYTES >> 20} MB") from None
+        except Unfit as unfit:
+            raise TerrainError(here, f"{name}: cannot read it ({unfit.reason})") from None
         except OSError as error:
             raise TerrainError(here, f"{name}: cannot read it ({error.strerror})") from None
-        if len(data) > MAX_MESH_BYTES:
-            raise TerrainError(here, f"{name}: larger than {MAX_MESH_BYTES >> 20} MB")
         suffix = path.suffix.lower()
         key = _key(data, suffix, scale)
         known = _KNOWN.get(key) or self.over.get(key)
