@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
-CHUNK = 65_536  # points queried at once: about 300 bytes each of temporaries
+CHUNK = 65_536  # points queried at once: under 1 KB each of temporaries
 SPARE = 2  # distinct roots asked of the tree beyond `k`: room for near ties
 SLACK = 1e-9  # relative: the tree's distances and numpy's differ in the last bits
 
