@@ -34,6 +34,7 @@ if TYPE_CHECKING:
     from ecs_tentacles.host import Host
     from ecs_tentacles.registry import App
     from ecs_tentacles.store import ArrayStore
+    from ecs_tentacles.take.tracks import TrackSize
 
 
 class HookFailure(RuntimeError):
@@ -189,6 +190,12 @@ class Plugin:
         return []
 
     # -- output hooks (takes, shard plans, run reports) -------------------------------
+    def take_sizes(self, scene: Mapping[str, Any]) -> list[TrackSize]:
+        """What this plugin's take tracks will hold for `scene` (defaults filled in),
+        from the scene alone: a bake counts them with the bodies before anything is
+        built, and refuses a take the reader would not read back."""
+        return []
+
     def __repr__(self) -> str:
         return f"<plugin {self.key}>"
 

@@ -140,6 +140,11 @@ def run_wedge(args: argparse.Namespace, plan: BakePlan, save: Any) -> int:
         )
         for v in every
     ]
+    for variant, variant_plan in zip(every, plans, strict=True):
+        problem = variant_plan.size_problem()  # a variant may grow what a take holds
+        if problem:
+            print(f"error: argument --wedge: variant {variant.name}: {problem}", file=sys.stderr)
+            return 2
     print(f"wedge: {len(every)} variants -> {pattern.parent}", file=sys.stderr, flush=True)
     takes = _wedge_takes(args, plans)
     rows = []

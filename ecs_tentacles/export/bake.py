@@ -21,13 +21,16 @@ from pathlib import Path
 from typing import Any
 
 from ecs_tentacles.export.recording import Recording, scene_sha256
+from ecs_tentacles.export.take_size import NPY_HEADERS, TakeSize, take_size
 from ecs_tentacles.output.progress import status, step_frames
-from ecs_tentacles.scene.construction import tentacle_params
-from ecs_tentacles.scene.load import load_scene, load_scene_plugins, resolve_scene_path
+from ecs_tentacles.scene.load import load_scene_plugins, resolve_scene_path
 from ecs_tentacles.scene.plugins import builtin
 from ecs_tentacles.take import Take
-from ecs_tentacles.take.read import MAX_FRAMES, MAX_TAKE_BYTES
+from ecs_tentacles.take.read import MAX_FRAMES, MAX_HEADER_BYTES, MAX_TAKE_BYTES
+from ecs_tentacles.take.tracks import TrackSize
 from ecs_tentacles.world import World
+
+GIB, MIB = 1024**3, 1024**2
 
 
 def _count(value: float) -> str:
@@ -35,22 +38,23 @@ def _count(value: float) -> str:
     return f"{value:,.0f}" if value < 1e15 else f"{value:.3g}"
 
 
-POSE_BYTES = 7 * 4  # a body's position and quaternion in a frame (float32)
-SUCKER_BYTES = 1 + 3 * 4  # attached flag and anchor
+def _seconds(value: float) -> str:
+    """Seconds for a message, rounded down to the millisecond (never up past a limit)."""
+    return f"{math.floor(value * 1000) / 1000:,.3f}".rstrip("0").rstrip(".")
 
 
-def scene_sizes(scene: dict[str, Any]) -> tuple[int, int]:
-    """(bodies, suckers) a loaded scene's creatures have: mantles and links; suckers at
-    most (the suckers plugin may be off)."""
-    bodies = suckers = 0
-    for creature in scene["creatures"]:
-        tentacles = creature["tentacles"]
-        for k in range(tentacles["count"]):
-            params = tentacle_params(tentacles, k)
-            bodies += params["links"]
-            suckers += params["links"] if params.get("suckers") == "every_link" else 1
-        bodies += 1
-    return bodies, suckers
+def _parts(size: TakeSize) -> str:
+    """'7 bodies, 1 sucker and 250,000 fur guides of 16 points' (the parts with items)."""
+    named = []
+    for part in (p for p in size.parts if p.items):
+        what = part.what if part.items > 1 else _one(part.what)
+        named.append(f"{part.items:,} {what}" + (f" {part.each}" if part.each else ""))
+    return ", ".join(named[:-1]) + (" and " if len(named) > 1 else "") + named[-1]
+
+
+def _one(what: str) -> str:
+    """'bodies' -> 'body', 'fur guides' -> 'fur guide'."""
+    return what[:-3] + "y" if what.endswith("ies") else what.removesuffix("s")
 
 
 @dataclass(frozen=True)
@@ -65,6 +69,7 @@ class BakePlan:
     every: int  # simulated frames per take frame
     seed: int
     folder: str | None = None  # the scene's folder: plugins from files are found there
+    tracks: tuple[TrackSize, ...] = ()  # what the scene's plugins' take tracks will hold
 
     @classmethod
     def make(
@@ -86,12 +91,12 @@ class BakePlan:
         folder = str(Path(os.getcwd() if scene_dir is None else scene_dir).resolve())
         if isinstance(scene, dict):
             where = Path(folder)
-            data = load_scene_plugins(scene, allow_systems=allow_systems, scene_dir=where)[0]
+            data, plugins = load_scene_plugins(scene, allow_systems=allow_systems, scene_dir=where)
             source = "<dict>"
         else:
             path = resolve_scene_path(os.fspath(scene))
-            source, data = str(path), load_scene(path, allow_systems=allow_systems)
-            folder = str(path.resolve().parent)
+            data, plugins = load_scene_plugins(path, allow_systems=allow_systems)
+            source, folder = str(path), str(path.resolve().parent)
         if not (seconds > 0 and math.isfinite(seconds)):
             raise ValueError(f"seconds must be a positive number, got {seconds}")
         scene_fps = float(data["physics"]["fps"])
@@ -108,6 +113,7 @@ class BakePlan:
             every=every,
             seed=int(data["seed"] if seed is None else seed),
             folder=folder,
+            tracks=tuple(size for plugin in plugins for size in plugin.take_sizes(data)),
         )
 
     @property
@@ -128,8 +134,10 @@ class BakePlan:
     def size_problem(self) -> str | None:
         """Why the take this plan makes could not be held or read back (one line), or None.
 
-        Checked before anything is built: a take has at most `MAX_FRAMES` frames and
-        `MAX_TAKE_BYTES` of arrays (poses are 28 bytes per body and frame).
+        Checked before anything is built: a take has at most `MAX_FRAMES` frames,
+        `MAX_TAKE_BYTES` in all and `MAX_HEADER_BYTES` of header, as counted from the
+        scene (`export.take_size`: the bodies, the suckers and the plugins' tracks, the
+        fur's guide curves among them). The message says what would fit.
         """
         frames = self.seconds * self.fps + 1  # a float: no overflow, whatever was asked
         if frames > MAX_FRAMES + 0.5:
@@ -137,15 +145,40 @@ class BakePlan:
                 f"{self.seconds:g} s at {self.fps:g} fps is {_count(frames)} frames; a take holds"
                 f" at most {MAX_FRAMES} (bake fewer seconds or at a lower --fps)"
             )
-        bodies, suckers = scene_sizes(self.scene)
-        size = self.frames * (bodies * POSE_BYTES + suckers * SUCKER_BYTES)
-        if size > MAX_TAKE_BYTES:
+        size = take_size(self.scene, self.tracks)
+        header = size.fixed_bytes - NPY_HEADERS  # at most: a point's position counts too
+        if header > MAX_HEADER_BYTES:
             return (
-                f"{self.frames} frames of {bodies} bodies would be {size / 1024**3:.1f} GiB;"
-                f" a take holds at most {MAX_TAKE_BYTES / 1024**3:g} GiB (bake fewer seconds"
-                " or at a lower --fps)"
+                f"the take's header would be {header / MIB:,.0f} MiB for {_parts(size)};"
+                f" a take's header holds at most {MAX_HEADER_BYTES / MIB:g} MiB (bake fewer"
+                " creatures)"
             )
-        return None
+        total = size.total(self.frames)
+        if total <= MAX_TAKE_BYTES:
+            return None
+        most = max(size.parts, key=lambda part: part.items * part.frame_bytes)
+        share = self.frames * most.items * most.frame_bytes + most.fixed_bytes
+        return (
+            f"{self.frames:,} frames of {_parts(size)} would be {total / GIB:.1f} GiB,"
+            f" {share / GIB:.1f} GiB of it the {most.what}; a take holds at most"
+            f" {MAX_TAKE_BYTES / GIB:g} GiB: {self._what_fits(size, most)}"
+        )
+
+    def _what_fits(self, size: TakeSize, most: TrackSize) -> str:
+        """The most seconds a take holds at this rate, and the most of the largest part
+        (a plugin's track) at these seconds: 'bake at most 0.55 s at 60 fps or at most
+        210,000 fur guides'."""
+        fits = []
+        frames = (MAX_TAKE_BYTES - size.fixed_bytes) // max(size.frame_bytes, 1)
+        if frames >= 2:
+            fits.append(f"bake at most {_seconds((frames - 1) / self.fps)} s at {self.fps:g} fps")
+        if most in size.parts[2:]:  # a plugin's track, not the bodies or suckers
+            others = size.total(self.frames) - self.frames * most.items * most.frame_bytes
+            room = MAX_TAKE_BYTES - (others - most.fixed_bytes)
+            each = self.frames * most.frame_bytes + most.fixed_bytes / max(most.items, 1)
+            if room >= 0:
+                fits.append(f"at most {math.floor(room / each):,} {most.what}")
+        return " or ".join(fits) or "bake fewer creatures"
 
     @property
     def scene_sha256(self) -> str:

@@ -11,6 +11,10 @@ Checked before anything is generated: a 1 KB scene could otherwise ask for tens 
 A scene over it gets one line naming the fur with the most guides. The largest crowd
 `ecs-tentacles crowd` writes (16,384 creatures) has about 132,000 guides of 8 points,
 1.06 million points; at the limits `validate` takes about 0.8 GB and `run` 1.2 GB.
+Child hairs (each fur's `children` per guide, as the sandbox draws them) are at most
+`MAX_SCENE_CHILDREN` a scene, one line at the fur with the most: the crowd has about
+180,000; at the limit their setup takes about 4.4 s and 0.7 GB (their nearest guides: a
+k-d tree, `fur.nearest`) and a frame of every one of them about 2 s.
 """
 
 from __future__ import annotations
@@ -28,6 +32,8 @@ Problem = tuple[Path, str]
 MAX_SCENE_GUIDES = 500_000  # about 1.1 KB each once built (an entity and its rows)
 MAX_SCENE_FUR_POINTS = 4_000_000  # about 64 bytes each (rest shape, posed curve, scratch)
 GUIDE_BYTES, POINT_BYTES = 1100, 64  # measured on `validate` (a groom of 40,000 guides)
+MAX_SCENE_CHILDREN = 1_000_000  # child hairs, guides x `children` of every fur
+CHILD_BYTES = 670  # the peak of their setup, each (`tools/bench_children.py`)
 
 
 def _where(path: Path) -> str:
@@ -111,7 +117,8 @@ def guide_count(fur: Mapping[str, Any], mantle: Mapping[str, Any]) -> tuple[int,
 
 def budget_problems(scene: Mapping[str, Any]) -> list[Problem]:
     """One problem when the scene's fur is over `MAX_SCENE_GUIDES` or
-    `MAX_SCENE_FUR_POINTS` (at the fur with the most guides), else none."""
+    `MAX_SCENE_FUR_POINTS` (at the fur with the most guides), or else over
+    `MAX_SCENE_CHILDREN` (at the fur with the most children), else none."""
     furs = []  # (guides, key, creature index)
     for i, creature in enumerate(scene["creatures"]):
         if "fur" in creature:
@@ -136,8 +143,28 @@ def budget_problems(scene: Mapping[str, Any]) -> list[Problem]:
         )
         advice = "groom fewer guides or fewer points per guide"
     else:
-        return []
+        return _children_problems(scene, furs)
     return [(path, f"{message} (about {gigabytes:.1f} GB); {advice}")]
+
+
+def _children_problems(scene: Mapping[str, Any], furs: list[tuple[int, str, int]]) -> list[Problem]:
+    """One problem when the furs' child hairs (guides x `children` each) are over
+    `MAX_SCENE_CHILDREN`, at the fur with the most of them, else none."""
+    each = [(guides * scene["creatures"][i]["fur"]["children"], guides, i) for guides, _, i in furs]
+    total = sum(n for n, _, _ in each)
+    if total <= MAX_SCENE_CHILDREN:
+        return []
+    most, guides, i = max(each, key=lambda fur: (fur[0], -fur[2]))  # the first of the largest
+    per = scene["creatures"][i]["fur"]["children"]
+    here = f"{'all' if most == total else f'{most:,}'} here: {guides:,} guides x {per}"
+    return [
+        (
+            ("creatures", i, "fur", "children"),
+            f"the scene's {total:,} child hairs ({here}) are over the budget of"
+            f" {MAX_SCENE_CHILDREN:,} a scene (about {total * CHILD_BYTES / 1e9:.1f} GB to set"
+            " up); fewer children per guide or fewer guides",
+        )
+    ]
 
 
 def fur_problems(scene: Mapping[str, Any]) -> list[Problem]:

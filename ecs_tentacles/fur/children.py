@@ -22,6 +22,7 @@ import numpy as np
 
 from ecs_tentacles.components import Creature
 from ecs_tentacles.fur.groom import closest_surface_point
+from ecs_tentacles.fur.nearest import nearest
 from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.numeric.quaternions import quat_rotate
 
@@ -29,7 +30,6 @@ if TYPE_CHECKING:
     from ecs_tentacles.host import Host
 
 NEIGHBOURS = 3
-CHUNK = 2048  # children whose guide distances are computed at once (memory bound)
 
 
 @dataclass
@@ -117,23 +117,15 @@ def _make_layout(world: Host, per_guide: int | None, seed: int) -> ChildLayout:
 def _nearest(
     points: np.ndarray, roots: np.ndarray, rows: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
-    """The 3 nearest roots of each point (guide rows) and inverse-distance weights."""
+    """The 3 nearest roots of each point (guide rows), nearest first (ties: the lower
+    row), and inverse-distance weights; with fewer guides, the last is repeated at
+    weight 0."""
     k = min(NEIGHBOURS, len(roots))
-    out_rows = np.empty((len(points), NEIGHBOURS), dtype=np.int64)
-    out_weights = np.zeros((len(points), NEIGHBOURS))
-    for start in range(0, len(points), CHUNK):
-        part = points[start : start + CHUNK]
-        d2 = np.sum((part[:, None, :] - roots[None]) ** 2, axis=2)
-        nearest = np.argpartition(d2, k - 1, axis=1)[:, :k] if k < len(roots) else None
-        if nearest is None:
-            nearest = np.tile(np.arange(len(roots)), (len(part), 1))
-        d = np.sqrt(np.take_along_axis(d2, nearest, axis=1))
-        w = 1.0 / np.maximum(d, 1e-6) ** 2
-        w /= w.sum(axis=1, keepdims=True)
-        pad = NEIGHBOURS - k  # fewer guides than neighbours: repeat the first, weight 0
-        out_rows[start : start + len(part)] = rows[np.pad(nearest, ((0, 0), (0, pad)), "edge")]
-        out_weights[start : start + len(part), :k] = w
-    return out_rows, out_weights
+    found, d2 = nearest(points, roots, k)
+    w = 1.0 / np.maximum(np.sqrt(d2), 1e-6) ** 2
+    w /= w.sum(axis=1, keepdims=True)
+    pad = NEIGHBOURS - k
+    return rows[np.pad(found, ((0, 0), (0, pad)), "edge")], np.pad(w, ((0, 0), (0, pad)))
 
 
 def point_indices(points: int, keep: int | None) -> np.ndarray:

@@ -4,7 +4,8 @@
   recorded frame (`ecs_tentacles.fur.hooks.take_guides`);
 - before a recording: the guides posed at the built pose, so take frame 0 has them;
 - shard groups: creatures marked `threat` and the creatures with an `emotion` they
-  may rouse bake in one shard (the emotion system reads every threat's position).
+  may rouse bake in one shard (the emotion system reads every threat's position);
+- take sizes: what the guide curves will hold, from a scene (`guide_sizes`).
 """
 
 from __future__ import annotations
@@ -12,16 +13,32 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
+from ecs_tentacles.fur.checks import guide_count
 from ecs_tentacles.fur.hooks import take_guides
 from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.take.registries import TrackSource
-from ecs_tentacles.take.tracks import TakeTrack
+from ecs_tentacles.take.tracks import TakeTrack, TrackSize
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
 
 GUIDES = TakeTrack("guides", "curves", ("guide_points", "guide_widths"), "fur", "guides")
 GUIDE_TRACK = TrackSource(GUIDES, take_guides)
+POINT_BYTES = 3 * 4 + 4  # a guide point in a frame: position and width (float32)
+
+
+def guide_sizes(scene: Mapping[str, Any]) -> list[TrackSize]:
+    """The guide curves of a take of `scene` (defaults filled in): every fur's guides
+    (as the groom makes them), each of the points every fur shares (the most a groom
+    asks), every frame; once, each guide's owner in the header."""
+    furs = [(i, c) for i, c in enumerate(scene["creatures"]) if "fur" in c]
+    if not furs:
+        return []
+    guides = [guide_count(c["fur"], c["mantle"])[0] for _, c in furs]
+    points = max(c["fur"]["groom"]["points"] for _, c in furs)
+    owners = sum(n * (len(str(i)) + 1) for n, (i, _) in zip(guides, furs, strict=True))
+    each = f"of {points} points"
+    return [TrackSize("fur guides", sum(guides), points * POINT_BYTES, owners, each)]
 
 
 def pose_fur_at_build(world: Host) -> None:

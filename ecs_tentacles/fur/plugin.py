@@ -29,6 +29,7 @@ if TYPE_CHECKING:
     from ecs_tentacles.render.registries import Panel, RenderView, SandboxView
     from ecs_tentacles.roster_change import RosterChange
     from ecs_tentacles.store import ArrayStore
+    from ecs_tentacles.take.tracks import TrackSize
 
 _FRAGMENT = fragment("ecs_tentacles.fur", "fur")
 STORES = ("guides", "controls", "sets", "emotions")
@@ -83,6 +84,11 @@ class FurPlugin(Plugin):
         from ecs_tentacles.fur.outputs import GUIDE_TRACK
 
         return [GUIDE_TRACK]
+
+    def take_sizes(self, scene: Mapping[str, Any]) -> list[TrackSize]:
+        from ecs_tentacles.fur.outputs import guide_sizes
+
+        return guide_sizes(scene)
 
     def _before_recording(self, world: Host) -> None:
         from ecs_tentacles.fur.outputs import pose_fur_at_build

@@ -5,11 +5,13 @@
 - shard reach: how far a creature may crawl during a bake (`CRAWL_SPEED` x its
   `locomotion.speed` x the bake's seconds), straight toward its first goal when that
   is farther than it can crawl, anywhere within that distance otherwise;
-- run summary: goals reached and goals left.
+- run summary: goals reached and goals left;
+- take sizes: what the goals track will hold, from a scene (`goal_sizes`).
 """
 
 from __future__ import annotations
 
+import json
 from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
@@ -20,7 +22,7 @@ from ecs_tentacles.components import Creature
 from ecs_tentacles.distributed.registries import Reach
 from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.take.registries import PointsFrame, TrackSource
-from ecs_tentacles.take.tracks import TakeTrack
+from ecs_tentacles.take.tracks import TakeTrack, TrackSize
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
@@ -43,6 +45,22 @@ def goal_points(world: Host) -> PointsFrame:
 
 
 GOAL_TRACK = TrackSource(GOALS, goal_points)
+
+
+def goal_sizes(scene: Mapping[str, Any]) -> list[TrackSize]:
+    """The goals track of a take of `scene` (defaults filled in), as far as the scene
+    says: its goals, each live or not every frame (a byte), where it is (12 bytes) and
+    its header entry once. Goals added while baking are counted by `Take.save`."""
+    goals = fixed = 0
+    for c, creature in enumerate(scene["creatures"]):
+        name = f"{creature.get('name', f'creature_{c}')}/goals/goal"
+        n = len(creature["goals"])
+        entry = {"creature": c, "name": name, "radius": 0}  # '{"creature":0,...}' and a comma
+        each = 3 * 4 + len(json.dumps(entry, separators=(",", ":"))) - 1 + 1
+        radii = sum(len(repr(float(goal["radius"]))) for goal in creature["goals"])
+        fixed += n * each + sum(len(str(k)) for k in range(n)) + radii
+        goals += n
+    return [TrackSize("goals", goals, 1, fixed)] if goals else []
 
 
 def crawl_reach(creature: Mapping[str, Any], seconds: float) -> Reach:

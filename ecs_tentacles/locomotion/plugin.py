@@ -62,6 +62,7 @@ if TYPE_CHECKING:
     from ecs_tentacles.render.registries import Click, Panel, RenderView, SandboxView
     from ecs_tentacles.roster_change import RosterChange
     from ecs_tentacles.store import ArrayStore
+    from ecs_tentacles.take.tracks import TrackSize
 
 _FRAGMENT = fragment("ecs_tentacles.locomotion", "locomotion")
 
@@ -246,6 +247,11 @@ class LocomotionPlugin(Plugin):
         from ecs_tentacles.locomotion.outputs import GOAL_TRACK
 
         return [GOAL_TRACK]
+
+    def take_sizes(self, scene: Mapping[str, Any]) -> list[TrackSize]:
+        from ecs_tentacles.locomotion.outputs import goal_sizes
+
+        return goal_sizes(scene)
 
     def _shard_reach(self, creature: Mapping[str, Any], seconds: float) -> Reach | None:
         from ecs_tentacles.locomotion.outputs import crawl_reach

@@ -30,6 +30,7 @@ capsule along its local +x (`length` = the spine between the cap centres).
 
 from __future__ import annotations
 
+import io
 import json
 import os
 import zipfile
@@ -44,6 +45,7 @@ from ecs_tentacles.take import ground as take_ground
 from ecs_tentacles.take import roster as take_roster
 from ecs_tentacles.take.read import (
     FORMAT,
+    MAX_HEADER_BYTES,
     MAX_TAKE_BYTES,
     VERSION,
     TakeError,
@@ -145,6 +147,10 @@ class Take:
 
     def arrays(self) -> dict[str, np.ndarray]:
         """The arrays to store, in file order (the header encoded as UTF-8 JSON bytes)."""
+        return {name: np.ascontiguousarray(value) for name, value in self._entries().items()}
+
+    def _entries(self) -> dict[str, np.ndarray]:
+        """`arrays()` as they are (not made contiguous: nothing copied)."""
         text = json.dumps(self.header, sort_keys=True, separators=(",", ":"))
         out = {"header": np.frombuffer(text.encode(), dtype=np.uint8)}
         names = [*CORE_ARRAYS[1:], *(a for t in self.track_list() for a in t.arrays)]
@@ -153,8 +159,27 @@ class Take:
         for name in names:
             value = self.array(name)
             if value is not None:
-                out[name] = np.ascontiguousarray(value)
+                out[name] = value
         return out
+
+    def size_problem(self) -> str | None:
+        """Why `read_take` would refuse this take for its size (one line), or None: the
+        file's entries (each array's `.npy` header and data) over `MAX_TAKE_BYTES`, or
+        its header over `MAX_HEADER_BYTES`. Counted from shapes: nothing is copied."""
+        entries = self._entries()
+        header = entries["header"].nbytes
+        if header > MAX_HEADER_BYTES:
+            return (
+                f"header: {header / 1024**2:,.0f} MiB, over the {MAX_HEADER_BYTES / 1024**2:g}"
+                " MiB a take's header holds"
+            )
+        stored = sum(_npy_bytes(value) for value in entries.values())
+        if stored > MAX_TAKE_BYTES:
+            return (
+                f"its {len(entries)} arrays would be {stored:,} bytes, over the"
+                f" {MAX_TAKE_BYTES:,} ({MAX_TAKE_BYTES / 1024**3:g} GiB) a take holds"
+            )
+        return None
 
     # -- files -------------------------------------------------------------------------
     def save(self, path: str | os.PathLike[str]) -> None:
@@ -181,7 +206,7 @@ class Take:
 
     def problem(self) -> str | None:
         """The first problem of this (in-memory) take, as `Take.load` would report it."""
-        problem = header_problem(self.header)
+        problem = header_problem(self.header) or self.size_problem()
         if problem:
             return problem
         tracks = self.track_list()
@@ -210,6 +235,14 @@ class Take:
         problem = self.problem()
         if problem:
             raise TakeError(f"{path}: cannot export this take: {problem}")
+
+
+def _npy_bytes(array: np.ndarray) -> int:
+    """Bytes of `array` as a `.npy` file: its header (as `write_array` makes it) and data."""
+    fields = np.lib.format.header_data_from_array_1_0(array)
+    buffer = io.BytesIO()
+    np.lib.format.write_array_header_1_0(buffer, fields)
+    return buffer.tell() + array.nbytes
 
 
 def write_npz(path: str | os.PathLike[str] | BinaryIO, arrays: dict[str, np.ndarray]) -> None:

@@ -19,6 +19,9 @@ take recorded without those plugins holds them empty (no goals, `guides` null), 
 every version 1 file has the same layout.
 Any other track a plugin adds is declared in `header["tracks"]` (absent when there is
 none) and stored after them, in the order declared.
+
+`TrackSize` is what a plugin says its tracks will hold for a scene before anything is
+built (`Plugin.take_sizes`), so a bake can refuse a take too big to read back.
 """
 
 from __future__ import annotations
@@ -82,6 +85,23 @@ CORE_KEYS = (
     "tracks",
 )
 CORE_ARRAYS = ("header", "pos", "quat", "sucker_attached", "sucker_anchor")
+
+
+WIDEST_FLOAT = -2.2250738585072014e-308  # 24 characters in JSON: no float is wider
+
+
+@dataclass(frozen=True)
+class TrackSize:
+    """What a track will hold in a take of a scene, from the scene alone: `items` of
+    `what` (a plural noun, "goals"; `each` may say more of one, "of 8 points"), each
+    `frame_bytes` a frame, and `fixed_bytes` in all once (header entries and arrays that
+    do not grow with frames; at most). Counted before anything is built."""
+
+    what: str
+    items: int
+    frame_bytes: int
+    fixed_bytes: int = 0
+    each: str = ""
 
 
 def dtypes(track: TakeTrack) -> tuple[str, str]:

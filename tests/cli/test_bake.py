@@ -8,12 +8,15 @@ import signal
 import subprocess
 import sys
 import time
+import zipfile
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from ecs_tentacles.cli import main
+from ecs_tentacles.export.bake import BakePlan
+from ecs_tentacles.export.take_size import take_size
 from ecs_tentacles.take import Take
 from tests.export.conftest import SMALL_SCENE
 
@@ -241,3 +244,66 @@ def test_lod_options_go_into_the_baked_scene(tmp_path: Path) -> None:
     assert off == bake("off") and off[1] != plain[1]  # the same scene, another motion
     focus = bake("scene", "--focus=-2,2,0.5")
     assert focus == bake("focus") and focus[1] not in (plain[1], off[1])
+
+
+def _groomed(guides: int) -> dict[str, object]:
+    """SMALL_SCENE's creature with a groom of `guides` guides of 16 points."""
+    fur = {"groom": {"count": guides, "points": 16}}
+    return {**SMALL_SCENE, "creatures": [{**SMALL_SCENE["creatures"][0], "fur": fur}]}
+
+
+def test_a_bake_whose_fur_would_outgrow_a_take_is_refused_before_it_starts(
+    tmp_path: Path,
+) -> None:
+    """250,000 guides of 16 points (the fur budget's 4 million points) are 61 MiB a frame:
+    a second at 60 fps is 3.6 GiB, more than a take may hold (the reader refuses it).
+    Refused up front in one line saying what fits, exit 2, nothing written; the seconds
+    and the guides it suggests are just what a take holds."""
+    scene = tmp_path / "groomed.json"
+    scene.write_text(json.dumps(_groomed(250_000)))
+    out = tmp_path / "take.npz"
+    bake = [sys.executable, "-P", "-m", "ecs_tentacles", "bake", str(scene), "--out", str(out)]
+    result = subprocess.run(
+        [*bake, "--seconds", "1"], capture_output=True, text=True, timeout=120, cwd=tmp_path
+    )
+    assert (result.returncode, result.stdout) == (2, ""), result.stderr
+    assert result.stderr.splitlines() == [
+        "error: argument --seconds: 61 frames of 13 bodies, 3 suckers, 1 goal and 250,000 fur"
+        " guides of 16 points would be 3.6 GiB, 3.6 GiB of it the fur guides; a take holds at"
+        " most 2 GiB: bake at most 0.533 s at 60 fps or at most 137,498 fur guides"
+    ]
+    assert sorted(tmp_path.iterdir()) == [scene]
+    at = BakePlan.make(str(scene), seconds=0.533)  # 32 intervals: 33 frames
+    assert at.size_problem() is None
+    assert BakePlan.make(str(scene), seconds=0.55).size_problem() is not None  # 34 frames
+    assert BakePlan.make(_groomed(137_498), seconds=1).size_problem() is None
+    assert BakePlan.make(_groomed(137_499), seconds=1).size_problem() is not None
+
+
+def test_the_take_a_bake_counts_on_is_the_take_it_writes(tmp_path: Path) -> None:
+    """What the plan counts before a bake (`export.take_size`) is what the written take
+    holds, frame for frame, and never less in all: a bake at the limit reads back."""
+    scene = tmp_path / "groomed.json"
+    scene.write_text(json.dumps(_groomed(300)))
+    sizes = []
+    for seconds in ("0.1", "0.2"):
+        out = tmp_path / f"{seconds}.npz"
+        argv = ["bake", str(scene), "--seconds", seconds, "--quiet", "--out", str(out)]
+        result = subprocess.run(
+            [sys.executable, "-P", "-m", "ecs_tentacles", *argv],
+            capture_output=True, text=True, timeout=120, cwd=tmp_path,
+        )  # fmt: skip
+        assert result.returncode == 0, result.stderr
+        with zipfile.ZipFile(out) as archive:  # what the reader counts against the limit
+            stored = sum(entry.file_size for entry in archive.infolist())
+        plan = BakePlan.make(str(scene), seconds=float(seconds))
+        counted = take_size(plan.scene, plan.tracks)
+        assert Take.load(out).frames == plan.frames
+        assert stored <= counted.total(plan.frames) <= stored + 12 * 1024
+        sizes.append((plan.frames, stored, counted.frame_bytes))
+    (frames, stored, per_frame), (more, stored_more, _) = sizes
+    assert (
+        per_frame
+        == (stored_more - stored) // (more - frames)
+        == 13 * 28 + 3 * 13 + 1 + 300 * 16 * 16
+    )

@@ -175,3 +175,41 @@ def test_bad_take_files_give_one_line(tmp_path: Path) -> None:
         with pytest.raises(TakeError) as caught:
             Take.load(path)
         assert str(caught.value) == f"{path}: {message}"
+
+
+def _stretched(take: Take, frames: int, guides: int) -> Take:
+    """`take` as if it ran `frames` frames with `guides` guides: views of its first frame
+    (nothing is allocated)."""
+    header = {**take.header, "frames": frames, "guides": {"creatures": [0] * guides}}
+
+    def each_frame(array: np.ndarray, shape: tuple[int, ...] | None = None) -> np.ndarray:
+        return np.broadcast_to(array[:1], (frames, *(shape or array.shape[1:])))
+
+    tracks = {**take.tracks, "goal_active": each_frame(take.tracks["goal_active"])}
+    tracks["guide_points"] = each_frame(take.tracks["guide_points"][:, :1], (guides, 4, 3))
+    tracks["guide_widths"] = each_frame(take.tracks["guide_widths"][:, :1], (guides, 4))
+    return Take(
+        header=header,
+        pos=each_frame(take.pos),
+        quat=each_frame(take.quat),
+        sucker_attached=each_frame(take.sucker_attached),
+        sucker_anchor=each_frame(take.sucker_anchor),
+        tracks=tracks,
+    )
+
+
+def test_a_take_too_big_to_read_back_is_never_written(guided_take: Take, tmp_path: Path) -> None:
+    """What a bake cannot count before it starts (tracks that grow while it runs, creatures
+    spawned) may still make a take over the reader's 2 GiB: `save` refuses it in one line
+    and writes nothing, as the reader would refuse it; just under the limit it is kept."""
+    out = tmp_path / "take.npz"
+    over = _stretched(guided_take, 100_000, 330)  # 64 bytes a guide a frame
+    with pytest.raises(TakeError) as refused:
+        over.save(out)
+    assert str(refused.value) == (
+        f"{out}: cannot write this take: its 9 arrays would be 2,152,404,253 bytes, over the"
+        " 2,147,483,648 (2 GiB) a take holds"
+    )
+    assert list(tmp_path.iterdir()) == []
+    assert over.size_problem() is not None
+    assert _stretched(guided_take, 100_000, 329).size_problem() is None

@@ -17,6 +17,7 @@ from ecs_tentacles.creator.crowd import crowd_scene
 from ecs_tentacles.creatures.spawning import SpawnError
 from ecs_tentacles.fur import groom
 from ecs_tentacles.fur.checks import (
+    MAX_SCENE_CHILDREN,
     MAX_SCENE_FUR_POINTS,
     MAX_SCENE_GUIDES,
     budget_problems,
@@ -116,6 +117,12 @@ def test_the_bundled_scenes_and_the_largest_crowd_are_well_within_the_budget() -
     points = max(c["fur"]["groom"]["points"] for c in crowd["creatures"] if "fur" in c)
     assert sum(counts) <= MAX_SCENE_GUIDES / 3
     assert sum(counts) * points <= MAX_SCENE_FUR_POINTS / 3
+    children = [
+        guide_count(c["fur"], c["mantle"])[0] * c["fur"]["children"]
+        for c in crowd["creatures"]
+        if "fur" in c
+    ]
+    assert sum(children) <= MAX_SCENE_CHILDREN / 5  # about 180,000
     assert budget_problems(crowd) == []
 
 
@@ -133,3 +140,39 @@ def test_a_creature_over_the_budget_is_not_spawned(make_world: Callable[..., Wor
 def test_the_schema_publishes_the_budget() -> None:
     text = load_schema()["$defs"]["groom"]["properties"]["count"]["description"]
     assert f"{MAX_SCENE_GUIDES:,} guides and {MAX_SCENE_FUR_POINTS:,} guide points" in text
+    text = load_schema()["$defs"]["fur"]["properties"]["children"]["description"]
+    assert f"at most {MAX_SCENE_CHILDREN:,} child hairs in all" in text
+
+
+def test_validate_refuses_more_child_hairs_than_a_scene_may_draw(tmp_path: Path) -> None:
+    """Two furs of 200,000 guides with 64 children each ask for 25.6 million child hairs
+    (about 17 GB to set up): one line naming the first fur's `children`, exit 2."""
+    scene = tmp_path / "hairy.json"
+    scene.write_text(json.dumps(_furry(*[{"count": 200_000, "points": 2}] * 2, children=64)))
+    result = subprocess.run(
+        [sys.executable, "-P", "-m", "ecs_tentacles", "validate", str(scene)],
+        capture_output=True, text=True, timeout=120, preexec_fn=_limit_memory, cwd=tmp_path,
+    )  # fmt: skip
+    assert (result.returncode, result.stdout) == (2, ""), result.stderr
+    assert result.stderr.splitlines() == [
+        f"error: {scene}: creatures[0].fur.children: the scene's 25,600,000 child hairs"
+        " (12,800,000 here: 200,000 guides x 64) are over the budget of 1,000,000 a scene"
+        " (about 17.2 GB to set up); fewer children per guide or fewer guides"
+    ]
+
+
+def test_children_are_counted_as_the_sandbox_draws_them_up_to_the_limit() -> None:
+    """Each fur's guides times its own `children`; the limit itself is allowed."""
+    at = _furry({"count": 250_000, "points": 2}, {"count": 125_000, "points": 2})
+    at["creatures"][0]["fur"]["children"] = 3
+    at["creatures"][1]["fur"]["children"] = 2
+    assert 250_000 * 3 + 125_000 * 2 == MAX_SCENE_CHILDREN
+    assert validate_scene(at) == []
+    at["creatures"][1]["fur"]["guides"] = [{"points": [[0.1, 0, 0.1], [0.2, 0, 0.2]]}]
+    assert validate_scene(at) == [
+        "creatures[0].fur.children: the scene's 1,000,002 child hairs (750,000 here: 250,000"
+        " guides x 3) are over the budget of 1,000,000 a scene (about 0.7 GB to set up);"
+        " fewer children per guide or fewer guides"
+    ]
+    without = _furry({"count": MAX_SCENE_GUIDES, "points": 2})  # no children: none drawn
+    assert validate_scene(without) == []

@@ -1,0 +1,170 @@
+"""The bytes a take of a scene will hold, counted from the scene before anything is built.
+
+`take_size(scene, tracks)` -> `TakeSize`, its parts as `TrackSize`s: the bodies (28
+bytes a frame each: position and quaternion, float32), the suckers (13 at most: the
+attached flag and the anchor; the suckers plugin may be off) and what each plugin says
+its tracks will hold (`Plugin.take_sizes`: the fur's guide curves, 16 bytes a point a
+frame; the goals, a byte). Once: the header's JSON (the creatures', bodies' and
+suckers' entries as the recorder writes them, names, indices and sizes as the scene
+builds them; the other fields at their widest) and room for the arrays' `.npy` headers.
+
+`export.bake` checks it against what the reader takes (`take.read`: `MAX_TAKE_BYTES`
+in all, `MAX_HEADER_BYTES` of header), so a bake refuses a take nobody could read
+before it simulates. What the scene cannot tell (goals a system adds, creatures spawned
+during the bake, the terrain's meshes, physics recoveries in the header) is not counted
+here: `Take.save` checks the finished take as the reader will.
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from ecs_tentacles.scene.construction import tentacle_params, tentacle_shape
+from ecs_tentacles.take.tracks import WIDEST_FLOAT, TrackSize
+
+POSE_BYTES = 7 * 4  # a body's position and quaternion in a frame (float32)
+SUCKER_BYTES = 1 + 3 * 4  # attached flag and anchor
+NPY_HEADERS = 64 * 128  # room for the `.npy` headers of 64 arrays (128 bytes each)
+
+
+@dataclass(frozen=True)
+class TakeSize:
+    """A take's bytes by part (`TrackSize`s: bodies, suckers, the plugins' tracks) and
+    the header's fields beside them (`base`, with the `.npy` headers)."""
+
+    parts: tuple[TrackSize, ...]
+    base: int
+
+    @property
+    def frame_bytes(self) -> int:
+        """Bytes each frame adds."""
+        return sum(part.items * part.frame_bytes for part in self.parts)
+
+    @property
+    def fixed_bytes(self) -> int:
+        """Bytes whatever the frames (the header at most, arrays that do not grow)."""
+        return self.base + sum(part.fixed_bytes for part in self.parts)
+
+    def total(self, frames: int) -> int:
+        """Bytes of a take of `frames` frames, at most."""
+        return frames * self.frame_bytes + self.fixed_bytes
+
+
+def _digits_below(n: int) -> int:
+    """Digits of the numbers 0 .. n-1 written out, in all."""
+    total, width, low = 0, 1, 0
+    while low < n:
+        high = min(n, 10**width)
+        total += (high - low) * width
+        low, width = high, width + 1
+    return total
+
+
+def scene_sizes(scene: Mapping[str, Any]) -> tuple[int, int]:
+    """(bodies, suckers) a loaded scene's creatures have: mantles and links; suckers at
+    most (the suckers plugin may be off)."""
+    bodies = suckers = 0
+    for creature in scene["creatures"]:
+        tentacles = creature["tentacles"]
+        for k in range(tentacles["count"]):
+            params = tentacle_params(tentacles, k)
+            bodies += params["links"]
+            suckers += params["links"] if params.get("suckers") == "every_link" else 1
+        bodies += 1
+    return bodies, suckers
+
+
+def _entry(value: Any) -> int:
+    """Bytes of `value` in the header's JSON (compact), with the comma after it."""
+    return len(json.dumps(value, separators=(",", ":"))) + 1
+
+
+def _digits(first: int, end: int) -> int:
+    """Digits of the numbers first .. end-1 written out, in all."""
+    return _digits_below(end) - _digits_below(first)
+
+
+@functools.lru_cache(maxsize=4096)
+def _link_numbers(
+    mantle_radius: float, params: tuple[float, float, int, float]
+) -> tuple[tuple[int, ...], tuple[int, ...]]:
+    """Characters of each link's length and radius in the header and of its sucker's
+    offset (half the length, minus the radius), as `tentacle_shape` makes them."""
+    shape = tentacle_shape(mantle_radius, *params)
+    return tuple(
+        len(repr(float(length))) + len(repr(float(radius)))
+        for length, radius in zip(shape.lengths, shape.radii, strict=True)
+    ), tuple(
+        len(repr(float(0.5 * length))) + len(repr(float(-radius)))
+        for length, radius in zip(shape.lengths, shape.radii, strict=True)
+    )
+
+
+def _header_entries(scene: Mapping[str, Any]) -> tuple[int, int]:
+    """Header bytes of (the creatures and bodies, the suckers), as the recorder writes
+    them: names, indices and every number as built from the scene."""
+    body_bytes = sucker_bytes = 0
+    first = 0  # the mantle's body index
+    for c, creature in enumerate(scene["creatures"]):
+        name, mantle = creature.get("name", f"creature_{c}"), creature["mantle"]
+        radius, height = float(mantle["radius"]), float(mantle["height"])
+        entry = {"axis": "Z", "creature": c, "length": height, "name": f"{name}/mantle"}
+        body_bytes += _entry({**entry, "radius": radius, "shape": "cylinder"})
+        listed = _entry({"mantle": 0, "name": name, "tentacles": []}) - 1 + len(str(first))
+        body = first + 1
+        tentacles = creature["tentacles"]
+        for k in range(tentacles["count"]):
+            params = tentacle_params(tentacles, k)
+            links, stem = params["links"], f"{name}/tentacles/t{k}/link"
+            asked = (params["link_length"], params["link_radius"], links, params["end_scale"])
+            numbers, offsets = _link_numbers(radius, asked)
+            link = {**entry, "axis": "X", "name": stem, "length": 0, "radius": 0}
+            body_bytes += links * (_entry({**link, "shape": "capsule"}) - 2) + sum(numbers)
+            body_bytes += _digits_below(links)
+            listed += 2 + links + _digits(body, body + links)  # [b,b,...], and a comma
+            sucker = {"body": 0, "name": f"{stem}/sucker0", "offset": [0, 0.0, 0]}
+            if params.get("suckers") == "every_link":  # one on each link
+                sucker_bytes += links * (_entry(sucker) - 3) + sum(offsets)
+                sucker_bytes += _digits_below(links) + _digits(body, body + links)
+            else:  # one at the tip
+                tip = links - 1
+                sucker_bytes += _entry(sucker) - 3 + len(str(tip)) + len(str(body + tip))
+                sucker_bytes += offsets[tip]
+            body += links
+        body_bytes += listed - (1 if tentacles["count"] else 0)  # no comma after the last
+        first = body
+    return body_bytes, sucker_bytes
+
+
+def _base(scene: Mapping[str, Any]) -> int:
+    """The header's fields beside the parts, at most, and the `.npy` headers."""
+    fields = {
+        "format": "ecs_tentacles.take",
+        "version": 1,
+        "scene": scene.get("name", ""),
+        "scene_sha256": 64 * "0",
+        "seed": -(2**63),
+        "fps": WIDEST_FLOAT,
+        "sim_fps": WIDEST_FLOAT,
+        "substeps": 10**6,
+        "frames": 10**7,
+        "health": {"recoveries": 0, "frozen": 0, "events": []},
+    }
+    return _entry(fields) + 16 * 32 + NPY_HEADERS  # and room for 16 keys of the parts
+
+
+def take_size(scene: Mapping[str, Any], tracks: Iterable[TrackSize] = ()) -> TakeSize:
+    """What a take of `scene` (loaded: defaults filled in) holds, from the scene alone:
+    the bodies, the suckers and `tracks` (the plugins' `take_sizes` for it)."""
+    bodies, suckers = scene_sizes(scene)
+    body_header, sucker_header = _header_entries(scene)
+    parts: Sequence[TrackSize] = (
+        TrackSize("bodies", bodies, POSE_BYTES, body_header),
+        TrackSize("suckers", suckers, SUCKER_BYTES, sucker_header),
+        *tracks,
+    )
+    return TakeSize(tuple(parts), _base(scene))
