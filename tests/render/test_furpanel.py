@@ -266,3 +266,15 @@ def test_only_the_edited_creatures_controls_are_drawn(make_sandbox: Callable[...
         sandbox.render()
         assert fur_display(sandbox.renderer.state).creature == world.creature(name)
         assert drawn_near() == {name}
+
+
+def test_the_children_slider_never_offers_more_child_hairs_than_a_scene_may_have() -> None:
+    from ecs_tentacles.fur.checks import MAX_SCENE_CHILDREN
+    from ecs_tentacles.fur.render.furpanel import children_slider_most
+
+    assert children_slider_most(1_500) == 16  # the bundled furs: the full range
+    assert children_slider_most(0) == 16
+    for guides in (62_500, 62_501, 100_000, 500_000):
+        most = children_slider_most(guides)
+        assert guides * most <= MAX_SCENE_CHILDREN < guides * (most + 1) or most == 16
+    assert children_slider_most(500_000) == 2  # was 16: 8 million children, about 5 GB

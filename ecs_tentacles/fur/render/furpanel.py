@@ -19,6 +19,7 @@ import numpy as np
 from imgui_bundle import imgui
 
 from ecs_tentacles.components import Creature, Transform
+from ecs_tentacles.fur.checks import MAX_SCENE_CHILDREN
 from ecs_tentacles.fur.editor import MIRRORS, SHAPES, VALUES, FurEditor
 from ecs_tentacles.fur.groom import closest_surface_point
 from ecs_tentacles.fur.render.strands import FurDisplay, fur_display
@@ -325,7 +326,18 @@ class FurPanel(Panel):
         imgui.text("children per guide")
         gui.item("children label")
         imgui.set_next_item_width(-1.0)
-        changed, per_guide = imgui.slider_int("##children", per_guide, 0, 16)
+        most = children_slider_most(len(world.resource(FurData).guides))
+        changed, per_guide = imgui.slider_int("##children", min(per_guide, most), 0, most)
         gui.item("children")
         if changed:
-            display.per_guide = per_guide
+            display.per_guide = min(per_guide, most)
+
+
+SLIDER_CHILDREN = 16  # the most child hairs per guide the slider offers
+
+
+def children_slider_most(guides: int) -> int:
+    """The most children per guide the slider offers for a world of `guides` guides: 16,
+    or fewer where that would pass the scene's budget of child hairs (`MAX_SCENE_CHILDREN`:
+    500,000 guides x 16 would take about 5 GB and 35 s to set up)."""
+    return min(SLIDER_CHILDREN, MAX_SCENE_CHILDREN // max(guides, 1))
