@@ -194,36 +194,27 @@ def test_a_failed_shard_is_named_and_resume_bakes_only_the_others(
     assert not work_folder(out).exists()
 
 
-def _tampered(path: Path, how: str) -> None:
-    """Rewrite the kept shard `path` as someone without the bake's key could: well-formed."""
+def _moved(path: Path) -> None:
+    """Rewrite the kept shard `path` as someone without the bake's key could: well-formed,
+    every body 5 m away."""
     from ecs_tentacles.take import write_npz
 
     with np.load(path) as npz:
         arrays = {name: npz[name] for name in npz.files}
-    header = json.loads(arrays["header"].tobytes())
-    if how == "every body moved 5 m":
-        arrays["pos"] = arrays["pos"] + np.float32(5.0)
-    text = {
-        "every body moved 5 m": json.dumps(header),
-        "a 400-digit fps": json.dumps({**header, "fps": 10**399}),
-        "a header nested 100000 deep": "[" * 100_000 + "]" * 100_000,
-    }[how]
-    write_npz(path, {**arrays, "header": np.frombuffer(text.encode(), np.uint8)})
+    write_npz(path, {**arrays, "pos": arrays["pos"] + np.float32(5.0)})
 
 
-@pytest.mark.parametrize(
-    "how", ["every body moved 5 m", "a 400-digit fps", "a header nested 100000 deep"]
-)
 def test_a_changed_kept_shard_is_named_and_baked_again_on_resume(
-    cluster: Path, crowd: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], how: str
+    cluster: Path, crowd: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    """Before, the moved creatures were merged (exit 0) and the others failed every
-    --resume (exit 1: OverflowError, RecursionError)."""
+    """Before, the moved creatures were merged (exit 0). A shard with a 400-digit or
+    deeply nested header (which failed every --resume with exit 1) meets the same
+    signature check first; signed ones that do not read are refused in test_work.py."""
     plan, shards = shards_of(crowd)
     (cluster / shard_key(plan, shards[-1], False)).write_text("crash")
     out = tmp_path / "ray.npz"
     assert bake(crowd, out, "--ray", "--retries", "0") == 1
-    _tampered(work_folder(out) / f"{shard_key(plan, shards[0], False)}.npz", how)
+    _moved(work_folder(out) / f"{shard_key(plan, shards[0], False)}.npz")
     capsys.readouterr()
     assert bake(crowd, out, "--ray", "--resume") == 0
     err = capsys.readouterr().err.splitlines()
