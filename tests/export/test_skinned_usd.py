@@ -1,9 +1,8 @@
-"""Skinned USD: a SkelRoot per creature that passes Pixar's checks and that USD's own
-skinning turns back into the simulated tentacles."""
+"""Skinned USD: a SkelRoot per creature that passes USD's validators (UsdSkel's included)
+and that USD's own skinning turns back into the simulated tentacles."""
 
 from __future__ import annotations
 
-import warnings
 from pathlib import Path
 from typing import Any
 
@@ -11,6 +10,7 @@ import numpy as np
 import pytest
 
 from ecs_tentacles.export.skinned_usd import build_skinned_stage, write_skinned_usd
+from ecs_tentacles.export.usd_validation import usd_problems
 from ecs_tentacles.numeric.quaternions import quat_rotate
 from ecs_tentacles.skin.keys import angle_between
 from ecs_tentacles.skin.mesh import Detail, creature_mesh
@@ -20,31 +20,18 @@ from ecs_tentacles.take import Take
 from tests.skin.cpu_skinning import skin_points, skinning_matrices
 
 pxr = pytest.importorskip("pxr", reason="USD export needs usd-core (the usd / dev extras)")
-from pxr import Usd, UsdGeom, UsdSkel, UsdUtils, Vt  # noqa: E402
-
-
-def compliance(path: Path) -> dict[str, list[str]]:
-    """Errors, failed checks and warnings of UsdUtils.ComplianceChecker on `path`."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", DeprecationWarning)
-        checker = UsdUtils.ComplianceChecker()
-        checker.CheckCompliance(str(path))
-    return {
-        "errors": checker.GetErrors(),
-        "failed": checker.GetFailedChecks(),
-        "warnings": checker.GetWarnings(),
-    }
+from pxr import Usd, UsdGeom, UsdSkel, Vt  # noqa: E402
 
 
 @pytest.mark.parametrize(
     ("suffix", "keys", "locators"), [(".usda", "all", False), (".usdc", "reduced", True)]
 )
-def test_the_skinned_stage_passes_the_compliance_checker(
+def test_the_skinned_stage_passes_the_usd_validators(
     guided_take: Take, tmp_path: Path, suffix: str, keys: str, locators: bool
 ) -> None:
     path = tmp_path / f"take{suffix}"
     write_skinned_usd(guided_take, path, keys=Keys(keys, 0.5), locators=locators)
-    assert compliance(path) == {"errors": [], "failed": [], "warnings": []}
+    assert usd_problems(path) == []
     stage = Usd.Stage.Open(str(path))
     root = stage.GetPrimAtPath("/World/octo")
     assert root.GetTypeName() == "SkelRoot"
