@@ -12,10 +12,11 @@ first word; informational notes are left out. `usd_validators()` names them all.
 
 UsdSkel's own validators check where `SkelBindingAPI` is applied and that it is; none
 checks that a SkelAnimation holds one value per joint, and UsdSkel meets a mismatch by
-posing the skeleton at rest with a warning on stderr (the creature stands still in
-every USD client). `ecsTentacles:SkelJointCounts` makes that an error: a Skeleton's
-bind and rest transforms and joint names, and a SkelAnimation's translations,
-rotations and scales at every time sample, hold as many values as the prim has joints.
+posing the skeleton at rest with only a warning on stderr (usd-core 26.11: the
+creature stands still). `ecsTentacles:SkelJointCounts` makes that an error: a
+Skeleton's bind and rest transforms and joint names, and a SkelAnimation's
+translations, rotations and scales at every time sample, hold as many values as the
+prim has joints.
 """
 
 from __future__ import annotations
@@ -38,6 +39,7 @@ def _validation() -> Any:
     from ecs_tentacles.export.usd import _pxr
 
     pxr = _pxr()
+    importlib.import_module("pxr.Tf")  # its ErrorException: a file USD cannot open
     return importlib.import_module("pxr.UsdValidation"), pxr
 
 
