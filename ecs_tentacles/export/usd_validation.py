@@ -60,8 +60,8 @@ def usd_validators() -> list[Any]:
 
 
 def usd_problems(source: str | os.PathLike[str] | Any) -> list[str]:
-    """The problems of the USD file (or `Usd.Stage`) `source`: errors first, then warnings,
-    one line each (`error: <validator>.<problem>: <message>`). A file USD cannot open is
+    """The problems of the USD file (or `Usd.Stage`) `source`: errors, then warnings, each
+    sorted, one line each (`error: <validator>.<problem>: <message>`). A file USD cannot open is
     one error naming it."""
     validation, pxr = _validation()
     stage = source
@@ -77,7 +77,7 @@ def usd_problems(source: str | os.PathLike[str] | Any) -> list[str]:
         kind = {kinds.Error: "error", kinds.Warn: "warning"}.get(problem.GetType())
         if kind is not None:
             lines[kind].append(f"{kind}: {problem.GetIdentifier()}: {problem.GetMessage()}")
-    return [*lines["error"], *lines["warning"]]
+    return [*sorted(lines["error"]), *sorted(lines["warning"])]  # validators run in parallel
 
 
 def _joint_counts(prim: Any, time_range: Any) -> list[Any]:
