@@ -4,6 +4,7 @@ FILE's suffix picks the format: `.npz` a take (the compact, reproducible record)
 `.usd`/`.usda`/`.usdc` a USD stage (needs the `usd` extra), `.glb` binary glTF. The
 output is written to a temporary file beside FILE and renamed at the end, so an
 interrupted bake never leaves a partial FILE (an existing FILE stays as it was).
+`--validate` checks a USD FILE once written (`ecs_tentacles.cli.usd_validate`).
 `--lod on|off` and `--focus X,Y,R` are written into the plan's scene (`physics.lod`), so
 the take's scene hash says what the bake ran with and Ray shards and wedge variants
 get them too. `--ray [ADDRESS]` bakes in shards on Ray and `--wedge PATH=VALUES` bakes variants
@@ -29,6 +30,8 @@ from ecs_tentacles.cli.arguments import add_threads_argument, counted, output_pa
 from ecs_tentacles.cli.lod_options import add_lod_arguments, apply_to_scene
 from ecs_tentacles.cli.skin_options import add_arguments as add_skin_arguments
 from ecs_tentacles.cli.skin_options import skin_options
+from ecs_tentacles.cli.usd_validate import add_argument as add_validate_argument
+from ecs_tentacles.cli.usd_validate import validate_problem, validated
 from ecs_tentacles.distributed.driver import ShardFailed
 from ecs_tentacles.distributed.wedge import WedgeError
 from ecs_tentacles.export import SUFFIXES, write
@@ -96,6 +99,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
     parser.add_argument("--json", action="store_true", help="print the summary as JSON")
     add_skin_arguments(parser)
+    add_validate_argument(parser)
     bake_ray.add_arguments(parser)
     parser.add_argument(
         "--allow-systems", action="store_true", help="import and run the systems the scene names"
@@ -112,7 +116,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 def handle(args: argparse.Namespace) -> int:
     problem = usd_missing(args.out)
-    problem = problem or bake_ray.ray_problem(args)
+    problem = problem or bake_ray.ray_problem(args) or validate_problem(args)
     if problem:
         print(f"error: {problem}", file=sys.stderr)
         return 2
@@ -184,7 +188,7 @@ def handle(args: argparse.Namespace) -> int:
         return 1
     getattr(args, "after_write", lambda: None)()
     print(summary(take, args.out, args.json, skinned))
-    return 0
+    return validated(args.out, progress=not args.quiet) if args.validate else 0
 
 
 def save(

@@ -4,7 +4,8 @@ The suffix of FILE picks the format (`.usd`, `.usda`, `.usdc`, `.glb`); the file
 written atomically. Creatures are skinned (a mesh on a joint skeleton with rotation
 keys) unless `--rigid`; each creature gets a material of its sandbox colour. Suckers and
 goals are locators with `--locators` (the default for `--rigid`; `--no-locators` leaves
-them out). A file that is not a take gives one line naming it and exit 2.
+them out). A file that is not a take gives one line naming it and exit 2. `--validate`
+checks the written USD (`ecs_tentacles.cli.usd_validate`): exit 1 on an error.
 """
 
 from __future__ import annotations
@@ -16,6 +17,8 @@ from ecs_tentacles.cli.arguments import output_path
 from ecs_tentacles.cli.bake import save, summary, usd_missing
 from ecs_tentacles.cli.skin_options import add_arguments as add_skin_arguments
 from ecs_tentacles.cli.skin_options import skin_options
+from ecs_tentacles.cli.usd_validate import add_argument as add_validate_argument
+from ecs_tentacles.cli.usd_validate import validate_problem, validated
 from ecs_tentacles.skin.mesh import MeshError
 from ecs_tentacles.take import Take
 
@@ -42,11 +45,12 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
     parser.add_argument("--json", action="store_true", help="print the summary as JSON")
     add_skin_arguments(parser)
+    add_validate_argument(parser)
     parser.set_defaults(handler=handle)
 
 
 def handle(args: argparse.Namespace) -> int:
-    problem = usd_missing(args.out)
+    problem = usd_missing(args.out) or validate_problem(args)
     if problem:
         print(f"error: {problem}", file=sys.stderr)
         return 2
@@ -62,4 +66,4 @@ def handle(args: argparse.Namespace) -> int:
         print(f"error: {error}", file=sys.stderr)
         return 2
     print(summary(take, args.out, args.json, skinned))
-    return 0
+    return validated(args.out, progress=not args.quiet) if args.validate else 0

@@ -14,13 +14,13 @@ import pytest
 
 from ecs_tentacles.export.gltf import read_glb, write_glb
 from ecs_tentacles.export.skinned_gltf import write_skinned_glb
+from ecs_tentacles.export.usd_validation import usd_problems
 from ecs_tentacles.ground import ground_of
 from ecs_tentacles.skin.colours import to_linear
 from ecs_tentacles.take import Take, write_npz
 from ecs_tentacles.take.read import TakeError
 from ecs_tentacles.terrain.ground_meshes import COLOURS
 from tests.export.conftest import khronos_report, record
-from tests.export.test_usd import compliance
 
 ROOT = Path(__file__).resolve().parents[2]
 TERRAIN_SCENE = {
@@ -126,7 +126,7 @@ def test_usd_holds_the_terrain_as_meshes_with_materials(
 
     path = tmp_path / "take.usda"
     (write_skinned_usd if skinned else write_usd)(terrain_take, path)
-    assert compliance(path) == {"errors": [], "failed": [], "warnings": []}
+    assert usd_problems(path) == []
     stage = Usd.Stage.Open(str(path))
     for label, name in (("surface", "terrain"), ("obstacles", "obstacles")):
         prim = stage.GetPrimAtPath(f"/World/terrain/{label}")

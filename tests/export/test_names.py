@@ -7,16 +7,16 @@ USD export tests check a file."""
 from __future__ import annotations
 
 import json
-import warnings
 from collections import Counter
 from pathlib import Path
 
 import pytest
 
 from ecs_tentacles.cli import main
+from ecs_tentacles.export.usd_validation import usd_problems
 
 pytest.importorskip("pxr", reason="USD export needs usd-core (the usd / dev extras)")
-from pxr import Usd, UsdUtils
+from pxr import Usd
 
 # rocky_shore: six creatures with goals on a heightfield with rocks (the ground's meshes
 # and materials); hedgehog_octopus: a furred creature (a curves track); named_as_folders:
@@ -54,25 +54,6 @@ def takes(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
     return out
 
 
-def _validation_problems(path: Path) -> list[str]:
-    """What UsdUtils.ComplianceChecker (and, where it exists, the Usd Validation
-    Framework) finds in `path`, as the USD export tests ask."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", DeprecationWarning)
-        checker = UsdUtils.ComplianceChecker()
-        checker.CheckCompliance(str(path))
-    found = [*checker.GetErrors(), *checker.GetFailedChecks(), *checker.GetWarnings()]
-    import pxr
-
-    validation = getattr(pxr, "UsdValidation", None)
-    if validation is not None:
-        context = validation.ValidationContext(
-            validation.ValidationRegistry().GetOrLoadAllValidators()
-        )
-        found += [error.GetMessage() for error in context.Validate(Usd.Stage.Open(str(path)))]
-    return found
-
-
 @pytest.mark.parametrize("form", sorted(FORMS))
 @pytest.mark.parametrize("scene", SCENES)
 def test_every_prim_name_is_unique_in_a_usd_export(
@@ -95,4 +76,4 @@ def test_every_prim_name_is_unique_in_a_usd_export(
     repeated = Counter(prim.GetName() for prim in prims) - Counter(set(p.GetName() for p in prims))
     where = {n: [str(p.GetPath()) for p in prims if p.GetName() == n] for n in repeated}
     assert where == {}
-    assert _validation_problems(path) == []
+    assert usd_problems(path) == []
