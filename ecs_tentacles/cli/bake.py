@@ -124,6 +124,14 @@ def handle(args: argparse.Namespace) -> int:
         allow_systems=args.allow_systems,
     )
     plan = replace(plan, scene=apply_to_scene(plan.scene, args))
+    try:
+        skin = skin_options(args)
+        problem = None if args.wedge else plan.glb_problem(args.out, skin, args.locators)
+    except (ValueError, MeshError) as error:  # bad skin options, a creature no mesh fits
+        problem = str(error)
+    if problem:
+        print(f"error: {problem}", file=sys.stderr)
+        return 2
     problem = plan.size_problem()
     if problem:
         print(f"error: argument --seconds: {problem}", file=sys.stderr)

@@ -16,6 +16,9 @@ from ecs_tentacles.cli.arguments import output_path
 from ecs_tentacles.cli.bake import save, summary, usd_missing
 from ecs_tentacles.cli.skin_options import add_arguments as add_skin_arguments
 from ecs_tentacles.cli.skin_options import skin_options
+from ecs_tentacles.export.bake import output_kind
+from ecs_tentacles.export.glb_size import glb_problem, glb_size, shapes_of_header
+from ecs_tentacles.export.skinned import Skin
 from ecs_tentacles.skin.mesh import MeshError
 from ecs_tentacles.take import Take
 
@@ -45,6 +48,20 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.set_defaults(handler=handle)
 
 
+def glb_refusal(args: argparse.Namespace, skin: Skin | None) -> str | None:
+    """Why the glb --out names cannot hold the take (one line), or None (and None for
+    USD): counted from the take's header before a frame is read (`export.glb_size`)."""
+    if output_kind(args.out) != "gltf":
+        return None
+    size = glb_size(
+        shapes_of_header(Take.read_header(args.take)),  # TakeError: one line, exit 2
+        None if skin is None else skin.detail,
+        None if skin is None else skin.keys,
+        args.locators,
+    )
+    return glb_problem(args.out, size, (".usdc",), "export")
+
+
 def handle(args: argparse.Namespace) -> int:
     problem = usd_missing(args.out)
     if problem:
@@ -54,6 +71,13 @@ def handle(args: argparse.Namespace) -> int:
         skin = skin_options(args)
     except ValueError as error:
         print(f"error: {error}", file=sys.stderr)
+        return 2
+    try:
+        problem = glb_refusal(args, skin)
+    except MeshError as error:  # e.g. tentacle bases that overlap on the mantle
+        problem = str(error)
+    if problem:
+        print(f"error: {problem}", file=sys.stderr)
         return 2
     take = Take.load(args.take)  # TakeError: one line, exit 2
     try:

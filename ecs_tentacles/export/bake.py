@@ -18,8 +18,9 @@ import os
 from collections.abc import Callable, Collection
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
+from ecs_tentacles.export.glb_size import glb_problem, glb_size, shapes_of_scene
 from ecs_tentacles.export.recording import Recording, scene_sha256
 from ecs_tentacles.export.take_size import NPY_HEADERS, TakeSize, take_size
 from ecs_tentacles.output.progress import status, step_frames
@@ -29,6 +30,9 @@ from ecs_tentacles.take import Take
 from ecs_tentacles.take.read import MAX_FRAMES, MAX_HEADER_BYTES, MAX_TAKE_BYTES
 from ecs_tentacles.take.tracks import TrackSize
 from ecs_tentacles.world import World
+
+if TYPE_CHECKING:
+    from ecs_tentacles.export.skinned import Skin
 
 GIB, MIB = 1024**3, 1024**2
 
@@ -163,6 +167,20 @@ class BakePlan:
             f" {share / GIB:.1f} GiB of it the {most.what}; a take holds at most"
             f" {MAX_TAKE_BYTES / GIB:g} GiB: {self._what_fits(size, most)}"
         )
+
+    def glb_problem(
+        self, out: str | os.PathLike[str], skin: Skin | None, locators: bool | None
+    ) -> str | None:
+        """Why the glb `out` cannot hold what this plan bakes (one line), or None (and
+        None when `out` is not a glb): counted from the scene before anything is built
+        (`export.glb_size`), as `skin` (None: rigid) and `locators` would write it."""
+        if output_kind(out) != "gltf":
+            return None
+        shapes = shapes_of_scene(self.scene, self.frames)
+        detail, keys = (None, None) if skin is None else (skin.detail, skin.keys)
+        size = glb_size(shapes, detail, keys, locators)
+        fits = (".usdc", ".npz") if self.size_problem() is None else ()
+        return glb_problem(out, size, fits)
 
     def _what_fits(self, size: TakeSize, most: TrackSize) -> str:
         """The most seconds a take holds at this rate, and the most of the largest part

@@ -204,6 +204,13 @@ class Take:
         header, arrays = read_take(Path(path), max_bytes)
         return cls.from_arrays(header, arrays)
 
+    @staticmethod
+    def read_header(path: str | os.PathLike[str]) -> dict[str, Any]:
+        """A take file's header alone, checked as `load` checks it (`TakeError`, one
+        line), without reading a frame: what an exporter counts before any work."""
+        header, _ = read_take(Path(path), header_only=True)
+        return header
+
     def problem(self) -> str | None:
         """The first problem of this (in-memory) take, as `Take.load` would report it."""
         problem = header_problem(self.header) or self.size_problem()
