@@ -22,8 +22,6 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-from tqdm import tqdm
-
 from ecs_tentacles.cli import bake_ray
 from ecs_tentacles.cli.arguments import add_threads_argument, counted, output_path, seed_int
 from ecs_tentacles.cli.lod_options import add_lod_arguments, apply_to_scene
@@ -31,9 +29,10 @@ from ecs_tentacles.cli.skin_options import add_arguments as add_skin_arguments
 from ecs_tentacles.cli.skin_options import skin_options
 from ecs_tentacles.distributed.driver import ShardFailed
 from ecs_tentacles.distributed.wedge import WedgeError
-from ecs_tentacles.export import SUFFIXES, write
+from ecs_tentacles.export import SUFFIXES, work_units, write
 from ecs_tentacles.export.bake import BakePlan, bake, output_kind
 from ecs_tentacles.export.skinned import Skin
+from ecs_tentacles.output.progress import bar
 from ecs_tentacles.skin.keys import KeyReport
 from ecs_tentacles.skin.mesh import MeshError
 from ecs_tentacles.take import Take, TakeError
@@ -203,15 +202,12 @@ def save(
     skin: Skin | None = None,
     locators: bool | None = None,
 ) -> KeyReport | None:
-    """Write `take` to `path` in the format its suffix names (a bar for slow, rigid USD
-    output); returns the key report when skinned. `locators`: as `export.write`."""
-    slow = output_kind(path) == "usd"
-    bodies = len(take.header["bodies"])
-    disable = None if progress and slow else True
-    with tqdm(
-        total=bodies, unit="body", desc="usd", disable=disable, file=sys.stderr, leave=False
-    ) as bar:
-        return write(take, path, bar.update, skin, locators)
+    """Write `take` to `path` in the format its suffix names, with a bar on stderr (the
+    take's bytes, the creatures of a skinned file, the bodies of a rigid one); returns the
+    key report when skinned. `locators`: as `export.write`."""
+    total, unit = work_units(take, path, skin)
+    with bar(total, f"write {path.name}", unit, progress=progress) as shown:
+        return write(take, path, shown.update, skin, locators)
 
 
 def report(take: Take, path: Path) -> dict[str, Any]:

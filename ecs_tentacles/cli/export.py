@@ -19,6 +19,7 @@ from ecs_tentacles.cli.skin_options import skin_options
 from ecs_tentacles.export.bake import output_kind
 from ecs_tentacles.export.glb_size import glb_problem, glb_size, shapes_of_header
 from ecs_tentacles.export.skinned import Skin
+from ecs_tentacles.output.progress import status
 from ecs_tentacles.skin.mesh import MeshError
 from ecs_tentacles.take import Take
 
@@ -79,7 +80,8 @@ def handle(args: argparse.Namespace) -> int:
     if problem:
         print(f"error: {problem}", file=sys.stderr)
         return 2
-    take = Take.load(args.take)  # TakeError: one line, exit 2
+    with status(f"export: reading {args.take}", progress=not args.quiet):
+        take = Take.load(args.take)  # TakeError: one line, exit 2
     try:
         skinned = save(take, args.out, progress=not args.quiet, skin=skin, locators=args.locators)
     except MeshError as error:  # e.g. tentacle bases that overlap on the mantle

@@ -261,7 +261,8 @@ def bake(
         assert isinstance(recording, Recording)  # the record plugin
         world.add_plugin(recording)
         step_frames(world, plan.steps, progress=progress, desc="bake", on_steps=on_steps)
-        return recording.take()
+        with status(f"bake: gathering {plan.frames} frames", progress=progress):
+            return recording.take()
     finally:
         world.close()
 
