@@ -126,11 +126,14 @@ def handle(args: argparse.Namespace) -> int:
     try:
         skin = skin_options(args)
         problem = None if args.wedge else plan.glb_problem(args.out, skin, args.locators)
+        note = None if args.wedge or problem else plan.glb_note(args.out, skin, args.locators)
     except (ValueError, MeshError) as error:  # bad skin options, a creature no mesh fits
         problem = str(error)
     if problem:
         print(f"error: {problem}", file=sys.stderr)
         return 2
+    if note:
+        print(f"note: {note}", file=sys.stderr)
     problem = plan.size_problem()
     if problem:
         print(f"error: argument --seconds: {problem}", file=sys.stderr)

@@ -17,7 +17,7 @@ from ecs_tentacles.cli.bake import save, summary, usd_missing
 from ecs_tentacles.cli.skin_options import add_arguments as add_skin_arguments
 from ecs_tentacles.cli.skin_options import skin_options
 from ecs_tentacles.export.bake import output_kind
-from ecs_tentacles.export.glb_size import glb_problem, glb_size, shapes_of_header
+from ecs_tentacles.export.glb_size import glb_note, glb_problem, glb_size, shapes_of_header
 from ecs_tentacles.export.skinned import Skin
 from ecs_tentacles.output.progress import status
 from ecs_tentacles.skin.mesh import MeshError
@@ -51,7 +51,8 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 
 def glb_refusal(args: argparse.Namespace, skin: Skin | None) -> str | None:
     """Why the glb --out names cannot hold the take (one line), or None (and None for
-    USD): counted from the take's header before a frame is read (`export.glb_size`)."""
+    USD): counted from the take's header before a frame is read (`export.glb_size`).
+    A glb past what Blender imports gets a note on stderr."""
     if output_kind(args.out) != "gltf":
         return None
     size = glb_size(
@@ -60,7 +61,11 @@ def glb_refusal(args: argparse.Namespace, skin: Skin | None) -> str | None:
         None if skin is None else skin.keys,
         args.locators,
     )
-    return glb_problem(args.out, size, (".usdc",), "export")
+    problem = glb_problem(args.out, size, (".usdc",), "export")
+    note = None if problem else glb_note(args.out, size)
+    if note:
+        print(f"note: {note}", file=sys.stderr)
+    return problem
 
 
 def handle(args: argparse.Namespace) -> int:

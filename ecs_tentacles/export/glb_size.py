@@ -36,6 +36,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+import psutil
 
 from ecs_tentacles.export.glb import GLB_MAX_BYTES, GlbTooLarge
 from ecs_tentacles.export.glb_json import JsonCount
@@ -46,7 +47,13 @@ from ecs_tentacles.skin.rig import Keys
 from ecs_tentacles.skin.skeleton import SkinLayout, build_skeleton, skin_layout
 from ecs_tentacles.take.tracks import tracks_of
 
-BLENDER_GLB_BYTES = 2 * 10**9  # Blender 5.0.1's glTF importer, measured: see the README
+# Blender 5.0.1's glTF importer, measured on 64 creatures (301 and 901 frames skinned,
+# 51 and 101 MB: 1.36 and 3.14 GB peak; 301 frames rigid, 50 MB: 2.12 GB): about 35 bytes
+# of memory for each byte of keys (40 rigid: an object per body), 7 for each byte of the
+# rest, 0.34 GB to start with
+BLENDER_BASE_BYTES = 340 * 10**6
+BLENDER_PER_KEY_BYTE = {"skinned": 35, "rigid": 40}
+BLENDER_PER_OTHER_BYTE = 7
 PNG_BYTES = 64 * (64 * 3 + 1) * 1001 // 1000 + 128  # a 64 x 64 RGB PNG, stored, at most
 MAX_SKIN_VERTICES = 65535  # a skinned mesh's triangles index its vertices in 16 bits
 SKIN_VERTEX_BYTES = 12 + 12 + 8 + 8 + 16  # position, normal, uv, 4 joints (uint16), weights
@@ -204,12 +211,19 @@ class GlbSize:
         """Bytes of the file at `frames` frames (the take's by default), at most."""
         return self.fixed + self.per_frame * (self.frames if frames is None else frames)
 
+    def blender_bytes(self) -> int:
+        """About the memory Blender's glTF importer holds to import this glb (measured:
+        `BLENDER_PER_KEY_BYTE` for each byte of keys, `BLENDER_PER_OTHER_BYTE` the rest)."""
+        keys, per_key = self.per_frame * self.frames, BLENDER_PER_KEY_BYTE[self.form]
+        return BLENDER_BASE_BYTES + per_key * keys + BLENDER_PER_OTHER_BYTE * self.fixed
+
     def most_frames(self) -> int:
         """The most frames a glb of these creatures holds (0: not even one)."""
         room = GLB_MAX_BYTES - self.fixed
         return max(0, room // self.per_frame) if self.per_frame else 0
 
 
+@functools.lru_cache(maxsize=8)
 def glb_size(
     shapes: GlbShapes,
     detail: Detail | None = None,
@@ -390,8 +404,22 @@ def glb_problem(
     return (
         f"{path}: the glb would be up to {_gb(total)} ({size.creatures:,} creatures x"
         f" {size.frames:,} frames, {size.form}); a glb holds at most {_gb(GLB_MAX_BYTES)}"
-        f" (4 GiB: its lengths are 32-bit) and Blender's glTF importer about"
-        f" {_gb(BLENDER_GLB_BYTES)}: {advice}"
+        f" (4 GiB: its lengths are 32-bit), and Blender's glTF importer would need about"
+        f" {_gb(size.blender_bytes())} of memory for it: {advice}"
+    )
+
+
+def glb_note(path: str | os.PathLike[str], size: GlbSize, memory: int | None = None) -> str | None:
+    """A note (one line) when a glb of `size` fits glTF but Blender's glTF importer would
+    need more than `memory` (this machine's, by default) to open it, else None."""
+    memory = psutil.virtual_memory().total if memory is None else memory
+    needs = size.blender_bytes()
+    if size.total() > GLB_MAX_BYTES or size.mesh_problem or needs <= memory:
+        return None
+    return (
+        f"{path}: up to {_gb(size.total())}; Blender's glTF importer would need about"
+        f" {_gb(needs)} of memory to open it, more than the {_gb(memory)} here: for Blender,"
+        " write .usdc, or fewer frames or creatures"
     )
 
 
