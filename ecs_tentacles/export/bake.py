@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ecs_tentacles.export.glb_size import GlbSize, glb_note, glb_problem, glb_size, shapes_of_scene
+from ecs_tentacles.export.kinds import output_kind
 from ecs_tentacles.export.recording import Recording, scene_sha256
 from ecs_tentacles.export.take_size import NPY_HEADERS, TakeSize, take_size
 from ecs_tentacles.output.progress import status, step_frames
@@ -281,11 +282,3 @@ def bake(
             return recording.take()
     finally:
         world.close()
-
-
-def output_kind(path: str | os.PathLike[str]) -> str | None:
-    """'take', 'usd' or 'gltf' from a file name's suffix, None if unsupported."""
-    suffix = Path(path).suffix.lower()
-    return {".npz": "take", ".usd": "usd", ".usda": "usd", ".usdc": "usd", ".glb": "gltf"}.get(
-        suffix
-    )

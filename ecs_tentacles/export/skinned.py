@@ -12,7 +12,7 @@ import os
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from ecs_tentacles.export.bake import output_kind
+from ecs_tentacles.export.kinds import output_kind
 from ecs_tentacles.skin.keys import KeyReport
 from ecs_tentacles.skin.mesh import Detail
 from ecs_tentacles.skin.rig import Keys
