@@ -123,7 +123,8 @@ def handle(args: argparse.Namespace) -> int:
         allow_systems=args.allow_systems,
     )
     plan = replace(plan, scene=apply_to_scene(plan.scene, args))
-    try:
+    note = None
+    try:  # a glb too large (or a mesh past 16-bit indices) is refused before anything is built
         skin = skin_options(args)
         problem = None if args.wedge else plan.glb_problem(args.out, skin, args.locators)
         note = None if args.wedge or problem else plan.glb_note(args.out, skin, args.locators)

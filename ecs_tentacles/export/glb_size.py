@@ -16,15 +16,18 @@ anything). What it counts, mirroring the writers (`export.gltf`, `export.skinned
 - at most, where the data decides: reduced keys as if every key were kept, each
   channel with its own key times; a creature that comes and goes (the take's roster)
   or a goal locator keyed at every frame; each skin's texture as an uncompressed PNG;
-- the JSON at its widest: every number as wide as it can be written (10-digit
-  integers, 24-character floats) and every name as long as its creature's name and the
-  longest suffix the writers add.
+- the JSON at its widest (`export.glb_json`): every number as wide as it can be
+  written (indices as wide as the most items of a kind, byte counts as the binary
+  chunk, 24-character floats), every name as the writers make it (a sucker's or goal's
+  at its longest).
 
 Not counted from a scene (the take's header knows them, and the writers check it before
 writing): the terrain's meshes, creatures spawned and goals added while baking.
 
 `glb_problem` says, in one line, why a glb of that size cannot be written and what fits;
-`refuse_large_glb` raises it (`GlbTooLarge`) for a take about to be exported.
+`refuse_large_glb` raises it (`GlbTooLarge`) for a take about to be exported. Blender's
+glTF importer holds far more than the file (`GlbSize.blender_bytes`, measured):
+`glb_note` says so, in one line, when that is more than the machine's memory.
 """
 
 from __future__ import annotations

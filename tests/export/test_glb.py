@@ -93,15 +93,16 @@ def test_a_rigid_glb_is_written_with_memory_a_fraction_of_its_size(
 
 
 def test_a_skinned_glb_is_written_one_creature_at_a_time(guided_take: Take, tmp_path: Path) -> None:
-    """6 times the creatures, 6 times the file, the same memory: one creature's rig (its
-    animation, keys and mesh) is held at a time, not the crowd's."""
+    """40 more creatures add less memory than they add to the file (their JSON): one
+    creature's rig (animation, keys, mesh) is held at a time. Holding every rig to the
+    end, they added 5 times what they add to the file."""
     peaks, sizes = [], []
     for creatures in (8, 48):
         take = _longer(guided_take, 300, creatures=creatures)
         path = tmp_path / f"crowd{creatures}.glb"
         peaks.append(_peak(lambda take=take, path=path: write_skinned_glb(take, path)))
         sizes.append(path.stat().st_size)
-    assert sizes[1] > 5.5 * sizes[0] and peaks[1] < 1.5 * peaks[0], (peaks, sizes)
+    assert sizes[1] > 5.5 * sizes[0] and peaks[1] - peaks[0] < sizes[1] - sizes[0], (peaks, sizes)
     document, binary, _ = build_skinned_gltf(take)
     assert path.read_bytes() == glb_bytes(document, binary)  # the same bytes, streamed
     assert len(document["skins"]) == 48
