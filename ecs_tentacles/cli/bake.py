@@ -23,8 +23,6 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-from tqdm import tqdm
-
 from ecs_tentacles.cli import bake_ray
 from ecs_tentacles.cli.arguments import add_threads_argument, counted, output_path, seed_int
 from ecs_tentacles.cli.lod_options import add_lod_arguments, apply_to_scene
@@ -34,9 +32,10 @@ from ecs_tentacles.cli.usd_validate import add_argument as add_validate_argument
 from ecs_tentacles.cli.usd_validate import validate_problem, validated
 from ecs_tentacles.distributed.driver import ShardFailed
 from ecs_tentacles.distributed.wedge import WedgeError
-from ecs_tentacles.export import SUFFIXES, write
+from ecs_tentacles.export import SUFFIXES, work_units, write
 from ecs_tentacles.export.bake import BakePlan, bake, output_kind
 from ecs_tentacles.export.skinned import Skin
+from ecs_tentacles.output.progress import bar
 from ecs_tentacles.skin.keys import KeyReport
 from ecs_tentacles.skin.mesh import MeshError
 from ecs_tentacles.take import Take, TakeError
@@ -128,6 +127,18 @@ def handle(args: argparse.Namespace) -> int:
         allow_systems=args.allow_systems,
     )
     plan = replace(plan, scene=apply_to_scene(plan.scene, args))
+    note = None
+    try:  # a glb too large (or a mesh past 16-bit indices) is refused before anything is built
+        skin = skin_options(args)
+        problem = None if args.wedge else plan.glb_problem(args.out, skin, args.locators)
+        note = None if args.wedge or problem else plan.glb_note(args.out, skin, args.locators)
+    except (ValueError, MeshError) as error:  # bad skin options, a creature no mesh fits
+        problem = str(error)
+    if problem:
+        print(f"error: {problem}", file=sys.stderr)
+        return 2
+    if note:
+        print(f"note: {note}", file=sys.stderr)
     problem = plan.size_problem()
     if problem:
         print(f"error: argument --seconds: {problem}", file=sys.stderr)
@@ -199,15 +210,12 @@ def save(
     skin: Skin | None = None,
     locators: bool | None = None,
 ) -> KeyReport | None:
-    """Write `take` to `path` in the format its suffix names (a bar for slow, rigid USD
-    output); returns the key report when skinned. `locators`: as `export.write`."""
-    slow = output_kind(path) == "usd"
-    bodies = len(take.header["bodies"])
-    disable = None if progress and slow else True
-    with tqdm(
-        total=bodies, unit="body", desc="usd", disable=disable, file=sys.stderr, leave=False
-    ) as bar:
-        return write(take, path, bar.update, skin, locators)
+    """Write `take` to `path` in the format its suffix names, with a bar on stderr (the
+    take's bytes, the creatures of a skinned file, the bodies of a rigid one); returns the
+    key report when skinned. `locators`: as `export.write`."""
+    total, unit = work_units(take, path, skin)
+    with bar(total, f"write {path.name}", unit, progress=progress) as shown:
+        return write(take, path, shown.update, skin, locators)
 
 
 def report(take: Take, path: Path) -> dict[str, Any]:

@@ -145,6 +145,10 @@ def run_wedge(args: argparse.Namespace, plan: BakePlan, save: Any) -> int:
         if problem:
             print(f"error: argument --wedge: variant {variant.name}: {problem}", file=sys.stderr)
             return 2
+        problem = variant_plan.glb_problem(output_for(pattern, variant.name), None, None)
+        if problem:  # each variant's glb (rigid, as `save` writes it) fits in 4 GiB
+            print(f"error: argument --wedge: variant {variant.name}: {problem}", file=sys.stderr)
+            return 2
     print(f"wedge: {len(every)} variants -> {pattern.parent}", file=sys.stderr, flush=True)
     takes = _wedge_takes(args, plans)
     rows = []

@@ -22,6 +22,7 @@ from ecs_tentacles.cli import (
     validate,
 )
 from ecs_tentacles.cli.arguments import NoDisplay, OneLineParser
+from ecs_tentacles.export.glb import GlbTooLarge
 from ecs_tentacles.output.atomic import OutputError, claimed_outputs, release_claims
 from ecs_tentacles.plugin import HookFailure
 from ecs_tentacles.scene import load
@@ -137,7 +138,7 @@ def _failure(args: argparse.Namespace, error: Exception) -> int:
         for problem in error.problems:
             print(f"error: {problem}", file=sys.stderr)
         return 2
-    if isinstance(error, (TakeError, NoDisplay)):
+    if isinstance(error, (TakeError, NoDisplay, GlbTooLarge)):
         print(f"error: {error}", file=sys.stderr)
         return 2
     if isinstance(error, OutputError):

@@ -19,6 +19,10 @@ from ecs_tentacles.cli.skin_options import add_arguments as add_skin_arguments
 from ecs_tentacles.cli.skin_options import skin_options
 from ecs_tentacles.cli.usd_validate import add_argument as add_validate_argument
 from ecs_tentacles.cli.usd_validate import validate_problem, validated
+from ecs_tentacles.export.bake import output_kind
+from ecs_tentacles.export.glb_size import glb_note, glb_problem, glb_size, shapes_of_header
+from ecs_tentacles.export.skinned import Skin
+from ecs_tentacles.output.progress import status
 from ecs_tentacles.skin.mesh import MeshError
 from ecs_tentacles.take import Take
 
@@ -49,6 +53,25 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.set_defaults(handler=handle)
 
 
+def glb_refusal(args: argparse.Namespace, skin: Skin | None) -> str | None:
+    """Why the glb --out names cannot hold the take (one line), or None (and None for
+    USD): counted from the take's header before a frame is read (`export.glb_size`).
+    A glb past what Blender imports gets a note on stderr."""
+    if output_kind(args.out) != "gltf":
+        return None
+    size = glb_size(
+        shapes_of_header(Take.read_header(args.take)),  # TakeError: one line, exit 2
+        None if skin is None else skin.detail,
+        None if skin is None else skin.keys,
+        args.locators,
+    )
+    problem = glb_problem(args.out, size, (".usdc",), "export")
+    note = None if problem else glb_note(args.out, size)
+    if note:
+        print(f"note: {note}", file=sys.stderr)
+    return problem
+
+
 def handle(args: argparse.Namespace) -> int:
     problem = usd_missing(args.out) or validate_problem(args)
     if problem:
@@ -59,7 +82,15 @@ def handle(args: argparse.Namespace) -> int:
     except ValueError as error:
         print(f"error: {error}", file=sys.stderr)
         return 2
-    take = Take.load(args.take)  # TakeError: one line, exit 2
+    try:
+        problem = glb_refusal(args, skin)
+    except MeshError as error:  # e.g. tentacle bases that overlap on the mantle
+        problem = str(error)
+    if problem:
+        print(f"error: {problem}", file=sys.stderr)
+        return 2
+    with status(f"export: reading {args.take}", progress=not args.quiet):
+        take = Take.load(args.take)  # TakeError: one line, exit 2
     try:
         skinned = save(take, args.out, progress=not args.quiet, skin=skin, locators=args.locators)
     except MeshError as error:  # e.g. tentacle bases that overlap on the mantle

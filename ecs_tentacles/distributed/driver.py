@@ -57,6 +57,7 @@ from ecs_tentacles.distributed.spheres import meetings
 from ecs_tentacles.distributed.task import ShardResult, bake_shard
 from ecs_tentacles.distributed.work import WorkFolder, remove_work, shard_key
 from ecs_tentacles.export.bake import BakePlan
+from ecs_tentacles.output.progress import status
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.take import Take
 
@@ -265,7 +266,8 @@ def ray_bake(
             stats.rebaked += len(todo)
             results.update(_run_all(plan, todo, work, retries, progress, allow_systems, stats))
             results = {tuple(s): results[tuple(s)] for s in shards}
-        take = merge_takes([(r.members, r.take) for r in results.values()])
+        with status(f"ray bake: merging {len(results)} shards", progress=progress):
+            take = merge_takes([(r.members, r.take) for r in results.values()])
         return take, stats
     finally:
         stop_ray(started)

@@ -21,7 +21,7 @@ if TYPE_CHECKING:
     from ecs_tentacles.export.skinned import Skin
     from ecs_tentacles.skin.keys import KeyReport
 
-__all__ = ["SUFFIXES", "Take", "TakeError", "output_kind", "write"]
+__all__ = ["SUFFIXES", "Take", "TakeError", "output_kind", "work_units", "write"]
 
 SUFFIXES = (".npz", ".usd", ".usda", ".usdc", ".glb")
 
@@ -35,10 +35,11 @@ def write(
 ) -> KeyReport | None:
     """Write `take` in the format its suffix names (see `SUFFIXES`), atomically.
 
-    `progress(n)` hears of bodies written, for the slow format (USD). With `skin`, USD
-    and glTF get skinned creatures (`ecs_tentacles.export.skinned`) and the key report
-    is returned; without, rigid bodies. `locators`: suckers and goals as locators (USD
-    Xforms, glTF nodes); None is the form's default: off when skinned, on when rigid.
+    `progress(n)` hears of the work done, n of the units `work_units` names at a time.
+    With `skin`, USD and glTF get skinned creatures (`ecs_tentacles.export.skinned`) and
+    the key report is returned; without, rigid bodies. `locators`: suckers and goals as
+    locators (USD Xforms, glTF nodes); None is the form's default: off when skinned, on
+    when rigid.
     """
     kind = output_kind(path)
     if kind != "take":  # a take refuses itself (`Take.save`), with its own verb
@@ -46,9 +47,9 @@ def write(
     if skin is not None and kind in ("usd", "gltf"):
         from ecs_tentacles.export.skinned import write_skinned
 
-        return write_skinned(take, path, skin, bool(locators))
+        return write_skinned(take, path, skin, bool(locators), progress)
     if kind == "take":
-        take.save(path)
+        take.save(path, progress)
     elif kind == "usd":
         from ecs_tentacles.export.usd import write_usd
 
@@ -56,7 +57,20 @@ def write(
     elif kind == "gltf":
         from ecs_tentacles.export.gltf import write_glb
 
-        write_glb(take, path, locators is not False)
+        write_glb(take, path, locators is not False, progress)
     else:
         raise ValueError(f"{path}: unknown output format (use {', '.join(SUFFIXES)})")
     return None
+
+
+def work_units(
+    take: Take, path: str | os.PathLike[str], skin: Skin | None = None
+) -> tuple[int, str]:
+    """(how many, of what) `write(take, path, progress, skin)` tells `progress` of: the
+    bytes of a take's arrays, the creatures of a skinned file, the bodies of a rigid one."""
+    kind = output_kind(path)
+    if kind == "take":
+        return take.stored_bytes(), "B"
+    if skin is not None:
+        return len(take.header["creatures"]), "creature"
+    return len(take.header["bodies"]), "body"

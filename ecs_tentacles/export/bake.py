@@ -18,8 +18,10 @@ import os
 from collections.abc import Callable, Collection
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
+from ecs_tentacles.export.glb_size import GlbSize, glb_note, glb_problem, glb_size, shapes_of_scene
+from ecs_tentacles.export.kinds import output_kind
 from ecs_tentacles.export.recording import Recording, scene_sha256
 from ecs_tentacles.export.take_size import NPY_HEADERS, TakeSize, take_size
 from ecs_tentacles.output.progress import status, step_frames
@@ -29,6 +31,9 @@ from ecs_tentacles.take import Take
 from ecs_tentacles.take.read import MAX_FRAMES, MAX_HEADER_BYTES, MAX_TAKE_BYTES
 from ecs_tentacles.take.tracks import TrackSize
 from ecs_tentacles.world import World
+
+if TYPE_CHECKING:
+    from ecs_tentacles.export.skinned import Skin
 
 GIB, MIB = 1024**3, 1024**2
 
@@ -164,6 +169,36 @@ class BakePlan:
             f" {MAX_TAKE_BYTES / GIB:g} GiB: {self._what_fits(size, most)}"
         )
 
+    def glb_size(self, skin: Skin | None, locators: bool | None) -> GlbSize:
+        """What a glb of this bake holds, at most, as `skin` (None: rigid) and `locators`
+        would write it: counted from the scene before anything is built."""
+        shapes = shapes_of_scene(self.scene, self.frames)
+        detail, keys = (None, None) if skin is None else (skin.detail, skin.keys)
+        return glb_size(shapes, detail, keys, locators)
+
+    def glb_problem(
+        self, out: str | os.PathLike[str], skin: Skin | None, locators: bool | None
+    ) -> str | None:
+        """Why the glb `out` cannot hold what this plan bakes (one line), or None (and
+        None when `out` is not a glb; `export.glb_size`)."""
+        if output_kind(out) != "gltf":
+            return None
+        fits = (".usdc", ".npz") if self.size_problem() is None else ()
+        return glb_problem(out, self.glb_size(skin, locators), fits)
+
+    def glb_note(
+        self,
+        out: str | os.PathLike[str],
+        skin: Skin | None,
+        locators: bool | None,
+        memory: int | None = None,
+    ) -> str | None:
+        """A note when the glb `out` fits glTF but Blender's importer would need more than
+        `memory` (this machine's) to open it, else None (`export.glb_size.glb_note`)."""
+        if output_kind(out) != "gltf":
+            return None
+        return glb_note(out, self.glb_size(skin, locators), memory)
+
     def _what_fits(self, size: TakeSize, most: TrackSize) -> str:
         """The most seconds a take holds at this rate, and the most of the largest part
         (a plugin's track) at these seconds: 'bake at most 0.55 s at 60 fps or at most
@@ -243,14 +278,7 @@ def bake(
         assert isinstance(recording, Recording)  # the record plugin
         world.add_plugin(recording)
         step_frames(world, plan.steps, progress=progress, desc="bake", on_steps=on_steps)
-        return recording.take()
+        with status(f"bake: gathering {plan.frames} frames", progress=progress):
+            return recording.take()
     finally:
         world.close()
-
-
-def output_kind(path: str | os.PathLike[str]) -> str | None:
-    """'take', 'usd' or 'gltf' from a file name's suffix, None if unsupported."""
-    suffix = Path(path).suffix.lower()
-    return {".npz": "take", ".usd": "usd", ".usda": "usd", ".usdc": "usd", ".glb": "gltf"}.get(
-        suffix
-    )

@@ -24,26 +24,35 @@ tests check files with the Khronos glTF validator.
 
 from __future__ import annotations
 
-import json
 import os
-import struct
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 
 from ecs_tentacles import __version__
+from ecs_tentacles.export.glb import (
+    ARRAY_BUFFER,
+    ELEMENT_ARRAY_BUFFER,
+    GlbBuffer,
+    accessor_array,
+    glb_bytes,
+    read_glb,
+    stream_glb,
+)
+from ecs_tentacles.export.glb_size import refuse_large_glb
 from ecs_tentacles.export.ground import add_gltf_ground
 from ecs_tentacles.export.materials import gltf_material, take_colours
 from ecs_tentacles.export.meshes import Mesh, body_mesh
 from ecs_tentacles.export.names import FOLDERS, part, unique_leaf, unique_path
-from ecs_tentacles.output.atomic import atomic_file
 from ecs_tentacles.take import Take
 from ecs_tentacles.take.roster import spans
 
+__all__ = ["accessor_array", "build_gltf", "glb_bytes", "read_glb", "write_glb"]
+
 Z_UP_TO_Y_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
-_FLOAT, _USHORT, _UINT = 5126, 5123, 5125
-_ARRAY_BUFFER, _ELEMENT_ARRAY_BUFFER = 34962, 34963
-_GLB_MAGIC, _JSON_CHUNK, _BIN_CHUNK = 0x46546C67, 0x4E4F534A, 0x004E4942
+BLOCK_BYTES = 64 * 1024**2  # float64 temporaries of the bodies turned y-up at once
+Progress = Callable[[int], object]
 
 
 def to_y_up_points(points: np.ndarray) -> np.ndarray:
@@ -59,50 +68,27 @@ def to_y_up_rotations(quat_wxyz: np.ndarray) -> np.ndarray:
     return np.concatenate([vector, q[..., :1]], axis=-1)
 
 
-class _Buffer:
-    """Binary chunk under construction: one buffer view and accessor per array."""
-
-    def __init__(self) -> None:
-        self.data = bytearray()
-        self.views: list[dict[str, Any]] = []
-        self.accessors: list[dict[str, Any]] = []
-
-    def add(self, array: np.ndarray, kind: str, target: int | None = None) -> int:
-        """Append `array` (float32, uint16 or uint32), return its accessor index."""
-        raw = np.ascontiguousarray(array).tobytes()
-        view: dict[str, Any] = {"buffer": 0, "byteOffset": len(self.data), "byteLength": len(raw)}
-        if target is not None:
-            view["target"] = target
-        self.data += raw + b"\0" * (-len(raw) % 4)
-        self.views.append(view)
-        accessor: dict[str, Any] = {
-            "bufferView": len(self.views) - 1,
-            "componentType": {np.dtype(np.float32): _FLOAT, np.dtype(np.uint32): _UINT}.get(
-                array.dtype, _USHORT
-            ),
-            "count": int(array.shape[0]),
-            "type": kind,
-        }
-        if kind in ("VEC3", "SCALAR") and array.dtype == np.float32:
-            flat = array.reshape(array.shape[0], -1)
-            accessor["min"] = flat.min(axis=0).tolist()
-            accessor["max"] = flat.max(axis=0).tolist()
-        self.accessors.append(accessor)
-        return len(self.accessors) - 1
-
-
 def build_gltf(take: Take, locators: bool = True) -> tuple[dict[str, Any], bytes]:
-    """The glTF JSON document and its binary buffer (with `locators`: sucker and goal nodes)."""
+    """The glTF JSON document and its binary buffer, in memory (with `locators`: sucker
+    and goal nodes)."""
+    buffer = GlbBuffer()
+    document = gltf_document(take, buffer, locators)
+    return document, buffer.value()
+
+
+def gltf_document(
+    take: Take, buffer: GlbBuffer, locators: bool = True, progress: Progress | None = None
+) -> dict[str, Any]:
+    """The glTF JSON document, its arrays added to `buffer` as they are made (the bodies'
+    keys a block of bodies at a time: `progress(n)` after each block of n bodies)."""
     header = take.header
-    buffer = _Buffer()
     meshes: list[dict[str, Any]] = []
     mesh_of: dict[tuple[str, str, float, float, int], int] = {}
     materials: list[dict[str, Any]] = []
     node_of_body: dict[int, int] = {}
     nodes: list[dict[str, Any]] = [{"name": "World", "children": []}]
-    body_nodes: list[int] = []
-    translations = to_y_up_points(take.pos).astype(np.float32)
-    rotations = to_y_up_rotations(take.quat).astype(np.float32)
+    translations = to_y_up_points(take.pos[0]).astype(np.float32)  # the rest pose: frame 0
+    rotations = to_y_up_rotations(take.quat[0]).astype(np.float32)
 
     def node(name: str, parent: int, **fields: Any) -> int:
         nodes.append({"name": name, **fields})
@@ -116,15 +102,12 @@ def build_gltf(take: Take, locators: bool = True) -> tuple[dict[str, Any], bytes
         if key not in mesh_of:
             mesh_of[key] = len(meshes)
             meshes.append(_mesh(buffer, body_mesh(*shape), info["shape"], material))
-        node_of_body[index] = len(nodes)
-        body_nodes.append(
-            node(
-                unique_leaf(info["name"]),
-                parent,
-                mesh=mesh_of[key],
-                translation=translations[0, index].tolist(),
-                rotation=rotations[0, index].tolist(),
-            )
+        node_of_body[index] = node(
+            unique_leaf(info["name"]),
+            parent,
+            mesh=mesh_of[key],
+            translation=translations[index].tolist(),
+            rotation=rotations[index].tolist(),
         )
 
     roots = []
@@ -159,21 +142,18 @@ def build_gltf(take: Take, locators: bool = True) -> tuple[dict[str, Any], bytes
         "meshes": meshes,
         "materials": materials,
     }
-    animation = _animation(buffer, take, body_nodes, translations, rotations)
+    animation = _animation(buffer, take, node_of_body, progress)
     shown = take.visible()
     for index, root in enumerate(roots):
         scale_visibility(buffer, take, shown[:, index], nodes[root], root, animation)
     if locators:
         add_gltf_goals(take, buffer, nodes, animation)
     document["animations"] = [animation]
-    document["buffers"] = [{"byteLength": len(buffer.data)}]
-    document["bufferViews"] = buffer.views
-    document["accessors"] = buffer.accessors
-    return document, bytes(buffer.data)
+    return document | buffer.fields()
 
 
 def scale_visibility(
-    buffer: _Buffer,
+    buffer: GlbBuffer,
     take: Take,
     shown: np.ndarray,
     node: dict[str, Any],
@@ -219,7 +199,7 @@ def sucker_nodes(
 
 
 def add_gltf_goals(
-    take: Take, buffer: _Buffer, nodes: list[dict[str, Any]], animation: dict[str, Any]
+    take: Take, buffer: GlbBuffer, nodes: list[dict[str, Any]], animation: dict[str, Any]
 ) -> None:
     """Every points track's items (the goals) as nodes under World: `<c>_goals/<c>_goal<j>`
     at the item's place (y-up), its scale keyed to zero while it is not live."""
@@ -244,87 +224,60 @@ def add_gltf_goals(
             scale_visibility(buffer, take, live[:, index], nodes[own], own, animation)
 
 
-def _mesh(buffer: _Buffer, mesh: Mesh, name: str, material: int) -> dict[str, Any]:
+def _mesh(buffer: GlbBuffer, mesh: Mesh, name: str, material: int) -> dict[str, Any]:
     positions = to_y_up_points(mesh.positions).astype(np.float32)
     normals = to_y_up_points(mesh.normals).astype(np.float32)
     attributes = {
-        "POSITION": buffer.add(positions, "VEC3", _ARRAY_BUFFER),
-        "NORMAL": buffer.add(normals, "VEC3", _ARRAY_BUFFER),
+        "POSITION": buffer.add(positions, "VEC3", ARRAY_BUFFER),
+        "NORMAL": buffer.add(normals, "VEC3", ARRAY_BUFFER),
     }
-    indices = buffer.add(mesh.indices, "SCALAR", _ELEMENT_ARRAY_BUFFER)
+    indices = buffer.add(mesh.indices, "SCALAR", ELEMENT_ARRAY_BUFFER)
     primitive = {"attributes": attributes, "indices": indices, "material": material, "mode": 4}
     return {"name": name, "primitives": [primitive]}
 
 
 def _animation(
-    buffer: _Buffer,
-    take: Take,
-    body_nodes: list[int],
-    translations: np.ndarray,
-    rotations: np.ndarray,
+    buffer: GlbBuffer, take: Take, node_of_body: dict[int, int], progress: Progress | None
 ) -> dict[str, Any]:
+    """One animation: a translation and a rotation channel per body, every frame keyed.
+    The bodies are turned y-up a block at a time (`BLOCK_BYTES` of temporaries)."""
     times = buffer.add(take.times.astype(np.float32), "SCALAR")
     interpolation = "LINEAR" if take.frames > 1 else "STEP"
     samplers: list[dict[str, Any]] = []
     channels: list[dict[str, Any]] = []
-    for index, target in enumerate(body_nodes):
-        for path, values, kind in (
-            ("translation", translations[:, index], "VEC3"),
-            ("rotation", rotations[:, index], "VEC4"),
-        ):
-            output = buffer.add(np.ascontiguousarray(values), kind)
-            samplers.append({"input": times, "output": output, "interpolation": interpolation})
-            channels.append(
-                {"sampler": len(samplers) - 1, "target": {"node": target, "path": path}}
-            )
+    bodies = list(node_of_body.items())
+    block = max(1, BLOCK_BYTES // (take.frames * 7 * 8 * 2))
+    for start in range(0, len(bodies), block):
+        chunk = bodies[start : start + block]
+        index = np.array([body for body, _ in chunk])
+        translations = to_y_up_points(take.pos[:, index]).astype(np.float32)
+        rotations = to_y_up_rotations(take.quat[:, index]).astype(np.float32)
+        for column, (_, target) in enumerate(chunk):
+            for path, values, kind in (
+                ("translation", translations[:, column], "VEC3"),
+                ("rotation", rotations[:, column], "VEC4"),
+            ):
+                output = buffer.add(values, kind)
+                samplers.append({"input": times, "output": output, "interpolation": interpolation})
+                channels.append(
+                    {"sampler": len(samplers) - 1, "target": {"node": target, "path": path}}
+                )
+        if progress is not None:
+            progress(len(chunk))
     return {"name": part(str(take.header["scene"]), "animation"), "samplers": samplers,
             "channels": channels}  # fmt: skip
 
 
-def glb_bytes(document: dict[str, Any], binary: bytes) -> bytes:
-    """A GLB container: 12-byte header, JSON chunk (space-padded), BIN chunk (zero-padded)."""
-    text = json.dumps(document, separators=(",", ":"), sort_keys=True, allow_nan=False).encode()
-    text += b" " * (-len(text) % 4)
-    binary += b"\0" * (-len(binary) % 4)
-    total = 12 + 8 + len(text) + 8 + len(binary)
-    return b"".join(
-        [
-            struct.pack("<III", _GLB_MAGIC, 2, total),
-            struct.pack("<II", len(text), _JSON_CHUNK),
-            text,
-            struct.pack("<II", len(binary), _BIN_CHUNK),
-            binary,
-        ]
-    )
-
-
-def read_glb(data: bytes) -> tuple[dict[str, Any], bytes]:
-    """Split a GLB into its JSON document and binary chunk (for tests and tools)."""
-    magic, version, total = struct.unpack_from("<III", data, 0)
-    if magic != _GLB_MAGIC or version != 2 or total != len(data):
-        raise ValueError("not a glTF 2.0 binary file")
-    json_length, _ = struct.unpack_from("<II", data, 12)
-    document = json.loads(data[20 : 20 + json_length])
-    bin_length, _ = struct.unpack_from("<II", data, 20 + json_length)
-    start = 28 + json_length
-    return document, data[start : start + bin_length]
-
-
-def accessor_array(document: dict[str, Any], binary: bytes, index: int) -> np.ndarray:
-    """Read accessor `index` of a document as a numpy array (float32 or uint16)."""
-    accessor = document["accessors"][index]
-    view = document["bufferViews"][accessor["bufferView"]]
-    dtype = np.float32 if accessor["componentType"] == _FLOAT else np.uint16
-    width = {"SCALAR": 1, "VEC3": 3, "VEC4": 4}[accessor["type"]]
-    start = view.get("byteOffset", 0) + accessor.get("byteOffset", 0)
-    flat = np.frombuffer(binary, dtype=dtype, count=accessor["count"] * width, offset=start)
-    return flat.reshape(accessor["count"], width) if width > 1 else flat
-
-
-def write_glb(take: Take, path: str | os.PathLike[str], locators: bool = True) -> None:
-    """Write `take` as a .glb file, atomically; `TakeError` for a take glTF cannot hold.
-    `locators=False` leaves the sucker and goal nodes out."""
+def write_glb(
+    take: Take,
+    path: str | os.PathLike[str],
+    locators: bool = True,
+    progress: Progress | None = None,
+) -> None:
+    """Write `take` as a .glb file, atomically, within bounded memory (the binary chunk
+    is spooled to disk: `ecs_tentacles.export.glb`); `TakeError` for a take glTF cannot
+    hold, `GlbTooLarge` for a file over glTF's 4 GiB (counted before any work).
+    `locators=False` leaves the sucker and goal nodes out; `progress(n)`: n bodies done."""
     take.check_exportable(path)
-    data = glb_bytes(*build_gltf(take, locators))
-    with atomic_file(path) as handle:
-        handle.write(data)
+    refuse_large_glb(take.header, path, None, locators)
+    stream_glb(path, lambda buffer: gltf_document(take, buffer, locators, progress))

@@ -9,9 +9,10 @@ adjust in Blender, Maya, Houdini or a game engine. `--rigid` keeps the capsule f
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from ecs_tentacles.export.bake import output_kind
+from ecs_tentacles.export.kinds import output_kind
 from ecs_tentacles.skin.keys import KeyReport
 from ecs_tentacles.skin.mesh import Detail
 from ecs_tentacles.skin.rig import Keys
@@ -27,17 +28,21 @@ class Skin:
 
 
 def write_skinned(
-    take: Take, path: str | os.PathLike[str], skin: Skin, locators: bool = False
+    take: Take,
+    path: str | os.PathLike[str],
+    skin: Skin,
+    locators: bool = False,
+    progress: Callable[[int], object] | None = None,
 ) -> KeyReport:
     """Write `take` with skinned creatures as USD or glTF (by suffix), atomically; with
-    `locators`, suckers and goals too."""
+    `locators`, suckers and goals too; `progress(1)` as each creature is done."""
     kind = output_kind(path)
     if kind == "usd":
         from ecs_tentacles.export.skinned_usd import write_skinned_usd
 
-        return write_skinned_usd(take, path, skin.detail, skin.keys, locators)
+        return write_skinned_usd(take, path, skin.detail, skin.keys, locators, progress)
     if kind == "gltf":
         from ecs_tentacles.export.skinned_gltf import write_skinned_glb
 
-        return write_skinned_glb(take, path, skin.detail, skin.keys, locators)
+        return write_skinned_glb(take, path, skin.detail, skin.keys, locators, progress)
     raise ValueError(f"{path}: skinned creatures are written as USD or glTF, not {kind}")

@@ -29,13 +29,17 @@ from typing import Any
 import numpy as np
 
 from ecs_tentacles import __version__
+from ecs_tentacles.export.glb import (
+    ARRAY_BUFFER,
+    ELEMENT_ARRAY_BUFFER,
+    GlbBuffer,
+    stream_glb,
+)
+from ecs_tentacles.export.glb_size import MAX_SKIN_VERTICES, refuse_large_glb
 from ecs_tentacles.export.gltf import (
-    _ARRAY_BUFFER,
-    _ELEMENT_ARRAY_BUFFER,
     Z_UP_TO_Y_UP,
-    _Buffer,
+    Progress,
     add_gltf_goals,
-    glb_bytes,
     scale_visibility,
     sucker_nodes,
     to_y_up_points,
@@ -44,11 +48,12 @@ from ecs_tentacles.export.gltf import (
 from ecs_tentacles.export.ground import add_gltf_ground
 from ecs_tentacles.export.materials import gltf_material, skin_texture, take_colours
 from ecs_tentacles.export.names import part
-from ecs_tentacles.output.atomic import atomic_output
 from ecs_tentacles.skin.keys import KeyReport
-from ecs_tentacles.skin.mesh import Detail, SkinMesh
-from ecs_tentacles.skin.rig import Keys, SkinnedCreature, skinned_creatures
+from ecs_tentacles.skin.mesh import Detail, SkinMesh, split_by_uv
+from ecs_tentacles.skin.rig import Keys, KeyTally, SkinnedCreature, rig_creature
 from ecs_tentacles.take import Take
+
+__all__ = ["build_skinned_gltf", "split_by_uv", "write_skinned_glb"]
 
 _TURN = np.eye(4)
 _TURN[:3, :3] = Z_UP_TO_Y_UP
@@ -60,23 +65,45 @@ def write_skinned_glb(
     detail: Detail | None = None,
     keys: Keys | None = None,
     locators: bool = False,
+    progress: Progress | None = None,
 ) -> KeyReport:
-    """Write `take` as a skinned .glb atomically; returns the key counts and errors.
-    With `locators`, suckers and goals are nodes too (the module doc)."""
-    document, binary, report = build_skinned_gltf(take, detail, keys, locators)
-    data = glb_bytes(document, binary)
-    with atomic_output(path) as temporary:
-        temporary.write_bytes(data)
-    return report
+    """Write `take` as a skinned .glb atomically, within bounded memory (one creature's
+    rig at a time, the binary chunk spooled to disk); returns the key counts and errors.
+    `GlbTooLarge` for a file over glTF's 4 GiB, counted before any work. With `locators`,
+    suckers and goals are nodes too (the module doc); `progress(1)` after each creature."""
+    refuse_large_glb(take.header, path, detail or Detail(), locators, keys)
+    reports: list[KeyReport] = []
+
+    def document(buffer: GlbBuffer) -> dict[str, Any]:
+        made, report = skinned_document(take, buffer, detail, keys, locators, progress)
+        reports.append(report)
+        return made
+
+    stream_glb(path, document)
+    return reports[0]
 
 
 def build_skinned_gltf(
     take: Take, detail: Detail | None = None, keys: Keys | None = None, locators: bool = False
 ) -> tuple[dict[str, Any], bytes, KeyReport]:
-    """The glTF JSON document, its binary buffer and the key report."""
+    """The glTF JSON document, its binary buffer (in memory) and the key report."""
+    buffer = GlbBuffer()
+    document, report = skinned_document(take, buffer, detail, keys, locators)
+    return document, buffer.value(), report
+
+
+def skinned_document(
+    take: Take,
+    buffer: GlbBuffer,
+    detail: Detail | None = None,
+    keys: Keys | None = None,
+    locators: bool = False,
+    progress: Progress | None = None,
+) -> tuple[dict[str, Any], KeyReport]:
+    """The glTF JSON document and the key report, the arrays added to `buffer` one
+    creature at a time (each creature's rig dropped before the next is made)."""
     header = take.header
-    creatures, report = skinned_creatures(take, detail, keys)
-    buffer = _Buffer()
+    tally = KeyTally(take.frames)
     nodes: list[dict[str, Any]] = [{"name": "World", "children": []}]
     roots = [0]
     meshes, skins = [], []
@@ -86,8 +113,8 @@ def build_skinned_gltf(
     animation: dict[str, Any] = {"name": "take", "samplers": [], "channels": []}
     times: dict[bytes, int] = {}
     shown = take.visible()
-    index = {c["name"]: i for i, c in enumerate(header["creatures"])}
-    for creature in creatures:
+    for number in range(len(header["creatures"])):
+        creature = tally.add(rig_creature(take, number, detail, keys))
         skeleton = creature.skeleton
         holder = len(nodes)
         nodes.append({"name": part(skeleton.layout.name, "skeleton"), "children": []})
@@ -117,7 +144,7 @@ def build_skinned_gltf(
             }
         )
         name = skeleton.layout.name
-        images.append({"bufferView": _image(buffer, skin_texture(colours[name])),
+        images.append({"bufferView": buffer.view(skin_texture(colours[name])),
                        "mimeType": "image/png"})  # fmt: skip
         materials.append(gltf_material(name, colours[name], texture=len(images) - 1))
         meshes.append(_mesh(buffer, creature.mesh, name, len(materials) - 1))
@@ -131,7 +158,7 @@ def build_skinned_gltf(
         )
         _channels(buffer, take, creature, first, animation, times)
         # while the creature is not there: its root joint (and so its skin) scaled to zero
-        seen = shown[:, index[skeleton.layout.name]]
+        seen = shown[:, number]
         scale_visibility(buffer, take, seen, nodes[first], first, animation)
         if locators:  # each sucker a child of its link's joint, at the sucker
             joint_of = {int(b): first + j for j, b in enumerate(skeleton.bodies)}
@@ -139,6 +166,8 @@ def build_skinned_gltf(
             for parent, child in sucker_nodes(take, name, offsets):
                 nodes.append(child)
                 nodes[joint_of[parent]].setdefault("children", []).append(len(nodes) - 1)
+        if progress is not None:
+            progress(1)
     if locators:
         add_gltf_goals(take, buffer, nodes, animation)
     ground = add_gltf_ground(take, buffer, nodes, meshes, materials, to_y_up_points)
@@ -160,32 +189,14 @@ def build_skinned_gltf(
         "samplers": [{"magFilter": 9729, "minFilter": 9729}],
         "images": images,
         "animations": [animation],
-        "buffers": [{"byteLength": len(buffer.data)}],
-        "bufferViews": buffer.views,
-        "accessors": buffer.accessors,
+        **buffer.fields(),
     }
-    return document, bytes(buffer.data), report
+    return document, tally.report()
 
 
-def _image(buffer: _Buffer, png: bytes) -> int:
-    """A buffer view holding `png` (images are views, not accessors)."""
-    buffer.views.append({"buffer": 0, "byteOffset": len(buffer.data), "byteLength": len(png)})
-    buffer.data += png + b"\0" * (-len(png) % 4)
-    return len(buffer.views) - 1
-
-
-def split_by_uv(mesh: SkinMesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """glTF vertices carry one UV each: (source vertex, uv) per new vertex, and triangles."""
-    corners = mesh.faces.reshape(-1)
-    uv = mesh.uv.reshape(-1, 2).astype(np.float32)
-    keys = np.concatenate([corners[:, None].astype(np.float64), uv.astype(np.float64)], axis=1)
-    unique, inverse = np.unique(keys, axis=0, return_inverse=True)
-    return unique[:, 0].astype(np.int64), unique[:, 1:].astype(np.float32), inverse.reshape(-1, 3)
-
-
-def _mesh(buffer: _Buffer, mesh: SkinMesh, name: str, material: int) -> dict[str, Any]:
+def _mesh(buffer: GlbBuffer, mesh: SkinMesh, name: str, material: int) -> dict[str, Any]:
     source, uv, triangles = split_by_uv(mesh)
-    if len(source) > 65535:
+    if len(source) > MAX_SKIN_VERTICES:
         raise ValueError(
             f"creature {name}: {len(source)} skinned vertices, over glTF's 16-bit indices here;"
             " use fewer rings per link or sides"
@@ -197,22 +208,22 @@ def _mesh(buffer: _Buffer, mesh: SkinMesh, name: str, material: int) -> dict[str
     weights[:, 1] = np.float32(1.0) - weights[:, 0]  # exact float32 sums
     attributes = {
         "POSITION": buffer.add(
-            to_y_up_points(mesh.positions[source]).astype(np.float32), "VEC3", _ARRAY_BUFFER
+            to_y_up_points(mesh.positions[source]).astype(np.float32), "VEC3", ARRAY_BUFFER
         ),
         "NORMAL": buffer.add(
-            to_y_up_points(mesh.normals[source]).astype(np.float32), "VEC3", _ARRAY_BUFFER
+            to_y_up_points(mesh.normals[source]).astype(np.float32), "VEC3", ARRAY_BUFFER
         ),
-        "TEXCOORD_0": buffer.add((uv * [1, -1] + [0, 1]).astype(np.float32), "VEC2", _ARRAY_BUFFER),
-        "JOINTS_0": buffer.add(joints, "VEC4", _ARRAY_BUFFER),
-        "WEIGHTS_0": buffer.add(weights, "VEC4", _ARRAY_BUFFER),
+        "TEXCOORD_0": buffer.add((uv * [1, -1] + [0, 1]).astype(np.float32), "VEC2", ARRAY_BUFFER),
+        "JOINTS_0": buffer.add(joints, "VEC4", ARRAY_BUFFER),
+        "WEIGHTS_0": buffer.add(weights, "VEC4", ARRAY_BUFFER),
     }
-    indices = buffer.add(triangles.reshape(-1).astype(np.uint16), "SCALAR", _ELEMENT_ARRAY_BUFFER)
+    indices = buffer.add(triangles.reshape(-1).astype(np.uint16), "SCALAR", ELEMENT_ARRAY_BUFFER)
     primitive = {"attributes": attributes, "indices": indices, "material": material, "mode": 4}
     return {"name": f"{name}/skin", "primitives": [primitive]}
 
 
 def _channels(
-    buffer: _Buffer,
+    buffer: GlbBuffer,
     take: Take,
     creature: SkinnedCreature,
     first: int,

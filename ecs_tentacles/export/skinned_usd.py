@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import importlib
 import os
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -52,10 +53,11 @@ def write_skinned_usd(
     detail: Detail | None = None,
     keys: Keys | None = None,
     locators: bool = False,
+    progress: Callable[[int], object] | None = None,
 ) -> KeyReport:
     """Write `take` as a skinned USD file (.usda, .usdc, .usd) atomically; returns the keys.
-    With `locators`, suckers and goals are written too."""
-    stage, report = build_skinned_stage(take, detail, keys, locators)
+    With `locators`, suckers and goals are written too; `progress(1)` after each creature."""
+    stage, report = build_skinned_stage(take, detail, keys, locators, progress)
     with atomic_output(path) as temporary:
         if not stage.GetRootLayer().Export(str(temporary)):
             raise OSError(f"{path}: USD could not write the file")
@@ -63,7 +65,11 @@ def write_skinned_usd(
 
 
 def build_skinned_stage(
-    take: Take, detail: Detail | None = None, keys: Keys | None = None, locators: bool = False
+    take: Take,
+    detail: Detail | None = None,
+    keys: Keys | None = None,
+    locators: bool = False,
+    progress: Callable[[int], object] | None = None,
 ) -> tuple[Any, KeyReport]:
     """An in-memory `Usd.Stage` with one SkelRoot per creature, and the key report."""
     pxr = _pxr()
@@ -82,6 +88,8 @@ def build_skinned_stage(
         _creature(pxr, stage, creature, colours[name], folder)
         mark_rate(stage, f"/World/{name}", take)
         key_visibility(stage, f"/World/{name}", shown[:, of_name[name]])
+        if progress is not None:
+            progress(1)
     if locators:
         for index, sucker in enumerate(take.header["suckers"]):
             _sucker(pxr, stage, take, index, sucker)

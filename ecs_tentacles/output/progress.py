@@ -1,5 +1,9 @@
-"""Progress on stderr: stepping a world for many frames with a bar (`run`, bakes), and a
-status line for work that has no count (`status`: loading, building, validating)."""
+"""Progress on stderr: stepping a world for many frames with a bar (`run`, bakes), a bar
+for any other counted work (`bar`: writing a file body by body or byte by byte), and a
+status line for work that has no count (`status`: loading, building, validating).
+
+Every one is drawn only when asked (`progress`: the commands' `--quiet` turns it off)
+and stderr is a terminal, on stderr, and cleared when the work ends."""
 
 from __future__ import annotations
 
@@ -7,7 +11,7 @@ import contextlib
 import sys
 import time
 from collections.abc import Callable, Iterator
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from tqdm import tqdm
 
@@ -46,6 +50,22 @@ def step_frames(
             bar.update(n)
             if on_steps is not None:
                 on_steps(n)
+
+
+def bar(total: int, desc: str, unit: str, *, progress: bool = True) -> tqdm[Any]:
+    """A tqdm bar for `total` `unit`s of work labelled `desc` (bytes are shown scaled:
+    kB, MB, GB); `bar.update(n)` as n are done. Use it as a context manager."""
+    scaled = unit == "B"
+    return tqdm(
+        total=total,
+        desc=desc,
+        unit=unit,
+        unit_scale=scaled,
+        unit_divisor=1024 if scaled else 1000,
+        disable=None if progress else True,
+        file=sys.stderr,
+        leave=False,
+    )
 
 
 @contextlib.contextmanager

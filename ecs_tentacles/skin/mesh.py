@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ecs_tentacles.skin.skeleton import Skeleton, TentacleLayout
+from ecs_tentacles.skin.skeleton import Skeleton, SkinLayout, TentacleLayout
 
 
 class MeshError(ValueError):
@@ -230,6 +230,29 @@ def creature_mesh(skeleton: Skeleton, detail: Detail | None = None) -> SkinMesh:
         ring_s=np.concatenate(ring_s),
         ring_tentacle=np.concatenate(ring_tentacle),
     )
+
+
+def topology(layout: SkinLayout, detail: Detail | None = None) -> tuple[object, ...]:
+    """What the size of `creature_mesh`'s mesh depends on: the detail, each tentacle's
+    links and the mantle's columns (where each tentacle's hole starts, and how many in
+    all). Two layouts with the same topology give meshes of the same vertex and triangle
+    counts (`export.glb_size` counts a crowd's meshes by building one per topology)."""
+    detail = detail or Detail()
+    k = detail.sides // 4
+    rb = max(float(t.radii[0]) for t in layout.tentacles)
+    theta, starts = _columns(layout.name, layout.mantle_radius, k, rb, layout.tentacles)
+    links = tuple(len(t.lengths) for t in layout.tentacles)
+    return (detail, links, tuple(starts), len(theta))
+
+
+def split_by_uv(mesh: SkinMesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Vertices with one UV each, as glTF wants them (a vertex is split where its UVs
+    differ): (source vertex, uv) per new vertex, and the triangles on them."""
+    corners = mesh.faces.reshape(-1)
+    uv = mesh.uv.reshape(-1, 2).astype(np.float32)
+    keys = np.concatenate([corners[:, None].astype(np.float64), uv.astype(np.float64)], axis=1)
+    unique, inverse = np.unique(keys, axis=0, return_inverse=True)
+    return unique[:, 0].astype(np.int64), unique[:, 1:].astype(np.float32), inverse.reshape(-1, 3)
 
 
 def _columns(

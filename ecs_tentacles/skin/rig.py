@@ -73,35 +73,61 @@ def skinned_creatures(
     take: Take, detail: Detail | None = None, keys: Keys | None = None
 ) -> tuple[list[SkinnedCreature], KeyReport]:
     """Every creature of `take` rigged, and the key counts and errors over all of them."""
+    tally = KeyTally(take.frames)
+    creatures = [tally.add(rig_creature(take, index, detail, keys)) for index in
+                 range(len(take.header["creatures"]))]  # fmt: skip
+    return creatures, tally.report()
+
+
+def rig_creature(
+    take: Take, index: int, detail: Detail | None = None, keys: Keys | None = None
+) -> SkinnedCreature:
+    """Creature number `index` of `take` rigged: its skeleton, mesh, animation and keys
+    (a writer that streams takes them one at a time, `KeyTally` adding up the report)."""
     keys = keys or Keys()
-    creatures: list[SkinnedCreature] = []
-    before = after = samples = 0
-    rotation_error = translation_error = 0.0
-    for index in range(len(take.header["creatures"])):
-        skeleton = creature_skeleton(take, index)
-        animation = creature_animation(skeleton, take)
+    skeleton = creature_skeleton(take, index)
+    animation = creature_animation(skeleton, take)
+    frames, joints = animation.rotation.shape[:2]
+    if keys.mode == "all" or frames < 3:
+        rotation_keys = np.ones((frames, joints), bool)
+        translation_keys = np.ones(frames, bool)
+    else:
+        rotation_keys = reduce_rotations(animation.rotation, keys.tolerance_deg)
+        translation_keys = reduce_points(animation.translation[:, 0], ROOT_TOLERANCE_M)
+    return SkinnedCreature(
+        skeleton=skeleton,
+        mesh=creature_mesh(skeleton, detail),
+        animation=animation,
+        rotation_keys=rotation_keys,
+        translation_keys=translation_keys,
+    )
+
+
+class KeyTally:
+    """The key counts and largest errors over creatures added one at a time."""
+
+    def __init__(self, frames: int) -> None:
+        self.frames = frames
+        self.before = self.after = self.samples = 0
+        self.rotation_error = self.translation_error = 0.0
+
+    def add(self, creature: SkinnedCreature) -> SkinnedCreature:
+        """Count `creature`'s keys and errors in; returns it."""
+        animation = creature.animation
         frames, joints = animation.rotation.shape[:2]
-        if keys.mode == "all" or frames < 3:
-            rotation_keys = np.ones((frames, joints), bool)
-            translation_keys = np.ones(frames, bool)
-        else:
-            rotation_keys = reduce_rotations(animation.rotation, keys.tolerance_deg)
-            translation_keys = reduce_points(animation.translation[:, 0], ROOT_TOLERANCE_M)
-        creature = SkinnedCreature(
-            skeleton=skeleton,
-            mesh=creature_mesh(skeleton, detail),
-            animation=animation,
-            rotation_keys=rotation_keys,
-            translation_keys=translation_keys,
-        )
-        creatures.append(creature)
-        samples = max(samples, len(creature.sample_frames))
-        before += frames * (joints + 1)
-        after += int(rotation_keys.sum() + translation_keys.sum())
+        self.samples = max(self.samples, len(creature.sample_frames))
+        self.before += frames * (joints + 1)
+        self.after += int(creature.rotation_keys.sum() + creature.translation_keys.sum())
         every = np.arange(frames)
         error = angle_between(creature.rotations_at(every), animation.rotation)
-        rotation_error = max(rotation_error, float(error.max(initial=0.0)))
+        self.rotation_error = max(self.rotation_error, float(error.max(initial=0.0)))
         moved = creature.translations_at(every)[:, 0] - animation.translation[:, 0]
-        translation_error = max(translation_error, float(np.linalg.norm(moved, axis=1).max()))
-    report = KeyReport(before, after, rotation_error, translation_error, samples, take.frames)
-    return creatures, report
+        self.translation_error = max(
+            self.translation_error, float(np.linalg.norm(moved, axis=1).max(initial=0.0))
+        )
+        return creature
+
+    def report(self) -> KeyReport:
+        """The report over every creature added."""
+        return KeyReport(self.before, self.after, self.rotation_error, self.translation_error,
+                         self.samples, self.frames)  # fmt: skip

@@ -34,9 +34,10 @@ import io
 import json
 import os
 import zipfile
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, BinaryIO
+from typing import IO, Any, BinaryIO
 
 import numpy as np
 
@@ -173,7 +174,7 @@ class Take:
                 f"header: {header / 1024**2:,.0f} MiB, over the {MAX_HEADER_BYTES / 1024**2:g}"
                 " MiB a take's header holds"
             )
-        stored = sum(_npy_bytes(value) for value in entries.values())
+        stored = self.stored_bytes()
         if stored > MAX_TAKE_BYTES:
             return (
                 f"its {len(entries)} arrays would be {stored:,} bytes, over the"
@@ -181,9 +182,17 @@ class Take:
             )
         return None
 
+    def stored_bytes(self) -> int:
+        """Bytes of the file's entries before compression: each array's `.npy` header and
+        data (what `save` tells its `progress` of). Counted from shapes: nothing copied."""
+        return sum(_npy_bytes(value) for value in self._entries().values())
+
     # -- files -------------------------------------------------------------------------
-    def save(self, path: str | os.PathLike[str]) -> None:
-        """Write the take to `path` atomically (see `ecs_tentacles.output.atomic`).
+    def save(
+        self, path: str | os.PathLike[str], progress: Callable[[int], object] | None = None
+    ) -> None:
+        """Write the take to `path` atomically (see `ecs_tentacles.output.atomic`);
+        `progress(n)` as n more bytes are stored (of `stored_bytes()`).
 
         Raises `TakeError` (one line, nothing written) when `Take.load` would refuse the
         result: a plugin that wrote NaN into the poses makes a take nobody can read."""
@@ -191,7 +200,7 @@ class Take:
         if problem:
             raise TakeError(f"{path}: cannot write this take: {problem}")
         with atomic_file(path) as handle:
-            write_npz(handle, self.arrays())
+            write_npz(handle, self.arrays(), progress)
 
     @classmethod
     def load(cls, path: str | os.PathLike[str], max_bytes: int = MAX_TAKE_BYTES) -> Take:
@@ -203,6 +212,13 @@ class Take:
         """
         header, arrays = read_take(Path(path), max_bytes)
         return cls.from_arrays(header, arrays)
+
+    @staticmethod
+    def read_header(path: str | os.PathLike[str]) -> dict[str, Any]:
+        """A take file's header alone, checked as `load` checks it (`TakeError`, one
+        line), without reading a frame: what an exporter counts before any work."""
+        header, _ = read_take(Path(path), header_only=True)
+        return header
 
     def problem(self) -> str | None:
         """The first problem of this (in-memory) take, as `Take.load` would report it."""
@@ -245,8 +261,13 @@ def _npy_bytes(array: np.ndarray) -> int:
     return buffer.tell() + array.nbytes
 
 
-def write_npz(path: str | os.PathLike[str] | BinaryIO, arrays: dict[str, np.ndarray]) -> None:
-    """Write `arrays` as an npz readable by `np.load`, byte-reproducibly.
+def write_npz(
+    path: str | os.PathLike[str] | BinaryIO,
+    arrays: dict[str, np.ndarray],
+    progress: Callable[[int], object] | None = None,
+) -> None:
+    """Write `arrays` as an npz readable by `np.load`, byte-reproducibly; `progress(n)`
+    as n more bytes are stored (numpy writes an array in pieces of 16 MiB).
 
     `np.savez` stamps each zip entry with the current time; here every entry gets the
     same fixed date and permissions, in the order of `arrays`.
@@ -258,4 +279,17 @@ def write_npz(path: str | os.PathLike[str] | BinaryIO, arrays: dict[str, np.ndar
             info.create_system = 3  # unix, whatever the writing platform
             info.external_attr = 0o644 << 16
             with zf.open(info, "w", force_zip64=True) as out:
-                np.lib.format.write_array(out, np.asanyarray(array), allow_pickle=False)
+                told = out if progress is None else _Told(out, progress)
+                np.lib.format.write_array(told, np.asanyarray(array), allow_pickle=False)
+
+
+class _Told:
+    """A file being written that tells `progress(n)` of every n bytes written to it."""
+
+    def __init__(self, out: IO[bytes], progress: Callable[[int], object]) -> None:
+        self.out, self.progress = out, progress
+
+    def write(self, data: bytes) -> int:
+        written = self.out.write(data)
+        self.progress(len(data))
+        return written

@@ -351,9 +351,10 @@ def data_problem(
 
 
 def read_take(
-    path: str | Path, max_bytes: int = MAX_TAKE_BYTES
+    path: str | Path, max_bytes: int = MAX_TAKE_BYTES, header_only: bool = False
 ) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
-    """Header and arrays of a take file, checked as described in the module docstring."""
+    """Header and arrays of a take file, checked as described in the module docstring;
+    `header_only`: the checked header and no arrays (nothing past the header is read)."""
     where = Path(path)
     try:
         info = where.stat()
@@ -367,7 +368,7 @@ def read_take(
         raise TakeError(f"{where}: not a take file (not an npz archive)")
     try:
         with zipfile.ZipFile(where) as archive:
-            return _read_archive(archive, max_bytes)
+            return _read_archive(archive, max_bytes, header_only)
     except TakeError as error:
         raise TakeError(f"{where}: {error}") from None
     except (
@@ -384,7 +385,7 @@ def read_take(
 
 
 def _read_archive(
-    archive: zipfile.ZipFile, max_bytes: int
+    archive: zipfile.ZipFile, max_bytes: int, header_only: bool = False
 ) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
     entries = archive.infolist()
     names = [entry.filename for entry in entries]
@@ -407,6 +408,8 @@ def _read_archive(
     problem = header_problem(header)
     if problem:
         raise TakeError(problem)
+    if header_only:
+        return header, {}
     wanted = array_dtypes(header)
     known = {f"{name}.npy" for name in wanted}
     for name in names:

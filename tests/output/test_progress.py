@@ -2,8 +2,14 @@
 
 from __future__ import annotations
 
+import fcntl
 import io
+import os
+import pty
+import struct
+import subprocess
 import sys
+import termios
 from collections.abc import Callable
 from pathlib import Path
 
@@ -62,3 +68,70 @@ def test_long_commands_say_what_they_are_doing_on_a_terminal(
     for doing in ("crowd: making and checking 8 creatures ...", f"validate: checking {out} ...",
                   f"run: building {out} ..."):  # fmt: skip
         assert (doing in shown) == terminal, (doing, shown)
+
+
+def _on_a_terminal(args: list[str], cwd: Path) -> tuple[int, str, str]:
+    """Run `ecs-tentacles ARGS` with stderr on a pseudo-terminal, as from a shell:
+    (exit code, stdout, everything drawn on the terminal)."""
+    main, child = pty.openpty()
+    fcntl.ioctl(child, termios.TIOCSWINSZ, struct.pack("HHHH", 24, 100, 0, 0))  # 100 columns
+    process = subprocess.Popen(
+        [sys.executable, "-m", "ecs_tentacles", *args],
+        cwd=cwd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=child,
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
+    )  # fmt: skip
+    os.close(child)
+    drawn = bytearray()
+    while True:
+        try:
+            piece = os.read(main, 65536)
+        except OSError:  # EIO: the process closed the terminal (it ended)
+            break
+        if not piece:
+            break
+        drawn += piece
+    os.close(main)
+    out, _ = process.communicate(timeout=300)
+    return process.returncode, out.decode(), drawn.decode(errors="replace")
+
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+@pytest.fixture(scope="module")
+def small_take(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    from ecs_tentacles.export.bake import BakePlan, bake
+
+    path = tmp_path_factory.mktemp("take") / "octopus.npz"
+    bake(BakePlan.make("octopus", seconds=0.2, fps=30), progress=False).save(path)
+    return path
+
+
+EXPORT = ["export", "{take}", "--out"]
+BAKE = ["bake", "octopus", "--seconds", "0.2", "--out", "x.npz"]
+
+
+@pytest.mark.parametrize(
+    ("args", "lines"),
+    [
+        ([*EXPORT, "x.glb"], ["export: reading", "write x.glb:", "/1 [", "creature"]),
+        ([*EXPORT, "x.glb", "--rigid"], ["write x.glb:", "/81 [", "body"]),
+        ([*EXPORT, "x.usda"], ["write x.usda:", "/1 [", "creature"]),
+        (BAKE, ["bake: building the world", "/12 [", "bake: gathering 13 frames", "write x.npz:"]),
+    ],
+    ids=["skinned glb", "rigid glb", "skinned usd", "take"],
+)
+def test_writing_shows_a_bar_on_a_terminal_and_nothing_with_quiet(
+    small_take: Path, tmp_path: Path, args: list[str], lines: list[str]
+) -> None:
+    args = [arg.format(take=small_take) for arg in args]
+    code, out, drawn = _on_a_terminal(args, tmp_path)
+    assert code == 0, drawn
+    for line in lines:
+        assert line in drawn, (line, drawn)
+    assert "x." in out  # the summary, on stdout
+    code, out, drawn = _on_a_terminal([*args, "--quiet"], tmp_path)
+    assert code == 0 and not any(line in drawn for line in lines), drawn
+    assert "\r" not in drawn.replace("\r\n", "")  # nothing redrawn: no bar, no status
+    if args[0] == "export":
+        assert drawn == ""
