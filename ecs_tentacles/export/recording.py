@@ -21,6 +21,7 @@ import numpy as np
 from ecs_tentacles.components import Creature, Link, Tentacle, Transform
 from ecs_tentacles.export.track_recording import CurvesTrack, PointsTrack
 from ecs_tentacles.ground import ground_of
+from ecs_tentacles.numeric.rows import run_slice
 from ecs_tentacles.take import FORMAT, VERSION, Take
 from ecs_tentacles.take import ground as take_ground
 from ecs_tentacles.take import roster as take_roster
@@ -160,6 +161,9 @@ class TakeRecorder:
         by_row = sorted(world.query(Creature), key=lambda item: item[1].row)
         for entity, creature in by_row:
             self._add_creature(world, entity, creature)
+        # the bodies as one run of store rows, or None (what a roster change leaves is
+        # gathered row by row: `_changes`)
+        self._span = run_slice(self._rows)
 
     def _add_creature(self, world: World, entity: int, creature: Creature) -> None:
         """Append one creature's bodies and suckers to the take's tables."""
@@ -225,8 +229,9 @@ class TakeRecorder:
             self._grow()
         transforms, suckers = world.transforms, world.suckers
         if not self._changes:  # every body and sucker there, in store order
-            self._pos[i] = transforms.pos[self._rows]
-            self._quat[i] = transforms.quat[self._rows]
+            bodies = self._rows if self._span is None else self._span  # a slice: no gather
+            self._pos[i] = transforms.pos[bodies]
+            self._quat[i] = transforms.quat[bodies]
             self._attached[i] = suckers.attached
             self._anchor[i] = suckers.anchor
         else:

@@ -147,10 +147,10 @@ class CurvesTrack:
         owners = np.asarray(frame.creatures, dtype=np.int64)
         if self._last is None or not np.array_equal(owners, self._last[0]):
             self._last = (owners, self._columns_of(owners.tolist()))  # the curves changed
+            self.recorder.header[key] = {"creatures": list(self._owners)}
         self.columns.append(self._last[1])
         self.points.append(points)
         self.widths.append(np.array(widths))
-        self.recorder.header[key] = {"creatures": list(self._owners)}
 
     def _columns_of(self, creatures: list[int]) -> np.ndarray:
         index, seen = self.recorder.creature_index, dict[int, int]()
