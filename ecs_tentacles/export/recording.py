@@ -21,7 +21,7 @@ import numpy as np
 from ecs_tentacles.components import Creature, Link, Tentacle, Transform
 from ecs_tentacles.export.track_recording import CurvesTrack, PointsTrack
 from ecs_tentacles.ground import ground_of
-from ecs_tentacles.numeric.rows import run_slice
+from ecs_tentacles.numeric.rows import ordinals, run_slice
 from ecs_tentacles.take import FORMAT, VERSION, Take
 from ecs_tentacles.take import ground as take_ground
 from ecs_tentacles.take import roster as take_roster
@@ -159,14 +159,24 @@ class TakeRecorder:
         self._rows = np.zeros(0, dtype=np.int64)  # take body -> Transform row (-1: gone)
         self._sucker_rows = np.zeros(0, dtype=np.int64)  # take sucker -> Sucker row
         by_row = sorted(world.query(Creature), key=lambda item: item[1].row)
-        for entity, creature in by_row:
-            self._add_creature(world, entity, creature)
+        self._add_creatures(world, by_row)
+
+    def _add_creatures(self, world: World, creatures: Sequence[tuple[int, Creature]]) -> None:
+        """Append creatures to the take's tables: each one's mantle, then its links
+        tentacle by tentacle; then their suckers, creature by creature, in store order."""
+        first = len(self._bodies)
+        rows: list[int] = []
+        for entity, creature in creatures:
+            rows += self._add_bodies(world, entity, creature)
+        added = np.asarray(rows, dtype=np.int64)
+        self._rows = np.concatenate([self._rows, added])
         # the bodies as one run of store rows, or None (what a roster change leaves is
         # gathered row by row: `_changes`)
         self._span = run_slice(self._rows)
+        self._add_suckers(world, added, first)
 
-    def _add_creature(self, world: World, entity: int, creature: Creature) -> None:
-        """Append one creature's bodies and suckers to the take's tables."""
+    def _add_bodies(self, world: World, entity: int, creature: Creature) -> list[int]:
+        """Append one creature's bodies to the take's tables; their Transform rows."""
         index = self.creature_index[entity] = len(self._creatures)
         world.kept_names.add(name := creature.name)  # a later spawn of it gets a suffix
         first = len(self._bodies)
@@ -184,18 +194,25 @@ class TakeRecorder:
                 self._bodies.append(_body(body, index, "capsule", "X", link))
             entry["tentacles"].append(chain)
         self._creatures.append(entry)
-        self._rows = np.concatenate([self._rows, rows]).astype(np.int64)
-        body_of_row = {row: first + i for i, row in enumerate(rows)}
+        return rows
+
+    def _add_suckers(self, world: World, rows: np.ndarray, first: int) -> None:
+        """Append the suckers on the take's bodies `first...` (at Transform `rows`):
+        creature by creature, each creature's in store order, named by their body."""
         suckers = world.suckers
-        mine = np.flatnonzero(np.isin(suckers.link_row, rows))
-        seen: dict[int, int] = {}
-        for row in mine.tolist():
-            carrier = body_of_row[int(suckers.link_row[row])]
-            n = seen[carrier] = seen.get(carrier, -1) + 1
-            sucker = f"{self._bodies[carrier]['name']}/sucker{n}"
-            offset = suckers.offset[row].tolist()
-            self._suckers.append({"name": sucker, "body": carrier, "offset": offset})
-        self._sucker_rows = np.concatenate([self._sucker_rows, mine]).astype(np.int64)
+        body_of_row = np.full(len(world.transforms), -1, dtype=np.int64)
+        body_of_row[rows] = np.arange(first, first + len(rows))
+        carrier = body_of_row[suckers.link_row]
+        mine = np.flatnonzero(carrier >= 0)
+        owner = np.array([body["creature"] for body in self._bodies[first:]], dtype=np.int64)
+        mine = mine[np.argsort(owner[carrier[mine] - first], kind="stable")]
+        carriers = carrier[mine]
+        number = ordinals(carriers)  # each sucker's place among its body's
+        offsets = suckers.offset[mine].tolist()
+        for body, n, offset in zip(carriers.tolist(), number.tolist(), offsets, strict=True):
+            name = f"{self._bodies[body]['name']}/sucker{n}"
+            self._suckers.append({"name": name, "body": body, "offset": offset})
+        self._sucker_rows = np.concatenate([self._sucker_rows, mine])
 
     # -- creatures that come and go --------------------------------------------------
     def roster_changed(self, change: RosterChange) -> None:
@@ -212,7 +229,7 @@ class TakeRecorder:
                     rows[live] = moved[rows[live]]
             return
         bodies, suckers = len(self._bodies), len(self._suckers)
-        self._add_creature(world, change.creature, world.component(change.creature, Creature))
+        self._add_creatures(world, [(change.creature, world.component(change.creature, Creature))])
         self._alive = np.append(self._alive, True)
         new_rows = self._rows[bodies:]
         self._pos = _widen(self._pos, world.transforms.pos[new_rows])
@@ -243,6 +260,11 @@ class TakeRecorder:
         for recorder in self.tracks:
             recorder.capture(world)
         self.count += 1
+
+    @property
+    def capacity(self) -> int:
+        """Frames the arrays have room for now (they double when full)."""
+        return len(self._pos)
 
     @property
     def roster_changes(self) -> int:
