@@ -243,7 +243,7 @@ def bake(
         assert isinstance(recording, Recording)  # the record plugin
         world.add_plugin(recording)
         step_frames(world, plan.steps, progress=progress, desc="bake", on_steps=on_steps)
-        return recording.take()
+        return recording.finish()  # the recorder's arrays: the frames are held once
     finally:
         world.close()
 

@@ -43,6 +43,8 @@ class Recording(Protocol):
 
     def take(self) -> Take: ...
 
+    def finish(self) -> Take: ...
+
 
 def plugin_tracks(world: World) -> list[TrackSource]:
     """The take tracks of the world's plugins (`TakeTracks` entries), in plugin order."""
@@ -115,6 +117,7 @@ class TakeRecorder:
         self._visible = np.empty((capacity, len(self._creatures)), np.bool_)
         self._alive = np.ones(len(self._creatures), dtype=bool)
         self._changes = 0  # spawns and despawns while recording
+        self._finished = False  # finish(): the arrays are the take's now
         self.count = 0
         # physics recoveries, marked on the take frame that follows them
         self._health: list[dict[str, Any]] = []
@@ -241,6 +244,8 @@ class TakeRecorder:
 
     def capture(self) -> None:
         """Append the world's current frame."""
+        if self._finished:
+            raise RuntimeError("this recording has finished (TakeRecorder.finish)")
         world, i = self.world, self.count
         if i == len(self._pos):
             self._grow()
@@ -267,6 +272,11 @@ class TakeRecorder:
         return len(self._pos)
 
     @property
+    def finished(self) -> bool:
+        """Whether `finish()` ended the recording."""
+        return self._finished
+
+    @property
     def roster_changes(self) -> int:
         """Spawns and despawns since the recording started."""
         return self._changes
@@ -280,12 +290,23 @@ class TakeRecorder:
 
     def take(self) -> Take:
         """The frames captured so far as a Take (copies; recording may go on)."""
+        return self._take(copy=True)
+
+    def finish(self) -> Take:
+        """The frames captured, ending the recording: the take holds the recorder's own
+        arrays and header, not copies (a bake holds its frames once, not twice; a
+        capacity larger than the frames stays with them). `capture()` fails after."""
+        self._finished = True
+        return self._take(copy=False)
+
+    def _take(self, copy: bool) -> Take:
         n = self.count
+        kept = np.copy if copy else np.asarray  # np.asarray: the array itself
         tracks: dict[str, np.ndarray] = {}
         for recorder in self.tracks:  # first: a curves track may name new owners
-            tracks.update(recorder.arrays(n))
-        tracks.update({name: a.copy() for name, a in self._ground_arrays.items()})
-        header = json.loads(json.dumps(self.header))  # a deep copy
+            tracks.update(recorder.arrays(n, copy))
+        tracks.update({name: kept(a) for name, a in self._ground_arrays.items()})
+        header = json.loads(json.dumps(self.header)) if copy else self.header  # deep copy
         header["frames"] = n
         events = [e for e in self._health if e["frame"] < n]
         header["health"] = {
@@ -295,13 +316,13 @@ class TakeRecorder:
         }
         if self._changes:
             header[take_roster.KEY] = {"changes": self._changes}
-            tracks[take_roster.ARRAY] = self._visible[:n].copy()
+            tracks[take_roster.ARRAY] = kept(self._visible[:n])
         return Take(
             header=header,
-            pos=self._pos[:n].copy(),
-            quat=self._quat[:n].copy(),
-            sucker_attached=self._attached[:n].copy(),
-            sucker_anchor=self._anchor[:n].copy(),
+            pos=kept(self._pos[:n]),
+            quat=kept(self._quat[:n]),
+            sucker_attached=kept(self._attached[:n]),
+            sucker_anchor=kept(self._anchor[:n]),
             tracks=tracks,
         )
 

@@ -88,7 +88,8 @@ class PointsTrack:
         order = np.argsort(every, kind="stable")
         self._keys, self._columns = every[order], columns[order]
 
-    def arrays(self, frames: int) -> dict[str, np.ndarray]:
+    def arrays(self, frames: int, copy: bool = True) -> dict[str, np.ndarray]:
+        """The track's arrays for the first `frames` frames (new arrays either way)."""
         count = len(self.positions)
         live = np.zeros((frames, count), np.bool_)
         for frame, alive in enumerate(self.alive[:frames]):
@@ -207,12 +208,16 @@ class CurvesTrack:
             self._pairs, self._pair_columns = every[order], columns[order]
         return self._pair_columns[np.searchsorted(self._pairs, pairs)]
 
-    def arrays(self, frames: int) -> dict[str, np.ndarray]:
-        """Copies of the track's arrays for the first `frames` frames."""
+    def arrays(self, frames: int, copy: bool = True) -> dict[str, np.ndarray]:
+        """The track's arrays for the first `frames` frames (`copy=False`: views of the
+        recorder's own, for a take that ends the recording)."""
         if self._points is None:
             return {}
         first, second = self.track.arrays
-        return {first: self._points[:frames].copy(), second: self._widths[:frames].copy()}
+        points, widths = self._points[:frames], self._widths[:frames]
+        if copy:
+            points, widths = points.copy(), widths.copy()
+        return {first: points, second: widths}
 
 
 def _resized(array: np.ndarray, frames: int, columns: int) -> np.ndarray:

@@ -23,4 +23,4 @@ def test_bench_record_prints_a_row_per_crowd(
     assert [(row["creatures"], row["bodies"]) for row in rows] == [(1, 81), (2, 162)]
     assert all(row["recorded_frame_calls"] > 0 for row in rows)
     assert all(row["live_frame_ms"] > 0 and row["recorded_frame_ms"] > 0 for row in rows)
-    assert {"take_ms", "frame_mb", "bake_all_s", "bake_recorded_frame_ms"} <= rows[0].keys()
+    assert {"finish_ms", "frame_mb", "bake_all_s", "bake_recorded_frame_ms"} <= rows[0].keys()
