@@ -220,7 +220,10 @@ class TakeRecorder:
     # -- creatures that come and go --------------------------------------------------
     def roster_changed(self, change: RosterChange) -> None:
         """A creature was spawned (its bodies join the take, hidden before now) or
-        despawned (its bodies hold their last pose, hidden from now on)."""
+        despawned (its bodies hold their last pose, hidden from now on). Nothing once the
+        recording has finished: the take holds the recorder's tables."""
+        if self._finished:
+            return
         world = self.world
         self._changes += 1
         if not change.spawned:

@@ -84,7 +84,9 @@ def test_finishing_hands_the_frames_over_and_the_world_steps_on(
     assert take.header["frames"] == 4
     np.testing.assert_array_equal(take.pos, kept.pos)
     assert take.header == kept.header
-    world.step(2)  # the record system records no more
+    world.spawn({"name": "late", "tentacles": {"count": 3}}, position=[9.0, 9.0])
+    world.step(2)  # the record system records no more, the take stays as it was
     assert take.frames == 4 and recorder.count == 4
+    assert take.header == kept.header and len(take.header["creatures"]) == 2
     with pytest.raises(RuntimeError, match="finished"):
         recorder.capture()
