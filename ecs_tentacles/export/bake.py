@@ -279,6 +279,6 @@ def bake(
         world.add_plugin(recording)
         step_frames(world, plan.steps, progress=progress, desc="bake", on_steps=on_steps)
         with status(f"bake: gathering {plan.frames} frames", progress=progress):
-            return recording.take()
+            return recording.finish()  # the recorder's arrays: the frames are held once
     finally:
         world.close()

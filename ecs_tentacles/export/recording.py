@@ -21,6 +21,7 @@ import numpy as np
 from ecs_tentacles.components import Creature, Link, Tentacle, Transform
 from ecs_tentacles.export.track_recording import CurvesTrack, PointsTrack
 from ecs_tentacles.ground import ground_of
+from ecs_tentacles.numeric.rows import ordinals, run_slice
 from ecs_tentacles.take import FORMAT, VERSION, Take
 from ecs_tentacles.take import ground as take_ground
 from ecs_tentacles.take import roster as take_roster
@@ -41,6 +42,8 @@ class Recording(Protocol):
     """What records a world into a take (the record plugin, which bakes add by name)."""
 
     def take(self) -> Take: ...
+
+    def finish(self) -> Take: ...
 
 
 def plugin_tracks(world: World) -> list[TrackSource]:
@@ -114,6 +117,7 @@ class TakeRecorder:
         self._visible = np.empty((capacity, len(self._creatures)), np.bool_)
         self._alive = np.ones(len(self._creatures), dtype=bool)
         self._changes = 0  # spawns and despawns while recording
+        self._finished = False  # finish(): the arrays are the take's now
         self.count = 0
         # physics recoveries, marked on the take frame that follows them
         self._health: list[dict[str, Any]] = []
@@ -158,11 +162,24 @@ class TakeRecorder:
         self._rows = np.zeros(0, dtype=np.int64)  # take body -> Transform row (-1: gone)
         self._sucker_rows = np.zeros(0, dtype=np.int64)  # take sucker -> Sucker row
         by_row = sorted(world.query(Creature), key=lambda item: item[1].row)
-        for entity, creature in by_row:
-            self._add_creature(world, entity, creature)
+        self._add_creatures(world, by_row)
 
-    def _add_creature(self, world: World, entity: int, creature: Creature) -> None:
-        """Append one creature's bodies and suckers to the take's tables."""
+    def _add_creatures(self, world: World, creatures: Sequence[tuple[int, Creature]]) -> None:
+        """Append creatures to the take's tables: each one's mantle, then its links
+        tentacle by tentacle; then their suckers, creature by creature, in store order."""
+        first = len(self._bodies)
+        rows: list[int] = []
+        for entity, creature in creatures:
+            rows += self._add_bodies(world, entity, creature)
+        added = np.asarray(rows, dtype=np.int64)
+        self._rows = np.concatenate([self._rows, added])
+        # the bodies as one run of store rows, or None (what a roster change leaves is
+        # gathered row by row: `_changes`)
+        self._span = run_slice(self._rows)
+        self._add_suckers(world, added, first)
+
+    def _add_bodies(self, world: World, entity: int, creature: Creature) -> list[int]:
+        """Append one creature's bodies to the take's tables; their Transform rows."""
         index = self.creature_index[entity] = len(self._creatures)
         world.kept_names.add(name := creature.name)  # a later spawn of it gets a suffix
         first = len(self._bodies)
@@ -180,23 +197,33 @@ class TakeRecorder:
                 self._bodies.append(_body(body, index, "capsule", "X", link))
             entry["tentacles"].append(chain)
         self._creatures.append(entry)
-        self._rows = np.concatenate([self._rows, rows]).astype(np.int64)
-        body_of_row = {row: first + i for i, row in enumerate(rows)}
+        return rows
+
+    def _add_suckers(self, world: World, rows: np.ndarray, first: int) -> None:
+        """Append the suckers on the take's bodies `first...` (at Transform `rows`):
+        creature by creature, each creature's in store order, named by their body."""
         suckers = world.suckers
-        mine = np.flatnonzero(np.isin(suckers.link_row, rows))
-        seen: dict[int, int] = {}
-        for row in mine.tolist():
-            carrier = body_of_row[int(suckers.link_row[row])]
-            n = seen[carrier] = seen.get(carrier, -1) + 1
-            sucker = f"{self._bodies[carrier]['name']}/sucker{n}"
-            offset = suckers.offset[row].tolist()
-            self._suckers.append({"name": sucker, "body": carrier, "offset": offset})
-        self._sucker_rows = np.concatenate([self._sucker_rows, mine]).astype(np.int64)
+        body_of_row = np.full(len(world.transforms), -1, dtype=np.int64)
+        body_of_row[rows] = np.arange(first, first + len(rows))
+        carrier = body_of_row[suckers.link_row]
+        mine = np.flatnonzero(carrier >= 0)
+        owner = np.array([body["creature"] for body in self._bodies[first:]], dtype=np.int64)
+        mine = mine[np.argsort(owner[carrier[mine] - first], kind="stable")]
+        carriers = carrier[mine]
+        number = ordinals(carriers)  # each sucker's place among its body's
+        offsets = suckers.offset[mine].tolist()
+        for body, n, offset in zip(carriers.tolist(), number.tolist(), offsets, strict=True):
+            name = f"{self._bodies[body]['name']}/sucker{n}"
+            self._suckers.append({"name": name, "body": body, "offset": offset})
+        self._sucker_rows = np.concatenate([self._sucker_rows, mine])
 
     # -- creatures that come and go --------------------------------------------------
     def roster_changed(self, change: RosterChange) -> None:
         """A creature was spawned (its bodies join the take, hidden before now) or
-        despawned (its bodies hold their last pose, hidden from now on)."""
+        despawned (its bodies hold their last pose, hidden from now on). Nothing once the
+        recording has finished: the take holds the recorder's tables."""
+        if self._finished:
+            return
         world = self.world
         self._changes += 1
         if not change.spawned:
@@ -208,7 +235,7 @@ class TakeRecorder:
                     rows[live] = moved[rows[live]]
             return
         bodies, suckers = len(self._bodies), len(self._suckers)
-        self._add_creature(world, change.creature, world.component(change.creature, Creature))
+        self._add_creatures(world, [(change.creature, world.component(change.creature, Creature))])
         self._alive = np.append(self._alive, True)
         new_rows = self._rows[bodies:]
         self._pos = _widen(self._pos, world.transforms.pos[new_rows])
@@ -220,13 +247,16 @@ class TakeRecorder:
 
     def capture(self) -> None:
         """Append the world's current frame."""
+        if self._finished:
+            raise RuntimeError("this recording has finished (TakeRecorder.finish)")
         world, i = self.world, self.count
         if i == len(self._pos):
             self._grow()
         transforms, suckers = world.transforms, world.suckers
         if not self._changes:  # every body and sucker there, in store order
-            self._pos[i] = transforms.pos[self._rows]
-            self._quat[i] = transforms.quat[self._rows]
+            bodies = self._rows if self._span is None else self._span  # a slice: no gather
+            self._pos[i] = transforms.pos[bodies]
+            self._quat[i] = transforms.quat[bodies]
             self._attached[i] = suckers.attached
             self._anchor[i] = suckers.anchor
         else:
@@ -238,6 +268,16 @@ class TakeRecorder:
         for recorder in self.tracks:
             recorder.capture(world)
         self.count += 1
+
+    @property
+    def capacity(self) -> int:
+        """Frames the arrays have room for now (they double when full)."""
+        return len(self._pos)
+
+    @property
+    def finished(self) -> bool:
+        """Whether `finish()` ended the recording."""
+        return self._finished
 
     @property
     def roster_changes(self) -> int:
@@ -253,12 +293,23 @@ class TakeRecorder:
 
     def take(self) -> Take:
         """The frames captured so far as a Take (copies; recording may go on)."""
+        return self._take(copy=True)
+
+    def finish(self) -> Take:
+        """The frames captured, ending the recording: the take holds the recorder's own
+        arrays and header, not copies (a bake holds its frames once, not twice; a
+        capacity larger than the frames stays with them). `capture()` fails after."""
+        self._finished = True
+        return self._take(copy=False)
+
+    def _take(self, copy: bool) -> Take:
         n = self.count
+        kept = np.copy if copy else np.asarray  # np.asarray: the array itself
         tracks: dict[str, np.ndarray] = {}
         for recorder in self.tracks:  # first: a curves track may name new owners
-            tracks.update(recorder.arrays(n))
-        tracks.update({name: a.copy() for name, a in self._ground_arrays.items()})
-        header = json.loads(json.dumps(self.header))  # a deep copy
+            tracks.update(recorder.arrays(n, copy))
+        tracks.update({name: kept(a) for name, a in self._ground_arrays.items()})
+        header = json.loads(json.dumps(self.header)) if copy else self.header  # deep copy
         header["frames"] = n
         events = [e for e in self._health if e["frame"] < n]
         header["health"] = {
@@ -268,13 +319,13 @@ class TakeRecorder:
         }
         if self._changes:
             header[take_roster.KEY] = {"changes": self._changes}
-            tracks[take_roster.ARRAY] = self._visible[:n].copy()
+            tracks[take_roster.ARRAY] = kept(self._visible[:n])
         return Take(
             header=header,
-            pos=self._pos[:n].copy(),
-            quat=self._quat[:n].copy(),
-            sucker_attached=self._attached[:n].copy(),
-            sucker_anchor=self._anchor[:n].copy(),
+            pos=kept(self._pos[:n]),
+            quat=kept(self._quat[:n]),
+            sucker_attached=kept(self._attached[:n]),
+            sucker_anchor=kept(self._anchor[:n]),
             tracks=tracks,
         )
 

@@ -10,6 +10,8 @@ from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
+from ecs_tentacles.numeric.rows import ordinals
+
 if TYPE_CHECKING:
     from ecs_tentacles.take.registries import CurvesFrame, PointsFrame
     from ecs_tentacles.take.tracks import TakeTrack
@@ -22,6 +24,9 @@ class Recorder(Protocol):
     header: dict[str, Any]
     creature_index: dict[int, int]  # creature entity -> its index in the take
     count: int  # frames captured so far
+
+    @property
+    def capacity(self) -> int: ...  # frames the recorder has room for now
 
     @property
     def roster_changes(self) -> int: ...
@@ -83,7 +88,8 @@ class PointsTrack:
         order = np.argsort(every, kind="stable")
         self._keys, self._columns = every[order], columns[order]
 
-    def arrays(self, frames: int) -> dict[str, np.ndarray]:
+    def arrays(self, frames: int, copy: bool = True) -> dict[str, np.ndarray]:
+        """The track's arrays for the first `frames` frames (new arrays either way)."""
         count = len(self.positions)
         live = np.zeros((frames, count), np.bool_)
         for frame, alive in enumerate(self.alive[:frames]):
@@ -93,6 +99,7 @@ class PointsTrack:
 
 
 _NONE = np.zeros(0, dtype=np.int64)
+_PAIR = 2**32  # an owner entity and its k-th curve as one number: entity * _PAIR + k
 
 
 def _found(known: np.ndarray, keys: np.ndarray) -> np.ndarray:
@@ -109,86 +116,113 @@ class CurvesTrack:
     first shape before) or hold their last shape after; points per curve never change.
     A track first sampled after frame 0 (the first furred creature spawned then) holds
     its first shapes before.
+
+    Frames go into preallocated (frames, columns, points) arrays: a frame whose curves
+    are every column in order is one copy of the sample (which may be a view of the
+    plugin's buffers); after a creature came or went, one copy of the frame before and
+    one scatter. Columns are mapped to curves again only when the owners change.
     """
 
     def __init__(self, track: TakeTrack, sample: Any, recorder: Recorder):
         self.track, self.sample, self.recorder = track, sample, recorder
-        self.points: list[np.ndarray] = []
-        self.widths: list[np.ndarray] = []
-        self.columns: list[np.ndarray] = []  # per frame: the column of each curve sampled
-        self._column: dict[tuple[int, int], int] = {}  # (owner entity, k-th) -> column
+        self._points: np.ndarray | None = None  # (capacity, columns, points, 3) float32
+        self._widths = np.zeros((0, 0, 0), np.float32)  # (capacity, columns, points)
+        self._pairs = np.zeros(0, dtype=np.int64)  # every (owner entity, k-th) seen, sorted ...
+        self._pair_columns = np.zeros(0, dtype=np.int64)  # ... and its column
         self._owners: list[int] = []  # per column: the take's creature index (-1: none)
         self.start = 0  # the take frame of the first sample
-        self._last: tuple[np.ndarray, np.ndarray] | None = None  # owners and their columns
+        self._first_shape: tuple[int, ...] = ()  # of the first sample
+        # owners at the last change, their columns, and whether those are every column
+        self._last: tuple[np.ndarray, np.ndarray, bool] | None = None
 
     def capture(self, world: World) -> None:
         frame: CurvesFrame | None = self.sample(world) if self.sample else None
-        key = self.track.key
+        key, f = self.track.key, self.recorder.count
         if frame is None:
-            if not self.points:
+            if self._points is None:
                 return
             if not self.recorder.roster_changes:
                 raise ValueError(f"take track {key!r} disappeared during the recording")
-            shape = self.points[0].shape  # its creatures were despawned: every curve holds
-            self.columns.append(np.zeros(0, dtype=np.int64))
-            self.points.append(np.zeros((0, *shape[1:]), np.float32))
-            self.widths.append(np.zeros((0, shape[1]), np.float32))
+            self._room(f)  # its creatures were despawned: every curve holds
+            self._points[f], self._widths[f] = self._points[f - 1], self._widths[f - 1]
             return
         points = np.asarray(frame.points, dtype=np.float32)
         widths = np.broadcast_to(np.asarray(frame.widths, dtype=np.float32), points.shape[:2])
         if points.ndim != 3 or points.shape[2] != 3:
             raise ValueError(f"{key} points must be (curves, points, 3), got {points.shape}")
-        if (self.points and points.shape[2:] != self.points[0].shape[2:]) or (
-            self.points and points.shape[1] != self.points[0].shape[1]
-        ):
-            raise ValueError(f"{key} changed shape: {self.points[0].shape} -> {points.shape}")
-        if not self.points:
-            self.start = self.recorder.count
+        if self._points is not None and points.shape[1] != self._first_shape[1]:
+            raise ValueError(f"{key} changed shape: {self._first_shape} -> {points.shape}")
         owners = np.asarray(frame.creatures, dtype=np.int64)
+        known = len(self._owners)
         if self._last is None or not np.array_equal(owners, self._last[0]):
-            self._last = (owners, self._columns_of(owners.tolist()))  # the curves changed
-        self.columns.append(self._last[1])
-        self.points.append(points)
-        self.widths.append(np.array(widths))
-        self.recorder.header[key] = {"creatures": list(self._owners)}
+            columns = self._columns_of(owners)  # the curves changed
+            whole = len(columns) == len(self._owners) and bool(
+                np.array_equal(columns, np.arange(len(columns)))
+            )
+            self._last = (owners, columns, whole)
+            self.recorder.header[key] = {"creatures": list(self._owners)}
+        _, columns, whole = self._last
+        if self._points is None:
+            self.start, self._first_shape = f, points.shape
+        self._room(f)
+        assert self._points is not None
+        if len(self._owners) > known:  # new curves: their first shape up to now
+            new = np.flatnonzero(columns >= known)
+            self._points[: f + 1, columns[new]] = points[new]
+            self._widths[: f + 1, columns[new]] = widths[new]
+        if whole:
+            self._points[f], self._widths[f] = points, widths
+        else:  # curves not sampled now hold their last shape
+            self._points[f], self._widths[f] = self._points[f - 1], self._widths[f - 1]
+            self._points[f, columns], self._widths[f, columns] = points, widths
 
-    def _columns_of(self, creatures: list[int]) -> np.ndarray:
-        index, seen = self.recorder.creature_index, dict[int, int]()
-        out = np.empty(len(creatures), dtype=np.int64)
-        for i, entity in enumerate(creatures):
-            k = seen[entity] = seen.get(entity, -1) + 1
-            column = self._column.get((entity, k))
-            if column is None:
-                column = self._column[entity, k] = len(self._owners)
-                self._owners.append(index.get(entity, -1))
-            out[i] = column
-        return out
+    def _room(self, f: int) -> None:
+        """Make the arrays hold frame `f` and every column."""
+        count, size = len(self._owners), self._first_shape[1]
+        if self._points is None:
+            frames = max(self.recorder.capacity, f + 1)
+            self._points = np.empty((frames, count, size, 3), np.float32)
+            self._widths = np.empty((frames, count, size), np.float32)
+            return
+        frames = len(self._points)
+        if f >= frames:
+            frames = max(2 * frames, f + 1)
+        if frames > len(self._points) or count > self._points.shape[1]:
+            self._points = _resized(self._points, frames, count)
+            self._widths = _resized(self._widths, frames, count)
 
-    def arrays(self, frames: int) -> dict[str, np.ndarray]:
-        if not self.points:
+    def _columns_of(self, creatures: np.ndarray) -> np.ndarray:
+        """Each curve's column: the k-th curve of a creature keeps its column, curves not
+        seen before take the next ones in order (array work; Python only per new owner)."""
+        pairs = creatures * _PAIR + ordinals(creatures)  # (entity, k-th) as one number
+        new = np.flatnonzero(~_found(self._pairs, pairs))
+        if len(new):
+            index = self.recorder.creature_index
+            entities, which = np.unique(creatures[new], return_inverse=True)
+            owners = np.array([index.get(e, -1) for e in entities.tolist()], dtype=np.int64)
+            first = len(self._owners)
+            self._owners += owners[which].tolist()
+            every = np.concatenate([self._pairs, pairs[new]])
+            columns = np.concatenate([self._pair_columns, np.arange(first, len(self._owners))])
+            order = np.argsort(every, kind="stable")
+            self._pairs, self._pair_columns = every[order], columns[order]
+        return self._pair_columns[np.searchsorted(self._pairs, pairs)]
+
+    def arrays(self, frames: int, copy: bool = True) -> dict[str, np.ndarray]:
+        """The track's arrays for the first `frames` frames (`copy=False`: views of the
+        recorder's own, for a take that ends the recording)."""
+        if self._points is None:
             return {}
         first, second = self.track.arrays
-        count, start = len(self._owners), self.start
-        sampled = range(max(0, min(frames - start, len(self.columns))))
-        if start == 0 and all(
-            len(self.columns[s]) == count and (self.columns[s] == np.arange(count)).all()
-            for s in sampled
-        ):
-            return {first: np.stack(self.points[:frames]), second: np.stack(self.widths[:frames])}
-        size = self.points[0].shape[1]
-        points = np.empty((frames, count, size, 3), np.float32)
-        widths = np.empty((frames, count, size), np.float32)
-        seen = np.zeros(count, dtype=bool)  # before a curve's first sample: its first shape
-        for s in range(len(self.columns)):
-            fresh = ~seen[self.columns[s]]
-            columns = self.columns[s][fresh]
-            points[0, columns], widths[0, columns] = self.points[s][fresh], self.widths[s][fresh]
-            seen[columns] = True
-        for f in range(frames):
-            if f:  # curves not sampled now hold their last shape
-                points[f], widths[f] = points[f - 1], widths[f - 1]
-            if f - start in sampled:
-                s = f - start
-                points[f, self.columns[s]] = self.points[s]
-                widths[f, self.columns[s]] = self.widths[s]
+        points, widths = self._points[:frames], self._widths[:frames]
+        if copy:
+            points, widths = points.copy(), widths.copy()
         return {first: points, second: widths}
+
+
+def _resized(array: np.ndarray, frames: int, columns: int) -> np.ndarray:
+    """`array` (frames, columns, ...) in a new one of `frames` frames and `columns`
+    columns, what it held kept in place (the rest to be written)."""
+    grown = np.empty((frames, columns, *array.shape[2:]), array.dtype)
+    grown[: len(array), : array.shape[1]] = array
+    return grown

@@ -147,16 +147,14 @@ def control_markers(world: Host, creature: int | None = None) -> list[ControlMar
 def take_guides(world: Host) -> CurvesFrame | None:
     """The world's fur guide curves as the rig posed them, or None without fur.
 
-    The fur plugin's take track (`ecs_tentacles.fur.outputs`): world polylines and
-    root widths (kept along each guide, `ecs_tentacles.fur.hooks.guide_curves`);
-    owners from the guides' fur sets.
+    The fur plugin's take track (`ecs_tentacles.fur.outputs`): world polylines (a view
+    of the rig's output, which the recorder copies) and root widths (kept along each
+    guide, as `guide_curves` gives them); owners from the guides' fur sets.
     """
     fur = world.get_resource(FurData)
-    if fur is None:
+    if fur is None or not len(fur.guides):
         return None
-    curves = guide_curves(world)
-    if len(curves.points) == 0:
-        return None
-    owners = np.asarray(fur.sets.creature)[np.asarray(fur.guides.fur_row)]
-    widths = np.repeat(np.asarray(curves.width)[:, None], curves.points.shape[1], axis=1)
-    return CurvesFrame(points=curves.points, widths=widths, creatures=owners)
+    rows = np.asarray(fur.guides.fur_row)
+    widths = fur.sets.width[rows].astype(np.float32)[:, None]  # the same along a guide
+    owners = np.asarray(fur.sets.creature)[rows]
+    return CurvesFrame(points=fur.curves[: len(rows)], widths=widths, creatures=owners)

@@ -3,7 +3,7 @@
     record = RecordPlugin(every=2)        # a 30 fps take of a 60 fps world
     world.add_plugin(record)
     world.step(120)
-    take = record.take()
+    take = record.take()                  # a copy; record.finish(): for good, no copy
 
 Systems: record (stage output), which captures the frame after everything else ran.
 """
@@ -31,5 +31,10 @@ class RecordPlugin(Plugin):
         return [self.system]
 
     def take(self) -> Take:
-        """The frames recorded so far."""
+        """The frames recorded so far (copies; recording may go on)."""
         return self.system.take()
+
+    def finish(self) -> Take:
+        """The frames recorded, ending the recording (the take holds the recorder's
+        arrays: no copies)."""
+        return self.system.finish()

@@ -26,8 +26,10 @@ if TYPE_CHECKING:
 @dataclass(frozen=True)
 class CurvesFrame:
     """A curves track at one frame (`TrackSource.sample`; the fur guides):
-    `points` (curves, points, 3) world metres, `widths` (curves, points) metres,
-    `creatures` (curves,) owning creature entities."""
+    `points` (curves, points, 3) world metres, `widths` (curves, points) metres (or any
+    shape that broadcasts to it: (curves, 1) for one width along each curve),
+    `creatures` (curves,) owning creature entities. The recorder copies what it keeps:
+    they may be views of the plugin's own buffers."""
 
     points: Any
     widths: Any

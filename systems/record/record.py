@@ -27,7 +27,7 @@ if TYPE_CHECKING:
 
 
 class Record(System):
-    """Record the world into a take; `record.take()` returns it."""
+    """Record the world into a take; `record.take()` returns it (`finish()`: for good)."""
 
     name = "record"
     calls_hooks = True  # the plugins' TakeTracks entries
@@ -59,11 +59,21 @@ class Record(System):
             self.recorder.roster_changed(change)
 
     def process(self, world: Host, dt: float) -> None:
-        if (world.frame + 1 - self._start) % self.every == 0 and self.recorder is not None:
-            self.recorder.capture()
+        recorder = self.recorder
+        if recorder is None or recorder.finished:  # finish(): the world may step on
+            return
+        if (world.frame + 1 - self._start) % self.every == 0:
+            recorder.capture()
 
     def take(self) -> Take:
-        """The frames recorded so far."""
+        """The frames recorded so far (copies; recording may go on)."""
+        return self._recorder().take()
+
+    def finish(self) -> Take:
+        """The frames recorded, ending the recording (no copies: `TakeRecorder.finish`)."""
+        return self._recorder().finish()
+
+    def _recorder(self) -> TakeRecorder:
         if self.recorder is None:
             raise RuntimeError("the record system has not joined a world yet")
-        return self.recorder.take()
+        return self.recorder
