@@ -13,7 +13,6 @@ roots at an equal distance, to the last bit) takes every root within that distan
 from __future__ import annotations
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 CHUNK = 65_536  # points queried at once: under 1 KB each of temporaries
 SPARE = 2  # distinct roots asked of the tree beyond `k`: room for near ties
@@ -36,6 +35,8 @@ def nearest(points: np.ndarray, roots: np.ndarray, k: int) -> tuple[np.ndarray, 
     for j in range(k):
         has = count > j
         members[has, j] = order[start[has] + j]
+    from scipy.spatial import cKDTree  # here: scipy.spatial costs 0.25 s to import
+
     tree = cKDTree(spots)
     asked = min(k + SPARE, len(spots))
     rows = np.empty((len(points), k), np.int64)

@@ -33,7 +33,6 @@ from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 
 from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.ground import ground_of
@@ -207,6 +206,8 @@ def formation_goals(
     if len(made) < wanted:
         raise ValueError(f"no room for a {shape} of {wanted} creatures around {centre.tolist()}")
     cost = np.linalg.norm(where[:, None, :] - made[None, :, :], axis=2)
+    from scipy.optimize import linear_sum_assignment  # here: a slow import
+
     rows, columns = linear_sum_assignment(cost)
     out = np.empty((wanted, 2))
     out[rows] = made[columns]

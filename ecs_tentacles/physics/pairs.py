@@ -19,7 +19,6 @@ comparison are not cached (it is cheap, and it stays the one code path they take
 from __future__ import annotations
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from ecs_tentacles.numeric.optional_kernels import OptionalKernels
 
@@ -85,6 +84,8 @@ def near_pairs(
     the candidates (linear in creatures, not quadratic) and keep the same test."""
     n = len(centre)
     if n > DENSE_PAIRS:
+        from scipy.spatial import cKDTree  # here: scipy.spatial costs 0.25 s to import
+
         tree = cKDTree(centre)
         i, j = tree.query_pairs(2.0 * float(radius.max()) + margin, output_type="ndarray").T
         keep = spheres_within(centre, radius, i, j, margin)

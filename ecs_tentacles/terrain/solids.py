@@ -17,7 +17,6 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from ecs_tentacles.terrain.heightfield import Heightfield
 from ecs_tentacles.terrain.heights import Problem, TerrainError
@@ -87,6 +86,8 @@ def _solid(
     shape = obstacle["shape"]
     position = np.asarray(obstacle["position"], dtype=np.float64)
     angles = obstacle.get("rotation_deg", [0.0, 0.0, 0.0])
+    from scipy.spatial.transform import Rotation  # here: a slow import
+
     rotation = Rotation.from_euler("xyz", angles, degrees=True).as_matrix()
     if shape == "box":
         return Solid("box", position, rotation, tuple(0.5 * float(v) for v in obstacle["size"]))
