@@ -9,8 +9,10 @@ creatures on rocky ground (`tools/bench_sandbox.py`, 2 cores): 35 ms a physics f
 with BLAS on two threads, 27-30 ms with one.
 
 `quiet_blas()` (called when a world steps on more than one thread) limits BLAS to one
-thread for the process, once, unless the user chose for themselves with
-`OPENBLAS_NUM_THREADS`, `OMP_NUM_THREADS` or `MKL_NUM_THREADS`.
+thread for the process, unless the user chose for themselves with
+`OPENBLAS_NUM_THREADS`, `OMP_NUM_THREADS` or `MKL_NUM_THREADS`. Each call limits every
+BLAS loaded by then: scipy, imported where it is used, brings its own OpenBLAS, which a
+world built after it finds and limits too (no frame calls scipy's BLAS).
 """
 
 from __future__ import annotations
@@ -20,15 +22,11 @@ import os
 from threadpoolctl import threadpool_limits
 
 CHOSEN_BY_USER = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
-_quieted = False
 
 
 def quiet_blas() -> bool:
-    """Limit BLAS to one thread (once per process); False if the user chose a number."""
-    global _quieted
+    """Limit every BLAS loaded so far to one thread; False if the user chose a number."""
     if any(name in os.environ for name in CHOSEN_BY_USER):
         return False
-    if not _quieted:
-        threadpool_limits(limits=1, user_api="blas")
-        _quieted = True
+    threadpool_limits(limits=1, user_api="blas")
     return True
