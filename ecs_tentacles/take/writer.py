@@ -36,12 +36,14 @@ class TakeWriter:
         path: str | os.PathLike[str],
         chunk_frames: int | None = None,
         progress: Callable[[int], object] | None = None,
+        quantised: dict[str, float] | None = None,
     ) -> None:
         if chunk_frames is not None and chunk_frames < 1:
             raise ValueError(f"chunk_frames must be >= 1, got {chunk_frames}")
         self.path = path
         self.chunk_frames = chunk_frames
         self.progress = progress
+        self.quantised = dict(quantised or {})  # array name -> step (`chunks.quantise`)
         self.frames = 0  # frames given so far
         self.stored = 0  # bytes stored so far (before compression)
         self._pending: dict[str, list[np.ndarray]] = {}
@@ -107,18 +109,23 @@ class TakeWriter:
             widest = max(p.shape[1] for p in parts) if parts[0].ndim > 1 else None
             if widest is not None:  # a creature came within the chunk: later frames are wider
                 parts = [_pad_to_later(p, parts, widest) for p in parts]
-            self._entry(chunks.entry_name(name, self._chunk), np.concatenate(parts))
+            joined = np.concatenate(parts)
+            step = self.quantised.get(name)
+            stored = joined if step is None else chunks.quantise(joined, step)
+            self._entry(chunks.entry_name(name, self._chunk), stored, joined.nbytes)
         self._pending = {}
         self._pending_frames = 0
         self._chunk += 1
 
-    def _entry(self, name: str, array: np.ndarray) -> None:
+    def _entry(self, name: str, array: np.ndarray, counted: int | None = None) -> None:
+        """Store `array` as entry `name`; `counted`: the bytes it stands for (progress)."""
         assert self._archive is not None, "TakeWriter is used in a with block"
         data = chunks.npy_bytes(array)
         chunks.add_entry(self._archive, name, data)
-        self.stored += array.nbytes
+        told = array.nbytes if counted is None else counted
+        self.stored += told
         if self.progress is not None:
-            self.progress(array.nbytes)
+            self.progress(told)
 
     def discard(self) -> None:
         """Keep nothing: the temporary file is removed when the block ends."""
@@ -134,6 +141,8 @@ class TakeWriter:
             self._entry(f"{name}.npy", array)
         header = {**header, "version": VERSION, "frames": self.frames,
                   "chunk_frames": self.chunk_frames}  # fmt: skip
+        if self.quantised:
+            header["quantised"] = dict(self.quantised)
         text = json.dumps(header, sort_keys=True, separators=(",", ":"))
         self._entry("header.npy", np.frombuffer(text.encode(), dtype=np.uint8))
         self._finished = True
