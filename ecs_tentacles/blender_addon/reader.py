@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import stat
 import zipfile
 import zlib
@@ -43,6 +44,7 @@ MAX_CHUNK_BYTES = 2 * 1024**3  # what one entry of a version 2 take may decode t
 BLOCK_BYTES = 64 * 1024**2  # a version 1 array is read about this much at a time
 MAX_COORDINATE = 1e6  # metres: farther out is a blow-up, not a creature
 KINDS = 2  # replay kinds: 0 idle, 1 crawl
+NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")  # a creature's name, as the take's header checks it
 FLOATS = (np.dtype("<f4"), np.dtype("<f8"))
 # arrays with a frames axis: name -> (dtypes accepted, the shape after the frames axis
 # as a function of (bodies, creatures))
@@ -213,7 +215,7 @@ class TakeFile:
             if not isinstance(entry, dict):
                 raise TakeFileError(f"{where}: not an object")
             name = entry.get("name")
-            if not isinstance(name, str) or not name.isidentifier() or name in names:
+            if not isinstance(name, str) or not NAME.fullmatch(name) or name in names:
                 raise TakeFileError(f"{where}.name: must be a unique identifier, got {name!r}")
             names.add(name)
             chains = entry.get("tentacles")
@@ -304,10 +306,8 @@ class TakeFile:
             return
         handles = {n: self._stream(n) for n in names}
         try:
-            width = max(
-                1, max(math.prod(shape) * dtype.itemsize for _, shape, dtype in handles.values())
-            )
-            rows = max(1, BLOCK_BYTES // width)
+            width = sum(math.prod(shape) * dtype.itemsize for _, shape, dtype in handles.values())
+            rows = max(1, BLOCK_BYTES // max(1, width))
             for first in range(0, self.frames, rows):
                 count = min(rows, self.frames - first)
                 yield first, {n: _rows(n, *handles[n], count) for n in names}
@@ -410,7 +410,7 @@ def value_problem(name: str, array: np.ndarray, first: int = 0) -> str | None:
     if not bad.any():
         return None
     where = np.argwhere(bad)[0]
-    value = array[tuple(where)]
+    value = float(array[tuple(where)])
     where[0] += first
     at = tuple(where.tolist())
     return f"{name}: {value!r} at {at} is not a finite number within {MAX_COORDINATE:g} m"
