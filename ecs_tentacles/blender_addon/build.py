@@ -29,7 +29,7 @@ import bpy
 import numpy as np
 
 from . import keys, rig
-from .motion import Plan, Segment, clip_keys, continuous, rate_or_one, segments
+from .motion import CLIP_KEYS, Plan, Segment, clip_keys, continuous, rate_or_one, segments
 from .reader import TakeFile, TakeFileError
 from .stream import Group, Report, kinds, plans_of, read_motion, replay_arrays
 
@@ -133,14 +133,13 @@ def _clip_actions(
         for k in used:
             start = 0 if k == 0 else clip.frames[0]
             try:
-                rotation, location = clip_keys(
-                    plan, offsets[plan], poses, slice(start, start + clip.frames[k])
-                )
+                rows = slice(start, start + clip.frames[k])
+                rotation, location = clip_keys(plan, offsets[plan], poses, rows, CLIP_KEYS)
             except ValueError as error:
                 raise TakeFileError(f"{take.path}: replay_clip.{i}: {error}") from None
             action, _, channels = keys.new_action(f"clip{i}_{KIND_NAMES[k]}")
-            keys.bone_curves(channels, plan.names, np.arange(clip.frames[k] + 1.0), rotation,
-                             location, cyclic=True)  # fmt: skip
+            keys.bone_curves(channels, plan.names, np.arange(len(rotation), dtype=np.float64),
+                             rotation, location, cyclic=True)  # fmt: skip
             actions[(i, k)] = action
     return actions
 
@@ -178,10 +177,10 @@ def _clip_strips(
     for s, stretch in enumerate(stretches):
         action = clips[(index, stretch.kind)]
         length = stretch.end - stretch.first - GAP
-        span = (stretch.phase, stretch.phase + length * stretch.rate)
+        span = (stretch.phase * CLIP_KEYS, (stretch.phase + length * stretch.rate) * CLIP_KEYS)
         follows = s + 1 < len(stretches) and stretches[s + 1].first == stretch.end
-        keys.strip(track, f"{action.name}.{s}", action, stretch.first, span, stretch.rate,
-                   hold=follows)  # fmt: skip
+        keys.strip(track, f"{action.name}.{s}", action, stretch.first, span,
+                   stretch.rate * CLIP_KEYS, hold=follows)  # fmt: skip
     return len(stretches)
 
 

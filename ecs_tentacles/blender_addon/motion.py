@@ -30,6 +30,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 EPSILON = 1e-6  # clip frames: two phase steps that differ by less are the same rate
+# a shared clip action's keys per clip frame (`clip_keys`): action frame = phase * this
+CLIP_KEYS = 4
+# an NLA strip's scale (take frames per action frame: 1 / (rate * CLIP_KEYS)) is 0.0001
+# to 1000 in Blender
+MIN_RATE, MAX_RATE = 0.001 / CLIP_KEYS, 10000.0 / CLIP_KEYS
 
 
 def multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -244,24 +249,42 @@ def segments(
     return out
 
 
-# an NLA strip's scale (take frames per action frame) is 0.0001 to 1000 in Blender
-MIN_RATE, MAX_RATE = 0.001, 10000.0
-
-
 def rate_or_one(rate: float) -> float:
     """`rate` if an NLA strip can play it, else 1 (a one-frame strip shows its pose at
     its frame whatever the rate)."""
     return rate if MIN_RATE <= rate <= MAX_RATE else 1.0
 
 
-def clip_keys(
-    plan: Plan, offset: np.ndarray, clip: np.ndarray, rows: slice
-) -> tuple[np.ndarray, np.ndarray]:
-    """Bone keys of one clip kind: `clip[rows]` (F, J, 7: x y z, w x y z in the ground
-    frame) and its first row again (the loop closes), as (F + 1, J, 4) rotations and
-    (F + 1, 3) mantle locations, signs continuous along the loop."""
+def clip_poses(clip: np.ndarray, rows: slice, keys: int) -> np.ndarray:
+    """One clip kind's poses (F * keys + 1, J, 7) at every 1/`keys` of a clip frame round
+    its loop (the last is the first again), interpolated as a take interpolates a
+    replayed creature's bodies between clip frames: positions linearly, rotations
+    normalised-linearly (the next one's sign turned to the first's side)."""
     poses = clip[rows]
-    poses = np.concatenate([poses, poses[:1]])
-    quat = unit(poses[..., 3:], "replay_clip")
-    rotation, location = bases(plan, offset, quat, poses[:, 0, :3])
+    count = len(poses)
+    at = np.arange(count * keys + 1) / keys
+    row = np.floor(at).astype(np.int64)
+    t = (at - row)[:, None, None]
+    first, then = poses[row % count], poses[(row + 1) % count]
+    quat = unit(first[..., 3:], "replay_clip")
+    after = unit(then[..., 3:], "replay_clip")
+    after = np.where(np.einsum("...i,...i->...", quat, after)[..., None] < 0, -after, after)
+    moved = (1 - t) * first[..., :3] + t * then[..., :3]
+    turned = unit((1 - t) * quat + t * after, "replay_clip")
+    return np.concatenate([moved, turned], axis=-1)
+
+
+def clip_keys(
+    plan: Plan, offset: np.ndarray, clip: np.ndarray, rows: slice, keys: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """Bone keys of one clip kind (`clip[rows]`: F, J, 7 of x y z, w x y z in the ground
+    frame): `keys` a clip frame round the loop (`clip_poses`), as (F * keys + 1, J, 4)
+    rotations and (F * keys + 1, 3) mantle locations, signs continuous along the loop.
+
+    Blender interpolates a bone's rotation relative to its parent, the take a body's in
+    the world; keys between the clip's frames keep the two within a fraction of the
+    clip's motion from one of its frames to the next (the error falls with the square
+    of `keys`)."""
+    poses = clip_poses(clip, rows, keys)
+    rotation, location = bases(plan, offset, poses[..., 3:], poses[:, 0, :3])
     return continuous(rotation, axis=0), location
