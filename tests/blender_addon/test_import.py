@@ -5,6 +5,7 @@ them; the scene plays at the take's rate over its range; a bad file is one line.
 from __future__ import annotations
 
 import json
+import subprocess
 from pathlib import Path
 
 import numpy as np
@@ -15,13 +16,12 @@ from ecs_tentacles.creator.crowd import crowd_scene
 from ecs_tentacles.export.materials import take_colours
 from ecs_tentacles.skin.colours import to_linear
 from ecs_tentacles.take import Take
-from tests.blender_addon.conftest import needs_blender, run
+from tests.blender_addon.conftest import BLENDER, needs_blender, run
 from tests.export.broken_takes import BROKEN_TAKES
 
 pytestmark = needs_blender
 
-IMPORT = """
-bpy.ops.import_scene.ecs_tentacles_take(filepath=sys.argv[1])
+READ = """
 scene = bpy.context.scene
 armatures = sorted((o for o in scene.objects if o.type == "ARMATURE"), key=lambda o: o.name)
 joints = {}
@@ -36,7 +36,7 @@ for frame in json.loads(sys.argv[2]):
 def strips(o):
     return {t.name: [[s.action.name, s.frame_start, s.frame_end] for s in t.strips]
             for t in o.animation_data.nla_tracks}
-skins = {o.parent.name: o for o in scene.objects if o.type == "MESH"}
+skins = {o.name: o for o in scene.objects if o.type == "MESH"}
 print(json.dumps({
     "fps": scene.render.fps / scene.render.fps_base,
     "range": [scene.frame_start, scene.frame_end],
@@ -50,12 +50,17 @@ print(json.dumps({
                          list(s.material.node_tree.nodes["Principled BSDF"]
                               .inputs["Base Color"].default_value)[:3]]
                   for name, o in skins.items() for s in o.material_slots},
-    "active": {o.name: o.animation_data.action.name for o in armatures},
+    "active": {o.name: o.animation_data.action and o.animation_data.action.name
+               for o in armatures},
     "tracks": {o.name: strips(o) for o in armatures},
+    "skin_vertices": {name: len(o.data.vertices) for name, o in skins.items()},
     "users": {a.name: a.users for a in bpy.data.actions},
     "vertices": {m.name: len(m.vertices) for m in bpy.data.meshes},
 }))
 """
+IMPORT = "bpy.ops.import_scene.ecs_tentacles_take(filepath=sys.argv[1])" + READ
+OPEN = "bpy.ops.wm.open_mainfile(filepath=sys.argv[1])" + READ
+TOOL = Path(__file__).resolve().parents[2] / "tools" / "blender_import.py"
 
 
 @pytest.fixture(scope="module")
@@ -111,10 +116,10 @@ def test_a_small_crowd_comes_in_sharing_data_per_body_plan_and_every_creature_mo
     assert set(found["armature_data"].values()) == {"plan_skeleton"}
     assert set(found["mesh_data"].values()) == {"plan_skin"}
     assert list(found["vertices"]) == ["plan_skin"] and found["vertices"]["plan_skin"] > 1000
-    assert found["deformed_by"] == {s: [s] for s in skeletons}
+    assert found["deformed_by"] == {f"{n}_skin": [f"{n}_skeleton"] for n in names}
     colours = take_colours(take)
     for name, skeleton in zip(names, skeletons, strict=True):
-        link, material, colour = found["materials"][skeleton]
+        link, material, colour = found["materials"][f"{name}_skin"]
         assert (link, material) == ("OBJECT", f"{name}_material")  # the mesh is shared
         np.testing.assert_allclose(colour, to_linear(colours[name]), atol=1e-6)
         assert found["active"][skeleton] == f"{name}_root"
@@ -150,3 +155,36 @@ def test_a_bad_file_is_one_line_and_makes_nothing(
     }
     assert said.strip() == f"Error: {bad}: {expected[case]}"
     assert found["made"][0] == found["made"][1]
+
+
+def test_the_addon_shows_what_the_usd_import_shows(
+    blender_env: dict[str, str], tmp_path: Path
+) -> None:
+    """thesis_four_by_six through the add-on and through today's USD import
+    (`tools/blender_import.py`): the same armatures, bones and skin vertices, every
+    joint within 1 mm at three frames, the same material colours."""
+    take = tmp_path / "four.npz"
+    argv = ["bake", "thesis_four_by_six", "--seconds", "0.5", "--fps", "30", "--quiet"]
+    assert main([*argv, "--out", str(take)]) == 0
+    usd = tmp_path / "four.usdc"
+    assert main(["export", str(take), "--out", str(usd), "--quiet"]) == 0
+    blend = tmp_path / "four.blend"
+    done = subprocess.run([BLENDER, str(TOOL), str(usd), "--out", str(blend)],
+                          capture_output=True, text=True, timeout=180, check=False)  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    frames = json.dumps([0, 7, 15])
+    through_usd = run(blender_env, OPEN, str(blend), frames)
+    through_addon = run(blender_env, IMPORT, str(take), frames)
+    assert sorted(through_addon["joints"]) == sorted(through_usd["joints"])
+    assert len(through_addon["joints"]) == 4
+    assert through_addon["bones"] == through_usd["bones"]
+    assert through_addon["skin_vertices"] == through_usd["skin_vertices"]
+    for name, joints in through_usd["joints"].items():
+        np.testing.assert_allclose(through_addon["joints"][name], joints, atol=0.001)
+    for name, (_, material, colour) in through_usd["materials"].items():
+        assert through_addon["materials"][name][1] == material
+        np.testing.assert_allclose(through_addon["materials"][name][2], colour, atol=1e-4)
+    assert (through_addon["fps"], through_addon["range"]) == (
+        through_usd["fps"],
+        through_usd["range"],
+    )
