@@ -7,7 +7,7 @@ anything is allocated, and raises `TakeFileError` (one line naming the file and 
 field) for a file that is not a sound take:
 
     with TakeFile(path) as take:
-        take.header, take.frames, take.fps, take.creatures   # checked
+        take.header, take.frames, take.fps, take.creatures   # checked (`header.check`)
         for first, arrays in take.blocks(("pos", "quat")):   # a block of frames at a time
             ...                                              # version 1: BLOCK_BYTES a read
         take.static("replay_clip.0")                          # arrays without a frames axis
@@ -23,28 +23,22 @@ from __future__ import annotations
 
 import json
 import math
-import re
 import stat
 import zipfile
 import zlib
 from collections.abc import Iterator
-from dataclasses import dataclass
 from pathlib import Path
-from typing import IO, Any, TypeGuard
+from typing import IO, Any
 
 import numpy as np
 
-FORMAT = "ecs_tentacles.take"
-VERSIONS = (1, 2)
+from .header import Clip, Creature, TakeFileError, check
+
+__all__ = ["Clip", "Creature", "TakeFile", "TakeFileError", "value_problem"]
 MAX_HEADER_BYTES = 64 * 1024**2
-MAX_FRAMES = 1_000_000
-MAX_BODIES = 16384 * 1025
-MAX_FPS = 1000
 MAX_CHUNK_BYTES = 2 * 1024**3  # what one entry of a version 2 take may decode to
 BLOCK_BYTES = 64 * 1024**2  # a version 1 array is read about this much at a time
 MAX_COORDINATE = 1e6  # metres: farther out is a blow-up, not a creature
-KINDS = 2  # replay kinds: 0 idle, 1 crawl
-NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")  # a creature's name, as the take's header checks it
 FLOATS = (np.dtype("<f4"), np.dtype("<f8"))
 # arrays with a frames axis: name -> (dtypes accepted, the shape after the frames axis
 # as a function of (bodies, creatures))
@@ -57,43 +51,6 @@ PER_FRAME: dict[str, tuple[tuple[np.dtype[Any], ...], Any]] = {
     "replay_xy": ((np.dtype("<f8"),), lambda b, c: (c, 2)),
     "replay_heading": ((np.dtype("<f8"),), lambda b, c: (c,)),
 }
-
-
-class TakeFileError(ValueError):
-    """A take cannot be imported; the message is one line naming the file and the field."""
-
-    def __init__(self, message: str) -> None:
-        super().__init__(" ".join(message.split()))
-
-
-@dataclass(frozen=True)
-class Creature:
-    """One creature as the header lists it: `bodies` its take body indices, mantle first
-    then the links tentacle by tentacle (the joints' order), `links` per tentacle."""
-
-    name: str
-    bodies: np.ndarray
-    links: tuple[int, ...]
-
-
-@dataclass(frozen=True)
-class Clip:
-    """A replay clip (`header.replay.clips[i]`): `bodies` per pose, seconds per clip frame,
-    frames of each kind (idle, crawl)."""
-
-    bodies: int
-    dt: float
-    frames: tuple[int, int]
-
-
-def _number(value: object) -> TypeGuard[int | float]:
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        return False
-    return math.isfinite(value) and abs(value) < 1e300
-
-
-def _whole(value: object) -> TypeGuard[int]:
-    return isinstance(value, int) and not isinstance(value, bool)
 
 
 class TakeFile:
@@ -118,7 +75,7 @@ class TakeFile:
         try:
             self.entries = {entry.filename: entry for entry in self.archive.infolist()}
             self.header = self._header()
-            self._check()
+            checked = check(self.header)
         except TakeFileError as error:
             self.archive.close()
             raise TakeFileError(f"{self.path}: {error}") from None
@@ -127,6 +84,10 @@ class TakeFile:
             raise TakeFileError(
                 f"{self.path}: not a take file ({type(exc).__name__}: {exc})"
             ) from None
+        self.version, self.fps, self.frames = checked.version, checked.fps, checked.frames
+        self.chunk_frames, self.bodies = checked.chunk_frames, checked.bodies
+        self.creatures, self.clips = checked.creatures, checked.clips
+        self.replayed, self.roster = checked.replayed, checked.roster
 
     def __enter__(self) -> TakeFile:
         return self
@@ -156,128 +117,9 @@ class TakeFile:
             header = json.loads(text.decode("utf-8"))
         except (UnicodeDecodeError, ValueError, RecursionError) as exc:
             raise TakeFileError(f"header: not JSON ({str(exc).splitlines()[0]})") from None
-        if not isinstance(header, dict) or header.get("format") != FORMAT:
-            raise TakeFileError(f"header.format: expected {FORMAT!r}")
+        if not isinstance(header, dict):
+            raise TakeFileError("header: not a JSON object")
         return header
-
-    def _check(self) -> None:
-        """Check what the import reads of the header; sets frames, fps, creatures, clips."""
-        header = self.header
-        version = header.get("version")
-        if version not in VERSIONS:
-            raise TakeFileError(
-                f"header.version: this add-on reads versions 1 and 2, got {version!r}"
-            )
-        self.version = int(version)
-        fps = header.get("fps")
-        if not _number(fps) or not 0 < fps <= MAX_FPS:
-            raise TakeFileError(f"header.fps: must be a number in (0, {MAX_FPS}], got {fps!r}")
-        self.fps = float(fps)
-        frames = header.get("frames")
-        if not _whole(frames) or not 1 <= frames <= MAX_FRAMES:
-            raise TakeFileError(
-                f"header.frames: must be a whole number in [1, {MAX_FRAMES}], got {frames!r}"
-            )
-        self.frames = int(frames)
-        self.chunk_frames = self.frames
-        if self.version == 2:
-            chunk = header.get("chunk_frames")
-            if not _whole(chunk) or chunk < 1:
-                raise TakeFileError(
-                    f"header.chunk_frames: must be a whole number >= 1, got {chunk!r}"
-                )
-            self.chunk_frames = int(chunk)
-        bodies = header.get("bodies")
-        if not isinstance(bodies, list) or len(bodies) > MAX_BODIES:
-            raise TakeFileError(f"header.bodies: must be a list of at most {MAX_BODIES}")
-        for b, body in enumerate(bodies):
-            if not isinstance(body, dict) or not all(
-                _number(body.get(k)) and 0 < body[k] <= 1e4 for k in ("radius", "length")
-            ):
-                raise TakeFileError(
-                    f"header.bodies[{b}]: radius and length must be numbers in (0, 10000] m"
-                )
-        self.bodies = len(bodies)
-        self.creatures = self._creatures(header.get("creatures"))
-        self.clips, self.replayed = self._replay(
-            header.get("replay") if self.version == 2 else None
-        )
-        self.roster = header.get("roster") is not None
-
-    def _creatures(self, creatures: object) -> list[Creature]:
-        if not isinstance(creatures, list) or not creatures:
-            raise TakeFileError("header.creatures: must be a non-empty list")
-        used: set[int] = set()
-        names: set[str] = set()
-        out = []
-        for c, entry in enumerate(creatures):
-            where = f"header.creatures[{c}]"
-            if not isinstance(entry, dict):
-                raise TakeFileError(f"{where}: not an object")
-            name = entry.get("name")
-            if not isinstance(name, str) or not NAME.fullmatch(name) or name in names:
-                raise TakeFileError(f"{where}.name: must be a unique identifier, got {name!r}")
-            names.add(name)
-            chains = entry.get("tentacles")
-            if (
-                not isinstance(chains, list)
-                or not chains
-                or not all(isinstance(k, list) and k for k in chains)
-            ):
-                raise TakeFileError(
-                    f"{where}.tentacles: must be a non-empty list of non-empty lists"
-                )
-            indices = [entry.get("mantle"), *(i for chain in chains for i in chain)]
-            for index in indices:
-                if not _whole(index) or not 0 <= index < self.bodies or index in used:
-                    raise TakeFileError(
-                        f"{where}: body index {index!r} is out of range or used twice"
-                    )
-                used.add(index)
-            out.append(Creature(name, np.array(indices, np.int64), tuple(len(k) for k in chains)))
-        return out
-
-    def _replay(self, replay: object) -> tuple[list[Clip], np.ndarray]:
-        """The clips and each creature's clip index (-1: never replayed)."""
-        none = np.full(len(self.creatures), -1, np.int64)
-        if replay is None:
-            return [], none
-        if not isinstance(replay, dict):
-            raise TakeFileError("header.replay: must be null or an object")
-        clips = replay.get("clips")
-        if not isinstance(clips, list):
-            raise TakeFileError("header.replay.clips: must be a list")
-        out = []
-        for i, clip in enumerate(clips):
-            where = f"header.replay.clips[{i}]"
-            if not isinstance(clip, dict):
-                raise TakeFileError(f"{where}: not an object")
-            bodies, dt, frames = clip.get("bodies"), clip.get("dt"), clip.get("frames")
-            if not _whole(bodies) or not 1 <= bodies <= MAX_BODIES:
-                raise TakeFileError(f"{where}.bodies: must be a whole number >= 1, got {bodies!r}")
-            if not _number(dt) or not dt > 0:
-                raise TakeFileError(f"{where}.dt: must be a number > 0, got {dt!r}")
-            if (
-                not isinstance(frames, list)
-                or len(frames) != KINDS
-                or not all(_whole(f) and 1 <= f <= MAX_FRAMES for f in frames)
-            ):
-                raise TakeFileError(f"{where}.frames: must be [idle, crawl] frame counts >= 1")
-            out.append(Clip(int(bodies), float(dt), (int(frames[0]), int(frames[1]))))
-        owners = replay.get("creatures")
-        if not isinstance(owners, list) or len(owners) != len(self.creatures):
-            raise TakeFileError("header.replay.creatures: must hold a clip index per creature")
-        for c, clip in enumerate(owners):
-            if not _whole(clip) or not -1 <= clip < len(out):
-                raise TakeFileError(
-                    f"header.replay.creatures[{c}]: must be a clip index or -1, got {clip!r}"
-                )
-            if clip >= 0 and out[clip].bodies != len(self.creatures[c].bodies):
-                raise TakeFileError(
-                    f"header.replay.creatures[{c}]: clip {clip} poses {out[clip].bodies} bodies,"
-                    f" the creature has {len(self.creatures[c].bodies)}"
-                )
-        return out, np.array(owners, np.int64)
 
     # -- arrays --------------------------------------------------------------------------
     def has(self, name: str) -> bool:
