@@ -4,6 +4,7 @@ creatures move and sit where the take has them.
 
     python tools/bench_blender_addon.py crowd.npz --blender /path/to/python-with-bpy
     python tools/bench_blender_addon.py crowd.npz --sample 32 --json
+    python tools/bench_blender_addon.py shot.npz --usd     # beside today's USD import
 
 The add-on is installed into a fresh Blender user folder (`BLENDER_USER_RESOURCES`), then
 one Blender process imports the take (`bpy.ops.import_scene.ecs_tentacles_take`) and
@@ -11,7 +12,9 @@ reads, for `--sample` creatures spread over the take, their mantles' world posit
 (the depsgraph evaluated) at its first, middle and last frames; the mantles are compared
 with the take's (`ecs_tentacles.take`), and a creature moves when a bone of it moved
 more than 1 cm between the first frame and another. Peak memory is the Blender
-process's own (`wait4`). One JSON line with `--json`.
+process's own (`wait4`). With `--usd` the take also goes today's way (`ecs-tentacles
+export` to .usdc, `tools/blender_import.py`): its figures, and how far the same creatures'
+joints and material colours there are from the add-on's. One JSON line with `--json`.
 """
 
 from __future__ import annotations
@@ -20,6 +23,7 @@ import argparse
 import json
 import os
 import subprocess
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -27,13 +31,7 @@ from typing import Any
 
 import numpy as np
 
-IMPORT = """
-import json, sys, time, bpy
-bpy.ops.wm.read_userpref()
-bpy.ops.wm.read_homefile(use_empty=True)
-start = time.perf_counter()
-bpy.ops.import_scene.ecs_tentacles_take(filepath=sys.argv[1])
-seconds = time.perf_counter() - start
+READ = """
 names, frames = json.loads(sys.argv[2]), json.loads(sys.argv[3])
 scene = bpy.context.scene
 mantles, bones = [], []
@@ -48,9 +46,35 @@ for frame in frames:
         heads.append([list(world @ b.head) for b in posed.pose.bones])
     mantles.append(here)
     bones.append(heads)
+def colour(name):
+    nodes = bpy.data.materials[f"{name}_material"].node_tree.nodes
+    shader = next(n for n in nodes if n.type == "BSDF_PRINCIPLED")
+    return list(shader.inputs["Base Color"].default_value)[:3]
 print(json.dumps({"import_s": seconds, "mantles": mantles, "bones": bones,
+                  "colours": [colour(n) for n in names],
+                  "skeletons": sorted(o.name for o in bpy.data.objects if o.type == "ARMATURE"),
                   "actions": len(bpy.data.actions), "objects": len(bpy.data.objects)}))
 """
+IMPORT = (
+    """
+import json, sys, time, bpy
+bpy.ops.wm.read_userpref()
+bpy.ops.wm.read_homefile(use_empty=True)
+start = time.perf_counter()
+bpy.ops.import_scene.ecs_tentacles_take(filepath=sys.argv[1])
+seconds = time.perf_counter() - start
+"""
+    + READ
+)
+OPEN = (
+    """
+import json, sys, bpy
+bpy.ops.wm.open_mainfile(filepath=sys.argv[1])
+seconds = 0.0
+"""
+    + READ
+)
+TOOL = Path(__file__).resolve().parent / "blender_import.py"
 
 
 def measured(command: list[str], env: dict[str, str]) -> tuple[float, int, str]:
@@ -69,26 +93,23 @@ def measured(command: list[str], env: dict[str, str]) -> tuple[float, int, str]:
     return time.perf_counter() - start, usage.ru_maxrss * 1024, out
 
 
-def reference(take: Path, creatures: list[int], frames: list[int]) -> tuple[list[str], np.ndarray]:
-    """The sampled creatures' names and their mantles' positions (frames, n, 3) in the take."""
-    from ecs_tentacles.take import Take
-
-    loaded = Take.load(take)
-    entries = [loaded.header["creatures"][c] for c in creatures]
-    mantles = [e["mantle"] for e in entries]
-    return [e["name"] for e in entries], loaded.pos[np.ix_(frames, mantles)].astype(np.float64)
-
-
-def bench(take: Path, blender: str, sample: int) -> dict[str, Any]:
-    """Install the add-on, import `take` in Blender; the figures (see the module)."""
-    from ecs_tentacles.cli import main
+def sample(take: Path, count: int) -> tuple[list[int], list[int]]:
+    """`count` creatures spread over the take (indices) and its first, middle and last
+    frames."""
     from ecs_tentacles.take import Take
 
     header = Take.read_header(take)
-    count, frames_in = len(header["creatures"]), int(header["frames"])
-    creatures = sorted({round(i) for i in np.linspace(0, count - 1, min(sample, count))})
-    frames = [0, frames_in // 2, frames_in - 1]
-    names, expected = reference(take, creatures, frames)
+    creatures = len(header["creatures"])
+    chosen = sorted({round(i) for i in np.linspace(0, creatures - 1, min(count, creatures))})
+    frames = int(header["frames"])
+    return chosen, [0, frames // 2, frames - 1]
+
+
+def addon(take: Path, blender: str, names: list[str], frames: list[int]) -> dict[str, Any]:
+    """Install the add-on into a fresh user folder and import `take` with it: what READ
+    found, and the Blender process's wall time and peak memory."""
+    from ecs_tentacles.cli import main
+
     with tempfile.TemporaryDirectory(prefix="bench-blender-addon-") as folder:
         env = {**os.environ, "BLENDER_USER_RESOURCES": folder}
         os.environ["BLENDER_USER_RESOURCES"] = folder
@@ -99,27 +120,78 @@ def bench(take: Path, blender: str, sample: int) -> dict[str, Any]:
             del os.environ["BLENDER_USER_RESOURCES"]
         command = [blender, "-c", IMPORT, str(take), json.dumps(names), json.dumps(frames)]
         wall, peak, out = measured(command, env)
-    found = json.loads(out.splitlines()[-1])
+    found: dict[str, Any] = json.loads(out.splitlines()[-1])
+    return {**found, "blender_s": wall, "peak": peak}
+
+
+def through_usd(take: Path, blender: str, names: list[str], frames: list[int]) -> dict[str, Any]:
+    """The take exported to USD and opened by `tools/blender_import.py` (today's path):
+    what READ found there, the export's and the import's wall time and peak memory."""
+    with tempfile.TemporaryDirectory(prefix="bench-blender-usd-") as folder:
+        usd, blend = Path(folder) / f"{take.stem}.usdc", Path(folder) / f"{take.stem}.blend"
+        export = [sys.executable, "-m", "ecs_tentacles", "export", str(take), "--out", str(usd),
+                  "--quiet"]  # fmt: skip
+        export_s, export_peak, _ = measured(export, dict(os.environ))
+        opened = [blender, str(TOOL), str(usd), "--out", str(blend)]
+        import_s, import_peak, _ = measured(opened, dict(os.environ))
+        command = [blender, "-c", OPEN, str(blend), json.dumps(names), json.dumps(frames)]
+        _, _, out = measured(command, dict(os.environ))
+    found: dict[str, Any] = json.loads(out.splitlines()[-1])
+    return {**found, "export_s": export_s, "export_peak": export_peak, "import_s": import_s,
+            "import_peak": import_peak}  # fmt: skip
+
+
+def by_creature(bones: list[list[list[list[float]]]]) -> list[np.ndarray]:
+    """READ's bone heads (frames, creatures, bones, 3; bones per creature vary with its
+    body plan) as one (frames, bones, 3) array per creature."""
+    return [np.array([frame[c] for frame in bones]) for c in range(len(bones[0]))]
+
+
+def bench(take: Path, blender: str, count: int, usd: bool) -> dict[str, Any]:
+    """The add-on's figures for `take` (see the module); with `usd`, today's USD path's
+    beside them and how far the two imports differ."""
+    from ecs_tentacles.take import Take
+
+    creatures, frames = sample(take, count)
+    loaded = Take.load(take)
+    entries = [loaded.header["creatures"][c] for c in creatures]
+    names = [e["name"] for e in entries]
+    expected = loaded.pos[np.ix_(frames, [e["mantle"] for e in entries])].astype(np.float64)
+    found = addon(take, blender, names, frames)
     mantles = np.array(found["mantles"])
-    bones = np.array(found["bones"])  # (frames, n, J, 3)
-    moved = np.linalg.norm(bones[1:] - bones[:1], axis=-1).max(axis=(0, 2))
-    return {
+    bones = by_creature(found["bones"])  # per creature (frames, J, 3)
+    moved = np.array([np.linalg.norm(b[1:] - b[:1], axis=-1).max() for b in bones])
+    row: dict[str, Any] = {
         "take": take.name,
-        "creatures": count,
-        "frames": frames_in,
-        "fps": header["fps"],
+        "creatures": len(loaded.header["creatures"]),
+        "frames": loaded.frames,
+        "fps": loaded.fps,
         "import_s": round(found["import_s"], 2),
-        "blender_s": round(wall, 2),
-        "blender_peak_gb": round(peak / 1e9, 3),
+        "blender_s": round(found["blender_s"], 2),
+        "blender_peak_gb": round(found["peak"] / 1e9, 3),
         "sampled": len(names),
         "moving": int((moved > 0.01).sum()),
-        "mantle_error_mm": round(
-            1000 * float(np.linalg.norm(mantles - expected, axis=-1).max()), 4
-        ),
+        "mantle_error_mm": float(f"{1000 * np.linalg.norm(mantles - expected, axis=-1).max():.3g}"),
         "actions": found["actions"],
         "objects": found["objects"],
-        "load": [round(x, 2) for x in os.getloadavg()],
     }
+    if usd:
+        other = through_usd(take, blender, names, frames)
+        there = by_creature(other["bones"])
+        apart = max(np.linalg.norm(a - b, axis=-1).max() for a, b in zip(there, bones, strict=True))
+        row["usd"] = {
+            "export_s": round(other["export_s"], 2),
+            "export_peak_gb": round(other["export_peak"] / 1e9, 3),
+            "import_s": round(other["import_s"], 2),
+            "import_peak_gb": round(other["import_peak"] / 1e9, 3),
+            "same_creatures": other["skeletons"] == found["skeletons"],
+            "joints_apart_mm": float(f"{1000 * apart:.3g}"),
+            "colours_apart": float(
+                f"{np.abs(np.subtract(other['colours'], found['colours'])).max():.3g}"
+            ),
+        }
+    row["load"] = [round(x, 2) for x in os.getloadavg()]
+    return row
 
 
 def main() -> None:
@@ -131,9 +203,15 @@ def main() -> None:
         help="Blender or a Python with bpy (default: $ECS_TENTACLES_BLENDER_PYTHON, blender)",
     )
     parser.add_argument("--sample", type=int, default=32, help="creatures checked (default 32)")
+    parser.add_argument(
+        "--usd",
+        action="store_true",
+        help="also export the take to USD and open it with tools/blender_import.py: its"
+        " figures, and how far its creatures' joints and colours are from the add-on's",
+    )
     parser.add_argument("--json", action="store_true", help="one JSON line")
     args = parser.parse_args()
-    row = bench(args.take, args.blender, args.sample)
+    row = bench(args.take, args.blender, args.sample, args.usd)
     if args.json:
         print(json.dumps(row))
         return
@@ -144,6 +222,14 @@ def main() -> None:
         f" creatures move, mantles within {row['mantle_error_mm']} mm of the take;"
         f" load {row['load']}"
     )
+    if "usd" in row:
+        usd = row["usd"]
+        print(
+            f"  through USD: export {usd['export_s']} s ({usd['export_peak_gb']} GB), Blender's"
+            f" import {usd['import_s']} s ({usd['import_peak_gb']} GB); the same creatures:"
+            f" {usd['same_creatures']}, joints {usd['joints_apart_mm']} mm and colours"
+            f" {usd['colours_apart']} apart"
+        )
 
 
 if __name__ == "__main__":
