@@ -10,12 +10,14 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from ecs_tentacles.systems.record.record import Record
 
 from ecs_tentacles.cli import main
 from ecs_tentacles.creator.crowd import crowd_scene
 from ecs_tentacles.export.materials import take_colours
 from ecs_tentacles.skin.colours import to_linear
 from ecs_tentacles.take import Take
+from ecs_tentacles.world import World
 from tests.blender_addon.conftest import BLENDER, needs_blender, run
 from tests.export.broken_takes import BROKEN_TAKES
 
@@ -188,3 +190,43 @@ def test_the_addon_shows_what_the_usd_import_shows(
         through_usd["fps"],
         through_usd["range"],
     )
+
+
+SHOWN = """
+bpy.ops.import_scene.ecs_tentacles_take(filepath=sys.argv[1])
+scene = bpy.context.scene
+shown = {}
+for frame in range(scene.frame_start, scene.frame_end + 1):
+    scene.frame_set(frame)
+    for o in scene.objects:
+        if o.type == "MESH":
+            shown.setdefault(o.name, []).append(not o.hide_render and not o.hide_viewport)
+print(json.dumps(shown))
+"""
+
+
+def test_creatures_that_come_and_go_are_hidden_while_they_are_not_there(
+    blender_env: dict[str, str], tmp_path: Path
+) -> None:
+    """`b` despawned after frame 4, `late` spawned after frame 6: their skins are hidden
+    (viewport and render) exactly while the take says they are not there."""
+
+    def creature(name: str, x: float) -> dict[str, object]:
+        return {"name": name, "position": [x, 0.0], "tentacles": {"count": 3, "links": 3}}
+
+    scene = {"version": 1, "creatures": [creature("a", 0.0), creature("b", 3.0)]}
+    with World.from_scene(scene) as world:
+        record = world.add_system(Record())
+        world.step(4)
+        world.despawn(world.creature("b"))
+        world.step(2)
+        world.spawn(creature("late", 6.0))
+        world.step(5)
+        take = record.take()
+    path = tmp_path / "roster.npz"
+    take.save(path)
+    shown = run(blender_env, SHOWN, str(path))
+    visible = take.visible()
+    assert sorted(shown) == ["a_skin", "b_skin", "late_skin"]
+    for c, name in enumerate(("a", "b", "late")):
+        assert shown[f"{name}_skin"] == visible[:, c].tolist(), name
