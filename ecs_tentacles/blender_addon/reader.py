@@ -37,7 +37,7 @@ from .header import Clip, Creature, TakeFileError, check
 __all__ = ["Clip", "Creature", "TakeFile", "TakeFileError", "value_problem"]
 MAX_HEADER_BYTES = 64 * 1024**2
 MAX_CHUNK_BYTES = 2 * 1024**3  # what one entry of a version 2 take may decode to
-BLOCK_BYTES = 64 * 1024**2  # a version 1 array is read about this much at a time
+BLOCK_BYTES = 16 * 1024**2  # a version 1 take is read about this much at a time
 MAX_COORDINATE = 1e6  # metres: farther out is a blow-up, not a creature
 FLOATS = (np.dtype("<f4"), np.dtype("<f8"))
 # arrays with a frames axis: name -> (dtypes accepted, the shape after the frames axis
