@@ -12,7 +12,8 @@
    its own bone keys (`<c>_pose`, only for creatures simulated at some frame) under a
    `clips` track of strips of the shared clip actions (`clip<i>_<kind>`: one per clip
    and kind, every creature replaying it uses it), one strip per replayed stretch.
-5. The scene takes the take's frame rate and range (frame i of the take is frame i).
+5. The ground's meshes on terrain (`ground`), as the USD import shows them.
+6. The scene takes the take's frame rate and range (frame i of the take is frame i).
 
 `report(fraction, text)` is told of the progress (the operator shows it and prints a
 line per tenth). Anything that fails half-way removes what was made.
@@ -28,7 +29,7 @@ from typing import Any
 import bpy
 import numpy as np
 
-from . import keys, rig
+from . import ground, keys, rig
 from .motion import CLIP_KEYS, Plan, Segment, clip_keys, continuous, rate_or_one, segments
 from .reader import TakeFile, TakeFileError
 from .stream import Group, Report, kinds, plans_of, read_motion, replay_arrays
@@ -60,6 +61,7 @@ _KINDS = ("objects", "meshes", "armatures", "materials", "actions", "collections
 def _import(context: Any, take: TakeFile, report: Report) -> str:
     frames, count = take.frames, len(take.creatures)
     report(0.0, f"{take.path.name}: {count} creatures, {frames} frames")
+    ground.meshes(take.header)  # checked before anything is made
     replay = replay_arrays(take)
     kind = kinds(take, replay)
     plans = plans_of(take)
@@ -95,6 +97,7 @@ def _import(context: Any, take: TakeFile, report: Report) -> str:
             made.keys += _visibility(skin, creature.name, visible[:, c])
         if (c + 1) % max(1, count // 20) == 0:
             report(0.5 + 0.5 * (c + 1) / count, f"creature {c + 1} of {count}")
+    on_ground = ground.make(take, collection)
     _set_rate(context.scene, take.fps)
     context.scene.frame_start, context.scene.frame_end = 0, frames - 1
     report(1.0, "done")
@@ -103,6 +106,7 @@ def _import(context: Any, take: TakeFile, report: Report) -> str:
         f" plan{'s' if len(plans) > 1 else ''}, {frames} frames at {take.fps:g} fps;"
         f" {len(own)} with keys of their own, {len(clips)} shared clip actions in"
         f" {made.strips} strips; {made.keys} keys"
+        + (f"; {on_ground} ground meshes" if on_ground else "")
     )
 
 

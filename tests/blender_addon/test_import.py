@@ -230,3 +230,42 @@ def test_creatures_that_come_and_go_are_hidden_while_they_are_not_there(
     assert sorted(shown) == ["a_skin", "b_skin", "late_skin"]
     for c, name in enumerate(("a", "b", "late")):
         assert shown[f"{name}_skin"] == visible[:, c].tolist(), name
+
+
+GROUND = """
+bpy.ops.import_scene.ecs_tentacles_take(filepath=sys.argv[1])
+def shader(material):
+    return next(n for n in material.node_tree.nodes if n.type == "BSDF_PRINCIPLED")
+print(json.dumps({
+    o.name: {
+        "parent": o.parent and o.parent.name,
+        "vertices": len(o.data.vertices),
+        "triangles": len(o.data.polygons),
+        "materials": [[m.name, list(shader(m).inputs["Base Color"].default_value)[:3]]
+                      for m in o.data.materials],
+    }
+    for o in bpy.context.scene.objects if o.type == "MESH" and not o.name.endswith("_skin")
+}))
+"""
+
+
+def test_the_terrain_comes_in_as_the_usd_import_shows_it(
+    blender_env: dict[str, str], tmp_path: Path
+) -> None:
+    """rocky_shore: the heightfield (`surface`) and the obstacles under `terrain`, each
+    with its mesh and a material of the sandbox's colour."""
+    path = tmp_path / "shore.npz"
+    argv = ["bake", "rocky_shore", "--seconds", "0.2", "--fps", "30", "--quiet"]
+    assert main([*argv, "--out", str(path)]) == 0
+    found = run(blender_env, GROUND, str(path))
+    take = Take.load(path)
+    colours = take.ground_colours()
+    assert sorted(found) == ["obstacles", "surface"]
+    for name, mesh in (("surface", "terrain"), ("obstacles", "obstacles")):
+        entry = next(m for m in take.header["ground"]["meshes"] if m["name"] == mesh)
+        made = found[name]
+        assert made["parent"] == "terrain"
+        assert (made["vertices"], made["triangles"]) == (entry["vertices"], entry["triangles"])
+        ((material, colour),) = made["materials"]
+        assert material == f"{name}_material"
+        np.testing.assert_allclose(colour, to_linear(colours[mesh]), atol=1e-6)

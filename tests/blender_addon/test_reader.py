@@ -4,12 +4,14 @@ file, before it allocates what the file claims."""
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from ecs_tentacles.blender_addon import reader
+from ecs_tentacles.blender_addon.ground import meshes as ground_meshes
 from ecs_tentacles.blender_addon.motion import Plan
 from ecs_tentacles.blender_addon.reader import TakeFile, TakeFileError
 from ecs_tentacles.blender_addon.stream import Group, kinds, plans_of, read_motion, replay_arrays
@@ -98,3 +100,21 @@ def test_a_missing_file_and_a_folder_are_one_line_each(tmp_path: Path) -> None:
     for path, said in ((tmp_path / "none.npz", "no such file"), (tmp_path, "not a regular file")):
         with pytest.raises(TakeFileError, match=f"^{path}: {said}$"):
             TakeFile(path)
+
+
+@pytest.mark.parametrize(
+    ("ground", "said"),
+    [
+        ({"digest": "x", "meshes": []}, "header.ground.meshes: must list 1 to 8 meshes"),
+        ({"digest": "x", "meshes": [{"name": "a b", "vertices": 3, "triangles": 1}]},
+         "header.ground.meshes[0].name: must be a unique identifier, got 'a b'"),
+        ({"digest": "x", "meshes": [{"name": "t", "vertices": 0, "triangles": 1}]},
+         "header.ground.meshes[0]: vertices and triangles must be whole numbers >= 1"),
+        ({"digest": "x", "meshes": [{"name": "t", "vertices": 3, "triangles": 1,
+                                     "rgb": [2, 0, 0]}]},
+         "header.ground.meshes[0].rgb: must be three numbers in [0, 1]"),
+    ],
+)  # fmt: skip
+def test_a_broken_ground_entry_is_one_line(ground: dict[str, object], said: str) -> None:
+    with pytest.raises(TakeFileError, match=f"^{re.escape(said)}$"):
+        ground_meshes({"ground": ground})
