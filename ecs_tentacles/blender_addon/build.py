@@ -133,14 +133,14 @@ def _clip_actions(
         if any(plan_of[int(c)] != plan for c in users):
             raise TakeFileError(f"{take.path}: header.replay.creatures: clip {i} is replayed"
                                 " by creatures of different body plans")  # fmt: skip
-        poses = take.static(f"replay_clip.{i}", (sum(clip.frames), clip.bodies, 7), "<f8")
+        poses = take.static(f"replay_clip_{i}", (sum(clip.frames), clip.bodies, 7), "<f8")
         for k in used:
             start = 0 if k == 0 else clip.frames[0]
             try:
                 rows = slice(start, start + clip.frames[k])
                 rotation, location = clip_keys(plan, offsets[plan], poses, rows, CLIP_KEYS)
             except ValueError as error:
-                raise TakeFileError(f"{take.path}: replay_clip.{i}: {error}") from None
+                raise TakeFileError(f"{take.path}: replay_clip_{i}: {error}") from None
             action, _, channels = keys.new_action(f"clip{i}_{KIND_NAMES[k]}")
             keys.bone_curves(channels, plan.names, np.arange(len(rotation), dtype=np.float64),
                              rotation, location, cyclic=True)  # fmt: skip

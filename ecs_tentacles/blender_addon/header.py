@@ -20,6 +20,9 @@ MAX_FRAMES = 1_000_000
 MAX_BODIES = 16384 * 1025
 MAX_FPS = 1000
 KINDS = 2  # replay kinds: 0 idle, 1 crawl
+# a version 2 take's arrays stored in chunks when its header does not list them
+CHUNKED = ("pos", "quat", "sucker_attached", "sucker_anchor")
+REPLAYED = ("replay_kind", "replay_phase", "replay_xy", "replay_heading")
 NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")  # a creature's name, as the project checks it
 
 
@@ -54,7 +57,8 @@ class Clip:
 class Header:
     """What the import reads of a sound header. `chunk_frames`: frames an entry of a
     version 2 take holds (version 1: all of them); `replayed`: each creature's clip
-    index (-1: never replayed); `roster`: creatures come and go (`creature_visible`)."""
+    index (-1: never replayed); `roster`: creatures come and go (`creature_visible`);
+    `chunked`: the arrays stored in chunks (version 1: none)."""
 
     version: int
     fps: float
@@ -65,6 +69,7 @@ class Header:
     clips: list[Clip]
     replayed: np.ndarray
     roster: bool
+    chunked: tuple[str, ...]
 
 
 def _number(value: object) -> TypeGuard[int | float]:
@@ -109,10 +114,24 @@ def check(header: object) -> Header:
                 f"header.bodies[{b}]: radius and length must be numbers in (0, 10000] m"
             )
     creatures = _creatures(header.get("creatures"), len(bodies))
-    clips, replayed = _replay(header.get("replay") if version == 2 else None, creatures)
+    replay = header.get("replay") if version == 2 else None
+    clips, replayed = _replay(replay, creatures)
     roster = header.get("roster") is not None
+    chunked = _chunked(header.get("chunked"), replay is not None) if version == 2 else ()
     return Header(int(version), float(fps), frames, chunk_frames, len(bodies), creatures, clips,
-                  replayed, roster)  # fmt: skip
+                  replayed, roster, chunked)  # fmt: skip
+
+
+def _chunked(listed: object, replay: bool) -> tuple[str, ...]:
+    """The arrays a version 2 take stores in chunks: `header.chunked`, or without it the
+    bodies, suckers and (with replayed creatures) the replay records."""
+    if listed is None:
+        return CHUNKED + (REPLAYED if replay else ())
+    if not isinstance(listed, list) or not all(isinstance(n, str) for n in listed):
+        raise TakeFileError("header.chunked: must be a list of array names")
+    if not set(CHUNKED[:2]) <= set(listed):
+        raise TakeFileError("header.chunked: must hold pos and quat")
+    return tuple(listed)
 
 
 def _creatures(creatures: object, bodies: int) -> list[Creature]:

@@ -10,13 +10,17 @@ field) for a file that is not a sound take:
         take.header, take.frames, take.fps, take.creatures   # checked (`header.check`)
         for first, arrays in take.blocks(("pos", "quat")):   # a block of frames at a time
             ...                                              # version 1: BLOCK_BYTES a read
-        take.static("replay_clip.0")                          # arrays without a frames axis
+        take.static("replay_clip_0")                          # arrays without a frames axis
         take.per_frame("replay_kind")                         # (frames, creatures) whole
 
-Version 2 stores every array with a frames axis in chunks (`<name>.<k:05d>.npy`, frames
-[k*C, (k+1)*C)); version 1 in one entry (`<name>.npy`), read here a block at a time. Each
-entry's dtype and shape are read from its `.npy` header and compared with what the take's
-header implies, and its stored size with the zip directory's, before its data is read.
+Version 2 stores its big per-frame arrays (`header.chunked`: poses, suckers, replay
+records) in chunks (`<name>.<k:06d>.npy`, frames [k*C, (k+1)*C), C = `chunk_frames`; a
+creature spawned while the bake wrote is missing from the chunks before it came: it gets
+its values at the first frame of the first chunk holding everyone, as the project's
+reader gives it), the others in one entry (`<name>.npy`), as version 1 does every array
+(read here a block of frames at a time). Each entry's dtype and shape are read from its
+`.npy` header and compared with what the take's header implies, and its stored size with
+the zip directory's, before its data is read.
 """
 
 from __future__ import annotations
@@ -39,7 +43,7 @@ MAX_HEADER_BYTES = 64 * 1024**2
 MAX_CHUNK_BYTES = 2 * 1024**3  # what one entry of a version 2 take may decode to
 BLOCK_BYTES = 16 * 1024**2  # a version 1 take is read about this much at a time
 MAX_COORDINATE = 1e6  # metres: farther out is a blow-up, not a creature
-FLOATS = (np.dtype("<f4"), np.dtype("<f8"))
+FLOATS = (np.dtype("<f4"),)
 # arrays with a frames axis: name -> (dtypes accepted, the shape after the frames axis
 # as a function of (bodies, creatures))
 PER_FRAME: dict[str, tuple[tuple[np.dtype[Any], ...], Any]] = {
@@ -88,6 +92,8 @@ class TakeFile:
         self.chunk_frames, self.bodies = checked.chunk_frames, checked.bodies
         self.creatures, self.clips = checked.creatures, checked.clips
         self.replayed, self.roster = checked.replayed, checked.roster
+        self.chunked = checked.chunked
+        self._later: dict[tuple[str, int], np.ndarray] = {}
 
     def __enter__(self) -> TakeFile:
         return self
@@ -122,10 +128,6 @@ class TakeFile:
         return header
 
     # -- arrays --------------------------------------------------------------------------
-    def has(self, name: str) -> bool:
-        """Whether the take stores the per-frame array `name`."""
-        return f"{name}.npy" in self.entries or f"{name}.00000.npy" in self.entries
-
     def blocks(self, names: tuple[str, ...]) -> Iterator[tuple[int, dict[str, np.ndarray]]]:
         """(first frame, {name: block}) over the take: blocks of the per-frame arrays
         `names`, each (n, ...) for frames [first, first + n), their floats checked finite
@@ -142,9 +144,18 @@ class TakeFile:
 
     def _blocks(self, names: tuple[str, ...]) -> Iterator[tuple[int, dict[str, np.ndarray]]]:
         if self.version == 2:
+            whole = {n: self._whole(n) for n in names if n not in self.chunked}
             for k, first in enumerate(range(0, self.frames, self.chunk_frames)):
                 count = min(self.chunk_frames, self.frames - first)
-                yield first, {n: self._read(f"{n}.{k:05d}", n, count) for n in names}
+                yield (
+                    first,
+                    {
+                        n: self._chunk(n, k)
+                        if n in self.chunked
+                        else whole[n][first : first + count]
+                        for n in names
+                    },
+                )
             return
         handles = {n: self._stream(n) for n in names}
         try:
@@ -156,6 +167,12 @@ class TakeFile:
         finally:
             for handle, _, _ in handles.values():
                 handle.close()
+
+    def _whole(self, name: str) -> np.ndarray:
+        """A per-frame array stored in one entry (a version 2 take's unchunked ones)."""
+        handle, rest, dtype = self._stream(name)
+        with handle:
+            return _rows(name, handle, rest, dtype, self.frames)
 
     def per_frame(self, name: str) -> np.ndarray:
         """The whole per-frame array `name` (for the small ones: a value per creature)."""
@@ -191,24 +208,57 @@ class TakeFile:
         dtypes, rest = PER_FRAME[name]
         return dtypes, rest(self.bodies, len(self.creatures))
 
-    def _read(self, filename: str, name: str, count: int) -> np.ndarray:
-        """A version 2 chunk, checked (`count` frames) before its data is read."""
-        entry = self._entry(f"{filename}.npy", filename)
+    def _chunk(self, name: str, k: int) -> np.ndarray:
+        """Chunk `k` of `name`; items (bodies, creatures) that came later than the chunk
+        hold their values at the first frame of the first chunk holding every item."""
+        value = self._read(name, k, 0)
+        items = self._expected(name)[1][0]
+        have = value.shape[1]
+        if have == items:
+            return value
+        key = (name, have)
+        if key not in self._later:
+            for j in range(k + 1, math.ceil(self.frames / self.chunk_frames)):
+                later = self._read(name, j, have)
+                if later.shape[1] == items:
+                    self._later[key] = np.array(later[0, have:])
+                    break
+            else:
+                raise TakeFileError(f"{name}: no chunk holds all its {items} items")
+        out = np.empty((value.shape[0], items, *value.shape[2:]), value.dtype)
+        out[:, :have] = value
+        out[:, have:] = self._later[key]
+        return out
+
+    def _read(self, name: str, k: int, at_least: int) -> np.ndarray:
+        """Chunk `k` of `name` as stored, checked before its data is read: its frames,
+        between `at_least` items and the header's (creatures spawned while a bake wrote
+        the take are missing from its earlier chunks), the rest of its shape, its size."""
+        label = f"{name} chunk {k}"
+        entry = self._entry(f"{name}.{k:06d}.npy", label)
+        count = min(self.chunk_frames, self.frames - k * self.chunk_frames)
         dtypes, rest = self._expected(name)
         with self.archive.open(entry) as handle:
-            stored, dtype, fortran = _npy_header(handle, filename)
-            if dtype not in dtypes or stored != (count, *rest):
+            stored, dtype, fortran = _npy_header(handle, label)
+            if (
+                dtype not in dtypes
+                or len(stored) != 1 + len(rest)
+                or stored[0] != count
+                or stored[2:] != rest[1:]
+                or not at_least <= stored[1] <= rest[0]
+            ):
+                expected = (count, f"{at_least}..{rest[0]}", *rest[1:])
                 raise TakeFileError(
-                    f"{filename}: dtype {dtype} shape {stored}, expected"
-                    f" {' or '.join(map(str, dtypes))} {(count, *rest)}"
+                    f"{label}: dtype {dtype} shape {stored}, expected"
+                    f" {' or '.join(map(str, dtypes))} {expected}".replace("'", "")
                 )
             size = math.prod(stored) * dtype.itemsize
             if size > MAX_CHUNK_BYTES:
                 raise TakeFileError(
-                    f"{filename}: {size} bytes, over the {MAX_CHUNK_BYTES} a chunk holds"
+                    f"{label}: {size} bytes, over the {MAX_CHUNK_BYTES} a chunk holds"
                 )
-            self._sized(entry, handle, filename, size)
-            return _data(handle, filename, stored, dtype, fortran)
+            self._sized(entry, handle, label, size)
+            return _data(handle, label, stored, dtype, fortran)
 
     def _stream(self, name: str) -> tuple[IO[bytes], tuple[int, ...], np.dtype[Any]]:
         """A version 1 array's entry, checked and opened at its data; (handle, the shape of

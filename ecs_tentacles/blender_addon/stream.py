@@ -56,9 +56,9 @@ def kinds(take: TakeFile, replay: dict[str, np.ndarray] | None) -> np.ndarray:
 
 
 def replay_arrays(take: TakeFile) -> dict[str, np.ndarray] | None:
-    """The per-frame replay arrays (kind, phase, ground frame), whole, or None when no
-    creature is replayed."""
-    if not (take.replayed >= 0).any():
+    """The per-frame replay arrays (kind, phase, ground frame), whole (a few numbers a
+    creature-frame), or None for a take without them."""
+    if take.header.get("replay") is None:
         return None
     names = ("replay_kind", "replay_phase", "replay_xy", "replay_heading")
     parts: dict[str, list[np.ndarray]] = {n: [] for n in names}

@@ -17,6 +17,7 @@ from ecs_tentacles.creator.crowd import crowd_scene
 from ecs_tentacles.export.materials import take_colours
 from ecs_tentacles.skin.colours import to_linear
 from ecs_tentacles.take import Take
+from ecs_tentacles.take.stream import open_take
 from ecs_tentacles.world import World
 from tests.blender_addon.conftest import BLENDER, needs_blender, run
 from tests.export.broken_takes import BROKEN_TAKES
@@ -125,6 +126,33 @@ def test_a_small_crowd_comes_in_sharing_data_per_body_plan_and_every_creature_mo
         assert (link, material) == ("OBJECT", f"{name}_material")  # the mesh is shared
         np.testing.assert_allclose(colour, to_linear(colours[name]), atol=1e-6)
         assert found["active"][skeleton] == f"{name}_root"
+
+
+def test_replayed_creatures_share_one_action_per_clip_through_nla_strips(
+    crowd_take: Path, blender_env: dict[str, str]
+) -> None:
+    """The crowd's replayed stretches (level of detail) are strips of one shared action
+    per clip and kind, placed at their frames; a creature simulated at some frame has its
+    own keys (`<c>_pose`, under the strips), one never simulated has none."""
+    with open_take(crowd_take) as source:
+        names = [c["name"] for c in source.header["creatures"]]
+        stretches = {n: source.segments(c) for c, n in enumerate(names)}
+        kind = source.replay_records()["replay_kind"]
+    assert sum(map(len, stretches.values())) >= 3  # the crowd has replayed stretches
+    found = run(blender_env, IMPORT, str(crowd_take), json.dumps([0]))
+    kinds = ("idle", "crawl")
+    for c, name in enumerate(names):
+        tracks = found["tracks"][f"{name}_skeleton"]
+        expected = [[f"clip{s.clip}_{kinds[s.kind]}", s.first] for s in stretches[name]]
+        assert [[a, start] for a, start, _ in tracks.get("clips", [])] == expected, name
+        simulated = bool((kind[:, c] < 0).any())
+        assert ("physical" in tracks) == simulated, name
+        if simulated:
+            assert [a for a, _, _ in tracks["physical"]] == [f"{name}_pose"]
+    shared = [s for strips in found["tracks"].values() for s in strips.get("clips", [])]
+    for action in {a for a, _, _ in shared}:  # one action, used by every strip playing it
+        assert found["users"][action] == sum(a == action for a, _, _ in shared) >= 2
+    assert not [a for a in found["users"] if a.endswith("_pose") and a[:-5] not in names]
 
 
 BAD = """
