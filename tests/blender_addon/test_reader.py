@@ -21,6 +21,7 @@ from ecs_tentacles.blender_addon.stream import Group, kinds, plans_of, read_moti
 from ecs_tentacles.cli import main
 from ecs_tentacles.take import Take
 from ecs_tentacles.take.chunks import add_entry, npy_bytes
+from ecs_tentacles.take.stream import open_take
 from tests.export.broken_takes import BROKEN_TAKES
 
 # the cases that break what the add-on reads: the header's timing, creatures and bodies,
@@ -195,3 +196,37 @@ def test_a_broken_version_2_take_is_refused_in_one_line(
     with pytest.raises(TakeFileError) as refused:
         read_everything(bad)
     assert str(refused.value).startswith(f"{bad}: {said}"), str(refused.value)
+
+
+def test_a_creature_missing_from_early_chunks_reads_as_the_project_reads_it(
+    good_take: Path, tmp_path: Path
+) -> None:
+    """A creature spawned while a bake streamed its take is missing from the chunks
+    written before it came (its bodies last): both readers give it its values at the
+    first frame of the first chunk holding everyone."""
+    late = tmp_path / "late.npz"
+
+    def rechunk(header: dict[str, Any], entries: dict[str, np.ndarray]) -> None:
+        header["chunk_frames"] = 4
+        last = header["creatures"][-1]
+        bodies = min([last["mantle"], *(i for chain in last["tentacles"] for i in chain)])
+        for name in header["chunked"]:
+            whole = entries.pop(f"{name}.000000")
+            for k, first in enumerate(range(0, len(whole), 4)):
+                part = whole[first : first + 4]
+                if k == 0 and name in ("pos", "quat"):
+                    part = part[:, :bodies]
+                elif k == 0 and name.startswith("replay_"):
+                    part = part[:, :-1]
+                entries[f"{name}.{k:06d}"] = np.ascontiguousarray(part)
+
+    _rewrite(good_take, late, rechunk)
+    with open_take(late) as source:
+        expected = np.concatenate([chunk.pos for _, chunk in source.chunks()])
+    with TakeFile(late) as take:
+        assert take.chunk_frames == 4
+        pos = np.concatenate([b["pos"] for _, b in take.blocks(("pos",))])
+    np.testing.assert_array_equal(pos, expected)
+    original = Take.load(good_take).pos
+    assert not np.array_equal(pos[:4], original[:4])  # the late creature at frame 4's place
+    np.testing.assert_array_equal(pos[4:], original[4:])
