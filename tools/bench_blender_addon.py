@@ -105,6 +105,23 @@ def sample(take: Path, count: int) -> tuple[list[int], list[int]]:
     return chosen, [0, frames // 2, frames - 1]
 
 
+def mantles_in(
+    take: Path, creatures: list[int], frames: list[int]
+) -> tuple[dict[str, Any], np.ndarray]:
+    """The take's header and the mantles of `creatures` at `frames` (frames, n, 3), read
+    a chunk at a time (replayed creatures' poses filled in: `take.stream`)."""
+    from ecs_tentacles.take.stream import open_take
+
+    with open_take(take) as source:
+        mantles = [source.header["creatures"][c]["mantle"] for c in creatures]
+        found = {}
+        for first, chunk in source.chunks():
+            for f in frames:
+                if first <= f < first + chunk.frames:
+                    found[f] = chunk.pos[f - first, mantles].astype(np.float64)
+        return source.header, np.stack([found[f] for f in frames])
+
+
 def addon(take: Path, blender: str, names: list[str], frames: list[int]) -> dict[str, Any]:
     """Install the add-on into a fresh user folder and import `take` with it: what READ
     found, and the Blender process's wall time and peak memory."""
@@ -150,22 +167,18 @@ def by_creature(bones: list[list[list[list[float]]]]) -> list[np.ndarray]:
 def bench(take: Path, blender: str, count: int, usd: bool) -> dict[str, Any]:
     """The add-on's figures for `take` (see the module); with `usd`, today's USD path's
     beside them and how far the two imports differ."""
-    from ecs_tentacles.take import Take
-
     creatures, frames = sample(take, count)
-    loaded = Take.load(take)
-    entries = [loaded.header["creatures"][c] for c in creatures]
-    names = [e["name"] for e in entries]
-    expected = loaded.pos[np.ix_(frames, [e["mantle"] for e in entries])].astype(np.float64)
+    header, expected = mantles_in(take, creatures, frames)
+    names = [header["creatures"][c]["name"] for c in creatures]
     found = addon(take, blender, names, frames)
     mantles = np.array(found["mantles"])
     bones = by_creature(found["bones"])  # per creature (frames, J, 3)
     moved = np.array([np.linalg.norm(b[1:] - b[:1], axis=-1).max() for b in bones])
     row: dict[str, Any] = {
         "take": take.name,
-        "creatures": len(loaded.header["creatures"]),
-        "frames": loaded.frames,
-        "fps": loaded.fps,
+        "creatures": len(header["creatures"]),
+        "frames": header["frames"],
+        "fps": header["fps"],
         "import_s": round(found["import_s"], 2),
         "blender_s": round(found["blender_s"], 2),
         "blender_peak_gb": round(found["peak"] / 1e9, 3),
