@@ -89,7 +89,7 @@ def _import(context: Any, take: TakeFile, report: Report) -> str:
                                               collection)  # fmt: skip
         made.keys += _root_action(skeleton, creature.name, root[:, c])
         if c in own:
-            made.keys += _pose_action(skeleton, creature.name, kind[:, c], *own[c])
+            made.keys += _pose_action(skeleton, creature.name, *own[c])
         if replay is not None and (kind[:, c] >= 0).any():
             made.strips += _clip_strips(take, skeleton, c, kind[:, c],
                                         replay["replay_phase"][:, c], clips)  # fmt: skip
@@ -148,14 +148,13 @@ def _clip_actions(
     return actions
 
 
-def _pose_action(skeleton: Any, name: str, kind: np.ndarray, group: Group, i: int) -> int:
+def _pose_action(skeleton: Any, name: str, group: Group, i: int) -> int:
     """`<name>_pose`: the creature's own bone keys at the frames it is simulated, in a
     `physical` NLA track (under the clips'). Returns the keys written."""
-    keyed = np.flatnonzero(kind < 0)
+    keyed, rotation, location = group.keys(i)
     action, _, channels = keys.new_action(f"{name}_pose")
     written = keys.bone_curves(channels, group.plan.names, keyed.astype(np.float64),
-                               continuous(group.rotation[keyed, i], axis=0),
-                               group.location[keyed, i])  # fmt: skip
+                               continuous(rotation, axis=0), location)  # fmt: skip
     track = skeleton.animation_data.nla_tracks.new()
     track.name = "physical"
     strip = track.strips.new(action.name, int(keyed[0]), action)  # action frames = frames

@@ -7,10 +7,10 @@ only: no bpy).
 
 `read_motion` reads the body poses block by block (`TakeFile.blocks`): every creature's
 ground frame at every frame (its armature object's keys: the replay's where it is
-replayed, its mantle's where it is simulated), and each group's bone keys at every frame
-(`motion.bases`; only the frames where a creature is simulated are keyed). A zero-length
-quaternion where a creature is simulated is an error; replayed creatures' bodies hold
-zeros (the take says so), read as the identity.
+replayed, its mantle's where it is simulated), and each group's bone keys at the frames
+where a creature is simulated (`motion.bases`; replayed creatures' bodies hold zeros
+there, and are not read). A zero-length quaternion where a creature is simulated is an
+error.
 """
 
 from __future__ import annotations
@@ -29,13 +29,32 @@ Report = Callable[[float, str], None]
 
 @dataclass
 class Group:
-    """The creatures of one body plan that are simulated at some frame: their keys."""
+    """The creatures of one body plan that are simulated at some frame, and the bone keys
+    of those frames (`read_motion` fills them in): one row per simulated creature-frame,
+    creature by creature, frames in order (`keys` gives a creature's)."""
 
     plan: Plan
     creatures: list[int]
     offset: np.ndarray
-    rotation: np.ndarray = field(init=False)  # (frames, n, J, 4) float32
-    location: np.ndarray = field(init=False)  # (frames, n, 3) float32
+    rows: np.ndarray = field(init=False)  # (frames, n): a key row, or -1 where replayed
+    rotation: np.ndarray = field(init=False)  # (rows, J, 4) float32
+    location: np.ndarray = field(init=False)  # (rows, 3) float32
+
+    def allocate(self, kind: np.ndarray) -> None:
+        """Rows for the simulated frames (`kind` < 0) of `kind` (frames, creatures)."""
+        simulated = (kind[:, self.creatures] < 0).T  # (n, frames), creature by creature
+        rows = np.cumsum(simulated.ravel()).reshape(simulated.shape) - 1
+        self.rows = np.where(simulated, rows, -1).T
+        count = int(simulated.sum())
+        self.rotation = np.zeros((count, self.plan.joints, 4), np.float32)
+        self.location = np.zeros((count, 3), np.float32)
+
+    def keys(self, i: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The `i`-th creature's simulated frames (K,) and their bone keys: rotations
+        (K, J, 4), the mantle's location (K, 3)."""
+        frames = np.flatnonzero(self.rows[:, i] >= 0)
+        rows = self.rows[frames, i]
+        return frames, self.rotation[rows], self.location[rows]
 
 
 def plans_of(take: TakeFile) -> dict[Plan, list[int]]:
@@ -85,53 +104,44 @@ def read_motion(
     report: Report,
 ) -> np.ndarray:
     """Every creature's ground frame (frames, creatures, 3: x, y, heading unwrapped), and
-    each group's bone keys at every frame (filled in place; only its creatures' simulated
-    frames are keys: `kind` < 0)."""
+    each group's bone keys at its creatures' simulated frames (`kind` < 0; in place)."""
     frames = take.frames
     root = np.zeros((frames, len(take.creatures), 3))
     if replay is not None:
         root[..., :2] = replay["replay_xy"]
         root[..., 2] = replay["replay_heading"]
     for group in groups:
-        n, joints = len(group.creatures), group.plan.joints
-        group.rotation = np.zeros((frames, n, joints, 4), np.float32)
-        group.location = np.zeros((frames, n, 3), np.float32)
+        group.allocate(kind)
     bodies = [np.stack([take.creatures[c].bodies for c in g.creatures]) for g in groups]
     for first, block in take.blocks(("pos", "quat")):
         count = len(block["pos"])
         for group, index in zip(groups, bodies, strict=True):
-            physical = kind[first : first + count, group.creatures] < 0  # (count, n)
-            quat = _unit(block["quat"][:, index], physical, take.path, first, index)
-            pos = block["pos"][:, index[:, 0]].astype(np.float64)
-            frame = root_frame(pos, quat[..., 0, :])
+            at, i = np.nonzero(group.rows[first : first + count] >= 0)  # simulated here
+            if not len(at):
+                continue
+            quat = _unit(block["quat"][at[:, None], index[i]], take.path, first + at, index[i])
+            pos = block["pos"][at, index[i, 0]].astype(np.float64)
+            frame = root_frame(pos, quat[:, 0])
             mantle_pos, quat = in_frame(pos, quat, frame)
             rotation, location = bases(group.plan, group.offset, quat, mantle_pos)
-            rows = slice(first, first + count)
+            rows = group.rows[first + at, i]
             group.rotation[rows] = rotation
             group.location[rows] = location
-            cols = np.asarray(group.creatures)
-            view = root[rows][:, cols]
-            view[physical] = frame[physical]
-            root[rows, cols] = view
+            root[first + at, np.asarray(group.creatures)[i]] = frame
         report(0.5 * (first + count) / frames, f"frame {first + count} of {frames}")
     root[..., 2] = np.unwrap(root[..., 2], axis=0)
     return root
 
 
-def _unit(
-    quat: np.ndarray, physical: np.ndarray, path: Path, first: int, index: np.ndarray
-) -> np.ndarray:
-    """Body quaternions (count, n, J, 4) as float64 unit ones; a zero-length one at a
-    physical frame is an error (replayed creatures' bodies hold zeros: the identity)."""
+def _unit(quat: np.ndarray, path: Path, frames: np.ndarray, bodies: np.ndarray) -> np.ndarray:
+    """Simulated bodies' quaternions (K, J, 4) as float64 unit ones; one of zero length
+    is an error naming its frame (`frames` (K,)) and body (`bodies` (K, J))."""
     quat = quat.astype(np.float64)
     length = np.linalg.norm(quat, axis=-1)
     short = length < 1e-6
-    wrong = short & physical[..., None]
-    if wrong.any():
-        f, c, j = np.argwhere(wrong)[0].tolist()
+    if short.any():
+        k, j = np.argwhere(short)[0].tolist()
         raise TakeFileError(
-            f"{path}: quat: zero-length quaternion at frame {first + f}, body {index[c, j]}"
+            f"{path}: quat: zero-length quaternion at frame {frames[k]}, body {bodies[k, j]}"
         )
-    quat[short] = (1.0, 0.0, 0.0, 0.0)
-    length[short] = 1.0
     return quat / length[..., None]
