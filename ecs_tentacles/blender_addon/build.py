@@ -4,14 +4,15 @@
 
 1. The file is read and checked (`reader`); nothing is made for a bad one.
 2. Per body plan: an Armature and a Mesh datablock (`rig`), shared by its creatures.
-3. The take is read a block of frames at a time (`motion`): every creature's ground
+3. The take is read a block of frames at a time (`stream`): every creature's ground
    frame (its armature object's keys), and the bone keys of the frames a creature was
    simulated (physical); replayed frames name a clip, its kind and phase instead.
 4. Per creature: its objects and material (`rig`), an action of its root motion
    (`<c>_root`, the object's active action), and, in the NLA, a `physical` track with
    its own bone keys (`<c>_pose`, only for creatures simulated at some frame) under a
    `clips` track of strips of the shared clip actions (`clip<i>_<kind>`: one per clip
-   and kind, every creature replaying it uses it), one strip per replayed stretch.
+   and kind, every creature replaying it uses it, `motion.CLIP_KEYS` keys a clip frame,
+   looping), one strip per replayed stretch, offset and scaled to its frames and phase.
 5. The ground's meshes on terrain (`ground`), as the USD import shows them.
 6. The scene takes the take's frame rate and range (frame i of the take is frame i).
 
