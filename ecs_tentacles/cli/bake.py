@@ -227,9 +227,15 @@ def report(take: Take, path: Path) -> dict[str, Any]:
         "frames": take.frames,
         "fps": take.fps,
         **{key: len(header[key]) for key in ("creatures", "bodies", "suckers", *_points(take))},
-        "sha256": hashlib.sha256(path.read_bytes()).hexdigest(),
+        "sha256": file_sha256(path),
         "recoveries": header.get("health", {}).get("recoveries", 0),
     }
+
+
+def file_sha256(path: Path) -> str:
+    """The SHA-256 of the file at `path`, read in pieces (a crowd's USD is gigabytes)."""
+    with path.open("rb") as handle:
+        return hashlib.file_digest(handle, "sha256").hexdigest()
 
 
 def _points(take: Take) -> list[str]:

@@ -67,10 +67,13 @@ def work_units(
     take: Take, path: str | os.PathLike[str], skin: Skin | None = None
 ) -> tuple[int, str]:
     """(how many, of what) `write(take, path, progress, skin)` tells `progress` of: the
-    bytes of a take's arrays, the creatures of a skinned file, the bodies of a rigid one."""
+    bytes of a take's arrays, the frames of a USD file (written a chunk of frames at a
+    time), the creatures of a skinned glb, the bodies of a rigid one."""
     kind = output_kind(path)
     if kind == "take":
         return take.stored_bytes(), "B"
+    if kind == "usd":
+        return take.frames, "frame"
     if skin is not None:
         return len(take.header["creatures"]), "creature"
     return len(take.header["bodies"]), "body"
