@@ -67,7 +67,7 @@ from ecs_tentacles.export.ground import write_usd_ground
 from ecs_tentacles.export.materials import take_colours, usd_folder
 from ecs_tentacles.export.names import unique_path
 from ecs_tentacles.export.root_frames import RootFrames
-from ecs_tentacles.export.take_chunks import TakeChunks
+from ecs_tentacles.export.take_chunks import TakeChunks, frame_slice
 from ecs_tentacles.export.usd import _pxr, mark_rate, set_timing, static_take
 from ecs_tentacles.export.usd_joint_samples import PlanSamples, key_report
 from ecs_tentacles.export.usd_layer import StreamedLayer
@@ -81,6 +81,7 @@ from ecs_tentacles.skin.rig import Keys
 from ecs_tentacles.take import Take
 
 Progress = Callable[[int], object]
+WORK_BYTES = 32 * 1024**2  # joint rotations (float64) worked on at once: chunks are split
 
 
 def write_skinned_usd(
@@ -143,15 +144,19 @@ def _fill(
     tracks = UsdTracks(layer, header, source.static, locators, relative=True)
     write_usd_ground(pxr, stage, still)
     animated = [PlanSamples(pxr, layer, plan, keys or Keys(), source.frames) for plan in plans]
+    rows = max(1, WORK_BYTES // (32 * max(1, len(header["bodies"]))))
     for first, chunk in source.chunks():
-        origin = np.zeros((chunk.frames, len(names), 3))
-        for samples in animated:  # each creature's root motion as written
-            origin[:, samples.plan.members] = samples.add(first, chunk)
-        roots = RootFrames(origin)
-        if suckers is not None:
-            suckers.add(first, chunk, roots)
-        visibility.add(first, chunk)
-        tracks.add(first, chunk, roots)
+        for start in range(0, chunk.frames, rows):
+            end = min(start + rows, chunk.frames)
+            piece = chunk if end - start == chunk.frames else frame_slice(chunk, start, end)
+            origin = np.zeros((piece.frames, len(names), 3))
+            for samples in animated:  # each creature's root motion as written
+                origin[:, samples.plan.members] = samples.add(first + start, piece)
+            roots = RootFrames(origin)
+            if suckers is not None:
+                suckers.add(first + start, piece, roots)
+            visibility.add(first + start, piece)
+            tracks.add(first + start, piece, roots)
         layer.flush()
         if progress is not None:
             progress(chunk.frames)

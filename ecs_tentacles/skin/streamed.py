@@ -20,8 +20,18 @@ from __future__ import annotations
 
 import numpy as np
 
-from ecs_tentacles.numeric.quaternions import quat_multiply
-from ecs_tentacles.skin.skeleton import quat_conjugate
+
+def undo(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """conj(a) * b for unit quaternion arrays (..., 4): `b` seen from `a`'s frame (the
+    Hamilton product with the conjugate written out: no conjugate array made)."""
+    aw, ax, ay, az = np.moveaxis(a, -1, 0)
+    bw, bx, by, bz = np.moveaxis(b, -1, 0)
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape))
+    out[..., 0] = aw * bw + ax * bx + ay * by + az * bz
+    out[..., 1] = aw * bx - ax * bw - ay * bz + az * by
+    out[..., 2] = aw * by + ax * bz - ay * bw - az * bx
+    out[..., 3] = aw * bz - ax * by + ay * bx - az * bw
+    return out
 
 
 class JointRotations:
@@ -36,7 +46,7 @@ class JointRotations:
     def world(self, quat: np.ndarray) -> np.ndarray:
         """(n, C, J, 4) unit world rotations of every joint from a chunk's body `quat`."""
         world = quat[:, self.bodies].astype(np.float64)
-        world /= np.linalg.norm(world, axis=-1, keepdims=True)
+        world /= np.sqrt(np.einsum("...c,...c->...", world, world))[..., None]
         return world
 
     def local(self, quat: np.ndarray) -> np.ndarray:
@@ -45,9 +55,7 @@ class JointRotations:
         world = self.world(quat)
         local = world.copy()
         parents = self.parents[self.children]
-        local[..., self.children, :] = quat_multiply(
-            quat_conjugate(world[..., parents, :]), world[..., self.children, :]
-        )
+        local[..., self.children, :] = undo(world[..., parents, :], world[..., self.children, :])
         return self.continuous(local)
 
     def continuous(self, local: np.ndarray) -> np.ndarray:
