@@ -73,7 +73,7 @@ def measure(take: Path, out: Path, python: str, validate: bool) -> dict[str, Any
     }
     row["sharing"], row["own_animation"] = shared(out)
     if validate:
-        line = next(l for l in done.stderr.splitlines() if "USD validation:" in l)
+        line = next(t for t in done.stderr.splitlines() if "USD validation:" in t)
         counts = re.findall(r"(\d+) (error|warning)", line)
         row.update({f"{kind}s": int(n) for n, kind in counts})
     return row
