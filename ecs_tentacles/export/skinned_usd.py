@@ -59,6 +59,7 @@ from __future__ import annotations
 import importlib
 import os
 from collections.abc import Callable
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -69,9 +70,10 @@ from ecs_tentacles.export.names import unique_path
 from ecs_tentacles.export.root_frames import RootFrames
 from ecs_tentacles.export.take_chunks import TakeChunks, frame_slice
 from ecs_tentacles.export.usd import _pxr, mark_rate, set_timing, static_take
+from ecs_tentacles.export.usd_clips import SharedClips
 from ecs_tentacles.export.usd_joint_samples import PlanSamples, key_report
 from ecs_tentacles.export.usd_layer import StreamedLayer
-from ecs_tentacles.export.usd_plans import body_plans, define_creature
+from ecs_tentacles.export.usd_plans import BodyPlan, body_plans, define_creature
 from ecs_tentacles.export.usd_tracks import Steps, UsdTracks, Visibility, key_steps
 from ecs_tentacles.numeric.quaternions import quat_rotate
 from ecs_tentacles.output.atomic import atomic_output
@@ -134,25 +136,33 @@ def _fill(
     still = static_take(source)
     colours, folder = take_colours(still), usd_folder(still)
     plans = body_plans(header, detail)
+    clips = SharedClips(pxr, layer, source, plans)
     plan_of = {name: plan for plan in plans for name in plan.names}
     names = [c["name"] for c in header["creatures"]]
-    for name in names:  # in the take's order
-        define_creature(pxr, stage, plan_of[name], name, colours[name], folder)
+    for creature, name in enumerate(names):  # in the take's order
+        alone = creature not in clips.sharers
+        define_creature(pxr, stage, plan_of[name], name, colours[name], folder, alone)
+        clips.bind(name, creature)
         mark_rate(stage, f"/World/{name}", source.fps, source.frames)
     visibility = Visibility(layer, [f"/World/{name}" for name in names])
     suckers = Suckers(pxr, layer, header) if locators else None
     tracks = UsdTracks(layer, header, source.static, locators, relative=True)
     write_usd_ground(pxr, stage, still)
-    animated = [PlanSamples(pxr, layer, plan, keys or Keys(), source.frames) for plan in plans]
+    own = [alone_in(plan, clips.sharers) for plan in plans]
+    animated = [PlanSamples(pxr, layer, plan, keys or Keys(), source.frames) for plan in own]
     rows = max(1, WORK_BYTES // (32 * max(1, len(header["bodies"]))))
     for first, chunk in source.chunks():
         for start in range(0, chunk.frames, rows):
             end = min(start + rows, chunk.frames)
             piece = chunk if end - start == chunk.frames else frame_slice(chunk, start, end)
             origin = np.zeros((piece.frames, len(names), 3))
+            yaw = np.zeros((piece.frames, len(names)))
             for samples in animated:  # each creature's root motion as written
-                origin[:, samples.plan.members] = samples.add(first + start, piece)
-            roots = RootFrames(origin)
+                if len(samples.plan.members):
+                    origin[:, samples.plan.members] = samples.add(first + start, piece)
+            if clips.order:
+                origin[:, clips.order], yaw[:, clips.order] = clips.add(first + start, end - start)
+            roots = RootFrames(origin, yaw if clips.order else None)
             if suckers is not None:
                 suckers.add(first + start, piece, roots)
             visibility.add(first + start, piece)
@@ -161,6 +171,13 @@ def _fill(
         if progress is not None:
             progress(chunk.frames)
     return key_report(animated, source.frames)
+
+
+def alone_in(plan: BodyPlan, sharers: dict[int, Any]) -> BodyPlan:
+    """`plan` narrowed to its creatures that keep their own animation."""
+    keep = np.array([c not in sharers for c in plan.members.tolist()], dtype=bool)
+    names = [name for name, kept in zip(plan.names, keep.tolist(), strict=True) if kept]
+    return replace(plan, names=names, members=plan.members[keep], bodies=plan.bodies[keep])
 
 
 class Suckers:

@@ -102,14 +102,22 @@ def _plan_arrays(pxr: Any, skeleton: Skeleton, mesh: SkinMesh) -> dict[str, Any]
 
 
 def define_creature(
-    pxr: Any, stage: Any, plan: BodyPlan, name: str, colour: np.ndarray, folder: str
+    pxr: Any,
+    stage: Any,
+    plan: BodyPlan,
+    name: str,
+    colour: np.ndarray,
+    folder: str,
+    own_animation: bool = True,
 ) -> None:
     """Creature `name`'s prims: SkelRoot (its root motion's translate op), Skeleton,
-    SkelAnimation (constant channels set), skinned Mesh, material."""
+    SkelAnimation (with `own_animation` its constant channels set; else empty, for a
+    reference to a shared clip's: `ecs_tentacles.export.usd_clips`), skinned Mesh,
+    material."""
     Gf, Sdf, UsdGeom, UsdSkel = pxr.Gf, pxr.Sdf, pxr.UsdGeom, pxr.UsdSkel
     arrays = plan.arrays
     base = f"/World/{name}"
-    UsdSkel.Root.Define(stage, base).AddTranslateOp()  # double3, sampled: the mantle's position
+    UsdSkel.Root.Define(stage, base).AddTranslateOp()  # double3, sampled: the root's motion
     skel = UsdSkel.Skeleton.Define(stage, f"{base}/{part(name, 'skeleton')}")
     skel.CreateJointsAttr(arrays["joints"])
     skel.CreateJointNamesAttr(arrays["joint_names"])
@@ -117,10 +125,11 @@ def define_creature(
     skel.CreateRestTransformsAttr(arrays["rest"])
 
     anim = UsdSkel.Animation.Define(stage, f"{skel.GetPath()}/{part(name, 'animation')}")
-    anim.CreateJointsAttr(arrays["joints"])
-    anim.CreateTranslationsAttr(arrays["translations"])
-    anim.CreateScalesAttr(arrays["scales"])
-    anim.CreateRotationsAttr()
+    if own_animation:  # a local opinion would hide a referenced clip's samples
+        anim.CreateJointsAttr(arrays["joints"])
+        anim.CreateTranslationsAttr(arrays["translations"])
+        anim.CreateScalesAttr(arrays["scales"])
+        anim.CreateRotationsAttr()
     binding = UsdSkel.BindingAPI.Apply(skel.GetPrim())
     binding.CreateAnimationSourceRel().SetTargets([anim.GetPath()])
 
