@@ -33,12 +33,13 @@ from ecs_tentacles.cli.usd_validate import validate_problem, validated
 from ecs_tentacles.distributed.driver import ShardFailed
 from ecs_tentacles.distributed.wedge import WedgeError
 from ecs_tentacles.export import SUFFIXES, work_units, write
-from ecs_tentacles.export.bake import BakePlan, bake, output_kind
+from ecs_tentacles.export.bake import BakePlan, bake, bake_to_file, output_kind
 from ecs_tentacles.export.skinned import Skin
 from ecs_tentacles.output.progress import bar
 from ecs_tentacles.skin.keys import KeyReport
 from ecs_tentacles.skin.mesh import MeshError
 from ecs_tentacles.take import Take, TakeError
+from ecs_tentacles.take.tracks import tracks_of
 
 
 def positive_float(text: str) -> float:
@@ -167,6 +168,8 @@ def handle(args: argparse.Namespace) -> int:
     except ValueError as error:
         print(f"error: {error}", file=sys.stderr)
         return 2
+    if args.ray is None and output_kind(args.out) == "take":
+        return _bake_streamed(args, plan)
     if args.ray is not None:
         try:
             take = bake_ray.bake_on_ray(args, plan)
@@ -177,18 +180,8 @@ def handle(args: argparse.Namespace) -> int:
         take = bake(
             plan, progress=not args.quiet, allow_systems=args.allow_systems, threads=args.threads
         )
-    health = take.header["health"]
-    if health["recoveries"]:
-        frames = sorted({e["frame"] for e in health["events"]})
-        shown = ", ".join(map(str, frames[:8])) + (", ..." if len(frames) > 8 else "")
-        print(
-            f"{'error' if args.strict else 'warning'}: physics recovered {health['recoveries']}"
-            f" times, {health['frozen']} creatures frozen (take frames {shown};"
-            " marked in the take header)",
-            file=sys.stderr,
-        )
-        if args.strict:
-            return 1
+    if _recoveries_refused(take.header, args.strict):
+        return 1
     try:
         skinned = save(take, args.out, progress=not args.quiet, skin=skin, locators=args.locators)
     except MeshError as error:  # e.g. tentacle bases that overlap on the mantle
@@ -200,6 +193,48 @@ def handle(args: argparse.Namespace) -> int:
     getattr(args, "after_write", lambda: None)()
     print(summary(take, args.out, args.json, skinned))
     return validated(args.out, progress=not args.quiet) if args.validate else 0
+
+
+def _recoveries_refused(header: dict[str, Any], strict: bool) -> bool:
+    """Tell of physics recoveries in the take (an error with --strict: True)."""
+    health = header["health"]
+    if not health["recoveries"]:
+        return False
+    frames = sorted({e["frame"] for e in health["events"]})
+    shown = ", ".join(map(str, frames[:8])) + (", ..." if len(frames) > 8 else "")
+    print(
+        f"{'error' if strict else 'warning'}: physics recovered {health['recoveries']}"
+        f" times, {health['frozen']} creatures frozen (take frames {shown};"
+        " marked in the take header)",
+        file=sys.stderr,
+    )
+    return strict
+
+
+def _bake_streamed(args: argparse.Namespace, plan: BakePlan) -> int:
+    """A bake to a take file, written as the frames come (memory does not grow with the
+    shot); with --strict a take with physics recoveries is not kept."""
+
+    def accept(header: dict[str, Any]) -> bool:
+        return not _recoveries_refused(header, args.strict)
+
+    try:
+        header = bake_to_file(
+            plan,
+            args.out,
+            progress=not args.quiet,
+            allow_systems=args.allow_systems,
+            threads=args.threads,
+            accept=accept,
+        )
+    except TakeError as error:  # the run made numbers no take may hold (a plugin's NaN)
+        print(f"error: {error}", file=sys.stderr)
+        return 1
+    if header is None:
+        return 1
+    getattr(args, "after_write", lambda: None)()
+    print(summary(header, args.out, args.json))
+    return 0
 
 
 def save(
@@ -218,39 +253,49 @@ def save(
         return write(take, path, shown.update, skin, locators)
 
 
-def report(take: Take, path: Path) -> dict[str, Any]:
+def report(take: Take | dict[str, Any], path: Path) -> dict[str, Any]:
     """What was written and the file's SHA-256 (equal for equal bakes); counts of
-    creatures, bodies, suckers and of every points track's items (goals)."""
-    header = take.header
+    creatures, bodies, suckers and of every points track's items (goals). `take`: the
+    take, or the header of one written as it was baked."""
+    header = take if isinstance(take, dict) else take.header
     return {
         "out": str(path),
-        "frames": take.frames,
-        "fps": take.fps,
-        **{key: len(header[key]) for key in ("creatures", "bodies", "suckers", *_points(take))},
-        "sha256": file_sha256(path),
+        "frames": header["frames"],
+        "fps": float(header["fps"]),
+        **{key: len(header[key]) for key in ("creatures", "bodies", "suckers", *_points(header))},
+        "sha256": _sha256(path),
         "recoveries": header.get("health", {}).get("recoveries", 0),
     }
 
 
-def file_sha256(path: Path) -> str:
-    """The SHA-256 of the file at `path`, read in pieces (a crowd's USD is gigabytes)."""
+def _sha256(path: Path) -> str:
+    """SHA-256 of a file, read a MiB at a time (a film crowd's take is gigabytes)."""
+    digest = hashlib.sha256()
     with path.open("rb") as handle:
-        return hashlib.file_digest(handle, "sha256").hexdigest()
+        for block in iter(lambda: handle.read(1024**2), b""):
+            digest.update(block)
+    return digest.hexdigest()
 
 
-def _points(take: Take) -> list[str]:
+def _points(header: dict[str, Any]) -> list[str]:
     """The header keys of the take's points tracks (`goals`, ...)."""
-    return [track.key for track in take.track_list() if track.kind == "points"]
+    return [track.key for track in tracks_of(header) if track.kind == "points"]
 
 
-def summary(take: Take, path: Path, as_json: bool = False, skinned: KeyReport | None = None) -> str:
+def summary(
+    take: Take | dict[str, Any],
+    path: Path,
+    as_json: bool = False,
+    skinned: KeyReport | None = None,
+) -> str:
     """The report as a sentence (a second line for skinned creatures), or as JSON."""
-    r = report(take, path)
+    header = take if isinstance(take, dict) else take.header
+    r = report(header, path)
     if skinned is not None:
         r["skinned"] = skinned.line()
     if as_json:
         return json.dumps(r)
-    items = "".join(f", {counted(r[key], key.removesuffix('s'))}" for key in _points(take))
+    items = "".join(f", {counted(r[key], key.removesuffix('s'))}" for key in _points(header))
     line = (
         f"{path}: {r['frames']} frames at {r['fps']:g} fps, {counted(r['creatures'], 'creature')},"
         f" {r['bodies']} bodies, {counted(r['suckers'], 'sucker')}{items}; sha256 {r['sha256']}"

@@ -10,6 +10,7 @@ the replay's state.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
 from ecs_tentacles.plugin import Plugin
@@ -17,6 +18,7 @@ from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
+    from ecs_tentacles.take.tracks import TrackSize
 
 
 class ClipsPlugin(Plugin):
@@ -27,6 +29,17 @@ class ClipsPlugin(Plugin):
         from ecs_tentacles.systems.clips.replay import LodReplay
 
         return [LodReplay()]
+
+    def take_sizes(self, scene: Mapping[str, Any]) -> list[TrackSize]:
+        """A take of a scene on flat ground records each creature's replay (kind, phase,
+        place, heading: 33 bytes a frame; `ecs_tentacles.take.replay`), and each body
+        plan's clips once (not counted: known only when recorded)."""
+        from ecs_tentacles.take.tracks import TrackSize
+
+        if scene.get("terrain") is not None:
+            return []
+        count = len(scene.get("creatures", []))
+        return [TrackSize("replay records", count, 33, chunked=True)] if count else []
 
     def snapshot(self, world: Host) -> Any:
         replay = world.physics.lod.replay

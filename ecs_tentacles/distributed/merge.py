@@ -17,6 +17,7 @@ import numpy as np
 
 from ecs_tentacles.take import Take
 from ecs_tentacles.take import ground as take_ground
+from ecs_tentacles.take import replay as take_replay
 from ecs_tentacles.take.tracks import TakeTrack
 
 
@@ -56,6 +57,8 @@ def merge_takes(parts: Sequence[tuple[Sequence[int], Take]]) -> Take:
         }
         for track in tracks:
             _track_owners(track, h, glob, tables[track.key], owners, axes)
+        if h.get(take_replay.KEY) is not None:  # per creature, frames first
+            owners.update(dict.fromkeys(take_replay.PER_FRAME, glob))
         for name, owner in owners.items():
             value = take.array(name)
             assert value is not None
@@ -89,7 +92,39 @@ def merge_takes(parts: Sequence[tuple[Sequence[int], Take]]) -> Take:
         )
     # the ground is the scene's, the same in every shard (checked above): the first's
     merged.update({name: first.tracks[name] for name in take_ground.dtypes(first.header)})
+    if first.header.get(take_replay.KEY) is not None:
+        header[take_replay.KEY] = _replay(parts, merged)
     return Take.from_arrays(header, merged)
+
+
+def _replay(parts: Sequence[tuple[Sequence[int], Take]], merged: dict[str, Any]) -> dict[str, Any]:
+    """The merged take's replay header, its clips put into `merged`: numbered as a local
+    recording numbers them (by the frame each creature first replays, then creature
+    order), one per distinct clip."""
+    clip_of: dict[int, tuple[np.ndarray, dict[str, Any]]] = {}
+    for members, take in parts:
+        replay = take.header[take_replay.KEY]
+        for c, k in enumerate(replay["creatures"]):
+            if k >= 0:
+                clip_of[int(members[c])] = (
+                    take.tracks[take_replay.clip_array(k)],
+                    replay["clips"][k],
+                )
+    kind = merged["replay_kind"]
+    creatures = np.full(kind.shape[1], take_replay.PHYSICAL, dtype=np.int64)
+    replayed = (kind >= 0).any(axis=0)
+    first = np.where(replayed, np.argmax(kind >= 0, axis=0), kind.shape[0])
+    clips: list[dict[str, Any]] = []
+    numbers: dict[bytes, int] = {}
+    for c in sorted(clip_of, key=lambda c: (int(first[c]), c)):
+        pose, meta = clip_of[c]
+        key = pose.tobytes() + repr(sorted(meta.items())).encode()
+        if key not in numbers:
+            numbers[key] = len(clips)
+            merged[take_replay.clip_array(len(clips))] = pose
+            clips.append(meta)
+        creatures[c] = numbers[key]
+    return {"clips": clips, "creatures": creatures.tolist()}
 
 
 def _track_owners(

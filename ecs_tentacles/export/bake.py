@@ -158,15 +158,15 @@ class BakePlan:
                 f" a take's header holds at most {MAX_HEADER_BYTES / MIB:g} MiB (bake fewer"
                 " creatures)"
             )
-        total = size.total(self.frames)
+        total = size.at_once(self.frames)
         if total <= MAX_TAKE_BYTES:
             return None
         most = max(size.parts, key=lambda part: part.items * part.frame_bytes)
         share = self.frames * most.items * most.frame_bytes + most.fixed_bytes
         return (
-            f"{self.frames:,} frames of {_parts(size)} would be {total / GIB:.1f} GiB,"
-            f" {share / GIB:.1f} GiB of it the {most.what}; a take holds at most"
-            f" {MAX_TAKE_BYTES / GIB:g} GiB: {self._what_fits(size, most)}"
+            f"{self.frames:,} frames of {_parts(size)} would be {total / GIB:.1f} GiB to read at"
+            f" once, {share / GIB:.1f} GiB of it the {most.what}; a take's reader decodes at"
+            f" most {MAX_TAKE_BYTES / GIB:g} GiB at once: {self._what_fits(size, most)}"
         )
 
     def glb_size(self, skin: Skin | None, locators: bool | None) -> GlbSize:
@@ -204,7 +204,8 @@ class BakePlan:
         (a plugin's track) at these seconds: 'bake at most 0.55 s at 60 fps or at most
         210,000 fur guides'."""
         fits = []
-        frames = (MAX_TAKE_BYTES - size.fixed_bytes) // max(size.frame_bytes, 1)
+        tracks = size.frame_bytes - size.chunked_frame_bytes
+        frames = (MAX_TAKE_BYTES - size.fixed_bytes) // max(tracks, 1)
         if frames >= 2:
             fits.append(f"bake at most {_seconds((frames - 1) / self.fps)} s at {self.fps:g} fps")
         if most in size.parts[2:]:  # a plugin's track, not the bodies or suckers
@@ -280,5 +281,46 @@ def bake(
         step_frames(world, plan.steps, progress=progress, desc="bake", on_steps=on_steps)
         with status(f"bake: gathering {plan.frames} frames", progress=progress):
             return recording.finish()  # the recorder's arrays: the frames are held once
+    finally:
+        world.close()
+
+
+def bake_to_file(
+    plan: BakePlan,
+    out: str | os.PathLike[str],
+    *,
+    progress: bool = True,
+    allow_systems: bool = False,
+    on_world: Callable[[World], None] | None = None,
+    threads: int | None = None,
+    accept: Callable[[dict[str, Any]], bool] | None = None,
+) -> dict[str, Any] | None:
+    """Run the plan, writing the take to `out` as the frames come (`take.writer`: a
+    chunk of frames held at a time, so memory does not grow with the shot); returns the
+    header written. Stopped (an exception, Ctrl-C), it leaves no file and no chunks;
+    `accept(header)` False at the end: no file either, and None."""
+    from ecs_tentacles.take.writer import TakeWriter
+
+    with status("bake: building the world", progress=progress):
+        world = plan.world(allow_systems=allow_systems, threads=threads)
+    try:
+        if on_world is not None:
+            on_world(world)
+        with TakeWriter(out) as writer:
+            recording = builtin(
+                "record",
+                every=plan.every,
+                scene_sha256=plan.scene_sha256,
+                capacity=plan.frames,
+                writer=writer,
+            )
+            world.add_plugin(recording)
+            step_frames(world, plan.steps, progress=progress, desc="bake")
+            with status(f"bake: writing {out}", progress=progress):
+                header: dict[str, Any] = recording.finish_stream()  # type: ignore[attr-defined]
+            if accept is not None and not accept(header):
+                writer.discard()
+                return None
+        return header
     finally:
         world.close()

@@ -19,12 +19,15 @@ from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
 import numpy as np
 
 from ecs_tentacles.components import Creature, Link, Tentacle, Transform
+from ecs_tentacles.export.replay_recording import ReplayRecorder
 from ecs_tentacles.export.track_recording import CurvesTrack, PointsTrack
 from ecs_tentacles.ground import ground_of
 from ecs_tentacles.numeric.rows import ordinals, run_slice
-from ecs_tentacles.take import FORMAT, VERSION, Take
+from ecs_tentacles.take import FORMAT, VERSION, Take, TakeError, chunks
 from ecs_tentacles.take import ground as take_ground
+from ecs_tentacles.take import replay as take_replay
 from ecs_tentacles.take import roster as take_roster
+from ecs_tentacles.take.entries import data_problem
 from ecs_tentacles.take.registries import (
     RecordingStarts,
     TakeTracks,
@@ -34,6 +37,7 @@ from ecs_tentacles.take.tracks import STANDARD, declared_problem
 
 if TYPE_CHECKING:
     from ecs_tentacles.roster_change import RosterChange
+    from ecs_tentacles.take.writer import TakeWriter
     from ecs_tentacles.world import World
 
 
@@ -81,8 +85,10 @@ class TakeRecorder:
         scene_sha256: str | None = None,
         capacity: int = 64,
         tracks: Sequence[TrackSource] = (),
+        writer: TakeWriter | None = None,
     ):
         self.world = world
+        self.writer = writer
         self._layout(world)
         self.tracks = self._tracks([*plugin_tracks(world), *tracks])
         self.header: dict[str, Any] = {
@@ -109,13 +115,27 @@ class TakeRecorder:
         if ground is not None:
             self.header[take_ground.KEY] = ground
         bodies, suckers = len(self._rows), len(self._suckers)
-        capacity = max(1, capacity)
+        self._replay = ReplayRecorder(world, self.header, len(self._creatures))
+        self._capacity_hint = capacity = max(1, capacity)
+        if writer is not None:  # streamed: the arrays hold a chunk; the file the rest
+            each = (
+                bodies * 28
+                + suckers * 13
+                + (33 * len(self._creatures) if self._replay.active else 0)
+            )
+            writer.chunk_frames = capacity = chunks.chunk_frames(each)
         self._pos = np.empty((capacity, bodies, 3), np.float32)
         self._quat = np.empty((capacity, bodies, 4), np.float32)
         self._attached = np.empty((capacity, suckers), np.bool_)
         self._anchor = np.empty((capacity, suckers, 3), np.float32)
-        self._visible = np.empty((capacity, len(self._creatures)), np.bool_)
+        self._replayed = (
+            self._replay.empty(capacity, len(self._creatures)) if self._replay.active else {}
+        )
+        self._visible = np.empty((max(1, self._capacity_hint), len(self._creatures)), np.bool_)
         self._alive = np.ones(len(self._creatures), dtype=bool)
+        self._base = 0  # frames handed to the writer (streamed)
+        self._flushed_last: dict[str, np.ndarray] = {}  # the last frame handed over
+        self._chunked_curves: list[CurvesTrack] | None = None  # streamed: decided at a flush
         self._changes = 0  # spawns and despawns while recording
         self._finished = False  # finish(): the arrays are the take's now
         self.count = 0
@@ -226,6 +246,7 @@ class TakeRecorder:
             return
         world = self.world
         self._changes += 1
+        self._replay.roster_changed()
         if not change.spawned:
             self._alive[self.creature_index[change.creature]] = False
             for rows, store in ((self._rows, "transforms"), (self._sucker_rows, "suckers")):
@@ -244,14 +265,29 @@ class TakeRecorder:
         self._attached = _widen(self._attached, np.zeros(added, np.bool_))
         self._anchor = _widen(self._anchor, np.zeros((added, 3)))
         self._visible = _widen(self._visible, np.zeros(1, np.bool_))
+        widened = {"pos": world.transforms.pos[new_rows], "quat": world.transforms.quat[new_rows],
+                   "anchor": np.zeros((added, 3), np.float32)}  # fmt: skip
+        for name, value in widened.items():  # the frame handed over last, widened too
+            if name in self._flushed_last:
+                self._flushed_last[name] = np.concatenate([self._flushed_last[name], value])
+        if self._replayed:
+            self._replay.creature_added()
+            blank = self._replay.empty(1, 1)
+            self._replayed = {k: _widen(v, blank[k][0]) for k, v in self._replayed.items()}
 
     def capture(self) -> None:
         """Append the world's current frame."""
         if self._finished:
             raise RuntimeError("this recording has finished (TakeRecorder.finish)")
-        world, i = self.world, self.count
+        world, i = self.world, self.count - self._base
         if i == len(self._pos):
-            self._grow()
+            if self.writer is not None:
+                self._flush()
+                i = 0
+            else:
+                self._grow()
+        if self.count == len(self._visible):
+            self._visible = _doubled(self._visible)
         transforms, suckers = world.transforms, world.suckers
         if not self._changes:  # every body and sucker there, in store order
             bodies = self._rows if self._span is None else self._span  # a slice: no gather
@@ -260,18 +296,79 @@ class TakeRecorder:
             self._attached[i] = suckers.attached
             self._anchor[i] = suckers.anchor
         else:
-            _gather(self._pos, i, transforms.pos, self._rows)
-            _gather(self._quat, i, transforms.quat, self._rows)
+            _gather(self._pos, i, transforms.pos, self._rows, self._before("pos", i))
+            _gather(self._quat, i, transforms.quat, self._rows, self._before("quat", i))
             _gather(self._attached, i, suckers.attached, self._sucker_rows, fill=False)
-            _gather(self._anchor, i, suckers.anchor, self._sucker_rows)
-        self._visible[i] = self._alive
+            _gather(self._anchor, i, suckers.anchor, self._sucker_rows, self._before("anchor", i))
+        if self._replayed:
+            self._replay.capture(self._replayed, i, self.creature_index, self._rows)
+        self._visible[self.count] = self._alive
         for recorder in self.tracks:
             recorder.capture(world)
         self.count += 1
+        if self.writer is not None and self.writer.chunk_frames is None:
+            self._size_chunks()
+
+    def _size_chunks(self) -> None:
+        """Frames per chunk from the first frame's bytes of every chunked array (the
+        curves tracks sampled by now among them), as `Take.save` counts them."""
+        assert self.writer is not None
+        frame = sum(a[:1].nbytes for a in self._chunk_arrays(1).values())
+        for track in self.tracks:
+            if isinstance(track, CurvesTrack):
+                frame += sum(a[:1].nbytes for a in track.arrays(1, copy=False).values())
+        self.writer.chunk_frames = per = chunks.chunk_frames(frame)
+        for name in ("_pos", "_quat", "_attached", "_anchor"):
+            setattr(self, name, _resized_frames(getattr(self, name), per))
+        self._replayed = {k: _resized_frames(v, per) for k, v in self._replayed.items()}
+
+    def _before(self, name: str, i: int) -> np.ndarray | None:
+        """Frame `i - 1` of chunked array `name` (`_pos`, ...): in the array, or the last
+        frame handed to the writer when `i` starts a chunk; None before the first."""
+        if i:
+            return np.asarray(getattr(self, f"_{name}")[i - 1])
+        return self._flushed_last.get(name)
+
+    def _chunk_arrays(self, frames: int) -> dict[str, np.ndarray]:
+        """The chunked arrays' first `frames` frames, by file name."""
+        out = {
+            "pos": self._pos[:frames],
+            "quat": self._quat[:frames],
+            "sucker_attached": self._attached[:frames],
+            "sucker_anchor": self._anchor[:frames],
+        }
+        out.update({name: value[:frames] for name, value in self._replayed.items()})
+        return out
+
+    def _flush(self) -> None:
+        """Hand the frames held to the writer (streamed recording). The first time, the
+        curves tracks recording by then are chunked too (`header["chunked"]`)."""
+        assert self.writer is not None
+        held = self.count - self._base
+        if not held:
+            return
+        if self._chunked_curves is None:
+            self._chunked_curves = [t for t in self.tracks if isinstance(t, CurvesTrack)
+                                    and t.flush(self._base) is not None]  # fmt: skip
+            curves = [a for t in self._chunked_curves for a in t.track.arrays]
+            self.header["chunked"] = [*self._chunk_arrays(0), *curves]
+        arrays = self._chunk_arrays(held)
+        for track in self._chunked_curves:
+            arrays.update(track.flush(self.count) or {})
+        numbers = {k: v for k, v in arrays.items() if not k.startswith("replay_")}
+        problem = data_problem(numbers, [t.track for t in self._chunked_curves], self._base)
+        if problem:  # a plugin's NaN: nobody could read the take
+            raise TakeError(f"{self.writer.path}: cannot write this take: {problem}")
+        self.writer.add_frames(take_replay.blanked(self.header, arrays))
+        # a creature gone keeps its last pose: remembered across the chunk boundary
+        self._flushed_last = {
+            name: getattr(self, f"_{name}")[held - 1].copy() for name in ("pos", "quat", "anchor")
+        }
+        self._base = self.count
 
     @property
     def capacity(self) -> int:
-        """Frames the arrays have room for now (they double when full)."""
+        """Frames the arrays have room for now (they double when full; streamed: a chunk)."""
         return len(self._pos)
 
     @property
@@ -285,29 +382,44 @@ class TakeRecorder:
         return self._changes
 
     def _grow(self) -> None:
-        for name in ("_pos", "_quat", "_attached", "_anchor", "_visible"):
-            old = getattr(self, name)
-            grown = np.empty((2 * len(old), *old.shape[1:]), old.dtype)
-            grown[: len(old)] = old
-            setattr(self, name, grown)
+        for name in ("_pos", "_quat", "_attached", "_anchor"):
+            setattr(self, name, _doubled(getattr(self, name)))
+        self._replayed = {name: _doubled(value) for name, value in self._replayed.items()}
 
     def take(self) -> Take:
         """The frames captured so far as a Take (copies; recording may go on)."""
+        if self.writer is not None:
+            raise RuntimeError("a streamed recording's frames are in its file")
         return self._take(copy=True)
 
     def finish(self) -> Take:
         """The frames captured, ending the recording: the take holds the recorder's own
         arrays and header, not copies (a bake holds its frames once, not twice; a
         capacity larger than the frames stays with them). `capture()` fails after."""
+        if self.writer is not None:
+            raise RuntimeError("a streamed recording ends with finish_stream()")
         self._finished = True
         return self._take(copy=False)
 
-    def _take(self, copy: bool) -> Take:
-        n = self.count
+    def finish_stream(self) -> dict[str, Any]:
+        """End a streamed recording: the last frames, the arrays without chunks and the
+        header go to the writer (its file is renamed into place when its block ends);
+        returns the header as written."""
+        assert self.writer is not None, "finish_stream() ends a streamed recording"
+        self._flush()
+        self._finished = True
+        header, tracks = self._header_and_tracks(self.count, copy=False)
+        self.writer.finish(header, tracks)
+        return {**header, "frames": self.writer.frames, "chunk_frames": self.writer.chunk_frames}
+
+    def _header_and_tracks(
+        self, n: int, copy: bool
+    ) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
         kept = np.copy if copy else np.asarray  # np.asarray: the array itself
         tracks: dict[str, np.ndarray] = {}
         for recorder in self.tracks:  # first: a curves track may name new owners
-            tracks.update(recorder.arrays(n, copy))
+            if recorder not in (self._chunked_curves or ()):  # streamed: in the chunks
+                tracks.update(recorder.arrays(n, copy))
         tracks.update({name: kept(a) for name, a in self._ground_arrays.items()})
         header = json.loads(json.dumps(self.header)) if copy else self.header  # deep copy
         header["frames"] = n
@@ -320,6 +432,14 @@ class TakeRecorder:
         if self._changes:
             header[take_roster.KEY] = {"changes": self._changes}
             tracks[take_roster.ARRAY] = kept(self._visible[:n])
+        tracks.update(self._replay.static_arrays())  # in file order: after the roster
+        return header, tracks
+
+    def _take(self, copy: bool) -> Take:
+        n = self.count
+        kept = np.copy if copy else np.asarray  # np.asarray: the array itself
+        header, tracks = self._header_and_tracks(n, copy)
+        tracks.update({name: kept(value[:n]) for name, value in self._replayed.items()})
         return Take(
             header=header,
             pos=kept(self._pos[:n]),
@@ -330,6 +450,20 @@ class TakeRecorder:
         )
 
 
+def _resized_frames(old: np.ndarray, frames: int) -> np.ndarray:
+    """`old` with room for `frames` frames (its first frame kept)."""
+    grown = np.empty((max(frames, 1), *old.shape[1:]), old.dtype)
+    grown[:1] = old[:1]
+    return grown
+
+
+def _doubled(old: np.ndarray) -> np.ndarray:
+    """`old` with room for twice its frames (the first ones copied)."""
+    grown = np.empty((2 * len(old), *old.shape[1:]), old.dtype)
+    grown[: len(old)] = old
+    return grown
+
+
 def _widen(frames: np.ndarray, now: np.ndarray) -> np.ndarray:
     """`frames` (capacity, items, ...) with items appended, every frame holding `now`."""
     extra = np.broadcast_to(np.asarray(now, dtype=frames.dtype), (len(frames), *now.shape))
@@ -337,17 +471,22 @@ def _widen(frames: np.ndarray, now: np.ndarray) -> np.ndarray:
 
 
 def _gather(
-    frames: np.ndarray, i: int, values: np.ndarray, rows: np.ndarray, fill: Any = None
+    frames: np.ndarray,
+    i: int,
+    values: np.ndarray,
+    rows: np.ndarray,
+    before: np.ndarray | None = None,
+    fill: Any = None,
 ) -> None:
-    """Frame `i` of `frames` from `values[rows]`; items whose row is gone (-1) hold the
-    previous frame's value (or `fill`)."""
+    """Frame `i` of `frames` from `values[rows]`; items whose row is gone (-1) hold
+    `before` (the previous frame's values; None: 0) or `fill`."""
     live = rows >= 0
     frames[i, live] = values[rows[live]]
     if not live.all():
         if fill is not None:
             frames[i, ~live] = fill
-        elif i:
-            frames[i, ~live] = frames[i - 1, ~live]
+        elif before is not None:
+            frames[i, ~live] = before[~live]
         else:
             frames[i, ~live] = 0
 

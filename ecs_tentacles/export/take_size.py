@@ -24,6 +24,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from ecs_tentacles.scene.construction import tentacle_params, tentacle_shape
+from ecs_tentacles.take.chunks import chunk_frames
 from ecs_tentacles.take.tracks import WIDEST_FLOAT, TrackSize
 
 POSE_BYTES = 7 * 4  # a body's position and quaternion in a frame (float32)
@@ -52,6 +53,23 @@ class TakeSize:
     def total(self, frames: int) -> int:
         """Bytes of a take of `frames` frames, at most."""
         return frames * self.frame_bytes + self.fixed_bytes
+
+    @property
+    def chunked_frame_bytes(self) -> int:
+        """Bytes a frame adds to the arrays stored in chunks (bodies, suckers, and the
+        tracks a bake stores in chunks: curves, replay records)."""
+        return sum(
+            part.items * part.frame_bytes
+            for i, part in enumerate(self.parts)
+            if i < 2 or part.chunked
+        )
+
+    def at_once(self, frames: int) -> int:
+        """Bytes a reader decodes at once, at most, for `frames` frames: a chunk of the
+        bodies and suckers (`take.chunks`), every frame of the tracks, the fixed part."""
+        chunked = self.chunked_frame_bytes
+        per_chunk = min(frames, chunk_frames(chunked))
+        return per_chunk * chunked + frames * (self.frame_bytes - chunked) + self.fixed_bytes
 
 
 def _digits_below(n: int) -> int:

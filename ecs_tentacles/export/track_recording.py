@@ -134,17 +134,20 @@ class CurvesTrack:
         self._first_shape: tuple[int, ...] = ()  # of the first sample
         # owners at the last change, their columns, and whether those are every column
         self._last: tuple[np.ndarray, np.ndarray, bool] | None = None
+        self._offset = 0  # the frame of row 0 (frames before were handed on: `flush`)
+        self._handed: tuple[np.ndarray, np.ndarray] | None = None  # the last frame handed on
 
     def capture(self, world: World) -> None:
         frame: CurvesFrame | None = self.sample(world) if self.sample else None
         key, f = self.track.key, self.recorder.count
+        r = f - self._offset  # the row of frame f (frames before were handed on: `flush`)
         if frame is None:
             if self._points is None:
                 return
             if not self.recorder.roster_changes:
                 raise ValueError(f"take track {key!r} disappeared during the recording")
-            self._room(f)  # its creatures were despawned: every curve holds
-            self._points[f], self._widths[f] = self._points[f - 1], self._widths[f - 1]
+            self._room(r)  # its creatures were despawned: every curve holds
+            self._hold(r)
             return
         points = np.asarray(frame.points, dtype=np.float32)
         widths = np.broadcast_to(np.asarray(frame.widths, dtype=np.float32), points.shape[:2])
@@ -164,29 +167,52 @@ class CurvesTrack:
         _, columns, whole = self._last
         if self._points is None:
             self.start, self._first_shape = f, points.shape
-        self._room(f)
+        self._room(r)
         assert self._points is not None
         if len(self._owners) > known:  # new curves: their first shape up to now
             new = np.flatnonzero(columns >= known)
-            self._points[: f + 1, columns[new]] = points[new]
-            self._widths[: f + 1, columns[new]] = widths[new]
+            self._points[: r + 1, columns[new]] = points[new]
+            self._widths[: r + 1, columns[new]] = widths[new]
         if whole:
-            self._points[f], self._widths[f] = points, widths
+            self._points[r], self._widths[r] = points, widths
         else:  # curves not sampled now hold their last shape
-            self._points[f], self._widths[f] = self._points[f - 1], self._widths[f - 1]
-            self._points[f, columns], self._widths[f, columns] = points, widths
+            self._hold(r)
+            self._points[r, columns], self._widths[r, columns] = points, widths
 
-    def _room(self, f: int) -> None:
-        """Make the arrays hold frame `f` and every column."""
+    def _hold(self, r: int) -> None:
+        """Row `r` holds the frame before's curves (handed on already when `r` is 0)."""
+        assert self._points is not None
+        if r:
+            self._points[r], self._widths[r] = self._points[r - 1], self._widths[r - 1]
+        elif self._handed is not None:
+            points, widths = self._handed
+            self._points[0, : points.shape[0]], self._widths[0, : widths.shape[0]] = points, widths
+
+    def flush(self, upto: int) -> dict[str, np.ndarray] | None:
+        """Hand on frames up to `upto` (exclusive) and forget them: their arrays (None
+        before the first sample). A streamed take stores them in chunks; frames before a
+        curve first appeared are filled by the reader with its first shape."""
+        if self._points is None:
+            return None
+        rows = upto - self._offset
+        first, second = self.track.arrays
+        out = {first: self._points[:rows].copy(), second: self._widths[:rows].copy()}
+        if rows:
+            self._handed = (out[first][-1], out[second][-1])
+        self._offset = upto
+        return out
+
+    def _room(self, r: int) -> None:
+        """Make the arrays hold row `r` and every column."""
         count, size = len(self._owners), self._first_shape[1]
         if self._points is None:
-            frames = max(self.recorder.capacity, f + 1)
+            frames = max(self.recorder.capacity, r + 1)
             self._points = np.empty((frames, count, size, 3), np.float32)
             self._widths = np.empty((frames, count, size), np.float32)
             return
         frames = len(self._points)
-        if f >= frames:
-            frames = max(2 * frames, f + 1)
+        if r >= frames:
+            frames = max(2 * frames, r + 1)
         if frames > len(self._points) or count > self._points.shape[1]:
             self._points = _resized(self._points, frames, count)
             self._widths = _resized(self._widths, frames, count)
@@ -214,7 +240,8 @@ class CurvesTrack:
         if self._points is None:
             return {}
         first, second = self.track.arrays
-        points, widths = self._points[:frames], self._widths[:frames]
+        rows = frames - self._offset
+        points, widths = self._points[:rows], self._widths[:rows]
         if copy:
             points, widths = points.copy(), widths.copy()
         return {first: points, second: widths}

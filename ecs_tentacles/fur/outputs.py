@@ -38,7 +38,7 @@ def guide_sizes(scene: Mapping[str, Any]) -> list[TrackSize]:
     points = max(c["fur"]["groom"]["points"] for _, c in furs)
     owners = sum(n * (len(str(i)) + 1) for n, (i, _) in zip(guides, furs, strict=True))
     each = f"of {points} points"
-    return [TrackSize("fur guides", sum(guides), points * POINT_BYTES, owners, each)]
+    return [TrackSize("fur guides", sum(guides), points * POINT_BYTES, owners, each, chunked=True)]
 
 
 def pose_fur_at_build(world: Host) -> None:

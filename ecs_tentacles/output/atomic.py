@@ -22,10 +22,12 @@ fsynced and renamed onto the target, then the folder is fsynced.
   without a claim, when the writing starts); at the end, under a lock on the folder,
   a run whose target changed meanwhile discards its own output and raises
   `OutputConflict` instead of overwriting the other run's file.
-- A process killed outright (SIGKILL, power loss) can leave its hidden temporary file
-  behind (USD's own `.take.3f9a1c2e.partial.XXXXXX` too), never a partial target. The
-  next write to the same target removes such leftovers older than a day
-  (`STALE_SECONDS`) and says so on stderr.
+- A process killed outright (SIGKILL, power loss) never leaves a partial target. Writers
+  that take a file (`atomic_file`: takes, glb, PNG) write an unnamed file on Linux
+  (`O_TMPFILE`), named only when it is finished, so a killed one leaves nothing at all;
+  elsewhere, and for writers that take a path (USD's own `.take.3f9a1c2e.partial.XXXXXX`
+  too), a hidden temporary file can stay behind: the next write to the same target
+  removes such leftovers older than a day (`STALE_SECONDS`) and says so on stderr.
 """
 
 from __future__ import annotations
@@ -91,6 +93,41 @@ def _create_exclusive(path: Path) -> tuple[Path, int]:
             continue
         except OSError as error:
             raise OutputError(f"{path}: cannot write: {error.strerror or error}") from None
+
+
+def _link_descriptor(descriptor: int, name: Path) -> bool:
+    """Give the unnamed file `descriptor` the name `name` (`linkat`): through /proc, else
+    by `AT_EMPTY_PATH`; False where neither is allowed (FileExistsError: name taken)."""
+    try:
+        os.link(f"/proc/self/fd/{descriptor}", name, follow_symlinks=True)
+        return True
+    except FileExistsError:
+        raise
+    except OSError:
+        pass
+    import ctypes
+
+    libc = ctypes.CDLL(None, use_errno=True)
+    at_fdcwd, at_empty_path = -100, 0x1000
+    if libc.linkat(descriptor, b"", at_fdcwd, os.fsencode(name), at_empty_path) == 0:
+        return True
+    if ctypes.get_errno() == errno.EEXIST:
+        raise FileExistsError(errno.EEXIST, os.strerror(errno.EEXIST), str(name))
+    return False
+
+
+def _create_unnamed(path: Path) -> int | None:
+    """An unnamed file in `path`'s folder (Linux `O_TMPFILE`), or None where the system
+    or the file system has none (the caller then makes a named one)."""
+    flag = getattr(os, "O_TMPFILE", None)
+    if flag is None or not os.path.isdir("/proc/self/fd"):
+        return None
+    try:
+        return os.open(path.parent, flag | os.O_WRONLY | os.O_CLOEXEC, 0o666)
+    except OSError as error:
+        if error.errno in (errno.EOPNOTSUPP, errno.EISDIR, errno.EINVAL, errno.ENOENT):
+            return None
+        raise OutputError(f"{path}: cannot write: {error.strerror or error}") from None
 
 
 def partial_pattern(path: Path) -> re.Pattern[str]:
@@ -223,18 +260,57 @@ class AtomicOutput:
     def __init__(self, target: str | os.PathLike[str]):
         self.target = Path(target)
         self.temporary: Path | None = None
+        self.unnamed: int | None = None  # the descriptor of an unnamed file (O_TMPFILE)
         self._before: Identity = None
         self._created: tuple[int, int] | None = None
 
-    def open(self) -> int:
-        """Clean stale leftovers, create the temporary file; returns its open descriptor."""
+    def open(self, *, unnamed: bool = False) -> int:
+        """Clean stale leftovers, create the temporary file; returns its open descriptor.
+
+        `unnamed`: where the system allows (Linux `O_TMPFILE`), a file with no name in the
+        folder until `commit` links it there, so even a killed process leaves nothing
+        behind; the caller keeps the descriptor open until `commit`."""
         remove_stale_partials(self.target)
         key = _claim_key(self.target)
         self._before = _claims.pop(key) if key in _claims else _identity(self.target)
-        self.temporary, descriptor = _create_exclusive(self.target)
+        descriptor = _create_unnamed(self.target) if unnamed else None
+        if descriptor is None:
+            self.temporary, descriptor = _create_exclusive(self.target)
+        else:
+            self.unnamed = descriptor
         info = os.fstat(descriptor)
         self._created = (info.st_dev, info.st_ino)
         return descriptor
+
+    def _link_unnamed(self) -> None:
+        """Give the unnamed file its temporary name in the target's folder (fsynced first)."""
+        assert self.unnamed is not None
+        descriptor, self.unnamed = self.unnamed, None
+        with self.discarded_on_error():
+            _stop_if_asked()
+            os.fsync(descriptor)
+            while True:
+                candidate = temporary_name(self.target, secrets.token_hex(4))
+                try:
+                    linked = _link_descriptor(descriptor, candidate)
+                except FileExistsError:
+                    continue
+                if linked:
+                    self.temporary = candidate
+                    return
+                break
+            # no way to name it here: a copy into a named temporary file
+            self.temporary, copy = _create_exclusive(self.target)
+            try:
+                size = os.fstat(descriptor).st_size
+                done = 0
+                while done < size:
+                    done += os.copy_file_range(descriptor, copy, size - done, done, done)
+                os.fsync(copy)
+                info = os.fstat(copy)
+                self._created = (info.st_dev, info.st_ino)
+            finally:
+                os.close(copy)
 
     def commit(self, *, same_file: bool = False) -> Path:
         """Fsync the finished temporary file and rename it onto the target.
@@ -243,6 +319,8 @@ class AtomicOutput:
         the one we created (path-based writers such as USD may replace it by rename).
         Raises `OutputConflict` (and discards) if the target changed since `open()`.
         """
+        if self.unnamed is not None:
+            self._link_unnamed()
         assert self.temporary is not None, "open() first"
         temporary = self.temporary
         try:
@@ -350,7 +428,9 @@ def atomic_file(target: str | os.PathLike[str]) -> Iterator[BinaryIO]:
     The writer never opens a path itself, so nothing planted in the folder is followed.
     """
     output = AtomicOutput(target)
-    descriptor = output.open()
+    descriptor = output.open(unnamed=True)
+    # a full disk may show only when the buffer is flushed: inside, so it is one line
     with output.discarded_on_error(), os.fdopen(descriptor, "wb") as handle:
         yield handle
-    output.commit(same_file=True)
+        handle.flush()
+        output.commit(same_file=True)  # the file still open: an unnamed one is linked

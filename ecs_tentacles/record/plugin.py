@@ -38,3 +38,7 @@ class RecordPlugin(Plugin):
         """The frames recorded, ending the recording (the take holds the recorder's
         arrays: no copies)."""
         return self.system.finish()
+
+    def finish_stream(self) -> dict[str, Any]:
+        """End a recording streamed to its `writer` (a `TakeWriter`); the header written."""
+        return self.system.finish_stream()

@@ -6,22 +6,35 @@ goals still to reach (points, from locomotion) and, when the world has fur, the 
 curves (curves, from fur), plus any track a plugin declares. The header (JSON) names
 everything and carries the geometry, so exporters (USD, glTF) need nothing but the take.
 
-The file is a zip of `.npy` arrays in this fixed order; every entry is dated
-1980-01-01, so the same scene and seed give byte-identical files:
+The file is a zip of `.npy` arrays (`np.load(path)` opens it), every entry dated
+1980-01-01 and deflated, so the same scene and seed give byte-identical files. Version 2
+(what is written) stores the arrays that grow with the shot in chunks of frames,
+written as a bake goes (`ecs_tentacles.take.chunks`: entry `pos.000003.npy` holds frames
+3C..4C-1 of `pos`, C = `header["chunk_frames"]`), the others whole:
 
-    header           uint8    UTF-8 JSON (see `Take.header`)
-    pos              float32  (frames, bodies, 3)  body centres, metres, z up
-    quat             float32  (frames, bodies, 4)  body orientations (w, x, y, z)
-    sucker_attached  bool     (frames, suckers)
-    sucker_anchor    float32  (frames, suckers, 3) world anchor (kept after release)
-    goal_pos         float32  (goals, 3)                       the standard points track
-    goal_active      bool     (frames, goals)      still in its creature's path
+    pos              float32  (frames, bodies, 3)  body centres, metres, z up   chunked
+    quat             float32  (frames, bodies, 4)  body orientations (w, x, y, z) chunked
+    sucker_attached  bool     (frames, suckers)                                  chunked
+    sucker_anchor    float32  (frames, suckers, 3) world anchor (kept after release) chunked
+    replay_*         a replayed creature's clip, phase and root motion per frame  chunked
+                     (`ecs_tentacles.take.replay`; its bodies are zeros in pos/quat)
     guide_points     float32  (frames, guides, points, 3)   the standard curves track,
     guide_widths     float32  (frames, guides, points)      only when guides are recorded
+                     (chunked when recording when the first chunk was stored:
+                     `header["chunked"]` lists every chunked array)
+    goal_pos         float32  (goals, 3)                       the standard points track
+    goal_active      bool     (frames, goals)      still in its creature's path
     ...              the arrays of the tracks `header.tracks` declares, in its order
+    replay_clip_<i>  float64  a gait clip's frames, once per body plan
     ground_*         the terrain's meshes, on terrain (`ecs_tentacles.take.ground`)
     creature_visible bool     (frames, creatures)  only when creatures came or went
                                                    (`ecs_tentacles.take.roster`)
+    header           uint8    UTF-8 JSON (see `Take.header`), last
+
+Version 1 files (every array one entry, header first, no replay records) still read.
+Readers decode a chunk at a time (`ecs_tentacles.take.stream.open_take`) or the whole
+take (`Take.load`, replayed creatures' poses filled in); `MAX_TAKE_BYTES` caps what is
+decoded at once, not the shot.
 
 Frame i is simulated time i / fps; frame 0 is the pose the scene was built in.
 Bodies: a mantle is a cylinder along its local +z (`length` = height), a link a
@@ -41,8 +54,9 @@ from typing import IO, Any, BinaryIO
 
 import numpy as np
 
-from ecs_tentacles.output.atomic import atomic_file
+from ecs_tentacles.take import chunks
 from ecs_tentacles.take import ground as take_ground
+from ecs_tentacles.take import replay as take_replay
 from ecs_tentacles.take import roster as take_roster
 from ecs_tentacles.take.read import (
     FORMAT,
@@ -89,7 +103,9 @@ class Take:
 
     @classmethod
     def from_arrays(cls, header: dict[str, Any], arrays: dict[str, np.ndarray]) -> Take:
-        """A take from its header and arrays by file name (as `read_take` returns them)."""
+        """A take from its header and arrays by file name (as `read_take` returns them);
+        what the header says of the file's layout (its chunks) is left out."""
+        header = {k: v for k, v in header.items() if k not in ("chunk_frames", "chunked")}
         core = {k: arrays[k] for k in CORE_ARRAYS[1:]}
         rest = {k: v for k, v in arrays.items() if k not in CORE_ARRAYS}
         return cls(header=header, **core, tracks=rest)
@@ -157,6 +173,7 @@ class Take:
         names = [*CORE_ARRAYS[1:], *(a for t in self.track_list() for a in t.arrays)]
         names += list(take_ground.dtypes(self.header))
         names += list(take_roster.dtypes(self.header))
+        names += list(take_replay.dtypes(self.header))
         for name in names:
             value = self.array(name)
             if value is not None:
@@ -174,18 +191,29 @@ class Take:
                 f"header: {header / 1024**2:,.0f} MiB, over the {MAX_HEADER_BYTES / 1024**2:g}"
                 " MiB a take's header holds"
             )
-        stored = self.stored_bytes()
-        if stored > MAX_TAKE_BYTES:
+        at_once = self.decoded_at_once()
+        if at_once > MAX_TAKE_BYTES:
             return (
-                f"its {len(entries)} arrays would be {stored:,} bytes, over the"
-                f" {MAX_TAKE_BYTES:,} ({MAX_TAKE_BYTES / 1024**3:g} GiB) a take holds"
+                f"its {len(entries)} arrays would be {at_once:,} bytes to read at once, over"
+                f" the {MAX_TAKE_BYTES:,} ({MAX_TAKE_BYTES / 1024**3:g} GiB) a take's reader"
+                " decodes at once"
             )
         return None
 
+    def decoded_at_once(self) -> int:
+        """Bytes a reader of the saved file decodes at once (`take.stream`): a chunk of
+        the chunked arrays (bodies, suckers, replay records) and every other array whole."""
+        entries = self._entries()
+        chunked = tuple(n for n in chunks.chunkable(self.header) if n in entries)
+        frame = sum(entries[n][:1].nbytes for n in chunked)
+        per = min(self.frames, chunks.chunk_frames(frame))
+        rest = sum(v.nbytes for n, v in entries.items() if n not in chunked and n != "header")
+        return per * frame + rest + entries["header"].nbytes
+
     def stored_bytes(self) -> int:
-        """Bytes of the file's entries before compression: each array's `.npy` header and
-        data (what `save` tells its `progress` of). Counted from shapes: nothing copied."""
-        return sum(_npy_bytes(value) for value in self._entries().values())
+        """Bytes of the file's arrays before compression (what `save` tells its
+        `progress` of). Counted from shapes: nothing copied."""
+        return sum(value.nbytes for value in self._entries().values())
 
     # -- files -------------------------------------------------------------------------
     def save(
@@ -199,8 +227,18 @@ class Take:
         problem = self.problem()
         if problem:
             raise TakeError(f"{path}: cannot write this take: {problem}")
-        with atomic_file(path) as handle:
-            write_npz(handle, self.arrays(), progress)
+        from ecs_tentacles.take.writer import TakeWriter
+
+        entries = self._entries()
+        del entries["header"]
+        chunked = tuple(n for n in chunks.chunkable(self.header) if n in entries)
+        header = {**self.header, "chunked": list(chunked)}
+        per = chunks.chunk_frames(sum(entries[n][:1].nbytes for n in chunked))
+        with TakeWriter(path, per, progress) as writer:
+            for first in range(0, self.frames, per):
+                part = {n: entries[n][first : first + per] for n in chunked}
+                writer.add_frames(take_replay.blanked(header, part))
+            writer.finish(header, {n: a for n, a in entries.items() if n not in chunked})
 
     @classmethod
     def load(cls, path: str | os.PathLike[str], max_bytes: int = MAX_TAKE_BYTES) -> Take:
@@ -235,6 +273,7 @@ class Take:
                 points[track.arrays[0]] = first.shape[2] if first.ndim == 4 else -1
         known = {*CORE_ARRAYS, *(a for t in tracks for a in t.arrays)}
         known |= set(take_ground.dtypes(self.header)) | set(take_roster.dtypes(self.header))
+        known |= set(take_replay.dtypes(self.header))
         unknown = sorted(set(self.tracks) - known)
         if unknown:
             return f"{unknown[0]}: not a track of this take"

@@ -18,6 +18,7 @@ from typing import Any, cast
 import numpy as np
 
 from ecs_tentacles.take import ground as take_ground
+from ecs_tentacles.take import replay as take_replay
 from ecs_tentacles.take import roster as take_roster
 from ecs_tentacles.take.tracks import TakeTrack, declared_problem, dtypes, tracks_of
 
@@ -28,7 +29,8 @@ MAX_COORDINATE = 1e6  # metres: a position farther out is a blow-up, not a creat
 MAX_FRAMES = 1_000_000  # 4.6 hours at 60 fps: frames are bounded even with no bodies
 MAX_BODIES = 16384 * 1025  # the schema's most creatures x the bodies of its largest one
 FORMAT = "ecs_tentacles.take"
-VERSION = 1
+VERSION = 2  # what is written; version 1 files (no chunks, no replay records) still read
+VERSIONS = (1, 2)
 CORE_DTYPES: dict[str, np.dtype[Any]] = {
     "header": np.dtype(np.uint8),
     "pos": np.dtype("<f4"),
@@ -174,8 +176,11 @@ def header_problem(header: object) -> str | None:
     """The first problem of a take header as a one-line `header.<path>: <what>`, or None."""
     if not isinstance(header, dict) or header.get("format") != FORMAT:
         return f"header.format: expected {FORMAT!r}"
-    if header.get("version") != VERSION:
-        return f"header.version: this reader knows version {VERSION}, got {header.get('version')!r}"
+    version = header.get("version")
+    from ecs_tentacles.take import chunks  # imports the tracks, as this module does
+
+    if isinstance(version, bool) or version not in VERSIONS:
+        return f"header.version: this reader knows versions 1 and 2, got {version!r}"
     fps: Any = header.get("fps")
     if not _is_number(fps) or not 0 < fps <= MAX_FPS:
         return f"header.fps: must be a number in (0, {MAX_FPS}], got {fps!r}"
@@ -183,6 +188,14 @@ def header_problem(header: object) -> str | None:
         return f"header.frames: must be a whole number >= 1, got {header.get('frames')!r}"
     if header["frames"] > MAX_FRAMES:
         return f"header.frames: at most {MAX_FRAMES} in a take, got {header['frames']}"
+    if version == 2:  # absent in memory: the file's writer sets it
+        chunk = header.get("chunk_frames", 1)
+        if not _is_int(chunk) or not 1 <= chunk <= MAX_FRAMES:
+            return (
+                f"header.chunk_frames: must be a whole number in [1, {MAX_FRAMES}], got {chunk!r}"
+            )
+    elif header.get(take_replay.KEY) is not None:
+        return f"header.{take_replay.KEY}: only version 2 takes record replayed creatures"
     for key, check in (("scene", str), ("scene_sha256", str)):
         if not isinstance(header.get(key), check):
             return f"header.{key}: missing or not a string"
@@ -201,6 +214,8 @@ def header_problem(header: object) -> str | None:
         or _parts_problem(header)
         or take_ground.problem(header)
         or take_roster.problem(header)
+        or take_replay.problem(header)
+        or (chunks.chunked_problem(header) if version == 2 else None)
     )
 
 
@@ -228,6 +243,7 @@ def expected_shapes(
             shapes[second] = (frames, curves, points[first])
     shapes.update(take_ground.shapes(header))
     shapes.update(take_roster.shapes(header))
+    shapes.update(take_replay.shapes(header))
     return shapes
 
 
@@ -239,4 +255,5 @@ def array_dtypes(header: dict[str, Any]) -> dict[str, np.dtype[Any]]:
             out[name] = np.dtype(dtype)
     out.update(take_ground.dtypes(header))
     out.update(take_roster.dtypes(header))
+    out.update(take_replay.dtypes(header))
     return out

@@ -95,13 +95,15 @@ class TrackSize:
     """What a track will hold in a take of a scene, from the scene alone: `items` of
     `what` (a plural noun, "goals"; `each` may say more of one, "of 8 points"), each
     `frame_bytes` a frame, and `fixed_bytes` in all once (header entries and arrays that
-    do not grow with frames; at most). Counted before anything is built."""
+    do not grow with frames; at most); `chunked` when a bake stores it in chunks of
+    frames (curves tracks, replay records). Counted before anything is built."""
 
     what: str
     items: int
     frame_bytes: int
     fixed_bytes: int = 0
     each: str = ""
+    chunked: bool = False  # stored in chunks of frames (a reader holds one chunk of it)
 
 
 def dtypes(track: TakeTrack) -> tuple[str, str]:

@@ -39,7 +39,7 @@ class Record(System):
         if every < 1:
             raise ValueError(f"every must be >= 1, got {every}")
         self.every = every
-        self._options = recorder  # TakeRecorder keywords: scene_sha256, capacity, tracks
+        self._options = recorder  # TakeRecorder keywords: scene_sha256, capacity, tracks, writer
         self.recorder: TakeRecorder | None = None
         self._start = 0
 
@@ -72,6 +72,10 @@ class Record(System):
     def finish(self) -> Take:
         """The frames recorded, ending the recording (no copies: `TakeRecorder.finish`)."""
         return self._recorder().finish()
+
+    def finish_stream(self) -> dict[str, Any]:
+        """End a streamed recording (`TakeRecorder.finish_stream`); the header written."""
+        return self._recorder().finish_stream()
 
     def _recorder(self) -> TakeRecorder:
         if self.recorder is None:

@@ -30,9 +30,22 @@ BEACONS = {
 
 
 def _read(good: Path) -> tuple[dict[str, Any], Entries]:
+    """The header and arrays of `good`, in version 1's layout (chunks joined): the cases
+    break a whole array; `CHUNK_CASES` break a version 2 file's chunks."""
     with np.load(good) as npz:
         arrays: Entries = {name: npz[name] for name in npz.files}
     header = json.loads(arrays["header"].tobytes())
+    chunked: dict[str, list[Any]] = {}
+    for name in sorted(arrays):
+        if "." in name:
+            chunked.setdefault(name.split(".")[0], []).append(arrays.pop(name))
+    arrays.update({name: np.concatenate(parts) for name, parts in chunked.items()})
+    if chunked:
+        header["version"] = 1
+        for key in ("chunk_frames", "chunked", "replay"):
+            header.pop(key, None)
+        for name in [n for n in arrays if n.startswith("replay_")]:
+            del arrays[name]
     return header, arrays
 
 
@@ -88,7 +101,7 @@ def _claim_huge(data: bytes) -> bytes:
     while at >= 0:
         name_length = struct.unpack_from("<H", out, at + 28)[0]
         name = bytes(out[at + 46 : at + 46 + name_length])
-        if name == b"pos.npy":
+        if name in (b"pos.npy", b"pos.000000.npy"):
             struct.pack_into("<I", out, at + 24, 0xFFFFFF00)  # about 4 GiB
         at = out.find(b"PK\x01\x02", at + 4)
     return bytes(out)
@@ -166,7 +179,7 @@ BROKEN_TAKES: dict[str, Callable[[Path, Path], None]] = {
     "frames_float": edit(lambda h, a: h.update(frames=float(h["frames"]))),
     "frames_billions": edit(lambda h, a: h.update(frames=10**9)),
     "frames_trillion_without_bodies": edit(_trillion_empty_frames),
-    "version_2": edit(lambda h, a: h.update(version=2)),
+    "version_3": edit(lambda h, a: h.update(version=3)),
     "no_format": edit(lambda h, a: h.pop("format")),
     "header_not_json": edit(lambda h, a: a.update(header=_npy(np.frombuffer(b"{oops", np.uint8)))),
     "body_index_out_of_range": edit(lambda h, a: h["creatures"][0]["tentacles"][0].append(999)),

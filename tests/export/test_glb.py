@@ -53,6 +53,7 @@ def _longer(take: Take, frames: int, creatures: int = 1) -> Take:
         header["bodies"] += [renamed(body, creature=c) for body in bodies]
         header["suckers"] += [renamed(s, body=first + s["body"]) for s in take.header["suckers"]]
     header["frames"], header["goals"], header["guides"] = frames, [], None
+    header.pop("replay", None)  # nobody replays here
     apart = np.repeat(np.arange(creatures) * 2.0, per)[None, :, None] * [1.0, 0.0, 0.0]
     arrays = {
         "pos": (np.tile(take.pos[order], (1, creatures, 1)) + apart).astype(np.float32),
@@ -84,7 +85,7 @@ def test_a_rigid_glb_is_written_with_memory_a_fraction_of_its_size(
     (4 here), the bytes spooled; building it in memory held the file three times over."""
     take = _longer(guided_take, 2_000, creatures=32)
     monkeypatch.setattr("ecs_tentacles.export.gltf.BLOCK_BYTES", 1024**2)
-    monkeypatch.setattr("ecs_tentacles.take.read.CHECK_BYTES", 1024**2)  # the take's checks
+    monkeypatch.setattr("ecs_tentacles.take.entries.CHECK_BYTES", 1024**2)  # the take's checks
     path = tmp_path / "long.glb"
     peak = _peak(lambda: write_glb(take, path))
     size = path.stat().st_size

@@ -68,9 +68,16 @@ def test_a_take_on_terrain_holds_its_meshes_and_reads_back(
 
 
 def _rewrite(path: Path, out: Path, change: dict[str, np.ndarray]) -> None:
+    """`path` with arrays replaced; a new header keeps what the file's said of its layout
+    (its chunks)."""
     with np.load(path) as data:
         arrays = {name: data[name] for name in data.files}
+    layout = {k: v for k, v in json.loads(arrays["header"].tobytes()).items()
+              if k in ("chunk_frames", "chunked")}  # fmt: skip
     arrays.update(change)
+    if "header" in change:
+        header = {**json.loads(change["header"].tobytes()), **layout}
+        arrays["header"] = np.frombuffer(json.dumps(header).encode(), np.uint8)
     write_npz(out, arrays)
 
 

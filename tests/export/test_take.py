@@ -103,7 +103,10 @@ def test_two_bakes_of_the_same_scene_and_seed_are_byte_identical(tmp_path: Path)
     assert a != c  # the seed matters (per-tentacle wave phases)
     with zipfile.ZipFile(tmp_path / "a.npz") as archive:
         entries = archive.infolist()
-    assert [e.filename for e in entries] == [f"{n}.npy" for n in ARRAYS[:7]]
+    replay = ["replay_kind", "replay_phase", "replay_xy", "replay_heading"]
+    chunked = [f"{n}.000000.npy" for n in [*ARRAYS[1:5], *replay]]  # one chunk of 9 frames
+    assert [e.filename for e in entries] == [*chunked, "goal_pos.npy", "goal_active.npy",
+                                             "header.npy"]  # fmt: skip
     assert {e.date_time for e in entries} == {(1980, 1, 1, 0, 0, 0)}
     header = json.loads(np.load(tmp_path / "a.npz")["header"].tobytes())
     assert header["scene_sha256"] == plan.scene_sha256 and len(plan.scene_sha256) == 64
@@ -137,10 +140,13 @@ def _take(tmp_path: Path, **changes: object) -> Path:
     world.add_system(system)
     take = system.take()
     world.close()
-    arrays = take.arrays()
+    # a version 1 file (one entry per array, no replay records)
+    base = {k: v for k, v in take.header.items() if k != "replay"} | {"version": 1}
+    arrays = {k: v for k, v in take.arrays().items() if not k.startswith("replay_")}
+    arrays["header"] = np.frombuffer(json.dumps(base).encode(), np.uint8)
     for key, value in changes.items():
         if key == "header":
-            header = {**take.header, **value}  # type: ignore[dict-item]
+            header = {**base, **value}  # type: ignore[dict-item]
             arrays["header"] = np.frombuffer(json.dumps(header).encode(), np.uint8)
         elif value is None:
             del arrays[key]
@@ -163,7 +169,7 @@ def test_bad_take_files_give_one_line(tmp_path: Path) -> None:
             Take.load(path)
         assert str(caught.value) == f"{path}: {message}"
     for changes, message in [
-        ({"header": {"version": 9}}, "header.version: this reader knows version 1, got 9"),
+        ({"header": {"version": 9}}, "header.version: this reader knows versions 1 and 2, got 9"),
         ({"header": {"format": "x"}}, "header.format: expected 'ecs_tentacles.take'"),
         ({"quat": None}, "quat: missing"),
         (
@@ -177,7 +183,7 @@ def test_bad_take_files_give_one_line(tmp_path: Path) -> None:
         assert str(caught.value) == f"{path}: {message}"
 
 
-def _stretched(take: Take, frames: int, guides: int) -> Take:
+def _stretched(take: Take, frames: int, guides: int, points: int = 4) -> Take:
     """`take` as if it ran `frames` frames with `guides` guides: views of its first frame
     (nothing is allocated)."""
     header = {**take.header, "frames": frames, "guides": {"creatures": [0] * guides}}
@@ -186,8 +192,10 @@ def _stretched(take: Take, frames: int, guides: int) -> Take:
         return np.broadcast_to(array[:1], (frames, *(shape or array.shape[1:])))
 
     tracks = {**take.tracks, "goal_active": each_frame(take.tracks["goal_active"])}
-    tracks["guide_points"] = each_frame(take.tracks["guide_points"][:, :1], (guides, 4, 3))
-    tracks["guide_widths"] = each_frame(take.tracks["guide_widths"][:, :1], (guides, 4))
+    for name in [n for n in tracks if n.startswith("replay_") and not n.startswith("replay_clip")]:
+        tracks[name] = each_frame(tracks[name])
+    tracks["guide_points"] = each_frame(take.tracks["guide_points"][:, :1, :1], (guides, points, 3))
+    tracks["guide_widths"] = each_frame(take.tracks["guide_widths"][:, :1, :1], (guides, points))
     return Take(
         header=header,
         pos=each_frame(take.pos),
@@ -200,16 +208,19 @@ def _stretched(take: Take, frames: int, guides: int) -> Take:
 
 def test_a_take_too_big_to_read_back_is_never_written(guided_take: Take, tmp_path: Path) -> None:
     """What a bake cannot count before it starts (tracks that grow while it runs, creatures
-    spawned) may still make a take over the reader's 2 GiB: `save` refuses it in one line
-    and writes nothing, as the reader would refuse it; just under the limit it is kept."""
+    spawned) may still make a take whose reader would decode over 2 GiB at once (the
+    tracks held whole, a chunk of the rest): `save` refuses it in one line and writes
+    nothing, as the reader would refuse it; just under the limit it is kept. A long shot
+    alone is no reason: its frames are read a chunk at a time."""
     out = tmp_path / "take.npz"
-    over = _stretched(guided_take, 100_000, 330)  # 64 bytes a guide a frame
+    long_shot = _stretched(guided_take, 100_000, 330)  # 64 bytes a guide a frame: 2 GiB
+    assert long_shot.size_problem() is None
+    over = _stretched(guided_take, 2, 1_000_000, 135)  # one frame of guides: 2.16 GB
     with pytest.raises(TakeError) as refused:
         over.save(out)
     assert str(refused.value) == (
-        f"{out}: cannot write this take: its 9 arrays would be 2,152,404,253 bytes, over the"
-        " 2,147,483,648 (2 GiB) a take holds"
+        f"{out}: cannot write this take: its 13 arrays would be 2,162,002,913 bytes to read at"
+        " once, over the 2,147,483,648 (2 GiB) a take's reader decodes at once"
     )
     assert list(tmp_path.iterdir()) == []
-    assert over.size_problem() is not None
-    assert _stretched(guided_take, 100_000, 329).size_problem() is None
+    assert _stretched(guided_take, 2, 1_000_000, 133).size_problem() is None

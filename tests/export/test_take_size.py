@@ -54,13 +54,18 @@ def test_what_a_bake_counts_is_what_its_take_holds(tmp_path: Path) -> None:
         ("suckers", 256),
         ("goals", 12),
         ("fur guides", 360),
+        ("replay records", 12),
     ]
-    assert counted.frame_bytes == 458 * 28 + 256 * 13 + 12 + 360 * 10 * 16
-    arrays = sum(size - 128 for name, size in stored.items() if name != "header.npy")
+    assert counted.frame_bytes == 458 * 28 + 256 * 13 + 12 + 360 * 10 * 16 + 12 * 33
+    arrays = sum(
+        size - 128
+        for name, size in stored.items()
+        if name != "header.npy" and not name.startswith("replay_clip_")  # once, if any
+    )
     per_frame = arrays - 12 * 12  # the goals' positions are stored once
     assert per_frame == plan.frames * counted.frame_bytes
     entries = {key: len(json.dumps(header[key], separators=(",", ":"))) for key in header}
-    bodies, suckers, goals, guides = counted.parts
+    bodies, suckers, goals, guides, _ = counted.parts
     assert entries["bodies"] + entries["creatures"] == bodies.fixed_bytes + 2  # the brackets
     assert entries["suckers"] == suckers.fixed_bytes + 1
     assert entries["goals"] + 12 * 12 == goals.fixed_bytes + 1
@@ -83,7 +88,8 @@ def test_a_header_the_reader_would_refuse_is_refused_before_anything_is_built() 
     """1,000 creatures of 481 bodies and 480 suckers name them in 119 MiB of header; a
     reader takes 64 MiB: a bake of a frame is refused. 500 of them fit in 60 MiB."""
     assert BakePlan.make(_crowd(1000), seconds=0.05).size_problem() == (
-        "the take's header would be 119 MiB for 481,000 bodies and 480,000 suckers; a take's"
+        "the take's header would be 119 MiB for 481,000 bodies, 480,000 suckers and 1,000 replay"
+        " records; a take's"
         " header holds at most 64 MiB (bake fewer creatures)"
     )
     assert BakePlan.make(_crowd(500), seconds=0.05).size_problem() is None
