@@ -19,9 +19,18 @@ from ecs_tentacles.take import Take, TakeError
 
 if TYPE_CHECKING:
     from ecs_tentacles.export.skinned import Skin
+    from ecs_tentacles.export.take_chunks import ChunkSource
     from ecs_tentacles.skin.keys import KeyReport
 
-__all__ = ["SUFFIXES", "Take", "TakeError", "output_kind", "work_units", "write"]
+__all__ = [
+    "SUFFIXES",
+    "Take",
+    "TakeError",
+    "output_kind",
+    "work_units",
+    "write",
+    "write_usd_stream",
+]
 
 SUFFIXES = (".npz", ".usd", ".usda", ".usdc", ".glb")
 
@@ -60,6 +69,26 @@ def write(
         write_glb(take, path, locators is not False, progress)
     else:
         raise ValueError(f"{path}: unknown output format (use {', '.join(SUFFIXES)})")
+    return None
+
+
+def write_usd_stream(
+    source: ChunkSource,
+    path: str | os.PathLike[str],
+    progress: Callable[[int], object] | None = None,
+    skin: Skin | None = None,
+    locators: bool | None = None,
+) -> KeyReport | None:
+    """Write a take read a chunk of frames at a time (`ecs_tentacles.take.stream.open_take`)
+    as USD, atomically: skinned with `skin` (the key report returned), else rigid;
+    `progress(n)` as n more frames are written; `locators` as `write`'s."""
+    if skin is not None:
+        from ecs_tentacles.export.skinned_usd import write_skinned_usd
+
+        return write_skinned_usd(source, path, skin.detail, skin.keys, bool(locators), progress)
+    from ecs_tentacles.export.usd import write_usd
+
+    write_usd(source, path, progress, locators is not False)
     return None
 
 

@@ -68,7 +68,7 @@ from ecs_tentacles.export.ground import write_usd_ground
 from ecs_tentacles.export.materials import take_colours, usd_folder
 from ecs_tentacles.export.names import unique_path
 from ecs_tentacles.export.root_frames import RootFrames
-from ecs_tentacles.export.take_chunks import TakeChunks, frame_slice
+from ecs_tentacles.export.take_chunks import ChunkSource, TakeChunks, frame_slice
 from ecs_tentacles.export.usd import _pxr, mark_rate, set_timing, static_take
 from ecs_tentacles.export.usd_clips import SharedClips
 from ecs_tentacles.export.usd_joint_samples import PlanSamples, key_report
@@ -87,7 +87,7 @@ WORK_BYTES = 32 * 1024**2  # joint rotations (float64) worked on at once: chunks
 
 
 def write_skinned_usd(
-    take: Take | TakeChunks,
+    take: Take | ChunkSource,
     path: str | os.PathLike[str],
     detail: Detail | None = None,
     keys: Keys | None = None,
@@ -120,7 +120,7 @@ def build_skinned_stage(
 
 def _fill(
     layer: StreamedLayer,
-    source: TakeChunks,
+    source: ChunkSource,
     detail: Detail | None,
     keys: Keys | None,
     locators: bool,
@@ -170,7 +170,8 @@ def _fill(
         layer.flush()
         if progress is not None:
             progress(chunk.frames)
-    return key_report(animated, source.frames)
+    groups = {id(group) for group in clips.sharers.values()}
+    return key_report(animated, source.frames, len(names), len(clips.sharers), len(groups))
 
 
 def alone_in(plan: BodyPlan, sharers: dict[int, Any]) -> BodyPlan:

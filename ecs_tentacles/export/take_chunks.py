@@ -16,7 +16,7 @@ Reads the `Take` it is given; writes nothing. A chunk's arrays are views of the 
 from __future__ import annotations
 
 from collections.abc import Iterator
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -56,6 +56,25 @@ def chunk_frames(bodies: int, budget: int = CHUNK_BYTES) -> int:
     return max(1, budget // max(1, 28 * bodies))
 
 
+class ChunkSource(Protocol):
+    """What the streaming writers read of a take: `TakeChunks` (a take in memory) and
+    `ecs_tentacles.take.stream.TakeSource` (a take file, versions 1 and 2)."""
+
+    @property
+    def header(self) -> dict[str, Any]: ...
+    @property
+    def frames(self) -> int: ...
+    @property
+    def fps(self) -> float: ...
+    @property
+    def static(self) -> dict[str, np.ndarray]: ...
+
+    def chunks(self) -> Iterator[tuple[int, Take]]: ...
+    def segments(self, creature: int) -> list[Any]: ...
+    def clip_pose(self, clip: int) -> np.ndarray: ...
+    def root_motion(self, creature: int) -> tuple[np.ndarray, np.ndarray]: ...
+
+
 class TakeChunks:
     """A `Take` in memory as a stream of chunks of `chunk` frames (default: `chunk_frames`)."""
 
@@ -92,3 +111,11 @@ class TakeChunks:
     def segments(self, creature: int) -> list[Any]:
         """Replayed stretches of `creature`: none (a take in memory holds every pose)."""
         return []
+
+    def clip_pose(self, clip: int) -> np.ndarray:
+        """A take in memory replays no clip (`segments` is empty)."""
+        raise KeyError(f"a take in memory holds every pose: no clip {clip}")
+
+    def root_motion(self, creature: int) -> tuple[np.ndarray, np.ndarray]:
+        """A take in memory replays no creature (`segments` is empty)."""
+        raise KeyError(f"a take in memory holds every pose: creature {creature} replays nothing")

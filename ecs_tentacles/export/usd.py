@@ -52,7 +52,7 @@ import numpy as np
 from ecs_tentacles.export.ground import write_usd_ground
 from ecs_tentacles.export.materials import bind_usd, take_colours, usd_folder, usd_material
 from ecs_tentacles.export.names import unique_path
-from ecs_tentacles.export.take_chunks import TakeChunks
+from ecs_tentacles.export.take_chunks import ChunkSource, TakeChunks
 from ecs_tentacles.export.usd_layer import StreamedLayer
 from ecs_tentacles.export.usd_pxr import UsdUnavailable, usd_modules
 from ecs_tentacles.export.usd_tracks import Steps, UsdTracks, Visibility, key_steps
@@ -66,7 +66,7 @@ _pxr = usd_modules  # the name the other USD writers import
 
 
 def write_usd(
-    take: Take | TakeChunks,
+    take: Take | ChunkSource,
     path: str | os.PathLike[str],
     progress: Callable[[int], object] | None = None,
     locators: bool = True,
@@ -98,7 +98,7 @@ def build_stage(
 
 def _fill(
     layer: StreamedLayer,
-    source: TakeChunks,
+    source: ChunkSource,
     progress: Callable[[int], object] | None,
     locators: bool,
 ) -> None:
@@ -152,7 +152,7 @@ def _fill(
             progress(chunk.frames)
 
 
-def static_take(source: TakeChunks) -> Take:
+def static_take(source: ChunkSource) -> Take:
     """A take of no frames with `source`'s header and arrays without a frames axis:
     what the writers that need no frame read (colours, materials, the ground)."""
     header = source.header

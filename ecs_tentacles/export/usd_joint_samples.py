@@ -156,8 +156,11 @@ class ChunkTally:
         self.translation_error = max(self.translation_error, moved)
 
 
-def key_report(animated: list[PlanSamples], frames: int) -> KeyReport:
-    """The key report over every plan's creatures."""
+def key_report(
+    animated: list[PlanSamples], frames: int, creatures: int = 0, sharing: int = 0, shared: int = 0
+) -> KeyReport:
+    """The key report over every plan's creatures with their own animation; of
+    `creatures`, `sharing` bind one of `shared` clip animations (their keys not counted)."""
     tallies = [a.tally for a in animated]
     return KeyReport(
         before=sum(t.before for t in tallies),
@@ -166,4 +169,7 @@ def key_report(animated: list[PlanSamples], frames: int) -> KeyReport:
         max_translation_error_m=max((t.translation_error for t in tallies), default=0.0),
         sample_frames=int(max((t.samples.max(initial=0) for t in tallies), default=0)),
         frames=frames,
+        creatures=creatures,
+        sharing=sharing,
+        shared=shared,
     )
