@@ -42,3 +42,21 @@ class RootFrames:
             moved[..., 1] = -sin * x + cos * y
         out[:, own] = moved
         return out
+
+    def local_pose(
+        self, pos: np.ndarray, quat: np.ndarray, owners: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """World poses, positions (n, K, 3) and unit rotations (n, K, 4) w-first, of
+        items owned by creatures `owners` (K,), in those creatures' frames."""
+        where = self.local(pos, owners)
+        turn = np.array(quat, dtype=np.float64)
+        if self.yaw is None:
+            return where, turn
+        half = 0.5 * self.yaw[:, np.asarray(owners, dtype=np.int64)]
+        c, s = np.cos(half), np.sin(half)
+        w, x, y, z = (turn[..., i].copy() for i in range(4))
+        turn[..., 0] = c * w + s * z  # (cos h/2, 0, 0, -sin h/2) * q
+        turn[..., 1] = c * x + s * y
+        turn[..., 2] = c * y - s * x
+        turn[..., 3] = c * z - s * w
+        return where, turn

@@ -1,14 +1,16 @@
 """A take's tracks and held values on a USD stage, written chunk of frames by chunk.
 
-    tracks = UsdTracks(layer, header, static, first_chunk, locators=True)  # defines prims
+    tracks = UsdTracks(layer, header, static, locators=True)   # defines prims
     for first, chunk in source.chunks():
-        tracks.add(first, chunk)                                          # time samples
+        tracks.add(first, chunk)                                # time samples
 
 Tracks (`ecs_tentacles.take.tracks`) by kind: a points track's items (the goals) are
 locators, `Xform`s at their position with `ecs:radius`, visibility keyed where their
 live flag changes (written with `locators`); a curves track's curves (the fur guides)
-are `BasisCurves` (linear) per owner, points, widths and extent sampled every frame.
-Layout and names as `ecs_tentacles.export.usd`'s docstring shows them.
+are `BasisCurves` per owner (`ecs_tentacles.export.usd_curves`). Layout and names as
+`ecs_tentacles.export.usd`'s docstring shows them. With `relative` (the skinned form,
+whose creature roots move) positions are written in the creature's root frame
+(`RootFrames`) and a creature's curves ride its mantle.
 
 `Steps` keys a held (step) value where it changes, across chunks: visibility, a
 sucker's `ecs:attached`. Reads the chunks it is handed; writes time samples through
@@ -23,6 +25,7 @@ import numpy as np
 
 from ecs_tentacles.export.names import FOLDERS, unique_path
 from ecs_tentacles.export.root_frames import RootFrames
+from ecs_tentacles.export.usd_curves import CurvesTrack
 from ecs_tentacles.export.usd_layer import StreamedLayer
 from ecs_tentacles.export.usd_pxr import usd_modules as _pxr
 from ecs_tentacles.take import Take, TakeTrack
@@ -82,12 +85,14 @@ class UsdTracks:
         self.pxr, self.layer, self.header, self.relative = pxr, layer, header, relative
         self.static = static
         self.points: list[tuple[TakeTrack, list[tuple[Any, Any]], Steps]] = []
-        self.curves: list[tuple[TakeTrack, list[tuple[np.ndarray, Any, Any, Any, Any]]]] = []
+        self.curves: list[CurvesTrack] = []
+        mantles = np.array([c["mantle"] for c in header["creatures"]], dtype=np.int64)
         for track in tracks_of(header):
             if track.kind == "points" and locators:
                 self.points.append((track, self._locators(track, static), Steps()))
             elif track.kind == "curves" and header.get(track.key) is not None:
-                self.curves.append((track, self._curves(track)))
+                carried = mantles if relative else None
+                self.curves.append(CurvesTrack(pxr, layer, header, track, carried))
 
     def _locators(self, track: TakeTrack, static: dict[str, np.ndarray]) -> list[tuple[Any, Any]]:
         """The points track's locators, placed (`relative`: their translate is sampled in
@@ -107,45 +112,12 @@ class UsdTracks:
             paths.append((xform.CreateVisibilityAttr().GetPath(), translate.GetAttr().GetPath()))
         return paths
 
-    def _curves(self, track: TakeTrack) -> list[tuple[np.ndarray, Any, Any, Any, Any]]:
-        """One BasisCurves per owner: (the curves it holds, it, its points, widths and
-        extent attributes' paths)."""
-        UsdGeom = self.pxr.UsdGeom
-        owners = np.asarray(self.header[track.key]["creatures"], dtype=np.int64)
-        names = [c["name"] for c in self.header["creatures"]]
-        made = []
-        for owner in sorted(set(owners.tolist())):
-            chosen = np.flatnonzero(owners == owner)
-            if 0 <= owner < len(names):
-                name = f"{names[owner]}/{track.folder}/{track.item}"
-                path = f"/World/{unique_path(name, FOLDERS | {track.folder})}"
-            else:  # curves no creature owns
-                path = f"/World/{track.folder}/{track.item}"
-            UsdGeom.Xform.Define(self.layer.stage, path.rsplit("/", 1)[0])
-            curves = UsdGeom.BasisCurves.Define(self.layer.stage, path)
-            curves.CreateTypeAttr(UsdGeom.Tokens.linear)
-            curves.CreateWrapAttr(UsdGeom.Tokens.nonperiodic)
-            curves.SetWidthsInterpolation(UsdGeom.Tokens.vertex)
-            made.append(
-                (
-                    chosen,
-                    curves,
-                    curves.CreatePointsAttr().GetPath(),
-                    curves.CreateWidthsAttr().GetPath(),
-                    curves.CreateExtentAttr().GetPath(),
-                )
-            )
-        return made
-
     def add(self, first: int, chunk: Take, roots: RootFrames | None = None) -> None:
         """The chunk's samples (frames `first` on): locators' visibility, curves' poses;
         with `roots` (`relative`), world positions in their creature's root frame."""
         layer = self.layer
-        if first == 0:  # points per curve: the arrays' (the header does not say)
-            for track, made in self.curves:
-                count = chunk.tracks[track.arrays[0]].shape[2]
-                for chosen, curves, *_ in made:
-                    curves.CreateCurveVertexCountsAttr([count] * len(chosen))
+        for curves in self.curves:
+            curves.add(first, chunk, roots)
         tokens = (self.pxr.UsdGeom.Tokens.invisible, self.pxr.UsdGeom.Tokens.inherited)
         with layer.batch():  # Sdf edits only from here (no Usd API inside a change block)
             for track, paths, steps in self.points:
@@ -153,8 +125,6 @@ class UsdTracks:
                 key_steps(layer, shown, steps, first, chunk.tracks[track.arrays[1]], tokens)
                 if roots is not None:
                     self._placed(track, [t for _, t in paths], first, chunk.frames, roots)
-            for track, made in self.curves:
-                self._posed(track, made, first, chunk, roots)
 
     def _placed(
         self, track: TakeTrack, paths: list[Any], first: int, frames: int, roots: RootFrames
@@ -167,36 +137,6 @@ class UsdTracks:
         for row, points in enumerate(local):
             for path, point in zip(paths, points, strict=True):
                 self.layer.sample(path, first + row, Gf.Vec3d(*point), 24)
-
-    def _posed(
-        self,
-        track: TakeTrack,
-        made: list[tuple[np.ndarray, Any, Any, Any, Any]],
-        first: int,
-        chunk: Take,
-        roots: RootFrames | None,
-    ) -> None:
-        """Each BasisCurves' points, widths and extent at every frame of the chunk."""
-        Gf, Vt, layer = self.pxr.Gf, self.pxr.Vt, self.layer
-        all_points, all_widths = (chunk.tracks[name] for name in track.arrays)
-        owners = np.asarray(self.header[track.key]["creatures"], dtype=np.int64)
-        for chosen, _, points_path, widths_path, extent_path in made:
-            curve_points = all_points[:, chosen]  # (n, curves, points, 3)
-            if roots is not None:
-                n, curves, count = curve_points.shape[:3]
-                flat = curve_points.reshape(n, curves * count, 3)
-                owner = np.repeat(owners[chosen], count)
-                curve_points = roots.local(flat, owner).astype(np.float32)
-            for row in range(chunk.frames):
-                frame = first + row
-                points = np.ascontiguousarray(curve_points[row]).reshape(-1, 3)
-                widths = all_widths[row, chosen].reshape(-1)
-                layer.sample(points_path, frame, Vt.Vec3fArray.FromNumpy(points), points.nbytes)
-                layer.sample(widths_path, frame, Vt.FloatArray.FromNumpy(widths), widths.nbytes)
-                pad = 0.5 * float(widths.max(initial=0.0))
-                low, high = points.min(axis=0) - pad, points.max(axis=0) + pad
-                box = [Gf.Vec3f(*low.tolist()), Gf.Vec3f(*high.tolist())]
-                layer.sample(extent_path, frame, Vt.Vec3fArray(box), 24)
 
 
 class Visibility:

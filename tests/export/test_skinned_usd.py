@@ -11,6 +11,7 @@ import pytest
 
 from ecs_tentacles.cli import main
 from ecs_tentacles.export.skinned_usd import build_skinned_stage, write_skinned_usd
+from ecs_tentacles.export.usd_curves import TOLERANCE
 from ecs_tentacles.export.usd_validation import usd_problems
 from ecs_tentacles.numeric.quaternions import quat_rotate
 from ecs_tentacles.skin.keys import angle_between
@@ -64,7 +65,7 @@ def test_the_skinned_stage_passes_the_usd_validators(
     for frame in (0, 3, take.frames - 1):  # world positions, below the moving SkelRoot
         points = _world(curves.GetPrim(), frame, np.array(curves.GetPointsAttr().Get(frame)))
         expected = take.tracks["guide_points"][frame].reshape(-1, 3)
-        np.testing.assert_allclose(points, expected, atol=1e-6)
+        np.testing.assert_allclose(points, expected, atol=TOLERANCE)  # held where still
         if locators:
             quat = take.quat[frame, entry["body"]].astype(np.float64)
             point = take.pos[frame, entry["body"]] + quat_rotate(quat, np.array(entry["offset"]))

@@ -4,11 +4,7 @@ a sharer costs its root motion, not its joints."""
 
 from __future__ import annotations
 
-import json
-import subprocess
-import sys
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import pytest
@@ -24,33 +20,9 @@ pxr = pytest.importorskip("pxr", reason="USD export needs usd-core (the usd / de
 from pxr import Usd, UsdGeom, UsdSkel  # noqa: E402
 
 
-def replay_crowd_take(folder: Path, seconds: float = 2.0) -> Path:
-    """16 uniform creatures, `seconds` at 24 fps, level of detail on with room for one at
-    full physics and one reduced: the others replay the crawl clip from frame 1 (a take
-    of version 2 records them as clip, phase and root motion). The take's path."""
-    scene = folder / "crowd16.json"
-    subprocess.run(
-        [sys.executable, "-P", "-m", "ecs_tentacles", "crowd", "16", "--uniform", "--seed", "1",
-         "--out", str(scene)],
-        capture_output=True, text=True, check=True,
-    )  # fmt: skip
-    data: dict[str, Any] = json.loads(scene.read_text())
-    data.setdefault("physics", {})["lod"] = {"full": 1, "reduced": 1, "hold_seconds": 0}
-    scene.write_text(json.dumps(data))
-    take = folder / "crowd16.npz"
-    argv = ["bake", str(scene), "--seconds", str(seconds), "--fps", "24", "--out", str(take)]
-    assert main([*argv, "--quiet"]) == 0
-    return take
-
-
-@pytest.fixture(scope="module")
-def replayed(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    return replay_crowd_take(tmp_path_factory.mktemp("replayed"))
-
-
 def _hinges(take: Path, frames: list[int]) -> dict[int, tuple[np.ndarray, np.ndarray]]:
     """Every body's pose at `frames`, read from the take as its reader gives them
-    (replayed creatures' bodies filled in from their clip)."""
+    (replay_take creatures' bodies filled in from their clip)."""
     found = {}
     with open_take(take) as source:
         for first, chunk in source.chunks():
@@ -60,17 +32,17 @@ def _hinges(take: Path, frames: list[int]) -> dict[int, tuple[np.ndarray, np.nda
     return found
 
 
-def test_replayed_creatures_share_one_clip_animation_and_pose_as_the_take(
-    replayed: Path, tmp_path: Path
+def test_replay_take_creatures_share_one_clip_animation_and_pose_as_the_take(
+    replay_take: Path, tmp_path: Path
 ) -> None:
     """The 15 of 16 creatures that replay reference one clip animation; through UsdSkel's
     own evaluation
     (world-space joint transforms) a physical creature's joints are within 1 mm of the
     take's hinge points and a sharer's within 1 cm, at the built frame, the first
-    replayed one, the middle and the last."""
+    replay_take one, the middle and the last."""
     usd = tmp_path / "crowd16.usdc"
-    assert main(["export", str(replayed), "--out", str(usd), "--quiet", "--validate"]) == 0
-    with open_take(replayed) as source:
+    assert main(["export", str(replay_take), "--out", str(usd), "--quiet", "--validate"]) == 0
+    with open_take(replay_take) as source:
         header, frames = source.header, source.frames
         replays = [len(source.segments(c)) == 1 for c in range(len(header["creatures"]))]
     stage = Usd.Stage.Open(str(usd))
@@ -80,7 +52,7 @@ def test_replayed_creatures_share_one_clip_animation_and_pose_as_the_take(
     cache = UsdSkel.Cache()
     lengths = np.array([body["length"] for body in header["bodies"]])
     checked = [0, 1, frames // 2, frames - 1]
-    poses = _hinges(replayed, checked)
+    poses = _hinges(replay_take, checked)
     worst = {True: 0.0, False: 0.0}
     for creature, entry in enumerate(header["creatures"]):
         name = entry["name"]
@@ -108,15 +80,15 @@ def test_replayed_creatures_share_one_clip_animation_and_pose_as_the_take(
     assert worst[False] < 1e-3 and worst[True] < 1e-2, worst
 
 
-def test_a_sharer_costs_its_root_motion_not_its_joints(replayed: Path, tmp_path: Path) -> None:
+def test_a_sharer_costs_its_root_motion_not_its_joints(replay_take: Path, tmp_path: Path) -> None:
     """The same take with every creature animated alone (a take in memory: no replay
     records) takes each sharer's joint rotations more (81 quaternions a frame), less the
     one animation they share."""
     shared, alone = tmp_path / "shared.usdc", tmp_path / "alone.usdc"
-    with open_take(replayed) as source:
+    with open_take(replay_take) as source:
         report = write_skinned_usd(source, shared)
         frames = source.frames
-    full = Take.load(replayed)
+    full = Take.load(replay_take)
     assert write_skinned_usd(TakeChunks(full), alone).sharing == 0
     assert (report.sharing, report.shared, report.creatures) == (15, 1, 16)
     saved = alone.stat().st_size - shared.stat().st_size

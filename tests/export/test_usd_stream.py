@@ -54,6 +54,7 @@ def test_chunk_by_chunk_writes_the_samples_of_the_whole_take(
     extra: dict[str, Any] = {"locators": True}
     write(TakeChunks(take), whole, **extra)
     monkeypatch.setattr(usd_layer, "FLUSH_BYTES", 1)
+    monkeypatch.setattr(usd_layer, "REWRITE_SHARE", 0)  # a save after every chunk
     write(TakeChunks(take, 2), pieces, **extra)
     expected, got = _samples(whole), _samples(pieces)
     assert sorted(got) == sorted(expected) and len(got) > 10
@@ -151,10 +152,10 @@ print(status("VmHWM") - before, Path(out).stat().st_size / 1024**2)
 
 @pytest.mark.skipif(not os.access("/proc/self/clear_refs", os.W_OK), reason="Linux's peak reset")
 def test_memory_does_not_grow_with_the_take(guided_take: Take, tmp_path: Path) -> None:
-    """64 creatures, 1,000 then 3,000 frames (40 MB more of samples in the file), saved
-    every 4 MB: the peak grows by about 100 B a time sample (USD's index of the samples
-    in the file: 26 MB here), a third of what holding the stage to one save at the end
-    costs (84 MB here, twice what it adds to the file)."""
+    """64 creatures of 13 joints, 1,000 then 3,000 frames (about 30 MB more in the file),
+    saved as it grows: the peak grows by USD's index of the samples (about 70 B a time
+    sample) and what waits for the next save (29 MB here), a third of what holding the
+    stage to one save at the end costs (80 MB here, nearly three times the file's)."""
     source = tmp_path / "short.npz"
     _longer(guided_take, 20, creatures=64).save(source)
     grew, files = {}, {}
@@ -171,7 +172,7 @@ def test_memory_does_not_grow_with_the_take(guided_take: Take, tmp_path: Path) -
         files[flush] = found[1][1] - found[0][1]
     streamed, held = grew[4 * 1024**2], grew[1024**4]
     assert min(files.values()) > 25 and held > files[1024**4], (grew, files)
-    assert streamed < 0.5 * held and streamed < 0.8 * files[4 * 1024**2], (grew, files)
+    assert streamed < 0.5 * held, (grew, files)
 
 
 @pytest.mark.parametrize("skinned", [True, False])
@@ -181,6 +182,7 @@ def test_a_stop_while_writing_leaves_nothing(
     """Ctrl-C once the first chunk is in the file (saved): no file, no partial file, nor
     USD's own temporary file, in the folder."""
     monkeypatch.setattr(usd_layer, "FLUSH_BYTES", 1)
+    monkeypatch.setattr(usd_layer, "REWRITE_SHARE", 0)  # a save after every chunk
     take = _longer(guided_take, 30, creatures=3)
 
     def stop(n: int) -> None:

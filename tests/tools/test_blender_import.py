@@ -208,7 +208,7 @@ def test_a_crowd_sharing_clip_animations_plays_where_the_take_has_it(tmp_path: P
     animation in the USD) comes into Blender with every creature moving, each mantle
     within 1 cm of the take's at four frames."""
     from ecs_tentacles.take.stream import open_take
-    from tests.export.test_usd_clips import replay_crowd_take
+    from tests.export.conftest import replay_crowd_take
 
     take = replay_crowd_take(tmp_path)
     usd = tmp_path / "crowd16.usdc"
