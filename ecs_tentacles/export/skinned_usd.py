@@ -1,16 +1,19 @@
 """Take -> USD stage with skinned creatures (UsdSkel), the form artists animate; streamed.
 
     /World                                   Xform, the default prim
-      /<c>                                   SkelRoot (c: the creature's name):
-                                             xformOp:translate sampled, the mantle's
-                                             position (root motion); visibility keyed
-                                             where it came or went
+      /<c>                                   SkelRoot (c: the creature's name): the root
+                                             motion, xformOp:translate sampled (the
+                                             mantle's position; for a creature sharing a
+                                             clip its ground frame, with xformOp:rotateZ);
+                                             visibility keyed where it came or went
         /<c>_skeleton                        Skeleton: joints (mantle/t0_link0/...),
                                              bindTransforms, restTransforms (its body
                                              plan's, at the origin)
           /<c>_animation                     SkelAnimation: rotations sampled (the root's:
                                              the mantle's world rotation); translations
-                                             and scales constant (one value, not samples)
+                                             and scales constant (one value, not samples);
+                                             or, sharing a clip, an internal reference to
+                                             /World/clips/... (`usd_clips`)
         /<c>_skin                            Mesh (bound to the skeleton): points in the
                                              bind pose, normals, primvars:st (faceVarying),
                                              primvars:skel:jointIndices / jointWeights (2),
@@ -18,13 +21,14 @@
         /<c>_suckers/<c>_t<k>/<c>_t<k>_link<i>/<c>_t<k>_link<i>_sucker<n>
                                              locator (`locators=True`): Xform, translate
                                              sampled (the sucker point), `ecs:attached`
-        /<c>_goals/<c>_goal<j>, /<c>_fur/... the take's tracks, as in the rigid form
-                                             (`ecs_tentacles.export.usd_tracks`); the goals
-                                             only with `locators=True`
-                                             Below the SkelRoot, so in its moving frame:
-                                             points are the take's world points less the
-                                             root's motion (`root_frames`); goals are
-                                             sampled every frame for that
+        /<c>_goals/<c>_goal<j>               goal locators (`locators=True`), translate
+                                             sampled (`usd_tracks`)
+        /<c>_fur/<c>_guides                  fur guides: BasisCurves in the mantle's frame,
+                                             the folder following the mantle (`usd_curves`)
+                                             Below the SkelRoot, so in its moving frame
+                                             (`root_frames`): USD and Blender both put
+                                             them back where the take has them
+      /clips/plan<p>_clip<i>_<kind>_<g>      class SkelAnimations creatures share
       /materials/<c>_material                each creature's material, its sandbox colour
                                              (`ecs_tentacles.export.materials`)
 

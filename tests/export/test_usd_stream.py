@@ -4,9 +4,17 @@ a body plan's creatures; a stop leaves nothing behind."""
 
 from __future__ import annotations
 
+import fcntl
 import os
+import pty
+import re
+import select
+import signal
+import struct
 import subprocess
 import sys
+import termios
+import time
 from pathlib import Path
 from typing import Any
 
@@ -23,6 +31,8 @@ from ecs_tentacles.skin.rig import Keys
 from ecs_tentacles.skin.skeleton import creature_animation, creature_skeleton
 from ecs_tentacles.take import Take
 from tests.export.test_glb import _longer
+
+ROOT = Path(__file__).resolve().parents[2]
 
 pxr = pytest.importorskip("pxr", reason="USD export needs usd-core (the usd / dev extras)")
 from pxr import Sdf, Usd, UsdSkel  # noqa: E402
@@ -193,3 +203,40 @@ def test_a_stop_while_writing_leaves_nothing(
     with pytest.raises(KeyboardInterrupt):
         write(TakeChunks(take, 10), tmp_path / "crowd.usdc", progress=stop)
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.usefixtures("ctrl_c_reaches_children")
+def test_ctrl_c_while_a_crowd_usd_is_written_leaves_only_the_take(
+    guided_take: Take, tmp_path: Path
+) -> None:
+    """A real export on a terminal, stopped once its bar shows frames written: exit 130,
+    the take alone in the folder (no partial file, ours or USD's)."""
+    take = tmp_path / "crowd.npz"
+    _longer(guided_take, 3000, creatures=48).save(take)
+    main, child = pty.openpty()
+    fcntl.ioctl(child, termios.TIOCSWINSZ, struct.pack("HHHH", 24, 100, 0, 0))
+    process = subprocess.Popen(
+        [sys.executable, "-m", "ecs_tentacles", "export", str(take), "--out", "crowd.usdc"],
+        cwd=tmp_path, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=child,
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
+    )  # fmt: skip
+    os.close(child)
+    drawn, deadline = "", time.monotonic() + 120
+    while re.search(r"write crowd\.usdc: .*\| ?([1-9]\d*)/3000", drawn) is None:
+        assert time.monotonic() < deadline and process.poll() is None, drawn
+        if select.select([main], [], [], 0.5)[0]:
+            drawn += os.read(main, 65536).decode(errors="replace")
+    process.send_signal(signal.SIGINT)
+    process.wait(timeout=60)
+    while True:  # what it drew after
+        try:
+            piece = os.read(main, 65536)
+        except OSError:
+            break
+        if not piece:
+            break
+        drawn += piece.decode(errors="replace")
+    os.close(main)
+    assert process.returncode == 130, drawn
+    assert "error: interrupted (Ctrl-C); partial outputs removed" in drawn
+    assert [p.name for p in tmp_path.iterdir()] == ["crowd.npz"]
