@@ -73,6 +73,7 @@ def test_wheel_holds_every_module_and_asset_and_runs(tmp_path: Path) -> None:
         f"ecs_tentacles/assets/{p.relative_to(ROOT / 'assets')}"
         for p in ROOT.glob("assets/**/*.json")
     }
+    expected.add("ecs_tentacles/blender_addon/blender_manifest.toml")  # the add-on's zip
     assert expected <= names, sorted(expected - names)
     assert not any(n.startswith(("systems/", "assets/", "tests/", "tools/")) for n in names)
     unpacked = tmp_path / "site"

@@ -13,7 +13,8 @@ process, timed (wall) with its peak memory (the child's max RSS, `os.wait4`):
              wall over this is what recording and writing cost
     usd      export crowd.npz --out crowd.usdc (MB, bytes per creature-frame)
     blender  the crowd take opened by the Blender add-on in a Python with bpy
-             ($ECS_TENTACLES_BLENDER_PYTHON), when there is one
+             ($ECS_TENTACLES_BLENDER_PYTHON), when there is one (`ecs-tentacles
+             blender-addon --install` into a fresh Blender user folder first)
 
 One run each: state the machine's load (printed) beside the figures.
 """
@@ -33,10 +34,12 @@ from typing import Any
 STEPS = ("bake", "run", "usd", "blender")
 
 
-def timed(argv: list[str], cwd: Path) -> dict[str, Any]:
+def timed(argv: list[str], cwd: Path, env: dict[str, str] | None = None) -> dict[str, Any]:
     """Run `argv`; wall seconds, peak RSS (MB) and exit code."""
     start = time.perf_counter()
-    process = subprocess.Popen(argv, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    process = subprocess.Popen(
+        argv, cwd=cwd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE
+    )
     _, status, usage = os.wait4(process.pid, 0)
     wall = time.perf_counter() - start
     out = process.stdout.read().decode() if process.stdout else ""
@@ -77,11 +80,15 @@ def one_size(count: int, seconds: float, steps: list[str], folder: Path) -> dict
             row["usd_bytes_per_creature_frame"] = round(usd.stat().st_size / (count * frames), 1)
     blender = os.environ.get("ECS_TENTACLES_BLENDER_PYTHON")
     if "blender" in steps and blender and take.exists():
+        user = folder / "blender_user"  # a Blender user folder with the add-on installed
+        env = {**os.environ, "BLENDER_USER_RESOURCES": str(user)}
+        subprocess.run(cli("blender-addon", "--install", "--blender", blender), env=env,
+                       check=True, capture_output=True)  # fmt: skip
         script = (
-            "import sys, bpy, addon_utils; addon_utils.enable('ecs_tentacles_crowds',"
-            " default_set=True); bpy.ops.import_scene.ecs_tentacles_take(filepath=sys.argv[1])"
+            "import sys, bpy; bpy.ops.wm.read_userpref();"
+            " bpy.ops.import_scene.ecs_tentacles_take(filepath=sys.argv[1])"
         )
-        row["blender"] = timed([blender, "-c", script, str(take)], folder)
+        row["blender"] = timed([blender, "-c", script, str(take)], folder, env)
     return row
 
 

@@ -11,6 +11,7 @@ from ecs_tentacles import __version__, stops
 from ecs_tentacles.cli import (
     bake,
     bench,
+    blender_addon,
     create,
     crowd,
     export,
@@ -34,7 +35,7 @@ from ecs_tentacles.take import TakeError
 COMMANDS = {"validate": validate, "run": run, "play": play}
 COMMANDS |= {"bake": bake, "export": export, "create": create}
 COMMANDS |= {"crowd": crowd, "bench": bench, "systems": systems, "migrate": migrate}
-COMMANDS |= {"schema": schema}
+COMMANDS |= {"schema": schema, "blender-addon": blender_addon}
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -352,6 +352,8 @@ class TakeRecorder:
                                     and t.flush(self._base) is not None]  # fmt: skip
             curves = [a for t in self._chunked_curves for a in t.track.arrays]
             self.header["chunked"] = [*self._chunk_arrays(0), *curves]
+            points = [t.track.arrays[0] for t in self._chunked_curves]
+            self.writer.quantised = dict.fromkeys(points, chunks.STEP)  # as `Take.save` does
         arrays = self._chunk_arrays(held)
         for track in self._chunked_curves:
             arrays.update(track.flush(self.count) or {})

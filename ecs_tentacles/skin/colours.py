@@ -33,6 +33,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+# numpy and the standard library only when it runs: the Blender add-on runs this file as
+# it is (`ecs_tentacles.blender_addon.shared`)
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
 

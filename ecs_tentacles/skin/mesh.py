@@ -24,10 +24,14 @@ the underside of each link, rigidly bound to it (extra shells; still closed).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ecs_tentacles.skin.skeleton import Skeleton, SkinLayout, TentacleLayout
+# numpy and the standard library only when it runs: the Blender add-on runs this file as
+# it is (`ecs_tentacles.blender_addon.shared`)
+if TYPE_CHECKING:
+    from ecs_tentacles.skin.skeleton import Skeleton, SkinLayout, TentacleLayout
 
 
 class MeshError(ValueError):

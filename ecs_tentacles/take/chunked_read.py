@@ -20,7 +20,7 @@ from ecs_tentacles.take import ground as take_ground
 from ecs_tentacles.take import replay as take_replay
 from ecs_tentacles.take import roster as take_roster
 from ecs_tentacles.take.entries import _npy_header, data_problem, read_npy
-from ecs_tentacles.take.header import TakeError, array_dtypes, expected_shapes
+from ecs_tentacles.take.header import MAX_COORDINATE, TakeError, array_dtypes, expected_shapes
 from ecs_tentacles.take.tracks import tracks_of
 
 
@@ -36,6 +36,7 @@ class Layout:
         self.count = chunks.chunk_count(frames, per)
         self.chunked = chunks.chunked_names(header)
         self.dtypes = array_dtypes(header)
+        self.quantised: dict[str, float] = dict(header.get("quantised") or {})
         self.curves = {t.arrays[0]: t for t in tracks_of(header) if t.kind == "curves"}
         listed = [entry.filename for entry in archive.infolist()]
         names = set(listed)
@@ -121,7 +122,14 @@ class Layout:
             return None
 
         label = f"{name} chunk {k}"
-        return read_npy(self.archive, chunks.entry_name(name, k), label, self.dtypes[name], check)
+        step = self.quantised.get(name)
+        dtype = self.dtypes[name] if step is None else chunks.QUANTISED
+        value = read_npy(self.archive, chunks.entry_name(name, k), label, dtype, check)
+        if step is None:
+            return value
+        if value.size and np.abs(value).max() > 2 * MAX_COORDINATE / step:  # before summing
+            raise TakeError(f"{label}: a step beyond {MAX_COORDINATE:g} m")
+        return chunks.dequantise(value, step)
 
 
 def read_whole(

@@ -77,6 +77,49 @@ def chunked_problem(header: dict[str, Any]) -> str | None:
     return None
 
 
+STEP = 1e-4  # m: the step curves' points are stored in (`quantise`): at most 0.05 mm off
+QUANTISED = np.dtype("<i8")
+
+
+def quantised_names(header: dict[str, Any]) -> tuple[str, ...]:
+    """The chunked arrays stored quantised (`header["quantised"]`: name -> step)."""
+    return tuple(header.get("quantised") or {})
+
+
+def curves_points(header: dict[str, Any]) -> list[str]:
+    """The points arrays of the take's curves tracks (world metres, every frame)."""
+    return [t.arrays[0] for t in tracks_of(header) if t.kind == "curves"]
+
+
+def quantise(values: np.ndarray, step: float) -> np.ndarray:
+    """Positions (frames, ...) as whole steps, each frame after the first as its change
+    from the frame before (small numbers: they deflate to a quarter of the floats)."""
+    steps = np.rint(np.asarray(values, dtype=np.float64) / step).astype(QUANTISED)
+    steps[1:] -= steps[:-1].copy()
+    return steps
+
+
+def dequantise(steps: np.ndarray, step: float) -> np.ndarray:
+    """`quantise`'s positions back (float32), within half a step."""
+    return (np.cumsum(steps, axis=0) * step).astype(np.float32)
+
+
+def quantised_problem(header: dict[str, Any]) -> str | None:
+    """The first problem of `header["quantised"]`, or None."""
+    listed = header.get("quantised")
+    if listed is None:
+        return None
+    allowed = set(curves_points(header)) & set(chunked_names(header))
+    if not isinstance(listed, dict) or not set(listed) <= allowed:
+        return (
+            f"header.quantised: names the chunked curves' points of this take, of {sorted(allowed)}"
+        )
+    for name, step in listed.items():
+        if isinstance(step, bool) or not isinstance(step, float) or not 1e-7 <= step <= 1e-3:
+            return f"header.quantised.{name}: a step in metres in [1e-07, 0.001], got {step!r}"
+    return None
+
+
 def chunk_frames(frame_bytes: int) -> int:
     """Frames per chunk when a frame of the chunked arrays is `frame_bytes`."""
     return max(1, min(MAX_CHUNK_FRAMES, CHUNK_BYTES // max(frame_bytes, 1)))

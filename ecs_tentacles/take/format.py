@@ -105,7 +105,8 @@ class Take:
     def from_arrays(cls, header: dict[str, Any], arrays: dict[str, np.ndarray]) -> Take:
         """A take from its header and arrays by file name (as `read_take` returns them);
         what the header says of the file's layout (its chunks) is left out."""
-        header = {k: v for k, v in header.items() if k not in ("chunk_frames", "chunked")}
+        layout = ("chunk_frames", "chunked", "quantised")
+        header = {k: v for k, v in header.items() if k not in layout}
         core = {k: arrays[k] for k in CORE_ARRAYS[1:]}
         rest = {k: v for k, v in arrays.items() if k not in CORE_ARRAYS}
         return cls(header=header, **core, tracks=rest)
@@ -234,7 +235,8 @@ class Take:
         chunked = tuple(n for n in chunks.chunkable(self.header) if n in entries)
         header = {**self.header, "chunked": list(chunked)}
         per = chunks.chunk_frames(sum(entries[n][:1].nbytes for n in chunked))
-        with TakeWriter(path, per, progress) as writer:
+        quantised = {n: chunks.STEP for n in chunks.curves_points(header) if n in chunked}
+        with TakeWriter(path, per, progress, quantised) as writer:
             for first in range(0, self.frames, per):
                 part = {n: entries[n][first : first + per] for n in chunked}
                 writer.add_frames(take_replay.blanked(header, part))

@@ -216,6 +216,7 @@ def header_problem(header: object) -> str | None:
         or take_roster.problem(header)
         or take_replay.problem(header)
         or (chunks.chunked_problem(header) if version == 2 else None)
+        or (chunks.quantised_problem(header) if version == 2 else None)
     )
 
 

@@ -5,7 +5,9 @@
         writer.finish(header, other_arrays)                  # the header last
 
 The frames of the chunked arrays are buffered up to a chunk and stored (deflated) as each
-chunk fills, so a bake's memory holds one chunk, not the shot. The file is written to a
+chunk fills, so a bake's memory holds one chunk, not the shot. Deflating and writing run
+on a thread of the writer's own (zlib lets go of the interpreter), one chunk behind the
+simulation: a bake does not wait for its take to be compressed. The file is written to a
 temporary name beside the target and renamed when `finish` returns and the block ends
 (`ecs_tentacles.output.atomic`); leaving the block by an exception (Ctrl-C included)
 removes it, so a stopped bake leaves neither a take nor chunks.
@@ -16,6 +18,8 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import queue
+import threading
 import zipfile
 from collections.abc import Callable
 from types import TracebackType
@@ -36,12 +40,14 @@ class TakeWriter:
         path: str | os.PathLike[str],
         chunk_frames: int | None = None,
         progress: Callable[[int], object] | None = None,
+        quantised: dict[str, float] | None = None,
     ) -> None:
         if chunk_frames is not None and chunk_frames < 1:
             raise ValueError(f"chunk_frames must be >= 1, got {chunk_frames}")
         self.path = path
         self.chunk_frames = chunk_frames
         self.progress = progress
+        self.quantised = dict(quantised or {})  # array name -> step (`chunks.quantise`)
         self.frames = 0  # frames given so far
         self.stored = 0  # bytes stored so far (before compression)
         self._pending: dict[str, list[np.ndarray]] = {}
@@ -51,11 +57,38 @@ class TakeWriter:
         self._archive: zipfile.ZipFile | None = None
         self._finished = False
         self._discarded = False
+        self._queue: queue.Queue[tuple[str, np.ndarray] | None] = queue.Queue(maxsize=1)
+        self._thread: threading.Thread | None = None
+        self._failure: BaseException | None = None
+        self._abort = False
 
     def __enter__(self) -> TakeWriter:
         handle = self._stack.enter_context(atomic_file(self.path))
         self._archive = zipfile.ZipFile(handle, "w", allowZip64=True)
+        self._thread = threading.Thread(target=self._store, name="take writer", daemon=True)
+        self._thread.start()
         return self
+
+    def _store(self) -> None:
+        """The writer's thread: each entry handed over, deflated into the archive."""
+        while (item := self._queue.get()) is not None:
+            if self._abort or self._failure is not None:
+                continue  # stopped: the entries left are dropped
+            try:
+                assert self._archive is not None
+                chunks.add_entry(self._archive, item[0], chunks.npy_bytes(item[1]))
+            except BaseException as error:  # handed to the main thread at its next entry
+                self._failure = error
+
+    def _join(self) -> None:
+        """Wait for the thread to store what it was handed; raise what it failed with."""
+        if self._thread is not None:
+            self._queue.put(None)
+            self._thread.join()
+            self._thread = None
+        if self._failure is not None:
+            failure, self._failure = self._failure, None
+            raise failure
 
     def __exit__(
         self,
@@ -63,6 +96,16 @@ class TakeWriter:
         error: BaseException | None,
         trace: TracebackType | None,
     ) -> bool | None:
+        if error is not None or self._discarded or not self._finished:
+            self._abort = True  # nothing more is stored
+        with contextlib.suppress(BaseException):
+            if error is not None:  # the thread's own failure matters no more
+                self._join()
+        if error is None and self._thread is not None:
+            try:
+                self._join()
+            except BaseException as failure:  # e.g. the disk filled: no file
+                error, kind, trace = failure, type(failure), failure.__traceback__
         if self._archive is not None:  # its central directory: the file is whole (or dropped)
             archive, self._archive = self._archive, None
             with contextlib.suppress(Exception):
@@ -107,18 +150,24 @@ class TakeWriter:
             widest = max(p.shape[1] for p in parts) if parts[0].ndim > 1 else None
             if widest is not None:  # a creature came within the chunk: later frames are wider
                 parts = [_pad_to_later(p, parts, widest) for p in parts]
-            self._entry(chunks.entry_name(name, self._chunk), np.concatenate(parts))
+            joined = np.concatenate(parts)
+            step = self.quantised.get(name)
+            stored = joined if step is None else chunks.quantise(joined, step)
+            self._entry(chunks.entry_name(name, self._chunk), stored, joined.nbytes)
         self._pending = {}
         self._pending_frames = 0
         self._chunk += 1
 
-    def _entry(self, name: str, array: np.ndarray) -> None:
-        assert self._archive is not None, "TakeWriter is used in a with block"
-        data = chunks.npy_bytes(array)
-        chunks.add_entry(self._archive, name, data)
-        self.stored += array.nbytes
+    def _entry(self, name: str, array: np.ndarray, counted: int | None = None) -> None:
+        """Store `array` as entry `name`; `counted`: the bytes it stands for (progress)."""
+        assert self._thread is not None, "TakeWriter is used in a with block"
+        if self._failure is not None:
+            self._join()  # raises it
+        self._queue.put((name, array))
+        told = array.nbytes if counted is None else counted
+        self.stored += told
         if self.progress is not None:
-            self.progress(array.nbytes)
+            self.progress(told)
 
     def discard(self) -> None:
         """Keep nothing: the temporary file is removed when the block ends."""
@@ -134,8 +183,11 @@ class TakeWriter:
             self._entry(f"{name}.npy", array)
         header = {**header, "version": VERSION, "frames": self.frames,
                   "chunk_frames": self.chunk_frames}  # fmt: skip
+        if self.quantised:
+            header["quantised"] = dict(self.quantised)
         text = json.dumps(header, sort_keys=True, separators=(",", ":"))
         self._entry("header.npy", np.frombuffer(text.encode(), dtype=np.uint8))
+        self._join()  # every entry stored (or the failure raised here)
         self._finished = True
 
 

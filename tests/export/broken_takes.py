@@ -36,13 +36,18 @@ def _read(good: Path) -> tuple[dict[str, Any], Entries]:
         arrays: Entries = {name: npz[name] for name in npz.files}
     header = json.loads(arrays["header"].tobytes())
     chunked: dict[str, list[Any]] = {}
+    steps = header.get("quantised") or {}
     for name in sorted(arrays):
         if "." in name:
-            chunked.setdefault(name.split(".")[0], []).append(arrays.pop(name))
+            base = name.split(".")[0]
+            part = arrays.pop(name)
+            if base in steps:  # stored in steps, each frame's change: positions again
+                part = (np.cumsum(part, axis=0) * steps[base]).astype(np.float32)
+            chunked.setdefault(base, []).append(part)
     arrays.update({name: np.concatenate(parts) for name, parts in chunked.items()})
     if chunked:
         header["version"] = 1
-        for key in ("chunk_frames", "chunked", "replay"):
+        for key in ("chunk_frames", "chunked", "replay", "quantised"):
             header.pop(key, None)
         for name in [n for n in arrays if n.startswith("replay_")]:
             del arrays[name]

@@ -63,14 +63,15 @@ def test_what_a_bake_counts_is_what_its_take_holds(tmp_path: Path) -> None:
         if name != "header.npy" and not name.startswith("replay_clip_")  # once, if any
     )
     per_frame = arrays - 12 * 12  # the goals' positions are stored once
-    assert per_frame == plan.frames * counted.frame_bytes
+    # guides' points are stored as 64-bit steps (12 bytes more a point than decoded)
+    assert per_frame == plan.frames * (counted.frame_bytes + 360 * 10 * 12)
     entries = {key: len(json.dumps(header[key], separators=(",", ":"))) for key in header}
     bodies, suckers, goals, guides, _ = counted.parts
     assert entries["bodies"] + entries["creatures"] == bodies.fixed_bytes + 2  # the brackets
     assert entries["suckers"] == suckers.fixed_bytes + 1
     assert entries["goals"] + 12 * 12 == goals.fixed_bytes + 1
     assert entries["guides"] == guides.fixed_bytes + len('{"creatures":[]}') - 1
-    total = sum(stored.values())
+    total = sum(stored.values()) - plan.frames * 360 * 10 * 12  # decoded: float32 points
     assert total <= counted.total(plan.frames) <= total + NPY_HEADERS + 1024
 
 

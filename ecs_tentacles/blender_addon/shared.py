@@ -1,0 +1,26 @@
+"""The project's own modules the add-on runs as they are (numpy and the standard library
+only): the skinned mesh (`ecs_tentacles.skin.mesh`) and the creatures' colours
+(`ecs_tentacles.skin.colours`), so Blender shows the mesh and the colours the exporters
+write.
+
+`ecs-tentacles blender-addon` puts those two files into the add-on's zip as
+`skin_mesh.py` and `skin_colours.py`; run from the package itself (a development
+checkout, the tests) the add-on uses the package's modules.
+"""
+
+from __future__ import annotations
+
+from importlib import import_module
+from types import ModuleType
+
+SHARED = {"skin_mesh": "ecs_tentacles.skin.mesh", "skin_colours": "ecs_tentacles.skin.colours"}
+
+
+def module(name: str) -> ModuleType:
+    """`skin_mesh` or `skin_colours`: the copy in the add-on, else the package's."""
+    try:
+        return import_module(f"{__package__}.{name}")
+    except ModuleNotFoundError as missing:
+        if missing.name != f"{__package__}.{name}":
+            raise
+        return import_module(SHARED[name])
