@@ -14,14 +14,15 @@ validator, UsdSkel's included). One run each: state the machine's load (`uptime`
 Measured (one run each; `crowd N --uniform --seed 3`, `bake --seconds 30 --fps 24`, 721
 frames; export alone, then `usd_problems` on the file):
 
-    1,024 creatures, load 3.7-4.2: 83 s, peak 739 MB, 753 MB (1,020 B a creature-frame),
-        522 creatures sharing one clip animation, 502 alone; validators 0 errors (12 s,
-        189 MB). Reading the take alone (open_take, every chunk) takes 39 s and 454 MB.
-        Before (cb9ca9a, the issue's figure, 5 s at 60 fps): 3 min 10 s, 6.56 GB, 1.07 GB
-        (3.5 KB a creature-frame).
-    64 creatures (all within the full and reduced budgets: none replayed), load 3.7:
-        3.8 s, peak 463 MB, 71 MB (1,547 B); 0 errors. Before (d5bb160, the same scene's
-        version 1 take): 12.2 s, peak 909 MB, 138 MB (3,000 B).
+    1,024 creatures, load 3.1: 55 s, peak 792 MB, 753 MB (1,020 B a creature-frame),
+        522 creatures sharing one clip animation, 502 alone; validators 0 errors (7.8 s,
+        189 MB); every joint of every creature through UsdSkel.Cache within 0.003 mm of
+        the take at frames 0, 1, 360, 720. Reading the take alone (open_take, every
+        chunk) takes 26 s and 483 MB. Before (cb9ca9a, the issue's figure, 5 s at 60
+        fps): 3 min 10 s, 6.56 GB, 1.07 GB (3.5 KB a creature-frame).
+    64 creatures (all within the full and reduced budgets: none replayed), load 3.4,
+        with --validate: 4.5 s, peak 473 MB, 71 MB (1,547 B); 0 errors. Before (d5bb160,
+        the same scene's version 1 take): 12.2 s, peak 909 MB, 138 MB (3,000 B).
 
 Where the 1,024 crowd's bytes go: the 502 creatures with their own animation, 81
 quaternions a frame (470 MB); swaying fur guides (169 MB; stiff fur is written once);
