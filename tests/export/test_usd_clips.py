@@ -22,7 +22,7 @@ from pxr import Usd, UsdGeom, UsdSkel  # noqa: E402
 
 def _hinges(take: Path, frames: list[int]) -> dict[int, tuple[np.ndarray, np.ndarray]]:
     """Every body's pose at `frames`, read from the take as its reader gives them
-    (replay_take creatures' bodies filled in from their clip)."""
+    (replayed creatures' bodies filled in from their clip)."""
     found = {}
     with open_take(take) as source:
         for first, chunk in source.chunks():
@@ -32,14 +32,14 @@ def _hinges(take: Path, frames: list[int]) -> dict[int, tuple[np.ndarray, np.nda
     return found
 
 
-def test_replay_take_creatures_share_one_clip_animation_and_pose_as_the_take(
+def test_replayed_creatures_share_one_clip_animation_and_pose_as_the_take(
     replay_take: Path, tmp_path: Path
 ) -> None:
     """The 15 of 16 creatures that replay reference one clip animation; through UsdSkel's
     own evaluation
     (world-space joint transforms) a physical creature's joints are within 1 mm of the
     take's hinge points and a sharer's within 1 cm, at the built frame, the first
-    replay_take one, the middle and the last."""
+    replayed one, the middle and the last."""
     usd = tmp_path / "crowd16.usdc"
     assert main(["export", str(replay_take), "--out", str(usd), "--quiet", "--validate"]) == 0
     with open_take(replay_take) as source:
