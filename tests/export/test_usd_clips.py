@@ -36,10 +36,9 @@ def test_replayed_creatures_share_one_clip_animation_and_pose_as_the_take(
     replay_take: Path, tmp_path: Path
 ) -> None:
     """The 15 of 16 creatures that replay reference one clip animation; through UsdSkel's
-    own evaluation
-    (world-space joint transforms) a physical creature's joints are within 1 mm of the
-    take's hinge points and a sharer's within 1 cm, at the built frame, the first
-    replayed one, the middle and the last."""
+    own evaluation (world-space joint transforms) a physical creature's joints are within
+    1 mm of the take's hinge points and a sharer's within 1 cm, at the built frame, the
+    first replayed one, the middle and the last."""
     usd = tmp_path / "crowd16.usdc"
     assert main(["export", str(replay_take), "--out", str(usd), "--quiet", "--validate"]) == 0
     with open_take(replay_take) as source:
