@@ -19,10 +19,11 @@ from ecs_tentacles.cli.skin_options import add_arguments as add_skin_arguments
 from ecs_tentacles.cli.skin_options import skin_options
 from ecs_tentacles.cli.usd_validate import add_argument as add_validate_argument
 from ecs_tentacles.cli.usd_validate import validate_problem, validated
+from ecs_tentacles.export import write_usd_stream
 from ecs_tentacles.export.bake import output_kind
 from ecs_tentacles.export.glb_size import glb_note, glb_problem, glb_size, shapes_of_header
 from ecs_tentacles.export.skinned import Skin
-from ecs_tentacles.output.progress import status
+from ecs_tentacles.output.progress import bar, status
 from ecs_tentacles.skin.mesh import MeshError
 from ecs_tentacles.take import Take
 
@@ -89,6 +90,8 @@ def handle(args: argparse.Namespace) -> int:
     if problem:
         print(f"error: {problem}", file=sys.stderr)
         return 2
+    if output_kind(args.out) == "usd":
+        return _export_usd(args, skin)
     with status(f"export: reading {args.take}", progress=not args.quiet):
         take = Take.load(args.take)  # TakeError: one line, exit 2
     try:
@@ -97,4 +100,24 @@ def handle(args: argparse.Namespace) -> int:
         print(f"error: {error}", file=sys.stderr)
         return 2
     print(summary(take, args.out, args.json, skinned))
+    return validated(args.out, progress=not args.quiet) if args.validate else 0
+
+
+def _export_usd(args: argparse.Namespace, skin: Skin | None) -> int:
+    """USD written as the take is read, a chunk of frames at a time (memory does not
+    grow with the shot); a bar in frames."""
+    from ecs_tentacles.take.stream import open_take
+
+    with status(f"export: opening {args.take}", progress=not args.quiet):
+        source = open_take(args.take)  # TakeError: one line, exit 2
+    with (
+        source,
+        bar(source.frames, f"write {args.out.name}", "frame", progress=not args.quiet) as shown,
+    ):
+        try:
+            skinned = write_usd_stream(source, args.out, shown.update, skin, args.locators)
+        except MeshError as error:  # e.g. tentacle bases that overlap on the mantle
+            print(f"error: {error}", file=sys.stderr)
+            return 2
+    print(summary(source.header, args.out, args.json, skinned))
     return validated(args.out, progress=not args.quiet) if args.validate else 0

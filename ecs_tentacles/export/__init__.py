@@ -19,9 +19,18 @@ from ecs_tentacles.take import Take, TakeError
 
 if TYPE_CHECKING:
     from ecs_tentacles.export.skinned import Skin
+    from ecs_tentacles.export.take_chunks import ChunkSource
     from ecs_tentacles.skin.keys import KeyReport
 
-__all__ = ["SUFFIXES", "Take", "TakeError", "output_kind", "work_units", "write"]
+__all__ = [
+    "SUFFIXES",
+    "Take",
+    "TakeError",
+    "output_kind",
+    "work_units",
+    "write",
+    "write_usd_stream",
+]
 
 SUFFIXES = (".npz", ".usd", ".usda", ".usdc", ".glb")
 
@@ -63,14 +72,37 @@ def write(
     return None
 
 
+def write_usd_stream(
+    source: ChunkSource,
+    path: str | os.PathLike[str],
+    progress: Callable[[int], object] | None = None,
+    skin: Skin | None = None,
+    locators: bool | None = None,
+) -> KeyReport | None:
+    """Write a take read a chunk of frames at a time (`ecs_tentacles.take.stream.open_take`)
+    as USD, atomically: skinned with `skin` (the key report returned), else rigid;
+    `progress(n)` as n more frames are written; `locators` as `write`'s."""
+    if skin is not None:
+        from ecs_tentacles.export.skinned_usd import write_skinned_usd
+
+        return write_skinned_usd(source, path, skin.detail, skin.keys, bool(locators), progress)
+    from ecs_tentacles.export.usd import write_usd
+
+    write_usd(source, path, progress, locators is not False)
+    return None
+
+
 def work_units(
     take: Take, path: str | os.PathLike[str], skin: Skin | None = None
 ) -> tuple[int, str]:
     """(how many, of what) `write(take, path, progress, skin)` tells `progress` of: the
-    bytes of a take's arrays, the creatures of a skinned file, the bodies of a rigid one."""
+    bytes of a take's arrays, the frames of a USD file (written a chunk of frames at a
+    time), the creatures of a skinned glb, the bodies of a rigid one."""
     kind = output_kind(path)
     if kind == "take":
         return take.stored_bytes(), "B"
+    if kind == "usd":
+        return take.frames, "frame"
     if skin is not None:
         return len(take.header["creatures"]), "creature"
     return len(take.header["bodies"]), "body"

@@ -1,11 +1,19 @@
-"""Take -> USD stage with skinned creatures (UsdSkel), the form artists animate.
+"""Take -> USD stage with skinned creatures (UsdSkel), the form artists animate; streamed.
 
     /World                                   Xform, the default prim
-      /<c>                                   SkelRoot (c: the creature's name)
+      /<c>                                   SkelRoot (c: the creature's name): the root
+                                             motion, xformOp:translate sampled (the
+                                             mantle's position; for a creature sharing a
+                                             clip its ground frame, with xformOp:rotateZ);
+                                             visibility keyed where it came or went
         /<c>_skeleton                        Skeleton: joints (mantle/t0_link0/...),
-                                             bindTransforms (world), restTransforms (local)
-          /<c>_animation                     SkelAnimation: rotations, translations
-                                             (time-sampled), scales (constant 1)
+                                             bindTransforms, restTransforms (its body
+                                             plan's, at the origin)
+          /<c>_animation                     SkelAnimation: rotations sampled (the root's:
+                                             the mantle's world rotation); translations
+                                             and scales constant (one value, not samples);
+                                             or, sharing a clip, an internal reference to
+                                             /World/clips/... (`usd_clips`)
         /<c>_skin                            Mesh (bound to the skeleton): points in the
                                              bind pose, normals, primvars:st (faceVarying),
                                              primvars:skel:jointIndices / jointWeights (2),
@@ -13,11 +21,36 @@
         /<c>_suckers/<c>_t<k>/<c>_t<k>_link<i>/<c>_t<k>_link<i>_sucker<n>
                                              locator (`locators=True`): Xform, translate
                                              sampled (the sucker point), `ecs:attached`
-        /<c>_goals/<c>_goal<j>, /<c>_fur/... the take's tracks, as in the rigid form
-                                             (`ecs_tentacles.export.usd`); the goals only
-                                             with `locators=True`
+        /<c>_goals/<c>_goal<j>               goal locators (`locators=True`), translate
+                                             sampled (`usd_tracks`)
+        /<c>_fur/<c>_guides                  fur guides: BasisCurves in the mantle's frame,
+                                             the folder following the mantle (`usd_curves`)
+                                             Below the SkelRoot, so in its moving frame
+                                             (`root_frames`): USD and Blender both put
+                                             them back where the take has them
+      /clips/plan<p>_clip<i>_<kind>_<g>      class SkelAnimations creatures share
       /materials/<c>_material                each creature's material, its sandbox colour
                                              (`ecs_tentacles.export.materials`)
+
+What is constant is written once. Links do not stretch: a joint's translation in its
+parent is the rest offset at every frame (MuJoCo's hinges sit at fixed points of the
+parent body), so the animation's translations (and scales, 1) are one value each, and
+the root's motion is the SkelRoot's transform: the animation samples only
+rotations. Creatures of one body plan (the same mantle and links) share their rest
+state: skeleton, bind pose and mesh are the same arrays, held once in memory and
+stored once in a `.usdc` (USD's crate files keep one copy of equal arrays).
+UsdSkel poses a mesh point as `S(t) * sum_i w_i inv(bind_i) joint_i(t) p` with S the
+Skeleton's world transform (its ancestors' included), so the mesh is bound at the
+origin and moves with S. The motion is on the SkelRoot, not the Skeleton: Blender's
+importer (5.0.1) moves the armature with an animated SkelRoot, while with the motion on
+the Skeleton the creatures came in out of place and torn.
+
+Streamed: the take is read a chunk of frames at a time (`TakeChunks`, or a take file
+opened for streaming), each chunk's rotations made for every creature of a body plan
+at once (`ecs_tentacles.skin.streamed`) and written as time samples; a `.usdc` is
+saved as it grows (`ecs_tentacles.export.usd_layer`), so memory does not grow with
+the take. With reduced keys each chunk is reduced on its own (its first and last
+frames kept), so the error stays within the tolerance across chunks.
 
 A SkelAnimation samples all its joints at once, so with reduced keys its time samples
 are the frames where any joint has a key (each joint's value there comes from its own
@@ -30,37 +63,49 @@ from __future__ import annotations
 import importlib
 import os
 from collections.abc import Callable
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
 
 from ecs_tentacles.export.ground import write_usd_ground
-from ecs_tentacles.export.materials import bind_usd, take_colours, usd_folder, usd_material
-from ecs_tentacles.export.names import part, unique_path
-from ecs_tentacles.export.usd import _pxr, key_visibility, mark_rate, new_stage, write_tracks
+from ecs_tentacles.export.materials import take_colours, usd_folder
+from ecs_tentacles.export.names import unique_path
+from ecs_tentacles.export.root_frames import RootFrames
+from ecs_tentacles.export.take_chunks import ChunkSource, TakeChunks, frame_slice
+from ecs_tentacles.export.usd import _pxr, mark_rate, set_timing, static_take
+from ecs_tentacles.export.usd_clips import SharedClips
+from ecs_tentacles.export.usd_joint_samples import PlanSamples, key_report
+from ecs_tentacles.export.usd_layer import StreamedLayer
+from ecs_tentacles.export.usd_plans import BodyPlan, body_plans, define_creature
+from ecs_tentacles.export.usd_tracks import Steps, UsdTracks, Visibility, key_steps
 from ecs_tentacles.numeric.quaternions import quat_rotate
 from ecs_tentacles.output.atomic import atomic_output
 from ecs_tentacles.skin.keys import KeyReport
 from ecs_tentacles.skin.mesh import Detail
-from ecs_tentacles.skin.rig import Keys, SkinnedCreature, skinned_creatures
-from ecs_tentacles.skin.skeleton import transforms
+from ecs_tentacles.skin.rig import Keys
 from ecs_tentacles.take import Take
+
+Progress = Callable[[int], object]
+WORK_BYTES = 32 * 1024**2  # joint rotations (float64) worked on at once: chunks are split
 
 
 def write_skinned_usd(
-    take: Take,
+    take: Take | ChunkSource,
     path: str | os.PathLike[str],
     detail: Detail | None = None,
     keys: Keys | None = None,
     locators: bool = False,
-    progress: Callable[[int], object] | None = None,
+    progress: Progress | None = None,
 ) -> KeyReport:
-    """Write `take` as a skinned USD file (.usda, .usdc, .usd) atomically; returns the keys.
-    With `locators`, suckers and goals are written too; `progress(1)` after each creature."""
-    stage, report = build_skinned_stage(take, detail, keys, locators, progress)
+    """Write `take` (in memory, or a stream of chunks) as a skinned USD file (.usda, .usdc,
+    .usd) atomically, a chunk of frames at a time; returns the keys. With `locators`,
+    suckers and goals are written too; `progress(n)` as n more frames are written."""
+    source = TakeChunks(take) if isinstance(take, Take) else take
     with atomic_output(path) as temporary:
-        if not stage.GetRootLayer().Export(str(temporary)):
-            raise OSError(f"{path}: USD could not write the file")
+        layer = StreamedLayer(temporary)
+        report = _fill(layer, source, detail, keys, locators, progress)
+        layer.finish()
     return report
 
 
@@ -69,114 +114,111 @@ def build_skinned_stage(
     detail: Detail | None = None,
     keys: Keys | None = None,
     locators: bool = False,
-    progress: Callable[[int], object] | None = None,
+    progress: Progress | None = None,
 ) -> tuple[Any, KeyReport]:
     """An in-memory `Usd.Stage` with one SkelRoot per creature, and the key report."""
+    layer = StreamedLayer(None)
+    report = _fill(layer, TakeChunks(take), detail, keys, locators, progress)
+    return layer.stage, report
+
+
+def _fill(
+    layer: StreamedLayer,
+    source: ChunkSource,
+    detail: Detail | None,
+    keys: Keys | None,
+    locators: bool,
+    progress: Progress | None,
+) -> KeyReport:
+    """Every prim of the take on `layer`'s stage, then its frames chunk by chunk."""
     pxr = _pxr()
     importlib.import_module("pxr.UsdSkel")  # the skel schemas, into the `pxr` namespace
     importlib.import_module("pxr.UsdShade")
-
-    UsdGeom = pxr.UsdGeom
-    stage = new_stage(take)
-    stage.SetDefaultPrim(UsdGeom.Xform.Define(stage, "/World").GetPrim())
-    creatures, report = skinned_creatures(take, detail, keys)
-    shown = take.visible()
-    of_name = {c["name"]: i for i, c in enumerate(take.header["creatures"])}
-    colours, folder = take_colours(take), usd_folder(take)
-    for creature in creatures:
-        name = creature.skeleton.layout.name
-        _creature(pxr, stage, creature, colours[name], folder)
-        mark_rate(stage, f"/World/{name}", take)
-        key_visibility(stage, f"/World/{name}", shown[:, of_name[name]])
+    stage, header = layer.stage, source.header
+    set_timing(stage, source.fps, source.frames)
+    stage.SetDefaultPrim(pxr.UsdGeom.Xform.Define(stage, "/World").GetPrim())
+    still = static_take(source)
+    colours, folder = take_colours(still), usd_folder(still)
+    plans = body_plans(header, detail)
+    clips = SharedClips(pxr, layer, source, plans)
+    plan_of = {name: plan for plan in plans for name in plan.names}
+    names = [c["name"] for c in header["creatures"]]
+    for creature, name in enumerate(names):  # in the take's order
+        alone = creature not in clips.sharers
+        define_creature(pxr, stage, plan_of[name], name, colours[name], folder, alone)
+        clips.bind(name, creature)
+        mark_rate(stage, f"/World/{name}", source.fps, source.frames)
+    visibility = Visibility(layer, [f"/World/{name}" for name in names])
+    suckers = Suckers(pxr, layer, header) if locators else None
+    tracks = UsdTracks(layer, header, source.static, locators, relative=True)
+    write_usd_ground(pxr, stage, still)
+    own = [alone_in(plan, clips.sharers) for plan in plans]
+    animated = [PlanSamples(pxr, layer, plan, keys or Keys(), source.frames) for plan in own]
+    rows = max(1, WORK_BYTES // (32 * max(1, len(header["bodies"]))))
+    for first, chunk in source.chunks():
+        for start in range(0, chunk.frames, rows):
+            end = min(start + rows, chunk.frames)
+            piece = chunk if end - start == chunk.frames else frame_slice(chunk, start, end)
+            origin = np.zeros((piece.frames, len(names), 3))
+            yaw = np.zeros((piece.frames, len(names)))
+            for samples in animated:  # each creature's root motion as written
+                if len(samples.plan.members):
+                    origin[:, samples.plan.members] = samples.add(first + start, piece)
+            if clips.order:
+                origin[:, clips.order], yaw[:, clips.order] = clips.add(first + start, end - start)
+            roots = RootFrames(origin, yaw if clips.order else None)
+            if suckers is not None:
+                suckers.add(first + start, piece, roots)
+            visibility.add(first + start, piece)
+            tracks.add(first + start, piece, roots)
+        layer.flush()
         if progress is not None:
-            progress(1)
-    if locators:
-        for index, sucker in enumerate(take.header["suckers"]):
-            _sucker(pxr, stage, take, index, sucker)
-    write_tracks(pxr, stage, take, locators)
-    write_usd_ground(pxr, stage, take)
-    return stage, report
+            progress(chunk.frames)
+    groups = {id(group) for group in clips.sharers.values()}
+    return key_report(animated, source.frames, len(names), len(clips.sharers), len(groups))
 
 
-def _matrices(pxr: Any, matrices: np.ndarray) -> Any:
-    # USD matrices act on row vectors: store the transpose of the column-vector form
-    return pxr.Vt.Matrix4dArray.FromNumpy(np.ascontiguousarray(np.swapaxes(matrices, -1, -2)))
+def alone_in(plan: BodyPlan, sharers: dict[int, Any]) -> BodyPlan:
+    """`plan` narrowed to its creatures that keep their own animation."""
+    keep = np.array([c not in sharers for c in plan.members.tolist()], dtype=bool)
+    names = [name for name, kept in zip(plan.names, keep.tolist(), strict=True) if kept]
+    return replace(plan, names=names, members=plan.members[keep], bodies=plan.bodies[keep])
 
 
-def _creature(
-    pxr: Any, stage: Any, creature: SkinnedCreature, colour: np.ndarray, folder: str
-) -> None:
-    Gf, Sdf, UsdGeom, UsdSkel, Vt = pxr.Gf, pxr.Sdf, pxr.UsdGeom, pxr.UsdSkel, pxr.Vt
-    skeleton, mesh = creature.skeleton, creature.mesh
-    base = f"/World/{skeleton.layout.name}"
-    UsdSkel.Root.Define(stage, base)
-    name = skeleton.layout.name
-    skel = UsdSkel.Skeleton.Define(stage, f"{base}/{part(name, 'skeleton')}")
-    skel.CreateJointsAttr(skeleton.names)
-    skel.CreateJointNamesAttr(skeleton.leaf_names)
-    skel.CreateBindTransformsAttr(_matrices(pxr, skeleton.bind))
-    rest = transforms(skeleton.rest_rotation, skeleton.rest_translation)
-    skel.CreateRestTransformsAttr(_matrices(pxr, rest))
+class Suckers:
+    """Every sucker as a locator: translate sampled (the sucker point, in its creature's
+    root frame), `ecs:attached` keyed."""
 
-    anim = UsdSkel.Animation.Define(stage, f"{skel.GetPath()}/{part(name, 'animation')}")
-    anim.CreateJointsAttr(skeleton.names)
-    frames = creature.sample_frames
-    rotations = creature.rotations_at(frames).astype(np.float32)
-    translations = creature.translations_at(frames).astype(np.float32)
-    rotation_attr = anim.CreateRotationsAttr()
-    translation_attr = anim.CreateTranslationsAttr()
-    for row, frame in enumerate(frames.tolist()):
-        w, xyz = rotations[row, :, :1], rotations[row, :, 1:]
-        rotation_attr.Set(Vt.QuatfArray.FromNumpy(np.concatenate([xyz, w], axis=1)), frame)
-        translation_attr.Set(Vt.Vec3fArray.FromNumpy(translations[row]), frame)
-    anim.CreateScalesAttr(Vt.Vec3hArray.FromNumpy(np.ones((len(skeleton.names), 3), np.float16)))
-    binding = UsdSkel.BindingAPI.Apply(skel.GetPrim())
-    binding.CreateAnimationSourceRel().SetTargets([anim.GetPath()])
+    def __init__(self, pxr: Any, layer: StreamedLayer, header: dict[str, Any]) -> None:
+        Gf, Sdf, UsdGeom = pxr.Gf, pxr.Sdf, pxr.UsdGeom
+        self.Gf, self.layer = Gf, layer
+        stage = layer.stage
+        self.bodies = np.array([s["body"] for s in header["suckers"]], dtype=np.int64)
+        owner = [header["bodies"][body]["creature"] for body in self.bodies.tolist()]
+        self.owners = np.array(owner, dtype=np.int64)
+        self.offsets = np.array([s["offset"] for s in header["suckers"]], dtype=np.float64)
+        self.translates, self.attached = [], []
+        for sucker in header["suckers"]:
+            creature, _, rest = sucker["name"].split("/", 2)
+            path = f"/World/{unique_path(f'{creature}/suckers/{rest}')}"
+            parts = path.split("/")
+            for depth in range(4, len(parts)):
+                UsdGeom.Xform.Define(stage, "/".join(parts[:depth]))
+            xform = UsdGeom.Xform.Define(stage, path)
+            self.translates.append(xform.AddTranslateOp().GetAttr().GetPath())
+            attached = xform.GetPrim().CreateAttribute("ecs:attached", Sdf.ValueTypeNames.Bool)
+            self.attached.append(attached.GetPath())
+        self.steps = Steps()
 
-    skin = UsdGeom.Mesh.Define(stage, f"{base}/{part(name, 'skin')}")
-    skin.CreateSubdivisionSchemeAttr(UsdGeom.Tokens.none)
-    skin.CreatePointsAttr(Vt.Vec3fArray.FromNumpy(mesh.positions.astype(np.float32)))
-    skin.CreateFaceVertexCountsAttr(Vt.IntArray.FromNumpy(np.full(len(mesh.faces), 3, np.int32)))
-    skin.CreateFaceVertexIndicesAttr(Vt.IntArray.FromNumpy(mesh.faces.reshape(-1).astype(np.int32)))
-    skin.CreateNormalsAttr(Vt.Vec3fArray.FromNumpy(mesh.normals.astype(np.float32)))
-    skin.SetNormalsInterpolation(UsdGeom.Tokens.vertex)
-    low, high = mesh.positions.min(axis=0), mesh.positions.max(axis=0)
-    skin.CreateExtentAttr([Gf.Vec3f(*low.tolist()), Gf.Vec3f(*high.tolist())])
-    primvars = UsdGeom.PrimvarsAPI(skin.GetPrim())
-    st = primvars.CreatePrimvar(
-        "st", Sdf.ValueTypeNames.TexCoord2fArray, UsdGeom.Tokens.faceVarying
-    )
-    st.Set(Vt.Vec2fArray.FromNumpy(mesh.uv.reshape(-1, 2).astype(np.float32)))
-    bound = UsdSkel.BindingAPI.Apply(skin.GetPrim())
-    bound.CreateSkeletonRel().SetTargets([skel.GetPath()])
-    bound.CreateJointIndicesPrimvar(False, 2).Set(
-        Vt.IntArray.FromNumpy(mesh.joints.reshape(-1).astype(np.int32))
-    )
-    bound.CreateJointWeightsPrimvar(False, 2).Set(
-        Vt.FloatArray.FromNumpy(mesh.weights.reshape(-1).astype(np.float32))
-    )
-    bound.CreateGeomBindTransformAttr(Gf.Matrix4d(1.0))
-    material = usd_material(pxr, stage, folder, name, colour)
-    bind_usd(pxr, skin.GetPrim(), material, colour)
-
-
-def _sucker(pxr: Any, stage: Any, take: Take, index: int, sucker: dict[str, Any]) -> None:
-    """The sucker point as a world-space sampled translate, under the creature's `suckers`."""
-    Gf, Sdf, UsdGeom = pxr.Gf, pxr.Sdf, pxr.UsdGeom
-    creature, _, rest = sucker["name"].split("/", 2)
-    path = f"/World/{unique_path(f'{creature}/suckers/{rest}')}"
-    parts = path.split("/")
-    for depth in range(4, len(parts)):
-        UsdGeom.Xform.Define(stage, "/".join(parts[:depth]))
-    xform = UsdGeom.Xform.Define(stage, path)
-    body = sucker["body"]
-    quat = take.quat[:, body].astype(np.float64)
-    points = take.pos[:, body] + quat_rotate(quat, np.asarray(sucker["offset"], np.float64))
-    translate = xform.AddTranslateOp()
-    for frame, point in enumerate(points.tolist()):
-        translate.Set(Gf.Vec3d(*point), frame)
-    attached = xform.GetPrim().CreateAttribute("ecs:attached", Sdf.ValueTypeNames.Bool)
-    values = take.sucker_attached[:, index].tolist()
-    for frame, value in enumerate(values):
-        if frame == 0 or value != values[frame - 1]:
-            attached.Set(value, frame)
+    def add(self, first: int, chunk: Take, roots: RootFrames) -> None:
+        """The chunk's sucker points (in their creature's root frame) and attachments."""
+        if not len(self.bodies):
+            return
+        quat = chunk.quat[:, self.bodies].astype(np.float64)
+        points = chunk.pos[:, self.bodies] + quat_rotate(quat, self.offsets)
+        rows = roots.local(points, self.owners).tolist()
+        with self.layer.batch():
+            for row, frame_points in enumerate(rows):
+                for path, point in zip(self.translates, frame_points, strict=True):
+                    self.layer.sample(path, first + row, self.Gf.Vec3d(*point), 24)
+            key_steps(self.layer, self.attached, self.steps, first, chunk.sucker_attached)

@@ -29,15 +29,26 @@ class KeyReport:
     max_translation_error_m: float
     sample_frames: int  # frames where any channel keeps a key (USD's time samples)
     frames: int
+    creatures: int = 0  # creatures in the file (0: not counted)
+    sharing: int = 0  # of them, those bound to a shared clip animation (keys not counted)
+    shared: int = 0  # the shared clip animations
 
     def line(self) -> str:
         """One line for the CLI: what was kept, and what reducing cost (when it did)."""
         if self.after == self.before:
-            return f"{self.after} keys (every frame: nothing reduced; --keys reduced keeps fewer)"
+            kept = f"{self.after} keys (every frame: nothing reduced; --keys reduced keeps fewer)"
+        else:
+            kept = (
+                f"keys {self.before} -> {self.after} (frames with a key: {self.sample_frames} of"
+                f" {self.frames}); max error {self.max_rotation_error_deg:.3f} deg,"
+                f" {1000 * self.max_translation_error_m:.3f} mm"
+            )
+        if not self.sharing:
+            return kept
+        animations = "animation" if self.shared == 1 else "animations"
         return (
-            f"keys {self.before} -> {self.after} (frames with a key: {self.sample_frames} of"
-            f" {self.frames}); max error {self.max_rotation_error_deg:.3f} deg,"
-            f" {1000 * self.max_translation_error_m:.3f} mm"
+            f"{self.sharing} of {self.creatures} creatures share {self.shared} clip {animations};"
+            f" the other {self.creatures - self.sharing}: {kept}"
         )
 
 

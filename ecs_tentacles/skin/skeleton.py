@@ -18,6 +18,7 @@ hinge point is fixed in the parent's frame), so only the root moves by translati
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -109,8 +110,16 @@ class Animation:
 def creature_skeleton(take: Take, creature: int) -> Skeleton:
     """The skeleton of creature number `creature` of `take`, bound at the construction pose
     placed at the mantle's frame-0 pose."""
-    entry = take.header["creatures"][creature]
-    bodies = take.header["bodies"]
+    layout, body_index = creature_layout(take.header, creature)
+    mantle = take.header["creatures"][creature]["mantle"]
+    return build_skeleton(layout, body_index, take.quat[0, mantle], take.pos[0, mantle])
+
+
+def creature_layout(header: dict[str, Any], creature: int) -> tuple[SkinLayout, np.ndarray]:
+    """Creature number `creature` of a take with this header: its layout (from the
+    header's body sizes) and the take body of each joint (mantle, then link by link)."""
+    entry = header["creatures"][creature]
+    bodies = header["bodies"]
     mantle = bodies[entry["mantle"]]
     chains = entry["tentacles"]
     tentacles = [
@@ -122,9 +131,7 @@ def creature_skeleton(take: Take, creature: int) -> Skeleton:
         for chain, angle in zip(chains, tentacle_angles(len(chains)), strict=True)
     ]
     layout = skin_layout(entry["name"], mantle["radius"], mantle["length"], tentacles)
-    body_index = [entry["mantle"], *(i for chain in chains for i in chain)]
-    pose = (take.quat[0, entry["mantle"]], take.pos[0, entry["mantle"]])
-    return build_skeleton(layout, np.array(body_index), *pose)
+    return layout, np.array([entry["mantle"], *(i for chain in chains for i in chain)])
 
 
 def skin_layout(

@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 from ecs_tentacles.systems.record.record import Record
 
+from ecs_tentacles.cli import main
 from ecs_tentacles.components import Creature, Link, Tentacle, Transform
 from ecs_tentacles.fur.outputs import GUIDES
 from ecs_tentacles.take import Take
@@ -103,3 +104,29 @@ def khronos_report(path: Path, validator: tuple[str, Path]) -> dict[str, Any]:
     assert result.returncode == 0, result.stdout + result.stderr
     report: dict[str, Any] = json.loads(result.stdout)
     return report
+
+
+def replay_crowd_take(folder: Path, seconds: float = 2.0) -> Path:
+    """16 uniform creatures, `seconds` at 24 fps, level of detail on with room for one at
+    full physics and one reduced: the others replay the crawl clip from frame 1 (a take
+    of version 2 records them as clip, phase and root motion). The take's path."""
+    scene = folder / "crowd16.json"
+    subprocess.run(
+        [sys.executable, "-P", "-m", "ecs_tentacles", "crowd", "16", "--uniform", "--seed", "1",
+         "--out", str(scene)],
+        capture_output=True, text=True, check=True,
+    )  # fmt: skip
+    data: dict[str, Any] = json.loads(scene.read_text())
+    data.setdefault("physics", {})["lod"] = {"full": 1, "reduced": 1, "hold_seconds": 0}
+    scene.write_text(json.dumps(data))
+    take = folder / "crowd16.npz"
+    argv = ["bake", str(scene), "--seconds", str(seconds), "--fps", "24", "--out", str(take)]
+    assert main([*argv, "--quiet"]) == 0
+    return take
+
+
+@pytest.fixture(scope="session")
+def replay_take(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A take (version 2) of 16 creatures, 15 of them replaying a gait clip from frame 1
+    (`replay_crowd_take`)."""
+    return replay_crowd_take(tmp_path_factory.mktemp("replayed"))

@@ -11,6 +11,7 @@ import pytest
 
 from ecs_tentacles.cli import main
 from ecs_tentacles.export.skinned_usd import build_skinned_stage, write_skinned_usd
+from ecs_tentacles.export.usd_curves import TOLERANCE
 from ecs_tentacles.export.usd_validation import usd_problems
 from ecs_tentacles.numeric.quaternions import quat_rotate
 from ecs_tentacles.skin.keys import angle_between
@@ -51,32 +52,51 @@ def test_the_skinned_stage_passes_the_usd_validators(
     skeleton = UsdSkel.Skeleton(stage.GetPrimAtPath("/World/octo/octo_skeleton"))
     assert len(skeleton.GetJointsAttr().Get()) == 1 + 3 * 4
     assert len(skeleton.GetRestTransformsAttr().Get()) == 13
+    take = guided_take
     curves = UsdGeom.BasisCurves(stage.GetPrimAtPath("/World/octo/octo_fur/octo_guides"))
-    np.testing.assert_array_equal(
-        np.array(curves.GetPointsAttr().Get(3)),
-        guided_take.tracks["guide_points"][3].reshape(-1, 3),
-    )
     sucker = stage.GetPrimAtPath(
         "/World/octo/octo_suckers/octo_t0/octo_t0_link3/octo_t0_link3_sucker0"
     )
-    assert bool(sucker) is locators
+    goal = stage.GetPrimAtPath("/World/octo/octo_goals/octo_goal0")
+    assert bool(sucker) is bool(goal) is locators
+    entry = take.header["suckers"][take.header["suckers"].index(
+        next(s for s in take.header["suckers"] if s["name"] == "octo/tentacles/t0/link3/sucker0")
+    )]  # fmt: skip
+    for frame in (0, 3, take.frames - 1):  # world positions, below the moving SkelRoot
+        points = _world(curves.GetPrim(), frame, np.array(curves.GetPointsAttr().Get(frame)))
+        expected = take.tracks["guide_points"][frame].reshape(-1, 3)
+        np.testing.assert_allclose(points, expected, atol=TOLERANCE)  # held where still
+        if locators:
+            quat = take.quat[frame, entry["body"]].astype(np.float64)
+            point = take.pos[frame, entry["body"]] + quat_rotate(quat, np.array(entry["offset"]))
+            np.testing.assert_allclose(_world(sucker, frame, np.zeros((1, 3)))[0], point, atol=1e-6)
+            np.testing.assert_allclose(
+                _world(goal, frame, np.zeros((1, 3)))[0], take.tracks["goal_pos"][0], atol=1e-6
+            )
     if locators:
         assert sucker.GetAttribute("ecs:attached").Get(0) is False
 
 
+def _world(prim: Any, frame: int, points: np.ndarray) -> np.ndarray:
+    """`points` (N, 3) in `prim`'s space, in the world at `frame`."""
+    matrix = np.array(UsdGeom.XformCache(frame).GetLocalToWorldTransform(prim))
+    return np.asarray(points, np.float64) @ matrix[:3, :3] + matrix[3, :3]  # row vectors
+
+
 def _skinned(stage: Any, creature: str, frame: int) -> np.ndarray:
-    """The mesh points as USD's own UsdSkel skinning poses them at `frame`."""
+    """The mesh points in the world as USD poses them at `frame`: UsdSkel's own skinning
+    (skeleton space), then the Skeleton's world transform (USD's definition: a skinned
+    prim's own transform is ignored)."""
     cache = UsdSkel.Cache()
     root = UsdSkel.Root(stage.GetPrimAtPath(f"/World/{creature}"))
     cache.Populate(root, Usd.TraverseInstanceProxies())
-    skel = cache.GetSkelQuery(
-        UsdSkel.Skeleton(stage.GetPrimAtPath(f"/World/{creature}/{creature}_skeleton"))
-    )
+    skeleton = stage.GetPrimAtPath(f"/World/{creature}/{creature}_skeleton")
+    skel = cache.GetSkelQuery(UsdSkel.Skeleton(skeleton))
     skinning = cache.GetSkinningQuery(stage.GetPrimAtPath(f"/World/{creature}/{creature}_skin"))
     xforms = skel.ComputeSkinningTransforms(frame)
     points = Vt.Vec3fArray(UsdGeom.Mesh(skinning.GetPrim()).GetPointsAttr().Get())
     assert skinning.ComputeSkinnedPoints(xforms, points, frame)
-    return np.array(points, dtype=np.float64)
+    return _world(skeleton, frame, np.array(points, dtype=np.float64))
 
 
 def test_usd_skinning_puts_the_tubes_on_the_simulated_links(octopus_take: Take) -> None:

@@ -189,6 +189,42 @@ def test_every_creature_of_a_crowd_on_all_three_tiers_plays_in_blender(
         assert armature["moved"] > 0.01, f"{name} does not move"
 
 
+CROWD = """
+import json, sys, bpy
+bpy.ops.wm.open_mainfile(filepath=sys.argv[1])
+scene = bpy.context.scene
+found = {}
+for frame in (0, 1, 24, 48):
+    scene.frame_set(frame)
+    for o in bpy.data.objects:
+        if o.type == "ARMATURE":
+            found.setdefault(o.name, []).append(list(o.matrix_world @ o.pose.bones[0].head))
+print(json.dumps(found))
+"""
+
+
+def test_a_crowd_sharing_clip_animations_plays_where_the_take_has_it(tmp_path: Path) -> None:
+    """A level-of-detail crowd's take (15 of 16 creatures bound to one shared clip
+    animation in the USD) comes into Blender with every creature moving, each mantle
+    within 1 cm of the take's at four frames."""
+    from ecs_tentacles.take.stream import open_take
+    from tests.export.conftest import replay_crowd_take
+
+    take = replay_crowd_take(tmp_path)
+    usd = tmp_path / "crowd16.usdc"
+    assert main(["export", str(take), "--out", str(usd), "--quiet"]) == 0
+    found = _imported(usd, tmp_path / "crowd16.blend", CROWD)
+    with open_take(take) as source:
+        header = source.header
+        chunk = next(iter(source.chunks()))[1]
+    assert len(found) == 16
+    for entry in header["creatures"]:
+        mantles = np.array(found[f"{entry['name']}_skeleton"])
+        expected = chunk.pos[[0, 1, 24, 48], entry["mantle"]]
+        assert np.linalg.norm(mantles - expected, axis=1).max() < 0.01, entry["name"]
+        assert np.linalg.norm(mantles[-1] - mantles[0]) > 0.05, entry["name"]  # it moved
+
+
 LOOKS = """
 import json, sys, bpy
 bpy.ops.wm.open_mainfile(filepath=sys.argv[1])

@@ -1,0 +1,71 @@
+"""Joint rotations of many creatures of one body plan, chunk of frames by chunk.
+
+    rotations = JointRotations(plan.parents, joint_bodies)     # joint_bodies (C, J)
+    for first, chunk in source.chunks():
+        local = rotations.local(chunk.quat)                   # (n, C, J, 4) w-first
+
+Each creature's joints are its bodies (`Skeleton.bodies`: the mantle, then every link);
+a joint turns with its body, so a joint's local rotation is its parent body's world
+rotation undone from its own (`ecs_tentacles.skin.skeleton.creature_animation` does
+the same for one creature over a whole take). The root's local rotation is the mantle's
+world rotation. Signs are made continuous along time across chunks (q and -q are the
+same rotation, but interpolating between them takes the long way round): the last
+frame of a chunk is kept for the next.
+
+Reads body quaternions; writes nothing. Whole-array work: a chunk of every creature of
+a plan at once.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def undo(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """conj(a) * b for unit quaternion arrays (..., 4): `b` seen from `a`'s frame (the
+    Hamilton product with the conjugate written out: no conjugate array made)."""
+    aw, ax, ay, az = np.moveaxis(a, -1, 0)
+    bw, bx, by, bz = np.moveaxis(b, -1, 0)
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape))
+    out[..., 0] = aw * bw + ax * bx + ay * by + az * bz
+    out[..., 1] = aw * bx - ax * bw - ay * bz + az * by
+    out[..., 2] = aw * by + ax * bz - ay * bw - az * bx
+    out[..., 3] = aw * bz - ax * by + ay * bx - az * bw
+    return out
+
+
+class JointRotations:
+    """Local joint rotations of creatures sharing a skeleton, continuous over chunks."""
+
+    def __init__(self, parents: np.ndarray, joint_bodies: np.ndarray) -> None:
+        self.parents = np.asarray(parents)
+        self.bodies = np.asarray(joint_bodies)  # (creatures, joints) take body indices
+        self.children = np.flatnonzero(self.parents >= 0)
+        self.last: np.ndarray | None = None  # (creatures, joints, 4) the previous frame's
+
+    def world(self, quat: np.ndarray) -> np.ndarray:
+        """(n, C, J, 4) unit world rotations of every joint from a chunk's body `quat`."""
+        world = quat[:, self.bodies].astype(np.float64)
+        world /= np.sqrt(np.einsum("...c,...c->...", world, world))[..., None]
+        return world
+
+    def local(self, quat: np.ndarray) -> np.ndarray:
+        """(n, C, J, 4) local rotations (the root's: its world rotation) for the chunk's
+        frames, signs continuous with the chunk before."""
+        world = self.world(quat)
+        local = world.copy()
+        parents = self.parents[self.children]
+        local[..., self.children, :] = undo(world[..., parents, :], world[..., self.children, :])
+        return self.continuous(local)
+
+    def continuous(self, local: np.ndarray) -> np.ndarray:
+        """`local` (n, C, J, 4) with each quaternion's sign flipped where that keeps it in
+        the previous frame's hemisphere (the previous chunk's last frame too)."""
+        flips = np.zeros(local.shape[:-1], dtype=bool)
+        flips[1:] = np.einsum("f...c,f...c->f...", local[1:], local[:-1]) < 0
+        if self.last is not None:
+            flips[0] = np.einsum("...c,...c->...", local[0], self.last) < 0
+        sign = np.where(np.cumsum(flips, axis=0) % 2 == 1, -1.0, 1.0)
+        local *= sign[..., None]
+        self.last = local[-1].copy()
+        return local
