@@ -203,8 +203,9 @@ def poses(
         frames = (int(entry["frames"][0]), int(entry["frames"][1]))
         ground = blend(clips[clip], frames, kind[mine].astype(np.int64), phase[mine])
         pos, quat = place(ground, xy[mine], heading[mine])
-        rows = np.array([body_rows(header["creatures"][c]) for c in creatures[mine].tolist()])
-        out[clip] = (rows.reshape(len(mine), -1), pos, quat)
+        which, back = np.unique(creatures[mine], return_inverse=True)  # Python per creature
+        table = np.array([body_rows(header["creatures"][c]) for c in which.tolist()])
+        out[clip] = (table.reshape(len(which), -1)[back.reshape(-1)], pos, quat)
     return out
 
 
@@ -247,9 +248,11 @@ def blanked(header: dict[str, Any], arrays: dict[str, np.ndarray]) -> dict[str, 
     if not len(frame):
         return arrays
     creatures = header["creatures"]
-    rows = [body_rows(creatures[c]) for c in creature.tolist()]
+    which, back = np.unique(creature, return_inverse=True)  # Python once per creature
+    each = [np.asarray(body_rows(creatures[c]), dtype=np.int64) for c in which.tolist()]
+    rows = [each[k] for k in back.reshape(-1).tolist()]
     frames = np.repeat(frame, [len(r) for r in rows])
-    bodies = np.concatenate([np.asarray(r, dtype=np.int64) for r in rows])
+    bodies = np.concatenate(rows)
     out = dict(arrays)
     out["pos"], out["quat"] = arrays["pos"].copy(), arrays["quat"].copy()
     out["pos"][frames, bodies] = 0.0
