@@ -69,6 +69,10 @@ def read_npy(
             raise TakeError(f"{label}: dtype {dtype}, expected {wanted}")
         if math.prod(stored) * dtype.itemsize > entry.file_size:
             raise TakeError(f"{label}: shape {tuple(stored)} holds more than the stored data")
+        if entry.file_size > math.prod(stored) * dtype.itemsize + NPY_HEADER_ROOM:
+            raise TakeError(  # a zip directory that lies: refused before inflating
+                f"{label}: the archive claims {entry.file_size} bytes for shape {tuple(stored)}"
+            )
         problem = check(tuple(stored))
         if problem:
             raise TakeError(f"{label}: {problem}")
@@ -89,6 +93,7 @@ def read_npy(
     return array
 
 
+NPY_HEADER_ROOM = 64 * 1024  # an .npy entry's bytes beyond its data: its header, at most
 READ_PIECE = 4 * 1024**2  # bytes an entry is read in at a time
 CHECK_BYTES = 16 * 1024**2  # the checks below look at this much of an array at a time
 

@@ -19,7 +19,7 @@ from __future__ import annotations
 import stat
 import zipfile
 import zlib
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from types import TracebackType
@@ -166,7 +166,7 @@ class TakeSource:
         assert archive is not None, "the take is closed"
         buffered: Take | None = None
         for k in range(archive.count):
-            piece = self._chunk(k)
+            piece = self._named(self._chunk, k)
             buffered = piece if buffered is None else _join(buffered, piece)
             while buffered is not None and buffered.frames >= step:
                 first = k * archive.per_chunk + piece.frames - buffered.frames
@@ -176,6 +176,17 @@ class TakeSource:
                 )
         if buffered is not None:
             yield self.frames - buffered.frames, buffered
+
+    def _named(self, read: Callable[[int], Take], k: int) -> Take:
+        """`read(k)`, its failures as one line naming the file (`TakeError`)."""
+        try:
+            return read(k)
+        except TakeError as error:
+            message = str(error)
+            named = message if message.startswith(str(self.path)) else f"{self.path}: {message}"
+            raise TakeError(named) from None
+        except (zipfile.BadZipFile, zlib.error, EOFError, OSError, ValueError) as exc:
+            raise TakeError(f"{self.path}: not a take file ({type(exc).__name__}: {exc})") from None
 
     def _chunk(self, k: int) -> Take:
         archive = self._archive

@@ -116,7 +116,7 @@ BAKE = ["bake", "octopus", "--seconds", "0.2", "--out", "x.npz"]
     [
         ([*EXPORT, "x.glb"], ["export: reading", "write x.glb:", "/1 [", "creature"]),
         ([*EXPORT, "x.glb", "--rigid"], ["write x.glb:", "/81 [", "body"]),
-        ([*EXPORT, "x.usda"], ["write x.usda:", "/1 [", "creature"]),
+        ([*EXPORT, "x.usda"], ["write x.usda:", "frame"]),  # USD streams: frames
         # a take is written as the bake goes: its bar is the bake's, then the last chunk
         (BAKE, ["bake: building the world", "/12 [", "bake: writing x.npz"]),
     ],
