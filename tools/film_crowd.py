@@ -65,6 +65,8 @@ def one_size(count: int, seconds: float, steps: list[str], folder: Path) -> dict
     if "bake" in steps:
         row["bake"] = timed(cli("bake", str(scene), "--seconds", str(seconds), "--fps", "24",
                                 "--quiet", "--out", str(take)), folder)  # fmt: skip
+        if row["bake"]["exit"] != 0:  # refused (its line is on stderr): nothing to measure
+            return row
         size = take.stat().st_size
         row["take_mb_per_s"] = round(size / 1e6 / seconds, 2)
         row["take_bytes_per_creature_frame"] = round(size / (count * frames), 1)
