@@ -133,10 +133,14 @@ def values_problem(header: dict[str, Any], arrays: dict[str, np.ndarray]) -> str
         values = arrays[name]
         if not np.isfinite(values).all() or (np.abs(values) > 1e9).any():
             return f"{name}: values must be finite numbers"
-    for i in range(len(replay["clips"])):
-        pose = arrays.get(clip_array(i))
-        if pose is None:
-            continue
+    return clips_problem(header, {i: arrays[clip_array(i)] for i in range(len(replay["clips"]))
+                                  if clip_array(i) in arrays})  # fmt: skip
+
+
+def clips_problem(header: dict[str, Any], clips: dict[int, np.ndarray]) -> str | None:
+    """The first clip frame the poses cannot come from: a number not finite or beyond
+    1e6 m, a rotation of no length."""
+    for i, pose in clips.items():
         if not np.isfinite(pose).all() or (np.abs(pose[..., :3]) > 1e6).any():
             return f"{clip_array(i)}: values must be finite numbers within 1e6 m"
         if (np.einsum("...i,...i->...", pose[..., 3:], pose[..., 3:]) < 1e-12).any():

@@ -83,36 +83,16 @@ class TakeSource:
                 i: self.static[take_replay.clip_array(i)]
                 for i in range(len((self.header.get(take_replay.KEY) or {}).get("clips", [])))
             }
-            problem = take_replay.values_problem(
-                self.header, {**self._clips_only(), **self._replay_or_empty()}
-            ) if self._clips else None  # fmt: skip
+            problem = take_replay.clips_problem(self.header, self._clips)
             problem = problem or take_ground.index_problem(self.header, self.static)
             if problem:
                 raise TakeError(problem)
-        except TakeError as error:
-            self.close()
-            message = str(error)
-            named = message if message.startswith(str(where)) else f"{where}: {message}"
-            raise TakeError(named) from None
         except FileNotFoundError:
             self.close()
             raise TakeError(f"{where}: no such file") from None
-        except (zipfile.BadZipFile, zipfile.LargeZipFile, zlib.error, EOFError, OSError,
-                ValueError, NotImplementedError) as exc:  # fmt: skip
+        except (TakeError, *_UNSOUND) as error:
             self.close()
-            raise TakeError(f"{where}: not a take file ({type(exc).__name__}: {exc})") from None
-
-    def _clips_only(self) -> dict[str, np.ndarray]:
-        return {take_replay.clip_array(i): pose for i, pose in self._clips.items()}
-
-    def _replay_or_empty(self) -> dict[str, np.ndarray]:
-        empty: dict[str, np.ndarray] = {
-            "replay_kind": np.zeros((0, len(self.header["creatures"])), np.int8),
-            "replay_phase": np.zeros((0, 0)),
-            "replay_xy": np.zeros((0, 0, 2)),
-            "replay_heading": np.zeros((0, 0)),
-        }
-        return empty
+            raise _named(where, error) from None
 
     @staticmethod
     def _v1_static(take: Take) -> dict[str, np.ndarray]:
@@ -181,12 +161,17 @@ class TakeSource:
         """`read(k)`, its failures as one line naming the file (`TakeError`)."""
         try:
             return read(k)
-        except TakeError as error:
-            message = str(error)
-            named = message if message.startswith(str(self.path)) else f"{self.path}: {message}"
-            raise TakeError(named) from None
-        except (zipfile.BadZipFile, zlib.error, EOFError, OSError, ValueError) as exc:
-            raise TakeError(f"{self.path}: not a take file ({type(exc).__name__}: {exc})") from None
+        except (TakeError, *_UNSOUND) as error:
+            raise _named(self.path, error) from None
+
+    def _padded(self, name: str, k: int) -> np.ndarray:
+        """Chunk `k` of `name`, items it lacks (spawned later) at their first values."""
+        archive = self._archive
+        assert archive is not None
+        value = archive.chunk(name, k, 0)
+        if value.shape[1] < archive.items[name]:
+            value = chunks.pad_items(value, archive.items[name], self._later(name, k, value))
+        return value
 
     def _chunk(self, k: int) -> Take:
         archive = self._archive
@@ -194,12 +179,7 @@ class TakeSource:
         header = self.header
         first = k * archive.per_chunk
         end = min(first + archive.per_chunk, self.frames)
-        arrays: dict[str, np.ndarray] = {}
-        for name in archive.chunked:
-            value = archive.chunk(name, k, 0)
-            if value.shape[1] < archive.items[name]:
-                value = chunks.pad_items(value, archive.items[name], self._later(name, k, value))
-            arrays[name] = value
+        arrays = {name: self._padded(name, k) for name in archive.chunked}
         for name in archive.singles:
             if name in archive.frame_singles:
                 arrays[name] = self.static[name][first:end]
@@ -207,9 +187,8 @@ class TakeSource:
         if problem:
             raise TakeError(f"{self.path}: {problem}")
         take_replay.fill(header, self._clips, arrays, arrays["pos"], arrays["quat"])
-        tracks = [t for t in tracks_of(header)]
         checked = {n: a for n, a in arrays.items() if n not in take_replay.PER_FRAME}
-        problem = data_problem(checked, tracks)
+        problem = data_problem(checked, tracks_of(header))
         if problem:
             raise TakeError(f"{self.path}: frames {first}-{end - 1}: {problem}")
         piece_header = {**header, "frames": end - first}
@@ -245,17 +224,10 @@ class TakeSource:
         if archive is None or self.header.get(take_replay.KEY) is None:
             self._replay = {}
             return self._replay
-        out = {}
-        for name in take_replay.PER_FRAME:
-            parts = []
-            for k in range(archive.count):
-                value = archive.chunk(name, k, 0)
-                if value.shape[1] < archive.items[name]:
-                    value = chunks.pad_items(
-                        value, archive.items[name], self._later(name, k, value)
-                    )
-                parts.append(value)
-            out[name] = np.concatenate(parts)
+        out = {
+            name: np.concatenate([self._padded(name, k) for k in range(archive.count)])
+            for name in take_replay.PER_FRAME
+        }
         problem = take_replay.values_problem(self.header, out)
         if problem:
             raise TakeError(f"{self.path}: {problem}")
@@ -290,6 +262,18 @@ class TakeSource:
             for a, b in zip(starts.tolist(), ends.tolist(), strict=True)
             if kind[a] >= 0
         ]
+
+
+_UNSOUND = (zipfile.BadZipFile, zipfile.LargeZipFile, zlib.error, EOFError, OSError,
+            ValueError, NotImplementedError)  # fmt: skip  # what a broken archive raises
+
+
+def _named(where: Path, error: BaseException) -> TakeError:
+    """`error` as one line naming the take file."""
+    if not isinstance(error, TakeError):
+        return TakeError(f"{where}: not a take file ({type(error).__name__}: {error})")
+    message = str(error)
+    return TakeError(message if message.startswith(str(where)) else f"{where}: {message}")
 
 
 def open_take(path: str | Path, max_bytes: int = MAX_TAKE_BYTES) -> TakeSource:
