@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
 import numpy as np
 
 from ecs_tentacles.components import Creature, Link, Tentacle, Transform
+from ecs_tentacles.export.frame_arrays import doubled, gather, resized_frames, widen
 from ecs_tentacles.export.replay_recording import ReplayRecorder
 from ecs_tentacles.export.track_recording import CurvesTrack, PointsTrack
 from ecs_tentacles.ground import ground_of
@@ -259,12 +260,12 @@ class TakeRecorder:
         self._add_creatures(world, [(change.creature, world.component(change.creature, Creature))])
         self._alive = np.append(self._alive, True)
         new_rows = self._rows[bodies:]
-        self._pos = _widen(self._pos, world.transforms.pos[new_rows])
-        self._quat = _widen(self._quat, world.transforms.quat[new_rows])
+        self._pos = widen(self._pos, world.transforms.pos[new_rows])
+        self._quat = widen(self._quat, world.transforms.quat[new_rows])
         added = len(self._suckers) - suckers
-        self._attached = _widen(self._attached, np.zeros(added, np.bool_))
-        self._anchor = _widen(self._anchor, np.zeros((added, 3)))
-        self._visible = _widen(self._visible, np.zeros(1, np.bool_))
+        self._attached = widen(self._attached, np.zeros(added, np.bool_))
+        self._anchor = widen(self._anchor, np.zeros((added, 3)))
+        self._visible = widen(self._visible, np.zeros(1, np.bool_))
         widened = {"pos": world.transforms.pos[new_rows], "quat": world.transforms.quat[new_rows],
                    "anchor": np.zeros((added, 3), np.float32)}  # fmt: skip
         for name, value in widened.items():  # the frame handed over last, widened too
@@ -273,7 +274,7 @@ class TakeRecorder:
         if self._replayed:
             self._replay.creature_added()
             blank = self._replay.empty(1, 1)
-            self._replayed = {k: _widen(v, blank[k][0]) for k, v in self._replayed.items()}
+            self._replayed = {k: widen(v, blank[k][0]) for k, v in self._replayed.items()}
 
     def capture(self) -> None:
         """Append the world's current frame."""
@@ -287,7 +288,7 @@ class TakeRecorder:
             else:
                 self._grow()
         if self.count == len(self._visible):
-            self._visible = _doubled(self._visible)
+            self._visible = doubled(self._visible)
         transforms, suckers = world.transforms, world.suckers
         if not self._changes:  # every body and sucker there, in store order
             bodies = self._rows if self._span is None else self._span  # a slice: no gather
@@ -296,10 +297,10 @@ class TakeRecorder:
             self._attached[i] = suckers.attached
             self._anchor[i] = suckers.anchor
         else:
-            _gather(self._pos, i, transforms.pos, self._rows, self._before("pos", i))
-            _gather(self._quat, i, transforms.quat, self._rows, self._before("quat", i))
-            _gather(self._attached, i, suckers.attached, self._sucker_rows, fill=False)
-            _gather(self._anchor, i, suckers.anchor, self._sucker_rows, self._before("anchor", i))
+            gather(self._pos, i, transforms.pos, self._rows, self._before("pos", i))
+            gather(self._quat, i, transforms.quat, self._rows, self._before("quat", i))
+            gather(self._attached, i, suckers.attached, self._sucker_rows, fill=False)
+            gather(self._anchor, i, suckers.anchor, self._sucker_rows, self._before("anchor", i))
         if self._replayed:
             self._replay.capture(self._replayed, i, self.creature_index, self._rows)
         self._visible[self.count] = self._alive
@@ -319,8 +320,8 @@ class TakeRecorder:
                 frame += sum(a[:1].nbytes for a in track.arrays(1, copy=False).values())
         self.writer.chunk_frames = per = chunks.chunk_frames(frame)
         for name in ("_pos", "_quat", "_attached", "_anchor"):
-            setattr(self, name, _resized_frames(getattr(self, name), per))
-        self._replayed = {k: _resized_frames(v, per) for k, v in self._replayed.items()}
+            setattr(self, name, resized_frames(getattr(self, name), per))
+        self._replayed = {k: resized_frames(v, per) for k, v in self._replayed.items()}
 
     def _before(self, name: str, i: int) -> np.ndarray | None:
         """Frame `i - 1` of chunked array `name` (`_pos`, ...): in the array, or the last
@@ -385,8 +386,8 @@ class TakeRecorder:
 
     def _grow(self) -> None:
         for name in ("_pos", "_quat", "_attached", "_anchor"):
-            setattr(self, name, _doubled(getattr(self, name)))
-        self._replayed = {name: _doubled(value) for name, value in self._replayed.items()}
+            setattr(self, name, doubled(getattr(self, name)))
+        self._replayed = {name: doubled(value) for name, value in self._replayed.items()}
 
     def take(self) -> Take:
         """The frames captured so far as a Take (copies; recording may go on)."""
@@ -450,47 +451,6 @@ class TakeRecorder:
             sucker_anchor=kept(self._anchor[:n]),
             tracks=tracks,
         )
-
-
-def _resized_frames(old: np.ndarray, frames: int) -> np.ndarray:
-    """`old` with room for `frames` frames (its first frame kept)."""
-    grown = np.empty((max(frames, 1), *old.shape[1:]), old.dtype)
-    grown[:1] = old[:1]
-    return grown
-
-
-def _doubled(old: np.ndarray) -> np.ndarray:
-    """`old` with room for twice its frames (the first ones copied)."""
-    grown = np.empty((2 * len(old), *old.shape[1:]), old.dtype)
-    grown[: len(old)] = old
-    return grown
-
-
-def _widen(frames: np.ndarray, now: np.ndarray) -> np.ndarray:
-    """`frames` (capacity, items, ...) with items appended, every frame holding `now`."""
-    extra = np.broadcast_to(np.asarray(now, dtype=frames.dtype), (len(frames), *now.shape))
-    return np.concatenate([frames, extra], axis=1)
-
-
-def _gather(
-    frames: np.ndarray,
-    i: int,
-    values: np.ndarray,
-    rows: np.ndarray,
-    before: np.ndarray | None = None,
-    fill: Any = None,
-) -> None:
-    """Frame `i` of `frames` from `values[rows]`; items whose row is gone (-1) hold
-    `before` (the previous frame's values; None: 0) or `fill`."""
-    live = rows >= 0
-    frames[i, live] = values[rows[live]]
-    if not live.all():
-        if fill is not None:
-            frames[i, ~live] = fill
-        elif before is not None:
-            frames[i, ~live] = before[~live]
-        else:
-            frames[i, ~live] = 0
 
 
 def _body(name: str, creature: int, shape: str, axis: str, part: Any) -> dict[str, Any]:
