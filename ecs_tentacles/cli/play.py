@@ -172,15 +172,35 @@ def handle(args: argparse.Namespace) -> int:
                 return 2
         if args.headless:
             result = sandbox.run_headless(
-                args.frames, screenshot=args.screenshot, video=args.video, progress=not args.quiet
+                args.frames,
+                screenshot=args.screenshot,
+                video=args.video,
+                progress=not args.quiet,
+                until=game_ended,
             )
-            report = {"scene": str(path), **result}
+            report = {"scene": str(path), **result, **game_report(sandbox.world)}
             print(json.dumps(report) if args.json else sentence(report))
         else:
             sandbox.run()
     finally:
         sandbox.close()
     return 0
+
+
+def game_ended(world: Any) -> bool:
+    """True once the world's game (a level's) is won or lost: a headless play stops."""
+    from ecs_tentacles.game.rules import playing
+
+    found = playing(world)
+    return found is not None and found[1].ended
+
+
+def game_report(world: Any) -> dict[str, Any]:
+    """`{"game": ...}`: the level's result as `--json` gives it ({} without a game)."""
+    from ecs_tentacles.game.rules import playing
+
+    found = playing(world)
+    return {} if found is None else {"game": found[1].report(found[0])}
 
 
 def sentence(report: dict[str, Any]) -> str:
@@ -192,4 +212,7 @@ def sentence(report: dict[str, Any]) -> str:
         f" physics {report['physics_ms']:.1f} ms a frame: {report['realtime_factor']:.2f}x real"
         " time)"
     )
+    game = report.get("game")
+    if game is not None:
+        text += f"; game {game['outcome']} at {game['seconds']:.1f} s"
     return text + (f"; wrote {', '.join(written)}" if written else "")
