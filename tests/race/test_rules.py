@@ -73,3 +73,11 @@ def test_the_mode_s_defaults_are_filled_and_the_bundled_levels_are_valid() -> No
         assert (race.radius, race.rivals_wait, race.level) == (0.5, 0.0, "test race")
     for name in ("race_1_rock", "race_2_wall"):
         assert load_scene(bundled_scene(name))["game"]["mode"] == "race"
+
+
+def test_every_entry_of_a_race_world_is_its_owners() -> None:
+    from tests.test_registry import strangers
+
+    with World.from_scene(bundled_scene("race_2_wall")) as world:
+        assert strangers(world) == []
+        assert len(world.registry(GameModes)) == 1
