@@ -1,4 +1,7 @@
-"""`ecs-tentacles play SCENE`: the interactive sandbox, or headless screenshots/video."""
+"""`ecs-tentacles play SCENE`: the interactive sandbox, or headless screenshots/video.
+
+Headless, a level (a scene with a `game`) stops once its game is won or lost, and the
+report holds the game's result (`ecs_tentacles.game`)."""
 
 from __future__ import annotations
 
@@ -66,7 +69,12 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("scene", metavar="SCENE", help="scene file or bundled scene name")
     parser.add_argument("--headless", action="store_true", help="no window: render off-screen")
-    parser.add_argument("--frames", type=frame_count, default=300, help="headless: frames to run")
+    parser.add_argument(
+        "--frames",
+        type=frame_count,
+        default=300,
+        help="headless: frames to run (a level stops sooner once its game is won or lost)",
+    )
     parser.add_argument("--screenshot", type=output_path(".png"), help="headless: final PNG")
     parser.add_argument("--video", type=output_path(".mp4"), help="headless: record an MP4")
     parser.add_argument("--width", type=even_size, default=1280, help=f"{SIZE_RULE} (default 1280)")
@@ -116,7 +124,9 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         help="start with the HUD hidden (h)",
     )
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
-    parser.add_argument("--json", action="store_true", help="headless: the summary as JSON")
+    parser.add_argument(
+        "--json", action="store_true", help="headless: the summary as JSON (a level's: its game)"
+    )
     add_lod_arguments(parser)
     add_threads_argument(parser)  # without --focus, the focus follows the camera (render.sandbox)
     parser.set_defaults(handler=handle)

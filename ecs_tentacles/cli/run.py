@@ -44,7 +44,10 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("scene", metavar="SCENE", help="scene file or bundled scene name")
     parser.add_argument(
-        "--frames", type=frame_count, default=600, help="frames to run (default 600)"
+        "--frames",
+        type=frame_count,
+        default=600,
+        help="frames to run (default 600; a level stops sooner once its game is won or lost)",
     )
     parser.add_argument("--seed", type=seed_int, default=None, help="override the scene's seed")
     parser.add_argument("--json", action="store_true", help="print the summary as one JSON object")
