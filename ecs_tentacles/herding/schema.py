@@ -23,7 +23,7 @@ import numpy as np
 
 from ecs_tentacles.scene.schema import fragment
 
-GAME = fragment("ecs_tentacles.herding", "herding")["game_mode"]
+GAME = fragment("ecs_tentacles.herding", "herding")["game_mode"]["game"]
 
 Problem = tuple[tuple[str | int, ...], str]
 
