@@ -16,20 +16,25 @@ RULES = {  # the mode's keys of the scene's `game` ("mode" is added)
 }
 
 
+def result(world):
+    """The game now: won once a mantle is inside the ring, lost when the time is up."""
+    game = rules(world.scene, SPRINT)  # the scene's `game`, the mode's defaults filled in
+    creatures = world.creatures  # one row per creature: entity, mantle_row, ...
+    mantles = world.transforms.pos[creatures.mantle_row, :2]
+    there = np.hypot(*(mantles - game["finish"]).T) < game["radius"]
+    if there.any():
+        first = world.creature_name(int(creatures.entity[there][0]))
+        return GameResult(WON, world.time, details={"first": first}, text=f"{first} first")
+    return GameResult(LOST if world.time >= game["seconds"] else PLAYING, world.time)
+
+
+SPRINT = GameMode("sprint", RULES, result)
+
+
 class Sprint(Plugin):
     name = "sprint"
     description = "the first creature inside the finish ring wins"
-    requires = ("locomotion", "game")
+    requires = ("locomotion", "game")  # the game layer is turned on with it
 
     def build(self, app):
-        app.add(GameModes, GameMode("sprint", RULES, self.result))
-
-    def result(self, world):
-        game = rules(world.scene, GameMode("sprint", RULES, self.result))  # defaults filled
-        creatures = world.creatures
-        mantles = world.transforms.pos[creatures.mantle_row, :2]
-        there = np.hypot(*(mantles - game["finish"]).T) < game["radius"]
-        if there.any():
-            first = world.creature_name(int(creatures.entity[there][0]))
-            return GameResult(WON, world.time, details={"first": first}, text=f"{first} first")
-        return GameResult(LOST if world.time >= game["seconds"] else PLAYING, world.time)
+        app.add(GameModes, SPRINT)
