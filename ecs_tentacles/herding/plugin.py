@@ -1,10 +1,13 @@
 """`HerdingPlugin`: the herding game as a plugin (`"plugins": {"herding": {}}`).
 
-Scene key `game` (`ecs_tentacles.herding.schema`); resource `HerdingGame`
+Game mode "herding" (the scene's `game`, whose keys are `ecs_tentacles.herding.schema`'s;
+the `game` layer owns the key); resource `HerdingGame`
 (`ecs_tentacles.herding.game`); systems `Predator` and `Referee` (`systems/herding/`).
 It needs the flee plugin (what makes creatures run from the predator) and locomotion.
 
 What it adds to the registries in `build`:
+- `GameModes` (`ecs_tentacles.game.modes`): the mode "herding", its rules' schema and
+  checks, and its result (which ends `run` and `play --headless` once won or lost);
 - `Dangers` (`ecs_tentacles.behaviour`): the predator, so everything that fears
   dangers fears it (the flee plugin runs, fur's emotion raises quills);
 - `Lines`, `Spheres` and `FramedPoints` (the renderer): the pen's ring on the ground,
@@ -24,8 +27,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ecs_tentacles.behaviour import Dangers, DangerSource
+from ecs_tentacles.game.modes import GameMode, GameModes, GameResult
 from ecs_tentacles.herding.game import HerdingGame
-from ecs_tentacles.herding.schema import GAME, game_problems
+from ecs_tentacles.herding.schema import GAME, game_problems, plugin_problems
 from ecs_tentacles.plugin import Plugin
 
 if TYPE_CHECKING:
@@ -37,11 +41,10 @@ if TYPE_CHECKING:
 class HerdingPlugin(Plugin):
     name = "herding"
     description = "the herding game: drive creatures into a pen with a predator"
-    requires = ("locomotion", "flee")
-    scene_schema = {"game": GAME}
+    requires = ("locomotion", "flee", "game")
 
     def problems(self, scene: Mapping[str, Any]) -> list[tuple[tuple[str | int, ...], str]]:
-        return game_problems(scene)
+        return plugin_problems(scene)
 
     def resources(self, world: Host) -> list[object]:
         scene = world.scene or {}
@@ -69,6 +72,7 @@ class HerdingPlugin(Plugin):
         from ecs_tentacles.render.registries import FramedPoints, Lines, Panels, Spheres
         from ecs_tentacles.take.registries import TakeTracks
 
+        app.add(GameModes, GameMode("herding", GAME, _result, game_problems, self.description))
         app.add(Dangers, DangerSource(sense=_predator_danger))
         app.add(Lines, entries.lines)
         app.add(Spheres, entries.spheres)
@@ -84,3 +88,10 @@ def _predator_danger(world: Host) -> tuple[np.ndarray, np.ndarray]:
     xy = world.resource(HerdingGame).predator
     z = ground_of(world).height(xy[None])[0]
     return np.array([[xy[0], xy[1], z]]), np.array([-1])
+
+
+def _result(world: Host) -> GameResult:
+    game = world.resource(HerdingGame)
+    details = {"penned": game.penned, "need": game.need, "left": round(game.left, 3)}
+    text = f"{game.penned} of {game.need} penned"
+    return GameResult(game.outcome, game.elapsed, game.level, details, text)

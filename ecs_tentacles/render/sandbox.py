@@ -65,7 +65,7 @@ from ecs_tentacles.skin.colours import PALETTES
 from ecs_tentacles.world import World
 
 if TYPE_CHECKING:
-    pass
+    from collections.abc import Callable
 
 FRAME_EASE = 0.08  # share of the way to the new framing a video frame moves (frame-all)
 DISPLAY_HZ = 60
@@ -342,26 +342,33 @@ class Sandbox(SandboxPicture):
         screenshot: str | os.PathLike[str] | None = None,
         video: str | os.PathLike[str] | None = None,
         progress: bool = True,
+        until: Callable[[World], bool] | None = None,
     ) -> dict[str, Any]:
-        """Step `frames` frames off-screen, recording a video and/or a final screenshot."""
+        """Step `frames` frames off-screen, recording a video and/or a final screenshot;
+        with `until`, stop after the first frame at which `until(world)` is True (a game
+        won or lost). `frames` in the result: the frames run."""
         if video is not None:
             self.toggle_video(video)
         physics_ms = []
+        done = 0
         try:
             for _ in tqdm(
                 range(frames), unit="frame", disable=None if progress else True, leave=False
             ):
                 self.step(1)
+                done += 1
                 physics_ms.append(self.stats["physics_ms"])
                 if self.video is not None:
                     self.keep_framed(FRAME_EASE)
                     self.render()
+                if until is not None and until(self.world):
+                    break
         except BaseException:
             if self.video is not None:
                 self.video.abort()
                 self.video = None
             raise
-        result: dict[str, Any] = {"frames": frames, "sim_seconds": self.world.time}
+        result: dict[str, Any] = {"frames": done, "sim_seconds": self.world.time}
         result["tiers"] = self.world.lod.counts()  # creatures per physics tier at the end
         # a frame's physics, median over the run: at most the frame's duration keeps real time
         median = float(np.median(physics_ms))
