@@ -63,7 +63,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
             "to append, right-click a goal to remove it. Keys: space pause, . step, r reset, "
             "h HUD, f follow, a frame all, tab next tentacle, F12 screenshot, v video, o the"
             " clean view (the editor's overlays hidden: goal paths, selection rings, sucker"
-            " dots, the fur timeline; a game's HUD and banners stay)."
+            " dots, the fur timeline, the metre grid; a game's HUD and banners stay)."
         ),
     )
     parser.add_argument("scene", metavar="SCENE", help="scene file or bundled scene name")
@@ -126,7 +126,8 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         default=None,
         help="the clean view, a picture for showing: none of the editor's overlays (goal"
         " paths and rings, selection rings and names, sucker dots, tier spheres, the fur"
-        " timeline); default: clean in a game (a scene with a `game` key) and in a --video",
+        " timeline, the metre grid); default: clean in a game (a scene with a `game` key)"
+        " and in a --video",
     )
     clean.add_argument(
         "--no-clean",
