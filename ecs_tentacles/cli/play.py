@@ -64,7 +64,9 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
             "right-drag orbit, middle-drag pan, wheel zoom, click a creature to select it, "
             "click the ground to set its goal, shift-click "
             "to append, right-click a goal to remove it. Keys: space pause, . step, r reset, "
-            "h HUD, f follow, a frame all, tab next tentacle, F12 screenshot, v video."
+            "h HUD, f follow, a frame all, tab next tentacle, F12 screenshot, v video, o the"
+            " clean view (the editor's overlays hidden: goal paths, selection rings, sucker"
+            " dots, the fur timeline, the metre grid; a game's HUD and banners stay)."
         ),
     )
     parser.add_argument("scene", metavar="SCENE", help="scene file or bundled scene name")
@@ -123,6 +125,25 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         const=False,
         help="start with the HUD hidden (h)",
     )
+    clean = parser.add_mutually_exclusive_group()
+    clean.add_argument(
+        "--clean",
+        dest="clean",
+        action="store_const",
+        const=True,
+        default=None,
+        help="the clean view, a picture for showing: none of the editor's overlays (goal"
+        " paths and rings, selection rings and names, sucker dots, tier spheres, the fur"
+        " timeline, the metre grid); default: clean in a game (a scene with a `game` key)"
+        " and in a --video",
+    )
+    clean.add_argument(
+        "--no-clean",
+        dest="clean",
+        action="store_const",
+        const=False,
+        help="draw the editor's overlays, in a game or a --video too (o toggles them)",
+    )
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
     parser.add_argument(
         "--json", action="store_true", help="headless: the summary as JSON (a level's: its game)"
@@ -172,6 +193,7 @@ def handle(args: argparse.Namespace) -> int:
         focus=args.focus,
         threads=args.threads,
         palette=args.palette,
+        clean=True if args.clean is None and args.video else args.clean,
     )
     try:
         if args.camera is not None:

@@ -76,6 +76,11 @@ def scene_palette(scene: dict[str, Any] | None) -> str:
     return str(((scene or {}).get("render") or {}).get("palette", "natural"))
 
 
+def is_game(scene: dict[str, Any] | None) -> bool:
+    """Whether a validated scene is a game's (it has a `game` key): its view starts clean."""
+    return scene is not None and bool(scene.get("game"))
+
+
 class Sandbox(SandboxPicture):
     """One scene in a window, with the renderer, HUD and input."""
 
@@ -93,12 +98,14 @@ class Sandbox(SandboxPicture):
         focus: tuple[float, float, float] | None = None,
         threads: int | None = None,
         palette: str | None = None,
+        clean: bool | None = None,
     ):
         """`lod` turns level of detail on or off over the scene's (None: the scene's);
         `focus` (x, y, radius in m) pins the full-physics region instead of the camera's;
         `threads` step the physics (None: one per core); `palette` colours the creatures
         ("natural" or "debug": `ecs_tentacles.skin.colours`; None: the scene's `render.palette`,
-        natural if it says none)."""
+        natural if it says none); `clean` starts in the clean view, without the editor's
+        overlays (None: a game's scene, one with a `game` key, starts clean; o toggles)."""
         self.headless = headless
         self.window = pyglet.window.Window(
             width, height, caption="ecs_tentacles", visible=not headless, vsync=False
@@ -113,6 +120,8 @@ class Sandbox(SandboxPicture):
             threads=threads,
             say=lambda ok, text: self.scripts.say(ok, text),
         )
+        # the clean view (`render.registries`: a picture for showing), kept across resets
+        self.clean: bool = is_game(self.world.scene) if clean is None else clean
         self.hud = Hud(self.window, self.world, visible=hud)
         self.hud.label_at = self.creature_labels
         self.hud.selection_label = self.selected_label
@@ -166,7 +175,9 @@ class Sandbox(SandboxPicture):
         self.camera_choice = choice
 
     def _view_section(self, gui: Gui) -> None:
-        """The HUD's "View": the creatures' palette."""
+        """The HUD's "View": the clean view and the creatures' palette."""
+        _, self.clean = imgui.checkbox("clean view (o)", self.clean)
+        gui.item("clean view")
         imgui.text("colours")
         gui.item("colours")
         for name in PALETTES:
