@@ -63,7 +63,6 @@ from __future__ import annotations
 import importlib
 import os
 from collections.abc import Callable
-from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -77,7 +76,7 @@ from ecs_tentacles.export.usd import _pxr, mark_rate, set_timing, static_take
 from ecs_tentacles.export.usd_clips import SharedClips
 from ecs_tentacles.export.usd_joint_samples import PlanSamples, key_report
 from ecs_tentacles.export.usd_layer import StreamedLayer
-from ecs_tentacles.export.usd_plans import BodyPlan, body_plans, define_creature
+from ecs_tentacles.export.usd_plans import body_plans, define_creature
 from ecs_tentacles.export.usd_tracks import Steps, UsdTracks, Visibility, key_steps
 from ecs_tentacles.numeric.quaternions import quat_rotate
 from ecs_tentacles.output.atomic import atomic_output
@@ -143,17 +142,19 @@ def _fill(
     clips = SharedClips(pxr, layer, source, plans)
     plan_of = {name: plan for plan in plans for name in plan.names}
     names = [c["name"] for c in header["creatures"]]
+    turns = clips.timeline.turns.tolist()
     for creature, name in enumerate(names):  # in the take's order
-        alone = creature not in clips.sharers
-        define_creature(pxr, stage, plan_of[name], name, colours[name], folder, alone)
-        clips.bind(name, creature)
+        define_creature(pxr, stage, plan_of[name], name, colours[name], folder, turns[creature])
+        clips.bind(name, creature, colours[name], folder)
         mark_rate(stage, f"/World/{name}", source.fps, source.frames)
     visibility = Visibility(layer, [f"/World/{name}" for name in names])
     suckers = Suckers(pxr, layer, header) if locators else None
     tracks = UsdTracks(layer, header, source.static, locators, relative=True)
     write_usd_ground(pxr, stage, still)
-    own = [alone_in(plan, clips.sharers) for plan in plans]
-    animated = [PlanSamples(pxr, layer, plan, keys or Keys(), source.frames) for plan in own]
+    animated = [
+        PlanSamples(pxr, layer, plan, keys or Keys(), source.frames, clips.timeline)
+        for plan in plans
+    ]
     rows = max(1, WORK_BYTES // (32 * max(1, len(header["bodies"]))))
     for first, chunk in source.chunks():
         for start in range(0, chunk.frames, rows):
@@ -162,11 +163,9 @@ def _fill(
             origin = np.zeros((piece.frames, len(names), 3))
             yaw = np.zeros((piece.frames, len(names)))
             for samples in animated:  # each creature's root motion as written
-                if len(samples.plan.members):
-                    origin[:, samples.plan.members] = samples.add(first + start, piece)
-            if clips.order:
-                origin[:, clips.order], yaw[:, clips.order] = clips.add(first + start, end - start)
-            roots = RootFrames(origin, yaw if clips.order else None)
+                members = samples.plan.members
+                origin[:, members], yaw[:, members] = samples.add(first + start, piece)
+            roots = RootFrames(origin, yaw if clips.sharing else None)
             if suckers is not None:
                 suckers.add(first + start, piece, roots)
             visibility.add(first + start, piece)
@@ -174,15 +173,10 @@ def _fill(
         layer.flush()
         if progress is not None:
             progress(chunk.frames)
-    groups = {id(group) for group in clips.sharers.values()}
-    return key_report(animated, source.frames, len(names), len(clips.sharers), len(groups))
-
-
-def alone_in(plan: BodyPlan, sharers: dict[int, Any]) -> BodyPlan:
-    """`plan` narrowed to its creatures that keep their own animation."""
-    keep = np.array([c not in sharers for c in plan.members.tolist()], dtype=bool)
-    names = [name for name, kept in zip(plan.names, keep.tolist(), strict=True) if kept]
-    return replace(plan, names=names, members=plan.members[keep], bodies=plan.bodies[keep])
+    stretches = sum(len(s) for s in clips.stretches.values())
+    return key_report(
+        animated, source.frames, len(names), clips.sharing, len(clips.shared), stretches
+    )
 
 
 class Suckers:

@@ -30,8 +30,9 @@ class KeyReport:
     sample_frames: int  # frames where any channel keeps a key (USD's time samples)
     frames: int
     creatures: int = 0  # creatures in the file (0: not counted)
-    sharing: int = 0  # of them, those bound to a shared clip animation (keys not counted)
+    sharing: int = 0  # of them, those with replayed stretches on shared clip animations
     shared: int = 0  # the shared clip animations
+    stretches: int = 0  # the replayed stretches (a skeleton each, its keys not counted)
 
     def line(self) -> str:
         """One line for the CLI: what was kept, and what reducing cost (when it did)."""
@@ -47,8 +48,9 @@ class KeyReport:
             return kept
         animations = "animation" if self.shared == 1 else "animations"
         return (
-            f"{self.sharing} of {self.creatures} creatures share {self.shared} clip {animations};"
-            f" the other {self.creatures - self.sharing}: {kept}"
+            f"{self.sharing} of {self.creatures} creatures replay {self.stretches} stretches on"
+            f" {self.shared} shared clip {animations}; their own skeletons (physical frames):"
+            f" {kept}"
         )
 
 

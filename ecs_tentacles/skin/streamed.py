@@ -49,13 +49,20 @@ class JointRotations:
         world /= np.sqrt(np.einsum("...c,...c->...", world, world))[..., None]
         return world
 
-    def local(self, quat: np.ndarray) -> np.ndarray:
-        """(n, C, J, 4) local rotations (the root's: its world rotation) for the chunk's
-        frames, signs continuous with the chunk before."""
+    def local(self, quat: np.ndarray, yaw: np.ndarray | None = None) -> np.ndarray:
+        """(n, C, J, 4) local rotations (the root's: its world rotation, or with `yaw`
+        (n, C) that rotation seen from a frame turned by `yaw` radians about +z) for the
+        chunk's frames, signs continuous with the chunk before."""
         world = self.world(quat)
         local = world.copy()
         parents = self.parents[self.children]
         local[..., self.children, :] = undo(world[..., parents, :], world[..., self.children, :])
+        if yaw is not None:
+            half = 0.5 * np.asarray(yaw, dtype=np.float64)[..., None]
+            turn = np.zeros((*half.shape, 4))
+            turn[..., 0], turn[..., 3] = np.cos(half), np.sin(half)
+            roots = self.parents < 0
+            local[..., roots, :] = undo(turn, local[..., roots, :])
         return self.continuous(local)
 
     def continuous(self, local: np.ndarray) -> np.ndarray:
