@@ -2,22 +2,28 @@
 
     /World                                   Xform, the default prim
       /<c>                                   SkelRoot (c: the creature's name): the root
-                                             motion, xformOp:translate sampled (the
-                                             mantle's position; for a creature sharing a
-                                             clip its ground frame, with xformOp:rotateZ);
-                                             visibility keyed where it came or went
+                                             motion, xformOp:translate (float3) sampled
+                                             (the mantle's position), and for a creature
+                                             that replays a clip xformOp:rotateZ (its
+                                             heading); visibility keyed where it came or
+                                             went
         /<c>_skeleton                        Skeleton: joints (mantle/t0_link0/...),
                                              bindTransforms, restTransforms (its body
-                                             plan's, at the origin)
+                                             plan's, at the origin); for a creature that
+                                             replays, shown on its physical frames only
           /<c>_animation                     SkelAnimation: rotations sampled (the root's:
-                                             the mantle's world rotation); translations
-                                             and scales constant (one value, not samples);
-                                             or, sharing a clip, an internal reference to
-                                             /World/clips/... (`usd_clips`)
+                                             the mantle's rotation, seen from the heading
+                                             where there is one) at the frames this
+                                             skeleton needs; translations and scales
+                                             constant (one value, not samples)
         /<c>_skin                            Mesh (bound to the skeleton): points in the
                                              bind pose, normals, primvars:st (faceVarying),
                                              primvars:skel:jointIndices / jointWeights (2),
                                              bound to /World/materials/<c>_material
+        /<c>_replay<k>_skeleton, _skin       replayed stretch k: a Skeleton and its skin,
+          /<c>_replay<k>_animation           shown on the stretch's frames, the animation
+                                             an internal reference to /World/clips/...
+                                             offset in time (`usd_clips`)
         /<c>_suckers/<c>_t<k>/<c>_t<k>_link<i>/<c>_t<k>_link<i>_sucker<n>
                                              locator (`locators=True`): Xform, translate
                                              sampled (the sucker point), `ecs:attached`
@@ -28,7 +34,7 @@
                                              Below the SkelRoot, so in its moving frame
                                              (`root_frames`): USD and Blender both put
                                              them back where the take has them
-      /clips/plan<p>_clip<i>_<kind>_<g>      class SkelAnimations creatures share
+      /clips/plan<p>_clip<i>_<kind>          class SkelAnimations the stretches share
       /materials/<c>_material                each creature's material, its sandbox colour
                                              (`ecs_tentacles.export.materials`)
 
@@ -36,14 +42,18 @@ What is constant is written once. Links do not stretch: a joint's translation in
 parent is the rest offset at every frame (MuJoCo's hinges sit at fixed points of the
 parent body), so the animation's translations (and scales, 1) are one value each, and
 the root's motion is the SkelRoot's transform: the animation samples only
-rotations. Creatures of one body plan (the same mantle and links) share their rest
-state: skeleton, bind pose and mesh are the same arrays, held once in memory and
-stored once in a `.usdc` (USD's crate files keep one copy of equal arrays).
+rotations. The SkelRoot's translate is float3: a 30 m crowd's positions are then
+within 4 micrometres. Creatures of one body plan (the same mantle and links) share
+their rest state: skeleton, bind pose and mesh are the same arrays, held once in memory
+and stored once in a `.usdc` (USD's crate files keep one copy of equal arrays).
 UsdSkel poses a mesh point as `S(t) * sum_i w_i inv(bind_i) joint_i(t) p` with S the
 Skeleton's world transform (its ancestors' included), so the mesh is bound at the
 origin and moves with S. The motion is on the SkelRoot, not the Skeleton: Blender's
 importer (5.0.1) moves the armature with an animated SkelRoot, while with the motion on
-the Skeleton the creatures came in out of place and torn.
+the Skeleton the creatures came in out of place and torn. That importer does not bring
+USD's animated visibility along either: there a replayed creature's skeletons (its own
+and its stretches') all stay shown, each posed right on its own frames; the add-on
+(`ecs-tentacles blender-addon`) is Blender's way in for such crowds.
 
 Streamed: the take is read a chunk of frames at a time (`TakeChunks`, or a take file
 opened for streaming), each chunk's rotations made for every creature of a body plan
