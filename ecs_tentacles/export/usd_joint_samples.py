@@ -88,14 +88,19 @@ class PlanSamples:
         headings (n, C, radians; 0 for a creature that does not turn)."""
         n = chunk.frames
         yaw = self._headings(first, chunk)
-        local = self.rotations.local(chunk.quat, yaw if len(self.turning) else None)
+        turned = yaw if len(self.turning) else None
         root = chunk.pos[:, self.plan.bodies[:, 0]].astype(np.float64)  # (n, C, 3)
-        self.previous, previous = (local[-1], root[-1]), self.previous
         samples = self.samples[first : first + n]
-        if self.keys.mode == "all":
+        if self.keys.mode == "all":  # the rotations of the creature-frames sampled only
+            rows, columns = np.nonzero(samples)
+            at = None if turned is None else turned[rows, columns]
+            local = np.zeros((n, *self.plan.bodies.shape, 4))
+            local[rows, columns] = self.rotations.local_at(chunk.quat, rows, columns, at)
             self._write(first, local, root, yaw, samples, None)
             self.tally.every(samples)
             return root, yaw
+        local = self.rotations.local(chunk.quat, turned)
+        self.previous, previous = (local[-1], root[-1]), self.previous
         return self._write_reduced(first, local, root, yaw, previous), yaw
 
     def _headings(self, first: int, chunk: Take) -> np.ndarray:
@@ -167,18 +172,15 @@ class PlanSamples:
             root = np.concatenate([previous[1][None], root])
         n, count, joints = local.shape[:3]
         flat = local.reshape(n, count * joints, 4)
+        needed = np.repeat(samples, joints, axis=1)
         if n < 3:
-            keep = np.ones((n, count * joints), bool)
+            keep = needed.copy()
             root_keep = np.ones((n, count), bool)
         else:
-            keep = reduce_rotations(flat, self.keys.tolerance_deg)
+            keep = reduce_rotations(flat, self.keys.tolerance_deg, needed)
             root_keep = np.stack(
                 [reduce_points(root[:, c], ROOT_TOLERANCE_M) for c in range(count)], axis=1
             )
-        ends = samples.copy()  # the first and last frame of each run of needed frames
-        ends[1:-1] &= ~(samples[:-2] & samples[2:])
-        needed = np.repeat(samples, joints, axis=1)
-        keep = (keep | np.repeat(ends, joints, axis=1)) & needed
         curve = interpolate_rotations(flat, keep | ~needed).reshape(local.shape)
         apart = angle_between(curve.reshape(flat.shape), flat)
         error = float(apart[needed].max(initial=0.0))

@@ -15,6 +15,8 @@ from ecs_tentacles.cli import main
 from ecs_tentacles.export.skinned_usd import write_skinned_usd
 from ecs_tentacles.export.take_chunks import TakeChunks
 from ecs_tentacles.numeric.quaternions import quat_rotate
+from ecs_tentacles.skin.keys import angle_between
+from ecs_tentacles.skin.rig import Keys
 from ecs_tentacles.take import Take
 from ecs_tentacles.take.stream import open_take
 
@@ -155,3 +157,29 @@ def test_a_replayed_frame_costs_its_root_motion_not_its_joints(
     saved = alone.stat().st_size - shared.stat().st_size
     joints = 81 * 16  # bytes of a creature-frame's rotations (quatf)
     assert saved > 0.9 * (replayed - rows) * joints, (saved, replayed, rows, report)
+
+
+def test_reduced_keys_of_a_switching_creature_hold_their_tolerance_where_it_is_shown(
+    switching_take: Path, tmp_path: Path
+) -> None:
+    """With `--keys reduced` a creature's own animation keys only frames its skeleton
+    needs, and on every physical frame each joint's rotation as USD interpolates it is
+    within the tolerance of the take's (the export of every frame)."""
+    every, reduced = tmp_path / "every.usdc", tmp_path / "reduced.usdc"
+    with open_take(switching_take) as source:
+        write_skinned_usd(source, every)
+    with open_take(switching_take) as source:
+        report = write_skinned_usd(source, reduced, keys=Keys("reduced", 0.5))
+        kind = source.replay_records()["replay_kind"]
+        names = [c["name"] for c in source.header["creatures"]]
+    assert report.after < 0.6 * report.before and report.max_rotation_error_deg <= 0.5
+    stages = [Usd.Stage.Open(str(path)) for path in (every, reduced)]
+    worst = 0.0
+    for creature, name in enumerate(names):
+        path = f"/World/{name}/{name}_skeleton/{name}_animation"
+        full, kept = (UsdSkel.Animation(s.GetPrimAtPath(path)).GetRotationsAttr() for s in stages)
+        assert set(kept.GetTimeSamples()) <= set(full.GetTimeSamples())
+        for frame in np.flatnonzero(kind[:, creature] < 0).tolist():
+            a, b = (np.array(attr.Get(frame), dtype=np.float64) for attr in (full, kept))
+            worst = max(worst, float(angle_between(a, b).max()))
+    assert worst < 0.5 + 0.01, worst  # float32 samples
