@@ -92,9 +92,11 @@ class Timeline:
     @property
     def samples(self) -> np.ndarray:
         """(frames, C) the frames the own animation is sampled at: its own, and the
-        frame after each run of them."""
+        frame after each run of them (frame 0 for a creature with none: a value)."""
         out = self.own.copy()
         out[1:] |= self.own[:-1]
+        if len(out):
+            out[0, ~out.any(axis=0)] = True
         return out
 
 
