@@ -15,15 +15,16 @@ validator, UsdSkel's included). One run each: state the machine's load (`uptime`
 Measured (one run each; `crowd N --uniform --seed 3`, `bake --seconds 30 --fps 24`, 721
 frames; export alone, then `usd_problems` on the file):
 
-    1,024 creatures, load 13.5: 211 s, peak 816 MB, 371 MB (503 B a creature-frame),
+    1,024 creatures, load 14-15: 142 s, peak 803 MB, 371 MB (503 B a creature-frame),
         1,503 replayed stretches of 1,024 creatures sharing one clip animation, 1,024
-        own animations (sampled at their physical frames only); validators 0 errors.
-        Through UsdSkel.Cache, the skeleton shown within 0.003 mm of the take at every
-        frame (23 creatures, the 12 that switch most among them). Before (6dd3c68, load
-        10.6): 204 s, peak 793 MB, 753 MB (1,020 B), 522 creatures sharing, 502 alone;
-        before that (cb9ca9a, the issue's figure, 5 s at 60 fps): 3 min 10 s, 6.56 GB,
-        1.07 GB (3.5 KB a creature-frame). Reading the take alone (open_take, every
-        chunk) takes 26 s and 483 MB at load 3.
+        own animations (sampled at their physical frames only); validators 0 errors
+        (50 s, 220 MB). Through UsdSkel.Cache, the skeleton shown within 0.003 mm of
+        the take at every frame (23 creatures, the 12 that switch most among them).
+        Before (6dd3c68, run just before, load 12-14): 128 s, peak 784 MB, 753 MB
+        (1,020 B), 522 creatures sharing, 502 alone; before that (cb9ca9a, the issue's
+        figure, 5 s at 60 fps): 3 min 10 s, 6.56 GB, 1.07 GB (3.5 KB a creature-frame).
+        Reading the take alone (open_take, every chunk) takes 26 s and 483 MB at load 3;
+        under load it is 40 % of the export (filling replayed bodies from their clip).
     64 creatures (all within the full and reduced budgets: none replayed), load 3.4,
         with --validate: 4.5 s, peak 473 MB, 71 MB (1,547 B); 0 errors. Before (d5bb160,
         the same scene's version 1 take): 12.2 s, peak 909 MB, 138 MB (3,000 B).
