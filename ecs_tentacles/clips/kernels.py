@@ -1,4 +1,5 @@
-"""The numba kernel of gait-clip replay: `GaitClips.evaluate` for K creatures in one pass.
+"""The numba kernels of gait-clip replay: `GaitClips.evaluate` for K creatures in one pass,
+and the clip frame each creature starts replaying from (`nearest_frames`).
 
 Optional, as the fur rig's kernels are: `clips` imports this module only when numba is
 installed (the ``dev`` extra brings it) and falls back to its whole-array numpy path
@@ -62,3 +63,30 @@ def place(
             out_quat[o, b, 1] = hc * qx - hs * qy
             out_quat[o, b, 2] = hc * qy + hs * qx
             out_quat[o, b, 3] = hc * qz + hs * w
+
+
+@njit(cache=True, nogil=True)
+def nearest_frames(shapes: np.ndarray, shape: np.ndarray, out: np.ndarray) -> None:
+    """`replay._nearest_frame`: for each pose `shape[k]` (K, B, 3), the first frame f of
+    `shapes` (F, B, 3) whose farthest body (Euclidean distance, summed as numpy's norm
+    sums x, y, z) is nearest, into `out[k]`. A frame is left as soon as one of its bodies
+    is as far as the best frame's farthest: it can no longer be strictly nearer, so the
+    answer is numpy's `argmin` of the maxima. Finite inputs only."""
+    for k in range(shape.shape[0]):
+        best = np.inf
+        found = 0
+        for f in range(shapes.shape[0]):
+            worst = -np.inf
+            for b in range(shapes.shape[1]):
+                dx = shape[k, b, 0] - shapes[f, b, 0]
+                dy = shape[k, b, 1] - shapes[f, b, 1]
+                dz = shape[k, b, 2] - shapes[f, b, 2]
+                d = math.sqrt(dx * dx + dy * dy + dz * dz)
+                if d > worst:
+                    worst = d
+                    if worst >= best:
+                        break
+            if worst < best:
+                best = worst
+                found = f
+        out[k] = found
