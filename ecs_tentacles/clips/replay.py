@@ -40,7 +40,7 @@ if TYPE_CHECKING:
 log = logging.getLogger("ecs_tentacles.clips")
 
 KERNELS = OptionalKernels("ecs_tentacles.clips.kernels", "ECS_TENTACLES_REPLAY")
-SHARED = ClipCache()  # clips by morphology, shared by every world of this process
+SHARED = ClipCache(disk=True)  # clips by morphology: every world of this process, kept on disk
 TURN_RATE = math.radians(60.0)  # rad/s a replayed creature turns toward its way
 ARRIVED = 0.05  # m: closer than this to its target, a replayed creature idles
 
