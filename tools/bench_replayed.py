@@ -66,10 +66,16 @@ def _wrap(owner: type, name: str, bucket: list[float]) -> Callable[[], None]:
     return lambda: setattr(owner, name, original)
 
 
-def run(crowd: int, frames: int, warmup: int, threads: int, seed: int) -> dict[str, Any]:
-    """Build the crowd, time it, and return the split (see the module doc)."""
+def run(
+    crowd: int, frames: int, warmup: int, threads: int, seed: int, reduced: int | None = None
+) -> dict[str, Any]:
+    """Build the crowd, time it, and return the split (see the module doc); `reduced`:
+    the scene's budget of REDUCED creatures (None: the default)."""
+    scene = crowd_scene(crowd, seed=seed, uniform=True)
+    if reduced is not None:
+        scene.setdefault("physics", {}).setdefault("lod", {})["reduced"] = reduced
     start = time.perf_counter()
-    world = World.from_scene(crowd_scene(crowd, seed=seed, uniform=True), threads=threads)
+    world = World.from_scene(scene, threads=threads)
     build_s = time.perf_counter() - start
     try:
         world.step(warmup)
@@ -117,19 +123,25 @@ def run(crowd: int, frames: int, warmup: int, threads: int, seed: int) -> dict[s
     }
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--crowd", type=int, default=10000)
     parser.add_argument("--frames", type=int, default=60)
     parser.add_argument("--warmup", type=int, default=30)
     parser.add_argument("--threads", type=int, default=2)
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--reduced", type=int, help="REDUCED budget (default: the scene's)")
     parser.add_argument("--json", action="store_true", help="one JSON object on stdout")
-    args = parser.parse_args()
-    result = run(args.crowd, args.frames, args.warmup, args.threads, args.seed)
+    args = parser.parse_args(argv)
+    for name, least in (("crowd", 1), ("frames", 1), ("warmup", 0), ("threads", 1)):
+        if getattr(args, name) < least:
+            parser.error(f"--{name} must be >= {least}, got {getattr(args, name)}")
+    if args.reduced is not None and args.reduced < 0:
+        parser.error(f"--reduced must be >= 0, got {args.reduced}")
+    result = run(args.crowd, args.frames, args.warmup, args.threads, args.seed, args.reduced)
     if args.json:
         print(json.dumps(result))
-        return
+        return 0
     print(
         f"{result['creatures']} creatures, {result['replayed']:.0f} replayed, "
         f"{result['threads']} threads, built in {result['build_s']:.1f} s"
@@ -143,7 +155,8 @@ def main() -> None:
         print(f"{group}:")
         for name, row in sorted(result[group].items(), key=lambda kv: -kv[1]["ms"]):
             print(f"  {name:20s} {row['ms']:8.2f} ms {row['us_per_replayed']:7.3f} us")
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(main())
