@@ -83,6 +83,7 @@ class GaitClips:
     crawl: Clip
     seconds: float  # wall-clock cost of recording both
     store_lag: float  # m: how far the Transform store lagged the recorded qpos (info)
+    kept: bool = False  # read back from the clips kept on disk (`clips.disk`), not recorded
 
     def __post_init__(self) -> None:
         # Both clips stacked: row offset[kind] + frame holds that frame's pose (position,

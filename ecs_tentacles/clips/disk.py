@@ -174,7 +174,7 @@ def decode(key: str, data: bytes, shape: Shape, morphology: tuple[Any, ...]) -> 
         made.append(Clip(kind, dt, speed, pos, quat, qpos, qvel, mismatch, (first, end)))
     if offset != len(body) or not (0.0 <= seconds and np.isfinite(lag)):
         return None
-    return GaitClips(morphology, list(shape.bodies), made[0], made[1], seconds, lag)
+    return GaitClips(morphology, list(shape.bodies), made[0], made[1], seconds, lag, kept=True)
 
 
 def _sane(pos: np.ndarray, quat: np.ndarray, qpos: np.ndarray, qvel: np.ndarray) -> bool:

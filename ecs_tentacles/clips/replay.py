@@ -73,8 +73,11 @@ class ClipReplay:
         if clips is None:
             entity = int(self.roster.entity[batch.members[0]])
             clips = self.cache.for_creature(self.world, entity)
-            log.info("gait clips for %s recorded in %.1f s", self.world.creature_name(entity),
-                     clips.seconds)  # fmt: skip
+            name = self.world.creature_name(entity)
+            if clips.kept:
+                log.info("gait clips for %s read from the clips kept on disk", name)
+            else:
+                log.info("gait clips for %s recorded in %.1f s", name, clips.seconds)
             self.clips[batch.index] = clips
         return clips
 
