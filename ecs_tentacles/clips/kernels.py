@@ -31,14 +31,19 @@ def place(
     out_rows: np.ndarray,
     out_pos: np.ndarray,
     out_quat: np.ndarray,
+    also_pos: np.ndarray,
+    also_quat: np.ndarray,
 ) -> None:
     """Creature k shows clip table row `row[k]` (+ `fraction[k]` of `change` when
     `interpolate`, quaternions renormalised) moved to `xy[k]` and turned by `heading[k]`,
-    written to row `out_rows[k]` of the outputs (a batch's pose arrays: no copy after).
+    written to row `out_rows[k]` of the outputs (a batch's pose arrays: no copy after),
+    and of `also_pos` / `also_quat` too unless they have no rows (the Transform store's
+    rows of that batch: the sync's copy made in the same pass).
 
     `pose` and `change` are (rows, B, 7) ground-frame tables (position, quaternion);
     the outputs are (N, B, 3) and (N, B, 4).
     """
+    twice = also_pos.shape[0] > 0
     for k in range(len(row)):
         r = row[k]
         o = out_rows[k]
@@ -56,13 +61,21 @@ def place(
                 w, qx, qy, qz = w + d[3] * t, qx + d[4] * t, qy + d[5] * t, qz + d[6] * t
                 norm = math.sqrt(w * w + qx * qx + qy * qy + qz * qz)
                 w, qx, qy, qz = w / norm, qx / norm, qy / norm, qz / norm
-            out_pos[o, b, 0] = c * x - s * y + ox
-            out_pos[o, b, 1] = s * x + c * y + oy
-            out_pos[o, b, 2] = z
-            out_quat[o, b, 0] = hc * w - hs * qz
-            out_quat[o, b, 1] = hc * qx - hs * qy
-            out_quat[o, b, 2] = hc * qy + hs * qx
-            out_quat[o, b, 3] = hc * qz + hs * w
+            px, py = c * x - s * y + ox, s * x + c * y + oy
+            qw, q1, q2, q3 = (
+                hc * w - hs * qz,
+                hc * qx - hs * qy,
+                hc * qy + hs * qx,
+                hc * qz + hs * w,
+            )
+            out_pos[o, b, 0], out_pos[o, b, 1], out_pos[o, b, 2] = px, py, z
+            out_quat[o, b, 0], out_quat[o, b, 1], out_quat[o, b, 2], out_quat[o, b, 3] = (
+                qw, q1, q2, q3,
+            )  # fmt: skip
+            if twice:
+                also_pos[o, b, 0], also_pos[o, b, 1], also_pos[o, b, 2] = px, py, z
+                also_quat[o, b, 0], also_quat[o, b, 1] = qw, q1
+                also_quat[o, b, 2], also_quat[o, b, 3] = q2, q3
 
 
 @njit(cache=True, nogil=True)
