@@ -11,9 +11,11 @@ creature (the mean count over the timed frames), and the frame's total per repla
 creature less the stepping (`PhysicsBackend.step`: MuJoCo and the bookkeeping of the
 creatures it steps, the reduced ones at 10,000, which do not scale with the replayed
 ones; the proxies' refresh between its rounds is in it too).
-The parts overlap (a part inside a system is also in the system's figure). One run:
-state the machine's load (`uptime`) with its figures; shares and microseconds per
-creature move less with the load than milliseconds do.
+The parts overlap (a part inside a system is also in the system's figure). Each part
+also gets the calling (main) thread's CPU time per replayed creature, and so does the
+frame less the stepping (`cpu_us_per_replayed_less_stepping`): on a shared machine
+that moves far less with the load than wall time. One run: state the machine's load
+(`uptime`) with its figures.
 """
 
 from __future__ import annotations
@@ -52,15 +54,17 @@ PARTS: list[tuple[str, type, str]] = [
 
 
 def _wrap(owner: type, name: str, bucket: list[float]) -> Callable[[], None]:
-    """Time every call of `owner.name` into `bucket[0]`; returns the undo."""
+    """Time every call of `owner.name` into `bucket[0]` (wall) and `bucket[1]` (the
+    calling thread's CPU time); returns the undo."""
     original = getattr(owner, name)
 
     def wrapper(*args: Any, **kwargs: Any) -> Any:
-        start = time.perf_counter()
+        start, cpu = time.perf_counter(), time.thread_time()
         try:
             return original(*args, **kwargs)
         finally:
             bucket[0] += time.perf_counter() - start
+            bucket[1] += time.thread_time() - cpu
 
     setattr(owner, name, wrapper)
     return lambda: setattr(owner, name, original)
@@ -80,17 +84,18 @@ def run(
     try:
         world.step(warmup)
         systems = time_systems(world)
-        parts = {label: [0.0] for label, _, _ in PARTS}
+        parts = {label: [0.0, 0.0] for label, _, _ in PARTS}
         undo = [_wrap(owner, name, parts[label]) for label, owner, name in PARTS]
-        kinematic, took = [], []
+        kinematic, took, cpu = [], [], []
         try:
             for bucket in systems.values():
                 bucket[0] = 0.0
             for _ in range(frames):
                 kinematic.append(int(np.count_nonzero(world.physics.roster.tier == KINEMATIC)))
-                began = time.perf_counter()
+                began, began_cpu = time.perf_counter(), time.thread_time()
                 world.step(1)
                 took.append(time.perf_counter() - began)
+                cpu.append(time.thread_time() - began_cpu)
         finally:
             for restore in undo:
                 restore()
@@ -99,16 +104,18 @@ def run(
     replayed = statistics.mean(kinematic)
     frame_ms = 1000 * sum(took) / frames
 
+    per = 1e6 / frames / max(replayed, 1.0)  # seconds in all frames -> us a creature-frame
+
     def split(buckets: dict[str, list[float]]) -> dict[str, dict[str, float]]:
-        return {
-            name: {
-                "ms": 1000 * b[0] / frames,
-                "us_per_replayed": 1e6 * b[0] / frames / max(replayed, 1.0),
-            }
-            for name, b in buckets.items()
-        }
+        out = {}
+        for name, b in buckets.items():
+            out[name] = {"ms": 1000 * b[0] / frames, "us_per_replayed": per * b[0]}
+            if len(b) > 1:
+                out[name]["cpu_us_per_replayed"] = per * b[1]
+        return out
 
     rest_ms = frame_ms - 1000 * parts["stepping"][0] / frames
+    rest_cpu = sum(cpu) - parts["stepping"][1]
     return {
         "creatures": crowd,
         "threads": threads,
@@ -118,6 +125,8 @@ def run(
         "frame_ms": frame_ms,
         "frame_less_stepping_ms": rest_ms,
         "us_per_replayed_less_stepping": 1000 * rest_ms / max(replayed, 1.0),
+        # the main thread's CPU time: what the machine's load changes least
+        "cpu_us_per_replayed_less_stepping": per * rest_cpu,
         "systems": split(systems),
         "parts": split(parts),
     }
@@ -151,10 +160,13 @@ def main(argv: list[str] | None = None) -> int:
         f"{result['frame_less_stepping_ms']:.1f} ms = "
         f"{result['us_per_replayed_less_stepping']:.2f} us a replayed creature"
     )
+    print(f"  main thread's CPU time: {result['cpu_us_per_replayed_less_stepping']:.2f} us")
     for group in ("systems", "parts"):
         print(f"{group}:")
         for name, row in sorted(result[group].items(), key=lambda kv: -kv[1]["ms"]):
-            print(f"  {name:20s} {row['ms']:8.2f} ms {row['us_per_replayed']:7.3f} us")
+            cpu = row.get("cpu_us_per_replayed")
+            shown = "" if cpu is None else f" (CPU {cpu:.3f} us)"
+            print(f"  {name:20s} {row['ms']:8.2f} ms {row['us_per_replayed']:7.3f} us{shown}")
     return 0
 
 

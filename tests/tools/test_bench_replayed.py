@@ -22,6 +22,7 @@ def test_every_part_is_timed_per_replayed_creature(capsys: pytest.CaptureFixture
     replay = result["parts"]["replay_advance"]
     assert replay["ms"] > 0 and replay["us_per_replayed"] == pytest.approx(1000 * replay["ms"] / 8)
     assert 0 < result["frame_less_stepping_ms"] < result["frame_ms"]
+    assert 0 < replay["cpu_us_per_replayed"] and 0 < result["cpu_us_per_replayed_less_stepping"]
 
 
 def test_a_bad_count_is_refused_by_name(capsys: pytest.CaptureFixture[str]) -> None:
