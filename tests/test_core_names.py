@@ -1,8 +1,9 @@
 """Core's code names no feature: no `locomotion`, `fur`, `goals`, `guides`, `terrain`,
 `threat`, `director` or `herding` in the names and strings of the package top,
 `creatures/`, `ground/`, `numeric/`, `output/`, `physics/`, `scene/` and `take/`
-(docstrings, comments and data files aside). The one exception, listed below: the list
-of built-in plugins, where core finds them by name; a new one fails here."""
+(docstrings, comments and data files aside). The exceptions, listed below: the list of
+built-in plugins, where core finds them by name, and the columns sending a creature
+writes (`behaviour.DESTINATION_WRITES`); a new one fails here."""
 
 from __future__ import annotations
 
@@ -39,6 +40,18 @@ ALLOWED = {
             '"ecs_tentacles.director.plugin:DirectorPlugin"',
             '"herding"',
             '"ecs_tentacles.herding.plugin:HerdingPlugin"',
+        )
+    },
+    # the columns the Destinations entry (the locomotion plugin's goals) writes: named
+    # once in core so a behaviour's or game mode's systems can declare them from a public
+    # module (issue 55), not from the examples package or another feature
+    **{
+        ("behaviour.py", s): "what sending a creature writes"
+        for s in (
+            '"goals"',
+            '"locomotion.creatures.goal"',
+            '"locomotion.creatures.has_goal"',
+            '"locomotion.creatures.goal_radius"',
         )
     },
 }
