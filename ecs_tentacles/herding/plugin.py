@@ -1,10 +1,13 @@
 """`HerdingPlugin`: the herding game as a plugin (`"plugins": {"herding": {}}`).
 
 Scene key `game` (`ecs_tentacles.herding.schema`); resource `HerdingGame`
-(`ecs_tentacles.herding.game`); systems `Predator` and `Referee` (`systems/herding/`).
-It needs the flee plugin (what makes creatures run from the predator) and locomotion.
+(`ecs_tentacles.herding.game`); systems `Predator`, `Herd` and `Referee`
+(`systems/herding/`: `Herd` makes the creatures flee the predator and graze as a
+flock, so no flee plugin is needed). It needs locomotion.
 
 What it adds to the registries in `build`:
+- `StaticGeometry` (`ecs_tentacles.physics.model`): the pen's fence, solid to the
+  creatures (`ecs_tentacles.herding.fence`);
 - `Dangers` (`ecs_tentacles.behaviour`): the predator, so everything that fears
   dangers fears it (the flee plugin runs, fur's emotion raises quills);
 - `Lines`, `Spheres` and `FramedPoints` (the renderer): the pen's ring on the ground,
@@ -37,7 +40,7 @@ if TYPE_CHECKING:
 class HerdingPlugin(Plugin):
     name = "herding"
     description = "the herding game: drive creatures into a pen with a predator"
-    requires = ("locomotion", "flee")
+    requires = ("locomotion",)
     scene_schema = {"game": GAME}
 
     def problems(self, scene: Mapping[str, Any]) -> list[tuple[tuple[str | int, ...], str]]:
@@ -52,10 +55,11 @@ class HerdingPlugin(Plugin):
         world.resource(HerdingGame).start = world.snapshot()
 
     def systems(self) -> list[System]:
+        from ecs_tentacles.systems.herding.herd import Herd
         from ecs_tentacles.systems.herding.predator import Predator
         from ecs_tentacles.systems.herding.referee import Referee
 
-        return [Predator(), Referee()]
+        return [Predator(), Herd(), Referee()]
 
     def snapshot(self, world: Host) -> Any:
         return world.resource(HerdingGame).state.copy()
@@ -65,10 +69,13 @@ class HerdingPlugin(Plugin):
 
     def build(self, app: App) -> None:
         from ecs_tentacles.cli.registries import RunSummaries
-        from ecs_tentacles.herding import entries
+        from ecs_tentacles.herding import entries, fence
+        from ecs_tentacles.physics.model import StaticGeometry
         from ecs_tentacles.render.registries import FramedPoints, Lines, Panels, Spheres
         from ecs_tentacles.take.registries import TakeTracks
 
+        if app.world is not None:  # (a shard planner builds plugins without a world)
+            app.add(StaticGeometry, fence.static_geometry(app.world))
         app.add(Dangers, DangerSource(sense=_predator_danger))
         app.add(Lines, entries.lines)
         app.add(Spheres, entries.spheres)
