@@ -33,6 +33,7 @@ def main(argv: list[str] | None = None) -> int:
             creatures = world.creatures.count
             result = play(world, Bot())
         result.pop("log")
+        result.pop("runs")
         result["creatures"] = creatures
         if args.json:
             print(json.dumps({"scene": name, **result}), flush=True)

@@ -25,7 +25,7 @@ if TYPE_CHECKING:
     from ecs_tentacles.snapshot import Snapshot
 
 PLAYING, WON, LOST = "playing", "won", "lost"
-RECOVERED = 0.3
+RECOVERED = 0.3  # the stamina a winded predator needs before it runs again
 HERD_DEFAULTS = {
     "flee": 1.0,
     "graze": 0.4,
@@ -35,7 +35,7 @@ HERD_DEFAULTS = {
     "alignment": 0.5,
     "separation": 1.5,
     "interval": 0.5,
-}  # the scene's `game.herd` (herding.schema.json gives the same defaults)  # the stamina a winded predator needs before it runs again
+}  # the scene's `game.herd` (herding.schema.json gives the same defaults)
 
 
 @dataclass

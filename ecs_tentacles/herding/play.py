@@ -2,18 +2,21 @@
 
     world = World.from_scene("herding_1_field")
     result = play(world, Bot())                  # the bot plays until the game ends
-    again = play(World.from_scene(...), Replay(result["log"]))   # the same game, exactly
+    again = play(World.from_scene(...), Replay(result["log"], result["runs"]))  # the same game
 
 `play` steps the world, asking the player (a `Bot`, a `Replay`, or anything with
 `decide(world, game)`) where to aim the predator every `every` frames (0.25 s), until
 the game is won or lost (or `max_seconds` of game time pass). It returns the game's
-summary, the input log, the wall time and the median frame's step time (`frame_ms`:
-physics and every system) with its real-time factor.
+summary, the input logs (`log`: aims, `runs`: run/walk changes), the wall time and the
+median frame's step time (`frame_ms`: physics and every system) with its real-time
+factor.
 
 `Bot` is a simple, honest strategy, a sheepdog's: herd the group of creatures nearest
-the pen, as many as are still needed and a spare; take the one of them farthest from
-the pen, get behind it (on the side away from the pen, `behind` metres off) and push it
-toward the pen; to get behind it, go around it, never through it. Pushing the group's
+the gate, as many as are still needed and a spare; take the one of them farthest from
+it, get behind it (on the side away from where it should go, `behind` metres off) and
+push it: toward the point just outside the gate, or, once it stands in front of the
+gate, into the pen; to get behind it, go around it and around the pen, never through
+them. It runs (Shift) to get somewhere far and walks to push. Pushing the group's
 rearmost creature drives the group from behind.
 """
 
@@ -25,6 +28,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
+from ecs_tentacles.herding.fence import Fence
 from ecs_tentacles.herding.game import PLAYING, HerdingGame
 
 if TYPE_CHECKING:
@@ -37,11 +41,12 @@ class Player(Protocol):
 
 
 class Bot:
-    """Push the laggard of the creatures nearest the pen toward it; go around it."""
+    """Push the laggard of the creatures nearest the gate toward it; go around it."""
 
-    def __init__(self, behind: float = 0.9, spare: int = 2):
+    def __init__(self, behind: float = 0.9, spare: int = 2, approach: float = 1.0):
         self.behind = behind  # metres behind the creature pushed
         self.spare = spare  # creatures herded beyond those still needed
+        self.approach = approach  # metres outside the gate the creatures are brought to
 
     def decide(self, world: Host, game: HerdingGame) -> Sequence[float] | None:
         creatures = world.creatures
@@ -49,16 +54,38 @@ class Bot:
         left = ~np.isin(creatures.entity, game.state.penned)
         if not left.any():
             return None
+        fence = Fence.of(game)
+        outward = (fence.gate_point - fence.centre) / fence.radius
+        mouth = fence.gate_point + self.approach * outward  # just outside the gate
         flock = xy[left]
-        gaps = np.hypot(*(flock - game.pen_centre).T)
-        # the group herded: the creatures still needed (and a spare), those nearest the pen
+        # in front of the gate: near the line from the mouth to the centre
+        rel = flock - fence.gate_point
+        lateral = np.abs(rel @ np.array([-outward[1], outward[0]]))
+        ahead = rel @ outward
+        lined_up = (lateral < 0.45 * fence.width) & (ahead < self.approach + 0.6)
+        goals = np.where(lined_up[:, None], fence.centre, mouth)
+        gaps = np.hypot(*(flock - mouth).T)
+        # the group herded: the creatures still needed (and a spare), those nearest the gate
         group = np.argsort(gaps, kind="stable")[: game.need - game.penned + self.spare]
         laggard = group[int(np.argmax(gaps[group]))]
         pushed = flock[laggard]
-        to_pen = (game.pen_centre - pushed) / max(float(gaps[laggard]), 1e-9)
-        target = pushed - self.behind * to_pen
-        x, y = self._around(game.predator, pushed, 0.8 * self.behind, target)
-        return (float(x), float(y))
+        to_goal = goals[laggard] - pushed
+        to_goal = to_goal / max(float(np.hypot(*to_goal)), 1e-9)
+        target = pushed - self.behind * to_goal
+        target = self._outside(fence, target)
+        aim = self._around(game.predator, pushed, 0.8 * self.behind, target)
+        aim = self._around(game.predator, fence.centre, fence.radius + 0.6, aim)
+        far = float(np.hypot(*(aim - game.predator))) > 1.5
+        game.run(world, far and game.state.stamina > 0.4)
+        return (float(aim[0]), float(aim[1]))
+
+    @staticmethod
+    def _outside(fence: Fence, point: np.ndarray) -> np.ndarray:
+        """`point`, or the nearest point 0.4 m outside the pen (the predator keeps out)."""
+        off = point - fence.centre
+        gap = float(np.hypot(*off))
+        keep = fence.radius + 0.4
+        return point if gap >= keep else fence.centre + off * (keep / max(gap, 1e-9))
 
     @staticmethod
     def _around(at: np.ndarray, centre: np.ndarray, keep: float, target: np.ndarray) -> np.ndarray:
@@ -80,17 +107,34 @@ class Bot:
 
 
 class Replay:
-    """Aims where a recorded log aimed, at the same frames."""
+    """Aims where a recorded log aimed, and runs when it ran, at the same frames."""
 
-    def __init__(self, log: Sequence[tuple[int, float, float]]):
+    def __init__(
+        self,
+        log: Sequence[tuple[int, float, float]],
+        runs: Sequence[tuple[int, bool]] = (),
+    ):
         self.log = sorted(log)
         self.next = 0
+        self.runs = sorted(runs)
+        self.next_run = 0
+
+    def running(self, frame: int) -> list[bool]:
+        """The run/walk changes due by `frame`, in order."""
+        out = []
+        while self.next_run < len(self.runs) and self.runs[self.next_run][0] <= frame:
+            out.append(bool(self.runs[self.next_run][1]))
+            self.next_run += 1
+        return out
 
     def frames_to_next(self, frame: int, most: int) -> int:
         """Frames to step before the next logged aim is due (at most `most`)."""
-        if self.next >= len(self.log):
-            return most
-        return max(1, min(most, self.log[self.next][0] - frame))
+        due = [most]
+        if self.next < len(self.log):
+            due.append(self.log[self.next][0] - frame)
+        if self.next_run < len(self.runs):
+            due.append(self.runs[self.next_run][0] - frame)
+        return max(1, min(due))
 
     def due(self, frame: int) -> list[tuple[float, float]]:
         out = []
@@ -117,6 +161,8 @@ def play(
         if isinstance(player, Replay):
             for point in player.due(world.frame):
                 game.aim(world, point)
+            for running in player.running(world.frame):
+                game.run(world, running)
             frames = player.frames_to_next(world.frame, block)
         else:
             aim = player.decide(world, game)
@@ -130,6 +176,7 @@ def play(
     return {
         **game.summary(),
         "log": list(game.state.log),
+        "runs": list(game.state.runs),
         "wall_s": round(time.perf_counter() - started, 2),
         "frame_ms": round(median, 2),  # median over the game's blocks
         "realtime_factor": round(1000.0 * world.settings.dt / median, 2) if median else None,
