@@ -11,13 +11,12 @@ summary, the input logs (`log`: aims, `runs`: run/walk changes), the wall time a
 median frame's step time (`frame_ms`: physics and every system) with its real-time
 factor.
 
-`Bot` is a simple, honest strategy, a sheepdog's: herd the group of creatures nearest
-the gate, as many as are still needed and a spare; take the one of them farthest from
-it, get behind it (on the side away from where it should go, `behind` metres off) and
-push it: toward the point just outside the gate, or, once it stands in front of the
-gate, into the pen; to get behind it, go around it and around the pen, never through
-them. It runs (Shift) to get somewhere far and walks to push. Pushing the group's
-rearmost creature drives the group from behind.
+`Bot` is a simple, honest strategy, a sheepdog's, one creature at a time: take the
+creature nearest the gate, get behind it (on the side away from where it should go,
+`behind` metres off) and push it: toward the point just outside the gate, or, once it
+stands in front of the gate, into the pen; to get behind it, go around it (out of its
+reach) and around the pen, never through them. It runs (Shift) only to get somewhere
+far with no creature near, and walks to push.
 """
 
 from __future__ import annotations
@@ -41,12 +40,12 @@ class Player(Protocol):
 
 
 class Bot:
-    """Push the laggard of the creatures nearest the gate toward it; go around it."""
+    """Push the creature nearest the gate to it and in; go around it and the pen."""
 
-    def __init__(self, behind: float = 0.9, spare: int = 2, approach: float = 1.0):
+    def __init__(self, behind: float = 0.9, approach: float = 1.0):
         self.behind = behind  # metres behind the creature pushed
-        self.spare = spare  # creatures herded beyond those still needed
         self.approach = approach  # metres outside the gate the creatures are brought to
+        self.chosen: int | None = None  # the creature pushed, until it is penned
 
     def decide(self, world: Host, game: HerdingGame) -> Sequence[float] | None:
         creatures = world.creatures
@@ -57,49 +56,68 @@ class Bot:
         fence = Fence.of(game)
         outward = (fence.gate_point - fence.centre) / fence.radius
         mouth = fence.gate_point + self.approach * outward  # just outside the gate
-        flock = xy[left]
-        # in front of the gate: near the line from the mouth to the centre
-        rel = flock - fence.gate_point
-        lateral = np.abs(rel @ np.array([-outward[1], outward[0]]))
-        ahead = rel @ outward
-        lined_up = (lateral < 0.45 * fence.width) & (ahead < self.approach + 0.6)
-        goals = np.where(lined_up[:, None], fence.centre, mouth)
-        gaps = np.hypot(*(flock - mouth).T)
-        # the group herded: the creatures still needed (and a spare), those nearest the gate
-        group = np.argsort(gaps, kind="stable")[: game.need - game.penned + self.spare]
-        laggard = group[int(np.argmax(gaps[group]))]
-        pushed = flock[laggard]
-        to_goal = goals[laggard] - pushed
+        rows = np.flatnonzero(left)
+        entities = creatures.entity[rows]
+        if self.chosen not in entities.tolist():  # penned (or gone): the next nearest
+            gaps = np.hypot(*(xy[rows] - mouth).T)
+            self.chosen = int(entities[int(np.argmin(gaps))])
+        pushed = xy[rows[entities.tolist().index(self.chosen)]]
+        # in front of the gate (near the line from the mouth in): push it in, else to the mouth
+        rel = pushed - fence.gate_point
+        lateral = abs(float(rel @ np.array([-outward[1], outward[0]])))
+        lined_up = lateral < 0.3 * fence.width and float(rel @ outward) < self.approach + 0.5
+        goal = fence.centre if lined_up else mouth
+        to_goal = goal - pushed
         to_goal = to_goal / max(float(np.hypot(*to_goal)), 1e-9)
-        target = pushed - self.behind * to_goal
-        target = self._outside(fence, target)
-        aim = self._around(game.predator, pushed, 0.8 * self.behind, target)
-        aim = self._around(game.predator, fence.centre, fence.radius + 0.6, aim)
+        target = self._outside(fence, pushed - self.behind * to_goal, 0.5)
+        aim = self._behind(game.predator, pushed, game.reach + 0.1, target)
+        aim = self._around(game.predator, fence.centre, fence.radius + 0.3, aim)
+        clear = float(np.min(np.hypot(*(xy[rows] - game.predator).T))) > game.run_reach + 0.3
         far = float(np.hypot(*(aim - game.predator))) > 1.5
-        game.run(world, far and game.state.stamina > 0.4)
+        game.run(world, clear and far and game.state.stamina > 0.4)
         return (float(aim[0]), float(aim[1]))
 
     @staticmethod
-    def _outside(fence: Fence, point: np.ndarray) -> np.ndarray:
-        """`point`, or the nearest point 0.4 m outside the pen (the predator keeps out)."""
+    def _outside(fence: Fence, point: np.ndarray, margin: float) -> np.ndarray:
+        """`point`, or the nearest point `margin` m outside the pen (the predator keeps out)."""
         off = point - fence.centre
         gap = float(np.hypot(*off))
-        keep = fence.radius + 0.4
+        keep = fence.radius + margin
         return point if gap >= keep else fence.centre + off * (keep / max(gap, 1e-9))
+
+    @staticmethod
+    def _behind(at: np.ndarray, centre: np.ndarray, keep: float, target: np.ndarray) -> np.ndarray:
+        """`target` (behind the creature at `centre`) when the predator is on its side
+        already (within 60 degrees of it, seen from the creature); else a step round the
+        creature, `keep` m out, toward that side (so it is not pushed the wrong way)."""
+        a, b = at - centre, target - centre
+        la, lb = float(np.hypot(*a)), float(np.hypot(*b))
+        if la < 1e-9 or lb < 1e-9 or np.dot(a, b) > 0.5 * la * lb:
+            return target
+        radial = a / la
+        side = np.array([-radial[1], radial[0]])
+        if np.dot(side, b) < 0:
+            side = -side
+        return centre + keep * (radial + side) / np.sqrt(2.0) * 1.2
 
     @staticmethod
     def _around(at: np.ndarray, centre: np.ndarray, keep: float, target: np.ndarray) -> np.ndarray:
         """`target`, or a point on the circle of radius `keep` about `centre` that leads
-        there without crossing the circle (the flock)."""
-        seg = target - at
+        there without crossing the circle (a target inside it is entered from its side)."""
+        off = target - centre
+        gap = float(np.hypot(*off))
+        edge = centre + off * (keep / gap) if 1e-9 < gap < keep else target
+        seg = edge - at
         length = float(np.hypot(*seg))
         if length < 1e-9:
             return target
         t = np.clip(np.dot(centre - at, seg) / length**2, 0.0, 1.0)
-        if np.hypot(*(at + t * seg - centre)) >= keep:
+        if np.hypot(*(at + t * seg - centre)) >= 0.95 * keep:
             return target
-        # step around: the tangent direction turning toward the target's side
         radial = (at - centre) / max(float(np.hypot(*(at - centre))), 1e-9)
+        if np.hypot(*(at - centre)) < 0.95 * keep:  # inside the circle: outward is fine
+            return target if np.dot(seg, radial) > 0 else centre + 1.3 * keep * radial
+        # step around: the tangent direction turning toward the target's side
         side = np.array([-radial[1], radial[0]])
         if np.dot(side, target - centre) < 0:
             side = -side
