@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ecs_tentacles.ground import ground_of
+from ecs_tentacles.herding.fence import CLEAR
 
 if TYPE_CHECKING:
     from ecs_tentacles.herding.fence import Fence
@@ -62,6 +63,15 @@ def open_goals(
     reach = np.broadcast_to(np.asarray(metres, dtype=np.float64), (n,))[:, None, None]
     origin = np.repeat(starts[:, None, :], k, axis=1)
     goals = origin + reach * unit  # (n, k, 2)
+    # a goal inside the pen is kept off its fence (drawn in toward the centre)
+    off = goals - fence.centre
+    gap = np.linalg.norm(off, axis=2, keepdims=True)
+    room = max(fence.radius - CLEAR, 0.0)
+    goals = np.where(
+        gap < fence.radius,
+        fence.centre + off * np.minimum(1.0, room / np.maximum(gap, 1e-9)),
+        goals,
+    )
     flat_origin, flat_goals = origin.reshape(-1, 2), goals.reshape(-1, 2)
     ok = fence.crossing_ok(flat_origin, flat_goals)
     same_side = fence.inside(flat_origin) == fence.inside(flat_goals)

@@ -62,15 +62,16 @@ class Bot:
             gaps = np.hypot(*(xy[rows] - mouth).T)
             self.chosen = int(entities[int(np.argmin(gaps))])
         pushed = xy[rows[entities.tolist().index(self.chosen)]]
-        # in front of the gate (near the line from the mouth in): push it in, else to the mouth
+        # in the funnel before the gate (within 40 degrees of its axis): push it through the
+        # gate, else to the mouth
         rel = pushed - fence.gate_point
-        lateral = abs(float(rel @ np.array([-outward[1], outward[0]])))
-        lined_up = lateral < 0.3 * fence.width and float(rel @ outward) < self.approach + 0.5
-        goal = fence.centre if lined_up else mouth
+        gap = float(np.hypot(*rel))
+        in_funnel = gap < self.approach + 1.5 and float(rel @ outward) > np.cos(0.7) * gap
+        goal = fence.gate_point - 0.8 * outward if in_funnel else mouth
         to_goal = goal - pushed
         to_goal = to_goal / max(float(np.hypot(*to_goal)), 1e-9)
         target = self._outside(fence, pushed - self.behind * to_goal, 0.5)
-        aim = self._behind(game.predator, pushed, game.reach + 0.1, target)
+        aim = self._behind(game.predator, pushed, game.reach + 0.1, target, fence)
         aim = self._around(game.predator, fence.centre, fence.radius + 0.3, aim)
         clear = float(np.min(np.hypot(*(xy[rows] - game.predator).T))) > game.run_reach + 0.3
         far = float(np.hypot(*(aim - game.predator))) > 1.5
@@ -86,10 +87,13 @@ class Bot:
         return point if gap >= keep else fence.centre + off * (keep / max(gap, 1e-9))
 
     @staticmethod
-    def _behind(at: np.ndarray, centre: np.ndarray, keep: float, target: np.ndarray) -> np.ndarray:
+    def _behind(
+        at: np.ndarray, centre: np.ndarray, keep: float, target: np.ndarray, fence: Fence
+    ) -> np.ndarray:
         """`target` (behind the creature at `centre`) when the predator is on its side
         already (within 60 degrees of it, seen from the creature); else a step round the
-        creature, `keep` m out, toward that side (so it is not pushed the wrong way)."""
+        creature, `keep` m out, toward that side (so it is not pushed the wrong way), or
+        round the other way when the pen is in the way."""
         a, b = at - centre, target - centre
         la, lb = float(np.hypot(*a)), float(np.hypot(*b))
         if la < 1e-9 or lb < 1e-9 or np.dot(a, b) > 0.5 * la * lb:
@@ -98,7 +102,9 @@ class Bot:
         side = np.array([-radial[1], radial[0]])
         if np.dot(side, b) < 0:
             side = -side
-        return centre + keep * (radial + side) / np.sqrt(2.0) * 1.2
+        steps = [centre + keep * (radial + s) / np.sqrt(2.0) * 1.2 for s in (side, -side)]
+        clear = [np.hypot(*(p - fence.centre)) > fence.radius + 0.5 for p in steps]
+        return steps[0] if clear[0] or not clear[1] else steps[1]
 
     @staticmethod
     def _around(at: np.ndarray, centre: np.ndarray, keep: float, target: np.ndarray) -> np.ndarray:

@@ -42,7 +42,7 @@ APART = 0.8  # metres: closer creatures push apart
 CRAWL = 0.1  # m/s: a flock going this fast aligns a creature fully
 GOAL_RADIUS = 0.3  # metres: a goal is reached within this
 RUN_FLEE = 1.5  # a running predator's flight goals lie this much farther
-TOWARD_FLOCK = 0.3  # how much a fleeing creature bends toward its flock
+TOWARD_FLOCK = 0.15  # how much a fleeing creature bends toward its flock
 
 
 def _unit(vectors: np.ndarray) -> np.ndarray:
