@@ -3,15 +3,20 @@
     ecs-tentacles levels           # one line a level: open or locked, stars, best and par
     ecs-tentacles levels --json    # one JSON object a level (`ecs_tentacles.herding.levels.Level`)
 
-Reads the bundled scenes' `game` keys and the best-times file; writes nothing.
+Reads the bundled scenes' `game` keys and the best-times file; writes nothing. The
+listing is the game layer's (`ecs_tentacles.herding.levels`), which sits above the
+command line (it fills the command line's registries): it is imported by name when the
+command runs, as plugins are (`ecs_tentacles.scene.plugins`), never at import.
 """
 
 from __future__ import annotations
 
 import argparse
+import importlib
 import json
+from typing import Any
 
-from ecs_tentacles.herding.levels import Level, levels, stars_text
+LISTING = "ecs_tentacles.herding.levels"  # levels(), stars_text(): the game's listing
 
 
 def add_parser(commands: argparse._SubParsersAction) -> None:
@@ -28,7 +33,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.set_defaults(handler=handle)
 
 
-def sentence(level: Level) -> str:
+def sentence(level: Any, stars_text: Any) -> str:
     best = f"best {level.best:.1f} s" if level.best is not None else "not won yet"
     lock = "" if level.unlocked else "  (locked: win the one before)"
     return (
@@ -39,6 +44,7 @@ def sentence(level: Level) -> str:
 
 
 def handle(args: argparse.Namespace) -> int:
-    for level in levels():
-        print(json.dumps(level.as_dict()) if args.json else sentence(level))
+    listing = importlib.import_module(LISTING)
+    for level in listing.levels():
+        print(json.dumps(level.as_dict()) if args.json else sentence(level, listing.stars_text))
     return 0

@@ -64,9 +64,10 @@ class Fence:
 
     def in_gate(self, angles: np.ndarray, margin: float = 0.0) -> np.ndarray:
         """(n,) bool: directions (radians from the centre) through the gate, `margin`
-        metres clear of its posts."""
+        metres clear of its posts (at most a quarter of the gate's width each side)."""
         off = np.angle(np.exp(1j * (np.asarray(angles) - self.heading)))
-        return np.abs(off) < self.half_gate - margin / self.radius
+        clear = min(margin / self.radius, 0.5 * self.half_gate)
+        return np.abs(off) < self.half_gate - clear
 
     def inside(self, xy: np.ndarray) -> np.ndarray:
         """(n,) bool: points (n, 2) inside the pen's circle."""

@@ -34,7 +34,7 @@ HERD_DEFAULTS = {
     "cohesion": 1.0,
     "alignment": 0.5,
     "separation": 1.5,
-    "interval": 0.5,
+    "interval": 1.0,
 }  # the scene's `game.herd` (herding.schema.json gives the same defaults)
 
 
@@ -80,7 +80,7 @@ class HerdingGame:
         self.recover_s = float(predator.get("recover_s", 8.0))
         pen = game["pen"]
         self.gate_heading_deg = float((pen.get("gate") or {}).get("heading_deg", 180.0))
-        self.gate_width = float((pen.get("gate") or {}).get("width", 1.6))
+        self.gate_width = float((pen.get("gate") or {}).get("width", min(1.6, self.pen_radius)))
         self.fence_height = float((pen.get("fence") or {}).get("height", 0.5))
         self.par = float(game.get("par") or 0.5 * float(game["seconds"]))
         self.herd: dict[str, float] = {**HERD_DEFAULTS, **(game.get("herd") or {})}

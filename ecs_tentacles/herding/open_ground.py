@@ -81,4 +81,4 @@ def open_goals(
     ok = ok.reshape(n, k)
     found = ok.any(axis=1)
     first = np.argmax(ok, axis=1)
-    return goals[np.arange(n), first], found
+    return goals[np.arange(n), first], np.asarray(found, dtype=bool)
