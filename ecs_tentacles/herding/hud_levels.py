@@ -61,6 +61,7 @@ class LevelPicker:
     def open(self, level: Level) -> None:
         """Play `level`: the world built again from its bundled scene."""
         scene = json.loads(bundled_scene(level.scene).read_text(encoding="utf-8"))
+        self.sandbox.select_many([])  # (a rebuild keeps the selection by name: not there)
         self.sandbox.rebuild(scene)
 
     def open_wanted(self) -> bool:
