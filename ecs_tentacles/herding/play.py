@@ -14,9 +14,9 @@ factor.
 `Bot` is a simple, honest strategy, a sheepdog's, one creature at a time: take the
 creature nearest the gate, get behind it (on the side away from where it should go,
 `behind` metres off) and push it: toward the point just outside the gate, or, once it
-stands in the funnel before the gate (within 40 degrees of its axis), through it; to get behind it, go around it (out of its
-reach) and around the pen, never through them. It runs (Shift) only to get somewhere
-far with no creature near, and walks to push.
+stands in the funnel before the gate (within 40 degrees of its axis), through it; to
+get behind it, go around it (out of its reach) and around the pen, never through them.
+It runs (Shift) only to get somewhere far with no creature near, and walks to push.
 """
 
 from __future__ import annotations
