@@ -84,7 +84,9 @@ class Herd(System):
             mantle = world.transforms.pos[world.creatures.mantle_row[-1:], :2]
             self.last = change.follow(self.last, "creatures", mantle)
 
-    def flock(self, pos: np.ndarray, vel: np.ndarray, side: np.ndarray, herd: dict[str, float]):
+    def flock(
+        self, pos: np.ndarray, vel: np.ndarray, side: np.ndarray, herd: dict[str, float]
+    ) -> tuple[np.ndarray, np.ndarray]:
         """(n, 2) the idle steering (cohesion, alignment, separation), and (n, 2) the
         direction to each creature's flock centre (zero alone)."""
         offset = pos[:, None, :] - pos[None, :, :]
