@@ -36,10 +36,10 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
 def sentence(level: Any, stars_text: Any) -> str:
     best = f"best {level.best:.1f} s" if level.best is not None else "not won yet"
     lock = "" if level.unlocked else "  (locked: win the one before)"
+    goal = f" {level.need} of {level.creatures}" if level.need else ""
     return (
-        f"{level.scene:<20} {stars_text(level.stars)}  {level.title}: {level.mode},"
-        f" {level.need} of {level.creatures} in {level.seconds:.0f} s, par"
-        f" {level.par:.0f} s, {best}{lock}"
+        f"{level.scene:<20} {stars_text(level.stars)}  {level.title}: {level.mode},{goal}"
+        f" in {level.seconds:.0f} s, par {level.par:.0f} s, {best}{lock}"
     )
 
 
