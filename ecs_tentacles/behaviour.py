@@ -20,8 +20,8 @@ A `Destinations` entry is a `Travel`: `send(world, creature, point, radius)` (cr
 `point`, x, y[, z], arriving within `radius` m, instead of wherever it was going),
 `stop(world, creature)` (nowhere to go) and `going(world)` (bool per CreatureStore row:
 has somewhere to go). The locomotion plugin adds one (its goals). A system that sends
-creatures declares the store columns that writes as its own writes (the examples:
-`systems/examples`, `DESTINATION_WRITES`).
+creatures declares the store columns that writes as its own writes: `writes =
+DESTINATION_WRITES` (and reads `DESTINATION_READS` to ask `going`).
 """
 
 from __future__ import annotations
@@ -44,6 +44,16 @@ if TYPE_CHECKING:
 DANGERS_MOVED = "dangers_moved"  # the dangers are where they are this frame
 ARRIVALS = "arrivals"  # creatures that reached where they went have let it go
 DESTINATIONS_READ = "destinations_read"  # where creatures go is read for this frame
+
+# the store columns the `Destinations` entry (the locomotion plugin's goals) writes when a
+# system sends or stops a creature, and reads for `going`: such a system declares them
+DESTINATION_WRITES = (
+    "goals",
+    "locomotion.creatures.goal",
+    "locomotion.creatures.has_goal",
+    "locomotion.creatures.goal_radius",
+)
+DESTINATION_READS = ("locomotion.creatures.has_goal",)
 
 
 @dataclass(frozen=True)

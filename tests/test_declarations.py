@@ -20,6 +20,7 @@ from ecs_tentacles.record.plugin import RecordPlugin
 from ecs_tentacles.scene.load import resolve_scene_path
 from ecs_tentacles.world import World
 from tests.declarations import UndeclaredRead, columns, declared_only, step_declared
+from tests.race.levels import level
 
 
 def _everything() -> dict[str, Any]:
@@ -41,6 +42,7 @@ SCENES = {
     "flee": lambda: "flee",
     "flock": lambda: "flock",
     "follow_leader": lambda: "follow_leader",
+    "race": lambda: level(rival_at=(0.0, 0.9)),  # the rival crawls to the flag and wins
 }
 
 

@@ -1,6 +1,7 @@
 """Headless pictures of the fur scenes: the presets side by side (labelled), the hedgehog
 octopus before and after the roach arrives (quills lowered, then raised), close-ups of
-cat hair and bird feathers as lit strands, and the fur tool editing the hedgehog.
+cat hair and bird feathers as lit strands (these in the clean view: no overlays), and the
+fur tool editing the hedgehog (its markers and timeline shown).
 
     python tools/fur_screenshots.py --out-dir shots/
 """
@@ -27,7 +28,8 @@ def main() -> None:
     from ecs_tentacles.fur.render.furpanel import FurPanel
     from ecs_tentacles.render.sandbox import Sandbox
 
-    presets = Sandbox("fur_presets", width=args.width, height=args.height, headless=True)
+    size = {"width": args.width, "height": args.height, "headless": True}
+    presets = Sandbox("fur_presets", **size, clean=True)  # for showing: no overlays
     presets.hud.visible = False
     presets.hud.name_labels = True
     presets.renderer.camera.shift_x = 0.0
@@ -43,7 +45,7 @@ def main() -> None:
         print(presets.screenshot(args.out_dir / f"fur_{name}_strands.png"))
     presets.close()
 
-    tool = Sandbox("hedgehog_octopus", width=args.width, height=args.height, headless=True)
+    tool = Sandbox("hedgehog_octopus", **size)  # the editor: its overlays are the point
     tool.step(60)
     tool.paused = True
     fur = tool.panel("Fur")
@@ -63,7 +65,7 @@ def main() -> None:
     print(tool.screenshot(args.out_dir / "fur_tool.png"))
     tool.close()
 
-    hedgehog = Sandbox("hedgehog_octopus", width=args.width, height=args.height, headless=True)
+    hedgehog = Sandbox("hedgehog_octopus", **size, clean=True)
     hedgehog.hud.visible = False
     hedgehog.renderer.camera.shift_x = 0.0
     camera = hedgehog.renderer.camera

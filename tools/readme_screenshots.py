@@ -1,6 +1,7 @@
 """Every README picture of the sandbox, made headless with the current HUD: the
 four-creature sandbox, the HUD at 640 x 360, the skinned octopus, the three terrain
-scenes (rocky shore, ramp, maze; HUD hidden) and, through `tools/fur_screenshots.py`
+scenes (rocky shore, ramp, maze; HUD hidden; the shore and the ramp in the clean view,
+the maze with the path navigation planned) and, through `tools/fur_screenshots.py`
 (`--only fur`), the fur pictures and, through `tools/director_screenshots.py` (`--only
 director`), the crowd director's sequence. (The plots are the benchmarks': `tools/crowd_scaling.py`,
 `tools/slope_climb.py`.)
@@ -30,6 +31,9 @@ SHOTS = {
     # terrain: the path navigation planned, the maze whole (framing the start cut it off)
     "maze": ("maze", 600, 960, 540, False, "3.5,-7.5,5.5,0.0,-0.3,0.0"),
 }
+# pictures for showing (`play --clean`: none of the editor's overlays); the sandbox and HUD
+# pictures show the editor, the maze the path navigation planned
+CLEAN = {"rocky_shore", "ramp"}
 CLOSE_UP = ("octopus", 120, 960, 540)  # skinned_sandbox: the skinned octopus, no HUD, near
 DEFAULT_DIR = Path(__file__).resolve().parents[1] / "assets" / "screenshots"
 
@@ -55,6 +59,7 @@ def main(argv: list[str] | None = None) -> int:
         out = args.out_dir / f"{name}.png"
         argv_play = ["play", scene, "--headless", "--frames", str(frames), "--quiet"]
         argv_play += ["--hud"] if hud else ["--no-hud"]
+        argv_play += ["--clean"] if name in CLEAN else []
         argv_play += ["--width", str(width), "--height", str(height), "--screenshot", str(out)]
         argv_play += [f"--camera={camera}"] if camera else []
         code = cli(argv_play)
@@ -65,15 +70,15 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _close_up(out: Path) -> None:
-    """The octopus after `CLOSE_UP` frames, framed close, HUD hidden (through the API:
-    nearer than any `--camera` choice frames it)."""
+    """The octopus after `CLOSE_UP` frames, framed close, HUD hidden, in the clean view
+    (through the API: nearer than any `--camera` choice frames it)."""
     from ecs_tentacles.render import configure
 
     configure(headless=True)
     from ecs_tentacles.render.sandbox import Sandbox
 
     scene, frames, width, height = CLOSE_UP
-    sandbox = Sandbox(scene, width=width, height=height, headless=True, hud=False)
+    sandbox = Sandbox(scene, width=width, height=height, headless=True, hud=False, clean=True)
     sandbox.step(frames)
     # on the octopus alone (`frame_all` also takes in its far goal), its ring inside
     sandbox.renderer.follow(sandbox.renderer.creature_entities[0], span=1.5)

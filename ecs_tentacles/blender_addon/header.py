@@ -15,7 +15,7 @@ from typing import TypeGuard
 import numpy as np
 
 FORMAT = "ecs_tentacles.take"
-VERSIONS = (1, 2)
+VERSIONS = (1, 2, 3)
 MAX_FRAMES = 1_000_000
 MAX_BODIES = 16384 * 1025
 MAX_FPS = 1000
@@ -88,7 +88,7 @@ def check(header: object) -> Header:
         raise TakeFileError(f"header.format: expected {FORMAT!r}")
     version = header.get("version")
     if version not in VERSIONS:
-        raise TakeFileError(f"header.version: this add-on reads versions 1 and 2, got {version!r}")
+        raise TakeFileError(f"header.version: this add-on reads versions 1 to 3, got {version!r}")
     fps = header.get("fps")
     if not _number(fps) or not 0 < fps <= MAX_FPS:
         raise TakeFileError(f"header.fps: must be a number in (0, {MAX_FPS}], got {fps!r}")
@@ -98,7 +98,7 @@ def check(header: object) -> Header:
             f"header.frames: must be a whole number in [1, {MAX_FRAMES}], got {frames!r}"
         )
     chunk_frames = frames
-    if version == 2:
+    if version >= 2:
         chunk = header.get("chunk_frames")
         if not _whole(chunk) or chunk < 1:
             raise TakeFileError(f"header.chunk_frames: must be a whole number >= 1, got {chunk!r}")
@@ -114,10 +114,10 @@ def check(header: object) -> Header:
                 f"header.bodies[{b}]: radius and length must be numbers in (0, 10000] m"
             )
     creatures = _creatures(header.get("creatures"), len(bodies))
-    replay = header.get("replay") if version == 2 else None
+    replay = header.get("replay") if version >= 2 else None
     clips, replayed = _replay(replay, creatures)
     roster = header.get("roster") is not None
-    chunked = _chunked(header.get("chunked"), replay is not None) if version == 2 else ()
+    chunked = _chunked(header.get("chunked"), replay is not None) if version >= 2 else ()
     return Header(int(version), float(fps), frames, chunk_frames, len(bodies), creatures, clips,
                   replayed, roster, chunked)  # fmt: skip
 

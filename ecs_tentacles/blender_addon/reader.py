@@ -1,7 +1,7 @@
 """The take file as the add-on reads it: numpy and the standard library only (Blender's
 own Python runs it; it cannot import ecs_tentacles).
 
-A take is a zip of `.npy` arrays (`ecs_tentacles.take.format`, versions 1 and 2). This
+A take is a zip of `.npy` arrays (`ecs_tentacles.take.format`, versions 1 to 3). This
 reads the header and the arrays an import needs, checked as untrusted input before
 anything is allocated, and raises `TakeFileError` (one line naming the file and the
 field) for a file that is not a sound take:
@@ -32,11 +32,12 @@ import zipfile
 import zlib
 from collections.abc import Iterator
 from pathlib import Path
-from typing import IO, Any
+from typing import IO, Any, cast
 
 import numpy as np
 
 from .header import Clip, Creature, TakeFileError, check
+from .shared import module
 
 __all__ = ["Clip", "Creature", "TakeFile", "TakeFileError", "value_problem"]
 MAX_HEADER_BYTES = 64 * 1024**2
@@ -125,7 +126,11 @@ class TakeFile:
             raise TakeFileError(f"header: not JSON ({str(exc).splitlines()[0]})") from None
         if not isinstance(header, dict):
             raise TakeFileError("header: not a JSON object")
-        return header
+        compact = module("take_compact")
+        try:
+            return cast(dict[str, Any], compact.unpacked(header))
+        except compact.PlanError as exc:
+            raise TakeFileError(str(exc)) from None
 
     # -- arrays --------------------------------------------------------------------------
     def blocks(self, names: tuple[str, ...]) -> Iterator[tuple[int, dict[str, np.ndarray]]]:
@@ -143,7 +148,7 @@ class TakeFile:
             raise self._located(error) from None
 
     def _blocks(self, names: tuple[str, ...]) -> Iterator[tuple[int, dict[str, np.ndarray]]]:
-        if self.version == 2:
+        if self.version >= 2:
             whole = {n: self._whole(n) for n in names if n not in self.chunked}
             for k, first in enumerate(range(0, self.frames, self.chunk_frames)):
                 count = min(self.chunk_frames, self.frames - first)

@@ -1,10 +1,10 @@
 """The project's own modules the add-on runs as they are (numpy and the standard library
 only): the skinned mesh (`ecs_tentacles.skin.mesh`) and the creatures' colours
 (`ecs_tentacles.skin.colours`), so Blender shows the mesh and the colours the exporters
-write.
+write, and a take header's body plans (`ecs_tentacles.take.compact`).
 
-`ecs-tentacles blender-addon` puts those two files into the add-on's zip as
-`skin_mesh.py` and `skin_colours.py`; run from the package itself (a development
+`ecs-tentacles blender-addon` puts those files into the add-on's zip as
+`skin_mesh.py`, `skin_colours.py` and `take_compact.py`; run from the package itself (a development
 checkout, the tests) the add-on uses the package's modules.
 """
 
@@ -13,11 +13,15 @@ from __future__ import annotations
 from importlib import import_module
 from types import ModuleType
 
-SHARED = {"skin_mesh": "ecs_tentacles.skin.mesh", "skin_colours": "ecs_tentacles.skin.colours"}
+SHARED = {
+    "skin_mesh": "ecs_tentacles.skin.mesh",
+    "skin_colours": "ecs_tentacles.skin.colours",
+    "take_compact": "ecs_tentacles.take.compact",
+}
 
 
 def module(name: str) -> ModuleType:
-    """`skin_mesh` or `skin_colours`: the copy in the add-on, else the package's."""
+    """`skin_mesh`, `skin_colours` or `take_compact`: the copy in the add-on, else the package's."""
     try:
         return import_module(f"{__package__}.{name}")
     except ModuleNotFoundError as missing:

@@ -34,7 +34,8 @@ ID = "ecs_tentacles_take"  # the manifest's id: Blender names the module bl_ext.
 REPOSITORY = "user_default"
 # the project's own files the add-on runs as they are (ecs_tentacles.blender_addon.shared)
 SHARED = {"skin_mesh.py": ("ecs_tentacles.skin", "mesh.py"),
-          "skin_colours.py": ("ecs_tentacles.skin", "colours.py")}  # fmt: skip
+          "skin_colours.py": ("ecs_tentacles.skin", "colours.py"),
+          "take_compact.py": ("ecs_tentacles.take", "compact.py")}  # fmt: skip
 _EPOCH = (1980, 1, 1, 0, 0, 0)
 INSTALL = """
 import sys, bpy

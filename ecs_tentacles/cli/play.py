@@ -1,4 +1,7 @@
-"""`ecs-tentacles play SCENE`: the interactive sandbox, or headless screenshots/video."""
+"""`ecs-tentacles play SCENE`: the interactive sandbox, or headless screenshots/video.
+
+Headless, a level (a scene with a `game`) stops once its game is won or lost, and the
+report holds the game's result (`ecs_tentacles.game`)."""
 
 from __future__ import annotations
 
@@ -61,12 +64,19 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
             "right-drag orbit, middle-drag pan, wheel zoom, click a creature to select it, "
             "click the ground to set its goal, shift-click "
             "to append, right-click a goal to remove it. Keys: space pause, . step, r reset, "
-            "h HUD, f follow, a frame all, tab next tentacle, F12 screenshot, v video."
+            "h HUD, f follow, a frame all, tab next tentacle, F12 screenshot, v video, o the"
+            " clean view (the editor's overlays hidden: goal paths, selection rings, sucker"
+            " dots, the fur timeline, the metre grid; a game's HUD and banners stay)."
         ),
     )
     parser.add_argument("scene", metavar="SCENE", help="scene file or bundled scene name")
     parser.add_argument("--headless", action="store_true", help="no window: render off-screen")
-    parser.add_argument("--frames", type=frame_count, default=300, help="headless: frames to run")
+    parser.add_argument(
+        "--frames",
+        type=frame_count,
+        default=300,
+        help="headless: frames to run (a level stops sooner once its game is won or lost)",
+    )
     parser.add_argument("--screenshot", type=output_path(".png"), help="headless: final PNG")
     parser.add_argument("--video", type=output_path(".mp4"), help="headless: record an MP4")
     parser.add_argument("--width", type=even_size, default=1280, help=f"{SIZE_RULE} (default 1280)")
@@ -115,8 +125,29 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         const=False,
         help="start with the HUD hidden (h)",
     )
+    clean = parser.add_mutually_exclusive_group()
+    clean.add_argument(
+        "--clean",
+        dest="clean",
+        action="store_const",
+        const=True,
+        default=None,
+        help="the clean view, a picture for showing: none of the editor's overlays (goal"
+        " paths and rings, selection rings and names, sucker dots, tier spheres, the fur"
+        " timeline, the metre grid); default: clean in a game (a scene with a `game` key)"
+        " and in a --video",
+    )
+    clean.add_argument(
+        "--no-clean",
+        dest="clean",
+        action="store_const",
+        const=False,
+        help="draw the editor's overlays, in a game or a --video too (o toggles them)",
+    )
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
-    parser.add_argument("--json", action="store_true", help="headless: the summary as JSON")
+    parser.add_argument(
+        "--json", action="store_true", help="headless: the summary as JSON (a level's: its game)"
+    )
     add_lod_arguments(parser)
     add_threads_argument(parser)  # without --focus, the focus follows the camera (render.sandbox)
     parser.set_defaults(handler=handle)
@@ -162,6 +193,7 @@ def handle(args: argparse.Namespace) -> int:
         focus=args.focus,
         threads=args.threads,
         palette=args.palette,
+        clean=True if args.clean is None and args.video else args.clean,
     )
     try:
         if args.camera is not None:
@@ -172,15 +204,35 @@ def handle(args: argparse.Namespace) -> int:
                 return 2
         if args.headless:
             result = sandbox.run_headless(
-                args.frames, screenshot=args.screenshot, video=args.video, progress=not args.quiet
+                args.frames,
+                screenshot=args.screenshot,
+                video=args.video,
+                progress=not args.quiet,
+                until=game_ended,
             )
-            report = {"scene": str(path), **result}
+            report = {"scene": str(path), **result, **game_report(sandbox.world)}
             print(json.dumps(report) if args.json else sentence(report))
         else:
             sandbox.run()
     finally:
         sandbox.close()
     return 0
+
+
+def game_ended(world: Any) -> bool:
+    """True once the world's game (a level's) is won or lost: a headless play stops."""
+    from ecs_tentacles.game.rules import playing
+
+    found = playing(world)
+    return found is not None and found[1].ended
+
+
+def game_report(world: Any) -> dict[str, Any]:
+    """`{"game": ...}`: the level's result as `--json` gives it ({} without a game)."""
+    from ecs_tentacles.game.rules import playing
+
+    found = playing(world)
+    return {} if found is None else {"game": found[1].report(found[0])}
 
 
 def sentence(report: dict[str, Any]) -> str:
@@ -192,4 +244,7 @@ def sentence(report: dict[str, Any]) -> str:
         f" physics {report['physics_ms']:.1f} ms a frame: {report['realtime_factor']:.2f}x real"
         " time)"
     )
+    game = report.get("game")
+    if game is not None:
+        text += f"; game {game['outcome']} at {game['seconds']:.1f} s"
     return text + (f"; wrote {', '.join(written)}" if written else "")

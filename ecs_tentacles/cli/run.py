@@ -1,7 +1,9 @@
 """`ecs-tentacles run SCENE --frames N`: step a scene headless and report the speed.
 
 The report holds timing, sizes, physics health and sucker attaches, and what the
-plugins add (`Plugin.run_summary`: locomotion's goals reached and left).
+plugins add (`RunSummaries` entries: locomotion's goals reached and left). A level (a
+scene with a `game`) stops when its game mode says the game is won or lost
+(`ecs_tentacles.game`), and the report's `game` holds the result (`frames`: those run).
 """
 
 from __future__ import annotations
@@ -10,6 +12,7 @@ import argparse
 import json
 import sys
 import time
+from collections.abc import Callable
 from typing import Any
 
 from ecs_tentacles.cli.arguments import (
@@ -22,6 +25,7 @@ from ecs_tentacles.cli.arguments import (
 from ecs_tentacles.cli.lod_options import add_lod_arguments, apply_focus, lod_choice
 from ecs_tentacles.cli.registries import RunSummaries, RunSummary
 from ecs_tentacles.components import Creature
+from ecs_tentacles.game.rules import playing
 from ecs_tentacles.output.progress import status, step_frames
 from ecs_tentacles.scene.load import resolve_scene_path
 from ecs_tentacles.world import World
@@ -40,7 +44,10 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("scene", metavar="SCENE", help="scene file or bundled scene name")
     parser.add_argument(
-        "--frames", type=frame_count, default=600, help="frames to run (default 600)"
+        "--frames",
+        type=frame_count,
+        default=600,
+        help="frames to run (default 600; a level stops sooner once its game is won or lost)",
     )
     parser.add_argument("--seed", type=seed_int, default=None, help="override the scene's seed")
     parser.add_argument("--json", action="store_true", help="print the summary as one JSON object")
@@ -95,6 +102,8 @@ def handle(args: argparse.Namespace) -> int:
     summary = simulate(world, args.frames, progress=not args.quiet)
     texts = [found.text for found in plugin_summaries(world) if found.text]
     summary = {"scene": str(path), **summary, "build_seconds": round(build_seconds, 4)}
+    if summary.get("game") is not None:
+        texts.append(game_phrase(summary["game"], summary["frames"], args.frames))
     attaches = f"sucker attaches {summary['sucker_attaches']}"
     if args.json:
         print(json.dumps(summary))
@@ -117,16 +126,19 @@ def handle(args: argparse.Namespace) -> int:
 
 
 def simulate(world: World, frames: int, *, progress: bool = True) -> dict[str, Any]:
-    """Step `world` for `frames` frames and return timing and size figures, physics
-    health, and the plugins' counts (`Plugin.run_summary`)."""
+    """Step `world` for `frames` frames (fewer when its game ends first) and return timing
+    and size figures, physics health, the plugins' counts (`RunSummaries`) and the game's
+    result (`game`, for a level)."""
     physics = world.physics
     start_time = world.time
     wall_start = time.perf_counter()
-    step_frames(world, frames, progress=progress)
+    until = game_over(world)
+    done = step_frames(world, frames, progress=progress, until=until)
     wall = time.perf_counter() - wall_start
     sim = world.time - start_time
+    game = playing(world)
     return {
-        "frames": frames,
+        "frames": done,
         "seed": world.seed,
         "sim_seconds": round(sim, 6),
         "wall_seconds": round(wall, 4),
@@ -144,7 +156,30 @@ def simulate(world: World, frames: int, *, progress: bool = True) -> dict[str, A
         "promotions": physics.lod.promotions,
         **{k: v for found in plugin_summaries(world) for k, v in found.counts.items()},
         "sucker_attaches": int(world.events.counts["sucker_attached"]),
+        **({} if game is None else {"game": game[1].report(game[0])}),
     }
+
+
+def game_over(world: World) -> Callable[[], bool] | None:
+    """For a level: a test that its game is won or lost (the run stops there); None
+    for a scene without a game."""
+    if playing(world) is None:
+        return None
+
+    def over() -> bool:
+        found = playing(world)
+        return found is not None and found[1].ended
+
+    return over
+
+
+def game_phrase(game: dict[str, Any], frames: int, asked: int) -> str:
+    """`game won in 41.2 s (1. Open field), stopped at frame 2472 of 3600`."""
+    where = f" ({game['level']})" if game.get("level") else ""
+    if game["outcome"] == "playing":
+        return f"game still playing after {game['seconds']:.1f} s{where}"
+    stopped = f", stopped at frame {frames} of {asked}" if frames < asked else ""
+    return f"game {game['outcome']} in {game['seconds']:.1f} s{where}{stopped}"
 
 
 def plugin_summaries(world: World) -> list[RunSummary]:

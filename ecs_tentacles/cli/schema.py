@@ -2,7 +2,8 @@
 
 `assets/schema/core.schema.json` is the core only; each plugin adds its keys
 (`<name>.schema.json` in each built-in feature package). This writes the schema a scene
-is checked against: the default plugins' keys, or those of the plugins SCENE turns on.
+is checked against: the default plugins' keys, or those of the plugins SCENE turns on
+(a level's `game` key: its game mode's schema).
 Point an editor at the file with the scene's `"$schema"`. The bundled
 `assets/schema/scene.schema.json` is this command's output for the default plugins
 (a test keeps it so), which the bundled scenes name.
@@ -15,8 +16,10 @@ import json
 import sys
 
 from ecs_tentacles.cli.arguments import output_path
+from ecs_tentacles.game.rules import scene_schema
 from ecs_tentacles.output.atomic import atomic_output
 from ecs_tentacles.scene.load import load_scene_plugins, resolve_scene_path
+from ecs_tentacles.scene.registries import plugin_entries
 from ecs_tentacles.scene.schema import load_schema, schema_for
 
 
@@ -51,8 +54,8 @@ def handle(args: argparse.Namespace) -> int:
         schema = load_schema()
     else:
         path = resolve_scene_path(args.scene)
-        _, plugins = load_scene_plugins(path, allow_systems=args.allow_systems)
-        schema = schema_for(plugins)
+        scene, plugins = load_scene_plugins(path, allow_systems=args.allow_systems)
+        schema = scene_schema(schema_for(plugins), scene, plugin_entries(plugins))
     text = json.dumps(schema, indent=2) + "\n"
     if args.out is None:
         if sys.stdout.isatty():

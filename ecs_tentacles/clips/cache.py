@@ -13,7 +13,9 @@ a world replays never depends on which worlds this process built before it.
     cache.seconds                                    # recording cost per key
 
 Reads scene creature entries (from the world's `scene` for `for_creature`); records
-with `GaitClips.record` on a miss; keeps the clips and their cost.
+with `GaitClips.record` on a miss; keeps the clips and their cost. With `disk=True` (the
+cache replay uses) a miss first reads the clips kept on disk by an earlier run, and a
+recording is kept there (`ecs_tentacles.clips.disk`: checked as it is read).
 """
 
 from __future__ import annotations
@@ -21,11 +23,12 @@ from __future__ import annotations
 import json
 from typing import TYPE_CHECKING, Any
 
+from ecs_tentacles.clips import disk
 from ecs_tentacles.clips.clips import GaitClips
 from ecs_tentacles.clips.record import one_creature_scene
 from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.creatures.body import build_creature
-from ecs_tentacles.physics.model import model_layout
+from ecs_tentacles.physics.model import ModelLayout, model_layout
 from ecs_tentacles.scene.spec import as_spec
 from ecs_tentacles.settings import Settings
 from ecs_tentacles.world import World
@@ -35,10 +38,13 @@ if TYPE_CHECKING:
 
 
 class ClipCache:
-    """Clips by morphology key; `record_options` go to `GaitClips.record`."""
+    """Clips by morphology key; `record_options` go to `GaitClips.record`. With `disk`,
+    recordings are also kept between runs (`ecs_tentacles.clips.disk`) and read back
+    (checked) instead of recorded again."""
 
-    def __init__(self, **record_options: Any):
+    def __init__(self, *, disk: bool = False, **record_options: Any):
         self.record_options = record_options
+        self.disk = disk
         self.clips: dict[tuple[Any, ...], GaitClips] = {}
 
     @property
@@ -52,28 +58,41 @@ class ClipCache:
     def get(self, creature: dict[str, Any], physics: dict[str, Any] | None = None) -> GaitClips:
         """The clips of the morphology of `creature` (a scene creature entry, defaults
         filled in as `load_scene` leaves them), recorded on first use."""
-        return self._get(morphology_key(creature, physics), creature, physics)
+        layout = _morphology(creature, physics)
+        return self._get(layout, _seconds_per_frame(physics), creature, physics)
 
     def for_creature(self, world: Host, entity: int) -> GaitClips:
         """The clips of creature `entity` of `world`, from its entry (the scene's, or the
         one it was spawned from: `world.creature_specs`)."""
         creature = world.component(entity, Creature)
-        key = model_layout(world, creature, world.component(entity, Transform)).key
+        layout = model_layout(world, creature, world.component(entity, Transform))
         entry = world.creature_specs.get(entity)
         if entry is None:
             raise ValueError(f"creature {creature.name!r}: no entry to record its clips from")
         physics = world.scene.get("physics") if world.scene is not None else None
-        return self._get(key, dict(entry), physics)
+        return self._get(layout, world.settings.dt, dict(entry), physics)
 
     def _get(
-        self, key: tuple[Any, ...], creature: dict[str, Any], physics: dict[str, Any] | None
+        self,
+        layout: ModelLayout,
+        dt: float,
+        creature: dict[str, Any],
+        physics: dict[str, Any] | None,
     ) -> GaitClips:
-        full_key = (key, recording_input(creature, physics))
+        key, recording = layout.key, recording_input(creature, physics)
+        full_key = (key, recording)
         clips = self.clips.get(full_key)
         if clips is None:
-            clips = GaitClips.record(creature, physics, **self.record_options)
-            if clips.key != key:
-                raise RuntimeError(f"creature {creature.get('name')!r}: recorded another key")
+            stored = disk.entry_key(recording, self.record_options) if self.disk else ""
+            hinges = len(layout.actuators)  # the free joint (7 / 6), then one per hinge
+            shape = disk.Shape(list(layout.bodies), 7 + hinges, 6 + hinges, dt)
+            clips = disk.read(stored, shape, key) if self.disk else None
+            if clips is None:
+                clips = GaitClips.record(creature, physics, **self.record_options)
+                if clips.key != key:
+                    raise RuntimeError(f"creature {creature.get('name')!r}: recorded another key")
+                if self.disk:
+                    disk.keep(stored, clips)
             self.clips[full_key] = clips
         return clips
 
@@ -90,12 +109,24 @@ def morphology_key(
     creature: dict[str, Any], physics: dict[str, Any] | None = None
 ) -> tuple[Any, ...]:
     """The physics morphology key of a scene creature entry, compiling nothing."""
-    settings = Settings.from_physics(physics) if physics is not None else Settings()
-    world = World(settings, name="clip-key")
+    return _morphology(creature, physics).key
+
+
+def _morphology(creature: dict[str, Any], physics: dict[str, Any] | None) -> ModelLayout:
+    """The model layout of a scene creature entry (alone in a world), compiling nothing."""
+    world = World(_settings(physics), name="clip-key")
     try:
         entity = build_creature(world, as_spec(creature))
         return model_layout(
             world, world.component(entity, Creature), world.component(entity, Transform)
-        ).key
+        )
     finally:
         world.close()
+
+
+def _settings(physics: dict[str, Any] | None) -> Settings:
+    return Settings.from_physics(physics) if physics is not None else Settings()
+
+
+def _seconds_per_frame(physics: dict[str, Any] | None) -> float:
+    return _settings(physics).dt

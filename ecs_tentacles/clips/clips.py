@@ -83,6 +83,7 @@ class GaitClips:
     crawl: Clip
     seconds: float  # wall-clock cost of recording both
     store_lag: float  # m: how far the Transform store lagged the recorded qpos (info)
+    kept: bool = False  # read back from the clips kept on disk (`clips.disk`), not recorded
 
     def __post_init__(self) -> None:
         # Both clips stacked: row offset[kind] + frame holds that frame's pose (position,
@@ -147,9 +148,12 @@ class GaitClips:
         *,
         interpolate: bool = True,
         rows: np.ndarray | None = None,
+        also: tuple[np.ndarray, np.ndarray] | None = None,
     ) -> None:
         """Body poses of K creatures into `out_pos` (K, B, 3) and `out_quat` (K, B, 4),
-        or into their rows `rows` (K,) of larger (N, B, .) arrays (a batch's poses).
+        or into their rows `rows` (K,) of larger (N, B, .) arrays (a batch's poses), and
+        into the same rows of `also` (positions, rotations shaped as the outputs: the
+        Transform store's rows of the batch) when given.
 
         `kind` (K,) is `IDLE` or `CRAWL`; `phase` (K,) the frame in that clip (any real
         number: it wraps; fractions interpolate positions linearly and rotations by
@@ -167,8 +171,15 @@ class GaitClips:
             turn = np.ascontiguousarray(heading, dtype=np.float64)
             fraction = phase - below
             into = np.arange(len(kind)) if rows is None else np.asarray(rows, dtype=np.int64)
+            also_pos, also_quat = also if also is not None else (_NO_POSE[0], _NO_POSE[1])
             fast.place(self._pose, self._change, row, fraction, interpolate, where, turn,
-                       into, out_pos, out_quat)  # fmt: skip
+                       into, out_pos, out_quat, also_pos, also_quat)  # fmt: skip
+            return
+        if also is not None:  # numpy: the outputs first, then a copy
+            self.evaluate(kind, phase, xy, heading, out_pos, out_quat, interpolate=interpolate,
+                          rows=rows)  # fmt: skip
+            at = slice(None) if rows is None else rows
+            also[0][at], also[1][at] = out_pos[at], out_quat[at]
             return
         if rows is not None:  # numpy: whole arrays, then one scatter
             pos, quat = (
@@ -215,6 +226,7 @@ class GaitClips:
 
 
 KERNELS = OptionalKernels("ecs_tentacles.clips.kernels", "ECS_TENTACLES_REPLAY")
+_NO_POSE = (np.zeros((0, 1, 3)), np.zeros((0, 1, 4)))  # `place` writes no second copy
 
 
 def _place(

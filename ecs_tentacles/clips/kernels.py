@@ -1,4 +1,5 @@
-"""The numba kernel of gait-clip replay: `GaitClips.evaluate` for K creatures in one pass.
+"""The numba kernels of gait-clip replay: `GaitClips.evaluate` for K creatures in one pass,
+and the clip frame each creature starts replaying from (`nearest_frames`).
 
 Optional, as the fur rig's kernels are: `clips` imports this module only when numba is
 installed (the ``dev`` extra brings it) and falls back to its whole-array numpy path
@@ -30,14 +31,19 @@ def place(
     out_rows: np.ndarray,
     out_pos: np.ndarray,
     out_quat: np.ndarray,
+    also_pos: np.ndarray,
+    also_quat: np.ndarray,
 ) -> None:
     """Creature k shows clip table row `row[k]` (+ `fraction[k]` of `change` when
     `interpolate`, quaternions renormalised) moved to `xy[k]` and turned by `heading[k]`,
-    written to row `out_rows[k]` of the outputs (a batch's pose arrays: no copy after).
+    written to row `out_rows[k]` of the outputs (a batch's pose arrays: no copy after),
+    and of `also_pos` / `also_quat` too unless they have no rows (the Transform store's
+    rows of that batch: the sync's copy made in the same pass).
 
     `pose` and `change` are (rows, B, 7) ground-frame tables (position, quaternion);
     the outputs are (N, B, 3) and (N, B, 4).
     """
+    twice = also_pos.shape[0] > 0
     for k in range(len(row)):
         r = row[k]
         o = out_rows[k]
@@ -55,10 +61,45 @@ def place(
                 w, qx, qy, qz = w + d[3] * t, qx + d[4] * t, qy + d[5] * t, qz + d[6] * t
                 norm = math.sqrt(w * w + qx * qx + qy * qy + qz * qz)
                 w, qx, qy, qz = w / norm, qx / norm, qy / norm, qz / norm
-            out_pos[o, b, 0] = c * x - s * y + ox
-            out_pos[o, b, 1] = s * x + c * y + oy
-            out_pos[o, b, 2] = z
-            out_quat[o, b, 0] = hc * w - hs * qz
-            out_quat[o, b, 1] = hc * qx - hs * qy
-            out_quat[o, b, 2] = hc * qy + hs * qx
-            out_quat[o, b, 3] = hc * qz + hs * w
+            px, py = c * x - s * y + ox, s * x + c * y + oy
+            qw, q1, q2, q3 = (
+                hc * w - hs * qz,
+                hc * qx - hs * qy,
+                hc * qy + hs * qx,
+                hc * qz + hs * w,
+            )
+            out_pos[o, b, 0], out_pos[o, b, 1], out_pos[o, b, 2] = px, py, z
+            out_quat[o, b, 0], out_quat[o, b, 1], out_quat[o, b, 2], out_quat[o, b, 3] = (
+                qw, q1, q2, q3,
+            )  # fmt: skip
+            if twice:
+                also_pos[o, b, 0], also_pos[o, b, 1], also_pos[o, b, 2] = px, py, z
+                also_quat[o, b, 0], also_quat[o, b, 1] = qw, q1
+                also_quat[o, b, 2], also_quat[o, b, 3] = q2, q3
+
+
+@njit(cache=True, nogil=True)
+def nearest_frames(shapes: np.ndarray, shape: np.ndarray, out: np.ndarray) -> None:
+    """`replay._nearest_frame`: for each pose `shape[k]` (K, B, 3), the first frame f of
+    `shapes` (F, B, 3) whose farthest body (Euclidean distance, summed as numpy's norm
+    sums x, y, z) is nearest, into `out[k]`. A frame is left as soon as one of its bodies
+    is as far as the best frame's farthest: it can no longer be strictly nearer, so the
+    answer is numpy's `argmin` of the maxima. Finite inputs only."""
+    for k in range(shape.shape[0]):
+        best = np.inf
+        found = 0
+        for f in range(shapes.shape[0]):
+            worst = -np.inf
+            for b in range(shapes.shape[1]):
+                dx = shape[k, b, 0] - shapes[f, b, 0]
+                dy = shape[k, b, 1] - shapes[f, b, 1]
+                dz = shape[k, b, 2] - shapes[f, b, 2]
+                d = math.sqrt(dx * dx + dy * dy + dz * dz)
+                if d > worst:
+                    worst = d
+                    if worst >= best:
+                        break
+            if worst < best:
+                best = worst
+                found = f
+        out[k] = found

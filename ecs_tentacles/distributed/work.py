@@ -37,6 +37,7 @@ from ecs_tentacles.distributed.task import ShardResult
 from ecs_tentacles.export.bake import BakePlan
 from ecs_tentacles.output.atomic import atomic_file
 from ecs_tentacles.take import Take, write_npz
+from ecs_tentacles.take.compact import unpacked
 from ecs_tentacles.take.read import MAX_HEADER_BYTES, MAX_TAKE_BYTES
 from ecs_tentacles.untrusted import bounded_json
 from ecs_tentacles.untrusted.files import Unfit, regular_file
@@ -150,7 +151,7 @@ def _regular(path: Path, limit: int, what: str) -> Iterator[BinaryIO]:
 def _parse(handle: BinaryIO) -> ShardResult:
     with np.load(handle, allow_pickle=False) as data:
         text = bytes(data["header"]).decode()
-        header = bounded_json.loads(text, "header", max_bytes=MAX_HEADER_BYTES)
+        header = unpacked(bounded_json.loads(text, "header", max_bytes=MAX_HEADER_BYTES))
         own = ("header", "spheres", "members")
         arrays = {k: data[k] for k in data.files if k not in own}
         take = Take.from_arrays(header, arrays)

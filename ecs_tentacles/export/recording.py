@@ -362,11 +362,11 @@ class TakeRecorder:
         problem = data_problem(numbers, [t.track for t in self._chunked_curves], self._base)
         if problem:  # a plugin's NaN: nobody could read the take
             raise TakeError(f"{self.writer.path}: cannot write this take: {problem}")
-        self.writer.add_frames(take_replay.blanked(self.header, arrays))
         # a creature gone keeps its last pose: remembered across the chunk boundary
         self._flushed_last = {
             name: getattr(self, f"_{name}")[held - 1].copy() for name in ("pos", "quat", "anchor")
         }
+        self.writer.add_frames(take_replay.blanked(self.header, arrays, in_place=True))
         self._base = self.count
 
     @property

@@ -45,6 +45,7 @@ class ReplayRecorder:
         self.clips: dict[int, np.ndarray] = {}  # take clip index -> (F, B, 7)
         self._clip_keys: dict[tuple[int, tuple[int, ...]], int] = {}
         self._owner = np.full(creatures, take_replay.PHYSICAL, dtype=np.int64)
+        self._rows: dict[int, np.ndarray] = {}  # clip -> (creatures, B) body rows (-1: other)
         self._roster_size = -1
         self._take_of_roster = np.zeros(0, dtype=np.int64)
         if self.active:
@@ -102,7 +103,7 @@ class ReplayRecorder:
         kind = replay.kind[moving].astype(np.int8)
         phase, xy, heading = replay.phase[moving], replay.xy[moving], replay.heading[moving]
         found = take_replay.poses(
-            self.header, self.clips, take_of, kind.astype(np.int64), phase, xy, heading
+            self.header, self.clips, take_of, kind.astype(np.int64), phase, xy, heading, self._rows
         )
         good = np.zeros(len(moving), dtype=bool)
         owner = self._owner[take_of]
@@ -164,6 +165,12 @@ class ReplayRecorder:
                 }
             )
         self._owner[creature] = clip
+        table = self._rows.setdefault(clip, np.full((0, len(mine)), -1, dtype=np.int64))
+        if len(table) < len(self._owner):
+            grown = np.full((len(self._owner), len(mine)), -1, dtype=np.int64)
+            grown[: len(table)] = table
+            self._rows[clip] = table = grown
+        table[creature] = mine
 
     def static_arrays(self) -> dict[str, np.ndarray]:
         """The clips' frames, by file name."""

@@ -2,22 +2,28 @@
 
     /World                                   Xform, the default prim
       /<c>                                   SkelRoot (c: the creature's name): the root
-                                             motion, xformOp:translate sampled (the
-                                             mantle's position; for a creature sharing a
-                                             clip its ground frame, with xformOp:rotateZ);
-                                             visibility keyed where it came or went
+                                             motion, xformOp:translate (float3) sampled
+                                             (the mantle's position), and for a creature
+                                             that replays a clip xformOp:rotateZ (its
+                                             heading); visibility keyed where it came or
+                                             went
         /<c>_skeleton                        Skeleton: joints (mantle/t0_link0/...),
                                              bindTransforms, restTransforms (its body
-                                             plan's, at the origin)
+                                             plan's, at the origin); for a creature that
+                                             replays, shown on its physical frames only
           /<c>_animation                     SkelAnimation: rotations sampled (the root's:
-                                             the mantle's world rotation); translations
-                                             and scales constant (one value, not samples);
-                                             or, sharing a clip, an internal reference to
-                                             /World/clips/... (`usd_clips`)
+                                             the mantle's rotation, seen from the heading
+                                             where there is one) at the frames this
+                                             skeleton needs; translations and scales
+                                             constant (one value, not samples)
         /<c>_skin                            Mesh (bound to the skeleton): points in the
                                              bind pose, normals, primvars:st (faceVarying),
                                              primvars:skel:jointIndices / jointWeights (2),
                                              bound to /World/materials/<c>_material
+        /<c>_replay<k>_skeleton, _skin       replayed stretch k: a Skeleton and its skin,
+          /<c>_replay<k>_animation           shown on the stretch's frames, the animation
+                                             an internal reference to /World/clips/...
+                                             offset in time (`usd_clips`)
         /<c>_suckers/<c>_t<k>/<c>_t<k>_link<i>/<c>_t<k>_link<i>_sucker<n>
                                              locator (`locators=True`): Xform, translate
                                              sampled (the sucker point), `ecs:attached`
@@ -28,7 +34,7 @@
                                              Below the SkelRoot, so in its moving frame
                                              (`root_frames`): USD and Blender both put
                                              them back where the take has them
-      /clips/plan<p>_clip<i>_<kind>_<g>      class SkelAnimations creatures share
+      /clips/plan<p>_clip<i>_<kind>          class SkelAnimations the stretches share
       /materials/<c>_material                each creature's material, its sandbox colour
                                              (`ecs_tentacles.export.materials`)
 
@@ -36,14 +42,18 @@ What is constant is written once. Links do not stretch: a joint's translation in
 parent is the rest offset at every frame (MuJoCo's hinges sit at fixed points of the
 parent body), so the animation's translations (and scales, 1) are one value each, and
 the root's motion is the SkelRoot's transform: the animation samples only
-rotations. Creatures of one body plan (the same mantle and links) share their rest
-state: skeleton, bind pose and mesh are the same arrays, held once in memory and
-stored once in a `.usdc` (USD's crate files keep one copy of equal arrays).
+rotations. The SkelRoot's translate is float3: a 30 m crowd's positions are then
+within 4 micrometres. Creatures of one body plan (the same mantle and links) share
+their rest state: skeleton, bind pose and mesh are the same arrays, held once in memory
+and stored once in a `.usdc` (USD's crate files keep one copy of equal arrays).
 UsdSkel poses a mesh point as `S(t) * sum_i w_i inv(bind_i) joint_i(t) p` with S the
 Skeleton's world transform (its ancestors' included), so the mesh is bound at the
 origin and moves with S. The motion is on the SkelRoot, not the Skeleton: Blender's
 importer (5.0.1) moves the armature with an animated SkelRoot, while with the motion on
-the Skeleton the creatures came in out of place and torn.
+the Skeleton the creatures came in out of place and torn. That importer does not bring
+USD's animated visibility along either: there a replayed creature's skeletons (its own
+and its stretches') all stay shown, each posed right on its own frames; the add-on
+(`ecs-tentacles blender-addon`) is Blender's way in for such crowds.
 
 Streamed: the take is read a chunk of frames at a time (`TakeChunks`, or a take file
 opened for streaming), each chunk's rotations made for every creature of a body plan
@@ -63,7 +73,6 @@ from __future__ import annotations
 import importlib
 import os
 from collections.abc import Callable
-from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -77,7 +86,7 @@ from ecs_tentacles.export.usd import _pxr, mark_rate, set_timing, static_take
 from ecs_tentacles.export.usd_clips import SharedClips
 from ecs_tentacles.export.usd_joint_samples import PlanSamples, key_report
 from ecs_tentacles.export.usd_layer import StreamedLayer
-from ecs_tentacles.export.usd_plans import BodyPlan, body_plans, define_creature
+from ecs_tentacles.export.usd_plans import body_plans, define_creature
 from ecs_tentacles.export.usd_tracks import Steps, UsdTracks, Visibility, key_steps
 from ecs_tentacles.numeric.quaternions import quat_rotate
 from ecs_tentacles.output.atomic import atomic_output
@@ -143,17 +152,19 @@ def _fill(
     clips = SharedClips(pxr, layer, source, plans)
     plan_of = {name: plan for plan in plans for name in plan.names}
     names = [c["name"] for c in header["creatures"]]
+    turns = clips.timeline.turns.tolist()
     for creature, name in enumerate(names):  # in the take's order
-        alone = creature not in clips.sharers
-        define_creature(pxr, stage, plan_of[name], name, colours[name], folder, alone)
-        clips.bind(name, creature)
+        define_creature(pxr, stage, plan_of[name], name, colours[name], folder, turns[creature])
+        clips.bind(name, creature, colours[name], folder)
         mark_rate(stage, f"/World/{name}", source.fps, source.frames)
     visibility = Visibility(layer, [f"/World/{name}" for name in names])
     suckers = Suckers(pxr, layer, header) if locators else None
     tracks = UsdTracks(layer, header, source.static, locators, relative=True)
     write_usd_ground(pxr, stage, still)
-    own = [alone_in(plan, clips.sharers) for plan in plans]
-    animated = [PlanSamples(pxr, layer, plan, keys or Keys(), source.frames) for plan in own]
+    animated = [
+        PlanSamples(pxr, layer, plan, keys or Keys(), source.frames, clips.timeline)
+        for plan in plans
+    ]
     rows = max(1, WORK_BYTES // (32 * max(1, len(header["bodies"]))))
     for first, chunk in source.chunks():
         for start in range(0, chunk.frames, rows):
@@ -162,11 +173,9 @@ def _fill(
             origin = np.zeros((piece.frames, len(names), 3))
             yaw = np.zeros((piece.frames, len(names)))
             for samples in animated:  # each creature's root motion as written
-                if len(samples.plan.members):
-                    origin[:, samples.plan.members] = samples.add(first + start, piece)
-            if clips.order:
-                origin[:, clips.order], yaw[:, clips.order] = clips.add(first + start, end - start)
-            roots = RootFrames(origin, yaw if clips.order else None)
+                members = samples.plan.members
+                origin[:, members], yaw[:, members] = samples.add(first + start, piece)
+            roots = RootFrames(origin, yaw if clips.sharing else None)
             if suckers is not None:
                 suckers.add(first + start, piece, roots)
             visibility.add(first + start, piece)
@@ -174,15 +183,10 @@ def _fill(
         layer.flush()
         if progress is not None:
             progress(chunk.frames)
-    groups = {id(group) for group in clips.sharers.values()}
-    return key_report(animated, source.frames, len(names), len(clips.sharers), len(groups))
-
-
-def alone_in(plan: BodyPlan, sharers: dict[int, Any]) -> BodyPlan:
-    """`plan` narrowed to its creatures that keep their own animation."""
-    keep = np.array([c not in sharers for c in plan.members.tolist()], dtype=bool)
-    names = [name for name, kept in zip(plan.names, keep.tolist(), strict=True) if kept]
-    return replace(plan, names=names, members=plan.members[keep], bodies=plan.bodies[keep])
+    stretches = sum(len(s) for s in clips.stretches.values())
+    return key_report(
+        animated, source.frames, len(names), clips.sharing, len(clips.shared), stretches
+    )
 
 
 class Suckers:

@@ -58,7 +58,7 @@ def chunk_frames(bodies: int, budget: int = CHUNK_BYTES) -> int:
 
 class ChunkSource(Protocol):
     """What the streaming writers read of a take: `TakeChunks` (a take in memory) and
-    `ecs_tentacles.take.stream.TakeSource` (a take file, versions 1 and 2)."""
+    `ecs_tentacles.take.stream.TakeSource` (a take file, versions 1 to 3)."""
 
     @property
     def header(self) -> dict[str, Any]: ...

@@ -123,39 +123,62 @@ def _link_numbers(
 
 
 def _header_entries(scene: Mapping[str, Any]) -> tuple[int, int]:
-    """Header bytes of (the creatures and bodies, the suckers), as the recorder writes
-    them: names, indices and every number as built from the scene."""
+    """Header bytes of (the creatures and bodies, the suckers) at most, as the recorder
+    writes them: names, indices and every number as built from the scene; bodies and
+    suckers once per body plan (`take.compact`), each creature's entry and plan index."""
     body_bytes = sucker_bytes = 0
     first = 0  # the mantle's body index
+    plans: set[str] = set()
     for c, creature in enumerate(scene["creatures"]):
-        name, mantle = creature.get("name", f"creature_{c}"), creature["mantle"]
-        radius, height = float(mantle["radius"]), float(mantle["height"])
-        entry = {"axis": "Z", "creature": c, "length": height, "name": f"{name}/mantle"}
-        body_bytes += _entry({**entry, "radius": radius, "shape": "cylinder"})
-        listed = _entry({"mantle": 0, "name": name, "tentacles": []}) - 1 + len(str(first))
-        body = first + 1
         tentacles = creature["tentacles"]
-        for k in range(tentacles["count"]):
-            params = tentacle_params(tentacles, k)
-            links, stem = params["links"], f"{name}/tentacles/t{k}/link"
-            asked = (params["link_length"], params["link_radius"], links, params["end_scale"])
-            numbers, offsets = _link_numbers(radius, asked)
-            link = {**entry, "axis": "X", "name": stem, "length": 0, "radius": 0}
-            body_bytes += links * (_entry({**link, "shape": "capsule"}) - 2) + sum(numbers)
-            body_bytes += _digits_below(links)
-            listed += 2 + links + _digits(body, body + links)  # [b,b,...], and a comma
-            sucker = {"body": 0, "name": f"{stem}/sucker0", "offset": [0, 0.0, 0]}
-            if params.get("suckers") == "every_link":  # one on each link
-                sucker_bytes += links * (_entry(sucker) - 3) + sum(offsets)
-                sucker_bytes += _digits_below(links) + _digits(body, body + links)
-            else:  # one at the tip
-                tip = links - 1
-                sucker_bytes += _entry(sucker) - 3 + len(str(tip)) + len(str(body + tip))
-                sucker_bytes += offsets[tip]
-            body += links
-        body_bytes += listed - (1 if tentacles["count"] else 0)  # no comma after the last
-        first = body
+        every = [tentacle_params(tentacles, k) for k in range(tentacles["count"])]
+        plan = repr([_shape_of(creature["mantle"], params) for params in every])
+        listed, bodies, suckers, first = _creature_entries(c, creature, every, first)
+        body_bytes += listed + len(str(len(plans))) + 1
+        if plan not in plans:
+            plans.add(plan)
+            body_bytes, sucker_bytes = body_bytes + bodies, sucker_bytes + suckers
     return body_bytes, sucker_bytes
+
+
+def _shape_of(mantle: Mapping[str, Any], params: Mapping[str, Any]) -> tuple[Any, ...]:
+    """What a tentacle's bodies and suckers in the header are made of (not its motion)."""
+    shape = ("links", "link_length", "link_radius", "end_scale", "suckers")
+    return (mantle["radius"], mantle["height"], *(params.get(key) for key in shape))
+
+
+def _creature_entries(
+    c: int, creature: Mapping[str, Any], every: list[dict[str, Any]], first: int
+) -> tuple[int, int, int, int]:
+    """(bytes of creature `c`'s entry, of its bodies', of its suckers', the next
+    creature's first body), its mantle being body `first`."""
+    body_bytes = sucker_bytes = 0
+    name, mantle = creature.get("name", f"creature_{c}"), creature["mantle"]
+    radius, height = float(mantle["radius"]), float(mantle["height"])
+    entry = {"axis": "Z", "creature": c, "length": height, "name": f"{name}/mantle"}
+    body_bytes += _entry({**entry, "radius": radius, "shape": "cylinder"})
+    listed = _entry({"mantle": 0, "name": name, "tentacles": []}) - 1 + len(str(first))
+    body = first + 1
+    tentacles = creature["tentacles"]
+    for k, params in enumerate(every):
+        links, stem = params["links"], f"{name}/tentacles/t{k}/link"
+        asked = (params["link_length"], params["link_radius"], links, params["end_scale"])
+        numbers, offsets = _link_numbers(radius, asked)
+        link = {**entry, "axis": "X", "name": stem, "length": 0, "radius": 0}
+        body_bytes += links * (_entry({**link, "shape": "capsule"}) - 2) + sum(numbers)
+        body_bytes += _digits_below(links)
+        listed += 2 + links + _digits(body, body + links)  # [b,b,...], and a comma
+        sucker = {"body": 0, "name": f"{stem}/sucker0", "offset": [0, 0.0, 0]}
+        if params.get("suckers") == "every_link":  # one on each link
+            sucker_bytes += links * (_entry(sucker) - 3) + sum(offsets)
+            sucker_bytes += _digits_below(links) + _digits(body, body + links)
+        else:  # one at the tip
+            tip = links - 1
+            sucker_bytes += _entry(sucker) - 3 + len(str(tip)) + len(str(body + tip))
+            sucker_bytes += offsets[tip]
+        body += links
+    listed -= 1 if tentacles["count"] else 0  # no comma after the last
+    return listed, body_bytes, sucker_bytes, body
 
 
 def _base(scene: Mapping[str, Any]) -> int:

@@ -1,50 +1,52 @@
-"""Creatures that replay one gait clip from the same start share one SkelAnimation.
+"""Replayed stretches of creatures share one SkelAnimation per body plan, clip and kind.
 
-    clips = SharedClips(pxr, layer, source, plans)     # who shares; the shared prims
-    clips.bind(name, creature)                          # a sharer's animation: a reference
-    for first, chunk in source.chunks():
-        origin, yaw = clips.add(first, frames)          # the sharers' root motion samples
+    clips = SharedClips(pxr, layer, source, plans)     # the stretches; the shared prims
+    clips.bind(name, creature)                          # a creature's stretches' skeletons
+    clips.timeline                                      # which frames its own skeleton shows
 
 A take of a crowd with level of detail records a replayed creature as what it is
-(take format version 2, `ReplaySegment`): clip `clip`'s `kind` loop (idle or crawl) at
-phase `phase + (f - first) * rate` on frame f, carried by a ground frame (`replay_xy`,
-`replay_heading`). Such a creature moves as the clip does, carried over the ground.
-UsdSkel's instancing pattern says so in USD: the rest state shared (the body plan's,
-`ecs_tentacles.export.usd_plans`), one SkelAnimation per group of creatures that move
-alike in their own frames, and per creature an animation prim that is an internal
-reference to it, its root motion on its SkelRoot:
+(take format version 2, `ReplaySegment`): over a stretch of frames [first, end), clip
+`clip`'s `kind` loop (idle or crawl) at clip frame `phase + (f - first) * rate` on frame
+f, carried by a ground frame (`replay_xy`, `replay_heading`). UsdSkel's instancing
+pattern says so in USD: the rest state shared (the body plan's,
+`ecs_tentacles.export.usd_plans`), one SkelAnimation per (body plan, clip, kind) holding
+the clip's own frames, and per stretch a Skeleton (with its skinned Mesh) whose
+animation is an internal reference to the shared one, offset and scaled in time:
 
     /World/<clips>                           class (abstract: not drawn, not imported)
-      /plan<p>_clip<i>_<kind>_<g>            class SkelAnimation: joints, scales
-                                             constant; rotations and translations (the
-                                             root's, in the ground frame) every frame
-    /World/<c>/<c>_skeleton/<c>_animation    def SkelAnimation: references the group's
-    /World/<c>                               SkelRoot: translate (X, Y, 0) and rotateZ
-                                             (heading, degrees, unwrapped) sampled
+      /plan<p>_clip<i>_<kind>                class SkelAnimation: joints, translations,
+                                             scales constant; rotations at clip frames
+                                             lo..hi (the loop unrolled as far as the
+                                             take's stretches reach), the root's in the
+                                             clip's ground frame
+    /World/<c>                               SkelRoot: translate (the mantle's position)
+                                             and rotateZ (its ground frame's heading,
+                                             degrees, unwrapped) sampled every frame
+      /<c>_skeleton, /<c>_skin               its own: physical frames (`usd_joint_samples`)
+      /<c>_replay<k>_skeleton                stretch k: its animation references the
+        /<c>_replay<k>_animation             shared one with Sdf.LayerOffset(offset,
+      /<c>_replay<k>_skin                    scale): take frame t is clip frame
+                                             (t - offset) / scale = phase + (t - first) * rate
 
-Who shares: a creature with one replayed stretch that lasts to the take's end, of one
-clip and kind. A take's frame 0 is the pose the scene was built in, so every stretch
-starts at frame 1 or later and the frames before it are physical: the group's
-animation holds them too (the first member's, in its own frame: the mantle's position
-and heading), and a creature joins only if its frames before the stretch are that
-pose in its frame (within `PREFIX_TOLERANCE`: a crowd built alike and replayed from
-frame 1). A group is (body plan, clip, kind, rate, the frame the stretch starts, its
-phase there): a time offset on the reference (`Sdf.LayerOffset`) cannot shift a
-creature whose first frames are not the clip's, so the members of a group start
-together and the reference has no offset. Crowds replay from one phase (every
-creature demoted at frame 1 starts the crawl at the same clip frame), so one group
-holds them all. The group's animation is sampled at every take frame from the clip as
-the take blends it (`ecs_tentacles.take.replay.blend`: positions lerped, rotations
-nlerped), so its joints are the take's at every frame; between frames USD slerps.
+Each skeleton and its skin are visible only on their frames (`visibility` keyed:
+invisible, inherited where they take over), so a USD client shows one of a creature's
+skeletons at a time, the one that poses it as the take does. The own skeleton's
+rotations are sampled only at the creature's physical frames and the frame after each
+run of them (so that between that run's last frame and the next, where it is still
+shown, USD interpolates towards the take's pose). A clip's phase starts anywhere in its
+loop, so each stretch's start is taken modulo the loop's length: the shared animation
+holds the clip frames from the lowest start to the furthest end (plus a rate's worth,
+for the frame after a stretch's last), whatever the take's length in loops.
 
-A creature physical after its first frames, or that switches clip or kind, keeps its
-own animation (`ecs_tentacles.export.usd_joint_samples`), its replayed frames filled
-in by the take. Reads the take's replay records, clips and first chunk; writes prims
-and time samples on the layer.
+The clip's poses are the take's own (`ecs_tentacles.take.replay.blend`) at whole clip
+frames; a take whose phases fall between clip frames is interpolated by USD (slerp of
+local rotations where the take nlerps world ones: a small difference). Reads the take's
+replay records and clips; writes prims and their (few) time samples on the layer.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -53,200 +55,185 @@ import numpy as np
 from ecs_tentacles.export.names import part
 from ecs_tentacles.export.take_chunks import ChunkSource
 from ecs_tentacles.export.usd_layer import StreamedLayer
-from ecs_tentacles.export.usd_plans import BodyPlan
+from ecs_tentacles.export.usd_plans import BodyPlan, define_skin
 from ecs_tentacles.skin.streamed import JointRotations
-from ecs_tentacles.take import Take
 from ecs_tentacles.take.replay import blend
 
 KINDS = ("idle", "crawl")  # replay_kind 0 and 1
 FOLDER = "clips"
-PREFIX_TOLERANCE = 1e-4  # m: a body's distance from the group's before the stretch
 
 
-@dataclass
-class Group:
-    """Creatures that move alike in their own frames: the shared animation's path, its
-    plan, and the segment they replay (first frame, clip, kind, phase there, rate)."""
+@dataclass(frozen=True)
+class Stretch:
+    """Creature `creature`'s frames [first, end): clip `clip`'s `kind` loop at clip frame
+    `phase + (f - first) * rate` (`phase` taken into the loop's first turn), on the
+    shared animation at `path`."""
 
-    path: str
-    plan: BodyPlan
+    creature: int
     first: int
+    end: int
     clip: int
     kind: int
     phase: float
     rate: float
-    members: list[int]
-    prefix: np.ndarray  # (first, B, 7) the first member's bodies before the stretch
+    path: str
+
+
+@dataclass(frozen=True)
+class Timeline:
+    """Per take frame and creature: `own` (frames, C) where its own skeleton shows,
+    `heading` (frames, C) its ground frame's yaw (radians) where a stretch shows (NaN
+    elsewhere); `turns` (C,) creatures with stretches (their SkelRoot has a rotateZ)."""
+
+    own: np.ndarray
+    heading: np.ndarray
+    turns: np.ndarray
+
+    @property
+    def samples(self) -> np.ndarray:
+        """(frames, C) the frames the own animation is sampled at: its own, and the
+        frame after each run of them (frame 0 for a creature with none: a value)."""
+        out = self.own.copy()
+        out[1:] |= self.own[:-1]
+        if len(out):
+            out[0, ~out.any(axis=0)] = True
+        return out
+
+
+@dataclass
+class Shared:
+    """One shared animation: its path, plan, clip, kind and the clip frames it holds."""
+
+    path: str
+    plan: BodyPlan
+    clip: int
+    kind: int
+    low: int
+    high: int
 
 
 class SharedClips:
-    """The shared animations of a take's replayed creatures, and their root motion."""
+    """The shared animations of a take's replayed stretches and who shows what when."""
 
     def __init__(
         self, pxr: Any, layer: StreamedLayer, source: ChunkSource, plans: list[BodyPlan]
     ) -> None:
         self.pxr, self.layer, self.source = pxr, layer, source
-        names = [c["name"] for c in source.header["creatures"]]
+        header = source.header
+        names = [c["name"] for c in header["creatures"]]
         self.folder = _folder(set(names))
-        self.sharers: dict[int, Group] = {}
-        self.order: list[int] = []
-        candidates = self._candidates(plans)
-        if not candidates:
-            return
-        _, opening = next(iter(source.chunks()))  # the frames before every stretch
-        groups: dict[tuple[Any, ...], Group] = {}
-        self.xy = np.zeros((source.frames, 0, 2))
-        columns_xy, columns_heading = [], []
-        for creature, (plan, segment) in candidates.items():
-            if segment.first > opening.frames:
-                continue
-            xy, heading = (np.array(a, dtype=np.float64) for a in source.root_motion(creature))
-            prefix, xy[: segment.first], heading[: segment.first] = _own_frames(
-                opening, plan, plan.bodies[list(plan.members).index(creature)], segment.first
-            )
-            key = (id(plan), segment.clip, segment.kind, segment.rate, segment.first,
-                   round(segment.phase, 9))  # fmt: skip
-            group = groups.get(key)
-            if group is None:
-                group = groups[key] = Group(
-                    path=f"/World/{self.folder}/plan{plans.index(plan)}_clip{segment.clip}"
-                    f"_{KINDS[segment.kind]}_{len(groups)}",
-                    plan=plan, first=segment.first, clip=segment.clip, kind=segment.kind,
-                    phase=segment.phase, rate=segment.rate, members=[], prefix=prefix,
-                )  # fmt: skip
-            elif len(prefix) and _apart(prefix, group.prefix) > PREFIX_TOLERANCE:
-                continue  # its first frames are its own: it keeps its own animation
-            group.members.append(creature)
-            self.sharers[creature] = group
-            self.order.append(creature)
-            columns_xy.append(xy)
-            columns_heading.append(np.unwrap(heading))
-        if not self.order:
-            return
-        self.xy = np.stack(columns_xy, axis=1)  # (frames, sharers, 2)
-        self.heading = np.stack(columns_heading, axis=1)
-        for group in groups.values():
-            if group.members:
-                self._define(group)
-        Sdf = pxr.Sdf
-        self.translates = [Sdf.Path(f"/World/{names[c]}.xformOp:translate") for c in self.order]
-        self.turns = [Sdf.Path(f"/World/{names[c]}.xformOp:rotateZ") for c in self.order]
-
-    def _candidates(self, plans: list[BodyPlan]) -> dict[int, tuple[BodyPlan, Any]]:
-        """Creatures with one replayed stretch lasting to the end, of a clip of their
-        plan's bodies: (plan, segment) by creature."""
-        out = {}
-        for plan in plans:
+        frames, count = source.frames, len(names)
+        own = np.ones((frames, count), dtype=bool)
+        heading = np.full((frames, count), np.nan)
+        self.stretches: dict[int, list[Stretch]] = {}
+        self.plan_of: dict[int, BodyPlan] = {}
+        self.shared: dict[tuple[int, int, int], Shared] = {}
+        for p, plan in enumerate(plans):
             for creature in plan.members.tolist():
-                segments = self.source.segments(creature)
-                if len(segments) != 1 or segments[0].end != self.source.frames:
+                segments = [s for s in source.segments(creature) if s.end > s.first]
+                if not segments:
                     continue
-                pose = self.source.clip_pose(segments[0].clip)
-                if pose.shape[1] == plan.bodies.shape[1]:
-                    out[creature] = (plan, segments[0])
-        return out
+                pose = source.clip_pose(segments[0].clip)
+                if pose.shape[1] != plan.bodies.shape[1]:
+                    continue  # a clip not of its plan's bodies: its own animation shows all
+                _, turn = source.root_motion(creature)
+                mine = []
+                for segment in segments:
+                    loop = int(header["replay"]["clips"][segment.clip]["frames"][segment.kind])
+                    phase = segment.phase - loop * math.floor(segment.phase / loop)
+                    shared = self._shared(p, plan, segment.clip, segment.kind)
+                    # the last frame's clip frame, and a rate's worth after it
+                    reach = phase + (segment.end - segment.first) * segment.rate
+                    shared.low = min(shared.low, math.floor(phase))
+                    shared.high = max(shared.high, math.ceil(reach))
+                    mine.append(
+                        Stretch(creature, segment.first, segment.end, segment.clip,
+                                segment.kind, phase, segment.rate, shared.path)
+                    )  # fmt: skip
+                    own[segment.first : segment.end, creature] = False
+                    heading[segment.first : segment.end, creature] = turn[
+                        segment.first : segment.end
+                    ]
+                self.stretches[creature] = mine
+                self.plan_of[creature] = plan
+        turns = np.zeros(count, dtype=bool)
+        turns[list(self.stretches)] = True
+        self.timeline = Timeline(own=own, heading=heading, turns=turns)
+        for shared in self.shared.values():
+            self._define(shared)
 
-    def _define(self, group: Group) -> None:
-        """The group's SkelAnimation (abstract), sampled at every take frame."""
+    def _shared(self, p: int, plan: BodyPlan, clip: int, kind: int) -> Shared:
+        """The shared animation of plan `p`'s clip `clip`, kind `kind` (made on first ask)."""
+        key = (p, clip, kind)
+        if key not in self.shared:
+            path = f"/World/{self.folder}/plan{p}_clip{clip}_{KINDS[kind]}"
+            self.shared[key] = Shared(path, plan, clip, kind, low=2**62, high=-(2**62))
+        return self.shared[key]
+
+    def _define(self, shared: Shared) -> None:
+        """The shared SkelAnimation (abstract), sampled at clip frames low..high."""
         pxr, layer, source = self.pxr, self.layer, self.source
         Vt, UsdSkel = pxr.Vt, pxr.UsdSkel
-        frames = source.frames
-        counts = tuple(source.header["replay"]["clips"][group.clip]["frames"])
-        later = np.arange(group.first, frames)
-        phase = group.phase + (later - group.first) * group.rate
-        kind = np.full(len(later), group.kind, dtype=np.int64)
-        clip = blend(source.clip_pose(group.clip), counts, kind, phase)
-        poses = np.concatenate([group.prefix, clip])  # (frames, B, 7) in its own frame
-        rotations = JointRotations(group.plan.skeleton.parents, np.arange(poses.shape[1])[None])
-        local = rotations.local(poses[:, :, 3:])[:, 0]  # (frames, J, 4)
-        xyzw = np.ascontiguousarray(local[..., [1, 2, 3, 0]], dtype=np.float32)
-        rest = group.plan.skeleton.rest_translation.astype(np.float32)
-        translations = np.broadcast_to(rest, (frames, *rest.shape)).copy()
-        translations[:, 0] = poses[:, 0, :3]  # the mantle in the creature's own frame
+        counts = tuple(source.header["replay"]["clips"][shared.clip]["frames"])
+        phase = np.arange(shared.low, shared.high + 1, dtype=np.float64)
+        kind = np.full(len(phase), shared.kind, dtype=np.int64)
+        poses = blend(source.clip_pose(shared.clip), counts, kind, phase)  # ground frame
+        joints = np.arange(poses.shape[1])[None]
+        local = JointRotations(shared.plan.skeleton.parents, joints).local(poses[:, :, 3:])
+        xyzw = np.ascontiguousarray(local[:, 0][..., [1, 2, 3, 0]], dtype=np.float32)
         layer.stage.CreateClassPrim(f"/World/{self.folder}")  # abstract: nothing to draw
-        prim = layer.stage.CreateClassPrim(group.path)
+        prim = layer.stage.CreateClassPrim(shared.path)
         prim.SetTypeName("SkelAnimation")
         anim = UsdSkel.Animation(prim)
-        anim.CreateJointsAttr(group.plan.arrays["joints"])
-        anim.CreateScalesAttr(group.plan.arrays["scales"])
-        rotation_path = anim.CreateRotationsAttr().GetPath()
-        translation_path = anim.CreateTranslationsAttr().GetPath()
+        anim.CreateJointsAttr(shared.plan.arrays["joints"])
+        anim.CreateTranslationsAttr(shared.plan.arrays["translations"])
+        anim.CreateScalesAttr(shared.plan.arrays["scales"])
+        rotations = anim.CreateRotationsAttr().GetPath()
         with layer.batch():
-            for frame in range(frames):
-                value = Vt.QuatfArray.FromNumpy(xyzw[frame])
-                layer.sample(rotation_path, frame, value, xyzw[frame].nbytes)
-                value = Vt.Vec3fArray.FromNumpy(translations[frame])
-                layer.sample(translation_path, frame, value, translations[frame].nbytes)
+            for row, frame in enumerate(range(shared.low, shared.high + 1)):
+                value = Vt.QuatfArray.FromNumpy(xyzw[row])
+                layer.sample(rotations, frame, value, xyzw[row].nbytes)
 
-    def bind(self, name: str, creature: int) -> bool:
-        """Creature `name` (number `creature`) animated by its group's animation; False
-        when it does not share (its own animation is written)."""
-        group = self.sharers.get(creature)
-        if group is None:
-            return False
-        Sdf, UsdGeom = self.pxr.Sdf, self.pxr.UsdGeom
-        stage = self.layer.stage
-        skeleton = f"/World/{name}/{part(name, 'skeleton')}"
-        anim = stage.GetPrimAtPath(f"{skeleton}/{part(name, 'animation')}")
-        anim.GetReferences().AddInternalReference(Sdf.Path(group.path))
-        root = UsdGeom.Xformable(stage.GetPrimAtPath(f"/World/{name}"))
-        root.AddRotateZOp()  # after the translate: turned in place, then moved
-        return True
+    def bind(self, name: str, creature: int, colour: np.ndarray, materials: str) -> None:
+        """Creature `name`'s (number `creature`) skeletons of its stretches, each bound to
+        its shared animation offset in time, shown on its frames; its own skeleton shown
+        on the others. Nothing for a creature without stretches."""
+        mine = self.stretches.get(creature)
+        if not mine:
+            return
+        pxr = self.pxr
+        Sdf, stage, plan = pxr.Sdf, self.layer.stage, self.plan_of[creature]
+        own = self.timeline.own[:, creature]
+        base = f"/World/{name}"
+        _show(pxr, stage, [f"{base}/{part(name, 'skeleton')}", f"{base}/{part(name, 'skin')}"],
+              own)  # fmt: skip
+        for k, stretch in enumerate(mine):
+            prefix = part(name, f"replay{k}")
+            skeleton, skin = define_skin(pxr, stage, plan, name, prefix, colour, materials, False)
+            anim = stage.GetPrimAtPath(f"{skeleton}/{part(prefix, 'animation')}")
+            offset = Sdf.LayerOffset(stretch.first - stretch.phase / stretch.rate, 1 / stretch.rate)
+            anim.GetReferences().AddInternalReference(Sdf.Path(stretch.path), offset)
+            shown = np.zeros(len(own), dtype=bool)
+            shown[stretch.first : stretch.end] = True
+            _show(pxr, stage, [skeleton, skin], shown)
 
-    def add(self, first: int, frames: int) -> tuple[np.ndarray, np.ndarray]:
-        """The sharers' root motion at frames [first, first + frames): translate and
-        rotateZ samples; returns their origins (n, S, 3) and yaws (n, S) in `order`."""
-        Gf = self.pxr.Gf
-        xy = self.xy[first : first + frames]
-        heading = self.heading[first : first + frames]
-        degrees = np.degrees(heading).tolist()
-        rows = xy.tolist()
-        with self.layer.batch():
-            for row in range(frames):
-                frame = first + row
-                paths = zip(self.translates, self.turns, strict=True)
-                for column, (translate, turn) in enumerate(paths):
-                    x, y = rows[row][column]
-                    self.layer.sample(translate, frame, Gf.Vec3d(x, y, 0.0), 24)
-                    self.layer.sample(turn, frame, degrees[row][column], 4)
-        origin = np.zeros((frames, len(self.order), 3))
-        origin[..., :2] = xy
-        return origin, heading
+    @property
+    def sharing(self) -> int:
+        """Creatures with a replayed stretch."""
+        return len(self.stretches)
 
 
-def _own_frames(
-    opening: Take, plan: BodyPlan, bodies: np.ndarray, first: int
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """A creature's frames before its stretch in its own frame (the mantle's ground
-    position and heading): (poses (first, B, 7), xy (first, 2), heading (first,))."""
-    pos = opening.pos[:first, bodies].astype(np.float64)
-    quat = opening.quat[:first, bodies].astype(np.float64)
-    quat /= np.sqrt(np.einsum("fbi,fbi->fb", quat, quat))[..., None]
-    w, x, y, z = np.moveaxis(quat[:, 0], -1, 0)
-    heading = np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))  # the mantle's
-    xy = pos[:, 0, :2]
-    c, s = np.cos(heading)[:, None], np.sin(heading)[:, None]
-    dx, dy = pos[..., 0] - xy[:, :1], pos[..., 1] - xy[:, 1:]
-    out = np.empty((first, len(bodies), 7))
-    out[..., 0] = c * dx + s * dy  # turned by -heading
-    out[..., 1] = -s * dx + c * dy
-    out[..., 2] = pos[..., 2]
-    hc, hs = np.cos(0.5 * heading)[:, None], np.sin(0.5 * heading)[:, None]
-    qw, qx, qy, qz = np.moveaxis(quat, -1, 0)  # (cos h/2, 0, 0, -sin h/2) * q
-    out[..., 3] = hc * qw + hs * qz
-    out[..., 4] = hc * qx + hs * qy
-    out[..., 5] = hc * qy - hs * qx
-    out[..., 6] = hc * qz - hs * qw
-    return out, xy, heading
-
-
-def _apart(a: np.ndarray, b: np.ndarray) -> float:
-    """The largest distance between two creatures' bodies (poses (F, B, 7)), their
-    links' far ends included (a rotation shows at the end of a link)."""
-    far = np.linalg.norm(a[..., :3] - b[..., :3], axis=-1).max(initial=0.0)
-    turned = np.abs(np.einsum("fbi,fbi->fb", a[..., 3:], b[..., 3:])).clip(0.0, 1.0)
-    angle = 2.0 * np.arccos(turned).max(initial=0.0)
-    return float(far + 0.1 * angle)  # a 10 cm link turned by `angle` moves its end this much
+def _show(pxr: Any, stage: Any, paths: list[str], shown: np.ndarray) -> None:
+    """Key the visibility of the prims at `paths`: inherited on the frames `shown` (bool
+    per frame), invisible on the others; keys only where it changes (and at frame 0)."""
+    UsdGeom = pxr.UsdGeom
+    changes = np.flatnonzero(np.diff(shown.astype(np.int8))) + 1
+    frames = [0, *changes.tolist()]
+    tokens = (UsdGeom.Tokens.invisible, UsdGeom.Tokens.inherited)
+    for path in paths:
+        attr = UsdGeom.Imageable(stage.GetPrimAtPath(path)).CreateVisibilityAttr()
+        for frame in frames:
+            attr.Set(tokens[int(shown[frame])], frame)
 
 
 def _folder(names: set[str]) -> str:

@@ -10,8 +10,9 @@ points, widths and extent sampled; curves no creature owns sit at `/World/<folde
 World space (the rigid form: `mantles` None): the take's points every frame.
 
 Carried (the skinned form): a creature's folder Xform (`<c>_fur`) follows its mantle
-(translate and orient sampled: the mantle's pose in the creature's moving root frame,
-`RootFrames`), and the points are in the mantle's frame. Guides that ride the mantle
+(the mantle's pose in the creature's moving root frame, `RootFrames`: orient sampled,
+translate (float3) written where it moves, which with the SkelRoot at the mantle is
+once), and the points are in the mantle's frame. Guides that ride the mantle
 without swaying (a replayed creature's) then keep their points frame after frame, and
 a sample is written only where they move: `Held` keeps a value once it is more than
 half of `TOLERANCE` (0.25 mm) from the one last written (and the frame before it, so
@@ -98,7 +99,7 @@ class CurvesTrack:
         owners = np.asarray(header[track.key]["creatures"], dtype=np.int64)
         names = [c["name"] for c in header["creatures"]]
         self.owners: list[Owner] = []
-        self.carriers: dict[int, tuple[Any, Any]] = {}  # creature -> translate, orient
+        self.carriers: dict[int, tuple[Any, Any, Held]] = {}  # creature -> translate, orient
         carried = mantles is not None
         for owner in sorted(set(owners.tolist())):
             if 0 <= owner < len(names):
@@ -109,8 +110,9 @@ class CurvesTrack:
             folder = UsdGeom.Xform.Define(layer.stage, path.rsplit("/", 1)[0])
             if carried and owner >= 0:
                 self.carriers[owner] = (
-                    folder.AddTranslateOp().GetAttr().GetPath(),
+                    folder.AddTranslateOp(UsdGeom.XformOp.PrecisionFloat).GetAttr().GetPath(),
                     folder.AddOrientOp().GetAttr().GetPath(),
+                    Held(0.0),  # the mantle is its root's origin: written where it moves
                 )
             curves = UsdGeom.BasisCurves.Define(layer.stage, path)
             curves.CreateTypeAttr(UsdGeom.Tokens.linear)
@@ -162,11 +164,12 @@ class CurvesTrack:
         where, turn = roots.local_pose(pos, quat, creatures)
         with self.layer.batch():
             for column, creature in enumerate(creatures.tolist()):
-                translate, orient = self.carriers[creature]
+                translate, orient, held = self.carriers[creature]
+                places = where[:, column].astype(np.float32)
                 for row in range(chunk.frames):
                     w, x, y, z = turn[row, column].tolist()
-                    at = Gf.Vec3d(*where[row, column].tolist())
-                    self.layer.sample(translate, first + row, at, 24)
+                    for frame, at in held.keep(first + row, places[row]):
+                        self.layer.sample(translate, frame, Gf.Vec3f(*at.tolist()), 12)
                     self.layer.sample(orient, first + row, Gf.Quatf(w, x, y, z), 16)
         column_of = {c: i for i, c in enumerate(creatures.tolist())}
         inverse = quat * np.array([1.0, -1.0, -1.0, -1.0])

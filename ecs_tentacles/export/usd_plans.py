@@ -1,7 +1,7 @@
 """Body plans of a skinned USD: creatures built alike share one rest state.
 
     plans = body_plans(take.header, detail)         # creatures grouped by body plan
-    define_creature(pxr, stage, plan, name, colour, materials)
+    define_creature(pxr, stage, plan, name, colour, materials, turns)
 
 Creatures with the same mantle and links (sizes, tentacle count and angles) share a
 skeleton bound at the origin and one mesh (`ecs_tentacles.skin`): their USD arrays
@@ -11,8 +11,9 @@ on every creature of it. VtArrays share their data, so the layer holds one copy,
 `.usdc` stores equal arrays once: a crowd of one body plan pays for one mesh.
 
 `define_creature` makes one creature's prims (SkelRoot, Skeleton, SkelAnimation, skinned
-Mesh, material) as `ecs_tentacles.export.skinned_usd` lays them out; the time samples
-are `ecs_tentacles.export.usd_joint_samples`'. Reads the take's header; writes prims on
+Mesh, material) as `ecs_tentacles.export.skinned_usd` lays them out, `define_skin` a
+Skeleton with its animation and skin (a replayed stretch's: `usd_clips`); the time
+samples are `ecs_tentacles.export.usd_joint_samples`'. Reads the take's header; writes prims on
 the stage it is given.
 """
 
@@ -108,23 +109,44 @@ def define_creature(
     name: str,
     colour: np.ndarray,
     folder: str,
-    own_animation: bool = True,
+    turns: bool = False,
 ) -> None:
-    """Creature `name`'s prims: SkelRoot (its root motion's translate op), Skeleton,
-    SkelAnimation (with `own_animation` its constant channels set; else empty, for a
-    reference to a shared clip's: `ecs_tentacles.export.usd_clips`), skinned Mesh,
-    material."""
+    """Creature `name`'s prims: SkelRoot (its root motion: a translate op, float3, and
+    with `turns` a rotateZ op after it), its own Skeleton, SkelAnimation (constant
+    channels set; rotations sampled by `ecs_tentacles.export.usd_joint_samples`) and
+    skinned Mesh, its material."""
+    root = pxr.UsdSkel.Root.Define(stage, f"/World/{name}")
+    root.AddTranslateOp(pxr.UsdGeom.XformOp.PrecisionFloat)  # sampled: the mantle's place
+    if turns:
+        root.AddRotateZOp()  # after the translate: turned in place, then moved
+    define_skin(pxr, stage, plan, name, name, colour, folder, own_animation=True)
+
+
+def define_skin(
+    pxr: Any,
+    stage: Any,
+    plan: BodyPlan,
+    name: str,
+    prefix: str,
+    colour: np.ndarray,
+    folder: str,
+    own_animation: bool,
+) -> tuple[str, str]:
+    """A Skeleton `<prefix>_skeleton` with its SkelAnimation `<prefix>_animation` and the
+    skinned Mesh `<prefix>_skin` bound to it, under creature `name`'s SkelRoot, in its
+    material. With `own_animation` the animation's constant channels are set; else it is
+    left empty, for a reference to a shared clip's (`ecs_tentacles.export.usd_clips`).
+    Returns the paths of the skeleton and the skin."""
     Gf, Sdf, UsdGeom, UsdSkel = pxr.Gf, pxr.Sdf, pxr.UsdGeom, pxr.UsdSkel
     arrays = plan.arrays
     base = f"/World/{name}"
-    UsdSkel.Root.Define(stage, base).AddTranslateOp()  # double3, sampled: the root's motion
-    skel = UsdSkel.Skeleton.Define(stage, f"{base}/{part(name, 'skeleton')}")
+    skel = UsdSkel.Skeleton.Define(stage, f"{base}/{part(prefix, 'skeleton')}")
     skel.CreateJointsAttr(arrays["joints"])
     skel.CreateJointNamesAttr(arrays["joint_names"])
     skel.CreateBindTransformsAttr(arrays["bind"])
     skel.CreateRestTransformsAttr(arrays["rest"])
 
-    anim = UsdSkel.Animation.Define(stage, f"{skel.GetPath()}/{part(name, 'animation')}")
+    anim = UsdSkel.Animation.Define(stage, f"{skel.GetPath()}/{part(prefix, 'animation')}")
     if own_animation:  # a local opinion would hide a referenced clip's samples
         anim.CreateJointsAttr(arrays["joints"])
         anim.CreateTranslationsAttr(arrays["translations"])
@@ -133,7 +155,7 @@ def define_creature(
     binding = UsdSkel.BindingAPI.Apply(skel.GetPrim())
     binding.CreateAnimationSourceRel().SetTargets([anim.GetPath()])
 
-    skin = UsdGeom.Mesh.Define(stage, f"{base}/{part(name, 'skin')}")
+    skin = UsdGeom.Mesh.Define(stage, f"{base}/{part(prefix, 'skin')}")
     skin.CreateSubdivisionSchemeAttr(UsdGeom.Tokens.none)
     skin.CreatePointsAttr(arrays["points"])
     skin.CreateFaceVertexCountsAttr(arrays["counts"])
@@ -153,3 +175,4 @@ def define_creature(
     bound.CreateGeomBindTransformAttr(Gf.Matrix4d(1.0))
     material = usd_material(pxr, stage, folder, name, colour)
     bind_usd(pxr, skin.GetPrim(), material, colour)
+    return str(skel.GetPath()), str(skin.GetPath())

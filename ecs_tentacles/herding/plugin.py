@@ -1,11 +1,14 @@
 """`HerdingPlugin`: the herding game as a plugin (`"plugins": {"herding": {}}`).
 
-Scene key `game` (`ecs_tentacles.herding.schema`); resource `HerdingGame`
+Game mode "herding" (the scene's `game`, whose keys are `ecs_tentacles.herding.schema`'s;
+the `game` layer owns the key); resource `HerdingGame`
 (`ecs_tentacles.herding.game`); systems `Predator`, `Herd` and `Referee`
 (`systems/herding/`: `Herd` makes the creatures flee the predator and graze as a
-flock, so no flee plugin is needed). It needs locomotion.
+flock, so no flee plugin is needed). It needs locomotion and the game layer.
 
 What it adds to the registries in `build`:
+- `GameModes` (`ecs_tentacles.game.modes`): the mode "herding", its rules' schema and
+  checks, and its result (which ends `run` and `play --headless` once won or lost);
 - `StaticGeometry` (`ecs_tentacles.physics.model`): the pen's fence, solid to the
   creatures (`ecs_tentacles.herding.fence`);
 - `Dangers` (`ecs_tentacles.behaviour`): the predator, so everything that fears
@@ -27,8 +30,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ecs_tentacles.behaviour import Dangers, DangerSource
+from ecs_tentacles.game.modes import GameMode, GameModes, GameResult
 from ecs_tentacles.herding.game import HerdingGame
-from ecs_tentacles.herding.schema import GAME, game_problems
+from ecs_tentacles.herding.schema import GAME, game_problems, plugin_problems
 from ecs_tentacles.plugin import Plugin
 
 if TYPE_CHECKING:
@@ -40,11 +44,10 @@ if TYPE_CHECKING:
 class HerdingPlugin(Plugin):
     name = "herding"
     description = "the herding game: drive creatures into a pen with a predator"
-    requires = ("locomotion",)
-    scene_schema = {"game": GAME}
+    requires = ("locomotion", "game")
 
     def problems(self, scene: Mapping[str, Any]) -> list[tuple[tuple[str | int, ...], str]]:
-        return game_problems(scene)
+        return plugin_problems(scene)
 
     def resources(self, world: Host) -> list[object]:
         scene = world.scene or {}
@@ -74,6 +77,7 @@ class HerdingPlugin(Plugin):
         from ecs_tentacles.render.registries import FramedPoints, Lines, Panels, Spheres
         from ecs_tentacles.take.registries import TakeTracks
 
+        app.add(GameModes, GameMode("herding", GAME, _result, game_problems, self.description))
         if app.world is not None:  # (a shard planner builds plugins without a world)
             app.add(StaticGeometry, fence.static_geometry(app.world))
         app.add(Dangers, DangerSource(sense=_predator_danger))
@@ -91,3 +95,10 @@ def _predator_danger(world: Host) -> tuple[np.ndarray, np.ndarray]:
     xy = world.resource(HerdingGame).predator
     z = ground_of(world).height(xy[None])[0]
     return np.array([[xy[0], xy[1], z]]), np.array([-1])
+
+
+def _result(world: Host) -> GameResult:
+    game = world.resource(HerdingGame)
+    details = {"penned": game.penned, "need": game.need, "left": round(game.left, 3)}
+    text = f"{game.penned} of {game.need} penned"
+    return GameResult(game.outcome, game.elapsed, game.level, details, text)

@@ -1,6 +1,6 @@
-"""The scene's `game` key, as the herding plugin adds it to the scene schema
-(`herding.schema.json` beside this module, read without importing the plugin when a
-scene names the key with the plugin off).
+"""The herding mode's keys of the scene's `game` (`herding.schema.json` beside this
+module, `game_mode`): the schema the game layer checks a `"mode": "herding"` level
+against (`ecs_tentacles.game`, which owns the `game` key and adds `mode`).
 
     "game": {"mode": "herding", "level": "Open field",
              "pen": {"centre": [3.0, 0.0], "radius": 1.2},
@@ -25,16 +25,23 @@ import numpy as np
 
 from ecs_tentacles.scene.schema import fragment
 
-GAME = fragment("ecs_tentacles.herding", "herding")["scene"]["game"]
+GAME = fragment("ecs_tentacles.herding", "herding")["game_mode"]["game"]
 
 Problem = tuple[tuple[str | int, ...], str]
 
 
-def game_problems(scene: Mapping[str, Any]) -> list[Problem]:
-    """What the schema cannot say about a defaults-filled scene's `game`."""
+def plugin_problems(scene: Mapping[str, Any]) -> list[Problem]:
+    """A scene with the herding plugin on is a level: it has a `game` (its mode and the
+    mode's keys are the game layer's to check: `game_problems`)."""
     game = scene.get("game")
     if game is None:
         return [(("game",), "required when the herding plugin is on (the level's rules)")]
+    return []
+
+
+def game_problems(scene: Mapping[str, Any]) -> list[Problem]:
+    """What the schema cannot say about a herding level's `game` (defaults filled)."""
+    game = scene["game"]
     found: list[Problem] = []
     creatures = len(scene.get("creatures") or [])
     if game["need"] > creatures:

@@ -3,6 +3,7 @@ the `Navigator` that steers each creature along its route.
 
     grid = CostGrid.of(ground, reach=1.0, around=points)   # None: nothing to steer around
     waypoints = grid.route(start_xy, goal_xy)               # (k, 2), ending at the goal
+    survey = Survey.of(ground, points); survey.grid(1.0)     # the same, the ground once
     world.resource(Navigator).waypoints(row)                # a creature's planned path
 
 The grid covers the ground's extent (the heightfield, or the obstacles and `around`
@@ -14,7 +15,11 @@ creature's `reach` (the footprints inflated by the reach, so tentacles fit past
 unless there is no other way), and with the slope (`SLOPE_COST` per unit of
 tan(slope); steeper than `MAX_SLOPE` is impassable). Routes are scikit-image's minimum-cost paths
 (`MCP_Geometric`, 8-connected), pulled tight: a waypoint is kept only where the
-straight line to the next one would cross an impassable cell.
+straight line to the next one would cross an impassable cell. The ground's part (its
+walls, the room beside them, its slopes: `Survey`) is made once; each creature plans on
+the grid of its own reach, so its route does not depend on which other creatures share
+its world (a shard of a bake plans as the whole crowd does); the last `KEPT_GRIDS`
+grids are kept (a grid from the survey is a few array operations, a route far more).
 """
 
 from __future__ import annotations
@@ -42,22 +47,24 @@ MAX_CELLS = 1_000_000  # 100 m x 100 m at 10 cm; larger extents get coarser cell
 WAYPOINT_RADIUS = 0.35  # metres: a waypoint this close is passed
 STUCK_SECONDS = 8.0  # no progress toward a waypoint this long: plan again
 PROGRESS = 0.1  # metres closer that count as progress
+KEPT_GRIDS = 16  # cost grids kept, one a reach (a crowd of one body plan needs one)
 
 
 @dataclass
-class CostGrid:
-    """Costs (rows along y, columns along x) of `cell` m cells from `origin` (x, y)."""
+class Survey:
+    """What every creature's cost grid shares: `room` (metres from each cell to the
+    nearest wall's foot) and `slope` (tan of the slope, 0 on walls) of `cell` m cells
+    from `origin` (x, y), rows along y."""
 
     origin: np.ndarray
     cell: float
-    costs: np.ndarray  # inf where impassable
+    room: np.ndarray
+    slope: np.ndarray
 
     @classmethod
-    def of(
-        cls, ground: Ground, reach: float, around: np.ndarray, body: float = BODY
-    ) -> CostGrid | None:
-        """The grid for creatures of `reach` m whose bodies need `body` m of room; None
-        when the ground has no obstacles."""
+    def of(cls, ground: Ground, around: np.ndarray) -> Survey | None:
+        """The ground's survey over its extent (or the obstacles' and the `around`
+        points' with a margin); None when the ground has no obstacles."""
         if not ground.has_obstacles:
             return None
         from scipy.ndimage import distance_transform_edt
@@ -80,10 +87,33 @@ class CostGrid:
         gy_, gx_ = np.gradient(top, cell)
         slope = np.hypot(gx_, gy_)
         slope[wall] = 0.0
+        return cls(low, cell, room, slope)
+
+    def grid(self, reach: float, body: float = BODY) -> CostGrid:
+        """The grid for creatures of `reach` m whose bodies need `body` m of room."""
+        room, slope = self.room, self.slope
         costs = 1.0 + SLOPE_COST * slope
         costs += NEAR_COST * np.clip((reach - room) / max(reach, 1e-9), 0.0, 1.0)
         costs[(room < body) | (slope > MAX_SLOPE)] = np.inf
-        return cls(low, cell, costs)
+        return CostGrid(self.origin, self.cell, costs)
+
+
+@dataclass
+class CostGrid:
+    """Costs (rows along y, columns along x) of `cell` m cells from `origin` (x, y)."""
+
+    origin: np.ndarray
+    cell: float
+    costs: np.ndarray  # inf where impassable
+
+    @classmethod
+    def of(
+        cls, ground: Ground, reach: float, around: np.ndarray, body: float = BODY
+    ) -> CostGrid | None:
+        """The grid for creatures of `reach` m whose bodies need `body` m of room; None
+        when the ground has no obstacles."""
+        survey = Survey.of(ground, around)
+        return None if survey is None else survey.grid(reach, body)
 
     def index(self, xy: np.ndarray) -> tuple[int, int]:
         """(row, column) of the cell holding point `xy`, clipped to the grid."""
@@ -163,7 +193,7 @@ class Navigator:
     On a ground without obstacles every creature steers straight at its current goal,
     as the thesis does. With obstacles, a creature whose `navigate` is on (the scene's
     `navigation`, default true) gets a route when its goal changes (`CostGrid`, made
-    at the first frame for the largest creature reach); it steers at each waypoint in
+    at the first frame, for the creature's own reach); it steers at each waypoint in
     turn until within `WAYPOINT_RADIUS`, then at the goal. A creature that gets no
     closer to its waypoint for `STUCK_SECONDS` is re-planned from where it is.
     The tentacle_selection system calls `steer` first thing each frame.
@@ -177,7 +207,8 @@ class Navigator:
         self.best = np.zeros(0)  # closest to the current waypoint so far
         self.since = np.zeros(0)  # when `best` last improved
         self.target = np.zeros((0, 3))  # each route's next waypoint (NaN: none), for arrays
-        self.grid: CostGrid | None = None
+        self.survey: Survey | None = None
+        self.grids: dict[float, CostGrid] = {}  # by reach, the last KEPT_GRIDS made
         self._ground: Ground | None = None
         self.plans = 0  # routes planned so far (first plans and re-plans)
 
@@ -253,20 +284,33 @@ class Navigator:
         self.best = np.full(n, np.inf)
         self.since = np.zeros(n)
         self.target = np.full((n, 3), np.nan)
-        longest = np.zeros(n)
-        np.maximum.at(longest, world.tentacles.creature_row, world.tentacles.length)
-        reach = float((world.creatures.mantle_radius + longest).max())
         g = world.resource(LocomotionStores).creatures
         points = [world.transforms.pos[world.creatures.mantle_row, :2], g.goal[:, :2]]
-        self.grid = CostGrid.of(ground, reach, np.vstack(points))
+        self.survey = Survey.of(ground, np.vstack(points))
+        self.grids = {}
+
+    def grid_for(self, world: Host, row: int) -> CostGrid | None:
+        """The cost grid creature `row` plans on: its reach's (its mantle's radius and
+        longest tentacle)."""
+        if self.survey is None:
+            return None
+        lengths = world.tentacles.length[world.tentacles.creature_row == row]
+        reach = float(world.creatures.mantle_radius[row]) + float(lengths.max(initial=0.0))
+        grid = self.grids.get(reach)
+        if grid is None:
+            if len(self.grids) >= KEPT_GRIDS:
+                del self.grids[next(iter(self.grids))]  # the oldest
+            grid = self.grids[reach] = self.survey.grid(reach)
+        return grid
 
     def _plan(self, world: Host, g: Any, row: int, mantle: np.ndarray) -> None:
         self.planned[row] = g.goal[row]
         self._drop(row)
         self._reset_progress(world, row)
-        if self.grid is None or self.grid.clear_line(mantle[:2], g.goal[row, :2]):
+        grid = self.grid_for(world, row)
+        if grid is None or grid.clear_line(mantle[:2], g.goal[row, :2]):
             return  # the goal is in plain sight
-        route = self.grid.route(mantle[:2], g.goal[row, :2])
+        route = grid.route(mantle[:2], g.goal[row, :2])
         self.plans += 1
         if route is None or len(route) < 2:
             return  # nowhere to go around: straight at the goal, as without navigation

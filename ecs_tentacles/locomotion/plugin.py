@@ -43,7 +43,7 @@ from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.render.registries import (
     Clicks,
     FramedPoints,
-    Lines,
+    OverlayLines,
     Panels,
     UndoState,
     UndoStates,
@@ -187,7 +187,7 @@ class LocomotionPlugin(Plugin):
         app.add(MeetingReaches, self._meeting_reach)
         app.add(RunSummaries, self._run_summary)
         app.add(TakeTracks, self._take_tracks)
-        app.add(Lines, self._lines)
+        app.add(OverlayLines, self._lines)  # the editor's: none in the clean view
         app.add(FramedPoints, self._framed_points)
         app.add(Panels, self._panels)
         app.add(Clicks, self._click)

@@ -5,7 +5,8 @@ carry the release thresholds). Systems: suckers (stage act). The sucker bodies a
 their MuJoCo constraints are core (every creature has them); without this plugin they
 stay released unless a script attaches them (`ecs_tentacles.locomotion.grip`:
 `attach(world, sucker)`, `release(world, sucker)`, `sucker_points(world)`). Render hook:
-each attached sucker as a small yellow sphere at its anchor.
+each attached sucker as a small yellow sphere at its anchor (an editing aid: not in the
+clean view).
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ecs_tentacles.plugin import Plugin
-from ecs_tentacles.render.registries import Marker, Spheres
+from ecs_tentacles.render.registries import Marker, OverlaySpheres
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
@@ -38,7 +39,7 @@ class SuckersPlugin(Plugin):
 
     def build(self, app: App) -> None:
         """Its drawing, HUD sections and clicks (`ecs_tentacles.render.registries`)."""
-        app.add(Spheres, self._spheres)
+        app.add(OverlaySpheres, self._spheres)  # an editing aid: none in the clean view
 
     def _spheres(self, world: Host) -> list[Marker]:
         suckers = world.suckers

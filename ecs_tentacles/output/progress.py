@@ -26,14 +26,17 @@ def step_frames(
     progress: bool = True,
     desc: str | None = None,
     on_steps: Callable[[int], None] | None = None,
-) -> None:
-    """Run `frames` frames of `world`, in chunks of about a tenth of a simulated second.
+    until: Callable[[], bool] | None = None,
+) -> int:
+    """Run `frames` frames of `world`, in chunks of about a tenth of a simulated second;
+    the frames run.
 
     With `progress`, a tqdm bar (frames, rate, ETA; labelled `desc`) goes to stderr when
     stderr is a terminal, and is cleared at the end. `on_steps(n)` is told after every
-    chunk of `n` frames.
+    chunk of `n` frames. With `until`, it is asked after every frame and the run stops
+    early once it says True (a game won or lost).
     """
-    chunk = max(1, round(world.settings.fps / 10))
+    chunk = 1 if until is not None else max(1, round(world.settings.fps / 10))
     with tqdm(
         total=frames,
         unit="frame",
@@ -50,6 +53,9 @@ def step_frames(
             bar.update(n)
             if on_steps is not None:
                 on_steps(n)
+            if until is not None and until():
+                break
+    return done
 
 
 def bar(total: int, desc: str, unit: str, *, progress: bool = True) -> tqdm[Any]:

@@ -124,6 +124,9 @@ class Batch:
         # uniform crowd): `sync` then copies instead of scattering, 6x faster at 10,000
         self._span: slice | None = None
         self._span_of: np.ndarray | None = None  # the body_rows the span was found for
+        # rows whose poses the replay wrote into the Transform store this frame as well
+        # (`store_rows`): the next `sync` copies the others only, and forgets it
+        self.shown: np.ndarray | None = None
 
     def __len__(self) -> int:
         return len(self.members)
@@ -308,7 +311,13 @@ class Batch:
         """Every row's body poses into the Transform store (one scatter per field, or one
         copy when the rows are consecutive)."""
         span = self.body_span()
+        shown, self.shown = self.shown, None
         if span is not None:
+            if shown is not None and len(shown) == len(self.members):
+                others = np.flatnonzero(~shown)  # the replayed rows are there already
+                pos, quat = self.store_rows(transforms)
+                pos[others], quat[others] = self.xpos[others], self.xquat[others]
+                return
             transforms.pos[span] = self.xpos.reshape(-1, 3)
             transforms.quat[span] = self.xquat.reshape(-1, 4)
             return
@@ -319,6 +328,16 @@ class Batch:
         else:
             transforms.pos[self.body_rows] = self.xpos
             transforms.quat[self.body_rows] = self.xquat
+
+    def store_rows(self, transforms: TransformStore) -> tuple[np.ndarray, np.ndarray]:
+        """The Transform store's pos and quat of this batch's bodies as (rows, bodies, 3)
+        and (rows, bodies, 4) views, like `xpos` and `xquat` (only when `body_span` is
+        a slice: a uniform crowd's batch)."""
+        span = self.body_span()
+        if span is None:
+            raise ValueError("the batch's bodies are not consecutive rows of the store")
+        shape = self.xpos.shape[:2]
+        return transforms.pos[span].reshape(*shape, 3), transforms.quat[span].reshape(*shape, 4)
 
     def body_span(self) -> slice | None:
         """`body_rows` (rows, bodies) as one slice of store rows when they are consecutive

@@ -82,6 +82,25 @@ def fastest_moves(
 
 
 @njit(cache=True, nogil=True)
+def copy_bodies(
+    pos: np.ndarray,
+    previous: np.ndarray,
+    rows: np.ndarray,
+    start: np.ndarray,
+    count: np.ndarray,
+    who: np.ndarray,
+) -> None:
+    """`HealthCheck._remember`: for each creature c of `who`, its bodies' positions (store
+    rows `rows[start[c]:start[c] + count[c]]`) from `pos` into `previous`."""
+    for k in range(len(who)):
+        c = who[k]
+        for i in range(start[c], start[c] + count[c]):
+            row = rows[i]
+            for j in range(3):
+                previous[row, j] = pos[row, j]
+
+
+@njit(cache=True, nogil=True)
 def row_faults(
     members: np.ndarray,
     active: np.ndarray,

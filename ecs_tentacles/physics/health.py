@@ -34,6 +34,7 @@ import numpy as np
 from ecs_tentacles.events import CreatureFrozen, CreatureRecovered, SuckerReleased
 from ecs_tentacles.numeric.optional_kernels import OptionalKernels
 from ecs_tentacles.numeric.rows import run_slice, without_row
+from ecs_tentacles.physics.tiers import KINEMATIC
 
 if TYPE_CHECKING:
     from ecs_tentacles.physics.host import PhysicsHost
@@ -223,7 +224,29 @@ class HealthCheck:
             batch.errors.clear()
         for index, cause in causes.items():
             self._recover(world, index, cause, physics_time)
-        self.previous[:] = pos
+        self._remember(pos)
+
+    def _remember(self, pos: np.ndarray) -> None:
+        """This frame's poses as the next check's `previous`, but a replayed (KINEMATIC)
+        creature's: it is never checked, and leaves the tier only through
+        `PhysicsBackend.place_joints`, whose `restart` sets its rows (10,000 creatures'
+        bodies were a 19 MB copy a frame)."""
+        roster = self.roster
+        kept = roster.tier != KINEMATIC
+        if kept.all():
+            self.previous[:] = pos
+            return
+        who = np.flatnonzero(kept)
+        if not len(who):
+            return
+        fast = KERNELS.get()
+        if fast is not None:  # the same copies, without the index arrays
+            fast.copy_bodies(pos, self.previous, self.rows, self.start, self.count, who)
+            return
+        count = self.count[who]
+        first = np.repeat(self.start[who] - (np.cumsum(count) - count), count)
+        rows = self.rows[first + np.arange(count.sum())]
+        self.previous[rows] = pos[rows]
 
     def _fastest(self, pos: np.ndarray, active: np.ndarray) -> np.ndarray:
         """Per creature, its fastest body's move since last frame (m; 0 if not stepped)."""

@@ -2,8 +2,9 @@
 
 Each creature's model holds a pool of kinematic (mocap) capsules and cylinders
 (`ecs_tentacles.physics.model`). Before each frame's step, every creature near
-another gets proxies, sized and posed like the other creature's bodies as they were
-at the end of the last frame (poses into its state row, sizes into its batch's
+another gets proxies (a replayed, KINEMATIC, creature is not stepped and gets none),
+sized and posed like the other creature's bodies as they were at the end of the last
+frame (poses into its state row, sizes into its batch's
 overlay); MuJoCo then pushes the creature out of them. Both creatures see each other
 this way, so they push each other apart. Far from everyone, a creature's proxies stay
 parked out of reach.
@@ -24,6 +25,7 @@ import numpy as np
 from ecs_tentacles.numeric.optional_kernels import OptionalKernels
 from ecs_tentacles.physics.model import PROXY_CAPSULES, PROXY_CYLINDERS, PROXY_PARKED
 from ecs_tentacles.physics.pairs import NearPairCache
+from ecs_tentacles.physics.tiers import KINEMATIC
 
 if TYPE_CHECKING:
     from ecs_tentacles.physics.batch import Batch
@@ -303,6 +305,9 @@ class ContactProxies:
     ) -> None:
         roster = self.roster
         a, b = self._pairs(centre, radius, MARGIN)
+        stepped = roster.tier[a] != KINEMATIC  # a replayed creature is not stepped: no proxies
+        if not stepped.all():
+            a, b = a[stepped], b[stepped]
         self.gather(pos, np.concatenate([a, b]))
         who, body, slot = self._assign(a, b, pos, centre, radius) if len(a) else (_NONE,) * 3
         if ready is not None:

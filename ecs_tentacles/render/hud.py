@@ -62,6 +62,8 @@ class Hud:
         # all folded, UNSET until the first frame picks the first that starts open
         self.open: str | None = UNSET
         self.name_labels = False  # creatures' names over them (even with the panel hidden)
+        # the clean view: no selected creature's name, no panel's editing windows (timeline)
+        self.clean = False
         self.label_at: Callable[[], list[tuple[str, float, float]]] = list  # (text, x, y)
         # the selected creature's name over it, while the panel shows (labels off)
         self.selection_label: Callable[[], list[tuple[str, float, float]]] = list
@@ -133,7 +135,7 @@ class Hud:
         gui.begin_frame()
         if self.name_labels:
             self._name_labels(self.label_at())
-        elif self.visible:
+        elif self.visible and not self.clean:  # the selection is the editor's
             self._name_labels(self.selection_label())
         if self.band is not None:
             self._band(*self.band)
@@ -175,7 +177,8 @@ class Hud:
         for window in self.windows:
             window(gui)
         for panel in self.panels:
-            panel.windows(gui)
+            if not (self.clean and panel.overlay_windows):
+                panel.windows(gui)
 
     def _band(self, x0: float, y0: float, x1: float, y1: float) -> None:
         """The rectangle a drag selects in (pyglet pixels), outlined and tinted."""

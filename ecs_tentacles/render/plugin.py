@@ -4,7 +4,8 @@ Systems: render (stage output). Other plugins draw, add HUD sections and take cl
 through the render layer's registries (`Spheres`, `Lines`, `Draws`, `FramedPoints`,
 `Panels`, `Clicks`, `UndoStates`: `ecs_tentacles.render.registries`), which the
 renderer, HUD and sandbox call; none of them names a feature. Its own spheres: each
-creature's physics tier while the renderer's `show_tiers` is on (`render.tiers`).
+creature's physics tier while the renderer's `show_tiers` is on (`render.tiers`; a
+debugging aid, not in the clean view).
 """
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 from ecs_tentacles.plugin import Plugin
-from ecs_tentacles.render.registries import Marker, Spheres
+from ecs_tentacles.render.registries import Marker, OverlaySpheres
 from ecs_tentacles.render.tiers import tier_markers
 from ecs_tentacles.system import System
 
@@ -39,7 +40,7 @@ class RenderPlugin(Plugin):
 
     def build(self, app: App) -> None:
         """Its drawing, HUD sections and clicks (`ecs_tentacles.render.registries`)."""
-        app.add(Spheres, self._spheres)
+        app.add(OverlaySpheres, self._spheres)
 
     def _spheres(self, world: Host) -> list[Marker]:
         return tier_markers(self.renderer) if self.renderer.show_tiers else []

@@ -5,15 +5,20 @@ The generic renderer, HUD and mouse handling (`ecs_tentacles.render`) name no fe
 plugins add entries in `build(app)` (`app.add(Spheres, entry)`), and the layer calls
 every entry, in plugin order:
 
-- `Spheres`: `entry(world)` -> `Marker`s: instanced spheres (suckers, threats, tiers);
+- `Spheres`: `entry(world)` -> `Marker`s: instanced spheres (threats, a game's markers);
 - `Lines`: `entry(world, view)` -> a list of line-list vertex arrays (2n, 7: xyz rgba),
-  joined into the renderer's one line batch (goal rings and paths, fur control markers);
+  joined into the renderer's one line batch (a game's pen and reach rings, fur control
+  markers, which draw only while `view.overlays`);
+- `OverlaySpheres`, `OverlayLines`: the same, for the editor's aids (attached suckers,
+  physics tiers; goal rings and paths): drawn except in the clean view (`view.clean`:
+  a game, `play --clean`, a video), as the selection rings are;
 - `Draws`: `entry(world, view)` -> draw calls made: anything else, drawn with the
   plugin's own GL objects, made lazily inside the entry and kept in `view.state`
   (fur's ribbons);
 - `FramedPoints`: `entry(world)` -> points (n, 3) that "frame all" keeps in view, or
   None (goals);
-- `Panels`: `entry(sandbox)` -> `Panel`s: HUD sections, their windows and mouse grabs,
+- `Panels`: `entry(sandbox)` -> `Panel`s: HUD sections, their windows (a panel's with
+  `overlay_windows` set, the fur timeline, not in the clean view) and mouse grabs,
   made once per sandbox and kept across rebuilds and resets; `sandbox` is a
   `SandboxView`, what a panel may use of the sandbox;
 - `Clicks`: `entry(world, click)` -> True when it took the click in the 3D view
@@ -65,7 +70,10 @@ class RenderView:
     `pixel` (metres one pixel spans at the camera's target), `per_metre` (what one
     pixel spans 1 m from the eye, so `per_metre * distance` at any distance; 0: not
     known): the camera; `overlays`:
-    editing aids (the fur controls' markers) are wanted (the sandbox's HUD is showing);
+    editing aids (the fur controls' markers) are wanted (the sandbox's HUD is showing,
+    not the clean view); `clean`: the clean view, a picture for showing (a game, `play
+    --clean`, a video): the editor's aids are not drawn (`OverlaySpheres`, `OverlayLines`,
+    the selection rings; `overlays` is False);
     `state`: objects plugins keep for as long as the renderer lives, across worlds
     (their GL buffers and display settings), by a key starting with the plugin's name;
     `selected`: the creature the sandbox has selected (None: none), the last picked of
@@ -82,6 +90,7 @@ class RenderView:
     pixel: float = 0.0
     per_metre: float = 0.0
     overlays: bool = False
+    clean: bool = False
     state: dict[str, Any] = field(default_factory=dict)
     selected: int | None = None  # the sandbox's selected creature (an entity), if any
     selection: tuple[int, ...] = ()  # every selected creature
@@ -131,6 +140,7 @@ class Panel:
     title: str = ""
     order: int = 10
     closed: bool = False
+    overlay_windows: bool = False  # its `windows` are editing aids: none in the clean view
 
     def draw(self, gui: Any) -> None:
         """The section's widgets (called while it is open)."""
@@ -166,6 +176,14 @@ class Spheres(Registry[Callable[["Host"], list[Marker]]]):
 
 class Lines(Registry[Callable[["Host", RenderView], list[np.ndarray]]]):
     """Line-list vertices to join into the frame's line batch."""
+
+
+class OverlaySpheres(Registry[Callable[["Host"], list[Marker]]]):
+    """Instanced spheres that are editing aids (none in the clean view)."""
+
+
+class OverlayLines(Registry[Callable[["Host", RenderView], list[np.ndarray]]]):
+    """Line-list vertices that are editing aids (none in the clean view)."""
 
 
 class Draws(Registry[Callable[["Host", RenderView], int]]):

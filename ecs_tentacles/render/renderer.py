@@ -45,7 +45,14 @@ from ecs_tentacles.render.horizon import HORIZON, fog_range
 from ecs_tentacles.render.instances import CreatureStatic, creature_links, link_instances
 from ecs_tentacles.render.meshes import CAPSULE_LODS, CYLINDER_LOD, SPHERE_LOD
 from ecs_tentacles.render.outlines import outlined_ribbons
-from ecs_tentacles.render.registries import Draws, FramedPoints, RenderView, Spheres
+from ecs_tentacles.render.registries import (
+    Draws,
+    FramedPoints,
+    OverlayLines,
+    OverlaySpheres,
+    RenderView,
+    Spheres,
+)
 from ecs_tentacles.render.registries import Lines as LineEntries
 from ecs_tentacles.render.rings import CIRCLE, draped
 from ecs_tentacles.render.scenery import Scenery, set_fog
@@ -93,6 +100,8 @@ class Renderer:
         self.draw_calls = 0
         self.extra_lines: list[Callable[[World], np.ndarray]] = []  # -> (2n, 7) segments
         self.overlays = False  # editing aids wanted (the sandbox sets it while its HUD shows)
+        # the clean view: none of the editor's aids (overlay entries, selection rings)
+        self.clean = False
         self.show_tiers = False  # a marker per creature coloured by physics tier (render.tiers)
         self.state: dict[str, Any] = {}  # what plugins keep here (GL objects), across worlds
         self.palette = "natural"  # the creatures' colours (`ecs_tentacles.skin.colours`)
@@ -287,7 +296,8 @@ class Renderer:
             light=LIGHT,
             pixel=float(pixel),
             per_metre=camera.per_metre,
-            overlays=self.overlays,
+            overlays=self.overlays and not self.clean,
+            clean=self.clean,
             selected=self.selected,
             selection=self.selection,
             state=self.state,
@@ -296,7 +306,10 @@ class Renderer:
 
     def _sphere_instances(self) -> np.ndarray:
         """The plugins' spheres (attached suckers, threats): one instanced batch."""
-        markers = [m for spheres in self.world.registry(Spheres) for m in spheres(self.world)]
+        entries = [*self.world.registry(Spheres)]
+        if not self.clean:
+            entries += self.world.registry(OverlaySpheres)
+        markers = [m for spheres in entries for m in spheres(self.world)]
         count = sum(len(m.positions) for m in markers)
         out = np.zeros((count, INSTANCE_FLOATS), np.float32)
         out[:, 3] = 1.0
@@ -310,13 +323,17 @@ class Renderer:
         return out
 
     def _line_vertices(self, pos: np.ndarray) -> np.ndarray:
-        """The plugins' line segments, a ring round each selected creature, `extra_lines`."""
+        """The plugins' line segments, a ring round each selected creature, `extra_lines`
+        (in the clean view, the `Lines` entries' and `extra_lines` only)."""
         view = self.render_view
         segments = [np.zeros((0, 7))]
-        for lines in self.world.registry(LineEntries):
+        entries = [*self.world.registry(LineEntries)]
+        if not self.clean:
+            entries += self.world.registry(OverlayLines)
+        for lines in entries:
             segments += lines(self.world, view)
         chosen = self.selection or ((self.selected,) if self.selected is not None else ())
-        if chosen:  # one ring round each, in one pass
+        if chosen and not self.clean:  # one ring round each, in one pass
             drawn = [self._index_of[e] for e in chosen if e in self._index_of]
             mantles = pos[self._mantle_rows[drawn]]
             centres = np.column_stack([mantles[:, :2], np.zeros(len(drawn))])
@@ -350,7 +367,8 @@ class Renderer:
         view_projection = self.camera.view_projection()
         eye = tuple(self.camera.eye.astype(np.float32))
         fog = fog_range(self.camera.distance)
-        calls = self.scenery.draw(ground_of(self.world), view_projection, eye, LIGHT, fog)
+        ground = ground_of(self.world)
+        calls = self.scenery.draw(ground, view_projection, eye, LIGHT, fog, grid=not self.clean)
         # the ground is sent to be rasterised (software GL's threads fill it while this
         # one fills the creatures' arrays: about 4 ms less of a crowd's 50 ms frame)
         gl.glFlush()

@@ -65,7 +65,7 @@ from ecs_tentacles.skin.colours import PALETTES
 from ecs_tentacles.world import World
 
 if TYPE_CHECKING:
-    pass
+    from collections.abc import Callable
 
 FRAME_EASE = 0.08  # share of the way to the new framing a video frame moves (frame-all)
 DISPLAY_HZ = 60
@@ -74,6 +74,11 @@ DISPLAY_HZ = 60
 def scene_palette(scene: dict[str, Any] | None) -> str:
     """The creature palette a scene asks for (`render.palette`), natural if none."""
     return str(((scene or {}).get("render") or {}).get("palette", "natural"))
+
+
+def is_game(scene: dict[str, Any] | None) -> bool:
+    """Whether a validated scene is a game's (it has a `game` key): its view starts clean."""
+    return scene is not None and bool(scene.get("game"))
 
 
 class Sandbox(SandboxPicture):
@@ -93,12 +98,14 @@ class Sandbox(SandboxPicture):
         focus: tuple[float, float, float] | None = None,
         threads: int | None = None,
         palette: str | None = None,
+        clean: bool | None = None,
     ):
         """`lod` turns level of detail on or off over the scene's (None: the scene's);
         `focus` (x, y, radius in m) pins the full-physics region instead of the camera's;
         `threads` step the physics (None: one per core); `palette` colours the creatures
         ("natural" or "debug": `ecs_tentacles.skin.colours`; None: the scene's `render.palette`,
-        natural if it says none)."""
+        natural if it says none); `clean` starts in the clean view, without the editor's
+        overlays (None: a game's scene, one with a `game` key, starts clean; o toggles)."""
         self.headless = headless
         self.window = pyglet.window.Window(
             width, height, caption="ecs_tentacles", visible=not headless, vsync=False
@@ -113,6 +120,8 @@ class Sandbox(SandboxPicture):
             threads=threads,
             say=lambda ok, text: self.scripts.say(ok, text),
         )
+        # the clean view (`render.registries`: a picture for showing), kept across resets
+        self.clean: bool = is_game(self.world.scene) if clean is None else clean
         self.hud = Hud(self.window, self.world, visible=hud)
         self.hud.label_at = self.creature_labels
         self.hud.selection_label = self.selected_label
@@ -166,7 +175,9 @@ class Sandbox(SandboxPicture):
         self.camera_choice = choice
 
     def _view_section(self, gui: Gui) -> None:
-        """The HUD's "View": the creatures' palette."""
+        """The HUD's "View": the clean view and the creatures' palette."""
+        _, self.clean = imgui.checkbox("clean view (o)", self.clean)
+        gui.item("clean view")
         imgui.text("colours")
         gui.item("colours")
         for name in PALETTES:
@@ -342,26 +353,33 @@ class Sandbox(SandboxPicture):
         screenshot: str | os.PathLike[str] | None = None,
         video: str | os.PathLike[str] | None = None,
         progress: bool = True,
+        until: Callable[[World], bool] | None = None,
     ) -> dict[str, Any]:
-        """Step `frames` frames off-screen, recording a video and/or a final screenshot."""
+        """Step `frames` frames off-screen, recording a video and/or a final screenshot;
+        with `until`, stop after the first frame at which `until(world)` is True (a game
+        won or lost). `frames` in the result: the frames run."""
         if video is not None:
             self.toggle_video(video)
         physics_ms = []
+        done = 0
         try:
             for _ in tqdm(
                 range(frames), unit="frame", disable=None if progress else True, leave=False
             ):
                 self.step(1)
+                done += 1
                 physics_ms.append(self.stats["physics_ms"])
                 if self.video is not None:
                     self.keep_framed(FRAME_EASE)
                     self.render()
+                if until is not None and until(self.world):
+                    break
         except BaseException:
             if self.video is not None:
                 self.video.abort()
                 self.video = None
             raise
-        result: dict[str, Any] = {"frames": frames, "sim_seconds": self.world.time}
+        result: dict[str, Any] = {"frames": done, "sim_seconds": self.world.time}
         result["tiers"] = self.world.lod.counts()  # creatures per physics tier at the end
         # a frame's physics, median over the run: at most the frame's duration keeps real time
         median = float(np.median(physics_ms))

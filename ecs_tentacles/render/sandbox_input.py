@@ -9,7 +9,8 @@ offered to the HUD's panels first (`Panel.press`: a fur marker, the director's t
 and keys too (`Panel.key`). Keys: space pause, . single step, r reset, h HUD,
 f follow, a frame all, Ctrl+A select every creature, Esc select none, Ctrl+Z /
 Ctrl+Shift+Z undo / redo, Ctrl+S save the roster, c skinned / capsules, tab next
-tentacle, F5 / F9 save / restore the state, F12 screenshot, v video.
+tentacle, F5 / F9 save / restore the state, F12 screenshot, v video, o the clean view
+(the editor's overlays hidden or shown again).
 Reads and writes only through the sandbox.
 """
 
@@ -177,6 +178,9 @@ class SandboxInput:
                   "no saved state: F5 saves one")  # fmt: skip
         elif symbol == key.F12:
             print(f"saved {sandbox.screenshot()}")
+        elif symbol == key.O:
+            sandbox.clean = not sandbox.clean
+            print(f"clean view {'on' if sandbox.clean else 'off'} (o)")
         elif symbol == key.V:
             finished = sandbox.toggle_video()
             print(f"saved {finished}" if finished else "recording video (v to stop)")

@@ -38,6 +38,7 @@ class SandboxPicture:
     window: Any
     headless: bool
     camera_choice: CameraChoice | None
+    clean: bool
 
     @property
     def world(self) -> World:
@@ -68,6 +69,7 @@ class SandboxPicture:
         session = self.session
         alpha = 1.0 if session.paused else session.accumulator / session.world.settings.dt
         self.renderer.overlays = self.hud.visible  # editing aids (fur control markers)
+        self.renderer.clean = self.hud.clean = self.clean  # none of them (o toggles)
         self.renderer.show_tiers = self.hud.show_tiers
         self.renderer.draw(alpha)
         self._update_stats()

@@ -85,15 +85,18 @@ class Scenery:
         eye: tuple[float, ...],
         light: np.ndarray,
         fog: tuple[float, float],
+        grid: bool = True,
     ) -> int:
-        """The ground as `ground` is now, then the sky; returns the draw calls. The
-        caller has the depth test on and the depth buffer cleared."""
+        """The ground as `ground` is now (with its metre grid unless `grid` is False: the
+        clean view), then the sky; returns the draw calls. The caller has the depth test
+        on and the depth buffer cleared."""
         calls = 0
         self.build(ground)  # nothing to do unless the terrain was edited
         if ground.extent is None:  # the plane's grid
             self.ground_program.use()
             set_matrix(self.ground_program, "u_view_projection", view_projection)
             self.ground_program["u_eye"] = eye
+            self.ground_program["u_grid"] = float(grid)
             set_fog(self.ground_program, fog)
             gl.glDisable(gl.GL_CULL_FACE)
             calls += self.plane.draw()
@@ -103,6 +106,7 @@ class Scenery:
             set_matrix(self.terrain_program, "u_view_projection", view_projection)
             self.terrain_program["u_light"] = tuple(light.astype(np.float32))
             self.terrain_program["u_eye"] = eye
+            self.terrain_program["u_grid"] = float(grid)
             set_fog(self.terrain_program, fog)
             for mesh in self.ground_meshes:
                 calls += mesh.draw()

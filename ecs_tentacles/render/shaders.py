@@ -98,6 +98,7 @@ GROUND_FRAGMENT = (
 #version 330 core
 in vec3 v_world;
 uniform vec3 u_eye;
+uniform float u_grid;  // 1: the metre grid drawn, 0: none (the clean view)
 out vec4 f_colour;
 // @grid
 // @fog_function
@@ -108,7 +109,7 @@ void main() {
     vec2 p = v_world.xy;
     float mottle = 0.04 * sin(p.x * 1.7 + sin(p.y * 1.3)) * sin(p.y * 2.1 + sin(p.x * 0.9));
     vec3 base = vec3(0.66, 0.59, 0.47) * (1.0 + mottle);
-    float clear = 1.0 - fog_amount(v_world);
+    float clear = (1.0 - fog_amount(v_world)) * u_grid;
     float fine = grid(p, 0.25, 1.0) * 0.06 * clear;
     float coarse = grid(p, 1.0, 1.5) * 0.18 * clear;
     vec3 colour = mix(base, base * 0.62, fine + coarse);
@@ -123,13 +124,14 @@ TERRAIN_FRAGMENT = (
     _LIT_HEAD
     + _FOG_FUNCTION
     + """// @grid
+uniform float u_grid;  // 1: the metre grid drawn, 0: none (the clean view)
 void main() {
     vec3 n = normalize(gl_FrontFacing ? v_normal : -v_normal);
     float diffuse = max(dot(n, u_light), 0.0);
     float sky = 0.5 + 0.5 * n.z;
     vec3 colour = v_colour.rgb * (0.30 + 0.25 * sky + 0.62 * diffuse);
     // a faint metre grid on the ground (scale at a glance), as on the plane
-    float clear = 1.0 - fog_amount(v_world);
+    float clear = (1.0 - fog_amount(v_world)) * u_grid;
     colour = mix(colour, colour * 0.6, grid(v_world.xy, 1.0, 1.5) * 0.35 * v_colour.a * clear);
     // @fog
 }

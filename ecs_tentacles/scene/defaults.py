@@ -84,9 +84,15 @@ def copied(data: Any) -> Any:
 
 def plugin_config(plugin: Plugin, given: object) -> dict[str, Any]:
     """A plugin's config as a scene gives it (`true`, absent or an object), defaults filled."""
-    config = copy.deepcopy(dict(given)) if isinstance(given, Mapping) else {}
-    _fill(config, plugin.config_schema, plugin.config_schema)
-    return config
+    return filled(given if isinstance(given, Mapping) else {}, plugin.config_schema)
+
+
+def filled(data: Mapping[str, Any], schema: Mapping[str, Any]) -> dict[str, Any]:
+    """A deep copy of `data` with the defaults of its own JSON Schema `schema` filled in
+    (a plugin's config, a game mode's keys)."""
+    out = copy.deepcopy(dict(data))
+    _fill(out, schema, schema)
+    return out
 
 
 def with_defaults(data: dict[str, Any], plugins: Sequence[Plugin] | None = None) -> dict[str, Any]:

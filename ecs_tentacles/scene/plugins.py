@@ -5,11 +5,13 @@ A scene turns plugins on and configures them:
     "plugins": {"wander": {"radius": 2.0}, "fur": false, "mine": {"from": "mine.py"}}
 
 Built-in plugins (`BUILTIN`) and the bundled examples (`BUNDLED`) are found by name;
-`DEFAULT_ON` are on unless a scene says `false`. Other plugins come from a file or
-module named by `from` (the scene's folder is searched first; a relative file may not
-leave it) or from the `ecs_tentacles.plugins` entry point group of an installed
-package. Those run user code, so they need `allow_systems` (`--allow-systems`).
-Nothing here imports a feature until a world uses it (targets are "module:Class").
+`DEFAULT_ON` are on unless a scene says `false`; a built-in plugin another one `requires`
+is turned on with it unless the scene names it (the `game` layer with a game mode).
+Other plugins come from a file or module named by `from` (the scene's folder is
+searched first; a relative file may not leave it) or from the `ecs_tentacles.plugins`
+entry point group of an installed package. Those run user code, so they need
+`allow_systems` (`--allow-systems`). Nothing here imports a feature until a world uses
+it (targets are "module:Class").
 """
 
 from __future__ import annotations
@@ -41,6 +43,8 @@ BUILTIN = {
     "terrain": "ecs_tentacles.terrain.plugin:TerrainPlugin",
     "director": "ecs_tentacles.director.plugin:DirectorPlugin",
     "herding": "ecs_tentacles.herding.plugin:HerdingPlugin",
+    "game": "ecs_tentacles.game.plugin:GamePlugin",
+    "race": "ecs_tentacles.race.plugin:RacePlugin",
 }
 BUNDLED = {
     "wander": "ecs_tentacles.systems.examples.wander:WanderPlugin",
@@ -246,9 +250,15 @@ def resolve(
         except (Exception, SystemExit) as exc:  # the user's plugin class failed to construct
             problems.append(f"plugins.{key}: cannot make {found.target!r}: {_one_line(exc)}")
     on = {p.key for p in plugins}
-    for plugin in plugins:
+    for plugin in list(plugins):
         for need in plugin.requires:
-            if need not in on:
+            if need in on:
+                continue
+            if need in BUILTIN and need not in choices:  # a layer it needs, on with it
+                brought = instantiate(load(need, BUILTIN[need], None), need, {}, None)
+                plugins.insert(plugins.index(plugin), brought)
+                on.add(need)
+            else:
                 problems.append(f"plugins.{plugin.key}: needs the {need!r} plugin, which is off")
     if problems and problems_out is None:
         raise PluginError("\n".join(problems))

@@ -186,6 +186,14 @@ def _schema_problems(data: object, validator: Any, prefix: JsonPath = ()) -> lis
     ]
 
 
+def schema_problems(
+    data: object, schema: Mapping[str, Any], prefix: JsonPath = ()
+) -> list[Problem]:
+    """`data` checked against the JSON Schema `schema` (the scene's validator), each
+    problem's path under `prefix` (a plugin's keys: `("game",)`)."""
+    return _schema_problems(data, StrictValidator(schema), prefix)
+
+
 def _plugin_configs(data: Mapping[str, Any], plugins: Sequence[Plugin]) -> list[Problem]:
     """Each plugin's `plugins.<name>` config against the plugin's own `config_schema`."""
     chosen = data.get("plugins", {})
@@ -197,6 +205,16 @@ def _plugin_configs(data: Mapping[str, Any], plugins: Sequence[Plugin]) -> list[
             validator = StrictValidator(plugin.config_schema)
             problems += _schema_problems(config, validator, ("plugins", plugin.key))
     return problems
+
+
+def registered_problems(scene: Mapping[str, Any], plugins: Sequence[Plugin]) -> list[Problem]:
+    """What the `SceneChecks` entries of `plugins` find in a defaults-filled `scene` (the
+    rules that depend on what the plugins registered: a game's mode)."""
+    from ecs_tentacles.scene.registries import SceneChecks, plugin_entries
+
+    registries = plugin_entries(plugins)
+    checks = registries.get(SceneChecks)
+    return [problem for check in checks for problem in check(scene, registries)]
 
 
 def validate_scene(data: object, plugins: Sequence[Plugin] | None = None) -> list[str]:
@@ -240,6 +258,7 @@ def validated(
         for plugin in plugins:
             with calling(plugin, "problems"):
                 problems += plugin.problems(full)
+        problems += registered_problems(full, plugins)
     problems = _name_plugins_that_are_off(problems, {p.name for p in plugins})
     unique = sorted(set(problems), key=_path_key)
     lines = [f"{format_path(path)}: {message}" for path, message in unique]

@@ -30,8 +30,9 @@ class KeyReport:
     sample_frames: int  # frames where any channel keeps a key (USD's time samples)
     frames: int
     creatures: int = 0  # creatures in the file (0: not counted)
-    sharing: int = 0  # of them, those bound to a shared clip animation (keys not counted)
+    sharing: int = 0  # of them, those with replayed stretches on shared clip animations
     shared: int = 0  # the shared clip animations
+    stretches: int = 0  # the replayed stretches (a skeleton each, its keys not counted)
 
     def line(self) -> str:
         """One line for the CLI: what was kept, and what reducing cost (when it did)."""
@@ -47,8 +48,9 @@ class KeyReport:
             return kept
         animations = "animation" if self.shared == 1 else "animations"
         return (
-            f"{self.sharing} of {self.creatures} creatures share {self.shared} clip {animations};"
-            f" the other {self.creatures - self.sharing}: {kept}"
+            f"{self.sharing} of {self.creatures} creatures replay {self.stretches} stretches on"
+            f" {self.shared} shared clip {animations}; their own skeletons (physical frames):"
+            f" {kept}"
         )
 
 
@@ -98,10 +100,14 @@ def interpolate_points(p: np.ndarray, keep: np.ndarray) -> np.ndarray:
 
 
 def _rdp(
-    error_of: Callable[[np.ndarray], np.ndarray], shape: tuple[int, int], tolerance: float
+    error_of: Callable[[np.ndarray], np.ndarray],
+    shape: tuple[int, int],
+    tolerance: float,
+    initial: np.ndarray | None = None,
 ) -> np.ndarray:
-    """Keep mask (F, C): endpoints, then each segment's worst sample while above tolerance."""
-    keep = np.zeros(shape, bool)
+    """Keep mask (F, C): endpoints (and `initial`), then each segment's worst sample while
+    above tolerance."""
+    keep = np.zeros(shape, bool) if initial is None else initial.copy()
     keep[0] = keep[-1] = True
     while True:
         error = error_of(keep)
@@ -118,12 +124,26 @@ def _rdp(
         keep[frame, channel] = True
 
 
-def reduce_rotations(q: np.ndarray, tolerance_deg: float) -> np.ndarray:
-    """Keep mask (F, J): the keys each joint's rotation curve needs to stay within tolerance."""
+def reduce_rotations(
+    q: np.ndarray, tolerance_deg: float, needed: np.ndarray | None = None
+) -> np.ndarray:
+    """Keep mask (F, J): the keys each joint's rotation curve needs to stay within tolerance.
+    With `needed` (F, J) only those frames count (the curve is what is shown there): the
+    first and last frame of each run of them are kept, no other frame."""
     q = np.asarray(q, dtype=np.float64)
-    return _rdp(
-        lambda keep: angle_between(interpolate_rotations(q, keep), q), q.shape[:2], tolerance_deg
-    )
+    if needed is None:
+        return _rdp(
+            lambda keep: angle_between(interpolate_rotations(q, keep), q),
+            q.shape[:2],
+            tolerance_deg,
+        )
+    ends = needed.copy()
+    ends[1:-1] &= ~(needed[:-2] & needed[2:])
+
+    def error(keep: np.ndarray) -> np.ndarray:  # the frames not needed bound no segment
+        return np.where(needed, angle_between(interpolate_rotations(q, keep | ~needed), q), 0.0)
+
+    return _rdp(error, q.shape[:2], tolerance_deg, ends) & needed
 
 
 def reduce_points(p: np.ndarray, tolerance: float) -> np.ndarray:

@@ -49,14 +49,49 @@ class JointRotations:
         world /= np.sqrt(np.einsum("...c,...c->...", world, world))[..., None]
         return world
 
-    def local(self, quat: np.ndarray) -> np.ndarray:
-        """(n, C, J, 4) local rotations (the root's: its world rotation) for the chunk's
-        frames, signs continuous with the chunk before."""
+    def local(self, quat: np.ndarray, yaw: np.ndarray | None = None) -> np.ndarray:
+        """(n, C, J, 4) local rotations (the root's: its world rotation, or with `yaw`
+        (n, C) that rotation seen from a frame turned by `yaw` radians about +z) for the
+        chunk's frames, signs continuous with the chunk before."""
         world = self.world(quat)
         local = world.copy()
         parents = self.parents[self.children]
         local[..., self.children, :] = undo(world[..., parents, :], world[..., self.children, :])
+        if yaw is not None:
+            self._turned(local, yaw)
         return self.continuous(local)
+
+    def local_at(
+        self, quat: np.ndarray, rows: np.ndarray, columns: np.ndarray, yaw: np.ndarray | None
+    ) -> np.ndarray:
+        """(K, J, 4) local rotations, as `local` makes them, of creature `columns[k]` at
+        the chunk's frame `rows[k]` only (pairs in frame order; `yaw` (K,) or None), signs
+        continuous with that creature's pair before (this chunk's or an earlier one's)."""
+        world = quat[rows[:, None], self.bodies[columns]].astype(np.float64)  # (K, J, 4)
+        world /= np.sqrt(np.einsum("...c,...c->...", world, world))[..., None]
+        local = world.copy()
+        parents = self.parents[self.children]
+        local[:, self.children] = undo(world[:, parents], world[:, self.children])
+        if yaw is not None:
+            self._turned(local, yaw)
+        if self.last is None:
+            self.last = np.zeros((len(self.bodies), self.bodies.shape[1], 4))
+        for row in np.unique(rows).tolist():  # a few frames: whole creatures at once
+            pick = np.flatnonzero(rows == row)
+            mine = columns[pick]
+            flip = np.einsum("kjc,kjc->kj", local[pick], self.last[mine]) < 0
+            local[pick] = np.where(flip[..., None], -local[pick], local[pick])
+            self.last[mine] = local[pick]
+        return local
+
+    def _turned(self, local: np.ndarray, yaw: np.ndarray) -> None:
+        """The roots' rotations in `local` (..., J, 4) seen from frames turned by `yaw`
+        (...) radians about +z, in place."""
+        half = 0.5 * np.asarray(yaw, dtype=np.float64)[..., None]
+        turn = np.zeros((*half.shape, 4))
+        turn[..., 0], turn[..., 3] = np.cos(half), np.sin(half)
+        roots = self.parents < 0
+        local[..., roots, :] = undo(turn, local[..., roots, :])
 
     def continuous(self, local: np.ndarray) -> np.ndarray:
         """`local` (n, C, J, 4) with each quaternion's sign flipped where that keeps it in

@@ -16,6 +16,7 @@ from typing import IO, Any, cast
 
 import numpy as np
 
+from ecs_tentacles.take import compact
 from ecs_tentacles.take.header import (
     CORE_DTYPES,
     MAX_COORDINATE,
@@ -158,6 +159,10 @@ def checked_header(archive: zipfile.ZipFile) -> dict[str, Any]:
         raise TakeError(str(exc)) from None
     except (UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise TakeError(f"header: not JSON ({str(exc).splitlines()[0]})") from None
+    try:
+        header = compact.unpacked(header)
+    except compact.PlanError as exc:
+        raise TakeError(str(exc)) from None
     problem = header_problem(header)
     if problem:
         raise TakeError(problem)

@@ -29,8 +29,8 @@ MAX_COORDINATE = 1e6  # metres: a position farther out is a blow-up, not a creat
 MAX_FRAMES = 1_000_000  # 4.6 hours at 60 fps: frames are bounded even with no bodies
 MAX_BODIES = 16384 * 1025  # the schema's most creatures x the bodies of its largest one
 FORMAT = "ecs_tentacles.take"
-VERSION = 2  # what is written; version 1 files (no chunks, no replay records) still read
-VERSIONS = (1, 2)
+VERSION = 3  # what is written: version 2 with bodies stored per body plan (`take.compact`)
+VERSIONS = (1, 2, 3)  # version 1: no chunks, no replay records; both still read
 CORE_DTYPES: dict[str, np.dtype[Any]] = {
     "header": np.dtype(np.uint8),
     "pos": np.dtype("<f4"),
@@ -180,7 +180,7 @@ def header_problem(header: object) -> str | None:
     from ecs_tentacles.take import chunks  # imports the tracks, as this module does
 
     if isinstance(version, bool) or version not in VERSIONS:
-        return f"header.version: this reader knows versions 1 and 2, got {version!r}"
+        return f"header.version: this reader knows versions 1 to 3, got {version!r}"
     fps: Any = header.get("fps")
     if not _is_number(fps) or not 0 < fps <= MAX_FPS:
         return f"header.fps: must be a number in (0, {MAX_FPS}], got {fps!r}"
@@ -188,14 +188,14 @@ def header_problem(header: object) -> str | None:
         return f"header.frames: must be a whole number >= 1, got {header.get('frames')!r}"
     if header["frames"] > MAX_FRAMES:
         return f"header.frames: at most {MAX_FRAMES} in a take, got {header['frames']}"
-    if version == 2:  # absent in memory: the file's writer sets it
+    if version >= 2:  # absent in memory: the file's writer sets it
         chunk = header.get("chunk_frames", 1)
         if not _is_int(chunk) or not 1 <= chunk <= MAX_FRAMES:
             return (
                 f"header.chunk_frames: must be a whole number in [1, {MAX_FRAMES}], got {chunk!r}"
             )
     elif header.get(take_replay.KEY) is not None:
-        return f"header.{take_replay.KEY}: only version 2 takes record replayed creatures"
+        return f"header.{take_replay.KEY}: version 1 takes record no replayed creatures"
     for key, check in (("scene", str), ("scene_sha256", str)):
         if not isinstance(header.get(key), check):
             return f"header.{key}: missing or not a string"
@@ -215,8 +215,8 @@ def header_problem(header: object) -> str | None:
         or take_ground.problem(header)
         or take_roster.problem(header)
         or take_replay.problem(header)
-        or (chunks.chunked_problem(header) if version == 2 else None)
-        or (chunks.quantised_problem(header) if version == 2 else None)
+        or (chunks.chunked_problem(header) if version >= 2 else None)
+        or (chunks.quantised_problem(header) if version >= 2 else None)
     )
 
 

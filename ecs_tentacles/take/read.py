@@ -114,7 +114,7 @@ def _read_archive(
     header = checked_header(archive)
     if header_only:
         return header, {}
-    if header["version"] == 2:
+    if header["version"] >= 2:
         return header, read_whole(archive, header, max_bytes)
     wanted = array_dtypes(header)
     known = {f"{name}.npy" for name in wanted}

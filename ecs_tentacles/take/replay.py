@@ -195,9 +195,12 @@ def poses(
     phase: np.ndarray,
     xy: np.ndarray,
     heading: np.ndarray,
+    rows: dict[int, np.ndarray] | None = None,
 ) -> dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]]:
     """Clip index -> (body indices (K, B), positions (K, B, 3), rotations (K, B, 4)) of
-    the creature-frames given (K each: creature index, kind, phase, place, heading)."""
+    the creature-frames given (K each: creature index, kind, phase, place, heading).
+    `rows`: clip -> each creature's `body_rows` (C, B), when the caller keeps them (a
+    recorder does, every frame); else they are worked out here, a creature at a time."""
     replay = header[KEY]
     owner = np.asarray(replay["creatures"], dtype=np.int64)[creatures]
     out = {}
@@ -207,6 +210,9 @@ def poses(
         frames = (int(entry["frames"][0]), int(entry["frames"][1]))
         ground = blend(clips[clip], frames, kind[mine].astype(np.int64), phase[mine])
         pos, quat = place(ground, xy[mine], heading[mine])
+        if rows is not None:
+            out[clip] = (rows[clip][creatures[mine]], pos, quat)
+            continue
         which, back = np.unique(creatures[mine], return_inverse=True)  # Python per creature
         table = np.array([body_rows(header["creatures"][c]) for c in which.tolist()])
         out[clip] = (table.reshape(len(which), -1)[back.reshape(-1)], pos, quat)
@@ -243,9 +249,12 @@ def fill(
         quat[frames, rows] = rot
 
 
-def blanked(header: dict[str, Any], arrays: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+def blanked(
+    header: dict[str, Any], arrays: dict[str, np.ndarray], in_place: bool = False
+) -> dict[str, np.ndarray]:
     """`arrays` (some frames of the chunked arrays) as the file stores them: the bodies
-    of every replayed creature-frame hold zeros in `pos` and `quat` (copies where any)."""
+    of every replayed creature-frame hold zeros in `pos` and `quat` (copies where any;
+    with `in_place`, zeroed where they are: a recorder's own buffers)."""
     if header.get(KEY) is None:
         return arrays
     frame, creature = np.nonzero(arrays["replay_kind"] >= 0)
@@ -258,7 +267,8 @@ def blanked(header: dict[str, Any], arrays: dict[str, np.ndarray]) -> dict[str, 
     frames = np.repeat(frame, [len(r) for r in rows])
     bodies = np.concatenate(rows)
     out = dict(arrays)
-    out["pos"], out["quat"] = arrays["pos"].copy(), arrays["quat"].copy()
+    if not in_place:
+        out["pos"], out["quat"] = arrays["pos"].copy(), arrays["quat"].copy()
     out["pos"][frames, bodies] = 0.0
     out["quat"][frames, bodies] = 0.0
     return out

@@ -1,4 +1,4 @@
-"""Reading a take a chunk of frames at a time: `open_take` (versions 1 and 2).
+"""Reading a take a chunk of frames at a time: `open_take` (versions 1 to 3).
 
     with open_take("shot.npz") as source:
         source.header, source.frames, source.fps

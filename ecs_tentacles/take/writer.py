@@ -16,7 +16,6 @@ removes it, so a stopped bake leaves neither a take nor chunks.
 from __future__ import annotations
 
 import contextlib
-import json
 import os
 import queue
 import threading
@@ -28,7 +27,7 @@ from typing import Any
 import numpy as np
 
 from ecs_tentacles.output.atomic import atomic_file
-from ecs_tentacles.take import chunks
+from ecs_tentacles.take import chunks, compact
 from ecs_tentacles.take.header import VERSION
 
 
@@ -185,7 +184,7 @@ class TakeWriter:
                   "chunk_frames": self.chunk_frames}  # fmt: skip
         if self.quantised:
             header["quantised"] = dict(self.quantised)
-        text = json.dumps(header, sort_keys=True, separators=(",", ":"))
+        text = compact.header_text(header)
         self._entry("header.npy", np.frombuffer(text.encode(), dtype=np.uint8))
         self._join()  # every entry stored (or the failure raised here)
         self._finished = True

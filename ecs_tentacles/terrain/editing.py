@@ -39,6 +39,7 @@ SHAPES = {  # a new obstacle of each shape: its keys, for a `size` of 1 m
     "box": lambda s: {"size": [s, s, 0.5 * s]},
     "cylinder": lambda s: {"radius": 0.5 * s, "height": 0.6 * s},
     "sphere": lambda s: {"radius": 0.5 * s},
+    "rock": lambda s: {"size": [s, 0.8 * s, 0.6 * s]},  # a boulder; its seed: its place
 }
 BRUSHES = ("raise", "lower", "smooth")
 PICK_DISTANCE = 0.05  # metres: a point this close to an obstacle picks it
@@ -67,9 +68,15 @@ class TerrainEditor:
         x, y = float(point[0]), float(point[1])
         base = float(ground_of(world).surface(np.array([[x, y]]))[0])
         keys = SHAPES[shape](size)
-        half = keys["size"][2] / 2 if shape == "box" else keys.get("height", 2 * keys["radius"]) / 2
-        if shape == "sphere":
+        if shape == "box":
+            half = keys["size"][2] / 2
+        elif shape == "cylinder":
+            half = keys["height"] / 2
+        elif shape == "sphere":
             half = 0.6 * keys["radius"]  # sunk a little: a boulder, not a ball on a plane
+        else:  # a rock: a third of it in the ground; each a stone of its own
+            half = 0.2 * keys["size"][2]
+            keys["seed"] = len(self._terrain(world).get("obstacles", []))
         ground = float(ground_of(world).height(np.array([[x, y]]))[0])
         z = base + half - ground  # on_ground: its z is measured from the ground under it
         obstacle = {"shape": shape, "position": [round(x, 4), round(y, 4), round(z, 4)]}

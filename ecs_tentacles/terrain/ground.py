@@ -22,6 +22,7 @@ import numpy as np
 
 from ecs_tentacles.ground import GroundMesh, Plane, StaticSpec, ground_of
 from ecs_tentacles.numeric.optional_kernels import OptionalKernels
+from ecs_tentacles.terrain.convex_pieces import ConvexPieces
 from ecs_tentacles.terrain.ground_meshes import ground_meshes
 from ecs_tentacles.terrain.heightfield import BEYOND_DROP, Heightfield
 from ecs_tentacles.terrain.shapes import Solid
@@ -87,8 +88,9 @@ class TerrainGround:
             best = (points[:, 2] - self.heightfield.height(xy)) * normal_z
         if not self.solids:
             return best
-        for k, near in self._under_bounds(points, NEAR, self._by_numpy()):
+        for k, near in self._under_bounds(points, NEAR, self._one_by_one()):
             best[near] = np.minimum(best[near], self.solids[k].signed_distance(points[near]))
+        self._pieces().lower_distances(points, NEAR, best)  # the meshes', in one pass
         fast = KERNELS.get()
         if fast is not None and self._spheres()[0].size:  # the spheres, in one pass
             fast.sphere_distances(points, *self._spheres()[1:], NEAR, best)
@@ -144,6 +146,26 @@ class TerrainGround:
             others = np.setdiff1d(np.arange(len(self.solids)), self._spheres()[0])
             object.__setattr__(self, "_others_cache", others)  # a cache, not a field
         return others
+
+    def _one_by_one(self) -> np.ndarray:
+        """The solids `distance` and `touches_obstacle` ask numpy about solid by solid:
+        `_by_numpy`'s less the meshes (`_pieces` answers for those in one pass)."""
+        cached = self.__dict__.get("_one_by_one_cache")
+        if cached is None:
+            among = self._by_numpy()
+            among = np.arange(len(self.solids)) if among is None else among
+            cached = np.array([k for k in among.tolist() if self.solids[k].kind != "mesh"])
+            cached = cached.astype(np.int64)
+            object.__setattr__(self, "_one_by_one_cache", cached)  # a cache, not a field
+        return cached
+
+    def _pieces(self) -> ConvexPieces:
+        """The mesh solids' convex pieces as arrays (made once)."""
+        cached = self.__dict__.get("_pieces_cache")
+        if cached is None:
+            cached = ConvexPieces.of(self.solids)
+            object.__setattr__(self, "_pieces_cache", cached)  # a cache, not a field
+        return cached
 
     def _positions(self) -> np.ndarray:
         """(k, 3) the solids' centres (made once)."""
@@ -300,10 +322,11 @@ class TerrainGround:
         if fast is not None and self._spheres()[0].size:  # the spheres, in one pass
             fast.sphere_touches(centres, reach, *self._spheres()[1:], near)
         # each ball its own pad
-        for k, rows in self._under_bounds(centres, reach, self._by_numpy()):
+        for k, rows in self._under_bounds(centres, reach, self._one_by_one()):
             rows = rows[~near[rows]]
             if len(rows):
                 near[rows] = self.solids[k].signed_distance(centres[rows]) <= reach[rows]
+        self._pieces().touch(centres, reach, near)  # the meshes', in one pass
         return near
 
     def obstacle_spans(self) -> tuple[np.ndarray, np.ndarray]:

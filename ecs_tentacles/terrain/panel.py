@@ -4,7 +4,8 @@ heightfield, save the scene.
 A tool is chosen with its radio button; with one on, a left press in the 3D view acts
 where the cursor's ray meets the ground (or an obstacle) instead of selecting:
 
-* box / cylinder / sphere: a new obstacle of the `size` slider, resting there;
+* box / cylinder / sphere / rock: a new obstacle of the `size` slider, resting there
+  (a rock: a noise-displaced boulder, a third of it in the ground);
 * move: press on an obstacle, drag, release: it rests where the mouse let go;
 * delete: the obstacle under the cursor goes;
 * raise / lower / smooth: the brush (radius, strength) acts under the cursor, again

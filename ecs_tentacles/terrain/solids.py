@@ -1,6 +1,9 @@
 """A scene's `terrain.obstacles` -> `Solid`s (static shapes in every physics model).
 
-Boxes, cylinders and spheres are MuJoCo primitives. A mesh (.obj, .stl, .glb next to
+Boxes, cylinders and spheres are MuJoCo primitives. A rock is a noise-displaced
+boulder made from its seed (`ecs_tentacles.terrain.rocks`), one convex mesh piece; on a
+heightfield it is lowered, if need be, until its lowest point is at or under the lowest
+ground beneath it (on a slope no side is in the air). A mesh (.obj, .stl, .glb next to
 the scene, at most `MAX_MESH_BYTES`) is read with trimesh; a convex one is one piece,
 any other is split into convex pieces with CoACD (MuJoCo collides a mesh as its convex
 hull, so a concave rock would otherwise fill in its hollows). Both run in a worker
@@ -21,6 +24,7 @@ import numpy as np
 from ecs_tentacles.terrain.heightfield import Heightfield
 from ecs_tentacles.terrain.heights import Problem, TerrainError
 from ecs_tentacles.terrain.meshes import MAX_MESH_BYTES, MESH_SUFFIXES, MeshReader
+from ecs_tentacles.terrain.rocks import rock_vertices
 from ecs_tentacles.terrain.shapes import Solid, convex_planes
 
 __all__ = ["MAX_MESH_BYTES", "MESH_SUFFIXES", "obstacle_problems", "solids"]
@@ -30,8 +34,9 @@ NEEDS = {
     "cylinder": ("radius", "height"),
     "sphere": ("radius",),
     "mesh": ("file", "scale"),
+    "rock": ("size", "seed"),
 }
-OPTIONAL = {"scale"}  # a mesh's; the others' keys are all required
+OPTIONAL = {"scale", "seed"}  # a mesh's scale (1), a rock's seed (0); the others' are required
 
 
 def obstacle_problems(obstacles: Sequence[Mapping[str, Any]]) -> list[Problem]:
@@ -45,10 +50,8 @@ def obstacle_problems(obstacles: Sequence[Mapping[str, Any]]) -> list[Problem]:
                 problems.append((here, f"a {shape} needs {key!r}"))
         foreign = sorted(
             key
-            for key in ("size", "radius", "height", "file", "scale")
-            if key in obstacle
-            and key not in NEEDS[shape]
-            and not (shape == "mesh" and key == "scale")
+            for key in ("size", "radius", "height", "file", "scale", "seed")
+            if key in obstacle and key not in NEEDS[shape]
         )
         if foreign:
             problems.append((here, f"a {shape} takes no {', '.join(map(repr, foreign))}"))
@@ -73,6 +76,10 @@ def solids(
     if standing:
         centres = np.array([made[i].position[:2] for i in standing])
         for i, lift in zip(standing, field.height(centres).tolist(), strict=True):
+            if obstacles[i]["shape"] == "rock":  # no lower side in the air: sunk as needed
+                outline = made[i].pieces[0] @ made[i].rotation.T + made[i].position
+                lowest = float(field.height(outline[:, :2]).min())
+                lift = min(lift, lowest - float(outline[:, 2].min()))
             made[i] = dataclasses.replace(made[i], position=made[i].position + [0.0, 0.0, lift])
     return tuple(made)
 
@@ -96,6 +103,11 @@ def _solid(
         return Solid("cylinder", position, rotation, size)
     if shape == "sphere":
         return Solid("sphere", position, rotation, (float(obstacle["radius"]),))
+    if shape == "rock":
+        vertices = rock_vertices(obstacle["size"], int(obstacle.get("seed", 0)))
+        return Solid(
+            "mesh", position, rotation, pieces=(vertices,), planes=(convex_planes(vertices),)
+        )
     here = ("terrain", "obstacles", index, "file")
     pieces = reader.pieces(obstacle["file"], float(obstacle.get("scale", 1.0)), here)
     planes = known.get(id(pieces))

@@ -5,7 +5,8 @@ creatures somewhere (`ecs_tentacles.behaviour.travel`: the locomotion plugin's g
 though no example names it) every `interval` seconds rather than every frame, so
 strokes can finish. What they share is here: a number setting, the two re-planning
 settings, the check that a goal set some distance away is not reached at once, and the
-columns sending a creature writes (`DESTINATION_WRITES`, what each system declares).
+columns sending a creature writes (`ecs_tentacles.behaviour.DESTINATION_WRITES`, what
+each system declares).
 """
 
 from __future__ import annotations
@@ -13,19 +14,15 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
+from ecs_tentacles.behaviour import DESTINATION_WRITES
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.scene.defaults import plugin_config
 
 Problem = tuple[tuple[str | int, ...], str]
 
-# the store columns the `Destinations` entry writes when a system sends or stops a
-# creature (the locomotion plugin's goals): a system that calls it declares them
-DESTINATION_WRITES = (
-    "goals",
-    "locomotion.creatures.goal",
-    "locomotion.creatures.has_goal",
-    "locomotion.creatures.goal_radius",
-)
+# the store columns sending a creature writes: `ecs_tentacles.behaviour`'s (named here
+# too, for code that imported it from the examples)
+__all__ = ["DESTINATION_WRITES", "Problem", "farther_than_reach", "number", "replanning"]
 
 
 def number(low: float, high: float, default: float, description: str) -> dict[str, Any]:

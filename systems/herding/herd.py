@@ -27,7 +27,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ecs_tentacles.behaviour import ARRIVALS, DESTINATIONS_READ, travel
+from ecs_tentacles.behaviour import ARRIVALS, DESTINATION_WRITES, DESTINATIONS_READ, travel
 from ecs_tentacles.herding.fence import Fence
 from ecs_tentacles.herding.game import HerdingGame
 from ecs_tentacles.herding.open_ground import open_goals
@@ -37,15 +37,6 @@ if TYPE_CHECKING:
     from ecs_tentacles.host import Host
     from ecs_tentacles.roster_change import RosterChange
 
-# the store columns the `Destinations` entry (the locomotion plugin's goals) writes when
-# a creature is sent: what a system that sends creatures declares (as the examples'
-# `DESTINATION_WRITES`, which a feature may not import)
-DESTINATION_WRITES = (
-    "goals",
-    "locomotion.creatures.goal",
-    "locomotion.creatures.has_goal",
-    "locomotion.creatures.goal_radius",
-)
 APART = 0.8  # metres: closer creatures push apart
 CRAWL = 0.1  # m/s: a flock going this fast aligns a creature fully
 GOAL_RADIUS = 0.3  # metres: a goal is reached within this

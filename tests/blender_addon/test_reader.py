@@ -39,6 +39,7 @@ REFUSED = [
     "truncated_file", "empty_file", "not_a_zip",
 ]  # fmt: skip
 V1_TAKE = Path(__file__).resolve().parents[1] / "data" / "octopus_take_v1.npz"
+V2_TAKE = V1_TAKE.with_name("octopus_take_v2.npz")
 
 
 @pytest.fixture(scope="module")
@@ -83,12 +84,20 @@ def test_a_version_1_take_reads_as_the_project_reads_it_a_block_at_a_time(
     np.testing.assert_array_equal(np.concatenate(quat), expected.quat)
 
 
-def test_a_version_2_take_reads_as_the_project_reads_it_a_chunk_at_a_time(
+def test_a_version_2_take_reads_with_its_bodies_listed() -> None:
+    expected = Take.load(V2_TAKE)
+    with TakeFile(V2_TAKE) as take:
+        assert (take.version, take.frames, take.bodies) == (2, expected.frames, 81)
+        pos = np.concatenate([b["pos"] for _, b in take.blocks(("pos",))])
+        np.testing.assert_array_equal(pos, expected.pos)
+
+
+def test_a_version_3_take_reads_as_the_project_reads_it_a_chunk_at_a_time(
     good_take: Path,
 ) -> None:
     expected = Take.load(good_take)
     with TakeFile(good_take) as take:
-        assert (take.version, take.frames, take.fps) == (2, expected.frames, expected.fps)
+        assert (take.version, take.frames, take.fps) == (3, expected.frames, expected.fps)
         assert [c.name for c in take.creatures] == [c["name"] for c in expected.header["creatures"]]
         pos = np.concatenate([b["pos"] for _, b in take.blocks(("pos",))])
         np.testing.assert_array_equal(pos, expected.pos)

@@ -10,7 +10,7 @@ from ecs_tentacles.scene.load import load_scene
 from ecs_tentacles.world import World
 
 SMALL = {"count": 4, "links": 5}
-QUICK = {"warmup": 1.0, "seconds": 2.5, "loop": (0.5, 2.0)}  # short recordings for tests
+QUICK: dict[str, Any] = {"warmup": 1.0, "seconds": 2.5, "loop": (0.5, 2.0)}  # short ones
 
 
 def _scene() -> dict[str, Any]:

@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from ecs_tentacles.take import write_npz
+from ecs_tentacles.take import compact, write_npz
 
 Entries = dict[str, Any]  # name -> ndarray, or bytes for a raw .npy entry
 # a plugin's points track as a take header declares it (`ecs_tentacles.take.tracks`)
@@ -30,11 +30,12 @@ BEACONS = {
 
 
 def _read(good: Path) -> tuple[dict[str, Any], Entries]:
-    """The header and arrays of `good`, in version 1's layout (chunks joined): the cases
-    break a whole array; `CHUNK_CASES` break a version 2 file's chunks."""
+    """The header and arrays of `good`, in version 1's layout (chunks joined, bodies
+    listed in the header): the cases break a whole array; `CHUNK_CASES` break a version
+    2 file's chunks."""
     with np.load(good) as npz:
         arrays: Entries = {name: npz[name] for name in npz.files}
-    header = json.loads(arrays["header"].tobytes())
+    header = compact.unpack(json.loads(arrays["header"].tobytes()))  # bodies listed
     chunked: dict[str, list[Any]] = {}
     steps = header.get("quantised") or {}
     for name in sorted(arrays):

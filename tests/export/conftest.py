@@ -130,3 +130,30 @@ def replay_take(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """A take (version 2) of 16 creatures, 15 of them replaying a gait clip from frame 1
     (`replay_crowd_take`)."""
     return replay_crowd_take(tmp_path_factory.mktemp("replayed"))
+
+
+def switching_crowd_take(folder: Path) -> Path:
+    """9 uniform creatures packed 1.3 m apart, 3 s at 24 fps, level of detail on with room
+    for one at full physics and one reduced: crawling inwards they come near each other
+    and go physical, then apart and replay again, so some leave their clip and come back
+    (creature 8: replayed on frames 3-10, 38-39 and 62-72). The take's path."""
+    scene = folder / "switching9.json"
+    subprocess.run(
+        [sys.executable, "-P", "-m", "ecs_tentacles", "crowd", "9", "--uniform", "--seed", "2",
+         "--spacing", "1.3", "--out", str(scene)],
+        capture_output=True, text=True, check=True,
+    )  # fmt: skip
+    data: dict[str, Any] = json.loads(scene.read_text())
+    data.setdefault("physics", {})["lod"] = {"full": 1, "reduced": 1, "hold_seconds": 0}
+    scene.write_text(json.dumps(data))
+    take = folder / "switching9.npz"
+    argv = ["bake", str(scene), "--seconds", "3", "--fps", "24", "--out", str(take)]
+    assert main([*argv, "--quiet"]) == 0
+    return take
+
+
+@pytest.fixture(scope="session")
+def switching_take(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A take (version 2) of 9 creatures that switch between physics and a gait clip,
+    several of them more than once (`switching_crowd_take`)."""
+    return switching_crowd_take(tmp_path_factory.mktemp("switching"))

@@ -122,8 +122,8 @@ HOSTILE_HEADERS = {  # header edit -> the one line `export` says after the file'
         "header.fps: a number of 400 characters, at most 100",
     ),
     "a 400-digit radius": (
-        lambda header: header["bodies"][1].update(radius=-(10**399)),
-        "header.bodies[1].radius: a number of 401 characters, at most 100",
+        lambda header: header["body_plans"]["plans"][0]["bodies"][1].update(radius=-(10**399)),
+        "header.body_plans.plans[0].bodies[1].radius: a number of 401 characters, at most 100",
     ),
     "a key nested 500 deep": (
         lambda header: header.update(notes=_nested(500)),

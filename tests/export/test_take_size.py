@@ -67,30 +67,42 @@ def test_what_a_bake_counts_is_what_its_take_holds(tmp_path: Path) -> None:
     assert per_frame == plan.frames * (counted.frame_bytes + 360 * 10 * 12)
     entries = {key: len(json.dumps(header[key], separators=(",", ":"))) for key in header}
     bodies, suckers, goals, guides, _ = counted.parts
-    assert entries["bodies"] + entries["creatures"] == bodies.fixed_bytes + 2  # the brackets
+    # every creature is a body plan of its own: its bodies are counted, and its plan index
+    plan_indices = sum(len(str(i)) + 1 for i in range(12))
+    assert entries["bodies"] + entries["creatures"] + plan_indices == bodies.fixed_bytes + 2
+    # the file stores each plan once, its names relative: less than counted
+    packed = stored["header.npy"] - 128
+    assert packed <= sum(p.fixed_bytes for p in counted.parts) + counted.base
     assert entries["suckers"] == suckers.fixed_bytes + 1
     assert entries["goals"] + 12 * 12 == goals.fixed_bytes + 1
     assert entries["guides"] == guides.fixed_bytes + len('{"creatures":[]}') - 1
     total = sum(stored.values()) - plan.frames * 360 * 10 * 12  # decoded: float32 points
+    listed = len(json.dumps(header, separators=(",", ":"))) + plan_indices
+    total += listed - packed  # counted as listed, plan indices too: an upper bound
     assert total <= counted.total(plan.frames) <= total + NPY_HEADERS + 1024
 
 
-def _crowd(count: int) -> dict[str, Any]:
-    """`count` creatures of 8 tentacles of 60 links, a sucker on each."""
-    tentacles = {"count": 8, "links": 60, "suckers": "every_link"}
+def _crowd(count: int, plans: int | None = None) -> dict[str, Any]:
+    """`count` creatures of 8 tentacles of 60 links, a sucker on each, of `plans` body
+    plans (their links' lengths differ; default: each creature its own)."""
+    plans = plans or count
     creatures = [
-        {"name": f"c{i}", "position": [6.0 * (i % 40), 6.0 * (i // 40)], "tentacles": tentacles}
+        {"name": f"c{i}", "position": [6.0 * (i % 40), 6.0 * (i // 40)],
+         "tentacles": {"count": 8, "links": 60, "suckers": "every_link",
+                       "link_length": 0.05 + 1e-5 * (i % plans)}}
         for i in range(count)
-    ]
+    ]  # fmt: skip
     return {"version": 1, "creatures": creatures}
 
 
 def test_a_header_the_reader_would_refuse_is_refused_before_anything_is_built() -> None:
-    """1,000 creatures of 481 bodies and 480 suckers name them in 119 MiB of header; a
-    reader takes 64 MiB: a bake of a frame is refused. 500 of them fit in 60 MiB."""
+    """1,000 creatures of 481 bodies and 480 suckers, each of its own body plan, name
+    them in 119 MiB of header; a reader takes 64 MiB: a bake of a frame is refused. 500
+    of them fit in 60 MiB; 1,000 of 10 body plans in a few (`take.compact`)."""
     assert BakePlan.make(_crowd(1000), seconds=0.05).size_problem() == (
         "the take's header would be 119 MiB for 481,000 bodies, 480,000 suckers and 1,000 replay"
         " records; a take's"
         " header holds at most 64 MiB (bake fewer creatures)"
     )
     assert BakePlan.make(_crowd(500), seconds=0.05).size_problem() is None
+    assert BakePlan.make(_crowd(1000, plans=10), seconds=0.05).size_problem() is None

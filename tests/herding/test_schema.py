@@ -43,7 +43,7 @@ def test_the_herding_plugin_needs_a_game_and_a_game_needs_the_plugin() -> None:
         World.from_scene(scene)
     scene = level()
     scene["plugins"]["herding"] = False
-    with pytest.raises(SceneError, match=r"game: unknown key: the herding plugin's, which is off"):
+    with pytest.raises(SceneError, match=r"game: unknown key: the game plugin's, which is off"):
         World.from_scene(scene)
 
 
@@ -55,13 +55,15 @@ def test_the_levels_schema_for_editors_is_the_assembled_one_and_every_level_is_v
 
     import jsonschema
 
+    from ecs_tentacles.game.rules import scene_schema
     from ecs_tentacles.scene.load import bundled_scene, load_scene_plugins
+    from ecs_tentacles.scene.registries import plugin_entries
     from ecs_tentacles.scene.schema import schema_for
 
     folder = importlib.resources.files("ecs_tentacles.assets")
     written = json.loads((folder / "schema" / "herding.schema.json").read_text())
-    _, plugins = load_scene_plugins(bundled_scene("herding_1_field"))
-    assert written == schema_for(plugins), (
+    first, plugins = load_scene_plugins(bundled_scene("herding_1_field"))
+    assert written == scene_schema(schema_for(plugins), first, plugin_entries(plugins)), (
         "regenerate: ecs-tentacles schema herding_1_field > assets/schema/herding.schema.json"
     )
     for name in ("herding_1_field", "herding_2_shore", "herding_3_maze"):

@@ -113,3 +113,26 @@ def test_a_creature_spawned_after_the_last_one_left_is_routed(
     world.step(2)
     route = world.resource(Navigator).waypoints(world.component(entity, Creature).row)
     assert len(route) and (route[:, 0] > 0.8).all()  # around the wall's end, as the first
+
+
+def test_a_route_does_not_depend_on_who_else_is_in_the_world(
+    make_world: Callable[..., World],
+) -> None:
+    """Each creature plans on the grid of its own reach: the cost grid was made for the
+    largest creature's, so a long-armed creature elsewhere changed a small one's route
+    (and a shard of a bake, holding some of a crowd, planned otherwise than the whole
+    crowd: its take differed from the local bake's)."""
+    alone = behind_the_wall(True)
+    small = alone["creatures"][0]
+    small["tentacles"] = {"count": 4, "links": 4, "link_length": 0.05}
+    big = {"name": "big", "position": [6, 6], "tentacles": {"links": 12, "link_length": 0.12}}
+    crowd = {**alone, "creatures": [small, big]}
+    routes = []
+    for scene in (alone, crowd):
+        world = make_world(scene)
+        world.step()
+        routes.append(
+            world.resource(Navigator).waypoints(world.component(world.creature("o"), Creature).row)
+        )
+    assert len(routes[0]) >= 1
+    np.testing.assert_array_equal(routes[0], routes[1])

@@ -267,3 +267,44 @@ def test_the_refresh_kernel_gives_the_numpy_numbers_bit_for_bit(
     assert len(moved) == 2 and not (pos == before[0]).all()  # a and b moved, far did not
     assert (radius[moved] != before[3][moved]).all() and radius[2] == before[3][2]
     assert (centre[moved] != before[2][moved]).all()
+
+
+def test_a_replayed_creature_gets_no_proxies_and_the_crowd_moves_as_when_it_did(
+    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A KINEMATIC creature is not stepped: proxies placed for it were work for nothing.
+    It gets none now (its neighbours still get proxies of its bodies), and every pose
+    is the same, bit for bit, as when it got them."""
+    from ecs_tentacles.physics import proxies as module
+    from ecs_tentacles.physics.tiers import KINEMATIC
+
+    small = {"count": 4, "links": 5}
+    creatures = [  # every other one turned 45 degrees: reach spheres overlap, tentacles not
+        {
+            "name": f"c{i}",
+            "position": [0.85 * (i % 4), 0.85 * (i // 4)],
+            "heading_deg": 45.0 * (i % 2),
+            "tentacles": small,
+            "goals": [{"position": [0.85 * (i % 4) + 1.0, 0.85 * (i // 4)]}],
+        }
+        for i in range(8)
+    ]
+    lod = {"full": 0, "reduced": 1, "hold_seconds": 0.1}
+    scene = {"version": 1, "physics": {"lod": lod}, "creatures": creatures}
+    runs = []
+    for replayed_get_proxies in (True, False):
+        with monkeypatch.context() as patch:
+            if replayed_get_proxies:  # as before: no creature's tier is KINEMATIC to it
+                patch.setattr(module, "KINEMATIC", -1)
+            world = make_world(scene)
+            poses, served = [], 0
+            for _ in range(40):
+                world.step(1)
+                roster = world.physics.roster
+                served += int(((roster.tier == KINEMATIC) & (roster.proxies_used > 0)).sum())
+                poses.append(world.transforms.pos.copy())
+            runs.append((np.array(poses), served, world.lod.counts()))
+    (before, served_before, tiers), (after, served_after, _) = runs
+    assert tiers["kinematic"] >= 2 and served_before >= 20  # replayed creatures had proxies
+    assert served_after == 0
+    np.testing.assert_array_equal(after, before)

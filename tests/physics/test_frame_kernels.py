@@ -76,6 +76,32 @@ def test_the_fastest_body_is_numpys(
         assert (found[0][:3][active[:3]] > 0.0).all()
 
 
+def test_the_poses_the_health_check_remembers_are_numpys_and_skip_replayed_creatures(
+    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A replayed creature is never checked (promoted, `restart` sets its rows), so its
+    bodies are not copied for the next check; everyone else's are, as numpy copies them."""
+    from ecs_tentacles.physics.tiers import FULL, KINEMATIC, REDUCED
+
+    world = make_world(SCENE)
+    world.step(2)
+    health, tier = world.physics.health, world.physics.roster.tier
+    pos = world.transforms.pos + 1.0
+    for tiers in ([FULL, KINEMATIC, REDUCED, KINEMATIC], [FULL] * 4, [KINEMATIC] * 4):
+        tier[:] = tiers
+        found = []
+        for backend in ("auto", "numpy"):
+            monkeypatch.setattr(health_module.KERNELS, "backend", backend)
+            health.previous = np.full_like(pos, -7.0)
+            health._remember(pos)
+            found.append(health.previous)
+        assert_array_equal(found[0], found[1])
+        for c in range(4):
+            rows = health.rows[health.start[c] : health.start[c] + health.count[c]]
+            want = -7.0 if tiers[c] == KINEMATIC else pos[rows]
+            assert_array_equal(found[0][rows], np.broadcast_to(want, (len(rows), 3)))
+
+
 def test_the_health_check_finds_the_same_faults_with_and_without_kernels(
     make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
 ) -> None:

@@ -182,6 +182,8 @@ def test_every_registry_entry_belongs_to_a_plugin_that_is_on(
         Draws,
         FramedPoints,
         Lines,
+        OverlayLines,
+        OverlaySpheres,
         Panels,
         Spheres,
         UndoStates,
@@ -200,10 +202,13 @@ def test_every_registry_entry_belongs_to_a_plugin_that_is_on(
         return found
 
     seen = owners()
-    kinds = {Spheres, Lines, Draws, FramedPoints, Panels, Clicks, UndoStates}
+    kinds = {Spheres, Lines, OverlaySpheres, OverlayLines, Draws, FramedPoints, Panels, Clicks}
+    kinds.add(UndoStates)
     assert {k.__name__ for k in kinds} <= set(seen)
     assert "beacon" in seen["Clicks"] and "locomotion" in seen["Clicks"]
-    assert {"render", "suckers", "threats", "beacon"} <= seen["Spheres"]
+    assert {"threats", "beacon"} <= seen["Spheres"]
+    assert {"render", "suckers"} <= seen["OverlaySpheres"]  # the editor's: tiers, suckers
+    assert "locomotion" in seen["OverlayLines"]  # goal rings and paths
     assert "locomotion" in seen["UndoStates"]
     scene = json.loads((tmp_path / "beacon_scene.json").read_text())
     scene["plugins"]["threats"] = False

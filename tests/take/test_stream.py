@@ -3,6 +3,7 @@ a time; version 1 takes still read and export."""
 
 from __future__ import annotations
 
+import json
 import shutil
 import zipfile
 from pathlib import Path
@@ -12,7 +13,7 @@ import pytest
 
 from ecs_tentacles.cli import main
 from ecs_tentacles.export.bake import BakePlan, bake_to_file
-from ecs_tentacles.take import Take, TakeError
+from ecs_tentacles.take import VERSION, Take, TakeError, compact
 from ecs_tentacles.take.stream import open_take
 
 DATA = Path(__file__).parent.parent / "data"
@@ -84,17 +85,23 @@ def test_chunks_read_one_at_a_time_equal_the_whole(crowd_take: Take, tmp_path: P
     assert seen == whole.frames
 
 
-def test_a_version_1_take_reads_exports_and_migrates(tmp_path: Path) -> None:
-    """A take written before version 2 (bundled, made by the version 1 writer) reads,
-    exports, and saved again becomes a version 2 file holding the same frames."""
+@pytest.mark.parametrize("version", [1, 2])
+def test_an_old_take_reads_exports_and_migrates(version: int, tmp_path: Path) -> None:
+    """A take written by an older writer (bundled: version 1, every array whole; version
+    2, bodies listed one by one in the header) reads, exports, and saved again becomes a
+    file of today's version holding the same frames, its bodies stored per body plan."""
     old = tmp_path / "old.npz"
-    shutil.copy(DATA / "octopus_take_v1.npz", old)
+    shutil.copy(DATA / f"octopus_take_v{version}.npz", old)
     take = Take.load(old)
-    assert take.header["version"] == 1 and take.frames == 9
+    assert take.header["version"] == version and take.frames == 9
     assert main(["export", str(old), "--out", str(tmp_path / "old.usda"), "--quiet"]) == 0
     take.save(tmp_path / "new.npz")
     new = Take.load(tmp_path / "new.npz")
-    assert new.header["version"] == 2
+    assert new.header["version"] == VERSION == 3
+    assert new.header["bodies"] == take.header["bodies"]
+    assert new.header["suckers"] == take.header["suckers"]
+    with np.load(tmp_path / "new.npz") as stored:
+        assert compact.KEY in json.loads(bytes(stored["header"]))
     assert np.array_equal(new.pos, take.pos) and np.array_equal(new.quat, take.quat)
     assert np.array_equal(new.tracks["goal_active"], take.tracks["goal_active"])
     with open_take(old) as source:

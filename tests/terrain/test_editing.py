@@ -64,6 +64,25 @@ def test_placed_moved_and_deleted_obstacles_reach_the_physics_and_nothing_moves(
     )
 
 
+def test_a_placed_rock_is_a_boulder_in_the_physics_each_its_own_stone(
+    make_world: Callable[..., World],
+) -> None:
+    world = make_world(scene({"heightfield": HILLS}))
+    editor = world.resource(TerrainEditor)
+    for point in ((2.5, 1.5), (-2.5, 1.5)):
+        editor.place(world, "rock", (*point, 0.0), size=0.8)
+    one, two = ground_of(world).solids
+    assert one.kind == two.kind == "mesh"
+    assert one.pieces[0].shape != two.pieces[0].shape or not np.allclose(
+        one.pieces[0], two.pieces[0]
+    )  # two seeds, two stones
+    top = ground_of(world).surface(np.array([[2.5, 1.5]]))[0]
+    assert _ray_down(world, 2.5, 1.5) == pytest.approx(top, abs=1e-5)  # in the physics
+    assert top > ground_of(world).height(np.array([[2.5, 1.5]]))[0] + 0.2
+    world.step(20)
+    assert world.physics.health.recoveries == 0
+
+
 def test_an_obstacle_into_a_creature_is_refused_and_changes_nothing(
     make_world: Callable[..., World],
 ) -> None:

@@ -54,7 +54,7 @@ def test_in_process_soak_times_frames_and_reports_the_medians_at_both_ends() -> 
     )  # fmt: skip
     assert done.returncode == 0, done.stdout + done.stderr
     rows = [line.split() for line in done.stdout.splitlines() if line[:8].strip().isdigit()]
-    assert len(rows) >= 3
+    assert len(rows) >= 2  # the start and the end (a slow machine may fit no more)
     assert all(float(row[3]) > 0 for row in rows)  # a frame's median time on every row
     ends = re.search(r"([0-9.]+) ms at the start, ([0-9.]+) ms at the end", done.stdout)
     assert ends and float(ends.group(1)) > 0 and float(ends.group(2)) > 0, done.stdout

@@ -82,6 +82,7 @@ class FurPanel(Panel):
     """The "Fur" section, its timeline and the 3D picking and dragging of controls."""
 
     title = "Fur"
+    overlay_windows = True  # the keyframe timeline: not in the clean view
 
     def __init__(self, sandbox: SandboxView):
         self.sandbox = sandbox

@@ -1,0 +1,1 @@
+"""The race mode's systems: `steering` (stage decide) and `referee` (stage output)."""
