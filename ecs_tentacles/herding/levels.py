@@ -7,7 +7,8 @@
 A level is a bundled scene (`assets/scenes/`) with a `game` key; the levels of one mode
 go in the order of their scene names (`herding_1_field`, `herding_2_shore`, ...). The
 first level of a mode is always open; each next one opens once the one before it is won
-(it has a best time). Stars come from the best time against the level's `par`: 3 within
+(it has a best time), in the modes whose wins the best-times file keeps (`RECORDED`:
+the herding game's section writes them); a mode that keeps none has every level open. Stars come from the best time against the level's `par`: 3 within
 par, 2 within 1.5x par, 1 for any win (`ecs_tentacles.herding.game.stars_for`). The best
 times are the best-times file's (`ecs_tentacles.herding.best_times`, keyed by the level's
 name as the game shows it); nothing here writes.
@@ -25,6 +26,9 @@ from typing import Any
 from ecs_tentacles.herding import best_times
 from ecs_tentacles.herding.game import stars_for
 from ecs_tentacles.scene.load import bundled_scene, bundled_scene_names
+
+
+RECORDED = ("herding",)  # the modes whose wins are written to the best-times file
 
 
 @dataclass(frozen=True)
@@ -86,7 +90,7 @@ def levels(times: Mapping[str, float] | None = None) -> list[Level]:
                     par=par,
                     best=best,
                     stars=stars_for(best, par) if best is not None else 0,
-                    unlocked=previous_won,
+                    unlocked=previous_won or mode not in RECORDED,
                 )
             )
             previous_won = best is not None
