@@ -8,7 +8,8 @@ A level is a bundled scene (`assets/scenes/`) with a `game` key; the levels of o
 go in the order of their scene names (`herding_1_field`, `herding_2_shore`, ...). The
 first level of a mode is always open; each next one opens once the one before it is won
 (it has a best time), in the modes whose wins the best-times file keeps (`RECORDED`:
-the herding game's section writes them); a mode that keeps none has every level open. Stars come from the best time against the level's `par`: 3 within
+the herding game's section writes them); a mode that keeps none has every level open.
+Stars come from the best time against the level's `par`: 3 within
 par, 2 within 1.5x par, 1 for any win (`ecs_tentacles.herding.game.stars_for`). The best
 times are the best-times file's (`ecs_tentacles.herding.best_times`, keyed by the level's
 name as the game shows it); nothing here writes.
@@ -26,7 +27,6 @@ from typing import Any
 from ecs_tentacles.herding import best_times
 from ecs_tentacles.herding.game import stars_for
 from ecs_tentacles.scene.load import bundled_scene, bundled_scene_names
-
 
 RECORDED = ("herding",)  # the modes whose wins are written to the best-times file
 
