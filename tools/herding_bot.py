@@ -7,7 +7,8 @@
 For each level: won or lost, creatures penned of those needed, game seconds, and the
 median frame's step time (physics and every system) with its real-time factor, the
 figure that says whether the level plays at interactive rates on this machine. The bot
-is `ecs_tentacles.herding.play.Bot`: push the creature farthest from the pen toward it.
+is `ecs_tentacles.herding.play.Bot`: one creature at a time, the one nearest the gate,
+pushed from behind to the gate and through it. It plays the same game every time.
 """
 
 from __future__ import annotations
@@ -33,6 +34,7 @@ def main(argv: list[str] | None = None) -> int:
             creatures = world.creatures.count
             result = play(world, Bot())
         result.pop("log")
+        result.pop("runs")
         result["creatures"] = creatures
         if args.json:
             print(json.dumps({"scene": name, **result}), flush=True)

@@ -1,5 +1,5 @@
 """The `ecs-tentacles` command line: validate, run, play, bake, export, create, crowd, bench,
-systems, migrate, schema, blender-addon.
+systems, migrate, schema, blender-addon, levels.
 
 It speaks one way: every error is one line `error: <where>: <what>` on stderr (one per
 problem for a scene), exit 2 for bad input (arguments, scenes, takes, no display),

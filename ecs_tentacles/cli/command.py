@@ -15,6 +15,7 @@ from ecs_tentacles.cli import (
     create,
     crowd,
     export,
+    levels,
     migrate,
     play,
     run,
@@ -35,7 +36,7 @@ from ecs_tentacles.take import TakeError
 COMMANDS = {"validate": validate, "run": run, "play": play}
 COMMANDS |= {"bake": bake, "export": export, "create": create}
 COMMANDS |= {"crowd": crowd, "bench": bench, "systems": systems, "migrate": migrate}
-COMMANDS |= {"schema": schema, "blender-addon": blender_addon}
+COMMANDS |= {"schema": schema, "blender-addon": blender_addon, "levels": levels}
 
 
 def build_parser() -> argparse.ArgumentParser:

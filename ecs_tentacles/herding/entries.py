@@ -1,8 +1,10 @@
 """The herding game's entries in the renderer's, sandbox's, take's and report's registries.
 
-- `lines`: the pen's ring on the ground (green; gold once won, red once lost) and the
-  ring of the predator's reach;
-- `spheres`: the predator, a dark sphere above the ground;
+- `lines`: the pen's ring on the ground (green; gold once won, red once lost), its
+  fence (posts and two rails, none across the gate) and the ring of the predator's
+  reach (orange walking, yellow running, drawn thick);
+- `spheres`: the predator's body (`ecs_tentacles.herding.predator_body`: body, head
+  and ears, facing where it goes) and the gate's posts;
 - `framed_points`: the pen and the predator, which "frame all" keeps in view;
 - `panels`: the HUD's Game section and the win/lose banner (`ecs_tentacles.herding.hud`);
 - `run_summary`: `run`'s report gets the outcome (`game won in 41.2 s, 5 of 4 penned`);
@@ -18,7 +20,9 @@ import numpy as np
 
 from ecs_tentacles.cli.registries import RunSummary
 from ecs_tentacles.ground import ground_of
+from ecs_tentacles.herding.fence import Fence
 from ecs_tentacles.herding.game import LOST, PLAYING, WON, HerdingGame
+from ecs_tentacles.herding.predator_body import predator_body
 from ecs_tentacles.render.registries import Marker
 from ecs_tentacles.take.registries import PointsFrame, TrackSource
 from ecs_tentacles.take.tracks import TakeTrack
@@ -34,9 +38,11 @@ PEN_RGBA = {
     WON: (1.0, 0.8, 0.2, 1.0),  # gold
     LOST: (0.9, 0.2, 0.2, 1.0),  # red
 }
-REACH_RGBA = (0.55, 0.1, 0.1, 1.0)
-PREDATOR_SIZE = (0.13, 0.13, 0.13)
-PREDATOR_RGBA = (0.25, 0.05, 0.05, 1.0)
+REACH_RGBA = (1.0, 0.45, 0.1, 1.0)  # orange: the walking predator's reach
+RUN_RGBA = (1.0, 0.9, 0.15, 1.0)  # yellow: the running predator's
+FENCE_RGBA = (0.55, 0.38, 0.2, 1.0)  # wood
+GATE_RGBA = (1.0, 0.85, 0.3, 1.0)
+RAILS = (0.4, 0.85)  # the rails' heights, in parts of the fence's height
 GAME_TRACK = TakeTrack("game", "points", ("game_pos", "game_live"), "game", "penned")
 
 
@@ -52,10 +58,30 @@ def ring(world: Host, centre: np.ndarray, radius: float, rgba: tuple[float, ...]
     return out
 
 
+def fence_lines(world: Host, fence: Fence) -> np.ndarray:
+    """Line-list vertices of the fence: a post at each panel's ends and two rails."""
+    centres, half, angles = fence.boxes()
+    along = half[:, None] * np.stack([np.cos(angles), np.sin(angles)], axis=1)
+    ends = np.concatenate([centres - along, centres + along])  # (2m, 2)
+    base = ground_of(world).height(ends)
+    tops = [base + fence.height * part for part in RAILS]
+    m = len(centres)
+    rails = [
+        np.stack([np.column_stack([ends[:m], top[:m]]), np.column_stack([ends[m:], top[m:]])], 1)
+        for top in tops
+    ]
+    posts = np.stack([np.column_stack([ends, base]), np.column_stack([ends, tops[-1] + 0.05])], 1)
+    points = np.concatenate([*rails, posts]).reshape(-1, 3)
+    return np.column_stack([points, np.tile(FENCE_RGBA, (len(points), 1))])
+
+
 def lines(world: Host, view: RenderView) -> list[np.ndarray]:
     game = world.resource(HerdingGame)
     pen = ring(world, game.pen_centre, game.pen_radius, PEN_RGBA[game.outcome])
-    return [pen, ring(world, game.predator, game.reach, REACH_RGBA)]
+    reach = game.scare
+    colour = RUN_RGBA if game.sprinting else REACH_RGBA
+    rings = [ring(world, game.predator, reach + d, colour) for d in (-0.04, 0.0, 0.04)]
+    return [pen, fence_lines(world, Fence.of(game)), *rings]
 
 
 def framed_points(world: Host) -> np.ndarray:
@@ -68,9 +94,13 @@ def framed_points(world: Host) -> np.ndarray:
 
 def spheres(world: Host) -> list[Marker]:
     game = world.resource(HerdingGame)
-    xy = game.predator
-    z = ground_of(world).height(xy[None])[0] + PREDATOR_SIZE[2]
-    return [Marker(np.array([[xy[0], xy[1], z]]), PREDATOR_SIZE, PREDATOR_RGBA)]
+    fence = Fence.of(game)
+    half = fence.half_gate
+    angles = fence.heading + np.array([-half, half])
+    xy = fence.centre + fence.radius * np.stack([np.cos(angles), np.sin(angles)], axis=1)
+    z = ground_of(world).height(xy) + fence.height + 0.06
+    posts = Marker(np.column_stack([xy, z]), (0.09, 0.09, 0.09), GATE_RGBA)
+    return [*predator_body(world, game), posts]
 
 
 def panels(sandbox: SandboxView) -> list[Panel]:

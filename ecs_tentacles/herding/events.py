@@ -23,6 +23,15 @@ class CreaturePenned(Event):
 
 
 @dataclass(frozen=True)
+class CreatureLeft(Event):
+    """Penned creature `creature` was driven out of the pen at game time `seconds`."""
+
+    name: ClassVar[str] = "creature_left"
+    creature: int
+    seconds: float
+
+
+@dataclass(frozen=True)
 class GameWon(Event):
     """Enough creatures are penned: won in `seconds` of game time."""
 

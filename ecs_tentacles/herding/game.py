@@ -2,6 +2,7 @@
 
     game = world.resource(HerdingGame)
     game.aim(world, (1.0, 2.0))     # the player points the predator there (logged)
+    game.run(world, True)           # the predator runs (farther reach, faster, tiring; logged)
     game.penned, game.left, game.outcome   # creatures penned, seconds left, "playing"/"won"/"lost"
     game.restart(world)             # back to the level's start, exactly
 
@@ -24,6 +25,17 @@ if TYPE_CHECKING:
     from ecs_tentacles.snapshot import Snapshot
 
 PLAYING, WON, LOST = "playing", "won", "lost"
+RECOVERED = 0.3  # the stamina a winded predator needs before it runs again
+HERD_DEFAULTS = {
+    "flee": 1.0,
+    "graze": 0.4,
+    "graze_share": 0.4,
+    "flock_radius": 3.0,
+    "cohesion": 1.0,
+    "alignment": 0.5,
+    "separation": 1.5,
+    "interval": 1.0,
+}  # the scene's `game.herd` (herding.schema.json gives the same defaults)
 
 
 @dataclass
@@ -37,6 +49,11 @@ class GameState:
     penned_at: list[tuple[float, float, float]] = field(default_factory=list)  # where
     outcome: str = PLAYING
     log: list[tuple[int, float, float]] = field(default_factory=list)  # (frame, x, y)
+    heading: float = 0.0  # radians: the way the predator faces (where it last went)
+    running: bool = False  # the player asks the predator to run
+    stamina: float = 1.0  # 1: rested; running drains it, walking recovers it
+    winded: bool = False  # ran out of stamina: walks until it has `RECOVERED` again
+    runs: list[tuple[int, bool]] = field(default_factory=list)  # (frame, running) asked
 
     def copy(self) -> GameState:
         """A copy sharing nothing mutable (every field, whatever is added later)."""
@@ -57,6 +74,16 @@ class HerdingGame:
         self.seconds = float(game["seconds"])
         self.speed = float(predator.get("speed", 0.8))
         self.reach = float(predator.get("reach", 1.5))
+        self.run_speed = float(predator.get("run_speed", 1.6))
+        self.run_reach = float(predator.get("run_reach", 2.4))
+        self.stamina_s = float(predator.get("stamina_s", 6.0))
+        self.recover_s = float(predator.get("recover_s", 8.0))
+        pen = game["pen"]
+        self.gate_heading_deg = float((pen.get("gate") or {}).get("heading_deg", 180.0))
+        self.gate_width = float((pen.get("gate") or {}).get("width", min(1.6, self.pen_radius)))
+        self.fence_height = float((pen.get("fence") or {}).get("height", 0.5))
+        self.par = float(game.get("par") or 0.5 * float(game["seconds"]))
+        self.herd: dict[str, float] = {**HERD_DEFAULTS, **(game.get("herd") or {})}
         self.fps = float(fps)
         start = np.asarray(predator.get("position", (0.0, -3.0)), dtype=np.float64)
         self.state = GameState(start.copy(), start.copy())
@@ -70,6 +97,12 @@ class HerdingGame:
             raise ValueError(f"aim: ({x}, {y}) is not a point on the ground")
         self.state.aim = np.array([x, y])
         self.state.log.append((world.frame, x, y))
+
+    def run(self, world: Host, running: bool) -> None:
+        """The predator runs (True) or walks from this frame on; logged when it changes."""
+        if bool(running) != self.state.running:
+            self.state.running = bool(running)
+            self.state.runs.append((world.frame, bool(running)))
 
     def restart(self, world: Host) -> None:
         """Back to the level's start: the world as it was built, bit for bit."""
@@ -100,6 +133,20 @@ class HerdingGame:
     def predator(self) -> np.ndarray:
         return self.state.predator
 
+    @property
+    def sprinting(self) -> bool:
+        """The predator runs now: asked to, and not winded."""
+        return self.state.running and not self.state.winded
+
+    @property
+    def scare(self) -> float:
+        """Metres: creatures closer than this to the predator flee (its reach now)."""
+        return self.run_reach if self.sprinting else self.reach
+
+    def stars(self) -> int:
+        """Stars this game earned: 3 within par, 2 within 1.5x par, 1 for a win, else 0."""
+        return stars_for(self.elapsed, self.par) if self.outcome == WON else 0
+
     def in_pen(self, xy: np.ndarray) -> np.ndarray:
         """(n,) bool: points (n, 2) inside the pen."""
         return np.hypot(*(np.asarray(xy)[:, :2] - self.pen_centre).T) < self.pen_radius
@@ -113,4 +160,11 @@ class HerdingGame:
             "need": self.need,
             "seconds": round(self.elapsed, 3),
             "left": round(self.left, 3),
+            "par": self.par,
+            "stars": self.stars(),
         }
+
+
+def stars_for(seconds: float, par: float) -> int:
+    """Stars a win in `seconds` earns on a level of `par` seconds (1 to 3)."""
+    return 3 if seconds <= par else 2 if seconds <= 1.5 * par else 1

@@ -1,9 +1,12 @@
 """The herding game in the sandbox: the HUD's Game section, the banner, mouse and keys.
 
-The section shows the level, creatures penned of those needed, the time left and the
-level's best time. Holding the left button in the view and dragging points the
-predator (it follows at its own speed); R restarts the level from its start, P
-pauses. When the game ends a banner says how, with the time and the best time; a
+The section shows the level, creatures penned of those needed, the time left, the
+level's best time, the predator's stamina and the level select (`hud_levels`: every
+level with its stars; the locked ones greyed). Holding the left button in the view and
+dragging points the predator (it follows at its own speed); holding Shift makes it run
+(it scares farther and tires); R restarts the level from its start, P pauses, N opens
+the next level after a win. When the game ends a banner says how, with the time, the
+stars and the best time, and after a win offers the next level; a
 win is written to the best-times file once (`ecs_tentacles.herding.best_times`), on
 the best-times thread (`win_recorder`): a frame never waits for the file or its lock.
 
@@ -21,6 +24,8 @@ from pyglet.window import key
 
 from ecs_tentacles.herding import best_times, win_recorder
 from ecs_tentacles.herding.game import LOST, WON, HerdingGame
+from ecs_tentacles.herding.hud_levels import LevelPicker
+from ecs_tentacles.herding.levels import stars_text
 from ecs_tentacles.render.registries import Panel
 from ecs_tentacles.snapshot import SnapshotMismatch
 
@@ -40,6 +45,7 @@ class GamePanel(Panel):
         self.writing: list[win_recorder.PendingWin] = []  # wins not written yet (any game)
         self.message = ""
         self.best = self._best()  # read once a game, not every frame
+        self.levels = LevelPicker(sandbox)
         win_recorder.start()  # now, not in the frame the game is won
 
     @property
@@ -66,6 +72,7 @@ class GamePanel(Panel):
             self.writing.remove(done)
             if done.best is not None and done.level == game.level:
                 self.best = done.best
+                self.levels.refresh()  # the next level opens, the stars show
             if done.message:
                 self.message = done.message
 
@@ -80,8 +87,19 @@ class GamePanel(Panel):
             return
         self.attach(self.sandbox.world)
 
+    def next_level(self) -> bool:
+        """After a win, open the next level (False: not won, or the last level)."""
+        following = self.levels.next(self.game)
+        if self.game.outcome != WON or following is None:
+            return False
+        self.levels.open(following)
+        return True
+
     def draw(self, gui: Any) -> None:
+        if self.levels.open_wanted():
+            return  # the section is drawn for the new level from the next frame
         game = self.game
+        self.levels.poll_run(game)
         self._record()
         imgui.text(game.level)
         gui.item("game level")
@@ -92,12 +110,14 @@ class GamePanel(Panel):
         best = self.best
         imgui.text(f"best {best:.1f} s" if best is not None else "best: not won yet")
         gui.item("game best")
-        imgui.text_wrapped("drag: move the predator  R: restart  P: pause")
+        self.levels.draw(gui, game)
+        imgui.text_wrapped("drag: move the predator  Shift: run  R: restart  P: pause")
         if self.message:
             imgui.text_wrapped(self.message)
 
     def windows(self, gui: Any) -> None:
         game = self.game
+        self.levels.poll_run(game)
         if game.outcome not in (WON, LOST):
             return
         self._record()
@@ -105,7 +125,7 @@ class GamePanel(Panel):
         imgui.set_next_window_pos((width / 2, height * 0.3), 0, (0.5, 0.5))
         # a fixed height: a window sized to fit its contents is hidden on its first frame
         line = imgui.get_text_line_height_with_spacing()
-        imgui.set_next_window_size((BANNER_WIDTH * line / 17.0, 6.5 * line))
+        imgui.set_next_window_size((BANNER_WIDTH * line / 17.0, 8.5 * line))
         flags = imgui.WindowFlags_.no_move | imgui.WindowFlags_.no_resize
         flags |= imgui.WindowFlags_.no_collapse | imgui.WindowFlags_.no_title_bar
         imgui.begin("Game over", None, flags | imgui.WindowFlags_.no_scrollbar)
@@ -114,10 +134,17 @@ class GamePanel(Panel):
         imgui.text("You won!" if game.outcome == WON else "Time's up")
         imgui.pop_font()
         if game.outcome == WON:
-            imgui.text(f"{game.penned} penned in {game.elapsed:.1f} s")
+            imgui.text(f"{game.penned} penned in {game.elapsed:.1f} s (par {game.par:.0f} s)")
+            imgui.text(f"{stars_text(game.stars())}  {game.stars()} of 3 stars")
             imgui.text(self._best_line())
         else:
             imgui.text(f"{game.penned} of {game.need} penned")
+        following = self.levels.next(game) if game.outcome == WON else None
+        if following is not None:
+            if imgui.button(f"Next level: {following.title} (N)"):
+                self.next_level()
+                imgui.end()
+                return
         imgui.text("R: play again")
         imgui.end()
 
@@ -136,6 +163,8 @@ class GamePanel(Panel):
         if symbol == key.P:
             self.sandbox.paused = not self.sandbox.paused
             return True
+        if symbol == key.N:
+            return self.next_level()
         return False
 
     def press(self, x: float, y: float) -> bool:

@@ -2,19 +2,21 @@
 
     world = World.from_scene("herding_1_field")
     result = play(world, Bot())                  # the bot plays until the game ends
-    again = play(World.from_scene(...), Replay(result["log"]))   # the same game, exactly
+    again = play(World.from_scene(...), Replay(result["log"], result["runs"]))  # the same game
 
 `play` steps the world, asking the player (a `Bot`, a `Replay`, or anything with
 `decide(world, game)`) where to aim the predator every `every` frames (0.25 s), until
 the game is won or lost (or `max_seconds` of game time pass). It returns the game's
-summary, the input log, the wall time and the median frame's step time (`frame_ms`:
-physics and every system) with its real-time factor.
+summary, the input logs (`log`: aims, `runs`: run/walk changes), the wall time and the
+median frame's step time (`frame_ms`: physics and every system) with its real-time
+factor.
 
-`Bot` is a simple, honest strategy, a sheepdog's: herd the group of creatures nearest
-the pen, as many as are still needed and a spare; take the one of them farthest from
-the pen, get behind it (on the side away from the pen, `behind` metres off) and push it
-toward the pen; to get behind it, go around it, never through it. Pushing the group's
-rearmost creature drives the group from behind.
+`Bot` is a simple, honest strategy, a sheepdog's, one creature at a time: take the
+creature nearest the gate, get behind it (on the side away from where it should go,
+`behind` metres off) and push it: toward the point just outside the gate, or, once it
+stands in the funnel before the gate (within 40 degrees of its axis), through it; to
+get behind it, go around it (out of its reach) and around the pen, never through them.
+It runs (Shift) only to get somewhere far with no creature near, and walks to push.
 """
 
 from __future__ import annotations
@@ -25,6 +27,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
+from ecs_tentacles.herding.fence import Fence
 from ecs_tentacles.herding.game import PLAYING, HerdingGame
 
 if TYPE_CHECKING:
@@ -37,11 +40,12 @@ class Player(Protocol):
 
 
 class Bot:
-    """Push the laggard of the creatures nearest the pen toward it; go around it."""
+    """Push the creature nearest the gate to it and in; go around it and the pen."""
 
-    def __init__(self, behind: float = 0.9, spare: int = 2):
+    def __init__(self, behind: float = 0.9, approach: float = 1.0):
         self.behind = behind  # metres behind the creature pushed
-        self.spare = spare  # creatures herded beyond those still needed
+        self.approach = approach  # metres outside the gate the creatures are brought to
+        self.chosen: int | None = None  # the creature pushed, until it is penned
 
     def decide(self, world: Host, game: HerdingGame) -> Sequence[float] | None:
         creatures = world.creatures
@@ -49,30 +53,77 @@ class Bot:
         left = ~np.isin(creatures.entity, game.state.penned)
         if not left.any():
             return None
-        flock = xy[left]
-        gaps = np.hypot(*(flock - game.pen_centre).T)
-        # the group herded: the creatures still needed (and a spare), those nearest the pen
-        group = np.argsort(gaps, kind="stable")[: game.need - game.penned + self.spare]
-        laggard = group[int(np.argmax(gaps[group]))]
-        pushed = flock[laggard]
-        to_pen = (game.pen_centre - pushed) / max(float(gaps[laggard]), 1e-9)
-        target = pushed - self.behind * to_pen
-        x, y = self._around(game.predator, pushed, 0.8 * self.behind, target)
-        return (float(x), float(y))
+        fence = Fence.of(game)
+        outward = (fence.gate_point - fence.centre) / fence.radius
+        mouth = fence.gate_point + self.approach * outward  # just outside the gate
+        rows = np.flatnonzero(left)
+        entities = creatures.entity[rows]
+        if self.chosen not in entities.tolist():  # penned (or gone): the next nearest
+            gaps = np.hypot(*(xy[rows] - mouth).T)
+            self.chosen = int(entities[int(np.argmin(gaps))])
+        pushed = xy[rows[entities.tolist().index(self.chosen)]]
+        # in the funnel before the gate (within 40 degrees of its axis): push it through the
+        # gate, else to the mouth
+        rel = pushed - fence.gate_point
+        gap = float(np.hypot(*rel))
+        in_funnel = gap < self.approach + 1.5 and float(rel @ outward) > np.cos(0.7) * gap
+        goal = fence.gate_point - 0.8 * outward if in_funnel else mouth
+        to_goal = goal - pushed
+        to_goal = to_goal / max(float(np.hypot(*to_goal)), 1e-9)
+        target = self._outside(fence, pushed - self.behind * to_goal, 0.5)
+        aim = self._behind(game.predator, pushed, game.reach + 0.1, target, fence)
+        aim = self._around(game.predator, fence.centre, fence.radius + 0.3, aim)
+        clear = float(np.min(np.hypot(*(xy[rows] - game.predator).T))) > game.run_reach + 0.3
+        far = float(np.hypot(*(aim - game.predator))) > 1.5
+        game.run(world, clear and far and game.state.stamina > 0.4)
+        return (float(aim[0]), float(aim[1]))
+
+    @staticmethod
+    def _outside(fence: Fence, point: np.ndarray, margin: float) -> np.ndarray:
+        """`point`, or the nearest point `margin` m outside the pen (the predator keeps out)."""
+        off = point - fence.centre
+        gap = float(np.hypot(*off))
+        keep = fence.radius + margin
+        return point if gap >= keep else fence.centre + off * (keep / max(gap, 1e-9))
+
+    @staticmethod
+    def _behind(
+        at: np.ndarray, centre: np.ndarray, keep: float, target: np.ndarray, fence: Fence
+    ) -> np.ndarray:
+        """`target` (behind the creature at `centre`) when the predator is on its side
+        already (within 60 degrees of it, seen from the creature); else a step round the
+        creature, `keep` m out, toward that side (so it is not pushed the wrong way), or
+        round the other way when the pen is in the way."""
+        a, b = at - centre, target - centre
+        la, lb = float(np.hypot(*a)), float(np.hypot(*b))
+        if la < 1e-9 or lb < 1e-9 or np.dot(a, b) > 0.5 * la * lb:
+            return target
+        radial = a / la
+        side = np.array([-radial[1], radial[0]])
+        if np.dot(side, b) < 0:
+            side = -side
+        steps = [centre + keep * (radial + s) / np.sqrt(2.0) * 1.2 for s in (side, -side)]
+        clear = [np.hypot(*(p - fence.centre)) > fence.radius + 0.5 for p in steps]
+        return steps[0] if clear[0] or not clear[1] else steps[1]
 
     @staticmethod
     def _around(at: np.ndarray, centre: np.ndarray, keep: float, target: np.ndarray) -> np.ndarray:
         """`target`, or a point on the circle of radius `keep` about `centre` that leads
-        there without crossing the circle (the flock)."""
-        seg = target - at
+        there without crossing the circle (a target inside it is entered from its side)."""
+        off = target - centre
+        gap = float(np.hypot(*off))
+        edge = centre + off * (keep / gap) if 1e-9 < gap < keep else target
+        seg = edge - at
         length = float(np.hypot(*seg))
         if length < 1e-9:
             return target
         t = np.clip(np.dot(centre - at, seg) / length**2, 0.0, 1.0)
-        if np.hypot(*(at + t * seg - centre)) >= keep:
+        if np.hypot(*(at + t * seg - centre)) >= 0.95 * keep:
             return target
-        # step around: the tangent direction turning toward the target's side
         radial = (at - centre) / max(float(np.hypot(*(at - centre))), 1e-9)
+        if np.hypot(*(at - centre)) < 0.95 * keep:  # inside the circle: outward is fine
+            return target if np.dot(seg, radial) > 0 else centre + 1.3 * keep * radial
+        # step around: the tangent direction turning toward the target's side
         side = np.array([-radial[1], radial[0]])
         if np.dot(side, target - centre) < 0:
             side = -side
@@ -80,17 +131,34 @@ class Bot:
 
 
 class Replay:
-    """Aims where a recorded log aimed, at the same frames."""
+    """Aims where a recorded log aimed, and runs when it ran, at the same frames."""
 
-    def __init__(self, log: Sequence[tuple[int, float, float]]):
+    def __init__(
+        self,
+        log: Sequence[tuple[int, float, float]],
+        runs: Sequence[tuple[int, bool]] = (),
+    ):
         self.log = sorted(log)
         self.next = 0
+        self.runs = sorted(runs)
+        self.next_run = 0
+
+    def running(self, frame: int) -> list[bool]:
+        """The run/walk changes due by `frame`, in order."""
+        out = []
+        while self.next_run < len(self.runs) and self.runs[self.next_run][0] <= frame:
+            out.append(bool(self.runs[self.next_run][1]))
+            self.next_run += 1
+        return out
 
     def frames_to_next(self, frame: int, most: int) -> int:
         """Frames to step before the next logged aim is due (at most `most`)."""
-        if self.next >= len(self.log):
-            return most
-        return max(1, min(most, self.log[self.next][0] - frame))
+        due = [most]
+        if self.next < len(self.log):
+            due.append(self.log[self.next][0] - frame)
+        if self.next_run < len(self.runs):
+            due.append(self.runs[self.next_run][0] - frame)
+        return max(1, min(due))
 
     def due(self, frame: int) -> list[tuple[float, float]]:
         out = []
@@ -117,6 +185,8 @@ def play(
         if isinstance(player, Replay):
             for point in player.due(world.frame):
                 game.aim(world, point)
+            for running in player.running(world.frame):
+                game.run(world, running)
             frames = player.frames_to_next(world.frame, block)
         else:
             aim = player.decide(world, game)
@@ -130,6 +200,7 @@ def play(
     return {
         **game.summary(),
         "log": list(game.state.log),
+        "runs": list(game.state.runs),
         "wall_s": round(time.perf_counter() - started, 2),
         "frame_ms": round(median, 2),  # median over the game's blocks
         "realtime_factor": round(1000.0 * world.settings.dt / median, 2) if median else None,

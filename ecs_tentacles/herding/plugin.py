@@ -2,12 +2,15 @@
 
 Game mode "herding" (the scene's `game`, whose keys are `ecs_tentacles.herding.schema`'s;
 the `game` layer owns the key); resource `HerdingGame`
-(`ecs_tentacles.herding.game`); systems `Predator` and `Referee` (`systems/herding/`).
-It needs the flee plugin (what makes creatures run from the predator) and locomotion.
+(`ecs_tentacles.herding.game`); systems `Predator`, `Herd` and `Referee`
+(`systems/herding/`: `Herd` makes the creatures flee the predator and graze as a
+flock, so no flee plugin is needed). It needs locomotion and the game layer.
 
 What it adds to the registries in `build`:
 - `GameModes` (`ecs_tentacles.game.modes`): the mode "herding", its rules' schema and
   checks, and its result (which ends `run` and `play --headless` once won or lost);
+- `StaticGeometry` (`ecs_tentacles.physics.model`): the pen's fence, solid to the
+  creatures (`ecs_tentacles.herding.fence`);
 - `Dangers` (`ecs_tentacles.behaviour`): the predator, so everything that fears
   dangers fears it (the flee plugin runs, fur's emotion raises quills);
 - `Lines`, `Spheres` and `FramedPoints` (the renderer): the pen's ring on the ground,
@@ -41,7 +44,7 @@ if TYPE_CHECKING:
 class HerdingPlugin(Plugin):
     name = "herding"
     description = "the herding game: drive creatures into a pen with a predator"
-    requires = ("locomotion", "flee", "game")
+    requires = ("locomotion", "game")
 
     def problems(self, scene: Mapping[str, Any]) -> list[tuple[tuple[str | int, ...], str]]:
         return plugin_problems(scene)
@@ -55,10 +58,11 @@ class HerdingPlugin(Plugin):
         world.resource(HerdingGame).start = world.snapshot()
 
     def systems(self) -> list[System]:
+        from ecs_tentacles.systems.herding.herd import Herd
         from ecs_tentacles.systems.herding.predator import Predator
         from ecs_tentacles.systems.herding.referee import Referee
 
-        return [Predator(), Referee()]
+        return [Predator(), Herd(), Referee()]
 
     def snapshot(self, world: Host) -> Any:
         return world.resource(HerdingGame).state.copy()
@@ -68,11 +72,14 @@ class HerdingPlugin(Plugin):
 
     def build(self, app: App) -> None:
         from ecs_tentacles.cli.registries import RunSummaries
-        from ecs_tentacles.herding import entries
+        from ecs_tentacles.herding import entries, fence
+        from ecs_tentacles.physics.model import StaticGeometry
         from ecs_tentacles.render.registries import FramedPoints, Lines, Panels, Spheres
         from ecs_tentacles.take.registries import TakeTracks
 
         app.add(GameModes, GameMode("herding", GAME, _result, game_problems, self.description))
+        if app.world is not None:  # (a shard planner builds plugins without a world)
+            app.add(StaticGeometry, fence.static_geometry(app.world))
         app.add(Dangers, DangerSource(sense=_predator_danger))
         app.add(Lines, entries.lines)
         app.add(Spheres, entries.spheres)

@@ -9,9 +9,11 @@ against (`ecs_tentacles.game`, which owns the `game` key and adds `mode`).
 
 `need` creatures must enter the pen (a disc on the ground) within `seconds` of game
 time; the predator starts at `position` and moves toward where the player aims it at
-up to `speed` m/s. `reach` is only drawn: the flee plugin's `distance` is what scares.
+up to `speed` m/s walking (`run_speed` running, on its stamina); creatures within `reach`
+(`run_reach` running) flee it. The pen has a fence and a `gate`; `par` and `herd` tune
+the stars and the creatures' flocking (`herding.schema.json` says each key).
 Rules the schema cannot say (`problems`): `need` at most the scene's creatures, the
-predator not starting inside the pen.
+predator not starting inside the pen, the gate no wider than the pen.
 """
 
 from __future__ import annotations
@@ -50,4 +52,7 @@ def game_problems(scene: Mapping[str, Any]) -> list[Problem]:
     start = (game.get("predator") or {}).get("position", [0.0, -3.0])
     if np.hypot(*np.subtract(start, pen["centre"])) < pen["radius"]:
         found.append((("game", "predator", "position"), "inside the pen: start it outside"))
+    gate = (pen.get("gate") or {}).get("width", 0.0)
+    if gate > 2 * pen["radius"]:
+        found.append((("game", "pen", "gate", "width"), f"{gate} is wider than the pen"))
     return found

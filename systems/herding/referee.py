@@ -1,13 +1,13 @@
 """referee: the herding game's clock, pen and outcome.
 
-While the game is played, each frame adds one to the clock and every creature whose
-mantle is inside the pen for the first time is penned (it stays counted if it walks
-out again). When `need` creatures are penned the game is won (`GameWon`); when the
+While the game is played, each frame adds one to the clock; a creature whose mantle
+comes inside the pen's fence is penned, and one driven out again (through the gate) is
+no longer (`CreatureLeft`). When `need` creatures are penned the game is won (`GameWon`); when the
 clock reaches `seconds` first it is lost (`GameLost`). Either way the clock stops.
 
 Reads: `HerdingGame`, CreatureStore (entity, mantle_row), Transform store (pos).
 Writes: `HerdingGame.state` (frames, penned, outcome); events `CreaturePenned`,
-`GameWon`, `GameLost`.
+`CreatureLeft`, `GameWon`, `GameLost`.
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ecs_tentacles.herding.events import CreaturePenned, GameLost, GameWon
+from ecs_tentacles.herding.events import CreatureLeft, CreaturePenned, GameLost, GameWon
 from ecs_tentacles.herding.game import LOST, PLAYING, WON, HerdingGame
 from ecs_tentacles.system import System
 
@@ -41,6 +41,12 @@ class Referee(System):
         creatures = world.creatures
         mantles = world.transforms.pos[creatures.mantle_row]
         inside = game.in_pen(mantles[:, :2])
+        out = set(creatures.entity[~inside].tolist())
+        for i in [i for i, entity in enumerate(state.penned) if entity in out]:  # driven out
+            world.events.emit(CreatureLeft(world, state.penned[i], game.elapsed))
+        kept = [i for i, entity in enumerate(state.penned) if entity not in out]
+        state.penned = [state.penned[i] for i in kept]
+        state.penned_at = [state.penned_at[i] for i in kept]
         arrived = inside & ~np.isin(creatures.entity, state.penned)  # in for the first time
         for row in np.flatnonzero(arrived).tolist():
             entity = int(creatures.entity[row])

@@ -25,7 +25,7 @@ def level(**game: Any) -> dict[str, Any]:
         "version": 1,
         "name": "test level",
         "seed": 3,
-        "plugins": {"flee": {"distance": 1.2, "run": 0.8, "interval": 0.25}, "herding": {}},
+        "plugins": {"herding": {}},
         "game": rules,
         "creatures": [
             {"name": "a", "position": [0.0, 0.0], **copy.deepcopy(CREATURE)},

@@ -87,7 +87,7 @@ def test_a_recorded_input_log_replays_to_the_same_game() -> None:
         first = play(world, Scripted())
         end = _state(world)
     with World.from_scene(level(need=1, seconds=30)) as world:
-        again = play(world, Replay(first["log"]))
+        again = play(world, Replay(first["log"], first["runs"]))
         assert {k: again[k] for k in ("outcome", "penned", "seconds")} == {
             k: first[k] for k in ("outcome", "penned", "seconds")
         }

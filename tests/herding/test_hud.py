@@ -127,3 +127,40 @@ def test_r_after_a_creature_is_deleted_restarts_the_level(sandbox: Any) -> None:
     sandbox.step(10)
     event(sandbox, "on_key_press", key.R, 0)  # and R goes on restarting from the snapshot
     assert sandbox.world is world and world.frame == 0 and game.state.frames == 0
+
+
+def test_the_section_shows_stamina_and_the_level_select(sandbox: Any) -> None:
+    sandbox.render()
+    assert {"game stamina", "game levels"} <= set(sandbox.hud.gui.rects)
+    game = sandbox.world.resource(HerdingGame)
+    sandbox.keys.on_key_press(key.LSHIFT, 0)  # held: the predator runs
+    sandbox.render()
+    assert game.state.running and game.state.runs == [(0, True)]
+    sandbox.keys.on_key_release(key.LSHIFT, 0)
+    sandbox.render()
+    assert not game.state.running
+
+
+def test_a_win_offers_the_next_level_and_n_opens_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Level 1's rules on the small test level: won, the banner offers level 2 and N
+    opens it (the level select then lists level 2 open)."""
+    from ecs_tentacles.render.sandbox import Sandbox
+
+    monkeypatch.setenv("ECS_TENTACLES_DATA", str(tmp_path / "data"))
+    made = Sandbox(level(need=1, level="1. Open field"), headless=True, width=640, height=360)
+    try:
+        _win(made)
+        made.render()
+        panel = made.panel("Game")
+        assert panel.win.wait(10)
+        made.render()
+        assert "game banner" in made.hud.gui.windows
+        assert panel.levels.next(made.world.resource(HerdingGame)).scene == "herding_2_shore"
+        event(made, "on_key_press", key.N, 0)
+        game = made.world.resource(HerdingGame)
+        assert game.level == "2. Rocky shore" and made.world.creatures.count == 48
+        assert [lv.unlocked for lv in made.panel("Game").levels.levels][:3] == [True, True, False]
+    finally:
+        made.close()

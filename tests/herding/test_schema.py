@@ -22,6 +22,10 @@ from tests.herding.levels import level
         ({"pen": {"centre": [1, 0], "radius": -1}}, "game.pen.radius"),
         ({"predator": {"position": [1.2, 0.1]}}, "game.predator.position: inside the pen"),
         ({"predator": {"speed": "fast"}}, "game.predator.speed"),
+        (
+            {"pen": {"centre": [1.2, 0], "radius": 0.6, "gate": {"width": 1.5}}},
+            "game.pen.gate.width: 1.5 is wider than the pen",
+        ),
         ({"bonus": 1}, "game"),
     ],
 )
