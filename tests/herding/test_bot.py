@@ -12,6 +12,7 @@ from ecs_tentacles.world import World
 SPARE = 0.15  # the share of the level's time the bot has left at least
 
 
+@pytest.mark.slow  # each level is minutes of game: `pytest -m slow tests/herding`
 @pytest.mark.parametrize("name", ["herding_1_field", "herding_2_shore", "herding_3_maze"])
 def test_the_bot_wins_the_level_headless_with_time_to_spare(name: str) -> None:
     with World.from_scene(bundled_scene(name)) as world:
