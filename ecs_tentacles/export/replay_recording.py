@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ecs_tentacles.ground import ground_of
+from ecs_tentacles.numeric.optional_kernels import OptionalKernels
 from ecs_tentacles.physics.tiers import KINEMATIC
 from ecs_tentacles.take import replay as take_replay
 
@@ -28,6 +29,8 @@ if TYPE_CHECKING:
     from ecs_tentacles.world import World
 
 ROTATION = 1e-6  # 1 - |q . q'| allowed: about a tenth of a degree
+# the check in one pass (numba), or None: numpy reconstructs the poses, then compares
+KERNELS = OptionalKernels("ecs_tentacles.export.replay_check_kernel", "ECS_TENTACLES_REPLAY")
 
 
 class ReplayRecorder:
@@ -102,24 +105,55 @@ class ReplayRecorder:
             return
         kind = replay.kind[moving].astype(np.int8)
         phase, xy, heading = replay.phase[moving], replay.xy[moving], replay.heading[moving]
-        found = take_replay.poses(
-            self.header, self.clips, take_of, kind.astype(np.int64), phase, xy, heading, self._rows
-        )
-        good = np.zeros(len(moving), dtype=bool)
-        owner = self._owner[take_of]
-        transforms = self.world.transforms
-        for clip, (rows, pos, quat) in found.items():
-            store = body_rows[rows]
-            if (store < 0).any():
-                continue
-            near = np.abs(pos - transforms.pos[store]).max(axis=(1, 2)) <= take_replay.TOLERANCE
-            dot = np.abs(np.einsum("kbi,kbi->kb", quat, transforms.quat[store]))
-            good[owner == clip] = near & ((1.0 - dot).max(axis=1) <= ROTATION)
+        good = self._within(take_of, kind.astype(np.int64), phase, xy, heading, body_rows)
         at = take_of[good]
         kind_out[at] = kind[good]
         arrays["replay_phase"][i, at] = phase[good]
         arrays["replay_xy"][i, at] = xy[good]
         arrays["replay_heading"][i, at] = heading[good]
+
+    def _within(
+        self,
+        take_of: np.ndarray,
+        kind: np.ndarray,
+        phase: np.ndarray,
+        xy: np.ndarray,
+        heading: np.ndarray,
+        body_rows: np.ndarray,
+    ) -> np.ndarray:
+        """Whether each creature's reconstruction (`take.replay.poses`) is within the
+        tolerance of what the world shows (False where a body has no Transform row)."""
+        good = np.zeros(len(take_of), dtype=bool)
+        owner = self._owner[take_of]
+        transforms = self.world.transforms
+        fast = KERNELS.get()
+        if fast is None:
+            found = take_replay.poses(
+                self.header, self.clips, take_of, kind, phase, xy, heading, self._rows
+            )
+            for clip, (rows, pos, quat) in found.items():
+                store = body_rows[rows]
+                if (store < 0).any():
+                    continue
+                near = np.abs(pos - transforms.pos[store]).max(axis=(1, 2))
+                dot = np.abs(np.einsum("kbi,kbi->kb", quat, transforms.quat[store]))
+                good[owner == clip] = (near <= take_replay.TOLERANCE) & (
+                    (1.0 - dot).max(axis=1) <= ROTATION
+                )
+            return good
+        clips = self.header[take_replay.KEY]["clips"]
+        for clip in np.unique(owner).tolist():
+            mine = np.flatnonzero(owner == clip)
+            store = body_rows[self._rows[clip][take_of[mine]]]
+            if (store < 0).any():
+                continue
+            idle, crawl = (int(n) for n in clips[clip]["frames"])
+            good[mine] = fast.replay_within(
+                self.clips[clip], idle, crawl, kind[mine], phase[mine], xy[mine],
+                heading[mine], store, transforms.pos, transforms.quat,
+                take_replay.TOLERANCE, ROTATION,
+            )  # fmt: skip
+        return good
 
     def _take_of(self, roster: Any, creature_index: dict[int, int]) -> np.ndarray:
         """Roster index -> take creature index (-1: not in the take), kept until the

@@ -56,7 +56,9 @@ class TakeWriter:
         self._archive: zipfile.ZipFile | None = None
         self._finished = False
         self._discarded = False
-        self._queue: queue.Queue[tuple[str, np.ndarray] | None] = queue.Queue(maxsize=1)
+        self._queue: queue.Queue[tuple[str, list[np.ndarray], float | None] | None] = queue.Queue(
+            maxsize=1
+        )
         self._thread: threading.Thread | None = None
         self._failure: BaseException | None = None
         self._abort = False
@@ -69,13 +71,17 @@ class TakeWriter:
         return self
 
     def _store(self) -> None:
-        """The writer's thread: each entry handed over, deflated into the archive."""
+        """The writer's thread: each entry handed over (its frames' parts joined and, for
+        a quantised array, put in steps here), deflated into the archive."""
         while (item := self._queue.get()) is not None:
             if self._abort or self._failure is not None:
                 continue  # stopped: the entries left are dropped
             try:
                 assert self._archive is not None
-                chunks.add_entry(self._archive, item[0], chunks.npy_bytes(item[1]))
+                name, parts, step = item
+                joined = parts[0] if len(parts) == 1 else np.concatenate(parts)
+                stored = joined if step is None else chunks.quantise(joined, step)
+                chunks.add_entry(self._archive, name, chunks.npy_bytes(stored))
             except BaseException as error:  # handed to the main thread at its next entry
                 self._failure = error
 
@@ -149,21 +155,23 @@ class TakeWriter:
             widest = max(p.shape[1] for p in parts) if parts[0].ndim > 1 else None
             if widest is not None:  # a creature came within the chunk: later frames are wider
                 parts = [_pad_to_later(p, parts, widest) for p in parts]
-            joined = np.concatenate(parts)
-            step = self.quantised.get(name)
-            stored = joined if step is None else chunks.quantise(joined, step)
-            self._entry(chunks.entry_name(name, self._chunk), stored, joined.nbytes)
+            entry = chunks.entry_name(name, self._chunk)
+            self._entry(entry, parts, self.quantised.get(name))
         self._pending = {}
         self._pending_frames = 0
         self._chunk += 1
 
-    def _entry(self, name: str, array: np.ndarray, counted: int | None = None) -> None:
-        """Store `array` as entry `name`; `counted`: the bytes it stands for (progress)."""
+    def _entry(
+        self, name: str, array: np.ndarray | list[np.ndarray], step: float | None = None
+    ) -> None:
+        """Store `array` (or the frames' parts of one, joined on the writer's thread and
+        put in steps of `step` there) as entry `name`; the parts are the writer's own."""
         assert self._thread is not None, "TakeWriter is used in a with block"
         if self._failure is not None:
             self._join()  # raises it
-        self._queue.put((name, array))
-        told = array.nbytes if counted is None else counted
+        parts = array if isinstance(array, list) else [array]
+        self._queue.put((name, parts, step))
+        told = sum(part.nbytes for part in parts)
         self.stored += told
         if self.progress is not None:
             self.progress(told)

@@ -169,3 +169,20 @@ def test_a_take_that_lies_about_its_chunks_is_refused_in_one_line(
             with open_take(bad) as source:
                 for _ in source.chunks():
                     pass
+
+
+def test_the_replay_check_decides_alike_with_and_without_its_kernel(
+    crowd_plan: BakePlan, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The recorder's one-pass check (numba) and the numpy reconstruction record the
+    same replayed creature-frames: the two takes are byte for byte one file."""
+    from ecs_tentacles.export import replay_recording
+
+    pytest.importorskip("ecs_tentacles.export.replay_check_kernel")
+    fast, slow = tmp_path / "fast.npz", tmp_path / "slow.npz"
+    bake_to_file(crowd_plan, fast, progress=False)
+    monkeypatch.setattr(replay_recording.KERNELS, "backend", "numpy")
+    bake_to_file(crowd_plan, slow, progress=False)
+    with open_take(fast) as source:
+        assert any(source.segments(c) for c in range(len(source.header["creatures"])))
+    assert fast.read_bytes() == slow.read_bytes()
