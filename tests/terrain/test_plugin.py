@@ -290,9 +290,10 @@ def _above_ground(world: World) -> np.ndarray:
 
 
 def _footprint(solid: Solid, ground: TerrainGround) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Over the points (k, 2) a 2 cm grid puts under `solid`: its lowest and highest
-    point on each vertical line there and the ground's height."""
-    side = np.arange(-solid.bound, solid.bound + 0.02, 0.02)
+    """Over the points (k, 2) a 4 cm grid puts under `solid` (2 cm made this test 35 s
+    once the rocky preset had a rock per 1.5 creatures): its lowest and highest point on
+    each vertical line there and the ground's height."""
+    side = np.arange(-solid.bound, solid.bound + 0.04, 0.04)
     xy = solid.position[:2] + np.stack(np.meshgrid(side, side), axis=-1).reshape(-1, 2)
     top = solid.top(xy)
     xy, top = xy[np.isfinite(top)], top[np.isfinite(top)]
