@@ -34,7 +34,6 @@ from __future__ import annotations
 
 import hashlib
 import importlib.util
-import os
 import pathlib
 import struct
 from dataclasses import dataclass
@@ -44,8 +43,7 @@ import mujoco
 import numpy as np
 
 from ecs_tentacles.clips.clips import CRAWL, KINDS, MAX_CRAWL_SPEED, Clip, GaitClips
-from ecs_tentacles.output.atomic import atomic_file
-from ecs_tentacles.untrusted.files import Unfit, read_regular
+from ecs_tentacles.untrusted.sealed_cache import DIGEST, SealedCache
 
 MAGIC = b"ECSTCLP1"
 SUFFIX = ".clips"
@@ -53,10 +51,10 @@ MAX_FRAMES = 100_000  # a clip's frames at most (a 5 s loop at 60 fps is 300)
 MAX_BODIES = 4096
 MAX_JOINTS = 16_384  # qpos or qvel entries
 MAX_METRES = 1000.0  # a body this far from its ground frame's origin is no recording
-_DIGEST = 32
-_HEAD = len(MAGIC) + _DIGEST + 3 * 4 + 2 * 8
+_HEAD = len(MAGIC) + DIGEST + 3 * 4 + 2 * 8
 _CLIP_HEAD = 3 * 4 + 3 * 8
 MAX_ENTRY_BYTES = 64 << 20  # far above a real entry (the octopus: about 1 MB)
+CACHE = SealedCache("clips", MAGIC, SUFFIX, MAX_ENTRY_BYTES)
 
 
 @dataclass(frozen=True)
@@ -72,13 +70,12 @@ class Shape:
 
 def cache_folder() -> pathlib.Path:
     """Where recorded clips are kept between runs."""
-    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
-    return pathlib.Path(base) / "ecs_tentacles" / "clips"
+    return CACHE.folder()
 
 
 def entry(key: str) -> pathlib.Path:
     """The file that keeps the clips of `key` (a SHA-256 in hex)."""
-    return cache_folder() / f"{key}{SUFFIX}"
+    return CACHE.entry(key)
 
 
 _SOURCES: str | None = None
@@ -119,13 +116,14 @@ def entry_key(recording: str, options: dict[str, Any]) -> str:
 
 def encode(key: str, clips: GaitClips) -> bytes:
     """The entry's bytes for `clips` under `key`."""
+    return CACHE.seal(key, _payload(clips))
+
+
+def _payload(clips: GaitClips) -> bytes:
+    """What an entry holds after the key: the sizes, then each clip's head and arrays."""
     idle, crawl = clips.idle, clips.crawl
     nq, nv = idle.qpos.shape[1], idle.qvel.shape[1]
-    parts = [
-        MAGIC,
-        bytes.fromhex(key),
-        struct.pack("<3I2d", len(clips.bodies), nq, nv, clips.seconds, clips.store_lag),
-    ]
+    parts = [struct.pack("<3I2d", len(clips.bodies), nq, nv, clips.seconds, clips.store_lag)]
     for clip in (idle, crawl):
         first, end = clip.span
         parts.append(
@@ -133,20 +131,15 @@ def encode(key: str, clips: GaitClips) -> bytes:
         )
         for array in (clip.pos, clip.quat, clip.qpos, clip.qvel):
             parts.append(np.ascontiguousarray(array, dtype="<f8").tobytes())
-    body = b"".join(parts)
-    return body + hashlib.sha256(body).digest()
+    return b"".join(parts)
 
 
 def decode(key: str, data: bytes, shape: Shape, morphology: tuple[Any, ...]) -> GaitClips | None:
     """The clips in an entry's bytes, or None unless every check holds (module doc)."""
-    if not _HEAD + 2 * _CLIP_HEAD + _DIGEST <= len(data) <= MAX_ENTRY_BYTES:
+    body = CACHE.opened(key, data, _HEAD - CACHE.head + 2 * _CLIP_HEAD)
+    if body is None:
         return None
-    body, digest = data[:-_DIGEST], data[-_DIGEST:]
-    if hashlib.sha256(body).digest() != digest or not body.startswith(MAGIC):
-        return None
-    if body[len(MAGIC) : len(MAGIC) + _DIGEST] != _source(key):
-        return None
-    bodies, nq, nv, seconds, lag = struct.unpack_from("<3I2d", body, len(MAGIC) + _DIGEST)
+    bodies, nq, nv, seconds, lag = struct.unpack_from("<3I2d", body, CACHE.head)
     if (bodies, nq, nv) != (len(shape.bodies), shape.nq, shape.nv):
         return None
     if not (0 < bodies <= MAX_BODIES and 0 < nq <= MAX_JOINTS and 0 < nv <= MAX_JOINTS):
@@ -185,35 +178,14 @@ def _sane(pos: np.ndarray, quat: np.ndarray, qpos: np.ndarray, qvel: np.ndarray)
     return bool(unit.all() and (np.abs(pos) <= MAX_METRES).all())
 
 
-def _source(key: str) -> bytes:
-    """The key's 32 bytes as kept in an entry (b"" for a key that is not a SHA-256)."""
-    try:
-        digest = bytes.fromhex(key)
-    except ValueError:
-        return b""
-    return digest if len(digest) == _DIGEST else b""
-
-
 def read(key: str, shape: Shape, morphology: tuple[Any, ...]) -> GaitClips | None:
     """The clips kept under `key` for a creature of `shape` (its physics `morphology`
     key), or None: absent, not a regular file, too large, unreadable or failing a check."""
-    if not _source(key):
-        return None
-    try:
-        data = read_regular(entry(key), MAX_ENTRY_BYTES, follow=False)
-    except (OSError, Unfit):  # absent, a link, a FIFO, too large, no permission
-        return None
-    return decode(key, data, shape, morphology)
+    data = CACHE.load(key)
+    return None if data is None else decode(key, data, shape, morphology)
 
 
 def keep(key: str, clips: GaitClips) -> None:
     """Write `clips` as the entry of `key`, atomically (`atomic_file`); a cache that
     cannot be written is skipped silently (the next run records again)."""
-    if not _source(key):
-        return
-    try:
-        cache_folder().mkdir(parents=True, exist_ok=True)
-        with atomic_file(entry(key)) as handle:
-            handle.write(encode(key, clips))
-    except OSError:  # OutputError included: a full disk, another run's entry first
-        pass
+    CACHE.keep(key, _payload(clips))

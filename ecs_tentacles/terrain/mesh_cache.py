@@ -39,24 +39,21 @@ Layout (little-endian): `MAGIC` (8 bytes) | the key's digest (32) | the number o
 
 from __future__ import annotations
 
-import hashlib
-import os
 import pathlib
 import struct
 from collections.abc import Sequence
 
 import numpy as np
 
-from ecs_tentacles.output.atomic import atomic_file
 from ecs_tentacles.terrain.mesh_worker import MAX_PIECE_VERTICES, MAX_PIECES, has_volume
-from ecs_tentacles.untrusted.files import Unfit, read_regular
+from ecs_tentacles.untrusted.sealed_cache import DIGEST, SealedCache, key_bytes
 
 MAGIC = b"ECSTPCS1"
 SUFFIX = ".pieces"
 MAX_ENTRY_VERTICES = 4 * MAX_PIECE_VERTICES  # per piece: CoACD's decimation aims at 256
-_DIGEST = 32
-_HEAD = len(MAGIC) + _DIGEST + 4  # magic, the key's digest, the number of pieces
-MAX_ENTRY_BYTES = _HEAD + MAX_PIECES * (4 + 24 * MAX_ENTRY_VERTICES) + _DIGEST
+_HEAD = len(MAGIC) + DIGEST + 4  # magic, the key's digest, the number of pieces
+MAX_ENTRY_BYTES = _HEAD + MAX_PIECES * (4 + 24 * MAX_ENTRY_VERTICES) + DIGEST
+CACHE = SealedCache("meshes", MAGIC, SUFFIX, MAX_ENTRY_BYTES)
 TOLERANCE = 0.05  # of the source box's diagonal: how far past the box a piece may reach
 
 Pieces = tuple[np.ndarray, ...]
@@ -64,13 +61,12 @@ Pieces = tuple[np.ndarray, ...]
 
 def cache_folder() -> pathlib.Path:
     """Where decomposed meshes are kept between runs."""
-    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
-    return pathlib.Path(base) / "ecs_tentacles" / "meshes"
+    return CACHE.folder()
 
 
 def entry(key: str) -> pathlib.Path:
     """The file that keeps the pieces of `key` (a SHA-256 in hex)."""
-    return cache_folder() / f"{key}{SUFFIX}"
+    return CACHE.entry(key)
 
 
 def sane(pieces: Sequence[np.ndarray]) -> bool:
@@ -88,22 +84,21 @@ def sane(pieces: Sequence[np.ndarray]) -> bool:
 
 def encode(key: str, pieces: Sequence[np.ndarray]) -> bytes:
     """The entry's bytes for `pieces` under `key`."""
+    return CACHE.seal(key, _payload(pieces))
+
+
+def _payload(pieces: Sequence[np.ndarray]) -> bytes:
+    """What an entry holds after the key: the count, each piece's size, the vertices."""
     sizes = struct.pack(f"<{len(pieces)}I", *(len(p) for p in pieces))
     vertices = b"".join(np.ascontiguousarray(p, dtype="<f8").tobytes() for p in pieces)
-    body = MAGIC + bytes.fromhex(key) + struct.pack("<I", len(pieces)) + sizes + vertices
-    return body + hashlib.sha256(body).digest()
+    return struct.pack("<I", len(pieces)) + sizes + vertices
 
 
 def decode(key: str, data: bytes) -> Pieces | None:
     """The pieces in an entry's bytes, or None unless every check above holds (`fits`
     aside: it needs the source)."""
-    if not _HEAD + _DIGEST <= len(data) <= MAX_ENTRY_BYTES:
-        return None
-    body, digest = data[:-_DIGEST], data[-_DIGEST:]
-    if hashlib.sha256(body).digest() != digest or not body.startswith(MAGIC):
-        return None
-    source = _source(key)
-    if not source or body[len(MAGIC) : _HEAD - 4] != source:
+    body = CACHE.opened(key, data, 4)
+    if body is None:
         return None
     (count,) = struct.unpack_from("<I", body, _HEAD - 4)
     if not 1 <= count <= MAX_PIECES or len(body) < _HEAD + 4 * count:
@@ -119,23 +114,11 @@ def decode(key: str, data: bytes) -> Pieces | None:
     return pieces if sane(pieces) else None
 
 
-def _source(key: str) -> bytes:
-    """The key's 32 bytes as kept in an entry (b"" for a key that is not a SHA-256)."""
-    try:
-        digest = bytes.fromhex(key)
-    except ValueError:
-        return b""
-    return digest if len(digest) == _DIGEST else b""
-
-
 def read(key: str) -> Pieces | None:
     """The pieces kept under `key`, or None: absent, not a regular file, larger than
     `MAX_ENTRY_BYTES`, unreadable, or failing a check (`decode`)."""
-    try:
-        data = read_regular(entry(key), MAX_ENTRY_BYTES, follow=False)
-    except (OSError, Unfit):  # absent, a link, a FIFO, too large, no permission
-        return None
-    return decode(key, data)
+    data = CACHE.load(key)
+    return None if data is None else decode(key, data)
 
 
 def fits(pieces: Pieces, box: np.ndarray) -> bool:
@@ -152,11 +135,5 @@ def keep(key: str, pieces: Sequence[np.ndarray]) -> None:
     """Write `pieces` as the entry of `key`, atomically (`atomic_file`: a temporary file
     renamed into place); pieces that would not read back, or a cache that cannot be
     written, are skipped silently (the next run decomposes again)."""
-    if not _source(key) or not sane(pieces):
-        return
-    try:
-        cache_folder().mkdir(parents=True, exist_ok=True)
-        with atomic_file(entry(key)) as handle:
-            handle.write(encode(key, pieces))
-    except OSError:  # OutputError included: a full disk, another run's entry first
-        pass
+    if key_bytes(key) and sane(pieces):
+        CACHE.keep(key, _payload(pieces))
