@@ -82,7 +82,8 @@ def run_json(example: Example) -> None:
 def commands(text: str) -> list[list[str]]:
     """The block's commands, continuation lines joined and comments dropped."""
     joined = re.sub(r"\\\n\s*", " ", text)
-    return [argv for argv in map(lambda line: shlex.split(line, comments=True), joined.splitlines()) if argv]
+    split = [shlex.split(line, comments=True) for line in joined.splitlines()]
+    return [argv for argv in split if argv]
 
 
 def run_sh(example: Example) -> None:
@@ -104,9 +105,10 @@ def takes_quiet(argv: list[str]) -> bool:
 
 
 SYBIL = Sybil(
-    parsers=[CodeBlockParser(language, evaluator) for language, evaluator in (
-        ("python", run_python), ("json", run_json), ("sh", run_sh)
-    )],
+    parsers=[
+        CodeBlockParser(language, evaluator)
+        for language, evaluator in (("python", run_python), ("json", run_json), ("sh", run_sh))
+    ],
 )
 
 

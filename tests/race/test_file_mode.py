@@ -17,7 +17,8 @@ PAGE = Path(__file__).resolve().parents[2] / "docs" / "extending" / "game-modes.
 
 def test_the_files_are_the_page_s() -> None:
     blocks = re.findall(r"<!-- file: (\S+) -->\n```\w+\n(.*?)```", PAGE.read_text(), flags=re.S)
-    assert dict(blocks) == {name: (SPRINT / name).read_text() for name in ("sprint.py", "sprint.json")}
+    files = ("sprint.py", "sprint.json")
+    assert dict(blocks) == {name: (SPRINT / name).read_text() for name in files}
 
 
 def test_a_mode_from_a_file_ends_the_run_and_reports_its_result(tmp_path: Path, capsys) -> None:  # type: ignore[no-untyped-def]
