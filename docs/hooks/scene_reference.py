@@ -155,10 +155,14 @@ def page() -> str:
             ("Tentacle keys (`creatures[].tentacles`)", cls.tentacle_schema, "tentacles"),
             (f"Its config (`plugins.{name}`)", cls.config_schema, f"plugins.{name}"),
         )
+        shown = False
         for title, keys, path in places:
             node = keys if path.startswith("plugins.") else {"properties": keys}
             if node.get("properties"):
                 out += [f"### {title}\n\n", table(node, path), "\n"]
+                shown = True
+        if not shown:
+            out.append("No scene keys of its own.\n\n")
         if cls.defs:
             out += ["### Its shared definitions\n\n", *section_of_defs(cls.defs, "####")]
         try:
