@@ -1,8 +1,9 @@
 """The scene reference's markdown (`scenes/reference.md`, written by scene_reference.py when
 the site is built), from the schema the validator uses: the core schema
-(`assets/schema/core.schema.json`) and the fragment of every installed built-in plugin (their `<name>.schema.json`, read through the plugins themselves),
-and the `game` keys of every game mode they register. Every key gets a row; nothing is
-written by hand, so the page cannot go stale."""
+(`assets/schema/core.schema.json`), the fragment of every installed built-in plugin (their
+`<name>.schema.json`, read through the plugins themselves) and the `game` keys of every
+game mode they register. Every key gets a row; nothing is written by hand, so the page
+cannot go stale (tests/docs/test_scene_reference.py)."""
 
 from __future__ import annotations
 
