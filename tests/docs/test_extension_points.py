@@ -9,6 +9,7 @@ importing anything optional (GL, Blender, Ray)."""
 from __future__ import annotations
 
 import ast
+import functools
 import re
 import tomllib
 from pathlib import Path
@@ -39,17 +40,23 @@ def surface(cls: type) -> set[str]:
     return {f"{cls.__name__}.{n}" for n in names | set(made) if not n.startswith("_")}
 
 
-def subclasses_in_source(*roots: str) -> set[str]:
-    """Classes of the package's source whose bases lead, by name, to one of `roots`."""
+@functools.cache
+def class_bases() -> dict[str, set[str]]:
+    """Every class of the package's source (top level) and the names of its bases."""
     bases: dict[str, set[str]] = {}
-    package = ROOT / "ecs_tentacles"
-    for source in package.rglob("*.py"):
-        for node in ast.walk(ast.parse(source.read_text(encoding="utf-8"))):
+    for source in (ROOT / "ecs_tentacles").rglob("*.py"):
+        for node in ast.parse(source.read_text(encoding="utf-8")).body:
             if isinstance(node, ast.ClassDef):
                 for base in node.bases:
                     target = base.value if isinstance(base, ast.Subscript) else base
                     name = ast.unparse(target).rpartition(".")[2]
                     bases.setdefault(node.name, set()).add(name)
+    return bases
+
+
+def subclasses_in_source(*roots: str) -> set[str]:
+    """Classes of the package's source whose bases lead, by name, to one of `roots`."""
+    bases = class_bases()
     found = set(roots)
     grew = True
     while grew:
