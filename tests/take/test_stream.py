@@ -66,7 +66,7 @@ def test_replayed_creatures_are_stored_as_clips_not_poses(
         segments = source.segments(3)
         assert segments and segments[0].kind == 1  # crawling
         assert segments[-1].end == source.frames
-        assert all(s.rate == pytest.approx(3.0) for s in segments)  # 72 fps clip, 24 fps take
+        assert all(s.rate == pytest.approx(2.0) for s in segments)  # 48 fps clip, 24 fps take
 
 
 def test_chunks_read_one_at_a_time_equal_the_whole(crowd_take: Take, tmp_path: Path) -> None:
