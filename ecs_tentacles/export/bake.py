@@ -5,10 +5,13 @@
     take.save("octopus.npz")
 
 The take's frame rate may differ from the scene's: when it divides the scene's
-`physics.fps` the bake records every k-th frame; otherwise the simulation runs at the
-smallest multiple of the take's rate not below the scene's (24 fps from a 60 fps
-scene simulates at 72 fps, recording every third frame), so every take frame is a
-simulated frame, never an interpolation.
+`physics.fps` the bake records every k-th frame. Otherwise the simulation runs at a
+multiple of the take's rate, so every take frame is a simulated frame, never an
+interpolation: the multiple nearest the scene's rate whose frame is a whole number of
+the scene's physics steps, keeping the scene's step (24 fps from a 60 fps scene of 8
+substeps simulates at 48 fps of 10 substeps, 1/480 s each, recording every other
+frame); when no multiple keeps it (23.976 fps), the smallest not below the scene's,
+with the scene's substeps (a shorter step).
 """
 
 from __future__ import annotations
@@ -72,6 +75,7 @@ class BakePlan:
     fps: float  # of the take
     sim_fps: float  # of the simulation
     every: int  # simulated frames per take frame
+    substeps: int  # physics steps per simulated frame
     seed: int
     folder: str | None = None  # the scene's folder: plugins from files are found there
     tracks: tuple[TrackSize, ...] = ()  # what the scene's plugins' take tracks will hold
@@ -108,7 +112,9 @@ class BakePlan:
         take_fps = scene_fps if fps is None else float(fps)
         if not (take_fps > 0 and math.isfinite(take_fps)):
             raise ValueError(f"fps must be a positive number, got {fps}")
-        every, sim_fps = simulation_rate(scene_fps, take_fps)
+        every, sim_fps, substeps = simulation_rate(
+            scene_fps, take_fps, int(data["physics"]["substeps"])
+        )
         return cls(
             scene=data,
             source=source,
@@ -116,6 +122,7 @@ class BakePlan:
             fps=take_fps,
             sim_fps=sim_fps,
             every=every,
+            substeps=substeps,
             seed=int(data["seed"] if seed is None else seed),
             folder=folder,
             tracks=tuple(size for plugin in plugins for size in plugin.take_sizes(data)),
@@ -230,7 +237,7 @@ class BakePlan:
     ) -> World:
         """Build the world to bake, at the simulation frame rate (`only`: see `World`)."""
         scene = dict(self.scene)
-        scene["physics"] = {**scene["physics"], "fps": self.sim_fps}
+        scene["physics"] = {**scene["physics"], "fps": self.sim_fps, "substeps": self.substeps}
         return World.from_scene(
             scene,
             seed=self.seed,
@@ -241,14 +248,35 @@ class BakePlan:
         )
 
 
-def simulation_rate(scene_fps: float, take_fps: float) -> tuple[int, float]:
-    """(simulated frames per take frame, simulation fps) for a take at `take_fps`."""
+MAX_SUBSTEPS = 100  # the schema's physics.substeps maximum
+
+
+def simulation_rate(scene_fps: float, take_fps: float, substeps: int) -> tuple[int, float, int]:
+    """(simulated frames per take frame, simulation fps, substeps) for a take at `take_fps`.
+
+    A take rate that divides the scene's keeps the scene's clock. Otherwise the
+    simulation runs at a multiple of the take's rate whose frame is a whole number of
+    the scene's physics steps (the same MuJoCo timestep as `run`), the multiple nearest
+    the scene's rate (the higher on a tie; at most twice the scene's rate, or the take's
+    own rate if that is faster; at most the schema's 100 substeps); failing
+    that, at the smallest multiple not below the scene's rate with the scene's substeps.
+    """
     ratio = scene_fps / take_fps
     nearest = round(ratio)
     if nearest >= 1 and math.isclose(ratio, nearest, rel_tol=1e-9):
-        return int(nearest), scene_fps
+        return int(nearest), scene_fps, substeps
+    steps_per_second = scene_fps * substeps
+    keeping_step = {}  # every -> substeps, where a frame is a whole number of steps
+    for every in range(1, max(1, math.floor(2 * ratio)) + 1):
+        per_frame = steps_per_second / (take_fps * every)
+        whole = round(per_frame)
+        if 1 <= whole <= MAX_SUBSTEPS and math.isclose(per_frame, whole, rel_tol=1e-9):
+            keeping_step[every] = whole
+    if keeping_step:
+        every = min(keeping_step, key=lambda e: (abs(take_fps * e - scene_fps), -e))
+        return every, take_fps * every, keeping_step[every]
     every = max(1, math.ceil(ratio))
-    return every, take_fps * every
+    return every, take_fps * every, substeps
 
 
 def bake(

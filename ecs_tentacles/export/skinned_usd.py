@@ -83,7 +83,7 @@ from ecs_tentacles.export.names import unique_path
 from ecs_tentacles.export.root_frames import RootFrames
 from ecs_tentacles.export.take_chunks import ChunkSource, TakeChunks, frame_slice
 from ecs_tentacles.export.usd import _pxr, mark_rate, set_timing, static_take
-from ecs_tentacles.export.usd_clips import SharedClips
+from ecs_tentacles.export.usd_clips import SharedClips, Timeline
 from ecs_tentacles.export.usd_joint_samples import PlanSamples, key_report
 from ecs_tentacles.export.usd_layer import StreamedLayer
 from ecs_tentacles.export.usd_plans import body_plans, define_creature
@@ -166,7 +166,7 @@ def _fill(
         for plan in plans
     ]
     rows = max(1, WORK_BYTES // (32 * max(1, len(header["bodies"]))))
-    for first, chunk in source.chunks():
+    for first, chunk in source.chunks(**_posed(animated, suckers, clips.timeline)):
         for start in range(0, chunk.frames, rows):
             end = min(start + rows, chunk.frames)
             piece = chunk if end - start == chunk.frames else frame_slice(chunk, start, end)
@@ -187,6 +187,20 @@ def _fill(
     return key_report(
         animated, source.frames, len(names), clips.sharing, len(clips.shared), stretches
     )
+
+
+def _posed(
+    animated: list[PlanSamples], suckers: Suckers | None, timeline: Timeline
+) -> dict[str, np.ndarray]:
+    """What the writers read of a replayed creature's frames, for `TakeSource.chunks`:
+    every frame its mantle (root motion, carried curves) and sucker links (locators),
+    its whole pose only where its own skeleton is sampled. Reduced keys read every
+    frame's whole pose: all bodies then."""
+    if any(samples.keys.mode != "all" for samples in animated):
+        return {}
+    mantles = [samples.plan.bodies[:, 0] for samples in animated]
+    links = [] if suckers is None else [suckers.bodies]
+    return {"bodies": np.unique(np.concatenate([*mantles, *links])), "whole": timeline.samples}
 
 
 class Suckers:

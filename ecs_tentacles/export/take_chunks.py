@@ -69,7 +69,13 @@ class ChunkSource(Protocol):
     @property
     def static(self) -> dict[str, np.ndarray]: ...
 
-    def chunks(self) -> Iterator[tuple[int, Take]]: ...
+    def chunks(
+        self, *, bodies: np.ndarray | None = None, whole: np.ndarray | None = None
+    ) -> Iterator[tuple[int, Take]]:
+        """Every chunk, in order; `bodies` and `whole`: what the reader needs posed of a
+        replayed creature (`TakeSource.chunks`); a source may pose more."""
+        ...
+
     def segments(self, creature: int) -> list[Any]: ...
     def clip_pose(self, clip: int) -> np.ndarray: ...
     def root_motion(self, creature: int) -> tuple[np.ndarray, np.ndarray]: ...
@@ -103,8 +109,11 @@ class TakeChunks:
         moving = set(per_frame(self.take))
         return {k: v for k, v in self.take.tracks.items() if k not in moving}
 
-    def chunks(self) -> Iterator[tuple[int, Take]]:
-        """(first frame, the take's frames from there) for every chunk, in order."""
+    def chunks(
+        self, *, bodies: np.ndarray | None = None, whole: np.ndarray | None = None
+    ) -> Iterator[tuple[int, Take]]:
+        """(first frame, the take's frames from there) for every chunk, in order (every
+        body posed, whatever `bodies` and `whole` ask: a take in memory holds them)."""
         for first in range(0, self.frames, self.chunk):
             yield first, frame_slice(self.take, first, min(first + self.chunk, self.frames))
 

@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 
 KEY = "replay"
+IDENTITY = np.array([1.0, 0.0, 0.0, 0.0], dtype=np.float32)
 PER_FRAME = ("replay_kind", "replay_phase", "replay_xy", "replay_heading")
 DTYPES: dict[str, np.dtype[Any]] = {
     "replay_kind": np.dtype(np.int8),
@@ -196,11 +197,14 @@ def poses(
     xy: np.ndarray,
     heading: np.ndarray,
     rows: dict[int, np.ndarray] | None = None,
+    needed: np.ndarray | None = None,
 ) -> dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]]:
     """Clip index -> (body indices (K, B), positions (K, B, 3), rotations (K, B, 4)) of
     the creature-frames given (K each: creature index, kind, phase, place, heading).
     `rows`: clip -> each creature's `body_rows` (C, B), when the caller keeps them (a
-    recorder does, every frame); else they are worked out here, a creature at a time."""
+    recorder does, every frame); else they are worked out here, a creature at a time.
+    `needed` (bool per take body): only the clip's bodies some of these creatures need
+    are posed (B is then their count)."""
     replay = header[KEY]
     owner = np.asarray(replay["creatures"], dtype=np.int64)[creatures]
     out = {}
@@ -208,14 +212,19 @@ def poses(
         mine = np.flatnonzero(owner == clip)
         entry = replay["clips"][clip]
         frames = (int(entry["frames"][0]), int(entry["frames"][1]))
-        ground = blend(clips[clip], frames, kind[mine].astype(np.int64), phase[mine])
-        pos, quat = place(ground, xy[mine], heading[mine])
         if rows is not None:
-            out[clip] = (rows[clip][creatures[mine]], pos, quat)
-            continue
-        which, back = np.unique(creatures[mine], return_inverse=True)  # Python per creature
-        table = np.array([body_rows(header["creatures"][c]) for c in which.tolist()])
-        out[clip] = (table.reshape(len(which), -1)[back.reshape(-1)], pos, quat)
+            table = rows[clip][creatures[mine]]
+        else:
+            which, back = np.unique(creatures[mine], return_inverse=True)  # per creature
+            table = np.array([body_rows(header["creatures"][c]) for c in which.tolist()])
+            table = table.reshape(len(which), -1)[back.reshape(-1)]
+        pose = clips[clip]
+        if needed is not None:
+            columns = np.flatnonzero(needed[table].any(axis=0))
+            table, pose = table[:, columns], pose[:, columns]
+        ground = blend(pose, frames, kind[mine].astype(np.int64), phase[mine])
+        pos, quat = place(ground, xy[mine], heading[mine])
+        out[clip] = (table, pos, quat)
     return out
 
 
@@ -225,12 +234,46 @@ def fill(
     arrays: dict[str, np.ndarray],
     pos: np.ndarray,
     quat: np.ndarray,
+    bodies: np.ndarray | None = None,
+    whole: np.ndarray | None = None,
 ) -> None:
     """Put the poses of every replayed creature-frame of `arrays` (per-frame replay
-    arrays of some frames) into `pos` (frames, bodies, 3) and `quat` of those frames."""
+    arrays of some frames) into `pos` (frames, bodies, 3) and `quat` of those frames.
+
+    `bodies` (take body indices): pose only these (a reader that needs the mantles and
+    the sucker links, not every link), except at the creature-frames `whole` (frames,
+    creatures) marks, posed whole; a replayed creature's other bodies are left at the
+    origin with the identity rotation (the file's zeros are no rotation at all).
+    """
     if header.get(KEY) is None:
         return
-    frame, creature = np.nonzero(arrays["replay_kind"] >= 0)
+    replayed = arrays["replay_kind"] >= 0
+    frame, creature = np.nonzero(replayed)
+    if not len(frame):
+        return
+    if bodies is None:
+        _fill(header, clips, arrays, pos, quat, frame, creature, None)
+        return
+    needed = np.zeros(pos.shape[1], dtype=bool)
+    needed[bodies] = True
+    owner_of_body = np.array([b["creature"] for b in header["bodies"]], dtype=np.int64)
+    quat[replayed[:, owner_of_body] & ~needed] = IDENTITY
+    full = np.zeros(len(frame), dtype=bool) if whole is None else whole[frame, creature]
+    _fill(header, clips, arrays, pos, quat, frame[full], creature[full], None)
+    _fill(header, clips, arrays, pos, quat, frame[~full], creature[~full], needed)
+
+
+def _fill(
+    header: dict[str, Any],
+    clips: dict[int, np.ndarray],
+    arrays: dict[str, np.ndarray],
+    pos: np.ndarray,
+    quat: np.ndarray,
+    frame: np.ndarray,
+    creature: np.ndarray,
+    needed: np.ndarray | None,
+) -> None:
+    """`fill` at the creature-frames (`frame`, `creature`), `needed` bodies only."""
     if not len(frame):
         return
     found = poses(
@@ -241,6 +284,7 @@ def fill(
         arrays["replay_phase"][frame, creature],
         arrays["replay_xy"][frame, creature],
         arrays["replay_heading"][frame, creature],
+        needed=needed,
     )
     owner = np.asarray(header[KEY]["creatures"], dtype=np.int64)[creature]
     for clip, (rows, at, rot) in found.items():

@@ -16,6 +16,7 @@ without frames), not the shot. A version 1 file is read whole and handed out in 
 
 from __future__ import annotations
 
+import functools
 import stat
 import zipfile
 import zlib
@@ -134,10 +135,20 @@ class TakeSource:
         """Clip `clip`'s frames (F_idle + F_crawl, B, 7) in the ground frame, take order."""
         return self._clips[clip]
 
-    def chunks(self, frames: int | None = None) -> Iterator[tuple[int, Take]]:
+    def chunks(
+        self,
+        frames: int | None = None,
+        bodies: np.ndarray | None = None,
+        whole: np.ndarray | None = None,
+    ) -> Iterator[tuple[int, Take]]:
         """(first frame, a `Take` of the next frames) for the whole take, in order; each
-        chunk holds `frames` frames (default: the file's chunk), the last fewer."""
+        chunk holds `frames` frames (default: the file's chunk), the last fewer.
+
+        `bodies`: a replayed creature's bodies posed, but where `whole` (frames,
+        creatures) says (`replay.fill`): the rest at the origin, unrotated. Default: all.
+        """
         step = frames or self.chunk_frames
+        read = functools.partial(self._chunk, bodies=bodies, whole=whole)
         if self._take is not None:  # version 1: read whole
             for first in range(0, self.frames, step):
                 yield first, _slice(self._take, first, min(first + step, self.frames))
@@ -146,7 +157,7 @@ class TakeSource:
         assert archive is not None, "the take is closed"
         buffered: Take | None = None
         for k in range(archive.count):
-            piece = self._named(self._chunk, k)
+            piece = self._named(read, k)
             buffered = piece if buffered is None else _join(buffered, piece)
             while buffered is not None and buffered.frames >= step:
                 first = k * archive.per_chunk + piece.frames - buffered.frames
@@ -173,7 +184,9 @@ class TakeSource:
             value = chunks.pad_items(value, archive.items[name], self._later(name, k, value))
         return value
 
-    def _chunk(self, k: int) -> Take:
+    def _chunk(
+        self, k: int, bodies: np.ndarray | None = None, whole: np.ndarray | None = None
+    ) -> Take:
         archive = self._archive
         assert archive is not None
         header = self.header
@@ -186,7 +199,8 @@ class TakeSource:
         problem = take_replay.values_problem(header, arrays) if self._clips else None
         if problem:
             raise TakeError(f"{self.path}: {problem}")
-        take_replay.fill(header, self._clips, arrays, arrays["pos"], arrays["quat"])
+        part = None if whole is None else whole[first:end]
+        take_replay.fill(header, self._clips, arrays, arrays["pos"], arrays["quat"], bodies, part)
         checked = {n: a for n, a in arrays.items() if n not in take_replay.PER_FRAME}
         problem = data_problem(checked, tracks_of(header))
         if problem:

@@ -115,24 +115,43 @@ def test_two_bakes_of_the_same_scene_and_seed_are_byte_identical(tmp_path: Path)
 
 
 @pytest.mark.parametrize(
-    ("scene_fps", "take_fps", "expected"),
+    ("scene_fps", "take_fps", "substeps", "expected"),
     [
-        (60, 60, (1, 60)),
-        (60, 30, (2, 60)),
-        (60, 24, (3, 72)),
-        (60, 120, (1, 120)),
-        (50, 30, (2, 60)),
+        (60, 60, 8, (1, 60, 8)),
+        (60, 30, 8, (2, 60, 8)),
+        (60, 24, 8, (2, 48, 10)),  # 1/480 s steps as in `run`, every other frame kept
+        (60, 120, 8, (1, 120, 4)),
+        (60, 240, 8, (1, 240, 2)),
+        (50, 30, 8, (2, 60, 8)),  # no multiple of 30 is a whole number of 1/400 s steps
+        (60, 25, 8, (3, 75, 8)),
+        (30, 24, 16, (1, 24, 20)),
+        (4, 1000, 100, (1, 1000, 100)),  # 0.4 steps a frame: the scene's substeps, shorter
     ],
 )
-def test_simulation_rate(scene_fps: float, take_fps: float, expected: tuple[int, float]) -> None:
-    assert simulation_rate(scene_fps, take_fps) == expected
+def test_simulation_rate(
+    scene_fps: float, take_fps: float, substeps: int, expected: tuple[int, float, int]
+) -> None:
+    every, sim_fps, sim_substeps = simulation_rate(scene_fps, take_fps, substeps)
+    assert (every, sim_fps, sim_substeps) == expected
+    assert sim_fps == pytest.approx(take_fps * every)  # every take frame is a simulated one
+    if sim_substeps != substeps:  # the scene's physics step is kept exactly
+        assert sim_fps * sim_substeps == pytest.approx(scene_fps * substeps)
 
 
-def test_a_24_fps_take_simulates_at_72_fps() -> None:
+def test_a_24_fps_take_simulates_at_48_fps_with_the_scenes_physics_step() -> None:
     plan = BakePlan.make(SMALL_SCENE, seconds=0.25, fps=24)
-    assert (plan.every, plan.sim_fps, plan.frames, plan.steps) == (3, 72.0, 7, 18)
+    assert (plan.every, plan.sim_fps, plan.substeps, plan.frames, plan.steps) == (
+        2,
+        48.0,
+        10,
+        7,
+        12,
+    )
     take = bake(plan, progress=False)
-    assert (take.frames, take.fps, take.header["sim_fps"]) == (7, 24.0, 72.0)
+    assert (take.frames, take.fps, take.header["sim_fps"]) == (7, 24.0, 48.0)
+    physics = SMALL_SCENE.get("physics", {})
+    scene_step = 1 / (physics.get("fps", 60) * physics.get("substeps", 8))
+    assert 1 / (take.header["sim_fps"] * take.header["substeps"]) == pytest.approx(scene_step)
 
 
 def _take(tmp_path: Path, **changes: object) -> Path:

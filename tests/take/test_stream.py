@@ -66,7 +66,7 @@ def test_replayed_creatures_are_stored_as_clips_not_poses(
         segments = source.segments(3)
         assert segments and segments[0].kind == 1  # crawling
         assert segments[-1].end == source.frames
-        assert all(s.rate == pytest.approx(3.0) for s in segments)  # 72 fps clip, 24 fps take
+        assert all(s.rate == pytest.approx(2.0) for s in segments)  # 48 fps clip, 24 fps take
 
 
 def test_chunks_read_one_at_a_time_equal_the_whole(crowd_take: Take, tmp_path: Path) -> None:
@@ -186,3 +186,35 @@ def test_the_replay_check_decides_alike_with_and_without_its_kernel(
     with open_take(fast) as source:
         assert any(source.segments(c) for c in range(len(source.header["creatures"])))
     assert fast.read_bytes() == slow.read_bytes()
+
+
+def test_a_reader_that_asks_for_some_bodies_gets_those_posed_as_a_whole_read(
+    crowd_plan: BakePlan, tmp_path: Path
+) -> None:
+    out = tmp_path / "streamed.npz"
+    bake_to_file(crowd_plan, out, progress=False)
+    with open_take(out) as source:
+        full = [chunk for _, chunk in source.chunks()]
+        header = source.header
+        mantles = np.array([c["mantle"] for c in header["creatures"]])
+        count = len(header["creatures"])
+        whole = np.zeros((source.frames, count), dtype=bool)
+        whole[3, :] = True  # frame 3: every creature posed whole
+        some = [chunk for _, chunk in source.chunks(bodies=mantles, whole=whole)]
+    pos = np.concatenate([c.pos for c in full])
+    quat = np.concatenate([c.quat for c in full])
+    kind = np.concatenate([c.tracks["replay_kind"] for c in full])
+    part_pos = np.concatenate([c.pos for c in some])
+    part_quat = np.concatenate([c.quat for c in some])
+    owner = np.array([b["creature"] for b in header["bodies"]])
+    replayed = kind[:, owner] >= 0  # (frames, bodies)
+    asked = np.zeros(len(owner), dtype=bool)
+    asked[mantles] = True
+    posed = ~replayed | asked | whole[:, owner]
+    assert (~posed).sum() > 1000, "most replayed bodies are left out"
+    assert np.array_equal(part_pos[posed], pos[posed])  # the same bits where asked
+    assert np.array_equal(part_quat[posed], quat[posed])
+    assert not part_pos[~posed].any()  # the rest at the origin, unrotated: still sound
+    assert np.array_equal(
+        part_quat[~posed], np.broadcast_to([1, 0, 0, 0], (int((~posed).sum()), 4))
+    )
