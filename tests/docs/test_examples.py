@@ -2,7 +2,9 @@
 
 Read with sybil. A page's blocks run in order in a scratch folder of its own (where
 `assets/` leads to the repository's): Python blocks share one namespace a page; JSON
-blocks parse (a fragment as the inside of an object) and a whole scene validates; shell
+blocks parse (a fragment as the inside of an object) and a whole scene validates; TOML
+blocks parse (packaging snippets: an entry-point group named is the one plugins are
+found in); shell
 blocks run each `ecs-tentacles` command in-process and expect exit 0. A block preceded by
 `<!-- not run: why -->` is not run (the built page shows why); a block preceded by
 `<!-- file: NAME -->` (or the tutorial's `<!-- tutorial: NAME -->`) is also written to the
@@ -18,6 +20,7 @@ import glob
 import json
 import re
 import shlex
+import tomllib
 from pathlib import Path
 from typing import Any
 
@@ -26,10 +29,11 @@ from sybil import Example, Sybil
 from sybil.parsers.markdown import CodeBlockParser
 
 from ecs_tentacles.cli import main
+from ecs_tentacles.scene.plugins import ENTRY_POINTS
 
 ROOT = Path(__file__).resolve().parents[2]
 PAGES = sorted((ROOT / "docs").rglob("*.md")) + [ROOT / "README.md"]
-LANGUAGES = ("python", "json", "sh")  # run; `text` is output shown, not run
+LANGUAGES = ("python", "json", "sh", "toml")  # run; `text` is output shown, not run
 NOT_RUN = re.compile(r"<!-- not run: .+ -->|<!-- tutorial: commands -->")
 FILE = re.compile(r"<!-- (?:file|tutorial): (\S+\.\w+) -->")
 FENCE = re.compile(r"^ *```(\w*)$", flags=re.M)
@@ -79,6 +83,12 @@ def run_json(example: Example) -> None:
             assert main(["validate", str(scene), "--allow-systems"]) == 0, text
 
 
+def run_toml(example: Example) -> None:
+    if keep_file(example):
+        groups = tomllib.loads(str(example.parsed)).get("project", {}).get("entry-points", {})
+        assert set(groups) <= {ENTRY_POINTS}, groups
+
+
 def commands(text: str) -> list[list[str]]:
     """The block's commands, continuation lines joined and comments dropped."""
     joined = re.sub(r"\\\n\s*", " ", text)
@@ -107,7 +117,12 @@ def takes_quiet(argv: list[str]) -> bool:
 SYBIL = Sybil(
     parsers=[
         CodeBlockParser(language, evaluator)
-        for language, evaluator in (("python", run_python), ("json", run_json), ("sh", run_sh))
+        for language, evaluator in (
+            ("python", run_python),
+            ("json", run_json),
+            ("sh", run_sh),
+            ("toml", run_toml),
+        )
     ],
 )
 
