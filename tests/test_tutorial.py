@@ -1,4 +1,5 @@
-"""The README's "Write your first plugin" runs as written: its files, its commands, its effect."""
+"""The docs' "Write your first plugin" (docs/extending/first-plugin.md) runs as written: its
+files, its commands, its effect."""
 
 from __future__ import annotations
 
@@ -14,17 +15,16 @@ from ecs_tentacles.cli import main
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.world import World
 
-README = Path(__file__).resolve().parents[1] / "README.md"
-HEADING = "## Write your first plugin\n"
+PAGE = Path(__file__).resolve().parents[1] / "docs" / "extending" / "first-plugin.md"
+HEADING = "# Write your first plugin\n"
 BLOCK = re.compile(r"<!-- tutorial: (\S+) -->\n```\w*\n(.*?)```", flags=re.S)
 
 
 def _tutorial() -> dict[str, str]:
     """The marked code blocks of the tutorial section, by name."""
-    text = README.read_text()
-    assert text.count(HEADING) == 1
-    section = text.split(HEADING)[1].split("\n## ")[0]
-    return dict(BLOCK.findall(section))
+    text = PAGE.read_text()
+    assert text.startswith(HEADING)
+    return dict(BLOCK.findall(text))
 
 
 @pytest.fixture
@@ -38,7 +38,7 @@ def folder(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
     return tmp_path
 
 
-pytestmark = pytest.mark.skipif(not README.exists(), reason="needs the source tree")
+pytestmark = pytest.mark.skipif(not PAGE.exists(), reason="needs the source tree")
 
 
 def test_the_plugin_adds_its_configured_sweep(folder: Path) -> None:
@@ -56,7 +56,7 @@ def test_the_plugin_adds_its_configured_sweep(folder: Path) -> None:
 
 
 def test_the_refusals_are_the_ones_the_text_quotes(folder: Path) -> None:
-    section = " ".join(README.read_text().split(HEADING)[1].split("\n## ")[0].split())
+    section = " ".join(PAGE.read_text().split())
     scene = folder / "wavy.json"
     untrusted = "plugins.mywave: runs code from 'mywave.py'; allow it with --allow-systems"
     with pytest.raises(SceneError) as refused:

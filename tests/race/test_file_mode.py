@@ -1,15 +1,24 @@
-"""A game mode from a plugin file beside its level (the README's `sprint.py`): it
-registers, its keys are checked, and it ends `run` (`tests/data/sprint/`)."""
+"""A game mode from a plugin file beside its level (the docs' `sprint.py`,
+docs/extending/game-modes.md): it registers, its keys are checked, and it ends `run`
+(`tests/data/sprint/`, the page's two files as the page shows them)."""
 
 from __future__ import annotations
 
 import json
+import re
 import shutil
 from pathlib import Path
 
 from ecs_tentacles.cli import main
 
 SPRINT = Path(__file__).resolve().parents[1] / "data" / "sprint"
+PAGE = Path(__file__).resolve().parents[2] / "docs" / "extending" / "game-modes.md"
+
+
+def test_the_files_are_the_page_s() -> None:
+    blocks = re.findall(r"<!-- file: (\S+) -->\n```\w+\n(.*?)```", PAGE.read_text(), flags=re.S)
+    files = ("sprint.py", "sprint.json")
+    assert dict(blocks) == {name: (SPRINT / name).read_text() for name in files}
 
 
 def test_a_mode_from_a_file_ends_the_run_and_reports_its_result(tmp_path: Path, capsys) -> None:  # type: ignore[no-untyped-def]
