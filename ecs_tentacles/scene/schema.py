@@ -47,10 +47,11 @@ def _fragment_file(package: str, name: str) -> importlib.resources.abc.Traversab
 
 
 def builtin_fragment(name: str) -> dict[str, Any]:
-    """The fragment of built-in plugin `name` ({} when it has none), its code not imported."""
-    from ecs_tentacles.scene.plugins import BUILTIN
+    """The fragment of the engine's plugin `name` ({} when it has none), its code not
+    imported (where it is: its entry point)."""
+    from ecs_tentacles.scene.plugins import shipped
 
-    package = BUILTIN[name].partition(":")[0].rpartition(".")[0]  # the feature package
+    package = shipped()[name].partition(":")[0].rpartition(".")[0]  # the feature package
     return fragment(package, name) if _fragment_file(package, name).is_file() else {}
 
 
@@ -82,9 +83,9 @@ def load_schema() -> dict[str, Any]:
 
     Assembled from the fragment files of the default plugins (their code is not imported).
     """
-    from ecs_tentacles.scene.plugins import DEFAULT_ON
+    from ecs_tentacles.scene.plugins import default_on
 
-    parts = [(name, builtin_fragment(name)) for name in DEFAULT_ON]
+    parts = [(name, builtin_fragment(name)) for name in default_on()]
     return _assemble([(name, tuple(part.get(p, {}) for p in PLACES)) for name, part in parts])
 
 
