@@ -62,10 +62,9 @@ def locate(key: str, config: Mapping[str, Any] | bool) -> Found:
     """Where the plugin turned on as `key` lives (PluginError if nowhere)."""
     if isinstance(config, Mapping) and FROM in config:
         return Found(str(config[FROM]), trusted=False)
-    entries = [e for e in _entry_points() if e.name == key]
-    entry = next((e for e in entries if _ours(e)), entries[0] if entries else None)
-    if entry is not None:
-        return Found(entry.value, trusted=_ours(entry))
+    entries = sorted((e for e in _entry_points() if e.name == key), key=lambda e: not e.ours)
+    if entries:  # the engine's own first: another package cannot take a built-in's name
+        return Found(entries[0].value, trusted=entries[0].ours)
     known = sorted({e.name for e in _entry_points()})
     raise PluginError(
         f"plugins.{key}: no plugin of that name (known: {', '.join(known)});"
@@ -75,7 +74,7 @@ def locate(key: str, config: Mapping[str, Any] | bool) -> Found:
 
 def shipped() -> dict[str, str]:
     """Every plugin the engine's own package registers: scene key -> "module:Class"."""
-    return {e.name: e.value for e in _entry_points() if _ours(e)}
+    return {e.name: e.value for e in _entry_points() if e.ours}
 
 
 def default_on() -> tuple[str, ...]:
@@ -90,24 +89,40 @@ def sandbox_on() -> tuple[str, ...]:
 
 
 def _role(group: str) -> tuple[str, ...]:
-    return tuple(sorted(e.name for e in _entry_points() if e.group == group and _ours(e)))
+    return tuple(sorted(e.name for e in _entry_points() if e.group == group and e.ours))
 
 
-def _ours(entry: importlib.metadata.EntryPoint) -> bool:
-    """Whether `entry` is the engine's own (consented to when it was installed)."""
-    dist = getattr(entry, "dist", None)
-    return dist is not None and dist.name.replace("_", "-").lower() == DISTRIBUTION
+@dataclass(frozen=True)
+class Entry:
+    """An installed plugin entry point, read (never loaded), and whether it is the
+    engine's own (consented to when the engine was installed)."""
+
+    name: str
+    group: str
+    value: str  # "module:Class"
+    ours: bool
 
 
-def _entry_points() -> tuple[importlib.metadata.EntryPoint, ...]:
-    """Every installed plugin entry point, of every group (read, never loaded)."""
+def _entry_points() -> tuple[Entry, ...]:
+    """Every installed plugin entry point, of every group."""
     return _entry_points_on(tuple(sys.path))
 
 
 @functools.lru_cache(maxsize=8)
-def _entry_points_on(path: tuple[str, ...]) -> tuple[importlib.metadata.EntryPoint, ...]:
-    # read once per import path (reading every installed package's metadata costs ~7 ms)
-    return tuple(e for group in GROUPS for e in importlib.metadata.entry_points(group=group))
+def _entry_points_on(path: tuple[str, ...]) -> tuple[Entry, ...]:
+    # read once per import path, and each distribution's name once (it is parsed from
+    # the distribution's whole METADATA, the engine's README included)
+    every = importlib.metadata.entry_points()  # one pass over the installed packages
+    found = [e for group in GROUPS for e in every.select(group=group)]
+    names: dict[int, str] = {}
+    for entry in found:
+        dist = getattr(entry, "dist", None)
+        if dist is not None and id(dist) not in names:
+            names[id(dist)] = dist.name.replace("_", "-").lower()
+    return tuple(
+        Entry(e.name, e.group, e.value, names.get(id(getattr(e, "dist", None))) == DISTRIBUTION)
+        for e in found
+    )
 
 
 def load(
