@@ -8,11 +8,12 @@ Every plugin is found through entry points, the engine's own as any installed
 package's (reads `importlib.metadata`; core lists none by name). Three groups:
 `ecs_tentacles.plugins` (found by name, on when a scene turns it on), and two roles the
 engine's own package declares in its `pyproject.toml`: `ecs_tentacles.plugins.default`
-(on unless a scene says `false`, built by their `build_order`) and `ecs_tentacles.plugins.sandbox`
-(added by the sandbox to the world it shows). A role is honoured only for the engine's
-own entries: another package's plugin, in whichever group, is on only when a scene names
-it. A plugin another one `requires` that the engine ships is turned on with it unless
-the scene names it (the `game` layer with a game mode).
+(on unless a scene says `false`, built by their `build_order`) and
+`ecs_tentacles.plugins.sandbox` (added by the sandbox to the world it shows). A role is
+honoured only for the engine's own entries: another package's plugin, in whichever
+group, is on only when a scene names it. A plugin another one `requires` that the
+engine ships is turned on with it unless the scene names it (the `game` layer with a
+game mode).
 
 Trust: the engine's own entry points were consented to when it was installed. A plugin
 from a file or module named by `from` (the scene's folder is searched first; a relative

@@ -13,7 +13,9 @@ from __future__ import annotations
 import copy
 import functools
 import importlib.resources
+import importlib.util
 import json
+import pathlib
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
@@ -41,9 +43,15 @@ def fragment(package: str, name: str) -> dict[str, Any]:
 
 
 def _fragment_file(package: str, name: str) -> importlib.resources.abc.Traversable:
-    """`<name>.schema.json` in a feature package, found without importing the package."""
+    """`<name>.schema.json` in a feature package, found without importing the package
+    (nor its top: `importlib.resources.files` would run an examples package's
+    `__init__`)."""
     top, *rest = package.split(".")
-    return importlib.resources.files(top).joinpath(*rest, f"{name}.schema.json")
+    spec = importlib.util.find_spec(top)
+    folders = list(spec.submodule_search_locations or []) if spec is not None else []
+    if not folders:
+        return importlib.resources.files(top).joinpath(*rest, f"{name}.schema.json")
+    return pathlib.Path(folders[0]).joinpath(*rest, f"{name}.schema.json")
 
 
 def builtin_fragment(name: str) -> dict[str, Any]:

@@ -132,10 +132,14 @@ def test_listing_the_plugins_and_their_roles_imports_none() -> None:
         """
         import sys
         from ecs_tentacles.scene.plugins import default_on, sandbox_on, shipped
-        from ecs_tentacles.scene.schema import load_schema
+        from ecs_tentacles.scene.schema import builtin_keys, load_schema
         listed = (default_on(), sandbox_on(), sorted(shipped()), len(load_schema()))
+        keys = {name: builtin_keys(name) for name in shipped()}  # their schema fragments
         modules = {target.partition(":")[0] for target in shipped().values()}
-        imported = sorted(m for m in sys.modules if m in modules or ".systems" in m)
+        imported = sorted(
+            m for m in sys.modules
+            if m in modules or ".systems" in m or m.startswith("ecs_tentacles_examples")
+        )
         print(listed, imported)
         """
     )
