@@ -59,6 +59,9 @@ class Plugin:
     name: ClassVar[str] = ""
     description: ClassVar[str] = ""
     requires: ClassVar[tuple[str, ...]] = ()  # plugins that must be on too
+    # where a plugin on by default is built among the other defaults (lower first, then
+    # by key); on by default is the entry point's group (`ecs_tentacles.scene.plugins`)
+    build_order: ClassVar[int] = 0
     # store columns this plugin's hooks read when a generic system calls them
     # (registry entries and take hooks): they count as that system's reads
     hook_reads: ClassVar[tuple[str, ...]] = ()

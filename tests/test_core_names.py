@@ -1,9 +1,14 @@
-"""Core's code names no feature: no `locomotion`, `fur`, `goals`, `guides`, `terrain`,
-`threat`, `director` or `herding` in the names and strings of the package top,
-`creatures/`, `ground/`, `numeric/`, `output/`, `physics/`, `scene/` and `take/`
-(docstrings, comments and data files aside). The exceptions, listed below: the list of
-built-in plugins, where core finds them by name, and the columns sending a creature
-writes (`behaviour.DESTINATION_WRITES`); a new one fails here."""
+"""Core's code names no feature. Core is what the import contract "Core depends on no
+feature" (pyproject's [tool.importlinter]) lists; the features are the packages its
+"Features do not import each other" contract lists. In core's names and strings
+(docstrings, comments and data files aside):
+
+* no feature package's import path (`ecs_tentacles.locomotion`, ...), nor the examples'
+  (`ecs_tentacles_examples`): not even a list of plugins (they are entry points);
+* no feature word (`locomotion`, `fur`, `goals`, `guides`, `terrain`, `threat`,
+  `director`, `herding`, `race`), but the columns sending a creature writes
+  (`behaviour.DESTINATION_WRITES`), listed below; a new one fails here.
+"""
 
 from __future__ import annotations
 
@@ -11,37 +16,41 @@ import ast
 import io
 import re
 import tokenize
+import tomllib
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent / "ecs_tentacles"
-FEATURES = re.compile(r"(?i)\b(locomotion|fur|goals?|guides?|terrain|threats?|director|herding)\b")
-CORE = [*ROOT.glob("*.py")] + [
-    p
-    for d in ("creatures", "ground", "numeric", "output", "physics", "scene", "take")
-    for p in (ROOT / d).rglob("*.py")
-]
+TOP = Path(__file__).resolve().parent.parent
+ROOT = TOP / "ecs_tentacles"
+CONTRACTS = tomllib.loads((TOP / "pyproject.toml").read_text())["tool"]["importlinter"]["contracts"]
+
+
+def _contract(prefix: str) -> dict[str, list[str]]:
+    return next(c for c in CONTRACTS if c["name"].startswith(prefix))
+
+
+FEATURE_PACKAGES = _contract("Features do not import each other")["modules"]
+PATHS = re.compile("|".join(re.escape(m) + r"\b" for m in FEATURE_PACKAGES))
+WORDS = re.compile(
+    r"(?i)\b(locomotion|fur|goals?|guides?|terrain|threats?|director|herding|race)\b"
+)
+
+
+def _files(module: str) -> list[Path]:
+    """The source files of `module` (the examples' package is in `systems/`)."""
+    path = TOP.joinpath(*module.split("."))
+    if module.startswith("ecs_tentacles_examples"):
+        path = TOP / "systems" / path.relative_to(TOP)
+    return (
+        [path.with_suffix(".py")]
+        if path.with_suffix(".py").is_file()
+        else sorted(path.rglob("*.py"))
+    )
+
+
+CORE = [p for m in _contract("Core depends on no feature")["source_modules"] for p in _files(m)]
 
 # (file, the name or string) still allowed, and why
 ALLOWED = {
-    # the list of built-in plugins: where core finds them by name
-    **{
-        ("scene/plugins.py", s): "built-in plugins"
-        for s in (
-            '"locomotion"',
-            '"ecs_tentacles.locomotion.plugin:LocomotionPlugin"',
-            '"ecs_tentacles.locomotion.suckers:SuckersPlugin"',
-            '"fur"',
-            '"ecs_tentacles.fur.plugin:FurPlugin"',
-            '"threats"',
-            '"ecs_tentacles.threats.plugin:ThreatsPlugin"',
-            '"terrain"',
-            '"ecs_tentacles.terrain.plugin:TerrainPlugin"',
-            '"director"',
-            '"ecs_tentacles.director.plugin:DirectorPlugin"',
-            '"herding"',
-            '"ecs_tentacles.herding.plugin:HerdingPlugin"',
-        )
-    },
     # the columns the Destinations entry (the locomotion plugin's goals) writes: named
     # once in core so a behaviour's or game mode's systems can declare them from a public
     # module (issue 55), not from the examples package or another feature
@@ -67,7 +76,7 @@ def _docstring_lines(tree: ast.AST) -> set[int]:
     return lines
 
 
-def feature_names() -> set[tuple[str, str]]:
+def feature_names(pattern: re.Pattern[str] = WORDS) -> set[tuple[str, str]]:
     """(file relative to the package, token) of every feature name core's code says."""
     found = set()
     for path in CORE:
@@ -76,9 +85,19 @@ def feature_names() -> set[tuple[str, str]]:
         for token in tokenize.generate_tokens(io.StringIO(source).readline):
             if token.type not in (tokenize.NAME, tokenize.STRING) or token.start[0] in skip:
                 continue
-            if FEATURES.search(token.string):
+            if pattern.search(token.string):
                 found.add((str(path.relative_to(ROOT)), token.string))
     return found
+
+
+def test_core_is_what_the_contract_says_and_every_feature_is_a_package() -> None:
+    assert len(CORE) > 80 and ROOT / "world.py" in CORE and ROOT / "scene" / "plugins.py" in CORE
+    assert all(_files(m) for m in FEATURE_PACKAGES), FEATURE_PACKAGES
+
+
+def test_core_names_no_feature_package_not_even_a_plugin_list() -> None:
+    found = feature_names(PATHS)
+    assert not found, f"core names a feature package: {sorted(found)}"
 
 
 def test_core_code_names_no_feature_but_what_is_listed() -> None:

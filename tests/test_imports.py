@@ -1,7 +1,7 @@
 """No import circle between the engine's modules, type-only imports included.
 
 Every `import` and `from ... import` statement of every module of `ecs_tentacles` and
-of `systems/` (installed as `ecs_tentacles.systems`) is read with `ast`: those at the
+of the example plugins (`systems/ecs_tentacles_examples`) is read with `ast`: those at the
 top, under `if TYPE_CHECKING:` and inside functions alike. An import of `a.b.c` (or
 `from a.b import c` where `c` is a module) is an edge to `a.b.c`; the packages above
 it are not counted. A circle is named module by module (a -> b -> c -> a).
@@ -14,7 +14,10 @@ from collections.abc import Iterator
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-PACKAGES = {"ecs_tentacles": ROOT / "ecs_tentacles", "ecs_tentacles.systems": ROOT / "systems"}
+PACKAGES = {
+    "ecs_tentacles": ROOT / "ecs_tentacles",
+    "ecs_tentacles_examples": ROOT / "systems" / "ecs_tentacles_examples",
+}
 WORLD = "ecs_tentacles.world"
 
 Graph = dict[str, set[str]]
@@ -118,7 +121,7 @@ def test_the_scan_sees_type_only_and_function_level_imports() -> None:
     graph = import_graph()
     assert "ecs_tentacles.host" in graph["ecs_tentacles.system"]  # under TYPE_CHECKING
     assert "ecs_tentacles.creatures.loading" in graph[WORLD]  # inside World.from_scene
-    assert "ecs_tentacles.systems.locomotion.suckers" in graph["ecs_tentacles.locomotion.suckers"]
+    assert "ecs_tentacles.locomotion.systems.suckers" in graph["ecs_tentacles.locomotion.suckers"]
     assert circles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c", "a"]]
 
 
@@ -142,7 +145,7 @@ CORE = (
     "ecs_tentacles.components",
     "ecs_tentacles.creatures.body", "ecs_tentacles.scene.construction", "ecs_tentacles.physics",
     "ecs_tentacles.snapshot", "ecs_tentacles.events", "ecs_tentacles.scene",
-    "ecs_tentacles.systems.physics",
+    "ecs_tentacles.physics.systems",
 )  # fmt: skip
 FEATURES = ("locomotion", "fur", "threats", "record", "clips")
 
@@ -152,11 +155,11 @@ def _within(module: str, prefixes: tuple[str, ...]) -> bool:
 
 
 def test_core_imports_no_feature_nor_its_systems() -> None:
-    """import-linter reads `systems/` as its own package, so it cannot see core importing
-    `ecs_tentacles.systems.<feature>`; this scan can (type-only imports included)."""
+    """The contracts leave out imports under TYPE_CHECKING; this scan counts them too. A
+    feature's systems are in its package (`ecs_tentacles.<feature>.systems`)."""
     graph = import_graph()
-    features = tuple(f"ecs_tentacles.{f}" for f in FEATURES) + tuple(
-        f"ecs_tentacles.systems.{f}" for f in (*FEATURES, "render", "examples")
+    features = tuple(f"ecs_tentacles.{f}" for f in (*FEATURES, "render")) + (
+        "ecs_tentacles_examples",
     )
     wrong = sorted(
         (source, target)

@@ -1,4 +1,7 @@
-"""Packaging: `systems/` ships as `ecs_tentacles.systems`, never as a top-level `systems`."""
+"""Packaging: every package found (none listed by hand), a feature's systems inside its
+package, the example plugins of `systems/` as `ecs_tentacles_examples` (never a top-level
+`systems`: users have their own), the bundled scenes and schemas as `ecs_tentacles.assets`,
+and every plugin registered as an entry point."""
 
 from __future__ import annotations
 
@@ -13,11 +16,11 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 
 USER_CHECK = """
-import systems, ecs_tentacles, ecs_tentacles.systems
+import systems, ecs_tentacles, ecs_tentacles_examples
 from ecs_tentacles.world import World
 assert systems.MINE is True, "the user's own systems package"
 assert ecs_tentacles.__file__.startswith({where!r}), ecs_tentacles.__file__
-assert ecs_tentacles.systems.__file__.startswith({where!r}), ecs_tentacles.systems.__file__
+assert ecs_tentacles_examples.__file__.startswith({where!r}), ecs_tentacles_examples.__file__
 world = World.from_scene("octopus")
 world.step(2)
 print(world.schedule.names)
@@ -68,11 +71,18 @@ def test_wheel_holds_every_module_and_asset_and_runs(tmp_path: Path) -> None:
         f"ecs_tentacles/{p.relative_to(ROOT / 'ecs_tentacles')}"
         for p in ROOT.glob("ecs_tentacles/**/*.py")
     }
-    expected |= {f"ecs_tentacles/systems/{p.name}" for p in ROOT.glob("systems/*.py")}
+    expected |= {
+        f"ecs_tentacles_examples/{p.name}" for p in ROOT.glob("systems/ecs_tentacles_examples/*.py")
+    }
     expected |= {
         f"ecs_tentacles/assets/{p.relative_to(ROOT / 'assets')}"
         for p in ROOT.glob("assets/**/*.json")
     }
+    expected |= {  # each feature's schema fragment, by pattern
+        f"ecs_tentacles/{p.relative_to(ROOT / 'ecs_tentacles')}"
+        for p in ROOT.glob("ecs_tentacles/*/*.schema.json")
+    }
+    expected.add("ecs_tentacles/take/version1.json")
     expected.add("ecs_tentacles/blender_addon/blender_manifest.toml")  # the add-on's zip
     assert expected <= names, sorted(expected - names)
     assert not any(n.startswith(("systems/", "assets/", "tests/", "tools/")) for n in names)

@@ -186,9 +186,9 @@ CORE_ALONE = textwrap.dedent(
     registries = ("ecs_tentacles.render", "ecs_tentacles.render.registries")
     loaded = sorted(m for m in sys.modules if m.startswith(("ecs_tentacles.record",
         "ecs_tentacles.locomotion", "ecs_tentacles.fur", "ecs_tentacles.threats",
-        "ecs_tentacles.render", "ecs_tentacles.export", "ecs_tentacles.systems.locomotion",
-        "ecs_tentacles.systems.fur", "ecs_tentacles.systems.threats", "pyglet",
-        "ecs_tentacles.herding", "ecs_tentacles.systems.herding", "filelock", "platformdirs"))
+        "ecs_tentacles.render", "ecs_tentacles.export", "ecs_tentacles.locomotion.systems",
+        "ecs_tentacles.fur.systems", "ecs_tentacles.threats.systems", "pyglet",
+        "ecs_tentacles.herding", "ecs_tentacles.herding.systems", "filelock", "platformdirs"))
         and m not in registries)
     print(loaded)
     print(sorted(columns.items()))

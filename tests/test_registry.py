@@ -1,5 +1,5 @@
 """Registries: every entry in a built world belongs to a plugin that is on, and its code
-is that plugin's own (its feature's package or its systems folder); a plugin turned off
+is that plugin's own (its feature's package, its systems included); a plugin turned off
 or swapped leaves no entry behind."""
 
 from __future__ import annotations
@@ -15,13 +15,13 @@ import pytest
 from ecs_tentacles.cli.migrate import migrate
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.registry import App, Registries, Registry
-from ecs_tentacles.scene.plugins import BUILTIN, BUNDLED
+from ecs_tentacles.scene.plugins import shipped
 from ecs_tentacles.world import World
 
 SCENES = Path(__file__).resolve().parent.parent / "assets" / "scenes"
 # render needs a sandbox's renderer: tests/render/test_registries.py turns it on; a level
 # plays one game mode (herding here): tests/race/ walks the race mode's world
-EVERY = [key for key in [*BUILTIN, *BUNDLED] if key not in ("render", "race")]
+EVERY = [key for key in shipped() if key not in ("render", "race")]
 
 
 def _code(entry: Any) -> Iterator[Any]:
@@ -36,12 +36,12 @@ def _code(entry: Any) -> Iterator[Any]:
 
 
 def _home(plugin: Plugin) -> tuple[str, ...]:
-    """Module prefixes of a plugin's own code: its package, and its systems folder."""
-    package = type(plugin).__module__.rsplit(".", 1)[0]
-    if package.startswith("ecs_tentacles.systems."):
-        return (type(plugin).__module__,)
-    feature = package.rsplit(".", 1)[-1]
-    return (package + ".", f"ecs_tentacles.systems.{feature}.")
+    """Module prefixes of a plugin's own code: its feature's package (its systems in
+    `<feature>.systems`), or an example's own module."""
+    module = type(plugin).__module__
+    if module.startswith("ecs_tentacles_examples."):
+        return (module,)
+    return (module.rsplit(".", 1)[0] + ".",)
 
 
 def strangers(world: Any) -> list[str]:

@@ -131,8 +131,8 @@ def test_scene_system_that_is_not_a_system(user_system_module: str) -> None:
 
 
 def test_user_system_base_class_is_the_builtin_one() -> None:
-    from ecs_tentacles.systems.physics.physics import Physics
-    from ecs_tentacles.systems.physics.physics_sync import PhysicsSync
+    from ecs_tentacles.physics.systems.physics import Physics
+    from ecs_tentacles.physics.systems.physics_sync import PhysicsSync
 
     assert issubclass(Physics, System) and issubclass(PhysicsSync, System)
 

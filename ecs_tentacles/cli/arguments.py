@@ -122,12 +122,13 @@ thread_count = bounded_int(1, MAX_THREADS)
 
 
 def installed_folders() -> set[Path]:
-    """The package's folders (its code, bundled scenes, schemas and systems): read-only
-    inputs. (The repository's other assets, such as the README's pictures, are not.)"""
+    """The package's folders (its code and systems, bundled scenes and schemas, the example
+    plugins): read-only inputs. (The repository's other assets, such as the README's
+    pictures, are not.)"""
     import ecs_tentacles
 
     folders = {Path(ecs_tentacles.__file__).resolve().parent}
-    for package in ("ecs_tentacles.assets", "ecs_tentacles.systems"):
+    for package in ("ecs_tentacles.assets", "ecs_tentacles_examples"):
         found = importlib.resources.files(package)
         # an editable install may give a MultiplexedPath: every folder it joins
         for root in getattr(found, "_paths", [found]):

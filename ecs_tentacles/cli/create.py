@@ -124,7 +124,7 @@ def open_window(design: CreatureDesign, out: Path) -> int:
     from ecs_tentacles.render import configure
 
     configure(headless=False)
-    from ecs_tentacles.render.creator import Creator
+    from ecs_tentacles.creator.window import Creator
 
     creator = Creator(design, out)
     try:

@@ -18,12 +18,12 @@ from ecs_tentacles.cli.bake import positive_float
 from ecs_tentacles.cli.run import positive_int
 from ecs_tentacles.creator.crowd import (
     DEFAULT_SPECIES,
-    creature_reach,
     crowd_scene,
     max_creatures,
     write_crowd_scene,
 )
 from ecs_tentacles.output.progress import status
+from ecs_tentacles.scene.construction import creature_reach
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.terrain import presets
 

@@ -23,7 +23,7 @@ from ecs_tentacles.cli.arguments import output_path, read_only_problem
 from ecs_tentacles.output.atomic import atomic_output, claim
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.load import load_scene_plugins, read_scene_json, resolve_scene_path
-from ecs_tentacles.scene.plugins import BUILTIN, DEFAULT_ON, FROM
+from ecs_tentacles.scene.plugins import FROM, default_on, shipped
 from ecs_tentacles.scene.schema import builtin_keys
 
 
@@ -67,7 +67,7 @@ def migrate(raw: dict[str, Any]) -> tuple[dict[str, Any], list[str]]:
     scene = copy.deepcopy(raw)
     changes: list[str] = []
     plugins: dict[str, Any] = dict(scene.get("plugins") or {})
-    for name in DEFAULT_ON:
+    for name in default_on():
         if name not in plugins:
             plugins[name] = {}
             changes.append(f"plugins.{name}: on (it was on by default)")
@@ -78,7 +78,7 @@ def migrate(raw: dict[str, Any]) -> tuple[dict[str, Any], list[str]]:
         plugins[key] = {FROM: target}
         changes.append(f"systems[{i}] -> plugins.{key} (from {target})")
     scene["plugins"] = plugins
-    changes += _drop_keys_of_plugins_off(scene, [n for n in BUILTIN if plugins.get(n) is False])
+    changes += _drop_keys_of_plugins_off(scene, [n for n in shipped() if plugins.get(n) is False])
     return scene, changes
 
 

@@ -12,7 +12,6 @@ import json
 
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.scene.load import resolve_scene_path
-from ecs_tentacles.scene.plugins import BUNDLED
 from ecs_tentacles.world import World
 
 
@@ -62,4 +61,5 @@ def _origin(plugin: Plugin) -> str:
     """Where a plugin came from: built in, a bundled example, or its file or module."""
     if plugin.source is not None:
         return plugin.source
-    return "bundled example" if plugin.key in BUNDLED else "built in"
+    # the engine's plugins are in its package; the examples in their own (`systems/`)
+    return "built in" if type(plugin).__module__.startswith("ecs_tentacles.") else "bundled example"

@@ -33,7 +33,6 @@ SHA-256 of all the bytes before (32).
 from __future__ import annotations
 
 import hashlib
-import importlib.util
 import pathlib
 import struct
 from dataclasses import dataclass
@@ -82,17 +81,13 @@ _SOURCES: str | None = None
 
 
 def _sources() -> str:
-    """SHA-256 of every source file of this package and its systems (once a process)."""
+    """SHA-256 of every source file of this package, its systems included (once a process)."""
     global _SOURCES
     if _SOURCES is None:
         import ecs_tentacles
 
-        # the systems' folder is installed under the package (found, not imported)
-        systems = importlib.util.find_spec("ecs_tentacles.systems")
-        found = systems.submodule_search_locations if systems is not None else None
         digest = hashlib.sha256()
-        paths = [*ecs_tentacles.__path__, *(found or [])]
-        for root in sorted({pathlib.Path(p).resolve() for p in paths}):
+        for root in sorted({pathlib.Path(p).resolve() for p in ecs_tentacles.__path__}):
             for path in sorted(root.rglob("*.py")):
                 digest.update(str(path.relative_to(root)).encode())
                 digest.update(path.read_bytes())

@@ -23,10 +23,11 @@ if TYPE_CHECKING:
 
 class ClipsPlugin(Plugin):
     name = "lod"
+    build_order = 50  # a default plugin: built after fur (40), before terrain (60)
     description = "kinematic crowds: creatures far from the action replay gait clips"
 
     def systems(self) -> list[System]:
-        from ecs_tentacles.systems.clips.replay import LodReplay
+        from ecs_tentacles.clips.systems.replay import LodReplay
 
         return [LodReplay()]
 

@@ -1,7 +1,7 @@
 """The creature creator (thesis III.B, IV.A.2): `CreatureDesign` is its model.
 
 `ecs-tentacles create ... --out scene.json` drives it from the command line; the
-interactive window (a thin layer over the same model) needs the renderer.
+interactive window (`window`: a thin layer over the same model) needs the renderer.
 """
 
 from __future__ import annotations

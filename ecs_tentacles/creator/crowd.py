@@ -43,7 +43,7 @@ import numpy as np
 
 from ecs_tentacles.creator.limits import default
 from ecs_tentacles.output.atomic import atomic_output
-from ecs_tentacles.scene.construction import tentacle_params, tentacle_shape
+from ecs_tentacles.scene.construction import creature_reach
 from ecs_tentacles.scene.load import load_scene
 from ecs_tentacles.scene.schema import core_schema
 
@@ -65,24 +65,6 @@ def max_creatures() -> int:
 def _r(value: float) -> float:
     """A JSON-friendly float: 4 decimals are a tenth of a millimetre."""
     return round(float(value), 4)
-
-
-def creature_reach(creature: dict[str, Any]) -> float:
-    """Radius (m) of the circle around a creature's position that holds it at build.
-
-    `creature` is a scene creature entry with its mantle radius and tentacle shape
-    keys present (a `load_scene` result, or one made by `crowd_scene`).
-    """
-    tentacles = creature["tentacles"]
-    radius = creature["mantle"]["radius"]
-    longest, thickest = 0.0, 0.0
-    for k in range(tentacles["count"]):
-        params = tentacle_params(tentacles, k)
-        keys = ("link_length", "link_radius", "links", "end_scale")
-        shape = tentacle_shape(radius, *(params[key] for key in keys))
-        longest = max(longest, float(shape.lengths.sum()))
-        thickest = max(thickest, float(shape.radii.max()))
-    return float(radius + longest + thickest)
 
 
 def _strength_factor(links: int, link_length: float, link_radius: float) -> float:

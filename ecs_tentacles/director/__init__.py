@@ -1,7 +1,7 @@
 """The crowd director: the sandbox's tools to place, remove, move and send creatures.
 
 A feature package like any other (its plugin, `director.plugin`, is added by the
-sandbox: `scene.plugins.SANDBOX_ON`). Its parts:
+sandbox: entry-point group `ecs_tentacles.plugins.sandbox`). Its parts:
 
 * `palette`: the creatures (and threats) that can be placed: the bundled scenes',
   the creature generator's species, creatures exported from the creator;

@@ -15,7 +15,7 @@ falls. Suckers that hold on release when stretched, as locomotion's rules say. W
 grabbed a creature runs full physics and never sleeps.
 
 `Grab` is the state the director's panel sets from the mouse; the `grab` system
-(`systems/director/grab.py`) applies the force before each physics step.
+(`director/systems/grab.py`) applies the force before each physics step.
 """
 
 from __future__ import annotations

@@ -1,9 +1,10 @@
 """The director plugin: the sandbox's crowd-directing tools (`ecs_tentacles.director`).
 
-The sandbox turns it on (`scene.plugins.SANDBOX_ON`); scenes and bakes never see it.
-Resource: `Director` (the creature held by the mouse, the scatter brush). System: grab
-(stage act; `systems/director/grab.py`). Sandbox hooks: the "Director" HUD section
-with the palette and the mouse and keys (`director.panel`); lines for the grab's
+The sandbox turns it on (its entry point is in the `ecs_tentacles.plugins.sandbox`
+group); scenes and bakes never see it. Resource: `Director` (the creature held by the
+mouse, the scatter brush). System: grab (stage act; `director/systems/grab.py`). Sandbox hooks:
+the "Director" HUD section with the palette and the mouse and keys (`director.panel`);
+lines for the grab's
 spring and the brush. Its `MotionWants` entry: a held creature never sleeps; `despawning`:
 removing the held creature ends the grab.
 """
@@ -40,7 +41,7 @@ class DirectorPlugin(Plugin):
         return [Director()]
 
     def systems(self) -> list[System]:
-        from ecs_tentacles.systems.director.grab import GrabSpring
+        from ecs_tentacles.director.systems.grab import GrabSpring
 
         return [GrabSpring()]
 

@@ -1,7 +1,7 @@
 """`Director`: what the director's tools hold between frames (a world resource).
 
 The panel (`director.panel`) writes it from the mouse; the grab system
-(`systems/director/grab.py`) and the plugin's drawing read it.
+(`director/systems/grab.py`) and the plugin's drawing read it.
 """
 
 from __future__ import annotations

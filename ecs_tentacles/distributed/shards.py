@@ -26,11 +26,11 @@ from typing import Any
 
 import numpy as np
 
-from ecs_tentacles.creator.crowd import creature_reach
 from ecs_tentacles.distributed.registries import Reach, ShardGroups, ShardReaches
 from ecs_tentacles.physics.proxies import MARGIN
 from ecs_tentacles.plugin import Plugin, calling
 from ecs_tentacles.registry import App, Registries
+from ecs_tentacles.scene.construction import creature_reach
 from ecs_tentacles.scene.plugins import resolve
 
 SLACK = 0.15  # metres: settling at the start, sideways drift, tentacles lifting

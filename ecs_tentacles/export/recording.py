@@ -2,7 +2,7 @@
 
 `TakeRecorder(world)` fixes the layout once (which store rows are which bodies and
 suckers) and `capture()` copies the current frame with one gather per array; the
-`record` system (`ecs_tentacles.systems.record.record`) calls it after physics_sync.
+`record` system (`ecs_tentacles.record.systems.record`) calls it after physics_sync.
 Everything else a take holds comes from the plugins' take tracks (the `TakeTracks`
 entries: the locomotion plugin's goals, the fur plugin's guides, a user plugin's own),
 recorded by kind (`export.track_recording`: `PointsTrack`, `CurvesTrack`); the standard

@@ -3,7 +3,7 @@
 - `groom`: guides generated on the mantle (or listed), roots in the body frame;
 - `controls`: mirrored twins, nearest-control assignment;
 - `rig`, `bind`, `dynamics`: the vectorised rig (lift, aim, direction, random
-  twist, dynamic blend) run by `ecs_tentacles.systems.fur.rig`; `kernels`: its optional
+  twist, dynamic blend) run by `ecs_tentacles.fur.systems.rig`; `kernels`: its optional
   numba kernels (used when numba is installed);
 - `tracks`: keyframes and easing; `presets`: hedgehog, cat, bird;
 - `hooks`: polylines and child hairs for the renderer and the exporter;

@@ -37,6 +37,7 @@ STORES = ("guides", "controls", "sets", "emotions")
 
 class FurPlugin(Plugin):
     name = "fur"
+    build_order = 40  # a default plugin: built after threats (30), before lod (50)
     description = "fur and feathers (lift, aim, direction, random, dynamic blend) and emotion"
     creature_schema = _FRAGMENT["creature"]
     defs = _FRAGMENT["$defs"]
@@ -60,8 +61,8 @@ class FurPlugin(Plugin):
             world.resource(FurData).drop(change.moved)
 
     def systems(self) -> list[System]:
-        from ecs_tentacles.systems.fur.emotion import EmotionSystem
-        from ecs_tentacles.systems.fur.rig import Rig
+        from ecs_tentacles.fur.systems.emotion import EmotionSystem
+        from ecs_tentacles.fur.systems.rig import Rig
 
         return [EmotionSystem(), Rig()]
 

@@ -17,7 +17,7 @@ as drawn), `levels` (the levels in order, par times, stars, which are open),
 (the sandbox's game section, level select and banner), `entries` (what the plugin adds
 to the renderer's, take's and report's registries), `play` (driving a level headless:
 the bot and replays), `plugin` (`HerdingPlugin`: what it adds to the registries). Its
-systems are in `systems/herding/`: `predator` (moves the predator toward where the
+systems are in `herding/systems/`: `predator` (moves the predator toward where the
 player aims it, walking or running on its stamina), `herd` (the creatures flee it,
 graze and keep together) and `referee` (pens, clock, win and lose).
 """

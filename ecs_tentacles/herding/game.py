@@ -6,7 +6,7 @@
     game.penned, game.left, game.outcome   # creatures penned, seconds left, "playing"/"won"/"lost"
     game.restart(world)             # back to the level's start, exactly
 
-Its systems (`systems/herding/`) move the predator toward the aim and referee the
+Its systems (`herding/systems/`) move the predator toward the aim and referee the
 game; the sandbox's panel and the bot only aim and restart. Every aim is logged with
 its frame (`log`), so a game replays from its inputs (`ecs_tentacles.herding.play`).
 """

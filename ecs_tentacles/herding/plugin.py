@@ -3,7 +3,7 @@
 Game mode "herding" (the scene's `game`, whose keys are `ecs_tentacles.herding.schema`'s;
 the `game` layer owns the key); resource `HerdingGame`
 (`ecs_tentacles.herding.game`); systems `Predator`, `Herd` and `Referee`
-(`systems/herding/`: `Herd` makes the creatures flee the predator and graze as a
+(`herding/systems/`: `Herd` makes the creatures flee the predator and graze as a
 flock, so no flee plugin is needed). It needs locomotion and the game layer.
 
 What it adds to the registries in `build`:
@@ -58,9 +58,9 @@ class HerdingPlugin(Plugin):
         world.resource(HerdingGame).start = world.snapshot()
 
     def systems(self) -> list[System]:
-        from ecs_tentacles.systems.herding.herd import Herd
-        from ecs_tentacles.systems.herding.predator import Predator
-        from ecs_tentacles.systems.herding.referee import Referee
+        from ecs_tentacles.herding.systems.herd import Herd
+        from ecs_tentacles.herding.systems.predator import Predator
+        from ecs_tentacles.herding.systems.referee import Referee
 
         return [Predator(), Herd(), Referee()]
 

@@ -1,11 +1,11 @@
-"""The numba kernel of the goals system (`systems/locomotion/goals.py`): the creatures
+"""The numba kernel of the goals system (`locomotion/systems/goals.py`): the creatures
 whose mantle is within their goal's radius, on the ground plane, in one pass where the
 numpy path takes eight whole-array operations a frame.
 
 Optional, as the other kernels are (`ecs_tentacles.numeric.optional_kernels`): the
 system uses it only when numba is installed and falls back to numpy otherwise. Both
 compare the same numbers: dx * dx + dy * dy (two terms: the same sum in any order)
-against radius * radius. tests/systems/locomotion/test_goals.py compares the two.
+against radius * radius. tests/locomotion/systems/test_goals.py compares the two.
 """
 
 from __future__ import annotations

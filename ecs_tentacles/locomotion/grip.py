@@ -5,7 +5,7 @@
     attach(world, sucker_entity)             # fires sucker_attached (anchor: where it is now)
     release(world, sucker_entity, "script")  # fires sucker_released (with the reason)
 
-The suckers plugin's system (`ecs_tentacles.systems.locomotion.suckers`) grips with
+The suckers plugin's system (`ecs_tentacles.locomotion.systems.suckers`) grips with
 these; a script may call them whether the plugin is on or not (the sucker bodies and
 their MuJoCo constraints are core).
 

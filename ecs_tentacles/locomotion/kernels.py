@@ -7,7 +7,7 @@ system imports this module only when numba is installed and falls back to numpy
 otherwise. Both compute the same numbers bit for bit: the same operations in the same
 order, the sines and cosines taken by numpy in both (numba may vectorise them with
 other libraries), no fused multiply-adds (numba contracts only with `fastmath`).
-tests/systems/locomotion/test_motor_targets.py compares the two.
+tests/locomotion/systems/test_motor_targets.py compares the two.
 """
 
 from __future__ import annotations

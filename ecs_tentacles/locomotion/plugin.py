@@ -69,6 +69,7 @@ _FRAGMENT = fragment("ecs_tentacles.locomotion", "locomotion")
 
 class LocomotionPlugin(Plugin):
     name = "locomotion"
+    build_order = 10  # a default plugin: built before suckers (20)
     description = "goal-directed crawling: goal paths, gait, action queues, motor targets"
     creature_schema = _FRAGMENT["creature"]
     tentacle_schema = _FRAGMENT["tentacles"]
@@ -131,11 +132,11 @@ class LocomotionPlugin(Plugin):
         world.resource(Navigator).roster_changed(change)
 
     def systems(self) -> list[System]:
-        from ecs_tentacles.systems.locomotion.action_queue import ActionQueueSystem
-        from ecs_tentacles.systems.locomotion.avoidance import CrowdAvoidance
-        from ecs_tentacles.systems.locomotion.goals import Goals
-        from ecs_tentacles.systems.locomotion.motor_targets import MotorTargets
-        from ecs_tentacles.systems.locomotion.tentacle_selection import TentacleSelection
+        from ecs_tentacles.locomotion.systems.action_queue import ActionQueueSystem
+        from ecs_tentacles.locomotion.systems.avoidance import CrowdAvoidance
+        from ecs_tentacles.locomotion.systems.goals import Goals
+        from ecs_tentacles.locomotion.systems.motor_targets import MotorTargets
+        from ecs_tentacles.locomotion.systems.tentacle_selection import TentacleSelection
 
         return [Goals(), CrowdAvoidance(), TentacleSelection(), ActionQueueSystem(),
                 MotorTargets()]  # fmt: skip

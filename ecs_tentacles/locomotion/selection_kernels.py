@@ -1,4 +1,4 @@
-"""The numba kernels of tentacle selection (`systems/locomotion/tentacle_selection.py`):
+"""The numba kernels of tentacle selection (`locomotion/systems/tentacle_selection.py`):
 on the plane, each live tentacle's vectors mantle -> goal (turned by the avoidance
 term) and mantle -> base, and the thesis's push/pull test on them, in one pass where
 the numpy path takes some twenty whole-array operations; the strokes that stop
@@ -8,7 +8,7 @@ Optional, as the other kernels are (`ecs_tentacles.numeric.optional_kernels`): t
 system uses it only when numba is installed and falls back to numpy otherwise. Both
 compute the same numbers bit for bit: the same operations in the same order, no fused
 multiply-adds (numba contracts only with `fastmath`).
-tests/systems/locomotion/test_tentacle_selection.py compares the two.
+tests/locomotion/systems/test_tentacle_selection.py compares the two.
 """
 
 from __future__ import annotations

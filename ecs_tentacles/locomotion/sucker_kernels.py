@@ -1,10 +1,10 @@
-"""The numba kernel of the suckers system's release test (`systems/locomotion/suckers.py`).
+"""The numba kernel of the suckers system's release test (`locomotion/systems/suckers.py`).
 
 Optional, as the other kernels are (`ecs_tentacles.numeric.optional_kernels`): the
 system uses it only when numba is installed and falls back to numpy otherwise. Both
 find the same reasons from the same numbers: each held sucker's point is rotated as
 `quaternion_kernels.rotate` does (`quat_rotate`'s kernel), its distances summed in
-`np.linalg.norm`'s order. tests/systems/locomotion/test_suckers.py compares the two.
+`np.linalg.norm`'s order. tests/locomotion/systems/test_suckers.py compares the two.
 The numpy path takes about a dozen whole-array passes over the held suckers a frame.
 """
 

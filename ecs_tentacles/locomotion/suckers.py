@@ -29,11 +29,12 @@ SUCKER_RGBA = (1.0, 0.92, 0.25, 1.0)
 
 class SuckersPlugin(Plugin):
     name = "suckers"
+    build_order = 20  # a default plugin: built after locomotion (10), before threats (30)
     description = "suckers attach at the ground on command; release on command, stretch or reach"
     requires = ("locomotion",)
 
     def systems(self) -> list[System]:
-        from ecs_tentacles.systems.locomotion.suckers import Suckers
+        from ecs_tentacles.locomotion.systems.suckers import Suckers
 
         return [Suckers()]
 

@@ -3,5 +3,5 @@
 `backend` (the groups, stepped in parallel; `state()` / `set_state()`), `group`,
 `model`, `proxies`, `health`, `sleep`, `registries`; `host` is what the physics needs
 of a world (a Protocol: nothing here imports `ecs_tentacles.world`); `frame_systems`
-declares the physics systems every world runs (their code is in `systems/physics/`).
+declares the physics systems every world runs (their code is in `physics/systems/`).
 """

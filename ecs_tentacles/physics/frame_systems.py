@@ -1,4 +1,4 @@
-"""The physics package's systems, declared here (their code is in `systems/physics/`).
+"""The physics package's systems, declared here (their code is in `physics/systems/`).
 
 physics (stage physics) steps MuJoCo; physics_sync and physics_health (stage sync)
 copy the poses back and recover blow-ups. Every world runs them, whatever plugins
@@ -12,9 +12,9 @@ from ecs_tentacles.system import System
 
 def physics_systems() -> list[System]:
     """Fresh instances of the physics systems (physics, sync, health), in frame order."""
-    from ecs_tentacles.systems.physics.physics import Physics
-    from ecs_tentacles.systems.physics.physics_health import PhysicsHealth
-    from ecs_tentacles.systems.physics.physics_sync import PhysicsSync
+    from ecs_tentacles.physics.systems.physics import Physics
+    from ecs_tentacles.physics.systems.physics_health import PhysicsHealth
+    from ecs_tentacles.physics.systems.physics_sync import PhysicsSync
 
     systems: list[System] = [Physics(), PhysicsSync(), PhysicsHealth()]
     for system in systems:

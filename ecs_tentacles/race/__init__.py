@@ -16,6 +16,6 @@ resource: the flag, the runner's path, the clock, the outcome, the input log, th
 level's start), `entries` (what the plugin adds to the renderer's, sandbox's and game
 layer's registries), `hud` (the sandbox's Race section and banner), `play` (driving a
 level headless: a player, recorded inputs, replays), `plugin` (`RacePlugin`). Its
-systems are in `systems/race/`: `steering` (sends the rivals to the flag and the runner
+systems are in `race/systems/`: `steering` (sends the rivals to the flag and the runner
 along its path) and `referee` (the clock, who reached the flag first).
 """

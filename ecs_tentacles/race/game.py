@@ -6,7 +6,7 @@
     race.outcome, race.left, race.winner      # "playing"/"won"/"lost", seconds left, who
     race.restart(world)                       # back to the level's start, exactly
 
-Its systems (`systems/race/`) move the runner along its path and the rivals to the
+Its systems (`race/systems/`) move the runner along its path and the rivals to the
 flag, and referee the race; the sandbox's panel and a headless player only steer and
 restart. Every input is logged with its frame (`log`), so a race replays from its
 inputs (`ecs_tentacles.race.play`).

@@ -1,7 +1,7 @@
 """`RacePlugin`: race to the flag as a plugin (`"plugins": {"race": {}}`), game mode "race".
 
 Keys of the scene's `game` (`ecs_tentacles.race.rules`); resource `RaceGame`
-(`ecs_tentacles.race.game`); systems `Steering` and `Referee` (`systems/race/`). It
+(`ecs_tentacles.race.game`); systems `Steering` and `Referee` (`race/systems/`). It
 needs the locomotion plugin (what sends creatures: `behaviour.travel`) and the game
 layer (turned on with it).
 
@@ -62,8 +62,8 @@ class RacePlugin(Plugin):
         world.resource(RaceGame).start = world.snapshot()
 
     def systems(self) -> list[System]:
-        from ecs_tentacles.systems.race.referee import Referee
-        from ecs_tentacles.systems.race.steering import Steering
+        from ecs_tentacles.race.systems.referee import Referee
+        from ecs_tentacles.race.systems.steering import Steering
 
         return [Steering(), Referee()]
 

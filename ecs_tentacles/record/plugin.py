@@ -23,7 +23,7 @@ class RecordPlugin(Plugin):
 
     def __init__(self, config: dict[str, Any] | None = None, *, every: int = 1, **recorder: Any):
         super().__init__(config)
-        from ecs_tentacles.systems.record.record import Record
+        from ecs_tentacles.record.systems.record import Record
 
         self.system = Record(every, **recorder)
 

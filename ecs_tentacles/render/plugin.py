@@ -34,7 +34,7 @@ class RenderPlugin(Plugin):
         self.renderer = renderer
 
     def systems(self) -> list[System]:
-        from ecs_tentacles.systems.render.render import RenderSync
+        from ecs_tentacles.render.systems.render import RenderSync
 
         return [RenderSync(self.renderer)]
 

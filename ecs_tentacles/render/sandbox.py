@@ -202,8 +202,8 @@ class Sandbox(SandboxPicture):
         self.select(first)
 
     def _add_sandbox_plugins(self) -> None:
-        """The sandbox's own plugins join the world: its drawing, and the ones the
-        registry turns on in sandboxes (`scene.plugins.SANDBOX_ON`: the director)."""
+        """The sandbox's own plugins join the world: its drawing, and the engine's plugins
+        of the entry-point group `ecs_tentacles.plugins.sandbox` (the director)."""
         self.world.add_plugin(RenderPlugin(renderer=self.renderer))
         on = {plugin.key for plugin in self.world.plugins}
         for plugin in sandbox_plugins():

@@ -213,3 +213,22 @@ def cylinder_mass_inertia(radius: float, height: float, density: float) -> tuple
     axial = mass * radius**2 / 2.0
     across = mass * (3.0 * radius**2 + height**2) / 12.0
     return float(mass), float(min(axial, across))
+
+
+def creature_reach(creature: dict[str, Any]) -> float:
+    """Radius (m) of the circle around a creature's position that holds it at build.
+
+    `creature` is a scene creature entry with its mantle radius and tentacle shape
+    keys present (a `load_scene` result, or one the crowd generator made): the crowd
+    generator and the shard planner space creatures by it.
+    """
+    tentacles = creature["tentacles"]
+    radius = creature["mantle"]["radius"]
+    longest, thickest = 0.0, 0.0
+    for k in range(tentacles["count"]):
+        params = tentacle_params(tentacles, k)
+        keys = ("link_length", "link_radius", "links", "end_scale")
+        shape = tentacle_shape(radius, *(params[key] for key in keys))
+        longest = max(longest, float(shape.lengths.sum()))
+        thickest = max(thickest, float(shape.radii.max()))
+    return float(radius + longest + thickest)

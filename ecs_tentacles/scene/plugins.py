@@ -4,19 +4,28 @@ A scene turns plugins on and configures them:
 
     "plugins": {"wander": {"radius": 2.0}, "fur": false, "mine": {"from": "mine.py"}}
 
-Built-in plugins (`BUILTIN`) and the bundled examples (`BUNDLED`) are found by name;
-`DEFAULT_ON` are on unless a scene says `false`; a built-in plugin another one `requires`
-is turned on with it unless the scene names it (the `game` layer with a game mode).
-Other plugins come from a file or module named by `from` (the scene's folder is
-searched first; a relative file may not leave it) or from the `ecs_tentacles.plugins`
-entry point group of an installed package. Those run user code, so they need
-`allow_systems` (`--allow-systems`). Nothing here imports a feature until a world uses
-it (targets are "module:Class").
+Every plugin is found through entry points, the engine's own as any installed
+package's (reads `importlib.metadata`; core lists none by name). Three groups:
+`ecs_tentacles.plugins` (found by name, on when a scene turns it on), and two roles the
+engine's own package declares in its `pyproject.toml`: `ecs_tentacles.plugins.default`
+(on unless a scene says `false`, built by their `build_order`) and
+`ecs_tentacles.plugins.sandbox` (added by the sandbox to the world it shows). A role is
+honoured only for the engine's own entries: another package's plugin, in whichever
+group, is on only when a scene names it. A plugin another one `requires` that the
+engine ships is turned on with it unless the scene names it (the `game` layer with a
+game mode).
+
+Trust: the engine's own entry points were consented to when it was installed. A plugin
+from a file or module named by `from` (the scene's folder is searched first; a relative
+file may not leave it), or from another package's entry point, runs user code, so it
+needs `allow_systems` (`--allow-systems`). Nothing here imports a plugin until a world
+uses it (targets are "module:Class"), so finding and listing them runs no code.
 """
 
 from __future__ import annotations
 
 import contextlib
+import functools
 import importlib
 import importlib.metadata
 import importlib.util
@@ -30,30 +39,11 @@ from typing import Any
 from ecs_tentacles.plugin import Plugin, SystemsPlugin
 from ecs_tentacles.system import System
 
-ENTRY_POINTS = "ecs_tentacles.plugins"
-# name -> where it lives; imported only when a world uses it
-BUILTIN = {
-    "locomotion": "ecs_tentacles.locomotion.plugin:LocomotionPlugin",
-    "suckers": "ecs_tentacles.locomotion.suckers:SuckersPlugin",
-    "fur": "ecs_tentacles.fur.plugin:FurPlugin",
-    "threats": "ecs_tentacles.threats.plugin:ThreatsPlugin",
-    "record": "ecs_tentacles.record.plugin:RecordPlugin",
-    "render": "ecs_tentacles.render.plugin:RenderPlugin",
-    "lod": "ecs_tentacles.clips.plugin:ClipsPlugin",
-    "terrain": "ecs_tentacles.terrain.plugin:TerrainPlugin",
-    "director": "ecs_tentacles.director.plugin:DirectorPlugin",
-    "herding": "ecs_tentacles.herding.plugin:HerdingPlugin",
-    "game": "ecs_tentacles.game.plugin:GamePlugin",
-    "race": "ecs_tentacles.race.plugin:RacePlugin",
-}
-BUNDLED = {
-    "wander": "ecs_tentacles.systems.examples.wander:WanderPlugin",
-    "flee": "ecs_tentacles.systems.examples.flee:FleePlugin",
-    "follow_leader": "ecs_tentacles.systems.examples.follow_leader:FollowLeaderPlugin",
-    "flock": "ecs_tentacles.systems.examples.flock:FlockPlugin",
-}
-DEFAULT_ON = ("locomotion", "suckers", "threats", "fur", "lod", "terrain")  # in build order
-SANDBOX_ON = ("director",)  # added by the sandbox (`play`) to the world it shows
+ENTRY_POINTS = "ecs_tentacles.plugins"  # found by name; what third parties register in
+DEFAULT_GROUP = f"{ENTRY_POINTS}.default"  # the engine's: on unless a scene says false
+SANDBOX_GROUP = f"{ENTRY_POINTS}.sandbox"  # the engine's: added by the sandbox
+GROUPS = (DEFAULT_GROUP, SANDBOX_GROUP, ENTRY_POINTS)
+DISTRIBUTION = "ecs-tentacles"  # the engine's own package: its entry points are trusted
 FROM = "from"  # the config key naming where a plugin's code is
 
 
@@ -73,24 +63,67 @@ def locate(key: str, config: Mapping[str, Any] | bool) -> Found:
     """Where the plugin turned on as `key` lives (PluginError if nowhere)."""
     if isinstance(config, Mapping) and FROM in config:
         return Found(str(config[FROM]), trusted=False)
-    if key in BUILTIN:
-        return Found(BUILTIN[key], trusted=True)
-    if key in BUNDLED:
-        return Found(BUNDLED[key], trusted=True)
-    for entry in _entry_points():
-        if entry.name == key:
-            dist = getattr(entry, "dist", None)
-            ours = dist is not None and dist.name.replace("_", "-") == "ecs-tentacles"
-            return Found(entry.value, trusted=ours)
-    known = sorted({*BUILTIN, *BUNDLED, *(e.name for e in _entry_points())})
+    entries = sorted((e for e in _entry_points() if e.name == key), key=lambda e: not e.ours)
+    if entries:  # the engine's own first: another package cannot take a built-in's name
+        return Found(entries[0].value, trusted=entries[0].ours)
+    known = sorted({e.name for e in _entry_points()})
     raise PluginError(
         f"plugins.{key}: no plugin of that name (known: {', '.join(known)});"
         f' name its code with {{"{FROM}": "file.py"}}'
     )
 
 
-def _entry_points() -> list[importlib.metadata.EntryPoint]:
-    return list(importlib.metadata.entry_points(group=ENTRY_POINTS))
+def shipped() -> dict[str, str]:
+    """Every plugin the engine's own package registers: scene key -> "module:Class"."""
+    return {e.name: e.value for e in _entry_points() if e.ours}
+
+
+def default_on() -> tuple[str, ...]:
+    """The plugins on unless a scene says `false`, by key (`resolve` builds them by their
+    `build_order`, which needs their code: this list imports none)."""
+    return _role(DEFAULT_GROUP)
+
+
+def sandbox_on() -> tuple[str, ...]:
+    """The plugins the sandbox (`play`) adds to the world it shows."""
+    return _role(SANDBOX_GROUP)
+
+
+def _role(group: str) -> tuple[str, ...]:
+    return tuple(sorted(e.name for e in _entry_points() if e.group == group and e.ours))
+
+
+@dataclass(frozen=True)
+class Entry:
+    """An installed plugin entry point, read (never loaded), and whether it is the
+    engine's own (consented to when the engine was installed)."""
+
+    name: str
+    group: str
+    value: str  # "module:Class"
+    ours: bool
+
+
+def _entry_points() -> tuple[Entry, ...]:
+    """Every installed plugin entry point, of every group."""
+    return _entry_points_on(tuple(sys.path))
+
+
+@functools.lru_cache(maxsize=8)
+def _entry_points_on(path: tuple[str, ...]) -> tuple[Entry, ...]:
+    # read once per import path, and each distribution's name once (it is parsed from
+    # the distribution's whole METADATA, the engine's README included)
+    every = importlib.metadata.entry_points()  # one pass over the installed packages
+    found = [e for group in GROUPS for e in every.select(group=group)]
+    names: dict[int, str] = {}
+    for entry in found:
+        dist = getattr(entry, "dist", None)
+        if dist is not None and id(dist) not in names:
+            names[id(dist)] = dist.name.replace("_", "-").lower()
+    return tuple(
+        Entry(e.name, e.group, e.value, names.get(id(getattr(e, "dist", None))) == DISTRIBUTION)
+        for e in found
+    )
 
 
 def load(
@@ -194,17 +227,18 @@ def instantiate(
 
 
 def builtin(key: str, **options: Any) -> Plugin:
-    """The built-in plugin `key`, made with keyword `options` (a bake's record plugin:
+    """The engine's plugin `key`, made with keyword `options` (a bake's record plugin:
     `builtin("record", every=2)`), so generic code needs no feature's import."""
-    if key not in BUILTIN:
-        raise PluginError(f"plugins.{key}: not a built-in plugin (known: {', '.join(BUILTIN)})")
-    made = load(key, BUILTIN[key], None)
+    known = shipped()
+    if key not in known:
+        raise PluginError(f"plugins.{key}: not a built-in plugin (known: {', '.join(known)})")
+    made = load(key, known[key], None)
     return instantiate(made(**options) if isinstance(made, type) else made, key, {}, None)
 
 
 def sandbox_plugins() -> list[Plugin]:
-    """The built-in plugins every sandbox adds to its world (`SANDBOX_ON`)."""
-    return [builtin(key) for key in SANDBOX_ON]
+    """The engine's plugins every sandbox adds to its world (`sandbox_on()`)."""
+    return [builtin(key) for key in sandbox_on()]
 
 
 def resolve(
@@ -212,7 +246,7 @@ def resolve(
     scene_dir: pathlib.Path | None = None,
     *,
     allow: bool = False,
-    defaults: tuple[str, ...] = DEFAULT_ON,
+    defaults: tuple[str, ...] | None = None,
     problems_out: list[str] | None = None,
 ) -> list[Plugin]:
     """Instances of the plugins a scene's `plugins` field turns on, defaults first.
@@ -223,6 +257,7 @@ def resolve(
     are returned (the loader goes on to check the rest of the scene).
     """
     choices = dict(choices or {})
+    defaults = default_on() if defaults is None else defaults
     wanted = [n for n in defaults if choices.get(n, True) is not False]
     wanted += [n for n in choices if n not in wanted and choices[n] is not False]
     problems: list[str] = []
@@ -249,13 +284,16 @@ def resolve(
             )
         except (Exception, SystemExit) as exc:  # the user's plugin class failed to construct
             problems.append(f"plugins.{key}: cannot make {found.target!r}: {_one_line(exc)}")
+    first = set(defaults)
+    plugins.sort(key=lambda p: (0, p.build_order, p.key) if p.key in first else (1, 0, ""))
     on = {p.key for p in plugins}
+    known = shipped()
     for plugin in list(plugins):
         for need in plugin.requires:
             if need in on:
                 continue
-            if need in BUILTIN and need not in choices:  # a layer it needs, on with it
-                brought = instantiate(load(need, BUILTIN[need], None), need, {}, None)
+            if need in known and need not in choices:  # a layer it needs, on with it
+                brought = instantiate(load(need, known[need], None), need, {}, None)
                 plugins.insert(plugins.index(plugin), brought)
                 on.add(need)
             else:

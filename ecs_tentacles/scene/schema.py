@@ -13,7 +13,9 @@ from __future__ import annotations
 import copy
 import functools
 import importlib.resources
+import importlib.util
 import json
+import pathlib
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
@@ -41,16 +43,23 @@ def fragment(package: str, name: str) -> dict[str, Any]:
 
 
 def _fragment_file(package: str, name: str) -> importlib.resources.abc.Traversable:
-    """`<name>.schema.json` in a feature package, found without importing the package."""
+    """`<name>.schema.json` in a feature package, found without importing the package
+    (nor its top: `importlib.resources.files` would run an examples package's
+    `__init__`)."""
     top, *rest = package.split(".")
-    return importlib.resources.files(top).joinpath(*rest, f"{name}.schema.json")
+    spec = importlib.util.find_spec(top)
+    folders = list(spec.submodule_search_locations or []) if spec is not None else []
+    if not folders:
+        return importlib.resources.files(top).joinpath(*rest, f"{name}.schema.json")
+    return pathlib.Path(folders[0]).joinpath(*rest, f"{name}.schema.json")
 
 
 def builtin_fragment(name: str) -> dict[str, Any]:
-    """The fragment of built-in plugin `name` ({} when it has none), its code not imported."""
-    from ecs_tentacles.scene.plugins import BUILTIN
+    """The fragment of the engine's plugin `name` ({} when it has none), its code not
+    imported (where it is: its entry point)."""
+    from ecs_tentacles.scene.plugins import shipped
 
-    package = BUILTIN[name].partition(":")[0].rpartition(".")[0]  # the feature package
+    package = shipped()[name].partition(":")[0].rpartition(".")[0]  # the feature package
     return fragment(package, name) if _fragment_file(package, name).is_file() else {}
 
 
@@ -82,9 +91,9 @@ def load_schema() -> dict[str, Any]:
 
     Assembled from the fragment files of the default plugins (their code is not imported).
     """
-    from ecs_tentacles.scene.plugins import DEFAULT_ON
+    from ecs_tentacles.scene.plugins import default_on
 
-    parts = [(name, builtin_fragment(name)) for name in DEFAULT_ON]
+    parts = [(name, builtin_fragment(name)) for name in default_on()]
     return _assemble([(name, tuple(part.get(p, {}) for p in PLACES)) for name, part in parts])
 
 

@@ -319,11 +319,11 @@ def _place(path: JsonPath) -> str | None:
 
 def _name_plugins_that_are_off(problems: list[Problem], on: set[str]) -> list[Problem]:
     """An unknown key that a built-in plugin which is off would know says so."""
-    from ecs_tentacles.scene.plugins import BUILTIN
+    from ecs_tentacles.scene.plugins import shipped
 
     if not any(message.startswith("unknown key") for _, message in problems):
         return problems
-    off = {name: builtin_keys(name) for name in BUILTIN if name not in on}
+    off = {name: builtin_keys(name) for name in shipped() if name not in on}
     named: list[Problem] = []
     for path, message in problems:
         place = _place(path) if message.startswith("unknown key") else None

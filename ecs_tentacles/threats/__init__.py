@@ -2,5 +2,5 @@
 
 - `data`: the store and `ThreatData` resource, scene building and checks;
 - `plugin`: the `threats` plugin (scene keys in `threats.schema.json`, its render
-  markers); its system is `ecs_tentacles.systems.threats.threats`.
+  markers); its system is `ecs_tentacles.threats.systems.threats`.
 """

@@ -32,6 +32,7 @@ THREAT_RGBA = (0.35, 0.12, 0.08, 1.0)
 
 class ThreatsPlugin(Plugin):
     name = "threats"
+    build_order = 30  # a default plugin: built after suckers (20), before fur (40)
     description = "marked threats on keyframed paths, and creatures marked as threats"
     creature_schema = _FRAGMENT["creature"]
     scene_schema = _FRAGMENT["scene"]
@@ -73,7 +74,7 @@ class ThreatsPlugin(Plugin):
         build_threats(world, scene["threats"])
 
     def systems(self) -> list[System]:
-        from ecs_tentacles.systems.threats.threats import ThreatPaths
+        from ecs_tentacles.threats.systems.threats import ThreatPaths
 
         return [ThreatPaths()]
 

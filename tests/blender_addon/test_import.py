@@ -10,11 +10,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from ecs_tentacles.systems.record.record import Record
 
 from ecs_tentacles.cli import main
 from ecs_tentacles.creator.crowd import crowd_scene
 from ecs_tentacles.export.materials import take_colours
+from ecs_tentacles.record.systems.record import Record
 from ecs_tentacles.skin.colours import to_linear
 from ecs_tentacles.take import Take
 from ecs_tentacles.take.stream import open_take

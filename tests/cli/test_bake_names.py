@@ -61,9 +61,8 @@ def test_a_bake_that_spawns_a_name_used_before_writes_its_take(
 
 
 def test_a_placed_entry_whose_name_a_recording_kept_is_refused_when_it_happens() -> None:
-    from ecs_tentacles.systems.record.record import Record
-
     from ecs_tentacles.creatures.spawning import place
+    from ecs_tentacles.record.systems.record import Record
 
     scene = {"version": 1, "creatures": [{"name": "a", "tentacles": {"count": 3, "links": 2}}]}
     with World.from_scene(scene) as world:

@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 from ecs_tentacles.components import Creature, Link, Tentacle, Transform
-from ecs_tentacles.creator.crowd import CLEARANCE, creature_reach, crowd_scene
+from ecs_tentacles.creator.crowd import CLEARANCE, crowd_scene
+from ecs_tentacles.scene.construction import creature_reach
 from ecs_tentacles.scene.load import load_scene
 from ecs_tentacles.world import World
 

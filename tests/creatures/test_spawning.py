@@ -193,8 +193,7 @@ def test_a_snapshot_naming_a_despawned_creature_is_refused_and_changes_nothing()
 
 
 def test_a_take_records_the_roster_per_frame(tmp_path):
-    from ecs_tentacles.systems.record.record import Record
-
+    from ecs_tentacles.record.systems.record import Record
     from ecs_tentacles.take import Take
 
     with World.from_scene(_scene(APART)) as world:

@@ -20,12 +20,13 @@ import numpy as np
 import pytest
 
 from ecs_tentacles.cli import main
-from ecs_tentacles.creator.crowd import creature_reach, crowd_scene
+from ecs_tentacles.creator.crowd import crowd_scene
 from ecs_tentacles.distributed.merge import merge_takes
 from ecs_tentacles.distributed.shards import default_tasks, plan_shards
 from ecs_tentacles.distributed.task import CRASH_DIR, bake_shard
 from ecs_tentacles.distributed.work import shard_key, work_folder
 from ecs_tentacles.export.bake import BakePlan
+from ecs_tentacles.scene.construction import creature_reach
 from ecs_tentacles.take import Take
 from ecs_tentacles.terrain.presets import rocky
 

@@ -13,11 +13,11 @@ from typing import Any
 
 import numpy as np
 import pytest
-from ecs_tentacles.systems.record.record import Record
 
 from ecs_tentacles.cli import main
 from ecs_tentacles.components import Creature, Link, Tentacle, Transform
 from ecs_tentacles.fur.outputs import GUIDES
+from ecs_tentacles.record.systems.record import Record
 from ecs_tentacles.take import Take
 from ecs_tentacles.take.registries import CurvesFrame, TrackSource
 from ecs_tentacles.world import World

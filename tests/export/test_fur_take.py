@@ -6,10 +6,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from ecs_tentacles.systems.record.record import Record
 
 from ecs_tentacles.export.usd import write_usd
 from ecs_tentacles.fur.stores import FurData
+from ecs_tentacles.record.systems.record import Record
 from ecs_tentacles.world import World
 
 hooks = pytest.importorskip("ecs_tentacles.fur.hooks", reason="the fur package is not here yet")

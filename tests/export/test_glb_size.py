@@ -17,7 +17,6 @@ from typing import Any
 
 import numpy as np
 import pytest
-from ecs_tentacles.systems.record.record import Record
 
 from ecs_tentacles.creator.crowd import crowd_scene
 from ecs_tentacles.export.bake import BakePlan, bake
@@ -26,6 +25,7 @@ from ecs_tentacles.export.glb_size import glb_problem, glb_size, shapes_of_heade
 from ecs_tentacles.export.gltf import write_glb
 from ecs_tentacles.export.skinned import Skin
 from ecs_tentacles.export.skinned_gltf import write_skinned_glb
+from ecs_tentacles.record.systems.record import Record
 from ecs_tentacles.skin.mesh import Detail
 from ecs_tentacles.skin.rig import Keys
 from ecs_tentacles.take import Take

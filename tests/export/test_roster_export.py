@@ -7,12 +7,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from ecs_tentacles.systems.record.record import Record
 
 from ecs_tentacles.export.gltf import read_glb, write_glb
 from ecs_tentacles.export.skinned_gltf import write_skinned_glb
 from ecs_tentacles.export.skinned_usd import write_skinned_usd
 from ecs_tentacles.export.usd import write_usd
+from ecs_tentacles.record.systems.record import Record
 from ecs_tentacles.take import Take
 from ecs_tentacles.world import World
 

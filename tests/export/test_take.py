@@ -8,11 +8,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from ecs_tentacles.systems.record.record import Record
 
 from ecs_tentacles.components import Creature, Sucker, Tentacle, Transform
 from ecs_tentacles.export.bake import BakePlan, bake, simulation_rate
 from ecs_tentacles.locomotion.goals import GoalBook
+from ecs_tentacles.record.systems.record import Record
 from ecs_tentacles.take import ARRAYS, Take, TakeError
 from ecs_tentacles.world import World
 from tests.export.conftest import LINK_CENTRES, SMALL_SCENE, link_centres

@@ -9,13 +9,13 @@ from typing import Any
 
 import numpy as np
 import pytest
-from ecs_tentacles.systems.record.record import Record
 
 from ecs_tentacles.cli import main
 from ecs_tentacles.export import write
 from ecs_tentacles.export.gltf import read_glb
 from ecs_tentacles.host import Host
 from ecs_tentacles.plugin import Plugin
+from ecs_tentacles.record.systems.record import Record
 from ecs_tentacles.registry import App
 from ecs_tentacles.system import SystemFailure
 from ecs_tentacles.take import Take, TakeError

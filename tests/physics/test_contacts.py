@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from ecs_tentacles.creator.crowd import creature_reach
+from ecs_tentacles.scene.construction import creature_reach
 from ecs_tentacles.scene.load import load_scene
 from ecs_tentacles.world import World
 from tests.conftest import NO_LOCOMOTION

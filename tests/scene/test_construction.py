@@ -13,6 +13,7 @@ from ecs_tentacles.components import Creature, Link, Tentacle, Transform
 from ecs_tentacles.scene.construction import (
     capsule_mass_inertia,
     creature_layout,
+    creature_reach,
     cylinder_mass_inertia,
     link_scales,
     tentacle_angles,
@@ -155,3 +156,13 @@ def test_cylinder_mass_and_inertia_are_mujocos(radius: float, height: float) -> 
     cylinder = mujoco.mjtGeom.mjGEOM_CYLINDER
     geom = {"type": cylinder, "size": [radius, 0.5 * height, 0], "density": 400.0}
     assert_allclose(_compiled_body(geom), cylinder_mass_inertia(radius, height, 400.0), rtol=1e-9)
+
+
+def test_a_creatures_reach_is_its_mantle_and_longest_tentacle_and_thickest_link() -> None:
+    # two links at scales 1 and 0.5: 0.3 + 0.15 m long; the first is the thickest (5 cm)
+    tentacles = {"count": 4, "links": 2, "link_length": 0.3, "link_radius": 0.05}
+    creature = {"mantle": {"radius": 0.4}, "tentacles": {**tentacles, "end_scale": 0.5}}
+    assert creature_reach(creature) == pytest.approx(0.4 + 0.45 + 0.05)
+    # one tentacle made longer by its override reaches further
+    creature["tentacles"]["overrides"] = [{"index": 2, "link_length": 0.5}]
+    assert creature_reach(creature) == pytest.approx(0.4 + 0.75 + 0.05)

@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 
 from ecs_tentacles.cli import main
-from ecs_tentacles.creator.crowd import creature_reach
 from ecs_tentacles.export.glb import accessor_array, read_glb
 from ecs_tentacles.locomotion.navigation import CostGrid
+from ecs_tentacles.scene.construction import creature_reach
 from ecs_tentacles.terrain.ground import TerrainGround
 from ecs_tentacles.terrain.rocks import rock_vertices
 from ecs_tentacles.terrain.scene_ground import build_ground

@@ -8,10 +8,10 @@ from collections.abc import Callable
 
 import numpy as np
 import pytest
-from ecs_tentacles.systems.locomotion.suckers import ATTACH_HEIGHT
 
 from ecs_tentacles.ground import ground_of
 from ecs_tentacles.locomotion.grip import attach, sucker_points
+from ecs_tentacles.locomotion.systems.suckers import ATTACH_HEIGHT
 from ecs_tentacles.world import World
 
 WALL = {"shape": "box", "position": [-0.25, 0, 1.0], "size": [0.5, 4.0, 4.0]}  # face at x = 0

@@ -1,5 +1,8 @@
 """Example plugins (not on by default): wander, flee, follow_leader, flock.
 
+Written as a user writes a plugin: a package of its own beside the engine, importing only
+the engine's public modules, registered by entry points (`ecs_tentacles.plugins` in
+pyproject.toml) as any installed plugin is; a scene turns one on by name under `plugins`.
 Each is one file: a `Plugin` and the stage-`decide` `System` it brings, which sends
 creatures somewhere (`ecs_tentacles.behaviour.travel`: the locomotion plugin's goals,
 though no example names it) every `interval` seconds rather than every frame, so

@@ -22,18 +22,18 @@ from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from ecs_tentacles.systems.examples import (
+
+from ecs_tentacles.behaviour import ARRIVALS, DESTINATIONS_READ, travel
+from ecs_tentacles.plugin import Plugin
+from ecs_tentacles.scene.defaults import plugin_config
+from ecs_tentacles.system import System
+from ecs_tentacles_examples import (
     DESTINATION_WRITES,
     Problem,
     farther_than_reach,
     number,
     replanning,
 )
-
-from ecs_tentacles.behaviour import ARRIVALS, DESTINATIONS_READ, travel
-from ecs_tentacles.plugin import Plugin
-from ecs_tentacles.scene.defaults import plugin_config
-from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host

@@ -7,10 +7,10 @@ from typing import Any
 
 import numpy as np
 import pytest
-from ecs_tentacles.systems.locomotion import goals
 
 from ecs_tentacles.creator.crowd import crowd_scene
 from ecs_tentacles.locomotion.stores import LocomotionStores
+from ecs_tentacles.locomotion.systems import goals
 from ecs_tentacles.world import World
 
 

@@ -6,10 +6,10 @@ from typing import Any
 
 import numpy as np
 import pytest
-from ecs_tentacles.systems.examples.flock import Flock
 
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.world import World
+from ecs_tentacles_examples.flock import Flock
 
 SECONDS = 10
 SEPARATION = 0.9  # metres: two mantles of the flock never come closer (tentacles reach 0.6)

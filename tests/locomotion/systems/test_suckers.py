@@ -7,12 +7,12 @@ from typing import Any
 
 import numpy as np
 import pytest
-from ecs_tentacles.systems.locomotion.suckers import ATTACH_HEIGHT
 from numpy.testing import assert_allclose, assert_array_equal
 
 from ecs_tentacles.components import Creature, Sucker, Tentacle
 from ecs_tentacles.locomotion.actions import Kind
 from ecs_tentacles.locomotion.grip import sucker_points
+from ecs_tentacles.locomotion.systems.suckers import ATTACH_HEIGHT
 from ecs_tentacles.world import World
 from tests.conftest import creature_scene
 
@@ -237,9 +237,8 @@ def test_replayed_creatures_hold_no_sucker_and_a_promoted_one_starts_free(
 def test_a_crowd_lets_go_for_the_same_reasons_with_and_without_the_kernel(
     make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    from ecs_tentacles.systems.locomotion import suckers
-
     from ecs_tentacles.creator.crowd import crowd_scene
+    from ecs_tentacles.locomotion.systems import suckers
 
     assert suckers.KERNELS.get() is not None  # numba comes with the dev extra
     runs = []
@@ -272,9 +271,8 @@ def test_a_sucker_stretched_exactly_to_its_limit_holds_with_and_without_the_kern
 ) -> None:
     """Limits set to suckers' own stretches: the kernel must find every stretch to the
     bit for the same suckers to let go."""
-    from ecs_tentacles.systems.locomotion import suckers
-
     from ecs_tentacles.creator.crowd import crowd_scene
+    from ecs_tentacles.locomotion.systems import suckers
 
     world = make_world(crowd_scene(8, seed=1))
     world.step(60)

@@ -20,7 +20,7 @@ from ecs_tentacles.world import World
 
 @pytest.fixture
 def creator(tmp_path: Path) -> Iterator[Any]:
-    from ecs_tentacles.render.creator import Creator
+    from ecs_tentacles.creator.window import Creator
 
     window = Creator(
         CreatureDesign(name="squid"), tmp_path / "squid.json", width=960, height=600, headless=True

@@ -7,13 +7,6 @@ from collections.abc import Callable
 
 import numpy as np
 import pytest
-from ecs_tentacles.systems.locomotion.motor_targets import (
-    KERNELS,
-    LIFT,
-    SMOOTHING_SECONDS,
-    MotorTargets,
-    _links_of,
-)
 from numpy.testing import assert_allclose, assert_array_equal
 
 from ecs_tentacles.components import Creature
@@ -27,6 +20,13 @@ from ecs_tentacles.locomotion.actions import (
 )
 from ecs_tentacles.locomotion.grip import sucker_points
 from ecs_tentacles.locomotion.params import Locomotion
+from ecs_tentacles.locomotion.systems.motor_targets import (
+    KERNELS,
+    LIFT,
+    SMOOTHING_SECONDS,
+    MotorTargets,
+    _links_of,
+)
 from ecs_tentacles.world import World
 from tests.conftest import creature_scene, worlds_by_backend
 
@@ -252,10 +252,9 @@ def test_the_ground_follow_kernel_reaches_numpys_points_bit_for_bit(
     """The droop that lays tentacles onto terrain, with the mantles turned every way, a
     tentacle folded straight up its mantle's axis (nothing left to lay down) and one NaN
     pose: the kernel's reach points are numpy's."""
-    from ecs_tentacles.systems.locomotion.motor_targets import ground_follow
-
     from ecs_tentacles.cli.crowd import crowd_from_args
     from ecs_tentacles.ground import ground_of
+    from ecs_tentacles.locomotion.systems.motor_targets import ground_follow
 
     args = argparse.Namespace(seed=2, spacing=None, idle=0.0, species=8, uniform=False)
     world = make_world(crowd_from_args(12, argparse.Namespace(**vars(args), terrain="rocky")))

@@ -7,12 +7,12 @@ from typing import Any
 
 import numpy as np
 import pytest
-from ecs_tentacles.systems.fur import rig as rig_module
 from numpy.testing import assert_allclose
 
 from ecs_tentacles.fur import FurControl, FurGuide
 from ecs_tentacles.fur import blocks as blocks_module
 from ecs_tentacles.fur.stores import FurData
+from ecs_tentacles.fur.systems import rig as rig_module
 from ecs_tentacles.numeric.quaternions import quat_rotate
 from ecs_tentacles.world import World
 from tests.conftest import NO_LOCOMOTION

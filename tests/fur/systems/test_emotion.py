@@ -6,11 +6,11 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
-from ecs_tentacles.systems.fur.emotion import NINETY_PERCENT
 from numpy.testing import assert_allclose
 
 from ecs_tentacles.fur import Emotion
 from ecs_tentacles.fur.stores import FurData
+from ecs_tentacles.fur.systems.emotion import NINETY_PERCENT
 from ecs_tentacles.world import World
 from tests.conftest import NO_LOCOMOTION
 

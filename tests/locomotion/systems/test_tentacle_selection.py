@@ -7,17 +7,17 @@ from typing import Any
 
 import numpy as np
 import pytest
-from ecs_tentacles.systems.locomotion.tentacle_selection import (
-    KERNELS,
-    STROKE_SECONDS,
-    TentacleSelection,
-    classify,
-)
 
 from ecs_tentacles.creator.crowd import crowd_scene
 from ecs_tentacles.locomotion.actions import Kind, Mode, drive_sequence
 from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.locomotion.params import Locomotion
+from ecs_tentacles.locomotion.systems.tentacle_selection import (
+    KERNELS,
+    STROKE_SECONDS,
+    TentacleSelection,
+    classify,
+)
 from ecs_tentacles.world import World
 from tests.conftest import creature_scene, worlds_by_backend
 
