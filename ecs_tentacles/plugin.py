@@ -60,7 +60,7 @@ class Plugin:
     description: ClassVar[str] = ""
     requires: ClassVar[tuple[str, ...]] = ()  # plugins that must be on too
     # where a plugin on by default is built among the other defaults (lower first, then
-    # by key); on by default is the entry point's group (`ecs_tentacles.scene.plugins`)
+    # by key); on by default is the entry point's group (`ecs_tentacles.plugins.default`)
     build_order: ClassVar[int] = 0
     # store columns this plugin's hooks read when a generic system calls them
     # (registry entries and take hooks): they count as that system's reads
