@@ -48,6 +48,7 @@ from typing import Any
 import psutil
 from tqdm import tqdm
 
+from ecs_tentacles.options import WorldOptions
 from ecs_tentacles.physics import heap
 from ecs_tentacles.physics.bare import BareFrame, Recorder
 from ecs_tentacles.world import World
@@ -179,15 +180,12 @@ def _timed_block(
 
 def bench(
     source: str | os.PathLike[str] | dict[str, Any],
+    options: WorldOptions | None = None,
     *,
     frames: int = 120,
-    threads: int | None = None,
     block: int = BLOCK,
     warmup: int = WARMUP,
-    allow_systems: bool = False,
     sleep: bool = True,
-    lod: bool | None = None,
-    focus: tuple[float, float, float] | None = None,
     progress: bool = False,
 ) -> dict[str, Any]:
     """Build `source` (scene path, bundled name or dict), run `measure`, report sizes.
@@ -197,17 +195,15 @@ def bench(
     asleep (creatures asleep at the end), compiles (models compiled: one per
     morphology, shared by its creatures), recoveries, lod, tiers, promotions, demotions.
     With `sleep=False` idle creatures are stepped like the rest (to show what sleep saves).
-    `lod` turns level of detail on or off over the scene's (None: the scene's);
-    `focus` (x, y, radius in m) is a region whose creatures always run full.
+    `options` build the world (`ecs_tentacles.options.WorldOptions`: threads, level of
+    detail over the scene's and a `focus` region whose creatures always run full).
     """
     if not sleep:
         source = _without_sleep(source)
     start = time.perf_counter()
     with _bar(1, "bench: building the world", progress, bar_format="{desc} ..."):
-        world = World.from_scene(source, threads=threads, allow_systems=allow_systems, lod=lod)
+        world = World.from_scene(source, options)
     build_s = time.perf_counter() - start
-    if focus is not None:
-        world.lod.focus(focus[:2], focus[2])
     try:
         sizes = {
             "creatures": len(world.physics),
