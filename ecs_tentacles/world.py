@@ -14,8 +14,8 @@ from __future__ import annotations
 import os
 import pathlib
 import uuid
-from collections.abc import Callable, Collection, Iterator, Mapping, Sequence
-from typing import TYPE_CHECKING, Any, Literal, TypeVar
+from collections.abc import Callable, Collection, Iterator, Mapping
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import esper
 import numpy as np
@@ -40,6 +40,9 @@ from ecs_tentacles.store import (
 from ecs_tentacles.system import System, SystemFailure
 
 if TYPE_CHECKING:
+    from typing_extensions import Unpack  # (typing's own from Python 3.12)
+
+    from ecs_tentacles.host import Placement
     from ecs_tentacles.physics.lod import LevelOfDetail
     from ecs_tentacles.scene.spec import CreatureSpec
     from ecs_tentacles.snapshot import Snapshot
@@ -139,27 +142,19 @@ class World:
         return load_world(world_class, source, options)
 
     # -- creatures that come and go ------------------------------------------------------
-    def spawn(
-        self,
-        creature: Mapping[str, Any],
-        *,
-        position: Sequence[float] | None = None,
-        heading_deg: float | None = None,
-        on_overlap: Literal["refuse", "move"] = "refuse",
-    ) -> int:
+    def spawn(self, creature: Mapping[str, Any], **placement: Unpack[Placement]) -> int:
         """Build one creature (a scene-style entry) into this running world; its entity.
 
         Validated as a scene entry (`SpawnError`, one line per problem); a taken name
-        gets a suffix (`octo_2`). Overlapping a creature or an obstacle is refused, or
-        with `on_overlap="move"` moved to the nearest free spot. Other creatures step
-        on exactly as if it never came. Emits `creature_spawned`
+        gets a suffix (`octo_2`). `placement` (`ecs_tentacles.host.Placement`): `position`
+        and `heading_deg` over the entry's; overlapping a creature or an obstacle is
+        refused, or with `on_overlap="move"` moved to the nearest free spot. Other
+        creatures step on exactly as if it never came. Emits `creature_spawned`
         (`ecs_tentacles.creatures.spawning`).
         """
         from ecs_tentacles.creatures.spawning import spawn
 
-        return spawn(
-            self, creature, position=position, heading_deg=heading_deg, on_overlap=on_overlap
-        )
+        return spawn(self, creature, **placement)
 
     def despawn(self, creature: int) -> None:
         """Remove creature `creature` (an entity) and all it owns; others step on as if it

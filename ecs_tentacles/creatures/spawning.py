@@ -39,6 +39,7 @@ from ecs_tentacles.components import Creature, Tentacle
 from ecs_tentacles.creatures.body import build_creature
 from ecs_tentacles.events import CreatureDespawned, CreatureSpawned, SuckerReleased
 from ecs_tentacles.ground import ground_of
+from ecs_tentacles.host import PLACEMENT_KEYS
 from ecs_tentacles.numeric.quaternions import quat_rotate
 from ecs_tentacles.plugin import calling
 from ecs_tentacles.roster_change import RosterChange
@@ -49,7 +50,9 @@ from ecs_tentacles.scene.spec import CreatureSpec, creature_specs
 from ecs_tentacles.scene.validate import validated
 
 if TYPE_CHECKING:
-    from ecs_tentacles.host import Host as World  # any world (`ecs_tentacles.world.World`)
+    from typing_extensions import Unpack  # (typing's own from Python 3.12)
+
+    from ecs_tentacles.host import Host, Placement  # any world (`ecs_tentacles.world.World`)
 
 log = logging.getLogger("ecs_tentacles.creatures.spawning")
 
@@ -69,7 +72,7 @@ class SpawnError(ValueError):
 
 # -- the creature entry ------------------------------------------------------------------
 def creature_entry(
-    world: World,
+    world: Host,
     spec: Mapping[str, Any],
     position: Sequence[float] | None = None,
     heading_deg: float | None = None,
@@ -104,7 +107,7 @@ def _as_creature(problem: str) -> str:
     return re.sub(r"^creatures\[0\]", "creature", problem)
 
 
-def unique_name(world: World, name: str) -> str:
+def unique_name(world: Host, name: str) -> str:
     """`name`, or `name_2`, `name_3`... : the first no creature of `world` has and no
     take being recorded has seen (`World.kept_names`)."""
     taken = taken_names(world)
@@ -117,7 +120,7 @@ def unique_name(world: World, name: str) -> str:
     return _suffixed(base, n)
 
 
-def taken_names(world: World) -> set[str]:
+def taken_names(world: Host) -> set[str]:
     """Names a new creature may not take: every creature's now and `World.kept_names`."""
     return {c.name for _, c in world.query(Creature)} | world.kept_names
 
@@ -129,7 +132,7 @@ def _suffixed(base: str, n: int, longest: int = 64) -> str:
 
 
 # -- overlap with the creatures there and the obstacles ------------------------------------
-def obstruction(world: World, layout: CreatureLayout) -> str | None:
+def obstruction(world: Host, layout: CreatureLayout) -> str | None:
     """What a creature built as `layout` would overlap now: `"creature 'octo'"`, `"an
     obstacle"`, or None when the spot is free."""
     starts, ends, radii = layout.capsules()
@@ -159,7 +162,7 @@ def obstruction(world: World, layout: CreatureLayout) -> str | None:
     return None
 
 
-def free_spot(world: World, entry: CreatureSpec) -> tuple[CreatureSpec, str | None]:
+def free_spot(world: Host, entry: CreatureSpec) -> tuple[CreatureSpec, str | None]:
     """`entry` where it asked to be if free, else moved to the nearest free spot on rings
     around it; and what was in the way (None: not moved). SpawnError if none is free."""
     placed, blocker, _ = free_spot_layout(world, entry)
@@ -167,7 +170,7 @@ def free_spot(world: World, entry: CreatureSpec) -> tuple[CreatureSpec, str | No
 
 
 def free_spot_layout(
-    world: World, entry: CreatureSpec
+    world: Host, entry: CreatureSpec
 ) -> tuple[CreatureSpec, str | None, CreatureLayout]:
     """`free_spot`, and the layout on this world's ground of the entry it returns (the
     one it last checked: a spawn builds from it instead of working it out again)."""
@@ -213,15 +216,14 @@ def nearest_free(
 
 
 # -- spawn and despawn ---------------------------------------------------------------------
-def spawn(
-    world: World,
-    spec: Mapping[str, Any],
-    *,
-    position: Sequence[float] | None = None,
-    heading_deg: float | None = None,
-    on_overlap: OnOverlap = "refuse",
-) -> int:
+def spawn(world: Host, spec: Mapping[str, Any], **placement: Unpack[Placement]) -> int:
     """Build one creature into the running `world`; its entity (module docstring)."""
+    unknown = sorted(set(placement) - PLACEMENT_KEYS)
+    if unknown:  # (a script without a type checker: a typo is not silently dropped)
+        known = ", ".join(sorted(PLACEMENT_KEYS))
+        raise TypeError(f"spawn() got an unexpected keyword {unknown[0]!r} (takes {known})")
+    position, heading_deg = placement.get("position"), placement.get("heading_deg")
+    on_overlap = placement.get("on_overlap", "refuse")
     if on_overlap not in ("refuse", "move"):
         raise ValueError(f"on_overlap: must be 'refuse' or 'move', got {on_overlap!r}")
     world.activate()
@@ -250,7 +252,7 @@ def spawn(
 
 
 def place(
-    world: World,
+    world: Host,
     entry: CreatureSpec,
     moved_to: tuple[float, ...] | None = None,
     layout: CreatureLayout | None = None,
@@ -281,7 +283,7 @@ def place(
     return entity
 
 
-def despawn(world: World, entity: int) -> None:
+def despawn(world: Host, entity: int) -> None:
     """Remove creature `entity` and everything it owns (module docstring)."""
     world.activate()
     creature = world.try_component(entity, Creature)
@@ -309,7 +311,7 @@ def despawn(world: World, entity: int) -> None:
     world.events.emit(CreatureDespawned(world, entity, name))
 
 
-def _owned_rows(world: World, creature: Creature) -> dict[str, np.ndarray]:
+def _owned_rows(world: Host, creature: Creature) -> dict[str, np.ndarray]:
     """Every store's rows that belong to `creature`: the body's, then every store whose
     rows line up with a body store's or refer to rows that go (fur guides -> mantle)."""
     c = creature.row
@@ -358,7 +360,7 @@ def _owned_rows(world: World, creature: Creature) -> dict[str, np.ndarray]:
     return dead
 
 
-def _row_entities(world: World, dead: dict[str, np.ndarray]) -> list[int]:
+def _row_entities(world: Host, dead: dict[str, np.ndarray]) -> list[int]:
     """The entities that the going rows of plugin stores with an `entity` column stand
     for (fur guides and controls): they go with their rows."""
     owned: list[int] = []
@@ -369,7 +371,7 @@ def _row_entities(world: World, dead: dict[str, np.ndarray]) -> list[int]:
     return owned
 
 
-def _delete_entities(world: World, entity: int, creature: Creature, rows: list[int]) -> None:
+def _delete_entities(world: Host, entity: int, creature: Creature, rows: list[int]) -> None:
     for row_entity in rows:
         esper.delete_entity(row_entity, immediate=True)
     for tentacle_entity in creature.tentacles:
@@ -379,7 +381,7 @@ def _delete_entities(world: World, entity: int, creature: Creature, rows: list[i
     esper.delete_entity(entity, immediate=True)
 
 
-def _tell(world: World, change: RosterChange) -> None:
+def _tell(world: Host, change: RosterChange) -> None:
     for plugin in world.plugins:
         plugin.roster_changed(world, change)
     for system in world.schedule:

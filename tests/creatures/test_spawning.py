@@ -421,3 +421,13 @@ def test_a_spawn_works_out_the_creatures_layout_once(
     calls.clear()
     world.spawn({**new, "name": "c"}, position=(-4.0, -4.0), on_overlap="move")  # free
     assert calls == ["layout"]
+
+
+def test_a_misspelt_placement_is_refused_not_dropped():
+    with World.from_scene(_scene(APART[:1]), threads=1) as world:
+        with pytest.raises(TypeError, match="'positon'"):
+            world.spawn(_creature("d", 30.0), positon=(30.0, 0.0))
+        assert len(world.physics) == 1  # nothing built
+        made = world.spawn(_creature("d", 0.0), position=(30.0, 0.0), heading_deg=90.0)
+        assert world.creature_specs[made]["position"] == [30.0, 0.0]
+        assert world.creature_specs[made]["heading_deg"] == 90.0
