@@ -28,6 +28,7 @@ if TYPE_CHECKING:
     from typing_extensions import Unpack  # (typing's own from Python 3.12)
 
     from ecs_tentacles.physics.backend import PhysicsBackend
+    from ecs_tentacles.scene.layouts import Layouts
     from ecs_tentacles.scene.spec import CreatureSpec
     from ecs_tentacles.store import ArrayStore, MotorStore, TentacleStore
 
@@ -69,6 +70,11 @@ class Host(PhysicsHost, Protocol):
     @property
     def creature_specs(self) -> dict[int, CreatureSpec]:
         """Every creature's entry (validated, defaults in) by entity, spawned ones too."""
+
+    @property
+    def layouts(self) -> Layouts:
+        """Each creature entry's layout, worked out once while the world is built (a
+        plugin's `build_scene` reads them: `layouts.on(spec, ground)`); empty after."""
 
     @property
     def kept_names(self) -> set[str]:

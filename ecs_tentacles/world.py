@@ -27,6 +27,7 @@ from ecs_tentacles.options import Focus, WorldOptions
 from ecs_tentacles.physics.backend import PhysicsBackend
 from ecs_tentacles.plugin import Plugin, calling
 from ecs_tentacles.registry import App, Registries, Registry
+from ecs_tentacles.scene.layouts import Layouts
 from ecs_tentacles.schedule import Schedule
 from ecs_tentacles.settings import Settings as Settings  # re-exported: old imports work
 from ecs_tentacles.store import (
@@ -89,6 +90,8 @@ class World:
         self.scene_dir: pathlib.Path | None = None  # its folder: plugin files are found there
         # every creature's entry (validated, defaults in) by entity: the scene's and spawns'
         self.creature_specs: dict[int, CreatureSpec] = {}  # by entity, spawned ones too
+        # each creature entry's layout while the world is built (`scene.layouts`)
+        self.layouts = Layouts()
         # names no new creature may take although no creature has them now: a take being
         # recorded names each creature once (`TakeRecorder` keeps its creatures' here)
         self.kept_names: set[str] = set()

@@ -77,9 +77,10 @@ def creature_reach(creature: dict[str, Any]) -> float:
     radius = creature["mantle"]["radius"]
     longest, thickest = 0.0, 0.0
     for k in range(tentacles["count"]):
-        params = tentacle_params(tentacles, k)
-        keys = ("link_length", "link_radius", "links", "end_scale")
-        shape = tentacle_shape(radius, *(params[key] for key in keys))
+        p = tentacle_params(tentacles, k)
+        shape = tentacle_shape(
+            radius, p["link_length"], p["link_radius"], p["links"], p["end_scale"]
+        )
         longest = max(longest, float(shape.lengths.sum()))
         thickest = max(thickest, float(shape.radii.max()))
     return float(radius + longest + thickest)

@@ -27,11 +27,13 @@ from typing import Any, Protocol, TypeVar
 
 from ecs_tentacles import stops
 from ecs_tentacles.creatures.body import build_creature
+from ecs_tentacles.ground import ground_of
 from ecs_tentacles.host import Host
 from ecs_tentacles.options import WorldOptions
 from ecs_tentacles.physics.frame_systems import physics_systems
 from ecs_tentacles.plugin import HookFailure, Plugin, SystemsPlugin, calling
 from ecs_tentacles.scene.errors import SceneError
+from ecs_tentacles.scene.layouts import Layouts
 from ecs_tentacles.scene.load import load_scene_plugins, read_scene_json, resolve_scene_path
 from ecs_tentacles.scene.plugins import scene_first
 from ecs_tentacles.scene.spec import CreatureSpec, creature_specs
@@ -43,6 +45,7 @@ class SceneWorld(Host, Protocol):
     """What loading needs of the world it builds (`ecs_tentacles.world.World`)."""
 
     options: WorldOptions
+    layouts: Layouts
     scene: dict[str, Any] | None
     scene_dir: pathlib.Path | None
     creature_specs: dict[int, CreatureSpec]
@@ -89,7 +92,10 @@ def load_world(
     if plugins:  # the caller's choices over the scene's
         raw = source if isinstance(source, dict) else _read_scene(source)
         source = {**raw, "plugins": {**(raw.get("plugins") or {}), **plugins}}
-    data, chosen = load_scene_plugins(source, allow_systems=allow_systems, scene_dir=folder)
+    layouts = Layouts()  # each creature's, worked out once: the checks', then the build's
+    data, chosen = load_scene_plugins(
+        source, allow_systems=allow_systems, scene_dir=folder, layouts=layouts
+    )
     if allow_systems or not checks_only:  # validate says what a scene asks to run
         chosen += _scene_systems(data["systems"], folder, allow_systems)
     settings = Settings.from_physics(data["physics"])
@@ -101,8 +107,12 @@ def load_world(
         name=data.get("name", "scene"),
     )
     world.scene, world.scene_dir, world.options = data, folder, options
+    world.layouts = layouts
     with stops.deferred():  # a Ctrl-C waits for the next creature (`ecs_tentacles.stops`)
-        _build(world, data, chosen, options.only, checks_only, options.threads)
+        try:
+            _build(world, data, chosen, options.only, checks_only, options.threads)
+        finally:
+            layouts.clear()  # built: a crowd's layouts would only take memory
     if options.focus is not None and not checks_only:
         x, y, radius = options.focus
         world.physics.lod.focus((x, y), radius)
@@ -124,7 +134,8 @@ def _build(
         for index, creature in enumerate(creature_specs(data)):
             stops.check()
             if only is None or index in only:
-                entity = build_creature(world, creature)
+                layout = world.layouts.on(creature, ground_of(world))  # the checks' one
+                entity = build_creature(world, creature, layout)
                 world.creature_specs[entity] = creature
                 for plugin in chosen:
                     with calling(plugin, "build_creature"):

@@ -44,6 +44,7 @@ from ecs_tentacles.numeric.quaternions import quat_rotate
 from ecs_tentacles.plugin import calling
 from ecs_tentacles.roster_change import RosterChange
 from ecs_tentacles.scene.construction import CreatureLayout, creature_layout
+from ecs_tentacles.scene.layouts import Layouts
 from ecs_tentacles.scene.overlap import segment_distances
 from ecs_tentacles.scene.physical import physical_problems
 from ecs_tentacles.scene.spec import CreatureSpec, creature_specs
@@ -76,10 +77,12 @@ def creature_entry(
     spec: Mapping[str, Any],
     position: Sequence[float] | None = None,
     heading_deg: float | None = None,
+    layouts: Layouts | None = None,
 ) -> CreatureSpec:
     """`spec` validated as a scene's creature entry, defaults filled in, placed at
     `position` / `heading_deg` when given, its name made unique in `world` (`octo` ->
-    `octo_2`). Raises SpawnError (one line per problem) when it is not a valid entry."""
+    `octo_2`). Raises SpawnError (one line per problem) when it is not a valid entry.
+    Its layout is worked out in `layouts` (a spawn's: it builds from it)."""
     if not isinstance(spec, Mapping):
         raise SpawnError([f"creature: must be an object, got {type(spec).__name__}"])
     entry = copy.deepcopy(dict(spec))
@@ -96,7 +99,7 @@ def creature_entry(
         mini["version"], mini["physics"] = world.scene["version"], world.scene["physics"]
     problems, completed = validated(mini, world.plugins)
     if completed is not None and not problems:
-        problems = physical_problems(completed)
+        problems = physical_problems(completed, layouts=layouts)
     if problems:
         raise SpawnError([_as_creature(p) for p in problems])
     assert completed is not None
@@ -170,34 +173,42 @@ def free_spot(world: Host, entry: CreatureSpec) -> tuple[CreatureSpec, str | Non
 
 
 def free_spot_layout(
-    world: Host, entry: CreatureSpec
+    world: Host, entry: CreatureSpec, layouts: Layouts | None = None
 ) -> tuple[CreatureSpec, str | None, CreatureLayout]:
     """`free_spot`, and the layout on this world's ground of the entry it returns (the
-    one it last checked: a spawn builds from it instead of working it out again)."""
+    one it last checked: a spawn builds from it instead of working it out again).
+    `layouts`: where `entry`'s layout may be already (a spawn's)."""
     ground = ground_of(world)
+    book = Layouts() if layouts is None else layouts
     last: list[tuple[CreatureSpec, CreatureLayout]] = []
 
     def blocked(candidate: CreatureSpec) -> str | None:
-        layout = creature_layout(candidate, ground)
+        if candidate is entry:
+            layout = book.on(entry, ground)
+        else:  # a copy moved to another spot
+            layout = creature_layout(candidate, ground)
         last[:] = [(candidate, layout)]
         return obstruction(world, layout)
 
-    placed, blocker = nearest_free(entry, blocked)
+    placed, blocker = nearest_free(entry, blocked, book.on_plane(entry))
     checked, layout = last[0]
     assert checked is placed  # the last spot checked is the free one returned
     return placed, blocker, layout
 
 
 def nearest_free(
-    entry: CreatureSpec, blocked: Callable[[CreatureSpec], str | None]
+    entry: CreatureSpec,
+    blocked: Callable[[CreatureSpec], str | None],
+    flat: CreatureLayout | None = None,
 ) -> tuple[CreatureSpec, str | None]:
     """`entry` if `blocked` finds nothing in the way of it, else a copy at the nearest
     spot on rings around it (a quarter of its reach apart) where nothing is; and what
-    was in the way first (None: not moved). SpawnError if no spot is free."""
+    was in the way first (None: not moved). SpawnError if no spot is free. `flat`:
+    `entry`'s layout on the plane, when the caller has it."""
     blocker = blocked(entry)
     if blocker is None:
         return entry, None
-    layout = creature_layout(entry)  # on the plane: only its reach is wanted
+    layout = creature_layout(entry) if flat is None else flat  # only its reach is wanted
     _, ends, radii = layout.capsules()
     reach = float(np.max(np.linalg.norm(ends[:, :2] - layout.origin[:2], axis=1)) + radii.max())
     x, y = entry["position"][:2]
@@ -227,10 +238,11 @@ def spawn(world: Host, spec: Mapping[str, Any], **placement: Unpack[Placement]) 
     if on_overlap not in ("refuse", "move"):
         raise ValueError(f"on_overlap: must be 'refuse' or 'move', got {on_overlap!r}")
     world.activate()
-    entry = creature_entry(world, spec, position, heading_deg)
+    layouts = Layouts()  # its layout: the physical checks', then the spot's and the build's
+    entry = creature_entry(world, spec, position, heading_deg, layouts)
     moved_to = None
     if on_overlap == "move":
-        placed, blocker, layout = free_spot_layout(world, entry)
+        placed, blocker, layout = free_spot_layout(world, entry, layouts)
         if blocker is not None:
             moved_to = tuple(placed["position"])
             log.info(
@@ -242,7 +254,7 @@ def spawn(world: Host, spec: Mapping[str, Any], **placement: Unpack[Placement]) 
             )
         entry = placed
     else:
-        layout = creature_layout(entry, ground_of(world))
+        layout = layouts.on(entry, ground_of(world))
         blocker = obstruction(world, layout)
         if blocker is not None:
             where = ", ".join(f"{v:g}" for v in entry["position"])

@@ -33,13 +33,13 @@ import numpy as np
 from ecs_tentacles.scene.construction import (
     CreatureLayout,
     capsule_mass_inertia,
-    creature_layout,
     cylinder_mass_inertia,
 )
 from ecs_tentacles.scene.errors import SceneError
+from ecs_tentacles.scene.layouts import Layouts
 from ecs_tentacles.scene.overlap import Bodies, Overlap, find_overlaps, separate
 from ecs_tentacles.scene.ranges import damping_floor
-from ecs_tentacles.scene.spec import CreatureSpec, creature_specs
+from ecs_tentacles.scene.spec import CreatureSpec, TentaclesSpec, creature_specs
 from ecs_tentacles.scene.validate import format_path
 
 log = logging.getLogger(__name__)
@@ -63,20 +63,25 @@ Path = tuple[str | int, ...]
 
 
 def physically_checked(
-    scene: dict[str, Any], prefix: str = "", plane: bool = True
+    scene: dict[str, Any],
+    prefix: str = "",
+    plane: bool = True,
+    layouts: Layouts | None = None,
 ) -> dict[str, Any]:
     """`scene` (creatures moved apart if it asks), or SceneError with every physical problem.
 
-    `prefix` starts each problem line (the loader passes `"<file>: "`); `plane`: as
-    `physical_problems`.
+    `prefix` starts each problem line (the loader passes `"<file>: "`); `plane` and
+    `layouts`: as `physical_problems`.
     """
-    problems = physical_problems(scene, plane)
+    problems = physical_problems(scene, plane, layouts)
     if problems:
         raise SceneError([prefix + problem for problem in problems])
     return scene
 
 
-def physical_problems(scene: dict[str, Any], plane: bool = True) -> list[str]:
+def physical_problems(
+    scene: dict[str, Any], plane: bool = True, layouts: Layouts | None = None
+) -> list[str]:
     """Every physical problem of a schema-valid scene (defaults filled in), one line each.
 
     `plane`: the ground under the creatures is the plane z = 0, so no part may start
@@ -86,12 +91,16 @@ def physical_problems(scene: dict[str, Any], plane: bool = True) -> list[str]:
     With `physics.separate_overlaps` true, overlapping creatures are moved apart by
     changing their `position` in `scene`; only a crowd that cannot be pulled apart is
     then a problem.
+
+    Each creature's layout comes from `layouts` (the load's: the build reuses them),
+    worked out there the first time.
     """
+    layouts = Layouts() if layouts is None else layouts
     physics = scene["physics"]
     problems: list[tuple[Path, str]] = _timestep_problems(physics) + _gravity_problems(physics)
-    bodies: list[Bodies] = []  # each creature's capsules; its layout is dropped (crowds)
+    bodies: list[Bodies] = []  # each creature's capsules
     for i, creature in enumerate(creature_specs(scene)):
-        layout = creature_layout(creature)
+        layout = layouts.on_plane(creature)
         weights = [  # (links, 2) masses and inertias per tentacle, for both checks below
             capsule_mass_inertia(shape.lengths, shape.radii, params["density"])
             for params, shape in zip(layout.params, layout.shapes, strict=True)
@@ -148,7 +157,7 @@ def _gravity_problems(physics: dict[str, Any]) -> list[tuple[Path, str]]:
     return [(("physics", "gravity"), message)]
 
 
-def _tentacle_path(index: int, tentacles: dict[str, Any], k: int) -> Path:
+def _tentacle_path(index: int, tentacles: TentaclesSpec, k: int) -> Path:
     """Where tentacle `k`'s shape comes from: its override if that sets one, else the creature."""
     for j, override in enumerate(tentacles["overrides"]):
         if override["index"] == k and any(key in override for key in SHAPE_KEYS):

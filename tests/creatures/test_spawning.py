@@ -395,10 +395,10 @@ def test_a_body_plan_whose_first_creature_left_still_gets_its_reduced_model():
 def test_a_spawn_works_out_the_creatures_layout_once(
     make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """The spot check's layout is the one the creature is built from (it was worked out
-    two or three times a spawn)."""
+    """The physical checks' layout is the one the spot is checked with and the creature
+    is built from (it was worked out two or three times a spawn)."""
     from ecs_tentacles.creatures import body, spawning
-    from ecs_tentacles.scene import construction
+    from ecs_tentacles.scene import construction, layouts, physical
 
     calls: list[str] = []
     real = construction.creature_layout
@@ -407,8 +407,8 @@ def test_a_spawn_works_out_the_creatures_layout_once(
         calls.append("layout")
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(spawning, "creature_layout", counted)
-    monkeypatch.setattr(body, "creature_layout", counted)
+    for module in (spawning, body, layouts, physical):
+        monkeypatch.setattr(module, "creature_layout", counted, raising=False)
     world = make_world("octopus")
     calls.clear()  # building the scene's own creature
     new = {"tentacles": {"count": 3, "links": 3}}
@@ -417,7 +417,7 @@ def test_a_spawn_works_out_the_creatures_layout_once(
     calls.clear()
     world.spawn({**new, "name": "b"}, position=(4.0, 4.0), on_overlap="move")  # on "a"
     free = len(calls)
-    assert free >= 2  # the taken spot, then spots on rings until a free one
+    assert free >= 2  # the checks' (the taken spot's), then spots on rings until a free one
     calls.clear()
     world.spawn({**new, "name": "c"}, position=(-4.0, -4.0), on_overlap="move")  # free
     assert calls == ["layout"]
