@@ -227,7 +227,7 @@ class DirectorPanel(Panel):
         if creature is None:
             return False
         origin, direction = sandbox.renderer.camera.ray(x, y)
-        view = world.physics.group_of(world.component(creature, Creature))
+        view = world.physics.view_of(world.component(creature, Creature))
         bodies = world.transforms.pos[view.body_rows]
         along = np.clip((bodies - origin) @ direction, 0.0, None)
         miss = np.linalg.norm(bodies - (origin + along[:, None] * direction), axis=1)
@@ -246,7 +246,7 @@ class DirectorPanel(Panel):
         if world.try_component(grab.creature, Creature) is None:
             return
         world.lod.release(grab.creature)
-        view = world.physics.group_of(world.component(grab.creature, Creature))
+        view = world.physics.view_of(world.component(grab.creature, Creature))
         if self.grab_start is not None:
             name = world.creature_name(grab.creature)
             self._push(Moved(f"move {name}", name, self.grab_start, view.data.qpos.copy()))

@@ -36,7 +36,7 @@ APART = [
 def _bodies(world: World, name: str) -> np.ndarray:
     """Every body pose of creature `name` (mantle then links), as one array."""
     creature = world.component(world.creature(name), Creature)
-    view = world.physics.group_of(creature)
+    view = world.physics.view_of(creature)
     rows = view.body_rows
     return np.concatenate([world.transforms.pos[rows], world.transforms.quat[rows]], axis=1)
 
@@ -94,7 +94,7 @@ def test_components_made_before_a_despawn_still_find_their_rows():
         assert np.array_equal(pose.pos, before)
         assert world.creatures.mantle_row[c.row] == pose.row
         world.step(5)  # the physics reads the renumbered rows
-        assert world.physics.group_of(c).creature == world.creature("c")
+        assert world.physics.view_of(c).creature == world.creature("c")
 
 
 def test_despawn_then_spawn_reuses_the_batch_and_steps_on():
@@ -316,7 +316,7 @@ def test_a_newcomer_meets_the_creatures_there_through_contact():
         for _ in range(400):  # head-on: they crawl into each other
             world.step(1)
             met = max(met, int(world.physics.proxies_used.max()))
-            views = (world.physics.group_of(world.component(e, Creature)) for e in (b,))
+            views = (world.physics.view_of(world.component(e, Creature)) for e in (b,))
             deepest = min(deepest, *(v.data.deepest_contact for v in views))
         assert met > 0  # each felt the other's bodies
         assert deepest > -0.01 and world.physics.health.recoveries == 0
@@ -342,7 +342,7 @@ def test_models_rebuilt_after_a_body_plan_left_retire_its_empty_batch():
         world.physics.rebuild_models(world)  # (a terrain edit): nobody left to build it from
         again = world.spawn({"name": "odd", "tentacles": {"count": 3}}, position=(30.0, 0.0))
         assert world.physics.compiles == 3  # a new batch for the shape
-        assert world.physics.group_of(world.component(again, Creature)).batch.index == 2
+        assert world.physics.view_of(world.component(again, Creature)).batch.index == 2
         world.step(10)
         assert world.physics.health.recoveries == 0
 

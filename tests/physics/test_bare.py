@@ -51,7 +51,7 @@ def test_a_pushed_creature_is_pushed_in_the_bare_frame_too(
 ) -> None:
     world = make_world(crowd_scene(3, seed=2, spacing=4.0, uniform=True), lod=False)
     world.step(2)
-    view = world.physics.groups[1]
+    view = world.physics.views[1]
     view.data.xfrc_applied[view.body_ids[0], 2] = 50.0  # a script pushes its mantle up
     frame, states, _ = _recorded_then_stepped(world)
     full = frame.rows[0][FULL]
