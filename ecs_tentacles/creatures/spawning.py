@@ -44,11 +44,12 @@ from ecs_tentacles.numeric.quaternions import quat_rotate
 from ecs_tentacles.plugin import calling
 from ecs_tentacles.roster_change import RosterChange
 from ecs_tentacles.scene.construction import CreatureLayout, creature_layout
+from ecs_tentacles.scene.defaults import with_defaults
 from ecs_tentacles.scene.layouts import Layouts
 from ecs_tentacles.scene.overlap import segment_distances
-from ecs_tentacles.scene.physical import physical_problems
-from ecs_tentacles.scene.spec import CreatureSpec, creature_specs
-from ecs_tentacles.scene.validate import validated
+from ecs_tentacles.scene.physical import creature_problems
+from ecs_tentacles.scene.spec import CreatureSpec, as_spec
+from ecs_tentacles.scene.validate import format_path, validated_creature
 
 if TYPE_CHECKING:
     from typing_extensions import Unpack  # (typing's own from Python 3.12)
@@ -94,20 +95,25 @@ def creature_entry(
     entry.setdefault("position", [0.0, 0.0])
     if isinstance(entry["name"], str):
         entry["name"] = unique_name(world, entry["name"])
-    mini: dict[str, Any] = {"version": 1, "creatures": [entry]}
-    if world.scene is not None:
-        mini["version"], mini["physics"] = world.scene["version"], world.scene["physics"]
-    problems, completed = validated(mini, world.plugins)
+    scene = _scene_now(world)
+    problems, completed = validated_creature(entry, scene, world.plugins)
     if completed is not None and not problems:
-        problems = physical_problems(completed, layouts=layouts)
+        where = ("creature",)  # (one creature: its paths start at `creature`)
+        found = creature_problems(where, as_spec(completed), scene["physics"], layouts=layouts)
+        problems = [f"{format_path(path)}: {message}" for path, message in found]
     if problems:
-        raise SpawnError([_as_creature(p) for p in problems])
+        raise SpawnError(problems)
     assert completed is not None
-    return creature_specs(completed)[0]
+    return as_spec(completed)
 
 
-def _as_creature(problem: str) -> str:
-    return re.sub(r"^creatures\[0\]", "creature", problem)
+def _scene_now(world: Host) -> dict[str, Any]:
+    """The world's scene with the creatures it has now (a spawn is checked among them);
+    a scene of defaults for a world built by hand."""
+    scene = world.scene
+    if scene is None:
+        scene = with_defaults({"version": 1, "creatures": []}, world.plugins)
+    return {**scene, "creatures": list(world.creature_specs.values())}
 
 
 def unique_name(world: Host, name: str) -> str:

@@ -431,3 +431,33 @@ def test_a_misspelt_placement_is_refused_not_dropped():
         made = world.spawn(_creature("d", 0.0), position=(30.0, 0.0), heading_deg=90.0)
         assert world.creature_specs[made]["position"] == [30.0, 0.0]
         assert world.creature_specs[made]["heading_deg"] == 90.0
+
+
+@pytest.mark.parametrize("level", ["herding_1_field", "race_1_rock"])
+def test_a_creature_spawns_into_a_game_level(level: str) -> None:
+    """The entry is checked among the level's creatures and game: it was checked in a
+    scene of its own, which has no `game`, and refused ("game: required")."""
+    with World.from_scene(level, threads=1) as world:
+        before = len(world.physics)
+        made = world.spawn(_creature("visitor", 0.0), position=(20.0, 20.0), on_overlap="move")
+        assert len(world.physics) == before + 1
+        assert world.creature_name(made) == "visitor"
+        world.step(2)
+
+
+def test_a_bad_entry_names_its_fields_from_creature() -> None:
+    with World.from_scene(_scene(APART[:1]), threads=1) as world:
+        with pytest.raises(SpawnError) as raised:
+            world.spawn({"name": "x", "tentacles": {"count": 0, "links": 3, "ovverrides": []}})
+        count, unknown = raised.value.problems
+        assert count == "creature.tentacles.count: must be in [1, 16], got 0"
+        assert unknown.startswith("creature.tentacles.ovverrides: unknown key (allowed: count,")
+        with pytest.raises(SpawnError) as raised:
+            world.spawn({"name": "y", "tentacles": {"count": 3, "overrides": [{"index": 5}]}})
+        assert raised.value.problems == [
+            "creature.tentacles.overrides[0].index: must be < count (3), got 5"
+        ]
+        with pytest.raises(SpawnError) as raised:
+            world.spawn({"name": "z", "mantle": {"height": 0.001}}, position=(9.0, 9.0))
+        assert raised.value.problems[0].startswith("creature.mantle: is too flat to simulate")
+        assert len(world.physics) == 1
