@@ -40,7 +40,7 @@ class Placement(TypedDict, total=False):
     """Where a spawned creature goes (`World.spawn(entry, position=..., ...)`), over its
     entry's own `position` and `heading_deg`."""
 
-    position: Sequence[float] | None  # x, y (resting on the ground) or x, y, z
+    position: Sequence[float] | np.ndarray | None  # x, y (resting on the ground) or x, y, z
     heading_deg: float | None
     # "refuse": a creature or an obstacle in the way is a SpawnError; "move": the
     # nearest free spot is taken instead

@@ -76,7 +76,7 @@ class SpawnError(ValueError):
 def creature_entry(
     world: Host,
     spec: Mapping[str, Any],
-    position: Sequence[float] | None = None,
+    position: Sequence[float] | np.ndarray | None = None,
     heading_deg: float | None = None,
     layouts: Layouts | None = None,
 ) -> CreatureSpec:
