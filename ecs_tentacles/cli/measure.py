@@ -10,9 +10,9 @@ How `bench` measures (every figure is milliseconds per frame, the median over bl
 * `build_s`: `World.from_scene` (validate, build entities, compile, schedule).
 * After `warmup` untimed frames, the run alternates blocks of `block` framework
   frames (`world.step`) with blocks of as many bare frames. Each framework frame's
-  stepping inputs are recorded just before its step (`ecs_tentacles.physics.bare`:
-  every stepped row's state and overlay; the recording's own time is taken out of the
-  frame's and the physics system's); a bare block steps the last recorded block's
+  stepping inputs are captured just before its step (`ecs_tentacles.physics.bare`:
+  every stepped row's state and overlay; the capture's own time is taken out of the
+  frame's and the physics system's); a bare block steps the last captured block's
   frames with MuJoCo alone (`mj_setState`, `mj_step`, `mj_getState` per creature) on
   the world's threads and scratch data, never touching the world's state. So both do
   the same MuJoCo work, and alternating in the same run means both see the same
@@ -50,7 +50,7 @@ from tqdm import tqdm
 
 from ecs_tentacles.options import WorldOptions
 from ecs_tentacles.physics import heap
-from ecs_tentacles.physics.bare import BareFrame, Recorder
+from ecs_tentacles.physics.bare import BareFrame, FrameCapture
 from ecs_tentacles.world import World
 
 BLOCK = 10  # frames per interleaved block
@@ -88,19 +88,19 @@ def _bare_block(world: World, frames: list[BareFrame], k: int) -> float:
 
 
 def _framework_block(
-    world: World, frames: int, buckets: dict[str, list[float]], recorder: Recorder
+    world: World, frames: int, buckets: dict[str, list[float]], capture: FrameCapture
 ) -> float:
-    """Seconds to run `frames` framework frames, less the recording (recorded into
-    `recorder`); `buckets` hold each system's seconds, the physics' less the recording."""
+    """Seconds to run `frames` framework frames, less the capture (captured into
+    `capture`); `buckets` hold each system's seconds, the physics' less the capture."""
     for bucket in buckets.values():
         bucket[0] = 0.0
-    recorder.frames, recorder.seconds = [], 0.0
+    capture.frames, capture.seconds = [], 0.0
     start = time.perf_counter()
     world.step(frames)
     took = time.perf_counter() - start
     if "physics" in buckets:
-        buckets["physics"][0] -= recorder.seconds
-    return took - recorder.seconds
+        buckets["physics"][0] -= capture.seconds
+    return took - capture.seconds
 
 
 def _bar(total: int, desc: str, progress: bool, **kwargs: Any) -> tqdm[Any]:
@@ -123,25 +123,25 @@ def measure(
     """Median ms per frame of `frames` framework frames and as many bare ones, interleaved."""
     if frames < 1 or block < 1 or warmup < 0:
         raise ValueError(f"frames and block must be >= 1, warmup >= 0; got {frames, block, warmup}")
-    recorder = Recorder(world.physics)
+    capture = FrameCapture(world.physics)
     try:
         with _bar(warmup, "bench warm-up", progress) as bar:
             for _ in range(warmup):
-                recorder.frames = []  # the last warm-up frame is kept
+                capture.frames = []  # the last warm-up frame is kept
                 world.step(1)
                 bar.update(1)
-        _bare_block(world, recorder.frames, 1)  # the bare path's first call warms it up
+        _bare_block(world, capture.frames, 1)  # the bare path's first call warms it up
         buckets = time_systems(world)
         per_frame: dict[str, list[float]] = defaultdict(list)
         with _bar(frames, "bench frames", progress) as bar:
             for index, first in enumerate(range(0, frames, block)):
                 k = min(block, frames - first)
-                _timed_block(world, k, buckets, recorder, per_frame, bare_first=index % 2 == 1)
+                _timed_block(world, k, buckets, capture, per_frame, bare_first=index % 2 == 1)
                 bar.update(k)
     finally:
-        recorder.close()
-        recorder.frames = []
-        heap.trim()  # the recordings' memory goes back: `rss_mb` is the world's
+        capture.close()
+        capture.frames = []
+        heap.trim()  # the captures' memory goes back: `rss_mb` is the world's
     physics = zip(*(per_frame[name] for name in PHYSICS_SYSTEMS), strict=True)
     physics_ms = statistics.median(map(sum, physics))
     medians = {name: statistics.median(values) for name, values in per_frame.items()}
@@ -161,20 +161,20 @@ def _timed_block(
     world: World,
     k: int,
     buckets: dict[str, list[float]],
-    recorder: Recorder,
+    capture: FrameCapture,
     per_frame: dict[str, list[float]],
     *,
     bare_first: bool,
 ) -> None:
     """One block of `k` framework frames and `k` bare ones, in that order or the other
-    (bare first steps the frames the last block recorded); appends each figure's ms per
+    (bare first steps the frames the last block captured); appends each figure's ms per
     frame to `per_frame`."""
-    bare = _bare_block(world, recorder.frames, k) if bare_first else 0.0
-    per_frame["frame"].append(_framework_block(world, k, buckets, recorder) * 1000 / k)
+    bare = _bare_block(world, capture.frames, k) if bare_first else 0.0
+    per_frame["frame"].append(_framework_block(world, k, buckets, capture) * 1000 / k)
     for name, bucket in buckets.items():
         per_frame[name].append(bucket[0] * 1000 / k)
     if not bare_first:
-        bare = _bare_block(world, recorder.frames, k)
+        bare = _bare_block(world, capture.frames, k)
     per_frame["raw"].append(bare * 1000 / k)
 
 

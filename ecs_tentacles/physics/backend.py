@@ -35,7 +35,7 @@ import numpy as np
 from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.numeric.optional_kernels import OptionalKernels
 from ecs_tentacles.physics import heap
-from ecs_tentacles.physics.bare import BareFrame, step_recorded
+from ecs_tentacles.physics.bare import BareFrame, step_captured
 from ecs_tentacles.physics.batch import Batch
 from ecs_tentacles.physics.blas import quiet_blas
 from ecs_tentacles.physics.health import SOFT_GAIN, HealthCheck, HealthState
@@ -395,12 +395,12 @@ class PhysicsBackend(Membership):
                 future.result()
 
     def step_bare(self, frame: BareFrame, substeps: int) -> None:
-        """Step `frame`'s rows (recorded by `physics.bare.Recorder`) with MuJoCo alone on
+        """Step `frame`'s rows (captured by `physics.bare.FrameCapture`) with MuJoCo alone on
         this pool: nothing of the framework and nothing of the world's state, so the
         framework's cost is a frame minus this. `frame` can be stepped again."""
         segments = plan(self.batches, frame.active, frame.tier, self.threads)
         steps = {FULL: substeps, REDUCED: reduced_substeps(substeps)}
-        self._dispatch(step_recorded, segments, frame, steps)
+        self._dispatch(step_captured, segments, frame, steps)
 
     def sync(self, transforms: TransformStore) -> None:
         """Copy every body's world pose into the Transform store (one scatter per batch)."""

@@ -12,7 +12,7 @@ import pytest
 from ecs_tentacles.cli.measure import bench, measure, timed
 from ecs_tentacles.creator.crowd import crowd_scene
 from ecs_tentacles.options import WorldOptions
-from ecs_tentacles.physics.bare import Recorder
+from ecs_tentacles.physics.bare import FrameCapture
 from ecs_tentacles.physics.tiers import FULL, REDUCED
 from ecs_tentacles.world import World
 
@@ -129,16 +129,16 @@ def test_the_bare_frames_step_the_tiers_the_framework_steps() -> None:
     of the two runs' times said so before, and failed on a busy machine: 0.75x.)"""
     with World.from_scene(lod_crowd(), threads=1) as world:
         world.step(12)  # the bench's warm-up and frames
-        recorder = Recorder(world.physics)
+        capture = FrameCapture(world.physics)
         try:
             world.step(1)
         finally:
-            recorder.close()
+            capture.close()
         assert world.lod.counts() == {"full": 1, "reduced": 2, "kinematic": 3}
-        (frame,) = recorder.frames
+        (frame,) = capture.frames
         stepped = {FULL: 0, REDUCED: 0}
-        for recorded in frame.rows:
-            for tier, rows in recorded.items():
+        for captured in frame.rows:
+            for tier, rows in captured.items():
                 stepped[tier] += len(rows.rows)
         assert stepped == {FULL: 1, REDUCED: 2}
 
