@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import os
 import pathlib
+import warnings
 from collections.abc import Collection, Mapping
 from dataclasses import dataclass, replace
 from typing import Any
@@ -73,6 +74,20 @@ class WorldOptions:
     def with_only(self, only: Collection[int] | None) -> WorldOptions:
         """These options building just the creatures at scene indices `only`."""
         return self.but(only=None if only is None else frozenset(only))
+
+    def given(self, keywords: Mapping[str, Any], where: str) -> WorldOptions:
+        """These options with old-style keywords over them (`bake(plan, threads=2)`, from
+        before the options had an object), with a DeprecationWarning naming `where`;
+        TypeError for a keyword no field has."""
+        if not keywords:
+            return self
+        warnings.warn(
+            f"{where}: the keywords {', '.join(keywords)} are deprecated; pass them in a"
+            " WorldOptions (ecs_tentacles.options)",
+            DeprecationWarning,
+            stacklevel=3,
+        )
+        return self.but(**keywords)
 
     def scene_with_lod(self, scene: Mapping[str, Any]) -> dict[str, Any]:
         """`scene` with `lod` and `focus` written into its `physics.lod` (a new dict;

@@ -59,3 +59,19 @@ def test_scene_with_lod_writes_lod_and_focus_and_leaves_the_scene() -> None:
     }
     assert scene["physics"]["lod"] == {"budgets": {"full": 4}}
     assert WorldOptions().scene_with_lod(scene) == scene
+
+
+def test_old_keywords_still_work_and_say_so() -> None:
+    from ecs_tentacles.export.bake import BakePlan
+    from ecs_tentacles.render.session import SandboxSession
+
+    scene = crowd_scene(1, seed=1)
+    with pytest.warns(DeprecationWarning, match="BakePlan.make: the keywords seed"):
+        plan = BakePlan.make(scene, seconds=0.1, seed=5)
+    assert plan.seed == 5
+    with pytest.warns(DeprecationWarning, match="SandboxSession: the keywords seed, threads"):
+        session = SandboxSession(scene, seed=3, threads=1)
+    assert (session.world.seed, session.world.physics.threads) == (3, 1)
+    session.world.close()
+    with pytest.raises(TypeError), pytest.warns(DeprecationWarning):
+        BakePlan.make(scene, seconds=0.1, sede=5)

@@ -85,6 +85,7 @@ class BakePlan:
         *,
         seconds: float,
         fps: float | None = None,
+        **deprecated: Any,
     ) -> BakePlan:
         """Load and validate `scene` (SceneError if bad) and work out the frame rates.
 
@@ -92,8 +93,9 @@ class BakePlan:
         `allow_systems` lets the scene's plugins from files or modules be imported, those
         of a dict scene found in `scene_dir` (default: the current folder); `lod` and
         `focus` are written into the plan's scene (the take's scene hash sees them).
+        (`seed=`, `allow_systems=`, `scene_dir=` as keywords: deprecated.)
         """
-        options = options or WorldOptions()
+        options = (options or WorldOptions()).given(deprecated, "BakePlan.make")
         allow_systems, seed, scene_dir = options.allow_systems, options.seed, options.scene_dir
         # absolute: a Ray worker runs in a folder of its own (distributed.driver)
         folder = str(Path(os.getcwd() if scene_dir is None else scene_dir).resolve())
@@ -253,14 +255,17 @@ def bake(
     progress: bool = True,
     on_world: Callable[[World], None] | None = None,
     on_steps: Callable[[int], None] | None = None,
+    **deprecated: Any,
 ) -> Take:
     """Run the plan and return the take; a tqdm bar with ETA goes to stderr when `progress`.
 
     `options` build the world (`BakePlan.world`: code allowed, `threads` stepping the
     physics groups, `only` the creatures at those scene indices: a shard).
     `on_world(world)` is called once the world is built (tests use it to add systems);
-    `on_steps(n)` is told of every `n` frames simulated.
+    `on_steps(n)` is told of every `n` frames simulated. (`allow_systems=`, `threads=`,
+    `only=` as keywords: deprecated.)
     """
+    options = (options or WorldOptions()).given(deprecated, "bake")
     with status("bake: building the world", progress=progress):
         world = plan.world(options)
     try:
@@ -286,6 +291,7 @@ def bake_to_file(
     progress: bool = True,
     on_world: Callable[[World], None] | None = None,
     accept: Callable[[dict[str, Any]], bool] | None = None,
+    **deprecated: Any,
 ) -> dict[str, Any] | None:
     """Run the plan, writing the take to `out` as the frames come (`take.writer`: a
     chunk of frames held at a time, so memory does not grow with the shot); returns the
@@ -293,6 +299,7 @@ def bake_to_file(
     `accept(header)` False at the end: no file either, and None. `options`: as `bake`."""
     from ecs_tentacles.take.writer import TakeWriter
 
+    options = (options or WorldOptions()).given(deprecated, "bake_to_file")
     with status("bake: building the world", progress=progress):
         world = plan.world(options)
     try:

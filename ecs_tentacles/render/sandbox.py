@@ -96,13 +96,16 @@ class Sandbox(SandboxPicture):
         hud: bool = True,
         palette: str | None = None,
         clean: bool | None = None,
+        **deprecated: Any,
     ):
         """`options` build its worlds (`ecs_tentacles.options.WorldOptions`: seed, code
         allowed, threads, level of detail; a `focus` pins the full-physics region instead
         of the camera's); `palette` colours the creatures
         ("natural" or "debug": `ecs_tentacles.skin.colours`; None: the scene's `render.palette`,
         natural if it says none); `clean` starts in the clean view, without the editor's
-        overlays (None: a game's scene, one with a `game` key, starts clean; o toggles)."""
+        overlays (None: a game's scene, one with a `game` key, starts clean; o toggles).
+        (`seed=`, `lod=`... as keywords: deprecated, `WorldOptions.given`.)"""
+        options = (options or WorldOptions()).given(deprecated, "Sandbox")
         self.headless = headless
         self.window = pyglet.window.Window(
             width, height, caption="ecs_tentacles", visible=not headless, vsync=False

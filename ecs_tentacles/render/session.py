@@ -44,11 +44,13 @@ class SandboxSession:
         options: WorldOptions | None = None,
         *,
         say: Callable[[bool, str], None] = lambda ok, text: None,
+        **deprecated: Any,
     ):
         """`options` build every world of the session (`ecs_tentacles.options`); their
-        `focus` (x, y, radius in m) pins the full-physics region instead of the camera's."""
+        `focus` (x, y, radius in m) pins the full-physics region instead of the camera's.
+        (`seed=`, `lod=`... as keywords: deprecated, `WorldOptions.given`.)"""
         self.scene = scene
-        self.options = options or WorldOptions()
+        self.options = (options or WorldOptions()).given(deprecated, "SandboxSession")
         self.say = say
         self.world = self.build(scene)
         # plugin files of an edited (dict) scene are looked up where the first one's were
