@@ -19,19 +19,35 @@ from __future__ import annotations
 
 import pathlib
 from collections.abc import Iterator, Mapping, Sequence
-from typing import TYPE_CHECKING, Any, Literal, Protocol, TypeVar
+from typing import TYPE_CHECKING, Any, Literal, Protocol, TypedDict, TypeVar
 
 from ecs_tentacles.physics.host import PhysicsHost
 
 if TYPE_CHECKING:
     import numpy as np
+    from typing_extensions import Unpack  # (typing's own from Python 3.12)
 
     from ecs_tentacles.physics.backend import PhysicsBackend
+    from ecs_tentacles.scene.layouts import Layouts
     from ecs_tentacles.scene.spec import CreatureSpec
     from ecs_tentacles.store import ArrayStore, MotorStore, TentacleStore
 
 C = TypeVar("C")
 R = TypeVar("R")
+
+
+class Placement(TypedDict, total=False):
+    """Where a spawned creature goes (`World.spawn(entry, position=..., ...)`), over its
+    entry's own `position` and `heading_deg`."""
+
+    position: Sequence[float] | np.ndarray | None  # x, y (resting on the ground) or x, y, z
+    heading_deg: float | None
+    # "refuse": a creature or an obstacle in the way is a SpawnError; "move": the
+    # nearest free spot is taken instead
+    on_overlap: Literal["refuse", "move"]
+
+
+PLACEMENT_KEYS = frozenset(Placement.__annotations__)
 
 
 class Host(PhysicsHost, Protocol):
@@ -56,18 +72,19 @@ class Host(PhysicsHost, Protocol):
         """Every creature's entry (validated, defaults in) by entity, spawned ones too."""
 
     @property
+    def layouts(self) -> Layouts:
+        """Each creature entry's layout, worked out once while the world is built (a
+        plugin's `build_scene` reads them: `layouts.on(spec, ground)`); empty after."""
+
+    @property
     def kept_names(self) -> set[str]:
         """Names no new creature may take (a recording's creatures, despawned ones too)."""
 
     # -- creatures that come and go (`ecs_tentacles.creatures.spawning`) ---------------
-    def spawn(
-        self,
-        creature: Mapping[str, Any],
-        *,
-        position: Sequence[float] | None = None,
-        heading_deg: float | None = None,
-        on_overlap: Literal["refuse", "move"] = "refuse",
-    ) -> int: ...
+    def spawn(self, creature: Mapping[str, Any], **placement: Unpack[Placement]) -> int:
+        """Build one creature (a scene-style entry) into the running world; its entity
+        (`World.spawn`)."""
+
     def despawn(self, creature: int) -> None: ...
 
     # -- the other core stores (every store by name in `stores`) ---------------------------

@@ -14,8 +14,8 @@ from __future__ import annotations
 import os
 import pathlib
 import uuid
-from collections.abc import Callable, Collection, Iterator, Mapping, Sequence
-from typing import TYPE_CHECKING, Any, Literal, TypeVar
+from collections.abc import Callable, Collection, Iterator, Mapping
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import esper
 import numpy as np
@@ -23,9 +23,11 @@ import numpy as np
 from ecs_tentacles import stops
 from ecs_tentacles.components import Creature
 from ecs_tentacles.events import Events
+from ecs_tentacles.options import Focus, WorldOptions
 from ecs_tentacles.physics.backend import PhysicsBackend
 from ecs_tentacles.plugin import Plugin, calling
 from ecs_tentacles.registry import App, Registries, Registry
+from ecs_tentacles.scene.layouts import Layouts
 from ecs_tentacles.schedule import Schedule
 from ecs_tentacles.settings import Settings as Settings  # re-exported: old imports work
 from ecs_tentacles.store import (
@@ -39,6 +41,9 @@ from ecs_tentacles.store import (
 from ecs_tentacles.system import System, SystemFailure
 
 if TYPE_CHECKING:
+    from typing_extensions import Unpack  # (typing's own from Python 3.12)
+
+    from ecs_tentacles.host import Placement
     from ecs_tentacles.physics.lod import LevelOfDetail
     from ecs_tentacles.scene.spec import CreatureSpec
     from ecs_tentacles.snapshot import Snapshot
@@ -80,10 +85,13 @@ class World:
         self.schedule = Schedule()
         self.events = Events()
         self._physics: PhysicsBackend | None = None
+        self.options = WorldOptions(seed=seed)  # the run's choices (`from_scene` sets them)
         self.scene: dict[str, Any] | None = None  # the validated scene, defaults filled in
         self.scene_dir: pathlib.Path | None = None  # its folder: plugin files are found there
         # every creature's entry (validated, defaults in) by entity: the scene's and spawns'
         self.creature_specs: dict[int, CreatureSpec] = {}  # by entity, spawned ones too
+        # each creature entry's layout while the world is built (`scene.layouts`)
+        self.layouts = Layouts()
         # names no new creature may take although no creature has them now: a take being
         # recorded names each creature once (`TakeRecorder` keeps its creatures' here)
         self.kept_names: set[str] = set()
@@ -94,14 +102,16 @@ class World:
     def from_scene(
         cls,
         source: str | os.PathLike[str] | dict[str, Any],
+        options: WorldOptions | None = None,
         *,
         seed: int | None = None,
-        allow_systems: bool = False,
+        allow_systems: bool | None = None,
         threads: int | None = None,
         only: Collection[int] | None = None,
         plugins: Mapping[str, Any] | None = None,
         scene_dir: str | os.PathLike[str] | None = None,
         lod: bool | None = None,
+        focus: Focus | None = None,
     ) -> World:
         """Build a world from a scene file, bundled scene name or dict.
 
@@ -109,54 +119,45 @@ class World:
         hooks), compiles the physics, schedules the systems of every plugin on
         (`ecs_tentacles.creatures.loading`).
 
-        Raises `SceneError` (one line per problem) before anything is built. Plugins
-        from a file or module, and systems the scene names, are imported only with
-        `allow_systems=True`; files are looked up in the scene's folder (`scene_dir` for
-        a dict). `plugins` turns plugins on, off or configures them over what the scene
-        says (`{"locomotion": False, "suckers": False}`: scripts drive the motors).
-        `threads` steps the physics groups on that many threads (default: one per
-        core); results do not depend on it. `only` builds just the creatures at those
-        scene indices (a shard of a distributed bake); `world.scene` is still the whole
-        scene. `lod=False` runs every creature at full physics whatever the scene's
-        `physics.lod` says (`True` turns level of detail on); None keeps the scene's.
+        Raises `SceneError` (one line per problem) before anything is built. `options`
+        (`ecs_tentacles.options.WorldOptions`) are the run's choices over the scene's:
+        seed, code the scene may import (`allow_systems`), threads, level of detail and
+        its focus, plugins turned on or off, the creatures to build (`only`). Each
+        keyword given sets that field over `options` (`World.from_scene(path,
+        threads=1)`); None leaves it.
         """
         from ecs_tentacles.creatures.loading import WorldClass, load_world
 
-        world_class: WorldClass[World] = cls
-        return load_world(
-            world_class,
-            source,
-            seed=seed,
-            allow_systems=allow_systems,
-            threads=threads,
-            only=only,
-            plugins=plugins,
-            scene_dir=scene_dir,
-            lod=lod,
+        given = {
+            "seed": seed,
+            "allow_systems": allow_systems,
+            "threads": threads,
+            "only": only,
+            "plugins": plugins,
+            "scene_dir": scene_dir,
+            "lod": lod,
+            "focus": focus,
+        }
+        options = (options or WorldOptions()).but(
+            **{name: value for name, value in given.items() if value is not None}
         )
+        world_class: WorldClass[World] = cls
+        return load_world(world_class, source, options)
 
     # -- creatures that come and go ------------------------------------------------------
-    def spawn(
-        self,
-        creature: Mapping[str, Any],
-        *,
-        position: Sequence[float] | None = None,
-        heading_deg: float | None = None,
-        on_overlap: Literal["refuse", "move"] = "refuse",
-    ) -> int:
+    def spawn(self, creature: Mapping[str, Any], **placement: Unpack[Placement]) -> int:
         """Build one creature (a scene-style entry) into this running world; its entity.
 
         Validated as a scene entry (`SpawnError`, one line per problem); a taken name
-        gets a suffix (`octo_2`). Overlapping a creature or an obstacle is refused, or
-        with `on_overlap="move"` moved to the nearest free spot. Other creatures step
-        on exactly as if it never came. Emits `creature_spawned`
+        gets a suffix (`octo_2`). `placement` (`ecs_tentacles.host.Placement`): `position`
+        and `heading_deg` over the entry's; overlapping a creature or an obstacle is
+        refused, or with `on_overlap="move"` moved to the nearest free spot. Other
+        creatures step on exactly as if it never came. Emits `creature_spawned`
         (`ecs_tentacles.creatures.spawning`).
         """
         from ecs_tentacles.creatures.spawning import spawn
 
-        return spawn(
-            self, creature, position=position, heading_deg=heading_deg, on_overlap=on_overlap
-        )
+        return spawn(self, creature, **placement)
 
     def despawn(self, creature: int) -> None:
         """Remove creature `creature` (an entity) and all it owns; others step on as if it

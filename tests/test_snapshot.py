@@ -15,7 +15,7 @@ from ecs_tentacles.world import World
 
 
 def _state(world: World) -> list[np.ndarray]:
-    groups = world.physics.groups
+    groups = world.physics.views
     physics = [a for g in groups for a in (g.data.qpos, g.data.qvel, g.integration_state())]
     stores = [
         world.transforms.pos,
@@ -115,8 +115,8 @@ def test_a_handler_that_spawns_during_a_restore_runs_after_it_whole() -> None:
         world.step(20)
         twin.step(20)
         for name in ("a", "b"):  # restored exactly: as if c had never come
-            mine = world.physics.group_of(world.component(world.creature(name), Creature))
-            theirs = twin.physics.group_of(twin.component(twin.creature(name), Creature))
+            mine = world.physics.view_of(world.component(world.creature(name), Creature))
+            theirs = twin.physics.view_of(twin.component(twin.creature(name), Creature))
             assert_array_equal(
                 world.transforms.pos[mine.body_rows], twin.transforms.pos[theirs.body_rows]
             )

@@ -40,3 +40,32 @@ def test_mypy_strict_rejects_unknown_world_attributes(tmp_path: Path) -> None:
     assert len(errors) == 2, result.stdout + result.stderr
     assert '"World" has no attribute "no_such_thing"' in errors[0]
     assert '"GoalBook" has no attribute "no_such_method"' in errors[1]
+
+
+SPAWN = textwrap.dedent(
+    """
+    from ecs_tentacles.host import Host
+    from ecs_tentacles.world import World
+
+
+    def add(world: World, host: Host) -> None:
+        world.spawn({"name": "a"}, position=(1.0, 2.0), on_overlap="move")
+        host.spawn({"name": "b"}, heading_deg=90.0)
+        world.spawn({"name": "c"}, positon=(1.0, 2.0))
+        host.spawn({"name": "d"}, on_overlap="push")
+    """
+)
+
+
+def test_mypy_strict_checks_spawn_placements(tmp_path: Path) -> None:
+    script = tmp_path / "script.py"
+    script.write_text(SPAWN)
+    result = subprocess.run(
+        [sys.executable, "-m", "mypy", "--strict", "--follow-imports=silent",
+         "--cache-dir", str(tmp_path / "cache"), "--no-error-summary", str(script)],
+        capture_output=True, text=True, check=False, cwd=Path(__file__).parents[1],
+    )  # fmt: skip
+    errors = [line for line in result.stdout.splitlines() if ": error:" in line]
+    assert len(errors) == 2, result.stdout + result.stderr
+    assert '"positon"' in errors[0]
+    assert "'push'" in errors[1]

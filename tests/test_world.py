@@ -33,7 +33,7 @@ def test_step_advances_the_fixed_clock(make_world: Callable[..., World]) -> None
     world.step(25)
     assert world.time == 0.5
     assert world.physics.time == pytest.approx(0.5, abs=1e-12)
-    assert world.physics.groups[0].model.opt.timestep == 0.0025
+    assert world.physics.views[0].model.opt.timestep == 0.0025
 
 
 def test_goals_become_entities_in_path_order(make_world: Callable[..., World]) -> None:

@@ -24,6 +24,7 @@ import time
 from typing import Any
 
 from ecs_tentacles.cli.crowd import crowd_from_args
+from ecs_tentacles.options import WorldOptions
 from ecs_tentacles.render import configure
 
 
@@ -44,7 +45,7 @@ def bench(
     from ecs_tentacles.cli.play import camera_option
     from ecs_tentacles.render.sandbox import Sandbox
 
-    sandbox = Sandbox(scene, width=1280, height=720, headless=True, hud=hud, lod=lod)
+    sandbox = Sandbox(scene, WorldOptions(lod=lod), width=1280, height=720, headless=True, hud=hud)
     try:
         sandbox.aim(camera_option("frame-all"))
         physics, drawn = [], []

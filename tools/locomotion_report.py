@@ -66,7 +66,7 @@ def run(world: World, case: str, seconds: float) -> dict[str, Any]:
     deepest = 0.0
     flipped = False
     angles = []
-    data = world.physics.groups[0].data
+    data = world.physics.views[0].data
     while world.time < seconds - 1e-9:
         world.step(1)
         here = mantle.pos[:2]

@@ -33,6 +33,7 @@ from typing import Any
 from ecs_tentacles.creator.crowd import crowd_scene
 from ecs_tentacles.distributed.driver import ray_bake, start_ray
 from ecs_tentacles.export.bake import BakePlan, bake
+from ecs_tentacles.options import WorldOptions
 from ecs_tentacles.take import Take, write_npz
 
 
@@ -61,7 +62,7 @@ def run(creatures: int, seconds: float, stripes: int, workers: int) -> dict[str,
     for threads in (1, 2):
         print(f"local, {threads} thread(s)...", file=sys.stderr, flush=True)
         start, cpu = time.perf_counter(), time.process_time()
-        takes[threads] = bake(plan, progress=False, threads=threads)
+        takes[threads] = bake(plan, WorldOptions(threads=threads), progress=False)
         rows[f"local_{threads}_s"] = time.perf_counter() - start
         rows[f"local_{threads}_cpu_s"] = time.process_time() - cpu
     print(f"ray, {workers} workers...", file=sys.stderr, flush=True)

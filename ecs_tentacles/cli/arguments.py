@@ -149,16 +149,6 @@ def read_only_problem(path: Path) -> str | None:
     return None
 
 
-def add_threads_argument(parser: argparse.ArgumentParser) -> None:
-    """`--threads N`, the same on every command that steps the physics."""
-    parser.add_argument(
-        "--threads",
-        type=thread_count,
-        default=None,
-        help="threads that step the physics (default: one per core); results are the same",
-    )
-
-
 def output_path(*suffixes: str) -> Callable[[str], Path]:
     """An argparse type: a file ending in one of `suffixes`, in a folder this user may
     write; the file is claimed (`atomic.claim`): if another program writes it before

@@ -19,17 +19,16 @@ import importlib.util
 import json
 import math
 import sys
-from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 from ecs_tentacles.cli import bake_ray
-from ecs_tentacles.cli.arguments import add_threads_argument, counted, output_path, seed_int
-from ecs_tentacles.cli.lod_options import add_lod_arguments, apply_to_scene
+from ecs_tentacles.cli.arguments import counted, output_path
 from ecs_tentacles.cli.skin_options import add_arguments as add_skin_arguments
 from ecs_tentacles.cli.skin_options import skin_options
 from ecs_tentacles.cli.usd_validate import add_argument as add_validate_argument
 from ecs_tentacles.cli.usd_validate import validate_problem, validated
+from ecs_tentacles.cli.world_options import CODE, PHYSICS, SEED, parents, world_options
 from ecs_tentacles.distributed.driver import ShardFailed
 from ecs_tentacles.distributed.wedge import WedgeError
 from ecs_tentacles.export import SUFFIXES, work_units, write
@@ -77,6 +76,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         help="simulate a scene headless and write every frame to a take (.npz), USD or glTF",
         description="Simulate a scene headless and record every frame: mantle and link poses,"
         " sucker states, goals (and fur guides). The output is written atomically.",
+        parents=parents(SEED, CODE, PHYSICS),
     )
     parser.add_argument("scene", metavar="SCENE", help="scene file or bundled scene name")
     parser.add_argument(
@@ -89,7 +89,6 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         metavar="FILE",
         help=f"output file; its suffix picks the format ({', '.join(SUFFIXES)})",
     )
-    parser.add_argument("--seed", type=seed_int, default=None, help="override the scene's seed")
     parser.add_argument(
         "--fps",
         type=fps_float,
@@ -102,15 +101,10 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     add_validate_argument(parser)
     bake_ray.add_arguments(parser)
     parser.add_argument(
-        "--allow-systems", action="store_true", help="import and run the systems the scene names"
-    )
-    parser.add_argument(
         "--strict",
         action="store_true",
         help="write nothing and exit 1 if any creature's physics had to be recovered",
     )
-    add_lod_arguments(parser)
-    add_threads_argument(parser)
     parser.set_defaults(handler=handle)
 
 
@@ -120,14 +114,7 @@ def handle(args: argparse.Namespace) -> int:
     if problem:
         print(f"error: {problem}", file=sys.stderr)
         return 2
-    plan = BakePlan.make(
-        args.scene,
-        seconds=args.seconds,
-        fps=args.fps,
-        seed=args.seed,
-        allow_systems=args.allow_systems,
-    )
-    plan = replace(plan, scene=apply_to_scene(plan.scene, args))
+    plan = BakePlan.make(args.scene, world_options(args), seconds=args.seconds, fps=args.fps)
     note = None
     try:  # a glb too large (or a mesh past 16-bit indices) is refused before anything is built
         skin = skin_options(args)
@@ -177,9 +164,7 @@ def handle(args: argparse.Namespace) -> int:
             print(f"error: {error}", file=sys.stderr)
             return 1
     else:
-        take = bake(
-            plan, progress=not args.quiet, allow_systems=args.allow_systems, threads=args.threads
-        )
+        take = bake(plan, world_options(args), progress=not args.quiet)
     if _recoveries_refused(take.header, args.strict):
         return 1
     try:
@@ -220,12 +205,7 @@ def _bake_streamed(args: argparse.Namespace, plan: BakePlan) -> int:
 
     try:
         header = bake_to_file(
-            plan,
-            args.out,
-            progress=not args.quiet,
-            allow_systems=args.allow_systems,
-            threads=args.threads,
-            accept=accept,
+            plan, args.out, world_options(args), progress=not args.quiet, accept=accept
         )
     except TakeError as error:  # the run made numbers no take may hold (a plugin's NaN)
         print(f"error: {error}", file=sys.stderr)

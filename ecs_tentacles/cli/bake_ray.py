@@ -11,7 +11,9 @@ from pathlib import Path
 from typing import Any
 
 from ecs_tentacles.cli.arguments import bounded_int
+from ecs_tentacles.cli.world_options import world_options
 from ecs_tentacles.export.bake import BakePlan, bake
+from ecs_tentacles.options import WorldOptions
 from ecs_tentacles.output.atomic import claim
 from ecs_tentacles.take import Take
 
@@ -80,7 +82,7 @@ def bake_on_ray(args: argparse.Namespace, plan: BakePlan) -> Take:
             resume=args.resume,
             retries=args.retries,
             progress=not args.quiet,
-            allow_systems=args.allow_systems,
+            options=world_options(args),
         )
     except BaseException:
         kept = len(list(folder.glob("*.npz"))) if folder.is_dir() else 0
@@ -98,8 +100,8 @@ def bake_on_ray(args: argparse.Namespace, plan: BakePlan) -> Take:
     return take
 
 
-def _bake_variant(plan: BakePlan, allow: bool) -> Take:
-    return bake(plan, progress=False, allow_systems=allow, threads=1)
+def _bake_variant(plan: BakePlan, options: WorldOptions) -> Take:
+    return bake(plan, options.but(threads=1), progress=False)
 
 
 def run_wedge(args: argparse.Namespace, plan: BakePlan, save: Any) -> int:
@@ -129,16 +131,9 @@ def run_wedge(args: argparse.Namespace, plan: BakePlan, save: Any) -> int:
         claim(out)  # what each file is now: another run writing one meanwhile wins it
     if index.exists():
         print(f"note: {index} exists: this wedge replaces it", file=sys.stderr)
-    plans = [
-        BakePlan.make(
-            v.scene,
-            seconds=plan.seconds,
-            fps=plan.fps,
-            seed=args.seed,
-            allow_systems=allow,
-            scene_dir=plan.folder,
-        )
-        for v in every
+    options = world_options(args).but(scene_dir=plan.folder, lod=None, focus=None)
+    plans = [  # (the variants' scenes have the options' lod and focus in: `plan.scene`'s)
+        BakePlan.make(v.scene, options, seconds=plan.seconds, fps=plan.fps) for v in every
     ]
     for variant, variant_plan in zip(every, plans, strict=True):
         problem = variant_plan.size_problem()  # a variant may grow what a take holds
@@ -177,7 +172,7 @@ def _wedge_takes(args: argparse.Namespace, plans: list[BakePlan]) -> list[Take]:
         if args.ray is None:
             out = []
             for p in plans:
-                out.append(bake(p, progress=False, allow_systems=args.allow_systems))
+                out.append(bake(p, world_options(args), progress=False))
                 bar.update(1)
             return out
         import ray
@@ -189,7 +184,7 @@ def _wedge_takes(args: argparse.Namespace, plans: list[BakePlan]) -> list[Take]:
             task = ray.remote(num_cpus=1, max_retries=args.retries, retry_exceptions=True)(
                 _bake_variant
             )
-            refs = [task.remote(p, args.allow_systems) for p in plans]
+            refs = [task.remote(p, world_options(args)) for p in plans]
             pending = set(refs)
             try:
                 while pending:

@@ -14,11 +14,11 @@ import argparse
 import json
 from typing import Any
 
-from ecs_tentacles.cli.arguments import add_threads_argument, bounded_int, counted
+from ecs_tentacles.cli.arguments import bounded_int, counted
 from ecs_tentacles.cli.crowd import add_crowd_options, crowd_from_args, crowd_size
-from ecs_tentacles.cli.lod_options import add_lod_arguments, lod_choice
 from ecs_tentacles.cli.measure import BLOCK, WARMUP, bench
 from ecs_tentacles.cli.run import tier_line
+from ecs_tentacles.cli.world_options import CODE, PHYSICS, parents, world_options
 from ecs_tentacles.scene.load import resolve_scene_path
 
 
@@ -30,6 +30,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
             "Build a scene (or a generated crowd), run it headless and report build seconds,"
             " ms per frame, per system, and MuJoCo stepping the same models bare."
         ),
+        parents=parents(CODE, PHYSICS),
     )
     source = parser.add_mutually_exclusive_group(required=True)
     source.add_argument("scene", nargs="?", metavar="SCENE", help="scene file or bundled name")
@@ -42,7 +43,6 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--frames", type=bounded_int(1, 1_000_000), default=120, help="timed frames (default 120)"
     )
-    add_threads_argument(parser)
     parser.add_argument(
         "--block",
         type=bounded_int(1, 10_000),
@@ -60,11 +60,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--no-sleep", action="store_true", help="step idle creatures too (to see what sleep saves)"
     )
-    parser.add_argument(
-        "--allow-systems", action="store_true", help="import and run the systems the scene names"
-    )
     add_crowd_options(parser)
-    add_lod_arguments(parser)
     parser.set_defaults(handler=handle)
 
 
@@ -77,14 +73,11 @@ def handle(args: argparse.Namespace) -> int:
         label = str(source)
     result = bench(
         source,
+        world_options(args).but(seed=None),  # (--seed is the generated crowd's)
         frames=args.frames,
-        threads=args.threads,
         block=args.block,
         warmup=args.warmup,
-        allow_systems=args.allow_systems,
         sleep=not args.no_sleep,
-        lod=lod_choice(args),
-        focus=args.focus,
         progress=not args.quiet,
     )
     if args.json:

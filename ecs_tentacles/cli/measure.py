@@ -10,9 +10,9 @@ How `bench` measures (every figure is milliseconds per frame, the median over bl
 * `build_s`: `World.from_scene` (validate, build entities, compile, schedule).
 * After `warmup` untimed frames, the run alternates blocks of `block` framework
   frames (`world.step`) with blocks of as many bare frames. Each framework frame's
-  stepping inputs are recorded just before its step (`ecs_tentacles.physics.bare`:
-  every stepped row's state and overlay; the recording's own time is taken out of the
-  frame's and the physics system's); a bare block steps the last recorded block's
+  stepping inputs are captured just before its step (`ecs_tentacles.physics.bare`:
+  every stepped row's state and overlay; the capture's own time is taken out of the
+  frame's and the physics system's); a bare block steps the last captured block's
   frames with MuJoCo alone (`mj_setState`, `mj_step`, `mj_getState` per creature) on
   the world's threads and scratch data, never touching the world's state. So both do
   the same MuJoCo work, and alternating in the same run means both see the same
@@ -48,8 +48,9 @@ from typing import Any
 import psutil
 from tqdm import tqdm
 
+from ecs_tentacles.options import WorldOptions
 from ecs_tentacles.physics import heap
-from ecs_tentacles.physics.bare import BareFrame, Recorder
+from ecs_tentacles.physics.bare import BareFrame, FrameCapture
 from ecs_tentacles.world import World
 
 BLOCK = 10  # frames per interleaved block
@@ -87,19 +88,19 @@ def _bare_block(world: World, frames: list[BareFrame], k: int) -> float:
 
 
 def _framework_block(
-    world: World, frames: int, buckets: dict[str, list[float]], recorder: Recorder
+    world: World, frames: int, buckets: dict[str, list[float]], capture: FrameCapture
 ) -> float:
-    """Seconds to run `frames` framework frames, less the recording (recorded into
-    `recorder`); `buckets` hold each system's seconds, the physics' less the recording."""
+    """Seconds to run `frames` framework frames, less the capture (captured into
+    `capture`); `buckets` hold each system's seconds, the physics' less the capture."""
     for bucket in buckets.values():
         bucket[0] = 0.0
-    recorder.frames, recorder.seconds = [], 0.0
+    capture.frames, capture.seconds = [], 0.0
     start = time.perf_counter()
     world.step(frames)
     took = time.perf_counter() - start
     if "physics" in buckets:
-        buckets["physics"][0] -= recorder.seconds
-    return took - recorder.seconds
+        buckets["physics"][0] -= capture.seconds
+    return took - capture.seconds
 
 
 def _bar(total: int, desc: str, progress: bool, **kwargs: Any) -> tqdm[Any]:
@@ -122,25 +123,25 @@ def measure(
     """Median ms per frame of `frames` framework frames and as many bare ones, interleaved."""
     if frames < 1 or block < 1 or warmup < 0:
         raise ValueError(f"frames and block must be >= 1, warmup >= 0; got {frames, block, warmup}")
-    recorder = Recorder(world.physics)
+    capture = FrameCapture(world.physics)
     try:
         with _bar(warmup, "bench warm-up", progress) as bar:
             for _ in range(warmup):
-                recorder.frames = []  # the last warm-up frame is kept
+                capture.frames = []  # the last warm-up frame is kept
                 world.step(1)
                 bar.update(1)
-        _bare_block(world, recorder.frames, 1)  # the bare path's first call warms it up
+        _bare_block(world, capture.frames, 1)  # the bare path's first call warms it up
         buckets = time_systems(world)
         per_frame: dict[str, list[float]] = defaultdict(list)
         with _bar(frames, "bench frames", progress) as bar:
             for index, first in enumerate(range(0, frames, block)):
                 k = min(block, frames - first)
-                _timed_block(world, k, buckets, recorder, per_frame, bare_first=index % 2 == 1)
+                _timed_block(world, k, buckets, capture, per_frame, bare_first=index % 2 == 1)
                 bar.update(k)
     finally:
-        recorder.close()
-        recorder.frames = []
-        heap.trim()  # the recordings' memory goes back: `rss_mb` is the world's
+        capture.close()
+        capture.frames = []
+        heap.trim()  # the captures' memory goes back: `rss_mb` is the world's
     physics = zip(*(per_frame[name] for name in PHYSICS_SYSTEMS), strict=True)
     physics_ms = statistics.median(map(sum, physics))
     medians = {name: statistics.median(values) for name, values in per_frame.items()}
@@ -160,34 +161,31 @@ def _timed_block(
     world: World,
     k: int,
     buckets: dict[str, list[float]],
-    recorder: Recorder,
+    capture: FrameCapture,
     per_frame: dict[str, list[float]],
     *,
     bare_first: bool,
 ) -> None:
     """One block of `k` framework frames and `k` bare ones, in that order or the other
-    (bare first steps the frames the last block recorded); appends each figure's ms per
+    (bare first steps the frames the last block captured); appends each figure's ms per
     frame to `per_frame`."""
-    bare = _bare_block(world, recorder.frames, k) if bare_first else 0.0
-    per_frame["frame"].append(_framework_block(world, k, buckets, recorder) * 1000 / k)
+    bare = _bare_block(world, capture.frames, k) if bare_first else 0.0
+    per_frame["frame"].append(_framework_block(world, k, buckets, capture) * 1000 / k)
     for name, bucket in buckets.items():
         per_frame[name].append(bucket[0] * 1000 / k)
     if not bare_first:
-        bare = _bare_block(world, recorder.frames, k)
+        bare = _bare_block(world, capture.frames, k)
     per_frame["raw"].append(bare * 1000 / k)
 
 
 def bench(
     source: str | os.PathLike[str] | dict[str, Any],
+    options: WorldOptions | None = None,
     *,
     frames: int = 120,
-    threads: int | None = None,
     block: int = BLOCK,
     warmup: int = WARMUP,
-    allow_systems: bool = False,
     sleep: bool = True,
-    lod: bool | None = None,
-    focus: tuple[float, float, float] | None = None,
     progress: bool = False,
 ) -> dict[str, Any]:
     """Build `source` (scene path, bundled name or dict), run `measure`, report sizes.
@@ -197,17 +195,15 @@ def bench(
     asleep (creatures asleep at the end), compiles (models compiled: one per
     morphology, shared by its creatures), recoveries, lod, tiers, promotions, demotions.
     With `sleep=False` idle creatures are stepped like the rest (to show what sleep saves).
-    `lod` turns level of detail on or off over the scene's (None: the scene's);
-    `focus` (x, y, radius in m) is a region whose creatures always run full.
+    `options` build the world (`ecs_tentacles.options.WorldOptions`: threads, level of
+    detail over the scene's and a `focus` region whose creatures always run full).
     """
     if not sleep:
         source = _without_sleep(source)
     start = time.perf_counter()
     with _bar(1, "bench: building the world", progress, bar_format="{desc} ..."):
-        world = World.from_scene(source, threads=threads, allow_systems=allow_systems, lod=lod)
+        world = World.from_scene(source, options)
     build_s = time.perf_counter() - start
-    if focus is not None:
-        world.lod.focus(focus[:2], focus[2])
     try:
         sizes = {
             "creatures": len(world.physics),

@@ -10,14 +10,8 @@ import json
 import sys
 from typing import Any
 
-from ecs_tentacles.cli.arguments import (
-    add_threads_argument,
-    frame_count,
-    output_path,
-    require_display,
-    seed_int,
-)
-from ecs_tentacles.cli.lod_options import add_lod_arguments, lod_choice
+from ecs_tentacles.cli.arguments import frame_count, output_path, require_display
+from ecs_tentacles.cli.world_options import CODE, PHYSICS, SEED, parents, world_options
 from ecs_tentacles.scene.load import resolve_scene_path
 
 SIZE_RULE = "an even number of pixels in [64, 8192]"
@@ -68,6 +62,8 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
             " clean view (the editor's overlays hidden: goal paths, selection rings, sucker"
             " dots, the fur timeline, the metre grid; a game's HUD and banners stay)."
         ),
+        # without --focus, the focus follows the camera (render.sandbox)
+        parents=parents(SEED, CODE, PHYSICS),
     )
     parser.add_argument("scene", metavar="SCENE", help="scene file or bundled scene name")
     parser.add_argument("--headless", action="store_true", help="no window: render off-screen")
@@ -107,8 +103,6 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         help="draw the HUD FACTOR times larger, in [0.5, 3] (default: as the display asks,"
         " its DPI over 96; 1 headless); either way it also grows with the window's height",
     )
-    parser.add_argument("--seed", type=seed_int, default=None, help="override the scene's seed")
-    parser.add_argument("--allow-systems", action="store_true", help="run systems the scene names")
     shown = parser.add_mutually_exclusive_group()
     shown.add_argument(
         "--hud",
@@ -148,8 +142,6 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--json", action="store_true", help="headless: the summary as JSON (a level's: its game)"
     )
-    add_lod_arguments(parser)
-    add_threads_argument(parser)  # without --focus, the focus follows the camera (render.sandbox)
     parser.set_defaults(handler=handle)
 
 
@@ -183,15 +175,11 @@ def handle(args: argparse.Namespace) -> int:
 
     sandbox = Sandbox(
         path,
+        world_options(args),
         width=args.width,
         height=args.height,
         headless=args.headless,
-        seed=args.seed,
-        allow_systems=args.allow_systems,
         hud=args.hud if args.hud is not None else not args.video,
-        lod=lod_choice(args),
-        focus=args.focus,
-        threads=args.threads,
         palette=args.palette,
         clean=True if args.clean is None and args.video else args.clean,
     )

@@ -15,15 +15,9 @@ import time
 from collections.abc import Callable
 from typing import Any
 
-from ecs_tentacles.cli.arguments import (
-    add_threads_argument,
-    bounded_int,
-    counted,
-    frame_count,
-    seed_int,
-)
-from ecs_tentacles.cli.lod_options import add_lod_arguments, apply_focus, lod_choice
+from ecs_tentacles.cli.arguments import bounded_int, counted, frame_count
 from ecs_tentacles.cli.registries import RunSummaries, RunSummary
+from ecs_tentacles.cli.world_options import CODE, PHYSICS, SEED, parents, world_options
 from ecs_tentacles.components import Creature
 from ecs_tentacles.game.rules import playing
 from ecs_tentacles.output.progress import status, step_frames
@@ -41,6 +35,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         "run",
         help="simulate a scene headless and print sim time, wall time and real-time factor",
         description="Simulate a scene headless (no window) for a number of frames.",
+        parents=parents(SEED, CODE, PHYSICS),
     )
     parser.add_argument("scene", metavar="SCENE", help="scene file or bundled scene name")
     parser.add_argument(
@@ -49,25 +44,14 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         default=600,
         help="frames to run (default 600; a level stops sooner once its game is won or lost)",
     )
-    parser.add_argument("--seed", type=seed_int, default=None, help="override the scene's seed")
     parser.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
-    parser.add_argument(
-        "--allow-systems", action="store_true", help="import and run the systems the scene names"
-    )
-    add_physics_arguments(parser)
-    parser.set_defaults(handler=handle)
-
-
-def add_physics_arguments(parser: argparse.ArgumentParser) -> None:
-    """`--threads`, `--strict`, `--lod` and `--focus`, shared by the commands that simulate."""
-    add_threads_argument(parser)
     parser.add_argument(
         "--strict",
         action="store_true",
         help="exit 1 if any creature's physics had to be recovered or frozen",
     )
-    add_lod_arguments(parser)
+    parser.set_defaults(handler=handle)
 
 
 def health_line(summary: dict[str, Any]) -> str:
@@ -90,14 +74,7 @@ def handle(args: argparse.Namespace) -> int:
     path = resolve_scene_path(args.scene)
     build_start = time.perf_counter()
     with status(f"run: building {path}", progress=not args.quiet):
-        world = World.from_scene(
-            path,
-            seed=args.seed,
-            allow_systems=args.allow_systems,
-            threads=args.threads,
-            lod=lod_choice(args),
-        )
-    apply_focus(world, args.focus)
+        world = World.from_scene(path, world_options(args))
     build_seconds = time.perf_counter() - build_start
     summary = simulate(world, args.frames, progress=not args.quiet)
     texts = [found.text for found in plugin_summaries(world) if found.text]

@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import json
 
+from ecs_tentacles.cli.world_options import CODE, parents, world_options
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.scene.load import resolve_scene_path
 from ecs_tentacles.world import World
@@ -22,20 +23,16 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         description="Build the scene (no simulation) and print the plugins on and every"
         " system in frame order with the stage it runs in and the fields it reads and"
         " writes; warn about unordered writers of one field.",
+        parents=parents(CODE),
     )
     parser.add_argument("scene", metavar="SCENE", help="scene file or bundled scene name")
-    parser.add_argument(
-        "--allow-systems",
-        action="store_true",
-        help="import the plugins and systems the scene names",
-    )
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     parser.set_defaults(handler=handle)
 
 
 def handle(args: argparse.Namespace) -> int:
     path = resolve_scene_path(args.scene)
-    with World.from_scene(path, allow_systems=args.allow_systems, threads=1) as world:
+    with World.from_scene(path, world_options(args).but(threads=1)) as world:
         schedule = world.schedule
         plugins = [
             {"name": p.key, "source": _origin(p), "description": p.description}

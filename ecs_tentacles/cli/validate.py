@@ -15,6 +15,7 @@ import sys
 from typing import TYPE_CHECKING, Any
 
 from ecs_tentacles.cli.arguments import counted
+from ecs_tentacles.cli.world_options import CODE, parents
 from ecs_tentacles.output.progress import status
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.load import resolve_scene_path
@@ -30,6 +31,7 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         description="Check scene files as run does before it simulates (the files a scene"
         " names included); print one line per problem with its JSON path, and the systems a"
         " scene asks for (run, bake and play import them only with --allow-systems).",
+        parents=parents(CODE),
     )
     parser.add_argument(
         "scenes", nargs="+", metavar="SCENE", help="scene file or bundled scene name"
@@ -38,11 +40,6 @@ def add_parser(commands: argparse._SubParsersAction) -> None:
         "--json",
         action="store_true",
         help='one JSON object per scene ({"ok": false, "problems": [...]} for a bad one)',
-    )
-    parser.add_argument(
-        "--allow-systems",
-        action="store_true",
-        help="import the plugins scenes name from files or modules, to check their configs",
     )
     parser.set_defaults(handler=handle)
 
@@ -78,10 +75,12 @@ def checked(path: pathlib.Path, allow_systems: bool) -> tuple[dict[str, Any], li
     """The scene at `path`, completed, and its plugins, once every check a run makes
     before simulating has passed (SceneError otherwise, each line led by the path)."""
     from ecs_tentacles.creatures.loading import load_world
+    from ecs_tentacles.options import WorldOptions
     from ecs_tentacles.world import World
 
     try:
-        world = load_world(World, path, allow_systems=allow_systems, checks_only=True)
+        options = WorldOptions(allow_systems=allow_systems)
+        world = load_world(World, path, options, checks_only=True)
     except SceneError as error:
         named = f"{path}:"  # `path: ...` or, located in the text, `path:5:3: ...`
         lines = [p if p.startswith(named) else f"{named} {p}" for p in error.problems]

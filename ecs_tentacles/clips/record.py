@@ -95,7 +95,7 @@ def record(scene: dict[str, Any], warmup: float, seconds: float) -> GaitRecordin
 
 def _joint_state(world: World) -> tuple[np.ndarray, np.ndarray]:
     """The one creature's MuJoCo qpos and qvel (views; copy before stepping on)."""
-    data = world.physics.groups[0].data
+    data = world.physics.views[0].data
     return data.qpos, data.qvel
 
 

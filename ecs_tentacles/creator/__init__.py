@@ -6,6 +6,7 @@ interactive window (`window`: a thin layer over the same model) needs the render
 
 from __future__ import annotations
 
-from ecs_tentacles.creator.design import SHAPE_KEYS, CreatureDesign, DesignError, TentacleDesign
+from ecs_tentacles.creator.design import SHAPE_KEYS, CreatureDesign, TentacleDesign
+from ecs_tentacles.creator.limits import DesignError
 
 __all__ = ["SHAPE_KEYS", "CreatureDesign", "DesignError", "TentacleDesign"]

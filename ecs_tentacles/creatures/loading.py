@@ -21,16 +21,19 @@ from __future__ import annotations
 import importlib
 import os
 import pathlib
-from collections.abc import Collection, Mapping
+from collections.abc import Collection
 from dataclasses import replace
 from typing import Any, Protocol, TypeVar
 
 from ecs_tentacles import stops
 from ecs_tentacles.creatures.body import build_creature
+from ecs_tentacles.ground import ground_of
 from ecs_tentacles.host import Host
+from ecs_tentacles.options import WorldOptions
 from ecs_tentacles.physics.frame_systems import physics_systems
 from ecs_tentacles.plugin import HookFailure, Plugin, SystemsPlugin, calling
 from ecs_tentacles.scene.errors import SceneError
+from ecs_tentacles.scene.layouts import Layouts
 from ecs_tentacles.scene.load import load_scene_plugins, read_scene_json, resolve_scene_path
 from ecs_tentacles.scene.plugins import scene_first
 from ecs_tentacles.scene.spec import CreatureSpec, creature_specs
@@ -41,6 +44,8 @@ from ecs_tentacles.system import System
 class SceneWorld(Host, Protocol):
     """What loading needs of the world it builds (`ecs_tentacles.world.World`)."""
 
+    options: WorldOptions
+    layouts: Layouts
     scene: dict[str, Any] | None
     scene_dir: pathlib.Path | None
     creature_specs: dict[int, CreatureSpec]
@@ -66,44 +71,51 @@ class WorldClass(Protocol[W_co]):
 def load_world(
     cls: WorldClass[W],
     source: str | os.PathLike[str] | dict[str, Any],
+    options: WorldOptions | None = None,
     *,
-    seed: int | None = None,
-    allow_systems: bool = False,
-    threads: int | None = None,
-    only: Collection[int] | None = None,
-    plugins: Mapping[str, Any] | None = None,
-    scene_dir: str | os.PathLike[str] | None = None,
-    lod: bool | None = None,
     checks_only: bool = False,
 ) -> W:
-    """A `cls` world built from a scene file, bundled scene name or dict (`World.from_scene`).
+    """A `cls` world built from a scene file, bundled scene name or dict (`World.from_scene`),
+    with `options` over what the scene says (`ecs_tentacles.options.WorldOptions`).
 
     `checks_only` stops once every check a run makes before it simulates has run (the
     scene, the plugins' resources with the files they read, the build hooks, the plugins'
     systems): no physics models are compiled and nothing is scheduled; a scene's own
     `systems` are imported only when allowed (`validate`; close the world after).
     """
-    folder = pathlib.Path(scene_dir) if scene_dir is not None else None
+    options = options or WorldOptions()
+    allow_systems, plugins, seed = options.allow_systems, options.plugins, options.seed
+    folder = options.scene_dir
     if not isinstance(source, dict):
         source = resolve_scene_path(os.fspath(source))  # a path, or a bundled scene's name
         folder = source.resolve().parent
     if plugins:  # the caller's choices over the scene's
         raw = source if isinstance(source, dict) else _read_scene(source)
         source = {**raw, "plugins": {**(raw.get("plugins") or {}), **plugins}}
-    data, chosen = load_scene_plugins(source, allow_systems=allow_systems, scene_dir=folder)
+    layouts = Layouts()  # each creature's, worked out once: the checks', then the build's
+    data, chosen = load_scene_plugins(
+        source, allow_systems=allow_systems, scene_dir=folder, layouts=layouts
+    )
     if allow_systems or not checks_only:  # validate says what a scene asks to run
         chosen += _scene_systems(data["systems"], folder, allow_systems)
     settings = Settings.from_physics(data["physics"])
-    if lod is not None:  # the caller's choice over the scene's
-        settings = replace(settings, lod=replace(settings.lod, enabled=lod))
+    if options.lod is not None:  # the caller's choice over the scene's
+        settings = replace(settings, lod=replace(settings.lod, enabled=options.lod))
     world = cls(
         settings,
         seed=data["seed"] if seed is None else seed,
         name=data.get("name", "scene"),
     )
-    world.scene, world.scene_dir = data, folder
+    world.scene, world.scene_dir, world.options = data, folder, options
+    world.layouts = layouts
     with stops.deferred():  # a Ctrl-C waits for the next creature (`ecs_tentacles.stops`)
-        _build(world, data, chosen, only, checks_only, threads)
+        try:
+            _build(world, data, chosen, options.only, checks_only, options.threads)
+        finally:
+            layouts.clear()  # built: a crowd's layouts would only take memory
+    if options.focus is not None and not checks_only:
+        x, y, radius = options.focus
+        world.physics.lod.focus((x, y), radius)
     return world
 
 
@@ -122,7 +134,8 @@ def _build(
         for index, creature in enumerate(creature_specs(data)):
             stops.check()
             if only is None or index in only:
-                entity = build_creature(world, creature)
+                layout = world.layouts.on(creature, ground_of(world))  # the checks' one
+                entity = build_creature(world, creature, layout)
                 world.creature_specs[entity] = creature
                 for plugin in chosen:
                     with calling(plugin, "build_creature"):

@@ -39,17 +39,22 @@ from ecs_tentacles.components import Creature, Tentacle
 from ecs_tentacles.creatures.body import build_creature
 from ecs_tentacles.events import CreatureDespawned, CreatureSpawned, SuckerReleased
 from ecs_tentacles.ground import ground_of
+from ecs_tentacles.host import PLACEMENT_KEYS
 from ecs_tentacles.numeric.quaternions import quat_rotate
 from ecs_tentacles.plugin import calling
 from ecs_tentacles.roster_change import RosterChange
 from ecs_tentacles.scene.construction import CreatureLayout, creature_layout
+from ecs_tentacles.scene.defaults import with_defaults
+from ecs_tentacles.scene.layouts import Layouts
 from ecs_tentacles.scene.overlap import segment_distances
-from ecs_tentacles.scene.physical import physical_problems
-from ecs_tentacles.scene.spec import CreatureSpec, creature_specs
-from ecs_tentacles.scene.validate import validated
+from ecs_tentacles.scene.physical import creature_problems
+from ecs_tentacles.scene.spec import CreatureSpec, as_spec
+from ecs_tentacles.scene.validate import format_path, validated_creature
 
 if TYPE_CHECKING:
-    from ecs_tentacles.host import Host as World  # any world (`ecs_tentacles.world.World`)
+    from typing_extensions import Unpack  # (typing's own from Python 3.12)
+
+    from ecs_tentacles.host import Host, Placement  # any world (`ecs_tentacles.world.World`)
 
 log = logging.getLogger("ecs_tentacles.creatures.spawning")
 
@@ -69,14 +74,16 @@ class SpawnError(ValueError):
 
 # -- the creature entry ------------------------------------------------------------------
 def creature_entry(
-    world: World,
+    world: Host,
     spec: Mapping[str, Any],
-    position: Sequence[float] | None = None,
+    position: Sequence[float] | np.ndarray | None = None,
     heading_deg: float | None = None,
+    layouts: Layouts | None = None,
 ) -> CreatureSpec:
     """`spec` validated as a scene's creature entry, defaults filled in, placed at
     `position` / `heading_deg` when given, its name made unique in `world` (`octo` ->
-    `octo_2`). Raises SpawnError (one line per problem) when it is not a valid entry."""
+    `octo_2`). Raises SpawnError (one line per problem) when it is not a valid entry.
+    Its layout is worked out in `layouts` (a spawn's: it builds from it)."""
     if not isinstance(spec, Mapping):
         raise SpawnError([f"creature: must be an object, got {type(spec).__name__}"])
     entry = copy.deepcopy(dict(spec))
@@ -88,23 +95,28 @@ def creature_entry(
     entry.setdefault("position", [0.0, 0.0])
     if isinstance(entry["name"], str):
         entry["name"] = unique_name(world, entry["name"])
-    mini: dict[str, Any] = {"version": 1, "creatures": [entry]}
-    if world.scene is not None:
-        mini["version"], mini["physics"] = world.scene["version"], world.scene["physics"]
-    problems, completed = validated(mini, world.plugins)
+    scene = _scene_now(world)
+    problems, completed = validated_creature(entry, scene, world.plugins)
     if completed is not None and not problems:
-        problems = physical_problems(completed)
+        where = ("creature",)  # (one creature: its paths start at `creature`)
+        found = creature_problems(where, as_spec(completed), scene["physics"], layouts=layouts)
+        problems = [f"{format_path(path)}: {message}" for path, message in found]
     if problems:
-        raise SpawnError([_as_creature(p) for p in problems])
+        raise SpawnError(problems)
     assert completed is not None
-    return creature_specs(completed)[0]
+    return as_spec(completed)
 
 
-def _as_creature(problem: str) -> str:
-    return re.sub(r"^creatures\[0\]", "creature", problem)
+def _scene_now(world: Host) -> dict[str, Any]:
+    """The world's scene with the creatures it has now (a spawn is checked among them);
+    a scene of defaults for a world built by hand."""
+    scene = world.scene
+    if scene is None:
+        scene = with_defaults({"version": 1, "creatures": []}, world.plugins)
+    return {**scene, "creatures": list(world.creature_specs.values())}
 
 
-def unique_name(world: World, name: str) -> str:
+def unique_name(world: Host, name: str) -> str:
     """`name`, or `name_2`, `name_3`... : the first no creature of `world` has and no
     take being recorded has seen (`World.kept_names`)."""
     taken = taken_names(world)
@@ -117,7 +129,7 @@ def unique_name(world: World, name: str) -> str:
     return _suffixed(base, n)
 
 
-def taken_names(world: World) -> set[str]:
+def taken_names(world: Host) -> set[str]:
     """Names a new creature may not take: every creature's now and `World.kept_names`."""
     return {c.name for _, c in world.query(Creature)} | world.kept_names
 
@@ -129,7 +141,7 @@ def _suffixed(base: str, n: int, longest: int = 64) -> str:
 
 
 # -- overlap with the creatures there and the obstacles ------------------------------------
-def obstruction(world: World, layout: CreatureLayout) -> str | None:
+def obstruction(world: Host, layout: CreatureLayout) -> str | None:
     """What a creature built as `layout` would overlap now: `"creature 'octo'"`, `"an
     obstacle"`, or None when the spot is free."""
     starts, ends, radii = layout.capsules()
@@ -159,7 +171,7 @@ def obstruction(world: World, layout: CreatureLayout) -> str | None:
     return None
 
 
-def free_spot(world: World, entry: CreatureSpec) -> tuple[CreatureSpec, str | None]:
+def free_spot(world: Host, entry: CreatureSpec) -> tuple[CreatureSpec, str | None]:
     """`entry` where it asked to be if free, else moved to the nearest free spot on rings
     around it; and what was in the way (None: not moved). SpawnError if none is free."""
     placed, blocker, _ = free_spot_layout(world, entry)
@@ -167,34 +179,42 @@ def free_spot(world: World, entry: CreatureSpec) -> tuple[CreatureSpec, str | No
 
 
 def free_spot_layout(
-    world: World, entry: CreatureSpec
+    world: Host, entry: CreatureSpec, layouts: Layouts | None = None
 ) -> tuple[CreatureSpec, str | None, CreatureLayout]:
     """`free_spot`, and the layout on this world's ground of the entry it returns (the
-    one it last checked: a spawn builds from it instead of working it out again)."""
+    one it last checked: a spawn builds from it instead of working it out again).
+    `layouts`: where `entry`'s layout may be already (a spawn's)."""
     ground = ground_of(world)
+    book = Layouts() if layouts is None else layouts
     last: list[tuple[CreatureSpec, CreatureLayout]] = []
 
     def blocked(candidate: CreatureSpec) -> str | None:
-        layout = creature_layout(candidate, ground)
+        if candidate is entry:
+            layout = book.on(entry, ground)
+        else:  # a copy moved to another spot
+            layout = creature_layout(candidate, ground)
         last[:] = [(candidate, layout)]
         return obstruction(world, layout)
 
-    placed, blocker = nearest_free(entry, blocked)
+    placed, blocker = nearest_free(entry, blocked, book.on_plane(entry))
     checked, layout = last[0]
     assert checked is placed  # the last spot checked is the free one returned
     return placed, blocker, layout
 
 
 def nearest_free(
-    entry: CreatureSpec, blocked: Callable[[CreatureSpec], str | None]
+    entry: CreatureSpec,
+    blocked: Callable[[CreatureSpec], str | None],
+    flat: CreatureLayout | None = None,
 ) -> tuple[CreatureSpec, str | None]:
     """`entry` if `blocked` finds nothing in the way of it, else a copy at the nearest
     spot on rings around it (a quarter of its reach apart) where nothing is; and what
-    was in the way first (None: not moved). SpawnError if no spot is free."""
+    was in the way first (None: not moved). SpawnError if no spot is free. `flat`:
+    `entry`'s layout on the plane, when the caller has it."""
     blocker = blocked(entry)
     if blocker is None:
         return entry, None
-    layout = creature_layout(entry)  # on the plane: only its reach is wanted
+    layout = creature_layout(entry) if flat is None else flat  # only its reach is wanted
     _, ends, radii = layout.capsules()
     reach = float(np.max(np.linalg.norm(ends[:, :2] - layout.origin[:2], axis=1)) + radii.max())
     x, y = entry["position"][:2]
@@ -213,22 +233,22 @@ def nearest_free(
 
 
 # -- spawn and despawn ---------------------------------------------------------------------
-def spawn(
-    world: World,
-    spec: Mapping[str, Any],
-    *,
-    position: Sequence[float] | None = None,
-    heading_deg: float | None = None,
-    on_overlap: OnOverlap = "refuse",
-) -> int:
+def spawn(world: Host, spec: Mapping[str, Any], **placement: Unpack[Placement]) -> int:
     """Build one creature into the running `world`; its entity (module docstring)."""
+    unknown = sorted(set(placement) - PLACEMENT_KEYS)
+    if unknown:  # (a script without a type checker: a typo is not silently dropped)
+        known = ", ".join(sorted(PLACEMENT_KEYS))
+        raise TypeError(f"spawn() got an unexpected keyword {unknown[0]!r} (takes {known})")
+    position, heading_deg = placement.get("position"), placement.get("heading_deg")
+    on_overlap = placement.get("on_overlap", "refuse")
     if on_overlap not in ("refuse", "move"):
         raise ValueError(f"on_overlap: must be 'refuse' or 'move', got {on_overlap!r}")
     world.activate()
-    entry = creature_entry(world, spec, position, heading_deg)
+    layouts = Layouts()  # its layout: the physical checks', then the spot's and the build's
+    entry = creature_entry(world, spec, position, heading_deg, layouts)
     moved_to = None
     if on_overlap == "move":
-        placed, blocker, layout = free_spot_layout(world, entry)
+        placed, blocker, layout = free_spot_layout(world, entry, layouts)
         if blocker is not None:
             moved_to = tuple(placed["position"])
             log.info(
@@ -240,7 +260,7 @@ def spawn(
             )
         entry = placed
     else:
-        layout = creature_layout(entry, ground_of(world))
+        layout = layouts.on(entry, ground_of(world))
         blocker = obstruction(world, layout)
         if blocker is not None:
             where = ", ".join(f"{v:g}" for v in entry["position"])
@@ -250,7 +270,7 @@ def spawn(
 
 
 def place(
-    world: World,
+    world: Host,
     entry: CreatureSpec,
     moved_to: tuple[float, ...] | None = None,
     layout: CreatureLayout | None = None,
@@ -281,7 +301,7 @@ def place(
     return entity
 
 
-def despawn(world: World, entity: int) -> None:
+def despawn(world: Host, entity: int) -> None:
     """Remove creature `entity` and everything it owns (module docstring)."""
     world.activate()
     creature = world.try_component(entity, Creature)
@@ -309,7 +329,7 @@ def despawn(world: World, entity: int) -> None:
     world.events.emit(CreatureDespawned(world, entity, name))
 
 
-def _owned_rows(world: World, creature: Creature) -> dict[str, np.ndarray]:
+def _owned_rows(world: Host, creature: Creature) -> dict[str, np.ndarray]:
     """Every store's rows that belong to `creature`: the body's, then every store whose
     rows line up with a body store's or refer to rows that go (fur guides -> mantle)."""
     c = creature.row
@@ -358,7 +378,7 @@ def _owned_rows(world: World, creature: Creature) -> dict[str, np.ndarray]:
     return dead
 
 
-def _row_entities(world: World, dead: dict[str, np.ndarray]) -> list[int]:
+def _row_entities(world: Host, dead: dict[str, np.ndarray]) -> list[int]:
     """The entities that the going rows of plugin stores with an `entity` column stand
     for (fur guides and controls): they go with their rows."""
     owned: list[int] = []
@@ -369,7 +389,7 @@ def _row_entities(world: World, dead: dict[str, np.ndarray]) -> list[int]:
     return owned
 
 
-def _delete_entities(world: World, entity: int, creature: Creature, rows: list[int]) -> None:
+def _delete_entities(world: Host, entity: int, creature: Creature, rows: list[int]) -> None:
     for row_entity in rows:
         esper.delete_entity(row_entity, immediate=True)
     for tentacle_entity in creature.tentacles:
@@ -379,7 +399,7 @@ def _delete_entities(world: World, entity: int, creature: Creature, rows: list[i
     esper.delete_entity(entity, immediate=True)
 
 
-def _tell(world: World, change: RosterChange) -> None:
+def _tell(world: Host, change: RosterChange) -> None:
     for plugin in world.plugins:
         plugin.roster_changed(world, change)
     for system in world.schedule:

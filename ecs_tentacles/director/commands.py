@@ -113,7 +113,7 @@ class Moved:
             return
         physics = world.physics
         index = physics.lod.index(entity)
-        view = physics.groups[index]
+        view = physics.views[index]
         physics.place_joints(index, qpos, np.zeros(view.model.nv))
         view.batch.sync(world.transforms)
 

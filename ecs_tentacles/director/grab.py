@@ -37,7 +37,8 @@ def spring_force(
     pull = mass * (STIFFNESS * (np.asarray(target) - position) - DAMPING * np.asarray(velocity))
     size = float(np.linalg.norm(pull))
     limit = mass * MAX_ACCELERATION
-    return pull * (limit / size) if size > limit else pull
+    capped: np.ndarray = pull * (limit / size) if size > limit else pull
+    return capped
 
 
 @dataclass

@@ -19,7 +19,7 @@ the `Director` resource.
 from __future__ import annotations
 
 import logging
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from imgui_bundle import imgui
@@ -35,6 +35,9 @@ from ecs_tentacles.director.scatter import reach_of, scatter
 from ecs_tentacles.director.state import Director
 from ecs_tentacles.render.gui import Gui
 from ecs_tentacles.render.registries import Panel, SandboxView
+
+if TYPE_CHECKING:
+    from ecs_tentacles.host import Host
 
 log = logging.getLogger("ecs_tentacles.director")
 
@@ -62,8 +65,9 @@ class DirectorPanel(Panel):
         self.message = ""
 
     @property
-    def world(self) -> Any:
-        return self.sandbox.world
+    def world(self) -> Host:
+        world: Host = self.sandbox.world
+        return world
 
     @property
     def preset(self) -> Preset:
@@ -227,7 +231,7 @@ class DirectorPanel(Panel):
         if creature is None:
             return False
         origin, direction = sandbox.renderer.camera.ray(x, y)
-        view = world.physics.group_of(world.component(creature, Creature))
+        view = world.physics.view_of(world.component(creature, Creature))
         bodies = world.transforms.pos[view.body_rows]
         along = np.clip((bodies - origin) @ direction, 0.0, None)
         miss = np.linalg.norm(bodies - (origin + along[:, None] * direction), axis=1)
@@ -235,7 +239,7 @@ class DirectorPanel(Panel):
         point = bodies[body].copy()
         toward = -direction / np.linalg.norm(direction)
         world.resource(Director).grab = Grab(creature, body, point, point.copy(), toward)
-        world.lod.promote(creature)
+        world.physics.lod.promote(creature)
         self.grab_start = view.data.qpos.copy()
         return True
 
@@ -245,8 +249,8 @@ class DirectorPanel(Panel):
         assert grab is not None
         if world.try_component(grab.creature, Creature) is None:
             return
-        world.lod.release(grab.creature)
-        view = world.physics.group_of(world.component(grab.creature, Creature))
+        world.physics.lod.release(grab.creature)
+        view = world.physics.view_of(world.component(grab.creature, Creature))
         if self.grab_start is not None:
             name = world.creature_name(grab.creature)
             self._push(Moved(f"move {name}", name, self.grab_start, view.data.qpos.copy()))

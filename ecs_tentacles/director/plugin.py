@@ -75,7 +75,7 @@ class DirectorPlugin(Plugin):
         lines = []
         grab = director.grab
         if grab is not None and world.try_component(grab.creature, Creature) is not None:
-            rows = world.physics.group_of(world.component(grab.creature, Creature)).body_rows
+            rows = world.physics.view_of(world.component(grab.creature, Creature)).body_rows
             held = view.pos[rows[grab.body]]
             lines.append(line_segments(np.array([held, grab.target]), GRAB_RGBA))
         if director.brush is not None:

@@ -57,6 +57,7 @@ from ecs_tentacles.distributed.spheres import meetings
 from ecs_tentacles.distributed.task import ShardResult, bake_shard
 from ecs_tentacles.distributed.work import WorkFolder, remove_work, shard_key
 from ecs_tentacles.export.bake import BakePlan
+from ecs_tentacles.options import WorldOptions
 from ecs_tentacles.output.progress import status
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.take import Take
@@ -206,11 +207,11 @@ def _signal_handlers() -> dict[int, Any]:
     return {n: h for n in numbers if (h := signal.getsignal(n)) is not None}
 
 
-def _run_shard(plan: BakePlan, members: list[int], key: str, counter: Any, allow: bool) -> Any:
+def _run_shard(
+    plan: BakePlan, members: list[int], key: str, counter: Any, options: WorldOptions
+) -> Any:
     """The Ray task: bake one shard, telling `counter` of progress."""
-    return bake_shard(
-        plan, members, key, allow_systems=allow, on_steps=lambda n: counter.add.remote(n)
-    )
+    return bake_shard(plan, members, key, options, on_steps=lambda n: counter.add.remote(n))
 
 
 class _Counter:
@@ -233,12 +234,16 @@ def ray_bake(
     resume: bool = False,
     retries: int = 3,
     progress: bool = True,
-    allow_systems: bool = False,
+    options: WorldOptions | None = None,
     note: Callable[[str], None] = lambda line: print(line, file=sys.stderr),
 ) -> tuple[Take, RayStats]:
-    """Bake `plan` on Ray; finished shards go to `folder` (see the module docstring)."""
+    """Bake `plan` on Ray; finished shards go to `folder` (see the module docstring).
+    `options`: the code each shard may import (`allow_systems`); a shard steps on one
+    thread and builds its own creatures."""
     import ray
 
+    options = options or WorldOptions()
+    allow_systems = options.allow_systems
     started = start_ray(address, cpus)
     try:
         stats = RayStats(workers=float(ray.cluster_resources().get("CPU", 1)))
@@ -250,7 +255,7 @@ def ray_bake(
             remove_work(folder)
         work = WorkFolder.open(folder, resume=resume, note=note)
         shards = stats.plan.shards
-        results = _run_all(plan, shards, work, retries, progress, allow_systems, stats)
+        results = _run_all(plan, shards, work, retries, progress, options, stats)
         while True:
             met = _meetings(plan, results, plugins)
             if not met:
@@ -264,7 +269,7 @@ def ray_bake(
                 )
             todo = [s for s in shards if tuple(s) not in results]
             stats.rebaked += len(todo)
-            results.update(_run_all(plan, todo, work, retries, progress, allow_systems, stats))
+            results.update(_run_all(plan, todo, work, retries, progress, options, stats))
             results = {tuple(s): results[tuple(s)] for s in shards}
         with status(f"ray bake: merging {len(results)} shards", progress=progress):
             take = merge_takes([(r.members, r.take) for r in results.values()])
@@ -279,13 +284,13 @@ def _run_all(
     work: WorkFolder,
     retries: int,
     progress: bool,
-    allow: bool,
+    options: WorldOptions,
     stats: RayStats,
 ) -> dict[tuple[int, ...], ShardResult]:
     import ray
 
     results: dict[tuple[int, ...], ShardResult] = {}
-    keys = {tuple(s): shard_key(plan, s, allow) for s in shards}
+    keys = {tuple(s): shard_key(plan, s, options.allow_systems) for s in shards}
     number = {tuple(s): i for i, s in enumerate(shards)}
     for shard in shards:
         label = _label(plan, number[tuple(shard)], shard)
@@ -297,7 +302,7 @@ def _run_all(
     task = ray.remote(num_cpus=1, max_retries=retries, retry_exceptions=True)(_run_shard)
     plan_ref = ray.put(plan)
     pending = {
-        task.remote(plan_ref, s, keys[tuple(s)], counter, allow): tuple(s)
+        task.remote(plan_ref, s, keys[tuple(s)], counter, options): tuple(s)
         for s in shards
         if tuple(s) not in results
     }

@@ -25,6 +25,7 @@ import numpy as np
 
 from ecs_tentacles.distributed.spheres import ContactSpheres
 from ecs_tentacles.export.bake import BakePlan, bake
+from ecs_tentacles.options import WorldOptions
 from ecs_tentacles.take import Take
 
 CRASH_DIR = "ECS_TENTACLES_CRASH_DIR"
@@ -45,21 +46,20 @@ def bake_shard(
     plan: BakePlan,
     members: list[int],
     key: str = "",
+    options: WorldOptions | None = None,
     *,
-    allow_systems: bool = False,
     on_steps: Callable[[int], None] | None = None,
 ) -> ShardResult:
-    """Bake creatures `members` of `plan`'s scene; `key` names the shard (test hook)."""
+    """Bake creatures `members` of `plan`'s scene with `options` (the code it may import),
+    on one thread; `key` names the shard (test hook)."""
     _crash_if_asked(key)
     started, cpu = time.perf_counter(), time.process_time()
     spheres = ContactSpheres(plan.steps)
     take = bake(
         plan,
+        (options or WorldOptions()).but(threads=1, only=frozenset(members)),
         progress=False,
-        allow_systems=allow_systems,
         on_world=lambda world: world.add_systems(spheres),
-        threads=1,
-        only=set(members),
         on_steps=on_steps,
     )
     wall, cpu = time.perf_counter() - started, time.process_time() - cpu

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Callable, Collection
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -27,6 +27,7 @@ from ecs_tentacles.export.glb_size import GlbSize, glb_note, glb_problem, glb_si
 from ecs_tentacles.export.kinds import output_kind
 from ecs_tentacles.export.recording import Recording, scene_sha256
 from ecs_tentacles.export.take_size import NPY_HEADERS, TakeSize, take_size
+from ecs_tentacles.options import WorldOptions
 from ecs_tentacles.output.progress import status, step_frames
 from ecs_tentacles.scene.load import load_scene_plugins, resolve_scene_path
 from ecs_tentacles.scene.plugins import builtin
@@ -84,18 +85,22 @@ class BakePlan:
     def make(
         cls,
         scene: str | os.PathLike[str] | dict[str, Any],
+        options: WorldOptions | None = None,
         *,
         seconds: float,
         fps: float | None = None,
-        seed: int | None = None,
-        allow_systems: bool = False,
-        scene_dir: str | os.PathLike[str] | None = None,
+        **deprecated: Any,
     ) -> BakePlan:
         """Load and validate `scene` (SceneError if bad) and work out the frame rates.
 
-        `allow_systems` lets the scene's plugins from files or modules be imported; those
-        of a dict scene are found in `scene_dir` (default: the current folder).
+        `options` (`ecs_tentacles.options.WorldOptions`): `seed` over the scene's;
+        `allow_systems` lets the scene's plugins from files or modules be imported, those
+        of a dict scene found in `scene_dir` (default: the current folder); `lod` and
+        `focus` are written into the plan's scene (the take's scene hash sees them).
+        (`seed=`, `allow_systems=`, `scene_dir=` as keywords: deprecated.)
         """
+        options = (options or WorldOptions()).given(deprecated, "BakePlan.make")
+        allow_systems, seed, scene_dir = options.allow_systems, options.seed, options.scene_dir
         # absolute: a Ray worker runs in a folder of its own (distributed.driver)
         folder = str(Path(os.getcwd() if scene_dir is None else scene_dir).resolve())
         if isinstance(scene, dict):
@@ -116,7 +121,7 @@ class BakePlan:
             scene_fps, take_fps, int(data["physics"]["substeps"])
         )
         return cls(
-            scene=data,
+            scene=options.scene_with_lod(data),
             source=source,
             seconds=float(seconds),
             fps=take_fps,
@@ -228,24 +233,16 @@ class BakePlan:
         """Hash of the scene as loaded (before a frame-rate change for the bake)."""
         return scene_sha256(self.scene)
 
-    def world(
-        self,
-        *,
-        allow_systems: bool = False,
-        threads: int | None = None,
-        only: Collection[int] | None = None,
-    ) -> World:
-        """Build the world to bake, at the simulation frame rate (`only`: see `World`)."""
+    def world(self, options: WorldOptions | None = None) -> World:
+        """Build the world to bake, at the simulation frame rate, with `options`' code
+        allowed, threads and creatures (`only`); the plan's seed, and its scene's level
+        of detail (`make` wrote the options' there)."""
         scene = dict(self.scene)
         scene["physics"] = {**scene["physics"], "fps": self.sim_fps, "substeps": self.substeps}
-        return World.from_scene(
-            scene,
-            seed=self.seed,
-            allow_systems=allow_systems,
-            threads=threads,
-            only=only,
-            scene_dir=self.folder,
+        own = (options or WorldOptions()).but(
+            seed=self.seed, scene_dir=self.folder, lod=None, focus=None
         )
+        return World.from_scene(scene, own)
 
 
 MAX_SUBSTEPS = 100  # the schema's physics.substeps maximum
@@ -281,23 +278,24 @@ def simulation_rate(scene_fps: float, take_fps: float, substeps: int) -> tuple[i
 
 def bake(
     plan: BakePlan,
+    options: WorldOptions | None = None,
     *,
     progress: bool = True,
-    allow_systems: bool = False,
     on_world: Callable[[World], None] | None = None,
-    threads: int | None = None,
-    only: Collection[int] | None = None,
     on_steps: Callable[[int], None] | None = None,
+    **deprecated: Any,
 ) -> Take:
     """Run the plan and return the take; a tqdm bar with ETA goes to stderr when `progress`.
 
-    `on_world(world)` is called once the world is built (tests use it to add systems).
-    `threads` steps the physics groups on that many threads; `only` bakes just the
-    creatures at those scene indices (a shard); `on_steps(n)` is told of every `n`
-    frames simulated.
+    `options` build the world (`BakePlan.world`: code allowed, `threads` stepping the
+    physics groups, `only` the creatures at those scene indices: a shard).
+    `on_world(world)` is called once the world is built (tests use it to add systems);
+    `on_steps(n)` is told of every `n` frames simulated. (`allow_systems=`, `threads=`,
+    `only=` as keywords: deprecated.)
     """
+    options = (options or WorldOptions()).given(deprecated, "bake")
     with status("bake: building the world", progress=progress):
-        world = plan.world(allow_systems=allow_systems, threads=threads, only=only)
+        world = plan.world(options)
     try:
         if on_world is not None:
             on_world(world)
@@ -316,21 +314,22 @@ def bake(
 def bake_to_file(
     plan: BakePlan,
     out: str | os.PathLike[str],
+    options: WorldOptions | None = None,
     *,
     progress: bool = True,
-    allow_systems: bool = False,
     on_world: Callable[[World], None] | None = None,
-    threads: int | None = None,
     accept: Callable[[dict[str, Any]], bool] | None = None,
+    **deprecated: Any,
 ) -> dict[str, Any] | None:
     """Run the plan, writing the take to `out` as the frames come (`take.writer`: a
     chunk of frames held at a time, so memory does not grow with the shot); returns the
     header written. Stopped (an exception, Ctrl-C), it leaves no file and no chunks;
-    `accept(header)` False at the end: no file either, and None."""
+    `accept(header)` False at the end: no file either, and None. `options`: as `bake`."""
     from ecs_tentacles.take.writer import TakeWriter
 
+    options = (options or WorldOptions()).given(deprecated, "bake_to_file")
     with status("bake: building the world", progress=progress):
-        world = plan.world(allow_systems=allow_systems, threads=threads)
+        world = plan.world(options)
     try:
         if on_world is not None:
             on_world(world)

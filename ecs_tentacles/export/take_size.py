@@ -148,7 +148,7 @@ def _shape_of(mantle: Mapping[str, Any], params: Mapping[str, Any]) -> tuple[Any
 
 
 def _creature_entries(
-    c: int, creature: Mapping[str, Any], every: list[dict[str, Any]], first: int
+    c: int, creature: Mapping[str, Any], every: Sequence[Mapping[str, Any]], first: int
 ) -> tuple[int, int, int, int]:
     """(bytes of creature `c`'s entry, of its bodies', of its suckers', the next
     creature's first body), its mantle being body `first`."""

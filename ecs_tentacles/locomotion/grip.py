@@ -33,7 +33,8 @@ def sucker_points(world: Host, rows: np.ndarray | None = None) -> np.ndarray:
     suckers, transforms = world.suckers, world.transforms
     links = suckers.link_row if rows is None else suckers.link_row[rows]
     offset = suckers.offset if rows is None else suckers.offset[rows]
-    return transforms.pos[links] + quat_rotate(transforms.quat[links], offset)
+    points: np.ndarray = transforms.pos[links] + quat_rotate(transforms.quat[links], offset)
+    return points
 
 
 def attach(world: Host, sucker_entity: int) -> None:

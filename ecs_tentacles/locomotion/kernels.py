@@ -48,7 +48,8 @@ def _pitch(
     arc: np.ndarray,
 ) -> float:
     """Link `link`'s pose pitch: its tentacle's arch, lift and droop ramp at its arc."""
-    return arch * arch_shape[link] + lift + droop * arc[link]
+    pitch: float = arch * arch_shape[link] + lift + droop * arc[link]
+    return pitch
 
 
 @njit(cache=True, nogil=True)

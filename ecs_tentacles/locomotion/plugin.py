@@ -143,7 +143,8 @@ class LocomotionPlugin(Plugin):
 
     def _wants_motion(self, world: Host) -> np.ndarray:
         """Creatures with a goal crawl: they never fall asleep."""
-        return world.resource(LocomotionStores).creatures.has_goal
+        wants: np.ndarray = world.resource(LocomotionStores).creatures.has_goal
+        return wants
 
     def _travel_targets(self, world: Host) -> np.ndarray:
         """Creatures crawl toward their current goal (or the waypoint on the way to it),

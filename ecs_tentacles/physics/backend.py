@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import functools
 import os
+import warnings
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
@@ -34,7 +35,7 @@ import numpy as np
 from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.numeric.optional_kernels import OptionalKernels
 from ecs_tentacles.physics import heap
-from ecs_tentacles.physics.bare import BareFrame, step_recorded
+from ecs_tentacles.physics.bare import BareFrame, step_captured
 from ecs_tentacles.physics.batch import Batch
 from ecs_tentacles.physics.blas import quiet_blas
 from ecs_tentacles.physics.health import SOFT_GAIN, HealthCheck, HealthState
@@ -107,9 +108,9 @@ class PhysicsBackend(Membership):
                 transform = creatures[i][1][1]
                 batch.place(row, np.array(transform.pos), np.array(transform.quat))
         self.compiles = len(self.batches)
-        self.group_of_creature_row = np.zeros(0, dtype=np.int64)
-        self.groups = CreatureViews(self.roster)
-        self._index_groups(len(world.creatures))
+        self.view_of_creature_row = np.zeros(0, dtype=np.int64)
+        self.views = CreatureViews(self.roster)
+        self._index_views(len(world.creatures))
         self.proxies = ContactProxies(roster)
         self.health = HealthCheck(world, roster, self.proxies)
         self.sleep = Sleep(roster)
@@ -135,12 +136,12 @@ class PhysicsBackend(Membership):
     proxies_used = property(lambda self: self.roster.proxies_used)
     tier = property(lambda self: self.roster.tier)
 
-    def _index_groups(self, creature_rows: int) -> None:
+    def _index_views(self, creature_rows: int) -> None:
         """Each creature's `CreatureView`, and where to find it by creature-store row."""
         roster = self.roster
-        self.groups = CreatureViews(roster)
-        self.group_of_creature_row = np.full(creature_rows, -1, dtype=np.int64)
-        self.group_of_creature_row[roster.creature_row] = np.arange(len(roster))
+        self.views = CreatureViews(roster)
+        self.view_of_creature_row = np.full(creature_rows, -1, dtype=np.int64)
+        self.view_of_creature_row[roster.creature_row] = np.arange(len(roster))
 
     def rebuild_models(self, world: PhysicsHost) -> None:
         """Compile every morphology's model again (the static ground changed: terrain
@@ -394,12 +395,12 @@ class PhysicsBackend(Membership):
                 future.result()
 
     def step_bare(self, frame: BareFrame, substeps: int) -> None:
-        """Step `frame`'s rows (recorded by `physics.bare.Recorder`) with MuJoCo alone on
+        """Step `frame`'s rows (captured by `physics.bare.FrameCapture`) with MuJoCo alone on
         this pool: nothing of the framework and nothing of the world's state, so the
         framework's cost is a frame minus this. `frame` can be stepped again."""
         segments = plan(self.batches, frame.active, frame.tier, self.threads)
         steps = {FULL: substeps, REDUCED: reduced_substeps(substeps)}
-        self._dispatch(step_recorded, segments, frame, steps)
+        self._dispatch(step_captured, segments, frame, steps)
 
     def sync(self, transforms: TransformStore) -> None:
         """Copy every body's world pose into the Transform store (one scatter per batch)."""
@@ -411,9 +412,25 @@ class PhysicsBackend(Membership):
     def substep_dt(self) -> float:
         return float(self.batches[0].model.opt.timestep) if self.batches else 0.0
 
-    def group_of(self, creature: Creature) -> CreatureView:
+    def view_of(self, creature: Creature) -> CreatureView:
         """The physics of `creature` (its batch, row and ids)."""
-        return self.groups[int(self.group_of_creature_row[creature.row])]
+        return self.views[int(self.view_of_creature_row[creature.row])]
+
+    # -- names kept for scripts written before views had their name -------------------
+    def group_of(self, creature: Creature) -> CreatureView:
+        """Deprecated: `view_of` (a creature's physics is a view, not a group)."""
+        warnings.warn(
+            "physics.group_of is deprecated: use physics.view_of", DeprecationWarning, stacklevel=2
+        )
+        return self.view_of(creature)
+
+    @property
+    def groups(self) -> CreatureViews:
+        """Deprecated: `views` (each creature's `CreatureView`)."""
+        warnings.warn(
+            "physics.groups is deprecated: use physics.views", DeprecationWarning, stacklevel=2
+        )
+        return self.views
 
     @property
     def bodies(self) -> int:

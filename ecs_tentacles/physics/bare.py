@@ -1,15 +1,15 @@
 """MuJoCo alone on the framework's own inputs: what a frame's stepping costs without
 the framework (benchmarks, `ecs_tentacles.cli.measure`).
 
-`Recorder(world.physics)` calls `record(physics)` just before each frame's step (until
+`FrameCapture(world.physics)` calls `capture(physics)` just before each frame's step (until
 `close()`), which copies what that step will read of every row it steps: the state (a
 REDUCED row's reduced state, fitted or with the frame's inputs pulled in as its step
 will), the overlay (servo gains, torque limits, sucker anchors, proxy sizes) and the
-forces scripts apply. `step_recorded` (`PhysicsBackend.step_bare`) later steps those
+forces scripts apply. `step_captured` (`PhysicsBackend.step_bare`) later steps those
 copies with MuJoCo alone on the backend's threads (overlay into the thread's scratch
 model, `mj_setState`, `mj_step`, `mj_getState`; into `after` when the frame was
-recorded with `keep`, else into a scratch vector), shares handed out as the
-framework's are. A recorded frame can be stepped again and again: its inputs are never
+captured with `keep`, else into a scratch vector), shares handed out as the
+framework's are. A captured frame can be stepped again and again: its inputs are never
 written.
 
 So a bare frame does the framework frame's very work: the same states, contacts and
@@ -40,7 +40,7 @@ if TYPE_CHECKING:
 
 
 class Stepped(Protocol):
-    """What `record` reads of the physics (`PhysicsBackend`)."""
+    """What `capture` reads of the physics (`PhysicsBackend`)."""
 
     batches: list[Batch]
     threads: int
@@ -53,7 +53,7 @@ class Stepped(Protocol):
 
 
 class Steps(Stepped, Protocol):
-    """The physics a `Recorder` follows: what `record` reads, and its step."""
+    """The physics a `FrameCapture` follows: what `capture` reads, and its step."""
 
     def step(
         self,
@@ -65,9 +65,9 @@ class Steps(Stepped, Protocol):
 
 
 @dataclass
-class RecordedRows:
+class CapturedRows:
     """Some rows of one batch at one tier as its step will read them (the `Rows` the
-    overlay writers read: per recorded row, in `rows` order)."""
+    overlay writers read: per captured row, in `rows` order)."""
 
     rows: np.ndarray  # the batch's rows, ascending
     states: np.ndarray  # the state each step starts from (the tier's model's layout)
@@ -81,7 +81,7 @@ class RecordedRows:
     proxy_geoms: np.ndarray  # the batch's
     equality_ids: np.ndarray  # the batch's
     forces: dict[int, np.ndarray] = field(default_factory=dict)  # by position: xfrc_applied
-    after: np.ndarray | None = None  # the steps' results (recorded with `keep`)
+    after: np.ndarray | None = None  # the steps' results (captured with `keep`)
 
 
 @dataclass(frozen=True)
@@ -90,16 +90,16 @@ class BareFrame:
 
     active: np.ndarray  # per creature (backend order)
     tier: np.ndarray
-    rows: list[dict[int, RecordedRows]]  # per batch, per stepped tier
+    rows: list[dict[int, CapturedRows]]  # per batch, per stepped tier
 
 
-def record(backend: Stepped, keep: bool = False) -> BareFrame:
+def capture(backend: Stepped, keep: bool = False) -> BareFrame:
     """What `backend.step` would read now, copied (call it just before the step); with
-    `keep`, room for the bare steps' results (`RecordedRows.after`)."""
+    `keep`, room for the bare steps' results (`CapturedRows.after`)."""
     active, tier = backend.active.copy(), backend.tier.copy()
-    per_batch: list[dict[int, RecordedRows]] = []
+    per_batch: list[dict[int, CapturedRows]] = []
     for batch in backend.batches:
-        recorded: dict[int, RecordedRows] = {}
+        captured: dict[int, CapturedRows] = {}
         for level in (FULL, REDUCED):
             rows = np.flatnonzero(active[batch.members] & (tier[batch.members] == level))
             if not len(rows):
@@ -113,21 +113,21 @@ def record(backend: Stepped, keep: bool = False) -> BareFrame:
             if level == REDUCED and applied:
                 assert batch.reduced is not None
                 applied = {p: batch.reduced.body_group @ f for p, f in applied.items()}
-            recorded[level] = RecordedRows(
+            captured[level] = CapturedRows(
                 rows, states, batch.kp[rows].copy(), batch.kv[rows].copy(),
                 batch.torque[rows].copy(), batch.anchor[rows].copy(), batch.near[rows].copy(),
                 batch.proxy_size[rows].copy(), batch.proxy_cylinder, batch.proxy_geoms,
                 batch.equality_ids, {p: f.copy() for p, f in applied.items()},
                 np.zeros_like(states) if keep else None,
             )  # fmt: skip
-        per_batch.append(recorded)
+        per_batch.append(captured)
     return BareFrame(active, tier, per_batch)
 
 
-class Recorder:
-    """Records each frame's stepping inputs (`record`) just before `physics` steps it,
-    by wrapping its `step` until `close()`; `seconds` is what the recording took (the
-    bench takes it out of the framework's time). `keep`: as in `record`."""
+class FrameCapture:
+    """Captures each frame's stepping inputs (`capture`) just before `physics` steps it,
+    by wrapping its `step` until `close()`; `seconds` is what the capture took (the
+    bench takes it out of the framework's time). `keep`: as in `capture`."""
 
     def __init__(self, physics: Steps, keep: bool = False) -> None:
         self.physics = physics
@@ -135,16 +135,16 @@ class Recorder:
         self.seconds = 0.0
         step = physics.step
 
-        def recorded_step(*args: Any, **kwargs: Any) -> None:
+        def capturing_step(*args: Any, **kwargs: Any) -> None:
             began = time.perf_counter()
-            self.frames.append(record(physics, keep))
+            self.frames.append(capture(physics, keep))
             self.seconds += time.perf_counter() - began
             step(*args, **kwargs)
 
-        physics.step = recorded_step  # type: ignore[method-assign]
+        physics.step = capturing_step  # type: ignore[method-assign]
 
     def close(self) -> None:
-        """Stop recording: `physics.step` is its class's again."""
+        """Stop capturing: `physics.step` is its class's again."""
         del self.physics.step
 
 
@@ -166,37 +166,37 @@ def _reduced_states(backend: Stepped, index: int, rows: np.ndarray) -> np.ndarra
     return out
 
 
-def step_recorded(work: Work, frame: BareFrame, substeps: dict[int, int], thread: int) -> None:
+def step_captured(work: Work, frame: BareFrame, substeps: dict[int, int], thread: int) -> None:
     """Step shares of `frame`'s rows taken from `work` with MuJoCo alone on scratch
     `thread`, each by its tier's `substeps`, results into `after` if kept (runs on each
     thread of a dispatch)."""
     while (segment := work.take()) is not None:
         batch = segment.batch
-        recorded = frame.rows[batch.index][segment.tier]
+        captured = frame.rows[batch.index][segment.tier]
         scratch = batch.scratch_for(thread, segment.tier)
         m, d, n = scratch.model, scratch.data, substeps[segment.tier]
         reduced = batch.reduced if segment.tier == REDUCED else None
-        kept = recorded.after
-        out = kept if kept is not None else np.empty((1, recorded.states.shape[1]))
+        kept = captured.after
+        out = kept if kept is not None else np.empty((1, captured.states.shape[1]))
         if scratch.forced:  # the framework's last step there applied forces
             d.xfrc_applied[:] = 0.0
             scratch.forced = False
-        positions = np.searchsorted(recorded.rows, segment.rows)
+        positions = np.searchsorted(captured.rows, segment.rows)
         servos = None  # as `Batch._step_reduced` forms them: for all at once
         if reduced is not None:
             servos = reduced.servos(
-                recorded.kp[positions], recorded.kv[positions], recorded.torque[positions]
+                captured.kp[positions], captured.kv[positions], captured.torque[positions]
             )
         for at, position in enumerate(positions.tolist()):
             split = 1
             if reduced is not None and servos is not None:
-                split = reduced.write_overlay(recorded, m, position, servos, at)
+                split = reduced.write_overlay(captured, m, position, servos, at)
             else:
-                write_overlay(recorded, m, position)
-            forces = recorded.forces.get(position)
+                write_overlay(captured, m, position)
+            forces = captured.forces.get(position)
             if forces is not None:
                 d.xfrc_applied[:] = forces
-            mujoco.mj_setState(m, d, recorded.states[position], STATE)
+            mujoco.mj_setState(m, d, captured.states[position], STATE)
             mujoco.mj_step(m, d, nstep=n * split)
             mujoco.mj_getState(m, d, out[position if kept is not None else 0], STATE)
             if forces is not None:

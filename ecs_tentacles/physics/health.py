@@ -1,7 +1,7 @@
 """Physics health: find every blow-up, put the creature back, tell the truth.
 
 Each frame, after the step and before poses reach the Transform store, every active
-group is checked:
+creature is checked:
 
 * a fatal MuJoCo error in the step (a blown-up state overflowing the arena);
 * any MuJoCo warning counted since the last frame (bad qacc, qpos, qvel or ctrl,

@@ -1,6 +1,6 @@
 """What the physics package needs of a world, and nothing more.
 
-The physics (model building, groups, health check, sleep) is written against this
+The physics (model building, batches, health check, sleep) is written against this
 `typing.Protocol`, not against `ecs_tentacles.world.World`: the World satisfies it
 structurally, and the physics package never imports the module that builds on it.
 """

@@ -68,7 +68,7 @@ class Membership:
     sleep: Sleep
     lod: LevelOfDetail
 
-    def _index_groups(self, creature_rows: int) -> None: ...
+    def _index_views(self, creature_rows: int) -> None: ...
 
     def add_creature(self, world: PhysicsHost, entity: int) -> int:
         """Give the just-built creature `entity` its physics, at its built pose: a row in
@@ -97,7 +97,7 @@ class Membership:
         self.health.grow(batch.index, batch.state[row], poses, self.proxies)
         self.sleep.grow(batch.index, 2 * batch.model.nu)
         self.lod.grow()
-        self._index_groups(len(world.creatures))
+        self._index_views(len(world.creatures))
         return index
 
     def remove_creature(
@@ -123,4 +123,4 @@ class Membership:
         self.health.remove(index, batch.index, row, kept, self.proxies)
         self.sleep.remove(index, batch.index, row)
         self.lod.remove(index)
-        self._index_groups(len(world.creatures))
+        self._index_views(len(world.creatures))

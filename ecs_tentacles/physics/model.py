@@ -1,6 +1,6 @@
 """One creature's entities -> a MuJoCo model built in code with `mujoco.MjSpec`.
 
-Every creature is its own physics group (`ecs_tentacles.physics.group`): a model
+Every creature has its own model (its state a row of a batch, `physics.batch`): a model
 holding that creature alone, built at the origin and placed by its free joint, so
 creatures of one morphology share one compiled model (`model_layout(...).key` says which
 ones match; the backend compiles each key once and copies the compiled model).

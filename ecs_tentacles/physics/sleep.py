@@ -1,4 +1,4 @@
-"""Idle creatures sleep: their group is not stepped until something changes.
+"""Idle creatures sleep: their row is not stepped until something changes.
 
 A creature falls asleep after `SETTLE_FRAMES` frames in which no plugin wanted it to
 move (the `MotionWants` entries: the locomotion plugin wants creatures with a goal), no

@@ -1,6 +1,6 @@
 """One creature's physics, seen through its batch's arrays (for scripts, tools and tests).
 
-    view = world.physics.group_of(creature)     # or world.physics.groups[i]
+    view = world.physics.view_of(creature)     # or world.physics.views[i]
     view.data.qvel[:6]                          # its free joint's velocity (a view)
     view.data.xfrc_applied[view.body_ids[0], 2] = 50.0   # push its mantle up
 
@@ -189,7 +189,7 @@ class CreatureView:
 
 
 class CreatureViews(Sequence[CreatureView]):
-    """`physics.groups`: each creature's `CreatureView`, by roster index, made when asked
+    """`physics.views`: each creature's `CreatureView`, by roster index, made when asked
     (a spawn or despawn into a big crowd makes none)."""
 
     def __init__(self, roster: Roster):

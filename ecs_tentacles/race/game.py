@@ -109,7 +109,8 @@ class RaceGame:
 
     def at_flag(self, xy: np.ndarray) -> np.ndarray:
         """(n,) bool: points (n, 2+) inside the flag's ring."""
-        return np.hypot(*(np.asarray(xy)[:, :2] - self.flag).T) < self.radius
+        inside: np.ndarray = np.hypot(*(np.asarray(xy)[:, :2] - self.flag).T) < self.radius
+        return inside
 
     def summary(self) -> dict[str, Any]:
         """The race as a report gives it."""

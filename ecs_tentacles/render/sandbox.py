@@ -47,6 +47,7 @@ from tqdm import tqdm
 
 from ecs_tentacles.components import Creature
 from ecs_tentacles.ground import ground_of
+from ecs_tentacles.options import WorldOptions
 from ecs_tentacles.render.camera import CameraChoice
 from ecs_tentacles.render.gui import Gui, same_line_if_fits, text_width
 from ecs_tentacles.render.hud import Hud
@@ -87,38 +88,31 @@ class Sandbox(SandboxPicture):
     def __init__(
         self,
         scene: str | os.PathLike[str] | dict[str, Any],
+        options: WorldOptions | None = None,
         *,
         width: int = 1280,
         height: int = 720,
         headless: bool = False,
-        seed: int | None = None,
-        allow_systems: bool = False,
         hud: bool = True,
-        lod: bool | None = None,
-        focus: tuple[float, float, float] | None = None,
-        threads: int | None = None,
         palette: str | None = None,
         clean: bool | None = None,
+        **deprecated: Any,
     ):
-        """`lod` turns level of detail on or off over the scene's (None: the scene's);
-        `focus` (x, y, radius in m) pins the full-physics region instead of the camera's;
-        `threads` step the physics (None: one per core); `palette` colours the creatures
+        """`options` build its worlds (`ecs_tentacles.options.WorldOptions`: seed, code
+        allowed, threads, level of detail; a `focus` pins the full-physics region instead
+        of the camera's); `palette` colours the creatures
         ("natural" or "debug": `ecs_tentacles.skin.colours`; None: the scene's `render.palette`,
         natural if it says none); `clean` starts in the clean view, without the editor's
-        overlays (None: a game's scene, one with a `game` key, starts clean; o toggles)."""
+        overlays (None: a game's scene, one with a `game` key, starts clean; o toggles).
+        (`seed=`, `lod=`... as keywords: deprecated, `WorldOptions.given`.)"""
+        options = (options or WorldOptions()).given(deprecated, "Sandbox")
         self.headless = headless
         self.window = pyglet.window.Window(
             width, height, caption="ecs_tentacles", visible=not headless, vsync=False
         )
         # the simulation (world, rebuild, reset, stepping, saves): `render.session`
         self.session = SandboxSession(
-            scene,
-            seed=seed,
-            allow_systems=allow_systems,
-            lod=lod,
-            focus=focus,
-            threads=threads,
-            say=lambda ok, text: self.scripts.say(ok, text),
+            scene, options, say=lambda ok, text: self.scripts.say(ok, text)
         )
         # the clean view (`render.registries`: a picture for showing), kept across resets
         self.clean: bool = is_game(self.world.scene) if clean is None else clean

@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from ecs_tentacles.creatures.roster_save import save_roster
+from ecs_tentacles.options import WorldOptions
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.save import default_file_name
 from ecs_tentacles.snapshot import Snapshot, SnapshotMismatch
@@ -40,42 +41,34 @@ class SandboxSession:
     def __init__(
         self,
         scene: str | os.PathLike[str] | dict[str, Any],
+        options: WorldOptions | None = None,
         *,
-        seed: int | None = None,
-        allow_systems: bool = False,
-        lod: bool | None = None,
-        focus: tuple[float, float, float] | None = None,
-        threads: int | None = None,
         say: Callable[[bool, str], None] = lambda ok, text: None,
+        **deprecated: Any,
     ):
-        """`lod` turns level of detail on or off over the scene's (None: the scene's);
-        `focus` (x, y, radius in m) pins the full-physics region instead of the camera's;
-        `threads` step the physics (None: one per core)."""
-        self.scene, self.seed, self.allow_systems = scene, seed, allow_systems
-        self.lod, self.focus, self.threads = lod, focus, threads
+        """`options` build every world of the session (`ecs_tentacles.options`); their
+        `focus` (x, y, radius in m) pins the full-physics region instead of the camera's.
+        (`seed=`, `lod=`... as keywords: deprecated, `WorldOptions.given`.)"""
+        self.scene = scene
+        self.options = (options or WorldOptions()).given(deprecated, "SandboxSession")
         self.say = say
-        self.scene_dir: Path | None = None
         self.world = self.build(scene)
-        self.scene_dir = self.world.scene_dir  # plugin files of an edited (dict) scene
+        # plugin files of an edited (dict) scene are looked up where the first one's were
+        self.options = self.options.but(scene_dir=self.world.scene_dir)
         self.paused = False
         self.accumulator = 0.0
         self.saved_state: Snapshot | None = None
 
+    @property
+    def scene_dir(self) -> Path | None:
+        """The folder plugin files are looked up in (the first scene's)."""
+        return self.options.scene_dir
+
     # -- worlds ------------------------------------------------------------------------
     def build(self, scene: str | os.PathLike[str] | dict[str, Any]) -> World:
-        """A new world from `scene`, as this session builds them (its seed, threads,
-        level of detail and pinned focus)."""
-        world = World.from_scene(
-            scene,
-            seed=self.seed,
-            allow_systems=self.allow_systems,
-            scene_dir=self.scene_dir,
-            lod=self.lod,
-            threads=self.threads,
-        )
-        if self.focus is not None:
-            world.lod.focus(self.focus[:2], self.focus[2])
-        return world
+        """A new world from `scene`, as this session builds them (its options: seed,
+        threads, level of detail and pinned focus)."""
+        return World.from_scene(scene, self.options)
 
     def rebuild(self, scene: dict[str, Any]) -> World:
         """The world rebuilt from an edited scene (the old one closed); raises if it
@@ -103,7 +96,7 @@ class SandboxSession:
     @property
     def camera_focus(self) -> bool:
         """True when the level of detail's focus follows the camera (none is pinned)."""
-        return self.focus is None and self.world.lod.settings.focus is None
+        return self.options.focus is None and self.world.lod.settings.focus is None
 
     def steer_lod(self, target: np.ndarray, selected: Iterable[int], distance: float) -> None:
         """Tell the level of detail what the player looks at: the selected creatures run

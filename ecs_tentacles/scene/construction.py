@@ -19,13 +19,14 @@ build (`ecs_tentacles.creatures.body`) and the load-time physical checks
 from __future__ import annotations
 
 import functools
+from collections.abc import Mapping
 from dataclasses import dataclass, replace
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
 from ecs_tentacles.ground import FLAT, Ground
-from ecs_tentacles.scene.spec import CreatureSpec
+from ecs_tentacles.scene.spec import CreatureSpec, TentacleSettings, TentaclesSpec
 
 # metres between a creature placed on terrain and the surface (it settles in the first
 # steps); the plane needs none: its creatures start exactly resting
@@ -97,19 +98,29 @@ def tentacle_shape(
     return TentacleShape(scales=scales, lengths=lengths, radii=radii, centres=centres)
 
 
-def tentacle_params(tentacles: dict[str, Any], index: int) -> dict[str, Any]:
+def tentacle_params(tentacles: Mapping[str, Any], index: int) -> TentacleSettings:
     """The creature-wide tentacle settings with tentacle `index`'s overrides applied."""
     params = {key: tentacles[key] for key in tentacles if key != "overrides"}
     for override in tentacles.get("overrides", []):
         if override["index"] == index:
             params.update({k: v for k, v in override.items() if k != "index"})
-    return params
+    return cast(TentacleSettings, params)
 
 
-def resting_height(tentacles: dict[str, Any]) -> float:
+def every_tentacle_params(tentacles: TentaclesSpec) -> list[TentacleSettings]:
+    """`tentacle_params` of each tentacle; the tentacles no override names share one dict
+    (a layout's `params` are read, never written: a crowd keeps one per creature)."""
+    shared = tentacle_params(tentacles, -1)
+    overridden = {override["index"] for override in tentacles.get("overrides", [])}
+    return [
+        tentacle_params(tentacles, k) if k in overridden else shared
+        for k in range(tentacles["count"])
+    ]
+
+
+def resting_height(tentacles: TentaclesSpec) -> float:
     """Base height that lets the thickest first link rest on the ground."""
-    radii = [tentacle_params(tentacles, k)["link_radius"] for k in range(tentacles["count"])]
-    return float(max(radii))
+    return float(max(p["link_radius"] for p in every_tentacle_params(tentacles)))
 
 
 @dataclass(frozen=True)
@@ -121,8 +132,18 @@ class CreatureLayout:
     mantle_radius: float
     mantle_height: float
     angles: np.ndarray  # base angle of each tentacle in the creature frame
-    params: list[dict[str, Any]]  # each tentacle's settings, overrides applied
+    params: list[TentacleSettings]  # each tentacle's settings, overrides applied (read only)
     shapes: list[TentacleShape]
+    resting: bool = False  # placed by x, y alone: it rests on the ground under it
+
+    def on(self, ground: Ground) -> CreatureLayout:
+        """This layout (made on the plane) on `ground`: itself on the plane, or for a
+        creature placed at x, y, z; else raised until its lowest point rests on the
+        surface under it (plus `GROUND_CLEARANCE`)."""
+        if not self.resting or ground.extent is None:
+            return self
+        lift = ground.lift(*_resting_points(self)) + GROUND_CLEARANCE
+        return replace(self, origin=self.origin + [0.0, 0.0, lift])
 
     def axis(self, k: int) -> np.ndarray:
         """World-frame unit axis of tentacle `k`."""
@@ -155,13 +176,14 @@ def creature_layout(spec: CreatureSpec, ground: Ground = FLAT) -> CreatureLayout
 
     A 2-d `position` rests the creature on `ground`: on the plane its thickest first
     link touches z = 0; on terrain the whole body is raised until its lowest point
-    rests on the surface under it (plus `GROUND_CLEARANCE`).
+    rests on the surface under it (plus `GROUND_CLEARANCE`; `CreatureLayout.on`). A
+    load works each entry's out once (`ecs_tentacles.scene.layouts.Layouts`).
     """
     mantle, tentacles = spec["mantle"], spec["tentacles"]
+    params = every_tentacle_params(tentacles)
     position = [float(v) for v in spec["position"]]
-    if len(position) == 2:
-        position.append(resting_height(tentacles))
-    params = [tentacle_params(tentacles, k) for k in range(tentacles["count"])]
+    if len(position) == 2:  # resting on the plane: the thickest first link touches it
+        position.append(float(max(p["link_radius"] for p in params)))
     shapes = [
         tentacle_shape(
             mantle["radius"], p["link_length"], p["link_radius"], p["links"], p["end_scale"]
@@ -176,11 +198,9 @@ def creature_layout(spec: CreatureSpec, ground: Ground = FLAT) -> CreatureLayout
         angles=tentacle_angles(tentacles["count"]),
         params=params,
         shapes=shapes,
+        resting=len(spec["position"]) == 2,
     )
-    if len(spec["position"]) == 2 and ground.extent is not None:  # shaped: rest on it
-        lift = ground.lift(*_resting_points(layout)) + GROUND_CLEARANCE
-        layout = replace(layout, origin=layout.origin + [0.0, 0.0, lift])
-    return layout
+    return layout.on(ground)
 
 
 def _resting_points(layout: CreatureLayout) -> tuple[np.ndarray, np.ndarray]:
@@ -226,9 +246,10 @@ def creature_reach(creature: dict[str, Any]) -> float:
     radius = creature["mantle"]["radius"]
     longest, thickest = 0.0, 0.0
     for k in range(tentacles["count"]):
-        params = tentacle_params(tentacles, k)
-        keys = ("link_length", "link_radius", "links", "end_scale")
-        shape = tentacle_shape(radius, *(params[key] for key in keys))
+        p = tentacle_params(tentacles, k)
+        shape = tentacle_shape(
+            radius, p["link_length"], p["link_radius"], p["links"], p["end_scale"]
+        )
         longest = max(longest, float(shape.lengths.sum()))
         thickest = max(thickest, float(shape.radii.max()))
     return float(radius + longest + thickest)

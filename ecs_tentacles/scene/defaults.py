@@ -60,6 +60,12 @@ def _fill(value: Any, schema: Mapping[str, Any], root: Mapping[str, Any]) -> Non
             _fill(item, schema["items"], root)
 
 
+def fill(value: Any, schema: Mapping[str, Any], root: Mapping[str, Any]) -> None:
+    """Fill the defaults of `schema` (a part of the schema `root`, whose `$ref`s it may
+    use) into `value` in place (a spawned creature's entry: `validate.validated_creature`)."""
+    _fill(value, schema, root)
+
+
 def _merge_under(value: dict[str, Any], base: Mapping[str, Any]) -> None:
     """Copy into ``value`` every key of ``base`` it lacks, merging nested objects."""
     for key, item in base.items():

@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING, Any
 
 from ecs_tentacles.scene.defaults import plugin_config, with_defaults
 from ecs_tentacles.scene.errors import SceneError
+from ecs_tentacles.scene.layouts import Layouts
 from ecs_tentacles.scene.physical import physical_problems, physically_checked
 from ecs_tentacles.scene.plugins import resolve
 from ecs_tentacles.scene.validate import repaired, validated
@@ -140,11 +141,13 @@ def load_scene_plugins(
     *,
     allow_systems: bool = False,
     scene_dir: pathlib.Path | None = None,
+    layouts: Layouts | None = None,
 ) -> tuple[dict[str, Any], list[Plugin]]:
     """`load_scene`, and the plugins the scene turns on, configured (in build order).
 
     Plugins from a file are looked up in the scene's folder (`scene_dir` for a dict;
-    default: the current folder).
+    default: the current folder). The physical checks lay the creatures out in
+    `layouts` (the loader's, which the build then reuses).
     """
     if isinstance(source, dict):
         data: object = source
@@ -167,7 +170,7 @@ def load_scene_plugins(
         problems = plugin_problems + problems + _later_problems(data, problems, plugins)
         raise SceneError([prefix + problem for problem in problems])
     assert isinstance(data, dict) and completed is not None  # the schema requires an object
-    full = physically_checked(completed, prefix, on_plane(completed, plugins))
+    full = physically_checked(completed, prefix, on_plane(completed, plugins), layouts)
     for plugin in plugins:
         config = plugin_config(plugin, (data.get("plugins") or {}).get(plugin.key))
         plugin.config = {k: v for k, v in config.items() if k != "from"}

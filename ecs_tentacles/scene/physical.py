@@ -33,13 +33,13 @@ import numpy as np
 from ecs_tentacles.scene.construction import (
     CreatureLayout,
     capsule_mass_inertia,
-    creature_layout,
     cylinder_mass_inertia,
 )
 from ecs_tentacles.scene.errors import SceneError
+from ecs_tentacles.scene.layouts import Layouts
 from ecs_tentacles.scene.overlap import Bodies, Overlap, find_overlaps, separate
 from ecs_tentacles.scene.ranges import damping_floor
-from ecs_tentacles.scene.spec import CreatureSpec, creature_specs
+from ecs_tentacles.scene.spec import CreatureSpec, TentaclesSpec, creature_specs
 from ecs_tentacles.scene.validate import format_path
 
 log = logging.getLogger(__name__)
@@ -63,20 +63,25 @@ Path = tuple[str | int, ...]
 
 
 def physically_checked(
-    scene: dict[str, Any], prefix: str = "", plane: bool = True
+    scene: dict[str, Any],
+    prefix: str = "",
+    plane: bool = True,
+    layouts: Layouts | None = None,
 ) -> dict[str, Any]:
     """`scene` (creatures moved apart if it asks), or SceneError with every physical problem.
 
-    `prefix` starts each problem line (the loader passes `"<file>: "`); `plane`: as
-    `physical_problems`.
+    `prefix` starts each problem line (the loader passes `"<file>: "`); `plane` and
+    `layouts`: as `physical_problems`.
     """
-    problems = physical_problems(scene, plane)
+    problems = physical_problems(scene, plane, layouts)
     if problems:
         raise SceneError([prefix + problem for problem in problems])
     return scene
 
 
-def physical_problems(scene: dict[str, Any], plane: bool = True) -> list[str]:
+def physical_problems(
+    scene: dict[str, Any], plane: bool = True, layouts: Layouts | None = None
+) -> list[str]:
     """Every physical problem of a schema-valid scene (defaults filled in), one line each.
 
     `plane`: the ground under the creatures is the plane z = 0, so no part may start
@@ -86,27 +91,45 @@ def physical_problems(scene: dict[str, Any], plane: bool = True) -> list[str]:
     With `physics.separate_overlaps` true, overlapping creatures are moved apart by
     changing their `position` in `scene`; only a crowd that cannot be pulled apart is
     then a problem.
+
+    Each creature's layout comes from `layouts` (the load's: the build reuses them),
+    worked out there the first time.
     """
+    layouts = Layouts() if layouts is None else layouts
     physics = scene["physics"]
     problems: list[tuple[Path, str]] = _timestep_problems(physics) + _gravity_problems(physics)
-    bodies: list[Bodies] = []  # each creature's capsules; its layout is dropped (crowds)
+    bodies: list[Bodies] = []  # each creature's capsules
     for i, creature in enumerate(creature_specs(scene)):
-        layout = creature_layout(creature)
-        weights = [  # (links, 2) masses and inertias per tentacle, for both checks below
-            capsule_mass_inertia(shape.lengths, shape.radii, params["density"])
-            for params, shape in zip(layout.params, layout.shapes, strict=True)
-        ]
-        # a body too light says enough; its proportions would be refused too
-        problems += _light_bodies(i, creature, layout, weights) or _proportion_problems(
-            i, creature, layout, weights
-        )
-        problems += _servo_problems(i, creature, layout, _step(physics))
-        if plane:  # a plugin that shapes the ground checks its own
-            problems += _below_ground(i, layout)
-        bodies.append(Bodies(*layout.capsules()))
+        problems += creature_problems(("creatures", i), creature, physics, plane, layouts)
+        bodies.append(Bodies(*layouts.on_plane(creature).capsules()))
     if not problems:
         problems += _overlap_problems(scene, bodies)
     return [f"{format_path(path)}: {message}" for path, message in problems]
+
+
+def creature_problems(
+    where: Path,
+    creature: CreatureSpec,
+    physics: dict[str, Any],
+    plane: bool = True,
+    layouts: Layouts | None = None,
+) -> list[tuple[Path, str]]:
+    """The physical problems of one creature entry at `where` (`("creatures", 2)`) in a
+    scene of these `physics` settings: too light, needles, servos that shake, inside
+    the plane (`plane`; `physical_problems`). Its layout comes from `layouts`."""
+    layout = (Layouts() if layouts is None else layouts).on_plane(creature)
+    weights = [  # (links, 2) masses and inertias per tentacle, for both checks below
+        capsule_mass_inertia(shape.lengths, shape.radii, params["density"])
+        for params, shape in zip(layout.params, layout.shapes, strict=True)
+    ]
+    # a body too light says enough; its proportions would be refused too
+    problems = _light_bodies(where, creature, layout, weights) or _proportion_problems(
+        where, creature, layout, weights
+    )
+    problems += _servo_problems(where, creature, layout, _step(physics))
+    if plane:  # a plugin that shapes the ground checks its own
+        problems += _below_ground(where, layout)
+    return problems
 
 
 def _step(physics: dict[str, Any]) -> float:
@@ -148,16 +171,16 @@ def _gravity_problems(physics: dict[str, Any]) -> list[tuple[Path, str]]:
     return [(("physics", "gravity"), message)]
 
 
-def _tentacle_path(index: int, tentacles: dict[str, Any], k: int) -> Path:
+def _tentacle_path(where: Path, tentacles: TentaclesSpec, k: int) -> Path:
     """Where tentacle `k`'s shape comes from: its override if that sets one, else the creature."""
     for j, override in enumerate(tentacles["overrides"]):
         if override["index"] == k and any(key in override for key in SHAPE_KEYS):
-            return ("creatures", index, "tentacles", "overrides", j)
-    return ("creatures", index, "tentacles")
+            return (*where, "tentacles", "overrides", j)
+    return (*where, "tentacles")
 
 
 def _light_bodies(
-    index: int, creature: CreatureSpec, layout: CreatureLayout, weights: list[np.ndarray]
+    where: Path, creature: CreatureSpec, layout: CreatureLayout, weights: list[np.ndarray]
 ) -> list[tuple[Path, str]]:
     problems: list[tuple[Path, str]] = []
     mantle = creature["mantle"]
@@ -165,7 +188,7 @@ def _light_bodies(
     if mantle["height"] < MIN_FLATNESS * mantle["radius"]:
         problems.append(
             (
-                ("creatures", index, "mantle"),
+                (*where, "mantle"),
                 f"is too flat to simulate (height {mantle['height']:.2g} m, under"
                 f" {MIN_FLATNESS:g} x its radius {mantle['radius']:.2g} m); raise height",
             )
@@ -173,14 +196,14 @@ def _light_bodies(
     elif mass < MIN_MASS or inertia < MIN_INERTIA:
         problems.append(
             (
-                ("creatures", index, "mantle"),
+                (*where, "mantle"),
                 f"too light to simulate ({_weights(mass, inertia)});"
                 " raise radius, height or density",
             )
         )
     seen: set[Path] = set()
     for k, (shape, tentacle) in enumerate(zip(layout.shapes, weights, strict=True)):
-        path = _tentacle_path(index, creature["tentacles"], k)
+        path = _tentacle_path(where, creature["tentacles"], k)
         light = (tentacle[:, 0] < MIN_MASS) | (tentacle[:, 1] < MIN_INERTIA)
         short = shape.lengths < MIN_LENGTH
         if path in seen or not (light.any() or short.any()):
@@ -201,7 +224,7 @@ def _light_bodies(
 
 
 def _proportion_problems(
-    index: int, creature: CreatureSpec, layout: CreatureLayout, weights: list[np.ndarray]
+    where: Path, creature: CreatureSpec, layout: CreatureLayout, weights: list[np.ndarray]
 ) -> list[tuple[Path, str]]:
     problems: list[tuple[Path, str]] = []
     for k, params in enumerate(layout.params):
@@ -209,7 +232,7 @@ def _proportion_problems(
         if slender > MAX_SLENDERNESS:
             problems.append(
                 (
-                    _tentacle_path(index, creature["tentacles"], k),
+                    _tentacle_path(where, creature["tentacles"], k),
                     f"links {slender:.3g} times longer than their radius (at most"
                     f" {MAX_SLENDERNESS:g}) are needles, not tentacle links; shorten link_length"
                     " or thicken link_radius",
@@ -223,7 +246,7 @@ def _proportion_problems(
     if not 1.0 / MAX_MASS_RATIO <= ratio <= MAX_MASS_RATIO:
         problems.append(
             (
-                ("creatures", index, "mantle"),
+                (*where, "mantle"),
                 f"weighs {mantle_mass:.3g} kg against {tentacles:.3g} kg of tentacles; keep the"
                 f" ratio within {MAX_MASS_RATIO:g} either way (change the mantle's or the"
                 " tentacles' size or density)",
@@ -233,7 +256,7 @@ def _proportion_problems(
 
 
 def _servo_problems(
-    index: int, creature: CreatureSpec, layout: CreatureLayout, step: float
+    where: Path, creature: CreatureSpec, layout: CreatureLayout, step: float
 ) -> list[tuple[Path, str]]:
     problems: list[tuple[Path, str]] = []
     seen: set[Path] = set()
@@ -241,10 +264,10 @@ def _servo_problems(
         least = damping_floor(params["strength"], step)
         if params["damping"] >= least:
             continue
-        path: Path = ("creatures", index, "tentacles", "damping")
+        path: Path = (*where, "tentacles", "damping")
         for j, override in enumerate(creature["tentacles"]["overrides"]):
             if override["index"] == k and ("strength" in override or "damping" in override):
-                path = ("creatures", index, "tentacles", "overrides", j, "damping")
+                path = (*where, "tentacles", "overrides", j, "damping")
         if path in seen:
             continue
         seen.add(path)
@@ -267,7 +290,7 @@ def _weights(mass: float, inertia: float) -> str:
     )
 
 
-def _below_ground(index: int, layout: CreatureLayout) -> list[tuple[Path, str]]:
+def _below_ground(where: Path, layout: CreatureLayout) -> list[tuple[Path, str]]:
     thickest = max(float(shape.radii.max()) for shape in layout.shapes)
     lowest = layout.origin[2] - thickest
     if lowest >= -1e-9:
@@ -276,7 +299,7 @@ def _below_ground(index: int, layout: CreatureLayout) -> list[tuple[Path, str]]:
         f"the creature starts {_millimetres(-lowest)} inside the ground; give z >= {thickest:g}"
         " (its thickest link radius) or leave z out"
     )
-    return [(("creatures", index, "position"), message)]
+    return [((*where, "position"), message)]
 
 
 def _millimetres(metres: float) -> str:

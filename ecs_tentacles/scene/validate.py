@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any
 from jsonschema import ValidationError
 
 from ecs_tentacles.plugin import calling
-from ecs_tentacles.scene.defaults import nested, resolve, with_defaults
+from ecs_tentacles.scene.defaults import copied, fill, nested, resolve, with_defaults
 from ecs_tentacles.scene.json_validator import StrictValidator, validator_for
 from ecs_tentacles.scene.schema import builtin_keys, schema_for
 from ecs_tentacles.scene.shards import shard_problems
@@ -158,20 +158,27 @@ def _semantic_problems(scene: Mapping[str, Any]) -> list[Problem]:
             )
         else:
             seen_names[name] = i
-        tentacles = creature["tentacles"]
-        count = tentacles["count"]
-        seen_indices: dict[int, int] = {}
-        for j, override in enumerate(tentacles["overrides"]):
-            where: JsonPath = ("creatures", i, "tentacles", "overrides", j, "index")
-            index = override["index"]
-            if index >= count:
-                problems.append((where, f"must be < count ({count}), got {index}"))
-            if index in seen_indices:
-                first = format_path(("creatures", i, "tentacles", "overrides", seen_indices[index]))
-                problems.append((where, f"duplicate index {index} (also {first})"))
-            else:
-                seen_indices[index] = j
+        problems += _creature_rules(("creatures", i), creature)
     return problems + shard_problems(scene)
+
+
+def _creature_rules(where: JsonPath, creature: Mapping[str, Any]) -> list[Problem]:
+    """The rules of one creature entry the schema cannot express (its overrides' indices)."""
+    problems: list[Problem] = []
+    tentacles = creature["tentacles"]
+    count = tentacles["count"]
+    seen_indices: dict[int, int] = {}
+    for j, override in enumerate(tentacles["overrides"]):
+        path: JsonPath = (*where, "tentacles", "overrides", j, "index")
+        index = override["index"]
+        if index >= count:
+            problems.append((path, f"must be < count ({count}), got {index}"))
+        if index in seen_indices:
+            first = format_path((*where, "tentacles", "overrides", seen_indices[index]))
+            problems.append((path, f"duplicate index {index} (also {first})"))
+        else:
+            seen_indices[index] = j
+    return problems
 
 
 def _schema_problems(data: object, validator: Any, prefix: JsonPath = ()) -> list[Problem]:
@@ -265,6 +272,66 @@ def validated(
     return lines, None if lines else full
 
 
+def validated_creature(
+    entry: object, scene: Mapping[str, Any], plugins: Sequence[Plugin]
+) -> tuple[list[str], dict[str, Any] | None]:
+    """`entry` checked as one more creature of `scene` (validated, defaults in: a running
+    world's, with the creatures it has now), and the entry with its defaults filled in
+    when there are no problems (a spawn's: `ecs_tentacles.creatures.spawning`).
+
+    The entry alone is checked against the scene schema's creature, completed and held
+    to the creature rules; the plugins' checks (`Plugin.problems`, `SceneChecks`) see it
+    among the scene's creatures, in the scene's game and settings, and only what they
+    find in it is reported. Each problem is one line whose path starts at `creature`.
+    """
+    schema = schema_for(plugins)
+    items = resolve(schema["properties"]["creatures"]["items"], schema)
+    where: JsonPath = ("creatures", len(scene["creatures"]))
+    lines = _entry_lines
+    too_long = _limit_problems(entry, items, schema)
+    if too_long:
+        return lines([((*where, *path), message) for path, message in too_long]), None
+    deep = _too_deep(entry, where)
+    if deep is not None:
+        return lines([(deep, f"nested deeper than {MAX_DEPTH} levels")]), None
+    problems = _schema_problems(entry, validator_for(_entry_schema(schema)), where)
+    if problems or not isinstance(entry, dict):
+        return lines(_name_plugins_that_are_off(problems, {p.name for p in plugins})), None
+    completed = copied(entry)
+    fill(completed, items, schema)
+    problems = _creature_rules(where, completed)
+    if not problems:
+        among = {**scene, "creatures": [*scene["creatures"], completed]}
+        found: list[Problem] = []
+        for plugin in plugins:
+            with calling(plugin, "problems"):
+                found += plugin.problems(among)
+        found += registered_problems(among, plugins)
+        problems = [problem for problem in found if problem[0][: len(where)] == where]
+    return lines(problems), None if problems else completed
+
+
+def _entry_lines(problems: list[Problem]) -> list[str]:
+    """A spawned entry's problems, sorted, their paths starting at `creature`."""
+    unique = sorted(set(problems), key=_path_key)
+    return [format_path(("creature", *path[2:])) + f": {message}" for path, message in unique]
+
+
+def _entry_schema(schema: dict[str, Any]) -> dict[str, Any]:
+    """The schema of one creature entry of the assembled `schema` (its `$defs` along);
+    made once per assembled schema, so its validator is made once too."""
+    found = _ENTRY_SCHEMAS.get(id(schema))
+    if found is None or found[0] is not schema:
+        if len(_ENTRY_SCHEMAS) > 64:
+            _ENTRY_SCHEMAS.clear()
+        entry = {**schema["properties"]["creatures"]["items"], "$defs": schema.get("$defs", {})}
+        found = _ENTRY_SCHEMAS[id(schema)] = (schema, entry)
+    return found[1]
+
+
+_ENTRY_SCHEMAS: dict[int, tuple[dict[str, Any], dict[str, Any]]] = {}
+
+
 def repaired(data: object, plugins: Sequence[Plugin]) -> dict[str, Any] | None:
     """`data` with every value the schema refuses taken out (so its default applies) and
     unknown keys dropped: a scene the later stages (semantic and physical checks) can
@@ -337,9 +404,10 @@ def _name_plugins_that_are_off(problems: list[Problem], on: set[str]) -> list[Pr
     return named
 
 
-def _too_deep(data: object) -> JsonPath | None:
-    """The path of the first value nested deeper than `MAX_DEPTH`, or None (no recursion)."""
-    stack: list[tuple[JsonPath, object]] = [((), data)]
+def _too_deep(data: object, start: JsonPath = ()) -> JsonPath | None:
+    """The path of the first value nested deeper than `MAX_DEPTH`, or None (no recursion);
+    `data` sits at `start` in the scene."""
+    stack: list[tuple[JsonPath, object]] = [(start, data)]
     while stack:
         path, value = stack.pop()
         if len(path) > MAX_DEPTH:

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import copy
 import os
+from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -35,7 +36,7 @@ from ecs_tentacles.terrain.scene_ground import build_ground
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
 
-SHAPES = {  # a new obstacle of each shape: its keys, for a `size` of 1 m
+SHAPES: dict[str, Callable[[float], dict[str, Any]]] = {  # a new obstacle: its keys for `size`
     "box": lambda s: {"size": [s, s, 0.5 * s]},
     "cylinder": lambda s: {"radius": 0.5 * s, "height": 0.6 * s},
     "sphere": lambda s: {"radius": 0.5 * s},

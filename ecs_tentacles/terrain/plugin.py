@@ -23,9 +23,9 @@ from ecs_tentacles.ground import WorldGround, ground_of
 from ecs_tentacles.physics.model import StaticGeometry
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.render.registries import Panels
-from ecs_tentacles.scene.construction import creature_layout
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.schema import fragment
+from ecs_tentacles.scene.spec import as_spec
 from ecs_tentacles.terrain.editing import TerrainEditor
 from ecs_tentacles.terrain.heights import source_problems
 from ecs_tentacles.terrain.scene_ground import build_ground
@@ -93,7 +93,7 @@ class TerrainPlugin(Plugin):
             return
         problems = []
         for i, creature in enumerate(scene["creatures"]):
-            starts, ends, radii = creature_layout(creature, ground).capsules()
+            starts, ends, radii = world.layouts.on(as_spec(creature), ground).capsules()
             points = np.concatenate([starts, ends, 0.5 * (starts + ends)])
             balls = np.concatenate([radii, radii, radii])
             where = f"creatures[{i}].position: {creature['name']}"

@@ -11,7 +11,8 @@ import pytest
 
 from ecs_tentacles.cli.measure import bench, measure, timed
 from ecs_tentacles.creator.crowd import crowd_scene
-from ecs_tentacles.physics.bare import Recorder
+from ecs_tentacles.options import WorldOptions
+from ecs_tentacles.physics.bare import FrameCapture
 from ecs_tentacles.physics.tiers import FULL, REDUCED
 from ecs_tentacles.world import World
 
@@ -39,7 +40,7 @@ KEYS = [
 
 
 def test_bench_reports_every_key_finite() -> None:
-    result = bench(crowd_scene(2, seed=4), frames=4, threads=1, block=2, warmup=2)
+    result = bench(crowd_scene(2, seed=4), WorldOptions(threads=1), frames=4, block=2, warmup=2)
     assert list(result) == KEYS
     numbers = [v for k, v in result.items() if k not in ("systems", "tiers")]
     numbers += list(result["systems"].values())
@@ -113,11 +114,11 @@ def lod_crowd(n: int = 6, focus: bool = True) -> dict[str, Any]:
 
 def test_bench_reports_the_tiers_and_lod_off_runs_everyone_full() -> None:
     scene = lod_crowd()
-    on = bench(scene, frames=10, threads=1, block=2, warmup=2)
+    on = bench(scene, WorldOptions(threads=1), frames=10, block=2, warmup=2)
     assert on["lod"] is True
     assert on["tiers"] == {"full": 1, "reduced": 2, "kinematic": 3}
     assert on["demotions"] >= 5 and on["promotions"] >= 0
-    off = bench(scene, frames=10, threads=1, block=2, warmup=2, lod=False)
+    off = bench(scene, WorldOptions(threads=1, lod=False), frames=10, block=2, warmup=2)
     assert off["lod"] is False
     assert off["tiers"] == {"full": 6, "reduced": 0, "kinematic": 0}
     assert (off["promotions"], off["demotions"]) == (0, 0)
@@ -128,21 +129,23 @@ def test_the_bare_frames_step_the_tiers_the_framework_steps() -> None:
     of the two runs' times said so before, and failed on a busy machine: 0.75x.)"""
     with World.from_scene(lod_crowd(), threads=1) as world:
         world.step(12)  # the bench's warm-up and frames
-        recorder = Recorder(world.physics)
+        capture = FrameCapture(world.physics)
         try:
             world.step(1)
         finally:
-            recorder.close()
+            capture.close()
         assert world.lod.counts() == {"full": 1, "reduced": 2, "kinematic": 3}
-        (frame,) = recorder.frames
+        (frame,) = capture.frames
         stepped = {FULL: 0, REDUCED: 0}
-        for recorded in frame.rows:
-            for tier, rows in recorded.items():
+        for captured in frame.rows:
+            for tier, rows in captured.items():
                 stepped[tier] += len(rows.rows)
         assert stepped == {FULL: 1, REDUCED: 2}
 
 
 def test_a_focus_keeps_the_creatures_inside_it_full() -> None:
     scene = lod_crowd()
-    everyone = bench(scene, frames=2, threads=1, block=2, warmup=1, focus=(0.0, 0.0, 1000.0))
+    everyone = bench(
+        scene, WorldOptions(threads=1, focus=(0.0, 0.0, 1000.0)), frames=2, block=2, warmup=1
+    )
     assert everyone["tiers"] == {"full": 6, "reduced": 0, "kinematic": 0}

@@ -125,7 +125,7 @@ def fresh_world(octopus: dict[str, Any]) -> Iterator[World]:
 def _promote(world: World, qpos: np.ndarray, qvel: np.ndarray, bodies: list[str]) -> np.ndarray:
     """Set the creature's joint state in the full model and run forward kinematics; the
     bodies' world positions (B, 3)."""
-    group = world.physics.groups[0]
+    group = world.physics.views[0]
     world.physics.place_joints(group.index, qpos, qvel)  # as a promotion does
     world.physics.sync(world.transforms)
     ids = [mujoco.mj_name2id(group.model, mujoco.mjtObj.mjOBJ_BODY, b) for b in bodies]
@@ -160,7 +160,7 @@ def test_promoted_creature_steps_on(clips: GaitClips, fresh_world: World) -> Non
     qpos, qvel = clips.joint_state_at(CRAWL, 10.0, np.array([1.0, 2.0]), 0.7)
     before = _promote(fresh_world, qpos, qvel, clips.bodies)
     fresh_world.step(30)
-    after = np.array(fresh_world.transforms.pos[fresh_world.physics.groups[0].body_rows])
+    after = np.array(fresh_world.transforms.pos[fresh_world.physics.views[0].body_rows])
     assert np.isfinite(after).all()
     assert np.linalg.norm(after - before, axis=-1).max() < 0.5
 

@@ -33,7 +33,7 @@ def test_small_crowds_validate_build_and_run_stably(
     scene = crowd_scene(n, seed=n)
     assert len(load_scene(scene)["creatures"]) == n
     world = make_world(scene)
-    assert sum(len(group.creatures) for group in world.physics.groups) == n
+    assert sum(len(group.creatures) for group in world.physics.views) == n
     world.step(20)
     assert world.events.counts["creature_recovered"] == 0  # the physics never failed
     assert np.isfinite(world.transforms.pos).all()

@@ -95,7 +95,7 @@ def test_loading_the_export_builds_exactly_the_creature_shown(tmp_path: Path) ->
     assert len(_creature_numbers(shown)) == 61
     np.testing.assert_array_equal(shown.transforms.pos, loaded.transforms.pos)
     np.testing.assert_array_equal(shown.transforms.quat, loaded.transforms.quat)
-    m1, m2 = shown.physics.groups[0].model, loaded.physics.groups[0].model
+    m1, m2 = shown.physics.views[0].model, loaded.physics.views[0].model
     assert (m1.nbody, m1.njnt, m1.nu, m1.neq) == (m2.nbody, m2.njnt, m2.nu, m2.neq)
     np.testing.assert_array_equal(m1.geom_size, m2.geom_size)
     lengths = [link.length for link in (shown.component(e, Link) for e in _links(shown, 2))]

@@ -76,8 +76,8 @@ def test_every_link_has_a_motor_and_every_tip_a_sucker(make_world: Callable[...,
     assert len(links) == 7 * 10 + 3
     tips = {world.component(e, Tentacle).links[-1] for e, _ in world.query(Tentacle)}
     assert {s.link for _, s in world.query(Sucker)} == tips
-    model = world.physics.groups[0].model
-    assert (len(world.physics.groups[0].body_ids), model.nu, model.neq) == (1 + 73, 2 * 73, 8)
+    model = world.physics.views[0].model
+    assert (len(world.physics.views[0].body_ids), model.nu, model.neq) == (1 + 73, 2 * 73, 8)
 
 
 def test_suckers_along_the_tentacle(make_world: Callable[..., World]) -> None:
@@ -87,7 +87,7 @@ def test_suckers_along_the_tentacle(make_world: Callable[..., World]) -> None:
     }
     world = make_world(scene)
     assert len(world.suckers) == 12
-    assert world.physics.groups[0].model.neq == 12
+    assert world.physics.views[0].model.neq == 12
     assert not world.suckers.attached.any()
 
 
@@ -95,7 +95,7 @@ def test_twist_adds_a_third_hinge(make_world: Callable[..., World]) -> None:
     world = make_world(
         {"version": 1, "creatures": [{"tentacles": {"count": 3, "links": 2, "twist": True}}]}
     )
-    assert world.physics.groups[0].model.nu == 3 * 2 * 3
+    assert world.physics.views[0].model.nu == 3 * 2 * 3
 
 
 def test_heading_rotates_the_whole_creature(make_world: Callable[..., World]) -> None:

@@ -36,7 +36,7 @@ APART = [
 def _bodies(world: World, name: str) -> np.ndarray:
     """Every body pose of creature `name` (mantle then links), as one array."""
     creature = world.component(world.creature(name), Creature)
-    view = world.physics.group_of(creature)
+    view = world.physics.view_of(creature)
     rows = view.body_rows
     return np.concatenate([world.transforms.pos[rows], world.transforms.quat[rows]], axis=1)
 
@@ -94,7 +94,7 @@ def test_components_made_before_a_despawn_still_find_their_rows():
         assert np.array_equal(pose.pos, before)
         assert world.creatures.mantle_row[c.row] == pose.row
         world.step(5)  # the physics reads the renumbered rows
-        assert world.physics.group_of(c).creature == world.creature("c")
+        assert world.physics.view_of(c).creature == world.creature("c")
 
 
 def test_despawn_then_spawn_reuses_the_batch_and_steps_on():
@@ -315,7 +315,7 @@ def test_a_newcomer_meets_the_creatures_there_through_contact():
         for _ in range(400):  # head-on: they crawl into each other
             world.step(1)
             met = max(met, int(world.physics.proxies_used.max()))
-            views = (world.physics.group_of(world.component(e, Creature)) for e in (b,))
+            views = (world.physics.view_of(world.component(e, Creature)) for e in (b,))
             deepest = min(deepest, *(v.data.deepest_contact for v in views))
         assert met > 0  # each felt the other's bodies
         assert deepest > -0.01 and world.physics.health.recoveries == 0
@@ -341,7 +341,7 @@ def test_models_rebuilt_after_a_body_plan_left_retire_its_empty_batch():
         world.physics.rebuild_models(world)  # (a terrain edit): nobody left to build it from
         again = world.spawn({"name": "odd", "tentacles": {"count": 3}}, position=(30.0, 0.0))
         assert world.physics.compiles == 3  # a new batch for the shape
-        assert world.physics.group_of(world.component(again, Creature)).batch.index == 2
+        assert world.physics.view_of(world.component(again, Creature)).batch.index == 2
         world.step(10)
         assert world.physics.health.recoveries == 0
 
@@ -394,10 +394,10 @@ def test_a_body_plan_whose_first_creature_left_still_gets_its_reduced_model():
 def test_a_spawn_works_out_the_creatures_layout_once(
     make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """The spot check's layout is the one the creature is built from (it was worked out
-    two or three times a spawn)."""
+    """The physical checks' layout is the one the spot is checked with and the creature
+    is built from (it was worked out two or three times a spawn)."""
     from ecs_tentacles.creatures import body, spawning
-    from ecs_tentacles.scene import construction
+    from ecs_tentacles.scene import construction, layouts, physical
 
     calls: list[str] = []
     real = construction.creature_layout
@@ -406,8 +406,8 @@ def test_a_spawn_works_out_the_creatures_layout_once(
         calls.append("layout")
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(spawning, "creature_layout", counted)
-    monkeypatch.setattr(body, "creature_layout", counted)
+    for module in (spawning, body, layouts, physical):
+        monkeypatch.setattr(module, "creature_layout", counted, raising=False)
     world = make_world("octopus")
     calls.clear()  # building the scene's own creature
     new = {"tentacles": {"count": 3, "links": 3}}
@@ -416,7 +416,47 @@ def test_a_spawn_works_out_the_creatures_layout_once(
     calls.clear()
     world.spawn({**new, "name": "b"}, position=(4.0, 4.0), on_overlap="move")  # on "a"
     free = len(calls)
-    assert free >= 2  # the taken spot, then spots on rings until a free one
+    assert free >= 2  # the checks' (the taken spot's), then spots on rings until a free one
     calls.clear()
     world.spawn({**new, "name": "c"}, position=(-4.0, -4.0), on_overlap="move")  # free
     assert calls == ["layout"]
+
+
+def test_a_misspelt_placement_is_refused_not_dropped():
+    with World.from_scene(_scene(APART[:1]), threads=1) as world:
+        with pytest.raises(TypeError, match="'positon'"):
+            world.spawn(_creature("d", 30.0), positon=(30.0, 0.0))
+        assert len(world.physics) == 1  # nothing built
+        made = world.spawn(_creature("d", 0.0), position=(30.0, 0.0), heading_deg=90.0)
+        assert world.creature_specs[made]["position"] == [30.0, 0.0]
+        assert world.creature_specs[made]["heading_deg"] == 90.0
+
+
+@pytest.mark.parametrize("level", ["herding_1_field", "race_1_rock"])
+def test_a_creature_spawns_into_a_game_level(level: str) -> None:
+    """The entry is checked among the level's creatures and game: it was checked in a
+    scene of its own, which has no `game`, and refused ("game: required")."""
+    with World.from_scene(level, threads=1) as world:
+        before = len(world.physics)
+        made = world.spawn(_creature("visitor", 0.0), position=(20.0, 20.0), on_overlap="move")
+        assert len(world.physics) == before + 1
+        assert world.creature_name(made) == "visitor"
+        world.step(2)
+
+
+def test_a_bad_entry_names_its_fields_from_creature() -> None:
+    with World.from_scene(_scene(APART[:1]), threads=1) as world:
+        with pytest.raises(SpawnError) as raised:
+            world.spawn({"name": "x", "tentacles": {"count": 0, "links": 3, "ovverrides": []}})
+        count, unknown = raised.value.problems
+        assert count == "creature.tentacles.count: must be in [1, 16], got 0"
+        assert unknown.startswith("creature.tentacles.ovverrides: unknown key (allowed: count,")
+        with pytest.raises(SpawnError) as raised:
+            world.spawn({"name": "y", "tentacles": {"count": 3, "overrides": [{"index": 5}]}})
+        assert raised.value.problems == [
+            "creature.tentacles.overrides[0].index: must be < count (3), got 5"
+        ]
+        with pytest.raises(SpawnError) as raised:
+            world.spawn({"name": "z", "mantle": {"height": 0.001}}, position=(9.0, 9.0))
+        assert raised.value.problems[0].startswith("creature.mantle: is too flat to simulate")
+        assert len(world.physics) == 1

@@ -51,6 +51,6 @@ def test_the_grab_system_touches_only_what_it_declares_and_lets_go() -> None:
         assert world.component(octo, Transform).pos[2] > start[2] + 0.2
         world.resource(Director).grab = None
         world.step(1)
-        assert not world.physics.groups[0].batch.applied  # the force is gone
+        assert not world.physics.views[0].batch.applied  # the force is gone
         world.step(120)
         assert world.physics.health.recoveries == 0

@@ -12,6 +12,7 @@ import pytest
 from ecs_tentacles.components import Creature, Sucker, Tentacle, Transform
 from ecs_tentacles.export.bake import BakePlan, bake, simulation_rate
 from ecs_tentacles.locomotion.goals import GoalBook
+from ecs_tentacles.options import WorldOptions
 from ecs_tentacles.record.systems.record import Record
 from ecs_tentacles.take import ARRAYS, Take, TakeError
 from ecs_tentacles.world import World
@@ -97,7 +98,7 @@ def test_two_bakes_of_the_same_scene_and_seed_are_byte_identical(tmp_path: Path)
     plan = BakePlan.make(SMALL_SCENE, seconds=0.25, fps=30)
     bake(plan, progress=False).save(tmp_path / "a.npz")
     bake(plan, progress=False).save(tmp_path / "b.npz")
-    other = BakePlan.make(SMALL_SCENE, seconds=0.25, fps=30, seed=5)
+    other = BakePlan.make(SMALL_SCENE, WorldOptions(seed=5), seconds=0.25, fps=30)
     bake(other, progress=False).save(tmp_path / "c.npz")
     a, b, c = ((tmp_path / f"{n}.npz").read_bytes() for n in "abc")
     assert a == b

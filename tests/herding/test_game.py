@@ -16,7 +16,7 @@ from tests.herding.levels import level
 
 
 def _state(world: World) -> list[np.ndarray]:
-    groups = world.physics.groups
+    groups = world.physics.views
     physics = [a for g in groups for a in (g.data.qpos, g.data.qvel, g.integration_state())]
     game = world.resource(HerdingGame).state
     return [

@@ -24,7 +24,7 @@ def test_coordinated_creature_crawls_toward_its_goal(make_world: Callable[..., W
     goal = np.array([1.5, 0.0])
     start = float(np.linalg.norm(goal - mantle.pos[:2]))
     world.step(240)  # 4 simulated seconds
-    data = world.physics.groups[0].data
+    data = world.physics.views[0].data
     assert np.isfinite(data.qpos).all() and np.isfinite(data.qvel).all()
     assert world.physics.health.recoveries == 0
     assert float(np.linalg.norm(goal - mantle.pos[:2])) < start - 0.15
@@ -36,7 +36,7 @@ def test_idle_creature_writhes_in_place(make_world: Callable[..., World]) -> Non
     world = make_world(creature_scene())  # 8 tentacles, no goal
     octo = world.creature("octo")
     mantle = world.component(octo, Transform)
-    model, data = world.physics.groups[0].model, world.physics.groups[0].data
+    model, data = world.physics.views[0].model, world.physics.views[0].data
     hinges = np.flatnonzero(model.jnt_type == mujoco.mjtJoint.mjJNT_HINGE)
     assert len(hinges) == 8 * 10 * 2  # curl and sweep of every link
     start = mantle.pos[:2].copy()

@@ -29,13 +29,13 @@ def _links(world: World, tentacle: int) -> np.ndarray:
 
 
 def _actuators(world: World, motor_rows: np.ndarray) -> np.ndarray:
-    return np.flatnonzero(np.isin(world.physics.groups[0].actuator_motor_rows, motor_rows))
+    return np.flatnonzero(np.isin(world.physics.views[0].actuator_motor_rows, motor_rows))
 
 
 def test_strength_of_one_tentacle_reaches_its_servos(make_world: Callable[..., World]) -> None:
     world = _world(make_world)
     octo = world.creature("octo")
-    group = world.physics.groups[0]
+    group = world.physics.views[0]
     world.step(1)
     before = group.kp.copy()
     world.resource(Locomotion).set(octo, tentacle=1, strength=40.0, damping=2.0)
@@ -47,7 +47,7 @@ def test_strength_of_one_tentacle_reaches_its_servos(make_world: Callable[..., W
     assert_allclose(group.kp[base], 40.0 * motors.gain[links[0]], rtol=1e-12)
     assert_allclose(group.kv[base], 2.0 * motors.gain[links[0]], rtol=1e-12)
     # every link of the tentacle, tapered by its scale
-    rows = world.physics.groups[0].actuator_motor_rows
+    rows = world.physics.views[0].actuator_motor_rows
     mine = _actuators(world, links)
     assert_allclose(
         group.kp[mine],

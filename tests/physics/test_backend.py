@@ -25,12 +25,12 @@ def _joint(world: World, link_entity: int, hinge: str) -> int:
     link = world.component(link_entity, Link)
     tentacle = world.component(link.tentacle, Tentacle)
     name = f"t{tentacle.index}/l{link.index:02d}/{hinge}"
-    return int(world.physics.groups[0].model.joint(name).id)
+    return int(world.physics.views[0].model.joint(name).id)
 
 
 def test_model_options(make_world: Callable[..., World]) -> None:
     world = make_world(creature_scene(count=3, links=2), plugins=NO_LOCOMOTION)
-    model = world.physics.groups[0].model
+    model = world.physics.views[0].model
     assert model.opt.integrator == mujoco.mjtIntegrator.mjINT_IMPLICITFAST
     assert model.opt.timestep == world.settings.substep_dt == 1 / 480
     assert model.geom("ground").type == mujoco.mjtGeom.mjGEOM_PLANE
@@ -44,7 +44,7 @@ def test_model_options(make_world: Callable[..., World]) -> None:
 def test_creature_settles_on_the_ground(make_world: Callable[..., World]) -> None:
     world = make_world(creature_scene(), plugins=NO_LOCOMOTION)  # 8 tentacles x 10 links, r 0.025
     world.step(300)  # 5 simulated seconds
-    data = world.physics.groups[0].data
+    data = world.physics.views[0].data
     assert np.isfinite(data.qpos).all() and np.isfinite(data.qvel).all()
     assert world.physics.health.recoveries == 0
     mantle = world.component(world.creature("octo"), Transform)
@@ -75,7 +75,7 @@ def test_servo_reaches_its_target(
     link = _tentacle(world, 0).links[link_index]
     world.component(link, Motor).target = target
     world.step(120)
-    group = world.physics.groups[0]
+    group = world.physics.views[0]
     angle = group.data.qpos[group.model.jnt_qposadr[_joint(world, link, hinge)]]
     assert abs(angle - sum(target)) < 0.01
 
@@ -87,7 +87,7 @@ def test_strength_change_at_run_time_changes_the_servo_force(
     link = _tentacle(world, 1).links[0]
     motor = world.component(link, Motor)
     motor.target = [0.0, 0.4, 0.0]
-    group = world.physics.groups[0]
+    group = world.physics.views[0]
     actuator = int(group.model.actuator("t1/l00/sweep").id)
     joint = _joint(world, link, "sweep")
 
@@ -151,11 +151,11 @@ def test_physics_sync_copies_poses_bit_for_bit(make_world: Callable[..., World])
     world = make_world(creature_scene(count=5, links=4), plugins=NO_LOCOMOTION)
     world.motors.target[:, 0] = 0.3
     world.step(20)
-    data, ids = world.physics.groups[0].data, world.physics.groups[0].body_ids
+    data, ids = world.physics.views[0].data, world.physics.views[0].body_ids
     assert_array_equal(world.transforms.pos, data.xpos[ids])
     assert_array_equal(world.transforms.quat, data.xquat[ids])
     link = _tentacle(world, 3).links[2]
-    body = world.physics.groups[0].model.body("t3/l02").id
+    body = world.physics.views[0].model.body("t3/l02").id
     assert_array_equal(world.component(link, Transform).pos, data.xpos[body])
 
 

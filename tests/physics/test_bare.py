@@ -8,19 +8,19 @@ import numpy as np
 import pytest
 
 from ecs_tentacles.creator.crowd import crowd_scene
-from ecs_tentacles.physics.bare import BareFrame, Recorder
+from ecs_tentacles.physics.bare import BareFrame, FrameCapture
 from ecs_tentacles.physics.tiers import FULL, REDUCED
 from ecs_tentacles.world import World
 
 
-def _recorded_then_stepped(world: World) -> tuple[BareFrame, list[np.ndarray], list[np.ndarray]]:
-    """Record the next frame's inputs, run the frame; the frame and every batch's full
+def _captured_then_stepped(world: World) -> tuple[BareFrame, list[np.ndarray], list[np.ndarray]]:
+    """Capture the next frame's inputs, run the frame; the frame and every batch's full
     and reduced state rows after it."""
     physics = world.physics
-    recorder = Recorder(physics, keep=True)
+    capture = FrameCapture(physics, keep=True)
     world.step(1)
-    recorder.close()
-    (frame,) = recorder.frames
+    capture.close()
+    (frame,) = capture.frames
     batches = physics.batches
     return frame, [b.state.copy() for b in batches], [b.rstate.copy() for b in batches]
 
@@ -34,10 +34,10 @@ def test_a_bare_frame_ends_where_the_framework_frame_ended(
     scene["physics"] = {"lod": {"full": 2, "reduced": 2, "hold_seconds": 0, "focus": focus}}
     world = make_world(scene, threads=threads)
     world.step(8)  # two demoted to REDUCED
-    frame, states, rstates = _recorded_then_stepped(world)
+    frame, states, rstates = _captured_then_stepped(world)
     assert {FULL, REDUCED} <= set(frame.rows[0])
     before = {tier: r.states.copy() for tier, r in frame.rows[0].items()}
-    for _ in range(2):  # a recorded frame can be stepped again: its inputs stay
+    for _ in range(2):  # a captured frame can be stepped again: its inputs stay
         world.physics.step_bare(frame, world.settings.substeps)
         full, reduced = frame.rows[0][FULL], frame.rows[0][REDUCED]
         np.testing.assert_array_equal(full.after, states[0][full.rows])
@@ -51,9 +51,9 @@ def test_a_pushed_creature_is_pushed_in_the_bare_frame_too(
 ) -> None:
     world = make_world(crowd_scene(3, seed=2, spacing=4.0, uniform=True), lod=False)
     world.step(2)
-    view = world.physics.groups[1]
+    view = world.physics.views[1]
     view.data.xfrc_applied[view.body_ids[0], 2] = 50.0  # a script pushes its mantle up
-    frame, states, _ = _recorded_then_stepped(world)
+    frame, states, _ = _captured_then_stepped(world)
     full = frame.rows[0][FULL]
     assert list(full.forces) == [1]  # creature 1's row, by its position among the rows
     world.physics.step_bare(frame, world.settings.substeps)
@@ -63,7 +63,7 @@ def test_a_pushed_creature_is_pushed_in_the_bare_frame_too(
 def test_bare_frames_leave_the_world_alone(make_world: Callable[..., World]) -> None:
     scene = crowd_scene(2, seed=1, uniform=True)
     measured, plain = make_world(scene), make_world(scene)
-    frame, _, _ = _recorded_then_stepped(measured)
+    frame, _, _ = _captured_then_stepped(measured)
     state = measured.physics.state()
     measured.physics.step_bare(frame, measured.settings.substeps)
     after = measured.physics.state()

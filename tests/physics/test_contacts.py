@@ -61,7 +61,7 @@ def test_proxies_stand_where_the_other_creatures_bodies_are(
     }
     world = make_world(scene, plugins=NO_LOCOMOTION)
     world.physics.proxies.update(world.transforms)  # as each frame starts
-    a, b, far = world.physics.groups
+    a, b, far = world.physics.views
     assert far.proxies_used == 0 and a.proxies_used > 0 and b.proxies_used > 0
     # every proxy of a stands exactly on one of b's bodies, with its size
     used = a.proxy_mocap[: a.proxies_used]  # capsules first; no mantle is near

@@ -52,7 +52,7 @@ def test_the_physics_writes_no_column_it_does_not_declare(
     }  # fmt: skip
     step_declared(world, 30)  # each system with only its declared columns (tests/declarations)
     assert world.physics.proxies.in_use  # the creatures are near each other
-    world.physics.groups[1].data.qvel[7] = np.nan
+    world.physics.views[1].data.qvel[7] = np.nan
     step_declared(world, 5)
     assert world.physics.health.recoveries == 1
     with (

@@ -36,18 +36,18 @@ def _hit_strength(world: World) -> None:
     spring of kp 1e5 on links of ~1e-4 kg m^2 at 1/480 s steps (dt * sqrt(kp / I) ~ 60,
     stable only below 2) diverges in its first step on any CPU. Within the torque limit
     a blow-up depended on rounding: some CPUs rode it out."""
-    rows = world.physics.groups[1].actuator_motor_rows
+    rows = world.physics.views[1].actuator_motor_rows
     world.motors.strength[rows[:10]] = 1e5
     world.motors.max_torque[rows[:10]] = 1e12
 
 
 def _hit_force(world: World) -> None:
-    group = world.physics.groups[1]
+    group = world.physics.views[1]
     group.data.xfrc_applied[group.body_ids[0], 2] = 1e7  # on the mantle, for one frame
 
 
 def _hit_nan(world: World) -> None:
-    world.physics.groups[1].data.qvel[7] = np.nan
+    world.physics.views[1].data.qvel[7] = np.nan
 
 
 FAULTS = {"strength": _hit_strength, "force": _hit_force, "nan": _hit_nan}
@@ -65,7 +65,7 @@ def test_a_blow_up_recovers_only_the_creature_hit(
     FAULTS[fault](hurt)
     hurt.step(1)
     if fault == "force":
-        hurt.physics.groups[1].data.xfrc_applied[:] = 0.0
+        hurt.physics.views[1].data.xfrc_applied[:] = 0.0
     clean.step(1)
     clean.step(120)
     hurt.step(120)
@@ -75,7 +75,7 @@ def test_a_blow_up_recovers_only_the_creature_hit(
     assert hurt.physics.health.recoveries == expected >= 1
     assert hurt.events.counts["creature_recovered"] == expected
     for k in (0, 2):  # the others never noticed
-        rows = hurt.physics.groups[k].body_rows
+        rows = hurt.physics.views[k].body_rows
         assert_array_equal(hurt.transforms.pos[rows], clean.transforms.pos[rows])
     assert np.isfinite(hurt.transforms.pos).all()
     speed = np.linalg.norm(hurt.transforms.pos - clean.transforms.pos, axis=1)
@@ -85,7 +85,7 @@ def test_a_blow_up_recovers_only_the_creature_hit(
 def test_a_teleport_never_reaches_a_goal(make_world: Callable[..., World]) -> None:
     world = make_world(SCENE)
     world.step(10)
-    group = world.physics.groups[0]
+    group = world.physics.views[0]
     goal = world.stores["locomotion.creatures"].goal[0]
     group.data.qpos[0:2] = goal[:2]  # jump into the goal between two frames
     world.step(5)
@@ -105,7 +105,7 @@ def test_a_creature_that_keeps_failing_is_frozen(
         for _ in range(3):
             _hit_nan(world)
             world.step(5)
-    group = world.physics.groups[1]
+    group = world.physics.views[1]
     assert group.frozen and world.physics.health.frozen == 1 and len(frozen) == 1
     [line] = [r.message for r in caplog.records if r.name == "ecs_tentacles.physics"]
     assert line.startswith("creature 'c1' frozen: 3 physics failures in 2.0 s (last: ")
@@ -127,7 +127,7 @@ class BreakOne(System):
 
     def process(self, world, dt):
         if world.frame == 20:
-            world.physics.groups[0].data.qvel[0] = np.nan
+            world.physics.views[0].data.qvel[0] = np.nan
 """
 
 
@@ -174,7 +174,7 @@ def test_mujoco_messages_go_to_logging_not_a_file(
     causes: list[str] = []
     world.events.on("creature_recovered", lambda **e: causes.append(e["cause"]))
     with caplog.at_level(logging.WARNING, logger="ecs_tentacles.mujoco"):
-        world.physics.groups[2].data.qvel[0] = 1e12  # MuJoCo warns: bad qvel (> 1e10)
+        world.physics.views[2].data.qvel[0] = 1e12  # MuJoCo warns: bad qvel (> 1e10)
         world.step(2)
     assert any("QVEL" in r.message for r in caplog.records)
     assert world.physics.health.causes == {"mujoco": 1}
@@ -209,7 +209,7 @@ def test_an_allowed_speed_lets_one_creature_fly_for_a_while(
     make_world: Callable[..., World],
 ) -> None:
     def jump(world: World) -> None:  # 0.5 m in one frame: 30 m/s, over the scene's 12
-        world.physics.groups[0].data.qpos[2] += 0.5  # straight up: nothing is in the way
+        world.physics.views[0].data.qpos[2] += 0.5  # straight up: nothing is in the way
         world.step(1)
 
     world = make_world(SCENE)

@@ -184,7 +184,7 @@ def test_promotion_starts_from_the_shown_pose(make_world: Callable[..., World]) 
     creature = world.creature("c0")
     world.step(60)
     assert world.lod.tier_of(creature) == "kinematic"
-    rows = world.physics.groups[0].body_rows
+    rows = world.physics.views[0].body_rows
     shown = world.transforms.pos[rows].copy()
     world.step(1)
     replayed = np.linalg.norm(world.transforms.pos[rows] - shown, axis=1).max()

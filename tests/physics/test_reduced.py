@@ -161,7 +161,7 @@ def test_the_stiffest_servos_the_schema_allows_simulate_at_the_reduced_tier(
     assert np.all(world.transforms.pos[rows, 0] - start > 0.03)  # they crawl, not frozen
     splits = []
     for name in ("c0", "plain"):
-        view = world.physics.group_of(world.component(world.creature(name), Creature))
+        view = world.physics.view_of(world.component(world.creature(name), Creature))
         reduced, model = view.batch.reduced, view.batch.scratch_for(0, REDUCED).model
         assert reduced is not None
         batch, row = view.batch, view.row
@@ -227,7 +227,7 @@ def test_recovering_one_reduced_creature_leaves_the_others_alone(
         runs.append(world)
     assert runs[1].physics.health.recoveries >= 1
     for name in ("c0", "c2", "c3"):
-        rows = runs[0].physics.groups[int(name[1])].body_rows
+        rows = runs[0].physics.views[int(name[1])].body_rows
         np.testing.assert_array_equal(runs[0].transforms.pos[rows], runs[1].transforms.pos[rows])
     assert np.isfinite(runs[1].transforms.pos).all()
 

@@ -35,7 +35,7 @@ def test_a_still_idle_creature_sleeps_and_a_goal_wakes_it(
     make_world: Callable[..., World],
 ) -> None:
     world = make_world(_scene(RESTING))
-    rest, busy = world.physics.groups
+    rest, busy = world.physics.views
     world.step(240)  # settles on the ground, then lies still
     assert rest.sleeping and not busy.sleeping  # the writhing one never sleeps
     assert world.physics.sleep.asleep == 1
@@ -54,7 +54,7 @@ def test_a_still_idle_creature_sleeps_and_a_goal_wakes_it(
 def test_a_script_moving_a_servo_wakes_it(make_world: Callable[..., World]) -> None:
     # the script drives the servos (waves and writhing are locomotion's keys: none here)
     world = make_world(_scene({"count": 3, "links": 5}), plugins=NO_LOCOMOTION)
-    rest = world.physics.groups[0]
+    rest = world.physics.views[0]
     world.step(240)
     assert rest.sleeping
     world.motors.target[rest.actuator_motor_rows[0], 0] = -0.5
@@ -99,7 +99,7 @@ def test_a_plugin_that_wants_a_creature_to_move_keeps_it_awake(
     world = make_world(_scene({"count": 3, "links": 5}), plugins=off)
     world.add_plugin(KeepAwake("rest"))
     world.add_plugin(NoOpinion())
-    rest, other = world.physics.groups  # no locomotion: nothing drives either one
+    rest, other = world.physics.views  # no locomotion: nothing drives either one
     world.step(240)  # as long as it took to fall asleep above
     assert not rest.sleeping and other.sleeping
     assert np.abs(rest.data.qvel).max() < 1e-3  # still, yet stepped: someone wants it
@@ -111,7 +111,7 @@ def test_with_locomotion_off_no_goal_keeps_anyone_awake(
     off = {"locomotion": False, "suckers": False}  # its waves and writhing are keys no more
     world = make_world(_scene({"count": 3, "links": 5}), plugins=off)
     world.step(240)
-    assert world.physics.groups[0].sleeping
+    assert world.physics.views[0].sleeping
 
 
 def test_the_sleep_kernel_decides_as_numpy_bit_for_bit(

@@ -37,7 +37,7 @@ RESTING: dict[str, Any] = {
 
 
 def _blow_up(world: World) -> None:
-    world.physics.groups[1].data.qvel[7] = np.nan
+    world.physics.views[1].data.qvel[7] = np.nan
 
 
 def test_set_state_forgets_a_recovery_and_the_clock_since(
@@ -46,21 +46,21 @@ def test_set_state_forgets_a_recovery_and_the_clock_since(
     world = make_world(CRAWLERS)
     world.step(30)
     saved = world.physics.state()
-    before = [g.integration_state() for g in world.physics.groups]
+    before = [g.integration_state() for g in world.physics.views]
     _blow_up(world)
     world.step(12)
     health = world.physics.health
     assert health.recoveries == 1 and health.causes == {"mujoco": 1}
-    assert world.physics.groups[1].soften < 1.0  # servos soft after the recovery
+    assert world.physics.views[1].soften < 1.0  # servos soft after the recovery
     world.physics.set_state(saved)
     assert health.recoveries == 0 and health.causes == {}
     assert world.physics.time == saved.time
-    for group, state in zip(world.physics.groups, before, strict=True):
+    for group, state in zip(world.physics.views, before, strict=True):
         assert_array_equal(group.integration_state(), state)
         assert group.soften == 1.0 and not group.frozen
     world.step(12)  # the saved state was copied: it goes back the same way again
     world.physics.set_state(saved)
-    assert_array_equal(world.physics.groups[1].integration_state(), before[1])
+    assert_array_equal(world.physics.views[1].integration_state(), before[1])
 
 
 def test_a_restored_blow_up_recovers_the_same_way(make_world: Callable[..., World]) -> None:
@@ -84,7 +84,7 @@ def test_a_sleeping_creature_is_asleep_again_after_set_state(
     make_world: Callable[..., World],
 ) -> None:
     world = make_world(RESTING)
-    rest = world.physics.groups[0]
+    rest = world.physics.views[0]
     world.step(240)
     assert rest.sleeping
     saved = world.physics.state()

@@ -27,15 +27,21 @@ def ui_scale_as_the_display_asks() -> Iterator[None]:
 
 @pytest.fixture
 def make_sandbox() -> Iterator[Callable[..., Any]]:
-    """Headless sandboxes (640 x 360 unless told), closed after the test."""
+    """Headless sandboxes (640 x 360 unless told), closed after the test; keywords that
+    are `WorldOptions` fields (`allow_systems=True`, `lod=False`) go into its options."""
+    from dataclasses import fields
+
+    from ecs_tentacles.options import WorldOptions
     from ecs_tentacles.render.sandbox import Sandbox
 
     made: list[Sandbox] = []
+    option_names = {f.name for f in fields(WorldOptions)}
 
     def make(scene: Any, **kwargs: Any) -> Sandbox:
         kwargs.setdefault("width", 640)
         kwargs.setdefault("height", 360)
-        sandbox = Sandbox(scene, headless=True, **kwargs)
+        chosen = {name: kwargs.pop(name) for name in option_names & set(kwargs)}
+        sandbox = Sandbox(scene, WorldOptions(**chosen), headless=True, **kwargs)
         made.append(sandbox)
         return sandbox
 

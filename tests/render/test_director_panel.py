@@ -113,7 +113,7 @@ def test_ctrl_drag_lifts_and_throws_a_creature_with_a_bounded_force(
     event(sandbox, "on_mouse_press", x, y, mouse.LEFT, key.MOD_CTRL)
     grab = world.resource(Director).grab
     assert grab is not None and grab.creature == octo
-    view = world.physics.group_of(world.component(octo, Creature))
+    view = world.physics.view_of(world.component(octo, Creature))
     limit = float(view.model.body_subtreemass[view.body_ids[0]]) * MAX_ACCELERATION
     forces = []
     for i in range(60):  # up the screen: up in the world
@@ -162,7 +162,7 @@ def test_removing_the_creature_being_dragged_ends_the_grab(
     assert not world.schedule.disabled()  # no system failed and was switched off
     assert world.physics.health.recoveries == 0
     assert not any(batch.applied for batch in world.physics.batches)
-    other_view = world.physics.group_of(world.component(world.creature(other), Creature))
+    other_view = world.physics.view_of(world.component(world.creature(other), Creature))
     moved = world.transforms.pos[other_view.body_rows[0]]
     assert np.isfinite(moved).all()
     _key(sandbox, key.Z, key.MOD_CTRL)  # the removal undone: it is back

@@ -120,7 +120,7 @@ def test_slider_click_reaches_the_servo_gains(make_sandbox: Callable[..., Any]) 
         kp
     ] * 8  # "all"
     sandbox.step(1)
-    group = world.physics.groups[0]
+    group = world.physics.views[0]
     actuator = group.model.actuator("t3/l00/curl").id
     row = int(world.tentacles.first_link[3])
     assert group.kp[actuator] == pytest.approx(kp * world.motors.gain[row], rel=1e-12)

@@ -100,3 +100,22 @@ def test_format_path() -> None:
     )
     assert format_path(["$schema"]) == "$schema"
     assert format_path(["my key", 0]) == '["my key"][0]'
+
+
+def test_a_creature_entry_is_checked_as_one_more_creature_of_its_scene() -> None:
+    from ecs_tentacles.scene.load import bundled_scene, load_scene_plugins
+    from ecs_tentacles.scene.validate import validated_creature
+
+    scene, plugins = load_scene_plugins(bundled_scene("herding_1_field"))
+    problems, entry = validated_creature({"name": "new", "mantle": {}}, scene, plugins)
+    assert problems == [] and entry is not None  # the level's `game` is there
+    assert entry["tentacles"]["count"] == 8 and entry["position"] == [0, 0]  # defaults in
+    problems, entry = validated_creature(
+        {"name": "new", "mantle": {"radius": -1}, "tentacles": {"overrides": [{"index": 9}]}},
+        scene,
+        plugins,
+    )
+    assert entry is None
+    assert problems == ["creature.mantle.radius: must be in [5e-05, 10], got -1"]
+    problems, _ = validated_creature({"tentacles": {"overrides": [{"index": 9}]}}, scene, plugins)
+    assert problems == ["creature.tentacles.overrides[0].index: must be < count (8), got 9"]

@@ -41,7 +41,7 @@ class GrabSpring(System):
         if grab is None or world.try_component(grab.creature, Creature) is None:
             self.release(world)
             return
-        view = world.physics.group_of(world.component(grab.creature, Creature))
+        view = world.physics.view_of(world.component(grab.creature, Creature))
         body_id = int(view.body_ids[grab.body])
         if self.held is not None and self.held != (grab.creature, body_id):
             self.release(world)
@@ -70,5 +70,5 @@ class GrabSpring(System):
         self.held = None
         if world.try_component(creature, Creature) is None:
             return
-        view = world.physics.group_of(world.component(creature, Creature))
+        view = world.physics.view_of(world.component(creature, Creature))
         view.batch.applied.pop(view.row, None)

@@ -96,7 +96,8 @@ def ground_follow(world: Host, ground: Ground, rows: np.ndarray) -> np.ndarray:
         along /= np.maximum(np.linalg.norm(along, axis=1, keepdims=True), 1e-9)
         reach = base + length[:, None] * along
     gap = ground.distance(reach)
-    return np.clip(2.0 * np.arctan2(gap, length), -FOLLOW_LIMIT, FOLLOW_LIMIT)
+    follow: np.ndarray = np.clip(2.0 * np.arctan2(gap, length), -FOLLOW_LIMIT, FOLLOW_LIMIT)
+    return follow
 
 
 class MotorTargets(System):

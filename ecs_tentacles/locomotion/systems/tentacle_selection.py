@@ -97,7 +97,8 @@ def ground_plane(normals: np.ndarray) -> np.ndarray:
 
 def _in_plane(basis: np.ndarray, vectors: np.ndarray) -> np.ndarray:
     """(n, 2) coordinates of `vectors` (n, 3) along each row's plane axes (n, 2, 3)."""
-    return np.einsum("nij,nj->ni", basis, vectors)
+    coordinates: np.ndarray = np.einsum("nij,nj->ni", basis, vectors)
+    return coordinates
 
 
 class TentacleSelection(System):

@@ -1,4 +1,4 @@
-"""Physics groups: one compiled model per morphology, threads, a creature alone."""
+"""Creatures' physics views: one compiled model per morphology, threads, a creature alone."""
 
 from __future__ import annotations
 
@@ -6,6 +6,7 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
+import pytest
 from numpy.testing import assert_array_equal
 
 from ecs_tentacles.components import Creature
@@ -30,10 +31,10 @@ def test_one_compile_per_morphology(make_world: Callable[..., World]) -> None:
     same = {"count": 4, "links": 5}
     world = make_world(_far_apart([same, same, {"count": 5, "links": 5}, same]))
     physics = world.physics
-    assert (len(physics.groups), physics.compiles) == (4, 2)
-    assert [g.creatures for g in physics.groups] == [[world.creature(f"c{i}")] for i in range(4)]
+    assert (len(physics.views), physics.compiles) == (4, 2)
+    assert [g.creatures for g in physics.views] == [[world.creature(f"c{i}")] for i in range(4)]
     # creatures of one morphology share its model; each owns its state and servo gains
-    first, second, third = physics.groups[0], physics.groups[1], physics.groups[2]
+    first, second, third = physics.views[0], physics.views[1], physics.views[2]
     assert first.model is second.model is not third.model
     assert first.batch is second.batch is not third.batch and first.row != second.row
     assert not np.shares_memory(first.kp, second.kp)
@@ -59,8 +60,8 @@ def test_a_creature_alone_moves_as_in_a_world_of_its_own(make_world: Callable[..
     # the first creature draws the same random tentacle phases in both worlds
     crowd = make_world(_far_apart([{"count": 4, "links": 5}, {"count": 6}, {"count": 3}]))
     alone = make_world(_far_apart([{"count": 4, "links": 5}]))
-    rows = crowd.physics.groups[0].body_rows
-    assert_array_equal(rows, alone.physics.groups[0].body_rows)
+    rows = crowd.physics.views[0].body_rows
+    assert_array_equal(rows, alone.physics.views[0].body_rows)
     for _ in range(5):
         crowd.step(24)
         alone.step(24)
@@ -71,7 +72,7 @@ def test_a_creature_alone_moves_as_in_a_world_of_its_own(make_world: Callable[..
 def test_groups_are_visible(make_world: Callable[..., World]) -> None:
     world = make_world(_far_apart([{"count": 3, "links": 4}] * 2), threads=2)
     octo = world.component(world.creature("c1"), Creature)
-    assert world.physics.group_of(octo) is world.physics.groups[1]
+    assert world.physics.view_of(octo) is world.physics.views[1]
     assert repr(world.physics) == "<physics: 2 creatures, 1 compiled models, 2 threads>"
     assert world.physics.bodies == 2 * (1 + 3 * 4)
 
@@ -97,3 +98,12 @@ def test_sync_copies_consecutive_rows_as_one_slice_and_follows_a_despawn() -> No
             np.testing.assert_array_equal(world.transforms.pos[batch.body_rows], batch.xpos)
             np.testing.assert_array_equal(world.transforms.quat[batch.body_rows], batch.xquat)
             assert np.isfinite(world.transforms.pos[batch.body_rows]).all()
+
+
+def test_the_old_names_still_work_and_say_so(make_world: Callable[..., World]) -> None:
+    world = make_world(_far_apart([{"count": 4, "links": 5}]))
+    creature = world.component(world.creature("c0"), Creature)
+    with pytest.warns(DeprecationWarning, match="physics.view_of"):
+        assert world.physics.group_of(creature) is world.physics.view_of(creature)
+    with pytest.warns(DeprecationWarning, match="physics.views"):
+        assert world.physics.groups is world.physics.views
