@@ -28,9 +28,10 @@ SCRIPT = textwrap.dedent(
 )
 
 
-def test_mypy_strict_rejects_unknown_world_attributes(tmp_path: Path) -> None:
+def strict_errors(tmp_path: Path, source: str) -> list[str]:
+    """mypy --strict's error lines on `source` (two expected), written to a script."""
     script = tmp_path / "script.py"
-    script.write_text(SCRIPT)
+    script.write_text(source)
     result = subprocess.run(
         [sys.executable, "-m", "mypy", "--strict", "--follow-imports=silent",
          "--cache-dir", str(tmp_path / "cache"), "--no-error-summary", str(script)],
@@ -38,6 +39,11 @@ def test_mypy_strict_rejects_unknown_world_attributes(tmp_path: Path) -> None:
     )  # fmt: skip
     errors = [line for line in result.stdout.splitlines() if ": error:" in line]
     assert len(errors) == 2, result.stdout + result.stderr
+    return errors
+
+
+def test_mypy_strict_rejects_unknown_world_attributes(tmp_path: Path) -> None:
+    errors = strict_errors(tmp_path, SCRIPT)
     assert '"World" has no attribute "no_such_thing"' in errors[0]
     assert '"GoalBook" has no attribute "no_such_method"' in errors[1]
 
@@ -58,14 +64,6 @@ SPAWN = textwrap.dedent(
 
 
 def test_mypy_strict_checks_spawn_placements(tmp_path: Path) -> None:
-    script = tmp_path / "script.py"
-    script.write_text(SPAWN)
-    result = subprocess.run(
-        [sys.executable, "-m", "mypy", "--strict", "--follow-imports=silent",
-         "--cache-dir", str(tmp_path / "cache"), "--no-error-summary", str(script)],
-        capture_output=True, text=True, check=False, cwd=Path(__file__).parents[1],
-    )  # fmt: skip
-    errors = [line for line in result.stdout.splitlines() if ": error:" in line]
-    assert len(errors) == 2, result.stdout + result.stderr
+    errors = strict_errors(tmp_path, SPAWN)
     assert '"positon"' in errors[0]
     assert "'push'" in errors[1]

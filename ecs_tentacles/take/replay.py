@@ -251,29 +251,30 @@ def fill(
     frame, creature = np.nonzero(replayed)
     if not len(frame):
         return
+    out = (pos, quat)
     if bodies is None:
-        _fill(header, clips, arrays, pos, quat, frame, creature, None)
+        _fill(header, clips, arrays, out, (frame, creature), None)
         return
     needed = np.zeros(pos.shape[1], dtype=bool)
     needed[bodies] = True
     owner_of_body = np.array([b["creature"] for b in header["bodies"]], dtype=np.int64)
     quat[replayed[:, owner_of_body] & ~needed] = IDENTITY
     full = np.zeros(len(frame), dtype=bool) if whole is None else whole[frame, creature]
-    _fill(header, clips, arrays, pos, quat, frame[full], creature[full], None)
-    _fill(header, clips, arrays, pos, quat, frame[~full], creature[~full], needed)
+    _fill(header, clips, arrays, out, (frame[full], creature[full]), None)
+    _fill(header, clips, arrays, out, (frame[~full], creature[~full]), needed)
 
 
 def _fill(
     header: dict[str, Any],
     clips: dict[int, np.ndarray],
     arrays: dict[str, np.ndarray],
-    pos: np.ndarray,
-    quat: np.ndarray,
-    frame: np.ndarray,
-    creature: np.ndarray,
+    out: tuple[np.ndarray, np.ndarray],
+    at: tuple[np.ndarray, np.ndarray],
     needed: np.ndarray | None,
 ) -> None:
-    """`fill` at the creature-frames (`frame`, `creature`), `needed` bodies only."""
+    """`fill` into `out` (pos, quat) at the creature-frames `at` (frame, creature
+    indices), `needed` bodies only (None: all)."""
+    (pos, quat), (frame, creature) = out, at
     if not len(frame):
         return
     found = poses(
@@ -287,9 +288,9 @@ def _fill(
         needed=needed,
     )
     owner = np.asarray(header[KEY]["creatures"], dtype=np.int64)[creature]
-    for clip, (rows, at, rot) in found.items():
+    for clip, (rows, where, rot) in found.items():
         frames = frame[owner == clip][:, None]
-        pos[frames, rows] = at
+        pos[frames, rows] = where
         quat[frames, rows] = rot
 
 
