@@ -76,7 +76,9 @@ class Plugin:
     # hooks of earlier versions, and what replaced them: a plugin that still defines
     # one is refused when its class is made, instead of being silently never called
     RENAMED_HOOKS: ClassVar[dict[str, str]] = {
-        "export_curves": "a TakeTracks entry (a TrackSource of kind 'curves'; README)",
+        "export_curves": (
+            "a TakeTracks entry (a TrackSource of kind 'curves'; docs/extending/output-hooks.md)"
+        ),
         **{
             hook: f"a {kind} entry added in build(app) (ecs_tentacles.render.registries)"
             for hook, kind in (

@@ -287,5 +287,5 @@ def test_a_plugin_with_a_hook_of_an_earlier_version_is_refused_with_its_new_name
         World.from_scene(scene, scene_dir=tmp_path, allow_systems=True)
     assert str(refused.value) == (
         "plugins.old: cannot import 'old.py': TypeError: Old.export_curves: this hook is now"
-        " a TakeTracks entry (a TrackSource of kind 'curves'; README)"
+        " a TakeTracks entry (a TrackSource of kind 'curves'; docs/extending/output-hooks.md)"
     )

@@ -67,7 +67,7 @@ CONTACT_SOLREF = [0.006, 1.0]
 # still for the frame while the body it stands for moves on, so its contact starts
 # PROXY_MARGIN early and is as stiff as the step allows (timeconst 2 substeps, high
 # impedance); measured on crowds, creatures then never interpenetrate by more than a
-# few mm (README "Crowds").
+# few mm (docs/crowds.md).
 PROXY_SOLREF = [0.004, 1.0]
 PROXY_SOLIMP = [0.95, 0.99, 0.002, 0.5, 2.0]
 PROXY_MARGIN = 0.008

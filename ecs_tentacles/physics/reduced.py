@@ -82,7 +82,7 @@ DAMPING_GAIN = 2.0
 # swing of a chain matched at the tip, an inertial effect. A heavily damped servo is not
 # swinging but creeping, at kp / kv, and doubled damping slowed it: default octopuses
 # with damping 2, 5 and 25 crawled reduced at 0.92, 0.66 and 0.70 of their full selves,
-# now 1.08, 1.06 and 1.28 (`tools/reduced_pace.py --servos`, README "Crowds"). The
+# now 1.08, 1.06 and 1.28 (`tools/reduced_pace.py --servos`, docs/crowds.md). The
 # crowd barely moves (1.04 of full, sd 0.089 over the tool's 128 creatures; 1.03 and
 # 0.088 without the cap).
 DAMPING_CAP = 1.0

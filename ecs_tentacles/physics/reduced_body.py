@@ -36,7 +36,7 @@ if TYPE_CHECKING:
 # a reduced creature's pace apart from its full self's: the per-creature progress ratio
 # has an sd of 0.089 at 120 Hz and 0.098 at 480 Hz, 0.045 with every link kept at 120 Hz
 # and 0.009 (the floor) with every link at 480 Hz (128 creatures, `tools/reduced_pace.py
-# --model`, README "Crowds").
+# --model`, docs/crowds.md).
 LINK_SHARE = 0.5
 AXES = ("curl", "sweep", "twist")
 

@@ -1,6 +1,7 @@
 """Race to the flag: steer your creature to the flag before the rivals crawl there.
 
-A game mode written from the README, as a plugin (`ecs_tentacles.game`):
+A game mode written from the handbook (docs/extending/game-modes.md), as a plugin
+(`ecs_tentacles.game`):
 
     "plugins": {"race": {}},
     "game": {"mode": "race", "level": "1. Sprint", "runner": "you",

@@ -11,6 +11,6 @@ FIFO. What reads them goes through here:
 - `strict_json`: JSON as users write it, every key once in its object and every number
   finite (scenes and levels).
 
-What each reader checks beyond that (digests, signatures, budgets) is README
-"Security and limits".
+What each reader checks beyond that (digests, signatures, budgets) is in the
+handbook's "Files it trusts and checks" (docs/trust.md).
 """
