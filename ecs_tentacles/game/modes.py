@@ -17,19 +17,24 @@
   `details` (the mode's counts for `--json`: penned, need...) and `text` (a phrase for
   `run`'s line). A result that is not `PLAYING` ends `run` and `play --headless`.
 
-Pure data (no command, no GL): a feature imports it to register its mode.
+- `PlayedGame` and `Referee`: what every mode's game resource and referee system share
+  (the level's start and restart, the outcome, the clock that runs while it is played).
+
+No command, no GL: a feature imports it to register its mode.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
 from ecs_tentacles.registry import Registry
+from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
+    from ecs_tentacles.snapshot import Snapshot
 
 PLAYING, WON, LOST = "playing", "won", "lost"
 Problem = tuple[tuple[str | int, ...], str]
@@ -74,3 +79,56 @@ class GameMode:
 
 class GameModes(Registry[GameMode]):
     """The modes the plugins on registered, by `GameMode.name`."""
+
+
+class PlayedGame:
+    """What a game mode's resource shares: its `state` (with `frames` played and the
+    `outcome`), the frame rate `fps`, and the level's `start` (a snapshot taken when the
+    level is ready, not itself in snapshots)."""
+
+    state: Any
+    fps: float
+    start: Snapshot | None = None
+
+    def restart(self, world: Host) -> None:
+        """Back to the level's start: the world as it was built, bit for bit."""
+        if self.start is None:
+            raise RuntimeError("the level has no start yet (the world is still being built)")
+        world.restore(self.start)
+
+    @property
+    def outcome(self) -> str:
+        return str(self.state.outcome)
+
+    @property
+    def elapsed(self) -> float:
+        """Seconds of game time played."""
+        return float(self.state.frames / self.fps)
+
+
+G = TypeVar("G", bound=PlayedGame)
+
+
+class Referee(System, Generic[G]):
+    """A mode's referee (stage output): while its game is played, the clock moves a
+    frame and `judge` decides from the mantles where things stand; once the game is won
+    or lost, nothing. A mode's referee names its game (`played`) and judges."""
+
+    stage = "output"
+    reads = ("transforms.pos", "creatures.entity", "creatures.mantle_row")
+    writes = ()
+
+    def played(self, world: Host) -> G:
+        """The game this referee keeps (its mode's resource)."""
+        raise NotImplementedError
+
+    def judge(self, world: Host, game: G) -> None:
+        """After the frame `game.state.frames` counts: penned, arrived, won or lost."""
+        raise NotImplementedError
+
+    def process(self, world: Host, dt: float) -> None:
+        game = self.played(world)
+        if game.state.outcome != PLAYING:
+            return
+        game.state.frames += 1
+        self.judge(world, game)

@@ -20,6 +20,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ecs_tentacles.game.modes import PlayedGame
+
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
     from ecs_tentacles.snapshot import Snapshot
@@ -60,7 +62,7 @@ class GameState:
         return copy.deepcopy(self)
 
 
-class HerdingGame:
+class HerdingGame(PlayedGame):
     """The level's rules (from the scene's `game`) and the game's state."""
 
     provided_by = "herding"
@@ -86,7 +88,7 @@ class HerdingGame:
         self.herd: dict[str, float] = {**HERD_DEFAULTS, **(game.get("herd") or {})}
         self.fps = float(fps)
         start = np.asarray(predator.get("position", (0.0, -3.0)), dtype=np.float64)
-        self.state = GameState(start.copy(), start.copy())
+        self.state: GameState = GameState(start.copy(), start.copy())
         self.start: Snapshot | None = None  # the level's start (`ready`), not in snapshots
 
     # -- what the player does ------------------------------------------------------------
@@ -104,25 +106,10 @@ class HerdingGame:
             self.state.running = bool(running)
             self.state.runs.append((world.frame, bool(running)))
 
-    def restart(self, world: Host) -> None:
-        """Back to the level's start: the world as it was built, bit for bit."""
-        if self.start is None:
-            raise RuntimeError("the level has no start yet (the world is still being built)")
-        world.restore(self.start)
-
     # -- what the HUD and the bot read ---------------------------------------------------
-    @property
-    def outcome(self) -> str:
-        return self.state.outcome
-
     @property
     def penned(self) -> int:
         return len(self.state.penned)
-
-    @property
-    def elapsed(self) -> float:
-        """Seconds of game time played."""
-        return self.state.frames / self.fps
 
     @property
     def left(self) -> float:

@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ecs_tentacles.game.modes import PLAYING
+from ecs_tentacles.game.modes import PLAYING, PlayedGame
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
@@ -47,7 +47,7 @@ class RaceState:
         return copy.deepcopy(self)
 
 
-class RaceGame:
+class RaceGame(PlayedGame):
     """The level's rules (the scene's `game`, defaults filled) and the race's state."""
 
     provided_by = "race"
@@ -61,7 +61,7 @@ class RaceGame:
         self.rivals_wait = float(rules["rivals_wait"])
         self.fps = float(fps)
         self.runner = NOBODY  # the runner's entity, once the creatures are built
-        self.state = RaceState()
+        self.state: RaceState = RaceState()
         self.start: Snapshot | None = None  # the level's start (`ready`), not in snapshots
 
     # -- what the player does ------------------------------------------------------------
@@ -77,21 +77,7 @@ class RaceGame:
             self.state.sent = None  # sent again, even to the same point
         self.state.log.append((world.frame, x, y, add))
 
-    def restart(self, world: Host) -> None:
-        """Back to the level's start: the world as it was built, bit for bit."""
-        if self.start is None:
-            raise RuntimeError("the level has no start yet (the world is still being built)")
-        world.restore(self.start)
-
     # -- what the HUD and a player read --------------------------------------------------
-    @property
-    def outcome(self) -> str:
-        return self.state.outcome
-
-    @property
-    def elapsed(self) -> float:
-        """Seconds of race time run."""
-        return self.state.frames / self.fps
 
     @property
     def left(self) -> float:

@@ -16,28 +16,24 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ecs_tentacles.game.modes import Referee as ModeReferee
 from ecs_tentacles.herding.events import CreatureLeft, CreaturePenned, GameLost, GameWon
-from ecs_tentacles.herding.game import LOST, PLAYING, WON, HerdingGame
-from ecs_tentacles.system import System
+from ecs_tentacles.herding.game import LOST, WON, HerdingGame
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
 
 
-class Referee(System):
+class Referee(ModeReferee[HerdingGame]):
     """Pens creatures, runs the clock, and ends the game."""
 
     name = "herding_referee"
-    stage = "output"
-    reads = ("transforms.pos", "creatures.entity", "creatures.mantle_row")
-    writes = ()
 
-    def process(self, world: Host, dt: float) -> None:
-        game = world.resource(HerdingGame)
+    def played(self, world: Host) -> HerdingGame:
+        return world.resource(HerdingGame)
+
+    def judge(self, world: Host, game: HerdingGame) -> None:
         state = game.state
-        if state.outcome != PLAYING:
-            return
-        state.frames += 1
         creatures = world.creatures
         mantles = world.transforms.pos[creatures.mantle_row]
         inside = game.in_pen(mantles[:, :2])

@@ -15,29 +15,25 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ecs_tentacles.game.modes import LOST, PLAYING, WON
+from ecs_tentacles.game.modes import LOST, WON
+from ecs_tentacles.game.modes import Referee as ModeReferee
 from ecs_tentacles.race.events import RaceFinished
 from ecs_tentacles.race.game import NOBODY, RaceGame
-from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
 
 
-class Referee(System):
+class Referee(ModeReferee[RaceGame]):
     """Runs the clock and ends the race at the flag."""
 
     name = "race_referee"
-    stage = "output"
-    reads = ("transforms.pos", "creatures.entity", "creatures.mantle_row")
-    writes = ()
 
-    def process(self, world: Host, dt: float) -> None:
-        race = world.resource(RaceGame)
+    def played(self, world: Host) -> RaceGame:
+        return world.resource(RaceGame)
+
+    def judge(self, world: Host, race: RaceGame) -> None:
         state = race.state
-        if state.outcome != PLAYING:
-            return
-        state.frames += 1
         creatures = world.creatures
         there = creatures.entity[race.at_flag(world.transforms.pos[creatures.mantle_row])]
         if race.runner in there:
