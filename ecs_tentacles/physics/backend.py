@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import functools
 import os
-import warnings
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
@@ -49,7 +48,7 @@ from ecs_tentacles.physics.rounds import Ready, Rounds
 from ecs_tentacles.physics.sleep import Sleep, SleepState
 from ecs_tentacles.physics.stepping import Segment, Work, plan, step_segments
 from ecs_tentacles.physics.tiers import FULL, KINEMATIC, REDUCED, reduced_substeps
-from ecs_tentacles.physics.view import CreatureView, CreatureViews
+from ecs_tentacles.physics.view import CreatureViews
 
 if TYPE_CHECKING:
     from ecs_tentacles.physics.host import PhysicsHost
@@ -135,13 +134,6 @@ class PhysicsBackend(Membership):
     soften = property(lambda self: self.roster.soften)
     proxies_used = property(lambda self: self.roster.proxies_used)
     tier = property(lambda self: self.roster.tier)
-
-    def _index_views(self, creature_rows: int) -> None:
-        """Each creature's `CreatureView`, and where to find it by creature-store row."""
-        roster = self.roster
-        self.views = CreatureViews(roster)
-        self.view_of_creature_row = np.full(creature_rows, -1, dtype=np.int64)
-        self.view_of_creature_row[roster.creature_row] = np.arange(len(roster))
 
     def rebuild_models(self, world: PhysicsHost) -> None:
         """Compile every morphology's model again (the static ground changed: terrain
@@ -411,26 +403,6 @@ class PhysicsBackend(Membership):
     @property
     def substep_dt(self) -> float:
         return float(self.batches[0].model.opt.timestep) if self.batches else 0.0
-
-    def view_of(self, creature: Creature) -> CreatureView:
-        """The physics of `creature` (its batch, row and ids)."""
-        return self.views[int(self.view_of_creature_row[creature.row])]
-
-    # -- names kept for scripts written before views had their name -------------------
-    def group_of(self, creature: Creature) -> CreatureView:
-        """Deprecated: `view_of` (a creature's physics is a view, not a group)."""
-        warnings.warn(
-            "physics.group_of is deprecated: use physics.view_of", DeprecationWarning, stacklevel=2
-        )
-        return self.view_of(creature)
-
-    @property
-    def groups(self) -> CreatureViews:
-        """Deprecated: `views` (each creature's `CreatureView`)."""
-        warnings.warn(
-            "physics.groups is deprecated: use physics.views", DeprecationWarning, stacklevel=2
-        )
-        return self.views
 
     @property
     def bodies(self) -> int:

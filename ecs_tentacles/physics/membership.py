@@ -3,13 +3,15 @@
 `add_creature` gives a just-built creature a row in the batch of its morphology
 (compiling a model only for a new morphology) and a place in every per-creature table
 (roster, contact proxies, health, sleep, level of detail); `remove_creature` takes one
-out after its store rows were removed, renumbering the store rows the batches hold.
+out after its store rows were removed, renumbering the store rows the batches hold;
+`view_of(creature)` finds a creature's physics (the index is made again after each).
 Nothing of any other creature changes: each is its own row of state. `Membership` is
 part of `PhysicsBackend` (its parts are declared here for the type checker).
 """
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
@@ -22,6 +24,7 @@ from ecs_tentacles.physics.model import build_spec, model_layout
 from ecs_tentacles.physics.reduced import ReducedModel
 from ecs_tentacles.physics.reduced_body import chains, reduced_spec
 from ecs_tentacles.physics.tiers import FULL, reduced_substeps
+from ecs_tentacles.physics.view import CreatureView, CreatureViews
 
 if TYPE_CHECKING:
     from ecs_tentacles.physics.health import HealthCheck
@@ -67,8 +70,36 @@ class Membership:
     health: HealthCheck
     sleep: Sleep
     lod: LevelOfDetail
+    views: CreatureViews
+    view_of_creature_row: np.ndarray
 
-    def _index_views(self, creature_rows: int) -> None: ...
+    def _index_views(self, creature_rows: int) -> None:
+        """Each creature's `CreatureView`, and where to find it by creature-store row
+        (after every join and leave)."""
+        roster = self.roster
+        self.views = CreatureViews(roster)
+        self.view_of_creature_row = np.full(creature_rows, -1, dtype=np.int64)
+        self.view_of_creature_row[roster.creature_row] = np.arange(len(roster))
+
+    def view_of(self, creature: Creature) -> CreatureView:
+        """The physics of `creature` (its batch, row and ids)."""
+        return self.views[int(self.view_of_creature_row[creature.row])]
+
+    # -- names kept for scripts written before views had their name -------------------
+    def group_of(self, creature: Creature) -> CreatureView:
+        """Deprecated: `view_of` (a creature's physics is a view, not a group)."""
+        warnings.warn(
+            "physics.group_of is deprecated: use physics.view_of", DeprecationWarning, stacklevel=2
+        )
+        return self.view_of(creature)
+
+    @property
+    def groups(self) -> CreatureViews:
+        """Deprecated: `views` (each creature's `CreatureView`)."""
+        warnings.warn(
+            "physics.groups is deprecated: use physics.views", DeprecationWarning, stacklevel=2
+        )
+        return self.views
 
     def add_creature(self, world: PhysicsHost, entity: int) -> int:
         """Give the just-built creature `entity` its physics, at its built pose: a row in
