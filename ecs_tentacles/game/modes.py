@@ -25,6 +25,7 @@ No command, no GL: a feature imports it to register its mode.
 
 from __future__ import annotations
 
+from abc import ABC, abstractmethod
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Generic, TypeVar
@@ -109,7 +110,7 @@ class PlayedGame:
 G = TypeVar("G", bound=PlayedGame)
 
 
-class Referee(System, Generic[G]):
+class Referee(System, ABC, Generic[G]):
     """A mode's referee (stage output): while its game is played, the clock moves a
     frame and `judge` decides from the mantles where things stand; once the game is won
     or lost, nothing. A mode's referee names its game (`played`) and judges."""
@@ -118,13 +119,13 @@ class Referee(System, Generic[G]):
     reads = ("transforms.pos", "creatures.entity", "creatures.mantle_row")
     writes = ()
 
+    @abstractmethod
     def played(self, world: Host) -> G:
         """The game this referee keeps (its mode's resource)."""
-        raise NotImplementedError
 
+    @abstractmethod
     def judge(self, world: Host, game: G) -> None:
         """After the frame `game.state.frames` counts: penned, arrived, won or lost."""
-        raise NotImplementedError
 
     def process(self, world: Host, dt: float) -> None:
         game = self.played(world)
