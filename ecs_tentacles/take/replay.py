@@ -85,6 +85,11 @@ def problem(header: dict[str, Any]) -> str | None:
     return None
 
 
+def body_owners(header: dict[str, Any]) -> np.ndarray:
+    """Each take body's creature index (bodies,)."""
+    return np.array([body["creature"] for body in header["bodies"]], dtype=np.int64)
+
+
 def body_rows(creature: dict[str, Any]) -> list[int]:
     """A take creature's body indices in clip order: mantle, then links by tentacle."""
     return [creature["mantle"], *(i for chain in creature["tentacles"] for i in chain)]
@@ -236,6 +241,7 @@ def fill(
     quat: np.ndarray,
     bodies: np.ndarray | None = None,
     whole: np.ndarray | None = None,
+    owners: np.ndarray | None = None,
 ) -> None:
     """Put the poses of every replayed creature-frame of `arrays` (per-frame replay
     arrays of some frames) into `pos` (frames, bodies, 3) and `quat` of those frames.
@@ -244,6 +250,7 @@ def fill(
     the sucker links, not every link), except at the creature-frames `whole` (frames,
     creatures) marks, posed whole; a replayed creature's other bodies are left at the
     origin with the identity rotation (the file's zeros are no rotation at all).
+    `owners`: each body's creature (`body_owners`), when the caller keeps it.
     """
     if header.get(KEY) is None:
         return
@@ -257,8 +264,8 @@ def fill(
         return
     needed = np.zeros(pos.shape[1], dtype=bool)
     needed[bodies] = True
-    owner_of_body = np.array([b["creature"] for b in header["bodies"]], dtype=np.int64)
-    quat[replayed[:, owner_of_body] & ~needed] = IDENTITY
+    owners = body_owners(header) if owners is None else owners
+    quat[replayed[:, owners] & ~needed] = IDENTITY
     full = np.zeros(len(frame), dtype=bool) if whole is None else whole[frame, creature]
     _fill(header, clips, arrays, out, (frame[full], creature[full]), None)
     _fill(header, clips, arrays, out, (frame[~full], creature[~full]), needed)

@@ -200,7 +200,10 @@ class TakeSource:
         if problem:
             raise TakeError(f"{self.path}: {problem}")
         part = None if whole is None else whole[first:end]
-        take_replay.fill(header, self._clips, arrays, arrays["pos"], arrays["quat"], bodies, part)
+        owners = None if bodies is None else self._body_owners
+        take_replay.fill(
+            header, self._clips, arrays, arrays["pos"], arrays["quat"], bodies, part, owners
+        )
         checked = {n: a for n, a in arrays.items() if n not in take_replay.PER_FRAME}
         problem = data_problem(checked, tracks_of(header))
         if problem:
@@ -216,6 +219,11 @@ class TakeSource:
             sucker_anchor=arrays["sucker_anchor"],
             tracks=rest,
         )
+
+    @functools.cached_property
+    def _body_owners(self) -> np.ndarray:
+        """Each body's creature, worked out once (a reader asking for some bodies)."""
+        return take_replay.body_owners(self.header)
 
     def _later(self, name: str, k: int, value: np.ndarray) -> np.ndarray:
         """The values of the items chunk `k` of `name` lacks, at the first frame holding them."""
