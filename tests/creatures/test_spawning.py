@@ -3,9 +3,8 @@
 from __future__ import annotations
 
 import copy
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from contextlib import contextmanager
-from typing import Any
 
 import numpy as np
 import pytest
@@ -13,24 +12,7 @@ import pytest
 from ecs_tentacles.components import Creature, Motor, Tentacle, Transform
 from ecs_tentacles.creatures.spawning import SpawnError
 from ecs_tentacles.world import World
-
-
-def _creature(name: str, x: float, y: float = 0.0, goal: tuple[float, float] | None = None):
-    spec = {"name": name, "position": [x, y], "tentacles": {"count": 5, "links": 6}}
-    if goal is not None:
-        spec["goals"] = [{"position": list(goal)}]
-    return spec
-
-
-def _scene(creatures: list[dict]) -> dict:
-    return {"version": 1, "name": "spawning", "creatures": creatures}
-
-
-APART = [
-    _creature("a", 0.0, goal=(0.0, 3.0)),
-    _creature("b", 6.0, goal=(6.0, -3.0)),
-    _creature("c", 12.0, goal=(12.0, 3.0)),
-]
+from tests.creatures.spawn_scenes import APART, creature_entry, scene_of
 
 
 def _bodies(world: World, name: str) -> np.ndarray:
@@ -44,8 +26,8 @@ def _bodies(world: World, name: str) -> np.ndarray:
 @contextmanager
 def _twins() -> Iterator[tuple[World, World]]:
     """Two identical worlds of `APART`, 20 frames in, stepped on two threads."""
-    with World.from_scene(_scene(APART), threads=2) as one:
-        with World.from_scene(_scene(APART), threads=2) as two:
+    with World.from_scene(scene_of(APART), threads=2) as one:
+        with World.from_scene(scene_of(APART), threads=2) as two:
             one.step(20)
             two.step(20)
             yield one, two
@@ -53,7 +35,7 @@ def _twins() -> Iterator[tuple[World, World]]:
 
 def test_a_spawn_leaves_every_bystander_bit_identical():
     with _twins() as (quiet, busy):
-        newcomer = busy.spawn(_creature("d", 30.0, goal=(30.0, 3.0)))
+        newcomer = busy.spawn(creature_entry("d", 30.0, goal=(30.0, 3.0)))
         quiet.step(90)
         busy.step(90)
         for name in ("a", "b", "c"):
@@ -82,7 +64,7 @@ def test_a_despawn_leaves_every_bystander_bit_identical():
 
 
 def test_components_made_before_a_despawn_still_find_their_rows():
-    with World.from_scene(_scene(APART)) as world:
+    with World.from_scene(scene_of(APART)) as world:
         c = world.component(world.creature("c"), Creature)
         first_link = world.component(c.tentacles[0], Tentacle).links[0]
         motor = world.component(first_link, Motor)
@@ -98,7 +80,7 @@ def test_components_made_before_a_despawn_still_find_their_rows():
 
 
 def test_despawn_then_spawn_reuses_the_batch_and_steps_on():
-    with World.from_scene(_scene(APART)) as world:
+    with World.from_scene(scene_of(APART)) as world:
         world.step(10)
         spec = copy.deepcopy(world.creature_specs[world.creature("b")])
         world.despawn(world.creature("b"))
@@ -109,58 +91,8 @@ def test_despawn_then_spawn_reuses_the_batch_and_steps_on():
         assert world.physics.health.recoveries == 0
 
 
-def test_a_spawn_onto_a_creature_is_refused_in_one_line_or_moved():
-    with World.from_scene(_scene(APART)) as world:
-        with pytest.raises(SpawnError) as refused:
-            world.spawn(_creature("d", 0.1))
-        (line,) = str(refused.value).splitlines()
-        assert "overlaps creature 'a'" in line and "on_overlap='move'" in line
-        assert len(world.physics) == 3  # nothing was built
-        seen = []
-        world.events.on("creature_spawned", lambda **e: seen.append(e))
-        moved = world.spawn(_creature("d", 0.1), on_overlap="move")
-        (event,) = seen
-        assert event["creature"] == moved and event["moved_to"] is not None
-        x, y = event["moved_to"][:2]
-        assert np.hypot(x - 0.1, y) > 0.3
-        assert world.component(moved, Transform).pos[0] == pytest.approx(x, abs=0.01)
-        world.step(20)
-        assert world.physics.health.recoveries == 0
-
-
-def test_a_bad_creature_entry_names_the_field_in_one_line():
-    with World.from_scene(_scene(APART)) as world:
-        with pytest.raises(SpawnError) as bad:
-            world.spawn({"name": "d", "position": [20, 0], "tentacles": {"count": 0}})
-        assert str(bad.value).startswith("creature.tentacles.count:")
-        with pytest.raises(SpawnError, match=r"^creature: must be an object"):
-            world.spawn(["not", "a", "creature"])  # type: ignore[arg-type]
-        with pytest.raises(KeyError, match="not a creature"):
-            world.despawn(10_000)
-        assert len(world.physics) == 3
-
-
-@pytest.mark.parametrize("bad", [float("nan"), float("inf"), -float("inf")])
-def test_a_position_or_heading_that_is_not_finite_is_refused(bad: float):
-    """NaN passes every numeric bound; spawned, it froze the creature after three blow-ups."""
-    with World.from_scene(_scene(APART)) as world:
-        with pytest.raises(SpawnError, match=r"^creature.position\[0\]: must be a finite number"):
-            world.spawn(_creature("d", 20.0), position=(bad, 0.0))
-        with pytest.raises(SpawnError, match=r"^creature.heading_deg: must be a finite number"):
-            world.spawn(_creature("d", 20.0), heading_deg=bad)
-        assert len(world.physics) == 3
-
-
-def test_a_taken_name_gets_a_suffix():
-    with World.from_scene(_scene(APART)) as world:
-        first = world.spawn(_creature("a", 20.0))
-        second = world.spawn(_creature("a", 26.0))
-        assert world.creature_name(first) == "a_2"
-        assert world.creature_name(second) == "a_3"
-
-
 def test_restoring_a_snapshot_from_before_a_spawn_removes_the_newcomer():
-    with World.from_scene(_scene(APART)) as world:
+    with World.from_scene(scene_of(APART)) as world:
         world.step(10)
         snap = world.snapshot()
         world.step(40)
@@ -168,8 +100,8 @@ def test_restoring_a_snapshot_from_before_a_spawn_removes_the_newcomer():
         world.restore(snap)
         gone = []
         world.events.on("creature_despawned", lambda **e: gone.append(e["creature_name"]))
-        world.spawn(_creature("d", 30.0, goal=(30.0, 3.0)))
-        world.spawn({**_creature("e", -30.0), "tentacles": {"count": 7}})  # a new model
+        world.spawn(creature_entry("d", 30.0, goal=(30.0, 3.0)))
+        world.spawn({**creature_entry("e", -30.0), "tentacles": {"count": 7}})  # a new model
         world.step(25)
         world.restore(snap)
         assert sorted(gone) == ["d", "e"]
@@ -182,10 +114,10 @@ def test_restoring_a_snapshot_from_before_a_spawn_removes_the_newcomer():
 def test_a_snapshot_naming_a_despawned_creature_is_refused_and_changes_nothing():
     from ecs_tentacles.snapshot import SnapshotMismatch
 
-    with World.from_scene(_scene(APART)) as world:
+    with World.from_scene(scene_of(APART)) as world:
         snap = world.snapshot()
         world.despawn(world.creature("b"))
-        newcomer = world.spawn(_creature("d", 30.0))
+        newcomer = world.spawn(creature_entry("d", 30.0))
         with pytest.raises(SnapshotMismatch, match="creature 'b' was despawned since"):
             world.restore(snap)
         assert world.creature_name(newcomer) == "d"  # still there: nothing changed
@@ -196,10 +128,10 @@ def test_a_take_records_the_roster_per_frame(tmp_path):
     from ecs_tentacles.record.systems.record import Record
     from ecs_tentacles.take import Take
 
-    with World.from_scene(_scene(APART)) as world:
+    with World.from_scene(scene_of(APART)) as world:
         record = world.add_system(Record())
         world.step(10)
-        newcomer = world.spawn(_creature("d", 30.0, goal=(30.0, 3.0)))
+        newcomer = world.spawn(creature_entry("d", 30.0, goal=(30.0, 3.0)))
         world.step(10)
         world.despawn(world.creature("b"))
         world.step(10)
@@ -306,7 +238,7 @@ def test_what_a_despawn_updates_in_place_equals_what_a_rebuild_makes():
 
 def test_a_newcomer_meets_the_creatures_there_through_contact():
     octopus = {"name": "a", "position": [0.0, 0.0], "goals": [{"position": [3.0, 0.0]}]}
-    scene = _scene([octopus])
+    scene = scene_of([octopus])
     scene["avoidance"] = {"enabled": False}  # straight into each other, not around
     with World.from_scene(scene) as world:
         world.step(5)
@@ -323,10 +255,10 @@ def test_a_newcomer_meets_the_creatures_there_through_contact():
 
 def test_a_spawn_inside_a_rock_is_refused_or_moved_out_of_it():
     rock = {"obstacles": [{"shape": "box", "position": [5.0, 0.0, 0.5], "size": [2, 2, 1]}]}
-    with World.from_scene({**_scene(APART[:1]), "terrain": rock}) as world:
+    with World.from_scene({**scene_of(APART[:1]), "terrain": rock}) as world:
         with pytest.raises(SpawnError, match="overlaps an obstacle"):
-            world.spawn(_creature("d", 5.0))
-        moved = world.spawn(_creature("d", 5.0), on_overlap="move")
+            world.spawn(creature_entry("d", 5.0))
+        moved = world.spawn(creature_entry("d", 5.0), on_overlap="move")
         x, y = world.component(moved, Transform).pos[:2]
         assert max(abs(x - 5.0), abs(y)) > 1.0  # out of the 2 m box
         world.step(20)
@@ -334,7 +266,7 @@ def test_a_spawn_inside_a_rock_is_refused_or_moved_out_of_it():
 
 
 def test_models_rebuilt_after_a_body_plan_left_retire_its_empty_batch():
-    with World.from_scene(_scene(APART)) as world:
+    with World.from_scene(scene_of(APART)) as world:
         odd = world.spawn({"name": "odd", "tentacles": {"count": 3}}, position=(30.0, 0.0))
         assert world.physics.compiles == 2
         world.despawn(odd)
@@ -377,8 +309,8 @@ def test_a_body_plan_whose_first_creature_left_still_gets_its_reduced_model():
     """The reduced model is compiled lazily, when a creature of the plan first drops to the
     reduced tier; it was built from the plan's first creature, gone by then (KeyError: the
     physics system failed and the sandbox froze)."""
-    scene = {**_scene(APART), "physics": {"lod": {"full": 1, "reduced": 64}}}
-    seven = {**_creature("e", -30.0), "tentacles": {"count": 7, "links": 4}}
+    scene = {**scene_of(APART), "physics": {"lod": {"full": 1, "reduced": 64}}}
+    seven = {**creature_entry("e", -30.0), "tentacles": {"count": 7, "links": 4}}
     with World.from_scene(scene) as world:
         snap = world.snapshot()
         world.step(5)
@@ -389,74 +321,3 @@ def test_a_body_plan_whose_first_creature_left_still_gets_its_reduced_model():
         world.step(30)
         assert world.lod.counts()["reduced"] >= 5
         assert world.physics.health.recoveries == 0
-
-
-def test_a_spawn_works_out_the_creatures_layout_once(
-    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
-) -> None:
-    """The physical checks' layout is the one the spot is checked with and the creature
-    is built from (it was worked out two or three times a spawn)."""
-    from ecs_tentacles.creatures import body, spawning
-    from ecs_tentacles.scene import construction, layouts, physical
-
-    calls: list[str] = []
-    real = construction.creature_layout
-
-    def counted(*args: Any, **kwargs: Any) -> Any:
-        calls.append("layout")
-        return real(*args, **kwargs)
-
-    for module in (spawning, body, layouts, physical):
-        monkeypatch.setattr(module, "creature_layout", counted, raising=False)
-    world = make_world("octopus")
-    calls.clear()  # building the scene's own creature
-    new = {"tentacles": {"count": 3, "links": 3}}
-    world.spawn({**new, "name": "a"}, position=(4.0, 4.0))
-    assert calls == ["layout"]
-    calls.clear()
-    world.spawn({**new, "name": "b"}, position=(4.0, 4.0), on_overlap="move")  # on "a"
-    free = len(calls)
-    assert free >= 2  # the checks' (the taken spot's), then spots on rings until a free one
-    calls.clear()
-    world.spawn({**new, "name": "c"}, position=(-4.0, -4.0), on_overlap="move")  # free
-    assert calls == ["layout"]
-
-
-def test_a_misspelt_placement_is_refused_not_dropped():
-    with World.from_scene(_scene(APART[:1]), threads=1) as world:
-        with pytest.raises(TypeError, match="'positon'"):
-            world.spawn(_creature("d", 30.0), positon=(30.0, 0.0))
-        assert len(world.physics) == 1  # nothing built
-        made = world.spawn(_creature("d", 0.0), position=(30.0, 0.0), heading_deg=90.0)
-        assert world.creature_specs[made]["position"] == [30.0, 0.0]
-        assert world.creature_specs[made]["heading_deg"] == 90.0
-
-
-@pytest.mark.parametrize("level", ["herding_1_field", "race_1_rock"])
-def test_a_creature_spawns_into_a_game_level(level: str) -> None:
-    """The entry is checked among the level's creatures and game: it was checked in a
-    scene of its own, which has no `game`, and refused ("game: required")."""
-    with World.from_scene(level, threads=1) as world:
-        before = len(world.physics)
-        made = world.spawn(_creature("visitor", 0.0), position=(20.0, 20.0), on_overlap="move")
-        assert len(world.physics) == before + 1
-        assert world.creature_name(made) == "visitor"
-        world.step(2)
-
-
-def test_a_bad_entry_names_its_fields_from_creature() -> None:
-    with World.from_scene(_scene(APART[:1]), threads=1) as world:
-        with pytest.raises(SpawnError) as raised:
-            world.spawn({"name": "x", "tentacles": {"count": 0, "links": 3, "ovverrides": []}})
-        count, unknown = raised.value.problems
-        assert count == "creature.tentacles.count: must be in [1, 16], got 0"
-        assert unknown.startswith("creature.tentacles.ovverrides: unknown key (allowed: count,")
-        with pytest.raises(SpawnError) as raised:
-            world.spawn({"name": "y", "tentacles": {"count": 3, "overrides": [{"index": 5}]}})
-        assert raised.value.problems == [
-            "creature.tentacles.overrides[0].index: must be < count (3), got 5"
-        ]
-        with pytest.raises(SpawnError) as raised:
-            world.spawn({"name": "z", "mantle": {"height": 0.001}}, position=(9.0, 9.0))
-        assert raised.value.problems[0].startswith("creature.mantle: is too flat to simulate")
-        assert len(world.physics) == 1
