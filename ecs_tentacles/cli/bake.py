@@ -32,7 +32,8 @@ from ecs_tentacles.cli.world_options import CODE, PHYSICS, SEED, parents, world_
 from ecs_tentacles.distributed.driver import ShardFailed
 from ecs_tentacles.distributed.wedge import WedgeError
 from ecs_tentacles.export import SUFFIXES, work_units, write
-from ecs_tentacles.export.bake import BakePlan, bake, bake_to_file, output_kind
+from ecs_tentacles.export.bake import BakePlan, bake, bake_to_file
+from ecs_tentacles.export.kinds import output_kind
 from ecs_tentacles.export.skinned import Skin
 from ecs_tentacles.output.progress import bar
 from ecs_tentacles.skin.keys import KeyReport
@@ -70,7 +71,7 @@ def usd_missing(path: Path) -> str | None:
     return None
 
 
-def add_parser(commands: argparse._SubParsersAction) -> None:
+def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     parser = commands.add_parser(
         "bake",
         help="simulate a scene headless and write every frame to a take (.npz), USD or glTF",

@@ -22,7 +22,7 @@ from ecs_tentacles.cli.world_options import CODE, PHYSICS, parents, world_option
 from ecs_tentacles.scene.load import resolve_scene_path
 
 
-def add_parser(commands: argparse._SubParsersAction) -> None:
+def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     parser = commands.add_parser(
         "bench",
         help="time building and running a scene or a generated crowd, headless",

@@ -51,7 +51,7 @@ print("enabled" if "bl_ext.{repo}.{id}" in enabled else "not enabled")
 TIMEOUT = 300  # seconds an install may take (Blender starts in a few)
 
 
-def add_parser(commands: argparse._SubParsersAction) -> None:
+def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     parser = commands.add_parser(
         "blender-addon",
         help="write or install the Blender add-on that imports takes (crowds sharing clips)",

@@ -60,7 +60,7 @@ def tentacle_edit(text: str) -> tuple[int, dict[str, float]]:
     return int(index), changes
 
 
-def add_parser(commands: argparse._SubParsersAction) -> None:
+def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     parser = commands.add_parser(
         "create",
         help="the creature creator: a window, or --out FILE for scripts",

@@ -101,7 +101,7 @@ def crowd_from_args(n: int, args: argparse.Namespace) -> dict[str, Any]:
     return scene
 
 
-def add_parser(commands: argparse._SubParsersAction) -> None:
+def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     parser = commands.add_parser(
         "crowd",
         help="write a scene of N varied creatures whose paths cross",

@@ -20,8 +20,8 @@ from ecs_tentacles.cli.skin_options import skin_options
 from ecs_tentacles.cli.usd_validate import add_argument as add_validate_argument
 from ecs_tentacles.cli.usd_validate import validate_problem, validated
 from ecs_tentacles.export import write_usd_stream
-from ecs_tentacles.export.bake import output_kind
 from ecs_tentacles.export.glb_size import glb_note, glb_problem, glb_size, shapes_of_header
+from ecs_tentacles.export.kinds import output_kind
 from ecs_tentacles.export.skinned import Skin
 from ecs_tentacles.output.progress import bar, status
 from ecs_tentacles.skin.mesh import MeshError
@@ -33,7 +33,7 @@ FORMATS = (".usd", ".usda", ".usdc", ".glb")
 converted_file = output_path(*FORMATS)  # an output path for a conversion: USD or glTF
 
 
-def add_parser(commands: argparse._SubParsersAction) -> None:
+def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     parser = commands.add_parser(
         "export",
         help="convert a take (.npz from `bake`) to USD or glTF",

@@ -19,7 +19,7 @@ from typing import Any
 LISTING = "ecs_tentacles.herding.levels"  # levels(), stars_text(): the game's listing
 
 
-def add_parser(commands: argparse._SubParsersAction) -> None:
+def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     parser = commands.add_parser(
         "levels",
         help="list the game's levels: open or locked, par time, best time, stars",

@@ -27,7 +27,7 @@ from ecs_tentacles.scene.plugins import FROM, default_on, shipped
 from ecs_tentacles.scene.schema import builtin_keys
 
 
-def add_parser(commands: argparse._SubParsersAction) -> None:
+def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     parser = commands.add_parser(
         "migrate",
         help="rewrite a scene with an explicit plugins block (systems list -> plugins)",

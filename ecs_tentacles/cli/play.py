@@ -49,7 +49,7 @@ def ui_scale(text: str) -> float:
     return value
 
 
-def add_parser(commands: argparse._SubParsersAction) -> None:
+def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     parser = commands.add_parser(
         "play",
         help="open the sandbox: watch, click goals, tune tentacles (or render headless)",

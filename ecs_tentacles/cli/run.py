@@ -30,7 +30,7 @@ def positive_int(text: str) -> int:
     return bounded_int(1, 1_000_000)(text)
 
 
-def add_parser(commands: argparse._SubParsersAction) -> None:
+def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     parser = commands.add_parser(
         "run",
         help="simulate a scene headless and print sim time, wall time and real-time factor",

@@ -23,7 +23,7 @@ from ecs_tentacles.scene.registries import plugin_entries
 from ecs_tentacles.scene.schema import load_schema, schema_for
 
 
-def add_parser(commands: argparse._SubParsersAction) -> None:
+def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     parser = commands.add_parser(
         "schema",
         help="write the scene JSON Schema with the plugins' keys (for editors)",

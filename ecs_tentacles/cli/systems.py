@@ -16,7 +16,7 @@ from ecs_tentacles.scene.load import resolve_scene_path
 from ecs_tentacles.world import World
 
 
-def add_parser(commands: argparse._SubParsersAction) -> None:
+def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     parser = commands.add_parser(
         "systems",
         help="print the frame's systems: stage, plugin, reads, writes",

@@ -13,7 +13,7 @@ import sys
 from pathlib import Path
 
 from ecs_tentacles.cli.arguments import counted
-from ecs_tentacles.export.bake import output_kind
+from ecs_tentacles.export.kinds import output_kind
 from ecs_tentacles.output.progress import status
 
 

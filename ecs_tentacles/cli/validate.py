@@ -24,7 +24,7 @@ if TYPE_CHECKING:
     from ecs_tentacles.plugin import Plugin
 
 
-def add_parser(commands: argparse._SubParsersAction) -> None:
+def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     parser = commands.add_parser(
         "validate",
         help="check scene files against the schema (exit 0 if all are valid, 2 if not)",
