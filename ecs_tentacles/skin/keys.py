@@ -65,13 +65,15 @@ def slerp(a: np.ndarray, b: np.ndarray, t: np.ndarray) -> np.ndarray:
     wa = np.where(small, 1.0 - t, np.sin((1.0 - t) * angle) / sin)
     wb = np.where(small, t, np.sin(t * angle) / sin)
     out = wa[..., None] * a + wb[..., None] * b
-    return out / np.linalg.norm(out, axis=-1, keepdims=True)
+    unit: np.ndarray = out / np.linalg.norm(out, axis=-1, keepdims=True)
+    return unit
 
 
 def angle_between(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Rotation angle (degrees) between unit quaternions (..., 4)."""
     dot = np.abs(np.einsum("...c,...c->...", a, b))
-    return np.degrees(2.0 * np.arccos(np.clip(dot, -1.0, 1.0)))
+    degrees: np.ndarray = np.degrees(2.0 * np.arccos(np.clip(dot, -1.0, 1.0)))
+    return degrees
 
 
 def _brackets(keep: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -143,7 +145,8 @@ def reduce_rotations(
     def error(keep: np.ndarray) -> np.ndarray:  # the frames not needed bound no segment
         return np.where(needed, angle_between(interpolate_rotations(q, keep | ~needed), q), 0.0)
 
-    return _rdp(error, q.shape[:2], tolerance_deg, ends) & needed
+    keep: np.ndarray = _rdp(error, q.shape[:2], tolerance_deg, ends) & needed
+    return keep
 
 
 def reduce_points(p: np.ndarray, tolerance: float) -> np.ndarray:
@@ -151,6 +154,7 @@ def reduce_points(p: np.ndarray, tolerance: float) -> np.ndarray:
     p = np.asarray(p, dtype=np.float64)
 
     def error(keep: np.ndarray) -> np.ndarray:
-        return np.linalg.norm(interpolate_points(p, keep[:, 0]) - p, axis=1)[:, None]
+        errors: np.ndarray = np.linalg.norm(interpolate_points(p, keep[:, 0]) - p, axis=1)[:, None]
+        return errors
 
     return _rdp(error, (len(p), 1), tolerance)[:, 0]

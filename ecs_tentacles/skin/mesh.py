@@ -159,7 +159,8 @@ class _Builder:
 def smoothstep(x: np.ndarray) -> np.ndarray:
     """0 below 0, 1 above 1, 3x^2 - 2x^3 between."""
     x = np.clip(x, 0.0, 1.0)
-    return x * x * (3.0 - 2.0 * x)
+    eased: np.ndarray = x * x * (3.0 - 2.0 * x)
+    return eased
 
 
 def hole_offsets(radius: float, k: int) -> np.ndarray:
@@ -402,4 +403,5 @@ def vertex_normals(positions: np.ndarray, faces: np.ndarray) -> np.ndarray:
     normals = np.zeros_like(positions)
     for i in range(3):
         np.add.at(normals, faces[:, i], face)
-    return normals / np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-30)
+    unit: np.ndarray = normals / np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-30)
+    return unit

@@ -59,14 +59,16 @@ class SkinnedCreature:
     def rotations_at(self, frames: np.ndarray) -> np.ndarray:
         """Joint rotations (len(frames), J, 4) of the kept curves at `frames`."""
         curve = interpolate_rotations(self.animation.rotation, self.rotation_keys)
-        return curve[frames]
+        rotations: np.ndarray = curve[frames]
+        return rotations
 
     def translations_at(self, frames: np.ndarray) -> np.ndarray:
         """Joint translations (len(frames), J, 3): the root's kept curve, links' rest offsets."""
         out = self.animation.translation[frames].copy()
         root = interpolate_points(self.animation.translation[:, 0], self.translation_keys)
         out[:, 0] = root[frames]
-        return out
+        translations: np.ndarray = out
+        return translations
 
 
 def skinned_creatures(

@@ -29,7 +29,8 @@ from ecs_tentacles.take import Take
 
 def quat_conjugate(q: np.ndarray) -> np.ndarray:
     """Inverse of unit quaternions (..., 4)."""
-    return q * np.array([1.0, -1.0, -1.0, -1.0])
+    inverse: np.ndarray = q * np.array([1.0, -1.0, -1.0, -1.0])
+    return inverse
 
 
 def quat_matrix(q: np.ndarray) -> np.ndarray:

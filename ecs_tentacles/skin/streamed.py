@@ -82,7 +82,8 @@ class JointRotations:
             flip = np.einsum("kjc,kjc->kj", local[pick], self.last[mine]) < 0
             local[pick] = np.where(flip[..., None], -local[pick], local[pick])
             self.last[mine] = local[pick]
-        return local
+        flipped: np.ndarray = local
+        return flipped
 
     def _turned(self, local: np.ndarray, yaw: np.ndarray) -> None:
         """The roots' rotations in `local` (..., J, 4) seen from frames turned by `yaw`
