@@ -67,11 +67,13 @@ class Fence:
         metres clear of its posts (at most a quarter of the gate's width each side)."""
         off = np.angle(np.exp(1j * (np.asarray(angles) - self.heading)))
         clear = min(margin / self.radius, 0.5 * self.half_gate)
-        return np.abs(off) < self.half_gate - clear
+        through: np.ndarray = np.abs(off) < self.half_gate - clear
+        return through
 
     def inside(self, xy: np.ndarray) -> np.ndarray:
         """(n,) bool: points (n, 2) inside the pen's circle."""
-        return np.hypot(*(np.asarray(xy)[:, :2] - self.centre).T) < self.radius
+        inside: np.ndarray = np.hypot(*(np.asarray(xy)[:, :2] - self.centre).T) < self.radius
+        return inside
 
     def boxes(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The fence's boxes: centres (m, 2), half lengths (m,), angles (m,) of their
@@ -104,7 +106,8 @@ class Fence:
             ok &= ~hits | through
         goal = a + d
         near = np.abs(np.hypot(*goal.T) - self.radius) < CLEAR
-        return ok & (~near | self.in_gate(np.arctan2(goal[:, 1], goal[:, 0]), CLEAR))
+        ok_goal: np.ndarray = ok & (~near | self.in_gate(np.arctan2(goal[:, 1], goal[:, 0]), CLEAR))
+        return ok_goal
 
     def add_to_spec(
         self,

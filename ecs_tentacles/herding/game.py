@@ -136,7 +136,10 @@ class HerdingGame(PlayedGame):
 
     def in_pen(self, xy: np.ndarray) -> np.ndarray:
         """(n,) bool: points (n, 2) inside the pen."""
-        return np.hypot(*(np.asarray(xy)[:, :2] - self.pen_centre).T) < self.pen_radius
+        inside: np.ndarray = (
+            np.hypot(*(np.asarray(xy)[:, :2] - self.pen_centre).T) < self.pen_radius
+        )
+        return inside
 
     def summary(self) -> dict[str, Any]:
         """The game as a report gives it."""

@@ -104,7 +104,8 @@ class Bot:
             side = -side
         steps = [centre + keep * (radial + s) / np.sqrt(2.0) * 1.2 for s in (side, -side)]
         clear = [np.hypot(*(p - fence.centre)) > fence.radius + 0.5 for p in steps]
-        return steps[0] if clear[0] or not clear[1] else steps[1]
+        step: np.ndarray = steps[0] if clear[0] or not clear[1] else steps[1]
+        return step
 
     @staticmethod
     def _around(at: np.ndarray, centre: np.ndarray, keep: float, target: np.ndarray) -> np.ndarray:
@@ -127,7 +128,8 @@ class Bot:
         side = np.array([-radial[1], radial[0]])
         if np.dot(side, target - centre) < 0:
             side = -side
-        return centre + keep * (radial + side) / np.sqrt(2.0) * 1.2
+        step: np.ndarray = centre + keep * (radial + side) / np.sqrt(2.0) * 1.2
+        return step
 
 
 class Replay:

@@ -46,7 +46,8 @@ TOWARD_FLOCK = 0.15  # how much a fleeing creature bends toward its flock
 
 def _unit(vectors: np.ndarray) -> np.ndarray:
     length = np.linalg.norm(vectors, axis=-1, keepdims=True)
-    return np.divide(vectors, length, out=np.zeros_like(vectors), where=length > 1e-12)
+    unit: np.ndarray = np.divide(vectors, length, out=np.zeros_like(vectors), where=length > 1e-12)
+    return unit
 
 
 class Herd(System):
