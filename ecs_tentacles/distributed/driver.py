@@ -246,7 +246,8 @@ def ray_bake(
     allow_systems = options.allow_systems
     started = start_ray(address, cpus)
     try:
-        stats = RayStats(workers=float(ray.cluster_resources().get("CPU", 1)))
+        cpus_total = ray.cluster_resources().get("CPU", 1)  # type: ignore[no-untyped-call, unused-ignore]
+        stats = RayStats(workers=float(cpus_total))
         plugins = scene_plugins(plan.scene, plan.folder, allow_systems=allow_systems)
         tasks = default_tasks(stats.workers)
         stats.plan = plan_shards(plan.scene, plan.seconds, tasks, plugins)
@@ -352,7 +353,7 @@ def _run_all(
 
 def _meetings(
     plan: BakePlan, results: dict[tuple[int, ...], ShardResult], plugins: Sequence[Plugin]
-) -> list:
+) -> list[tuple[int, int, int]]:
     n = len(plan.scene["creatures"])
     first = next(iter(results.values())).spheres
     spheres = np.zeros((len(first), n, 4))

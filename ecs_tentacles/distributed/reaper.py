@@ -78,7 +78,7 @@ class Reaper:
 
 def _alive(pid: int) -> bool:
     try:
-        return psutil.Process(pid).status() != psutil.STATUS_ZOMBIE
+        return bool(psutil.Process(pid).status() != psutil.STATUS_ZOMBIE)  # (psutil: untyped)
     except psutil.Error:
         return False
 

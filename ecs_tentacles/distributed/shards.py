@@ -192,11 +192,13 @@ def segment_distance(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray, q1: np.ndar
         d = s1 - s0
         length2 = np.einsum("ij,ij->i", d, d)
         t = np.clip(np.einsum("ij,ij->i", x - s0, d) / np.where(length2 > 0, length2, 1), 0, 1)
-        return np.linalg.norm(x - (s0 + t[:, None] * d), axis=1)
+        distance: np.ndarray = np.linalg.norm(x - (s0 + t[:, None] * d), axis=1)
+        return distance
 
     def side(o: np.ndarray, s: np.ndarray, x: np.ndarray) -> np.ndarray:
         u, v = s - o, x - o
-        return np.sign(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0])
+        sides: np.ndarray = np.sign(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0])
+        return sides
 
     ends = np.minimum.reduce(
         [
