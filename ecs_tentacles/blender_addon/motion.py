@@ -54,7 +54,8 @@ def multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 def conjugate(q: np.ndarray) -> np.ndarray:
     """The inverse of unit quaternions (..., 4)."""
-    return q * np.array([1.0, -1.0, -1.0, -1.0])
+    inverse: np.ndarray = q * np.array([1.0, -1.0, -1.0, -1.0])
+    return inverse
 
 
 def rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -201,7 +202,8 @@ def unit(quat: np.ndarray, where: str) -> np.ndarray:
     if (length < 1e-6).any():
         at = np.argwhere(length[..., 0] < 1e-6)[0].tolist()
         raise ValueError(f"{where}: zero-length quaternion at {tuple(at)}")
-    return quat / length
+    unit: np.ndarray = quat / length
+    return unit
 
 
 @dataclass(frozen=True)

@@ -43,7 +43,8 @@ class Progress:
         self.manager.progress_end()
 
 
-class ImportTake(bpy.types.Operator, ImportHelper):
+# bpy has no type information outside Blender: its classes are Any to mypy
+class ImportTake(bpy.types.Operator, ImportHelper):  # type: ignore[misc, unused-ignore]
     """Import an ecs_tentacles take (.npz): creatures as armatures with skinned meshes"""
 
     bl_idname = "import_scene.ecs_tentacles_take"

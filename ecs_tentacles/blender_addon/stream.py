@@ -144,4 +144,5 @@ def _unit(quat: np.ndarray, path: Path, frames: np.ndarray, bodies: np.ndarray) 
         raise TakeFileError(
             f"{path}: quat: zero-length quaternion at frame {frames[k]}, body {bodies[k, j]}"
         )
-    return quat / length[..., None]
+    unit: np.ndarray = quat / length[..., None]
+    return unit
