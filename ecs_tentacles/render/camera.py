@@ -126,7 +126,8 @@ class OrbitCamera:
         return matrix
 
     def view_projection(self) -> np.ndarray:
-        return self.projection() @ self.view()
+        matrix: np.ndarray = self.projection() @ self.view()
+        return matrix
 
     def orbit(self, dx: float, dy: float) -> None:
         """Turn by mouse motion in pixels."""
@@ -261,7 +262,8 @@ class OrbitCamera:
         """Pixel coordinates (n, 2), origin bottom-left, of world points (n, 3)."""
         homogeneous = np.hstack([points, np.ones((len(points), 1))]) @ self.view_projection().T
         ndc = homogeneous[:, :2] / homogeneous[:, 3:4]
-        return (ndc + 1) / 2 * [self.width, self.height]
+        pixels: np.ndarray = (ndc + 1) / 2 * [self.width, self.height]
+        return pixels
 
 
 def ray_sphere(

@@ -71,7 +71,8 @@ VIEWS = ("skinned", "capsules")
 def _nlerp(a: np.ndarray, b: np.ndarray, t: float) -> np.ndarray:
     b = np.where((np.einsum("ij,ij->i", a, b) < 0)[:, None], -b, b)
     q = a + t * (b - a)
-    return q / np.linalg.norm(q, axis=1, keepdims=True)
+    unit: np.ndarray = q / np.linalg.norm(q, axis=1, keepdims=True)
+    return unit
 
 
 class Renderer:

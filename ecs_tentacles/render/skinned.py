@@ -73,7 +73,8 @@ def vertex_colours(mesh: SkinMesh, skeleton: Skeleton, colour: np.ndarray) -> np
     base = np.clip(colour * shade[:, None] + 0.08 * (1 - shade[:, None]), 0.0, 1.0)
     on_tube = (mesh.joints[:, 0] > 0) | (mesh.weights[:, 1] > 0)
     underside = np.clip(-mesh.normals[:, 2], 0.0, 1.0) ** 2 * on_tube
-    return base + 0.55 * underside[:, None] * (PALE - base)
+    shaded: np.ndarray = base + 0.55 * underside[:, None] * (PALE - base)
+    return shaded
 
 
 class SkinnedCreatures:
