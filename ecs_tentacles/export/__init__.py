@@ -14,7 +14,7 @@ import os
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
-from ecs_tentacles.export.bake import output_kind
+from ecs_tentacles.export.kinds import output_kind
 from ecs_tentacles.take import Take, TakeError
 
 if TYPE_CHECKING:

@@ -57,7 +57,8 @@ Progress = Callable[[int], object]
 
 def to_y_up_points(points: np.ndarray) -> np.ndarray:
     """(..., 3) z-up points or vectors -> y-up."""
-    return np.asarray(points, dtype=np.float64) @ Z_UP_TO_Y_UP.T
+    y_up: np.ndarray = np.asarray(points, dtype=np.float64) @ Z_UP_TO_Y_UP.T
+    return y_up
 
 
 def to_y_up_rotations(quat_wxyz: np.ndarray) -> np.ndarray:

@@ -232,7 +232,8 @@ class CurvesTrack:
             columns = np.concatenate([self._pair_columns, np.arange(first, len(self._owners))])
             order = np.argsort(every, kind="stable")
             self._pairs, self._pair_columns = every[order], columns[order]
-        return self._pair_columns[np.searchsorted(self._pairs, pairs)]
+        found: np.ndarray = self._pair_columns[np.searchsorted(self._pairs, pairs)]
+        return found
 
     def arrays(self, frames: int, copy: bool = True) -> dict[str, np.ndarray]:
         """The track's arrays for the first `frames` frames (`copy=False`: views of the
