@@ -8,11 +8,14 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ecs_tentacles.cli.arguments import frame_count, output_path, require_display
 from ecs_tentacles.cli.world_options import CODE, PHYSICS, SEED, parents, world_options
 from ecs_tentacles.scene.load import resolve_scene_path
+
+if TYPE_CHECKING:
+    from ecs_tentacles.host import Host
 
 SIZE_RULE = "an even number of pixels in [64, 8192]"
 
@@ -207,7 +210,7 @@ def handle(args: argparse.Namespace) -> int:
     return 0
 
 
-def game_ended(world: Any) -> bool:
+def game_ended(world: Host) -> bool:
     """True once the world's game (a level's) is won or lost: a headless play stops."""
     from ecs_tentacles.game.rules import playing
 
@@ -215,7 +218,7 @@ def game_ended(world: Any) -> bool:
     return found is not None and found[1].ended
 
 
-def game_report(world: Any) -> dict[str, Any]:
+def game_report(world: Host) -> dict[str, Any]:
     """`{"game": ...}`: the level's result as `--json` gives it ({} without a game)."""
     from ecs_tentacles.game.rules import playing
 

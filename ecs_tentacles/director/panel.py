@@ -38,6 +38,7 @@ from ecs_tentacles.render.registries import Panel, SandboxView
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
+    from ecs_tentacles.world import World
 
 log = logging.getLogger("ecs_tentacles.director")
 
@@ -73,7 +74,7 @@ class DirectorPanel(Panel):
     def preset(self) -> Preset:
         return self.presets[self.chosen]
 
-    def attach(self, world: Any) -> None:
+    def attach(self, world: World) -> None:
         self.stroke, self.grab_start = None, None
 
     # -- widgets -----------------------------------------------------------------------

@@ -17,7 +17,7 @@ again from its scene instead (`Sandbox.reset`), and the section says so.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from imgui_bundle import imgui
 from pyglet.window import key
@@ -30,7 +30,9 @@ from ecs_tentacles.render.registries import Panel
 from ecs_tentacles.snapshot import SnapshotMismatch
 
 if TYPE_CHECKING:
+    from ecs_tentacles.render.gui import Gui
     from ecs_tentacles.render.registries import SandboxView
+    from ecs_tentacles.world import World
 
 BANNER_WIDTH = 360.0
 
@@ -52,7 +54,7 @@ class GamePanel(Panel):
     def game(self) -> HerdingGame:
         return self.sandbox.world.resource(HerdingGame)
 
-    def attach(self, world: Any) -> None:
+    def attach(self, world: World) -> None:
         self.win, self.message = None, ""
         self.best = self._best()
 
@@ -95,7 +97,7 @@ class GamePanel(Panel):
         self.levels.open(following)
         return True
 
-    def draw(self, gui: Any) -> None:
+    def draw(self, gui: Gui) -> None:
         if self.levels.open_wanted():
             return  # the section is drawn for the new level from the next frame
         game = self.game
@@ -115,7 +117,7 @@ class GamePanel(Panel):
         if self.message:
             imgui.text_wrapped(self.message)
 
-    def windows(self, gui: Any) -> None:
+    def windows(self, gui: Gui) -> None:
         game = self.game
         self.levels.poll_run(game)
         if game.outcome not in (WON, LOST):

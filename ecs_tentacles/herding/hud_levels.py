@@ -18,7 +18,7 @@ level opened), `HerdingGame.run`.
 from __future__ import annotations
 
 import json
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from imgui_bundle import imgui
 from pyglet.window import key
@@ -28,6 +28,7 @@ from ecs_tentacles.scene.load import bundled_scene
 
 if TYPE_CHECKING:
     from ecs_tentacles.herding.game import HerdingGame
+    from ecs_tentacles.render.gui import Gui
     from ecs_tentacles.render.registries import SandboxView
 
 
@@ -79,7 +80,7 @@ class LevelPicker:
         if held != game.state.running:
             game.run(self.sandbox.world, held)
 
-    def draw(self, gui: Any, game: HerdingGame) -> None:
+    def draw(self, gui: Gui, game: HerdingGame) -> None:
         state = game.state
         label = "winded" if state.winded else "running" if game.sprinting else "walking"
         imgui.progress_bar(state.stamina, (-1.0, 0.0), f"stamina: {label}")

@@ -8,7 +8,7 @@ took the flag.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from imgui_bundle import imgui
 from pyglet.window import key
@@ -19,7 +19,9 @@ from ecs_tentacles.render.registries import Panel
 from ecs_tentacles.snapshot import SnapshotMismatch
 
 if TYPE_CHECKING:
+    from ecs_tentacles.render.gui import Gui
     from ecs_tentacles.render.registries import SandboxView
+    from ecs_tentacles.world import World
 
 BANNER_WIDTH = 360.0
 
@@ -36,7 +38,7 @@ class RacePanel(Panel):
     def race(self) -> RaceGame:
         return self.sandbox.world.resource(RaceGame)
 
-    def attach(self, world: Any) -> None:
+    def attach(self, world: World) -> None:
         self.message = ""
 
     def restart(self) -> None:
@@ -47,7 +49,7 @@ class RacePanel(Panel):
             if self.sandbox.reset():
                 self.message = "restarted: built again from the scene (a creature was removed)"
 
-    def draw(self, gui: Any) -> None:
+    def draw(self, gui: Gui) -> None:
         race = self.race
         imgui.text(race.level)
         gui.item("race level")
@@ -58,7 +60,7 @@ class RacePanel(Panel):
         if self.message:
             imgui.text_wrapped(self.message)
 
-    def windows(self, gui: Any) -> None:
+    def windows(self, gui: Gui) -> None:
         race = self.race
         if race.outcome not in (WON, LOST):
             return

@@ -11,12 +11,15 @@ colour, paler toward the tips) in one numpy pass.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ecs_tentacles.components import Creature, Link, Tentacle, Transform
 from ecs_tentacles.render.gpu import INSTANCE_FLOATS
+
+if TYPE_CHECKING:
+    from ecs_tentacles.host import Host
 
 
 @dataclass(frozen=True)
@@ -41,7 +44,7 @@ class LinkInstances:
     index: np.ndarray
 
 
-def creature_links(world: Any, creature: Creature, mantle_row: int) -> CreatureStatic:
+def creature_links(world: Host, creature: Creature, mantle_row: int) -> CreatureStatic:
     """`creature`'s link table, its rows relative to `mantle_row`."""
     rows, sizes, index, length = [], [], [], []
     for tentacle_entity in creature.tentacles:

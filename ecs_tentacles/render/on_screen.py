@@ -8,19 +8,23 @@ Reads the Transform store (mantle poses), `Creature` sizes and names, the camera
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ecs_tentacles.components import Creature
 from ecs_tentacles.render.camera import ray_sphere
 
+if TYPE_CHECKING:
+    from ecs_tentacles.render.renderer import Renderer
+    from ecs_tentacles.world import World
+
 Label = tuple[str, float, float]  # text, pixel x, pixel y (pyglet's: from the bottom)
 ABOVE = 1.8  # a label sits this many mantle heights (+ 5 cm) over the mantle's base
 PICK_GROW = 1.25  # a click this far out from a mantle still picks it
 
 
-def labels_over(world: Any, renderer: Any, entities: Sequence[int]) -> list[Label]:
+def labels_over(world: World, renderer: Renderer, entities: Sequence[int]) -> list[Label]:
     """Labels above the mantles of creature `entities` (the drawn ones among them)."""
     wanted = set(entities)
     chosen = [(i, e) for i, e in enumerate(renderer.creature_entities) if e in wanted]
@@ -34,7 +38,7 @@ def labels_over(world: Any, renderer: Any, entities: Sequence[int]) -> list[Labe
 
 
 def creatures_in(
-    world: Any, renderer: Any, corner: Sequence[float], other: Sequence[float]
+    world: World, renderer: Renderer, corner: Sequence[float], other: Sequence[float]
 ) -> list[int]:
     """The creatures whose mantle centre projects inside the pixel rectangle between
     `corner` and `other` (x, y; any two opposite corners), in drawing order."""
@@ -50,7 +54,7 @@ def creatures_in(
     return [entities[i] for i in np.flatnonzero(inside)]
 
 
-def creature_at(world: Any, renderer: Any, x: float, y: float) -> int | None:
+def creature_at(world: World, renderer: Renderer, x: float, y: float) -> int | None:
     """The creature whose mantle is under pixel (x, y), nearest first, or None."""
     entities = renderer.creature_entities
     if not entities:

@@ -45,6 +45,7 @@ from ecs_tentacles.registry import Registry
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
     from ecs_tentacles.render.camera import OrbitCamera
+    from ecs_tentacles.render.gui import Gui
     from ecs_tentacles.render.selection import Selection
     from ecs_tentacles.world import World
 
@@ -142,13 +143,13 @@ class Panel:
     closed: bool = False
     overlay_windows: bool = False  # its `windows` are editing aids: none in the clean view
 
-    def draw(self, gui: Any) -> None:
+    def draw(self, gui: Gui) -> None:
         """The section's widgets (called while it is open)."""
 
-    def windows(self, gui: Any) -> None:
+    def windows(self, gui: Gui) -> None:
         """More ImGui windows beside the panel (the fur timeline), every frame."""
 
-    def attach(self, world: Any) -> None:
+    def attach(self, world: World) -> None:
         """The sandbox draws `world` from now on (rebuilt or reset)."""
 
     def select(self, creature: int | None, tentacle: int | None) -> None:

@@ -19,9 +19,12 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 from ecs_tentacles.render.registries import UndoStates
+
+if TYPE_CHECKING:
+    from ecs_tentacles.world import World
 
 LIMIT = 200  # edits kept
 MERGE_SECONDS = 1.0  # a slider dragged: one edit while it keeps changing this often
@@ -30,11 +33,11 @@ MERGE_SECONDS = 1.0  # a slider dragged: one edit while it keeps changing this o
 class Edit(Protocol):
     label: str
 
-    def undo(self, world: Any) -> None: ...
-    def redo(self, world: Any) -> None: ...
+    def undo(self, world: World) -> None: ...
+    def redo(self, world: World) -> None: ...
 
 
-def plugin_state(world: Any) -> dict[tuple[str, int], Any]:
+def plugin_state(world: World) -> dict[tuple[str, int], Any]:
     """Every plugin's directable state (its `UndoStates` entries), by (plugin key, entry)."""
     found = {}
     for index, (owner, undo) in enumerate(world.registry(UndoStates).items()):
@@ -44,7 +47,7 @@ def plugin_state(world: Any) -> dict[tuple[str, int], Any]:
     return found
 
 
-def restore_plugin_state(world: Any, state: dict[tuple[str, int], Any]) -> None:
+def restore_plugin_state(world: World, state: dict[tuple[str, int], Any]) -> None:
     for index, (owner, undo) in enumerate(world.registry(UndoStates).items()):
         if (owner, index) in state:
             undo.restore(world, state[(owner, index)])
@@ -59,10 +62,10 @@ class Memento:
     after: dict[tuple[str, int], Any]
     at: float = field(default_factory=time.monotonic)
 
-    def undo(self, world: Any) -> None:
+    def undo(self, world: World) -> None:
         restore_plugin_state(world, self.before)
 
-    def redo(self, world: Any) -> None:
+    def redo(self, world: World) -> None:
         restore_plugin_state(world, self.after)
 
 
@@ -79,7 +82,7 @@ class UndoStack:
         del self.done[:-LIMIT]
         self.undone.clear()
 
-    def record(self, world: Any, label: str, action: Callable[[], object]) -> object:
+    def record(self, world: World, label: str, action: Callable[[], object]) -> object:
         """Run `action` (an edit of goals or parameters) and keep the plugins' state
         before and after it as one edit; nothing is kept if nothing changed. A slider
         dragged (the same label again within `MERGE_SECONDS`) stays one edit."""
@@ -100,7 +103,7 @@ class UndoStack:
         self.push(Memento(label, before, after))
         return result
 
-    def undo(self, world: Any) -> str | None:
+    def undo(self, world: World) -> str | None:
         """Undo the newest edit; its label, or None when there is nothing to undo."""
         if not self.done:
             return None
@@ -109,7 +112,7 @@ class UndoStack:
         self.undone.append(self.done.pop())
         return edit.label
 
-    def redo(self, world: Any) -> str | None:
+    def redo(self, world: World) -> str | None:
         """Do the newest undone edit again; its label, or None."""
         if not self.undone:
             return None
