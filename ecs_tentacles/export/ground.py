@@ -17,6 +17,7 @@ the creatures' materials are: an importer shows the ground the sandbox drew.
 
 from __future__ import annotations
 
+from types import ModuleType
 from typing import Any
 
 import numpy as np
@@ -47,7 +48,7 @@ def root_name(take: Take) -> str:
     return "terrain" if "terrain" not in names else "terrain_ground"
 
 
-def write_usd_ground(pxr: Any, stage: Any, take: Take) -> None:
+def write_usd_ground(pxr: ModuleType, stage: Any, take: Take) -> None:
     """The take's ground meshes under `/World/<root_name>` (nothing on the plane)."""
     meshes = take.ground_meshes()
     if not meshes:

@@ -23,6 +23,7 @@ the colour the sandbox drew.
 from __future__ import annotations
 
 import io
+from types import ModuleType
 from typing import Any
 
 import numpy as np
@@ -63,7 +64,9 @@ def usd_folder(take: Take) -> str:
     return f"/World/{folder}"
 
 
-def usd_material(pxr: Any, stage: Any, folder: str, creature: str, colour: np.ndarray) -> Any:
+def usd_material(
+    pxr: ModuleType, stage: Any, folder: str, creature: str, colour: np.ndarray
+) -> Any:
     """`<folder>/<c>_material` (`folder`: `usd_folder(take)`), a UsdPreviewSurface of
     `colour` (display rgb): made once, returned again after."""
     Sdf, UsdShade = pxr.Sdf, pxr.UsdShade
@@ -82,7 +85,7 @@ def usd_material(pxr: Any, stage: Any, folder: str, creature: str, colour: np.nd
     return material
 
 
-def bind_usd(pxr: Any, prim: Any, material: Any, colour: np.ndarray) -> None:
+def bind_usd(pxr: ModuleType, prim: Any, material: Any, colour: np.ndarray) -> None:
     """Bind `material` to `prim` (a Gprim) and give it the same display colour."""
     linear = pxr.Gf.Vec3f(*to_linear(colour).tolist())
     pxr.UsdGeom.Gprim(prim).CreateDisplayColorAttr([linear])

@@ -73,6 +73,7 @@ from __future__ import annotations
 import importlib
 import os
 from collections.abc import Callable
+from types import ModuleType
 from typing import Any
 
 import numpy as np
@@ -207,7 +208,7 @@ class Suckers:
     """Every sucker as a locator: translate sampled (the sucker point, in its creature's
     root frame), `ecs:attached` keyed."""
 
-    def __init__(self, pxr: Any, layer: StreamedLayer, header: dict[str, Any]) -> None:
+    def __init__(self, pxr: ModuleType, layer: StreamedLayer, header: dict[str, Any]) -> None:
         Gf, Sdf, UsdGeom = pxr.Gf, pxr.Sdf, pxr.UsdGeom
         self.Gf, self.layer = Gf, layer
         stage = layer.stage

@@ -45,6 +45,7 @@ from __future__ import annotations
 import importlib
 import os
 from collections.abc import Callable
+from types import ModuleType
 from typing import Any
 
 import numpy as np
@@ -189,7 +190,7 @@ def mark_rate(stage: Any, path: str, fps: float, frames: int) -> None:
 
 
 def _body(
-    pxr: Any, stage: Any, header: dict[str, Any], index: int, skin: tuple[Any, np.ndarray]
+    pxr: ModuleType, stage: Any, header: dict[str, Any], index: int, skin: tuple[Any, np.ndarray]
 ) -> tuple[int, Any, Any]:
     """Body `index`'s Xform and shape; (index, its translate's and orient's paths)."""
     Gf, UsdGeom = pxr.Gf, pxr.UsdGeom
@@ -212,7 +213,7 @@ def _body(
     return index, translate.GetAttr().GetPath(), orient.GetAttr().GetPath()
 
 
-def _sucker(pxr: Any, stage: Any, sucker: dict[str, Any]) -> Any:
+def _sucker(pxr: ModuleType, stage: Any, sucker: dict[str, Any]) -> Any:
     """A sucker's locator under its link (a fixed offset); the path of `ecs:attached`."""
     Gf, Sdf, UsdGeom = pxr.Gf, pxr.Sdf, pxr.UsdGeom
     xform = UsdGeom.Xform.Define(stage, f"/World/{unique_path(sucker['name'])}")

@@ -48,6 +48,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from types import ModuleType
 from typing import Any
 
 import numpy as np
@@ -116,7 +117,7 @@ class SharedClips:
     """The shared animations of a take's replayed stretches and who shows what when."""
 
     def __init__(
-        self, pxr: Any, layer: StreamedLayer, source: ChunkSource, plans: list[BodyPlan]
+        self, pxr: ModuleType, layer: StreamedLayer, source: ChunkSource, plans: list[BodyPlan]
     ) -> None:
         self.pxr, self.layer, self.source = pxr, layer, source
         header = source.header
@@ -223,7 +224,7 @@ class SharedClips:
         return len(self.stretches)
 
 
-def _show(pxr: Any, stage: Any, paths: list[str], shown: np.ndarray) -> None:
+def _show(pxr: ModuleType, stage: Any, paths: list[str], shown: np.ndarray) -> None:
     """Key the visibility of the prims at `paths`: inherited on the frames `shown` (bool
     per frame), invisible on the others; keys only where it changes (and at frame 0)."""
     UsdGeom = pxr.UsdGeom

@@ -30,6 +30,7 @@ Reads the chunks it is handed; writes prims and time samples through the layer.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from types import ModuleType
 from typing import Any
 
 import numpy as np
@@ -88,7 +89,7 @@ class CurvesTrack:
 
     def __init__(
         self,
-        pxr: Any,
+        pxr: ModuleType,
         layer: StreamedLayer,
         header: dict[str, Any],
         track: TakeTrack,

@@ -23,7 +23,7 @@ Reads chunks of a take; writes time samples through a `StreamedLayer`.
 
 from __future__ import annotations
 
-from typing import Any
+from types import ModuleType
 
 import numpy as np
 
@@ -51,7 +51,7 @@ class PlanSamples:
 
     def __init__(
         self,
-        pxr: Any,
+        pxr: ModuleType,
         layer: StreamedLayer,
         plan: BodyPlan,
         keys: Keys,

@@ -35,6 +35,7 @@ from __future__ import annotations
 import contextlib
 import os
 from collections.abc import Iterator
+from types import ModuleType
 from typing import Any
 
 from ecs_tentacles.export.usd_pxr import usd_modules as _pxr
@@ -93,7 +94,7 @@ class StreamedLayer:
         self.save()
 
 
-def _crate(pxr: Any, layer: Any) -> bool:
+def _crate(pxr: ModuleType, layer: Any) -> bool:
     """Whether `layer` is written in the binary crate format (`.usdc`; `.usd` unless
     `USD_DEFAULT_FILE_FORMAT` asks for text)."""
     format_id = layer.GetFileFormat().formatId

@@ -20,6 +20,7 @@ the stage it is given.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from types import ModuleType
 from typing import Any
 
 import numpy as np
@@ -72,12 +73,12 @@ def body_plans(header: dict[str, Any], detail: Detail | None = None) -> list[Bod
     return plans
 
 
-def _matrices(pxr: Any, matrices: np.ndarray) -> Any:
+def _matrices(pxr: ModuleType, matrices: np.ndarray) -> Any:
     # USD matrices act on row vectors: store the transpose of the column-vector form
     return pxr.Vt.Matrix4dArray.FromNumpy(np.ascontiguousarray(np.swapaxes(matrices, -1, -2)))
 
 
-def _plan_arrays(pxr: Any, skeleton: Skeleton, mesh: SkinMesh) -> dict[str, Any]:
+def _plan_arrays(pxr: ModuleType, skeleton: Skeleton, mesh: SkinMesh) -> dict[str, Any]:
     """The USD arrays every creature of a plan holds: made once, set on each (VtArrays
     share their data: the layer holds one copy)."""
     Gf, Vt = pxr.Gf, pxr.Vt
@@ -103,7 +104,7 @@ def _plan_arrays(pxr: Any, skeleton: Skeleton, mesh: SkinMesh) -> dict[str, Any]
 
 
 def define_creature(
-    pxr: Any,
+    pxr: ModuleType,
     stage: Any,
     plan: BodyPlan,
     name: str,
@@ -123,7 +124,7 @@ def define_creature(
 
 
 def define_skin(
-    pxr: Any,
+    pxr: ModuleType,
     stage: Any,
     plan: BodyPlan,
     name: str,

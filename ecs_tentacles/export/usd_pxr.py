@@ -13,14 +13,14 @@ with reads 189 MB (usd-core 26.11; 5 s and 8 s).
 from __future__ import annotations
 
 import os
-from typing import Any
+from types import ModuleType
 
 
 class UsdUnavailable(RuntimeError):
     """usd-core is not installed."""
 
 
-def usd_modules() -> Any:
+def usd_modules() -> ModuleType:
     """The `pxr` package with the modules every USD writer uses imported."""
     os.environ.setdefault("USDC_USE_PREAD", "1")  # read before pxr opens a crate file
     try:
@@ -33,4 +33,5 @@ def usd_modules() -> Any:
         raise UsdUnavailable(
             "writing USD needs usd-core: pip install 'ecs-tentacles[usd]'"
         ) from None
-    return pxr
+    package: ModuleType = pxr  # (untyped: usd-core ships no stubs)
+    return package
