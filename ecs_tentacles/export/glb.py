@@ -26,11 +26,14 @@ import struct
 import tempfile
 from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import IO, Any, BinaryIO
+from typing import IO, TYPE_CHECKING, BinaryIO
 
 import numpy as np
 
 from ecs_tentacles.output.atomic import atomic_file
+
+if TYPE_CHECKING:
+    from ecs_tentacles.export.gltf_types import Accessor, AccessorType, BufferView, Document
 
 GLB_MAX_BYTES = 2**32 - 1  # the header's total length is a uint32
 FLOAT, USHORT, UINT = 5126, 5123, 5125
@@ -50,13 +53,13 @@ class GlbBuffer:
     def __init__(self, sink: IO[bytes] | None = None) -> None:
         self.sink: IO[bytes] = io.BytesIO() if sink is None else sink
         self.length = 0  # bytes written so far, each view padded to 4
-        self.views: list[dict[str, Any]] = []
-        self.accessors: list[dict[str, Any]] = []
+        self.views: list[BufferView] = []
+        self.accessors: list[Accessor] = []
 
     def view(self, raw: bytes | memoryview, target: int | None = None) -> int:
         """Append `raw` as a buffer view (zero-padded to 4 bytes); its index."""
         size = len(memoryview(raw).cast("B"))
-        view: dict[str, Any] = {"buffer": 0, "byteOffset": self.length, "byteLength": size}
+        view: BufferView = {"buffer": 0, "byteOffset": self.length, "byteLength": size}
         if target is not None:
             view["target"] = target
         self.sink.write(raw)
@@ -67,11 +70,11 @@ class GlbBuffer:
         self.views.append(view)
         return len(self.views) - 1
 
-    def add(self, array: np.ndarray, kind: str, target: int | None = None) -> int:
+    def add(self, array: np.ndarray, kind: AccessorType, target: int | None = None) -> int:
         """Append `array` (float32, uint16 or uint32), return its accessor index; float
         VEC3 and SCALAR accessors carry their bounds (`min`, `max`)."""
         data = np.ascontiguousarray(array)
-        accessor: dict[str, Any] = {
+        accessor: Accessor = {
             "bufferView": self.view(data.tobytes() if data.size else b"", target),
             "componentType": {np.dtype(np.float32): FLOAT, np.dtype(np.uint32): UINT}.get(
                 data.dtype, USHORT
@@ -86,7 +89,7 @@ class GlbBuffer:
         self.accessors.append(accessor)
         return len(self.accessors) - 1
 
-    def fields(self) -> dict[str, Any]:
+    def fields(self) -> Document:
         """The document's `buffers`, `bufferViews` and `accessors`."""
         return {"buffers": [{"byteLength": self.length}], "bufferViews": self.views,
                 "accessors": self.accessors}  # fmt: skip
@@ -97,9 +100,7 @@ class GlbBuffer:
         return self.sink.getvalue()
 
 
-def stream_glb(
-    path: str | os.PathLike[str], document: Callable[[GlbBuffer], dict[str, Any]]
-) -> int:
+def stream_glb(path: str | os.PathLike[str], document: Callable[[GlbBuffer], Document]) -> int:
     """Write a GLB to `path` atomically: `document(buffer)` adds its arrays to a buffer
     spooled beside `path` and returns the JSON; then the file is written. Its size.
     Any error (a full disk: one line naming `path`) or stop leaves nothing behind."""
@@ -117,7 +118,7 @@ def spool_beside(path: str | os.PathLike[str]) -> Iterator[BinaryIO]:
         yield spool
 
 
-def _json_chunk(document: dict[str, Any]) -> bytes:
+def _json_chunk(document: Document) -> bytes:
     text = json.dumps(document, separators=(",", ":"), sort_keys=True, allow_nan=False).encode()
     return text + b" " * (-len(text) % 4)
 
@@ -135,7 +136,7 @@ def _header(text: bytes, binary_length: int) -> bytes:
 
 
 def write_glb_file(
-    handle: IO[bytes], document: dict[str, Any], buffer: GlbBuffer, path: object = "glb"
+    handle: IO[bytes], document: Document, buffer: GlbBuffer, path: object = "glb"
 ) -> int:
     """Write the GLB of `document` and `buffer`'s binary chunk to `handle`; its size.
     `GlbTooLarge` (nothing written) when it would pass `GLB_MAX_BYTES`."""
@@ -156,7 +157,7 @@ def write_glb_file(
     return total
 
 
-def glb_bytes(document: dict[str, Any], binary: bytes) -> bytes:
+def glb_bytes(document: Document, binary: bytes) -> bytes:
     """A GLB container in memory: 12-byte header, JSON chunk (space-padded), BIN chunk
     (zero-padded)."""
     text = _json_chunk(document)
@@ -164,19 +165,19 @@ def glb_bytes(document: dict[str, Any], binary: bytes) -> bytes:
     return _header(text, len(binary)) + binary
 
 
-def read_glb(data: bytes) -> tuple[dict[str, Any], bytes]:
+def read_glb(data: bytes) -> tuple[Document, bytes]:
     """Split a GLB into its JSON document and binary chunk (for tests and tools)."""
     magic, version, total = struct.unpack_from("<III", data, 0)
     if magic != _GLB_MAGIC or version != 2 or total != len(data):
         raise ValueError("not a glTF 2.0 binary file")
     json_length, _ = struct.unpack_from("<II", data, 12)
-    document = json.loads(data[20 : 20 + json_length])
+    document: Document = json.loads(data[20 : 20 + json_length])
     bin_length, _ = struct.unpack_from("<II", data, 20 + json_length)
     start = 28 + json_length
     return document, data[start : start + bin_length]
 
 
-def accessor_array(document: dict[str, Any], binary: bytes, index: int) -> np.ndarray:
+def accessor_array(document: Document, binary: bytes, index: int) -> np.ndarray:
     """Read accessor `index` of a document as a numpy array (float32 or uint16)."""
     accessor = document["accessors"][index]
     view = document["bufferViews"][accessor["bufferView"]]

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -43,10 +43,29 @@ from ecs_tentacles.export.glb import (
 from ecs_tentacles.export.glb_size import refuse_large_glb
 from ecs_tentacles.export.ground import add_gltf_ground
 from ecs_tentacles.export.materials import gltf_material, take_colours
-from ecs_tentacles.export.meshes import Mesh, body_mesh
+from ecs_tentacles.export.meshes import Mesh as BodyMesh
+from ecs_tentacles.export.meshes import body_mesh
 from ecs_tentacles.export.names import FOLDERS, part, unique_leaf, unique_path
 from ecs_tentacles.take import Take
 from ecs_tentacles.take.roster import spans
+
+if TYPE_CHECKING:
+    from typing_extensions import Unpack  # (typing's own from Python 3.12)
+
+    from ecs_tentacles.export.gltf_types import (
+        AccessorType,
+        Animation,
+        AnimationSampler,
+        Channel,
+        Document,
+        Interpolation,
+        Material,
+        Mesh,
+        Node,
+        NodeFields,
+        Primitive,
+        TargetPath,
+    )
 
 __all__ = ["accessor_array", "build_gltf", "glb_bytes", "read_glb", "write_glb"]
 
@@ -69,7 +88,7 @@ def to_y_up_rotations(quat_wxyz: np.ndarray) -> np.ndarray:
     return np.concatenate([vector, q[..., :1]], axis=-1)
 
 
-def build_gltf(take: Take, locators: bool = True) -> tuple[dict[str, Any], bytes]:
+def build_gltf(take: Take, locators: bool = True) -> tuple[Document, bytes]:
     """The glTF JSON document and its binary buffer, in memory (with `locators`: sucker
     and goal nodes)."""
     buffer = GlbBuffer()
@@ -79,19 +98,19 @@ def build_gltf(take: Take, locators: bool = True) -> tuple[dict[str, Any], bytes
 
 def gltf_document(
     take: Take, buffer: GlbBuffer, locators: bool = True, progress: Progress | None = None
-) -> dict[str, Any]:
+) -> Document:
     """The glTF JSON document, its arrays added to `buffer` as they are made (the bodies'
     keys a block of bodies at a time: `progress(n)` after each block of n bodies)."""
     header = take.header
-    meshes: list[dict[str, Any]] = []
+    meshes: list[Mesh] = []
     mesh_of: dict[tuple[str, str, float, float, int], int] = {}
-    materials: list[dict[str, Any]] = []
+    materials: list[Material] = []
     node_of_body: dict[int, int] = {}
-    nodes: list[dict[str, Any]] = [{"name": "World", "children": []}]
+    nodes: list[Node] = [{"name": "World", "children": []}]
     translations = to_y_up_points(take.pos[0]).astype(np.float32)  # the rest pose: frame 0
     rotations = to_y_up_rotations(take.quat[0]).astype(np.float32)
 
-    def node(name: str, parent: int, **fields: Any) -> int:
+    def node(name: str, parent: int, **fields: Unpack[NodeFields]) -> int:
         nodes.append({"name": name, **fields})
         nodes[parent].setdefault("children", []).append(len(nodes) - 1)
         return len(nodes) - 1
@@ -127,11 +146,12 @@ def gltf_document(
     if locators:
         for creature in header["creatures"]:
             for parent, child in sucker_nodes(take, creature["name"]):
-                node(child.pop("name"), node_of_body[parent], **child)
+                nodes.append(child)
+                nodes[node_of_body[parent]].setdefault("children", []).append(len(nodes) - 1)
     ground = add_gltf_ground(take, buffer, nodes, meshes, materials, to_y_up_points)
     if ground is not None:
         nodes[0]["children"].append(ground)
-    document: dict[str, Any] = {
+    document: Document = {
         "asset": {
             "version": "2.0",
             "generator": f"ecs_tentacles {__version__}",
@@ -157,9 +177,9 @@ def scale_visibility(
     buffer: GlbBuffer,
     take: Take,
     shown: np.ndarray,
-    node: dict[str, Any],
+    node: Node,
     index: int,
-    animation: dict[str, Any],
+    animation: Animation,
 ) -> None:
     """Hide node `index` (`node`: its entry) while a creature is not there
     (`ecs_tentacles.take.roster`): glTF has no visibility, so its scale is keyed to zero
@@ -173,18 +193,23 @@ def scale_visibility(
     if not keys[0][1]:
         node["scale"] = [0.0, 0.0, 0.0]  # as the animation starts
     samplers, channels = animation["samplers"], animation["channels"]
-    sampler = {"input": buffer.add(times, "SCALAR"), "output": buffer.add(scales, "VEC3")}
-    samplers.append({**sampler, "interpolation": "STEP"})
+    samplers.append(
+        {
+            "input": buffer.add(times, "SCALAR"),
+            "output": buffer.add(scales, "VEC3"),
+            "interpolation": "STEP",
+        }
+    )
     channels.append({"sampler": len(samplers) - 1, "target": {"node": index, "path": "scale"}})
 
 
 def sucker_nodes(
     take: Take, creature: str, joint_offsets: dict[int, float] | None = None
-) -> list[tuple[int, dict[str, Any]]]:
+) -> list[tuple[int, Node]]:
     """(body, node) for each sucker of `creature`: a node named as USD names it, placed at
     the sucker in its body's frame (y-up), or, with `joint_offsets` (body -> the joint's
     origin along the body's x: `Skeleton.offset`), in the frame of that body's joint."""
-    out = []
+    out: list[tuple[int, Node]] = []
     for sucker in take.header["suckers"]:
         if sucker["name"].split("/", 1)[0] != creature:
             continue
@@ -193,15 +218,14 @@ def sucker_nodes(
         if joint_offsets is not None:
             local = local - [joint_offsets[body], 0.0, 0.0]
         point = to_y_up_points(local).astype(np.float32).tolist()
-        extras = {"ecs:locator": "sucker"}  # what it is (an importer's custom property)
+        # what it is (an importer's custom property)
+        extras: dict[str, str | float] = {"ecs:locator": "sucker"}
         out.append((body, {"name": unique_leaf(sucker["name"]), "translation": point,
                            "extras": extras}))  # fmt: skip
     return out
 
 
-def add_gltf_goals(
-    take: Take, buffer: GlbBuffer, nodes: list[dict[str, Any]], animation: dict[str, Any]
-) -> None:
+def add_gltf_goals(take: Take, buffer: GlbBuffer, nodes: list[Node], animation: Animation) -> None:
     """Every points track's items (the goals) as nodes under World: `<c>_goals/<c>_goal<j>`
     at the item's place (y-up), its scale keyed to zero while it is not live."""
     folders: dict[str, int] = {}
@@ -218,14 +242,14 @@ def add_gltf_goals(
                 nodes[0].setdefault("children", []).append(folders[folder])
             point = to_y_up_points(where[index]).astype(np.float32).tolist()
             extras = {"ecs:locator": track.item, "ecs:radius": item.get("radius")}
-            extras = {key: value for key, value in extras.items() if value is not None}
-            nodes.append({"name": leaf, "translation": point, "extras": extras})
+            kept: dict[str, str | float] = {k: v for k, v in extras.items() if v is not None}
+            nodes.append({"name": leaf, "translation": point, "extras": kept})
             nodes[folders[folder]].setdefault("children", []).append(len(nodes) - 1)
             own = len(nodes) - 1
             scale_visibility(buffer, take, live[:, index], nodes[own], own, animation)
 
 
-def _mesh(buffer: GlbBuffer, mesh: Mesh, name: str, material: int) -> dict[str, Any]:
+def _mesh(buffer: GlbBuffer, mesh: BodyMesh, name: str, material: int) -> Mesh:
     positions = to_y_up_points(mesh.positions).astype(np.float32)
     normals = to_y_up_points(mesh.normals).astype(np.float32)
     attributes = {
@@ -233,19 +257,24 @@ def _mesh(buffer: GlbBuffer, mesh: Mesh, name: str, material: int) -> dict[str, 
         "NORMAL": buffer.add(normals, "VEC3", ARRAY_BUFFER),
     }
     indices = buffer.add(mesh.indices, "SCALAR", ELEMENT_ARRAY_BUFFER)
-    primitive = {"attributes": attributes, "indices": indices, "material": material, "mode": 4}
+    primitive: Primitive = {
+        "attributes": attributes,
+        "indices": indices,
+        "material": material,
+        "mode": 4,
+    }
     return {"name": name, "primitives": [primitive]}
 
 
 def _animation(
     buffer: GlbBuffer, take: Take, node_of_body: dict[int, int], progress: Progress | None
-) -> dict[str, Any]:
+) -> Animation:
     """One animation: a translation and a rotation channel per body, every frame keyed.
     The bodies are turned y-up a block at a time (`BLOCK_BYTES` of temporaries)."""
     times = buffer.add(take.times.astype(np.float32), "SCALAR")
-    interpolation = "LINEAR" if take.frames > 1 else "STEP"
-    samplers: list[dict[str, Any]] = []
-    channels: list[dict[str, Any]] = []
+    interpolation: Interpolation = "LINEAR" if take.frames > 1 else "STEP"
+    samplers: list[AnimationSampler] = []
+    channels: list[Channel] = []
     bodies = list(node_of_body.items())
     block = max(1, BLOCK_BYTES // (take.frames * 7 * 8 * 2))
     for start in range(0, len(bodies), block):
@@ -254,10 +283,11 @@ def _animation(
         translations = to_y_up_points(take.pos[:, index]).astype(np.float32)
         rotations = to_y_up_rotations(take.quat[:, index]).astype(np.float32)
         for column, (_, target) in enumerate(chunk):
-            for path, values, kind in (
+            keyed: tuple[tuple[TargetPath, np.ndarray, AccessorType], ...] = (
                 ("translation", translations[:, column], "VEC3"),
                 ("rotation", rotations[:, column], "VEC4"),
-            ):
+            )
+            for path, values, kind in keyed:
                 output = buffer.add(values, kind)
                 samplers.append({"input": times, "output": output, "interpolation": interpolation})
                 channels.append(

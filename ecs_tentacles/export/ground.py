@@ -17,14 +17,19 @@ the creatures' materials are: an importer shows the ground the sandbox drew.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from types import ModuleType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ecs_tentacles.export.materials import shader_name
 from ecs_tentacles.skin.colours import to_linear
 from ecs_tentacles.take import Take
+
+if TYPE_CHECKING:
+    from ecs_tentacles.export.glb import GlbBuffer
+    from ecs_tentacles.export.gltf_types import Material, Mesh, Node, Primitive
 
 EXPORT_NAMES = {"terrain": "surface", "obstacles": "obstacles"}
 ROUGHNESS = 0.9
@@ -90,11 +95,11 @@ def write_usd_ground(pxr: ModuleType, stage: Any, take: Take) -> None:
 
 def add_gltf_ground(
     take: Take,
-    buffer: Any,
-    nodes: list[dict[str, Any]],
-    meshes: list[dict[str, Any]],
-    materials: list[dict[str, Any]],
-    to_y_up: Any,
+    buffer: GlbBuffer,
+    nodes: list[Node],
+    meshes: list[Mesh],
+    materials: list[Material],
+    to_y_up: Callable[[np.ndarray], np.ndarray],
 ) -> int | None:
     """Append the ground's node (and its meshes and materials); its index, or None."""
     found = take.ground_meshes()
@@ -122,7 +127,7 @@ def add_gltf_ground(
             "NORMAL": buffer.add(normals, "VEC3", 34962),
         }
         indices = buffer.add(np.asarray(mesh.triangles, np.uint32).reshape(-1), "SCALAR", 34963)
-        primitive = {
+        primitive: Primitive = {
             "attributes": attributes,
             "indices": indices,
             "material": len(materials) - 1,

@@ -24,13 +24,16 @@ from __future__ import annotations
 
 import io
 from types import ModuleType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ecs_tentacles.export.names import part
 from ecs_tentacles.skin.colours import PALE, creature_colour, look_in_take, to_linear
 from ecs_tentacles.take import Take
+
+if TYPE_CHECKING:
+    from ecs_tentacles.export.gltf_types import Material, PbrMetallicRoughness
 
 FOLDER = "materials"  # USD: the scope under /World holding the creatures' materials
 ROUGHNESS = 0.6
@@ -92,10 +95,10 @@ def bind_usd(pxr: ModuleType, prim: Any, material: Any, colour: np.ndarray) -> N
     pxr.UsdShade.MaterialBindingAPI.Apply(prim).Bind(material)
 
 
-def gltf_material(creature: str, colour: np.ndarray, texture: int | None = None) -> dict[str, Any]:
+def gltf_material(creature: str, colour: np.ndarray, texture: int | None = None) -> Material:
     """The glTF material of creature `creature`: its linear colour as the base colour
     factor, or with `texture` (a texture index of the colour) a white factor."""
-    pbr: dict[str, Any] = {"metallicFactor": 0.0, "roughnessFactor": ROUGHNESS}
+    pbr: PbrMetallicRoughness = {"metallicFactor": 0.0, "roughnessFactor": ROUGHNESS}
     if texture is None:
         pbr["baseColorFactor"] = [*to_linear(colour).tolist(), 1.0]
     else:

@@ -24,7 +24,7 @@ node under its link's joint (so it follows the joint), each goal a node under
 from __future__ import annotations
 
 import os
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -53,6 +53,21 @@ from ecs_tentacles.skin.mesh import Detail, SkinMesh, split_by_uv
 from ecs_tentacles.skin.rig import Keys, KeyTally, SkinnedCreature, rig_creature
 from ecs_tentacles.take import Take
 
+if TYPE_CHECKING:
+    from ecs_tentacles.export.gltf_types import (
+        AccessorType,
+        Animation,
+        Document,
+        Image,
+        Interpolation,
+        Material,
+        Mesh,
+        Node,
+        Primitive,
+        Skin,
+        TargetPath,
+    )
+
 __all__ = ["build_skinned_gltf", "split_by_uv", "write_skinned_glb"]
 
 _TURN = np.eye(4)
@@ -74,7 +89,7 @@ def write_skinned_glb(
     refuse_large_glb(take.header, path, detail or Detail(), locators, keys)
     reports: list[KeyReport] = []
 
-    def document(buffer: GlbBuffer) -> dict[str, Any]:
+    def document(buffer: GlbBuffer) -> Document:
         made, report = skinned_document(take, buffer, detail, keys, locators, progress)
         reports.append(report)
         return made
@@ -85,7 +100,7 @@ def write_skinned_glb(
 
 def build_skinned_gltf(
     take: Take, detail: Detail | None = None, keys: Keys | None = None, locators: bool = False
-) -> tuple[dict[str, Any], bytes, KeyReport]:
+) -> tuple[Document, bytes, KeyReport]:
     """The glTF JSON document, its binary buffer (in memory) and the key report."""
     buffer = GlbBuffer()
     document, report = skinned_document(take, buffer, detail, keys, locators)
@@ -99,18 +114,19 @@ def skinned_document(
     keys: Keys | None = None,
     locators: bool = False,
     progress: Progress | None = None,
-) -> tuple[dict[str, Any], KeyReport]:
+) -> tuple[Document, KeyReport]:
     """The glTF JSON document and the key report, the arrays added to `buffer` one
     creature at a time (each creature's rig dropped before the next is made)."""
     header = take.header
     tally = KeyTally(take.frames)
-    nodes: list[dict[str, Any]] = [{"name": "World", "children": []}]
+    nodes: list[Node] = [{"name": "World", "children": []}]
     roots = [0]
-    meshes, skins = [], []
+    meshes: list[Mesh] = []
+    skins: list[Skin] = []
     colours = take_colours(take)
-    materials: list[dict[str, Any]] = []
-    images: list[dict[str, Any]] = []
-    animation: dict[str, Any] = {"name": "take", "samplers": [], "channels": []}
+    materials: list[Material] = []
+    images: list[Image] = []
+    animation: Animation = {"name": "take", "samplers": [], "channels": []}
     times: dict[bytes, int] = {}
     shown = take.visible()
     for number in range(len(header["creatures"])):
@@ -173,7 +189,7 @@ def skinned_document(
     ground = add_gltf_ground(take, buffer, nodes, meshes, materials, to_y_up_points)
     if ground is not None:
         nodes[0]["children"].append(ground)
-    document: dict[str, Any] = {
+    document: Document = {
         "asset": {
             "version": "2.0",
             "generator": f"ecs_tentacles {__version__}",
@@ -194,7 +210,7 @@ def skinned_document(
     return document, tally.report()
 
 
-def _mesh(buffer: GlbBuffer, mesh: SkinMesh, name: str, material: int) -> dict[str, Any]:
+def _mesh(buffer: GlbBuffer, mesh: SkinMesh, name: str, material: int) -> Mesh:
     source, uv, triangles = split_by_uv(mesh)
     if len(source) > MAX_SKIN_VERTICES:
         raise ValueError(
@@ -218,7 +234,12 @@ def _mesh(buffer: GlbBuffer, mesh: SkinMesh, name: str, material: int) -> dict[s
         "WEIGHTS_0": buffer.add(weights, "VEC4", ARRAY_BUFFER),
     }
     indices = buffer.add(triangles.reshape(-1).astype(np.uint16), "SCALAR", ELEMENT_ARRAY_BUFFER)
-    primitive = {"attributes": attributes, "indices": indices, "material": material, "mode": 4}
+    primitive: Primitive = {
+        "attributes": attributes,
+        "indices": indices,
+        "material": material,
+        "mode": 4,
+    }
     return {"name": f"{name}/skin", "primitives": [primitive]}
 
 
@@ -227,18 +248,20 @@ def _channels(
     take: Take,
     creature: SkinnedCreature,
     first: int,
-    animation: dict[str, Any],
+    animation: Animation,
     times: dict[bytes, int],
 ) -> None:
     """A rotation channel per joint and the root's translation channel, with their keys,
     added to `animation`."""
     samplers, channels = animation["samplers"], animation["channels"]
     seconds = take.times.astype(np.float32)
-    interpolation = "LINEAR" if take.frames > 1 else "STEP"
+    interpolation: Interpolation = "LINEAR" if take.frames > 1 else "STEP"
     rotation = to_y_up_rotations(creature.animation.rotation).astype(np.float32)
     root = to_y_up_points(creature.translations_at(np.arange(take.frames))[:, 0])
 
-    def sampler(keep: np.ndarray, values: np.ndarray, kind: str, node: int, path: str) -> None:
+    def sampler(
+        keep: np.ndarray, values: np.ndarray, kind: AccessorType, node: int, path: TargetPath
+    ) -> None:
         mask = keep.tobytes()
         if mask not in times:
             times[mask] = buffer.add(seconds[keep], "SCALAR")
