@@ -15,11 +15,10 @@ from __future__ import annotations
 
 import math
 import time
-from typing import Any
 
 import pyglet
 from imgui_bundle import imgui
-from pyglet.window import key, mouse
+from pyglet.window import BaseWindow, key, mouse
 
 BASE_HEIGHT = 720  # the window height at which the GUI is drawn at scale 1
 
@@ -53,7 +52,7 @@ UI_SCALE: dict[str, float | None] = {"scale": None}  # the user's factor (`play 
 SCALE_RANGE = (0.5, 3.0)  # the least and the largest factor, the user's or the display's
 
 
-def display_scale(window: Any) -> float:
+def display_scale(window: BaseWindow) -> float:
     """How much larger the display wants the GUI drawn: the window's DPI scale (pyglet's
     `Window.scale`, its DPI over 96) over the stretch its framebuffer already gives the
     picture (a Retina framebuffer is twice the window: what is drawn at window size is
@@ -107,9 +106,9 @@ def text_width(label: str) -> float:
 class Gui:
     """One ImGui context bound to a pyglet window; draws into the current framebuffer."""
 
-    def __init__(self, window: Any):
+    def __init__(self, window: BaseWindow):
         self.window = window
-        self.context: Any = imgui.create_context()
+        self.context: imgui.internal.Context | None = imgui.create_context()
         imgui.set_current_context(self.context)
         io = imgui.get_io()
         io.set_ini_filename("")  # no imgui.ini written into the user's directory
@@ -131,11 +130,12 @@ class Gui:
         self.remeasure = False  # this frame is to be built again before it is drawn
 
     # -- events: pyglet -> ImGui -------------------------------------------------------
-    def _use(self) -> Any:
+    def _use(self) -> imgui.IO:
+        assert self.context is not None, "the GUI is closed"
         imgui.set_current_context(self.context)
         return imgui.get_io()
 
-    def _mouse(self, x: float, y: float) -> Any:
+    def _mouse(self, x: float, y: float) -> imgui.IO:
         io = self._use()
         io.add_mouse_pos_event(float(x), float(self.window.height - y))
         return io
@@ -182,7 +182,7 @@ class Gui:
     def begin_frame(self) -> None:
         """Start a GUI frame sized and scaled for the window."""
         io = self._use()
-        io.display_size = (float(self.window.width), float(self.window.height))
+        io.display_size = imgui.ImVec2(float(self.window.width), float(self.window.height))
         now = time.perf_counter()
         io.delta_time = max(now - self._last, 1e-4)
         self._last = now

@@ -17,7 +17,7 @@ and one tentacle or all) and tells every panel when it changes.
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING
 
 from imgui_bundle import imgui
 
@@ -25,6 +25,11 @@ from ecs_tentacles.components import Creature
 from ecs_tentacles.render.gui import Gui, gui_scale, same_line_if_fits
 from ecs_tentacles.render.registries import Panel
 from ecs_tentacles.render.tiers import text_colour
+
+if TYPE_CHECKING:
+    from pyglet.window import BaseWindow
+
+    from ecs_tentacles.world import World
 
 PANEL_WIDTH = 280  # the panel's width at scale 1: under 22 % of a 1280 x 720 window
 PANEL_SHARE = 0.4  # the panel never covers more than this share of the window's width
@@ -46,7 +51,7 @@ UNSET = "\0"  # `Hud.open` before the first frame
 class Hud:
     """The sandbox's panel: the selection, the HUD's own sections and the plugins'."""
 
-    def __init__(self, window: Any, world: Any, *, visible: bool = True):
+    def __init__(self, window: BaseWindow, world: World, *, visible: bool = True):
         self.window = window
         self.world = world
         self.visible = visible

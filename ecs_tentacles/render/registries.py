@@ -43,6 +43,9 @@ import numpy as np
 from ecs_tentacles.registry import Registry
 
 if TYPE_CHECKING:
+    from pyglet.window import BaseWindow
+    from pyglet.window.key import KeyStateHandler
+
     from ecs_tentacles.host import Host
     from ecs_tentacles.render.camera import OrbitCamera
     from ecs_tentacles.render.gui import Gui
@@ -228,9 +231,9 @@ class SandboxView(Protocol):
     @property
     def hud(self) -> HudView: ...
 
-    window: Any  # the pyglet window (width, height)
+    window: BaseWindow  # the pyglet window (width, height)
     selection: Selection
-    keys: Any  # pyglet's KeyStateHandler: keys[key.S] is True while S is down
+    keys: KeyStateHandler  # keys[key.S] is True while S is down
 
     @property
     def scene(self) -> str | os.PathLike[str] | dict[str, Any]: ...  # the world's source

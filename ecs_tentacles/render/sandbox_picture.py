@@ -12,7 +12,7 @@ from __future__ import annotations
 import os
 import time
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 from pyglet import gl
@@ -21,6 +21,8 @@ from ecs_tentacles.render.on_screen import labels_over
 from ecs_tentacles.render.output import VideoWriter, save_png
 
 if TYPE_CHECKING:
+    from pyglet.window import BaseWindow
+
     from ecs_tentacles.render.camera import CameraChoice
     from ecs_tentacles.render.hud import Hud
     from ecs_tentacles.render.renderer import Renderer
@@ -35,7 +37,7 @@ class SandboxPicture:
     session: SandboxSession
     renderer: Renderer
     hud: Hud
-    window: Any
+    window: BaseWindow
     headless: bool
     camera_choice: CameraChoice | None
     clean: bool

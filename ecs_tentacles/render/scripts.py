@@ -18,13 +18,15 @@ from __future__ import annotations
 import logging
 from collections import deque
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from imgui_bundle import imgui
 
 from ecs_tentacles.reload import Reload, Reloader
 
 if TYPE_CHECKING:
+    from pyglet.window import BaseWindow
+
     from ecs_tentacles.render.gui import Gui
     from ecs_tentacles.system import SystemFailure
     from ecs_tentacles.world import World
@@ -56,7 +58,7 @@ class Failure:
 class Scripts:
     """Failures and reloads of the user's systems in one sandbox world."""
 
-    def __init__(self, window: Any):
+    def __init__(self, window: BaseWindow):
         self.window = window
         self.failures: list[Failure] = []
         self.notes: deque[tuple[bool, str]] = deque(maxlen=NOTES)  # (ok, line)
