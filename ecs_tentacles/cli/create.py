@@ -17,7 +17,6 @@ import argparse
 import json
 import sys
 from pathlib import Path
-from typing import Any
 
 from ecs_tentacles.cli.arguments import output_path, require_display
 from ecs_tentacles.cli.bake import positive_float
@@ -137,7 +136,7 @@ def open_window(design: CreatureDesign, out: Path) -> int:
 def make_design(args: argparse.Namespace) -> CreatureDesign:
     """Apply the options in the creator's order: start, uniform build, tentacle edits."""
     if args.source:
-        creature: Any = int(args.creature) if args.creature.isdigit() else args.creature
+        creature: int | str = int(args.creature) if args.creature.isdigit() else args.creature
         design = CreatureDesign.from_scene(args.source, creature)
     else:
         design = CreatureDesign()

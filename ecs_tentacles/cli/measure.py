@@ -43,7 +43,7 @@ import sys
 import time
 from collections import defaultdict
 from collections.abc import Callable
-from typing import Any
+from typing import Any, ParamSpec, TypeVar
 
 import psutil
 from tqdm import tqdm
@@ -58,10 +58,14 @@ WARMUP = 30  # untimed frames first: goals chosen, suckers in use, kernels loade
 PHYSICS_SYSTEMS = ("physics", "physics_health", "physics_sync")
 
 
-def timed(func: Callable[..., Any], bucket: list[float]) -> Callable[..., Any]:
+P = ParamSpec("P")
+R = TypeVar("R")
+
+
+def timed(func: Callable[P, R], bucket: list[float]) -> Callable[P, R]:
     """`func` wrapped so every call adds its wall seconds to `bucket[0]`."""
 
-    def wrapper(*args: Any, **kwargs: Any) -> Any:
+    def wrapper(*args: P.args, **kwargs: P.kwargs) -> R:
         start = time.perf_counter()
         result = func(*args, **kwargs)
         bucket[0] += time.perf_counter() - start

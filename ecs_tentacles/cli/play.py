@@ -16,6 +16,7 @@ from ecs_tentacles.scene.load import resolve_scene_path
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
+    from ecs_tentacles.render.camera import CameraChoice
 
 SIZE_RULE = "an even number of pixels in [64, 8192]"
 
@@ -31,7 +32,7 @@ def even_size(text: str) -> int:
     return value
 
 
-def camera_option(text: str) -> Any:
+def camera_option(text: str) -> CameraChoice:
     """argparse type: `frame-all`, `follow NAME` or `X,Y,Z,TX,TY,TZ` (a `CameraChoice`)."""
     from ecs_tentacles.render.camera import parse_camera
 

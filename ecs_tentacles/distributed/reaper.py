@@ -24,7 +24,7 @@ import select
 import subprocess
 import sys
 import time
-from typing import Any
+from collections.abc import Iterable
 
 import psutil
 
@@ -83,7 +83,7 @@ def _alive(pid: int) -> bool:
         return False
 
 
-def reap(recorded: list[list[Any]]) -> None:
+def reap(recorded: Iterable[tuple[int, float]]) -> None:
     """Terminate the recorded processes (if they are still the same ones) and their
     descendants; kill what is left after `GRACE_SECONDS`."""
     victims: list[psutil.Process] = []
@@ -134,21 +134,21 @@ def end_started_since(before: set[tuple[int, float]], rounds: int = 5) -> None:
         new = descendants() - before
         if not new:
             return
-        reap([[pid, created] for pid, created in new])
+        reap(new)
 
 
-def _descendants(pid: int) -> list[list[Any]]:
+def _descendants(pid: int) -> list[tuple[int, float]]:
     try:
-        return [[p.pid, p.create_time()] for p in psutil.Process(pid).children(recursive=True)]
+        return [(p.pid, p.create_time()) for p in psutil.Process(pid).children(recursive=True)]
     except psutil.Error:
         return []
 
 
-def of_session(session: str) -> list[list[Any]]:
-    """[pid, create_time] of every living process of Ray session `session`: its command
+def of_session(session: str) -> list[tuple[int, float]]:
+    """(pid, create_time) of every living process of Ray session `session`: its command
     line names it (GCS, raylet), or a file it has open does (agents and workers retitle
     themselves `ray::...`, but keep their logs in the session's folder open)."""
-    found = []
+    found: list[tuple[int, float]] = []
     for process in psutil.process_iter(["cmdline", "create_time", "status"]):
         if process.info["status"] == psutil.STATUS_ZOMBIE:
             continue
@@ -158,7 +158,7 @@ def of_session(session: str) -> list[list[Any]]:
         except psutil.Error:  # gone, or another user's
             continue
         if named:
-            found.append([process.pid, process.info["create_time"]])
+            found.append((process.pid, process.info["create_time"]))
     return found
 
 
@@ -180,7 +180,7 @@ def main(argv: list[str]) -> int:
         return 0  # a normal end: the bake shut Ray down itself
     if session:  # what started since the last look, wherever it was re-parented
         known.update({pid: created for pid, created in of_session(session) if pid != os.getpid()})
-    reap([[pid, created] for pid, created in known.items()])
+    reap(known.items())
     return 0
 
 
