@@ -14,7 +14,10 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numpy.typing import ArrayLike
 
 from ecs_tentacles.registry import Registry
 from ecs_tentacles.take.tracks import TakeTrack
@@ -31,9 +34,9 @@ class CurvesFrame:
     `creatures` (curves,) owning creature entities. The recorder copies what it keeps:
     they may be views of the plugin's own buffers."""
 
-    points: Any
-    widths: Any
-    creatures: Any
+    points: ArrayLike
+    widths: ArrayLike
+    creatures: ArrayLike
 
 
 @dataclass(frozen=True)
@@ -47,11 +50,11 @@ class PointsFrame:
     the last frame costs the recorder one comparison of them.
     """
 
-    keys: Sequence[int] | Any
-    creatures: Sequence[int] | Any
-    order: Sequence[int] | Any
-    positions: Any
-    radii: Sequence[float] | Any
+    keys: Sequence[int] | np.ndarray
+    creatures: Sequence[int] | np.ndarray
+    order: Sequence[int] | np.ndarray
+    positions: Sequence[Sequence[float]] | np.ndarray
+    radii: Sequence[float] | np.ndarray
 
 
 @dataclass(frozen=True)
