@@ -45,7 +45,8 @@ CRAWL_SPEED = 0.1  # m/s: a neighbour moving this fast aligns others fully
 def _unit(vectors: np.ndarray) -> np.ndarray:
     """Rows scaled to length 1 (zero rows stay zero)."""
     length = np.linalg.norm(vectors, axis=-1, keepdims=True)
-    return np.divide(vectors, length, out=np.zeros_like(vectors), where=length > 1e-12)
+    unit: np.ndarray = np.divide(vectors, length, out=np.zeros_like(vectors), where=length > 1e-12)
+    return unit
 
 
 class Flock(System):
