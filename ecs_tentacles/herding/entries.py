@@ -14,7 +14,7 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -137,5 +137,5 @@ def _penned_points(world: Host) -> PointsFrame:
     )
 
 
-def take_tracks(world: Host) -> list[Any]:
+def take_tracks(world: Host) -> list[TrackSource]:
     return [TrackSource(GAME_TRACK, _penned_points)]

@@ -16,15 +16,17 @@ spec it is handed).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
 
 if TYPE_CHECKING:
-    from ecs_tentacles.ground import Ground
+    from ecs_tentacles.ground import Ground, StaticSpec
+    from ecs_tentacles.herding.game import HerdingGame
+    from ecs_tentacles.world import World
 
 PANEL = 0.35  # metres: the longest box of the fence
 THICKNESS = 0.05  # metres
@@ -42,7 +44,7 @@ class Fence:
     height: float
 
     @classmethod
-    def of(cls, game: Any) -> Fence:
+    def of(cls, game: HerdingGame) -> Fence:
         """The fence of a `HerdingGame` (its `pen`, `gate` and `fence` keys)."""
         return cls(
             np.asarray(game.pen_centre, dtype=np.float64),
@@ -111,7 +113,7 @@ class Fence:
 
     def add_to_spec(
         self,
-        spec: Any,
+        spec: StaticSpec,
         ground: Ground,
         friction: float,
         contype: int,
@@ -135,7 +137,9 @@ class Fence:
             )
 
 
-def static_geometry(world: Any) -> Any:
+def static_geometry(
+    world: World,
+) -> Callable[[StaticSpec, float, int, int, Sequence[float]], None]:
     """The herding plugin's `StaticGeometry` entry (`ecs_tentacles.physics.model`): the
     fence in every creature's model; with no other entry (no terrain), the ground too,
     as the model would have had it without any."""
@@ -143,7 +147,9 @@ def static_geometry(world: Any) -> Any:
     from ecs_tentacles.herding.game import HerdingGame
     from ecs_tentacles.physics.model import StaticGeometry
 
-    def add(spec: Any, friction: float, contype: int, conaffinity: int, solref: Any) -> None:
+    def add(
+        spec: StaticSpec, friction: float, contype: int, conaffinity: int, solref: Sequence[float]
+    ) -> None:
         ground = ground_of(world)
         if len(list(world.registry(StaticGeometry))) == 1:  # only this one: the plane too
             ground.add_to_spec(spec, friction, contype, conaffinity, solref)

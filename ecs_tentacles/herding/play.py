@@ -172,7 +172,7 @@ class Replay:
 
 def play(
     world: World,
-    player: Bot | Replay | Any,
+    player: Bot | Replay | Player,
     *,
     every: float = 0.25,
     max_seconds: float | None = None,
