@@ -14,7 +14,7 @@ from __future__ import annotations
 import hashlib
 import json
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
+from typing import TYPE_CHECKING, Any, Literal, Protocol, runtime_checkable
 
 import numpy as np
 
@@ -38,6 +38,7 @@ from ecs_tentacles.take.tracks import STANDARD, declared_problem
 
 if TYPE_CHECKING:
     from ecs_tentacles.roster_change import RosterChange
+    from ecs_tentacles.take.header_entries import HeaderBody, HeaderCreature, HeaderSucker
     from ecs_tentacles.take.writer import TakeWriter
     from ecs_tentacles.world import World
 
@@ -176,9 +177,9 @@ class TakeRecorder:
 
     def _layout(self, world: World) -> None:
         """Body and sucker tables in take order: creature by creature, mantle then links."""
-        self._creatures: list[dict[str, Any]] = []
-        self._bodies: list[dict[str, Any]] = []
-        self._suckers: list[dict[str, Any]] = []
+        self._creatures: list[HeaderCreature] = []
+        self._bodies: list[HeaderBody] = []
+        self._suckers: list[HeaderSucker] = []
         self.creature_index: dict[int, int] = {}  # creature entity -> its index in the take
         self._rows = np.zeros(0, dtype=np.int64)  # take body -> Transform row (-1: gone)
         self._sucker_rows = np.zeros(0, dtype=np.int64)  # take sucker -> Sucker row
@@ -205,7 +206,7 @@ class TakeRecorder:
         world.kept_names.add(name := creature.name)  # a later spawn of it gets a suffix
         first = len(self._bodies)
         rows = [world.component(entity, Transform).row]
-        entry: dict[str, Any] = {"name": name, "mantle": first, "tentacles": []}
+        entry: HeaderCreature = {"name": name, "mantle": first, "tentacles": []}
         self._bodies.append(_body(f"{name}/mantle", index, "cylinder", "Z", creature))
         for tentacle_entity in creature.tentacles:
             tentacle = world.component(tentacle_entity, Tentacle)
@@ -453,7 +454,13 @@ class TakeRecorder:
         )
 
 
-def _body(name: str, creature: int, shape: str, axis: str, part: Any) -> dict[str, Any]:
+def _body(
+    name: str,
+    creature: int,
+    shape: Literal["cylinder", "capsule"],
+    axis: Literal["X", "Z"],
+    part: Creature | Link,
+) -> HeaderBody:
     if isinstance(part, Creature):
         radius, length = part.mantle_radius, part.mantle_height
     else:

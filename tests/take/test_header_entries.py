@@ -1,0 +1,63 @@
+"""A take's creature, body and sucker rows are what their TypedDicts say: exactly their
+fields, of their types, in memory and read back from the file."""
+
+from __future__ import annotations
+
+import typing
+from pathlib import Path
+
+from ecs_tentacles.export.bake import BakePlan, bake
+from ecs_tentacles.take import Take
+from ecs_tentacles.take.header_entries import HeaderBody, HeaderCreature, HeaderSucker
+
+SCENE = {
+    "version": 1,
+    "creatures": [
+        {"name": "octo", "position": [0, 0], "tentacles": {"count": 3, "links": 3}},
+        {"name": "squid", "position": [1.5, 0],
+         "tentacles": {"count": 2, "links": 4, "suckers": "every_link"}},
+    ],
+}  # fmt: skip
+
+
+def _strays(rows: list[dict[str, object]], kind: typing.Any) -> list[str]:
+    """Where rows differ from `kind`: other keys, or a value not of the field's type."""
+    fields = typing.get_type_hints(kind)
+    out = []
+    for i, row in enumerate(rows):
+        if set(row) != set(fields):
+            out.append(f"{kind.__name__}[{i}]: keys {sorted(row)}")
+            continue
+        for key, hint in fields.items():
+            origin = typing.get_origin(hint)
+            if origin is typing.Literal:
+                ok = row[key] in typing.get_args(hint)
+            elif origin is list:
+                ok = isinstance(row[key], list)
+            else:  # an int where a float is declared is a float to JSON and mypy alike
+                ok = isinstance(row[key], (int, float) if hint is float else hint)
+            if not ok:
+                out.append(f"{kind.__name__}[{i}].{key}: {row[key]!r}")
+    return out
+
+
+def test_the_rows_are_their_typed_dicts_in_memory_and_in_the_file(tmp_path: Path) -> None:
+    take = bake(BakePlan.make(SCENE, seconds=0.1, fps=30), progress=False)
+    path = tmp_path / "t.npz"
+    take.save(path)
+    for header in (take.header, Take.load(path).header):
+        assert len(header["creatures"]) == 2 and len(header["suckers"]) == 3 + 8
+        assert _strays(header["creatures"], HeaderCreature) == []
+        assert _strays(header["bodies"], HeaderBody) == []
+        assert _strays(header["suckers"], HeaderSucker) == []
+
+
+def test_a_stray_key_or_value_is_found() -> None:
+    rows: list[dict[str, object]] = [
+        {"name": "a/sucker0", "body": 0, "offset": [0.0, 0.0, 0.0], "extra": 1},
+        {"name": "a/sucker1", "body": "0", "offset": [0.0, 0.0, 0.0]},
+    ]
+    assert _strays(rows, HeaderSucker) == [
+        "HeaderSucker[0]: keys ['body', 'extra', 'name', 'offset']",
+        "HeaderSucker[1].body: '0'",
+    ]
