@@ -96,7 +96,7 @@ def scene_sizes(scene: Mapping[str, Any]) -> tuple[int, int]:
     return bodies, suckers
 
 
-def _entry(value: Any) -> int:
+def _entry(value: object) -> int:
     """Bytes of `value` in the header's JSON (compact), with the comma after it."""
     return len(json.dumps(value, separators=(",", ":"))) + 1
 

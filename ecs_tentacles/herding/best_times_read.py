@@ -54,7 +54,7 @@ def _constant(text: str) -> _Refused:
     return _Refused(text)  # NaN, Infinity, -Infinity: JSON has no such numbers
 
 
-def _describe(value: Any) -> str:
+def _describe(value: object) -> str:
     """A short name for a JSON value (never the whole of a large one)."""
     if isinstance(value, _Refused):
         return value.said
@@ -108,7 +108,7 @@ def read_best_times(file: Path) -> BestTimesRead:
     if text is None:
         return BestTimesRead()
     try:
-        raw: Any = json.loads(text, parse_int=_int, parse_constant=_constant)
+        raw: object = json.loads(text, parse_int=_int, parse_constant=_constant)
     except RecursionError:
         return _unread("not JSON (nested too deeply)")
     except ValueError as error:
