@@ -19,7 +19,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import TYPE_CHECKING, Protocol
 
 from ecs_tentacles.render.registries import UndoStates
 
@@ -37,7 +37,7 @@ class Edit(Protocol):
     def redo(self, world: World) -> None: ...
 
 
-def plugin_state(world: World) -> dict[tuple[str, int], Any]:
+def plugin_state(world: World) -> dict[tuple[str, int], object]:
     """Every plugin's directable state (its `UndoStates` entries), by (plugin key, entry)."""
     found = {}
     for index, (owner, undo) in enumerate(world.registry(UndoStates).items()):
@@ -47,7 +47,7 @@ def plugin_state(world: World) -> dict[tuple[str, int], Any]:
     return found
 
 
-def restore_plugin_state(world: World, state: dict[tuple[str, int], Any]) -> None:
+def restore_plugin_state(world: World, state: dict[tuple[str, int], object]) -> None:
     for index, (owner, undo) in enumerate(world.registry(UndoStates).items()):
         if (owner, index) in state:
             undo.restore(world, state[(owner, index)])
@@ -58,8 +58,8 @@ class Memento:
     """The plugins' directable state before and after one edit."""
 
     label: str
-    before: dict[tuple[str, int], Any]
-    after: dict[tuple[str, int], Any]
+    before: dict[tuple[str, int], object]
+    after: dict[tuple[str, int], object]
     at: float = field(default_factory=time.monotonic)
 
     def undo(self, world: World) -> None:
@@ -122,7 +122,7 @@ class UndoStack:
         return edit.label
 
 
-def _same(a: Any, b: Any) -> bool:
+def _same(a: object, b: object) -> bool:
     """Deep equality that compares numpy arrays by value."""
     import numpy as np
 
