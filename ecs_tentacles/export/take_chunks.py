@@ -16,12 +16,15 @@ Reads the `Take` it is given; writes nothing. A chunk's arrays are views of the 
 from __future__ import annotations
 
 from collections.abc import Iterator
-from typing import Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
 from ecs_tentacles.take import Take
 from ecs_tentacles.take import roster as take_roster
+
+if TYPE_CHECKING:
+    from ecs_tentacles.take.stream import ReplaySegment
 
 CHUNK_BYTES = 32 * 1024**2  # body poses (float32 pos + quat) a chunk holds, about
 
@@ -76,7 +79,7 @@ class ChunkSource(Protocol):
         replayed creature (`TakeSource.chunks`); a source may pose more."""
         ...
 
-    def segments(self, creature: int) -> list[Any]: ...
+    def segments(self, creature: int) -> list[ReplaySegment]: ...
     def clip_pose(self, clip: int) -> np.ndarray: ...
     def root_motion(self, creature: int) -> tuple[np.ndarray, np.ndarray]: ...
 
@@ -117,7 +120,7 @@ class TakeChunks:
         for first in range(0, self.frames, self.chunk):
             yield first, frame_slice(self.take, first, min(first + self.chunk, self.frames))
 
-    def segments(self, creature: int) -> list[Any]:
+    def segments(self, creature: int) -> list[ReplaySegment]:
         """Replayed stretches of `creature`: none (a take in memory holds every pose)."""
         return []
 
