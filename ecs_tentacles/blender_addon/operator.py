@@ -43,7 +43,7 @@ class Progress:
         self.manager.progress_end()
 
 
-# bpy has no type information outside Blender: its classes are Any to mypy
+# bpy has no type information outside Blender: mypy cannot see its classes
 class ImportTake(bpy.types.Operator, ImportHelper):  # type: ignore[misc, unused-ignore]
     """Import an ecs_tentacles take (.npz): creatures as armatures with skinned meshes"""
 
