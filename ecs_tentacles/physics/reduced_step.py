@@ -25,19 +25,46 @@ result does not depend on the number of threads or on how rows are shared.
 from __future__ import annotations
 
 import time
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 
-from ecs_tentacles.physics.state_layout import S
+from ecs_tentacles.physics.state_layout import Rows, S
 from ecs_tentacles.physics.tiers import FULL, REDUCED
 
 if TYPE_CHECKING:
-    from ecs_tentacles.physics.batch import Batch
+    from ecs_tentacles.physics.poses import PoseMap
+    from ecs_tentacles.physics.reduced import ReducedModel
+    from ecs_tentacles.physics.scratch import Scratch
+
+
+class ReducedRows(Rows, Protocol):
+    """What the reduced step reads and writes of a batch (`physics.batch.Batch`)."""
+
+    reduced: ReducedModel | None
+    pose_map: PoseMap | None
+    state: np.ndarray
+    rstate: np.ndarray
+    rsource: np.ndarray
+    xpos: np.ndarray
+    xquat: np.ndarray
+    applied: dict[int, np.ndarray]
+    slices: dict[int, slice]
+
+    def scratch_for(self, thread: int, tier: int = FULL) -> Scratch: ...
+
+    def advance(
+        self,
+        scratch: Scratch,
+        row: int,
+        vector: np.ndarray,
+        forces: np.ndarray | None,
+        substeps: int,
+    ) -> bool: ...
 
 
 def step_reduced(
-    batch: Batch, rows: np.ndarray, substeps: int, thread: int
+    batch: ReducedRows, rows: np.ndarray, substeps: int, thread: int
 ) -> tuple[np.ndarray, float]:
     """Step batch rows `rows` by `substeps` steps of its reduced model on scratch
     `thread`; returns each row's own seconds and the seconds of the parts done for all
