@@ -5,10 +5,12 @@ bodies a creature is made of.
 It does MuJoCo's arithmetic in MuJoCo's order (`mj_kinematics` in
 engine_core_smooth.c and the quaternion helpers it calls: `mju_normalize4`,
 `mju_mulQuat`, `mju_rotVecQuat`, `mju_axisAngle2Quat`, `mju_quat2Mat`,
-`mju_mulMatVec3`, with their special cases, which decide signed zeros), so its poses
-are MuJoCo's bit for bit (tests/physics/test_poses.py compares them with
-`mj_kinematics` on states a crowd reaches). Only free and hinge joints; bodies with
-mocap or other joints are left to MuJoCo (`physics.poses.PoseMap` says which).
+`mju_mulMatVec3`, with their special cases, which decide signed zeros; MuJoCo 4.0.1
+sums a quaternion's four products pairwise), so its poses are MuJoCo's bit for bit
+(tests/physics/test_poses.py compares them with `mj_kinematics` on states a crowd
+reaches; a state gone bad gives NaN where MuJoCo's does, whose sign bit may differ).
+Only free and hinge joints; bodies with mocap or other joints are left to MuJoCo
+(`physics.poses.PoseMap` says which).
 
 Optional, as the other kernels are: `physics.poses` imports this module only when
 numba is installed and steps MuJoCo's `mj_kinematics` row by row otherwise. One call

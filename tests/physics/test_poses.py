@@ -132,3 +132,28 @@ def test_a_reduced_crowd_steps_the_same_bits_with_the_kernel_as_with_mujoco(
         assert ours.rstate.tobytes() == theirs.rstate.tobytes()
     moved = kernel.transforms.pos[kernel.physics.batches[0].body_rows[:, 0]]
     assert np.ptp(moved[:, 0]) > 0.0 and (kernel.physics.tier == REDUCED).all()
+
+
+def test_a_state_gone_bad_gives_nan_and_infinite_poses_where_mujoco_does(
+    make_world: Callable[..., World],
+) -> None:
+    """A blown-up row (NaN or infinite joints or root, before the health check restores
+    it) is shown as MuJoCo shows it: the same values, a NaN's sign bit aside."""
+    world = make_world(_crowd(True))
+    for batch in world.physics.batches:
+        qpos = batch.slices[int(S.mjSTATE_QPOS)]
+        states = np.repeat(batch.state, 4, axis=0)
+        states[0, qpos.start + 9] = np.nan  # a joint
+        states[1, qpos.start + 3] = np.nan  # the mantle's orientation
+        states[2, qpos.start] = np.inf  # its position
+        states[3, qpos.start + 8] = -np.inf
+        rows = np.arange(len(states))
+        xpos = np.zeros((len(rows), len(batch.body_ids), 3))
+        xquat = np.zeros((len(rows), len(batch.body_ids), 4))
+        PoseMap(batch.model, batch.body_ids).show(
+            rows, states, qpos, xpos, xquat, batch.model, mujoco.MjData(batch.model)
+        )
+        expected = _mujocos_poses(batch.model, batch.body_ids, states, qpos)
+        np.testing.assert_array_equal(xpos, expected[0])  # NaN where MuJoCo's is NaN
+        np.testing.assert_array_equal(xquat, expected[1])
+        assert np.isnan(xpos[:2]).any() and not np.isfinite(xpos[2:]).all()
