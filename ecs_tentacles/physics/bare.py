@@ -151,7 +151,7 @@ class FrameCapture:
 def _reduced_states(backend: Stepped, index: int, rows: np.ndarray) -> np.ndarray:
     """The reduced states REDUCED `rows` of batch `index` will start their step from:
     fitted again where the full state was written from outside, else the frame's
-    inputs pulled in (`Batch._step_reduced`)."""
+    inputs pulled in (`physics.reduced_step`)."""
     batch = backend.batches[index]
     batch.prepare(REDUCED, backend.threads)
     reduced = batch.reduced
@@ -182,7 +182,7 @@ def step_captured(work: Work, frame: BareFrame, substeps: dict[int, int], thread
             d.xfrc_applied[:] = 0.0
             scratch.forced = False
         positions = np.searchsorted(captured.rows, segment.rows)
-        servos = None  # as `Batch._step_reduced` forms them: for all at once
+        servos = None  # as `physics.reduced_step` forms them: for all at once
         if reduced is not None:
             servos = reduced.servos(
                 captured.kp[positions], captured.kv[positions], captured.torque[positions]

@@ -13,7 +13,8 @@ model and one MjData (`Scratch`), and steps its share of the rows one after anot
 overlay into the scratch model, `mj_setState`, `mj_step`, `mj_getState`, poses out. A
 creature's step therefore reads only its own row, so results never depend on the
 number of threads or on which thread stepped which creature, and a creature steps
-exactly as it would alone in its own model and data.
+exactly as it would alone in its own model and data. REDUCED rows are stepped with the
+reduced model and shown as the full creature (`physics.reduced_step`).
 """
 
 from __future__ import annotations
@@ -35,7 +36,9 @@ from ecs_tentacles.physics.model import (
     PROXY_SLOTS,
     ModelLayout,
 )
+from ecs_tentacles.physics.poses import PoseMap
 from ecs_tentacles.physics.reduced import KERNELS as REDUCED_KERNELS
+from ecs_tentacles.physics.reduced_step import step_reduced
 from ecs_tentacles.physics.scratch import Scratch
 from ecs_tentacles.physics.state_layout import STATE, S, state_slices, write_overlay
 from ecs_tentacles.physics.tiers import FULL, REDUCED, REDUCED_RATE
@@ -71,6 +74,7 @@ class Batch:
         self.models = {FULL: model}  # per tier; REDUCED compiled on first use
         self._compile_reduced = reduced
         self.reduced: ReducedModel | None = None  # the REDUCED tier's model (`physics.reduced`)
+        self.pose_map: PoseMap | None = None  # its show step's kinematics (`physics.poses`)
         m, obj = model, mujoco.mjtObj
         n = len(layouts)
         first = layouts[0]
@@ -242,6 +246,7 @@ class Batch:
 
     def _make_reduced(self, reduced: ReducedModel) -> None:
         reduced.name_ids(self, self.model)
+        self.pose_map = PoseMap(self.model, self.body_ids)
         self.reduced = reduced
         self.models[REDUCED] = reduced.model
         width = (reduced.size, reduced.watched.stop - reduced.watched.start)
@@ -350,19 +355,20 @@ class Batch:
 
     def step_rows(self, rows: np.ndarray, substeps: int, thread: int, tier: int = FULL) -> None:
         """Advance `rows` by `substeps` steps each of `tier`'s model, on `thread`'s scratch."""
-        if tier == REDUCED:
-            self._step_reduced(rows, substeps, thread)
+        if tier == REDUCED:  # (`physics.reduced_step`)
+            seconds, shared = step_reduced(self, rows, substeps, thread)
+            running_costs(self.step_cost, rows, REDUCED, seconds, shared, substeps)
             return
         scratch = self.scratch_for(thread, tier)
         m, poses, turns = scratch.model, scratch.xpos, scratch.xquat
         state, bodies, applied = self.state, self.model_bodies, self.applied
         xpos, xquat, clock = self.xpos, self.xquat, time.perf_counter
-        scratch.warnings[:] = 0  # `_advance` clears them after a row that raised one
+        scratch.warnings[:] = 0  # `advance` clears them after a row that raised one
         took = []  # each row's seconds, into the running costs at once after the share
         began = clock()
         for row in rows.tolist():
             write_overlay(self, m, row)
-            if self._advance(scratch, row, state[row], applied.get(row), substeps):
+            if self.advance(scratch, row, state[row], applied.get(row), substeps):
                 xpos[row] = poses[bodies]
                 xquat[row] = turns[bodies]
             ended = clock()
@@ -370,7 +376,7 @@ class Batch:
             began = ended
         running_costs(self.step_cost, rows, FULL, np.array(took), 0.0, substeps)
 
-    def _advance(
+    def advance(
         self,
         scratch: Scratch,
         row: int,
@@ -404,49 +410,6 @@ class Batch:
         # velocity test first); a list's min is twice as fast as numpy's for a few contacts
         self.deepest[row] = min(d.contact.dist.tolist()) if d.ncon else np.inf
         return True
-
-    def _step_reduced(self, rows: np.ndarray, substeps: int, thread: int) -> None:
-        """Step `rows` with the reduced model (`physics.reduced`): each row's reduced state
-        fitted again if its full state was written from outside, the frame's inputs
-        pulled in, stepped, and shown as the full state and the full model's poses."""
-        reduced = self.reduced
-        assert reduced is not None  # `prepare(REDUCED)` ran before the threads
-        scratch, full = self.scratch_for(thread, REDUCED), self.scratch_for(thread, FULL)
-        m, fm, fd = scratch.model, full.model, full.data
-        state, rstate, rsource = self.state, self.rstate, self.rsource
-        qpos = self.slices[int(S.mjSTATE_QPOS)]
-        bodies = self.model_bodies  # a slice when the bodies are one run: no gather
-        # whole-array work for the rows at once (each row's bits as if alone): the frame's
-        # inputs pulled into the reduced states (fitted again where the full state was
-        # written from outside since the row's last step), every row's reduced servos
-        began = time.perf_counter()
-        for row in reduced.pull_into(rows, state, rstate, rsource).tolist():
-            reduced.fit_state(state[row], rstate[row])
-        servos = reduced.servos(self.kp, self.kv, self.torque, rows)
-        stepped = np.zeros(len(rows), dtype=bool)
-        took = np.zeros(len(rows))
-        shared = time.perf_counter() - began
-        scratch.warnings[:] = 0  # `_advance` clears them after a row that raised one
-        for at, row in enumerate(rows.tolist()):
-            began = time.perf_counter()
-            split = reduced.write_overlay(self, m, row, servos, at)
-            pushed = self.applied.get(row)
-            forces = None if pushed is None else reduced.body_group @ pushed
-            stepped[at] = self._advance(scratch, row, rstate[row], forces, substeps * split)
-            took[at] = time.perf_counter() - began
-        # the stepped rows shown as full states, their poses from the full model
-        began = time.perf_counter()
-        done = rows[stepped]
-        if len(done):
-            reduced.show_rows(done, rstate, state, rsource)
-        joints, poses, turns = fd.qpos, fd.xpos, fd.xquat  # MjData's arrays: fixed views
-        for row in done.tolist():
-            joints[:] = state[row, qpos]
-            mujoco.mj_kinematics(fm, fd)
-            self.xpos[row] = poses[bodies]
-            self.xquat[row] = turns[bodies]
-        shared = (shared + time.perf_counter() - began) / len(rows) if len(rows) else 0.0
-        running_costs(self.step_cost, rows, REDUCED, took, shared, substeps)
 
 
 def running_costs(
