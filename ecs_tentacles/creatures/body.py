@@ -64,84 +64,115 @@ def build_creature(world: Host, spec: CreatureSpec, layout: CreatureLayout | Non
     creature_entity = world.create_entity(creature, Transform(world.transforms, row))
     world.creatures.entity[creature.row] = creature_entity
 
+    rows = _add_rows(world, layout, creature.row)
     for k, angle in enumerate(layout.angles):
         tentacle = Tentacle(creature=creature_entity, index=k, base_angle=float(angle))
         tentacle_entity = world.create_entity(tentacle)
         creature.tentacles.append(tentacle_entity)
-        rows = _build_links(world, tentacle, tentacle_entity, layout, k)
-        _add_tentacle_row(world, tentacle, creature.row, layout, k, rows)
+        _link_entities(world, tentacle, tentacle_entity, layout, k, rows[k])
+        tentacle.attach(world.tentacles, rows[k].tentacle)
+        apply_parameters(world, "tentacles", layout.params[k], {"tentacles": tentacle.row})
     return creature_entity
 
 
-def _add_tentacle_row(
-    world: Host,
-    tentacle: Tentacle,
-    creature_row: int,
-    layout: CreatureLayout,
-    k: int,
-    rows: LinkRows,
-) -> None:
-    params, shape = layout.params[k], layout.shapes[k]
-    added = world.tentacles.add(
-        creature_row=creature_row,
-        base_angle=tentacle.base_angle,
-        first_link=rows.motors[0],
-        links=len(rows.motors),
-        base_row=rows.transforms[0],
-        tip_sucker=rows.suckers[-1],
-        length=shape.length,
-        rest_pitch=shape.rest_pitch,
-    )
-    tentacle.attach(world.tentacles, int(added[0]))
-    apply_parameters(world, "tentacles", params, {"tentacles": tentacle.row})
-    world.motors.tentacle_row[rows.motors] = tentacle.row
-    world.suckers.tentacle_row[rows.suckers] = tentacle.row
-
-
 class LinkRows(NamedTuple):
-    """The store rows of one tentacle's links (transforms, motors) and suckers, in order."""
+    """The store rows of one tentacle: its links' (transforms, motors), its suckers' (on
+    the links `carriers`) and its own."""
 
-    transforms: list[int]
-    motors: list[int]
-    suckers: list[int]
+    transforms: np.ndarray
+    motors: np.ndarray
+    suckers: np.ndarray
+    carriers: np.ndarray
+    tentacle: int
 
 
-def _build_links(
+def _add_rows(world: Host, layout: CreatureLayout, creature_row: int) -> list[LinkRows]:
+    """Every tentacle's rows in each store, added at once per store (one `add` a store
+    for the creature, not one a tentacle: the same rows in the same order), filled from
+    the layout and the tentacles' parameters."""
+    mantle_radius = layout.mantle_radius
+    heading = layout.heading
+    centres, quats, arcs, scales, carriers, offsets, counts = [], [], [], [], [], [], []
+    for k, shape in enumerate(layout.shapes):
+        n = len(shape.scales)
+        counts.append(n)
+        centres.append(layout.link_centres(k))
+        quat = quat_about_z(heading + float(layout.angles[k]))
+        quats.append(np.broadcast_to(quat, (n, 4)))
+        reach = shape.centres[-1] + 0.5 * shape.lengths[-1] - mantle_radius
+        arcs.append((shape.centres - mantle_radius) / reach)
+        scales.append(shape.scales)
+        on = np.arange(n) if layout.params[k]["suckers"] == "every_link" else np.array([n - 1])
+        offset = np.zeros((len(on), 3))  # on the link's underside, half way along
+        offset[:, 0] = 0.5 * shape.lengths[on]
+        offset[:, 2] = -shape.radii[on]
+        carriers.append(on)
+        offsets.append(offset)
+    total = sum(counts)
+    transforms = world.transforms.add(
+        total, pos=np.concatenate(centres), quat=np.concatenate(quats)
+    )
+    motors = world.motors.add(total, arc=np.concatenate(arcs), scale=np.concatenate(scales))
+    firsts = np.cumsum([0, *counts[:-1]])
+    sucker_links = np.concatenate(
+        [transforms[f + on] for f, on in zip(firsts, carriers, strict=True)]
+    )
+    suckers = world.suckers.add(
+        len(sucker_links), link_row=sucker_links, offset=np.concatenate(offsets)
+    )
+    sucker_firsts = np.cumsum([0, *[len(on) for on in carriers[:-1]]])
+    tips = sucker_firsts + [len(on) - 1 for on in carriers]
+    tentacles = world.tentacles.add(
+        len(counts),
+        creature_row=creature_row,
+        base_angle=layout.angles,
+        first_link=motors[firsts],
+        links=counts,
+        base_row=transforms[firsts],
+        tip_sucker=suckers[tips],
+        length=[shape.length for shape in layout.shapes],
+        rest_pitch=[shape.rest_pitch for shape in layout.shapes],
+    )
+    found = []
+    for k, (first, n, on, sucker_first) in enumerate(
+        zip(firsts, counts, carriers, sucker_firsts, strict=True)
+    ):
+        rows = LinkRows(
+            transforms[first : first + n],
+            motors[first : first + n],
+            suckers[sucker_first : sucker_first + len(on)],
+            on,
+            int(tentacles[k]),
+        )
+        # tapered by `scale`
+        apply_parameters(world, "tentacles", layout.params[k], {"motors": rows.motors})
+        world.motors.tentacle_row[rows.motors] = rows.tentacle
+        world.suckers.tentacle_row[rows.suckers] = rows.tentacle
+        found.append(rows)
+    return found
+
+
+def _link_entities(
     world: Host,
     tentacle: Tentacle,
     tentacle_entity: int,
     layout: CreatureLayout,
     k: int,
-) -> LinkRows:
+    rows: LinkRows,
+) -> None:
+    """Tentacle `k`'s link and sucker entities, on their rows (`_add_rows`)."""
     params, shape = layout.params[k], layout.shapes[k]
-    mantle_radius = layout.mantle_radius
-    quat = quat_about_z(layout.heading + tentacle.base_angle)
-    n = len(shape.scales)
-    rows = world.transforms.add(n, pos=layout.link_centres(k), quat=quat)
-    motor_rows = world.motors.add(
-        n,
-        arc=(shape.centres - mantle_radius)
-        / (shape.centres[-1] + 0.5 * shape.lengths[-1] - mantle_radius),
-        scale=shape.scales,
-    )
-    apply_parameters(world, "tentacles", params, {"motors": motor_rows})  # tapered by `scale`
     limit = float(parameter("tentacles", "joint_limit_deg").from_scene(params["joint_limit_deg"]))
     density, twist = params["density"], params["twist"]
     lengths, radii, scales = shape.lengths.tolist(), shape.radii.tolist(), shape.scales.tolist()
     transforms, motors = world.transforms, world.motors
-    found = LinkRows(rows.tolist(), motor_rows.tolist(), [])
-    for i, (row, motor_row) in enumerate(zip(found.transforms, found.motors, strict=True)):
+    for i, (row, motor_row) in enumerate(
+        zip(rows.transforms.tolist(), rows.motors.tolist(), strict=True)
+    ):
         link = Link(tentacle_entity, i, lengths[i], radii[i], scales[i], density, limit, twist)
         entity = world.create_entity(link, Transform(transforms, row), Motor(motors, motor_row))
         tentacle.links.append(entity)
-    carriers = np.arange(n) if params["suckers"] == "every_link" else np.array([n - 1])
-    offsets = np.zeros((len(carriers), 3))  # on the link's underside, half way along
-    offsets[:, 0] = 0.5 * shape.lengths[carriers]
-    offsets[:, 2] = -shape.radii[carriers]
-    sucker_rows = world.suckers.add(len(carriers), link_row=rows[carriers], offset=offsets)
-    for i, sucker_row in zip(carriers.tolist(), sucker_rows.tolist(), strict=True):
+    for i, sucker_row in zip(rows.carriers.tolist(), rows.suckers.tolist(), strict=True):
         entity = world.create_entity(Sucker(world.suckers, sucker_row, tentacle.links[i]))
         world.suckers.entity[sucker_row] = entity
         tentacle.suckers.append(entity)
-        found.suckers.append(sucker_row)
-    return found
