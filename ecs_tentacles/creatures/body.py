@@ -71,7 +71,6 @@ def build_creature(world: Host, spec: CreatureSpec, layout: CreatureLayout | Non
         creature.tentacles.append(tentacle_entity)
         _link_entities(world, tentacle, tentacle_entity, layout, k, rows[k])
         tentacle.attach(world.tentacles, rows[k].tentacle)
-        apply_parameters(world, "tentacles", layout.params[k], {"tentacles": tentacle.row})
     return creature_entity
 
 
@@ -133,22 +132,29 @@ def _add_rows(world: Host, layout: CreatureLayout, creature_row: int) -> list[Li
         length=[shape.length for shape in layout.shapes],
         rest_pitch=[shape.rest_pitch for shape in layout.shapes],
     )
-    found = []
-    for k, (first, n, on, sucker_first) in enumerate(
-        zip(firsts, counts, carriers, sucker_firsts, strict=True)
-    ):
-        rows = LinkRows(
+    found = [
+        LinkRows(
             transforms[first : first + n],
             motors[first : first + n],
             suckers[sucker_first : sucker_first + len(on)],
             on,
             int(tentacles[k]),
         )
-        # tapered by `scale`
-        apply_parameters(world, "tentacles", layout.params[k], {"motors": rows.motors})
-        world.motors.tentacle_row[rows.motors] = rows.tentacle
-        world.suckers.tentacle_row[rows.suckers] = rows.tentacle
-        found.append(rows)
+        for k, (first, n, on, sucker_first) in enumerate(
+            zip(firsts, counts, carriers, sucker_firsts, strict=True)
+        )
+    ]
+    world.motors.tentacle_row[motors] = np.repeat(tentacles, counts)
+    world.suckers.tentacle_row[suckers] = np.repeat(tentacles, [len(on) for on in carriers])
+    # each parameter written once for the tentacles that share their settings (those no
+    # override names share one dict: `every_tentacle_params`); links tapered by `scale`
+    sharing: dict[int, list[int]] = {}
+    for k, params in enumerate(layout.params):
+        sharing.setdefault(id(params), []).append(k)
+    for ks in sharing.values():
+        link_rows = np.concatenate([found[k].motors for k in ks])
+        rows = {"motors": link_rows, "tentacles": tentacles[ks]}
+        apply_parameters(world, "tentacles", layout.params[ks[0]], rows)
     return found
 
 
