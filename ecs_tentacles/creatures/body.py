@@ -9,6 +9,7 @@ built afterwards, from these entities (`ecs_tentacles.physics.model`).
 
 from __future__ import annotations
 
+import functools
 import hashlib
 from typing import TYPE_CHECKING, NamedTuple
 
@@ -17,8 +18,8 @@ import numpy as np
 from ecs_tentacles.components import Creature, Link, Motor, Sucker, Tentacle, Transform
 from ecs_tentacles.ground import ground_of
 from ecs_tentacles.numeric.quaternions import quat_about_z
-from ecs_tentacles.scene.construction import CreatureLayout, creature_layout
-from ecs_tentacles.scene.parameters import apply_parameters, parameter
+from ecs_tentacles.scene.construction import CreatureLayout, TentacleShape, creature_layout
+from ecs_tentacles.scene.parameters import Parameter, apply_parameters, parameter
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
@@ -89,27 +90,21 @@ def _add_rows(world: Host, layout: CreatureLayout, creature_row: int) -> list[Li
     """Every tentacle's rows in each store, added at once per store (one `add` a store
     for the creature, not one a tentacle: the same rows in the same order), filled from
     the layout and the tentacles' parameters."""
-    mantle_radius = layout.mantle_radius
     heading = layout.heading
     centres, quats, arcs, scales, carriers, offsets, counts = [], [], [], [], [], [], []
     for k, shape in enumerate(layout.shapes):
-        n = len(shape.scales)
+        every_link = layout.params[k]["suckers"] == "every_link"
+        n, arc, on, offset = _shape_rows(shape, layout.mantle_radius, every_link)
         counts.append(n)
         centres.append(layout.link_centres(k))
-        quat = quat_about_z(heading + float(layout.angles[k]))
-        quats.append(np.broadcast_to(quat, (n, 4)))
-        reach = shape.centres[-1] + 0.5 * shape.lengths[-1] - mantle_radius
-        arcs.append((shape.centres - mantle_radius) / reach)
+        quats.append(quat_about_z(heading + float(layout.angles[k])))
+        arcs.append(arc)
         scales.append(shape.scales)
-        on = np.arange(n) if layout.params[k]["suckers"] == "every_link" else np.array([n - 1])
-        offset = np.zeros((len(on), 3))  # on the link's underside, half way along
-        offset[:, 0] = 0.5 * shape.lengths[on]
-        offset[:, 2] = -shape.radii[on]
         carriers.append(on)
         offsets.append(offset)
     total = sum(counts)
     transforms = world.transforms.add(
-        total, pos=np.concatenate(centres), quat=np.concatenate(quats)
+        total, pos=np.concatenate(centres), quat=np.repeat(quats, counts, axis=0)
     )
     motors = world.motors.add(total, arc=np.concatenate(arcs), scale=np.concatenate(scales))
     firsts = np.cumsum([0, *counts[:-1]])
@@ -158,6 +153,47 @@ def _add_rows(world: Host, layout: CreatureLayout, creature_row: int) -> list[Li
     return found
 
 
+@functools.cache
+def _joint_limit() -> Parameter:
+    """The `tentacles.joint_limit_deg` parameter (looked up once)."""
+    return parameter("tentacles", "joint_limit_deg")
+
+
+# (id(shape), mantle radius, suckers on every link) -> (shape kept alive, `_shape_rows`)
+_SHAPE_ROWS: dict[tuple[int, float, bool], tuple[TentacleShape, ShapeRows]] = {}
+
+
+class ShapeRows(NamedTuple):
+    """What a tentacle's rows are filled with that its shape alone decides (read only)."""
+
+    links: int
+    arc: np.ndarray  # each link centre's place along the tentacle, 0 at the base, 1 at the tip
+    carriers: np.ndarray  # the links with a sucker
+    offsets: np.ndarray  # (carriers, 3): each sucker on its link's underside, half way along
+
+
+def _shape_rows(shape: TentacleShape, mantle_radius: float, every_link: bool) -> ShapeRows:
+    """`ShapeRows` of tentacles of `shape` on a mantle of `mantle_radius`, worked out once
+    per shape (shapes are shared: `tentacle_shape`)."""
+    key = (id(shape), mantle_radius, every_link)
+    found = _SHAPE_ROWS.get(key)
+    if found is not None and found[0] is shape:
+        return found[1]
+    n = len(shape.scales)
+    reach = shape.centres[-1] + 0.5 * shape.lengths[-1] - mantle_radius
+    on = np.arange(n) if every_link else np.array([n - 1])
+    offsets = np.zeros((len(on), 3))
+    offsets[:, 0] = 0.5 * shape.lengths[on]
+    offsets[:, 2] = -shape.radii[on]
+    rows = ShapeRows(n, (shape.centres - mantle_radius) / reach, on, offsets)
+    for array in rows[1:]:
+        array.flags.writeable = False
+    if len(_SHAPE_ROWS) > 4096:
+        _SHAPE_ROWS.clear()
+    _SHAPE_ROWS[key] = (shape, rows)
+    return rows
+
+
 def _link_entities(
     world: Host,
     tentacle: Tentacle,
@@ -168,7 +204,7 @@ def _link_entities(
 ) -> None:
     """Tentacle `k`'s link and sucker entities, on their rows (`_add_rows`)."""
     params, shape = layout.params[k], layout.shapes[k]
-    limit = float(parameter("tentacles", "joint_limit_deg").from_scene(params["joint_limit_deg"]))
+    limit = float(_joint_limit().from_scene(params["joint_limit_deg"]))
     density, twist = params["density"], params["twist"]
     lengths, radii, scales = shape.lengths.tolist(), shape.radii.tolist(), shape.scales.tolist()
     transforms, motors = world.transforms, world.motors
