@@ -9,6 +9,7 @@ built afterwards, from these entities (`ecs_tentacles.physics.model`).
 
 from __future__ import annotations
 
+import functools
 import hashlib
 from typing import TYPE_CHECKING, NamedTuple
 
@@ -17,8 +18,8 @@ import numpy as np
 from ecs_tentacles.components import Creature, Link, Motor, Sucker, Tentacle, Transform
 from ecs_tentacles.ground import ground_of
 from ecs_tentacles.numeric.quaternions import quat_about_z
-from ecs_tentacles.scene.construction import CreatureLayout, creature_layout
-from ecs_tentacles.scene.parameters import apply_parameters, parameter
+from ecs_tentacles.scene.construction import CreatureLayout, TentacleShape, creature_layout
+from ecs_tentacles.scene.parameters import Parameter, apply_parameters, parameter
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
@@ -64,84 +65,156 @@ def build_creature(world: Host, spec: CreatureSpec, layout: CreatureLayout | Non
     creature_entity = world.create_entity(creature, Transform(world.transforms, row))
     world.creatures.entity[creature.row] = creature_entity
 
+    rows = _add_rows(world, layout, creature.row)
     for k, angle in enumerate(layout.angles):
         tentacle = Tentacle(creature=creature_entity, index=k, base_angle=float(angle))
         tentacle_entity = world.create_entity(tentacle)
         creature.tentacles.append(tentacle_entity)
-        rows = _build_links(world, tentacle, tentacle_entity, layout, k)
-        _add_tentacle_row(world, tentacle, creature.row, layout, k, rows)
+        _link_entities(world, tentacle, tentacle_entity, layout, k, rows[k])
+        tentacle.attach(world.tentacles, rows[k].tentacle)
     return creature_entity
 
 
-def _add_tentacle_row(
-    world: Host,
-    tentacle: Tentacle,
-    creature_row: int,
-    layout: CreatureLayout,
-    k: int,
-    rows: LinkRows,
-) -> None:
-    params, shape = layout.params[k], layout.shapes[k]
-    added = world.tentacles.add(
-        creature_row=creature_row,
-        base_angle=tentacle.base_angle,
-        first_link=rows.motors[0],
-        links=len(rows.motors),
-        base_row=rows.transforms[0],
-        tip_sucker=rows.suckers[-1],
-        length=shape.length,
-        rest_pitch=shape.rest_pitch,
-    )
-    tentacle.attach(world.tentacles, int(added[0]))
-    apply_parameters(world, "tentacles", params, {"tentacles": tentacle.row})
-    world.motors.tentacle_row[rows.motors] = tentacle.row
-    world.suckers.tentacle_row[rows.suckers] = tentacle.row
-
-
 class LinkRows(NamedTuple):
-    """The store rows of one tentacle's links (transforms, motors) and suckers, in order."""
+    """The store rows of one tentacle: its links' (transforms, motors), its suckers' (on
+    the links `carriers`) and its own."""
 
-    transforms: list[int]
-    motors: list[int]
-    suckers: list[int]
+    transforms: np.ndarray
+    motors: np.ndarray
+    suckers: np.ndarray
+    carriers: np.ndarray
+    tentacle: int
 
 
-def _build_links(
+def _add_rows(world: Host, layout: CreatureLayout, creature_row: int) -> list[LinkRows]:
+    """Every tentacle's rows in each store, added at once per store (one `add` a store
+    for the creature, not one a tentacle: the same rows in the same order), filled from
+    the layout and the tentacles' parameters."""
+    heading = layout.heading
+    centres, quats, arcs, scales, carriers, offsets, counts = [], [], [], [], [], [], []
+    for k, shape in enumerate(layout.shapes):
+        every_link = layout.params[k]["suckers"] == "every_link"
+        n, arc, on, offset = _shape_rows(shape, layout.mantle_radius, every_link)
+        counts.append(n)
+        centres.append(layout.link_centres(k))
+        quats.append(quat_about_z(heading + float(layout.angles[k])))
+        arcs.append(arc)
+        scales.append(shape.scales)
+        carriers.append(on)
+        offsets.append(offset)
+    total = sum(counts)
+    transforms = world.transforms.add(
+        total, pos=np.concatenate(centres), quat=np.repeat(quats, counts, axis=0)
+    )
+    motors = world.motors.add(total, arc=np.concatenate(arcs), scale=np.concatenate(scales))
+    firsts = np.cumsum([0, *counts[:-1]])
+    sucker_links = np.concatenate(
+        [transforms[f + on] for f, on in zip(firsts, carriers, strict=True)]
+    )
+    suckers = world.suckers.add(
+        len(sucker_links), link_row=sucker_links, offset=np.concatenate(offsets)
+    )
+    sucker_firsts = np.cumsum([0, *[len(on) for on in carriers[:-1]]])
+    tips = sucker_firsts + [len(on) - 1 for on in carriers]
+    tentacles = world.tentacles.add(
+        len(counts),
+        creature_row=creature_row,
+        base_angle=layout.angles,
+        first_link=motors[firsts],
+        links=counts,
+        base_row=transforms[firsts],
+        tip_sucker=suckers[tips],
+        length=[shape.length for shape in layout.shapes],
+        rest_pitch=[shape.rest_pitch for shape in layout.shapes],
+    )
+    found = [
+        LinkRows(
+            transforms[first : first + n],
+            motors[first : first + n],
+            suckers[sucker_first : sucker_first + len(on)],
+            on,
+            int(tentacles[k]),
+        )
+        for k, (first, n, on, sucker_first) in enumerate(
+            zip(firsts, counts, carriers, sucker_firsts, strict=True)
+        )
+    ]
+    world.motors.tentacle_row[motors] = np.repeat(tentacles, counts)
+    world.suckers.tentacle_row[suckers] = np.repeat(tentacles, [len(on) for on in carriers])
+    # each parameter written once for the tentacles that share their settings (those no
+    # override names share one dict: `every_tentacle_params`); links tapered by `scale`
+    sharing: dict[int, list[int]] = {}
+    for k, params in enumerate(layout.params):
+        sharing.setdefault(id(params), []).append(k)
+    for ks in sharing.values():
+        link_rows = np.concatenate([found[k].motors for k in ks])
+        rows = {"motors": link_rows, "tentacles": tentacles[ks]}
+        apply_parameters(world, "tentacles", layout.params[ks[0]], rows)
+    return found
+
+
+@functools.cache
+def _joint_limit() -> Parameter:
+    """The `tentacles.joint_limit_deg` parameter (looked up once)."""
+    return parameter("tentacles", "joint_limit_deg")
+
+
+# (id(shape), mantle radius, suckers on every link) -> (shape kept alive, `_shape_rows`)
+_SHAPE_ROWS: dict[tuple[int, float, bool], tuple[TentacleShape, ShapeRows]] = {}
+
+
+class ShapeRows(NamedTuple):
+    """What a tentacle's rows are filled with that its shape alone decides (read only)."""
+
+    links: int
+    arc: np.ndarray  # each link centre's place along the tentacle, 0 at the base, 1 at the tip
+    carriers: np.ndarray  # the links with a sucker
+    offsets: np.ndarray  # (carriers, 3): each sucker on its link's underside, half way along
+
+
+def _shape_rows(shape: TentacleShape, mantle_radius: float, every_link: bool) -> ShapeRows:
+    """`ShapeRows` of tentacles of `shape` on a mantle of `mantle_radius`, worked out once
+    per shape (shapes are shared: `tentacle_shape`)."""
+    key = (id(shape), mantle_radius, every_link)
+    found = _SHAPE_ROWS.get(key)
+    if found is not None and found[0] is shape:
+        return found[1]
+    n = len(shape.scales)
+    reach = shape.centres[-1] + 0.5 * shape.lengths[-1] - mantle_radius
+    on = np.arange(n) if every_link else np.array([n - 1])
+    offsets = np.zeros((len(on), 3))
+    offsets[:, 0] = 0.5 * shape.lengths[on]
+    offsets[:, 2] = -shape.radii[on]
+    rows = ShapeRows(n, (shape.centres - mantle_radius) / reach, on, offsets)
+    for array in rows[1:]:
+        array.flags.writeable = False
+    if len(_SHAPE_ROWS) > 4096:
+        _SHAPE_ROWS.clear()
+    _SHAPE_ROWS[key] = (shape, rows)
+    return rows
+
+
+def _link_entities(
     world: Host,
     tentacle: Tentacle,
     tentacle_entity: int,
     layout: CreatureLayout,
     k: int,
-) -> LinkRows:
+    rows: LinkRows,
+) -> None:
+    """Tentacle `k`'s link and sucker entities, on their rows (`_add_rows`)."""
     params, shape = layout.params[k], layout.shapes[k]
-    mantle_radius = layout.mantle_radius
-    quat = quat_about_z(layout.heading + tentacle.base_angle)
-    n = len(shape.scales)
-    rows = world.transforms.add(n, pos=layout.link_centres(k), quat=quat)
-    motor_rows = world.motors.add(
-        n,
-        arc=(shape.centres - mantle_radius)
-        / (shape.centres[-1] + 0.5 * shape.lengths[-1] - mantle_radius),
-        scale=shape.scales,
-    )
-    apply_parameters(world, "tentacles", params, {"motors": motor_rows})  # tapered by `scale`
-    limit = float(parameter("tentacles", "joint_limit_deg").from_scene(params["joint_limit_deg"]))
+    limit = float(_joint_limit().from_scene(params["joint_limit_deg"]))
     density, twist = params["density"], params["twist"]
     lengths, radii, scales = shape.lengths.tolist(), shape.radii.tolist(), shape.scales.tolist()
     transforms, motors = world.transforms, world.motors
-    found = LinkRows(rows.tolist(), motor_rows.tolist(), [])
-    for i, (row, motor_row) in enumerate(zip(found.transforms, found.motors, strict=True)):
+    for i, (row, motor_row) in enumerate(
+        zip(rows.transforms.tolist(), rows.motors.tolist(), strict=True)
+    ):
         link = Link(tentacle_entity, i, lengths[i], radii[i], scales[i], density, limit, twist)
         entity = world.create_entity(link, Transform(transforms, row), Motor(motors, motor_row))
         tentacle.links.append(entity)
-    carriers = np.arange(n) if params["suckers"] == "every_link" else np.array([n - 1])
-    offsets = np.zeros((len(carriers), 3))  # on the link's underside, half way along
-    offsets[:, 0] = 0.5 * shape.lengths[carriers]
-    offsets[:, 2] = -shape.radii[carriers]
-    sucker_rows = world.suckers.add(len(carriers), link_row=rows[carriers], offset=offsets)
-    for i, sucker_row in zip(carriers.tolist(), sucker_rows.tolist(), strict=True):
+    for i, sucker_row in zip(rows.carriers.tolist(), rows.suckers.tolist(), strict=True):
         entity = world.create_entity(Sucker(world.suckers, sucker_row, tentacle.links[i]))
         world.suckers.entity[sucker_row] = entity
         tentacle.suckers.append(entity)
-        found.suckers.append(sucker_row)
-    return found

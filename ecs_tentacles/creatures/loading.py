@@ -18,10 +18,12 @@ and esper context) before the error goes on.
 
 from __future__ import annotations
 
+import contextlib
+import gc
 import importlib
 import os
 import pathlib
-from collections.abc import Collection
+from collections.abc import Collection, Iterator
 from dataclasses import replace
 from typing import Any, Protocol, TypeVar
 
@@ -83,6 +85,17 @@ def load_world(
     systems): no physics models are compiled and nothing is scheduled; a scene's own
     `systems` are imported only when allowed (`validate`; close the world after).
     """
+    with collection_paused():  # the scene's and the crowd's objects are made, none freed
+        return _load_world(cls, source, options, checks_only)
+
+
+def _load_world(
+    cls: WorldClass[W],
+    source: str | os.PathLike[str] | dict[str, Any],
+    options: WorldOptions | None,
+    checks_only: bool,
+) -> W:
+    """`load_world`, with the collector off."""
     options = options or WorldOptions()
     allow_systems, plugins, seed = options.allow_systems, options.plugins, options.seed
     folder = options.scene_dir
@@ -117,6 +130,23 @@ def load_world(
         x, y, radius = options.focus
         world.physics.lod.focus((x, y), radius)
     return world
+
+
+@contextlib.contextmanager
+def collection_paused() -> Iterator[None]:
+    """Python's cyclic garbage collector off inside (as it was, after).
+
+    A build makes about a hundred objects a creature (components, store rows' handles,
+    spec dicts) and frees almost none: every collection the allocations set off would
+    walk all of them again, a fifth of a 1,024-creature build's time for nothing to free.
+    """
+    was = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if was:
+            gc.enable()
 
 
 def _build(

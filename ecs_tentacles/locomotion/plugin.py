@@ -106,14 +106,10 @@ class LocomotionPlugin(Plugin):
         loco.creatures.avoid[row] = bool(spec.get("avoid", True))
         rng = creature_rng(world.seed, spec["name"])  # the creature's own stream
         tentacles = spec["tentacles"]
-        for k, entity in enumerate(body.tentacles):
-            tentacle = world.component(entity, Tentacle)
-            added = int(
-                loco.tentacles.add(
-                    phase=rng.uniform(0.0, 2.0 * np.pi), action_strength=STRENGTH[Kind.IDLE]
-                )[0]
-            )
-            if added != tentacle.row:
+        phases = [rng.uniform(0.0, 2.0 * np.pi) for _ in body.tentacles]  # drawn in order
+        rows = loco.tentacles.add(len(phases), phase=phases, action_strength=STRENGTH[Kind.IDLE])
+        for k, (entity, added) in enumerate(zip(body.tentacles, rows.tolist(), strict=True)):
+            if added != world.component(entity, Tentacle).row:
                 raise RuntimeError("locomotion's tentacle rows must line up with the body's")
             params = tentacle_params(tentacles, k)
             apply_parameters(world, "tentacles", params, {"locomotion.tentacles": added})

@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING, Any, Protocol, TypeVar
 
 from ecs_tentacles.events import Events
 from ecs_tentacles.settings import Settings
-from ecs_tentacles.store import CreatureStore, SuckerStore, TransformStore
+from ecs_tentacles.store import CreatureStore, SuckerStore, TentacleStore, TransformStore
 
 if TYPE_CHECKING:
     from ecs_tentacles.registry import Registry
@@ -43,6 +43,9 @@ class PhysicsHost(Protocol):
 
     @property
     def creatures(self) -> CreatureStore: ...
+
+    @property
+    def tentacles(self) -> TentacleStore: ...
 
     @property
     def events(self) -> Events: ...

@@ -24,9 +24,10 @@ lists, in model order, which store rows they belong to.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import mujoco
 import numpy as np
@@ -90,7 +91,12 @@ class ModelLayout:
 
 
 def model_layout(world: PhysicsHost, creature: Creature, transform: Transform) -> ModelLayout:
-    """The creature model's morphology key and its elements' store rows, building nothing."""
+    """The creature model's morphology key and its elements' store rows, building nothing.
+
+    A tentacle's links are the consecutive rows of the Transform and Motor stores from its
+    `base_row` and `first_link` (`TentacleStore`), so those rows are read from the
+    tentacle's; element names are made once per tentacle shape (`_tentacle_names`).
+    """
     key: list[Any] = [
         _settings_key(world.settings),
         (creature.mantle_radius, creature.mantle_height, creature.mantle_density),
@@ -98,32 +104,56 @@ def model_layout(world: PhysicsHost, creature: Creature, transform: Transform) -
     layout = ModelLayout(key=())
     layout.bodies.append("mantle")
     layout.body_rows.append(transform.row)
+    tentacles, sucker_offsets = world.tentacles, world.suckers.offset
     for tentacle_entity in creature.tentacles:
         tentacle = world.component(tentacle_entity, Tentacle)
-        links: list[tuple[Any, ...]] = []
-        for link_entity in tentacle.links:
-            link = world.component(link_entity, Link)
-            prefix = f"t{tentacle.index}/l{link.index:02d}"
-            layout.bodies.append(prefix)
-            layout.body_rows.append(world.component(link_entity, Transform).row)
-            motor = world.component(link_entity, Motor)
-            for hinge in hinges(link):
-                layout.actuators.append(f"{prefix}/{hinge}")
-                layout.actuator_motor_rows.append(motor.row)
-                layout.actuator_axes.append(AXIS_INDEX[hinge])
-            links.append(
-                (link.length, link.radius, link.density, link.joint_limit, link.twist, link.scale)
-            )
+        links = [world.component(entity, Link) for entity in tentacle.links]
+        names = _tentacle_names(tentacle.index, tuple((lk.index, bool(lk.twist)) for lk in links))
+        row = tentacle.row
+        base, first = int(tentacles.base_row[row]), int(tentacles.first_link[row])
+        layout.bodies += names.bodies
+        layout.body_rows += range(base, base + len(links))
+        layout.actuators += names.actuators
+        layout.actuator_motor_rows += [first + i for i in names.actuator_links]
+        layout.actuator_axes += names.actuator_axes
+        index_of = {entity: i for i, entity in enumerate(tentacle.links)}
+        found = [world.component(entity, Sucker) for entity in tentacle.suckers]
+        rows = [sucker.row for sucker in found]
+        offsets = sucker_offsets[rows].tolist()
         suckers: list[tuple[Any, ...]] = []
-        for sucker_entity in tentacle.suckers:
-            sucker = world.component(sucker_entity, Sucker)
-            index = tentacle.links.index(sucker.link)
+        for sucker, sucker_row, offset in zip(found, rows, offsets, strict=True):
             layout.equalities.append(f"t{tentacle.index}/sucker{len(layout.equalities)}")
-            layout.sucker_rows.append(sucker.row)
-            suckers.append((index, *np.asarray(sucker.offset).tolist()))
-        key.append((tentacle.base_angle, tuple(links), tuple(suckers)))
+            layout.sucker_rows.append(sucker_row)
+            suckers.append((index_of[sucker.link], *offset))
+        shape = tuple(
+            (lk.length, lk.radius, lk.density, lk.joint_limit, lk.twist, lk.scale) for lk in links
+        )
+        key.append((tentacle.base_angle, shape, tuple(suckers)))
     layout.key = tuple(key)
     return layout
+
+
+class TentacleNames(NamedTuple):
+    """A tentacle's element names in model order, and each actuator's link and axis."""
+
+    bodies: tuple[str, ...]
+    actuators: tuple[str, ...]
+    actuator_links: tuple[int, ...]  # the link (0 at the base) of each actuator
+    actuator_axes: tuple[int, ...]  # `AXIS_INDEX` of each actuator's hinge
+
+
+@functools.lru_cache(maxsize=1024)
+def _tentacle_names(index: int, links: tuple[tuple[int, bool], ...]) -> TentacleNames:
+    """The names of tentacle `index` whose links are `(link index, twist)`, base first."""
+    bodies, actuators, actuator_links, axes = [], [], [], []
+    for i, (link, twist) in enumerate(links):
+        prefix = f"t{index}/l{link:02d}"
+        bodies.append(prefix)
+        for hinge in ("curl", "sweep", "twist") if twist else ("curl", "sweep"):
+            actuators.append(f"{prefix}/{hinge}")
+            actuator_links.append(i)
+            axes.append(AXIS_INDEX[hinge])
+    return TentacleNames(tuple(bodies), tuple(actuators), tuple(actuator_links), tuple(axes))
 
 
 def _settings_key(settings: Settings) -> tuple[Any, ...]:

@@ -28,8 +28,30 @@ def nested(values: list[Any]) -> list[tuple[int, Any]]:
     return [(i, v) for i, v in enumerate(values) if isinstance(v, (dict, list))]
 
 
+# (id(schema), id(root)) -> (schema, root, resolved): both kept alive, so the ids stay theirs
+_RESOLVED: dict[tuple[int, int], tuple[Mapping[str, Any], Mapping[str, Any], Mapping[str, Any]]]
+_RESOLVED = {}
+
+
 def resolve(schema: Mapping[str, Any], root: Mapping[str, Any]) -> Mapping[str, Any]:
-    """Follow local ``$ref``s; keywords beside a ``$ref`` (like ``default``) win."""
+    """Follow local ``$ref``s; keywords beside a ``$ref`` (like ``default``) win.
+
+    Worked out once per schema object and root (a crowd's creatures resolve the same
+    `$ref`s some hundred thousand times); the answer is read, never written."""
+    if "$ref" not in schema:
+        return schema
+    found = _RESOLVED.get((id(schema), id(root)))
+    if found is not None and found[0] is schema and found[1] is root:
+        return found[2]
+    resolved = _resolve(schema, root)
+    if len(_RESOLVED) > 4096:
+        _RESOLVED.clear()
+    _RESOLVED[id(schema), id(root)] = (schema, root, resolved)
+    return resolved
+
+
+def _resolve(schema: Mapping[str, Any], root: Mapping[str, Any]) -> Mapping[str, Any]:
+    """`resolve`, worked out."""
     seen: set[str] = set()
     while isinstance(schema.get("$ref"), str) and schema["$ref"] not in seen:
         ref: str = schema["$ref"]

@@ -114,9 +114,77 @@ def _items(validator: Any, items: Any, instance: object, schema: Any) -> Iterato
     yield from _STANDARD_ITEMS(validator, items, instance, schema)
 
 
+_BOUNDS = ("minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum")
+_LEAF_KINDS = {"number": _is_number, "integer": _is_integer, "boolean": None, "string": None}
+_NOTES = {"description", "default", "title", "examples", "$comment"}  # (and x-...: ours)
+_LEAVES: dict[int, tuple[object, Any]] = {}  # id -> (schema kept alive, its check or None)
+
+
+def _leaf_check(schema: object) -> Any:
+    """For a schema that only says a value's type (number, integer, boolean or string)
+    and, for numbers, its bounds: a function telling that a value passes it; else None."""
+    found = _LEAVES.get(id(schema))
+    if found is not None and found[0] is schema:
+        return found[1]
+    check = None
+    if (
+        isinstance(schema, dict)
+        and isinstance(schema.get("type"), str)
+        and schema["type"] in _LEAF_KINDS
+    ):
+        kind = schema["type"]
+        rules = {k for k in schema if k not in _NOTES and not k.startswith("x-")} - {"type"}
+        numeric = kind in ("number", "integer")
+        if not rules or (numeric and rules <= set(_BOUNDS)):
+            check = _leaf(kind, *(schema.get(k) for k in _BOUNDS))
+    if len(_LEAVES) > 4096:
+        _LEAVES.clear()
+    _LEAVES[id(schema)] = (schema, check)
+    return check
+
+
+def _leaf(kind: str, low: Any, high: Any, above: Any, below: Any) -> Callable[[object], bool]:
+    """`_leaf_check`'s function: True when a value is of `kind` within the bounds (each
+    None when absent), exactly when jsonschema would find nothing wrong with it."""
+    is_kind = _LEAF_KINDS[kind]
+    if kind == "boolean":
+        return lambda value: isinstance(value, bool)
+    if kind == "string":
+        return lambda value: isinstance(value, str)
+    assert is_kind is not None
+
+    def passes(value: Any) -> bool:
+        return bool(
+            is_kind(None, value)
+            and (low is None or not value < low)
+            and (high is None or not value > high)
+            and (above is None or not value <= above)
+            and (below is None or not value >= below)
+        )
+
+    return passes
+
+
+def _properties(validator: Any, properties: Any, instance: object, schema: Any) -> Iterator[Any]:
+    """`properties`, with values that plainly pass a type-and-bounds schema not descended
+    into: jsonschema would find nothing there (a crowd's creatures are mostly such
+    values, and a descent costs some microseconds each); any other value, and one that
+    fails, is descended into as usual for the usual messages."""
+    if not validator.is_type(instance, "object"):
+        return
+    assert isinstance(instance, dict)
+    for name, subschema in properties.items():
+        if name in instance:
+            value = instance[name]
+            check = _leaf_check(subschema)
+            if check is not None and check(value):
+                continue
+            yield from validator.descend(value, subschema, path=name, schema_path=name)
+
+
 StrictValidator = cast(Any, validators.extend)(  # jsonschema leaves extend untyped
     Draft202012Validator,
-    validators={"pattern": _pattern, "items": _items},
+    validators={"pattern": _pattern, "items": _items, "properties": _properties},
     type_checker=Draft202012Validator.TYPE_CHECKER.redefine_many(
         {"integer": _is_integer, "number": _is_number}
     ),

@@ -118,6 +118,57 @@ def creature_problems(
     scene of these `physics` settings: too light, needles, servos that shake, inside
     the plane (`plane`; `physical_problems`). Its layout comes from `layouts`."""
     layout = (Layouts() if layouts is None else layouts).on_plane(creature)
+    step = _step(physics)
+    key = _body_key(creature, layout, step)
+    found = _BODY_PROBLEMS.get(key)
+    if found is None:  # a body plan not seen yet (a uniform crowd has one)
+        found = _body_problems(creature, layout, step)
+        if len(_BODY_PROBLEMS) > 1024:
+            _BODY_PROBLEMS.clear()
+        _BODY_PROBLEMS[key] = found
+    problems = [((*where, *path), message) for path, message in found]
+    if plane:  # a plugin that shapes the ground checks its own
+        problems += _below_ground(where, layout)
+    return problems
+
+
+# a body plan's problems (`_body_key`), paths from the creature: worked out once per plan
+_BODY_PROBLEMS: dict[tuple[Any, ...], list[tuple[Path, str]]] = {}
+
+
+def _body_key(creature: CreatureSpec, layout: CreatureLayout, step: float) -> tuple[Any, ...]:
+    """Everything `_body_problems` reads: the mantle, each tentacle's shape, density and
+    servo, which overrides set a shape or a servo (problem paths name them), the step."""
+    mantle = creature["mantle"]
+    overrides = tuple(
+        (o["index"], any(k in o for k in SHAPE_KEYS), "strength" in o or "damping" in o)
+        for o in creature["tentacles"]["overrides"]
+    )
+    return (
+        step,
+        (mantle["radius"], mantle["height"], mantle["density"]),
+        tuple(
+            (
+                p["link_length"],
+                p["link_radius"],
+                p["links"],
+                p["end_scale"],
+                p["density"],
+                p["strength"],
+                p["damping"],
+            )
+            for p in layout.params
+        ),
+        overrides,
+    )
+
+
+def _body_problems(
+    creature: CreatureSpec, layout: CreatureLayout, step: float
+) -> list[tuple[Path, str]]:
+    """`creature_problems` of its body plan alone (not where it stands), paths from the
+    creature (`("mantle",)`)."""
+    where: Path = ()
     weights = [  # (links, 2) masses and inertias per tentacle, for both checks below
         capsule_mass_inertia(shape.lengths, shape.radii, params["density"])
         for params, shape in zip(layout.params, layout.shapes, strict=True)
@@ -126,10 +177,7 @@ def creature_problems(
     problems = _light_bodies(where, creature, layout, weights) or _proportion_problems(
         where, creature, layout, weights
     )
-    problems += _servo_problems(where, creature, layout, _step(physics))
-    if plane:  # a plugin that shapes the ground checks its own
-        problems += _below_ground(where, layout)
-    return problems
+    return problems + _servo_problems(where, creature, layout, step)
 
 
 def _step(physics: dict[str, Any]) -> float:

@@ -232,3 +232,21 @@ def test_every_bundled_scene_still_loads() -> None:
     assert len(names) >= 6
     for name in names:
         load_scene(bundled_scene(name))
+
+
+def test_a_body_plan_checked_once_is_refused_at_every_creature_that_has_it() -> None:
+    """Body plans are checked once per plan: each creature still gets its own lines."""
+    light = {"tentacles": {"link_radius": 1e-4, "link_length": 0.01}}
+    data = scene(
+        {"position": [0, 0], **light},
+        {"position": [3, 0]},
+        {"position": [6, 0], "name": "third", **light},
+    )
+    with pytest.raises(SceneError) as refused:
+        load_scene(data)
+    assert [line.split(":")[0] for line in refused.value.problems] == [
+        "creatures[0].tentacles",
+        "creatures[2].tentacles",
+    ]
+    first, third = (line.split(":", 1)[1] for line in refused.value.problems)
+    assert first == third
