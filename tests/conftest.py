@@ -27,26 +27,6 @@ STOPS = [
 ]
 
 
-def worlds_by_backend(
-    make_world: Callable[..., World],
-    kernels: Any,
-    monkeypatch: pytest.MonkeyPatch,
-    scene: dict[str, Any],
-    frames: int,
-) -> list[World]:
-    """`scene` stepped `frames` frames twice: with `kernels` (an `OptionalKernels`) on
-    numba's path, then on numpy's; every body must stand where it stood the other way,
-    bit for bit. The two worlds, in that order."""
-    worlds = []
-    for backend in ("auto", "numpy"):
-        monkeypatch.setattr(kernels, "backend", backend)
-        world = make_world(scene)
-        world.step(frames)
-        worlds.append(world)
-    np.testing.assert_array_equal(worlds[0].transforms.pos, worlds[1].transforms.pos)
-    return worlds
-
-
 def python_calls(action: Callable[[], object]) -> int:
     """Python function calls (and generator resumptions) made while `action` runs: how
     the work grows with a problem's size, counted rather than timed (no noise)."""
@@ -103,6 +83,15 @@ def uniform_crowd(path: Path, count: int, lod: dict[str, Any], *options: str) ->
     return path
 
 
+def baked(scene: str, out: Path, seconds: float, fps: float = 30.0) -> Path:
+    """`ecs-tentacles bake SCENE --seconds SECONDS --fps FPS --out OUT`; `out`."""
+    from ecs_tentacles.cli import main
+
+    argv = ["bake", scene, "--seconds", str(seconds), "--fps", str(fps), "--quiet"]
+    assert main([*argv, "--out", str(out)]) == 0
+    return out
+
+
 @pytest.fixture
 def make_world() -> Iterator[Callable[..., World]]:
     """Build worlds from scene dicts; every world is closed at the end of the test."""
@@ -116,6 +105,31 @@ def make_world() -> Iterator[Callable[..., World]]:
     yield make
     for world in worlds:
         world.close()
+
+
+# (kernels, scene, frames) -> the two worlds: see `worlds_by_backend`
+ByBackend = Callable[[Any, dict[str, Any], int], list[World]]
+
+
+@pytest.fixture
+def worlds_by_backend(
+    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
+) -> ByBackend:
+    """`(kernels, scene, frames)`: `scene` stepped `frames` frames twice, with `kernels`
+    (an `OptionalKernels`) on numba's path, then on numpy's; every body must stand where
+    it stood the other way, bit for bit. The two worlds, in that order."""
+
+    def both(kernels: Any, scene: dict[str, Any], frames: int) -> list[World]:
+        worlds = []
+        for backend in ("auto", "numpy"):
+            monkeypatch.setattr(kernels, "backend", backend)
+            world = make_world(scene)
+            world.step(frames)
+            worlds.append(world)
+        np.testing.assert_array_equal(worlds[0].transforms.pos, worlds[1].transforms.pos)
+        return worlds
+
+    return both
 
 
 @pytest.fixture

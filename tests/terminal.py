@@ -61,3 +61,13 @@ def interrupted_on_a_terminal(args: list[str], cwd: Path, shown: str) -> tuple[i
     process.send_signal(signal.SIGINT)
     process.wait(timeout=60)
     return process.returncode, drawn + drawn_until_closed(main)
+
+
+def export_stopped_leaves_only_the_take(take: Path, out: str, shown: str) -> None:
+    """`ecs-tentacles export TAKE --out OUT` in the take's folder, given Ctrl-C once the
+    terminal shows `shown`: exit 130, its one line said, and the take alone left in the
+    folder (no partial file, ours or a library's)."""
+    code, drawn = interrupted_on_a_terminal(["export", str(take), "--out", out], take.parent, shown)
+    assert code == 130, drawn
+    assert "error: interrupted (Ctrl-C); partial outputs removed" in drawn
+    assert [p.name for p in take.parent.iterdir()] == [take.name]

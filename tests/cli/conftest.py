@@ -7,6 +7,7 @@ from pathlib import Path
 
 import pytest
 
+from ecs_tentacles.cli import main
 from tests.export.conftest import SMALL_SCENE
 
 
@@ -16,3 +17,12 @@ def scene(tmp_path: Path) -> Path:
     path = tmp_path / "small.json"
     path.write_text(json.dumps(SMALL_SCENE))
     return path
+
+
+def refused(argv: list[str], capsys: pytest.CaptureFixture[str]) -> str:
+    """What `ecs-tentacles ARGV` said on stderr when it refused its arguments: it must
+    stop with exit 2 (argparse's way) before doing anything."""
+    with pytest.raises(SystemExit) as caught:
+        main(argv)
+    assert caught.value.code == 2
+    return capsys.readouterr().err

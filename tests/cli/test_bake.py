@@ -18,6 +18,7 @@ from ecs_tentacles.cli import main
 from ecs_tentacles.export.bake import BakePlan
 from ecs_tentacles.export.take_size import take_size
 from ecs_tentacles.take import Take
+from tests.cli.conftest import refused
 from tests.conftest import STOPS
 from tests.export.conftest import SMALL_SCENE
 
@@ -81,10 +82,7 @@ def test_bad_bake_arguments_exit_2_with_one_line(
     args: list[str], message: str, scene: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     argv = ["bake", str(scene), "--out", "t.npz", *args]
-    with pytest.raises(SystemExit) as caught:
-        main(argv)
-    assert caught.value.code == 2
-    assert capsys.readouterr().err == f"error: {message} (see ecs-tentacles bake --help)\n"
+    assert refused(argv, capsys) == f"error: {message} (see ecs-tentacles bake --help)\n"
 
 
 def test_bake_errors_found_after_parsing_exit_2(

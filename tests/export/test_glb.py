@@ -18,7 +18,7 @@ from ecs_tentacles.export.glb import GlbTooLarge, glb_bytes
 from ecs_tentacles.export.gltf import build_gltf, write_glb
 from ecs_tentacles.export.skinned_gltf import build_skinned_gltf, write_skinned_glb
 from ecs_tentacles.take import Take
-from tests.terminal import interrupted_on_a_terminal
+from tests.terminal import export_stopped_leaves_only_the_take
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -134,11 +134,4 @@ def test_ctrl_c_while_a_glb_is_written_leaves_only_the_take(
     """A real export on a terminal, stopped once its bar shows creatures written."""
     take = tmp_path / "crowd.npz"
     _longer(guided_take, 1000, creatures=48).save(take)
-    code, drawn = interrupted_on_a_terminal(
-        ["export", str(take), "--out", "crowd.glb"],
-        tmp_path,
-        r"write crowd\.glb: .*\| ?([1-9]\d*)/48",
-    )
-    assert code == 130, drawn
-    assert "error: interrupted (Ctrl-C); partial outputs removed" in drawn
-    assert [p.name for p in tmp_path.iterdir()] == ["crowd.npz"]
+    export_stopped_leaves_only_the_take(take, "crowd.glb", r"write crowd\.glb: .*\| ?([1-9]\d*)/48")

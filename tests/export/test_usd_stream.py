@@ -23,7 +23,7 @@ from ecs_tentacles.skin.rig import Keys
 from ecs_tentacles.skin.skeleton import creature_animation, creature_skeleton
 from ecs_tentacles.take import Take
 from tests.export.test_glb import _longer
-from tests.terminal import interrupted_on_a_terminal
+from tests.terminal import export_stopped_leaves_only_the_take
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -206,11 +206,6 @@ def test_ctrl_c_while_a_crowd_usd_is_written_leaves_only_the_take(
     the take alone in the folder (no partial file, ours or USD's)."""
     take = tmp_path / "crowd.npz"
     _longer(guided_take, 3000, creatures=48).save(take)
-    code, drawn = interrupted_on_a_terminal(
-        ["export", str(take), "--out", "crowd.usdc"],
-        tmp_path,
-        r"write crowd\.usdc: .*\| ?([1-9]\d*)/3000",
+    export_stopped_leaves_only_the_take(
+        take, "crowd.usdc", r"write crowd\.usdc: .*\| ?([1-9]\d*)/3000"
     )
-    assert code == 130, drawn
-    assert "error: interrupted (Ctrl-C); partial outputs removed" in drawn
-    assert [p.name for p in tmp_path.iterdir()] == ["crowd.npz"]
