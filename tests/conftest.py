@@ -2,35 +2,37 @@
 
 from __future__ import annotations
 
+import json
+import os
 import signal
+import subprocess
 import sys
 from collections.abc import Callable, Iterator
+from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
+from hypothesis import settings
 
 from ecs_tentacles.world import World
+
+# Property tests draw the same examples every run (seeded from each test's name), so what
+# fails in CI fails again on a developer's machine, and 60 of them where a test does not
+# say how many; `pytest --hypothesis-profile thorough` draws 1,000 new ones each run.
+settings.register_profile("seeded", derandomize=True, database=None, max_examples=60)
+settings.register_profile("thorough", max_examples=1000)
+settings.load_profile("seeded")
 
 # plugins off where a test's script drives the motors: `make_world(scene, plugins=NO_LOCOMOTION)`
 NO_LOCOMOTION = {"locomotion": False, "suckers": False}
 
 
-def worlds_by_backend(
-    make_world: Callable[..., World],
-    kernels: Any,
-    monkeypatch: pytest.MonkeyPatch,
-    scene: dict[str, Any],
-    frames: int,
-) -> list[World]:
-    """`scene` stepped `frames` frames twice: with `kernels` (an `OptionalKernels`) on
-    numba's path, then on numpy's; the two worlds, in that order."""
-    worlds = []
-    for backend in ("auto", "numpy"):
-        monkeypatch.setattr(kernels, "backend", backend)
-        world = make_world(scene)
-        world.step(frames)
-        worlds.append(world)
-    return worlds
+# what a stopped command exits with and says last: (signal, exit code, its one line)
+STOPS = [
+    (signal.SIGINT, 130, "error: interrupted (Ctrl-C); partial outputs removed"),
+    (signal.SIGTERM, 143, "error: stopped by SIGTERM; partial outputs removed"),
+]
 
 
 def python_calls(action: Callable[[], object]) -> int:
@@ -58,6 +60,46 @@ def creature_scene(**tentacles: Any) -> dict[str, Any]:
     }
 
 
+def crawlers(n: int, *, apart: float = 3.0, links: int = 4, ahead: float = 1.5) -> dict[str, Any]:
+    """`n` small creatures (3 tentacles of `links` links) `apart` m apart in a row along
+    x, each crawling to a goal `ahead` m along +y: a scene whose creatures never touch."""
+    return {
+        "version": 1,
+        "creatures": [
+            {
+                "name": f"c{i}",
+                "position": [apart * i, 0.0],
+                "tentacles": {"count": 3, "links": links},
+                "goals": [{"position": [apart * i, ahead]}],
+            }
+            for i in range(n)
+        ],
+    }
+
+
+def uniform_crowd(path: Path, count: int, lod: dict[str, Any], *options: str) -> Path:
+    """`ecs-tentacles crowd COUNT --uniform OPTIONS` written to `path` (in a process of its
+    own, as a user runs it), its level of detail then set to `lod`; `path`."""
+    subprocess.run(
+        [sys.executable, "-P", "-m", "ecs_tentacles", "crowd", str(count), "--uniform",
+         *options, "--out", str(path)],
+        capture_output=True, text=True, check=True,
+    )  # fmt: skip
+    scene: dict[str, Any] = json.loads(path.read_text())
+    scene.setdefault("physics", {})["lod"] = lod
+    path.write_text(json.dumps(scene))
+    return path
+
+
+def baked(scene: str, out: Path, seconds: float, fps: float = 30.0) -> Path:
+    """`ecs-tentacles bake SCENE --seconds SECONDS --fps FPS --out OUT`; `out`."""
+    from ecs_tentacles.cli import main
+
+    argv = ["bake", scene, "--seconds", str(seconds), "--fps", str(fps), "--quiet"]
+    assert main([*argv, "--out", str(out)]) == 0
+    return out
+
+
 @pytest.fixture
 def make_world() -> Iterator[Callable[..., World]]:
     """Build worlds from scene dicts; every world is closed at the end of the test."""
@@ -71,6 +113,31 @@ def make_world() -> Iterator[Callable[..., World]]:
     yield make
     for world in worlds:
         world.close()
+
+
+# (kernels, scene, frames) -> the two worlds: see `worlds_by_backend`
+ByBackend = Callable[[Any, dict[str, Any], int], list[World]]
+
+
+@pytest.fixture
+def worlds_by_backend(
+    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
+) -> ByBackend:
+    """`(kernels, scene, frames)`: `scene` stepped `frames` frames twice, with `kernels`
+    (an `OptionalKernels`) on numba's path, then on numpy's; every body must stand where
+    it stood the other way, bit for bit. The two worlds, in that order."""
+
+    def both(kernels: Any, scene: dict[str, Any], frames: int) -> list[World]:
+        worlds = []
+        for backend in ("auto", "numpy"):
+            monkeypatch.setattr(kernels, "backend", backend)
+            world = make_world(scene)
+            world.step(frames)
+            worlds.append(world)
+        np.testing.assert_array_equal(worlds[0].transforms.pos, worlds[1].transforms.pos)
+        return worlds
+
+    return both
 
 
 @pytest.fixture
@@ -94,31 +161,27 @@ def octopus_take() -> Any:
     return bake(BakePlan.make("octopus", seconds=4.0, fps=30.0), progress=False)
 
 
+def _own_folder(variable: str, folder: Path) -> Iterator[None]:
+    """The environment variable `variable` set to `folder` while the session runs (and
+    in the CLI processes tests start), put back after."""
+    before = os.environ.get(variable)
+    os.environ[variable] = str(folder)
+    yield
+    if before is None:
+        os.environ.pop(variable, None)
+    else:
+        os.environ[variable] = before
+
+
 @pytest.fixture(scope="session", autouse=True)
 def _private_cache(tmp_path_factory: pytest.TempPathFactory) -> Iterator[None]:
     """Decomposed meshes are cached in a folder of the test session's own, not the user's
-    (`ecs_tentacles.terrain.mesh_cache.cache_folder`); the CLI processes tests start inherit it."""
-    import os
-
-    before = os.environ.get("XDG_CACHE_HOME")
-    os.environ["XDG_CACHE_HOME"] = str(tmp_path_factory.mktemp("cache"))
-    yield
-    if before is None:
-        os.environ.pop("XDG_CACHE_HOME", None)
-    else:
-        os.environ["XDG_CACHE_HOME"] = before
+    (`ecs_tentacles.terrain.mesh_cache.cache_folder`)."""
+    yield from _own_folder("XDG_CACHE_HOME", tmp_path_factory.mktemp("cache"))
 
 
 @pytest.fixture(scope="session", autouse=True)
 def _private_state(tmp_path_factory: pytest.TempPathFactory) -> Iterator[None]:
     """The key work shards are signed with is made in a folder of the test session's own,
-    not the user's (`ecs_tentacles.distributed.secret`); CLI processes inherit it."""
-    import os
-
-    before = os.environ.get("XDG_STATE_HOME")
-    os.environ["XDG_STATE_HOME"] = str(tmp_path_factory.mktemp("state"))
-    yield
-    if before is None:
-        os.environ.pop("XDG_STATE_HOME", None)
-    else:
-        os.environ["XDG_STATE_HOME"] = before
+    not the user's (`ecs_tentacles.distributed.secret`)."""
+    yield from _own_folder("XDG_STATE_HOME", tmp_path_factory.mktemp("state"))

@@ -45,13 +45,8 @@ class Late(Probe):
     after = ("physics_sync",)
 
 
-BUILTIN = [
-    "goals",
-    "avoidance",
-    "tentacle_selection",
-    "action_queue",
-    "motor_targets",
-    "suckers",
+# without locomotion's plugins (NO_LOCOMOTION) the frame is these
+PHYSICS_ON = [
     "physics",
     "lod_replay",
     "physics_sync",
@@ -60,21 +55,22 @@ BUILTIN = [
     "emotion",
     "rig",
 ]
+BUILTIN = [
+    "goals",
+    "avoidance",
+    "tentacle_selection",
+    "action_queue",
+    "motor_targets",
+    "suckers",
+    *PHYSICS_ON,
+]
 
 
 def test_builtin_order(make_world: Callable[..., World]) -> None:
     world = make_world(creature_scene(count=3, links=2))
     assert world.schedule.names == BUILTIN
     physics_only = make_world(creature_scene(count=3, links=2), plugins=NO_LOCOMOTION)
-    assert physics_only.schedule.names == [
-        "physics",
-        "lod_replay",
-        "physics_sync",
-        "physics_health",
-        "threats",
-        "emotion",
-        "rig",
-    ]
+    assert physics_only.schedule.names == PHYSICS_ON
     assert [world.schedule.stage_of(n) for n in BUILTIN] == [
         "decide", "decide", "decide", "act", "act", "act", "physics", "physics", "sync", "sync",
         "animate", "animate", "animate",
@@ -87,17 +83,14 @@ def test_probe_records_frame_and_substep_order(make_world: Callable[..., World])
     world.add_system(Late())
     world.add_system(SubstepProbe())
     world.add_system(Early())
+    # late: after physics_sync, it joins the sync stage, before fur animates
+    late_at = PHYSICS_ON.index("physics_health") + 1
     assert world.schedule.names == [
         "substep_probe",
         "early",
-        "physics",
-        "lod_replay",
-        "physics_sync",
-        "physics_health",
-        "late",  # after physics_sync: joins the sync stage, before fur animates
-        "threats",
-        "emotion",
-        "rig",
+        *PHYSICS_ON[:late_at],
+        "late",
+        *PHYSICS_ON[late_at:],
     ]
     world.step(2)
     substeps = world.settings.substeps

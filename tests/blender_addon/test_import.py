@@ -14,13 +14,12 @@ import pytest
 from ecs_tentacles.cli import main
 from ecs_tentacles.creator.crowd import crowd_scene
 from ecs_tentacles.export.materials import take_colours
-from ecs_tentacles.record.systems.record import Record
 from ecs_tentacles.skin.colours import to_linear
 from ecs_tentacles.take import Take
 from ecs_tentacles.take.stream import open_take
-from ecs_tentacles.world import World
 from tests.blender_addon.conftest import BLENDER, needs_blender, run
 from tests.export.broken_takes import BROKEN_TAKES
+from tests.export.conftest import come_and_go_take
 
 pytestmark = needs_blender
 
@@ -239,18 +238,7 @@ def test_creatures_that_come_and_go_are_hidden_while_they_are_not_there(
     """`b` despawned after frame 4, `late` spawned after frame 6: their skins are hidden
     (viewport and render) exactly while the take says they are not there."""
 
-    def creature(name: str, x: float) -> dict[str, object]:
-        return {"name": name, "position": [x, 0.0], "tentacles": {"count": 3, "links": 3}}
-
-    scene = {"version": 1, "creatures": [creature("a", 0.0), creature("b", 3.0)]}
-    with World.from_scene(scene) as world:
-        record = world.add_system(Record())
-        world.step(4)
-        world.despawn(world.creature("b"))
-        world.step(2)
-        world.spawn(creature("late", 6.0))
-        world.step(5)
-        take = record.take()
+    take = come_and_go_take()
     path = tmp_path / "roster.npz"
     take.save(path)
     shown = run(blender_env, SHOWN, str(path))

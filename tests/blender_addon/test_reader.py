@@ -18,10 +18,10 @@ from ecs_tentacles.blender_addon.ground import meshes as ground_meshes
 from ecs_tentacles.blender_addon.motion import Plan
 from ecs_tentacles.blender_addon.reader import TakeFile, TakeFileError
 from ecs_tentacles.blender_addon.stream import Group, kinds, plans_of, read_motion, replay_arrays
-from ecs_tentacles.cli import main
 from ecs_tentacles.take import Take
 from ecs_tentacles.take.chunks import add_entry, npy_bytes
 from ecs_tentacles.take.stream import open_take
+from tests.conftest import baked
 from tests.export.broken_takes import BROKEN_TAKES
 
 # the cases that break what the add-on reads: the header's timing, creatures and bodies,
@@ -45,10 +45,7 @@ V2_TAKE = V1_TAKE.with_name("octopus_take_v2.npz")
 @pytest.fixture(scope="module")
 def good_take(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """thesis_four_by_six, 0.3 s at 30 fps: four creatures of one body plan."""
-    path = tmp_path_factory.mktemp("good") / "four.npz"
-    argv = ["bake", "thesis_four_by_six", "--seconds", "0.3", "--fps", "30", "--quiet"]
-    assert main([*argv, "--out", str(path)]) == 0
-    return path
+    return baked("thesis_four_by_six", tmp_path_factory.mktemp("good") / "four.npz", 0.3)
 
 
 def read_everything(path: Path) -> np.ndarray:

@@ -18,14 +18,9 @@ from ecs_tentacles.cli import main
 from ecs_tentacles.export.bake import BakePlan
 from ecs_tentacles.export.take_size import take_size
 from ecs_tentacles.take import Take
+from tests.cli.conftest import refused
+from tests.conftest import STOPS
 from tests.export.conftest import SMALL_SCENE
-
-
-@pytest.fixture
-def scene(tmp_path: Path) -> Path:
-    path = tmp_path / "small.json"
-    path.write_text(json.dumps(SMALL_SCENE))
-    return path
 
 
 def test_bake_writes_a_take_and_reports_it(
@@ -87,10 +82,7 @@ def test_bad_bake_arguments_exit_2_with_one_line(
     args: list[str], message: str, scene: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     argv = ["bake", str(scene), "--out", "t.npz", *args]
-    with pytest.raises(SystemExit) as caught:
-        main(argv)
-    assert caught.value.code == 2
-    assert capsys.readouterr().err == f"error: {message} (see ecs-tentacles bake --help)\n"
+    assert refused(argv, capsys) == f"error: {message} (see ecs-tentacles bake --help)\n"
 
 
 def test_bake_errors_found_after_parsing_exit_2(
@@ -163,13 +155,7 @@ def test_a_killed_bake_leaves_no_file_or_the_previous_one(tmp_path: Path) -> Non
     assert list(previous.parent.iterdir()) == [previous]
 
 
-@pytest.mark.parametrize(
-    ("stop", "code", "line"),
-    [
-        (signal.SIGINT, 130, "error: interrupted (Ctrl-C); partial outputs removed"),
-        (signal.SIGTERM, 143, "error: stopped by SIGTERM; partial outputs removed"),
-    ],
-)
+@pytest.mark.parametrize(("stop", "code", "line"), STOPS)
 @pytest.mark.usefixtures("ctrl_c_reaches_children")
 def test_an_interrupted_bake_exits_with_one_line_and_leaves_nothing(
     tmp_path: Path, stop: signal.Signals, code: int, line: str

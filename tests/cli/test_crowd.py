@@ -9,6 +9,7 @@ import pytest
 
 from ecs_tentacles.cli import main
 from ecs_tentacles.scene.load import load_scene
+from tests.cli.conftest import refused
 
 
 def test_writes_a_valid_scene_and_says_what_is_in_it(
@@ -64,9 +65,6 @@ def test_too_small_spacing_is_one_line_and_writes_nothing(
 def test_bad_arguments_are_one_line_exit_2(
     argv: list[str], message: str, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    with pytest.raises(SystemExit) as caught:
-        main(argv)
-    assert caught.value.code == 2
-    err = capsys.readouterr().err
+    err = refused(argv, capsys)
     assert err.startswith("error: ") and message in err
     assert err.count("\n") == 1

@@ -9,6 +9,7 @@ import pytest
 
 from ecs_tentacles.cli import main
 from ecs_tentacles.scene.load import bundled_scene
+from tests.cli.conftest import refused
 
 
 def test_systems_prints_the_frame_with_stages_plugins_and_fields(
@@ -162,10 +163,7 @@ def _refuses_and_copies(bundled: Path, tmp_path: Path, capsys: pytest.CaptureFix
     assert capsys.readouterr().err == (
         "error: octopus: a bundled scene is read-only; write a copy with --out FILE\n"
     )
-    with pytest.raises(SystemExit) as stop:
-        main(["migrate", "octopus", "--out", str(bundled.with_name("x.json"))])
-    assert stop.value.code == 2
-    err = capsys.readouterr().err
+    err = refused(["migrate", "octopus", "--out", str(bundled.with_name("x.json"))], capsys)
     assert err.startswith("error: argument --out: ") and "bundled files are read-only" in err
     assert main(["migrate", "octopus"]) == 0
     captured = capsys.readouterr()
@@ -188,10 +186,7 @@ def test_migrate_in_place_through_a_symlink_keeps_the_link(tmp_path: Path) -> No
 def test_schema_refuses_an_output_that_is_not_json_or_a_terminal(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    with pytest.raises(SystemExit) as stop:
-        main(["schema", "--out", str(tmp_path / "x.py")])
-    assert stop.value.code == 2
-    assert capsys.readouterr().err == (
+    assert refused(["schema", "--out", str(tmp_path / "x.py")], capsys) == (
         f"error: argument --out: must end in .json, got '{tmp_path / 'x.py'}'"
         " (see ecs-tentacles schema --help)\n"
     )

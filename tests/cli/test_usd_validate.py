@@ -11,17 +11,9 @@ import pytest
 from ecs_tentacles.cli import main
 from ecs_tentacles.cli.usd_validate import validated
 from ecs_tentacles.export.usd_validation import usd_validators
-from tests.export.conftest import SMALL_SCENE
 
 pytest.importorskip("pxr", reason="USD export needs usd-core (the usd / dev extras)")
 from pxr import Usd, UsdSkel
-
-
-@pytest.fixture
-def scene(tmp_path: Path) -> Path:
-    path = tmp_path / "small.json"
-    path.write_text(json.dumps(SMALL_SCENE))
-    return path
 
 
 def test_bake_and_export_validate_what_they_wrote(

@@ -29,6 +29,7 @@ from ecs_tentacles.export.bake import BakePlan
 from ecs_tentacles.scene.construction import creature_reach
 from ecs_tentacles.take import Take
 from ecs_tentacles.terrain.presets import rocky
+from tests.conftest import STOPS
 
 ray = pytest.importorskip("ray", reason="the `ray` extra is not installed")
 
@@ -232,13 +233,7 @@ def test_a_changed_kept_shard_is_named_and_baked_again_on_resume(
     assert not work_folder(out).exists()
 
 
-@pytest.mark.parametrize(
-    ("stop", "code", "message"),
-    [
-        (signal.SIGINT, 130, "error: interrupted (Ctrl-C); partial outputs removed"),
-        (signal.SIGTERM, 143, "error: stopped by SIGTERM; partial outputs removed"),
-    ],
-)
+@pytest.mark.parametrize(("stop", "code", "message"), STOPS)
 @pytest.mark.usefixtures("ctrl_c_reaches_children")
 def test_ctrl_c_or_sigterm_cancels_the_bake_and_leaves_no_output(
     cluster: Path, crowd: Path, tmp_path: Path, stop: int, code: int, message: str

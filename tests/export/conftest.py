@@ -21,6 +21,7 @@ from ecs_tentacles.record.systems.record import Record
 from ecs_tentacles.take import Take
 from ecs_tentacles.take.registries import CurvesFrame, TrackSource
 from ecs_tentacles.world import World
+from tests.conftest import uniform_crowd
 
 # One creature, three tentacles of four links, tip suckers, a goal 1 m ahead.
 SMALL_SCENE: dict[str, Any] = {
@@ -36,6 +37,26 @@ SMALL_SCENE: dict[str, Any] = {
         }
     ],
 }
+
+
+def three_by_three(name: str, x: float) -> dict[str, Any]:
+    """A scene's creature entry: `name` at (x, 0), three tentacles of three links."""
+    return {"name": name, "position": [x, 0.0], "tentacles": {"count": 3, "links": 3}}
+
+
+def come_and_go_take() -> Take:
+    """12 frames of creatures `a` and `b` (`three_by_three`, 3 m apart): `b` despawned
+    after frame 4, `late` spawned 6 m along after frame 6."""
+    creature = three_by_three
+    scene = {"version": 1, "creatures": [creature("a", 0.0), creature("b", 3.0)]}
+    with World.from_scene(scene) as world:
+        recorder = world.add_system(Record())
+        world.step(4)
+        world.despawn(world.creature("b"))
+        world.step(2)
+        world.spawn(creature("late", 6.0))
+        world.step(5)
+        return recorder.take()
 
 
 def link_centres(world: World) -> CurvesFrame:
@@ -110,15 +131,8 @@ def replay_crowd_take(folder: Path, seconds: float = 2.0) -> Path:
     """16 uniform creatures, `seconds` at 24 fps, level of detail on with room for one at
     full physics and one reduced: the others replay the crawl clip from frame 1 (a take
     of version 2 records them as clip, phase and root motion). The take's path."""
-    scene = folder / "crowd16.json"
-    subprocess.run(
-        [sys.executable, "-P", "-m", "ecs_tentacles", "crowd", "16", "--uniform", "--seed", "1",
-         "--out", str(scene)],
-        capture_output=True, text=True, check=True,
-    )  # fmt: skip
-    data: dict[str, Any] = json.loads(scene.read_text())
-    data.setdefault("physics", {})["lod"] = {"full": 1, "reduced": 1, "hold_seconds": 0}
-    scene.write_text(json.dumps(data))
+    lod = {"full": 1, "reduced": 1, "hold_seconds": 0}
+    scene = uniform_crowd(folder / "crowd16.json", 16, lod, "--seed", "1")
     take = folder / "crowd16.npz"
     argv = ["bake", str(scene), "--seconds", str(seconds), "--fps", "24", "--out", str(take)]
     assert main([*argv, "--quiet"]) == 0
@@ -137,15 +151,8 @@ def switching_crowd_take(folder: Path) -> Path:
     for one at full physics and one reduced: crawling inwards they come near each other
     and go physical, then apart and replay again, so some leave their clip and come back
     (creature 8: replayed on frames 3-10, 38-39 and 62-72). The take's path."""
-    scene = folder / "switching9.json"
-    subprocess.run(
-        [sys.executable, "-P", "-m", "ecs_tentacles", "crowd", "9", "--uniform", "--seed", "2",
-         "--spacing", "1.3", "--out", str(scene)],
-        capture_output=True, text=True, check=True,
-    )  # fmt: skip
-    data: dict[str, Any] = json.loads(scene.read_text())
-    data.setdefault("physics", {})["lod"] = {"full": 1, "reduced": 1, "hold_seconds": 0}
-    scene.write_text(json.dumps(data))
+    lod = {"full": 1, "reduced": 1, "hold_seconds": 0}
+    scene = uniform_crowd(folder / "switching9.json", 9, lod, "--seed", "2", "--spacing", "1.3")
     take = folder / "switching9.npz"
     argv = ["bake", str(scene), "--seconds", "3", "--fps", "24", "--out", str(take)]
     assert main([*argv, "--quiet"]) == 0

@@ -4,18 +4,7 @@ or a file past 4 GiB leaves nothing in the folder."""
 
 from __future__ import annotations
 
-import fcntl
 import json
-import os
-import pty
-import re
-import select
-import signal
-import struct
-import subprocess
-import sys
-import termios
-import time
 import tracemalloc
 from collections.abc import Callable
 from pathlib import Path
@@ -29,6 +18,7 @@ from ecs_tentacles.export.glb import GlbTooLarge, glb_bytes
 from ecs_tentacles.export.gltf import build_gltf, write_glb
 from ecs_tentacles.export.skinned_gltf import build_skinned_gltf, write_skinned_glb
 from ecs_tentacles.take import Take
+from tests.terminal import export_stopped_leaves_only_the_take
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -144,30 +134,4 @@ def test_ctrl_c_while_a_glb_is_written_leaves_only_the_take(
     """A real export on a terminal, stopped once its bar shows creatures written."""
     take = tmp_path / "crowd.npz"
     _longer(guided_take, 1000, creatures=48).save(take)
-    main, child = pty.openpty()
-    fcntl.ioctl(child, termios.TIOCSWINSZ, struct.pack("HHHH", 24, 100, 0, 0))
-    process = subprocess.Popen(
-        [sys.executable, "-m", "ecs_tentacles", "export", str(take), "--out", "crowd.glb"],
-        cwd=tmp_path, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=child,
-        env={**os.environ, "PYTHONPATH": str(ROOT)},
-    )  # fmt: skip
-    os.close(child)
-    drawn, deadline = "", time.monotonic() + 120
-    while re.search(r"write crowd\.glb: .*\| ?([1-9]\d*)/48", drawn) is None:
-        assert time.monotonic() < deadline and process.poll() is None, drawn
-        if select.select([main], [], [], 0.5)[0]:
-            drawn += os.read(main, 65536).decode(errors="replace")
-    process.send_signal(signal.SIGINT)
-    process.wait(timeout=60)
-    while True:  # what it drew after
-        try:
-            piece = os.read(main, 65536)
-        except OSError:
-            break
-        if not piece:
-            break
-        drawn += piece.decode(errors="replace")
-    os.close(main)
-    assert process.returncode == 130, drawn
-    assert "error: interrupted (Ctrl-C); partial outputs removed" in drawn
-    assert [p.name for p in tmp_path.iterdir()] == ["crowd.npz"]
+    export_stopped_leaves_only_the_take(take, "crowd.glb", r"write crowd\.glb: .*\| ?([1-9]\d*)/48")

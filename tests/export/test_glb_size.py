@@ -106,6 +106,7 @@ def _uniform_crowd() -> dict[str, Any]:
     return crowd_scene(1024, seed=3, uniform=True)
 
 
+@functools.cache  # a plan is frozen, and checking 1,024 creatures costs most of a second
 def _uniform_plan(frames: int) -> BakePlan:
     return BakePlan.make(_uniform_crowd(), seconds=(frames - 1) / 60, fps=60.0)
 

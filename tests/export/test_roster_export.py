@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -16,25 +15,13 @@ from ecs_tentacles.record.systems.record import Record
 from ecs_tentacles.take import Take
 from ecs_tentacles.world import World
 
-from .conftest import khronos_report
-
-
-def _creature(name: str, x: float) -> dict:
-    return {"name": name, "position": [x, 0.0], "tentacles": {"count": 3, "links": 3}}
+from .conftest import come_and_go_take, khronos_report, three_by_three
 
 
 @pytest.fixture(scope="module")
-def roster_take() -> Iterator[Take]:
-    """12 frames: `b` despawned after frame 4, `late` spawned after frame 6."""
-    scene = {"version": 1, "creatures": [_creature("a", 0.0), _creature("b", 3.0)]}
-    with World.from_scene(scene) as world:
-        record = world.add_system(Record())
-        world.step(4)
-        world.despawn(world.creature("b"))
-        world.step(2)
-        world.spawn(_creature("late", 6.0))
-        world.step(5)
-        yield record.take()
+def roster_take() -> Take:
+    """`come_and_go_take`: `b` despawned after frame 4, `late` spawned after frame 6."""
+    return come_and_go_take()
 
 
 def test_the_take_knows_who_is_there(roster_take: Take) -> None:
@@ -92,7 +79,7 @@ def test_gltf_scales_a_creature_to_zero_while_it_is_away_and_validates(
 
 
 def test_fur_that_comes_late_or_goes_away_is_held_in_the_take(tmp_path: Path) -> None:
-    with World.from_scene({"version": 1, "creatures": [_creature("bare", 0.0)]}) as world:
+    with World.from_scene({"version": 1, "creatures": [three_by_three("bare", 0.0)]}) as world:
         record = world.add_system(Record())
         world.step(3)
         cat = world.spawn({"name": "cat", "fur": {"preset": "cat"}}, position=(4.0, 0.0))
@@ -112,7 +99,7 @@ def test_fur_that_comes_late_or_goes_away_is_held_in_the_take(tmp_path: Path) ->
 
 
 @pytest.mark.parametrize("skinned", [False, True])
-def test_one_animation_drives_every_creature(
+def test_one_animation_drives_everythree_by_three(
     roster_take: Take, tmp_path: Path, skinned: bool
 ) -> None:
     """Blender plays only a file's first animation (the others go to muted NLA tracks) and

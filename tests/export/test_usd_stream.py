@@ -4,17 +4,9 @@ a body plan's creatures; a stop leaves nothing behind."""
 
 from __future__ import annotations
 
-import fcntl
 import os
-import pty
-import re
-import select
-import signal
-import struct
 import subprocess
 import sys
-import termios
-import time
 from pathlib import Path
 from typing import Any
 
@@ -31,6 +23,7 @@ from ecs_tentacles.skin.rig import Keys
 from ecs_tentacles.skin.skeleton import creature_animation, creature_skeleton
 from ecs_tentacles.take import Take
 from tests.export.test_glb import _longer
+from tests.terminal import export_stopped_leaves_only_the_take
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -213,30 +206,6 @@ def test_ctrl_c_while_a_crowd_usd_is_written_leaves_only_the_take(
     the take alone in the folder (no partial file, ours or USD's)."""
     take = tmp_path / "crowd.npz"
     _longer(guided_take, 3000, creatures=48).save(take)
-    main, child = pty.openpty()
-    fcntl.ioctl(child, termios.TIOCSWINSZ, struct.pack("HHHH", 24, 100, 0, 0))
-    process = subprocess.Popen(
-        [sys.executable, "-m", "ecs_tentacles", "export", str(take), "--out", "crowd.usdc"],
-        cwd=tmp_path, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=child,
-        env={**os.environ, "PYTHONPATH": str(ROOT)},
-    )  # fmt: skip
-    os.close(child)
-    drawn, deadline = "", time.monotonic() + 120
-    while re.search(r"write crowd\.usdc: .*\| ?([1-9]\d*)/3000", drawn) is None:
-        assert time.monotonic() < deadline and process.poll() is None, drawn
-        if select.select([main], [], [], 0.5)[0]:
-            drawn += os.read(main, 65536).decode(errors="replace")
-    process.send_signal(signal.SIGINT)
-    process.wait(timeout=60)
-    while True:  # what it drew after
-        try:
-            piece = os.read(main, 65536)
-        except OSError:
-            break
-        if not piece:
-            break
-        drawn += piece.decode(errors="replace")
-    os.close(main)
-    assert process.returncode == 130, drawn
-    assert "error: interrupted (Ctrl-C); partial outputs removed" in drawn
-    assert [p.name for p in tmp_path.iterdir()] == ["crowd.npz"]
+    export_stopped_leaves_only_the_take(
+        take, "crowd.usdc", r"write crowd\.usdc: .*\| ?([1-9]\d*)/3000"
+    )

@@ -15,12 +15,7 @@ import pytest
 
 from ecs_tentacles.herding import best_times
 
-
-@pytest.fixture(autouse=True)
-def data_folder(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
-    folder = tmp_path / "data"
-    monkeypatch.setenv("ECS_TENTACLES_DATA", str(folder))
-    return folder
+pytestmark = pytest.mark.usefixtures("data_folder")  # best times kept in the test's folder
 
 
 def test_a_win_is_kept_when_it_beats_the_best(data_folder: Path) -> None:

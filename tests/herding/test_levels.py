@@ -4,7 +4,6 @@
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
 import pytest
 
@@ -16,11 +15,7 @@ from ecs_tentacles.herding.levels import levels, next_level
 HERDING = ["herding_1_field", "herding_2_shore", "herding_3_maze"]
 
 
-@pytest.fixture(autouse=True)
-def data_folder(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
-    folder = tmp_path / "data"
-    monkeypatch.setenv("ECS_TENTACLES_DATA", str(folder))
-    return folder
+pytestmark = pytest.mark.usefixtures("data_folder")  # best times kept in the test's folder
 
 
 def _herding() -> list:

@@ -2,14 +2,8 @@
 
 from __future__ import annotations
 
-import fcntl
 import io
-import os
-import pty
-import struct
-import subprocess
 import sys
-import termios
 from collections.abc import Callable
 from pathlib import Path
 
@@ -18,6 +12,7 @@ import pytest
 from ecs_tentacles.output.progress import step_frames
 from ecs_tentacles.world import World
 from tests.conftest import creature_scene
+from tests.terminal import drawn_until_closed, on_a_terminal
 
 
 class Terminal(io.StringIO):
@@ -73,29 +68,10 @@ def test_long_commands_say_what_they_are_doing_on_a_terminal(
 def _on_a_terminal(args: list[str], cwd: Path) -> tuple[int, str, str]:
     """Run `ecs-tentacles ARGS` with stderr on a pseudo-terminal, as from a shell:
     (exit code, stdout, everything drawn on the terminal)."""
-    main, child = pty.openpty()
-    fcntl.ioctl(child, termios.TIOCSWINSZ, struct.pack("HHHH", 24, 100, 0, 0))  # 100 columns
-    process = subprocess.Popen(
-        [sys.executable, "-m", "ecs_tentacles", *args],
-        cwd=cwd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=child,
-        env={**os.environ, "PYTHONPATH": str(ROOT)},
-    )  # fmt: skip
-    os.close(child)
-    drawn = bytearray()
-    while True:
-        try:
-            piece = os.read(main, 65536)
-        except OSError:  # EIO: the process closed the terminal (it ended)
-            break
-        if not piece:
-            break
-        drawn += piece
-    os.close(main)
+    process, main = on_a_terminal(args, cwd)
+    drawn = drawn_until_closed(main)
     out, _ = process.communicate(timeout=300)
-    return process.returncode, out.decode(), drawn.decode(errors="replace")
-
-
-ROOT = Path(__file__).resolve().parents[2]
+    return process.returncode, out.decode(), drawn
 
 
 @pytest.fixture(scope="module")

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any
 
 import numpy as np
 import pytest
@@ -13,19 +12,9 @@ from ecs_tentacles.physics import backend as backend_module
 from ecs_tentacles.physics import health as health_module
 from ecs_tentacles.physics.state_layout import S
 from ecs_tentacles.world import World
+from tests.conftest import crawlers
 
-SCENE: dict[str, Any] = {
-    "version": 1,
-    "creatures": [
-        {
-            "name": f"c{i}",
-            "position": [3.0 * i, 0.0],
-            "tentacles": {"count": 3, "links": 4},
-            "goals": [{"position": [3.0 * i, 1.5]}],
-        }
-        for i in range(4)
-    ],
-}
+SCENE = crawlers(4)
 
 
 def test_servo_commands_are_numpys(

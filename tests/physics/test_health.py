@@ -16,19 +16,9 @@ from numpy.testing import assert_array_equal
 from ecs_tentacles.cli import main
 from ecs_tentacles.locomotion.goals import GoalBook
 from ecs_tentacles.world import World
+from tests.conftest import crawlers
 
-SCENE: dict[str, Any] = {
-    "version": 1,
-    "creatures": [
-        {
-            "name": f"c{i}",
-            "position": [4.0 * i, 0.0],
-            "tentacles": {"count": 3, "links": 5},
-            "goals": [{"position": [4.0 * i, 1.5]}],
-        }
-        for i in range(3)
-    ],
-}
+SCENE = crawlers(3, apart=4.0, links=5)
 
 
 def _hit_strength(world: World) -> None:

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any
 
 import numpy as np
 import pytest
@@ -11,22 +10,7 @@ import pytest
 from ecs_tentacles.physics.stepping import Segment, Work, plan
 from ecs_tentacles.physics.tiers import FULL, REDUCED
 from ecs_tentacles.world import World
-
-
-def _crawlers(n: int) -> dict[str, Any]:
-    """`n` small creatures far apart, each crawling to a goal."""
-    return {
-        "version": 1,
-        "creatures": [
-            {
-                "name": f"c{i}",
-                "position": [3.0 * i, 0.0],
-                "tentacles": {"count": 3, "links": 4},
-                "goals": [{"position": [3.0 * i, 2.0]}],
-            }
-            for i in range(n)
-        ],
-    }
+from tests.conftest import crawlers
 
 
 def _shares(work: Work) -> list[Segment]:
@@ -40,7 +24,7 @@ def _shares(work: Work) -> list[Segment]:
 def test_every_row_is_handed_out_once_in_order(
     make_world: Callable[..., World], threads: int
 ) -> None:
-    world = make_world(_crawlers(5))
+    world = make_world(crawlers(5, ahead=2.0))
     physics = world.physics
     segments = plan(physics.batches, physics.active, physics.tier, threads)
     shares = _shares(Work(segments, threads))
@@ -61,7 +45,7 @@ def test_shares_shrink_toward_the_end_and_cover_their_cost() -> None:
 def test_stepped_rows_keep_a_running_mean_of_their_step_time(
     make_world: Callable[..., World],
 ) -> None:
-    world = make_world(_crawlers(3), threads=2)
+    world = make_world(crawlers(3, ahead=2.0), threads=2)
     physics = world.physics
     batch = physics.batches[0]
     rows = np.array([int(physics.row_of[i]) for i in range(3)])
@@ -76,7 +60,10 @@ def test_stepped_rows_keep_a_running_mean_of_their_step_time(
 
 
 def test_reduced_rows_keep_their_step_time_apart(make_world: Callable[..., World]) -> None:
-    scene = {**_crawlers(3), "physics": {"lod": {"full": 0, "reduced": 8, "hold_seconds": 0}}}
+    scene = {
+        **crawlers(3, ahead=2.0),
+        "physics": {"lod": {"full": 0, "reduced": 8, "hold_seconds": 0}},
+    }
     world = make_world(scene, threads=2)
     world.step(3)
     physics = world.physics

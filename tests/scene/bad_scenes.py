@@ -25,6 +25,12 @@ def scene(*creatures: dict[str, Any], **top: Any) -> dict[str, Any]:
     return {"version": 1, **({"creatures": placed} if creatures else {}), **top}
 
 
+def fur_track(attribute: str, *keys: dict[str, Any]) -> dict[str, Any]:
+    """A creature with one fur control `a` whose one track keys `attribute` with `keys`."""
+    track = {"attribute": attribute, "keys": list(keys)}
+    return {"fur": {"controls": [{"name": "a", "tracks": [track]}]}}
+
+
 def tentacles(**fields: Any) -> dict[str, Any]:
     """A creature whose tentacles have the given fields."""
     return {"tentacles": fields}
@@ -271,83 +277,25 @@ BAD_SCENES: list[tuple[str, object, str]] = [
     ),
     (
         "track keys out of order",
-        scene(
-            {
-                "fur": {
-                    "controls": [
-                        {
-                            "name": "a",
-                            "tracks": [
-                                {
-                                    "attribute": "lift",
-                                    "keys": [{"time": 1, "value": 0}, {"time": 0.5, "value": 1}],
-                                }
-                            ],
-                        }
-                    ]
-                }
-            }
-        ),
+        scene(fur_track("lift", {"time": 1, "value": 0}, {"time": 0.5, "value": 1})),
         "creatures[0].fur.controls[0].tracks[0].keys[1].time: must be > 1 (the previous key's), "
         "got 0.5",
     ),
     (
         "position track with a number",
-        scene(
-            {
-                "fur": {
-                    "controls": [
-                        {
-                            "name": "a",
-                            "tracks": [
-                                {"attribute": "position", "keys": [{"time": 0, "value": 0.5}]}
-                            ],
-                        }
-                    ]
-                }
-            }
-        ),
+        scene(fur_track("position", {"time": 0, "value": 0.5})),
         "creatures[0].fur.controls[0].tracks[0].keys[0].value: must be [x, y, z] for position, "
         "got 0.5",
     ),
     (
         "lift track with a vector",
-        scene(
-            {
-                "fur": {
-                    "controls": [
-                        {
-                            "name": "a",
-                            "tracks": [
-                                {"attribute": "lift", "keys": [{"time": 0, "value": [1, 2, 3]}]}
-                            ],
-                        }
-                    ]
-                }
-            }
-        ),
+        scene(fur_track("lift", {"time": 0, "value": [1, 2, 3]})),
         "creatures[0].fur.controls[0].tracks[0].keys[0].value: must be a number in [0, 1] for "
         "lift, got [1, 2, 3]",
     ),
     (
         "unknown easing",
-        scene(
-            {
-                "fur": {
-                    "controls": [
-                        {
-                            "name": "a",
-                            "tracks": [
-                                {
-                                    "attribute": "lift",
-                                    "keys": [{"time": 0, "value": 1, "easing": "bounce"}],
-                                }
-                            ],
-                        }
-                    ]
-                }
-            }
-        ),
+        scene(fur_track("lift", {"time": 0, "value": 1, "easing": "bounce"})),
         'creatures[0].fur.controls[0].tracks[0].keys[0].easing: must be one of "linear", '
         '"ease", "slow_out", "slow_in", "step", got "bounce"',
     ),

@@ -139,11 +139,15 @@ def test_unknown_bundled_scene(scenes_dir: pathlib.Path, name: str) -> None:
     assert info.value.problems == [f"{name}: no such bundled scene (available: duel, octopus)"]
 
 
-def test_resolve_scene_path(
-    scenes_dir: pathlib.Path, tmp_path: pathlib.Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
+@pytest.fixture
+def here(tmp_path: pathlib.Path, monkeypatch: pytest.MonkeyPatch) -> pathlib.Path:
+    """The test's folder, made the working folder (relative paths resolve in it)."""
     monkeypatch.chdir(tmp_path)
-    write(tmp_path / "mine.json", '{"version": 1}')
+    return tmp_path
+
+
+def test_resolve_scene_path(scenes_dir: pathlib.Path, here: pathlib.Path) -> None:
+    write(here / "mine.json", '{"version": 1}')
     assert resolve_scene_path("mine.json") == pathlib.Path("mine.json")
     assert resolve_scene_path("octopus") == scenes_dir / "octopus.json"
     assert resolve_scene_path("nowhere.json") == pathlib.Path("nowhere.json")
@@ -155,11 +159,9 @@ def test_resolve_scene_path(
     ]
 
 
-def test_existing_path_wins_over_bundled_name(
-    scenes_dir: pathlib.Path, tmp_path: pathlib.Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    monkeypatch.chdir(tmp_path)
-    write(tmp_path / "octopus", '{"version": 1}')
+@pytest.mark.usefixtures("scenes_dir")
+def test_existing_path_wins_over_bundled_name(here: pathlib.Path) -> None:
+    write(here / "octopus", '{"version": 1}')
     assert resolve_scene_path("octopus") == pathlib.Path("octopus")
 
 

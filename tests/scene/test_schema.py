@@ -61,6 +61,21 @@ def test_every_default_is_valid_for_its_own_schema() -> None:
     assert checked >= 20
 
 
+# every default of `physics`, written out (not read from the schema under test)
+PHYSICS_DEFAULTS = {
+    "fps": 60,
+    "substeps": 8,
+    "gravity": [0, 0, -9.81],
+    "ground_friction": 0.4,
+    "sucker_timeconst": 0.005,
+    "max_speed": 12,
+    "max_penetration": 0.05,
+    "sleep": True,
+    "lod": {"enabled": True, "full": 8, "reduced": 128, "hold_seconds": 1.0, "contact_margin": 0.1},
+    "separate_overlaps": False,
+}
+
+
 def test_with_defaults_fills_nested_defaults_exactly() -> None:
     data = {
         "version": 1,
@@ -74,24 +89,7 @@ def test_with_defaults_fills_nested_defaults_exactly() -> None:
     assert full == {
         "version": 1,
         "seed": 0,
-        "physics": {
-            "fps": 60,
-            "substeps": 8,
-            "gravity": [0, 0, -9.81],
-            "ground_friction": 0.4,
-            "sucker_timeconst": 0.005,
-            "max_speed": 12,
-            "max_penetration": 0.05,
-            "sleep": True,
-            "lod": {
-                "enabled": True,
-                "full": 8,
-                "reduced": 128,
-                "hold_seconds": 1.0,
-                "contact_margin": 0.1,
-            },
-            "separate_overlaps": False,
-        },
+        "physics": PHYSICS_DEFAULTS,
         "systems": [],
         "threats": [],
         "creatures": [
@@ -146,24 +144,7 @@ def test_with_defaults_keeps_given_values_and_names() -> None:
     assert full["creatures"][1]["tentacles"]["end_scale"] == 0.5
     assert full["creatures"][0]["tentacles"]["end_scale"] == 0.3
     assert full["creatures"][0]["tentacles"]["overrides"] == []
-    assert full["physics"] == {
-        "fps": 60,
-        "substeps": 2,
-        "gravity": [0, 0, -9.81],
-        "ground_friction": 0.4,
-        "sucker_timeconst": 0.005,
-        "max_speed": 12,
-        "max_penetration": 0.05,
-        "sleep": True,
-        "lod": {
-            "enabled": True,
-            "full": 8,
-            "reduced": 128,
-            "hold_seconds": 1.0,
-            "contact_margin": 0.1,
-        },
-        "separate_overlaps": False,
-    }
+    assert full["physics"] == {**PHYSICS_DEFAULTS, "substeps": 2}
 
 
 def test_with_defaults_copies_defaults() -> None:

@@ -2,30 +2,19 @@
 
 from __future__ import annotations
 
-import json
-import subprocess
-import sys
 from pathlib import Path
-from typing import Any
 
 import pytest
 
 from ecs_tentacles.export.bake import BakePlan, bake
 from ecs_tentacles.take import Take
+from tests.conftest import uniform_crowd
 
 
 def replay_crowd(path: Path, count: int = 6) -> Path:
     """`count` creatures of one plan crawling across, at most one at full physics, the
     rest replaying gait clips (level of detail), written to `path`."""
-    subprocess.run(
-        [sys.executable, "-P", "-m", "ecs_tentacles", "crowd", str(count), "--uniform",
-         "--seed", "1", "--out", str(path)],
-        capture_output=True, text=True, check=True,
-    )  # fmt: skip
-    scene: dict[str, Any] = json.loads(path.read_text())
-    scene.setdefault("physics", {})["lod"] = {"full": 1, "reduced": 0, "hold_seconds": 0}
-    path.write_text(json.dumps(scene))
-    return path
+    return uniform_crowd(path, count, {"full": 1, "reduced": 0, "hold_seconds": 0}, "--seed", "1")
 
 
 @pytest.fixture(scope="session")

@@ -83,10 +83,12 @@ def validated_once(tmp_path_factory: pytest.TempPathFactory) -> pathlib.Path:
     return folder
 
 
+# a cached rock: (scene, cache folder, its one entry, the entry's bytes)
+Cached = tuple[pathlib.Path, pathlib.Path, pathlib.Path, bytes]
+
+
 @pytest.fixture
-def cached(
-    validated_once: pathlib.Path, tmp_path: pathlib.Path
-) -> tuple[pathlib.Path, pathlib.Path, pathlib.Path, bytes]:
+def cached(validated_once: pathlib.Path, tmp_path: pathlib.Path) -> Cached:
     """A copy of the validated rock: (scene, cache, its one entry, the entry's bytes)."""
     for name in ("scene", "cache"):
         shutil.copytree(validated_once / name, tmp_path / name)
@@ -123,9 +125,7 @@ def test_a_good_entry_is_used_by_the_next_process(tmp_path: pathlib.Path, mesh: 
 
 
 @pytest.mark.parametrize("damage", ["truncated", "one byte changed", "empty"])
-def test_a_damaged_entry_is_ignored_and_written_again(
-    cached: tuple[pathlib.Path, pathlib.Path, pathlib.Path, bytes], damage: str
-) -> None:
+def test_a_damaged_entry_is_ignored_and_written_again(cached: Cached, damage: str) -> None:
     """A truncated entry failed every run (`error: run: BadZipFile`, naming no file)
     until deleted by hand."""
     scene, cache, entry, good = cached
@@ -141,9 +141,7 @@ def test_a_damaged_entry_is_ignored_and_written_again(
 
 @pytest.mark.parametrize("kind", ["FIFO", "symlink to a FIFO", "symlink to the entry"])
 def test_an_entry_that_is_not_a_regular_file_is_never_read(
-    cached: tuple[pathlib.Path, pathlib.Path, pathlib.Path, bytes],
-    tmp_path: pathlib.Path,
-    kind: str,
+    cached: Cached, tmp_path: pathlib.Path, kind: str
 ) -> None:
     """A FIFO in the cache blocked `validate` forever (and kept its first SIGTERM)."""
     scene, cache, entry, good = cached
@@ -183,7 +181,7 @@ sys.exit(code)
 
 
 def test_a_big_entry_costs_the_main_process_nothing(
-    cached: tuple[pathlib.Path, pathlib.Path, pathlib.Path, bytes],
+    cached: Cached,
 ) -> None:
     """A 2.9 MB entry took 8.9 GB and 97 s in the main process, outside the mesh budget.
     Here a 0.6 MB one that decompresses to 600 MB: the main process's peak memory is
@@ -212,9 +210,7 @@ def forged(kind: str, side: float) -> tuple[np.ndarray, ...]:
 
 @pytest.mark.parametrize("kind", ["a flat piece", "a 1 km tetrahedron", "another mesh's entry"])
 def test_an_entry_that_is_not_the_meshs_pieces_is_replaced(
-    cached: tuple[pathlib.Path, pathlib.Path, pathlib.Path, bytes],
-    tmp_path: pathlib.Path,
-    kind: str,
+    cached: Cached, tmp_path: pathlib.Path, kind: str
 ) -> None:
     """Entries that pass every check of their own format: a degenerate piece made the
     good rock refused on every run; a 1 km tetrahedron replaced the 0.5 m rock (the

@@ -309,10 +309,16 @@ def _footprint(solid: Solid, ground: TerrainGround) -> tuple[np.ndarray, np.ndar
     return lowest, top, ground.height(xy)
 
 
-def _rocky_scenes(tmp_path: pathlib.Path) -> list[tuple[str, dict[str, Any], Any]]:
-    """rocky_shore and `crowd N --terrain rocky` for a small and a large crowd."""
+RockyScenes = list[tuple[str, dict[str, Any], Any]]
+
+
+@pytest.fixture(scope="module")
+def rocky_scenes(tmp_path_factory: pytest.TempPathFactory) -> RockyScenes:
+    """rocky_shore and `crowd N --terrain rocky` for a small and a large crowd: (name,
+    scene, its folder); read only."""
     shore = bundled_scene("rocky_shore")
     made = [("rocky_shore", json.loads(shore.read_text()), shore.parent)]
+    tmp_path = tmp_path_factory.mktemp("rocky")
     for count in (40, 256):
         out = tmp_path / f"crowd{count}.json"
         assert main(["crowd", str(count), "--terrain", "rocky", "--out", str(out)]) == 0
@@ -320,14 +326,14 @@ def _rocky_scenes(tmp_path: pathlib.Path) -> list[tuple[str, dict[str, Any], Any
     return made
 
 
-def test_rocks_stand_on_the_terrain_not_in_it(tmp_path: pathlib.Path) -> None:
+def test_rocks_stand_on_the_terrain_not_in_it(rocky_scenes: RockyScenes) -> None:
     """rocky_shore's ledge was 0.13 m under the surface, and 5 of 6 rocks of `crowd 40
     --terrain rocky` had their tops below the ground (of 34 with 256 creatures, 8 stuck
     out more than 5 cm): the ground read as plain sand. Every obstacle a scene does not
     bury on purpose (`on_ground`: false) now rests on the ground, its lowest point at
     or under the lowest ground beneath it (no gap under a side), and rises 5 cm or more
     above the highest ground beneath it (seen from any side)."""
-    for name, scene, folder in _rocky_scenes(tmp_path):
+    for name, scene, folder in rocky_scenes:
         terrain = scene["terrain"]
         ground = build_ground(terrain, folder)
         standing = [o.get("on_ground", True) for o in terrain["obstacles"]]
@@ -340,12 +346,12 @@ def test_rocks_stand_on_the_terrain_not_in_it(tmp_path: pathlib.Path) -> None:
             assert top.max() - under.max() >= 0.05, f"{name}: obstacle {k} is buried"
 
 
-def test_rocky_ground_has_relief_an_artist_notices(tmp_path: pathlib.Path) -> None:
+def test_rocky_ground_has_relief_an_artist_notices(rocky_scenes: RockyScenes) -> None:
     """The heightfield rises and falls 0.5 m or more where the creatures are: twice the
     tallest mantle a generated crowd has (0.25 m), so from a camera at a creature's
     height a hill hides a creature behind it (the preset had 0.4 m, rocky_shore 0.47 m
     where its creatures are)."""
-    for name, scene, folder in _rocky_scenes(tmp_path):
+    for name, scene, folder in rocky_scenes:
         field = build_ground(scene["terrain"], folder).heightfield
         assert field is not None
         starts = np.array([c["position"][:2] for c in scene["creatures"]])

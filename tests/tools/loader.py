@@ -7,6 +7,8 @@ import sys
 from pathlib import Path
 from types import ModuleType
 
+import pytest
+
 TOOLS = Path(__file__).resolve().parents[2] / "tools"
 
 
@@ -22,3 +24,11 @@ def load_tool(name: str) -> ModuleType:
     sys.modules[name] = module
     spec.loader.exec_module(module)
     return module
+
+
+def refused(name: str, argv: list[str], capsys: pytest.CaptureFixture[str]) -> str:
+    """What `tools/<name>.py` said on stderr when it refused `argv`: it must exit 2."""
+    with pytest.raises(SystemExit) as exit_info:
+        load_tool(name).main(argv)
+    assert exit_info.value.code == 2
+    return capsys.readouterr().err

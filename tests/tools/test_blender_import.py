@@ -18,6 +18,7 @@ from ecs_tentacles.cli import main
 from ecs_tentacles.export.materials import take_colours
 from ecs_tentacles.skin.colours import to_linear
 from ecs_tentacles.take import Take
+from tests.conftest import baked
 
 BLENDER = os.environ.get("ECS_TENTACLES_BLENDER_PYTHON", "")
 TOOL = Path(__file__).resolve().parents[2] / "tools" / "blender_import.py"
@@ -40,20 +41,25 @@ pytestmark = pytest.mark.skipif(
 )
 
 
+def _tool(take: Path, blend: Path, *options: str) -> str:
+    """`tools/blender_import.py TAKE --out BLEND OPTIONS` in Blender's Python: what it
+    printed (it must succeed within 3 minutes)."""
+    done = subprocess.run(
+        [BLENDER, str(TOOL), str(take), "--out", str(blend), *options],
+        capture_output=True, text=True, timeout=180,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    return done.stdout
+
+
 @pytest.mark.parametrize("suffix", [".usdc", ".glb"])
 def test_an_export_opens_in_blender_at_its_rate_and_range(tmp_path: Path, suffix: str) -> None:
     take = tmp_path / f"take{suffix}"
     argv = ["bake", "octopus", "--seconds", "1", "--fps", "30", "--out", str(take), "--quiet"]
     assert main(argv) == 0
     blend = tmp_path / "take.blend"
-    done = subprocess.run(
-        [BLENDER, str(TOOL), str(take), "--out", str(blend)],
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
-    assert done.returncode == 0, done.stderr
-    assert done.stdout.splitlines()[-1] == f"{blend}: {take.name} at 30 fps, frames 0-30"
+    said = _tool(take, blend)
+    assert said.splitlines()[-1] == f"{blend}: {take.name} at 30 fps, frames 0-30"
     read = subprocess.run(
         [BLENDER, "-c", READ, str(blend)], capture_output=True, text=True, timeout=120
     )
@@ -120,13 +126,7 @@ def test_four_creatures_import_with_their_own_names_in_usd_and_glb(tmp_path: Pat
 
 def _imported(take: Path, blend: Path, script: str) -> dict[str, Any]:
     """Import `take` with the tool into `blend`, then what `script` prints of it (JSON)."""
-    done = subprocess.run(
-        [BLENDER, str(TOOL), str(take), "--out", str(blend)],
-        capture_output=True,
-        text=True,
-        timeout=180,
-    )
-    assert done.returncode == 0, done.stderr
+    _tool(take, blend)
     read = subprocess.run(
         [BLENDER, "-c", script, str(blend)], capture_output=True, text=True, timeout=120
     )
@@ -260,22 +260,12 @@ FOUR = [f"creature_{i}" for i in range(4)]
 @pytest.fixture(scope="module")
 def four_take(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """thesis_four_by_six, 0.5 s at 30 fps: four creatures of six tentacles, a goal each."""
-    take = tmp_path_factory.mktemp("four") / "four.npz"
-    argv = ["bake", "thesis_four_by_six", "--seconds", "0.5", "--fps", "30", "--quiet"]
-    assert main([*argv, "--out", str(take)]) == 0
-    return take
+    return baked("thesis_four_by_six", tmp_path_factory.mktemp("four") / "four.npz", 0.5)
 
 
 def _report(take: Path, blend: Path) -> tuple[dict[str, Any], dict[str, Any]]:
     """Import `take` with `--report`: (the tool's report, what LOOKS reads back)."""
-    done = subprocess.run(
-        [BLENDER, str(TOOL), str(take), "--out", str(blend), "--report"],
-        capture_output=True,
-        text=True,
-        timeout=180,
-    )
-    assert done.returncode == 0, done.stderr
-    report: dict[str, Any] = json.loads(done.stdout.splitlines()[-2])
+    report: dict[str, Any] = json.loads(_tool(take, blend, "--report").splitlines()[-2])
     read = subprocess.run(
         [BLENDER, "-c", LOOKS, str(blend)], capture_output=True, text=True, timeout=120
     )

@@ -6,7 +6,7 @@ import json
 
 import pytest
 
-from tests.tools.loader import TOOLS, load_tool
+from tests.tools.loader import TOOLS, load_tool, refused
 
 pytestmark = pytest.mark.skipif(not TOOLS.is_dir(), reason="needs the source tree")
 
@@ -28,8 +28,4 @@ def test_every_system_is_timed_both_ways_and_only_the_stepped_run_moves(
 
 
 def test_a_bad_count_is_refused_by_name(capsys: pytest.CaptureFixture[str]) -> None:
-    tool = load_tool("step_cache_cost")
-    with pytest.raises(SystemExit) as exit_info:
-        tool.main(["--frames", "0"])
-    assert exit_info.value.code == 2
-    assert "--frames must be >= 1, got 0" in capsys.readouterr().err
+    assert "--frames must be >= 1, got 0" in refused("step_cache_cost", ["--frames", "0"], capsys)
