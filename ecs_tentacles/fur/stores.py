@@ -14,7 +14,9 @@ The rig's outputs (`FurData.curves`, `FurData.frames`) may be evaluated when fir
 rather than in the rig's slot of the frame: the rig hands `defer` the evaluation with
 its inputs of that slot (controls, body poses, bind), and reading either output, or a
 change of the guide rows (a spawn's shapes, a despawn), runs it first. What is read is
-the same either way; a frame whose fur nobody reads does not evaluate it.
+the same either way; a frame whose fur nobody reads does not evaluate it. (`reads`
+counts the reads: while they come every frame, as a recorder's or a renderer's do,
+the rig evaluates in its slot.)
 """
 
 from __future__ import annotations
@@ -137,6 +139,7 @@ class FurData:
         self.touches = 0  # ... and this too when not by a creature coming or going
         self.tracks: list[Channel] = []  # control attributes (columns: COLUMNS)
         self._pending: Callable[[], None] | None = None  # the rig's evaluation, run when read
+        self.reads = 0  # times `curves` or `frames` was read (the rig defers while none come)
 
     @property
     def shape(self) -> np.ndarray:
@@ -147,6 +150,7 @@ class FurData:
     @property
     def curves(self) -> np.ndarray:
         """World polylines (n_guides, points, 3) as the rig last posed them."""
+        self.reads += 1
         self.settle()
         self._join()
         return self._curves[: self._rows]
@@ -154,6 +158,7 @@ class FurData:
     @property
     def frames(self) -> np.ndarray:
         """World frames (n_guides, 4, 3): axis, up, side and root, as the rig last posed them."""
+        self.reads += 1
         self.settle()
         self._join()
         return self._frames[: self._rows]

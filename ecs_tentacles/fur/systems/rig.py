@@ -15,7 +15,8 @@ state from frame to frame), every other guide's evaluation is handed to `FurData
 with this frame's inputs and runs when `FurData.curves` or `frames` is next read (a
 take's recorder, the renderer, an exporter, a snapshot, a script), giving the same bits
 it would have given here. A headless crowd with no recorder then pays for the dynamic
-guides only.
+guides only. Fur read since the last frame (`FurData.reads`: a recorder, a renderer) is
+evaluated here, every guide at once, as it will be read again.
 
 Reads: Transform store (mantle rows), fur ControlStore (position, rest position,
 behaviour values, drives), GuideStore and FurSetStore (bind pose, re-read when
@@ -71,6 +72,7 @@ class Rig(System):
         self.strand_body = np.zeros(0, dtype=np.int64)  # the strands' bodies
         # the strands' guides, evaluated every frame: (their rows, their bind) in blocks
         self.eager: list[tuple[np.ndarray, Bind]] = []
+        self.reads_seen = -1  # `FurData.reads` when this rig last ran
 
     @property
     def bind(self) -> Bind | None:
@@ -165,9 +167,11 @@ class Rig(System):
         position = world.transforms.pos[binds.bodies]
         frames, curves = fur.outputs()
         strands = self.strands
-        if strands is not None and len(strands.guides) == len(binds):  # every guide is needed
+        read, self.reads_seen = fur.reads != self.reads_seen, fur.reads  # read since last frame
+        if read or (strands is not None and len(strands.guides) == len(binds)):  # every guide
             self._evaluate(frames, curves, list(binds.blocks), plan, rotation, position)
-            self._dynamics(frames, curves, rotation, dynamic)
+            if strands is not None:
+                self._dynamics(frames, curves, rotation, dynamic)
             return
         if strands is not None:  # the strands' guides now, the others when read
             for rows, part in self.eager:
