@@ -14,8 +14,15 @@ gathers, a subtraction, a norm and a `maximum.reduceat`, each a pass over every 
 from __future__ import annotations
 
 import math
+import os
 
 import numpy as np
+
+# OpenMP's worker threads (numba's "omp" layer, `reach_parallel`) spin after each parallel
+# kernel by default, taking the cores from the stepping threads; passive ones sleep. Read
+# when numba first starts its pool: the fur rig's kernels set the same
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+
 from numba import njit, prange
 
 
