@@ -1,8 +1,10 @@
 """The numba kernels of the physics' per-frame queries: the contact proxies' `sense`
 (gather every body and every reach sphere in one pass) and `reach` (the spheres alone:
-a frame copies only the bodies it needs), the near pairs' tests (reading bodies where
-they are; every pair of a small crowd), the proxies' candidate bodies, and the ground's
-heightfield heights (`ground.Heightfield.height`).
+a frame copies only the bodies it needs, `gather`; `reach_parallel` on all cores for a
+large crowd), the near pairs' tests (reading bodies where they are; every pair of a
+small crowd; how far the spheres moved since the pair cache's tree was asked,
+`largest_move`), the proxies' candidate bodies, and the ground's heightfield heights
+(`ground.Heightfield.height`).
 
 Optional, as the other kernels are: their users import this module only when numba is
 installed and fall back to numpy otherwise; both compute the same numbers bit for bit
