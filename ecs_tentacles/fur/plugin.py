@@ -77,6 +77,7 @@ class FurPlugin(Plugin):
     def restore(self, world: Host, state: Any) -> None:
         curves, frames = state
         fur = world.resource(FurData)
+        fur.discard()  # the snapshot's outputs replace whatever the rig deferred
         fur.curves[...] = curves
         fur.frames[...] = frames
 

@@ -9,10 +9,19 @@ Anything that changes the bind pose (roots, normals, rest directions, shapes,
 multipliers, control assignment) must call `FurData.touch()` so the rig re-binds;
 the `FurGuide` component does that on every write. (Creatures coming and going bump
 `version` alone: the rig then binds or cuts out just their guides.)
+
+The rig's outputs (`FurData.curves`, `FurData.frames`) may be evaluated when first read
+rather than in the rig's slot of the frame: the rig hands `defer` the evaluation with
+its inputs of that slot (controls, body poses, bind), and reading either output, or a
+change of the guide rows (a spawn's shapes, a despawn), runs it first. What is read is
+the same either way; a frame whose fur nobody reads does not evaluate it. (`reads`
+counts the reads: while they come every frame, as a recorder's or a renderer's do,
+the rig evaluates in its slot.)
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import replace
 
 import numpy as np
@@ -129,6 +138,8 @@ class FurData:
         self.version = 0  # bumped by any change of the bind pose ...
         self.touches = 0  # ... and this too when not by a creature coming or going
         self.tracks: list[Channel] = []  # control attributes (columns: COLUMNS)
+        self._pending: Callable[[], None] | None = None  # the rig's evaluation, run when read
+        self.reads = 0  # times `curves` or `frames` was read (the rig defers while none come)
 
     @property
     def shape(self) -> np.ndarray:
@@ -138,13 +149,40 @@ class FurData:
 
     @property
     def curves(self) -> np.ndarray:
+        """World polylines (n_guides, points, 3) as the rig last posed them."""
+        self.reads += 1
+        self.settle()
         self._join()
         return self._curves[: self._rows]
 
     @property
     def frames(self) -> np.ndarray:
+        """World frames (n_guides, 4, 3): axis, up, side and root, as the rig last posed them."""
+        self.reads += 1
+        self.settle()
         self._join()
         return self._frames[: self._rows]
+
+    def outputs(self) -> tuple[np.ndarray, np.ndarray]:
+        """(frames, curves) as they are, without running a deferred evaluation (the rig
+        writes them through this)."""
+        self._join()
+        return self._frames[: self._rows], self._curves[: self._rows]
+
+    def defer(self, evaluation: Callable[[], None]) -> None:
+        """The rig's evaluation of this frame, writing `outputs()`: run when the outputs
+        are next read (`settle`), replacing any earlier one not run yet."""
+        self._pending = evaluation
+
+    def settle(self) -> None:
+        """Run the deferred evaluation, if any (reading `curves` or `frames` does)."""
+        pending, self._pending = self._pending, None
+        if pending is not None:
+            pending()
+
+    def discard(self) -> None:
+        """Forget the deferred evaluation: every output row is about to be written anew."""
+        self._pending = None
 
     def add_shapes(self, shapes: np.ndarray) -> None:
         """Append rest shapes (k, points, 3) for guides just added; grow the buffers.
@@ -153,6 +191,7 @@ class FurData:
         crowd whose creatures each add a few guides is joined once; the buffers grow by
         doubling, so a creature spawned into a big furred crowd copies no one else's.
         """
+        self.settle()  # the rows it writes are the rows known now
         self._added.append((len(self.guides), shapes))
         self.version += 1
 
@@ -194,6 +233,7 @@ class FurData:
         follow; the rig re-binds if fur went with it."""
         guides = moved.get("fur.guides")
         if guides is not None:
+            self.settle()  # into the rows as they were
             self._join()
             rows = self._rows
             for buffer in (self._shape, self._curves, self._frames):

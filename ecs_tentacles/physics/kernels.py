@@ -1,8 +1,10 @@
 """The numba kernels of the physics' per-frame queries: the contact proxies' `sense`
 (gather every body and every reach sphere in one pass) and `reach` (the spheres alone:
-a frame copies only the bodies it needs), the near pairs' tests (reading bodies where
-they are; every pair of a small crowd), the proxies' candidate bodies, and the ground's
-heightfield heights (`ground.Heightfield.height`).
+a frame copies only the bodies it needs, `gather`; `reach_parallel` on all cores for a
+large crowd), the near pairs' tests (reading bodies where they are; every pair of a
+small crowd; how far the spheres moved since the pair cache's tree was asked,
+`largest_move`), the proxies' candidate bodies, and the ground's heightfield heights
+(`ground.Heightfield.height`).
 
 Optional, as the other kernels are: their users import this module only when numba is
 installed and fall back to numpy otherwise; both compute the same numbers bit for bit
@@ -14,9 +16,16 @@ gathers, a subtraction, a norm and a `maximum.reduceat`, each a pass over every 
 from __future__ import annotations
 
 import math
+import os
 
 import numpy as np
-from numba import njit
+
+# OpenMP's worker threads (numba's "omp" layer, `reach_parallel`) spin after each parallel
+# kernel by default, taking the cores from the stepping threads; passive ones sleep. Read
+# when numba first starts its pool: the fur rig's kernels set the same
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+
+from numba import njit, prange
 
 
 @njit(cache=True, nogil=True)
@@ -46,6 +55,32 @@ def sense(
 
 
 @njit(cache=True, nogil=True)
+def gather(
+    store_pos: np.ndarray,
+    store_quat: np.ndarray,
+    rows: np.ndarray,
+    start: np.ndarray,
+    count: np.ndarray,
+    creatures: np.ndarray,
+    gathered: np.ndarray,
+    out_pos: np.ndarray,
+    out_quat: np.ndarray,
+) -> None:
+    """The bodies of `creatures` not `gathered` yet into `out_pos` / `out_quat` (`sense`'s
+    copies, for those creatures only), marking them gathered."""
+    for c in creatures:
+        if gathered[c]:
+            continue
+        gathered[c] = True
+        for i in range(start[c], start[c] + count[c]):
+            row = rows[i]
+            for j in range(3):
+                out_pos[i, j] = store_pos[row, j]
+            for j in range(4):
+                out_quat[i, j] = store_quat[row, j]
+
+
+@njit(cache=True, nogil=True)
 def reach(
     store_pos: np.ndarray,
     rows: np.ndarray,
@@ -58,6 +93,21 @@ def reach(
     """`sense`'s reach spheres alone: no body is copied (a frame needs the bodies of the
     creatures near another only, `ContactProxies.gather`)."""
     for c in range(len(start)):
+        _sphere(store_pos, rows, start[c], count[c], rbound, c, out_centre, out_radius)
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def reach_parallel(
+    store_pos: np.ndarray,
+    rows: np.ndarray,
+    start: np.ndarray,
+    count: np.ndarray,
+    rbound: np.ndarray,
+    out_centre: np.ndarray,
+    out_radius: np.ndarray,
+) -> None:
+    """`reach` on all cores, creature by creature (each sphere's numbers are `reach`'s)."""
+    for c in prange(len(start)):
         _sphere(store_pos, rows, start[c], count[c], rbound, c, out_centre, out_radius)
 
 
@@ -260,6 +310,27 @@ def spheres_within(
             total += d * d
         out[p] = math.sqrt(total) - (radius[i] + radius[j]) < margin
     return out
+
+
+@njit(cache=True, nogil=True)
+def largest_move(
+    centre: np.ndarray, was_centre: np.ndarray, radius: np.ndarray, was_radius: np.ndarray
+) -> float:
+    """The most any sphere moved (centre) and grew (radius) since `was_*`: NaN if any
+    number is NaN (`NearPairCache`'s validity test, without its temporaries)."""
+    most = 0.0
+    for i in range(len(radius)):
+        total = 0.0
+        for k in range(centre.shape[1]):
+            d = centre[i, k] - was_centre[i, k]
+            total += d * d
+        grew = radius[i] - was_radius[i]
+        moved = math.sqrt(total) + (0.0 if grew <= 0.0 else grew)  # NaN stays NaN
+        if moved != moved:
+            return moved
+        if moved > most:
+            most = moved
+    return most
 
 
 @njit(cache=True, nogil=True)

@@ -40,27 +40,56 @@ class NearPairCache:
         self._centre = np.zeros((0, 3))
         self._radius = np.zeros(0)
         self._reach = 0.0
+        self._offsets = np.zeros(1, dtype=np.int64)  # creature c's kept pairs: [c, c + 1)
 
     def __call__(
-        self, centre: np.ndarray, radius: np.ndarray, margin: float
+        self, centre: np.ndarray, radius: np.ndarray, margin: float, among: np.ndarray | None = None
     ) -> tuple[np.ndarray, np.ndarray]:
+        """`near_pairs(centre, radius, margin)`; with `among` ((n,) bool), only its pairs
+        whose first creature is among them (the same pairs in the same order: the
+        proxies ask for the stepped creatures' pairs, a few of a replayed crowd's)."""
         if len(centre) <= DENSE_PAIRS:
-            return near_pairs(centre, radius, margin)
+            a, b = near_pairs(centre, radius, margin)
+            if among is not None:
+                first = among[a]
+                a, b = a[first], b[first]
+            return a, b
         if not self._still_valid(centre, radius, margin):
             reach = margin + self.slack
             self._kept = near_pairs(centre, radius, reach)
+            self._offsets = np.searchsorted(self._kept[0], np.arange(len(centre) + 1))
             self._centre, self._radius, self._reach = centre.copy(), radius.copy(), reach
             self.queries += 1
         assert self._kept is not None
         a, b = self._kept
+        if among is not None:  # the kept pairs are sorted by a: each creature's are a run
+            a, b = _runs_of(self._offsets, np.flatnonzero(among), a, b)
         keep = spheres_within(centre, radius, a, b, margin)
         return a[keep], b[keep]
 
     def _still_valid(self, centre: np.ndarray, radius: np.ndarray, margin: float) -> bool:
         if self._kept is None or self._centre.shape != centre.shape:
             return False
+        fast = KERNELS.get()
+        if fast is not None:  # one pass, no temporaries (called a few times a frame)
+            most = float(fast.largest_move(centre, self._centre, radius, self._radius))
+            return bool(margin + 2.0 * most < self._reach)  # NaN: never valid
         moved = np.linalg.norm(centre - self._centre, axis=1) + np.maximum(radius - self._radius, 0)
         return bool(margin + 2.0 * moved.max() < self._reach)  # NaN: never valid
+
+
+def _runs_of(
+    offsets: np.ndarray, creatures: np.ndarray, a: np.ndarray, b: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """The pairs (a, b) of `creatures` (ascending), each creature's run of pairs from
+    `offsets[c]` to `offsets[c + 1]`, in order."""
+    first, end = offsets[creatures], offsets[creatures + 1]
+    per = end - first
+    total = int(per.sum())
+    if total == len(a):
+        return a, b
+    index = np.arange(total) - np.repeat(np.cumsum(per) - per - first, per)
+    return a[index], b[index]
 
 
 def spheres_within(

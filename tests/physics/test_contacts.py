@@ -147,6 +147,12 @@ def test_the_sense_kernel_gives_the_numpy_numbers_bit_for_bit(
     for backend in ("auto", "numpy"):
         monkeypatch.setattr(module.KERNELS, "backend", backend)
         sensed.append(world.physics.proxies.sense(world.transforms))
+    for parallel_from in (1 << 40, 0):  # a frame's spheres, on one core and on all
+        monkeypatch.setattr(module, "PARALLEL_REACH", parallel_from)
+        monkeypatch.setattr(module.KERNELS, "backend", "auto")
+        _, _, centre, radius = world.physics.proxies.sense(world.transforms, 1000 + parallel_from)
+        np.testing.assert_array_equal(centre, sensed[1][2])
+        np.testing.assert_array_equal(radius, sensed[1][3])
     for kernel, numpy_path in zip(*sensed, strict=True):
         np.testing.assert_array_equal(kernel, numpy_path)
 

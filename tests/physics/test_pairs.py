@@ -104,3 +104,38 @@ def test_a_small_crowds_pairs_are_the_same_with_the_kernel_and_numpy(
             assert_array_equal(kernel, numpy)
         if n >= 16:
             assert 0 < len(found[0][0]) < n * (n - 1)
+
+
+@pytest.mark.parametrize("n", [DENSE_PAIRS - 4, 400])
+def test_the_pairs_of_some_creatures_are_theirs_of_all_the_pairs_in_order(n: int) -> None:
+    """The proxies ask for the pairs of the stepped creatures only (a few of a replayed
+    crowd): what filtering every pair would give, in the same order."""
+    rng = np.random.default_rng(6)
+    centre, radius = _crowd(rng, n)
+    cache, found = NearPairCache(slack=0.2), 0
+    for frame in range(30):
+        centre[:, :2] += rng.normal(0.0, 0.01, (n, 2))
+        among = rng.random(n) < 0.2
+        among[0] = frame % 2 == 0  # a first creature with pairs, or not
+        a, b = near_pairs(centre, radius, 0.05)
+        got = cache(centre, radius, 0.05, among=among)
+        found += len(got[0])
+        assert_array_equal(got[0], a[among[a]])
+        assert_array_equal(got[1], b[among[a]])
+        everyone = cache(centre, radius, 0.05, among=np.ones(n, dtype=bool))
+        assert_array_equal(everyone[0], a)
+        assert_array_equal(everyone[1], b)
+    assert found > 30
+
+
+def test_a_nan_sphere_makes_the_cache_ask_the_tree_again() -> None:
+    rng = np.random.default_rng(7)
+    centre, radius = _crowd(rng, 300)
+    cache = NearPairCache()
+    cache(centre, radius, 0.1)
+    cache(centre, radius, 0.1)
+    assert cache.queries == 1
+    radius = radius.copy()
+    radius[5] = np.nan  # a blown-up creature's reach: never trusted
+    cache(centre, radius, 0.1)
+    assert cache.queries == 2

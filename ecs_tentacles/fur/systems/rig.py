@@ -10,12 +10,20 @@ tip. A world without fur returns at once. See `ecs_tentacles.fur.rig` for the ma
 the guides go through `rig.evaluate` in blocks that share one scratch (no allocation
 per frame), by numba kernels when numba is installed, else whole-array numpy.
 
+Fur nobody reads is not evaluated: the guides of dynamic furs are (their strands carry
+state from frame to frame), every other guide's evaluation is handed to `FurData.defer`
+with this frame's inputs and runs when `FurData.curves` or `frames` is next read (a
+take's recorder, the renderer, an exporter, a snapshot, a script), giving the same bits
+it would have given here. A headless crowd with no recorder then pays for the dynamic
+guides only. Fur read since the last frame (`FurData.reads`: a recorder, a renderer) is
+evaluated here, every guide at once, as it will be read again.
+
 Reads: Transform store (mantle rows), fur ControlStore (position, rest position,
 behaviour values, drives), GuideStore and FurSetStore (bind pose, re-read when
 `world.resource(FurData).version` changes; when a creature spawns or is despawned only
 its guides are bound or cut out, `ecs_tentacles.fur.blocks`). Writes: ControlStore
 (tracked attributes), FurData's `frames` (axis, up, side, root per guide) and `curves`
-(polylines).
+(polylines), now or when first read.
 """
 
 from __future__ import annotations
@@ -25,9 +33,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ecs_tentacles.fur.bind import ControlTracks, control_plan, make_strands
-from ecs_tentacles.fur.blocks import BindBlocks
+from ecs_tentacles.fur.blocks import BLOCK, BindBlocks, Block
 from ecs_tentacles.fur.dynamics import Strands
-from ecs_tentacles.fur.rig import Bind, RigBuffers, evaluate, use_parallel
+from ecs_tentacles.fur.rig import Bind, Plan, RigBuffers, evaluate, use_parallel
 from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.fur.vectors import quat_matrices
 from ecs_tentacles.numeric.keyframes import TrackSet
@@ -62,6 +70,9 @@ class Rig(System):
         self.strand_normal = np.zeros((3, 0), dtype=np.float32)  # skin normals (3, m)
         self.strand_control = np.zeros(0, dtype=np.int64)  # the strands' controls
         self.strand_body = np.zeros(0, dtype=np.int64)  # the strands' bodies
+        # the strands' guides, evaluated every frame: (their rows, their bind) in blocks
+        self.eager: list[tuple[np.ndarray, Bind]] = []
+        self.reads_seen = -1  # `FurData.reads` when this rig last ran
 
     @property
     def bind(self) -> Bind | None:
@@ -85,6 +96,10 @@ class Rig(System):
             self.strand_normal = np.ascontiguousarray(bind.normal[:, guides], np.float32)
             self.strand_control = bind.control[guides]
             self.strand_body = bind.body[guides]
+            rows = [guides[start : start + BLOCK] for start in range(0, len(guides), BLOCK)]
+            self.eager = [(part, bind.part(part)) for part in rows]
+        else:
+            self.eager = []
         self.parallel = use_parallel(len(self.binds))
         self.version, self.touches = fur.version, fur.touches
 
@@ -139,6 +154,7 @@ class Rig(System):
         fur = world.resource(FurData)
         if not len(fur.guides):
             return
+        fur.discard()  # last frame's evaluation, if nobody read it, is superseded
         if self.version != fur.version or self.binds is None:
             self.rebind(world)
         binds = self.binds
@@ -149,19 +165,46 @@ class Rig(System):
         plan, dynamic = control_plan(fur)  # per-control values and skips, once a frame
         rotation = quat_matrices(world.transforms.quat[binds.bodies])
         position = world.transforms.pos[binds.bodies]
-        for rows, part in binds.blocks:
-            evaluate(
-                part,
-                plan,
-                rotation,
-                position,
-                fur.frames[rows],
-                fur.curves[rows],
-                self.scratch,
-                self.parallel,
-            )
-        if self.strands is not None:
-            self._dynamics(fur.frames, fur.curves, rotation, dynamic)
+        frames, curves = fur.outputs()
+        strands = self.strands
+        read, self.reads_seen = fur.reads != self.reads_seen, fur.reads  # read since last frame
+        if read or (strands is not None and len(strands.guides) == len(binds)):  # every guide
+            self._evaluate(frames, curves, list(binds.blocks), plan, rotation, position)
+            if strands is not None:
+                self._dynamics(frames, curves, rotation, dynamic)
+            return
+        if strands is not None:  # the strands' guides now, the others when read
+            for rows, part in self.eager:
+                out = np.empty((len(part), 4, 3), np.float32), np.empty_like(curves[: len(part)])
+                evaluate(part, plan, rotation, position, *out, self.scratch, self.parallel)
+                frames[rows], curves[rows] = out
+            self._dynamics(frames, curves, rotation, dynamic)
+        blocks, keep = list(binds.blocks), None if strands is None else strands.guides
+        parallel = self.parallel
+
+        def deferred() -> None:
+            now_frames, now_curves = fur.outputs()
+            kept = None if keep is None else (now_frames[keep], now_curves[keep])
+            self._evaluate(now_frames, now_curves, blocks, plan, rotation, position, parallel)
+            if kept is not None:  # the strands' blended curves stay as they are
+                now_frames[keep], now_curves[keep] = kept
+
+        fur.defer(deferred)
+
+    def _evaluate(
+        self,
+        frames: np.ndarray,
+        curves: np.ndarray,
+        blocks: list[Block],
+        plan: Plan,
+        rotation: np.ndarray,
+        position: np.ndarray,
+        parallel: bool | None = None,
+    ) -> None:
+        """Every guide of `blocks` posed into `frames` and `curves`, block by block."""
+        many = self.parallel if parallel is None else parallel
+        for rows, part in blocks:
+            evaluate(part, plan, rotation, position, frames[rows], curves[rows], self.scratch, many)
 
     def _dynamics(
         self,

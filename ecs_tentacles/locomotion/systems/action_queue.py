@@ -20,12 +20,14 @@ import numpy as np
 
 from ecs_tentacles.locomotion.actions import ATTACH_PATIENCE, STRENGTH, ActionQueues, Kind, Mode
 from ecs_tentacles.locomotion.stores import LocomotionStores
+from ecs_tentacles.numeric.optional_kernels import OptionalKernels
 from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
     from ecs_tentacles.roster_change import RosterChange
 
+KERNELS = OptionalKernels("ecs_tentacles.locomotion.action_kernels", "ECS_TENTACLES_ACTIONS")
 TIME_EPSILON = 1e-9  # sums of frame durations fall a hair short of whole durations
 ATTACH = int(Kind.ATTACH)
 
@@ -57,6 +59,16 @@ class ActionQueueSystem(System):
         t = self.strokes
         if not len(t):
             return
+        replayed = world.physics.kinematic_creatures(len(world.creatures))
+        fast = KERNELS.get()
+        if fast is not None:  # the same rows and timers in one pass
+            tentacles = world.tentacles
+            rows = fast.due(t.timer, t.duration, t.action, t.interrupted, tentacles.creature_row,
+                            replayed, world.suckers.attached, tentacles.tip_sucker, float(dt),
+                            TIME_EPSILON, ATTACH, float(ATTACH_PATIENCE))  # fmt: skip
+            for row in rows:
+                self._advance(world, int(row))
+            return
         t.timer += dt
         done = t.timer >= t.duration - TIME_EPSILON
         attaching = t.action == ATTACH
@@ -67,7 +79,6 @@ class ActionQueueSystem(System):
         interrupted = t.interrupted
         if interrupted.any():
             done |= interrupted
-        replayed = world.physics.kinematic_creatures(len(world.creatures))
         if replayed.any():  # their actions pause (an interruption waits): the clip carries them
             done &= ~replayed[world.tentacles.creature_row]
         interrupted[done] = False

@@ -176,3 +176,43 @@ def test_kernels_serial_or_parallel_and_numpy_give_the_same_fur(
     # the rig's own float32 rounding (see tests/fur/test_rig_kernels.py), carried by the strands
     assert_allclose(serial, results["numpy", 0], atol=1e-5)
     assert not rig_math.use_parallel(rig_math.PARALLEL_GUIDES - 1)
+
+
+@pytest.mark.parametrize("parallel_from", [1 << 40, 0])
+def test_fur_nobody_reads_is_posed_when_read_with_the_same_bits(
+    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch, parallel_from: int
+) -> None:
+    from ecs_tentacles.fur import rig as rig_math
+
+    monkeypatch.setattr(rig_math, "PARALLEL_GUIDES", parallel_from)
+    monkeypatch.setattr(blocks_module, "BLOCK", 64)  # strands' guides among other guides
+    scene = {
+        "version": 1,
+        "creatures": [
+            creature("bird", 0.0, {"preset": "bird", "groom": {"count": 50}}),
+            creature("cat", 2.0, {"preset": "cat", "groom": {"count": 70}}),
+            creature("hog", 4.0, {"preset": "hedgehog", "groom": {"count": 40}}),
+        ],
+    }
+    scene["creatures"][1]["goals"] = [{"position": [3.0, 1.0]}]
+    every, seldom = make_world(scene), make_world(scene)
+    read_every = []
+    for frame in range(1, 25):  # one world's fur read every frame, as a recorder reads it
+        every.step(1)
+        fur = every.resource(FurData)
+        read_every.append((frame, fur.frames.copy(), fur.curves.copy()))
+    fur = seldom.resource(FurData)
+    cat = fur.guides.fur_row == 1  # the dynamic fur's guides
+    unread = 0
+    for frame, frames, curves in read_every:
+        before = fur.outputs()[1].copy()
+        seldom.step(1)
+        written = np.any(fur.outputs()[1] != before, axis=(1, 2))
+        assert written[cat].all()  # the dynamic fur is posed every frame (strands carry state)
+        if frame > 1 and (frame - 1) % 5:  # nobody read it since the last frame
+            assert not written[~cat].any()  # the rest is posed when read
+            unread += 1
+        if frame % 5 == 0 or frame == 24:  # read now and then: exactly what was read above
+            np.testing.assert_array_equal(fur.curves, curves)
+            np.testing.assert_array_equal(fur.frames, frames)
+    assert unread == 19
