@@ -58,8 +58,9 @@ def test_replayed_poses_written_once_are_the_poses_the_sync_copied(
     """A replayed creature's poses are written into the Transform store only, not into
     its batch's pose rows for the sync to copy: the store holds the same bits every
     frame as before, whether a batch's store rows are consecutive (a uniform crowd) or
-    not (several morphologies), on the plane or draped over terrain; read back from the
-    batch (`Batch.poses`, `Batch.all_poses`) they are the poses the batch held."""
+    not (several morphologies, a creature spawned and one despawned), on the plane or
+    draped over terrain; read back from the batch (`Batch.poses`, `Batch.all_poses`)
+    they are the poses the batch held."""
     from ecs_tentacles.creator.crowd import crowd_scene
 
     scene = crowd_scene(6, seed=2, uniform=crowd != "varied")
@@ -75,7 +76,12 @@ def test_replayed_poses_written_once_are_the_poses_the_sync_copied(
             world.spawn(late, position=(12.0, 12.0))
         consecutive = [b.body_span() is not None for b in world.physics.batches]
         assert all(consecutive) if crowd != "varied" else not all(consecutive)
-        runs.append(_replayed_run(world, 30))
+        run = _replayed_run(world, 30)
+        if crowd == "varied":  # a replayed creature leaves: the rows after it move up
+            replayed = np.flatnonzero(world.physics.tier == KINEMATIC)
+            world.despawn(int(world.physics.roster.entity[replayed[0]]))
+            run += _replayed_run(world, 10)
+        runs.append(run)
         assert world.lod.counts()["kinematic"] >= 3
         shown = [b.shown for b in world.physics.batches if b.shown is not None]
         assert (sum(int(s.sum()) for s in shown) >= 3) if direct else not shown
