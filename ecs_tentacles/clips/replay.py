@@ -197,22 +197,20 @@ class ClipReplay:
         not into the batch's pose rows (`Batch.show`; `Batch.poses` reads them back)."""
         kind, phase = self.kind[mine], self.phase[mine]
         xy, heading = self.xy[mine], self.heading[mine]
-        body_rows = None
         if not DIRECT:  # into the batch's pose rows; the sync copies them like any others
-            pos, quat = batch.xpos, batch.xquat
-        elif batch.body_span() is not None:  # a uniform crowd's batch: store rows as rows
+            clips.evaluate(kind, phase, xy, heading, batch.xpos, batch.xquat,
+                           interpolate=interpolate, rows=rows)  # fmt: skip
+            batch.show(transforms, None)
+            return
+        if batch.body_span() is not None:  # a uniform crowd's batch: its store rows as rows
             pos, quat = batch.store_rows(transforms)
+            clips.evaluate(kind, phase, xy, heading, pos, quat, interpolate=interpolate,
+                           rows=rows)  # fmt: skip
         else:
-            pos, quat, body_rows = transforms.pos, transforms.quat, batch.body_rows
-
-        def part(at: slice) -> None:  # creatures `at` (the kernel runs outside the GIL)
-            clips.evaluate(kind[at], phase[at], xy[at], heading[at], pos, quat,
-                           interpolate=interpolate, rows=rows[at],
-                           body_rows=body_rows)  # fmt: skip
-
-        # on the stepping threads too (idle now): each creature's poses as if alone
-        self.world.physics.alongside(part, len(mine))
-        batch.show(transforms, rows if DIRECT else None)
+            clips.evaluate(kind, phase, xy, heading, transforms.pos, transforms.quat,
+                           interpolate=interpolate, rows=rows,
+                           body_rows=batch.body_rows)  # fmt: skip
+        batch.show(transforms, rows)
 
     # -- snapshots -------------------------------------------------------------------------
     def state(self) -> tuple[np.ndarray, ...]:

@@ -22,7 +22,6 @@ physics through them alone. The backend sees a world as `PhysicsHost` (`physics.
 from __future__ import annotations
 
 import functools
-import itertools
 import os
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
@@ -56,7 +55,6 @@ if TYPE_CHECKING:
     from ecs_tentacles.store import MotorStore, SuckerStore, TransformStore
 
 KERNELS = OptionalKernels("ecs_tentacles.physics.frame_kernels", "ECS_TENTACLES_PHYSICS_FRAME")
-SHARE = 256  # items `alongside` gives a thread at least (fewer: not worth a hand-over)
 S = mujoco.mjtState
 
 
@@ -385,25 +383,6 @@ class PhysicsBackend(Membership):
         futures = [self._pool.submit(step, work, *args, thread) for thread in range(1, helpers + 1)]
         try:
             step(work, *args, 0)
-        finally:
-            for future in futures:
-                future.result()
-
-    def alongside(self, work: Callable[[slice], None], count: int) -> None:
-        """`work(part)` over `count` items cut into a part per stepping thread, the parts
-        at once (this thread takes the first). For kernels that release the interpreter,
-        run between the steps while the stepping threads are idle (the replayed
-        creatures' poses); each item's result must not depend on the cut."""
-        parts = min(self.threads, count // SHARE) if self._pool is not None else 1
-        if parts < 2:
-            work(slice(0, count))
-            return
-        assert self._pool is not None
-        cuts = [count * k // parts for k in range(parts + 1)]
-        later = itertools.pairwise(cuts[1:])
-        futures = [self._pool.submit(work, slice(a, b)) for a, b in later]
-        try:
-            work(slice(0, cuts[1]))
         finally:
             for future in futures:
                 future.result()

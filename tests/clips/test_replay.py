@@ -118,35 +118,3 @@ def test_a_snapshot_keeps_the_replayed_poses_as_shown(make_world: Callable[..., 
     for first, again in zip(ahead, _replayed_run(world, 10), strict=True):
         for a, b in zip(first, again, strict=True):
             assert_array_equal(a, b)
-
-
-def test_replayed_poses_are_the_same_on_one_thread_or_two(
-    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
-) -> None:
-    """The replay's kernel runs on the stepping threads too (idle after the step): a
-    part of the crowd each, the same bits as on one thread."""
-    import threading
-
-    from ecs_tentacles.clips.clips import GaitClips
-    from ecs_tentacles.creator.crowd import crowd_scene
-    from ecs_tentacles.physics import backend
-
-    monkeypatch.setattr(backend, "SHARE", 1)  # parts of one creature: six creatures cut
-    evaluate, threads_seen = GaitClips.evaluate, set()
-
-    def noting(*args: object, **kwargs: object) -> None:
-        threads_seen.add(threading.get_ident())
-        evaluate(*args, **kwargs)  # type: ignore[arg-type]
-
-    monkeypatch.setattr(GaitClips, "evaluate", noting)
-    scene = crowd_scene(6, seed=2, uniform=True)
-    scene.setdefault("physics", {})["lod"] = {"full": 0, "reduced": 2, "hold_seconds": 0.1}
-    runs, seen = [], []
-    for threads in (1, 2):
-        threads_seen.clear()
-        runs.append(_replayed_run(make_world(scene, threads=threads), 20))
-        seen.append(len(threads_seen))
-    assert seen == [1, 2]
-    for one, two in zip(*runs, strict=True):
-        for a, b in zip(one, two, strict=True):
-            assert_array_equal(a, b)

@@ -193,19 +193,3 @@ def test_a_world_stepping_on_two_threads_keeps_blas_to_one(
     assert pools and all(p["num_threads"] == 1 for p in pools)
     monkeypatch.setenv("OPENBLAS_NUM_THREADS", "2")  # the user's choice stands
     assert blas.quiet_blas() is False
-
-
-@pytest.mark.parametrize(("threads", "count", "parts"), [(2, 1000, 2), (2, 300, 1), (1, 1000, 1)])
-def test_work_alongside_the_stepping_threads_covers_every_item_once(
-    make_world: Callable[..., World], threads: int, count: int, parts: int
-) -> None:
-    """`alongside` cuts the items into a part per stepping thread (none for a few),
-    runs them at once, and every item is in exactly one part."""
-    import threading
-
-    world = make_world(creature_scene(), threads=threads)
-    done: list[tuple[slice, int]] = []
-    world.physics.alongside(lambda at: done.append((at, threading.get_ident())), count)
-    covered = np.concatenate([np.arange(count)[at] for at, _ in done])
-    assert_array_equal(np.sort(covered), np.arange(count))
-    assert len(done) == parts == len({thread for _, thread in done})
