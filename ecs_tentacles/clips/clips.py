@@ -148,12 +148,13 @@ class GaitClips:
         *,
         interpolate: bool = True,
         rows: np.ndarray | None = None,
-        also: tuple[np.ndarray, np.ndarray] | None = None,
+        body_rows: np.ndarray | None = None,
     ) -> None:
         """Body poses of K creatures into `out_pos` (K, B, 3) and `out_quat` (K, B, 4),
-        or into their rows `rows` (K,) of larger (N, B, .) arrays (a batch's poses), and
-        into the same rows of `also` (positions, rotations shaped as the outputs: the
-        Transform store's rows of the batch) when given.
+        or into their rows `rows` (K,) of larger (N, B, .) arrays (a batch's poses), or,
+        given `body_rows` (N, B), body b of creature k into row `body_rows[rows[k], b]`
+        of `out_pos` (M, 3) and `out_quat` (M, 4): the Transform store's rows of a
+        batch's bodies (`Batch.body_rows`), consecutive or not.
 
         `kind` (K,) is `IDLE` or `CRAWL`; `phase` (K,) the frame in that clip (any real
         number: it wraps; fractions interpolate positions linearly and rotations by
@@ -171,23 +172,21 @@ class GaitClips:
             turn = np.ascontiguousarray(heading, dtype=np.float64)
             fraction = phase - below
             into = np.arange(len(kind)) if rows is None else np.asarray(rows, dtype=np.int64)
-            also_pos, also_quat = also if also is not None else (_NO_POSE[0], _NO_POSE[1])
-            fast.place(self._pose, self._change, row, fraction, interpolate, where, turn,
-                       into, out_pos, out_quat, also_pos, also_quat)  # fmt: skip
+            if body_rows is None:
+                fast.place(self._pose, self._change, row, fraction, interpolate, where, turn,
+                           into, out_pos, out_quat)  # fmt: skip
+            else:
+                fast.place_scattered(self._pose, self._change, row, fraction, interpolate,
+                                     where, turn, into, body_rows, out_pos, out_quat)  # fmt: skip
             return
-        if also is not None:  # numpy: the outputs first, then a copy
-            self.evaluate(kind, phase, xy, heading, out_pos, out_quat, interpolate=interpolate,
-                          rows=rows)  # fmt: skip
-            at = slice(None) if rows is None else rows
-            also[0][at], also[1][at] = out_pos[at], out_quat[at]
-            return
-        if rows is not None:  # numpy: whole arrays, then one scatter
-            pos, quat = (
-                np.empty((len(kind), *out_pos.shape[1:])),
-                np.empty((len(kind), *out_quat.shape[1:])),
-            )
+        if rows is not None or body_rows is not None:  # numpy: whole arrays, then a scatter
+            bodies = self._pose.shape[1]
+            pos, quat = np.empty((len(kind), bodies, 3)), np.empty((len(kind), bodies, 4))
             self.evaluate(kind, phase, xy, heading, pos, quat, interpolate=interpolate)
-            out_pos[rows], out_quat[rows] = pos, quat
+            at = np.arange(len(kind)) if rows is None else rows
+            if body_rows is not None:
+                at = body_rows[at]
+            out_pos[at], out_quat[at] = pos, quat
             return
         if interpolate:
             below = np.floor(phase)
@@ -226,7 +225,6 @@ class GaitClips:
 
 
 KERNELS = OptionalKernels("ecs_tentacles.clips.kernels", "ECS_TENTACLES_REPLAY")
-_NO_POSE = (np.zeros((0, 1, 3)), np.zeros((0, 1, 4)))  # `place` writes no second copy
 
 
 def _place(

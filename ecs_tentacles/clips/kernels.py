@@ -1,5 +1,7 @@
-"""The numba kernels of gait-clip replay: `GaitClips.evaluate` for K creatures in one pass,
-and the clip frame each creature starts replaying from (`nearest_frames`).
+"""The numba kernels of gait-clip replay: `GaitClips.evaluate` for K creatures in one pass
+(into rows of (N, B) arrays, `place`, or into a batch's Transform store rows wherever
+they are, `place_scattered`), and the clip frame each creature starts replaying from
+(`nearest_frames`).
 
 Optional, as the fur rig's kernels are: `clips` imports this module only when numba is
 installed (the ``dev`` extra brings it) and falls back to its whole-array numpy path
@@ -31,23 +33,16 @@ def place(
     out_rows: np.ndarray,
     out_pos: np.ndarray,
     out_quat: np.ndarray,
-    also_pos: np.ndarray,
-    also_quat: np.ndarray,
 ) -> None:
     """Creature k shows clip table row `row[k]` (+ `fraction[k]` of `change` when
     `interpolate`, quaternions renormalised) moved to `xy[k]` and turned by `heading[k]`,
-    written to row `out_rows[k]` of the outputs (a batch's pose arrays: no copy after),
-    and of `also_pos` / `also_quat` too unless they have no rows (the Transform store's
-    rows of that batch: the sync's copy made in the same pass).
+    written to row `out_rows[k]` of the outputs (rows of a larger array: no copy after).
 
     `pose` and `change` are (rows, B, 7) ground-frame tables (position, quaternion);
     the outputs are (N, B, 3) and (N, B, 4).
     """
-    twice = also_pos.shape[0] > 0
     for k in range(len(row)):
-        r = row[k]
-        o = out_rows[k]
-        t = fraction[k]
+        r, o, t = row[k], out_rows[k], fraction[k]
         c, s = math.cos(heading[k]), math.sin(heading[k])
         hc, hs = math.cos(0.5 * heading[k]), math.sin(0.5 * heading[k])
         ox, oy = xy[k, 0], xy[k, 1]
@@ -72,10 +67,51 @@ def place(
             out_quat[o, b, 0], out_quat[o, b, 1], out_quat[o, b, 2], out_quat[o, b, 3] = (
                 qw, q1, q2, q3,
             )  # fmt: skip
-            if twice:
-                also_pos[o, b, 0], also_pos[o, b, 1], also_pos[o, b, 2] = px, py, z
-                also_quat[o, b, 0], also_quat[o, b, 1] = qw, q1
-                also_quat[o, b, 2], also_quat[o, b, 3] = q2, q3
+
+
+@njit(cache=True, nogil=True)
+def place_scattered(
+    pose: np.ndarray,
+    change: np.ndarray,
+    row: np.ndarray,
+    fraction: np.ndarray,
+    interpolate: bool,
+    xy: np.ndarray,
+    heading: np.ndarray,
+    out_rows: np.ndarray,
+    body_rows: np.ndarray,
+    out_pos: np.ndarray,
+    out_quat: np.ndarray,
+) -> None:
+    """`place` (the same numbers), body b of creature k written to row
+    `body_rows[out_rows[k], b]` of `out_pos` (rows, 3) and `out_quat` (rows, 4): the
+    Transform store, whose rows of a batch's bodies (`Batch.body_rows`, (N, B)) need
+    not be consecutive."""
+    for k in range(len(row)):
+        r, o, t = row[k], out_rows[k], fraction[k]
+        c, s = math.cos(heading[k]), math.sin(heading[k])
+        hc, hs = math.cos(0.5 * heading[k]), math.sin(0.5 * heading[k])
+        ox, oy = xy[k, 0], xy[k, 1]
+        for b in range(pose.shape[1]):
+            p = pose[r, b]
+            x, y, z = p[0], p[1], p[2]
+            w, qx, qy, qz = p[3], p[4], p[5], p[6]
+            if interpolate:
+                d = change[r, b]
+                x, y, z = x + d[0] * t, y + d[1] * t, z + d[2] * t
+                w, qx, qy, qz = w + d[3] * t, qx + d[4] * t, qy + d[5] * t, qz + d[6] * t
+                norm = math.sqrt(w * w + qx * qx + qy * qy + qz * qz)
+                w, qx, qy, qz = w / norm, qx / norm, qy / norm, qz / norm
+            px, py = c * x - s * y + ox, s * x + c * y + oy
+            qw, q1, q2, q3 = (
+                hc * w - hs * qz,
+                hc * qx - hs * qy,
+                hc * qy + hs * qx,
+                hc * qz + hs * w,
+            )
+            at = body_rows[o, b]
+            out_pos[at, 0], out_pos[at, 1], out_pos[at, 2] = px, py, z
+            out_quat[at, 0], out_quat[at, 1], out_quat[at, 2], out_quat[at, 3] = qw, q1, q2, q3
 
 
 @njit(cache=True, nogil=True)

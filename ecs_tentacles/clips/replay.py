@@ -4,10 +4,12 @@ Per creature (roster order) it keeps a ground frame (`xy`, `heading`), a clip (`
 idle or crawl) and a `phase` in frames. Each frame (`advance`) every kinematic
 creature turns toward where the plugins say it is going (the `TravelTargets` entries; at
 most `TURN_RATE`), moves along its heading at its morphology's crawl speed, steps its
-clip one frame on, and its body poses are written into its batch's pose rows, which
-`physics_sync` copies into the Transform store like any other (on the plane, for a
-batch whose bodies are consecutive store rows, the store's rows are written in the same
-pass and the sync leaves them: `Batch.shown`). A creature that starts
+clip one frame on, and its body poses are written once, straight into the Transform
+store (which the renderer, recorders, proxies, rig and level of detail read): not into
+its batch's pose rows as well, which keep its last stepped pose. The sync leaves those
+rows (`Batch.show`), and whoever reads a replayed creature's poses through its batch
+gets them from the store (`Batch.poses`, `Batch.all_poses`: views, snapshots). A
+creature that starts
 replaying (`start`) keeps where it stands and which way it faces; promoted again, it
 starts the physics from the joint state of the pose it was shown in (`joint_state`).
 On terrain the clips (recorded on the plane) are draped over the heightfield: each body
@@ -38,6 +40,7 @@ if TYPE_CHECKING:
     from ecs_tentacles.host import Host
     from ecs_tentacles.physics.batch import Batch
     from ecs_tentacles.roster_change import RosterChange
+    from ecs_tentacles.store import TransformStore
 
 log = logging.getLogger("ecs_tentacles.clips")
 
@@ -45,7 +48,7 @@ KERNELS = OptionalKernels("ecs_tentacles.clips.kernels", "ECS_TENTACLES_REPLAY")
 SHARED = ClipCache(disk=True)  # clips by morphology: every world of this process, kept on disk
 TURN_RATE = math.radians(60.0)  # rad/s a replayed creature turns toward its way
 ARRIVED = 0.05  # m: closer than this to its target, a replayed creature idles
-DIRECT = True  # on the plane, write a consecutive batch's poses into the store as well
+DIRECT = True  # replayed poses into the Transform store only (False: into the batches, synced)
 
 
 class ClipReplay:
@@ -138,7 +141,7 @@ class ClipReplay:
         )
         ground = ground_of(self.world)
         if ground.extent is not None:  # the clip's flat pose, raised onto the terrain
-            shown = batch.xpos[row]
+            shown, _ = batch.poses(row)
             lift = float(np.max(ground.height(shown[:, :2])))
             qpos = qpos.copy()
             qpos[batch.root_qpos + 2] += lift
@@ -150,6 +153,8 @@ class ClipReplay:
         roster = self.roster
         moving = np.flatnonzero(roster.tier == KINEMATIC)
         if not len(moving):
+            for batch in roster.batches:
+                batch.show(world.transforms, None)
             return
         ground = ground_of(world)
         targets = _targets(world, roster.creature_row[moving])
@@ -162,12 +167,12 @@ class ClipReplay:
         heading = self.heading[moving] + np.where(crawl, np.clip(turn, -limit, limit), 0.0)
         self.heading[moving] = heading
         self.kind[moving] = np.where(crawl, CRAWL, IDLE)
-        flat = ground.extent is None
+        transforms = world.transforms
         for batch in roster.batches:
-            batch.shown = None
             here = roster.batch_of[moving] == batch.index
             mine = moving[here]
             if not len(mine):
+                batch.show(transforms, None)
                 continue
             clips = self.clips_of(batch)
             speed = np.where(crawl[here], clips.crawl.speed, 0.0)
@@ -177,21 +182,35 @@ class ClipReplay:
             self.phase[mine] += dt / clips.crawl.dt
             rows = roster.row_of[mine]
             whole = bool(np.all(self.phase[mine] == np.round(self.phase[mine])))
-            # a uniform crowd's batch: the poses into the store in the same pass, so the
-            # sync copies only the stepped rows (the same numbers: 45 MB less a frame
-            # read and written at 10,000 creatures)
-            direct = DIRECT and flat and batch.body_span() is not None
-            store = batch.store_rows(world.transforms) if direct else None
-            clips.evaluate(self.kind[mine], self.phase[mine], self.xy[mine], self.heading[mine],
-                           batch.xpos, batch.xquat, interpolate=not whole, rows=rows,
-                           also=store)  # fmt: skip
-            if store is not None:
-                batch.shown = np.zeros(len(batch.members), dtype=bool)
-                batch.shown[rows] = True
+            self._show(batch, clips, mine, rows, transforms, interpolate=not whole)
             if ground.extent is not None:  # draped over the terrain, body by body
-                pos = batch.xpos[rows]
+                into = transforms.pos if batch.shown is not None else batch.xpos
+                at = batch.body_rows[rows] if batch.shown is not None else rows
+                pos = into[at]
                 lift = ground.height(pos[..., :2].reshape(-1, 2)).reshape(pos.shape[:2])
-                batch.xpos[rows, :, 2] += lift
+                into[at, ..., 2] = pos[..., 2] + lift
+
+    def _show(self, batch: Batch, clips: GaitClips, mine: np.ndarray, rows: np.ndarray,
+              transforms: TransformStore, *, interpolate: bool) -> None:  # fmt: skip
+        """Creatures `mine` (rows `rows` of `batch`) in their clip poses, written once:
+        into the Transform store (which the renderer, recorders, proxies and rig read),
+        not into the batch's pose rows (`Batch.show`; `Batch.poses` reads them back)."""
+        kind, phase = self.kind[mine], self.phase[mine]
+        xy, heading = self.xy[mine], self.heading[mine]
+        if not DIRECT:  # into the batch's pose rows; the sync copies them like any others
+            clips.evaluate(kind, phase, xy, heading, batch.xpos, batch.xquat,
+                           interpolate=interpolate, rows=rows)  # fmt: skip
+            batch.show(transforms, None)
+            return
+        if batch.body_span() is not None:  # a uniform crowd's batch: its store rows as rows
+            pos, quat = batch.store_rows(transforms)
+            clips.evaluate(kind, phase, xy, heading, pos, quat, interpolate=interpolate,
+                           rows=rows)  # fmt: skip
+        else:
+            clips.evaluate(kind, phase, xy, heading, transforms.pos, transforms.quat,
+                           interpolate=interpolate, rows=rows,
+                           body_rows=batch.body_rows)  # fmt: skip
+        batch.show(transforms, rows)
 
     # -- snapshots -------------------------------------------------------------------------
     def state(self) -> tuple[np.ndarray, ...]:

@@ -158,7 +158,7 @@ class PhysicsBackend(Membership):
         return PhysicsState(
             time=self.time,
             states=[b.state.copy() for b in self.batches],
-            poses=[(b.xpos.copy(), b.xquat.copy()) for b in self.batches],
+            poses=[b.all_poses() for b in self.batches],  # the replayed ones as shown
             reduced=[(b.rstate.copy(), b.rsource.copy()) for b in self.batches],
             applied=[{r: f.copy() for r, f in b.applied.items()} for b in self.batches],
             frozen=self.frozen.copy(),
@@ -193,6 +193,7 @@ class PhysicsBackend(Membership):
         ):  # batches compiled since are empty (`state_problem`)
             batch.state[:] = rows
             batch.xpos[:], batch.xquat[:] = xpos, xquat
+            batch.show(None, None)  # every row's poses as saved, replayed ones too
             if rstate.shape == batch.rstate.shape:
                 batch.rstate[:], batch.rsource[:] = rstate, rsource
             else:  # compiled since: no row was REDUCED then; each fits on its first step

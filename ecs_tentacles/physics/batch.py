@@ -4,7 +4,8 @@ A `Batch` holds the compiled model of a morphology (`model_layout(...).key`) onc
 each of its creatures as one row of contiguous arrays: the MuJoCo state (`state`:
 time, qpos, qvel, warm start, ctrl, sucker switches, proxy poses; `STATE`), what
 differs per creature in the model (servo gains and torque limits, sucker anchors,
-proxy sizes: the *overlay*), the body poses the last step produced (`xpos`, `xquat`)
+proxy sizes: the *overlay*), the body poses the last step produced (`xpos`, `xquat`;
+a replayed row's poses are written into the Transform store instead: `show`, `poses`)
 and what the health check needs from it (warnings raised, deepest contact, fatal
 errors). Nothing per creature is a MuJoCo object.
 
@@ -128,9 +129,11 @@ class Batch:
         # uniform crowd): `sync` then copies instead of scattering, 6x faster at 10,000
         self._span: slice | None = None
         self._span_of: np.ndarray | None = None  # the body_rows the span was found for
-        # rows whose poses the replay wrote into the Transform store this frame as well
-        # (`store_rows`): the next `sync` copies the others only, and forgets it
+        # rows (bool per row) whose poses the replay wrote into the Transform store
+        # `shown_in` this frame instead of `xpos` / `xquat`, which keep the row's last
+        # stepped pose: `sync` copies the others only, `poses(row)` reads them there
         self.shown: np.ndarray | None = None
+        self.shown_in: TransformStore | None = None
 
     def __len__(self) -> int:
         return len(self.members)
@@ -172,6 +175,7 @@ class Batch:
             grown = np.full((len(array) + 1, *array.shape[1:]), fill, dtype=array.dtype)
             grown[:-1] = array
             setattr(self, name, grown)
+        self._follow_shown(None)
         return len(self) - 1
 
     def remove(self, row: int) -> None:
@@ -180,6 +184,16 @@ class Batch:
             setattr(self, name, without_row(getattr(self, name), row))
         self.applied = {r - (r > row): f for r, f in self.applied.items() if r != row}
         self.errors = {r - (r > row): e for r, e in self.errors.items() if r != row}
+        self._follow_shown(row)
+
+    def _follow_shown(self, row: int | None) -> None:
+        """`shown` after `append` (row None: a new row, not shown) or `remove(row)`."""
+        if self.shown is None:
+            return
+        if row is None:
+            self.shown = np.append(self.shown, False)
+        else:
+            self.shown = np.delete(self.shown, row)
 
     def renumber(self, moved: dict[str, np.ndarray]) -> None:
         """Store rows moved (`ArrayStore.remove`'s answers by store name): follow them."""
@@ -289,6 +303,7 @@ class Batch:
         mujoco.mj_getState(m, d, self.state[row], STATE)
         self.xpos[row] = d.xpos[self.body_ids]
         self.xquat[row] = d.xquat[self.body_ids]
+        self._stepped(row)
 
     def standalone(self, row: int) -> tuple[mujoco.MjModel, mujoco.MjData]:
         """A new model and data of row `row` alone, as its next step would see them.
@@ -313,19 +328,29 @@ class Batch:
         mujoco.mj_forward(m, d)
         self.xpos[row] = d.xpos[self.body_ids]
         self.xquat[row] = d.xquat[self.body_ids]
+        self._stepped(row)
+
+    def _stepped(self, row: int) -> None:
+        """Row `row`'s poses are in `xpos` / `xquat` again (placed or recomputed)."""
+        if self.shown is not None:
+            self.shown[row] = False
 
     # -- per frame -----------------------------------------------------------------
     def sync(self, transforms: TransformStore) -> None:
         """Every row's body poses into the Transform store (one scatter per field, or one
-        copy when the rows are consecutive)."""
+        copy when the rows are consecutive), but those the replay wrote there (`shown`)."""
         span = self.body_span()
-        shown, self.shown = self.shown, None
-        if span is not None:
-            if shown is not None and len(shown) == len(self.members):
-                others = np.flatnonzero(~shown)  # the replayed rows are there already
+        shown = self.shown
+        if shown is not None and self.shown_in is transforms and len(shown) == len(self):
+            others = np.flatnonzero(~shown)  # the replayed rows are there already
+            if span is not None:
                 pos, quat = self.store_rows(transforms)
                 pos[others], quat[others] = self.xpos[others], self.xquat[others]
-                return
+            else:
+                rows = self.body_rows[others]
+                transforms.pos[rows], transforms.quat[rows] = self.xpos[others], self.xquat[others]
+            return
+        if span is not None:
             transforms.pos[span] = self.xpos.reshape(-1, 3)
             transforms.quat[span] = self.xquat.reshape(-1, 4)
             return
@@ -336,6 +361,35 @@ class Batch:
         else:
             transforms.pos[self.body_rows] = self.xpos
             transforms.quat[self.body_rows] = self.xquat
+
+    def show(self, transforms: TransformStore | None, rows: np.ndarray | None) -> None:
+        """The replay wrote the poses of `rows` (None: of no row) into `transforms` this
+        frame and not into `xpos` / `xquat` (one write, not two): `sync` leaves them,
+        `poses` and `all_poses` read them there."""
+        if transforms is None or rows is None or not len(rows):
+            self.shown, self.shown_in = None, None
+            return
+        self.shown = np.zeros(len(self), dtype=bool)
+        self.shown[rows] = True
+        self.shown_in = transforms
+
+    def poses(self, row: int) -> tuple[np.ndarray, np.ndarray]:
+        """Row `row`'s body poses as shown now, (bodies, 3) and (bodies, 4): its last
+        step's (`xpos`, `xquat`), or, replayed (`show`), its Transform store rows (copies)."""
+        if self.shown is not None and self.shown_in is not None and self.shown[row]:
+            at = self.body_rows[row]
+            return self.shown_in.pos[at], self.shown_in.quat[at]
+        return self.xpos[row].copy(), self.xquat[row].copy()
+
+    def all_poses(self) -> tuple[np.ndarray, np.ndarray]:
+        """Copies of `xpos` and `xquat` with the replayed rows (`show`) as shown: every
+        row's poses as shown now (what a snapshot keeps)."""
+        xpos, xquat = self.xpos.copy(), self.xquat.copy()
+        if self.shown is not None and self.shown_in is not None:
+            rows = np.flatnonzero(self.shown)
+            at = self.body_rows[rows]
+            xpos[rows], xquat[rows] = self.shown_in.pos[at], self.shown_in.quat[at]
+        return xpos, xquat
 
     def store_rows(self, transforms: TransformStore) -> tuple[np.ndarray, np.ndarray]:
         """The Transform store's pos and quat of this batch's bodies as (rows, bodies, 3)

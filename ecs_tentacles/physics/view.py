@@ -69,12 +69,13 @@ class StateView:
 
     @property
     def xpos(self) -> np.ndarray:
-        """World positions by MuJoCo body id (the creature's bodies; others zero)."""
-        return self._by_body_id(self._batch.xpos[self._row], 3)
+        """World positions by MuJoCo body id (the creature's bodies; others zero), as
+        shown now (replayed: as the replay placed them)."""
+        return self._by_body_id(self._batch.poses(self._row)[0], 3)
 
     @property
     def xquat(self) -> np.ndarray:
-        return self._by_body_id(self._batch.xquat[self._row], 4)
+        return self._by_body_id(self._batch.poses(self._row)[1], 4)
 
     def _by_body_id(self, values: np.ndarray, width: int) -> np.ndarray:
         out = np.zeros((self._batch.model.nbody, width))

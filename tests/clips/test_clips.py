@@ -231,3 +231,11 @@ def test_poses_written_into_rows_of_a_batch_array_are_the_poses_evaluated(
     np.testing.assert_array_equal(batch_quat[rows], quat)
     others = np.setdiff1d(np.arange(100), rows)
     assert (batch_pos[others] == 7.0).all() and (batch_quat[others] == 7.0).all()  # untouched
+    # through a batch's store rows (Batch.body_rows), in no order: the store's rows
+    body_rows = rng.permutation(100 * bodies).reshape(100, bodies)
+    store_pos, store_quat = np.full((100 * bodies, 3), 7.0), np.full((100 * bodies, 4), 7.0)
+    clips.evaluate(kind, phase, xy, heading, store_pos, store_quat, rows=rows,
+                   body_rows=body_rows)  # fmt: skip
+    np.testing.assert_array_equal(store_pos[body_rows[rows]], pos)
+    np.testing.assert_array_equal(store_quat[body_rows[rows]], quat)
+    assert (store_pos[body_rows[others]] == 7.0).all()

@@ -1,15 +1,16 @@
-"""Replay: the clip frame a creature starts from (the kernel is numpy's), poses into the store."""
+"""Replay: the clip frame a creature starts from (the kernel is numpy's), poses written once
+into the store (read back from the batches, kept by snapshots)."""
 
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any
 
 import numpy as np
 import pytest
 from numpy.testing import assert_array_equal
 
 from ecs_tentacles.clips import replay
+from ecs_tentacles.physics.tiers import KINEMATIC
 from ecs_tentacles.world import World
 
 
@@ -32,42 +33,88 @@ def test_the_nearest_frame_kernel_picks_numpys_frames(monkeypatch: pytest.Monkey
     assert (found[0][10:] == picked[10:]).mean() > 0.9  # a small nudge keeps its frame
 
 
-def test_poses_written_into_the_store_by_the_replay_are_the_syncs(
-    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
+HILLS = {"size": [40, 40], "resolution": 64, "height": 0.3, "noise": {"seed": 3, "scale": 6.0}}
+
+
+def _replayed_run(world: World, frames: int) -> list[tuple[np.ndarray, ...]]:
+    """Per frame: the Transform store's poses, every batch's poses as shown (what a
+    snapshot keeps) and each replayed creature's poses read back from its batch."""
+    run = []
+    for _ in range(frames):
+        world.step(1)
+        shown = [np.concatenate([p.ravel() for p in b.all_poses()]) for b in world.physics.batches]
+        each = []
+        for index in np.flatnonzero(world.physics.tier == KINEMATIC).tolist():
+            batch, row = world.physics.roster.locate(index)
+            each.extend(batch.poses(row))
+        run.append((world.transforms.pos.copy(), world.transforms.quat.copy(), *shown, *each))
+    return run
+
+
+@pytest.mark.parametrize("crowd", ["uniform", "varied", "terrain"])
+def test_replayed_poses_written_once_are_the_poses_the_sync_copied(
+    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch, crowd: str
 ) -> None:
-    """On the plane a uniform crowd's replayed poses go into the Transform store in the
-    replay's own pass (the sync then copies the stepped rows only): the same poses,
-    bit for bit, in the store and in the batch, as when the sync copied them all."""
+    """A replayed creature's poses are written into the Transform store only, not into
+    its batch's pose rows for the sync to copy: the store holds the same bits every
+    frame as before, whether a batch's store rows are consecutive (a uniform crowd) or
+    not (several morphologies, a creature spawned and one despawned), on the plane or
+    draped over terrain; read back from the batch (`Batch.poses`, `Batch.all_poses`)
+    they are the poses the batch held."""
     from ecs_tentacles.creator.crowd import crowd_scene
+
+    scene = crowd_scene(6, seed=2, uniform=crowd != "varied")
+    scene.setdefault("physics", {})["lod"] = {"full": 0, "reduced": 2, "hold_seconds": 0.1}
+    if crowd == "terrain":
+        scene["terrain"] = {"heightfield": HILLS}
+    runs = []
+    for direct in (False, True):  # the old path first: poses into the batches, synced
+        monkeypatch.setattr(replay, "DIRECT", direct)
+        world = make_world(scene)
+        if crowd == "varied":  # one more of the first morphology: its rows after the others'
+            late = {**scene["creatures"][0], "name": "late", "goals": []}
+            world.spawn(late, position=(12.0, 12.0))
+        consecutive = [b.body_span() is not None for b in world.physics.batches]
+        assert all(consecutive) if crowd != "varied" else not all(consecutive)
+        run = _replayed_run(world, 30)
+        if crowd == "varied":  # a replayed creature leaves: the rows after it move up
+            replayed = np.flatnonzero(world.physics.tier == KINEMATIC)
+            world.despawn(int(world.physics.roster.entity[replayed[0]]))
+            run += _replayed_run(world, 10)
+        runs.append(run)
+        assert world.lod.counts()["kinematic"] >= 3
+        shown = [b.shown for b in world.physics.batches if b.shown is not None]
+        assert (sum(int(s.sum()) for s in shown) >= 3) if direct else not shown
+        if direct and crowd == "varied":  # replayed rows scattered through the store too
+            assert any(b.shown is not None and b.shown.any() for b in world.physics.batches
+                       if b.body_span() is None)  # fmt: skip
+    for old, new in zip(*runs, strict=True):
+        assert len(old) == len(new)
+        for a, b in zip(old, new, strict=True):
+            assert_array_equal(a, b)
+
+
+def test_a_snapshot_keeps_the_replayed_poses_as_shown(make_world: Callable[..., World]) -> None:
+    """The batches' pose rows of replayed creatures are not written each frame; a
+    snapshot keeps the poses shown and, restored, the world steps on bit for bit."""
+    from ecs_tentacles.creator.crowd import crowd_scene
+    from ecs_tentacles.snapshot import restore, take
 
     scene = crowd_scene(6, seed=2, uniform=True)
     scene.setdefault("physics", {})["lod"] = {"full": 0, "reduced": 2, "hold_seconds": 0.1}
-    from ecs_tentacles.physics.batch import Batch
-
-    synced, sync = [], Batch.sync
-
-    def noting(batch: Batch, transforms: Any) -> None:
-        synced.append(0 if batch.shown is None else int(batch.shown.sum()))
-        sync(batch, transforms)
-
-    monkeypatch.setattr(Batch, "sync", noting)
-    runs = []
-    for direct in (True, False):
-        synced.clear()
-        monkeypatch.setattr(replay, "DIRECT", direct)
-        world = make_world(scene)
-        (batch,) = world.physics.batches
-        assert batch.body_span() is not None  # one morphology, its bodies in a row
-        poses = []
-        for _ in range(30):
-            world.step(1)
-            poses.append(
-                (world.transforms.pos.copy(), world.transforms.quat.copy(), batch.xpos.copy())
-            )
-        assert world.lod.counts()["kinematic"] >= 3
-        assert (max(synced) >= 3) if direct else (max(synced) == 0)  # rows the sync left
-        runs.append(poses)
-    for (pos, quat, xpos), (pos0, quat0, xpos0) in zip(*runs, strict=True):
-        assert_array_equal(pos, pos0)
-        assert_array_equal(quat, quat0)
-        assert_array_equal(xpos, xpos0)
+    world = make_world(scene)
+    world.step(20)
+    (batch,) = world.physics.batches
+    saved = take(world)
+    kept = saved.physics.poses[0]
+    rows = np.flatnonzero(world.physics.tier[batch.members] == KINEMATIC)
+    assert len(rows) >= 3
+    assert_array_equal(kept[0][rows], world.transforms.pos[batch.body_rows[rows]])
+    assert_array_equal(kept[1][rows], world.transforms.quat[batch.body_rows[rows]])
+    ahead = _replayed_run(world, 10)
+    restore(world, saved)
+    assert batch.shown is None  # every row's poses are the batch's again, as saved
+    assert_array_equal(batch.xpos, kept[0])
+    for first, again in zip(ahead, _replayed_run(world, 10), strict=True):
+        for a, b in zip(first, again, strict=True):
+            assert_array_equal(a, b)

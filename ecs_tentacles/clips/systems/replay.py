@@ -2,8 +2,8 @@
 
 Reads: the physics roster's tiers, each kinematic creature's morphology clips and the
 plugins' travel targets (`Plugin.travel_targets`). Writes: the kinematic creatures'
-body poses in their physics batch (copied into the Transform store by
-`physics_sync`, like every other creature's). Registers its replay with the level of
+body poses, straight into the Transform store (their batch rows say so, `Batch.show`:
+`physics_sync` copies only the stepped creatures' poses). Registers its replay with the level of
 detail when it joins a world, so demotions to KINEMATIC become possible
 (`ecs_tentacles.clips.replay`; on terrain the clips are draped over the heightfield).
 """

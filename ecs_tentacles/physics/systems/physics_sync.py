@@ -2,7 +2,7 @@
 
 Reads: every batch's body poses after the step (`physics.batch`: xpos, xquat).
 Writes: Transform store (pos, quat) of every mantle and link, one scatter per batch
-and field.
+and field, but those of replayed creatures (`lod_replay` wrote them there already).
 """
 
 from __future__ import annotations
