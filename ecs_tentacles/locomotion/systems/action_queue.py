@@ -35,7 +35,7 @@ ATTACH = int(Kind.ATTACH)
 class ActionQueueSystem(System):
     name = "action_queue"
     stage = "act"
-    reads = ("action_queues", "suckers.attached", "tentacles.tip_sucker")
+    reads = ("action_queues", "suckers.attached", "tentacles.tip_sucker", "tentacles.creature_row")
     writes = (
         "locomotion.tentacles.action",
         "locomotion.tentacles.timer",

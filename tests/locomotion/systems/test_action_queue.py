@@ -21,7 +21,7 @@ from ecs_tentacles.locomotion.actions import (
 )
 from ecs_tentacles.locomotion.params import Locomotion
 from ecs_tentacles.world import World
-from tests.conftest import creature_scene
+from tests.conftest import ByBackend, creature_scene
 
 
 def _frames(seconds: float, fps: float) -> int:
@@ -234,7 +234,7 @@ def test_interrupt_ends_an_attach_that_waits_for_its_sucker(
 
 
 def test_the_kernel_advances_the_same_actions_as_numpy_bit_for_bit(
-    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
+    worlds_by_backend: ByBackend,
 ) -> None:
     """A crowd crawling, some of it replayed (its actions pause): the same timers,
     actions and poses with numba's one pass and with numpy's whole-array steps."""
@@ -242,12 +242,11 @@ def test_the_kernel_advances_the_same_actions_as_numpy_bit_for_bit(
     from ecs_tentacles.locomotion.stores import LocomotionStores
     from ecs_tentacles.locomotion.systems.action_queue import KERNELS
     from ecs_tentacles.physics.tiers import KINEMATIC
-    from tests.conftest import worlds_by_backend
 
     assert KERNELS.get() is not None  # numba comes with the dev extra
     scene = crowd_scene(6, seed=1, uniform=True)  # one body plan: one gait clip to record
     scene.setdefault("physics", {})["lod"] = {"full": 0, "reduced": 2}
-    kernel, numpy_path = worlds_by_backend(make_world, KERNELS, monkeypatch, scene, 30)
+    kernel, numpy_path = worlds_by_backend(KERNELS, scene, 30)
     assert (kernel.physics.roster.tier == KINEMATIC).sum() >= 3  # some actions paused
     for name in ("timer", "duration", "action", "interrupted", "driving", "mode"):
         np.testing.assert_array_equal(
