@@ -1,4 +1,4 @@
-"""The herding mode's keys of the scene's `game` (`herding.schema.json` beside this
+"""The herding mode's keys of the scene's `game` (`herding/herding.schema.json` beside this
 module, `game_mode`): the schema the game layer checks a `"mode": "herding"` level
 against (`ecs_tentacles.game`, which owns the `game` key and adds `mode`).
 

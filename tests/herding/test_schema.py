@@ -48,7 +48,7 @@ def test_the_herding_plugin_needs_a_game_and_a_game_needs_the_plugin() -> None:
 
 
 def test_the_levels_schema_for_editors_is_the_assembled_one_and_every_level_is_valid() -> None:
-    """`herding.schema.json` (what the levels' "$schema" names) is `ecs-tentacles schema
+    """`herding_level.schema.json` (what the levels' "$schema" names) is `ecs-tentacles schema
     herding_1_field`'s output, and every bundled level passes it."""
     import importlib.resources
     import json
@@ -61,13 +61,13 @@ def test_the_levels_schema_for_editors_is_the_assembled_one_and_every_level_is_v
     from ecs_tentacles.scene.schema import schema_for
 
     folder = importlib.resources.files("ecs_tentacles.assets")
-    written = json.loads((folder / "schema" / "herding.schema.json").read_text())
+    written = json.loads((folder / "schema" / "herding_level.schema.json").read_text())
     first, plugins = load_scene_plugins(bundled_scene("herding_1_field"))
     assert written == scene_schema(schema_for(plugins), first, plugin_entries(plugins)), (
-        "regenerate: ecs-tentacles schema herding_1_field > assets/schema/herding.schema.json"
+        "regenerate: ecs-tentacles schema herding_1_field > assets/schema/herding_level.schema.json"
     )
     for name in ("herding_1_field", "herding_2_shore", "herding_3_maze"):
         scene = json.loads(bundled_scene(name).read_text())
-        assert scene["$schema"] == "../schema/herding.schema.json"
+        assert scene["$schema"] == "../schema/herding_level.schema.json"
         jsonschema.validate(scene, written)
         World.from_scene(scene).close()  # and it builds
