@@ -70,7 +70,9 @@ class Clip:
     def steps(self) -> np.ndarray:
         """(F,) the farthest body's move (m, ground frame) from each frame to the next; the
         last is the wrap (last frame -> first): no larger than the others once closed."""
-        return np.linalg.norm(np.roll(self.pos, -1, axis=0) - self.pos, axis=-1).max(axis=-1)
+        moves: np.ndarray = np.linalg.norm(np.roll(self.pos, -1, axis=0) - self.pos, axis=-1)
+        farthest: np.ndarray = moves.max(axis=-1)
+        return farthest
 
 
 @dataclass
@@ -332,4 +334,5 @@ def best_loop(
 def mantle_yaw(quat: np.ndarray) -> np.ndarray:
     """The heading (rad) of the x axis of rotations `quat` (..., 4) projected on the ground."""
     w, x, y, z = quat[..., 0], quat[..., 1], quat[..., 2], quat[..., 3]
-    return np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+    yaw: np.ndarray = np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+    return yaw

@@ -49,7 +49,8 @@ def nlerp(a: np.ndarray, b: np.ndarray, t: np.ndarray) -> np.ndarray:
     sign = np.where(np.sum(a * b, axis=-1) < 0.0, -1.0, 1.0)
     t = np.asarray(t, dtype=np.float64)
     q = a * (1.0 - t)[..., None] + b * (sign * t)[..., None]
-    return q / np.linalg.norm(q, axis=-1, keepdims=True)
+    unit: np.ndarray = q / np.linalg.norm(q, axis=-1, keepdims=True)
+    return unit
 
 
 def quat_power(q: np.ndarray, s: np.ndarray) -> np.ndarray:

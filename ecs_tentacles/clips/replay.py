@@ -224,7 +224,7 @@ def _mantle_frame(pos: np.ndarray, mantle: np.ndarray, yaw: np.ndarray) -> np.nd
     """Body positions (K, B, 3) relative to their mantle (K, 3), yaw (K,) turned away."""
     rel = pos - mantle[:, None, :]
     c, s = np.cos(-yaw)[:, None], np.sin(-yaw)[:, None]
-    out = rel.copy()
+    out: np.ndarray = rel.copy()
     out[..., 0] = c * rel[..., 0] - s * rel[..., 1]
     out[..., 1] = s * rel[..., 0] + c * rel[..., 1]
     return out

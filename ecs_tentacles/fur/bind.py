@@ -69,7 +69,8 @@ def make_bind(fur: FurData, rows: slice = slice(None)) -> tuple[Bind, np.ndarray
 def _unit_interval(x: np.ndarray) -> np.ndarray:
     """x clipped to [0, 1] (np.clip's overhead is large for a few controls each frame);
     NaN stays NaN and -0.0 becomes 0.0 (np.maximum's zero sign depends on the CPU)."""
-    return np.minimum(np.maximum(x, 0.0), 1.0) + 0.0
+    clipped: np.ndarray = np.minimum(np.maximum(x, 0.0), 1.0) + 0.0
+    return clipped
 
 
 def control_values(fur: FurData) -> tuple[ControlValues, np.ndarray]:

@@ -30,7 +30,7 @@ def _points_per_guide(world: Host, spec: dict[str, Any]) -> int:
     asked = [spec["groom"]["points"]]
     if world.scene is not None:
         asked += [c["fur"]["groom"]["points"] for c in world.scene["creatures"] if "fur" in c]
-    return max(asked)
+    return int(max(asked))
 
 
 def build_fur(world: Host, creature: int, spec: dict[str, Any]) -> int:

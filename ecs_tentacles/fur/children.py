@@ -158,4 +158,5 @@ def interpolated_children(
     normal = quat_rotate(quat, children.normal).astype(np.float32)
     height = np.einsum("mpk,mk->mp", offsets, normal)
     offsets -= np.minimum(height, 0.0)[:, :, None] * normal[:, None, :]  # not below the skin
-    return (root[:, None, :] + offsets).astype(np.float32)
+    points: np.ndarray = (root[:, None, :] + offsets).astype(np.float32)
+    return points

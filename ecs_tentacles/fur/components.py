@@ -54,12 +54,14 @@ class FurGuide(RowComponent):
     @property
     def points(self) -> np.ndarray:
         """World polyline (points, 3) from the last rig evaluation (float32 view)."""
-        return self.fur.curves[self.row]
+        points: np.ndarray = self.fur.curves[self.row]
+        return points
 
     @property
     def direction(self) -> np.ndarray:
         """World unit direction of the guide's root after the last rig evaluation."""
-        return self.fur.frames[self.row, 0]
+        direction: np.ndarray = self.fur.frames[self.row, 0]
+        return direction
 
 
 @dataclass(eq=False, repr=False)

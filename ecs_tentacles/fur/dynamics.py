@@ -121,7 +121,7 @@ class Strands:
             below += (pos[k, 2] - root[2]) * normal[2]
             np.minimum(below, 0.0, out=below)
             pos[k] -= below * normal
-        result = pos - rig
+        result: np.ndarray = pos - rig
         result *= self.profile * weight
         result += rig
         return result

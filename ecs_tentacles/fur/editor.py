@@ -62,12 +62,14 @@ class FurEditor:
             raise ValueError("no creature with fur is selected")
         for spec in self.scene["creatures"]:
             if spec["name"] == self.creature:
-                return spec
+                found: dict[str, Any] = spec
+                return found
         raise KeyError(f"no creature named {self.creature!r} in the scene")
 
     def fur_spec(self) -> dict[str, Any]:
         """The selected creature's `fur` entry of the document."""
-        return self._creature_spec()["fur"]
+        fur: dict[str, Any] = self._creature_spec()["fur"]
+        return fur
 
     def control_names(self) -> list[str]:
         """Every control of the selected creature, mirrored twins after their originals."""

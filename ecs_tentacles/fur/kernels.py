@@ -67,7 +67,9 @@ def _compiled(func: Callable[..., Any]) -> tuple[Any, Any]:
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _capped(vx, vy, vz, tan_min, weight):
+def _capped(
+    vx: np.float32, vy: np.float32, vz: np.float32, tan_min: np.float32, weight: np.float32
+) -> tuple[np.float32, np.float32, np.float32]:
     """weight * unit(clamp(unit(v))): `rig.clamp_to_cap` in skin coordinates, weighted."""
     length = math.sqrt(vx * vx + vy * vy + vz * vz)
     inv = ONE / (length if length > TINY else TINY)
@@ -79,20 +81,20 @@ def _capped(vx, vy, vz, tan_min, weight):
 
 
 def _blend(
-    control,
-    table,
-    rest_cos,
-    rest_sin,
-    tan_min,
-    multiplier,
-    basis,
-    root,
-    normalise,
-    axis,
-    flat,
-    unlift,
-    angle,
-):
+    control: np.ndarray,
+    table: np.ndarray,
+    rest_cos: np.ndarray,
+    rest_sin: np.ndarray,
+    tan_min: np.ndarray,
+    multiplier: np.ndarray,
+    basis: np.ndarray,
+    root: np.ndarray,
+    normalise: bool,
+    axis: np.ndarray,
+    flat: np.ndarray,
+    unlift: np.ndarray,
+    angle: np.ndarray,
+) -> None:
     """Pass 1: blended axis (3, n) in skin coordinates; lift and twist inputs (n,).
 
     `normalise`: make the blend a unit vector (when no lift does it).
@@ -136,7 +138,7 @@ def _blend(
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _pose_guide(shape_h, frames, out, g):
+def _pose_guide(shape_h: np.ndarray, frames: np.ndarray, out: np.ndarray, g: int) -> None:
     """Guide g's points: rest-frame coordinates x its world frame (float32, fixed order)."""
     for p in range(shape_h.shape[1]):
         x, y, z = shape_h[g, p, 0], shape_h[g, p, 1], shape_h[g, p, 2]
@@ -147,24 +149,24 @@ def _pose_guide(shape_h, frames, out, g):
 
 
 def _frames(
-    axis,
-    flat,
-    polar_sin,
-    polar_cos,
-    twist_cos,
-    twist_sin,
-    lifting,
-    twisting,
-    basis,
-    root,
-    body,
-    rotation,
-    position,
-    local,
-    world,
-    shape_h,
-    curves,
-):
+    axis: np.ndarray,
+    flat: np.ndarray,
+    polar_sin: np.ndarray,
+    polar_cos: np.ndarray,
+    twist_cos: np.ndarray,
+    twist_sin: np.ndarray,
+    lifting: bool,
+    twisting: bool,
+    basis: np.ndarray,
+    root: np.ndarray,
+    body: np.ndarray,
+    rotation: np.ndarray,
+    position: np.ndarray,
+    local: np.ndarray,
+    world: np.ndarray,
+    shape_h: np.ndarray,
+    curves: np.ndarray,
+) -> None:
     """Pass 3: lift, twist, side, up; body-local frames (4, 3, n) into `local` and/or
     world frames (n, 4, 3) into `world`, posed into `curves` (n, points, 3) (a
     zero-length array skips any of them)."""
@@ -223,15 +225,27 @@ def _frames(
                 _pose_guide(shape_h, world, curves, g)
 
 
-def _pose(shape_h, frames, out):
+def _pose(shape_h: np.ndarray, frames: np.ndarray, out: np.ndarray) -> None:
     """World points (n, points, 3): rest-frame coordinates x world frame, guide by guide."""
     for g in prange(shape_h.shape[0]):
         _pose_guide(shape_h, frames, out, g)
 
 
 def _strands(
-    pos, prev, fresh, curves, frames, rows, normal, weight, keep, pull, gravity, segment, profile
-):
+    pos: np.ndarray,
+    prev: np.ndarray,
+    fresh: np.ndarray,
+    curves: np.ndarray,
+    frames: np.ndarray,
+    rows: np.ndarray,
+    normal: np.ndarray,
+    weight: np.ndarray,
+    keep: np.ndarray,
+    pull: np.ndarray,
+    gravity: np.ndarray,
+    segment: np.ndarray,
+    profile: np.ndarray,
+) -> None:
     """One Verlet step of the strands toward the rig's curves, blended in place.
 
     `pos`, `prev` (points, 3, m) and `fresh` (m,) are `Strands`' state; strand g is

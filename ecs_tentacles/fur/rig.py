@@ -211,7 +211,8 @@ def _clamp(x: np.ndarray, y: np.ndarray, z: np.ndarray, tan_min: np.ndarray) -> 
 
 def _to_skin(bind: Bind, v: np.ndarray) -> np.ndarray:
     """Body-local vectors (3, n) in each guide's skin basis: rows along, side, normal."""
-    return np.einsum("in,jin->jn", v, bind.basis)
+    skin: np.ndarray = np.einsum("in,jin->jn", v, bind.basis)
+    return skin
 
 
 def skin_directions(bind: Bind, values: ControlValues) -> tuple[Coords, Coords | None]:

@@ -30,7 +30,8 @@ def _ring(axis: int, n: int = 16) -> np.ndarray:
 def _cube() -> np.ndarray:
     corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], float)
     edges = [(a, b) for a in range(8) for b in range(a + 1, 8) if bin(a ^ b).count("1") == 1]
-    return corners[np.array(edges)] * 0.8
+    lines: np.ndarray = corners[np.array(edges)] * 0.8
+    return lines
 
 
 def _diamond() -> np.ndarray:

@@ -74,7 +74,8 @@ class Timeline:
         if editor.control is None:
             return False
         within = self.sandbox.world.settings.dt
-        return editor.delete_key(editor.control, ATTRIBUTES[self.attribute], self.time, within)
+        deleted = editor.delete_key(editor.control, ATTRIBUTES[self.attribute], self.time, within)
+        return bool(deleted)
 
     def draw(self, gui: Gui, left: float) -> None:
         """The window, from x = `left` to the window's right edge, at the bottom."""

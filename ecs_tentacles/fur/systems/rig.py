@@ -35,7 +35,8 @@ import numpy as np
 from ecs_tentacles.fur.bind import ControlTracks, control_plan, make_strands
 from ecs_tentacles.fur.blocks import BLOCK, BindBlocks, Block
 from ecs_tentacles.fur.dynamics import Strands
-from ecs_tentacles.fur.rig import Bind, Plan, RigBuffers, evaluate, use_parallel
+from ecs_tentacles.fur.rig import Bind, Plan, evaluate, use_parallel
+from ecs_tentacles.fur.scratch import RigBuffers
 from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.fur.vectors import quat_matrices
 from ecs_tentacles.numeric.keyframes import TrackSet
