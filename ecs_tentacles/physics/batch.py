@@ -28,8 +28,8 @@ from typing import TYPE_CHECKING
 import mujoco
 import numpy as np
 
-from ecs_tentacles.numeric.optional_kernels import OptionalKernels
 from ecs_tentacles.numeric.rows import run_slice, without_row
+from ecs_tentacles.physics.batch_poses import BatchPoses
 from ecs_tentacles.physics.model import (
     PROXY_CAPSULES,
     PROXY_CYLINDERS,
@@ -48,10 +48,6 @@ if TYPE_CHECKING:
     from ecs_tentacles.physics.reduced import ReducedModel
     from ecs_tentacles.store import TransformStore
 
-# the poses' scatter by numba when installed (`physics.frame_kernels`); =numpy: numpy
-FRAME_KERNELS = OptionalKernels(
-    "ecs_tentacles.physics.frame_kernels", "ECS_TENTACLES_PHYSICS_FRAME"
-)
 WARNING_KINDS = len(mujoco.MjData(mujoco.MjModel.from_xml_string("<mujoco/>")).warning)
 
 
@@ -59,7 +55,7 @@ def _ids(model: mujoco.MjModel, kind: mujoco.mjtObj, names: list[str]) -> np.nda
     return np.array([mujoco.mj_name2id(model, kind, n) for n in names], dtype=np.int64)
 
 
-class Batch:
+class Batch(BatchPoses):
     """The creatures of one morphology: a shared model and their rows of state."""
 
     def __init__(
@@ -135,9 +131,6 @@ class Batch:
         self.shown: np.ndarray | None = None
         self.shown_in: TransformStore | None = None
 
-    def __len__(self) -> int:
-        return len(self.members)
-
     # the per-row arrays, in the order `append` and `remove` treat them
     PER_ROW = ("body_rows", "actuator_motor_rows", "actuator_target_index", "sucker_rows",
                "members", "state", "kp", "kv", "torque", "anchor", "proxy_size", "near",
@@ -185,15 +178,6 @@ class Batch:
         self.applied = {r - (r > row): f for r, f in self.applied.items() if r != row}
         self.errors = {r - (r > row): e for r, e in self.errors.items() if r != row}
         self._follow_shown(row)
-
-    def _follow_shown(self, row: int | None) -> None:
-        """`shown` after `append` (row None: a new row, not shown) or `remove(row)`."""
-        if self.shown is None:
-            return
-        if row is None:
-            self.shown = np.append(self.shown, False)
-        else:
-            self.shown = np.delete(self.shown, row)
 
     def renumber(self, moved: dict[str, np.ndarray]) -> None:
         """Store rows moved (`ArrayStore.remove`'s answers by store name): follow them."""
@@ -329,86 +313,6 @@ class Batch:
         self.xpos[row] = d.xpos[self.body_ids]
         self.xquat[row] = d.xquat[self.body_ids]
         self._stepped(row)
-
-    def _stepped(self, row: int) -> None:
-        """Row `row`'s poses are in `xpos` / `xquat` again (placed or recomputed)."""
-        if self.shown is not None:
-            self.shown[row] = False
-
-    # -- per frame -----------------------------------------------------------------
-    def sync(self, transforms: TransformStore) -> None:
-        """Every row's body poses into the Transform store (one scatter per field, or one
-        copy when the rows are consecutive), but those the replay wrote there (`shown`)."""
-        span = self.body_span()
-        shown = self.shown
-        if shown is not None and self.shown_in is transforms and len(shown) == len(self):
-            others = np.flatnonzero(~shown)  # the replayed rows are there already
-            if span is not None:
-                pos, quat = self.store_rows(transforms)
-                pos[others], quat[others] = self.xpos[others], self.xquat[others]
-            else:
-                rows = self.body_rows[others]
-                transforms.pos[rows], transforms.quat[rows] = self.xpos[others], self.xquat[others]
-            return
-        if span is not None:
-            transforms.pos[span] = self.xpos.reshape(-1, 3)
-            transforms.quat[span] = self.xquat.reshape(-1, 4)
-            return
-        fast = FRAME_KERNELS.get()
-        if fast is not None:  # the same copies, without numpy's indexing
-            fast.scatter_poses(self.body_rows, self.xpos, self.xquat, transforms.pos,
-                               transforms.quat)  # fmt: skip
-        else:
-            transforms.pos[self.body_rows] = self.xpos
-            transforms.quat[self.body_rows] = self.xquat
-
-    def show(self, transforms: TransformStore | None, rows: np.ndarray | None) -> None:
-        """The replay wrote the poses of `rows` (None: of no row) into `transforms` this
-        frame and not into `xpos` / `xquat` (one write, not two): `sync` leaves them,
-        `poses` and `all_poses` read them there."""
-        if transforms is None or rows is None or not len(rows):
-            self.shown, self.shown_in = None, None
-            return
-        self.shown = np.zeros(len(self), dtype=bool)
-        self.shown[rows] = True
-        self.shown_in = transforms
-
-    def poses(self, row: int) -> tuple[np.ndarray, np.ndarray]:
-        """Row `row`'s body poses as shown now, (bodies, 3) and (bodies, 4): its last
-        step's (`xpos`, `xquat`), or, replayed (`show`), its Transform store rows (copies)."""
-        if self.shown is not None and self.shown_in is not None and self.shown[row]:
-            at = self.body_rows[row]
-            return self.shown_in.pos[at], self.shown_in.quat[at]
-        return self.xpos[row].copy(), self.xquat[row].copy()
-
-    def all_poses(self) -> tuple[np.ndarray, np.ndarray]:
-        """Copies of `xpos` and `xquat` with the replayed rows (`show`) as shown: every
-        row's poses as shown now (what a snapshot keeps)."""
-        xpos, xquat = self.xpos.copy(), self.xquat.copy()
-        if self.shown is not None and self.shown_in is not None:
-            rows = np.flatnonzero(self.shown)
-            at = self.body_rows[rows]
-            xpos[rows], xquat[rows] = self.shown_in.pos[at], self.shown_in.quat[at]
-        return xpos, xquat
-
-    def store_rows(self, transforms: TransformStore) -> tuple[np.ndarray, np.ndarray]:
-        """The Transform store's pos and quat of this batch's bodies as (rows, bodies, 3)
-        and (rows, bodies, 4) views, like `xpos` and `xquat` (only when `body_span` is
-        a slice: a uniform crowd's batch)."""
-        span = self.body_span()
-        if span is None:
-            raise ValueError("the batch's bodies are not consecutive rows of the store")
-        shape = self.xpos.shape[:2]
-        return transforms.pos[span].reshape(*shape, 3), transforms.quat[span].reshape(*shape, 4)
-
-    def body_span(self) -> slice | None:
-        """`body_rows` (rows, bodies) as one slice of store rows when they are consecutive
-        in row order, else None; found again only when `body_rows` was replaced."""
-        rows = self.body_rows
-        if self._span_of is not rows:
-            self._span = run_slice(rows.ravel())
-            self._span_of = rows
-        return self._span
 
     def step_rows(self, rows: np.ndarray, substeps: int, thread: int, tier: int = FULL) -> None:
         """Advance `rows` by `substeps` steps each of `tier`'s model, on `thread`'s scratch."""

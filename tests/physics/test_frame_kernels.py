@@ -168,7 +168,7 @@ def test_the_poses_scatter_is_numpys(
     """Body poses copied into the Transform store where a batch's rows are not one run
     of store rows (several body plans, their creatures interleaved)."""
     from ecs_tentacles.creator.crowd import crowd_scene
-    from ecs_tentacles.physics import batch as batch_module
+    from ecs_tentacles.physics import batch_poses as batch_module
 
     world = make_world(crowd_scene(16, seed=2))
     world.step(2)
