@@ -24,6 +24,7 @@ from ecs_tentacles.export.replay_recording import ReplayRecorder
 from ecs_tentacles.export.track_recording import CurvesTrack, PointsTrack
 from ecs_tentacles.ground import ground_of
 from ecs_tentacles.numeric.rows import ordinals, run_slice
+from ecs_tentacles.scene.plugins import former_keys
 from ecs_tentacles.take import FORMAT, VERSION, Take, TakeError, chunks
 from ecs_tentacles.take import ground as take_ground
 from ecs_tentacles.take import replay as take_replay
@@ -64,10 +65,11 @@ def before_recording(world: World) -> None:
 
 
 def scene_sha256(scene: dict[str, Any] | None) -> str:
-    """SHA-256 of a scene's canonical JSON (sorted keys, no spaces); '' without a scene."""
+    """SHA-256 of a scene's canonical JSON (sorted keys, no spaces; plugins by the keys
+    they had first, `scene.plugins.former_keys`); '' without a scene."""
     if scene is None:
         return ""
-    text = json.dumps(scene, sort_keys=True, separators=(",", ":"))
+    text = json.dumps(former_keys(scene), sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode()).hexdigest()
 
 

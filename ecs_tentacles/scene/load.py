@@ -27,7 +27,7 @@ from ecs_tentacles.scene.defaults import plugin_config, with_defaults
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.layouts import Layouts
 from ecs_tentacles.scene.physical import physical_problems, physically_checked
-from ecs_tentacles.scene.plugins import resolve
+from ecs_tentacles.scene.plugins import current_keys, resolve
 from ecs_tentacles.scene.validate import repaired, validated
 from ecs_tentacles.untrusted.files import TooLarge, Unfit, read_regular
 from ecs_tentacles.untrusted.strict_json import DuplicateKey, strict_loads
@@ -157,6 +157,7 @@ def load_scene_plugins(
         data = read_scene_json(path)
         prefix = f"{path}: "
         scene_dir = path.resolve().parent
+    data = current_keys(data, prefix)  # a plugin's former key read as its key now
     chosen = data.get("plugins") if isinstance(data, dict) else None
     plugin_problems: list[str] = []
     plugins = resolve(
