@@ -28,7 +28,6 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ecs_tentacles import __version__
 from ecs_tentacles.export.glb import (
     ARRAY_BUFFER,
     ELEMENT_ARRAY_BUFFER,
@@ -40,6 +39,7 @@ from ecs_tentacles.export.gltf import (
     Z_UP_TO_Y_UP,
     Progress,
     add_gltf_goals,
+    document_head,
     scale_visibility,
     sucker_nodes,
     to_y_up_points,
@@ -190,13 +190,7 @@ def skinned_document(
     if ground is not None:
         nodes[0]["children"].append(ground)
     document: Document = {
-        "asset": {
-            "version": "2.0",
-            "generator": f"ecs_tentacles {__version__}",
-            "extras": {k: header[k] for k in ("scene", "scene_sha256", "seed", "fps")},
-        },
-        "scene": 0,
-        "scenes": [{"name": str(header["scene"]), "nodes": roots}],
+        **document_head(header, roots),
         "nodes": nodes,
         "meshes": meshes,
         "skins": skins,
