@@ -266,6 +266,12 @@ def _mesh(buffer: GlbBuffer, mesh: BodyMesh, name: str, material: int) -> Mesh:
         "NORMAL": buffer.add(normals, "VEC3", ARRAY_BUFFER),
     }
     indices = buffer.add(mesh.indices, "SCALAR", ELEMENT_ARRAY_BUFFER)
+    return triangle_mesh(name, attributes, indices, material)
+
+
+def triangle_mesh(name: str, attributes: dict[str, int], indices: int, material: int) -> Mesh:
+    """A mesh of one primitive: triangles (mode 4) of the accessors `attributes` and
+    `indices`, in `material`."""
     primitive: Primitive = {
         "attributes": attributes,
         "indices": indices,

@@ -44,6 +44,7 @@ from ecs_tentacles.export.gltf import (
     sucker_nodes,
     to_y_up_points,
     to_y_up_rotations,
+    triangle_mesh,
 )
 from ecs_tentacles.export.ground import add_gltf_ground
 from ecs_tentacles.export.materials import gltf_material, skin_texture, take_colours
@@ -63,7 +64,6 @@ if TYPE_CHECKING:
         Material,
         Mesh,
         Node,
-        Primitive,
         Skin,
         TargetPath,
     )
@@ -228,13 +228,7 @@ def _mesh(buffer: GlbBuffer, mesh: SkinMesh, name: str, material: int) -> Mesh:
         "WEIGHTS_0": buffer.add(weights, "VEC4", ARRAY_BUFFER),
     }
     indices = buffer.add(triangles.reshape(-1).astype(np.uint16), "SCALAR", ELEMENT_ARRAY_BUFFER)
-    primitive: Primitive = {
-        "attributes": attributes,
-        "indices": indices,
-        "material": material,
-        "mode": 4,
-    }
-    return {"name": f"{name}/skin", "primitives": [primitive]}
+    return triangle_mesh(f"{name}/skin", attributes, indices, material)
 
 
 def _channels(
