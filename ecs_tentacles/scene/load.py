@@ -149,15 +149,15 @@ def load_scene_plugins(
     default: the current folder). The physical checks lay the creatures out in
     `layouts` (the loader's, which the build then reuses).
     """
+    # (a plugin's former key in `plugins` is read as its key now, with a warning)
     if isinstance(source, dict):
-        data: object = source
+        data: object = current_keys(source)
         prefix = ""
     else:
         path = pathlib.Path(source)
-        data = read_scene_json(path)
+        data = current_keys(read_scene_json(path), path)
         prefix = f"{path}: "
         scene_dir = path.resolve().parent
-    data = current_keys(data, prefix)  # a plugin's former key read as its key now
     chosen = data.get("plugins") if isinstance(data, dict) else None
     plugin_problems: list[str] = []
     plugins = resolve(

@@ -103,11 +103,11 @@ def _renamed_on(path: tuple[str, ...]) -> tuple[tuple[str, str], ...]:
     return tuple((e.name, e.value) for e in every if _distribution(e) == DISTRIBUTION)
 
 
-def current_keys(scene: object, where: str) -> object:
+def current_keys(scene: object, path: pathlib.Path | None = None) -> object:
     """`scene` with each former plugin key in its `plugins` under the key the plugin has
     now (`renamed()`; a new dict, `scene` untouched), and one `FutureWarning` a key
-    naming `where` (the scene's file) and both keys. Where a scene has both, the new
-    key's value is kept."""
+    naming both keys, issued at the scene file `path`, on the key's line (else at the
+    caller). Where a scene has both keys, the new key's value is kept."""
     if not isinstance(scene, dict) or not isinstance(scene.get("plugins"), dict):
         return scene
     chosen: dict[str, Any] = scene["plugins"]
@@ -121,13 +121,22 @@ def current_keys(scene: object, where: str) -> object:
             current.setdefault(key, value)
             continue
         kept = "ignored: plugins." + new + " is set too" if new in chosen else "read as such"
-        warnings.warn(
-            f"{where}plugins.{key} is deprecated: the plugin is now plugins.{new} ({kept})",
-            FutureWarning,
-            stacklevel=3,
-        )
+        message = f"plugins.{key} is deprecated: the plugin is now plugins.{new} ({kept})"
+        if path is None:
+            warnings.warn(message, FutureWarning, stacklevel=3)
+        else:
+            warnings.warn_explicit(message, FutureWarning, str(path), _line_of(path, key))
         current[new] = chosen.get(new, value)
     return {**scene, "plugins": current}
+
+
+def _line_of(path: pathlib.Path, key: str) -> int:
+    """The line of `path` where `plugins.<key>` is written (the first `"key"` from the
+    line that opens `plugins`; 1 if not found)."""
+    lines = path.read_text(encoding="utf-8", errors="replace").splitlines()
+    start = next((i for i, line in enumerate(lines) if '"plugins"' in line), 0)
+    found = (i for i, line in enumerate(lines[start:], start) if f'"{key}"' in line)
+    return next(found, 0) + 1
 
 
 def former_keys(scene: dict[str, Any]) -> dict[str, Any]:

@@ -215,11 +215,10 @@ def test_a_scene_with_the_clips_plugins_former_key_loads_with_one_warning() -> N
         keys = [p.key for p in world.plugins]
     assert "clips" not in keys and "lod" not in keys  # plugins.lod: false turned it off
     assert "physics_health" in world.schedule.names
-    [warning] = caught
-    message = str(warning.message)
-    assert message == (
-        f"{OLD_KEY_SCENE}: plugins.lod is deprecated: the plugin is now plugins.clips"
-        " (read as such)"
+    [warning] = caught  # one, at the file's line that names the old key
+    assert (warning.filename, warning.lineno) == (str(OLD_KEY_SCENE), 5)
+    assert str(warning.message) == (
+        "plugins.lod is deprecated: the plugin is now plugins.clips (read as such)"
     )
     assert world.scene is not None and world.scene["plugins"]["clips"] is False
 
