@@ -94,13 +94,8 @@ def sandbox_on() -> tuple[str, ...]:
 
 def renamed() -> dict[str, str]:
     """The scene keys the engine's plugins had before -> their keys now."""
-    return dict(_renamed_on(tuple(sys.path)))
-
-
-@functools.lru_cache(maxsize=8)
-def _renamed_on(path: tuple[str, ...]) -> tuple[tuple[str, str], ...]:
-    every = importlib.metadata.entry_points().select(group=RENAMED_GROUP)
-    return tuple((e.name, e.value) for e in every if _distribution(e) == DISTRIBUTION)
+    every = _entry_points_on(tuple(sys.path))
+    return {e.name: e.value for e in every if e.group == RENAMED_GROUP and e.ours}
 
 
 def current_keys(scene: object, path: pathlib.Path | None = None) -> object:
@@ -169,8 +164,8 @@ class Entry:
 
 
 def _entry_points() -> tuple[Entry, ...]:
-    """Every installed plugin entry point, of every group."""
-    return _entry_points_on(tuple(sys.path))
+    """Every installed plugin entry point, of every group (`GROUPS`)."""
+    return tuple(e for e in _entry_points_on(tuple(sys.path)) if e.group != RENAMED_GROUP)
 
 
 @functools.lru_cache(maxsize=8)
@@ -178,7 +173,7 @@ def _entry_points_on(path: tuple[str, ...]) -> tuple[Entry, ...]:
     # read once per import path, and each distribution's name once (it is parsed from
     # the distribution's whole METADATA, the engine's README included)
     every = importlib.metadata.entry_points()  # one pass over the installed packages
-    found = [e for group in GROUPS for e in every.select(group=group)]
+    found = [e for group in (*GROUPS, RENAMED_GROUP) for e in every.select(group=group)]
     names: dict[int, str] = {}
     for entry in found:
         dist = getattr(entry, "dist", None)
