@@ -104,6 +104,9 @@ class Renderer:
         # the clean view: none of the editor's aids (overlay entries, selection rings)
         self.clean = False
         self.show_tiers = False  # a marker per creature coloured by physics tier (render.tiers)
+        # pixels on the picture's left that an opaque panel drawn after the world covers
+        # (the sandbox's HUD): the world is not drawn there (`draw`)
+        self.covered_left = 0
         self.state: dict[str, Any] = {}  # what plugins keep here (GL objects), across worlds
         self.palette = "natural"  # the creatures' colours (`ecs_tentacles.skin.colours`)
         self.set_world(world)
@@ -361,6 +364,10 @@ class Renderer:
         """Render into the off-screen target; returns the number of draw calls."""
         pos, quat = self._posed(alpha)
         self.target.bind()
+        covered = min(max(int(self.covered_left), 0), self.target.width)
+        if covered:  # what the panel hides is neither cleared nor drawn (scissored off)
+            gl.glEnable(gl.GL_SCISSOR_TEST)
+            gl.glScissor(covered, 0, self.target.width - covered, self.target.height)
         gl.glClearColor(*SKY, 1.0)
         gl.glClear(gl.GL_COLOR_BUFFER_BIT | gl.GL_DEPTH_BUFFER_BIT)
         gl.glEnable(gl.GL_DEPTH_TEST)
@@ -420,6 +427,7 @@ class Renderer:
             calls += draw(self.world, self.render_view)
         gl.glBindVertexArray(0)
         gl.glUseProgram(0)
+        gl.glDisable(gl.GL_SCISSOR_TEST)
         self.draw_calls = calls
         return calls
 
