@@ -36,7 +36,7 @@ from ecs_tentacles.render.decals import QUAD, SUCKER_DISC, shadow_instances, suc
 from ecs_tentacles.render.gpu import (
     INSTANCE_FLOATS,
     InstancedMesh,
-    Lines,
+    SegmentRibbons,
     Target,
     program,
     set_matrix,
@@ -44,7 +44,8 @@ from ecs_tentacles.render.gpu import (
 from ecs_tentacles.render.horizon import HORIZON, fog_range
 from ecs_tentacles.render.instances import CreatureStatic, creature_links, link_instances
 from ecs_tentacles.render.meshes import CAPSULE_LODS, CYLINDER_LOD, SPHERE_LOD
-from ecs_tentacles.render.outlines import outlined_ribbons
+from ecs_tentacles.render.outlines import INSTANCE_FLOATS as RIBBON_FLOATS
+from ecs_tentacles.render.outlines import RIBBON_VERTEX, ribbon_instances
 from ecs_tentacles.render.registries import (
     Draws,
     FramedPoints,
@@ -83,7 +84,7 @@ class Renderer:
         self.target = Target(width, height)
         self.camera = OrbitCamera(width, height)
         self.lit = program(shaders.INSTANCED_VERTEX, shaders.LIT_FRAGMENT)
-        self.line_program = program(shaders.LINE_VERTEX, shaders.LINE_FRAGMENT)
+        self.line_program = program(RIBBON_VERTEX, shaders.LINE_FRAGMENT)
         self.scenery = Scenery()  # the sky and the ground (`render.scenery`)
         self.skinned_program = program(shaders.SKINNED_VERTEX, shaders.LIT_FRAGMENT)
         self.skinned = SkinnedCreatures()
@@ -95,7 +96,8 @@ class Renderer:
         self.blob_program = program(shaders.BLOB_VERTEX, shaders.BLOB_FRAGMENT)
         self.shadows = InstancedMesh(QUAD)  # a soft blob under every mantle and link
         self.sucker_discs = InstancedMesh(SUCKER_DISC)
-        self.lines = Lines(triangles=True)  # every line as an outlined ribbon
+        # every line as an outlined ribbon: ends a and b, rgba, width in pixels
+        self.lines = SegmentRibbons(RIBBON_FLOATS, ((3, 0), (3, 3), (4, 6), (1, 10)))
         self.selected: int | None = None  # creature entity (the HUD's)
         self.selection: tuple[int, ...] = ()  # every selected creature (a ring each)
         self.draw_calls = 0
@@ -284,7 +286,7 @@ class Renderer:
             )
         )  # fmt: skip
         self.spheres.update(self._sphere_instances())
-        self.lines.update(outlined_ribbons(self._line_vertices(pos), camera.eye, per_metre))
+        self.lines.update(ribbon_instances(self._line_vertices(pos)))
 
     def view_of_frame(self, pos: np.ndarray, quat: np.ndarray) -> RenderView:
         """The `RenderView` the plugins' hooks get this frame (kept in `render_view`)."""
@@ -412,6 +414,8 @@ class Renderer:
         # over their dark edges (no depth written between them)
         self.line_program.use()
         set_matrix(self.line_program, "u_view_projection", view_projection)
+        self.line_program["u_eye"] = eye
+        self.line_program["u_per_metre"] = float(self.camera.per_metre)
         gl.glEnable(gl.GL_BLEND)
         gl.glBlendFunc(gl.GL_SRC_ALPHA, gl.GL_ONE_MINUS_SRC_ALPHA)
         gl.glDisable(gl.GL_CULL_FACE)
