@@ -378,7 +378,9 @@ class Renderer:
         eye = tuple(self.camera.eye.astype(np.float32))
         fog = fog_range(self.camera.distance)
         ground = ground_of(self.world)
-        calls = self.scenery.draw(ground, view_projection, eye, LIGHT, fog, grid=not self.clean)
+        calls = self.scenery.draw_kept(
+            self.target, ground, view_projection, eye, LIGHT, fog, grid=not self.clean
+        )
         # the ground is sent to be rasterised (software GL's threads fill it while this
         # one fills the creatures' arrays: about 4 ms less of a crowd's 50 ms frame)
         gl.glFlush()
