@@ -11,6 +11,7 @@ live side by side; every World method switches to its context first.
 
 from __future__ import annotations
 
+import gc
 import os
 import pathlib
 import uuid
@@ -65,6 +66,7 @@ class World:
         self.rng = np.random.default_rng(seed)
         self.context = f"ecs_tentacles:{name}:{uuid.uuid4().hex}"
         esper.switch_world(self.context)
+        self.froze_build = False  # a crowd's build froze its objects (`close` unfreezes)
         self.transforms = TransformStore()
         self.motors = MotorStore()
         self.suckers = SuckerStore()
@@ -406,7 +408,11 @@ class World:
         raise KeyError(f"no creature named {name!r}; this world has: {names}")
 
     def close(self) -> None:
-        """Stop the physics threads and delete this world's esper context."""
+        """Stop the physics threads and delete this world's esper context; the objects
+        a crowd's build froze are the collector's again (`loading.FROZEN_CROWD`)."""
+        if self.froze_build:
+            self.froze_build = False
+            gc.unfreeze()
         if self._physics is not None:
             self._physics.close()
         if esper.current_world == self.context:

@@ -1,4 +1,5 @@
-"""Loading a scene leaves Python's garbage collector as it found it, built or refused."""
+"""Loading a scene leaves Python's garbage collector as it found it, built or refused;
+a crowd's objects frozen while its world lives."""
 
 from __future__ import annotations
 
@@ -7,6 +8,8 @@ from collections.abc import Iterator
 
 import pytest
 
+from ecs_tentacles.creator.crowd import crowd_scene
+from ecs_tentacles.creatures import loading
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.world import World
 
@@ -31,3 +34,26 @@ def test_a_collector_switched_off_stays_off(collector: None) -> None:
     gc.disable()
     with World.from_scene("octopus", threads=1):
         assert not gc.isenabled()
+
+
+def test_a_crowds_objects_are_frozen_until_it_closes(
+    collector: None, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A crowd's build leaves its objects out of the collector's walks (`gc.freeze`)
+    while the world lives; closed, they are the collector's again. A smaller world
+    freezes nothing."""
+    gc.enable()
+    assert gc.get_freeze_count() == 0
+    with World.from_scene("octopus", threads=1):  # one creature: not a crowd
+        assert gc.get_freeze_count() == 0
+    monkeypatch.setattr(loading, "FROZEN_CROWD", 2)
+    world = World.from_scene(crowd_scene(2, 0, None, uniform=True), threads=1)
+    try:
+        assert gc.isenabled()
+        frozen = gc.get_freeze_count()
+        assert frozen > 0
+        world.step(2)  # a frame's new objects are the collector's as usual
+        assert gc.get_freeze_count() <= frozen
+    finally:
+        world.close()
+    assert gc.get_freeze_count() == 0
