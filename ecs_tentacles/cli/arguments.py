@@ -91,6 +91,17 @@ def require_display(command: str) -> None:
         raise NoDisplay(f"{command}: {NoDisplay.advice(command)}")
 
 
+def add_switch(parser: argparse.ArgumentParser, name: str, on: str, off: str) -> None:
+    """`--NAME` (True, help `on`) or `--no-NAME` (False, help `off`), not both; neither:
+    None (the command decides)."""
+    either = parser.add_mutually_exclusive_group()
+    dest = name.replace("-", "_")
+    either.add_argument(
+        f"--{name}", dest=dest, action="store_const", const=True, default=None, help=on
+    )
+    either.add_argument(f"--no-{name}", dest=dest, action="store_const", const=False, help=off)
+
+
 def counted(count: int, noun: str) -> str:
     """`1 creature`, `2 creatures`, `0 goals` (nouns that take an s)."""
     return f"{count} {noun if count == 1 else noun + 's'}"

@@ -10,7 +10,7 @@ import json
 import sys
 from typing import TYPE_CHECKING, Any
 
-from ecs_tentacles.cli.arguments import frame_count, output_path, require_display
+from ecs_tentacles.cli.arguments import add_switch, frame_count, output_path, require_display
 from ecs_tentacles.cli.world_options import CODE, PHYSICS, SEED, parents, world_options
 from ecs_tentacles.scene.load import resolve_scene_path
 
@@ -107,40 +107,20 @@ def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) ->
         help="draw the HUD FACTOR times larger, in [0.5, 3] (default: as the display asks,"
         " its DPI over 96; 1 headless); either way it also grows with the window's height",
     )
-    shown = parser.add_mutually_exclusive_group()
-    shown.add_argument(
-        "--hud",
-        dest="hud",
-        action="store_const",
-        const=True,
-        default=None,
-        help="show the HUD (default: shown, except in a --video: a film has no sliders in it)",
+    add_switch(
+        parser,
+        "hud",
+        "show the HUD (default: shown, except in a --video: a film has no sliders in it)",
+        "start with the HUD hidden (h)",
     )
-    shown.add_argument(
-        "--no-hud",
-        dest="hud",
-        action="store_const",
-        const=False,
-        help="start with the HUD hidden (h)",
-    )
-    clean = parser.add_mutually_exclusive_group()
-    clean.add_argument(
-        "--clean",
-        dest="clean",
-        action="store_const",
-        const=True,
-        default=None,
-        help="the clean view, a picture for showing: none of the editor's overlays (goal"
+    add_switch(
+        parser,
+        "clean",
+        "the clean view, a picture for showing: none of the editor's overlays (goal"
         " paths and rings, selection rings and names, sucker dots, tier spheres, the fur"
         " timeline, the metre grid); default: clean in a game (a scene with a `game` key)"
         " and in a --video",
-    )
-    clean.add_argument(
-        "--no-clean",
-        dest="clean",
-        action="store_const",
-        const=False,
-        help="draw the editor's overlays, in a game or a --video too (o toggles them)",
+        "draw the editor's overlays, in a game or a --video too (o toggles them)",
     )
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
     parser.add_argument(
