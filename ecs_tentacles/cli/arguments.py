@@ -128,6 +128,20 @@ MAX_FRAMES = 10_000_000  # frames a command runs: 46 hours of simulated time at 
 MAX_SEED = 2**63 - 1
 MAX_THREADS = 256
 frame_count = bounded_int(1, MAX_FRAMES)
+
+
+def add_frames(parser: argparse.ArgumentParser, default: int, when: str = "") -> None:
+    """`--frames N` (default `default`), the frames a run steps; `when` heads its help
+    (`"headless: "`: only then)."""
+    parser.add_argument(
+        "--frames",
+        type=frame_count,
+        default=default,
+        help=f"{when}frames to run (default {default}; a level stops sooner once its game"
+        " is won or lost)",
+    )
+
+
 seed_int = bounded_int(0, MAX_SEED)
 thread_count = bounded_int(1, MAX_THREADS)
 

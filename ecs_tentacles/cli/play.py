@@ -10,7 +10,7 @@ import json
 import sys
 from typing import TYPE_CHECKING, Any
 
-from ecs_tentacles.cli.arguments import add_switch, frame_count, output_path, require_display
+from ecs_tentacles.cli.arguments import add_frames, add_switch, output_path, require_display
 from ecs_tentacles.cli.world_options import CODE, PHYSICS, SEED, parents, world_options
 from ecs_tentacles.scene.load import resolve_scene_path
 
@@ -71,12 +71,7 @@ def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) ->
     )
     parser.add_argument("scene", metavar="SCENE", help="scene file or bundled scene name")
     parser.add_argument("--headless", action="store_true", help="no window: render off-screen")
-    parser.add_argument(
-        "--frames",
-        type=frame_count,
-        default=300,
-        help="headless: frames to run (a level stops sooner once its game is won or lost)",
-    )
+    add_frames(parser, 300, "headless: ")
     parser.add_argument("--screenshot", type=output_path(".png"), help="headless: final PNG")
     parser.add_argument("--video", type=output_path(".mp4"), help="headless: record an MP4")
     parser.add_argument("--width", type=even_size, default=1280, help=f"{SIZE_RULE} (default 1280)")
