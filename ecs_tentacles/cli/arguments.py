@@ -91,6 +91,17 @@ def require_display(command: str) -> None:
         raise NoDisplay(f"{command}: {NoDisplay.advice(command)}")
 
 
+def add_switch(parser: argparse.ArgumentParser, name: str, on: str, off: str) -> None:
+    """`--NAME` (True, help `on`) or `--no-NAME` (False, help `off`), not both; neither:
+    None (the command decides)."""
+    either = parser.add_mutually_exclusive_group()
+    dest = name.replace("-", "_")
+    either.add_argument(
+        f"--{name}", dest=dest, action="store_const", const=True, default=None, help=on
+    )
+    either.add_argument(f"--no-{name}", dest=dest, action="store_const", const=False, help=off)
+
+
 def counted(count: int, noun: str) -> str:
     """`1 creature`, `2 creatures`, `0 goals` (nouns that take an s)."""
     return f"{count} {noun if count == 1 else noun + 's'}"
@@ -117,6 +128,20 @@ MAX_FRAMES = 10_000_000  # frames a command runs: 46 hours of simulated time at 
 MAX_SEED = 2**63 - 1
 MAX_THREADS = 256
 frame_count = bounded_int(1, MAX_FRAMES)
+
+
+def add_frames(parser: argparse.ArgumentParser, default: int, when: str = "") -> None:
+    """`--frames N` (default `default`), the frames a run steps; `when` heads its help
+    (`"headless: "`: only then)."""
+    parser.add_argument(
+        "--frames",
+        type=frame_count,
+        default=default,
+        help=f"{when}frames to run (default {default}; a level stops sooner once its game"
+        " is won or lost)",
+    )
+
+
 seed_int = bounded_int(0, MAX_SEED)
 thread_count = bounded_int(1, MAX_THREADS)
 

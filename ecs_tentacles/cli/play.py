@@ -10,7 +10,7 @@ import json
 import sys
 from typing import TYPE_CHECKING, Any
 
-from ecs_tentacles.cli.arguments import frame_count, output_path, require_display
+from ecs_tentacles.cli.arguments import add_frames, add_switch, output_path, require_display
 from ecs_tentacles.cli.world_options import CODE, PHYSICS, SEED, parents, world_options
 from ecs_tentacles.scene.load import resolve_scene_path
 
@@ -71,12 +71,7 @@ def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) ->
     )
     parser.add_argument("scene", metavar="SCENE", help="scene file or bundled scene name")
     parser.add_argument("--headless", action="store_true", help="no window: render off-screen")
-    parser.add_argument(
-        "--frames",
-        type=frame_count,
-        default=300,
-        help="headless: frames to run (a level stops sooner once its game is won or lost)",
-    )
+    add_frames(parser, 300, "headless: ")
     parser.add_argument("--screenshot", type=output_path(".png"), help="headless: final PNG")
     parser.add_argument("--video", type=output_path(".mp4"), help="headless: record an MP4")
     parser.add_argument("--width", type=even_size, default=1280, help=f"{SIZE_RULE} (default 1280)")
@@ -107,40 +102,20 @@ def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) ->
         help="draw the HUD FACTOR times larger, in [0.5, 3] (default: as the display asks,"
         " its DPI over 96; 1 headless); either way it also grows with the window's height",
     )
-    shown = parser.add_mutually_exclusive_group()
-    shown.add_argument(
-        "--hud",
-        dest="hud",
-        action="store_const",
-        const=True,
-        default=None,
-        help="show the HUD (default: shown, except in a --video: a film has no sliders in it)",
+    add_switch(
+        parser,
+        "hud",
+        "show the HUD (default: shown, except in a --video: a film has no sliders in it)",
+        "start with the HUD hidden (h)",
     )
-    shown.add_argument(
-        "--no-hud",
-        dest="hud",
-        action="store_const",
-        const=False,
-        help="start with the HUD hidden (h)",
-    )
-    clean = parser.add_mutually_exclusive_group()
-    clean.add_argument(
-        "--clean",
-        dest="clean",
-        action="store_const",
-        const=True,
-        default=None,
-        help="the clean view, a picture for showing: none of the editor's overlays (goal"
+    add_switch(
+        parser,
+        "clean",
+        "the clean view, a picture for showing: none of the editor's overlays (goal"
         " paths and rings, selection rings and names, sucker dots, tier spheres, the fur"
         " timeline, the metre grid); default: clean in a game (a scene with a `game` key)"
         " and in a --video",
-    )
-    clean.add_argument(
-        "--no-clean",
-        dest="clean",
-        action="store_const",
-        const=False,
-        help="draw the editor's overlays, in a game or a --video too (o toggles them)",
+        "draw the editor's overlays, in a game or a --video too (o toggles them)",
     )
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
     parser.add_argument(

@@ -15,7 +15,7 @@ import time
 from collections.abc import Callable
 from typing import Any
 
-from ecs_tentacles.cli.arguments import bounded_int, counted, frame_count
+from ecs_tentacles.cli.arguments import add_frames, bounded_int, counted
 from ecs_tentacles.cli.registries import RunSummaries, RunSummary
 from ecs_tentacles.cli.world_options import CODE, PHYSICS, SEED, parents, world_options
 from ecs_tentacles.components import Creature
@@ -38,12 +38,7 @@ def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) ->
         parents=parents(SEED, CODE, PHYSICS),
     )
     parser.add_argument("scene", metavar="SCENE", help="scene file or bundled scene name")
-    parser.add_argument(
-        "--frames",
-        type=frame_count,
-        default=600,
-        help="frames to run (default 600; a level stops sooner once its game is won or lost)",
-    )
+    add_frames(parser, 600)
     parser.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
     parser.add_argument(

@@ -148,9 +148,7 @@ def gltf_document(
             for parent, child in sucker_nodes(take, creature["name"]):
                 nodes.append(child)
                 nodes[node_of_body[parent]].setdefault("children", []).append(len(nodes) - 1)
-    ground = add_gltf_ground(take, buffer, nodes, meshes, materials, to_y_up_points)
-    if ground is not None:
-        nodes[0]["children"].append(ground)
+    add_gltf_ground(take, buffer, nodes, meshes, materials, to_y_up_points)
     document: Document = {
         **document_head(header, [0]),
         "nodes": nodes,

@@ -100,11 +100,12 @@ def add_gltf_ground(
     meshes: list[Mesh],
     materials: list[Material],
     to_y_up: Callable[[np.ndarray], np.ndarray],
-) -> int | None:
-    """Append the ground's node (and its meshes and materials); its index, or None."""
+) -> None:
+    """Append the ground's node (and its meshes and materials), a child of the document's
+    first node (both writers' scene root); nothing for a take without ground meshes."""
     found = take.ground_meshes()
     if not found:
-        return None
+        return
     root = root_name(take)
     holder = len(nodes)
     nodes.append({"name": root, "children": []})
@@ -136,4 +137,4 @@ def add_gltf_ground(
         meshes.append({"name": f"{root}/{label}", "primitives": [primitive]})
         nodes[holder]["children"].append(len(nodes))
         nodes.append({"name": f"{root}/{label}", "mesh": len(meshes) - 1})
-    return holder
+    nodes[0]["children"].append(holder)

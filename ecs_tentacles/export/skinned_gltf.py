@@ -186,9 +186,7 @@ def skinned_document(
             progress(1)
     if locators:
         add_gltf_goals(take, buffer, nodes, animation)
-    ground = add_gltf_ground(take, buffer, nodes, meshes, materials, to_y_up_points)
-    if ground is not None:
-        nodes[0]["children"].append(ground)
+    add_gltf_ground(take, buffer, nodes, meshes, materials, to_y_up_points)
     document: Document = {
         **document_head(header, roots),
         "nodes": nodes,

@@ -18,13 +18,15 @@
   `run`'s line). A result that is not `PLAYING` ends `run` and `play --headless`.
 
 - `PlayedGame` and `Referee`: what every mode's game resource and referee system share
-  (the level's start and restart, the outcome, the clock that runs while it is played).
+  (the level's start and restart, the outcome, the clock that runs while it is played);
+  `play_out`: a bot's or a replay's game played to its end, a block of frames at a time.
 
 No command, no GL: a feature imports it to register its mode.
 """
 
 from __future__ import annotations
 
+import time
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
@@ -36,6 +38,7 @@ from ecs_tentacles.system import System
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
     from ecs_tentacles.snapshot import Snapshot
+    from ecs_tentacles.world import World
 
 PLAYING, WON, LOST = "playing", "won", "lost"
 Problem = tuple[tuple[str | int, ...], str]
@@ -133,3 +136,25 @@ class Referee(System, ABC, Generic[G]):
             return
         game.state.frames += 1
         self.judge(world, game)
+
+
+def play_out(
+    world: World,
+    game: PlayedGame,
+    seconds: float,
+    every: float,
+    turn: Callable[[int], int],
+) -> tuple[float, list[float]]:
+    """Step `world` until `game` is won or lost (or `seconds` of world time and one more
+    pass), `every` seconds of frames at a time: `turn(block)` moves the player and says
+    how many frames to step (`block`, or fewer to the next replayed move). Returns the
+    wall seconds taken and each step's milliseconds per frame."""
+    block = max(1, round(every * world.settings.fps))
+    started = time.perf_counter()
+    frame_ms: list[float] = []
+    while game.outcome == PLAYING and world.time < seconds + 1.0:
+        frames = turn(block)
+        before = time.perf_counter()
+        world.step(frames)
+        frame_ms.append(1000.0 * (time.perf_counter() - before) / frames)
+    return round(time.perf_counter() - started, 2), frame_ms

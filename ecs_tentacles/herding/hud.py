@@ -22,12 +22,11 @@ from typing import TYPE_CHECKING
 from imgui_bundle import imgui
 from pyglet.window import key
 
+from ecs_tentacles.game.panel import ModePanel
 from ecs_tentacles.herding import best_times, win_recorder
 from ecs_tentacles.herding.game import LOST, WON, HerdingGame
 from ecs_tentacles.herding.hud_levels import LevelPicker
 from ecs_tentacles.herding.levels import stars_text
-from ecs_tentacles.render.registries import Panel
-from ecs_tentacles.snapshot import SnapshotMismatch
 
 if TYPE_CHECKING:
     from ecs_tentacles.render.gui import Gui
@@ -35,15 +34,13 @@ if TYPE_CHECKING:
     from ecs_tentacles.world import World
 
 
-class GamePanel(Panel):
+class GamePanel(ModePanel):
     title = "Game"
-    order = -20  # first, before the selected creature's Locomotion (-10): the game is the point
 
     def __init__(self, sandbox: SandboxView):
-        self.sandbox = sandbox
+        super().__init__(sandbox)
         self.win: win_recorder.PendingWin | None = None  # this game's win, once won
         self.writing: list[win_recorder.PendingWin] = []  # wins not written yet (any game)
-        self.message = ""
         self.best = self._best()  # read once a game, not every frame
         self.levels = LevelPicker(sandbox)
         win_recorder.start()  # now, not in the frame the game is won
@@ -51,6 +48,10 @@ class GamePanel(Panel):
     @property
     def game(self) -> HerdingGame:
         return self.sandbox.world.resource(HerdingGame)
+
+    @property
+    def played(self) -> HerdingGame:
+        return self.game
 
     def attach(self, world: World) -> None:
         self.win, self.message = None, ""
@@ -76,16 +77,12 @@ class GamePanel(Panel):
             if done.message:
                 self.message = done.message
 
-    def restart(self) -> None:
-        """Back to the level's start: its snapshot, or (when a creature was removed since)
-        the level built again from its scene."""
-        try:
-            self.game.restart(self.sandbox.world)
-        except SnapshotMismatch:
-            if self.sandbox.reset():  # `attach` follows; the Scripts window says a failure
-                self.message = "restarted: built again from the scene (a creature was removed)"
-            return
+    def restart(self) -> bool:
+        """`ModePanel.restart`, the section's win and message cleared after a snapshot's."""
+        if not super().restart():
+            return False
         self.attach(self.sandbox.world)
+        return True
 
     def next_level(self) -> bool:
         """After a win, open the next level (False: not won, or the last level)."""
@@ -147,15 +144,9 @@ class GamePanel(Panel):
         return "a new best time!" if win.new else f"best time {win.best:.1f} s"
 
     def key(self, symbol: int, modifiers: int) -> bool:
-        if symbol == key.R:
-            self.restart()
+        if super().key(symbol, modifiers):
             return True
-        if symbol == key.P:
-            self.sandbox.paused = not self.sandbox.paused
-            return True
-        if symbol == key.N:
-            return self.next_level()
-        return False
+        return symbol == key.N and self.next_level()
 
     def press(self, x: float, y: float) -> bool:
         point = self.sandbox.ground_point(x, y)

@@ -21,14 +21,14 @@ It runs (Shift) only to get somewhere far with no creature near, and walks to pu
 
 from __future__ import annotations
 
-import time
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
+from ecs_tentacles.game.modes import play_out
 from ecs_tentacles.herding.fence import Fence
-from ecs_tentacles.herding.game import PLAYING, HerdingGame
+from ecs_tentacles.herding.game import HerdingGame
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
@@ -179,31 +179,28 @@ def play(
 ) -> dict[str, Any]:
     """Play the world's level to its end; the game's summary, `log`, `wall_s`."""
     game = world.resource(HerdingGame)
-    block = max(1, round(every * world.settings.fps))
-    limit = game.seconds if max_seconds is None else max_seconds
-    started = time.perf_counter()
-    frame_ms: list[float] = []  # a frame's step (physics and every system), by block
-    while game.outcome == PLAYING and world.time < limit + 1.0:
+
+    def turn(block: int) -> int:
         if isinstance(player, Replay):
             for point in player.due(world.frame):
                 game.aim(world, point)
             for running in player.running(world.frame):
                 game.run(world, running)
-            frames = player.frames_to_next(world.frame, block)
-        else:
-            aim = player.decide(world, game)
-            if aim is not None:
-                game.aim(world, aim)
-            frames = block
-        before = time.perf_counter()
-        world.step(frames)
-        frame_ms.append(1000.0 * (time.perf_counter() - before) / frames)
+            return player.frames_to_next(world.frame, block)
+        aim = player.decide(world, game)
+        if aim is not None:
+            game.aim(world, aim)
+        return block
+
+    limit = game.seconds if max_seconds is None else max_seconds
+    # a frame's step (physics and every system), by block
+    wall_s, frame_ms = play_out(world, game, limit, every, turn)
     median = float(np.median(frame_ms)) if frame_ms else 0.0
     return {
         **game.summary(),
         "log": list(game.state.log),
         "runs": list(game.state.runs),
-        "wall_s": round(time.perf_counter() - started, 2),
+        "wall_s": wall_s,
         "frame_ms": round(median, 2),  # median over the game's blocks
         "realtime_factor": round(1000.0 * world.settings.dt / median, 2) if median else None,
     }

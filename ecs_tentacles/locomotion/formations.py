@@ -76,10 +76,22 @@ def _everywhere(points: np.ndarray) -> np.ndarray:
     return np.ones(len(points), dtype=bool)
 
 
-def _ring(count: int, centre: np.ndarray, step: float, usable: Usable) -> np.ndarray:
+def _gathered(count: int, tiers: range, pick: Callable[[int, int], np.ndarray]) -> np.ndarray:
+    """Places (k, 2) from `tiers` in turn, `pick(tier, need)` choosing at most `need` of a
+    tier's usable places, until `count` are found (fewer when the tiers run out)."""
     taken: list[np.ndarray] = []
     need = count
-    for ring in range(1, FARTHEST + 1):
+    for tier in tiers:
+        chosen = pick(tier, need)
+        taken.append(chosen)
+        need -= len(chosen)
+        if need == 0:
+            break
+    return np.vstack(taken)
+
+
+def _ring(count: int, centre: np.ndarray, step: float, usable: Usable) -> np.ndarray:
+    def pick(ring: int, need: int) -> np.ndarray:
         radius = ring * step
         places = max(1, int(np.floor(2.0 * np.pi * radius / step)))
         angle = np.arange(places) * 2.0 * np.pi / places + 0.5 * ring
@@ -87,11 +99,9 @@ def _ring(count: int, centre: np.ndarray, step: float, usable: Usable) -> np.nda
         free = on_ring[usable(on_ring)]
         if len(free) > need:  # the outermost ring: spread evenly round it
             free = free[np.floor(np.arange(need) * len(free) / need).astype(np.int64)]
-        taken.append(free)
-        need -= len(free)
-        if need == 0:
-            break
-    return np.vstack(taken)
+        return free
+
+    return _gathered(count, range(1, FARTHEST + 1), pick)
 
 
 def _line(
@@ -99,18 +109,16 @@ def _line(
 ) -> np.ndarray:
     across = np.array([-facing[1], facing[0]])
     offsets = np.arange(count) - (count - 1) / 2.0
-    taken: list[np.ndarray] = []
-    need = count
-    for row in range(2 * FARTHEST):  # rows behind (toward the group), then before, in turn
+
+    def pick(row: int, need: int) -> np.ndarray:
         back = (row + 1) // 2 if row % 2 else -(row // 2)
-        places = centre + (offsets[:, None] * across - back * facing) * step
+        places: np.ndarray = centre + (offsets[:, None] * across - back * facing) * step
         free = np.flatnonzero(usable(places))
         free = np.sort(free[np.argsort(np.abs(offsets[free]), kind="stable")][:need])
-        taken.append(places[free])  # the usable places nearest the middle, in a row
-        need -= len(free)
-        if need == 0:
-            break
-    return np.vstack(taken)
+        return places[free]  # the usable places nearest the middle, in a row
+
+    # rows behind (toward the group), then before, in turn
+    return _gathered(count, range(2 * FARTHEST), pick)
 
 
 def _grid(
@@ -128,16 +136,13 @@ def _grid(
     near = np.hypot(jj, ii)
     order = np.lexsort((near, ~in_block))  # the block first, nearest the point first
     places = places[order]
-    free: list[np.ndarray] = []
-    need = count
-    for start in range(0, len(places), 4 * count):  # a batch at a time: tests cost
-        batch = places[start : start + 4 * count]
-        kept = batch[usable(batch)][:need]
-        free.append(kept)
-        need -= len(kept)
-        if need == 0:
-            break
-    return np.vstack(free)
+
+    def pick(start: int, need: int) -> np.ndarray:
+        batch: np.ndarray = places[start : start + 4 * count]
+        return batch[usable(batch)][:need]
+
+    # a batch at a time: tests cost
+    return _gathered(count, range(0, len(places), 4 * count), pick)
 
 
 def slots(

@@ -14,38 +14,27 @@ from imgui_bundle import imgui
 from pyglet.window import key
 
 from ecs_tentacles.game.modes import LOST, WON
+from ecs_tentacles.game.panel import ModePanel
 from ecs_tentacles.race.game import RaceGame
-from ecs_tentacles.render.registries import Panel
-from ecs_tentacles.snapshot import SnapshotMismatch
 
 if TYPE_CHECKING:
     from ecs_tentacles.render.gui import Gui
-    from ecs_tentacles.render.registries import SandboxView
     from ecs_tentacles.world import World
 
 
-class RacePanel(Panel):
+class RacePanel(ModePanel):
     title = "Race"
-    order = -20  # first: the game is the point
-
-    def __init__(self, sandbox: SandboxView):
-        self.sandbox = sandbox
-        self.message = ""
 
     @property
     def race(self) -> RaceGame:
         return self.sandbox.world.resource(RaceGame)
 
+    @property
+    def played(self) -> RaceGame:
+        return self.race
+
     def attach(self, world: World) -> None:
         self.message = ""
-
-    def restart(self) -> None:
-        """Back to the level's start (built again from its scene if a creature was removed)."""
-        try:
-            self.race.restart(self.sandbox.world)
-        except SnapshotMismatch:
-            if self.sandbox.reset():
-                self.message = "restarted: built again from the scene (a creature was removed)"
 
     def draw(self, gui: Gui) -> None:
         race = self.race
@@ -71,15 +60,6 @@ class RacePanel(Panel):
             imgui.text(f"{winner} took the flag" if winner else "the time ran out")
         imgui.text("R: race again")
         imgui.end()
-
-    def key(self, symbol: int, modifiers: int) -> bool:
-        if symbol == key.R:
-            self.restart()
-            return True
-        if symbol == key.P:
-            self.sandbox.paused = not self.sandbox.paused
-            return True
-        return False
 
     def press(self, x: float, y: float) -> bool:
         point = self.sandbox.ground_point(x, y)

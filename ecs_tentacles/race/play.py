@@ -12,11 +12,10 @@ summary (`RaceGame.summary`), who took the flag, the input log and the wall time
 
 from __future__ import annotations
 
-import time
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any, Protocol
 
-from ecs_tentacles.game.modes import PLAYING
+from ecs_tentacles.game.modes import play_out
 from ecs_tentacles.race.game import RaceGame
 
 if TYPE_CHECKING:
@@ -53,24 +52,23 @@ def play(
 ) -> dict[str, Any]:
     """Run the world's race to its end; its summary, `winner`, `log`, `wall_s`."""
     race = world.resource(RaceGame)
-    block = max(1, round(every * world.settings.fps))
-    limit = race.seconds if max_seconds is None else max_seconds
-    started = time.perf_counter()
-    while race.outcome == PLAYING and world.time < limit + 1.0:
+
+    def turn(block: int) -> int:
         if isinstance(player, Replay):
             wait = player.apply(world, race)
-            frames = min(block, wait) if wait else block
-        else:
-            path = player.decide(world, race)
-            if path:
-                race.steer(world, path[0])
-                for point in path[1:]:
-                    race.steer(world, point, add=True)
-            frames = block
-        world.step(frames)
+            return min(block, wait) if wait else block
+        path = player.decide(world, race)
+        if path:
+            race.steer(world, path[0])
+            for point in path[1:]:
+                race.steer(world, point, add=True)
+        return block
+
+    limit = race.seconds if max_seconds is None else max_seconds
+    wall_s, _ = play_out(world, race, limit, every, turn)
     return {
         **race.summary(),
         "winner": race.winner_name(world),
         "log": list(race.state.log),
-        "wall_s": round(time.perf_counter() - started, 2),
+        "wall_s": wall_s,
     }

@@ -56,7 +56,7 @@ from ecs_tentacles.render.registries import (
 )
 from ecs_tentacles.render.registries import Lines as LineEntries
 from ecs_tentacles.render.rings import CIRCLE, draped
-from ecs_tentacles.render.scenery import Scenery, set_fog
+from ecs_tentacles.render.scenery import Scenery, use_lit
 from ecs_tentacles.render.skinned import SkinnedCreatures
 from ecs_tentacles.roster_change import RosterChange
 from ecs_tentacles.skin.colours import PALETTES, Look, creature_colour, look_in_world
@@ -396,20 +396,12 @@ class Renderer:
         gl.glEnable(gl.GL_CULL_FACE)
         gl.glDepthMask(gl.GL_TRUE)
         gl.glDisable(gl.GL_BLEND)
-        self.lit.use()
-        set_matrix(self.lit, "u_view_projection", view_projection)
-        self.lit["u_light"] = tuple(LIGHT.astype(np.float32))
-        self.lit["u_eye"] = eye
-        set_fog(self.lit, fog)
+        use_lit(self.lit, view_projection, LIGHT, eye, fog)
         for mesh in (self.mantles, self.links_near, self.links_far, self.spheres):
             calls += mesh.draw()
         calls += self.sucker_discs.draw()
         if self.view == "skinned":
-            self.skinned_program.use()
-            set_matrix(self.skinned_program, "u_view_projection", view_projection)
-            self.skinned_program["u_light"] = tuple(LIGHT.astype(np.float32))
-            self.skinned_program["u_eye"] = eye
-            set_fog(self.skinned_program, fog)
+            use_lit(self.skinned_program, view_projection, LIGHT, eye, fog)
             self.skinned_program["u_palette"] = 0
             calls += self.skinned.draw()
         # the ribbons: over what they lie on (pulled toward the eye), the bright cores

@@ -18,7 +18,8 @@ draws the ground every frame and keeps nothing.
 Reads the world's `Ground` (`ground_of`), the camera's view, the light; writes only the
 framebuffer bound by the caller (`Renderer.draw`) and its own GL objects. The ground's
 meshes are made again only when the world has another `Ground` (a new world, a terrain
-edit). `set_fog` puts the same fog on the renderer's other programs.
+edit). `set_fog` puts the same fog on the renderer's other programs; `use_lit` readies a lit
+surface's program (the terrain's, the creatures').
 """
 
 from __future__ import annotations
@@ -47,6 +48,22 @@ def set_fog(prog: Any, fog: tuple[float, float]) -> None:
     """The distance fog's uniforms (`render.horizon.fog_range`) on a program that fogs."""
     prog["u_fog_colour"] = HORIZON
     prog["u_fog_start"], prog["u_fog_end"] = fog
+
+
+def use_lit(
+    prog: Any,
+    view_projection: np.ndarray,
+    light: np.ndarray,
+    eye: tuple[float, ...],
+    fog: tuple[float, float],
+) -> None:
+    """Make `prog`, a lit and fogged surface's program, current with this frame's
+    view-projection, light direction, eye and fog."""
+    prog.use()
+    set_matrix(prog, "u_view_projection", view_projection)
+    prog["u_light"] = tuple(light.astype(np.float32))
+    prog["u_eye"] = eye
+    set_fog(prog, fog)
 
 
 class Scenery:
@@ -117,12 +134,8 @@ class Scenery:
             calls += self.plane.draw()
             gl.glEnable(gl.GL_CULL_FACE)
         if self.ground_meshes:  # terrain, beyond it, obstacles: lit, three draws at most
-            self.terrain_program.use()
-            set_matrix(self.terrain_program, "u_view_projection", view_projection)
-            self.terrain_program["u_light"] = tuple(light.astype(np.float32))
-            self.terrain_program["u_eye"] = eye
+            use_lit(self.terrain_program, view_projection, light, eye, fog)
             self.terrain_program["u_grid"] = float(grid)
-            set_fog(self.terrain_program, fog)
             for mesh in self.ground_meshes:
                 calls += mesh.draw()
         return calls + self.draw_sky(view_projection)

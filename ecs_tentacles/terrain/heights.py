@@ -111,14 +111,7 @@ def _image_heights(name: str, folder: pathlib.Path | None) -> np.ndarray:
 
     here = HERE + ("image",)
     path = beside_scene(name, folder, here)
-    try:  # read once, as it is now: what `beside_scene` found may have been swapped
-        data = read_regular(path, MAX_IMAGE_BYTES)
-    except TooLarge:
-        raise TerrainError(here, f"{name}: larger than {MAX_IMAGE_BYTES >> 20} MB") from None
-    except Unfit as unfit:
-        raise TerrainError(here, f"{name}: cannot read it ({unfit.reason})") from None
-    except OSError as error:
-        raise TerrainError(here, f"{name}: cannot read it ({error.strerror})") from None
+    data = read_found(path, name, here, MAX_IMAGE_BYTES)
     sides = png_size(data[:24])
     if sides is None:
         raise TerrainError(here, f"{name}: not a PNG image (its first bytes are not a PNG's)")
@@ -161,3 +154,17 @@ def beside_scene(
     if not found.is_file():
         raise TerrainError(path, f"{name}: no such file in the scene's folder ({base})")
     return found
+
+
+def read_found(path: pathlib.Path, name: str, here: tuple[str | int, ...], limit: int) -> bytes:
+    """The bytes of file `path` (scene name `name`, at JSON path `here`), read once, as it
+    is now: what `beside_scene` found may have been swapped since, so it is checked as
+    read (a regular file of at most `limit` bytes)."""
+    try:
+        return read_regular(path, limit)
+    except TooLarge:
+        raise TerrainError(here, f"{name}: larger than {limit >> 20} MB") from None
+    except Unfit as unfit:
+        raise TerrainError(here, f"{name}: cannot read it ({unfit.reason})") from None
+    except OSError as error:
+        raise TerrainError(here, f"{name}: cannot read it ({error.strerror})") from None

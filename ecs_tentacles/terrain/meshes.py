@@ -42,8 +42,7 @@ from ecs_tentacles import stops
 from ecs_tentacles.processes import python_module
 from ecs_tentacles.scene.load import MAX_SCENE_BYTES
 from ecs_tentacles.terrain import mesh_cache, mesh_worker
-from ecs_tentacles.terrain.heights import TerrainError, beside_scene
-from ecs_tentacles.untrusted.files import TooLarge, Unfit, read_regular
+from ecs_tentacles.terrain.heights import TerrainError, beside_scene, read_found
 
 MESH_SECONDS = 60.0  # per mesh: reading, checks and decomposition
 MESH_MEMORY_MB = 1024  # the worker's resident memory while it works on one mesh
@@ -197,14 +196,7 @@ class MeshReader:
         path = beside_scene(name, self.folder, here)
         if path.suffix.lower() not in MESH_SUFFIXES:
             raise TerrainError(here, f"{name}: a mesh must be one of {', '.join(MESH_SUFFIXES)}")
-        try:  # what `beside_scene` found may have been swapped since: checked as read
-            data = read_regular(path, MAX_MESH_BYTES)
-        except TooLarge:
-            raise TerrainError(here, f"{name}: larger than {MAX_MESH_BYTES >> 20} MB") from None
-        except Unfit as unfit:
-            raise TerrainError(here, f"{name}: cannot read it ({unfit.reason})") from None
-        except OSError as error:
-            raise TerrainError(here, f"{name}: cannot read it ({error.strerror})") from None
+        data = read_found(path, name, here, MAX_MESH_BYTES)
         suffix = path.suffix.lower()
         key = _key(data, suffix, scale)
         known = _KNOWN.get(key) or self.over.get(key)

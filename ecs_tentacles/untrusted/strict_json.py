@@ -19,6 +19,7 @@ from json import JSONDecoder
 from typing import Any
 
 _WHITESPACE = " \t\n\r"
+_CLOSING = {"{": "}", "[": "]"}  # a container's opening character -> its closing one
 
 
 class DuplicateKey(ValueError):
@@ -105,37 +106,26 @@ def _second_key_at(text: str) -> tuple[str, int] | None:
 def _walk(text: str, index: int) -> tuple[tuple[str, int] | None, int]:
     """Walk the value at `index` (no whitespace before it): the first repeated key
     inside it (key, index) or None, and the index after the value."""
-    opening = text[index]
-    if opening == "{":
-        seen: set[str] = set()
-        index = _skip(text, index + 1)
-        if text[index] == "}":
-            return None, index + 1
-        while True:
+    closing = _CLOSING.get(text[index])
+    if closing is None:  # a string, number, true, false or null
+        _, end = _PLAIN.raw_decode(text, index)
+        return None, end
+    seen: set[str] = set()  # an object's keys so far
+    index = _skip(text, index + 1)
+    if text[index] == closing:
+        return None, index + 1
+    while True:
+        if closing == "}":
             start = index
             key, index = _PLAIN.raw_decode(text, index)
             if key in seen:
                 return (key, start), index
             seen.add(key)
             index = _skip(text, _skip(text, index) + 1)  # past the colon
-            found, index = _walk(text, index)
-            if found is not None:
-                return found, index
-            index = _skip(text, index)
-            if text[index] == "}":
-                return None, index + 1
-            index = _skip(text, index + 1)  # past the comma
-    if opening == "[":
-        index = _skip(text, index + 1)
-        if text[index] == "]":
+        found, index = _walk(text, index)
+        if found is not None:
+            return found, index
+        index = _skip(text, index)
+        if text[index] == closing:
             return None, index + 1
-        while True:
-            found, index = _walk(text, index)
-            if found is not None:
-                return found, index
-            index = _skip(text, index)
-            if text[index] == "]":
-                return None, index + 1
-            index = _skip(text, index + 1)
-    _, end = _PLAIN.raw_decode(text, index)
-    return None, end
+        index = _skip(text, index + 1)  # past the comma

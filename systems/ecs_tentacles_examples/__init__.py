@@ -7,7 +7,8 @@ Each is one file: a `Plugin` and the stage-`decide` `System` it brings, which se
 creatures somewhere (`ecs_tentacles.behaviour.travel`: the locomotion plugin's goals,
 though no example names it) every `interval` seconds rather than every frame, so
 strokes can finish. What they share is here: a number setting, the two re-planning
-settings, the check that a goal set some distance away is not reached at once, and the
+settings, the check that a goal set some distance away is not reached at once, the config
+schema's frame (`settings`), sending creatures to their goals (`send_goals`) and the
 columns sending a creature writes (`ecs_tentacles.behaviour.DESTINATION_WRITES`, what
 each system declares).
 """
@@ -15,17 +16,30 @@ each system declares).
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from ecs_tentacles.behaviour import DESTINATION_WRITES
+import numpy as np
+
+from ecs_tentacles.behaviour import DESTINATION_WRITES, travel
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.scene.defaults import plugin_config
+
+if TYPE_CHECKING:
+    from ecs_tentacles.host import Host
 
 Problem = tuple[tuple[str | int, ...], str]
 
 # the store columns sending a creature writes: `ecs_tentacles.behaviour`'s (named here
 # too, for code that imported it from the examples)
-__all__ = ["DESTINATION_WRITES", "Problem", "farther_than_reach", "number", "replanning"]
+__all__ = [
+    "DESTINATION_WRITES",
+    "Problem",
+    "farther_than_reach",
+    "number",
+    "replanning",
+    "send_goals",
+    "settings",
+]
 
 
 def number(low: float, high: float, default: float, description: str) -> dict[str, Any]:
@@ -37,6 +51,11 @@ def number(low: float, high: float, default: float, description: str) -> dict[st
         "default": default,
         "description": description,
     }
+
+
+def settings(**properties: dict[str, Any]) -> dict[str, Any]:
+    """A plugin's config schema: an object of these `properties` and no others."""
+    return {"type": "object", "additionalProperties": False, "properties": properties}
 
 
 def replanning(interval: float) -> dict[str, dict[str, Any]]:
@@ -61,3 +80,11 @@ def farther_than_reach(
     factor = "" if times == 1 else f"{times:g} x "
     message = f"must be > {factor}goal_radius ({reach:g}), got {config[key]:g}"
     return [(("plugins", plugin.key, key), message)]
+
+
+def send_goals(world: Host, rows: np.ndarray, goals: np.ndarray, goal_radius: float) -> None:
+    """Send the creatures at CreatureStore `rows` to `goals` ((n, 2) metres), each reached
+    within `goal_radius` (`ecs_tentacles.behaviour.travel`)."""
+    entities = world.creatures.entity[rows]
+    for entity, goal in zip(entities, goals, strict=True):
+        travel(world).send(world, int(entity), goal, goal_radius)

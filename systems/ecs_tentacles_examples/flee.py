@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ecs_tentacles.behaviour import ARRIVALS, DESTINATIONS_READ, dangers, travel
+from ecs_tentacles.behaviour import ARRIVALS, DESTINATIONS_READ, dangers
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.scene.defaults import plugin_config
 from ecs_tentacles.system import System
@@ -31,6 +31,8 @@ from ecs_tentacles_examples import (
     farther_than_reach,
     number,
     replanning,
+    send_goals,
+    settings,
 )
 
 if TYPE_CHECKING:
@@ -75,23 +77,18 @@ class Flee(System):
         length = np.linalg.norm(push, axis=1)
         fleeing = np.flatnonzero(length > 1e-9)
         goals = mantles[fleeing] + self.run * push[fleeing] / length[fleeing, None]
-        for row, goal in zip(fleeing, goals, strict=True):
-            travel(world).send(world, int(creatures.entity[row]), goal, self.goal_radius)
+        send_goals(world, fleeing, goals, self.goal_radius)
 
 
 class FleePlugin(Plugin):
     name = "flee"
     description = "creatures near a threat crawl away from it"
     requires = ("locomotion",)  # dangers from any plugin (`behaviour.dangers`), threats or yours
-    config_schema = {
-        "type": "object",
-        "additionalProperties": False,
-        "properties": {
-            "distance": number(0.1, 100, 1.5, "Metres: threats closer than this are fled."),
-            "run": number(0.2, 100, 1.0, "Metres ahead of the creature its flight goal lies."),
-            **replanning(1.0),
-        },
-    }
+    config_schema = settings(
+        distance=number(0.1, 100, 1.5, "Metres: threats closer than this are fled."),
+        run=number(0.2, 100, 1.0, "Metres ahead of the creature its flight goal lies."),
+        **replanning(1.0),
+    )
 
     def problems(self, scene: Mapping[str, Any]) -> list[Problem]:
         return farther_than_reach(self, scene, "run")

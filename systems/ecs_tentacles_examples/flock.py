@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ecs_tentacles.behaviour import ARRIVALS, DESTINATIONS_READ, travel
+from ecs_tentacles.behaviour import ARRIVALS, DESTINATIONS_READ
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.scene.defaults import plugin_config
 from ecs_tentacles.system import System
@@ -33,6 +33,8 @@ from ecs_tentacles_examples import (
     farther_than_reach,
     number,
     replanning,
+    send_goals,
+    settings,
 )
 
 if TYPE_CHECKING:
@@ -105,35 +107,30 @@ class Flock(System):
         direction = np.einsum("w,wnk->nk", self.weights, self.steering(pos, vel))
         steer = np.flatnonzero(np.linalg.norm(direction, axis=1) > 1e-6)
         goals = pos[steer] + self.config["step"] * _unit(direction[steer])
-        for row, goal in zip(steer, goals, strict=True):
-            travel(world).send(world, int(creatures.entity[row]), goal, self.config["goal_radius"])
+        send_goals(world, steer, goals, self.config["goal_radius"])
 
 
 class FlockPlugin(Plugin):
     name = "flock"
     description = "the crowd moves together: separation, alignment, cohesion through goals"
     requires = ("locomotion",)
-    config_schema = {
-        "type": "object",
-        "additionalProperties": False,
-        "properties": {
-            "radius": number(0.5, 100, 3.0, "Metres: mantles closer than this are neighbours."),
-            "separation": number(0.3, 50, 1.4, "Metres: neighbours closer than this push away."),
-            "separate": number(0, 10, 1.5, "Weight of separation."),
-            "align": number(0, 10, 0.5, "Weight of alignment (the neighbours' mean velocity)."),
-            "cohere": number(0, 10, 1.0, "Weight of cohesion (toward the neighbours' centre)."),
-            "seek": number(0, 10, 1.0, "Weight of seeking `toward`."),
-            "toward": {
-                "type": "array",
-                "minItems": 2,
-                "maxItems": 2,
-                "items": {"type": "number", "minimum": -1e4, "maximum": 1e4},
-                "description": "Optional [x, y] in metres the flock travels to.",
-            },
-            "step": number(0.4, 20, 0.8, "Metres ahead of a creature its goal is set."),
-            **replanning(1.0),
+    config_schema = settings(
+        radius=number(0.5, 100, 3.0, "Metres: mantles closer than this are neighbours."),
+        separation=number(0.3, 50, 1.4, "Metres: neighbours closer than this push away."),
+        separate=number(0, 10, 1.5, "Weight of separation."),
+        align=number(0, 10, 0.5, "Weight of alignment (the neighbours' mean velocity)."),
+        cohere=number(0, 10, 1.0, "Weight of cohesion (toward the neighbours' centre)."),
+        seek=number(0, 10, 1.0, "Weight of seeking `toward`."),
+        toward={
+            "type": "array",
+            "minItems": 2,
+            "maxItems": 2,
+            "items": {"type": "number", "minimum": -1e4, "maximum": 1e4},
+            "description": "Optional [x, y] in metres the flock travels to.",
         },
-    }
+        step=number(0.4, 20, 0.8, "Metres ahead of a creature its goal is set."),
+        **replanning(1.0),
+    )
 
     def problems(self, scene: Mapping[str, Any]) -> list[Problem]:
         return farther_than_reach(self, scene, "step")

@@ -27,7 +27,7 @@ from ecs_tentacles.components import Creature
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.scene.defaults import plugin_config
 from ecs_tentacles.system import System
-from ecs_tentacles_examples import DESTINATION_WRITES, Problem, number, replanning
+from ecs_tentacles_examples import DESTINATION_WRITES, Problem, number, replanning, settings
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
@@ -102,16 +102,10 @@ class FollowLeaderPlugin(Plugin):
             "description": "The name of the creature this one follows (plugin follow_leader).",
         }
     }
-    config_schema = {
-        "type": "object",
-        "additionalProperties": False,
-        "properties": {
-            "gap": number(
-                0.3, 50, 0.8, "Metres kept between a follower's and its leader's mantles."
-            ),
-            **replanning(1.0),
-        },
-    }
+    config_schema = settings(
+        gap=number(0.3, 50, 0.8, "Metres kept between a follower's and its leader's mantles."),
+        **replanning(1.0),
+    )
 
     def problems(self, scene: Mapping[str, Any]) -> list[Problem]:
         creatures = scene.get("creatures", [])

@@ -31,6 +31,8 @@ from ecs_tentacles_examples import (
     farther_than_reach,
     number,
     replanning,
+    send_goals,
+    settings,
 )
 
 if TYPE_CHECKING:
@@ -90,22 +92,17 @@ class Wander(System):
         distance = self.radius * np.sqrt(0.25 + 0.75 * draws[:, 1])  # uniform in the ring
         mantles = world.transforms.pos[creatures.mantle_row[idle], :2]
         goals = mantles + distance[:, None] * np.column_stack([np.cos(angle), np.sin(angle)])
-        for row, goal in zip(idle, goals, strict=True):
-            travel(world).send(world, int(creatures.entity[row]), goal, self.goal_radius)
+        send_goals(world, idle, goals, self.goal_radius)
 
 
 class WanderPlugin(Plugin):
     name = "wander"
     description = "idle creatures get random goals near where they are"
     requires = ("locomotion",)
-    config_schema = {
-        "type": "object",
-        "additionalProperties": False,
-        "properties": {
-            "radius": number(0.2, 50, 1.0, "Metres: new goals lie radius / 2 to radius away."),
-            **replanning(0.5),
-        },
-    }
+    config_schema = settings(
+        radius=number(0.2, 50, 1.0, "Metres: new goals lie radius / 2 to radius away."),
+        **replanning(0.5),
+    )
 
     def problems(self, scene: Mapping[str, Any]) -> list[Problem]:
         return farther_than_reach(self, scene, "radius", times=2)
