@@ -81,7 +81,7 @@ class Host(PhysicsHost, Protocol):
         """Names no new creature may take (a recording's creatures, despawned ones too)."""
 
     # -- creatures that come and go (`ecs_tentacles.creatures.spawning`) ---------------
-    def spawn(self, creature: Mapping[str, Any], **placement: Unpack[Placement]) -> int:
+    def spawn(self, creature: Mapping[str, object], **placement: Unpack[Placement]) -> int:
         """Build one creature (a scene-style entry) into the running world; its entity
         (`World.spawn`)."""
 

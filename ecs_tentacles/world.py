@@ -108,7 +108,7 @@ class World:
         allow_systems: bool | None = None,
         threads: int | None = None,
         only: Collection[int] | None = None,
-        plugins: Mapping[str, Any] | None = None,
+        plugins: Mapping[str, object] | None = None,
         scene_dir: str | os.PathLike[str] | None = None,
         lod: bool | None = None,
         focus: Focus | None = None,
@@ -145,7 +145,7 @@ class World:
         return load_world(world_class, source, options)
 
     # -- creatures that come and go ------------------------------------------------------
-    def spawn(self, creature: Mapping[str, Any], **placement: Unpack[Placement]) -> int:
+    def spawn(self, creature: Mapping[str, object], **placement: Unpack[Placement]) -> int:
         """Build one creature (a scene-style entry) into this running world; its entity.
 
         Validated as a scene entry (`SpawnError`, one line per problem); a taken name

@@ -46,7 +46,7 @@ class HerdingPlugin(Plugin):
     description = "the herding game: drive creatures into a pen with a predator"
     requires = ("locomotion", "game")
 
-    def problems(self, scene: Mapping[str, Any]) -> list[tuple[tuple[str | int, ...], str]]:
+    def problems(self, scene: Mapping[str, object]) -> list[tuple[tuple[str | int, ...], str]]:
         return plugin_problems(scene)
 
     def resources(self, world: Host) -> list[object]:

@@ -116,7 +116,7 @@ def _later_problems(data: object, found: list[str], plugins: list[Plugin]) -> li
     return [problem for problem in later if not _caused_by_repair(problem, found)]
 
 
-def on_plane(scene: Mapping[str, Any], plugins: Sequence[Plugin]) -> bool:
+def on_plane(scene: Mapping[str, object], plugins: Sequence[Plugin]) -> bool:
     """Whether the creatures of `scene` stand on the plane z = 0: no plugin on shapes the
     ground there (`Plugin.shapes_ground`)."""
     return not any(plugin.shapes_ground(scene) for plugin in plugins)

@@ -22,7 +22,7 @@ if TYPE_CHECKING:
 Problem = tuple[tuple[str | int, ...], str]
 
 
-class SceneChecks(Registry[Callable[[Mapping[str, Any], Registries], list[Problem]]]):
+class SceneChecks(Registry[Callable[[Mapping[str, object], Registries], list[Problem]]]):
     """Checks of a scene against what its plugins registered."""
 
 

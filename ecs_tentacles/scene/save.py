@@ -86,7 +86,7 @@ class Carried:
 
 
 def named_files(
-    scene: Mapping[str, Any], plugins: Sequence[Plugin]
+    scene: Mapping[str, object], plugins: Sequence[Plugin]
 ) -> list[tuple[tuple[str | int, ...], str]]:
     """Every file `scene` names relative to its folder, as (JSON path, name): plugin code
     (`plugins.<key>.from: "file.py"`) and what each plugin's keys name

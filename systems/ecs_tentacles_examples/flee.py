@@ -93,7 +93,7 @@ class FleePlugin(Plugin):
         },
     }
 
-    def problems(self, scene: Mapping[str, Any]) -> list[Problem]:
+    def problems(self, scene: Mapping[str, object]) -> list[Problem]:
         return farther_than_reach(self, scene, "run")
 
     def systems(self) -> list[System]:

@@ -107,7 +107,7 @@ class WanderPlugin(Plugin):
         },
     }
 
-    def problems(self, scene: Mapping[str, Any]) -> list[Problem]:
+    def problems(self, scene: Mapping[str, object]) -> list[Problem]:
         return farther_than_reach(self, scene, "radius", times=2)
 
     def systems(self) -> list[System]:
