@@ -31,7 +31,7 @@ class Event:
     name: ClassVar[str] = ""
     world: Any
 
-    def payload(self) -> dict[str, Any]:
+    def payload(self) -> dict[str, object]:
         """Its fields by name (what a handler subscribed by name gets)."""
         return {f.name: getattr(self, f.name) for f in fields(self)}
 

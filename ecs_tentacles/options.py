@@ -89,7 +89,7 @@ class WorldOptions:
         )
         return self.but(**keywords)
 
-    def scene_with_lod(self, scene: Mapping[str, Any]) -> dict[str, Any]:
+    def scene_with_lod(self, scene: Mapping[str, Any]) -> dict[str, object]:
         """`scene` with `lod` and `focus` written into its `physics.lod` (a new dict;
         `scene` is left as it was): a bake's take and its shards see them in the scene
         and its hash. The same scene unchanged (a copy of the top level) without them."""

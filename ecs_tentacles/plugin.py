@@ -66,12 +66,12 @@ class Plugin:
     # (registry entries and take hooks): they count as that system's reads
     hook_reads: ClassVar[tuple[str, ...]] = ()
     # JSON Schema of this plugin's `plugins.<name>` config (defaults are filled in)
-    config_schema: ClassVar[dict[str, Any]] = {"type": "object", "additionalProperties": False}
-    creature_schema: ClassVar[dict[str, Any]] = {}  # creature key -> its schema
-    scene_schema: ClassVar[dict[str, Any]] = {}  # scene key -> its schema
+    config_schema: ClassVar[dict[str, object]] = {"type": "object", "additionalProperties": False}
+    creature_schema: ClassVar[dict[str, object]] = {}  # creature key -> its schema
+    scene_schema: ClassVar[dict[str, object]] = {}  # scene key -> its schema
     # keys of a creature's `tentacles` (and its `overrides`, without default) -> schema
-    tentacle_schema: ClassVar[dict[str, Any]] = {}
-    defs: ClassVar[dict[str, Any]] = {}  # "$defs" the fragments refer to ("#/$defs/...")
+    tentacle_schema: ClassVar[dict[str, object]] = {}
+    defs: ClassVar[dict[str, object]] = {}  # "$defs" the fragments refer to ("#/$defs/...")
 
     # hooks of earlier versions, and what replaced them: a plugin that still defines
     # one is refused when its class is made, instead of being silently never called
@@ -109,7 +109,7 @@ class Plugin:
                 raise TypeError(f"{cls.__name__}.{old}: this hook is now {new}")
 
     def __init__(self, config: Mapping[str, object] | None = None):
-        self.config: dict[str, Any] = dict(config or {})
+        self.config: dict[str, object] = dict(config or {})
         self.key = self.name  # the name a scene turned it on by
         self.source: str | None = None  # the file or module it came from, if not built in
 
@@ -179,12 +179,12 @@ class Plugin:
         """Put back what `snapshot` returned."""
 
     # -- saving --------------------------------------------------------------------------
-    def save_creature(self, world: Host, creature: int, entry: dict[str, Any]) -> None:
+    def save_creature(self, world: Host, creature: int, entry: dict[str, object]) -> None:
         """Write what this plugin knows of `creature` now into its scene entry `entry`
         (its goals, its parameters), for saving a directed crowd as a scene
         (`ecs_tentacles.creatures.roster_save`)."""
 
-    def save_scene(self, world: Host, scene: dict[str, Any]) -> None:
+    def save_scene(self, world: Host, scene: dict[str, object]) -> None:
         """Write this plugin's scene-level state into `scene` when a running world is
         saved (`ecs_tentacles.creatures.roster_save`; the threats plugin: threats dropped since)."""
 

@@ -133,12 +133,12 @@ class ArrayStore:
         elif name in ("_arrays", "cache_views") and "cache_views" in self.__dict__:
             self._views()
 
-    def __getstate__(self) -> dict[str, Any]:
+    def __getstate__(self) -> dict[str, object]:
         """Without the views: a copy makes its own of its own arrays."""
         fields = {f.name for f in self.fields()}
         return {k: v for k, v in self.__dict__.items() if k not in fields}
 
-    def __setstate__(self, state: dict[str, Any]) -> None:
+    def __setstate__(self, state: dict[str, object]) -> None:
         self.__dict__.update(state)
         self._views()
 

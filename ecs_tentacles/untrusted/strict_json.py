@@ -50,7 +50,7 @@ def _refuse_constant(name: str) -> Any:
     raise ValueError(f"{name} is not valid JSON")
 
 
-def _unique_pairs(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+def _unique_pairs(pairs: list[tuple[str, Any]]) -> dict[str, object]:
     """An object's pairs as a dict; `_Repeated` if a key comes twice."""
     out = dict(pairs)
     if len(out) != len(pairs):
