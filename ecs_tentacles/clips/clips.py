@@ -107,8 +107,8 @@ class GaitClips:
     @classmethod
     def record(
         cls,
-        creature: dict[str, Any],
-        physics: dict[str, Any] | None = None,
+        creature: dict[str, object],
+        physics: dict[str, object] | None = None,
         *,
         warmup: float = WARMUP,
         seconds: float = RECORD,

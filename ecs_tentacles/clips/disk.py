@@ -95,7 +95,7 @@ def _sources() -> str:
     return _SOURCES
 
 
-def entry_key(recording: str, options: dict[str, Any]) -> str:
+def entry_key(recording: str, options: dict[str, object]) -> str:
     """The key of the clips recorded from `recording` (`cache.recording_input`) with
     `options` (`GaitClips.record`'s keywords) by this code and these libraries."""
     parts = [

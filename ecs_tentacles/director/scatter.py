@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import copy
 from collections.abc import Mapping, Sequence
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -115,7 +115,7 @@ def scatter(
     entry = creature_entry(world, spec)  # checked once: SpawnError names the field
     made = []
     for x, y, heading in spots(world, entry, centre, radius, count, seed).tolist():
-        copy_of: dict[str, Any] = copy.deepcopy(dict(entry))
+        copy_of: dict[str, object] = copy.deepcopy(dict(entry))
         copy_of["name"] = unique_name(world, entry["name"])
         copy_of["position"] = [x, y]
         copy_of["heading_deg"] = heading
