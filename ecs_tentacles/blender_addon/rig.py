@@ -122,7 +122,7 @@ def plan_mesh(name: str, plan: Plan) -> Any:
     return mesh
 
 
-def material(name: str, header: dict[str, Any], index: int) -> Any:
+def material(name: str, header: dict[str, object], index: int) -> Any:
     """Creature `index`'s material: its sandbox colour (the natural palette, as the
     exporters choose it) as the base colour (linear) and the viewport colour."""
     colours = module("skin_colours")

@@ -11,7 +11,7 @@ filled in plugins' `build(app)`, and the world-less registries it is called with
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from ecs_tentacles.plugin import calling
 from ecs_tentacles.registry import App, Registries, Registry
