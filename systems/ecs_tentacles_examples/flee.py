@@ -17,7 +17,7 @@ Transform store (mantle positions). Writes: goals, through `travel(world).send`
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
