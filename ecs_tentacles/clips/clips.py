@@ -34,6 +34,7 @@ from ecs_tentacles.clips.frames import nlerp, quat_power, rotate_z, to_ground, y
 from ecs_tentacles.clips.record import GaitRecording, forward_poses, one_creature_scene, record
 from ecs_tentacles.numeric.optional_kernels import OptionalKernels
 from ecs_tentacles.numeric.quaternions import quat_multiply
+from ecs_tentacles.scene.scene_spec import PhysicsSpec
 
 IDLE, CRAWL = 0, 1
 KINDS = ("idle", "crawl")
@@ -108,7 +109,7 @@ class GaitClips:
     def record(
         cls,
         creature: dict[str, object],
-        physics: dict[str, object] | None = None,
+        physics: PhysicsSpec | None = None,
         *,
         warmup: float = WARMUP,
         seconds: float = RECORD,

@@ -23,6 +23,7 @@ import numpy as np
 
 from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.physics.model import build_spec, model_layout
+from ecs_tentacles.scene.scene_spec import PhysicsSpec
 from ecs_tentacles.world import World
 
 GOAL_RADIUS = 0.3
@@ -47,7 +48,7 @@ class GaitRecording:
 
 
 def one_creature_scene(
-    creature: dict[str, Any], physics: dict[str, Any] | None = None, goal: float | None = None
+    creature: dict[str, Any], physics: PhysicsSpec | None = None, goal: float | None = None
 ) -> dict[str, Any]:
     """A scene of `creature` alone at the origin, heading 0, its goal `goal` m ahead (None: idle).
 
