@@ -102,7 +102,7 @@ class Plugin:
         "run_summary": "a RunSummaries entry added in build(app) (cli.registries)",
     }
 
-    def __init_subclass__(cls, **kwargs: Any) -> None:
+    def __init_subclass__(cls, **kwargs: object) -> None:
         super().__init_subclass__(**kwargs)
         for old, new in Plugin.RENAMED_HOOKS.items():
             if old in vars(cls):
@@ -175,7 +175,7 @@ class Plugin:
         """A copy of this plugin's state between frames (for `world.snapshot()`)."""
         return None
 
-    def restore(self, world: Host, state: Any) -> None:
+    def restore(self, world: Host, state: object) -> None:
         """Put back what `snapshot` returned."""
 
     # -- saving --------------------------------------------------------------------------

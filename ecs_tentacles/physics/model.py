@@ -97,7 +97,7 @@ def model_layout(world: PhysicsHost, creature: Creature, transform: Transform) -
     `base_row` and `first_link` (`TentacleStore`), so those rows are read from the
     tentacle's; element names are made once per tentacle shape (`_tentacle_names`).
     """
-    key: list[Any] = [
+    key: list[object] = [
         _settings_key(world.settings),
         (creature.mantle_radius, creature.mantle_height, creature.mantle_density),
     ]
@@ -296,7 +296,7 @@ def add_sucker(
     tentacle: int,
     number: int,
     link: int,
-    offset: Any,
+    offset: object,
 ) -> None:
     """Sucker equality `number`: link `link` of tentacle `tentacle` held to the world at
     `offset` in the link's frame (off until it attaches; the world anchor is set then)."""
