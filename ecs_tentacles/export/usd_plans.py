@@ -105,7 +105,7 @@ def _plan_arrays(pxr: ModuleType, skeleton: Skeleton, mesh: SkinMesh) -> dict[st
 
 def define_creature(
     pxr: ModuleType,
-    stage: Any,
+    stage: object,
     plan: BodyPlan,
     name: str,
     colour: np.ndarray,
@@ -125,7 +125,7 @@ def define_creature(
 
 def define_skin(
     pxr: ModuleType,
-    stage: Any,
+    stage: object,
     plan: BodyPlan,
     name: str,
     prefix: str,

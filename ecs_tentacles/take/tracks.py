@@ -52,7 +52,7 @@ class TakeTrack:
         out["arrays"] = list(self.arrays)
         return out
 
-    def empty_header(self) -> list[Any] | None:
+    def empty_header(self) -> list[object] | None:
         """Its header entry before anything is recorded."""
         return [] if self.kind == "points" else None
 
