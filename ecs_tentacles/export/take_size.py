@@ -141,7 +141,7 @@ def _header_entries(scene: Mapping[str, Any]) -> tuple[int, int]:
     return body_bytes, sucker_bytes
 
 
-def _shape_of(mantle: Mapping[str, Any], params: Mapping[str, Any]) -> tuple[Any, ...]:
+def _shape_of(mantle: Mapping[str, Any], params: Mapping[str, Any]) -> tuple[object, ...]:
     """What a tentacle's bodies and suckers in the header are made of (not its motion)."""
     shape = ("links", "link_length", "link_radius", "end_scale", "suckers")
     return (mantle["radius"], mantle["height"], *(params.get(key) for key in shape))

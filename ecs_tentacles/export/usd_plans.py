@@ -48,7 +48,7 @@ class BodyPlan:
 def body_plans(header: dict[str, Any], detail: Detail | None = None) -> list[BodyPlan]:
     """The take's creatures grouped by body plan, in the order plans first appear."""
     pxr = usd_modules()
-    grouped: dict[tuple[Any, ...], list[int]] = {}
+    grouped: dict[tuple[object, ...], list[int]] = {}
     layouts = [creature_layout(header, c) for c in range(len(header["creatures"]))]
     for index, (layout, _) in enumerate(layouts):
         key = (layout.mantle_radius, layout.mantle_height) + tuple(

@@ -124,7 +124,7 @@ def shapes(header: dict[str, Any]) -> dict[str, tuple[int, ...]]:
     return out
 
 
-def dtypes(header: dict[str, Any]) -> dict[str, np.dtype[Any]]:
+def dtypes(header: dict[str, Any]) -> dict[str, np.dtype[np.generic]]:
     """Array name -> dtype, in file order, for a sound header."""
     return {
         array_name(mesh["name"], part): np.dtype(dtype)

@@ -31,7 +31,7 @@ MAX_BODIES = 16384 * 1025  # the schema's most creatures x the bodies of its lar
 FORMAT = "ecs_tentacles.take"
 VERSION = 3  # what is written: version 2 with bodies stored per body plan (`take.compact`)
 VERSIONS = (1, 2, 3)  # version 1: no chunks, no replay records; both still read
-CORE_DTYPES: dict[str, np.dtype[Any]] = {
+CORE_DTYPES: dict[str, np.dtype[np.generic]] = {
     "header": np.dtype(np.uint8),
     "pos": np.dtype("<f4"),
     "quat": np.dtype("<f4"),
@@ -248,7 +248,7 @@ def expected_shapes(
     return shapes
 
 
-def array_dtypes(header: dict[str, Any]) -> dict[str, np.dtype[Any]]:
+def array_dtypes(header: dict[str, Any]) -> dict[str, np.dtype[np.generic]]:
     """Every array a take with this (sound) header may hold -> its dtype, in file order."""
     out = dict(CORE_DTYPES)
     for track in tracks_of(header):

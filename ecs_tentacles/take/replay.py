@@ -30,7 +30,7 @@ import numpy as np
 KEY = "replay"
 IDENTITY = np.array([1.0, 0.0, 0.0, 0.0], dtype=np.float32)
 PER_FRAME = ("replay_kind", "replay_phase", "replay_xy", "replay_heading")
-DTYPES: dict[str, np.dtype[Any]] = {
+DTYPES: dict[str, np.dtype[np.generic]] = {
     "replay_kind": np.dtype(np.int8),
     "replay_phase": np.dtype("<f8"),
     "replay_xy": np.dtype("<f8"),
@@ -112,7 +112,7 @@ def shapes(header: dict[str, Any]) -> dict[str, tuple[int, ...]]:
     return out
 
 
-def dtypes(header: dict[str, Any]) -> dict[str, np.dtype[Any]]:
+def dtypes(header: dict[str, Any]) -> dict[str, np.dtype[np.generic]]:
     """Array name -> dtype, in file order, for a sound header."""
     replay = header.get(KEY)
     if replay is None:

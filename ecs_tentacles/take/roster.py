@@ -46,7 +46,7 @@ def shapes(header: dict[str, Any]) -> dict[str, tuple[int, ...]]:
     return {ARRAY: (header["frames"], len(header["creatures"]))}
 
 
-def dtypes(header: dict[str, Any]) -> dict[str, np.dtype[Any]]:
+def dtypes(header: dict[str, Any]) -> dict[str, np.dtype[np.generic]]:
     """Array name -> dtype, in file order, for a sound header."""
     return {} if header.get(KEY) is None else {ARRAY: np.dtype(np.bool_)}
 
