@@ -25,7 +25,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator, Mapping, Sequence
 from contextlib import contextmanager
-from typing import TYPE_CHECKING, Any, ClassVar
+from typing import TYPE_CHECKING, ClassVar
 
 from ecs_tentacles.roster_change import RosterChange
 from ecs_tentacles.system import System
@@ -171,7 +171,7 @@ class Plugin:
         return []
 
     # -- state ---------------------------------------------------------------------------
-    def snapshot(self, world: Host) -> Any:
+    def snapshot(self, world: Host) -> object:
         """A copy of this plugin's state between frames (for `world.snapshot()`)."""
         return None
 

@@ -70,7 +70,7 @@ class FurPlugin(Plugin):
         fur = world.resource(FurData)
         return {f"fur.{name}": getattr(fur, name) for name in STORES}
 
-    def snapshot(self, world: Host) -> Any:
+    def snapshot(self, world: Host) -> object:
         fur = world.resource(FurData)  # its stores are copied with every store
         return fur.curves.copy(), fur.frames.copy()
 

@@ -64,7 +64,7 @@ class HerdingPlugin(Plugin):
 
         return [Predator(), Herd(), Referee()]
 
-    def snapshot(self, world: Host) -> Any:
+    def snapshot(self, world: Host) -> object:
         return world.resource(HerdingGame).state.copy()
 
     def restore(self, world: Host, state: Any) -> None:

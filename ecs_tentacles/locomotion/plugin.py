@@ -153,7 +153,7 @@ class LocomotionPlugin(Plugin):
             target[turned] = mantle + bent(target[turned] - mantle, creatures.avoidance[turned])
         return np.where(creatures.has_goal[:, None], target, np.nan)
 
-    def snapshot(self, world: Host) -> Any:
+    def snapshot(self, world: Host) -> object:
         goals = {
             entity: [
                 (world.component(g, Goal).position.copy(), world.component(g, Goal).radius)

@@ -67,7 +67,7 @@ class RacePlugin(Plugin):
 
         return [Steering(), Referee()]
 
-    def snapshot(self, world: Host) -> Any:
+    def snapshot(self, world: Host) -> object:
         return world.resource(RaceGame).state.copy()
 
     def restore(self, world: Host, state: Any) -> None:
