@@ -280,7 +280,7 @@ class World:
         return self.get_resource(kind) is not None
 
     @property
-    def resources(self) -> tuple[Any, ...]:
+    def resources(self) -> tuple[object, ...]:
         """Every plugin resource of this world."""
         return tuple(self._resources.values())
 

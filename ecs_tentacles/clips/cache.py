@@ -46,10 +46,10 @@ class ClipCache:
     def __init__(self, *, disk: bool = False, **record_options: Any):
         self.record_options = record_options
         self.disk = disk
-        self.clips: dict[tuple[Any, ...], GaitClips] = {}
+        self.clips: dict[tuple[object, ...], GaitClips] = {}
 
     @property
-    def seconds(self) -> dict[tuple[Any, ...], float]:
+    def seconds(self) -> dict[tuple[object, ...], float]:
         """Wall-clock seconds each morphology's recording took."""
         return {key: clips.seconds for key, clips in self.clips.items()}
 
@@ -106,7 +106,9 @@ def recording_input(creature: dict[str, Any], physics: PhysicsSpec | None = None
     return json.dumps(scene, sort_keys=True, default=str)
 
 
-def morphology_key(creature: dict[str, Any], physics: PhysicsSpec | None = None) -> tuple[Any, ...]:
+def morphology_key(
+    creature: dict[str, Any], physics: PhysicsSpec | None = None
+) -> tuple[object, ...]:
     """The physics morphology key of a scene creature entry, compiling nothing."""
     return _morphology(creature, physics).key
 

@@ -26,7 +26,6 @@ writes only the caller's `out` arrays.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
@@ -80,7 +79,7 @@ class Clip:
 class GaitClips:
     """The idle and crawl clips of one morphology, stacked for vectorised replay."""
 
-    key: tuple[Any, ...]  # the physics morphology key (`model_layout(...).key`)
+    key: tuple[object, ...]  # the physics morphology key (`model_layout(...).key`)
     bodies: list[str]
     idle: Clip
     crawl: Clip

@@ -35,7 +35,7 @@ NOT_RECORDED = ("fur",)
 class GaitRecording:
     """Frames of one creature's full simulation; shapes (F, ...), world frame."""
 
-    key: tuple[Any, ...]  # the physics morphology key (`model_layout(...).key`)
+    key: tuple[object, ...]  # the physics morphology key (`model_layout(...).key`)
     model: mujoco.MjModel  # the creature's compiled model (for forward kinematics)
     dt: float  # seconds per frame
     bodies: list[str]  # body names, mantle first

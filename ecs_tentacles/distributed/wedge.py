@@ -46,7 +46,7 @@ class WedgeAxis:
     """One `--wedge PATH=VALUES`."""
 
     path: tuple[str | int, ...]
-    values: tuple[Any, ...]
+    values: tuple[object, ...]
 
     @property
     def text(self) -> str:

@@ -134,10 +134,10 @@ def creature_problems(
 
 
 # a body plan's problems (`_body_key`), paths from the creature: worked out once per plan
-_BODY_PROBLEMS: dict[tuple[Any, ...], list[tuple[Path, str]]] = {}
+_BODY_PROBLEMS: dict[tuple[object, ...], list[tuple[Path, str]]] = {}
 
 
-def _body_key(creature: CreatureSpec, layout: CreatureLayout, step: float) -> tuple[Any, ...]:
+def _body_key(creature: CreatureSpec, layout: CreatureLayout, step: float) -> tuple[object, ...]:
     """Everything `_body_problems` reads: the mantle, each tentacle's shape, density and
     servo, which overrides set a shape or a servo (problem paths name them), the step."""
     mantle = creature["mantle"]

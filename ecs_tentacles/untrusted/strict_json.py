@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import json
 from json import JSONDecoder
-from typing import Any
+from typing import Any, NoReturn
 
 _WHITESPACE = " \t\n\r"
 
@@ -45,7 +45,7 @@ def _finite_float(text: str) -> float:
     return value
 
 
-def _refuse_constant(name: str) -> Any:
+def _refuse_constant(name: str) -> NoReturn:
     """Refuse the non-standard ``NaN``/``Infinity`` literals Python's json accepts."""
     raise ValueError(f"{name} is not valid JSON")
 
