@@ -75,7 +75,7 @@ class WorldOptions:
         """These options building just the creatures at scene indices `only`."""
         return self.but(only=None if only is None else frozenset(only))
 
-    def given(self, keywords: Mapping[str, Any], where: str) -> WorldOptions:
+    def given(self, keywords: Mapping[str, object], where: str) -> WorldOptions:
         """These options with old-style keywords over them (`bake(plan, threads=2)`, from
         before the options had an object), with a DeprecationWarning naming `where`;
         TypeError for a keyword no field has."""

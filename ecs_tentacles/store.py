@@ -118,7 +118,7 @@ class ArrayStore:
         for field in self.fields():
             state.pop(field.name, None)
 
-    def __setattr__(self, name: str, value: Any) -> None:
+    def __setattr__(self, name: str, value: object) -> None:
         """`store.field = values` writes into the live rows (the field's view is kept);
         `count`, `_arrays` and `cache_views` make the views again."""
         if isinstance(getattr(type(self), name, None), Field):
@@ -160,7 +160,7 @@ class ArrayStore:
     def capacity(self) -> int:
         return len(next(iter(self._arrays.values()))) if self._arrays else 0
 
-    def add(self, n: int = 1, **values: Any) -> np.ndarray:
+    def add(self, n: int = 1, **values: object) -> np.ndarray:
         """Append `n` rows (defaults, then `values` broadcast over them); return their indices."""
         if n < 0:
             raise ValueError(f"cannot add {n} rows")

@@ -151,7 +151,7 @@ def collection_paused() -> Iterator[None]:
 
 def _build(
     world: SceneWorld,
-    data: dict[str, Any],
+    data: dict[str, object],
     chosen: list[Plugin],
     only: Collection[int] | None,
     checks_only: bool,

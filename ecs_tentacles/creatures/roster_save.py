@@ -68,7 +68,7 @@ def roster_scene(world: Host) -> dict[str, Any]:
     return scene
 
 
-def fit_at_rest(world: Host, entries: list[dict[str, Any]]) -> int:
+def fit_at_rest(world: Host, entries: list[dict[str, object]]) -> int:
     """Move entries (in order) whose creature, built at rest where it is, would overlap
     an obstacle or a creature placed before it to the nearest spot where it fits
     (`spawning.nearest_free`); how many moved."""

@@ -137,7 +137,7 @@ def _caused_by_repair(problem: str, found: list[str]) -> bool:
 
 
 def load_scene_plugins(
-    source: str | os.PathLike[str] | dict[str, Any],
+    source: str | os.PathLike[str] | dict[str, object],
     *,
     allow_systems: bool = False,
     scene_dir: pathlib.Path | None = None,

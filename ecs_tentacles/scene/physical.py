@@ -64,7 +64,7 @@ Path = tuple[str | int, ...]
 
 
 def physically_checked(
-    scene: dict[str, Any],
+    scene: dict[str, object],
     prefix: str = "",
     plane: bool = True,
     layouts: Layouts | None = None,
