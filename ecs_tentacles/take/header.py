@@ -64,7 +64,7 @@ def _index(value: object, size: int) -> bool:
     return isinstance(value, int) and not isinstance(value, bool) and 0 <= value < size
 
 
-def _list_of_dicts(header: dict[str, Any], key: str) -> str | None:
+def _list_of_dicts(header: dict[str, object], key: str) -> str | None:
     value = header.get(key)
     if not isinstance(value, list):
         return f"header.{key}: missing or not a list"
@@ -74,7 +74,7 @@ def _list_of_dicts(header: dict[str, Any], key: str) -> str | None:
     return None
 
 
-def _creature_problem(creatures: list[dict[str, Any]], bodies: int) -> str | None:
+def _creature_problem(creatures: list[dict[str, object]], bodies: int) -> str | None:
     used: set[int] = set()
     names: set[str] = set()
     for c, creature in enumerate(creatures):
@@ -248,7 +248,7 @@ def expected_shapes(
     return shapes
 
 
-def array_dtypes(header: dict[str, Any]) -> dict[str, np.dtype[np.generic]]:
+def array_dtypes(header: dict[str, object]) -> dict[str, np.dtype[np.generic]]:
     """Every array a take with this (sound) header may hold -> its dtype, in file order."""
     out = dict(CORE_DTYPES)
     for track in tracks_of(header):

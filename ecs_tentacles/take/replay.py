@@ -143,7 +143,7 @@ def values_problem(header: dict[str, Any], arrays: dict[str, np.ndarray]) -> str
                                   if clip_array(i) in arrays})  # fmt: skip
 
 
-def clips_problem(header: dict[str, Any], clips: dict[int, np.ndarray]) -> str | None:
+def clips_problem(header: dict[str, object], clips: dict[int, np.ndarray]) -> str | None:
     """The first clip frame the poses cannot come from: a number not finite or beyond
     1e6 m, a rotation of no length."""
     for i, pose in clips.items():
@@ -234,7 +234,7 @@ def poses(
 
 
 def fill(
-    header: dict[str, Any],
+    header: dict[str, object],
     clips: dict[int, np.ndarray],
     arrays: dict[str, np.ndarray],
     pos: np.ndarray,

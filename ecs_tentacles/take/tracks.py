@@ -111,7 +111,7 @@ def dtypes(track: TakeTrack) -> tuple[str, str]:
     return ("<f4", "|b1") if track.kind == "points" else ("<f4", "<f4")
 
 
-def declared_problem(header: dict[str, Any]) -> str | None:
+def declared_problem(header: dict[str, object]) -> str | None:
     """The first problem of `header["tracks"]` (the declared tracks), or None."""
     declared = header.get("tracks", [])
     if not isinstance(declared, list):
