@@ -84,7 +84,7 @@ class BakePlan:
     @classmethod
     def make(
         cls,
-        scene: str | os.PathLike[str] | dict[str, Any],
+        scene: str | os.PathLike[str] | dict[str, object],
         options: WorldOptions | None = None,
         *,
         seconds: float,
@@ -318,7 +318,7 @@ def bake_to_file(
     *,
     progress: bool = True,
     on_world: Callable[[World], None] | None = None,
-    accept: Callable[[dict[str, Any]], bool] | None = None,
+    accept: Callable[[dict[str, object]], bool] | None = None,
     **deprecated: object,
 ) -> dict[str, Any] | None:
     """Run the plan, writing the take to `out` as the frames come (`take.writer`: a
