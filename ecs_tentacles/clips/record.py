@@ -48,7 +48,7 @@ class GaitRecording:
 
 
 def one_creature_scene(
-    creature: dict[str, Any], physics: PhysicsSpec | None = None, goal: float | None = None
+    creature: dict[str, object], physics: PhysicsSpec | None = None, goal: float | None = None
 ) -> dict[str, Any]:
     """A scene of `creature` alone at the origin, heading 0, its goal `goal` m ahead (None: idle).
 

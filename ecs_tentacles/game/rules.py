@@ -48,7 +48,7 @@ def unknown(name: str, modes: Mapping[str, GameMode]) -> str:
     return f"{name!r} is not a registered game mode (registered: {', '.join(sorted(modes))})"
 
 
-def check_game(scene: Mapping[str, Any], registries: Registries) -> list[Problem]:
+def check_game(scene: Mapping[str, object], registries: Registries) -> list[Problem]:
     """The problems of a defaults-filled scene's `game` (none without one)."""
     game = scene.get("game")
     if not isinstance(game, Mapping):
