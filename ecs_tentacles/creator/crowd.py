@@ -248,7 +248,7 @@ def crowd_scene(
     }
 
 
-def write_crowd_scene(scene: dict[str, Any], path: str | os.PathLike[str]) -> None:
+def write_crowd_scene(scene: dict[str, object], path: str | os.PathLike[str]) -> None:
     """Validate `scene` (SceneError if it does not) and write it as JSON, atomically."""
     load_scene(scene)
     with atomic_output(path) as temporary:

@@ -103,7 +103,7 @@ def safe(text: str) -> str:
     return re.sub(r"[^A-Za-z0-9.+-]", "_", text)
 
 
-def variant_name(values: dict[str, Any]) -> str:
+def variant_name(values: dict[str, object]) -> str:
     """`PATH-VALUE` per parameter, joined by `_` (see the module docstring)."""
     parts = []
     for path, value in values.items():
@@ -113,7 +113,7 @@ def variant_name(values: dict[str, Any]) -> str:
 
 
 def variants(
-    raw: dict[str, Any],
+    raw: dict[str, object],
     parameters: list[WedgeAxis],
     source: str = "",
     *,
