@@ -51,7 +51,7 @@ class WorldOptions:
     threads: int | None = None
     lod: bool | None = None
     focus: Focus | None = None
-    plugins: Mapping[str, Any] | None = None
+    plugins: Mapping[str, object] | None = None
     scene_dir: pathlib.Path | None = None
     only: frozenset[int] | None = None
 

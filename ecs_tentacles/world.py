@@ -101,7 +101,7 @@ class World:
     @classmethod
     def from_scene(
         cls,
-        source: str | os.PathLike[str] | dict[str, Any],
+        source: str | os.PathLike[str] | dict[str, object],
         options: WorldOptions | None = None,
         *,
         seed: int | None = None,

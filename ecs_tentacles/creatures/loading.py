@@ -48,7 +48,7 @@ class SceneWorld(Host, Protocol):
 
     options: WorldOptions
     layouts: Layouts
-    scene: dict[str, Any] | None
+    scene: dict[str, object] | None
     scene_dir: pathlib.Path | None
     creature_specs: dict[int, CreatureSpec]
 
@@ -72,7 +72,7 @@ class WorldClass(Protocol[W_co]):
 
 def load_world(
     cls: WorldClass[W],
-    source: str | os.PathLike[str] | dict[str, Any],
+    source: str | os.PathLike[str] | dict[str, object],
     options: WorldOptions | None = None,
     *,
     checks_only: bool = False,

@@ -151,5 +151,5 @@ def with_defaults(
         for i, creature in enumerate(creatures):
             if isinstance(creature, dict):
                 creature.setdefault("name", f"creature_{i}")
-    filled: dict[str, Any] = result
+    filled: dict[str, object] = result
     return filled

@@ -85,7 +85,7 @@ def read_scene_json(path: pathlib.Path) -> object:
 
 
 def load_scene(
-    source: str | os.PathLike[str] | dict[str, Any], *, allow_systems: bool = False
+    source: str | os.PathLike[str] | dict[str, object], *, allow_systems: bool = False
 ) -> dict[str, Any]:
     """Load, validate and complete a scene.
 

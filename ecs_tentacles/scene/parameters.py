@@ -209,8 +209,8 @@ def parameter(section: str, key: str, table: Iterable[Parameter] | None = None) 
 def apply_parameters(
     world: Host,
     section: str,
-    entry: Mapping[str, Any],
-    rows: Mapping[str, Any],
+    entry: Mapping[str, object],
+    rows: Mapping[str, object],
     table: Sequence[Parameter] | None = None,
 ) -> None:
     """Fill store columns from a scene entry (defaults applied) of `section`, at `rows`.

@@ -100,7 +100,7 @@ def field_schema(section: str, key: str) -> dict[str, Any]:
     """The schema of `<section>.<key>` (section: mantle, tentacles, locomotion...)."""
     for name, node, _ in schema_objects(load_schema()):  # the default plugins' fields too
         if name == section and key in node["properties"]:
-            found: dict[str, Any] = node["properties"][key]
+            found: dict[str, object] = node["properties"][key]
             return found
     raise KeyError(f"{section}.{key}: not a field of the scene schema")
 
