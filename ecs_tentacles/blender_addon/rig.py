@@ -64,7 +64,7 @@ def plan_armature(name: str, plan: Plan, collection: Any) -> tuple[Any, np.ndarr
     layer.objects.active = holder
     try:
         bpy.ops.object.mode_set(mode="EDIT")
-        bones: list[Any] = []
+        bones: list[object] = []
         for j, bone_name in enumerate(plan.names):
             bone = armature.edit_bones.new(bone_name)
             bone.head = plan.heads[j].tolist()

@@ -42,7 +42,7 @@ class BodyPlan:
     names: list[str]
     members: np.ndarray  # (C,) the creatures' indices in the take
     bodies: np.ndarray
-    arrays: dict[str, Any]
+    arrays: dict[str, object]
 
 
 def body_plans(header: dict[str, Any], detail: Detail | None = None) -> list[BodyPlan]:

@@ -98,8 +98,8 @@ def unpack(header: dict[str, object]) -> dict[str, Any]:
     total = sum(len(plans[p]["bodies"]) for p in of)
     if total > MAX_BODIES or sum(len(plans[p]["suckers"]) for p in of) > MAX_BODIES:
         raise PlanError(f"header.{KEY}: lists more than {MAX_BODIES} bodies or suckers")
-    bodies: list[dict[str, Any]] = []
-    suckers: list[dict[str, Any]] = []
+    bodies: list[dict[str, object]] = []
+    suckers: list[dict[str, object]] = []
     for c, plan in enumerate(of):
         stem, first = _stem(creatures[c], c), len(bodies)
         for body in plans[plan]["bodies"]:
