@@ -66,7 +66,7 @@ def migrate(raw: dict[str, Any]) -> tuple[dict[str, Any], list[str]]:
     """The scene with `plugins` explicit and `systems` folded in; and what changed."""
     scene = copy.deepcopy(raw)
     changes: list[str] = []
-    plugins: dict[str, Any] = dict(scene.get("plugins") or {})
+    plugins: dict[str, object] = dict(scene.get("plugins") or {})
     for name in default_on():
         if name not in plugins:
             plugins[name] = {}

@@ -77,7 +77,7 @@ class ClipCache:
         self,
         layout: ModelLayout,
         dt: float,
-        creature: dict[str, Any],
+        creature: dict[str, object],
         physics: PhysicsSpec | None,
     ) -> GaitClips:
         key, recording = layout.key, recording_input(creature, physics)
@@ -107,7 +107,7 @@ def recording_input(creature: dict[str, Any], physics: PhysicsSpec | None = None
 
 
 def morphology_key(
-    creature: dict[str, Any], physics: PhysicsSpec | None = None
+    creature: dict[str, object], physics: PhysicsSpec | None = None
 ) -> tuple[object, ...]:
     """The physics morphology key of a scene creature entry, compiling nothing."""
     return _morphology(creature, physics).key

@@ -58,7 +58,7 @@ def one_creature_scene(
     entry = {k: copy.deepcopy(v) for k, v in creature.items() if k not in NOT_RECORDED}
     entry.update(position=[0.0, 0.0], heading_deg=0.0)
     entry["goals"] = [] if goal is None else [{"position": [goal, 0.0], "radius": GOAL_RADIUS}]
-    scene: dict[str, Any] = {"version": 1, "name": "clip", "creatures": [entry]}
+    scene: dict[str, object] = {"version": 1, "name": "clip", "creatures": [entry]}
     if physics is not None:
         scene["physics"] = copy.deepcopy(physics)
     return scene

@@ -57,9 +57,9 @@ class WedgeAxis:
 class Variant:
     """One combination: its values, its output name and its validated scene."""
 
-    values: dict[str, Any]
+    values: dict[str, object]
     name: str
-    scene: dict[str, Any]
+    scene: dict[str, object]
 
 
 def parse_parameter(text: str) -> WedgeAxis:
@@ -85,7 +85,7 @@ def parse_parameter(text: str) -> WedgeAxis:
             raise WedgeError(
                 f"argument --wedge: {path_text}: {high - low + 1} values, more than {MAX_VARIANTS}"
             )
-        values: list[Any] = list(range(low, high + 1))
+        values: list[object] = list(range(low, high + 1))
     else:
         values = [_value(v.strip()) for v in values_text.split(",")]
     return WedgeAxis(tuple(path), tuple(values))
