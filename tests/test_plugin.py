@@ -173,7 +173,7 @@ CORE_ALONE = textwrap.dedent(
     """
     import sys
     from ecs_tentacles.world import World
-    off = {"locomotion": False, "suckers": False, "threats": False, "fur": False, "lod": False}
+    off = {"locomotion": False, "suckers": False, "threats": False, "fur": False, "clips": False}
     scene = {"version": 1, "creatures": [{"tentacles": {"count": 3, "links": 2}}]}
     with World.from_scene(scene, plugins=off) as world:
         start = world.transforms.pos.copy()

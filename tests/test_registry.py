@@ -86,7 +86,7 @@ def test_every_entry_of_a_world_with_every_plugin_on_is_its_owners(everything_on
 @pytest.mark.parametrize("off", ["locomotion", "fur", "threats", "terrain", "director"])
 def test_a_plugin_turned_off_has_no_entry(off: str) -> None:
     scene = json.loads((SCENES / "rocky_shore.json").read_text())
-    keys = [key for key in ("locomotion", "suckers", "threats", "fur", "lod", "terrain",
+    keys = [key for key in ("locomotion", "suckers", "threats", "fur", "clips", "terrain",
                             "director") if key != off]  # fmt: skip
     scene["plugins"] = {key: (key in keys and {}) for key in [*keys, off]}
     if off == "locomotion":

@@ -165,7 +165,7 @@ def test_locomotion_is_an_ordinary_plugin_switch(make_world: Callable[..., World
         creature_scene(count=3, links=2), plugins={"locomotion": False, "suckers": False}
     )
     assert not {"goals", "motor_targets", "suckers"} & set(off.schedule.names)
-    assert [p.key for p in off.plugins] == ["threats", "fur", "lod", "terrain"]
+    assert [p.key for p in off.plugins] == ["threats", "fur", "clips", "terrain"]
     scene = {**creature_scene(count=3, links=2)}
     scene["creatures"][0]["goals"] = [{"position": [1, 0]}]
     with pytest.raises(SceneError, match=r"creatures\[0\]\.goals: unknown key"):

@@ -3,15 +3,18 @@
     python tools/bench_sandbox.py                      # 64 and 256 creatures on rocky ground
     python tools/bench_sandbox.py --crowd 64 --frames 120 --json
     python tools/bench_sandbox.py --crowd 64 --terrain flat --lod off
+    python tools/bench_sandbox.py --still              # the camera framed once, then still
 
 A crowd as `ecs-tentacles crowd N --terrain rocky` writes it, opened in the headless
 sandbox at 1280 x 720 with the HUD shown and the camera framing every creature (`play
 --camera frame-all`); the level of detail follows the camera as it does in the window.
 Each frame is timed in two parts: `physics` (the sandbox's step: the level of detail's
 choices and every system of one world frame) and `drawn` (the world and the HUD drawn,
-ending with glFinish, so llvmpipe's rasterising counts). Real time is the frame's
-duration over the median physics time: >= 1.0 keeps up with the clock. Medians over the
-measured frames, after a warm-up; the tiers are those at the end.
+ending with glFinish, so llvmpipe's rasterising counts). `--still` frames the crowd
+once and leaves the camera where it is, as the window does until the player moves it
+(without it the camera eases after the crowd every frame, as a `--video` does). Real
+time is the frame's duration over the median physics time: >= 1.0 keeps up with the
+clock. Medians over the measured frames, after a warm-up; the tiers are those at the end.
 """
 
 from __future__ import annotations
@@ -37,7 +40,12 @@ def crowd(count: int, terrain: str, seed: int) -> dict[str, Any]:
 
 
 def bench(
-    scene: dict[str, Any], frames: int, warmup: int, lod: bool | None, hud: bool
+    scene: dict[str, Any],
+    frames: int,
+    warmup: int,
+    lod: bool | None,
+    hud: bool,
+    still: bool = False,
 ) -> dict[str, Any]:
     """Median ms of the physics and of a drawn frame, and the tiers at the end."""
     from pyglet import gl
@@ -53,7 +61,8 @@ def bench(
             start = time.perf_counter()
             sandbox.step(1)
             stepped = time.perf_counter()
-            sandbox.keep_framed(0.1)
+            if not still:
+                sandbox.keep_framed(0.1)
             sandbox.render()
             gl.glFinish()
             if frame >= warmup:
@@ -82,6 +91,7 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--lod", choices=("on", "off"), default=None)
     parser.add_argument("--no-hud", action="store_true")
+    parser.add_argument("--still", action="store_true", help="frame once, then keep still")
     parser.add_argument("--json", action="store_true")
     args = parser.parse_args()
     if args.frames < 1 or args.warmup < 0 or any(n < 1 for n in args.crowd):
@@ -91,8 +101,12 @@ def main() -> None:
     rows = []
     for count in args.crowd:
         scene = crowd(count, args.terrain, args.seed)
-        row = {"crowd": count, "terrain": args.terrain}
-        row.update(bench(scene, args.frames, args.warmup, lod, not args.no_hud))
+        row = {
+            "crowd": count,
+            "terrain": args.terrain,
+            "camera": "still" if args.still else "eased",
+        }
+        row.update(bench(scene, args.frames, args.warmup, lod, not args.no_hud, args.still))
         rows.append(row)
         if not args.json:
             tiers = " / ".join(f"{n} {name}" for name, n in row["tiers"].items())

@@ -35,7 +35,8 @@ REPOSITORY = "user_default"
 # the project's own files the add-on runs as they are (ecs_tentacles.blender_addon.shared)
 SHARED = {"skin_mesh.py": ("ecs_tentacles.skin", "mesh.py"),
           "skin_colours.py": ("ecs_tentacles.skin", "colours.py"),
-          "take_compact.py": ("ecs_tentacles.take", "compact.py")}  # fmt: skip
+          "take_compact.py": ("ecs_tentacles.take", "compact.py"),
+          "numeric_hamilton.py": ("ecs_tentacles.numeric", "hamilton.py")}  # fmt: skip
 _EPOCH = (1980, 1, 1, 0, 0, 0)
 INSTALL = """
 import sys, bpy

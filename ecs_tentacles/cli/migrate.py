@@ -5,9 +5,10 @@ writes every plugin the scene runs under `plugins`, with its full config, turns
 the older `systems` list of import paths into plugin entries (`{"from": "module:Class"}`)
 so they are configured like any plugin, and removes the keys of built-in plugins the
 scene turns off (an older scene with locomotion off may carry tentacle waves, which
-are the locomotion plugin's keys now). The result is validated before it is written,
-atomically, to `--out` (default: beside the scene, `<name>.migrated.json`) or over the
-scene with `--in-place`.
+are the locomotion plugin's keys now), and writes a plugin's former key under its key
+now (`plugins.lod` -> `plugins.clips`; the loader reads the old key too, with a warning).
+The result is validated before it is written, atomically, to `--out` (default: beside
+the scene, `<name>.migrated.json`) or over the scene with `--in-place`.
 """
 
 from __future__ import annotations
@@ -23,7 +24,7 @@ from ecs_tentacles.cli.arguments import output_path, read_only_problem
 from ecs_tentacles.output.atomic import atomic_output, claim
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.load import load_scene_plugins, read_scene_json, resolve_scene_path
-from ecs_tentacles.scene.plugins import FROM, default_on, shipped
+from ecs_tentacles.scene.plugins import FROM, default_on, renamed, shipped
 from ecs_tentacles.scene.schema import builtin_keys
 
 
@@ -66,7 +67,13 @@ def migrate(raw: dict[str, Any]) -> tuple[dict[str, Any], list[str]]:
     """The scene with `plugins` explicit and `systems` folded in; and what changed."""
     scene = copy.deepcopy(raw)
     changes: list[str] = []
-    plugins: dict[str, object] = dict(scene.get("plugins") or {})
+    plugins: dict[str, Any] = {}
+    old = renamed()
+    for key, value in (scene.get("plugins") or {}).items():
+        if key in old:
+            changes.append(f"plugins.{key} -> plugins.{old[key]} (the plugin's key now)")
+        if old.get(key, key) not in plugins or key not in old:  # the new key's value wins
+            plugins[old.get(key, key)] = value
     for name in default_on():
         if name not in plugins:
             plugins[name] = {}

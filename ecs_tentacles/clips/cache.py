@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 
 from ecs_tentacles.clips import disk
 from ecs_tentacles.clips.clips import GaitClips
-from ecs_tentacles.clips.record import one_creature_scene
+from ecs_tentacles.clips.gait_world import one_creature_scene
 from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.creatures.body import build_creature
 from ecs_tentacles.physics.model import ModelLayout, model_layout

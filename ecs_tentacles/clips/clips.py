@@ -30,7 +30,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from ecs_tentacles.clips.frames import nlerp, quat_power, rotate_z, to_ground, yaw_times
-from ecs_tentacles.clips.record import GaitRecording, forward_poses, one_creature_scene, record
+from ecs_tentacles.clips.gait_world import (
+    GaitRecording,
+    forward_poses,
+    one_creature_scene,
+    simulate,
+)
 from ecs_tentacles.numeric.optional_kernels import OptionalKernels
 from ecs_tentacles.numeric.quaternions import quat_multiply
 from ecs_tentacles.scene.scene_spec import PhysicsSpec
@@ -123,8 +128,8 @@ class GaitClips:
         if not 0 < loop[0] < loop[1] <= seconds:
             raise ValueError(f"loop: must be 0 < shortest < longest <= seconds, got {loop}")
         goal = (warmup + seconds) * MAX_CRAWL_SPEED + GOAL_MARGIN
-        crawling = record(one_creature_scene(creature, physics, goal), warmup, seconds)
-        resting = record(one_creature_scene(creature, physics, None), warmup, seconds)
+        crawling = simulate(one_creature_scene(creature, physics, goal), warmup, seconds)
+        resting = simulate(one_creature_scene(creature, physics, None), warmup, seconds)
         return cls(
             key=crawling.key,
             bodies=crawling.bodies,

@@ -1,4 +1,5 @@
-"""The lod plugin: gait-clip replay for the KINEMATIC level of detail.
+"""The clips plugin (scene key `plugins.clips`, `lod` before): gait-clip replay for the
+KINEMATIC level of detail.
 
 The physics decides who runs at which tier (`ecs_tentacles.physics.lod`, `world.lod`);
 without this plugin nobody is ever kinematic (the cheapest tier is REDUCED). With it,
@@ -22,7 +23,7 @@ if TYPE_CHECKING:
 
 
 class ClipsPlugin(Plugin):
-    name = "lod"
+    name = "clips"  # was "lod", which scenes still load by (the "renamed" entry points)
     build_order = 50  # a default plugin: built after fur (40), before terrain (60)
     description = "kinematic crowds: creatures far from the action replay gait clips"
 

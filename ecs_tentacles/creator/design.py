@@ -29,7 +29,7 @@ import os
 import pathlib
 import re
 from dataclasses import asdict, dataclass, replace
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, TypedDict
 
 from ecs_tentacles.creator.limits import DesignError, checked, default
 from ecs_tentacles.output.atomic import atomic_file
@@ -39,9 +39,23 @@ from ecs_tentacles.scene.load import load_scene, read_scene_json, resolve_scene_
 from ecs_tentacles.scene.schema import load_schema
 
 if TYPE_CHECKING:
+    from typing_extensions import Unpack  # (typing's own from Python 3.12)
+
     from ecs_tentacles.world import World
 
 SHAPE_KEYS = ("links", "link_length", "link_radius", "end_scale")
+
+
+class UniformSettings(TypedDict, total=False):
+    """The creature's uniform settings (`CreatureDesign(...)`, `build`); None: as it is."""
+
+    mantle_radius: float | None
+    mantle_height: float | None
+    count: int | None
+    links: int | None
+    link_length: float | None
+    link_radius: float | None
+    end_scale: float | None
 
 
 @dataclass(frozen=True)
@@ -62,18 +76,7 @@ class TentacleDesign:
 class CreatureDesign:
     """A creature being designed; see the module docstring for the two steps."""
 
-    def __init__(
-        self,
-        name: str = "creature",
-        *,
-        mantle_radius: float | None = None,
-        mantle_height: float | None = None,
-        count: int | None = None,
-        links: int | None = None,
-        link_length: float | None = None,
-        link_radius: float | None = None,
-        end_scale: float | None = None,
-    ):
+    def __init__(self, name: str = "creature", **settings: Unpack[UniformSettings]):
         self.name = name  # checked by the property
         self.mantle_radius: float = default("mantle", "radius")
         self.mantle_height: float = default("mantle", "height")
@@ -84,15 +87,7 @@ class CreatureDesign:
         self._scene: dict[str, Any] = {"version": 1}
         self._creatures: list[dict[str, Any]] = [{}]
         self._index = 0
-        self.build(
-            mantle_radius=mantle_radius,
-            mantle_height=mantle_height,
-            count=count,
-            links=links,
-            link_length=link_length,
-            link_radius=link_radius,
-            end_scale=end_scale,
-        )
+        self.build(**settings)
 
     @property
     def name(self) -> str:
@@ -109,29 +104,19 @@ class CreatureDesign:
         self._name = value
 
     # -- step 1: uniform settings ------------------------------------------------------
-    def build(
-        self,
-        *,
-        mantle_radius: float | None = None,
-        mantle_height: float | None = None,
-        count: int | None = None,
-        links: int | None = None,
-        link_length: float | None = None,
-        link_radius: float | None = None,
-        end_scale: float | None = None,
-    ) -> None:
+    def build(self, **settings: Unpack[UniformSettings]) -> None:
         """The "Build creature" button: take these uniform settings, make every tentacle so.
 
-        Settings left as None keep their current value. Per-tentacle changes are lost.
+        Settings left out or None keep their current value. Per-tentacle changes are lost.
         """
-        changes: dict[str, Any] = {"links": links, "link_length": link_length}
-        changes |= {"link_radius": link_radius, "end_scale": end_scale}
+        changes: dict[str, Any] = {k: settings.get(k) for k in SHAPE_KEYS}
         uniform = replace(self.uniform, **{k: v for k, v in changes.items() if v is not None})
         uniform = uniform.checked()
+        count = settings.get("count")
         if count is None:
             count = len(self.tentacles) or default("tentacles", "count")
         number = checked("count", "tentacles", "count", count)
-        self.set_mantle(radius=mantle_radius, height=mantle_height)
+        self.set_mantle(radius=settings.get("mantle_radius"), height=settings.get("mantle_height"))
         self.uniform = uniform
         self.tentacles = [uniform] * number
         self.selected = None

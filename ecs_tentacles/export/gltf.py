@@ -25,7 +25,7 @@ tests check files with the Khronos glTF validator.
 from __future__ import annotations
 
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -152,13 +152,7 @@ def gltf_document(
     if ground is not None:
         nodes[0]["children"].append(ground)
     document: Document = {
-        "asset": {
-            "version": "2.0",
-            "generator": f"ecs_tentacles {__version__}",
-            "extras": {k: header[k] for k in ("scene", "scene_sha256", "seed", "fps")},
-        },
-        "scene": 0,
-        "scenes": [{"name": str(header["scene"]), "nodes": [0]}],
+        **document_head(header, [0]),
         "nodes": nodes,
         "meshes": meshes,
         "materials": materials,
@@ -171,6 +165,21 @@ def gltf_document(
         add_gltf_goals(take, buffer, nodes, animation)
     document["animations"] = [animation]
     return document | buffer.fields()
+
+
+def document_head(header: Mapping[str, object], roots: list[int]) -> Document:
+    """What every glTF document the exporters write starts with: the asset (generator,
+    and the take's scene, scene hash, seed and fps as extras) and its one scene, whose
+    root nodes are `roots`."""
+    return {
+        "asset": {
+            "version": "2.0",
+            "generator": f"ecs_tentacles {__version__}",
+            "extras": {k: header[k] for k in ("scene", "scene_sha256", "seed", "fps")},
+        },
+        "scene": 0,
+        "scenes": [{"name": str(header["scene"]), "nodes": roots}],
+    }
 
 
 def scale_visibility(
@@ -257,6 +266,12 @@ def _mesh(buffer: GlbBuffer, mesh: BodyMesh, name: str, material: int) -> Mesh:
         "NORMAL": buffer.add(normals, "VEC3", ARRAY_BUFFER),
     }
     indices = buffer.add(mesh.indices, "SCALAR", ELEMENT_ARRAY_BUFFER)
+    return triangle_mesh(name, attributes, indices, material)
+
+
+def triangle_mesh(name: str, attributes: dict[str, int], indices: int, material: int) -> Mesh:
+    """A mesh of one primitive: triangles (mode 4) of the accessors `attributes` and
+    `indices`, in `material`."""
     primitive: Primitive = {
         "attributes": attributes,
         "indices": indices,

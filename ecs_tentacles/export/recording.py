@@ -14,21 +14,21 @@ from __future__ import annotations
 import hashlib
 import json
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, Any, Literal, Protocol, runtime_checkable
+from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
 
 import numpy as np
 
-from ecs_tentacles.components import Creature, Link, Tentacle, Transform
-from ecs_tentacles.export.frame_arrays import doubled, gather, resized_frames, widen
+from ecs_tentacles.components import Creature
+from ecs_tentacles.export.frame_arrays import doubled, gather, widen
+from ecs_tentacles.export.recording_stream import StreamedFrames
 from ecs_tentacles.export.replay_recording import ReplayRecorder
+from ecs_tentacles.export.take_tables import TakeTables
 from ecs_tentacles.export.track_recording import CurvesTrack, PointsTrack
 from ecs_tentacles.ground import ground_of
-from ecs_tentacles.numeric.rows import ordinals, run_slice
-from ecs_tentacles.take import FORMAT, VERSION, Take, TakeError, chunks
+from ecs_tentacles.scene.plugins import former_keys
+from ecs_tentacles.take import FORMAT, VERSION, Take, chunks
 from ecs_tentacles.take import ground as take_ground
-from ecs_tentacles.take import replay as take_replay
 from ecs_tentacles.take import roster as take_roster
-from ecs_tentacles.take.entries import data_problem
 from ecs_tentacles.take.registries import (
     RecordingStarts,
     TakeTracks,
@@ -38,7 +38,6 @@ from ecs_tentacles.take.tracks import STANDARD, declared_problem
 
 if TYPE_CHECKING:
     from ecs_tentacles.roster_change import RosterChange
-    from ecs_tentacles.take.header_entries import HeaderBody, HeaderCreature, HeaderSucker
     from ecs_tentacles.take.writer import TakeWriter
     from ecs_tentacles.world import World
 
@@ -64,14 +63,15 @@ def before_recording(world: World) -> None:
 
 
 def scene_sha256(scene: dict[str, Any] | None) -> str:
-    """SHA-256 of a scene's canonical JSON (sorted keys, no spaces); '' without a scene."""
+    """SHA-256 of a scene's canonical JSON (sorted keys, no spaces; plugins by the keys
+    they had first, `scene.plugins.former_keys`); '' without a scene."""
     if scene is None:
         return ""
-    text = json.dumps(scene, sort_keys=True, separators=(",", ":"))
+    text = json.dumps(former_keys(scene), sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode()).hexdigest()
 
 
-class TakeRecorder:
+class TakeRecorder(TakeTables, StreamedFrames):
     """Copies a world's frames into growing float32 arrays; `take()` returns the Take.
 
     `fps` is the take's frame rate (the world's by default; a bake recording every
@@ -175,70 +175,6 @@ class TakeRecorder:
 
         return handler
 
-    def _layout(self, world: World) -> None:
-        """Body and sucker tables in take order: creature by creature, mantle then links."""
-        self._creatures: list[HeaderCreature] = []
-        self._bodies: list[HeaderBody] = []
-        self._suckers: list[HeaderSucker] = []
-        self.creature_index: dict[int, int] = {}  # creature entity -> its index in the take
-        self._rows = np.zeros(0, dtype=np.int64)  # take body -> Transform row (-1: gone)
-        self._sucker_rows = np.zeros(0, dtype=np.int64)  # take sucker -> Sucker row
-        by_row = sorted(world.query(Creature), key=lambda item: item[1].row)
-        self._add_creatures(world, by_row)
-
-    def _add_creatures(self, world: World, creatures: Sequence[tuple[int, Creature]]) -> None:
-        """Append creatures to the take's tables: each one's mantle, then its links
-        tentacle by tentacle; then their suckers, creature by creature, in store order."""
-        first = len(self._bodies)
-        rows: list[int] = []
-        for entity, creature in creatures:
-            rows += self._add_bodies(world, entity, creature)
-        added = np.asarray(rows, dtype=np.int64)
-        self._rows = np.concatenate([self._rows, added])
-        # the bodies as one run of store rows, or None (what a roster change leaves is
-        # gathered row by row: `_changes`)
-        self._span = run_slice(self._rows)
-        self._add_suckers(world, added, first)
-
-    def _add_bodies(self, world: World, entity: int, creature: Creature) -> list[int]:
-        """Append one creature's bodies to the take's tables; their Transform rows."""
-        index = self.creature_index[entity] = len(self._creatures)
-        world.kept_names.add(name := creature.name)  # a later spawn of it gets a suffix
-        first = len(self._bodies)
-        rows = [world.component(entity, Transform).row]
-        entry: HeaderCreature = {"name": name, "mantle": first, "tentacles": []}
-        self._bodies.append(_body(f"{name}/mantle", index, "cylinder", "Z", creature))
-        for tentacle_entity in creature.tentacles:
-            tentacle = world.component(tentacle_entity, Tentacle)
-            chain = []
-            for link_entity in tentacle.links:
-                link = world.component(link_entity, Link)
-                chain.append(first + len(rows))
-                rows.append(world.component(link_entity, Transform).row)
-                body = f"{name}/tentacles/t{tentacle.index}/link{link.index}"
-                self._bodies.append(_body(body, index, "capsule", "X", link))
-            entry["tentacles"].append(chain)
-        self._creatures.append(entry)
-        return rows
-
-    def _add_suckers(self, world: World, rows: np.ndarray, first: int) -> None:
-        """Append the suckers on the take's bodies `first...` (at Transform `rows`):
-        creature by creature, each creature's in store order, named by their body."""
-        suckers = world.suckers
-        body_of_row = np.full(len(world.transforms), -1, dtype=np.int64)
-        body_of_row[rows] = np.arange(first, first + len(rows))
-        carrier = body_of_row[suckers.link_row]
-        mine = np.flatnonzero(carrier >= 0)
-        owner = np.array([body["creature"] for body in self._bodies[first:]], dtype=np.int64)
-        mine = mine[np.argsort(owner[carrier[mine] - first], kind="stable")]
-        carriers = carrier[mine]
-        number = ordinals(carriers)  # each sucker's place among its body's
-        offsets = suckers.offset[mine].tolist()
-        for body, n, offset in zip(carriers.tolist(), number.tolist(), offsets, strict=True):
-            name = f"{self._bodies[body]['name']}/sucker{n}"
-            self._suckers.append({"name": name, "body": body, "offset": offset})
-        self._sucker_rows = np.concatenate([self._sucker_rows, mine])
-
     # -- creatures that come and go --------------------------------------------------
     def roster_changed(self, change: RosterChange) -> None:
         """A creature was spawned (its bodies join the take, hidden before now) or
@@ -311,65 +247,6 @@ class TakeRecorder:
         if self.writer is not None and self.writer.chunk_frames is None:
             self._size_chunks()
 
-    def _size_chunks(self) -> None:
-        """Frames per chunk from the first frame's bytes of every chunked array (the
-        curves tracks sampled by now among them), as `Take.save` counts them."""
-        assert self.writer is not None
-        frame = sum(a[:1].nbytes for a in self._chunk_arrays(1).values())
-        for track in self.tracks:
-            if isinstance(track, CurvesTrack):
-                frame += sum(a[:1].nbytes for a in track.arrays(1, copy=False).values())
-        self.writer.chunk_frames = per = chunks.chunk_frames(frame)
-        for name in ("_pos", "_quat", "_attached", "_anchor"):
-            setattr(self, name, resized_frames(getattr(self, name), per))
-        self._replayed = {k: resized_frames(v, per) for k, v in self._replayed.items()}
-
-    def _before(self, name: str, i: int) -> np.ndarray | None:
-        """Frame `i - 1` of chunked array `name` (`_pos`, ...): in the array, or the last
-        frame handed to the writer when `i` starts a chunk; None before the first."""
-        if i:
-            return np.asarray(getattr(self, f"_{name}")[i - 1])
-        return self._flushed_last.get(name)
-
-    def _chunk_arrays(self, frames: int) -> dict[str, np.ndarray]:
-        """The chunked arrays' first `frames` frames, by file name."""
-        out = {
-            "pos": self._pos[:frames],
-            "quat": self._quat[:frames],
-            "sucker_attached": self._attached[:frames],
-            "sucker_anchor": self._anchor[:frames],
-        }
-        out.update({name: value[:frames] for name, value in self._replayed.items()})
-        return out
-
-    def _flush(self) -> None:
-        """Hand the frames held to the writer (streamed recording). The first time, the
-        curves tracks recording by then are chunked too (`header["chunked"]`)."""
-        assert self.writer is not None
-        held = self.count - self._base
-        if not held:
-            return
-        if self._chunked_curves is None:
-            self._chunked_curves = [t for t in self.tracks if isinstance(t, CurvesTrack)
-                                    and t.flush(self._base) is not None]  # fmt: skip
-            curves = [a for t in self._chunked_curves for a in t.track.arrays]
-            self.header["chunked"] = [*self._chunk_arrays(0), *curves]
-            points = [t.track.arrays[0] for t in self._chunked_curves]
-            self.writer.quantised = dict.fromkeys(points, chunks.STEP)  # as `Take.save` does
-        arrays = self._chunk_arrays(held)
-        for track in self._chunked_curves:
-            arrays.update(track.flush(self.count) or {})
-        numbers = {k: v for k, v in arrays.items() if not k.startswith("replay_")}
-        problem = data_problem(numbers, [t.track for t in self._chunked_curves], self._base)
-        if problem:  # a plugin's NaN: nobody could read the take
-            raise TakeError(f"{self.writer.path}: cannot write this take: {problem}")
-        # a creature gone keeps its last pose: remembered across the chunk boundary
-        self._flushed_last = {
-            name: getattr(self, f"_{name}")[held - 1].copy() for name in ("pos", "quat", "anchor")
-        }
-        self.writer.add_frames(take_replay.blanked(self.header, arrays, in_place=True))
-        self._base = self.count
-
     @property
     def capacity(self) -> int:
         """Frames the arrays have room for now (they double when full; streamed: a chunk)."""
@@ -404,17 +281,6 @@ class TakeRecorder:
             raise RuntimeError("a streamed recording ends with finish_stream()")
         self._finished = True
         return self._take(copy=False)
-
-    def finish_stream(self) -> dict[str, Any]:
-        """End a streamed recording: the last frames, the arrays without chunks and the
-        header go to the writer (its file is renamed into place when its block ends);
-        returns the header as written."""
-        assert self.writer is not None, "finish_stream() ends a streamed recording"
-        self._flush()
-        self._finished = True
-        header, tracks = self._header_and_tracks(self.count, copy=False)
-        self.writer.finish(header, tracks)
-        return {**header, "frames": self.writer.frames, "chunk_frames": self.writer.chunk_frames}
 
     def _header_and_tracks(
         self, n: int, copy: bool
@@ -452,27 +318,6 @@ class TakeRecorder:
             sucker_anchor=kept(self._anchor[:n]),
             tracks=tracks,
         )
-
-
-def _body(
-    name: str,
-    creature: int,
-    shape: Literal["cylinder", "capsule"],
-    axis: Literal["X", "Z"],
-    part: Creature | Link,
-) -> HeaderBody:
-    if isinstance(part, Creature):
-        radius, length = part.mantle_radius, part.mantle_height
-    else:
-        radius, length = part.radius, part.length
-    return {
-        "name": name,
-        "creature": creature,
-        "shape": shape,
-        "axis": axis,
-        "radius": float(radius),
-        "length": float(length),
-    }
 
 
 def _sha(world: World) -> str:

@@ -28,7 +28,6 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ecs_tentacles import __version__
 from ecs_tentacles.export.glb import (
     ARRAY_BUFFER,
     ELEMENT_ARRAY_BUFFER,
@@ -40,10 +39,12 @@ from ecs_tentacles.export.gltf import (
     Z_UP_TO_Y_UP,
     Progress,
     add_gltf_goals,
+    document_head,
     scale_visibility,
     sucker_nodes,
     to_y_up_points,
     to_y_up_rotations,
+    triangle_mesh,
 )
 from ecs_tentacles.export.ground import add_gltf_ground
 from ecs_tentacles.export.materials import gltf_material, skin_texture, take_colours
@@ -63,7 +64,6 @@ if TYPE_CHECKING:
         Material,
         Mesh,
         Node,
-        Primitive,
         Skin,
         TargetPath,
     )
@@ -190,13 +190,7 @@ def skinned_document(
     if ground is not None:
         nodes[0]["children"].append(ground)
     document: Document = {
-        "asset": {
-            "version": "2.0",
-            "generator": f"ecs_tentacles {__version__}",
-            "extras": {k: header[k] for k in ("scene", "scene_sha256", "seed", "fps")},
-        },
-        "scene": 0,
-        "scenes": [{"name": str(header["scene"]), "nodes": roots}],
+        **document_head(header, roots),
         "nodes": nodes,
         "meshes": meshes,
         "skins": skins,
@@ -234,13 +228,7 @@ def _mesh(buffer: GlbBuffer, mesh: SkinMesh, name: str, material: int) -> Mesh:
         "WEIGHTS_0": buffer.add(weights, "VEC4", ARRAY_BUFFER),
     }
     indices = buffer.add(triangles.reshape(-1).astype(np.uint16), "SCALAR", ELEMENT_ARRAY_BUFFER)
-    primitive: Primitive = {
-        "attributes": attributes,
-        "indices": indices,
-        "material": material,
-        "mode": 4,
-    }
-    return {"name": f"{name}/skin", "primitives": [primitive]}
+    return triangle_mesh(f"{name}/skin", attributes, indices, material)
 
 
 def _channels(

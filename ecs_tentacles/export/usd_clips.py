@@ -59,24 +59,19 @@ from ecs_tentacles.export.usd_layer import StreamedLayer
 from ecs_tentacles.export.usd_plans import BodyPlan, define_skin
 from ecs_tentacles.skin.streamed import JointRotations
 from ecs_tentacles.take.replay import blend
+from ecs_tentacles.take.stream import ReplaySegment
 
 KINDS = ("idle", "crawl")  # replay_kind 0 and 1
 FOLDER = "clips"
 
 
 @dataclass(frozen=True)
-class Stretch:
-    """Creature `creature`'s frames [first, end): clip `clip`'s `kind` loop at clip frame
-    `phase + (f - first) * rate` (`phase` taken into the loop's first turn), on the
-    shared animation at `path`."""
+class Stretch(ReplaySegment):
+    """Creature `creature`'s replay segment (frames [first, end): clip `clip`'s `kind`
+    loop at clip frame `phase + (f - first) * rate`, `phase` taken into the loop's first
+    turn), on the shared animation at `path`."""
 
     creature: int
-    first: int
-    end: int
-    clip: int
-    kind: int
-    phase: float
-    rate: float
     path: str
 
 
@@ -147,10 +142,8 @@ class SharedClips:
                     reach = phase + (segment.end - segment.first) * segment.rate
                     shared.low = min(shared.low, math.floor(phase))
                     shared.high = max(shared.high, math.ceil(reach))
-                    mine.append(
-                        Stretch(creature, segment.first, segment.end, segment.clip,
-                                segment.kind, phase, segment.rate, shared.path)
-                    )  # fmt: skip
+                    fields = {**vars(segment), "phase": phase}
+                    mine.append(Stretch(**fields, creature=creature, path=shared.path))
                     own[segment.first : segment.end, creature] = False
                     heading[segment.first : segment.end, creature] = turn[
                         segment.first : segment.end

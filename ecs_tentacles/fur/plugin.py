@@ -37,7 +37,7 @@ STORES = ("guides", "controls", "sets", "emotions")
 
 class FurPlugin(Plugin):
     name = "fur"
-    build_order = 40  # a default plugin: built after threats (30), before lod (50)
+    build_order = 40  # a default plugin: built after threats (30), before clips (50)
     description = "fur and feathers (lift, aim, direction, random, dynamic blend) and emotion"
     creature_schema = _FRAGMENT["creature"]
     defs = _FRAGMENT["$defs"]

@@ -34,8 +34,6 @@ if TYPE_CHECKING:
     from ecs_tentacles.render.registries import SandboxView
     from ecs_tentacles.world import World
 
-BANNER_WIDTH = 360.0
-
 
 class GamePanel(Panel):
     title = "Game"
@@ -123,18 +121,8 @@ class GamePanel(Panel):
         if game.outcome not in (WON, LOST):
             return
         self._record()
-        width, height = self.sandbox.window.width, self.sandbox.window.height
-        imgui.set_next_window_pos((width / 2, height * 0.3), 0, (0.5, 0.5))
-        # a fixed height: a window sized to fit its contents is hidden on its first frame
-        line = imgui.get_text_line_height_with_spacing()
-        imgui.set_next_window_size((BANNER_WIDTH * line / 17.0, 8.5 * line))
-        flags = imgui.WindowFlags_.no_move | imgui.WindowFlags_.no_resize
-        flags |= imgui.WindowFlags_.no_collapse | imgui.WindowFlags_.no_title_bar
-        imgui.begin("Game over", None, flags | imgui.WindowFlags_.no_scrollbar)
-        gui.window_rect("game banner")
-        imgui.push_font(None, 2.0 * imgui.get_style().font_size_base)
-        imgui.text("You won!" if game.outcome == WON else "Time's up")
-        imgui.pop_font()
+        headline = "You won!" if game.outcome == WON else "Time's up"
+        gui.begin_banner("Game over", "game banner", headline, rows=8.5)
         if game.outcome == WON:
             imgui.text(f"{game.penned} penned in {game.elapsed:.1f} s (par {game.par:.0f} s)")
             imgui.text(f"{stars_text(game.stars())}  {game.stars()} of 3 stars")

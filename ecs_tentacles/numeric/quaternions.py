@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ecs_tentacles.numeric.hamilton import multiply
 from ecs_tentacles.numeric.optional_kernels import OptionalKernels
 
 # numba's kernel when installed (the same numbers bit for bit; "numpy": never)
@@ -45,16 +46,4 @@ def quat_rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
     return np.asarray(v + w * t + cross(u, t))
 
 
-def quat_multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Hamilton product a * b of quaternion arrays (..., 4)."""
-    aw, ax, ay, az = np.moveaxis(a, -1, 0)
-    bw, bx, by, bz = np.moveaxis(b, -1, 0)
-    return np.stack(
-        [
-            aw * bw - ax * bx - ay * by - az * bz,
-            aw * bx + ax * bw + ay * bz - az * by,
-            aw * by - ax * bz + ay * bw + az * bx,
-            aw * bz + ax * by - ay * bx + az * bw,
-        ],
-        axis=-1,
-    )
+quat_multiply = multiply  # Hamilton product a * b of quaternion arrays (..., 4)

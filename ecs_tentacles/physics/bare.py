@@ -182,15 +182,16 @@ def step_captured(work: Work, frame: BareFrame, substeps: dict[int, int], thread
             d.xfrc_applied[:] = 0.0
             scratch.forced = False
         positions = np.searchsorted(captured.rows, segment.rows)
-        servos = None  # as `physics.reduced_step` forms them: for all at once
+        overlay = None  # as `physics.reduced_step` forms the servos: for all at once
         if reduced is not None:
             servos = reduced.servos(
                 captured.kp[positions], captured.kv[positions], captured.torque[positions]
             )
+            overlay = reduced.overlay_writer(captured, m, servos)
         for at, position in enumerate(positions.tolist()):
             split = 1
-            if reduced is not None and servos is not None:
-                split = reduced.write_overlay(captured, m, position, servos, at)
+            if overlay is not None:
+                split = overlay(position, at)
             else:
                 write_overlay(captured, m, position)
             forces = captured.forces.get(position)

@@ -3,6 +3,9 @@
 The physics (model building, batches, health check, sleep) is written against this
 `typing.Protocol`, not against `ecs_tentacles.world.World`: the World satisfies it
 structurally, and the physics package never imports the module that builds on it.
+Systems and plugins see the wider `ecs_tentacles.host.Host`, which extends this one
+(the stores, resources, schedule and plugins besides): `PhysicsHost` is the physics'
+view of a world, `Host` everyone else's.
 """
 
 from __future__ import annotations

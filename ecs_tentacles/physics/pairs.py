@@ -25,6 +25,7 @@ from ecs_tentacles.numeric.optional_kernels import OptionalKernels
 SLACK = 0.25  # metres of extra reach the kept pairs are found with
 DENSE_PAIRS = 32  # creatures up to which every pair is compared (no tree to build)
 _NONE = np.zeros(0, dtype=np.int64)
+_EVERY = np.zeros(0, dtype=np.bool_)  # `kept_within`'s "every creature"
 KERNELS = OptionalKernels("ecs_tentacles.physics.kernels", "ECS_TENTACLES_SENSE")
 
 
@@ -62,6 +63,13 @@ class NearPairCache:
             self.queries += 1
         assert self._kept is not None
         a, b = self._kept
+        fast = KERNELS.get()
+        if fast is not None:  # the same pairs in one pass (no index arrays)
+            every = _EVERY if among is None else np.asarray(among, dtype=np.bool_)
+            found_a, found_b = fast.kept_within(
+                centre, radius, a, b, self._offsets, every, float(margin)
+            )
+            return np.asarray(found_a), np.asarray(found_b)
         if among is not None:  # the kept pairs are sorted by a: each creature's are a run
             a, b = _runs_of(self._offsets, np.flatnonzero(among), a, b)
         keep = spheres_within(centre, radius, a, b, margin)

@@ -11,7 +11,8 @@ A share's rows go through three parts:
 1. for all rows at once (numba kernels, the interpreter's lock released): the frame's
    inputs pulled into the reduced states (fitted again where the full state was
    written from outside), every row's reduced servos;
-2. row by row on the thread's scratch: the overlay into the reduced model, MuJoCo's
+2. row by row on the thread's scratch: the overlay into the reduced model (what it
+   looks up found once for the share, `ReducedModel.overlay_writer`), MuJoCo's
    step (`Batch.advance`: `mj_setState`, `mj_step`, `mj_getState`, the warnings and
    the deepest contact); the bare frames of `physics.bare` do this part alone;
 3. for all rows at once: the stepped rows shown as full states and their body poses
@@ -78,24 +79,25 @@ def step_reduced(
     for row in reduced.pull_into(rows, state, rstate, rsource).tolist():
         reduced.fit_state(state[row], rstate[row])
     servos = reduced.servos(batch.kp, batch.kv, batch.torque, rows)
-    stepped = np.zeros(len(rows), dtype=bool)
-    took = np.zeros(len(rows))
+    overlay = reduced.overlay_writer(batch, scratch.model, servos)
+    stepped: list[bool] = []
+    took: list[float] = []
     shared = clock() - began
-    m, applied = scratch.model, batch.applied
+    applied, advance = batch.applied, batch.advance
     scratch.warnings[:] = 0  # `advance` clears them after a row that raised one
     for at, row in enumerate(rows.tolist()):
         began = clock()
-        split = reduced.write_overlay(batch, m, row, servos, at)
+        split = overlay(row, at)
         pushed = applied.get(row)
         forces = None if pushed is None else reduced.body_group @ pushed
-        stepped[at] = batch.advance(scratch, row, rstate[row], forces, substeps * split)
-        took[at] = clock() - began
+        stepped.append(advance(scratch, row, rstate[row], forces, substeps * split))
+        took.append(clock() - began)
     began = clock()
-    done = rows[stepped]
+    done = rows[np.array(stepped, dtype=bool)]
     if len(done):
         reduced.show_rows(done, rstate, state, rsource)
         full = batch.scratch_for(thread, FULL)
         pose_map.show(done, state, batch.slices[int(S.mjSTATE_QPOS)], batch.xpos, batch.xquat,
                       full.model, full.data)  # fmt: skip
     shared += clock() - began
-    return took, shared / len(rows) if len(rows) else 0.0
+    return np.array(took), shared / len(rows) if len(rows) else 0.0

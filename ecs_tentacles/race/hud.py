@@ -23,8 +23,6 @@ if TYPE_CHECKING:
     from ecs_tentacles.render.registries import SandboxView
     from ecs_tentacles.world import World
 
-BANNER_WIDTH = 360.0
-
 
 class RacePanel(Panel):
     title = "Race"
@@ -64,18 +62,9 @@ class RacePanel(Panel):
         race = self.race
         if race.outcome not in (WON, LOST):
             return
-        width, height = self.sandbox.window.width, self.sandbox.window.height
-        imgui.set_next_window_pos((width / 2, height * 0.3), 0, (0.5, 0.5))
-        line = imgui.get_text_line_height_with_spacing()
-        imgui.set_next_window_size((BANNER_WIDTH * line / 17.0, 5.5 * line))
-        flags = imgui.WindowFlags_.no_move | imgui.WindowFlags_.no_resize
-        flags |= imgui.WindowFlags_.no_collapse | imgui.WindowFlags_.no_title_bar
-        imgui.begin("Race over", None, flags | imgui.WindowFlags_.no_scrollbar)
-        gui.window_rect("race banner")
-        imgui.push_font(None, 2.0 * imgui.get_style().font_size_base)
+        headline = "You won!" if race.outcome == WON else "You lost"
+        gui.begin_banner("Race over", "race banner", headline, rows=5.5)
         winner = race.winner_name(self.sandbox.world)
-        imgui.text("You won!" if race.outcome == WON else "You lost")
-        imgui.pop_font()
         if race.outcome == WON:
             imgui.text(f"flag taken in {race.elapsed:.1f} s")
         else:

@@ -113,32 +113,33 @@ class InstancedMesh:
         return 1
 
 
-class Lines:
-    """A list of coloured line segments (or, `triangles`, coloured triangles), drawn in
-    one call."""
+class SegmentRibbons:
+    """Line segments drawn as ribbons a vertex shader makes (`render.outlines`): one
+    instance a segment, six corners each, one instanced call."""
 
-    def __init__(self, triangles: bool = False) -> None:
-        self.mode = gl.GL_TRIANGLES if triangles else gl.GL_LINES
+    def __init__(self, instance_floats: int, layout: tuple[tuple[int, int], ...]) -> None:
+        self.floats = instance_floats
         self.vao = _vertex_array()
         gl.glBindVertexArray(self.vao)
         self.buffer = _buffer()
         self.capacity = [0]
-        _upload(gl.GL_ARRAY_BUFFER, self.buffer, np.zeros((2, 7), np.float32), self.capacity)
-        _attribute(0, 3, 7 * FLOAT, 0)
-        _attribute(1, 4, 7 * FLOAT, 3)
+        empty = np.zeros((1, instance_floats), np.float32)
+        _upload(gl.GL_ARRAY_BUFFER, self.buffer, empty, self.capacity)
+        for location, (size, offset) in enumerate(layout):
+            _attribute(location, size, instance_floats * FLOAT, offset, divisor=1)
         gl.glBindVertexArray(0)
         self.count = 0
 
-    def update(self, vertices: np.ndarray) -> None:
-        """float32 (2n, 7): segment end points with colour."""
-        self.count = len(vertices)
+    def update(self, instances: np.ndarray) -> None:
+        """float32 (n, instance_floats): one row a segment."""
+        self.count = len(instances)
         _upload(
-            gl.GL_ARRAY_BUFFER, self.buffer, vertices.astype(np.float32, copy=False), self.capacity
+            gl.GL_ARRAY_BUFFER, self.buffer, instances.astype(np.float32, copy=False), self.capacity
         )
 
     def draw(self) -> int:
         gl.glBindVertexArray(self.vao)
-        gl.glDrawArrays(self.mode, 0, self.count)
+        gl.glDrawArraysInstanced(gl.GL_TRIANGLES, 0, 6, self.count)
         return 1
 
 

@@ -21,6 +21,7 @@ from imgui_bundle import imgui
 from pyglet.window import BaseWindow, key, mouse
 
 BASE_HEIGHT = 720  # the window height at which the GUI is drawn at scale 1
+BANNER_WIDTH = 360.0  # a game banner's width (`Gui.begin_banner`) at 17 px a text line
 
 _KEYS = {
     key.TAB: imgui.Key.tab,
@@ -213,6 +214,24 @@ class Gui:
         self.windows[name] = (pos.x, pos.y, pos.x + size.x, pos.y + size.y)
         clip = imgui.internal.get_current_window().inner_clip_rect
         self.clips[name] = (clip.min.x, clip.min.y, clip.max.x, clip.max.y)
+
+    def begin_banner(self, title: str, name: str, headline: str, rows: float) -> None:
+        """Begin a game's end-of-round banner: a fixed window `rows` text lines high (a
+        window sized to fit its contents is hidden on its first frame), centred across
+        the window and a third of the way down, without title bar, moving or resizing;
+        its rectangle recorded as `name` (`window_rect`) and `headline` on top in
+        double-size text. The caller adds its lines and ends it (`imgui.end()`)."""
+        width, height = self.window.width, self.window.height
+        imgui.set_next_window_pos((width / 2, height * 0.3), 0, (0.5, 0.5))
+        line = imgui.get_text_line_height_with_spacing()
+        imgui.set_next_window_size((BANNER_WIDTH * line / 17.0, rows * line))
+        flags = imgui.WindowFlags_.no_move | imgui.WindowFlags_.no_resize
+        flags |= imgui.WindowFlags_.no_collapse | imgui.WindowFlags_.no_title_bar
+        imgui.begin(title, None, flags | imgui.WindowFlags_.no_scrollbar)
+        self.window_rect(name)
+        imgui.push_font(None, 2.0 * imgui.get_style().font_size_base)
+        imgui.text(headline)
+        imgui.pop_font()
 
     def measure_again(self) -> None:
         """A window sized to its content changed it this frame: ImGui sizes such a window

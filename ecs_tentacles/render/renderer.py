@@ -36,7 +36,7 @@ from ecs_tentacles.render.decals import QUAD, SUCKER_DISC, shadow_instances, suc
 from ecs_tentacles.render.gpu import (
     INSTANCE_FLOATS,
     InstancedMesh,
-    Lines,
+    SegmentRibbons,
     Target,
     program,
     set_matrix,
@@ -44,7 +44,8 @@ from ecs_tentacles.render.gpu import (
 from ecs_tentacles.render.horizon import HORIZON, fog_range
 from ecs_tentacles.render.instances import CreatureStatic, creature_links, link_instances
 from ecs_tentacles.render.meshes import CAPSULE_LODS, CYLINDER_LOD, SPHERE_LOD
-from ecs_tentacles.render.outlines import outlined_ribbons
+from ecs_tentacles.render.outlines import INSTANCE_FLOATS as RIBBON_FLOATS
+from ecs_tentacles.render.outlines import RIBBON_VERTEX, ribbon_instances
 from ecs_tentacles.render.registries import (
     Draws,
     FramedPoints,
@@ -83,7 +84,7 @@ class Renderer:
         self.target = Target(width, height)
         self.camera = OrbitCamera(width, height)
         self.lit = program(shaders.INSTANCED_VERTEX, shaders.LIT_FRAGMENT)
-        self.line_program = program(shaders.LINE_VERTEX, shaders.LINE_FRAGMENT)
+        self.line_program = program(RIBBON_VERTEX, shaders.LINE_FRAGMENT)
         self.scenery = Scenery()  # the sky and the ground (`render.scenery`)
         self.skinned_program = program(shaders.SKINNED_VERTEX, shaders.LIT_FRAGMENT)
         self.skinned = SkinnedCreatures()
@@ -95,7 +96,8 @@ class Renderer:
         self.blob_program = program(shaders.BLOB_VERTEX, shaders.BLOB_FRAGMENT)
         self.shadows = InstancedMesh(QUAD)  # a soft blob under every mantle and link
         self.sucker_discs = InstancedMesh(SUCKER_DISC)
-        self.lines = Lines(triangles=True)  # every line as an outlined ribbon
+        # every line as an outlined ribbon: ends a and b, rgba, width in pixels
+        self.lines = SegmentRibbons(RIBBON_FLOATS, ((3, 0), (3, 3), (4, 6), (1, 10)))
         self.selected: int | None = None  # creature entity (the HUD's)
         self.selection: tuple[int, ...] = ()  # every selected creature (a ring each)
         self.draw_calls = 0
@@ -104,6 +106,9 @@ class Renderer:
         # the clean view: none of the editor's aids (overlay entries, selection rings)
         self.clean = False
         self.show_tiers = False  # a marker per creature coloured by physics tier (render.tiers)
+        # pixels on the picture's left that an opaque panel drawn after the world covers
+        # (the sandbox's HUD): the world is not drawn there (`draw`)
+        self.covered_left = 0
         self.state: dict[str, Any] = {}  # what plugins keep here (GL objects), across worlds
         self.palette = "natural"  # the creatures' colours (`ecs_tentacles.skin.colours`)
         self.set_world(world)
@@ -281,7 +286,7 @@ class Renderer:
             )
         )  # fmt: skip
         self.spheres.update(self._sphere_instances())
-        self.lines.update(outlined_ribbons(self._line_vertices(pos), camera.eye, per_metre))
+        self.lines.update(ribbon_instances(self._line_vertices(pos)))
 
     def view_of_frame(self, pos: np.ndarray, quat: np.ndarray) -> RenderView:
         """The `RenderView` the plugins' hooks get this frame (kept in `render_view`)."""
@@ -361,6 +366,10 @@ class Renderer:
         """Render into the off-screen target; returns the number of draw calls."""
         pos, quat = self._posed(alpha)
         self.target.bind()
+        covered = min(max(int(self.covered_left), 0), self.target.width)
+        if covered:  # what the panel hides is neither cleared nor drawn (scissored off)
+            gl.glEnable(gl.GL_SCISSOR_TEST)
+            gl.glScissor(covered, 0, self.target.width - covered, self.target.height)
         gl.glClearColor(*SKY, 1.0)
         gl.glClear(gl.GL_COLOR_BUFFER_BIT | gl.GL_DEPTH_BUFFER_BIT)
         gl.glEnable(gl.GL_DEPTH_TEST)
@@ -369,7 +378,9 @@ class Renderer:
         eye = tuple(self.camera.eye.astype(np.float32))
         fog = fog_range(self.camera.distance)
         ground = ground_of(self.world)
-        calls = self.scenery.draw(ground, view_projection, eye, LIGHT, fog, grid=not self.clean)
+        calls = self.scenery.draw_kept(
+            self.target, ground, view_projection, eye, LIGHT, fog, grid=not self.clean
+        )
         # the ground is sent to be rasterised (software GL's threads fill it while this
         # one fills the creatures' arrays: about 4 ms less of a crowd's 50 ms frame)
         gl.glFlush()
@@ -405,6 +416,8 @@ class Renderer:
         # over their dark edges (no depth written between them)
         self.line_program.use()
         set_matrix(self.line_program, "u_view_projection", view_projection)
+        self.line_program["u_eye"] = eye
+        self.line_program["u_per_metre"] = float(self.camera.per_metre)
         gl.glEnable(gl.GL_BLEND)
         gl.glBlendFunc(gl.GL_SRC_ALPHA, gl.GL_ONE_MINUS_SRC_ALPHA)
         gl.glDisable(gl.GL_CULL_FACE)
@@ -420,6 +433,7 @@ class Renderer:
             calls += draw(self.world, self.render_view)
         gl.glBindVertexArray(0)
         gl.glUseProgram(0)
+        gl.glDisable(gl.GL_SCISSOR_TEST)
         self.draw_calls = calls
         return calls
 

@@ -73,6 +73,13 @@ class SandboxPicture:
         self.renderer.overlays = self.hud.visible  # editing aids (fur control markers)
         self.renderer.clean = self.hud.clean = self.clean  # none of them (o toggles)
         self.renderer.show_tiers = self.hud.show_tiers
+        # the panel is opaque and drawn over the world: no world is drawn under it (a
+        # fifth of a 1280 x 720 picture's pixels), when the picture is the window's size
+        same_size = (self.renderer.target.width, self.renderer.target.height) == (
+            self.window.width,
+            self.window.height,
+        )
+        self.renderer.covered_left = self.hud.width if same_size else 0
         self.renderer.draw(alpha)
         self._update_stats()
         gl.glDisable(gl.GL_DEPTH_TEST)

@@ -27,7 +27,7 @@ from ecs_tentacles.scene.defaults import plugin_config, with_defaults
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.layouts import Layouts
 from ecs_tentacles.scene.physical import physical_problems, physically_checked
-from ecs_tentacles.scene.plugins import resolve
+from ecs_tentacles.scene.plugins import current_keys, resolve
 from ecs_tentacles.scene.validate import repaired, validated
 from ecs_tentacles.untrusted.files import TooLarge, Unfit, read_regular
 from ecs_tentacles.untrusted.strict_json import DuplicateKey, strict_loads
@@ -149,12 +149,13 @@ def load_scene_plugins(
     default: the current folder). The physical checks lay the creatures out in
     `layouts` (the loader's, which the build then reuses).
     """
+    # (a plugin's former key in `plugins` is read as its key now, with a warning)
     if isinstance(source, dict):
-        data: object = source
+        data: object = current_keys(source)
         prefix = ""
     else:
         path = pathlib.Path(source)
-        data = read_scene_json(path)
+        data = current_keys(read_scene_json(path), path)
         prefix = f"{path}: "
         scene_dir = path.resolve().parent
     chosen = data.get("plugins") if isinstance(data, dict) else None

@@ -13,7 +13,8 @@ engine's own package declares in its `pyproject.toml`: `ecs_tentacles.plugins.de
 honoured only for the engine's own entries: another package's plugin, in whichever
 group, is on only when a scene names it. A plugin another one `requires` that the
 engine ships is turned on with it unless the scene names it (the `game` layer with a
-game mode).
+game mode). A fourth group, `ecs_tentacles.plugins.renamed`, maps a key one of the
+engine's plugins had before to its key now (`current_keys`: old scenes keep loading).
 
 Trust: the engine's own entry points were consented to when it was installed. A plugin
 from a file or module named by `from` (the scene's folder is searched first; a relative
@@ -31,6 +32,7 @@ import importlib.metadata
 import importlib.util
 import pathlib
 import sys
+import warnings
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 from types import ModuleType
@@ -43,6 +45,7 @@ ENTRY_POINTS = "ecs_tentacles.plugins"  # found by name; what third parties regi
 DEFAULT_GROUP = f"{ENTRY_POINTS}.default"  # the engine's: on unless a scene says false
 SANDBOX_GROUP = f"{ENTRY_POINTS}.sandbox"  # the engine's: added by the sandbox
 GROUPS = (DEFAULT_GROUP, SANDBOX_GROUP, ENTRY_POINTS)
+RENAMED_GROUP = f"{ENTRY_POINTS}.renamed"  # the engine's: a plugin's former key -> its key
 DISTRIBUTION = "ecs-tentacles"  # the engine's own package: its entry points are trusted
 FROM = "from"  # the config key naming where a plugin's code is
 
@@ -89,6 +92,62 @@ def sandbox_on() -> tuple[str, ...]:
     return _role(SANDBOX_GROUP)
 
 
+def renamed() -> dict[str, str]:
+    """The scene keys the engine's plugins had before -> their keys now."""
+    every = _entry_points_on(tuple(sys.path))
+    return {e.name: e.value for e in every if e.group == RENAMED_GROUP and e.ours}
+
+
+def current_keys(scene: object, path: pathlib.Path | None = None) -> object:
+    """`scene` with each former plugin key in its `plugins` under the key the plugin has
+    now (`renamed()`; a new dict, `scene` untouched), and one `FutureWarning` a key
+    naming both keys, issued at the scene file `path`, on the key's line (else at the
+    caller). Where a scene has both keys, the new key's value is kept."""
+    if not isinstance(scene, dict) or not isinstance(scene.get("plugins"), dict):
+        return scene
+    chosen: dict[str, Any] = scene["plugins"]
+    old = renamed()
+    if not any(key in old for key in chosen):
+        return scene
+    current: dict[str, Any] = {}
+    for key, value in chosen.items():
+        new = old.get(key)
+        if new is None:
+            current.setdefault(key, value)
+            continue
+        kept = "ignored: plugins." + new + " is set too" if new in chosen else "read as such"
+        message = f"plugins.{key} is deprecated: the plugin is now plugins.{new} ({kept})"
+        if path is None:
+            warnings.warn(message, FutureWarning, stacklevel=3)
+        else:
+            warnings.warn_explicit(message, FutureWarning, str(path), _line_of(path, key))
+        current[new] = chosen.get(new, value)
+    return {**scene, "plugins": current}
+
+
+def _line_of(path: pathlib.Path, key: str) -> int:
+    """The line of `path` where `plugins.<key>` is written (the first `"key"` from the
+    line that opens `plugins`; 1 if not found)."""
+    lines = path.read_text(encoding="utf-8", errors="replace").splitlines()
+    start = next((i for i, line in enumerate(lines) if '"plugins"' in line), 0)
+    found = (i for i, line in enumerate(lines[start:], start) if f'"{key}"' in line)
+    return next(found, 0) + 1
+
+
+def former_keys(scene: dict[str, Any]) -> dict[str, Any]:
+    """`scene` with its `plugins` under the keys they had first (`current_keys` undone;
+    `scene` itself if none was renamed): the form a scene's hash is taken of, so that a
+    scene hashes the same before and after a plugin's rename (a take's `scene_sha256`,
+    the shards of a distributed bake)."""
+    plugins = scene.get("plugins")
+    if not isinstance(plugins, dict):
+        return scene
+    first = {new: old for old, new in renamed().items()}
+    if not any(key in first for key in plugins):
+        return scene
+    return {**scene, "plugins": {first.get(key, key): value for key, value in plugins.items()}}
+
+
 def _role(group: str) -> tuple[str, ...]:
     return tuple(sorted(e.name for e in _entry_points() if e.group == group and e.ours))
 
@@ -105,8 +164,8 @@ class Entry:
 
 
 def _entry_points() -> tuple[Entry, ...]:
-    """Every installed plugin entry point, of every group."""
-    return _entry_points_on(tuple(sys.path))
+    """Every installed plugin entry point, of every group (`GROUPS`)."""
+    return tuple(e for e in _entry_points_on(tuple(sys.path)) if e.group != RENAMED_GROUP)
 
 
 @functools.lru_cache(maxsize=8)
@@ -114,16 +173,22 @@ def _entry_points_on(path: tuple[str, ...]) -> tuple[Entry, ...]:
     # read once per import path, and each distribution's name once (it is parsed from
     # the distribution's whole METADATA, the engine's README included)
     every = importlib.metadata.entry_points()  # one pass over the installed packages
-    found = [e for group in GROUPS for e in every.select(group=group)]
+    found = [e for group in (*GROUPS, RENAMED_GROUP) for e in every.select(group=group)]
     names: dict[int, str] = {}
     for entry in found:
         dist = getattr(entry, "dist", None)
         if dist is not None and id(dist) not in names:
-            names[id(dist)] = dist.name.replace("_", "-").lower()
+            names[id(dist)] = _distribution(entry)
     return tuple(
         Entry(e.name, e.group, e.value, names.get(id(getattr(e, "dist", None))) == DISTRIBUTION)
         for e in found
     )
+
+
+def _distribution(entry: importlib.metadata.EntryPoint) -> str:
+    """The normalised name of the package that declares `entry` ('' if unknown)."""
+    dist = getattr(entry, "dist", None)
+    return "" if dist is None else dist.name.replace("_", "-").lower()
 
 
 def load(

@@ -42,7 +42,7 @@ SINK_TOLERANCE = 0.001  # metres a 3-d placed creature may start inside the heig
 
 class TerrainPlugin(Plugin):
     name = "terrain"
-    build_order = 60  # a default plugin: built after lod (50)
+    build_order = 60  # a default plugin: built after clips (50)
     description = "a heightfield and static obstacles instead of the flat plane"
     scene_schema = _FRAGMENT["scene"]
     defs = _FRAGMENT["$defs"]

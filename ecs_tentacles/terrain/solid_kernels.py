@@ -1,15 +1,19 @@
 """The numba kernels of the terrain's queries against its spheres: the topmost surface
 above points (`TerrainGround.surface`), the distance from points (`distance`) and
 which balls reach one (`touches_obstacle`), every point against every sphere in one
-pass. `TerrainGround` hands them its spheres and asks numpy, solid by solid, about the
-rest; the answers are the largest top, the smallest distance and an or, which do not
-depend on the order the solids are taken in.
+pass; and which points lie within each solid's bounding sphere or circle
+(`under_bounds`, the test every query starts with). `TerrainGround` hands them its
+spheres and asks numpy, solid by solid, about the rest; the answers are the largest
+top, the smallest distance and an or, which do not depend on the order the solids are
+taken in.
 
 Optional, as the other kernels are: numpy computes the same numbers bit for bit (the
 same operations in the same order: a bounding-sphere test on squares summed
 (x^2 + y^2) + z^2, then the sphere's own test; tests/terrain/test_solid_kernels.py
 compares them). 64 creatures on the rocky preset asked these three about 0.6 ms a
-frame through numpy's solid-by-solid loop.
+frame through numpy's solid-by-solid loop; the sandbox's blob shadows asked `surface`
+about 5,600 points among 171 rocks each frame at 256 creatures, 23 ms of CPU for
+numpy's bounding test (a (points, solids, 2) array of gaps) against about 1 ms here.
 """
 
 from __future__ import annotations
@@ -88,3 +92,25 @@ def sphere_touches(
             if d2 <= bound * bound and math.sqrt(d2) - radii[k] <= reach[p]:
                 out[p] = True
                 break
+
+
+@njit(cache=True, nogil=True)
+def under_bounds(
+    points: np.ndarray, middles: np.ndarray, reaches: np.ndarray, pads: np.ndarray
+) -> np.ndarray:
+    """(n, k) bool: point p (of `points`, (n, 2) or (n, 3)) lies within bound k (centre
+    `middles[k]`, radius `reaches[k]` grown by `pads[p]`): squares summed
+    (x^2 + y^2) + z^2 against the grown radius squared, as numpy's test sums them."""
+    n, k, dims = points.shape[0], middles.shape[0], points.shape[1]
+    inside = np.zeros((n, k), np.bool_)
+    for p in range(n):
+        for s in range(k):
+            gx = points[p, 0] - middles[s, 0]
+            gy = points[p, 1] - middles[s, 1]
+            squares = gx * gx + gy * gy
+            if dims == 3:
+                gz = points[p, 2] - middles[s, 2]
+                squares += gz * gz
+            reach = reaches[s] + pads[p]
+            inside[p, s] = squares <= reach * reach
+    return inside

@@ -27,7 +27,8 @@ def test_the_zip_holds_the_addon_and_the_skin_files_as_they_are(tmp_path: Path) 
         addon = {
             p.name for p in (PACKAGE / "blender_addon").iterdir() if p.suffix in (".py", ".toml")
         }
-        assert names == addon | {"skin_mesh.py", "skin_colours.py", "take_compact.py"}
+        shared = {"skin_mesh.py", "skin_colours.py", "take_compact.py", "numeric_hamilton.py"}
+        assert names == addon | shared
         assert (
             "blender_manifest.toml" in names
             and 'id = "ecs_tentacles_take"' in archive.read("blender_manifest.toml").decode()
@@ -35,6 +36,8 @@ def test_the_zip_holds_the_addon_and_the_skin_files_as_they_are(tmp_path: Path) 
         assert archive.read("skin_mesh.py") == (PACKAGE / "skin" / "mesh.py").read_bytes()
         assert archive.read("skin_colours.py") == (PACKAGE / "skin" / "colours.py").read_bytes()
         assert archive.read("take_compact.py") == (PACKAGE / "take" / "compact.py").read_bytes()
+        hamilton = (PACKAGE / "numeric" / "hamilton.py").read_bytes()
+        assert archive.read("numeric_hamilton.py") == hamilton
         assert {i.date_time for i in archive.infolist()} == {(1980, 1, 1, 0, 0, 0)}
     again = tmp_path / "again.zip"
     assert main(["blender-addon", "--out", str(again)]) == 0

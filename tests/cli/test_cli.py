@@ -138,7 +138,7 @@ def test_validate_names_the_systems_a_scene_asks_for(
         "creatures": 1,
         "tentacles": 8,
         "systems": ["mine.wiggle:Wiggle"],
-        "plugins": ["locomotion", "suckers", "threats", "fur", "lod", "terrain"],
+        "plugins": ["locomotion", "suckers", "threats", "fur", "clips", "terrain"],
     }
 
 

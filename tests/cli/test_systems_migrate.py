@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import warnings
 from pathlib import Path
 
 import pytest
@@ -19,7 +20,7 @@ def test_systems_prints_the_frame_with_stages_plugins_and_fields(
     lines = capsys.readouterr().out.splitlines()
     assert (
         lines[0] == "plugins: locomotion (built in), suckers (built in), threats (built in),"
-        " fur (built in), lod (built in), terrain (built in)"
+        " fur (built in), clips (built in), terrain (built in)"
     )
     assert lines[1].split() == ["stage", "system", "plugin", "reads", "writes"]
     rows = [line.split()[:3] for line in lines[2:]]
@@ -63,13 +64,28 @@ def test_migrate_makes_plugins_explicit_and_folds_the_systems_list(
     new = json.loads((tmp_path / "old.migrated.json").read_text())
     assert "systems" not in new
     assert new["plugins"] == {
-        "locomotion": {}, "suckers": {}, "threats": {}, "fur": {}, "lod": {}, "terrain": {},
+        "locomotion": {}, "suckers": {}, "threats": {}, "fur": {}, "clips": {}, "terrain": {},
         "wave": {"from": "mywave:Wave"},
     }  # fmt: skip
     assert "systems[0] -> plugins.wave (from mywave:Wave)" in capsys.readouterr().out
     assert main(["systems", str(tmp_path / "old.migrated.json"), "--allow-systems"]) == 0
     assert "wave" in capsys.readouterr().out
     assert json.loads(path.read_text()) == scene  # the original is untouched
+
+
+def test_migrate_writes_a_plugins_former_key_under_its_key_now(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    old = Path(__file__).parents[1] / "data" / "old_lod_plugin_key.json"
+    out = tmp_path / "new.json"
+    assert main(["migrate", str(old), "--out", str(out)]) == 0
+    plugins = json.loads(out.read_text())["plugins"]
+    assert plugins["clips"] is False and "lod" not in plugins
+    assert "plugins.lod -> plugins.clips (the plugin's key now)" in capsys.readouterr().out
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # the migrated scene loads without a warning
+        assert main(["systems", str(out)]) == 0
+    assert "clips" not in capsys.readouterr().out.splitlines()[0]  # it is off
 
 
 def test_migrate_refuses_a_bad_scene_and_writes_nothing(

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from ecs_tentacles.clips.clips import CRAWL, IDLE, GaitClips
-from ecs_tentacles.clips.record import one_creature_scene, record
+from ecs_tentacles.clips.gait_world import one_creature_scene, simulate
 from ecs_tentacles.numeric.quaternions import quat_about_z, quat_multiply, quat_rotate
 from ecs_tentacles.scene.load import load_scene, resolve_scene_path
 from ecs_tentacles.world import World
@@ -56,7 +56,7 @@ def test_loops_wrap_without_a_jump(clips: GaitClips) -> None:
 
 
 def test_crawl_speed_matches_the_full_simulation(clips: GaitClips, octopus: dict[str, Any]) -> None:
-    rec = record(one_creature_scene(octopus["creatures"][0], octopus["physics"], 30.0), 2.0, 8.0)
+    rec = simulate(one_creature_scene(octopus["creatures"][0], octopus["physics"], 30.0), 2.0, 8.0)
     mantle = rec.pos[:, 0, :2]
     full = float(np.linalg.norm(mantle[-1] - mantle[0])) / ((len(mantle) - 1) * rec.dt)
     print(f"\ncrawl speed: clip {clips.crawl.speed:.3f} m/s, full sim over 8 s {full:.3f} m/s")

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from ecs_tentacles.creator.crowd import crowd_scene
-from ecs_tentacles.export.recording import TakeRecorder
+from ecs_tentacles.export.recording import TakeRecorder, scene_sha256
 from ecs_tentacles.record.plugin import RecordPlugin
 from ecs_tentacles.world import World
 from tests.conftest import python_calls
@@ -90,3 +90,14 @@ def test_finishing_hands_the_frames_over_and_the_world_steps_on(
     assert take.header == kept.header and len(take.header["creatures"]) == 2
     with pytest.raises(RuntimeError, match="finished"):
         recorder.capture()
+
+
+def test_a_scene_hashes_the_same_whichever_key_names_the_clips_plugin() -> None:
+    # a take's `scene_sha256` reads plugins by the keys they had first: a scene that
+    # names the clips plugin by its key now hashes as it did under its former key, `lod`
+    # (so takes, and shards of a distributed bake, keep their hashes across the rename)
+    now = {"version": 1, "plugins": {"clips": {}, "wander": {"radius": 1.0}}}
+    before = {"version": 1, "plugins": {"lod": {}, "wander": {"radius": 1.0}}}
+    assert scene_sha256(now) == scene_sha256(before)
+    assert scene_sha256(now) != scene_sha256({**now, "plugins": {"clips": False}})
+    assert now["plugins"] == {"clips": {}, "wander": {"radius": 1.0}}  # left as it was

@@ -128,6 +128,28 @@ def test_the_pairs_of_some_creatures_are_theirs_of_all_the_pairs_in_order(n: int
     assert found > 30
 
 
+def test_the_kept_pairs_are_filtered_to_the_same_pairs_by_the_kernel_and_numpy(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The cache's answer from its kept pairs (some creatures' or everyone's) is the
+    same pairs in the same order by either path."""
+    rng = np.random.default_rng(12)
+    n = 400
+    centre, radius = _crowd(rng, n)
+    cache = NearPairCache(slack=0.2)
+    cache(centre, radius, 0.05)  # the kept pairs, asked of the tree once
+    for _ in range(12):
+        centre[:, :2] += rng.normal(0.0, 0.005, (n, 2))
+        among = rng.random(n) < 0.3
+        for which in (among, None):
+            found = _by_backend(monkeypatch, lambda w=which: cache(centre, radius, 0.05, w))
+            for kernel, numpy in zip(found[0], found[1], strict=True):
+                assert kernel.dtype == numpy.dtype
+                assert_array_equal(kernel, numpy)
+            assert len(found[0][0]) > 0
+    assert cache.queries == 1  # every answer came from the kept pairs
+
+
 def test_a_nan_sphere_makes_the_cache_ask_the_tree_again() -> None:
     rng = np.random.default_rng(7)
     centre, radius = _crowd(rng, 300)

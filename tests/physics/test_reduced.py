@@ -262,3 +262,35 @@ def test_a_rows_reduced_servos_are_the_same_bits_whatever_rows_share_the_call(
 
     inverse = 1.0 / batch.kp[0, reduced.full_u]
     np.testing.assert_allclose(together.kp[0], STIFFNESS_GAIN / (reduced.compliance @ inverse))
+
+
+def test_a_shares_overlay_writer_writes_what_write_overlay_writes(
+    make_world: Callable[..., World],
+) -> None:
+    """The reduced step writes each row's overlay with `overlay_writer` (lookups made once
+    for a share): the same values in the same places of the scratch model as
+    `write_overlay`, row after row, split steps, sucker anchors and proxies included."""
+    import copy
+
+    world = make_world(_crowd(6, {"full": 0, "reduced": 8}))
+    world.step(3)
+    batch = world.physics.batches[0]
+    reduced = batch.reduced
+    assert reduced is not None and len(batch) == 6
+    rng = np.random.default_rng(1)
+    batch.kp[:] *= rng.uniform(0.5, 40.0, size=batch.kp.shape)  # some rows' steps split
+    batch.anchor[:] = rng.normal(size=batch.anchor.shape)
+    batch.near[:] = [True, False, True, True, False, False]
+    batch.proxy_size[:] = rng.uniform(0.01, 0.2, size=batch.proxy_size.shape)
+    rows = np.array([4, 0, 5, 2, 3])
+    servos = reduced.servos(batch.kp, batch.kv, batch.torque, rows)
+    assert servos.split.max() > 1
+    old, new = copy.copy(reduced.model), copy.copy(reduced.model)
+    write = reduced.overlay_writer(batch, new, servos)
+    fields = ("actuator_gainprm", "actuator_biasprm", "actuator_forcerange", "eq_data",
+              "geom_size", "geom_rbound", "geom_aabb")  # fmt: skip
+    for at, row in enumerate(rows.tolist()):
+        assert write(row, at) == reduced.write_overlay(batch, old, row, servos, at)
+        assert new.opt.timestep == old.opt.timestep
+        for name in fields:
+            np.testing.assert_array_equal(getattr(new, name), getattr(old, name), err_msg=name)

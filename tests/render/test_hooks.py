@@ -143,7 +143,7 @@ def test_the_sandbox_runs_with_fur_and_locomotion_off(
     scene = {"version": 1, "plugins": off, "creatures": [{"name": "still"}]}
     sandbox = make_sandbox(scene)
     plugins = [p.key for p in sandbox.world.plugins]
-    assert plugins == ["threats", "lod", "terrain", "render", "director"]  # the sandbox adds two
+    assert plugins == ["threats", "clips", "terrain", "render", "director"]  # the sandbox adds two
     x, y = sandbox.renderer.camera.project(np.array([[1.0, 0.5, 0.0]]))[0]
     for button in (mouse.LEFT, mouse.RIGHT):  # clicks nobody takes do nothing
         event(sandbox, "on_mouse_press", round(x), round(y), button, 0)

@@ -149,7 +149,7 @@ def test_listing_the_plugins_and_their_roles_imports_none() -> None:
 
 
 def test_the_engines_plugins_and_roles_are_its_entry_points() -> None:
-    assert default_on() == ("fur", "locomotion", "lod", "suckers", "terrain", "threats")
+    assert default_on() == ("clips", "fur", "locomotion", "suckers", "terrain", "threats")
     assert sandbox_on() == ("director",)
     assert set(shipped()) == {
         *default_on(),
@@ -161,7 +161,7 @@ def test_the_engines_plugins_and_roles_are_its_entry_points() -> None:
     world = World.from_scene({"version": 1})
     with world:
         assert [p.key for p in world.plugins] == [
-            "locomotion", "suckers", "threats", "fur", "lod", "terrain"
+            "locomotion", "suckers", "threats", "fur", "clips", "terrain"
         ]  # fmt: skip
 
 
@@ -185,7 +185,7 @@ def test_another_packages_plugin_is_never_on_by_default(
         "[ecs_tentacles.plugins.sandbox]\nlamp2 = lamp:LampPlugin\n",
     )
     assert (default_on(), sandbox_on()) == (
-        ("fur", "locomotion", "lod", "suckers", "terrain", "threats"),
+        ("clips", "fur", "locomotion", "suckers", "terrain", "threats"),
         ("director",),
     )
     with World.from_scene({"version": 1}, allow_systems=True) as world:
@@ -203,3 +203,36 @@ def test_another_package_cannot_take_a_built_in_plugins_name(
     with World.from_scene({"version": 1}) as world:
         assert type(world.plugin("fur")).__module__ == "ecs_tentacles.fur.plugin"
         assert world.plugin("fur").source is None and "lamp" not in world.schedule
+
+
+OLD_KEY_SCENE = Path(__file__).parents[1] / "data" / "old_lod_plugin_key.json"
+
+
+def test_a_scene_with_the_clips_plugins_former_key_loads_with_one_warning() -> None:
+    with pytest.warns(FutureWarning) as caught:
+        world = World.from_scene(OLD_KEY_SCENE)
+    with world:
+        keys = [p.key for p in world.plugins]
+    assert "clips" not in keys and "lod" not in keys  # plugins.lod: false turned it off
+    assert "physics_health" in world.schedule.names
+    [warning] = caught  # one, at the file's line that names the old key
+    assert (warning.filename, warning.lineno) == (str(OLD_KEY_SCENE), 5)
+    assert str(warning.message) == (
+        "plugins.lod is deprecated: the plugin is now plugins.clips (read as such)"
+    )
+    assert world.scene is not None and world.scene["plugins"]["clips"] is False
+
+
+def test_the_former_key_configures_the_plugin_and_the_new_key_wins_over_it() -> None:
+    scene = json.loads(OLD_KEY_SCENE.read_text())
+    scene["plugins"] = {"lod": {}}
+    with pytest.warns(FutureWarning, match=r"^plugins\.lod is deprecated"):
+        world = World.from_scene(scene)
+    with world:
+        assert "clips" in [p.key for p in world.plugins]
+    assert scene["plugins"] == {"lod": {}}  # the caller's dict is left as it was
+    scene["plugins"] = {"lod": {}, "clips": False}
+    with pytest.warns(FutureWarning, match=r"\(ignored: plugins\.clips is set too\)$"):
+        world = World.from_scene(scene)
+    with world:
+        assert "clips" not in [p.key for p in world.plugins]

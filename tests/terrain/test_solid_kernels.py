@@ -106,3 +106,27 @@ def test_one_reach_for_every_ball_is_each_balls_reach() -> None:
     one = ground.touches_obstacle(points, np.array(0.2))
     each = ground.touches_obstacle(points, np.full(len(points), 0.2))
     assert np.array_equal(one, each) and one.any() and not one.all()
+
+
+def test_the_bounds_kernel_picks_numpys_points_for_each_solid(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Which points lie within each solid's bounding sphere (points (n, 3)) or circle
+    (n, 2), grown by one pad or a pad a point: the same solids and rows with the kernel
+    as with numpy, points exactly on a grown bound included."""
+    rng = np.random.default_rng(11)
+    ground = _ground()
+    centres, bounds = ground._bounds()
+    pads = rng.uniform(0.0, 0.3, len(centres))
+    on_edge = ground._positions() + (bounds + pads)[:, None] * np.array([1.0, 0.0, 0.0])
+    points = np.vstack([rng.uniform([-3.0, -3.0, -0.3], [3.0, 3.0, 1.0], (2000, 3)), on_edge])
+    pad = np.concatenate([rng.uniform(0.0, 0.3, 2000), pads])
+    found = {}
+    for backend in ("numpy", "auto"):
+        monkeypatch.setattr(ground_module.KERNELS, "backend", backend)
+        found[backend] = [
+            [(k, rows.tolist()) for k, rows in ground._under_bounds(query, grow)]
+            for query, grow in ((points, pad), (points, 0.25), (points[:, :2], 0.0))
+        ]
+    assert found["numpy"] == found["auto"]
+    assert all(len(pairs) > 3 for pairs in found["auto"])

@@ -1,1 +1,1 @@
-"""The lod plugin's systems (`ecs_tentacles.clips`)."""
+"""The clips plugin's systems (`ecs_tentacles.clips`)."""

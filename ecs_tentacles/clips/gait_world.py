@@ -1,8 +1,9 @@
-"""GaitRecording one creature with the full physics: a one-creature world, stepped frame by frame.
+"""A gait recorded from one creature with the full physics: a one-creature world, stepped
+frame by frame (the clips' source; not a take: takes are the `record` plugin's).
 
 `one_creature_scene` turns a scene creature entry (a `load_scene(...)["creatures"][i]`
 or a `crowd_scene` entry) into a scene holding that creature alone at the origin,
-heading 0, crawling to a goal straight ahead (or with no goal: idle). `record` builds
+heading 0, crawling to a goal straight ahead (or with no goal: idle). `simulate` builds
 that world (`World.from_scene`), steps it, and returns every frame's MuJoCo joint
 state (`_joint_state`, the one place that reads the backend's data) and the body
 poses forward kinematics gives for it (mantle first, then each tentacle's links, the
@@ -64,8 +65,8 @@ def one_creature_scene(
     return scene
 
 
-def record(scene: dict[str, Any], warmup: float, seconds: float) -> GaitRecording:
-    """Build `scene` (one creature), step `warmup` s, then record `seconds` s frame by frame."""
+def simulate(scene: dict[str, Any], warmup: float, seconds: float) -> GaitRecording:
+    """Build `scene` (one creature), step `warmup` s, then keep `seconds` s frame by frame."""
     start = time.perf_counter()
     world = World.from_scene(scene, threads=1, lod=False)  # full physics, whatever the scene says
     try:
