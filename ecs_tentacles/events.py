@@ -19,7 +19,7 @@ from collections import Counter
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, fields
-from typing import Any, ClassVar
+from typing import ClassVar
 
 Handler = Callable[..., None]
 
@@ -29,9 +29,9 @@ class Event:
     """An event: subclass it, one dataclass per kind, with the kind's `name`."""
 
     name: ClassVar[str] = ""
-    world: Any
+    world: object
 
-    def payload(self) -> dict[str, Any]:
+    def payload(self) -> dict[str, object]:
         """Its fields by name (what a handler subscribed by name gets)."""
         return {f.name: getattr(self, f.name) for f in fields(self)}
 

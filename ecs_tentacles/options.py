@@ -51,7 +51,7 @@ class WorldOptions:
     threads: int | None = None
     lod: bool | None = None
     focus: Focus | None = None
-    plugins: Mapping[str, Any] | None = None
+    plugins: Mapping[str, object] | None = None
     scene_dir: pathlib.Path | None = None
     only: frozenset[int] | None = None
 
@@ -75,7 +75,7 @@ class WorldOptions:
         """These options building just the creatures at scene indices `only`."""
         return self.but(only=None if only is None else frozenset(only))
 
-    def given(self, keywords: Mapping[str, Any], where: str) -> WorldOptions:
+    def given(self, keywords: Mapping[str, object], where: str) -> WorldOptions:
         """These options with old-style keywords over them (`bake(plan, threads=2)`, from
         before the options had an object), with a DeprecationWarning naming `where`;
         TypeError for a keyword no field has."""
@@ -89,7 +89,7 @@ class WorldOptions:
         )
         return self.but(**keywords)
 
-    def scene_with_lod(self, scene: Mapping[str, Any]) -> dict[str, Any]:
+    def scene_with_lod(self, scene: Mapping[str, Any]) -> dict[str, object]:
         """`scene` with `lod` and `focus` written into its `physics.lod` (a new dict;
         `scene` is left as it was): a bake's take and its shards see them in the scene
         and its hash. The same scene unchanged (a copy of the top level) without them."""

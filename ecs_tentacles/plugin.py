@@ -25,7 +25,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator, Mapping, Sequence
 from contextlib import contextmanager
-from typing import TYPE_CHECKING, Any, ClassVar
+from typing import TYPE_CHECKING, ClassVar
 
 from ecs_tentacles.roster_change import RosterChange
 from ecs_tentacles.system import System
@@ -66,12 +66,12 @@ class Plugin:
     # (registry entries and take hooks): they count as that system's reads
     hook_reads: ClassVar[tuple[str, ...]] = ()
     # JSON Schema of this plugin's `plugins.<name>` config (defaults are filled in)
-    config_schema: ClassVar[dict[str, Any]] = {"type": "object", "additionalProperties": False}
-    creature_schema: ClassVar[dict[str, Any]] = {}  # creature key -> its schema
-    scene_schema: ClassVar[dict[str, Any]] = {}  # scene key -> its schema
+    config_schema: ClassVar[dict[str, object]] = {"type": "object", "additionalProperties": False}
+    creature_schema: ClassVar[dict[str, object]] = {}  # creature key -> its schema
+    scene_schema: ClassVar[dict[str, object]] = {}  # scene key -> its schema
     # keys of a creature's `tentacles` (and its `overrides`, without default) -> schema
-    tentacle_schema: ClassVar[dict[str, Any]] = {}
-    defs: ClassVar[dict[str, Any]] = {}  # "$defs" the fragments refer to ("#/$defs/...")
+    tentacle_schema: ClassVar[dict[str, object]] = {}
+    defs: ClassVar[dict[str, object]] = {}  # "$defs" the fragments refer to ("#/$defs/...")
 
     # hooks of earlier versions, and what replaced them: a plugin that still defines
     # one is refused when its class is made, instead of being silently never called
@@ -102,14 +102,14 @@ class Plugin:
         "run_summary": "a RunSummaries entry added in build(app) (cli.registries)",
     }
 
-    def __init_subclass__(cls, **kwargs: Any) -> None:
+    def __init_subclass__(cls, **kwargs: object) -> None:
         super().__init_subclass__(**kwargs)
         for old, new in Plugin.RENAMED_HOOKS.items():
             if old in vars(cls):
                 raise TypeError(f"{cls.__name__}.{old}: this hook is now {new}")
 
-    def __init__(self, config: Mapping[str, Any] | None = None):
-        self.config: dict[str, Any] = dict(config or {})
+    def __init__(self, config: Mapping[str, object] | None = None):
+        self.config: dict[str, object] = dict(config or {})
         self.key = self.name  # the name a scene turned it on by
         self.source: str | None = None  # the file or module it came from, if not built in
 
@@ -121,11 +121,11 @@ class Plugin:
         `resources` and `stores`."""
 
     # -- scene ---------------------------------------------------------------------------
-    def problems(self, scene: Mapping[str, Any]) -> list[tuple[tuple[str | int, ...], str]]:
+    def problems(self, scene: Mapping[str, object]) -> list[tuple[tuple[str | int, ...], str]]:
         """Rules the schema cannot say, on a defaults-filled scene: (json path, message)."""
         return []
 
-    def shapes_ground(self, scene: Mapping[str, Any]) -> bool:
+    def shapes_ground(self, scene: Mapping[str, object]) -> bool:
         """True when this plugin's keys of `scene` give the ground a shape (a heightfield)
         under the creatures: core's check that no creature starts below the plane z = 0
         is then left to this plugin (`problems` or `build_scene`)."""
@@ -146,10 +146,10 @@ class Plugin:
         against these names; snapshots copy them."""
         return {}
 
-    def build_creature(self, world: Host, creature: int, spec: Mapping[str, Any]) -> None:
+    def build_creature(self, world: Host, creature: int, spec: Mapping[str, object]) -> None:
         """Called for each creature, after its body is built (spec: its scene entry)."""
 
-    def build_scene(self, world: Host, scene: Mapping[str, Any]) -> None:
+    def build_scene(self, world: Host, scene: Mapping[str, object]) -> None:
         """Called once after every creature is built, before physics is compiled."""
 
     def ready(self, world: Host) -> None:
@@ -171,31 +171,31 @@ class Plugin:
         return []
 
     # -- state ---------------------------------------------------------------------------
-    def snapshot(self, world: Host) -> Any:
+    def snapshot(self, world: Host) -> object:
         """A copy of this plugin's state between frames (for `world.snapshot()`)."""
         return None
 
-    def restore(self, world: Host, state: Any) -> None:
+    def restore(self, world: Host, state: object) -> None:
         """Put back what `snapshot` returned."""
 
     # -- saving --------------------------------------------------------------------------
-    def save_creature(self, world: Host, creature: int, entry: dict[str, Any]) -> None:
+    def save_creature(self, world: Host, creature: int, entry: dict[str, object]) -> None:
         """Write what this plugin knows of `creature` now into its scene entry `entry`
         (its goals, its parameters), for saving a directed crowd as a scene
         (`ecs_tentacles.creatures.roster_save`)."""
 
-    def save_scene(self, world: Host, scene: dict[str, Any]) -> None:
+    def save_scene(self, world: Host, scene: dict[str, object]) -> None:
         """Write this plugin's scene-level state into `scene` when a running world is
         saved (`ecs_tentacles.creatures.roster_save`; the threats plugin: threats dropped since)."""
 
-    def scene_files(self, scene: Mapping[str, Any]) -> list[tuple[tuple[str | int, ...], str]]:
+    def scene_files(self, scene: Mapping[str, object]) -> list[tuple[tuple[str | int, ...], str]]:
         """The files this plugin's keys of `scene` name, each as (its JSON path, the name
         as written, relative to the scene's folder): a save to another folder takes them
         along (`ecs_tentacles.scene.save`; the terrain plugin: height images, meshes)."""
         return []
 
     # -- output hooks (takes, shard plans, run reports) -------------------------------
-    def take_sizes(self, scene: Mapping[str, Any]) -> list[TrackSize]:
+    def take_sizes(self, scene: Mapping[str, object]) -> list[TrackSize]:
         """What this plugin's take tracks will hold for `scene` (defaults filled in),
         from the scene alone: a bake counts them with the bodies before anything is
         built, and refuses a take the reader would not read back."""
@@ -210,7 +210,7 @@ class SystemsPlugin(Plugin):
 
     description = "systems named by import path"
 
-    def __init__(self, factories: list[type[System]], config: Mapping[str, Any] | None = None):
+    def __init__(self, factories: list[type[System]], config: Mapping[str, object] | None = None):
         super().__init__(config)
         self.factories = factories
 

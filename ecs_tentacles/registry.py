@@ -81,7 +81,7 @@ class Owner(Protocol):
     """What an `App` needs of the plugin it builds (`ecs_tentacles.plugin.Plugin`)."""
 
     key: str
-    config: dict[str, Any]
+    config: dict[str, object]
 
 
 class App:
@@ -95,7 +95,7 @@ class App:
         self.world = world
 
     @property
-    def config(self) -> dict[str, Any]:
+    def config(self) -> dict[str, object]:
         """The plugin's `plugins.<name>` config, defaults filled in."""
         return self.plugin.config
 

@@ -11,18 +11,19 @@ from __future__ import annotations
 
 import importlib.resources
 import json
-from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import cast
+
+from ecs_tentacles.scene.scene_spec import LodSpec, PhysicsSpec
 
 BUILD_ONLY = ("separate_overlaps",)  # read by scene validation, not kept in Settings
 
 
-def physics_defaults() -> dict[str, Any]:
-    """The `physics` defaults of the core scene schema, by key."""
+def physics_defaults() -> PhysicsSpec:
+    """The `physics` defaults of the core scene schema, by key (every key has one)."""
     schema = importlib.resources.files("ecs_tentacles.assets") / "schema" / "core.schema.json"
     physics = json.loads(schema.read_text(encoding="utf-8"))["properties"]["physics"]
-    return {key: spec["default"] for key, spec in physics["properties"].items()}
+    return cast(PhysicsSpec, {key: spec["default"] for key, spec in physics["properties"].items()})
 
 
 _DEFAULT = physics_defaults()
@@ -40,7 +41,7 @@ class LodSettings:
     focus: tuple[float, float, float] | None = None  # x, y, radius (m): always full inside
 
     @classmethod
-    def from_json(cls, lod: Mapping[str, Any]) -> LodSettings:
+    def from_json(cls, lod: LodSpec) -> LodSettings:
         defaults = cls()
         return cls(
             enabled=bool(lod.get("enabled", defaults.enabled)),
@@ -48,7 +49,7 @@ class LodSettings:
             reduced=int(lod.get("reduced", defaults.reduced)),
             hold_seconds=float(lod.get("hold_seconds", defaults.hold_seconds)),
             contact_margin=float(lod.get("contact_margin", defaults.contact_margin)),
-            focus=(*map(float, focus["center"]), float(focus["radius"]))  # type: ignore[arg-type]
+            focus=(float(focus["center"][0]), float(focus["center"][1]), float(focus["radius"]))
             if (focus := lod.get("focus"))
             else None,
         )
@@ -69,7 +70,7 @@ class Settings:
     lod: LodSettings = LodSettings()  # level of detail (physics/lod)
 
     @classmethod
-    def from_physics(cls, physics: Mapping[str, Any]) -> Settings:
+    def from_physics(cls, physics: PhysicsSpec) -> Settings:
         """The settings of a scene's `physics` object (defaults filled in)."""
         return cls(
             fps=float(physics["fps"]),

@@ -45,11 +45,11 @@ class Snapshot:
     """Everything `World.restore` needs; opaque to callers."""
 
     frame: int
-    rng: dict[str, Any]
+    rng: dict[str, object]
     stores: dict[str, tuple[int, dict[str, np.ndarray]]]
     physics: PhysicsState
-    plugins: dict[str, Any]
-    systems: dict[str, dict[str, Any]] = field(default_factory=dict)
+    plugins: dict[str, object]
+    systems: dict[str, dict[str, object]] = field(default_factory=dict)
     roster: dict[int, str] = field(default_factory=dict)  # creature entity -> name
     origin: str = ""  # the world it was taken of (its esper context)
 

@@ -118,7 +118,7 @@ class ArrayStore:
         for field in self.fields():
             state.pop(field.name, None)
 
-    def __setattr__(self, name: str, value: Any) -> None:
+    def __setattr__(self, name: str, value: object) -> None:
         """`store.field = values` writes into the live rows (the field's view is kept);
         `count`, `_arrays` and `cache_views` make the views again."""
         if isinstance(getattr(type(self), name, None), Field):
@@ -133,12 +133,12 @@ class ArrayStore:
         elif name in ("_arrays", "cache_views") and "cache_views" in self.__dict__:
             self._views()
 
-    def __getstate__(self) -> dict[str, Any]:
+    def __getstate__(self) -> dict[str, object]:
         """Without the views: a copy makes its own of its own arrays."""
         fields = {f.name for f in self.fields()}
         return {k: v for k, v in self.__dict__.items() if k not in fields}
 
-    def __setstate__(self, state: dict[str, Any]) -> None:
+    def __setstate__(self, state: dict[str, object]) -> None:
         self.__dict__.update(state)
         self._views()
 
@@ -160,7 +160,7 @@ class ArrayStore:
     def capacity(self) -> int:
         return len(next(iter(self._arrays.values()))) if self._arrays else 0
 
-    def add(self, n: int = 1, **values: Any) -> np.ndarray:
+    def add(self, n: int = 1, **values: object) -> np.ndarray:
         """Append `n` rows (defaults, then `values` broadcast over them); return their indices."""
         if n < 0:
             raise ValueError(f"cannot add {n} rows")

@@ -103,14 +103,14 @@ class World:
     @classmethod
     def from_scene(
         cls,
-        source: str | os.PathLike[str] | dict[str, Any],
+        source: str | os.PathLike[str] | dict[str, object],
         options: WorldOptions | None = None,
         *,
         seed: int | None = None,
         allow_systems: bool | None = None,
         threads: int | None = None,
         only: Collection[int] | None = None,
-        plugins: Mapping[str, Any] | None = None,
+        plugins: Mapping[str, object] | None = None,
         scene_dir: str | os.PathLike[str] | None = None,
         lod: bool | None = None,
         focus: Focus | None = None,
@@ -147,7 +147,7 @@ class World:
         return load_world(world_class, source, options)
 
     # -- creatures that come and go ------------------------------------------------------
-    def spawn(self, creature: Mapping[str, Any], **placement: Unpack[Placement]) -> int:
+    def spawn(self, creature: Mapping[str, object], **placement: Unpack[Placement]) -> int:
         """Build one creature (a scene-style entry) into this running world; its entity.
 
         Validated as a scene entry (`SpawnError`, one line per problem); a taken name
@@ -282,7 +282,7 @@ class World:
         return self.get_resource(kind) is not None
 
     @property
-    def resources(self) -> tuple[Any, ...]:
+    def resources(self) -> tuple[object, ...]:
         """Every plugin resource of this world."""
         return tuple(self._resources.values())
 

@@ -39,7 +39,7 @@ class GroundMesh:
     rgb: tuple[float, float, float]
 
 
-def meshes(header: dict[str, Any]) -> list[GroundMesh]:
+def meshes(header: dict[str, object]) -> list[GroundMesh]:
     """The ground meshes `header` lists (none on the plane); `TakeFileError` (one line)
     for an unsound entry."""
     ground = header.get("ground")

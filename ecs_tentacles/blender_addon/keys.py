@@ -54,7 +54,7 @@ def curve(
 
 
 def bone_curves(
-    channels: Any,
+    channels: object,
     names: list[str],
     frames: np.ndarray,
     rotation: np.ndarray,

@@ -54,7 +54,7 @@ class ImportTake(bpy.types.Operator, ImportHelper):  # type: ignore[misc, unused
     filename_ext = ".npz"
     filter_glob: StringProperty(default="*.npz", options={"HIDDEN"})  # type: ignore[valid-type]
 
-    def execute(self, context: Any) -> set[str]:
+    def execute(self, context: object) -> set[str]:
         progress = Progress(context)
         try:
             made = import_take(context, self.filepath, progress)

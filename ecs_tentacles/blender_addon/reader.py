@@ -47,7 +47,7 @@ MAX_COORDINATE = 1e6  # metres: farther out is a blow-up, not a creature
 FLOATS = (np.dtype("<f4"),)
 # arrays with a frames axis: name -> (dtypes accepted, the shape after the frames axis
 # as a function of (bodies, creatures))
-PER_FRAME: dict[str, tuple[tuple[np.dtype[Any], ...], Any]] = {
+PER_FRAME: dict[str, tuple[tuple[np.dtype[np.generic], ...], Any]] = {
     "pos": (FLOATS, lambda b, c: (b, 3)),
     "quat": (FLOATS, lambda b, c: (b, 4)),
     "creature_visible": ((np.dtype("|b1"),), lambda b, c: (c,)),
@@ -209,7 +209,7 @@ class TakeFile:
             raise TakeFileError(f"{name}: missing ({filename})")
         return entry
 
-    def _expected(self, name: str) -> tuple[tuple[np.dtype[Any], ...], tuple[int, ...]]:
+    def _expected(self, name: str) -> tuple[tuple[np.dtype[np.generic], ...], tuple[int, ...]]:
         dtypes, rest = PER_FRAME[name]
         return dtypes, rest(self.bodies, len(self.creatures))
 
@@ -265,7 +265,7 @@ class TakeFile:
             self._sized(entry, handle, label, size)
             return _data(handle, label, stored, dtype, fortran)
 
-    def _stream(self, name: str) -> tuple[IO[bytes], tuple[int, ...], np.dtype[Any]]:
+    def _stream(self, name: str) -> tuple[IO[bytes], tuple[int, ...], np.dtype[np.generic]]:
         """A version 1 array's entry, checked and opened at its data; (handle, the shape of
         a frame, dtype). A Fortran-ordered array is refused (numpy writes C order)."""
         entry = self._entry(f"{name}.npy", name)
@@ -313,7 +313,7 @@ def value_problem(name: str, array: np.ndarray, first: int = 0) -> str | None:
     return f"{name}: {value!r} at {at} is not a finite number within {MAX_COORDINATE:g} m"
 
 
-def _npy_header(handle: IO[bytes], name: str) -> tuple[tuple[int, ...], np.dtype[Any], bool]:
+def _npy_header(handle: IO[bytes], name: str) -> tuple[tuple[int, ...], np.dtype[np.generic], bool]:
     try:
         version = np.lib.format.read_magic(handle)
         if version == (1, 0):
@@ -328,7 +328,7 @@ def _npy_header(handle: IO[bytes], name: str) -> tuple[tuple[int, ...], np.dtype
 
 
 def _data(
-    handle: IO[bytes], name: str, shape: tuple[int, ...], dtype: np.dtype[Any], fortran: bool
+    handle: IO[bytes], name: str, shape: tuple[int, ...], dtype: np.dtype[np.generic], fortran: bool
 ) -> np.ndarray:
     """The rest of `handle`: the data of a checked `.npy` entry."""
     size = math.prod(shape) * dtype.itemsize
@@ -345,7 +345,7 @@ def _data(
 
 
 def _rows(
-    name: str, handle: IO[bytes], rest: tuple[int, ...], dtype: np.dtype[Any], count: int
+    name: str, handle: IO[bytes], rest: tuple[int, ...], dtype: np.dtype[np.generic], count: int
 ) -> np.ndarray:
     """The next `count` frames of a version 1 array being streamed."""
     return _data(handle, name, (count, *rest), dtype, False)

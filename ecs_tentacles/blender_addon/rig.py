@@ -64,7 +64,7 @@ def plan_armature(name: str, plan: Plan, collection: Any) -> tuple[Any, np.ndarr
     layer.objects.active = holder
     try:
         bpy.ops.object.mode_set(mode="EDIT")
-        bones: list[Any] = []
+        bones: list[object] = []
         for j, bone_name in enumerate(plan.names):
             bone = armature.edit_bones.new(bone_name)
             bone.head = plan.heads[j].tolist()
@@ -122,7 +122,7 @@ def plan_mesh(name: str, plan: Plan) -> Any:
     return mesh
 
 
-def material(name: str, header: dict[str, Any], index: int) -> Any:
+def material(name: str, header: dict[str, object], index: int) -> Any:
     """Creature `index`'s material: its sandbox colour (the natural palette, as the
     exporters choose it) as the base colour (linear) and the viewport colour."""
     colours = module("skin_colours")

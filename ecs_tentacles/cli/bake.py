@@ -201,7 +201,7 @@ def _bake_streamed(args: argparse.Namespace, plan: BakePlan) -> int:
     """A bake to a take file, written as the frames come (memory does not grow with the
     shot); with --strict a take with physics recoveries is not kept."""
 
-    def accept(header: dict[str, Any]) -> bool:
+    def accept(header: dict[str, object]) -> bool:
         return not _recoveries_refused(header, args.strict)
 
     try:
@@ -258,13 +258,13 @@ def _sha256(path: Path) -> str:
     return digest.hexdigest()
 
 
-def _points(header: dict[str, Any]) -> list[str]:
+def _points(header: dict[str, object]) -> list[str]:
     """The header keys of the take's points tracks (`goals`, ...)."""
     return [track.key for track in tracks_of(header) if track.kind == "points"]
 
 
 def summary(
-    take: Take | dict[str, Any],
+    take: Take | dict[str, object],
     path: Path,
     as_json: bool = False,
     skinned: KeyReport | None = None,

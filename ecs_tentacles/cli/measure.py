@@ -107,7 +107,7 @@ def _framework_block(
     return took - capture.seconds
 
 
-def _bar(total: int, desc: str, progress: bool, **kwargs: Any) -> tqdm[Any]:
+def _bar(total: int, desc: str, progress: bool, **kwargs: object) -> tqdm[Any]:
     """A frame bar on stderr, shown only with `progress` and a terminal there."""
     disable = None if progress else True
     return tqdm(
@@ -183,7 +183,7 @@ def _timed_block(
 
 
 def bench(
-    source: str | os.PathLike[str] | dict[str, Any],
+    source: str | os.PathLike[str] | dict[str, object],
     options: WorldOptions | None = None,
     *,
     frames: int = 120,

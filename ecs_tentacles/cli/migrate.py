@@ -89,7 +89,7 @@ def migrate(raw: dict[str, Any]) -> tuple[dict[str, Any], list[str]]:
     return scene, changes
 
 
-def _drop_keys_of_plugins_off(scene: dict[str, Any], off: list[str]) -> list[str]:
+def _drop_keys_of_plugins_off(scene: dict[str, object], off: list[str]) -> list[str]:
     """Remove the keys of built-in plugins the scene turns off (they would do nothing,
     and are refused): scene keys, creature keys, tentacle keys and their overrides'.
     Scenes written before the six locomotion tentacle keys moved out of the core schema

@@ -29,6 +29,7 @@ from ecs_tentacles.clips.gait_world import one_creature_scene
 from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.creatures.body import build_creature
 from ecs_tentacles.physics.model import ModelLayout, model_layout
+from ecs_tentacles.scene.scene_spec import PhysicsSpec
 from ecs_tentacles.scene.spec import as_spec
 from ecs_tentacles.settings import Settings
 from ecs_tentacles.world import World
@@ -45,17 +46,17 @@ class ClipCache:
     def __init__(self, *, disk: bool = False, **record_options: Any):
         self.record_options = record_options
         self.disk = disk
-        self.clips: dict[tuple[Any, ...], GaitClips] = {}
+        self.clips: dict[tuple[object, ...], GaitClips] = {}
 
     @property
-    def seconds(self) -> dict[tuple[Any, ...], float]:
+    def seconds(self) -> dict[tuple[object, ...], float]:
         """Wall-clock seconds each morphology's recording took."""
         return {key: clips.seconds for key, clips in self.clips.items()}
 
     def __len__(self) -> int:
         return len(self.clips)
 
-    def get(self, creature: dict[str, Any], physics: dict[str, Any] | None = None) -> GaitClips:
+    def get(self, creature: dict[str, Any], physics: PhysicsSpec | None = None) -> GaitClips:
         """The clips of the morphology of `creature` (a scene creature entry, defaults
         filled in as `load_scene` leaves them), recorded on first use."""
         layout = _morphology(creature, physics)
@@ -76,8 +77,8 @@ class ClipCache:
         self,
         layout: ModelLayout,
         dt: float,
-        creature: dict[str, Any],
-        physics: dict[str, Any] | None,
+        creature: dict[str, object],
+        physics: PhysicsSpec | None,
     ) -> GaitClips:
         key, recording = layout.key, recording_input(creature, physics)
         full_key = (key, recording)
@@ -97,7 +98,7 @@ class ClipCache:
         return clips
 
 
-def recording_input(creature: dict[str, Any], physics: dict[str, Any] | None = None) -> str:
+def recording_input(creature: dict[str, Any], physics: PhysicsSpec | None = None) -> str:
     """What a recording of `creature` is made from (its entry staged alone at the origin,
     without its name), as canonical JSON: equal strings record equal clips."""
     scene = one_creature_scene(creature, physics)
@@ -106,13 +107,13 @@ def recording_input(creature: dict[str, Any], physics: dict[str, Any] | None = N
 
 
 def morphology_key(
-    creature: dict[str, Any], physics: dict[str, Any] | None = None
-) -> tuple[Any, ...]:
+    creature: dict[str, object], physics: PhysicsSpec | None = None
+) -> tuple[object, ...]:
     """The physics morphology key of a scene creature entry, compiling nothing."""
     return _morphology(creature, physics).key
 
 
-def _morphology(creature: dict[str, Any], physics: dict[str, Any] | None) -> ModelLayout:
+def _morphology(creature: dict[str, Any], physics: PhysicsSpec | None) -> ModelLayout:
     """The model layout of a scene creature entry (alone in a world), compiling nothing."""
     world = World(_settings(physics), name="clip-key")
     try:
@@ -124,9 +125,9 @@ def _morphology(creature: dict[str, Any], physics: dict[str, Any] | None) -> Mod
         world.close()
 
 
-def _settings(physics: dict[str, Any] | None) -> Settings:
+def _settings(physics: PhysicsSpec | None) -> Settings:
     return Settings.from_physics(physics) if physics is not None else Settings()
 
 
-def _seconds_per_frame(physics: dict[str, Any] | None) -> float:
+def _seconds_per_frame(physics: PhysicsSpec | None) -> float:
     return _settings(physics).dt

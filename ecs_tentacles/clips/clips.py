@@ -26,7 +26,6 @@ writes only the caller's `out` arrays.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
@@ -39,6 +38,7 @@ from ecs_tentacles.clips.gait_world import (
 )
 from ecs_tentacles.numeric.optional_kernels import OptionalKernels
 from ecs_tentacles.numeric.quaternions import quat_multiply
+from ecs_tentacles.scene.scene_spec import PhysicsSpec
 
 IDLE, CRAWL = 0, 1
 KINDS = ("idle", "crawl")
@@ -84,7 +84,7 @@ class Clip:
 class GaitClips:
     """The idle and crawl clips of one morphology, stacked for vectorised replay."""
 
-    key: tuple[Any, ...]  # the physics morphology key (`model_layout(...).key`)
+    key: tuple[object, ...]  # the physics morphology key (`model_layout(...).key`)
     bodies: list[str]
     idle: Clip
     crawl: Clip
@@ -112,8 +112,8 @@ class GaitClips:
     @classmethod
     def record(
         cls,
-        creature: dict[str, Any],
-        physics: dict[str, Any] | None = None,
+        creature: dict[str, object],
+        physics: PhysicsSpec | None = None,
         *,
         warmup: float = WARMUP,
         seconds: float = RECORD,

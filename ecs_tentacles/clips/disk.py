@@ -36,7 +36,6 @@ import hashlib
 import pathlib
 import struct
 from dataclasses import dataclass
-from typing import Any
 
 import mujoco
 import numpy as np
@@ -95,7 +94,7 @@ def _sources() -> str:
     return _SOURCES
 
 
-def entry_key(recording: str, options: dict[str, Any]) -> str:
+def entry_key(recording: str, options: dict[str, object]) -> str:
     """The key of the clips recorded from `recording` (`cache.recording_input`) with
     `options` (`GaitClips.record`'s keywords) by this code and these libraries."""
     parts = [
@@ -129,7 +128,7 @@ def _payload(clips: GaitClips) -> bytes:
     return b"".join(parts)
 
 
-def decode(key: str, data: bytes, shape: Shape, morphology: tuple[Any, ...]) -> GaitClips | None:
+def decode(key: str, data: bytes, shape: Shape, morphology: tuple[object, ...]) -> GaitClips | None:
     """The clips in an entry's bytes, or None unless every check holds (module doc)."""
     body = CACHE.opened(key, data, _HEAD - CACHE.head + 2 * _CLIP_HEAD)
     if body is None:
@@ -173,7 +172,7 @@ def _sane(pos: np.ndarray, quat: np.ndarray, qpos: np.ndarray, qvel: np.ndarray)
     return bool(unit.all() and (np.abs(pos) <= MAX_METRES).all())
 
 
-def read(key: str, shape: Shape, morphology: tuple[Any, ...]) -> GaitClips | None:
+def read(key: str, shape: Shape, morphology: tuple[object, ...]) -> GaitClips | None:
     """The clips kept under `key` for a creature of `shape` (its physics `morphology`
     key), or None: absent, not a regular file, too large, unreadable or failing a check."""
     data = CACHE.load(key)

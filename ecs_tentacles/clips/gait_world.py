@@ -24,6 +24,7 @@ import numpy as np
 
 from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.physics.model import build_spec, model_layout
+from ecs_tentacles.scene.scene_spec import PhysicsSpec
 from ecs_tentacles.world import World
 
 GOAL_RADIUS = 0.3
@@ -35,7 +36,7 @@ NOT_RECORDED = ("fur",)
 class GaitRecording:
     """Frames of one creature's full simulation; shapes (F, ...), world frame."""
 
-    key: tuple[Any, ...]  # the physics morphology key (`model_layout(...).key`)
+    key: tuple[object, ...]  # the physics morphology key (`model_layout(...).key`)
     model: mujoco.MjModel  # the creature's compiled model (for forward kinematics)
     dt: float  # seconds per frame
     bodies: list[str]  # body names, mantle first
@@ -48,7 +49,7 @@ class GaitRecording:
 
 
 def one_creature_scene(
-    creature: dict[str, Any], physics: dict[str, Any] | None = None, goal: float | None = None
+    creature: dict[str, object], physics: PhysicsSpec | None = None, goal: float | None = None
 ) -> dict[str, Any]:
     """A scene of `creature` alone at the origin, heading 0, its goal `goal` m ahead (None: idle).
 
@@ -58,7 +59,7 @@ def one_creature_scene(
     entry = {k: copy.deepcopy(v) for k, v in creature.items() if k not in NOT_RECORDED}
     entry.update(position=[0.0, 0.0], heading_deg=0.0)
     entry["goals"] = [] if goal is None else [{"position": [goal, 0.0], "radius": GOAL_RADIUS}]
-    scene: dict[str, Any] = {"version": 1, "name": "clip", "creatures": [entry]}
+    scene: dict[str, object] = {"version": 1, "name": "clip", "creatures": [entry]}
     if physics is not None:
         scene["physics"] = copy.deepcopy(physics)
     return scene

@@ -43,7 +43,7 @@ class ClipsPlugin(Plugin):
         count = len(scene.get("creatures", []))
         return [TrackSize("replay records", count, 33, chunked=True)] if count else []
 
-    def snapshot(self, world: Host) -> Any:
+    def snapshot(self, world: Host) -> object:
         replay = world.physics.lod.replay
         return None if replay is None else replay.state()  # type: ignore[attr-defined]
 

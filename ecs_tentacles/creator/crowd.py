@@ -78,7 +78,7 @@ def _body_plan(rng: np.random.Generator, count: int) -> dict[str, Any]:
     links = int(rng.integers(7, 12))
     link_length = rng.uniform(0.055, 0.085)
     link_radius = rng.uniform(0.019, 0.029)
-    overrides: dict[int, dict[str, Any]] = {}
+    overrides: dict[int, dict[str, object]] = {}
     for index in rng.choice(count, size=int(rng.integers(1, 3)), replace=False):
         own_links = int(np.clip(links + rng.integers(-2, 3), 5, 13))
         own_length = _r(link_length * rng.uniform(0.85, 1.15))
@@ -137,7 +137,7 @@ def _creature(rng: np.random.Generator, name: str, plan: dict[str, Any]) -> dict
         writhe=_r(rng.uniform(0.15, 0.45)),
         overrides=[{"index": k, **overrides[k]} for k in sorted(overrides)],
     )
-    creature: dict[str, Any] = {
+    creature: dict[str, object] = {
         "name": name,
         "position": [0.0, 0.0],
         "heading_deg": _r(rng.uniform(-180.0, 180.0)),
@@ -248,7 +248,7 @@ def crowd_scene(
     }
 
 
-def write_crowd_scene(scene: dict[str, Any], path: str | os.PathLike[str]) -> None:
+def write_crowd_scene(scene: dict[str, object], path: str | os.PathLike[str]) -> None:
     """Validate `scene` (SceneError if it does not) and write it as JSON, atomically."""
     load_scene(scene)
     with atomic_output(path) as temporary:

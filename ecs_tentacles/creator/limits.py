@@ -22,7 +22,7 @@ class DesignError(ValueError):
         super().__init__(f"{field}: {message}")
 
 
-def checked(field: str, section: str, key: str, value: Any) -> Any:
+def checked(field: str, section: str, key: str, value: object) -> Any:
     """`value` if the schema allows it for `section.key`, else DesignError naming `field`."""
     try:
         return field_range(section, key).check(field, value)

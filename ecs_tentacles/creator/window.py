@@ -73,7 +73,7 @@ class Creator:
         )
         self.batch = pyglet.graphics.Batch()
         self.frame = Frame(self.window, cell_size=32)
-        self._keep: list[Any] = []
+        self._keep: list[object] = []
         self.buttons: list[PushButton] = []
         self.values: dict[str, float] = {}
         self.uniform: dict[str, tuple[Slider, pyglet.text.Label, Setting]] = {}

@@ -58,7 +58,7 @@ class SceneWorld(Host, Protocol):
     options: WorldOptions
     froze_build: bool
     layouts: Layouts
-    scene: dict[str, Any] | None
+    scene: dict[str, object] | None
     scene_dir: pathlib.Path | None
     creature_specs: dict[int, CreatureSpec]
 
@@ -82,7 +82,7 @@ class WorldClass(Protocol[W_co]):
 
 def load_world(
     cls: WorldClass[W],
-    source: str | os.PathLike[str] | dict[str, Any],
+    source: str | os.PathLike[str] | dict[str, object],
     options: WorldOptions | None = None,
     *,
     checks_only: bool = False,
@@ -165,7 +165,7 @@ def collection_paused() -> Iterator[None]:
 
 def _build(
     world: SceneWorld,
-    data: dict[str, Any],
+    data: dict[str, object],
     chosen: list[Plugin],
     only: Collection[int] | None,
     checks_only: bool,

@@ -48,7 +48,9 @@ def entry_now(world: Host, entity: int) -> dict[str, Any]:
     """Creature `entity`'s scene entry as it is now: where its mantle is, which way it
     heads, and what every plugin knows of it (`Plugin.save_creature`)."""
     name = world.component(entity, Creature).name
-    entry: dict[str, Any] = copy.deepcopy(dict(world.creature_specs.get(entity) or {"name": name}))
+    entry: dict[str, object] = copy.deepcopy(
+        dict(world.creature_specs.get(entity) or {"name": name})
+    )
     pose = world.component(entity, Transform)
     entry["position"] = [round(float(v), 6) for v in pose.pos[:2]]
     entry["heading_deg"] = round(heading_deg(pose.quat), 6)
@@ -59,7 +61,7 @@ def entry_now(world: Host, entity: int) -> dict[str, Any]:
 
 def roster_scene(world: Host) -> dict[str, Any]:
     """The scene dict of `world` as it is now (module docstring); not yet validated."""
-    scene: dict[str, Any] = copy.deepcopy(world.scene) if world.scene is not None else {}
+    scene: dict[str, object] = copy.deepcopy(world.scene) if world.scene is not None else {}
     scene.setdefault("version", 1)
     by_row = sorted(world.query(Creature), key=lambda item: item[1].row)
     scene["creatures"] = [entry_now(world, entity) for entity, _ in by_row]
@@ -68,7 +70,7 @@ def roster_scene(world: Host) -> dict[str, Any]:
     return scene
 
 
-def fit_at_rest(world: Host, entries: list[dict[str, Any]]) -> int:
+def fit_at_rest(world: Host, entries: list[dict[str, object]]) -> int:
     """Move entries (in order) whose creature, built at rest where it is, would overlap
     an obstacle or a creature placed before it to the nearest spot where it fits
     (`spawning.nearest_free`); how many moved."""

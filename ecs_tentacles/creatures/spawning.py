@@ -75,7 +75,7 @@ class SpawnError(ValueError):
 # -- the creature entry ------------------------------------------------------------------
 def creature_entry(
     world: Host,
-    spec: Mapping[str, Any],
+    spec: Mapping[str, object],
     position: Sequence[float] | np.ndarray | None = None,
     heading_deg: float | None = None,
     layouts: Layouts | None = None,
@@ -233,7 +233,7 @@ def nearest_free(
 
 
 # -- spawn and despawn ---------------------------------------------------------------------
-def spawn(world: Host, spec: Mapping[str, Any], **placement: Unpack[Placement]) -> int:
+def spawn(world: Host, spec: Mapping[str, object], **placement: Unpack[Placement]) -> int:
     """Build one creature into the running `world`; its entity (module docstring)."""
     unknown = sorted(set(placement) - PLACEMENT_KEYS)
     if unknown:  # (a script without a type checker: a typo is not silently dropped)

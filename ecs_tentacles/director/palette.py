@@ -66,7 +66,7 @@ def presets(scene_dir: str | os.PathLike[str] | None = None) -> list[Preset]:
     return found
 
 
-def _body_key(entry: dict[str, Any]) -> str:
+def _body_key(entry: dict[str, object]) -> str:
     body = {k: entry.get(k) for k in ("mantle", "tentacles", "fur")}
     return json.dumps(body, sort_keys=True)
 

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import copy
 from collections.abc import Mapping, Sequence
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -32,7 +32,7 @@ GAP = 0.1  # metres between two creatures' reach circles
 TRIES = 40  # candidate spots drawn per creature wanted
 
 
-def reach_of(entry: Mapping[str, Any]) -> float:
+def reach_of(entry: Mapping[str, object]) -> float:
     """How far a creature built from `entry` reaches from its mantle's axis (metres)."""
     layout = creature_layout(as_spec({**entry, "position": [0.0, 0.0]}))
     _, ends, radii = layout.capsules()
@@ -41,7 +41,7 @@ def reach_of(entry: Mapping[str, Any]) -> float:
 
 def spots(
     world: Host,
-    entry: Mapping[str, Any],
+    entry: Mapping[str, object],
     centre: Sequence[float] | np.ndarray,
     radius: float,
     count: int,
@@ -105,7 +105,7 @@ def _clear_of_obstacles(world: Host, points: np.ndarray, reach: float) -> np.nda
 
 def scatter(
     world: Host,
-    spec: Mapping[str, Any],
+    spec: Mapping[str, object],
     centre: Sequence[float] | np.ndarray,
     radius: float,
     count: int,
@@ -115,7 +115,7 @@ def scatter(
     entry = creature_entry(world, spec)  # checked once: SpawnError names the field
     made = []
     for x, y, heading in spots(world, entry, centre, radius, count, seed).tolist():
-        copy_of: dict[str, Any] = copy.deepcopy(dict(entry))
+        copy_of: dict[str, object] = copy.deepcopy(dict(entry))
         copy_of["name"] = unique_name(world, entry["name"])
         copy_of["position"] = [x, y]
         copy_of["heading_deg"] = heading

@@ -16,7 +16,6 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
 
 from ecs_tentacles.registry import Registry
 
@@ -30,13 +29,13 @@ class Reach:
     radius: float = 0.0
 
 
-class ShardReaches(Registry[Callable[[Mapping[str, Any], float], Reach | None]]):
+class ShardReaches(Registry[Callable[[Mapping[str, object], float], Reach | None]]):
     """How far each creature may get during a bake."""
 
 
-class MeetingReaches(Registry[Callable[[Mapping[str, Any]], Sequence[float] | None]]):
+class MeetingReaches(Registry[Callable[[Mapping[str, object]], Sequence[float] | None]]):
     """How far each creature acts on others without touching them."""
 
 
-class ShardGroups(Registry[Callable[[Sequence[Mapping[str, Any]]], list[list[int]]]]):
+class ShardGroups(Registry[Callable[[Sequence[Mapping[str, object]]], list[list[int]]]]):
     """Creatures that must bake in one shard."""

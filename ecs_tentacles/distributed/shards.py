@@ -140,7 +140,7 @@ def _combined(moves: list[Reach]) -> tuple[np.ndarray, float]:
 
 
 def islands_of(
-    creatures: list[dict[str, Any]], seconds: float, plugins: Sequence[Plugin] = ()
+    creatures: list[dict[str, object]], seconds: float, plugins: Sequence[Plugin] = ()
 ) -> list[list[int]]:
     """Sets of creature indices that may meet during the bake (union-find), sorted."""
     capsules = travel_capsules(creatures, seconds, plugins)

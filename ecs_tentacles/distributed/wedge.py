@@ -46,7 +46,7 @@ class WedgeAxis:
     """One `--wedge PATH=VALUES`."""
 
     path: tuple[str | int, ...]
-    values: tuple[Any, ...]
+    values: tuple[object, ...]
 
     @property
     def text(self) -> str:
@@ -57,9 +57,9 @@ class WedgeAxis:
 class Variant:
     """One combination: its values, its output name and its validated scene."""
 
-    values: dict[str, Any]
+    values: dict[str, object]
     name: str
-    scene: dict[str, Any]
+    scene: dict[str, object]
 
 
 def parse_parameter(text: str) -> WedgeAxis:
@@ -85,7 +85,7 @@ def parse_parameter(text: str) -> WedgeAxis:
             raise WedgeError(
                 f"argument --wedge: {path_text}: {high - low + 1} values, more than {MAX_VARIANTS}"
             )
-        values: list[Any] = list(range(low, high + 1))
+        values: list[object] = list(range(low, high + 1))
     else:
         values = [_value(v.strip()) for v in values_text.split(",")]
     return WedgeAxis(tuple(path), tuple(values))
@@ -103,7 +103,7 @@ def safe(text: str) -> str:
     return re.sub(r"[^A-Za-z0-9.+-]", "_", text)
 
 
-def variant_name(values: dict[str, Any]) -> str:
+def variant_name(values: dict[str, object]) -> str:
     """`PATH-VALUE` per parameter, joined by `_` (see the module docstring)."""
     parts = []
     for path, value in values.items():
@@ -113,7 +113,7 @@ def variant_name(values: dict[str, Any]) -> str:
 
 
 def variants(
-    raw: dict[str, Any],
+    raw: dict[str, object],
     parameters: list[WedgeAxis],
     source: str = "",
     *,

@@ -84,12 +84,12 @@ class BakePlan:
     @classmethod
     def make(
         cls,
-        scene: str | os.PathLike[str] | dict[str, Any],
+        scene: str | os.PathLike[str] | dict[str, object],
         options: WorldOptions | None = None,
         *,
         seconds: float,
         fps: float | None = None,
-        **deprecated: Any,
+        **deprecated: object,
     ) -> BakePlan:
         """Load and validate `scene` (SceneError if bad) and work out the frame rates.
 
@@ -283,7 +283,7 @@ def bake(
     progress: bool = True,
     on_world: Callable[[World], None] | None = None,
     on_steps: Callable[[int], None] | None = None,
-    **deprecated: Any,
+    **deprecated: object,
 ) -> Take:
     """Run the plan and return the take; a tqdm bar with ETA goes to stderr when `progress`.
 
@@ -318,8 +318,8 @@ def bake_to_file(
     *,
     progress: bool = True,
     on_world: Callable[[World], None] | None = None,
-    accept: Callable[[dict[str, Any]], bool] | None = None,
-    **deprecated: Any,
+    accept: Callable[[dict[str, object]], bool] | None = None,
+    **deprecated: object,
 ) -> dict[str, Any] | None:
     """Run the plan, writing the take to `out` as the frames come (`take.writer`: a
     chunk of frames held at a time, so memory does not grow with the shot); returns the

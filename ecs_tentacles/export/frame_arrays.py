@@ -3,8 +3,6 @@ items join, a frame gathered from a store's rows (`export.recording.TakeRecorder
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 
 
@@ -34,7 +32,7 @@ def gather(
     values: np.ndarray,
     rows: np.ndarray,
     before: np.ndarray | None = None,
-    fill: Any = None,
+    fill: object = None,
 ) -> None:
     """Frame `i` of `frames` from `values[rows]`; items whose row is gone (-1) hold
     `before` (the previous frame's values; None: 0) or `fill`."""

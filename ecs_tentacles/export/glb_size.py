@@ -427,7 +427,7 @@ def glb_note(path: str | os.PathLike[str], size: GlbSize, memory: int | None = N
 
 
 def refuse_large_glb(
-    header: Mapping[str, Any],
+    header: Mapping[str, object],
     path: str | os.PathLike[str],
     detail: Detail | None,
     locators: bool | None,

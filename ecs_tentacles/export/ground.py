@@ -19,7 +19,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from types import ModuleType
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -53,7 +53,7 @@ def root_name(take: Take) -> str:
     return "terrain" if "terrain" not in names else "terrain_ground"
 
 
-def write_usd_ground(pxr: ModuleType, stage: Any, take: Take) -> None:
+def write_usd_ground(pxr: ModuleType, stage: object, take: Take) -> None:
     """The take's ground meshes under `/World/<root_name>` (nothing on the plane)."""
     meshes = take.ground_meshes()
     if not meshes:

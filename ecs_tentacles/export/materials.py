@@ -88,7 +88,7 @@ def usd_material(
     return material
 
 
-def bind_usd(pxr: ModuleType, prim: Any, material: Any, colour: np.ndarray) -> None:
+def bind_usd(pxr: ModuleType, prim: object, material: object, colour: np.ndarray) -> None:
     """Bind `material` to `prim` (a Gprim) and give it the same display colour."""
     linear = pxr.Gf.Vec3f(*to_linear(colour).tolist())
     pxr.UsdGeom.Gprim(prim).CreateDisplayColorAttr([linear])

@@ -141,7 +141,7 @@ def _header_entries(scene: Mapping[str, Any]) -> tuple[int, int]:
     return body_bytes, sucker_bytes
 
 
-def _shape_of(mantle: Mapping[str, Any], params: Mapping[str, Any]) -> tuple[Any, ...]:
+def _shape_of(mantle: Mapping[str, object], params: Mapping[str, object]) -> tuple[object, ...]:
     """What a tentacle's bodies and suckers in the header are made of (not its motion)."""
     shape = ("links", "link_length", "link_radius", "end_scale", "suckers")
     return (mantle["radius"], mantle["height"], *(params.get(key) for key in shape))
@@ -181,7 +181,7 @@ def _creature_entries(
     return listed, body_bytes, sucker_bytes, body
 
 
-def _base(scene: Mapping[str, Any]) -> int:
+def _base(scene: Mapping[str, object]) -> int:
     """The header's fields beside the parts, at most, and the `.npy` headers."""
     fields = {
         "format": "ecs_tentacles.take",
@@ -198,7 +198,7 @@ def _base(scene: Mapping[str, Any]) -> int:
     return _entry(fields) + 16 * 32 + NPY_HEADERS  # and room for 16 keys of the parts
 
 
-def take_size(scene: Mapping[str, Any], tracks: Iterable[TrackSize] = ()) -> TakeSize:
+def take_size(scene: Mapping[str, object], tracks: Iterable[TrackSize] = ()) -> TakeSize:
     """What a take of `scene` (loaded: defaults filled in) holds, from the scene alone:
     the bodies, the suckers and `tracks` (the plugins' `take_sizes` for it)."""
     bodies, suckers = scene_sizes(scene)

@@ -68,7 +68,7 @@ class StreamedLayer:
         with self.Sdf.ChangeBlock():
             yield
 
-    def sample(self, path: Any, time: float, value: Any, nbytes: int = 16) -> None:
+    def sample(self, path: object, time: float, value: object, nbytes: int = 16) -> None:
         """Author `value` at `time` on the attribute at `path` (an `Sdf.Path`); `nbytes`:
         about what it holds, counted towards the next save."""
         self.layer.SetTimeSample(path, time, value)

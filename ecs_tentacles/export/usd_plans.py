@@ -42,13 +42,13 @@ class BodyPlan:
     names: list[str]
     members: np.ndarray  # (C,) the creatures' indices in the take
     bodies: np.ndarray
-    arrays: dict[str, Any]
+    arrays: dict[str, object]
 
 
 def body_plans(header: dict[str, Any], detail: Detail | None = None) -> list[BodyPlan]:
     """The take's creatures grouped by body plan, in the order plans first appear."""
     pxr = usd_modules()
-    grouped: dict[tuple[Any, ...], list[int]] = {}
+    grouped: dict[tuple[object, ...], list[int]] = {}
     layouts = [creature_layout(header, c) for c in range(len(header["creatures"]))]
     for index, (layout, _) in enumerate(layouts):
         key = (layout.mantle_radius, layout.mantle_height) + tuple(
@@ -105,7 +105,7 @@ def _plan_arrays(pxr: ModuleType, skeleton: Skeleton, mesh: SkinMesh) -> dict[st
 
 def define_creature(
     pxr: ModuleType,
-    stage: Any,
+    stage: object,
     plan: BodyPlan,
     name: str,
     colour: np.ndarray,
@@ -125,7 +125,7 @@ def define_creature(
 
 def define_skin(
     pxr: ModuleType,
-    stage: Any,
+    stage: object,
     plan: BodyPlan,
     name: str,
     prefix: str,

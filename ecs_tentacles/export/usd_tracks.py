@@ -127,7 +127,7 @@ class UsdTracks:
                     self._placed(track, [t for _, t in paths], first, chunk.frames, roots)
 
     def _placed(
-        self, track: TakeTrack, paths: list[Any], first: int, frames: int, roots: RootFrames
+        self, track: TakeTrack, paths: list[object], first: int, frames: int, roots: RootFrames
     ) -> None:
         """Locators' translates at every frame of the chunk, in their creatures' frames."""
         Gf = self.pxr.Gf
@@ -169,7 +169,7 @@ class Visibility:
 
 
 def key_steps(
-    layer: StreamedLayer, paths: list[Any], steps: Steps, first: int, values: np.ndarray,
+    layer: StreamedLayer, paths: list[object], steps: Steps, first: int, values: np.ndarray,
     tokens: tuple[Any, Any] | None = None,
 ) -> None:  # fmt: skip
     """Key the held `values` (n, K) of the chunk at `first` on the attributes `paths`

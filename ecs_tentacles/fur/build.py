@@ -67,7 +67,7 @@ def build_fur(world: Host, creature: int, spec: dict[str, Any]) -> int:
 
 
 def _build_controls(
-    world: Host, creature: int, fur_row: int, specs: list[dict[str, Any]]
+    world: Host, creature: int, fur_row: int, specs: list[dict[str, object]]
 ) -> dict[str, tuple[int, int]]:
     """Control entities (mirrored twins included): name -> (entity, control row)."""
     store = world.resource(FurData).controls

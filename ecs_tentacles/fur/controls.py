@@ -45,7 +45,7 @@ def mirror_point(point: list[float] | np.ndarray, axis: str) -> list[float]:
 
 def expand_mirrors(controls: list[dict[str, Any]]) -> list[dict[str, Any]]:
     """The controls with every mirrored twin inserted right after its original."""
-    result: list[dict[str, Any]] = []
+    result: list[dict[str, object]] = []
     for control in controls:
         result.append(control)
         axis = control.get("mirror", "none")

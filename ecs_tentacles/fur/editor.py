@@ -41,7 +41,7 @@ KEY_TOLERANCE = 1e-6  # seconds: a key set at the time of another replaces it
 class FurEditor:
     """The fur of one selected creature, edited in a world and in its scene document."""
 
-    def __init__(self, world: Host, rebuild: Callable[[dict[str, Any]], Host]):
+    def __init__(self, world: Host, rebuild: Callable[[dict[str, object]], Host]):
         if world.scene is None:
             raise ValueError("the fur editor needs a world built from a scene")
         self.scene: dict[str, Any] = copy.deepcopy(world.scene)

@@ -53,7 +53,7 @@ def pose_fur_at_build(world: Host) -> None:
         type(world.schedule["rig"])().process(world, 0.0)
 
 
-def roused(creatures: Sequence[Mapping[str, Any]]) -> list[int]:
+def roused(creatures: Sequence[Mapping[str, object]]) -> list[int]:
     """Creatures that must share a shard because one rouses another's emotion.
 
     A creature marked `threat` rouses any creature with an `emotion` near it (the

@@ -44,7 +44,7 @@ class FurPlugin(Plugin):
     # the take's guide curves and the sandbox's strands and markers
     hook_reads = ("fur.guides", "fur.sets", "fur.controls")
 
-    def problems(self, scene: Mapping[str, Any]) -> list[tuple[tuple[str | int, ...], str]]:
+    def problems(self, scene: Mapping[str, object]) -> list[tuple[tuple[str | int, ...], str]]:
         return fur_problems(scene)
 
     def resources(self, world: Host) -> list[object]:
@@ -70,7 +70,7 @@ class FurPlugin(Plugin):
         fur = world.resource(FurData)
         return {f"fur.{name}": getattr(fur, name) for name in STORES}
 
-    def snapshot(self, world: Host) -> Any:
+    def snapshot(self, world: Host) -> object:
         fur = world.resource(FurData)  # its stores are copied with every store
         return fur.curves.copy(), fur.frames.copy()
 
@@ -87,7 +87,7 @@ class FurPlugin(Plugin):
 
         return [GUIDE_TRACK]
 
-    def take_sizes(self, scene: Mapping[str, Any]) -> list[TrackSize]:
+    def take_sizes(self, scene: Mapping[str, object]) -> list[TrackSize]:
         from ecs_tentacles.fur.outputs import guide_sizes
 
         return guide_sizes(scene)
@@ -97,7 +97,7 @@ class FurPlugin(Plugin):
 
         pose_fur_at_build(world)
 
-    def _shard_groups(self, creatures: Sequence[Mapping[str, Any]]) -> list[list[int]]:
+    def _shard_groups(self, creatures: Sequence[Mapping[str, object]]) -> list[list[int]]:
         from ecs_tentacles.fur.outputs import roused
 
         together = roused(creatures)

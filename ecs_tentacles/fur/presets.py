@@ -36,5 +36,5 @@ def preset(name: str) -> dict[str, Any]:
 def resolve(fur: dict[str, Any]) -> dict[str, Any]:
     """A `fur` scene object with its preset and then the schema defaults filled in."""
     scene = with_defaults({"version": 1, "creatures": [{"fur": fur}]})
-    resolved: dict[str, Any] = scene["creatures"][0]["fur"]
+    resolved: dict[str, object] = scene["creatures"][0]["fur"]
     return resolved

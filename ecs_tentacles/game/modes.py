@@ -59,7 +59,7 @@ class GameResult:
         """Won or lost: the run stops here."""
         return self.outcome != PLAYING
 
-    def report(self, mode: str) -> dict[str, Any]:
+    def report(self, mode: str) -> dict[str, object]:
         """The result as `--json` gives it: mode, level, outcome, seconds and the details."""
         return {
             "mode": mode,

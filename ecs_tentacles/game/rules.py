@@ -26,7 +26,7 @@ if TYPE_CHECKING:
     from ecs_tentacles.registry import Registries
 
 
-def mode_schema(mode: GameMode) -> dict[str, Any]:
+def mode_schema(mode: GameMode) -> dict[str, object]:
     """The JSON Schema of a `game` key of `mode`: the mode's schema, `mode` added."""
     properties = {"mode": {"const": mode.name}, **mode.schema.get("properties", {})}
     return {
@@ -48,7 +48,7 @@ def unknown(name: str, modes: Mapping[str, GameMode]) -> str:
     return f"{name!r} is not a registered game mode (registered: {', '.join(sorted(modes))})"
 
 
-def check_game(scene: Mapping[str, Any], registries: Registries) -> list[Problem]:
+def check_game(scene: Mapping[str, object], registries: Registries) -> list[Problem]:
     """The problems of a defaults-filled scene's `game` (none without one)."""
     game = scene.get("game")
     if not isinstance(game, Mapping):
@@ -72,7 +72,7 @@ def check_game(scene: Mapping[str, Any], registries: Registries) -> list[Problem
 
 def scene_schema(
     schema: Mapping[str, Any], scene: Mapping[str, Any], registries: Registries
-) -> dict[str, Any]:
+) -> dict[str, object]:
     """The scene schema `schema` with its `game` key that of the scene's mode (for an
     editor checking a level's file: `ecs-tentacles schema LEVEL`); as it is without one."""
     name = (scene.get("game") or {}).get("mode")
@@ -83,7 +83,7 @@ def scene_schema(
     return {**schema, "properties": {**schema["properties"], "game": game}}
 
 
-def rules(scene: Mapping[str, Any] | None, mode: GameMode) -> dict[str, Any]:
+def rules(scene: Mapping[str, Any] | None, mode: GameMode) -> dict[str, object]:
     """`scene["game"]` (a copy) with `mode`'s schema defaults filled in."""
     return filled((scene or {}).get("game") or {}, mode_schema(mode))
 

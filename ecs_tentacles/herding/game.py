@@ -141,7 +141,7 @@ class HerdingGame(PlayedGame):
         )
         return inside
 
-    def summary(self) -> dict[str, Any]:
+    def summary(self) -> dict[str, object]:
         """The game as a report gives it."""
         return {
             "level": self.level,

@@ -46,7 +46,7 @@ class Level:
     stars: int
     unlocked: bool
 
-    def as_dict(self) -> dict[str, Any]:
+    def as_dict(self) -> dict[str, object]:
         return asdict(self)
 
 

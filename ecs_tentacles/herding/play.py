@@ -22,7 +22,7 @@ It runs (Shift) only to get somewhere far with no creature near, and walks to pu
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 
@@ -176,7 +176,7 @@ def play(
     *,
     every: float = 0.25,
     max_seconds: float | None = None,
-) -> dict[str, Any]:
+) -> dict[str, object]:
     """Play the world's level to its end; the game's summary, `log`, `wall_s`."""
     game = world.resource(HerdingGame)
 

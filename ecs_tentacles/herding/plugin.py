@@ -46,7 +46,7 @@ class HerdingPlugin(Plugin):
     description = "the herding game: drive creatures into a pen with a predator"
     requires = ("locomotion", "game")
 
-    def problems(self, scene: Mapping[str, Any]) -> list[tuple[tuple[str | int, ...], str]]:
+    def problems(self, scene: Mapping[str, object]) -> list[tuple[tuple[str | int, ...], str]]:
         return plugin_problems(scene)
 
     def resources(self, world: Host) -> list[object]:
@@ -64,7 +64,7 @@ class HerdingPlugin(Plugin):
 
         return [Predator(), Herd(), Referee()]
 
-    def snapshot(self, world: Host) -> Any:
+    def snapshot(self, world: Host) -> object:
         return world.resource(HerdingGame).state.copy()
 
     def restore(self, world: Host, state: Any) -> None:

@@ -30,7 +30,7 @@ GAME = fragment("ecs_tentacles.herding", "herding")["game_mode"]["game"]
 Problem = tuple[tuple[str | int, ...], str]
 
 
-def plugin_problems(scene: Mapping[str, Any]) -> list[Problem]:
+def plugin_problems(scene: Mapping[str, object]) -> list[Problem]:
     """A scene with the herding plugin on is a level: it has a `game` (its mode and the
     mode's keys are the game layer's to check: `game_problems`)."""
     game = scene.get("game")

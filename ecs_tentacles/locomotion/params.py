@@ -155,7 +155,7 @@ class Locomotion:
         assert allowed is not None
         return min(allowed.high, min(dampings) / step)
 
-    def get(self, creature: int, tentacle: int = 0) -> dict[str, Any]:
+    def get(self, creature: int, tentacle: int = 0) -> dict[str, object]:
         """One tentacle's parameters plus its creature's (`creature_speed`, gait, drivers)."""
         world = self._world
         row = world.component(creature, Creature).row

@@ -118,7 +118,7 @@ class LocomotionPlugin(Plugin):
             # a 2-d goal is on the ground under it (`GoalBook` puts it there)
             world.resource(GoalBook).append(creature, goal["position"], goal["radius"])
 
-    def build_scene(self, world: Host, scene: Mapping[str, Any]) -> None:
+    def build_scene(self, world: Host, scene: Mapping[str, object]) -> None:
         world.resource(Avoidance).configure(scene)
 
     def despawning(self, world: Host, creature: int) -> None:
@@ -153,7 +153,7 @@ class LocomotionPlugin(Plugin):
             target[turned] = mantle + bent(target[turned] - mantle, creatures.avoidance[turned])
         return np.where(creatures.has_goal[:, None], target, np.nan)
 
-    def snapshot(self, world: Host) -> Any:
+    def snapshot(self, world: Host) -> object:
         goals = {
             entity: [
                 (world.component(g, Goal).position.copy(), world.component(g, Goal).radius)
@@ -225,7 +225,7 @@ class LocomotionPlugin(Plugin):
 
         sandbox_restore(world, state)
 
-    def save_creature(self, world: Host, creature: int, entry: dict[str, Any]) -> None:
+    def save_creature(self, world: Host, creature: int, entry: dict[str, object]) -> None:
         from ecs_tentacles.locomotion.directing import save_creature
 
         save_creature(world, creature, entry)
@@ -246,17 +246,17 @@ class LocomotionPlugin(Plugin):
 
         return [GOAL_TRACK]
 
-    def take_sizes(self, scene: Mapping[str, Any]) -> list[TrackSize]:
+    def take_sizes(self, scene: Mapping[str, object]) -> list[TrackSize]:
         from ecs_tentacles.locomotion.outputs import goal_sizes
 
         return goal_sizes(scene)
 
-    def _shard_reach(self, creature: Mapping[str, Any], seconds: float) -> Reach | None:
+    def _shard_reach(self, creature: Mapping[str, object], seconds: float) -> Reach | None:
         from ecs_tentacles.locomotion.outputs import crawl_reach
 
         return crawl_reach(creature, seconds)
 
-    def _meeting_reach(self, scene: Mapping[str, Any]) -> list[float] | None:
+    def _meeting_reach(self, scene: Mapping[str, object]) -> list[float] | None:
         from ecs_tentacles.locomotion.avoidance import meeting_reach
 
         return meeting_reach(scene)

@@ -26,7 +26,7 @@ import os
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
@@ -370,7 +370,7 @@ class PhysicsBackend(Membership):
     def _run(self, segments: list[Segment], substeps: dict[int, int]) -> None:
         self._dispatch(step_segments, segments, substeps)
 
-    def _dispatch(self, step: Callable[..., None], segments: list[Segment], *args: Any) -> None:
+    def _dispatch(self, step: Callable[..., None], segments: list[Segment], *args: object) -> None:
         """`step(work, *args, thread)` on this thread and every pool thread at once, each
         taking shares of `segments` from one shared `Work` until none is left (this
         thread steps too instead of waiting idle; thread k always uses scratch k, and

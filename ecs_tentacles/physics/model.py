@@ -27,7 +27,7 @@ from __future__ import annotations
 import functools
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import mujoco
 import numpy as np
@@ -80,7 +80,7 @@ SUCKER_SOLIMP = [0.97, 0.995, 0.001, 0.5, 2.0]
 class ModelLayout:
     """Which store rows a creature model's elements belong to, in model-building order."""
 
-    key: tuple[Any, ...]  # the morphology: equal keys compile to equal models
+    key: tuple[object, ...]  # the morphology: equal keys compile to equal models
     body_rows: list[int] = field(default_factory=list)  # transform row per body name
     bodies: list[str] = field(default_factory=list)
     actuators: list[str] = field(default_factory=list)  # one per hinge
@@ -97,7 +97,7 @@ def model_layout(world: PhysicsHost, creature: Creature, transform: Transform) -
     `base_row` and `first_link` (`TentacleStore`), so those rows are read from the
     tentacle's; element names are made once per tentacle shape (`_tentacle_names`).
     """
-    key: list[Any] = [
+    key: list[object] = [
         _settings_key(world.settings),
         (creature.mantle_radius, creature.mantle_height, creature.mantle_density),
     ]
@@ -120,7 +120,7 @@ def model_layout(world: PhysicsHost, creature: Creature, transform: Transform) -
         found = [world.component(entity, Sucker) for entity in tentacle.suckers]
         rows = [sucker.row for sucker in found]
         offsets = sucker_offsets[rows].tolist()
-        suckers: list[tuple[Any, ...]] = []
+        suckers: list[tuple[object, ...]] = []
         for sucker, sucker_row, offset in zip(found, rows, offsets, strict=True):
             layout.equalities.append(f"t{tentacle.index}/sucker{len(layout.equalities)}")
             layout.sucker_rows.append(sucker_row)
@@ -156,7 +156,7 @@ def _tentacle_names(index: int, links: tuple[tuple[int, bool], ...]) -> Tentacle
     return TentacleNames(tuple(bodies), tuple(actuators), tuple(actuator_links), tuple(axes))
 
 
-def _settings_key(settings: Settings) -> tuple[Any, ...]:
+def _settings_key(settings: Settings) -> tuple[object, ...]:
     return (settings.substep_dt, tuple(settings.gravity), settings.ground_friction,
             settings.sucker_timeconst)  # fmt: skip
 
@@ -296,7 +296,7 @@ def add_sucker(
     tentacle: int,
     number: int,
     link: int,
-    offset: Any,
+    offset: object,
 ) -> None:
     """Sucker equality `number`: link `link` of tentacle `tentacle` held to the world at
     `offset` in the link's frame (off until it attaches; the world anchor is set then)."""

@@ -98,7 +98,7 @@ class RaceGame(PlayedGame):
         inside: np.ndarray = np.hypot(*(np.asarray(xy)[:, :2] - self.flag).T) < self.radius
         return inside
 
-    def summary(self) -> dict[str, Any]:
+    def summary(self) -> dict[str, object]:
         """The race as a report gives it."""
         return {
             "level": self.level,

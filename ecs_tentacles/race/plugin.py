@@ -44,7 +44,7 @@ class RacePlugin(Plugin):
 
         return GameMode(MODE_NAME, race_rules.RULES, result, race_rules.problems, self.description)
 
-    def problems(self, scene: Mapping[str, Any]) -> list[tuple[tuple[str | int, ...], str]]:
+    def problems(self, scene: Mapping[str, object]) -> list[tuple[tuple[str | int, ...], str]]:
         if scene.get("game") is None:
             return [(("game",), "required when the race plugin is on (the level's rules)")]
         return []
@@ -54,7 +54,7 @@ class RacePlugin(Plugin):
         name = str(scene.get("name") or "level")
         return [RaceGame(rules(scene, self.mode()), name, world.settings.fps)]
 
-    def build_scene(self, world: Host, scene: Mapping[str, Any]) -> None:
+    def build_scene(self, world: Host, scene: Mapping[str, object]) -> None:
         race = world.resource(RaceGame)
         race.runner = world.creature(race.runner_name)
 
@@ -67,7 +67,7 @@ class RacePlugin(Plugin):
 
         return [Steering(), Referee()]
 
-    def snapshot(self, world: Host) -> Any:
+    def snapshot(self, world: Host) -> object:
         return world.resource(RaceGame).state.copy()
 
     def restore(self, world: Host, state: Any) -> None:

@@ -28,7 +28,7 @@ XY = {
     "minItems": 2,
     "maxItems": 2,
 }
-RULES: dict[str, Any] = {
+RULES: dict[str, object] = {
     "description": "A race to the flag: the runner (yours) against every other creature.",
     "required": ["runner", "flag", "seconds"],
     "properties": {

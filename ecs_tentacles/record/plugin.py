@@ -10,8 +10,6 @@ Systems: record (stage output), which captures the frame after everything else r
 
 from __future__ import annotations
 
-from typing import Any
-
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.system import System
 from ecs_tentacles.take import Take
@@ -21,7 +19,9 @@ class RecordPlugin(Plugin):
     name = "record"
     description = "records every frame's poses, suckers and the plugins' take tracks into a take"
 
-    def __init__(self, config: dict[str, Any] | None = None, *, every: int = 1, **recorder: Any):
+    def __init__(
+        self, config: dict[str, object] | None = None, *, every: int = 1, **recorder: object
+    ):
         super().__init__(config)
         from ecs_tentacles.record.systems.record import Record
 
@@ -39,6 +39,6 @@ class RecordPlugin(Plugin):
         arrays: no copies)."""
         return self.system.finish()
 
-    def finish_stream(self) -> dict[str, Any]:
+    def finish_stream(self) -> dict[str, object]:
         """End a recording streamed to its `writer` (a `TakeWriter`); the header written."""
         return self.system.finish_stream()

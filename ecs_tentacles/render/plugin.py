@@ -10,7 +10,7 @@ debugging aid, not in the clean view).
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.render.registries import Marker, OverlaySpheres
@@ -27,7 +27,9 @@ class RenderPlugin(Plugin):
     name = "render"
     description = "hands the newest body poses to the sandbox renderer"
 
-    def __init__(self, config: dict[str, Any] | None = None, *, renderer: Renderer | None = None):
+    def __init__(
+        self, config: dict[str, object] | None = None, *, renderer: Renderer | None = None
+    ):
         super().__init__(config)
         if renderer is None:
             raise ValueError("the render plugin needs the sandbox's renderer (renderer=...)")

@@ -59,7 +59,7 @@ LINE_FLOATS = 7  # a line vertex: x, y, z, r, g, b, a
 class Marker:
     """Spheres a plugin asks the renderer to draw: centres (n, 3), size (x, y, z), rgba."""
 
-    positions: Any
+    positions: object
     size: tuple[float, float, float]
     rgba: tuple[float, float, float, float]
 

@@ -87,7 +87,7 @@ class Sandbox(SandboxPicture):
 
     def __init__(
         self,
-        scene: str | os.PathLike[str] | dict[str, Any],
+        scene: str | os.PathLike[str] | dict[str, object],
         options: WorldOptions | None = None,
         *,
         width: int = 1280,
@@ -373,7 +373,7 @@ class Sandbox(SandboxPicture):
                 self.video.abort()
                 self.video = None
             raise
-        result: dict[str, Any] = {"frames": done, "sim_seconds": self.world.time}
+        result: dict[str, object] = {"frames": done, "sim_seconds": self.world.time}
         result["tiers"] = self.world.lod.counts()  # creatures per physics tier at the end
         # a frame's physics, median over the run: at most the frame's duration keeps real time
         median = float(np.median(physics_ms))

@@ -40,7 +40,7 @@ class SandboxSession:
 
     def __init__(
         self,
-        scene: str | os.PathLike[str] | dict[str, Any],
+        scene: str | os.PathLike[str] | dict[str, object],
         options: WorldOptions | None = None,
         *,
         say: Callable[[bool, str], None] = lambda ok, text: None,
@@ -65,12 +65,12 @@ class SandboxSession:
         return self.options.scene_dir
 
     # -- worlds ------------------------------------------------------------------------
-    def build(self, scene: str | os.PathLike[str] | dict[str, Any]) -> World:
+    def build(self, scene: str | os.PathLike[str] | dict[str, object]) -> World:
         """A new world from `scene`, as this session builds them (its options: seed,
         threads, level of detail and pinned focus)."""
         return World.from_scene(scene, self.options)
 
-    def rebuild(self, scene: dict[str, Any]) -> World:
+    def rebuild(self, scene: dict[str, object]) -> World:
         """The world rebuilt from an edited scene (the old one closed); raises if it
         does not build."""
         self.world.close()

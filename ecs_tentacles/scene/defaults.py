@@ -20,7 +20,7 @@ if TYPE_CHECKING:
 ATOMS = {int, float, str, bool, type(None)}  # JSON values that hold no others
 
 
-def nested(values: list[Any]) -> list[tuple[int, Any]]:
+def nested(values: list[object]) -> list[tuple[int, Any]]:
     """The (index, item) of the objects and lists in `values` (a list of a million numbers
     is passed over at C speed)."""
     if set(map(type, values)) <= ATOMS:
@@ -82,7 +82,7 @@ def _fill(value: Any, schema: Mapping[str, Any], root: Mapping[str, Any]) -> Non
             _fill(item, schema["items"], root)
 
 
-def fill(value: Any, schema: Mapping[str, Any], root: Mapping[str, Any]) -> None:
+def fill(value: object, schema: Mapping[str, object], root: Mapping[str, object]) -> None:
     """Fill the defaults of `schema` (a part of the schema `root`, whose `$ref`s it may
     use) into `value` in place (a spawned creature's entry: `validate.validated_creature`)."""
     _fill(value, schema, root)
@@ -123,7 +123,9 @@ def filled(data: Mapping[str, Any], schema: Mapping[str, Any]) -> dict[str, Any]
     return out
 
 
-def with_defaults(data: dict[str, Any], plugins: Sequence[Plugin] | None = None) -> dict[str, Any]:
+def with_defaults(
+    data: dict[str, object], plugins: Sequence[Plugin] | None = None
+) -> dict[str, Any]:
     """Return a deep copy of ``data`` with every schema ``default`` filled in.
 
     Works recursively through nested objects (objects defaulting to ``{}`` get their own
@@ -149,5 +151,5 @@ def with_defaults(data: dict[str, Any], plugins: Sequence[Plugin] | None = None)
         for i, creature in enumerate(creatures):
             if isinstance(creature, dict):
                 creature.setdefault("name", f"creature_{i}")
-    filled: dict[str, Any] = result
+    filled: dict[str, object] = result
     return filled

@@ -60,7 +60,7 @@ def ecma_pattern(pattern: str) -> re.Pattern[str]:
     return re.compile("".join(out))
 
 
-def _pattern(validator: Any, pattern: str, instance: object, schema: object) -> Iterator[Any]:
+def _pattern(validator: object, pattern: str, instance: object, schema: object) -> Iterator[Any]:
     if isinstance(instance, str) and not ecma_pattern(pattern).search(instance):
         yield ValidationError(f"{instance!r} does not match {pattern!r}")
 
@@ -143,7 +143,9 @@ def _leaf_check(schema: object) -> Any:
     return check
 
 
-def _leaf(kind: str, low: Any, high: Any, above: Any, below: Any) -> Callable[[object], bool]:
+def _leaf(
+    kind: str, low: object, high: object, above: object, below: object
+) -> Callable[[object], bool]:
     """`_leaf_check`'s function: True when a value is of `kind` within the bounds (each
     None when absent), exactly when jsonschema would find nothing wrong with it."""
     is_kind = _LEAF_KINDS[kind]
@@ -194,7 +196,7 @@ StrictValidator = cast(Any, validators.extend)(  # jsonschema leaves extend unty
 _VALIDATORS: dict[int, tuple[dict[str, Any], Any]] = {}  # id -> (schema kept alive, validator)
 
 
-def validator_for(schema: dict[str, Any]) -> Any:
+def validator_for(schema: dict[str, object]) -> Any:
     """A validator per schema object (assembled schemas are cached, so this is too)."""
     found = _VALIDATORS.get(id(schema))
     if found is None or found[0] is not schema:

@@ -85,7 +85,7 @@ def read_scene_json(path: pathlib.Path) -> object:
 
 
 def load_scene(
-    source: str | os.PathLike[str] | dict[str, Any], *, allow_systems: bool = False
+    source: str | os.PathLike[str] | dict[str, object], *, allow_systems: bool = False
 ) -> dict[str, Any]:
     """Load, validate and complete a scene.
 
@@ -116,7 +116,7 @@ def _later_problems(data: object, found: list[str], plugins: list[Plugin]) -> li
     return [problem for problem in later if not _caused_by_repair(problem, found)]
 
 
-def on_plane(scene: Mapping[str, Any], plugins: Sequence[Plugin]) -> bool:
+def on_plane(scene: Mapping[str, object], plugins: Sequence[Plugin]) -> bool:
     """Whether the creatures of `scene` stand on the plane z = 0: no plugin on shapes the
     ground there (`Plugin.shapes_ground`)."""
     return not any(plugin.shapes_ground(scene) for plugin in plugins)
@@ -137,7 +137,7 @@ def _caused_by_repair(problem: str, found: list[str]) -> bool:
 
 
 def load_scene_plugins(
-    source: str | os.PathLike[str] | dict[str, Any],
+    source: str | os.PathLike[str] | dict[str, object],
     *,
     allow_systems: bool = False,
     scene_dir: pathlib.Path | None = None,

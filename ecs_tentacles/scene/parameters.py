@@ -108,7 +108,7 @@ class Parameter:
             return self.choices[int(stored)]
         return int(stored) if self.range and self.range.integer else float(stored)
 
-    def check(self, value: Any) -> Any:
+    def check(self, value: object) -> Any:
         """An API value (code units) if allowed, else a ValueError naming the parameter."""
         if self.choices:
             if value not in self.choices:
@@ -135,7 +135,7 @@ class Parameter:
         getattr(store, self.field)[rows] = stored
 
 
-def _annotated(schema: Mapping[str, Any]) -> Iterator[tuple[str, str, Mapping[str, Any], str]]:
+def _annotated(schema: Mapping[str, object]) -> Iterator[tuple[str, str, Mapping[str, Any], str]]:
     """(section, key, property schema, JSON path) of every annotated property of `schema`."""
     for section, node, path in schema_objects(schema):
         for key, spec in node["properties"].items():
@@ -178,7 +178,7 @@ def _parameter(section: str, key: str, spec: Mapping[str, Any], where: str) -> P
     )
 
 
-def read_parameters(schema: Mapping[str, Any]) -> tuple[Parameter, ...]:
+def read_parameters(schema: Mapping[str, object]) -> tuple[Parameter, ...]:
     """Every annotated parameter of `schema`, in document order; each column at most once."""
     table: list[Parameter] = []
     seen: dict[tuple[str, str], str] = {}
@@ -209,8 +209,8 @@ def parameter(section: str, key: str, table: Iterable[Parameter] | None = None) 
 def apply_parameters(
     world: Host,
     section: str,
-    entry: Mapping[str, Any],
-    rows: Mapping[str, Any],
+    entry: Mapping[str, object],
+    rows: Mapping[str, object],
     table: Sequence[Parameter] | None = None,
 ) -> None:
     """Fill store columns from a scene entry (defaults applied) of `section`, at `rows`.

@@ -39,6 +39,7 @@ from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.layouts import Layouts
 from ecs_tentacles.scene.overlap import Bodies, Overlap, find_overlaps, separate
 from ecs_tentacles.scene.ranges import damping_floor
+from ecs_tentacles.scene.scene_spec import PhysicsSpec
 from ecs_tentacles.scene.spec import CreatureSpec, TentaclesSpec, creature_specs
 from ecs_tentacles.scene.validate import format_path
 
@@ -63,7 +64,7 @@ Path = tuple[str | int, ...]
 
 
 def physically_checked(
-    scene: dict[str, Any],
+    scene: dict[str, object],
     prefix: str = "",
     plane: bool = True,
     layouts: Layouts | None = None,
@@ -110,7 +111,7 @@ def physical_problems(
 def creature_problems(
     where: Path,
     creature: CreatureSpec,
-    physics: dict[str, Any],
+    physics: PhysicsSpec,
     plane: bool = True,
     layouts: Layouts | None = None,
 ) -> list[tuple[Path, str]]:
@@ -133,10 +134,10 @@ def creature_problems(
 
 
 # a body plan's problems (`_body_key`), paths from the creature: worked out once per plan
-_BODY_PROBLEMS: dict[tuple[Any, ...], list[tuple[Path, str]]] = {}
+_BODY_PROBLEMS: dict[tuple[object, ...], list[tuple[Path, str]]] = {}
 
 
-def _body_key(creature: CreatureSpec, layout: CreatureLayout, step: float) -> tuple[Any, ...]:
+def _body_key(creature: CreatureSpec, layout: CreatureLayout, step: float) -> tuple[object, ...]:
     """Everything `_body_problems` reads: the mantle, each tentacle's shape, density and
     servo, which overrides set a shape or a servo (problem paths name them), the step."""
     mantle = creature["mantle"]
@@ -180,12 +181,12 @@ def _body_problems(
     return problems + _servo_problems(where, creature, layout, step)
 
 
-def _step(physics: dict[str, Any]) -> float:
+def _step(physics: PhysicsSpec) -> float:
     """The physics step 1 / (fps * substeps), in seconds."""
     return float(1.0 / (physics["fps"] * physics["substeps"]))
 
 
-def _timestep_problems(physics: dict[str, Any]) -> list[tuple[Path, str]]:
+def _timestep_problems(physics: PhysicsSpec) -> list[tuple[Path, str]]:
     fps, step = physics["fps"], _step(physics)
     if step <= MAX_SUBSTEP * (1 + 1e-9):
         return []
@@ -198,7 +199,7 @@ def _timestep_problems(physics: dict[str, Any]) -> list[tuple[Path, str]]:
     return [(("physics", "substeps"), message)]
 
 
-def _gravity_problems(physics: dict[str, Any]) -> list[tuple[Path, str]]:
+def _gravity_problems(physics: PhysicsSpec) -> list[tuple[Path, str]]:
     x, y, z = (float(g) for g in physics["gravity"])
     sideways, friction = math.hypot(x, y), physics["ground_friction"]
     if z > 0:

@@ -283,7 +283,7 @@ def scene_first(folder: pathlib.Path | None) -> Iterator[None]:
 
 
 def instantiate(
-    made: type[Plugin] | Plugin, key: str, config: Mapping[str, Any], source: str | None
+    made: type[Plugin] | Plugin, key: str, config: Mapping[str, object], source: str | None
 ) -> Plugin:
     """The plugin `load` found, made with `config` and known as `key` (from `source`)."""
     plugin = made if isinstance(made, Plugin) else made(dict(config))

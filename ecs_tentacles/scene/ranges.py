@@ -53,7 +53,7 @@ class Range:
         """The same range in other units (degrees in the scene, radians in the API)."""
         return replace(self, low=self.low * factor, high=self.high * factor)
 
-    def check(self, name: str, value: Any) -> Any:
+    def check(self, name: str, value: object) -> Any:
         """`value` (a float, or an int for integer ranges) if allowed, else a ValueError."""
         if isinstance(value, bool) or not isinstance(value, numbers.Real):
             raise ValueError(f"{name}: must be a number, got {value!r}")
@@ -75,7 +75,7 @@ def schema_range(spec: Mapping[str, Any]) -> Range:
     return Range(low, high, low_open, high_open, spec.get("type") == "integer")
 
 
-def schema_objects(node: Any, name: str = "", path: JsonPath = ()) -> Iterator[SchemaObject]:
+def schema_objects(node: object, name: str = "", path: JsonPath = ()) -> Iterator[SchemaObject]:
     """(name, object schema, JSON path) of every object schema with `properties` in `node`.
 
     An object is named by the property or definition holding it (`tentacles`,
@@ -100,7 +100,7 @@ def field_schema(section: str, key: str) -> dict[str, Any]:
     """The schema of `<section>.<key>` (section: mantle, tentacles, locomotion...)."""
     for name, node, _ in schema_objects(load_schema()):  # the default plugins' fields too
         if name == section and key in node["properties"]:
-            found: dict[str, Any] = node["properties"][key]
+            found: dict[str, object] = node["properties"][key]
             return found
     raise KeyError(f"{section}.{key}: not a field of the scene schema")
 

@@ -11,7 +11,7 @@ filled in plugins' `build(app)`, and the world-less registries it is called with
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from ecs_tentacles.plugin import calling
 from ecs_tentacles.registry import App, Registries, Registry
@@ -22,7 +22,7 @@ if TYPE_CHECKING:
 Problem = tuple[tuple[str | int, ...], str]
 
 
-class SceneChecks(Registry[Callable[[Mapping[str, Any], Registries], list[Problem]]]):
+class SceneChecks(Registry[Callable[[Mapping[str, object], Registries], list[Problem]]]):
     """Checks of a scene against what its plugins registered."""
 
 

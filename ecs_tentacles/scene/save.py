@@ -61,8 +61,8 @@ def default_file_name(name: object, suffix: str, fallback: str = "scene") -> str
 
 
 def checked_scene(
-    scene: dict[str, Any], plugins: Sequence[Plugin] | None = None
-) -> tuple[dict[str, Any], list[Plugin]]:
+    scene: dict[str, object], plugins: Sequence[Plugin] | None = None
+) -> tuple[dict[str, object], list[Plugin]]:
     """`scene` validated and completed as `load_scene` does (SceneError, one line per
     problem), and the plugins that checked it: `plugins`, a running world's, already
     made, so no plugin is looked up or imported again (a `spawner.py` in the current
@@ -86,7 +86,7 @@ class Carried:
 
 
 def named_files(
-    scene: Mapping[str, Any], plugins: Sequence[Plugin]
+    scene: Mapping[str, object], plugins: Sequence[Plugin]
 ) -> list[tuple[tuple[str | int, ...], str]]:
     """Every file `scene` names relative to its folder, as (JSON path, name): plugin code
     (`plugins.<key>.from: "file.py"`) and what each plugin's keys name
@@ -103,7 +103,7 @@ def named_files(
 
 
 def carried_files(
-    scene: dict[str, Any], plugins: Sequence[Plugin], source_dir: Path | None, target: Path
+    scene: dict[str, object], plugins: Sequence[Plugin], source_dir: Path | None, target: Path
 ) -> list[Carried]:
     """The files `scene` (from `source_dir`) names that a copy saved as `target` in
     another folder needs beside it, at the same names; `scene` is changed where a name
@@ -159,7 +159,7 @@ def _same_content(source: Path, destination: Path) -> bool:
         return False
 
 
-def _set(scene: dict[str, Any], path: tuple[str | int, ...], value: str) -> None:
+def _set(scene: dict[str, object], path: tuple[str | int, ...], value: str) -> None:
     node: Any = scene
     for step in path[:-1]:
         node = node[step]
@@ -167,7 +167,7 @@ def _set(scene: dict[str, Any], path: tuple[str | int, ...], value: str) -> None
 
 
 def save_scene(
-    scene: dict[str, Any],
+    scene: dict[str, object],
     path: str | os.PathLike[str],
     plugins: Sequence[Plugin] | None = None,
     *,
@@ -211,7 +211,7 @@ def save_scene(
     return target
 
 
-def point_schema(scene: dict[str, Any], folder: Path) -> None:
+def point_schema(scene: dict[str, object], folder: Path) -> None:
     """A scene's `$schema` (what editors complete and check against) rewritten to reach
     the bundled schema from `folder`, where the scene is saved; dropped when no relative
     path reaches it (another drive): loading validates by the bundled schema anyway."""

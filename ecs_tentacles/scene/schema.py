@@ -31,14 +31,14 @@ Part = tuple[str, tuple[Mapping[str, Any], ...]]  # plugin key, its keys by plac
 def core_schema() -> dict[str, Any]:
     """The core scene schema bundled with the package, without any plugin's keys."""
     resource = importlib.resources.files("ecs_tentacles.assets") / "schema" / "core.schema.json"
-    schema: dict[str, Any] = json.loads(resource.read_text(encoding="utf-8"))
+    schema: dict[str, object] = json.loads(resource.read_text(encoding="utf-8"))
     return schema
 
 
 @functools.cache
 def fragment(package: str, name: str) -> dict[str, Any]:
     """A built-in plugin's schema fragment: `<name>.schema.json` in its feature package."""
-    found: dict[str, Any] = json.loads(_fragment_file(package, name).read_text(encoding="utf-8"))
+    found: dict[str, object] = json.loads(_fragment_file(package, name).read_text(encoding="utf-8"))
     return found
 
 

@@ -82,6 +82,6 @@ def creature_specs(scene: Mapping[str, Any]) -> list[CreatureSpec]:
     return cast("list[CreatureSpec]", list(scene["creatures"]))
 
 
-def as_spec(entry: Mapping[str, Any]) -> CreatureSpec:
+def as_spec(entry: Mapping[str, object]) -> CreatureSpec:
     """A validated creature entry as a spec (the validator made it one)."""
     return cast("CreatureSpec", entry)

@@ -70,7 +70,7 @@ def _show(value: object) -> str:
     return text if len(text) <= _MAX_SHOWN else text[: _MAX_SHOWN - 3] + "..."
 
 
-def _range(schema: Mapping[str, Any]) -> str:
+def _range(schema: Mapping[str, object]) -> str:
     """Describe every numeric bound of ``schema``: ``in (0, 1]``, ``>= 1`` or ``< 5``."""
     low: tuple[str, Any] | None = None
     high: tuple[str, Any] | None = None
@@ -90,7 +90,7 @@ def _range(schema: Mapping[str, Any]) -> str:
     return f"{'<' if high[0] == ')' else '<='} {_show(high[1])}"
 
 
-def _count_bounds(schema: Mapping[str, Any], unit: str) -> str:
+def _count_bounds(schema: Mapping[str, object], unit: str) -> str:
     """Describe minItems/maxItems-style bounds: ``2 to 3 items``, ``at least 1 item``."""
     low, high = schema.get(f"min{unit}"), schema.get(f"max{unit}")
     noun = "items" if unit == "Items" else "characters"
@@ -194,14 +194,14 @@ def _schema_problems(data: object, validator: Any, prefix: JsonPath = ()) -> lis
 
 
 def schema_problems(
-    data: object, schema: Mapping[str, Any], prefix: JsonPath = ()
+    data: object, schema: Mapping[str, object], prefix: JsonPath = ()
 ) -> list[Problem]:
     """`data` checked against the JSON Schema `schema` (the scene's validator), each
     problem's path under `prefix` (a plugin's keys: `("game",)`)."""
     return _schema_problems(data, StrictValidator(schema), prefix)
 
 
-def _plugin_configs(data: Mapping[str, Any], plugins: Sequence[Plugin]) -> list[Problem]:
+def _plugin_configs(data: Mapping[str, object], plugins: Sequence[Plugin]) -> list[Problem]:
     """Each plugin's `plugins.<name>` config against the plugin's own `config_schema`."""
     chosen = data.get("plugins", {})
     problems: list[Problem] = []
@@ -214,7 +214,7 @@ def _plugin_configs(data: Mapping[str, Any], plugins: Sequence[Plugin]) -> list[
     return problems
 
 
-def registered_problems(scene: Mapping[str, Any], plugins: Sequence[Plugin]) -> list[Problem]:
+def registered_problems(scene: Mapping[str, object], plugins: Sequence[Plugin]) -> list[Problem]:
     """What the `SceneChecks` entries of `plugins` find in a defaults-filled `scene` (the
     rules that depend on what the plugins registered: a game's mode)."""
     from ecs_tentacles.scene.registries import SceneChecks, plugin_entries
@@ -420,7 +420,7 @@ def _too_deep(data: object, start: JsonPath = ()) -> JsonPath | None:
 
 
 def _limit_problems(
-    data: object, schema: Mapping[str, Any], root: Mapping[str, Any]
+    data: object, schema: Mapping[str, object], root: Mapping[str, object]
 ) -> list[Problem]:
     """Arrays longer than their schema's `maxItems`, found without descending into them."""
     problems: list[Problem] = []

@@ -173,7 +173,7 @@ def read_whole(
     return out
 
 
-def frame_arrays(header: dict[str, Any]) -> set[str]:
+def frame_arrays(header: dict[str, object]) -> set[str]:
     """The arrays of a take besides bodies and suckers that have a frames axis: the
     tracks' per-frame arrays, the roster's, the replay records."""
     out = set(take_replay.PER_FRAME) | {take_roster.ARRAY}

@@ -44,14 +44,14 @@ def chunked_names(header: dict[str, Any]) -> tuple[str, ...]:
     return (*CORE, *replay)
 
 
-def chunkable(header: dict[str, Any]) -> tuple[str, ...]:
+def chunkable(header: dict[str, object]) -> tuple[str, ...]:
     """Every array of this take that may be stored in chunks, in file order."""
     replay = take_replay.PER_FRAME if header.get(take_replay.KEY) is not None else ()
     curves = [a for t in tracks_of(header) if t.kind == "curves" for a in t.arrays]
     return (*CORE, *replay, *curves)
 
 
-def chunked_problem(header: dict[str, Any]) -> str | None:
+def chunked_problem(header: dict[str, object]) -> str | None:
     """The first problem of `header["chunked"]`, or None."""
     listed = header.get("chunked")
     if listed is None:
@@ -86,7 +86,7 @@ def quantised_names(header: dict[str, Any]) -> tuple[str, ...]:
     return tuple(header.get("quantised") or {})
 
 
-def curves_points(header: dict[str, Any]) -> list[str]:
+def curves_points(header: dict[str, object]) -> list[str]:
     """The points arrays of the take's curves tracks (world metres, every frame)."""
     return [t.arrays[0] for t in tracks_of(header) if t.kind == "curves"]
 
@@ -104,7 +104,7 @@ def dequantise(steps: np.ndarray, step: float) -> np.ndarray:
     return (np.cumsum(steps, axis=0) * step).astype(np.float32)
 
 
-def quantised_problem(header: dict[str, Any]) -> str | None:
+def quantised_problem(header: dict[str, object]) -> str | None:
     """The first problem of `header["quantised"]`, or None."""
     listed = header.get("quantised")
     if listed is None:

@@ -59,7 +59,7 @@ def pack(header: dict[str, Any]) -> dict[str, Any]:
     return packed
 
 
-def header_text(header: dict[str, Any]) -> str:
+def header_text(header: dict[str, object]) -> str:
     """The header as a take file stores it: compact JSON, packed from version 3 on."""
     version = header.get("version")
     stored = pack(header) if isinstance(version, int) and version >= 3 else header
@@ -76,7 +76,7 @@ def unpacked(header: _T) -> _T:
     return cast(_T, unpack(header))
 
 
-def unpack(header: dict[str, Any]) -> dict[str, Any]:
+def unpack(header: dict[str, object]) -> dict[str, Any]:
     """`header` with `bodies` and `suckers` listed in full (as it is without `body_plans`);
     raises `PlanError` when the plan table is unsound."""
     if KEY not in header:
@@ -98,8 +98,8 @@ def unpack(header: dict[str, Any]) -> dict[str, Any]:
     total = sum(len(plans[p]["bodies"]) for p in of)
     if total > MAX_BODIES or sum(len(plans[p]["suckers"]) for p in of) > MAX_BODIES:
         raise PlanError(f"header.{KEY}: lists more than {MAX_BODIES} bodies or suckers")
-    bodies: list[dict[str, Any]] = []
-    suckers: list[dict[str, Any]] = []
+    bodies: list[dict[str, object]] = []
+    suckers: list[dict[str, object]] = []
     for c, plan in enumerate(of):
         stem, first = _stem(creatures[c], c), len(bodies)
         for body in plans[plan]["bodies"]:
@@ -169,14 +169,14 @@ def _plan_sound(plan: object) -> bool:
     )
 
 
-def _stem(creature: dict[str, Any], c: int) -> str:
+def _stem(creature: dict[str, object], c: int) -> str:
     name = creature.get("name")
     if not isinstance(name, str):
         raise PlanError(f"header.creatures[{c}].name: missing or not a string")
     return name + "/"
 
 
-def _name(item: dict[str, Any], c: int) -> str:
+def _name(item: dict[str, object], c: int) -> str:
     name = item.get("name")
     if not isinstance(name, str):
         raise PlanError(f"header.{KEY}: a name of creature {c}'s plan is not a string")

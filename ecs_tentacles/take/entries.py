@@ -40,7 +40,7 @@ def _npy_header(handle: IO[bytes], name: str) -> tuple[tuple[int, ...], bool, np
 
 
 def _read_entry(
-    archive: zipfile.ZipFile, name: str, shape: tuple[int, ...] | None, wanted: np.dtype[Any]
+    archive: zipfile.ZipFile, name: str, shape: tuple[int, ...] | None, wanted: np.dtype[np.generic]
 ) -> np.ndarray:
     """Read `name`.npy, checking dtype and `shape` (None: any 4-d) before allocating."""
 
@@ -58,7 +58,7 @@ def read_npy(
     archive: zipfile.ZipFile,
     entry_name: str,
     label: str,
-    wanted: np.dtype[Any],
+    wanted: np.dtype[np.generic],
     check: Callable[[tuple[int, ...]], str | None],
 ) -> np.ndarray:
     """Read entry `entry_name` (an .npy), checking its dtype, that its data is there and

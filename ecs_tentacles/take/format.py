@@ -104,7 +104,7 @@ class Take:
     tracks: dict[str, np.ndarray] = field(default_factory=dict)
 
     @classmethod
-    def from_arrays(cls, header: dict[str, Any], arrays: dict[str, np.ndarray]) -> Take:
+    def from_arrays(cls, header: dict[str, object], arrays: dict[str, np.ndarray]) -> Take:
         """A take from its header and arrays by file name (as `read_take` returns them);
         what the header says of the file's layout (its chunks) is left out."""
         layout = ("chunk_frames", "chunked", "quantised")

@@ -69,7 +69,7 @@ def entries(header: dict[str, Any]) -> list[dict[str, Any]]:
     return [] if ground is None else list(ground["meshes"])
 
 
-def problem(header: dict[str, Any]) -> str | None:
+def problem(header: dict[str, object]) -> str | None:
     """The first problem of `header["ground"]`, or None."""
     ground = header.get(KEY)
     if ground is None:
@@ -114,7 +114,7 @@ def _is_colour(rgb: object) -> bool:
     )  # too large for a float is compared exactly, never converted
 
 
-def shapes(header: dict[str, Any]) -> dict[str, tuple[int, ...]]:
+def shapes(header: dict[str, object]) -> dict[str, tuple[int, ...]]:
     """Array name -> shape for a sound header."""
     out: dict[str, tuple[int, ...]] = {}
     for mesh in entries(header):
@@ -124,7 +124,7 @@ def shapes(header: dict[str, Any]) -> dict[str, tuple[int, ...]]:
     return out
 
 
-def dtypes(header: dict[str, Any]) -> dict[str, np.dtype[Any]]:
+def dtypes(header: dict[str, object]) -> dict[str, np.dtype[np.generic]]:
     """Array name -> dtype, in file order, for a sound header."""
     return {
         array_name(mesh["name"], part): np.dtype(dtype)
@@ -133,7 +133,7 @@ def dtypes(header: dict[str, Any]) -> dict[str, np.dtype[Any]]:
     }
 
 
-def index_problem(header: dict[str, Any], arrays: dict[str, np.ndarray]) -> str | None:
+def index_problem(header: dict[str, object], arrays: dict[str, np.ndarray]) -> str | None:
     """A triangle index at or past its mesh's vertex count, or None."""
     for mesh in entries(header):
         name = array_name(mesh["name"], "triangles")
@@ -143,7 +143,7 @@ def index_problem(header: dict[str, Any], arrays: dict[str, np.ndarray]) -> str 
     return None
 
 
-def colours(header: dict[str, Any]) -> dict[str, tuple[float, float, float]]:
+def colours(header: dict[str, object]) -> dict[str, tuple[float, float, float]]:
     """Mesh name -> its colour (display rgb) for the meshes a sound header gives one
     (takes before meshes carried their colour give none)."""
     return {
@@ -154,7 +154,7 @@ def colours(header: dict[str, Any]) -> dict[str, tuple[float, float, float]]:
 
 
 def meshes_of(
-    header: dict[str, Any], arrays: dict[str, np.ndarray]
+    header: dict[str, object], arrays: dict[str, np.ndarray]
 ) -> list[tuple[str, StaticMesh]]:
     """(name, mesh) of every ground mesh a (sound) take holds, for the exporters."""
     return [

@@ -31,7 +31,7 @@ MAX_BODIES = 16384 * 1025  # the schema's most creatures x the bodies of its lar
 FORMAT = "ecs_tentacles.take"
 VERSION = 3  # what is written: version 2 with bodies stored per body plan (`take.compact`)
 VERSIONS = (1, 2, 3)  # version 1: no chunks, no replay records; both still read
-CORE_DTYPES: dict[str, np.dtype[Any]] = {
+CORE_DTYPES: dict[str, np.dtype[np.generic]] = {
     "header": np.dtype(np.uint8),
     "pos": np.dtype("<f4"),
     "quat": np.dtype("<f4"),
@@ -64,7 +64,7 @@ def _index(value: object, size: int) -> bool:
     return isinstance(value, int) and not isinstance(value, bool) and 0 <= value < size
 
 
-def _list_of_dicts(header: dict[str, Any], key: str) -> str | None:
+def _list_of_dicts(header: dict[str, object], key: str) -> str | None:
     value = header.get(key)
     if not isinstance(value, list):
         return f"header.{key}: missing or not a list"
@@ -74,7 +74,7 @@ def _list_of_dicts(header: dict[str, Any], key: str) -> str | None:
     return None
 
 
-def _creature_problem(creatures: list[dict[str, Any]], bodies: int) -> str | None:
+def _creature_problem(creatures: list[dict[str, object]], bodies: int) -> str | None:
     used: set[int] = set()
     names: set[str] = set()
     for c, creature in enumerate(creatures):
@@ -248,7 +248,7 @@ def expected_shapes(
     return shapes
 
 
-def array_dtypes(header: dict[str, Any]) -> dict[str, np.dtype[Any]]:
+def array_dtypes(header: dict[str, object]) -> dict[str, np.dtype[np.generic]]:
     """Every array a take with this (sound) header may hold -> its dtype, in file order."""
     out = dict(CORE_DTYPES)
     for track in tracks_of(header):

@@ -30,7 +30,7 @@ import numpy as np
 KEY = "replay"
 IDENTITY = np.array([1.0, 0.0, 0.0, 0.0], dtype=np.float32)
 PER_FRAME = ("replay_kind", "replay_phase", "replay_xy", "replay_heading")
-DTYPES: dict[str, np.dtype[Any]] = {
+DTYPES: dict[str, np.dtype[np.generic]] = {
     "replay_kind": np.dtype(np.int8),
     "replay_phase": np.dtype("<f8"),
     "replay_xy": np.dtype("<f8"),
@@ -112,7 +112,7 @@ def shapes(header: dict[str, Any]) -> dict[str, tuple[int, ...]]:
     return out
 
 
-def dtypes(header: dict[str, Any]) -> dict[str, np.dtype[Any]]:
+def dtypes(header: dict[str, Any]) -> dict[str, np.dtype[np.generic]]:
     """Array name -> dtype, in file order, for a sound header."""
     replay = header.get(KEY)
     if replay is None:
@@ -143,7 +143,7 @@ def values_problem(header: dict[str, Any], arrays: dict[str, np.ndarray]) -> str
                                   if clip_array(i) in arrays})  # fmt: skip
 
 
-def clips_problem(header: dict[str, Any], clips: dict[int, np.ndarray]) -> str | None:
+def clips_problem(header: dict[str, object], clips: dict[int, np.ndarray]) -> str | None:
     """The first clip frame the poses cannot come from: a number not finite or beyond
     1e6 m, a rotation of no length."""
     for i, pose in clips.items():
@@ -234,7 +234,7 @@ def poses(
 
 
 def fill(
-    header: dict[str, Any],
+    header: dict[str, object],
     clips: dict[int, np.ndarray],
     arrays: dict[str, np.ndarray],
     pos: np.ndarray,

@@ -24,7 +24,7 @@ ARRAY = "creature_visible"
 MAX_CHANGES = 1_000_000
 
 
-def problem(header: dict[str, Any]) -> str | None:
+def problem(header: dict[str, object]) -> str | None:
     """The first problem of `header["roster"]`, or None."""
     roster = header.get(KEY)
     if roster is None:
@@ -46,7 +46,7 @@ def shapes(header: dict[str, Any]) -> dict[str, tuple[int, ...]]:
     return {ARRAY: (header["frames"], len(header["creatures"]))}
 
 
-def dtypes(header: dict[str, Any]) -> dict[str, np.dtype[Any]]:
+def dtypes(header: dict[str, object]) -> dict[str, np.dtype[np.generic]]:
     """Array name -> dtype, in file order, for a sound header."""
     return {} if header.get(KEY) is None else {ARRAY: np.dtype(np.bool_)}
 

@@ -52,7 +52,7 @@ class TakeTrack:
         out["arrays"] = list(self.arrays)
         return out
 
-    def empty_header(self) -> list[Any] | None:
+    def empty_header(self) -> list[object] | None:
         """Its header entry before anything is recorded."""
         return [] if self.kind == "points" else None
 
@@ -111,7 +111,7 @@ def dtypes(track: TakeTrack) -> tuple[str, str]:
     return ("<f4", "|b1") if track.kind == "points" else ("<f4", "<f4")
 
 
-def declared_problem(header: dict[str, Any]) -> str | None:
+def declared_problem(header: dict[str, object]) -> str | None:
     """The first problem of `header["tracks"]` (the declared tracks), or None."""
     declared = header.get("tracks", [])
     if not isinstance(declared, list):

@@ -22,7 +22,6 @@ import threading
 import zipfile
 from collections.abc import Callable
 from types import TracebackType
-from typing import Any
 
 import numpy as np
 
@@ -180,7 +179,7 @@ class TakeWriter:
         """Keep nothing: the temporary file is removed when the block ends."""
         self._discarded = True
 
-    def finish(self, header: dict[str, Any], arrays: dict[str, np.ndarray]) -> None:
+    def finish(self, header: dict[str, object], arrays: dict[str, np.ndarray]) -> None:
         """Store the last chunk, the arrays without chunks and the header (`frames` and
         `chunk_frames` set here); the file is renamed into place when the block ends."""
         self._store_chunk()

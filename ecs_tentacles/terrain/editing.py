@@ -170,7 +170,7 @@ class TerrainEditor:
         scene = world.scene or {}
         return copy.deepcopy(scene.get("terrain") or {})
 
-    def _apply(self, world: Host, terrain: dict[str, Any]) -> None:
+    def _apply(self, world: Host, terrain: dict[str, object]) -> None:
         ground = build_ground(terrain, world.scene_dir)
         _refuse_creatures_inside(world, ground)
         if world.scene is not None:

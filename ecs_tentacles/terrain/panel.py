@@ -154,7 +154,7 @@ class TerrainPanel(Panel):
         else:
             self.message = f"saved {saved}"
 
-    def _raw_scene(self) -> dict[str, Any]:
+    def _raw_scene(self) -> dict[str, object]:
         """The scene as its file says (defaults not filled in)."""
         source = self.sandbox.scene
         if isinstance(source, dict):

@@ -12,8 +12,6 @@ in). Each is sunk by `BURIED` of its height into the lowest ground under it.
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 
 from ecs_tentacles.terrain.heights import MAX_RESOLUTION
@@ -34,7 +32,7 @@ BURIED = (0.2, 0.4)  # the share of a rock's height under the ground
 TRIES = 60  # candidate places per creature
 
 
-def rocky(positions: np.ndarray, reach: float, seed: int) -> dict[str, Any]:
+def rocky(positions: np.ndarray, reach: float, seed: int) -> dict[str, object]:
     """A scene's `terrain` for creatures starting at `positions` (n, 2) within `reach` m."""
     half = np.abs(positions).max(axis=0) + reach + 1.0
     size = [float(round(2 * h, 2)) for h in half]
@@ -52,7 +50,7 @@ def rocky(positions: np.ndarray, reach: float, seed: int) -> dict[str, Any]:
 
 def boulders(
     positions: np.ndarray, reach: float, half: np.ndarray, seed: int
-) -> list[dict[str, Any]]:
+) -> list[dict[str, object]]:
     """`rock` obstacles within `half` (x, y) of the origin among starts `positions` (n, 2)."""
     rng = np.random.default_rng(seed)
     least, most = 0.5 * ROCK_WIDTH[0], 0.5 * ROCK_WIDTH[1]
@@ -63,7 +61,7 @@ def boulders(
         gaps = np.linalg.norm(candidates[:, None, :] - positions[None, :, :], axis=2)
         room = np.minimum(room, gaps.min(axis=1) - reach - CLEAR)
     placed: list[tuple[np.ndarray, float]] = []
-    rocks: list[dict[str, Any]] = []
+    rocks: list[dict[str, object]] = []
     for point, fits in zip(candidates, room.tolist(), strict=True):
         if len(rocks) == wanted:
             break

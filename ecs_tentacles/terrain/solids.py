@@ -59,7 +59,7 @@ def obstacle_problems(obstacles: Sequence[Mapping[str, Any]]) -> list[Problem]:
 
 
 def solids(
-    obstacles: Sequence[Mapping[str, Any]],
+    obstacles: Sequence[Mapping[str, object]],
     folder: pathlib.Path | None,
     field: Heightfield | None = None,
 ) -> tuple[Solid, ...]:

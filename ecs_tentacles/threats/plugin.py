@@ -39,7 +39,7 @@ class ThreatsPlugin(Plugin):
     defs = _FRAGMENT["$defs"]
     hook_reads = ("threats", "transforms.pos")  # its Dangers entry (`behaviour.dangers`)
 
-    def problems(self, scene: Mapping[str, Any]) -> list[tuple[tuple[str | int, ...], str]]:
+    def problems(self, scene: Mapping[str, object]) -> list[tuple[tuple[str | int, ...], str]]:
         return threat_problems(scene)
 
     def resources(self, world: Host) -> list[object]:

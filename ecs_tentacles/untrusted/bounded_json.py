@@ -78,7 +78,7 @@ def loads(
 Entry = tuple[Any, int, "tuple[Entry, object] | None"]  # value, depth, (parent, key)
 
 
-def _problem(value: Any, where: str, max_depth: int, max_number: int, long: bool) -> str | None:
+def _problem(value: object, where: str, max_depth: int, max_number: int, long: bool) -> str | None:
     """The first container nested too deep or (when `long`) number too long, or None.
     A loop, not recursion: the value may be nested as deep as the parser allowed."""
     if isinstance(value, _Long):

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import json
 from json import JSONDecoder
-from typing import Any
+from typing import Any, NoReturn
 
 _WHITESPACE = " \t\n\r"
 _CLOSING = {"{": "}", "[": "]"}  # a container's opening character -> its closing one
@@ -46,12 +46,12 @@ def _finite_float(text: str) -> float:
     return value
 
 
-def _refuse_constant(name: str) -> Any:
+def _refuse_constant(name: str) -> NoReturn:
     """Refuse the non-standard ``NaN``/``Infinity`` literals Python's json accepts."""
     raise ValueError(f"{name} is not valid JSON")
 
 
-def _unique_pairs(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+def _unique_pairs(pairs: list[tuple[str, Any]]) -> dict[str, object]:
     """An object's pairs as a dict; `_Repeated` if a key comes twice."""
     out = dict(pairs)
     if len(out) != len(pairs):

@@ -17,7 +17,7 @@ Transform store (mantle positions). Writes: goals, through `travel(world).send`
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -90,7 +90,7 @@ class FleePlugin(Plugin):
         **replanning(1.0),
     )
 
-    def problems(self, scene: Mapping[str, Any]) -> list[Problem]:
+    def problems(self, scene: Mapping[str, object]) -> list[Problem]:
         return farther_than_reach(self, scene, "run")
 
     def systems(self) -> list[System]:

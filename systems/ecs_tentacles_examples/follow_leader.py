@@ -62,7 +62,7 @@ class FollowLeader(System):
     def setup(self, world: Host) -> None:
         self.every = max(1, round(self.interval * world.settings.fps))
         rows = {c.name: c.row for _, c in world.query(Creature)}  # a shard may lack some
-        entries: list[Mapping[str, Any]] = list(world.creature_specs.values())  # our key too
+        entries: list[Mapping[str, object]] = list(world.creature_specs.values())  # our key too
         pairs = [
             (rows[entry["name"]], rows[entry[KEY]])
             for entry in entries

@@ -16,7 +16,7 @@ creatures that have none).
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -104,7 +104,7 @@ class WanderPlugin(Plugin):
         **replanning(0.5),
     )
 
-    def problems(self, scene: Mapping[str, Any]) -> list[Problem]:
+    def problems(self, scene: Mapping[str, object]) -> list[Problem]:
         return farther_than_reach(self, scene, "radius", times=2)
 
     def systems(self) -> list[System]:

@@ -73,7 +73,7 @@ class Record(System):
         """The frames recorded, ending the recording (no copies: `TakeRecorder.finish`)."""
         return self._recorder().finish()
 
-    def finish_stream(self) -> dict[str, Any]:
+    def finish_stream(self) -> dict[str, object]:
         """End a streamed recording (`TakeRecorder.finish_stream`); the header written."""
         return self._recorder().finish_stream()
 
