@@ -1,8 +1,8 @@
-"""The REDUCED tier's model: about half the links per tentacle at a quarter of the rate.
+"""The REDUCED tier's model: about half the links per tentacle at an eighth of the rate.
 
 The reduced creature's body is built in `physics.reduced_body`, the maps below in
-`physics.reduced_maps`; it steps at a quarter of the scene's rate
-(`tiers.reduced_substeps`: 120 Hz at the default 480 Hz).
+`physics.reduced_maps`; it steps at an eighth of the scene's rate
+(`tiers.reduced_substeps`: 60 Hz, one step a frame, at the default 480 Hz).
 
 `ReducedModel` maps states between the two models, tentacle by tentacle and hinge axis
 by hinge axis, through each link's heading along the tentacle (the sum of its joint
@@ -76,8 +76,13 @@ KERNELS = OptionalKernels("ecs_tentacles.physics.reduced_kernels", "ECS_TENTACLE
 # progress 1.03 of full, sd 0.088, correlation -0.22; the crossing crowd of
 # `tools/lod_fidelity.py --goals-within 0.8` arrives within 2 s for 60 of 61 creatures
 # (seed 0; 56 before), 55 of 61 (seed 1; 53 of 59) and 61 of 62 (seed 2; 60 of 62).
+# Those figures were taken at 120 Hz. At 60 Hz (one step a frame, `tiers.REDUCED_RATE`)
+# damping 2 made a heavy-mantled creature slower than its full self (0.74-0.99 at mantle
+# radius 0.19, 0.84-1.03 at 0.12; 120 Hz: 1.04-1.14); damping 1.5 gives 0.99-1.05 and
+# 1.07-1.10, and the crossing crowd of `tools/lod_fidelity.py` 0.983 of full progress
+# at 64 creatures (0.975 with damping 2).
 STIFFNESS_GAIN = 0.9
-DAMPING_GAIN = 2.0
+DAMPING_GAIN = 1.5
 # The damping DAMPING_GAIN adds over STIFFNESS_GAIN's share is at most DAMPING_CAP of the
 # hinge's critical damping (2 sqrt(kp I), I its inertia at rest): it calms the faster
 # swing of a chain matched at the tip, an inertial effect. A heavily damped servo is not
@@ -89,9 +94,11 @@ DAMPING_GAIN = 2.0
 DAMPING_CAP = 1.0
 # The stiffest a reduced servo may be at the reduced step h: kp h^2 / I <= STIFF_STEP, I
 # the hinge's inertia at rest (`dof_M0`). Stiffer rows take shorter steps, as many more
-# as it needs (`write_overlay`). Default creatures (strength 25) are at 0.47; the 120 Hz
-# step failed from 9.4 (strength 500 and damping 1.1 to 3, a default body) and held at
-# 7.6 (strength 400): 4 is the undamped limit of the integrator (omega h <= 2).
+# as it needs (`write_overlay`). At 120 Hz default creatures (strength 25) were at 0.47
+# and the step failed from 9.4 (strength 500 and damping 1.1 to 3, a default body) and
+# held at 7.6 (strength 400): 4 is the undamped limit of the integrator (omega h <= 2).
+# At 60 Hz (four times h^2) the crowd generator's creatures are at 0.8-4.6: 3 of a varied
+# crowd's 64 take two steps a frame, a uniform crowd's none.
 STIFF_STEP = 4.0
 MAX_SPLIT = 64  # at most this many shorter steps (a script's gain far past the schema's)
 _NO_CLIP = np.zeros(0)  # the map kernel's bounds when a map is not clipped

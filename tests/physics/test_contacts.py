@@ -76,13 +76,22 @@ def test_proxies_stand_where_the_other_creatures_bodies_are(
 HILLS = {"heightfield": {"size": [8, 4], "resolution": 41, "height": 0.3, "noise": {"seed": 7}}}
 
 
-@pytest.mark.parametrize("terrain", [{}, HILLS], ids=["plane", "rough ground"])
+REDUCED_ONLY = {"lod": {"full": 0, "reduced": 8}}  # no hero: both run at the reduced tier
+
+
+@pytest.mark.parametrize(
+    ("terrain", "physics"),
+    [({}, {}), (HILLS, {}), ({}, REDUCED_ONLY), (HILLS, REDUCED_ONLY)],
+    ids=["plane", "rough ground", "plane, reduced", "rough ground, reduced"],
+)
 def test_two_creatures_driven_head_on_never_interpenetrate(
-    make_world: Callable[..., World], terrain: dict[str, Any]
+    make_world: Callable[..., World], terrain: dict[str, Any], physics: dict[str, Any]
 ) -> None:
+    """Full or reduced (one step a frame, contact proxies as stiff as that step allows)."""
     scene = {
         "version": 1,
         "terrain": terrain,
+        "physics": physics,
         "creatures": [
             {"name": "a", "position": [-1.2, 0.0], "goals": [{"position": [2.4, 0.0]}]},
             {
@@ -95,6 +104,8 @@ def test_two_creatures_driven_head_on_never_interpenetrate(
     }
     world = make_world(scene)
     worst = _worst_clearance(world, 12 * 60)
+    tier = "reduced" if physics else "full"
+    assert world.lod.counts()[tier] == 2
     assert worst > -TOLERANCE
     assert world.physics.health.recoveries == 0  # the physics never became unstable
     mantles = world.transforms.pos[world.creatures.mantle_row]

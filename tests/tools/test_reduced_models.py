@@ -63,6 +63,6 @@ def test_the_model_set_is_the_one_worlds_step_until_the_defaults_come_back(
     default_hinges, default_steps = _reduced_links(tool, None)
     every_hinges, every_steps = _reduced_links(tool, {"links": 1.0, "rate": 2.0})
     assert every_hinges == 2 * default_hinges  # the default octopus: 10 links, then 5
-    assert (default_steps, every_steps) == (2, 4)  # 480 Hz scene: 120 Hz, then 240 Hz
+    assert (default_steps, every_steps) == (1, 4)  # 480 Hz scene: 60 Hz, then 240 Hz
     assert _reduced_links(tool, None) == (default_hinges, default_steps)
-    assert (reduced_body.LINK_SHARE, tiers.REDUCED_RATE) == (0.5, 4)
+    assert (reduced_body.LINK_SHARE, tiers.REDUCED_RATE) == (0.5, 8)
