@@ -5,8 +5,8 @@ which part of the gap between a reduced creature and its full self.
     use_model(model_settings("links=1,rate=1,gain=1,damping=1"))  # then build a World
 
 Keys: `links` (reduced links per full link, `physics.reduced_body.LINK_SHARE`, 0.5; 1 keeps
-every link), `rate` (full steps per reduced step, `physics.tiers.REDUCED_RATE`, 4; 1 is
-the full rate), `gain` and `damping` (`STIFFNESS_GAIN` 0.9 and `DAMPING_GAIN` 2; 1 and 1
+every link), `rate` (full steps per reduced step, `physics.tiers.REDUCED_RATE`, 8; 1 is
+the full rate), `gain` and `damping` (`STIFFNESS_GAIN` 0.9 and `DAMPING_GAIN` 1.5; 1 and 1
 are the full servos' gains when every link is kept). `use_model` sets them for this
 process: the worlds it builds after the call use them.
 """

@@ -12,7 +12,7 @@ import pytest
 
 from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.physics.batch import STATE
-from ecs_tentacles.physics.tiers import FULL, REDUCED
+from ecs_tentacles.physics.tiers import FULL, REDUCED, reduced_substeps
 from ecs_tentacles.terrain.presets import rocky
 from ecs_tentacles.world import World
 
@@ -101,6 +101,25 @@ def test_tier_moves_do_not_pop(make_world: Callable[..., World], terrain: bool) 
     world.lod.update(world)
     assert world.lod.tier_of(world.creature("c0")) == "full"
     np.testing.assert_array_equal(batch.state, before)
+
+
+def test_a_reduced_creature_takes_one_step_a_frame_and_stands_as_high_as_its_full_self(
+    make_world: Callable[..., World],
+) -> None:
+    """At the default 480 Hz a reduced creature takes one MuJoCo step a frame (60 Hz), its
+    contacts as soft as that step allows: it still lands on the ground and stands on its
+    tentacles within 3 mm of its full self's height (1.7 mm lower measured), never in it."""
+    heights = {}
+    for tier, lod in (("full", {"full": 8}), ("reduced", {"full": 0, "reduced": 8})):
+        world = make_world(_crowd(4, lod))
+        assert reduced_substeps(world.settings.substeps) == 1
+        rows = world.creatures.mantle_row
+        world.step(120)
+        assert world.lod.counts()[tier] == 4
+        assert world.physics.health.recoveries == 0
+        heights[tier] = world.transforms.pos[rows, 2].copy()
+    assert np.all(heights["reduced"] > 0.1), heights  # on its tentacles, not on its mantle
+    np.testing.assert_allclose(heights["reduced"], heights["full"], atol=0.003)
 
 
 def test_a_reduced_crowd_crawls_like_a_full_one(make_world: Callable[..., World]) -> None:
