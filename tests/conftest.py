@@ -7,6 +7,8 @@ import os
 import signal
 import subprocess
 import sys
+import tempfile
+import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
@@ -23,6 +25,38 @@ from ecs_tentacles.world import World
 settings.register_profile("seeded", derandomize=True, database=None, max_examples=60)
 settings.register_profile("thorough", max_examples=1000)
 settings.load_profile("seeded")
+
+# numba compiles each `cache=True` kernel on first call and keeps it on disk; on a fresh
+# clone every xdist worker would compile the same kernels again. The controller compiles
+# them once first, one process per worker, and the workers load them from the cache.
+NUMBA_WARMUP = Path(__file__).resolve().parents[1] / "tools" / "numba_warmup.py"
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    """On the xdist controller, before any worker starts: the kernels the suite calls
+    compiled into numba's cache (`tools/numba_warmup.py`), split over the workers' cores."""
+    workers = getattr(config.option, "numprocesses", None) or 0
+    if hasattr(config, "workerinput") or not isinstance(workers, int) or workers < 1:
+        return
+    if config.getoption("collectonly") or config.getoption("help"):
+        return
+    start = time.perf_counter()
+    with tempfile.TemporaryDirectory(prefix="numba-claims-") as claims:
+        command = [sys.executable, str(NUMBA_WARMUP), "compile", "--claims", claims]
+        runs = [
+            subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+            for _ in range(min(workers, os.cpu_count() or 1))
+        ]
+        said = [run.communicate()[0].strip().splitlines() or [""] for run in runs]
+    failed = [lines[-1] for run, lines in zip(runs, said, strict=True) if run.returncode]
+    line = (
+        f"numba kernels compiled ahead by {len(runs)} processes in "
+        f"{time.perf_counter() - start:.1f} s: " + "; ".join(lines[-1] for lines in said)
+    )
+    reporter = config.pluginmanager.get_plugin("terminalreporter")
+    if reporter is not None:  # shown under -q too: a stale list shows in CI's log
+        reporter.write_line(line + (f" (failed: {failed[0]})" if failed else ""))
+
 
 # plugins off where a test's script drives the motors: `make_world(scene, plugins=NO_LOCOMOTION)`
 NO_LOCOMOTION = {"locomotion": False, "suckers": False}
@@ -175,9 +209,17 @@ def _own_folder(variable: str, folder: Path) -> Iterator[None]:
 
 @pytest.fixture(scope="session", autouse=True)
 def _private_cache(tmp_path_factory: pytest.TempPathFactory) -> Iterator[None]:
-    """Decomposed meshes are cached in a folder of the test session's own, not the user's
-    (`ecs_tentacles.terrain.mesh_cache.cache_folder`)."""
-    yield from _own_folder("XDG_CACHE_HOME", tmp_path_factory.mktemp("cache"))
+    """Decomposed meshes and gait clips are cached in a folder of the test session's own,
+    not the user's (`ecs_tentacles.terrain.mesh_cache.cache_folder`,
+    `ecs_tentacles.clips.disk`): one folder for all xdist workers (each worker's
+    temporary folder is in the session's), so a morphology's clips are recorded once a
+    session, not once a worker. Entries are written whole or not at all, and a test
+    about the cache itself gives it a folder of its own."""
+    base = tmp_path_factory.getbasetemp()
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        base = base.parent
+    (base / "cache").mkdir(exist_ok=True)
+    yield from _own_folder("XDG_CACHE_HOME", base / "cache")
 
 
 @pytest.fixture(scope="session", autouse=True)
