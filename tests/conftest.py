@@ -32,6 +32,7 @@ settings.load_profile("seeded")
 NUMBA_WARMUP = Path(__file__).resolve().parents[1] / "tools" / "numba_warmup.py"
 
 
+@pytest.hookimpl(trylast=True)  # after the terminal's, which it writes to
 def pytest_configure(config: pytest.Config) -> None:
     """On the xdist controller, before any worker starts: the kernels the suite calls
     compiled into numba's cache (`tools/numba_warmup.py`), split over the workers' cores."""

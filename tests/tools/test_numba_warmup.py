@@ -51,7 +51,7 @@ def test_a_kernel_compiled_ahead_is_loaded_not_compiled_by_the_next_process(
          "--list", str(tmp_path / "list.json")],
         env=env, capture_output=True, text=True, check=True,
     )  # fmt: skip
-    assert done.stdout.startswith("1 compiled or loaded, 0 stale"), done.stdout
+    assert done.stdout.startswith("1 compiled or cached, 0 stale"), done.stdout
     assert _hits_and_misses(env) == [1, 0]
 
 
