@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import fcntl
 import json
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -196,6 +198,30 @@ def octopus_take() -> Any:
     return bake(BakePlan.make("octopus", seconds=4.0, fps=30.0), progress=False)
 
 
+def session_folder(factory: pytest.TempPathFactory) -> Path:
+    """The test session's temporary folder, the same for all its xdist workers (each
+    worker's own is inside it)."""
+    base = factory.getbasetemp()
+    return base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base
+
+
+def once_a_session(
+    factory: pytest.TempPathFactory, name: str, make: Callable[[Path], Path]
+) -> Path:
+    """`make(folder)`'s file, made once a session in the folder `name` (the session's,
+    shared by its workers): the first worker to ask makes it, the others wait for it (a
+    lock) and take the file it made. For files the tests read and never change."""
+    base = session_folder(factory)
+    folder, made = base / name, base / name / ".made"
+    with open(base / f"{name}.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file closes
+        if not made.exists():  # not yet, or the worker making it failed: from scratch
+            shutil.rmtree(folder, ignore_errors=True)
+            folder.mkdir()
+            made.write_text(make(folder).relative_to(folder).as_posix())
+    return folder / made.read_text()
+
+
 def _own_folder(variable: str, folder: Path) -> Iterator[None]:
     """The environment variable `variable` set to `folder` while the session runs (and
     in the CLI processes tests start), put back after."""
@@ -216,11 +242,9 @@ def _private_cache(tmp_path_factory: pytest.TempPathFactory) -> Iterator[None]:
     temporary folder is in the session's), so a morphology's clips are recorded once a
     session, not once a worker. Entries are written whole or not at all, and a test
     about the cache itself gives it a folder of its own."""
-    base = tmp_path_factory.getbasetemp()
-    if os.environ.get("PYTEST_XDIST_WORKER"):
-        base = base.parent
-    (base / "cache").mkdir(exist_ok=True)
-    yield from _own_folder("XDG_CACHE_HOME", base / "cache")
+    folder = session_folder(tmp_path_factory) / "cache"
+    folder.mkdir(exist_ok=True)
+    yield from _own_folder("XDG_CACHE_HOME", folder)
 
 
 @pytest.fixture(scope="session", autouse=True)
