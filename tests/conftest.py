@@ -2,11 +2,15 @@
 
 from __future__ import annotations
 
+import fcntl
 import json
 import os
+import shutil
 import signal
 import subprocess
 import sys
+import tempfile
+import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
@@ -23,6 +27,39 @@ from ecs_tentacles.world import World
 settings.register_profile("seeded", derandomize=True, database=None, max_examples=60)
 settings.register_profile("thorough", max_examples=1000)
 settings.load_profile("seeded")
+
+# numba compiles each `cache=True` kernel on first call and keeps it on disk; on a fresh
+# clone every xdist worker would compile the same kernels again. The controller compiles
+# them once first, one process per worker, and the workers load them from the cache.
+NUMBA_WARMUP = Path(__file__).resolve().parents[1] / "tools" / "numba_warmup.py"
+
+
+@pytest.hookimpl(trylast=True)  # after the terminal's, which it writes to
+def pytest_configure(config: pytest.Config) -> None:
+    """On the xdist controller, before any worker starts: the kernels the suite calls
+    compiled into numba's cache (`tools/numba_warmup.py`), split over the workers' cores."""
+    workers = getattr(config.option, "numprocesses", None) or 0
+    if hasattr(config, "workerinput") or not isinstance(workers, int) or workers < 1:
+        return
+    if config.getoption("collectonly") or config.getoption("help"):
+        return
+    start = time.perf_counter()
+    with tempfile.TemporaryDirectory(prefix="numba-claims-") as claims:
+        command = [sys.executable, str(NUMBA_WARMUP), "compile", "--claims", claims]
+        runs = [
+            subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+            for _ in range(min(workers, os.cpu_count() or 1))
+        ]
+        said = [run.communicate()[0].strip().splitlines() or [""] for run in runs]
+    failed = [lines[-1] for run, lines in zip(runs, said, strict=True) if run.returncode]
+    line = (
+        f"numba kernels compiled ahead by {len(runs)} processes in "
+        f"{time.perf_counter() - start:.1f} s: " + "; ".join(lines[-1] for lines in said)
+    )
+    reporter = config.pluginmanager.get_plugin("terminalreporter")
+    if reporter is not None:  # shown under -q too: a stale list shows in CI's log
+        reporter.write_line(line + (f" (failed: {failed[0]})" if failed else ""))
+
 
 # plugins off where a test's script drives the motors: `make_world(scene, plugins=NO_LOCOMOTION)`
 NO_LOCOMOTION = {"locomotion": False, "suckers": False}
@@ -161,6 +198,30 @@ def octopus_take() -> Any:
     return bake(BakePlan.make("octopus", seconds=4.0, fps=30.0), progress=False)
 
 
+def session_folder(factory: pytest.TempPathFactory) -> Path:
+    """The test session's temporary folder, the same for all its xdist workers (each
+    worker's own is inside it)."""
+    base = factory.getbasetemp()
+    return base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base
+
+
+def once_a_session(
+    factory: pytest.TempPathFactory, name: str, make: Callable[[Path], Path]
+) -> Path:
+    """`make(folder)`'s file, made once a session in the folder `name` (the session's,
+    shared by its workers): the first worker to ask makes it, the others wait for it (a
+    lock) and take the file it made. For files the tests read and never change."""
+    base = session_folder(factory)
+    folder, made = base / name, base / name / ".made"
+    with open(base / f"{name}.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file closes
+        if not made.exists():  # not yet, or the worker making it failed: from scratch
+            shutil.rmtree(folder, ignore_errors=True)
+            folder.mkdir()
+            made.write_text(make(folder).relative_to(folder).as_posix())
+    return folder / made.read_text()
+
+
 def _own_folder(variable: str, folder: Path) -> Iterator[None]:
     """The environment variable `variable` set to `folder` while the session runs (and
     in the CLI processes tests start), put back after."""
@@ -175,9 +236,15 @@ def _own_folder(variable: str, folder: Path) -> Iterator[None]:
 
 @pytest.fixture(scope="session", autouse=True)
 def _private_cache(tmp_path_factory: pytest.TempPathFactory) -> Iterator[None]:
-    """Decomposed meshes are cached in a folder of the test session's own, not the user's
-    (`ecs_tentacles.terrain.mesh_cache.cache_folder`)."""
-    yield from _own_folder("XDG_CACHE_HOME", tmp_path_factory.mktemp("cache"))
+    """Decomposed meshes and gait clips are cached in a folder of the test session's own,
+    not the user's (`ecs_tentacles.terrain.mesh_cache.cache_folder`,
+    `ecs_tentacles.clips.disk`): one folder for all xdist workers (each worker's
+    temporary folder is in the session's), so a morphology's clips are recorded once a
+    session, not once a worker. Entries are written whole or not at all, and a test
+    about the cache itself gives it a folder of its own."""
+    folder = session_folder(tmp_path_factory) / "cache"
+    folder.mkdir(exist_ok=True)
+    yield from _own_folder("XDG_CACHE_HOME", folder)
 
 
 @pytest.fixture(scope="session", autouse=True)

@@ -3,6 +3,7 @@ into the store (read back from the batches, kept by snapshots)."""
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Callable
 
 import numpy as np
@@ -33,6 +34,7 @@ def test_the_nearest_frame_kernel_picks_numpys_frames(monkeypatch: pytest.Monkey
     assert (found[0][10:] == picked[10:]).mean() > 0.9  # a small nudge keeps its frame
 
 
+BODY_PLAN = ("mantle", "tentacles", "locomotion", "fur")  # a varied crowd's creature's keys
 HILLS = {"size": [40, 40], "resolution": 64, "height": 0.3, "noise": {"seed": 3, "scale": 6.0}}
 
 
@@ -64,6 +66,12 @@ def test_replayed_poses_written_once_are_the_poses_the_sync_copied(
     from ecs_tentacles.creator.crowd import crowd_scene
 
     scene = crowd_scene(6, seed=2, uniform=crowd != "varied")
+    if crowd == "varied":  # two body plans, alternating: each batch's rows interleaved
+        plans = [{k: v for k, v in c.items() if k in BODY_PLAN} for c in scene["creatures"][:2]]
+        for i, creature in enumerate(scene["creatures"]):  # (two gait clips to record)
+            for key in BODY_PLAN:
+                creature.pop(key, None)
+            creature.update(copy.deepcopy(plans[i % 2]))
     scene.setdefault("physics", {})["lod"] = {"full": 0, "reduced": 2, "hold_seconds": 0.1}
     if crowd == "terrain":
         scene["terrain"] = {"heightfield": HILLS}

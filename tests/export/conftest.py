@@ -21,7 +21,7 @@ from ecs_tentacles.record.systems.record import Record
 from ecs_tentacles.take import Take
 from ecs_tentacles.take.registries import CurvesFrame, TrackSource
 from ecs_tentacles.world import World
-from tests.conftest import uniform_crowd
+from tests.conftest import once_a_session, uniform_crowd
 
 # One creature, three tentacles of four links, tip suckers, a goal 1 m ahead.
 SMALL_SCENE: dict[str, Any] = {
@@ -142,8 +142,8 @@ def replay_crowd_take(folder: Path, seconds: float = 2.0) -> Path:
 @pytest.fixture(scope="session")
 def replay_take(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """A take (version 2) of 16 creatures, 15 of them replaying a gait clip from frame 1
-    (`replay_crowd_take`)."""
-    return replay_crowd_take(tmp_path_factory.mktemp("replayed"))
+    (`replay_crowd_take`), baked once a session for all workers."""
+    return once_a_session(tmp_path_factory, "replayed", replay_crowd_take)
 
 
 def switching_crowd_take(folder: Path) -> Path:
@@ -164,5 +164,5 @@ def switching_crowd_take(folder: Path) -> Path:
 @pytest.fixture(scope="session")
 def switching_take(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """A take (version 2) of 9 creatures that switch between physics and a gait clip,
-    several of them more than once (`switching_crowd_take`)."""
-    return switching_crowd_take(tmp_path_factory.mktemp("switching"))
+    several of them more than once (`switching_crowd_take`), baked once a session."""
+    return once_a_session(tmp_path_factory, "switching", switching_crowd_take)
