@@ -36,8 +36,13 @@ NUMBA_WARMUP = Path(__file__).resolve().parents[1] / "tools" / "numba_warmup.py"
 
 @pytest.hookimpl(trylast=True)  # after the terminal's, which it writes to
 def pytest_configure(config: pytest.Config) -> None:
-    """On the xdist controller, before any worker starts: the kernels the suite calls
-    compiled into numba's cache (`tools/numba_warmup.py`), split over the workers' cores."""
+    """On the xdist controller, before any worker starts: `--dist worksteal` unless a
+    `--dist` was given (a worker out of tests takes the other's last ones, so one long
+    test does not leave a core idle), and the kernels the suite calls compiled into
+    numba's cache (`tools/numba_warmup.py`), split over the workers' cores."""
+    given = any(str(arg).startswith("--dist") for arg in config.invocation_params.args)
+    if getattr(config.option, "dist", None) == "load" and not given:
+        config.option.dist = "worksteal"  # read when the scheduler is made, at session start
     workers = getattr(config.option, "numprocesses", None) or 0
     if hasattr(config, "workerinput") or not isinstance(workers, int) or workers < 1:
         return
