@@ -9,6 +9,7 @@ recorder's arrays and tracks and writes nothing but to the writer.
 
 from __future__ import annotations
 
+from abc import ABC, abstractmethod
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -23,7 +24,7 @@ if TYPE_CHECKING:
     from ecs_tentacles.take.writer import TakeWriter
 
 
-class StreamedFrames:
+class StreamedFrames(ABC):
     """Chunks of frames to the writer, and the stream's end (the recorder's arrays)."""
 
     writer: TakeWriter | None
@@ -40,10 +41,11 @@ class StreamedFrames:
     _flushed_last: dict[str, np.ndarray]  # the last frame handed over
     _chunked_curves: list[CurvesTrack] | None  # decided at the first flush
 
+    @abstractmethod
     def _header_and_tracks(
         self, n: int, copy: bool
     ) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
-        raise NotImplementedError  # the recorder's
+        """The take's header and tracks of its first `n` frames (`TakeRecorder`'s)."""
 
     def _size_chunks(self) -> None:
         """Frames per chunk from the first frame's bytes of every chunked array (the

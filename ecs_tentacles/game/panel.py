@@ -8,6 +8,7 @@ its pause flag. Writes: the world back at the level's start, the pause flag, `me
 
 from __future__ import annotations
 
+from abc import ABC, abstractmethod
 from typing import TYPE_CHECKING
 
 from pyglet.window import key
@@ -20,7 +21,7 @@ if TYPE_CHECKING:
     from ecs_tentacles.render.registries import SandboxView
 
 
-class ModePanel(Panel):
+class ModePanel(Panel, ABC):
     """A game mode's HUD section: `restart` (R) and pause (P); subclasses draw the rest."""
 
     order = -20  # first, before the selected creature's Locomotion (-10): the game is the point
@@ -30,9 +31,9 @@ class ModePanel(Panel):
         self.message = ""
 
     @property
+    @abstractmethod
     def played(self) -> PlayedGame:
         """The mode's game resource in the sandbox's world."""
-        raise NotImplementedError
 
     def restart(self) -> bool:
         """Back to the level's start: its snapshot (True), or (when a creature was removed
