@@ -23,7 +23,6 @@ drawing (`Draws`: fur's ribbons, with GL objects the plugin makes and keeps in
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any
 
 import numpy as np
 from pyglet import gl
@@ -109,7 +108,7 @@ class Renderer:
         # pixels on the picture's left that an opaque panel drawn after the world covers
         # (the sandbox's HUD): the world is not drawn there (`draw`)
         self.covered_left = 0
-        self.state: dict[str, Any] = {}  # what plugins keep here (GL objects), across worlds
+        self.state: dict[str, object] = {}  # what plugins keep here (GL objects), across worlds
         self.palette = "natural"  # the creatures' colours (`ecs_tentacles.skin.colours`)
         self.set_world(world)
 
