@@ -25,7 +25,6 @@ plugin makes and keeps in `state`), handing them a `RenderView`; "frame all" kee
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any
 
 import numpy as np
 from pyglet import gl
@@ -102,7 +101,7 @@ class Renderer:
         # pixels on the picture's left that an opaque panel drawn after the world covers
         # (the sandbox's HUD): the world is not drawn there (`draw`)
         self.covered_left = 0
-        self.state: dict[str, Any] = {}  # what plugins keep here (GL objects), across worlds
+        self.state: dict[str, object] = {}  # what plugins keep here (GL objects), across worlds
         self.palette = "natural"  # the creatures' colours (`ecs_tentacles.skin.colours`)
         self.set_world(world)
 
