@@ -74,7 +74,7 @@ import importlib
 import os
 from collections.abc import Callable
 from types import ModuleType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -95,6 +95,9 @@ from ecs_tentacles.skin.keys import KeyReport
 from ecs_tentacles.skin.mesh import Detail
 from ecs_tentacles.skin.rig import Keys
 from ecs_tentacles.take import Take
+
+if TYPE_CHECKING:
+    from pxr import Usd
 
 Progress = Callable[[int], object]
 WORK_BYTES = 32 * 1024**2  # joint rotations (float64) worked on at once: chunks are split
@@ -125,7 +128,7 @@ def build_skinned_stage(
     keys: Keys | None = None,
     locators: bool = False,
     progress: Progress | None = None,
-) -> tuple[Any, KeyReport]:
+) -> tuple[Usd.Stage, KeyReport]:
     """An in-memory `Usd.Stage` with one SkelRoot per creature, and the key report."""
     layer = StreamedLayer(None)
     report = _fill(layer, TakeChunks(take), detail, keys, locators, progress)
