@@ -1,6 +1,6 @@
 """A take's header and the rows of its `creatures`, `bodies` and `suckers` tables, as
 TypedDicts (`TakeHeader`: every key the format names; a plugin's own track adds a key
-of its own, which no TypedDict can name, read as `Mapping[str, object]`).
+of its own, which no TypedDict mypy accepts can name, so `Take.header` stays a dict).
 
 The recorder (`ecs_tentacles.export.recording`) writes them; `take.header` checks a
 file's against the same fields (names, indices, shapes, sizes) before anything reads
