@@ -38,7 +38,7 @@ KIND_NAMES = ("idle", "crawl")
 GAP = 0.01  # a replayed stretch's strip ends this much (frames) before the next frame
 
 
-def import_take(context: object, path: str | Path, report: Report) -> str:
+def import_take(context: bpy.types.Context, path: str | Path, report: Report) -> str:
     """Import the take at `path` into `context.scene` (see the module); returns a line
     saying what was made. Raises `TakeFileError` (one line) for a file that is not a
     sound take, having made nothing."""

@@ -53,7 +53,7 @@ class ImportTake(bpy.types.Operator, ImportHelper):  # type: ignore[misc, unused
     filename_ext = ".npz"
     filter_glob: StringProperty(default="*.npz", options={"HIDDEN"})  # type: ignore[valid-type]
 
-    def execute(self, context: object) -> set[str]:
+    def execute(self, context: bpy.types.Context) -> set[str]:
         progress = Progress(context)
         try:
             made = import_take(context, self.filepath, progress)

@@ -32,7 +32,7 @@ from ecs_tentacles.skin.mesh import Detail, SkinMesh, creature_mesh
 from ecs_tentacles.skin.skeleton import Skeleton, build_skeleton, creature_layout, transforms
 
 if TYPE_CHECKING:
-    from pxr import Vt
+    from pxr import Usd, Vt
 
 
 @dataclass(frozen=True)
@@ -108,7 +108,7 @@ def _plan_arrays(pxr: ModuleType, skeleton: Skeleton, mesh: SkinMesh) -> dict[st
 
 def define_creature(
     pxr: ModuleType,
-    stage: object,
+    stage: Usd.Stage,
     plan: BodyPlan,
     name: str,
     colour: np.ndarray,
@@ -128,7 +128,7 @@ def define_creature(
 
 def define_skin(
     pxr: ModuleType,
-    stage: object,
+    stage: Usd.Stage,
     plan: BodyPlan,
     name: str,
     prefix: str,

@@ -19,6 +19,7 @@ the `StreamedLayer` (`ecs_tentacles.export.usd_layer`).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -132,7 +133,7 @@ class UsdTracks:
                     self._placed(track, [t for _, t in paths], first, chunk.frames, roots)
 
     def _placed(
-        self, track: TakeTrack, paths: list[object], first: int, frames: int, roots: RootFrames
+        self, track: TakeTrack, paths: Sequence[object], first: int, frames: int, roots: RootFrames
     ) -> None:
         """Locators' translates at every frame of the chunk, in their creatures' frames."""
         Gf = self.pxr.Gf
@@ -174,7 +175,7 @@ class Visibility:
 
 
 def key_steps(
-    layer: StreamedLayer, paths: list[object], steps: Steps, first: int, values: np.ndarray,
+    layer: StreamedLayer, paths: Sequence[object], steps: Steps, first: int, values: np.ndarray,
     tokens: tuple[str, str] | None = None,
 ) -> None:  # fmt: skip
     """Key the held `values` (n, K) of the chunk at `first` on the attributes `paths`
