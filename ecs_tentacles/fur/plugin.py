@@ -11,7 +11,9 @@ the emotional creatures they rouse baked in one shard. Sandbox hooks
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NamedTuple
+
+import numpy as np
 
 from ecs_tentacles.distributed.registries import ShardGroups
 from ecs_tentacles.fur.build import build_emotion, build_fur
@@ -33,6 +35,13 @@ if TYPE_CHECKING:
 
 _FRAGMENT = fragment("ecs_tentacles.fur", "fur")
 STORES = ("guides", "controls", "sets", "emotions")
+
+
+class FurState(NamedTuple):
+    """What a snapshot keeps: the posed curves and frames the rig last wrote."""
+
+    curves: np.ndarray
+    frames: np.ndarray
 
 
 class FurPlugin(Plugin):
@@ -72,9 +81,11 @@ class FurPlugin(Plugin):
 
     def snapshot(self, world: Host) -> object:
         fur = world.resource(FurData)  # its stores are copied with every store
-        return fur.curves.copy(), fur.frames.copy()
+        return FurState(fur.curves.copy(), fur.frames.copy())
 
-    def restore(self, world: Host, state: Any) -> None:
+    def restore(self, world: Host, state: object) -> None:
+        if not isinstance(state, FurState):
+            raise TypeError(f"fur: a snapshot's state is a FurState, not {state!r}")
         curves, frames = state
         fur = world.resource(FurData)
         fur.discard()  # the snapshot's outputs replace whatever the rig deferred
@@ -115,7 +126,7 @@ class FurPlugin(Plugin):
         app.add(Draws, self._draw)
         app.add(Panels, self._panels)
 
-    def _lines(self, world: Host, view: RenderView) -> list[Any]:
+    def _lines(self, world: Host, view: RenderView) -> list[np.ndarray]:
         from ecs_tentacles.fur.render.strands import fur_lines
 
         return fur_lines(world, view)
