@@ -14,7 +14,7 @@ stores.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, SupportsFloat
 
 import numpy as np
 
@@ -25,6 +25,7 @@ from ecs_tentacles.locomotion.params import ROWS, Locomotion, settable
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
+    from ecs_tentacles.scene.parameters import Parameter
 
 
 LAYOUT = {"creatures": ("first_tentacle", "tentacles"), "tentacles": ("first_link", "links")}
@@ -35,7 +36,7 @@ def goal_path(world: Host, creature: int) -> list[tuple[tuple[float, ...], float
     return [(tuple(g.position.tolist()), float(g.radius)) for g in goals]
 
 
-def _parameters() -> list[Any]:
+def _parameters() -> list[Parameter]:
     per_tentacle, per_creature = settable()
     return list({**per_tentacle, **per_creature}.values())
 
@@ -142,7 +143,9 @@ def save_creature(world: Host, creature: int, entry: dict[str, Any]) -> None:
     tentacles["overrides"] = kept
 
 
-def _scene_value(p: Any, value: Any) -> Any:
+def _scene_value(p: Parameter, value: object) -> object:
     if p.choices or isinstance(value, int):
         return value
+    if not isinstance(value, SupportsFloat):
+        raise TypeError(f"{p.api}: {value!r} is not a number")
     return round(float(value) / p.factor, 12)
