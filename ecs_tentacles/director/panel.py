@@ -194,8 +194,8 @@ class DirectorPanel(Panel):
                 self.message = "threats are off in this scene"
                 return None
             point = [float(v) for v in ground]
-            entity = source.drop(world, point, preset.entry["threat"])
-            name = source.placed(world)[entity] if source.placed else preset.entry["threat"]
+            entity = source.drop(world, point, preset.threat)
+            name = source.placed(world)[entity] if source.placed else preset.threat
             self._push(ThreatDropped(f"drop {name}", name, point))
             self.message = f"dropped {name}"
             return entity
