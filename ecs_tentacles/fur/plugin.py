@@ -11,7 +11,7 @@ the emotional creatures they rouse baked in one shard. Sandbox hooks
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from typing import TYPE_CHECKING, Any, NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
@@ -59,11 +59,16 @@ class FurPlugin(Plugin):
     def resources(self, world: Host) -> list[object]:
         return [FurData()]
 
-    def build_creature(self, world: Host, creature: int, spec: Mapping[str, Any]) -> None:
-        if "fur" in spec:
-            build_fur(world, creature, dict(spec["fur"]))
-        if "emotion" in spec:
-            build_emotion(world, creature, dict(spec["emotion"]))
+    def build_creature(self, world: Host, creature: int, spec: Mapping[str, object]) -> None:
+        fur, emotion = spec.get("fur"), spec.get("emotion")
+        if fur is not None and not isinstance(fur, Mapping):
+            raise TypeError(f"{spec.get('name')}: its fur is an object, not {fur!r}")
+        if emotion is not None and not isinstance(emotion, Mapping):
+            raise TypeError(f"{spec.get('name')}: its emotion is an object, not {emotion!r}")
+        if fur is not None:
+            build_fur(world, creature, dict(fur))
+        if emotion is not None:
+            build_emotion(world, creature, dict(emotion))
 
     def roster_changed(self, world: Host, change: RosterChange) -> None:
         if not change.spawned:  # a spawn's fur was added by `build_creature`
