@@ -125,9 +125,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--objects", action="store_true", help="Python objects by type too")
     parser.add_argument("--json", action="store_true", help="one JSON object")
     args = parser.parse_args(argv)
-    if args.crowd < 1 or args.frames < 0 or args.top < 0:
-        print("error: --crowd must be >= 1, --frames and --top >= 0", file=sys.stderr)
-        return 2
+    for name, least in (("crowd", 1), ("frames", 0), ("top", 0)):
+        if getattr(args, name) < least:
+            parser.error(f"--{name} must be >= {least}, got {getattr(args, name)}")  # exit 2
     result = measure(args.crowd, args.frames, args.objects, args.top)
     if args.json:
         print(json.dumps(result))
