@@ -194,6 +194,24 @@ def _shape_rows(shape: TentacleShape, mantle_radius: float, every_link: bool) ->
     return rows
 
 
+# id(shape) -> (shape kept alive, its links' lengths, radii and scales as Python floats)
+_LINK_FLOATS: dict[int, tuple[TentacleShape, tuple[list[float], ...]]] = {}
+
+
+def _link_floats(shape: TentacleShape) -> tuple[list[float], ...]:
+    """`shape`'s link lengths, radii and scales as Python floats, made once per shape
+    (read only): the `Link` components of every tentacle of that shape share them (a
+    uniform crowd of 10,000 made 2.4 million floats of them, 58 MB)."""
+    found = _LINK_FLOATS.get(id(shape))
+    if found is not None and found[0] is shape:
+        return found[1]
+    floats = (shape.lengths.tolist(), shape.radii.tolist(), shape.scales.tolist())
+    if len(_LINK_FLOATS) > 4096:
+        _LINK_FLOATS.clear()
+    _LINK_FLOATS[id(shape)] = (shape, floats)
+    return floats
+
+
 def _link_entities(
     world: Host,
     tentacle: Tentacle,
@@ -206,7 +224,7 @@ def _link_entities(
     params, shape = layout.params[k], layout.shapes[k]
     limit = float(_joint_limit().from_scene(params["joint_limit_deg"]))
     density, twist = params["density"], params["twist"]
-    lengths, radii, scales = shape.lengths.tolist(), shape.radii.tolist(), shape.scales.tolist()
+    lengths, radii, scales = _link_floats(shape)
     transforms, motors = world.transforms, world.motors
     for i, (row, motor_row) in enumerate(
         zip(rows.transforms.tolist(), rows.motors.tolist(), strict=True)

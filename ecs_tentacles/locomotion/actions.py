@@ -14,9 +14,9 @@ from __future__ import annotations
 
 from collections import deque
 from collections.abc import Iterable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from enum import IntEnum
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, overload
 
 import numpy as np
 
@@ -120,24 +120,62 @@ def drive_sequence(
     return actions
 
 
+class _Pending:
+    """`ActionQueue.pending`: a deque made on first use. An empty deque is 760 bytes, and
+    most of a crowd's 80,000 tentacles never queue an action (replayed creatures' clips
+    carry theirs): until one is asked for, the queue holds None."""
+
+    @overload
+    def __get__(self, queue: None, owner: type) -> None: ...
+    @overload
+    def __get__(self, queue: ActionQueue, owner: type) -> deque[Action]: ...
+    def __get__(self, queue: ActionQueue | None, owner: type) -> deque[Action] | None:
+        if queue is None:  # the dataclass's default (none given): made on first use
+            return None
+        made: deque[Action] | None = queue.__dict__.get("_pending")
+        if made is None:
+            made = queue.__dict__["_pending"] = deque()
+        return made
+
+    def __set__(self, queue: ActionQueue, actions: deque[Action] | None) -> None:
+        queue.__dict__["_pending"] = actions
+
+
 @dataclass(eq=False)
 class ActionQueue:
-    """A tentacle's pending actions (the current one lives in the TentacleStore row)."""
+    """A tentacle's pending actions (the current one lives in the TentacleStore row).
 
-    pending: deque[Action] = field(default_factory=deque)
+    `pending` is a deque of them; the methods below reach it without making one for a
+    queue that never held an action (`_Pending`)."""
+
+    pending: _Pending = _Pending()
+
+    def _made(self) -> deque[Action] | None:
+        made: deque[Action] | None = self.__dict__.get("_pending")
+        return made
 
     def extend(self, actions: Iterable[Action]) -> None:
         self.pending.extend(actions)
 
     def clear(self) -> None:
-        self.pending.clear()
+        made = self._made()
+        if made is not None:
+            made.clear()
+
+    def popleft(self) -> Action:
+        """The next pending action, taken off the queue (IndexError when there is none)."""
+        made = self._made()
+        if made is None:
+            raise IndexError("pop from an empty action queue")
+        return made.popleft()
 
     def __len__(self) -> int:
-        return len(self.pending)
+        made = self._made()
+        return 0 if made is None else len(made)
 
     def kinds(self) -> list[str]:
         """Names of the pending actions, for the HUD and tests."""
-        return [action.kind.name.lower() for action in self.pending]
+        return [action.kind.name.lower() for action in self._made() or ()]
 
 
 class ActionQueues:

@@ -73,7 +73,8 @@ _FRAGMENT = fragment("ecs_tentacles.locomotion", "locomotion")
 
 class LocomotionState(NamedTuple):
     """What a snapshot keeps: each creature's goal path (position, radius), each
-    tentacle's pending actions, and the navigator's routes."""
+    tentacle's pending actions (a tentacle with none is not listed), and the
+    navigator's routes."""
 
     goals: dict[int, list[tuple[np.ndarray, float]]]
     queues: dict[int, deque[Action]]
@@ -178,7 +179,7 @@ class LocomotionPlugin(Plugin):
             ]
             for entity, _ in world.query(Creature)
         }
-        queues = {e: copy.deepcopy(q.pending) for e, q in world.query(ActionQueue)}
+        queues = {e: copy.deepcopy(q.pending) for e, q in world.query(ActionQueue) if len(q)}
         return LocomotionState(goals, queues, world.resource(Navigator).state())
 
     def restore(self, world: Host, state: object) -> None:
@@ -189,8 +190,8 @@ class LocomotionPlugin(Plugin):
             world.resource(GoalBook).clear(entity)
             for position, radius in path:
                 world.resource(GoalBook).append(entity, position.tolist(), radius)
-        for entity, queue in world.query(ActionQueue):
-            queue.pending = copy.deepcopy(queues[entity])
+        for entity, queue in world.query(ActionQueue):  # (an empty queue: not in `queues`)
+            queue.pending = copy.deepcopy(queues[entity]) if entity in queues else None
         world.resource(Navigator).set_state(navigation)
 
     # -- registry entries ---------------------------------------------------------------

@@ -46,7 +46,7 @@ from ecs_tentacles.physics.proxies import ContactProxies
 from ecs_tentacles.physics.roster import Roster
 from ecs_tentacles.physics.rounds import Ready, Rounds
 from ecs_tentacles.physics.sleep import Sleep, SleepState
-from ecs_tentacles.physics.stepping import Segment, Work, plan, step_segments
+from ecs_tentacles.physics.stepping import Segment, Work, hold_reduced, plan, step_segments
 from ecs_tentacles.physics.tiers import FULL, KINEMATIC, REDUCED, reduced_substeps
 from ecs_tentacles.physics.view import CreatureViews
 
@@ -65,7 +65,7 @@ class PhysicsState:
     time: float
     states: list[np.ndarray]  # per batch: its state rows
     poses: list[tuple[np.ndarray, np.ndarray]]  # per batch: xpos, xquat after the last step
-    reduced: list[tuple[np.ndarray, np.ndarray]]  # per batch: rstate, rsource (REDUCED rows)
+    reduced: list[tuple[np.ndarray, ...]]  # per batch: rslot, rstate, rsource (REDUCED rows)
     applied: list[dict[int, np.ndarray]]  # per batch: forces scripts apply
     frozen: np.ndarray
     sleeping: np.ndarray
@@ -159,7 +159,7 @@ class PhysicsBackend(Membership):
             time=self.time,
             states=[b.state.copy() for b in self.batches],
             poses=[b.all_poses() for b in self.batches],  # the replayed ones as shown
-            reduced=[(b.rstate.copy(), b.rsource.copy()) for b in self.batches],
+            reduced=[(b.rslot.copy(), b.rstate.copy(), b.rsource.copy()) for b in self.batches],
             applied=[{r: f.copy() for r, f in b.applied.items()} for b in self.batches],
             frozen=self.frozen.copy(),
             sleeping=self.sleeping.copy(),
@@ -188,16 +188,16 @@ class PhysicsBackend(Membership):
         Warnings counted since and a pending fatal error are dropped: neither is state.
         """
         self.time = state.time
-        for batch, rows, (xpos, xquat), (rstate, rsource), applied in zip(
+        for batch, rows, (xpos, xquat), (rslot, rstate, rsource), applied in zip(
             self.batches, state.states, state.poses, state.reduced, state.applied, strict=False
         ):  # batches compiled since are empty (`state_problem`)
             batch.state[:] = rows
             batch.xpos[:], batch.xquat[:] = xpos, xquat
             batch.show(None, None)  # every row's poses as saved, replayed ones too
-            if rstate.shape == batch.rstate.shape:
-                batch.rstate[:], batch.rsource[:] = rstate, rsource
+            if rstate.shape[1] == batch.rstate.shape[1]:
+                batch.rslot[:], batch.rstate, batch.rsource = rslot, rstate.copy(), rsource.copy()
             else:  # compiled since: no row was REDUCED then; each fits on its first step
-                batch.rsource[:] = np.nan
+                batch.release_reduced(np.arange(len(batch)))
             batch.applied = {r: f.copy() for r, f in applied.items()}
             batch.warnings[:] = 0
             batch.errors.clear()
@@ -310,6 +310,7 @@ class PhysicsBackend(Membership):
         threads. Asleep or frozen creatures keep their state; the clock moves on.
         """
         reduced = reduced_substeps(substeps)
+        hold_reduced(self.batches, self.active, self.tier, self.threads)
         if before_substep is not None:
             segments = plan(self.batches, self.active, self.tier, self.threads)
             for i in range(substeps):

@@ -161,10 +161,11 @@ def _reduced_states(backend: Stepped, index: int, rows: np.ndarray) -> np.ndarra
     batch.prepare(REDUCED, backend.threads)
     reduced = batch.reduced
     assert reduced is not None
-    out: np.ndarray = batch.rstate[rows].copy()
+    out = np.zeros((len(rows), batch.rstate.shape[1]))
     for position, row in enumerate(rows.tolist()):
-        full = batch.state[row]
-        if np.array_equal(full[reduced.watched], batch.rsource[row]):
+        full, slot = batch.state[row], int(batch.rslot[row])  # (-1: none held yet: fitted)
+        if slot >= 0 and np.array_equal(full[reduced.watched], batch.rsource[slot]):
+            out[position] = batch.rstate[slot]
             reduced.pull_inputs(full, out[position])
         else:
             reduced.fit_state(full, out[position])

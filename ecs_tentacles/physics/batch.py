@@ -116,10 +116,13 @@ class Batch(BatchPoses):
         # shares rows between threads (a creature on rocks costs more than one at rest)
         self.step_cost = np.zeros((n, 2))
         # REDUCED rows: their reduced model's state, and the part of the full state the
-        # last reduced step wrote (when it differs, someone else wrote it: fit again).
-        # No columns until the reduced model is compiled.
-        self.rstate = np.zeros((n, 0))
-        self.rsource = np.zeros((n, 0))
+        # last reduced step wrote (when it differs, someone else wrote it: fit again),
+        # a row of each at `rslot` (-1: none) for the rows that step REDUCED only
+        # (`hold_reduced`; 10,000 creatures' were 93 MB). No columns until the reduced
+        # model is compiled.
+        self.rslot = np.full(n, -1, dtype=np.int64)
+        self.rstate = np.zeros((0, 0))
+        self.rsource = np.zeros((0, 0))
         self.scratch: dict[int, list[Scratch]] = {FULL: []}
         # `body_rows` as one slice of the Transform store when they are consecutive (a
         # uniform crowd): `sync` then copies instead of scattering, 6x faster at 10,000
@@ -134,8 +137,7 @@ class Batch(BatchPoses):
     # the per-row arrays, in the order `append` and `remove` treat them
     PER_ROW = ("body_rows", "actuator_motor_rows", "actuator_target_index", "sucker_rows",
                "members", "state", "kp", "kv", "torque", "anchor", "proxy_size", "near",
-               "xpos", "xquat", "warnings", "deepest", "rstate", "rsource",
-               "step_cost")  # fmt: skip
+               "xpos", "xquat", "warnings", "deepest", "rslot", "step_cost")  # fmt: skip
 
     def _store_rows(
         self, layouts: list[ModelLayout]
@@ -164,7 +166,7 @@ class Batch(BatchPoses):
             setattr(self, name, np.concatenate([getattr(self, name), value]))
         for name in self.PER_ROW[5:]:
             array = getattr(self, name)
-            fill = {"deepest": np.inf, "proxy_size": 0.01, "rsource": np.nan}.get(name, 0)
+            fill = {"deepest": np.inf, "proxy_size": 0.01, "rslot": -1}.get(name, 0)
             grown = np.full((len(array) + 1, *array.shape[1:]), fill, dtype=array.dtype)
             grown[:-1] = array
             setattr(self, name, grown)
@@ -173,6 +175,7 @@ class Batch(BatchPoses):
 
     def remove(self, row: int) -> None:
         """Take row `row` out; the rows after it move up one (forces and errors with them)."""
+        self.release_reduced(np.array([row]))
         for name in self.PER_ROW:
             setattr(self, name, without_row(getattr(self, name), row))
         self.applied = {r - (r > row): f for r, f in self.applied.items() if r != row}
@@ -249,8 +252,37 @@ class Batch(BatchPoses):
         self.models[REDUCED] = reduced.model
         width = (reduced.size, reduced.watched.stop - reduced.watched.start)
         if self.rstate.shape[1] != width[0]:  # first compile: every row fits on first step
-            self.rstate = np.zeros((len(self), width[0]))
-            self.rsource = np.full((len(self), width[1]), np.nan)
+            self.rslot[:] = -1
+            self.rstate = np.zeros((0, width[0]))
+            self.rsource = np.zeros((0, width[1]))
+
+    def hold_reduced(self, rows: np.ndarray) -> None:
+        """Rows `rows` (about to step REDUCED: `prepare(REDUCED)` ran) each hold a reduced
+        state; a row new to it fits its full state on its first step (its `rsource`: NaN,
+        which nothing equals)."""
+        new = rows[self.rslot[rows] < 0]
+        if not len(new):
+            return
+        held = len(self.rstate)
+        self.rslot[new] = held + np.arange(len(new))
+        self.rstate = np.concatenate([self.rstate, np.zeros((len(new), self.rstate.shape[1]))])
+        self.rsource = np.concatenate(
+            [self.rsource, np.full((len(new), self.rsource.shape[1]), np.nan)]
+        )
+
+    def release_reduced(self, rows: np.ndarray) -> None:
+        """Rows `rows` hold no reduced state from now on (replayed ones: a promotion writes
+        their full state, which they would fit again anyway); the others keep theirs."""
+        gone = self.rslot[rows]
+        gone = gone[gone >= 0]
+        if not len(gone):
+            return
+        kept = np.ones(len(self.rstate), dtype=bool)
+        kept[gone] = False
+        self.rslot[rows] = -1
+        held = self.rslot >= 0
+        self.rslot[held] = (np.cumsum(kept) - 1)[self.rslot[held]]
+        self.rstate, self.rsource = self.rstate[kept], self.rsource[kept]
 
     def frame_cost(self, rows: np.ndarray, tier: int) -> np.ndarray:
         """(len(rows),) what stepping each row at `tier` costs a frame, in seconds of a

@@ -12,14 +12,15 @@ creature is checked:
   `max_penetration` (teleports and runaway servos show up here).
 
 A failing creature is restored to a state saved at least `SAVE_EVERY` frames earlier
-(two are kept), its suckers are released and its servos softened for a moment, and
-`creature_recovered` is emitted with the cause. The check runs right after
-`physics_sync` and puts a failing creature's rows back before any other system runs.
-A creature that fails `FREEZE_AFTER`
-times within `FREEZE_WINDOW` seconds is frozen where it last was good
-(`creature_frozen`, and one logged warning). Other creatures are never touched: each
-is its own row of state. No system ever sees a bad pose, so a teleport never reaches a
-goal. Finding the failures is whole-array work; only failing creatures are visited.
+(two are kept, for the creatures MuJoCo steps only: a replayed creature's are dropped at
+the next save and made again when it is promoted, `restart`), its suckers are released
+and its servos softened for a moment, and `creature_recovered` is emitted with the cause.
+The check runs right after `physics_sync` and puts a failing creature's rows back before
+any other system runs. A creature that fails `FREEZE_AFTER` times within `FREEZE_WINDOW`
+seconds is frozen where it last was good (`creature_frozen`, and one logged warning).
+Other creatures are never touched: each is its own row of state. No system ever sees a
+bad pose, so a teleport never reaches a goal. Finding the failures is whole-array work;
+only failing creatures are visited.
 """
 
 from __future__ import annotations
@@ -33,7 +34,8 @@ import numpy as np
 
 from ecs_tentacles.events import CreatureFrozen, CreatureRecovered, SuckerReleased
 from ecs_tentacles.numeric.optional_kernels import OptionalKernels
-from ecs_tentacles.numeric.rows import run_slice, without_row
+from ecs_tentacles.numeric.rows import run_slice
+from ecs_tentacles.numeric.slots import SlotRows
 from ecs_tentacles.physics.tiers import KINEMATIC
 
 if TYPE_CHECKING:
@@ -61,7 +63,7 @@ S = mujoco.mjtState
 class HealthState:
     """The health check between frames (`HealthCheck.state()`), for snapshots."""
 
-    saved: list[np.ndarray]  # per batch: (rows, 2, state) older and newer good states
+    saved: list[SlotRows]  # per batch: (2, state) older and newer good states per row
     failures: dict[int, list[float]]
     recoveries: int
     frozen: int
@@ -77,8 +79,11 @@ class HealthCheck:
         self.roster = roster
         self.max_speed = world.settings.max_speed
         self.max_penetration = world.settings.max_penetration
-        # per batch: two good states per row, [older, newer]; at first both the start
-        self.saved = [np.repeat(b.state[:, None, :], 2, axis=1) for b in roster.batches]
+        # per batch: two good states per row, [older, newer]; at first both the start.
+        # Only rows stepped by MuJoCo keep theirs: a replayed (KINEMATIC) row's are
+        # dropped at the next save and made anew by `restart` when it is promoted
+        # (10,000 creatures' were 175 MB, the same bits for every creature restored)
+        self.saved = [SlotRows(np.repeat(b.state[:, None, :], 2, axis=1)) for b in roster.batches]
         self.failures: dict[int, list[float]] = {}  # creature index -> recent recovery times
         # creature index -> (speed m/s, until world time): a thrown creature may fly faster
         self.allowed: dict[int, tuple[float, float]] = {}
@@ -105,7 +110,7 @@ class HealthCheck:
     def set_state(self, state: HealthState) -> None:
         """Go back to `state()` (copied: one state can be restored many times)."""
         for saved, copy in zip(self.saved, state.saved, strict=False):  # later ones: empty
-            saved[:] = copy
+            saved.set_to(copy)
         self.failures = {k: list(v) for k, v in state.failures.items()}
         self.recoveries, self.frozen = state.recoveries, state.frozen
         self.causes = dict(state.causes)
@@ -119,8 +124,8 @@ class HealthCheck:
         """A creature was appended to batch `batch` at `state`, its bodies at `poses`
         (the new rows at the Transform store's end)."""
         if batch == len(self.saved):
-            self.saved.append(np.zeros((0, 2, len(state))))
-        self.saved[batch] = np.concatenate([self.saved[batch], np.repeat(state[None, None], 2, 1)])
+            self.saved.append(SlotRows(np.zeros((0, 2, len(state)))))
+        self.saved[batch].append(np.repeat(state[None], 2, 0))
         if len(self.previous):
             self.previous = np.concatenate([self.previous, poses])
         self.follow(proxies)
@@ -130,7 +135,7 @@ class HealthCheck:
     ) -> None:
         """Creature `index` (row `row` of batch `batch`) was taken out; `kept`: which
         Transform rows are left."""
-        self.saved[batch] = without_row(self.saved[batch], row)
+        self.saved[batch].remove(row)
         self.failures = {i - (i > index): times for i, times in self.failures.items() if i != index}
         self.allowed = {i - (i > index): a for i, a in self.allowed.items() if i != index}
         if len(self.previous):
@@ -156,7 +161,7 @@ class HealthCheck:
         roster = self.roster
         batch = roster.batches[int(roster.batch_of[index])]
         row = int(roster.row_of[index])
-        self.saved[batch.index][row] = batch.state[row]
+        self.saved[batch.index].hold(np.array([row]), batch.state[row])
         if len(self.previous):
             self.previous[batch.body_rows[row]] = batch.xpos[row]
 
@@ -215,10 +220,16 @@ class HealthCheck:
             1.0, roster.soften[softened] + ramp * (1.0 - SOFT_GAIN)
         )
         if save:
+            replayed = roster.tier == KINEMATIC
             for batch, saved in zip(roster.batches, self.saved, strict=True):
+                saved.release(np.flatnonzero(replayed[batch.members]))  # (`__init__`)
                 rows = np.flatnonzero(healthy[batch.members])
-                saved[rows, 0] = saved[rows, 1]
-                saved[rows, 1] = batch.state[rows]
+                slots = saved.slot[rows]
+                if (slots < 0).any():  # (never: a creature is promoted through `restart`)
+                    slots = saved.hold(rows, batch.state[rows, None])
+                older, newer = saved.pool[:, 0], saved.pool[:, 1]
+                older[slots] = newer[slots]
+                newer[slots] = batch.state[rows]
         for batch in roster.batches:
             batch.warnings[:] = 0
             batch.errors.clear()
@@ -300,7 +311,8 @@ class HealthCheck:
         self.failures[index] = failures
         key = cause.split(" ")[0]
         self.causes[key] = self.causes.get(key, 0) + 1
-        batch.state[row] = self.saved[batch.index][row, 0]
+        saved = self.saved[batch.index]
+        batch.state[row] = saved.pool[saved.slot[row], 0]
         batch.part(S.mjSTATE_TIME, row)[:] = physics_time
         batch.forward(row)
         world.transforms.pos[batch.body_rows[row]] = batch.xpos[row]  # before anyone reads

@@ -21,7 +21,8 @@ of them. A row whose servos are too stiff for the reduced step takes shorter one
 
 The batch keeps every creature's state in the full model's layout, so drawing,
 export, health, sleep, snapshots and the contact proxies never see a reduced model: a
-REDUCED row keeps a second state (`Batch.rstate`) that `step_rows` fits again whenever
+REDUCED row keeps a second state (`Batch.rstate`, at its row's `Batch.rslot`: only rows
+that step REDUCED hold one) that `step_rows` fits again whenever
 the full state was written from outside (a recovery, a promotion from replay, a
 restore), steps, and shows as the full state (joint angles expanded, poses from the
 full model's kinematics).
@@ -219,44 +220,55 @@ class ReducedModel:
         self.pull_inputs(full_state, out)
 
     def pull_into(
-        self, rows: np.ndarray, state: np.ndarray, rstate: np.ndarray, rsource: np.ndarray
+        self,
+        rows: np.ndarray,
+        slots: np.ndarray,
+        state: np.ndarray,
+        rstate: np.ndarray,
+        rsource: np.ndarray,
     ) -> np.ndarray:
-        """The frame's inputs pulled into the reduced states of batch rows `rows` (`rstate`,
-        in place; `state` the batch's full states) where the full state is still as their
-        last step left it (`rsource`, the watched part); returns the others, whose full
-        state was written from outside since (to fit again)."""
+        """The frame's inputs pulled into the reduced states of batch rows `rows` (rows
+        `slots` of `rstate`, in place; `state` the batch's full states) where the full
+        state is still as their last step left it (`rsource`, the watched part, at
+        `slots`); returns the positions in `rows` of the others, whose full state was
+        written from outside since (to fit again)."""
         fast = KERNELS.get()
         if fast is not None:  # the same numbers, row by row in place: no gathered copies
             changed = np.zeros(len(rows), dtype=bool)
             commands, servos = self._controls
-            fast.pull_into(rows, state, rsource, self._watched, rstate, self._input_pairs,
-                           commands, *self._fit_sums, servos, changed)  # fmt: skip
-            return rows[changed]
-        unchanged = (state[rows, self.watched] == rsource[rows]).all(axis=1)
-        pulled = rows[unchanged]
+            fast.pull_into(rows, slots, state, rsource, self._watched, rstate,
+                           self._input_pairs, commands, *self._fit_sums, servos,
+                           changed)  # fmt: skip
+            return np.flatnonzero(changed)
+        unchanged = (state[rows, self.watched] == rsource[slots]).all(axis=1)
+        pulled = slots[unchanged]
         if len(pulled):
             block = rstate[pulled]
-            self.pull_rows(state[pulled], block)
+            self.pull_rows(state[rows[unchanged]], block)
             rstate[pulled] = block
-        written: np.ndarray = rows[~unchanged]
-        return written
+        return np.flatnonzero(~unchanged)
 
     def show_rows(
-        self, rows: np.ndarray, rstate: np.ndarray, state: np.ndarray, rsource: np.ndarray
+        self,
+        rows: np.ndarray,
+        slots: np.ndarray,
+        rstate: np.ndarray,
+        state: np.ndarray,
+        rsource: np.ndarray,
     ) -> None:
-        """Batch rows `rows`' reduced states (`rstate`) shown as their full states (`state`,
-        in place: `expand_rows`), and the watched part kept in `rsource` (what `pull_into`
-        compares with next time)."""
+        """Batch rows `rows`' reduced states (rows `slots` of `rstate`) shown as their full
+        states (`state`, in place: `expand_rows`), and the watched part kept in `rsource`
+        (at `slots`: what `pull_into` compares with next time)."""
         fast = KERNELS.get()
         if fast is not None:  # the same numbers, row by row in place: no gathered copies
-            fast.show_rows(rows, rstate, state, self._shown_pairs, *self._angles, *self._speeds,
-                           *self._expand_sums, self._low, self.limit, self._warm, self._watched,
-                           rsource)  # fmt: skip
+            fast.show_rows(rows, slots, rstate, state, self._shown_pairs, *self._angles,
+                           *self._speeds, *self._expand_sums, self._low, self.limit, self._warm,
+                           self._watched, rsource)  # fmt: skip
             return
         block = state[rows]
-        self.expand_rows(rstate[rows], block)
+        self.expand_rows(rstate[slots], block)
         state[rows] = block
-        rsource[rows] = block[:, self.watched]
+        rsource[slots] = block[:, self.watched]
 
     def pull_inputs(self, full_state: np.ndarray, out: np.ndarray) -> None:
         """What the systems wrote into the full state this frame (servo targets fitted,
@@ -271,8 +283,9 @@ class ReducedModel:
         source, target = self._controls
         fast = KERNELS.get()
         if fast is not None:  # the same sums, the interpreter's lock released
-            fast.group_sums_into(full_states, np.arange(len(out)), source, *self._fit_sums,
-                                 _NO_CLIP, _NO_CLIP, out, target)  # fmt: skip
+            every = np.arange(len(out))
+            fast.group_sums_into(full_states, every, source, *self._fit_sums,
+                                 _NO_CLIP, _NO_CLIP, out, every, target)  # fmt: skip
             return
         out[:, target] = group_sums(full_states[:, source], *self._fit_sums)
 
@@ -291,10 +304,10 @@ class ReducedModel:
             rows = np.arange(len(out))
             source, target = self._angles
             fast.group_sums_into(reduced_states, rows, source, *self._expand_sums, self._low,
-                                 self.limit, out, target)  # fmt: skip
+                                 self.limit, out, rows, target)  # fmt: skip
             source, target = self._speeds
             fast.group_sums_into(reduced_states, rows, source, *self._expand_sums, _NO_CLIP,
-                                 _NO_CLIP, out, target)  # fmt: skip
+                                 _NO_CLIP, out, rows, target)  # fmt: skip
         else:
             source, target = self._angles
             angles = group_sums(reduced_states[:, source], *self._expand_sums)

@@ -31,13 +31,16 @@ def group_sums_into(
     low: np.ndarray,
     high: np.ndarray,
     out: np.ndarray,
+    out_rows: np.ndarray,
     out_columns: np.ndarray,
 ) -> None:
-    """For each of `rows` r and each k: the sum over p, in order, of
+    """For each i, r = rows[i], and each k: the sum over p, in order, of
     values[r, columns[members[k, p]]] x weights[k, p], clipped into [low[k], high[k]]
-    when `low` is not empty (NaN stays NaN), into out[r, out_columns[k]]."""
+    when `low` is not empty (NaN stays NaN), into out[out_rows[i], out_columns[k]]."""
     clip = low.shape[0] > 0
-    for r in rows:
+    for i in range(rows.shape[0]):
+        r = rows[i]
+        o = out_rows[i]
         for k in range(members.shape[0]):
             total = values[r, columns[members[k, 0]]] * weights[k, 0]
             for p in range(1, members.shape[1]):
@@ -47,12 +50,13 @@ def group_sums_into(
                     total = low[k]
                 if total > high[k]:
                     total = high[k]
-            out[r, out_columns[k]] = total
+            out[o, out_columns[k]] = total
 
 
 @njit(cache=True, nogil=True)
 def pull_into(
     rows: np.ndarray,
+    slots: np.ndarray,
     state: np.ndarray,
     source: np.ndarray,
     watched: np.ndarray,
@@ -64,35 +68,41 @@ def pull_into(
     servos: np.ndarray,
     changed: np.ndarray,
 ) -> None:
-    """`ReducedModel.pull_into` in place: for each of `rows` whose full state's entries
-    watched[0]:watched[1] equal its `source` row (as its last step left them), the
-    frame's inputs copied (`inputs`: full columns, reduced columns) and its servo
-    commands (full columns `commands`) summed into its `rstate` row (columns `servos`);
-    the others marked in `changed` (a NaN there counts as changed, as numpy's ==)."""
+    """`ReducedModel.pull_into` in place: for each of `rows` (its reduced rows at
+    `slots`) whose full state's entries watched[0]:watched[1] equal its `source` row (as
+    its last step left them), the frame's inputs copied (`inputs`: full columns, reduced
+    columns) and its servo commands (full columns `commands`) summed into its `rstate`
+    row (columns `servos`); the others marked in `changed` (a NaN there counts as
+    changed, as numpy's ==)."""
     start, stop = watched[0], watched[1]
     pulled = np.empty(rows.shape[0], dtype=np.int64)
+    into = np.empty(rows.shape[0], dtype=np.int64)
     count = 0
     for i in range(rows.shape[0]):
         row = rows[i]
+        slot = slots[i]
         same = True
         for c in range(start, stop):
-            if state[row, c] != source[row, c - start]:
+            if state[row, c] != source[slot, c - start]:
                 same = False
                 break
         if not same:
             changed[i] = True
             continue
         for c in range(inputs.shape[1]):
-            rstate[row, inputs[1, c]] = state[row, inputs[0, c]]
+            rstate[slot, inputs[1, c]] = state[row, inputs[0, c]]
         pulled[count] = row
+        into[count] = slot
         count += 1
     none = np.zeros(0)
-    group_sums_into(state, pulled[:count], commands, members, weights, none, none, rstate, servos)
+    group_sums_into(state, pulled[:count], commands, members, weights, none, none, rstate,
+                    into[:count], servos)  # fmt: skip
 
 
 @njit(cache=True, nogil=True)
 def show_rows(
     rows: np.ndarray,
+    slots: np.ndarray,
     rstate: np.ndarray,
     state: np.ndarray,
     shown: np.ndarray,
@@ -108,22 +118,24 @@ def show_rows(
     watched: np.ndarray,
     source: np.ndarray,
 ) -> None:
-    """`ReducedModel.show_rows` in place: each of `rows`' reduced state shown as its full
-    state (`shown` (reduced columns, full columns) copied; the reduced columns `angles`
-    summed and clipped into [low, high] into the full columns `full_angles`, `speeds`
-    into `full_speeds`; the warm start warm[0]:warm[1] cleared), and
-    the full state's watched[0]:watched[1] kept in its `source` row."""
+    """`ReducedModel.show_rows` in place: each of `rows`' reduced state (its row at
+    `slots` of `rstate`) shown as its full state (`shown` (reduced columns, full
+    columns) copied; the reduced columns `angles` summed and clipped into [low, high]
+    into the full columns `full_angles`, `speeds` into `full_speeds`; the warm start
+    warm[0]:warm[1] cleared), and
+    the full state's watched[0]:watched[1] kept in its `source` row (at `slots`)."""
     none = np.zeros(0)
-    group_sums_into(rstate, rows, angles, members, weights, low, high, state, full_angles)
-    group_sums_into(rstate, rows, speeds, members, weights, none, none, state, full_speeds)
+    group_sums_into(rstate, slots, angles, members, weights, low, high, state, rows, full_angles)
+    group_sums_into(rstate, slots, speeds, members, weights, none, none, state, rows, full_speeds)
     for i in range(rows.shape[0]):
         row = rows[i]
+        slot = slots[i]
         for c in range(shown.shape[1]):
-            state[row, shown[1, c]] = rstate[row, shown[0, c]]
+            state[row, shown[1, c]] = rstate[slot, shown[0, c]]
         for c in range(warm[0], warm[1]):
             state[row, c] = 0.0
         for c in range(watched[0], watched[1]):
-            source[row, c - watched[0]] = state[row, c]
+            source[slot, c - watched[0]] = state[row, c]
 
 
 @njit(cache=True, nogil=True, inline="always")

@@ -1,9 +1,9 @@
 """The REDUCED tier's step of some rows of a batch (`Batch.step_rows`, tier REDUCED).
 
 Reads the batch's full states (`Batch.state`: the frame's inputs, and whether someone
-else wrote a row since its last step), its reduced states (`rstate`, `rsource`), the
-overlay (servo gains, torque limits, sucker anchors, proxy sizes) and the forces
-scripts apply; writes the reduced states stepped, the full states showing them, the
+else wrote a row since its last step), its reduced states (`rstate`, `rsource`, a row's
+at `rslot`), the overlay (servo gains, torque limits, sucker anchors, proxy sizes) and
+the forces scripts apply; writes the reduced states stepped, the full states showing them, the
 full model's body poses (`xpos`, `xquat`), the warnings raised, the deepest contacts,
 MuJoCo's fatal errors and each row's step cost.
 
@@ -47,6 +47,7 @@ class ReducedRows(Rows, Protocol):
     state: np.ndarray
     rstate: np.ndarray
     rsource: np.ndarray
+    rslot: np.ndarray
     xpos: np.ndarray
     xquat: np.ndarray
     applied: dict[int, np.ndarray]
@@ -74,10 +75,11 @@ def step_reduced(
     assert reduced is not None and pose_map is not None  # `prepare(REDUCED)` ran first
     scratch = batch.scratch_for(thread, REDUCED)
     state, rstate, rsource = batch.state, batch.rstate, batch.rsource
+    slots = batch.rslot[rows]  # each row's reduced state (`Batch.hold_reduced`: made in `plan`)
     clock = time.perf_counter
     began = clock()
-    for row in reduced.pull_into(rows, state, rstate, rsource).tolist():
-        reduced.fit_state(state[row], rstate[row])
+    for at in reduced.pull_into(rows, slots, state, rstate, rsource).tolist():
+        reduced.fit_state(state[rows[at]], rstate[slots[at]])
     servos = reduced.servos(batch.kp, batch.kv, batch.torque, rows)
     overlay = reduced.overlay_writer(batch, scratch.model, servos)
     stepped: list[bool] = []
@@ -85,17 +87,18 @@ def step_reduced(
     shared = clock() - began
     applied, advance = batch.applied, batch.advance
     scratch.warnings[:] = 0  # `advance` clears them after a row that raised one
-    for at, row in enumerate(rows.tolist()):
+    for at, (row, slot) in enumerate(zip(rows.tolist(), slots.tolist(), strict=True)):
         began = clock()
         split = overlay(row, at)
         pushed = applied.get(row)
         forces = None if pushed is None else reduced.body_group @ pushed
-        stepped.append(advance(scratch, row, rstate[row], forces, substeps * split))
+        stepped.append(advance(scratch, row, rstate[slot], forces, substeps * split))
         took.append(clock() - began)
     began = clock()
-    done = rows[np.array(stepped, dtype=bool)]
+    ok = np.array(stepped, dtype=bool)
+    done = rows[ok]
     if len(done):
-        reduced.show_rows(done, rstate, state, rsource)
+        reduced.show_rows(done, slots[ok], rstate, state, rsource)
         full = batch.scratch_for(thread, FULL)
         pose_map.show(done, state, batch.slices[int(S.mjSTATE_QPOS)], batch.xpos, batch.xquat,
                       full.model, full.data)  # fmt: skip

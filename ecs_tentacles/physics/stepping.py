@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ecs_tentacles.physics.batch import Batch
-from ecs_tentacles.physics.tiers import FULL, REDUCED
+from ecs_tentacles.physics.tiers import FULL, KINEMATIC, REDUCED
 
 
 @dataclass(frozen=True)
@@ -94,6 +94,21 @@ def plan(
     if len(found) > 1:  # dearest rows first; a stable sort keeps ties in this order
         found.sort(key=lambda segment: -float(segment.cost.mean()))
     return found
+
+
+def hold_reduced(batches: list[Batch], active: np.ndarray, tier: np.ndarray, threads: int) -> None:
+    """Before a frame's step: the rows about to step REDUCED hold a reduced state, the
+    replayed (KINEMATIC) ones give theirs back (`Batch.hold_reduced`, `release_reduced`);
+    a row asleep or frozen keeps its own."""
+    for batch in batches:
+        members = batch.members
+        if len(batch.rstate):
+            held = np.flatnonzero(batch.rslot >= 0)
+            batch.release_reduced(held[tier[members[held]] == KINEMATIC])
+        rows = np.flatnonzero(active[members] & (tier[members] == REDUCED))
+        if len(rows):
+            batch.prepare(REDUCED, threads)
+            batch.hold_reduced(rows)
 
 
 def step_segments(work: Work, substeps: dict[int, int], thread: int) -> None:

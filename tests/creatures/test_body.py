@@ -124,3 +124,23 @@ def test_a_creatures_random_draws_do_not_depend_on_the_other_creatures() -> None
         assert not np.array_equal(
             world.stores["locomotion.tentacles"].phase[:5], phases[0]
         )  # the seed matters
+
+
+def test_tentacles_of_one_shape_share_their_links_numbers(make_world: Callable[..., World]) -> None:
+    world = make_world(
+        {
+            "version": 1,
+            "creatures": [
+                {"name": f"c{i}", "position": [3.0 * i, 0.0], "tentacles": {"count": 3}}
+                for i in range(2)
+            ],
+        }
+    )
+    firsts = [
+        world.component(world.component(t, Tentacle).links[0], Link)
+        for _, creature in world.query(Creature)
+        for t in creature.tentacles
+    ]
+    assert len(firsts) == 6 and len({id(link) for link in firsts}) == 6  # a Link each
+    assert len({id(link.length) for link in firsts}) == 1  # one float for them all
+    assert len({(link.length, link.radius, link.scale) for link in firsts}) == 1

@@ -20,7 +20,7 @@ from ecs_tentacles.locomotion.actions import (
     make_action,
 )
 from ecs_tentacles.world import World
-from tests.conftest import creature_scene
+from tests.conftest import crawlers, creature_scene
 
 PUSH = [Kind.COMPRESS, Kind.ATTACH, Kind.PUSH, Kind.DETACH]
 PULL = [Kind.EXTEND, Kind.ATTACH, Kind.PULL, Kind.DETACH]
@@ -91,6 +91,28 @@ def test_action_queue_names_its_pending_actions() -> None:
     assert len(queue) == 6
     queue.clear()
     assert (len(queue), queue.kinds()) == (0, [])
+
+
+def test_a_queue_never_used_holds_no_deque_and_a_used_one_keeps_its_own() -> None:
+    queue = ActionQueue()
+    assert len(queue) == 0 and queue.kinds() == [] and not queue
+    queue.clear()
+    with pytest.raises(IndexError):
+        queue.popleft()
+    assert queue.__dict__["_pending"] is None  # an empty deque is 760 bytes a tentacle
+    pending = queue.pending
+    queue.extend(drive_sequence(Mode.PUSH, 0.5, 1.0))
+    assert queue.pending is pending and len(pending) == 4
+    assert queue.popleft().kind == Kind.COMPRESS and queue.kinds() == ["attach", "push", "detach"]
+
+
+def test_a_crowd_of_replayed_creatures_makes_no_deques(make_world: Callable[..., World]) -> None:
+    scene = crawlers(3) | {"physics": {"lod": {"full": 0, "reduced": 0}}}  # goals to crawl to
+    world = make_world(scene)
+    world.step(30)  # replayed from the first frame on: one stroke queued then, no more
+    assert world.lod.counts()["kinematic"] == 3
+    made = [q.__dict__["_pending"] is not None for _, q in world.query(ActionQueue)]
+    assert len(made) == 9 and sum(made) <= 3  # a deque only where a stroke was queued
 
 
 def test_gripping_actions_are_attach_push_and_pull() -> None:

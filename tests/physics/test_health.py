@@ -217,3 +217,30 @@ def test_an_allowed_speed_lets_one_creature_fly_for_a_while(
     assert world.physics.health.recoveries == 0
     with pytest.raises(ValueError, match="speed"):
         health.allow_speed(1, 0.0, 1.0)
+
+
+def test_a_creature_promoted_from_replay_recovers_to_where_it_was_promoted(
+    make_world: Callable[..., World],
+) -> None:
+    replayed = {"full": 0, "reduced": 0, "hold_seconds": 0}
+    world = make_world({**crawlers(2, apart=4.0, links=5), "physics": {"lod": replayed}})
+    creature = world.creature("c0")
+    world.step(60)  # both replayed, through several saves: no saved state is kept for them
+    assert world.lod.tier_of(creature) == "kinematic"
+    health, view = world.physics.health, world.physics.views[0]
+    assert len(health.saved[view.batch.index].pool) == 0
+    rows = view.body_rows
+    shown = world.transforms.pos[rows].copy()
+    world.lod.promote(creature)
+    world.step(1)  # promoted (its good states made where it is shown), one frame stepped
+    assert world.lod.tier_of(creature) == "full"
+    assert len(health.saved[view.batch.index].pool) == 1  # the one stepped creature's
+    view.data.qvel[7] = np.nan
+    events: list[dict[str, Any]] = []
+    world.events.on("creature_recovered", lambda **e: events.append(e))
+    world.step(1)
+    assert [e["creature"] for e in events] == [creature]
+    assert health.recoveries == 1
+    back = world.transforms.pos[rows]
+    assert np.isfinite(back).all()
+    assert np.linalg.norm(back - shown, axis=1).max() <= 0.02  # where it was promoted

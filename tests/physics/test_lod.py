@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import hashlib
 from collections.abc import Callable
 from typing import Any
 
+import mujoco
 import numpy as np
+import pytest
 from numpy.testing import assert_array_equal
 
 from ecs_tentacles.components import Transform
@@ -219,3 +222,35 @@ def test_the_schemas_largest_creature_steps_at_full_and_reduced(
     assert world.lod.counts() == {"full": 1, "reduced": 1, "kinematic": 0}
     assert world.physics.health.recoveries == 0
     assert np.isfinite(world.transforms.pos).all()
+
+
+# What `test_tiers_changing_back_and_forth_move_as_recorded` saw, recorded on 164f417 (every
+# creature's reduced state kept then; now only the REDUCED rows', `Batch.rslot`)
+TIER_CHURN = "100906d37bea95cd38008157e52017709226d426631acddde3bcbe6a06bf4ec5"
+
+
+@pytest.mark.skipif(
+    {"mujoco": mujoco.__version__, "numpy": np.__version__}
+    != {"mujoco": "4.0.1", "numpy": "2.4.6"},
+    reason="recorded with mujoco 4.0.1, numpy 2.4.6",
+)
+def test_tiers_changing_back_and_forth_move_as_recorded(
+    make_world: Callable[..., World],
+) -> None:
+    world = make_world(_crowd(8, MIXED), threads=2)
+    digest = hashlib.sha256()
+    for k in range(12):
+        if k == 3:
+            world.lod.promote(world.creature("c7"))  # replayed -> full
+        if k == 5:
+            world.lod.release(world.creature("c7"))
+            world.lod.focus((6.0, 2.0), 0.0)  # the far corner's creatures full, the origin's not
+        if k == 8:
+            world.lod.focus((0.0, 0.0), 0.0)
+        world.step(10)
+        digest.update(world.transforms.pos.tobytes())
+        for batch in world.physics.batches:
+            digest.update(batch.state.tobytes())
+    # rows went REDUCED -> KINEMATIC -> REDUCED and FULL <-> REDUCED on the way
+    assert (world.lod.promotions, world.lod.demotions) == (9, 16)
+    assert digest.hexdigest() == TIER_CHURN

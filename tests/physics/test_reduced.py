@@ -59,7 +59,7 @@ def test_a_reduced_creature_draws_the_full_skeleton_on_its_chain(
     for row in range(len(batch)):
         shown = world.transforms.pos[batch.body_rows[row]]
         assert shown.shape == (len(batch.body_ids), 3) and np.isfinite(shown).all()
-        mujoco.mj_setState(m, d, batch.rstate[row], STATE)
+        mujoco.mj_setState(m, d, batch.rstate[batch.rslot[row]], STATE)
         mujoco.mj_kinematics(m, d)
         links = [i for i in range(1, m.nbody) if not m.body_mocapid[i] >= 0]
         axis = np.array([d.xmat[i].reshape(3, 3)[:, 0] for i in links])

@@ -165,22 +165,27 @@ def test_a_shares_rows_are_pulled_and_shown_as_numpy_does_bit_for_bit(
     rsource[3, 0] = np.nan  # and row 3's holds a NaN: never "as its step left it"
     state[3, reduced.watched.start] = np.nan
     rows = np.array([4, 1, 3, 0])  # a share, in the order the plan hands it out
+    slot_of = rng.permutation(len(rstate))  # each row's reduced state: its slot of the pool
+    pool, source_pool = np.empty_like(rstate), np.empty_like(rsource)
+    pool[slot_of], source_pool[slot_of] = rstate, rsource
+    slots = slot_of[rows]
     results = []
     for backend in ("auto", "numpy"):
         monkeypatch.setattr(reduced_module.KERNELS, "backend", backend)
-        mine = [state.copy(), rstate.copy(), rsource.copy()]
-        refit = reduced.pull_into(rows, mine[0], mine[1], mine[2])
+        mine = [state.copy(), pool.copy(), source_pool.copy()]
+        refit = reduced.pull_into(rows, slots, mine[0], mine[1], mine[2])
         servos = reduced.servos(batch.kp, batch.kv, batch.torque, rows)
         stepped = mine[1] + 0.25  # as if the rows stepped
-        reduced.show_rows(rows[[0, 3]], stepped, mine[0], mine[2])
+        reduced.show_rows(rows[[0, 3]], slots[[0, 3]], stepped, mine[0], mine[2])
         results.append((refit, servos.kp, servos.kv, servos.torque, servos.split, *mine))
     for kernel, numpy_path in zip(*results, strict=True):
         assert kernel.dtype == numpy_path.dtype and kernel.tobytes() == numpy_path.tobytes()
     refit, kp, *_ = results[0]
-    assert refit.tolist() == [1, 3]  # written from outside: fitted, not pulled
+    assert rows[refit].tolist() == [1, 3]  # written from outside: fitted, not pulled
     shown_state, pulled, kept = results[0][5:]
-    assert not np.array_equal(pulled[4], rstate[4]) and np.array_equal(pulled[1], rstate[1])
-    assert np.array_equal(kept[4], shown_state[4, reduced.watched])  # shown: kept to compare
+    assert not np.array_equal(pulled[slot_of[4]], rstate[4])
+    assert np.array_equal(pulled[slot_of[1]], rstate[1])
+    assert np.array_equal(kept[slot_of[4]], shown_state[4, reduced.watched])  # kept to compare
     assert np.array_equal(kp, reduced.servos(batch.kp[rows], batch.kv[rows], batch.torque[rows]).kp)
 
 

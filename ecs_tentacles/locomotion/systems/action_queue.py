@@ -87,7 +87,7 @@ class ActionQueueSystem(System):
 
     def _advance(self, world: Host, row: int) -> None:
         t = self.strokes
-        queue = self.queues[row].pending
+        queue = self.queues[row]  # (its methods make no deque for a queue never used)
         t.timer[row] = 0.0
         if not queue:
             t.action[row] = Kind.IDLE
