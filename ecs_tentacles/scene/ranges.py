@@ -17,7 +17,7 @@ from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, replace
 from typing import Any
 
-from ecs_tentacles.scene.schema import core_schema, load_schema
+from ecs_tentacles.scene.schema import at, core_schema, load_schema
 
 JsonPath = tuple[str | int, ...]
 SchemaObject = tuple[str, Mapping[str, object], JsonPath]
@@ -115,7 +115,7 @@ def field_range(section: str, key: str) -> Range:
 
 def physics_range(key: str) -> Range:
     """The range of the scene's `physics.<key>` (for gravity: of each component)."""
-    spec: Mapping[str, object] = core_schema()["properties"]["physics"]["properties"][key]
+    spec = at(core_schema(), "properties", "physics", "properties", key)
     items = spec.get("items")
     return schema_range(items if isinstance(items, Mapping) else spec)
 

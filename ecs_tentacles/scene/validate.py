@@ -22,7 +22,7 @@ from jsonschema import ValidationError
 from ecs_tentacles.plugin import calling
 from ecs_tentacles.scene.defaults import copied, fill, nested, resolve, with_defaults
 from ecs_tentacles.scene.json_validator import StrictValidator, validator_for
-from ecs_tentacles.scene.schema import builtin_keys, schema_for
+from ecs_tentacles.scene.schema import at, builtin_keys, schema_for
 from ecs_tentacles.scene.shards import shard_problems
 from ecs_tentacles.scene.spec import CreatureSpec, as_spec, creature_specs
 
@@ -291,7 +291,7 @@ def validated_creature(
     find in it is reported. Each problem is one line whose path starts at `creature`.
     """
     schema = schema_for(plugins)
-    entries = schema["properties"]["creatures"]["items"]
+    entries = at(schema, "properties", "creatures", "items")
     items = resolve(entries, schema)
     creatures = creature_specs(scene)
     where: JsonPath = ("creatures", len(creatures))
