@@ -362,9 +362,9 @@ def repaired(data: object, plugins: Sequence[Plugin]) -> dict[str, object] | Non
         try:
             node: object = fixed
             for part in path[:-1] if path else ():
-                node = _child(node, part)
+                node = json_child(node, part)
             if error.validator == "additionalProperties":
-                container = _child(node, path[-1]) if path else node
+                container = json_child(node, path[-1]) if path else node
                 if not isinstance(container, dict):
                     raise TypeError("additionalProperties: not an object")
                 allowed = (
@@ -383,8 +383,9 @@ def repaired(data: object, plugins: Sequence[Plugin]) -> dict[str, object] | Non
     return fixed
 
 
-def _child(node: object, part: str | int) -> object:
-    """`node[part]`: a KeyError, IndexError or TypeError as indexing raises them."""
+def json_child(node: object, part: str | int) -> object:
+    """`node[part]` of JSON data: a KeyError, IndexError or TypeError as indexing
+    raises them."""
     if isinstance(node, dict):
         return node[part]
     if isinstance(node, list) and isinstance(part, int):
