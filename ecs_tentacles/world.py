@@ -370,11 +370,11 @@ class World:
         if esper.current_world != self.context:
             esper.switch_world(self.context)
 
-    def create_entity(self, *components: Any) -> int:
+    def create_entity(self, *components: object) -> int:
         self.activate()
         return esper.create_entity(*components)
 
-    def add_component(self, entity: int, component: Any) -> None:
+    def add_component(self, entity: int, component: object) -> None:
         """Give `entity` a component (at build time: it invalidates esper's query cache)."""
         self.activate()
         esper.add_component(entity, component)
