@@ -27,7 +27,7 @@ from ecs_tentacles.events import Events
 from ecs_tentacles.options import Focus, WorldOptions
 from ecs_tentacles.physics.backend import PhysicsBackend
 from ecs_tentacles.plugin import Plugin, calling
-from ecs_tentacles.registry import App, Registries, Registry
+from ecs_tentacles.registry import App, Registries, RegistryLike
 from ecs_tentacles.scene.layouts import Layouts
 from ecs_tentacles.schedule import Schedule
 from ecs_tentacles.settings import Settings as Settings  # re-exported: old imports work
@@ -53,7 +53,7 @@ __all__ = ["MissingResource", "Settings", "World"]  # Settings lives in ecs_tent
 
 C = TypeVar("C")
 R = TypeVar("R")
-G = TypeVar("G", bound=Registry[Any])
+G = TypeVar("G", bound=RegistryLike)
 
 
 class World:
