@@ -98,7 +98,7 @@ def schema_objects(node: object, name: str = "", path: JsonPath = ()) -> Iterato
             yield from schema_objects(child, name, (*path, keyword, i))
 
 
-def field_schema(section: str, key: str) -> dict[str, Any]:  # (read as JSON by its callers)
+def field_schema(section: str, key: str) -> dict[str, Any]:
     """The schema of `<section>.<key>` (section: mantle, tentacles, locomotion...)."""
     for name, node, _ in schema_objects(load_schema()):  # the default plugins' fields too
         properties = node["properties"]
