@@ -89,14 +89,16 @@ class WorldOptions:
         )
         return self.but(**keywords)
 
-    def scene_with_lod(self, scene: Mapping[str, Any]) -> dict[str, object]:
+    def scene_with_lod(self, scene: Mapping[str, object]) -> dict[str, object]:
         """`scene` with `lod` and `focus` written into its `physics.lod` (a new dict;
         `scene` is left as it was): a bake's take and its shards see them in the scene
         and its hash. The same scene unchanged (a copy of the top level) without them."""
         if self.lod is None and self.focus is None:
             return dict(scene)
-        physics = dict(scene.get("physics") or {})
-        lod = dict(physics.get("lod") or {})
+        given = scene.get("physics")
+        physics = dict(given) if isinstance(given, Mapping) else {}
+        given = physics.get("lod")
+        lod = dict(given) if isinstance(given, Mapping) else {}
         if self.lod is not None:
             lod["enabled"] = self.lod
         if self.focus is not None:

@@ -21,11 +21,20 @@ from.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from typing import Any, Generic, Protocol, TypeVar
 
 Entry = TypeVar("Entry")
-R = TypeVar("R", bound="Registry[Any]")
+R = TypeVar("R", bound="RegistryLike")
+
+
+class RegistryLike(Protocol):
+    """What `Registries` knows of a registry whatever its entries are (a `Registry[E]` is
+    one): it forgets a plugin's entries and lists them with their owners."""
+
+    def drop(self, owner: str) -> None: ...
+    def items(self) -> Sequence[tuple[str, object]]: ...
+    def __len__(self) -> int: ...
 
 
 class Registry(Generic[Entry]):
@@ -58,7 +67,7 @@ class Registries:
     """A world's registries, one per kind, made empty when first asked for."""
 
     def __init__(self) -> None:
-        self._kinds: dict[type[Registry[Any]], Registry[Any]] = {}
+        self._kinds: dict[type[RegistryLike], RegistryLike] = {}
 
     def get(self, kind: type[R]) -> R:
         """The world's `kind` registry."""
@@ -72,7 +81,7 @@ class Registries:
         for registry in self._kinds.values():
             registry.drop(owner)
 
-    def all(self) -> dict[type[Registry[Any]], Registry[Any]]:
+    def all(self) -> dict[type[RegistryLike], RegistryLike]:
         """Every registry made so far, by kind."""
         return dict(self._kinds)
 

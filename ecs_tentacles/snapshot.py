@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import copy
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 
@@ -76,7 +76,7 @@ def take(world: Restorable) -> Snapshot:
     )
 
 
-def _creatures(world: Restorable) -> list[tuple[int, Any]]:
+def _creatures(world: Restorable) -> list[tuple[int, Creature]]:
     return sorted(world.query(Creature))
 
 

@@ -21,9 +21,10 @@ component made before a removal still finds its numbers after it.
 
 from __future__ import annotations
 
-from typing import Any, ClassVar
+from typing import ClassVar, overload
 
 import numpy as np
+from numpy.typing import DTypeLike
 
 HANDLE = "__handle__"  # the key of the rows' handles among a store's arrays
 
@@ -34,8 +35,8 @@ class Field:
     def __init__(
         self,
         shape: tuple[int, ...] = (),
-        dtype: Any = np.float64,
-        default: Any = 0,
+        dtype: DTypeLike = np.float64,
+        default: float | tuple[float, ...] = 0,
         refers: str | None = None,
     ):
         self.shape = shape
@@ -47,7 +48,11 @@ class Field:
     def __set_name__(self, owner: type, name: str) -> None:
         self.name = name
 
-    def __get__(self, store: ArrayStore | None, owner: type | None = None) -> Any:
+    @overload
+    def __get__(self, store: None, owner: type | None = None) -> Field: ...
+    @overload
+    def __get__(self, store: ArrayStore, owner: type | None = None) -> np.ndarray: ...
+    def __get__(self, store: ArrayStore | None, owner: type | None = None) -> Field | np.ndarray:
         # reached only while the store holds no view of this field: the view kept in the
         # instance's attributes is found first (no `__set__` here). One is made here,
         # and kept unless the store keeps none (`ArrayStore.cache_views`)

@@ -27,7 +27,7 @@ from ecs_tentacles.events import Events
 from ecs_tentacles.options import Focus, WorldOptions
 from ecs_tentacles.physics.backend import PhysicsBackend
 from ecs_tentacles.plugin import Plugin, calling
-from ecs_tentacles.registry import App, Registries, Registry
+from ecs_tentacles.registry import App, Registries, RegistryLike
 from ecs_tentacles.scene.layouts import Layouts
 from ecs_tentacles.schedule import Schedule
 from ecs_tentacles.settings import Settings as Settings  # re-exported: old imports work
@@ -53,7 +53,7 @@ __all__ = ["MissingResource", "Settings", "World"]  # Settings lives in ecs_tent
 
 C = TypeVar("C")
 R = TypeVar("R")
-G = TypeVar("G", bound=Registry[Any])
+G = TypeVar("G", bound=RegistryLike)
 
 
 class World:
@@ -370,11 +370,11 @@ class World:
         if esper.current_world != self.context:
             esper.switch_world(self.context)
 
-    def create_entity(self, *components: Any) -> int:
+    def create_entity(self, *components: object) -> int:
         self.activate()
         return esper.create_entity(*components)
 
-    def add_component(self, entity: int, component: Any) -> None:
+    def add_component(self, entity: int, component: object) -> None:
         """Give `entity` a component (at build time: it invalidates esper's query cache)."""
         self.activate()
         esper.add_component(entity, component)

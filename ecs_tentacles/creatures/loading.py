@@ -24,9 +24,9 @@ import gc
 import importlib
 import os
 import pathlib
-from collections.abc import Collection, Iterator
+from collections.abc import Collection, Iterator, Mapping
 from dataclasses import replace
-from typing import Any, Protocol, TypeVar
+from typing import Protocol, TypeVar
 
 from ecs_tentacles import stops
 from ecs_tentacles.creatures.body import build_creature
@@ -105,7 +105,7 @@ def load_world(
 
 def _load_world(
     cls: WorldClass[W],
-    source: str | os.PathLike[str] | dict[str, Any],
+    source: str | os.PathLike[str] | dict[str, object],
     options: WorldOptions | None,
     checks_only: bool,
 ) -> W:
@@ -118,7 +118,9 @@ def _load_world(
         folder = source.resolve().parent
     if plugins:  # the caller's choices over the scene's
         raw = source if isinstance(source, dict) else _read_scene(source)
-        source = {**raw, "plugins": {**(raw.get("plugins") or {}), **plugins}}
+        given = raw.get("plugins") or {}
+        if isinstance(given, Mapping):  # (else the schema reports the scene's own)
+            source = {**raw, "plugins": {**given, **plugins}}
     layouts = Layouts()  # each creature's, worked out once: the checks', then the build's
     data, chosen = load_scene_plugins(
         source, allow_systems=allow_systems, scene_dir=folder, layouts=layouts
@@ -250,7 +252,7 @@ def _scene_systems(
     return [legacy]
 
 
-def _read_scene(path: pathlib.Path) -> dict[str, Any]:
+def _read_scene(path: pathlib.Path) -> dict[str, object]:
     data = read_scene_json(path)
     if not isinstance(data, dict):
         raise SceneError([f"{path}: scene: must be an object"])

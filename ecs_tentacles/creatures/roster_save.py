@@ -20,7 +20,7 @@ import copy
 import logging
 import os
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -44,7 +44,7 @@ def heading_deg(quat: np.ndarray) -> float:
     return float(np.degrees(np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))))
 
 
-def entry_now(world: Host, entity: int) -> dict[str, Any]:
+def entry_now(world: Host, entity: int) -> dict[str, object]:
     """Creature `entity`'s scene entry as it is now: where its mantle is, which way it
     heads, and what every plugin knows of it (`Plugin.save_creature`)."""
     name = world.component(entity, Creature).name
@@ -59,7 +59,7 @@ def entry_now(world: Host, entity: int) -> dict[str, Any]:
     return entry
 
 
-def roster_scene(world: Host) -> dict[str, Any]:
+def roster_scene(world: Host) -> dict[str, object]:
     """The scene dict of `world` as it is now (module docstring); not yet validated."""
     scene: dict[str, object] = copy.deepcopy(world.scene) if world.scene is not None else {}
     scene.setdefault("version", 1)
@@ -126,7 +126,8 @@ def save_roster(world: Host, path: str | os.PathLike[str]) -> Path:
     fit (`fit_at_rest`; logged). Raises SceneError (one line per problem) and writes
     nothing when the scene would not load."""
     scene = roster_scene(world)
-    moved = fit_at_rest(world, scene["creatures"])
+    creatures = scene["creatures"]  # (the list `roster_scene` wrote)
+    moved = fit_at_rest(world, creatures) if isinstance(creatures, list) else 0
     if moved:
         log.info("%s: %d creature(s) moved to where they fit with tentacles spread", path, moved)
     # checked as any scene (SceneError, one line each) by the world's own plugins: none

@@ -18,10 +18,10 @@ from ecs_tentacles.settings import Settings
 from ecs_tentacles.store import CreatureStore, SuckerStore, TentacleStore, TransformStore
 
 if TYPE_CHECKING:
-    from ecs_tentacles.registry import Registry
+    from ecs_tentacles.registry import RegistryLike
 
 C = TypeVar("C")
-G = TypeVar("G", bound="Registry[Any]")
+G = TypeVar("G", bound="RegistryLike")
 
 
 class PhysicsHost(Protocol):

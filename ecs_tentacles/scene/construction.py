@@ -21,12 +21,12 @@ from __future__ import annotations
 import functools
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
-from typing import Any, cast
+from typing import cast
 
 import numpy as np
 
 from ecs_tentacles.ground import FLAT, Ground
-from ecs_tentacles.scene.spec import CreatureSpec, TentacleSettings, TentaclesSpec
+from ecs_tentacles.scene.spec import CreatureSpec, TentacleSettings, TentaclesSpec, as_spec
 
 # metres between a creature placed on terrain and the surface (it settles in the first
 # steps); the plane needs none: its creatures start exactly resting
@@ -98,10 +98,11 @@ def tentacle_shape(
     return TentacleShape(scales=scales, lengths=lengths, radii=radii, centres=centres)
 
 
-def tentacle_params(tentacles: Mapping[str, Any], index: int) -> TentacleSettings:
+def tentacle_params(tentacles: Mapping[str, object], index: int) -> TentacleSettings:
     """The creature-wide tentacle settings with tentacle `index`'s overrides applied."""
     params = {key: tentacles[key] for key in tentacles if key != "overrides"}
-    for override in tentacles.get("overrides", []):
+    overrides = tentacles.get("overrides", [])
+    for override in overrides if isinstance(overrides, list) else []:
         if override["index"] == index:
             params.update({k: v for k, v in override.items() if k != "index"})
     return cast(TentacleSettings, params)
@@ -235,15 +236,15 @@ def cylinder_mass_inertia(radius: float, height: float, density: float) -> tuple
     return float(mass), float(min(axial, across))
 
 
-def creature_reach(creature: dict[str, Any]) -> float:
+def creature_reach(creature: Mapping[str, object]) -> float:
     """Radius (m) of the circle around a creature's position that holds it at build.
 
     `creature` is a scene creature entry with its mantle radius and tentacle shape
     keys present (a `load_scene` result, or one the crowd generator made): the crowd
     generator and the shard planner space creatures by it.
     """
-    tentacles = creature["tentacles"]
-    radius = creature["mantle"]["radius"]
+    spec = as_spec(creature)
+    tentacles, radius = spec["tentacles"], spec["mantle"]["radius"]
     longest, thickest = 0.0, 0.0
     for k in range(tentacles["count"]):
         p = tentacle_params(tentacles, k)

@@ -20,7 +20,7 @@ if TYPE_CHECKING:
 ATOMS = {int, float, str, bool, type(None)}  # JSON values that hold no others
 
 
-def nested(values: list[object]) -> list[tuple[int, Any]]:
+def nested(values: list[object]) -> list[tuple[int, object]]:
     """The (index, item) of the objects and lists in `values` (a list of a million numbers
     is passed over at C speed)."""
     if set(map(type, values)) <= ATOMS:
@@ -29,11 +29,11 @@ def nested(values: list[object]) -> list[tuple[int, Any]]:
 
 
 # (id(schema), id(root)) -> (schema, root, resolved): both kept alive, so the ids stay theirs
-_RESOLVED: dict[tuple[int, int], tuple[Mapping[str, Any], Mapping[str, Any], Mapping[str, Any]]]
-_RESOLVED = {}
+_Schema = Mapping[str, object]
+_RESOLVED: dict[tuple[int, int], tuple[_Schema, _Schema, _Schema]] = {}
 
 
-def resolve(schema: Mapping[str, Any], root: Mapping[str, Any]) -> Mapping[str, Any]:
+def resolve(schema: Mapping[str, object], root: Mapping[str, object]) -> Mapping[str, object]:
     """Follow local ``$ref``s; keywords beside a ``$ref`` (like ``default``) win.
 
     Worked out once per schema object and root (a crowd's creatures resolve the same
@@ -50,36 +50,47 @@ def resolve(schema: Mapping[str, Any], root: Mapping[str, Any]) -> Mapping[str, 
     return resolved
 
 
-def _resolve(schema: Mapping[str, Any], root: Mapping[str, Any]) -> Mapping[str, Any]:
+def _resolve(schema: Mapping[str, object], root: Mapping[str, object]) -> Mapping[str, object]:
     """`resolve`, worked out."""
     seen: set[str] = set()
-    while isinstance(schema.get("$ref"), str) and schema["$ref"] not in seen:
-        ref: str = schema["$ref"]
+    ref = schema.get("$ref")
+    while isinstance(ref, str) and ref not in seen:
         seen.add(ref)
-        target: Any = root
+        target: object = root
         for part in ref.removeprefix("#").strip("/").split("/"):
             if part:
+                if not isinstance(target, Mapping):
+                    raise TypeError(f"$ref {ref!r} goes through a value that is no object")
                 target = target[part.replace("~1", "/").replace("~0", "~")]
+        if not isinstance(target, Mapping):
+            raise TypeError(f"$ref {ref!r} names a value that is no schema object")
         schema = {**target, **{k: v for k, v in schema.items() if k != "$ref"}}
+        ref = schema.get("$ref")
     return schema
 
 
-def _fill(value: Any, schema: Mapping[str, Any], root: Mapping[str, Any]) -> None:
+def _fill(value: object, schema: Mapping[str, object], root: Mapping[str, object]) -> None:
     """Fill schema defaults into ``value`` in place, recursing into objects and arrays."""
     schema = resolve(schema, root)
     if isinstance(value, dict):
         presets = schema.get("x-presets", {})
-        if value.get("preset") in presets:  # a preset fills what the scene leaves out
-            _merge_under(value, presets[value["preset"]])
-        for key, sub in schema.get("properties", {}).items():
+        preset = value.get("preset")
+        if isinstance(presets, Mapping) and preset in presets:  # fills what the scene lacks
+            _merge_under(value, presets[preset])
+        properties = schema.get("properties", {})
+        for key, sub in properties.items() if isinstance(properties, Mapping) else ():
+            if not isinstance(sub, Mapping):
+                continue  # (`true`: no defaults)
             sub = resolve(sub, root)
             if key not in value and "default" in sub:
                 value[key] = copy.deepcopy(sub["default"])
             if key in value:
                 _fill(value[key], sub, root)
-    elif isinstance(value, list) and isinstance(schema.get("items"), Mapping):
-        for _, item in nested(value):  # defaults go into objects only
-            _fill(item, schema["items"], root)
+    elif isinstance(value, list):
+        items = schema.get("items")
+        if isinstance(items, Mapping):
+            for _, item in nested(value):  # defaults go into objects only
+                _fill(item, items, root)
 
 
 def fill(value: object, schema: Mapping[str, object], root: Mapping[str, object]) -> None:
@@ -88,26 +99,27 @@ def fill(value: object, schema: Mapping[str, object], root: Mapping[str, object]
     _fill(value, schema, root)
 
 
-def _merge_under(value: dict[str, Any], base: Mapping[str, Any]) -> None:
-    """Copy into ``value`` every key of ``base`` it lacks, merging nested objects."""
-    for key, item in base.items():
+def _merge_under(value: dict[str, object], base: object) -> None:
+    """Copy into ``value`` every key of ``base`` (an object) it lacks, merging nested objects."""
+    for key, item in base.items() if isinstance(base, Mapping) else ():
         if key not in value:
             value[key] = copy.deepcopy(item)
-        elif isinstance(value[key], dict) and isinstance(item, Mapping):
-            _merge_under(value[key], item)
+            continue
+        mine = value[key]
+        if isinstance(mine, dict) and isinstance(item, Mapping):
+            _merge_under(mine, item)
 
 
-def copied(data: Any) -> Any:
+def copied(data: object) -> object:
     """A deep copy of scene data (JSON-like; anything else through `copy.deepcopy`); a
     list of numbers is copied at once (a million heights took a second one by one)."""
-    kind = type(data)
-    if kind is dict:
+    if type(data) is dict:
         return {key: copied(value) for key, value in data.items()}
-    if kind is list:
+    if type(data) is list:
         if set(map(type, data)) <= ATOMS:
             return list(data)  # immutable items: nothing to copy further
         return [copied(value) for value in data]
-    return data if kind in ATOMS else copy.deepcopy(data)
+    return data if type(data) in ATOMS else copy.deepcopy(data)
 
 
 def plugin_config(plugin: Plugin, given: object) -> dict[str, Any]:
@@ -115,7 +127,7 @@ def plugin_config(plugin: Plugin, given: object) -> dict[str, Any]:
     return filled(given if isinstance(given, Mapping) else {}, plugin.config_schema)
 
 
-def filled(data: Mapping[str, Any], schema: Mapping[str, Any]) -> dict[str, Any]:
+def filled(data: Mapping[str, object], schema: Mapping[str, object]) -> dict[str, object]:
     """A deep copy of `data` with the defaults of its own JSON Schema `schema` filled in
     (a plugin's config, a game mode's keys)."""
     out = copy.deepcopy(dict(data))
@@ -135,7 +147,7 @@ def with_defaults(
     stay absent; ``data`` is not modified. ``plugins`` (default: the default ones) add
     their keys' defaults, and each plugin's config gets its defaults under `plugins`.
     """
-    result = copied(data)
+    result = {key: copied(value) for key, value in data.items()}  # (`copied`)
     if plugins is None:
         from ecs_tentacles.scene.plugins import resolve
 

@@ -18,11 +18,14 @@ from __future__ import annotations
 import functools
 import math
 import re
-from collections.abc import Callable, Iterator
-from typing import Any, cast
+from collections.abc import Callable, Iterator, Mapping
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 from jsonschema import Draft202012Validator, ValidationError, _keywords, validators
+
+if TYPE_CHECKING:  # the class `validators.create` makes (the stubs' name; none at run time)
+    from jsonschema.validators import _Validator
 
 
 def _is_integer(checker: object, value: object) -> bool:
@@ -60,18 +63,21 @@ def ecma_pattern(pattern: str) -> re.Pattern[str]:
     return re.compile("".join(out))
 
 
-def _pattern(validator: object, pattern: str, instance: object, schema: object) -> Iterator[Any]:
+def _pattern(
+    validator: object, pattern: str, instance: object, schema: object
+) -> Iterator[ValidationError]:
     if isinstance(instance, str) and not ecma_pattern(pattern).search(instance):
         yield ValidationError(f"{instance!r} does not match {pattern!r}")
 
 
-_STANDARD_ITEMS = cast("Callable[..., Iterator[Any]]", _keywords.items)  # stubs say None
+# the stubs say None:
+_STANDARD_ITEMS = cast("Callable[..., Iterator[ValidationError]]", _keywords.items)
 FAST_ITEMS = 64  # arrays of numbers at least this long are checked with numpy
 _PLAIN_NUMBER = {"type", "minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum"}
 _PLAIN_NUMBER |= {"description", "default", "title"}
 
 
-def _failing_numbers(values: list[Any], schema: dict[str, Any]) -> np.ndarray | None:
+def _failing_numbers(values: list[object], schema: Mapping[str, object]) -> np.ndarray | None:
     """Indices of `values` that are not finite numbers within `schema`'s bounds, found at
     once; None when the list holds anything but ints and floats (looked at one by one)."""
     kinds = set(map(type, values))
@@ -85,18 +91,22 @@ def _failing_numbers(values: list[Any], schema: dict[str, Any]) -> np.ndarray | 
     if int in kinds and np.abs(array[ok]).max(initial=0.0) >= 2.0**53:
         return None  # ints a float could round into range
     with np.errstate(invalid="ignore"):
-        if "minimum" in schema:
-            ok &= array >= schema["minimum"]
-        if "maximum" in schema:
-            ok &= array <= schema["maximum"]
-        if "exclusiveMinimum" in schema:
-            ok &= array > schema["exclusiveMinimum"]
-        if "exclusiveMaximum" in schema:
-            ok &= array < schema["exclusiveMaximum"]
+        low, high = schema.get("minimum"), schema.get("maximum")
+        above, below = schema.get("exclusiveMinimum"), schema.get("exclusiveMaximum")
+        if isinstance(low, (int, float)):
+            ok &= array >= low
+        if isinstance(high, (int, float)):
+            ok &= array <= high
+        if isinstance(above, (int, float)):
+            ok &= array > above
+        if isinstance(below, (int, float)):
+            ok &= array < below
     return np.flatnonzero(~ok)
 
 
-def _items(validator: Any, items: Any, instance: object, schema: Any) -> Iterator[Any]:
+def _items(
+    validator: _Validator, items: object, instance: object, schema: Mapping[str, object]
+) -> Iterator[ValidationError]:
     """`items`, with long arrays of plain numbers checked at once (see the module's notes)."""
     if (
         isinstance(instance, list)
@@ -117,10 +127,11 @@ def _items(validator: Any, items: Any, instance: object, schema: Any) -> Iterato
 _BOUNDS = ("minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum")
 _LEAF_KINDS = {"number": _is_number, "integer": _is_integer, "boolean": None, "string": None}
 _NOTES = {"description", "default", "title", "examples", "$comment"}  # (and x-...: ours)
-_LEAVES: dict[int, tuple[object, Any]] = {}  # id -> (schema kept alive, its check or None)
+# id -> (schema kept alive, its check or None):
+_LEAVES: dict[int, tuple[object, Callable[[object], bool] | None]] = {}
 
 
-def _leaf_check(schema: object) -> Any:
+def _leaf_check(schema: object) -> Callable[[object], bool] | None:
     """For a schema that only says a value's type (number, integer, boolean or string)
     and, for numbers, its bounds: a function telling that a value passes it; else None."""
     found = _LEAVES.get(id(schema))
@@ -144,7 +155,7 @@ def _leaf_check(schema: object) -> Any:
 
 
 def _leaf(
-    kind: str, low: object, high: object, above: object, below: object
+    kind: str, low: float | None, high: float | None, above: float | None, below: float | None
 ) -> Callable[[object], bool]:
     """`_leaf_check`'s function: True when a value is of `kind` within the bounds (each
     None when absent), exactly when jsonschema would find nothing wrong with it."""
@@ -155,9 +166,10 @@ def _leaf(
         return lambda value: isinstance(value, str)
     assert is_kind is not None
 
-    def passes(value: Any) -> bool:
+    def passes(value: object) -> bool:
         return bool(
             is_kind(None, value)
+            and isinstance(value, (int, float))  # (is_kind said so: for mypy)
             and (low is None or not value < low)
             and (high is None or not value > high)
             and (above is None or not value <= above)
@@ -167,7 +179,12 @@ def _leaf(
     return passes
 
 
-def _properties(validator: Any, properties: Any, instance: object, schema: Any) -> Iterator[Any]:
+def _properties(
+    validator: _Validator,
+    properties: Mapping[str, Mapping[str, object] | bool],
+    instance: object,
+    schema: object,
+) -> Iterator[ValidationError]:
     """`properties`, with values that plainly pass a type-and-bounds schema not descended
     into: jsonschema would find nothing there (a crowd's creatures are mostly such
     values, and a descent costs some microseconds each); any other value, and one that
@@ -184,7 +201,8 @@ def _properties(validator: Any, properties: Any, instance: object, schema: Any) 
             yield from validator.descend(value, subschema, path=name, schema_path=name)
 
 
-StrictValidator = cast(Any, validators.extend)(  # jsonschema leaves extend untyped
+_extend: Callable[..., type[_Validator]] = validators.extend  # the stubs leave it untyped
+StrictValidator = _extend(
     Draft202012Validator,
     validators={"pattern": _pattern, "items": _items, "properties": _properties},
     type_checker=Draft202012Validator.TYPE_CHECKER.redefine_many(
@@ -193,10 +211,11 @@ StrictValidator = cast(Any, validators.extend)(  # jsonschema leaves extend unty
 )
 
 
-_VALIDATORS: dict[int, tuple[dict[str, Any], Any]] = {}  # id -> (schema kept alive, validator)
+# id -> (schema kept alive, validator):
+_VALIDATORS: dict[int, tuple[dict[str, object], _Validator]] = {}
 
 
-def validator_for(schema: dict[str, object]) -> Any:
+def validator_for(schema: dict[str, object]) -> _Validator:
     """A validator per schema object (assembled schemas are cached, so this is too)."""
     found = _VALIDATORS.get(id(schema))
     if found is None or found[0] is not schema:

@@ -37,7 +37,7 @@ import functools
 import math
 from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -94,40 +94,50 @@ class Parameter:
     def column(self) -> str:
         return f"{self.store}.{self.field}"
 
-    def code(self, choice: str) -> int:
+    def code(self, choice: object) -> int:
         """The stored code of one of `choices` (gait "coordinated" -> 1)."""
         return self.choices.index(choice)
 
-    def from_scene(self, value: Any) -> Any:
+    def from_scene(self, value: object) -> float | str:
         """A scene value in code units (radians for `_deg` keys); a choice stays its name."""
-        return value if self.choices else value * self.factor
+        if self.choices and isinstance(value, str):
+            return value
+        if not self.choices and isinstance(value, int | float):
+            return value * self.factor
+        raise TypeError(f"{self.section}.{self.key}: not a valid scene value: {value!r}")
 
-    def to_api(self, stored: Any) -> Any:
+    def to_api(self, stored: float) -> float | str:
         """A stored value as `world.resource(Locomotion).get` reports it (before any taper)."""
         if self.choices:
             return self.choices[int(stored)]
         return int(stored) if self.range and self.range.integer else float(stored)
 
-    def check(self, value: object) -> Any:
+    def check(self, value: object) -> float | str:
         """An API value (code units) if allowed, else a ValueError naming the parameter."""
         if self.choices:
-            if value not in self.choices:
+            if not isinstance(value, str) or value not in self.choices:
                 allowed = ", ".join(self.choices)
                 raise ValueError(f"{self.api}: must be one of {allowed}, got {value!r}")
             return value
         assert self.range is not None
         return self.range.check(self.api, value)
 
-    def cap(self, world: Any) -> Any:
+    def cap(self, world: Host) -> np.ndarray:
         """The `at_most` column of `world` (its rows line up with this parameter's store)."""
         assert self.at_most is not None
         store, _, field = self.at_most.rpartition(".")
-        return getattr(world.stores[store or self.store], field)
+        column: np.ndarray = getattr(world.stores[store or self.store], field)
+        return column
 
-    def write(self, world: Any, rows: Any, value: Any) -> None:
+    def write(self, world: Host, rows: int | np.ndarray, value: object) -> None:
         """Store an API value at `rows` of its column: tapered and capped by its row's columns."""
         store = world.stores[self.store]
-        stored = self.code(value) if self.choices else value
+        if self.choices:
+            stored: float | np.ndarray = self.code(value)
+        elif isinstance(value, int | float):
+            stored = value
+        else:
+            raise TypeError(f"{self.api}: must be a number, got {value!r}")
         if self.taper:
             stored = stored * getattr(store, self.taper)[rows]
         if self.at_most:
@@ -135,17 +145,22 @@ class Parameter:
         getattr(store, self.field)[rows] = stored
 
 
-def _annotated(schema: Mapping[str, object]) -> Iterator[tuple[str, str, Mapping[str, Any], str]]:
+def _annotated(
+    schema: Mapping[str, object],
+) -> Iterator[tuple[str, str, Mapping[str, object], str]]:
     """(section, key, property schema, JSON path) of every annotated property of `schema`."""
     for section, node, path in schema_objects(schema):
-        for key, spec in node["properties"].items():
+        properties = node["properties"]  # (a Mapping: `schema_objects` says so)
+        for key, spec in properties.items() if isinstance(properties, Mapping) else ():
             if isinstance(spec, Mapping) and ANNOTATION in spec:
                 yield section, key, spec, format_path([*path, "properties", key])
 
 
-def _parameter(section: str, key: str, spec: Mapping[str, Any], where: str) -> Parameter:
+def _parameter(section: str, key: str, spec: Mapping[str, object], where: str) -> Parameter:
     meta = spec[ANNOTATION]
     where = f"{where}.{ANNOTATION}"
+    if not isinstance(meta, Mapping):
+        raise ValueError(f"{where}: must be an object")
     unknown = set(meta) - _KEYS
     if unknown or not {"column", "units", "label"} <= set(meta):
         problem = f"unknown key {sorted(unknown)[0]!r}" if unknown else "needs column, units, label"
@@ -160,7 +175,8 @@ def _parameter(section: str, key: str, spec: Mapping[str, Any], where: str) -> P
     if slider is not None and set(slider) - _SLIDER_KEYS:
         raise ValueError(f"{where}.slider: unknown key {sorted(set(slider) - _SLIDER_KEYS)[0]!r}")
     factor = DEGREE if degrees else 1.0
-    choices = tuple(spec.get("enum", ()))
+    enum = spec.get("enum", ())
+    choices = tuple(enum) if isinstance(enum, list | tuple) else ()
     return Parameter(
         section=section,
         key=key,
@@ -210,7 +226,7 @@ def apply_parameters(
     world: Host,
     section: str,
     entry: Mapping[str, object],
-    rows: Mapping[str, object],
+    rows: Mapping[str, int | np.ndarray],
     table: Sequence[Parameter] | None = None,
 ) -> None:
     """Fill store columns from a scene entry (defaults applied) of `section`, at `rows`.

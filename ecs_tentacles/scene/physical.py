@@ -68,7 +68,7 @@ def physically_checked(
     prefix: str = "",
     plane: bool = True,
     layouts: Layouts | None = None,
-) -> dict[str, Any]:
+) -> dict[str, object]:
     """`scene` (creatures moved apart if it asks), or SceneError with every physical problem.
 
     `prefix` starts each problem line (the loader passes `"<file>: "`); `plane` and

@@ -33,10 +33,9 @@ import importlib.util
 import pathlib
 import sys
 import warnings
-from collections.abc import Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
 from types import ModuleType
-from typing import Any
 
 from ecs_tentacles.plugin import Plugin, SystemsPlugin
 from ecs_tentacles.system import System
@@ -62,8 +61,9 @@ class Found:
     trusted: bool
 
 
-def locate(key: str, config: Mapping[str, Any] | bool) -> Found:
-    """Where the plugin turned on as `key` lives (PluginError if nowhere)."""
+def locate(key: str, config: object) -> Found:
+    """Where the plugin turned on as `key` (its `config`: true or an object) lives
+    (PluginError if nowhere)."""
     if isinstance(config, Mapping) and FROM in config:
         return Found(str(config[FROM]), trusted=False)
     entries = sorted((e for e in _entry_points() if e.name == key), key=lambda e: not e.ours)
@@ -105,11 +105,11 @@ def current_keys(scene: object, path: pathlib.Path | None = None) -> object:
     caller). Where a scene has both keys, the new key's value is kept."""
     if not isinstance(scene, dict) or not isinstance(scene.get("plugins"), dict):
         return scene
-    chosen: dict[str, Any] = scene["plugins"]
+    chosen: dict[str, object] = scene["plugins"]
     old = renamed()
     if not any(key in old for key in chosen):
         return scene
-    current: dict[str, Any] = {}
+    current: dict[str, object] = {}
     for key, value in chosen.items():
         new = old.get(key)
         if new is None:
@@ -134,7 +134,7 @@ def _line_of(path: pathlib.Path, key: str) -> int:
     return next(found, 0) + 1
 
 
-def former_keys(scene: dict[str, Any]) -> dict[str, Any]:
+def former_keys(scene: Mapping[str, object]) -> Mapping[str, object]:
     """`scene` with its `plugins` under the keys they had first (`current_keys` undone;
     `scene` itself if none was renamed): the form a scene's hash is taken of, so that a
     scene hashes the same before and after a plugin's rename (a take's `scene_sha256`,
@@ -291,14 +291,17 @@ def instantiate(
     return plugin
 
 
-def builtin(key: str, **options: Any) -> Plugin:
+def builtin(key: str, **options: object) -> Plugin:
     """The engine's plugin `key`, made with keyword `options` (a bake's record plugin:
     `builtin("record", every=2)`), so generic code needs no feature's import."""
     known = shipped()
     if key not in known:
         raise PluginError(f"plugins.{key}: not a built-in plugin (known: {', '.join(known)})")
     made = load(key, known[key], None)
-    return instantiate(made(**options) if isinstance(made, type) else made, key, {}, None)
+    if isinstance(made, Plugin):
+        return instantiate(made, key, {}, None)
+    make: Callable[..., Plugin] = made  # the plugin class: its own keywords
+    return instantiate(make(**options), key, {}, None)
 
 
 def sandbox_plugins() -> list[Plugin]:
@@ -307,7 +310,7 @@ def sandbox_plugins() -> list[Plugin]:
 
 
 def resolve(
-    choices: Mapping[str, Any] | None,
+    choices: Mapping[str, object] | None,
     scene_dir: pathlib.Path | None = None,
     *,
     allow: bool = False,

@@ -17,10 +17,10 @@ from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, replace
 from typing import Any
 
-from ecs_tentacles.scene.schema import core_schema, load_schema
+from ecs_tentacles.scene.schema import at, core_schema, load_schema
 
 JsonPath = tuple[str | int, ...]
-SchemaObject = tuple[str, Mapping[str, Any], JsonPath]
+SchemaObject = tuple[str, Mapping[str, object], JsonPath]
 # schema keywords that hold subschemas, by name, one, or a list (the walk follows these)
 _BY_NAME = ("properties", "$defs", "patternProperties", "dependentSchemas")
 _NESTED = ("items", "additionalProperties", "not", "if", "then", "else", "contains")
@@ -53,7 +53,7 @@ class Range:
         """The same range in other units (degrees in the scene, radians in the API)."""
         return replace(self, low=self.low * factor, high=self.high * factor)
 
-    def check(self, name: str, value: object) -> Any:
+    def check(self, name: str, value: object) -> float:
         """`value` (a float, or an int for integer ranges) if allowed, else a ValueError."""
         if isinstance(value, bool) or not isinstance(value, numbers.Real):
             raise ValueError(f"{name}: must be a number, got {value!r}")
@@ -67,11 +67,13 @@ class Range:
         return int(value) if self.integer else float(value)
 
 
-def schema_range(spec: Mapping[str, Any]) -> Range:
+def schema_range(spec: Mapping[str, object]) -> Range:
     """The range a number property of the schema allows (`minimum`, `exclusiveMaximum`...)."""
     low_open, high_open = "exclusiveMinimum" in spec, "exclusiveMaximum" in spec
     low = spec.get("exclusiveMinimum", spec.get("minimum", -math.inf))
     high = spec.get("exclusiveMaximum", spec.get("maximum", math.inf))
+    if not isinstance(low, int | float) or not isinstance(high, int | float):
+        raise ValueError(f"a range's bounds are numbers, got {low!r} and {high!r}")
     return Range(low, high, low_open, high_open, spec.get("type") == "integer")
 
 
@@ -99,8 +101,9 @@ def schema_objects(node: object, name: str = "", path: JsonPath = ()) -> Iterato
 def field_schema(section: str, key: str) -> dict[str, Any]:
     """The schema of `<section>.<key>` (section: mantle, tentacles, locomotion...)."""
     for name, node, _ in schema_objects(load_schema()):  # the default plugins' fields too
-        if name == section and key in node["properties"]:
-            found: dict[str, object] = node["properties"][key]
+        properties = node["properties"]
+        found = properties.get(key) if isinstance(properties, Mapping) else None
+        if name == section and isinstance(found, dict):
             return found
     raise KeyError(f"{section}.{key}: not a field of the scene schema")
 
@@ -112,8 +115,9 @@ def field_range(section: str, key: str) -> Range:
 
 def physics_range(key: str) -> Range:
     """The range of the scene's `physics.<key>` (for gravity: of each component)."""
-    spec: dict[str, Any] = core_schema()["properties"]["physics"]["properties"][key]
-    return schema_range(spec.get("items", spec))
+    spec = at(core_schema(), "properties", "physics", "properties", key)
+    items = spec.get("items")
+    return schema_range(items if isinstance(items, Mapping) else spec)
 
 
 def damping_floor(strength: float, step: float) -> float:

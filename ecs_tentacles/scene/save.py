@@ -24,13 +24,13 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from importlib.resources import files
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from ecs_tentacles.output.atomic import AtomicOutput, OutputError, disk_full, temporary_name
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.load import load_scene_plugins, on_plane
 from ecs_tentacles.scene.physical import physically_checked
-from ecs_tentacles.scene.validate import format_path, validated
+from ecs_tentacles.scene.validate import format_path, json_child, validated
 
 if TYPE_CHECKING:
     from ecs_tentacles.plugin import Plugin
@@ -160,10 +160,15 @@ def _same_content(source: Path, destination: Path) -> bool:
 
 
 def _set(scene: dict[str, object], path: tuple[str | int, ...], value: str) -> None:
-    node: Any = scene
+    node: object = scene
     for step in path[:-1]:
-        node = node[step]
-    node[path[-1]] = value
+        node = json_child(node, step)
+    if isinstance(node, dict):
+        node[path[-1]] = value
+    elif isinstance(node, list) and isinstance(path[-1], int):
+        node[path[-1]] = value
+    else:
+        raise TypeError(f"{format_path(path)}: not in an object or a list")
 
 
 def save_scene(

@@ -24,7 +24,7 @@ if TYPE_CHECKING:
 
 PLACES = ("$defs", "creature", "scene", "tentacles")  # where a fragment adds keys
 NOT_IN_OVERRIDES = ("default", "x-parameter")  # an override's key only changes one tentacle
-Part = tuple[str, tuple[Mapping[str, Any], ...]]  # plugin key, its keys by place (PLACES)
+Part = tuple[str, tuple[Mapping[str, object], ...]]  # plugin key, its keys by place (PLACES)
 
 
 @functools.cache
@@ -54,7 +54,7 @@ def _fragment_file(package: str, name: str) -> importlib.resources.abc.Traversab
     return pathlib.Path(folders[0]).joinpath(*rest, f"{name}.schema.json")
 
 
-def builtin_fragment(name: str) -> dict[str, Any]:
+def builtin_fragment(name: str) -> dict[str, object]:
     """The fragment of the engine's plugin `name` ({} when it has none), its code not
     imported (where it is: its entry point)."""
     from ecs_tentacles.scene.plugins import shipped
@@ -65,11 +65,29 @@ def builtin_fragment(name: str) -> dict[str, Any]:
 
 def builtin_keys(name: str) -> dict[str, set[str]]:
     """A built-in plugin's keys by place (`creature`, `tentacles`, `scene`)."""
-    part = builtin_fragment(name)
-    return {place: set(part.get(place, {})) for place in ("creature", "tentacles", "scene")}
+    by_place = dict(zip(PLACES, by_places(builtin_fragment(name)), strict=True))
+    return {place: set(by_place[place]) for place in ("creature", "tentacles", "scene")}
 
 
-def schema_for(plugins: Sequence[Plugin]) -> dict[str, Any]:
+def by_places(part: Mapping[str, object]) -> tuple[Mapping[str, object], ...]:
+    """A fragment's keys at each of `PLACES` ({} where it adds none)."""
+    found = (part.get(place, {}) for place in PLACES)
+    return tuple(keys if isinstance(keys, Mapping) else {} for keys in found)
+
+
+def at(schema: Mapping[str, object], *path: str) -> Mapping[str, object]:
+    """The schema object at `path` in `schema` (`at(schema, "properties", "physics")`);
+    a KeyError naming the path where there is none."""
+    node = schema
+    for i, key in enumerate(path):
+        child = node.get(key)
+        if not isinstance(child, Mapping):
+            raise KeyError(f"schema: no object at {'.'.join(path[: i + 1])}")
+        node = child
+    return node
+
+
+def schema_for(plugins: Sequence[Plugin]) -> dict[str, object]:
     """The core schema with each plugin's keys added."""
     parts = [
         (p.key, (p.defs, p.creature_schema, p.scene_schema, p.tentacle_schema)) for p in plugins
@@ -82,7 +100,7 @@ def schema_for(plugins: Sequence[Plugin]) -> dict[str, Any]:
     return _SCHEMAS[key]
 
 
-_SCHEMAS: dict[tuple[tuple[str, type], ...], dict[str, Any]] = {}
+_SCHEMAS: dict[tuple[tuple[str, type], ...], dict[str, object]] = {}
 
 
 @functools.cache
@@ -94,10 +112,10 @@ def load_schema() -> dict[str, Any]:
     from ecs_tentacles.scene.plugins import default_on
 
     parts = [(name, builtin_fragment(name)) for name in default_on()]
-    return _assemble([(name, tuple(part.get(p, {}) for p in PLACES)) for name, part in parts])
+    return _assemble([(name, by_places(part)) for name, part in parts])
 
 
-def _assemble(parts: Sequence[Part]) -> dict[str, Any]:
+def _assemble(parts: Sequence[Part]) -> dict[str, object]:
     """Core schema + each plugin's keys. Tentacle keys join the creature's `tentacles`
     and, without their default and parameter annotation, each entry of its `overrides`."""
     schema = copy.deepcopy(core_schema())
@@ -122,7 +140,7 @@ def _assemble(parts: Sequence[Part]) -> dict[str, Any]:
                     )
                 owner[(place, name)] = key
                 places[place][name] = copy.deepcopy(entry)
-                if place == "tentacles":
+                if place == "tentacles" and isinstance(entry, Mapping):
                     overrides[name] = {
                         k: copy.deepcopy(v) for k, v in entry.items() if k not in NOT_IN_OVERRIDES
                     }

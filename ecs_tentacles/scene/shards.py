@@ -9,18 +9,20 @@ are the rules the schema cannot express, checked with the scene's other semantic
 from __future__ import annotations
 
 import json
-from collections.abc import Mapping, Sequence
-from typing import Any
+from collections.abc import Mapping
+
+from ecs_tentacles.scene.spec import creature_specs
 
 JsonPath = tuple[str | int, ...]
 
 
-def shard_problems(scene: Mapping[str, Any]) -> list[tuple[JsonPath, str]]:
-    """(JSON path, message) for each unknown, repeated or missing creature of `shards`."""
-    shards: Sequence[Sequence[str]] | None = scene.get("shards")
-    if shards is None:
+def shard_problems(scene: Mapping[str, object]) -> list[tuple[JsonPath, str]]:
+    """(JSON path, message) for each unknown, repeated or missing creature of `shards`
+    (a schema-valid scene's: lists of names)."""
+    shards = scene.get("shards")
+    if not isinstance(shards, list):
         return []
-    names = [creature["name"] for creature in scene["creatures"]]
+    names = [creature["name"] for creature in creature_specs(scene)]
     known = set(names)
     seen: dict[str, tuple[int, int]] = {}
     problems: list[tuple[JsonPath, str]] = []

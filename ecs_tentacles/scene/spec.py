@@ -5,7 +5,7 @@ building (`ecs_tentacles.creatures`), saving (`roster_save`) and `world.creature
 Core's keys are typed down to the leaves (`MantleSpec`, `TentaclesSpec`, each
 tentacle's `TentacleSettings` and `TentacleOverride`); the keys plugins add (goals,
 fur, emotion, locomotion's tentacle keys ...) are the plugins' own: core never reads
-them, and a plugin's hooks see the entry as a `Mapping[str, Any]`
+them, and a plugin's hooks see the entry as a `Mapping[str, object]`
 (`Plugin.build_creature`), so a feature reads its keys there.
 
 TypedDicts, not dataclasses: an entry is JSON the validator completed (a dict), and it
@@ -20,7 +20,7 @@ let mypy check every key core reads.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Any, Literal, Required, TypedDict, cast
+from typing import Literal, Required, TypedDict, cast
 
 
 class MantleSpec(TypedDict):
@@ -77,9 +77,12 @@ class CreatureSpec(TypedDict, total=False):
     tentacles: TentaclesSpec
 
 
-def creature_specs(scene: Mapping[str, Any]) -> list[CreatureSpec]:
+def creature_specs(scene: Mapping[str, object]) -> list[CreatureSpec]:
     """The creatures of a validated scene (defaults filled in), as specs."""
-    return cast("list[CreatureSpec]", list(scene["creatures"]))
+    creatures = scene["creatures"]
+    if not isinstance(creatures, list):
+        raise TypeError(f"scene.creatures: a list, not {type(creatures).__name__}")
+    return cast("list[CreatureSpec]", list(creatures))
 
 
 def as_spec(entry: Mapping[str, object]) -> CreatureSpec:

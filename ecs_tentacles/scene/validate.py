@@ -15,17 +15,20 @@ import json
 import math
 import re
 from collections.abc import Iterable, Mapping, Sequence
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from jsonschema import ValidationError
 
 from ecs_tentacles.plugin import calling
 from ecs_tentacles.scene.defaults import copied, fill, nested, resolve, with_defaults
 from ecs_tentacles.scene.json_validator import StrictValidator, validator_for
-from ecs_tentacles.scene.schema import builtin_keys, schema_for
+from ecs_tentacles.scene.schema import at, builtin_keys, schema_for
 from ecs_tentacles.scene.shards import shard_problems
+from ecs_tentacles.scene.spec import CreatureSpec, as_spec, creature_specs
 
 if TYPE_CHECKING:
+    from jsonschema.validators import _Validator  # what `StrictValidator(...)` makes
+
     from ecs_tentacles.plugin import Plugin
 
 JsonPath = tuple[str | int, ...]
@@ -72,8 +75,8 @@ def _show(value: object) -> str:
 
 def _range(schema: Mapping[str, object]) -> str:
     """Describe every numeric bound of ``schema``: ``in (0, 1]``, ``>= 1`` or ``< 5``."""
-    low: tuple[str, Any] | None = None
-    high: tuple[str, Any] | None = None
+    low: tuple[str, object] | None = None
+    high: tuple[str, object] | None = None
     if "exclusiveMinimum" in schema:
         low = ("(", schema["exclusiveMinimum"])
     elif "minimum" in schema:
@@ -102,27 +105,29 @@ def _count_bounds(schema: Mapping[str, object], unit: str) -> str:
 def _describe(error: ValidationError) -> list[Problem]:
     """Turn one jsonschema error into human one-line problems (with their paths)."""
     path: JsonPath = tuple(error.absolute_path)
-    schema: Mapping[str, Any] = error.schema if isinstance(error.schema, Mapping) else {}
-    value: Any = error.instance
-    expected: Any = error.validator_value
+    schema: Mapping[str, object] = error.schema if isinstance(error.schema, Mapping) else {}
+    value: object = error.instance
+    expected: object = error.validator_value
+    listed = expected if isinstance(expected, list) else [expected]  # types, keys, options
     kind = error.validator
     got = f"got {_show(value)}"
     if kind == "type" and isinstance(value, float) and not math.isfinite(value):
         return [(path, f"must be a finite number, {got}")]
     if kind == "type":
-        names = [expected] if isinstance(expected, str) else list(expected)
+        names = [str(t) for t in listed]
         return [(path, f"must be {' or '.join(_TYPE_NAMES.get(t, t) for t in names)}, {got}")]
     if kind in ("minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum"):
         return [(path, f"must be {_range(schema)}, {got}")]
     if kind == "additionalProperties" and isinstance(value, Mapping):
-        allowed = sorted(schema.get("properties", {}))
+        properties = schema.get("properties", {})
+        allowed = sorted(properties) if isinstance(properties, Mapping) else []
         extra = [key for key in value if key not in allowed]
         hint = f"unknown key (allowed: {', '.join(allowed)})"
         return [((*path, key), hint) for key in extra]
     if kind == "required" and isinstance(value, Mapping):
-        return [((*path, key), "is required") for key in expected if key not in value]
+        return [((*path, str(key)), "is required") for key in listed if key not in value]
     if kind == "enum":
-        options = ", ".join(_show(option) for option in expected)
+        options = ", ".join(_show(option) for option in listed)
         return [(path, f"must be one of {options}, {got}")]
     if kind == "const":
         return [(path, f"must be {_show(expected)}, {got}")]
@@ -133,7 +138,8 @@ def _describe(error: ValidationError) -> list[Problem]:
     if kind == "uniqueItems":
         return [(path, f"must not repeat an item, got {_show(value)}")]
     if kind == "pattern":
-        hint = schema.get("x-hint") or f"text matching {expected}"
+        given = schema.get("x-hint")
+        hint = given if isinstance(given, str) and given else f"text matching {expected}"
         return [(path, f"must be {hint}, {got}")]
     return [(path, " ".join(error.message.split()))]
 
@@ -144,10 +150,10 @@ def _path_key(problem: Problem) -> tuple[tuple[tuple[int, int | str], ...], str]
     return parts, problem[1]
 
 
-def _semantic_problems(scene: Mapping[str, Any]) -> list[Problem]:
+def _semantic_problems(scene: Mapping[str, object]) -> list[Problem]:
     """Rules the schema cannot express; ``scene`` is schema-valid with defaults applied."""
     problems: list[Problem] = []
-    creatures: Sequence[Mapping[str, Any]] = scene["creatures"]
+    creatures = creature_specs(scene)
     seen_names: dict[str, int] = {}
     for i, creature in enumerate(creatures):
         name = creature["name"]
@@ -162,7 +168,7 @@ def _semantic_problems(scene: Mapping[str, Any]) -> list[Problem]:
     return problems + shard_problems(scene)
 
 
-def _creature_rules(where: JsonPath, creature: Mapping[str, Any]) -> list[Problem]:
+def _creature_rules(where: JsonPath, creature: CreatureSpec) -> list[Problem]:
     """The rules of one creature entry the schema cannot express (its overrides' indices)."""
     problems: list[Problem] = []
     tentacles = creature["tentacles"]
@@ -181,7 +187,7 @@ def _creature_rules(where: JsonPath, creature: Mapping[str, Any]) -> list[Proble
     return problems
 
 
-def _schema_problems(data: object, validator: Any, prefix: JsonPath = ()) -> list[Problem]:
+def _schema_problems(data: object, validator: _Validator, prefix: JsonPath = ()) -> list[Problem]:
     errors = list(validator.iter_errors(data))
     # A value of the wrong type (0.5 for an integer) may fail its range too: report the type.
     mistyped = {tuple(e.absolute_path) for e in errors if e.validator == "type"}
@@ -238,7 +244,7 @@ def validate_scene(data: object, plugins: Sequence[Plugin] | None = None) -> lis
 
 def validated(
     data: object, plugins: Sequence[Plugin] | None = None
-) -> tuple[list[str], dict[str, Any] | None]:
+) -> tuple[list[str], dict[str, object] | None]:
     """`validate_scene`'s problems, and `with_defaults(data)` when there are none.
 
     The loader uses the scene completed here instead of completing it a second time
@@ -273,8 +279,8 @@ def validated(
 
 
 def validated_creature(
-    entry: object, scene: Mapping[str, Any], plugins: Sequence[Plugin]
-) -> tuple[list[str], dict[str, Any] | None]:
+    entry: object, scene: Mapping[str, object], plugins: Sequence[Plugin]
+) -> tuple[list[str], dict[str, object] | None]:
     """`entry` checked as one more creature of `scene` (validated, defaults in: a running
     world's, with the creatures it has now), and the entry with its defaults filled in
     when there are no problems (a spawn's: `ecs_tentacles.creatures.spawning`).
@@ -285,8 +291,10 @@ def validated_creature(
     find in it is reported. Each problem is one line whose path starts at `creature`.
     """
     schema = schema_for(plugins)
-    items = resolve(schema["properties"]["creatures"]["items"], schema)
-    where: JsonPath = ("creatures", len(scene["creatures"]))
+    entries = at(schema, "properties", "creatures", "items")
+    items = resolve(entries, schema)
+    creatures = creature_specs(scene)
+    where: JsonPath = ("creatures", len(creatures))
     lines = _entry_lines
     too_long = _limit_problems(entry, items, schema)
     if too_long:
@@ -294,14 +302,14 @@ def validated_creature(
     deep = _too_deep(entry, where)
     if deep is not None:
         return lines([(deep, f"nested deeper than {MAX_DEPTH} levels")]), None
-    problems = _schema_problems(entry, validator_for(_entry_schema(schema)), where)
+    problems = _schema_problems(entry, validator_for(_entry_schema(schema, entries)), where)
     if problems or not isinstance(entry, dict):
         return lines(_name_plugins_that_are_off(problems, {p.name for p in plugins})), None
-    completed = copied(entry)
+    completed = {key: copied(value) for key, value in entry.items()}  # (`copied`)
     fill(completed, items, schema)
-    problems = _creature_rules(where, completed)
+    problems = _creature_rules(where, as_spec(completed))
     if not problems:
-        among = {**scene, "creatures": [*scene["creatures"], completed]}
+        among = {**scene, "creatures": [*creatures, completed]}
         found: list[Problem] = []
         for plugin in plugins:
             with calling(plugin, "problems"):
@@ -317,22 +325,23 @@ def _entry_lines(problems: list[Problem]) -> list[str]:
     return [format_path(("creature", *path[2:])) + f": {message}" for path, message in unique]
 
 
-def _entry_schema(schema: dict[str, Any]) -> dict[str, Any]:
-    """The schema of one creature entry of the assembled `schema` (its `$defs` along);
-    made once per assembled schema, so its validator is made once too."""
+def _entry_schema(schema: dict[str, object], entries: Mapping[str, object]) -> dict[str, object]:
+    """The schema of one creature entry (`entries`, its `creatures.items`) of the
+    assembled `schema`, its `$defs` along; made once per assembled schema, so its
+    validator is made once too."""
     found = _ENTRY_SCHEMAS.get(id(schema))
     if found is None or found[0] is not schema:
         if len(_ENTRY_SCHEMAS) > 64:
             _ENTRY_SCHEMAS.clear()
-        entry = {**schema["properties"]["creatures"]["items"], "$defs": schema.get("$defs", {})}
+        entry = {**entries, "$defs": schema.get("$defs", {})}
         found = _ENTRY_SCHEMAS[id(schema)] = (schema, entry)
     return found[1]
 
 
-_ENTRY_SCHEMAS: dict[int, tuple[dict[str, Any], dict[str, Any]]] = {}
+_ENTRY_SCHEMAS: dict[int, tuple[dict[str, object], dict[str, object]]] = {}
 
 
-def repaired(data: object, plugins: Sequence[Plugin]) -> dict[str, Any] | None:
+def repaired(data: object, plugins: Sequence[Plugin]) -> dict[str, object] | None:
     """`data` with every value the schema refuses taken out (so its default applies) and
     unknown keys dropped: a scene the later stages (semantic and physical checks) can
     look at while the schema's problems are reported, so one run reports them all.
@@ -351,11 +360,13 @@ def repaired(data: object, plugins: Sequence[Plugin]) -> dict[str, Any] | None:
     for error in sorted(errors, key=lambda e: -len(e.absolute_path)):  # deepest first
         path = tuple(error.absolute_path)
         try:
-            node: Any = fixed
+            node: object = fixed
             for part in path[:-1] if path else ():
-                node = node[part]
+                node = json_child(node, part)
             if error.validator == "additionalProperties":
-                container = node[path[-1]] if path else node
+                container = json_child(node, path[-1]) if path else node
+                if not isinstance(container, dict):
+                    raise TypeError("additionalProperties: not an object")
                 allowed = (
                     error.schema.get("properties", {}) if isinstance(error.schema, dict) else {}
                 )
@@ -370,6 +381,16 @@ def repaired(data: object, plugins: Sequence[Plugin]) -> dict[str, Any] | None:
     if _schema_problems(fixed, validator) or _plugin_configs(fixed, plugins):
         return None
     return fixed
+
+
+def json_child(node: object, part: str | int) -> object:
+    """`node[part]` of JSON data: a KeyError, IndexError or TypeError as indexing
+    raises them."""
+    if isinstance(node, dict):
+        return node[part]
+    if isinstance(node, list) and isinstance(part, int):
+        return node[part]
+    raise TypeError(f"{type(node).__name__} has no item {part!r}")
 
 
 def _place(path: JsonPath) -> str | None:
@@ -424,21 +445,24 @@ def _limit_problems(
 ) -> list[Problem]:
     """Arrays longer than their schema's `maxItems`, found without descending into them."""
     problems: list[Problem] = []
-    stack: list[tuple[JsonPath, object, Mapping[str, Any]]] = [((), data, schema)]
+    stack: list[tuple[JsonPath, object, Mapping[str, object]]] = [((), data, schema)]
     while stack:
         path, value, node = stack.pop()
         node = resolve(node, root)
         if isinstance(value, list):
-            if len(value) > node.get("maxItems", len(value)):
+            most, items = node.get("maxItems"), node.get("items")
+            if isinstance(most, int) and len(value) > most:
                 problems.append(
                     (path, f"must have {_count_bounds(node, 'Items')}, got {len(value)}")
                 )
-            elif isinstance(node.get("items"), Mapping):
-                items = node["items"]
+            elif isinstance(items, Mapping):
                 stack.extend(((*path, i), v, items) for i, v in nested(value))
         elif isinstance(value, dict):
             properties = node.get("properties", {})
-            stack.extend(
-                ((*path, k), v, properties[k]) for k, v in value.items() if k in properties
-            )
+            if isinstance(properties, Mapping):
+                stack.extend(
+                    ((*path, k), v, properties[k])
+                    for k, v in value.items()
+                    if isinstance(properties.get(k), Mapping)
+                )
     return sorted(problems, key=_path_key)

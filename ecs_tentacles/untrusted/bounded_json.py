@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import json
 import re
+from collections.abc import Callable
 from typing import Any
 
 MAX_DEPTH = 64  # take headers nest 5 deep
@@ -55,7 +56,7 @@ def loads(
         raise JsonLimit(f"{where}: larger than {max_bytes} bytes")
     long = False
 
-    def number(kind: type[int] | type[float]) -> Any:
+    def number(kind: type[int] | type[float]) -> Callable[[str], int | float | _Long]:
         def parse(literal: str) -> int | float | _Long:
             nonlocal long
             if len(literal) > max_number:  # never converted: no float could hold it
@@ -75,7 +76,7 @@ def loads(
     return value
 
 
-Entry = tuple[Any, int, "tuple[Entry, object] | None"]  # value, depth, (parent, key)
+Entry = tuple[object, int, "tuple[Entry, object] | None"]  # value, depth, (parent, key)
 
 
 def _problem(value: object, where: str, max_depth: int, max_number: int, long: bool) -> str | None:

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import json
 from json import JSONDecoder
-from typing import Any, NoReturn
+from typing import NoReturn
 
 _WHITESPACE = " \t\n\r"
 _CLOSING = {"{": "}", "[": "]"}  # a container's opening character -> its closing one
@@ -51,7 +51,7 @@ def _refuse_constant(name: str) -> NoReturn:
     raise ValueError(f"{name} is not valid JSON")
 
 
-def _unique_pairs(pairs: list[tuple[str, Any]]) -> dict[str, object]:
+def _unique_pairs(pairs: list[tuple[str, object]]) -> dict[str, object]:
     """An object's pairs as a dict; `_Repeated` if a key comes twice."""
     out = dict(pairs)
     if len(out) != len(pairs):
@@ -69,7 +69,7 @@ _DECODER = JSONDecoder(
 _PLAIN = JSONDecoder()  # reads keys and steps over scalars while a repeated key is looked for
 
 
-def strict_loads(text: str) -> Any:
+def strict_loads(text: str) -> object:
     """`text` parsed as JSON with every key once per object and finite numbers.
 
     Raises DuplicateKey (naming the key and the line and column of its second
