@@ -79,7 +79,9 @@ class TerrainPlugin(Plugin):
         section (`render.registries`)."""
         world = app.world
         if world is not None:  # (a shard planner builds plugins without a world)
-            app.add(StaticGeometry, lambda spec, *args: ground_of(world).add_to_spec(spec, *args))
+            app.add(
+                StaticGeometry, lambda spec, contact: ground_of(world).add_to_spec(spec, contact)
+            )
         app.add(Panels, self._panels)
 
     def _panels(self, sandbox: SandboxView) -> list[Panel]:
