@@ -24,7 +24,7 @@ from ecs_tentacles.physics.model import StaticGeometry
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.render.registries import Panels
 from ecs_tentacles.scene.errors import SceneError
-from ecs_tentacles.scene.schema import fragment
+from ecs_tentacles.scene.schema import plugin_schemas
 from ecs_tentacles.scene.spec import as_spec
 from ecs_tentacles.terrain.editing import TerrainEditor
 from ecs_tentacles.terrain.heights import source_problems
@@ -36,7 +36,6 @@ if TYPE_CHECKING:
     from ecs_tentacles.registry import App
     from ecs_tentacles.render.registries import Panel, SandboxView
 
-_FRAGMENT = fragment("ecs_tentacles.terrain", "terrain")
 SINK_TOLERANCE = 0.001  # metres a 3-d placed creature may start inside the heightfield
 
 
@@ -44,8 +43,9 @@ class TerrainPlugin(Plugin):
     name = "terrain"
     build_order = 60  # a default plugin: built after clips (50)
     description = "a heightfield and static obstacles instead of the flat plane"
-    scene_schema = _FRAGMENT["scene"]
-    defs = _FRAGMENT["$defs"]
+    creature_schema, tentacle_schema, scene_schema, defs = plugin_schemas(
+        "ecs_tentacles.terrain", "terrain"
+    )
 
     def problems(self, scene: Mapping[str, Any]) -> list[tuple[tuple[str | int, ...], str]]:
         terrain = scene.get("terrain") or {}
