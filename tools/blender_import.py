@@ -78,9 +78,8 @@ def set_rate(scene: object, fps: float) -> None:
     scene.render.fps_base = ratio.denominator  # type: ignore[attr-defined]
 
 
-def main(argv: list[str] | None = None) -> int:
-    if argv is None:  # inside Blender the script's own arguments follow `--`
-        argv = sys.argv[sys.argv.index("--") + 1 :] if "--" in sys.argv else sys.argv[1:]
+def build_parser() -> argparse.ArgumentParser:
+    """The tool's arguments (the docs tests parse the handbook's lines with it)."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("take", type=Path, help="an export: .usd, .usda, .usdc or .glb")
     parser.add_argument("--out", type=Path, help="the .blend to write")
@@ -108,6 +107,13 @@ def main(argv: list[str] | None = None) -> int:
         metavar="WxH",
         help="the still's size in pixels (default 960x540)",
     )
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    if argv is None:  # inside Blender the script's own arguments follow `--`
+        argv = sys.argv[sys.argv.index("--") + 1 :] if "--" in sys.argv else sys.argv[1:]
+    parser = build_parser()
     args = parser.parse_args(argv)
     if args.out is None and args.render is None:
         parser.error("give --out (a .blend), --render (a .png) or both")

@@ -157,7 +157,8 @@ def lod_list(text: str) -> list[str]:
     return list(dict.fromkeys(values))
 
 
-def main(argv: list[str] | None = None) -> int:
+def build_parser() -> argparse.ArgumentParser:
+    """The tool's arguments (the docs tests parse the handbook's lines with it)."""
     parser = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
     parser.add_argument("--sizes", type=number_list, default=list(SIZES), help="creature counts")
     cores = os.cpu_count() or 1
@@ -198,7 +199,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--out", type=Path, default=Path("crowd_scaling"), help="writes OUT.csv and OUT.png"
     )
-    args = parser.parse_args(argv)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
     runs = [
         (n, lod, t)
         for n in args.sizes

@@ -24,11 +24,16 @@ from ecs_tentacles.world import World
 LEVELS = ("herding_1_field", "herding_2_shore", "herding_3_maze")
 
 
-def main(argv: list[str] | None = None) -> int:
+def build_parser() -> argparse.ArgumentParser:
+    """The tool's arguments (the docs tests parse the handbook's lines with it)."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("levels", nargs="*", default=list(LEVELS), metavar="LEVEL")
     parser.add_argument("--json", action="store_true", help="one JSON object per level")
-    args = parser.parse_args(argv)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
     for name in args.levels:
         with World.from_scene(resolve_scene_path(name)) as world:
             creatures = world.creatures.count

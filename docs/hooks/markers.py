@@ -2,6 +2,8 @@
 
 - `<!-- not run: why -->` on the line before a code block: the docs tests do not run that
   block (tests/docs/test_examples.py reads the marker); the built page shows why;
+- `<!-- parsed, not run: why -->`: the docs tests check the block's commands without
+  running them (tests/docs/parsed.py); the built page says so, and why;
 - `<!-- where -->` in a table row whose first cell is a class name in backticks: the
   module that defines the class, found in the package's source when the site is built
   and linked to its API page (the extension-points index), so no module path is written
@@ -19,6 +21,8 @@ from typing import Any
 
 ROOT = Path(__file__).resolve().parents[2]
 NOT_RUN = re.compile(r"^<!-- not run: (.+?) -->$", flags=re.M)
+PARSED = re.compile(r"^<!-- parsed, not run: (.+?) -->$", flags=re.M)
+CHECKED = "how-the-code-blocks-are-checked"  # the heading of docs/about.md that says how
 WHERE = re.compile(r"^(\| `(\w+)` \|[^\n]*?)<!-- where -->", flags=re.M)
 log = logging.getLogger("mkdocs.hooks.markers")
 
@@ -57,6 +61,11 @@ def where(name: str, depth: int) -> str:
 
 def on_page_markdown(markdown: str, page: Any, **_: Any) -> str:
     """Each marker replaced as the module docstring says."""
-    markdown = NOT_RUN.sub(lambda m: f"*Not run by the docs tests: {m.group(1)}.*\n", markdown)
     depth = page.file.src_uri.count("/")
+    markdown = NOT_RUN.sub(lambda m: f"*Not run by the docs tests: {m.group(1)}.*\n", markdown)
+    how = f"{'../' * depth}about.md#{CHECKED}"
+    markdown = PARSED.sub(
+        lambda m: f"*Checked, not run, by the docs tests ([how]({how})): {m.group(1)}.*\n",
+        markdown,
+    )
     return WHERE.sub(lambda m: m.group(1) + where(m.group(2), depth), markdown)

@@ -16,7 +16,6 @@ from __future__ import annotations
 import importlib
 import importlib.util
 from collections.abc import Sequence
-from typing import Any
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -28,7 +27,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     return run(argv)
 
 
-def __getattr__(name: str) -> Any:
+def __getattr__(name: str) -> object:
     """The command line's other names (`build_parser`, `Terminated`, ...), loaded when
     first asked for. A submodule's name is the submodule (`from ecs_tentacles.cli import
     bake_ray` asks here first: loading every command then would import the module that

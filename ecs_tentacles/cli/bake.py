@@ -19,6 +19,7 @@ import importlib.util
 import json
 import math
 import sys
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -181,10 +182,10 @@ def handle(args: argparse.Namespace) -> int:
     return validated(args.out, progress=not args.quiet) if args.validate else 0
 
 
-def _recoveries_refused(header: dict[str, Any], strict: bool) -> bool:
+def _recoveries_refused(header: Mapping[str, object], strict: bool) -> bool:
     """Tell of physics recoveries in the take (an error with --strict: True)."""
     health = header["health"]
-    if not health["recoveries"]:
+    if not isinstance(health, dict) or not health["recoveries"]:  # (a dict: as recorded)
         return False
     frames = sorted({e["frame"] for e in health["events"]})
     shown = ", ".join(map(str, frames[:8])) + (", ..." if len(frames) > 8 else "")

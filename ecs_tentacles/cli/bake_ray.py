@@ -8,7 +8,7 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
-from typing import Any
+from typing import Protocol
 
 from ecs_tentacles.cli.arguments import bounded_int
 from ecs_tentacles.cli.world_options import world_options
@@ -104,7 +104,13 @@ def _bake_variant(plan: BakePlan, options: WorldOptions) -> Take:
     return bake(plan, options.but(threads=1), progress=False)
 
 
-def run_wedge(args: argparse.Namespace, plan: BakePlan, save: Any) -> int:
+class Saves(Protocol):
+    """How a variant's take is written (`cli.bake.save`)."""
+
+    def __call__(self, take: Take, path: Path, *, progress: bool) -> object: ...
+
+
+def run_wedge(args: argparse.Namespace, plan: BakePlan, save: Saves) -> int:
     """Bake every variant (on Ray with --ray, else here), write each output and wedge.json."""
     from ecs_tentacles.distributed.wedge import (
         output_for,

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import argparse
 import json
-from typing import Any
+import os
 
 from ecs_tentacles.cli.arguments import bounded_int, counted
 from ecs_tentacles.cli.crowd import add_crowd_options, crowd_from_args, crowd_size
@@ -66,7 +66,7 @@ def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) ->
 
 def handle(args: argparse.Namespace) -> int:
     if args.crowd is not None:
-        source: Any = crowd_from_args(args.crowd, args)
+        source: str | os.PathLike[str] | dict[str, object] = crowd_from_args(args.crowd, args)
         label = f"crowd of {args.crowd} (seed {args.seed}, {args.idle:.0%} idle)"
     else:
         source = resolve_scene_path(args.scene)

@@ -9,7 +9,6 @@ The creatures, their placement and their goals are described in
 from __future__ import annotations
 
 import argparse
-from typing import Any
 
 import numpy as np
 
@@ -85,7 +84,7 @@ def add_crowd_options(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def crowd_from_args(n: int, args: argparse.Namespace) -> dict[str, Any]:
+def crowd_from_args(n: int, args: argparse.Namespace) -> dict[str, object]:
     """The crowd scene of `n` creatures the options ask for; SceneError names a bad option."""
     try:
         scene = crowd_scene(
@@ -125,6 +124,7 @@ def handle(args: argparse.Namespace) -> int:
         scene = crowd_from_args(args.n, args)
         write_crowd_scene(scene, args.out)
     creatures = scene["creatures"]
+    assert isinstance(creatures, list)  # (`crowd_scene`'s creature entries)
     furry = sum("fur" in c for c in creatures)
     idle = sum("goals" not in c for c in creatures)
     print(f"{args.out}: {len(creatures)} creatures ({furry} with fur, {idle} idle)")

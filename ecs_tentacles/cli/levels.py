@@ -14,7 +14,8 @@ from __future__ import annotations
 import argparse
 import importlib
 import json
-from typing import Any
+from collections.abc import Callable
+from typing import Protocol
 
 LISTING = "ecs_tentacles.herding.levels"  # levels(), stars_text(): the game's listing
 
@@ -33,7 +34,32 @@ def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) ->
     parser.set_defaults(handler=handle)
 
 
-def sentence(level: Any, stars_text: Any) -> str:
+class LevelLine(Protocol):
+    """What a line of the listing reads of a level (the game's `Level`)."""
+
+    @property
+    def scene(self) -> str: ...
+    @property
+    def title(self) -> str: ...
+    @property
+    def mode(self) -> str: ...
+    @property
+    def creatures(self) -> int: ...
+    @property
+    def need(self) -> int: ...
+    @property
+    def seconds(self) -> float: ...
+    @property
+    def par(self) -> float: ...
+    @property
+    def best(self) -> float | None: ...
+    @property
+    def stars(self) -> int: ...
+    @property
+    def unlocked(self) -> bool: ...
+
+
+def sentence(level: LevelLine, stars_text: Callable[[int], str]) -> str:
     best = f"best {level.best:.1f} s" if level.best is not None else "not won yet"
     lock = "" if level.unlocked else "  (locked: win the one before)"
     goal = f" {level.need} of {level.creatures}" if level.need else ""

@@ -43,7 +43,7 @@ import sys
 import time
 from collections import defaultdict
 from collections.abc import Callable
-from typing import Any, ParamSpec, TypeVar
+from typing import NoReturn, ParamSpec, TypedDict, TypeVar
 
 import psutil
 from tqdm import tqdm
@@ -60,6 +60,45 @@ PHYSICS_SYSTEMS = ("physics", "physics_health", "physics_sync")
 
 P = ParamSpec("P")
 R = TypeVar("R")
+
+
+class Timings(TypedDict):
+    """`measure`'s figures: medians over the timed blocks, in ms a frame."""
+
+    frames: int
+    frame_ms: float
+    physics_ms: float
+    raw_mujoco_ms: float
+    overhead_ratio: float  # frame_ms / raw_mujoco_ms
+    realtime_factor: float
+    systems: dict[str, float]  # each system's
+
+
+class Sizes(TypedDict):
+    """What `bench` built: creatures, bodies, stepping threads, seconds to build."""
+
+    creatures: int
+    bodies: int
+    threads: int
+    build_s: float
+
+
+class Ends(TypedDict):
+    """The world as `bench` left it: asleep, models compiled, recoveries, tiers."""
+
+    asleep: int
+    compiles: int
+    recoveries: int
+    lod: bool
+    tiers: dict[str, int]
+    promotions: int
+    demotions: int
+
+
+class BenchResult(Sizes, Timings, Ends):
+    """`bench`'s report (its keys in the order `bench`'s docstring gives)."""
+
+    rss_mb: float
 
 
 def timed(func: Callable[P, R], bucket: list[float]) -> Callable[P, R]:
@@ -107,7 +146,7 @@ def _framework_block(
     return took - capture.seconds
 
 
-def _bar(total: int, desc: str, progress: bool, **kwargs: object) -> tqdm[Any]:
+def _bar(total: int, desc: str, progress: bool, **kwargs: object) -> tqdm[NoReturn]:
     """A frame bar on stderr, shown only with `progress` and a terminal there."""
     disable = None if progress else True
     return tqdm(
@@ -123,7 +162,7 @@ def _bar(total: int, desc: str, progress: bool, **kwargs: object) -> tqdm[Any]:
 
 def measure(
     world: World, frames: int, *, block: int = BLOCK, warmup: int = WARMUP, progress: bool = False
-) -> dict[str, Any]:
+) -> Timings:
     """Median ms per frame of `frames` framework frames and as many bare ones, interleaved."""
     if frames < 1 or block < 1 or warmup < 0:
         raise ValueError(f"frames and block must be >= 1, warmup >= 0; got {frames, block, warmup}")
@@ -191,7 +230,7 @@ def bench(
     warmup: int = WARMUP,
     sleep: bool = True,
     progress: bool = False,
-) -> dict[str, Any]:
+) -> BenchResult:
     """Build `source` (scene path, bundled name or dict), run `measure`, report sizes.
 
     The keys, in order: creatures, bodies, threads, build_s, frames, frame_ms,
@@ -209,7 +248,7 @@ def bench(
         world = World.from_scene(source, options)
     build_s = time.perf_counter() - start
     try:
-        sizes = {
+        sizes: Sizes = {
             "creatures": len(world.physics),
             "bodies": world.physics.bodies,  # creature bodies, contact proxies not counted
             "threads": int(world.physics.threads),
@@ -217,7 +256,7 @@ def bench(
         }
         timings = measure(world, frames, block=block, warmup=warmup, progress=progress)
         level = world.lod
-        after = {
+        after: Ends = {
             "asleep": world.physics.sleep.asleep,
             "compiles": world.physics.compiles,
             "recoveries": world.physics.health.recoveries,
@@ -232,7 +271,7 @@ def bench(
     return {**sizes, **timings, "rss_mb": rss_mb, **after}
 
 
-def _without_sleep(source: Any) -> dict[str, Any]:
+def _without_sleep(source: str | os.PathLike[str] | dict[str, object]) -> dict[str, object]:
     from ecs_tentacles.scene.load import load_scene
 
     scene = copy.deepcopy(load_scene(source))

@@ -18,7 +18,7 @@ import copy
 import json
 import pathlib
 import sys
-from typing import Any
+from collections.abc import Mapping
 
 from ecs_tentacles.cli.arguments import output_path, read_only_problem
 from ecs_tentacles.output.atomic import atomic_output, claim
@@ -63,13 +63,15 @@ def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) ->
     parser.set_defaults(handler=handle)
 
 
-def migrate(raw: dict[str, Any]) -> tuple[dict[str, Any], list[str]]:
+def migrate(raw: Mapping[str, object]) -> tuple[dict[str, object], list[str]]:
     """The scene with `plugins` explicit and `systems` folded in; and what changed."""
-    scene = copy.deepcopy(raw)
+    scene = dict(copy.deepcopy(raw))
     changes: list[str] = []
-    plugins: dict[str, Any] = {}
+    plugins: dict[str, object] = {}
     old = renamed()
-    for key, value in (scene.get("plugins") or {}).items():
+    given = scene.get("plugins")
+    named: dict[str, object] = given if isinstance(given, dict) else {}
+    for key, value in named.items():
         if key in old:
             changes.append(f"plugins.{key} -> plugins.{old[key]} (the plugin's key now)")
         if old.get(key, key) not in plugins or key not in old:  # the new key's value wins
@@ -78,7 +80,8 @@ def migrate(raw: dict[str, Any]) -> tuple[dict[str, Any], list[str]]:
         if name not in plugins:
             plugins[name] = {}
             changes.append(f"plugins.{name}: on (it was on by default)")
-    for i, target in enumerate(scene.pop("systems", []) or []):
+    systems = scene.pop("systems", None)
+    for i, target in enumerate(systems if isinstance(systems, list) else []):
         key = target.rpartition(":")[2].lower() or f"system_{i}"
         while key in plugins:
             key += "_"

@@ -8,13 +8,15 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from ecs_tentacles.cli.arguments import add_frames, add_switch, output_path, require_display
 from ecs_tentacles.cli.world_options import CODE, PHYSICS, SEED, parents, world_options
 from ecs_tentacles.scene.load import resolve_scene_path
 
 if TYPE_CHECKING:
+    from collections.abc import Mapping
+
     from ecs_tentacles.host import Host
     from ecs_tentacles.render.camera import CameraChoice
 
@@ -194,7 +196,7 @@ def game_ended(world: Host) -> bool:
     return found is not None and found[1].ended
 
 
-def game_report(world: Host) -> dict[str, Any]:
+def game_report(world: Host) -> dict[str, dict[str, object]]:
     """`{"game": ...}`: the level's result as `--json` gives it ({} without a game)."""
     from ecs_tentacles.game.rules import playing
 
@@ -202,7 +204,7 @@ def game_report(world: Host) -> dict[str, Any]:
     return {} if found is None else {"game": found[1].report(found[0])}
 
 
-def sentence(report: dict[str, Any]) -> str:
+def sentence(report: Mapping[str, object]) -> str:
     """`octopus.json: 300 frames (5.00 s simulated, physics 4.1 ms a frame: 4.07x real
     time); wrote shot.png, clip.mp4`."""
     written = [str(report[k]) for k in ("screenshot", "video") if k in report]
@@ -212,6 +214,6 @@ def sentence(report: dict[str, Any]) -> str:
         " time)"
     )
     game = report.get("game")
-    if game is not None:
+    if isinstance(game, dict):  # (a level's: `game_report`)
         text += f"; game {game['outcome']} at {game['seconds']:.1f} s"
     return text + (f"; wrote {', '.join(written)}" if written else "")

@@ -12,7 +12,7 @@ import argparse
 import json
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from typing import Any
 
 from ecs_tentacles.cli.arguments import add_frames, bounded_int, counted
@@ -49,11 +49,12 @@ def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) ->
     parser.set_defaults(handler=handle)
 
 
-def health_line(summary: dict[str, Any]) -> str:
+def health_line(summary: Mapping[str, object]) -> str:
     """One sentence about recoveries, for the human-readable reports ('' when none)."""
-    if not summary["recoveries"]:
+    counted_causes = summary["recovery_causes"]
+    if not summary["recoveries"] or not isinstance(counted_causes, dict):  # (`simulate`'s)
         return ""
-    causes = ", ".join(f"{k} {v}" for k, v in sorted(summary["recovery_causes"].items()))
+    causes = ", ".join(f"{k} {v}" for k, v in sorted(counted_causes.items()))
     return (
         f"physics recovered {summary['recoveries']} times ({causes}),"
         f" {summary['frozen']} creatures frozen"
@@ -145,7 +146,7 @@ def game_over(world: World) -> Callable[[], bool] | None:
     return over
 
 
-def game_phrase(game: dict[str, Any], frames: int, asked: int) -> str:
+def game_phrase(game: Mapping[str, object], frames: int, asked: int) -> str:
     """`game won in 41.2 s (1. Open field), stopped at frame 2472 of 3600`."""
     where = f" ({game['level']})" if game.get("level") else ""
     if game["outcome"] == "playing":

@@ -12,7 +12,8 @@ import argparse
 import json
 import pathlib
 import sys
-from typing import TYPE_CHECKING, Any
+from collections.abc import Mapping
+from typing import TYPE_CHECKING, TypedDict
 
 from ecs_tentacles.cli.arguments import counted
 from ecs_tentacles.cli.world_options import CODE, parents
@@ -44,20 +45,32 @@ def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) ->
     parser.set_defaults(handler=handle)
 
 
-def summary(path: str, data: dict[str, Any], plugins: list[str]) -> dict[str, Any]:
+class Summary(TypedDict):
+    """What `validate` reports of a valid scene (--json prints it as it is)."""
+
+    scene: str
+    ok: bool
+    creatures: int
+    tentacles: int
+    systems: list[str]  # the systems it asks for ("package.module:ClassName")
+    plugins: list[str]  # the plugins it runs
+
+
+def summary(path: str, data: Mapping[str, object], plugins: list[str]) -> Summary:
     """What a valid scene holds, for the sentence and for --json."""
-    creatures = data["creatures"]
+    creatures, systems = data["creatures"], data.get("systems", [])
+    assert isinstance(creatures, list) and isinstance(systems, list)  # as validated
     return {
         "scene": path,
         "ok": True,
         "creatures": len(creatures),
         "tentacles": sum(c["tentacles"]["count"] for c in creatures),
-        "systems": list(data.get("systems", [])),
+        "systems": list(systems),
         "plugins": plugins,  # the plugins it runs
     }
 
 
-def sentence(report: dict[str, Any]) -> str:
+def sentence(report: Summary) -> str:
     """`octopus.json: ok (1 creature, 8 tentacles)`, plus the systems it asks for."""
     text = (
         f"{report['scene']}: ok ({counted(report['creatures'], 'creature')},"
@@ -71,7 +84,7 @@ def sentence(report: dict[str, Any]) -> str:
     return text
 
 
-def checked(path: pathlib.Path, allow_systems: bool) -> tuple[dict[str, Any], list[Plugin]]:
+def checked(path: pathlib.Path, allow_systems: bool) -> tuple[Mapping[str, object], list[Plugin]]:
     """The scene at `path`, completed, and its plugins, once every check a run makes
     before simulating has passed (SceneError otherwise, each line led by the path)."""
     from ecs_tentacles.creatures.loading import load_world

@@ -26,7 +26,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import TYPE_CHECKING, Protocol
 
 import mujoco
 import numpy as np
@@ -135,11 +135,16 @@ class FrameCapture:
         self.seconds = 0.0
         step = physics.step
 
-        def capturing_step(*args: Any, **kwargs: Any) -> None:
+        def capturing_step(
+            substeps: int,
+            before_substep: Callable[[int], None] | None = None,
+            rounds: int = 1,
+            between: Callable[[Callable[[np.ndarray], None]], None] | None = None,
+        ) -> None:
             began = time.perf_counter()
             self.frames.append(capture(physics, keep))
             self.seconds += time.perf_counter() - began
-            step(*args, **kwargs)
+            step(substeps, before_substep, rounds, between)
 
         physics.step = capturing_step  # type: ignore[method-assign]
 

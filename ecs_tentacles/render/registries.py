@@ -36,7 +36,7 @@ import os
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 
@@ -95,7 +95,7 @@ class RenderView:
     per_metre: float = 0.0
     overlays: bool = False
     clean: bool = False
-    state: dict[str, Any] = field(default_factory=dict)
+    state: dict[str, object] = field(default_factory=dict)
     selected: int | None = None  # the sandbox's selected creature (an entity), if any
     selection: tuple[int, ...] = ()  # every selected creature
 
@@ -204,7 +204,7 @@ class RendererView(Protocol):
     @property
     def camera(self) -> OrbitCamera: ...
     @property
-    def state(self) -> dict[str, Any]: ...  # plugins' objects kept across worlds
+    def state(self) -> dict[str, object]: ...  # plugins' objects kept across worlds
 
 
 class HudView(Protocol):
@@ -236,7 +236,7 @@ class SandboxView(Protocol):
     keys: KeyStateHandler  # keys[key.S] is True while S is down
 
     @property
-    def scene(self) -> str | os.PathLike[str] | dict[str, Any]: ...  # the world's source
+    def scene(self) -> str | os.PathLike[str] | dict[str, object]: ...  # the world's source
     @property
     def scene_dir(self) -> Path | None: ...
     @property
@@ -244,7 +244,7 @@ class SandboxView(Protocol):
     def ground_point(self, x: float, y: float) -> np.ndarray | None: ...
     def pick_creature(self, x: float, y: float) -> int | None: ...
     def select_many(self, creatures: Iterable[int]) -> None: ...
-    def rebuild(self, scene: dict[str, Any]) -> World: ...
+    def rebuild(self, scene: dict[str, object]) -> World: ...
     def reset(self) -> bool: ...  # the world built again from its scene (False: it did not build)
 
 
@@ -260,8 +260,8 @@ class Clicks(Registry[Callable[["Host", Click], bool]]):
 class UndoState:
     """A plugin's directable state as the sandbox's undo keeps it."""
 
-    capture: Callable[[Host], Any]
-    restore: Callable[[Host, Any], None]
+    capture: Callable[[Host], object]
+    restore: Callable[[Host, object], None]  # narrows what its `capture` gave
 
 
 class UndoStates(Registry[UndoState]):

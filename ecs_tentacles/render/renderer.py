@@ -15,22 +15,23 @@ grow with the number of creatures.
 The renderer names no feature: each frame it calls the entries plugins added to its
 registries (`ecs_tentacles.render.registries`) for spheres (`Spheres`: attached
 suckers, threats; one instanced batch), line segments (`Lines`: goal rings and paths,
-fur control markers; one line batch with the selected creature's ring) and their own
-drawing (`Draws`: fur's ribbons, with GL objects the plugin makes and keeps in
-`state`), handing them a `RenderView`; "frame all" keeps `FramedPoints` in view.
+fur control markers; one line batch with the selected creature's ring; both gathered
+in `render.marks`) and their own drawing (`Draws`: fur's ribbons, with GL objects the
+plugin makes and keeps in `state`), handing them a `RenderView`; "frame all" keeps
+`FramedPoints` in view. The blended passes (blob shadows, line ribbons) are
+`render.passes`.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any
 
 import numpy as np
 from pyglet import gl
 
 from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.ground import ground_of
-from ecs_tentacles.render import shaders
+from ecs_tentacles.render import marks, shaders
 from ecs_tentacles.render.camera import OrbitCamera
 from ecs_tentacles.render.decals import QUAD, SUCKER_DISC, shadow_instances, sucker_instances
 from ecs_tentacles.render.gpu import (
@@ -39,23 +40,14 @@ from ecs_tentacles.render.gpu import (
     SegmentRibbons,
     Target,
     program,
-    set_matrix,
 )
 from ecs_tentacles.render.horizon import HORIZON, fog_range
 from ecs_tentacles.render.instances import CreatureStatic, creature_links, link_instances
 from ecs_tentacles.render.meshes import CAPSULE_LODS, CYLINDER_LOD, SPHERE_LOD
 from ecs_tentacles.render.outlines import INSTANCE_FLOATS as RIBBON_FLOATS
 from ecs_tentacles.render.outlines import RIBBON_VERTEX, ribbon_instances
-from ecs_tentacles.render.registries import (
-    Draws,
-    FramedPoints,
-    OverlayLines,
-    OverlaySpheres,
-    RenderView,
-    Spheres,
-)
-from ecs_tentacles.render.registries import Lines as LineEntries
-from ecs_tentacles.render.rings import CIRCLE, draped
+from ecs_tentacles.render.passes import ribbon_pass, shadow_pass
+from ecs_tentacles.render.registries import Draws, FramedPoints, RenderView
 from ecs_tentacles.render.scenery import Scenery, Sight, use_lit
 from ecs_tentacles.render.skinned import SkinnedCreatures
 from ecs_tentacles.roster_change import RosterChange
@@ -109,7 +101,7 @@ class Renderer:
         # pixels on the picture's left that an opaque panel drawn after the world covers
         # (the sandbox's HUD): the world is not drawn there (`draw`)
         self.covered_left = 0
-        self.state: dict[str, Any] = {}  # what plugins keep here (GL objects), across worlds
+        self.state: dict[str, object] = {}  # what plugins keep here (GL objects), across worlds
         self.palette = "natural"  # the creatures' colours (`ecs_tentacles.skin.colours`)
         self.set_world(world)
 
@@ -312,55 +304,26 @@ class Renderer:
 
     def _sphere_instances(self) -> np.ndarray:
         """The plugins' spheres (attached suckers, threats): one instanced batch."""
-        entries = [*self.world.registry(Spheres)]
-        if not self.clean:
-            entries += self.world.registry(OverlaySpheres)
-        markers = [m for spheres in entries for m in spheres(self.world)]
-        count = sum(len(m.positions) for m in markers)
-        out = np.zeros((count, INSTANCE_FLOATS), np.float32)
-        out[:, 3] = 1.0
-        start = 0
-        for marker in markers:
-            end = start + len(marker.positions)
-            out[start:end, 0:3] = marker.positions
-            out[start:end, 7:11] = (*marker.size, 0.0)
-            out[start:end, 11:15] = marker.rgba
-            start = end
-        return out
+        return marks.sphere_instances(self.world, self.clean)
 
     def _line_vertices(self, pos: np.ndarray) -> np.ndarray:
         """The plugins' line segments, a ring round each selected creature, `extra_lines`
         (in the clean view, the `Lines` entries' and `extra_lines` only)."""
-        view = self.render_view
-        segments = [np.zeros((0, 7))]
-        entries = [*self.world.registry(LineEntries)]
-        if not self.clean:
-            entries += self.world.registry(OverlayLines)
-        for lines in entries:
-            segments += lines(self.world, view)
+        segments = marks.plugin_segments(self.world, self.render_view, self.clean)
         chosen = self.selection or ((self.selected,) if self.selected is not None else ())
         if chosen and not self.clean:  # one ring round each, in one pass
             drawn = [self._index_of[e] for e in chosen if e in self._index_of]
             mantles = pos[self._mantle_rows[drawn]]
             centres = np.column_stack([mantles[:, :2], np.zeros(len(drawn))])
-            radii = self._reach(pos)[drawn]  # round the tentacles, not under them
-            rings = centres[:, None, :] + radii[:, None, None] * CIRCLE
-            rings = draped(rings.reshape(-1, 3), ground_of(self.world), 0.01).reshape(rings.shape)
-            pairs = np.stack([rings[:, :-1], rings[:, 1:]], axis=2).reshape(-1, 3)
-            segments.append(np.hstack([pairs, np.ones((len(pairs), 4))]))
+            reach = marks.reach(
+                pos, self.mantle_instances[:, 7], self._mantle_rows, self.link_rows,
+                self.link_creature, self.link_instances[:, 7],
+            )  # fmt: skip
+            # round the tentacles, not under them
+            segments.append(marks.selection_rings(centres, reach[drawn], ground_of(self.world)))
         for provider in self.extra_lines:
             segments.append(provider(self.world))
         return np.vstack(segments).astype(np.float32)
-
-    def _reach(self, pos: np.ndarray) -> np.ndarray:
-        """Each drawn creature's reach in the ground plane now (m): its farthest link
-        from its mantle, at least 1.6 mantle radii."""
-        reach = 1.6 * self.mantle_instances[:, 7].astype(np.float64)
-        if len(self.link_rows):
-            mantle = pos[self._mantle_rows[self.link_creature], :2]
-            far = np.linalg.norm(pos[self.link_rows, :2] - mantle, axis=1)
-            np.maximum.at(reach, self.link_creature, far + self.link_instances[:, 7])
-        return reach
 
     def draw(self, alpha: float = 1.0) -> int:
         """Render into the off-screen target; returns the number of draw calls."""
@@ -384,17 +347,7 @@ class Renderer:
         # one fills the creatures' arrays: about 4 ms less of a crowd's 50 ms frame)
         gl.glFlush()
         self._fill(pos, quat)
-        # the blob shadows: blended over the ground, never hiding what is drawn after
-        self.blob_program.use()
-        set_matrix(self.blob_program, "u_view_projection", view_projection)
-        gl.glEnable(gl.GL_BLEND)
-        gl.glBlendFunc(gl.GL_SRC_ALPHA, gl.GL_ONE_MINUS_SRC_ALPHA)
-        gl.glDepthMask(gl.GL_FALSE)
-        gl.glDisable(gl.GL_CULL_FACE)
-        calls += self.shadows.draw()
-        gl.glEnable(gl.GL_CULL_FACE)
-        gl.glDepthMask(gl.GL_TRUE)
-        gl.glDisable(gl.GL_BLEND)
+        calls += shadow_pass(self.blob_program, self.shadows, view_projection)
         use_lit(self.lit, view_projection, LIGHT, eye, fog)
         for mesh in (self.mantles, self.links_near, self.links_far, self.spheres):
             calls += mesh.draw()
@@ -403,23 +356,9 @@ class Renderer:
             use_lit(self.skinned_program, view_projection, LIGHT, eye, fog)
             self.skinned_program["u_palette"] = 0
             calls += self.skinned.draw()
-        # the ribbons: over what they lie on (pulled toward the eye), the bright cores
-        # over their dark edges (no depth written between them)
-        self.line_program.use()
-        set_matrix(self.line_program, "u_view_projection", view_projection)
-        self.line_program["u_eye"] = eye
-        self.line_program["u_per_metre"] = float(self.camera.per_metre)
-        gl.glEnable(gl.GL_BLEND)
-        gl.glBlendFunc(gl.GL_SRC_ALPHA, gl.GL_ONE_MINUS_SRC_ALPHA)
-        gl.glDisable(gl.GL_CULL_FACE)
-        gl.glDepthMask(gl.GL_FALSE)
-        gl.glEnable(gl.GL_POLYGON_OFFSET_FILL)
-        gl.glPolygonOffset(-2.0, -8.0)
-        calls += self.lines.draw()
-        gl.glDisable(gl.GL_POLYGON_OFFSET_FILL)
-        gl.glDepthMask(gl.GL_TRUE)
-        gl.glEnable(gl.GL_CULL_FACE)
-        gl.glDisable(gl.GL_BLEND)
+        calls += ribbon_pass(
+            self.line_program, self.lines, view_projection, eye, self.camera.per_metre
+        )
         for draw in self.world.registry(Draws):  # what spheres and lines cannot say (fur)
             calls += draw(self.world, self.render_view)
         gl.glBindVertexArray(0)

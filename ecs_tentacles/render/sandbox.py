@@ -37,7 +37,7 @@ from __future__ import annotations
 import os
 import time
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pyglet
@@ -66,18 +66,19 @@ from ecs_tentacles.skin.colours import PALETTES
 from ecs_tentacles.world import World
 
 if TYPE_CHECKING:
-    from collections.abc import Callable
+    from collections.abc import Callable, Iterable, Mapping
 
 FRAME_EASE = 0.08  # share of the way to the new framing a video frame moves (frame-all)
 DISPLAY_HZ = 60
 
 
-def scene_palette(scene: dict[str, Any] | None) -> str:
+def scene_palette(scene: Mapping[str, object] | None) -> str:
     """The creature palette a scene asks for (`render.palette`), natural if none."""
-    return str(((scene or {}).get("render") or {}).get("palette", "natural"))
+    render = (scene or {}).get("render")
+    return str(render.get("palette", "natural")) if isinstance(render, dict) else "natural"
 
 
-def is_game(scene: dict[str, Any] | None) -> bool:
+def is_game(scene: Mapping[str, object] | None) -> bool:
     """Whether a validated scene is a game's (it has a `game` key): its view starts clean."""
     return scene is not None and bool(scene.get("game"))
 
@@ -96,7 +97,7 @@ class Sandbox(SandboxPicture):
         hud: bool = True,
         palette: str | None = None,
         clean: bool | None = None,
-        **deprecated: Any,
+        **deprecated: object,
     ):
         """`options` build its worlds (`ecs_tentacles.options.WorldOptions`: seed, code
         allowed, threads, level of detail; a `focus` pins the full-physics region instead
@@ -138,7 +139,7 @@ class Sandbox(SandboxPicture):
 
     # -- the session's state, as panels and scripts read it -----------------------------
     @property
-    def scene(self) -> str | os.PathLike[str] | dict[str, Any]:
+    def scene(self) -> str | os.PathLike[str] | dict[str, object]:
         """What the world was built from (a file, a bundled name or an edited scene)."""
         return self.session.scene
 
@@ -206,7 +207,7 @@ class Sandbox(SandboxPicture):
         self.world.events.on("creature_despawned", self._forget)
         self.undo = UndoStack()  # edits name the world they were made in
 
-    def _forget(self, *, creature: int, **_: Any) -> None:
+    def _forget(self, *, creature: int, **_: object) -> None:
         """A despawned creature leaves the selection."""
         if creature in self.selection:
             self.selection.discard(creature)
@@ -231,7 +232,7 @@ class Sandbox(SandboxPicture):
         """The plugins' HUD section titled `title` ("Fur", "Locomotion"), if shown."""
         return next((p for p in self.hud.panels if p.title == title), None)
 
-    def rebuild(self, scene: dict[str, Any]) -> World:
+    def rebuild(self, scene: dict[str, object]) -> World:
         """Rebuild the world from an edited scene; the camera and the selection stay."""
         selected = self.renderer.selected
         name = None if selected is None else self.world.component(selected, Creature).name
@@ -306,7 +307,7 @@ class Sandbox(SandboxPicture):
         self.selection.only(creature)
         self._selection_changed()
 
-    def select_many(self, creatures: Any) -> None:
+    def select_many(self, creatures: Iterable[int]) -> None:
         """Select `creatures` (entities; the last is the HUD's)."""
         self.selection.replace(creatures)
         self._selection_changed()
@@ -348,7 +349,7 @@ class Sandbox(SandboxPicture):
         video: str | os.PathLike[str] | None = None,
         progress: bool = True,
         until: Callable[[World], bool] | None = None,
-    ) -> dict[str, Any]:
+    ) -> dict[str, object]:
         """Step `frames` frames off-screen, recording a video and/or a final screenshot;
         with `until`, stop after the first frame at which `until(world)` is True (a game
         won or lost). `frames` in the result: the frames run."""

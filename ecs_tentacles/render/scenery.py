@@ -25,10 +25,10 @@ surface's program (the terrain's, the creatures').
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 from pyglet import gl
+from pyglet.graphics.shader import ShaderProgram
 
 from ecs_tentacles.ground import Ground
 from ecs_tentacles.render import shaders
@@ -68,14 +68,14 @@ class Sight:
         )
 
 
-def set_fog(prog: Any, fog: tuple[float, float]) -> None:
+def set_fog(prog: ShaderProgram, fog: tuple[float, float]) -> None:
     """The distance fog's uniforms (`render.horizon.fog_range`) on a program that fogs."""
     prog["u_fog_colour"] = HORIZON
     prog["u_fog_start"], prog["u_fog_end"] = fog
 
 
 def use_lit(
-    prog: Any,
+    prog: ShaderProgram,
     view_projection: np.ndarray,
     light: np.ndarray,
     eye: tuple[float, ...],
@@ -104,9 +104,9 @@ class Scenery:
         # `draw_kept`: the ground and sky of a still camera, what they were drawn for
         # (and the draw calls they took), and what the frame before was drawn for
         self.kept: Target | None = None
-        self.kept_for: tuple[Any, ...] | None = None
+        self.kept_for: tuple[object, ...] | None = None
         self.kept_calls = 0
-        self.last_for: tuple[Any, ...] | None = None
+        self.last_for: tuple[object, ...] | None = None
         self._kept_ground: object = None  # holds the ground whose id is in `kept_for`
 
     def build(self, ground: Ground) -> None:

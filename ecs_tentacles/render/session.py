@@ -15,7 +15,6 @@ from __future__ import annotations
 import os
 from collections.abc import Callable, Iterable
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
@@ -44,7 +43,7 @@ class SandboxSession:
         options: WorldOptions | None = None,
         *,
         say: Callable[[bool, str], None] = lambda ok, text: None,
-        **deprecated: Any,
+        **deprecated: object,
     ):
         """`options` build every world of the session (`ecs_tentacles.options`); their
         `focus` (x, y, radius in m) pins the full-physics region instead of the camera's.

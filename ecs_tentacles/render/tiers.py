@@ -9,6 +9,7 @@ so the counts are the legend. One numpy pass per frame, whatever the crowd's siz
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -63,13 +64,22 @@ def tier_markers(renderer: Renderer) -> list[Marker]:
     return markers
 
 
+@dataclass(frozen=True)
+class _Mantles:
+    """What `_mantles` keeps in the renderer's state, and for which world."""
+
+    world: object
+    heights: np.ndarray
+    radius: float
+
+
 def _mantles(renderer: Renderer) -> tuple[np.ndarray, float]:
     """Each creature's mantle height and the mean mantle radius (kept per renderer world)."""
     cached = renderer.state.get("tier_mantles")
-    if cached is not None and cached[0] is renderer.world:
-        return cached[1], cached[2]
+    if isinstance(cached, _Mantles) and cached.world is renderer.world:
+        return cached.heights, cached.radius
     creatures = [renderer.world.component(e, Creature) for e in renderer.creature_entities]
     heights = np.array([c.mantle_height for c in creatures])
     radius = float(np.mean([c.mantle_radius for c in creatures]))
-    renderer.state["tier_mantles"] = (renderer.world, heights, radius)
+    renderer.state["tier_mantles"] = _Mantles(renderer.world, heights, radius)
     return heights, radius

@@ -29,13 +29,15 @@ from __future__ import annotations
 import colorsys
 import hashlib
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 # numpy and the standard library only when it runs: the Blender add-on runs this file as
 # it is (`ecs_tentacles.blender_addon.shared`)
 if TYPE_CHECKING:
+    from collections.abc import Mapping
+
     from ecs_tentacles.host import Host
 
 FIRST_HUE = 0.02  # a warm red, octopus-like
@@ -112,10 +114,12 @@ def look_in_world(world: Host, entity: int, index: int) -> Look:
     return Look(str(creature.name), index, body_key(creature.mantle_radius, links))
 
 
-def look_in_take(header: dict[str, Any], index: int) -> Look:
+def look_in_take(header: Mapping[str, object], index: int) -> Look:
     """The `Look` of a take's `index`-th creature (its header's `creatures[index]`)."""
-    entry = header["creatures"][index]
-    radius = float(header["bodies"][entry["mantle"]]["radius"])
+    creatures, bodies = header["creatures"], header["bodies"]
+    assert isinstance(creatures, list) and isinstance(bodies, list)  # as `take.header` checks
+    entry = creatures[index]
+    radius = float(bodies[entry["mantle"]]["radius"])
     links = [len(chain) for chain in entry["tentacles"]]
     return Look(str(entry["name"]), index, body_key(radius, links))
 

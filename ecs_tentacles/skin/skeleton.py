@@ -17,8 +17,8 @@ hinge point is fixed in the parent's frame), so only the root moves by translati
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
@@ -116,11 +116,12 @@ def creature_skeleton(take: Take, creature: int) -> Skeleton:
     return build_skeleton(layout, body_index, take.quat[0, mantle], take.pos[0, mantle])
 
 
-def creature_layout(header: dict[str, Any], creature: int) -> tuple[SkinLayout, np.ndarray]:
+def creature_layout(header: Mapping[str, object], creature: int) -> tuple[SkinLayout, np.ndarray]:
     """Creature number `creature` of a take with this header: its layout (from the
     header's body sizes) and the take body of each joint (mantle, then link by link)."""
-    entry = header["creatures"][creature]
-    bodies = header["bodies"]
+    creatures, bodies = header["creatures"], header["bodies"]
+    assert isinstance(creatures, list) and isinstance(bodies, list)  # as `take.header` checks
+    entry = creatures[creature]
     mantle = bodies[entry["mantle"]]
     chains = entry["tentacles"]
     tentacles = [

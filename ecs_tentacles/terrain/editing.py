@@ -21,9 +21,9 @@ from __future__ import annotations
 
 import copy
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -32,11 +32,12 @@ from ecs_tentacles.scene.save import save_scene
 from ecs_tentacles.terrain.ground import TerrainGround, terrain_ground
 from ecs_tentacles.terrain.heights import heightfield
 from ecs_tentacles.terrain.scene_ground import build_ground
+from ecs_tentacles.terrain.terrain_spec import ObstacleSpec, ShapeKeys, TerrainSpec
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
 
-SHAPES: dict[str, Callable[[float], dict[str, Any]]] = {  # a new obstacle: its keys for `size`
+SHAPES: dict[str, Callable[[float], ShapeKeys]] = {  # a new obstacle: its keys for `size`
     "box": lambda s: {"size": [s, s, 0.5 * s]},
     "cylinder": lambda s: {"radius": 0.5 * s, "height": 0.6 * s},
     "sphere": lambda s: {"radius": 0.5 * s},
@@ -44,6 +45,7 @@ SHAPES: dict[str, Callable[[float], dict[str, Any]]] = {  # a new obstacle: its 
 }
 BRUSHES = ("raise", "lower", "smooth")
 PICK_DISTANCE = 0.05  # metres: a point this close to an obstacle picks it
+Point = Sequence[float] | np.ndarray  # x, y (and z: `obstacle_at`), in metres
 
 
 class TerrainEditError(ValueError):
@@ -59,7 +61,7 @@ class TerrainEditor:
         self.edits = 0  # edits made so far (the sandbox's panel shows it)
 
     # -- obstacles -----------------------------------------------------------------------
-    def place(self, world: Host, shape: str, point: Any, size: float = 0.6) -> int:
+    def place(self, world: Host, shape: str, point: Point, size: float = 0.6) -> int:
         """Put a new `shape` obstacle of `size` m resting on the ground at `point`;
         its index in `terrain.obstacles`."""
         if shape not in SHAPES:
@@ -80,14 +82,17 @@ class TerrainEditor:
             keys["seed"] = len(self._terrain(world).get("obstacles", []))
         ground = float(ground_of(world).height(np.array([[x, y]]))[0])
         z = base + half - ground  # on_ground: its z is measured from the ground under it
-        obstacle = {"shape": shape, "position": [round(x, 4), round(y, 4), round(z, 4)]}
-        obstacle.update(keys)
+        obstacle: ObstacleSpec = {
+            "shape": shape,
+            "position": [round(x, 4), round(y, 4), round(z, 4)],
+            **keys,
+        }
         terrain = self._terrain(world)
         terrain.setdefault("obstacles", []).append(obstacle)
         self._apply(world, terrain)
         return len(terrain["obstacles"]) - 1
 
-    def move(self, world: Host, index: int, point: Any) -> None:
+    def move(self, world: Host, index: int, point: Point) -> None:
         """Move obstacle `index` so it rests on the ground at `point` (x, y)."""
         terrain = self._terrain(world)
         obstacles = terrain.get("obstacles", [])
@@ -106,7 +111,7 @@ class TerrainEditor:
         obstacle["position"] = [round(x, 4), round(y, 4), round(base + lift, 4)]
         self._apply(world, terrain)
 
-    def obstacle_at(self, world: Host, point: Any) -> int | None:
+    def obstacle_at(self, world: Host, point: Point) -> int | None:
         """The index of the obstacle at (or within `PICK_DISTANCE` of) `point`, or None."""
         solids = terrain_ground(world).solids
         if not solids:
@@ -116,7 +121,7 @@ class TerrainEditor:
         best = int(np.argmin(distances))
         return best if distances[best] <= PICK_DISTANCE else None
 
-    def delete_at(self, world: Host, point: Any) -> int | None:
+    def delete_at(self, world: Host, point: Point) -> int | None:
         """Remove the obstacle at `point`; its index, or None when nothing is there."""
         index = self.obstacle_at(world, point)
         if index is None:
@@ -127,7 +132,7 @@ class TerrainEditor:
         return index
 
     # -- the heightfield -------------------------------------------------------------------
-    def brush(self, world: Host, kind: str, centre: Any, radius: float, amount: float) -> None:
+    def brush(self, world: Host, kind: str, centre: Point, radius: float, amount: float) -> None:
         """Raise, lower (by up to `amount` m at the centre) or smooth (toward the local
         mean, `amount` 0..1 of the way) the heightfield within `radius` m of `centre`."""
         if kind not in BRUSHES:
@@ -150,13 +155,15 @@ class TerrainEditor:
             heights += np.clip(amount, 0.0, 1.0) * weight * (uniform_filter(heights, 3) - heights)
         else:
             heights += (amount if kind == "raise" else -amount) * weight
-        for key in ("noise", "image", "resolution", "height"):
-            field.pop(key, None)
+        field.pop("noise", None)  # its heights now come from no other source
+        field.pop("image", None)
+        field.pop("resolution", None)
+        field.pop("height", None)
         field["heights"] = np.round(heights, 5).tolist()
         self._apply(world, terrain)
 
     # -- saving ----------------------------------------------------------------------------
-    def save(self, world: Host, raw: dict[str, Any], path: str | os.PathLike[str]) -> Path:
+    def save(self, world: Host, raw: dict[str, object], path: str | os.PathLike[str]) -> Path:
         """Write scene `raw` (the file as it was read) with the edited terrain to `path`,
         validated and atomically, with the files it names beside it when `path` is in
         another folder than the scene's (`ecs_tentacles.scene.save`)."""
@@ -165,12 +172,12 @@ class TerrainEditor:
         return save_scene(scene, path, world.plugins, source_dir=world.scene_dir)
 
     # -- internals -------------------------------------------------------------------------
-    def _terrain(self, world: Host) -> dict[str, Any]:
+    def _terrain(self, world: Host) -> TerrainSpec:
         """A copy of the world's current terrain entry (`{}` on the plane)."""
-        scene = world.scene or {}
-        return copy.deepcopy(scene.get("terrain") or {})
+        found: TerrainSpec | None = (world.scene or {}).get("terrain")
+        return copy.deepcopy(found) if found else {}
 
-    def _apply(self, world: Host, terrain: dict[str, object]) -> None:
+    def _apply(self, world: Host, terrain: TerrainSpec) -> None:
         ground = build_ground(terrain, world.scene_dir)
         _refuse_creatures_inside(world, ground)
         if world.scene is not None:

@@ -18,12 +18,11 @@ from __future__ import annotations
 
 import io
 import pathlib
-from collections.abc import Mapping
-from typing import Any
 
 import numpy as np
 
 from ecs_tentacles.terrain.heightfield import Heightfield
+from ecs_tentacles.terrain.terrain_spec import HeightfieldSpec, NoiseSpec
 from ecs_tentacles.untrusted.files import TooLarge, Unfit, read_regular
 
 Problem = tuple[tuple[str | int, ...], str]
@@ -43,7 +42,7 @@ class TerrainError(ValueError):
         self.path = path
 
 
-def source_problems(field: Mapping[str, Any]) -> list[Problem]:
+def source_problems(field: HeightfieldSpec) -> list[Problem]:
     """What the schema cannot say: exactly one source, a rectangular `heights`."""
     given = [key for key in SOURCES if key in field]
     if len(given) != 1:
@@ -57,7 +56,7 @@ def source_problems(field: Mapping[str, Any]) -> list[Problem]:
     return []
 
 
-def heightfield(field: Mapping[str, Any], folder: pathlib.Path | None) -> Heightfield:
+def heightfield(field: HeightfieldSpec, folder: pathlib.Path | None) -> Heightfield:
     """The heightfield `field` describes (schema-valid, defaults filled in)."""
     for path, message in source_problems(field):
         raise TerrainError(path, message)
@@ -76,9 +75,7 @@ def heightfield(field: Mapping[str, Any], folder: pathlib.Path | None) -> Height
     return Heightfield(size, heights)
 
 
-def noise_heights(
-    noise: Mapping[str, Any], size: tuple[float, float], resolution: int
-) -> np.ndarray:
+def noise_heights(noise: NoiseSpec, size: tuple[float, float], resolution: int) -> np.ndarray:
     """(resolution, resolution) OpenSimplex heights from 0 to 1: octaves of halving size and
     weight, the same for the same seed."""
     import opensimplex

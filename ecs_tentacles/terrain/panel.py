@@ -20,8 +20,8 @@ Reads and writes the terrain through `TerrainEditor`.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 from imgui_bundle import imgui
@@ -135,7 +135,7 @@ class TerrainPanel(Panel):
             amount = self.strength if self.tool != "smooth" else 0.5
             self._try(lambda: editor.brush(world, self.tool, point[:2], self.radius, amount), "")
 
-    def _try(self, action: Any, done: str) -> None:
+    def _try(self, action: Callable[[], object], done: str) -> None:
         try:
             action()
         except (TerrainEditError, SceneError) as error:

@@ -15,7 +15,7 @@ surface: on top of an obstacle, never inside).
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -30,6 +30,7 @@ from ecs_tentacles.terrain.editing import TerrainEditor
 from ecs_tentacles.terrain.heights import source_problems
 from ecs_tentacles.terrain.scene_ground import build_ground
 from ecs_tentacles.terrain.solids import obstacle_problems
+from ecs_tentacles.terrain.terrain_spec import TerrainSpec
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
@@ -47,15 +48,19 @@ class TerrainPlugin(Plugin):
         "ecs_tentacles.terrain", "terrain"
     )
 
-    def problems(self, scene: Mapping[str, Any]) -> list[tuple[tuple[str | int, ...], str]]:
-        terrain = scene.get("terrain") or {}
+    def problems(self, scene: Mapping[str, object]) -> list[tuple[tuple[str | int, ...], str]]:
+        terrain = scene.get("terrain")
+        if not isinstance(terrain, dict):  # (an object, if given: the schema says so)
+            return []
         found = []
         if "heightfield" in terrain:
             found += source_problems(terrain["heightfield"])
         return found + obstacle_problems(terrain.get("obstacles", []))
 
-    def scene_files(self, scene: Mapping[str, Any]) -> list[tuple[tuple[str | int, ...], str]]:
-        terrain = scene.get("terrain") or {}
+    def scene_files(self, scene: Mapping[str, object]) -> list[tuple[tuple[str | int, ...], str]]:
+        terrain = scene.get("terrain")
+        if not isinstance(terrain, dict):
+            return []
         files: list[tuple[tuple[str | int, ...], str]] = []
         field = terrain.get("heightfield") or {}
         if isinstance(field.get("image"), str):
@@ -66,12 +71,14 @@ class TerrainPlugin(Plugin):
         return files
 
     def resources(self, world: Host) -> list[object]:
-        ground = build_ground((world.scene or {}).get("terrain") or {}, world.scene_dir)
+        terrain: TerrainSpec | None = (world.scene or {}).get("terrain")
+        ground = build_ground(terrain or {}, world.scene_dir)
         return [WorldGround(ground), TerrainEditor()]
 
-    def shapes_ground(self, scene: Mapping[str, Any]) -> bool:
+    def shapes_ground(self, scene: Mapping[str, object]) -> bool:
         """A heightfield: its own check (`build_scene`) puts creatures above it."""
-        return bool((scene.get("terrain") or {}).get("heightfield"))
+        terrain = scene.get("terrain")
+        return isinstance(terrain, dict) and bool(terrain.get("heightfield"))
 
     def build(self, app: App) -> None:
         """Its heightfield and solids in every creature's model (`physics.registries`:
@@ -89,12 +96,13 @@ class TerrainPlugin(Plugin):
 
         return [TerrainPanel(sandbox)]
 
-    def build_scene(self, world: Host, scene: Mapping[str, Any]) -> None:
+    def build_scene(self, world: Host, scene: Mapping[str, object]) -> None:
         ground = ground_of(world)
-        if ground.flat:
+        creatures = scene.get("creatures")
+        if ground.flat or not isinstance(creatures, list):  # (a list: the schema says so)
             return
         problems = []
-        for i, creature in enumerate(scene["creatures"]):
+        for i, creature in enumerate(creatures):
             starts, ends, radii = world.layouts.on(as_spec(creature), ground).capsules()
             points = np.concatenate([starts, ends, 0.5 * (starts + ends)])
             balls = np.concatenate([radii, radii, radii])

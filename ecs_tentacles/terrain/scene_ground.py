@@ -6,8 +6,7 @@ missing or bad one is a `SceneError` naming the field.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from typing import Any
+import pathlib
 
 from ecs_tentacles.ground import FLAT, Ground
 from ecs_tentacles.scene.errors import SceneError
@@ -15,9 +14,10 @@ from ecs_tentacles.scene.validate import format_path
 from ecs_tentacles.terrain.ground import TerrainGround
 from ecs_tentacles.terrain.heights import TerrainError, heightfield
 from ecs_tentacles.terrain.solids import solids
+from ecs_tentacles.terrain.terrain_spec import TerrainSpec
 
 
-def build_ground(terrain: Mapping[str, Any], folder: Any) -> Ground:
+def build_ground(terrain: TerrainSpec, folder: pathlib.Path | None) -> Ground:
     """The `Ground` a scene's `terrain` describes (FLAT for `{}`); SceneError names the
     field when a file is missing or bad."""
     if (

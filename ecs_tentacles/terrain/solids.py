@@ -16,8 +16,7 @@ from __future__ import annotations
 
 import dataclasses
 import pathlib
-from collections.abc import Mapping, Sequence
-from typing import Any
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -26,6 +25,7 @@ from ecs_tentacles.terrain.heights import Problem, TerrainError
 from ecs_tentacles.terrain.meshes import MAX_MESH_BYTES, MESH_SUFFIXES, MeshReader
 from ecs_tentacles.terrain.rocks import rock_vertices
 from ecs_tentacles.terrain.shapes import Solid, convex_planes
+from ecs_tentacles.terrain.terrain_spec import ObstacleSpec
 
 __all__ = ["MAX_MESH_BYTES", "MESH_SUFFIXES", "obstacle_problems", "solids"]
 
@@ -39,7 +39,7 @@ NEEDS = {
 OPTIONAL = {"scale", "seed"}  # a mesh's scale (1), a rock's seed (0); the others' are required
 
 
-def obstacle_problems(obstacles: Sequence[Mapping[str, Any]]) -> list[Problem]:
+def obstacle_problems(obstacles: Sequence[ObstacleSpec]) -> list[Problem]:
     """What the schema cannot say: each shape has the keys it needs and no others'."""
     problems: list[Problem] = []
     for i, obstacle in enumerate(obstacles):
@@ -59,7 +59,7 @@ def obstacle_problems(obstacles: Sequence[Mapping[str, Any]]) -> list[Problem]:
 
 
 def solids(
-    obstacles: Sequence[Mapping[str, object]],
+    obstacles: Sequence[ObstacleSpec],
     folder: pathlib.Path | None,
     field: Heightfield | None = None,
 ) -> tuple[Solid, ...]:
@@ -86,7 +86,7 @@ def solids(
 
 def _solid(
     index: int,
-    obstacle: Mapping[str, Any],
+    obstacle: ObstacleSpec,
     reader: MeshReader,
     known: dict[int, tuple[np.ndarray, ...]],
 ) -> Solid:

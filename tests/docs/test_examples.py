@@ -5,10 +5,13 @@ Read with sybil. A page's blocks run in order in a scratch folder of its own (wh
 blocks parse (a fragment as the inside of an object) and a whole scene validates; TOML
 blocks parse (packaging snippets: an entry-point group named is the one plugins are
 found in); shell
-blocks run each `ecs-tentacles` command in-process and expect exit 0. A block preceded by
-`<!-- not run: why -->` is not run (the built page shows why); a block preceded by
+blocks run each `ecs-tentacles` command in-process and expect exit 0. A shell block
+preceded by `<!-- parsed, not run: why -->` is checked without running (tests/docs/parsed.py:
+each command parsed by its own parser, the scenes and files it reads found); one preceded
+by `<!-- not run: why -->` is not run at all (the built page shows why); a block preceded by
 `<!-- file: NAME -->` (or the tutorial's `<!-- tutorial: NAME -->`) is also written to the
-scratch folder as NAME, for the commands after it. `text` blocks are output, not code.
+scratch folder as NAME (its folder made), for the commands after it. `text` blocks are
+output, not code.
 The tutorial's commands (`<!-- tutorial: commands -->`, which open the sandbox) are run by
 tests/test_tutorial.py, the sandbox headless.
 """
@@ -30,11 +33,13 @@ from sybil.parsers.markdown import CodeBlockParser
 
 from ecs_tentacles.cli import main
 from ecs_tentacles.scene.plugins import ENTRY_POINTS
+from tests.docs.parsed import OTHER_COMMANDS, chained, check_block, kind
 
 ROOT = Path(__file__).resolve().parents[2]
 PAGES = sorted((ROOT / "docs").rglob("*.md")) + [ROOT / "README.md"]
 LANGUAGES = ("python", "json", "sh", "toml")  # run; `text` is output shown, not run
 NOT_RUN = re.compile(r"<!-- not run: .+ -->|<!-- tutorial: commands -->")
+PARSED = re.compile(r"<!-- parsed, not run: .+ -->")
 FILE = re.compile(r"<!-- (?:file|tutorial): (\S+\.\w+) -->")
 FENCE = re.compile(r"^ *```(\w*)$", flags=re.M)
 
@@ -55,9 +60,12 @@ def keep_file(example: Example) -> bool:
     line = marker(example)
     if NOT_RUN.fullmatch(line):
         return False
+    assert not PARSED.fullmatch(line), f"{example.path}:{example.line}: only shell is parsed"
     named = FILE.fullmatch(line)
     if named:
-        (scratch(example) / named.group(1)).write_text(str(example.parsed))
+        path = scratch(example) / named.group(1)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(str(example.parsed))
     return True
 
 
@@ -97,12 +105,17 @@ def commands(text: str) -> list[list[str]]:
 
 
 def run_sh(example: Example) -> None:
+    where = f"{example.path}:{example.line}"
+    if PARSED.fullmatch(marker(example)):
+        made: set[str] = example.namespace.setdefault("__made__", set())
+        check_block(commands(str(example.parsed)), scratch(example), made, where)
+        return
     if not keep_file(example):
         return
     for argv in commands(str(example.parsed)):
         assert argv[0] == "ecs-tentacles", (
-            f"{example.path}:{example.line}: `{shlex.join(argv)}` is not an ecs-tentacles"
-            " command: mark the block `<!-- not run: why -->`"
+            f"{where}: `{shlex.join(argv)}` is not an ecs-tentacles command: mark the"
+            " block `<!-- parsed, not run: why -->`"
         )
         with contextlib.chdir(scratch(example)):
             expanded = [found for arg in argv[1:] for found in (sorted(glob.glob(arg)) or [arg])]
@@ -156,3 +169,16 @@ def test_the_page_s_code_runs(page: Path, tmp_path: Path, monkeypatch: pytest.Mo
             close: Any = getattr(value, "close", None)
             if type(value).__name__ == "World" and callable(close):
                 close()
+
+
+def test_each_kind_of_command_left_unchecked_is_one_the_docs_show() -> None:
+    """The kinds of command parsed blocks hold that are not this project's (pip, Ray,
+    Blender, ...) are named in tests/docs/parsed.py, each with what checks it instead, and
+    that list names no kind the docs no longer show."""
+    shown = set()
+    for page in PAGES:
+        for example in SYBIL.parse(page):
+            if example.region.evaluator is run_sh and PARSED.fullmatch(marker(example)):
+                lines = commands(str(example.parsed))
+                shown |= {kind(command) for argv in lines for command in chained(argv)}
+    assert shown - {None} == set(OTHER_COMMANDS)
