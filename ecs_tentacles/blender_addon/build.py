@@ -25,7 +25,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 from fractions import Fraction
 from pathlib import Path
-from typing import Any
 
 import bpy
 import numpy as np
@@ -39,7 +38,7 @@ KIND_NAMES = ("idle", "crawl")
 GAP = 0.01  # a replayed stretch's strip ends this much (frames) before the next frame
 
 
-def import_take(context: object, path: str | Path, report: Report) -> str:
+def import_take(context: bpy.types.Context, path: str | Path, report: Report) -> str:
     """Import the take at `path` into `context.scene` (see the module); returns a line
     saying what was made. Raises `TakeFileError` (one line) for a file that is not a
     sound take, having made nothing."""
@@ -59,7 +58,7 @@ def import_take(context: object, path: str | Path, report: Report) -> str:
 _KINDS = ("objects", "meshes", "armatures", "materials", "actions", "collections")
 
 
-def _import(context: Any, take: TakeFile, report: Report) -> str:
+def _import(context: bpy.types.Context, take: TakeFile, report: Report) -> str:
     frames, count = take.frames, len(take.creatures)
     report(0.0, f"{take.path.name}: {count} creatures, {frames} frames")
     ground.meshes(take.header)  # checked before anything is made
@@ -68,7 +67,7 @@ def _import(context: Any, take: TakeFile, report: Report) -> str:
     plans = plans_of(take)
     collection = bpy.data.collections.new(take.path.stem)
     context.scene.collection.children.link(collection)
-    rigs: dict[Plan, tuple[Any, Any]] = {}
+    rigs: dict[Plan, tuple[bpy.types.Armature, bpy.types.Mesh]] = {}
     offsets: dict[Plan, np.ndarray] = {}
     groups = []
     for p, (plan, members) in enumerate(plans.items()):
@@ -121,9 +120,9 @@ class _Made:
 
 def _clip_actions(
     take: TakeFile, plans: dict[Plan, list[int]], offsets: dict[Plan, np.ndarray], kind: np.ndarray
-) -> dict[tuple[int, int], Any]:
+) -> dict[tuple[int, int], bpy.types.Action]:
     """One cyclic action per clip and kind some creature replays: (clip, kind) -> action."""
-    actions: dict[tuple[int, int], Any] = {}
+    actions: dict[tuple[int, int], bpy.types.Action] = {}
     plan_of = {c: plan for plan, members in plans.items() for c in members}
     for i, clip in enumerate(take.clips):
         users = np.flatnonzero(take.replayed == i)
@@ -149,7 +148,7 @@ def _clip_actions(
     return actions
 
 
-def _pose_action(skeleton: Any, name: str, group: Group, i: int) -> int:
+def _pose_action(skeleton: bpy.types.Object, name: str, group: Group, i: int) -> int:
     """`<name>_pose`: the creature's own bone keys at the frames it is simulated, in a
     `physical` NLA track (under the clips'). Returns the keys written."""
     keyed, rotation, location = group.keys(i)
@@ -165,11 +164,11 @@ def _pose_action(skeleton: Any, name: str, group: Group, i: int) -> int:
 
 def _clip_strips(
     take: TakeFile,
-    skeleton: Any,
+    skeleton: bpy.types.Object,
     c: int,
     kind: np.ndarray,
     phase: np.ndarray,
-    clips: dict[tuple[int, int], Any],
+    clips: dict[tuple[int, int], bpy.types.Action],
 ) -> int:
     """Creature `c`'s `clips` track: a strip of the shared action per replayed stretch."""
     index = int(take.replayed[c])
@@ -188,7 +187,7 @@ def _clip_strips(
     return len(stretches)
 
 
-def _root_action(skeleton: Any, name: str, root: np.ndarray) -> int:
+def _root_action(skeleton: bpy.types.Object, name: str, root: np.ndarray) -> int:
     """The armature object's action `<name>_root`: its ground frame at every frame
     (location x, y; rotation about z). Returns the keys written."""
     frames = np.arange(len(root), dtype=np.float64)
@@ -202,7 +201,7 @@ def _root_action(skeleton: Any, name: str, root: np.ndarray) -> int:
     return 3 * len(frames)
 
 
-def _visibility(skin: Any, name: str, shown: np.ndarray) -> int:
+def _visibility(skin: bpy.types.Object, name: str, shown: np.ndarray) -> int:
     """`<name>_shown`: the skin hidden (viewport and render) while the creature is not
     in the take (keys where it comes and goes). Returns the keys written."""
     changes = np.flatnonzero(np.diff(shown.astype(np.int8))) + 1
@@ -217,7 +216,7 @@ def _visibility(skin: Any, name: str, shown: np.ndarray) -> int:
     return 2 * len(at)
 
 
-def _set_rate(scene: Any, fps: float) -> None:
+def _set_rate(scene: bpy.types.Scene, fps: float) -> None:
     """`scene.render.fps` / `fps_base` for `fps` (integer rates exactly)."""
     ratio = Fraction(fps).limit_denominator(1001)
     scene.render.fps = ratio.numerator

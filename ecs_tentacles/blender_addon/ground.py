@@ -14,11 +14,16 @@ from __future__ import annotations
 import math
 import re
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .header import TakeFileError
+
+if TYPE_CHECKING:
+    import bpy
+
+    from .reader import TakeFile
 
 MAX_MESHES = 8
 MAX_VERTICES = 1025 * 1025 * 4
@@ -70,7 +75,7 @@ def meshes(header: dict[str, object]) -> list[GroundMesh]:
     return out
 
 
-def make(take: Any, collection: Any) -> int:
+def make(take: TakeFile, collection: bpy.types.Collection) -> int:
     """The take's ground meshes in `collection` under their empty (see the module);
     returns how many. `take` is an open `reader.TakeFile`."""
     import bpy

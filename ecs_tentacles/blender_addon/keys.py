@@ -8,8 +8,6 @@ one slot, one layer, one keyframe strip, its channelbag holding the curves.
 
 from __future__ import annotations
 
-from typing import Any
-
 import bpy
 import numpy as np
 
@@ -17,7 +15,9 @@ import numpy as np
 CONSTANT, LINEAR = 0, 1
 
 
-def new_action(name: str) -> tuple[Any, Any, Any]:
+def new_action(
+    name: str,
+) -> tuple[bpy.types.Action, bpy.types.ActionSlot, bpy.types.ActionChannelbag]:
     """A new action for objects: (action, its slot, the channelbag for the slot's curves)."""
     action = bpy.data.actions.new(name)
     slot = action.slots.new(id_type="OBJECT", name=name)
@@ -26,14 +26,14 @@ def new_action(name: str) -> tuple[Any, Any, Any]:
 
 
 def curve(
-    channels: Any,
+    channels: bpy.types.ActionChannelbag,
     path: str,
     index: int,
     frames: np.ndarray,
     values: np.ndarray,
     group: str = "",
     interpolation: int = LINEAR,
-) -> Any:
+) -> bpy.types.FCurve:
     """An F-curve of `channels` (a channelbag) for `path[index]` with a key at each of
     `frames` of `values`; handles a third of the way to the neighbouring keys (what an
     animator who turns a key to Bezier expects)."""
@@ -54,7 +54,7 @@ def curve(
 
 
 def bone_curves(
-    channels: object,
+    channels: bpy.types.ActionChannelbag,
     names: list[str],
     frames: np.ndarray,
     rotation: np.ndarray,
@@ -79,8 +79,8 @@ def bone_curves(
     return len(made) * len(frames)
 
 
-def strip(track: Any, name: str, action: Any, first: float, span: tuple[float, float],
-          rate: float, hold: bool) -> Any:  # fmt: skip
+def strip(track: bpy.types.NlaTrack, name: str, action: bpy.types.Action, first: float,
+          span: tuple[float, float], rate: float, hold: bool) -> bpy.types.NlaStrip:  # fmt: skip
     """An NLA strip on `track` playing `action` frames `span` from take frame `first` at
     `rate` action frames a take frame; `hold`: it holds its last pose until the next
     strip (else nothing after its end: the track below shows)."""

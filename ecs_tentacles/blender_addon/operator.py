@@ -9,7 +9,6 @@ made.
 from __future__ import annotations
 
 import time
-from typing import Any
 
 import bpy
 from bpy.props import StringProperty
@@ -25,7 +24,7 @@ class Progress:
     """Reports an import's progress: the window manager's bar, and a line on stdout per
     tenth (with the seconds since the start)."""
 
-    def __init__(self, context: Any) -> None:
+    def __init__(self, context: bpy.types.Context) -> None:
         self.manager = context.window_manager
         self.manager.progress_begin(0, 100)
         self.start = time.monotonic()
@@ -54,7 +53,7 @@ class ImportTake(bpy.types.Operator, ImportHelper):  # type: ignore[misc, unused
     filename_ext = ".npz"
     filter_glob: StringProperty(default="*.npz", options={"HIDDEN"})  # type: ignore[valid-type]
 
-    def execute(self, context: object) -> set[str]:
+    def execute(self, context: bpy.types.Context) -> set[str]:
         progress = Progress(context)
         try:
             made = import_take(context, self.filepath, progress)
@@ -67,7 +66,7 @@ class ImportTake(bpy.types.Operator, ImportHelper):  # type: ignore[misc, unused
         return {"FINISHED"}
 
 
-def menu(self: Any, context: Any) -> None:
+def menu(self: bpy.types.Menu, context: bpy.types.Context) -> None:
     self.layout.operator(ImportTake.bl_idname, text="ecs_tentacles take (.npz)")
 
 

@@ -30,7 +30,7 @@ import math
 import stat
 import zipfile
 import zlib
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import IO, Any, cast
 
@@ -47,7 +47,9 @@ MAX_COORDINATE = 1e6  # metres: farther out is a blow-up, not a creature
 FLOATS = (np.dtype("<f4"),)
 # arrays with a frames axis: name -> (dtypes accepted, the shape after the frames axis
 # as a function of (bodies, creatures))
-PER_FRAME: dict[str, tuple[tuple[np.dtype[np.generic], ...], Any]] = {
+PER_FRAME: dict[
+    str, tuple[tuple[np.dtype[np.generic], ...], Callable[[int, int], tuple[int, ...]]]
+] = {
     "pos": (FLOATS, lambda b, c: (b, 3)),
     "quat": (FLOATS, lambda b, c: (b, 4)),
     "creature_visible": ((np.dtype("|b1"),), lambda b, c: (c,)),

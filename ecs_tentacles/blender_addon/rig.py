@@ -12,7 +12,6 @@ it, deformed by it), and a material of the creature's sandbox colour
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 import bpy
 import numpy as np
@@ -52,7 +51,9 @@ class _Rest:
     bind: np.ndarray
 
 
-def plan_armature(name: str, plan: Plan, collection: Any) -> tuple[Any, np.ndarray]:
+def plan_armature(
+    name: str, plan: Plan, collection: bpy.types.Collection
+) -> tuple[bpy.types.Armature, np.ndarray]:
     """The plan's Armature datablock (bones in the construction pose; made through a
     temporary object in edit mode) and each bone's rest rotation offset from its joint
     (`motion.rest_offsets`)."""
@@ -81,7 +82,7 @@ def plan_armature(name: str, plan: Plan, collection: Any) -> tuple[Any, np.ndarr
     return armature, rest_offsets(plan, rotations)
 
 
-def plan_mesh(name: str, plan: Plan) -> Any:
+def plan_mesh(name: str, plan: Plan) -> bpy.types.Mesh:
     """The plan's skinned Mesh datablock in the armature's frame: the exporters' mesh
     (`ecs_tentacles.skin.mesh.creature_mesh`), smooth, with UVs and a vertex group per
     bone; one material slot (each creature's object fills it)."""
@@ -122,7 +123,7 @@ def plan_mesh(name: str, plan: Plan) -> Any:
     return mesh
 
 
-def material(name: str, header: dict[str, object], index: int) -> Any:
+def material(name: str, header: dict[str, object], index: int) -> bpy.types.Material:
     """Creature `index`'s material: its sandbox colour (the natural palette, as the
     exporters choose it) as the base colour (linear) and the viewport colour."""
     colours = module("skin_colours")
@@ -140,8 +141,12 @@ def material(name: str, header: dict[str, object], index: int) -> Any:
 
 
 def creature_objects(
-    name: str, armature: Any, mesh: Any, made_material: Any, collection: Any
-) -> tuple[Any, Any]:
+    name: str,
+    armature: bpy.types.Armature,
+    mesh: bpy.types.Mesh,
+    made_material: bpy.types.Material,
+    collection: bpy.types.Collection,
+) -> tuple[bpy.types.Object, bpy.types.Object]:
     """Creature `name`'s armature object (`<name>_skeleton`, on the shared armature) and
     skinned mesh object (`<name>_skin`, on the shared mesh, its child, deformed by it,
     its material linked to the object)."""

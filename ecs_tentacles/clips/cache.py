@@ -21,7 +21,7 @@ recording is kept there (`ecs_tentacles.clips.disk`: checked as it is read).
 from __future__ import annotations
 
 import json
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, TypedDict, Unpack
 
 from ecs_tentacles.clips import disk
 from ecs_tentacles.clips.clips import GaitClips
@@ -38,12 +38,20 @@ if TYPE_CHECKING:
     from ecs_tentacles.host import Host
 
 
+class RecordOptions(TypedDict, total=False):
+    """`GaitClips.record`'s keywords."""
+
+    warmup: float  # s
+    seconds: float  # s
+    loop: tuple[float, float]  # s
+
+
 class ClipCache:
     """Clips by morphology key; `record_options` go to `GaitClips.record`. With `disk`,
     recordings are also kept between runs (`ecs_tentacles.clips.disk`) and read back
     (checked) instead of recorded again."""
 
-    def __init__(self, *, disk: bool = False, **record_options: Any):
+    def __init__(self, *, disk: bool = False, **record_options: Unpack[RecordOptions]):
         self.record_options = record_options
         self.disk = disk
         self.clips: dict[tuple[object, ...], GaitClips] = {}
@@ -56,7 +64,7 @@ class ClipCache:
     def __len__(self) -> int:
         return len(self.clips)
 
-    def get(self, creature: dict[str, Any], physics: PhysicsSpec | None = None) -> GaitClips:
+    def get(self, creature: dict[str, object], physics: PhysicsSpec | None = None) -> GaitClips:
         """The clips of the morphology of `creature` (a scene creature entry, defaults
         filled in as `load_scene` leaves them), recorded on first use."""
         layout = _morphology(creature, physics)
@@ -98,12 +106,11 @@ class ClipCache:
         return clips
 
 
-def recording_input(creature: dict[str, Any], physics: PhysicsSpec | None = None) -> str:
+def recording_input(creature: dict[str, object], physics: PhysicsSpec | None = None) -> str:
     """What a recording of `creature` is made from (its entry staged alone at the origin,
     without its name), as canonical JSON: equal strings record equal clips."""
-    scene = one_creature_scene(creature, physics)
-    scene["creatures"][0].pop("name", None)
-    return json.dumps(scene, sort_keys=True, default=str)
+    unnamed = {key: value for key, value in creature.items() if key != "name"}
+    return json.dumps(one_creature_scene(unnamed, physics), sort_keys=True, default=str)
 
 
 def morphology_key(
@@ -113,7 +120,7 @@ def morphology_key(
     return _morphology(creature, physics).key
 
 
-def _morphology(creature: dict[str, Any], physics: PhysicsSpec | None) -> ModelLayout:
+def _morphology(creature: dict[str, object], physics: PhysicsSpec | None) -> ModelLayout:
     """The model layout of a scene creature entry (alone in a world), compiling nothing."""
     world = World(_settings(physics), name="clip-key")
     try:

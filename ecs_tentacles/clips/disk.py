@@ -35,6 +35,7 @@ from __future__ import annotations
 import hashlib
 import pathlib
 import struct
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import mujoco
@@ -94,7 +95,7 @@ def _sources() -> str:
     return _SOURCES
 
 
-def entry_key(recording: str, options: dict[str, object]) -> str:
+def entry_key(recording: str, options: Mapping[str, object]) -> str:
     """The key of the clips recorded from `recording` (`cache.recording_input`) with
     `options` (`GaitClips.record`'s keywords) by this code and these libraries."""
     parts = [

@@ -17,7 +17,6 @@ from __future__ import annotations
 import copy
 import time
 from dataclasses import dataclass
-from typing import Any
 
 import mujoco
 import numpy as np
@@ -50,7 +49,7 @@ class GaitRecording:
 
 def one_creature_scene(
     creature: dict[str, object], physics: PhysicsSpec | None = None, goal: float | None = None
-) -> dict[str, Any]:
+) -> dict[str, object]:
     """A scene of `creature` alone at the origin, heading 0, its goal `goal` m ahead (None: idle).
 
     `physics` is the scene's `physics` object (None: the defaults). Plugins come from
@@ -65,7 +64,7 @@ def one_creature_scene(
     return scene
 
 
-def simulate(scene: dict[str, Any], warmup: float, seconds: float) -> GaitRecording:
+def simulate(scene: dict[str, object], warmup: float, seconds: float) -> GaitRecording:
     """Build `scene` (one creature), step `warmup` s, then keep `seconds` s frame by frame."""
     start = time.perf_counter()
     world = World.from_scene(scene, threads=1, lod=False)  # full physics, whatever the scene says

@@ -12,7 +12,7 @@ the replay's state.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.system import System
@@ -32,7 +32,7 @@ class ClipsPlugin(Plugin):
 
         return [LodReplay()]
 
-    def take_sizes(self, scene: Mapping[str, Any]) -> list[TrackSize]:
+    def take_sizes(self, scene: Mapping[str, object]) -> list[TrackSize]:
         """A take of a scene on flat ground records each creature's replay (kind, phase,
         place, heading: 33 bytes a frame; `ecs_tentacles.take.replay`), and each body
         plan's clips once (not counted: known only when recorded)."""
@@ -40,14 +40,15 @@ class ClipsPlugin(Plugin):
 
         if scene.get("terrain") is not None:
             return []
-        count = len(scene.get("creatures", []))
+        creatures = scene.get("creatures")
+        count = len(creatures) if isinstance(creatures, list) else 0
         return [TrackSize("replay records", count, 33, chunked=True)] if count else []
 
     def snapshot(self, world: Host) -> object:
         replay = world.physics.lod.replay
         return None if replay is None else replay.state()  # type: ignore[attr-defined]
 
-    def restore(self, world: Host, state: Any) -> None:
+    def restore(self, world: Host, state: object) -> None:
         replay = world.physics.lod.replay
         if replay is not None and state is not None:
             replay.set_state(state)  # type: ignore[attr-defined]

@@ -37,7 +37,7 @@ from __future__ import annotations
 import json
 import math
 import os
-from typing import Any
+from typing import Any, TypedDict
 
 import numpy as np
 
@@ -57,6 +57,15 @@ GROOM_COUNT = (16, 48)  # guides per furry creature: a look, not a hero groom
 REFERENCE_WEIGHT_LENGTH = 0.025**2 * 0.7**2
 
 
+class BodyPlan(TypedDict):
+    """One species' body: its mantle and tentacles (creature entry keys), and the own
+    shape of a few of its tentacles, by index."""
+
+    mantle: dict[str, float]
+    tentacles: dict[str, float]  # `count` and `links` whole
+    shape_overrides: dict[int, dict[str, float]]
+
+
 def max_creatures() -> int:
     """The most creatures a scene holds (the schema's `creatures.maxItems`)."""
     return int(core_schema()["properties"]["creatures"]["maxItems"])
@@ -73,12 +82,12 @@ def _strength_factor(links: int, link_length: float, link_radius: float) -> floa
     return float(np.clip(weight_length / REFERENCE_WEIGHT_LENGTH, 0.6, 2.5))
 
 
-def _body_plan(rng: np.random.Generator, count: int) -> dict[str, Any]:
+def _body_plan(rng: np.random.Generator, count: int) -> BodyPlan:
     """Mantle and tentacle shape of one species with `count` tentacles."""
     links = int(rng.integers(7, 12))
     link_length = rng.uniform(0.055, 0.085)
     link_radius = rng.uniform(0.019, 0.029)
-    overrides: dict[int, dict[str, object]] = {}
+    overrides: dict[int, dict[str, float]] = {}
     for index in rng.choice(count, size=int(rng.integers(1, 3)), replace=False):
         own_links = int(np.clip(links + rng.integers(-2, 3), 5, 13))
         own_length = _r(link_length * rng.uniform(0.85, 1.15))
@@ -109,7 +118,7 @@ def _body_plan(rng: np.random.Generator, count: int) -> dict[str, Any]:
     }
 
 
-def _octopus() -> dict[str, Any]:
+def _octopus() -> BodyPlan:
     """The schema's default creature (8 x 10 links) as a body plan."""
     mantle = {key: default("mantle", key) for key in ("radius", "height", "density")}
     keys = ("count", "links", "link_length", "link_radius", "end_scale", "strength", "max_torque")
@@ -117,20 +126,20 @@ def _octopus() -> dict[str, Any]:
     return {"mantle": mantle, "tentacles": tentacles, "shape_overrides": {}}
 
 
-def _species(rng: np.random.Generator, species: int) -> list[dict[str, Any]]:
+def _species(rng: np.random.Generator, species: int) -> list[BodyPlan]:
     counts = [8 - k if k < 6 else int(rng.integers(3, 9)) for k in range(species)]
     return [_body_plan(rng, count) for count in counts]
 
 
-def _creature(rng: np.random.Generator, name: str, plan: dict[str, Any]) -> dict[str, Any]:
+def _creature(rng: np.random.Generator, name: str, plan: BodyPlan) -> dict[str, object]:
     """One creature of body plan `plan`, with its own behaviour and maybe fur."""
-    count = plan["tentacles"]["count"]
+    count = int(plan["tentacles"]["count"])
     overrides = {k: dict(v) for k, v in plan["shape_overrides"].items()}
     for index in rng.choice(count, size=int(rng.integers(0, 3)), replace=False):
         overrides.setdefault(int(index), {}).update(
             speed=_r(rng.uniform(0.8, 1.25)), wave_frequency=_r(rng.uniform(0.4, 0.9))
         )
-    tentacles = dict(plan["tentacles"])
+    tentacles: dict[str, object] = {**plan["tentacles"]}
     tentacles.update(
         wave_amplitude_deg=_r(rng.uniform(3.0, 9.0)),
         wave_frequency=_r(rng.uniform(0.4, 0.8)),
@@ -159,7 +168,7 @@ def _creature(rng: np.random.Generator, name: str, plan: dict[str, Any]) -> dict
     return creature
 
 
-def species_creatures(count: int = DEFAULT_SPECIES, seed: int = 0) -> list[dict[str, Any]]:
+def species_creatures(count: int = DEFAULT_SPECIES, seed: int = 0) -> list[dict[str, object]]:
     """One creature of each of the generator's first `count` species (the bodies a crowd
     mixes), named `species1` ..., at the origin: the director's palette lists them."""
     plans = _species(np.random.default_rng(seed), count)
@@ -169,7 +178,7 @@ def species_creatures(count: int = DEFAULT_SPECIES, seed: int = 0) -> list[dict[
     ]
 
 
-def _plan_reach(plan: dict[str, Any]) -> float:
+def _plan_reach(plan: BodyPlan) -> float:
     """`creature_reach` of every creature of `plan`: their own overrides keep its shape."""
     overrides = [{"index": k, **shape} for k, shape in plan["shape_overrides"].items()]
     tentacles = {**plan["tentacles"], "overrides": overrides}
@@ -255,9 +264,11 @@ def write_crowd_scene(scene: dict[str, object], path: str | os.PathLike[str]) ->
         temporary.write_text(json.dumps(scene, indent=1) + "\n", encoding="utf-8")
 
 
-def _rest(creature: dict[str, Any]) -> None:
+def _rest(creature: dict[str, object]) -> None:
     """No goal, and tentacles that lie still: no travelling waves, no writhing."""
     tentacles = creature.setdefault("tentacles", {})
+    if not isinstance(tentacles, dict):
+        raise TypeError(f"{creature.get('name')}: tentacles is an object, not {tentacles!r}")
     for part in (tentacles, *tentacles.get("overrides", [])):
         for key in ("wave_amplitude_deg", "writhe"):
             if key in part or part is tentacles:

@@ -15,7 +15,7 @@ from __future__ import annotations
 import os
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pyglet
@@ -27,6 +27,10 @@ from ecs_tentacles.creator.limits import Setting, editor_setting
 from ecs_tentacles.render.hud import TEXT
 from ecs_tentacles.render.output import save_png
 from ecs_tentacles.render.renderer import Renderer
+
+if TYPE_CHECKING:
+    from pyglet.customtypes import AnchorX
+    from pyglet.image import AbstractImage
 
 SELECTED = (1.0, 0.85, 0.2, 1.0)
 ROW = 30
@@ -49,7 +53,7 @@ PER_TENTACLE = tuple(
 )
 
 
-def _image(width: int, height: int, colour: tuple[int, int, int, int]) -> Any:
+def _image(width: int, height: int, colour: tuple[int, int, int, int]) -> AbstractImage:
     return pyglet.image.SolidColorImagePattern(colour).create_image(width, height)
 
 
@@ -87,10 +91,13 @@ class Creator:
         self.window.push_handlers(self)
 
     # -- widgets ---------------------------------------------------------------------
-    def _label(self, x: float, y: float, text: str, **kwargs: Any) -> pyglet.text.Label:
+    def _label(
+        self, x: float, y: float, text: str, anchor_x: AnchorX = "left", weight: str = "normal"
+    ) -> pyglet.text.Label:
         label = pyglet.text.Label(
-            text, x=x, y=y, font_size=10, color=TEXT, batch=self.batch, **kwargs
-        )
+            text, x=x, y=y, font_size=10, color=TEXT, batch=self.batch, anchor_x=anchor_x,
+            weight=weight,
+        )  # fmt: skip
         self._keep.append(label)
         return label
 
@@ -111,7 +118,11 @@ class Creator:
         return button
 
     def _slider(
-        self, y: int, setting: Setting, table: dict[str, Any], on_change: Callable[[], None] | None
+        self,
+        y: int,
+        setting: Setting,
+        table: dict[str, tuple[Slider, pyglet.text.Label, Setting]],
+        on_change: Callable[[], None] | None,
     ) -> None:
         """A labelled slider; `on_change` applies it at once (None: wait for a button)."""
         slider = Slider(

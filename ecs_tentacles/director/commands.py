@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import copy
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -28,7 +28,7 @@ from ecs_tentacles.behaviour import placeable
 from ecs_tentacles.components import Creature
 from ecs_tentacles.creatures.roster_save import entry_now
 from ecs_tentacles.creatures.spawning import SpawnError, free_spot, place
-from ecs_tentacles.scene.spec import as_spec
+from ecs_tentacles.scene.spec import CreatureSpec, as_spec
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
@@ -49,7 +49,7 @@ def _despawn_named(world: Host, names: list[str]) -> None:
             world.despawn(entity)
 
 
-def _place_all(world: Host, entries: list[dict[str, Any]]) -> None:
+def _place_all(world: Host, entries: list[CreatureSpec]) -> None:
     """Build `entries` again, each where it was or at the nearest free spot; all or none."""
     built: list[int] = []
     try:
@@ -67,11 +67,11 @@ def _place_all(world: Host, entries: list[dict[str, Any]]) -> None:
 @dataclass
 class Spawned:
     label: str
-    entries: list[dict[str, Any]]  # as they were placed (checked, names unique)
+    entries: list[CreatureSpec]  # as they were placed (checked, names unique)
 
     @classmethod
     def of(cls, world: Host, label: str, entities: list[int]) -> Spawned:
-        return cls(label, [copy.deepcopy(dict(world.creature_specs[e])) for e in entities])
+        return cls(label, [copy.deepcopy(world.creature_specs[e]) for e in entities])
 
     def undo(self, world: Host) -> None:
         _despawn_named(world, [e["name"] for e in self.entries])
@@ -83,12 +83,12 @@ class Spawned:
 @dataclass
 class Despawned:
     label: str
-    entries: list[dict[str, Any]] = field(default_factory=list)  # as they were when removed
+    entries: list[CreatureSpec] = field(default_factory=list)  # as they were when removed
 
     @classmethod
     def remove(cls, world: Host, label: str, entities: list[int]) -> Despawned:
         """Despawn `entities`, keeping what undo needs to build them again."""
-        made = cls(label, [entry_now(world, e) for e in entities])
+        made = cls(label, [as_spec(entry_now(world, e)) for e in entities])
         for entity in entities:
             world.despawn(entity)
         return made

@@ -23,7 +23,6 @@ import logging
 import os
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 from ecs_tentacles.scene.load import bundled_scene, bundled_scene_names, read_scene_json
 
@@ -43,13 +42,18 @@ class Preset:
 
     label: str
     source: str
-    entry: dict[str, Any]
+    entry: dict[str, object]
 
     @property
     def is_threat(self) -> bool:
         return "threat" in self.entry and "tentacles" not in self.entry
 
-    def creature(self) -> dict[str, Any]:
+    @property
+    def threat(self) -> str:
+        """The name a threat preset drops its threat by."""
+        return str(self.entry["threat"])
+
+    def creature(self) -> dict[str, object]:
         """A fresh copy of the creature entry (no position, goals or heading of its scene)."""
         entry = copy.deepcopy(self.entry)
         for key in ("position", "goals", "heading_deg"):

@@ -19,7 +19,7 @@ the `Director` resource.
 from __future__ import annotations
 
 import logging
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 from imgui_bundle import imgui
@@ -38,6 +38,7 @@ from ecs_tentacles.render.registries import Panel, SandboxView
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
+    from ecs_tentacles.render.undo import Edit
     from ecs_tentacles.world import World
 
 log = logging.getLogger("ecs_tentacles.director")
@@ -193,8 +194,8 @@ class DirectorPanel(Panel):
                 self.message = "threats are off in this scene"
                 return None
             point = [float(v) for v in ground]
-            entity = source.drop(world, point, preset.entry["threat"])
-            name = source.placed(world)[entity] if source.placed else preset.entry["threat"]
+            entity = source.drop(world, point, preset.threat)
+            name = source.placed(world)[entity] if source.placed else preset.threat
             self._push(ThreatDropped(f"drop {name}", name, point))
             self.message = f"dropped {name}"
             return entity
@@ -257,7 +258,7 @@ class DirectorPanel(Panel):
             self._push(Moved(f"move {name}", name, self.grab_start, view.data.qpos.copy()))
         self.grab_start = None
 
-    def _push(self, edit: Any) -> None:
+    def _push(self, edit: Edit) -> None:
         undo = getattr(self.sandbox, "undo", None)
         if undo is not None:
             undo.push(edit)

@@ -11,7 +11,7 @@ removing the held creature ends the grab.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -70,7 +70,7 @@ class DirectorPlugin(Plugin):
         wanted[world.component(grab.creature, Creature).row] = True
         return wanted
 
-    def _lines(self, world: Host, view: RenderView) -> list[Any]:
+    def _lines(self, world: Host, view: RenderView) -> list[np.ndarray]:
         director = world.resource(Director)
         lines = []
         grab = director.grab

@@ -23,6 +23,7 @@ or does not read, is baked again with one line naming it and why. Without the ke
 from __future__ import annotations
 
 import contextlib
+import functools
 import logging
 import os
 import shutil
@@ -33,6 +34,7 @@ import threading
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from types import FrameType
 from typing import Any
 
 import numpy as np
@@ -113,19 +115,20 @@ def start_ray(address: str | None, cpus: int | None) -> bool:
     return True
 
 
-def _init(address: str | None, cpus: int | None, ours: dict[int, Any]) -> None:
+def _init(address: str | None, cpus: int | None, ours: dict[int, _Handler]) -> None:
     """`ray.init`, quiet; a local Ray gets its watchdog; our signal handlers back."""
     import ray
 
     global _REAPER
-    options: dict[str, Any] = {"include_dashboard": False, "log_to_driver": False}
-    options["logging_level"] = logging.ERROR
+    quiet = functools.partial(
+        ray.init, include_dashboard=False, log_to_driver=False, logging_level=logging.ERROR
+    )
     try:
         with _empty_working_folder():
             if address:
-                ray.init(address=address, **options)
+                quiet(address)
             else:
-                ray.init(num_cpus=cpus, **options)
+                quiet(num_cpus=cpus)
                 session = ray.get_runtime_context().get_session_name()
                 _REAPER = Reaper.start(session)  # a local Ray never outlives a killed bake
     finally:
@@ -156,7 +159,7 @@ def _remove_empty_folder() -> None:
         _EMPTY = None
 
 
-def _abandon(before: set[tuple[int, float]], ours: dict[int, Any]) -> None:
+def _abandon(before: set[tuple[int, float]], ours: dict[int, _Handler]) -> None:
     """A Ray start cut short: shut down what `ray.init` made of it, then end every
     process started since `before` that is still there (its node was perhaps not yet
     known to `ray.shutdown`). SIGTERM, SIGINT and SIGHUP are ignored meanwhile (seconds):
@@ -195,11 +198,13 @@ def stop_ray(started: bool) -> None:
     _remove_empty_folder()
 
 
+# what `signal.getsignal` gives for a signal with a handler (`SIG_DFL`, `SIG_IGN` or ours)
+_Handler = Callable[[int, FrameType | None], object] | int | signal.Handlers
 _REAPER: Reaper | None = None
 _EMPTY: str | None = None  # the folder Ray was started from (`_empty_working_folder`)
 
 
-def _signal_handlers() -> dict[int, Any]:
+def _signal_handlers() -> dict[int, _Handler]:
     """This process's SIGTERM, SIGINT and SIGHUP handlers (none off the main thread)."""
     if threading.current_thread() is not threading.main_thread():
         return {}
@@ -209,7 +214,7 @@ def _signal_handlers() -> dict[int, Any]:
 
 def _run_shard(
     plan: BakePlan, members: list[int], key: str, counter: Any, options: WorldOptions
-) -> Any:
+) -> ShardResult:
     """The Ray task: bake one shard, telling `counter` of progress."""
     return bake_shard(plan, members, key, options, on_steps=lambda n: counter.add.remote(n))
 

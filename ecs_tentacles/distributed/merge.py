@@ -18,6 +18,7 @@ import numpy as np
 from ecs_tentacles.take import Take
 from ecs_tentacles.take import ground as take_ground
 from ecs_tentacles.take import replay as take_replay
+from ecs_tentacles.take.header_entries import HeaderHealth, HeaderReplay, HealthEvent, ReplayClip
 from ecs_tentacles.take.tracks import TakeTrack
 
 
@@ -97,11 +98,13 @@ def merge_takes(parts: Sequence[tuple[Sequence[int], Take]]) -> Take:
     return Take.from_arrays(header, merged)
 
 
-def _replay(parts: Sequence[tuple[Sequence[int], Take]], merged: dict[str, Any]) -> dict[str, Any]:
+def _replay(
+    parts: Sequence[tuple[Sequence[int], Take]], merged: dict[str, np.ndarray]
+) -> HeaderReplay:
     """The merged take's replay header, its clips put into `merged`: numbered as a local
     recording numbers them (by the frame each creature first replays, then creature
     order), one per distinct clip."""
-    clip_of: dict[int, tuple[np.ndarray, dict[str, Any]]] = {}
+    clip_of: dict[int, tuple[np.ndarray, ReplayClip]] = {}
     for members, take in parts:
         replay = take.header[take_replay.KEY]
         for c, k in enumerate(replay["creatures"]):
@@ -114,7 +117,7 @@ def _replay(parts: Sequence[tuple[Sequence[int], Take]], merged: dict[str, Any])
     creatures = np.full(kind.shape[1], take_replay.PHYSICAL, dtype=np.int64)
     replayed = (kind >= 0).any(axis=0)
     first = np.where(replayed, np.argmax(kind >= 0, axis=0), kind.shape[0])
-    clips: list[dict[str, Any]] = []
+    clips: list[ReplayClip] = []
     numbers: dict[bytes, int] = {}
     for c in sorted(clip_of, key=lambda c: (int(first[c]), c)):
         pose, meta = clip_of[c]
@@ -180,13 +183,16 @@ def _creatures(table: list[tuple[int, Any]], body_map: _Order) -> list[dict[str,
     return out
 
 
-def _health(parts: Sequence[tuple[Sequence[int], Take]]) -> dict[str, Any]:
+def _health(parts: Sequence[tuple[Sequence[int], Take]]) -> HeaderHealth:
     """Every shard's physics recoveries, renumbered and in the order a local bake logs them
     (by frame, then creature)."""
-    events = []
+    events: list[HealthEvent] = []
     for members, take in parts:
         for event in take.header.get("health", {}).get("events", []):
-            events.append({**event, "creature": int(members[event["creature"]])})
+            events.append(
+                {"frame": event["frame"], "creature": int(members[event["creature"]]),
+                 "event": event["event"], "cause": event["cause"]}
+            )  # fmt: skip
     events.sort(key=lambda e: (e["frame"], e["creature"]))  # stable: recovered before frozen
     return {
         "recoveries": sum(e["event"] == "recovered" for e in events),

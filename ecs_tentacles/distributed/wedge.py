@@ -29,6 +29,7 @@ from typing import Any
 
 from ecs_tentacles.output.atomic import atomic_file
 from ecs_tentacles.scene.errors import SceneError
+from ecs_tentacles.scene.json_types import JsonValue
 from ecs_tentacles.scene.load import load_scene_plugins
 from ecs_tentacles.scene.validate import format_path
 
@@ -91,11 +92,12 @@ def parse_parameter(text: str) -> WedgeAxis:
     return WedgeAxis(tuple(path), tuple(values))
 
 
-def _value(text: str) -> Any:
+def _value(text: str) -> JsonValue:
     try:
-        return json.loads(text)
+        value: JsonValue = json.loads(text)
     except ValueError:
         return text
+    return value
 
 
 def safe(text: str) -> str:

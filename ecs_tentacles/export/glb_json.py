@@ -16,7 +16,6 @@ from __future__ import annotations
 import json
 from collections import Counter
 from collections.abc import Callable
-from typing import Any
 
 from ecs_tentacles import __version__
 
@@ -26,7 +25,7 @@ KIND = "k" * 16  # a locator's kind (`goal`, a plugin's points item), at most
 
 # fmt: off
 # (index, byte count) -> the widest form of an item; "" stands for its name
-TEMPLATES: dict[str, Callable[[int, int], Any]] = {
+TEMPLATES: dict[str, Callable[[int, int], object]] = {
     "view": lambda i, b: {"buffer": 0, "byteLength": b, "byteOffset": b, "target": 34963},
     "vec3": lambda i, b: {"bufferView": i, "componentType": 5126, "count": b, "max": F3,
                           "min": F3, "type": "VEC3"},

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import io
 from types import ModuleType
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -33,6 +33,8 @@ from ecs_tentacles.skin.colours import PALE, creature_colour, look_in_take, to_l
 from ecs_tentacles.take import Take
 
 if TYPE_CHECKING:
+    from pxr import Usd, UsdShade
+
     from ecs_tentacles.export.gltf_types import Material, PbrMetallicRoughness
 
 FOLDER = "materials"  # USD: the scope under /World holding the creatures' materials
@@ -68,8 +70,8 @@ def usd_folder(take: Take) -> str:
 
 
 def usd_material(
-    pxr: ModuleType, stage: Any, folder: str, creature: str, colour: np.ndarray
-) -> Any:
+    pxr: ModuleType, stage: Usd.Stage, folder: str, creature: str, colour: np.ndarray
+) -> UsdShade.Material:
     """`<folder>/<c>_material` (`folder`: `usd_folder(take)`), a UsdPreviewSurface of
     `colour` (display rgb): made once, returned again after."""
     Sdf, UsdShade = pxr.Sdf, pxr.UsdShade

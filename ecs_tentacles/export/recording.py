@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
 import numpy as np
 
 from ecs_tentacles.components import Creature
+from ecs_tentacles.events import Handler
 from ecs_tentacles.export.frame_arrays import doubled, gather, widen
 from ecs_tentacles.export.recording_stream import StreamedFrames
 from ecs_tentacles.export.replay_recording import ReplayRecorder
@@ -29,6 +30,7 @@ from ecs_tentacles.scene.plugins import former_keys
 from ecs_tentacles.take import FORMAT, VERSION, Take, chunks
 from ecs_tentacles.take import ground as take_ground
 from ecs_tentacles.take import roster as take_roster
+from ecs_tentacles.take.header_entries import HealthEvent
 from ecs_tentacles.take.registries import (
     RecordingStarts,
     TakeTracks,
@@ -142,7 +144,7 @@ class TakeRecorder(TakeTables, StreamedFrames):
         self._finished = False  # finish(): the arrays are the take's now
         self.count = 0
         # physics recoveries, marked on the take frame that follows them
-        self._health: list[dict[str, Any]] = []
+        self._health: list[HealthEvent] = []
         world.events.on("creature_recovered", self._on_health("recovered"))
         world.events.on("creature_frozen", self._on_health("frozen"))
 
@@ -167,10 +169,11 @@ class TakeRecorder(TakeTables, StreamedFrames):
             made.append(kind(track, source.sample if source else None, self))
         return made
 
-    def _on_health(self, what: str) -> Any:
-        def handler(*, creature: int, cause: str, **_: Any) -> None:
+    def _on_health(self, what: str) -> Handler:
+        def handler(*, creature: int, cause: str, **_: object) -> None:
             index = self.creature_index[creature]
-            entry = {"frame": self.count, "creature": index, "event": what, "cause": cause}
+            entry: HealthEvent = {"frame": self.count, "creature": index, "event": what,
+                                  "cause": cause}  # fmt: skip
             self._health.append(entry)
 
         return handler

@@ -26,6 +26,8 @@ from ecs_tentacles.take import replay as take_replay
 
 if TYPE_CHECKING:
     from ecs_tentacles.clips.clips import GaitClips
+    from ecs_tentacles.clips.replay import ClipReplay
+    from ecs_tentacles.physics.roster import Roster
     from ecs_tentacles.world import World
 
 ROTATION = 1e-6  # 1 - |q . q'| allowed: about a tenth of a degree
@@ -155,7 +157,7 @@ class ReplayRecorder:
             )  # fmt: skip
         return good
 
-    def _take_of(self, roster: Any, creature_index: dict[int, int]) -> np.ndarray:
+    def _take_of(self, roster: Roster, creature_index: dict[int, int]) -> np.ndarray:
         """Roster index -> take creature index (-1: not in the take), kept until the
         roster changes."""
         if self._roster_size != len(roster):
@@ -167,7 +169,7 @@ class ReplayRecorder:
         return self._take_of_roster
 
     def _assign(
-        self, replay: Any, roster: Any, index: int, creature: int, body_rows: np.ndarray
+        self, replay: ClipReplay, roster: Roster, index: int, creature: int, body_rows: np.ndarray
     ) -> None:
         """Give take creature `creature` (roster `index`) its clip: its morphology's,
         bodies in take order; a clip is stored once per morphology and body order."""

@@ -74,7 +74,7 @@ import importlib
 import os
 from collections.abc import Callable
 from types import ModuleType
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -95,6 +95,10 @@ from ecs_tentacles.skin.keys import KeyReport
 from ecs_tentacles.skin.mesh import Detail
 from ecs_tentacles.skin.rig import Keys
 from ecs_tentacles.take import Take
+from ecs_tentacles.take.header_entries import HeaderBody, HeaderSucker
+
+if TYPE_CHECKING:
+    from pxr import Usd
 
 Progress = Callable[[int], object]
 WORK_BYTES = 32 * 1024**2  # joint rotations (float64) worked on at once: chunks are split
@@ -125,7 +129,7 @@ def build_skinned_stage(
     keys: Keys | None = None,
     locators: bool = False,
     progress: Progress | None = None,
-) -> tuple[Any, KeyReport]:
+) -> tuple[Usd.Stage, KeyReport]:
     """An in-memory `Usd.Stage` with one SkelRoot per creature, and the key report."""
     layer = StreamedLayer(None)
     report = _fill(layer, TakeChunks(take), detail, keys, locators, progress)
@@ -159,7 +163,7 @@ def _fill(
         clips.bind(name, creature, colours[name], folder)
         mark_rate(stage, f"/World/{name}", source.fps, source.frames)
     visibility = Visibility(layer, [f"/World/{name}" for name in names])
-    suckers = Suckers(pxr, layer, header) if locators else None
+    suckers = Suckers(pxr, layer, header["suckers"], header["bodies"]) if locators else None
     tracks = UsdTracks(layer, header, source.static, locators, relative=True)
     write_usd_ground(pxr, stage, still)
     animated = [
@@ -208,16 +212,22 @@ class Suckers:
     """Every sucker as a locator: translate sampled (the sucker point, in its creature's
     root frame), `ecs:attached` keyed."""
 
-    def __init__(self, pxr: ModuleType, layer: StreamedLayer, header: dict[str, Any]) -> None:
+    def __init__(
+        self,
+        pxr: ModuleType,
+        layer: StreamedLayer,
+        suckers: list[HeaderSucker],
+        bodies: list[HeaderBody],
+    ) -> None:
         Gf, Sdf, UsdGeom = pxr.Gf, pxr.Sdf, pxr.UsdGeom
         self.Gf, self.layer = Gf, layer
         stage = layer.stage
-        self.bodies = np.array([s["body"] for s in header["suckers"]], dtype=np.int64)
-        owner = [header["bodies"][body]["creature"] for body in self.bodies.tolist()]
+        self.bodies = np.array([s["body"] for s in suckers], dtype=np.int64)
+        owner = [bodies[body]["creature"] for body in self.bodies.tolist()]
         self.owners = np.array(owner, dtype=np.int64)
-        self.offsets = np.array([s["offset"] for s in header["suckers"]], dtype=np.float64)
+        self.offsets = np.array([s["offset"] for s in suckers], dtype=np.float64)
         self.translates, self.attached = [], []
-        for sucker in header["suckers"]:
+        for sucker in suckers:
             creature, _, rest = sucker["name"].split("/", 2)
             path = f"/World/{unique_path(f'{creature}/suckers/{rest}')}"
             parts = path.split("/")

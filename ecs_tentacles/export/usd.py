@@ -46,7 +46,7 @@ import importlib
 import os
 from collections.abc import Callable
 from types import ModuleType
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -59,6 +59,10 @@ from ecs_tentacles.export.usd_pxr import UsdUnavailable, usd_modules
 from ecs_tentacles.export.usd_tracks import Steps, UsdTracks, Visibility, key_steps
 from ecs_tentacles.output.atomic import atomic_output
 from ecs_tentacles.take import Take
+from ecs_tentacles.take.header_entries import HeaderBody, HeaderSucker
+
+if TYPE_CHECKING:
+    from pxr import Sdf, Usd, UsdShade
 
 __all__ = ["UsdUnavailable", "build_stage", "mark_rate", "set_timing", "static_take", "write_usd"]
 
@@ -90,7 +94,7 @@ def write_usd(
 
 def build_stage(
     take: Take, progress: Callable[[int], object] | None = None, locators: bool = True
-) -> Any:
+) -> Usd.Stage:
     """An in-memory `Usd.Stage` holding the take; `progress(n)` as n frames are done."""
     layer = StreamedLayer(None)
     _fill(layer, TakeChunks(take), progress, locators)
@@ -112,7 +116,7 @@ def _fill(
     stage.SetDefaultPrim(UsdGeom.Xform.Define(stage, "/World").GetPrim())
     still = static_take(source)
     colours, materials = take_colours(still), usd_folder(still)
-    poses: list[tuple[int, Any, Any]] = []  # (body, translate path, orient path)
+    poses: list[tuple[int, Sdf.Path, Sdf.Path]] = []  # (body, translate path, orient path)
     roots = []
     for creature in header["creatures"]:
         name = creature["name"]
@@ -122,11 +126,11 @@ def _fill(
         mark_rate(stage, base, source.fps, source.frames)
         colour = colours[creature["name"]]
         skin = (usd_material(pxr, stage, materials, creature["name"], colour), colour)
-        poses.append(_body(pxr, stage, header, creature["mantle"], skin))
+        poses.append(_body(pxr, stage, header["bodies"], creature["mantle"], skin))
         UsdGeom.Xform.Define(stage, f"/World/{unique_path(creature['name'] + '/tentacles')}")
         for k, chain in enumerate(creature["tentacles"]):
             UsdGeom.Xform.Define(stage, f"/World/{unique_path(f'{name}/tentacles/t{k}')}")
-            poses += [_body(pxr, stage, header, index, skin) for index in chain]
+            poses += [_body(pxr, stage, header["bodies"], index, skin) for index in chain]
     attached = [_sucker(pxr, stage, sucker) for sucker in header["suckers"]] if locators else []
     visibility = Visibility(layer, roots)
     tracks = UsdTracks(layer, header, source.static, locators)
@@ -168,7 +172,7 @@ def static_take(source: ChunkSource) -> Take:
     )
 
 
-def set_timing(stage: Any, fps: float, frames: int) -> None:
+def set_timing(stage: Usd.Stage, fps: float, frames: int) -> None:
     """Z up, metres, the take's frame rate and frame range on `stage`."""
     UsdGeom = _pxr().UsdGeom
     UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.z)
@@ -179,7 +183,7 @@ def set_timing(stage: Any, fps: float, frames: int) -> None:
     stage.SetEndTimeCode(frames - 1)
 
 
-def mark_rate(stage: Any, path: str, fps: float, frames: int) -> None:
+def mark_rate(stage: Usd.Stage, path: str, fps: float, frames: int) -> None:
     """`ecs:fps` and `ecs:frames` on the prim at `path` (a creature's root): importers that
     ignore the stage's frame rate (Blender's) bring these along as custom properties, and
     `tools/blender_import.py` sets the scene from them."""
@@ -190,11 +194,15 @@ def mark_rate(stage: Any, path: str, fps: float, frames: int) -> None:
 
 
 def _body(
-    pxr: ModuleType, stage: Any, header: dict[str, Any], index: int, skin: tuple[Any, np.ndarray]
-) -> tuple[int, Any, Any]:
+    pxr: ModuleType,
+    stage: Usd.Stage,
+    bodies: list[HeaderBody],
+    index: int,
+    skin: tuple[UsdShade.Material, np.ndarray],
+) -> tuple[int, Sdf.Path, Sdf.Path]:
     """Body `index`'s Xform and shape; (index, its translate's and orient's paths)."""
     Gf, UsdGeom = pxr.Gf, pxr.UsdGeom
-    body = header["bodies"][index]
+    body = bodies[index]
     xform = UsdGeom.Xform.Define(stage, f"/World/{unique_path(body['name'])}")
     translate = xform.AddTranslateOp()  # double3
     orient = xform.AddOrientOp()  # quatf
@@ -213,7 +221,7 @@ def _body(
     return index, translate.GetAttr().GetPath(), orient.GetAttr().GetPath()
 
 
-def _sucker(pxr: ModuleType, stage: Any, sucker: dict[str, Any]) -> Any:
+def _sucker(pxr: ModuleType, stage: Usd.Stage, sucker: HeaderSucker) -> Sdf.Path:
     """A sucker's locator under its link (a fixed offset); the path of `ecs:attached`."""
     Gf, Sdf, UsdGeom = pxr.Gf, pxr.Sdf, pxr.UsdGeom
     xform = UsdGeom.Xform.Define(stage, f"/World/{unique_path(sucker['name'])}")

@@ -49,7 +49,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from types import ModuleType
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -60,6 +60,9 @@ from ecs_tentacles.export.usd_plans import BodyPlan, define_skin
 from ecs_tentacles.skin.streamed import JointRotations
 from ecs_tentacles.take.replay import blend
 from ecs_tentacles.take.stream import ReplaySegment
+
+if TYPE_CHECKING:
+    from pxr import Usd
 
 KINDS = ("idle", "crawl")  # replay_kind 0 and 1
 FOLDER = "clips"
@@ -217,7 +220,7 @@ class SharedClips:
         return len(self.stretches)
 
 
-def _show(pxr: ModuleType, stage: Any, paths: list[str], shown: np.ndarray) -> None:
+def _show(pxr: ModuleType, stage: Usd.Stage, paths: list[str], shown: np.ndarray) -> None:
     """Key the visibility of the prims at `paths`: inherited on the frames `shown` (bool
     per frame), invisible on the others; keys only where it changes (and at frame 0)."""
     UsdGeom = pxr.UsdGeom

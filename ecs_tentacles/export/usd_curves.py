@@ -29,9 +29,10 @@ Reads the chunks it is handed; writes prims and time samples through the layer.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from types import ModuleType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -40,6 +41,9 @@ from ecs_tentacles.export.root_frames import RootFrames
 from ecs_tentacles.export.usd_layer import StreamedLayer
 from ecs_tentacles.numeric.quaternions import quat_rotate
 from ecs_tentacles.take import Take, TakeTrack
+
+if TYPE_CHECKING:
+    from pxr import Sdf, UsdGeom
 
 TOLERANCE = 5e-4  # m: a carried curve point is within this of the take's at every frame
 
@@ -76,10 +80,10 @@ class Owner:
 
     chosen: np.ndarray
     creature: int
-    curves: Any
-    points: Any
-    widths: Any
-    extent: Any
+    curves: UsdGeom.BasisCurves
+    points: Sdf.Path
+    widths: Sdf.Path
+    extent: Sdf.Path
     held_points: Held
     held_widths: Held
 
@@ -100,7 +104,7 @@ class CurvesTrack:
         owners = np.asarray(header[track.key]["creatures"], dtype=np.int64)
         names = [c["name"] for c in header["creatures"]]
         self.owners: list[Owner] = []
-        self.carriers: dict[int, tuple[Any, Any, Held]] = {}  # creature -> translate, orient
+        self.carriers: dict[int, tuple[Sdf.Path, Sdf.Path, Held]] = {}  # translate, orient
         carried = mantles is not None
         for owner in sorted(set(owners.tolist())):
             if 0 <= owner < len(names):
@@ -145,13 +149,15 @@ class CurvesTrack:
         with self.layer.batch():
             for owner in self.owners:
                 points = all_points[:, owner.chosen].reshape(chunk.frames, -1, 3)
-                if owner.creature >= 0:
+                if carried is not None and owner.creature >= 0:
                     points = carried(owner.creature, points)
                 widths = all_widths[:, owner.chosen].reshape(chunk.frames, -1)
                 for row in range(chunk.frames):
                     self._frame(owner, first + row, points[row], widths[row])
 
-    def _carried(self, first: int, chunk: Take, roots: RootFrames | None) -> Any:
+    def _carried(
+        self, first: int, chunk: Take, roots: RootFrames | None
+    ) -> Callable[[int, np.ndarray], np.ndarray] | None:
         """Sample each carrying folder's mantle pose (in its root frame) for the chunk;
         returns `in_mantle(creature, points (n, P, 3))`: world points in its mantle's frame."""
         if self.mantles is None or not self.carriers:

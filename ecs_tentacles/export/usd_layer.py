@@ -36,9 +36,12 @@ import contextlib
 import os
 from collections.abc import Iterator
 from types import ModuleType
-from typing import Any
+from typing import TYPE_CHECKING
 
 from ecs_tentacles.export.usd_pxr import usd_modules as _pxr
+
+if TYPE_CHECKING:
+    from pxr import Sdf
 
 FLUSH_BYTES = 64 * 1024**2  # samples held in memory before the file is saved, at least
 REWRITE_SHARE = 4  # ... and this many times the bytes a save rewrites (8 a sample so far)
@@ -94,7 +97,7 @@ class StreamedLayer:
         self.save()
 
 
-def _crate(pxr: ModuleType, layer: Any) -> bool:
+def _crate(pxr: ModuleType, layer: Sdf.Layer) -> bool:
     """Whether `layer` is written in the binary crate format (`.usdc`; `.usd` unless
     `USD_DEFAULT_FILE_FORMAT` asks for text)."""
     format_id = layer.GetFileFormat().formatId

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from types import ModuleType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -30,6 +30,9 @@ from ecs_tentacles.export.names import part
 from ecs_tentacles.export.usd_pxr import usd_modules
 from ecs_tentacles.skin.mesh import Detail, SkinMesh, creature_mesh
 from ecs_tentacles.skin.skeleton import Skeleton, build_skeleton, creature_layout, transforms
+
+if TYPE_CHECKING:
+    from pxr import Usd, Vt
 
 
 @dataclass(frozen=True)
@@ -73,12 +76,12 @@ def body_plans(header: dict[str, Any], detail: Detail | None = None) -> list[Bod
     return plans
 
 
-def _matrices(pxr: ModuleType, matrices: np.ndarray) -> Any:
+def _matrices(pxr: ModuleType, matrices: np.ndarray) -> Vt.Matrix4dArray:
     # USD matrices act on row vectors: store the transpose of the column-vector form
     return pxr.Vt.Matrix4dArray.FromNumpy(np.ascontiguousarray(np.swapaxes(matrices, -1, -2)))
 
 
-def _plan_arrays(pxr: ModuleType, skeleton: Skeleton, mesh: SkinMesh) -> dict[str, Any]:
+def _plan_arrays(pxr: ModuleType, skeleton: Skeleton, mesh: SkinMesh) -> dict[str, object]:
     """The USD arrays every creature of a plan holds: made once, set on each (VtArrays
     share their data: the layer holds one copy)."""
     Gf, Vt = pxr.Gf, pxr.Vt
@@ -105,7 +108,7 @@ def _plan_arrays(pxr: ModuleType, skeleton: Skeleton, mesh: SkinMesh) -> dict[st
 
 def define_creature(
     pxr: ModuleType,
-    stage: object,
+    stage: Usd.Stage,
     plan: BodyPlan,
     name: str,
     colour: np.ndarray,
@@ -125,7 +128,7 @@ def define_creature(
 
 def define_skin(
     pxr: ModuleType,
-    stage: object,
+    stage: Usd.Stage,
     plan: BodyPlan,
     name: str,
     prefix: str,

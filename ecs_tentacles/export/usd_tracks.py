@@ -19,7 +19,8 @@ the `StreamedLayer` (`ecs_tentacles.export.usd_layer`).
 
 from __future__ import annotations
 
-from typing import Any
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -32,6 +33,9 @@ from ecs_tentacles.take import Take, TakeTrack
 from ecs_tentacles.take import roster as take_roster
 from ecs_tentacles.take.tracks import tracks_of
 
+if TYPE_CHECKING:
+    from pxr import Sdf
+
 
 class Steps:
     """Held values of K items over chunks of frames: `changes` gives where a key goes."""
@@ -42,7 +46,7 @@ class Steps:
         self.first: np.ndarray | None = None  # frame 0's values (for `always_first=False`)
         self.keyed: np.ndarray | None = None  # items keyed at frame 0 so far
 
-    def changes(self, first: int, values: np.ndarray) -> list[tuple[int, int, Any]]:
+    def changes(self, first: int, values: np.ndarray) -> list[tuple[int, int, bool | int | float]]:
         """(frame, item, value) keys for the chunk `values` (n, K) starting at `first`:
         where an item's value differs from the frame before, and at frame 0 (with
         `always_first`; else frame 0 is keyed only once the item's value first changes)."""
@@ -51,7 +55,7 @@ class Steps:
         changed[1:] = values[1:] != values[:-1]
         if self.last is not None:
             changed[0] = values[0] != self.last
-        keys: list[tuple[int, int, Any]] = []
+        keys: list[tuple[int, int, bool | int | float]] = []
         if self.last is None:
             self.first = values[0].copy()
             self.keyed = np.full(values.shape[1], self.always_first)
@@ -84,7 +88,7 @@ class UsdTracks:
         pxr = _pxr()
         self.pxr, self.layer, self.header, self.relative = pxr, layer, header, relative
         self.static = static
-        self.points: list[tuple[TakeTrack, list[tuple[Any, Any]], Steps]] = []
+        self.points: list[tuple[TakeTrack, list[tuple[Sdf.Path, Sdf.Path]], Steps]] = []
         self.curves: list[CurvesTrack] = []
         mantles = np.array([c["mantle"] for c in header["creatures"]], dtype=np.int64)
         for track in tracks_of(header):
@@ -94,7 +98,9 @@ class UsdTracks:
                 carried = mantles if relative else None
                 self.curves.append(CurvesTrack(pxr, layer, header, track, carried))
 
-    def _locators(self, track: TakeTrack, static: dict[str, np.ndarray]) -> list[tuple[Any, Any]]:
+    def _locators(
+        self, track: TakeTrack, static: dict[str, np.ndarray]
+    ) -> list[tuple[Sdf.Path, Sdf.Path]]:
         """The points track's locators, placed (`relative`: their translate is sampled in
         add); the paths of their visibility and translate."""
         Gf, Sdf, UsdGeom = self.pxr.Gf, self.pxr.Sdf, self.pxr.UsdGeom
@@ -127,7 +133,7 @@ class UsdTracks:
                     self._placed(track, [t for _, t in paths], first, chunk.frames, roots)
 
     def _placed(
-        self, track: TakeTrack, paths: list[object], first: int, frames: int, roots: RootFrames
+        self, track: TakeTrack, paths: Sequence[object], first: int, frames: int, roots: RootFrames
     ) -> None:
         """Locators' translates at every frame of the chunk, in their creatures' frames."""
         Gf = self.pxr.Gf
@@ -169,8 +175,8 @@ class Visibility:
 
 
 def key_steps(
-    layer: StreamedLayer, paths: list[object], steps: Steps, first: int, values: np.ndarray,
-    tokens: tuple[Any, Any] | None = None,
+    layer: StreamedLayer, paths: Sequence[object], steps: Steps, first: int, values: np.ndarray,
+    tokens: tuple[str, str] | None = None,
 ) -> None:  # fmt: skip
     """Key the held `values` (n, K) of the chunk at `first` on the attributes `paths`
     (one per item) where they change; `tokens` (false, true): what a bool becomes."""

@@ -23,7 +23,12 @@ from __future__ import annotations
 
 import importlib
 import os
-from typing import Any
+from collections.abc import Sized
+from types import ModuleType
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from pxr import Usd, UsdValidation
 
 JOINT_COUNTS = "ecsTentacles:SkelJointCounts"
 
@@ -34,7 +39,7 @@ _JOINT_ARRAYS = {
 }
 
 
-def _validation() -> Any:
+def _validation() -> tuple[ModuleType, ModuleType]:
     """`pxr.UsdValidation`, with `pxr.Usd` loaded (UsdUnavailable without usd-core)."""
     from ecs_tentacles.export.usd import _pxr
 
@@ -43,7 +48,7 @@ def _validation() -> Any:
     return importlib.import_module("pxr.UsdValidation"), pxr
 
 
-def usd_validators() -> list[Any]:
+def usd_validators() -> list[UsdValidation.Validator]:
     """Every validator `usd_problems` runs: the registry's and `ecsTentacles:SkelJointCounts`."""
     validation, _ = _validation()
     registry = validation.ValidationRegistry()
@@ -59,7 +64,7 @@ def usd_validators() -> list[Any]:
     return list(registry.GetOrLoadAllValidators())
 
 
-def usd_problems(source: str | os.PathLike[str] | Any) -> list[str]:
+def usd_problems(source: str | os.PathLike[str] | Usd.Stage) -> list[str]:
     """The problems of the USD file (or `Usd.Stage`) `source`: errors, then warnings, each
     sorted, one line each (`error: <validator>.<problem>: <message>`). A file USD cannot open is
     one error naming it."""
@@ -80,7 +85,9 @@ def usd_problems(source: str | os.PathLike[str] | Any) -> list[str]:
     return [*sorted(lines["error"]), *sorted(lines["warning"])]  # validators run in parallel
 
 
-def _joint_counts(prim: Any, time_range: Any) -> list[Any]:
+def _joint_counts(
+    prim: Usd.Prim, time_range: UsdValidation.ValidationTimeRange
+) -> list[UsdValidation.ValidationError]:
     """`ecsTentacles:SkelJointCounts` on one Skeleton or SkelAnimation prim."""
     validation, pxr = _validation()
     joints = prim.GetAttribute("joints").Get()
@@ -113,6 +120,6 @@ def _joint_counts(prim: Any, time_range: Any) -> list[Any]:
     return errors
 
 
-def _size(value: Any) -> int | None:
+def _size(value: Sized | None) -> int | None:
     """The length of an authored array value; None where nothing is authored."""
     return None if value is None else len(value)

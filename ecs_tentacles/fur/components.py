@@ -14,7 +14,6 @@ control_row) marks the rig's bind pose stale, so the next frame re-binds.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
@@ -31,7 +30,7 @@ from ecs_tentacles.fur.stores import (
 class BindField(RowField):
     """A RowField whose writes bump the fur's version (the rig re-binds)."""
 
-    def __set__(self, component: Any, value: Any) -> None:
+    def __set__(self, component: FurGuide, value: object) -> None:
         super().__set__(component, value)
         component.fur.touch()
 

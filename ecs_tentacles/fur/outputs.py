@@ -11,7 +11,7 @@
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from ecs_tentacles.fur.checks import guide_count
 from ecs_tentacles.fur.hooks import take_guides
@@ -27,11 +27,14 @@ GUIDE_TRACK = TrackSource(GUIDES, take_guides)
 POINT_BYTES = 3 * 4 + 4  # a guide point in a frame: position and width (float32)
 
 
-def guide_sizes(scene: Mapping[str, Any]) -> list[TrackSize]:
+def guide_sizes(scene: Mapping[str, object]) -> list[TrackSize]:
     """The guide curves of a take of `scene` (defaults filled in): every fur's guides
     (as the groom makes them), each of the points every fur shares (the most a groom
     asks), every frame; once, each guide's owner in the header."""
-    furs = [(i, c) for i, c in enumerate(scene["creatures"]) if "fur" in c]
+    creatures = scene["creatures"]
+    if not isinstance(creatures, list):
+        raise TypeError("a scene's creatures are a list")
+    furs = [(i, c) for i, c in enumerate(creatures) if "fur" in c]
     if not furs:
         return []
     guides = [guide_count(c["fur"], c["mantle"])[0] for _, c in furs]

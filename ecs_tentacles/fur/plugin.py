@@ -11,7 +11,9 @@ the emotional creatures they rouse baked in one shard. Sandbox hooks
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, NamedTuple
+
+import numpy as np
 
 from ecs_tentacles.distributed.registries import ShardGroups
 from ecs_tentacles.fur.build import build_emotion, build_fur
@@ -34,6 +36,13 @@ if TYPE_CHECKING:
 STORES = ("guides", "controls", "sets", "emotions")
 
 
+class FurState(NamedTuple):
+    """What a snapshot keeps: the posed curves and frames the rig last wrote."""
+
+    curves: np.ndarray
+    frames: np.ndarray
+
+
 class FurPlugin(Plugin):
     name = "fur"
     build_order = 40  # a default plugin: built after threats (30), before clips (50)
@@ -50,11 +59,16 @@ class FurPlugin(Plugin):
     def resources(self, world: Host) -> list[object]:
         return [FurData()]
 
-    def build_creature(self, world: Host, creature: int, spec: Mapping[str, Any]) -> None:
-        if "fur" in spec:
-            build_fur(world, creature, dict(spec["fur"]))
-        if "emotion" in spec:
-            build_emotion(world, creature, dict(spec["emotion"]))
+    def build_creature(self, world: Host, creature: int, spec: Mapping[str, object]) -> None:
+        fur, emotion = spec.get("fur"), spec.get("emotion")
+        if fur is not None and not isinstance(fur, Mapping):
+            raise TypeError(f"{spec.get('name')}: its fur is an object, not {fur!r}")
+        if emotion is not None and not isinstance(emotion, Mapping):
+            raise TypeError(f"{spec.get('name')}: its emotion is an object, not {emotion!r}")
+        if fur is not None:
+            build_fur(world, creature, dict(fur))
+        if emotion is not None:
+            build_emotion(world, creature, dict(emotion))
 
     def roster_changed(self, world: Host, change: RosterChange) -> None:
         if not change.spawned:  # a spawn's fur was added by `build_creature`
@@ -72,9 +86,11 @@ class FurPlugin(Plugin):
 
     def snapshot(self, world: Host) -> object:
         fur = world.resource(FurData)  # its stores are copied with every store
-        return fur.curves.copy(), fur.frames.copy()
+        return FurState(fur.curves.copy(), fur.frames.copy())
 
-    def restore(self, world: Host, state: Any) -> None:
+    def restore(self, world: Host, state: object) -> None:
+        if not isinstance(state, FurState):
+            raise TypeError(f"fur: a snapshot's state is a FurState, not {state!r}")
         curves, frames = state
         fur = world.resource(FurData)
         fur.discard()  # the snapshot's outputs replace whatever the rig deferred
@@ -115,7 +131,7 @@ class FurPlugin(Plugin):
         app.add(Draws, self._draw)
         app.add(Panels, self._panels)
 
-    def _lines(self, world: Host, view: RenderView) -> list[Any]:
+    def _lines(self, world: Host, view: RenderView) -> list[np.ndarray]:
         from ecs_tentacles.fur.render.strands import fur_lines
 
         return fur_lines(world, view)

@@ -30,7 +30,7 @@ import time
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Generic, TypeVar
+from typing import TYPE_CHECKING, Generic, Protocol, TypeVar
 
 from ecs_tentacles.registry import Registry
 from ecs_tentacles.system import System
@@ -75,9 +75,9 @@ class GameMode:
     """A game mode a plugin registers (module docstring)."""
 
     name: str
-    schema: Mapping[str, Any]
+    schema: Mapping[str, object]
     result: Callable[[Host], GameResult]
-    problems: Callable[[Mapping[str, Any]], list[Problem]] | None = None
+    problems: Callable[[Mapping[str, object]], list[Problem]] | None = None
     description: str = ""
 
 
@@ -85,12 +85,19 @@ class GameModes(Registry[GameMode]):
     """The modes the plugins on registered, by `GameMode.name`."""
 
 
+class PlayState(Protocol):
+    """What every game's state has: the game frames played and the outcome so far."""
+
+    frames: int
+    outcome: str
+
+
 class PlayedGame:
     """What a game mode's resource shares: its `state` (with `frames` played and the
     `outcome`), the frame rate `fps`, and the level's `start` (a snapshot taken when the
     level is ready, not itself in snapshots)."""
 
-    state: Any
+    state: PlayState
     fps: float
     start: Snapshot | None = None
 

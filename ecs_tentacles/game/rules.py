@@ -15,7 +15,7 @@ plugin would build its game from this `game`).
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from ecs_tentacles.game.modes import GameMode, GameModes, GameResult, Problem
 from ecs_tentacles.scene.defaults import filled
@@ -28,13 +28,16 @@ if TYPE_CHECKING:
 
 def mode_schema(mode: GameMode) -> dict[str, object]:
     """The JSON Schema of a `game` key of `mode`: the mode's schema, `mode` added."""
-    properties = {"mode": {"const": mode.name}, **mode.schema.get("properties", {})}
+    given, required = mode.schema.get("properties", {}), mode.schema.get("required", [])
+    if not isinstance(given, Mapping) or not isinstance(required, list):
+        raise TypeError(f"game mode {mode.name!r}: its schema's properties and required")
+    properties = {"mode": {"const": mode.name}, **given}
     return {
         "type": "object",
         "additionalProperties": False,
         **mode.schema,
         "properties": properties,
-        "required": ["mode", *mode.schema.get("required", [])],
+        "required": ["mode", *required],
     }
 
 
@@ -71,21 +74,24 @@ def check_game(scene: Mapping[str, object], registries: Registries) -> list[Prob
 
 
 def scene_schema(
-    schema: Mapping[str, Any], scene: Mapping[str, Any], registries: Registries
+    schema: Mapping[str, object], scene: Mapping[str, object], registries: Registries
 ) -> dict[str, object]:
     """The scene schema `schema` with its `game` key that of the scene's mode (for an
     editor checking a level's file: `ecs-tentacles schema LEVEL`); as it is without one."""
-    name = (scene.get("game") or {}).get("mode")
+    played = scene.get("game")
+    name = played.get("mode") if isinstance(played, Mapping) else None
     mode = next((m for m in registries.get(GameModes) if m.name == name), None)
-    if mode is None or "game" not in schema.get("properties", {}):
+    properties = schema.get("properties", {})
+    if mode is None or not isinstance(properties, Mapping) or "game" not in properties:
         return dict(schema)
     game = {"description": f"A {name} level's rules (game mode {name!r})", **mode_schema(mode)}
-    return {**schema, "properties": {**schema["properties"], "game": game}}
+    return {**schema, "properties": {**properties, "game": game}}
 
 
-def rules(scene: Mapping[str, Any] | None, mode: GameMode) -> dict[str, object]:
+def rules(scene: Mapping[str, object] | None, mode: GameMode) -> dict[str, object]:
     """`scene["game"]` (a copy) with `mode`'s schema defaults filled in."""
-    return filled((scene or {}).get("game") or {}, mode_schema(mode))
+    game = (scene or {}).get("game")
+    return filled(game if isinstance(game, Mapping) else {}, mode_schema(mode))
 
 
 def mode_of(world: Host) -> GameMode | None:

@@ -20,7 +20,6 @@ import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
 
 from ecs_tentacles.untrusted.files import TooLarge, Unfit, read_regular
 
@@ -71,9 +70,10 @@ def _level(name: str) -> str:
     return repr(name if len(name) <= SHOWN else name[:SHOWN] + "...")
 
 
-def _problem(value: Any) -> str | None:
+def _problem(value: object) -> str | None:
     """Why `value` is not a time in seconds (None: it is one)."""
-    if type(value) not in (int, float) or not (math.isfinite(value) and value > 0):
+    number = value if type(value) in (int, float) else None  # a bool is no time
+    if not isinstance(number, (int, float)) or not (math.isfinite(number) and number > 0):
         return f"{_describe(value)} is not a time in seconds"
     return None
 

@@ -25,13 +25,13 @@ What it adds to the registries in `build`:
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ecs_tentacles.behaviour import Dangers, DangerSource
 from ecs_tentacles.game.modes import GameMode, GameModes, GameResult
-from ecs_tentacles.herding.game import HerdingGame
+from ecs_tentacles.herding.game import GameState, HerdingGame
 from ecs_tentacles.herding.schema import GAME, game_problems, plugin_problems
 from ecs_tentacles.plugin import Plugin
 
@@ -67,7 +67,9 @@ class HerdingPlugin(Plugin):
     def snapshot(self, world: Host) -> object:
         return world.resource(HerdingGame).state.copy()
 
-    def restore(self, world: Host, state: Any) -> None:
+    def restore(self, world: Host, state: object) -> None:
+        if not isinstance(state, GameState):
+            raise TypeError(f"herding: a snapshot's state is a GameState, not {state!r}")
         world.resource(HerdingGame).state = state.copy()
 
     def build(self, app: App) -> None:

@@ -19,7 +19,6 @@ predator not starting inside the pen, the gate no wider than the pen.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Any
 
 import numpy as np
 
@@ -39,11 +38,13 @@ def plugin_problems(scene: Mapping[str, object]) -> list[Problem]:
     return []
 
 
-def game_problems(scene: Mapping[str, Any]) -> list[Problem]:
+def game_problems(scene: Mapping[str, object]) -> list[Problem]:
     """What the schema cannot say about a herding level's `game` (defaults filled)."""
-    game = scene["game"]
+    game, listed = scene["game"], scene.get("creatures") or []
+    if not isinstance(game, Mapping) or not isinstance(listed, list):
+        raise TypeError("a herding level's game and creatures are filled in by the validator")
     found: list[Problem] = []
-    creatures = len(scene.get("creatures") or [])
+    creatures = len(listed)
     if game["need"] > creatures:
         found.append(
             (("game", "need"), f"{game['need']} is more than the scene's {creatures} creatures")

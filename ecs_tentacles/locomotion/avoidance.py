@@ -27,7 +27,6 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
@@ -35,6 +34,7 @@ from ecs_tentacles.numeric.optional_kernels import OptionalKernels
 from ecs_tentacles.physics.pairs import near_pairs
 from ecs_tentacles.scene.construction import creature_layout
 from ecs_tentacles.scene.schema import fragment
+from ecs_tentacles.scene.spec import creature_specs
 
 BEHIND = 0.3  # a neighbour straight behind weighs this much of one straight ahead
 SIDESTEP = 1.0  # the push to the right (keep right), relative to the push away
@@ -43,8 +43,8 @@ PairFinder = Callable[[np.ndarray, np.ndarray, float], tuple[np.ndarray, np.ndar
 _SCENE = fragment("ecs_tentacles.locomotion", "locomotion")["scene"]["avoidance"]
 
 
-def _default(key: str) -> Any:
-    return _SCENE["properties"][key]["default"]
+def _default(key: str) -> float:
+    return float(_SCENE["properties"][key]["default"])
 
 
 @dataclass
@@ -53,13 +53,15 @@ class Avoidance:
 
     provided_by = "locomotion"
 
-    enabled: bool = _default("enabled")
+    enabled: bool = bool(_default("enabled"))
     range: float = _default("range")  # m between personal circles where it starts
     strength: float = _default("strength")
 
-    def configure(self, scene: Mapping[str, Any]) -> None:
+    def configure(self, scene: Mapping[str, object]) -> None:
         """Take the scene's `avoidance` object (its defaults where it says nothing)."""
-        given = scene.get("avoidance", {})
+        given = scene.get("avoidance")
+        if not isinstance(given, Mapping):
+            given = {}
         self.enabled = bool(given.get("enabled", _default("enabled")))
         self.range = float(given.get("range", _default("range")))
         self.strength = float(given.get("strength", _default("strength")))
@@ -136,7 +138,7 @@ def bent(to_goal: np.ndarray, term: np.ndarray) -> np.ndarray:
     return out
 
 
-def meeting_reach(scene: Mapping[str, Any]) -> list[float] | None:
+def meeting_reach(scene: Mapping[str, object]) -> list[float] | None:
     """Per creature of `scene`, its personal radius and half the range: two creatures
     steer each other exactly when their mantles come within the sum of theirs (their
     personal circles within the range; `Plugin.meeting_reach`); None with avoidance off."""
@@ -145,7 +147,7 @@ def meeting_reach(scene: Mapping[str, Any]) -> list[float] | None:
     if not settings.enabled:
         return None
     out = []
-    for creature in scene["creatures"]:
+    for creature in creature_specs(scene):
         layout = creature_layout(creature)  # the shapes the built creature has
         longest = max((shape.length for shape in layout.shapes), default=0.0)
         out.append(float(creature["mantle"]["radius"]) + longest + 0.5 * settings.range)

@@ -14,7 +14,7 @@ stores.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, SupportsFloat
 
 import numpy as np
 
@@ -25,6 +25,7 @@ from ecs_tentacles.locomotion.params import ROWS, Locomotion, settable
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
+    from ecs_tentacles.scene.parameters import Parameter
 
 
 LAYOUT = {"creatures": ("first_tentacle", "tentacles"), "tentacles": ("first_link", "links")}
@@ -35,7 +36,7 @@ def goal_path(world: Host, creature: int) -> list[tuple[tuple[float, ...], float
     return [(tuple(g.position.tolist()), float(g.radius)) for g in goals]
 
 
-def _parameters() -> list[Any]:
+def _parameters() -> list[Parameter]:
     per_tentacle, per_creature = settable()
     return list({**per_tentacle, **per_creature}.values())
 
@@ -113,7 +114,7 @@ def sandbox_restore(world: Host, state: Directed) -> None:
             column[now.span(kind, creature.row)] = state.columns[p.column][state.span(kind, old)]
 
 
-def save_creature(world: Host, creature: int, entry: dict[str, Any]) -> None:
+def save_creature(world: Host, creature: int, entry: dict[str, object]) -> None:
     """The creature's goals and current parameters into its scene entry."""
     entry["goals"] = [
         {"position": list(position), "radius": radius}
@@ -124,11 +125,14 @@ def save_creature(world: Host, creature: int, entry: dict[str, Any]) -> None:
     first = api.get(creature, 0)
     for name, p in per_creature.items():
         shown = f"creature_{name}" if name in per_tentacle else name
-        entry.setdefault(p.section, {})[p.key] = _scene_value(p, first[shown])
+        _section(entry, p.section)[p.key] = _scene_value(p, first[shown])
     count = api.tentacle_count(creature)
     values = [api.get(creature, k) for k in range(count)]
-    tentacles = entry.setdefault("tentacles", {})
-    overrides = {o["index"]: dict(o) for o in tentacles.get("overrides", [])}
+    tentacles = _section(entry, "tentacles")
+    listed = tentacles.get("overrides", [])
+    if not isinstance(listed, list):
+        raise TypeError(f"{entry.get('name')}: its tentacles' overrides are a list")
+    overrides = {o["index"]: dict(o) for o in listed}
     for name, p in per_tentacle.items():
         base = _scene_value(p, values[0][name])
         tentacles[p.key] = base
@@ -142,7 +146,17 @@ def save_creature(world: Host, creature: int, entry: dict[str, Any]) -> None:
     tentacles["overrides"] = kept
 
 
-def _scene_value(p: Any, value: Any) -> Any:
+def _section(entry: dict[str, object], key: str) -> dict[str, object]:
+    """The entry's object `key` (made empty if it has none)."""
+    section = entry.setdefault(key, {})
+    if not isinstance(section, dict):
+        raise TypeError(f"{entry.get('name')}: its {key} is an object, not {section!r}")
+    return section
+
+
+def _scene_value(p: Parameter, value: object) -> object:
     if p.choices or isinstance(value, int):
         return value
+    if not isinstance(value, SupportsFloat):
+        raise TypeError(f"{p.api}: {value!r} is not a number")
     return round(float(value) / p.factor, 12)

@@ -25,12 +25,12 @@ grids are kept (a grid from the survey is a few array operations, a route far mo
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, TypeAlias
 
 import numpy as np
 
 from ecs_tentacles.ground import Ground, ground_of
-from ecs_tentacles.locomotion.stores import LocomotionStores
+from ecs_tentacles.locomotion.stores import CreatureGaitStore, LocomotionStores
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
@@ -48,6 +48,9 @@ WAYPOINT_RADIUS = 0.35  # metres: a waypoint this close is passed
 STUCK_SECONDS = 8.0  # no progress toward a waypoint this long: plan again
 PROGRESS = 0.1  # metres closer that count as progress
 KEPT_GRIDS = 16  # cost grids kept, one a reach (a crowd of one body plan needs one)
+
+# what a snapshot keeps: routes by creature row, and the planned, best and since columns
+NavigationState: TypeAlias = tuple[dict[int, np.ndarray], np.ndarray, np.ndarray, np.ndarray]
 
 
 @dataclass
@@ -212,19 +215,17 @@ class Navigator:
         self._ground: Ground | None = None
         self.plans = 0  # routes planned so far (first plans and re-plans)
 
-    def state(self) -> Any:
+    def state(self) -> NavigationState:
         """What a snapshot keeps (the grid is remade from the ground)."""
         routes = {row: r.copy() for row, r in self.routes.items()}
         return routes, self.planned.copy(), self.best.copy(), self.since.copy()
 
-    def set_state(self, state: Any) -> None:
-        routes, self.planned, self.best, self.since = (
-            {row: r.copy() for row, r in state[0].items()},
-            *(a.copy() for a in state[1:]),
-        )
-        self.routes = routes
+    def set_state(self, state: NavigationState) -> None:
+        routes, planned, best, since = state
+        self.routes = {row: r.copy() for row, r in routes.items()}
+        self.planned, self.best, self.since = planned.copy(), best.copy(), since.copy()
         self.target = np.full((len(self.best), 3), np.nan)
-        for row, route in routes.items():
+        for row, route in self.routes.items():
             self.target[row] = route[0]
 
     def roster_changed(self, change: RosterChange) -> None:
@@ -303,7 +304,7 @@ class Navigator:
             grid = self.grids[reach] = self.survey.grid(reach)
         return grid
 
-    def _plan(self, world: Host, g: Any, row: int, mantle: np.ndarray) -> None:
+    def _plan(self, world: Host, g: CreatureGaitStore, row: int, mantle: np.ndarray) -> None:
         self.planned[row] = g.goal[row]
         self._drop(row)
         self._reset_progress(world, row)

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import json
 from collections.abc import Mapping
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -21,6 +21,7 @@ from ecs_tentacles.cli.registries import RunSummary
 from ecs_tentacles.components import Creature
 from ecs_tentacles.distributed.registries import Reach
 from ecs_tentacles.locomotion.goals import GoalBook
+from ecs_tentacles.scene.spec import as_spec
 from ecs_tentacles.take.registries import PointsFrame, TrackSource
 from ecs_tentacles.take.tracks import TakeTrack, TrackSize
 
@@ -47,12 +48,15 @@ def goal_points(world: Host) -> PointsFrame:
 GOAL_TRACK = TrackSource(GOALS, goal_points)
 
 
-def goal_sizes(scene: Mapping[str, Any]) -> list[TrackSize]:
+def goal_sizes(scene: Mapping[str, object]) -> list[TrackSize]:
     """The goals track of a take of `scene` (defaults filled in), as far as the scene
     says: its goals, each live or not every frame (a byte), where it is (12 bytes) and
     its header entry once. Goals added while baking are counted by `Take.save`."""
     goals = fixed = 0
-    for c, creature in enumerate(scene["creatures"]):
+    creatures = scene["creatures"]
+    if not isinstance(creatures, list):
+        raise TypeError("a scene's creatures are a list")
+    for c, creature in enumerate(creatures):
         name = f"{creature.get('name', f'creature_{c}')}/goals/goal"
         n = len(creature["goals"])
         entry = {"creature": c, "name": name, "radius": 0}  # '{"creature":0,...}' and a comma
@@ -63,12 +67,14 @@ def goal_sizes(scene: Mapping[str, Any]) -> list[TrackSize]:
     return [TrackSize("goals", goals, 1, fixed)] if goals else []
 
 
-def crawl_reach(creature: Mapping[str, Any], seconds: float) -> Reach:
+def crawl_reach(creature: Mapping[str, object], seconds: float) -> Reach:
     """Where a creature (scene entry, defaults in) may crawl in `seconds`, beyond its body."""
-    travel = CRAWL_SPEED * creature["locomotion"]["speed"] * seconds
-    goals = creature["goals"]
+    locomotion, goals = creature["locomotion"], creature["goals"]
+    if not isinstance(locomotion, Mapping) or not isinstance(goals, list):
+        raise TypeError("a creature's locomotion and goals are filled in by the validator")
+    travel = CRAWL_SPEED * locomotion["speed"] * seconds
     if goals:
-        start = np.asarray(creature["position"][:2], dtype=np.float64)
+        start = np.asarray(as_spec(creature)["position"][:2], dtype=np.float64)
         towards = np.asarray(goals[0]["position"][:2], dtype=np.float64) - start
         length = float(np.linalg.norm(towards))
         if length >= travel:  # it heads straight for the goal all the bake

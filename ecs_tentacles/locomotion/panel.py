@@ -15,7 +15,7 @@ parameters through `Locomotion`.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, SupportsFloat
 
 from imgui_bundle import imgui
 
@@ -24,6 +24,9 @@ from ecs_tentacles.locomotion.params import Locomotion, settable
 from ecs_tentacles.render.gui import Gui, same_line_if_fits, text_width
 from ecs_tentacles.render.registries import Panel, SandboxView
 from ecs_tentacles.scene.parameters import Parameter, parameter
+
+if TYPE_CHECKING:
+    from ecs_tentacles.world import World
 
 
 @dataclass(frozen=True)
@@ -98,11 +101,17 @@ class LocomotionPanel(Panel):
         self.sandbox = sandbox  # its world and HUD (the tentacle selector steps the HUD's)
         self.creature: int | None = None
         self.tentacle: int | None = None  # None: all tentacles
-        self.values: dict[str, Any] = {}
+        self.values: dict[str, object] = {}  # `Locomotion.get`'s
 
     @property
-    def world(self) -> Any:
+    def world(self) -> World:
         return self.sandbox.world
+
+    def _number(self, name: str) -> float:
+        value = self.values[name]
+        if not isinstance(value, SupportsFloat):
+            raise TypeError(f"{name}: {value!r} is not a number")
+        return float(value)
 
     def select(self, creature: int | None, tentacle: int | None) -> None:
         self.creature, self.tentacle = creature, tentacle
@@ -133,7 +142,7 @@ class LocomotionPanel(Panel):
         api = self.world.resource(Locomotion)
         for creature in self.chosen:
             if name not in settable()[0]:  # creature-wide (the gait)
-                api.set(creature, **{name: value})
+                api.set(creature, None, **{name: value})
                 continue
             if self.tentacle is not None and self.tentacle >= api.tentacle_count(creature):
                 continue
@@ -172,7 +181,7 @@ class LocomotionPanel(Panel):
         for knob in KNOBS:
             imgui.text(knob.label)
             gui.item(f"{knob.name} label")
-            shown = float(self.values[knob.name]) * knob.to_shown
+            shown = self._number(knob.name) * knob.to_shown
             high = knob.high
             if knob.name == "strength":  # no stronger than the servos' damping holds
                 high = self.world.resource(Locomotion).strength_limit(self.creature, self.tentacle)

@@ -64,7 +64,7 @@ class Locomotion:
             raise ValueError(f"tentacle: must be in [0, {len(entities) - 1}], got {tentacle}")
         return [self._world.component(entities[tentacle], Tentacle)]
 
-    def set(self, creature: int, tentacle: int | None = None, **params: Any) -> None:
+    def set(self, creature: int, tentacle: int | None = None, **params: object) -> None:
         """Change parameters of a creature's tentacles (all, or the one at index `tentacle`).
 
         `speed` without `tentacle` is the creature's speed; `gait` and `drivers` are
@@ -95,7 +95,7 @@ class Locomotion:
         for name, p in chosen.items():
             p.write(world, at[name], checked[name])
 
-    def _rows(self, p: Parameter, creature_row: int, tentacle_rows: np.ndarray) -> Any:
+    def _rows(self, p: Parameter, creature_row: int, tentacle_rows: np.ndarray) -> int | np.ndarray:
         """The rows of `p`'s store that a change of these tentacles (or creature) writes."""
         if ROWS[p.store] == "creature":
             return creature_row

@@ -20,8 +20,9 @@ creature may crawl during a distributed bake, goals reached for `ecs-tentacles r
 from __future__ import annotations
 
 import copy
+from collections import deque
 from collections.abc import Mapping
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
@@ -35,7 +36,7 @@ from ecs_tentacles.locomotion.avoidance import Avoidance, bent
 from ecs_tentacles.locomotion.components import Goal
 from ecs_tentacles.locomotion.formations import FormationChoice
 from ecs_tentacles.locomotion.goals import GoalBook
-from ecs_tentacles.locomotion.navigation import Navigator
+from ecs_tentacles.locomotion.navigation import NavigationState, Navigator
 from ecs_tentacles.locomotion.params import Locomotion
 from ecs_tentacles.locomotion.stores import LocomotionStores
 from ecs_tentacles.physics.registries import MotionWants, TravelTargets
@@ -51,6 +52,7 @@ from ecs_tentacles.render.registries import (
 from ecs_tentacles.scene.construction import tentacle_params
 from ecs_tentacles.scene.parameters import apply_parameters
 from ecs_tentacles.scene.schema import plugin_schemas
+from ecs_tentacles.scene.spec import as_spec
 from ecs_tentacles.system import System
 from ecs_tentacles.take.registries import TakeTracks, TrackSource
 
@@ -58,11 +60,22 @@ if TYPE_CHECKING:
     import numpy as np
 
     from ecs_tentacles.host import Host
+    from ecs_tentacles.locomotion.actions import Action
+    from ecs_tentacles.locomotion.directing import Directed, DirectedStates
     from ecs_tentacles.registry import App
     from ecs_tentacles.render.registries import Click, Panel, RenderView, SandboxView
     from ecs_tentacles.roster_change import RosterChange
     from ecs_tentacles.store import ArrayStore
     from ecs_tentacles.take.tracks import TrackSize
+
+
+class LocomotionState(NamedTuple):
+    """What a snapshot keeps: each creature's goal path (position, radius), each
+    tentacle's pending actions, and the navigator's routes."""
+
+    goals: dict[int, list[tuple[np.ndarray, float]]]
+    queues: dict[int, deque[Action]]
+    navigation: NavigationState
 
 
 class LocomotionPlugin(Plugin):
@@ -82,7 +95,7 @@ class LocomotionPlugin(Plugin):
         "creatures.mantle_row",
     )
 
-    _directed: Any = None  # the sandbox's undo mementos (`locomotion.directing`)
+    _directed: DirectedStates | None = None  # the sandbox's undo mementos (`locomotion.directing`)
 
     def resources(self, world: Host) -> list[object]:
         return [LocomotionStores(), GoalBook(world), Locomotion(world), Navigator(),
@@ -92,17 +105,21 @@ class LocomotionPlugin(Plugin):
         loco = world.resource(LocomotionStores)
         return {"locomotion.tentacles": loco.tentacles, "locomotion.creatures": loco.creatures}
 
-    def build_creature(self, world: Host, creature: int, spec: Mapping[str, Any]) -> None:
+    def build_creature(self, world: Host, creature: int, spec: Mapping[str, object]) -> None:
+        entry = as_spec(spec)  # core's keys, typed; this plugin's below (defaults filled)
+        locomotion, goals = spec["locomotion"], spec["goals"]
+        if not isinstance(locomotion, Mapping) or not isinstance(goals, list):
+            raise TypeError(f"{entry['name']}: its locomotion and goals were not filled in")
         loco = world.resource(LocomotionStores)
         body = world.component(creature, Creature)
         row = int(loco.creatures.add()[0])
         if row != body.row:
             raise RuntimeError("locomotion's creature rows must line up with the body's")
-        apply_parameters(world, "locomotion", spec["locomotion"], {"locomotion.creatures": row})
+        apply_parameters(world, "locomotion", locomotion, {"locomotion.creatures": row})
         loco.creatures.navigate[row] = bool(spec.get("navigation", True))
         loco.creatures.avoid[row] = bool(spec.get("avoid", True))
-        rng = creature_rng(world.seed, spec["name"])  # the creature's own stream
-        tentacles = spec["tentacles"]
+        rng = creature_rng(world.seed, entry["name"])  # the creature's own stream
+        tentacles = entry["tentacles"]
         phases = [rng.uniform(0.0, 2.0 * np.pi) for _ in body.tentacles]  # drawn in order
         rows = loco.tentacles.add(len(phases), phase=phases, action_strength=STRENGTH[Kind.IDLE])
         for k, (entity, added) in enumerate(zip(body.tentacles, rows.tolist(), strict=True)):
@@ -111,7 +128,7 @@ class LocomotionPlugin(Plugin):
             params = tentacle_params(tentacles, k)
             apply_parameters(world, "tentacles", params, {"locomotion.tentacles": added})
             world.add_component(entity, ActionQueue())
-        for goal in spec["goals"]:
+        for goal in goals:
             # a 2-d goal is on the ground under it (`GoalBook` puts it there)
             world.resource(GoalBook).append(creature, goal["position"], goal["radius"])
 
@@ -159,9 +176,11 @@ class LocomotionPlugin(Plugin):
             for entity, _ in world.query(Creature)
         }
         queues = {e: copy.deepcopy(q.pending) for e, q in world.query(ActionQueue)}
-        return goals, queues, world.resource(Navigator).state()
+        return LocomotionState(goals, queues, world.resource(Navigator).state())
 
-    def restore(self, world: Host, state: Any) -> None:
+    def restore(self, world: Host, state: object) -> None:
+        if not isinstance(state, LocomotionState):
+            raise TypeError(f"locomotion: a snapshot's state is a LocomotionState, not {state!r}")
         goals, queues, navigation = state
         for entity, path in goals.items():
             world.resource(GoalBook).clear(entity)
@@ -200,26 +219,28 @@ class LocomotionPlugin(Plugin):
             ),
         )
 
-    def _lines(self, world: Host, view: RenderView) -> list[Any]:
+    def _lines(self, world: Host, view: RenderView) -> list[np.ndarray]:
         from ecs_tentacles.locomotion.render import path_lines
 
         return path_lines(world, view)
 
-    def _framed_points(self, world: Host) -> Any:
+    def _framed_points(self, world: Host) -> np.ndarray:
         from ecs_tentacles.locomotion.render import goal_points
 
         return goal_points(world)
 
-    def _undo_capture(self, world: Host) -> Any:
+    def _undo_capture(self, world: Host) -> Directed:
         from ecs_tentacles.locomotion.directing import DirectedStates
 
         if self._directed is None:
             self._directed = DirectedStates()
         return self._directed.capture(world)
 
-    def _undo_restore(self, world: Host, state: Any) -> None:
-        from ecs_tentacles.locomotion.directing import sandbox_restore
+    def _undo_restore(self, world: Host, state: object) -> None:
+        from ecs_tentacles.locomotion.directing import Directed, sandbox_restore
 
+        if not isinstance(state, Directed):
+            raise TypeError(f"locomotion: an undo state is a Directed, not {state!r}")
         sandbox_restore(world, state)
 
     def save_creature(self, world: Host, creature: int, entry: dict[str, object]) -> None:

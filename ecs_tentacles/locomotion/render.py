@@ -17,7 +17,7 @@ Writes: goals, through `GoalBook`.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -45,7 +45,8 @@ class GoalLines:
     """Rings, posts and legs between goals of one world at one `GoalBook.version`."""
 
     world: Host
-    version: Any  # (the goal book's version, the selection) it was made for
+    # (the goal book's version, the selection) it was made for
+    version: tuple[int, int | None, tuple[int, ...]]
     fixed: np.ndarray  # line-list vertices (2n, 7)
     leader_rows: np.ndarray  # Transform rows of the creatures that have a goal
     leader_ends: np.ndarray  # (n, 3) their current goals

@@ -11,7 +11,7 @@ import contextlib
 import sys
 import time
 from collections.abc import Callable, Iterator
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, NoReturn
 
 from tqdm import tqdm
 
@@ -58,7 +58,7 @@ def step_frames(
     return done
 
 
-def bar(total: int, desc: str, unit: str, *, progress: bool = True) -> tqdm[Any]:
+def bar(total: int, desc: str, unit: str, *, progress: bool = True) -> tqdm[NoReturn]:
     """A tqdm bar for `total` `unit`s of work labelled `desc` (bytes are shown scaled:
     kB, MB, GB); `bar.update(n)` as n are done. Use it as a context manager."""
     scaled = unit == "B"

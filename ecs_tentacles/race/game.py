@@ -17,7 +17,7 @@ from __future__ import annotations
 import copy
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -47,18 +47,28 @@ class RaceState:
         return copy.deepcopy(self)
 
 
+def _number(rules: Mapping[str, object], key: str) -> float:
+    value = rules[key]
+    if not isinstance(value, (int, float)):
+        raise TypeError(f"game.{key}: a number, not {value!r}")
+    return float(value)
+
+
 class RaceGame(PlayedGame):
     """The level's rules (the scene's `game`, defaults filled) and the race's state."""
 
     provided_by = "race"
 
-    def __init__(self, rules: Mapping[str, Any], scene_name: str, fps: float):
+    def __init__(self, rules: Mapping[str, object], scene_name: str, fps: float):
+        flag = rules["flag"]
+        if not isinstance(flag, Mapping):
+            raise TypeError(f"game.flag: an object, not {flag!r}")
         self.level = str(rules.get("level") or scene_name)
         self.runner_name = str(rules["runner"])
-        self.flag = np.asarray(rules["flag"]["position"], dtype=np.float64)
-        self.radius = float(rules["flag"]["radius"])
-        self.seconds = float(rules["seconds"])
-        self.rivals_wait = float(rules["rivals_wait"])
+        self.flag = np.asarray(flag["position"], dtype=np.float64)
+        self.radius = float(flag["radius"])
+        self.seconds = _number(rules, "seconds")
+        self.rivals_wait = _number(rules, "rivals_wait")
         self.fps = float(fps)
         self.runner = NOBODY  # the runner's entity, once the creatures are built
         self.state: RaceState = RaceState()

@@ -17,13 +17,13 @@ What it adds to the registries in `build`:
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from ecs_tentacles.game.modes import GameMode, GameModes
 from ecs_tentacles.game.rules import rules
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.race import rules as race_rules
-from ecs_tentacles.race.game import RaceGame
+from ecs_tentacles.race.game import RaceGame, RaceState
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
@@ -70,7 +70,9 @@ class RacePlugin(Plugin):
     def snapshot(self, world: Host) -> object:
         return world.resource(RaceGame).state.copy()
 
-    def restore(self, world: Host, state: Any) -> None:
+    def restore(self, world: Host, state: object) -> None:
+        if not isinstance(state, RaceState):
+            raise TypeError(f"race: a snapshot's state is a RaceState, not {state!r}")
         world.resource(RaceGame).state = state.copy()
 
     def build(self, app: App) -> None:

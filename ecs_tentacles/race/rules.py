@@ -16,7 +16,6 @@ flag.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Any
 
 import numpy as np
 
@@ -65,10 +64,11 @@ RULES: dict[str, object] = {
 }
 
 
-def problems(scene: Mapping[str, Any]) -> list[Problem]:
+def problems(scene: Mapping[str, object]) -> list[Problem]:
     """What the schema cannot say about a race level (its `game` has its defaults)."""
-    game = scene["game"]
-    creatures = scene.get("creatures") or []
+    game, creatures = scene["game"], scene.get("creatures") or []
+    if not isinstance(game, Mapping) or not isinstance(creatures, list):
+        raise TypeError("a race level's game and creatures are filled in by the validator")
     names = [creature["name"] for creature in creatures]
     found: list[Problem] = []
     if game["runner"] not in names:

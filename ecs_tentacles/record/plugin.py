@@ -10,9 +10,14 @@ Systems: record (stage output), which captures the frame after everything else r
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, Unpack
+
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.system import System
 from ecs_tentacles.take import Take
+
+if TYPE_CHECKING:
+    from ecs_tentacles.record.systems.record import RecorderOptions
 
 
 class RecordPlugin(Plugin):
@@ -20,7 +25,11 @@ class RecordPlugin(Plugin):
     description = "records every frame's poses, suckers and the plugins' take tracks into a take"
 
     def __init__(
-        self, config: dict[str, object] | None = None, *, every: int = 1, **recorder: object
+        self,
+        config: dict[str, object] | None = None,
+        *,
+        every: int = 1,
+        **recorder: Unpack[RecorderOptions],
     ):
         super().__init__(config)
         from ecs_tentacles.record.systems.record import Record

@@ -18,7 +18,7 @@ import io
 import math
 import re
 import zipfile
-from typing import Any
+from collections.abc import Mapping
 
 import numpy as np
 
@@ -33,12 +33,12 @@ LEVEL = 1  # deflate level: the poses barely shrink past it; zeros shrink at any
 ENTRY = re.compile(r"^(?P<name>[a-z_]+)\.(?P<chunk>[0-9]{6})\.npy$")
 
 
-def chunked_names(header: dict[str, Any]) -> tuple[str, ...]:
+def chunked_names(header: dict[str, object]) -> tuple[str, ...]:
     """The arrays a version 2 take stores in chunks: `header["chunked"]` (bodies,
     suckers, replay records, and the curves tracks being recorded when the first chunk
     was stored), or without it the bodies, suckers and replay records."""
     listed = header.get("chunked")
-    if listed is not None:
+    if isinstance(listed, list):  # else absent (a sound header's is a list: chunked_problem)
         return tuple(listed)
     replay = take_replay.PER_FRAME if header.get(take_replay.KEY) is not None else ()
     return (*CORE, *replay)
@@ -81,9 +81,10 @@ STEP = 1e-4  # m: the step curves' points are stored in (`quantise`): at most 0.
 QUANTISED = np.dtype("<i8")
 
 
-def quantised_names(header: dict[str, Any]) -> tuple[str, ...]:
+def quantised_names(header: dict[str, object]) -> tuple[str, ...]:
     """The chunked arrays stored quantised (`header["quantised"]`: name -> step)."""
-    return tuple(header.get("quantised") or {})
+    quantised = header.get("quantised")
+    return tuple(quantised) if isinstance(quantised, dict) else ()  # sound: a dict or absent
 
 
 def curves_points(header: dict[str, object]) -> list[str]:
@@ -164,7 +165,9 @@ def pad_items(chunk: np.ndarray, items: int, later: np.ndarray | None) -> np.nda
     return out
 
 
-def frame_bytes(shapes: dict[str, tuple[int, ...]], dtypes: dict[str, Any]) -> int:
+def frame_bytes(
+    shapes: dict[str, tuple[int, ...]], dtypes: Mapping[str, np.dtype[np.generic]]
+) -> int:
     """Bytes of one frame of the chunked arrays among `shapes`."""
     return sum(
         math.prod(shape[1:]) * np.dtype(dtypes[name]).itemsize

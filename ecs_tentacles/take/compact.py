@@ -39,11 +39,14 @@ _BODY_KEYS = ("axis", "length", "name", "radius", "shape")
 _SUCKER_KEYS = ("body", "name", "offset")
 
 
+_Part = tuple[int, str, tuple[float, ...]]  # a sucker: its body in the creature, name, offset
+
+
 class PlanError(ValueError):
     """The header's `body_plans` is unsound; the message is one line naming the field."""
 
 
-def pack(header: dict[str, Any]) -> dict[str, Any]:
+def pack(header: dict[str, object]) -> dict[str, object]:
     """`header` with its bodies and suckers stored per body plan, when that round-trips."""
     creatures, bodies, suckers = (header.get(k) for k in ("creatures", "bodies", "suckers"))
     if not (isinstance(creatures, list) and isinstance(bodies, list) and creatures):
@@ -76,7 +79,7 @@ def unpacked(header: _T) -> _T:
     return cast(_T, unpack(header))
 
 
-def unpack(header: dict[str, object]) -> dict[str, Any]:
+def unpack(header: dict[str, object]) -> dict[str, object]:
     """`header` with `bodies` and `suckers` listed in full (as it is without `body_plans`);
     raises `PlanError` when the plan table is unsound."""
     if KEY not in header:
@@ -116,16 +119,16 @@ def unpack(header: dict[str, object]) -> dict[str, Any]:
 
 def _plans(
     creatures: list[dict[str, Any]], bodies: list[dict[str, Any]], suckers: list[dict[str, Any]]
-) -> dict[str, Any]:
+) -> dict[str, object]:
     """The plan table of creatures whose bodies and suckers run in creature order, each
     item holding exactly the keys `unpack` gives back (else ValueError: not packed)."""
-    plans: list[dict[str, Any]] = []
-    index: dict[tuple[Any, ...], int] = {}
+    plans: list[dict[str, list[dict[str, object]]]] = []
+    index: dict[tuple[tuple[tuple[object, ...], ...], tuple[_Part, ...]], int] = {}
     of: list[int] = []
     b = s = 0
     for c, creature in enumerate(creatures):
         stem, first = creature["name"] + "/", b
-        own: list[tuple[Any, ...]] = []
+        own: list[tuple[object, ...]] = []
         while b < len(bodies) and bodies[b]["creature"] == c:
             body = bodies[b]
             if len(body) != len(_BODY_KEYS) + 1 or not body["name"].startswith(stem):
@@ -133,7 +136,7 @@ def _plans(
             own.append(tuple(body[k] for k in _BODY_KEYS[:2]) + (body["name"][len(stem) :],)
                        + tuple(body[k] for k in _BODY_KEYS[3:]))  # fmt: skip
             b += 1
-        parts: list[tuple[Any, ...]] = []
+        parts: list[_Part] = []
         while s < len(suckers) and first <= suckers[s]["body"] < b:
             sucker = suckers[s]
             if len(sucker) != len(_SUCKER_KEYS) or not sucker["name"].startswith(stem):
@@ -151,7 +154,9 @@ def _plans(
     return {"plans": plans, "creatures": of}
 
 
-def _plan(bodies: list[tuple[Any, ...]], suckers: list[tuple[Any, ...]]) -> dict[str, Any]:
+def _plan(
+    bodies: list[tuple[object, ...]], suckers: list[_Part]
+) -> dict[str, list[dict[str, object]]]:
     """A plan's JSON form from its creature's bodies and suckers (names relative)."""
     return {
         "bodies": [dict(zip(_BODY_KEYS, body, strict=True)) for body in bodies],

@@ -79,9 +79,7 @@ def read_npy(
             raise TakeError(f"{label}: {problem}")
         array = np.empty(stored[::-1], dtype).T if fortran else np.empty(stored, dtype)
         empty = memoryview(b"")  # an empty array (a track with no items): nothing to read
-        view = (
-            memoryview(cast(Any, array.T if fortran else array)).cast("B") if array.size else empty
-        )
+        view = (array.T if fortran else array).data.cast("B") if array.size else empty
         filled = 0
         while filled < len(view):  # in pieces: zip's readinto reads all it is asked into a copy
             piece = view[filled : filled + READ_PIECE]

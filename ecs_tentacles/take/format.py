@@ -56,6 +56,7 @@ from typing import IO, Any, BinaryIO
 
 import numpy as np
 
+from ecs_tentacles.ground import StaticMesh
 from ecs_tentacles.take import chunks, compact
 from ecs_tentacles.take import ground as take_ground
 from ecs_tentacles.take import replay as take_replay
@@ -141,7 +142,7 @@ class Take:
         except ValueError:
             raise KeyError(f"no body named {name!r} in this take") from None
 
-    def ground_meshes(self) -> list[tuple[str, Any]]:
+    def ground_meshes(self) -> list[tuple[str, StaticMesh]]:
         """(name, `StaticMesh`) of the ground's meshes (none on the plane)."""
         return take_ground.meshes_of(self.header, self.tracks)
 

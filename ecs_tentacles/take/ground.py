@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 
 from ecs_tentacles.ground import Ground, StaticMesh
+from ecs_tentacles.take.header_entries import GroundMeshEntry, HeaderGround
 
 KEY = "ground"
 MAX_MESHES = 8
@@ -40,13 +41,13 @@ def array_name(mesh: str, part: str) -> str:
     return f"ground_{mesh}_{part}"
 
 
-def header_entry_and_arrays(ground: Ground) -> tuple[dict[str, Any] | None, dict[str, np.ndarray]]:
+def header_entry_and_arrays(ground: Ground) -> tuple[HeaderGround | None, dict[str, np.ndarray]]:
     """`header["ground"]` and the arrays for `ground` (None and none on the plane)."""
     present = [part for part in ground.meshes() if part.recorded]
     if not present:
         return None, {}
     arrays: dict[str, np.ndarray] = {}
-    entries = []
+    entries: list[GroundMeshEntry] = []
     for part in present:
         name, mesh = part.name, part.mesh
         entries.append(
@@ -63,7 +64,7 @@ def header_entry_and_arrays(ground: Ground) -> tuple[dict[str, Any] | None, dict
     return {"digest": ground.digest(), "meshes": entries}, arrays
 
 
-def entries(header: dict[str, Any]) -> list[dict[str, Any]]:
+def entries(header: dict[str, Any]) -> list[GroundMeshEntry]:
     """The meshes `header` declares (none on the plane); the header must be sound."""
     ground = header.get(KEY)
     return [] if ground is None else list(ground["meshes"])

@@ -181,8 +181,8 @@ def header_problem(header: object) -> str | None:
 
     if isinstance(version, bool) or version not in VERSIONS:
         return f"header.version: this reader knows versions 1 to 3, got {version!r}"
-    fps: Any = header.get("fps")
-    if not _is_number(fps) or not 0 < fps <= MAX_FPS:
+    fps = header.get("fps")
+    if not _is_number(fps) or not isinstance(fps, int | float) or not 0 < fps <= MAX_FPS:
         return f"header.fps: must be a number in (0, {MAX_FPS}], got {fps!r}"
     if not _is_int(header.get("frames")) or header["frames"] < 1:
         return f"header.frames: must be a whole number >= 1, got {header.get('frames')!r}"

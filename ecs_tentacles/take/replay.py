@@ -27,6 +27,8 @@ from typing import Any
 
 import numpy as np
 
+from ecs_tentacles.take.header_entries import HeaderCreature
+
 KEY = "replay"
 IDENTITY = np.array([1.0, 0.0, 0.0, 0.0], dtype=np.float32)
 PER_FRAME = ("replay_kind", "replay_phase", "replay_xy", "replay_heading")
@@ -90,7 +92,7 @@ def body_owners(header: dict[str, Any]) -> np.ndarray:
     return np.array([body["creature"] for body in header["bodies"]], dtype=np.int64)
 
 
-def body_rows(creature: dict[str, Any]) -> list[int]:
+def body_rows(creature: HeaderCreature) -> list[int]:
     """A take creature's body indices in clip order: mantle, then links by tentacle."""
     return [creature["mantle"], *(i for chain in creature["tentacles"] for i in chain)]
 

@@ -29,8 +29,10 @@ from __future__ import annotations
 import importlib.resources
 import json
 import re
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from typing import Any
+
+from ecs_tentacles.take.header_entries import HeaderTrack
 
 KINDS = ("points", "curves")
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
@@ -46,11 +48,10 @@ class TakeTrack:
     folder: str  # the group under each creature in USD ("goals", "fur")
     item: str  # points: name stem of each ("goal" -> goal0); curves: the prim ("guides")
 
-    def declaration(self) -> dict[str, Any]:
+    def declaration(self) -> HeaderTrack:
         """This track as `header["tracks"]` lists it."""
-        out = asdict(self)
-        out["arrays"] = list(self.arrays)
-        return out
+        return {"key": self.key, "kind": self.kind, "arrays": list(self.arrays),
+                "folder": self.folder, "item": self.item}  # fmt: skip
 
     def empty_header(self) -> list[object] | None:
         """Its header entry before anything is recorded."""

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import esper
 import numpy as np
@@ -104,25 +104,39 @@ def mark_creature(world: Host, creature: int) -> None:
     threats.creatures = np.append(threats.creatures, creature)
 
 
-def build_threats(world: Host, specs: Sequence[Mapping[str, Any]]) -> list[int]:
+def scene_threats(scene: Mapping[str, object]) -> list[Mapping[str, object]]:
+    """The scene's `threats` (defaults filled in: [] when it names none)."""
+    found = scene.get("threats", [])
+    if not isinstance(found, list) or not all(isinstance(t, Mapping) for t in found):
+        raise TypeError(f"threats: a list of objects, not {found!r}")
+    return found
+
+
+def build_threats(world: Host, specs: Sequence[Mapping[str, object]]) -> list[int]:
     """Threat entities that follow keyframed paths; returns their entities."""
     threats: ThreatData = world.resource(ThreatData)
     entities = []
     for i, spec in enumerate(specs):
         path = spec["path"]
+        if not isinstance(path, list):
+            raise TypeError(f"threats[{i}].path: a list of keys, not {path!r}")
         row = int(threats.store.add(pos=path[0]["position"])[0])
-        entity = world.create_entity(Threat(threats.store, row, spec.get("name", f"threat_{i}")))
+        name = str(spec.get("name", f"threat_{i}"))
+        entity = world.create_entity(Threat(threats.store, row, name))
         threats.store.entity[row] = entity
         threats.paths += channels_from_keys(row, (0, 1, 2), path, "position")
         entities.append(entity)
     return entities
 
 
-def threat_problems(scene: Mapping[str, Any]) -> list[Problem]:
+def threat_problems(scene: Mapping[str, object]) -> list[Problem]:
     """Threat names are unique and path keys come in time order."""
     problems: list[Problem] = []
     seen: dict[str, int] = {}
-    for i, threat in enumerate(scene.get("threats", [])):
+    threats = scene.get("threats", [])
+    if not isinstance(threats, list):
+        raise TypeError(f"threats: a list, not {threats!r}")
+    for i, threat in enumerate(threats):
         name = threat.get("name", f"threat_{i}")
         if name in seen:
             problems.append(

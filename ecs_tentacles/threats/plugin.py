@@ -8,7 +8,7 @@ Resources: `world.resource(ThreatData)` (`ecs_tentacles.threats.ThreatData`). Sy
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -17,7 +17,13 @@ from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.render.registries import Marker, Spheres
 from ecs_tentacles.scene.schema import plugin_schemas
 from ecs_tentacles.system import System
-from ecs_tentacles.threats.data import ThreatData, build_threats, mark_creature, threat_problems
+from ecs_tentacles.threats.data import (
+    ThreatData,
+    build_threats,
+    mark_creature,
+    scene_threats,
+    threat_problems,
+)
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
@@ -44,7 +50,7 @@ class ThreatsPlugin(Plugin):
     def resources(self, world: Host) -> list[object]:
         return [ThreatData()]
 
-    def build_creature(self, world: Host, creature: int, spec: Mapping[str, Any]) -> None:
+    def build_creature(self, world: Host, creature: int, spec: Mapping[str, object]) -> None:
         if spec.get("threat"):
             mark_creature(world, creature)
 
@@ -56,10 +62,10 @@ class ThreatsPlugin(Plugin):
         threats.creatures = threats.creatures[keep]
         threats.bodies = change.moved["transforms"][threats.bodies[keep]]
 
-    def save_scene(self, world: Host, scene: dict[str, Any]) -> None:
+    def save_scene(self, world: Host, scene: dict[str, object]) -> None:
         """The scene's threats still there, and the ones dropped since (where they stand)."""
         here = world.resource(ThreatData).positions(world)
-        kept = [t for t in scene.get("threats", []) if t.get("name") in here]
+        kept = [t for t in scene_threats(scene) if t.get("name") in here]
         named = {t.get("name") for t in kept}
         dropped = [
             {"name": name, "path": [{"time": 0.0, "position": [round(float(v), 6) for v in pos]}]}
@@ -69,8 +75,8 @@ class ThreatsPlugin(Plugin):
         if kept or dropped:
             scene["threats"] = kept + dropped
 
-    def build_scene(self, world: Host, scene: Mapping[str, Any]) -> None:
-        build_threats(world, scene["threats"])
+    def build_scene(self, world: Host, scene: Mapping[str, object]) -> None:
+        build_threats(world, scene_threats(scene))
 
     def systems(self) -> list[System]:
         from ecs_tentacles.threats.systems.threats import ThreatPaths

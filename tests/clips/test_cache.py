@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import inspect
+import typing
 from collections.abc import Callable
 from typing import Any
 
-from ecs_tentacles.clips.cache import ClipCache, morphology_key
+from ecs_tentacles.clips.cache import ClipCache, RecordOptions, morphology_key
+from ecs_tentacles.clips.clips import GaitClips
 from ecs_tentacles.scene.load import load_scene
 from ecs_tentacles.world import World
 
@@ -60,3 +63,14 @@ def test_what_a_world_replays_does_not_depend_on_the_worlds_built_before() -> No
     assert cache.get(dict(fast, name="renamed", position=[3.0, 1.0])) is from_fast
     fresh = ClipCache(**QUICK).get(fast)
     assert fresh.crawl.speed == from_fast.crawl.speed  # as in a process that met it first
+
+
+def test_record_options_are_the_recording_keywords() -> None:
+    """`ClipCache`'s keywords are typed by `RecordOptions`: it names exactly the keywords
+    `GaitClips.record` takes, so neither can drift."""
+    keywords = {
+        name
+        for name, p in inspect.signature(GaitClips.record).parameters.items()
+        if p.kind is inspect.Parameter.KEYWORD_ONLY
+    }
+    assert set(typing.get_type_hints(RecordOptions)) == keywords

@@ -1,14 +1,22 @@
 """A take's creature, body and sucker rows are what their TypedDicts say: exactly their
-fields, of their types, in memory and read back from the file."""
+fields, of their types, in memory and read back from the file; the header's keys are
+those `TakeHeader` names (all it requires, none it does not name), so they cannot drift."""
 
 from __future__ import annotations
 
 import typing
 from pathlib import Path
 
-from ecs_tentacles.export.bake import BakePlan, bake
+from ecs_tentacles.export.bake import BakePlan, bake, bake_to_file
 from ecs_tentacles.take import Take
-from ecs_tentacles.take.header_entries import HeaderBody, HeaderCreature, HeaderSucker
+from ecs_tentacles.take.header_entries import (
+    HeaderBody,
+    HeaderCreature,
+    HeaderHealth,
+    HeaderReplay,
+    HeaderSucker,
+    TakeHeader,
+)
 
 SCENE = {
     "version": 1,
@@ -61,3 +69,29 @@ def test_a_stray_key_or_value_is_found() -> None:
         "HeaderSucker[0]: keys ['body', 'extra', 'name', 'offset']",
         "HeaderSucker[1].body: '0'",
     ]
+
+
+def _key_strays(header: dict[str, object], kind: typing.Any) -> list[str]:
+    """Keys of `header` that `kind` does not name, and keys it requires that are absent."""
+    named, required = set(typing.get_type_hints(kind)), set(kind.__required_keys__)
+    return sorted({f"not named: {k}" for k in set(header) - named}
+                  | {f"absent: {k}" for k in required - set(header)})  # fmt: skip
+
+
+def test_a_baked_header_has_the_keys_take_header_names(tmp_path: Path, crowd_take: Take) -> None:
+    path = tmp_path / "t.npz"
+    written = bake_to_file(BakePlan.make(SCENE, seconds=0.1, fps=30), path, progress=False)
+    assert written is not None
+    headers = {"in memory": crowd_take.header, "written": written,
+               "read back": Take.read_header(path)}  # fmt: skip
+    for where, header in headers.items():
+        assert _key_strays(header, TakeHeader) == [], where
+        assert _key_strays(header["health"], HeaderHealth) == [], where
+    assert {"chunk_frames", "chunked"} <= set(written)  # what a file adds, named too
+    assert crowd_take.header["replay"] is not None  # the crowd replays clips
+    assert _key_strays(crowd_take.header["replay"], HeaderReplay) == []
+
+
+def test_a_key_take_header_does_not_name_is_found() -> None:
+    header = {k: 0 for k in TakeHeader.__required_keys__ if k != "seed"} | {"extra": 1}
+    assert _key_strays(header, TakeHeader) == ["absent: seed", "not named: extra"]

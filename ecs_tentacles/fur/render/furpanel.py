@@ -13,7 +13,8 @@ the display options live in the renderer's state (`fur.render.strands.fur_displa
 
 from __future__ import annotations
 
-from typing import Any
+from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 import numpy as np
 from imgui_bundle import imgui
@@ -28,6 +29,9 @@ from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.numeric.quaternions import quat_rotate
 from ecs_tentacles.render.gui import Gui, same_line_if_fits, text_width
 from ecs_tentacles.render.registries import Panel, SandboxView
+
+if TYPE_CHECKING:
+    from ecs_tentacles.world import World
 
 PICK_PIXELS = 14  # a click this close to a control's marker picks it
 
@@ -102,7 +106,7 @@ class FurPanel(Panel):
         return fur_display(self.sandbox.renderer.state)
 
     # -- the panel's hooks -----------------------------------------------------------
-    def attach(self, world: Any) -> None:
+    def attach(self, world: World) -> None:
         self.editor.attach(world)
         self.sync_view()
 
@@ -144,7 +148,11 @@ class FurPanel(Panel):
         (the timeline scrubs or plays), so it can be keyed.
         """
         world = self.sandbox.world
-        rig: Any = world.schedule["rig"]  # the fur rig system: play_tracks pins its clock
+        from ecs_tentacles.fur.systems.rig import Rig
+
+        rig = world.schedule["rig"]  # the fur rig system: play_tracks pins its clock
+        if not isinstance(rig, Rig):
+            raise TypeError(f"the schedule's rig is a {type(rig).__name__}, not the fur Rig")
         rig.play_tracks = not edit if self.sandbox.paused else True
         if self.sandbox.paused and len(world.resource(FurData).guides):
             rig.process(world, world.settings.dt)
@@ -233,7 +241,7 @@ class FurPanel(Panel):
             imgui.text_wrapped(self.message)
             gui.item("message")
 
-    def _try(self, action: Any) -> None:
+    def _try(self, action: Callable[[], object]) -> None:
         try:
             action()
         except (ValueError, KeyError, OSError) as error:

@@ -11,7 +11,7 @@ is kept there too. Reads: `FurData` (guides, controls, sets) through `fur.hooks`
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -47,10 +47,10 @@ class FurDisplay:
     creature: int | None = None
 
 
-def fur_display(state: dict[str, Any]) -> FurDisplay:
+def fur_display(state: dict[str, object]) -> FurDisplay:
     """The renderer's fur display settings (`renderer.state` / `view.state`)."""
     display = state.get(DISPLAY)
-    if display is None:
+    if not isinstance(display, FurDisplay):
         display = state[DISPLAY] = FurDisplay()
     return display
 
@@ -144,10 +144,10 @@ class FurStrands:
         return calls
 
 
-def strands_of(state: dict[str, Any]) -> FurStrands:
+def strands_of(state: dict[str, object]) -> FurStrands:
     """The renderer's `FurStrands`, made on first use (needs the renderer's GL context)."""
     strands = state.get(STRANDS)
-    if strands is None:
+    if not isinstance(strands, FurStrands):
         strands = state[STRANDS] = FurStrands()
     return strands
 

@@ -11,7 +11,7 @@ picked control's chosen attribute at the current time with the chosen easing;
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING
 
 from imgui_bundle import imgui
 
@@ -20,6 +20,10 @@ from ecs_tentacles.numeric.keyframes import EASINGS
 from ecs_tentacles.render.gui import Gui, same_line_if_fits, text_width
 from ecs_tentacles.render.registries import SandboxView
 
+if TYPE_CHECKING:
+    from ecs_tentacles.fur.render.furpanel import FurPanel
+    from ecs_tentacles.fur.systems.rig import Rig
+
 MIN_SPAN = 5.0  # seconds the scrubber shows at least
 TICK = (0.85, 0.2, 0.15, 1.0)  # key markers
 
@@ -27,7 +31,7 @@ TICK = (0.85, 0.2, 0.15, 1.0)  # key markers
 class Timeline:
     """The timeline window over a sandbox and its fur panel."""
 
-    def __init__(self, sandbox: SandboxView, panel: Any):
+    def __init__(self, sandbox: SandboxView, panel: FurPanel):
         self.sandbox = sandbox
         self.panel = panel
         self.attribute = ATTRIBUTES.index("lift")
@@ -43,9 +47,14 @@ class Timeline:
         keys = self.panel.editor.key_times()
         return max(MIN_SPAN, self.sandbox.world.time, keys[-1] if keys else 0.0)
 
-    def _rig(self) -> Any:
+    def _rig(self) -> Rig:
         """The running rig system (its `track_time` pins the tracks' clock)."""
-        return self.sandbox.world.schedule["rig"]
+        from ecs_tentacles.fur.systems.rig import Rig
+
+        rig = self.sandbox.world.schedule["rig"]
+        if not isinstance(rig, Rig):
+            raise TypeError(f"the schedule's rig is a {type(rig).__name__}, not the fur Rig")
+        return rig
 
     def scrub(self, time: float) -> None:
         """Pause and show the fur at `time`."""

@@ -15,7 +15,8 @@ take at 30 fps of a 60 fps world has `every=2`. The record plugin
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, TypedDict, Unpack
 
 from ecs_tentacles.export.recording import TakeRecorder, before_recording
 from ecs_tentacles.system import System
@@ -24,6 +25,17 @@ from ecs_tentacles.take import Take
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
     from ecs_tentacles.roster_change import RosterChange
+    from ecs_tentacles.take.registries import TrackSource
+    from ecs_tentacles.take.writer import TakeWriter
+
+
+class RecorderOptions(TypedDict, total=False):
+    """`TakeRecorder`'s keywords a `Record` passes on (its `fps` is the world's / every)."""
+
+    scene_sha256: str | None
+    capacity: int
+    tracks: Sequence[TrackSource]
+    writer: TakeWriter | None
 
 
 class Record(System):
@@ -35,7 +47,7 @@ class Record(System):
     # and what the plugins' take tracks sample (their hook_reads: goals, fur guides)
     reads = ("transforms.pos", "transforms.quat", "suckers.attached", "suckers.anchor")
 
-    def __init__(self, every: int = 1, **recorder: Any):
+    def __init__(self, every: int = 1, **recorder: Unpack[RecorderOptions]):
         if every < 1:
             raise ValueError(f"every must be >= 1, got {every}")
         self.every = every
