@@ -37,6 +37,10 @@ if TYPE_CHECKING:
     from ecs_tentacles.take.tracks import TrackSize
 
 
+# a problem a check finds in a scene: the JSON path of what is wrong, and a message
+Problem = tuple[tuple[str | int, ...], str]
+
+
 class HookFailure(RuntimeError):
     """A plugin's hook called `sys.exit` (raised SystemExit): a failure like any other,
     one line naming the plugin and the hook (the command line exits 1), never a quiet
@@ -121,7 +125,7 @@ class Plugin:
         `resources` and `stores`."""
 
     # -- scene ---------------------------------------------------------------------------
-    def problems(self, scene: Mapping[str, object]) -> list[tuple[tuple[str | int, ...], str]]:
+    def problems(self, scene: Mapping[str, object]) -> list[Problem]:
         """Rules the schema cannot say, on a defaults-filled scene: (json path, message)."""
         return []
 
@@ -188,7 +192,7 @@ class Plugin:
         """Write this plugin's scene-level state into `scene` when a running world is
         saved (`ecs_tentacles.creatures.roster_save`; the threats plugin: threats dropped since)."""
 
-    def scene_files(self, scene: Mapping[str, object]) -> list[tuple[tuple[str | int, ...], str]]:
+    def scene_files(self, scene: Mapping[str, object]) -> list[Problem]:
         """The files this plugin's keys of `scene` name, each as (its JSON path, the name
         as written, relative to the scene's folder): a save to another folder takes them
         along (`ecs_tentacles.scene.save`; the terrain plugin: height images, meshes)."""

@@ -13,6 +13,8 @@ took 20 ms, a whole despawn has a budget of 5.
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from ecs_tentacles.fur.bind import make_bind
@@ -26,17 +28,7 @@ Block = tuple[slice, Bind]  # the guide rows a block holds, and their bind
 def renumbered(bind: Bind, control: np.ndarray, body: np.ndarray) -> Bind:
     """`bind`'s guides with control and body indices mapped (old -> new) by `control`
     and `body`; the float arrays are shared, not copied."""
-    return Bind(
-        root=bind.root,
-        basis=bind.basis,
-        rest_cos=bind.rest_cos,
-        rest_sin=bind.rest_sin,
-        tan_min=bind.tan_min,
-        multiplier=bind.multiplier,
-        control=control[bind.control],
-        body=body[bind.body],
-        shape_h=bind.shape_h,
-    )
+    return dataclasses.replace(bind, control=control[bind.control], body=body[bind.body])
 
 
 def joined(parts: list[Bind]) -> Bind:

@@ -21,7 +21,7 @@ from ecs_tentacles.fur.checks import fur_problems
 from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.render.registries import Draws, Lines, Panels
-from ecs_tentacles.scene.schema import fragment
+from ecs_tentacles.scene.schema import plugin_schemas
 from ecs_tentacles.system import System
 from ecs_tentacles.take.registries import RecordingStarts, TakeTracks, TrackSource
 
@@ -33,7 +33,6 @@ if TYPE_CHECKING:
     from ecs_tentacles.store import ArrayStore
     from ecs_tentacles.take.tracks import TrackSize
 
-_FRAGMENT = fragment("ecs_tentacles.fur", "fur")
 STORES = ("guides", "controls", "sets", "emotions")
 
 
@@ -48,8 +47,9 @@ class FurPlugin(Plugin):
     name = "fur"
     build_order = 40  # a default plugin: built after threats (30), before clips (50)
     description = "fur and feathers (lift, aim, direction, random, dynamic blend) and emotion"
-    creature_schema = _FRAGMENT["creature"]
-    defs = _FRAGMENT["$defs"]
+    creature_schema, tentacle_schema, scene_schema, defs = plugin_schemas(
+        "ecs_tentacles.fur", "fur"
+    )
     # the take's guide curves and the sandbox's strands and markers
     hook_reads = ("fur.guides", "fur.sets", "fur.controls")
 

@@ -29,7 +29,8 @@ import mujoco
 import numpy as np
 
 __all__ = [
-    "FLAT", "Ground", "GroundMesh", "Plane", "StaticMesh", "StaticSpec", "WorldGround", "ground_of",
+    "FLAT", "Ground", "GroundMesh", "Plane", "StaticContact", "StaticMesh", "StaticSpec",
+    "WorldGround", "ground_of",
 ]  # fmt: skip
 
 
@@ -40,6 +41,27 @@ class StaticSpec(Protocol):
 
     def add_hfield(self, **kwargs: object) -> mujoco.MjsHField: ...
     def add_mesh(self, **kwargs: object) -> mujoco.MjsMesh: ...
+
+
+@dataclass(frozen=True)
+class StaticContact:
+    """How the static geoms in a creature's model meet its bodies (`physics.model` gives
+    it): sliding friction, MuJoCo's contact bits and the contact's `solref`."""
+
+    friction: float
+    contype: int
+    conaffinity: int
+    solref: Sequence[float]
+
+    def geom(self, friction: float | None = None) -> dict[str, object]:
+        """`add_geom` keywords for a static geom, its sliding `friction` (when given) in
+        place of the model's."""
+        return {
+            "friction": [self.friction if friction is None else friction, 0.005, 1e-4],
+            "contype": self.contype,
+            "conaffinity": self.conaffinity,
+            "solref": list(self.solref),
+        }
 
 
 @dataclass(frozen=True)
@@ -107,14 +129,7 @@ class Ground(Protocol):
         """(k, 2) the obstacles' centres in x, y and (k,) their largest half extents."""
 
     def meshes(self) -> list[GroundMesh]: ...
-    def add_to_spec(
-        self,
-        spec: StaticSpec,
-        friction: float,
-        contype: int,
-        conaffinity: int,
-        solref: Sequence[float],
-    ) -> None:
+    def add_to_spec(self, spec: StaticSpec, contact: StaticContact) -> None:
         """Add the ground's static geoms (named `ground...`) to a creature's model spec."""
 
 
@@ -184,22 +199,12 @@ class Plane:
     def meshes(self) -> list[GroundMesh]:
         return []  # the renderer draws the plane's grid; takes hold no ground
 
-    def add_to_spec(
-        self,
-        spec: StaticSpec,
-        friction: float,
-        contype: int,
-        conaffinity: int,
-        solref: Sequence[float],
-    ) -> None:
+    def add_to_spec(self, spec: StaticSpec, contact: StaticContact) -> None:
         spec.worldbody.add_geom(
             name="ground",
             type=mujoco.mjtGeom.mjGEOM_PLANE,
             size=[0, 0, 1.0],
-            friction=[self.friction if self.friction is not None else friction, 0.005, 1e-4],
-            contype=contype,
-            conaffinity=conaffinity,
-            solref=list(solref),
+            **contact.geom(self.friction),
         )
 
 

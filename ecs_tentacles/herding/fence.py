@@ -16,7 +16,7 @@ spec it is handed).
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -24,7 +24,7 @@ import mujoco
 import numpy as np
 
 if TYPE_CHECKING:
-    from ecs_tentacles.ground import Ground, StaticSpec
+    from ecs_tentacles.ground import Ground, StaticContact, StaticSpec
     from ecs_tentacles.herding.game import HerdingGame
     from ecs_tentacles.world import World
 
@@ -111,15 +111,7 @@ class Fence:
         ok_goal: np.ndarray = ok & (~near | self.in_gate(np.arctan2(goal[:, 1], goal[:, 0]), CLEAR))
         return ok_goal
 
-    def add_to_spec(
-        self,
-        spec: StaticSpec,
-        ground: Ground,
-        friction: float,
-        contype: int,
-        conaffinity: int,
-        solref: Sequence[float],
-    ) -> None:
+    def add_to_spec(self, spec: StaticSpec, ground: Ground, contact: StaticContact) -> None:
         """The fence's boxes, standing on `ground`, as static geoms `pen/fence<i>`."""
         centres, half, angles = self.boxes()
         base = ground.height(centres)
@@ -130,16 +122,13 @@ class Fence:
                 size=[float(h), 0.5 * THICKNESS, 0.5 * self.height + 0.1],
                 pos=[float(xy[0]), float(xy[1]), float(z) + 0.5 * self.height - 0.1],
                 quat=[float(np.cos(0.5 * angle)), 0.0, 0.0, float(np.sin(0.5 * angle))],
-                friction=[friction, 0.005, 1e-4],
-                contype=contype,
-                conaffinity=conaffinity,
-                solref=list(solref),
+                **contact.geom(),
             )
 
 
 def static_geometry(
     world: World,
-) -> Callable[[StaticSpec, float, int, int, Sequence[float]], None]:
+) -> Callable[[StaticSpec, StaticContact], None]:
     """The herding plugin's `StaticGeometry` entry (`ecs_tentacles.physics.model`): the
     fence in every creature's model; with no other entry (no terrain), the ground too,
     as the model would have had it without any."""
@@ -147,13 +136,11 @@ def static_geometry(
     from ecs_tentacles.herding.game import HerdingGame
     from ecs_tentacles.physics.model import StaticGeometry
 
-    def add(
-        spec: StaticSpec, friction: float, contype: int, conaffinity: int, solref: Sequence[float]
-    ) -> None:
+    def add(spec: StaticSpec, contact: StaticContact) -> None:
         ground = ground_of(world)
         if len(list(world.registry(StaticGeometry))) == 1:  # only this one: the plane too
-            ground.add_to_spec(spec, friction, contype, conaffinity, solref)
+            ground.add_to_spec(spec, contact)
         fence = Fence.of(world.resource(HerdingGame))
-        fence.add_to_spec(spec, ground, friction, contype, conaffinity, solref)
+        fence.add_to_spec(spec, ground, contact)
 
     return add

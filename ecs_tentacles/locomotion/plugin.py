@@ -51,7 +51,7 @@ from ecs_tentacles.render.registries import (
 )
 from ecs_tentacles.scene.construction import tentacle_params
 from ecs_tentacles.scene.parameters import apply_parameters
-from ecs_tentacles.scene.schema import fragment
+from ecs_tentacles.scene.schema import plugin_schemas
 from ecs_tentacles.scene.spec import as_spec
 from ecs_tentacles.system import System
 from ecs_tentacles.take.registries import TakeTracks, TrackSource
@@ -68,8 +68,6 @@ if TYPE_CHECKING:
     from ecs_tentacles.store import ArrayStore
     from ecs_tentacles.take.tracks import TrackSize
 
-_FRAGMENT = fragment("ecs_tentacles.locomotion", "locomotion")
-
 
 class LocomotionState(NamedTuple):
     """What a snapshot keeps: each creature's goal path (position, radius), each
@@ -85,9 +83,9 @@ class LocomotionPlugin(Plugin):
     name = "locomotion"
     build_order = 10  # a default plugin: built before suckers (20)
     description = "goal-directed crawling: goal paths, gait, action queues, motor targets"
-    creature_schema = _FRAGMENT["creature"]
-    tentacle_schema = _FRAGMENT["tentacles"]
-    scene_schema = _FRAGMENT["scene"]
+    creature_schema, tentacle_schema, scene_schema, defs = plugin_schemas(
+        "ecs_tentacles.locomotion", "locomotion"
+    )
     # its MotionWants and TravelTargets entries
     hook_reads = (
         "locomotion.creatures.has_goal",
@@ -97,7 +95,6 @@ class LocomotionPlugin(Plugin):
         "transforms.pos",
         "creatures.mantle_row",
     )
-    defs = _FRAGMENT["$defs"]
 
     _directed: DirectedStates | None = None  # the sandbox's undo mementos (`locomotion.directing`)
 

@@ -25,7 +25,7 @@ lists, in model order, which store rows they belong to.
 from __future__ import annotations
 
 import functools
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, NamedTuple
 
@@ -33,7 +33,7 @@ import mujoco
 import numpy as np
 
 from ecs_tentacles.components import Creature, Link, Motor, Sucker, Tentacle, Transform
-from ecs_tentacles.ground import FLAT, StaticSpec
+from ecs_tentacles.ground import FLAT, StaticContact, StaticSpec
 from ecs_tentacles.numeric.quaternions import quat_about_z
 from ecs_tentacles.registry import Registry
 
@@ -161,11 +161,12 @@ def _settings_key(settings: Settings) -> tuple[object, ...]:
             settings.sucker_timeconst)  # fmt: skip
 
 
-class StaticGeometry(Registry[Callable[[StaticSpec, float, int, int, Sequence[float]], None]]):
+class StaticGeometry(Registry[Callable[[StaticSpec, StaticContact], None]]):
     """Static geoms in every creature's model, filled in plugins' `build(app)`: an entry
-    `(spec, friction, contype, conaffinity, solref)` adds them to a creature's MjSpec,
-    named `ground...` (the terrain plugin: its heightfield, the plane beyond it, its
-    solids). Without an entry the model has the plane z = 0 (`ground.FLAT`)."""
+    `(spec, contact)` adds them to a creature's MjSpec (their friction, contact bits and
+    solref from `contact`, a `ground.StaticContact`), named `ground...` (the terrain
+    plugin: its heightfield, the plane beyond it, its solids). Without an entry the model
+    has the plane z = 0 (`ground.FLAT`)."""
 
 
 def hinges(link: Link) -> tuple[str, ...]:
@@ -203,8 +204,9 @@ def new_spec(world: PhysicsHost, timestep: float | None = None) -> mujoco.MjSpec
     spec.memory = ARENA_BYTES
     # the static geometry plugins add (a heightfield, solids), else the plane z = 0
     statics = list(world.registry(StaticGeometry))
+    contact = StaticContact(settings.ground_friction, GROUND_BIT, CREATURE_BIT, CONTACT_SOLREF)
     for add in statics or [FLAT.add_to_spec]:
-        add(spec, settings.ground_friction, GROUND_BIT, CREATURE_BIT, CONTACT_SOLREF)
+        add(spec, contact)
     return spec
 
 

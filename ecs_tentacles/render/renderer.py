@@ -48,7 +48,7 @@ from ecs_tentacles.render.outlines import INSTANCE_FLOATS as RIBBON_FLOATS
 from ecs_tentacles.render.outlines import RIBBON_VERTEX, ribbon_instances
 from ecs_tentacles.render.passes import ribbon_pass, shadow_pass
 from ecs_tentacles.render.registries import Draws, FramedPoints, RenderView
-from ecs_tentacles.render.scenery import Scenery, use_lit
+from ecs_tentacles.render.scenery import Scenery, Sight, use_lit
 from ecs_tentacles.render.skinned import SkinnedCreatures
 from ecs_tentacles.roster_change import RosterChange
 from ecs_tentacles.skin.colours import PALETTES, Look, creature_colour, look_in_world
@@ -341,9 +341,8 @@ class Renderer:
         eye = tuple(self.camera.eye.astype(np.float32))
         fog = fog_range(self.camera.distance)
         ground = ground_of(self.world)
-        calls = self.scenery.draw_kept(
-            self.target, ground, view_projection, eye, LIGHT, fog, grid=not self.clean
-        )
+        sight = Sight(view_projection, eye, LIGHT, fog, grid=not self.clean)
+        calls = self.scenery.draw_kept(self.target, ground, sight)
         # the ground is sent to be rasterised (software GL's threads fill it while this
         # one fills the creatures' arrays: about 4 ms less of a crowd's 50 ms frame)
         gl.glFlush()

@@ -24,6 +24,8 @@ surface's program (the terrain's, the creatures').
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from pyglet import gl
 from pyglet.graphics.shader import ShaderProgram
@@ -41,6 +43,29 @@ from ecs_tentacles.render.gpu import (
 )
 from ecs_tentacles.render.horizon import HORIZON, REACH, ZENITH
 from ecs_tentacles.render.meshes import Mesh
+
+
+@dataclass(frozen=True, eq=False)
+class Sight:
+    """What the ground is drawn for: the camera's `view_projection` and `eye`, the
+    `light`, the `fog` (`render.horizon.fog_range`) and whether the metre `grid` shows
+    (False: the clean view)."""
+
+    view_projection: np.ndarray
+    eye: tuple[float, ...]
+    light: np.ndarray
+    fog: tuple[float, float]
+    grid: bool = True
+
+    def key(self) -> tuple[object, ...]:
+        """Equal for two sights that draw the same picture."""
+        return (
+            np.asarray(self.view_projection, np.float64).tobytes(),
+            self.eye,
+            tuple(np.asarray(self.light, np.float64)),
+            self.fog,
+            self.grid,
+        )
 
 
 def set_fog(prog: ShaderProgram, fog: tuple[float, float]) -> None:
@@ -109,18 +134,11 @@ class Scenery:
             drawn.update(instance)
             self.ground_meshes.append(drawn)
 
-    def draw(
-        self,
-        ground: Ground,
-        view_projection: np.ndarray,
-        eye: tuple[float, ...],
-        light: np.ndarray,
-        fog: tuple[float, float],
-        grid: bool = True,
-    ) -> int:
-        """The ground as `ground` is now (with its metre grid unless `grid` is False: the
-        clean view), then the sky; returns the draw calls. The caller has the depth test
-        on and the depth buffer cleared."""
+    def draw(self, ground: Ground, sight: Sight) -> int:
+        """The ground as `ground` is now (with its metre grid unless `sight.grid` is
+        False: the clean view), then the sky; returns the draw calls. The caller has the
+        depth test on and the depth buffer cleared."""
+        view_projection, eye, fog, grid = sight.view_projection, sight.eye, sight.fog, sight.grid
         calls = 0
         self.build(ground)  # nothing to do unless the terrain was edited
         if ground.extent is None:  # the plane's grid
@@ -133,41 +151,22 @@ class Scenery:
             calls += self.plane.draw()
             gl.glEnable(gl.GL_CULL_FACE)
         if self.ground_meshes:  # terrain, beyond it, obstacles: lit, three draws at most
-            use_lit(self.terrain_program, view_projection, light, eye, fog)
+            use_lit(self.terrain_program, view_projection, sight.light, eye, fog)
             self.terrain_program["u_grid"] = float(grid)
             for mesh in self.ground_meshes:
                 calls += mesh.draw()
         return calls + self.draw_sky(view_projection)
 
-    def draw_kept(
-        self,
-        target: Target,
-        ground: Ground,
-        view_projection: np.ndarray,
-        eye: tuple[float, ...],
-        light: np.ndarray,
-        fog: tuple[float, float],
-        grid: bool = True,
-    ) -> int:
+    def draw_kept(self, target: Target, ground: Ground, sight: Sight) -> int:
         """`draw` into `target` (bound, with the scissor the caller wants), or a copy of
         the same picture kept from an earlier frame drawn for the same view; returns the
         draw calls the drawing takes (the same either way)."""
         box = _scissor()
-        drawn_for = (
-            np.asarray(view_projection, np.float64).tobytes(),
-            eye,
-            tuple(np.asarray(light, np.float64)),
-            fog,
-            grid,
-            id(ground),
-            target.width,
-            target.height,
-            box,
-        )
+        drawn_for = (*sight.key(), id(ground), target.width, target.height, box)
         if drawn_for == self.kept_for and self.kept is not None:
             _copy(self.kept, target)
             return self.kept_calls
-        calls = self.draw(ground, view_projection, eye, light, fog, grid)
+        calls = self.draw(ground, sight)
         if drawn_for == self.last_for and can_keep():  # still since the frame before
             if self.kept is None or (self.kept.width, self.kept.height) != (
                 target.width,

@@ -13,13 +13,11 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping, Sequence
 from typing import TYPE_CHECKING
 
-from ecs_tentacles.plugin import calling
+from ecs_tentacles.plugin import Problem, calling
 from ecs_tentacles.registry import App, Registries, Registry
 
 if TYPE_CHECKING:
     from ecs_tentacles.plugin import Plugin
-
-Problem = tuple[tuple[str | int, ...], str]
 
 
 class SceneChecks(Registry[Callable[[Mapping[str, object], Registries], list[Problem]]]):

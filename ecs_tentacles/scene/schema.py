@@ -42,6 +42,16 @@ def fragment(package: str, name: str) -> dict[str, Any]:
     return found
 
 
+def plugin_schemas(package: str, name: str) -> tuple[dict[str, Any], ...]:
+    """A feature plugin's `creature_schema`, `tentacle_schema`, `scene_schema` and `defs`
+    from its fragment (`fragment(package, name)`; {} for a place it has no keys in):
+
+        creature_schema, tentacle_schema, scene_schema, defs = plugin_schemas(package, name)
+    """
+    found = fragment(package, name)
+    return tuple(found.get(place, {}) for place in ("creature", "tentacles", "scene", "$defs"))
+
+
 def _fragment_file(package: str, name: str) -> importlib.resources.abc.Traversable:
     """`<name>.schema.json` in a feature package, found without importing the package
     (nor its top: `importlib.resources.files` would run an examples package's

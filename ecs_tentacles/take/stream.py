@@ -23,7 +23,6 @@ import zlib
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from types import TracebackType
 
 import numpy as np
 
@@ -38,6 +37,7 @@ from ecs_tentacles.take.header import (
     TakeError,
 )
 from ecs_tentacles.take.tracks import tracks_of
+from ecs_tentacles.untrusted.files import ClosedOnExit
 
 __all__ = ["ReplaySegment", "TakeSource", "open_take"]
 
@@ -55,7 +55,7 @@ class ReplaySegment:
     rate: float
 
 
-class TakeSource:
+class TakeSource(ClosedOnExit):
     """An open take: its checked header, arrays without frames, and chunks of frames."""
 
     def __init__(self, path: str | Path, max_bytes: int = MAX_TAKE_BYTES) -> None:
@@ -100,18 +100,7 @@ class TakeSource:
         per_frame = frame_arrays(take.header)
         return {name: value for name, value in take.tracks.items() if name not in per_frame}
 
-    # -- the context manager ------------------------------------------------------------
-    def __enter__(self) -> TakeSource:
-        return self
-
-    def __exit__(
-        self,
-        kind: type[BaseException] | None,
-        error: BaseException | None,
-        trace: TracebackType | None,
-    ) -> None:
-        self.close()
-
+    # -- closing --------------------------------------------------------------------------
     def close(self) -> None:
         if self._zip is not None:
             self._zip.close()

@@ -14,13 +14,13 @@ registry), the renderer and takes its meshes (`meshes`, `ground_meshes.py`).
 from __future__ import annotations
 
 import hashlib
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 import mujoco
 import numpy as np
 
-from ecs_tentacles.ground import GroundMesh, Plane, StaticSpec, ground_of
+from ecs_tentacles.ground import GroundMesh, Plane, StaticContact, StaticSpec, ground_of
 from ecs_tentacles.numeric.optional_kernels import OptionalKernels
 from ecs_tentacles.terrain.convex_pieces import ConvexPieces
 from ecs_tentacles.terrain.ground_meshes import ground_meshes
@@ -290,7 +290,7 @@ class TerrainGround:
         cached = self.__dict__.get("_static_model")
         if cached is None:
             spec = mujoco.MjSpec()
-            self.add_to_spec(spec, 1.0, 1, 1, (0.02, 1.0))
+            self.add_to_spec(spec, StaticContact(1.0, 1, 1, (0.02, 1.0)))
             model = spec.compile()
             data = mujoco.MjData(model)
             mujoco.mj_forward(model, data)
@@ -351,24 +351,12 @@ class TerrainGround:
         return ground_meshes(self.heightfield, self.solids)
 
     # -- the physics ---------------------------------------------------------------------
-    def add_to_spec(
-        self,
-        spec: StaticSpec,
-        friction: float,
-        contype: int,
-        conaffinity: int,
-        solref: Sequence[float],
-    ) -> None:
+    def add_to_spec(self, spec: StaticSpec, contact: StaticContact) -> None:
         """Add the ground's static geoms (named `ground...`) to a creature's model spec."""
-        common = {
-            "friction": [self.friction if self.friction is not None else friction, 0.005, 1e-4],
-            "contype": contype,
-            "conaffinity": conaffinity,
-            "solref": list(solref),
-        }
+        common = contact.geom(self.friction)
         body = spec.worldbody
         if self.heightfield is None:  # the plane, as the world without a terrain has it
-            Plane(self.friction).add_to_spec(spec, friction, contype, conaffinity, solref)
+            Plane(self.friction).add_to_spec(spec, contact)
         else:
             field_ = self.heightfield
             low, high = float(field_.heights.min()), float(field_.heights.max())

@@ -33,7 +33,6 @@ import pathlib
 import select
 import subprocess
 import time
-from types import TracebackType
 from typing import IO
 
 import numpy as np
@@ -43,6 +42,7 @@ from ecs_tentacles.processes import python_module
 from ecs_tentacles.scene.load import MAX_SCENE_BYTES
 from ecs_tentacles.terrain import mesh_cache, mesh_worker
 from ecs_tentacles.terrain.heights import TerrainError, beside_scene, read_found
+from ecs_tentacles.untrusted.files import ClosedOnExit
 
 MESH_SECONDS = 60.0  # per mesh: reading, checks and decomposition
 MESH_MEMORY_MB = 1024  # the worker's resident memory while it works on one mesh
@@ -165,7 +165,7 @@ class _Worker:
         return b""
 
 
-class MeshReader:
+class MeshReader(ClosedOnExit):
     """Reads a scene's mesh files (see the module's notes); use it as a context manager,
     so its worker ends with the scene build."""
 
@@ -174,17 +174,6 @@ class MeshReader:
         self.worker: _Worker | None = None
         self.deadline = time.monotonic() + SCENE_MESH_SECONDS
         self.over: dict[str, str] = {}  # key -> why it went over a budget (this build)
-
-    def __enter__(self) -> MeshReader:
-        return self
-
-    def __exit__(
-        self,
-        kind: type[BaseException] | None,
-        error: BaseException | None,
-        trace: TracebackType | None,
-    ) -> None:
-        self.close()
 
     def close(self) -> None:
         if self.worker is not None:

@@ -24,7 +24,7 @@ from ecs_tentacles.physics.model import StaticGeometry
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.render.registries import Panels
 from ecs_tentacles.scene.errors import SceneError
-from ecs_tentacles.scene.schema import fragment
+from ecs_tentacles.scene.schema import plugin_schemas
 from ecs_tentacles.scene.spec import as_spec
 from ecs_tentacles.terrain.editing import TerrainEditor
 from ecs_tentacles.terrain.heights import source_problems
@@ -37,7 +37,6 @@ if TYPE_CHECKING:
     from ecs_tentacles.registry import App
     from ecs_tentacles.render.registries import Panel, SandboxView
 
-_FRAGMENT = fragment("ecs_tentacles.terrain", "terrain")
 SINK_TOLERANCE = 0.001  # metres a 3-d placed creature may start inside the heightfield
 
 
@@ -45,8 +44,9 @@ class TerrainPlugin(Plugin):
     name = "terrain"
     build_order = 60  # a default plugin: built after clips (50)
     description = "a heightfield and static obstacles instead of the flat plane"
-    scene_schema = _FRAGMENT["scene"]
-    defs = _FRAGMENT["$defs"]
+    creature_schema, tentacle_schema, scene_schema, defs = plugin_schemas(
+        "ecs_tentacles.terrain", "terrain"
+    )
 
     def problems(self, scene: Mapping[str, object]) -> list[tuple[tuple[str | int, ...], str]]:
         terrain = scene.get("terrain")
@@ -86,7 +86,9 @@ class TerrainPlugin(Plugin):
         section (`render.registries`)."""
         world = app.world
         if world is not None:  # (a shard planner builds plugins without a world)
-            app.add(StaticGeometry, lambda spec, *args: ground_of(world).add_to_spec(spec, *args))
+            app.add(
+                StaticGeometry, lambda spec, contact: ground_of(world).add_to_spec(spec, contact)
+            )
         app.add(Panels, self._panels)
 
     def _panels(self, sandbox: SandboxView) -> list[Panel]:

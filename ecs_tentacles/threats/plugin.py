@@ -15,7 +15,7 @@ import numpy as np
 from ecs_tentacles.behaviour import Dangers, DangerSource
 from ecs_tentacles.plugin import Plugin
 from ecs_tentacles.render.registries import Marker, Spheres
-from ecs_tentacles.scene.schema import fragment
+from ecs_tentacles.scene.schema import plugin_schemas
 from ecs_tentacles.system import System
 from ecs_tentacles.threats.data import (
     ThreatData,
@@ -31,7 +31,6 @@ if TYPE_CHECKING:
     from ecs_tentacles.roster_change import RosterChange
     from ecs_tentacles.store import ArrayStore
 
-_FRAGMENT = fragment("ecs_tentacles.threats", "threats")
 THREAT_SIZE = (0.07, 0.045, 0.04)  # metres along x, y, z
 THREAT_RGBA = (0.35, 0.12, 0.08, 1.0)
 
@@ -40,9 +39,9 @@ class ThreatsPlugin(Plugin):
     name = "threats"
     build_order = 30  # a default plugin: built after suckers (20), before fur (40)
     description = "marked threats on keyframed paths, and creatures marked as threats"
-    creature_schema = _FRAGMENT["creature"]
-    scene_schema = _FRAGMENT["scene"]
-    defs = _FRAGMENT["$defs"]
+    creature_schema, tentacle_schema, scene_schema, defs = plugin_schemas(
+        "ecs_tentacles.threats", "threats"
+    )
     hook_reads = ("threats", "transforms.pos")  # its Dangers entry (`behaviour.dangers`)
 
     def problems(self, scene: Mapping[str, object]) -> list[tuple[tuple[str | int, ...], str]]:

@@ -10,16 +10,20 @@ may be far larger than its kind ever is. The path is therefore opened with
 work shards are never links), checked with `fstat` on the same descriptor (so it
 cannot be swapped between check and read) and read at most `max_bytes + 1` bytes.
 `FileNotFoundError` and other `OSError`s of opening pass through (callers word them).
+`ClosedOnExit` is the base of a reader that holds files (or a worker) open between calls:
+`with` gives the reader and closes it however the block ends.
 """
 
 from __future__ import annotations
 
+import abc
 import contextlib
 import errno
 import os
 import stat
 from collections.abc import Iterator
-from typing import BinaryIO
+from types import TracebackType
+from typing import BinaryIO, Self
 
 _OPEN = os.O_RDONLY | os.O_NONBLOCK | os.O_NOCTTY | os.O_CLOEXEC
 
@@ -39,6 +43,26 @@ class TooLarge(Unfit):
     def __init__(self, limit: int) -> None:
         super().__init__(f"larger than {limit} bytes")
         self.limit = limit
+
+
+class ClosedOnExit(abc.ABC):
+    """A reader of files that holds them open until `close()`; as a context manager it
+    gives itself and is closed however the `with` block ends."""
+
+    @abc.abstractmethod
+    def close(self) -> None:
+        """Let go of what the reader holds open (callable more than once)."""
+
+    def __enter__(self) -> Self:
+        return self
+
+    def __exit__(
+        self,
+        kind: type[BaseException] | None,
+        error: BaseException | None,
+        trace: TracebackType | None,
+    ) -> None:
+        self.close()
 
 
 def kind_of(mode: int) -> str:

@@ -21,13 +21,11 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ecs_tentacles.behaviour import DESTINATION_WRITES, travel
-from ecs_tentacles.plugin import Plugin
+from ecs_tentacles.plugin import Plugin, Problem
 from ecs_tentacles.scene.defaults import plugin_config
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
-
-Problem = tuple[tuple[str | int, ...], str]
 
 # the store columns sending a creature writes: `ecs_tentacles.behaviour`'s (named here
 # too, for code that imported it from the examples)

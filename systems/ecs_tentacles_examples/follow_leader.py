@@ -22,12 +22,12 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ecs_tentacles.behaviour import ARRIVALS, DESTINATIONS_READ, travel
+from ecs_tentacles.behaviour import ARRIVALS, DESTINATION_WRITES, DESTINATIONS_READ, travel
 from ecs_tentacles.components import Creature
-from ecs_tentacles.plugin import Plugin
+from ecs_tentacles.plugin import Plugin, Problem
 from ecs_tentacles.scene.defaults import plugin_config
 from ecs_tentacles.system import System
-from ecs_tentacles_examples import DESTINATION_WRITES, Problem, number, replanning, settings
+from ecs_tentacles_examples import number, replanning, settings
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host

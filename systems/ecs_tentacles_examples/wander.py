@@ -20,20 +20,12 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ecs_tentacles.behaviour import ARRIVALS, DESTINATIONS_READ, travel
+from ecs_tentacles.behaviour import ARRIVALS, DESTINATION_WRITES, DESTINATIONS_READ, travel
 from ecs_tentacles.creatures.body import creature_rng
-from ecs_tentacles.plugin import Plugin
+from ecs_tentacles.plugin import Plugin, Problem
 from ecs_tentacles.scene.defaults import plugin_config
 from ecs_tentacles.system import System
-from ecs_tentacles_examples import (
-    DESTINATION_WRITES,
-    Problem,
-    farther_than_reach,
-    number,
-    replanning,
-    send_goals,
-    settings,
-)
+from ecs_tentacles_examples import farther_than_reach, number, replanning, send_goals, settings
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host

@@ -7,7 +7,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from ecs_tentacles.ground import FLAT
+from ecs_tentacles.ground import FLAT, StaticContact
 from ecs_tentacles.terrain.ground import TerrainGround
 from ecs_tentacles.terrain.heightfield import Heightfield
 from ecs_tentacles.terrain.shapes import Solid, convex_planes
@@ -25,7 +25,7 @@ def _ray_height(model: mujoco.MjModel, x: float, y: float) -> float:
 
 def _static_model(ground: TerrainGround) -> mujoco.MjModel:
     spec = mujoco.MjSpec()
-    ground.add_to_spec(spec, 1.0, 1, 2, [0.02, 1.0])
+    ground.add_to_spec(spec, StaticContact(1.0, 1, 2, [0.02, 1.0]))
     return spec.compile()
 
 
@@ -48,7 +48,7 @@ def test_the_plane_is_what_it_always_was() -> None:
     np.testing.assert_array_equal(FLAT.distance(points), points[:, 2])
     np.testing.assert_array_equal(FLAT.height(points[:, :2]), [0.0, 0.0])
     spec = mujoco.MjSpec()
-    FLAT.add_to_spec(spec, 0.4, 1, 2, [0.006, 1.0])
+    FLAT.add_to_spec(spec, StaticContact(0.4, 1, 2, [0.006, 1.0]))
     model = spec.compile()
     assert model.ngeom == 1 and model.geom_type[0] == mujoco.mjtGeom.mjGEOM_PLANE
 
