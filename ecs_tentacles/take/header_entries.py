@@ -137,7 +137,9 @@ class _OptionalKeys(TypedDict, total=False):
 
 class TakeHeader(_OptionalKeys):
     """A take's header as the recorder and the writer give it (`ecs_tentacles.take.format`
-    describes each key); the standard tracks' keys (`goals`, `guides`) included."""
+    describes each key), but its tracks' keys: each track (the standard ones of
+    `ecs_tentacles.take.tracks.STANDARD`, and those `tracks` declares) adds its own key
+    beside these, holding `HeaderPoint`s (points) or a `HeaderCurves` (curves, or null)."""
 
     format: str
     version: int
@@ -151,6 +153,4 @@ class TakeHeader(_OptionalKeys):
     creatures: list[HeaderCreature]
     bodies: list[HeaderBody]
     suckers: list[HeaderSucker]
-    goals: list[HeaderPoint]
-    guides: HeaderCurves | None
     health: HeaderHealth

@@ -17,6 +17,7 @@ from ecs_tentacles.take.header_entries import (
     HeaderSucker,
     TakeHeader,
 )
+from ecs_tentacles.take.tracks import STANDARD, tracks_of
 
 SCENE = {
     "version": 1,
@@ -71,9 +72,12 @@ def test_a_stray_key_or_value_is_found() -> None:
     ]
 
 
-def _key_strays(header: dict[str, object], kind: typing.Any) -> list[str]:
-    """Keys of `header` that `kind` does not name, and keys it requires that are absent."""
-    named, required = set(typing.get_type_hints(kind)), set(kind.__required_keys__)
+def _key_strays(
+    header: dict[str, object], kind: typing.Any, tracks: frozenset[str] = frozenset()
+) -> list[str]:
+    """Keys of `header` that `kind` does not name (nor are `tracks`' keys), and keys it
+    requires that are absent."""
+    named, required = set(typing.get_type_hints(kind)) | tracks, set(kind.__required_keys__)
     return sorted({f"not named: {k}" for k in set(header) - named}
                   | {f"absent: {k}" for k in required - set(header)})  # fmt: skip
 
@@ -85,7 +89,10 @@ def test_a_baked_header_has_the_keys_take_header_names(tmp_path: Path, crowd_tak
     headers = {"in memory": crowd_take.header, "written": written,
                "read back": Take.read_header(path)}  # fmt: skip
     for where, header in headers.items():
-        assert _key_strays(header, TakeHeader) == [], where
+        tracks = frozenset(t.key for t in tracks_of(header))
+        assert {t.key for t in STANDARD} <= tracks
+        assert set(header) >= tracks, where  # every track's key is there
+        assert _key_strays(header, TakeHeader, tracks) == [], where
         assert _key_strays(header["health"], HeaderHealth) == [], where
     assert {"chunk_frames", "chunked"} <= set(written)  # what a file adds, named too
     assert crowd_take.header["replay"] is not None  # the crowd replays clips

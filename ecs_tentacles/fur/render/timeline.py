@@ -11,27 +11,35 @@ picked control's chosen attribute at the current time with the chosen easing;
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Protocol
 
 from imgui_bundle import imgui
 
-from ecs_tentacles.fur.editor import ATTRIBUTES
+from ecs_tentacles.fur.editor import ATTRIBUTES, FurEditor
 from ecs_tentacles.numeric.keyframes import EASINGS
 from ecs_tentacles.render.gui import Gui, same_line_if_fits, text_width
 from ecs_tentacles.render.registries import SandboxView
 
 if TYPE_CHECKING:
-    from ecs_tentacles.fur.render.furpanel import FurPanel
     from ecs_tentacles.fur.systems.rig import Rig
 
 MIN_SPAN = 5.0  # seconds the scrubber shows at least
 TICK = (0.85, 0.2, 0.15, 1.0)  # key markers
 
 
+class KeyedPanel(Protocol):
+    """What the timeline asks of its panel (`fur.render.furpanel.FurPanel`, which owns
+    the timeline: named here by what it does, not imported back)."""
+
+    editor: FurEditor
+
+    def refresh_rig(self) -> None: ...
+
+
 class Timeline:
     """The timeline window over a sandbox and its fur panel."""
 
-    def __init__(self, sandbox: SandboxView, panel: FurPanel):
+    def __init__(self, sandbox: SandboxView, panel: KeyedPanel):
         self.sandbox = sandbox
         self.panel = panel
         self.attribute = ATTRIBUTES.index("lift")
