@@ -10,6 +10,7 @@ import pytest
 
 from ecs_tentacles.scene import json_types, scene_spec, spec
 from ecs_tentacles.scene.schema import core_schema
+from tests.schema_types import leaf_mismatches
 
 _SCHEMA = core_schema()
 _CREATURE = _SCHEMA["$defs"]["creature"]["properties"]
@@ -31,7 +32,6 @@ PAIRS: dict[str, tuple[Any, dict[str, Any]]] = {
         _SCHEMA["$defs"]["tentacle_override"],
     ),
 }
-LEAVES = {"integer": int, "number": float, "boolean": bool, "string": str}
 
 
 def _keys(typed: Any) -> set[str]:
@@ -67,8 +67,4 @@ def test_keys_the_schema_requires_are_required(where: str) -> None:
 @pytest.mark.parametrize("where", PAIRS)
 def test_leaf_types_are_the_schemas(where: str) -> None:
     typed, schema = PAIRS[where]
-    hints = _hints(typed)
-    for key, node in schema["properties"].items():
-        kind = node.get("type")
-        if isinstance(kind, str) and kind in LEAVES:
-            assert hints[key] is LEAVES[kind], f"{where}.{key}: {hints[key]} for {kind}"
+    assert leaf_mismatches(_hints(typed), schema) == [], where

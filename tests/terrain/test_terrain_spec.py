@@ -10,6 +10,7 @@ import pytest
 
 from ecs_tentacles.terrain import terrain_spec
 from ecs_tentacles.terrain.plugin import TerrainPlugin
+from tests.schema_types import leaf_mismatches
 
 _TERRAIN = TerrainPlugin.scene_schema["terrain"]
 _DEFS = TerrainPlugin.defs
@@ -22,7 +23,6 @@ PAIRS = {
     ),
     "terrain.obstacles[]": (terrain_spec.ObstacleSpec, _DEFS["obstacle"]),
 }
-LEAVES = {"integer": int, "number": float, "boolean": bool, "string": str}
 
 
 def _hints(typed: type, extras: bool = False) -> dict[str, object]:
@@ -47,8 +47,4 @@ def test_required_keys_are_the_schemas(where: str) -> None:
 @pytest.mark.parametrize("where", PAIRS)
 def test_leaf_types_are_the_schemas(where: str) -> None:
     typed, schema = PAIRS[where]
-    hints = _hints(typed)
-    for key, node in schema["properties"].items():
-        kind = node.get("type")
-        if isinstance(kind, str) and kind in LEAVES:
-            assert hints[key] is LEAVES[kind], f"{where}.{key}: {hints[key]} for {kind}"
+    assert leaf_mismatches(_hints(typed), schema) == [], where
