@@ -179,7 +179,7 @@ def test_take_arrays_are_plain_numpy(scene: Path, tmp_path: Path) -> None:
 
 def test_a_local_bake_never_imports_ray(scene: Path, tmp_path: Path) -> None:
     code = (
-        "from ecs_tentacles.cli import main;"
+        "import sys; from ecs_tentacles.cli import main;"
         f" assert main(['bake', {str(scene)!r}, '--seconds', '0.1', '--quiet',"
         f" '--out', {str(tmp_path / 't.npz')!r}]) == 0;"
         " print(sorted(m for m in sys.modules if m == 'ray' or m.startswith('ray.')))"
