@@ -125,6 +125,29 @@ def scenes() -> st.SearchStrategy[dict[str, Any]]:
     )
 
 
+@pytest.fixture(scope="module", autouse=True)
+def _strategies_built_once() -> Iterator[None]:
+    """hypothesis-jsonschema builds an object's property strategy afresh from its schema
+    each time it draws that property (canonicalising the schema again), which was more
+    than half this module's time: the same schema object gives the same strategy, so it
+    is built once here. The scenes drawn are the same ones, in the same order."""
+    from hypothesis_jsonschema import _from_schema
+
+    build = getattr(_from_schema, "__from_schema")
+    built: dict[tuple[int, int, int], tuple[object, ...]] = {}
+
+    def once(schema: Any, *, alphabet: Any, custom_formats: Any) -> Any:
+        key = (id(schema), id(alphabet), id(custom_formats))
+        if key not in built:  # the inputs are kept too: their ids stay theirs
+            strategy = build(schema, alphabet=alphabet, custom_formats=custom_formats)
+            built[key] = (schema, alphabet, custom_formats, strategy)
+        return built[key][-1]
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(_from_schema, "__from_schema", once)
+        yield
+
+
 @pytest.fixture(scope="module")
 def scene_file(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return tmp_path_factory.mktemp("generated") / "scene.json"

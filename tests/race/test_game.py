@@ -4,7 +4,12 @@ restarts from its start."""
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from dataclasses import dataclass
+from typing import Any
+
 import numpy as np
+import pytest
 
 from ecs_tentacles.behaviour import travel
 from ecs_tentacles.game.rules import playing
@@ -28,7 +33,24 @@ class Straight:
         return [(-0.75, 0.3), (0.0, 0.0)]
 
 
-def test_the_runner_follows_its_path_to_the_flag_and_wins() -> None:
+@dataclass
+class StraightRace:
+    """The level raced once along `Straight`: what the race showed as it ended, and the
+    world, left as the race left it (the replay test restarts it; nothing else reads it)."""
+
+    world: World
+    result: dict[str, Any]
+    moved: np.ndarray
+    path: list[Any]
+    finished: list[tuple[str, int]]
+    runner: int
+    mode: str
+    ended: bool
+    reported_winner: str
+
+
+@pytest.fixture(scope="module")
+def straight_race() -> Iterator[StraightRace]:
     finished: list[RaceFinished] = []
     with World.from_scene(level(rivals_wait=600)) as world:
         world.events.on(RaceFinished, finished.append)
@@ -37,12 +59,22 @@ def test_the_runner_follows_its_path_to_the_flag_and_wins() -> None:
         result = play(world, Straight())
         moved = world.transforms.pos[world.creatures.mantle_row[0], :2] - start
         mode, ended = playing(world) or ("", None)
+        events = [(event.outcome, event.winner) for event in finished]
+        over = ended is not None and ended.ended
+        winner = ended.report(mode)["winner"] if ended is not None else ""
+        path = list(race.state.path)
+        yield StraightRace(world, result, moved, path, events, race.runner, mode, over, winner)
+
+
+def test_the_runner_follows_its_path_to_the_flag_and_wins(straight_race: StraightRace) -> None:
+    result, moved = straight_race.result, straight_race.moved
     assert result["outcome"] == "won" and result["winner"] == "you", result
     assert 0 < result["seconds"] < 20 and moved[0] > 0.5  # it crawled toward the flag
-    assert race.state.path == [] or len(race.state.path) == 1  # the waypoint was passed
-    assert [(event.outcome, event.winner) for event in finished] == [("won", race.runner)]
-    assert mode == "race" and ended is not None and ended.ended
-    assert ended.report(mode)["winner"] == "you"
+    path = straight_race.path
+    assert path == [] or len(path) == 1  # the waypoint was passed
+    assert straight_race.finished == [("won", straight_race.runner)]
+    assert straight_race.mode == "race" and straight_race.ended
+    assert straight_race.reported_winner == "you"
 
 
 def test_a_rival_at_the_flag_first_loses_the_race_and_the_clock_stops_it_too() -> None:
@@ -65,12 +97,13 @@ def test_the_rivals_wait_then_crawl_to_the_flag() -> None:
         assert np.allclose(goal, (0.0, 0.0))
 
 
-def test_a_race_replays_exactly_from_its_inputs_and_restarts_from_its_start() -> None:
-    with World.from_scene(level(rivals_wait=600)) as world:
-        first = play(world, Straight())
-        race = world.resource(RaceGame)
-        race.restart(world)
-        assert (world.frame, race.outcome, race.state.log) == (0, "playing", [])
+def test_a_race_replays_exactly_from_its_inputs_and_restarts_from_its_start(
+    straight_race: StraightRace,
+) -> None:
+    world, first = straight_race.world, straight_race.result
+    race = world.resource(RaceGame)
+    race.restart(world)
+    assert (world.frame, race.outcome, race.state.log) == (0, "playing", [])
     with World.from_scene(level(rivals_wait=600)) as world:
         again = play(world, Replay(first["log"]))
     assert (again["outcome"], again["seconds"]) == (first["outcome"], first["seconds"])

@@ -7,6 +7,7 @@ import json
 import shutil
 import zipfile
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -20,11 +21,20 @@ DATA = Path(__file__).parent.parent / "data"
 MM = 1e-3
 
 
+@pytest.fixture(scope="module")
+def streamed(
+    crowd_plan: BakePlan, tmp_path_factory: pytest.TempPathFactory
+) -> tuple[Path, dict[str, Any] | None]:
+    """The crowd baked to a file as it goes, once for the tests that only read it: the
+    file and the header the bake returned."""
+    out = tmp_path_factory.mktemp("streamed") / "streamed.npz"
+    return out, bake_to_file(crowd_plan, out, progress=False)
+
+
 def test_a_streamed_bake_holds_the_poses_the_world_showed(
-    crowd_plan: BakePlan, crowd_take: Take, tmp_path: Path
+    streamed: tuple[Path, dict[str, Any] | None], crowd_take: Take, tmp_path: Path
 ) -> None:
-    out = tmp_path / "streamed.npz"
-    header = bake_to_file(crowd_plan, out, progress=False)
+    out, header = streamed
     assert header is not None and header["frames"] == crowd_take.frames == 25
     replay = header["replay"]
     assert len(replay["clips"]) == 1 and sum(c >= 0 for c in replay["creatures"]) >= 5
@@ -50,10 +60,9 @@ def test_a_streamed_bake_holds_the_poses_the_world_showed(
 
 
 def test_replayed_creatures_are_stored_as_clips_not_poses(
-    crowd_plan: BakePlan, tmp_path: Path
+    streamed: tuple[Path, dict[str, Any] | None],
 ) -> None:
-    out = tmp_path / "streamed.npz"
-    bake_to_file(crowd_plan, out, progress=False)
+    out, _ = streamed
     with np.load(out) as raw:  # a plain npz: the documented few lines read it
         kind = raw["replay_kind.000000"]
         pos = raw["pos.000000"]
@@ -172,15 +181,17 @@ def test_a_take_that_lies_about_its_chunks_is_refused_in_one_line(
 
 
 def test_the_replay_check_decides_alike_with_and_without_its_kernel(
-    crowd_plan: BakePlan, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    crowd_plan: BakePlan,
+    streamed: tuple[Path, dict[str, Any] | None],
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
 ) -> None:
     """The recorder's one-pass check (numba) and the numpy reconstruction record the
     same replayed creature-frames: the two takes are byte for byte one file."""
     from ecs_tentacles.export import replay_recording
 
     pytest.importorskip("ecs_tentacles.export.replay_check_kernel")
-    fast, slow = tmp_path / "fast.npz", tmp_path / "slow.npz"
-    bake_to_file(crowd_plan, fast, progress=False)
+    (fast, _), slow = streamed, tmp_path / "slow.npz"
     monkeypatch.setattr(replay_recording.KERNELS, "backend", "numpy")
     bake_to_file(crowd_plan, slow, progress=False)
     with open_take(fast) as source:
@@ -189,10 +200,9 @@ def test_the_replay_check_decides_alike_with_and_without_its_kernel(
 
 
 def test_a_reader_that_asks_for_some_bodies_gets_those_posed_as_a_whole_read(
-    crowd_plan: BakePlan, tmp_path: Path
+    streamed: tuple[Path, dict[str, Any] | None],
 ) -> None:
-    out = tmp_path / "streamed.npz"
-    bake_to_file(crowd_plan, out, progress=False)
+    out, _ = streamed
     with open_take(out) as source:
         full = [chunk for _, chunk in source.chunks()]
         header = source.header
