@@ -269,11 +269,11 @@ def test_past_the_heightfields_edge_the_ground_goes_on_at_its_lowest_height(
 ) -> None:
     rows = [[0.2 + 0.01 * (r % 2)] * 7 for r in range(7)]  # 0.2-0.21 m up, 3 m across
     world = make_world(
-        scene({"heightfield": {"size": [3, 3], "heights": rows}}, [0.4, 0], goal=[3.5, 0])
-    )
+        scene({"heightfield": {"size": [3, 3], "heights": rows}}, [1.1, 0], goal=[3.5, 0])
+    )  # 0.4 m in from the edge: over it at about 5 s, 1.8 m at about 9 s
     ground = ground_of(world)
     assert ground.height(np.array([[5.0, 0.0]]))[0] == pytest.approx(0.2)
-    while world.time < 30.0:
+    while world.time < 14.0:
         world.step()
     mantle = world.transforms.pos[world.creatures.mantle_row[0]]
     assert mantle[0] > 1.8  # it crawled off the edge
