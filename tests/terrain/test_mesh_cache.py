@@ -21,7 +21,6 @@ import numpy as np
 import pytest
 
 from ecs_tentacles.terrain import mesh_cache
-from ecs_tentacles.terrain.scene_ground import build_ground
 from tests.terrain.test_bounded_inputs import arch
 
 ROCK_SIDE = 0.5  # metres: a convex box, split without CoACD (fast)
@@ -216,21 +215,19 @@ def forged(kind: str, side: float) -> tuple[np.ndarray, ...]:
 
 @pytest.mark.parametrize("kind", ["a flat piece", "a 1 km tetrahedron", "another mesh's entry"])
 def test_an_entry_that_is_not_the_meshs_pieces_is_replaced(
-    cached: Cached, tmp_path: pathlib.Path, monkeypatch: pytest.MonkeyPatch, kind: str
+    cached: Cached, tmp_path: pathlib.Path, kind: str
 ) -> None:
     """Entries that pass every check of their own format: a degenerate piece made the
     good rock refused on every run; a 1 km tetrahedron replaced the 0.5 m rock (the
     creature then inside it); a smaller rock's entry under this rock's name replaced it
     silently. Each is ignored: the rock decomposed again, its entry written afresh."""
     scene, cache, entry, good = cached
-    if kind == "another mesh's entry":  # written by reading that mesh here, in a cache of its own
+    if kind == "another mesh's entry":
         other_cache = tmp_path / "other cache"
-        other = rock_scene(tmp_path / "other", side=0.3)
-        with monkeypatch.context() as patch:
-            patch.setenv("XDG_CACHE_HOME", str(other_cache))
-            build_ground(json.loads(other.read_text())["terrain"], other.parent)
-        [other_entry] = entries(other_cache)
-        entry.write_bytes(other_entry.read_bytes())
+        done = validate(rock_scene(tmp_path / "other", side=0.3), other_cache)
+        assert done.returncode == 0, done.stderr
+        [other] = entries(other_cache)
+        entry.write_bytes(other.read_bytes())
     else:  # laid out as this package lays its entries out: their digests check
         entry.write_bytes(mesh_cache.encode(entry.stem, forged(kind, ROCK_SIDE)))
         assert entry.read_bytes() != good
