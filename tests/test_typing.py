@@ -11,6 +11,10 @@ import sys
 import textwrap
 from pathlib import Path
 
+import pytest
+
+from tests.conftest import once_a_session
+
 SCRIPT = textwrap.dedent(
     """
     from ecs_tentacles.locomotion.goals import GoalBook
@@ -28,22 +32,8 @@ SCRIPT = textwrap.dedent(
 )
 
 
-def strict_errors(tmp_path: Path, source: str) -> list[str]:
-    """mypy --strict's error lines on `source` (two expected), written to a script."""
-    script = tmp_path / "script.py"
-    script.write_text(source)
-    result = subprocess.run(
-        [sys.executable, "-m", "mypy", "--strict", "--follow-imports=silent",
-         "--cache-dir", str(tmp_path / "cache"), "--no-error-summary", str(script)],
-        capture_output=True, text=True, check=False, cwd=Path(__file__).parents[1],
-    )  # fmt: skip
-    errors = [line for line in result.stdout.splitlines() if ": error:" in line]
-    assert len(errors) == 2, result.stdout + result.stderr
-    return errors
-
-
-def test_mypy_strict_rejects_unknown_world_attributes(tmp_path: Path) -> None:
-    errors = strict_errors(tmp_path, SCRIPT)
+def test_mypy_strict_rejects_unknown_world_attributes(mypy_output: str) -> None:
+    errors = strict_errors(mypy_output, "script")
     assert '"World" has no attribute "no_such_thing"' in errors[0]
     assert '"GoalBook" has no attribute "no_such_method"' in errors[1]
 
@@ -63,7 +53,41 @@ SPAWN = textwrap.dedent(
 )
 
 
-def test_mypy_strict_checks_spawn_placements(tmp_path: Path) -> None:
-    errors = strict_errors(tmp_path, SPAWN)
+def test_mypy_strict_checks_spawn_placements(mypy_output: str) -> None:
+    errors = strict_errors(mypy_output, "spawn")
     assert '"positon"' in errors[0]
     assert "'push'" in errors[1]
+
+
+SNIPPETS = {"script": SCRIPT, "spawn": SPAWN}
+
+
+def _check_snippets(folder: Path) -> Path:
+    """Every snippet written to `folder` and checked by one mypy --strict run (one
+    analysis of the package for all); its output saved to `mypy.out`."""
+    scripts = []
+    for name, source in SNIPPETS.items():
+        (folder / f"{name}.py").write_text(source)
+        scripts.append(str(folder / f"{name}.py"))
+    result = subprocess.run(
+        [sys.executable, "-m", "mypy", "--strict", "--follow-imports=silent",
+         "--cache-dir", str(folder / "cache"), "--no-error-summary", *scripts],
+        capture_output=True, text=True, check=False, cwd=Path(__file__).parents[1],
+    )  # fmt: skip
+    out = folder / "mypy.out"
+    out.write_text(result.stdout + result.stderr)
+    return out
+
+
+@pytest.fixture(scope="module")
+def mypy_output(tmp_path_factory: pytest.TempPathFactory) -> str:
+    """The one mypy --strict run's output over every snippet (made once a session)."""
+    return once_a_session(tmp_path_factory, "typing_snippets", _check_snippets).read_text()
+
+
+def strict_errors(output: str, name: str) -> list[str]:
+    """mypy --strict's error lines on the snippet `name` (two expected)."""
+    errors = [line for line in output.splitlines()
+              if ": error:" in line and Path(line.split(":")[0]).name == f"{name}.py"]  # fmt: skip
+    assert len(errors) == 2, output
+    return errors
