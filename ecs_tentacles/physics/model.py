@@ -72,6 +72,11 @@ CONTACT_SOLREF = [0.006, 1.0]
 PROXY_SOLREF = [0.004, 1.0]
 PROXY_SOLIMP = [0.95, 0.99, 0.002, 0.5, 2.0]
 PROXY_MARGIN = 0.008
+# The reduced tier steps once a frame (1 / 60 s), where MuJoCo keeps a contact's time
+# constant at two steps (33 ms): soft enough that two reduced creatures driven head on
+# (crowd avoidance off) went 25-31 mm into each other with the full tier's margin (12-15
+# mm at 120 Hz). Its proxies push from REDUCED_PROXY_MARGIN away instead.
+REDUCED_PROXY_MARGIN = 0.03
 # Suckers hold harder than contacts push (impedance close to 1): the tip stays put.
 SUCKER_SOLIMP = [0.97, 0.995, 0.001, 0.5, 2.0]
 
@@ -317,8 +322,9 @@ def add_sucker(
     equality.data = data
 
 
-def add_proxies(spec: mujoco.MjSpec) -> None:
-    """Kinematic stand-ins for other creatures' bodies; sized and placed per frame."""
+def add_proxies(spec: mujoco.MjSpec, margin: float = PROXY_MARGIN) -> None:
+    """Kinematic stand-ins for other creatures' bodies; sized and placed per frame; their
+    contacts start `margin` before the geoms touch."""
     z_to_x = [np.sqrt(0.5), 0.0, np.sqrt(0.5), 0.0]  # capsules lie along +x like links
     kinds = (
         ("capsule", PROXY_CAPSULES, mujoco.mjtGeom.mjGEOM_CAPSULE, z_to_x),
@@ -338,7 +344,7 @@ def add_proxies(spec: mujoco.MjSpec) -> None:
                 contype=PROXY_BIT,
                 conaffinity=CREATURE_BIT,
                 condim=1,  # frictionless: a zero-friction pyramid is degenerate and blows up
-                margin=PROXY_MARGIN,
+                margin=margin,
                 priority=1,  # its contact parameters win over the creature's
                 solref=PROXY_SOLREF,
                 solimp=PROXY_SOLIMP,

@@ -22,6 +22,7 @@ import numpy as np
 
 from ecs_tentacles.components import Creature, Link, Motor, Sucker, Tentacle
 from ecs_tentacles.physics.model import (
+    REDUCED_PROXY_MARGIN,
     add_link,
     add_mantle,
     add_proxies,
@@ -95,7 +96,7 @@ def reduced_spec(world: PhysicsHost, creature: Creature, timestep: float) -> muj
             offset = np.asarray(sucker.offset) + [full_centres[i] - centres[k], 0.0, 0.0]
             add_sucker(spec, world, tentacle.index, equalities, k, offset)
             equalities += 1
-    add_proxies(spec)
+    add_proxies(spec, margin=REDUCED_PROXY_MARGIN)
     return spec
 
 
