@@ -74,7 +74,7 @@ PROXY_SOLIMP = [0.95, 0.99, 0.002, 0.5, 2.0]
 PROXY_MARGIN = 0.008
 # The reduced tier steps once a frame (1 / 60 s), where MuJoCo keeps a contact's time
 # constant at two steps (33 ms): soft enough that two reduced creatures driven head on
-# (crowd avoidance off) went 25-31 mm into each other with the full tier's margin (12-15
+# (crowd avoidance off) went 25-31 mm into each other with the full tier's margin (5-15
 # mm at 120 Hz). Its proxies push from REDUCED_PROXY_MARGIN away instead.
 REDUCED_PROXY_MARGIN = 0.03
 # Suckers hold harder than contacts push (impedance close to 1): the tip stays put.
