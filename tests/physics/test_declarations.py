@@ -21,7 +21,7 @@ from ecs_tentacles.physics.host import PhysicsHost
 from ecs_tentacles.world import World
 from tests.declarations import declared_only, step_declared
 
-OFF = {"locomotion": False, "suckers": False, "threats": False, "fur": False, "lod": False}
+OFF = {"locomotion": False, "suckers": False, "threats": False, "fur": False, "clips": False}
 SCENE: dict[str, Any] = {
     "version": 1,
     "creatures": [

@@ -90,7 +90,7 @@ def test_a_sleeping_creature_is_asleep_again_after_set_state(
 def test_the_physics_systems_run_with_every_plugin_off(
     make_world: Callable[..., World],
 ) -> None:
-    off = {"locomotion": False, "suckers": False, "threats": False, "fur": False, "lod": False}
+    off = {"locomotion": False, "suckers": False, "threats": False, "fur": False, "clips": False}
     body_only = {"version": 1, "creatures": [{"tentacles": {"count": 3, "links": 5}}]}
     world = make_world(body_only, plugins=off)  # waves and writhing are locomotion's keys
     assert world.schedule.names == ["physics", "physics_sync", "physics_health"]
