@@ -101,6 +101,14 @@ DAMPING_CAP = 1.0
 # At 60 Hz (four times h^2) the crowd generator's creatures are at 0.8-4.6: 3 of a varied
 # crowd's 64 take two steps a frame, a uniform crowd's none.
 STIFF_STEP = 4.0
+# A row with another creature near (its contact proxies in use) takes at least NEAR_SPLIT
+# steps a frame: at one step a frame a contact's time constant is 33 ms (two steps), and
+# a reduced creature squeezed between neighbours (the 4 x 4 crossing crowd of
+# tests/physics/test_contacts.py with crowd avoidance off, 20 s) went 12 mm into one with
+# a recovery (28 mm and 15 recoveries with the full tier's proxy margin); two steps keep
+# it 8 mm apart with none, as full physics keeps it 6 mm apart. Only rows near another
+# pay for it.
+NEAR_SPLIT = 2
 MAX_SPLIT = 64  # at most this many shorter steps (a script's gain far past the schema's)
 _NO_CLIP = np.zeros(0)  # the map kernel's bounds when a map is not clipped
 _NO_EQUALITIES = np.zeros(0, dtype=np.int64)  # the overlay kernel's, without suckers
@@ -366,6 +374,8 @@ class ReducedModel:
         reduced scratch model `m`, and its step split in as many shorter ones as `servos`
         says, that number returned."""
         split = int(servos.split[at])
+        if batch.near[row]:
+            split = max(split, NEAR_SPLIT)
         m.opt.timestep = self.timestep / split
         fast = KERNELS.get()
         if fast is not None:  # the same values in one call
@@ -406,6 +416,8 @@ class ReducedModel:
 
         def write(row: int, at: int) -> int:
             split: int = splits[at]
+            if near[row]:
+                split = max(split, NEAR_SPLIT)
             opt.timestep = timestep / split
             overlay(gain, bias, limit, u, kp[at], kv[at], torque[at], eq_data, equalities,
                     anchor[row])  # fmt: skip

@@ -140,9 +140,15 @@ def _crossing_crowd(side: int) -> dict[str, Any]:
 def test_sixteen_creatures_with_crossing_goals_stay_apart_for_20_seconds(
     make_world: Callable[..., World],
 ) -> None:
-    world = make_world(_crossing_crowd(4))
+    """All reduced (16 fit the reduced budget), crowd avoidance off so that they press into
+    each other and the contacts are what keeps them apart (with avoidance on they hardly
+    touch): a creature squeezed between neighbours steps twice a frame (`NEAR_SPLIT`)."""
+    scene = _crossing_crowd(4)
+    scene["avoidance"] = {"enabled": False}
+    world = make_world(scene)
     start = world.transforms.pos[world.creatures.mantle_row].copy()
     worst = _worst_clearance(world, 20 * 60, every=9)
+    assert world.lod.counts()["reduced"] == 16
     assert worst > -TOLERANCE
     assert world.physics.health.recoveries == 0
     end = world.transforms.pos[world.creatures.mantle_row]
