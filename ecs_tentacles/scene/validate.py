@@ -11,17 +11,16 @@ core schema plus the fragment of each plugin the scene turns on; each plugin's
 from __future__ import annotations
 
 import copy
-import json
-import math
-import re
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING
-
-from jsonschema import ValidationError
 
 from ecs_tentacles.plugin import calling
 from ecs_tentacles.scene.defaults import copied, fill, nested, resolve, with_defaults
 from ecs_tentacles.scene.json_validator import StrictValidator, validator_for
+from ecs_tentacles.scene.problem_text import JsonPath as JsonPath
+from ecs_tentacles.scene.problem_text import Problem as Problem
+from ecs_tentacles.scene.problem_text import count_bounds, describe, path_key, shown
+from ecs_tentacles.scene.problem_text import format_path as format_path
 from ecs_tentacles.scene.schema import at, builtin_keys, schema_for
 from ecs_tentacles.scene.shards import shard_problems
 from ecs_tentacles.scene.spec import CreatureSpec, as_spec, creature_specs
@@ -31,123 +30,8 @@ if TYPE_CHECKING:
 
     from ecs_tentacles.plugin import Plugin
 
-JsonPath = tuple[str | int, ...]
-Problem = tuple[JsonPath, str]
 
-_IDENT = re.compile(r"^[A-Za-z_$][A-Za-z0-9_$]*$")
-_TYPE_NAMES = {
-    "number": "a number",
-    "integer": "an integer",
-    "string": "a string",
-    "boolean": "a boolean",
-    "object": "an object",
-    "array": "an array",
-    "null": "null",
-}
-_MAX_SHOWN = 60
 MAX_DEPTH = 32  # a scene is about 8 levels deep; deeper data is refused before recursing
-
-
-def format_path(path: Iterable[str | int]) -> str:
-    """Format a path such as ``("creatures", 1, "name")`` as ``creatures[1].name``."""
-    out = ""
-    for part in path:
-        if isinstance(part, int):
-            out += f"[{part}]"
-        elif _IDENT.fullmatch(part):
-            out += f".{part}" if out else part
-        else:
-            out += f"[{json.dumps(part)}]"
-    return out or "scene"
-
-
-def _show(value: object) -> str:
-    """JSON text of a value, shortened so a problem stays one readable line."""
-    try:
-        text = json.dumps(value)
-    except (TypeError, ValueError):
-        shape = getattr(value, "shape", None)
-        if isinstance(shape, tuple) and hasattr(value, "tolist"):  # a script's numpy array
-            return f"a numpy array of shape {shape} (give a list: .tolist())"
-        text = " ".join(repr(value).split())  # one line, whatever the object prints
-    return text if len(text) <= _MAX_SHOWN else text[: _MAX_SHOWN - 3] + "..."
-
-
-def _range(schema: Mapping[str, object]) -> str:
-    """Describe every numeric bound of ``schema``: ``in (0, 1]``, ``>= 1`` or ``< 5``."""
-    low: tuple[str, object] | None = None
-    high: tuple[str, object] | None = None
-    if "exclusiveMinimum" in schema:
-        low = ("(", schema["exclusiveMinimum"])
-    elif "minimum" in schema:
-        low = ("[", schema["minimum"])
-    if "exclusiveMaximum" in schema:
-        high = (")", schema["exclusiveMaximum"])
-    elif "maximum" in schema:
-        high = ("]", schema["maximum"])
-    if low and high:
-        return f"in {low[0]}{_show(low[1])}, {_show(high[1])}{high[0]}"
-    if low:
-        return f"{'>' if low[0] == '(' else '>='} {_show(low[1])}"
-    assert high is not None
-    return f"{'<' if high[0] == ')' else '<='} {_show(high[1])}"
-
-
-def _count_bounds(schema: Mapping[str, object], unit: str) -> str:
-    """Describe minItems/maxItems-style bounds: ``2 to 3 items``, ``at least 1 item``."""
-    low, high = schema.get(f"min{unit}"), schema.get(f"max{unit}")
-    noun = "items" if unit == "Items" else "characters"
-    if low is not None and high is not None:
-        return f"exactly {low} {noun}" if low == high else f"{low} to {high} {noun}"
-    return f"at least {low} {noun}" if low is not None else f"at most {high} {noun}"
-
-
-def _describe(error: ValidationError) -> list[Problem]:
-    """Turn one jsonschema error into human one-line problems (with their paths)."""
-    path: JsonPath = tuple(error.absolute_path)
-    schema: Mapping[str, object] = error.schema if isinstance(error.schema, Mapping) else {}
-    value: object = error.instance
-    expected: object = error.validator_value
-    listed = expected if isinstance(expected, list) else [expected]  # types, keys, options
-    kind = error.validator
-    got = f"got {_show(value)}"
-    if kind == "type" and isinstance(value, float) and not math.isfinite(value):
-        return [(path, f"must be a finite number, {got}")]
-    if kind == "type":
-        names = [str(t) for t in listed]
-        return [(path, f"must be {' or '.join(_TYPE_NAMES.get(t, t) for t in names)}, {got}")]
-    if kind in ("minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum"):
-        return [(path, f"must be {_range(schema)}, {got}")]
-    if kind == "additionalProperties" and isinstance(value, Mapping):
-        properties = schema.get("properties", {})
-        allowed = sorted(properties) if isinstance(properties, Mapping) else []
-        extra = [key for key in value if key not in allowed]
-        hint = f"unknown key (allowed: {', '.join(allowed)})"
-        return [((*path, key), hint) for key in extra]
-    if kind == "required" and isinstance(value, Mapping):
-        return [((*path, str(key)), "is required") for key in listed if key not in value]
-    if kind == "enum":
-        options = ", ".join(_show(option) for option in listed)
-        return [(path, f"must be one of {options}, {got}")]
-    if kind == "const":
-        return [(path, f"must be {_show(expected)}, {got}")]
-    if kind in ("minItems", "maxItems") and isinstance(value, list):
-        return [(path, f"must have {_count_bounds(schema, 'Items')}, got {len(value)}")]
-    if kind in ("minLength", "maxLength") and isinstance(value, str):
-        return [(path, f"must have {_count_bounds(schema, 'Length')}, got {len(value)}")]
-    if kind == "uniqueItems":
-        return [(path, f"must not repeat an item, got {_show(value)}")]
-    if kind == "pattern":
-        given = schema.get("x-hint")
-        hint = given if isinstance(given, str) and given else f"text matching {expected}"
-        return [(path, f"must be {hint}, {got}")]
-    return [(path, " ".join(error.message.split()))]
-
-
-def _path_key(problem: Problem) -> tuple[tuple[tuple[int, int | str], ...], str]:
-    """Sort key: paths compared part by part (indices numerically), then the message."""
-    parts = tuple((0, p) if isinstance(p, int) else (1, p) for p in problem[0])
-    return parts, problem[1]
 
 
 def _semantic_problems(scene: Mapping[str, object]) -> list[Problem]:
@@ -160,7 +44,7 @@ def _semantic_problems(scene: Mapping[str, object]) -> list[Problem]:
         if name in seen_names:
             first = format_path(("creatures", seen_names[name]))
             problems.append(
-                (("creatures", i, "name"), f"duplicate name {_show(name)} (also {first})")
+                (("creatures", i, "name"), f"duplicate name {shown(name)} (also {first})")
             )
         else:
             seen_names[name] = i
@@ -195,7 +79,7 @@ def _schema_problems(data: object, validator: _Validator, prefix: JsonPath = ())
         ((*prefix, *path), message)
         for error in errors
         if error.validator == "type" or tuple(error.absolute_path) not in mistyped
-        for path, message in _describe(error)
+        for path, message in describe(error)
     ]
 
 
@@ -273,7 +157,7 @@ def validated(
                 problems += plugin.problems(full)
         problems += registered_problems(full, plugins)
     problems = _name_plugins_that_are_off(problems, {p.name for p in plugins})
-    unique = sorted(set(problems), key=_path_key)
+    unique = sorted(set(problems), key=path_key)
     lines = [f"{format_path(path)}: {message}" for path, message in unique]
     return lines, None if lines else full
 
@@ -321,7 +205,7 @@ def validated_creature(
 
 def _entry_lines(problems: list[Problem]) -> list[str]:
     """A spawned entry's problems, sorted, their paths starting at `creature`."""
-    unique = sorted(set(problems), key=_path_key)
+    unique = sorted(set(problems), key=path_key)
     return [format_path(("creature", *path[2:])) + f": {message}" for path, message in unique]
 
 
@@ -453,7 +337,7 @@ def _limit_problems(
             most, items = node.get("maxItems"), node.get("items")
             if isinstance(most, int) and len(value) > most:
                 problems.append(
-                    (path, f"must have {_count_bounds(node, 'Items')}, got {len(value)}")
+                    (path, f"must have {count_bounds(node, 'Items')}, got {len(value)}")
                 )
             elif isinstance(items, Mapping):
                 stack.extend(((*path, i), v, items) for i, v in nested(value))
@@ -465,4 +349,4 @@ def _limit_problems(
                     for k, v in value.items()
                     if isinstance(properties.get(k), Mapping)
                 )
-    return sorted(problems, key=_path_key)
+    return sorted(problems, key=path_key)
