@@ -18,6 +18,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from types import ModuleType
 
 import numpy as np
 
@@ -56,31 +57,61 @@ class ConvexPieces:
     def __len__(self) -> int:
         return len(self.bounds)
 
+    def _arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The pieces' arrays as the kernels read them."""
+        return self.centres, self.bounds, self.normals, self.offsets
+
     def _pairs(self, points: np.ndarray, pad: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(point rows, piece indices) of each point within its `pad` of a piece's sphere."""
+        """(point rows, piece indices) of each point within its `pad` of a piece's sphere:
+        squares summed (x^2 + y^2) + z^2, as the kernels sum them."""
         gaps = points[:, None, :] - self.centres[None, :, :]
         reach = self.bounds[None, :] + pad[:, None]
-        rows, pieces = np.nonzero(np.einsum("npi,npi->np", gaps, gaps) <= reach * reach)
+        squares = (gaps[..., 0] * gaps[..., 0] + gaps[..., 1] * gaps[..., 1]) + gaps[..., 2] * gaps[
+            ..., 2
+        ]
+        rows, pieces = np.nonzero(squares <= reach * reach)
         return rows, pieces
 
     def _distances(self, points: np.ndarray, pieces: np.ndarray) -> np.ndarray:
-        """Each point's signed distance from its piece (one piece a point)."""
-        planes = np.einsum("pi,pfi->pf", points, self.normals[pieces]) - self.offsets[pieces]
+        """Each point's signed distance from its piece (one piece a point): dot products
+        summed x, y, z in that order (`terrain.solid_kernels` sums them so; numpy's
+        einsum sums in an order of its own, which may differ between CPUs)."""
+        normals = self.normals[pieces]
+        planes = (
+            points[:, None, 0] * normals[..., 0] + points[:, None, 1] * normals[..., 1]
+        ) + points[:, None, 2] * normals[..., 2]
+        planes -= self.offsets[pieces]
         return np.asarray(planes.max(axis=1))
 
-    def lower_distances(self, points: np.ndarray, pad: float, best: np.ndarray) -> None:
+    def lower_distances(
+        self, points: np.ndarray, pad: float, best: np.ndarray, fast: ModuleType | None = None
+    ) -> None:
         """`best` (n,) lowered to each piece's signed distance from points (n, 3) within
-        `pad` of its sphere (farther ones are left as they are)."""
+        `pad` of its sphere (farther ones are left as they are); by `fast`'s kernel when
+        given (`terrain.solid_kernels`: the same numbers, no (points, pieces) arrays)."""
         if not len(self) or not len(points):
+            return
+        if fast is not None:
+            fast.piece_distances(points, pad, *self._arrays(), best)
             return
         rows, pieces = self._pairs(points, np.full(len(points), pad))
         if len(rows):
             np.minimum.at(best, rows, self._distances(points[rows], pieces))
 
-    def touch(self, points: np.ndarray, reach: np.ndarray, near: np.ndarray) -> None:
+    def touch(
+        self,
+        points: np.ndarray,
+        reach: np.ndarray,
+        near: np.ndarray,
+        fast: ModuleType | None = None,
+    ) -> None:
         """`near` (n,) set where the ball at `points` (n, 3) of radius `reach` (n,) meets a
-        piece (its signed distance from the point at most `reach`)."""
+        piece (its signed distance from the point at most `reach`); by `fast`'s kernel
+        when given."""
         if not len(self) or not len(points):
+            return
+        if fast is not None:
+            fast.piece_touches(points, reach, *self._arrays(), near)
             return
         rows, pieces = self._pairs(points, reach)
         if len(rows):

@@ -90,8 +90,8 @@ class TerrainGround:
             return best
         for k, near in self._under_bounds(points, NEAR, self._one_by_one()):
             best[near] = np.minimum(best[near], self.solids[k].signed_distance(points[near]))
-        self._pieces().lower_distances(points, NEAR, best)  # the meshes', in one pass
         fast = KERNELS.get()
+        self._pieces().lower_distances(points, NEAR, best, fast)  # the meshes', in one pass
         if fast is not None and self._spheres()[0].size:  # the spheres, in one pass
             fast.sphere_distances(points, *self._spheres()[1:], NEAR, best)
         return best
@@ -335,7 +335,7 @@ class TerrainGround:
             rows = rows[~near[rows]]
             if len(rows):
                 near[rows] = self.solids[k].signed_distance(centres[rows]) <= reach[rows]
-        self._pieces().touch(centres, reach, near)  # the meshes', in one pass
+        self._pieces().touch(centres, reach, near, fast)  # the meshes', in one pass
         return near
 
     def obstacle_spans(self) -> tuple[np.ndarray, np.ndarray]:

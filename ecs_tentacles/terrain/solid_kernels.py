@@ -114,3 +114,58 @@ def under_bounds(
             reach = reaches[s] + pads[p]
             inside[p, s] = squares <= reach * reach
     return inside
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _piece_distance(points: np.ndarray, p: int, normals: np.ndarray, offsets: np.ndarray,
+                    k: int) -> float:  # fmt: skip
+    """Point `p`'s signed distance from convex piece `k`: its largest plane distance,
+    each a dot product summed x, y, z in that order (as `ConvexPieces` sums it)."""
+    largest = -math.inf
+    for f in range(normals.shape[1]):
+        plane = (
+            points[p, 0] * normals[k, f, 0]
+            + points[p, 1] * normals[k, f, 1]
+            + points[p, 2] * normals[k, f, 2]
+        ) - offsets[k, f]
+        largest = _largest(largest, plane) if f else plane
+    return largest
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _within(points: np.ndarray, p: int, centres: np.ndarray, k: int, reach: float) -> bool:
+    """Whether point `p` lies within `reach` of piece `k`'s centre: squares summed
+    (x^2 + y^2) + z^2 against `reach` squared."""
+    gx = points[p, 0] - centres[k, 0]
+    gy = points[p, 1] - centres[k, 1]
+    gz = points[p, 2] - centres[k, 2]
+    return (gx * gx + gy * gy) + gz * gz <= reach * reach
+
+
+@njit(cache=True, nogil=True)
+def piece_distances(points: np.ndarray, pad: float, centres: np.ndarray, bounds: np.ndarray,
+                    normals: np.ndarray, offsets: np.ndarray, out: np.ndarray) -> None:  # fmt: skip
+    """`out` (n,) lowered to each convex piece's signed distance from points (n, 3)
+    within `pad` of its bounding sphere (`ConvexPieces.lower_distances`)."""
+    for p in range(points.shape[0]):
+        best = out[p]
+        for k in range(centres.shape[0]):
+            if _within(points, p, centres, k, bounds[k] + pad):
+                best = _smallest(best, _piece_distance(points, p, normals, offsets, k))
+        out[p] = best
+
+
+@njit(cache=True, nogil=True)
+def piece_touches(points: np.ndarray, reach: np.ndarray, centres: np.ndarray,
+                  bounds: np.ndarray, normals: np.ndarray, offsets: np.ndarray,
+                  out: np.ndarray) -> None:  # fmt: skip
+    """`out` (n,) set where the ball at `points` (n, 3) of radius `reach` (n,) meets a
+    convex piece (`ConvexPieces.touch`)."""
+    for p in range(points.shape[0]):
+        if out[p]:
+            continue
+        for k in range(centres.shape[0]):
+            if _within(points, p, centres, k, bounds[k] + reach[p]):
+                if _piece_distance(points, p, normals, offsets, k) <= reach[p]:
+                    out[p] = True
+                    break

@@ -130,3 +130,52 @@ def test_the_bounds_kernel_picks_numpys_points_for_each_solid(
         ]
     assert found["numpy"] == found["auto"]
     assert all(len(pairs) > 3 for pairs in found["auto"])
+
+
+def _rocks() -> TerrainGround:
+    """Rocks as the rocky preset makes them (convex meshes), turned, with a sphere, on a
+    bumpy field: the convex pieces' kernels meet every kind of query."""
+    from ecs_tentacles.terrain.rocks import rock_vertices
+    from ecs_tentacles.terrain.shapes import convex_planes
+
+    rng = np.random.default_rng(17)
+    solids = [Solid("sphere", np.array([0.0, 0.0, 0.1]), np.eye(3), (0.4,))]
+    for seed, (x, y, yaw) in enumerate(rng.uniform([-2.5, -2.5, 0.0], [2.5, 2.5, 180.0], (12, 3))):
+        vertices = rock_vertices(rng.uniform(0.3, 1.2, 3), seed)
+        turn = Rotation.from_euler("z", yaw, degrees=True).as_matrix()
+        solids.append(Solid("mesh", np.array([x, y, 0.1]), turn, pieces=(vertices,),
+                            planes=(convex_planes(vertices),)))  # fmt: skip
+    heights = rng.uniform(-0.1, 0.2, size=(12, 14))
+    return TerrainGround(Heightfield((6.0, 6.0), heights), tuple(solids))
+
+
+def test_the_convex_piece_kernels_give_numpys_numbers_bit_for_bit(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The distance from points and which balls touch a rock, by the pieces' kernels and
+    by numpy's (points, pieces) arrays: the same bits, points exactly on a piece's
+    bounding sphere grown by NEAR (the distance's cut) and by a ball's reach included."""
+    rng = np.random.default_rng(19)
+    pieces = _rocks()._pieces()
+    edge = np.array([1.0, 0.0, 0.0])
+    points = np.vstack([
+        rng.uniform([-3.0, -3.0, -0.3], [3.0, 3.0, 1.2], (4000, 3)),
+        pieces.centres + (pieces.bounds + NEAR)[:, None] * edge,  # on the distance's cut
+        pieces.centres + (pieces.bounds + 0.25)[:, None] * edge,  # on a 0.25 m ball's
+    ])  # fmt: skip
+    reach = rng.uniform(0.0, 0.4, len(points))
+    reach[-len(pieces) :] = 0.25
+    found = {}
+    for backend in ("numpy", "auto"):
+        monkeypatch.setattr(ground_module.KERNELS, "backend", backend)
+        ground = _rocks()
+        found[backend] = [ground.distance(points), ground.touches_obstacle(points, reach)]
+    assert ground_module.KERNELS.get() is not None
+    for numpy_answer, kernel_answer in zip(found["numpy"], found["auto"], strict=True):
+        assert numpy_answer.tobytes() == kernel_answer.tobytes()
+    distance, touches = found["auto"]
+    inside = np.zeros(len(points), bool)
+    for solid in _rocks().solids[1:]:
+        inside |= solid.signed_distance(points) < 0.0
+    assert inside.sum() > 100 and np.all(distance[inside] < 0.0)  # inside a rock: negative
+    assert touches[inside].all() and not touches.all()
