@@ -40,9 +40,9 @@ def write_skinned(
     if kind == "usd":
         from ecs_tentacles.export.skinned_usd import write_skinned_usd
 
-        return write_skinned_usd(take, path, skin.detail, skin.keys, locators, progress)
+        return write_skinned_usd(take, path, skin, locators, progress)
     if kind == "gltf":
         from ecs_tentacles.export.skinned_gltf import write_skinned_glb
 
-        return write_skinned_glb(take, path, skin.detail, skin.keys, locators, progress)
+        return write_skinned_glb(take, path, skin, locators, progress)
     raise ValueError(f"{path}: skinned creatures are written as USD or glTF, not {kind}")
