@@ -47,9 +47,7 @@ class FurPlugin(Plugin):
     name = "fur"
     build_order = 40  # a default plugin: built after threats (30), before clips (50)
     description = "fur and feathers (lift, aim, direction, random, dynamic blend) and emotion"
-    creature_schema, tentacle_schema, scene_schema, defs = plugin_schemas(
-        "ecs_tentacles.fur", "fur"
-    )
+    creature_schema, tentacle_schema, scene_schema, defs = plugin_schemas(__package__, name)
     # the take's guide curves and the sandbox's strands and markers
     hook_reads = ("fur.guides", "fur.sets", "fur.controls")
 

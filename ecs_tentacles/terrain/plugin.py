@@ -44,9 +44,7 @@ class TerrainPlugin(Plugin):
     name = "terrain"
     build_order = 60  # a default plugin: built after clips (50)
     description = "a heightfield and static obstacles instead of the flat plane"
-    creature_schema, tentacle_schema, scene_schema, defs = plugin_schemas(
-        "ecs_tentacles.terrain", "terrain"
-    )
+    creature_schema, tentacle_schema, scene_schema, defs = plugin_schemas(__package__, name)
 
     def problems(self, scene: Mapping[str, object]) -> list[tuple[tuple[str | int, ...], str]]:
         terrain = scene.get("terrain")

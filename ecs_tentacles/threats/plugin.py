@@ -39,9 +39,7 @@ class ThreatsPlugin(Plugin):
     name = "threats"
     build_order = 30  # a default plugin: built after suckers (20), before fur (40)
     description = "marked threats on keyframed paths, and creatures marked as threats"
-    creature_schema, tentacle_schema, scene_schema, defs = plugin_schemas(
-        "ecs_tentacles.threats", "threats"
-    )
+    creature_schema, tentacle_schema, scene_schema, defs = plugin_schemas(__package__, name)
     hook_reads = ("threats", "transforms.pos")  # its Dangers entry (`behaviour.dangers`)
 
     def problems(self, scene: Mapping[str, object]) -> list[tuple[tuple[str | int, ...], str]]:
