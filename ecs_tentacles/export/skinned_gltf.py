@@ -49,10 +49,9 @@ from ecs_tentacles.export.gltf import (
 from ecs_tentacles.export.ground import add_gltf_ground
 from ecs_tentacles.export.materials import gltf_material, skin_texture, take_colours
 from ecs_tentacles.export.names import part
-from ecs_tentacles.export.skinned import Skin
 from ecs_tentacles.skin.keys import KeyReport
 from ecs_tentacles.skin.mesh import SkinMesh, split_by_uv
-from ecs_tentacles.skin.rig import KeyTally, SkinnedCreature, rig_creature
+from ecs_tentacles.skin.rig import KeyTally, Skin, SkinnedCreature, rig_creature
 from ecs_tentacles.take import Take
 
 if TYPE_CHECKING:

@@ -82,7 +82,6 @@ from ecs_tentacles.export.ground import write_usd_ground
 from ecs_tentacles.export.materials import take_colours, usd_folder
 from ecs_tentacles.export.names import unique_path
 from ecs_tentacles.export.root_frames import RootFrames
-from ecs_tentacles.export.skinned import Skin
 from ecs_tentacles.export.take_chunks import ChunkSource, TakeChunks, frame_slice
 from ecs_tentacles.export.usd import _pxr, mark_rate, set_timing, static_take
 from ecs_tentacles.export.usd_clips import SharedClips, Timeline
@@ -93,6 +92,7 @@ from ecs_tentacles.export.usd_tracks import Steps, UsdTracks, Visibility, key_st
 from ecs_tentacles.numeric.quaternions import quat_rotate
 from ecs_tentacles.output.atomic import atomic_output
 from ecs_tentacles.skin.keys import KeyReport
+from ecs_tentacles.skin.rig import Skin
 from ecs_tentacles.take import Take
 from ecs_tentacles.take.header_entries import HeaderBody, HeaderSucker
 
