@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ecs_tentacles.behaviour import Dangers, DangerSource
-from ecs_tentacles.plugin import Plugin
+from ecs_tentacles.plugin import Plugin, Problem
 from ecs_tentacles.render.registries import Marker, Spheres
 from ecs_tentacles.scene.schema import plugin_schemas
 from ecs_tentacles.system import System
@@ -42,7 +42,7 @@ class ThreatsPlugin(Plugin):
     creature_schema, tentacle_schema, scene_schema, defs = plugin_schemas(__package__, name)
     hook_reads = ("threats", "transforms.pos")  # its Dangers entry (`behaviour.dangers`)
 
-    def problems(self, scene: Mapping[str, object]) -> list[tuple[tuple[str | int, ...], str]]:
+    def problems(self, scene: Mapping[str, object]) -> list[Problem]:
         return threat_problems(scene)
 
     def resources(self, world: Host) -> list[object]:
