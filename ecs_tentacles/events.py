@@ -3,9 +3,11 @@
 Each kind of event is a dataclass (`Event`; its `name` is the kind's name): core's
 kinds are here (`SuckerReleased`, `CreatureRecovered`, `CreatureFrozen`,
 `CreatureSpawned`, `CreatureDespawned`), a feature's in its package (locomotion:
-`GoalReached`, `SuckerAttached`). Handlers subscribe by kind, getting the event
-(`world.events.on(GoalReached, handler)`), or by name, getting its fields as keyword
-arguments (`world.events.on("goal_reached", handler)`: a script need import nothing).
+`GoalReached`, `SuckerAttached`); a kind about one creature or one sucker subclasses
+`CreatureEvent` or `SuckerEvent`, which declare that entity's field. Handlers subscribe
+by kind, getting the event (`world.events.on(GoalReached, handler)`), or by name, getting
+its fields as keyword arguments (`world.events.on("goal_reached", handler)`: a script
+need import nothing).
 
 Events are for things that happen now and then, never for per-frame state. Every
 event is counted by name; handlers run immediately, in the order they were added,
@@ -37,48 +39,57 @@ class Event:
 
 
 @dataclass(frozen=True)
-class SuckerReleased(Event):
+class CreatureEvent(Event):
+    """An event about one creature: `creature`, its entity (the field after `world`)."""
+
+    creature: int
+
+
+@dataclass(frozen=True)
+class SuckerEvent(Event):
+    """An event about one sucker: `sucker`, its entity (the field after `world`)."""
+
+    sucker: int
+
+
+@dataclass(frozen=True)
+class SuckerReleased(SuckerEvent):
     """A sucker let go: `reason` command, stretch, reach, recovery, despawn, replayed."""
 
     name: ClassVar[str] = "sucker_released"
-    sucker: int
     reason: str
 
 
 @dataclass(frozen=True)
-class CreatureRecovered(Event):
+class CreatureRecovered(CreatureEvent):
     """The health check put a creature back to a good state (`cause`: what failed)."""
 
     name: ClassVar[str] = "creature_recovered"
-    creature: int
     cause: str
 
 
 @dataclass(frozen=True)
-class CreatureFrozen(Event):
+class CreatureFrozen(CreatureEvent):
     """A creature failed too often and is frozen (`cause`: the last failure)."""
 
     name: ClassVar[str] = "creature_frozen"
-    creature: int
     cause: str
 
 
 @dataclass(frozen=True)
-class CreatureSpawned(Event):
+class CreatureSpawned(CreatureEvent):
     """A creature joined the world (`moved_to`: where it went if its spot was taken)."""
 
     name: ClassVar[str] = "creature_spawned"
-    creature: int
     creature_name: str
     moved_to: tuple[float, ...] | None
 
 
 @dataclass(frozen=True)
-class CreatureDespawned(Event):
+class CreatureDespawned(CreatureEvent):
     """A creature left the world."""
 
     name: ClassVar[str] = "creature_despawned"
-    creature: int
     creature_name: str
 
 

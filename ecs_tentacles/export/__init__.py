@@ -85,7 +85,7 @@ def write_usd_stream(
     if skin is not None:
         from ecs_tentacles.export.skinned_usd import write_skinned_usd
 
-        return write_skinned_usd(source, path, skin.detail, skin.keys, bool(locators), progress)
+        return write_skinned_usd(source, path, skin, bool(locators), progress)
     from ecs_tentacles.export.usd import write_usd
 
     write_usd(source, path, progress, locators is not False)

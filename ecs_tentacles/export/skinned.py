@@ -1,4 +1,5 @@
-"""Skinned export options and the writer that picks USD or glTF from the suffix.
+"""Skinned export options (`Skin`, from `ecs_tentacles.skin.rig`) and the writer that
+picks USD or glTF from the suffix.
 
 Skinned is what `ecs-tentacles export` and `bake` write by default: one mesh per
 creature bound to a joint skeleton with rotation keys, which an animator can grab and
@@ -10,21 +11,11 @@ from __future__ import annotations
 
 import os
 from collections.abc import Callable
-from dataclasses import dataclass, field
 
 from ecs_tentacles.export.kinds import output_kind
 from ecs_tentacles.skin.keys import KeyReport
-from ecs_tentacles.skin.mesh import Detail
-from ecs_tentacles.skin.rig import Keys
+from ecs_tentacles.skin.rig import Skin as Skin  # where the writers' options are
 from ecs_tentacles.take import Take
-
-
-@dataclass(frozen=True)
-class Skin:
-    """How to write skinned creatures: the mesh's level of detail and which keys to keep."""
-
-    detail: Detail = field(default_factory=Detail)
-    keys: Keys = field(default_factory=Keys)
 
 
 def write_skinned(
@@ -40,9 +31,9 @@ def write_skinned(
     if kind == "usd":
         from ecs_tentacles.export.skinned_usd import write_skinned_usd
 
-        return write_skinned_usd(take, path, skin.detail, skin.keys, locators, progress)
+        return write_skinned_usd(take, path, skin, locators, progress)
     if kind == "gltf":
         from ecs_tentacles.export.skinned_gltf import write_skinned_glb
 
-        return write_skinned_glb(take, path, skin.detail, skin.keys, locators, progress)
+        return write_skinned_glb(take, path, skin, locators, progress)
     raise ValueError(f"{path}: skinned creatures are written as USD or glTF, not {kind}")

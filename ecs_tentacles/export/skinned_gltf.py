@@ -50,8 +50,8 @@ from ecs_tentacles.export.ground import add_gltf_ground
 from ecs_tentacles.export.materials import gltf_material, skin_texture, take_colours
 from ecs_tentacles.export.names import part
 from ecs_tentacles.skin.keys import KeyReport
-from ecs_tentacles.skin.mesh import Detail, SkinMesh, split_by_uv
-from ecs_tentacles.skin.rig import Keys, KeyTally, SkinnedCreature, rig_creature
+from ecs_tentacles.skin.mesh import SkinMesh, split_by_uv
+from ecs_tentacles.skin.rig import KeyTally, Skin, SkinnedCreature, rig_creature
 from ecs_tentacles.take import Take
 
 if TYPE_CHECKING:
@@ -64,8 +64,10 @@ if TYPE_CHECKING:
         Material,
         Mesh,
         Node,
-        Skin,
         TargetPath,
+    )
+    from ecs_tentacles.export.gltf_types import (
+        Skin as GltfSkin,
     )
 
 __all__ = ["build_skinned_gltf", "split_by_uv", "write_skinned_glb"]
@@ -77,20 +79,21 @@ _TURN[:3, :3] = Z_UP_TO_Y_UP
 def write_skinned_glb(
     take: Take,
     path: str | os.PathLike[str],
-    detail: Detail | None = None,
-    keys: Keys | None = None,
+    skin: Skin | None = None,
     locators: bool = False,
     progress: Progress | None = None,
 ) -> KeyReport:
     """Write `take` as a skinned .glb atomically, within bounded memory (one creature's
     rig at a time, the binary chunk spooled to disk); returns the key counts and errors.
-    `GlbTooLarge` for a file over glTF's 4 GiB, counted before any work. With `locators`,
-    suckers and goals are nodes too (the module doc); `progress(1)` after each creature."""
-    refuse_large_glb(take.header, path, detail or Detail(), locators, keys)
+    `skin`: the mesh's detail and the keys kept (None: `Skin()`'s defaults). `GlbTooLarge`
+    for a file over glTF's 4 GiB, counted before any work. With `locators`, suckers and
+    goals are nodes too (the module doc); `progress(1)` after each creature."""
+    skin = skin or Skin()
+    refuse_large_glb(take.header, path, skin.detail, locators, skin.keys)
     reports: list[KeyReport] = []
 
     def document(buffer: GlbBuffer) -> Document:
-        made, report = skinned_document(take, buffer, detail, keys, locators, progress)
+        made, report = skinned_document(take, buffer, skin, locators, progress)
         reports.append(report)
         return made
 
@@ -99,30 +102,30 @@ def write_skinned_glb(
 
 
 def build_skinned_gltf(
-    take: Take, detail: Detail | None = None, keys: Keys | None = None, locators: bool = False
+    take: Take, skin: Skin | None = None, locators: bool = False
 ) -> tuple[Document, bytes, KeyReport]:
     """The glTF JSON document, its binary buffer (in memory) and the key report."""
     buffer = GlbBuffer()
-    document, report = skinned_document(take, buffer, detail, keys, locators)
+    document, report = skinned_document(take, buffer, skin, locators)
     return document, buffer.value(), report
 
 
 def skinned_document(
     take: Take,
     buffer: GlbBuffer,
-    detail: Detail | None = None,
-    keys: Keys | None = None,
+    skin: Skin | None = None,
     locators: bool = False,
     progress: Progress | None = None,
 ) -> tuple[Document, KeyReport]:
     """The glTF JSON document and the key report, the arrays added to `buffer` one
     creature at a time (each creature's rig dropped before the next is made)."""
+    skin = skin or Skin()
     header = take.header
     tally = KeyTally(take.frames)
     nodes: list[Node] = [{"name": "World", "children": []}]
     roots = [0]
     meshes: list[Mesh] = []
-    skins: list[Skin] = []
+    skins: list[GltfSkin] = []
     colours = take_colours(take)
     materials: list[Material] = []
     images: list[Image] = []
@@ -130,7 +133,7 @@ def skinned_document(
     times: dict[bytes, int] = {}
     shown = take.visible()
     for number in range(len(header["creatures"])):
-        creature = tally.add(rig_creature(take, number, detail, keys))
+        creature = tally.add(rig_creature(take, number, skin.detail, skin.keys))
         skeleton = creature.skeleton
         holder = len(nodes)
         nodes.append({"name": part(skeleton.layout.name, "skeleton"), "children": []})

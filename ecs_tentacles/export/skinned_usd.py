@@ -92,8 +92,7 @@ from ecs_tentacles.export.usd_tracks import Steps, UsdTracks, Visibility, key_st
 from ecs_tentacles.numeric.quaternions import quat_rotate
 from ecs_tentacles.output.atomic import atomic_output
 from ecs_tentacles.skin.keys import KeyReport
-from ecs_tentacles.skin.mesh import Detail
-from ecs_tentacles.skin.rig import Keys
+from ecs_tentacles.skin.rig import Skin
 from ecs_tentacles.take import Take
 from ecs_tentacles.take.header_entries import HeaderBody, HeaderSucker
 
@@ -107,40 +106,38 @@ WORK_BYTES = 32 * 1024**2  # joint rotations (float64) worked on at once: chunks
 def write_skinned_usd(
     take: Take | ChunkSource,
     path: str | os.PathLike[str],
-    detail: Detail | None = None,
-    keys: Keys | None = None,
+    skin: Skin | None = None,
     locators: bool = False,
     progress: Progress | None = None,
 ) -> KeyReport:
     """Write `take` (in memory, or a stream of chunks) as a skinned USD file (.usda, .usdc,
-    .usd) atomically, a chunk of frames at a time; returns the keys. With `locators`,
-    suckers and goals are written too; `progress(n)` as n more frames are written."""
+    .usd) atomically, a chunk of frames at a time; returns the keys. `skin`: the mesh's
+    detail and the keys kept (None: `Skin()`'s defaults). With `locators`, suckers and
+    goals are written too; `progress(n)` as n more frames are written."""
     source = TakeChunks(take) if isinstance(take, Take) else take
     with atomic_output(path) as temporary:
         layer = StreamedLayer(temporary)
-        report = _fill(layer, source, detail, keys, locators, progress)
+        report = _fill(layer, source, skin or Skin(), locators, progress)
         layer.finish()
     return report
 
 
 def build_skinned_stage(
     take: Take,
-    detail: Detail | None = None,
-    keys: Keys | None = None,
+    skin: Skin | None = None,
     locators: bool = False,
     progress: Progress | None = None,
 ) -> tuple[Usd.Stage, KeyReport]:
     """An in-memory `Usd.Stage` with one SkelRoot per creature, and the key report."""
     layer = StreamedLayer(None)
-    report = _fill(layer, TakeChunks(take), detail, keys, locators, progress)
+    report = _fill(layer, TakeChunks(take), skin or Skin(), locators, progress)
     return layer.stage, report
 
 
 def _fill(
     layer: StreamedLayer,
     source: ChunkSource,
-    detail: Detail | None,
-    keys: Keys | None,
+    skin: Skin,
     locators: bool,
     progress: Progress | None,
 ) -> KeyReport:
@@ -153,7 +150,7 @@ def _fill(
     stage.SetDefaultPrim(pxr.UsdGeom.Xform.Define(stage, "/World").GetPrim())
     still = static_take(source)
     colours, folder = take_colours(still), usd_folder(still)
-    plans = body_plans(header, detail)
+    plans = body_plans(header, skin.detail)
     clips = SharedClips(pxr, layer, source, plans)
     plan_of = {name: plan for plan in plans for name in plan.names}
     names = [c["name"] for c in header["creatures"]]
@@ -167,8 +164,7 @@ def _fill(
     tracks = UsdTracks(layer, header, source.static, locators, relative=True)
     write_usd_ground(pxr, stage, still)
     animated = [
-        PlanSamples(pxr, layer, plan, keys or Keys(), source.frames, clips.timeline)
-        for plan in plans
+        PlanSamples(pxr, layer, plan, skin.keys, source.frames, clips.timeline) for plan in plans
     ]
     rows = max(1, WORK_BYTES // (32 * max(1, len(header["bodies"]))))
     for first, chunk in source.chunks(**_posed(animated, suckers, clips.timeline)):

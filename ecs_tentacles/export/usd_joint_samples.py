@@ -31,15 +31,7 @@ from ecs_tentacles.export.names import part
 from ecs_tentacles.export.usd_clips import Timeline
 from ecs_tentacles.export.usd_layer import StreamedLayer
 from ecs_tentacles.export.usd_plans import BodyPlan
-from ecs_tentacles.skin.keys import (
-    ROOT_TOLERANCE_M,
-    KeyReport,
-    angle_between,
-    interpolate_points,
-    interpolate_rotations,
-    reduce_points,
-    reduce_rotations,
-)
+from ecs_tentacles.skin.keys import KeyReport, reduce_chunk
 from ecs_tentacles.skin.rig import Keys
 from ecs_tentacles.skin.streamed import JointRotations
 from ecs_tentacles.take import Take
@@ -170,30 +162,13 @@ class PlanSamples:
         if previous is not None:
             local = np.concatenate([previous[0][None], local])
             root = np.concatenate([previous[1][None], root])
-        n, count, joints = local.shape[:3]
-        flat = local.reshape(n, count * joints, 4)
-        needed = np.repeat(samples, joints, axis=1)
-        if n < 3:
-            keep = needed.copy()
-            root_keep = np.ones((n, count), bool)
-        else:
-            keep = reduce_rotations(flat, self.keys.tolerance_deg, needed)
-            root_keep = np.stack(
-                [reduce_points(root[:, c], ROOT_TOLERANCE_M) for c in range(count)], axis=1
-            )
-        curve = interpolate_rotations(flat, keep | ~needed).reshape(local.shape)
-        apart = angle_between(curve.reshape(flat.shape), flat)
-        error = float(apart[needed].max(initial=0.0))
-        paths = np.stack(
-            [interpolate_points(root[:, c], root_keep[:, c]) for c in range(count)], axis=1
-        )
-        moved = float(np.linalg.norm(paths - root, axis=-1).max(initial=0.0))
-        keep = keep.reshape(n, count, joints)
+        reduced = reduce_chunk(local, root, samples, self.keys.tolerance_deg)
         skip = 1 if previous is not None else 0  # the previous chunk wrote that frame
-        rotation_keys: np.ndarray = np.any(keep, axis=2)[skip:]
-        self._write(first, curve[skip:], root[skip:], yaw, rotation_keys, root_keep[skip:])
-        self.tally.reduced(keep[skip:], root_keep[skip:], error, moved)
-        return paths[skip:]
+        keep, root_keep = reduced.rotation_keys[skip:], reduced.root_keys[skip:]
+        rotation_keys: np.ndarray = np.any(keep, axis=2)
+        self._write(first, reduced.rotations[skip:], root[skip:], yaw, rotation_keys, root_keep)
+        self.tally.reduced(keep, root_keep, reduced.rotation_error_deg, reduced.root_error_m)
+        return reduced.roots[skip:]
 
 
 class ChunkTally:

@@ -25,9 +25,9 @@ from typing import Any
 
 from ecs_tentacles.fur.controls import mirror_name
 from ecs_tentacles.fur.groom import region_area
+from ecs_tentacles.plugin import Problem
 
 Path = tuple[str | int, ...]
-Problem = tuple[Path, str]
 
 MAX_SCENE_GUIDES = 500_000  # about 1.1 KB each once built (an entity and its rows)
 MAX_SCENE_FUR_POINTS = 4_000_000  # about 64 bytes each (rest shape, posed curve, scratch)

@@ -19,7 +19,7 @@ from ecs_tentacles.distributed.registries import ShardGroups
 from ecs_tentacles.fur.build import build_emotion, build_fur
 from ecs_tentacles.fur.checks import fur_problems
 from ecs_tentacles.fur.stores import FurData
-from ecs_tentacles.plugin import Plugin
+from ecs_tentacles.plugin import Plugin, Problem
 from ecs_tentacles.render.registries import Draws, Lines, Panels
 from ecs_tentacles.scene.schema import plugin_schemas
 from ecs_tentacles.system import System
@@ -47,13 +47,11 @@ class FurPlugin(Plugin):
     name = "fur"
     build_order = 40  # a default plugin: built after threats (30), before clips (50)
     description = "fur and feathers (lift, aim, direction, random, dynamic blend) and emotion"
-    creature_schema, tentacle_schema, scene_schema, defs = plugin_schemas(
-        "ecs_tentacles.fur", "fur"
-    )
+    creature_schema, tentacle_schema, scene_schema, defs = plugin_schemas(__package__, name)
     # the take's guide curves and the sandbox's strands and markers
     hook_reads = ("fur.guides", "fur.sets", "fur.controls")
 
-    def problems(self, scene: Mapping[str, object]) -> list[tuple[tuple[str | int, ...], str]]:
+    def problems(self, scene: Mapping[str, object]) -> list[Problem]:
         return fur_problems(scene)
 
     def resources(self, world: Host) -> list[object]:

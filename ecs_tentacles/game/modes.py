@@ -32,6 +32,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Generic, Protocol, TypeVar
 
+from ecs_tentacles.plugin import Problem
 from ecs_tentacles.registry import Registry
 from ecs_tentacles.system import System
 
@@ -41,7 +42,6 @@ if TYPE_CHECKING:
     from ecs_tentacles.world import World
 
 PLAYING, WON, LOST = "playing", "won", "lost"
-Problem = tuple[tuple[str | int, ...], str]
 
 
 @dataclass(frozen=True)

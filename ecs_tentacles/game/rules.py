@@ -17,7 +17,8 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import TYPE_CHECKING
 
-from ecs_tentacles.game.modes import GameMode, GameModes, GameResult, Problem
+from ecs_tentacles.game.modes import GameMode, GameModes, GameResult
+from ecs_tentacles.plugin import Problem
 from ecs_tentacles.scene.defaults import filled
 from ecs_tentacles.scene.validate import schema_problems
 

@@ -9,42 +9,44 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import ClassVar
 
-from ecs_tentacles.events import Event
+from ecs_tentacles.events import CreatureEvent, Event
 
 
 @dataclass(frozen=True)
-class CreaturePenned(Event):
+class CreaturePenned(CreatureEvent):
     """Creature `creature` entered the pen at game time `seconds`; `penned` so far."""
 
     name: ClassVar[str] = "creature_penned"
-    creature: int
     seconds: float
     penned: int
 
 
 @dataclass(frozen=True)
-class CreatureLeft(Event):
+class CreatureLeft(CreatureEvent):
     """Penned creature `creature` was driven out of the pen at game time `seconds`."""
 
     name: ClassVar[str] = "creature_left"
-    creature: int
     seconds: float
 
 
 @dataclass(frozen=True)
-class GameWon(Event):
+class GameOver(Event):
+    """The game ended at game time `seconds` with `penned` creatures in the pen."""
+
+    seconds: float
+    penned: int
+
+
+@dataclass(frozen=True)
+class GameWon(GameOver):
     """Enough creatures are penned: won in `seconds` of game time."""
 
     name: ClassVar[str] = "game_won"
-    seconds: float
-    penned: int
 
 
 @dataclass(frozen=True)
-class GameLost(Event):
+class GameLost(GameOver):
     """The time ran out with `penned` creatures in the pen, `need` needed."""
 
     name: ClassVar[str] = "game_lost"
-    seconds: float
-    penned: int
     need: int

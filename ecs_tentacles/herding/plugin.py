@@ -33,7 +33,7 @@ from ecs_tentacles.behaviour import Dangers, DangerSource
 from ecs_tentacles.game.modes import GameMode, GameModes, GameResult
 from ecs_tentacles.herding.game import GameState, HerdingGame
 from ecs_tentacles.herding.schema import GAME, game_problems, plugin_problems
-from ecs_tentacles.plugin import Plugin
+from ecs_tentacles.plugin import Plugin, Problem
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
@@ -46,7 +46,7 @@ class HerdingPlugin(Plugin):
     description = "the herding game: drive creatures into a pen with a predator"
     requires = ("locomotion", "game")
 
-    def problems(self, scene: Mapping[str, object]) -> list[tuple[tuple[str | int, ...], str]]:
+    def problems(self, scene: Mapping[str, object]) -> list[Problem]:
         return plugin_problems(scene)
 
     def resources(self, world: Host) -> list[object]:

@@ -22,11 +22,10 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from ecs_tentacles.plugin import Problem
 from ecs_tentacles.scene.schema import fragment
 
 GAME = fragment("ecs_tentacles.herding", "herding")["game_mode"]["game"]
-
-Problem = tuple[tuple[str | int, ...], str]
 
 
 def plugin_problems(scene: Mapping[str, object]) -> list[Problem]:

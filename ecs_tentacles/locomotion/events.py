@@ -11,23 +11,21 @@ from typing import ClassVar
 
 import numpy as np
 
-from ecs_tentacles.events import Event
+from ecs_tentacles.events import CreatureEvent, SuckerEvent
 
 
 @dataclass(frozen=True)
-class GoalReached(Event):
+class GoalReached(CreatureEvent):
     """A creature reached goal entity `goal` at `position` (the goal is gone now)."""
 
     name: ClassVar[str] = "goal_reached"
-    creature: int
     goal: int
     position: np.ndarray
 
 
 @dataclass(frozen=True)
-class SuckerAttached(Event):
+class SuckerAttached(SuckerEvent):
     """A sucker attached at `anchor` (world metres)."""
 
     name: ClassVar[str] = "sucker_attached"
-    sucker: int
     anchor: np.ndarray

@@ -83,9 +83,7 @@ class LocomotionPlugin(Plugin):
     name = "locomotion"
     build_order = 10  # a default plugin: built before suckers (20)
     description = "goal-directed crawling: goal paths, gait, action queues, motor targets"
-    creature_schema, tentacle_schema, scene_schema, defs = plugin_schemas(
-        "ecs_tentacles.locomotion", "locomotion"
-    )
+    creature_schema, tentacle_schema, scene_schema, defs = plugin_schemas(__package__, name)
     # its MotionWants and TravelTargets entries
     hook_reads = (
         "locomotion.creatures.has_goal",

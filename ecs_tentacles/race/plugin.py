@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING
 
 from ecs_tentacles.game.modes import GameMode, GameModes
 from ecs_tentacles.game.rules import rules
-from ecs_tentacles.plugin import Plugin
+from ecs_tentacles.plugin import Plugin, Problem
 from ecs_tentacles.race import rules as race_rules
 from ecs_tentacles.race.game import RaceGame, RaceState
 
@@ -44,7 +44,7 @@ class RacePlugin(Plugin):
 
         return GameMode(MODE_NAME, race_rules.RULES, result, race_rules.problems, self.description)
 
-    def problems(self, scene: Mapping[str, object]) -> list[tuple[tuple[str | int, ...], str]]:
+    def problems(self, scene: Mapping[str, object]) -> list[Problem]:
         if scene.get("game") is None:
             return [(("game",), "required when the race plugin is on (the level's rules)")]
         return []

@@ -19,7 +19,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
-Problem = tuple[tuple[str | int, ...], str]
+from ecs_tentacles.plugin import Problem
 
 XY = {
     "type": "array",

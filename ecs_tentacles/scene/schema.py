@@ -44,9 +44,10 @@ def fragment(package: str, name: str) -> dict[str, Any]:
 
 def plugin_schemas(package: str, name: str) -> tuple[dict[str, Any], ...]:
     """A feature plugin's `creature_schema`, `tentacle_schema`, `scene_schema` and `defs`
-    from its fragment (`fragment(package, name)`; {} for a place it has no keys in):
+    from its fragment (`fragment(package, name)`; {} for a place it has no keys in). In
+    the plugin's class body, its own package and name:
 
-        creature_schema, tentacle_schema, scene_schema, defs = plugin_schemas(package, name)
+        creature_schema, tentacle_schema, scene_schema, defs = plugin_schemas(__package__, name)
     """
     found = fragment(package, name)
     return tuple(found.get(place, {}) for place in ("creature", "tentacles", "scene", "$defs"))

@@ -6,6 +6,8 @@ interpolation do); the sample furthest from it (as an angle) is kept when it is 
 than the tolerance away, until no sample is. Every round splits all joints' segments
 at once (array math over frames x joints), so the rounds number the recursion depth.
 `reduce_points` is the same on distance, for the root's translation.
+`reduce_chunk` reduces a chunk of frames of several creatures at once (the streamed USD
+writer's, `ecs_tentacles.export.usd_joint_samples`), with the curves kept and the errors.
 """
 
 from __future__ import annotations
@@ -158,3 +160,49 @@ def reduce_points(p: np.ndarray, tolerance: float) -> np.ndarray:
         return errors
 
     return _rdp(error, (len(p), 1), tolerance)[:, 0]
+
+
+@dataclass(frozen=True)
+class ReducedChunk:
+    """A chunk of frames of several creatures reduced: the keys kept, the curves they give
+    (what a reader interpolates between them) and the largest errors left."""
+
+    rotation_keys: np.ndarray  # (n, C, J)
+    root_keys: np.ndarray  # (n, C)
+    rotations: np.ndarray  # (n, C, J, 4) the kept rotation curves
+    roots: np.ndarray  # (n, C, 3) the kept root paths
+    rotation_error_deg: float  # over the frames needed
+    root_error_m: float
+
+
+def reduce_chunk(
+    local: np.ndarray, root: np.ndarray, needed: np.ndarray, tolerance_deg: float
+) -> ReducedChunk:
+    """The keys of joint rotations `local` (n, C, J, 4) within `tolerance_deg` among the
+    frames each creature needs (`needed`, (n, C): the ends of each run of them kept), and
+    of root translations `root` (n, C, 3) within `ROOT_TOLERANCE_M`; every frame is a key
+    when n < 3."""
+    n, count, joints = local.shape[:3]
+    flat = local.reshape(n, count * joints, 4)
+    wanted = np.repeat(needed, joints, axis=1)
+    if n < 3:
+        keep = wanted.copy()
+        root_keep = np.ones((n, count), bool)
+    else:
+        keep = reduce_rotations(flat, tolerance_deg, wanted)
+        root_keep = np.stack(
+            [reduce_points(root[:, c], ROOT_TOLERANCE_M) for c in range(count)], axis=1
+        )
+    curve = interpolate_rotations(flat, keep | ~wanted).reshape(local.shape)
+    apart = angle_between(curve.reshape(flat.shape), flat)
+    paths = np.stack(
+        [interpolate_points(root[:, c], root_keep[:, c]) for c in range(count)], axis=1
+    )
+    return ReducedChunk(
+        rotation_keys=keep.reshape(n, count, joints),
+        root_keys=root_keep,
+        rotations=curve,
+        roots=paths,
+        rotation_error_deg=float(apart[wanted].max(initial=0.0)),
+        root_error_m=float(np.linalg.norm(paths - root, axis=-1).max(initial=0.0)),
+    )

@@ -6,7 +6,7 @@ joints and the same keys.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -38,6 +38,15 @@ class Keys:
             raise ValueError(f"keys: must be one of {', '.join(KEY_MODES)}, got {self.mode!r}")
         if not self.tolerance_deg > 0:
             raise ValueError(f"key tolerance: must be > 0 degrees, got {self.tolerance_deg}")
+
+
+@dataclass(frozen=True)
+class Skin:
+    """How to write skinned creatures: the mesh's level of detail and which keys to keep
+    (what `ecs_tentacles.export.skinned`'s writers take)."""
+
+    detail: Detail = field(default_factory=Detail)
+    keys: Keys = field(default_factory=Keys)
 
 
 @dataclass(frozen=True)

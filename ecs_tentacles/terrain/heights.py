@@ -21,11 +21,11 @@ import pathlib
 
 import numpy as np
 
+from ecs_tentacles.plugin import Problem
 from ecs_tentacles.terrain.heightfield import Heightfield
 from ecs_tentacles.terrain.terrain_spec import HeightfieldSpec, NoiseSpec
 from ecs_tentacles.untrusted.files import TooLarge, Unfit, read_regular
 
-Problem = tuple[tuple[str | int, ...], str]
 SOURCES = ("noise", "image", "heights")
 HERE = ("terrain", "heightfield")
 MAX_RESOLUTION = 1024  # samples a side (the schema's maximum)

@@ -21,7 +21,7 @@ import numpy as np
 
 from ecs_tentacles.ground import WorldGround, ground_of
 from ecs_tentacles.physics.model import StaticGeometry
-from ecs_tentacles.plugin import Plugin
+from ecs_tentacles.plugin import Plugin, Problem
 from ecs_tentacles.render.registries import Panels
 from ecs_tentacles.scene.errors import SceneError
 from ecs_tentacles.scene.schema import plugin_schemas
@@ -44,11 +44,9 @@ class TerrainPlugin(Plugin):
     name = "terrain"
     build_order = 60  # a default plugin: built after clips (50)
     description = "a heightfield and static obstacles instead of the flat plane"
-    creature_schema, tentacle_schema, scene_schema, defs = plugin_schemas(
-        "ecs_tentacles.terrain", "terrain"
-    )
+    creature_schema, tentacle_schema, scene_schema, defs = plugin_schemas(__package__, name)
 
-    def problems(self, scene: Mapping[str, object]) -> list[tuple[tuple[str | int, ...], str]]:
+    def problems(self, scene: Mapping[str, object]) -> list[Problem]:
         terrain = scene.get("terrain")
         if not isinstance(terrain, dict):  # (an object, if given: the schema says so)
             return []

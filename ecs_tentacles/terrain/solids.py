@@ -20,8 +20,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from ecs_tentacles.plugin import Problem
 from ecs_tentacles.terrain.heightfield import Heightfield
-from ecs_tentacles.terrain.heights import Problem, TerrainError
+from ecs_tentacles.terrain.heights import TerrainError
 from ecs_tentacles.terrain.meshes import MAX_MESH_BYTES, MESH_SUFFIXES, MeshReader
 from ecs_tentacles.terrain.rocks import rock_vertices
 from ecs_tentacles.terrain.shapes import Solid, convex_planes

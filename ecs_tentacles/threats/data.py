@@ -18,12 +18,11 @@ import numpy as np
 from ecs_tentacles.components import RowComponent, RowField, Transform
 from ecs_tentacles.ground import ground_of
 from ecs_tentacles.numeric.keyframes import Channel, channels_from_keys
+from ecs_tentacles.plugin import Problem
 from ecs_tentacles.store import ArrayStore, Field
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
-
-Problem = tuple[tuple[str | int, ...], str]
 
 
 class ThreatStore(ArrayStore):

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ecs_tentacles.behaviour import Dangers, DangerSource
-from ecs_tentacles.plugin import Plugin
+from ecs_tentacles.plugin import Plugin, Problem
 from ecs_tentacles.render.registries import Marker, Spheres
 from ecs_tentacles.scene.schema import plugin_schemas
 from ecs_tentacles.system import System
@@ -39,12 +39,10 @@ class ThreatsPlugin(Plugin):
     name = "threats"
     build_order = 30  # a default plugin: built after suckers (20), before fur (40)
     description = "marked threats on keyframed paths, and creatures marked as threats"
-    creature_schema, tentacle_schema, scene_schema, defs = plugin_schemas(
-        "ecs_tentacles.threats", "threats"
-    )
+    creature_schema, tentacle_schema, scene_schema, defs = plugin_schemas(__package__, name)
     hook_reads = ("threats", "transforms.pos")  # its Dangers entry (`behaviour.dangers`)
 
-    def problems(self, scene: Mapping[str, object]) -> list[tuple[tuple[str | int, ...], str]]:
+    def problems(self, scene: Mapping[str, object]) -> list[Problem]:
         return threat_problems(scene)
 
     def resources(self, world: Host) -> list[object]:

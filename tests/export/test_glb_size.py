@@ -80,7 +80,7 @@ def test_the_count_is_never_less_than_the_file_and_close_to_it(
     if detail is None:
         write_glb(mixed_take, path, locators)
     else:
-        write_skinned_glb(mixed_take, path, detail, keys, locators)
+        write_skinned_glb(mixed_take, path, Skin(detail, keys or Keys()), locators)
     size = glb_size(shapes_of_header(mixed_take.header), detail, keys, locators)
     written = path.stat().st_size
     assert written <= size.total() <= 1.35 * written, (written, size.total())
@@ -226,7 +226,7 @@ def test_export_refuses_a_glb_too_large_before_reading_a_frame(tmp_path: Path) -
     )
     assert not (tmp_path / "crowd.glb").exists()
     with pytest.raises(GlbTooLarge, match="the glb would be up to"):  # the API refuses too
-        write_skinned_glb(Take.load(take), tmp_path / "crowd.glb", Detail(14, 64))
+        write_skinned_glb(Take.load(take), tmp_path / "crowd.glb", Skin(Detail(14, 64)))
     assert sorted(p.name for p in tmp_path.iterdir()) == ["crowd.npz", "damaged.npz"]
     broken = _run("export", str(damaged), "--out", "light.glb", cwd=tmp_path)
     assert (

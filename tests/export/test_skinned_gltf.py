@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from ecs_tentacles.export.gltf import accessor_array, read_glb, to_y_up_points
+from ecs_tentacles.export.skinned import Skin
 from ecs_tentacles.export.skinned_gltf import split_by_uv, write_skinned_glb
 from ecs_tentacles.skin.keys import slerp
 from ecs_tentacles.skin.mesh import creature_mesh
@@ -84,7 +85,7 @@ def test_skinning_the_file_lands_on_the_simulated_links(
     octopus_take: Take, tmp_path: Path, keys: str
 ) -> None:
     take = octopus_take
-    write_skinned_glb(take, tmp_path / "skinned.glb", keys=Keys(keys, 0.5))
+    write_skinned_glb(take, tmp_path / "skinned.glb", Skin(keys=Keys(keys, 0.5)))
     document, binary = read_glb((tmp_path / "skinned.glb").read_bytes())
     (skin,) = document["skins"]
     mesh_node = next(n for n in document["nodes"] if "skin" in n)
@@ -129,7 +130,7 @@ def test_the_khronos_validator_finds_nothing_in_a_skinned_file(
 ) -> None:
     for keys in ("all", "reduced"):
         path = tmp_path / f"{keys}.glb"
-        write_skinned_glb(guided_take, path, keys=Keys(keys, 0.5))
+        write_skinned_glb(guided_take, path, Skin(keys=Keys(keys, 0.5)))
         report = khronos_report(path, gltf_validator)
         assert report["issues"]["messages"] == []
         assert (report["issues"]["numErrors"], report["issues"]["numWarnings"]) == (0, 0)
@@ -151,7 +152,7 @@ def test_a_crowd_on_all_three_tiers_exports_every_creatures_full_skeleton(
         world.step(60)
         assert world.lod.counts() == {"full": 1, "reduced": 2, "kinematic": 3}
     take = bake(BakePlan.make(scene, seconds=1.0, fps=30.0), progress=False)
-    write_skinned_glb(take, tmp_path / "crowd.glb", keys=Keys("all", 0.5))
+    write_skinned_glb(take, tmp_path / "crowd.glb", Skin(keys=Keys("all", 0.5)))
     document, binary = read_glb((tmp_path / "crowd.glb").read_bytes())
     assert len(document["skins"]) == 6
     for creature, skin in enumerate(document["skins"]):

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from ecs_tentacles.cli import main
+from ecs_tentacles.export.skinned import Skin
 from ecs_tentacles.export.skinned_usd import build_skinned_stage, write_skinned_usd
 from ecs_tentacles.export.usd_curves import TOLERANCE
 from ecs_tentacles.export.usd_validation import usd_problems
@@ -37,7 +38,7 @@ def test_the_skinned_stage_passes_the_usd_validators(
     guided_take: Take, tmp_path: Path, suffix: str, keys: str, locators: bool
 ) -> None:
     path = tmp_path / f"take{suffix}"
-    write_skinned_usd(guided_take, path, keys=Keys(keys, 0.5), locators=locators)
+    write_skinned_usd(guided_take, path, Skin(keys=Keys(keys, 0.5)), locators=locators)
     assert usd_problems(path) == []
     stage = Usd.Stage.Open(str(path))
     root = stage.GetPrimAtPath("/World/octo")
@@ -133,7 +134,7 @@ def test_usd_skinning_puts_the_tubes_on_the_simulated_links(octopus_take: Take) 
 def test_reduced_keys_stay_within_the_tolerance_through_usd_interpolation(
     octopus_take: Take,
 ) -> None:
-    stage, report = build_skinned_stage(octopus_take, keys=Keys("reduced", 0.5))
+    stage, report = build_skinned_stage(octopus_take, Skin(keys=Keys("reduced", 0.5)))
     animation = UsdSkel.Animation(
         stage.GetPrimAtPath("/World/octopus/octopus_skeleton/octopus_animation")
     )

@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from ecs_tentacles.cli import main
+from ecs_tentacles.export.skinned import Skin
 from ecs_tentacles.export.skinned_usd import write_skinned_usd
 from ecs_tentacles.export.take_chunks import TakeChunks
 from ecs_tentacles.numeric.quaternions import quat_rotate
@@ -169,7 +170,7 @@ def test_reduced_keys_of_a_switching_creature_hold_their_tolerance_where_it_is_s
     with open_take(switching_take) as source:
         write_skinned_usd(source, every)
     with open_take(switching_take) as source:
-        report = write_skinned_usd(source, reduced, keys=Keys("reduced", 0.5))
+        report = write_skinned_usd(source, reduced, Skin(keys=Keys("reduced", 0.5)))
         kind = source.replay_records()["replay_kind"]
         names = [c["name"] for c in source.header["creatures"]]
     assert report.after < 0.6 * report.before and report.max_rotation_error_deg <= 0.5
