@@ -139,7 +139,8 @@ def _within(points: np.ndarray, p: int, centres: np.ndarray, k: int, reach: floa
     gx = points[p, 0] - centres[k, 0]
     gy = points[p, 1] - centres[k, 1]
     gz = points[p, 2] - centres[k, 2]
-    return (gx * gx + gy * gy) + gz * gz <= reach * reach
+    inside: bool = (gx * gx + gy * gy) + gz * gz <= reach * reach
+    return inside
 
 
 @njit(cache=True, nogil=True)
