@@ -10,9 +10,10 @@ otherwise; both give the same poses to float64 rounding (tests/lod/test_clips.py
 The numpy path makes about twenty passes over (creatures, bodies) arrays (gather the
 clip frame, interpolate, normalise, turn and move); at 10,000 kinematic creatures of
 81 bodies that was about 60 ms a frame. Here each body is read once and written once,
-and each creature's reach sphere (the contact proxies' and the level of detail's) is
-found from the poses as they are written, which spares the next frame a pass over every
-replayed body (`physics.proxies.PosedSpheres`). Compiled on first use and cached on disk
+and each creature's reach sphere (the contact proxies' and the level of detail's) can be
+found from its bodies as they were just written, still in the cache (`_sphere`: the
+contact proxies' numbers), which spares the next frame a pass over every replayed body
+(`physics.proxies.PosedSpheres`). Compiled on first use and cached on disk
 (``cache=True``).
 """
 
@@ -48,33 +49,42 @@ def place(
 
     `pose` and `change` are (rows, B, 7) ground-frame tables (position, quaternion);
     the outputs are (N, B, 3) and (N, B, 4). Unless `sphere_of` is empty, creature k's
-    reach sphere goes to row `sphere_of[k]` of `out_centre` / `out_radius` as it is
-    written (`_reach`: the contact proxies' numbers, body b's bound `rbound[start[sphere_of
-    [k]] + b]`), so nobody reads its bodies again for it.
+    reach sphere goes to row `sphere_of[k]` of `out_centre` / `out_radius`, found from
+    its bodies as written (`_sphere`; body b's bound is
+    `rbound[start[sphere_of[k]] + b]`).
     """
-    spheres = len(sphere_of) > 0
+    bodies = pose.shape[1]
+    every = np.arange(bodies)  # body b of a creature's output row at row b
     for k in range(len(row)):
         r, o, t = row[k], out_rows[k], fraction[k]
         c, s = math.cos(heading[k]), math.sin(heading[k])
         hc, hs = math.cos(0.5 * heading[k]), math.sin(0.5 * heading[k])
         ox, oy = xy[k, 0], xy[k, 1]
-        first = start[sphere_of[k]] if spheres else 0
-        cx, cy, cz, radius = 0.0, 0.0, 0.0, -np.inf
         for b in range(pose.shape[1]):
-            px, py, z, qw, q1, q2, q3 = _posed(pose, change, r, b, t, interpolate,
-                                               c, s, hc, hs, ox, oy)  # fmt: skip
+            p = pose[r, b]
+            x, y, z = p[0], p[1], p[2]
+            w, qx, qy, qz = p[3], p[4], p[5], p[6]
+            if interpolate:
+                d = change[r, b]
+                x, y, z = x + d[0] * t, y + d[1] * t, z + d[2] * t
+                w, qx, qy, qz = w + d[3] * t, qx + d[4] * t, qy + d[5] * t, qz + d[6] * t
+                norm = math.sqrt(w * w + qx * qx + qy * qy + qz * qz)
+                w, qx, qy, qz = w / norm, qx / norm, qy / norm, qz / norm
+            px, py = c * x - s * y + ox, s * x + c * y + oy
+            qw, q1, q2, q3 = (
+                hc * w - hs * qz,
+                hc * qx - hs * qy,
+                hc * qy + hs * qx,
+                hc * qz + hs * w,
+            )
             out_pos[o, b, 0], out_pos[o, b, 1], out_pos[o, b, 2] = px, py, z
             out_quat[o, b, 0], out_quat[o, b, 1], out_quat[o, b, 2], out_quat[o, b, 3] = (
                 qw, q1, q2, q3,
             )  # fmt: skip
-            if spheres:
-                if b == 0:
-                    cx, cy, cz = px, py, z
-                reach = _reach(px - cx, py - cy, z - cz, rbound[first + b])
-                if reach > radius:
-                    radius = reach
-        if spheres:
-            _sphere_out(sphere_of[k], cx, cy, cz, radius, out_centre, out_radius)
+        if len(sphere_of):
+            first = start[sphere_of[k]]
+            bounds = rbound[first : first + bodies]
+            _sphere(out_pos[o], every, bounds, sphere_of[k], out_centre, out_radius)
 
 
 @njit(cache=True, nogil=True)
@@ -100,84 +110,62 @@ def place_scattered(
     `body_rows[out_rows[k], b]` of `out_pos` (rows, 3) and `out_quat` (rows, 4): the
     Transform store, whose rows of a batch's bodies (`Batch.body_rows`, (N, B)) need
     not be consecutive."""
-    spheres = len(sphere_of) > 0
+    bodies = pose.shape[1]
     for k in range(len(row)):
         r, o, t = row[k], out_rows[k], fraction[k]
         c, s = math.cos(heading[k]), math.sin(heading[k])
         hc, hs = math.cos(0.5 * heading[k]), math.sin(0.5 * heading[k])
         ox, oy = xy[k, 0], xy[k, 1]
-        first = start[sphere_of[k]] if spheres else 0
-        cx, cy, cz, radius = 0.0, 0.0, 0.0, -np.inf
         for b in range(pose.shape[1]):
-            px, py, z, qw, q1, q2, q3 = _posed(pose, change, r, b, t, interpolate,
-                                               c, s, hc, hs, ox, oy)  # fmt: skip
+            p = pose[r, b]
+            x, y, z = p[0], p[1], p[2]
+            w, qx, qy, qz = p[3], p[4], p[5], p[6]
+            if interpolate:
+                d = change[r, b]
+                x, y, z = x + d[0] * t, y + d[1] * t, z + d[2] * t
+                w, qx, qy, qz = w + d[3] * t, qx + d[4] * t, qy + d[5] * t, qz + d[6] * t
+                norm = math.sqrt(w * w + qx * qx + qy * qy + qz * qz)
+                w, qx, qy, qz = w / norm, qx / norm, qy / norm, qz / norm
+            px, py = c * x - s * y + ox, s * x + c * y + oy
+            qw, q1, q2, q3 = (
+                hc * w - hs * qz,
+                hc * qx - hs * qy,
+                hc * qy + hs * qx,
+                hc * qz + hs * w,
+            )
             at = body_rows[o, b]
             out_pos[at, 0], out_pos[at, 1], out_pos[at, 2] = px, py, z
             out_quat[at, 0], out_quat[at, 1], out_quat[at, 2], out_quat[at, 3] = qw, q1, q2, q3
-            if spheres:
-                if b == 0:
-                    cx, cy, cz = px, py, z
-                reach = _reach(px - cx, py - cy, z - cz, rbound[first + b])
-                if reach > radius:
-                    radius = reach
-        if spheres:
-            _sphere_out(sphere_of[k], cx, cy, cz, radius, out_centre, out_radius)
+        if len(sphere_of):
+            first = start[sphere_of[k]]
+            bounds = rbound[first : first + bodies]
+            _sphere(out_pos, body_rows[o], bounds, sphere_of[k], out_centre, out_radius)
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _posed(
-    pose: np.ndarray,
-    change: np.ndarray,
-    r: int,
-    b: int,
-    t: float,
-    interpolate: bool,
-    c: float,
-    s: float,
-    hc: float,
-    hs: float,
-    ox: float,
-    oy: float,
-) -> tuple[float, float, float, float, float, float, float]:
-    """Body b of clip table row r (+ t of `change`), turned by the heading whose cosine
-    and sine are c, s (hc, hs: of half of it) and moved by (ox, oy): position, quaternion."""
-    p = pose[r, b]
-    x, y, z = p[0], p[1], p[2]
-    w, qx, qy, qz = p[3], p[4], p[5], p[6]
-    if interpolate:
-        d = change[r, b]
-        x, y, z = x + d[0] * t, y + d[1] * t, z + d[2] * t
-        w, qx, qy, qz = w + d[3] * t, qx + d[4] * t, qy + d[5] * t, qz + d[6] * t
-        norm = math.sqrt(w * w + qx * qx + qy * qy + qz * qz)
-        w, qx, qy, qz = w / norm, qx / norm, qy / norm, qz / norm
-    return (
-        c * x - s * y + ox,
-        s * x + c * y + oy,
-        z,
-        hc * w - hs * qz,
-        hc * qx - hs * qy,
-        hc * qy + hs * qx,
-        hc * qz + hs * w,
-    )
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _reach(dx: float, dy: float, dz: float, bound: float) -> float:
-    """How far a body reaches from its mantle (`physics.kernels._sphere`'s numbers)."""
-    return math.sqrt(dx * dx + dy * dy + dz * dz) + bound
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _sphere_out(
+def _sphere(
+    pos: np.ndarray,
+    rows: np.ndarray,
+    bounds: np.ndarray,
     c: int,
-    cx: float,
-    cy: float,
-    cz: float,
-    radius: float,
     out_centre: np.ndarray,
     out_radius: np.ndarray,
 ) -> None:
+    """Creature c's reach sphere from its bodies at `pos[rows]` (its mantle first; body
+    i's bounding radius `bounds[i]`): centre at the mantle, radius to the farthest body's
+    surface. The contact proxies' `physics.kernels._sphere`, operation for operation
+    (the same bits, tests/clips/test_replay.py): a copy, since numba's cache of a kernel
+    does not notice an edit to a function of another module it inlines."""
+    mantle = rows[0]
+    cx, cy, cz = pos[mantle, 0], pos[mantle, 1], pos[mantle, 2]
     out_centre[c, 0], out_centre[c, 1], out_centre[c, 2] = cx, cy, cz
+    radius = -np.inf
+    for i in range(len(rows)):
+        row = rows[i]
+        dx, dy, dz = pos[row, 0] - cx, pos[row, 1] - cy, pos[row, 2] - cz
+        reach = math.sqrt(dx * dx + dy * dy + dz * dz) + bounds[i]
+        if reach > radius:
+            radius = reach
     out_radius[c] = radius
 
 
