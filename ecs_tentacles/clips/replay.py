@@ -153,6 +153,8 @@ class ClipReplay:
     def advance(self, world: Host, dt: float) -> None:
         """Every kinematic creature one frame on its way; its poses into its batch rows."""
         roster = self.roster
+        proxies = world.physics.proxies
+        proxies.forget_posed()  # those the last frame posed may have moved since
         moving = np.flatnonzero(roster.tier == KINEMATIC)
         if not len(moving):
             for batch in roster.batches:
@@ -170,8 +172,6 @@ class ClipReplay:
         self.heading[moving] = heading
         self.kind[moving] = np.where(crawl, CRAWL, IDLE)
         transforms = world.transforms
-        proxies = world.physics.proxies
-        proxies.forget_posed()  # those the last frame posed may have moved since
         # each creature's reach sphere as its poses are written (the next frame's contact
         # proxies and level of detail ask): not on terrain, which lifts the bodies after
         posed = proxies.posed_spheres() if SPHERES and ground.extent is None else None
