@@ -26,6 +26,7 @@ writes only the caller's `out` arrays.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -40,6 +41,9 @@ from ecs_tentacles.numeric.optional_kernels import OptionalKernels
 from ecs_tentacles.numeric.quaternions import quat_multiply
 from ecs_tentacles.scene.scene_spec import PhysicsSpec
 
+if TYPE_CHECKING:
+    from ecs_tentacles.physics.proxies import PosedSpheres
+
 IDLE, CRAWL = 0, 1
 KINDS = ("idle", "crawl")
 WARMUP = 2.0  # s before recording: the creature settles, the gait is established
@@ -48,6 +52,8 @@ LOOP = (1.0, 5.0)  # s: shortest and longest loop
 GOAL_MARGIN = 2.0  # the goal is this much farther than a crawl at MAX_CRAWL_SPEED reaches
 LOOP_TOLERANCE = 0.002  # m: a shorter loop this much worse than the best is preferred
 MAX_CRAWL_SPEED = 1.0  # m/s: far above what creatures crawl (about 0.1 m/s)
+# the kernels' reach-sphere arguments when none are wanted
+_NONE, _NO_BOUNDS, _NO_CENTRES = np.zeros(0, np.int64), np.zeros(0), np.zeros((0, 3))
 
 
 @dataclass
@@ -156,6 +162,7 @@ class GaitClips:
         interpolate: bool = True,
         rows: np.ndarray | None = None,
         body_rows: np.ndarray | None = None,
+        spheres: tuple[PosedSpheres, np.ndarray] | None = None,
     ) -> None:
         """Body poses of K creatures into `out_pos` (K, B, 3) and `out_quat` (K, B, 4),
         or into their rows `rows` (K,) of larger (N, B, .) arrays (a batch's poses), or,
@@ -167,6 +174,10 @@ class GaitClips:
         number: it wraps; fractions interpolate positions linearly and rotations by
         nlerp, or take the nearest frame without `interpolate`); `xy` (K, 2) the ground
         frame's origin and `heading` (K,) its yaw (radians).
+
+        `spheres` (the contact proxies' `PosedSpheres` and each creature's roster index,
+        (K,)): their reach spheres as well, found as the poses are written, where the
+        kernels run (the numpy path leaves them unknown).
         """
         kind = np.asarray(kind, dtype=np.int64)
         phase = np.asarray(phase, dtype=np.float64)
@@ -179,12 +190,19 @@ class GaitClips:
             turn = np.ascontiguousarray(heading, dtype=np.float64)
             fraction = phase - below
             into = np.arange(len(kind)) if rows is None else np.asarray(rows, dtype=np.int64)
+            known, of = (None, _NONE) if spheres is None else spheres
+            reach = (_NONE, _NO_BOUNDS, _NO_CENTRES, _NO_BOUNDS) if known is None else (
+                known.start, known.rbound, known.centre, known.radius)  # fmt: skip
+            of = np.asarray(of, dtype=np.int64)
             if body_rows is None:
                 fast.place(self._pose, self._change, row, fraction, interpolate, where, turn,
-                           into, out_pos, out_quat)  # fmt: skip
+                           into, out_pos, out_quat, of, *reach)  # fmt: skip
             else:
                 fast.place_scattered(self._pose, self._change, row, fraction, interpolate,
-                                     where, turn, into, body_rows, out_pos, out_quat)  # fmt: skip
+                                     where, turn, into, body_rows, out_pos, out_quat, of,
+                                     *reach)  # fmt: skip
+            if known is not None:
+                known.known[of] = True
             return
         if rows is not None or body_rows is not None:  # numpy: whole arrays, then a scatter
             bodies = self._pose.shape[1]

@@ -9,8 +9,12 @@ otherwise; both give the same poses to float64 rounding (tests/lod/test_clips.py
 
 The numpy path makes about twenty passes over (creatures, bodies) arrays (gather the
 clip frame, interpolate, normalise, turn and move); at 10,000 kinematic creatures of
-81 bodies that was about 60 ms a frame. Here each body is read once and written once.
-Compiled on first use and cached on disk (``cache=True``).
+81 bodies that was about 60 ms a frame. Here each body is read once and written once,
+and each creature's reach sphere (the contact proxies' and the level of detail's) can be
+found from its bodies as they were just written, still in the cache (`_sphere`: the
+contact proxies' numbers), which spares the next frame a pass over every replayed body
+(`physics.proxies.PosedSpheres`). Compiled on first use and cached on disk
+(``cache=True``).
 """
 
 from __future__ import annotations
@@ -33,14 +37,24 @@ def place(
     out_rows: np.ndarray,
     out_pos: np.ndarray,
     out_quat: np.ndarray,
+    sphere_of: np.ndarray,
+    start: np.ndarray,
+    rbound: np.ndarray,
+    out_centre: np.ndarray,
+    out_radius: np.ndarray,
 ) -> None:
     """Creature k shows clip table row `row[k]` (+ `fraction[k]` of `change` when
     `interpolate`, quaternions renormalised) moved to `xy[k]` and turned by `heading[k]`,
     written to row `out_rows[k]` of the outputs (rows of a larger array: no copy after).
 
     `pose` and `change` are (rows, B, 7) ground-frame tables (position, quaternion);
-    the outputs are (N, B, 3) and (N, B, 4).
+    the outputs are (N, B, 3) and (N, B, 4). Unless `sphere_of` is empty, creature k's
+    reach sphere goes to row `sphere_of[k]` of `out_centre` / `out_radius`, found from
+    its bodies as written (`_sphere`; body b's bound is
+    `rbound[start[sphere_of[k]] + b]`).
     """
+    bodies = pose.shape[1]
+    every = np.arange(bodies)  # body b of a creature's output row at row b
     for k in range(len(row)):
         r, o, t = row[k], out_rows[k], fraction[k]
         c, s = math.cos(heading[k]), math.sin(heading[k])
@@ -67,6 +81,10 @@ def place(
             out_quat[o, b, 0], out_quat[o, b, 1], out_quat[o, b, 2], out_quat[o, b, 3] = (
                 qw, q1, q2, q3,
             )  # fmt: skip
+        if len(sphere_of):
+            first = start[sphere_of[k]]
+            bounds = rbound[first : first + bodies]
+            _sphere(out_pos[o], every, bounds, sphere_of[k], out_centre, out_radius)
 
 
 @njit(cache=True, nogil=True)
@@ -82,11 +100,17 @@ def place_scattered(
     body_rows: np.ndarray,
     out_pos: np.ndarray,
     out_quat: np.ndarray,
+    sphere_of: np.ndarray,
+    start: np.ndarray,
+    rbound: np.ndarray,
+    out_centre: np.ndarray,
+    out_radius: np.ndarray,
 ) -> None:
     """`place` (the same numbers), body b of creature k written to row
     `body_rows[out_rows[k], b]` of `out_pos` (rows, 3) and `out_quat` (rows, 4): the
     Transform store, whose rows of a batch's bodies (`Batch.body_rows`, (N, B)) need
     not be consecutive."""
+    bodies = pose.shape[1]
     for k in range(len(row)):
         r, o, t = row[k], out_rows[k], fraction[k]
         c, s = math.cos(heading[k]), math.sin(heading[k])
@@ -112,6 +136,37 @@ def place_scattered(
             at = body_rows[o, b]
             out_pos[at, 0], out_pos[at, 1], out_pos[at, 2] = px, py, z
             out_quat[at, 0], out_quat[at, 1], out_quat[at, 2], out_quat[at, 3] = qw, q1, q2, q3
+        if len(sphere_of):
+            first = start[sphere_of[k]]
+            bounds = rbound[first : first + bodies]
+            _sphere(out_pos, body_rows[o], bounds, sphere_of[k], out_centre, out_radius)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _sphere(
+    pos: np.ndarray,
+    rows: np.ndarray,
+    bounds: np.ndarray,
+    c: int,
+    out_centre: np.ndarray,
+    out_radius: np.ndarray,
+) -> None:
+    """Creature c's reach sphere from its bodies at `pos[rows]` (its mantle first; body
+    i's bounding radius `bounds[i]`): centre at the mantle, radius to the farthest body's
+    surface. The contact proxies' `physics.kernels._sphere`, operation for operation
+    (the same bits, tests/clips/test_replay.py): a copy, since numba's cache of a kernel
+    does not notice an edit to a function of another module it inlines."""
+    mantle = rows[0]
+    cx, cy, cz = pos[mantle, 0], pos[mantle, 1], pos[mantle, 2]
+    out_centre[c, 0], out_centre[c, 1], out_centre[c, 2] = cx, cy, cz
+    radius = -np.inf
+    for i in range(len(rows)):
+        row = rows[i]
+        dx, dy, dz = pos[row, 0] - cx, pos[row, 1] - cy, pos[row, 2] - cz
+        reach = math.sqrt(dx * dx + dy * dy + dz * dz) + bounds[i]
+        if reach > radius:
+            radius = reach
+    out_radius[c] = radius
 
 
 @njit(cache=True, nogil=True)

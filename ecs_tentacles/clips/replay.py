@@ -39,6 +39,7 @@ from ecs_tentacles.physics.tiers import KINEMATIC
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
     from ecs_tentacles.physics.batch import Batch
+    from ecs_tentacles.physics.proxies import PosedSpheres
     from ecs_tentacles.roster_change import RosterChange
     from ecs_tentacles.store import TransformStore
 
@@ -49,6 +50,7 @@ SHARED = ClipCache(disk=True)  # clips by morphology: every world of this proces
 TURN_RATE = math.radians(60.0)  # rad/s a replayed creature turns toward its way
 ARRIVED = 0.05  # m: closer than this to its target, a replayed creature idles
 DIRECT = True  # replayed poses into the Transform store only (False: into the batches, synced)
+SPHERES = True  # reach spheres found as poses are written (False: the next frame reads them)
 
 
 class ClipReplay:
@@ -151,6 +153,8 @@ class ClipReplay:
     def advance(self, world: Host, dt: float) -> None:
         """Every kinematic creature one frame on its way; its poses into its batch rows."""
         roster = self.roster
+        proxies = world.physics.proxies
+        proxies.forget_posed()  # those the last frame posed may have moved since
         moving = np.flatnonzero(roster.tier == KINEMATIC)
         if not len(moving):
             for batch in roster.batches:
@@ -168,6 +172,9 @@ class ClipReplay:
         self.heading[moving] = heading
         self.kind[moving] = np.where(crawl, CRAWL, IDLE)
         transforms = world.transforms
+        # each creature's reach sphere as its poses are written (the next frame's contact
+        # proxies and level of detail ask): not on terrain, which lifts the bodies after
+        posed = proxies.posed_spheres() if SPHERES and ground.extent is None else None
         for batch in roster.batches:
             here = roster.batch_of[moving] == batch.index
             mine = moving[here]
@@ -182,7 +189,9 @@ class ClipReplay:
             self.phase[mine] += dt / clips.crawl.dt
             rows = roster.row_of[mine]
             whole = bool(np.all(self.phase[mine] == np.round(self.phase[mine])))
-            self._show(batch, clips, mine, rows, transforms, interpolate=not whole)
+            spheres = None if posed is None else (posed, mine)
+            self._show(batch, clips, mine, rows, transforms, interpolate=not whole,
+                       spheres=spheres)  # fmt: skip
             if ground.extent is not None:  # draped over the terrain, body by body
                 into = transforms.pos if batch.shown is not None else batch.xpos
                 at = batch.body_rows[rows] if batch.shown is not None else rows
@@ -191,10 +200,12 @@ class ClipReplay:
                 into[at, ..., 2] = pos[..., 2] + lift
 
     def _show(self, batch: Batch, clips: GaitClips, mine: np.ndarray, rows: np.ndarray,
-              transforms: TransformStore, *, interpolate: bool) -> None:  # fmt: skip
+              transforms: TransformStore, *, interpolate: bool,
+              spheres: tuple[PosedSpheres, np.ndarray] | None = None) -> None:  # fmt: skip
         """Creatures `mine` (rows `rows` of `batch`) in their clip poses, written once:
         into the Transform store (which the renderer, recorders, proxies and rig read),
-        not into the batch's pose rows (`Batch.show`; `Batch.poses` reads them back)."""
+        not into the batch's pose rows (`Batch.show`; `Batch.poses` reads them back);
+        with `spheres`, their reach spheres as well (`GaitClips.evaluate`)."""
         kind, phase = self.kind[mine], self.phase[mine]
         xy, heading = self.xy[mine], self.heading[mine]
         if not DIRECT:  # into the batch's pose rows; the sync copies them like any others
@@ -205,11 +216,11 @@ class ClipReplay:
         if batch.body_span() is not None:  # a uniform crowd's batch: its store rows as rows
             pos, quat = batch.store_rows(transforms)
             clips.evaluate(kind, phase, xy, heading, pos, quat, interpolate=interpolate,
-                           rows=rows)  # fmt: skip
+                           rows=rows, spheres=spheres)  # fmt: skip
         else:
             clips.evaluate(kind, phase, xy, heading, transforms.pos, transforms.quat,
                            interpolate=interpolate, rows=rows,
-                           body_rows=batch.body_rows)  # fmt: skip
+                           body_rows=batch.body_rows, spheres=spheres)  # fmt: skip
         batch.show(transforms, rows)
 
     # -- snapshots -------------------------------------------------------------------------
@@ -218,6 +229,7 @@ class ClipReplay:
 
     def set_state(self, state: tuple[np.ndarray, ...]) -> None:
         self.xy[:], self.heading[:], self.phase[:], self.kind[:] = state
+        self.world.physics.proxies.forget_posed()  # the store goes back too
 
 
 def _mantle_frame(pos: np.ndarray, mantle: np.ndarray, yaw: np.ndarray) -> np.ndarray:

@@ -159,11 +159,29 @@ class LocomotionPlugin(Plugin):
         """Creatures crawl toward their current goal (or the waypoint on the way to it),
         turned by avoidance where a neighbour is near."""
         creatures = world.resource(LocomotionStores).creatures
+        term = creatures.avoidance
+        if 2 * np.count_nonzero(term[:, 0]) > len(term):  # most turned (a crowd): no gathers
+            return self._crowd_travel_targets(world)
         target = creatures.steer[:, :2].copy()
-        turned = np.flatnonzero(np.any(creatures.avoidance != 0.0, axis=1))
+        turned = np.flatnonzero(np.any(term != 0.0, axis=1))
         if len(turned):  # the others keep their steer point exactly
             mantle = world.transforms.pos[world.creatures.mantle_row[turned], :2]
             target[turned] = mantle + bent(target[turned] - mantle, creatures.avoidance[turned])
+        return np.where(creatures.has_goal[:, None], target, np.nan)
+
+    def _crowd_travel_targets(self, world: Host) -> np.ndarray:
+        """`_travel_targets` as whole-array math: every creature turned (`bent`'s
+        operations, in its order), then those with no avoidance term given back their
+        steer point; the same bits without a gather and a scatter of most rows."""
+        creatures = world.resource(LocomotionStores).creatures
+        steer, term = creatures.steer[:, :2], creatures.avoidance
+        mantle = world.transforms.pos[world.creatures.mantle_row, :2]
+        with np.errstate(invalid="ignore", over="ignore"):  # (rows not turned: not kept)
+            to_goal = steer - mantle
+            length = np.hypot(to_goal[:, 0], to_goal[:, 1])
+            to_goal += length[:, None] * term
+            to_goal += mantle  # (mantle + to_goal: addition commutes bit for bit)
+        target = np.where(np.any(term != 0.0, axis=1)[:, None], to_goal, steer)
         return np.where(creatures.has_goal[:, None], target, np.nan)
 
     def snapshot(self, world: Host) -> object:

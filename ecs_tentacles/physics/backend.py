@@ -206,6 +206,7 @@ class PhysicsBackend(Membership):
         self.lod.set_state(state.lod)
         self.health.set_state(state.health)
         self.sleep.set_state(state.sleep)
+        self.proxies.forget_posed()  # the replayed poses' spheres: the store goes back too
 
     # -- per frame -------------------------------------------------------------------
     def kinematic_creatures(self, creatures: int) -> np.ndarray:

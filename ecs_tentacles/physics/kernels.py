@@ -51,7 +51,8 @@ def sense(
             out_pos[i, j] = store_pos[row, j]
         for j in range(4):
             out_quat[i, j] = store_quat[row, j]
-    reach(store_pos, rows, start, count, rbound, out_centre, out_radius)
+    for c in range(len(start)):
+        _sphere(store_pos, rows, start[c], count[c], rbound, c, out_centre, out_radius)
 
 
 @njit(cache=True, nogil=True)
@@ -87,12 +88,14 @@ def reach(
     start: np.ndarray,
     count: np.ndarray,
     rbound: np.ndarray,
+    creatures: np.ndarray,
     out_centre: np.ndarray,
     out_radius: np.ndarray,
 ) -> None:
-    """`sense`'s reach spheres alone: no body is copied (a frame needs the bodies of the
-    creatures near another only, `ContactProxies.gather`)."""
-    for c in range(len(start)):
+    """`sense`'s reach spheres alone, of `creatures`: no body is copied (a frame needs the
+    bodies of the creatures near another only, `ContactProxies.gather`; a replayed
+    creature's sphere was found as its poses were written)."""
+    for c in creatures:
         _sphere(store_pos, rows, start[c], count[c], rbound, c, out_centre, out_radius)
 
 
@@ -103,11 +106,13 @@ def reach_parallel(
     start: np.ndarray,
     count: np.ndarray,
     rbound: np.ndarray,
+    creatures: np.ndarray,
     out_centre: np.ndarray,
     out_radius: np.ndarray,
 ) -> None:
     """`reach` on all cores, creature by creature (each sphere's numbers are `reach`'s)."""
-    for c in prange(len(start)):
+    for i in prange(len(creatures)):
+        c = creatures[i]
         _sphere(store_pos, rows, start[c], count[c], rbound, c, out_centre, out_radius)
 
 

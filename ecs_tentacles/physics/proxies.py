@@ -11,7 +11,9 @@ parked out of reach.
 
 All the per-frame work is array math over the bodies of creatures that are near
 someone: bounding spheres per creature, candidate bodies inside a neighbour's sphere,
-and the nearest ones kept when more are near than the pool holds.
+and the nearest ones kept when more are near than the pool holds. A replayed creature's
+reach sphere is found by the replay as it writes its poses (`posed_spheres`): the
+frame's `sense` reads no replayed body for it.
 """
 
 from __future__ import annotations
@@ -38,6 +40,7 @@ MARGIN = 0.05  # metres: a body this close to a neighbour's sphere gets a proxy
 POOL = np.array([PROXY_CAPSULES, PROXY_CYLINDERS])
 CAPSULE, CYLINDER = 0, 1
 _NONE = np.zeros(0, dtype=np.int64)
+ALL = slice(None)
 Sensed = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]  # pos, quat, centre, radius
 # creatures from which the frame's reach spheres are found on all cores (before the step,
 # while the stepping threads wait): at 10,000 one core took about 4 ms
@@ -88,6 +91,7 @@ class ContactProxies:
         self._within: Sensed | None = None  # the poses refresh() moves within a frame
         self._lazy: _Lazy | None = None  # the frame's sensed bodies, gathered as asked
         self._every = np.arange(len(self.rows))  # body i at pos[i] (pair_gaps' kernel)
+        self._posed = PosedSpheres.empty(self.start, self.rbound)
         self.index = [  # each batch row's bodies in this order
             self.start[batch.members][:, None] + np.arange(len(batch.body_ids))
             for batch in self.roster.batches
@@ -129,9 +133,11 @@ class ContactProxies:
         fast = KERNELS.get()
         if frame is not None and fast is not None:
             pos, quat = np.empty((len(self.rows), 3)), np.empty((len(self.rows), 4))
-            centre, radius = np.empty((len(self.start), 3)), np.empty(len(self.start))
-            spheres = fast.reach_parallel if len(self.start) >= PARALLEL_REACH else fast.reach
-            spheres(transforms.pos, self.rows, self.start, self.count, self.rbound,
+            posed, self._posed = self._posed, PosedSpheres.empty(self.start, self.rbound)
+            centre, radius = posed.centre, posed.radius  # the replayed ones' are there
+            todo = np.flatnonzero(~posed.known)
+            spheres = fast.reach_parallel if len(todo) >= PARALLEL_REACH else fast.reach
+            spheres(transforms.pos, self.rows, self.start, self.count, self.rbound, todo,
                     centre, radius)  # fmt: skip
             self._lazy = _Lazy(pos, quat, np.zeros(len(self.start), dtype=bool), transforms)
             sensed = (pos, quat, centre, radius)
@@ -148,6 +154,19 @@ class ContactProxies:
         sensed = (pos, quat, centre, radius)
         self._sensed = None if frame is None else (frame, sensed)
         return sensed
+
+    def posed_spheres(self) -> PosedSpheres:
+        """Where a writer of poses puts the reach spheres of the creatures it poses, for
+        the next frame's `sense` (`clips.replay`: a replayed creature's, as its clip
+        poses are written into the Transform store). Their numbers must be `spheres`'
+        of what the store holds when that `sense` runs: one that writes a creature's
+        bodies after its sphere marks it unknown again (`forget_posed`)."""
+        return self._posed
+
+    def forget_posed(self, creatures: np.ndarray | slice = ALL) -> None:
+        """The spheres `posed_spheres` holds for `creatures` (all: every one) no longer
+        stand for the store: the next `sense` finds them from the bodies."""
+        self._posed.known[creatures] = False
 
     def gather(self, pos: np.ndarray, creatures: np.ndarray) -> None:
         """The bodies of `creatures` (roster indices) into `pos` and its quaternions, if
@@ -390,6 +409,25 @@ class ContactProxies:
         gap = np.linalg.norm(pos[own] - pos[body[pair]], axis=1) - self.rbound[own]
         nearest = np.minimum.reduceat(gap, np.cumsum(per) - per)
         return np.asarray(nearest - self.rbound[body])
+
+
+@dataclass
+class PosedSpheres:
+    """Reach spheres found by whoever wrote creatures' poses (`ContactProxies.posed_spheres`),
+    for the next frame's `sense`: creature c's at `centre[c]`, `radius[c]` where `known[c]`.
+    `start` and `rbound` are the proxies' (creature c's body b is `start[c] + b`)."""
+
+    start: np.ndarray
+    rbound: np.ndarray
+    centre: np.ndarray
+    radius: np.ndarray
+    known: np.ndarray
+
+    @classmethod
+    def empty(cls, start: np.ndarray, rbound: np.ndarray) -> PosedSpheres:
+        count = len(start)
+        known = np.zeros(count, dtype=bool)
+        return cls(start, rbound, np.empty((count, 3)), np.empty(count), known)
 
 
 @dataclass

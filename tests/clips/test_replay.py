@@ -126,3 +126,69 @@ def test_a_snapshot_keeps_the_replayed_poses_as_shown(make_world: Callable[..., 
     for first, again in zip(ahead, _replayed_run(world, 10), strict=True):
         for a, b in zip(first, again, strict=True):
             assert_array_equal(a, b)
+
+
+@pytest.mark.parametrize("crowd", ["uniform", "varied"])
+def test_replayed_reach_spheres_found_as_written_are_the_stores(
+    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch, crowd: str
+) -> None:
+    """A replayed creature's reach sphere (the contact proxies' and the level of detail's)
+    is found as the replay writes its poses, not read back from the Transform store by
+    the next frame: every frame's spheres are the store's bit for bit as the frame starts
+    (`ContactProxies.spheres`), also as one is promoted and demoted and on the frame
+    after a snapshot is restored, and the crowd's tiers and poses are those of the path
+    that reads them back."""
+    from ecs_tentacles.creator.crowd import crowd_scene
+    from ecs_tentacles.physics.proxies import ContactProxies, Sensed
+    from ecs_tentacles.snapshot import restore, take
+    from ecs_tentacles.store import TransformStore
+
+    scene = crowd_scene(8, seed=2, uniform=crowd != "varied")
+    scene.setdefault("physics", {})["lod"] = {"full": 0, "reduced": 2, "hold_seconds": 0.1}
+    sensed: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
+    sense = ContactProxies.sense
+
+    def recorded(
+        self: ContactProxies, transforms: TransformStore, frame: int | None = None
+    ) -> Sensed:
+        out = sense(self, transforms, frame)
+        if frame is not None and (not sensed or sensed[-1][0] is not out[2]):
+            sensed.append((out[2], out[2].copy(), out[3].copy()))  # the frame's first ask
+        return out
+
+    monkeypatch.setattr(ContactProxies, "sense", recorded)
+    runs = []
+    for found in (False, True):  # the old path first: spheres read back from the store
+        monkeypatch.setattr(replay, "SPHERES", found)
+        world = make_world(scene)
+        proxies = world.physics.proxies
+        tiers, poses, came = [], [], 0
+        saved, chosen = None, -1
+        for frame in range(40):
+            if frame == 5:  # a replayed creature promoted, and later demoted again
+                chosen = int(world.physics.roster.entity[np.argmax(world.physics.tier)])
+                world.lod.promote(chosen)
+            if frame == 12:
+                world.lod.release(chosen)
+            if frame == 15:
+                saved = take(world)
+            if frame == 30 and saved is not None:  # back to 15: the replay's spheres are stale
+                restore(world, saved)
+            pos = world.transforms.pos[proxies.rows]
+            centre, radius = proxies.spheres(pos)
+            came += int(proxies.posed_spheres().known.sum())
+            count = len(sensed)
+            world.step(1)
+            assert len(sensed) == count + 1
+            _, got_centre, got_radius = sensed[-1]
+            assert_array_equal(got_centre, centre, err_msg=f"frame {frame}")
+            assert_array_equal(got_radius, radius, err_msg=f"frame {frame}")
+            tiers.append(world.physics.tier.copy())
+            poses.append(world.transforms.pos.copy())
+        kinematic = np.array(tiers) == KINEMATIC
+        assert kinematic.sum(axis=1).max() >= 4 and (kinematic != kinematic[0]).any()
+        assert (came > 100) if found else came == 0  # most replayed ones came from the replay
+        runs.append((tiers, poses))
+    for old, new in zip(*runs, strict=True):
+        for a, b in zip(old, new, strict=True):
+            assert_array_equal(a, b)

@@ -174,3 +174,32 @@ def test_a_crossing_crowd_moves_the_same_with_and_without_the_kernel(
     terms = [w.resource(LocomotionStores).creatures.avoidance for w in (kernel, numpy_path)]
     np.testing.assert_array_equal(*terms)
     assert terms[0].any()  # they did steer around each other
+
+
+def test_a_crowds_travel_targets_as_whole_arrays_are_the_gathered_ones(
+    make_world: Callable[..., World],
+) -> None:
+    """Where most creatures are turned by avoidance (a crowd), their travel targets (where
+    replayed creatures head) are found as whole-array math: the same bits as turning
+    only the turned rows (`bent`), with the others at their steer point exactly and
+    nan for no goal."""
+    from ecs_tentacles.locomotion.plugin import LocomotionPlugin
+
+    world = make_world(crowd_scene(12, seed=1, uniform=True))
+    world.step(2)
+    creatures = world.resource(LocomotionStores).creatures
+    term = creatures.avoidance
+    term[:] = np.random.default_rng(4).normal(0.0, 0.3, term.shape)
+    term[[1, 5]] = 0.0  # straight on
+    term[7, 0] = 0.0  # turned by one component only
+    creatures.has_goal[3] = False
+    steer = creatures.steer[:, :2]
+    turned = np.flatnonzero(np.any(term != 0.0, axis=1))
+    mantle = world.transforms.pos[world.creatures.mantle_row[turned], :2]
+    gathered = steer.copy()
+    gathered[turned] = mantle + bent(gathered[turned] - mantle, term[turned])
+    gathered[3] = np.nan
+    found = LocomotionPlugin()._travel_targets(world)  # most rows turned: whole arrays
+    np.testing.assert_array_equal(found, gathered)
+    np.testing.assert_array_equal(found[[1, 5]], steer[[1, 5]])
+    assert not (found[[0, 2, 7]] == steer[[0, 2, 7]]).all(axis=1).any()
