@@ -11,12 +11,18 @@ does: 288 -> 319 MB in ten minutes for that crowd, and a trim every two seconds 
 still left the heap's top holding up to 11 MB of free memory between trims (the
 threshold had climbed past 5 MB).
 
-So two things, both once a simulation is built (`PhysicsBackend`):
+So three things, all once a simulation is built (`PhysicsBackend`):
 - `settle()` fixes glibc's thresholds (`mallopt`), which also stops their climbing:
   blocks from `MMAP_THRESHOLD` (32 MB, glibc's ceiling) up are mmapped, and the top of
   the heap is given back by `free` itself past `TRIM_THRESHOLD` (1 MB): the trim
   threshold is what bounds the heap's top. A user's own
   `MALLOC_MMAP_THRESHOLD_` / `MALLOC_TRIM_THRESHOLD_` are left as they are.
+- `settle()` also stops numpy asking for transparent huge pages (numpy advises them
+  for every array of 4 MB or more, heap blocks too): a crowd's per-creature tables are
+  touched a few rows here and there (the stepped creatures' gains, last commands,
+  sensed bodies), and each touch made a whole 2 MB page resident; at 10,000 creatures
+  that was 72 MiB (1,543 -> 1,471 MiB after `bench`), and half the frame's system time.
+  A user's own `NUMPY_MADVISE_HUGEPAGE` is left as it is.
 - `trim()` (`malloc_trim(0)`) returns every whole free page in holes below live blocks,
   in every arena; the physics calls it every `TRIM_FRAMES` frames (`PhysicsBackend.step`),
   0.1-5 ms each time on that crowd's 90 MB heap.
@@ -31,6 +37,8 @@ import ctypes.util
 import os
 import sys
 from collections.abc import Callable
+
+import numpy as np
 
 TRIM_FRAMES = 120  # frames between two trims of a running simulation
 # bytes: blocks this big or bigger are mmapped. glibc's own ceiling: a lower one (256 KB
@@ -64,6 +72,7 @@ def settle() -> bool:
     """Fix glibc's mmap and trim thresholds (once; see the module doc); False where that
     cannot be done or the environment already sets them."""
     global settled
+    no_huge_pages()
     if _GLIBC is None:
         return False
     if settled:
@@ -85,3 +94,39 @@ def trim() -> bool:
     _GLIBC[0](0)
     trims += 1
     return True
+
+
+def no_huge_pages() -> bool:
+    """numpy stops advising transparent huge pages for the arrays it allocates from now
+    on (see the module doc); False where it cannot (a numpy without the switch) or the
+    environment chose (`NUMPY_MADVISE_HUGEPAGE`)."""
+    if "NUMPY_MADVISE_HUGEPAGE" in os.environ:
+        return False
+    core = getattr(np, "_core", None) or np.core  # (numpy 1.x: np.core)
+    switch = getattr(core.multiarray, "_set_madvise_hugepage", None)
+    if switch is None:
+        return False
+    switch(False)
+    return True
+
+
+def resident_bytes(array: np.ndarray) -> int | None:
+    """How much of the memory under `array` (its base's whole buffer) is resident now,
+    in bytes of whole pages (`mincore`); None off Linux. For measuring (tools, tests)."""
+    if not sys.platform.startswith("linux"):
+        return None
+    while isinstance(array.base, np.ndarray):
+        array = array.base
+    if not array.nbytes:
+        return 0
+    page = os.sysconf("SC_PAGE_SIZE")
+    start = array.ctypes.data // page * page
+    length = array.ctypes.data + array.nbytes - start
+    pages = -(-length // page)
+    vector = bytearray(pages)
+    mincore = ctypes.CDLL(None, use_errno=True).mincore
+    mincore.argtypes = [ctypes.c_void_p, ctypes.c_size_t, ctypes.c_void_p]
+    buffer = (ctypes.c_ubyte * pages).from_buffer(vector)
+    if mincore(ctypes.c_void_p(start), ctypes.c_size_t(length), buffer) != 0:
+        raise OSError(ctypes.get_errno(), "mincore failed")
+    return int((np.frombuffer(vector, dtype=np.uint8) & 1).sum()) * page
