@@ -38,6 +38,7 @@ from ecs_tentacles.events import CreatureFrozen, CreatureRecovered, SuckerReleas
 from ecs_tentacles.numeric.optional_kernels import OptionalKernels
 from ecs_tentacles.numeric.rows import run_slice, without_row
 from ecs_tentacles.numeric.slots import SlotRows
+from ecs_tentacles.numeric.untouched import untouched_zeros
 from ecs_tentacles.physics.tiers import KINEMATIC
 
 if TYPE_CHECKING:
@@ -201,8 +202,9 @@ class HealthCheck:
         save = world.frame % SAVE_EVERY == 0
         ramp = world.settings.dt / SOFT_SECONDS
         pos = world.transforms.pos
-        if len(self.previous) != len(pos):
-            self.previous = pos.copy()
+        if len(self.previous) != len(pos):  # (the first check, or a store changed)
+            self.previous = untouched_zeros(pos.shape)  # resident where written:
+            self._remember(pos)  # the stepped creatures' rows (a crowd's 19 MB otherwise)
         active = roster.active
         fastest = self._fastest(pos, active)
         bad = ~(fastest <= limit)  # also nan: a pose that is not finite
