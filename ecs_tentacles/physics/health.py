@@ -28,6 +28,7 @@ only failing creatures are visited.
 from __future__ import annotations
 
 import logging
+import mmap
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -202,9 +203,8 @@ class HealthCheck:
         save = world.frame % SAVE_EVERY == 0
         ramp = world.settings.dt / SOFT_SECONDS
         pos = world.transforms.pos
-        if len(self.previous) != len(pos):  # (the first check, or a store changed)
-            self.previous = untouched_zeros(pos.shape)  # resident where written:
-            self._remember(pos)  # the stepped creatures' rows (a crowd's 19 MB otherwise)
+        if len(self.previous) != len(pos):
+            self.previous = pos.copy()
         active = roster.active
         fastest = self._fastest(pos, active)
         bad = ~(fastest <= limit)  # also nan: a pose that is not finite
@@ -262,12 +262,16 @@ class HealthCheck:
         """This frame's poses as the next check's `previous`, but a replayed (KINEMATIC)
         creature's: it is never checked, and leaves the tier only through
         `PhysicsBackend.place_joints`, whose `restart` sets its rows (10,000 creatures'
-        bodies were a 19 MB copy a frame)."""
+        bodies were a 19 MB copy a frame). Once some are replayed, `previous` holds
+        pages for the others' rows only (`numeric.untouched`: the build's copy of every
+        pose was 19 MB resident at 10,000)."""
         roster = self.roster
         kept = roster.tier != KINEMATIC
         if kept.all():
             self.previous[:] = pos
             return
+        if not isinstance(self.previous.base, mmap.mmap):  # (the build's copy: every row)
+            self.previous = untouched_zeros(pos.shape)  # resident where written from now on
         who = np.flatnonzero(kept)
         if not len(who):
             return

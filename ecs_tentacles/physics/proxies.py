@@ -88,10 +88,18 @@ class ContactProxies:
         self._within: Sensed | None = None  # the poses refresh() moves within a frame
         self._lazy: _Lazy | None = None  # the frame's sensed bodies, gathered as asked
         self._every = np.arange(len(self.rows))  # body i at pos[i] (pair_gaps' kernel)
-        self.index = [  # each batch row's bodies in this order
-            self.start[batch.members][:, None] + np.arange(len(batch.body_ids))
-            for batch in self.roster.batches
-        ]
+        self._index: list[np.ndarray] | None = None  # (`index`)
+
+    @property
+    def index(self) -> list[np.ndarray]:
+        """Each batch's rows' bodies in this class's order, (rows, bodies) a batch: for
+        numpy's `refresh` (made when first asked: 6.5 MB at 10,000 the kernels never read)."""
+        if self._index is None:
+            self._index = [
+                self.start[batch.members][:, None] + np.arange(len(batch.body_ids))
+                for batch in self.roster.batches
+            ]
+        return self._index
 
     def append(self, batch: Batch, row: int) -> None:
         """Creature `batch.members[row]` joined the roster last: its bodies at the end of
