@@ -11,18 +11,12 @@ does: 288 -> 319 MB in ten minutes for that crowd, and a trim every two seconds 
 still left the heap's top holding up to 11 MB of free memory between trims (the
 threshold had climbed past 5 MB).
 
-So three things, all once a simulation is built (`PhysicsBackend`):
+So two things, both once a simulation is built (`PhysicsBackend`):
 - `settle()` fixes glibc's thresholds (`mallopt`), which also stops their climbing:
   blocks from `MMAP_THRESHOLD` (32 MB, glibc's ceiling) up are mmapped, and the top of
   the heap is given back by `free` itself past `TRIM_THRESHOLD` (1 MB): the trim
   threshold is what bounds the heap's top. A user's own
   `MALLOC_MMAP_THRESHOLD_` / `MALLOC_TRIM_THRESHOLD_` are left as they are.
-- `settle()` also stops numpy asking for transparent huge pages (numpy advises them
-  for every array of 4 MB or more, heap blocks too): a crowd's per-creature tables are
-  touched a few rows here and there (the stepped creatures' gains, last commands,
-  sensed bodies), and each touch made a whole 2 MB page resident; at 10,000 creatures
-  that was 72 MiB (1,543 -> 1,471 MiB after `bench`), and half the frame's system time.
-  A user's own `NUMPY_MADVISE_HUGEPAGE` is left as it is.
 - `trim()` (`malloc_trim(0)`) returns every whole free page in holes below live blocks,
   in every arena; the physics calls it every `TRIM_FRAMES` frames (`PhysicsBackend.step`),
   0.1-5 ms each time on that crowd's 90 MB heap.
@@ -72,7 +66,6 @@ def settle() -> bool:
     """Fix glibc's mmap and trim thresholds (once; see the module doc); False where that
     cannot be done or the environment already sets them."""
     global settled
-    no_huge_pages()
     if _GLIBC is None:
         return False
     if settled:
@@ -96,23 +89,11 @@ def trim() -> bool:
     return True
 
 
-def no_huge_pages() -> bool:
-    """numpy stops advising transparent huge pages for the arrays it allocates from now
-    on (see the module doc); False where it cannot (a numpy without the switch) or the
-    environment chose (`NUMPY_MADVISE_HUGEPAGE`)."""
-    if "NUMPY_MADVISE_HUGEPAGE" in os.environ:
-        return False
-    core = getattr(np, "_core", None) or np.core  # (numpy 1.x: np.core)
-    switch = getattr(core.multiarray, "_set_madvise_hugepage", None)
-    if switch is None:
-        return False
-    switch(False)
-    return True
-
-
 def resident_bytes(array: np.ndarray) -> int | None:
     """How much of the memory under `array` (its base's whole buffer) is resident now,
-    in bytes of whole pages (`mincore`); None off Linux. For measuring (tools, tests)."""
+    in bytes of whole pages (`mincore`); None off Linux. For measuring (tools, tests):
+    numpy asks for transparent huge pages for arrays of 4 MB or more, so one write can
+    make 2 MB of such an array resident."""
     if not sys.platform.startswith("linux"):
         return None
     while isinstance(array.base, np.ndarray):

@@ -1,7 +1,6 @@
 """The C heap gives freed memory back during a long run (`ecs_tentacles.physics.heap`): glibc's
 thresholds are fixed once a simulation is built, and the physics trims the heap every
-`TRIM_FRAMES` frames (skipped where the C library is not glibc); numpy's arrays stop
-taking transparent huge pages."""
+`TRIM_FRAMES` frames. Skipped where the C library is not glibc."""
 
 from __future__ import annotations
 
@@ -9,7 +8,6 @@ import ctypes
 import os
 from collections.abc import Callable
 
-import numpy as np
 import pytest
 
 from ecs_tentacles.physics import heap
@@ -71,30 +69,3 @@ def test_freed_memory_at_the_top_of_the_heap_goes_back_once_a_world_is_built(
     for block in reversed(blocks):
         lib.free(block)
     assert lib.mallinfo2().keepcost <= heap.TRIM_THRESHOLD
-
-
-def huge_pages_advisable() -> bool:
-    """The kernel gives transparent huge pages to memory advised for them."""
-    try:
-        with open("/sys/kernel/mm/transparent_hugepage/enabled") as f:
-            return "[never]" not in f.read()
-    except OSError:
-        return False
-
-
-@pytest.mark.skipif(not huge_pages_advisable(), reason="no transparent huge pages here")
-def test_a_big_table_touched_here_and_there_stays_small_once_a_world_is_built(
-    make_world: Callable[..., World],
-) -> None:
-    """numpy advises huge pages for arrays of 4 MB or more, and each touch of such an
-    array then made a whole 2 MB page resident (a crowd's tables are touched at the few
-    creatures MuJoCo steps). Once a world is built, a 64 MB table written every 2 MB
-    holds 32 small pages."""
-    if "NUMPY_MADVISE_HUGEPAGE" in os.environ:
-        pytest.skip("the environment chooses numpy's huge pages")
-    make_world(creature_scene(count=3, links=4), threads=1)
-    table = np.zeros(64 << 20, dtype=np.uint8)
-    table[:: 2 << 20] = 1
-    resident = heap.resident_bytes(table)
-    assert resident is not None
-    assert resident <= 32 * os.sysconf("SC_PAGE_SIZE")
