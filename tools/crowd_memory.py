@@ -6,8 +6,8 @@
 Builds `ecs-tentacles crowd N --uniform` in this process (`World.from_scene`, 2 threads)
 and reports the resident memory (psutil) and CPU seconds once built and after `--frames`
 frames, the peak, and the largest numpy arrays reachable from the world by attribute
-path (allocated bytes: with transparent huge pages, an array touched here and there is
-resident whole). With `--objects`, Python's tracked objects by type as well (the
+path, by their resident bytes (`physics.heap.resident_bytes`: the pages touched), with
+their allocated bytes beside. With `--objects`, Python's tracked objects by type as well (the
 collector's frozen objects included; slow at 10,000). One run: state the machine's
 load (`uptime`); the resident figures move little with it, the seconds do.
 """
@@ -29,16 +29,19 @@ import psutil
 
 from ecs_tentacles.creator.crowd import crowd_scene
 from ecs_tentacles.options import WorldOptions
+from ecs_tentacles.physics import heap
 from ecs_tentacles.world import World
 
 DEPTH = 9  # attribute path parts kept in a label
 
 
-def arrays_by_path(root: object, top: int) -> list[tuple[str, float]]:
-    """The `top` largest owned numpy arrays reachable from `root` (MB, by the first
-    attribute path found; a list or dict of many items is one label)."""
+def arrays_by_path(root: object, top: int) -> list[tuple[str, float, float]]:
+    """The `top` most resident owned numpy arrays reachable from `root`: (label, resident
+    MB, allocated MB), by the first attribute path found (a list or dict of many items
+    is one label)."""
     seen: set[int] = set()
     owners: collections.Counter[str] = collections.Counter()
+    resident: collections.Counter[str] = collections.Counter()
     stack: list[tuple[Any, str, int]] = [(root, "world", 0)]
     while stack:
         obj, path, depth = stack.pop()
@@ -51,7 +54,9 @@ def arrays_by_path(root: object, top: int) -> list[tuple[str, float]]:
                 base = base.base
             if base is obj or id(base) not in seen:
                 seen.add(id(base))
-                owners[".".join(path.split(".")[:DEPTH])] += base.nbytes
+                label = ".".join(path.split(".")[:DEPTH])
+                owners[label] += base.nbytes
+                resident[label] += heap.resident_bytes(base) or 0
             continue
         if depth > DEPTH:
             continue
@@ -70,7 +75,7 @@ def arrays_by_path(root: object, top: int) -> list[tuple[str, float]]:
             for key in getattr(type(obj), "__slots__", ()):
                 if hasattr(obj, key):
                     stack.append((getattr(obj, key), f"{path}.{key}", depth + 1))
-    return [(label, size / 1e6) for label, size in owners.most_common(top)]
+    return [(label, size / 1e6, owners[label] / 1e6) for label, size in resident.most_common(top)]
 
 
 def objects_by_type(top: int) -> list[tuple[str, int, float]]:
@@ -139,8 +144,9 @@ def main(argv: list[str] | None = None) -> int:
         f" ({result['frames_cpu_s']} s CPU) {result['rss_mib']} MiB, peak"
         f" {result['peak_mib']} MiB; tiers {result['tiers']}"
     )
-    for label, mb in result["arrays_mb"]:
-        print(f"  {mb:8.1f} MB  {label}")
+    print("  resident  allocated (MB)")
+    for label, mb, allocated in result["arrays_mb"]:
+        print(f"  {mb:8.1f} {allocated:8.1f}  {label}")
     for name, count, mb in result.get("objects", []):
         print(f"  {mb:8.1f} MB  {count:9d} {name}")
     return 0

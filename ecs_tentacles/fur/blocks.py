@@ -61,7 +61,6 @@ class BindBlocks:
     def __init__(self, blocks: list[Block], bodies: np.ndarray):
         self.blocks = blocks
         self.bodies = bodies  # sorted Transform rows; `Bind.body` indexes them
-        self._whole: Bind | None = None
 
     @classmethod
     def of(cls, fur: FurData) -> BindBlocks:
@@ -74,10 +73,10 @@ class BindBlocks:
 
     @property
     def whole(self) -> Bind:
-        """Every guide's bind as one `Bind` (joined when asked, then kept)."""
-        if self._whole is None:
-            self._whole = joined([bind for _, bind in self.blocks]) if self.blocks else _empty()
-        return self._whole
+        """Every guide's bind as one `Bind`, joined when asked (a copy, not kept: asked
+        when binding, it was a second bind pose beside the blocks, 25 MB at 10,000
+        creatures)."""
+        return joined([bind for _, bind in self.blocks]) if self.blocks else _empty()
 
     def added(self, fur: FurData, rows: np.ndarray) -> bool:
         """A spawn appended guide rows `rows` to `fur`: bind them and append them.
@@ -105,7 +104,6 @@ class BindBlocks:
             rows_before, last = self.blocks.pop()
             bind, n = joined([last, bind]), rows_before.start
         self.blocks += _split(bind, n)
-        self._whole = None
         return True
 
     def removed(
@@ -149,7 +147,6 @@ class BindBlocks:
             blocks.append((part_rows, part))
         self.blocks = blocks
         self.bodies = bodies[alive]
-        self._whole = None
 
 
 def _first_gone(new: np.ndarray, alive: np.ndarray | None = None) -> int:

@@ -24,6 +24,13 @@ class SlotRows:
         self.pool = items
         self.slot = np.arange(len(items), dtype=np.int64)
 
+    @classmethod
+    def empty(cls, rows: int, item: tuple[int, ...]) -> SlotRows:
+        """`rows` rows holding nothing (items of shape `item`, float64)."""
+        out = cls.__new__(cls)
+        out.pool, out.slot = np.zeros((0, *item)), np.full(rows, -1, dtype=np.int64)
+        return out
+
     def __len__(self) -> int:
         return len(self.slot)
 

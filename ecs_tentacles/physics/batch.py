@@ -29,6 +29,7 @@ import mujoco
 import numpy as np
 
 from ecs_tentacles.numeric.rows import run_slice, without_row
+from ecs_tentacles.numeric.untouched import untouched_zeros
 from ecs_tentacles.physics.batch_poses import BatchPoses
 from ecs_tentacles.physics.model import (
     PROXY_CAPSULES,
@@ -98,10 +99,11 @@ class Batch(BatchPoses):
         # the state and its parts
         self.slices = state_slices(m)
         self.state = np.zeros((n, mujoco.mj_stateSize(m, STATE)))
-        # the overlay: what differs per creature in the model
-        self.kp = np.zeros((n, m.nu))
-        self.kv = np.zeros((n, m.nu))
-        self.torque = np.zeros((n, m.nu))
+        # the overlay: what differs per creature in the model; the servos' written for
+        # the rows commanded only (a replayed row's when it is promoted): resident there
+        self.kp = untouched_zeros((n, m.nu))
+        self.kv = untouched_zeros((n, m.nu))
+        self.torque = untouched_zeros((n, m.nu))
         self.anchor = np.zeros((n, len(self.equality_ids), 3))
         self.proxy_size = np.full((n, PROXY_SLOTS, 2), 0.01)
         self.near = np.zeros(n, dtype=bool)  # proxies placed (parked ones need no size)

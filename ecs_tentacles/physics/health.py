@@ -12,9 +12,11 @@ creature is checked:
   `max_penetration` (teleports and runaway servos show up here).
 
 A failing creature is restored to a state saved at least `SAVE_EVERY` frames earlier
-(two are kept, for the creatures MuJoCo steps only: a replayed creature's are dropped at
-the next save and made again when it is promoted, `restart`), its suckers are released
-and its servos softened for a moment, and `creature_recovered` is emitted with the cause.
+(two are kept, for the creatures MuJoCo steps only: until the first save every
+creature's are its start state, kept once; the first save gives them to the creatures
+stepped, and a replayed creature's are made when it is promoted, `restart`), its
+suckers are released and its servos softened for a moment, and `creature_recovered` is
+emitted with the cause.
 The check runs right after `physics_sync` and puts a failing creature's rows back before
 any other system runs. A creature that fails `FREEZE_AFTER` times within `FREEZE_WINDOW`
 seconds is frozen where it last was good (`creature_frozen`, and one logged warning).
@@ -26,6 +28,7 @@ only failing creatures are visited.
 from __future__ import annotations
 
 import logging
+import mmap
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -34,8 +37,9 @@ import numpy as np
 
 from ecs_tentacles.events import CreatureFrozen, CreatureRecovered, SuckerReleased
 from ecs_tentacles.numeric.optional_kernels import OptionalKernels
-from ecs_tentacles.numeric.rows import run_slice
+from ecs_tentacles.numeric.rows import run_slice, without_row
 from ecs_tentacles.numeric.slots import SlotRows
+from ecs_tentacles.numeric.untouched import untouched_zeros
 from ecs_tentacles.physics.tiers import KINEMATIC
 
 if TYPE_CHECKING:
@@ -70,6 +74,7 @@ class HealthState:
     causes: dict[str, int]
     previous: np.ndarray  # last frame's poses
     allowed: dict[int, tuple[float, float]] = field(default_factory=dict)  # `allow_speed`
+    initial: list[np.ndarray | None] = field(default_factory=list)  # per batch, until saved
 
 
 class HealthCheck:
@@ -79,11 +84,13 @@ class HealthCheck:
         self.roster = roster
         self.max_speed = world.settings.max_speed
         self.max_penetration = world.settings.max_penetration
-        # per batch: two good states per row, [older, newer]; at first both the start.
-        # Only rows stepped by MuJoCo keep theirs: a replayed (KINEMATIC) row's are
-        # dropped at the next save and made anew by `restart` when it is promoted
-        # (10,000 creatures' were 175 MB, the same bits for every creature restored)
-        self.saved = [SlotRows(np.repeat(b.state[:, None, :], 2, axis=1)) for b in roster.batches]
+        # per batch: two good states per row, [older, newer], held by the rows stepped by
+        # MuJoCo only: a replayed (KINEMATIC) row's are made by `restart` when it is
+        # promoted (10,000 creatures' were 175 MB). Until the first save both are every
+        # row's start state, kept once (`initial`): the tiers are decided on the first
+        # frame, and making both for every row at the build made its peak 1.8 GiB
+        self.saved = [SlotRows.empty(len(b), (2, b.state.shape[1])) for b in roster.batches]
+        self.initial: list[np.ndarray | None] = [b.state.copy() for b in roster.batches]
         self.failures: dict[int, list[float]] = {}  # creature index -> recent recovery times
         # creature index -> (speed m/s, until world time): a thrown creature may fly faster
         self.allowed: dict[int, tuple[float, float]] = {}
@@ -105,12 +112,15 @@ class HealthCheck:
             dict(self.causes),
             self.previous.copy(),
             dict(self.allowed),
+            [None if s is None else s.copy() for s in self.initial],
         )
 
     def set_state(self, state: HealthState) -> None:
         """Go back to `state()` (copied: one state can be restored many times)."""
         for saved, copy in zip(self.saved, state.saved, strict=False):  # later ones: empty
             saved.set_to(copy)
+        initial = [None if s is None else s.copy() for s in state.initial]
+        self.initial = initial + [None] * (len(self.saved) - len(initial))
         self.failures = {k: list(v) for k, v in state.failures.items()}
         self.recoveries, self.frozen = state.recoveries, state.frozen
         self.causes = dict(state.causes)
@@ -125,7 +135,11 @@ class HealthCheck:
         (the new rows at the Transform store's end)."""
         if batch == len(self.saved):
             self.saved.append(SlotRows(np.zeros((0, 2, len(state)))))
+            self.initial.append(None)
         self.saved[batch].append(np.repeat(state[None], 2, 0))
+        initial = self.initial[batch]
+        if initial is not None:  # (its row holds its own: this one keeps rows aligned)
+            self.initial[batch] = np.concatenate([initial, state[None]])
         if len(self.previous):
             self.previous = np.concatenate([self.previous, poses])
         self.follow(proxies)
@@ -136,6 +150,9 @@ class HealthCheck:
         """Creature `index` (row `row` of batch `batch`) was taken out; `kept`: which
         Transform rows are left."""
         self.saved[batch].remove(row)
+        initial = self.initial[batch]
+        if initial is not None:
+            self.initial[batch] = without_row(initial, row)
         self.failures = {i - (i > index): times for i, times in self.failures.items() if i != index}
         self.allowed = {i - (i > index): a for i, a in self.allowed.items() if i != index}
         if len(self.previous):
@@ -221,8 +238,11 @@ class HealthCheck:
         )
         if save:
             replayed = roster.tier == KINEMATIC
-            for batch, saved in zip(roster.batches, self.saved, strict=True):
-                saved.release(np.flatnonzero(replayed[batch.members]))  # (`__init__`)
+            for batch, saved, initial in zip(roster.batches, self.saved, self.initial, strict=True):
+                if initial is not None:  # the first save: stepped rows hold their start
+                    new = np.flatnonzero(~replayed[batch.members] & (saved.slot < 0))
+                    saved.hold(new, initial[new, None])
+                saved.release(np.flatnonzero(replayed[batch.members]))
                 rows = np.flatnonzero(healthy[batch.members])
                 slots = saved.slot[rows]
                 if (slots < 0).any():  # (never: a creature is promoted through `restart`)
@@ -230,6 +250,7 @@ class HealthCheck:
                 older, newer = saved.pool[:, 0], saved.pool[:, 1]
                 older[slots] = newer[slots]
                 newer[slots] = batch.state[rows]
+            self.initial = [None] * len(self.saved)
         for batch in roster.batches:
             batch.warnings[:] = 0
             batch.errors.clear()
@@ -241,12 +262,16 @@ class HealthCheck:
         """This frame's poses as the next check's `previous`, but a replayed (KINEMATIC)
         creature's: it is never checked, and leaves the tier only through
         `PhysicsBackend.place_joints`, whose `restart` sets its rows (10,000 creatures'
-        bodies were a 19 MB copy a frame)."""
+        bodies were a 19 MB copy a frame). Once some are replayed, `previous` holds
+        pages for the others' rows only (`numeric.untouched`: the build's copy of every
+        pose was 19 MB resident at 10,000)."""
         roster = self.roster
         kept = roster.tier != KINEMATIC
         if kept.all():
             self.previous[:] = pos
             return
+        if not isinstance(self.previous.base, mmap.mmap):  # (the build's copy: every row)
+            self.previous = untouched_zeros(pos.shape)  # resident where written from now on
         who = np.flatnonzero(kept)
         if not len(who):
             return
@@ -311,8 +336,9 @@ class HealthCheck:
         self.failures[index] = failures
         key = cause.split(" ")[0]
         self.causes[key] = self.causes.get(key, 0) + 1
-        saved = self.saved[batch.index]
-        batch.state[row] = saved.pool[saved.slot[row], 0]
+        saved, initial = self.saved[batch.index], self.initial[batch.index]
+        slot = int(saved.slot[row])
+        batch.state[row] = initial[row] if slot < 0 and initial is not None else saved.pool[slot, 0]
         batch.part(S.mjSTATE_TIME, row)[:] = physics_time
         batch.forward(row)
         world.transforms.pos[batch.body_rows[row]] = batch.xpos[row]  # before anyone reads

@@ -32,6 +32,8 @@ import os
 import sys
 from collections.abc import Callable
 
+import numpy as np
+
 TRIM_FRAMES = 120  # frames between two trims of a running simulation
 # bytes: blocks this big or bigger are mmapped. glibc's own ceiling: a lower one (256 KB
 # was tried) makes every large per-frame temporary a fresh mapping whose pages fault in
@@ -85,3 +87,27 @@ def trim() -> bool:
     _GLIBC[0](0)
     trims += 1
     return True
+
+
+def resident_bytes(array: np.ndarray) -> int | None:
+    """How much of the memory under `array` (its base's whole buffer) is resident now,
+    in bytes of whole pages (`mincore`); None off Linux. For measuring (tools, tests):
+    numpy asks for transparent huge pages for arrays of 4 MB or more, so one write can
+    make 2 MB of such an array resident."""
+    if not sys.platform.startswith("linux"):
+        return None
+    while isinstance(array.base, np.ndarray):
+        array = array.base
+    if not array.nbytes:
+        return 0
+    page = os.sysconf("SC_PAGE_SIZE")
+    start = array.ctypes.data // page * page
+    length = array.ctypes.data + array.nbytes - start
+    pages = -(-length // page)
+    vector = bytearray(pages)
+    mincore = ctypes.CDLL(None, use_errno=True).mincore
+    mincore.argtypes = [ctypes.c_void_p, ctypes.c_size_t, ctypes.c_void_p]
+    buffer = (ctypes.c_ubyte * pages).from_buffer(vector)
+    if mincore(ctypes.c_void_p(start), ctypes.c_size_t(length), buffer) != 0:
+        raise OSError(ctypes.get_errno(), "mincore failed")
+    return int((np.frombuffer(vector, dtype=np.uint8) & 1).sum()) * page

@@ -25,6 +25,7 @@ import mujoco
 import numpy as np
 
 from ecs_tentacles.numeric.optional_kernels import OptionalKernels
+from ecs_tentacles.numeric.untouched import untouched_zeros
 from ecs_tentacles.physics.model import PROXY_CAPSULES, PROXY_CYLINDERS, PROXY_PARKED
 from ecs_tentacles.physics.pairs import NearPairCache
 from ecs_tentacles.physics.tiers import KINEMATIC
@@ -39,6 +40,7 @@ S = mujoco.mjtState
 MARGIN = 0.05  # metres: a body this close to a neighbour's sphere gets a proxy
 POOL = np.array([PROXY_CAPSULES, PROXY_CYLINDERS])
 CAPSULE, CYLINDER = 0, 1
+KIND, OWNER = np.int8, np.int32  # a body's kind and creature (numpy's work only)
 _NONE = np.zeros(0, dtype=np.int64)
 ALL = slice(None)
 Sensed = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]  # pos, quat, centre, radius
@@ -74,8 +76,9 @@ class ContactProxies:
         owner_all = np.concatenate([o.reshape(-1) for o in owner]) if owner else np.zeros(0, int)
         order = np.argsort(owner_all, kind="stable")  # creature by creature, bodies in order
         self.rows = np.concatenate([r.reshape(-1) for r in rows])[order] if rows else owner_all
-        self.owner = owner_all[order]
-        self.kind = np.concatenate([k.reshape(-1) for k in kind])[order] if kind else owner_all
+        self.owner = owner_all[order].astype(OWNER)  # (a table a body: 810,000 at 10,000)
+        kinds = np.concatenate([k.reshape(-1) for k in kind])[order] if kind else owner_all
+        self.kind = kinds.astype(KIND)
         self.size = (
             np.concatenate([z.reshape(-1, 2) for z in size])[order] if size else np.zeros((0, 2))
         )
@@ -92,10 +95,18 @@ class ContactProxies:
         self._lazy: _Lazy | None = None  # the frame's sensed bodies, gathered as asked
         self._every = np.arange(len(self.rows))  # body i at pos[i] (pair_gaps' kernel)
         self._posed = PosedSpheres.empty(self.start, self.rbound)
-        self.index = [  # each batch row's bodies in this order
-            self.start[batch.members][:, None] + np.arange(len(batch.body_ids))
-            for batch in self.roster.batches
-        ]
+        self._index: list[np.ndarray] | None = None  # (`index`)
+
+    @property
+    def index(self) -> list[np.ndarray]:
+        """Each batch's rows' bodies in this class's order, (rows, bodies) a batch: for
+        numpy's `refresh` (made when first asked: 6.5 MB at 10,000 the kernels never read)."""
+        if self._index is None:
+            self._index = [
+                self.start[batch.members][:, None] + np.arange(len(batch.body_ids))
+                for batch in self.roster.batches
+            ]
+        return self._index
 
     def append(self, batch: Batch, row: int) -> None:
         """Creature `batch.members[row]` joined the roster last: its bodies at the end of
@@ -106,8 +117,9 @@ class ContactProxies:
         kind = np.where(cylinder, CYLINDER, CAPSULE)
         size = m.geom_size[geoms, :2]
         self.rows = np.concatenate([self.rows, batch.body_rows[row]])
-        self.owner = np.concatenate([self.owner, np.full(len(geoms), int(batch.members[row]))])
-        self.kind = np.concatenate([self.kind, kind])
+        owner = np.full(len(geoms), int(batch.members[row]), dtype=OWNER)
+        self.owner = np.concatenate([self.owner, owner])
+        self.kind = np.concatenate([self.kind, kind.astype(KIND)])
         self.size = np.concatenate([self.size, size])
         self.rbound = np.concatenate([self.rbound, _bounds(kind, size)])
         self._counted(np.append(self.count, len(geoms)))
@@ -127,12 +139,13 @@ class ContactProxies:
         centre, radius). With `frame`, computed once per frame (the level of detail and
         the proxies both ask, before anything moves), and the body poses are filled only
         for the creatures `gather` is asked for (the pairs' and the proxies' users ask:
-        copying every body of 10,000 creatures took 8 ms a frame)."""
+        copying every body of 10,000 creatures took 8 ms a frame), in tables resident
+        where written (`numeric.untouched`; heap blocks kept 12 MiB more at 10,000)."""
         if frame is not None and self._sensed is not None and self._sensed[0] == frame:
             return self._sensed[1]
         fast = KERNELS.get()
-        if frame is not None and fast is not None:
-            pos, quat = np.empty((len(self.rows), 3)), np.empty((len(self.rows), 4))
+        if frame is not None and fast is not None:  # (pages of the gathered rows only)
+            pos, quat = untouched_zeros((len(self.rows), 3)), untouched_zeros((len(self.rows), 4))
             posed, self._posed = self._posed, PosedSpheres.empty(self.start, self.rbound)
             centre, radius = posed.centre, posed.radius  # the replayed ones' are there
             todo = np.flatnonzero(~posed.known)

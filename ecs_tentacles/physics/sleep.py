@@ -19,6 +19,7 @@ import numpy as np
 
 from ecs_tentacles.numeric.optional_kernels import OptionalKernels
 from ecs_tentacles.numeric.rows import without_row
+from ecs_tentacles.numeric.untouched import untouched_zeros
 
 if TYPE_CHECKING:
     from ecs_tentacles.physics.host import PhysicsHost
@@ -47,7 +48,8 @@ class Sleep:
     def __init__(self, roster: Roster):
         self.roster = roster
         self.still = np.zeros(len(roster), dtype=np.int64)  # frames each has been still
-        self.commands = [np.zeros((len(b), 2 * b.model.nu)) for b in roster.batches]
+        # written for the rows commanded only: resident there (`numeric.untouched`)
+        self.commands = [untouched_zeros((len(b), 2 * b.model.nu)) for b in roster.batches]
         self.known = np.zeros(len(roster), dtype=bool)  # `commands` hold last frame's
         self.enabled = True
 

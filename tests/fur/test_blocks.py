@@ -99,3 +99,35 @@ def test_despawning_every_furred_creature_then_spawning_one_binds_it():
         _assert_same_as_binding_anew(world)
         assert np.isfinite(world.resource(FurData).curves).all()
         assert np.abs(world.resource(FurData).curves).max() > 1.0  # posed near x = 10
+
+
+def _buffers(value: object, seen: dict[int, int]) -> None:
+    """The distinct numpy buffers under `value` (arrays, binds, blocks): id -> bytes."""
+    if isinstance(value, np.ndarray):
+        base = value
+        while isinstance(base.base, np.ndarray):
+            base = base.base
+        seen[id(base)] = base.nbytes
+    elif isinstance(value, (list, tuple)):
+        for item in value:
+            _buffers(item, seen)
+    elif hasattr(value, "__dict__"):
+        for item in vars(value).values():
+            _buffers(item, seen)
+
+
+def test_the_rig_holds_its_bind_pose_once(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The blocks are the bind pose; the whole bind is joined only when asked (binding
+    the dynamic strands asks), not kept beside them: a crowd's was a second copy."""
+    monkeypatch.setattr(blocks_module, "BLOCK", 64)  # several blocks: joining copies
+    scene = {"version": 1, "creatures": [_furred("hog", 0.0, "hedgehog", 90),
+                                         _furred("cat", 4.0, "cat", 70)]}  # fmt: skip
+    with World.from_scene(scene) as world:
+        world.step(2)
+        rig = world.schedule["rig"]
+        assert rig.strands is not None  # (the cat's fur is dynamic: the whole was joined)
+        held: dict[int, int] = {}
+        _buffers(rig.binds, held)
+        fresh, _ = make_bind(world.resource(FurData))
+        once = sum(getattr(fresh, k).nbytes for k in (*PER_GUIDE, "root", "basis", "shape_h"))
+        assert sum(held.values()) < 1.2 * once  # (and a few index arrays)

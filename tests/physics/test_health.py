@@ -15,6 +15,7 @@ from numpy.testing import assert_array_equal
 
 from ecs_tentacles.cli import main
 from ecs_tentacles.locomotion.goals import GoalBook
+from ecs_tentacles.physics.heap import resident_bytes
 from ecs_tentacles.world import World
 from tests.conftest import crawlers
 
@@ -244,3 +245,51 @@ def test_a_creature_promoted_from_replay_recovers_to_where_it_was_promoted(
     back = world.transforms.pos[rows]
     assert np.isfinite(back).all()
     assert np.linalg.norm(back - shown, axis=1).max() <= 0.02  # where it was promoted
+
+
+def test_a_blow_up_on_the_first_frame_goes_back_to_where_the_creature_was_built(
+    make_world: Callable[..., World],
+) -> None:
+    """Until the first save every creature's good states are its start, kept once (not
+    two copies a creature made at the build: 183 MB at 10,000 creatures, most of them
+    replayed from the first frame on and never restored)."""
+    world = make_world(SCENE)
+    health, view = world.physics.health, world.physics.views[1]
+    assert len(health.saved[view.batch.index].pool) == 0  # nothing doubled at the build
+    built = world.transforms.pos[view.body_rows].copy()
+    _hit_nan(world)
+    world.step(1)
+    assert health.recoveries == 1
+    np.testing.assert_allclose(world.transforms.pos[view.body_rows], built, rtol=0, atol=1e-12)
+    world.step(20)  # saves made since: the recovered creature steps on
+    assert health.recoveries == 1
+
+
+def test_replayed_creatures_take_no_servo_or_check_pages_and_a_promoted_one_gets_them(
+    make_world: Callable[..., World],
+) -> None:
+    """The tables written for stepped creatures only (servo gains and torque limits,
+    sleep's last commands, the check's last poses) hold no memory for a crowd replayed
+    from its first frame; a creature promoted later gets its rows there, steps under its
+    gains and is checked against where it was."""
+    replayed = {"full": 0, "reduced": 0, "hold_seconds": 0}
+    world = make_world({**crawlers(40, apart=4.0, links=5), "physics": {"lod": replayed}})
+    world.step(3)
+    physics = world.physics
+    batch, health = physics.batches[0], physics.health
+    tables = (batch.kp, batch.kv, batch.torque, physics.sleep.commands[0])
+    if resident_bytes(batch.kp) is None:
+        pytest.skip("mincore: Linux only")
+    assert [resident_bytes(t) for t in tables] == [0, 0, 0, 0]
+    assert resident_bytes(health.previous) == 0
+    creature = world.creature("c7")
+    view = physics.views[7]
+    world.lod.promote(creature)
+    world.step(1)
+    assert world.lod.tier_of(creature) == "full"
+    assert (batch.kp[view.row] > 0).any() and not batch.kp[np.arange(40) != view.row].any()
+    assert all((resident_bytes(t) or 0) > 0 for t in tables)
+    start = world.transforms.pos[view.body_rows[0]].copy()
+    world.step(60)  # under its own servos: it crawls, and the check finds nothing wrong
+    assert np.linalg.norm(world.transforms.pos[view.body_rows[0]] - start) > 0.005
+    assert health.recoveries == 0

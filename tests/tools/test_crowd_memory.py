@@ -20,7 +20,10 @@ def test_a_small_crowd_reports_its_memory_and_where_the_arrays_are(
     assert result["crowd"] == 3 and result["frames"] == 2
     assert 0 < result["built_rss_mib"] <= result["peak_mib"]
     assert sum(result["tiers"].values()) == 3
-    labels = [label for label, _ in result["arrays_mb"]]
+    labels = [label for label, _, _ in result["arrays_mb"]]
+    # resident (touched pages) and allocated megabytes; the state is written at the build
+    state = next(row for row in result["arrays_mb"] if row[0].endswith("batches.[0].state"))
+    assert 0 < state[1] and 0 < state[2]
     assert any(label.endswith("batches.[0].state") for label in labels)  # the physics state
     assert any("health.saved" in label for label in labels)
 
