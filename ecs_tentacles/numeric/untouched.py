@@ -29,3 +29,15 @@ def untouched_zeros(shape: tuple[int, ...], dtype: type | np.dtype = np.float64)
         return np.zeros(shape, dtype)
     mapping = mmap.mmap(-1, count * dtype.itemsize)
     return np.frombuffer(mapping, dtype=dtype, count=count).reshape(shape)
+
+
+def is_untouched(array: np.ndarray) -> bool:
+    """Whether `array` is (a view of) a table `untouched_zeros` made: its memory an
+    anonymous mapping (the chain of bases is followed to the buffer: a reshaped view's
+    base is an array, whose base is a memoryview of the mapping)."""
+    base: object = array
+    while isinstance(base, np.ndarray):
+        base = base.base
+    if isinstance(base, memoryview):
+        base = base.obj
+    return isinstance(base, mmap.mmap)

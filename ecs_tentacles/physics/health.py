@@ -28,7 +28,6 @@ only failing creatures are visited.
 from __future__ import annotations
 
 import logging
-import mmap
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -39,7 +38,7 @@ from ecs_tentacles.events import CreatureFrozen, CreatureRecovered, SuckerReleas
 from ecs_tentacles.numeric.optional_kernels import OptionalKernels
 from ecs_tentacles.numeric.rows import run_slice, without_row
 from ecs_tentacles.numeric.slots import SlotRows
-from ecs_tentacles.numeric.untouched import untouched_zeros
+from ecs_tentacles.numeric.untouched import is_untouched, untouched_zeros
 from ecs_tentacles.physics.tiers import KINEMATIC
 
 if TYPE_CHECKING:
@@ -270,7 +269,7 @@ class HealthCheck:
         if kept.all():
             self.previous[:] = pos
             return
-        if not isinstance(self.previous.base, mmap.mmap):  # (the build's copy: every row)
+        if not is_untouched(self.previous):  # (the build's copy: every row)
             self.previous = untouched_zeros(pos.shape)  # resident where written from now on
         who = np.flatnonzero(kept)
         if not len(who):

@@ -8,7 +8,7 @@ import pickle
 import numpy as np
 import pytest
 
-from ecs_tentacles.numeric.untouched import untouched_zeros
+from ecs_tentacles.numeric.untouched import is_untouched, untouched_zeros
 from ecs_tentacles.physics.heap import resident_bytes
 
 PAGE = os.sysconf("SC_PAGE_SIZE")
@@ -35,3 +35,9 @@ def test_copies_and_pickles_are_ordinary_arrays_with_the_same_numbers() -> None:
         other[0] = 9  # its own memory
     assert not table[0].any()
     assert untouched_zeros((0, 4)).shape == (0, 4)
+
+
+def test_a_table_and_its_views_are_known_as_untouched_its_copies_not() -> None:
+    table = untouched_zeros((20, 3))
+    assert is_untouched(table) and is_untouched(table[4:9]) and is_untouched(table.reshape(-1))
+    assert not is_untouched(table.copy()) and not is_untouched(np.zeros((20, 3)))

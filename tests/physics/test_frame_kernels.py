@@ -70,6 +70,7 @@ def test_the_poses_the_health_check_remembers_are_numpys_and_skip_replayed_creat
 ) -> None:
     """A replayed creature is never checked (promoted, `restart` sets its rows), so its
     bodies are not copied for the next check; everyone else's are, as numpy copies them."""
+    from ecs_tentacles.numeric.untouched import untouched_zeros
     from ecs_tentacles.physics.tiers import FULL, KINEMATIC, REDUCED
 
     world = make_world(SCENE)
@@ -81,7 +82,8 @@ def test_the_poses_the_health_check_remembers_are_numpys_and_skip_replayed_creat
         found = []
         for backend in ("auto", "numpy"):
             monkeypatch.setattr(health_module.KERNELS, "backend", backend)
-            health.previous = np.full_like(pos, -7.0)
+            health.previous = untouched_zeros(pos.shape)  # as in a crowd with some replayed
+            health.previous[:] = -7.0
             health._remember(pos)
             found.append(health.previous)
         assert_array_equal(found[0], found[1])
