@@ -66,6 +66,33 @@ def pytest_configure(config: pytest.Config) -> None:
         reporter.write_line(line + (f" (failed: {failed[0]})" if failed else ""))
 
 
+# The files whose tests hold a worker longest (a local Ray, processes started and waited
+# for), run first: they are at the head of the first worker's queue while the other worker
+# takes the many short tests, and worksteal hands out the short ones left at the end (a
+# worker steals from the end of the other's queue), so the run does not end with one
+# worker idle while the other still waits on one of these.
+FIRST = (
+    "distributed/test_driver.py",
+    "test_processes.py",
+    "export/test_glb_size.py",
+    "export/test_usd_stream.py",
+    "test_stops.py",
+)
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """`FIRST`'s files ahead of the rest, in that order; every file's tests stay together
+    and in their order (module fixtures are made once a worker)."""
+    here = Path(__file__).parent
+
+    def rank(item: pytest.Item) -> int:
+        path = item.path
+        name = path.relative_to(here).as_posix() if path.is_relative_to(here) else ""
+        return FIRST.index(name) if name in FIRST else len(FIRST)
+
+    items.sort(key=rank)  # stable
+
+
 # plugins off where a test's script drives the motors: `make_world(scene, plugins=NO_LOCOMOTION)`
 NO_LOCOMOTION = {"locomotion": False, "suckers": False}
 
