@@ -44,7 +44,10 @@ def keep_bytecode(config: pytest.Config) -> None:
     written in the tree, nor in a folder a test lists (a plugin a scene imports). Set on
     the controller before the workers start: they and the processes they start inherit
     it."""
-    folder = config._tmp_path_factory.getbasetemp() / "pycache"
+    factory = getattr(config, "_tmp_path_factory", None)  # none with `-p no:tmpdir`
+    if factory is None:
+        return
+    folder = factory.getbasetemp() / "pycache"
     os.environ.pop("PYTHONDONTWRITEBYTECODE", None)
     os.environ["PYTHONPYCACHEPREFIX"] = str(folder)
     sys.dont_write_bytecode = False
