@@ -4,7 +4,11 @@ forged one is ignored, the mesh decomposed again and the entry written afresh; n
 them stops, blocks or swells `validate`.
 
 Real processes (`python -P -m ecs_tentacles validate`, each with its own memory of
-meshes) over real files, in a cache folder of the test's own (`XDG_CACHE_HOME`).
+meshes) over real files, in a cache folder of the test's own (`XDG_CACHE_HOME`). The
+entries that must be used or written again are checked together, as a user's cache
+holds them: one process validates a rock of its own size for each case (and an arch),
+each case then does to its rock's entry what it tests, and one more process validates
+them all; each test asserts on its own rock's entry.
 """
 
 from __future__ import annotations
@@ -13,9 +17,11 @@ import json
 import os
 import pathlib
 import shutil
+import struct
 import subprocess
 import sys
 import zipfile
+from dataclasses import dataclass
 
 import numpy as np
 import pytest
@@ -53,13 +59,17 @@ def rock_scene(folder: pathlib.Path, side: float = ROCK_SIDE) -> pathlib.Path:
 
 
 def validate(
-    scene: pathlib.Path, cache: pathlib.Path, *, python: list[str] | None = None
+    scene: pathlib.Path | list[pathlib.Path],
+    cache: pathlib.Path,
+    *,
+    python: list[str] | None = None,
 ) -> subprocess.CompletedProcess[str]:
-    """`validate` in a process of its own, `cache` its XDG_CACHE_HOME."""
+    """`validate SCENE...` in a process of its own, `cache` its XDG_CACHE_HOME."""
     command = python or [sys.executable, "-P", "-m", "ecs_tentacles"]
+    scenes = scene if isinstance(scene, list) else [scene]
     try:
         return subprocess.run(
-            [*command, "validate", str(scene)],
+            [*command, "validate", *map(str, scenes)],
             env={**os.environ, "XDG_CACHE_HOME": str(cache)},
             capture_output=True,
             text=True,
@@ -96,70 +106,137 @@ def cached(validated_once: pathlib.Path, tmp_path: pathlib.Path) -> Cached:
     return tmp_path / "scene" / "scene.json", tmp_path / "cache", entry, entry.read_bytes()
 
 
-def assert_decomposed_again(
-    scene: pathlib.Path, cache: pathlib.Path, entry: pathlib.Path, good: bytes
-) -> None:
-    """`validate` says ok, and the entry is the rock's own again (a regular file)."""
-    done = validate(scene, cache)
+# the cases the shared runs check, each with a rock of its own size (an entry of its own):
+# what is done to its entry between the two runs
+UNTOUCHED = ["a box"]
+DAMAGED = ["truncated", "one byte changed", "empty"]
+NOT_REGULAR = ["FIFO", "symlink to a FIFO", "symlink to the entry"]
+NOT_THE_MESHS = ["a flat piece", "a 1 km tetrahedron", "another mesh's entry"]
+SIDES = {
+    case: round(ROCK_SIDE + 0.01 * i, 2)
+    for i, case in enumerate([*UNTOUCHED, *DAMAGED, *NOT_REGULAR, *NOT_THE_MESHS])
+}
+OTHER_SIDE = 0.3  # metres: the smaller rock whose entry "another mesh's entry" copies
+ARCH = "an arch"
+
+
+def size_of(entry: pathlib.Path) -> float:
+    """Twice the largest |coordinate| of an entry's pieces (laid out as `mesh_cache`'s
+    docstring says): a box rock's side."""
+    data = entry.read_bytes()
+    head = len(mesh_cache.MAGIC) + 32
+    (count,) = struct.unpack_from("<I", data, head)
+    vertices = np.frombuffer(data[head + 4 + 4 * count : -32], "<f8")
+    return round(2 * float(np.abs(vertices).max()), 3)
+
+
+def spoil(case: str, entry: pathlib.Path, good: bytes, other: bytes, aside: pathlib.Path) -> None:
+    """Do to `entry` (holding `good`) what `case` tests; `other` is the smaller rock's
+    entry, `aside` a folder outside the cache."""
+    if case in UNTOUCHED:
+        return
+    if case == "truncated":  # failed every run (`error: run: BadZipFile`, naming no file)
+        entry.write_bytes(good[: len(good) // 2])
+    elif case == "one byte changed":
+        middle = len(good) // 2
+        entry.write_bytes(good[:middle] + bytes([good[middle] ^ 0x40]) + good[middle + 1 :])
+    elif case == "empty":
+        entry.write_bytes(b"")
+    elif case in NOT_REGULAR:  # a FIFO blocked `validate` forever (and kept its first SIGTERM)
+        entry.unlink()
+        if case == "FIFO":
+            os.mkfifo(entry)
+        elif case == "symlink to a FIFO":
+            os.mkfifo(aside / "pipe")
+            entry.symlink_to(aside / "pipe")
+        else:  # even a good one: the cache's entries are files, never links to elsewhere
+            (aside / "elsewhere").write_bytes(good)
+            entry.symlink_to(aside / "elsewhere")
+    elif case == "another mesh's entry":
+        entry.write_bytes(other)
+    else:  # laid out as this package lays its entries out: their digests check
+        assert case in NOT_THE_MESHS, case
+        entry.write_bytes(mesh_cache.encode(entry.stem, forged(case, SIDES[case])))
+        assert entry.read_bytes() != good
+
+
+@dataclass
+class Together:
+    """The second shared run and what the tests compare it with, by case."""
+
+    done: subprocess.CompletedProcess[str]
+    cache: pathlib.Path
+    scenes: dict[str, pathlib.Path]
+    entries: dict[str, pathlib.Path]  # every entry the cache should hold (and "other")
+    good: dict[str, bytes]  # each entry as the first run wrote it
+    before: dict[str, os.stat_result]  # each entry before the second run
+
+
+@pytest.fixture(scope="module")
+def together(tmp_path_factory: pytest.TempPathFactory) -> Together:
+    """One process validates every case's rock, the arch and the smaller rock into one
+    cache; each case's entry is spoiled as the case says; one more process validates
+    every case's scene and the arch's."""
+    folder = tmp_path_factory.mktemp("together")
+    cache = folder / "cache"
+    scenes = {case: rock_scene(folder / f"rock {side}", side) for case, side in SIDES.items()}
+    scenes[ARCH] = rock_scene(folder / "arch")
+    arch(scenes[ARCH].parent / "rock.obj")
+    other = rock_scene(folder / "other", side=OTHER_SIDE)
+    first = validate([*scenes.values(), other], cache)
+    assert (first.returncode, first.stderr) == (0, ""), first.stderr
+    by_size = {size_of(entry): entry for entry in entries(cache)}
+    assert len(by_size) == len(scenes) + 1, sorted(by_size)
+    found = {case: by_size.pop(side) for case, side in SIDES.items()}
+    found["other"] = by_size.pop(OTHER_SIDE)
+    [found[ARCH]] = by_size.values()
+    good = {case: entry.read_bytes() for case, entry in found.items()}
+    for case in SIDES:
+        aside = folder / f"aside {case}"
+        aside.mkdir()
+        spoil(case, found[case], good[case], good["other"], aside)
+    before = {case: entry.lstat() for case, entry in found.items()}
+    done = validate(list(scenes.values()), cache)
+    return Together(done, cache, scenes, found, good, before)
+
+
+def assert_validated(together: Together, case: str) -> None:
+    """The shared run said ok for `case`'s scene and nothing else; the cache holds every
+    rock's entry and nothing more (no temporary file left either)."""
+    done = together.done
     assert (done.returncode, done.stderr) == (0, ""), done.stderr
-    assert "ok" in done.stdout
-    assert entries(cache) == [entry]  # no temporary file left either
-    assert entry.is_file() and not entry.is_symlink()
-    assert entry.read_bytes() == good
+    assert f"{together.scenes[case]}: ok (" in done.stdout, done.stdout
+    assert entries(together.cache) == sorted(together.entries.values())
 
 
-@pytest.mark.parametrize("mesh", ["a box", "an arch"])
-def test_a_good_entry_is_used_by_the_next_process(
-    request: pytest.FixtureRequest, tmp_path: pathlib.Path, mesh: str
-) -> None:
+@pytest.mark.parametrize("mesh", [*UNTOUCHED, ARCH])
+def test_a_good_entry_is_used_by_the_next_process(together: Together, mesh: str) -> None:
     """The checks pass what the decomposition wrote (an arch's CoACD pieces reach a
-    little past its box): the next run reads the entry, no decomposition rewrites it.
-    The box's first run is the module's (`validated_once`)."""
-    if mesh == "a box":
-        scene, cache, entry, _ = request.getfixturevalue("cached")
-    else:
-        scene, cache = rock_scene(tmp_path / "scene"), tmp_path / "cache"
-        arch(scene.parent / "rock.obj")
-        assert validate(scene, cache).returncode == 0
-        [entry] = entries(cache)
-    before = entry.stat()
-    done = validate(scene, cache)
-    assert (done.returncode, done.stderr) == (0, "")
-    after = entry.stat()
+    little past its box): the next run reads the entry, no decomposition rewrites it."""
+    assert_validated(together, mesh)
+    before, after = together.before[mesh], together.entries[mesh].stat()
     assert (after.st_ino, after.st_mtime_ns) == (before.st_ino, before.st_mtime_ns)
 
 
-@pytest.mark.parametrize("damage", ["truncated", "one byte changed", "empty"])
-def test_a_damaged_entry_is_ignored_and_written_again(cached: Cached, damage: str) -> None:
+def assert_decomposed_again(together: Together, case: str) -> None:
+    """`validate` says ok, and the entry is the rock's own again (a regular file)."""
+    assert_validated(together, case)
+    entry = together.entries[case]
+    assert entry.is_file() and not entry.is_symlink()
+    assert entry.read_bytes() == together.good[case]
+
+
+@pytest.mark.parametrize("damage", DAMAGED)
+def test_a_damaged_entry_is_ignored_and_written_again(together: Together, damage: str) -> None:
     """A truncated entry failed every run (`error: run: BadZipFile`, naming no file)
     until deleted by hand."""
-    scene, cache, entry, good = cached
-    if damage == "truncated":
-        entry.write_bytes(good[: len(good) // 2])
-    elif damage == "one byte changed":
-        middle = len(good) // 2
-        entry.write_bytes(good[:middle] + bytes([good[middle] ^ 0x40]) + good[middle + 1 :])
-    else:
-        entry.write_bytes(b"")
-    assert_decomposed_again(scene, cache, entry, good)
+    assert_decomposed_again(together, damage)
 
 
-@pytest.mark.parametrize("kind", ["FIFO", "symlink to a FIFO", "symlink to the entry"])
-def test_an_entry_that_is_not_a_regular_file_is_never_read(
-    cached: Cached, tmp_path: pathlib.Path, kind: str
-) -> None:
+@pytest.mark.parametrize("kind", NOT_REGULAR)
+def test_an_entry_that_is_not_a_regular_file_is_never_read(together: Together, kind: str) -> None:
     """A FIFO in the cache blocked `validate` forever (and kept its first SIGTERM)."""
-    scene, cache, entry, good = cached
-    entry.unlink()
-    if kind == "FIFO":
-        os.mkfifo(entry)
-    elif kind == "symlink to a FIFO":
-        os.mkfifo(tmp_path / "pipe")
-        entry.symlink_to(tmp_path / "pipe")
-    else:  # even a good one: the cache's entries are files, never links to elsewhere
-        (tmp_path / "elsewhere").write_bytes(good)
-        entry.symlink_to(tmp_path / "elsewhere")
-    assert_decomposed_again(scene, cache, entry, good)
+    assert_decomposed_again(together, kind)
 
 
 def zip_bomb(path: pathlib.Path, megabytes: int) -> None:
@@ -213,25 +290,13 @@ def forged(kind: str, side: float) -> tuple[np.ndarray, ...]:
     return (np.array([[-600.0, -600, -10], [600, -600, -10], [0, 600, -10], [0, 0, 800]]),)
 
 
-@pytest.mark.parametrize("kind", ["a flat piece", "a 1 km tetrahedron", "another mesh's entry"])
-def test_an_entry_that_is_not_the_meshs_pieces_is_replaced(
-    cached: Cached, tmp_path: pathlib.Path, kind: str
-) -> None:
+@pytest.mark.parametrize("kind", NOT_THE_MESHS)
+def test_an_entry_that_is_not_the_meshs_pieces_is_replaced(together: Together, kind: str) -> None:
     """Entries that pass every check of their own format: a degenerate piece made the
     good rock refused on every run; a 1 km tetrahedron replaced the 0.5 m rock (the
     creature then inside it); a smaller rock's entry under this rock's name replaced it
     silently. Each is ignored: the rock decomposed again, its entry written afresh."""
-    scene, cache, entry, good = cached
-    if kind == "another mesh's entry":
-        other_cache = tmp_path / "other cache"
-        done = validate(rock_scene(tmp_path / "other", side=0.3), other_cache)
-        assert done.returncode == 0, done.stderr
-        [other] = entries(other_cache)
-        entry.write_bytes(other.read_bytes())
-    else:  # laid out as this package lays its entries out: their digests check
-        entry.write_bytes(mesh_cache.encode(entry.stem, forged(kind, ROCK_SIDE)))
-        assert entry.read_bytes() != good
-    assert_decomposed_again(scene, cache, entry, good)
+    assert_decomposed_again(together, kind)
 
 
 def test_a_good_entry_is_read_back_as_it_was_kept(
