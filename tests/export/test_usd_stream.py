@@ -19,7 +19,7 @@ from ecs_tentacles.export.take_chunks import TakeChunks
 from ecs_tentacles.export.usd import write_usd
 from ecs_tentacles.export.usd_validation import usd_problems
 from ecs_tentacles.skin.keys import angle_between
-from ecs_tentacles.skin.rig import Keys
+from ecs_tentacles.skin.rig import Keys, Skin
 from ecs_tentacles.skin.skeleton import creature_animation, creature_skeleton
 from ecs_tentacles.take import Take
 from tests.export.test_glb import _longer
@@ -112,7 +112,7 @@ def test_reduced_keys_hold_their_tolerance_across_chunks(octopus_take: Take) -> 
     layer = usd_layer.StreamedLayer(None)
     from ecs_tentacles.export.skinned_usd import _fill
 
-    report = _fill(layer, TakeChunks(take, 16), None, Keys("reduced", 0.5), False, None)
+    report = _fill(layer, TakeChunks(take, 16), Skin(keys=Keys("reduced", 0.5)), False, None)
     attr = layer.stage.GetAttributeAtPath(
         "/World/octopus/octopus_skeleton/octopus_animation.rotations"
     )
