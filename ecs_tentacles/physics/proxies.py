@@ -47,6 +47,10 @@ Sensed = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]  # pos, quat, cen
 # creatures from which the frame's reach spheres are found on all cores (before the step,
 # while the stepping threads wait): at 10,000 one core took about 4 ms
 PARALLEL_REACH = 4096
+# From this many bodies a frame's sensed poses go in tables resident only where gathered
+# (`numeric.untouched`); fewer take ordinary arrays: a mapping made and dropped every
+# frame cost 16 creatures with lod off 1.5 % of their frame (overhead 1.085 -> 1.103).
+UNTOUCHED_BODIES = 32_768
 KERNELS = OptionalKernels("ecs_tentacles.physics.kernels", "ECS_TENTACLES_SENSE")
 
 
@@ -140,12 +144,14 @@ class ContactProxies:
         the proxies both ask, before anything moves), and the body poses are filled only
         for the creatures `gather` is asked for (the pairs' and the proxies' users ask:
         copying every body of 10,000 creatures took 8 ms a frame), in tables resident
-        where written (`numeric.untouched`; heap blocks kept 12 MiB more at 10,000)."""
+        where written in a big crowd (`numeric.untouched`; heap blocks kept 12 MiB more
+        at 10,000)."""
         if frame is not None and self._sensed is not None and self._sensed[0] == frame:
             return self._sensed[1]
         fast = KERNELS.get()
         if frame is not None and fast is not None:  # (pages of the gathered rows only)
-            pos, quat = untouched_zeros((len(self.rows), 3)), untouched_zeros((len(self.rows), 4))
+            table = untouched_zeros if len(self.rows) >= UNTOUCHED_BODIES else np.empty
+            pos, quat = table((len(self.rows), 3)), table((len(self.rows), 4))
             posed, self._posed = self._posed, PosedSpheres.empty(self.start, self.rbound)
             centre, radius = posed.centre, posed.radius  # the replayed ones' are there
             todo = np.flatnonzero(~posed.known)
