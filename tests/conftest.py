@@ -34,6 +34,17 @@ settings.load_profile("seeded")
 NUMBA_WARMUP = Path(__file__).resolve().parents[1] / "tools" / "numba_warmup.py"
 
 
+@pytest.hookimpl(tryfirst=True)  # before xdist's own, which reads `-n`
+def pytest_cmdline_main(config: pytest.Config) -> None:
+    """The suite runs on every core: `-n auto` unless `-n` was given, where xdist is
+    loaded (it is not in addopts: a run with `-p no:xdist`, or without xdist installed,
+    would stop at "unrecognized arguments: -n"). Not on a worker (xdist clears its `-n`)."""
+    if hasattr(config, "workerinput") or not config.pluginmanager.has_plugin("xdist"):
+        return
+    if config.option.numprocesses is None:
+        config.option.numprocesses = "auto"
+
+
 def keep_bytecode(config: pytest.Config) -> None:
     """Python's compiled bytecode kept for the session, in its temporary folder
     (`PYTHONPYCACHEPREFIX`), also where the environment says not to write it
