@@ -42,7 +42,7 @@ from ecs_tentacles.numeric.quaternions import quat_multiply
 from ecs_tentacles.scene.scene_spec import PhysicsSpec
 
 if TYPE_CHECKING:
-    from ecs_tentacles.physics.proxies import PosedSpheres
+    from ecs_tentacles.physics.posed_spheres import PosedSpheres
 
 IDLE, CRAWL = 0, 1
 KINDS = ("idle", "crawl")

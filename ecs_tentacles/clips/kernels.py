@@ -13,7 +13,7 @@ clip frame, interpolate, normalise, turn and move); at 10,000 kinematic creature
 and each creature's reach sphere (the contact proxies' and the level of detail's) can be
 found from its bodies as they were just written, still in the cache (`_sphere`: the
 contact proxies' numbers), which spares the next frame a pass over every replayed body
-(`physics.proxies.PosedSpheres`). Compiled on first use and cached on disk
+(`physics.posed_spheres.PosedSpheres`). Compiled on first use and cached on disk
 (``cache=True``).
 """
 

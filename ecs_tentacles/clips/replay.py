@@ -39,7 +39,7 @@ from ecs_tentacles.physics.tiers import KINEMATIC
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
     from ecs_tentacles.physics.batch import Batch
-    from ecs_tentacles.physics.proxies import PosedSpheres
+    from ecs_tentacles.physics.posed_spheres import PosedSpheres
     from ecs_tentacles.roster_change import RosterChange
     from ecs_tentacles.store import TransformStore
 

@@ -47,7 +47,8 @@ from typing import TYPE_CHECKING, Protocol
 import numpy as np
 
 from ecs_tentacles.ground import ground_of
-from ecs_tentacles.physics.proxies import ContactProxies, nearest_gap
+from ecs_tentacles.physics.pairs import nearest_gap
+from ecs_tentacles.physics.proxies import ContactProxies
 from ecs_tentacles.physics.tiers import FULL, KINEMATIC, NAMES, REDUCED
 
 if TYPE_CHECKING:

@@ -1,9 +1,11 @@
-"""Pairs of creatures near each other: `near_pairs` (the test) and `NearPairCache` (the
-same answers, kept from one call to the next while nothing moved far: a Verlet list).
+"""Pairs of creatures near each other: `near_pairs` (the test), `NearPairCache` (the
+same answers, kept from one call to the next while nothing moved far: a Verlet list) and
+`nearest_gap` (each creature's smallest gap among the pairs the proxies measured).
 
     a, b = near_pairs(centre, radius, margin)  # spheres within margin of each other
     pairs = NearPairCache(slack=0.25)
     a, b = pairs(centre, radius, margin)  # what near_pairs(centre, radius, margin) gives
+    near = nearest_gap(count, a, b, gaps)  # gaps: `ContactProxies.pair_gaps`'s
 
 A large crowd's pairs come from a k-d tree, built and queried on every call: at 10,000
 creatures about 3 ms each, and a frame asks several times (the level of detail, the
@@ -151,3 +153,19 @@ def near_pairs(
     if not found_a:
         return _NONE, _NONE
     return np.concatenate(found_a), np.concatenate(found_b)
+
+
+def nearest_gap(
+    count: int, a: np.ndarray, b: np.ndarray, gaps: np.ndarray, among: np.ndarray | None = None
+) -> np.ndarray:
+    """(count,) each creature's smallest gap of the pairs (`ContactProxies.pair_gaps`),
+    counting only partners in `among` ((count,) bool) when given; inf where none."""
+    near = np.full(count, np.inf)
+    if among is None:
+        np.minimum.at(near, a, gaps)
+        np.minimum.at(near, b, gaps)
+    else:
+        to_b, to_a = among[b], among[a]
+        np.minimum.at(near, a[to_b], gaps[to_b])
+        np.minimum.at(near, b[to_a], gaps[to_a])
+    return near

@@ -28,6 +28,7 @@ from ecs_tentacles.numeric.optional_kernels import OptionalKernels
 from ecs_tentacles.numeric.untouched import untouched_zeros
 from ecs_tentacles.physics.model import PROXY_CAPSULES, PROXY_CYLINDERS, PROXY_PARKED
 from ecs_tentacles.physics.pairs import NearPairCache
+from ecs_tentacles.physics.posed_spheres import PosedSpheres
 from ecs_tentacles.physics.tiers import KINEMATIC
 
 if TYPE_CHECKING:
@@ -431,25 +432,6 @@ class ContactProxies:
 
 
 @dataclass
-class PosedSpheres:
-    """Reach spheres found by whoever wrote creatures' poses (`ContactProxies.posed_spheres`),
-    for the next frame's `sense`: creature c's at `centre[c]`, `radius[c]` where `known[c]`.
-    `start` and `rbound` are the proxies' (creature c's body b is `start[c] + b`)."""
-
-    start: np.ndarray
-    rbound: np.ndarray
-    centre: np.ndarray
-    radius: np.ndarray
-    known: np.ndarray
-
-    @classmethod
-    def empty(cls, start: np.ndarray, rbound: np.ndarray) -> PosedSpheres:
-        count = len(start)
-        known = np.zeros(count, dtype=bool)
-        return cls(start, rbound, np.empty((count, 3)), np.empty(count), known)
-
-
-@dataclass
 class _Lazy:
     """A frame's `sense`: body poses filled creature by creature as `gather` is asked."""
 
@@ -464,19 +446,3 @@ def _bounds(kind: np.ndarray, size: np.ndarray) -> np.ndarray:
     """Bounding-sphere radii of bodies of `kind` and `size` (radius, half length)."""
     radius, half = size[:, 0], size[:, 1]
     return np.asarray(np.where(kind == CYLINDER, np.hypot(radius, half), radius + half))
-
-
-def nearest_gap(
-    count: int, a: np.ndarray, b: np.ndarray, gaps: np.ndarray, among: np.ndarray | None = None
-) -> np.ndarray:
-    """(count,) each creature's smallest gap of the pairs (`ContactProxies.pair_gaps`),
-    counting only partners in `among` ((count,) bool) when given; inf where none."""
-    near = np.full(count, np.inf)
-    if among is None:
-        np.minimum.at(near, a, gaps)
-        np.minimum.at(near, b, gaps)
-    else:
-        to_b, to_a = among[b], among[a]
-        np.minimum.at(near, a[to_b], gaps[to_b])
-        np.minimum.at(near, b[to_a], gaps[to_a])
-    return near
