@@ -1,7 +1,7 @@
 """A heightfield: heights on a grid, as MuJoCo's triangles give them under any point.
 
-Its heights come from an optional numba kernel (`physics.kernels`, numpy otherwise:
-the same numbers bit for bit).
+Its heights come from an optional numba kernel (`terrain.heightfield_kernels`, numpy
+otherwise: the same numbers bit for bit).
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from ecs_tentacles.numeric.optional_kernels import OptionalKernels
 BEYOND_DROP = 0.002  # metres the plane past a heightfield's edge lies under its lowest point
 
 # the heightfield kernel (numba, when installed; numpy otherwise: the same numbers)
-KERNELS = OptionalKernels("ecs_tentacles.physics.kernels", "ECS_TENTACLES_SENSE")
+KERNELS = OptionalKernels("ecs_tentacles.terrain.heightfield_kernels", "ECS_TENTACLES_SENSE")
 
 
 @dataclass(frozen=True)
