@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-import hashlib
+import os
+import pathlib
 from collections.abc import Callable
 from typing import Any
 
@@ -224,9 +225,13 @@ def test_the_schemas_largest_creature_steps_at_full_and_reduced(
     assert np.isfinite(world.transforms.pos).all()
 
 
-# What `test_tiers_changing_back_and_forth_move_as_recorded` saw, recorded on 164f417 (every
-# creature's reduced state kept then; now only the REDUCED rows', `Batch.rslot`)
-TIER_CHURN = "100906d37bea95cd38008157e52017709226d426631acddde3bcbe6a06bf4ec5"
+# What `test_tiers_changing_back_and_forth_move_as_recorded` saw: every body's place after
+# each of its 12 rounds (12, 168, 3). Recorded on 8d136e7 on an x86-64-v3 (AVX2) CPU; it
+# was a SHA-256 of the bytes (recorded on 164f417), which held only on the CPU it was
+# recorded on: numpy picks its SIMD paths by CPU, and the last bits differ between them.
+# Re-record on purpose with ECS_TENTACLES_RECORD_TIER_CHURN=1 (the test then skips).
+TIER_CHURN = pathlib.Path(__file__).parents[1] / "data" / "tier_churn_positions.npy"
+TIER_CHURN_TOLERANCE = 1e-6  # metres: last-bit differences between CPUs stay far below
 
 
 @pytest.mark.skipif(
@@ -238,7 +243,7 @@ def test_tiers_changing_back_and_forth_move_as_recorded(
     make_world: Callable[..., World],
 ) -> None:
     world = make_world(_crowd(8, MIXED), threads=2)
-    digest = hashlib.sha256()
+    places = []
     for k in range(12):
         if k == 3:
             world.lod.promote(world.creature("c7"))  # replayed -> full
@@ -248,9 +253,12 @@ def test_tiers_changing_back_and_forth_move_as_recorded(
         if k == 8:
             world.lod.focus((0.0, 0.0), 0.0)
         world.step(10)
-        digest.update(world.transforms.pos.tobytes())
-        for batch in world.physics.batches:
-            digest.update(batch.state.tobytes())
+        places.append(world.transforms.pos.copy())
     # rows went REDUCED -> KINEMATIC -> REDUCED and FULL <-> REDUCED on the way
     assert (world.lod.promotions, world.lod.demotions) == (9, 16)
-    assert digest.hexdigest() == TIER_CHURN
+    if os.environ.get("ECS_TENTACLES_RECORD_TIER_CHURN"):
+        np.save(TIER_CHURN, np.array(places))
+        pytest.skip(f"recorded {TIER_CHURN}")
+    recorded = np.load(TIER_CHURN)
+    assert recorded.shape == (12, *world.transforms.pos.shape)
+    np.testing.assert_allclose(np.array(places), recorded, rtol=0, atol=TIER_CHURN_TOLERANCE)
