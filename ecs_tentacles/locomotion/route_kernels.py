@@ -13,9 +13,11 @@ last level's pair by `<=`, a removal moving the last value into the hole, a leve
 when full and dropped when under a quarter full), so equal costs are taken in the same
 order and give the same path; the tightening samples each line at the points numpy's
 `linspace` and `round` give. tests/locomotion/test_navigation.py compares the two on
-rocky and walled grids. A 256-creature crowd on the rocky preset planned its first
-frame's routes in about 8.5 s of CPU through scikit-image and Python, most of it the
-per-route search's set-up, its heap and the pulling tight's quadratic line checks.
+rocky and walled grids. A 256-creature crowd on the rocky preset plans its first
+frame's routes in 2.8-3.0 s of CPU here against 8.1-8.3 s through scikit-image and
+Python (whose pulling tight's line checks, quadratic in a path's length, took a third
+of it); what is left is the search itself, which takes some 60 % of the grid's cells
+before it reaches a goal across the crowd.
 """
 
 from __future__ import annotations
