@@ -15,7 +15,8 @@ creature's `reach` (the footprints inflated by the reach, so tentacles fit past
 unless there is no other way), and with the slope (`SLOPE_COST` per unit of
 tan(slope); steeper than `MAX_SLOPE` is impassable). Routes are scikit-image's minimum-cost paths
 (`MCP_Geometric`, 8-connected), pulled tight: a waypoint is kept only where the
-straight line to the next one would cross an impassable cell. The ground's part (its
+straight line to the next one would cross an impassable cell (with numba, one kernel
+does both and finds the same cells: `route_kernels`). The ground's part (its
 walls, the room beside them, its slopes: `Survey`) is made once; each creature plans on
 the grid of its own reach, so its route does not depend on which other creatures share
 its world (a shard of a bake plans as the whole crowd does); the last `KEPT_GRIDS`
@@ -31,6 +32,7 @@ import numpy as np
 
 from ecs_tentacles.ground import Ground, ground_of
 from ecs_tentacles.locomotion.stores import CreatureGaitStore, LocomotionStores
+from ecs_tentacles.numeric.optional_kernels import OptionalKernels
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
@@ -48,6 +50,10 @@ WAYPOINT_RADIUS = 0.35  # metres: a waypoint this close is passed
 STUCK_SECONDS = 8.0  # no progress toward a waypoint this long: plan again
 PROGRESS = 0.1  # metres closer that count as progress
 KEPT_GRIDS = 16  # cost grids kept, one a reach (a crowd of one body plan needs one)
+
+# a route's search and pulling tight by numba when installed (`locomotion.route_kernels`,
+# the same cells); ECS_TENTACLES_ROUTES=numpy: scikit-image's search and Python's loops
+KERNELS = OptionalKernels("ecs_tentacles.locomotion.route_kernels", "ECS_TENTACLES_ROUTES")
 
 # what a snapshot keeps: routes by creature row, and the planned, best and since columns
 NavigationState: TypeAlias = tuple[dict[int, np.ndarray], np.ndarray, np.ndarray, np.ndarray]
@@ -131,20 +137,33 @@ class CostGrid:
         """Waypoints (k, 2) from near `start` to `goal` (the last one), or None when no
         passable route joins them. A start or goal inside an inflated footprint moves
         to the nearest passable cell first."""
-        from skimage.graph import MCP_Geometric
-
         begin = self._passable_near(self.index(start))
         end = self._passable_near(self.index(goal))
         if begin is None or end is None:
             return None
+        fast = KERNELS.get()
+        if fast is None:
+            kept = self._kept_cells(begin, end)
+        else:
+            cells = fast.route_cells(self.costs, np.array(begin), np.array(end))
+            kept = [(int(r), int(c)) for r, c in cells] if len(cells) else None
+        if kept is None:
+            return None
+        points = [self.point(c) for c in kept[1:-1]]
+        return np.array([*points, np.asarray(goal, dtype=np.float64)[:2]]).reshape(-1, 2)
+
+    def _kept_cells(
+        self, begin: tuple[int, int], end: tuple[int, int]
+    ) -> list[tuple[int, int]] | None:
+        """The cells of the minimum-cost path from `begin` to `end` pulled tight, by
+        scikit-image and Python (`route_kernels.route_cells` without numba)."""
+        from skimage.graph import MCP_Geometric
+
         mcp = MCP_Geometric(self.costs, fully_connected=True)
         cumulative, _ = mcp.find_costs([begin], [end])
         if not np.isfinite(cumulative[end]):
             return None
-        cells = mcp.traceback(end)
-        kept = self._pulled_tight(cells)
-        points = [self.point(c) for c in kept[1:-1]]
-        return np.array([*points, np.asarray(goal, dtype=np.float64)[:2]]).reshape(-1, 2)
+        return self._pulled_tight(mcp.traceback(end))
 
     def clear_line(self, a: np.ndarray, b: np.ndarray) -> bool:
         """Whether the straight line from `a` to `b` (x, y) crosses only passable cells."""

@@ -11,10 +11,12 @@ import pytest
 
 from ecs_tentacles.components import Creature
 from ecs_tentacles.ground import ground_of
-from ecs_tentacles.locomotion.navigation import STUCK_SECONDS, CostGrid, Navigator
+from ecs_tentacles.locomotion.navigation import KERNELS, STUCK_SECONDS, CostGrid, Navigator, Survey
 from ecs_tentacles.locomotion.render import path_lines
 from ecs_tentacles.render.registries import RenderView
+from ecs_tentacles.terrain import presets
 from ecs_tentacles.terrain.ground import TerrainGround
+from ecs_tentacles.terrain.scene_ground import build_ground
 from ecs_tentacles.terrain.shapes import Solid
 from ecs_tentacles.world import World
 
@@ -138,3 +140,54 @@ def test_a_route_does_not_depend_on_who_else_is_in_the_world(
         )
     assert len(routes[0]) >= 1
     np.testing.assert_array_equal(routes[0], routes[1])
+
+
+def box(x: float, y: float, sx: float, sy: float) -> dict[str, Any]:
+    return {"shape": "box", "position": [x, y, 0.0], "size": [sx, sy, 3.0]}
+
+
+@pytest.mark.parametrize("ground", ["rocky", "walls"])
+def test_routes_by_numba_are_scikit_images_bit_for_bit(
+    ground: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Every route numba plans (`route_kernels.route_cells`) has the waypoints of the
+    numpy path's (scikit-image's `MCP_Geometric` and `_pulled_tight`, the planner
+    before the kernel), from each start to every goal, one of them penned in (no route:
+    all the ground searched, the heap grown and shrunk to empty): on rocky ground (a
+    noise heightfield and boulders) and on flat ground between walls, where most cells
+    cost the same and many paths tie (a cell keeps its first predecessor unless a
+    strictly cheaper one comes: taking the first of equals instead moves waypoints)."""
+    assert KERNELS.get() is not None  # numba comes with the dev extra
+    rng = np.random.default_rng(7)
+    crowd = rng.uniform(-6.0, 6.0, size=(64, 2))  # the rocks' count follows the crowd's
+    starts = crowd[:8]
+    if ground == "rocky":
+        pen = (4.0, 2.8)
+        terrain = presets.rocky(crowd, 0.6, seed=3)
+    else:
+        pen = (0.0, 5.6)
+        walls = [box(0.0, 0.0, 4.1, 0.1), box(-3.0, -3.0, 0.1, 3.0), box(3.0, -3.0, 0.1, 3.0)]
+        terrain = {"obstacles": [*walls, box(0.0, 3.5, 3.0, 0.1)]}
+    x, y = pen
+    penned = [box(x, y + 1.2, 1.2, 0.1), box(x, y - 1.2, 1.2, 0.1)]
+    penned += [box(x - 1.1, y, 0.1, 1.3), box(x + 1.1, y, 0.1, 1.3)]
+    terrain["obstacles"] = [*terrain["obstacles"], *penned]  # type: ignore[misc]
+    survey = Survey.of(build_ground(terrain, None), starts)  # type: ignore[arg-type]
+    assert survey is not None
+    grids = [survey.grid(reach) for reach in (0.55, 0.66)]
+    goals = np.vstack([-starts[::2], [pen]])  # across the middle, and in the pen
+    planned = {}
+    for backend in ("auto", "numpy"):
+        monkeypatch.setattr(KERNELS, "backend", backend)
+        planned[backend] = [
+            grid.route(start, goal) for grid in grids for start in starts for goal in goals
+        ]
+    walled_in = sum(route is None for route in planned["numpy"])
+    bends = sum(route is not None and len(route) > 1 for route in planned["numpy"])
+    assert walled_in == 2 * len(starts) and bends >= 10, (walled_in, bends)
+    for fast, reference in zip(planned["auto"], planned["numpy"], strict=True):
+        if reference is None:
+            assert fast is None
+        else:
+            assert fast is not None
+            np.testing.assert_array_equal(fast, reference)
