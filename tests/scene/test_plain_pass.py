@@ -125,3 +125,12 @@ def test_a_valid_crowd_is_checked_without_descending_into_its_creatures() -> Non
     scene = crowd_scene(1000, 0)
     assert list(counting(schema_for(resolve(None))).iter_errors(scene)) == []
     assert len(checked) < 20  # the scene's own keys; 1,000 creatures took 60,000
+
+
+def test_a_long_array_deep_in_a_uniform_crowd_is_reported_before_the_schema() -> None:
+    scene = crowd_scene(10_000, 0, uniform=True)
+    scene["creatures"][7311]["goals"] = [{"position": [0, 0]}] * 5000
+    scene["creatures"][9]["mantle"]["radius"] = -0.1  # (the schema is not looked at)
+    assert validate_scene(scene) == [
+        "creatures[7311].goals: must have at most 1024 items, got 5000"
+    ]
