@@ -49,7 +49,7 @@ from ecs_tentacles.render.registries import (
     UndoState,
     UndoStates,
 )
-from ecs_tentacles.scene.construction import tentacle_params
+from ecs_tentacles.scene.construction import every_tentacle_params
 from ecs_tentacles.scene.parameters import apply_parameters
 from ecs_tentacles.scene.schema import plugin_schemas
 from ecs_tentacles.scene.spec import as_spec
@@ -119,14 +119,21 @@ class LocomotionPlugin(Plugin):
         loco.creatures.avoid[row] = bool(spec.get("avoid", True))
         rng = creature_rng(world.seed, entry["name"])  # the creature's own stream
         tentacles = entry["tentacles"]
-        phases = [rng.uniform(0.0, 2.0 * np.pi) for _ in body.tentacles]  # drawn in order
+        # one draw a tentacle, in order (an array of draws holds the same values)
+        phases = rng.uniform(0.0, 2.0 * np.pi, len(body.tentacles))
         rows = loco.tentacles.add(len(phases), phase=phases, action_strength=STRENGTH[Kind.IDLE])
-        for k, (entity, added) in enumerate(zip(body.tentacles, rows.tolist(), strict=True)):
+        for entity, added in zip(body.tentacles, rows.tolist(), strict=True):
             if added != world.component(entity, Tentacle).row:
                 raise RuntimeError("locomotion's tentacle rows must line up with the body's")
-            params = tentacle_params(tentacles, k)
-            apply_parameters(world, "tentacles", params, {"locomotion.tentacles": added})
             world.add_component(entity, ActionQueue())
+        # each parameter written once for the tentacles that share their settings
+        sharing: dict[int, list[int]] = {}
+        every = every_tentacle_params(tentacles)
+        for k, params in enumerate(every):
+            sharing.setdefault(id(params), []).append(k)
+        for ks in sharing.values():
+            at = {"locomotion.tentacles": rows[ks]}
+            apply_parameters(world, "tentacles", every[ks[0]], at)
         for goal in goals:
             # a 2-d goal is on the ground under it (`GoalBook` puts it there)
             world.resource(GoalBook).append(creature, goal["position"], goal["radius"])

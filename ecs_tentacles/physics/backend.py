@@ -103,9 +103,10 @@ class PhysicsBackend(Membership):
             batch = Batch(len(self.batches), model, [layouts[i] for i in indices], reduced)
             roster.add(batch, indices)
             batch.prepare(FULL, self.threads)  # every thread's scratch, before threads run
-            for row, i in enumerate(indices):
-                transform = creatures[i][1][1]
-                batch.place(row, np.array(transform.pos), np.array(transform.quat))
+            placed = [creatures[i][1][1] for i in indices]
+            pos = np.array([transform.pos for transform in placed])
+            quat = np.array([transform.quat for transform in placed])
+            batch.place_rows(range(len(indices)), pos, quat)
         self.compiles = len(self.batches)
         self.view_of_creature_row = np.zeros(0, dtype=np.int64)
         self.views = CreatureViews(self.roster)

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import copy
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING
 
 import mujoco
@@ -322,6 +322,24 @@ class Batch(BatchPoses):
         self.xpos[row] = d.xpos[self.body_ids]
         self.xquat[row] = d.xquat[self.body_ids]
         self._stepped(row)
+
+    def place_rows(self, rows: Sequence[int], pos: np.ndarray, quat: np.ndarray) -> None:
+        """`place` of each of `rows` (`pos` (n, 3), `quat` (n, 4)), the same state and
+        poses: the scratch data is reset once, not once a row (`mj_resetData` took 16 of
+        `place`'s 38 us), as between rows only the root is written and forward
+        kinematics reads nothing it wrote for the row before."""
+        scratch = self.scratch_for(0)
+        m, d = scratch.model, scratch.data
+        mujoco.mj_resetData(m, d)
+        d.mocap_pos[self.proxy_mocap] = PROXY_PARKED
+        root = d.qpos[self.root_qpos : self.root_qpos + 7]
+        for row, at, turn in zip(rows, pos, quat, strict=True):
+            root[:3], root[3:] = at, turn
+            mujoco.mj_kinematics(m, d)
+            mujoco.mj_getState(m, d, self.state[row], STATE)
+            self.xpos[row] = d.xpos[self.body_ids]
+            self.xquat[row] = d.xquat[self.body_ids]
+            self._stepped(row)
 
     def standalone(self, row: int) -> tuple[mujoco.MjModel, mujoco.MjData]:
         """A new model and data of row `row` alone, as its next step would see them.

@@ -15,14 +15,14 @@ scene needs it.
 
 from __future__ import annotations
 
-import functools
 import math
-import re
 from collections.abc import Callable, Iterator, Mapping
 from typing import TYPE_CHECKING, cast
 
 import numpy as np
 from jsonschema import Draft202012Validator, ValidationError, _keywords, validators
+
+from ecs_tentacles.scene.plain_pass import ecma_pattern, passes_check
 
 if TYPE_CHECKING:  # the class `validators.create` makes (the stubs' name; none at run time)
     from jsonschema.validators import _Validator
@@ -38,29 +38,6 @@ def _is_number(checker: object, value: object) -> bool:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         return False
     return isinstance(value, int) or math.isfinite(value)
-
-
-@functools.lru_cache(maxsize=256)
-def ecma_pattern(pattern: str) -> re.Pattern[str]:
-    """`pattern` as JSON Schema (ECMA 262) reads it: `$` is the end of the text.
-
-    Python's `$` also matches before a trailing newline, which let `"octo\\n"` pass as a
-    name; here every `$` outside a character class becomes `\\Z`.
-    """
-    out, escaped, in_class = [], False, False
-    for char in pattern:
-        if escaped:
-            escaped = False
-        elif char == "\\":
-            escaped = True
-        elif char == "[":
-            in_class = True
-        elif char == "]":
-            in_class = False
-        elif char == "$" and not in_class:
-            char = r"\Z"
-        out.append(char)
-    return re.compile("".join(out))
 
 
 def _pattern(
@@ -121,62 +98,19 @@ def _items(
             for index in failing.tolist():
                 yield from validator.descend(instance=instance[index], schema=items, path=index)
             return
+    if isinstance(instance, list) and isinstance(items, dict) and not schema.get("prefixItems"):
+        check = passes_check(items, _resolver(validator))
+        if check is not None:  # (the standard `items`, with the items that pass skipped)
+            for index, item in enumerate(instance):
+                if not check(item):
+                    yield from validator.descend(instance=item, schema=items, path=index)
+            return
     yield from _STANDARD_ITEMS(validator, items, instance, schema)
 
 
-_BOUNDS = ("minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum")
-_LEAF_KINDS = {"number": _is_number, "integer": _is_integer, "boolean": None, "string": None}
-_NOTES = {"description", "default", "title", "examples", "$comment"}  # (and x-...: ours)
-# id -> (schema kept alive, its check or None):
-_LEAVES: dict[int, tuple[object, Callable[[object], bool] | None]] = {}
-
-
-def _leaf_check(schema: object) -> Callable[[object], bool] | None:
-    """For a schema that only says a value's type (number, integer, boolean or string)
-    and, for numbers, its bounds: a function telling that a value passes it; else None."""
-    found = _LEAVES.get(id(schema))
-    if found is not None and found[0] is schema:
-        return found[1]
-    check = None
-    if (
-        isinstance(schema, dict)
-        and isinstance(schema.get("type"), str)
-        and schema["type"] in _LEAF_KINDS
-    ):
-        kind = schema["type"]
-        rules = {k for k in schema if k not in _NOTES and not k.startswith("x-")} - {"type"}
-        numeric = kind in ("number", "integer")
-        if not rules or (numeric and rules <= set(_BOUNDS)):
-            check = _leaf(kind, *(schema.get(k) for k in _BOUNDS))
-    if len(_LEAVES) > 4096:
-        _LEAVES.clear()
-    _LEAVES[id(schema)] = (schema, check)
-    return check
-
-
-def _leaf(
-    kind: str, low: float | None, high: float | None, above: float | None, below: float | None
-) -> Callable[[object], bool]:
-    """`_leaf_check`'s function: True when a value is of `kind` within the bounds (each
-    None when absent), exactly when jsonschema would find nothing wrong with it."""
-    is_kind = _LEAF_KINDS[kind]
-    if kind == "boolean":
-        return lambda value: isinstance(value, bool)
-    if kind == "string":
-        return lambda value: isinstance(value, str)
-    assert is_kind is not None
-
-    def passes(value: object) -> bool:
-        return bool(
-            is_kind(None, value)
-            and isinstance(value, (int, float))  # (is_kind said so: for mypy)
-            and (low is None or not value < low)
-            and (high is None or not value > high)
-            and (above is None or not value <= above)
-            and (below is None or not value >= below)
-        )
-
-    return passes
+def _resolver(validator: _Validator) -> object:
+    """The validator's `referencing` Resolver where it stands (for `$ref`s), or None."""
+    return getattr(validator, "_resolver", None)
 
 
 def _properties(
@@ -185,17 +119,17 @@ def _properties(
     instance: object,
     schema: object,
 ) -> Iterator[ValidationError]:
-    """`properties`, with values that plainly pass a type-and-bounds schema not descended
-    into: jsonschema would find nothing there (a crowd's creatures are mostly such
-    values, and a descent costs some microseconds each); any other value, and one that
-    fails, is descended into as usual for the usual messages."""
+    """`properties`, with values that surely pass their schema (`passes_check`) not
+    descended into: jsonschema would find nothing there (a descent costs some
+    microseconds each); any other value is descended into as usual, for the usual
+    messages."""
     if not validator.is_type(instance, "object"):
         return
     assert isinstance(instance, dict)
     for name, subschema in properties.items():
         if name in instance:
             value = instance[name]
-            check = _leaf_check(subschema)
+            check = passes_check(subschema, _resolver(validator))
             if check is not None and check(value):
                 continue
             yield from validator.descend(value, subschema, path=name, schema_path=name)

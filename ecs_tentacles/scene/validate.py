@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING
 from ecs_tentacles.plugin import calling
 from ecs_tentacles.scene.defaults import copied, fill, nested, resolve, with_defaults
 from ecs_tentacles.scene.json_validator import StrictValidator, validator_for
+from ecs_tentacles.scene.plain_pass import passes_check
 from ecs_tentacles.scene.problem_text import JsonPath as JsonPath
 from ecs_tentacles.scene.problem_text import Problem as Problem
 from ecs_tentacles.scene.problem_text import count_bounds, describe, path_key, shown
@@ -327,11 +328,17 @@ def _too_deep(data: object, start: JsonPath = ()) -> JsonPath | None:
 def _limit_problems(
     data: object, schema: Mapping[str, object], root: Mapping[str, object]
 ) -> list[Problem]:
-    """Arrays longer than their schema's `maxItems`, found without descending into them."""
+    """Arrays longer than their schema's `maxItems`, found without descending into them
+    (nor into values that surely pass their schema: `passes_check`, which looks at an
+    array's length before its items)."""
     problems: list[Problem] = []
     stack: list[tuple[JsonPath, object, Mapping[str, object]]] = [((), data, schema)]
+    resolver = getattr(validator_for(root), "_resolver", None) if isinstance(root, dict) else None
     while stack:
         path, value, node = stack.pop()
+        check = passes_check(node, resolver)
+        if check is not None and check(value):
+            continue
         node = resolve(node, root)
         if isinstance(value, list):
             most, items = node.get("maxItems"), node.get("items")
