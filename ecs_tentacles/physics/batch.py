@@ -93,10 +93,10 @@ class Batch(BatchPoses, Placing):
         (self.body_rows, self.actuator_motor_rows, self.actuator_target_index,
          self.sucker_rows) = self._store_rows(layouts)  # fmt: skip
         self.members = np.zeros(n, dtype=np.int64)  # creature index (backend order) per row
-        # the state and its parts: resident where written (a row the build only shows
-        # is written when first needed, `physics.placing`)
+        # the state and its parts (resident where written when the build only shows the
+        # rows, `physics.placing`)
         self.slices = state_slices(m)
-        self.state = untouched_zeros((n, mujoco.mj_stateSize(m, STATE)))
+        self.state = np.zeros((n, mujoco.mj_stateSize(m, STATE)))
         self.unplaced: np.ndarray | None = None  # rows not placed yet (`physics.placing`)
         self.placement = np.zeros((0, 7))
         self.placed_in: TransformStore | None = None
@@ -110,10 +110,9 @@ class Batch(BatchPoses, Placing):
         self.proxy_size = np.full((n, PROXY_SLOTS, 2), 0.01)
         self.near = np.zeros(n, dtype=bool)  # proxies placed (parked ones need no size)
         self.applied: dict[int, np.ndarray] = {}  # row -> xfrc_applied, while a script pushes
-        # what the last step produced (a replayed row's poses are in the store: resident
-        # for the rows placed or stepped)
-        self.xpos = untouched_zeros((n, len(self.body_ids), 3))
-        self.xquat = untouched_zeros((n, len(self.body_ids), 4))
+        # what the last step produced
+        self.xpos = np.zeros((n, len(self.body_ids), 3))
+        self.xquat = np.zeros((n, len(self.body_ids), 4))
         self.warnings = np.zeros((n, WARNING_KINDS), dtype=np.int64)  # raised since checked
         self.deepest = np.full(n, np.inf)  # deepest contact distance (m; < 0 penetrates)
         self.errors: dict[int, str] = {}  # row -> MuJoCo's fatal error in the last step

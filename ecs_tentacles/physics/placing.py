@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING
 import mujoco
 import numpy as np
 
+from ecs_tentacles.numeric.untouched import untouched_zeros
 from ecs_tentacles.physics.model import PROXY_PARKED
 from ecs_tentacles.physics.state_layout import STATE
 from ecs_tentacles.physics.tiers import KINEMATIC
@@ -92,9 +93,15 @@ class Placing:
 
     def place_all(self, pos: np.ndarray, quat: np.ndarray, shown: TransformStore | None) -> None:
         """Every row at the build, row i's mantle at pos[i] / quat[i]: placed, or, given
-        the store `shown`, only shown there (`show_placed`)."""
+        the store `shown`, only shown there (`show_placed`), the state and pose tables
+        then anonymous mappings, resident for the rows written (`numeric.untouched`)."""
         pos, quat = pos.reshape(-1, 3).astype(np.float64), quat.reshape(-1, 4).astype(np.float64)
-        if shown is not None:
+        if shown is not None:  # the tables resident for the rows written only
+            self.state = untouched_zeros(self.state.shape)
+            self.xpos, self.xquat = (
+                untouched_zeros(self.xpos.shape),
+                untouched_zeros(self.xquat.shape),
+            )
             self.show_placed(np.arange(len(pos)), pos, quat, shown)
             return
         for row in range(len(pos)):
