@@ -102,9 +102,10 @@ class ClipReplay:
             clips = self.clips_of(batch)
             rows = roster.row_of[mine]
             kind = np.where(np.isfinite(targets[here, 0]), CRAWL, IDLE)
-            mantle_pos, mantle_quat = batch.xpos[rows, 0], batch.xquat[rows, 0]
+            xpos, xquat = batch.placed_poses(rows)  # (a row not placed yet: as shown)
+            mantle_pos, mantle_quat = xpos[:, 0], xquat[:, 0]
             yaw = mantle_yaw(mantle_quat)
-            shape = _mantle_frame(batch.xpos[rows], mantle_pos, yaw)
+            shape = _mantle_frame(xpos, mantle_pos, yaw)
             phase = np.zeros(len(mine), dtype=np.int64)
             for k in (IDLE, CRAWL):
                 which = np.flatnonzero(kind == k)
@@ -209,6 +210,7 @@ class ClipReplay:
         kind, phase = self.kind[mine], self.phase[mine]
         xy, heading = self.xy[mine], self.heading[mine]
         if not DIRECT:  # into the batch's pose rows; the sync copies them like any others
+            batch.place_pending(rows)  # (their pose rows are theirs from now on)
             clips.evaluate(kind, phase, xy, heading, batch.xpos, batch.xquat,
                            interpolate=interpolate, rows=rows)  # fmt: skip
             batch.show(transforms, None)

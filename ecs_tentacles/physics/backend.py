@@ -42,6 +42,7 @@ from ecs_tentacles.physics.lod import LevelOfDetail
 from ecs_tentacles.physics.membership import Membership, compile_models
 from ecs_tentacles.physics.messages import route_mujoco_messages
 from ecs_tentacles.physics.model import ModelLayout, model_layout
+from ecs_tentacles.physics.placing import PlacingState, place_stepped
 from ecs_tentacles.physics.proxies import ContactProxies
 from ecs_tentacles.physics.roster import Roster
 from ecs_tentacles.physics.rounds import Ready, Rounds
@@ -56,6 +57,7 @@ if TYPE_CHECKING:
 
 KERNELS = OptionalKernels("ecs_tentacles.physics.frame_kernels", "ECS_TENTACLES_PHYSICS_FRAME")
 S = mujoco.mjtState
+PLACE_LATE = True  # a replayable crowd's rows placed when first stepped (False: at the build)
 
 
 @dataclass(frozen=True)
@@ -66,6 +68,7 @@ class PhysicsState:
     states: list[np.ndarray]  # per batch: its state rows
     poses: list[tuple[np.ndarray, np.ndarray]]  # per batch: xpos, xquat after the last step
     reduced: list[tuple[np.ndarray, ...]]  # per batch: rslot, rstate, rsource (REDUCED rows)
+    placing: list[PlacingState]  # per batch: the rows not placed yet (`physics.placing`)
     applied: list[dict[int, np.ndarray]]  # per batch: forces scripts apply
     frozen: np.ndarray
     sleeping: np.ndarray
@@ -98,21 +101,26 @@ class PhysicsBackend(Membership):
             np.array([c.row for _, (c, _) in creatures], dtype=np.int64),
         )
         self.batches = roster.batches
+        # a crowd the level of detail may replay from the first frame: its rows are
+        # shown at the build and placed when first stepped (`physics.placing`)
+        lod = world.settings.lod
+        late = PLACE_LATE and lod.enabled and len(creatures) > lod.full
         for indices in by_key.values():
             model, reduced = compile_models(world, creatures[indices[0]][1][0])
             batch = Batch(len(self.batches), model, [layouts[i] for i in indices], reduced)
             roster.add(batch, indices)
             batch.prepare(FULL, self.threads)  # every thread's scratch, before threads run
-            placed = [creatures[i][1][1] for i in indices]
-            pos = np.array([transform.pos for transform in placed])
-            quat = np.array([transform.quat for transform in placed])
-            batch.place_rows(range(len(indices)), pos, quat)
+            mantles = [creatures[i][1][1] for i in indices]
+            batch.place_all(np.array([t.pos for t in mantles]), np.array([t.quat for t in mantles]),
+                            world.transforms if late else None)  # fmt: skip
         self.compiles = len(self.batches)
         self.view_of_creature_row = np.zeros(0, dtype=np.int64)
         self.views = CreatureViews(self.roster)
         self._index_views(len(world.creatures))
         self.proxies = ContactProxies(roster)
         self.health = HealthCheck(world, roster, self.proxies)
+        for batch in self.batches:  # a row placed late starts the health check's memory
+            batch.when_placed = functools.partial(self.health.placed, batch.index)
         self.sleep = Sleep(roster)
         self.sleep.enabled = world.settings.sleep
         settings = world.settings
@@ -161,6 +169,7 @@ class PhysicsBackend(Membership):
             states=[b.state.copy() for b in self.batches],
             poses=[b.all_poses() for b in self.batches],  # the replayed ones as shown
             reduced=[(b.rslot.copy(), b.rstate.copy(), b.rsource.copy()) for b in self.batches],
+            placing=[b.placing_state() for b in self.batches],
             applied=[{r: f.copy() for r, f in b.applied.items()} for b in self.batches],
             frozen=self.frozen.copy(),
             sleeping=self.sleeping.copy(),
@@ -189,11 +198,16 @@ class PhysicsBackend(Membership):
         Warnings counted since and a pending fatal error are dropped: neither is state.
         """
         self.time = state.time
-        for batch, rows, (xpos, xquat), (rslot, rstate, rsource), applied in zip(
-            self.batches, state.states, state.poses, state.reduced, state.applied, strict=False
+        for batch, rows, (xpos, xquat), (rslot, rstate, rsource), applied, placing in zip(
+            self.batches,
+            state.states,
+            state.poses,
+            state.reduced,
+            state.applied,
+            state.placing,
+            strict=False,
         ):  # batches compiled since are empty (`state_problem`)
-            batch.state[:] = rows
-            batch.xpos[:], batch.xquat[:] = xpos, xquat
+            batch.set_rows(rows, xpos, xquat, placing)
             batch.show(None, None)  # every row's poses as saved, replayed ones too
             if rstate.shape[1] == batch.rstate.shape[1]:
                 batch.rslot[:], batch.rstate, batch.rsource = rslot, rstate.copy(), rsource.copy()
@@ -216,6 +230,10 @@ class PhysicsBackend(Membership):
         out = np.zeros(creatures, dtype=bool)
         out[self.roster.creature_row] = self.tier == KINEMATIC
         return out
+
+    def place_stepped(self) -> None:
+        """Place the rows the build only showed that are not replayed (`physics.placing`)."""
+        place_stepped(self.batches, self.tier)
 
     def write_controls(self, motors: MotorStore) -> None:
         """Targets into `ctrl`; kp = strength x gain, kv = damping x gain; torque limits."""
@@ -283,6 +301,7 @@ class PhysicsBackend(Membership):
         """
         batch = self.batches[int(self.batch_of[index])]
         row = int(self.row_of[index])
+        batch.place_pending(row)  # (its controls, switches and proxies as the build's)
         batch.part(S.mjSTATE_QPOS, row)[:] = qpos
         batch.part(S.mjSTATE_QVEL, row)[:] = qvel
         batch.part(S.mjSTATE_WARMSTART, row)[:] = 0.0
@@ -311,6 +330,7 @@ class PhysicsBackend(Membership):
         step reads only its own row, so the result does not depend on the number of
         threads. Asleep or frozen creatures keep their state; the clock moves on.
         """
+        self.place_stepped()  # (done after the level of detail decided: none left here)
         reduced = reduced_substeps(substeps)
         hold_reduced(self.batches, self.active, self.tier, self.threads)
         if before_substep is not None:

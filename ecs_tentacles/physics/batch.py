@@ -7,7 +7,9 @@ differs per creature in the model (servo gains and torque limits, sucker anchors
 proxy sizes: the *overlay*), the body poses the last step produced (`xpos`, `xquat`;
 a replayed row's poses are written into the Transform store instead: `show`, `poses`)
 and what the health check needs from it (warnings raised, deepest contact, fatal
-errors). Nothing per creature is a MuJoCo object.
+errors). Nothing per creature is a MuJoCo object. A row is placed at the build, or, in a
+crowd replayed from its first frame, when first needed (`physics.placing`): the state
+and pose tables are resident only for the rows written.
 
 A batch is stepped by `step_rows`: each stepping thread owns one scratch copy of the
 model and one MjData (`Scratch`), and steps its share of the rows one after another:
@@ -22,7 +24,7 @@ from __future__ import annotations
 
 import copy
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 import mujoco
@@ -31,13 +33,8 @@ import numpy as np
 from ecs_tentacles.numeric.rows import run_slice, without_row
 from ecs_tentacles.numeric.untouched import untouched_zeros
 from ecs_tentacles.physics.batch_poses import BatchPoses
-from ecs_tentacles.physics.model import (
-    PROXY_CAPSULES,
-    PROXY_CYLINDERS,
-    PROXY_PARKED,
-    PROXY_SLOTS,
-    ModelLayout,
-)
+from ecs_tentacles.physics.model import PROXY_CAPSULES, PROXY_CYLINDERS, PROXY_SLOTS, ModelLayout
+from ecs_tentacles.physics.placing import Placing
 from ecs_tentacles.physics.poses import PoseMap
 from ecs_tentacles.physics.reduced import KERNELS as REDUCED_KERNELS
 from ecs_tentacles.physics.reduced_step import step_reduced
@@ -56,7 +53,7 @@ def _ids(model: mujoco.MjModel, kind: mujoco.mjtObj, names: list[str]) -> np.nda
     return np.array([mujoco.mj_name2id(model, kind, n) for n in names], dtype=np.int64)
 
 
-class Batch(BatchPoses):
+class Batch(BatchPoses, Placing):
     """The creatures of one morphology: a shared model and their rows of state."""
 
     def __init__(
@@ -96,9 +93,14 @@ class Batch(BatchPoses):
         (self.body_rows, self.actuator_motor_rows, self.actuator_target_index,
          self.sucker_rows) = self._store_rows(layouts)  # fmt: skip
         self.members = np.zeros(n, dtype=np.int64)  # creature index (backend order) per row
-        # the state and its parts
+        # the state and its parts (resident where written when the build only shows the
+        # rows, `physics.placing`)
         self.slices = state_slices(m)
         self.state = np.zeros((n, mujoco.mj_stateSize(m, STATE)))
+        self.unplaced: np.ndarray | None = None  # rows not placed yet (`physics.placing`)
+        self.placement = np.zeros((0, 7))
+        self.placed_in: TransformStore | None = None
+        self.when_placed: Callable[[np.ndarray], None] | None = None
         # the overlay: what differs per creature in the model; the servos' written for
         # the rows commanded only (a replayed row's when it is promoted): resident there
         self.kp = untouched_zeros((n, m.nu))
@@ -172,6 +174,9 @@ class Batch(BatchPoses):
             grown = np.full((len(array) + 1, *array.shape[1:]), fill, dtype=array.dtype)
             grown[:-1] = array
             setattr(self, name, grown)
+        if self.unplaced is not None:  # (the new row is placed next)
+            self.unplaced = np.append(self.unplaced, False)
+            self.placement = np.concatenate([self.placement, np.zeros((1, 7))])
         self._follow_shown(None)
         return len(self) - 1
 
@@ -182,6 +187,9 @@ class Batch(BatchPoses):
             setattr(self, name, without_row(getattr(self, name), row))
         self.applied = {r - (r > row): f for r, f in self.applied.items() if r != row}
         self.errors = {r - (r > row): e for r, e in self.errors.items() if r != row}
+        if self.unplaced is not None:
+            self.unplaced = np.delete(self.unplaced, row)
+            self.placement = np.delete(self.placement, row, axis=0)
         self._follow_shown(row)
 
     def renumber(self, moved: dict[str, np.ndarray]) -> None:
@@ -306,47 +314,13 @@ class Batch(BatchPoses):
             self.prepare(tier, thread + 1)
         return self.scratch[tier][thread]
 
-    def place(self, row: int, pos: np.ndarray, quat: np.ndarray) -> None:
-        """Row `row`: the mantle at `pos` / `quat`, every joint at rest, proxies parked."""
-        scratch = self.scratch_for(0)
-        m, d = scratch.model, scratch.data
-        mujoco.mj_resetData(m, d)
-        d.qpos[self.root_qpos : self.root_qpos + 3] = pos
-        d.qpos[self.root_qpos + 3 : self.root_qpos + 7] = quat
-        d.mocap_pos[self.proxy_mocap] = PROXY_PARKED
-        # the poses are all a row needs here: forward kinematics gives them (and the
-        # state read below is what was written above; mj_step writes the warm start),
-        # a seventeenth of mj_forward's cost (contacts, constraints) per creature built
-        mujoco.mj_kinematics(m, d)
-        mujoco.mj_getState(m, d, self.state[row], STATE)
-        self.xpos[row] = d.xpos[self.body_ids]
-        self.xquat[row] = d.xquat[self.body_ids]
-        self._stepped(row)
-
-    def place_rows(self, rows: Sequence[int], pos: np.ndarray, quat: np.ndarray) -> None:
-        """`place` of each of `rows` (`pos` (n, 3), `quat` (n, 4)), the same state and
-        poses: the scratch data is reset once, not once a row (`mj_resetData` took 16 of
-        `place`'s 38 us), as between rows only the root is written and forward
-        kinematics reads nothing it wrote for the row before."""
-        scratch = self.scratch_for(0)
-        m, d = scratch.model, scratch.data
-        mujoco.mj_resetData(m, d)
-        d.mocap_pos[self.proxy_mocap] = PROXY_PARKED
-        root = d.qpos[self.root_qpos : self.root_qpos + 7]
-        for row, at, turn in zip(rows, pos, quat, strict=True):
-            root[:3], root[3:] = at, turn
-            mujoco.mj_kinematics(m, d)
-            mujoco.mj_getState(m, d, self.state[row], STATE)
-            self.xpos[row] = d.xpos[self.body_ids]
-            self.xquat[row] = d.xquat[self.body_ids]
-            self._stepped(row)
-
     def standalone(self, row: int) -> tuple[mujoco.MjModel, mujoco.MjData]:
         """A new model and data of row `row` alone, as its next step would see them.
 
         For inspection (servo forces, contacts, a viewer): forward kinematics and
         forces are computed; writing them changes nothing in the batch.
         """
+        self.place_pending(row)
         m = copy.copy(self.model)
         d = mujoco.MjData(m)
         write_overlay(self, m, row)
@@ -358,6 +332,7 @@ class Batch(BatchPoses):
 
     def forward(self, row: int) -> None:
         """Recompute row `row`'s body poses from its state (after a restore)."""
+        self.place_pending(row)
         scratch = self.scratch_for(0)
         m, d = scratch.model, scratch.data
         mujoco.mj_setState(m, d, self.state[row], STATE)

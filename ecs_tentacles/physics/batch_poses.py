@@ -1,10 +1,11 @@
 """A batch's body poses as the world sees them (`physics.batch.Batch` is one): the poses
 its last step produced (`xpos`, `xquat`, a row per creature), copied into the Transform
 store each frame (`sync`), and the rows a replay wrote straight into the store instead
-(`show`: one write, not two), read back from there (`poses`, `all_poses`).
+(`show`: one write, not two), read back from there (`poses`, `all_poses`), like the
+rows the build only showed there (`unplaced`, `physics.placing`).
 
-Reads `xpos`, `xquat`, `body_rows` and the Transform store; writes the store (`sync`)
-and which rows the store holds (`shown`, `shown_in`).
+Reads `xpos`, `xquat`, `body_rows`, `unplaced` and the Transform store; writes the store
+(`sync`) and which rows the store holds (`shown`, `shown_in`).
 """
 
 from __future__ import annotations
@@ -36,6 +37,8 @@ class BatchPoses:
     shown_in: TransformStore | None
     _span: slice | None  # `body_rows` as one slice of store rows, when consecutive
     _span_of: np.ndarray | None  # the body_rows the span was found for
+    unplaced: np.ndarray | None  # rows shown where the build placed them, not yet written
+    placed_in: TransformStore | None  # (`physics.placing`): the store showing them
 
     def __len__(self) -> int:
         return len(self.body_rows)
@@ -54,12 +57,24 @@ class BatchPoses:
         if self.shown is not None:
             self.shown[row] = False
 
+    def _in_store(self, transforms: TransformStore) -> np.ndarray | None:
+        """Rows (bool) whose poses are in `transforms` and not in `xpos` / `xquat`: those
+        the replay wrote there this frame and those the build only showed; None: none."""
+        shown = self.shown
+        if shown is not None and (self.shown_in is not transforms or len(shown) != len(self)):
+            shown = None
+        unplaced = self.unplaced
+        if unplaced is None:
+            return shown
+        return unplaced if shown is None else shown | unplaced
+
     def sync(self, transforms: TransformStore) -> None:
         """Every row's body poses into the Transform store (one scatter per field, or one
-        copy when the rows are consecutive), but those the replay wrote there (`shown`)."""
+        copy when the rows are consecutive), but those the replay wrote there (`shown`)
+        and those the build showed there and never placed (`unplaced`)."""
         span = self.body_span()
-        shown = self.shown
-        if shown is not None and self.shown_in is transforms and len(shown) == len(self):
+        shown = self._in_store(transforms)
+        if shown is not None:
             others = np.flatnonzero(~shown)  # the replayed rows are there already
             if span is not None:
                 pos, quat = self.store_rows(transforms)
@@ -93,20 +108,40 @@ class BatchPoses:
 
     def poses(self, row: int) -> tuple[np.ndarray, np.ndarray]:
         """Row `row`'s body poses as shown now, (bodies, 3) and (bodies, 4): its last
-        step's (`xpos`, `xquat`), or, replayed (`show`), its Transform store rows (copies)."""
+        step's (`xpos`, `xquat`), or, replayed (`show`) or not placed yet (`unplaced`), its
+        Transform store rows (copies)."""
         if self.shown is not None and self.shown_in is not None and self.shown[row]:
             at = self.body_rows[row]
             return self.shown_in.pos[at], self.shown_in.quat[at]
+        if self.unplaced is not None and self.placed_in is not None and self.unplaced[row]:
+            at = self.body_rows[row]
+            return self.placed_in.pos[at], self.placed_in.quat[at]
         return self.xpos[row].copy(), self.xquat[row].copy()
 
+    def placed_poses(self, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(len(rows), bodies, 3) and (.., 4): the poses the last step or the placing of
+        `rows` left (`xpos` / `xquat`; a row not placed yet: where the build showed it)."""
+        unplaced, store = self.unplaced, self.placed_in
+        if unplaced is None or store is None:
+            return self.xpos[rows], self.xquat[rows]
+        late = unplaced[rows]  # (their rows here are never read: no pages for them)
+        xpos = np.empty((len(rows), *self.xpos.shape[1:]))
+        xquat = np.empty((len(rows), *self.xquat.shape[1:]))
+        xpos[~late], xquat[~late] = self.xpos[rows[~late]], self.xquat[rows[~late]]
+        at = self.body_rows[rows[late]]
+        xpos[late], xquat[late] = store.pos[at], store.quat[at]
+        return xpos, xquat
+
     def all_poses(self) -> tuple[np.ndarray, np.ndarray]:
-        """Copies of `xpos` and `xquat` with the replayed rows (`show`) as shown: every
-        row's poses as shown now (what a snapshot keeps)."""
+        """Copies of `xpos` and `xquat` with the replayed rows (`show`) and those not
+        placed yet (`unplaced`) as shown: every row's poses as shown now (what a snapshot
+        keeps)."""
         xpos, xquat = self.xpos.copy(), self.xquat.copy()
-        if self.shown is not None and self.shown_in is not None:
-            rows = np.flatnonzero(self.shown)
-            at = self.body_rows[rows]
-            xpos[rows], xquat[rows] = self.shown_in.pos[at], self.shown_in.quat[at]
+        for held, store in ((self.unplaced, self.placed_in), (self.shown, self.shown_in)):
+            if held is not None and store is not None:
+                rows = np.flatnonzero(held)
+                at = self.body_rows[rows]
+                xpos[rows], xquat[rows] = store.pos[at], store.quat[at]
         return xpos, xquat
 
     def store_rows(self, transforms: TransformStore) -> tuple[np.ndarray, np.ndarray]:

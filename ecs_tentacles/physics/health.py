@@ -42,6 +42,7 @@ from ecs_tentacles.numeric.untouched import is_untouched, untouched_zeros
 from ecs_tentacles.physics.tiers import KINEMATIC
 
 if TYPE_CHECKING:
+    from ecs_tentacles.physics.batch import Batch
     from ecs_tentacles.physics.host import PhysicsHost
     from ecs_tentacles.physics.proxies import ContactProxies
     from ecs_tentacles.physics.roster import Roster
@@ -89,7 +90,7 @@ class HealthCheck:
         # row's start state, kept once (`initial`): the tiers are decided on the first
         # frame, and making both for every row at the build made its peak 1.8 GiB
         self.saved = [SlotRows.empty(len(b), (2, b.state.shape[1])) for b in roster.batches]
-        self.initial: list[np.ndarray | None] = [b.state.copy() for b in roster.batches]
+        self.initial: list[np.ndarray | None] = [_start_states(b) for b in roster.batches]
         self.failures: dict[int, list[float]] = {}  # creature index -> recent recovery times
         # creature index -> (speed m/s, until world time): a thrown creature may fly faster
         self.allowed: dict[int, tuple[float, float]] = {}
@@ -163,6 +164,13 @@ class HealthCheck:
         self.rows = proxies.rows
         self.start, self.count = proxies.start, proxies.count
         self.span = run_slice(self.rows)  # one run of Transform rows (a crowd): a slice
+
+    def placed(self, batch: int, rows: np.ndarray) -> None:
+        """Rows `rows` of batch `batch` were placed only now (`physics.placing`): their
+        state is their start state."""
+        initial = self.initial[batch]
+        if initial is not None:
+            initial[rows] = self.roster.batches[batch].state[rows]
 
     def allow_speed(self, index: int, speed: float, until: float) -> None:
         """Creature `index` may move its bodies up to `speed` m/s (instead of the scene's
@@ -366,3 +374,14 @@ class HealthCheck:
                 cause,
             )
             world.events.emit(CreatureFrozen(world, creature, cause))
+
+
+def _start_states(batch: Batch) -> np.ndarray:
+    """A copy of `batch`'s state rows, its start states: resident for the rows placed
+    only (a row placed later is written by `HealthCheck.placed`)."""
+    if batch.unplaced is None:
+        return batch.state.copy()
+    initial = untouched_zeros(batch.state.shape)
+    placed = np.flatnonzero(~batch.unplaced)
+    initial[placed] = batch.state[placed]
+    return initial

@@ -33,6 +33,7 @@ class StateView:
         self._batch, self._row = batch, row
 
     def _part(self, flag: int) -> np.ndarray:
+        self._batch.place_pending(self._row)  # (a row the build only showed)
         return self._batch.part(flag, self._row)
 
     @property
@@ -122,6 +123,7 @@ class CreatureView:
 
     def integration_state(self) -> np.ndarray:
         """A copy of this creature's state row (`physics.batch.STATE`)."""
+        self.batch.place_pending(self.row)
         return np.asarray(self.batch.state[self.row].copy())
 
     @property

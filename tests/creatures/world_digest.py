@@ -60,6 +60,8 @@ def world_parts(world: World) -> dict[str, Any]:
     physics = world.physics
     batches = []
     for batch in physics.batches:
+        # a crowd's rows the build only showed (`physics.placing`), placed as they would be
+        batch.place_pending(np.arange(len(batch)))
         batches.append(
             (
                 repr(batch.key),

@@ -48,6 +48,7 @@ class Physics(System):
     def process(self, world: Host, dt: float) -> None:
         backend = world.physics
         backend.lod.update(world)  # first: a promoted creature's servos start soft
+        backend.place_stepped()  # the rows stepped from now on that the build only showed
         backend.write_controls(world.motors)
         backend.write_suckers(world.suckers)
         backend.proxies.update(world.transforms, world.frame)
