@@ -106,6 +106,13 @@ def checked(path: pathlib.Path, allow_systems: bool) -> tuple[Mapping[str, objec
 
 
 def handle(args: argparse.Namespace) -> int:
+    from ecs_tentacles.terrain.meshes import one_worker
+
+    with one_worker():  # one mesh worker for all the scenes, not one a scene
+        return _validate_each(args)
+
+
+def _validate_each(args: argparse.Namespace) -> int:
     failed = False
     for scene in args.scenes:
         try:

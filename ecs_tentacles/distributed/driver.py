@@ -215,8 +215,9 @@ def _signal_handlers() -> dict[int, _Handler]:
 def _run_shard(
     plan: BakePlan, members: list[int], key: str, counter: Any, options: WorldOptions
 ) -> ShardResult:
-    """The Ray task: bake one shard, telling `counter` of progress."""
-    return bake_shard(plan, members, key, options, on_steps=lambda n: counter.add.remote(n))
+    """The Ray task: bake one shard, telling `counter` of progress (if there is one)."""
+    on_steps = None if counter is None else (lambda n: counter.add.remote(n))
+    return bake_shard(plan, members, key, options, on_steps=on_steps)
 
 
 class _Counter:
@@ -304,16 +305,11 @@ def _run_all(
         if found is not None:
             results[tuple(shard)] = found
             stats.resumed += 1
-    counter = ray.remote(num_cpus=0)(_Counter).remote()
     task = ray.remote(num_cpus=1, max_retries=retries, retry_exceptions=True)(_run_shard)
     plan_ref = ray.put(plan)
-    pending = {
-        task.remote(plan_ref, s, keys[tuple(s)], counter, options): tuple(s)
-        for s in shards
-        if tuple(s) not in results
-    }
+    to_bake = [s for s in shards if tuple(s) not in results]
     failures: list[str] = []
-    total = plan.steps * len(pending)
+    total = plan.steps * len(to_bake)
     with tqdm(
         total=total,
         unit="frame",
@@ -322,6 +318,12 @@ def _run_all(
         file=sys.stderr,
         leave=False,
     ) as bar:
+        # the tasks count their frames to an actor only for a bar that is shown: the
+        # actor is a process of its own (its start and imports: about a CPU-second)
+        counter = None if bar.disable is True else ray.remote(num_cpus=0)(_Counter).remote()
+        pending = {
+            task.remote(plan_ref, s, keys[tuple(s)], counter, options): tuple(s) for s in to_bake
+        }
         bar.set_postfix_str(f"shards 0/{len(pending)}")
         done = 0
         try:
@@ -343,7 +345,7 @@ def _run_all(
                     stats.result_bytes += _nbytes(result)
                     done += 1
                     bar.set_postfix_str(f"shards {done}/{done + len(pending)}")
-                if bar.disable is not True:
+                if counter is not None:
                     steps = ray.get(counter.value.remote())  # type: ignore[attr-defined]
                     bar.update(min(total, steps) - bar.n)
         except BaseException:  # Ctrl-C, SIGTERM: stop every running task

@@ -21,10 +21,15 @@ Every refusal is a `TerrainError` naming the obstacle's `file` field.
 
 Budgets (defaults; a concave rock of a few thousand triangles takes 1-3 s and under
 300 MB): 60 s and 1024 MB per mesh, 300 s for all of a scene's meshes not yet cached.
+
+The worker ends with the scene build, except inside `one_worker()`: there the builds
+hand an idle worker on to the next one, and it ends with the block (`validate` of many
+scenes starts one worker, not one a scene: its imports take about 1 CPU-second).
 """
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import hashlib
 import json
@@ -33,6 +38,7 @@ import pathlib
 import select
 import subprocess
 import time
+from collections.abc import Iterator
 from typing import IO
 
 import numpy as np
@@ -55,6 +61,7 @@ POLL = 0.05  # seconds between looks at the worker's time and memory
 
 JsonPath = tuple[str | int, ...]
 _KNOWN: dict[str, tuple[np.ndarray, ...] | str] = {}  # key -> pieces or the refusal
+_IDLE: list[_Worker] | None = None  # inside `one_worker()`: the idle worker kept, if any
 
 
 def _key(data: bytes, suffix: str, scale: float) -> str:
@@ -81,10 +88,25 @@ def _coacd_version() -> str:
         return "unknown"
 
 
+@contextlib.contextmanager
+def one_worker() -> Iterator[None]:
+    """The scene builds inside share one worker: a build's idle worker is kept for the
+    next (one that is busy, over a budget or stopped is not), and ended with the block."""
+    global _IDLE
+    outer, _IDLE = _IDLE, []
+    try:
+        yield
+    finally:
+        kept, _IDLE = _IDLE, outer
+        for worker in kept:
+            worker.close()
+
+
 class _Worker:
     """One worker process, fed one mesh at a time."""
 
     def __init__(self) -> None:
+        self.busy = False  # a request sent whose whole answer is not read yet
         self.process = subprocess.Popen(
             python_module("ecs_tentacles.terrain.mesh_worker", str(MESH_MEMORY_MB)),
             stdin=subprocess.PIPE,
@@ -122,6 +144,7 @@ class _Worker:
         if not isinstance(self.ready, bytes):  # it did not start
             return self.ready if self.ready.get("over") != "time" else {"over": "crash"}
         request = json.dumps({"suffix": suffix, "scale": scale, "size": len(data), "want": want})
+        self.busy = True
         try:
             self.process.stdin.write(request.encode() + b"\n" + data)
             self.process.stdin.flush()
@@ -143,6 +166,7 @@ class _Worker:
             flat = np.frombuffer(raw, dtype="<f8").reshape(-1, 3)
             cuts = np.cumsum([int(k) for k in sizes])[:-1]
             answer["arrays"] = tuple(np.array(p) for p in np.split(flat, cuts))
+        self.busy = False
         return answer
 
     def _read_until(self, done: object, deadline: float) -> bytes | dict[str, object]:
@@ -176,9 +200,13 @@ class MeshReader(ClosedOnExit):
         self.over: dict[str, str] = {}  # key -> why it went over a budget (this build)
 
     def close(self) -> None:
-        if self.worker is not None:
-            self.worker.close()
-            self.worker = None
+        worker, self.worker = self.worker, None
+        if worker is None:
+            return
+        if _IDLE is not None and not _IDLE and not worker.busy and worker.process.poll() is None:
+            _IDLE.append(worker)  # inside `one_worker()`: the next build's
+        else:
+            worker.close()
 
     def pieces(self, name: str, scale: float, here: JsonPath) -> tuple[np.ndarray, ...]:
         """The convex pieces of mesh file `name` (next to the scene) scaled by `scale`."""
@@ -228,11 +256,12 @@ class MeshReader(ClosedOnExit):
     ) -> dict[str, object] | tuple[str, bool]:
         """The worker's answer, or why there is none and whether that holds for good."""
         if self.worker is None:
-            self.worker = _Worker()
+            self.worker = _IDLE.pop() if _IDLE else _Worker()
         answer = self.worker.ask(want, data, suffix, scale, until - time.monotonic())
         over = answer.get("over") or ("memory" if answer.get("memory") else None)
         if over is not None or self.worker.resident_mb() > MESH_MEMORY_MB / 2:
-            self.close()  # a fresh worker for the next mesh
+            self.worker.close()  # a fresh worker for the next mesh (never kept)
+            self.worker = None
         if over == "time":
             if until >= self.deadline:  # the scene's budget ran out first
                 return self._over_scene(), False

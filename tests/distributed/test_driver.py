@@ -80,6 +80,19 @@ def test_sharded_bake_equals_local_bake_byte_for_byte(
     assert sorted(p.name for p in tmp_path.iterdir()) == ["crowd.json", "local.npz", "ray.npz"]
 
 
+def test_a_bake_that_shows_no_bar_starts_no_actor(
+    cluster: Path, crowd: Path, tmp_path: Path
+) -> None:
+    """The shards count their frames to an actor for the progress bar: a Ray worker
+    process of its own (its start and imports: about a CPU-second). A bake that shows no
+    bar (--quiet, or not on a terminal) started one all the same."""
+    from ray._private import state  # the actors table, the ended ones too (no dashboard)
+
+    before = len(state.actors())
+    assert bake(crowd, tmp_path / "ray.npz", "--ray") == 0
+    assert len(state.actors()) == before
+
+
 def test_a_sharded_bake_on_terrain_equals_the_local_bake(
     cluster: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

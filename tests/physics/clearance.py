@@ -27,20 +27,22 @@ SAMPLES = 9  # points along a link tested against a mantle
 def creature_shapes(world: PhysicsHost, creature_entity: int) -> dict[str, np.ndarray]:
     """The creature's capsules (start, end, radius) and mantle (centre, axis, radius, half)."""
     creature = world.component(creature_entity, Creature)
-    starts, ends, radii = [], [], []
-    for tentacle_entity in creature.tentacles:
-        for link_entity in world.component(tentacle_entity, Tentacle).links:
-            link = world.component(link_entity, Link)
-            pose = world.component(link_entity, Transform)
-            half = quat_rotate(pose.quat, np.array([0.5 * link.length, 0.0, 0.0]))
-            starts.append(pose.pos - half)
-            ends.append(pose.pos + half)
-            radii.append(link.radius)
+    links = [
+        link_entity
+        for tentacle_entity in creature.tentacles
+        for link_entity in world.component(tentacle_entity, Tentacle).links
+    ]
+    shapes = [world.component(e, Link) for e in links]
+    rows = [world.component(e, Transform).row for e in links]
     mantle = world.component(creature_entity, Transform)
+    pos, quat = mantle.store.pos[rows], mantle.store.quat[rows]  # every link at once
+    along = np.zeros((len(links), 3))
+    along[:, 0] = [0.5 * link.length for link in shapes]
+    half = quat_rotate(quat, along) if links else along
     return {
-        "start": np.array(starts).reshape(-1, 3),
-        "end": np.array(ends).reshape(-1, 3),
-        "radius": np.array(radii),
+        "start": pos - half,
+        "end": pos + half,
+        "radius": np.array([link.radius for link in shapes], dtype=np.float64),
         "centre": np.array(mantle.pos),
         "axis": quat_rotate(mantle.quat, np.array([0.0, 0.0, 1.0])),
         "mantle": np.array([creature.mantle_radius, 0.5 * creature.mantle_height]),

@@ -26,7 +26,8 @@ from dataclasses import dataclass
 import numpy as np
 import pytest
 
-from ecs_tentacles.terrain import mesh_cache
+from ecs_tentacles.cli import main
+from ecs_tentacles.terrain import mesh_cache, meshes
 from tests.terrain.test_bounded_inputs import arch
 
 ROCK_SIDE = 0.5  # metres: a convex box, split without CoACD (fast)
@@ -311,3 +312,29 @@ def test_a_good_entry_is_read_back_as_it_was_kept(
     for got, want in zip(back, pieces, strict=True):
         np.testing.assert_array_equal(got, want)
     assert mesh_cache.read("cd" * 32) is None  # absent
+
+
+def test_validate_starts_one_mesh_worker_for_all_its_scenes(
+    tmp_path: pathlib.Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Each scene's build started a worker of its own (its imports: about 1 CPU-second
+    each), also where every entry was cached; now `validate` hands the idle worker from
+    one scene to the next and ends it with the command."""
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    monkeypatch.setattr(meshes, "_KNOWN", {})  # this process has read no mesh yet
+    scenes = [str(rock_scene(tmp_path / f"rock {i}", 0.437 + 0.01 * i)) for i in range(3)]
+    started: list[meshes._Worker] = []
+    start = meshes._Worker.__init__
+
+    def counted(worker: meshes._Worker) -> None:
+        started.append(worker)
+        start(worker)
+
+    monkeypatch.setattr(meshes._Worker, "__init__", counted)
+    for run in ("decomposed", "cached"):
+        assert main(["validate", *scenes]) == 0, run
+        assert len(started) == 1, run
+        assert started[0].process.poll() is not None, run  # ended with the command
+        assert len(entries(tmp_path / "cache")) == 3
+        started.clear()
+        monkeypatch.setattr(meshes, "_KNOWN", {})  # as the next process: read from the cache

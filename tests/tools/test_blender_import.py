@@ -329,9 +329,15 @@ def test_a_rigid_usd_gives_every_capsule_its_creatures_material(
 SKY_SRGB = (206, 219, 231)  # the tool's sky, (0.62, 0.71, 0.80) linear, as 8-bit sRGB
 
 
+@pytest.fixture(scope="module")
+def shore_take(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """rocky_shore, 0.4 s at 30 fps: three creatures on each side of the shore."""
+    return baked("rocky_shore", tmp_path_factory.mktemp("shore") / "shore.npz", 0.4)
+
+
 @pytest.mark.parametrize("suffix", [".glb", ".usdc"])
 def test_a_still_of_the_import_shows_every_creature_in_its_colour_on_the_ground(
-    tmp_path: Path, suffix: str
+    shore_take: Path, tmp_path: Path, suffix: str
 ) -> None:
     """`--render`: a 960x540 PNG, mostly not sky, with the sandbox's creature colours on
     the left and on the right (rocky_shore has three creatures on each side) and the
@@ -340,9 +346,7 @@ def test_a_still_of_the_import_shows_every_creature_in_its_colour_on_the_ground(
 
     from ecs_tentacles.terrain.ground_meshes import COLOURS
 
-    take = tmp_path / "shore.npz"
-    argv = ["bake", "rocky_shore", "--seconds", "0.4", "--fps", "30", "--quiet"]
-    assert main([*argv, "--out", str(take)]) == 0
+    take = shore_take
     out = tmp_path / f"shore{suffix}"
     assert main(["export", str(take), "--out", str(out), "--quiet"]) == 0
     png = tmp_path / "shot.png"
