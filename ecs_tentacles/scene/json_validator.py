@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING, cast
 import numpy as np
 from jsonschema import Draft202012Validator, ValidationError, _keywords, validators
 
-from ecs_tentacles.scene.plain_pass import ecma_pattern, passes_check
+from ecs_tentacles.scene.plain_pass import LONG_NUMBERS, ecma_pattern, passes_check
 
 if TYPE_CHECKING:  # the class `validators.create` makes (the stubs' name; none at run time)
     from jsonschema.validators import _Validator
@@ -49,7 +49,7 @@ def _pattern(
 
 # the stubs say None:
 _STANDARD_ITEMS = cast("Callable[..., Iterator[ValidationError]]", _keywords.items)
-FAST_ITEMS = 64  # arrays of numbers at least this long are checked with numpy
+FAST_ITEMS = LONG_NUMBERS  # arrays of numbers at least this long are checked with numpy
 _PLAIN_NUMBER = {"type", "minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum"}
 _PLAIN_NUMBER |= {"description", "default", "title"}
 

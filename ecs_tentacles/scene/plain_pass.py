@@ -29,6 +29,7 @@ Check = Callable[[object], bool]
 # A schema's notes, which say nothing of a value (x-... are ours too):
 NOTES = frozenset({"description", "default", "title", "examples", "$comment", "$schema", "$defs"})
 _BOUNDS = ("minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum")
+LONG_NUMBERS = 64  # arrays of numbers at least this long: the validator's numpy check
 
 
 @functools.lru_cache(maxsize=256)
@@ -151,8 +152,9 @@ def _object_check(schema: dict[str, Any], resolver: Any, base: str) -> Check | N
     if "items" in rules:
         if "prefixItems" in rules:
             return None
-        each = passes_check(rules.pop("items"), resolver)
-        checks.append(_items_check(each))
+        items = rules.pop("items")
+        each = passes_check(items, resolver)
+        checks.append(_items_check(each, long_numbers=_plain_number(items)))
     if {"properties", "required", "additionalProperties"} & rules.keys():
         found = _properties_check(
             rules.pop("properties", {}),
@@ -257,9 +259,24 @@ def _length_check(keyword: str, limit: Any) -> Check:
     return passes
 
 
-def _items_check(each: Check | None) -> Check:
+def _plain_number(schema: object) -> bool:
+    """Whether `schema` is a number's type and bounds only: a long array of such items is
+    left to the validator, which checks it with numpy (`json_validator.FAST_ITEMS`), not
+    with a call per number (a million heights)."""
+    return (
+        isinstance(schema, dict)
+        and schema.get("type") == "number"
+        and all(k in NOTES or k == "type" or k in _BOUNDS for k in schema)
+    )
+
+
+def _items_check(each: Check | None, long_numbers: bool = False) -> Check:
     if each is None:  # an array's items are left to jsonschema
         return lambda value: not isinstance(value, list) or not value
+    if long_numbers:
+        return lambda value: (
+            not isinstance(value, list) or (len(value) < LONG_NUMBERS and all(map(each, value)))
+        )
     return lambda value: not isinstance(value, list) or all(map(each, value))
 
 
