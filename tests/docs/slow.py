@@ -90,10 +90,12 @@ def scratch_copy(folder: Path) -> None:
         check=True,
     ).stdout
     for name in filter(None, listed.decode().split("\0")):
-        source = ROOT / name
-        if source.is_file():  # (not one deleted but not yet committed)
-            (folder / name).parent.mkdir(parents=True, exist_ok=True)
-            shutil.copy2(source, folder / name)
+        source, copy = ROOT / name, folder / name
+        copy.parent.mkdir(parents=True, exist_ok=True)
+        if source.is_symlink():  # a link as a link (ecs_tentacles/assets -> ../assets)
+            copy.symlink_to(os.readlink(source))
+        elif source.is_file():  # (not one deleted but not yet committed)
+            shutil.copy2(source, copy)
 
 
 @contextlib.contextmanager
