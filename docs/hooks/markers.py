@@ -4,6 +4,8 @@
   block (tests/docs/test_examples.py reads the marker); the built page shows why;
 - `<!-- parsed, not run: why -->`: the docs tests check the block's commands without
   running them (tests/docs/parsed.py); the built page says so, and why;
+- `<!-- slow: why -->`: the default tests check the block as a parsed one, and `pytest -m
+  slow tests/docs` runs it as written (tests/docs/slow.py); the built page says so, and why;
 - `<!-- where -->` in a table row whose first cell is a class name in backticks: the
   module that defines the class, found in the package's source when the site is built
   and linked to its API page (the extension-points index), so no module path is written
@@ -22,6 +24,7 @@ from typing import Any
 ROOT = Path(__file__).resolve().parents[2]
 NOT_RUN = re.compile(r"^<!-- not run: (.+?) -->$", flags=re.M)
 PARSED = re.compile(r"^<!-- parsed, not run: (.+?) -->$", flags=re.M)
+SLOW = re.compile(r"^<!-- slow: (.+?) -->$", flags=re.M)
 CHECKED = "how-the-code-blocks-are-checked"  # the heading of docs/about.md that says how
 WHERE = re.compile(r"^(\| `(\w+)` \|[^\n]*?)<!-- where -->", flags=re.M)
 log = logging.getLogger("mkdocs.hooks.markers")
@@ -67,5 +70,8 @@ def on_page_markdown(markdown: str, page: Any, **_: Any) -> str:
     markdown = PARSED.sub(
         lambda m: f"*Checked, not run, by the docs tests ([how]({how})): {m.group(1)}.*\n",
         markdown,
+    )
+    markdown = SLOW.sub(
+        lambda m: f"*Run by the slow docs tests ([how]({how})): {m.group(1)}.*\n", markdown
     )
     return WHERE.sub(lambda m: m.group(1) + where(m.group(2), depth), markdown)

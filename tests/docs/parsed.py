@@ -1,4 +1,5 @@
-"""What a `<!-- parsed, not run: why -->` block of the docs is checked for, without running it.
+"""What a `<!-- parsed, not run: why -->` block of the docs is checked for, without running it
+(and a `<!-- slow: why -->` block, where the slow tier does not run: tests/docs/slow.py).
 
 Each `ecs-tentacles ...` line (and each command of a `&&` chain) is parsed by the
 command line's own parser (`ecs_tentacles.cli.build_parser`), and each `python tools/X.py
@@ -37,12 +38,12 @@ from ecs_tentacles.scene.load import bundled_scene
 ROOT = Path(__file__).resolve().parents[2]
 # commands that are not this project's, by kind (their first words): not checked here
 OTHER_COMMANDS = {
-    "python3 -m venv": "makes a virtual environment; CI (.ci/run) installs into a fresh one",
+    "python3 -m venv": "makes a virtual environment; the slow tier runs the install block",
     ".": "the shell's `source` (activates the virtual environment)",
-    "pip install": "installs the package; CI (.ci/run) installs it the same way",
+    "pip install": "installs the package; the slow tier runs `pip install -e .`, CI the rest",
     "pytest": "the whole suite; CI (.ci/run) runs it",
     "mkdocs build": "the docs build; CI (.ci/run) runs it, warnings as errors",
-    "ray start": "Ray's own command; tests/distributed runs bakes on a local Ray",
+    "ray start": "Ray's own command; tests/distributed and the slow docs tests bake on a local Ray",
     "blender": "Blender's own command; tests/blender_addon runs the add-on in bpy",
 }
 READS = ("scene", "scenes", "take", "source", "levels")  # what a line reads

@@ -7,7 +7,9 @@ blocks parse (packaging snippets: an entry-point group named is the one plugins 
 found in); shell
 blocks run each `ecs-tentacles` command in-process and expect exit 0. A shell block
 preceded by `<!-- parsed, not run: why -->` is checked without running (tests/docs/parsed.py:
-each command parsed by its own parser, the scenes and files it reads found); one preceded
+each command parsed by its own parser, the scenes and files it reads found), and so is one
+preceded by `<!-- slow: why -->`, which `pytest -m slow tests/docs` runs as written in a
+scratch copy, its outputs checked (tests/docs/slow.py); one preceded
 by `<!-- not run: why -->` is not run at all (the built page shows why); a block preceded by
 `<!-- file: NAME -->` (or the tutorial's `<!-- tutorial: NAME -->`) is also written to the
 scratch folder as NAME (its folder made), for the commands after it. `text` blocks are
@@ -34,12 +36,14 @@ from sybil.parsers.markdown import CodeBlockParser
 from ecs_tentacles.cli import main
 from ecs_tentacles.scene.plugins import ENTRY_POINTS
 from tests.docs.parsed import OTHER_COMMANDS, chained, check_block, kind
+from tests.docs.slow import run_block
 
 ROOT = Path(__file__).resolve().parents[2]
 PAGES = sorted((ROOT / "docs").rglob("*.md")) + [ROOT / "README.md"]
 LANGUAGES = ("python", "json", "sh", "toml")  # run; `text` is output shown, not run
 NOT_RUN = re.compile(r"<!-- not run: .+ -->|<!-- tutorial: commands -->")
 PARSED = re.compile(r"<!-- parsed, not run: .+ -->")
+SLOW = re.compile(r"<!-- slow: (.+) -->")  # run by `pytest -m slow tests/docs`, parsed by default
 FILE = re.compile(r"<!-- (?:file|tutorial): (\S+\.\w+) -->")
 FENCE = re.compile(r"^ *```(\w*)$", flags=re.M)
 
@@ -61,6 +65,7 @@ def keep_file(example: Example) -> bool:
     if NOT_RUN.fullmatch(line):
         return False
     assert not PARSED.fullmatch(line), f"{example.path}:{example.line}: only shell is parsed"
+    assert not SLOW.fullmatch(line), f"{example.path}:{example.line}: only shell runs slow"
     named = FILE.fullmatch(line)
     if named:
         path = scratch(example) / named.group(1)
@@ -106,7 +111,7 @@ def commands(text: str) -> list[list[str]]:
 
 def run_sh(example: Example) -> None:
     where = f"{example.path}:{example.line}"
-    if PARSED.fullmatch(marker(example)):
+    if PARSED.fullmatch(marker(example)) or SLOW.fullmatch(marker(example)):
         made: set[str] = example.namespace.setdefault("__made__", set())
         check_block(commands(str(example.parsed)), scratch(example), made, where)
         return
@@ -178,7 +183,30 @@ def test_each_kind_of_command_left_unchecked_is_one_the_docs_show() -> None:
     shown = set()
     for page in PAGES:
         for example in SYBIL.parse(page):
-            if example.region.evaluator is run_sh and PARSED.fullmatch(marker(example)):
+            checked = PARSED.fullmatch(marker(example)) or SLOW.fullmatch(marker(example))
+            if example.region.evaluator is run_sh and checked:
                 lines = commands(str(example.parsed))
                 shown |= {kind(command) for argv in lines for command in chained(argv)}
     assert shown - {None} == set(OTHER_COMMANDS)
+
+
+def slow_blocks() -> list[Any]:
+    """(page, line, the marker's reason, the block's lines) of every `slow:` block."""
+    found = []
+    for page in PAGES:
+        for example in SYBIL.parse(page):
+            said = SLOW.fullmatch(marker(example))
+            if example.region.evaluator is run_sh and said:
+                text = re.sub(r"\\\n\s*", " ", str(example.parsed))
+                lines = [line for line in text.splitlines() if shlex.split(line, comments=True)]
+                where = f"{page_id(page)}:{example.line}"
+                found.append(pytest.param(where, said.group(1), lines, id=where))
+    return found
+
+
+@pytest.mark.slow  # minutes a block: `pytest -m slow tests/docs`
+@pytest.mark.parametrize(("where", "reason", "lines"), slow_blocks())
+def test_the_slow_block_runs(where: str, reason: str, lines: list[str], tmp_path: Path) -> None:
+    """A `<!-- slow: why -->` block runs as written in a scratch copy (tests/docs/slow.py):
+    every line exits 0, and what it writes is there and of its kind."""
+    run_block(lines, reason, where, tmp_path)
