@@ -203,9 +203,24 @@ def _any(checks: list[Check]) -> Check:
     return lambda value: any(check(value) for check in checks)
 
 
+def _within(low: Any, high: Any, above: Any, below: Any) -> Callable[[float], bool]:
+    """Whether a finite number is within the bounds (each None when absent)."""
+
+    def within(value: float) -> bool:
+        return (
+            (low is None or not value < low)
+            and (high is None or not value > high)
+            and (above is None or not value <= above)
+            and (below is None or not value >= below)
+        )
+
+    return within
+
+
 def _number_check(kind: str, low: Any, high: Any, above: Any, below: Any) -> Check:
     """`type` number (finite) or integer (written 8, not 8.0), within its bounds."""
     integer = kind == "integer"
+    within = _within(low, high, above, below)
 
     def passes(value: object) -> bool:
         if isinstance(value, float):
@@ -213,12 +228,7 @@ def _number_check(kind: str, low: Any, high: Any, above: Any, below: Any) -> Che
                 return False
         elif not isinstance(value, int) or isinstance(value, bool):
             return False
-        return (
-            (low is None or not value < low)
-            and (high is None or not value > high)
-            and (above is None or not value <= above)
-            and (below is None or not value >= below)
-        )
+        return within(value)
 
     return passes
 
@@ -226,18 +236,14 @@ def _number_check(kind: str, low: Any, high: Any, above: Any, below: Any) -> Che
 def _bounds_check(low: Any, high: Any, above: Any, below: Any) -> Check:
     """Numeric bounds, which say nothing of a value that is not a number; a number
     that is not finite is left to jsonschema (False)."""
+    within = _within(low, high, above, below)
 
     def passes(value: object) -> bool:
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             return True
         if isinstance(value, float) and not math.isfinite(value):
             return False
-        return (
-            (low is None or not value < low)
-            and (high is None or not value > high)
-            and (above is None or not value <= above)
-            and (below is None or not value >= below)
-        )
+        return within(value)
 
     return passes
 
