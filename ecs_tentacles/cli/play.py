@@ -66,7 +66,8 @@ def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) ->
             "to append, right-click a goal to remove it. Keys: space pause, . step, r reset, "
             "h HUD, f follow, a frame all, tab next tentacle, F12 screenshot, v video, o the"
             " clean view (the editor's overlays hidden: goal paths, selection rings, sucker"
-            " dots, the fur timeline, the metre grid; a game's HUD and banners stay)."
+            " dots, the fur timeline, the metre grid; a game's HUD and banners stay), Ctrl+Q quit"
+            " (Ctrl-C in the terminal too)."
         ),
         # without --focus, the focus follows the camera (render.sandbox)
         parents=parents(SEED, CODE, PHYSICS),

@@ -35,6 +35,7 @@ Call `ecs_tentacles.render.configure(headless=...)` before importing this module
 from __future__ import annotations
 
 import os
+import signal
 import time
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -336,11 +337,20 @@ class Sandbox(SandboxPicture):
 
     # -- running -------------------------------------------------------------------------
     def run(self) -> None:
-        """Open the window and run until it is closed."""
+        """Open the window and run until it is closed (Ctrl+Q, or Ctrl-C in the terminal,
+        closes it as its close button does: a video being recorded is finished)."""
         pyglet.clock.schedule_interval(self.tick, 1 / 240)  # late calls are fine: dt is real
-        pyglet.app.run(1 / DISPLAY_HZ)
+        before = signal.signal(signal.SIGINT, lambda *_: self.quit())
+        try:
+            pyglet.app.run(1 / DISPLAY_HZ)
+        finally:
+            signal.signal(signal.SIGINT, before)
         if self.video is not None:
             self.video.close()
+
+    def quit(self) -> None:
+        """Leave `run` at the end of this frame, as closing the window does."""
+        pyglet.app.exit()
 
     def run_headless(
         self,

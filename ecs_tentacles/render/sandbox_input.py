@@ -10,7 +10,7 @@ and keys too (`Panel.key`). Keys: space pause, . single step, r reset, h HUD,
 f follow, a frame all, Ctrl+A select every creature, Esc select none, Ctrl+Z /
 Ctrl+Shift+Z undo / redo, Ctrl+S save the roster, c skinned / capsules, tab next
 tentacle, F5 / F9 save / restore the state, F12 screenshot, v video, o the clean view
-(the editor's overlays hidden or shown again).
+(the editor's overlays hidden or shown again), Ctrl+Q quit (as closing the window does).
 Reads and writes only through the sandbox.
 """
 
@@ -149,6 +149,8 @@ class SandboxInput:
                 sandbox.scripts.say(True, f"{what}: {label or 'nothing to do'}")
         elif symbol == key.S and ctrl:
             sandbox.save_roster()
+        elif symbol == key.Q and ctrl:
+            sandbox.quit()
         elif symbol == key.ESCAPE:
             sandbox.select(None)
         elif symbol == key.SPACE:

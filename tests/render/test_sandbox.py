@@ -233,3 +233,43 @@ def test_a_goal_click_the_plugins_refuse_is_a_red_line_not_a_crash(
     ok, line = sandbox.scripts.notes[-1]
     assert not ok and line.startswith("click refused: formation: must be one of")
     sandbox.step(1)  # the sandbox goes on
+
+
+def _run_until(sandbox: Any, leave: Callable[[], None], monkeypatch: pytest.MonkeyPatch) -> bool:
+    """Run the sandbox's window loop, `leave()` called 0.3 s in; True when the loop
+    ended by it (not by the 30 s fallback). (pyglet's loop switches its windows' event
+    queue off for good, and a headless window made after that fails: put back after.)"""
+    import pyglet
+
+    monkeypatch.setattr(pyglet.window.Window, "_enable_event_queue", True)
+    fallback = []
+    pyglet.clock.schedule_once(lambda _dt: leave(), 0.3)
+    pyglet.clock.schedule_once(lambda _dt: (fallback.append(1), pyglet.app.exit()), 30)
+    try:
+        sandbox.run()
+    finally:
+        pyglet.clock.unschedule(sandbox.tick)
+    return not fallback
+
+
+def test_ctrl_q_quits_the_window_loop(
+    make_sandbox: Callable[..., Any], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    sandbox = make_sandbox("octopus")
+    ctrl_q = lambda: _event(sandbox, "on_key_press", key.Q, key.MOD_CTRL)  # noqa: E731
+    assert _run_until(sandbox, ctrl_q, monkeypatch)
+    assert sandbox.world.time > 0  # it ran frames before
+
+
+def test_ctrl_c_in_the_terminal_quits_as_closing_does(
+    make_sandbox: Callable[..., Any], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """SIGINT ends the loop cleanly (no KeyboardInterrupt), and the handler that was
+    there before comes back."""
+    import os
+    import signal
+
+    sandbox = make_sandbox("octopus")
+    before = signal.getsignal(signal.SIGINT)
+    assert _run_until(sandbox, lambda: os.kill(os.getpid(), signal.SIGINT), monkeypatch)
+    assert signal.getsignal(signal.SIGINT) is before
