@@ -126,7 +126,10 @@ def _init(address: str | None, cpus: int | None, ours: dict[int, _Handler]) -> N
     try:
         with _empty_working_folder():
             if address:
-                quiet(address)
+                try:
+                    quiet(address)
+                except ConnectionError as error:
+                    raise ConnectionError(f"{error}{_token_hint()}") from None
             else:
                 quiet(num_cpus=cpus)
                 session = ray.get_runtime_context().get_session_name()
@@ -134,6 +137,20 @@ def _init(address: str | None, cpus: int | None, ours: dict[int, _Handler]) -> N
     finally:
         for number, handler in ours.items():  # Ray installs its own: SIGTERM must stay
             signal.signal(number, handler)  # ours (one line, exit 143, Ray shut down)
+
+
+def _token_hint() -> str:
+    """Why a cluster may have refused this bake: Ray (2.60) starts a head with token
+    authentication when `~/.ray/auth_token` exists (a local Ray writes it), and then
+    refuses a client that does not set RAY_AUTH_MODE=token."""
+    if os.environ.get("RAY_AUTH_MODE") == "token":
+        return ""
+    if not (Path.home() / ".ray" / "auth_token").is_file():
+        return ""
+    return (
+        "; if the cluster uses token authentication (a head started where ~/.ray/auth_token"
+        " exists does), run the bake with RAY_AUTH_MODE=token"
+    )
 
 
 @contextlib.contextmanager
