@@ -23,7 +23,9 @@ A `Destinations` entry is a `Travel`: `send(world, creature, point, radius)` (cr
 `stop(world, creature)` (nowhere to go) and `going(world)` (bool per CreatureStore row:
 has somewhere to go). The locomotion plugin adds one (its goals). A system that sends
 creatures declares the store columns that writes as its own writes: `writes =
-DESTINATION_WRITES` (and reads `DESTINATION_READS` to ask `going`).
+DESTINATION_WRITES` (and reads `DESTINATION_READS` to ask `going`). `DestinationSystem`
+is such a system's base: stage `decide`, after `ARRIVALS`, before `DESTINATIONS_READ`,
+those writes (the example plugins' systems and the game modes' are).
 """
 
 from __future__ import annotations
@@ -36,6 +38,7 @@ from ecs_tentacles.behaviour.destinations import (
     Travel,
     travel,
 )
+from ecs_tentacles.system import System
 
 __all__ = [
     "ARRIVALS",
@@ -45,6 +48,7 @@ __all__ = [
     "DESTINATION_WRITES",
     "DangerSource",
     "Dangers",
+    "DestinationSystem",
     "Destinations",
     "Travel",
     "dangers",
@@ -59,3 +63,16 @@ __all__ = [
 DANGERS_MOVED = "dangers_moved"  # the dangers are where they are this frame
 ARRIVALS = "arrivals"  # creatures that reached where they went have let it go
 DESTINATIONS_READ = "destinations_read"  # where creatures go is read for this frame
+
+
+class DestinationSystem(System):
+    """A system that decides where creatures go, through `travel(world).send` / `stop`:
+    in stage `decide`, after the creatures that arrived let their goals go (`ARRIVALS`),
+    before where creatures go is read this frame (`DESTINATIONS_READ`), declaring the
+    columns that writes (`DESTINATION_WRITES`). A subclass sets `name`, its `reads`
+    (with `DESTINATION_READS` to ask `going`) and `process`."""
+
+    stage = "decide"
+    after = (ARRIVALS,)
+    before = (DESTINATIONS_READ,)
+    writes = DESTINATION_WRITES

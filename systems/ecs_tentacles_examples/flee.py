@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ecs_tentacles.behaviour import ARRIVALS, DESTINATION_WRITES, DESTINATIONS_READ, dangers
+from ecs_tentacles.behaviour import DestinationSystem, dangers
 from ecs_tentacles.plugin import Plugin, Problem
 from ecs_tentacles.scene.defaults import plugin_config
 from ecs_tentacles.system import System
@@ -31,16 +31,12 @@ if TYPE_CHECKING:
     from ecs_tentacles.host import Host
 
 
-class Flee(System):
+class Flee(DestinationSystem):
     """Creatures within `distance` of a threat head `run` metres away from it."""
 
     name = "flee"
-    stage = "decide"
-    after = (ARRIVALS,)
-    before = (DESTINATIONS_READ,)
     calls_hooks = True  # the Dangers entries (`behaviour.dangers`)
     reads = ("transforms.pos", "creatures.entity", "creatures.mantle_row")
-    writes = DESTINATION_WRITES
 
     def __init__(self, distance: float, run: float, interval: float, goal_radius: float):
         self.distance = distance

@@ -23,7 +23,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ecs_tentacles.behaviour import ARRIVALS, DESTINATION_WRITES, DESTINATIONS_READ
+from ecs_tentacles.behaviour import DestinationSystem
+from ecs_tentacles.numeric.vectors import unit_rows
 from ecs_tentacles.plugin import Plugin, Problem
 from ecs_tentacles.scene.defaults import plugin_config
 from ecs_tentacles.system import System
@@ -36,22 +37,11 @@ if TYPE_CHECKING:
 CRAWL_SPEED = 0.1  # m/s: a neighbour moving this fast aligns others fully
 
 
-def _unit(vectors: np.ndarray) -> np.ndarray:
-    """Rows scaled to length 1 (zero rows stay zero)."""
-    length = np.linalg.norm(vectors, axis=-1, keepdims=True)
-    unit: np.ndarray = np.divide(vectors, length, out=np.zeros_like(vectors), where=length > 1e-12)
-    return unit
-
-
-class Flock(System):
+class Flock(DestinationSystem):
     """Separation, alignment, cohesion (and seek) over all mantles -> one goal each."""
 
     name = "flock"
-    stage = "decide"
-    after = (ARRIVALS,)
-    before = (DESTINATIONS_READ,)
     reads = ("transforms.pos", "creatures.entity", "creatures.mantle_row")
-    writes = DESTINATION_WRITES
     state_attributes = ("last",)  # positions at the last plan: velocities after a restore
 
     def __init__(self, config: Mapping[str, Any]):
@@ -85,7 +75,7 @@ class Flock(System):
         cohere = np.where(near.any(axis=1)[:, None], (near @ pos) / count - pos, 0.0)
         cohere /= config["radius"]
         toward = config.get("toward")
-        seek = _unit(np.asarray(toward, dtype=float)[None, :2] - pos) if toward else 0 * pos
+        seek = unit_rows(np.asarray(toward, dtype=float)[None, :2] - pos) if toward else 0 * pos
         return np.stack([separate, align, cohere, seek])
 
     def process(self, world: Host, dt: float) -> None:
@@ -98,7 +88,7 @@ class Flock(System):
         self.last = pos
         direction = np.einsum("w,wnk->nk", self.weights, self.steering(pos, vel))
         steer = np.flatnonzero(np.linalg.norm(direction, axis=1) > 1e-6)
-        goals = pos[steer] + self.config["step"] * _unit(direction[steer])
+        goals = pos[steer] + self.config["step"] * unit_rows(direction[steer])
         send_goals(world, steer, goals, self.config["goal_radius"])
 
 

@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ecs_tentacles.behaviour import ARRIVALS, DESTINATION_WRITES, DESTINATIONS_READ, travel
+from ecs_tentacles.behaviour import DestinationSystem, travel
 from ecs_tentacles.components import Creature
 from ecs_tentacles.plugin import Plugin, Problem
 from ecs_tentacles.scene.defaults import plugin_config
@@ -36,20 +36,16 @@ if TYPE_CHECKING:
 KEY = "follow"  # the creature-level scene key
 
 
-class FollowLeader(System):
+class FollowLeader(DestinationSystem):
     """Followers head for a point `gap` metres short of their leader's mantle."""
 
     name = "follow_leader"
-    stage = "decide"
-    after = (ARRIVALS,)
-    before = (DESTINATIONS_READ,)
     reads = (
         "transforms.pos",
         "locomotion.creatures.has_goal",
         "creatures.entity",
         "creatures.mantle_row",
     )
-    writes = DESTINATION_WRITES
 
     def __init__(self, gap: float, interval: float, goal_radius: float):
         self.gap = gap

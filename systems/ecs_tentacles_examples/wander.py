@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ecs_tentacles.behaviour import ARRIVALS, DESTINATION_WRITES, DESTINATIONS_READ, travel
+from ecs_tentacles.behaviour import DestinationSystem, travel
 from ecs_tentacles.creatures.body import creature_rng
 from ecs_tentacles.plugin import Plugin, Problem
 from ecs_tentacles.scene.defaults import plugin_config
@@ -32,20 +32,16 @@ if TYPE_CHECKING:
     from ecs_tentacles.roster_change import RosterChange
 
 
-class Wander(System):
+class Wander(DestinationSystem):
     """Idle creatures get a random goal within `radius` of their mantle."""
 
     name = "wander"
-    stage = "decide"
-    after = (ARRIVALS,)  # goals just reached are gone: those creatures are idle now
-    before = (DESTINATIONS_READ,)
     reads = (
         "locomotion.creatures.has_goal",
         "transforms.pos",
         "creatures.entity",
         "creatures.mantle_row",
     )
-    writes = DESTINATION_WRITES
     state_attributes = ("streams",)  # each creature's generator: snapshots repeat exactly
 
     def __init__(self, radius: float, interval: float, goal_radius: float):

@@ -27,11 +27,11 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ecs_tentacles.behaviour import ARRIVALS, DESTINATION_WRITES, DESTINATIONS_READ, travel
+from ecs_tentacles.behaviour import DestinationSystem, travel
 from ecs_tentacles.herding.fence import Fence
 from ecs_tentacles.herding.game import HerdingGame
 from ecs_tentacles.herding.open_ground import open_goals
-from ecs_tentacles.system import System
+from ecs_tentacles.numeric.vectors import unit_rows
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
@@ -44,21 +44,11 @@ RUN_FLEE = 1.5  # a running predator's flight goals lie this much farther
 TOWARD_FLOCK = 0.15  # how much a fleeing creature bends toward its flock
 
 
-def _unit(vectors: np.ndarray) -> np.ndarray:
-    length = np.linalg.norm(vectors, axis=-1, keepdims=True)
-    unit: np.ndarray = np.divide(vectors, length, out=np.zeros_like(vectors), where=length > 1e-12)
-    return unit
-
-
-class Herd(System):
+class Herd(DestinationSystem):
     """Flee the predator, else graze as a loose flock; goals on open ground."""
 
     name = "herding_herd"
-    stage = "decide"
-    after = (ARRIVALS,)
-    before = (DESTINATIONS_READ,)
     reads = ("transforms.pos", "creatures.entity", "creatures.mantle_row")
-    writes = DESTINATION_WRITES
     state_attributes = ("last",)  # positions at the last plan: velocities after a restore
 
     def __init__(self) -> None:
@@ -93,7 +83,7 @@ class Herd(System):
         push = np.where(gap < APART, APART / np.maximum(gap, 1e-9) - 1, 0.0)
         separate = np.einsum("ij,ijk->ik", push / np.maximum(gap, 1e-9), offset)
         steer = herd["cohesion"] * cohere + herd["alignment"] * align
-        return steer + herd["separation"] * separate, _unit(centre)
+        return steer + herd["separation"] * separate, unit_rows(centre)
 
     def process(self, world: Host, dt: float) -> None:
         if world.frame % self.every:
@@ -119,8 +109,8 @@ class Herd(System):
         moving = fleeing | grazing
         direction = np.where(
             fleeing[:, None],
-            _unit(away) + TOWARD_FLOCK * to_flock,
-            steer + 0.7 * _unit(wander),
+            unit_rows(away) + TOWARD_FLOCK * to_flock,
+            steer + 0.7 * unit_rows(wander),
         )
         metres = np.where(fleeing, herd["flee"] * (RUN_FLEE if game.sprinting else 1.0), 0.0)
         metres = np.where(grazing, herd["graze"], metres)

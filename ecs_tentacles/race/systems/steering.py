@@ -18,16 +18,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ecs_tentacles.behaviour import (
-    ARRIVALS,
-    DESTINATION_READS,
-    DESTINATION_WRITES,
-    DESTINATIONS_READ,
-    travel,
-)
+from ecs_tentacles.behaviour import DESTINATION_READS, DestinationSystem, travel
 from ecs_tentacles.game.modes import PLAYING
 from ecs_tentacles.race.game import RaceGame
-from ecs_tentacles.system import System
 
 if TYPE_CHECKING:
     from ecs_tentacles.host import Host
@@ -36,15 +29,11 @@ WAYPOINT_RADIUS = 0.25  # metres: a waypoint of the runner's path is reached wit
 EVERY = 0.5  # seconds between looks at the rivals
 
 
-class Steering(System):
+class Steering(DestinationSystem):
     """The runner along its path, the rivals to the flag."""
 
     name = "race_steering"
-    stage = "decide"
-    after = (ARRIVALS,)  # a waypoint just reached is let go: send the next
-    before = (DESTINATIONS_READ,)
     reads = ("creatures.entity", *DESTINATION_READS)
-    writes = DESTINATION_WRITES
 
     def process(self, world: Host, dt: float) -> None:
         race = world.resource(RaceGame)
