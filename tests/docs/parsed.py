@@ -38,13 +38,13 @@ from ecs_tentacles.scene.load import bundled_scene
 ROOT = Path(__file__).resolve().parents[2]
 # commands that are not this project's, by kind (their first words): not checked here
 OTHER_COMMANDS = {
-    "python3 -m venv": "makes a virtual environment; the slow tier runs the install block",
+    "python3 -m venv": "makes a virtual environment; the slow tier runs the install blocks",
     ".": "the shell's `source` (activates the virtual environment)",
-    "pip install": "installs the package; the slow tier runs `pip install -e .`, CI the rest",
-    "pytest": "the whole suite; CI (.ci/run) runs it",
-    "mkdocs build": "the docs build; CI (.ci/run) runs it, warnings as errors",
-    "ray start": "Ray's own command; tests/distributed and the slow docs tests bake on a local Ray",
-    "blender": "Blender's own command; tests/blender_addon runs the add-on in bpy",
+    "pip install": "installs the package; the slow tier runs the install blocks",
+    "pytest": "the whole suite; the slow tier runs the block, CI (.ci/run) the same suite",
+    "mkdocs build": "the docs build; the slow tier runs the block, CI (.ci/run) the same build",
+    "ray start": "Ray's own command; the slow tier starts a head and a second node on one machine",
+    "blender": "Blender's own command; the slow tier runs its extension command in bpy",
 }
 READS = ("scene", "scenes", "take", "source", "levels")  # what a line reads
 WRITES = ("out", "screenshot", "video", "render")  # what a line writes

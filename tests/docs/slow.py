@@ -38,7 +38,7 @@ import sys
 import tempfile
 import time
 import zipfile
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import numpy as np
@@ -48,6 +48,7 @@ from PIL import Image
 from ecs_tentacles.distributed.wedge import parse_parameter
 from ecs_tentacles.take.read import read_take
 from tests.docs.parsed import WRITES, chained, parse, tool, values
+from tests.docs.windows import opens_window, run_window, virtual_display
 
 ROOT = Path(__file__).resolve().parents[2]
 BPY = "ECS_TENTACLES_BLENDER_PYTHON"
@@ -61,23 +62,53 @@ def blender_python() -> str:
     return found
 
 
-# (what the line says, what runs, what the block's marker must say for it)
-SUBSTITUTIONS = (
-    (re.compile(r"/path/to/blender\b"), blender_python, "a Python with bpy"),
+# Blender's own `extension` command (`blender --command extension ...`), as Blender runs it:
+# the handler its bundled extensions add-on registers, in Blender as a module
+EXTENSION_COMMAND = (
+    "import sys, bpy; from bl_pkg import bl_extension_cli as cli;"
+    " sys.exit(cli.cli_extension_handler(sys.argv[1:]))"
+)
+
+# (what the line says, what runs in its place (shell words), what the block's marker
+# must say for it)
+SUBSTITUTIONS: tuple[tuple[re.Pattern[str], Callable[[], str], str], ...] = (
     (
-        re.compile(r"^python(?= tools/blender_import\.py)"),
-        blender_python,
+        re.compile(r"/path/to/blender\b"),
+        lambda: shlex.quote(blender_python()),
         "a Python with bpy",
     ),
+    (
+        re.compile(r"^python(?= tools/blender_import\.py)"),
+        lambda: shlex.quote(blender_python()),
+        "a Python with bpy",
+    ),
+    (
+        re.compile(r"^blender --command extension\b"),
+        lambda: f"{shlex.quote(blender_python())} -c {shlex.quote(EXTENSION_COMMAND)}",
+        "Blender's own extension command in a Python with bpy",
+    ),
+    (re.compile(r"\bHEAD_IP\b"), lambda: "127.0.0.1", "HEAD_IP is 127.0.0.1"),
 )
+ON_PATH = "a Python with bpy on the PATH as `blender`"  # the marker's words for that
+WINDOWS = "virtual X display"  # the marker's words for window lines (tests/docs/windows.py)
 
 
 def substituted(line: str, reason: str, where: str) -> str:
     for pattern, replacement, said in SUBSTITUTIONS:
-        if pattern.search(line):
+        while found := pattern.search(line):
             assert said in reason, f"{where}: the marker must say {said!r} to run {line!r}"
-            line = pattern.sub(shlex.quote(replacement()), line)
+            line = line[: found.start()] + replacement() + line[found.end() :]
     return line
+
+
+def blender_on_path(folder: Path, env: dict[str, str]) -> None:
+    """`blender` on the block's PATH: a script that runs the Python with bpy."""
+    where = folder / "bin"
+    where.mkdir()
+    shim = where / "blender"
+    shim.write_text(f'#!/bin/sh\nexec {shlex.quote(blender_python())} "$@"\n')
+    shim.chmod(0o755)
+    env["PATH"] = os.pathsep.join([str(where), env["PATH"]])
 
 
 def scratch_copy(folder: Path) -> None:
@@ -112,6 +143,7 @@ def environment(folder: Path) -> Iterator[dict[str, str]]:
         ECS_TENTACLES_DATA=str(folder / "data"),
         BLENDER_USER_RESOURCES=str(folder / "blender"),
         RAY_TMPDIR=str(ray),
+        PIP_CACHE_DIR=os.environ.get("PIP_CACHE_DIR") or pip_cache(),
         ECS_TENTACLES_DOCS_BLOCK=token,
     )
     env.pop("VIRTUAL_ENV", None)
@@ -122,6 +154,13 @@ def environment(folder: Path) -> Iterator[dict[str, str]]:
     finally:
         end_processes(token)
         shutil.rmtree(ray, ignore_errors=True)
+
+
+def pip_cache() -> str:
+    """pip's own cache folder for this user (the block's HOME is a scratch one: its
+    installs download nothing the user's pip already has)."""
+    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return str(Path(base) / "pip")
 
 
 def processes_with(token: str) -> list[int]:
@@ -153,9 +192,18 @@ def run_block(lines: list[str], reason: str, where: str, folder: Path) -> None:
     """Run the block's `lines` as the module's docstring says, then check their outputs."""
     scratch_copy(folder)
     started = time.time()
-    with environment(folder) as env:
+    with environment(folder) as env, contextlib.ExitStack() as display:
+        if ON_PATH in reason:
+            blender_on_path(folder, env)
         for line in lines:
             command = substituted(line, reason, where)
+            argv = shlex.split(line, comments=True)
+            if opens_window(argv):
+                assert WINDOWS in reason, f"{where}: the marker must say {WINDOWS!r} for {line!r}"
+                if not display._exit_callbacks:  # the block's first window: its X server
+                    env["DISPLAY"] = display.enter_context(virtual_display(env))
+                run_window(command, window_size(argv, folder, where), folder, env, where)
+                continue
             done = subprocess.run(
                 ["bash", "-c", command],
                 cwd=folder,
@@ -168,8 +216,29 @@ def run_block(lines: list[str], reason: str, where: str, folder: Path) -> None:
             said = done.stdout + done.stderr
             assert done.returncode == 0, f"{where}: `{command}` exited {done.returncode}:\n{said}"
             assert "Traceback" not in said, f"{where}: `{command}` printed a traceback:\n{said}"
-            for argv in chained(shlex.split(command, comments=True)):
-                check_outputs(argv, folder, env, started, where)
+            if argv[:4] == ["blender", "--command", "extension", "install-file"]:
+                addon_installed(env, where, line)
+            for words in chained(shlex.split(command, comments=True)):
+                check_outputs(words, folder, env, started, where)
+
+
+def window_size(argv: list[str], folder: Path, where: str) -> tuple[int, int]:
+    """The window's size a `play` line asks for (`--width`, `--height`)."""
+    from ecs_tentacles.cli import build_parser
+
+    with contextlib.chdir(folder):
+        args = parse(build_parser(), argv[1:], where)
+    return args.width, args.height
+
+
+def addon_installed(env: dict[str, str], where: str, line: str) -> None:
+    """The add-on is in the block's Blender user folder, and the preferences were saved."""
+    manifest = Path(env["BLENDER_USER_RESOURCES"]).glob(
+        "extensions/user_default/ecs_tentacles_take/blender_manifest.toml"
+    )
+    assert list(manifest), f"{where}: `{line}` installed no add-on"
+    prefs = list(Path(env["BLENDER_USER_RESOURCES"]).rglob("userpref.blend"))
+    assert prefs, f"{where}: `{line}` saved no preferences"
 
 
 def parser_of(argv: list[str]) -> tuple[object, list[str]] | None:
@@ -194,12 +263,7 @@ def check_outputs(
     with contextlib.chdir(folder):
         args = parse(parser, words, where)  # type: ignore[arg-type]
     if words[:1] == ["blender-addon"] and args.install:
-        manifest = Path(env["BLENDER_USER_RESOURCES"]).glob(
-            "extensions/user_default/ecs_tentacles_take/blender_manifest.toml"
-        )
-        assert list(manifest), f"{where}: `{shlex.join(argv)}` installed no add-on"
-        prefs = list(Path(env["BLENDER_USER_RESOURCES"]).rglob("userpref.blend"))
-        assert prefs, f"{where}: `{shlex.join(argv)}` saved no preferences"
+        addon_installed(env, where, shlex.join(argv))
     for name in values(args, WRITES):
         if "{name}" in name:  # a wedge: one file a variant
             axes = [parse_parameter(text) for text in args.wedge]

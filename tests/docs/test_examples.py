@@ -191,8 +191,10 @@ def test_each_kind_of_command_left_unchecked_is_one_the_docs_show() -> None:
 
 
 def slow_blocks() -> list[Any]:
-    """(page, line, the marker's reason, the block's lines) of every `slow:` block."""
-    found = []
+    """(page, line, the marker's reason, the block's lines) of every `slow:` block; a
+    block whose lines another page already shows (the README's and the handbook's test
+    command) is run once, where it is first found."""
+    found, seen = [], set()
     for page in PAGES:
         for example in SYBIL.parse(page):
             said = SLOW.fullmatch(marker(example))
@@ -200,7 +202,9 @@ def slow_blocks() -> list[Any]:
                 text = re.sub(r"\\\n\s*", " ", str(example.parsed))
                 lines = [line for line in text.splitlines() if shlex.split(line, comments=True)]
                 where = f"{page_id(page)}:{example.line}"
-                found.append(pytest.param(where, said.group(1), lines, id=where))
+                if tuple(lines) not in seen:
+                    seen.add(tuple(lines))
+                    found.append(pytest.param(where, said.group(1), lines, id=where))
     return found
 
 
