@@ -176,17 +176,22 @@ def test_without_the_handler_nothing_is_remembered_or_raised() -> None:
 
 
 @pytest.mark.usefixtures("installed")
-def test_a_stop_swallowed_by_a_c_callback_is_not_committed(tmp_path: Path) -> None:
+def test_a_stop_swallowed_by_a_c_callback_is_not_committed(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     import ctypes
 
     from ecs_tentacles.output.atomic import atomic_output
 
+    swallowed: list[object] = []  # what ctypes could not raise (else pytest's warning)
+    monkeypatch.setattr(sys, "unraisablehook", swallowed.append)
     target = tmp_path / "take.npz"
     with pytest.raises(KeyboardInterrupt), atomic_output(target) as temporary:
         temporary.write_bytes(b"half a take")
         ctypes.CFUNCTYPE(None)(lambda: signal.raise_signal(signal.SIGINT))()  # ignored there
         assert temporary.read_bytes() == b"half a take"  # the writer went on
     assert list(tmp_path.iterdir()) == []
+    assert [type(getattr(u, "exc_value", None)) for u in swallowed] == [KeyboardInterrupt]
 
 
 BLOCKER = """
