@@ -7,20 +7,26 @@ a line writes lands in that folder, never in the repository
 (`--render assets/screenshots/...` overwrites the copy). `ecs-tentacles`, `python`,
 `ray` and `pip` are the test's own environment's; HOME, the data folders, Blender's user
 folder (`BLENDER_USER_RESOURCES`) and Ray's (`RAY_TMPDIR`: no other Ray on the machine
-joins this one) are in the scratch folder.
+joins this one) are in the scratch folder; pip's download cache is the user's.
 
 Each line must exit 0 and print no traceback. Then what it wrote is checked (the
 outputs its parser names: `--out`, `--screenshot`, `--video`, `--render`): there and
 not empty, and a file of its kind: a PNG an image of the size asked for, a USD a stage
 pxr opens with the frames in it, a take a take the package reads, a glb, a .blend, an
 MP4, a zip, JSON. A wedge's `{name}` output is one file a variant; `blender-addon
---install` leaves the add-on enabled in the scratch Blender user folder.
+--install` and Blender's `extension install-file` leave the add-on enabled in the
+scratch Blender user folder. A line that opens the sandbox's window (`play` without
+`--headless`) runs on an X server of the block's own (tests/docs/windows.py).
 
 The only words changed before a line runs are the ones `SUBSTITUTIONS` names, each
 only where the block's marker says so: `/path/to/blender` and the `python` that runs
 `tools/blender_import.py` are a Python with bpy 5.0.1 (`ECS_TENTACLES_BLENDER_PYTHON`;
-skipped where it is not set). The processes a block leaves behind (a local Ray's) are
-ended by their ids: those whose environment holds the block's own token.
+skipped where it is not set); `blender --command extension` is Blender's own handler of
+that command run in that Python; `HEAD_IP` (a Ray cluster's head) is 127.0.0.1. Where
+the marker says "a Python with bpy on the PATH as `blender`", the block's PATH has a
+`blender` that runs that Python. A block that two pages show runs once. The processes a
+block leaves behind (a local Ray's, a Ray cluster's, the X server) are ended by their
+ids: those whose environment holds the block's own token.
 """
 
 from __future__ import annotations
