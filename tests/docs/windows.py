@@ -71,6 +71,23 @@ def xdotool(env: dict[str, str], *words: str, timeout: float = 30) -> str:
     return done.stdout
 
 
+def shown_window(process: subprocess.Popen[bytes], env: dict[str, str], what: str,
+                 log: Path) -> str:  # fmt: skip
+    """The id of the sandbox's window once it shows; fails (with what the line printed)
+    if the line ends first or the window takes over `SHOWN` seconds."""
+    deadline = time.monotonic() + SHOWN
+    while time.monotonic() < deadline:
+        assert process.poll() is None, f"{what} ended before its window showed:\n{log.read_text()}"
+        found = subprocess.run(
+            ["xdotool", "search", "--onlyvisible", "--name", f"^{CAPTION}$"],
+            env=env, capture_output=True, text=True, timeout=30, check=False,
+        )  # fmt: skip
+        if found.stdout.split():
+            return found.stdout.split()[0]
+        time.sleep(0.5)
+    raise AssertionError(f"{what}: no window in {SHOWN} s:\n{log.read_text()}")
+
+
 def run_window(command: str, size: tuple[int, int], folder: Path, env: dict[str, str],
                where: str) -> None:  # fmt: skip
     """Run a window line as the module's docstring says, and check what it left."""
@@ -82,9 +99,7 @@ def run_window(command: str, size: tuple[int, int], folder: Path, env: dict[str,
             ["bash", "-c", command], cwd=folder, env=env, stdout=out, stderr=subprocess.STDOUT
         )
     try:
-        found = xdotool(env, "search", "--sync", "--onlyvisible", "--name", f"^{CAPTION}$",
-                        timeout=SHOWN)  # fmt: skip
-        window = found.split()[0]
+        window = shown_window(process, env, f"{where}: `{command}`", log)
         time.sleep(PLAYING)
         assert process.poll() is None, f"{where}: `{command}` ended by itself:\n{log.read_text()}"
         xdotool(env, "key", "--window", window, "F12")
