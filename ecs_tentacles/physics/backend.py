@@ -14,7 +14,7 @@ glibc's thresholds (`ecs_tentacles.physics.heap`): the frames' numpy temporaries
 leave a long run growing.
 
 `state()` / `set_state()` copy everything that decides how the physics steps on
-(every batch's state rows and forces, the health check's memory, the sleep counters,
+(every batch's state rows and forces: `physics.batch_state`; the health check's memory, the sleep counters,
 the per-creature flags, the clock): `ecs_tentacles.snapshot` saves and restores the
 physics through them alone. The backend sees a world as `PhysicsHost` (`physics.host`).
 """
@@ -33,16 +33,17 @@ import numpy as np
 
 from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.numeric.optional_kernels import OptionalKernels
-from ecs_tentacles.physics import heap
+from ecs_tentacles.physics import batch_state, heap
 from ecs_tentacles.physics.bare import BareFrame, step_captured
 from ecs_tentacles.physics.batch import Batch
+from ecs_tentacles.physics.batch_state import BatchState
 from ecs_tentacles.physics.blas import quiet_blas
 from ecs_tentacles.physics.health import SOFT_GAIN, HealthCheck, HealthState
 from ecs_tentacles.physics.lod import LevelOfDetail
 from ecs_tentacles.physics.membership import Membership, compile_models
 from ecs_tentacles.physics.messages import route_mujoco_messages
 from ecs_tentacles.physics.model import ModelLayout, model_layout
-from ecs_tentacles.physics.placing import PlacingState, place_stepped
+from ecs_tentacles.physics.placing import place_stepped
 from ecs_tentacles.physics.proxies import ContactProxies
 from ecs_tentacles.physics.roster import Roster
 from ecs_tentacles.physics.rounds import Ready, Rounds
@@ -65,11 +66,7 @@ class PhysicsState:
     """The whole physics between frames (`PhysicsBackend.state()`); opaque to callers."""
 
     time: float
-    states: list[np.ndarray]  # per batch: its state rows
-    poses: list[tuple[np.ndarray, np.ndarray]]  # per batch: xpos, xquat after the last step
-    reduced: list[tuple[np.ndarray, ...]]  # per batch: rslot, rstate, rsource (REDUCED rows)
-    placing: list[PlacingState]  # per batch: the rows not placed yet (`physics.placing`)
-    applied: list[dict[int, np.ndarray]]  # per batch: forces scripts apply
+    batches: list[BatchState]  # per batch (`physics.batch_state`)
     frozen: np.ndarray
     sleeping: np.ndarray
     soften: np.ndarray
@@ -166,11 +163,7 @@ class PhysicsBackend(Membership):
         """A copy of the physics' state: restoring it steps on bit-identically."""
         return PhysicsState(
             time=self.time,
-            states=[b.state.copy() for b in self.batches],
-            poses=[b.all_poses() for b in self.batches],  # the replayed ones as shown
-            reduced=[(b.rslot.copy(), b.rstate.copy(), b.rsource.copy()) for b in self.batches],
-            placing=[b.placing_state() for b in self.batches],
-            applied=[{r: f.copy() for r, f in b.applied.items()} for b in self.batches],
+            batches=[batch_state.saved(b) for b in self.batches],
             frozen=self.frozen.copy(),
             sleeping=self.sleeping.copy(),
             soften=self.soften.copy(),
@@ -182,12 +175,12 @@ class PhysicsBackend(Membership):
 
     def state_problem(self, state: PhysicsState) -> str | None:
         """Why `set_state(state)` would not fit this backend (one line), or None."""
-        later = self.batches[len(state.states) :]  # models compiled since for spawns
-        if len(state.states) > len(self.batches) or any(len(b) for b in later):
-            return f"{len(state.states)} physics batches, here {len(self.batches)}"
-        for batch, rows, (xpos, _) in zip(self.batches, state.states, state.poses, strict=False):
-            if rows.shape != batch.state.shape or xpos.shape != batch.xpos.shape:
-                return f"batch {batch.index}: state {rows.shape}, here {batch.state.shape}"
+        later = self.batches[len(state.batches) :]  # models compiled since for spawns
+        if len(state.batches) > len(self.batches) or any(len(b) for b in later):
+            return f"{len(state.batches)} physics batches, here {len(self.batches)}"
+        for batch, saved in zip(self.batches, state.batches, strict=False):
+            if (problem := batch_state.problem(batch, saved)) is not None:
+                return problem
         if state.tier.shape != self.tier.shape:
             return f"{len(state.tier)} creatures, here {len(self.tier)}"
         return None
@@ -198,24 +191,8 @@ class PhysicsBackend(Membership):
         Warnings counted since and a pending fatal error are dropped: neither is state.
         """
         self.time = state.time
-        for batch, rows, (xpos, xquat), (rslot, rstate, rsource), applied, placing in zip(
-            self.batches,
-            state.states,
-            state.poses,
-            state.reduced,
-            state.applied,
-            state.placing,
-            strict=False,
-        ):  # batches compiled since are empty (`state_problem`)
-            batch.set_rows(rows, xpos, xquat, placing)
-            batch.show(None, None)  # every row's poses as saved, replayed ones too
-            if rstate.shape[1] == batch.rstate.shape[1]:
-                batch.rslot[:], batch.rstate, batch.rsource = rslot, rstate.copy(), rsource.copy()
-            else:  # compiled since: no row was REDUCED then; each fits on its first step
-                batch.release_reduced(np.arange(len(batch)))
-            batch.applied = {r: f.copy() for r, f in applied.items()}
-            batch.warnings[:] = 0
-            batch.errors.clear()
+        for batch, saved in zip(self.batches, state.batches, strict=False):
+            batch_state.restore(batch, saved)  # (batches compiled since are empty)
         self.frozen[:], self.sleeping[:] = state.frozen, state.sleeping
         self.soften[:], self.tier[:] = state.soften, state.tier
         self.lod.set_state(state.lod)

@@ -114,7 +114,7 @@ def test_a_snapshot_keeps_the_replayed_poses_as_shown(make_world: Callable[..., 
     world.step(20)
     (batch,) = world.physics.batches
     saved = take(world)
-    kept = saved.physics.poses[0]
+    kept = saved.physics.batches[0].poses
     rows = np.flatnonzero(world.physics.tier[batch.members] == KINEMATIC)
     assert len(rows) >= 3
     assert_array_equal(kept[0][rows], world.transforms.pos[batch.body_rows[rows]])
