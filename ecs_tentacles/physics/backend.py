@@ -14,9 +14,10 @@ glibc's thresholds (`ecs_tentacles.physics.heap`): the frames' numpy temporaries
 leave a long run growing.
 
 `state()` / `set_state()` copy everything that decides how the physics steps on
-(every batch's state rows and forces: `physics.batch_state`; the health check's memory, the sleep counters,
-the per-creature flags, the clock): `ecs_tentacles.snapshot` saves and restores the
-physics through them alone. The backend sees a world as `PhysicsHost` (`physics.host`).
+(every batch's state rows and forces: `physics.batch_state`; the health check's memory,
+the sleep counters, the per-creature flags, the clock): `ecs_tentacles.snapshot` saves
+and restores the physics through them alone. The backend sees a world as `PhysicsHost`
+(`physics.host`).
 """
 
 from __future__ import annotations
