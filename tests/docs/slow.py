@@ -154,6 +154,7 @@ def environment(folder: Path) -> Iterator[dict[str, str]]:
     )
     env.pop("VIRTUAL_ENV", None)
     env.pop("RAY_ADDRESS", None)
+    env.pop("DISPLAY", None)  # a window line gets an X server of the block's own
     (folder / "home").mkdir()
     try:
         yield env
@@ -206,7 +207,7 @@ def run_block(lines: list[str], reason: str, where: str, folder: Path) -> None:
             argv = shlex.split(line, comments=True)
             if opens_window(argv):
                 assert WINDOWS in reason, f"{where}: the marker must say {WINDOWS!r} for {line!r}"
-                if not display._exit_callbacks:  # the block's first window: its X server
+                if "DISPLAY" not in env:  # the block's first window: its X server
                     env["DISPLAY"] = display.enter_context(virtual_display(env))
                 run_window(command, window_size(argv, folder, where), folder, env, where)
                 continue
