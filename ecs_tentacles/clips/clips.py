@@ -25,6 +25,7 @@ writes only the caller's `out` arrays.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -45,6 +46,8 @@ if TYPE_CHECKING:
     from ecs_tentacles.physics.posed_spheres import PosedSpheres
 
 IDLE, CRAWL = 0, 1
+# `PhysicsBackend.share`: work(start, stop) over count items, in parts on its threads
+Share = Callable[[int, Callable[[int, int], None]], None]
 KINDS = ("idle", "crawl")
 WARMUP = 2.0  # s before recording: the creature settles, the gait is established
 RECORD = 8.0  # s recorded, the loop chosen inside
@@ -163,6 +166,7 @@ class GaitClips:
         rows: np.ndarray | None = None,
         body_rows: np.ndarray | None = None,
         spheres: tuple[PosedSpheres, np.ndarray] | None = None,
+        share: Share | None = None,
     ) -> None:
         """Body poses of K creatures into `out_pos` (K, B, 3) and `out_quat` (K, B, 4),
         or into their rows `rows` (K,) of larger (N, B, .) arrays (a batch's poses), or,
@@ -178,6 +182,10 @@ class GaitClips:
         `spheres` (the contact proxies' `PosedSpheres` and each creature's roster index,
         (K,)): their reach spheres as well, found as the poses are written, where the
         kernels run (the numpy path leaves them unknown).
+
+        `share(K, work)` runs `work(start, stop)` over the creatures in parts, each
+        part's poses by the kernel on its own thread (`PhysicsBackend.share`): the
+        same numbers, a creature's poses depend on nothing but its own inputs.
         """
         kind = np.asarray(kind, dtype=np.int64)
         phase = np.asarray(phase, dtype=np.float64)
@@ -194,13 +202,22 @@ class GaitClips:
             reach = (_NONE, _NO_BOUNDS, _NO_CENTRES, _NO_BOUNDS) if known is None else (
                 known.start, known.rbound, known.centre, known.radius)  # fmt: skip
             of = np.asarray(of, dtype=np.int64)
-            if body_rows is None:
-                fast.place(self._pose, self._change, row, fraction, interpolate, where, turn,
-                           into, out_pos, out_quat, of, *reach)  # fmt: skip
+
+            def part(start: int, stop: int) -> None:
+                k = slice(start, stop)
+                mine = (row[k], fraction[k], interpolate, where[k], turn[k], into[k])
+                found = of[k] if len(of) else of
+                if body_rows is None:
+                    fast.place(self._pose, self._change, *mine, out_pos, out_quat, found,
+                               *reach)  # fmt: skip
+                else:
+                    fast.place_scattered(self._pose, self._change, *mine, body_rows, out_pos,
+                                         out_quat, found, *reach)  # fmt: skip
+
+            if share is None:
+                part(0, len(kind))
             else:
-                fast.place_scattered(self._pose, self._change, row, fraction, interpolate,
-                                     where, turn, into, body_rows, out_pos, out_quat, of,
-                                     *reach)  # fmt: skip
+                share(len(kind), part)
             if known is not None:
                 known.known[of] = True
             return

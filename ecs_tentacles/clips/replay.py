@@ -215,14 +215,15 @@ class ClipReplay:
                            interpolate=interpolate, rows=rows)  # fmt: skip
             batch.show(transforms, None)
             return
+        share = self.world.physics.share  # large crowds' poses on the stepping threads
         if batch.body_span() is not None:  # a uniform crowd's batch: its store rows as rows
             pos, quat = batch.store_rows(transforms)
             clips.evaluate(kind, phase, xy, heading, pos, quat, interpolate=interpolate,
-                           rows=rows, spheres=spheres)  # fmt: skip
+                           rows=rows, spheres=spheres, share=share)  # fmt: skip
         else:
             clips.evaluate(kind, phase, xy, heading, transforms.pos, transforms.quat,
-                           interpolate=interpolate, rows=rows,
-                           body_rows=batch.body_rows, spheres=spheres)  # fmt: skip
+                           interpolate=interpolate, rows=rows, body_rows=batch.body_rows,
+                           spheres=spheres, share=share)  # fmt: skip
         batch.show(transforms, rows)
 
     # -- snapshots -------------------------------------------------------------------------

@@ -34,7 +34,7 @@ import numpy as np
 
 from ecs_tentacles.components import Creature, Transform
 from ecs_tentacles.numeric.optional_kernels import OptionalKernels
-from ecs_tentacles.physics import batch_state, heap
+from ecs_tentacles.physics import batch_state, heap, stepping
 from ecs_tentacles.physics.bare import BareFrame, step_captured
 from ecs_tentacles.physics.batch import Batch
 from ecs_tentacles.physics.batch_state import BatchState
@@ -387,6 +387,14 @@ class PhysicsBackend(Membership):
         finally:
             for future in futures:
                 future.result()
+
+    def share(
+        self, count: int, work: Callable[[int, int], None], least: int = stepping.SHARE_LEAST
+    ) -> None:
+        """`work(start, stop)` over items [0, count) shared by the stepping threads, the
+        same result as `work(0, count)` (`physics.stepping.share`: nogil work between
+        steps whose items are independent)."""
+        stepping.share(self._pool, self.threads, count, work, least)
 
     def step_bare(self, frame: BareFrame, substeps: int) -> None:
         """Step `frame`'s rows (captured by `physics.bare.FrameCapture`) with MuJoCo alone on

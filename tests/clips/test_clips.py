@@ -239,3 +239,34 @@ def test_poses_written_into_rows_of_a_batch_array_are_the_poses_evaluated(
     np.testing.assert_array_equal(store_pos[body_rows[rows]], pos)
     np.testing.assert_array_equal(store_quat[body_rows[rows]], quat)
     assert (store_pos[body_rows[others]] == 7.0).all()
+
+
+@pytest.mark.parametrize("scattered", [False, True])
+def test_poses_shared_by_threads_are_the_same_bits(clips: GaitClips, scattered: bool) -> None:
+    """The replay's poses and reach spheres written in parts on the stepping threads
+    (`PhysicsBackend.share`) are those of one call, bit for bit."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from ecs_tentacles.physics.posed_spheres import PosedSpheres
+    from ecs_tentacles.physics.stepping import share
+
+    rng = np.random.default_rng(7)
+    count, bodies, rows_all = 700, len(clips.bodies), 900
+    kind, phase = rng.integers(0, 2, count), rng.uniform(-5.0, 90.0, count)
+    xy, heading = rng.uniform(-9.0, 9.0, (count, 2)), rng.uniform(-4.0, 4.0, count)
+    rows = rng.permutation(rows_all)[:count]
+    body_rows = rng.permutation(rows_all * bodies).reshape(rows_all, bodies) if scattered else None
+    shape = (rows_all * bodies,) if scattered else (rows_all, bodies)
+    of = rng.permutation(count)  # each creature's roster index
+    rbound = rng.uniform(0.01, 0.1, count * bodies)
+    written = []
+    with ThreadPoolExecutor(3) as pool:
+        for shared in (None, lambda n, work: share(pool, 3, n, work, least=50)):
+            pos, quat = np.full((*shape, 3), 7.0), np.full((*shape, 4), 7.0)
+            spheres = PosedSpheres.empty(np.arange(count) * bodies, rbound)
+            clips.evaluate(kind, phase, xy, heading, pos, quat, rows=rows, body_rows=body_rows,
+                           spheres=(spheres, of), share=shared)  # fmt: skip
+            written.append((pos, quat, spheres.centre, spheres.radius, spheres.known))
+    for one, parts in zip(*written, strict=True):
+        np.testing.assert_array_equal(parts, one)
+    assert written[1][4].all()

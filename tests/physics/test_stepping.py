@@ -74,3 +74,41 @@ def test_reduced_rows_keep_their_step_time_apart(make_world: Callable[..., World
     world.step(1)
     after = batch.step_cost[rows, REDUCED]
     assert (after > 0.0).all() and (after != before).all() and (after > 0.75 * before).all()
+
+
+def test_shared_work_covers_every_item_once_one_part_a_thread() -> None:
+    import threading
+    from concurrent.futures import ThreadPoolExecutor
+
+    from ecs_tentacles.physics.stepping import share
+
+    parts: list[tuple[int, int, int]] = []
+    lock = threading.Lock()
+    both = threading.Barrier(3, timeout=10)  # all three parts run at once, or this fails
+
+    def work(start: int, stop: int) -> None:
+        both.wait()
+        with lock:
+            parts.append((start, stop, threading.get_ident()))
+
+    with ThreadPoolExecutor(3) as pool:
+        share(pool, 3, 1000, work, least=100)
+        assert sorted((a, b) for a, b, _ in parts) == [(0, 333), (333, 666), (666, 1000)]
+        assert len({thread for *_, thread in parts}) == 3
+        assert threading.get_ident() in {thread for *_, thread in parts}  # the caller took one
+
+        parts.clear()
+        share(pool, 3, 199, lambda a, b: parts.append((a, b, threading.get_ident())), least=100)
+        assert parts == [(0, 199, threading.get_ident())]  # too few for two parts: one call here
+        parts.clear()
+        share(pool, 3, 0, lambda a, b: parts.append((a, b, 0)), least=1)
+        assert parts == []
+
+        def fails(start: int, stop: int) -> None:
+            if start:
+                raise ValueError(f"part {start}")
+
+        with pytest.raises(ValueError, match="part 500"):
+            share(pool, 2, 1000, fails, least=1)
+    share(None, 2, 1000, lambda a, b: parts.append((a, b, 0)), least=1)  # no pool: one call
+    assert parts == [(0, 1000, 0)]
