@@ -388,13 +388,12 @@ class PhysicsBackend(Membership):
             for future in futures:
                 future.result()
 
-    def share(
-        self, count: int, work: Callable[[int, int], None], least: int = stepping.SHARE_LEAST
-    ) -> None:
+    def share(self, count: int, work: Callable[[int, int], None], least: int | None = None) -> None:
         """`work(start, stop)` over items [0, count) shared by the stepping threads, the
         same result as `work(0, count)` (`physics.stepping.share`: nogil work between
-        steps whose items are independent)."""
-        stepping.share(self._pool, self.threads, count, work, least)
+        steps whose items are independent; chunks of `least` or `SHARE_LEAST` items)."""
+        chunk = stepping.SHARE_LEAST if least is None else least
+        stepping.share(self._pool, self.threads, count, work, chunk)
 
     def step_bare(self, frame: BareFrame, substeps: int) -> None:
         """Step `frame`'s rows (captured by `physics.bare.FrameCapture`) with MuJoCo alone on

@@ -16,6 +16,7 @@ share a scratch MjData; which thread steps a row never changes its result
 from __future__ import annotations
 
 import bisect
+import itertools
 import threading
 from collections.abc import Callable
 from concurrent.futures import Executor
@@ -122,9 +123,13 @@ def step_segments(work: Work, substeps: dict[int, int], thread: int) -> None:
             segment.batch.step_rows(segment.rows, n, thread, segment.tier)
 
 
-# `share`'s least items a thread: a part handed to the pool costs some 20-50 us, and a
-# replayed creature's pose ~0.6 us (`clips.kernels.place`, 81 bodies)
-SHARE_LEAST = 256
+# `share`'s least items a chunk: replayed creatures' poses (`clips.kernels.place`, about
+# 0.6 us each) gain from a second thread only in large crowds. 10,000 replayed, 2 threads
+# (ms a frame, two runs each): quiet 5.7-5.8 -> 3.4-3.6; two busy processes beside it
+# 7.2-9.2 -> 8.1-8.9. 890 (1,024 creatures) in chunks of 297 gained 0.1 ms when quiet
+# (0.57-0.61 -> 0.47-0.49) and lost 0.4 beside the busy processes (0.60 -> 0.98): not shared.
+SHARE_LEAST = 1000
+SHARE_CHUNKS = 4  # chunks a thread at most: a thread that gets no core holds up one chunk
 
 
 def share(
@@ -134,20 +139,31 @@ def share(
     work: Callable[[int, int], None],
     least: int = SHARE_LEAST,
 ) -> None:
-    """`work(start, stop)` over items [0, count) in one contiguous part a thread (this
-    thread takes the first part, `pool`'s threads the others), for work between steps
-    whose items are independent and which releases the interpreter's lock (a numba
-    ``nogil`` kernel): the same result as `work(0, count)`. Parts of fewer than `least`
-    items are not worth a thread: one call on this thread."""
-    parts = min(threads, count // max(least, 1))
-    if pool is None or parts < 2:
+    """`work(start, stop)` over items [0, count) in contiguous chunks taken in turn by
+    this thread and `threads - 1` of `pool`'s, for work between steps whose items are
+    independent and which releases the interpreter's lock (a numba ``nogil`` kernel):
+    the same result as `work(0, count)`, whoever does which chunk.
+
+    Chunks are taken, not dealt: on a loaded machine a pool thread that gets no core
+    takes nothing (this thread does every chunk, and a helper not started by then is
+    cancelled), or holds up the end by the one chunk it took. Halves dealt out made a
+    1,024 crowd's replay 3.7 -> 12.2 ms a frame at load 7. Chunks of at least `least`
+    items (fewer: one call on this thread)."""
+    chunks = min(max(threads, 1) * SHARE_CHUNKS, count // max(least, 1))
+    if pool is None or threads < 2 or chunks < 2:
         if count:
             work(0, count)
         return
-    ends = [count * k // parts for k in range(parts + 1)]
-    futures = [pool.submit(work, ends[k], ends[k + 1]) for k in range(1, parts)]
+    taken = itertools.count()  # (its `next` is atomic: one C call under the GIL)
+
+    def take_chunks() -> None:
+        while (k := next(taken)) < chunks:
+            work(k * count // chunks, (k + 1) * count // chunks)  # `least` items or more
+
+    helpers = [pool.submit(take_chunks) for _ in range(min(threads, chunks) - 1)]
     try:
-        work(ends[0], ends[1])
+        take_chunks()
     finally:
-        for future in futures:
-            future.result()
+        for helper in helpers:
+            if not helper.cancel():  # started: wait for the chunk it is on
+                helper.result()

@@ -76,39 +76,61 @@ def test_reduced_rows_keep_their_step_time_apart(make_world: Callable[..., World
     assert (after > 0.0).all() and (after != before).all() and (after > 0.75 * before).all()
 
 
-def test_shared_work_covers_every_item_once_one_part_a_thread() -> None:
+def test_shared_work_covers_every_item_once_in_chunks_taken_by_the_threads() -> None:
     import threading
     from concurrent.futures import ThreadPoolExecutor
 
     from ecs_tentacles.physics.stepping import share
 
-    parts: list[tuple[int, int, int]] = []
+    chunks: list[tuple[int, int, int]] = []
     lock = threading.Lock()
-    both = threading.Barrier(3, timeout=10)  # all three parts run at once, or this fails
+    both = threading.Barrier(2, timeout=10)  # the first two chunks: two threads, or this fails
 
     def work(start: int, stop: int) -> None:
-        both.wait()
         with lock:
-            parts.append((start, stop, threading.get_ident()))
+            chunks.append((start, stop, threading.get_ident()))
+            first_two = len(chunks) <= 2
+        if first_two:
+            both.wait()
 
-    with ThreadPoolExecutor(3) as pool:
-        share(pool, 3, 1000, work, least=100)
-        assert sorted((a, b) for a, b, _ in parts) == [(0, 333), (333, 666), (666, 1000)]
-        assert len({thread for *_, thread in parts}) == 3
-        assert threading.get_ident() in {thread for *_, thread in parts}  # the caller took one
+    with ThreadPoolExecutor(2) as pool:
+        share(pool, 2, 1000, work, least=100)  # 125 a chunk: 8 chunks for 2 threads
+        assert sorted((a, b) for a, b, _ in chunks) == [(k, k + 125) for k in range(0, 1000, 125)]
+        assert len({thread for *_, thread in chunks}) == 2
 
-        parts.clear()
-        share(pool, 3, 199, lambda a, b: parts.append((a, b, threading.get_ident())), least=100)
-        assert parts == [(0, 199, threading.get_ident())]  # too few for two parts: one call here
-        parts.clear()
-        share(pool, 3, 0, lambda a, b: parts.append((a, b, 0)), least=1)
-        assert parts == []
+        chunks.clear()
+        share(pool, 2, 199, lambda a, b: chunks.append((a, b, threading.get_ident())), least=100)
+        assert chunks == [(0, 199, threading.get_ident())]  # too few for two chunks: one call
+        chunks.clear()
+        share(pool, 2, 0, lambda a, b: chunks.append((a, b, 0)), least=1)
+        assert chunks == []
 
         def fails(start: int, stop: int) -> None:
-            if start:
-                raise ValueError(f"part {start}")
+            if start == 500:
+                raise ValueError(f"chunk {start}")
 
-        with pytest.raises(ValueError, match="part 500"):
+        with pytest.raises(ValueError, match="chunk 500"):
             share(pool, 2, 1000, fails, least=1)
-    share(None, 2, 1000, lambda a, b: parts.append((a, b, 0)), least=1)  # no pool: one call
-    assert parts == [(0, 1000, 0)]
+    share(None, 2, 1000, lambda a, b: chunks.append((a, b, 0)), least=1)  # no pool: one call
+    assert chunks == [(0, 1000, 0)]
+
+
+def test_shared_work_does_not_wait_for_a_thread_that_never_starts() -> None:
+    """A loaded machine: the pool's thread is busy (here with another task) for longer
+    than the work takes; this thread does every chunk and returns without waiting."""
+    import threading
+    from concurrent.futures import ThreadPoolExecutor
+
+    from ecs_tentacles.physics.stepping import share
+
+    release = threading.Event()
+    done: list[tuple[int, int, int]] = []
+    with ThreadPoolExecutor(1) as pool:
+        busy = pool.submit(release.wait, 30)
+        try:
+            share(pool, 2, 1000, lambda a, b: done.append((a, b, threading.get_ident())), 100)
+            assert not busy.done()  # returned while the pool's thread was still held
+        finally:
+            release.set()
+    assert sorted((a, b) for a, b, _ in done) == [(k, k + 125) for k in range(0, 1000, 125)]
+    assert {thread for *_, thread in done} == {threading.get_ident()}
