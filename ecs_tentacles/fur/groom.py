@@ -20,6 +20,7 @@ import numpy as np
 from ecs_tentacles.numeric.quaternions import cross
 
 FLOWS = {"rear": (-1.0, 0.0, -0.3), "down": (-0.05, 0.0, -1.0)}
+X_AXIS, Y_AXIS = np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])  # fallback tangents
 DOWN_OUTWARD = 0.8  # how strongly "down" flows outward from the crown on the top cap
 
 
@@ -105,7 +106,7 @@ def tangent_flow(points: np.ndarray, normals: np.ndarray, flow: str, radius: flo
     t = f - np.sum(f * normals, axis=1, keepdims=True) * normals
     flat = np.linalg.norm(t, axis=1) < 1e-9
     if flat.any():  # a pole of the flow: any tangent
-        t[flat] = cross(normals[flat], np.array([0.0, 1.0, 0.0]))
+        t[flat] = cross(normals[flat], Y_AXIS)
     return _unit(t)
 
 
@@ -114,9 +115,9 @@ def side_vectors(normal: np.ndarray, rest: np.ndarray) -> np.ndarray:
     side = cross(normal, rest)  # (np.cross's arithmetic: the same bits, a fifth of the time)
     flat = np.linalg.norm(side, axis=1) < 1e-9
     if flat.any():
-        fallback = cross(normal[flat], np.array([1.0, 0.0, 0.0]))
+        fallback = cross(normal[flat], X_AXIS)
         weak = np.linalg.norm(fallback, axis=1) < 1e-9
-        fallback[weak] = cross(normal[flat][weak], np.array([0.0, 1.0, 0.0]))
+        fallback[weak] = cross(normal[flat][weak], Y_AXIS)
         side[flat] = fallback
     return _unit(side)
 

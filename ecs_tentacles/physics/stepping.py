@@ -11,6 +11,9 @@ threads 1-1.5 ms a frame behind: a row's time depends on what the other thread d
 meanwhile. Thread k always steps on scratch k of each batch, so two threads never
 share a scratch MjData; which thread steps a row never changes its result
 (`ecs_tentacles.physics.batch`).
+
+Between steps the same threads may share other work whose items are independent
+(`share`: a large crowd's replayed poses, `clips.replay`), in chunks taken in turn.
 """
 
 from __future__ import annotations

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import copy
 from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 import pytest
@@ -206,11 +207,19 @@ def test_replayed_poses_shared_by_the_stepping_threads_are_one_threads(
     scene = crowd_scene(6, seed=2, uniform=True)
     scene.setdefault("physics", {})["lod"] = {"full": 0, "reduced": 2, "hold_seconds": 0.1}
     monkeypatch.setattr(stepping, "SHARE_LEAST", 1)
-    chunked = []
+    chunked = [0]  # the chunks of the last shared call
     share = stepping.share
-    monkeypatch.setattr(stepping, "share", lambda pool, threads, count, work, least: (
-        chunked.append(min(threads * stepping.SHARE_CHUNKS, count // least)),
-        share(pool, threads, count, work, least)))  # fmt: skip
+
+    def counted(pool: Any, threads: int, count: int, work: Any, least: int) -> None:
+        chunked.append(0)
+
+        def chunk(start: int, stop: int) -> None:
+            chunked[-1] += 1
+            work(start, stop)
+
+        share(pool, threads, count, chunk, least)
+
+    monkeypatch.setattr(stepping, "share", counted)
     runs = [_replayed_run(make_world(scene, threads=threads), 20) for threads in (1, 2)]
     assert max(chunked) >= 4  # the two-thread world's replay went in chunks
     for one, two in zip(*runs, strict=True):
