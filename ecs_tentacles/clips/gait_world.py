@@ -29,6 +29,10 @@ from ecs_tentacles.world import World
 GOAL_RADIUS = 0.3
 # Keys of a creature entry that the recording leaves out: they do not move the body.
 NOT_RECORDED = ("fur",)
+# Keys of the scene's `physics` it leaves out: `simulate` runs the creature alone at full
+# physics (`lod=False`), so the level of detail's budgets, hold and focus never move it,
+# and scenes that differ only there replay one recording (in a process and on disk).
+NOT_RECORDED_PHYSICS = ("lod",)
 
 
 @dataclass
@@ -52,15 +56,19 @@ def one_creature_scene(
 ) -> dict[str, object]:
     """A scene of `creature` alone at the origin, heading 0, its goal `goal` m ahead (None: idle).
 
-    `physics` is the scene's `physics` object (None: the defaults). Plugins come from
-    the scene's defaults; the scene's own systems and threats are left out.
+    `physics` is the scene's `physics` object (None: the defaults) less its level of
+    detail (`NOT_RECORDED_PHYSICS`: a recording steps the creature at full physics
+    whatever the scene's budgets). Plugins come from the scene's defaults; the scene's
+    own systems and threats are left out.
     """
     entry = {k: copy.deepcopy(v) for k, v in creature.items() if k not in NOT_RECORDED}
     entry.update(position=[0.0, 0.0], heading_deg=0.0)
     entry["goals"] = [] if goal is None else [{"position": [goal, 0.0], "radius": GOAL_RADIUS}]
     scene: dict[str, object] = {"version": 1, "name": "clip", "creatures": [entry]}
     if physics is not None:
-        scene["physics"] = copy.deepcopy(physics)
+        scene["physics"] = {
+            k: copy.deepcopy(v) for k, v in physics.items() if k not in NOT_RECORDED_PHYSICS
+        }
     return scene
 
 

@@ -7,8 +7,11 @@ import typing
 from collections.abc import Callable
 from typing import Any
 
-from ecs_tentacles.clips.cache import ClipCache, RecordOptions, morphology_key
+import numpy as np
+
+from ecs_tentacles.clips.cache import ClipCache, RecordOptions, morphology_key, recording_input
 from ecs_tentacles.clips.clips import GaitClips
+from ecs_tentacles.clips.gait_world import one_creature_scene, simulate
 from ecs_tentacles.scene.load import load_scene
 from ecs_tentacles.world import World
 
@@ -74,3 +77,34 @@ def test_record_options_are_the_recording_keywords() -> None:
         if p.kind is inspect.Parameter.KEYWORD_ONLY
     }
     assert set(typing.get_type_hints(RecordOptions)) == keywords
+
+
+def test_scenes_that_differ_only_in_level_of_detail_share_one_recording() -> None:
+    """A recording steps its creature alone at full physics, so the scene's level of
+    detail (on or off, budgets, hold, focus) does not move it: stepped with two such
+    settings the frames are the same bits, and the cache records it once for both."""
+    scene = load_scene(_scene())
+    creature, physics = scene["creatures"][0], scene["physics"]
+    other = dict(physics)
+    other["lod"] = {
+        "enabled": not physics["lod"]["enabled"],
+        "full": 0,
+        "reduced": 1,
+        "hold_seconds": 0.0,
+        "focus": {"center": [0.0, 0.0], "radius": 1.0},
+    }
+    recorded = []
+    for settings in (physics, other):
+        staged = one_creature_scene(creature, None, goal=3.0)
+        staged["physics"] = settings  # the level of detail kept in the staged scene
+        recorded.append(simulate(staged, warmup=0.2, seconds=0.5))
+    first, second = recorded
+    assert first.qpos.shape == second.qpos.shape and np.abs(first.qvel).max() > 0
+    assert np.array_equal(first.qpos, second.qpos) and np.array_equal(first.qvel, second.qvel)
+
+    cache = ClipCache(**QUICK)
+    assert cache.get(creature, other) is cache.get(creature, physics)
+    assert len(cache) == 1
+    assert recording_input(creature, other) == recording_input(creature, physics)
+    moved = dict(physics, substeps=physics["substeps"] + 2)  # a setting that does move it
+    assert recording_input(creature, moved) != recording_input(creature, physics)
