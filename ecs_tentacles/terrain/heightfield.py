@@ -69,7 +69,8 @@ class Heightfield:
         """Unit surface normals (n, 3) under `xy` (n, 2), from the heights' gradient."""
         fast = KERNELS.get()
         if fast is not None:  # the same numbers, in one pass instead of fifteen
-            xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
+            # C order always: the kernel compiled for one layout, not a strided one too
+            xy = np.ascontiguousarray(np.asarray(xy, dtype=np.float64).reshape(-1, 2))
             out = np.empty((len(xy), 3))
             cell = np.array(self.cell, dtype=np.float64)
             fast.field_normals(self.heights, self.size[0], self.size[1], self._lowest_height(),

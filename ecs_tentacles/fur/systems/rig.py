@@ -222,7 +222,9 @@ class Rig(System):
             r, local = turn[0], self.strand_normal
             normal = r[:, 0:1] * local[0] + r[:, 1:2] * local[1] + r[:, 2:3] * local[2]
         else:
-            normal = np.einsum("mij,jm->im", turn[self.strand_body], self.strand_normal)
+            # C order as the one-body case's: the kernel compiled once for both (einsum
+            # may hand back Fortran order, a second 6 s compile of the strand kernel)
+            normal = np.einsum("mij,jm->im", turn[self.strand_body], self.strand_normal, order="C")
         if strands.step_kernel(curves, frames, normal, dynamic[self.strand_control], self.parallel):
             return
         first = int(guides[0])
