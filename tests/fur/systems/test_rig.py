@@ -176,6 +176,12 @@ def test_kernels_serial_or_parallel_and_numpy_give_the_same_fur(
     # the rig's own float32 rounding (see tests/fur/test_rig_kernels.py), carried by the strands
     assert_allclose(serial, results["numpy", 0], atol=1e-5)
     assert not rig_math.use_parallel(rig_math.PARALLEL_GUIDES - 1)
+    # the strands' normals reach the kernels in one layout (C), whether the fur's guides
+    # hang from one body or many: each kernel compiled once (a layout more: 2-7 s more)
+    from ecs_tentacles.fur import kernels
+
+    for kernel in (kernels.strands, kernels.strands_serial):
+        assert {signature[6].layout for signature in kernel.signatures} == {"C"}
 
 
 @pytest.mark.parametrize("parallel_from", [1 << 40, 0])
