@@ -335,13 +335,15 @@ def shore_take(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return baked("rocky_shore", tmp_path_factory.mktemp("shore") / "shore.npz", 0.4)
 
 
-@pytest.mark.parametrize("suffix", [".glb", ".usdc"])
+@pytest.mark.parametrize(
+    ("suffix", "size"), [(".glb", (960, 540)), (".usdc", (480, 270))]
+)  # the default size, and `--size` (a quarter of the pixels: 3 s less to render)
 def test_a_still_of_the_import_shows_every_creature_in_its_colour_on_the_ground(
-    shore_take: Path, tmp_path: Path, suffix: str
+    shore_take: Path, tmp_path: Path, suffix: str, size: tuple[int, int]
 ) -> None:
-    """`--render`: a 960x540 PNG, mostly not sky, with the sandbox's creature colours on
-    the left and on the right (rocky_shore has three creatures on each side) and the
-    ground's colour, written whole."""
+    """`--render`: a PNG of the default 960x540 or of `--size`, mostly not sky, with the
+    sandbox's creature colours on the left and on the right (rocky_shore has three
+    creatures on each side) and the ground's colour, written whole."""
     from PIL import Image
 
     from ecs_tentacles.terrain.ground_meshes import COLOURS
@@ -350,17 +352,19 @@ def test_a_still_of_the_import_shows_every_creature_in_its_colour_on_the_ground(
     out = tmp_path / f"shore{suffix}"
     assert main(["export", str(take), "--out", str(out), "--quiet"]) == 0
     png = tmp_path / "shot.png"
+    sized = [] if size == (960, 540) else ["--size", f"{size[0]}x{size[1]}"]
     done = subprocess.run(
-        [BLENDER, str(TOOL), str(out), "--render", str(png), "--frame", "6"],
+        [BLENDER, str(TOOL), str(out), "--render", str(png), "--frame", "6", *sized],
         capture_output=True,
         text=True,
         timeout=180,
     )
     assert done.returncode == 0, done.stderr
-    assert done.stdout.splitlines()[-2].startswith(f"{png}: 960x540, frame 6, 6 creature meshes")
+    said = f"{png}: {size[0]}x{size[1]}, frame 6, 6 creature meshes"
+    assert done.stdout.splitlines()[-2].startswith(said)
     assert [p.name for p in tmp_path.iterdir() if p.suffix == ".png"] == ["shot.png"]
     with Image.open(png) as image:
-        assert image.size == (960, 540)
+        assert image.size == size
         pixels = np.asarray(image.convert("RGB")).astype(float)
     sky = np.abs(pixels - SKY_SRGB).max(axis=2) <= 3
     assert 0.05 < sky.mean() < 0.5  # a sky above the ground, the picture mostly scene
@@ -375,5 +379,6 @@ def test_a_still_of_the_import_shows_every_creature_in_its_colour_on_the_ground(
         creatures |= near(colour)
     third = pixels.shape[1] // 3
     left, right = creatures[:, :third].sum(), creatures[:, -third:].sum()
-    assert left > 1000 and right > 1000, (left, right)  # west's three, east's three
+    least = 1000 * size[0] * size[1] / (960 * 540)  # pixels of creature at 960x540: 1,000
+    assert left > least and right > least, (left, right)  # west's three, east's three
     assert near(np.asarray(COLOURS["terrain"], float)).mean() > 0.25  # the sand
