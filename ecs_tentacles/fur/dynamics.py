@@ -53,6 +53,29 @@ class Strands:
             self.fresh = np.ones(len(self.guides), dtype=bool)
         return self.pos, self.prev, self.fresh
 
+    def subset(self, cols: np.ndarray) -> Strands:
+        """The strands `cols` (indices, ascending) as Strands of their own: their settings
+        and state copied (`put` writes the state back). Each strand steps alone, so a
+        subset's step gives its strands the bits the whole step gives them."""
+        pos, prev, fresh = self._state()
+        return Strands(
+            guides=self.guides[cols],
+            segment=np.ascontiguousarray(self.segment[:, cols]),
+            pull=self.pull[cols],
+            keep=self.keep[cols],
+            gravity=np.ascontiguousarray(self.gravity[:, cols]),
+            profile=self.profile,
+            pos=np.ascontiguousarray(pos[..., cols]),
+            prev=np.ascontiguousarray(prev[..., cols]),
+            fresh=fresh[cols],
+        )
+
+    def put(self, cols: np.ndarray, part: Strands) -> None:
+        """Write back the state of `part`, the `subset(cols)` that stepped."""
+        pos, prev, fresh = self._state()
+        assert part.pos is not None and part.prev is not None and part.fresh is not None
+        pos[..., cols], prev[..., cols], fresh[cols] = part.pos, part.prev, part.fresh
+
     def step_kernel(
         self,
         curves: np.ndarray,

@@ -15,10 +15,19 @@ state from frame to frame), every other guide's evaluation is handed to `FurData
 with this frame's inputs and runs when `FurData.curves` or `frames` is next read (a
 take's recorder, the renderer, an exporter, a snapshot, a script), giving the same bits
 it would have given here. A headless crowd with no recorder then pays for the dynamic
-guides only. Fur read since the last frame (`FurData.reads`: a recorder, a renderer) is
-evaluated here, every guide at once, as it will be read again.
+guides only, and once nobody has read the fur for a second (`UNREAD_SECONDS`; the
+world's start counts as a read) only the ones of creatures the level of detail does not
+replay: a replayed creature's strands then rest (marked fresh, they start again from the
+rig's pose when next stepped; a read in the meantime shows its dynamic guides as the rig
+poses them, without the strands, and every strand steps again from the next frame); the
+other strands step on their own, with the bits a step of every strand gives them
+(`Rig.rest_replayed` False: every strand steps, read or not). A recorder, an exporter,
+the sandbox or a script reading at least once a second sees what it always saw. Fur
+read since the last frame (`FurData.reads`) is evaluated here, every guide at once, as
+it will be read again.
 
-Reads: Transform store (mantle rows), fur ControlStore (position, rest position,
+Reads: Transform store (mantle rows), the creatures' mantle rows and the physics' tiers
+(which creatures are replayed), fur ControlStore (position, rest position,
 behaviour values, drives), GuideStore and FurSetStore (bind pose, re-read when
 `world.resource(FurData).version` changes; when a creature spawns or is despawned only
 its guides are bound or cut out, `ecs_tentacles.fur.blocks`). Writes: ControlStore
@@ -48,14 +57,27 @@ if TYPE_CHECKING:
 
 
 STRAND_BLOCK = 4096  # dynamic guides per block (their arrays are 8x larger)
+# When nobody has read the fur for UNREAD_SECONDS, the strands of replayed creatures rest
+# (module doc; `Rig.rest_replayed`, per world, starts as SKIP_UNREAD_REPLAYED): a
+# recorder, an exporter or a script reading at 1 Hz or more keeps every strand stepping
+SKIP_UNREAD_REPLAYED = True
+UNREAD_SECONDS = 1.0
 
 
 class Rig(System):
     name = "rig"
     stage = "animate"
-    reads = ("transforms.pos", "transforms.quat", "fur.controls", "fur.guides", "fur.sets")
+    reads = (
+        "transforms.pos",
+        "transforms.quat",
+        "fur.controls",
+        "fur.guides",
+        "fur.sets",
+        "creatures.mantle_row",
+    )
     writes = ("fur.curves", "fur.frames", "fur.controls")
-    state_attributes = ("strands",)  # the dynamic blend's strand positions and velocities
+    # the dynamic blend's strand positions and velocities; when the fur was last read
+    state_attributes = ("strands", "read_time")
 
     def __init__(self) -> None:
         self.version = -1
@@ -73,7 +95,11 @@ class Rig(System):
         self.strand_body = np.zeros(0, dtype=np.int64)  # the strands' bodies
         # the strands' guides, evaluated every frame: (their rows, their bind) in blocks
         self.eager: list[tuple[np.ndarray, Bind]] = []
+        self.strand_bind: Bind | None = None  # the strands' guides' bind, in strand order
         self.reads_seen = -1  # `FurData.reads` when this rig last ran
+        # False: every strand steps every frame, read or not (module doc)
+        self.rest_replayed = SKIP_UNREAD_REPLAYED
+        self.read_time = 0.0  # world time the fur was last read at (the start counts as read)
 
     @property
     def bind(self) -> Bind | None:
@@ -99,8 +125,10 @@ class Rig(System):
             self.strand_body = bind.body[guides]
             rows = [guides[start : start + BLOCK] for start in range(0, len(guides), BLOCK)]
             self.eager = [(part, bind.part(part)) for part in rows]
+            self.strand_bind = bind.part(guides)
         else:
             self.eager = []
+            self.strand_bind = None
         self.parallel = use_parallel(len(self.binds))
         self.version, self.touches = fur.version, fur.touches
 
@@ -169,19 +197,39 @@ class Rig(System):
         frames, curves = fur.outputs()
         strands = self.strands
         read, self.reads_seen = fur.reads != self.reads_seen, fur.reads  # read since last frame
-        if read or (strands is not None and len(strands.guides) == len(binds)):  # every guide
+        if read:
+            self.read_time = world.time
+        unread = world.time - self.read_time > UNREAD_SECONDS
+        stepped = None if not unread or strands is None else self._stepped_strands(world)
+        if read or (strands is not None and stepped is None and len(strands.guides) == len(binds)):
             self._evaluate(frames, curves, list(binds.blocks), plan, rotation, position)
-            if strands is not None:
+            if strands is not None:  # every guide, every strand
                 self._dynamics(frames, curves, rotation, dynamic)
             return
-        if strands is not None:  # the strands' guides now, the others when read
+        keep = None
+        if strands is not None and stepped is None:  # the strands' guides now, the others when read
             for rows, part in self.eager:
                 out = np.empty((len(part), 4, 3), np.float32), np.empty_like(curves[: len(part)])
                 evaluate(part, plan, rotation, position, *out, self.scratch, self.parallel)
                 frames[rows], curves[rows] = out
             self._dynamics(frames, curves, rotation, dynamic)
-        blocks, keep = list(binds.blocks), None if strands is None else strands.guides
-        parallel = self.parallel
+            keep = strands.guides
+        elif strands is not None and stepped is not None:  # replayed creatures' strands rest
+            keep, bound = strands.guides[stepped], self.strand_bind
+            assert bound is not None  # bound with the strands (`_bound`)
+            for start in range(0, len(keep), BLOCK):
+                rows = keep[start : start + BLOCK]
+                part = bound.part(stepped[start : start + BLOCK])
+                out = np.empty((len(part), 4, 3), np.float32), np.empty_like(curves[: len(part)])
+                evaluate(part, plan, rotation, position, *out, self.scratch, self.parallel)
+                frames[rows], curves[rows] = out
+            if len(keep):
+                self._dynamics(frames, curves, rotation, dynamic, stepped)
+            _, _, fresh = strands._state()
+            resting = np.ones(len(fresh), dtype=bool)
+            resting[stepped] = False
+            fresh[resting] = True  # they start again from the rig's pose when next stepped
+        blocks, parallel = list(binds.blocks), self.parallel
 
         def deferred() -> None:
             now_frames, now_curves = fur.outputs()
@@ -207,25 +255,67 @@ class Rig(System):
         for rows, part in blocks:
             evaluate(part, plan, rotation, position, frames[rows], curves[rows], self.scratch, many)
 
+    def _stepped_strands(self, world: Host) -> np.ndarray | None:
+        """The strands (indices, ascending) to step in a frame nobody reads the fur:
+        those of creatures not replayed (`SKIP_UNREAD_REPLAYED`); None for every one."""
+        strands, binds = self.strands, self.binds
+        if not self.rest_replayed or strands is None or binds is None:
+            return None
+        if not len(world.creatures):
+            return None
+        replayed = world.physics.kinematic_creatures(len(world.creatures))
+        if not replayed.any():
+            return None
+        mantles, bodies = world.creatures.mantle_row, binds.bodies  # the furred mantles' rows
+        order = None if (np.diff(mantles) > 0).all() else np.argsort(mantles)
+        if order is None:
+            creature = np.searchsorted(mantles, bodies)
+        else:
+            creature = order[np.searchsorted(mantles[order], bodies)]
+        resting = replayed[creature][self.strand_body]  # by body, then by strand
+        return None if not resting.any() else np.flatnonzero(~resting)
+
     def _dynamics(
         self,
         frames: np.ndarray,
         curves: np.ndarray,
         rotation: np.ndarray,
         dynamic: np.ndarray,
+        cols: np.ndarray | None = None,
     ) -> None:
-        strands = self.strands
-        assert strands is not None
+        """The strands `cols` (indices; None: all) stepped and blended into `curves`."""
+        whole = self.strands
+        assert whole is not None
+        local, control, body = self.strand_normal, self.strand_control, self.strand_body
+        strands = whole
+        if cols is not None:  # stepped on their own, their state then put back
+            strands = whole.subset(cols)
+            local, control, body = np.ascontiguousarray(local[:, cols]), control[cols], body[cols]
+        self._strand_step(strands, local, control, body, frames, curves, rotation, dynamic)
+        if cols is not None:
+            whole.put(cols, strands)
+
+    def _strand_step(
+        self,
+        strands: Strands,
+        local: np.ndarray,
+        control: np.ndarray,
+        body: np.ndarray,
+        frames: np.ndarray,
+        curves: np.ndarray,
+        rotation: np.ndarray,
+        dynamic: np.ndarray,
+    ) -> None:
         turn = rotation.astype(np.float32)
         guides = strands.guides
         if len(turn) == 1:  # three row sums: a BLAS call here woke its spinning threads
-            r, local = turn[0], self.strand_normal
+            r = turn[0]
             normal = r[:, 0:1] * local[0] + r[:, 1:2] * local[1] + r[:, 2:3] * local[2]
         else:
             # C order as the one-body case's: the kernel compiled once for both (einsum
             # may hand back Fortran order, a second 6 s compile of the strand kernel)
-            normal = np.einsum("mij,jm->im", turn[self.strand_body], self.strand_normal, order="C")
-        if strands.step_kernel(curves, frames, normal, dynamic[self.strand_control], self.parallel):
+            normal = np.einsum("mij,jm->im", turn[body], local, order="C")
+        if strands.step_kernel(curves, frames, normal, dynamic[control], self.parallel):
             return
         first = int(guides[0])
         contiguous = bool(guides[-1] - first == len(guides) - 1)
@@ -234,6 +324,6 @@ class Rig(System):
             rows = slice(first + start, first + cols.stop) if contiguous else guides[cols]
             rig = np.ascontiguousarray(curves[rows].transpose(1, 2, 0))
             root = frames[rows, 3].T
-            weight = dynamic[self.strand_control[cols]]
+            weight = dynamic[control[cols]]
             blended = strands.step(rig, root, normal[:, cols], weight, cols)
             curves[rows] = blended.transpose(2, 0, 1)

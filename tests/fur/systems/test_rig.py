@@ -222,3 +222,96 @@ def test_fur_nobody_reads_is_posed_when_read_with_the_same_bits(
             np.testing.assert_array_equal(fur.curves, curves)
             np.testing.assert_array_equal(fur.frames, frames)
     assert unread == 19
+
+
+def _replayed_cats(dynamic: bool = True) -> dict[str, Any]:
+    """Six small cats (dynamic fur) crawling apart, four of them replayed from the start
+    (the level of detail's budgets: 2 reduced, none full); `dynamic` False: the same
+    fur without its strands (what the rig alone poses)."""
+    behaviours = ["lift", "aim", "direction", "random", *(["dynamic"] if dynamic else [])]
+    fur = {"preset": "cat", "behaviours": behaviours, "groom": {"count": 60}}
+    creatures = [
+        creature(f"cat{i}", 3.0 * i, fur, goals=[{"position": [3.0 * i, 2.0]}]) for i in range(6)
+    ]
+    physics = {"lod": {"full": 0, "reduced": 2, "hold_seconds": 0.0}}
+    return {"version": 1, "physics": physics, "creatures": creatures}
+
+
+def _cats_world(make_world: Callable[..., World], dynamic: bool = True) -> World:
+    """`_replayed_cats` built, every strand blended in whole (`dynamic` 1)."""
+    world = make_world(_replayed_cats(dynamic))
+    world.resource(FurData).controls.dynamic[:] = 1.0
+    return world
+
+
+def _strand_rows(world: World) -> tuple[np.ndarray, np.ndarray]:
+    """The strands of replayed creatures and of stepped ones (indices into the strands)."""
+    rig = world.schedule["rig"]
+    replayed = world.physics.kinematic_creatures(len(world.creatures))
+    mantles = world.creatures.mantle_row
+    body = rig.binds.bodies[rig.strand_body]  # each strand's mantle row
+    resting = replayed[np.searchsorted(mantles, body)]
+    return np.flatnonzero(resting), np.flatnonzero(~resting)
+
+
+def test_strands_of_replayed_creatures_rest_while_nobody_reads_the_fur(
+    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Nobody reading the fur (`UNREAD_SECONDS`), a replayed creature's strands are not
+    stepped: the rest step as they did (the same bits as a world that steps every
+    strand), a read then shows the replayed ones' guides as the rig poses them, and from
+    then on, read every frame, every strand steps again, the replayed ones from the
+    rig's pose."""
+    monkeypatch.setattr(rig_module, "UNREAD_SECONDS", 0.05)  # 3 frames (else a second)
+    monkeypatch.setattr(rig_module, "SKIP_UNREAD_REPLAYED", False)
+    every, plain = _cats_world(make_world), _cats_world(make_world, dynamic=False)
+    monkeypatch.setattr(rig_module, "SKIP_UNREAD_REPLAYED", True)
+    resting = _cats_world(make_world)
+    for world in (every, plain, resting):
+        world.step(12)  # nobody reads any of them
+    rig, before = resting.schedule["rig"], every.schedule["rig"]
+    replayed, stepped = _strand_rows(resting)
+    assert len(replayed) and len(stepped)  # both kinds
+    assert np.array_equal(_strand_rows(every)[0], replayed)  # the same tiers in both
+    assert rig.strands.fresh[replayed].all() and not rig.strands.fresh[stepped].any()
+    for state in ("pos", "prev"):
+        np.testing.assert_array_equal(
+            getattr(rig.strands, state)[..., stepped], getattr(before.strands, state)[..., stepped]
+        )
+    shown, full, rigged = (w.resource(FurData) for w in (resting, every, plain))
+    np.testing.assert_array_equal(shown.frames, full.frames)  # strands move no frame
+    guides = rig.strands.guides
+    np.testing.assert_array_equal(shown.curves[guides[stepped]], full.curves[guides[stepped]])
+    np.testing.assert_array_equal(shown.curves[guides[replayed]], rigged.curves[guides[replayed]])
+    assert not np.array_equal(full.curves[guides[replayed]], rigged.curves[guides[replayed]])
+    for _ in range(6):  # read every frame from now on: every strand steps
+        for world in (every, resting):
+            world.step(1)
+            world.resource(FurData).curves  # noqa: B018 (a read, as a renderer's)
+        assert not rig.strands.fresh.any()
+        assert np.isfinite(shown.curves).all()
+        np.testing.assert_array_equal(shown.curves[guides[stepped]], full.curves[guides[stepped]])
+
+
+@pytest.mark.parametrize("every", [1, 2, 5])
+def test_fur_read_now_and_then_steps_every_strand_as_before(
+    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch, every: int
+) -> None:
+    """A renderer reads the fur every frame, a 30 fps recorder of a 60 Hz world every
+    other frame, a script now and then (within `UNREAD_SECONDS`, here 0.1 s): the
+    replayed creatures' strands step as they always did, the same bits at every read
+    with the rest on or off."""
+    monkeypatch.setattr(rig_module, "UNREAD_SECONDS", 0.1)
+    worlds = []
+    for skip in (False, True):
+        monkeypatch.setattr(rig_module, "SKIP_UNREAD_REPLAYED", skip)
+        worlds.append(_cats_world(make_world))
+    old, new = (w.resource(FurData) for w in worlds)
+    for frame in range(1, 25):
+        for world in worlds:
+            world.step(1)
+        if frame % every == 0:
+            np.testing.assert_array_equal(old.curves, new.curves)
+            np.testing.assert_array_equal(old.frames, new.frames)
+    assert len(_strand_rows(worlds[1])[0])  # some creatures are replayed
+    assert not worlds[1].schedule["rig"].strands.fresh.any()
