@@ -4,7 +4,8 @@
     python tools/bench_replayed.py --crowd 3000 --frames 60 --json
 
 Builds `ecs-tentacles crowd N --uniform` (the crowd `bench --crowd N --uniform` runs),
-steps `--warmup` frames, then times `--frames` frames with every system's `process`
+steps `--warmup` frames (90: past the second after which nobody reading the fur lets
+the replayed creatures' strands rest), then times `--frames` frames with every system's `process`
 and the per-frame calls whose work grows with the number of replayed creatures wrapped
 (wall seconds, summed). Prints each one's ms a frame and microseconds per KINEMATIC
 creature (the mean count over the timed frames), and the frame's total per replayed
@@ -136,7 +137,9 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--crowd", type=int, default=10000)
     parser.add_argument("--frames", type=int, default=60)
-    parser.add_argument("--warmup", type=int, default=30)
+    # 1.5 s, as `bench`: the timed frames start after the replayed creatures' fur strands
+    # came to rest (a second unread, `fur.systems.rig.UNREAD_SECONDS`)
+    parser.add_argument("--warmup", type=int, default=90)
     parser.add_argument("--threads", type=int, default=2)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--reduced", type=int, help="REDUCED budget (default: the scene's)")
