@@ -37,6 +37,7 @@ its guides are bound or cut out, `ecs_tentacles.fur.blocks`). Writes: ControlSto
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -200,35 +201,24 @@ class Rig(System):
         if read:
             self.read_time = world.time
         unread = world.time - self.read_time > UNREAD_SECONDS
-        stepped = None if not unread or strands is None else self._stepped_strands(world)
-        if read or (strands is not None and stepped is None and len(strands.guides) == len(binds)):
+        resting = None if not unread or strands is None else self._resting_strands(world)
+        if read or (strands is not None and resting is None and len(strands.guides) == len(binds)):
             self._evaluate(frames, curves, list(binds.blocks), plan, rotation, position)
             if strands is not None:  # every guide, every strand
                 self._dynamics(frames, curves, rotation, dynamic)
             return
-        keep = None
-        if strands is not None and stepped is None:  # the strands' guides now, the others when read
-            for rows, part in self.eager:
-                out = np.empty((len(part), 4, 3), np.float32), np.empty_like(curves[: len(part)])
-                evaluate(part, plan, rotation, position, *out, self.scratch, self.parallel)
-                frames[rows], curves[rows] = out
-            self._dynamics(frames, curves, rotation, dynamic)
-            keep = strands.guides
-        elif strands is not None and stepped is not None:  # replayed creatures' strands rest
-            keep, bound = strands.guides[stepped], self.strand_bind
-            assert bound is not None  # bound with the strands (`_bound`)
-            for start in range(0, len(keep), BLOCK):
-                rows = keep[start : start + BLOCK]
-                part = bound.part(stepped[start : start + BLOCK])
+        keep = None  # the strands' guides: posed and blended now, the others when read
+        if strands is not None:
+            stepped = None if resting is None else np.flatnonzero(~resting)
+            keep = strands.guides if stepped is None else strands.guides[stepped]
+            for rows, part in self._strand_parts(stepped):
                 out = np.empty((len(part), 4, 3), np.float32), np.empty_like(curves[: len(part)])
                 evaluate(part, plan, rotation, position, *out, self.scratch, self.parallel)
                 frames[rows], curves[rows] = out
             if len(keep):
                 self._dynamics(frames, curves, rotation, dynamic, stepped)
-            _, _, fresh = strands._state()
-            resting = np.ones(len(fresh), dtype=bool)
-            resting[stepped] = False
-            fresh[resting] = True  # they start again from the rig's pose when next stepped
+            if resting is not None:  # they start again from the rig's pose when next stepped
+                strands._state()[2][resting] = True
         blocks, parallel = list(binds.blocks), self.parallel
 
         def deferred() -> None:
@@ -255,13 +245,11 @@ class Rig(System):
         for rows, part in blocks:
             evaluate(part, plan, rotation, position, frames[rows], curves[rows], self.scratch, many)
 
-    def _stepped_strands(self, world: Host) -> np.ndarray | None:
-        """The strands (indices, ascending) to step in a frame nobody reads the fur:
-        those of creatures not replayed (`SKIP_UNREAD_REPLAYED`); None for every one."""
+    def _resting_strands(self, world: Host) -> np.ndarray | None:
+        """Which strands rest in a frame nobody reads the fur (bool, by strand): those of
+        replayed creatures (`rest_replayed`); None when none does."""
         strands, binds = self.strands, self.binds
-        if not self.rest_replayed or strands is None or binds is None:
-            return None
-        if not len(world.creatures):
+        if not self.rest_replayed or strands is None or binds is None or not len(world.creatures):
             return None
         replayed = world.physics.kinematic_creatures(len(world.creatures))
         if not replayed.any():
@@ -273,7 +261,19 @@ class Rig(System):
         else:
             creature = order[np.searchsorted(mantles[order], bodies)]
         resting = replayed[creature][self.strand_body]  # by body, then by strand
-        return None if not resting.any() else np.flatnonzero(~resting)
+        return resting if resting.any() else None
+
+    def _strand_parts(self, stepped: np.ndarray | None) -> Iterator[tuple[np.ndarray, Bind]]:
+        """(guide rows, their bind) of the strands `stepped` (None: every strand's, bound
+        once in `eager`), in blocks of `BLOCK`."""
+        if stepped is None:
+            yield from self.eager
+            return
+        strands, bound = self.strands, self.strand_bind
+        assert strands is not None and bound is not None  # bound with the strands (`_bound`)
+        for start in range(0, len(stepped), BLOCK):
+            part = stepped[start : start + BLOCK]
+            yield strands.guides[part], bound.part(part)
 
     def _dynamics(
         self,
