@@ -14,6 +14,7 @@ from ecs_tentacles.fur import blocks as blocks_module
 from ecs_tentacles.fur.stores import FurData
 from ecs_tentacles.fur.systems import rig as rig_module
 from ecs_tentacles.numeric.quaternions import quat_rotate
+from ecs_tentacles.physics.tiers import KINEMATIC
 from ecs_tentacles.world import World
 from tests.conftest import NO_LOCOMOTION
 
@@ -315,3 +316,23 @@ def test_fur_read_now_and_then_steps_every_strand_as_before(
             np.testing.assert_array_equal(old.frames, new.frames)
     assert len(_strand_rows(worlds[1])[0])  # some creatures are replayed
     assert not worlds[1].schedule["rig"].strands.fresh.any()
+
+
+def test_a_replayed_creature_promoted_while_nobody_reads_steps_its_strands_again(
+    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Creatures that meet are promoted: a cat promoted from replay while nobody reads
+    the fur has its strands stepped again from the next frame (from the rig's pose),
+    the other replayed cats' still resting, every strand finite."""
+    monkeypatch.setattr(rig_module, "UNREAD_SECONDS", 0.05)
+    world = _cats_world(make_world)
+    world.step(12)
+    strands = world.schedule["rig"].strands
+    replayed, _ = _strand_rows(world)
+    hero = int(world.physics.roster.entity[np.flatnonzero(world.physics.tier == KINEMATIC)[0]])
+    world.lod.promote(hero)
+    world.step(3)
+    still, _ = _strand_rows(world)
+    assert 0 < len(still) < len(replayed)  # the hero's strands left the resting ones
+    assert strands.fresh[still].all() and not np.delete(strands.fresh, still).any()
+    assert np.isfinite(strands.pos).all() and np.isfinite(world.resource(FurData).curves).all()
