@@ -1,7 +1,7 @@
 """The numba kernels of gait-clip replay: `GaitClips.evaluate` for K creatures in one pass
 (into rows of (N, B) arrays, `place`, or into a batch's Transform store rows wherever
-they are, `place_scattered`), and the clip frame each creature starts replaying from
-(`nearest_frames`).
+they are, `place_scattered`), each replayed creature turned and moved a frame on its way
+(`steer`), and the clip frame each creature starts replaying from (`nearest_frames`).
 
 Optional, as the fur rig's kernels are: `clips` imports this module only when numba is
 installed (the ``dev`` extra brings it) and falls back to its whole-array numpy path
@@ -194,3 +194,47 @@ def nearest_frames(shapes: np.ndarray, shape: np.ndarray, out: np.ndarray) -> No
                 best = worst
                 found = f
         out[k] = found
+
+
+@njit(cache=True, nogil=True)
+def steer(
+    moving: np.ndarray,
+    target: np.ndarray,
+    batch_of: np.ndarray,
+    speed: np.ndarray,
+    advance: np.ndarray,
+    dt: float,
+    limit: float,
+    arrived: float,
+    crawl_kind: int,
+    idle_kind: int,
+    xy: np.ndarray,
+    heading: np.ndarray,
+    phase: np.ndarray,
+    kind: np.ndarray,
+) -> None:
+    """`replay._steer_numpy` in one pass, creature by creature: creature `moving[k]`
+    (target `target[k]`, nan: none; its batch `batch_of[k]`) crawls if farther than
+    `arrived` from its target, turning toward it by at most `limit` and moving
+    `speed[batch] * dt` along its new heading; its clip kind is set and its phase moves
+    `advance[batch]` frames on. The same operations in the same order as numpy's
+    (`angle(exp(1j * x))` is `atan2(sin x, cos x)`): tests/clips/test_replay.py."""
+    for k in range(len(moving)):
+        i = moving[k]
+        wx = target[k, 0] - xy[i, 0]
+        wy = target[k, 1] - xy[i, 1]
+        distance = math.hypot(wx, wy)
+        crawl = math.isfinite(distance) and distance > arrived
+        h = heading[i]
+        turned = 0.0
+        if crawl:
+            off = math.atan2(wy, wx) - h
+            turned = min(max(math.atan2(math.sin(off), math.cos(off)), -limit), limit)
+        h = h + turned
+        heading[i] = h
+        kind[i] = crawl_kind if crawl else idle_kind
+        b = batch_of[k]
+        step = (speed[b] if crawl else 0.0) * dt
+        xy[i, 0] += step * math.cos(h)
+        xy[i, 1] += step * math.sin(h)
+        phase[i] += advance[b]

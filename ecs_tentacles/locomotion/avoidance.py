@@ -129,7 +129,7 @@ def bent(to_goal: np.ndarray, term: np.ndarray) -> np.ndarray:
     """`to_goal` (n, 2 or 3: toward each steer point) turned by avoidance `term` (n, 2):
     unit direction + term, at the length of `to_goal`'s ground part. Rows whose term is
     zero are returned as they were, bit for bit (the same array when every row is)."""
-    rows = np.flatnonzero(np.any(term != 0.0, axis=1))
+    rows = np.flatnonzero((term[:, 0] != 0.0) | (term[:, 1] != 0.0))
     if not len(rows):
         return to_goal
     out = to_goal.copy()

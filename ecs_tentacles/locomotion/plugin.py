@@ -170,7 +170,7 @@ class LocomotionPlugin(Plugin):
         if 2 * np.count_nonzero(term[:, 0]) > len(term):  # most turned (a crowd): no gathers
             return self._crowd_travel_targets(world)
         target = creatures.steer[:, :2].copy()
-        turned = np.flatnonzero(np.any(term != 0.0, axis=1))
+        turned = np.flatnonzero((term[:, 0] != 0.0) | (term[:, 1] != 0.0))
         if len(turned):  # the others keep their steer point exactly
             mantle = world.transforms.pos[world.creatures.mantle_row[turned], :2]
             target[turned] = mantle + bent(target[turned] - mantle, creatures.avoidance[turned])
@@ -188,7 +188,8 @@ class LocomotionPlugin(Plugin):
             length = np.hypot(to_goal[:, 0], to_goal[:, 1])
             to_goal += length[:, None] * term
             to_goal += mantle  # (mantle + to_goal: addition commutes bit for bit)
-        target = np.where(np.any(term != 0.0, axis=1)[:, None], to_goal, steer)
+        turned = (term[:, 0] != 0.0) | (term[:, 1] != 0.0)
+        target = np.where(turned[:, None], to_goal, steer)
         return np.where(creatures.has_goal[:, None], target, np.nan)
 
     def snapshot(self, world: Host) -> object:

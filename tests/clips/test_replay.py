@@ -225,3 +225,54 @@ def test_replayed_poses_shared_by_the_stepping_threads_are_one_threads(
     for one, two in zip(*runs, strict=True):
         for a, b in zip(one, two, strict=True):
             assert_array_equal(a, b)
+
+
+def test_the_steering_kernel_turns_and_moves_creatures_as_numpy_does(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Replayed creatures turned toward their targets and moved a frame on: the kernel's
+    headings, places, phases and clip kinds are numpy's (within float64 rounding: numba's
+    and numpy's sin, cos and atan2 may round differently on another CPU), at every kind
+    of way: far targets all round (turns past the limit, both ways, across +-pi), near
+    ones (a turn within the limit), arrived (idle), none (nan: idle), in two batches
+    crawling at different speeds."""
+    from ecs_tentacles.clips.clips import CRAWL, IDLE
+
+    rng = np.random.default_rng(11)
+    count, dt = 400, 1.0 / 60.0
+    xy = rng.uniform(-5.0, 5.0, (count, 2))
+    heading = rng.uniform(-4.0, 4.0, count)  # (not wrapped: replay never wraps them)
+    moving = np.flatnonzero(rng.random(count) < 0.8)
+    way = rng.uniform(-np.pi, np.pi, len(moving))
+    far = rng.choice([10.0, 0.3, 0.04, np.nan], len(moving), p=[0.5, 0.2, 0.2, 0.1])
+    targets = xy[moving] + far[:, None] * np.stack([np.cos(way), np.sin(way)], axis=1)
+    far[:3] = 3.0, 3.0, 0.0  # behind, across +-pi one way and the other; where it stands
+    targets[:3] = xy[moving[:3]] + [[-3.0, 1e-9], [-3.0, -1e-9], [0.0, 0.0]]
+    heading[moving[:3]] = 0.0
+    batch_of = rng.integers(0, 2, len(moving))
+    speed, advance = np.array([0.21, 0.35]), np.array([0.5, 1.0])
+    results = []
+    for backend in ("auto", "numpy"):
+        monkeypatch.setattr(replay.KERNELS, "backend", backend)
+        steered = replay.ClipReplay.__new__(replay.ClipReplay)
+        steered.xy, steered.heading = xy.copy(), heading.copy()
+        steered.phase, steered.kind = np.zeros(count), np.full(count, IDLE, dtype=np.int64)
+        for _ in range(3):
+            steered._steer(moving, targets, batch_of, speed, advance, dt)
+        results.append(steered)
+    assert replay.KERNELS.get() is None  # (the numpy run was numpy's)
+    kernel, numpy = results
+    assert_array_equal(kernel.kind, numpy.kind)
+    assert_array_equal(kernel.phase, numpy.phase)
+    np.testing.assert_allclose(kernel.heading, numpy.heading, rtol=0.0, atol=1e-12)
+    np.testing.assert_allclose(kernel.xy, numpy.xy, rtol=0.0, atol=1e-12)
+    crawled = np.isin(np.arange(count), moving[np.isfinite(far) & (far > replay.ARRIVED)])
+    assert (kernel.kind[crawled] == CRAWL).all() and (kernel.kind[~crawled] == IDLE).all()
+    limit = 3 * replay.TURN_RATE * dt
+    turned = np.abs(kernel.heading - heading)
+    assert np.isclose(turned[moving[:2]], limit).all()  # +-pi: the limit, one way or the other
+    assert (turned[~crawled] == 0.0).all() and (turned <= limit + 1e-12).all()
+    assert_array_equal(kernel.phase[moving], 3 * advance[batch_of])
+    moved = np.hypot(*(kernel.xy - xy).T)
+    assert (moved[~crawled] == 0.0).all()
+    assert np.isclose(moved[crawled].max(), 3 * speed[1] * dt)
