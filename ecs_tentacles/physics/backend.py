@@ -60,6 +60,9 @@ if TYPE_CHECKING:
 KERNELS = OptionalKernels("ecs_tentacles.physics.frame_kernels", "ECS_TENTACLES_PHYSICS_FRAME")
 S = mujoco.mjtState
 PLACE_LATE = True  # a replayable crowd's rows placed when first stepped (False: at the build)
+# rounds in which no near creature steps are left out, with the proxies' catch-up before
+# them (False: every round, as when a FULL creature is near)
+SKIP_IDLE_ROUNDS = True
 
 
 @dataclass(frozen=True)
@@ -304,7 +307,11 @@ class PhysicsBackend(Membership):
         catch up within the frame; `ready(creatures)` before it reads or writes those
         creatures' rows, `physics.rounds`); every other creature takes all its steps at
         once, on whichever thread the rounds leave idle, which gives the same result
-        (nothing it reads changes between rounds) for less bookkeeping. A creature's
+        (nothing it reads changes between rounds) for less bookkeeping. A round in which
+        none of the near creatures steps (a REDUCED one takes its step or two in one of
+        them) is left out with the `between` before it (`SKIP_IDLE_ROUNDS`): what a
+        catch-up reads has not moved since the frame's proxies were placed, or nothing
+        steps after it (the next frame places every proxy again). A creature's
         step reads only its own row, so the result does not depend on the number of
         threads. Asleep or frozen creatures keep their state; the clock moves on.
         """
@@ -329,6 +336,9 @@ class PhysicsBackend(Membership):
                     for n, r in zip(_split(substeps, rounds), _split(reduced, rounds), strict=True)
                     if n
                 ]
+                if SKIP_IDLE_ROUNDS:  # only rounds in which a near creature steps
+                    tiers = np.unique(self.tier[near]).tolist()
+                    parts = [part for part in parts if any(part.get(t, 0) for t in tiers)]
                 self._step_rounds(near, alone, whole, parts, between)
         self.time += substeps * self.substep_dt
         self._untrimmed += 1

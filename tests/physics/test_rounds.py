@@ -80,3 +80,47 @@ def test_a_pair_that_meets_moves_the_same_on_one_and_two_threads(
         near_frames.append(near)
     assert near_frames[0] == near_frames[1] >= 30  # the pair stepped in rounds
     assert_array_equal(runs[0], runs[1])
+
+
+@pytest.mark.parametrize("threads", [1, 2])
+def test_reduced_creatures_that_meet_move_the_same_without_the_idle_rounds(
+    make_world: Callable[..., World], monkeypatch: pytest.MonkeyPatch, threads: int
+) -> None:
+    """Past the full budget the pair steps REDUCED: its one step a frame (two, near) falls
+    in one of the four rounds, so the three others, and the proxies' catch-ups before
+    them, step nothing and are left out; every pose, joint, speed and contact as with
+    them."""
+    import mujoco
+
+    from ecs_tentacles.physics import backend
+    from ecs_tentacles.physics.tiers import REDUCED
+
+    runs, refreshes = [], []
+    for skip in (False, True):
+        monkeypatch.setattr(backend, "SKIP_IDLE_ROUNDS", skip)
+        world = make_world(_pair_and_others(others=8), threads=threads)
+        proxies, counted = world.physics.proxies, [0]
+        refresh = proxies.refresh
+
+        def counting(*args: Any, refresh: Any = refresh, counted: list[int] = counted) -> None:
+            counted[0] += 1
+            refresh(*args)
+
+        monkeypatch.setattr(proxies, "refresh", counting)
+        frames, near = [], 0
+        for _ in range(40):
+            world.step(1)
+            near += bool(proxies.in_use)
+            motion = []
+            for batch in world.physics.batches:
+                for part in (mujoco.mjtState.mjSTATE_QPOS, mujoco.mjtState.mjSTATE_QVEL):
+                    motion.append(batch.state[:, batch.slices[int(part)]].copy())
+                motion.append(batch.deepest.copy())
+            frames.append((world.transforms.pos.copy(), world.transforms.quat.copy(), *motion))
+        assert (world.physics.tier == REDUCED).all() and near >= 30  # met, reduced
+        runs.append(frames)
+        refreshes.append(counted[0])
+    assert refreshes[0] >= 3 * 30 and refreshes[1] == 0  # three catch-ups a frame, then none
+    for with_rounds, without in zip(*runs, strict=True):
+        for a, b in zip(with_rounds, without, strict=True):
+            assert_array_equal(a, b)
