@@ -334,7 +334,7 @@ class PhysicsBackend(Membership):
                 parts = [
                     {FULL: n, REDUCED: r}
                     for n, r in zip(_split(substeps, rounds), _split(reduced, rounds), strict=True)
-                    if n
+                    if n or r  # (3 substeps: the reduced step falls in the round of none)
                 ]
                 if SKIP_IDLE_ROUNDS:  # only rounds in which a near creature steps
                     tiers = np.unique(self.tier[near]).tolist()

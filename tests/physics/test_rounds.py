@@ -5,12 +5,15 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
+import mujoco
 import numpy as np
 import pytest
 from numpy.testing import assert_array_equal
 
 from ecs_tentacles.physics.tiers import FULL
 from ecs_tentacles.world import World
+
+TIME = int(mujoco.mjtState.mjSTATE_TIME)
 
 
 def _pair_and_others(others: int = 5) -> dict[str, Any]:
@@ -90,8 +93,6 @@ def test_reduced_creatures_that_meet_move_the_same_without_the_idle_rounds(
     in one of the four rounds, so the three others, and the proxies' catch-ups before
     them, step nothing and are left out; every pose, joint, speed and contact as with
     them."""
-    import mujoco
-
     from ecs_tentacles.physics import backend
     from ecs_tentacles.physics.tiers import REDUCED
 
@@ -124,3 +125,26 @@ def test_reduced_creatures_that_meet_move_the_same_without_the_idle_rounds(
     for with_rounds, without in zip(*runs, strict=True):
         for a, b in zip(with_rounds, without, strict=True):
             assert_array_equal(a, b)
+
+
+def test_reduced_creatures_that_meet_take_their_step_at_three_substeps_a_frame(
+    make_world: Callable[..., World],
+) -> None:
+    """At 3 substeps a frame (200 fps: within the schema's 2.5 ms step) the rounds split
+    the full tier's steps 1, 1, 0, 1 and the reduced tier's one step falls in the third
+    round, the one with no full step: the pair that meets still takes it every frame."""
+    from ecs_tentacles.physics.tiers import REDUCED
+
+    scene = _pair_and_others(others=8)
+    scene["physics"] = {"fps": 200, "substeps": 3}
+    world = make_world(scene)
+    physics = world.physics
+    near = 0
+    for _ in range(30):
+        world.step(1)
+        near += bool(physics.proxies.in_use)
+        for index in (0, 1):  # the pair's clocks: stepped to the world's
+            batch, row = physics.batches[int(physics.batch_of[index])], int(physics.row_of[index])
+            clock = batch.state[row, batch.slices[TIME]]
+            assert clock[0] == pytest.approx(physics.time)  # (it stood still at 0 before)
+    assert (physics.tier == REDUCED).all() and near >= 5  # stepped in rounds
