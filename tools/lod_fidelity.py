@@ -5,6 +5,7 @@
     python tools/lod_fidelity.py --goals-within 0.8   # goals near enough to arrive
     python tools/lod_fidelity.py --goals-within 0.8 --nudge 0.0001   # the floor: full vs full
     python tools/lod_fidelity.py --goals-within 0.8 --model links=1,gain=1,damping=1
+    python tools/lod_fidelity.py --creatures 160 --seconds 10 --reduced 64   # a smaller budget
 
 Runs `crowd_scene(N)` (every creature crawling across the crowd, so they meet) once with
 the scene's level of detail (default budgets) and once with `lod=False` (everyone full),
@@ -113,11 +114,15 @@ def run(
     within: float | None,
     nudge: float = 0.0,
     model: dict[str, float] | None = None,
+    reduced: int | None = None,
 ) -> dict[str, Any]:
     """One run (every start moved `nudge` metres along x; its reduced creatures on
-    `model`, `reduced_models.model_settings`); its figures."""
+    `model`, `reduced_models.model_settings`; with `reduced`, the scene's reduced budget,
+    `physics.lod.reduced`); its figures."""
     use_model(model)
     scene = crowd_scene(creatures, seed=seed)
+    if reduced is not None:
+        scene.setdefault("physics", {}).setdefault("lod", {})["reduced"] = reduced
     if within is not None:
         scene = goals_within(scene, within)
     for creature in scene["creatures"]:
@@ -206,8 +211,18 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--model", help="KEY=VALUE,...: another reduced model (links, rate, gain, damping)"
     )
+    parser.add_argument(
+        "--reduced",
+        type=int,
+        default=None,
+        metavar="N",
+        help="the level of detail's reduced budget (physics.lod.reduced; default the"
+        " scene's, 128): what a smaller or larger budget costs in fidelity",
+    )
     parser.add_argument("--json", action="store_true", help="one JSON object")
     args = parser.parse_args(argv)
+    if args.reduced is not None and args.reduced < 0:
+        parser.error(f"--reduced: must be >= 0 creatures, got {args.reduced}")
     if args.creatures < 1 or args.seconds <= 0 or args.every < 1:
         parser.error("--creatures and --every must be >= 1, --seconds > 0")
     if args.goals_within is not None and not args.goals_within > 0:
@@ -221,8 +236,9 @@ def main(argv: list[str] | None = None) -> int:
     first = (True, 0.0) if args.nudge is None else (False, args.nudge)
     with ProcessPoolExecutor(2) as pool:
         common = (args.creatures, args.seconds)
+        extra = (args.every, args.seed, args.goals_within)
         runs = [
-            pool.submit(run, *common, lod, args.every, args.seed, args.goals_within, nudge, model)
+            pool.submit(run, *common, lod, *extra, nudge, model, args.reduced)
             for lod, nudge in (first, (False, 0.0))
         ]
         on, off = (r.result() for r in runs)
@@ -232,6 +248,7 @@ def main(argv: list[str] | None = None) -> int:
         "goals_within_m": args.goals_within,
         "nudge_m": args.nudge,
         "model": model,
+        "reduced_budget": args.reduced,
         **compare(on, off),
     }
     if args.json:

@@ -3,6 +3,8 @@ short comparison reports what its doc promises."""
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import pytest
 
@@ -90,3 +92,29 @@ def test_a_bad_reduced_model_is_refused_naming_the_key(capsys: pytest.CaptureFix
     with pytest.raises(SystemExit):
         tool.main(["--model", "rate=0"])
     assert "--model: rate: must be an integer >= 1, got 0" in capsys.readouterr().err
+
+
+@pytest.mark.skipif(not TOOL.is_file(), reason="needs the source tree")
+def test_a_reduced_budget_reaches_the_scene_and_a_negative_one_is_refused(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    tool = load_tool("lod_fidelity")
+    built = []
+
+    class Built(Exception):
+        pass
+
+    def capture(scene: dict[str, Any], **options: Any) -> World:
+        built.append((scene, options))
+        raise Built
+
+    monkeypatch.setattr(tool.World, "from_scene", capture)
+    for reduced in (None, 5):
+        with pytest.raises(Built):
+            tool.run(12, 0.1, True, 5, 0, None, reduced=reduced)
+    (default, _), (smaller, options) = built
+    assert "lod" not in default.get("physics", {})  # the scene's own budget
+    assert smaller["physics"]["lod"]["reduced"] == 5 and options == {"lod": True}
+    with pytest.raises(SystemExit):
+        tool.main(["--reduced", "-1"])
+    assert "--reduced: must be >= 0 creatures, got -1" in capsys.readouterr().err
