@@ -47,7 +47,7 @@ from ecs_tentacles.physics.model import ModelLayout, model_layout
 from ecs_tentacles.physics.placing import place_stepped
 from ecs_tentacles.physics.proxies import ContactProxies
 from ecs_tentacles.physics.roster import Roster
-from ecs_tentacles.physics.rounds import Ready, Rounds
+from ecs_tentacles.physics.rounds import Ready, Rounds, round_steps
 from ecs_tentacles.physics.sleep import Sleep, SleepState
 from ecs_tentacles.physics.stepping import Segment, Work, hold_reduced, plan, step_segments
 from ecs_tentacles.physics.tiers import FULL, KINEMATIC, REDUCED, reduced_substeps
@@ -331,14 +331,8 @@ class PhysicsBackend(Membership):
             if not near.any():
                 self._run(plan(self.batches, alone, self.tier, self.threads), whole)
             else:
-                parts = [
-                    {FULL: n, REDUCED: r}
-                    for n, r in zip(_split(substeps, rounds), _split(reduced, rounds), strict=True)
-                    if n or r  # (3 substeps: the reduced step falls in the round of none)
-                ]
-                if SKIP_IDLE_ROUNDS:  # only rounds in which a near creature steps
-                    tiers = np.unique(self.tier[near]).tolist()
-                    parts = [part for part in parts if any(part.get(t, 0) for t in tiers)]
+                stepping = np.unique(self.tier[near]).tolist() if SKIP_IDLE_ROUNDS else None
+                parts = round_steps(substeps, reduced, rounds, stepping)
                 self._step_rounds(near, alone, whole, parts, between)
         self.time += substeps * self.substep_dt
         self._untrimmed += 1
@@ -443,10 +437,3 @@ class PhysicsBackend(Membership):
             f"<physics: {len(self)} creatures, {self.compiles} compiled models,"
             f" {self.threads} threads>"
         )
-
-
-@functools.cache
-def _split(steps: int, rounds: int) -> tuple[int, ...]:
-    """`steps` in `rounds` parts as equal as whole numbers allow (a world asks the same
-    few every frame: worked out once)."""
-    return tuple(int(n) for n in np.diff(np.linspace(0, steps, rounds + 1).round()))

@@ -17,12 +17,14 @@ one after the other did before the first refresh.
 
 from __future__ import annotations
 
+import functools
 import threading
 from collections.abc import Callable
 
 import numpy as np
 
 from ecs_tentacles.physics.stepping import Segment, Work
+from ecs_tentacles.physics.tiers import FULL, REDUCED
 
 Steps = dict[int, int]  # steps per tier
 Ready = Callable[[np.ndarray], None]  # (creatures,): step them to the frame's end first
@@ -114,3 +116,29 @@ class Rounds:
             with self._changed:
                 self._stepping[kind] -= 1
                 self._changed.notify_all()
+
+
+def round_steps(
+    substeps: int, reduced: int, rounds: int, stepping: list[int] | None = None
+) -> list[Steps]:
+    """A frame's steps in `rounds` rounds, each round's steps per tier (FULL ones of
+    `substeps`, REDUCED ones of `reduced`, spread as evenly as whole numbers allow).
+    Rounds in which no tier steps are left out (at 3 substeps the FULL tier's split
+    1, 1, 0, 1 leaves the REDUCED step alone in the third); with `stepping`, the tiers of
+    the creatures stepped in rounds, so are those in which none of these steps, with the
+    proxies' catch-up before them (`PhysicsBackend.step`)."""
+    parts = [
+        {FULL: n, REDUCED: r}
+        for n, r in zip(_split(substeps, rounds), _split(reduced, rounds), strict=True)
+        if n or r
+    ]
+    if stepping is not None:
+        parts = [part for part in parts if any(part.get(t, 0) for t in stepping)]
+    return parts
+
+
+@functools.cache
+def _split(steps: int, rounds: int) -> tuple[int, ...]:
+    """`steps` in `rounds` parts as equal as whole numbers allow (a world asks the same
+    few every frame: worked out once)."""
+    return tuple(int(n) for n in np.diff(np.linspace(0, steps, rounds + 1).round()))

@@ -148,3 +148,19 @@ def test_reduced_creatures_that_meet_take_their_step_at_three_substeps_a_frame(
             clock = batch.state[row, batch.slices[TIME]]
             assert clock[0] == pytest.approx(physics.time)  # (it stood still at 0 before)
     assert (physics.tier == REDUCED).all() and near >= 5  # stepped in rounds
+
+
+def test_round_steps_keep_every_step_and_leave_out_the_rounds_nobody_near_takes() -> None:
+    from ecs_tentacles.physics.rounds import round_steps
+    from ecs_tentacles.physics.tiers import REDUCED, reduced_substeps
+
+    for substeps in range(1, 101):  # the schema's substeps: no step lost in any split
+        reduced = reduced_substeps(substeps)
+        parts = round_steps(substeps, reduced, 4)
+        assert sum(p[FULL] for p in parts) == substeps
+        assert sum(p[REDUCED] for p in parts) == reduced
+        assert all(p[FULL] or p[REDUCED] for p in parts)
+    assert round_steps(3, 1, 4) == [{FULL: 1, REDUCED: 0}, {FULL: 1, REDUCED: 0},
+                                    {FULL: 0, REDUCED: 1}, {FULL: 1, REDUCED: 0}]  # fmt: skip
+    assert round_steps(8, 1, 4, [REDUCED]) == [{FULL: 2, REDUCED: 1}]  # only REDUCED near
+    assert len(round_steps(8, 1, 4, [FULL, REDUCED])) == 4  # a FULL one near: every round
