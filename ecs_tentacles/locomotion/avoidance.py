@@ -125,11 +125,18 @@ def bend(
     return out
 
 
+def turned(term: np.ndarray) -> np.ndarray:
+    """(n,) bool: the rows of avoidance `term` (n, 2) that turn a creature (not zero).
+    Two compares, not `np.any(term != 0, axis=1)`: a tenth of the time, the same rows."""
+    mask: np.ndarray = (term[:, 0] != 0.0) | (term[:, 1] != 0.0)
+    return mask
+
+
 def bent(to_goal: np.ndarray, term: np.ndarray) -> np.ndarray:
     """`to_goal` (n, 2 or 3: toward each steer point) turned by avoidance `term` (n, 2):
     unit direction + term, at the length of `to_goal`'s ground part. Rows whose term is
     zero are returned as they were, bit for bit (the same array when every row is)."""
-    rows = np.flatnonzero((term[:, 0] != 0.0) | (term[:, 1] != 0.0))
+    rows = np.flatnonzero(turned(term))
     if not len(rows):
         return to_goal
     out = to_goal.copy()

@@ -32,7 +32,7 @@ from ecs_tentacles.components import Creature, Tentacle
 from ecs_tentacles.creatures.body import creature_rng
 from ecs_tentacles.distributed.registries import MeetingReaches, Reach, ShardReaches
 from ecs_tentacles.locomotion.actions import STRENGTH, ActionQueue, Kind
-from ecs_tentacles.locomotion.avoidance import Avoidance, bent
+from ecs_tentacles.locomotion.avoidance import Avoidance, bent, turned
 from ecs_tentacles.locomotion.components import Goal
 from ecs_tentacles.locomotion.formations import FormationChoice
 from ecs_tentacles.locomotion.goals import GoalBook
@@ -170,10 +170,10 @@ class LocomotionPlugin(Plugin):
         if 2 * np.count_nonzero(term[:, 0]) > len(term):  # most turned (a crowd): no gathers
             return self._crowd_travel_targets(world)
         target = creatures.steer[:, :2].copy()
-        turned = np.flatnonzero((term[:, 0] != 0.0) | (term[:, 1] != 0.0))
-        if len(turned):  # the others keep their steer point exactly
-            mantle = world.transforms.pos[world.creatures.mantle_row[turned], :2]
-            target[turned] = mantle + bent(target[turned] - mantle, creatures.avoidance[turned])
+        rows = np.flatnonzero(turned(term))
+        if len(rows):  # the others keep their steer point exactly
+            mantle = world.transforms.pos[world.creatures.mantle_row[rows], :2]
+            target[rows] = mantle + bent(target[rows] - mantle, creatures.avoidance[rows])
         return np.where(creatures.has_goal[:, None], target, np.nan)
 
     def _crowd_travel_targets(self, world: Host) -> np.ndarray:
@@ -188,8 +188,7 @@ class LocomotionPlugin(Plugin):
             length = np.hypot(to_goal[:, 0], to_goal[:, 1])
             to_goal += length[:, None] * term
             to_goal += mantle  # (mantle + to_goal: addition commutes bit for bit)
-        turned = (term[:, 0] != 0.0) | (term[:, 1] != 0.0)
-        target = np.where(turned[:, None], to_goal, steer)
+        target = np.where(turned(term)[:, None], to_goal, steer)
         return np.where(creatures.has_goal[:, None], target, np.nan)
 
     def snapshot(self, world: Host) -> object:
